@@ -1,0 +1,107 @@
+"""Core commands: ``export``, ``import``, ``trace`` and ``demo`` (the table, the engine, the lists)."""
+
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from pathlib import Path
+
+import typer
+
+from tablebot import robopro
+from tablebot.cli.app import app
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.diagnostics import fail
+from tablebot.examples import example_path
+from tablebot.robot import BUMBERBOT, load_robot
+from tablebot.tablefile import parse_table
+from tablebot.tablewriter import format_table
+from tablebot.trace import load_inputs, replay, write_trace
+
+
+class Target(str, Enum):
+    robopro = "robopro"
+
+
+class Source(str, Enum):
+    robopro = "robopro"
+
+
+@app.command("export")
+@guarded
+def export_cmd(
+    table: Path = TABLE_ARG,
+    outdir: Path = typer.Argument(..., help="Folder to write into (created if missing)."),
+    to: Target = typer.Option(..., "--to", help="Export target."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Export a table for another system (robopro: the document's three ROBO Pro lists as CSV)."""
+    parsed, _ = load(table, robot)
+    lists = robopro.encode(parsed)
+    for path in robopro.write_lists(lists, outdir):
+        console.print(f"wrote {path}")
+
+
+@app.command("import")
+@guarded
+def import_cmd(
+    directory: Path = typer.Argument(..., help="Folder with event.csv, action.csv, timer.csv."),
+    source: Source = typer.Option(..., "--from", help="What the folder holds."),
+    out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output)."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
+    bot = load_robot(robot) if robot else BUMBERBOT
+    events = ("T", *bot.inputs)
+    if len(events) > robopro.MAX_EVENTS:
+        raise fail(bot.source, f"{len(events)} event columns do not fit the ROBO Pro layout",
+                   "import needs a robot with at most five inputs besides T")
+    table = robopro.decode(robopro.read_lists(directory), bot, events, str(directory))
+    text = format_table(table)
+    parse_table(text, str(out or directory), bot)  # the rebuilt table must be a valid table
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        out.write_text(text, encoding="utf-8")
+        err_console.print(f"wrote {out} ({len(table.rows)} rows; descriptions are not in the lists)")
+
+
+@app.command("trace")
+@guarded
+def trace_cmd(
+    table: Path = TABLE_ARG,
+    inputs: Path = typer.Option(..., "--inputs", help="Inputs CSV: header of input names, one row per tick."),
+    out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Replay recorded inputs through the engine and write the trace, one JSON line per tick."""
+    _, machine = load(table, robot)
+    ticks = load_inputs(inputs, machine)
+    if out is None:
+        write_trace(replay(machine, ticks), sys.stdout)
+        return
+    with out.open("w", encoding="utf-8") as stream:
+        count = write_trace(replay(machine, ticks), stream)
+    err_console.print(f"wrote {out} ({count} ticks)")
+
+
+@app.command("demo")
+@guarded
+def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for the trace.")) -> None:
+    """Replay the BumberBot on its built-in recorded inputs and summarise what it did."""
+    folder = example_path("bumberbot")
+    _, machine = load(folder / "table.csv")
+    ticks = load_inputs(folder / "inputs.csv", machine)
+    out.mkdir(parents=True, exist_ok=True)
+    lines = list(replay(machine, ticks))
+    with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
+        write_trace(lines, stream)
+    visits: dict[object, int] = {}
+    for line in lines:
+        visits[line["state"]] = visits.get(line["state"], 0) + 1
+    fired = sum(1 for line in lines if line["row"] is not None)
+    console.print(f"BumberBot: {len(lines)} ticks ({len(lines) * machine.table.robot.tick_ms / 1000:.1f} s), "
+                  f"{fired} rows fired")
+    for state, count in visits.items():
+        console.print(f"  state {state!s:>4}: {count * machine.table.robot.tick_ms / 1000:6.2f} s")
+    console.print(f"wrote {out / 'trace.jsonl'}")

@@ -1,0 +1,130 @@
+"""The compiled machine: a parsed table turned into integer masks and per-state lookup maps.
+
+This module owns the event-matching rule (:func:`first_match`): the first row of the current
+state, in table order, whose required events are a subset of the present events fires.
+Compilation precomputes that rule per state so that a tick costs O(1) in the number of rows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from tablebot.robot import StateId
+from tablebot.table import TIMER_EVENT, Table
+
+#: Per state, lookups are precomputed for every combination of the bits its rows use when there
+#: are at most this many such bits; beyond that they are computed on first use and cached.
+PREFILL_BITS = 12
+NO_ROW = -1
+
+
+@dataclass(frozen=True)
+class CompiledRow:
+    """A row in engine terms: masks and state indices instead of names."""
+
+    index: int
+    state: int
+    mask: int
+    next: int
+    timer: int
+    outputs: tuple[int | None, ...]  # motors then lamps; None = keep
+    loads: tuple[int | None, ...]  # per robot counter; None = leave alone
+    keeps: bool  # any output kept: the new outputs must be merged with the old ones
+
+
+def first_match(rows: Sequence[CompiledRow], events: int) -> CompiledRow | None:
+    """THE matching rule: the first row whose required event bits are all in ``events``."""
+    for row in rows:
+        if row.mask & events == row.mask:
+            return row
+    return None
+
+
+class Dispatch(dict[int, int]):
+    """One state's map from (events masked to the bits its rows use) to the row that fires."""
+
+    def __init__(self, rows: Sequence[CompiledRow]):
+        super().__init__()
+        self.rows = tuple(rows)
+        self.relevant = 0
+        for row in rows:
+            self.relevant |= row.mask
+        if self.relevant.bit_count() <= PREFILL_BITS:
+            sub = self.relevant
+            while True:  # every subset of the relevant bits
+                self[sub]
+                if sub == 0:
+                    break
+                sub = (sub - 1) & self.relevant
+
+    def __missing__(self, events: int) -> int:
+        row = first_match(self.rows, events)
+        self[events] = value = NO_ROW if row is None else row.index
+        return value
+
+
+@dataclass(frozen=True)
+class Machine:
+    """Everything the engine needs, as plain integers; ``table`` keeps the names for output."""
+
+    table: Table
+    states: tuple[StateId, ...]
+    rows: tuple[CompiledRow, ...]
+    dispatch: tuple[Dispatch, ...]
+    timer_bit: int
+    counter_bits: tuple[int, ...]
+    input_bits: dict[str, int]
+    initial_state: int
+    initial_timer: int
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        robot = self.table.robot
+        return (*robot.motors, *robot.lamps)
+
+    @property
+    def n_motors(self) -> int:
+        return len(self.table.robot.motors)
+
+    @property
+    def input_mask(self) -> int:
+        return sum(self.input_bits.values())
+
+    def state_index(self, state: StateId) -> int:
+        return self.states.index(state)
+
+    def lookup(self, state: int, events: int) -> int:
+        """Index of the row that fires in ``state`` for ``events``, or -1; O(1) after compilation."""
+        dispatch = self.dispatch[state]
+        return dispatch[events & dispatch.relevant]
+
+    def signature(self) -> tuple:
+        """What defines behaviour (not descriptions or file lines): equal signatures, equal machines."""
+        return (self.states, self.table.events, self.timer_bit, self.counter_bits,
+                tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
+                self.initial_state, self.initial_timer, self.output_names)
+
+
+def compile_table(table: Table) -> Machine:
+    """Turn names into bits and indices, and precompute the first-match lookup of every state."""
+    states = table.states
+    index = {state: i for i, state in enumerate(states)}
+    robot = table.robot
+    rows = tuple(
+        CompiledRow(index=row.index, state=index[row.state], mask=table.mask(row.events),
+                    next=index[row.next], timer=row.timer, outputs=(*row.motors, *row.lamps),
+                    loads=row.counters, keeps=None in (*row.motors, *row.lamps))
+        for row in table.rows)
+    per_state: list[list[CompiledRow]] = [[] for _ in states]
+    for row in rows:
+        per_state[row.state].append(row)
+    bit = table.bit
+    return Machine(
+        table=table, states=states, rows=rows,
+        dispatch=tuple(Dispatch(r) for r in per_state),
+        timer_bit=bit(TIMER_EVENT) if TIMER_EVENT in table.events else 0,
+        counter_bits=tuple(bit(c) if c in table.events else 0 for c in robot.counter_names),
+        input_bits={name: bit(name) for name in table.input_events},
+        initial_state=index[robot.initial_state], initial_timer=robot.initial_timer,
+    )

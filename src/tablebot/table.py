@@ -1,0 +1,69 @@
+"""The parsed table: plain immutable rows exactly as the user wrote them, with their file lines.
+
+A row says: in this state, when these events are all present, set these outputs, load the timer
+(and counters), and go to the next state. Nothing here knows about files or execution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+from tablebot.robot import Robot, StateId
+
+#: A motor speed, lamp level or counter load of ``None`` means "leave it as it is".
+KEEP = None
+#: The document's direction + speed encoding uses speed 7 for "keep".
+DOC_KEEP_SPEED = 7
+MAX_SPEED = 8
+MAX_LAMP = 8
+MAX_TIMER = 65535
+TIMER_EVENT = "T"
+
+
+@dataclass(frozen=True)
+class Row:
+    """One transition; ``index`` is 0-based in the table as written, ``line`` is the file line."""
+
+    index: int
+    line: int
+    description: str
+    state: StateId
+    events: frozenset[str]
+    motors: tuple[int | None, ...]
+    timer: int
+    next: StateId
+    counters: tuple[int | None, ...] = ()
+    lamps: tuple[int | None, ...] = ()
+
+
+@dataclass(frozen=True)
+class Table:
+    """A robot plus its rows; ``events`` are the event columns in header order (first = highest bit)."""
+
+    robot: Robot
+    events: tuple[str, ...]
+    rows: tuple[Row, ...]
+    path: str = "<table>"
+
+    @cached_property
+    def states(self) -> tuple[StateId, ...]:
+        """Every state a row names, in order of first appearance (states then next states)."""
+        seen: dict[StateId, None] = {}
+        for row in self.rows:
+            seen.setdefault(row.state, None)
+        for row in self.rows:
+            seen.setdefault(row.next, None)
+        return tuple(seen)
+
+    def bit(self, event: str) -> int:
+        """The bit of an event in the event mask: the first event column is the highest bit."""
+        return 1 << (len(self.events) - 1 - self.events.index(event))
+
+    def mask(self, events: frozenset[str] | set[str]) -> int:
+        return sum(self.bit(e) for e in events)
+
+    @property
+    def input_events(self) -> tuple[str, ...]:
+        """Event columns that are robot inputs (not the timer, not counters)."""
+        return tuple(e for e in self.events if e in self.robot.inputs)

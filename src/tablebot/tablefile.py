@@ -1,0 +1,253 @@
+"""Reading a table file (CSV/TSV as a spreadsheet saves it) into a parsed :class:`Table`.
+
+Column names come from the robot description; every problem of the file is reported at once
+as ``file:line:column: message`` with a hint. Loading never executes anything from the file.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from tablebot.csvtext import Cell, Record, read_text, split_records
+from tablebot.diagnostics import Collector, fail
+from tablebot.robot import BUMBERBOT, Robot, StateId, find_robot_file, load_robot
+from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, MAX_TIMER, TIMER_EVENT, Row, Table
+
+KEEP_WORDS = {"=", "keep", "k"}
+ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
+FIXED = ("description", "state", "timer", "next")
+INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
+STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
+
+
+@dataclass(frozen=True)
+class Column:
+    """What one header cell means: a fixed column, an event, or one field of an output."""
+
+    kind: str  # description|state|timer|next|event|dir|speed|signed|lamp|load
+    name: str  # event/motor/lamp/counter name, or the fixed column's name
+    cell: Cell
+
+
+def load_table(path: str | Path, robot: Robot | None = None) -> Table:
+    """Parse a table file; the robot comes from ``robot``, a side file, or the built-in BumberBot."""
+    path = Path(path)
+    if robot is None:
+        side = find_robot_file(path)
+        robot = load_robot(side) if side else BUMBERBOT
+    return parse_table(read_text(path), str(path), robot)
+
+
+def parse_table(text: str, path: str, robot: Robot) -> Table:
+    out = Collector(path)
+    records = split_records(text, path)
+    if not records or records[0].is_blank():
+        raise fail(path, "the table is empty", "the first line must be a header such as "
+                   "description,state,T,I3,M1_dir,M1_speed,timer,next", 1, 1)
+    columns = _header(records[0], robot, out)
+    events = tuple(c.name for c in columns if c.kind == "event")
+    rows = [row for record in records[1:] if not record.is_blank()
+            for row in [_row(record, columns, robot, out)] if row is not None]
+    rows = _number(rows)
+    if not rows and not out.items:
+        out.error(2, 1, "the table has a header but no rows", "add one row per transition below the header")
+    next_at = [i for i, c in enumerate(columns) if c.kind == "next"]
+    next_cells = {r.line: r.cells[next_at[0]] for r in records[1:] if next_at and len(r.cells) > next_at[0]}
+    _check_states(rows, robot, out, next_cells)
+    out.raise_if_any()
+    return Table(robot=robot, events=events, rows=tuple(rows), path=path)
+
+
+# --- header -------------------------------------------------------------------------------------
+
+def _normalise(name: str) -> str:
+    key = re.sub(r"[\s-]+", "_", name.strip())
+    low = key.lower()
+    low = ALIASES.get(low, low)
+    return low if low in FIXED else key
+
+
+def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
+    if name in FIXED:
+        return name, name
+    if name == TIMER_EVENT or name in robot.inputs or name in robot.counter_names:
+        return "event", name
+    if name in robot.motors:
+        return "signed", name
+    if name in robot.lamps:
+        return "lamp", name
+    base, _, suffix = name.rpartition("_")
+    if base in robot.motors and suffix.lower() in ("dir", "speed"):
+        return suffix.lower(), base
+    if base in robot.counter_names and suffix.lower() == "load":
+        return "load", base
+    return None
+
+
+def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
+    columns: list[Column] = []
+    seen: dict[tuple[str, str], Cell] = {}
+    known = ", ".join([*FIXED, TIMER_EVENT, *robot.inputs, *robot.counter_names,
+                       *(f"{m}_dir/{m}_speed or {m}" for m in robot.motors), *robot.lamps,
+                       *(f"{c}_load" for c in robot.counter_names)])
+    for cell in record.cells:
+        name = _normalise(cell.text)
+        if not name:
+            columns.append(Column("ignore", "", cell))
+            continue
+        kind_name = _classify(name, robot)
+        if kind_name is None:
+            out.error(cell.line, cell.column, f"unknown column {cell.text.strip()!r} for robot {robot.name}",
+                      f"known columns: {known}; declare new inputs or outputs in the robot file")
+            columns.append(Column("ignore", name, cell))
+            continue
+        if kind_name in seen:
+            first = seen[kind_name]
+            out.error(cell.line, cell.column, f"column {cell.text.strip()!r} appears twice "
+                      f"(first at column {first.column})", "delete or rename one of them")
+        seen[kind_name] = cell
+        columns.append(Column(kind_name[0], kind_name[1], cell))
+    for required in ("state", "next"):
+        if (required, required) not in seen:
+            out.error(record.line, None, f"the header has no {required!r} column",
+                      "every table needs state and next columns")
+    for motor in robot.motors:
+        forms = {k for (k, n) in seen if n == motor}
+        if "signed" in forms and forms & {"dir", "speed"}:
+            cell = seen[("signed", motor)]
+            out.error(cell.line, cell.column, f"motor {motor} is given both as {motor} and as "
+                      f"{motor}_dir/{motor}_speed", "use one form per motor")
+        elif "dir" in forms and "speed" not in forms:
+            cell = seen[("dir", motor)]
+            out.error(cell.line, cell.column, f"{motor}_dir has no {motor}_speed column",
+                      f"add a {motor}_speed column (or use one signed column {motor})")
+    return columns
+
+
+# --- rows ---------------------------------------------------------------------------------------
+
+def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int | None = 0,
+         keep: bool = False) -> int | None:
+    text = cell.text.strip()
+    if not text:
+        return blank
+    if keep and text.lower() in KEEP_WORDS:
+        return None
+    if not INT_RE.match(text):
+        extra = ", or = to keep it as it is" if keep else ""
+        out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer",
+                  f"write a whole number from {low} to {high}{extra}")
+        return blank
+    value = int(float(text))
+    if not low <= value <= high:
+        out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}",
+                  f"write a whole number from {low} to {high}")
+        return blank
+    return value
+
+
+def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
+    text = cell.text.strip()
+    if not text:
+        out.error(cell.line, cell.column, f"{what} is missing", "write a state number or name")
+        return None
+    if INT_RE.match(text):
+        value = int(float(text))
+        if value < 0:
+            out.error(cell.line, cell.column, f"{what} {value} is negative", "states are 0 or more")
+        return value
+    if not STATE_RE.match(text):
+        out.error(cell.line, cell.column, f"{what} {text!r} is not a valid state name",
+                  "use a number or a name starting with a letter")
+        return None
+    return text
+
+
+def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) -> Row | None:
+    before = len(out.items)
+    cells = list(record.cells)
+    for extra in cells[len(columns):]:
+        if extra.text.strip():
+            out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
+                      "remove it or add a header for it")
+    cells += [Cell("", record.line, (cells[-1].column + len(cells[-1].text) + 1) if cells else 1)] * max(
+        0, len(columns) - len(cells))
+    fields: dict[str, object] = {"description": "", "events": set(), "timer": 0}
+    dirs: dict[str, int] = {}
+    speeds: dict[str, int | None] = {}
+    signed: dict[str, int | None] = {}
+    lamps: dict[str, int | None] = {}
+    loads: dict[str, int | None] = {}
+    for column, cell in zip(columns, cells, strict=False):
+        kind, name = column.kind, column.name
+        label = column.cell.text.strip()
+        if kind == "description":
+            fields["description"] = cell.text.strip()
+        elif kind in ("state", "next"):
+            fields[kind] = _state(cell, f"{kind} state" if kind == "next" else "state", out)
+        elif kind == "timer":
+            fields["timer"] = _int(cell, "timer", 0, MAX_TIMER, out)
+        elif kind == "event":
+            if _int(cell, f"event {label}", 0, 1, out):
+                fields["events"].add(name)  # type: ignore[union-attr]
+        elif kind == "dir":
+            dirs[name] = _int(cell, label, 0, 1, out) or 0
+        elif kind == "speed":
+            speeds[name] = _int(cell, label, 0, MAX_SPEED, out)
+        elif kind == "signed":
+            signed[name] = _int(cell, label, -MAX_SPEED, MAX_SPEED, out, keep=True)
+        elif kind == "lamp":
+            lamps[name] = _int(cell, label, 0, MAX_LAMP, out, blank=None, keep=True)
+        elif kind == "load":
+            loads[name] = _int(cell, label, 0, MAX_TIMER, out, blank=None, keep=True)
+    if len(out.items) > before or fields.get("state") is None or fields.get("next") is None:
+        return None
+    motors = tuple(_motor(m, dirs, speeds, signed) for m in robot.motors)
+    return Row(index=-1, line=record.line, description=str(fields["description"]),
+               state=fields["state"], events=frozenset(fields["events"]),  # type: ignore[arg-type]
+               motors=motors, timer=int(fields["timer"]),  # type: ignore[call-overload]
+               next=fields["next"],  # type: ignore[arg-type]
+               counters=tuple(loads.get(c) for c in robot.counter_names),
+               lamps=tuple(lamps.get(lamp) for lamp in robot.lamps))
+
+
+def _motor(motor: str, dirs: dict[str, int], speeds: dict[str, int | None],
+           signed: dict[str, int | None]) -> int | None:
+    """The signed speed (None = keep) from either the document's dir+speed form or a signed cell."""
+    if motor in signed:
+        return signed[motor]
+    speed = speeds.get(motor) or 0
+    if speed == DOC_KEEP_SPEED:
+        return None
+    return -speed if dirs.get(motor) else speed
+
+
+def _number(rows: list[Row]) -> list[Row]:
+    """Give rows their 0-based index and let a blank description continue the one above."""
+    numbered: list[Row] = []
+    description = ""
+    for index, row in enumerate(rows):
+        description = row.description or description
+        numbered.append(Row(index, row.line, description, row.state, row.events, row.motors,
+                            row.timer, row.next, row.counters, row.lamps))
+    return numbered
+
+
+def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell]) -> None:
+    with_rows = {row.state for row in rows}
+    if not rows:
+        return
+    for row in rows:
+        if row.next not in with_rows:
+            cell = next_cells.get(row.line)
+            out.error(row.line, cell.column if cell else None, f"next state {row.next!r} is unknown: no row has state {row.next!r}",
+                      f"add rows for state {row.next!r} or fix the next state")
+    if robot.initial_state not in with_rows:
+        out.error(None, None, f"initial state {robot.initial_state!r} (from {robot.source} robot "
+                  f"{robot.name}) has no rows", "add rows for it or change initial_state in the robot file")
+    for state in robot.state_names:
+        if state not in with_rows:
+            out.error(None, None, f"state {state!r} is named in {robot.source} but has no rows",
+                      "add rows for it or remove it from [states]")

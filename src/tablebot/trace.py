@@ -1,0 +1,119 @@
+"""Recorded inputs in, JSON Lines traces out: the format every tablebot tool writes and compares.
+
+A trace line is one tick: ``tick``, ``event`` (bitmask, first event column highest), ``row``
+(0-based fired row or null), ``state`` and ``timer`` after the tick, each motor's signed speed,
+each lamp's level and each counter's value. Extra fields (a simulator's pose) may follow.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any
+
+from tablebot.csvtext import read_text, split_records
+from tablebot.diagnostics import Collector, fail
+from tablebot.engine import Engine
+from tablebot.machine import NO_ROW, Machine
+from tablebot.table import TIMER_EVENT
+
+
+@dataclass(frozen=True)
+class TickInput:
+    """What the robot read in one tick: input bits in event layout, and pulses per counter."""
+
+    mask: int
+    pulses: tuple[int, ...] = ()
+
+
+def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
+    """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0."""
+    path = Path(path)
+    records = split_records(read_text(path), str(path))
+    if not records:
+        raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
+    robot = machine.table.robot
+    out = Collector(path)
+    columns: list[tuple[str, str]] = []  # (kind, name)
+    for cell in records[0].cells:
+        name = cell.text.strip()
+        if name == TIMER_EVENT:
+            out.error(cell.line, cell.column, "T is never an input: the engine makes it from the timer",
+                      "remove the T column")
+            columns.append(("ignore", name))
+        elif name in robot.inputs:
+            columns.append(("input", name))
+        elif name in robot.counter_names:
+            columns.append(("pulses", name))
+        elif name in ("", "tick"):
+            columns.append(("ignore", name))
+        else:
+            out.error(cell.line, cell.column, f"unknown input {name!r} for robot {robot.name}",
+                      f"inputs are {', '.join(robot.inputs)}; counters (pulses per tick) are "
+                      f"{', '.join(robot.counter_names) or 'none'}")
+            columns.append(("ignore", name))
+    ticks = [_tick(record.cells, columns, machine, out) for record in records[1:]]
+    out.raise_if_any()
+    return ticks
+
+
+def _tick(cells: Iterable[Any], columns: list[tuple[str, str]], machine: Machine, out: Collector) -> TickInput:
+    robot = machine.table.robot
+    mask = 0
+    pulses = [0] * len(robot.counter_names)
+    for (kind, name), cell in zip(columns, cells, strict=False):
+        text = cell.text.strip()
+        if kind == "ignore" or not text:
+            continue
+        if not text.isdigit() or (kind == "input" and text not in ("0", "1")):
+            want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
+            out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
+            continue
+        if kind == "input":
+            mask |= machine.input_bits.get(name, 0) if text == "1" else 0
+        else:
+            pulses[robot.counter_names.index(name)] = int(text)
+    return TickInput(mask, tuple(pulses))
+
+
+def record(engine: Engine) -> dict[str, Any]:
+    """The trace line of the tick the engine just made."""
+    m = engine.machine
+    line: dict[str, Any] = {
+        "tick": engine.tick - 1,
+        "event": engine.event,
+        "row": None if engine.row == NO_ROW else engine.row,
+        "state": m.states[engine.state],
+        "timer": engine.timer,
+    }
+    line.update(zip(m.output_names, engine.outputs, strict=True))
+    line.update(zip(m.table.robot.counter_names, engine.counters, strict=True))
+    return line
+
+
+def replay(machine: Machine, ticks: Iterable[TickInput]) -> Iterator[dict[str, Any]]:
+    """Run a fresh engine over recorded inputs, yielding one trace line per tick."""
+    engine = Engine(machine)
+    for tick in ticks:
+        engine.step(tick.mask, tick.pulses)
+        yield record(engine)
+
+
+def dumps(line: dict[str, Any]) -> str:
+    """One trace line as compact JSON: the same line always gives the same bytes."""
+    return json.dumps(line, separators=(",", ":"), ensure_ascii=False)
+
+
+def write_trace(lines: Iterable[dict[str, Any]], stream: IO[str]) -> int:
+    count = 0
+    for line in lines:
+        stream.write(dumps(line) + "\n")
+        count += 1
+    return count
+
+
+def read_trace(path: str | Path) -> list[dict[str, Any]]:
+    with open(path, encoding="utf-8") as f:
+        return [json.loads(line) for line in f if line.strip()]
