@@ -1,9 +1,9 @@
-"""Core commands: ``export``, ``import``, ``trace`` and ``demo`` (the table, the engine, the lists)."""
+"""Core commands: ``import``, ``trace`` and ``demo`` (the table, the engine, the lists)."""
 
 from __future__ import annotations
 
 import sys
-from enum import Enum
+from enum import StrEnum
 from pathlib import Path
 
 import typer
@@ -19,27 +19,8 @@ from tablebot.tablewriter import format_table
 from tablebot.trace import load_inputs, replay, write_trace
 
 
-class Target(str, Enum):
+class Source(StrEnum):
     robopro = "robopro"
-
-
-class Source(str, Enum):
-    robopro = "robopro"
-
-
-@app.command("export")
-@guarded
-def export_cmd(
-    table: Path = TABLE_ARG,
-    outdir: Path = typer.Argument(..., help="Folder to write into (created if missing)."),
-    to: Target = typer.Option(..., "--to", help="Export target."),
-    robot: Path | None = ROBOT_OPT,
-) -> None:
-    """Export a table for another system (robopro: the document's three ROBO Pro lists as CSV)."""
-    parsed, _ = load(table, robot)
-    lists = robopro.encode(parsed)
-    for path in robopro.write_lists(lists, outdir):
-        console.print(f"wrote {path}")
 
 
 @app.command("import")
