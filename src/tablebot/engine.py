@@ -75,7 +75,8 @@ class Engine:
     def _fire(self, index: int) -> None:
         row = self.machine.rows[index]
         if row.keeps:
-            self.outputs = tuple(old if new is None else new for old, new in zip(self.outputs, row.outputs, strict=True))
+            merged = zip(self.outputs, row.outputs, strict=True)
+            self.outputs = tuple(old if new is None else new for old, new in merged)
         else:
             self.outputs = row.outputs  # type: ignore[assignment]  # no None when not keeps
         self.timer = row.timer

@@ -242,7 +242,8 @@ def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dic
     for row in rows:
         if row.next not in with_rows:
             cell = next_cells.get(row.line)
-            out.error(row.line, cell.column if cell else None, f"next state {row.next!r} is unknown: no row has state {row.next!r}",
+            out.error(row.line, cell.column if cell else None,
+                      f"next state {row.next!r} is unknown: no row has state {row.next!r}",
                       f"add rows for state {row.next!r} or fix the next state")
     if robot.initial_state not in with_rows:
         out.error(None, None, f"initial state {robot.initial_state!r} (from {robot.source} robot "
