@@ -6,10 +6,14 @@ separators and RFC 4180 quoting; every cell keeps its 1-based line and column fo
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import Diagnostic, TableBotError, fail
+
+#: A binary file would give thousands of bad lines; the first few say enough.
+MAX_BAD_LINES = 10
 
 
 @dataclass(frozen=True)
@@ -29,20 +33,32 @@ class Record:
 
 
 def read_text(path: Path) -> str:
-    """Decode a file as UTF-8 (BOM allowed), naming the line and column of the first bad byte."""
+    """Decode a file as UTF-8 (BOM allowed); if it is not, report where (see :func:`_bad_bytes`)."""
     try:
         data = path.read_bytes()
     except OSError as exc:
         raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
     try:
         return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        before = data[: exc.start]
-        line = before.count(b"\n") + 1
-        column = exc.start - (before.rfind(b"\n") + 1) + 1
-        raise fail(path, f"byte 0x{data[exc.start]:02x} is not UTF-8 text", "save the file as "
-                   "'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)",
-                   line, column) from None
+    except UnicodeDecodeError:
+        raise TableBotError(_bad_bytes(path, data)) from None
+
+
+def _bad_bytes(path: Path, data: bytes) -> list[Diagnostic]:
+    """One diagnostic per line holding undecodable bytes, at its first bad byte (columns in characters)."""
+    hint = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
+    found: list[Diagnostic] = []
+    start = 3 if data.startswith(b"\xef\xbb\xbf") else 0  # the BOM is not a character of line 1
+    for number, raw in enumerate(re.split(rb"\r\n|\r|\n", data[start:]), start=1):
+        try:
+            raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            column = len(raw[: exc.start].decode("utf-8")) + 1
+            found.append(Diagnostic(str(path), number, column, f"byte 0x{raw[exc.start]:02x} is not UTF-8 text",
+                                    hint))
+            if len(found) == MAX_BAD_LINES:
+                break
+    return found
 
 
 def detect_delimiter(first_line: str) -> str:
@@ -54,11 +70,16 @@ def detect_delimiter(first_line: str) -> str:
     return ","
 
 
+def _first_filled_line(text: str) -> str:
+    """The first line with any text (the header), so blank lines above it do not hide its delimiter."""
+    return next((line for line in text.split("\n") if line.strip()), "")
+
+
 def split_records(text: str, path: str, delimiter: str | None = None) -> list[Record]:
     """Split CSV text into records; a quoted cell may hold delimiters, quotes ("") and newlines."""
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     if delimiter is None:
-        delimiter = detect_delimiter(text.split("\n", 1)[0])
+        delimiter = detect_delimiter(_first_filled_line(text))
     records: list[Record] = []
     cells: list[Cell] = []
     line, column, i = 1, 1, 0

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tablebot.csvtext import Cell, Record, read_text, split_records
-from tablebot.diagnostics import Collector, fail
+from tablebot.diagnostics import Collector, Diagnostic, fail
 from tablebot.robot import BUMBERBOT, Robot, StateId, find_robot_file, load_robot
 from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, MAX_TIMER, TIMER_EVENT, Row, Table
 
@@ -42,20 +42,18 @@ def load_table(path: str | Path, robot: Robot | None = None) -> Table:
 
 def parse_table(text: str, path: str, robot: Robot) -> Table:
     out = Collector(path)
-    records = split_records(text, path)
-    if not records or records[0].is_blank():
+    records = [record for record in split_records(text, path) if not record.is_blank()]
+    if not records:
         raise fail(path, "the table is empty", "the first line must be a header such as "
                    "description,state,T,I3,M1_dir,M1_speed,timer,next", 1, 1)
-    columns = _header(records[0], robot, out)
+    header, body = records[0], records[1:]
+    columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
-    rows = [row for record in records[1:] if not record.is_blank()
-            for row in [_row(record, columns, robot, out)] if row is not None]
-    rows = _number(rows)
+    rows = _number([row for record in body for row in [_row(record, columns, robot, out)] if row is not None])
     if not rows and not out.items:
-        out.error(2, 1, "the table has a header but no rows", "add one row per transition below the header")
-    next_at = [i for i, c in enumerate(columns) if c.kind == "next"]
-    next_cells = {r.line: r.cells[next_at[0]] for r in records[1:] if next_at and len(r.cells) > next_at[0]}
-    _check_states(rows, robot, out, next_cells)
+        out.error(header.line + 1, 1, "the table has a header but no rows",
+                  "add one row per transition below the header")
+    _check_states(rows, robot, out, columns, body)
     out.raise_if_any()
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
 
@@ -166,12 +164,20 @@ def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
 
 
 def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) -> Row | None:
-    before = len(out.items)
+    """The row of one record, or None when its state or next state is unreadable.
+
+    A row with other bad cells is still returned (with the bad cells at their blank value) so that
+    its state counts as having rows; the collected errors stop the table from being used.
+    """
     cells = list(record.cells)
     for extra in cells[len(columns):]:
         if extra.text.strip():
             out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
                       "remove it or add a header for it")
+    for column, cell in zip(columns, cells, strict=False):
+        if column.kind == "ignore" and not column.name and cell.text.strip():
+            out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is in a column with no header",
+                      "name the column in the header, or clear the cell")
     cells += [Cell("", record.line, (cells[-1].column + len(cells[-1].text) + 1) if cells else 1)] * max(
         0, len(columns) - len(cells))
     fields: dict[str, object] = {"description": "", "events": set(), "timer": 0}
@@ -202,7 +208,7 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) ->
             lamps[name] = _int(cell, label, 0, MAX_LAMP, out, blank=None, keep=True)
         elif kind == "load":
             loads[name] = _int(cell, label, 0, MAX_TIMER, out, blank=None, keep=True)
-    if len(out.items) > before or fields.get("state") is None or fields.get("next") is None:
+    if fields.get("state") is None or fields.get("next") is None:
         return None
     motors = tuple(_motor(m, dirs, speeds, signed) for m in robot.motors)
     return Row(index=-1, line=record.line, description=str(fields["description"]),
@@ -235,10 +241,14 @@ def _number(rows: list[Row]) -> list[Row]:
     return numbered
 
 
-def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell]) -> None:
-    with_rows = {row.state for row in rows}
+def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[Column],
+                  body: list[Record]) -> None:
+    """Every next state, the initial state and every named state must have rows of its own."""
     if not rows:
         return
+    with_rows = {row.state for row in rows}
+    next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
+    next_cells = {r.line: r.cells[next_at] for r in body if next_at is not None and len(r.cells) > next_at}
     for row in rows:
         if row.next not in with_rows:
             cell = next_cells.get(row.line)
@@ -246,9 +256,21 @@ def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dic
                       f"next state {row.next!r} is unknown: no row has state {row.next!r}",
                       f"add rows for state {row.next!r} or fix the next state")
     if robot.initial_state not in with_rows:
-        out.error(None, None, f"initial state {robot.initial_state!r} (from {robot.source} robot "
-                  f"{robot.name}) has no rows", "add rows for it or change initial_state in the robot file")
+        _robot_error(out, robot, "initial_state", columns,
+                     f"initial state {robot.initial_state!r} (from {robot.source} robot {robot.name}) has no rows",
+                     "add rows for it or change initial_state in the robot file")
     for state in robot.state_names:
         if state not in with_rows:
-            out.error(None, None, f"state {state!r} is named in {robot.source} but has no rows",
-                      "add rows for it or remove it from [states]")
+            _robot_error(out, robot, str(state), columns, f"state {state!r} is named in {robot.source} "
+                         "but has no rows", "add rows for it or remove it from [states]")
+
+
+def _robot_error(out: Collector, robot: Robot, key: str, columns: list[Column], message: str, hint: str) -> None:
+    """A problem that comes from the robot description: located at its line in the robot file, or,
+    for the built-in robot, at the table's state column (where the missing rows belong)."""
+    line = robot.lines.get(key)
+    if line is not None:
+        out.items.append(Diagnostic(robot.source, line, 1, message, hint))
+        return
+    state = next((c.cell for c in columns if c.kind == "state"), None)
+    out.error(state.line if state else 1, state.column if state else 1, message, hint)
