@@ -1,4 +1,8 @@
-"""Writing a parsed table back as CSV in the document's column layout (direction + speed, 7 = keep)."""
+"""Writing a parsed table back as CSV in the document's column layout (direction + speed, 7 = keep).
+
+A motor that some row drives at a real speed of 7 cannot be written that way (7 means keep there),
+so that motor gets one signed column instead (``=`` = keep); the table reads back the same.
+"""
 
 from __future__ import annotations
 
@@ -8,14 +12,24 @@ import io
 from tablebot.table import DOC_KEEP_SPEED, Row, Table
 
 
+def signed_motors(table: Table) -> frozenset[str]:
+    """Motors that need the signed form: some row sets them to speed 7 (or -7)."""
+    speeds = [{abs(row.motors[i]) for row in table.rows if row.motors[i] is not None}
+              for i in range(len(table.robot.motors))]
+    return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
+
+
 def header(table: Table) -> list[str]:
     robot = table.robot
-    return ["description", "state", *table.events,
-            *(f"{m}_{field}" for m in robot.motors for field in ("dir", "speed")),
+    signed = signed_motors(table)
+    motors = [name for m in robot.motors for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
+    return ["description", "state", *table.events, *motors,
             *robot.lamps, *(f"{c}_load" for c in robot.counter_names), "timer", "next"]
 
 
-def _motor_cells(speed: int | None) -> list[str]:
+def _motor_cells(speed: int | None, signed: bool) -> list[str]:
+    if signed:
+        return ["=" if speed is None else str(speed)]
     if speed is None:
         return ["", str(DOC_KEEP_SPEED)]
     return ["1" if speed < 0 else "", str(abs(speed))]
@@ -25,10 +39,13 @@ def _keep(value: int | None) -> str:
     return "=" if value is None else str(value)
 
 
-def row_cells(table: Table, row: Row, previous: Row | None) -> list[str]:
+def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[str] | None = None) -> list[str]:
+    if signed is None:
+        signed = signed_motors(table)
     description = "" if previous and previous.description == row.description else row.description
+    motors = zip(table.robot.motors, row.motors, strict=True)
     return [description, str(row.state), *("1" if e in row.events else "" for e in table.events),
-            *(cell for speed in row.motors for cell in _motor_cells(speed)),
+            *(cell for motor, speed in motors for cell in _motor_cells(speed, motor in signed)),
             *(_keep(v) for v in row.lamps), *("" if v is None else str(v) for v in row.counters),
             str(row.timer), str(row.next)]
 
@@ -38,8 +55,9 @@ def format_table(table: Table) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header(table))
+    signed = signed_motors(table)
     previous = None
     for row in table.rows:
-        writer.writerow(row_cells(table, row, previous))
+        writer.writerow(row_cells(table, row, previous, signed))
         previous = row
     return buffer.getvalue()
