@@ -148,20 +148,37 @@ class Engine:
         }
 
     def restore(self, snapshot: Mapping[str, Any]) -> None:
-        """Resume from :meth:`snapshot` output; raises ValueError naming a field that does not fit."""
+        """Resume from :meth:`snapshot` output; raises ValueError naming a field that does not fit.
+
+        Everything is checked before anything changes, so a refused snapshot leaves the engine as it was.
+        """
         m = self.machine
-        try:
-            state = m.states.index(snapshot["state"])
-        except ValueError:
-            raise ValueError(f"state: {snapshot['state']!r} is not a state of this table") from None
-        tick, timer = int(snapshot["tick"]), int(snapshot["timer"])
-        if tick < 0 or timer < 0:
-            raise ValueError("tick and timer must not be negative")
+        tick, timer = _count(snapshot, "tick"), _count(snapshot, "timer")
+        if "state" not in snapshot:
+            raise ValueError("state: missing from the snapshot")
+        if snapshot["state"] not in m.states:
+            raise ValueError(f"state: {snapshot['state']!r} is not a state of this table")
         names = m.table.robot.counter_names
         counters = snapshot.get("counters", {})
         outputs = snapshot.get("outputs", {})
         if set(counters) != set(names) or set(outputs) != set(m.output_names):
             raise ValueError(f"counters/outputs must name exactly {names} and {m.output_names}")
-        self.tick, self.state, self.timer = tick, state, timer
-        self.counters = [int(counters[n]) for n in names]
-        self.outputs = tuple(int(outputs[n]) for n in m.output_names)
+        try:
+            counter_values = [int(counters[n]) for n in names]
+            output_values = tuple(int(outputs[n]) for n in m.output_names)
+        except (TypeError, ValueError):
+            raise ValueError("counters/outputs: every value must be an integer") from None
+        self.tick, self.state, self.timer = tick, m.states.index(snapshot["state"]), timer
+        self.counters, self.outputs = counter_values, output_values
+
+
+def _count(snapshot: Mapping[str, Any], key: str) -> int:
+    """A snapshot's tick or timer: present, an integer, not negative."""
+    if key not in snapshot:
+        raise ValueError(f"{key}: missing from the snapshot")
+    value = snapshot[key]
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{key}: {value!r} is not an integer")
+    if value < 0:
+        raise ValueError(f"{key}: {value} must not be negative")
+    return value
