@@ -13,9 +13,10 @@ import csv
 from dataclasses import dataclass
 from pathlib import Path
 
+from tablebot.csvtext import read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.robot import Robot, StateId
-from tablebot.table import DOC_KEEP_SPEED, Row, Table
+from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table
 
 STATE_WEIGHT = 64
 NEXT_WEIGHT = 256
@@ -54,8 +55,19 @@ def _motor_fields(speed: int | None) -> tuple[int, int]:
     return (1 if speed < 0 else 0), abs(speed)
 
 
+def event_layout(robot: Robot) -> tuple[str, ...]:
+    """The list's event bits, highest first: T, then the robot's inputs in robot-file order.
+
+    Fixed by the robot, not by the table's column order: the ROBO Pro program's DetectEvent sets one
+    bit per physical input (BumberBot: T=32, I3=16, I4=8, I5=4, I7=2, I8=1), and import decodes the
+    same way, so a table that omits or reorders event columns still exports to the right bits.
+    """
+    return (TIMER_EVENT, *robot.inputs)
+
+
 def encode_row(table: Table, row: Row, numbers: dict[StateId, int]) -> tuple[int, int, int]:
-    events = sum(1 << (len(table.events) - 1 - table.events.index(e)) for e in row.events)
+    layout = event_layout(table.robot)
+    events = sum(1 << (len(layout) - 1 - layout.index(e)) for e in row.events)
     motors = [_motor_fields(s) for s in row.motors] + [(0, 0)] * (MAX_MOTORS - len(row.motors))
     (d1, s1), (d2, s2) = motors
     action = numbers[row.next] * NEXT_WEIGHT + d1 * 128 + s1 * 16 + d2 * 8 + s2
@@ -66,21 +78,24 @@ def fit_problems(table: Table) -> list[Diagnostic]:
     """Everything in a table that the document's list layout cannot hold, row by row."""
     out = Collector(table.path)
     robot = table.robot
-    if len(table.events) > MAX_EVENTS:
-        out.error(1, None, f"{len(table.events)} event columns; the ROBO Pro layout holds at most {MAX_EVENTS}",
-                  "drop event columns this table does not need")
+    layout = event_layout(robot)
+    if len(layout) > MAX_EVENTS:
+        out.error(1, 1, f"{len(layout)} event columns (T and the inputs {', '.join(robot.inputs)}); "
+                  f"the ROBO Pro layout holds at most {MAX_EVENTS}",
+                  f"use a robot with at most {MAX_EVENTS - 1} inputs besides T")
     if len(robot.motors) > MAX_MOTORS:
-        out.error(1, None, f"{len(robot.motors)} motors; the ROBO Pro layout holds at most {MAX_MOTORS}",
+        out.error(1, 1, f"{len(robot.motors)} motors; the ROBO Pro layout holds at most {MAX_MOTORS}",
                   "the document's action word has room for M1 and M2 only")
-    if robot.counters or robot.lamps:
-        feature = "counters" if robot.counters else "lamps"
-        out.error(1, None, f"the robot has {feature}; the document's three lists have no place for them",
-                  "export a table without counters and lamps, or use --to c")
+    for feature, names in (("counters", robot.counter_names), ("lamps", robot.lamps)):
+        if names:
+            out.error(1, 1, f"the robot has {feature} ({', '.join(names)}); the document's three lists "
+                      "have no place for them", f"export a table for a robot without {feature}")
     numbers = number_states(table)
     for row in table.rows:
         for what, state in (("state", row.state), ("next state", row.next)):
             if numbers[state] > MAX_STATE:
-                out.error(row.line, None, f"row {row.index}: {what} {state} is over {MAX_STATE}",
+                out.error(row.line, None, f"row {row.index}: {what} {state!r} is number {numbers[state]}, "
+                          f"over {MAX_STATE}",
                           f"number states 0..{MAX_STATE} so the list values stay 16-bit")
         if row.timer > MAX_TIMER:
             out.error(row.line, None, f"row {row.index}: timer {row.timer} is over {MAX_TIMER}",
@@ -115,7 +130,8 @@ def write_lists(lists: Lists, outdir: Path) -> list[Path]:
         with path.open("w", encoding="utf-8", newline="") as f:
             writer = csv.writer(f, lineterminator="\n")
             writer.writerow(["number", "name"])
-            writer.writerows((n, s) for s, n in sorted(lists.numbers.items(), key=lambda kv: kv[1]))
+            named = [(n, s) for s, n in lists.numbers.items() if not isinstance(s, int)]  # ints are their number
+            writer.writerows(sorted(named))
         written.append(path)
     return written
 
@@ -123,10 +139,11 @@ def write_lists(lists: Lists, outdir: Path) -> list[Path]:
 # --- import -------------------------------------------------------------------------------------
 
 def _read_list(path: Path) -> list[int]:
+    """One list: an integer per line (ROBO Pro may add columns after a separator; they are ignored)."""
     if not path.is_file():
         raise fail(path, "list file not found", f"a ROBO Pro export has {', '.join(LIST_FILES)}")
     values = []
-    for number, line in enumerate(path.read_text(encoding="utf-8-sig").splitlines(), start=1):
+    for number, line in enumerate(read_text(path).splitlines(), start=1):
         text = line.split(",")[0].split(";")[0].strip()
         if not text:
             continue
@@ -134,26 +151,42 @@ def _read_list(path: Path) -> list[int]:
             value = int(text)
         except ValueError:
             raise fail(path, f"{text!r} is not an integer", "one integer per line", number, 1) from None
-        if not -32768 <= value <= 32767:
-            raise fail(path, f"{value} is not a 16-bit list value", "values are -32768..32767", number, 1)
+        if not 0 <= value <= 32767:
+            raise fail(path, f"{value} is not a value of the document's encoding",
+                       "list values are 16-bit signed, and the encoding never writes negative ones", number, 1)
         values.append(value)
     return values
 
 
 def _read_names(directory: Path) -> dict[int, StateId]:
+    """states.csv as export writes it: a header, then ``number,name`` per named state."""
     path = directory / STATES_FILE
     if not path.is_file():
         return {}
-    with path.open(encoding="utf-8-sig", newline="") as f:
-        return {int(row["number"]): row["name"] for row in csv.DictReader(f)}
+    names: dict[int, StateId] = {}
+    for record in split_records(read_text(path), str(path))[1:]:
+        cells = [cell.text.strip() for cell in record.cells]
+        if record.is_blank():
+            continue
+        if len(cells) < 2 or not cells[0].isdigit() or not cells[1]:
+            raise fail(path, f"expected number,name, not {','.join(cells)!r}",
+                       "export writes one named state per line, like: 1,seek", record.line, 1)
+        names[int(cells[0])] = int(cells[1]) if cells[1].isdigit() else cells[1]  # as the table parser reads it
+    return names
 
 
-def decode(lists: Lists, robot: Robot, events: tuple[str, ...], path: str = "<lists>") -> Table:
-    """Rebuild a table (descriptions are lost: the lists never held them)."""
+def decode(lists: Lists, robot: Robot, events: tuple[str, ...] | None = None, path: str = "<lists>") -> Table:
+    """Rebuild a table (descriptions are lost: the lists never held them); ``events`` defaults to
+    :func:`event_layout`, the layout :func:`encode` writes."""
+    events = event_layout(robot) if events is None else events
     names = {n: s for s, n in lists.numbers.items()}
     rows = []
     for index, (event, action, timer) in enumerate(zip(lists.event, lists.action, lists.timer, strict=True)):
         state, bits = divmod(event, STATE_WEIGHT)
+        if bits >> len(events):
+            raise fail(Path(path) / LIST_FILES[0], f"event {event} has bits beyond the {len(events)} events "
+                       f"{' '.join(events)}", "the lists were written for another robot: pass its --robot",
+                       index + 1, 1)
         nxt, low = divmod(action, NEXT_WEIGHT)
         fields = [(low >> 7) & 1, (low >> 4) & 7, (low >> 3) & 1, low & 7]
         motors = tuple(None if speed == DOC_KEEP_SPEED else (-speed if direction else speed)
@@ -161,7 +194,8 @@ def decode(lists: Lists, robot: Robot, events: tuple[str, ...], path: str = "<li
         required = frozenset(e for i, e in enumerate(events) if bits & (1 << (len(events) - 1 - i)))
         rows.append(Row(index=index, line=index + 1, description="", state=names.get(state, state),
                         events=required, motors=motors[: len(robot.motors)], timer=timer,
-                        next=names.get(nxt, nxt)))
+                        next=names.get(nxt, nxt), counters=(None,) * len(robot.counters),
+                        lamps=(None,) * len(robot.lamps)))
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
 
 
@@ -170,9 +204,5 @@ def read_lists(directory: Path) -> Lists:
     if not len(event) == len(action) == len(timer):
         raise fail(directory, f"the lists differ in length: event {len(event)}, action {len(action)}, "
                    f"timer {len(timer)}", "each row of the table is one entry in every list")
-    for i, value in enumerate(event):
-        if value < 0 or action[i] < 0:
-            raise fail(directory / (LIST_FILES[0] if value < 0 else LIST_FILES[1]),
-                       "negative value: not written by the document's encoding", "check the list", i + 1, 1)
     numbers = {state: number for number, state in _read_names(directory).items()}
     return Lists(tuple(event), tuple(action), tuple(timer), numbers)
