@@ -67,7 +67,7 @@ def _tick(cells: Iterable[Any], columns: list[tuple[str, str]], machine: Machine
         text = cell.text.strip()
         if kind == "ignore" or not text:
             continue
-        if not text.isdigit() or (kind == "input" and text not in ("0", "1")):
+        if not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
             want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
             out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
             continue

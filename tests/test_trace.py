@@ -1,0 +1,125 @@
+"""The trace format (one JSON object per tick) and the recorded-inputs CSV it replays."""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+
+import pytest
+
+from core_helpers import COUNTER_ROBOT, EXAMPLE, example_machine, write_table
+from tablebot.diagnostics import TableBotError
+from tablebot.machine import compile_table
+from tablebot.tablefile import load_table
+from tablebot.trace import TickInput, dumps, load_inputs, read_trace, replay, write_trace
+
+
+def trace_of(tmp_path, inputs_text: str, machine=None) -> list[dict]:
+    machine = machine or example_machine()
+    path = tmp_path / "inputs.csv"
+    path.write_text(inputs_text)
+    return list(replay(machine, load_inputs(path, machine)))
+
+
+def test_keys_in_order_and_the_readme_example(tmp_path):
+    lines = trace_of(tmp_path, "I3,I4,I5,I7,I8\n,,,,\n")
+    assert list(lines[0]) == ["tick", "event", "row", "state", "timer", "M1", "M2"]
+    assert dumps(lines[0]) == '{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}'
+
+
+def test_event_bits_first_column_highest(tmp_path):
+    """T=32, I3=16, I4=8, I5=4, I7=2, I8=1 (after tick 0 the timer holds 500, then 50: no T)."""
+    lines = trace_of(tmp_path, "I8,I7,I5,I4,I3\n0,0,0,0,0\n,,,,1\n,,,1,\n,,1,,\n,1,,,\n1,,,,\n1,1,1,1,1\n")
+    assert [line["event"] for line in lines] == [32, 16, 8, 4, 2, 1, 31]
+
+
+def test_row_is_null_when_nothing_fires_and_state_timer_are_after_the_tick(tmp_path):
+    lines = trace_of(tmp_path, "I3\n\n\n1\n")
+    assert [(x["row"], x["state"], x["timer"]) for x in lines] == [(7, 1, 500), (None, 1, 499), (1, 20, 50)]
+    assert '"row":null' in dumps(lines[1])
+
+
+def test_motors_are_signed(tmp_path):
+    lines = trace_of(tmp_path, "I3,I4\n\n1,1\n" + "\n" * 50 + "1,1\n")
+    assert (lines[-1]["row"], lines[-1]["M1"], lines[-1]["M2"]) == (9, -3, -3)  # Collision Frontal: backward
+
+
+def test_replay_is_deterministic_byte_for_byte():
+    machine = example_machine()
+    ticks = load_inputs(EXAMPLE / "inputs.csv", machine)
+    first, second = io.StringIO(), io.StringIO()
+    assert write_trace(replay(machine, ticks), first) == len(ticks) == 3000
+    write_trace(replay(example_machine(), load_inputs(EXAMPLE / "inputs.csv", machine)), second)
+    assert first.getvalue() == second.getvalue()
+    assert first.getvalue().endswith("\n") and "\r" not in first.getvalue()
+
+
+def test_write_and_read_trace(tmp_path):
+    machine = example_machine()
+    lines = list(replay(machine, [TickInput(0), TickInput(16)]))
+    path = tmp_path / "t.jsonl"
+    with path.open("w") as stream:
+        write_trace(lines, stream)
+    assert read_trace(path) == lines
+    assert path.read_text().splitlines()[1] == json.dumps(lines[1], separators=(",", ":"))
+
+
+def test_counters_and_lamps_follow_the_motors(tmp_path):
+    table = "state,T,A,C1,M1,M2,L1,L2,C1_load,C2_load,timer,next\n1,1,,,3,-2,5,=,4,,9,1\n"
+    machine = compile_table(load_table(write_table(tmp_path, table, COUNTER_ROBOT)))
+    lines = trace_of(tmp_path, "A,C1,C2\n,,\n,1,2\n", machine)
+    assert list(lines[0]) == ["tick", "event", "row", "state", "timer", "M1", "M2", "L1", "L2", "C1", "C2"]
+    assert [dumps(x) for x in lines] == [
+        '{"tick":0,"event":5,"row":0,"state":1,"timer":9,"M1":3,"M2":-2,"L1":5,"L2":0,"C1":4,"C2":0}',
+        '{"tick":1,"event":0,"row":null,"state":1,"timer":8,"M1":3,"M2":-2,"L1":5,"L2":0,"C1":3,"C2":0}',
+    ]
+
+
+# --- the inputs CSV -----------------------------------------------------------------------------------
+
+def test_inputs_blank_is_zero_and_tick_column_is_ignored(tmp_path):
+    machine = example_machine()
+    path = tmp_path / "in.csv"
+    path.write_text("tick,I7,I3\n0,,\n1,1,\n2,1,1\n")
+    assert [t.mask for t in load_inputs(path, machine)] == [0, 2, 18]
+
+
+def inputs_error(tmp_path, text, machine=None):
+    path = tmp_path / "in.csv"
+    path.write_text(text)
+    with pytest.raises(TableBotError) as info:
+        load_inputs(path, machine or example_machine())
+    return info.value.diagnostics
+
+
+@pytest.mark.parametrize(("text", "where", "pattern"), [
+    ("I3,T\n1,\n", (1, 4), "T is never an input"),
+    ("I3,I9\n1,\n", (1, 4), "unknown input 'I9'"),
+    ("I3,I4\n1,2\n", (2, 3), r"I4: '2' is not 0 or 1"),
+    ("I3,I4\n1,x\n", (2, 3), r"I4: 'x' is not 0 or 1"),
+    ("I3\n²\n", (2, 1), r"I3: '²' is not 0 or 1"),
+])
+def test_inputs_errors_are_located(tmp_path, text, where, pattern):
+    diagnostics = inputs_error(tmp_path, text)
+    assert len(diagnostics) == 1
+    d = diagnostics[0]
+    assert (d.line, d.column) == where
+    assert re.search(pattern, d.message) and d.hint
+
+
+def test_inputs_all_problems_at_once(tmp_path):
+    assert len(inputs_error(tmp_path, "I3,T,I9\n5,,\n1,,\nx,,\n")) == 4
+
+
+def test_inputs_empty_file(tmp_path):
+    (d,) = inputs_error(tmp_path, "")
+    assert "empty" in d.message and (d.line, d.column) == (1, 1)
+
+
+@pytest.mark.parametrize("value", ["-1", "²", "1.5"])
+def test_inputs_pulses_must_be_counts(tmp_path, value):
+    table = "state,T,C1,M1,C1_load,timer,next\n1,1,,3,4,9,1\n"
+    machine = compile_table(load_table(write_table(tmp_path, table, COUNTER_ROBOT)))
+    (d,) = inputs_error(tmp_path, f"C1\n{value}\n", machine)
+    assert "pulse count" in d.message and (d.line, d.column) == (2, 1)
