@@ -61,6 +61,11 @@ def guarded(func: F) -> F:
             for d in exc.diagnostics:
                 print_diagnostic(d)
             raise typer.Exit(2) from None
+        except OSError as exc:  # a file the command had to write (or read) is not there to be had
+            where = exc.filename if exc.filename is not None else "tablebot"
+            print_diagnostic(Diagnostic(str(where), None, None, exc.strerror or str(exc),
+                                        "check the path: its folder must exist, be a folder, and be writable"))
+            raise typer.Exit(2) from None
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
             raise typer.Exit(130) from None

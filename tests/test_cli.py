@@ -1,0 +1,215 @@
+"""The real `tablebot` command: check, export, import, trace, demo; errors exit 2 with located messages."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from core_helpers import EXAMPLE, MINI_ROBOT, SEED_TSV, column_of, example_machine, write_table
+from tablebot.cli import app
+from tablebot.machine import compile_table
+from tablebot.tablefile import load_table
+
+runner = CliRunner()
+LOCATED = re.compile(r"^(?P<path>\S.*?):(?P<line>\d+):(?P<column>\d+): error: .+$")
+BAD_TABLE = """\
+description,state,T,A,B,M1,M2,timer,next
+ok,1,1,,,3,3,10,1
+speed,1,1,,,9,3,10,1
+timer,1,1,,,3,3,x,1
+next,1,1,,,3,3,10,7
+"""
+
+
+def invoke(*args: object):
+    """Run the app in-process; anything but a clean exit (an escaped exception) fails the test."""
+    result = runner.invoke(app, [str(a) for a in args])
+    assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
+    return result
+
+
+def assert_located_errors(stderr: str, count: int) -> list[re.Match]:
+    """Every error line is file:line:column: error: …, each followed by a hint; no traceback."""
+    assert "Traceback" not in stderr
+    lines = stderr.splitlines()
+    errors = [LOCATED.match(line) for line in lines if ": error: " in line]
+    assert len(errors) == count and all(errors), stderr
+    for i, line in enumerate(lines):
+        if ": error: " in line:
+            assert lines[i + 1].startswith("    hint: "), stderr
+    return errors  # type: ignore[return-value]
+
+
+# --- help ---------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [[], ["check"], ["export"], ["import"], ["trace"], ["demo"]])
+def test_help(command):
+    result = invoke(*command, "--help")
+    assert result.exit_code == 0, result.output
+    assert "Usage" in result.output and "--help" in result.output
+
+
+def test_no_arguments_shows_help():
+    result = invoke()
+    assert "check" in result.output and "trace" in result.output
+
+
+def test_usage_error_exits_2():
+    result = invoke("check")
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+
+
+# --- check --------------------------------------------------------------------------------------------
+
+def test_check_seed_tsv(tmp_path):
+    shutil.copy(SEED_TSV, tmp_path / "bumberbot-table.tsv")
+    result = invoke("check", tmp_path / "bumberbot-table.tsv")
+    assert result.exit_code == 0, result.output
+    assert "37 rows, 10 states" in result.stdout and "BumberBot" in result.stdout
+
+
+def test_check_a_folder_means_its_table():
+    result = invoke("check", EXAMPLE)
+    assert result.exit_code == 0 and "table.csv" in result.stdout
+
+
+def test_check_reports_every_problem_located(tmp_path):
+    path = write_table(tmp_path, BAD_TABLE, MINI_ROBOT)
+    result = invoke("check", path)
+    assert result.exit_code == 2
+    errors = assert_located_errors(result.stderr, 3)
+    lines = BAD_TABLE.splitlines()
+    expected = [(3, column_of(lines[2], 5)), (4, column_of(lines[3], 7)), (5, column_of(lines[4], 8))]
+    assert [(int(m["line"]), int(m["column"])) for m in errors] == expected
+    assert all(m["path"] == str(path) for m in errors)
+    assert result.stdout == ""
+
+
+def test_check_undecodable_file(tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_bytes(b"state,T,I3,M1_speed,next\n1,1,\xff,3,1\n")
+    result = invoke("check", path)
+    assert result.exit_code == 2
+    (m,) = assert_located_errors(result.stderr, 1)
+    assert (m["line"], m["column"]) == ("2", "5")
+
+
+def test_check_with_explicit_robot(tmp_path):
+    table = write_table(tmp_path, "state,T,A,M1,timer,next\n1,1,,3,0,1\n")
+    (tmp_path / "mini.toml").write_text(MINI_ROBOT)
+    assert invoke("check", table).exit_code == 2  # the built-in BumberBot has no input A
+    result = invoke("check", table, "--robot", tmp_path / "mini.toml")
+    assert result.exit_code == 0, result.output
+    assert "robot Mini" in result.stdout
+
+
+def test_check_missing_file(tmp_path):
+    result = invoke("check", tmp_path / "nope.csv")
+    assert result.exit_code == 2
+    assert "cannot read" in result.stderr and "Traceback" not in result.output
+
+
+def test_real_command_is_plain_when_piped(tmp_path):
+    """The installed script, in a subprocess: stderr is a pipe, so no colour codes, and exit code 2."""
+    path = write_table(tmp_path, BAD_TABLE, MINI_ROBOT)
+    script = Path(sys.executable).parent / "tablebot"
+    done = subprocess.run([str(script), "check", str(path)], capture_output=True, text=True, check=False)
+    assert done.returncode == 2
+    assert "\x1b[" not in done.stderr
+    assert_located_errors(done.stderr, 3)
+
+
+# --- export and import --------------------------------------------------------------------------------
+
+def test_export_then_import_round_trip(tmp_path):
+    out = tmp_path / "lists"
+    result = invoke("export", EXAMPLE / "table.csv", out, "--to", "robopro")
+    assert result.exit_code == 0, result.output
+    assert (out / "event.csv").read_text().splitlines()[0] == "88"
+    assert (out / "action.csv").read_text().splitlines()[0] == "5120"
+    assert (out / "timer.csv").read_text().splitlines()[0] == "50"
+    result = invoke("import", out, "--from", "robopro", "--out", tmp_path / "back.csv")
+    assert result.exit_code == 0, result.output
+    assert "descriptions" in result.stderr
+    back = compile_table(load_table(tmp_path / "back.csv", example_machine().table.robot))
+    assert back.signature() == example_machine().signature()
+
+
+def test_import_to_standard_output(tmp_path):
+    invoke("export", EXAMPLE, tmp_path, "--to", "robopro")
+    result = invoke("import", tmp_path, "--from", "robopro")
+    assert result.exit_code == 0
+    assert result.stdout.splitlines()[0].startswith("description,state,T,I3,I4,I5,I7,I8,M1_dir")
+    assert result.stdout.splitlines()[1] == ",1,,1,1,,,,,0,,0,50,20"
+
+
+def test_export_named_states(tmp_path):
+    robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "go"')
+    table = write_table(tmp_path, "state,T,M1,M2,timer,next\ngo,1,3,3,9,stop\nstop,1,0,0,9,go\n", robot)
+    assert invoke("export", table, tmp_path / "l", "--to", "robopro").exit_code == 0
+    assert (tmp_path / "l" / "states.csv").read_text() == "number,name\n1,go\n2,stop\n"
+    result = invoke("import", tmp_path / "l", "--from", "robopro", "--robot", tmp_path / "robot.toml")
+    assert result.exit_code == 0, result.output
+    assert [line.split(",")[1] for line in result.stdout.splitlines()[1:]] == ["go", "stop"]
+
+
+def test_export_refuses_what_does_not_fit(tmp_path):
+    table = write_table(tmp_path, "state,T,M1,M2,timer,next\n1,1,8,3,40000,1\n", MINI_ROBOT)
+    result = invoke("export", table, tmp_path / "l", "--to", "robopro")
+    assert result.exit_code == 2
+    assert "row 0: timer 40000 is over 32767" in result.stderr and "row 0: M1 speed 8" in result.stderr
+    assert not (tmp_path / "l").exists()
+
+
+def test_export_into_a_file_is_an_error_not_a_traceback(tmp_path):
+    (tmp_path / "afile").write_text("")
+    result = invoke("export", EXAMPLE, tmp_path / "afile", "--to", "robopro")
+    assert result.exit_code == 2
+    assert ("afile" in result.stderr and result.exception is None) or isinstance(result.exception, SystemExit)
+
+
+def test_import_errors(tmp_path):
+    result = invoke("import", tmp_path, "--from", "robopro")
+    assert result.exit_code == 2 and "list file not found" in result.stderr
+
+
+# --- trace and demo -----------------------------------------------------------------------------------
+
+def test_trace_to_stdout_and_file_are_the_same_bytes(tmp_path):
+    inputs = EXAMPLE / "inputs.csv"
+    to_stdout = invoke("trace", EXAMPLE, "--inputs", inputs)
+    assert to_stdout.exit_code == 0
+    assert invoke("trace", EXAMPLE, "--inputs", inputs, "--out", tmp_path / "a.jsonl").exit_code == 0
+    assert invoke("trace", EXAMPLE / "table.csv", "--inputs", inputs, "--out", tmp_path / "b.jsonl").exit_code == 0
+    a, b = (tmp_path / "a.jsonl").read_bytes(), (tmp_path / "b.jsonl").read_bytes()
+    assert a == b == to_stdout.stdout.encode()
+    assert a.startswith(b'{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}\n')
+    assert len(a.splitlines()) == 3000
+
+
+def test_trace_bad_inputs(tmp_path):
+    (tmp_path / "in.csv").write_text("I3,T\n1,\n")
+    result = invoke("trace", EXAMPLE, "--inputs", tmp_path / "in.csv")
+    assert result.exit_code == 2
+    (m,) = assert_located_errors(result.stderr, 1)
+    assert (m["line"], m["column"]) == ("1", "4")
+
+
+def test_trace_into_a_missing_folder(tmp_path):
+    result = invoke("trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out", tmp_path / "no" / "t.jsonl")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+
+
+def test_demo_writes_the_trace_of_the_example(tmp_path):
+    result = invoke("demo", "--out", tmp_path)
+    assert result.exit_code == 0, result.output
+    assert "BumberBot: 3000 ticks (30.0 s)" in result.stdout
+    expected = invoke("trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv").stdout
+    assert (tmp_path / "trace.jsonl").read_text() == expected
