@@ -1,0 +1,77 @@
+"""The ``sim`` command: run a table on the simulated robot in a world and write its trace and pictures."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+from tablebot.cli.app import app
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.diagnostics import fail
+
+
+@app.command("sim")
+@guarded
+def sim_cmd(
+    table: Path = TABLE_ARG,
+    world: Path | None = typer.Option(None, "--world", help="World TOML (default: the robot's sim.world, "
+                                      "else arena.toml beside the table, else an empty room)."),
+    seconds: float = typer.Option(120.0, "--seconds", min=0.01, max=86400, help="Simulated time."),
+    seed: int = typer.Option(1, "--seed", help="Seed of all simulated noise: same seed, same trace bytes."),
+    out: Path = typer.Option(Path("out/sim"), "--out", help="Folder for trace.jsonl and the pictures."),
+    view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
+    gif: bool = typer.Option(False, "--gif", help="Also write run.gif, an animation of the run."),
+    charge: float | None = typer.Option(None, "--battery", min=0.0, max=1.0,
+                                        help="Battery charge at the start, 0..1 (overrides the world)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no summary."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif)."""
+    from tablebot.sim import plots
+    from tablebot.sim import setup as sim_setup
+    from tablebot.sim.draw import state_names
+    from tablebot.sim.runner import run, write_trace
+    from tablebot.sim.summary import summarise
+
+    parsed, machine = load(table, robot)
+    layer, robot_world = sim_setup.robot_layer(parsed.robot)
+    the_world = sim_setup.find_world(parsed, world, robot_world)
+    overrides = {"battery": {"charge": charge}} if charge is not None else {}
+    setup = sim_setup.prepare(parsed, machine, the_world, layer, overrides)
+    result = _run_with_progress(run, setup, seconds, seed, quiet)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise fail(out, f"cannot create the output folder: {exc.strerror}", "choose another --out") from None
+    with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
+        write_trace(result, stream)
+    summary = summarise(result)
+    written = [out / "trace.jsonl", plots.trajectory(result, summary, out / "trajectory.png"),
+               plots.timeline(result, summary, out / "timeline.png")]
+    if gif:
+        from tablebot.sim.animate import write_gif
+        written.append(write_gif(result, summary, out / "run.gif"))
+    if not quiet:
+        names = state_names(parsed)
+        for line in summary.lines(names):
+            console.print(line)
+        speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
+        console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
+        for path in written:
+            err_console.print(f"wrote {path}")
+    if view:
+        from tablebot.sim.animate import show
+        show(result, summary)
+
+
+def _run_with_progress(run, setup, seconds: float, seed: int, quiet: bool):  # type: ignore[no-untyped-def]
+    if quiet or not sys.stderr.isatty():
+        return run(setup, seconds, seed)
+    ticks = max(1, round(seconds / setup.tick_s))
+    columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
+    with Progress(*columns, console=err_console, transient=True) as bar:
+        task = bar.add_task("sim", total=ticks)
+        return run(setup, seconds, seed, progress=lambda done: bar.update(task, completed=done))

@@ -1,0 +1,147 @@
+"""Drawing pieces shared by the pictures and the animation: arena, obstacles, lamp, the robot, state colours.
+
+Only matplotlib artists on a given Axes; no figure or backend is chosen here, so headless use
+never touches a display.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Polygon, Wedge
+
+from tablebot.robot import StateId
+from tablebot.sim.params import Params
+from tablebot.sim.world import World
+from tablebot.table import TIMER_EVENT, Table
+
+FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
+LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
+COLLISION, LIGHT_SEEN, REACHED = "#e8413a", "#f0a500", "#20bf6b"
+# tab10 without its red (red marks collisions) and with darker extras after it
+PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#e377c2", "#7f7f7f",
+           "#bcbd22", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd", "#31a354")
+
+
+def state_colours(states: tuple[StateId, ...]) -> list[str]:
+    """One colour per state index, stable across the pictures of a table."""
+    return [PALETTE[i % len(PALETTE)] for i in range(len(states))]
+
+
+def state_names(table: Table) -> dict[StateId, str]:
+    """Names from the robot file's [states]; else the description of the state's timer row (the
+    document names its T rows after what the state does: "Seek - Straight", "Follow Light"), else its first row's."""
+    names = dict(table.robot.state_names)
+    for row in table.rows:
+        if row.state not in names and TIMER_EVENT in row.events and row.description:
+            names[row.state] = row.description
+    for row in table.rows:
+        if row.state not in names and row.description:
+            names[row.state] = row.description
+    return names
+
+
+def state_label(state: StateId, names: dict[StateId, str]) -> str:
+    return f"{state} · {names[state]}" if state in names else f"state {state}"
+
+
+def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
+    """Floor, walls, obstacles and lamps, with equal axes in metres."""
+    floor = Polygon(world.walls, closed=True, facecolor=FLOOR, edgecolor=WALL, linewidth=3, zorder=0)
+    ax.add_patch(floor)
+    for box in world.boxes:
+        ax.add_patch(Polygon(box.corners(), closed=True, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE,
+                             linewidth=1.2, hatch="//", zorder=2))
+    for circle in world.circles:
+        ax.add_patch(CirclePatch(circle.at, circle.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE,
+                                 linewidth=1.2, hatch="//", zorder=2))
+    for seg in world.segments:
+        ax.plot(*zip(seg.start, seg.end, strict=True), color=WALL, linewidth=3, solid_capstyle="round", zorder=2)
+    for lamp in world.lamps:
+        if lamp_glow:
+            for k, radius in enumerate((0.45, 0.3, 0.18)):
+                ax.add_patch(CirclePatch(lamp.at, radius, facecolor=LAMP_ON, alpha=0.12 + 0.08 * k,
+                                         linewidth=0, zorder=1))
+            # a sensor looking straight at the lamp reads the threshold at sqrt(intensity) metres
+            ring = CirclePatch(lamp.at, math.sqrt(lamp.intensity), fill=False, edgecolor="#b8860b",
+                               linestyle="--", linewidth=1, alpha=0.6, zorder=1)
+            ax.add_patch(ring)
+            ring.set_clip_path(floor)
+        if lamp.radius > 0:
+            ax.add_patch(CirclePatch(lamp.at, lamp.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, zorder=2))
+        ax.plot(*lamp.at, marker="*", markersize=20, color=LAMP_ON, markeredgecolor="#b8860b", zorder=12)
+    xs, ys = zip(*world.walls, strict=True)
+    pad = 0.05 * max(max(xs) - min(xs), max(ys) - min(ys))
+    ax.set_xlim(min(xs) - pad, max(xs) + pad)
+    ax.set_ylim(min(ys) - pad, max(ys) + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+
+
+def _transform(points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.column_stack((x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]))
+
+
+@dataclass
+class RobotArtist:
+    """The robot drawn to scale: body, front bumper halves, rear bumper, sensor cones, lit lamps."""
+
+    ax: Axes
+    params: Params
+    n_lamps: int = 0
+    alpha: float = 1.0
+
+    def __post_init__(self) -> None:
+        b, light = self.params["body"], self.params["light"]
+        f, r, w, ov = b["front"], -b["rear"], b["half_width"], b["bumper_overlap"]
+        self.body_pts = np.array([(f, -w), (f, w), (r, w), (r, -w)])
+        t = 0.012  # drawn bumper thickness
+        # bumpers drawn just inside the outline (the body outline is what touches)
+        self.bump_pts = [np.array([(f, -w), (f, ov), (f - t, ov), (f - t, -w)]),
+                         np.array([(f, -ov), (f, w), (f - t, w), (f - t, -ov)]),
+                         np.array([(r, -w), (r, w), (r + t, w), (r + t, -w)])]
+        self.lamp_pts = np.array([(r + 0.03 + 0.035 * k, 0.0) for k in range(self.n_lamps)]).reshape(-1, 2)
+        self.cone_len = 0.25
+        self.sensor_pts = np.array([(light["forward"], -light["sideways"]), (light["forward"], light["sideways"])])
+        self.toe = math.radians(light["toe_out"])
+        self.fov = light["half_response"]
+        z = 8
+        self.body = Polygon(self.body_pts, closed=True, facecolor=BODY, edgecolor=WALL, lw=1.2, alpha=self.alpha,
+                            zorder=z)
+        self.bumpers = [Polygon(p, closed=True, facecolor=BUMPER, lw=0, alpha=self.alpha, zorder=z + 1)
+                        for p in self.bump_pts]
+        self.cones = [Wedge((0, 0), self.cone_len, 0, 1, facecolor=LAMP_ON, alpha=0.18 * self.alpha, lw=0,
+                            zorder=z - 1) for _ in range(2)]
+        self.lamps = [CirclePatch((0, 0), 0.014, facecolor=LAMP_OFF, edgecolor=WALL, lw=0.8, alpha=self.alpha,
+                                  zorder=z + 2) for _ in range(self.n_lamps)]
+        self.heading = self.ax.plot([], [], color=WALL, lw=1.5, alpha=self.alpha, zorder=z + 1)[0]
+        for patch in (self.body, *self.bumpers, *self.cones, *self.lamps):
+            self.ax.add_patch(patch)
+
+    def artists(self) -> list:
+        return [self.body, *self.bumpers, *self.cones, *self.lamps, self.heading]
+
+    def update(self, x: float, y: float, theta: float, bumpers: tuple[bool, bool, bool] = (False,) * 3,
+               lights: tuple[bool, bool] = (False, False), lamps: tuple[int, ...] = ()) -> None:
+        self.body.set_xy(_transform(self.body_pts, x, y, theta))
+        for patch, pts, on in zip(self.bumpers, self.bump_pts, bumpers, strict=True):
+            patch.set_xy(_transform(pts, x, y, theta))
+            patch.set_facecolor(BUMPER_ON if on else BUMPER)
+        for cone, pt, side, seen in zip(self.cones, self.sensor_pts, (-1, 1), lights, strict=True):
+            cx, cy = _transform(pt[None, :], x, y, theta)[0]
+            aim = math.degrees(theta + side * self.toe)
+            cone.set_center((cx, cy))
+            cone.set_theta1(aim - self.fov)
+            cone.set_theta2(aim + self.fov)
+            cone.set_alpha((0.45 if seen else 0.15) * self.alpha)
+        for patch, pt, level in zip(self.lamps, self.lamp_pts, lamps, strict=False):
+            patch.center = tuple(_transform(pt[None, :], x, y, theta)[0])
+            patch.set_facecolor(LAMP_ON if level else LAMP_OFF)
+        nose = _transform(np.array([(0.0, 0.0), (self.body_pts[0, 0] * 0.8, 0.0)]), x, y, theta)
+        self.heading.set_data(nose[:, 0], nose[:, 1])

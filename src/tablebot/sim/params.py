@@ -1,0 +1,212 @@
+"""The BumberBot's physical parameters: defaults with their sources, validation, and the packed parameter row.
+
+Values come, in rising priority, from :data:`DEFAULTS`, the robot file's ``[sim.*]`` sections and the
+world file's sections of the same names. The motor's speed constant is calibrated (unless given)
+so that the document's Seek-Straight spin — M1 back, M2 forward, speed 2, 895 ticks — turns 270°
+on a full battery.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from tablebot.sim import layout as L
+from tablebot.sim.tomlsrc import Source, known_keys, number, table_of
+
+Number = int | float
+
+# Each entry: (default, low, high, what it is and where the number comes from).
+DEFAULTS: dict[str, dict[str, tuple[Any, Number, Number, str]]] = {
+    "body": {
+        # The ROBO Mobile Set's assembly drawings are not at hand: the body numbers are estimates on the
+        # fischertechnik 15 mm grid (a 9-grid axle between the wheel centres, a 12 × 18 cm frame).
+        "wheel_base": (0.135, 0.02, 2.0, "m between the wheel contact points (estimate)"),
+        "wheel_diameter": (0.060, 0.005, 1.0, "m (estimate: fischertechnik 60 mm tyre)"),
+        "front": (0.12, 0.01, 2.0, "m from the axle centre to the front bumper (estimate)"),
+        "rear": (0.07, 0.01, 2.0, "m from the axle centre to the rear bumper (estimate)"),
+        "half_width": (0.09, 0.01, 2.0, "m, half the body width over the wheels (estimate)"),
+        "bumper_overlap": (0.012, 0.0, 1.0, "m each half of the front bumper reaches past the middle: "
+                           "a hit this close to the middle closes both switches (estimate)"),
+        "bumper_wrap": (0.02, 0.0, 1.0, "m each front bumper wraps round its corner (estimate)"),
+        "switch_travel": (0.001, 0.0, 0.05, "m an obstacle may be from a bumper and still close it"),
+        "gyration_radius": (0.07, 0.005, 2.0, "m; how a corner push splits into shift and turn (estimate)"),
+    },
+    "motor": {
+        "levels": (8, 1, 64, "speed levels: the table's 1..8 are duty level/8 (ROBO Interface PWM)"),
+        "speed_per_volt": (0.0, 0.0, 10.0, "wheel m/s per volt above friction; 0 = calibrate from spin"),
+        "friction_volts": (0.3, 0.0, 5.0, "volts a motor needs before it turns at all (estimate)"),
+        "time_constant": (0.05, 0.0, 5.0, "s for a wheel to reach 63% of a new speed (estimate)"),
+        "spin_level": (2, 1, 64, "calibration: the document's Seek-Straight spin uses speed 2 ..."),
+        "spin_ticks": (895, 1, 1_000_000, "... for 895 ticks of the timer ..."),
+        "spin_degrees": (270.0, 1.0, 100_000.0, "... and the prose says it turns 270 degrees"),
+    },
+    "battery": {
+        "charge": (1.0, 0.0, 1.0, "state of charge at the start: 1 = full, 0 = empty"),
+        # fischertechnik Accu Set (art. 34969): 8.4 V NiMH pack, i.e. 7 cells; a NiMH cell reads about
+        # 1.3 V charged and 1.0 V empty (standard NiMH figures, not a measurement of this pack).
+        "full_volts": (9.1, 1.0, 50.0, "open-circuit volts of a full pack (7 × 1.3 V NiMH)"),
+        "empty_volts": (7.0, 0.5, 50.0, "open-circuit volts of an empty pack (7 × 1.0 V)"),
+        "capacity_mah": (1500.0, 1.0, 1e6, "mAh (Accu Set nominal capacity, estimate)"),
+        "internal_ohms": (0.5, 0.0, 20.0, "ohms of pack and wiring: the sag under load (estimate)"),
+        "idle_amps": (0.1, 0.0, 10.0, "A the interface draws (estimate)"),
+        "motor_amps": (0.3, 0.0, 10.0, "A one motor draws at full duty under load (estimate)"),
+    },
+    "encoder": {
+        # ftrobopy (setDistance docstring): "190 pulses per 3 axle turns, so 63 1/3 per turn" for the
+        # TXT encoder motor; see also ../shared/notes/fischertechnik.md. Wheels sit on the output shaft.
+        "pulses_per_turn": (190 / 3, 1.0, 100_000.0, "pulses per wheel turn (encoder motor: 63⅓)"),
+    },
+    "light": {
+        "forward": (0.11, -2.0, 2.0, "m from the axle centre to the phototransistors (estimate)"),
+        "sideways": (0.03, 0.0, 2.0, "m each phototransistor sits right/left of the middle (estimate)"),
+        "toe_out": (10.0, 0.0, 90.0, "degrees each one points outward, so they see different sides"),
+        "half_response": (20.0, 0.5, 89.0, "degrees off its axis at which a sensor gets half the light"),
+        "field_of_view": (40.0, 1.0, 90.0, "degrees off axis beyond which it sees nothing (lens tube)"),
+        "near": (0.05, 0.001, 1.0, "m; closer lamps count as this close (no infinite readings)"),
+    },
+    "noise": {
+        "motor_spread": (0.02, 0.0, 0.5, "relative sd of each motor's speed factor, drawn once per run"),
+        "motor": (0.01, 0.0, 0.5, "relative sd of motor speed, drawn every tick"),
+        "light": (0.05, 0.0, 0.5, "relative sd of light readings, drawn every tick"),
+    },
+}
+SECTIONS = (*DEFAULTS, "wiring")
+#: Which robot names play which part; the document's BumberBot wiring.
+WIRING: dict[str, str] = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
+                          "rear": "I5", "light_right": "I7", "light_left": "I8"}
+INPUT_ROLES = ("front_right", "front_left", "rear", "light_right", "light_left")  # layout B_* order
+
+
+@dataclass(frozen=True)
+class Params:
+    """Resolved parameters: ``values[section][key]`` plus the wiring of roles to robot names."""
+
+    values: dict[str, dict[str, Any]]
+    wiring: dict[str, str]
+
+    def __getitem__(self, section: str) -> dict[str, Any]:
+        return self.values[section]
+
+
+def check_layer(src: Source, data: dict[str, Any], prefix: str = "") -> dict[str, dict[str, Any]]:
+    """The parameter sections of one file (``[battery]`` … or ``[sim.battery]`` …), checked."""
+    layer: dict[str, dict[str, Any]] = {}
+    for section in SECTIONS:
+        if section not in data:
+            continue
+        name = prefix + section
+        table = table_of(src, (name, None, None), data[section])
+        known = tuple(WIRING) if section == "wiring" else tuple(DEFAULTS[section])
+        known_keys(src, (name, None), table, known)
+        checked: dict[str, Any] = {}
+        for key, value in table.items():
+            if key not in known:
+                continue
+            if section == "wiring":
+                if isinstance(value, str) and value:
+                    checked[key] = value
+                else:
+                    src.error((name, None, key), f"[{name}] {key} must name a robot input or motor",
+                              f'for example: {key} = "{WIRING[key]}"')
+                continue
+            default, low, high, _ = DEFAULTS[section][key]
+            got = number(src, (name, None, key), value, low, high, integer=isinstance(default, int))
+            if got is not None:
+                checked[key] = got
+        layer[section] = checked
+    return layer
+
+
+def merged(*layers: dict[str, Any]) -> Params:
+    """Defaults overlaid by each layer (already validated): ``{section: {key: value}}``."""
+    values = {sec: {k: spec[0] for k, spec in keys.items()} for sec, keys in DEFAULTS.items()}
+    wiring = dict(WIRING)
+    for layer in layers:
+        for section, keys in layer.items():
+            (wiring if section == "wiring" else values[section]).update(keys)
+    return Params(values, wiring)
+
+
+def problems(params: Params) -> list[tuple[str, str, str]]:
+    """Combinations no single value shows: (section, key, message)."""
+    found = []
+    bat, body = params["battery"], params["body"]
+    if bat["empty_volts"] >= bat["full_volts"]:
+        found.append(("battery", "empty_volts", "empty_volts must be below full_volts"))
+    if body["bumper_overlap"] > body["half_width"]:
+        found.append(("body", "bumper_overlap", "bumper_overlap must not exceed half_width"))
+    try:
+        speed_per_volt(params, 0.01)
+    except ValueError as exc:
+        found.append(("motor", "friction_volts", str(exc)))
+    return found
+
+
+def spin_speed(params: Params, tick_s: float) -> float:
+    """Wheel surface speed (m/s) the calibration spin needs: 270° in 8.95 s about the axle centre."""
+    m = params["motor"]
+    radians = math.radians(m["spin_degrees"])
+    return radians / (m["spin_ticks"] * tick_s) * params["body"]["wheel_base"] / 2
+
+
+def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> float:
+    """Battery volts under the load of motors at these speed levels (the physics core's formula)."""
+    b, m = params["battery"], params["motor"]
+    amps = b["idle_amps"] + b["motor_amps"] * sum(min(1.0, abs(v) / m["levels"]) for v in levels)
+    return b["empty_volts"] + (b["full_volts"] - b["empty_volts"]) * charge - amps * b["internal_ohms"]
+
+
+def speed_per_volt(params: Params, tick_s: float) -> float:
+    """The motor constant: given, or solved from the calibration spin on a full battery."""
+    m = params["motor"]
+    if m["speed_per_volt"] > 0:
+        return float(m["speed_per_volt"])
+    level = m["spin_level"]
+    volts = terminal_volts(params, 1.0, (level, level))
+    drive = level / m["levels"] * volts - m["friction_volts"]
+    if drive <= 0:
+        raise ValueError("the calibration spin's speed level cannot overcome friction_volts")
+    return spin_speed(params, tick_s) / drive
+
+
+def wheel_speed(params: Params, tick_s: float, level: int, charge: float, levels: tuple[int, ...]) -> float:
+    """Steady wheel speed (m/s) at a speed level, battery charge and total motor load, without noise."""
+    m = params["motor"]
+    volts = terminal_volts(params, charge, levels)
+    return speed_per_volt(params, tick_s) * max(0.0, abs(level) / m["levels"] * volts - m["friction_volts"])
+
+
+def pulses_for_turn(params: Params, degrees: float) -> float:
+    """Encoder pulses each wheel makes while the robot spins in place by ``degrees``."""
+    body = params["body"]
+    arc = math.radians(degrees) * body["wheel_base"] / 2
+    return arc / (math.pi * body["wheel_diameter"]) * params["encoder"]["pulses_per_turn"]
+
+
+def param_row(params: Params, tick_s: float) -> np.ndarray:
+    """The packed row the physics core reads (layout ``P_*``)."""
+    body, motor, bat, light, noise = (params[s] for s in ("body", "motor", "battery", "light", "noise"))
+    p = np.zeros(L.N_PARAM)
+    p[L.P_DT] = tick_s
+    p[L.P_BASE], p[L.P_WHEEL_R] = body["wheel_base"], body["wheel_diameter"] / 2
+    p[L.P_FRONT], p[L.P_REAR], p[L.P_HALF_W] = body["front"], body["rear"], body["half_width"]
+    p[L.P_OVERLAP], p[L.P_WRAP], p[L.P_GAP] = body["bumper_overlap"], body["bumper_wrap"], body["switch_travel"]
+    p[L.P_GYR2] = body["gyration_radius"] ** 2
+    p[L.P_KV], p[L.P_VF] = speed_per_volt(params, tick_s), motor["friction_volts"]
+    tau = motor["time_constant"]
+    p[L.P_ALPHA] = 1.0 if tau <= 0 else 1.0 - math.exp(-tick_s / tau)
+    p[L.P_LEVELS] = motor["levels"]
+    p[L.P_VFULL], p[L.P_VEMPTY], p[L.P_RINT] = bat["full_volts"], bat["empty_volts"], bat["internal_ohms"]
+    p[L.P_CAP] = bat["capacity_mah"] * 3.6  # ampere-seconds
+    p[L.P_IIDLE], p[L.P_IMOTOR] = bat["idle_amps"], bat["motor_amps"]
+    p[L.P_PPR] = params["encoder"]["pulses_per_turn"]
+    p[L.P_LX], p[L.P_LY], p[L.P_TOE] = light["forward"], light["sideways"], math.radians(light["toe_out"])
+    p[L.P_COS_FOV] = math.cos(math.radians(light["field_of_view"]))
+    p[L.P_EXP] = math.log(0.5) / math.log(math.cos(math.radians(light["half_response"])))
+    p[L.P_DMIN] = light["near"]
+    p[L.P_NMOTOR], p[L.P_NLIGHT] = noise["motor"], noise["light"]
+    return p

@@ -1,0 +1,423 @@
+"""All geometry and physics of the simulator: motors and battery, kinematics, collisions, bumpers, light.
+
+The core works on numpy arrays of N robots (layout in :mod:`tablebot.sim.layout`) and is compiled
+with numba, so one robot and a batch of thousands share this code. Robots do not see each other.
+
+World geometry (built by :mod:`tablebot.sim.world`):
+``verts`` (V, 2) and ``pstart`` (P+1,) are convex pieces (a wall or segment is a 2-vertex piece,
+a box a 4-vertex one); ``pbound`` (P, 3) their bounding circles; ``edges`` (E, 4) every piece's
+edges for ray casts; ``circles`` (C, 4) = x, y, r, lamp index or -1; ``lamps`` (L, 3) = x, y, intensity.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from tablebot.sim.layout import (
+    AMPS,
+    B_FL,
+    B_FR,
+    B_LIGHT_L,
+    B_LIGHT_R,
+    B_REAR,
+    BUMP_FL,
+    BUMP_FR,
+    BUMP_REAR,
+    CONTACT,
+    DIST,
+    ENC_L,
+    ENC_R,
+    GAIN_L,
+    GAIN_R,
+    LIGHT_L,
+    LIGHT_R,
+    MASK,
+    P_ALPHA,
+    P_BASE,
+    P_CAP,
+    P_COS_FOV,
+    P_DMIN,
+    P_DT,
+    P_EXP,
+    P_FRONT,
+    P_GAP,
+    P_GYR2,
+    P_HALF_W,
+    P_IIDLE,
+    P_IMOTOR,
+    P_KV,
+    P_LEVELS,
+    P_LX,
+    P_LY,
+    P_NLIGHT,
+    P_NMOTOR,
+    P_OVERLAP,
+    P_PPR,
+    P_REAR,
+    P_RINT,
+    P_TOE,
+    P_VEMPTY,
+    P_VF,
+    P_VFULL,
+    P_WHEEL_R,
+    P_WRAP,
+    PUL_L,
+    PUL_R,
+    SOC,
+    TH,
+    V_L,
+    V_R,
+    VBAT,
+    Z_LIGHT_L,
+    Z_LIGHT_R,
+    Z_MOTOR_L,
+    Z_MOTOR_R,
+    X,
+    Y,
+)
+
+RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
+TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)
+
+# --- small geometry ------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def point_segment_distance(px, py, ax, ay, bx, by):
+    """Distance from point p to segment ab."""
+    ex, ey = bx - ax, by - ay
+    length2 = ex * ex + ey * ey
+    t = 0.0 if length2 == 0.0 else ((px - ax) * ex + (py - ay) * ey) / length2
+    t = min(1.0, max(0.0, t))
+    return math.hypot(px - ax - t * ex, py - ay - t * ey)
+
+
+@njit(cache=True)
+def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
+    """Whether segments ab and cd intersect (touching counts)."""
+    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    return d1 * d2 <= 0.0 and d3 * d4 <= 0.0 and not (d1 == 0.0 and d2 == 0.0)
+
+
+@njit(cache=True)
+def segment_distance(ax, ay, bx, by, cx, cy, dx, dy):
+    """Distance between segments ab and cd (0 when they cross)."""
+    if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
+        return 0.0
+    return min(point_segment_distance(ax, ay, cx, cy, dx, dy), point_segment_distance(bx, by, cx, cy, dx, dy),
+               point_segment_distance(cx, cy, ax, ay, bx, by), point_segment_distance(dx, dy, ax, ay, bx, by))
+
+
+@njit(cache=True)
+def body_corners(s, p, out):
+    """The body rectangle's corners in world coordinates: front-right, front-left, rear-left, rear-right."""
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
+    for k, (bx, by) in enumerate(((f, -w), (f, w), (r, w), (r, -w))):
+        out[k, 0] = s[X] + c * bx - sn * by
+        out[k, 1] = s[Y] + sn * bx + c * by
+
+
+@njit(cache=True)
+def bounding_radius(p):
+    return math.hypot(max(p[P_FRONT], p[P_REAR]), p[P_HALF_W])
+
+
+# --- contacts ------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def piece_contact(s, corners, verts, a, b):
+    """Separating-axis test of the body against convex piece verts[a:b].
+
+    Returns (depth, dx, dy, px, py): push the robot by depth along (dx, dy); (px, py) is where they
+    touch. depth <= 0 means apart. Piece axes are tried first so that a face-to-face touch is taken
+    on the piece's normal and its contact point lies between the touching corners.
+    """
+    ux, uy = math.cos(s[TH]), math.sin(s[TH])
+    k = b - a
+    n_piece = 1 if k == 2 else k
+    best, dx, dy, robot_axis = 1e300, 0.0, 0.0, False
+    for ai in range(n_piece + 2):
+        if ai < n_piece:
+            j0, j1 = a + ai, a + (ai + 1) % k
+            ex, ey = verts[j1, 0] - verts[j0, 0], verts[j1, 1] - verts[j0, 1]
+            length = math.hypot(ex, ey)
+            if length == 0.0:
+                continue
+            ax, ay = -ey / length, ex / length
+        elif ai == n_piece:
+            ax, ay = ux, uy
+        else:
+            ax, ay = -uy, ux
+        rmin, rmax = 1e300, -1e300
+        for m in range(4):
+            q = corners[m, 0] * ax + corners[m, 1] * ay
+            rmin, rmax = min(rmin, q), max(rmax, q)
+        pmin, pmax = 1e300, -1e300
+        for j in range(a, b):
+            q = verts[j, 0] * ax + verts[j, 1] * ay
+            pmin, pmax = min(pmin, q), max(pmax, q)
+        back, ahead = rmax - pmin, pmax - rmin  # push along -axis by back, or along +axis by ahead
+        if back <= 0.0 or ahead <= 0.0:
+            return 0.0, 0.0, 0.0, 0.0, 0.0
+        overlap = min(back, ahead)
+        if overlap < best - (TIE if ai >= n_piece else 0.0):
+            best, robot_axis = overlap, ai >= n_piece
+            dx, dy = (-ax, -ay) if back < ahead else (ax, ay)
+    # the touching features: robot corners deepest against -d, or piece vertices deepest along d
+    px = py = 0.0
+    count = 0
+    if robot_axis:
+        top = -1e300
+        for j in range(a, b):
+            top = max(top, verts[j, 0] * dx + verts[j, 1] * dy)
+        for j in range(a, b):
+            if verts[j, 0] * dx + verts[j, 1] * dy >= top - TIE:
+                px, py, count = px + verts[j, 0], py + verts[j, 1], count + 1
+    else:
+        low = 1e300
+        for m in range(4):
+            low = min(low, corners[m, 0] * dx + corners[m, 1] * dy)
+        for m in range(4):
+            if corners[m, 0] * dx + corners[m, 1] * dy <= low + TIE:
+                px, py, count = px + corners[m, 0], py + corners[m, 1], count + 1
+    return best, dx, dy, px / count, py / count
+
+
+@njit(cache=True)
+def circle_contact(s, p, cx, cy, radius):
+    """Body rectangle against a circle; same result convention as :func:`piece_contact`."""
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    rx, ry = cx - s[X], cy - s[Y]
+    bx, by = c * rx + sn * ry, -sn * rx + c * ry  # circle centre in the body frame
+    f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
+    qx, qy = min(f, max(r, bx)), min(w, max(-w, by))
+    if qx == bx and qy == by:  # centre inside the body: leave through the nearest face
+        faces = (f - bx, bx - r, w - by, by + w)
+        normals = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
+        k = 0
+        for m in range(1, 4):
+            if faces[m] < faces[k]:
+                k = m
+        depth = faces[k] + radius
+        nbx, nby = -normals[k][0], -normals[k][1]  # the robot moves away from the centre
+        qx, qy = bx + normals[k][0] * faces[k], by + normals[k][1] * faces[k]
+    else:
+        gap = math.hypot(qx - bx, qy - by)
+        if gap >= radius:
+            return 0.0, 0.0, 0.0, 0.0, 0.0
+        depth = radius - gap
+        nbx, nby = (qx - bx) / gap, (qy - by) / gap
+    return (depth, c * nbx - sn * nby, sn * nbx + c * nby,
+            s[X] + c * qx - sn * qy, s[Y] + sn * qx + c * qy)
+
+
+@njit(cache=True)
+def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
+    """The deepest overlap of the body with any piece or circle (bounding circles prune the rest)."""
+    reach = bounding_radius(p)
+    best = (0.0, 0.0, 0.0, 0.0, 0.0)
+    for k in range(pstart.shape[0] - 1):
+        if math.hypot(pbound[k, 0] - s[X], pbound[k, 1] - s[Y]) > pbound[k, 2] + reach:
+            continue
+        hit = piece_contact(s, corners, verts, pstart[k], pstart[k + 1])
+        if hit[0] > best[0]:
+            best = hit
+    for k in range(circles.shape[0]):
+        if math.hypot(circles[k, 0] - s[X], circles[k, 1] - s[Y]) > circles[k, 2] + reach:
+            continue
+        hit = circle_contact(s, p, circles[k, 0], circles[k, 1], circles[k, 2])
+        if hit[0] > best[0]:
+            best = hit
+    return best
+
+
+@njit(cache=True)
+def resolve(s, p, corners, verts, pstart, pbound, circles):
+    """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn).
+
+    A corner touching first turns the robot about it, as a real robot pushing one bumper corner
+    against a wall swings square to it; the touching point is clamped to the body.
+    """
+    s[CONTACT] = 0.0
+    for _ in range(RESOLVE_ITERATIONS):
+        body_corners(s, p, corners)
+        depth, dx, dy, px, py = deepest_contact(s, p, corners, verts, pstart, pbound, circles)
+        if depth <= 0.0:
+            return
+        s[CONTACT] = 1.0
+        c, sn = math.cos(s[TH]), math.sin(s[TH])
+        rx, ry = px - s[X], py - s[Y]
+        bx = min(p[P_FRONT], max(-p[P_REAR], c * rx + sn * ry))
+        by = min(p[P_HALF_W], max(-p[P_HALF_W], -sn * rx + c * ry))
+        rx, ry = c * bx - sn * by, sn * bx + c * by
+        arm = rx * dy - ry * dx  # turning leverage of the push about the axle centre
+        weight = 1.0 + arm * arm / p[P_GYR2]
+        s[X] += dx * depth / weight
+        s[Y] += dy * depth / weight
+        s[TH] += arm / p[P_GYR2] * depth / weight
+
+
+# --- sensing -------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def near_plate(s, p, x0, y0, x1, y1, verts, pstart, pbound, circles):
+    """Whether anything lies within the switch travel of a bumper plate given in the body frame."""
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    ax, ay = s[X] + c * x0 - sn * y0, s[Y] + sn * x0 + c * y0
+    bx, by = s[X] + c * x1 - sn * y1, s[Y] + sn * x1 + c * y1
+    gap, reach = p[P_GAP], bounding_radius(p) + p[P_GAP]
+    for k in range(pstart.shape[0] - 1):
+        if math.hypot(pbound[k, 0] - s[X], pbound[k, 1] - s[Y]) > pbound[k, 2] + reach:
+            continue
+        a, b = pstart[k], pstart[k + 1]
+        n_edges = 1 if b - a == 2 else b - a
+        for j in range(n_edges):
+            j0, j1 = a + j, a + (j + 1) % (b - a)
+            if segment_distance(ax, ay, bx, by, verts[j0, 0], verts[j0, 1], verts[j1, 0], verts[j1, 1]) <= gap:
+                return True
+    for k in range(circles.shape[0]):
+        if point_segment_distance(circles[k, 0], circles[k, 1], ax, ay, bx, by) <= circles[k, 2] + gap:
+            return True
+    return False
+
+
+@njit(cache=True)
+def sense_bumpers(s, p, verts, pstart, pbound, circles):
+    """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and rear."""
+    f, r, w, ov, wrap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP]
+    fr = (near_plate(s, p, f, -w, f, ov, verts, pstart, pbound, circles)
+          or near_plate(s, p, f - wrap, -w, f, -w, verts, pstart, pbound, circles))
+    fl = (near_plate(s, p, f, -ov, f, w, verts, pstart, pbound, circles)
+          or near_plate(s, p, f - wrap, w, f, w, verts, pstart, pbound, circles))
+    rear = near_plate(s, p, r, -w, r, w, verts, pstart, pbound, circles)
+    s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
+
+
+@njit(cache=True)
+def shadowed(sx, sy, lx, ly, lamp, edges, circles):
+    """Whether a wall, obstacle edge or circle blocks the straight line from sensor to lamp."""
+    for k in range(edges.shape[0]):
+        if segments_cross(sx, sy, lx, ly, edges[k, 0], edges[k, 1], edges[k, 2], edges[k, 3]):
+            return True
+    for k in range(circles.shape[0]):
+        if int(circles[k, 3]) != lamp and point_segment_distance(
+                circles[k, 0], circles[k, 1], sx, sy, lx, ly) < circles[k, 2]:
+            return True
+    return False
+
+
+@njit(cache=True)
+def light_at(s, p, side, edges, circles, lamps):
+    """Light one phototransistor receives: sum of intensity / d² × cos(angle)^k over unshadowed lamps.
+
+    The response fades to zero over the last quarter of the field of view (a lens tube's edge).
+    """
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    lx, ly = p[P_LX], side * p[P_LY]
+    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly
+    aim = s[TH] + side * p[P_TOE]
+    ax, ay = math.cos(aim), math.sin(aim)
+    total = 0.0
+    for k in range(lamps.shape[0]):
+        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
+        d = math.hypot(dx, dy)
+        cosine = 1.0 if d == 0.0 else (dx * ax + dy * ay) / d
+        if cosine <= p[P_COS_FOV]:
+            continue
+        d = max(d, p[P_DMIN])
+        # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
+        taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
+        value = lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
+        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):
+            total += value
+    return total
+
+
+# --- motors, battery, motion ---------------------------------------------------------------------
+
+
+@njit(cache=True)
+def motor(s, p, level, volts, gain, speed, enc, pul, noise):
+    """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
+
+    The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
+    """
+    duty = min(1.0, abs(level) / p[P_LEVELS])
+    target = np.sign(level) * s[gain] * p[P_KV] * max(0.0, duty * volts - p[P_VF]) * (1.0 + p[P_NMOTOR] * noise)
+    s[speed] += (target - s[speed]) * p[P_ALPHA]
+    before = s[enc]
+    s[enc] += abs(s[speed]) * p[P_DT] / (2.0 * math.pi * p[P_WHEEL_R]) * p[P_PPR]
+    s[pul] = math.floor(s[enc]) - math.floor(before)
+
+
+@njit(cache=True)
+def drive(s, cmd, p, z):
+    """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
+    dt = p[P_DT]
+    duty = (min(1.0, abs(cmd[0]) / p[P_LEVELS]) + min(1.0, abs(cmd[1]) / p[P_LEVELS]))
+    amps = p[P_IIDLE] + p[P_IMOTOR] * duty
+    volts = p[P_VEMPTY] + (p[P_VFULL] - p[P_VEMPTY]) * s[SOC] - amps * p[P_RINT]
+    s[AMPS], s[VBAT] = amps, volts
+    s[SOC] = max(0.0, s[SOC] - amps * dt / p[P_CAP])
+    motor(s, p, cmd[0], volts, GAIN_R, V_R, ENC_R, PUL_R, z[Z_MOTOR_R])
+    motor(s, p, cmd[1], volts, GAIN_L, V_L, ENC_L, PUL_L, z[Z_MOTOR_L])
+    turn = (s[V_R] - s[V_L]) / p[P_BASE] * dt
+    ahead = 0.5 * (s[V_R] + s[V_L]) * dt
+    mid = s[TH] + 0.5 * turn  # midpoint heading: exact for straight runs and spins, close on arcs
+    s[X] += ahead * math.cos(mid)
+    s[Y] += ahead * math.sin(mid)
+    s[TH] += turn
+
+
+@njit(cache=True)
+def input_mask(s, bits):
+    """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
+    mask = 0
+    if s[BUMP_FR] > 0.0:
+        mask |= bits[B_FR]
+    if s[BUMP_FL] > 0.0:
+        mask |= bits[B_FL]
+    if s[BUMP_REAR] > 0.0:
+        mask |= bits[B_REAR]
+    if s[LIGHT_R] >= 1.0:
+        mask |= bits[B_LIGHT_R]
+    if s[LIGHT_L] >= 1.0:
+        mask |= bits[B_LIGHT_L]
+    return mask
+
+
+@njit(cache=True)
+def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move):
+    """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
+    corners = np.empty((4, 2))
+    for i in range(S.shape[0]):
+        s, p, z = S[i], P[i], Z[i]
+        if move:
+            x0, y0 = s[X], s[Y]
+            drive(s, cmd[i], p, z)
+            resolve(s, p, corners, verts, pstart, pbound, circles)
+            s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
+        sense_bumpers(s, p, verts, pstart, pbound, circles)
+        s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
+        s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
+        s[MASK] = input_mask(s, bits)
+
+
+@njit(cache=True)
+def step_one(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb, j, bits, hist, t):
+    """The single-robot runner's tick: move (unless t == 0) and sense robot 0, log its row at ``hist[t]``.
+
+    Returns the input mask for the engine's next tick; ``Zb[j]`` is this tick's noise, shape (N, N_NOISE).
+    """
+    step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb[j], bits, t > 0)
+    hist[t, :] = S[0, :]
+    return int(S[0, MASK])

@@ -1,0 +1,227 @@
+"""The run's pictures: ``trajectory.png`` (the path in the arena, coloured by state) and ``timeline.png``.
+
+Figures are drawn with the Agg canvas directly, never through pyplot, so they need no display.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from tablebot.sim import layout as L
+from tablebot.sim.draw import (
+    COLLISION,
+    LAMP_ON,
+    LIGHT_SEEN,
+    REACHED,
+    WALL,
+    RobotArtist,
+    draw_world,
+    state_colours,
+    state_label,
+    state_names,
+)
+from tablebot.sim.runner import Result, trace_lines
+from tablebot.sim.summary import Summary
+
+DPI = 150
+
+
+def title_of(result: Result) -> str:
+    robot, world = result.setup.table.robot.name, result.setup.world.name
+    return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
+
+
+def subtitle_of(summary: Summary) -> str:
+    def when(v: float | None) -> str:
+        return "never" if v is None else f"{v:.1f} s"
+    return (f"light first seen: {when(summary.first_light_s)}   ·   lamp reached: {when(summary.reached_s)}   ·   "
+            f"{summary.collisions} collision{'s' * (summary.collisions != 1)}   ·   {summary.distance_m:.2f} m driven")
+
+
+def trajectory(result: Result, summary: Summary, path: Path) -> Path:
+    """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
+    world = result.setup.world
+    xs, ys = zip(*world.walls, strict=True)
+    aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
+    fig = Figure(figsize=(11, max(4.5, 7.2 * aspect + 1.2)), dpi=DPI)
+    FigureCanvasAgg(fig)
+    ax = fig.add_axes((0.06, 0.08, 0.62, 0.8))
+    draw_world(ax, world)
+    machine, h = result.setup.machine, result.hist
+    colours = state_colours(machine.states)
+    pts = h[:, [L.X, L.Y]]
+    segments = np.stack((pts[:-1], pts[1:]), axis=1)
+    lines = LineCollection(segments, colors=[colours[s] for s in result.states.tolist()], linewidths=2.2,
+                           capstyle="round", zorder=4)
+    ax.add_collection(lines)
+    # spins in place draw no line: a dot where each state begins shows them
+    change = np.flatnonzero(np.diff(result.states)) + 1
+    ax.scatter(h[change, L.X], h[change, L.Y], s=18, c=[colours[s] for s in result.states[change].tolist()],
+               edgecolors="white", linewidths=0.6, zorder=5)
+    _markers(ax, result, summary)
+    _robot_poses(ax, result)
+    fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.06, ha="left", y=0.975)
+    fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
+    _legend(fig, result, summary)
+    fig.savefig(path, facecolor="white")
+    return path
+
+
+def _markers(ax, result: Result, summary: Summary) -> None:
+    h, front = result.hist, result.setup.params["body"]["front"]
+    for row in summary.collision_ticks:
+        x, y, th = h[row, L.X], h[row, L.Y], h[row, L.TH]
+        # mark the bumper side that touched: the nose for front hits, the tail for rear ones
+        reach = -result.setup.params["body"]["rear"] if h[row, L.BUMP_REAR] > 0 else front
+        ax.plot(x + reach * math.cos(th), y + reach * math.sin(th), marker="X", markersize=11, color=COLLISION,
+                markeredgecolor="white", markeredgewidth=1.2, zorder=9)
+    tick = result.tick_s
+    if summary.first_light_s is not None:
+        row = round(summary.first_light_s / tick)
+        ax.plot(h[row, L.X], h[row, L.Y], marker="o", markersize=12, color=LIGHT_SEEN, markeredgecolor=WALL,
+                zorder=9)
+    if summary.reached_s is not None:
+        row = round(summary.reached_s / tick)
+        ax.plot(h[row, L.X], h[row, L.Y], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
+
+
+def _robot_poses(ax, result: Result) -> None:
+    """The robot at its start (faded) and at its end, with its lamps as they were last set."""
+    h, setup = result.hist, result.setup
+    n_lamps = len(setup.lamp_outputs)
+    start = RobotArtist(ax, setup.params, n_lamps, alpha=0.35)
+    start.update(h[0, L.X], h[0, L.Y], h[0, L.TH])
+    end = RobotArtist(ax, setup.params, n_lamps)
+    last = result.outputs[-1] if result.ticks else ()
+    end.update(h[-1, L.X], h[-1, L.Y], h[-1, L.TH],
+               bumpers=(h[-1, L.BUMP_FR] > 0, h[-1, L.BUMP_FL] > 0, h[-1, L.BUMP_REAR] > 0),
+               lights=(h[-1, L.LIGHT_R] >= 1, h[-1, L.LIGHT_L] >= 1),
+               lamps=tuple(int(last[i]) for i in setup.lamp_outputs))
+
+
+def _legend(fig: Figure, result: Result, summary: Summary) -> None:
+    machine = result.setup.machine
+    names = state_names(result.setup.table)
+    colours = state_colours(machine.states)
+    handles = [Patch(color=colours[machine.states.index(state)],
+                     label=f"{state_label(state, names)}  ({secs:.1f} s)")
+               for state, secs in summary.state_seconds.items()]
+    states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
+                               bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
+    states_legend._legend_box.align = "left"
+    marks = [Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
+                    label="collision (bumper side)"),
+             Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
+                    label="light first seen"),
+             Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
+                    label=f"lamp reached (≤ {result.setup.world.reach:g} m)"),
+             Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
+                    label="a state begins (spins show as dots)"),
+             Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=15, label="lamp"),
+             Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)"),
+             Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle")]
+    fig.legend(handles=marks, loc="lower left", bbox_to_anchor=(0.70, 0.08), frameon=False, fontsize=9)
+
+
+# --- timeline ------------------------------------------------------------------------------------
+
+
+def timeline(result: Result, summary: Summary, path: Path) -> Path:
+    """State, motor speeds (and lamps), event bits and light readings against time."""
+    t = np.arange(result.ticks) * result.tick_s
+    lines = list(trace_lines(result))
+    fig = Figure(figsize=(12, 9), dpi=DPI)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.6, 1.6, 1.3], "hspace": 0.12})
+    _state_panel(axes[0], result)
+    _output_panel(axes[1], result, t)
+    _event_panel(axes[2], result, t, [line["event"] for line in lines])
+    _light_panel(axes[3], result, t)
+    for ax in axes:
+        for row in summary.collision_ticks:
+            ax.axvline(row * result.tick_s, color=COLLISION, lw=0.8, alpha=0.5, zorder=0)
+        if summary.first_light_s is not None:
+            ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
+        ax.grid(axis="x", alpha=0.3)
+    axes[-1].set_xlabel("time (s)")
+    axes[-1].set_xlim(0, max(t[-1], result.tick_s))
+    fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.07, ha="left", y=0.975)
+    fig.text(0.07, 0.935, subtitle_of(summary) + "   (red lines: collisions, dashed: first light)",
+             fontsize=10, color="#444")
+    fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
+    fig.savefig(path, facecolor="white")
+    return path
+
+
+def _state_panel(ax, result: Result) -> None:
+    machine = result.setup.machine
+    names = state_names(result.setup.table)
+    colours = state_colours(machine.states)
+    visited = sorted(set(result.states.tolist()))
+    rows = {s: k for k, s in enumerate(visited)}
+    change = np.flatnonzero(np.diff(result.states)) + 1
+    starts = np.concatenate(([0], change))
+    ends = np.concatenate((change, [result.ticks]))
+    tick = result.tick_s
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        s = int(result.states[a])
+        ax.broken_barh([(a * tick, (b - a) * tick)], (rows[s] - 0.4, 0.8), facecolors=colours[s])
+    ax.set_yticks(range(len(visited)))
+    ax.set_yticklabels([state_label(machine.states[s], names) for s in visited], fontsize=8)
+    ax.set_ylim(-0.7, len(visited) - 0.3)
+    ax.invert_yaxis()
+    ax.set_ylabel("state")
+
+
+def _output_panel(ax, result: Result, t: np.ndarray) -> None:
+    names = result.setup.machine.output_names
+    n_motors = result.setup.machine.n_motors
+    labels = result.setup.table.robot.labels
+    for k, name in enumerate(names):
+        style = "-" if k < n_motors else ":"
+        label = f"{name} ({labels[name]})" if labels.get(name) else name
+        wide = k == 0  # the first drawn wide and pale, so equal speeds show both lines
+        ax.step(t, result.outputs[:, k], where="post", lw=3.2 if wide else 1.3, alpha=0.55 if wide else 1.0,
+                ls=style, label=label)
+    ax.axhline(0, color="#999", lw=0.6)
+    ax.set_ylim(-8.9, 8.9)
+    ax.set_yticks([-8, -4, 0, 4, 8])
+    ax.set_ylabel("motor speed\n(+ forward)")
+    ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
+
+
+def _event_panel(ax, result: Result, t: np.ndarray, events: list[int]) -> None:
+    table = result.setup.table
+    ev = np.array(events, dtype=np.int64)
+    labels = table.robot.labels
+    tick, least = result.tick_s, result.ticks * result.tick_s / 500  # one-tick events stay visible
+    for k, name in enumerate(table.events):
+        on = np.concatenate(([False], (ev & table.bit(name)) != 0, [False])).astype(np.int8)
+        edges = np.flatnonzero(np.diff(on))
+        runs = [(a * tick, max((b - a) * tick, least)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+        ax.broken_barh(runs, (k - 0.38, 0.76), facecolors="#2f3640")
+    ax.set_yticks(range(len(table.events)))
+    ax.set_yticklabels([f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}" for n in table.events],
+                       fontsize=8)
+    ax.set_ylim(-0.7, len(table.events) - 0.3)
+    ax.invert_yaxis()
+    ax.set_ylabel("events")
+
+
+def _light_panel(ax, result: Result, t: np.ndarray) -> None:
+    h, wiring = result.hist[:-1], result.setup.params.wiring
+    ax.plot(t, h[:, L.LIGHT_R], lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
+    ax.plot(t, h[:, L.LIGHT_L], lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
+    ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
+    ax.set_yscale("symlog", linthresh=0.1)
+    ax.set_ylim(0, max(10.0, float(h[:, [L.LIGHT_R, L.LIGHT_L]].max()) * 1.5))
+    ax.set_ylabel("light\n(× threshold)")
+    ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)

@@ -1,0 +1,120 @@
+"""Putting a simulation together: table + robot ``[sim]`` + world → arrays the runner and physics core use.
+
+Finds the default arena, merges parameter layers (defaults < robot file < world file), checks the
+wiring of sensors and motors against the robot, and checks the start pose is free.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.machine import Machine
+from tablebot.robot import Robot
+from tablebot.sim import layout as L
+from tablebot.sim.params import INPUT_ROLES, Params, check_layer, merged, param_row, problems
+from tablebot.sim.physics import body_corners, deepest_contact
+from tablebot.sim.tomlsrc import Source
+from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
+from tablebot.table import Table
+
+SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
+
+
+@dataclass(frozen=True)
+class Setup:
+    """Everything fixed for one run: the machine, the world, the parameters and their packed arrays."""
+
+    table: Table
+    machine: Machine
+    world: World
+    params: Params
+    geometry: Geometry
+    P: np.ndarray  # (1, N_PARAM)
+    bits: np.ndarray  # (N_BITS,) event bits of the sensors, 0 = not wired
+    drive: tuple[int, int]  # output indices of the right and left motor
+    pulse_columns: tuple[int, ...]  # per robot counter: state column of its motor's pulses, -1 = none
+    lamp_outputs: tuple[int, ...]  # output indices of the robot's lamps
+
+    @property
+    def tick_s(self) -> float:
+        return self.table.robot.tick_ms / 1000
+
+
+def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
+    """The robot file's ``[sim]`` parameter sections, checked, and its default world (``sim.world``)."""
+    sim = robot.sections.get("sim")
+    if not sim:
+        return {}, None
+    src = Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
+    if not isinstance(sim, dict):
+        raise fail(robot.source, "[sim] must be a table", "write [sim.battery] etc.")
+    layer = check_layer(src, sim, prefix="sim.")
+    world = sim.get("world")
+    if world is not None and not isinstance(world, str):
+        src.error(("sim", None, "world"), "sim.world must be a file name", 'for example: world = "arena.toml"')
+    src.raise_if_any()
+    return layer, (Path(robot.source).parent / world) if isinstance(world, str) else None
+
+
+def find_world(table: Table, world_path: Path | None, robot_world: Path | None) -> World:
+    """--world, else the robot's sim.world, else arena.toml beside the table, else an empty room."""
+    for candidate in (world_path, robot_world):
+        if candidate is not None:
+            return load_world(candidate)
+    beside = Path(table.path).parent / "arena.toml"
+    return load_world(beside) if beside.is_file() else default_world()
+
+
+def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None = None,
+            overrides: dict[str, Any] | None = None) -> Setup:
+    """Check that robot, table and world fit together and pack them for the physics core."""
+    params = merged(robot_params or {}, world.params, overrides or {})
+    errors = [Diagnostic(world.path, world.line(section, key), msg, "fix the value in the world or robot file")
+              for section, key, msg in problems(params)]
+    errors += _wiring_errors(params, table.robot, world)
+    if errors:
+        raise TableBotError(errors)
+    tick_s = table.robot.tick_ms / 1000
+    P = param_row(params, tick_s)[None, :]
+    geo = geometry(world)
+    _check_start(world, geo, P)
+    outputs = machine.output_names
+    robot = table.robot
+    bits = np.array([machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES], dtype=np.int64)
+    motor_roles = {params.wiring["right_motor"]: "right_motor", params.wiring["left_motor"]: "left_motor"}
+    columns = tuple(SIDE_COLUMNS[motor_roles[c.motor]] if c.motor in motor_roles else -1 for c in robot.counters)
+    return Setup(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
+                 drive=(outputs.index(params.wiring["right_motor"]), outputs.index(params.wiring["left_motor"])),
+                 pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps))
+
+
+def _wiring_errors(params: Params, robot: Robot, world: World) -> list[Diagnostic]:
+    errors = []
+    for role, name in params.wiring.items():
+        wanted = robot.motors if role.endswith("motor") else robot.inputs
+        if name not in wanted:
+            kind = "motor" if role.endswith("motor") else "input"
+            errors.append(Diagnostic(
+                world.path if "wiring" in world.params else robot.source, world.line("wiring", role),
+                f"wiring: {role} = {name!r} is not a {kind} of robot {robot.name}",
+                f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} in the world "
+                f"or [sim.wiring] in the robot file"))
+    return errors
+
+
+def _check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
+    x, y, heading = world.start
+    s = np.zeros(L.N_STATE)
+    s[L.X], s[L.Y], s[L.TH] = x, y, np.radians(heading)
+    corners = np.empty((4, 2))
+    body_corners(s, P[0], corners)
+    hit = deepest_contact(s, P[0], corners, geo.verts, geo.pstart, geo.pbound, geo.circles)
+    if hit[0] > 1e-9:
+        raise fail(world.path, f"the robot at its start pose ({x:g}, {y:g}, heading {heading:g}°) overlaps "
+                   f"a wall or obstacle near ({hit[3]:.2f}, {hit[4]:.2f})",
+                   "move [start] at, or turn it with heading", world.line("start", "at"))

@@ -1,0 +1,282 @@
+"""World files: the arena a simulated robot drives in (walls, obstacles, lamps, start pose), read and checked.
+
+A world is TOML; ``examples/bumberbot/arena.toml`` is the commented reference. Lengths are metres,
+angles degrees (0 = +x, counter-clockwise). Besides geometry a world may hold the same parameter
+sections as a robot file's ``[sim]`` ([body], [motor], [battery], [encoder], [light], [noise],
+[wiring]); they win over the robot's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tablebot.sim.params import SECTIONS, check_layer
+from tablebot.sim.tomlsrc import Source, known_keys, number, point, table_of
+
+TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", *SECTIONS)
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Lamp:
+    at: Point
+    intensity: float = 3.0  # threshold units at 1 m, straight ahead: seen on-axis up to √3 ≈ 1.7 m
+    radius: float = 0.04  # its base is an obstacle; 0 = a lamp hanging in the air
+
+
+@dataclass(frozen=True)
+class Box:
+    at: Point
+    size: Point
+    angle: float = 0.0
+
+    def corners(self) -> list[Point]:
+        c, s = math.cos(math.radians(self.angle)), math.sin(math.radians(self.angle))
+        w, h = self.size[0] / 2, self.size[1] / 2
+        corners = ((-w, -h), (w, -h), (w, h), (-w, h))
+        return [(self.at[0] + c * x - s * y, self.at[1] + s * x + c * y) for x, y in corners]
+
+
+@dataclass(frozen=True)
+class Circle:
+    at: Point
+    radius: float
+
+
+@dataclass(frozen=True)
+class Segment:
+    start: Point
+    end: Point
+
+
+@dataclass(frozen=True)
+class World:
+    """A checked world; ``params`` holds its parameter sections, ``line`` finds a key's line for errors."""
+
+    name: str
+    walls: tuple[Point, ...]
+    start: tuple[float, float, float]  # x, y, heading in degrees
+    lamps: tuple[Lamp, ...] = ()
+    boxes: tuple[Box, ...] = ()
+    circles: tuple[Circle, ...] = ()
+    segments: tuple[Segment, ...] = ()
+    reach: float = 0.25  # the lamp counts as found when the axle centre is this close
+    params: dict[str, dict[str, Any]] = field(default_factory=dict)
+    path: str = "<world>"
+    source: Source | None = field(default=None, compare=False, repr=False)
+
+    def line(self, section: str, key: str | None = None) -> int | None:
+        return self.source.line(section, None, key) if self.source else None
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A world as the physics core's arrays (see :mod:`tablebot.sim.physics`)."""
+
+    verts: np.ndarray
+    pstart: np.ndarray
+    pbound: np.ndarray
+    edges: np.ndarray
+    circles: np.ndarray
+    lamps: np.ndarray
+
+
+DEFAULT_WORLD = """\
+name = "empty room"
+[arena]
+walls = [[0, 0], [2.5, 0], [2.5, 2.0], [0, 2.0]]
+[start]
+at = [0.5, 0.5]
+heading = 30
+[[lamp]]
+at = [2.0, 1.5]
+"""
+
+
+def load_world(path: str | Path) -> World:
+    return parse_world(Source.read(path))
+
+
+def default_world() -> World:
+    return parse_world(Source.parse("<built-in empty room>", DEFAULT_WORLD))
+
+
+def parse_world(src: Source) -> World:
+    """Check every part of a world file, reporting all problems at once."""
+    data = src.data
+    known_keys(src, ("", None), data, TOP_KEYS)
+    name = data.get("name", Path(src.path).stem)
+    if not isinstance(name, str):
+        src.error(("", None, "name"), "name must be a string", 'for example: name = "living room"')
+    reach = number(src, ("", None, "reach"), data.get("reach", 0.25), 0.01, 100.0)
+    walls = _walls(src, table_of(src, ("arena", None, None), data.get("arena", {})))
+    start = _start(src, table_of(src, ("start", None, None), data.get("start", {})))
+    lamps = _many(src, data, "lamp", _lamp)
+    boxes = _many(src, data, "box", _box)
+    circles = _many(src, data, "circle", _circle)
+    segments = _many(src, data, "segment", _segment)
+    params = check_layer(src, data)
+    if walls and start:
+        _inside(src, walls, [("start", None, "at", start[:2])]
+                + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)])
+    src.raise_if_any()
+    return World(name=str(name), walls=tuple(walls), start=start, lamps=tuple(lamps),  # type: ignore[arg-type]
+                 boxes=tuple(boxes), circles=tuple(circles), segments=tuple(segments),
+                 reach=float(reach or 0.25), params=params, path=src.path, source=src)
+
+
+def _many(src: Source, data: dict[str, Any], section: str, read: Any) -> list[Any]:
+    items = data.get(section, [])
+    if isinstance(items, dict):
+        items = [items]
+    if not isinstance(items, list):
+        src.error((section, None, None), f"{section} must be written as [[{section}]] tables",
+                  "see examples/bumberbot/arena.toml")
+        return []
+    found = [read(src, i, table_of(src, (section, i, None), item)) for i, item in enumerate(items)]
+    return [item for item in found if item is not None]
+
+
+def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
+    known_keys(src, ("arena", None), arena, ("walls",))
+    raw = arena.get("walls")
+    where = ("arena", None, "walls")
+    if not isinstance(raw, list) or len(raw) < 3:
+        src.error(where, "[arena] walls must list at least three corners [x, y]",
+                  "for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]")
+        return []
+    corners = [point(src, where, p) for p in raw]
+    if any(c is None for c in corners):
+        return []
+    walls: list[Point] = corners  # type: ignore[assignment]
+    if abs(_area(walls)) < 1e-6:
+        src.error(where, "[arena] walls enclose no area", "list the corners of the room in order")
+    crossing = _self_crossing(walls)
+    if crossing:
+        src.error(where, f"[arena] walls cross themselves (wall {crossing[0] + 1} and wall {crossing[1] + 1})",
+                  "list the corners in order around the room, clockwise or counter-clockwise")
+    return walls
+
+
+def _start(src: Source, start: dict[str, Any]) -> tuple[float, float, float] | None:
+    known_keys(src, ("start", None), start, ("at", "heading"))
+    if "at" not in start:
+        src.error(("start", None, None), "[start] needs at = [x, y], the robot's axle centre",
+                  "add a [start] section with at = [0.5, 0.5] and heading = 0")
+        return None
+    at = point(src, ("start", None, "at"), start["at"])
+    heading = number(src, ("start", None, "heading"), start.get("heading", 0.0), -3600, 3600)
+    if at is None or heading is None:
+        return None
+    return at[0], at[1], float(heading)
+
+
+def _lamp(src: Source, i: int, t: dict[str, Any]) -> Lamp | None:
+    known_keys(src, ("lamp", i), t, ("at", "intensity", "radius"))
+    at = point(src, ("lamp", i, "at"), t.get("at"))
+    intensity = number(src, ("lamp", i, "intensity"), t.get("intensity", 3.0), 1e-6, 1e6)
+    radius = number(src, ("lamp", i, "radius"), t.get("radius", 0.04), 0.0, 10.0)
+    if at is None or intensity is None or radius is None:
+        return None
+    return Lamp(at, float(intensity), float(radius))
+
+
+def _box(src: Source, i: int, t: dict[str, Any]) -> Box | None:
+    known_keys(src, ("box", i), t, ("at", "size", "angle"))
+    at = point(src, ("box", i, "at"), t.get("at"))
+    size = point(src, ("box", i, "size"), t.get("size"))
+    angle = number(src, ("box", i, "angle"), t.get("angle", 0.0), -3600, 3600)
+    if size is not None and min(size) <= 0:
+        src.error(("box", i, "size"), f"[[box]] #{i + 1} size must be positive, not {list(size)}",
+                  "size = [width, depth] in metres")
+        return None
+    if at is None or size is None or angle is None:
+        return None
+    return Box(at, size, float(angle))
+
+
+def _circle(src: Source, i: int, t: dict[str, Any]) -> Circle | None:
+    known_keys(src, ("circle", i), t, ("at", "radius"))
+    at = point(src, ("circle", i, "at"), t.get("at"))
+    radius = number(src, ("circle", i, "radius"), t.get("radius"), 0.001, 100.0)
+    return None if at is None or radius is None else Circle(at, float(radius))
+
+
+def _segment(src: Source, i: int, t: dict[str, Any]) -> Segment | None:
+    known_keys(src, ("segment", i), t, ("from", "to"))
+    a = point(src, ("segment", i, "from"), t.get("from"))
+    b = point(src, ("segment", i, "to"), t.get("to"))
+    if a is not None and a == b:
+        src.error(("segment", i, "to"), f"[[segment]] #{i + 1} has no length", "give two different points")
+        return None
+    return None if a is None or b is None else Segment(a, b)
+
+
+def _area(poly: list[Point]) -> float:
+    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1], strict=True))
+
+
+def _cross(a: Point, b: Point, c: Point, d: Point) -> bool:
+    def orient(p: Point, q: Point, r: Point) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    return orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0
+
+
+def _self_crossing(poly: list[Point]) -> tuple[int, int] | None:
+    n = len(poly)
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue  # neighbours through the closing corner
+            if _cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n]):
+                return i, j
+    return None
+
+
+def inside(poly: tuple[Point, ...] | list[Point], p: Point) -> bool:
+    """Even-odd rule point-in-polygon."""
+    x, y = p
+    result = False
+    for (x0, y0), (x1, y1) in zip(poly, [*poly[1:], poly[0]], strict=True):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            result = not result
+    return result
+
+
+def _inside(src: Source, walls: list[Point], places: list[tuple[str, int | None, str, Point]]) -> None:
+    for section, index, key, at in places:
+        if not inside(walls, at):
+            src.error((section, index, key), f"{section} at {list(at)} is outside the arena walls",
+                      "move it inside the [arena] walls polygon")
+
+
+def geometry(world: World) -> Geometry:
+    """The world as convex pieces (each wall and segment a 2-vertex piece, each box a 4-vertex one)."""
+    pieces: list[list[Point]] = []
+    walls = list(world.walls)
+    pieces += [[a, b] for a, b in zip(walls, walls[1:] + walls[:1], strict=True)]
+    pieces += [[s.start, s.end] for s in world.segments]
+    pieces += [b.corners() for b in world.boxes]
+    verts = np.array([v for piece in pieces for v in piece], dtype=np.float64).reshape(-1, 2)
+    pstart = np.cumsum([0] + [len(piece) for piece in pieces]).astype(np.int64)
+    pbound = np.zeros((len(pieces), 3))
+    edges: list[tuple[float, float, float, float]] = []
+    for k, piece in enumerate(pieces):
+        arr = np.array(piece)
+        centre = arr.mean(axis=0)
+        pbound[k] = (*centre, np.hypot(*(arr - centre).T).max())
+        pairs = [(piece[0], piece[1])] if len(piece) == 2 else list(zip(piece, piece[1:] + piece[:1], strict=True))
+        edges += [(a[0], a[1], b[0], b[1]) for a, b in pairs]
+    circles = [(c.at[0], c.at[1], c.radius, -1.0) for c in world.circles]
+    circles += [(lamp.at[0], lamp.at[1], lamp.radius, float(k))
+                for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
+    lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
+    return Geometry(verts=verts, pstart=pstart, pbound=pbound,
+                    edges=np.array(edges, dtype=np.float64).reshape(-1, 4),
+                    circles=np.array(circles, dtype=np.float64).reshape(-1, 4),
+                    lamps=np.array(lamps, dtype=np.float64).reshape(-1, 3))
