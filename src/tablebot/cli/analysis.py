@@ -1,17 +1,166 @@
-"""Analysis commands: ``check`` (a table is valid, and what the checker finds in it)."""
+"""Analysis commands: ``check`` (findings and properties), ``tests`` (golden tests), ``diagram``."""
 
 from __future__ import annotations
 
+import json
+import sys
+from enum import StrEnum
 from pathlib import Path
 
+import typer
+from rich.markup import escape
+
+from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
+from tablebot.analysis.diagram import FORMATS, render
+from tablebot.analysis.finding import Finding
+from tablebot.analysis.findings import TARGETS
+from tablebot.analysis.properties import find_property_files, load_properties
+from tablebot.analysis.prove import Result
+from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, resolve_table_path
+from tablebot.diagnostics import fail
+
+COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
+
+
+class Format(StrEnum):
+    text = "text"
+    json = "json"
 
 
 @app.command("check")
 @guarded
-def check_cmd(table: Path = TABLE_ARG, robot: Path | None = ROBOT_OPT) -> None:
-    """Parse and compile a table; every problem is reported as file:line:column (exit code 2)."""
-    parsed, machine = load(table, robot)
-    console.print(f"{parsed.path}: {len(parsed.rows)} rows, {len(machine.states)} states, "
-                  f"events {' '.join(parsed.events)}, robot {parsed.robot.name}: ok")
+def check_cmd(
+    table: Path = TABLE_ARG,
+    robot: Path | None = ROBOT_OPT,
+    properties: list[Path] = typer.Option([], "--properties", "-p", help="Property file(s) (default: "
+                                          "NAME.properties.toml or properties.toml beside the table)."),
+    target: list[str] = typer.Option([], "--target", help=f"Export target to check limits for: {', '.join(TARGETS)}."),
+    strict: bool = typer.Option(False, "--strict", help="Exit with 1 when there are warnings."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="List every info finding (overlaps, ignored inputs)."),
+    fmt: Format = typer.Option(Format.text, "--format", help="text, or json for machines."),
+    cex_dir: Path = typer.Option(Path("out/check"), "--counterexamples", help="Folder for counterexample CSVs."),
+) -> None:
+    """Check a table: rows that never fire, overlaps, unreachable states, loops, properties.
+
+    Exit code 0 when clean, 1 for warnings with --strict, 2 for errors.
+    """
+    for name in target:
+        if name not in TARGETS:
+            raise fail(name, f"unknown export target {name!r}", f"targets: {', '.join(TARGETS)}")
+    _, machine = load(table, robot)
+    files = properties or find_property_files(resolve_table_path(table))
+    report = run_check(machine, load_properties(machine, files), tuple(target))
+    report.property_files = files
+    write_counterexamples(report, cex_dir)
+    if fmt == Format.json:
+        sys.stdout.write(json.dumps(report_json(report, strict), indent=2) + "\n")
+    else:
+        _print_report(report, table, verbose)
+    raise typer.Exit(report.exit_code(strict))
+
+
+def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
+    machine = report.machine
+    table = machine.table
+    console.print(f"[bold]{escape(table.path)}[/bold]: {len(table.rows)} rows, {len(machine.states)} states, "
+                  f"robot {escape(table.robot.name)}; {report.situations} situations explored")
+    hidden: dict[str, int] = {}
+    for finding in report.findings:
+        if finding.severity == "info" and not verbose:
+            hidden[finding.code] = hidden.get(finding.code, 0) + 1
+            continue
+        _print_finding(table.path, finding)
+    if report.results:
+        sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
+        console.print(f"\n[bold]properties[/bold] ({escape(sources)}):")
+        for result in report.results:
+            _print_result(report, result, table_arg, verbose)
+    counts = report.counts()
+    tail = ""
+    if hidden:
+        tail = " (" + ", ".join(f"{n} {code}" for code, n in hidden.items()) + "; --verbose lists them)"
+    console.print(f"\n{counts['error']} errors, {counts['warning']} warnings, {counts['info']} notes{tail}")
+
+
+def _print_finding(path: str, finding: Finding) -> None:
+    where = f"{path}:{finding.lines[0]}" if finding.lines else path
+    colour = COLOURS[finding.severity]
+    console.print(f"[bold]{escape(where)}[/bold]: [{colour}]{finding.severity}[/{colour}]: {escape(finding.message)}")
+    if finding.hint:
+        console.print(f"    [dim]hint:[/dim] {escape(finding.hint)}")
+
+
+def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool) -> None:
+    prop = result.prop
+    marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
+             "unknown": "[yellow]unknown [/yellow]"}
+    level = f" [dim]({prop.level})[/dim]" if result.status == "violated" and prop.level != "error" else ""
+    console.print(f"  {marks[result.status]} [bold]{escape(prop.name)}[/bold]{level}: {escape(prop.text)}")
+    if verbose or result.failed:
+        console.print(f"           [dim]{escape(prop.claim())}; {result.explored} situations[/dim]")
+    if result.detail:
+        console.print(f"           {escape(result.detail)}")
+    if prop.note and result.failed:
+        console.print(f"           note: {escape(prop.note)}")
+    path = report.counterexamples.get(prop.name)
+    if path is None:
+        return
+    kind = "example" if prop.kind == "reachable" else "counterexample"
+    shortest = "shortest " if result.exact else ""
+    console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks, written to {escape(str(path))}")
+    console.print(f"           replay: tablebot trace {escape(str(table_arg))} --inputs {escape(str(path))}")
+    if result.failed or verbose:
+        for line in story(report.machine, result):
+            console.print(f"             {escape(line)}")
+
+
+@app.command("tests")
+@guarded
+def tests_cmd(
+    table: Path = TABLE_ARG,
+    out: Path = typer.Option(..., "--out", help="Folder for the golden tests (created if missing)."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Generate golden tests: input CSVs that together fire every row that can fire, each with its
+    expected trace (JSON Lines), plus coverage.json."""
+    _, machine = load(table, robot)
+    golden = generate(machine)
+    write_golden(golden, out)
+    for seq in golden.sequences:
+        console.print(f"wrote {escape(str(out / seq.inputs_name))} and {escape(seq.trace_name)} "
+                      f"({len(seq.inputs)} ticks, {len(seq.rows)} rows)")
+    table_rows = machine.table.rows
+    console.print(f"row coverage: {len(golden.covered)} of {len(table_rows)} rows fired "
+                  f"({len(golden.fireable)} can fire at all)")
+    for index, reason in sorted(golden.reasons.items()):
+        console.print(f"  line {table_rows[index].line}: not covered: {escape(reason)}")
+    console.print(f"wrote {escape(str(out / 'coverage.json'))}")
+
+
+@app.command("diagram")
+@guarded
+def diagram_cmd(
+    table: Path = TABLE_ARG,
+    fmt: str | None = typer.Option(None, "--format", help=f"One of {', '.join(FORMATS)} (default: from "
+                                   "--out's suffix, else svg)."),
+    out: Path | None = typer.Option(None, "--out", help="File to write (default: standard output)."),
+    colour: bool = typer.Option(True, "--colour/--no-colour", help="Colour edges by motion."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Draw the state diagram (the document's Figure 1) from the table."""
+    if fmt is None:
+        suffix = out.suffix.lstrip(".").lower() if out else ""
+        fmt = {"mmd": "mermaid", "gv": "dot"}.get(suffix, suffix) if suffix else "svg"
+    if fmt not in FORMATS:
+        raise fail(fmt, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)}")
+    parsed, _ = load(table, robot)
+    data = render(parsed, fmt, colour)
+    if out is None:
+        sys.stdout.buffer.write(data)
+        sys.stdout.flush()
+        return
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_bytes(data)
+    err_console.print(f"wrote {out} ({fmt}, {len(data)} bytes)")

@@ -1,0 +1,1 @@
+"""Static and exhaustive analysis of a table: findings, properties, generated tests and diagrams."""

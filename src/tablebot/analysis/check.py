@@ -1,0 +1,152 @@
+"""One whole ``tablebot check`` run as data: findings, property results, exit code, and the
+counterexample CSVs (inputs files that ``tablebot trace`` replays)."""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tablebot.analysis.finding import Finding
+from tablebot.analysis.findings import find_all
+from tablebot.analysis.model import Model
+from tablebot.analysis.properties import Property
+from tablebot.analysis.prove import Result, check_property
+from tablebot.machine import Machine
+from tablebot.trace import TickInput, replay
+
+
+@dataclass
+class CheckReport:
+    """Everything one check found; ``counterexamples`` maps property names to written CSV files."""
+
+    machine: Machine
+    findings: list[Finding]
+    results: list[Result]
+    situations: int
+    property_files: list[Path] = field(default_factory=list)
+    counterexamples: dict[str, Path] = field(default_factory=dict)
+
+    def severity_of(self, result: Result) -> str | None:
+        """A property's failure counts as its level; an undecided one as a warning."""
+        if result.status == "violated":
+            return result.prop.level
+        return "warning" if result.status == "unknown" else None
+
+    def counts(self) -> dict[str, int]:
+        counts = {"error": 0, "warning": 0, "info": 0}
+        for f in self.findings:
+            counts[f.severity] += 1
+        for r in self.results:
+            level = self.severity_of(r)
+            if level:
+                counts[level] += 1
+        return counts
+
+    def exit_code(self, strict: bool) -> int:
+        """0 clean, 1 warnings under ``--strict``, 2 errors."""
+        counts = self.counts()
+        if counts["error"]:
+            return 2
+        return 1 if strict and counts["warning"] else 0
+
+
+def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = ()) -> CheckReport:
+    graph = Model(machine).explore()
+    findings = find_all(machine, graph, targets)
+    results = [check_property(p, machine) for p in props]
+    return CheckReport(machine, findings, results, len(graph.nodes))
+
+
+def write_counterexamples(report: CheckReport, outdir: Path) -> None:
+    """Write each counterexample (and each ``reachable`` witness) as ``outdir/NAME.csv``."""
+    for result in report.results:
+        if result.inputs:
+            path = outdir / f"{result.prop.name}.csv"
+            write_inputs(report.machine, result.inputs, path)
+            report.counterexamples[result.prop.name] = path
+
+
+def write_inputs(machine: Machine, ticks: Sequence[TickInput], path: Path) -> None:
+    """An inputs CSV as ``tablebot trace --inputs`` reads it: input names (then counter pulses),
+    one row per tick, 1 for pressed and blank for 0."""
+    robot = machine.table.robot
+    names = list(machine.input_bits)
+    counters = list(robot.counter_names)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", encoding="utf-8", newline="") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow([*names, *counters])
+        for tick in ticks:
+            cells = ["1" if tick.mask & machine.input_bits[n] else "" for n in names]
+            cells += [str(p) if p else "" for p in tick.pulses]
+            writer.writerow(cells)
+
+
+def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:
+    """What happens in a counterexample, tick by tick, with quiet stretches folded into one line."""
+    lines = list(replay(machine, result.inputs))
+    items: list[str] = []
+    quiet_from = None
+    for i, line in enumerate(lines):
+        pressed = [n for n, b in machine.input_bits.items() if line["event"] & b]
+        last = i == len(lines) - 1
+        if line["row"] is None and not pressed and not last:
+            quiet_from = i if quiet_from is None else quiet_from
+            continue
+        if quiet_from is not None:
+            items.append(_quiet(quiet_from, i - 1, lines[i - 1]))
+            quiet_from = None
+        items.append(_tick_text(machine, line, pressed) + ("   <- it shows here" if last else ""))
+    if len(items) > limit:
+        items = [items[0], f"... ({len(items) - limit + 1} more steps) ...", *items[-(limit - 2):]]
+    return items
+
+
+def _quiet(first: int, last: int, line: dict[str, Any]) -> str:
+    span = f"tick {first}" if first == last else f"ticks {first}-{last}"
+    return f"{span}: nothing pressed, nothing fires (state {line['state']}, timer counts down)"
+
+
+def _tick_text(machine: Machine, line: dict[str, Any], pressed: list[str]) -> str:
+    table = machine.table
+    what = " + ".join(pressed) if pressed else "nothing pressed"
+    if line["event"] & machine.timer_bit:
+        what += ", timer ran out"
+    outputs = " ".join(f"{n} {line[n]}" for n in machine.output_names)
+    if line["row"] is None:
+        return f"tick {line['tick']}: {what}; no row fires (state {line['state']}, {outputs})"
+    row = table.rows[line["row"]]
+    label = f" ({row.description})" if row.description else ""
+    return f"tick {line['tick']}: {what} -> line {row.line}{label} fires: state {line['state']}, {outputs}"
+
+
+def report_json(report: CheckReport, strict: bool) -> dict[str, Any]:
+    table = report.machine.table
+    return {
+        "table": table.path, "robot": table.robot.name, "rows": len(table.rows),
+        "states": len(report.machine.states), "situations_explored": report.situations,
+        "findings": [f.as_json() for f in report.findings],
+        "properties": [_result_json(report, r) for r in report.results],
+        "counts": report.counts(), "exit_code": report.exit_code(strict),
+    }
+
+
+def _result_json(report: CheckReport, result: Result) -> dict[str, Any]:
+    prop = result.prop
+    data: dict[str, Any] = {"name": prop.name, "text": prop.text, "claim": prop.claim(), "status": result.status,
+                            "level": prop.level, "note": prop.note, "source": prop.source, "line": prop.line,
+                            "situations_explored": result.explored}
+    if result.inputs:
+        path = report.counterexamples.get(prop.name)
+        data["inputs_csv"] = str(path) if path else None
+        data["ticks"] = len(result.inputs)
+        data["shows_at_tick"] = result.at_tick
+        data["shortest"] = result.exact
+    if result.state is not None:
+        data["trapped_in_state"] = result.state
+    if result.detail:
+        data["detail"] = result.detail
+    return data

@@ -1,0 +1,215 @@
+"""The small condition language of properties, parsed by hand (never eval'd) into predicates on one tick.
+
+A condition looks at one tick as the trace records it: the events of the tick (``I3``, ``T``, ``C1``),
+the row that fired (``line == 14``, ``fired``), and the state and outputs after it
+(``state == 20``, ``state in [22, 24]``, ``M1 < 0``); combine with ``and``, ``or``, ``not`` and
+parentheses. ``true`` and ``false`` are conditions too.
+"""
+
+from __future__ import annotations
+
+import operator
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from tablebot.machine import Machine
+from tablebot.table import TIMER_EVENT
+
+#: One tick as conditions see it: (event mask, fired row index or -1, state index after, outputs after).
+Obs = tuple[int, int, int, tuple[int, ...]]
+Predicate = Callable[[int, int, int, tuple[int, ...]], bool]
+
+TOKEN_RE = re.compile(r"\s*(?:(?P<num>-?\d+)|(?P<op>==|!=|<=|>=|<|>|\(|\)|\[|\]|,)|(?P<word>[A-Za-z_][\w.-]*))")
+COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
+           ">": operator.gt, ">=": operator.ge}
+KEYWORDS = {"and", "or", "not", "in", "true", "false", "state", "line", "fired"}
+
+
+class ConditionError(ValueError):
+    """A condition that does not parse or names something the table does not have."""
+
+
+@dataclass(frozen=True)
+class Condition:
+    """A parsed condition: its text, its predicate, and the input bits it reads (they must stay visible)."""
+
+    text: str
+    test: Predicate
+    input_bits: int
+
+    def __call__(self, obs: Obs) -> bool:
+        return self.test(*obs)
+
+
+def parse_condition(text: str, machine: Machine) -> Condition:
+    """Parse ``text`` against the names of ``machine``; raises :class:`ConditionError` with a hint."""
+    parser = _Parser(_tokens(text), machine)
+    test = parser.expression()
+    if parser.peek() is not None:
+        raise ConditionError(f"unexpected {parser.peek()!r} in {text!r}")
+    return Condition(text, test, parser.input_bits)
+
+
+def _tokens(text: str) -> list[str]:
+    tokens, pos = [], 0
+    text = text.strip()
+    while pos < len(text):
+        match = TOKEN_RE.match(text, pos)
+        if not match or match.end() == pos:
+            raise ConditionError(f"cannot read {text[pos:]!r} in condition {text!r}")
+        tokens.append(match.group().strip())
+        pos = match.end()
+    if not tokens:
+        raise ConditionError("the condition is empty")
+    return tokens
+
+
+class _Parser:
+    """Recursive descent: or > and > not > atom; builds closures as it goes."""
+
+    def __init__(self, tokens: list[str], machine: Machine):
+        self.tokens, self.pos, self.machine = tokens, 0, machine
+        self.input_bits = 0
+
+    def peek(self) -> str | None:
+        return self.tokens[self.pos] if self.pos < len(self.tokens) else None
+
+    def take(self, what: str = "more") -> str:
+        """The next token, whatever it is; ``what`` says what was wanted if there is none."""
+        token = self.peek()
+        if token is None:
+            raise ConditionError(f"the condition ends too early (expected {what})")
+        self.pos += 1
+        return token
+
+    def expect(self, token: str) -> None:
+        found = self.take(repr(token))
+        if found != token:
+            raise ConditionError(f"expected {token!r} but found {found!r}")
+
+    def expression(self) -> Predicate:
+        left = self.conjunction()
+        while self.peek() == "or":
+            self.take()
+            left = _or(left, self.conjunction())
+        return left
+
+    def conjunction(self) -> Predicate:
+        left = self.negation()
+        while self.peek() == "and":
+            self.take()
+            left = _and(left, self.negation())
+        return left
+
+    def negation(self) -> Predicate:
+        if self.peek() == "not":
+            self.take()
+            inner = self.negation()
+            return lambda e, r, s, o: not inner(e, r, s, o)
+        return self.atom()
+
+    def atom(self) -> Predicate:
+        token = self.take("a condition")
+        if token == "(":
+            inner = self.expression()
+            self.expect(")")
+            return inner
+        if token in ("true", "false"):
+            value = token == "true"
+            return lambda e, r, s, o: value
+        if token == "fired":
+            return lambda e, r, s, o: r >= 0
+        if token == "state":
+            return self.state_test()
+        if token == "line":
+            return self.line_test()
+        return self.name_test(token)
+
+    # --- atoms ----------------------------------------------------------------------------------
+
+    def values(self) -> list[str]:
+        """After ``==``/``!=``: one value; after ``in``: a bracketed list."""
+        if self.peek() == "in":
+            self.take()
+            self.expect("[")
+            items = [self.take("a value")]
+            while self.peek() == ",":
+                self.take()
+                items.append(self.take("a value"))
+            self.expect("]")
+            return items
+        return [self.take("a value")]
+
+    def state_test(self) -> Predicate:
+        op = self.take("== or != or in")
+        if op not in ("==", "!=", "in"):
+            raise ConditionError(f"state can be compared with ==, != or in, not {op!r}")
+        if op == "in":
+            self.pos -= 1
+        indices = frozenset(self.state_index(v) for v in self.values())
+        if op == "!=":
+            return lambda e, r, s, o: s not in indices
+        return lambda e, r, s, o: s in indices
+
+    def state_index(self, text: str) -> int:
+        states = self.machine.states
+        for index, state in enumerate(states):
+            if str(state) == text:
+                return index
+        raise ConditionError(f"there is no state {text} in the table (states: {', '.join(map(str, states))})")
+
+    def line_test(self) -> Predicate:
+        op = self.take("== or in")
+        if op not in ("==", "in"):
+            raise ConditionError(f"line can be compared with == or in, not {op!r}")
+        if op == "in":
+            self.pos -= 1
+        by_line = {row.line: row.index for row in self.machine.table.rows}
+        rows = set()
+        for value in self.values():
+            if not value.isdigit() or int(value) not in by_line:
+                raise ConditionError(f"no row of the table is on line {value}")
+            rows.add(by_line[int(value)])
+        frozen = frozenset(rows)
+        return lambda e, r, s, o: r in frozen
+
+    def name_test(self, name: str) -> Predicate:
+        machine = self.machine
+        if name == TIMER_EVENT or name in machine.input_bits or name in machine.table.robot.counter_names:
+            bit = self.event_bit(name)
+            if self.peek() in COMPARE:
+                raise ConditionError(f"{name} is an event: write just {name} (or not {name})")
+            return lambda e, r, s, o: e & bit != 0
+        if name in machine.output_names:
+            index = machine.output_names.index(name)
+            op = self.take("a comparison such as < 0")
+            if op not in COMPARE:
+                raise ConditionError(f"compare {name} with a number, like {name} < 0 or {name} == 0")
+            value = self.take("a number")
+            if not re.fullmatch(r"-?\d+", value):
+                raise ConditionError(f"{name} {op} needs a number, not {value!r}")
+            compare, number = COMPARE[op], int(value)
+            return lambda e, r, s, o: compare(o[index], number)
+        known = [TIMER_EVENT, *machine.input_bits, *machine.table.robot.counter_names, *machine.output_names]
+        raise ConditionError(f"unknown name {name!r}; use state, line, fired or one of {', '.join(known)}")
+
+    def event_bit(self, name: str) -> int:
+        machine = self.machine
+        if name == TIMER_EVENT:
+            return machine.timer_bit
+        if name in machine.input_bits:
+            self.input_bits |= machine.input_bits[name]
+            return machine.input_bits[name]
+        bit = machine.counter_bits[machine.table.robot.counter_names.index(name)]
+        if not bit:
+            raise ConditionError(f"counter {name} has no event column in the table, so it is never an event")
+        return bit
+
+
+def _and(a: Predicate, b: Predicate) -> Predicate:
+    return lambda e, r, s, o: a(e, r, s, o) and b(e, r, s, o)
+
+
+def _or(a: Predicate, b: Predicate) -> Predicate:
+    return lambda e, r, s, o: a(e, r, s, o) or b(e, r, s, o)

@@ -1,0 +1,212 @@
+"""The document's Figure 1 drawn from the table: states as nodes, rows as labelled edges (rows
+between the same two states merged), coloured by the motion they start; Graphviz or Mermaid."""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import graphviz
+
+from tablebot.analysis.names import state_label
+from tablebot.diagnostics import fail
+from tablebot.robot import StateId
+from tablebot.table import TIMER_EVENT, Row, Table
+
+FORMATS = ("svg", "png", "dot", "mermaid")
+COLOURS = {"forward": "#2e7d32", "reverse": "#c62828", "turn": "#1565c0", "stop": "#222222", "keep": "#888888"}
+
+
+@dataclass(frozen=True)
+class Action:
+    """What a group of merged rows does: a motion word, its colour class, and the timer load."""
+
+    text: str
+    motion: str
+    timer: str
+
+
+@dataclass(frozen=True)
+class Edge:
+    source: StateId
+    target: StateId
+    lines: tuple[tuple[str, Action], ...]  # (condition, action) per distinct action, in row order
+
+
+def edges(table: Table) -> list[Edge]:
+    """One edge per (state, next) pair; rows with the same action are merged into one condition."""
+    groups: dict[tuple[StateId, StateId], list[Row]] = {}
+    for row in table.rows:
+        groups.setdefault((row.state, row.next), []).append(row)
+    result = []
+    for (source, target), rows in groups.items():
+        by_action: dict[Action, list[frozenset[str]]] = {}
+        for row in rows:
+            by_action.setdefault(action(table, row), []).append(row.events)
+        lines = tuple((condition(table, sets), act) for act, sets in by_action.items())
+        result.append(Edge(source, target, lines))
+    return result
+
+
+def condition(table: Table, event_sets: Sequence[frozenset[str]]) -> str:
+    """``I3 or I4`` for rows {I3,I4}, {I3}, {I4}: a set that contains another adds nothing."""
+    minimal = [s for s in event_sets if not any(o < s for o in event_sets)]
+    unique = list(dict.fromkeys(minimal))
+    parts = ["+".join(e if e != TIMER_EVENT else "T" for e in table.events if e in s) or "always" for s in unique]
+    return " or ".join(parts)
+
+
+def action(table: Table, row: Row) -> Action:
+    text, motion = motion_of(table, row.motors)
+    extras = [f"{n}={v}" for n, v in zip(table.robot.lamps, row.lamps, strict=True) if v is not None]
+    extras += [f"{n}:={v}" for n, v in zip(table.robot.counter_names, row.counters, strict=True) if v is not None]
+    if extras:
+        text = f"{text} {' '.join(extras)}"
+    return Action(text, motion, duration(table, row.timer))
+
+
+def duration(table: Table, ticks: int) -> str:
+    if ticks == 0:
+        return ""
+    ms = ticks * table.robot.tick_ms
+    return f"{ms / 1000:g} s" if ms >= 1000 else f"{ms} ms"
+
+
+def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:
+    """A word for what the motors do, and its colour class (forward, reverse, turn, stop, keep)."""
+    if not motors or all(m is None for m in motors):
+        return "keep", "keep"
+    if any(m is None for m in motors):
+        return " ".join(f"{n} {'=' if m is None else f'{m:+d}'}" for n, m in zip(table.robot.motors, motors,
+                                                                                  strict=True)), "turn"
+    if all(m == 0 for m in motors):
+        return "stop", "stop"
+    sides = _sides(table)
+    if len(motors) != 2 or sides is None:
+        text = " ".join(f"{n} {m:+d}" for n, m in zip(table.robot.motors, motors, strict=True))
+        return text, "forward" if all(m > 0 for m in motors) else "reverse" if all(m < 0 for m in motors) else "turn"
+    left, right = motors[sides[0]], motors[sides[1]]  # type: ignore[index]
+    if left == right:
+        return (f"forward {left}", "forward") if left > 0 else (f"reverse {-left}", "reverse")
+    # The heading turns toward the slower side going forward (signed: right > left turns left).
+    toward = "left" if right > left else "right"
+    wheels = f"L{left} R{right}"
+    if left * right < 0:
+        return f"spin {toward} {wheels}", "turn"
+    if left < 0 or right < 0:
+        return f"back, turn {toward} {wheels}", "reverse"
+    return f"{'pivot' if left * right == 0 else 'curve'} {toward} {wheels}", "turn"
+
+
+def _sides(table: Table) -> tuple[int, int] | None:
+    """Indices of the left and right motor, from their labels ("left motor", "right motor")."""
+    labels = [table.robot.labels.get(m, m).lower() for m in table.robot.motors]
+    if len(labels) != 2:
+        return None
+    left = [i for i, lab in enumerate(labels) if "left" in lab]
+    right = [i for i, lab in enumerate(labels) if "right" in lab]
+    return (left[0], right[0]) if len(left) == len(right) == 1 and left != right else None
+
+
+# --- Graphviz ---------------------------------------------------------------------------------------
+
+def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
+    robot = table.robot
+    graph = graphviz.Digraph(robot.name, graph_attr={
+        "rankdir": "TB", "fontname": "Helvetica", "fontsize": "11", "nodesep": "0.35", "ranksep": "0.9",
+        "labelloc": "t", "label": f"{robot.name}: {table.path}", "pad": "0.2"})
+    graph.attr("node", shape="box", style="rounded,filled", fillcolor="#f4f4f4", fontname="Helvetica",
+               fontsize="12", color="#555555")
+    graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
+    graph.node("__start", "", shape="circle", style="filled", fillcolor="black", width="0.18")
+    for state in table.states:
+        label = state_label(table, state)
+        title = f"<<b>{html.escape(str(state))}</b>" + (f"<br/>{html.escape(label)}>" if label else ">")
+        initial = state == robot.initial_state
+        graph.node(_id(state), title, penwidth="2.5" if initial else "1",
+                   fillcolor="#fff7d6" if initial else "#f4f4f4")
+    graph.edge("__start", _id(robot.initial_state), label=f" start, timer {robot.initial_timer}")
+    for edge in edges(table):
+        first = edge.lines[0][1].motion
+        same = all(a.motion == first for _, a in edge.lines)
+        graph.edge(_id(edge.source), _id(edge.target), label=_html_label(edge, colour),
+                   color=COLOURS[first] if colour and same else "#666666",
+                   penwidth="1.6" if colour and same else "1.0")
+    graph.node("__legend", _legend(table, colour), shape="plain", fontsize="9")
+    return graph
+
+
+def _id(state: StateId) -> str:
+    return f"s_{state}"
+
+
+def _html_label(edge: Edge, colour: bool) -> str:
+    timers = {act.timer for _, act in edge.lines}
+    shared = len(edge.lines) > 1 and len(timers) == 1  # say a common timer once, not on every line
+    rows = []
+    for cond, act in edge.lines:
+        timer = f" · {act.timer}" if act.timer and not shared else ""
+        text = f"<b>{html.escape(cond)}</b> → {html.escape(act.text)}{html.escape(timer)}"
+        if colour:
+            text = f'<font color="{COLOURS[act.motion]}">{text}</font>'
+        rows.append(text)
+    if shared and next(iter(timers)):
+        rows.append(f"timer {html.escape(next(iter(timers)))}")
+    return "<" + "<br/>".join(rows) + ">"
+
+
+def _legend(table: Table, colour: bool) -> str:
+    robot = table.robot
+    cells = [f"<b>{html.escape(name)}</b> {html.escape(robot.labels.get(name, ''))}"
+             for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
+    cells.insert(0, "<b>T</b> timer ran out")
+    cells.append("times: timer loaded by the row")
+    if colour:
+        cells += [f'<font color="{c}">■ {m}</font>' for m, c in COLOURS.items()]
+    body = "".join(f'<tr><td align="left">{c}</td></tr>' for c in cells)
+    return f'<<table border="1" cellborder="0" cellspacing="1" color="#999999">{body}</table>>'
+
+
+def render(table: Table, fmt: str, colour: bool = True) -> bytes:
+    """The diagram as file contents in ``fmt`` (one of FORMATS)."""
+    if fmt == "mermaid":
+        return to_mermaid(table).encode()
+    graph = to_graphviz(table, colour)
+    if fmt == "dot":
+        return graph.source.encode()
+    try:
+        return graph.pipe(format=fmt)
+    except graphviz.ExecutableNotFound:
+        raise fail("dot", "the Graphviz program 'dot' is not installed",
+                   "install it (apt-get install graphviz, or run scripts/bootstrap.sh), "
+                   "or use --format dot or --format mermaid") from None
+    except graphviz.CalledProcessError as exc:
+        raise fail("dot", f"Graphviz failed: {exc.stderr!r}", "report this with the table attached") from None
+
+
+# --- Mermaid ----------------------------------------------------------------------------------------
+
+def to_mermaid(table: Table) -> str:
+    """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""
+    out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {_mid(table.robot.initial_state)}"]
+    for state in table.states:
+        label = state_label(table, state)
+        name = f"{state}: {label}" if label else str(state)
+        out.append(f'    state "{_mermaid_text(name)}" as {_mid(state)}')
+    for edge in edges(table):
+        parts = []
+        for cond, act in edge.lines:
+            timer = f" {act.timer}" if act.timer else ""
+            parts.append(f"{cond} / {act.text}{timer}")
+        out.append(f"    {_mid(edge.source)} --> {_mid(edge.target)}: {_mermaid_text('; '.join(parts))}")
+    return "\n".join(out) + "\n"
+
+
+def _mid(state: StateId) -> str:
+    return "s_" + "".join(ch if ch.isalnum() else "_" for ch in str(state))
+
+
+def _mermaid_text(text: str) -> str:
+    # Mermaid reads ':' and quotes as syntax inside labels; '#' starts an entity.
+    return text.replace('"', "'").replace(":", " -").replace("#", "no.")

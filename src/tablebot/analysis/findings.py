@@ -1,0 +1,241 @@
+"""What ``tablebot check`` finds in a table without any properties: rows that can never fire,
+order-dependent overlaps, unreachable states, dead ends, zero-time loops, timers that never run
+out, ignored inputs and export limits. Each finding names rows by their line in the file.
+"""
+
+from __future__ import annotations
+
+import functools
+import operator
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from tablebot import robopro
+from tablebot.analysis.finding import SEVERITIES, Finding
+from tablebot.analysis.loops import zero_time_loops
+from tablebot.analysis.model import Graph, Model
+from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, state_text
+from tablebot.diagnostics import Diagnostic
+from tablebot.machine import NO_ROW, Machine, first_match
+from tablebot.robot import StateId
+from tablebot.table import TIMER_EVENT, Row, Table
+
+#: Export targets and the function that lists what of a table the target cannot hold.
+TARGETS: dict[str, Callable[[Table], list[Diagnostic]]] = {"robopro": robopro.fit_problems}
+MAX_IGNORED_BITS = 16
+
+
+def find_all(machine: Machine, graph: Graph | None = None, targets: tuple[str, ...] = ()) -> list[Finding]:
+    """Every finding, in file order; ``graph`` is the explored model (built here if not given)."""
+    table = machine.table
+    graph = graph or Model(machine).explore()
+    shadowed = shadowed_rows(table)
+    found = [*shadowed, *overlaps(table), *ignored_inputs(machine), *zero_time_loops(graph)]
+    found += reachability(machine, graph, {f.lines[0] for f in shadowed})
+    for target in targets:
+        found += encoding(table, target)
+    order = {s: i for i, s in enumerate(SEVERITIES)}
+    return sorted(found, key=lambda f: (f.lines[0] if f.lines else 0, order[f.severity], f.code))
+
+
+def rows_of(table: Table, state: StateId) -> list[Row]:
+    return [r for r in table.rows if r.state == state]
+
+
+def _same_effect(a: Row, b: Row) -> bool:
+    return (a.next, a.motors, a.timer, a.counters, a.lamps) == (b.next, b.motors, b.timer, b.counters, b.lamps)
+
+
+# --- row order --------------------------------------------------------------------------------------
+
+def shadowed_rows(table: Table) -> list[Finding]:
+    """A row can never fire if an earlier row of its state needs a subset of its events: whenever
+    this row's events are all present, so are the earlier row's, and the earlier row wins."""
+    found = []
+    for state in table.states:
+        rows = rows_of(table, state)
+        for i, row in enumerate(rows):
+            earlier = next((q for q in rows[:i] if q.events <= row.events), None)
+            if earlier is None:
+                continue
+            needs = events_text(table, earlier.events)
+            found.append(Finding(
+                "shadowed-row", "warning",
+                f"row on line {row.line} can never fire: the earlier row on line {earlier.line} "
+                f"(same {state_text(table, state)}) needs only {needs}, so it always wins first",
+                (row.line, earlier.line), "move this row above line "
+                f"{earlier.line} if it is the more specific case, or delete it", state,
+                {"shadowed_by": earlier.line}))
+    return found
+
+
+def overlaps(table: Table) -> list[Finding]:
+    """Pairs of rows of one state that both match some event set: the earlier one wins there."""
+    found = []
+    for state in table.states:
+        rows = rows_of(table, state)
+        masks = [table.mask(r.events) for r in rows]
+        for j, later in enumerate(rows):
+            for i, first in enumerate(rows[:j]):
+                if first.events <= later.events or _same_effect(first, later):
+                    continue  # shadowing is its own finding; same effect means order cannot matter
+                both = first.events | later.events
+                winner = next(k for k in range(j + 1) if masks[k] & table.mask(both) == masks[k])
+                if winner != i:
+                    continue  # an even earlier row takes this event set: the pair never competes
+                kind = "specific before general" if later.events <= first.events else "neither contains the other"
+                found.append(Finding(
+                    "overlap", "info",
+                    f"in {state_text(table, state)}, when {events_text(table, both)} happen together, "
+                    f"the rows on lines {first.line} and {later.line} both match; line {first.line} "
+                    f"wins because it comes first ({kind})",
+                    (first.line, later.line), "", state,
+                    {"events": sorted(both, key=table.events.index), "winner": first.line}))
+    return found
+
+
+def ignored_inputs(machine: Machine) -> list[Finding]:
+    """Inputs that never change which row fires in a state (pressing them there does nothing)."""
+    table = machine.table
+    found = []
+    for index, state in enumerate(machine.states):
+        dispatch = machine.dispatch[index]
+        ignored = [name for name, bit in machine.input_bits.items() if _never_matters(dispatch, bit)]
+        if not ignored or not rows_of(table, state):
+            continue
+        names = ", ".join(event_name(table, n) for n in ignored)
+        found.append(Finding(
+            "ignored-inputs", "info", f"in {state_text(table, state)} the robot does not react to {names}",
+            (rows_of(table, state)[0].line,), "", state, {"inputs": ignored}))
+    return found
+
+
+def _never_matters(dispatch: Any, bit: int) -> bool:
+    if not dispatch.relevant & bit:
+        return True
+    relevant = dispatch.relevant
+    if relevant.bit_count() > MAX_IGNORED_BITS:
+        return False
+    sub = relevant
+    while True:
+        if dispatch[sub] != dispatch[sub ^ bit]:
+            return False
+        if sub == 0:
+            return True
+        sub = (sub - 1) & relevant
+
+
+# --- reachability -----------------------------------------------------------------------------------
+
+@dataclass
+class Seen:
+    """What the explored model says per state: the timer/counter events seen there, rows fired."""
+
+    contexts: dict[int, set[int]] = field(default_factory=dict)
+    fired: set[int] = field(default_factory=set)
+    idle_rows: dict[int, set[int]] = field(default_factory=dict)  # rows firing with no input pressed
+
+    @classmethod
+    def of(cls, graph: Graph) -> Seen:
+        seen = cls()
+        input_mask = graph.model.machine.input_mask
+        for node, (events, _, row, _) in graph.ticks():
+            seen.contexts.setdefault(node[0], set()).add(events & ~input_mask)
+            if row != NO_ROW:
+                seen.fired.add(row)
+                if not events & input_mask:
+                    seen.idle_rows.setdefault(node[0], set()).add(row)
+        return seen
+
+
+def reachability(machine: Machine, graph: Graph, shadowed_lines: set[int]) -> list[Finding]:
+    """Unreachable states, dead ends, timers that never run out, and rows that never fire."""
+    table = machine.table
+    seen = Seen.of(graph)
+    reached = graph.states()
+    found = []
+    for index, state in enumerate(machine.states):
+        rows = rows_of(table, state)
+        if index not in reached:
+            found.append(_unreachable(machine, state, rows, seen))
+            continue
+        found += _dead_end(table, state, rows, seen)
+        silent = [r for r in rows if r.index not in seen.fired and r.line not in shadowed_lines]
+        found += _never_fire(machine, index, silent, seen)
+    return found
+
+
+def _unreachable(machine: Machine, state: StateId, rows: list[Row], seen: Seen) -> Finding:
+    table = machine.table
+    into = [r for r in table.rows if r.next == state and r.state != state]
+    start = state_text(table, machine.states[machine.initial_state])
+    why = ("no row leads to it" if not into else
+           f"the rows that lead to it ({lines_text(into)}) can never fire")
+    return Finding("unreachable-state", "warning",
+                   f"{state_text(table, state)} can never be reached from the initial {start}: {why}; "
+                   f"its rows ({lines_text(rows)}) are dead",
+                   tuple(r.line for r in rows), "add a row that leads here, or delete these rows", state)
+
+
+def _dead_end(table: Table, state: StateId, rows: list[Row], seen: Seen) -> list[Finding]:
+    leaving = [r for r in rows if r.next != state]
+    if any(r.index in seen.fired for r in leaving):
+        return []
+    why = ("no row of it leads to another state" if not leaving else
+           f"the rows that lead out ({lines_text(leaving)}) can never fire")
+    return [Finding("dead-end", "warning",
+                    f"once the robot is in {state_text(table, state)} it can never leave: {why}",
+                    (rows[0].line,), "add a row that leads to another state (a timeout on T, say)", state)]
+
+
+def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> list[Finding]:
+    table = machine.table
+    state = machine.states[index]
+    contexts = seen.contexts.get(index, set())
+    waiting_for_t = [r for r in silent if TIMER_EVENT in r.events and not any(c & machine.timer_bit for c in contexts)]
+    found = []
+    if waiting_for_t:
+        busy = sorted(seen.idle_rows.get(index, set()))
+        reload = lines_text([table.rows[i] for i in busy]) if busy else "other rows"
+        found.append(Finding(
+            "timer-never-expires", "warning",
+            f"in {state_text(table, state)} the timer never runs out: on every tick a row fires first "
+            f"and reloads it ({reload}), so the {lines_text(waiting_for_t)} waiting for T can never fire",
+            tuple(r.line for r in waiting_for_t), "give the rows that fire on every tick an input to wait "
+            "for, or move them below the T rows", state))
+    for row in silent:
+        if row in waiting_for_t:
+            continue
+        found.append(Finding("row-never-fires", "warning", _why_silent(machine, index, row, contexts),
+                             (row.line,), "check the order and the events of this state's rows", state))
+    return found
+
+
+def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> str:
+    """Why a row that is not shadowed still never fires in any reachable situation."""
+    table = machine.table
+    mask = table.mask(row.events)
+    needs = mask & ~machine.input_mask
+    where = state_text(table, machine.states[index])
+    fits = [c for c in contexts if c & needs == needs]
+    if not fits:
+        missing = [e for e in mask_events(table, needs) if not any(c & table.bit(e) for c in contexts)]
+        return (f"row on line {row.line} can never fire: it needs {events_text(table, missing)}, "
+                f"which never happens while the robot is in {where}")
+    rows = machine.dispatch[index].rows
+    winners = {first_match(rows, c | (mask & machine.input_mask)) for c in fits}
+    lines = sorted(table.rows[w.index].line for w in winners if w is not None)
+    always = functools.reduce(operator.and_, fits) & ~needs
+    also = events_text(table, mask_events(table, always))
+    because = f" (in {where} there is always {also} as well)" if always else ""
+    return (f"row on line {row.line} can never fire: whenever its events happen, the row on "
+            f"line {', '.join(map(str, lines))} fires first{because}")
+
+
+# --- export limits ----------------------------------------------------------------------------------
+
+def encoding(table: Table, target: str) -> list[Finding]:
+    """What an export target cannot hold, as errors (``tablebot export`` would refuse the table)."""
+    return [Finding(f"encoding-{target}", "error", f"{target}: {d.message}",
+                    (d.line,) if d.line is not None else (), d.hint) for d in TARGETS[target](table)]

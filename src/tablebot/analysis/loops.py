@@ -1,0 +1,92 @@
+"""Zero-time loops: cycles of rows that fire on consecutive ticks with no input pressed at all, so
+the robot hops between states every tick (motors may flicker) and never waits for anything."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from tablebot.analysis.finding import Finding
+from tablebot.analysis.model import Graph, Node
+from tablebot.analysis.names import lines_text, state_text
+from tablebot.machine import NO_ROW
+
+
+def zero_time_loops(graph: Graph) -> list[Finding]:
+    """One finding per distinct set of rows that forms such a cycle in the explored model."""
+    machine = graph.model.machine
+    table = machine.table
+    edges: dict[Node, list[tuple[Node, int]]] = {}
+    for node, (events, zeroed, row, after) in graph.ticks():
+        # encoder pulses are input too: a loop that needs them does wait for something
+        if row != NO_ROW and not events & machine.input_mask and not zeroed:
+            edges.setdefault(node, []).append((after, row))
+    found, reported = [], set()
+    for component in _cycles(edges):
+        rows = frozenset(r for n in component for a, r in edges.get(n, []) if a in component)
+        if rows in reported:
+            continue
+        reported.add(rows)
+        row_objs = [table.rows[i] for i in sorted(rows)]
+        states = list(dict.fromkeys(table.rows[i].state for i in sorted(rows)))
+        trapped = not _can_escape(graph, component)
+        path = " → ".join(state_text(table, s) for s in states)
+        message = (f"zero-time loop: the {lines_text(row_objs)} fire on every tick with no input "
+                   f"pressed, so the robot cycles {path} without ever waiting")
+        message += (" and no input can ever get it out: it is stuck for good" if trapped
+                    else "; it only leaves when an input arrives")
+        found.append(Finding("zero-time-loop", "error" if trapped else "warning", message,
+                             tuple(r.line for r in row_objs),
+                             "load a timer above 0 and wait for T, or wait for an input", states[0],
+                             {"states": states}))
+    return found
+
+
+def _can_escape(graph: Graph, component: set[Node]) -> bool:
+    """Whether some tick (any inputs) leaves the loop's situations."""
+    return any(tick[3] not in component for node in component for tick in graph.model.successors(node))
+
+
+def _cycles(edges: dict[Node, list[tuple[Node, int]]]) -> Iterable[set[Node]]:
+    """Strongly connected components with at least one edge inside (iterative Tarjan)."""
+    index: dict[Node, int] = {}
+    low: dict[Node, int] = {}
+    stack: list[Node] = []
+    on_stack: set[Node] = set()
+    counter = 0
+    for root in list(edges):
+        if root in index:
+            continue
+        work = [(root, iter(edges.get(root, [])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, successors = work[-1]
+            advanced = False
+            for after, _ in successors:
+                if after not in index:
+                    index[after] = low[after] = counter
+                    counter += 1
+                    stack.append(after)
+                    on_stack.add(after)
+                    work.append((after, iter(edges.get(after, []))))
+                    advanced = True
+                    break
+                if after in on_stack:
+                    low[node] = min(low[node], index[after])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = set()
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.add(member)
+                    if member == node:
+                        break
+                if len(component) > 1 or any(a == node for a, _ in edges.get(node, [])):
+                    yield component

@@ -1,0 +1,57 @@
+"""How the analysis names things for people: states with their labels, rows by file line, event sets."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from tablebot.robot import StateId
+from tablebot.table import TIMER_EVENT, Row, Table
+
+
+def state_label(table: Table, state: StateId) -> str:
+    """A state's name: from the robot file's ``[states]``, else the description of the row that
+    fires on ``T`` alone (what the state does until its time is up), else of its first row."""
+    named = table.robot.state_names.get(state)
+    if named:
+        return named
+    rows = [r for r in table.rows if r.state == state]
+    for row in rows:
+        if row.events == frozenset({TIMER_EVENT}) and row.description:
+            return row.description
+    return next((r.description for r in rows if r.description), "")
+
+
+def state_text(table: Table, state: StateId) -> str:
+    """``state 20 (Collision Entry)``."""
+    label = state_label(table, state)
+    return f"state {state} ({label})" if label else f"state {state}"
+
+
+def event_name(table: Table, name: str) -> str:
+    """``I3 (front-right bumper)``, ``T (timer ran out)``."""
+    if name == TIMER_EVENT:
+        return "T (timer ran out)"
+    label = table.robot.labels.get(name)
+    if name in table.robot.counter_names:
+        return f"{name} (counter at 0)"
+    return f"{name} ({label})" if label else name
+
+
+def events_text(table: Table, events: Iterable[str], short: bool = False) -> str:
+    """Events in column order joined with "and"; ``nothing`` for none."""
+    ordered = [e for e in table.events if e in set(events)]
+    if not ordered:
+        return "nothing"
+    return " and ".join(ordered if short else [event_name(table, e) for e in ordered])
+
+
+def mask_events(table: Table, mask: int) -> list[str]:
+    return [e for e in table.events if mask & table.bit(e)]
+
+
+def lines_text(rows: Iterable[Row]) -> str:
+    """``line 4`` or ``lines 4, 7 and 9``."""
+    numbers = sorted({r.line for r in rows})
+    if len(numbers) == 1:
+        return f"line {numbers[0]}"
+    return "lines " + ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}"

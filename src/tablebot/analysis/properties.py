@@ -1,0 +1,194 @@
+"""Properties of a table: what they say, where they come from, and how to read them from TOML.
+
+A property file (or the robot file's ``[properties]`` section) holds named tables; each has a
+``text`` for people and exactly one kind of claim (see ``docs/checking.md``)::
+
+    [front_bumper_stops]
+    text = "whenever a front bumper is pressed, within 1 tick both motors are stopped or reversing"
+    when = "I3 or I4"
+    then = "M1 <= 0 and M2 <= 0"
+    within = "1 tick"            # or "10 ms", "0.5 s", or a bare number of ticks
+
+Kinds: ``never = COND``, ``always = COND``, ``reachable = COND`` (it can happen),
+``always_reachable = COND`` (from every situation some inputs still make it happen) and
+``when``/``then``/``within`` (a bounded response). ``level = "warning"`` makes a violation a
+warning instead of an error; ``note`` is shown with the result. Nothing is ever executed.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
+from tablebot.diagnostics import Collector, TableBotError, fail
+from tablebot.machine import Machine
+
+KINDS = ("never", "always", "reachable", "always_reachable", "when")
+KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
+LEVELS = ("error", "warning")
+DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(ticks?|ms|s)\s*$")
+PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
+
+
+@dataclass(frozen=True)
+class Property:
+    """One claim about every run of the table; ``cond`` for single-condition kinds, else when/then."""
+
+    name: str
+    text: str
+    kind: str
+    cond: Condition | None = None
+    when: Condition | None = None
+    then: Condition | None = None
+    within: int = 0  # ticks
+    level: str = "error"
+    note: str = ""
+    source: str = ""
+    line: int | None = None
+
+    @property
+    def watch(self) -> int:
+        """Input bits the property reads: the model keeps ticks that differ in them apart."""
+        return sum(c.input_bits for c in (self.cond, self.when, self.then) if c is not None)
+
+    @property
+    def horizon(self) -> int:
+        """Timer values the model must keep exact for this property (see the model's docstring)."""
+        return self.within + 1 if self.kind == "when" else 1
+
+    def claim(self) -> str:
+        """The claim in tablebot's words, e.g. ``never: state == 20 and M1 > 0``."""
+        if self.kind == "when":
+            ticks = f"{self.within} tick{'' if self.within == 1 else 's'}"
+            return f"when {self.when.text}, then {self.then.text} within {ticks}"  # type: ignore[union-attr]
+        return f"{self.kind.replace('_', ' ')}: {self.cond.text}"  # type: ignore[union-attr]
+
+
+def find_property_files(table_path: Path) -> list[Path]:
+    """``NAME.properties.toml`` or ``properties.toml`` beside the table (the first that exists)."""
+    for pattern in PROPERTY_FILES:
+        candidate = table_path.parent / pattern.format(stem=table_path.stem)
+        if candidate.is_file():
+            return [candidate]
+    return []
+
+
+def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
+    """The robot file's ``[properties]`` plus every file given; all problems are reported at once."""
+    robot = machine.table.robot
+    found: list[Property] = []
+    errors = []
+    sources: list[tuple[str, dict[str, Any], str]] = []
+    if "properties" in robot.sections:
+        text = Path(robot.source).read_text(encoding="utf-8-sig") if Path(robot.source).is_file() else ""
+        sources.append((robot.source, robot.sections["properties"], text))
+    for path in files:
+        sources.append((str(path), *_read_file(path)))
+    for source, entries, text in sources:
+        out = Collector(source)
+        if not isinstance(entries, dict):
+            out.error(_line_of(text, "properties"), None, "properties must be named tables",
+                      'write [properties.my_name] (robot file) or [my_name] (properties file)')
+        else:
+            for name, entry in entries.items():
+                prop = _property(name, entry, machine, out, source, _line_of(text, name))
+                if prop is not None:
+                    found.append(prop)
+        errors.extend(out.items)
+    if errors:
+        raise TableBotError(errors)
+    return found
+
+
+def _read_file(path: Path) -> tuple[dict[str, Any], str]:
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
+    except UnicodeDecodeError:
+        raise fail(path, "not UTF-8 text", "save the file as UTF-8") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        line, col = (int(match[1]), int(match[2])) if match else (None, None)
+        message = re.sub(r"\s*\(at line.*", "", str(exc))
+        raise fail(path, f"TOML syntax: {message}", "see the property format in docs/checking.md",
+                   line, col) from None
+    if set(data) == {"properties"}:  # a robot-file section copied as it is
+        data = data["properties"]
+    return data, text
+
+
+def _line_of(text: str, name: str) -> int | None:
+    """The line of ``[name]``, ``[properties.name]`` or ``name = …`` (tomllib keeps no positions)."""
+    pattern = re.compile(rf"^\s*(\[\s*(properties\s*\.\s*)?\"?{re.escape(name)}\"?\s*\]|\"?{re.escape(name)}\"?\s*=)")
+    for number, line in enumerate(text.splitlines(), start=1):
+        if pattern.match(line):
+            return number
+    return None
+
+
+def _property(name: str, entry: Any, machine: Machine, out: Collector, source: str,
+              line: int | None) -> Property | None:
+    if not isinstance(entry, dict):
+        out.error(line, None, f"property {name!r} must be a table of keys",
+                  f'write [{name}] followed by lines like never = "state == 3"')
+        return None
+    before = len(out.items)
+    for key in entry:
+        if key not in KEYS:
+            out.error(line, None, f"property {name}: unknown key {key!r}", f"known keys: {', '.join(sorted(KEYS))}")
+    kinds = [k for k in KINDS if k in entry]
+    if len(kinds) != 1:
+        out.error(line, None, f"property {name} needs exactly one of {', '.join(KINDS)} (found {len(kinds)})",
+                  'for example: never = "state == 20 and M1 > 0"')
+        return None
+    kind = kinds[0]
+    level = entry.get("level", "error")
+    if level not in LEVELS:
+        out.error(line, None, f"property {name}: level must be error or warning, not {level!r}", "")
+
+    def condition(key: str) -> Condition | None:
+        value = entry.get(key)
+        if not isinstance(value, str):
+            out.error(line, None, f"property {name}: {key} must be a condition in quotes",
+                      f'for example: {key} = "state == 20"')
+            return None
+        try:
+            return parse_condition(value, machine)
+        except ConditionError as exc:
+            out.error(line, None, f"property {name}: {key}: {exc}", "see the condition language in docs/checking.md")
+            return None
+
+    fields: dict[str, Any] = {}
+    if kind == "when":
+        fields["when"], fields["then"] = condition("when"), condition("then")
+        fields["within"] = _duration(entry.get("within"), machine.table.robot.tick_ms, name, line, out)
+    else:
+        fields["cond"] = condition(kind)
+    if len(out.items) > before:
+        return None
+    return Property(name=name, text=str(entry.get("text", name)), kind=kind, level=level,
+                    note=str(entry.get("note", "")), source=source, line=line, **fields)
+
+
+def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collector) -> int:
+    """``within`` in ticks, from a number of ticks or a text like "10 ms", "1 tick", "0.5 s"."""
+    hint = f'write within = "100 ms" or "3 ticks" (one tick is {tick_ms} ms)'
+    if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
+        return value
+    match = DURATION_RE.match(value) if isinstance(value, str) else None
+    if match is None:
+        out.error(line, None, f"property {name}: within = {value!r} is not a duration", hint)
+        return 0
+    number, unit = float(match[1]), match[2]
+    ticks = number if unit.startswith("tick") else number * (1000 if unit == "s" else 1) / tick_ms
+    if abs(ticks - round(ticks)) > 1e-9:
+        out.error(line, None, f"property {name}: {value} is not a whole number of {tick_ms} ms ticks", hint)
+        return 0
+    return round(ticks)
