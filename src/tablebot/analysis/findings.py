@@ -15,7 +15,7 @@ from tablebot import robopro
 from tablebot.analysis.finding import SEVERITIES, Finding
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Graph, Model
-from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, state_text
+from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
 from tablebot.diagnostics import Diagnostic
 from tablebot.machine import NO_ROW, Machine, first_match
 from tablebot.robot import StateId
@@ -59,11 +59,12 @@ def shadowed_rows(table: Table) -> list[Finding]:
             earlier = next((q for q in rows[:i] if q.events <= row.events), None)
             if earlier is None:
                 continue
-            needs = events_text(table, earlier.events)
+            needs = (f"needs only {events_text(table, earlier.events)}, so it always wins first"
+                     if earlier.events else "needs no event at all, so it fires first every time")
             found.append(Finding(
                 "shadowed-row", "warning",
-                f"row on line {row.line} can never fire: the earlier row on line {earlier.line} "
-                f"(same {state_text(table, state)}) needs only {needs}, so it always wins first",
+                f"row on line {row.line} can never fire: in {state_text(table, state)} the earlier row "
+                f"on line {earlier.line} {needs}",
                 (row.line, earlier.line), "move this row above line "
                 f"{earlier.line} if it is the more specific case, or delete it", state,
                 {"shadowed_by": earlier.line}))
@@ -201,9 +202,9 @@ def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> 
         found.append(Finding(
             "timer-never-expires", "warning",
             f"in {state_text(table, state)} the timer never runs out: on every tick a row fires first "
-            f"and reloads it ({reload}), so the {lines_text(waiting_for_t)} waiting for T can never fire",
-            tuple(r.line for r in waiting_for_t), "give the rows that fire on every tick an input to wait "
-            "for, or move them below the T rows", state))
+            f"and reloads it ({reload}), so {rows_phrase(waiting_for_t)} waiting for T can never fire",
+            tuple(r.line for r in waiting_for_t), "a row that needs no input fires whenever nothing "
+            "above it matches; give it an input to wait for", state))
     for row in silent:
         if row in waiting_for_t:
             continue

@@ -7,7 +7,7 @@ from collections.abc import Iterable
 
 from tablebot.analysis.finding import Finding
 from tablebot.analysis.model import Graph, Node
-from tablebot.analysis.names import lines_text, state_text
+from tablebot.analysis.names import rows_phrase, state_text, verb
 from tablebot.machine import NO_ROW
 
 
@@ -30,8 +30,9 @@ def zero_time_loops(graph: Graph) -> list[Finding]:
         states = list(dict.fromkeys(table.rows[i].state for i in sorted(rows)))
         trapped = not _can_escape(graph, component)
         path = " → ".join(state_text(table, s) for s in states)
-        message = (f"zero-time loop: the {lines_text(row_objs)} fire on every tick with no input "
-                   f"pressed, so the robot cycles {path} without ever waiting")
+        goes = f"cycles {path}" if len(states) > 1 else f"stays in {path}"
+        message = (f"zero-time loop: {rows_phrase(row_objs)} {verb(row_objs, 'fires', 'fire')} on every "
+                   f"tick with no input pressed, so the robot {goes} without ever waiting")
         message += (" and no input can ever get it out: it is stuck for good" if trapped
                     else "; it only leaves when an input arrives")
         found.append(Finding("zero-time-loop", "error" if trapped else "warning", message,

@@ -55,3 +55,17 @@ def lines_text(rows: Iterable[Row]) -> str:
     if len(numbers) == 1:
         return f"line {numbers[0]}"
     return "lines " + ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}"
+
+
+def rows_phrase(rows: Iterable[Row]) -> str:
+    """``the row on line 4`` or ``the rows on lines 4 and 7`` (pair with :func:`verb`)."""
+    rows = list(rows)
+    return f"the row{'s' if len({r.line for r in rows}) > 1 else ''} on {lines_text(rows)}"
+
+
+def verb(rows: Iterable[Row], singular: str, plural: str) -> str:
+    return plural if len({r.line for r in rows}) > 1 else singular
+
+
+def plural(count: int, noun: str) -> str:
+    return f"{count} {noun}{'' if count == 1 else 's'}"

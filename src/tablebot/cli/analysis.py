@@ -14,6 +14,7 @@ from tablebot.analysis.check import CheckReport, report_json, run_check, story, 
 from tablebot.analysis.diagram import FORMATS, render
 from tablebot.analysis.finding import Finding
 from tablebot.analysis.findings import TARGETS
+from tablebot.analysis.names import plural
 from tablebot.analysis.properties import find_property_files, load_properties
 from tablebot.analysis.prove import Result
 from tablebot.analysis.testgen import generate, write_golden
@@ -81,7 +82,8 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
     tail = ""
     if hidden:
         tail = " (" + ", ".join(f"{n} {code}" for code, n in hidden.items()) + "; --verbose lists them)"
-    console.print(f"\n{counts['error']} errors, {counts['warning']} warnings, {counts['info']} notes{tail}")
+    console.print(f"\n{plural(counts['error'], 'error')}, {plural(counts['warning'], 'warning')}, "
+                  f"{plural(counts['info'], 'note')}{tail}")
 
 
 def _print_finding(path: str, finding: Finding) -> None:
