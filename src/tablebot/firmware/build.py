@@ -1,0 +1,93 @@
+"""``tablebot build``: the generated engine, table and wiring compiled with avr-gcc into .elf and .hex.
+
+The sources are written next to the products (``OUT/src``) so a build can be inspected or rebuilt
+by hand; avr-size gives the flash and static RAM use.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from tablebot.codegen import generate
+from tablebot.codegen.layout import Layout
+from tablebot.diagnostics import fail
+from tablebot.firmware.boards import Board, Wiring, load_board, wire
+from tablebot.firmware.cgen import board_header
+from tablebot.machine import Machine
+
+CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-Os", "-ffunction-sections", "-fdata-sections")
+FIRMWARE_MAIN = "tb_firmware.c"
+BENCH_MAIN = "tb_bench.c"
+
+
+@dataclass(frozen=True)
+class Firmware:
+    """What a build produced, and how big it is."""
+
+    elf: Path
+    hex: Path
+    board: Board
+    wiring: Wiring | None
+    layout: Layout
+    flash: int  # bytes: .text + .data
+    ram: int  # bytes of static RAM: .data + .bss (the stack comes on top)
+
+
+def tool(name: str) -> str:
+    found = shutil.which(name)
+    if not found:
+        raise fail(name, f"{name} not found", "install the AVR toolchain: apt-get install gcc-avr avr-libc "
+                   "(scripts/bootstrap.sh does it)")
+    return found
+
+
+def c_source(name: str) -> str:
+    return resources.files("tablebot.firmware").joinpath("c").joinpath(name).read_text(encoding="utf-8")
+
+
+def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "auto",
+                  main: str = FIRMWARE_MAIN) -> tuple[Wiring | None, Layout]:
+    """All C files of one firmware into ``srcdir``; the benchmark main needs no wiring."""
+    source = generate(machine, lookup)
+    source.write(srcdir)
+    wiring = None
+    if main == FIRMWARE_MAIN:
+        wiring = wire(machine.table.robot, board)
+        (srcdir / "tb_board.h").write_text(board_header(machine, wiring, source.layout), encoding="utf-8")
+        (srcdir / f"board_{board.name}.h").write_text(c_source(f"board_{board.name}.h"), encoding="utf-8")
+    (srcdir / main).write_text(c_source(main), encoding="utf-8")
+    return wiring, source.layout
+
+
+def _run(command: list[str], what: str) -> str:
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    if done.returncode:
+        raise fail(command[0], f"{what} failed:\n{done.stderr.strip()}", "report this as a tablebot bug")
+    return done.stdout
+
+
+def sizes(elf: Path) -> tuple[int, int]:
+    """(flash, static RAM) in bytes from avr-size's Berkeley format: text+data, data+bss."""
+    text, data, bss = (int(v) for v in _run([tool("avr-size"), str(elf)], "avr-size").splitlines()[1].split()[:3])
+    return text + data, data + bss
+
+
+def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto",
+          main: str = FIRMWARE_MAIN) -> Firmware:
+    """Generate, compile and link; ``outdir`` gets ``src/``, ``NAME.elf`` and ``NAME.hex``."""
+    board = load_board(board_name)
+    srcdir = outdir / "src"
+    srcdir.mkdir(parents=True, exist_ok=True)
+    wiring, layout = write_sources(machine, board, srcdir, lookup, main)
+    stem = "tablebot" if main == FIRMWARE_MAIN else "bench"
+    elf, hexfile = outdir / f"{stem}.elf", outdir / f"{stem}.hex"
+    sources = [str(srcdir / name) for name in (main, "tb_engine.c", "tb_table.c")]
+    _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS, f"-I{srcdir}",
+          "-Wl,--gc-sections", "-o", str(elf), *sources], "avr-gcc")
+    _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(elf), str(hexfile)], "avr-objcopy")
+    flash, ram = sizes(elf)
+    return Firmware(elf, hexfile, board, wiring, layout, flash, ram)

@@ -1,0 +1,161 @@
+"""The firmware's UART trace framing, both ways: frames to core trace lines (``monitor``) and back.
+
+A frame is ``0x7E TYPE PAYLOAD CHECK``; CHECK makes the 8-bit sum of TYPE, PAYLOAD and CHECK 0.
+'H' (hello, once after reset): version, table hash (u32), states (u16), rows (u16), event bytes,
+outputs, counters. 'T' (tick): tick (u16), event, row (all ones = none), state, timer (u16), one
+signed byte per output, counters (u16). Little-endian; widths come from the generated C layout.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+from tablebot.codegen.host import trace_line
+from tablebot.codegen.layout import Layout, plan
+from tablebot.machine import NO_ROW, Machine
+
+SYNC = 0x7E
+HELLO = ord("H")
+TICK = ord("T")
+VERSION = 1
+HELLO_FORMAT = "<BIHHBBB"
+HELLO_PAYLOAD = struct.calcsize(HELLO_FORMAT)
+
+
+@dataclass(frozen=True)
+class Hello:
+    """What the firmware says about itself after a reset."""
+
+    version: int
+    table_hash: int
+    n_states: int
+    n_rows: int
+    event_bytes: int
+    n_outputs: int
+    n_counters: int
+
+
+def checksum(body: bytes) -> int:
+    return -sum(body) & 0xFF
+
+
+def _frame(kind: int, payload: bytes) -> bytes:
+    body = bytes([kind]) + payload
+    return bytes([SYNC]) + body + bytes([checksum(body)])
+
+
+@dataclass
+class Decoder:
+    """Feed it UART bytes in any chunks; it returns core trace lines and notes what went wrong."""
+
+    machine: Machine
+    layout: Layout | None = None
+    hellos: list[Hello] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+    buffer: bytearray = field(default_factory=bytearray)
+    last_tick: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.layout is None:
+            self.layout = plan(self.machine)
+        lay = self.layout
+        self.n_outputs = len(self.machine.output_names)
+        self.n_counters = len(self.machine.table.robot.counters)
+        self.tick_payload = (2 + lay.event.size + lay.row.size + lay.state.size + 2
+                             + self.n_outputs + 2 * self.n_counters)
+
+    def feed(self, data: bytes) -> list[dict[str, Any]]:
+        self.buffer += data
+        lines: list[dict[str, Any]] = []
+        at = 0
+        buf = self.buffer
+        while True:
+            at = buf.find(SYNC, at)
+            if at < 0 or at + 2 > len(buf):
+                break
+            length = {HELLO: HELLO_PAYLOAD, TICK: self.tick_payload}.get(buf[at + 1])
+            if length is None:
+                at += 1  # not a frame start: resynchronise on the next sync byte
+                continue
+            end = at + 2 + length + 1
+            if end > len(buf):
+                break
+            body = bytes(buf[at + 1:end])
+            if sum(body) & 0xFF:
+                self.problems.append(f"bad checksum at byte {at} of this chunk; resynchronising")
+                at += 1
+                continue
+            line = self._frame(body[0], body[1:-1])
+            if line is not None:
+                lines.append(line)
+            at = end
+        del buf[:at if at >= 0 else len(buf)]
+        return lines
+
+    def _frame(self, kind: int, payload: bytes) -> dict[str, Any] | None:
+        if kind == HELLO:
+            hello = Hello(*struct.unpack(HELLO_FORMAT, payload))
+            self.hellos.append(hello)
+            self.last_tick = None  # the firmware restarted: its tick count starts again at 0
+            return None
+        return self._tick(payload)
+
+    def _tick(self, payload: bytes) -> dict[str, Any] | None:
+        lay = self.layout
+        assert lay is not None
+        values = []
+        at = 0
+        for size in (2, lay.event.size, lay.row.size, lay.state.size, 2):
+            values.append(int.from_bytes(payload[at:at + size], "little"))
+            at += size
+        tick16, event, row, state, timer = values
+        if state >= len(self.machine.states):
+            self.problems.append(f"tick frame names state index {state}: not this table's firmware?")
+            return None
+        outputs = [b - 256 if b > 127 else b for b in payload[at:at + self.n_outputs]]
+        at += self.n_outputs
+        counters = [int.from_bytes(payload[at + 2 * i:at + 2 * i + 2], "little") for i in range(self.n_counters)]
+        tick = self._unwrap(tick16)
+        return trace_line(self.machine, tick, event, NO_ROW if row == lay.no_row else row, state, timer,
+                          outputs, counters)
+
+    def _unwrap(self, tick16: int) -> int:
+        """Full tick numbers from their low 16 bits; a jump means frames were lost."""
+        if self.last_tick is None:
+            tick = tick16
+        else:
+            tick = self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
+            if tick != self.last_tick + 1:
+                self.problems.append(f"ticks {self.last_tick + 1}..{tick - 1} missing from the stream")
+        self.last_tick = tick
+        return tick
+
+
+def hello_frame(machine: Machine, layout: Layout) -> bytes:
+    """The hello frame the firmware of this machine sends."""
+    payload = struct.pack(HELLO_FORMAT, VERSION, layout.table_hash, len(machine.states), len(machine.rows),
+                          layout.event.size, len(machine.output_names), len(machine.table.robot.counters))
+    return _frame(HELLO, payload)
+
+
+def tick_frame(machine: Machine, layout: Layout, line: dict[str, Any]) -> bytes:
+    """One trace line as the firmware frames it (for tests and for replaying traces to a monitor)."""
+    row = layout.no_row if line["row"] is None else line["row"]
+    payload = bytearray((line["tick"] & 0xFFFF).to_bytes(2, "little"))
+    payload += line["event"].to_bytes(layout.event.size, "little")
+    payload += row.to_bytes(layout.row.size, "little")
+    payload += machine.states.index(line["state"]).to_bytes(layout.state.size, "little")
+    payload += line["timer"].to_bytes(2, "little")
+    payload += bytes(line[name] & 0xFF for name in machine.output_names)
+    for name in machine.table.robot.counter_names:
+        payload += line[name].to_bytes(2, "little")
+    return _frame(TICK, bytes(payload))
+
+
+def encode(machine: Machine, lines: Iterable[dict[str, Any]], layout: Layout | None = None) -> bytes:
+    """A whole stream: hello, then one tick frame per trace line."""
+    layout = layout or plan(machine)
+    return hello_frame(machine, layout) + b"".join(tick_frame(machine, layout, line) for line in lines)
