@@ -102,7 +102,7 @@ def test_check_undecodable_file(tmp_path):
 
 
 def test_check_with_explicit_robot(tmp_path):
-    table = write_table(tmp_path, "state,T,A,M1,timer,next\n1,1,,3,0,1\n")
+    table = write_table(tmp_path, "state,T,A,M1,timer,next\n1,,1,0,5,2\n1,1,,3,10,2\n2,1,,-3,10,1\n")
     (tmp_path / "mini.toml").write_text(MINI_ROBOT)
     assert invoke("check", table).exit_code == 2  # the built-in BumberBot has no input A
     result = invoke("check", table, "--robot", tmp_path / "mini.toml")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from core_helpers import EXAMPLE, MINI_ROBOT, example_machine, machine_of
@@ -238,3 +239,72 @@ def test_failed_restore_leaves_the_engine_as_it_was():
     with pytest.raises(ValueError):
         engine.restore({**before, "outputs": {"M1": 1}})
     assert engine.snapshot() == before
+
+
+# --- the batch path -----------------------------------------------------------------------------------
+
+def test_batch_results_as_lists_and_arrays():
+    engine = bumberbot()
+    batch = engine.run([0, I7, 0, I5])
+    assert batch.events == [T, I7, 0, I5]
+    assert batch.rows == [7, 21, NO_ROW, NO_ROW]
+    assert [engine.machine.states[s] for s in batch.states] == [1, 11, 11, 11]
+    assert batch.timers == [500, 125, 124, 123]
+    assert len(batch) == 4 and [list(a) for a in batch.arrays] == [batch.events, batch.rows, batch.states, batch.timers]
+    assert batch == bumberbot().run([0, I7, 0, I5], jit=False)
+    assert "rows=[7, 21, -1, -1]" in repr(batch)
+    assert (engine.tick, engine.event, engine.row, engine.outputs) == (4, I5, NO_ROW, (1, 5))
+
+
+@pytest.mark.parametrize("masks", [
+    [0, I3 | I4, 0, 0],
+    (0, I3 | I4, 0, 0),
+    np.array([0, I3 | I4, 0, 0], dtype=np.uint8),
+    np.array([0, I3 | I4, 0, 0], dtype=np.int32),
+    np.array([0, I3 | I4, 0, 0, 99], dtype=np.int64)[:4],
+    [0, I3 | I4 | 256, 0, 0],  # bits above the table's events are ignored, as step does
+])
+def test_batch_accepts_any_integer_sequence(masks):
+    assert bumberbot().run(masks).rows == [7, 0, NO_ROW, NO_ROW]
+
+
+def test_step_accepts_numpy_integers():
+    engine = bumberbot()
+    engine.step(np.uint8(0))
+    assert engine.step(np.int64(I7)) == (1, 5)
+
+
+def test_empty_batch_changes_nothing():
+    engine = bumberbot()
+    assert len(engine.run([])) == 0
+    assert engine.snapshot()["tick"] == 0 and engine.event == 0 and engine.row == NO_ROW
+
+
+def wide_engine(tmp_path, inputs: int) -> Engine:
+    names = [f"I{i}" for i in range(inputs)]
+    robot = 'name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'{n} = ""\n' for n in names)
+    robot += '[motors]\nM1 = ""\n'
+    rows = [f"1,{','.join('1' if j in (i, (i * 7) % inputs) else '' for j in range(inputs))},{i % 9},{i},2"
+            for i in range(inputs)]
+    rows += [f"2,{','.join('1' if j == i else '' for j in range(inputs))},-{i % 9},{i},1" for i in range(inputs)]
+    table = f"state,{','.join(names)},M1,timer,next\n" + "\n".join(rows) + "\n"
+    return Engine(machine_of(tmp_path, table, robot))
+
+
+@pytest.mark.parametrize("inputs", [10, 14])
+def test_wide_tables_batch_and_step_agree(tmp_path, inputs):
+    """10 event columns: flat lookup, masks over 255 (int64 path); 14: no flat table, Python batch."""
+    engine = wide_engine(tmp_path, inputs)
+    assert (engine.machine.flat is None) == (inputs > 10)
+    rng = np.random.default_rng(inputs)
+    masks = (rng.integers(0, 1 << inputs, 500) & rng.integers(0, 1 << inputs, 500)).tolist()
+    stepped = []
+    for mask in masks:
+        engine.step(mask)
+        stepped.append((engine.event, engine.row, engine.state, engine.timer))
+    for jit in (None, False):
+        batch = Engine(engine.machine).run(masks, jit=jit)
+        assert list(zip(batch.events, batch.rows, batch.states, batch.timers, strict=True)) == stepped
+    if inputs > 10:
+        with pytest.raises(RuntimeError, match="FLAT_BITS"):
+            Engine(engine.machine).run(masks, jit=True)

@@ -207,9 +207,10 @@ def test_compiled_engine_equals_linear_scan(spec, inputs):
 
 
 @SETTINGS
-@given(spec=specs(), inputs=ticks, split=st.integers(0, 40))
-def test_batch_path_equals_step_path(spec, inputs, split):
-    """``run(masks)`` (no pulses on that path) gives what ``step`` gives, also when the two alternate."""
+@given(spec=specs(), inputs=ticks, split=st.integers(0, 40), jit=st.booleans())
+def test_batch_path_equals_step_path(spec, inputs, split, jit):
+    """``run(masks)`` (no pulses on that path), compiled or in Python, gives what ``step`` gives,
+    also when a run resumes from where the last one stopped."""
     machine = build(spec)
     masks = [sum(machine.input_bits.get(name, 0) for name in present) for present, _ in inputs]
     stepper, batcher = Engine(machine), Engine(machine)
@@ -217,7 +218,7 @@ def test_batch_path_equals_step_path(spec, inputs, split):
     for mask in masks:
         stepper.step(mask)
         expected.append((stepper.event, stepper.row, stepper.state, stepper.timer))
-    first, second = batcher.run(masks[:split]), batcher.run(masks[split:])
+    first, second = batcher.run(masks[:split], jit=jit), batcher.run(masks[split:], jit=jit)
     got = [*zip(first.events, first.rows, first.states, first.timers, strict=True),
            *zip(second.events, second.rows, second.states, second.timers, strict=True)]
     assert got == expected

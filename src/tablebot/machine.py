@@ -9,6 +9,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
 
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Table
@@ -16,6 +19,9 @@ from tablebot.table import TIMER_EVENT, Table
 #: Per state, lookups are precomputed for every combination of the bits its rows use when there
 #: are at most this many such bits; beyond that they are computed on first use and cached.
 PREFILL_BITS = 12
+#: Tables with at most this many event columns also get one flat lookup over (state, full event
+#: mask): a single list index per tick, no masking. 10 bits = 1024 entries per state.
+FLAT_BITS = 10
 NO_ROW = -1
 
 
@@ -87,7 +93,7 @@ class Machine:
     def n_motors(self) -> int:
         return len(self.table.robot.motors)
 
-    @property
+    @cached_property
     def input_mask(self) -> int:
         return sum(self.input_bits.values())
 
@@ -99,11 +105,63 @@ class Machine:
         dispatch = self.dispatch[state]
         return dispatch[events & dispatch.relevant]
 
+    @cached_property
+    def flat(self) -> list[int] | None:
+        """Fired row (or -1) at ``state << len(events) | events`` for every state and full event mask;
+        None when the table has more than FLAT_BITS event columns (then use :meth:`lookup`)."""
+        width = len(self.table.events)
+        if width > FLAT_BITS:
+            return None
+        return [dispatch[events & dispatch.relevant] for dispatch in self.dispatch for events in range(1 << width)]
+
+    @cached_property
+    def arrays(self) -> MachineArrays | None:
+        """The machine as flat integer arrays (for compiled loops); None when :attr:`flat` is None."""
+        if self.flat is None:
+            return None
+        return MachineArrays.of(self)
+
     def signature(self) -> tuple:
         """What defines behaviour (not descriptions or file lines): equal signatures, equal machines."""
         return (self.states, self.table.events, self.timer_bit, self.counter_bits,
                 tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
                 self.initial_state, self.initial_timer, self.output_names)
+
+
+@dataclass(frozen=True)
+class MachineArrays:
+    """A machine as int64/bool arrays: what a compiled tick loop (numba, C) indexes directly.
+
+    ``lookup[state, events]`` is the fired row or -1; per row, ``outputs``/``keep`` give each output's
+    new value or "keep", ``loads``/``load_set`` each counter's load or "leave alone".
+    """
+
+    lookup: np.ndarray
+    next: np.ndarray
+    timer: np.ndarray
+    outputs: np.ndarray
+    keep: np.ndarray
+    loads: np.ndarray
+    load_set: np.ndarray
+    counter_bits: np.ndarray
+
+    @staticmethod
+    def of(machine: Machine) -> MachineArrays:
+        rows, width = machine.rows, len(machine.table.events)
+        n_out, n_counters = len(machine.output_names), len(machine.counter_bits)
+        outputs = [[0 if v is None else v for v in row.outputs] for row in rows]
+        loads = [[0 if v is None else v for v in row.loads] for row in rows]
+        return MachineArrays(
+            lookup=np.array(machine.flat, dtype=np.int64).reshape(len(machine.states), 1 << width),
+            next=np.array([row.next for row in rows], dtype=np.int64),
+            timer=np.array([row.timer for row in rows], dtype=np.int64),
+            outputs=np.array(outputs, dtype=np.int64).reshape(len(rows), n_out),
+            keep=np.array([[v is None for v in row.outputs] for row in rows], dtype=np.bool_).reshape(len(rows), n_out),
+            loads=np.array(loads, dtype=np.int64).reshape(len(rows), n_counters),
+            load_set=np.array([[v is not None for v in row.loads] for row in rows],
+                              dtype=np.bool_).reshape(len(rows), n_counters),
+            counter_bits=np.array(machine.counter_bits, dtype=np.int64).reshape(n_counters),
+        )
 
 
 def compile_table(table: Table) -> Machine:
