@@ -36,6 +36,9 @@ def sim_cmd(
     from tablebot.sim.runner import run, write_trace
     from tablebot.sim.summary import summarise
 
+    if view:
+        from tablebot.sim.animate import check_display
+        check_display()
     parsed, machine = load(table, robot)
     layer, robot_world = sim_setup.robot_layer(parsed.robot)
     the_world = sim_setup.find_world(parsed, world, robot_world)
