@@ -82,6 +82,14 @@ def test_bom_and_crlf(tmp_path):
     assert machine.signature() == example_machine().signature()
 
 
+def test_utf16_with_bom_as_excel_saves_unicode_text(tmp_path):
+    text = (EXAMPLE / "table.csv").read_text().replace(",", "\t").replace("\n", "\r\n")
+    path = tmp_path / "table.txt"
+    path.write_bytes(text.encode("utf-16"))  # with BOM
+    (tmp_path / "robot.toml").write_text((EXAMPLE / "robot.toml").read_text())
+    assert compile_table(load_table(path)).signature() == example_machine().signature()
+
+
 def test_old_mac_line_ends(tmp_path):
     text = (EXAMPLE / "table.csv").read_text().replace("\n", "\r")
     machine = machine_of(tmp_path, text, (EXAMPLE / "robot.toml").read_text())

@@ -1,11 +1,12 @@
 """Spreadsheet text as records of cells that remember their line and column.
 
-Handles what spreadsheets save: UTF-8 with or without BOM, CRLF or LF, comma, semicolon or tab
+Handles what spreadsheets save: UTF-8 with or without BOM (or UTF-16 with its BOM), CRLF or LF, comma, semicolon or tab
 separators and RFC 4180 quoting; every cell keeps its 1-based line and column for error messages.
 """
 
 from __future__ import annotations
 
+import codecs
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +39,11 @@ def read_text(path: Path) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):  # Excel's "Unicode Text" save
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            pass  # not UTF-16 after all: report it as bad UTF-8 below
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
