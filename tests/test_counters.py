@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
@@ -42,6 +43,16 @@ def test_counter_counts_its_own_motors_pulses_and_never_below_zero(tmp_path):
     assert engine.counters == [3, 0] and engine.row == NO_ROW
     engine.step(0, (7, 0))  # more pulses than left: 0, and the event fires at once
     assert engine.counters == [0, 0] and engine.row == 1
+
+
+def test_pulses_as_a_numpy_array(tmp_path):
+    import numpy as np
+    engine = Engine(machine_of(tmp_path, COUNT_DOWN, COUNTER_ROBOT))
+    for pulses in ([0, 0], np.array([1, 0]), np.array([2, 0], dtype=np.int64)):
+        engine.step(np.int64(0), pulses)
+    assert engine.row == 1 and engine.counters == [0, 0]
+    engine.step(0, np.array([0, 3]))
+    assert json.loads(json.dumps(engine.snapshot()))["counters"] == {"C1": 0, "C2": 0}
 
 
 def test_counters_ignore_pulses_on_the_first_tick(tmp_path):

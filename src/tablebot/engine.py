@@ -114,7 +114,7 @@ class Engine:
         if self.tick:
             if self.timer:
                 self.timer -= 1
-            if pulses:
+            if len(pulses):  # len, not truth: pulses may be a numpy array
                 self._count_down(pulses)
         self.tick += 1
         if not self.timer:
@@ -136,7 +136,7 @@ class Engine:
     def _count_down(self, pulses: Sequence[int]) -> None:
         counters = self.counters
         for i, count in enumerate(pulses):
-            counters[i] = max(0, counters[i] - count)
+            counters[i] = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
 
     def _fire(self, row: CompiledRow) -> None:
         if row.keeps:
