@@ -254,6 +254,8 @@ def test_batch_results_as_lists_and_arrays():
     assert batch == bumberbot().run([0, I7, 0, I5], jit=False)
     assert "rows=[7, 21, -1, -1]" in repr(batch)
     assert (engine.tick, engine.event, engine.row, engine.outputs) == (4, I5, NO_ROW, (1, 5))
+    assert json.loads(json.dumps(engine.snapshot())) == engine.snapshot()  # plain ints, not numpy ones
+    assert all(type(v) is int for v in (engine.state, engine.timer, engine.event, engine.row, *engine.outputs))
 
 
 @pytest.mark.parametrize("masks", [
