@@ -1,0 +1,91 @@
+"""Shared builders for the simulator tests: a small robot, a table of signed motor rows, a room world.
+
+Also tests that the builders themselves give a working setup (so a broken builder fails here first).
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+from tablebot.cli.common import load
+from tablebot.sim.runner import Result, run, write_trace
+from tablebot.sim.setup import Setup, find_world, prepare, robot_layer
+from tablebot.sim.world import load_world
+
+ROOT = Path(__file__).resolve().parents[1]
+BUMBERBOT = ROOT / "examples" / "bumberbot"
+
+ROBOT = """\
+name = "TestBot"
+tick_ms = 10
+initial_state = 1
+[inputs]
+I3 = "front-right bumper"
+I4 = "front-left bumper"
+I5 = "rear bumper"
+I7 = "right phototransistor"
+I8 = "left phototransistor"
+[motors]
+M1 = "right motor"
+M2 = "left motor"
+"""
+HEADER = "description,state,T,I3,I4,I5,I7,I8,M1,M2,timer,next"
+QUIET = "[noise]\nmotor_spread = 0\nmotor = 0\nlight = 0\n"
+
+
+def room(start: tuple[float, float, float] = (1.5, 1.5, 0.0), extra: str = "", noise: bool = False,
+         size: float = 3.0) -> str:
+    """A square room world (no lamp unless ``extra`` adds one); exact physics unless ``noise``."""
+    x, y, heading = start
+    text = (f'name = "test room"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
+            f"[start]\nat = [{x}, {y}]\nheading = {heading}\n{extra}\n")
+    return text if noise else text + QUIET
+
+
+def write_bot(tmp_path: Path, rows: list[str], world: str, robot: str = ROBOT) -> tuple[Path, Path]:
+    """A table of signed-motor rows (after HEADER) with its robot file, and a world file."""
+    (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
+    table = tmp_path / "table.csv"
+    table.write_text("\n".join([HEADER, *rows]) + "\n", encoding="utf-8")
+    world_path = tmp_path / "world.toml"
+    world_path.write_text(world, encoding="utf-8")
+    return table, world_path
+
+
+def setup_of(table: Path, world: Path | None = None, **overrides: dict) -> Setup:
+    parsed, machine = load(table)
+    layer, robot_world = robot_layer(parsed.robot)
+    the_world = load_world(world) if world else find_world(parsed, None, robot_world)
+    return prepare(parsed, machine, the_world, layer, overrides)
+
+
+def bot(tmp_path: Path, rows: list[str], world: str, **overrides: dict) -> Setup:
+    table, world_path = write_bot(tmp_path, rows, world)
+    return setup_of(table, world_path, **overrides)
+
+
+def trace_text(result: Result) -> str:
+    buf = io.StringIO()
+    write_trace(result, buf)
+    return buf.getvalue()
+
+
+#: Drive forward at speed 4 for 5 s, then stop for good.
+STRAIGHT = ["go,1,1,,,,,,4,4,500,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,0,3"]
+#: The document's Seek-Straight spin: right motor back, left forward, speed 2, 895 ticks; then stop.
+SPIN = ["spin,1,1,,,,,,-2,2,895,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,0,3"]
+
+
+def test_builders_give_a_runnable_setup(tmp_path: Path) -> None:
+    setup = bot(tmp_path, STRAIGHT, room())
+    result = run(setup, 0.5)
+    assert result.ticks == 50
+    assert setup.drive == (0, 1)
+    assert trace_text(result).count("\n") == 50
+
+
+def test_bumberbot_example_finds_its_arena() -> None:
+    setup = setup_of(BUMBERBOT / "table.csv")
+    assert setup.world.name == "BumberBot arena"
+    assert setup.world.path.endswith("arena.toml")

@@ -1,0 +1,101 @@
+"""Whole runs: the shipped arena, determinism, the trace format, the summary and the ``tablebot sim`` command."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from PIL import Image
+from typer.testing import CliRunner
+
+from tablebot.cli.app import app
+from tablebot.engine import Engine
+from tablebot.sim.runner import run
+from tablebot.sim.summary import summarise
+from tablebot.trace import record
+from test_sim_helpers import BUMBERBOT, room, setup_of, trace_text
+
+CORE_KEYS = ["tick", "event", "row", "state", "timer", "M1", "M2"]
+
+
+@pytest.fixture(scope="module")
+def arena_run():
+    return run(setup_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+
+
+def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run) -> None:
+    summary = summarise(arena_run)
+    assert summary.first_light_s is not None and summary.reached_s is not None
+    assert summary.first_light_s < summary.reached_s < 120.0
+    assert summary.collisions >= 1  # the lamp's base is an obstacle: it bumps into it
+    assert 11 in summary.state_seconds and 20 in summary.state_seconds
+    assert abs(sum(summary.state_seconds.values()) - 120.0) < 1e-9
+
+
+def test_the_lamp_is_found_with_other_seeds_too() -> None:
+    setup = setup_of(BUMBERBOT / "table.csv")
+    for seed in (2, 3):
+        assert summarise(run(setup, 120.0, seed=seed)).reached_s is not None
+
+
+def test_same_seed_same_trace_bytes(arena_run) -> None:
+    again = run(setup_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+    assert trace_text(again) == trace_text(arena_run)
+
+
+def test_another_seed_another_trace() -> None:
+    setup = setup_of(BUMBERBOT / "table.csv")
+    assert trace_text(run(setup, 20.0, seed=1)) != trace_text(run(setup, 20.0, seed=2))
+
+
+def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run) -> None:
+    lines = [json.loads(line) for line in trace_text(arena_run).splitlines()]
+    assert len(lines) == arena_run.ticks
+    assert list(lines[0])[:7] == CORE_KEYS
+    assert list(lines[0])[7:] == ["x", "y", "heading", "I7_light", "I8_light", "battery_v"]
+    engine = Engine(arena_run.setup.machine)  # the core, stepped live on the recorded inputs
+    for line, tick in zip(lines[:3000], arena_run.inputs()[:3000], strict=True):
+        engine.step(tick.mask, tick.pulses)
+        assert {k: line[k] for k in CORE_KEYS} == record(engine)
+    assert lines[0]["x"] == 0.35 and lines[0]["heading"] == 20.0
+    assert all(-180 <= line["heading"] < 180 for line in lines)
+
+
+def test_cli_writes_trace_and_pictures(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "40", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "first light seen:" in result.output and "time per state:" in result.output
+    assert (out / "trace.jsonl").read_text().count("\n") == 4000
+    for name in ("trajectory.png", "timeline.png"):
+        with Image.open(out / name) as image:
+            assert image.format == "PNG" and image.width >= 1500
+    assert not (out / "run.gif").exists()
+
+
+def test_cli_gif_and_quiet(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "3", "--out", str(out), "--gif", "-q"])
+    assert result.exit_code == 0, result.output
+    assert result.output == ""
+    with Image.open(out / "run.gif") as gif:
+        assert gif.n_frames == 31
+
+
+def test_cli_bad_world_is_a_located_error(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text(room() + "[[box]]\nat = [1, 1]\nsize = [0.5, -1]\n", encoding="utf-8")
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--world", str(bad), "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert f"{bad}:{room().count(chr(10)) + 3}: error: [[box]] #1 size must be positive" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_cli_view_without_display_fails_cleanly(tmp_path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)  # as on a machine without a display, even where there is one
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "1", "--out", str(tmp_path), "--view"])
+    assert result.exit_code == 2
+    assert "no window can be opened" in result.output
