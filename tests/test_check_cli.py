@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from tablebot.analysis.prove import first_violation
 from tablebot.analysis.properties import load_properties
+from tablebot.analysis.prove import first_violation
 from tablebot.cli import app
 from tablebot.machine import compile_table
 from tablebot.tablefile import load_table

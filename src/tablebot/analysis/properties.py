@@ -53,7 +53,10 @@ class Property:
     @property
     def watch(self) -> int:
         """Input bits the property reads: the model keeps ticks that differ in them apart."""
-        return sum(c.input_bits for c in (self.cond, self.when, self.then) if c is not None)
+        bits = 0
+        for c in (self.cond, self.when, self.then):
+            bits |= c.input_bits if c is not None else 0  # OR, not +: conditions share inputs
+        return bits
 
     @property
     def horizon(self) -> int:

@@ -1,0 +1,173 @@
+"""Exhaustive property checking: proofs, shortest counterexamples that replay on the engine, the
+found BumberBot bug, and the abstraction checked against the exact model on random tables."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tablebot.analysis.check import write_inputs
+from tablebot.analysis.conditions import parse_condition
+from tablebot.analysis.model import Model
+from tablebot.analysis.properties import Property, load_properties
+from tablebot.analysis.prove import check_property, first_violation, monitor_of, search
+from tablebot.machine import compile_table
+from tablebot.robot import Robot
+from tablebot.table import Row, Table
+from tablebot.tablefile import load_table
+from tablebot.trace import TickInput, load_inputs, replay
+
+FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
+
+
+def props_of(table: Path, props: Path | None = None):
+    machine = compile_table(load_table(table))
+    return machine, {p.name: p for p in load_properties(machine, [props or table.with_suffix(".properties.toml")])}
+
+
+def replayed_violation(machine, result, tmp_path: Path) -> int | None:
+    """Write the counterexample as `tablebot trace` reads it, read it back, replay, run the monitor."""
+    path = tmp_path / "cex.csv"
+    write_inputs(machine, result.inputs, path)
+    return first_violation(result.prop, machine, replay(machine, load_inputs(path, machine)))
+
+
+def test_bump_counterexample_is_shortest_and_replays(tmp_path):
+    machine, props = props_of(FIX / "bump.csv")
+    result = check_property(props["bump_stops"], machine)
+    # A at tick 0 (stop, 20 ticks), back off 30 ticks, A exactly when the turn starts, released.
+    assert result.status == "violated" and result.exact
+    assert len(result.inputs) == 52 and result.at_tick == 51
+    assert replayed_violation(machine, result, tmp_path) == 51
+    assert result.inputs[50].mask == machine.input_bits["A"] and result.inputs[51].mask == 0
+
+
+def test_the_fix_makes_it_hold():
+    machine, props = props_of(FIX / "bump_fixed.csv")
+    results = {name: check_property(p, machine).status for name, p in props.items()}
+    assert results == {"bump_stops": "holds", "backs_off": "holds", "no_spin_in_1": "violated", "returns": "holds"}
+
+
+def test_never_counterexample(tmp_path):
+    machine, props = props_of(FIX / "bump.csv")
+    result = check_property(props["no_spin_in_1"], machine)
+    assert result.status == "violated" and len(result.inputs) == 51
+    assert replayed_violation(machine, result, tmp_path) == 50
+
+
+def test_reachable_gives_a_witness_and_impossible_is_a_failure():
+    machine, props = props_of(FIX / "bump.csv")
+    result = check_property(props["backs_off"], machine)
+    assert result.status == "holds" and len(result.inputs) == 21  # A, then 20 ticks of stopping
+    lines = list(replay(machine, result.inputs))
+    assert lines[-1]["state"] == 3 and lines[-1]["M1"] < 0
+    never = Property("p", "p", "reachable", cond=parse_condition("state == 2 and M1 > 0", machine))
+    assert check_property(never, machine).status == "violated"
+
+
+def test_always_reachable_finds_the_trap():
+    machine = compile_table(load_table(FIX / "trap.csv"))
+    prop = Property("back", "back", "always_reachable", cond=parse_condition("state == 1", machine))
+    result = check_property(prop, machine)
+    assert result.status == "violated" and result.state == 2
+    lines = list(replay(machine, result.inputs))
+    assert lines[-1]["state"] == 2 and len(lines) == 2  # T wins tick 0; B at tick 1 parks it
+
+
+def test_counter_witness_uses_pulses():
+    machine = compile_table(load_table(FIX / "counters.csv"))
+    prop = Property("w", "w", "reachable", cond=parse_condition("line == 3", machine))
+    result = check_property(prop, machine)
+    assert result.status == "holds" and [t.pulses for t in result.inputs] == [(0,), (65535,)]
+    assert list(replay(machine, result.inputs))[-1]["row"] == 1
+
+
+def test_bumberbot_found_bug_replays(tmp_path):
+    machine, props = props_of(EXAMPLES / "table.csv", EXAMPLES / "properties.toml")
+    result = check_property(props["front_bumper_stops"], machine)
+    assert result.status == "violated" and len(result.inputs) == 54
+    assert replayed_violation(machine, result, tmp_path) == 53
+    last = list(replay(machine, result.inputs))[-2:]
+    assert [line["state"] for line in last] == [29, 29]  # turning away, front bumpers ignored
+    assert last[-1]["M2"] > 0
+
+
+def test_fixed_bumberbot_satisfies_every_shipped_property():
+    machine, props = props_of(FIX / "bumberbot_fixed.csv", EXAMPLES / "properties.toml")
+    assert {name: check_property(p, machine).status for name, p in props.items()} == dict.fromkeys(props, "holds")
+
+
+def test_timed_property_is_exact_to_the_tick():
+    machine = compile_table(load_table(EXAMPLES / "table.csv"))
+
+    def pause(ticks: int):
+        return Property("p", "p", "when", when=parse_condition("state == 20", machine),
+                        then=parse_condition("state != 20", machine), within=ticks)
+
+    assert check_property(pause(50), machine).status == "holds"
+    result = check_property(pause(49), machine)
+    assert result.status == "violated" and len(result.inputs) == 50 and result.at_tick == 49
+
+
+def test_within_zero_means_the_same_tick(tmp_path):
+    machine = compile_table(load_table(FIX / "bump.csv"))
+    prop = Property("z", "z", "when", when=parse_condition("A", machine),
+                    then=parse_condition("M1 == 0", machine), within=0)
+    result = check_property(prop, machine)
+    assert result.status == "violated" and replayed_violation(machine, result, tmp_path) == len(result.inputs) - 1
+
+
+# --- the abstraction against the exact model, on random tables --------------------------------------
+
+ROBOT = Robot(name="R", inputs=("A", "B"), motors=("M1", "M2"), initial_state=1)
+EVENTS = ("T", "A", "B")
+
+
+@st.composite
+def tables(draw) -> Table:
+    n = draw(st.integers(2, 3))
+    rows = []
+    for state in range(1, n + 1):
+        for _ in range(draw(st.integers(1, 3))):
+            events = frozenset(e for e in EVENTS if draw(st.booleans()))
+            motors = (draw(st.integers(-2, 2)), draw(st.sampled_from([None, -1, 0, 1])))
+            rows.append(Row(len(rows), len(rows) + 2, "", state, events, motors,
+                            draw(st.integers(0, 6)), draw(st.integers(1, n))))
+    return Table(ROBOT, EVENTS, tuple(rows), "<random>")
+
+
+CONDITIONS = ["A", "state == 1", "state == 2", "M1 > 0", "M2 < 0", "T", "fired", "not A and M1 == 0"]
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tables(), st.sampled_from(CONDITIONS), st.sampled_from(CONDITIONS), st.integers(0, 4), st.randoms())
+def test_abstract_proofs_are_sound_and_counterexamples_real(table, when, then, within, rnd):
+    machine = compile_table(table)
+    coarse, fine = Model(machine).explore(), Model.exact(machine).explore()
+    assert {(n[0], n[3]) for n in coarse.nodes} == {(n[0], n[3]) for n in fine.nodes}  # same situations
+    assert coarse.fired_rows() == fine.fired_rows()
+    for prop in (Property("n", "n", "never", cond=parse_condition(f"{when} and {then}", machine)),
+                 Property("r", "r", "when", when=parse_condition(when, machine),
+                          then=parse_condition(then, machine), within=within)):
+        abstract, _ = search(Model(machine, prop.horizon, prop.watch), monitor_of(prop))
+        exact, _ = search(Model.exact(machine, prop.watch), monitor_of(prop))
+        assert abstract is not None or exact is None  # a proof in the model is a proof
+        if prop.kind == "never":  # untimed: the model is exact, not just sound
+            assert (abstract is None) == (exact is None)
+        result = check_property(prop, machine)
+        if result.status == "violated":
+            assert first_violation(prop, machine, replay(machine, result.inputs)) == result.at_tick
+            assert result.at_tick == len(exact) - 1  # shortest: as long as the exact search's path
+        else:
+            assert exact is None
+            _no_random_run_breaks(machine, prop, rnd)
+
+
+def _no_random_run_breaks(machine, prop, rnd: random.Random) -> None:
+    for _ in range(5):
+        ticks = [TickInput(rnd.getrandbits(2) & machine.input_mask) for _ in range(40)]
+        assert first_violation(prop, machine, replay(machine, ticks)) is None
