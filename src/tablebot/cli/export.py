@@ -1,4 +1,4 @@
-"""The ``export`` command: a table for another system (ROBO Pro lists; later C and firmware)."""
+"""The ``export`` command: a table for another system (ROBO Pro lists, a ROBO Pro program, C)."""
 
 from __future__ import annotations
 
@@ -7,27 +7,68 @@ from pathlib import Path
 
 import typer
 
-from tablebot import robopro
+from tablebot import robopro, rpp
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.codegen import generate
+from tablebot.diagnostics import fail
 
 
 class Target(StrEnum):
     robopro = "robopro"
+    robopro_rpp = "robopro-rpp"
+    c = "c"
+
+
+class Lookup(StrEnum):
+    auto = "auto"
+    dense = "dense"
+    scan = "scan"
 
 
 @app.command("export")
 @guarded
 def export_cmd(
     table: Path = TABLE_ARG,
-    outdir: Path = typer.Argument(..., help="Folder to write into (created if missing)."),
-    to: Target = typer.Option(..., "--to", help="Export target."),
+    outdir: Path | None = typer.Argument(None, help="Folder to write into (created if missing); "
+                                         "for robopro-rpp, where to put the program instead of rewriting it."),
+    to: Target = typer.Option(..., "--to", help="robopro: the three lists as CSV; robopro-rpp: the lists "
+                              "written into a ROBO Pro program (--into); c: portable C99 engine + table."),
+    into: Path | None = typer.Option(None, "--into", help="robopro-rpp: the ROBO Pro program (.rpp) to update."),
+    event_list: str = typer.Option(rpp.DEFAULT_NAMES[0], "--event-list", help="robopro-rpp: the event list's name."),
+    action_list: str = typer.Option(rpp.DEFAULT_NAMES[1], "--action-list", help="robopro-rpp: the action list's name."),
+    timer_list: str = typer.Option(rpp.DEFAULT_NAMES[2], "--timer-list", help="robopro-rpp: the timer list's name."),
+    lookup: Lookup = typer.Option(Lookup.auto, "--lookup", help="c: first-match lookup, dense (O(1) table) or "
+                                  "scan (rows per state); auto takes dense while it needs at most 8 KB."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
-    """Export a table for another system (robopro: the document's three ROBO Pro lists as CSV)."""
-    parsed, _ = load(table, robot)
-    lists = robopro.encode(parsed)
-    for path in robopro.write_lists(lists, outdir):
+    """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
+    parsed, machine = load(table, robot)
+    if to == Target.robopro_rpp:
+        if into is None:
+            raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
+        lists = robopro.encode(parsed)
+        named = {event_list: lists.event, action_list: lists.action, timer_list: lists.timer}
+        if len(named) < 3:
+            raise fail("--event-list", "the three list names must differ", "give each list its own name")
+        out = outdir / into.name if outdir else None
+        if outdir:
+            outdir.mkdir(parents=True, exist_ok=True)
+        written, from_csv = rpp.write_lists(into, named, out)
+        console.print(f"wrote {written} (lists {', '.join(named)}: {len(lists.event)} values each)")
+        for name in from_csv:
+            err_console.print(f"warning: list {name} loads its values from a CSV file in ROBO Pro "
+                              "(initcsvcolumn), which replaces the values written here")
+        return
+    if outdir is None:
+        raise fail("OUTDIR", f"--to {to.value} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
+    if to == Target.c:
+        source = generate(machine, lookup.value)
+        for path in source.write(outdir):
+            console.print(f"wrote {path}")
+        lookup_kind = "dense" if source.layout.dense else "scan"
+        console.print(f"lookup: {lookup_kind}, {source.layout.lookup_bytes} bytes; "
+                      f"table hash 0x{source.layout.table_hash:08x}")
+        return
+    for path in robopro.write_lists(robopro.encode(parsed), outdir):
         console.print(f"wrote {path}")
-
-

@@ -115,6 +115,7 @@ def config_header(machine: Machine, layout: Layout) -> str:
         f"typedef {layout.event.name} tb_event_t;",
         f"typedef {layout.state.name} tb_state_t;",
         f"typedef {layout.row.name} tb_row_t;",
+        f"#define TB_STATE_BYTES {layout.state.size}",
         f"#define TB_INDEX_T {index_t}",
         f"#define TB_NO_ROW ((tb_row_t){layout.no_row}u)",
         f"#define TB_RD_EVENT(p) ((tb_event_t){layout.event.reader}(p))",
@@ -127,24 +128,32 @@ def config_header(machine: Machine, layout: Layout) -> str:
 
 # --- tb_table.c ---------------------------------------------------------------------------------
 
-def _action(machine: Machine, index: int) -> str:
+def action_bytes(machine: Machine, layout: Layout, index: int) -> list[int]:
+    """One row's action as the engine reads it: next, timer, outputs, then load flags and loads."""
     row = machine.rows[index]
-    parts = [f"{row.next}u", f"{row.timer}u"]
-    if machine.output_names:
-        parts.append("{" + ", ".join(str(KEEP if v is None else v) for v in row.outputs) + "}")
+    data = list(row.next.to_bytes(layout.state.size, "little")) + list(row.timer.to_bytes(2, "little"))
+    data += [(KEEP if v is None else v) & 0xFF for v in row.outputs]
     if machine.table.robot.counters:
-        flags = sum(1 << i for i, load in enumerate(row.loads) if load is not None)
-        parts.append(f"{flags}u")
-        parts.append("{" + ", ".join(f"{0 if v is None else v}u" for v in row.loads) + "}")
-    source = machine.table.rows[index]
-    note = comment_text(f"row {index}, line {source.line}: {source.description}".rstrip(": "))
-    return f"    {{{', '.join(parts)}}}, /* {note} */"
+        data.append(sum(1 << i for i, load in enumerate(row.loads) if load is not None))
+        for load in row.loads:
+            data += list((load or 0).to_bytes(2, "little"))
+    return data
+
+
+def _action(machine: Machine, layout: Layout, index: int) -> str:
+    row, source = machine.rows[index], machine.table.rows[index]
+    outputs = " ".join(f"{n}={'keep' if v is None else v}" for n, v in zip(machine.output_names, row.outputs,
+                                                                           strict=True))
+    note = comment_text(f"row {index}, line {source.line}: {source.description} -> {machine.states[row.next]}, "
+                        f"timer {row.timer}, {outputs}")
+    values = ", ".join(f"0x{b:02x}" for b in action_bytes(machine, layout, index))
+    return f"    {values}, /* {note} */"
 
 
 def table_source(machine: Machine, layout: Layout) -> str:
     lines = [_header_comment(machine, layout), '#include "tb_engine.h"', "",
-             "TB_ROM const tb_action_t tb_actions[TB_N_ROWS] = {"]
-    lines += [_action(machine, i) for i in range(len(machine.rows))]
+             "TB_ROM const uint8_t tb_actions[TB_N_ROWS * TB_ACTION_BYTES] = {"]
+    lines += [_action(machine, layout, i) for i in range(len(machine.rows))]
     lines.append("};")
     lines.append("")
     if layout.dense:

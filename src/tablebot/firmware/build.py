@@ -19,7 +19,9 @@ from tablebot.firmware.boards import Board, Wiring, load_board, wire
 from tablebot.firmware.cgen import board_header
 from tablebot.machine import Machine
 
-CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-Os", "-ffunction-sections", "-fdata-sections")
+# -O2 with link-time optimisation: tb_tick() is inlined into the tick interrupt, so the engine
+# state is addressed directly (about half the cycles of a call through a pointer).
+CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-flto", "-ffunction-sections", "-fdata-sections")
 FIRMWARE_MAIN = "tb_firmware.c"
 BENCH_MAIN = "tb_bench.c"
 

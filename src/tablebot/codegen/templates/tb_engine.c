@@ -37,28 +37,43 @@ tb_row_t tb_lookup_row(tb_state_t state, tb_event_t events)
 #endif
 }
 
+static uint16_t next16(const uint8_t **p)
+{
+    const uint8_t *q = *p;
+    uint8_t lo = TB_NEXT8(q);
+    uint8_t hi = TB_NEXT8(q);
+    *p = q;
+    return (uint16_t)(lo | (uint16_t)hi << 8);
+}
+
 static void fire(tb_engine_t *e, tb_row_t row)
 {
-    const tb_action_t *a = &tb_actions[row];
+    const uint8_t *p = &tb_actions[(TB_INDEX_T)row * TB_ACTION_BYTES];
 #if TB_N_OUTPUTS > 0
     uint8_t i;
 #endif
-    e->state = TB_RD_STATE(&a->next);
-    e->timer = TB_RD16(&a->timer);
+#if TB_STATE_BYTES == 1
+    e->state = TB_NEXT8(p);
+#else
+    e->state = next16(&p);
+#endif
+    e->timer = next16(&p);
 #if TB_N_OUTPUTS > 0
     for (i = 0; i < TB_N_OUTPUTS; i++) {
-        int8_t v = (int8_t)TB_RD8(&a->out[i]);
+        int8_t v = (int8_t)TB_NEXT8(p);
         if (v != TB_KEEP)
             e->out[i] = v;
     }
 #endif
 #if TB_N_COUNTERS > 0
     {
-        uint8_t loads = TB_RD8(&a->load_mask);
+        uint8_t loads = TB_NEXT8(p);
         uint8_t c;
-        for (c = 0; c < TB_N_COUNTERS; c++)
+        for (c = 0; c < TB_N_COUNTERS; c++) {
+            uint16_t value = next16(&p);
             if (loads & (1u << c))
-                e->counter[c] = TB_RD16(&a->load[c]);
+                e->counter[c] = value;
+        }
     }
 #endif
 }
@@ -66,23 +81,25 @@ static void fire(tb_engine_t *e, tb_row_t row)
 const int8_t *tb_tick(tb_engine_t *e, tb_event_t inputs, const uint16_t *pulses)
 {
     tb_event_t events = inputs & (tb_event_t)TB_INPUT_MASK;
+    uint16_t timer = e->timer;
     tb_row_t row;
 #if TB_N_COUNTERS > 0
     uint8_t c;
 #endif
     if (e->started) {
-        if (e->timer)
-            e->timer--;
+        if (timer)
+            e->timer = --timer;
 #if TB_N_COUNTERS > 0
         if (pulses)
             for (c = 0; c < TB_N_COUNTERS; c++)
                 e->counter[c] = pulses[c] >= e->counter[c] ? 0 : (uint16_t)(e->counter[c] - pulses[c]);
 #endif
+    } else {
+        e->started = 1;
     }
-    e->started = 1;
     (void)pulses;
 #if TB_TIMER_BIT
-    if (e->timer == 0)
+    if (timer == 0)
         events |= (tb_event_t)TB_TIMER_BIT;
 #endif
 #if TB_N_COUNTERS > 0

@@ -22,11 +22,14 @@
 #define TB_RD8(p) pgm_read_byte(p)
 #define TB_RD16(p) pgm_read_word(p)
 #define TB_RD32(p) pgm_read_dword(p)
+/* Read one flash byte and advance the pointer: one LPM Z+ instruction. */
+#define TB_NEXT8(p) __extension__({ uint8_t v_; __asm__("lpm %0, Z+" : "=r"(v_), "+z"(p)); v_; })
 #else
 #define TB_ROM
 #define TB_RD8(p) (*(const uint8_t *)(p))
 #define TB_RD16(p) (*(const uint16_t *)(p))
 #define TB_RD32(p) (*(const uint32_t *)(p))
+#define TB_NEXT8(p) (*(p)++)
 #endif
 
 #include "tb_config.h"
@@ -34,18 +37,10 @@
 /* An output value of TB_KEEP leaves that output as it is. */
 #define TB_KEEP (-128)
 
-/* What a row does when it fires. */
-typedef struct {
-    tb_state_t next;
-    uint16_t timer;
-#if TB_N_OUTPUTS > 0
-    int8_t out[TB_N_OUTPUTS];
-#endif
-#if TB_N_COUNTERS > 0
-    uint8_t load_mask; /* bit i: load counter i */
-    uint16_t load[TB_N_COUNTERS];
-#endif
-} tb_action_t;
+/* What a row does when it fires, TB_ACTION_BYTES per row, little-endian and unpadded so that
+ * fire() reads it front to back: next state (tb_state_t), timer (2 bytes), one signed byte per
+ * output (TB_KEEP: leave it), then, with counters, a byte of load flags and 2 bytes per counter. */
+#define TB_ACTION_BYTES (sizeof(tb_state_t) + 2 + TB_N_OUTPUTS + (TB_N_COUNTERS > 0 ? 1 + 2 * TB_N_COUNTERS : 0))
 
 /* The whole runtime state: plain data, so it can be saved and compared. */
 typedef struct {
@@ -58,7 +53,7 @@ typedef struct {
     uint16_t counter[TB_N_COUNTERS > 0 ? TB_N_COUNTERS : 1];
 } tb_engine_t;
 
-extern TB_ROM const tb_action_t tb_actions[TB_N_ROWS];
+extern TB_ROM const uint8_t tb_actions[TB_N_ROWS * TB_ACTION_BYTES];
 #if TB_LOOKUP_DENSE
 extern TB_ROM const tb_row_t tb_lookup[(uint32_t)TB_N_STATES << TB_N_EVENTS];
 #else

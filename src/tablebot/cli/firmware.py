@@ -1,0 +1,105 @@
+"""Firmware commands: ``build`` (a .hex for a board), ``flash`` (avrdude) and ``monitor`` (the trace)."""
+
+from __future__ import annotations
+
+import sys
+from enum import StrEnum
+from pathlib import Path
+
+import typer
+
+from tablebot.cli.app import app
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.diagnostics import fail
+from tablebot.firmware.boards import load_board
+from tablebot.firmware.build import Firmware, build
+from tablebot.firmware.flash import NOTES, avrdude_command, flash
+from tablebot.firmware.monitor import file_chunks, monitor, serial_chunks
+
+
+class BoardName(StrEnum):
+    uno = "uno"
+    ftduino = "ftduino"
+
+
+BOARD_OPT = typer.Option(..., "--board", help="uno (Arduino Uno + Motor Shield Rev3) or ftduino.")
+OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: build/firmware/BOARD).")
+
+
+def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
+    _, machine = load(table, robot)
+    firmware = build(machine, board.value, out or Path("build") / "firmware" / board.value)
+    wiring = firmware.wiring
+    assert wiring is not None
+    pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
+                     for n, t in kind.items())
+    console.print(f"wrote {firmware.hex} and {firmware.elf} for {firmware.board.title}")
+    console.print(f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {pins}")
+    console.print(f"trace: {firmware.board.uart}, {firmware.board.baud} baud 8N1")
+    return firmware
+
+
+@app.command("build")
+@guarded
+def build_cmd(table: Path = TABLE_ARG, board: BoardName = BOARD_OPT, out: Path | None = OUT_OPT,
+              robot: Path | None = ROBOT_OPT) -> None:
+    """Build firmware (.hex and .elf) running the table every tick and streaming its trace."""
+    _build(table, board, out, robot)
+
+
+@app.command("flash")
+@guarded
+def flash_cmd(
+    table: Path = typer.Argument(..., help="Table (built first) or a firmware .hex built by `tablebot build`."),
+    board: BoardName = BOARD_OPT,
+    port: str = typer.Option(..., "--port", help="Serial port of the board's bootloader (/dev/ttyACM0, COM3)."),
+    out: Path | None = OUT_OPT,
+    baud: int | None = typer.Option(None, "--baud", help="Bootloader speed (default: the board file's)."),
+    programmer: str | None = typer.Option(None, "--programmer", help="avrdude programmer (default: the board's)."),
+    dry_run: bool = typer.Option(False, "--dry-run", help="Print the avrdude command instead of running it."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Write the firmware to a board with avrdude (untested here: no board is attached to CI)."""
+    if table.suffix.lower() == ".hex":
+        if not table.is_file():
+            raise fail(table, "firmware file not found", "build it first: tablebot build TABLE --board BOARD")
+        hexfile = table
+    else:
+        hexfile = _build(table, board, out, robot).hex
+    command = avrdude_command(load_board(board.value), hexfile, port, baud, programmer)
+    console.print(" ".join(command))
+    if dry_run:
+        return
+    if board.value in NOTES:
+        err_console.print(f"note: {NOTES[board.value]}")
+    status = flash(command)
+    if status:
+        raise fail("avrdude", f"avrdude failed with exit status {status}", "check --port, the cable and the "
+                   "board; the Uno needs no button, the ftDuino a reset just before")
+
+
+@app.command("monitor")
+@guarded
+def monitor_cmd(
+    source: str = typer.Argument(..., help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."),
+    table: Path = typer.Option(..., "--table", help="The table the firmware was built from (names states)."),
+    out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
+    baud: int = typer.Option(115200, "--baud", help="Serial speed of the trace stream."),
+    ticks: int | None = typer.Option(None, "--ticks", help="Stop after this many ticks."),
+    seconds: float | None = typer.Option(None, "--seconds", help="Stop a serial port after this many seconds."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Decode a firmware's trace stream into the core's JSON Lines trace, one line per tick."""
+    _, machine = load(table, robot)
+    path = Path(source)
+    chunks = file_chunks(path) if path.is_file() else serial_chunks(source, baud, seconds)
+
+    def warn(text: str) -> None:
+        err_console.print(text, markup=False)
+
+    if out is None:
+        count = monitor(machine, chunks, sys.stdout, source, ticks, warn)
+    else:
+        with out.open("w", encoding="utf-8") as stream:
+            count = monitor(machine, chunks, stream, source, ticks, warn)
+        err_console.print(f"wrote {out} ({count} ticks)")

@@ -1,0 +1,37 @@
+"""``tablebot flash``: the avrdude command line that writes a firmware .hex to a board's bootloader.
+
+It cannot be tested here without a board: the tests check the command line it builds, and
+``--dry-run`` prints it without running avrdude.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+from tablebot.diagnostics import fail
+from tablebot.firmware.boards import Board
+
+#: What to tell the user before avrdude runs, per board.
+NOTES = {
+    "ftduino": "press the ftDuino's reset button just before flashing: its bootloader listens for a few "
+               "seconds after a reset (the Arduino IDE does this with a 1200-baud touch)",
+}
+
+
+def avrdude_command(board: Board, hexfile: Path, port: str, baud: int | None = None,
+                    programmer: str | None = None, avrdude: str = "avrdude") -> list[str]:
+    """avrdude with the board's part, programmer and speed; -D as the Arduino IDE uses it (the
+    bootloader erases the pages it writes)."""
+    settings = board.avrdude
+    return [avrdude, "-p", settings["part"], "-c", programmer or settings["programmer"], "-P", port,
+            "-b", str(baud or settings["baud"]), "-D", "-U", f"flash:w:{hexfile}:i"]
+
+
+def flash(command: list[str]) -> int:
+    """Run avrdude; its own output goes to the terminal. Returns its exit status."""
+    if not shutil.which(command[0]):
+        raise fail(command[0], "avrdude not found", "install it (Debian: apt-get install avrdude) or use "
+                   "--dry-run and run the printed command where avrdude is")
+    return subprocess.run(command, check=False).returncode

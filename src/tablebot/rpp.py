@@ -1,0 +1,175 @@
+"""Writing the document's three lists into an existing ROBO Pro program (.rpp), touching nothing else.
+
+A .rpp file is XML; a list is ``<o classname="ftProDataArray1D" name="…" N="…">`` with one
+``<init value="…"></init>`` child per value. Only those children and ``N`` change: the file is
+edited as text, so every other byte stays as it was.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tablebot.diagnostics import Collector, fail
+
+LIST_CLASS = "ftProDataArray1D"
+DEFAULT_NAMES = ("Event", "Action", "Timer")
+TAG_RE = re.compile(r"""<(/?)([A-Za-z_][\w.:-]*)((?:\s+[^\s=/>]+\s*=\s*(?:"[^"]*"|'[^']*'))*)\s*(/?)>""")
+SKIP_RE = re.compile(r"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<!DOCTYPE[^>]*>", re.S)
+ATTR_RE = re.compile(r"""([^\s=/>]+)\s*=\s*("([^"]*)"|'([^']*)')""")
+ENCODING_RE = re.compile(rb"""^(?:\xef\xbb\xbf)?<\?xml[^>]*encoding\s*=\s*["']([\w.-]+)["']""")
+
+
+@dataclass
+class ListElement:
+    """Where one list sits in the text: its start tag, its N attribute, its init children."""
+
+    name: str
+    line: int
+    start: int
+    tag_end: int  # just after the start tag's '>'
+    close: int = -1  # start of its '</o>'
+    n_span: tuple[int, int] | None = None  # the N attribute's value
+    n_value: int = 0
+    csv_column: str = "-1"
+    inits: list[tuple[int, int]] = field(default_factory=list)
+
+
+def _attrs(text: str) -> dict[str, tuple[str, int, int]]:
+    """Attribute name -> (value, value start, value end) within ``text``."""
+    found = {}
+    for m in ATTR_RE.finditer(text):
+        group = 3 if m.group(3) is not None else 4
+        found[m.group(1)] = (m.group(group), m.start(group), m.end(group))
+    return found
+
+
+def find_lists(text: str) -> list[ListElement]:
+    """Every ftProDataArray1D element, with its direct init children, by scanning the tags."""
+    skipped = [(m.start(), m.end()) for m in SKIP_RE.finditer(text)]
+    stack: list[tuple[str, ListElement | None]] = []
+    lists: list[ListElement] = []
+    for m in TAG_RE.finditer(text):
+        if any(a <= m.start() < b for a, b in skipped):
+            continue
+        closing, tag, attr_text, empty = m.group(1), m.group(2), m.group(3), m.group(4)
+        if closing:
+            if stack and stack[-1][0] == tag:
+                _, element = stack.pop()
+                if element is not None:
+                    element.close = m.start()
+                holder = stack[-1][1] if stack else None
+                if tag == "init" and holder is not None and holder.inits and holder.inits[-1][1] < 0:
+                    holder.inits[-1] = (holder.inits[-1][0], m.end())
+            continue
+        parent = stack[-1][1] if stack else None
+        attrs = _attrs(attr_text)
+        element = None
+        if tag == "o" and attrs.get("classname", ("",))[0] == LIST_CLASS:
+            element = ListElement(attrs.get("name", ("",))[0], text.count("\n", 0, m.start()) + 1, m.start(), m.end())
+            if "N" in attrs:
+                value, a, b = attrs["N"]
+                element.n_span = (m.start(3) + a, m.start(3) + b)
+                element.n_value = int(value) if value.strip().lstrip("-").isdigit() else 0
+            element.csv_column = attrs.get("initcsvcolumn", ("-1",))[0]
+            lists.append(element)
+        elif tag == "init" and isinstance(parent, ListElement):
+            parent.inits.append((m.start(), m.end() if empty else -1))
+        if not empty:
+            stack.append((tag, element))
+    return lists
+
+
+def _line_indent(text: str, at: int) -> str:
+    start = text.rfind("\n", 0, at) + 1
+    return text[start:at] if not text[start:at].strip() else ""
+
+
+def _init_texts(text: str, element: ListElement, values: Sequence[int]) -> tuple[int, int, str]:
+    """(start, end, replacement) that puts ``values`` as the list's init children.
+
+    Existing inits are replaced in their own form and spacing; a list without any gets them on
+    lines of their own just before its closing tag, indented one step deeper.
+    """
+    if element.inits:
+        first_start, first_end = element.inits[0]
+        sample = text[first_start:first_end]
+        if len(element.inits) > 1:
+            separator = text[first_end:element.inits[1][0]]
+        else:
+            separator = "\n" + _line_indent(text, first_start)
+        form = re.sub(r"""value\s*=\s*("[^"]*"|'[^']*')""", 'value="\x00"', sample, count=1)
+        return first_start, element.inits[-1][1], separator.join(form.replace("\x00", str(v)) for v in values)
+    indent = _line_indent(text, element.close)
+    lines = "".join(f'{indent}    <init value="{v}"></init>\n' for v in values)
+    line_start = text.rfind("\n", 0, element.close) + 1
+    if text[line_start:element.close].strip() == "" and line_start > 0:
+        return line_start, line_start, lines  # the closing tag has its own line: insert above it
+    return element.close, element.close, "\n" + lines + indent
+
+
+def rewrite(text: str, lists: Mapping[str, Sequence[int]], path: str | Path = "<rpp>") -> str:
+    """The program with each named list holding ``values`` (N grown as needed); refuses a missing list."""
+    out = Collector(path)
+    found = find_lists(text)
+    by_name: dict[str, list[ListElement]] = {}
+    for element in found:
+        by_name.setdefault(element.name, []).append(element)
+    names = ", ".join(sorted(by_name)) or "none"
+    edits: list[tuple[int, int, str]] = []
+    for name, values in lists.items():
+        matches = by_name.get(name, [])
+        if not matches:
+            out.error(None, None, f"no list named {name!r} ({LIST_CLASS}) in this program",
+                      f"lists in the program: {names}; choose names with --event-list/--action-list/--timer-list")
+            continue
+        if len(matches) > 1:
+            out.error(matches[1].line, None, f"{len(matches)} lists are named {name!r} "
+                      f"(lines {', '.join(str(e.line) for e in matches)})", "rename all but one in ROBO Pro")
+            continue
+        element = matches[0]
+        if element.close < 0:
+            out.error(element.line, None, f"list {name!r} is never closed", "is the .rpp file complete?")
+            continue
+        edits.append(_init_texts(text, element, values))
+        if element.n_span and len(values) > element.n_value:
+            edits.append((*element.n_span, str(len(values))))
+    out.raise_if_any()
+    for start, end, new in sorted(edits, reverse=True):
+        text = text[:start] + new + text[end:]
+    return text
+
+
+def file_encoding(data: bytes) -> str:
+    """The XML declaration's encoding (ROBO Pro writes UTF-8; older files may say ISO-8859-1)."""
+    match = ENCODING_RE.match(data)
+    return match.group(1).decode("ascii") if match else "utf-8"
+
+
+def csv_loaded(text: str, names: Sequence[str]) -> list[str]:
+    """Lists among ``names`` that ROBO Pro fills from a CSV file at start (their inits are ignored)."""
+    return [e.name for e in find_lists(text) if e.name in names and e.csv_column.strip() not in ("-1", "")]
+
+
+def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None = None) -> tuple[Path, list[str]]:
+    """Rewrite ``rpp`` (or write the result to ``out``); returns the path and lists loaded from CSV."""
+    try:
+        data = rpp.read_bytes()
+    except OSError as exc:
+        raise fail(rpp, f"cannot read: {exc.strerror}", "give an existing ROBO Pro .rpp file") from None
+    encoding = file_encoding(data)
+    try:
+        text = data.decode(encoding)
+    except (UnicodeDecodeError, LookupError) as exc:
+        raise fail(rpp, f"not {encoding} text: {exc}", "save the program again in ROBO Pro") from None
+    if "<cvg" not in text[:4096] and LIST_CLASS not in text:
+        raise fail(rpp, "not a ROBO Pro program (no <cvg> document element)", "give a .rpp file", 1, 1)
+    new = rewrite(text, lists, rpp)
+    target = out or rpp
+    tmp = target.with_name(target.name + ".tmp")
+    tmp.write_bytes(new.encode(encoding))
+    os.replace(tmp, target)  # all or nothing: a failed write leaves the program as it was
+    return target, csv_loaded(new, list(lists))
