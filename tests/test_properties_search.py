@@ -52,6 +52,21 @@ def test_the_fix_makes_it_hold():
     assert results == {"bump_stops": "holds", "backs_off": "holds", "no_spin_in_1": "violated", "returns": "holds"}
 
 
+def test_too_large_for_the_exact_search_falls_back_to_a_padded_abstract_run(tmp_path):
+    machine, props = props_of(FIX / "bump.csv")
+    result = check_property(props["bump_stops"], machine, budget=5)
+    assert result.status == "violated" and not result.exact  # not promised shortest, but real:
+    assert replayed_violation(machine, result, tmp_path) == result.at_tick == len(result.inputs) - 1
+
+
+def test_without_a_t_column_the_timer_is_not_tracked():
+    robot = Robot(name="R", inputs=("A",), motors=("M1",), initial_state=1)
+    rows = (Row(0, 2, "", 1, frozenset({"A"}), (3,), 500, 2), Row(1, 3, "", 2, frozenset({"A"}), (0,), 900, 1))
+    machine = compile_table(Table(robot, ("A",), rows))
+    exact = Model.exact(machine).explore()
+    assert len(exact.nodes) == 3 and exact.model.is_exact  # start, state 2, back in state 1
+
+
 def test_never_counterexample(tmp_path):
     machine, props = props_of(FIX / "bump.csv")
     result = check_property(props["no_spin_in_1"], machine)

@@ -11,9 +11,10 @@ from typing import Any
 
 from tablebot.analysis.finding import Finding
 from tablebot.analysis.findings import find_all
-from tablebot.analysis.model import Model
+from tablebot.analysis.model import Model, ModelTooLarge
 from tablebot.analysis.properties import Property
 from tablebot.analysis.prove import Result, check_property
+from tablebot.diagnostics import fail
 from tablebot.machine import Machine
 from tablebot.trace import TickInput, replay
 
@@ -54,9 +55,13 @@ class CheckReport:
 
 
 def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = ()) -> CheckReport:
-    graph = Model(machine).explore()
-    findings = find_all(machine, graph, targets)
-    results = [check_property(p, machine) for p in props]
+    try:
+        graph = Model(machine).explore()
+        findings = find_all(machine, graph, targets)
+        results = [check_property(p, machine) for p in props]
+    except ModelTooLarge as exc:
+        raise fail(machine.table.path, f"too large to explore: {exc}",
+                   "split the table, or give states fewer inputs to look at") from None
     return CheckReport(machine, findings, results, len(graph.nodes))
 
 

@@ -55,7 +55,9 @@ class Model:
 
     def __post_init__(self) -> None:
         m = self.machine
-        self.horizon = max(1, self.horizon)
+        # Without a T column nothing reads the timer: one class is then exact and much smaller.
+        self.timed = m.timer_bit != 0
+        self.horizon = max(1, self.horizon) if self.timed else 1
         self.omega = self.horizon + 1
         self.watch &= m.input_mask
         # Counters whose event column is missing cannot change what fires: do not track them.
@@ -72,11 +74,14 @@ class Model:
 
     @property
     def is_exact(self) -> bool:
-        return self.horizon >= max([self.machine.initial_timer, *(r.timer for r in self.machine.rows)])
+        loads = [self.machine.initial_timer, *(r.timer for r in self.machine.rows)]
+        return not self.timed or self.horizon >= max(loads)
 
     # --- nodes ----------------------------------------------------------------------------------
 
     def timer_class(self, value: int) -> int:
+        if not self.timed:
+            return 0
         return value if value <= self.horizon else self.omega
 
     def initial(self) -> Node:

@@ -22,7 +22,7 @@ from tablebot.machine import NO_ROW, Machine
 from tablebot.trace import TickInput, replay
 
 VIOLATION = None  # a monitor step returning this means the property is broken at this tick
-EXACT_BUDGET = 1_000_000
+EXACT_BUDGET = 300_000  # about 2-3 s of searching before falling back
 Path = list[tuple[Node, Tick]]
 
 

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from tablebot.analysis.check import write_inputs
 from tablebot.analysis.findings import find_all
-from tablebot.analysis.model import Graph, Model, Node, Tick
+from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick
+from tablebot.diagnostics import fail
 from tablebot.machine import Machine
 from tablebot.trace import TickInput, replay, write_trace
 
@@ -50,7 +51,10 @@ class GoldenSet:
 
 def generate(machine: Machine) -> GoldenSet:
     model = Model(machine)
-    graph = model.explore()
+    try:
+        graph = model.explore()
+    except ModelTooLarge as exc:
+        raise fail(machine.table.path, f"too large to explore: {exc}", "split the table") from None
     golden = GoldenSet(machine, fireable=graph.fired_rows())
     while golden.fireable - golden.covered:
         path = _sequence(model, golden.fireable - golden.covered)
