@@ -94,21 +94,22 @@ def _init_texts(text: str, element: ListElement, values: Sequence[int]) -> tuple
     Existing inits are replaced in their own form and spacing; a list without any gets them on
     lines of their own just before its closing tag, indented one step deeper.
     """
+    newline = "\r\n" if "\r\n" in text else "\n"
     if element.inits:
         first_start, first_end = element.inits[0]
         sample = text[first_start:first_end]
         if len(element.inits) > 1:
             separator = text[first_end:element.inits[1][0]]
         else:
-            separator = "\n" + _line_indent(text, first_start)
+            separator = newline + _line_indent(text, first_start)
         form = re.sub(r"""value\s*=\s*("[^"]*"|'[^']*')""", 'value="\x00"', sample, count=1)
         return first_start, element.inits[-1][1], separator.join(form.replace("\x00", str(v)) for v in values)
     indent = _line_indent(text, element.close)
-    lines = "".join(f'{indent}    <init value="{v}"></init>\n' for v in values)
+    lines = "".join(f'{indent}    <init value="{v}"></init>{newline}' for v in values)
     line_start = text.rfind("\n", 0, element.close) + 1
     if text[line_start:element.close].strip() == "" and line_start > 0:
         return line_start, line_start, lines  # the closing tag has its own line: insert above it
-    return element.close, element.close, "\n" + lines + indent
+    return element.close, element.close, newline + lines + indent
 
 
 def rewrite(text: str, lists: Mapping[str, Sequence[int]], path: str | Path = "<rpp>") -> str:

@@ -7,7 +7,7 @@
  * the tick samples the latest results.
  * Outputs O1..O8 are two daisy-chained MC33879 drivers on SPI (/SS = PB0, SCK = PB1,
  * MOSI = PB2, EN = PE6). A background SPI interrupt sends one of 8 PWM slots per 32-bit word,
- * so speed s (0..8) is on in s of 8 slots (about 1 kHz PWM).
+ * so speed s (0..8) is on in s of 8 slots (125 kHz SPI: about 490 Hz PWM).
  * The trace goes out on USART1 (TXD1 = PD3 = the C2 terminal).
  */
 #ifndef TB_BOARD_FTDUINO_H
@@ -63,7 +63,7 @@ static inline void ft_outputs_init(void)
     PORTB &= (uint8_t)~(1 << PB7); /* no PWM on the driver's IN6 */
     DDRE |= 1 << PE6;
     PORTE |= 1 << PE6; /* drivers awake */
-    SPCR = (1 << SPIE) | (1 << SPE) | (1 << MSTR) | (1 << CPHA) | (1 << SPR1); /* mode 1, 250 kHz */
+    SPCR = (1 << SPIE) | (1 << SPE) | (1 << MSTR) | (1 << CPHA) | (1 << SPR1) | (1 << SPR0); /* mode 1, 125 kHz */
     ft_spi_state = 0;
     SPDR = 0; /* the first transfer starts the interrupt chain */
 }

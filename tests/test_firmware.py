@@ -1,0 +1,140 @@
+"""Firmware under emulation: built with avr-gcc, run by the simavr harness, its decoded UART trace must
+equal the Python engine's trace tick for tick (BumberBot's recorded run and random tables)."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tablebot.cli.common import load
+from tablebot.codegen.random_table import Shape, random_inputs, random_table
+from tablebot.diagnostics import TableBotError
+from tablebot.firmware.boards import load_board, wire
+from tablebot.firmware.build import build
+from tablebot.firmware.cgen import timer_setting, ubrr
+from tablebot.firmware.emulate import build_harness, emulate, pins_csv
+from tablebot.machine import compile_table
+from tablebot.robot import BUMBERBOT, Counter, Robot
+from tablebot.trace import TickInput, load_inputs, replay
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "bumberbot"
+STEP_TARGET = 100  # cycles per engine step, worst case (issue 6)
+
+
+@pytest.fixture(scope="module")
+def harness(tmp_path_factory):
+    return build_harness(tmp_path_factory.mktemp("harness"))
+
+
+@pytest.fixture(scope="module")
+def bumberbot():
+    _, machine = load(EXAMPLE)
+    return machine, load_inputs(EXAMPLE / "inputs.csv", machine)
+
+
+def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot, harness, tmp_path):
+    machine, ticks = bumberbot
+    firmware = build(machine, "uno", tmp_path / "fw")
+    run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
+    assert run.problems == []
+    assert [h.table_hash for h in run.hellos] == [firmware.layout.table_hash]
+    assert run.trace == list(replay(machine, ticks))
+    assert len(run.cycles) == len(ticks)
+    assert max(c.step for c in run.cycles) <= STEP_TARGET
+    assert firmware.flash < 4096 and firmware.ram < 256
+    assert firmware.hex.read_text().startswith(":")
+
+
+def test_bumberbot_on_ftduino_equals_python(bumberbot, harness, tmp_path):
+    machine, ticks = bumberbot
+    firmware = build(machine, "ftduino", tmp_path / "fw")
+    run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
+    assert run.problems == [] and run.trace == list(replay(machine, ticks))
+    assert firmware.flash < 4096 and firmware.ram < 256
+
+
+def _fits(board: str, shape: Shape) -> bool:
+    if board == "uno":
+        return shape.inputs + shape.lamps <= 8 and shape.motors <= 2 and shape.counters <= 2
+    return shape.inputs <= 8 and 2 * shape.motors + shape.lamps <= 8 and shape.counters <= 3
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 2**32 - 1), board=st.sampled_from(["uno", "uno", "ftduino"]),
+       inputs=st.integers(1, 4), motors=st.integers(1, 2), lamps=st.integers(0, 2), counters=st.integers(0, 2),
+       lookup=st.sampled_from(["auto", "scan"]))
+def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed, board, inputs, motors, lamps,
+                                                counters, lookup):
+    shape = Shape(states=5, rows=15, inputs=inputs, motors=motors, lamps=lamps, counters=counters)
+    assert _fits(board, shape)
+    rng = random.Random(seed)
+    table = random_table(rng, shape)
+    machine = compile_table(table)
+    ticks = random_inputs(rng, table, 120)
+    work = tmp_path_factory.mktemp("random")
+    firmware = build(machine, board, work / "fw", lookup)
+    run = emulate(firmware, machine, ticks, work / "run", harness)
+    assert run.problems == []
+    assert run.trace == list(replay(machine, ticks))
+
+
+# --- boards and wiring --------------------------------------------------------------------------
+
+def _robot(**changes) -> Robot:
+    return Robot(**{**BUMBERBOT.__dict__, **changes})
+
+
+def test_bumberbot_wiring_on_both_boards():
+    uno = wire(BUMBERBOT, load_board("uno"))
+    assert uno.inputs == {"I3": "D2", "I4": "D4", "I5": "D5", "I7": "D6", "I8": "D7"}
+    assert uno.motors == {"M1": "A", "M2": "B"}
+    ftduino = wire(BUMBERBOT, load_board("ftduino"))
+    assert ftduino.inputs == {n: n for n in BUMBERBOT.inputs}  # I3 on the ftDuino's I3, and so on
+    assert ftduino.motors == {"M1": "M1", "M2": "M2"}
+
+
+def test_robot_file_maps_terminals_and_polarity():
+    robot = _robot(sections={"board": {"uno": {"I7": "A2", "M1": "B", "active_high": ["I8"]}}})
+    wiring = wire(robot, load_board("uno"))
+    assert wiring.inputs["I7"] == "A2" and wiring.motors == {"M1": "B", "M2": "A"}
+    assert wiring.active_high == frozenset({"I8"})
+
+
+def test_too_many_motors_for_the_uno_is_refused():
+    robot = _robot(motors=("M1", "M2", "M3"))
+    with pytest.raises(TableBotError, match="no free terminal for motor M3"):
+        wire(robot, load_board("uno"))
+
+
+def test_ftduino_c2_carries_the_trace_not_a_counter():
+    robot = _robot(counters=(Counter("C1", "M1"), Counter("C2", "M2")))
+    wiring = wire(robot, load_board("ftduino"))
+    assert wiring.counters == {"C1": "C1", "C2": "C3"}  # C2 is TXD1: the counter takes the next free one
+    with pytest.raises(TableBotError, match="cannot use 'C2'"):
+        wire(_robot(counters=(Counter("C1", "M1"),), sections={"board": {"ftduino": {"C1": "C2"}}}),
+             load_board("ftduino"))
+
+
+def test_unknown_board_terminal_is_reported():
+    with pytest.raises(TableBotError, match="input I3 cannot use 'D13'"):
+        wire(_robot(sections={"board": {"uno": {"I3": "D13"}}}), load_board("uno"))
+
+
+def test_pins_csv_drives_active_low_inputs_and_pulses():
+    _, machine = load(EXAMPLE)
+    wiring = wire(BUMBERBOT, load_board("uno"))
+    text = pins_csv(machine, wiring, [TickInput(0), TickInput(machine.input_bits["I3"])])
+    assert text.splitlines() == ["PD2,PD4,PD5,PD6,PD7", "1,1,1,1,1", "0,1,1,1,1"]
+
+
+def test_tick_timer_and_uart_settings():
+    assert timer_setting(16_000_000, 10) == (19999, "(1 << CS11)")  # /8: 2 MHz, 20000 counts
+    assert timer_setting(16_000_000, 1000)[0] == 62499  # /256
+    with pytest.raises(TableBotError):
+        timer_setting(16_000_000, 5000)
+    assert ubrr(16_000_000, 115200) == 16
