@@ -65,7 +65,15 @@ def test_timer_that_never_runs_out():
     found = findings("busy.csv")
     f = only(found, "timer-never-expires")
     assert f.lines == (3,) and "(line 5)" in f.message and "never runs out" in f.message
-    assert only(found, "zero-time-loop").lines == (5,)  # the row that keeps reloading it
+    # line 5 fires every tick but changes nothing after the first time: not a loop between states
+    assert not [f for f in found if f.code == "zero-time-loop"]
+
+
+def test_a_row_that_changes_nothing_is_not_a_loop(tmp_path):
+    (tmp_path / "robot.toml").write_text((FIX / "robot.toml").read_text())
+    (tmp_path / "t.csv").write_text("state,T,A,M1,M2,timer,next\n1,1,,3,3,0,2\n2,1,,0,0,0,2\n")
+    found = findings(tmp_path / "t.csv")
+    assert [f.code for f in found if f.severity != "info"] == ["dead-end"]  # a deliberate halt
 
 
 def test_row_that_never_fires_because_t_is_always_there():

@@ -1,5 +1,6 @@
 """Zero-time loops: cycles of rows that fire on consecutive ticks with no input pressed at all, so
-the robot hops between states every tick (motors may flicker) and never waits for anything."""
+the robot hops between states every tick (motors may flicker) and never waits for anything.
+A row that fires every tick without changing anything (same state, same outputs) is not one."""
 
 from __future__ import annotations
 
@@ -17,8 +18,9 @@ def zero_time_loops(graph: Graph) -> list[Finding]:
     table = machine.table
     edges: dict[Node, list[tuple[Node, int]]] = {}
     for node, (events, zeroed, row, after) in graph.ticks():
-        # encoder pulses are input too: a loop that needs them does wait for something
-        if row != NO_ROW and not events & machine.input_mask and not zeroed:
+        # Encoder pulses are input too: a loop that needs them does wait for something. A row that
+        # fires but leaves the situation as it was (a "rest" or polling row) is like no row firing.
+        if row != NO_ROW and not events & machine.input_mask and not zeroed and after != node:
             edges.setdefault(node, []).append((after, row))
     found, reported = [], set()
     for component in _cycles(edges):
