@@ -58,6 +58,17 @@ def test_bumberbot_on_ftduino_equals_python(bumberbot, harness, tmp_path):
     assert firmware.flash < 4096 and firmware.ram < 256
 
 
+def test_remapped_active_high_inputs_under_emulation(bumberbot, harness, tmp_path):
+    machine, ticks = bumberbot
+    robot = _robot(sections={"board": {"uno": {"I7": "A2", "I8": "A3", "M1": "B", "active_high": ["I7", "I8"]}}})
+    table = load(EXAMPLE)[0]
+    moved = compile_table(type(table)(robot=robot, events=table.events, rows=table.rows, path=table.path))
+    firmware = build(moved, "uno", tmp_path / "fw")
+    assert "if (pc & (1u << 2)) ev |= 2u; /* I7 on A2, 1 = high */" in (tmp_path / "fw/src/tb_board.h").read_text()
+    run = emulate(firmware, moved, ticks[:2000], tmp_path / "run", harness)
+    assert run.trace == list(replay(machine, ticks[:2000]))
+
+
 def _fits(board: str, shape: Shape) -> bool:
     if board == "uno":
         return shape.inputs + shape.lamps <= 8 and shape.motors <= 2 and shape.counters <= 2

@@ -175,7 +175,9 @@ def _init_statements(machine: Machine, wiring: Wiring) -> list[str]:
     if wiring.board.name == "uno":
         for name, terminal in wiring.inputs.items():
             port, bit = _pin(wiring.board.inputs[terminal])
-            lines += [f"    DDR{port} &= (uint8_t)~(1u << {bit}); /* {name} */", f"    PORT{port} |= 1u << {bit};"]
+            lines.append(f"    DDR{port} &= (uint8_t)~(1u << {bit}); /* {name} */")
+            if name not in wiring.active_high:  # an active-high sensor drives the pin: no pull-up
+                lines.append(f"    PORT{port} |= 1u << {bit};")
         for name, terminal in wiring.lamps.items():
             port, bit = _pin(wiring.board.inputs[terminal])
             lines.append(f"    DDR{port} |= 1u << {bit}; /* {name} */")

@@ -152,3 +152,25 @@ def emulate(firmware: Firmware, machine: Machine, ticks: Sequence[TickInput], wo
 
 def summary(values: Sequence[int]) -> dict[str, float]:
     return {"min": min(values), "median": statistics.median(values), "max": max(values)}
+
+
+def bench_steps(firmware: Firmware, workdir: Path, harness: Path | None = None) -> list[int]:
+    """Cycles of every step the benchmark firmware (``tb_bench.c``) times, in its loop order."""
+    harness = harness or build_harness()
+    workdir.mkdir(parents=True, exist_ok=True)
+    marks = workdir / "marks.csv"
+    board = firmware.board
+    run_harness(harness, ["--elf", str(firmware.elf), "--mcu", board.mcu, "--freq", str(board.f_cpu),
+                          "--marks-out", str(marks), "--max-ms", "60000"], timeout=600)
+    overhead, start, steps = 0, 0, []
+    for line in marks.read_text().splitlines():
+        value, cycle = (int(v) for v in line.split(","))
+        if value == 0xE0:
+            start = cycle
+        elif value == 0xE1:
+            overhead = cycle - start
+        elif value == 2:
+            start = cycle
+        elif value == 3:
+            steps.append(cycle - start - overhead)
+    return steps
