@@ -45,7 +45,7 @@ def test_motion_words(motors, words, kind):
 
 def test_dot_source_marks_the_initial_state_and_labels_states():
     source = render(BB, "dot").decode()
-    assert source.count("s_2 [label=<<b>2</b><br/>Seek - Turn>") == 1
+    assert source.count("s_2 [label=<<b>2</b><br/>Seek: turn>") == 1
     assert "\t__start -> s_2 [" in source and "penwidth=2.5" in source
     for state in BB.states:
         assert f"s_{state} [" in source
@@ -63,7 +63,7 @@ def test_mermaid():
 def test_png_and_svg(tmp_path):
     assert render(BB, "png").startswith(b"\x89PNG")
     svg = render(BB, "svg").decode()
-    assert "<svg" in svg and "Collision Entry" in svg
+    assert "<svg" in svg and "Collision entry" in svg
 
 
 @needs_dot
