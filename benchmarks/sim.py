@@ -50,19 +50,21 @@ def physics_only(result: Result) -> float:
     right, left = setup.drive
     commands = result.outputs[:, [right, left]].tolist()
     args = (setup.P, geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
+    pcols = np.array(setup.pulse_columns, dtype=np.int64)
+    pulses = np.zeros(len(pcols), dtype=np.int64)
     start = time.perf_counter()
-    step_one(S, cmd, *args, noise, 0, setup.bits, hist, 0)
+    step_one(S, cmd, *args, noise, 0, setup.bits, hist, 0, pcols, pulses)
     for t, (r, lft) in enumerate(commands):
         cmd[0, 0], cmd[0, 1] = r, lft
-        step_one(S, cmd, *args, noise, (t + 1) % NOISE_BLOCK, setup.bits, hist, t + 1)
+        step_one(S, cmd, *args, noise, (t + 1) % NOISE_BLOCK, setup.bits, hist, t + 1, pcols, pulses)
     return time.perf_counter() - start
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--seconds", type=float, default=120.0)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     table, machine = load(ROOT / "examples" / "bumberbot")
     layer, robot_world = robot_layer(table.robot)
     setup = prepare(table, machine, find_world(table, None, robot_world), layer)

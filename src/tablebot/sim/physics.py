@@ -413,11 +413,14 @@ def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move)
 
 
 @njit(cache=True)
-def step_one(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb, j, bits, hist, t):
+def step_one(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb, j, bits, hist, t, pcols, pulses):
     """The single-robot runner's tick: move (unless t == 0) and sense robot 0, log its row at ``hist[t]``.
 
-    Returns the input mask for the engine's next tick; ``Zb[j]`` is this tick's noise, shape (N, N_NOISE).
+    Returns the input mask for the engine's next tick and fills ``pulses[k]`` with the pulses of the
+    state column ``pcols[k]`` (-1: none) for the engine's counters; ``Zb[j]`` is this tick's noise.
     """
     step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb[j], bits, t > 0)
     hist[t, :] = S[0, :]
+    for k in range(pcols.shape[0]):
+        pulses[k] = 0 if pcols[k] < 0 else int(S[0, pcols[k]])
     return int(S[0, MASK])

@@ -84,13 +84,14 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
     noise = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE))
     engine = Engine(setup.machine)
     right, left = setup.drive
-    columns = setup.pulse_columns
+    pcols = np.array(setup.pulse_columns, dtype=np.int64)
+    pulse_out = np.zeros(len(pcols), dtype=np.int64)
     states = np.zeros(ticks, dtype=np.int64)
     outputs: list[tuple[int, ...]] = []
-    pulse_log: list[tuple[int, ...]] = []
-    mask = step_one(S, cmd, *args, noise, 0, bits, hist, 0)
-    pulses: tuple[int, ...] = (0,) * len(columns)
-    s0, j, started = S[0], 1, time.perf_counter()
+    pulse_log: list[list[int]] = []
+    mask = step_one(S, cmd, *args, noise, 0, bits, hist, 0, pcols, pulse_out)
+    pulses: list[int] = pulse_out.tolist()  # tolist: plain ints for the engine (and its JSON)
+    j, started = 1, time.perf_counter()
     for first in range(0, ticks, CHUNK):
         for t in range(first, min(ticks, first + CHUNK)):
             if j == NOISE_BLOCK:
@@ -100,16 +101,15 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
             outputs.append(out)
             pulse_log.append(pulses)
             cmd[0, 0], cmd[0, 1] = out[right], out[left]
-            mask = step_one(S, cmd, *args, noise, j, bits, hist, t + 1)
+            mask = step_one(S, cmd, *args, noise, j, bits, hist, t + 1, pcols, pulse_out)
+            pulses = pulse_out.tolist()
             j += 1
-            if columns:
-                pulses = tuple(int(s0[c]) if c >= 0 else 0 for c in columns)
         if progress:
             progress(min(ticks, first + CHUNK))
     wall = time.perf_counter() - started
     return Result(setup=setup, seed=seed, hist=hist, states=states,
                   outputs=np.array(outputs, dtype=np.int64).reshape(ticks, -1),
-                  pulses=np.array(pulse_log, dtype=np.int64).reshape(ticks, len(columns)), wall_s=wall)
+                  pulses=np.array(pulse_log, dtype=np.int64).reshape(ticks, len(pcols)), wall_s=wall)
 
 
 # --- trace ---------------------------------------------------------------------------------------
