@@ -77,7 +77,7 @@ def _fits(board: str, shape: Shape) -> bool:
 
 @settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seed=st.integers(0, 2**32 - 1), board=st.sampled_from(["uno", "uno", "ftduino"]),
-       inputs=st.integers(1, 4), motors=st.integers(1, 2), lamps=st.integers(0, 2), counters=st.integers(0, 2),
+       inputs=st.integers(0, 4), motors=st.integers(1, 2), lamps=st.integers(0, 2), counters=st.integers(0, 2),
        lookup=st.sampled_from(["auto", "scan"]))
 def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed, board, inputs, motors, lamps,
                                                 counters, lookup):

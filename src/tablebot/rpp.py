@@ -1,9 +1,5 @@
 """Writing the document's three lists into an existing ROBO Pro program (.rpp), touching nothing else.
-
-A .rpp file is XML; a list is ``<o classname="ftProDataArray1D" name="…" N="…">`` with one
-``<init value="…"></init>`` child per value. Only those children and ``N`` change: the file is
-edited as text, so every other byte stays as it was.
-"""
+Only the lists' ``<init value="…">`` children and ``N`` change: the file is edited as text."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
 """C generation: a table as const C data plus the portable C99 engine that runs it (``export --to c``).
-
-The engine sources are package data (``templates/``); ``tb_config.h`` and ``tb_table.c`` are
-generated per table. The C engine matches :mod:`tablebot.engine` tick for tick.
-"""
+The engine sources are package data (``templates/``); ``tb_config.h`` and ``tb_table.c`` are generated."""
 
 from __future__ import annotations
 

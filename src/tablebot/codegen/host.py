@@ -1,7 +1,5 @@
-"""The generated C engine compiled for this computer: build it, feed it ticks, read back a core trace.
-
-Tests use it to prove the C engine equals the Python engine tick for tick; it needs a C compiler.
-"""
+"""The generated C engine compiled for this computer: build it, feed it ticks, read back a core trace
+(the tests' proof that the C engine equals the Python engine; needs a C compiler)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
 """How a compiled machine becomes C data: integer widths, the first-match lookup and a table hash.
-
-Two lookup strategies exist: ``dense`` (one entry per state and event set, O(1) per tick) and
-``scan`` (per state, its reachable rows in table order). ``auto`` takes dense while it stays small.
-"""
+``dense`` is one entry per state and event set (O(1)); ``scan`` is each state's reachable rows in order."""
 
 from __future__ import annotations
 

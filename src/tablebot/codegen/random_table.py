@@ -1,8 +1,5 @@
-"""Random tables and random recorded inputs, for property tests and benchmarks of generated code.
-
-Tables use every core feature: keep cells, the timer, counters with pulses, lamps, named and
-numbered states, and event columns in a shuffled order.
-"""
+"""Random tables and recorded inputs for property tests and benchmarks of generated code, using keep
+cells, the timer, counters, lamps, named states and shuffled event columns."""
 
 from __future__ import annotations
 

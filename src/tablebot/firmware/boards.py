@@ -1,10 +1,6 @@
-"""Board files (``boards/*.toml``) and the wiring of a robot onto one: which pin each input, motor,
-lamp and counter of the table uses.
-
-Names that equal a board terminal (ftDuino ``I3``, ``M1``, ``C1``) take it; a robot file can map
-others in ``[board.NAME]`` (``I3 = "D4"``, ``active_high = ["I7"]``); the rest take free terminals
-in order.
-"""
+"""Board files (``boards/*.toml``) and the wiring of a robot onto a board: the terminal of each input,
+motor, lamp and counter. A name that is a terminal takes it, ``[board.NAME]`` in the robot file maps
+others, and the rest take free terminals in order."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
-"""``tablebot build``: the generated engine, table and wiring compiled with avr-gcc into .elf and .hex.
-
-The sources are written next to the products (``OUT/src``) so a build can be inspected or rebuilt
-by hand; avr-size gives the flash and static RAM use.
-"""
+"""``tablebot build``: the generated engine, table and wiring compiled with avr-gcc into .elf and .hex;
+the sources stay next to the products (``OUT/src``) for inspection."""
 
 from __future__ import annotations
 

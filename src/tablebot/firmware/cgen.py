@@ -73,7 +73,7 @@ def _inputs_uno(machine: Machine, wiring: Wiring) -> list[str]:
 
 
 def _inputs_ftduino(machine: Machine, wiring: Wiring) -> list[str]:
-    lines = ["    tb_event_t ev = 0;", "    uint8_t in = ft_inputs;"]
+    lines = ["    tb_event_t ev = 0;", "    uint8_t in = ft_inputs;", "    (void)in;"]
     for name, terminal in wiring.inputs.items():
         if name not in machine.input_bits:
             continue

@@ -1,8 +1,5 @@
-"""Running a firmware under simavr with the project's C harness: recorded inputs in, the decoded UART
-trace and exact cycle counts per tick out.
-
-The harness (``harness/harness.c``) is compiled once per source version into a cache folder.
-"""
+"""Running a firmware under simavr with the project's C harness (``harness/harness.c``, compiled once
+per version into a cache folder): recorded inputs in, decoded UART trace and exact cycles out."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
 """``tablebot flash``: the avrdude command line that writes a firmware .hex to a board's bootloader.
-
-It cannot be tested here without a board: the tests check the command line it builds, and
-``--dry-run`` prints it without running avrdude.
-"""
+It cannot be tested without a board: the tests check the command line it builds (``--dry-run``)."""
 
 from __future__ import annotations
 

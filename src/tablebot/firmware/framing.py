@@ -1,10 +1,5 @@
 """The firmware's UART trace framing, both ways: frames to core trace lines (``monitor``) and back.
-
-A frame is ``0x7E TYPE PAYLOAD CHECK``; CHECK makes the 8-bit sum of TYPE, PAYLOAD and CHECK 0.
-'H' (hello, once after reset): version, table hash (u32), states (u16), rows (u16), event bytes,
-outputs, counters. 'T' (tick): tick (u16), event, row (all ones = none), state, timer (u16), one
-signed byte per output, counters (u16). Little-endian; widths come from the generated C layout.
-"""
+The frame layout is documented in docs/firmware.md and at the constants below."""
 
 from __future__ import annotations
 
@@ -17,6 +12,10 @@ from tablebot.codegen.host import trace_line
 from tablebot.codegen.layout import Layout, plan
 from tablebot.machine import NO_ROW, Machine
 
+# A frame is 0x7E TYPE PAYLOAD CHECK; CHECK makes the 8-bit sum of TYPE, PAYLOAD and CHECK zero.
+# 'H' (once after reset): version, table hash u32, states u16, rows u16, event bytes, outputs, counters.
+# 'T' (each tick): tick u16, event, row (all ones = none), state, timer u16, outputs i8, counters u16.
+# Little-endian; event, row and state widths come from the generated C layout.
 SYNC = 0x7E
 HELLO = ord("H")
 TICK = ord("T")

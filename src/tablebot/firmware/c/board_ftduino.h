@@ -71,6 +71,8 @@ static inline void ft_outputs_init(void)
 /* --- inputs: ADC scan with the CD4051 pull-up ------------------------------------------- */
 
 static volatile uint8_t ft_inputs; /* bit i: input I(i+1) reads below the threshold */
+
+#if TB_FT_N_CHANNELS > 0
 static uint8_t ft_adc_next, ft_adc_phase;
 
 static void ft_adc_start(uint8_t ch)
@@ -100,7 +102,6 @@ static inline void ft_inputs_init(void)
     ADCSRA = (1 << ADEN) | (1 << ADIE) | (1 << ADPS2) | (1 << ADPS1) | (1 << ADPS0); /* /128 */
 }
 
-#if TB_FT_N_CHANNELS > 0
 static const uint8_t ft_channels[TB_FT_N_CHANNELS] = TB_FT_CHANNELS;
 
 ISR(ADC_vect)
