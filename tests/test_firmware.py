@@ -58,6 +58,17 @@ def test_bumberbot_on_ftduino_equals_python(bumberbot, harness, tmp_path):
     assert firmware.flash < 4096 and firmware.ram < 256
 
 
+@pytest.mark.parametrize("board", ["uno", "ftduino"])
+def test_counters_example_with_encoder_pulses(board, harness, tmp_path):
+    table, machine = load(ROOT / "examples" / "bumberbot-counters")
+    ticks = random_inputs(random.Random(1), table, 800, density=0.03, max_pulses=3)
+    firmware = build(machine, board, tmp_path / "fw")
+    run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
+    expected = list(replay(machine, ticks))
+    assert len({line["C1"] for line in expected}) > 5  # the counters really count down
+    assert run.problems == [] and run.trace == expected
+
+
 def test_remapped_active_high_inputs_under_emulation(bumberbot, harness, tmp_path):
     machine, ticks = bumberbot
     robot = _robot(sections={"board": {"uno": {"I7": "A2", "I8": "A3", "M1": "B", "active_high": ["I7", "I8"]}}})
