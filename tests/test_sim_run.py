@@ -99,3 +99,38 @@ def test_cli_view_without_display_fails_cleanly(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "1", "--out", str(tmp_path), "--view"])
     assert result.exit_code == 2
     assert "no window can be opened" in result.output
+
+
+LAMP_ROBOT = """name = "FlashBot"
+initial_state = 1
+[inputs]
+I3 = "front-right bumper"
+[motors]
+M1 = "right motor"
+M2 = "left motor"
+[lamps]
+L1 = "flash light"
+[sim.wiring]
+front_left = "none"
+"""
+LAMP_TABLE = "description,state,T,M1,M2,L1,timer,next\nlit,1,1,2,2,8,50,2\ndark,2,1,=,=,0,50,1\n"
+
+
+def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    from tablebot.sim.draw import LAMP_OFF, LAMP_ON, RobotArtist
+
+    (tmp_path / "robot.toml").write_text(LAMP_ROBOT, encoding="utf-8")
+    (tmp_path / "table.csv").write_text(LAMP_TABLE, encoding="utf-8")
+    setup = setup_of(tmp_path / "table.csv")
+    result = run(setup, 1.2)
+    assert setup.lamp_outputs == (2,)
+    assert result.outputs[:, 2].tolist() == [8] * 50 + [0] * 50 + [8] * 20
+    ax = Figure().add_subplot()
+    robot = RobotArtist(ax, setup.params, n_lamps=1)
+    robot.update(1.0, 1.0, 0.0, lamps=(8,))
+    assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_ON) and robot.glows[0].get_alpha() > 0
+    robot.update(1.0, 1.0, 0.0, lamps=(0,))
+    assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_OFF) and robot.glows[0].get_alpha() == 0

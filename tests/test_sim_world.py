@@ -68,8 +68,15 @@ def test_a_start_overlapping_an_obstacle_is_refused(tmp_path: Path) -> None:
 
 def test_wiring_must_name_robot_inputs(tmp_path: Path) -> None:
     world = room(extra='[wiring]\nlight_left = "I9"\n')
-    with pytest.raises(TableBotError, match=r"world.toml:\d+:.*light_left = 'I9' is not a input"):
+    with pytest.raises(TableBotError, match=r"world.toml:\d+:.*light_left = 'I9' is not an input"):
         bot(tmp_path, STRAIGHT, world)
+
+
+def test_unconnected_sensors(tmp_path: Path) -> None:
+    setup = bot(tmp_path, STRAIGHT, room(extra='[wiring]\nrear = "none"\nlight_left = ""\n'))
+    assert setup.bits.tolist() == [16, 8, 0, 2, 0]  # I3 I4 - I7 -
+    with pytest.raises(TableBotError, match="right_motor must name a robot input or motor"):
+        bot(tmp_path, STRAIGHT, room(extra='[wiring]\nright_motor = ""\n'))
 
 
 def test_inconsistent_battery_is_refused(tmp_path: Path) -> None:

@@ -65,7 +65,9 @@ class Player:
                           lamps=tuple(int(last[i]) for i in setup.lamp_outputs))
         state = setup.machine.states[r.states[max(0, t - 1)]] if r.ticks else setup.table.robot.initial_state
         names = setup.machine.output_names
-        outputs = "  ".join(f"{n} {int(v):+d}" for n, v in zip(names, last, strict=True))
+        n_motors = setup.machine.n_motors
+        outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {'on ' + str(int(v)) if v else 'off'}"
+                            for k, (n, v) in enumerate(zip(names, last, strict=True)))
         speed = f"   ({self.speed:g}× speed)" if self.speed != 1 else ""
         self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{state_label(state, self.names)}   {outputs}")
         return [self.trail, self.hud, *self.robot.artists()]

@@ -17,7 +17,7 @@ from matplotlib.patches import Polygon, Wedge
 from tablebot.robot import StateId
 from tablebot.sim.params import Params
 from tablebot.sim.world import World
-from tablebot.table import TIMER_EVENT, Table
+from tablebot.table import Table
 
 FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
@@ -33,16 +33,9 @@ def state_colours(states: tuple[StateId, ...]) -> list[str]:
 
 
 def state_names(table: Table) -> dict[StateId, str]:
-    """Names from the robot file's [states]; else the description of the state's timer row (the
-    document names its T rows after what the state does: "Seek - Straight", "Follow Light"), else its first row's."""
-    names = dict(table.robot.state_names)
-    for row in table.rows:
-        if row.state not in names and TIMER_EVENT in row.events and row.description:
-            names[row.state] = row.description
-    for row in table.rows:
-        if row.state not in names and row.description:
-            names[row.state] = row.description
-    return names
+    """Names from the robot file's [states] (row descriptions are not used: some tables describe the
+    state a row leaves, others the action it starts)."""
+    return dict(table.robot.state_names)
 
 
 def state_label(state: StateId, names: dict[StateId, str]) -> str:
@@ -118,14 +111,16 @@ class RobotArtist:
                         for p in self.bump_pts]
         self.cones = [Wedge((0, 0), self.cone_len, 0, 1, facecolor=LAMP_ON, alpha=0.18 * self.alpha, lw=0,
                             zorder=z - 1) for _ in range(2)]
-        self.lamps = [CirclePatch((0, 0), 0.014, facecolor=LAMP_OFF, edgecolor=WALL, lw=0.8, alpha=self.alpha,
-                                  zorder=z + 2) for _ in range(self.n_lamps)]
+        self.lamps = [CirclePatch((0, 0), 0.016, facecolor=LAMP_OFF, edgecolor=WALL, lw=0.8, alpha=self.alpha,
+                                  zorder=z + 3) for _ in range(self.n_lamps)]
+        self.glows = [CirclePatch((0, 0), 0.04, facecolor=LAMP_ON, lw=0, alpha=0.0, zorder=z + 2)
+                      for _ in range(self.n_lamps)]
         self.heading = self.ax.plot([], [], color=WALL, lw=1.5, alpha=self.alpha, zorder=z + 1)[0]
-        for patch in (self.body, *self.bumpers, *self.cones, *self.lamps):
+        for patch in (self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps):
             self.ax.add_patch(patch)
 
     def artists(self) -> list:
-        return [self.body, *self.bumpers, *self.cones, *self.lamps, self.heading]
+        return [self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps, self.heading]
 
     def update(self, x: float, y: float, theta: float, bumpers: tuple[bool, bool, bool] = (False,) * 3,
                lights: tuple[bool, bool] = (False, False), lamps: tuple[int, ...] = ()) -> None:
@@ -140,8 +135,10 @@ class RobotArtist:
             cone.set_theta1(aim - self.fov)
             cone.set_theta2(aim + self.fov)
             cone.set_alpha((0.45 if seen else 0.15) * self.alpha)
-        for patch, pt, level in zip(self.lamps, self.lamp_pts, lamps, strict=False):
-            patch.center = tuple(_transform(pt[None, :], x, y, theta)[0])
+        levels = tuple(lamps) + (0,) * (self.n_lamps - len(lamps))
+        for patch, glow, pt, level in zip(self.lamps, self.glows, self.lamp_pts, levels, strict=True):
+            patch.center = glow.center = tuple(_transform(pt[None, :], x, y, theta)[0])
             patch.set_facecolor(LAMP_ON if level else LAMP_OFF)
+            glow.set_alpha(0.25 + 0.4 * min(level, 8) / 8 if level else 0.0)  # brighter for higher levels
         nose = _transform(np.array([(0.0, 0.0), (self.body_pts[0, 0] * 0.8, 0.0)]), x, y, theta)
         self.heading.set_data(nose[:, 0], nose[:, 1])

@@ -87,6 +87,7 @@ class Params:
 
     values: dict[str, dict[str, Any]]
     wiring: dict[str, str]
+    wired: frozenset[str] = frozenset()  # roles a file set explicitly (the rest are the BumberBot's)
 
     def __getitem__(self, section: str) -> dict[str, Any]:
         return self.values[section]
@@ -107,11 +108,11 @@ def check_layer(src: Source, data: dict[str, Any], prefix: str = "") -> dict[str
             if key not in known:
                 continue
             if section == "wiring":
-                if isinstance(value, str) and value:
-                    checked[key] = value
+                if isinstance(value, str) and (value or not key.endswith("motor")):
+                    checked[key] = "" if value.lower() == "none" else value
                 else:
                     src.error((name, None, key), f"[{name}] {key} must name a robot input or motor",
-                              f'for example: {key} = "{WIRING[key]}"')
+                              f'for example: {key} = "{WIRING[key]}" (a sensor may be "none")')
                 continue
             default, low, high, _ = DEFAULTS[section][key]
             got = number(src, (name, None, key), value, low, high, integer=isinstance(default, int))
@@ -125,10 +126,13 @@ def merged(*layers: dict[str, Any]) -> Params:
     """Defaults overlaid by each layer (already validated): ``{section: {key: value}}``."""
     values = {sec: {k: spec[0] for k, spec in keys.items()} for sec, keys in DEFAULTS.items()}
     wiring = dict(WIRING)
+    wired: set[str] = set()
     for layer in layers:
         for section, keys in layer.items():
             (wiring if section == "wiring" else values[section]).update(keys)
-    return Params(values, wiring)
+            if section == "wiring":
+                wired |= set(keys)
+    return Params(values, wiring, frozenset(wired))
 
 
 def problems(params: Params) -> list[tuple[str, str, str]]:

@@ -7,6 +7,11 @@ World geometry (built by :mod:`tablebot.sim.world`):
 ``verts`` (V, 2) and ``pstart`` (P+1,) are convex pieces (a wall or segment is a 2-vertex piece,
 a box a 4-vertex one); ``pbound`` (P, 3) their bounding circles; ``edges`` (E, 4) every piece's
 edges for ray casts; ``circles`` (C, 4) = x, y, r, lamp index or -1; ``lamps`` (L, 3) = x, y, intensity.
+
+No shapely or pymunk: both work object by object from Python, which would not batch over thousands
+of robots; the few primitives needed (separating axes for convex pieces, segment distances, ray
+tests) are short compiled functions here. Contacts are resolved by position projection (no masses or
+impulses): a kinematic robot that is pushed back out of whatever it drove into.
 """
 
 from __future__ import annotations

@@ -94,16 +94,25 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
 
 
 def _wiring_errors(params: Params, robot: Robot, world: World) -> list[Diagnostic]:
+    """Drive motors must exist; a sensor role set in a file must name an input ("" = not connected).
+
+    Sensor roles left at the BumberBot's wiring quietly stay unconnected on a robot without that input.
+    """
     errors = []
-    for role, name in params.wiring.items():
-        wanted = robot.motors if role.endswith("motor") else robot.inputs
-        if name not in wanted:
-            kind = "motor" if role.endswith("motor") else "input"
-            errors.append(Diagnostic(
-                world.path if "wiring" in world.params else robot.source, world.line("wiring", role),
-                f"wiring: {role} = {name!r} is not a {kind} of robot {robot.name}",
-                f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} in the world "
-                f"or [sim.wiring] in the robot file"))
+    for role, name in list(params.wiring.items()):
+        motor = role.endswith("motor")
+        wanted = robot.motors if motor else robot.inputs
+        if name in wanted or (not motor and name == ""):
+            continue
+        if not motor and role not in params.wired:
+            params.wiring[role] = ""
+            continue
+        kind = "motor" if motor else "input"
+        errors.append(Diagnostic(
+            world.path if "wiring" in world.params else robot.source, world.line("wiring", role),
+            f"wiring: {role} = {name!r} is not {'a' if motor else 'an'} {kind} of robot {robot.name}",
+            f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} in the world "
+            f"or [sim.wiring] in the robot file" + ("" if motor else ' ("none": not connected)')))
     return errors
 
 
