@@ -36,41 +36,45 @@ static tb_engine_t engine;
 static uint16_t tick_no;
 static uint8_t tx_buf[TB_TX_SIZE];
 static volatile uint8_t tx_head, tx_tail;
-static uint8_t frame_at, frame_sum;
 
-static void put(uint8_t b)
+/* A frame being written into the ring: a local, so that it lives in registers. */
+typedef struct {
+    uint8_t at, sum;
+} frame_t;
+
+static inline void put(frame_t *f, uint8_t b)
 {
-    tx_buf[frame_at] = b;
-    frame_at = (uint8_t)((frame_at + 1) & TB_TX_MASK);
-    frame_sum = (uint8_t)(frame_sum + b);
+    tx_buf[f->at] = b;
+    f->at = (uint8_t)((f->at + 1) & TB_TX_MASK);
+    f->sum = (uint8_t)(f->sum + b);
 }
 
-static void put_le(uint32_t v, uint8_t n)
+static inline void put_le(frame_t *f, uint32_t v, uint8_t n)
 {
     while (n--) {
-        put((uint8_t)v);
+        put(f, (uint8_t)v);
         v >>= 8;
     }
 }
 
 /* Start a frame of `len` payload bytes, or refuse (0) when the ring cannot take it whole:
  * the frame is dropped and the decoder sees a gap in the tick numbers. */
-static uint8_t frame_begin(uint8_t type, uint8_t len)
+static inline uint8_t frame_begin(frame_t *f, uint8_t type, uint8_t len)
 {
     uint8_t room = (uint8_t)((tx_tail - tx_head - 1) & TB_TX_MASK);
     if (room < (uint8_t)(len + 3))
         return 0;
-    frame_at = tx_head;
-    put(TB_SYNC);
-    frame_sum = 0;
-    put(type);
+    f->at = tx_head;
+    put(f, TB_SYNC);
+    f->sum = 0;
+    put(f, type);
     return 1;
 }
 
-static void frame_end(void)
+static inline void frame_end(frame_t *f)
 {
-    put((uint8_t)(0 - frame_sum));
-    tx_head = frame_at;
+    put(f, (uint8_t)(0 - f->sum));
+    tx_head = f->at;
     TB_UCSRB |= 1 << TB_UDRIE;
 }
 
@@ -87,16 +91,17 @@ ISR(TB_UDRE_vect)
 
 static void send_hello(void)
 {
-    if (!frame_begin(TB_FRAME_HELLO, 12))
+    frame_t f;
+    if (!frame_begin(&f, TB_FRAME_HELLO, 12))
         return;
-    put(TB_FRAME_VERSION);
-    put_le(TB_TABLE_HASH, 4);
-    put_le(TB_N_STATES, 2);
-    put_le(TB_N_ROWS, 2);
-    put(sizeof(tb_event_t));
-    put(TB_N_OUTPUTS);
-    put(TB_N_COUNTERS);
-    frame_end();
+    put(&f, TB_FRAME_VERSION);
+    put_le(&f, TB_TABLE_HASH, 4);
+    put_le(&f, TB_N_STATES, 2);
+    put_le(&f, TB_N_ROWS, 2);
+    put(&f, sizeof(tb_event_t));
+    put(&f, TB_N_OUTPUTS);
+    put(&f, TB_N_COUNTERS);
+    frame_end(&f);
 }
 
 static void send_tick(void)
@@ -104,22 +109,23 @@ static void send_tick(void)
 #if TB_N_OUTPUTS > 0 || TB_N_COUNTERS > 0
     uint8_t i;
 #endif
-    if (!frame_begin(TB_FRAME_TICK, TB_TICK_PAYLOAD))
+    frame_t f;
+    if (!frame_begin(&f, TB_FRAME_TICK, TB_TICK_PAYLOAD))
         return;
-    put_le(tick_no, 2);
-    put_le(engine.event, sizeof(tb_event_t));
-    put_le(engine.row, sizeof(tb_row_t));
-    put_le(engine.state, sizeof(tb_state_t));
-    put_le(engine.timer, 2);
+    put_le(&f, tick_no, 2);
+    put_le(&f, engine.event, sizeof(tb_event_t));
+    put_le(&f, engine.row, sizeof(tb_row_t));
+    put_le(&f, engine.state, sizeof(tb_state_t));
+    put_le(&f, engine.timer, 2);
 #if TB_N_OUTPUTS > 0
     for (i = 0; i < TB_N_OUTPUTS; i++)
-        put((uint8_t)engine.out[i]);
+        put(&f, (uint8_t)engine.out[i]);
 #endif
 #if TB_N_COUNTERS > 0
     for (i = 0; i < TB_N_COUNTERS; i++)
-        put_le(engine.counter[i], 2);
+        put_le(&f, engine.counter[i], 2);
 #endif
-    frame_end();
+    frame_end(&f);
 }
 
 ISR(TIMER1_COMPA_vect)
