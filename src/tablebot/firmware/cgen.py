@@ -35,14 +35,14 @@ def tx_size(payload: int) -> int:
     return size
 
 
-def timer_setting(f_cpu: int, tick_ms: int) -> tuple[int, str]:
+def timer_setting(f_cpu: int, tick_ms: int, where: str = "robot") -> tuple[int, str]:
     """(compare value, clock-select bits) of Timer1 for an exact tick, finest prescaler first."""
     for prescaler, bits in PRESCALERS:
         counts, rest = divmod(f_cpu * tick_ms, prescaler * 1000)
         if rest == 0 and 0 < counts <= 65536:
             return counts - 1, bits
-    raise fail("robot", f"tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz",
-               "use a tick of 1 to 4000 ms")
+    raise fail(where, f"tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz",
+               "use a tick of at most 4000 ms (above 1048 ms, a multiple of 8 ms)")
 
 
 def ubrr(f_cpu: int, baud: int) -> int:
@@ -191,7 +191,7 @@ def board_header(machine: Machine, wiring: Wiring, layout: Layout) -> str:
     if payload + 3 > 128:
         raise fail(machine.table.path, f"a trace frame of {payload + 3} bytes is too long for the UART ring",
                    "use fewer outputs and counters")
-    top, ticks = timer_setting(board.f_cpu, robot.tick_ms)
+    top, ticks = timer_setting(board.f_cpu, robot.tick_ms, robot.source)
     isrs, counter_init = _counter_code(machine, wiring)
     channels = [int(t[1:]) - 1 for n, t in wiring.inputs.items() if n in machine.input_bits]
     n_out = max(1, len(machine.output_names))
