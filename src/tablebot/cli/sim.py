@@ -19,7 +19,7 @@ def sim_cmd(
     table: Path = TABLE_ARG,
     world: Path | None = typer.Option(None, "--world", help="World TOML (default: the robot's sim.world, "
                                       "else arena.toml beside the table, else an empty room)."),
-    seconds: float = typer.Option(120.0, "--seconds", min=0.01, max=86400, help="Simulated time."),
+    seconds: float = typer.Option(120.0, "--seconds", min=0.01, max=3600, help="Simulated time (up to an hour)."),
     seed: int = typer.Option(1, "--seed", help="Seed of all simulated noise: same seed, same trace bytes."),
     out: Path = typer.Option(Path("out/sim"), "--out", help="Folder for trace.jsonl and the pictures."),
     view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
