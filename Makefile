@@ -1,15 +1,15 @@
 # The two commands of the README: `make demo` and `make test`; both set themselves up first.
-.PHONY: setup demo test lint bench
+.PHONY: setup demo test bench
 
 setup:
 	@./scripts/bootstrap.sh
 
 demo: setup
-	.venv/bin/tablebot demo
+	.venv/bin/tablebot sim examples/bumberbot --out out/demo
 
 test: setup
 	.venv/bin/python -m pytest
 	.venv/bin/ruff check .
 
 bench: setup
-	.venv/bin/python benchmarks/engine.py
+	for b in engine sim check mcu turn_drift; do .venv/bin/python benchmarks/$$b.py || exit 1; done
