@@ -7,12 +7,12 @@ BumberBot is built in so that the seed table reads with no side file at all.
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tablebot.diagnostics import Collector, fail
+from tablebot.diagnostics import Collector
+from tablebot.tomlfile import read_toml
 
 StateId = int | str
 
@@ -94,23 +94,6 @@ def _error(out: Collector, line: int | None, message: str, hint: str) -> None:
     out.error(line, None if line is None else 1, message, hint)
 
 
-def _parse_toml(path: Path) -> tuple[dict[str, Any], str]:
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise fail(path, f"not UTF-8 text (byte {exc.start})", "save the file as UTF-8") from None
-    except OSError as exc:
-        raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
-    try:
-        return tomllib.loads(text), text
-    except tomllib.TOMLDecodeError as exc:
-        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-        line, col = (int(match[1]), int(match[2])) if match else (None, None)
-        message = re.sub(r"\s*\(at line.*\)", "", str(exc))
-        raise fail(path, f"TOML syntax: {message}", "see the robot file format in the README",
-                   line, col) from None
-
-
 def _names(section: Any, key: str, text: str, out: Collector) -> dict[str, str]:
     """A ``[inputs]``-style table of NAME = "label" pairs (or a list of names)."""
     if section is None:
@@ -145,7 +128,7 @@ def _state_id(value: Any) -> StateId:
 
 def load_robot(path: Path) -> Robot:
     """Read a robot TOML file, reporting every problem with its line."""
-    data, text = _parse_toml(path)
+    data, text = read_toml(path, "see the robot file format in the README")
     out = Collector(path)
     for key in data:
         if key not in KNOWN_KEYS:

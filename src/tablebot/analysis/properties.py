@@ -18,14 +18,14 @@ warning instead of an error; ``note`` is shown with the result. Nothing is ever 
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
-from tablebot.diagnostics import Collector, TableBotError, fail
+from tablebot.diagnostics import Collector, TableBotError
 from tablebot.machine import Machine
+from tablebot.tomlfile import read_toml
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
@@ -108,20 +108,7 @@ def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
 
 
 def _read_file(path: Path) -> tuple[dict[str, Any], str]:
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except OSError as exc:
-        raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
-    except UnicodeDecodeError:
-        raise fail(path, "not UTF-8 text", "save the file as UTF-8") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-        line, col = (int(match[1]), int(match[2])) if match else (None, None)
-        message = re.sub(r"\s*\(at line.*", "", str(exc))
-        raise fail(path, f"TOML syntax: {message}", "see the property format in docs/checking.md",
-                   line, col) from None
+    data, text = read_toml(path, "see the property format in docs/checking.md")
     if set(data) == {"properties"}:  # a robot-file section copied as it is
         data = data["properties"]
     return data, text

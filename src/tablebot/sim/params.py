@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.sim import layout as L
-from tablebot.sim.tomlsrc import Source, known_keys, number, table_of
+from tablebot.tomlfile import Source, known_keys, number, table_of
 
 Number = int | float
 

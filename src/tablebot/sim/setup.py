@@ -18,9 +18,9 @@ from tablebot.robot import Robot
 from tablebot.sim import layout as L
 from tablebot.sim.params import INPUT_ROLES, Params, check_layer, merged, param_row, problems
 from tablebot.sim.physics import body_corners, deepest_contact
-from tablebot.sim.tomlsrc import Source
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
+from tablebot.tomlfile import Source
 
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
 

@@ -13,8 +13,8 @@ from tablebot.cli.common import load
 from tablebot.sim import layout as L
 from tablebot.sim.runner import run
 from tablebot.sim.setup import prepare, robot_layer
-from tablebot.sim.tomlsrc import Source
 from tablebot.sim.world import World, parse_world
+from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.
 OPEN_ROOM = """\

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.sim.params import SECTIONS, check_layer
-from tablebot.sim.tomlsrc import Source, known_keys, number, point, table_of
+from tablebot.tomlfile import Source, known_keys, number, point, table_of
 
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", *SECTIONS)
 Point = tuple[float, float]

@@ -18,6 +18,28 @@ HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 Where = tuple[str, int | None, str | None]  # (section path, index in an array of tables, key)
 
 
+def read_toml(path: Path, hint: str) -> tuple[dict[str, Any], str]:
+    """The data and text of a TOML file; unreadable bytes and syntax errors raise located errors."""
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise fail(path, f"not UTF-8 text (byte {exc.start})", "save the file as UTF-8") from None
+    except OSError as exc:
+        raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
+    return loads(path, text, hint), text
+
+
+def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
+    """Parse TOML text; a syntax error names its line and column and gives ``hint``."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        line, col = (int(match[1]), int(match[2])) if match else (None, None)
+        message = re.sub(r"\s*\(at line.*\)", "", str(exc))
+        raise fail(path, f"TOML syntax: {message}", hint, line, col) from None
+
+
 class Source:
     """A parsed TOML file and its text, for error locations."""
 
@@ -27,27 +49,14 @@ class Source:
         self._lines = text.splitlines()
 
     @classmethod
-    def read(cls, path: str | Path) -> Source:
-        path = Path(path)
-        try:
-            text = path.read_bytes().decode("utf-8-sig")
-        except UnicodeDecodeError as exc:
-            raise fail(path, f"not UTF-8 text (byte {exc.start})", "save the file as UTF-8") from None
-        except OSError as exc:
-            raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
-        return cls.parse(path, text)
+    def read(cls, path: str | Path, hint: str = "see the commented example examples/bumberbot/arena.toml") -> Source:
+        data, text = read_toml(Path(path), hint)
+        return cls(path, text, data)
 
     @classmethod
-    def parse(cls, path: str | Path, text: str) -> Source:
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-            line, col = (int(match[1]), int(match[2])) if match else (None, None)
-            message = re.sub(r"\s*\(at line.*\)", "", str(exc))
-            raise fail(path, f"TOML syntax: {message}", "see the commented example examples/bumberbot/arena.toml",
-                       line, col) from None
-        return cls(path, text, data)
+    def parse(cls, path: str | Path, text: str,
+              hint: str = "see the commented example examples/bumberbot/arena.toml") -> Source:
+        return cls(path, text, loads(path, text, hint))
 
     def line(self, section: str = "", index: int | None = None, key: str | None = None) -> int | None:
         """Line of ``key`` in ``[section]`` (the index-th ``[[section]]``), else of the section header."""
