@@ -21,7 +21,7 @@ from tablebot.engine import Engine
 from tablebot.sim import layout as L
 from tablebot.sim.physics import step_one
 from tablebot.sim.runner import NOISE_BLOCK, Result, initial_state, run, write_trace
-from tablebot.sim.setup import find_world, prepare, robot_layer
+from tablebot.sim.setup import setup_for
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = 1000.0
@@ -66,8 +66,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seconds", type=float, default=120.0)
     args = parser.parse_args(argv)
     table, machine = load(ROOT / "examples" / "bumberbot")
-    layer, robot_world = robot_layer(table.robot)
-    setup = prepare(table, machine, find_world(table, None, robot_world), layer)
+    setup = setup_for(table, machine)
     run(setup, 1.0)  # compile (or load the cached compilation of) the physics core
     full, engine, physics, trace = [], [], [], []
     for seed in range(1, args.repeat + 1):

@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 from tablebot.cli.common import load
 from tablebot.sim.runner import run
-from tablebot.sim.setup import find_world, prepare, robot_layer
+from tablebot.sim.setup import setup_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.sweep import Turn, turns
 
@@ -43,8 +43,7 @@ class Level:
 
 def lamp_times(folder: Path, charge: float, seeds: list[int]) -> list[float | None]:
     table, machine = load(folder)
-    layer, robot_world = robot_layer(table.robot)
-    setup = prepare(table, machine, find_world(table, None, robot_world), layer, {"battery": {"charge": charge}})
+    setup = setup_for(table, machine, overrides={"battery": {"charge": charge}})
     return [summarise(run(setup, 120.0, seed)).reached_s for seed in seeds]
 
 

@@ -10,8 +10,7 @@ from pathlib import Path
 
 from tablebot.cli.common import load
 from tablebot.sim.runner import Result, run, write_trace
-from tablebot.sim.setup import Setup, find_world, prepare, robot_layer
-from tablebot.sim.world import load_world
+from tablebot.sim.setup import Setup, setup_for
 
 ROOT = Path(__file__).resolve().parents[1]
 BUMBERBOT = ROOT / "examples" / "bumberbot"
@@ -55,9 +54,7 @@ def write_bot(tmp_path: Path, rows: list[str], world: str, robot: str = ROBOT) -
 
 def setup_of(table: Path, world: Path | None = None, **overrides: dict) -> Setup:
     parsed, machine = load(table)
-    layer, robot_world = robot_layer(parsed.robot)
-    the_world = load_world(world) if world else find_world(parsed, None, robot_world)
-    return prepare(parsed, machine, the_world, layer, overrides)
+    return setup_for(parsed, machine, world, overrides)
 
 
 def bot(tmp_path: Path, rows: list[str], world: str, **overrides: dict) -> Setup:

@@ -20,7 +20,7 @@ def sim_cmd(
     world: Path | None = typer.Option(None, "--world", help="World TOML (default: the robot's sim.world, "
                                       "else arena.toml beside the table, else an empty room)."),
     seconds: float = typer.Option(120.0, "--seconds", min=0.01, max=3600, help="Simulated time (up to an hour)."),
-    seed: int = typer.Option(1, "--seed", help="Seed of all simulated noise: same seed, same trace bytes."),
+    seed: int = typer.Option(1, "--seed", min=0, help="Seed of all simulated noise: same seed, same trace bytes."),
     out: Path = typer.Option(Path("out/sim"), "--out", help="Folder for trace.jsonl and the pictures."),
     view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif, an animation of the run."),
@@ -33,22 +33,18 @@ def sim_cmd(
     from tablebot.sim import plots
     from tablebot.sim import setup as sim_setup
     from tablebot.sim.draw import state_names
-    from tablebot.sim.runner import run, write_trace
+    from tablebot.sim.runner import run, ticks_for, write_trace
     from tablebot.sim.summary import summarise
 
     if view:
         from tablebot.sim.animate import check_display
         check_display()
     parsed, machine = load(table, robot)
-    layer, robot_world = sim_setup.robot_layer(parsed.robot)
-    the_world = sim_setup.find_world(parsed, world, robot_world)
     overrides = {"battery": {"charge": charge}} if charge is not None else {}
-    setup = sim_setup.prepare(parsed, machine, the_world, layer, overrides)
-    result = _run_with_progress(run, setup, seconds, seed, quiet)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise fail(out, f"cannot create the output folder: {exc.strerror}", "choose another --out") from None
+    setup = sim_setup.setup_for(parsed, machine, world, overrides)
+    ticks = ticks_for(setup, seconds)  # refuses too long a run before anything is written
+    _output_folder(out)
+    result = _run_with_progress(run, setup, seconds, seed, None if quiet else ticks)
     with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
         write_trace(result, stream)
     summary = summarise(result)
@@ -70,10 +66,20 @@ def sim_cmd(
         show(result, summary)
 
 
-def _run_with_progress(run, setup, seconds: float, seed: int, quiet: bool):  # type: ignore[no-untyped-def]
-    if quiet or not sys.stderr.isatty():
+def _output_folder(out: Path) -> None:
+    """Make --out before a long run, so that a bad path fails at once."""
+    if out.exists() and not out.is_dir():
+        raise fail(out, "--out names a file, not a folder", "give --out a folder (it is created if missing)")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise fail(out, f"cannot create the output folder: {exc.strerror}", "choose another --out") from None
+
+
+def _run_with_progress(run, setup, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]
+    """``run`` with a progress bar of ``ticks`` on a terminal (None: quiet)."""
+    if ticks is None or not sys.stderr.isatty():
         return run(setup, seconds, seed)
-    ticks = max(1, round(seconds / setup.tick_s))
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)

@@ -15,6 +15,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.sim import layout as L
 from tablebot.sim.params import terminal_volts
@@ -22,6 +23,7 @@ from tablebot.sim.physics import step_one
 from tablebot.sim.setup import Setup
 from tablebot.trace import TickInput, dumps, replay
 
+MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
 NOISE_BLOCK = 4096  # ticks of noise drawn at once: one Generator call instead of one per tick
 CHUNK = 2000  # ticks between progress reports
 
@@ -72,9 +74,18 @@ def initial_state(setup: Setup, rng: np.random.Generator) -> np.ndarray:
     return S
 
 
+def ticks_for(setup: Setup, seconds: float) -> int:
+    """The ticks in ``seconds`` of robot time (at least one); more than MAX_TICKS are refused."""
+    ticks = max(1, round(seconds / setup.tick_s))
+    if ticks > MAX_TICKS:
+        raise fail("--seconds", f"{seconds:g} s at tick_ms = {setup.table.robot.tick_ms} is {ticks:,} ticks; "
+                   f"a run holds at most {MAX_TICKS:,}", f"simulate at most {MAX_TICKS * setup.tick_s:g} s")
+    return ticks
+
+
 def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None) -> Result:
     """Simulate ``seconds`` of robot time; ``progress(ticks_done)`` is called every few thousand ticks."""
-    ticks = max(1, round(seconds / setup.tick_s))
+    ticks = ticks_for(setup, seconds)
     rng = np.random.default_rng(seed)
     S = initial_state(setup, rng)
     geo, P, bits = setup.geometry, setup.P, setup.bits

@@ -6,7 +6,7 @@ wiring of sensors and motors against the robot, and checks the start pose is fre
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -16,11 +16,11 @@ from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.robot import Robot
 from tablebot.sim import layout as L
-from tablebot.sim.params import INPUT_ROLES, Params, check_layer, merged, param_row, problems
+from tablebot.sim.params import INPUT_ROLES, SECTIONS, Params, check_layer, merged, param_row, problems
 from tablebot.sim.physics import body_corners, deepest_contact
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
-from tablebot.tomlfile import Source
+from tablebot.tomlfile import Source, known_keys
 
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
 
@@ -50,15 +50,20 @@ def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
     sim = robot.sections.get("sim")
     if not sim:
         return {}, None
-    src = Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
+    src = _robot_source(robot)
     if not isinstance(sim, dict):
-        raise fail(robot.source, "[sim] must be a table", "write [sim.battery] etc.")
+        raise fail(robot.source, "[sim] must be a table", "write [sim.battery] etc.", src.line("", None, "sim"))
+    known_keys(src, ("sim", None), sim, (*SECTIONS, "world"))
     layer = check_layer(src, sim, prefix="sim.")
     world = sim.get("world")
+    path = Path(robot.source).parent / world if isinstance(world, str) else None
     if world is not None and not isinstance(world, str):
         src.error(("sim", None, "world"), "sim.world must be a file name", 'for example: world = "arena.toml"')
+    elif path is not None and not path.is_file():
+        src.error(("sim", None, "world"), f"sim.world: {path} is not a file",
+                  "name a world file, relative to the robot file's folder")
     src.raise_if_any()
-    return layer, (Path(robot.source).parent / world) if isinstance(world, str) else None
+    return layer, path
 
 
 def find_world(table: Table, world_path: Path | None, robot_world: Path | None) -> World:
@@ -70,15 +75,24 @@ def find_world(table: Table, world_path: Path | None, robot_world: Path | None) 
     return load_world(beside) if beside.is_file() else default_world()
 
 
+def setup_for(table: Table, machine: Machine, world_path: Path | None = None,
+              overrides: dict[str, Any] | None = None) -> Setup:
+    """The whole chain for one table: its robot's [sim], its world (see :func:`find_world`), checked and packed."""
+    layer, robot_world = robot_layer(table.robot)
+    return prepare(table, machine, find_world(table, world_path, robot_world), layer, overrides)
+
+
 def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None = None,
             overrides: dict[str, Any] | None = None) -> Setup:
     """Check that robot, table and world fit together and pack them for the physics core."""
-    params = merged(robot_params or {}, world.params, overrides or {})
-    errors = [Diagnostic(world.path, world.line(section, key), msg, "fix the value in the world or robot file")
-              for section, key, msg in problems(params)]
-    errors += _wiring_errors(params, table.robot, world)
-    if errors:
-        raise TableBotError(errors)
+    robot_params = robot_params or {}
+    params = _unwire_absent_sensors(merged(robot_params, world.params, overrides or {}), table.robot)
+    found = [(section, key, message, "fix the value in the world or robot file")
+             for section, key, message in problems(params)]
+    found += _wiring_errors(params, table.robot)
+    if found:
+        raise TableBotError(Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
+                            for section, key, message, hint in found)
     tick_s = table.robot.tick_ms / 1000
     P = param_row(params, tick_s)[None, :]
     geo = geometry(world)
@@ -93,26 +107,52 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
                  pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps))
 
 
-def _wiring_errors(params: Params, robot: Robot, world: World) -> list[Diagnostic]:
-    """Drive motors must exist; a sensor role set in a file must name an input ("" = not connected).
+def _robot_source(robot: Robot) -> Source:
+    """The robot file again, for the lines of its [sim] keys (the built-in robot has no file)."""
+    return Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
 
-    Sensor roles left at the BumberBot's wiring quietly stay unconnected on a robot without that input.
-    """
+
+def _locate(section: str, key: str, world: World, robot: Robot,
+            robot_params: dict[str, Any]) -> tuple[str, int | None]:
+    """The file and line that set ``[section] key`` (the world wins over the robot's ``[sim.*]``), else
+    the section's line; a value no file set is the robot's to fix."""
+    for whole in (False, True):
+        found = None if whole else key
+        if section in world.params and (whole or key in world.params[section]):
+            return world.path, world.line(section, found)
+        if section in robot_params and (whole or key in robot_params[section]):
+            return robot.source, _robot_source(robot).line(f"sim.{section}", None, found)
+    return robot.source, None
+
+
+def _unwire_absent_sensors(params: Params, robot: Robot) -> Params:
+    """Sensor roles left at the BumberBot's wiring stay unconnected on a robot without that input."""
+    wiring = {role: name if role.endswith("motor") or role in params.wired or name in robot.inputs else ""
+              for role, name in params.wiring.items()}
+    return replace(params, wiring=wiring)
+
+
+def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, str]]:
+    """Drive motors must be two motors of the robot; a sensor must name an input ("" = not connected)."""
+    if len(robot.motors) < 2:
+        return [("wiring", "right_motor", f"the simulated robot drives two wheels, but robot {robot.name} has "
+                 f"{len(robot.motors) or 'no'} motor{'s' * (len(robot.motors) != 1)}",
+                 "add a right and a left motor to [motors] in the robot file")]
     errors = []
-    for role, name in list(params.wiring.items()):
+    for role, name in params.wiring.items():
         motor = role.endswith("motor")
         wanted = robot.motors if motor else robot.inputs
         if name in wanted or (not motor and name == ""):
             continue
-        if not motor and role not in params.wired:
-            params.wiring[role] = ""
-            continue
         kind = "motor" if motor else "input"
-        errors.append(Diagnostic(
-            world.path if "wiring" in world.params else robot.source, world.line("wiring", role),
-            f"wiring: {role} = {name!r} is not {'a' if motor else 'an'} {kind} of robot {robot.name}",
-            f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} in the world "
-            f"or [sim.wiring] in the robot file" + ("" if motor else ' ("none": not connected)')))
+        unwired = "" if motor else ' ("none": not connected)'
+        errors.append(("wiring", role, f"wiring: {role} = {name!r} is not {'a' if motor else 'an'} {kind} of "
+                       f"robot {robot.name}", f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} "
+                       f"in the world or [sim.wiring] in the robot file{unwired}"))
+    right, left = params.wiring["right_motor"], params.wiring["left_motor"]
+    if right == left and right in robot.motors:
+        errors.append(("wiring", "left_motor", f"wiring: right_motor and left_motor are both {right}",
+                       "the simulated robot drives two wheels: give each its own motor"))
     return errors
 
 

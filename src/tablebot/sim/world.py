@@ -16,8 +16,10 @@ from typing import Any
 import numpy as np
 
 from tablebot.sim.params import SECTIONS, check_layer
-from tablebot.tomlfile import Source, known_keys, number, point, table_of
+from tablebot.sim.physics import point_segment_distance
+from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
 
+ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", *SECTIONS)
 Point = tuple[float, float]
 
@@ -124,6 +126,8 @@ def parse_world(src: Source) -> World:
     if walls and start:
         _inside(src, walls, [("start", None, "at", start[:2])]
                 + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)])
+    if walls:
+        _lamps_in_the_open(src, walls, lamps, boxes, circles, segments)
     src.raise_if_any()
     return World(name=str(name), walls=tuple(walls), start=start, lamps=tuple(lamps),  # type: ignore[arg-type]
                  boxes=tuple(boxes), circles=tuple(circles), segments=tuple(segments),
@@ -131,15 +135,25 @@ def parse_world(src: Source) -> World:
 
 
 def _many(src: Source, data: dict[str, Any], section: str, read: Any) -> list[Any]:
+    """Every ``[[section]]`` table, each read by ``read``; anything else is reported once."""
     items = data.get(section, [])
     if isinstance(items, dict):
         items = [items]
-    if not isinstance(items, list):
-        src.error((section, None, None), f"{section} must be written as [[{section}]] tables",
+    if not isinstance(items, list) or not all(isinstance(item, dict) for item in items):
+        src.error(("", None, section), f"{section} must be written as [[{section}]] tables, not {items!r}",
                   "see examples/bumberbot/arena.toml")
         return []
-    found = [read(src, i, table_of(src, (section, i, None), item)) for i, item in enumerate(items)]
+    found = [read(src, i, item) for i, item in enumerate(items)]
     return [item for item in found if item is not None]
+
+
+def _point(src: Source, where: Where, table: dict[str, Any]) -> Point | None:
+    """The point ``where`` names in ``table``; a missing one is reported as missing."""
+    key = where[2]
+    if key not in table:
+        src.error(where, f"{label(where)} is missing", f"add {key} = [x, y] (metres)")
+        return None
+    return point(src, where, table[key])
 
 
 def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
@@ -154,12 +168,12 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     if any(c is None for c in corners):
         return []
     walls: list[Point] = corners  # type: ignore[assignment]
-    if abs(_area(walls)) < 1e-6:
-        src.error(where, "[arena] walls enclose no area", "list the corners of the room in order")
     crossing = _self_crossing(walls)
     if crossing:
         src.error(where, f"[arena] walls cross themselves (wall {crossing[0] + 1} and wall {crossing[1] + 1})",
                   "list the corners in order around the room, clockwise or counter-clockwise")
+    elif abs(_area(walls)) < 1e-6:
+        src.error(where, "[arena] walls enclose no area", "list the corners of the room in order")
     return walls
 
 
@@ -178,7 +192,7 @@ def _start(src: Source, start: dict[str, Any]) -> tuple[float, float, float] | N
 
 def _lamp(src: Source, i: int, t: dict[str, Any]) -> Lamp | None:
     known_keys(src, ("lamp", i), t, ("at", "intensity", "radius"))
-    at = point(src, ("lamp", i, "at"), t.get("at"))
+    at = _point(src, ("lamp", i, "at"), t)
     intensity = number(src, ("lamp", i, "intensity"), t.get("intensity", 3.0), 1e-6, 1e6)
     radius = number(src, ("lamp", i, "radius"), t.get("radius", 0.04), 0.0, 10.0)
     if at is None or intensity is None or radius is None:
@@ -188,8 +202,8 @@ def _lamp(src: Source, i: int, t: dict[str, Any]) -> Lamp | None:
 
 def _box(src: Source, i: int, t: dict[str, Any]) -> Box | None:
     known_keys(src, ("box", i), t, ("at", "size", "angle"))
-    at = point(src, ("box", i, "at"), t.get("at"))
-    size = point(src, ("box", i, "size"), t.get("size"))
+    at = _point(src, ("box", i, "at"), t)
+    size = _point(src, ("box", i, "size"), t)
     angle = number(src, ("box", i, "angle"), t.get("angle", 0.0), -3600, 3600)
     if size is not None and min(size) <= 0:
         src.error(("box", i, "size"), f"[[box]] #{i + 1} size must be positive, not {list(size)}",
@@ -202,15 +216,18 @@ def _box(src: Source, i: int, t: dict[str, Any]) -> Box | None:
 
 def _circle(src: Source, i: int, t: dict[str, Any]) -> Circle | None:
     known_keys(src, ("circle", i), t, ("at", "radius"))
-    at = point(src, ("circle", i, "at"), t.get("at"))
-    radius = number(src, ("circle", i, "radius"), t.get("radius"), 0.001, 100.0)
+    at = _point(src, ("circle", i, "at"), t)
+    if "radius" not in t:
+        src.error(("circle", i, "radius"), f"[[circle]] #{i + 1} radius is missing", "add radius = 0.1 (metres)")
+        return None
+    radius = number(src, ("circle", i, "radius"), t["radius"], 0.001, 100.0)
     return None if at is None or radius is None else Circle(at, float(radius))
 
 
 def _segment(src: Source, i: int, t: dict[str, Any]) -> Segment | None:
     known_keys(src, ("segment", i), t, ("from", "to"))
-    a = point(src, ("segment", i, "from"), t.get("from"))
-    b = point(src, ("segment", i, "to"), t.get("to"))
+    a = _point(src, ("segment", i, "from"), t)
+    b = _point(src, ("segment", i, "to"), t)
     if a is not None and a == b:
         src.error(("segment", i, "to"), f"[[segment]] #{i + 1} has no length", "give two different points")
         return None
@@ -253,6 +270,30 @@ def _inside(src: Source, walls: list[Point], places: list[tuple[str, int | None,
         if not inside(walls, at):
             src.error((section, index, key), f"{section} at {list(at)} is outside the arena walls",
                       "move it inside the [arena] walls polygon")
+
+
+def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes: list[Box],
+                       circles: list[Circle], segments: list[Segment]) -> None:
+    """A lamp inside an obstacle or on a wall is dark: every ray from it to the robot is blocked."""
+    lines = [*zip(walls, walls[1:] + walls[:1], strict=True), *((s.start, s.end) for s in segments)]
+    for i, lamp in enumerate(lamps):
+        place = _blocked(lamp.at, lines, boxes, circles) if inside(walls, lamp.at) else None  # else: outside
+        if place:
+            src.error(("lamp", i, "at"), f"[[lamp]] #{i + 1} at {list(lamp.at)} is {place}: its light cannot "
+                      "reach the robot", "move the lamp into the open")
+
+
+def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circles: list[Circle]) -> str | None:
+    """Where ``at`` is shut in: inside a box or a circle, or on a wall line; None when in the open."""
+    for k, box in enumerate(boxes):
+        if inside(box.corners(), at):
+            return f"inside [[box]] #{k + 1}"
+    for k, circle in enumerate(circles):
+        if math.dist(circle.at, at) < circle.radius:
+            return f"inside [[circle]] #{k + 1}"
+    if any(point_segment_distance(*at, *a, *b) < ON_A_WALL for a, b in lines):
+        return "on a wall"
+    return None
 
 
 def geometry(world: World) -> Geometry:
