@@ -1,4 +1,4 @@
-"""Spreadsheet text as records of cells that remember their line and column.
+"""Text files read with located errors, and spreadsheet text as records of cells that remember their place.
 
 Handles what spreadsheets save: UTF-8 with or without BOM (or UTF-16 with its BOM), CRLF or LF, comma, semicolon or tab
 separators and RFC 4180 quoting; every cell keeps its 1-based line and column for error messages.
@@ -33,8 +33,14 @@ class Record:
         return all(not c.text.strip() for c in self.cells)
 
 
-def read_text(path: Path) -> str:
+#: What to do about a file that is not UTF-8 text, for files a spreadsheet saves.
+CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
+
+
+def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT) -> str:
     """Decode a file as UTF-8 (BOM allowed); if it is not, report where (see :func:`_bad_bytes`)."""
+    if path.is_dir():
+        raise fail(path, "this is a folder, not a file", "give the path of a file")
     try:
         data = path.read_bytes()
     except OSError as exc:
@@ -47,12 +53,11 @@ def read_text(path: Path) -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise TableBotError(_bad_bytes(path, data)) from None
+        raise TableBotError(_bad_bytes(path, data, encoding_hint)) from None
 
 
-def _bad_bytes(path: Path, data: bytes) -> list[Diagnostic]:
+def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:
     """One diagnostic per line holding undecodable bytes, at its first bad byte (columns in characters)."""
-    hint = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
     found: list[Diagnostic] = []
     start = 3 if data.startswith(b"\xef\xbb\xbf") else 0  # the BOM is not a character of line 1
     for number, raw in enumerate(re.split(rb"\r\n|\r|\n", data[start:]), start=1):

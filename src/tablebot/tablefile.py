@@ -126,6 +126,11 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
 
 # --- rows ---------------------------------------------------------------------------------------
 
+def _whole(text: str) -> int:
+    """The integer of a cell that matches INT_RE ("3", "+3", "3.0"), exactly: no detour through float."""
+    return int(text.partition(".")[0])
+
+
 def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int | None = 0,
          keep: bool = False) -> int | None:
     text = cell.text.strip()
@@ -138,7 +143,7 @@ def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int 
         out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer",
                   f"write a whole number from {low} to {high}{extra}")
         return blank
-    value = int(float(text))
+    value = _whole(text)
     if not low <= value <= high:
         out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}",
                   f"write a whole number from {low} to {high}")
@@ -152,13 +157,13 @@ def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
         out.error(cell.line, cell.column, f"{what} is missing", "write a state number or name")
         return None
     if INT_RE.match(text):
-        value = int(float(text))
+        value = _whole(text)
         if value < 0:
             out.error(cell.line, cell.column, f"{what} {value} is negative", "states are 0 or more")
         return value
     if not STATE_RE.match(text):
         out.error(cell.line, cell.column, f"{what} {text!r} is not a valid state name",
-                  "use a number or a name starting with a letter")
+                  "use a number, or a name that starts with A-Z or _ (then letters, digits, spaces, _ . -)")
         return None
     return text
 

@@ -12,6 +12,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
@@ -20,12 +21,7 @@ Where = tuple[str, int | None, str | None]  # (section path, index in an array o
 
 def read_toml(path: Path, hint: str) -> tuple[dict[str, Any], str]:
     """The data and text of a TOML file; unreadable bytes and syntax errors raise located errors."""
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise fail(path, f"not UTF-8 text (byte {exc.start})", "save the file as UTF-8") from None
-    except OSError as exc:
-        raise fail(path, f"cannot read: {exc.strerror}", "check the path") from None
+    text = read_text(path, "save the file as UTF-8 text")
     return loads(path, text, hint), text
 
 

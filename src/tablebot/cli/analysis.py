@@ -19,7 +19,17 @@ from tablebot.analysis.properties import find_property_files, load_properties
 from tablebot.analysis.prove import Result
 from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, resolve_table_path
+from tablebot.cli.common import (
+    ROBOT_OPT,
+    TABLE_ARG,
+    console,
+    err_console,
+    guarded,
+    load,
+    out_file,
+    out_folder,
+    resolve_table_path,
+)
 from tablebot.diagnostics import fail
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
@@ -49,12 +59,13 @@ def check_cmd(
     """
     for name in target:
         if name not in TARGETS:
-            raise fail(name, f"unknown export target {name!r}", f"targets: {', '.join(TARGETS)}")
+            raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(TARGETS)}")
     _, machine = load(table, robot)
     files = properties or find_property_files(resolve_table_path(table))
     report = run_check(machine, load_properties(machine, files), tuple(target))
     report.property_files = files
-    write_counterexamples(report, cex_dir)
+    if any(result.inputs for result in report.results):
+        write_counterexamples(report, out_folder(cex_dir, "--counterexamples"))
     if fmt == Format.json:
         sys.stdout.write(json.dumps(report_json(report, strict), indent=2) + "\n")
     else:
@@ -129,7 +140,7 @@ def tests_cmd(
     expected trace (JSON Lines), plus coverage.json."""
     _, machine = load(table, robot)
     golden = generate(machine)
-    write_golden(golden, out)
+    write_golden(golden, out_folder(out, "--out"))
     for seq in golden.sequences:
         console.print(f"wrote {escape(str(out / seq.inputs_name))} and {escape(seq.trace_name)} "
                       f"({len(seq.inputs)} ticks, {len(seq.rows)} rows)")
@@ -152,17 +163,19 @@ def diagram_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Draw the state diagram (the document's Figure 1) from the table."""
+    option = "--format"
     if fmt is None:
         suffix = out.suffix.lstrip(".").lower() if out else ""
         fmt = {"mmd": "mermaid", "gv": "dot"}.get(suffix, suffix) if suffix else "svg"
+        option = "--out"
     if fmt not in FORMATS:
-        raise fail(fmt, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)}")
+        raise fail(option, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)} "
+                   "(--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, .mmd)")
     parsed, _ = load(table, robot)
     data = render(parsed, fmt, colour)
     if out is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
         return
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_bytes(data)
+    out_file(out, "--out", make_folder=True).write_bytes(data)
     err_console.print(f"wrote {out} ({fmt}, {len(data)} bytes)")

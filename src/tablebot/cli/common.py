@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import functools
 import sys
 from collections.abc import Callable
@@ -12,7 +13,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from tablebot.diagnostics import Diagnostic, TableBotError
+from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import load_robot
 from tablebot.table import Table
@@ -26,12 +27,53 @@ TABLE_ARG = typer.Argument(..., help="Table file (CSV or TSV) or a folder holdin
 ROBOT_OPT = typer.Option(None, "--robot", help="Robot TOML file (default: NAME.toml or robot.toml beside the table).")
 
 
+#: Per errno of a failed read or write: what the user can do about it.
+OS_HINTS = {
+    errno.EEXIST: "a file stands where a folder is needed: choose another path",
+    errno.ENOTDIR: "a file stands where a folder is needed: choose another path",
+    errno.EISDIR: "a folder stands where a file is needed: give a file name",
+    errno.ENOENT: "the folder does not exist: create it or choose another path",
+    errno.EACCES: "you may not write there: choose another path or change its permissions",
+    errno.EPERM: "you may not write there: choose another path or change its permissions",
+    errno.EROFS: "the disk is read-only: choose another path",
+    errno.ENOSPC: "the disk is full: free some space or choose another disk",
+}
+
+
 def resolve_table_path(path: Path) -> Path:
     """A folder stands for the table.csv inside it, so ``tablebot trace examples/bumberbot`` works."""
     if path.is_dir():
         for name in ("table.csv", "table.tsv"):
             if (path / name).is_file():
                 return path / name
+        raise fail(path, "this folder holds no table.csv or table.tsv",
+                   "give the table file itself, or a folder that holds table.csv")
+    return path
+
+
+def out_folder(path: Path, option: str) -> Path:
+    """The folder an option names for writing into, created (with its parents) if missing."""
+    if path.exists() and not path.is_dir():
+        raise fail(path, f"{option} names a file, not a folder", f"give {option} a folder (it is created if missing)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise fail(exc.filename or path, f"cannot create the folder for {option}: {exc.strerror}",
+                   OS_HINTS.get(exc.errno or 0, f"give {option} another folder")) from None
+    return path
+
+
+def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
+    """The file an option names for writing (an existing file is replaced); its folder must exist,
+    unless ``make_folder`` says to create it."""
+    if path.is_dir():
+        raise fail(path, f"{option} names a folder, not a file", f"give {option} a file name")
+    if make_folder:
+        out_folder(path.parent, option)
+    elif not path.parent.is_dir():
+        what = "is not a folder" if path.parent.exists() else "does not exist"
+        raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
+                   f"give {option} a file in an existing folder")
     return path
 
 
@@ -63,8 +105,8 @@ def guarded(func: F) -> F:
             raise typer.Exit(2) from None
         except OSError as exc:  # a file the command had to write (or read) is not there to be had
             where = exc.filename if exc.filename is not None else "tablebot"
-            print_diagnostic(Diagnostic(str(where), None, None, exc.strerror or str(exc),
-                                        "check the path: its folder must exist, be a folder, and be writable"))
+            print_diagnostic(Diagnostic(str(where), None, None, f"cannot write or read: {exc.strerror or exc}",
+                                        OS_HINTS.get(exc.errno or 0, "check the path")))
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)

@@ -10,7 +10,7 @@ import typer
 
 from tablebot import robopro
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
 from tablebot.diagnostics import fail
 from tablebot.examples import example_path
 from tablebot.robot import BUMBERBOT, load_robot
@@ -43,7 +43,7 @@ def import_cmd(
     if out is None:
         sys.stdout.write(text)
     else:
-        out.write_text(text, encoding="utf-8")
+        out_file(out, "--out").write_text(text, encoding="utf-8")
         err_console.print(f"wrote {out} ({len(table.rows)} rows; descriptions are not in the lists)")
 
 
@@ -61,7 +61,7 @@ def trace_cmd(
     if out is None:
         write_trace(replay(machine, ticks), sys.stdout)
         return
-    with out.open("w", encoding="utf-8") as stream:
+    with out_file(out, "--out").open("w", encoding="utf-8") as stream:
         count = write_trace(replay(machine, ticks), stream)
     err_console.print(f"wrote {out} ({count} ticks)")
 
@@ -73,7 +73,7 @@ def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder fo
     folder = example_path("bumberbot")
     _, machine = load(folder / "table.csv")
     ticks = load_inputs(folder / "inputs.csv", machine)
-    out.mkdir(parents=True, exist_ok=True)
+    out_folder(out, "--out")
     lines = list(replay(machine, ticks))
     with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
         write_trace(lines, stream)

@@ -9,9 +9,10 @@ import typer
 
 from tablebot import robopro, rpp
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.codegen import generate
 from tablebot.diagnostics import fail
+from tablebot.table import Table
 
 
 class Target(StrEnum):
@@ -45,30 +46,34 @@ def export_cmd(
     """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
     parsed, machine = load(table, robot)
     if to == Target.robopro_rpp:
-        if into is None:
-            raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
-        lists = robopro.encode(parsed)
-        named = {event_list: lists.event, action_list: lists.action, timer_list: lists.timer}
-        if len(named) < 3:
-            raise fail("--event-list", "the three list names must differ", "give each list its own name")
-        out = outdir / into.name if outdir else None
-        if outdir:
-            outdir.mkdir(parents=True, exist_ok=True)
-        written, from_csv = rpp.write_lists(into, named, out)
-        console.print(f"wrote {written} (lists {', '.join(named)}: {len(lists.event)} values each)")
-        for name in from_csv:
-            err_console.print(f"warning: list {name} loads its values from a CSV file in ROBO Pro "
-                              "(initcsvcolumn), which replaces the values written here")
+        _export_rpp(parsed, outdir, into, (event_list, action_list, timer_list))
         return
     if outdir is None:
         raise fail("OUTDIR", f"--to {to.value} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
     if to == Target.c:
-        source = generate(machine, lookup.value)
-        for path in source.write(outdir):
+        source = generate(machine, lookup.value)  # before the folder is made: a refused table leaves none
+        for path in source.write(out_folder(outdir, "OUTDIR")):
             console.print(f"wrote {path}")
         lookup_kind = "dense" if source.layout.dense else "scan"
         console.print(f"lookup: {lookup_kind}, {source.layout.lookup_bytes} bytes; "
                       f"table hash 0x{source.layout.table_hash:08x}")
         return
-    for path in robopro.write_lists(robopro.encode(parsed), outdir):
+    lists = robopro.encode(parsed)
+    for path in robopro.write_lists(lists, out_folder(outdir, "OUTDIR")):
         console.print(f"wrote {path}")
+
+
+def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tuple[str, str, str]) -> None:
+    """The three lists written into a ROBO Pro program: ``into`` itself, or its copy in ``outdir``."""
+    if into is None:
+        raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
+    lists = robopro.encode(table)
+    named = dict(zip(names, (lists.event, lists.action, lists.timer), strict=True))
+    if len(named) < 3:
+        raise fail("--event-list", "the three list names must differ", "give each list its own name")
+    out = out_folder(outdir, "OUTDIR") / into.name if outdir else None
+    written, from_csv = rpp.write_lists(into, named, out)
+    console.print(f"wrote {written} (lists {', '.join(named)}: {len(lists.event)} values each)")
+    for name in from_csv:
+        err_console.print(f"warning: list {name} loads its values from a CSV file in ROBO Pro "
+                          "(initcsvcolumn), which replaces the values written here")

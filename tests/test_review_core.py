@@ -1,0 +1,112 @@
+"""Review regressions: a user's first five minutes with bad inputs and bad output paths.
+
+Every case must end with exit code 2, a message that names the file (and line) or the option, a
+hint, and no traceback.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from core_helpers import EXAMPLE, MINI_ROBOT, problems, write_table
+from tablebot.cli import app
+from tablebot.robot import BUMBERBOT
+from tablebot.tablefile import parse_table
+
+runner = CliRunner()
+
+
+def fails(*args: object) -> str:
+    """Run the app; it must exit 2 without an escaped exception. Returns stderr."""
+    result = runner.invoke(app, [str(a) for a in args])
+    assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output and "hint: " in result.stderr, result.stderr
+    return result.stderr
+
+
+# --- input files ------------------------------------------------------------------------------------
+
+def test_folder_without_a_table(tmp_path):
+    assert "holds no table.csv" in fails("check", tmp_path)
+
+
+def test_inputs_that_are_a_folder(tmp_path):
+    assert "is a folder, not a file" in fails("trace", EXAMPLE, "--inputs", tmp_path)
+
+
+def test_robot_file_with_bad_bytes_names_line_and_column(tmp_path):
+    table = write_table(tmp_path, "state,next\n1,1\n")
+    (tmp_path / "robot.toml").write_bytes(b'initial_state = 1\n[motors]\nM1 = "r\xe9chts"\n')
+    (d,) = problems(table)
+    assert (d.line, d.column) == (3, 8) and "0xe9" in d.message and "UTF-8" in d.hint
+
+
+def test_huge_state_numbers_are_read_exactly():
+    big = 99999999999999999999999
+    table = parse_table(f"state,T,next\n2,1,{big}\n{big},1,2\n", "<mem>", BUMBERBOT)
+    assert table.rows[1].state == big
+
+
+def test_bad_state_name_hint_says_what_a_name_may_hold(tmp_path):
+    table = write_table(tmp_path, 'state,next\n"a ""b",1\n1,1\n', MINI_ROBOT)
+    (d,) = problems(table)
+    assert "not a valid state name" in d.message and "A-Z" in d.hint
+
+
+# --- output paths -----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [
+    ["tests", EXAMPLE, "--out"],
+    ["demo", "--out"],
+    ["export", EXAMPLE, "--to", "robopro"],
+    ["export", EXAMPLE, "--to", "c"],
+])
+def test_output_folder_that_is_a_file(tmp_path, command):
+    afile = tmp_path / "afile"
+    afile.write_text("keep me")
+    assert "names a file, not a folder" in fails(*command, afile)
+    assert afile.read_text() == "keep me"
+
+
+def test_counterexample_folder_that_is_a_file(tmp_path):
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    err = fails("check", EXAMPLE, "--properties", EXAMPLE / "properties.toml", "--counterexamples", afile)
+    assert "--counterexamples names a file" in err
+
+
+@pytest.mark.parametrize("command", [
+    ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
+    ["diagram", EXAMPLE, "--format", "dot", "--out"],
+])
+def test_output_file_that_is_a_folder(tmp_path, command):
+    assert "--out names a folder, not a file" in fails(*command, tmp_path)
+
+
+def test_output_file_in_a_missing_folder_says_so(tmp_path):
+    err = fails("trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out", tmp_path / "no" / "t.jsonl")
+    assert "does not exist" in err
+
+
+def test_output_file_below_a_file(tmp_path):
+    (tmp_path / "afile").write_text("")
+    assert "names a file, not a folder" in fails("diagram", EXAMPLE, "--out", tmp_path / "afile" / "x.dot")
+
+
+def test_existing_output_file_is_replaced(tmp_path):
+    out = tmp_path / "t.jsonl"
+    out.write_text("old")
+    result = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(EXAMPLE / "inputs.csv"), "--out", str(out)])
+    assert result.exit_code == 0 and out.read_text().startswith('{"tick":0')
+
+
+def test_unknown_diagram_suffix_names_the_option():
+    assert fails("diagram", EXAMPLE, "--out", Path("x.pdf")).startswith("--out: error: unknown diagram format 'pdf'")
+
+
+def test_unknown_check_target_names_the_option():
+    assert fails("check", EXAMPLE, "--target", "foo").startswith("--target: error: unknown export target 'foo'")
