@@ -16,6 +16,8 @@ DEFAULT_NAMES = ("Event", "Action", "Timer")
 TAG_RE = re.compile(r"""<(/?)([A-Za-z_][\w.:-]*)((?:\s+[^\s=/>]+\s*=\s*(?:"[^"]*"|'[^']*'))*)\s*(/?)>""")
 SKIP_RE = re.compile(r"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<!DOCTYPE[^>]*>", re.S)
 ATTR_RE = re.compile(r"""([^\s=/>]+)\s*=\s*("([^"]*)"|'([^']*)')""")
+DEFAULT_INIT = '<init value="\x00"></init>'  # as ROBO Pro writes an init; \x00 stands for the value
+VALUE_RE = re.compile(r"""value\s*=\s*("[^"]*"|'[^']*')""")
 ENCODING_RE = re.compile(rb"""^(?:\xef\xbb\xbf)?<\?xml[^>]*encoding\s*=\s*["']([\w.-]+)["']""")
 
 
@@ -27,7 +29,7 @@ class ListElement:
     line: int
     start: int
     tag_end: int  # just after the start tag's '>'
-    close: int = -1  # start of its '</o>'
+    close: int = -1  # start of its '</o>'; -1: never closed, -2: written as an empty element <o .../>
     n_span: tuple[int, int] | None = None  # the N attribute's value
     n_value: int = 0
     csv_column: str = "-1"
@@ -74,6 +76,8 @@ def find_lists(text: str) -> list[ListElement]:
             lists.append(element)
         elif tag == "init" and isinstance(parent, ListElement):
             parent.inits.append((m.start(), m.end() if empty else -1))
+        if element is not None and empty:
+            element.close = -2  # written <o .../>: it has no place for children
         if not empty:
             stack.append((tag, element))
     return lists
@@ -98,10 +102,11 @@ def _init_texts(text: str, element: ListElement, values: Sequence[int]) -> tuple
             separator = text[first_end:element.inits[1][0]]
         else:
             separator = newline + _line_indent(text, first_start)
-        form = re.sub(r"""value\s*=\s*("[^"]*"|'[^']*')""", 'value="\x00"', sample, count=1)
+        # an init without a value (<init/>) has no form to copy: take ROBO Pro's own
+        form = VALUE_RE.sub('value="\x00"', sample, count=1) if VALUE_RE.search(sample) else DEFAULT_INIT
         return first_start, element.inits[-1][1], separator.join(form.replace("\x00", str(v)) for v in values)
     indent = _line_indent(text, element.close)
-    lines = "".join(f'{indent}    <init value="{v}"></init>{newline}' for v in values)
+    lines = "".join(f'{indent}    {DEFAULT_INIT.replace(chr(0), str(v))}{newline}' for v in values)
     line_start = text.rfind("\n", 0, element.close) + 1
     if text[line_start:element.close].strip() == "" and line_start > 0:
         return line_start, line_start, lines  # the closing tag has its own line: insert above it
@@ -128,6 +133,10 @@ def rewrite(text: str, lists: Mapping[str, Sequence[int]], path: str | Path = "<
                       f"(lines {', '.join(str(e.line) for e in matches)})", "rename all but one in ROBO Pro")
             continue
         element = matches[0]
+        if element.close == -2:
+            out.error(element.line, None, f"list {name!r} is an empty element <o .../> with no place for values",
+                      f"give it an end tag: <o ...></o>, or give {name} a value in ROBO Pro and save again")
+            continue
         if element.close < 0:
             out.error(element.line, None, f"list {name!r} is never closed", "is the .rpp file complete?")
             continue
@@ -160,8 +169,12 @@ def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None 
     encoding = file_encoding(data)
     try:
         text = data.decode(encoding)
-    except (UnicodeDecodeError, LookupError) as exc:
-        raise fail(rpp, f"not {encoding} text: {exc}", "save the program again in ROBO Pro") from None
+    except UnicodeDecodeError as exc:
+        raise fail(rpp, f"not a ROBO Pro program: byte {exc.start} is not {encoding} text",
+                   "give a .rpp file saved by ROBO Pro") from None
+    except LookupError:
+        raise fail(rpp, f"unknown text encoding {encoding!r} in the XML declaration",
+                   "save the program again in ROBO Pro (it writes UTF-8)", 1) from None
     if "<cvg" not in text[:4096] and LIST_CLASS not in text:
         raise fail(rpp, "not a ROBO Pro program (no <cvg> document element)", "give a .rpp file", 1, 1)
     new = rewrite(text, lists, rpp)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -13,8 +14,8 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.diagnostics import fail
 from tablebot.firmware.boards import load_board
 from tablebot.firmware.build import Firmware, build
-from tablebot.firmware.flash import NOTES, avrdude_command, flash
-from tablebot.firmware.monitor import file_chunks, monitor, serial_chunks
+from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
+from tablebot.firmware.monitor import chunks_from, monitor
 
 
 class BoardName(StrEnum):
@@ -54,20 +55,21 @@ def flash_cmd(
     board: BoardName = BOARD_OPT,
     port: str = typer.Option(..., "--port", help="Serial port of the board's bootloader (/dev/ttyACM0, COM3)."),
     out: Path | None = OUT_OPT,
-    baud: int | None = typer.Option(None, "--baud", help="Bootloader speed (default: the board file's)."),
+    baud: int | None = typer.Option(None, "--baud", min=1, help="Bootloader speed (default: the board file's)."),
     programmer: str | None = typer.Option(None, "--programmer", help="avrdude programmer (default: the board's)."),
     dry_run: bool = typer.Option(False, "--dry-run", help="Print the avrdude command instead of running it."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Write the firmware to a board with avrdude (untested here: no board is attached to CI)."""
+    if not port.strip():
+        raise fail("--port", "the port is empty", "give the board's serial port, such as /dev/ttyACM0 or COM3")
     if table.suffix.lower() == ".hex":
-        if not table.is_file():
-            raise fail(table, "firmware file not found", "build it first: tablebot build TABLE --board BOARD")
+        check_hex(table)
         hexfile = table
     else:
         hexfile = _build(table, board, out, robot).hex
     command = avrdude_command(load_board(board.value), hexfile, port, baud, programmer)
-    console.print(" ".join(command))
+    console.print(shlex.join(command))
     if dry_run:
         return
     if board.value in NOTES:
@@ -84,18 +86,18 @@ def monitor_cmd(
     source: str = typer.Argument(..., help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."),
     table: Path = typer.Option(..., "--table", help="The table the firmware was built from (names states)."),
     out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
-    baud: int = typer.Option(115200, "--baud", help="Serial speed of the trace stream."),
-    ticks: int | None = typer.Option(None, "--ticks", help="Stop after this many ticks."),
-    seconds: float | None = typer.Option(None, "--seconds", help="Stop a serial port after this many seconds."),
+    baud: int = typer.Option(115200, "--baud", min=1, help="Serial speed of the trace stream."),
+    ticks: int | None = typer.Option(None, "--ticks", min=1, help="Stop after this many ticks."),
+    seconds: float | None = typer.Option(None, "--seconds", min=0.001,
+                                         help="Stop a serial port after this many seconds."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Decode a firmware's trace stream into the core's JSON Lines trace, one line per tick."""
     _, machine = load(table, robot)
-    path = Path(source)
-    chunks = file_chunks(path) if path.is_file() else serial_chunks(source, baud, seconds)
+    chunks = chunks_from(source, baud, seconds)
 
     def warn(text: str) -> None:
-        err_console.print(text, markup=False)
+        err_console.print(text, markup=False, soft_wrap=True)
 
     if out is None:
         count = monitor(machine, chunks, sys.stdout, source, ticks, warn)

@@ -7,10 +7,12 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
+from pathlib import Path
 from typing import Any
 
-from tablebot.diagnostics import Collector, fail
+from tablebot.diagnostics import fail
 from tablebot.robot import Robot
+from tablebot.tomlfile import Source
 
 BOARDS = ("uno", "ftduino")
 
@@ -65,40 +67,74 @@ class Wiring:
         return taken | set(self.lamps.values())
 
 
-def _overrides(robot: Robot, board: Board, out: Collector) -> tuple[dict[str, str], frozenset[str]]:
-    section = robot.sections.get("board", {})
-    mine = section.get(board.name, {}) if isinstance(section, dict) else {}
+def _robot_source(robot: Robot) -> Source:
+    """The robot file again, for the lines of its keys (the built-in robot has no file)."""
+    return Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
+
+
+def _overrides(robot: Robot, board: Board, src: Source) -> tuple[dict[str, str], frozenset[str]]:
+    """The robot file's ``[board.NAME]``: terminal per robot name, and the active-high inputs."""
+    section = f"board.{board.name}"
+    boards = robot.sections.get("board", {})
+    mine = boards.get(board.name, {}) if isinstance(boards, dict) else {}
     if not isinstance(mine, dict):
-        out.error(None, None, f"[board.{board.name}] must be a table of NAME = \"TERMINAL\"",
+        src.error(("board", None, board.name), f"[{section}] must be a table of NAME = \"TERMINAL\"",
                   'for example: I3 = "D4"')
         return {}, frozenset()
     active_high = mine.get("active_high", [])
     if not isinstance(active_high, list) or not all(isinstance(n, str) for n in active_high):
-        out.error(None, None, f"[board.{board.name}] active_high must be a list of input names",
+        src.error((section, None, "active_high"), f"[{section}] active_high must be a list of input names",
                   'for example: active_high = ["I7", "I8"]')
         active_high = []
     for name in active_high:
         if name not in robot.inputs:
-            out.error(None, None, f"[board.{board.name}] active_high names {name!r}, not an input",
-                      f"inputs are {', '.join(robot.inputs)}")
-    maps = {k: str(v) for k, v in mine.items() if k != "active_high"}
+            src.error((section, None, "active_high"), f"[{section}] active_high names {name!r}, not an input",
+                      f"inputs are {', '.join(robot.inputs) or 'none'}")
+    maps = {}
+    for name, terminal in mine.items():
+        if name == "active_high":
+            continue
+        if name not in (*robot.inputs, *robot.motors, *robot.lamps, *robot.counter_names):
+            src.error((section, None, name), f"[{section}] maps {name!r}, which the robot does not have",
+                      "map the robot's inputs, motors, lamps and counters")
+        elif not isinstance(terminal, str):
+            src.error((section, None, name), f"[{section}] {name} must be a terminal name, not {terminal!r}",
+                      f'write it in quotes, for example: {name} = "{_example(board, robot, name)}"')
+        else:
+            maps[name] = terminal
     return maps, frozenset(active_high)
 
 
+def _example(board: Board, robot: Robot, name: str) -> str:
+    """A terminal of the board for the kind of signal ``name`` is, for hints."""
+    kinds = ((robot.inputs, board.inputs), (robot.motors, board.motors), (robot.lamps, board.lamps),
+             (robot.counter_names, board.counters))
+    terminals = next((tuple(terminals) for names, terminals in kinds if name in names), ())
+    return terminals[0] if terminals else "?"
+
+
+def _unknown_terminal_hint(kind: str, want: str, terminals: tuple[str, ...]) -> str:
+    same = [t for t in terminals if t.lower() == want.lower()]
+    if same:
+        return f"terminal names are case-sensitive: write {same[0]!r}"
+    return f"{kind} terminals: {', '.join(terminals) or 'none'}"
+
+
 def _assign(kind: str, names: tuple[str, ...], terminals: tuple[str, ...], maps: dict[str, str],
-            taken: set[str], board: Board, out: Collector) -> dict[str, str]:
+            taken: set[str], board: Board, src: Source) -> dict[str, str]:
     """Explicit map first, then a terminal of the same name, then the next free terminal."""
     chosen: dict[str, str] = {}
+    section = f"board.{board.name}"
     for name in names:
         want = maps.get(name) or (name if name in terminals and name not in taken else None)
         if want is None:
             continue
         if want not in terminals:
-            out.error(None, None, f"{kind} {name} cannot use {want!r} on the {board.name} board",
-                      f"{kind} terminals: {', '.join(terminals) or 'none'}")
+            src.error((section, None, name), f"{kind} {name} cannot use {want!r} on the {board.name} board",
+                      _unknown_terminal_hint(kind, want, terminals))
         elif want in taken:
-            out.error(None, None, f"{kind} {name}: terminal {want} is already used",
-                      f"give {name} another terminal in [board.{board.name}]")
+            src.error((section, None, name), f"{kind} {name}: terminal {want} is already used",
+                      f"give {name} another terminal in [{section}]")
         else:
             chosen[name] = want
             taken.add(want)
@@ -107,8 +143,9 @@ def _assign(kind: str, names: tuple[str, ...], terminals: tuple[str, ...], maps:
         if name in chosen or name in maps:
             continue
         if not free:
-            out.error(None, None, f"the {board.name} board has no free terminal for {kind} {name}",
-                      f"{kind} terminals: {', '.join(terminals) or 'none'}")
+            src.error((f"{kind}s", None, name), f"the {board.name} board has no free terminal for {kind} {name}",
+                      f"its {kind} terminals ({', '.join(terminals) or 'none'}) are all taken: use fewer "
+                      f"{kind}s, or another board")
             continue
         chosen[name] = free.pop(0)
         taken.add(chosen[name])
@@ -117,18 +154,14 @@ def _assign(kind: str, names: tuple[str, ...], terminals: tuple[str, ...], maps:
 
 def wire(robot: Robot, board: Board) -> Wiring:
     """Assign every robot signal to a terminal, reporting all conflicts at once."""
-    out = Collector(robot.source)
-    maps, active_high = _overrides(robot, board, out)
-    for name in maps:
-        if name not in (*robot.inputs, *robot.motors, *robot.lamps, *robot.counter_names):
-            out.error(None, None, f"[board.{board.name}] maps {name!r}, which the robot does not have",
-                      "map the robot's inputs, motors, lamps and counters")
+    src = _robot_source(robot)
+    maps, active_high = _overrides(robot, board, src)
     taken: set[str] = set()
-    inputs = _assign("input", robot.inputs, tuple(board.inputs), maps, taken, board, out)
-    motors = _assign("motor", robot.motors, tuple(board.motors), maps, set(), board, out)
+    inputs = _assign("input", robot.inputs, tuple(board.inputs), maps, taken, board, src)
+    motors = _assign("motor", robot.motors, tuple(board.motors), maps, set(), board, src)
     motor_outputs = {o for m in motors.values() for o in board.motors[m].split()}
     lamp_terminals = tuple(t for t in board.lamps if t not in motor_outputs)
-    lamps = _assign("lamp", robot.lamps, lamp_terminals, maps, taken, board, out)
-    counters = _assign("counter", robot.counter_names, tuple(board.counters), maps, set(), board, out)
-    out.raise_if_any()
+    lamps = _assign("lamp", robot.lamps, lamp_terminals, maps, taken, board, src)
+    counters = _assign("counter", robot.counter_names, tuple(board.counters), maps, set(), board, src)
+    src.raise_if_any()
     return Wiring(board, inputs, motors, lamps, counters, active_high)

@@ -7,6 +7,7 @@ from __future__ import annotations
 from tablebot.codegen.layout import Layout
 from tablebot.diagnostics import fail
 from tablebot.firmware.boards import Wiring
+from tablebot.firmware.framing import tick_payload
 from tablebot.machine import Machine
 
 PRESCALERS = ((1, "(1 << CS10)"), (8, "(1 << CS11)"), (64, "((1 << CS11) | (1 << CS10))"),
@@ -18,13 +19,6 @@ EXTINT = {"atmega328p": {"PD2": 0, "PD3": 1}, "atmega32u4": {"PD0": 0, "PD1": 1,
 FT_HIGHSIDE = (2, 6, 4, 5)
 FT_LOWSIDE = (8, 1, 7, 3)
 FT_THRESHOLD = 512  # half scale: below it an input is pulled low (closed switch, lit sensor)
-HELLO_PAYLOAD = 12
-
-
-def tick_payload(machine: Machine, layout: Layout) -> int:
-    """Bytes of a tick frame's payload: tick, event, row, state, timer, outputs, counters."""
-    return (2 + layout.event.size + layout.row.size + layout.state.size + 2
-            + len(machine.output_names) + 2 * len(machine.table.robot.counters))
 
 
 def tx_size(payload: int) -> int:

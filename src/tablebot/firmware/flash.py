@@ -26,6 +26,17 @@ def avrdude_command(board: Board, hexfile: Path, port: str, baud: int | None = N
             "-b", str(baud or settings["baud"]), "-D", "-U", f"flash:w:{hexfile}:i"]
 
 
+def check_hex(path: Path) -> None:
+    """Refuse, before avrdude sees it, a file that is missing or is not Intel HEX (every record starts ':')."""
+    if not path.is_file():
+        raise fail(path, "firmware file not found", "build it first: tablebot build TABLE --board BOARD")
+    with path.open("rb") as f:
+        first = f.readline().strip()
+    if not first.startswith(b":"):
+        raise fail(path, "not an Intel HEX file: its first line does not start with ':'",
+                   "give the .hex file that `tablebot build` wrote, or the table itself", 1, 1)
+
+
 def flash(command: list[str]) -> int:
     """Run avrdude; its own output goes to the terminal. Returns its exit status."""
     if not shutil.which(command[0]):

@@ -37,6 +37,12 @@ class Hello:
     n_counters: int
 
 
+def tick_payload(machine: Machine, layout: Layout) -> int:
+    """Bytes of a tick frame's payload: tick, event, row, state, timer, outputs, counters."""
+    return (2 + layout.event.size + layout.row.size + layout.state.size + 2
+            + len(machine.output_names) + 2 * len(machine.table.robot.counters))
+
+
 def checksum(body: bytes) -> int:
     return -sum(body) & 0xFF
 
@@ -56,15 +62,16 @@ class Decoder:
     problems: list[str] = field(default_factory=list)
     buffer: bytearray = field(default_factory=bytearray)
     last_tick: int | None = None
+    consumed: int = 0  # bytes of the stream before ``buffer``: positions in problems count from the start
+    ticks: int = 0  # tick frames decoded so far
+    rejected: int = 0  # whole tick frames this table's engine could not have sent
 
     def __post_init__(self) -> None:
         if self.layout is None:
             self.layout = plan(self.machine)
-        lay = self.layout
         self.n_outputs = len(self.machine.output_names)
         self.n_counters = len(self.machine.table.robot.counters)
-        self.tick_payload = (2 + lay.event.size + lay.row.size + lay.state.size + 2
-                             + self.n_outputs + 2 * self.n_counters)
+        self.lengths = {HELLO: HELLO_PAYLOAD, TICK: tick_payload(self.machine, self.layout)}  # payload per type
 
     def feed(self, data: bytes) -> list[dict[str, Any]]:
         self.buffer += data
@@ -75,7 +82,7 @@ class Decoder:
             at = buf.find(SYNC, at)
             if at < 0 or at + 2 > len(buf):
                 break
-            length = {HELLO: HELLO_PAYLOAD, TICK: self.tick_payload}.get(buf[at + 1])
+            length = self.lengths.get(buf[at + 1])
             if length is None:
                 at += 1  # not a frame start: resynchronise on the next sync byte
                 continue
@@ -84,14 +91,17 @@ class Decoder:
                 break
             body = bytes(buf[at + 1:end])
             if sum(body) & 0xFF:
-                self.problems.append(f"bad checksum at byte {at} of this chunk; resynchronising")
+                self.problems.append(f"bad checksum at byte {self.consumed + at}; resynchronising")
                 at += 1
                 continue
             line = self._frame(body[0], body[1:-1])
             if line is not None:
                 lines.append(line)
             at = end
-        del buf[:at if at >= 0 else len(buf)]
+        done = at if at >= 0 else len(buf)
+        del buf[:done]
+        self.consumed += done
+        self.ticks += len(lines)
         return lines
 
     def _frame(self, kind: int, payload: bytes) -> dict[str, Any] | None:
@@ -111,15 +121,39 @@ class Decoder:
             values.append(int.from_bytes(payload[at:at + size], "little"))
             at += size
         tick16, event, row, state, timer = values
-        if state >= len(self.machine.states):
-            self.problems.append(f"tick frame names state index {state}: not this table's firmware?")
+        row = NO_ROW if row == lay.no_row else row
+        wrong = self._impossible(event, row, state, timer)
+        if wrong:
+            self.problems.append(f"tick frame {tick16} {wrong}: not this table's firmware?")
+            self.rejected += 1
             return None
         outputs = [b - 256 if b > 127 else b for b in payload[at:at + self.n_outputs]]
         at += self.n_outputs
         counters = [int.from_bytes(payload[at + 2 * i:at + 2 * i + 2], "little") for i in range(self.n_counters)]
         tick = self._unwrap(tick16)
-        return trace_line(self.machine, tick, event, NO_ROW if row == lay.no_row else row, state, timer,
-                          outputs, counters)
+        return trace_line(self.machine, tick, event, row, state, timer, outputs, counters)
+
+    def _impossible(self, event: int, row: int, state: int, timer: int) -> str:
+        """What this table's engine could never report ("" when nothing), so that frames of another
+        table's firmware are not read as this one's: a fired row sets its next state and timer; with
+        no row fired, none matches and T is present exactly when the timer is 0."""
+        machine = self.machine
+        if state >= len(machine.states):
+            return f"names state index {state}"
+        if event >> len(machine.table.events):
+            return f"has event bits {event:#x} beyond the table's {len(machine.table.events)} events"
+        if row == NO_ROW:
+            if machine.lookup(state, event) != NO_ROW:
+                return f"says no row fired, but row {machine.lookup(state, event)} matches its events"
+            if machine.timer_bit and (timer == 0) != bool(event & machine.timer_bit):
+                return f"has timer {timer} but {'no ' * (timer == 0)}T event"
+            return ""
+        if row >= len(machine.rows):
+            return f"names row {row}"
+        fired = machine.rows[row]
+        if (fired.next, fired.timer) != (state, timer) or fired.mask & event != fired.mask:
+            return f"says row {row} fired, but its events, state or timer are not that row's"
+        return ""
 
     def _unwrap(self, tick16: int) -> int:
         """Full tick numbers from their low 16 bits; a jump means frames were lost."""

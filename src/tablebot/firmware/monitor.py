@@ -4,6 +4,7 @@ decoded into the core's JSON Lines trace.
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -16,6 +17,21 @@ from tablebot.machine import Machine
 from tablebot.trace import dumps
 
 CHUNK = 4096
+MAX_WARNINGS = 20  # a stream of garbage would otherwise print a warning per sync byte
+PORT_RE = re.compile(r"^(/dev/|COM\d+$|\\\\\.\\|\w+://)", re.IGNORECASE)  # /dev/tty*, COM3, \\.\COM10, URLs
+
+
+def chunks_from(source: str, baud: int, seconds: float | None) -> Iterator[bytes]:
+    """The bytes of a capture file, or of a serial port when ``source`` names one."""
+    path = Path(source)
+    if path.is_dir():
+        raise fail(source, "is a folder, not a capture file or serial port", "give the file of captured bytes")
+    if path.is_file():
+        return file_chunks(path)
+    if not PORT_RE.match(source):
+        raise fail(source, "no such file, and not a serial port name",
+                   "give a file of captured UART bytes, or a port such as /dev/ttyACM0 or COM3")
+    return serial_chunks(source, baud, seconds)
 
 
 def file_chunks(path: Path) -> Iterator[bytes]:
@@ -55,21 +71,41 @@ def check_hello(decoder: Decoder, source: str) -> None:
 
 def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str,
             ticks: int | None = None, warn: Callable[[str], Any] = print) -> int:
-    """Decode until the chunks end or ``ticks`` lines are written; returns the lines written."""
+    """Decode until the chunks end or ``ticks`` lines are written; returns the lines written.
+
+    A stream in which no frame decodes at all is refused: it is not this firmware's trace.
+    """
     decoder = Decoder(machine, plan(machine))
-    written = 0
+    written = warned = 0
     for chunk in chunks:
         lines = decoder.feed(chunk)
         check_hello(decoder, source)
-        for problem in decoder.problems:
-            warn(f"{source}: warning: {problem}")
-        decoder.problems.clear()
-        for line in lines:
+        warned = _warn(decoder, source, warn, warned)
+        for line in lines[:len(lines) if ticks is None else ticks - written]:
             out.write(dumps(line) + "\n")
             written += 1
-            if ticks is not None and written >= ticks:
-                return written
+        if ticks is not None and written >= ticks:
+            return written
         out.flush()
+    if not decoder.hellos and not decoder.ticks:
+        raise fail(source, f"no trace frame in {decoder.consumed + len(decoder.buffer)} bytes",
+                   "give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this table by "
+                   "`tablebot build`")
+    if decoder.rejected * 10 > decoder.rejected + decoder.ticks:  # more than noise: another table's stream
+        raise fail(source, f"{decoder.rejected} of {decoder.rejected + decoder.ticks} tick frames are impossible for "
+                   "this table", "give the table the firmware was built from")
     if decoder.buffer:
         warn(f"{source}: warning: {len(decoder.buffer)} bytes at the end are not a whole frame")
     return written
+
+
+def _warn(decoder: Decoder, source: str, warn: Callable[[str], Any], warned: int) -> int:
+    """Pass the decoder's new problems on, up to MAX_WARNINGS in all; returns how many were passed."""
+    for problem in decoder.problems:
+        if warned < MAX_WARNINGS:
+            warn(f"{source}: warning: {problem}")
+        elif warned == MAX_WARNINGS:
+            warn(f"{source}: warning: more problems follow; not shown")
+        warned += 1
+    decoder.problems.clear()
+    return warned
