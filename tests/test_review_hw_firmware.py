@@ -192,3 +192,20 @@ def test_binary_and_unknown_encoding_files_are_not_programs(tmp_path: Path) -> N
     odd.write_text('<?xml version="1.0" encoding="klingon"?>\n<cvg></cvg>\n', encoding="utf-8")
     result = invoke("export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(odd))
     assert result.exit_code == 2 and "unknown text encoding 'klingon'" in result.output
+
+
+# --- output paths -----------------------------------------------------------------------------------
+
+def test_build_out_naming_a_file_is_refused_before_building(tmp_path: Path) -> None:
+    afile = tmp_path / "afile"
+    afile.write_text("keep", encoding="utf-8")
+    result = invoke("build", str(EXAMPLE), "--board", "uno", "--out", str(afile))
+    assert result.exit_code == 2 and "--out names a file, not a folder" in result.output
+
+
+def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path, bumberbot) -> None:
+    machine, trace = bumberbot
+    capture = tmp_path / "uart.bin"
+    capture.write_bytes(encode(machine, trace))
+    result = invoke("monitor", str(capture), "--table", str(EXAMPLE), "--out", str(tmp_path))
+    assert result.exit_code == 2 and "--out names a folder, not a file" in result.output

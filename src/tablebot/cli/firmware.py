@@ -10,7 +10,7 @@ from pathlib import Path
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
 from tablebot.diagnostics import fail
 from tablebot.firmware.boards import load_board
 from tablebot.firmware.build import Firmware, build
@@ -29,7 +29,7 @@ OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: bu
 
 def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
     _, machine = load(table, robot)
-    firmware = build(machine, board.value, out or Path("build") / "firmware" / board.value)
+    firmware = build(machine, board.value, out_folder(out or Path("build") / "firmware" / board.value, "--out"))
     wiring = firmware.wiring
     assert wiring is not None
     pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
@@ -102,6 +102,6 @@ def monitor_cmd(
     if out is None:
         count = monitor(machine, chunks, sys.stdout, source, ticks, warn)
     else:
-        with out.open("w", encoding="utf-8") as stream:
+        with out_file(out, "--out").open("w", encoding="utf-8") as stream:
             count = monitor(machine, chunks, stream, source, ticks, warn)
         err_console.print(f"wrote {out} ({count} ticks)")

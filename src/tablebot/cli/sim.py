@@ -9,8 +9,7 @@ import typer
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
-from tablebot.diagnostics import fail
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 
 
 @app.command("sim")
@@ -43,7 +42,7 @@ def sim_cmd(
     overrides = {"battery": {"charge": charge}} if charge is not None else {}
     setup = sim_setup.setup_for(parsed, machine, world, overrides)
     ticks = ticks_for(setup, seconds)  # refuses too long a run before anything is written
-    _output_folder(out)
+    out_folder(out, "--out")  # before the run, so that a bad path fails at once
     result = _run_with_progress(run, setup, seconds, seed, None if quiet else ticks)
     with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
         write_trace(result, stream)
@@ -64,16 +63,6 @@ def sim_cmd(
     if view:
         from tablebot.sim.animate import show
         show(result, summary)
-
-
-def _output_folder(out: Path) -> None:
-    """Make --out before a long run, so that a bad path fails at once."""
-    if out.exists() and not out.is_dir():
-        raise fail(out, "--out names a file, not a folder", "give --out a folder (it is created if missing)")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise fail(out, f"cannot create the output folder: {exc.strerror}", "choose another --out") from None
 
 
 def _run_with_progress(run, setup, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]
