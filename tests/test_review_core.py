@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from core_helpers import EXAMPLE, MINI_ROBOT, problems, write_table
+from core_helpers import EXAMPLE, MINI_ROBOT, find, problems, write_table
 from tablebot.cli import app
 from tablebot.robot import BUMBERBOT
 from tablebot.tablefile import parse_table
@@ -110,3 +110,47 @@ def test_unknown_diagram_suffix_names_the_option():
 
 def test_unknown_check_target_names_the_option():
     assert fails("check", EXAMPLE, "--target", "foo").startswith("--target: error: unknown export target 'foo'")
+
+
+# --- robot files with wrong types -------------------------------------------------------------------
+
+GOOD_TABLE = "state,T,A,M1,timer,next\n1,1,,3,10,1\n"
+
+
+@pytest.mark.parametrize(("change", "pattern", "line"), [
+    (("initial_timer = 0", "initial_timer = true"), "initial_timer must be a whole number 0..65535, not True", 3),
+    (("initial_timer = 0", "initial_timer = 1.5"), "initial_timer must be", 3),
+    (("initial_state = 1", "initial_state = true"), "initial_state True is not a state", 2),
+    (("initial_state = 1", "initial_state = [1]"), r"initial_state \[1\] is not a state", 2),
+    (("initial_state = 1", "initial_state = 1.0"), "initial_state 1.0 is not a state", 2),
+    (("initial_state = 1", "initial_state = -1"), "initial_state -1 is not a state", 2),
+    (("initial_state = 1", "initial_state = {a = 1}"), "is not a state", 2),
+    (("initial_state = 1", 'initial_state = "a \\"b"'), "is not a state", 2),
+    (('name = "Mini"', "name = 5"), "name must be text, not 5", 1),
+    (('M1 = "right"', "M1 = 7"), r"\[motors\] M1: the label must be text, not 7", 8),
+    (('A = "left switch"', "A = {a = 1}"), r"\[inputs\] A: the label must be text", 5),
+    (("initial_timer = 0", "initial_timer = 0\ntick_ms = 99999999999999999999"), "tick_ms must be a positive", 4),
+    (("initial_timer = 0", "initial_timer = 0\ntick_ms = true"), "tick_ms must be a positive whole number", 4),
+    (("[motors]", "tick_ms = 5\n[motors]"), r"tick_ms is inside \[inputs\]", 7),
+])
+def test_robot_file_wrong_types(tmp_path, change, pattern, line):
+    robot = MINI_ROBOT.replace(*change)
+    assert robot != MINI_ROBOT
+    d = find(problems(write_table(tmp_path, GOOD_TABLE, robot)), pattern)
+    assert d.path.endswith("robot.toml") and d.line == line and d.hint
+
+
+@pytest.mark.parametrize(("extra", "pattern", "line"), [
+    ('[states]\n1 = ["x"]\n', r"\[states\] 1: the name must be text", 11),
+    ('[states]\n"-3" = "neg"\n', r"\[states\] '-3' is not a state", 11),
+    ('[counters]\nC1 = {motor = "M1", extra = 3}\n', "counter C1 may only say motor", 11),
+    ('[counters]\nC1 = 5\n', "counter C1 counts motor 5", 11),
+])
+def test_robot_file_wrong_types_in_sections(tmp_path, extra, pattern, line):
+    d = find(problems(write_table(tmp_path, GOOD_TABLE, MINI_ROBOT + extra)), pattern)
+    assert d.line == line and d.hint
+
+
+def test_robot_file_errors_go_through_the_cli(tmp_path):
+    table = write_table(tmp_path, GOOD_TABLE, MINI_ROBOT.replace("initial_timer = 0", "initial_timer = true"))
+    assert "robot.toml:3:1: error: initial_timer must be" in fails("check", table)

@@ -11,17 +11,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tablebot.diagnostics import Collector
-from tablebot.tomlfile import read_toml
+from tablebot.tomlfile import Source, Where
 
 StateId = int | str
 
 #: Sections of a robot file that belong to other stages (simulator, checker, hardware);
 #: the core keeps them as plain data and does not interpret them.
 FOREIGN_SECTIONS = ("sim", "wiring", "properties", "board")
-KNOWN_KEYS = ("name", "tick_ms", "initial_state", "initial_timer", "inputs", "motors",
-              "counters", "lamps", "states", *FOREIGN_SECTIONS)
+TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
+KNOWN_KEYS = (*TOP_KEYS, "inputs", "motors", "counters", "lamps", "states", *FOREIGN_SECTIONS)
 NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
+#: A state name as tables and robot files write it (a state is otherwise a whole number 0 or more).
+STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
+STATE_HINT = "use a number, or a name that starts with A-Z or _ (then letters, digits, spaces, _ . -)"
+#: Timer loads and the initial timer are 16-bit tick counts; one tick lasts at most a minute.
+MAX_TIMER = 65535
+MAX_TICK_MS = 60_000
 RESERVED_NAMES = {"T", "description", "state", "timer", "next"}
 #: Header names the table parser reads case-insensitively as fixed columns (aliases included).
 RESERVED_LOWER = {"description", "desc", "state", "st", "timer", "next"}
@@ -80,108 +85,157 @@ def find_robot_file(table_path: Path) -> Path | None:
     return None
 
 
-def _key_line(text: str, key: str) -> int | None:
-    """Line of ``key = …`` or ``[key]`` in TOML text, for error messages (tomllib keeps no positions)."""
-    pattern = re.compile(rf"^\s*(\[\s*{re.escape(key)}\s*\]|\"?{re.escape(key)}\"?\s*=)")
-    for number, line in enumerate(text.splitlines(), start=1):
-        if pattern.match(line):
-            return number
-    return None
+def load_robot(path: Path) -> Robot:
+    """Read a robot TOML file, reporting every problem with its line."""
+    src = Source.read(path, "see the robot file format in the README")
+    data = src.data
+    for key in data:
+        if key not in KNOWN_KEYS:
+            _error(src, ("", None, key), f"unknown key {key!r}", f"known keys: {', '.join(KNOWN_KEYS)}")
+    inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
+    counters = _counters(src, motors)
+    _distinct(src, {"inputs": inputs, "motors": motors, "lamps": lamps, "counters": {c.name: "" for c in counters}})
+    if not motors and not lamps:
+        src.out.error(None, None, "the robot has no [motors] and no [lamps]",
+                      'add a section like [motors] with M1 = "right motor"')
+    tick_ms = _whole(src, "tick_ms", 10, (1, MAX_TICK_MS), f"a positive whole number up to {MAX_TICK_MS}",
+                     "the document's engine ticks every 10 ms: tick_ms = 10")
+    initial_timer = _whole(src, "initial_timer", 0, (0, MAX_TIMER), f"a whole number 0..{MAX_TIMER}",
+                           "the timer counts ticks; 0 means it has expired")
+    initial_state = _initial_state(src)
+    states = _state_names(src)
+    name = data.get("name", path.stem)
+    if not isinstance(name, str):
+        _error(src, ("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
+    src.raise_if_any()
+    return Robot(
+        name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
+        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms,
+        labels={**inputs, **motors, **lamps}, state_names=states,
+        sections={k: data[k] for k in FOREIGN_SECTIONS if k in data}, source=str(path),
+        lines={key: line for key, where in (("initial_state", ("", None, "initial_state")),
+                                             *((str(s), ("states", None, str(s))) for s in states))
+               if (line := src.line(*where)) is not None},
+    )
 
 
-def _error(out: Collector, line: int | None, message: str, hint: str) -> None:
+def _error(src: Source, where: Where, message: str, hint: str) -> None:
     """A robot-file problem at the start of its line (TOML keys start lines)."""
-    out.error(line, None if line is None else 1, message, hint)
+    line = src.line(*where)
+    src.out.error(line, None if line is None else 1, message, hint)
 
 
-def _names(section: Any, key: str, text: str, out: Collector) -> dict[str, str]:
+def _names(src: Source, key: str) -> dict[str, str]:
     """A ``[inputs]``-style table of NAME = "label" pairs (or a list of names)."""
+    section = src.data.get(key)
     if section is None:
         return {}
     if isinstance(section, list):
         section = {str(name): "" for name in section}
     if not isinstance(section, dict):
-        _error(out, _key_line(text, key), f"[{key}] must be a table of NAME = \"label\"",
-                  'for example: I3 = "front-right bumper"')
+        _error(src, ("", None, key), f"[{key}] must be a table of NAME = \"label\"",
+               'for example: I3 = "front-right bumper"')
         return {}
-    names: dict[str, str] = {}
     for name, label in section.items():
-        _check_name(name, key, text, out)
-        names[name] = label if isinstance(label, str) else str(label)
-    return names
+        if _good_name(src, key, name) and not isinstance(label, str):
+            _error(src, (key, None, name), f"[{key}] {name}: the label must be text, not {label!r}",
+                   f'write it in quotes: {name} = "what it is"')
+    return {name: str(label) for name, label in section.items()}
 
 
-def _check_name(name: str, key: str, text: str, out: Collector) -> None:
+def _good_name(src: Source, key: str, name: str) -> bool:
     """Names become column headers, so they must not clash with the fixed columns or suffixes."""
-    if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-        _error(out, _key_line(text, name), f"bad {key} name {name!r}",
-                  "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
-
-
-def _state_id(value: Any) -> StateId:
-    """A state as the table parser reads it: digits are the integer state (``"2"`` is state 2)."""
-    if isinstance(value, int):
-        return value
-    text = str(value).strip()
-    return int(text) if text.isascii() and text.isdigit() else text
-
-
-def load_robot(path: Path) -> Robot:
-    """Read a robot TOML file, reporting every problem with its line."""
-    data, text = read_toml(path, "see the robot file format in the README")
-    out = Collector(path)
-    for key in data:
-        if key not in KNOWN_KEYS:
-            _error(out, _key_line(text, key), f"unknown key {key!r}",
-                      f"known keys: {', '.join(KNOWN_KEYS)}")
-    inputs = _names(data.get("inputs"), "inputs", text, out)
-    motors = _names(data.get("motors"), "motors", text, out)
-    lamps = _names(data.get("lamps"), "lamps", text, out)
-    counters_raw = data.get("counters") or {}
-    counters: list[Counter] = []
-    if isinstance(counters_raw, dict):
-        for name, motor in counters_raw.items():
-            _check_name(name, "counters", text, out)
-            motor_name = motor.get("motor") if isinstance(motor, dict) else motor
-            if motor_name not in motors:
-                _error(out, _key_line(text, name),
-                          f"counter {name} counts motor {motor_name!r}, which is not in [motors]",
-                          f'write {name} = "M1" with a motor name from [motors]')
-            counters.append(Counter(name, str(motor_name)))
+    if name in TOP_KEYS:  # a top-level key written below a [section] header belongs to that section
+        _error(src, (key, None, name), f"{name} is inside [{key}]",
+               f"move {name} = … above the first [section]: every key below [{key}] belongs to it")
+    elif not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
+        _error(src, (key, None, name), f"bad {key} name {name!r}",
+               "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
     else:
-        _error(out, _key_line(text, "counters"), "[counters] must be a table of C1 = \"M1\"",
-                  "each counter names the motor whose encoder it counts")
-    all_names = [*inputs, *motors, *lamps, *(c.name for c in counters)]
-    for name in {n for n in all_names if all_names.count(n) > 1}:
-        _error(out, _key_line(text, name), f"name {name} is used twice",
-                  "inputs, motors, counters and lamps need distinct names")
-    if not motors and not lamps:
-        out.error(None, None, "the robot has no [motors] and no [lamps]",
-                  'add a section like [motors] with M1 = "right motor"')
-    tick_ms = data.get("tick_ms", 10)
-    if not isinstance(tick_ms, int) or isinstance(tick_ms, bool) or tick_ms <= 0:
-        _error(out, _key_line(text, "tick_ms"), f"tick_ms must be a positive integer, not {tick_ms!r}",
-                  "the document's engine ticks every 10 ms: tick_ms = 10")
-    initial_timer = data.get("initial_timer", 0)
-    if not isinstance(initial_timer, int) or not 0 <= initial_timer <= 65535:
-        _error(out, _key_line(text, "initial_timer"),
-                  f"initial_timer must be an integer 0..65535, not {initial_timer!r}",
-                  "the timer counts ticks; 0 means it has expired")
-    if "initial_state" not in data:
-        out.error(None, None, "initial_state is missing", "add a line like: initial_state = 2")
-    states = data.get("states") or {}
-    if not isinstance(states, dict):
-        _error(out, _key_line(text, "states"), "[states] must be a table of NUMBER = \"name\"",
+        return True
+    return False
+
+
+def _counters(src: Source, motors: dict[str, str]) -> list[Counter]:
+    """``[counters]``: C1 = "M1" (or C1 = {motor = "M1"}), each counting one motor's encoder."""
+    section = src.data.get("counters") or {}
+    if not isinstance(section, dict):
+        _error(src, ("", None, "counters"), "[counters] must be a table of C1 = \"M1\"",
+               "each counter names the motor whose encoder it counts")
+        return []
+    counters = []
+    for name, value in section.items():
+        _good_name(src, "counters", name)
+        motor = value.get("motor") if isinstance(value, dict) else value
+        if isinstance(value, dict) and set(value) != {"motor"}:
+            _error(src, ("counters", None, name), f"counter {name} may only say motor = \"M1\", not "
+                   f"{', '.join(sorted(set(value) - {'motor'})) or 'nothing'}", f'write {name} = "M1"')
+        elif motor not in motors:
+            _error(src, ("counters", None, name), f"counter {name} counts motor {motor!r}, which is not in [motors]",
+                   f'write {name} = "M1" with a motor name from [motors]')
+        counters.append(Counter(name, str(motor)))
+    return counters
+
+
+def _distinct(src: Source, sections: dict[str, dict[str, str]]) -> None:
+    """Inputs, motors, lamps and counters share the table's header, so a name may be used once."""
+    first: dict[str, str] = {}
+    for key, names in sections.items():
+        for name in names:
+            if name in first and first[name] != key:
+                _error(src, (first[name], None, name), f"name {name} is used twice ([{first[name]}] and [{key}])",
+                       "inputs, motors, counters and lamps need distinct names")
+            first.setdefault(name, key)
+
+
+def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], want: str, hint: str) -> int:
+    """A top-level whole number within ``bounds`` (``default`` when absent or after reporting why not)."""
+    value = src.data.get(key, default)
+    if not isinstance(value, int) or isinstance(value, bool) or not bounds[0] <= value <= bounds[1]:
+        _error(src, ("", None, key), f"{key} must be {want}, not {value!r}", hint)
+        return default
+    return value
+
+
+def _state_id(value: Any) -> StateId | None:
+    """A state as the table parser reads it (``"2"`` is state 2), or None if no table could name it."""
+    if isinstance(value, bool) or not isinstance(value, int | str):
+        return None
+    if isinstance(value, int):
+        return value if value >= 0 else None
+    text = value.strip()
+    if text.isascii() and text.isdigit():
+        return int(text)
+    return text if STATE_RE.match(text) else None
+
+
+def _initial_state(src: Source) -> StateId:
+    if "initial_state" not in src.data:
+        src.out.error(None, None, "initial_state is missing", "add a line like: initial_state = 2")
+        return 0
+    state = _state_id(src.data["initial_state"])
+    if state is None:
+        _error(src, ("", None, "initial_state"), f"initial_state {src.data['initial_state']!r} is not a state",
+               STATE_HINT)
+        return 0
+    return state
+
+
+def _state_names(src: Source) -> dict[StateId, str]:
+    """``[states]``: NUMBER = "name", the names people read for the table's states."""
+    section = src.data.get("states") or {}
+    if not isinstance(section, dict):
+        _error(src, ("", None, "states"), "[states] must be a table of NUMBER = \"name\"",
                'for example: 20 = "collision"')
-    out.raise_if_any()
-    return Robot(
-        name=str(data.get("name", path.stem)),
-        inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
-        initial_state=_state_id(data["initial_state"]), initial_timer=initial_timer, tick_ms=tick_ms,
-        labels={**inputs, **motors, **lamps},
-        state_names={_state_id(k): str(v) for k, v in states.items()},
-        sections={k: data[k] for k in FOREIGN_SECTIONS if k in data},
-        source=str(path),
-        lines={key: line for key in ("initial_state", *map(str, states))
-               if (line := _key_line(text, key)) is not None},
-    )
+        return {}
+    names: dict[StateId, str] = {}
+    for key, label in section.items():
+        state = _state_id(key)
+        if state is None:
+            _error(src, ("states", None, key), f"[states] {key!r} is not a state", STATE_HINT)
+        elif not isinstance(label, str):
+            _error(src, ("states", None, key), f"[states] {key}: the name must be text, not {label!r}",
+                   f'write it in quotes: {key} = "seek"')
+        else:
+            names[state] = label
+    return names

@@ -12,14 +12,22 @@ from pathlib import Path
 
 from tablebot.csvtext import Cell, Record, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
-from tablebot.robot import BUMBERBOT, Robot, StateId, find_robot_file, load_robot
-from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, MAX_TIMER, TIMER_EVENT, Row, Table
+from tablebot.robot import (
+    BUMBERBOT,
+    MAX_TIMER,
+    STATE_HINT,
+    STATE_RE,
+    Robot,
+    StateId,
+    find_robot_file,
+    load_robot,
+)
+from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table
 
 KEEP_WORDS = {"=", "keep", "k"}
 ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
 FIXED = ("description", "state", "timer", "next")
 INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
-STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
 
 
 @dataclass(frozen=True)
@@ -162,8 +170,7 @@ def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
             out.error(cell.line, cell.column, f"{what} {value} is negative", "states are 0 or more")
         return value
     if not STATE_RE.match(text):
-        out.error(cell.line, cell.column, f"{what} {text!r} is not a valid state name",
-                  "use a number, or a name that starts with A-Z or _ (then letters, digits, spaces, _ . -)")
+        out.error(cell.line, cell.column, f"{what} {text!r} is not a valid state name", STATE_HINT)
         return None
     return text
 
