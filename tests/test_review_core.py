@@ -154,3 +154,22 @@ def test_robot_file_wrong_types_in_sections(tmp_path, extra, pattern, line):
 def test_robot_file_errors_go_through_the_cli(tmp_path):
     table = write_table(tmp_path, GOOD_TABLE, MINI_ROBOT.replace("initial_timer = 0", "initial_timer = true"))
     assert "robot.toml:3:1: error: initial_timer must be" in fails("check", table)
+
+
+# --- inputs CSVs ------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize(("text", "where", "pattern"), [
+    ("I3,I3\n1,0\n", "1:4", "column 'I3' appears twice"),
+    ("I3,I4\n1,0,1\n", "2:5", "cell '1' is beyond the last column"),
+    ("I3,,I4\n1,x,1\n", "2:3", "cell 'x' is in a column with no header"),
+])
+def test_inputs_csv_problems(tmp_path, text, where, pattern):
+    (tmp_path / "in.csv").write_text(text)
+    err = fails("trace", EXAMPLE, "--inputs", tmp_path / "in.csv")
+    assert f"in.csv:{where}: error: {pattern}" in err
+
+
+def test_inputs_csv_tick_column_and_trailing_blank_cells_are_fine(tmp_path):
+    (tmp_path / "in.csv").write_text("tick,I3,\n0,1,\n1,,\n")
+    result = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(tmp_path / "in.csv")])
+    assert result.exit_code == 0 and len(result.stdout.splitlines()) == 2

@@ -8,12 +8,12 @@ each lamp's level and each counter's value. Extra fields (a simulator's pose) ma
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from tablebot.csvtext import read_text, split_records
+from tablebot.csvtext import Cell, read_text, split_records
 from tablebot.diagnostics import Collector, fail
 from tablebot.engine import Engine
 from tablebot.machine import NO_ROW, Machine
@@ -34,44 +34,59 @@ def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
     records = split_records(read_text(path), str(path))
     if not records:
         raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
-    robot = machine.table.robot
     out = Collector(path)
-    columns: list[tuple[str, str]] = []  # (kind, name)
-    for cell in records[0].cells:
-        name = cell.text.strip()
-        if name == TIMER_EVENT:
-            out.error(cell.line, cell.column, "T is never an input: the engine makes it from the timer",
-                      "remove the T column")
-            columns.append(("ignore", name))
-        elif name in robot.inputs:
-            columns.append(("input", name))
-        elif name in robot.counter_names:
-            columns.append(("pulses", name))
-        elif name in ("", "tick"):
-            columns.append(("ignore", name))
-        else:
-            out.error(cell.line, cell.column, f"unknown input {name!r} for robot {robot.name}",
-                      f"inputs are {', '.join(robot.inputs)}; counters (pulses per tick) are "
-                      f"{', '.join(robot.counter_names) or 'none'}")
-            columns.append(("ignore", name))
+    columns = _columns(records[0].cells, machine, out)
     ticks = [_tick(record.cells, columns, machine, out) for record in records[1:]]
     out.raise_if_any()
     return ticks
 
 
-def _tick(cells: Iterable[Any], columns: list[tuple[str, str]], machine: Machine, out: Collector) -> TickInput:
+def _columns(header: Sequence[Cell], machine: Machine, out: Collector) -> list[tuple[str, str]]:
+    """(kind, name) per header cell: ``input``, ``pulses`` (a counter), ``tick`` or ``blank`` (read
+    but ignored), or ``bad`` (already reported)."""
+    robot = machine.table.robot
+    columns: list[tuple[str, str]] = []
+    seen: dict[str, Cell] = {}
+    for cell in header:
+        name = cell.text.strip()
+        kind = ("input" if name in robot.inputs else "pulses" if name in robot.counter_names
+                else "tick" if name == "tick" else "blank" if not name else "bad")
+        if name == TIMER_EVENT:
+            out.error(cell.line, cell.column, "T is never an input: the engine makes it from the timer",
+                      "remove the T column")
+        elif kind == "bad":
+            out.error(cell.line, cell.column, f"unknown input {name!r} for robot {robot.name}",
+                      f"inputs are {', '.join(robot.inputs)}; counters (pulses per tick) are "
+                      f"{', '.join(robot.counter_names) or 'none'}")
+        elif name in seen:
+            out.error(cell.line, cell.column, f"column {name!r} appears twice (first at column {seen[name].column})",
+                      "delete or rename one of them")
+            kind = "bad"
+        if name:
+            seen.setdefault(name, cell)
+        columns.append((kind, name))
+    return columns
+
+
+def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machine, out: Collector) -> TickInput:
     robot = machine.table.robot
     mask = 0
     pulses = [0] * len(robot.counter_names)
+    for extra in cells[len(columns):]:
+        if extra.text.strip():
+            out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
+                      "remove it or add a header for it")
     for (kind, name), cell in zip(columns, cells, strict=False):
         text = cell.text.strip()
-        if kind == "ignore" or not text:
+        if kind in ("bad", "tick") or not text:
             continue
-        if not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
+        if kind == "blank":
+            out.error(cell.line, cell.column, f"cell {text!r} is in a column with no header",
+                      "name the column in the header, or clear the cell")
+        elif not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
             want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
             out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
-            continue
-        if kind == "input":
+        elif kind == "input":
             mask |= machine.input_bits.get(name, 0) if text == "1" else 0
         else:
             pulses[robot.counter_names.index(name)] = int(text)
