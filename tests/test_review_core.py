@@ -6,12 +6,13 @@ hint, and no traceback.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
-from core_helpers import EXAMPLE, MINI_ROBOT, find, problems, write_table
+from core_helpers import EXAMPLE, MINI_ROBOT, example_machine, find, problems, write_table
 from tablebot.cli import app
 from tablebot.robot import BUMBERBOT
 from tablebot.tablefile import parse_table
@@ -173,3 +174,32 @@ def test_inputs_csv_tick_column_and_trailing_blank_cells_are_fine(tmp_path):
     (tmp_path / "in.csv").write_text("tick,I3,\n0,1,\n1,,\n")
     result = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(tmp_path / "in.csv")])
     assert result.exit_code == 0 and len(result.stdout.splitlines()) == 2
+
+
+# --- property files ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize(("body", "pattern"), [
+    ('[p]\nwhen = "I3"\nthen = "M1 <= 0"\n', "property p: within is missing"),
+    ('[p]\nnever = "I3"\ntext = 5\n', "property p: text must be text, not 5"),
+    ('[p]\nnever = "I3"\nnote = ["x"]\n', r"property p: note must be text, not \['x'\]"),
+    ('[p]\nnever = "I3"\nlevel = "fatal"\n', "property p: level must be error or warning"),
+    ('[p]\nnever = "I3"\nlevel = 3\n', "property p: level must be error or warning"),
+])
+def test_property_file_problems_have_hints(tmp_path, body, pattern):
+    (tmp_path / "p.toml").write_text(body)
+    err = fails("check", EXAMPLE, "--properties", tmp_path / "p.toml")
+    assert re.search(rf"p\.toml:1: error: {pattern}.*\n    hint: \S", err), err
+
+
+def test_property_too_large_to_search_is_unknown_not_a_table_error(monkeypatch):
+    from tablebot.analysis import prove
+    from tablebot.analysis.conditions import parse_condition
+    from tablebot.analysis.properties import Property
+
+    machine = example_machine()
+    real = prove.search
+    monkeypatch.setattr(prove, "search", lambda model, monitor, budget=1000: real(model, monitor, budget))
+    prop = Property("slow", "slow", "when", when=parse_condition("I3", machine),
+                    then=parse_condition("M1 < 0", machine), within=10_000)
+    result = prove.check_property(prop, machine)
+    assert result.status == "unknown" and "a shorter within" in result.detail

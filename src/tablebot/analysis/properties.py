@@ -141,7 +141,12 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
     kind = kinds[0]
     level = entry.get("level", "error")
     if level not in LEVELS:
-        out.error(line, None, f"property {name}: level must be error or warning, not {level!r}", "")
+        out.error(line, None, f"property {name}: level must be error or warning, not {level!r}",
+                  'write level = "warning" to make a violation a warning, or leave level out')
+    for key in ("text", "note"):
+        if not isinstance(entry.get(key, ""), str):
+            out.error(line, None, f"property {name}: {key} must be text, not {entry[key]!r}",
+                      f'write it in quotes: {key} = "…"')
 
     def condition(key: str) -> Condition | None:
         value = entry.get(key)
@@ -170,6 +175,9 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
 def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collector) -> int:
     """``within`` in ticks, from a number of ticks or a text like "10 ms", "1 tick", "0.5 s"."""
     hint = f'write within = "100 ms" or "3 ticks" (one tick is {tick_ms} ms)'
+    if value is None:
+        out.error(line, None, f"property {name}: within is missing (when/then needs a time limit)", hint)
+        return 0
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
         return value
     match = DURATION_RE.match(value) if isinstance(value, str) else None

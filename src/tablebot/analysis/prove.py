@@ -11,7 +11,7 @@ counterexample is real and shortest in ticks, and it is confirmed by replaying i
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -195,7 +195,11 @@ def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET)
     if prop.kind == "always_reachable":
         return _check_always_reachable(prop, machine, budget)
     model = Model(machine, prop.horizon, prop.watch)
-    path, explored = search(model, monitor_of(prop))
+    try:
+        path, explored = search(model, monitor_of(prop))
+    except ModelTooLarge as exc:
+        hint = "a shorter within" if prop.kind == "when" else "a condition that reads fewer inputs"
+        return Result(prop, "unknown", detail=f"too large to search ({exc}); {hint} makes it smaller")
     reachable = prop.kind == "reachable"
     if path is None:
         status = "violated" if reachable else "holds"
@@ -241,7 +245,3 @@ def _check_always_reachable(prop: Property, machine: Machine, budget: int) -> Re
     return Result(prop, "violated", explored, inputs, len(inputs) - 1 if inputs else None,
                   state=state, exact=model.is_exact,
                   detail=f"from state {state} on, no inputs can ever make it happen again")
-
-
-def check_all(props: Sequence[Property], machine: Machine) -> list[Result]:
-    return [check_property(p, machine) for p in props]
