@@ -10,10 +10,24 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tablebot.sim import layout as L
-from tablebot.sim.params import pulses_for_turn, wheel_speed
+from tablebot.sim.params import Params, speed_per_volt, terminal_volts
 from tablebot.sim.runner import run
 from tablebot.sim.world import inside
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
+
+
+def wheel_speed(params: Params, tick_s: float, level: int, charge: float, levels: tuple[int, ...]) -> float:
+    """Steady wheel speed (m/s) at a speed level, battery charge and total motor load, without noise."""
+    m = params["motor"]
+    volts = terminal_volts(params, charge, levels)
+    return speed_per_volt(params, tick_s) * max(0.0, abs(level) / m["levels"] * volts - m["friction_volts"])
+
+
+def pulses_for_turn(params: Params, degrees: float) -> float:
+    """Encoder pulses each wheel makes while the robot spins in place by ``degrees``."""
+    body = params["body"]
+    arc = math.radians(degrees) * body["wheel_base"] / 2
+    return arc / (math.pi * body["wheel_diameter"]) * params["encoder"]["pulses_per_turn"]
 
 
 def turned(tmp_path: Path, charge: float, noise: bool = False, seed: int = 1) -> float:

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.sim import layout as L
+from tablebot.sim.physics import duty, pack_volts
 from tablebot.tomlfile import Source, known_keys, number, table_of
 
 Number = int | float
@@ -158,10 +159,10 @@ def spin_speed(params: Params, tick_s: float) -> float:
 
 
 def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> float:
-    """Battery volts under the load of motors at these speed levels (the physics core's formula)."""
+    """Battery volts under the load of motors at these speed levels, by the physics core's formula."""
     b, m = params["battery"], params["motor"]
-    amps = b["idle_amps"] + b["motor_amps"] * sum(min(1.0, abs(v) / m["levels"]) for v in levels)
-    return b["empty_volts"] + (b["full_volts"] - b["empty_volts"]) * charge - amps * b["internal_ohms"]
+    amps = b["idle_amps"] + b["motor_amps"] * sum(duty(v, m["levels"]) for v in levels)
+    return pack_volts(b["full_volts"], b["empty_volts"], charge, amps, b["internal_ohms"])
 
 
 def speed_per_volt(params: Params, tick_s: float) -> float:
@@ -171,24 +172,10 @@ def speed_per_volt(params: Params, tick_s: float) -> float:
         return float(m["speed_per_volt"])
     level = m["spin_level"]
     volts = terminal_volts(params, 1.0, (level, level))
-    drive = level / m["levels"] * volts - m["friction_volts"]
+    drive = duty(level, m["levels"]) * volts - m["friction_volts"]
     if drive <= 0:
         raise ValueError("the calibration spin's speed level cannot overcome friction_volts")
     return spin_speed(params, tick_s) / drive
-
-
-def wheel_speed(params: Params, tick_s: float, level: int, charge: float, levels: tuple[int, ...]) -> float:
-    """Steady wheel speed (m/s) at a speed level, battery charge and total motor load, without noise."""
-    m = params["motor"]
-    volts = terminal_volts(params, charge, levels)
-    return speed_per_volt(params, tick_s) * max(0.0, abs(level) / m["levels"] * volts - m["friction_volts"])
-
-
-def pulses_for_turn(params: Params, degrees: float) -> float:
-    """Encoder pulses each wheel makes while the robot spins in place by ``degrees``."""
-    body = params["body"]
-    arc = math.radians(degrees) * body["wheel_base"] / 2
-    return arc / (math.pi * body["wheel_diameter"]) * params["encoder"]["pulses_per_turn"]
 
 
 def param_row(params: Params, tick_s: float) -> np.ndarray:

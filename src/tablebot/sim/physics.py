@@ -351,13 +351,25 @@ def light_at(s, p, side, edges, circles, lamps):
 
 
 @njit(cache=True)
+def duty(level, levels):
+    """The fraction of full power a speed level gives (the table's 1..8 are PWM duty level/8)."""
+    return min(1.0, abs(level) / levels)
+
+
+@njit(cache=True)
+def pack_volts(full, empty, charge, amps, ohms):
+    """Battery terminal volts: open-circuit volts fall linearly with the charge and sag with the current."""
+    return empty + (full - empty) * charge - amps * ohms
+
+
+@njit(cache=True)
 def motor(s, p, level, volts, gain, speed, enc, pul, noise):
     """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
     The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
     """
-    duty = min(1.0, abs(level) / p[P_LEVELS])
-    target = np.sign(level) * s[gain] * p[P_KV] * max(0.0, duty * volts - p[P_VF]) * (1.0 + p[P_NMOTOR] * noise)
+    power = duty(level, p[P_LEVELS])
+    target = np.sign(level) * s[gain] * p[P_KV] * max(0.0, power * volts - p[P_VF]) * (1.0 + p[P_NMOTOR] * noise)
     s[speed] += (target - s[speed]) * p[P_ALPHA]
     before = s[enc]
     s[enc] += abs(s[speed]) * p[P_DT] / (2.0 * math.pi * p[P_WHEEL_R]) * p[P_PPR]
@@ -368,9 +380,8 @@ def motor(s, p, level, volts, gain, speed, enc, pul, noise):
 def drive(s, cmd, p, z):
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
     dt = p[P_DT]
-    duty = (min(1.0, abs(cmd[0]) / p[P_LEVELS]) + min(1.0, abs(cmd[1]) / p[P_LEVELS]))
-    amps = p[P_IIDLE] + p[P_IMOTOR] * duty
-    volts = p[P_VEMPTY] + (p[P_VFULL] - p[P_VEMPTY]) * s[SOC] - amps * p[P_RINT]
+    amps = p[P_IIDLE] + p[P_IMOTOR] * (duty(cmd[0], p[P_LEVELS]) + duty(cmd[1], p[P_LEVELS]))
+    volts = pack_volts(p[P_VFULL], p[P_VEMPTY], s[SOC], amps, p[P_RINT])
     s[AMPS], s[VBAT] = amps, volts
     s[SOC] = max(0.0, s[SOC] - amps * dt / p[P_CAP])
     motor(s, p, cmd[0], volts, GAIN_R, V_R, ENC_R, PUL_R, z[Z_MOTOR_R])
