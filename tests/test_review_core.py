@@ -203,3 +203,50 @@ def test_property_too_large_to_search_is_unknown_not_a_table_error(monkeypatch):
                     then=parse_condition("M1 < 0", machine), within=10_000)
     result = prove.check_property(prop, machine)
     assert result.status == "unknown" and "a shorter within" in result.detail
+
+
+# --- ROBO Pro import --------------------------------------------------------------------------------
+
+@pytest.fixture
+def lists(tmp_path):
+    """The BumberBot exported as ROBO Pro lists."""
+    folder = tmp_path / "lists"
+    assert runner.invoke(app, ["export", str(EXAMPLE), str(folder), "--to", "robopro"]).exit_code == 0
+    return folder
+
+
+def test_import_robot_with_three_motors_is_refused(tmp_path, lists):
+    robot = tmp_path / "three.toml"
+    robot.write_text('initial_state = 2\n[inputs]\nI3 = "a"\n[motors]\nM1 = "a"\nM2 = "b"\nM3 = "c"\n')
+    assert "3 motors do not fit the ROBO Pro layout" in fails("import", lists, "--from", "robopro", "--robot", robot)
+
+
+def test_import_problems_of_the_rebuilt_table_point_into_the_lists(lists):
+    (lists / "event.csv").write_text("88\n89\n")
+    (lists / "action.csv").write_text(f"{20 * 256}\n{1 * 256}\n")
+    (lists / "timer.csv").write_text("0\n0\n")
+    err = fails("import", lists, "--from", "robopro")
+    assert f"{lists / 'action.csv'}:1:1: error: next state 20 is unknown" in err
+    assert f"{lists / 'event.csv'}: error: initial state 2" in err and "--robot" in err
+
+
+def test_import_empty_lists(lists):
+    for name in ("event.csv", "action.csv", "timer.csv"):
+        (lists / name).write_text("")
+    assert "the lists are empty" in fails("import", lists, "--from", "robopro")
+
+
+@pytest.mark.parametrize(("states", "pattern"), [
+    ("number,name\n1,seek\n1,turn\n", "is given twice"),
+    ("number,name\n1,seek\n2,seek\n", "is given twice"),
+    ('number,name\n1,"a ""b"\n', "expected number,name"),
+])
+def test_import_bad_state_names(lists, states, pattern):
+    (lists / "states.csv").write_text(states)
+    assert pattern in fails("import", lists, "--from", "robopro")
+
+
+def test_import_from_a_file_or_nothing(tmp_path):
+    (tmp_path / "afile").write_text("")
+    assert "afile: error: not a folder" in fails("import", tmp_path / "afile", "--from", "robopro")
+    assert "nope: error: folder not found" in fails("import", tmp_path / "nope", "--from", "robopro")

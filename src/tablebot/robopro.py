@@ -15,8 +15,8 @@ from pathlib import Path
 
 from tablebot.csvtext import read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
-from tablebot.robot import Robot, StateId
-from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table
+from tablebot.robot import STATE_RE, Robot, StateId
+from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table, missing_states
 
 STATE_WEIGHT = 64
 NEXT_WEIGHT = 256
@@ -168,10 +168,14 @@ def _read_names(directory: Path) -> dict[int, StateId]:
         cells = [cell.text.strip() for cell in record.cells]
         if record.is_blank():
             continue
-        if len(cells) < 2 or not cells[0].isdigit() or not cells[1]:
+        if len(cells) < 2 or not cells[0].isdigit() or not (cells[1].isdigit() or STATE_RE.match(cells[1])):
             raise fail(path, f"expected number,name, not {','.join(cells)!r}",
                        "export writes one named state per line, like: 1,seek", record.line, 1)
-        names[int(cells[0])] = int(cells[1]) if cells[1].isdigit() else cells[1]  # as the table parser reads it
+        number, name = int(cells[0]), int(cells[1]) if cells[1].isdigit() else cells[1]  # as tables read it
+        if number in names or name in names.values():
+            raise fail(path, f"state number {number} or name {name!r} is given twice",
+                       "each number names one state and each name one number", record.line, 1)
+        names[number] = name
     return names
 
 
@@ -200,9 +204,34 @@ def decode(lists: Lists, robot: Robot, events: tuple[str, ...] | None = None, pa
 
 
 def read_lists(directory: Path) -> Lists:
+    if not directory.is_dir():
+        raise fail(directory, "not a folder" if directory.exists() else "folder not found",
+                   f"give the folder that holds {', '.join(LIST_FILES)}")
     event, action, timer = (_read_list(directory / name) for name in LIST_FILES)
     if not len(event) == len(action) == len(timer):
         raise fail(directory, f"the lists differ in length: event {len(event)}, action {len(action)}, "
                    f"timer {len(timer)}", "each row of the table is one entry in every list")
+    if not event:
+        raise fail(directory, "the lists are empty", "export a table with at least one row")
     numbers = {state: number for number, state in _read_names(directory).items()}
     return Lists(tuple(event), tuple(action), tuple(timer), numbers)
+
+
+def read_table(directory: Path, robot: Robot) -> Table:
+    """The table that the lists in ``directory`` hold for ``robot``; problems are located in the lists."""
+    layout = event_layout(robot)
+    if len(layout) > MAX_EVENTS or len(robot.motors) > MAX_MOTORS:
+        raise fail(robot.source, f"{len(layout) - 1} inputs and {len(robot.motors)} motors do not fit the ROBO Pro "
+                   "layout", f"import needs a robot with at most {MAX_EVENTS - 1} inputs and {MAX_MOTORS} motors")
+    table = decode(read_lists(directory), robot, layout, str(directory))
+    problems = []
+    for row, key, message, hint in missing_states(table.rows, robot):
+        if row is not None:  # the row's line is its line in every list; its next state is in action.csv
+            problems.append(Diagnostic(str(directory / LIST_FILES[1]), row.line, 1, message, hint))
+        else:
+            line = robot.lines.get(key)
+            where = (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None)
+            problems.append(Diagnostic(*where, message, "the lists may be for another robot: pass its --robot"))
+    if problems:
+        raise TableBotError(problems)
+    return table

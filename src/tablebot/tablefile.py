@@ -22,7 +22,7 @@ from tablebot.robot import (
     find_robot_file,
     load_robot,
 )
-from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table
+from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table, missing_states
 
 KEEP_WORDS = {"=", "keep", "k"}
 ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
@@ -255,26 +255,17 @@ def _number(rows: list[Row]) -> list[Row]:
 
 def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[Column],
                   body: list[Record]) -> None:
-    """Every next state, the initial state and every named state must have rows of its own."""
+    """Report :func:`missing_states` at the next-state cell, or where the robot names the state."""
     if not rows:
         return
-    with_rows = {row.state for row in rows}
     next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
     next_cells = {r.line: r.cells[next_at] for r in body if next_at is not None and len(r.cells) > next_at}
-    for row in rows:
-        if row.next not in with_rows:
+    for row, key, message, hint in missing_states(rows, robot):
+        if row is None:
+            _robot_error(out, robot, key, columns, message, hint)
+        else:
             cell = next_cells.get(row.line)
-            out.error(row.line, cell.column if cell else None,
-                      f"next state {row.next!r} is unknown: no row has state {row.next!r}",
-                      f"add rows for state {row.next!r} or fix the next state")
-    if robot.initial_state not in with_rows:
-        _robot_error(out, robot, "initial_state", columns,
-                     f"initial state {robot.initial_state!r} (from {robot.source} robot {robot.name}) has no rows",
-                     "add rows for it or change initial_state in the robot file")
-    for state in robot.state_names:
-        if state not in with_rows:
-            _robot_error(out, robot, str(state), columns, f"state {state!r} is named in {robot.source} "
-                         "but has no rows", "add rows for it or remove it from [states]")
+            out.error(row.line, cell.column if cell else None, message, hint)
 
 
 def _robot_error(out: Collector, robot: Robot, key: str, columns: list[Column], message: str, hint: str) -> None:

@@ -11,10 +11,8 @@ import typer
 from tablebot import robopro
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
-from tablebot.diagnostics import fail
 from tablebot.examples import example_path
 from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.tablefile import parse_table
 from tablebot.tablewriter import format_table
 from tablebot.trace import load_inputs, replay, write_trace
 
@@ -32,14 +30,8 @@ def import_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
-    bot = load_robot(robot) if robot else BUMBERBOT
-    events = ("T", *bot.inputs)
-    if len(events) > robopro.MAX_EVENTS:
-        raise fail(bot.source, f"{len(events)} event columns do not fit the ROBO Pro layout",
-                   "import needs a robot with at most five inputs besides T")
-    table = robopro.decode(robopro.read_lists(directory), bot, events, str(directory))
+    table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
     text = format_table(table)
-    parse_table(text, str(out or directory), bot)  # the rebuilt table must be a valid table
     if out is None:
         sys.stdout.write(text)
     else:
