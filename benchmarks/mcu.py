@@ -100,10 +100,11 @@ def main() -> int:
         harness = build_harness(work / "harness")
         results = {name: measure(machine, ticks, work / str(i), harness)
                    for i, (name, (machine, ticks)) in enumerate(tables(args.ticks).items())}
-    print("\n".join(report(results)))
+    lines = report(results)
+    print("\n".join(lines))
     if args.json:
         args.json.write_text(json.dumps(results, indent=2), encoding="utf-8")
-    return 0 if all(not line.startswith("FAIL") for line in report(results)) else 1
+    return 0 if all(not line.startswith("FAIL") for line in lines) else 1
 
 
 if __name__ == "__main__":

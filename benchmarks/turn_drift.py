@@ -16,6 +16,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -89,10 +90,24 @@ def write_table(levels: list[Level], out: Path) -> str:
 
 
 def plot(levels: list[Level], seeds: int, out: Path) -> Path:
+    """turn_drift.png: turn angles against battery charge, and the time each BumberBot takes to find the lamp."""
     fig = Figure(figsize=(12, 5.2), dpi=150)
     FigureCanvasAgg(fig)
     ax, lamp = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.5, 1], "wspace": 0.25})
     x = [100 * lv.charge for lv in levels]
+    _turn_panel(ax, levels, x)
+    _lamp_panel(lamp, levels, x)
+    fig.suptitle("Timer or pulse counter: the BumberBot's turns as the battery drains", fontsize=14,
+                 fontweight="bold", x=0.06, ha="left", y=0.99)
+    fig.text(0.06, 0.9, f"simulated, {seeds} seeds per point (band: min…max); "
+             "examples/bumberbot-counters, benchmarks/turn_drift.py", fontsize=9, color="#444")
+    fig.subplots_adjust(left=0.06, right=0.98, top=0.8, bottom=0.11)
+    path = out / "turn_drift.png"
+    fig.savefig(path, facecolor="white")
+    return path
+
+
+def _turn_panel(ax: Axes, levels: list[Level], x: list[float]) -> None:
     ax.axhspan(TARGET - TOLERANCE, TARGET + TOLERANCE, color=COUNTED, alpha=0.12, label="90° ± 3°")
     ax.axhline(DRIFTED, color="#555", ls=":", lw=1)
     ax.text(x[0], DRIFTED + 0.6, " 80°: the document's \"80° and less\"", fontsize=8, color="#555", ha="left")
@@ -110,6 +125,9 @@ def plot(levels: list[Level], seeds: int, out: Path) -> Path:
     ax.grid(alpha=0.3)
     top = ax.secondary_xaxis("top", functions=(lambda c: c, lambda c: c))
     top.set_xticks(x[::2], [f"{lv.volts:.1f} V" for lv in levels[::2]], fontsize=8)
+
+
+def _lamp_panel(lamp: Axes, levels: list[Level], x: list[float]) -> None:
     for key, colour, label, dx in (("timed_lamp", TIMED, "BumberBot (timed turns)", -1.2),
                                    ("counted_lamp", COUNTED, "with counters", 1.2)):
         for lv, xi in zip(levels, x, strict=True):
@@ -129,14 +147,6 @@ def plot(levels: list[Level], seeds: int, out: Path) -> Path:
     lamp.set_title("Finding the lamp in the arena (120 s runs)", fontsize=11, loc="left", pad=22)
     lamp.legend(loc="upper left", bbox_to_anchor=(0.0, 0.9), fontsize=9, frameon=False)
     lamp.grid(alpha=0.3)
-    fig.suptitle("Timer or pulse counter: the BumberBot's turns as the battery drains", fontsize=14,
-                 fontweight="bold", x=0.06, ha="left", y=0.99)
-    fig.text(0.06, 0.9, f"simulated, {seeds} seeds per point (band: min…max); "
-             "examples/bumberbot-counters, benchmarks/turn_drift.py", fontsize=9, color="#444")
-    fig.subplots_adjust(left=0.06, right=0.98, top=0.8, bottom=0.11)
-    path = out / "turn_drift.png"
-    fig.savefig(path, facecolor="white")
-    return path
 
 
 def verdict(levels: list[Level]) -> list[str]:

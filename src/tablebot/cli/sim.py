@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+
+if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
+    from tablebot.sim.runner import Result
+    from tablebot.sim.summary import Summary
 
 
 @app.command("sim")
@@ -29,10 +34,8 @@ def sim_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif)."""
-    from tablebot.sim import plots
     from tablebot.sim import setup as sim_setup
-    from tablebot.sim.draw import state_names
-    from tablebot.sim.runner import run, ticks_for, write_trace
+    from tablebot.sim.runner import run, ticks_for
     from tablebot.sim.summary import summarise
 
     if view:
@@ -44,25 +47,40 @@ def sim_cmd(
     ticks = ticks_for(setup, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     result = _run_with_progress(run, setup, seconds, seed, None if quiet else ticks)
+    summary = summarise(result)
+    written = _write_files(result, summary, out, gif)
+    if not quiet:
+        _report(result, summary, written)
+    if view:
+        from tablebot.sim.animate import show
+        show(result, summary)
+
+
+def _write_files(result: Result, summary: Summary, out: Path, gif: bool) -> list[Path]:
+    """trace.jsonl, the two pictures and, with ``gif``, the animation."""
+    from tablebot.sim import plots
+    from tablebot.sim.runner import write_trace
+
     with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
         write_trace(result, stream)
-    summary = summarise(result)
     written = [out / "trace.jsonl", plots.trajectory(result, summary, out / "trajectory.png"),
                plots.timeline(result, summary, out / "timeline.png")]
     if gif:
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))
-    if not quiet:
-        names = state_names(parsed)
-        for line in summary.lines(names):
-            console.print(line)
-        speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
-        console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
-        for path in written:
-            err_console.print(f"wrote {path}")
-    if view:
-        from tablebot.sim.animate import show
-        show(result, summary)
+    return written
+
+
+def _report(result: Result, summary: Summary, written: list[Path]) -> None:
+    """The summary on standard output, the files written on standard error."""
+    from tablebot.sim.draw import state_names
+
+    for line in summary.lines(state_names(result.setup.table)):
+        console.print(line)
+    speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
+    console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
+    for path in written:
+        err_console.print(f"wrote {path}")
 
 
 def _run_with_progress(run, setup, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]

@@ -63,15 +63,9 @@ def build_harness(where: Path | None = None) -> Path:
 def _signal(wiring: Wiring, name: str) -> tuple[str, int, int]:
     """(harness column, level when active, level when not) of one robot input."""
     board = wiring.board
-    terminal = wiring.inputs[name]
-    high = name in wiring.active_high
-    if board.name == "ftduino":
-        column = board.inputs[terminal]
-        closed, open_ = ADC_CLOSED_MV, ADC_OPEN_MV
-    else:
-        column = board.inputs[terminal]
-        closed, open_ = 0, 1
-    return (column, open_, closed) if high else (column, closed, open_)
+    column = board.inputs[wiring.inputs[name]]
+    closed, open_ = (ADC_CLOSED_MV, ADC_OPEN_MV) if board.name == "ftduino" else (0, 1)  # millivolts or levels
+    return (column, open_, closed) if name in wiring.active_high else (column, closed, open_)
 
 
 def pins_csv(machine: Machine, wiring: Wiring, ticks: Sequence[TickInput]) -> str:

@@ -28,8 +28,9 @@ from tablebot.sim.draw import (
     state_label,
     state_names,
 )
-from tablebot.sim.runner import Result, trace_lines
+from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
+from tablebot.trace import replay
 
 DPI = 150
 
@@ -137,13 +138,13 @@ def _legend(fig: Figure, result: Result, summary: Summary) -> None:
 def timeline(result: Result, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits and light readings against time."""
     t = np.arange(result.ticks) * result.tick_s
-    lines = list(trace_lines(result))
+    events = [line["event"] for line in replay(result.setup.machine, result.inputs())]
     fig = Figure(figsize=(12, 9), dpi=DPI)
     FigureCanvasAgg(fig)
     axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.6, 1.6, 1.3], "hspace": 0.12})
     _state_panel(axes[0], result)
     _output_panel(axes[1], result, t)
-    _event_panel(axes[2], result, t, [line["event"] for line in lines])
+    _event_panel(axes[2], result, t, events)
     _light_panel(axes[3], result, t)
     for ax in axes:
         for row in summary.collision_ticks:

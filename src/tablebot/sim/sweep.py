@@ -9,11 +9,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tablebot.cli.common import load
+from tablebot.machine import compile_table
 from tablebot.sim import layout as L
 from tablebot.sim.runner import run
 from tablebot.sim.setup import prepare, robot_layer
 from tablebot.sim.world import World, parse_world
+from tablebot.tablefile import load_table
 from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.
@@ -42,7 +43,8 @@ def open_room() -> World:
 def turns(table_path: Path, charges: list[float], seeds: list[int], seconds: float = 6.0,
           world: World | None = None) -> list[Turn]:
     """Run ``table_path`` once per (charge, seed) and measure how far the robot turned."""
-    table, machine = load(table_path)
+    table = load_table(table_path)
+    machine = compile_table(table)
     layer, _ = robot_layer(table.robot)
     world = world or open_room()
     found = []
