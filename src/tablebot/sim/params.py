@@ -97,30 +97,30 @@ class Params:
 def check_layer(src: Source, data: dict[str, Any], prefix: str = "") -> dict[str, dict[str, Any]]:
     """The parameter sections of one file (``[battery]`` … or ``[sim.battery]`` …), checked."""
     layer: dict[str, dict[str, Any]] = {}
-    for section in SECTIONS:
-        if section not in data:
-            continue
+    for section in (s for s in SECTIONS if s in data):
         name = prefix + section
         table = table_of(src, (name, None, None), data[section])
         known = tuple(WIRING) if section == "wiring" else tuple(DEFAULTS[section])
         known_keys(src, (name, None), table, known)
-        checked: dict[str, Any] = {}
-        for key, value in table.items():
-            if key not in known:
-                continue
-            if section == "wiring":
-                if isinstance(value, str) and (value or not key.endswith("motor")):
-                    checked[key] = "" if value.lower() == "none" else value
-                else:
-                    src.error((name, None, key), f"[{name}] {key} must name a robot input or motor",
-                              f'for example: {key} = "{WIRING[key]}" (a sensor may be "none")')
-                continue
-            default, low, high, _ = DEFAULTS[section][key]
-            got = number(src, (name, None, key), value, low, high, integer=isinstance(default, int))
-            if got is not None:
-                checked[key] = got
-        layer[section] = checked
+        read = _wiring_value if section == "wiring" else _parameter_value
+        values = {key: read(src, name, key, value) for key, value in table.items() if key in known}
+        layer[section] = {key: value for key, value in values.items() if value is not None}
     return layer
+
+
+def _parameter_value(src: Source, name: str, key: str, value: Any) -> Number | None:
+    """A number within the parameter's range (an integer where its default is one), else None after an error."""
+    default, low, high, _ = DEFAULTS[name.rsplit(".", 1)[-1]][key]  # [battery] or [sim.battery]
+    return number(src, (name, None, key), value, low, high, integer=isinstance(default, int))
+
+
+def _wiring_value(src: Source, name: str, key: str, value: Any) -> str | None:
+    """The robot name a role is wired to ("" for a sensor that is "none"), else None after an error."""
+    if isinstance(value, str) and (value or not key.endswith("motor")):
+        return "" if value.lower() == "none" else value
+    src.error((name, None, key), f"[{name}] {key} must name a robot input or motor",
+              f'for example: {key} = "{WIRING[key]}" (a sensor may be "none")')
+    return None
 
 
 def merged(*layers: dict[str, Any]) -> Params:
