@@ -250,3 +250,21 @@ def test_import_from_a_file_or_nothing(tmp_path):
     (tmp_path / "afile").write_text("")
     assert "afile: error: not a folder" in fails("import", tmp_path / "afile", "--from", "robopro")
     assert "nope: error: folder not found" in fails("import", tmp_path / "nope", "--from", "robopro")
+
+
+# --- table parsing order and diagrams ---------------------------------------------------------------
+
+def test_row_errors_come_in_column_order(tmp_path):
+    table = write_table(tmp_path, "state,T,next,\n,1,,junk,more\n1,1,1\n", MINI_ROBOT)
+    assert [(d.line, d.column) for d in problems(table)] == [(2, 1), (2, 4), (2, 5), (2, 10)]
+
+
+def test_mermaid_ids_of_names_that_differ_only_in_punctuation_stay_apart(tmp_path):
+    from tablebot.analysis.diagram import to_mermaid
+    from tablebot.tablefile import load_table
+
+    robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "a.b"')
+    table = write_table(tmp_path, "state,T,M1,M2,timer,next\na.b,1,1,1,5,a-b\na-b,1,2,2,5,a b\na b,1,0,0,5,a.b\n",
+                        robot)
+    text = to_mermaid(load_table(table))
+    assert "s_a_b --> s_a_b_2" in text and "s_a_b_2 --> s_a_b_3" in text and "s_a_b_3 --> s_a_b:" in text

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from tablebot.csvtext import Cell, Record, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
@@ -175,71 +176,65 @@ def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
     return text
 
 
+#: How _int reads each numeric column kind: (low, high, value of a blank cell, whether "=" keeps).
+NUMBERS: dict[str, tuple[int, int, int | None, bool]] = {
+    "timer": (0, MAX_TIMER, 0, False), "event": (0, 1, 0, False), "dir": (0, 1, 0, False),
+    "speed": (0, MAX_SPEED, 0, False), "signed": (-MAX_SPEED, MAX_SPEED, 0, True),
+    "lamp": (0, MAX_LAMP, None, True), "load": (0, MAX_TIMER, None, True),
+}
+
+
 def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) -> Row | None:
     """The row of one record, or None when its state or next state is unreadable.
 
     A row with other bad cells is still returned (with the bad cells at their blank value) so that
     its state counts as having rows; the collected errors stop the table from being used.
     """
-    cells = list(record.cells)
-    for extra in cells[len(columns):]:
+    cells = list(record.cells[: len(columns)])
+    end = (cells[-1].column + len(cells[-1].text) + 1) if cells else 1
+    cells += [Cell("", record.line, end)] * (len(columns) - len(cells))
+    values = {(c.kind, c.name): _value(c, cell, out) for c, cell in zip(columns, cells, strict=True)}
+    for extra in record.cells[len(columns):]:
         if extra.text.strip():
             out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
                       "remove it or add a header for it")
-    for column, cell in zip(columns, cells, strict=False):
-        if column.kind == "ignore" and not column.name and cell.text.strip():
-            out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is in a column with no header",
-                      "name the column in the header, or clear the cell")
-    cells += [Cell("", record.line, (cells[-1].column + len(cells[-1].text) + 1) if cells else 1)] * max(
-        0, len(columns) - len(cells))
-    fields: dict[str, object] = {"description": "", "events": set(), "timer": 0}
-    dirs: dict[str, int] = {}
-    speeds: dict[str, int | None] = {}
-    signed: dict[str, int | None] = {}
-    lamps: dict[str, int | None] = {}
-    loads: dict[str, int | None] = {}
-    for column, cell in zip(columns, cells, strict=False):
-        kind, name = column.kind, column.name
-        label = column.cell.text.strip()
-        if kind == "description":
-            fields["description"] = cell.text.strip()
-        elif kind in ("state", "next"):
-            fields[kind] = _state(cell, f"{kind} state" if kind == "next" else "state", out)
-        elif kind == "timer":
-            fields["timer"] = _int(cell, "timer", 0, MAX_TIMER, out)
-        elif kind == "event":
-            if _int(cell, f"event {label}", 0, 1, out):
-                fields["events"].add(name)  # type: ignore[union-attr]
-        elif kind == "dir":
-            dirs[name] = _int(cell, label, 0, 1, out) or 0
-        elif kind == "speed":
-            speeds[name] = _int(cell, label, 0, MAX_SPEED, out)
-        elif kind == "signed":
-            signed[name] = _int(cell, label, -MAX_SPEED, MAX_SPEED, out, keep=True)
-        elif kind == "lamp":
-            lamps[name] = _int(cell, label, 0, MAX_LAMP, out, blank=None, keep=True)
-        elif kind == "load":
-            loads[name] = _int(cell, label, 0, MAX_TIMER, out, blank=None, keep=True)
-    if fields.get("state") is None or fields.get("next") is None:
+    state, nxt = values.get(("state", "state")), values.get(("next", "next"))
+    if state is None or nxt is None:
         return None
-    motors = tuple(_motor(m, dirs, speeds, signed) for m in robot.motors)
-    return Row(index=-1, line=record.line, description=str(fields["description"]),
-               state=fields["state"], events=frozenset(fields["events"]),  # type: ignore[arg-type]
-               motors=motors, timer=int(fields["timer"]),  # type: ignore[call-overload]
-               next=fields["next"],  # type: ignore[arg-type]
-               counters=tuple(loads.get(c) for c in robot.counter_names),
-               lamps=tuple(lamps.get(lamp) for lamp in robot.lamps))
+    return Row(index=-1, line=record.line, description=values.get(("description", "description")) or "",
+               state=state, events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
+               motors=tuple(_motor(motor, values) for motor in robot.motors),
+               timer=values.get(("timer", "timer")) or 0, next=nxt,
+               counters=tuple(values.get(("load", c)) for c in robot.counter_names),
+               lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
 
 
-def _motor(motor: str, dirs: dict[str, int], speeds: dict[str, int | None],
-           signed: dict[str, int | None]) -> int | None:
+def _value(column: Column, cell: Cell, out: Collector) -> Any:
+    """What one cell says: text (description), a state, a number or None (keep); errors go to ``out``."""
+    kind, text = column.kind, cell.text.strip()
+    if kind == "description":
+        return text
+    if kind in ("state", "next"):
+        return _state(cell, "next state" if kind == "next" else "state", out)
+    if kind in NUMBERS:
+        low, high, blank, keep = NUMBERS[kind]
+        label = column.cell.text.strip()
+        what = "timer" if kind == "timer" else f"event {label}" if kind == "event" else label
+        return _int(cell, what, low, high, out, blank, keep)
+    if not column.name and text:  # an ignored column with a name was reported in the header
+        out.error(cell.line, cell.column, f"cell {text!r} is in a column with no header",
+                  "name the column in the header, or clear the cell")
+    return None
+
+
+def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:
     """The signed speed (None = keep) from either the document's dir+speed form or a signed cell."""
-    if motor in signed:
-        return signed[motor]
-    speed = speeds.get(motor) or 0
+    if ("signed", motor) in values:
+        return values[("signed", motor)]
+    speed = values.get(("speed", motor)) or 0
     if speed == DOC_KEEP_SPEED:
         return None
-    return -speed if dirs.get(motor) else speed
+    return -speed if values.get(("dir", motor)) else speed
 
 
 def _number(rows: list[Row]) -> list[Row]:

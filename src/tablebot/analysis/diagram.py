@@ -189,22 +189,33 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
 
 def to_mermaid(table: Table) -> str:
     """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""
-    out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {_mid(table.robot.initial_state)}"]
+    ids = _mermaid_ids(table.states)
+    out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {ids[table.robot.initial_state]}"]
     for state in table.states:
         label = state_label(table, state)
         name = f"{state}: {label}" if label else str(state)
-        out.append(f'    state "{_mermaid_text(name)}" as {_mid(state)}')
+        out.append(f'    state "{_mermaid_text(name)}" as {ids[state]}')
     for edge in edges(table):
         parts = []
         for cond, act in edge.lines:
             timer = f" {act.timer}" if act.timer else ""
             parts.append(f"{cond} / {act.text}{timer}")
-        out.append(f"    {_mid(edge.source)} --> {_mid(edge.target)}: {_mermaid_text('; '.join(parts))}")
+        out.append(f"    {ids[edge.source]} --> {ids[edge.target]}: {_mermaid_text('; '.join(parts))}")
     return "\n".join(out) + "\n"
 
 
-def _mid(state: StateId) -> str:
-    return "s_" + "".join(ch if ch.isalnum() else "_" for ch in str(state))
+def _mermaid_ids(states: Sequence[StateId]) -> dict[StateId, str]:
+    """Mermaid ids (``s_20``, ``s_seek``): ASCII letters, digits and ``_``, so names that differ only
+    in other characters (``a.b``, ``a-b``) get a number to stay apart."""
+    ids: dict[StateId, str] = {}
+    for state in states:
+        base = "s_" + "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in str(state))
+        mid, count = base, 1
+        while mid in ids.values():
+            count += 1
+            mid = f"{base}_{count}"
+        ids[state] = mid
+    return ids
 
 
 def _mermaid_text(text: str) -> str:
