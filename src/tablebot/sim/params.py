@@ -1,9 +1,6 @@
 """The BumberBot's physical parameters: defaults with their sources, validation, and the packed parameter row.
-
 Values come, in rising priority, from :data:`DEFAULTS`, the robot file's ``[sim.*]`` sections and the
-world file's sections of the same names. The motor's speed constant is calibrated (unless given)
-so that the document's Seek-Straight spin — M1 back, M2 forward, speed 2, 895 ticks — turns 270°
-on a full battery.
+world file's sections of the same names.
 """
 
 from __future__ import annotations
@@ -166,7 +163,8 @@ def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> fl
 
 
 def speed_per_volt(params: Params, tick_s: float) -> float:
-    """The motor constant: given, or solved from the calibration spin on a full battery."""
+    """The motor constant: given, or solved from the calibration spin on a full battery (the document's
+    Seek-Straight spin: M1 back, M2 forward, speed 2, 895 ticks, turns 270°)."""
     m = params["motor"]
     if m["speed_per_volt"] > 0:
         return float(m["speed_per_volt"])

@@ -1,18 +1,17 @@
 """All geometry and physics of the simulator: motors and battery, kinematics, collisions, bumpers, light.
-
-The core works on numpy arrays of N robots (layout in :mod:`tablebot.sim.layout`) and is compiled
-with numba, so one robot and a batch of thousands share this code. Robots do not see each other.
-
-World geometry (built by :mod:`tablebot.sim.world`):
-``verts`` (V, 2) and ``pstart`` (P+1,) are convex pieces (a wall or segment is a 2-vertex piece,
-a box a 4-vertex one); ``pbound`` (P, 3) their bounding circles; ``edges`` (E, 4) every piece's
-edges for ray casts; ``circles`` (C, 4) = x, y, r, lamp index or -1; ``lamps`` (L, 3) = x, y, intensity.
-
-No shapely or pymunk: both work object by object from Python, which would not batch over thousands
-of robots; the few primitives needed (separating axes for convex pieces, segment distances, ray
-tests) are short compiled functions here. Contacts are resolved by position projection (no masses or
-impulses): a kinematic robot that is pushed back out of whatever it drove into.
+It works on numpy arrays of N robots (layout in :mod:`tablebot.sim.layout`), compiled with numba, so one
+robot and a batch of thousands (which do not see each other) share this code.
 """
+
+# World geometry (built by tablebot.sim.world): ``verts`` (V, 2) and ``pstart`` (P+1,) are convex
+# pieces (a wall or segment is a 2-vertex piece, a box a 4-vertex one); ``pbound`` (P, 3) their
+# bounding circles; ``edges`` (E, 4) every piece's edges for ray casts; ``circles`` (C, 4) = x, y, r,
+# lamp index or -1; ``lamps`` (L, 3) = x, y, intensity.
+#
+# No shapely or pymunk: both work object by object from Python, which would not batch over thousands
+# of robots; the few primitives needed (separating axes for convex pieces, segment distances, ray
+# tests) are short compiled functions here. Contacts are resolved by position projection (no masses
+# or impulses): a kinematic robot that is pushed back out of whatever it drove into.
 
 from __future__ import annotations
 

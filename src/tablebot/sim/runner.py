@@ -1,8 +1,6 @@
 """The simulation loop: the core engine ticks, the physics core moves and senses, and the run is logged.
-
 Tick t: the engine reads the inputs sensed at the start of the tick, fires its row, and the motors
-then run for one tick. Everything random comes from one numpy Generator seeded explicitly, and
-nothing depends on the wall clock, so a table, world and seed always give the same trace bytes.
+then run for one tick.
 """
 
 from __future__ import annotations
@@ -84,7 +82,11 @@ def ticks_for(setup: Setup, seconds: float) -> int:
 
 
 def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None) -> Result:
-    """Simulate ``seconds`` of robot time; ``progress(ticks_done)`` is called every few thousand ticks."""
+    """Simulate ``seconds`` of robot time; ``progress(ticks_done)`` is called every few thousand ticks.
+
+    Everything random comes from one numpy Generator seeded with ``seed``, and nothing depends on the
+    wall clock, so a table, world and seed always give the same trace bytes.
+    """
     ticks = ticks_for(setup, seconds)
     rng = np.random.default_rng(seed)
     S = initial_state(setup, rng)

@@ -1,9 +1,7 @@
-"""World files: the arena a simulated robot drives in (walls, obstacles, lamps, start pose), read and checked.
-
-A world is TOML; ``examples/bumberbot/arena.toml`` is the commented reference. Lengths are metres,
-angles degrees (0 = +x, counter-clockwise). Besides geometry a world may hold the same parameter
-sections as a robot file's ``[sim]`` ([body], [motor], [battery], [encoder], [light], [noise],
-[wiring]); they win over the robot's.
+"""World files: the arena a simulated robot drives in (walls, obstacles, lamps, start pose), read and checked;
+``examples/bumberbot/arena.toml`` is the commented reference of the TOML format.
+Lengths are metres, angles degrees (0 = +x, counter-clockwise); a world may also hold the parameter
+sections of a robot file's ``[sim]`` ([body], [motor], [battery], ...), which win over the robot's.
 """
 
 from __future__ import annotations
