@@ -156,3 +156,25 @@ def test_a_bad_robot_wiring_is_exit_2_on_the_command_line(tmp_path: Path) -> Non
 
 def test_setup_helper_still_builds(tmp_path: Path) -> None:
     assert bot(tmp_path, STRAIGHT, room()).drive == (0, 1)
+
+
+# --- the robot's tick ------------------------------------------------------------------------------
+
+def test_the_motors_do_not_depend_on_the_tables_tick(tmp_path: Path) -> None:
+    """The calibration spin is 8.95 s of the document's 10 ms ticks: at 20 ms, 448 ticks turn 270° too."""
+    from tablebot.sim.runner import run
+
+    robot = ROBOT.replace("tick_ms = 10", "tick_ms = 20")
+    rows = ["spin,1,1,,,,,,-2,2,448,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,0,3"]
+    table, world = write_bot(tmp_path, rows, room(), robot)
+    result = run(setup_of(table, world), 10.0)
+    heading = result.heading_deg()
+    assert abs(heading[-1] - heading[0] + 270.0) < 3.0
+
+
+def test_a_tick_too_coarse_for_the_physics_is_refused_on_its_line(tmp_path: Path) -> None:
+    robot = ROBOT.replace("tick_ms = 10", "tick_ms = 1000")
+    found = setup_errors(tmp_path, room(), robot)
+    assert found == [f"{tmp_path / 'robot.toml'}:2: error: tick_ms = 1000 is too coarse for the simulator: the robot "
+                     "would move up to 15 cm per tick, through thin walls\n    hint: simulate with tick_ms = 258 or "
+                     "less (the engine and the firmware take any tick)"]

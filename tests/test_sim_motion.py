@@ -16,11 +16,11 @@ from tablebot.sim.world import inside
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
 
 
-def wheel_speed(params: Params, tick_s: float, level: int, charge: float, levels: tuple[int, ...]) -> float:
+def wheel_speed(params: Params, level: int, charge: float, levels: tuple[int, ...]) -> float:
     """Steady wheel speed (m/s) at a speed level, battery charge and total motor load, without noise."""
     m = params["motor"]
     volts = terminal_volts(params, charge, levels)
-    return speed_per_volt(params, tick_s) * max(0.0, abs(level) / m["levels"] * volts - m["friction_volts"])
+    return speed_per_volt(params) * max(0.0, abs(level) / m["levels"] * volts - m["friction_volts"])
 
 
 def pulses_for_turn(params: Params, degrees: float) -> float:
@@ -41,7 +41,7 @@ def turned(tmp_path: Path, charge: float, noise: bool = False, seed: int = 1) ->
 def test_straight_run_covers_speed_times_time(tmp_path: Path) -> None:
     setup = bot(tmp_path, STRAIGHT, room(start=(0.4, 1.5, 0)))
     result = run(setup, 6.0)
-    expected = wheel_speed(setup.params, setup.tick_s, 4, 1.0, (4, 4)) * 5.0
+    expected = wheel_speed(setup.params, 4, 1.0, (4, 4)) * 5.0
     h = result.hist
     assert abs(math.hypot(h[-1, L.X] - h[0, L.X], h[-1, L.Y] - h[0, L.Y]) - h[-1, L.DIST]) < 1e-9
     assert abs(h[-1, L.DIST] - expected) < 0.01 * expected

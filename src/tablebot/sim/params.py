@@ -73,6 +73,9 @@ DEFAULTS: dict[str, dict[str, tuple[Any, Number, Number, str]]] = {
     },
 }
 SECTIONS = (*DEFAULTS, "wiring")
+#: The calibration spin's ticks are the document's 10 ms ticks (895 of them: 8.95 s), whatever the tick of
+#: the robot simulated: a table with another tick_ms runs on the same motors.
+SPIN_TICK_S = 0.010
 #: Which robot names play which part; the document's BumberBot wiring.
 WIRING: dict[str, str] = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                           "rear": "I5", "light_right": "I7", "light_left": "I8"}
@@ -142,17 +145,17 @@ def problems(params: Params) -> list[tuple[str, str, str]]:
     if body["bumper_overlap"] > body["half_width"]:
         found.append(("body", "bumper_overlap", "bumper_overlap must not exceed half_width"))
     try:
-        speed_per_volt(params, 0.01)
+        speed_per_volt(params)
     except ValueError as exc:
         found.append(("motor", "friction_volts", str(exc)))
     return found
 
 
-def spin_speed(params: Params, tick_s: float) -> float:
+def spin_speed(params: Params) -> float:
     """Wheel surface speed (m/s) the calibration spin needs: 270° in 8.95 s about the axle centre."""
     m = params["motor"]
     radians = math.radians(m["spin_degrees"])
-    return radians / (m["spin_ticks"] * tick_s) * params["body"]["wheel_base"] / 2
+    return radians / (m["spin_ticks"] * SPIN_TICK_S) * params["body"]["wheel_base"] / 2
 
 
 def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> float:
@@ -162,7 +165,7 @@ def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> fl
     return pack_volts(b["full_volts"], b["empty_volts"], charge, amps, b["internal_ohms"])
 
 
-def speed_per_volt(params: Params, tick_s: float) -> float:
+def speed_per_volt(params: Params) -> float:
     """The motor constant: given, or solved from the calibration spin on a full battery (the document's
     Seek-Straight spin: M1 back, M2 forward, speed 2, 895 ticks, turns 270°)."""
     m = params["motor"]
@@ -173,7 +176,14 @@ def speed_per_volt(params: Params, tick_s: float) -> float:
     drive = duty(level, m["levels"]) * volts - m["friction_volts"]
     if drive <= 0:
         raise ValueError("the calibration spin's speed level cannot overcome friction_volts")
-    return spin_speed(params, tick_s) / drive
+    return spin_speed(params) / drive
+
+
+def top_speed(params: Params) -> float:
+    """The fastest steady wheel speed (m/s): both motors at full duty on a full battery, without noise."""
+    levels = params["motor"]["levels"]
+    volts = terminal_volts(params, 1.0, (levels, levels))
+    return speed_per_volt(params) * max(0.0, volts - params["motor"]["friction_volts"])
 
 
 def param_row(params: Params, tick_s: float) -> np.ndarray:
@@ -185,7 +195,7 @@ def param_row(params: Params, tick_s: float) -> np.ndarray:
     p[L.P_FRONT], p[L.P_REAR], p[L.P_HALF_W] = body["front"], body["rear"], body["half_width"]
     p[L.P_OVERLAP], p[L.P_WRAP], p[L.P_GAP] = body["bumper_overlap"], body["bumper_wrap"], body["switch_travel"]
     p[L.P_GYR2] = body["gyration_radius"] ** 2
-    p[L.P_KV], p[L.P_VF] = speed_per_volt(params, tick_s), motor["friction_volts"]
+    p[L.P_KV], p[L.P_VF] = speed_per_volt(params), motor["friction_volts"]
     tau = motor["time_constant"]
     p[L.P_ALPHA] = 1.0 if tau <= 0 else 1.0 - math.exp(-tick_s / tau)
     p[L.P_LEVELS] = motor["levels"]

@@ -6,6 +6,7 @@ wiring of sensors and motors against the robot, and checks the start pose is fre
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -16,12 +17,22 @@ from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.robot import Robot
 from tablebot.sim import layout as L
-from tablebot.sim.params import INPUT_ROLES, SECTIONS, Params, check_layer, merged, param_row, problems
+from tablebot.sim.params import (
+    INPUT_ROLES,
+    SECTIONS,
+    Params,
+    check_layer,
+    merged,
+    param_row,
+    problems,
+    top_speed,
+)
 from tablebot.sim.physics import body_corners, deepest_contact
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
 from tablebot.tomlfile import Source, known_keys
 
+MAX_STEP_M = 0.04  # the most the robot may move in one tick: well under half its length, so contacts stay found
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
 
 
@@ -93,6 +104,7 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     if found:
         raise TableBotError(Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
                             for section, key, message, hint in found)
+    _check_tick(params, table.robot)
     tick_s = table.robot.tick_ms / 1000
     P = param_row(params, tick_s)[None, :]
     geo = geometry(world)
@@ -154,6 +166,17 @@ def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, st
         errors.append(("wiring", "left_motor", f"wiring: right_motor and left_motor are both {right}",
                        "the simulated robot drives two wheels: give each its own motor"))
     return errors
+
+
+def _check_tick(params: Params, robot: Robot) -> None:
+    """The robot moves once per tick: a coarse tick would carry it through thin walls unnoticed."""
+    top = top_speed(params)
+    step = top * robot.tick_ms / 1000
+    if step > MAX_STEP_M:
+        raise fail(robot.source, f"tick_ms = {robot.tick_ms} is too coarse for the simulator: the robot would move "
+                   f"up to {100 * step:.0f} cm per tick, through thin walls",
+                   f"simulate with tick_ms = {math.floor(MAX_STEP_M / top * 1000)} or less (the engine and the "
+                   "firmware take any tick)", _robot_source(robot).line("", None, "tick_ms"))
 
 
 def _check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
