@@ -268,3 +268,15 @@ def test_mermaid_ids_of_names_that_differ_only_in_punctuation_stay_apart(tmp_pat
                         robot)
     text = to_mermaid(load_table(table))
     assert "s_a_b --> s_a_b_2" in text and "s_a_b_2 --> s_a_b_3" in text and "s_a_b_3 --> s_a_b:" in text
+
+
+def test_toml_syntax_error_at_the_end_of_the_file_has_a_place(tmp_path):
+    (tmp_path / "p.toml").write_text('[p]\nnever = "I3"\n[q')
+    err = fails("check", EXAMPLE, "--properties", tmp_path / "p.toml")
+    assert "p.toml:3:3: error: TOML syntax: Expected ']'" in err
+
+
+def test_top_level_key_below_states_says_where_it_belongs(tmp_path):
+    robot = MINI_ROBOT + '[states]\n1 = "drive"\ntick_ms = 5\n'
+    d = find(problems(write_table(tmp_path, GOOD_TABLE, robot)), r"tick_ms is inside \[states\]")
+    assert d.line == 12 and "above the first [section]" in d.hint

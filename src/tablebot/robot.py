@@ -145,15 +145,23 @@ def _names(src: Source, key: str) -> dict[str, str]:
 
 def _good_name(src: Source, key: str, name: str) -> bool:
     """Names become column headers, so they must not clash with the fixed columns or suffixes."""
-    if name in TOP_KEYS:  # a top-level key written below a [section] header belongs to that section
-        _error(src, (key, None, name), f"{name} is inside [{key}]",
-               f"move {name} = … above the first [section]: every key below [{key}] belongs to it")
-    elif not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
+    if _misplaced(src, key, name):
+        return False
+    if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
         _error(src, (key, None, name), f"bad {key} name {name!r}",
                "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
-    else:
-        return True
-    return False
+        return False
+    return True
+
+
+def _misplaced(src: Source, section: str, key: str) -> bool:
+    """Whether ``key`` is a top-level key written below the ``[section]`` header (TOML then puts it
+    in that section); reported if so."""
+    if key not in TOP_KEYS:
+        return False
+    _error(src, (section, None, key), f"{key} is inside [{section}]",
+           f"move {key} = … above the first [section]: every key below [{section}] belongs to it")
+    return True
 
 
 def _counters(src: Source, motors: dict[str, str]) -> list[Counter]:
@@ -231,6 +239,8 @@ def _state_names(src: Source) -> dict[StateId, str]:
     names: dict[StateId, str] = {}
     for key, label in section.items():
         state = _state_id(key)
+        if _misplaced(src, "states", key):
+            continue
         if state is None:
             _error(src, ("states", None, key), f"[states] {key!r} is not a state", STATE_HINT)
         elif not isinstance(label, str):

@@ -31,8 +31,12 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-        line, col = (int(match[1]), int(match[2])) if match else (None, None)
-        message = re.sub(r"\s*\(at line.*\)", "", str(exc))
+        if match:
+            line, col = int(match[1]), int(match[2])
+        else:  # "(at end of document)": the last line, after its last character
+            lines = text.splitlines() or [""]
+            line, col = len(lines), len(lines[-1]) + 1
+        message = re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc))
         raise fail(path, f"TOML syntax: {message}", hint, line, col) from None
 
 
