@@ -209,3 +209,18 @@ def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path, bumberbot) -> No
     capture.write_bytes(encode(machine, trace))
     result = invoke("monitor", str(capture), "--table", str(EXAMPLE), "--out", str(tmp_path))
     assert result.exit_code == 2 and "--out names a folder, not a file" in result.output
+
+
+def test_a_lamp_on_an_ftduino_output_a_motor_drives_is_already_used(tmp_path: Path) -> None:
+    robot = ('name = "L"\ninitial_state = 1\n[motors]\nM1 = "a"\nM2 = "b"\n[lamps]\nL1 = "x"\n'
+             '[board.ftduino]\nL1 = "O1"\n')
+    path = tmp_path / "robot.toml"
+    path.write_text(robot, encoding="utf-8")
+    with pytest.raises(TableBotError) as info:
+        wire(load_robot(path), load_board("ftduino"))
+    (found,) = [d.render() for d in info.value.diagnostics]
+    assert found.startswith(f"{path}:9: error: lamp L1: terminal O1 is already used")
+    full = robot.replace('M2 = "b"\n', 'M2 = "b"\nM3 = "c"\nM4 = "d"\n').replace('[board.ftduino]\nL1 = "O1"\n', "")
+    path.write_text(full, encoding="utf-8")
+    with pytest.raises(TableBotError, match=r"its lamp terminals \(O1, O2, O3, O4, O5, O6, O7, O8\) are all taken"):
+        wire(load_robot(path), load_board("ftduino"))

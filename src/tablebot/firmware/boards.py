@@ -159,9 +159,8 @@ def wire(robot: Robot, board: Board) -> Wiring:
     taken: set[str] = set()
     inputs = _assign("input", robot.inputs, tuple(board.inputs), maps, taken, board, src)
     motors = _assign("motor", robot.motors, tuple(board.motors), maps, set(), board, src)
-    motor_outputs = {o for m in motors.values() for o in board.motors[m].split()}
-    lamp_terminals = tuple(t for t in board.lamps if t not in motor_outputs)
-    lamps = _assign("lamp", robot.lamps, lamp_terminals, maps, taken, board, src)
+    taken |= {o for m in motors.values() for o in board.motors[m].split()}  # ftDuino outputs the motors drive
+    lamps = _assign("lamp", robot.lamps, board.lamps, maps, taken, board, src)
     counters = _assign("counter", robot.counter_names, tuple(board.counters), maps, set(), board, src)
     src.raise_if_any()
     return Wiring(board, inputs, motors, lamps, counters, active_high)
