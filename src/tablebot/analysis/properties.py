@@ -25,13 +25,14 @@ from typing import Any
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
 from tablebot.diagnostics import Collector, TableBotError
 from tablebot.machine import Machine
-from tablebot.tomlfile import read_toml
+from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
 LEVELS = ("error", "warning")
 DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(ticks?|ms|s)\s*$")
 PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
+HINT = "see the property format in docs/checking.md"
 
 
 @dataclass(frozen=True)
@@ -83,44 +84,31 @@ def find_property_files(table_path: Path) -> list[Path]:
 def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
     """The robot file's ``[properties]`` plus every file given; all problems are reported at once."""
     robot = machine.table.robot
+    sources: list[tuple[Source, Any, str]] = []  # (file, its property tables, the section holding them)
+    if "properties" in robot.sections:
+        source = Path(robot.source)
+        src = Source.read(source, HINT) if source.is_file() else Source.parse(robot.source, "", HINT)
+        sources.append((src, robot.sections["properties"], "properties"))
+    for path in files:
+        src = Source.read(path, HINT)
+        copied = set(src.data) == {"properties"}  # a robot-file section copied as it is
+        sources.append((src, src.data["properties"] if copied else src.data, "properties" if copied else ""))
     found: list[Property] = []
     errors = []
-    sources: list[tuple[str, dict[str, Any], str]] = []
-    if "properties" in robot.sections:
-        text = Path(robot.source).read_text(encoding="utf-8-sig") if Path(robot.source).is_file() else ""
-        sources.append((robot.source, robot.sections["properties"], text))
-    for path in files:
-        sources.append((str(path), *_read_file(path)))
-    for source, entries, text in sources:
-        out = Collector(source)
+    for src, entries, section in sources:
         if not isinstance(entries, dict):
-            out.error(_line_of(text, "properties"), None, "properties must be named tables",
-                      'write [properties.my_name] (robot file) or [my_name] (properties file)')
+            src.out.error(src.line("", None, "properties"), None, "properties must be named tables",
+                          'write [properties.my_name] (robot file) or [my_name] (properties file)')
         else:
             for name, entry in entries.items():
-                prop = _property(name, entry, machine, out, source, _line_of(text, name))
+                line = src.line(f"{section}.{name}" if section else name) or src.line(section, None, name)
+                prop = _property(name, entry, machine, src.out, src.path, line)
                 if prop is not None:
                     found.append(prop)
-        errors.extend(out.items)
+        errors.extend(src.out.items)
     if errors:
         raise TableBotError(errors)
     return found
-
-
-def _read_file(path: Path) -> tuple[dict[str, Any], str]:
-    data, text = read_toml(path, "see the property format in docs/checking.md")
-    if set(data) == {"properties"}:  # a robot-file section copied as it is
-        data = data["properties"]
-    return data, text
-
-
-def _line_of(text: str, name: str) -> int | None:
-    """The line of ``[name]``, ``[properties.name]`` or ``name = …`` (tomllib keeps no positions)."""
-    pattern = re.compile(rf"^\s*(\[\s*(properties\s*\.\s*)?\"?{re.escape(name)}\"?\s*\]|\"?{re.escape(name)}\"?\s*=)")
-    for number, line in enumerate(text.splitlines(), start=1):
-        if pattern.match(line):
-            return number
-    return None
 
 
 def _property(name: str, entry: Any, machine: Machine, out: Collector, source: str,
