@@ -11,7 +11,6 @@ from tablebot.codegen.layout import KEEP, Layout, plan
 from tablebot.machine import Machine
 
 ENGINE_FILES = ("tb_engine.h", "tb_engine.c")
-GENERATED_FILES = ("tb_config.h", "tb_table.c")
 HOST_RUNNER = "host_run.c"
 
 
