@@ -10,18 +10,9 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from tablebot.sim.world import load_world
-from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, setup_of, write_bot
+from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, setup_of, world_errors, write_bot
 
 runner = CliRunner()
-
-
-def world_errors(tmp_path: Path, text: str) -> list[str]:
-    path = tmp_path / "bad.toml"
-    path.write_text(text, encoding="utf-8")
-    with pytest.raises(TableBotError) as info:
-        load_world(path)
-    return [d.render() for d in info.value.diagnostics]
 
 
 def setup_errors(tmp_path: Path, world: str, robot: str = ROBOT) -> list[str]:

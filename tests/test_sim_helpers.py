@@ -8,9 +8,13 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
+import pytest
+
 from tablebot.cli.common import load
+from tablebot.diagnostics import TableBotError
 from tablebot.sim.runner import Result, run, write_trace
 from tablebot.sim.setup import Setup, setup_for
+from tablebot.sim.world import load_world
 
 ROOT = Path(__file__).resolve().parents[1]
 BUMBERBOT = ROOT / "examples" / "bumberbot"
@@ -60,6 +64,15 @@ def setup_of(table: Path, world: Path | None = None, **overrides: dict) -> Setup
 def bot(tmp_path: Path, rows: list[str], world: str, **overrides: dict) -> Setup:
     table, world_path = write_bot(tmp_path, rows, world)
     return setup_of(table, world_path, **overrides)
+
+
+def world_errors(tmp_path: Path, text: str) -> list[str]:
+    """The rendered diagnostics of a world file that must not load."""
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(TableBotError) as info:
+        load_world(path)
+    return [d.render() for d in info.value.diagnostics]
 
 
 def trace_text(result: Result) -> str:

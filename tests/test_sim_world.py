@@ -8,18 +8,10 @@ import pytest
 
 from tablebot.diagnostics import TableBotError
 from tablebot.sim.world import geometry, load_world
-from test_sim_helpers import ROBOT, STRAIGHT, bot, room, setup_of, write_bot
+from test_sim_helpers import ROBOT, STRAIGHT, bot, room, setup_of, world_errors, write_bot
 
 GOOD = room(extra="[[lamp]]\nat = [2, 2]\n[[box]]\nat = [0.5, 2.5]\nsize = [0.2, 0.3]\nangle = 45\n"
              "[[circle]]\nat = [2.5, 0.5]\nradius = 0.1\n[[segment]]\nfrom = [0, 1]\nto = [0.5, 1]\n")
-
-
-def errors(tmp_path: Path, text: str) -> list[str]:
-    path = tmp_path / "bad.toml"
-    path.write_text(text, encoding="utf-8")
-    with pytest.raises(TableBotError) as info:
-        load_world(path)
-    return [d.render() for d in info.value.diagnostics]
 
 
 def test_a_good_world_loads_into_arrays(tmp_path: Path) -> None:
@@ -51,12 +43,12 @@ R = room().count("\n")  # lines of the room text; the bad parts follow it
     (room() + "[arena\n", R + 1, "TOML syntax"),
 ])
 def test_bad_worlds_are_located(tmp_path: Path, text: str, line: int, words: str) -> None:
-    found = errors(tmp_path, text)
+    found = world_errors(tmp_path, text)
     assert any(f"bad.toml:{line}" in e and words in e for e in found), found
 
 
 def test_every_problem_is_reported_at_once(tmp_path: Path) -> None:
-    found = errors(tmp_path, room() + "[[box]]\nat = [1, 1]\nsize = [0, 1]\n[[circle]]\nat = [2, 2]\n")
+    found = world_errors(tmp_path, room() + "[[box]]\nat = [1, 1]\nsize = [0, 1]\n[[circle]]\nat = [2, 2]\n")
     assert len(found) == 2
 
 
