@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 from tablebot.engine import Engine
 from tablebot.machine import NO_ROW, Machine
@@ -36,6 +37,7 @@ Node = tuple[int, int, int, tuple[int, ...], bool]
 Tick = tuple[int, int, int, Node]
 #: Pulses written for a counter that must reach 0 this tick: more than any load can hold.
 ZERO_PULSES = 65535
+K = TypeVar("K")
 #: Input bits a state is enumerated over; beyond this the model would be too large to explore.
 MAX_ENUMERATED_BITS = 16
 
@@ -218,6 +220,17 @@ class Graph:
 
     def states(self) -> set[int]:
         return {node[0] for node in self.nodes}
+
+
+def walk_back(parent: dict[K, tuple[K, Tick] | None], key: K) -> list[tuple[K, Tick]]:
+    """The steps of a breadth-first search from its start (whose parent is None) to ``key``, in order:
+    each step is (where it was taken, the tick taken)."""
+    steps = []
+    while (step := parent[key]) is not None:
+        steps.append(step)
+        key = step[0]
+    steps.reverse()
+    return steps
 
 
 def _subsets(bits: int) -> Iterator[int]:

@@ -113,20 +113,27 @@ def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
 
 def _property(name: str, entry: Any, machine: Machine, out: Collector, source: str,
               line: int | None) -> Property | None:
+    """One property table, or None after reporting everything wrong with it."""
     if not isinstance(entry, dict):
         out.error(line, None, f"property {name!r} must be a table of keys",
                   f'write [{name}] followed by lines like never = "state == 3"')
         return None
     before = len(out.items)
+    kind = _kind(name, entry, line, out)
+    if kind is None:
+        return None
+    fields = _claims(name, entry, kind, machine, line, out)
+    if len(out.items) > before:
+        return None
+    return Property(name=name, text=str(entry.get("text", name)), kind=kind, level=entry.get("level", "error"),
+                    note=str(entry.get("note", "")), source=source, line=line, **fields)
+
+
+def _kind(name: str, entry: dict[str, Any], line: int | None, out: Collector) -> str | None:
+    """The property's kind (exactly one of KINDS must be given); the other keys are checked on the way."""
     for key in entry:
         if key not in KEYS:
             out.error(line, None, f"property {name}: unknown key {key!r}", f"known keys: {', '.join(sorted(KEYS))}")
-    kinds = [k for k in KINDS if k in entry]
-    if len(kinds) != 1:
-        out.error(line, None, f"property {name} needs exactly one of {', '.join(KINDS)} (found {len(kinds)})",
-                  'for example: never = "state == 20 and M1 > 0"')
-        return None
-    kind = kinds[0]
     level = entry.get("level", "error")
     if level not in LEVELS:
         out.error(line, None, f"property {name}: level must be error or warning, not {level!r}",
@@ -135,6 +142,17 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
         if not isinstance(entry.get(key, ""), str):
             out.error(line, None, f"property {name}: {key} must be text, not {entry[key]!r}",
                       f'write it in quotes: {key} = "…"')
+    kinds = [k for k in KINDS if k in entry]
+    if len(kinds) != 1:
+        out.error(line, None, f"property {name} needs exactly one of {', '.join(KINDS)} (found {len(kinds)})",
+                  'for example: never = "state == 20 and M1 > 0"')
+        return None
+    return kinds[0]
+
+
+def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line: int | None,
+            out: Collector) -> dict[str, Any]:
+    """The parsed conditions (and ``within``) of a property of ``kind``, as Property fields."""
 
     def condition(key: str) -> Condition | None:
         value = entry.get(key)
@@ -148,16 +166,10 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
             out.error(line, None, f"property {name}: {key}: {exc}", "see the condition language in docs/checking.md")
             return None
 
-    fields: dict[str, Any] = {}
-    if kind == "when":
-        fields["when"], fields["then"] = condition("when"), condition("then")
-        fields["within"] = _duration(entry.get("within"), machine.table.robot.tick_ms, name, line, out)
-    else:
-        fields["cond"] = condition(kind)
-    if len(out.items) > before:
-        return None
-    return Property(name=name, text=str(entry.get("text", name)), kind=kind, level=level,
-                    note=str(entry.get("note", "")), source=source, line=line, **fields)
+    if kind != "when":
+        return {"cond": condition(kind)}
+    return {"when": condition("when"), "then": condition("then"),
+            "within": _duration(entry.get("within"), machine.table.robot.tick_ms, name, line, out)}
 
 
 def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collector) -> int:

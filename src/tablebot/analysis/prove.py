@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tablebot.analysis.conditions import Obs
-from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick
+from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.analysis.properties import Property
 from tablebot.machine import NO_ROW, Machine
 from tablebot.trace import TickInput, replay
@@ -136,12 +136,8 @@ def search(model: Model, monitor: Monitor, budget: int = 10_000_000) -> tuple[Pa
 
 
 def _path(parent: dict, key: Any) -> Path:
-    steps: Path = []
-    while parent[key] is not None:
-        key, tick = parent[key]
-        steps.append((key[0], tick))
-    steps.reverse()
-    return steps
+    """The model steps to a (node, monitor state) pair."""
+    return [(pair[0], tick) for pair, tick in walk_back(parent, key)]
 
 
 def trapped(graph: Graph, good: Any) -> tuple[Path | None, set[Node]]:
@@ -177,13 +173,7 @@ def trapped(graph: Graph, good: Any) -> tuple[Path | None, set[Node]]:
                 continue
             parent[after] = (node, tick)
             if after in dead:
-                steps: Path = []
-                key = after
-                while parent[key] is not None:
-                    prev, t = parent[key]  # type: ignore[misc]
-                    steps.append((prev, t))
-                    key = prev
-                return steps[::-1], dead
+                return walk_back(parent, after), dead
             queue2.append(after)
     return None, dead
 

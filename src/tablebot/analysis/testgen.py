@@ -15,7 +15,7 @@ from pathlib import Path
 
 from tablebot.analysis.check import write_inputs
 from tablebot.analysis.findings import find_all
-from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick
+from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
 from tablebot.machine import Machine
 from tablebot.trace import TickInput, replay, write_trace
@@ -91,12 +91,7 @@ def _nearest(model: Model, start: Node, wanted: set[int]) -> list[tuple[Node, Ti
         node = queue.popleft()
         for tick in model.successors(node):
             if tick[2] in wanted:
-                steps = [(node, tick)]
-                while parent[node] is not None:
-                    prev, prev_tick = parent[node]  # type: ignore[misc]
-                    steps.append((prev, prev_tick))
-                    node = prev
-                return steps[::-1]
+                return [*walk_back(parent, node), (node, tick)]
             after = tick[3]
             if after not in parent:
                 parent[after] = (node, tick)
