@@ -102,6 +102,11 @@ def test_missing_keys_are_named_not_shown_as_none(tmp_path: Path) -> None:
     assert not any("None" in e for e in found), found
 
 
+def test_a_world_without_arena_says_it_is_missing(tmp_path: Path) -> None:
+    found = world_errors(tmp_path, 'name = "nothing"\n')
+    assert any("[arena] walls is missing" in e and "add an [arena] section" in e for e in found), found
+
+
 def test_a_section_that_is_not_an_array_of_tables_is_one_located_error(tmp_path: Path) -> None:
     found = world_errors(tmp_path, "box = [1, 2]\n" + room())
     assert found == [f"{tmp_path / 'bad.toml'}:1: error: box must be written as [[box]] tables, not [1, 2]\n"

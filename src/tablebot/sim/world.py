@@ -158,6 +158,10 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     known_keys(src, ("arena", None), arena, ("walls",))
     raw = arena.get("walls")
     where = ("arena", None, "walls")
+    if raw is None:
+        src.error(where, "[arena] walls is missing: the room's corners", "add an [arena] section with "
+                  "walls = [[0, 0], [3, 0], [3, 2], [0, 2]] (metres, in order around the room)")
+        return []
     if not isinstance(raw, list) or len(raw) < 3:
         src.error(where, "[arena] walls must list at least three corners [x, y]",
                   "for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]")
