@@ -12,8 +12,6 @@ from functools import cached_property
 
 from tablebot.robot import Robot, StateId
 
-#: A motor speed, lamp level or counter load of ``None`` means "leave it as it is".
-KEEP = None
 #: The document's direction + speed encoding uses speed 7 for "keep".
 DOC_KEEP_SPEED = 7
 MAX_SPEED = 8
@@ -23,7 +21,10 @@ TIMER_EVENT = "T"
 
 @dataclass(frozen=True)
 class Row:
-    """One transition; ``index`` is 0-based in the table as written, ``line`` is the file line."""
+    """One transition; ``index`` is 0-based in the table as written, ``line`` is the file line.
+
+    A motor speed, lamp level or counter load of ``None`` means "leave it as it is".
+    """
 
     index: int
     line: int

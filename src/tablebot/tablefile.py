@@ -35,7 +35,7 @@ INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
 class Column:
     """What one header cell means: a fixed column, an event, or one field of an output."""
 
-    kind: str  # description|state|timer|next|event|dir|speed|signed|lamp|load
+    kind: str  # description|state|timer|next|event|dir|speed|signed|lamp|load, or ignore (no such column)
     name: str  # event/motor/lamp/counter name, or the fixed column's name
     cell: Cell
 

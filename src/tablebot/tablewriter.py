@@ -19,9 +19,8 @@ def signed_motors(table: Table) -> frozenset[str]:
     return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
 
 
-def header(table: Table) -> list[str]:
+def header(table: Table, signed: frozenset[str]) -> list[str]:
     robot = table.robot
-    signed = signed_motors(table)
     motors = [name for m in robot.motors for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
     return ["description", "state", *table.events, *motors,
             *robot.lamps, *(f"{c}_load" for c in robot.counter_names), "timer", "next"]
@@ -39,9 +38,7 @@ def _keep(value: int | None) -> str:
     return "=" if value is None else str(value)
 
 
-def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[str] | None = None) -> list[str]:
-    if signed is None:
-        signed = signed_motors(table)
+def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[str]) -> list[str]:
     description = "" if previous and previous.description == row.description else row.description
     motors = zip(table.robot.motors, row.motors, strict=True)
     return [description, str(row.state), *("1" if e in row.events else "" for e in table.events),
@@ -54,8 +51,8 @@ def format_table(table: Table) -> str:
     """CSV text that :func:`tablebot.tablefile.parse_table` reads back into the same machine."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header(table))
     signed = signed_motors(table)
+    writer.writerow(header(table, signed))
     previous = None
     for row in table.rows:
         writer.writerow(row_cells(table, row, previous, signed))
