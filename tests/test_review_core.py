@@ -280,3 +280,12 @@ def test_top_level_key_below_states_says_where_it_belongs(tmp_path):
     robot = MINI_ROBOT + '[states]\n1 = "drive"\ntick_ms = 5\n'
     d = find(problems(write_table(tmp_path, GOOD_TABLE, robot)), r"tick_ms is inside \[states\]")
     assert d.line == 12 and "above the first [section]" in d.hint
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+@pytest.mark.parametrize("command", [
+    ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
+    ["diagram", EXAMPLE, "--format", "dot", "--out"],
+])
+def test_a_full_disk_names_the_output_file(command):
+    assert fails(*command, "/dev/full").startswith("/dev/full: error: cannot write or read: No space left")

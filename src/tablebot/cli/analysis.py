@@ -29,6 +29,7 @@ from tablebot.cli.common import (
     out_file,
     out_folder,
     resolve_table_path,
+    writing,
 )
 from tablebot.diagnostics import fail
 
@@ -177,5 +178,6 @@ def diagram_cmd(
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
         return
-    out_file(out, "--out", make_folder=True).write_bytes(data)
+    with writing(out):
+        out_file(out, "--out", make_folder=True).write_bytes(data)
     err_console.print(f"wrote {out} ({fmt}, {len(data)} bytes)")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import errno
 import functools
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -75,6 +76,17 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
         raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
                    f"give {option} a file in an existing folder")
     return path
+
+
+@contextmanager
+def writing(path: Path) -> Iterator[None]:
+    """Name ``path`` in an OSError raised while writing it: a full disk or a failing device names no file."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = str(path)
+        raise
 
 
 def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:

@@ -10,7 +10,17 @@ import typer
 
 from tablebot import robopro
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
+from tablebot.cli.common import (
+    ROBOT_OPT,
+    TABLE_ARG,
+    console,
+    err_console,
+    guarded,
+    load,
+    out_file,
+    out_folder,
+    writing,
+)
 from tablebot.examples import example_path
 from tablebot.robot import BUMBERBOT, load_robot
 from tablebot.tablewriter import format_table
@@ -35,7 +45,8 @@ def import_cmd(
     if out is None:
         sys.stdout.write(text)
     else:
-        out_file(out, "--out").write_text(text, encoding="utf-8")
+        with writing(out):
+            out_file(out, "--out").write_text(text, encoding="utf-8")
         err_console.print(f"wrote {out} ({len(table.rows)} rows; descriptions are not in the lists)")
 
 
@@ -53,7 +64,7 @@ def trace_cmd(
     if out is None:
         write_trace(replay(machine, ticks), sys.stdout)
         return
-    with out_file(out, "--out").open("w", encoding="utf-8") as stream:
+    with writing(out), out_file(out, "--out").open("w", encoding="utf-8") as stream:
         count = write_trace(replay(machine, ticks), stream)
     err_console.print(f"wrote {out} ({count} ticks)")
 
