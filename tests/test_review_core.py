@@ -289,3 +289,22 @@ def test_top_level_key_below_states_says_where_it_belongs(tmp_path):
 ])
 def test_a_full_disk_names_the_output_file(command):
     assert fails(*command, "/dev/full").startswith("/dev/full: error: cannot write or read: No space left")
+
+
+# --- what spreadsheets save -------------------------------------------------------------------------
+
+def test_excel_sep_line_names_the_delimiter_and_keeps_line_numbers(tmp_path):
+    from tablebot.tablefile import load_table
+
+    table = write_table(tmp_path, "sep=;\nstate;T;M1;timer;next\n1;1;3;10;1\n1;1;9;10;1\n", MINI_ROBOT)
+    d = find(problems(table), "out of range")
+    assert (d.line, d.column) == (4, 5)
+    table.write_text("sep=;\nstate;T;M1;timer;next\n1;1;3;10;1\n")
+    assert load_table(table).rows[0].line == 3
+
+
+def test_inputs_with_a_sep_line_or_blank_lines_above_the_header(tmp_path):
+    for text in ("sep=;\nI3;I4\n1;1\n", "\n\nI3,I4\n1,1\n"):
+        (tmp_path / "in.csv").write_text(text)
+        result = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(tmp_path / "in.csv")])
+        assert result.exit_code == 0 and result.stdout.startswith('{"tick":0,"event":56,'), result.output

@@ -8,11 +8,14 @@ from __future__ import annotations
 
 import codecs
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 
+#: The line Excel may put above the header to name the delimiter: ``sep=;``.
+SEP_RE = re.compile(r"^\s*sep=([,;\t])\s*$")
 #: A binary file would give thousands of bad lines; the first few say enough.
 MAX_BAD_LINES = 10
 
@@ -89,8 +92,12 @@ def _first_filled_line(text: str) -> str:
 def split_records(text: str, path: str, delimiter: str | None = None) -> list[Record]:
     """Split CSV text into records; a quoted cell may hold delimiters, quotes ("") and newlines."""
     text = text.replace("\r\n", "\n").replace("\r", "\n")
+    first = _first_filled_line(text)
+    excel = SEP_RE.match(first)
+    if excel:  # Excel's "sep=;" line names the delimiter; blanked, so that line numbers stay
+        text = text.replace(first, "", 1)
     if delimiter is None:
-        delimiter = detect_delimiter(_first_filled_line(text))
+        delimiter = excel[1] if excel else detect_delimiter(first)
     records: list[Record] = []
     cells: list[Cell] = []
     line, column, i = 1, 1, 0
@@ -152,3 +159,18 @@ def _quoted(text: str, i: int, line: int, column: int, path: str) -> tuple[str, 
         i += 1
     raise fail(path, "a quoted cell is never closed", 'add the closing " (write "" for a quote inside)',
                start_line, start_col)
+
+
+def cells_beyond(cells: Sequence[Cell], width: int, out: Collector) -> None:
+    """Report the filled cells right of a ``width``-column header (a spreadsheet shows them; nothing reads them)."""
+    for cell in cells[width:]:
+        if cell.text.strip():
+            out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is beyond the last column",
+                      "remove it or add a header for it")
+
+
+def headerless(cell: Cell, out: Collector) -> None:
+    """Report a filled cell in a column whose header is blank."""
+    if cell.text.strip():
+        out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is in a column with no header",
+                  "name the column in the header, or clear the cell")

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tablebot.csvtext import Cell, Record, read_text, split_records
+from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
 from tablebot.robot import (
     BUMBERBOT,
@@ -194,10 +194,7 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) ->
     end = (cells[-1].column + len(cells[-1].text) + 1) if cells else 1
     cells += [Cell("", record.line, end)] * (len(columns) - len(cells))
     values = {(c.kind, c.name): _value(c, cell, out) for c, cell in zip(columns, cells, strict=True)}
-    for extra in record.cells[len(columns):]:
-        if extra.text.strip():
-            out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
-                      "remove it or add a header for it")
+    cells_beyond(record.cells, len(columns), out)
     state, nxt = values.get(("state", "state")), values.get(("next", "next"))
     if state is None or nxt is None:
         return None
@@ -221,9 +218,8 @@ def _value(column: Column, cell: Cell, out: Collector) -> Any:
         label = column.cell.text.strip()
         what = "timer" if kind == "timer" else f"event {label}" if kind == "event" else label
         return _int(cell, what, low, high, out, blank, keep)
-    if not column.name and text:  # an ignored column with a name was reported in the header
-        out.error(cell.line, cell.column, f"cell {text!r} is in a column with no header",
-                  "name the column in the header, or clear the cell")
+    if not column.name:  # an ignored column with a name was reported in the header
+        headerless(cell, out)
     return None
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from tablebot.csvtext import Cell, read_text, split_records
+from tablebot.csvtext import Cell, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, fail
 from tablebot.engine import Engine
 from tablebot.machine import NO_ROW, Machine
@@ -32,6 +32,8 @@ def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
     """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0."""
     path = Path(path)
     records = split_records(read_text(path), str(path))
+    while records and records[0].is_blank():  # blank lines above the header (below it, a blank row is a tick)
+        records.pop(0)
     if not records:
         raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
     out = Collector(path)
@@ -72,17 +74,12 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machin
     robot = machine.table.robot
     mask = 0
     pulses = [0] * len(robot.counter_names)
-    for extra in cells[len(columns):]:
-        if extra.text.strip():
-            out.error(extra.line, extra.column, f"cell {extra.text.strip()!r} is beyond the last column",
-                      "remove it or add a header for it")
     for (kind, name), cell in zip(columns, cells, strict=False):
         text = cell.text.strip()
         if kind in ("bad", "tick") or not text:
             continue
         if kind == "blank":
-            out.error(cell.line, cell.column, f"cell {text!r} is in a column with no header",
-                      "name the column in the header, or clear the cell")
+            headerless(cell, out)
         elif not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
             want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
             out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
@@ -90,6 +87,7 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machin
             mask |= machine.input_bits.get(name, 0) if text == "1" else 0
         else:
             pulses[robot.counter_names.index(name)] = int(text)
+    cells_beyond(cells, len(columns), out)
     return TickInput(mask, tuple(pulses))
 
 
