@@ -1,4 +1,4 @@
-"""What every command shares: loading a table into a machine, and turning errors into exit code 2."""
+"""What every command shares: loading a table, checking output paths, and turning errors into exit code 2."""
 
 from __future__ import annotations
 
