@@ -308,3 +308,11 @@ def test_inputs_with_a_sep_line_or_blank_lines_above_the_header(tmp_path):
         (tmp_path / "in.csv").write_text(text)
         result = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(tmp_path / "in.csv")])
         assert result.exit_code == 0 and result.stdout.startswith('{"tick":0,"event":56,'), result.output
+
+
+@pytest.mark.parametrize("name", ["../../escaped", "a/b", "", ".hidden", "nul\\u0000"])
+def test_property_names_must_be_plain_file_names(tmp_path, name):
+    (tmp_path / "p.toml").write_text(f'["{name}"]\nreachable = "I3"\n')
+    err = fails("check", EXAMPLE, "--properties", tmp_path / "p.toml", "--counterexamples", tmp_path / "cex" / "x")
+    assert "cannot name a file" in err
+    assert not (tmp_path / "escaped.csv").exists()

@@ -33,6 +33,8 @@ LEVELS = ("error", "warning")
 DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(ticks?|ms|s)\s*$")
 PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
 HINT = "see the property format in docs/checking.md"
+#: A property's name names its counterexample file, so it must stay a plain file name.
+NAME_RE = re.compile(r"^\w[\w .-]*$")
 
 
 @dataclass(frozen=True)
@@ -119,6 +121,9 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
                   f'write [{name}] followed by lines like never = "state == 3"')
         return None
     before = len(out.items)
+    if not NAME_RE.match(name):
+        out.error(line, None, f"property name {name!r} cannot name a file",
+                  "use letters, digits, spaces, _ . and - (its counterexample is written to NAME.csv)")
     kind = _kind(name, entry, line, out)
     if kind is None:
         return None
