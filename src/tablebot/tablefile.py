@@ -147,17 +147,21 @@ def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int 
         return blank
     if keep and text.lower() in KEEP_WORDS:
         return None
+    hint = _range_hint(low, high, keep)
     if not INT_RE.match(text):
-        extra = ", or = to keep it as it is" if keep else ""
-        out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer",
-                  f"write a whole number from {low} to {high}{extra}")
+        out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer", hint)
         return blank
     value = _whole(text)
     if not low <= value <= high:
-        out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}",
-                  f"write a whole number from {low} to {high}")
+        out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}", hint)
         return blank
     return value
+
+
+def _range_hint(low: int, high: int, keep: bool) -> str:
+    if (low, high) == (0, 1):  # event and direction cells: a flag, not a quantity
+        return "write 1 or 0 (a blank cell is 0)"
+    return f"write a whole number from {low} to {high}" + (", or = to keep it as it is" if keep else "")
 
 
 def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
