@@ -213,3 +213,17 @@ def test_demo_writes_the_trace_of_the_example(tmp_path):
     assert "BumberBot: 3000 ticks (30.0 s)" in result.stdout
     expected = invoke("trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv").stdout
     assert (tmp_path / "trace.jsonl").read_text() == expected
+
+
+def test_trace_into_a_closed_pipe_stops_quietly():
+    """`tablebot trace ... | head -1`: the reader leaving early is no error."""
+    command = [sys.executable, "-c", "from tablebot.cli import main; main()", "trace", str(EXAMPLE),
+               "--inputs", str(EXAMPLE / "inputs.csv")]
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdout is not None and proc.stderr is not None
+    first = proc.stdout.readline()
+    proc.stdout.close()
+    stderr = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 0
+    assert first.startswith(b'{"tick":0,')
+    assert stderr == ""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -115,6 +116,9 @@ def guarded(func: F) -> F:
             for d in exc.diagnostics:
                 print_diagnostic(d)
             raise typer.Exit(2) from None
+        except BrokenPipeError:  # the reader went away (`tablebot trace ... | head`): stop quietly, as Unix tools do
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+            raise typer.Exit(0) from None
         except OSError as exc:  # a file the command had to write (or read) is not there to be had
             where = exc.filename if exc.filename is not None else "tablebot"
             print_diagnostic(Diagnostic(str(where), None, None, f"cannot write or read: {exc.strerror or exc}",
