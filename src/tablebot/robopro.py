@@ -225,11 +225,11 @@ def read_table(directory: Path, robot: Robot) -> Table:
                    "layout", f"import needs a robot with at most {MAX_EVENTS - 1} inputs and {MAX_MOTORS} motors")
     table = decode(read_lists(directory), robot, layout, str(directory))
     problems = []
-    for row, key, message, hint in missing_states(table.rows, robot):
+    for row, where, message, hint in missing_states(table.rows, robot):
         if row is not None:  # the row's line is its line in every list; its next state is in action.csv
             problems.append(Diagnostic(str(directory / LIST_FILES[1]), row.line, 1, message, hint))
         else:
-            line = robot.lines.get(key)
+            line = robot.line(*where)
             where = (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None)
             problems.append(Diagnostic(*where, message, "the lists may be for another robot: pass its --robot"))
     if problems:

@@ -56,12 +56,22 @@ class Robot:
     state_names: dict[StateId, str] = field(default_factory=dict, compare=False)
     sections: dict[str, Any] = field(default_factory=dict, compare=False)
     source: str = "built-in"
-    #: Line in the robot file of ``initial_state`` and of each ``[states]`` entry, for error messages.
-    lines: dict[str, int] = field(default_factory=dict, compare=False)
+    #: The parsed robot file (None for the built-in robot), kept so that every stage can locate
+    #: its errors in the file without reading it again.
+    toml: Source | None = field(default=None, compare=False, repr=False)
 
     @property
     def counter_names(self) -> tuple[str, ...]:
         return tuple(c.name for c in self.counters)
+
+    def line(self, section: str, key: str | None = None) -> int | None:
+        """Line of ``[section] key`` (top-level keys: section "") in the robot file, if it has one."""
+        return self.toml.line(section, None, key) if self.toml else None
+
+    def file_source(self) -> Source:
+        """The robot file as a :class:`Source` with a fresh error collector (empty for the built-in robot)."""
+        toml = self.toml
+        return Source(self.source, "", {}) if toml is None else Source(toml.path, toml.text, toml.data)
 
 
 BUMBERBOT = Robot(
@@ -112,10 +122,7 @@ def load_robot(path: Path) -> Robot:
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
         initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms,
         labels={**inputs, **motors, **lamps}, state_names=states,
-        sections={k: data[k] for k in FOREIGN_SECTIONS if k in data}, source=str(path),
-        lines={key: line for key, where in (("initial_state", ("", None, "initial_state")),
-                                             *((str(s), ("states", None, str(s))) for s in states))
-               if (line := src.line(*where)) is not None},
+        sections={k: data[k] for k in FOREIGN_SECTIONS if k in data}, source=str(path), toml=src,
     )
 
 

@@ -71,20 +71,20 @@ class Table:
 
 
 #: A state that is used but has no rows: (the row whose next state it is, or None when the robot
-#: file names it; the robot-file key that names it; message; hint).
-MissingState = tuple[Row | None, str, str, str]
+#: file names it; where the robot file names it, as (section, key); message; hint).
+MissingState = tuple[Row | None, tuple[str, str], str, str]
 
 
 def missing_states(rows: Sequence[Row], robot: Robot) -> list[MissingState]:
     """Every next state, the initial state and every named state must have rows of its own."""
     with_rows = {row.state for row in rows}
     found: list[MissingState] = [
-        (row, "next", f"next state {row.next!r} is unknown: no row has state {row.next!r}",
+        (row, ("", "next"), f"next state {row.next!r} is unknown: no row has state {row.next!r}",
          f"add rows for state {row.next!r} or fix the next state") for row in rows if row.next not in with_rows]
     if robot.initial_state not in with_rows:
-        found.append((None, "initial_state",
+        found.append((None, ("", "initial_state"),
                       f"initial state {robot.initial_state!r} (from {robot.source} robot {robot.name}) has no rows",
                       "add rows for it or change initial_state in the robot file"))
-    found += [(None, str(state), f"state {state!r} is named in {robot.source} but has no rows",
+    found += [(None, ("states", str(state)), f"state {state!r} is named in {robot.source} but has no rows",
                "add rows for it or remove it from [states]") for state in robot.state_names if state not in with_rows]
     return found

@@ -255,18 +255,19 @@ def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[C
         return
     next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
     next_cells = {r.line: r.cells[next_at] for r in body if next_at is not None and len(r.cells) > next_at}
-    for row, key, message, hint in missing_states(rows, robot):
+    for row, where, message, hint in missing_states(rows, robot):
         if row is None:
-            _robot_error(out, robot, key, columns, message, hint)
+            _robot_error(out, robot, where, columns, message, hint)
         else:
             cell = next_cells.get(row.line)
             out.error(row.line, cell.column if cell else None, message, hint)
 
 
-def _robot_error(out: Collector, robot: Robot, key: str, columns: list[Column], message: str, hint: str) -> None:
+def _robot_error(out: Collector, robot: Robot, where: tuple[str, str], columns: list[Column], message: str,
+                 hint: str) -> None:
     """A problem that comes from the robot description: located at its line in the robot file, or,
     for the built-in robot, at the table's state column (where the missing rows belong)."""
-    line = robot.lines.get(key)
+    line = robot.line(*where)
     if line is not None:
         out.items.append(Diagnostic(robot.source, line, 1, message, hint))
         return

@@ -88,8 +88,7 @@ def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
     robot = machine.table.robot
     sources: list[tuple[Source, Any, str]] = []  # (file, its property tables, the section holding them)
     if "properties" in robot.sections:
-        source = Path(robot.source)
-        src = Source.read(source, HINT) if source.is_file() else Source.parse(robot.source, "", HINT)
+        src = robot.file_source()
         sources.append((src, robot.sections["properties"], "properties"))
     for path in files:
         src = Source.read(path, HINT)

@@ -7,7 +7,6 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import fail
@@ -65,11 +64,6 @@ class Wiring:
         """ftDuino O terminals taken by motors and lamps."""
         taken = {o for m in self.motors.values() for o in self.board.motors[m].split()}
         return taken | set(self.lamps.values())
-
-
-def _robot_source(robot: Robot) -> Source:
-    """The robot file again, for the lines of its keys (the built-in robot has no file)."""
-    return Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
 
 
 def _overrides(robot: Robot, board: Board, src: Source) -> tuple[dict[str, str], frozenset[str]]:
@@ -154,7 +148,7 @@ def _assign(kind: str, names: tuple[str, ...], terminals: tuple[str, ...], maps:
 
 def wire(robot: Robot, board: Board) -> Wiring:
     """Assign every robot signal to a terminal, reporting all conflicts at once."""
-    src = _robot_source(robot)
+    src = robot.file_source()
     maps, active_high = _overrides(robot, board, src)
     taken: set[str] = set()
     inputs = _assign("input", robot.inputs, tuple(board.inputs), maps, taken, board, src)

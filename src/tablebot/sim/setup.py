@@ -30,7 +30,7 @@ from tablebot.sim.params import (
 from tablebot.sim.physics import body_corners, deepest_contact
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
-from tablebot.tomlfile import Source, known_keys
+from tablebot.tomlfile import known_keys
 
 MAX_STEP_M = 0.04  # the most the robot may move in one tick: well under half its length, so contacts stay found
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
@@ -61,7 +61,7 @@ def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
     sim = robot.sections.get("sim")
     if not sim:
         return {}, None
-    src = _robot_source(robot)
+    src = robot.file_source()
     if not isinstance(sim, dict):
         raise fail(robot.source, "[sim] must be a table", "write [sim.battery] etc.", src.line("", None, "sim"))
     known_keys(src, ("sim", None), sim, (*SECTIONS, "world"))
@@ -119,11 +119,6 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
                  pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps))
 
 
-def _robot_source(robot: Robot) -> Source:
-    """The robot file again, for the lines of its [sim] keys (the built-in robot has no file)."""
-    return Source.read(robot.source) if Path(robot.source).is_file() else Source.parse(robot.source, "")
-
-
 def _locate(section: str, key: str, world: World, robot: Robot,
             robot_params: dict[str, Any]) -> tuple[str, int | None]:
     """The file and line that set ``[section] key`` (the world wins over the robot's ``[sim.*]``), else
@@ -133,7 +128,7 @@ def _locate(section: str, key: str, world: World, robot: Robot,
         if section in world.params and (whole or key in world.params[section]):
             return world.path, world.line(section, found)
         if section in robot_params and (whole or key in robot_params[section]):
-            return robot.source, _robot_source(robot).line(f"sim.{section}", None, found)
+            return robot.source, robot.line(f"sim.{section}", found)
     return robot.source, None
 
 
@@ -176,7 +171,7 @@ def _check_tick(params: Params, robot: Robot) -> None:
         raise fail(robot.source, f"tick_ms = {robot.tick_ms} is too coarse for the simulator: the robot would move "
                    f"up to {100 * step:.0f} cm per tick, through thin walls",
                    f"simulate with tick_ms = {math.floor(MAX_STEP_M / top * 1000)} or less (the engine and the "
-                   "firmware take any tick)", _robot_source(robot).line("", None, "tick_ms"))
+                   "firmware take any tick)", robot.line("", "tick_ms"))
 
 
 def _check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
