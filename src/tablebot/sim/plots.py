@@ -30,7 +30,6 @@ from tablebot.sim.draw import (
 )
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
-from tablebot.trace import replay
 
 DPI = 150
 
@@ -138,13 +137,12 @@ def _legend(fig: Figure, result: Result, summary: Summary) -> None:
 def timeline(result: Result, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits and light readings against time."""
     t = np.arange(result.ticks) * result.tick_s
-    events = [line["event"] for line in replay(result.setup.machine, result.inputs())]
     fig = Figure(figsize=(12, 9), dpi=DPI)
     FigureCanvasAgg(fig)
     axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.6, 1.6, 1.3], "hspace": 0.12})
     _state_panel(axes[0], result)
     _output_panel(axes[1], result, t)
-    _event_panel(axes[2], result, t, events)
+    _event_panel(axes[2], result, t)
     _light_panel(axes[3], result, t)
     for ax in axes:
         for row in summary.collision_ticks:
@@ -199,9 +197,9 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
 
 
-def _event_panel(ax, result: Result, t: np.ndarray, events: list[int]) -> None:
+def _event_panel(ax, result: Result, t: np.ndarray) -> None:
     table = result.setup.table
-    ev = np.array(events, dtype=np.int64)
+    ev = result.events
     labels = table.robot.labels
     tick, least = result.tick_s, result.ticks * result.tick_s / 500  # one-tick events stay visible
     for k, name in enumerate(table.events):

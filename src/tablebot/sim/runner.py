@@ -13,13 +13,14 @@ from typing import IO, Any
 
 import numpy as np
 
+from tablebot import trace
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.sim import layout as L
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.physics import step_one
 from tablebot.sim.setup import Setup
-from tablebot.trace import TickInput, dumps, replay
+from tablebot.trace import TickInput, replay
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
 NOISE_BLOCK = 4096  # ticks of noise drawn at once: one Generator call instead of one per tick
@@ -29,12 +30,14 @@ CHUNK = 2000  # ticks between progress reports
 @dataclass
 class Result:
     """A finished run. ``hist[t]`` is the robot at the start of tick t (what the engine sensed then);
-    ``states[t]``/``outputs[t]`` are the engine's state index and outputs after tick t."""
+    ``events[t]`` is the event set the engine saw in tick t, ``states[t]``/``outputs[t]`` its state index
+    and outputs after tick t."""
 
     setup: Setup
     seed: int
     hist: np.ndarray  # (ticks + 1, N_STATE)
     states: np.ndarray  # (ticks,) int
+    events: np.ndarray  # (ticks,) int
     outputs: np.ndarray  # (ticks, n_outputs) int
     pulses: np.ndarray  # (ticks, n_counters) int
     wall_s: float  # how long the loop took; shown to people, never written into result files
@@ -100,6 +103,7 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
     pcols = np.array(setup.pulse_columns, dtype=np.int64)
     pulse_out = np.zeros(len(pcols), dtype=np.int64)
     states = np.zeros(ticks, dtype=np.int64)
+    events = np.zeros(ticks, dtype=np.int64)
     outputs: list[tuple[int, ...]] = []
     pulse_log: list[list[int]] = []
     mask = step_one(S, cmd, *args, noise, 0, bits, hist, 0, pcols, pulse_out)
@@ -110,7 +114,7 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
             if j == NOISE_BLOCK:
                 noise, j = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE)), 0
             out = engine.step(mask, pulses)
-            states[t] = engine.state
+            states[t], events[t] = engine.state, engine.event
             outputs.append(out)
             pulse_log.append(pulses)
             cmd[0, 0], cmd[0, 1] = out[right], out[left]
@@ -120,7 +124,7 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
         if progress:
             progress(min(ticks, first + CHUNK))
     wall = time.perf_counter() - started
-    return Result(setup=setup, seed=seed, hist=hist, states=states,
+    return Result(setup=setup, seed=seed, hist=hist, states=states, events=events,
                   outputs=np.array(outputs, dtype=np.int64).reshape(ticks, -1),
                   pulses=np.array(pulse_log, dtype=np.int64).reshape(ticks, len(pcols)), wall_s=wall)
 
@@ -147,8 +151,5 @@ def trace_lines(result: Result) -> Iterator[dict[str, Any]]:
 
 
 def write_trace(result: Result, stream: IO[str]) -> int:
-    count = 0
-    for line in trace_lines(result):
-        stream.write(dumps(line) + "\n")
-        count += 1
-    return count
+    """Write the run's trace as JSON Lines (the core's writer); returns the number of ticks."""
+    return trace.write_trace(trace_lines(result), stream)
