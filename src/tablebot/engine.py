@@ -85,7 +85,7 @@ class Engine:
         self._rows = machine.rows
         self._flat = machine.flat
         self._width = len(machine.table.events)
-        self._dispatch = machine.dispatch
+        self._lookup = machine.lookup  # tables too wide for the flat list
         self.reset()
 
     def reset(self) -> None:
@@ -123,11 +123,7 @@ class Engine:
             events |= self._counter_events()
         self.event = events
         flat = self._flat
-        if flat is not None:
-            index = flat[self.state << self._width | events]
-        else:
-            dispatch = self._dispatch[self.state]
-            index = dispatch[events & dispatch.relevant]
+        index = flat[self.state << self._width | events] if flat is not None else self._lookup(self.state, events)
         self.row = index
         if index != NO_ROW:
             self._fire(self._rows[index])
@@ -189,7 +185,7 @@ class Engine:
     def _run_python(self, masks: Sequence[int]) -> Batch:
         """The batch loop without numba: step's semantics with the per-tick work inlined."""
         rows, input_mask, timer_bit = self._rows, self._input_mask, self._timer_bit
-        flat, width, lookup = self._flat, self._width, self.machine.lookup
+        flat, width, lookup = self._flat, self._width, self._lookup
         state, timer, first, outputs = self.state, self.timer, self.tick == 0, self.outputs
         counter_bits = self._counter_events()
         events_out: list[int] = []
