@@ -80,6 +80,15 @@ def test_counterexample_folder_that_is_a_file(tmp_path):
     assert "--counterexamples names a file" in err
 
 
+def test_an_unusable_counterexample_folder_still_shows_the_report(tmp_path):
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    result = runner.invoke(app, ["check", str(EXAMPLE), "--counterexamples", str(afile)])
+    assert result.exit_code == 2 and "names a file" in result.stderr
+    assert "VIOLATED front_bumper_stops" in result.stdout
+    assert "54 ticks (not written)" in result.stdout and "tick 53:" in result.stdout  # the story is kept
+
+
 @pytest.mark.parametrize("command", [
     ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
     ["diagram", EXAMPLE, "--format", "dot", "--out"],

@@ -31,7 +31,7 @@ from tablebot.cli.common import (
     resolve_table_path,
     writing,
 )
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import TableBotError, fail
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
 
@@ -65,13 +65,26 @@ def check_cmd(
     files = properties or find_property_files(resolve_table_path(table))
     report = run_check(machine, load_properties(machine, files), tuple(target))
     report.property_files = files
-    if any(result.inputs for result in report.results):
-        write_counterexamples(report, out_folder(cex_dir, "--counterexamples"))
+    unsaved = _save_counterexamples(report, cex_dir) if any(r.inputs for r in report.results) else None
     if fmt == Format.json:
         sys.stdout.write(json.dumps(report_json(report, strict), indent=2) + "\n")
     else:
         _print_report(report, table, verbose)
+    if unsaved is not None:  # reported after the report, which a folder problem must not cost the user
+        raise unsaved
     raise typer.Exit(report.exit_code(strict))
+
+
+def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | None:
+    """Write the counterexample CSVs; returns (not raises) the error of a folder that cannot take them."""
+    try:
+        write_counterexamples(report, out_folder(folder, "--counterexamples"))
+    except TableBotError as exc:
+        return exc
+    except OSError as exc:
+        return fail(exc.filename or folder, f"counterexamples not written: {exc.strerror or exc}",
+                    "give --counterexamples a folder you can write to")
+    return None
 
 
 def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
@@ -118,13 +131,15 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
         console.print(f"           {escape(result.detail)}")
     if prop.note and result.failed:
         console.print(f"           note: {escape(prop.note)}")
-    path = report.counterexamples.get(prop.name)
-    if path is None:
+    if not result.inputs:
         return
+    path = report.counterexamples.get(prop.name)
     kind = "example" if prop.kind == "reachable" else "counterexample"
     shortest = "shortest " if result.exact else ""
-    console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks, written to {escape(str(path))}")
-    console.print(f"           replay: tablebot trace {escape(str(table_arg))} --inputs {escape(str(path))}")
+    written = f", written to {escape(str(path))}" if path else " (not written)"
+    console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks{written}")
+    if path:
+        console.print(f"           replay: tablebot trace {escape(str(table_arg))} --inputs {escape(str(path))}")
     if result.failed or verbose:
         for line in story(report.machine, result):
             console.print(f"             {escape(line)}")
