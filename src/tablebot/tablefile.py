@@ -7,7 +7,7 @@ as ``file:line:column: message`` with a hint. Loading never executes anything fr
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -243,8 +243,7 @@ def _number(rows: list[Row]) -> list[Row]:
     description = ""
     for index, row in enumerate(rows):
         description = row.description or description
-        numbered.append(Row(index, row.line, description, row.state, row.events, row.motors,
-                            row.timer, row.next, row.counters, row.lamps))
+        numbered.append(replace(row, index=index, description=description))
     return numbered
 
 
