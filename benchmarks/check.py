@@ -17,10 +17,10 @@ from pathlib import Path
 from tablebot.analysis.check import run_check
 from tablebot.analysis.conditions import parse_condition
 from tablebot.analysis.properties import Property, load_properties
+from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import BUMBERBOT
 from tablebot.table import Row, Table
-from tablebot.tablefile import load_table
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

@@ -34,8 +34,8 @@ import numpy as np
 from transitions import Machine as TransitionsMachine
 
 from tablebot.engine import Engine
+from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table, first_match
-from tablebot.tablefile import load_table
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv"
 Result = tuple[Any, int, tuple[int | None, ...]]  # final state (name), timer, outputs

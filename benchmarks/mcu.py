@@ -22,11 +22,11 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from tablebot.codegen.random_table import Shape, random_inputs, random_table
 from tablebot.firmware.build import BENCH_MAIN, build
 from tablebot.firmware.emulate import bench_steps, build_harness, emulate, summary
+from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
-from tablebot.tablefile import load_table
+from tablebot.testing.random_tables import Shape, random_inputs, random_table
 from tablebot.trace import TickInput, load_inputs, replay
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

@@ -21,7 +21,7 @@ from tablebot.engine import Engine
 from tablebot.sim import layout as L
 from tablebot.sim.physics import step_one
 from tablebot.sim.runner import NOISE_BLOCK, Result, initial_state, run, write_trace
-from tablebot.sim.setup import setup_for
+from tablebot.sim.scene import scene_for
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = 1000.0
@@ -30,7 +30,7 @@ TARGET = 1000.0
 def engine_only(result: Result) -> float:
     """Wall seconds for a fresh engine to step through the run's recorded inputs."""
     inputs = [(t.mask, t.pulses) for t in result.inputs()]
-    engine = Engine(result.setup.machine)
+    engine = Engine(result.scene.machine)
     step = engine.step
     start = time.perf_counter()
     for mask, pulses in inputs:
@@ -40,23 +40,23 @@ def engine_only(result: Result) -> float:
 
 def physics_only(result: Result) -> float:
     """Wall seconds for the physics core to replay the run's motor commands (no engine)."""
-    setup = result.setup
-    geo = setup.geometry
+    scene = result.scene
+    geo = scene.geometry
     rng = np.random.default_rng(result.seed)
-    S = initial_state(setup, rng)
+    S = initial_state(scene, rng)
     noise = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE))
     hist = np.zeros((result.ticks + 1, L.N_STATE))
     cmd = np.zeros((1, 2), dtype=np.int64)
-    right, left = setup.drive
+    right, left = scene.drive
     commands = result.outputs[:, [right, left]].tolist()
-    args = (setup.P, geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
-    pcols = np.array(setup.pulse_columns, dtype=np.int64)
+    args = (scene.P, geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
+    pcols = np.array(scene.pulse_columns, dtype=np.int64)
     pulses = np.zeros(len(pcols), dtype=np.int64)
     start = time.perf_counter()
-    step_one(S, cmd, *args, noise, 0, setup.bits, hist, 0, pcols, pulses)
+    step_one(S, cmd, *args, noise, 0, scene.bits, hist, 0, pcols, pulses)
     for t, (r, lft) in enumerate(commands):
         cmd[0, 0], cmd[0, 1] = r, lft
-        step_one(S, cmd, *args, noise, (t + 1) % NOISE_BLOCK, setup.bits, hist, t + 1, pcols, pulses)
+        step_one(S, cmd, *args, noise, (t + 1) % NOISE_BLOCK, scene.bits, hist, t + 1, pcols, pulses)
     return time.perf_counter() - start
 
 
@@ -66,11 +66,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seconds", type=float, default=120.0)
     args = parser.parse_args(argv)
     table, machine = load(ROOT / "examples" / "bumberbot")
-    setup = setup_for(table, machine)
-    run(setup, 1.0)  # compile (or load the cached compilation of) the physics core
+    scene = scene_for(table, machine)
+    run(scene, 1.0)  # compile (or load the cached compilation of) the physics core
     full, engine, physics, trace = [], [], [], []
     for seed in range(1, args.repeat + 1):
-        result = run(setup, args.seconds, seed)
+        result = run(scene, args.seconds, seed)
         full.append(result.wall_s)
         engine.append(engine_only(result))
         physics.append(physics_only(result))
@@ -78,8 +78,8 @@ def main(argv: list[str] | None = None) -> None:
         write_trace(result, io.StringIO())
         trace.append(time.perf_counter() - start)
     sim_s = args.seconds
-    ticks = round(sim_s / setup.tick_s)
-    print(f"one {table.robot.name} in {setup.world.name}: {sim_s:g} s simulated ({ticks} ticks), "
+    ticks = round(sim_s / scene.tick_s)
+    print(f"one {table.robot.name} in {scene.world.name}: {sim_s:g} s simulated ({ticks} ticks), "
           f"median of {args.repeat} runs (seeds 1..{args.repeat})")
     print(f"{'part':<28}{'wall s':>9}{'µs/tick':>10}{'× real time':>14}")
     for name, times in (("engine + physics (the loop)", full), ("engine only", engine),

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 
 from tablebot.cli.common import load
 from tablebot.sim.runner import run
-from tablebot.sim.setup import setup_for
+from tablebot.sim.scene import scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.sweep import Turn, turns
 
@@ -44,8 +44,8 @@ class Level:
 
 def lamp_times(folder: Path, charge: float, seeds: list[int]) -> list[float | None]:
     table, machine = load(folder)
-    setup = setup_for(table, machine, overrides={"battery": {"charge": charge}})
-    return [summarise(run(setup, 120.0, seed)).reached_s for seed in seeds]
+    scene = scene_for(table, machine, overrides={"battery": {"charge": charge}})
+    return [summarise(run(scene, 120.0, seed)).reached_s for seed in seeds]
 
 
 def measure(charges: list[float], seeds: list[int]) -> list[Level]:

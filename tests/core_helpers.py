@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from tablebot.diagnostics import Diagnostic, TableBotError
+from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
-from tablebot.tablefile import load_table
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

@@ -11,8 +11,8 @@ from typer.testing import CliRunner
 from tablebot.analysis.properties import load_properties
 from tablebot.analysis.prove import first_violation
 from tablebot.cli import app
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 from tablebot.trace import load_inputs, read_trace, replay
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from tablebot.analysis.findings import find_all, overlaps, shadowed_rows
+from tablebot.analysis.lints import find_all, overlaps, shadowed_rows
 from tablebot.analysis.model import Model
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv"

@@ -13,8 +13,8 @@ from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE, MINI_ROBOT, SEED_TSV, column_of, example_machine, write_table
 from tablebot.cli import app
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 
 runner = CliRunner()
 LOCATED = re.compile(r"^(?P<path>\S.*?):(?P<line>\d+):(?P<column>\d+): error: .+$")

@@ -17,8 +17,8 @@ from tablebot.cli.common import load
 from tablebot.codegen import ENGINE_FILES, generate, template
 from tablebot.codegen.host import build_host, run_host
 from tablebot.codegen.layout import DENSE_LIMIT_BYTES, plan, reachable, unsigned_for
-from tablebot.codegen.random_table import Shape, random_inputs, random_table
 from tablebot.machine import compile_table
+from tablebot.testing.random_tables import Shape, random_inputs, random_table
 from tablebot.trace import load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from tablebot.analysis.diagram import condition, edges, motion_of, render, to_mermaid
 from tablebot.cli import app
-from tablebot.tablefile import load_table
+from tablebot.formats.table_read import load_table
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

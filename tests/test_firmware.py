@@ -11,14 +11,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tablebot.cli.common import load
-from tablebot.codegen.random_table import Shape, random_inputs, random_table
 from tablebot.diagnostics import TableBotError
+from tablebot.firmware.board_header import timer_setting, ubrr
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.build import build
-from tablebot.firmware.cgen import timer_setting, ubrr
 from tablebot.firmware.emulate import build_harness, emulate, pins_csv
 from tablebot.machine import compile_table
 from tablebot.robot import BUMBERBOT, Counter, Robot
+from tablebot.testing.random_tables import Shape, random_inputs, random_table
 from tablebot.trace import TickInput, load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]

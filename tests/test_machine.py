@@ -16,11 +16,11 @@ from hypothesis import strategies as st
 
 from core_helpers import example_machine
 from tablebot.engine import Engine
+from tablebot.formats.table_read import parse_table
+from tablebot.formats.table_write import format_table
 from tablebot.machine import NO_ROW, PREFILL_BITS, compile_table, first_match
 from tablebot.robot import Counter, Robot
 from tablebot.table import Row, Table
-from tablebot.tablefile import parse_table
-from tablebot.tablewriter import format_table
 
 SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 INPUTS = ("A", "B", "C")

@@ -9,8 +9,8 @@ import pytest
 from tablebot.analysis.conditions import ConditionError, parse_condition
 from tablebot.analysis.properties import Property, find_property_files, load_properties
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv"

@@ -10,11 +10,11 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from tablebot import robopro
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from tablebot.rpp import find_lists, rewrite, write_lists
-from tablebot.tablefile import load_table
+from tablebot.formats import robopro_lists as robopro
+from tablebot.formats.robopro_program import find_lists, rewrite, write_lists
+from tablebot.formats.table_read import load_table
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

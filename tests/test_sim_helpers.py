@@ -1,6 +1,6 @@
 """Shared builders for the simulator tests: a small robot, a table of signed motor rows, a room world.
 
-Also tests that the builders themselves give a working setup (so a broken builder fails here first).
+Also tests that the builders themselves give a working scene (so a broken builder fails here first).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import pytest
 from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
 from tablebot.sim.runner import Result, run, write_trace
-from tablebot.sim.setup import Setup, setup_for
+from tablebot.sim.scene import Scene, scene_for
 from tablebot.sim.world import load_world
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,14 +56,14 @@ def write_bot(tmp_path: Path, rows: list[str], world: str, robot: str = ROBOT) -
     return table, world_path
 
 
-def setup_of(table: Path, world: Path | None = None, **overrides: dict) -> Setup:
+def scene_of(table: Path, world: Path | None = None, **overrides: dict) -> Scene:
     parsed, machine = load(table)
-    return setup_for(parsed, machine, world, overrides)
+    return scene_for(parsed, machine, world, overrides)
 
 
-def bot(tmp_path: Path, rows: list[str], world: str, **overrides: dict) -> Setup:
+def bot(tmp_path: Path, rows: list[str], world: str, **overrides: dict) -> Scene:
     table, world_path = write_bot(tmp_path, rows, world)
-    return setup_of(table, world_path, **overrides)
+    return scene_of(table, world_path, **overrides)
 
 
 def world_errors(tmp_path: Path, text: str) -> list[str]:
@@ -88,14 +88,14 @@ SPIN = ["spin,1,1,,,,,,-2,2,895,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,
 
 
 def test_builders_give_a_runnable_setup(tmp_path: Path) -> None:
-    setup = bot(tmp_path, STRAIGHT, room())
-    result = run(setup, 0.5)
+    scene = bot(tmp_path, STRAIGHT, room())
+    result = run(scene, 0.5)
     assert result.ticks == 50
-    assert setup.drive == (0, 1)
+    assert scene.drive == (0, 1)
     assert trace_text(result).count("\n") == 50
 
 
 def test_bumberbot_example_finds_its_arena() -> None:
-    setup = setup_of(BUMBERBOT / "table.csv")
-    assert setup.world.name == "BumberBot arena"
-    assert setup.world.path.endswith("arena.toml")
+    scene = scene_of(BUMBERBOT / "table.csv")
+    assert scene.world.name == "BumberBot arena"
+    assert scene.world.path.endswith("arena.toml")

@@ -32,16 +32,16 @@ def pulses_for_turn(params: Params, degrees: float) -> float:
 
 def turned(tmp_path: Path, charge: float, noise: bool = False, seed: int = 1) -> float:
     """Degrees the SPIN table turns (negative = clockwise) from a battery charge."""
-    setup = bot(tmp_path, SPIN, room(noise=noise), battery={"charge": charge})
-    result = run(setup, 10.0, seed)
+    scene = bot(tmp_path, SPIN, room(noise=noise), battery={"charge": charge})
+    result = run(scene, 10.0, seed)
     heading = result.heading_deg()
     return float(heading[-1] - heading[0])
 
 
 def test_straight_run_covers_speed_times_time(tmp_path: Path) -> None:
-    setup = bot(tmp_path, STRAIGHT, room(start=(0.4, 1.5, 0)))
-    result = run(setup, 6.0)
-    expected = wheel_speed(setup.params, 4, 1.0, (4, 4)) * 5.0
+    scene = bot(tmp_path, STRAIGHT, room(start=(0.4, 1.5, 0)))
+    result = run(scene, 6.0)
+    expected = wheel_speed(scene.params, 4, 1.0, (4, 4)) * 5.0
     h = result.hist
     assert abs(math.hypot(h[-1, L.X] - h[0, L.X], h[-1, L.Y] - h[0, L.Y]) - h[-1, L.DIST]) < 1e-9
     assert abs(h[-1, L.DIST] - expected) < 0.01 * expected
@@ -62,28 +62,28 @@ def test_the_same_spin_turns_less_on_a_drained_battery(tmp_path: Path) -> None:
 
 
 def test_encoders_count_63_and_a_third_pulses_per_wheel_turn(tmp_path: Path) -> None:
-    setup = bot(tmp_path, SPIN, room())
-    result = run(setup, 10.0)
+    scene = bot(tmp_path, SPIN, room())
+    result = run(scene, 10.0)
     h = result.hist
     assert h[-1, L.DIST] < 1e-9  # a spin in place drives the centre nowhere
-    expected = pulses_for_turn(setup.params, -result.heading_deg()[-1])
+    expected = pulses_for_turn(scene.params, -result.heading_deg()[-1])
     for column in (L.ENC_R, L.ENC_L):
         assert abs(h[-1, column] - expected) < 0.5
     assert h[:, L.PUL_R].sum() == math.floor(h[-1, L.ENC_R])
 
 
 def test_battery_drains_and_sags_under_load(tmp_path: Path) -> None:
-    setup = bot(tmp_path, STRAIGHT, room())
-    h = run(setup, 6.0).hist
+    scene = bot(tmp_path, STRAIGHT, room())
+    h = run(scene, 6.0).hist
     assert h[-1, L.SOC] < h[0, L.SOC] == 1.0
     driving, stopped = h[100, L.VBAT], h[-1, L.VBAT]
     assert stopped > driving  # motors draw current through the internal resistance
 
 
 def test_driving_into_a_wall_stops_at_the_wall(tmp_path: Path) -> None:
-    setup = bot(tmp_path, STRAIGHT, room(start=(2.7, 1.5, 0)))
-    h = run(setup, 6.0).hist
-    front = setup.params["body"]["front"]
+    scene = bot(tmp_path, STRAIGHT, room(start=(2.7, 1.5, 0)))
+    h = run(scene, 6.0).hist
+    front = scene.params["body"]["front"]
     assert abs(h[-1, L.X] + front - 3.0) < 1e-6  # pushed out exactly to the wall
     assert h[-1, L.DIST] < 0.2
     assert h[-1, L.BUMP_FR] == h[-1, L.BUMP_FL] == 1.0 and h[-1, L.BUMP_REAR] == 0.0
@@ -95,9 +95,9 @@ def test_the_robot_never_leaves_the_room(tmp_path_factory, heading: float, right
     tmp = tmp_path_factory.mktemp("room")
     rows = [f"go,1,1,,,,,,{right},{left},3000,1"]
     extra = "[[box]]\nat = [0.9, 0.9]\nsize = [0.3, 0.3]\nangle = 20\n[[circle]]\nat = [0.3, 0.3]\nradius = 0.08"
-    setup = bot(tmp, rows, room(start=(0.6, 0.6, heading), size=1.2, extra=extra, noise=True))
-    h = run(setup, 20.0, seed=3).hist
-    walls = setup.world.walls
+    scene = bot(tmp, rows, room(start=(0.6, 0.6, heading), size=1.2, extra=extra, noise=True))
+    h = run(scene, 20.0, seed=3).hist
+    walls = scene.world.walls
     assert all(inside(walls, (x, y)) for x, y in h[::50, [L.X, L.Y]])
     box_centre = np.array([0.9, 0.9])
     assert np.min(np.hypot(*(h[:, [L.X, L.Y]] - box_centre).T)) > 0.15  # never inside the box
@@ -107,16 +107,16 @@ def test_a_batch_of_robots_moves_exactly_like_robots_one_by_one(tmp_path: Path) 
     """The physics core is vectorised over rows: what the batch simulator will build on."""
     from tablebot.sim.physics import step
 
-    setup = bot(tmp_path, STRAIGHT, room(extra="[[circle]]\nat = [2.2, 1.5]\nradius = 0.2\n"))
-    geo = setup.geometry
+    scene = bot(tmp_path, STRAIGHT, room(extra="[[circle]]\nat = [2.2, 1.5]\nradius = 0.2\n"))
+    geo = scene.geometry
     world = (geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
     n = 4
     S = np.zeros((n, L.N_STATE))
     S[:, L.X], S[:, L.Y], S[:, L.TH] = [1.5, 1.0, 2.0, 0.5], [1.5, 2.0, 0.6, 0.4], [0.0, 1.0, 2.0, 3.0]
     S[:, L.SOC], S[:, L.GAIN_R], S[:, L.GAIN_L] = [1.0, 0.7, 0.4, 0.1], 1.0, 1.0
     cmd = np.array([[8, 8], [-3, 5], [2, -2], [-6, -6]], dtype=np.int64)
-    P = np.repeat(setup.P, n, axis=0)
-    bits = setup.bits
+    P = np.repeat(scene.P, n, axis=0)
+    bits = scene.bits
     rng = np.random.default_rng(7)
     alone = S.copy()
     for _ in range(800):

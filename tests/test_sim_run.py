@@ -14,14 +14,14 @@ from tablebot.engine import Engine
 from tablebot.sim.runner import run
 from tablebot.sim.summary import summarise
 from tablebot.trace import record
-from test_sim_helpers import BUMBERBOT, room, setup_of, trace_text
+from test_sim_helpers import BUMBERBOT, room, scene_of, trace_text
 
 CORE_KEYS = ["tick", "event", "row", "state", "timer", "M1", "M2"]
 
 
 @pytest.fixture(scope="module")
 def arena_run():
-    return run(setup_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+    return run(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
 
 
 def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run) -> None:
@@ -34,19 +34,19 @@ def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run)
 
 
 def test_the_lamp_is_found_with_other_seeds_too() -> None:
-    setup = setup_of(BUMBERBOT / "table.csv")
+    scene = scene_of(BUMBERBOT / "table.csv")
     for seed in (2, 3):
-        assert summarise(run(setup, 120.0, seed=seed)).reached_s is not None
+        assert summarise(run(scene, 120.0, seed=seed)).reached_s is not None
 
 
 def test_same_seed_same_trace_bytes(arena_run) -> None:
-    again = run(setup_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+    again = run(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
     assert trace_text(again) == trace_text(arena_run)
 
 
 def test_another_seed_another_trace() -> None:
-    setup = setup_of(BUMBERBOT / "table.csv")
-    assert trace_text(run(setup, 20.0, seed=1)) != trace_text(run(setup, 20.0, seed=2))
+    scene = scene_of(BUMBERBOT / "table.csv")
+    assert trace_text(run(scene, 20.0, seed=1)) != trace_text(run(scene, 20.0, seed=2))
 
 
 def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run) -> None:
@@ -54,7 +54,7 @@ def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run) -> None:
     assert len(lines) == arena_run.ticks
     assert list(lines[0])[:7] == CORE_KEYS
     assert list(lines[0])[7:] == ["x", "y", "heading", "I7_light", "I8_light", "battery_v"]
-    engine = Engine(arena_run.setup.machine)  # the core, stepped live on the recorded inputs
+    engine = Engine(arena_run.scene.machine)  # the core, stepped live on the recorded inputs
     for line, tick in zip(lines[:3000], arena_run.inputs()[:3000], strict=True):
         engine.step(tick.mask, tick.pulses)
         assert {k: line[k] for k in CORE_KEYS} == record(engine)
@@ -124,12 +124,12 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
 
     (tmp_path / "robot.toml").write_text(LAMP_ROBOT, encoding="utf-8")
     (tmp_path / "table.csv").write_text(LAMP_TABLE, encoding="utf-8")
-    setup = setup_of(tmp_path / "table.csv")
-    result = run(setup, 1.2)
-    assert setup.lamp_outputs == (2,)
+    scene = scene_of(tmp_path / "table.csv")
+    result = run(scene, 1.2)
+    assert scene.lamp_outputs == (2,)
     assert result.outputs[:, 2].tolist() == [8] * 50 + [0] * 50 + [8] * 20
     ax = Figure().add_subplot()
-    robot = RobotArtist(ax, setup.params, n_lamps=1)
+    robot = RobotArtist(ax, scene.params, n_lamps=1)
     robot.update(1.0, 1.0, 0.0, lamps=(8,))
     assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_ON) and robot.glows[0].get_alpha() > 0
     robot.update(1.0, 1.0, 0.0, lamps=(0,))

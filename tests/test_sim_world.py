@@ -8,7 +8,7 @@ import pytest
 
 from tablebot.diagnostics import TableBotError
 from tablebot.sim.world import geometry, load_world
-from test_sim_helpers import ROBOT, STRAIGHT, bot, room, setup_of, world_errors, write_bot
+from test_sim_helpers import ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
 
 GOOD = room(extra="[[lamp]]\nat = [2, 2]\n[[box]]\nat = [0.5, 2.5]\nsize = [0.2, 0.3]\nangle = 45\n"
              "[[circle]]\nat = [2.5, 0.5]\nradius = 0.1\n[[segment]]\nfrom = [0, 1]\nto = [0.5, 1]\n")
@@ -65,8 +65,8 @@ def test_wiring_must_name_robot_inputs(tmp_path: Path) -> None:
 
 
 def test_unconnected_sensors(tmp_path: Path) -> None:
-    setup = bot(tmp_path, STRAIGHT, room(extra='[wiring]\nrear = "none"\nlight_left = ""\n'))
-    assert setup.bits.tolist() == [16, 8, 0, 2, 0]  # I3 I4 - I7 -
+    scene = bot(tmp_path, STRAIGHT, room(extra='[wiring]\nrear = "none"\nlight_left = ""\n'))
+    assert scene.bits.tolist() == [16, 8, 0, 2, 0]  # I3 I4 - I7 -
     with pytest.raises(TableBotError, match="right_motor must name a robot input or motor"):
         bot(tmp_path, STRAIGHT, room(extra='[wiring]\nright_motor = ""\n'))
 
@@ -78,7 +78,7 @@ def test_inconsistent_battery_is_refused(tmp_path: Path) -> None:
 
 def test_robot_file_sim_section_sets_parameters(tmp_path: Path) -> None:
     table, world = write_bot(tmp_path, STRAIGHT, room(), robot=ROBOT + "[sim.body]\nwheel_base = 0.2\n")
-    assert setup_of(table, world).params["body"]["wheel_base"] == 0.2
+    assert scene_of(table, world).params["body"]["wheel_base"] == 0.2
     (tmp_path / "robot.toml").write_text(ROBOT + "[sim.body]\nwheel_base = -1\n", encoding="utf-8")
     with pytest.raises(TableBotError, match=r"robot.toml:14:.*wheel_base = -1 is out of range"):
-        setup_of(table, world)
+        scene_of(table, world)

@@ -19,9 +19,9 @@ from core_helpers import (
     write_table,
 )
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.table_read import load_table, parse_table
 from tablebot.machine import compile_table
 from tablebot.robot import BUMBERBOT
-from tablebot.tablefile import load_table, parse_table
 
 HEADER = "description,state,T,A,B,M1_dir,M1_speed,M2_dir,M2_speed,timer,next"
 GOOD = HEADER + "\nGo,1,1,,,,3,,3,10,2\nBack,2,1,,,1,2,,0,5,1\n"

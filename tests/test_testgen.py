@@ -9,8 +9,8 @@ from typer.testing import CliRunner
 
 from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli import app
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 from tablebot.trace import dumps, load_inputs, replay
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"

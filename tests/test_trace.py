@@ -10,8 +10,8 @@ import pytest
 
 from core_helpers import COUNTER_ROBOT, EXAMPLE, example_machine, write_table
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
-from tablebot.tablefile import load_table
 from tablebot.trace import TickInput, dumps, load_inputs, read_trace, replay, write_trace
 
 

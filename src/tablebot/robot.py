@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tablebot.tomlfile import Source, Where
+from tablebot.formats.tomlfile import Source, Where
 
 StateId = int | str
 

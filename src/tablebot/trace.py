@@ -13,9 +13,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from tablebot.csvtext import Cell, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, fail
 from tablebot.engine import Engine
+from tablebot.formats.csvtext import Cell, cells_beyond, headerless, read_text, split_records
 from tablebot.machine import NO_ROW, Machine
 from tablebot.table import TIMER_EVENT
 

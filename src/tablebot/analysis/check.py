@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.analysis.finding import Finding
-from tablebot.analysis.findings import find_all
+from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Model, ModelTooLarge
 from tablebot.analysis.properties import Property
 from tablebot.analysis.prove import Result, check_property

@@ -24,8 +24,8 @@ from typing import Any
 
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
 from tablebot.diagnostics import Collector, TableBotError
+from tablebot.formats.tomlfile import Source
 from tablebot.machine import Machine
-from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}

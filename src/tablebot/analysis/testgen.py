@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tablebot.analysis.check import write_inputs
-from tablebot.analysis.findings import find_all
+from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
 from tablebot.machine import Machine

@@ -13,7 +13,7 @@ from rich.markup import escape
 from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
 from tablebot.analysis.diagram import FORMATS, render
 from tablebot.analysis.finding import Finding
-from tablebot.analysis.findings import TARGETS
+from tablebot.analysis.lints import TARGETS
 from tablebot.analysis.names import plural
 from tablebot.analysis.properties import find_property_files, load_properties
 from tablebot.analysis.prove import Result

@@ -16,10 +16,10 @@ from rich.console import Console
 from rich.markup import escape
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import load_robot
 from tablebot.table import Table
-from tablebot.tablefile import load_table
 
 F = TypeVar("F", bound=Callable[..., Any])
 err_console = Console(stderr=True, highlight=False)

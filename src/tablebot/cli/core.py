@@ -8,7 +8,6 @@ from pathlib import Path
 
 import typer
 
-from tablebot import robopro
 from tablebot.cli.app import app
 from tablebot.cli.common import (
     ROBOT_OPT,
@@ -22,8 +21,9 @@ from tablebot.cli.common import (
     writing,
 )
 from tablebot.examples import example_path
+from tablebot.formats import robopro_lists as robopro
+from tablebot.formats.table_write import format_table
 from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.tablewriter import format_table
 from tablebot.trace import load_inputs, replay, write_trace
 
 

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import typer
 
-from tablebot import robopro, rpp
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.codegen import generate
 from tablebot.diagnostics import fail
+from tablebot.formats import robopro_lists as robopro
+from tablebot.formats import robopro_program as rpp
 from tablebot.table import Table
 
 

@@ -34,7 +34,7 @@ def sim_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif)."""
-    from tablebot.sim import setup as sim_setup
+    from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import run, ticks_for
     from tablebot.sim.summary import summarise
 
@@ -43,10 +43,10 @@ def sim_cmd(
         check_display()
     parsed, machine = load(table, robot)
     overrides = {"battery": {"charge": charge}} if charge is not None else {}
-    setup = sim_setup.setup_for(parsed, machine, world, overrides)
-    ticks = ticks_for(setup, seconds)  # refuses too long a run before anything is written
+    scene = sim_scene.scene_for(parsed, machine, world, overrides)
+    ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    result = _run_with_progress(run, setup, seconds, seed, None if quiet else ticks)
+    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks)
     summary = summarise(result)
     written = _write_files(result, summary, out, gif)
     if not quiet:
@@ -75,7 +75,7 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
     """The summary on standard output, the files written on standard error."""
     from tablebot.sim.draw import state_names
 
-    for line in summary.lines(state_names(result.setup.table)):
+    for line in summary.lines(state_names(result.scene.table)):
         console.print(line)
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
     console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
@@ -83,11 +83,11 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
         err_console.print(f"wrote {path}")
 
 
-def _run_with_progress(run, setup, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]
+def _run_with_progress(run, scene, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]
     """``run`` with a progress bar of ``ticks`` on a terminal (None: quiet)."""
     if ticks is None or not sys.stderr.isatty():
-        return run(setup, seconds, seed)
+        return run(scene, seconds, seed)
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
-        return run(setup, seconds, seed, progress=lambda done: bar.update(task, completed=done))
+        return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done))

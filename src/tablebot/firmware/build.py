@@ -12,8 +12,8 @@ from pathlib import Path
 from tablebot.codegen import generate
 from tablebot.codegen.layout import Layout
 from tablebot.diagnostics import fail
+from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import Board, Wiring, load_board, wire
-from tablebot.firmware.cgen import board_header
 from tablebot.machine import Machine
 
 # -O2 with link-time optimisation: tb_tick() is inlined into the tick interrupt, so the engine

@@ -1,4 +1,4 @@
 """The simulator: a table runs on a modelled BumberBot (motors, battery, bumpers, light sensors) in a world.
 
-world (TOML) + robot [sim] -> setup -> runner (core engine + physics core) -> trace, summary, pictures.
+world (TOML) + robot [sim] -> scene -> runner (core engine + physics core) -> trace, summary, pictures.
 """

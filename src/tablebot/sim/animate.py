@@ -32,40 +32,40 @@ class Player:
 
     def __init__(self, fig: Figure, result: Result, summary: Summary, ticks_per_frame: int, speed: float):
         self.result, self.step = result, ticks_per_frame
-        setup = result.setup
+        scene = result.scene
         self.ax = fig.add_axes((0.08, 0.08, 0.9, 0.78))
-        draw_world(self.ax, setup.world)
+        draw_world(self.ax, scene.world)
         fig.suptitle(title_of(result), fontsize=12, fontweight="bold", x=0.08, ha="left", y=0.975)
         fig.text(0.08, 0.93, subtitle_of(summary), fontsize=8, color="#444")
         # the trail at frame resolution: one segment per frame keeps redrawing it cheap
         ticks = np.minimum(np.arange(0, result.ticks + ticks_per_frame, ticks_per_frame), result.ticks)
         points = result.hist[ticks][:, [L.X, L.Y]]
         self.segments = np.stack((points[:-1], points[1:]), axis=1)
-        colours = to_rgba_array(state_colours(setup.machine.states))
+        colours = to_rgba_array(state_colours(scene.machine.states))
         self.colours = colours[result.states[np.minimum(ticks[:-1], max(0, result.ticks - 1))]]
         self.trail = LineCollection([], linewidths=1.8, zorder=4)
         self.ax.add_collection(self.trail)
-        self.robot = RobotArtist(self.ax, setup.params, len(setup.lamp_outputs))
-        self.names = state_names(setup.table)
+        self.robot = RobotArtist(self.ax, scene.params, len(scene.lamp_outputs))
+        self.names = state_names(scene.table)
         self.hud = self.ax.text(1.0, 1.02, "", transform=self.ax.transAxes, va="bottom", ha="right", fontsize=9,
                                 family="monospace", zorder=20)
         self.speed = speed
         self.frames = result.ticks // ticks_per_frame + 1
 
     def draw(self, frame: int) -> list:
-        r, setup = self.result, self.result.setup
+        r, scene = self.result, self.result.scene
         t = min(frame * self.step, r.ticks)
         self.trail.set_segments(self.segments[:frame])
         self.trail.set_color(self.colours[:frame])
         h = r.hist[t]
-        last = r.outputs[t - 1] if t > 0 else np.zeros(len(setup.machine.output_names), dtype=np.int64)
+        last = r.outputs[t - 1] if t > 0 else np.zeros(len(scene.machine.output_names), dtype=np.int64)
         self.robot.update(h[L.X], h[L.Y], h[L.TH],
                           bumpers=(h[L.BUMP_FR] > 0, h[L.BUMP_FL] > 0, h[L.BUMP_REAR] > 0),
                           lights=(h[L.LIGHT_R] >= 1, h[L.LIGHT_L] >= 1),
-                          lamps=tuple(int(last[i]) for i in setup.lamp_outputs))
-        state = setup.machine.states[r.states[max(0, t - 1)]] if r.ticks else setup.table.robot.initial_state
-        names = setup.machine.output_names
-        n_motors = setup.machine.n_motors
+                          lamps=tuple(int(last[i]) for i in scene.lamp_outputs))
+        state = scene.machine.states[r.states[max(0, t - 1)]] if r.ticks else scene.table.robot.initial_state
+        names = scene.machine.output_names
+        n_motors = scene.machine.n_motors
         outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {'on ' + str(int(v)) if v else 'off'}"
                             for k, (n, v) in enumerate(zip(names, last, strict=True)))
         speed = f"   ({self.speed:g}× speed)" if self.speed != 1 else ""

@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from tablebot.formats.tomlfile import Source, known_keys, number, table_of
 from tablebot.sim import layout as L
 from tablebot.sim.physics import duty, pack_volts
-from tablebot.tomlfile import Source, known_keys, number, table_of
 
 Number = int | float
 

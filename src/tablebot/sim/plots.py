@@ -35,7 +35,7 @@ DPI = 150
 
 
 def title_of(result: Result) -> str:
-    robot, world = result.setup.table.robot.name, result.setup.world.name
+    robot, world = result.scene.table.robot.name, result.scene.world.name
     return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
 
 
@@ -48,14 +48,14 @@ def subtitle_of(summary: Summary) -> str:
 
 def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
-    world = result.setup.world
+    world = result.scene.world
     xs, ys = zip(*world.walls, strict=True)
     aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
     fig = Figure(figsize=(11, max(4.5, 7.2 * aspect + 1.2)), dpi=DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((0.06, 0.08, 0.62, 0.8))
     draw_world(ax, world)
-    machine, h = result.setup.machine, result.hist
+    machine, h = result.scene.machine, result.hist
     colours = state_colours(machine.states)
     pts = h[:, [L.X, L.Y]]
     segments = np.stack((pts[:-1], pts[1:]), axis=1)
@@ -76,11 +76,11 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
 
 
 def _markers(ax, result: Result, summary: Summary) -> None:
-    h, front = result.hist, result.setup.params["body"]["front"]
+    h, front = result.hist, result.scene.params["body"]["front"]
     for row in summary.collision_ticks:
         x, y, th = h[row, L.X], h[row, L.Y], h[row, L.TH]
         # mark the bumper side that touched: the nose for front hits, the tail for rear ones
-        reach = -result.setup.params["body"]["rear"] if h[row, L.BUMP_REAR] > 0 else front
+        reach = -result.scene.params["body"]["rear"] if h[row, L.BUMP_REAR] > 0 else front
         ax.plot(x + reach * math.cos(th), y + reach * math.sin(th), marker="X", markersize=11, color=COLLISION,
                 markeredgecolor="white", markeredgewidth=1.2, zorder=9)
     tick = result.tick_s
@@ -95,21 +95,21 @@ def _markers(ax, result: Result, summary: Summary) -> None:
 
 def _robot_poses(ax, result: Result) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
-    h, setup = result.hist, result.setup
-    n_lamps = len(setup.lamp_outputs)
-    start = RobotArtist(ax, setup.params, n_lamps, alpha=0.35)
+    h, scene = result.hist, result.scene
+    n_lamps = len(scene.lamp_outputs)
+    start = RobotArtist(ax, scene.params, n_lamps, alpha=0.35)
     start.update(h[0, L.X], h[0, L.Y], h[0, L.TH])
-    end = RobotArtist(ax, setup.params, n_lamps)
+    end = RobotArtist(ax, scene.params, n_lamps)
     last = result.outputs[-1] if result.ticks else ()
     end.update(h[-1, L.X], h[-1, L.Y], h[-1, L.TH],
                bumpers=(h[-1, L.BUMP_FR] > 0, h[-1, L.BUMP_FL] > 0, h[-1, L.BUMP_REAR] > 0),
                lights=(h[-1, L.LIGHT_R] >= 1, h[-1, L.LIGHT_L] >= 1),
-               lamps=tuple(int(last[i]) for i in setup.lamp_outputs))
+               lamps=tuple(int(last[i]) for i in scene.lamp_outputs))
 
 
 def _legend(fig: Figure, result: Result, summary: Summary) -> None:
-    machine = result.setup.machine
-    names = state_names(result.setup.table)
+    machine = result.scene.machine
+    names = state_names(result.scene.table)
     colours = state_colours(machine.states)
     handles = [Patch(color=colours[machine.states.index(state)],
                      label=f"{state_label(state, names)}  ({secs:.1f} s)")
@@ -122,7 +122,7 @@ def _legend(fig: Figure, result: Result, summary: Summary) -> None:
              Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
                     label="light first seen"),
              Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
-                    label=f"lamp reached (≤ {result.setup.world.reach:g} m)"),
+                    label=f"lamp reached (≤ {result.scene.world.reach:g} m)"),
              Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
                     label="a state begins (spins show as dots)"),
              Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=15, label="lamp"),
@@ -161,8 +161,8 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
 
 
 def _state_panel(ax, result: Result) -> None:
-    machine = result.setup.machine
-    names = state_names(result.setup.table)
+    machine = result.scene.machine
+    names = state_names(result.scene.table)
     colours = state_colours(machine.states)
     visited = sorted(set(result.states.tolist()))
     rows = {s: k for k, s in enumerate(visited)}
@@ -181,9 +181,9 @@ def _state_panel(ax, result: Result) -> None:
 
 
 def _output_panel(ax, result: Result, t: np.ndarray) -> None:
-    names = result.setup.machine.output_names
-    n_motors = result.setup.machine.n_motors
-    labels = result.setup.table.robot.labels
+    names = result.scene.machine.output_names
+    n_motors = result.scene.machine.n_motors
+    labels = result.scene.table.robot.labels
     for k, name in enumerate(names):
         style = "-" if k < n_motors else ":"
         label = f"{name} ({labels[name]})" if labels.get(name) else name
@@ -198,7 +198,7 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
 
 
 def _event_panel(ax, result: Result, t: np.ndarray) -> None:
-    table = result.setup.table
+    table = result.scene.table
     ev = result.events
     labels = table.robot.labels
     tick, least = result.tick_s, result.ticks * result.tick_s / 500  # one-tick events stay visible
@@ -216,7 +216,7 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
 
 
 def _light_panel(ax, result: Result, t: np.ndarray) -> None:
-    h, wiring = result.hist[:-1], result.setup.params.wiring
+    h, wiring = result.hist[:-1], result.scene.params.wiring
     ax.plot(t, h[:, L.LIGHT_R], lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
     ax.plot(t, h[:, L.LIGHT_L], lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
     ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")

@@ -19,7 +19,7 @@ from tablebot.engine import Engine
 from tablebot.sim import layout as L
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.physics import step_one
-from tablebot.sim.setup import Setup
+from tablebot.sim.scene import Scene
 from tablebot.trace import TickInput, replay
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
@@ -33,7 +33,7 @@ class Result:
     ``events[t]`` is the event set the engine saw in tick t, ``states[t]``/``outputs[t]`` its state index
     and outputs after tick t."""
 
-    setup: Setup
+    scene: Scene
     seed: int
     hist: np.ndarray  # (ticks + 1, N_STATE)
     states: np.ndarray  # (ticks,) int
@@ -48,7 +48,7 @@ class Result:
 
     @property
     def tick_s(self) -> float:
-        return self.setup.tick_s
+        return self.scene.tick_s
 
     @property
     def masks(self) -> np.ndarray:
@@ -64,43 +64,43 @@ class Result:
         return np.degrees(self.hist[:, L.TH])
 
 
-def initial_state(setup: Setup, rng: np.random.Generator) -> np.ndarray:
+def initial_state(scene: Scene, rng: np.random.Generator) -> np.ndarray:
     S = np.zeros((1, L.N_STATE))
-    x, y, heading = setup.world.start
+    x, y, heading = scene.world.start
     S[0, L.X], S[0, L.Y], S[0, L.TH] = x, y, math.radians(heading)
-    S[0, L.SOC] = charge = setup.params["battery"]["charge"]
-    S[0, L.VBAT] = terminal_volts(setup.params, charge, ())
-    spread = setup.params["noise"]["motor_spread"]
+    S[0, L.SOC] = charge = scene.params["battery"]["charge"]
+    S[0, L.VBAT] = terminal_volts(scene.params, charge, ())
+    spread = scene.params["noise"]["motor_spread"]
     S[0, L.GAIN_R], S[0, L.GAIN_L] = 1.0 + spread * rng.standard_normal(2)
     return S
 
 
-def ticks_for(setup: Setup, seconds: float) -> int:
+def ticks_for(scene: Scene, seconds: float) -> int:
     """The ticks in ``seconds`` of robot time (at least one); more than MAX_TICKS are refused."""
-    ticks = max(1, round(seconds / setup.tick_s))
+    ticks = max(1, round(seconds / scene.tick_s))
     if ticks > MAX_TICKS:
-        raise fail("--seconds", f"{seconds:g} s at tick_ms = {setup.table.robot.tick_ms} is {ticks:,} ticks; "
-                   f"a run holds at most {MAX_TICKS:,}", f"simulate at most {MAX_TICKS * setup.tick_s:g} s")
+        raise fail("--seconds", f"{seconds:g} s at tick_ms = {scene.table.robot.tick_ms} is {ticks:,} ticks; "
+                   f"a run holds at most {MAX_TICKS:,}", f"simulate at most {MAX_TICKS * scene.tick_s:g} s")
     return ticks
 
 
-def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None) -> Result:
+def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None) -> Result:
     """Simulate ``seconds`` of robot time; ``progress(ticks_done)`` is called every few thousand ticks.
 
     Everything random comes from one numpy Generator seeded with ``seed``, and nothing depends on the
     wall clock, so a table, world and seed always give the same trace bytes.
     """
-    ticks = ticks_for(setup, seconds)
+    ticks = ticks_for(scene, seconds)
     rng = np.random.default_rng(seed)
-    S = initial_state(setup, rng)
-    geo, P, bits = setup.geometry, setup.P, setup.bits
+    S = initial_state(scene, rng)
+    geo, P, bits = scene.geometry, scene.P, scene.bits
     args = (P, geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
     cmd = np.zeros((1, 2), dtype=np.int64)
     hist = np.zeros((ticks + 1, L.N_STATE))
     noise = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE))
-    engine = Engine(setup.machine)
-    right, left = setup.drive
-    pcols = np.array(setup.pulse_columns, dtype=np.int64)
+    engine = Engine(scene.machine)
+    right, left = scene.drive
+    pcols = np.array(scene.pulse_columns, dtype=np.int64)
     pulse_out = np.zeros(len(pcols), dtype=np.int64)
     states = np.zeros(ticks, dtype=np.int64)
     events = np.zeros(ticks, dtype=np.int64)
@@ -124,7 +124,7 @@ def run(setup: Setup, seconds: float, seed: int = 1, progress: Callable[[int], N
         if progress:
             progress(min(ticks, first + CHUNK))
     wall = time.perf_counter() - started
-    return Result(setup=setup, seed=seed, hist=hist, states=states, events=events,
+    return Result(scene=scene, seed=seed, hist=hist, states=states, events=events,
                   outputs=np.array(outputs, dtype=np.int64).reshape(ticks, -1),
                   pulses=np.array(pulse_log, dtype=np.int64).reshape(ticks, len(pcols)), wall_s=wall)
 
@@ -138,10 +138,10 @@ def trace_lines(result: Result) -> Iterator[dict[str, Any]]:
     Added per line: ``x``, ``y`` (m), ``heading`` (degrees, -180..180) at the start of the tick, the
     light each phototransistor received (``<input>_light``, 1.0 = threshold) and the battery volts.
     """
-    wiring = result.setup.params.wiring
+    wiring = result.scene.params.wiring
     light_r, light_l = f"{wiring['light_right']}_light", f"{wiring['light_left']}_light"
     hist = result.hist
-    for t, line in enumerate(replay(result.setup.machine, result.inputs())):
+    for t, line in enumerate(replay(result.scene.machine, result.inputs())):
         row = hist[t]
         heading = (math.degrees(row[L.TH]) + 180.0) % 360.0 - 180.0
         line.update({"x": round(float(row[L.X]), 5), "y": round(float(row[L.Y]), 5),

@@ -48,7 +48,7 @@ class Summary:
 
 
 def light_bits(result: Result) -> int:
-    bits = result.setup.bits
+    bits = result.scene.bits
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 
@@ -79,13 +79,13 @@ def first(mask: np.ndarray) -> int | None:
 def summarise(result: Result) -> Summary:
     tick_s, h = result.tick_s, result.hist
     light = first((result.masks & light_bits(result)) != 0)
-    lamps = result.setup.geometry.lamps
+    lamps = result.scene.geometry.lamps
     reached = None
     if len(lamps):
         dist = np.min(np.hypot(h[:, L.X, None] - lamps[None, :, 0], h[:, L.Y, None] - lamps[None, :, 1]), axis=1)
-        reached = first(dist <= result.setup.world.reach)
+        reached = first(dist <= result.scene.world.reach)
     starts = collision_starts(result)
-    states = result.setup.machine.states
+    states = result.scene.machine.states
     seconds: dict[StateId, float] = {}
     order, first_seen = np.unique(result.states, return_index=True)
     counts = np.bincount(result.states, minlength=len(states))

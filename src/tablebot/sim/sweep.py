@@ -9,13 +9,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from tablebot.formats.table_read import load_table
+from tablebot.formats.tomlfile import Source
 from tablebot.machine import compile_table
 from tablebot.sim import layout as L
 from tablebot.sim.runner import run
-from tablebot.sim.setup import prepare, robot_layer
+from tablebot.sim.scene import prepare, robot_layer
 from tablebot.sim.world import World, parse_world
-from tablebot.tablefile import load_table
-from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.
 OPEN_ROOM = """\
@@ -49,9 +49,9 @@ def turns(table_path: Path, charges: list[float], seeds: list[int], seconds: flo
     world = world or open_room()
     found = []
     for charge in charges:
-        setup = prepare(table, machine, world, layer, {"battery": {"charge": charge}})
+        scene = prepare(table, machine, world, layer, {"battery": {"charge": charge}})
         for seed in seeds:
-            result = run(setup, seconds, seed)
+            result = run(scene, seconds, seed)
             heading = result.heading_deg()
             found.append(Turn(charge, seed, float(heading[-1] - heading[0]), float(result.hist[1, L.VBAT])))
     return found

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.formats.tomlfile import known_keys
 from tablebot.machine import Machine
 from tablebot.robot import Robot
 from tablebot.sim import layout as L
@@ -30,14 +31,13 @@ from tablebot.sim.params import (
 from tablebot.sim.physics import body_corners, deepest_contact
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
-from tablebot.tomlfile import known_keys
 
 MAX_STEP_M = 0.04  # the most the robot may move in one tick: well under half its length, so contacts stay found
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
 
 
 @dataclass(frozen=True)
-class Setup:
+class Scene:
     """Everything fixed for one run: the machine, the world, the parameters and their packed arrays."""
 
     table: Table
@@ -86,15 +86,15 @@ def find_world(table: Table, world_path: Path | None, robot_world: Path | None) 
     return load_world(beside) if beside.is_file() else default_world()
 
 
-def setup_for(table: Table, machine: Machine, world_path: Path | None = None,
-              overrides: dict[str, Any] | None = None) -> Setup:
+def scene_for(table: Table, machine: Machine, world_path: Path | None = None,
+              overrides: dict[str, Any] | None = None) -> Scene:
     """The whole chain for one table: its robot's [sim], its world (see :func:`find_world`), checked and packed."""
     layer, robot_world = robot_layer(table.robot)
     return prepare(table, machine, find_world(table, world_path, robot_world), layer, overrides)
 
 
 def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None = None,
-            overrides: dict[str, Any] | None = None) -> Setup:
+            overrides: dict[str, Any] | None = None) -> Scene:
     """Check that robot, table and world fit together and pack them for the physics core."""
     robot_params = robot_params or {}
     params = _unwire_absent_sensors(merged(robot_params, world.params, overrides or {}), table.robot)
@@ -114,7 +114,7 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     bits = np.array([machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES], dtype=np.int64)
     motor_roles = {params.wiring["right_motor"]: "right_motor", params.wiring["left_motor"]: "left_motor"}
     columns = tuple(SIDE_COLUMNS[motor_roles[c.motor]] if c.motor in motor_roles else -1 for c in robot.counters)
-    return Setup(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
+    return Scene(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
                  drive=(outputs.index(params.wiring["right_motor"]), outputs.index(params.wiring["left_motor"])),
                  pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps))
 

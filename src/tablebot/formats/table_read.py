@@ -11,8 +11,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
+from tablebot.formats.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,

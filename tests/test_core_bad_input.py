@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE, MINI_ROBOT, example_machine, find, problems, write_table
 from tablebot.cli import app
+from tablebot.formats.table_read import parse_table
 from tablebot.robot import BUMBERBOT
-from tablebot.tablefile import parse_table
 
 runner = CliRunner()
 
@@ -270,7 +270,7 @@ def test_row_errors_come_in_column_order(tmp_path):
 
 def test_mermaid_ids_of_names_that_differ_only_in_punctuation_stay_apart(tmp_path):
     from tablebot.analysis.diagram import to_mermaid
-    from tablebot.tablefile import load_table
+    from tablebot.formats.table_read import load_table
 
     robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "a.b"')
     table = write_table(tmp_path, "state,T,M1,M2,timer,next\na.b,1,1,1,5,a-b\na-b,1,2,2,5,a b\na b,1,0,0,5,a.b\n",
@@ -303,7 +303,7 @@ def test_a_full_disk_names_the_output_file(command):
 # --- what spreadsheets save -------------------------------------------------------------------------
 
 def test_excel_sep_line_names_the_delimiter_and_keeps_line_numbers(tmp_path):
-    from tablebot.tablefile import load_table
+    from tablebot.formats.table_read import load_table
 
     table = write_table(tmp_path, "sep=;\nstate;T;M1;timer;next\n1;1;3;10;1\n1;1;9;10;1\n", MINI_ROBOT)
     d = find(problems(table), "out of range")

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, setup_of, world_errors, write_bot
+from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
 
 runner = CliRunner()
 
@@ -18,7 +18,7 @@ runner = CliRunner()
 def setup_errors(tmp_path: Path, world: str, robot: str = ROBOT) -> list[str]:
     table, world_path = write_bot(tmp_path, STRAIGHT, world, robot)
     with pytest.raises(TableBotError) as info:
-        setup_of(table, world_path)
+        scene_of(table, world_path)
     return [d.render() for d in info.value.diagnostics]
 
 
@@ -55,7 +55,7 @@ def test_a_robot_without_two_drive_motors_is_refused_once(tmp_path: Path) -> Non
     table = tmp_path / "table.csv"
     table.write_text("state,T,M1,timer,next\n1,1,4,0,1\n", encoding="utf-8")
     with pytest.raises(TableBotError) as info:
-        setup_of(table, None)
+        scene_of(table, None)
     (found,) = info.value.diagnostics
     assert "drives two wheels, but robot TestBot has 1 motor" in found.message and "[motors]" in found.hint
 
@@ -70,7 +70,7 @@ def test_unknown_sim_keys_and_a_missing_sim_world_are_located(tmp_path: Path) ->
     (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
     (tmp_path / "table.csv").write_text("state,T,M1,M2,timer,next\n1,1,4,4,0,1\n", encoding="utf-8")
     with pytest.raises(TableBotError) as info:
-        setup_of(tmp_path / "table.csv")
+        scene_of(tmp_path / "table.csv")
     found = [d.render() for d in info.value.diagnostics]
     line = ROBOT.count("\n") + 2
     assert any(f"robot.toml:{line + 1}: error: unknown key 'colour' in [sim]" in e for e in found), found
@@ -163,7 +163,7 @@ def test_the_motors_do_not_depend_on_the_tables_tick(tmp_path: Path) -> None:
     robot = ROBOT.replace("tick_ms = 10", "tick_ms = 20")
     rows = ["spin,1,1,,,,,,-2,2,448,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,0,3"]
     table, world = write_bot(tmp_path, rows, room(), robot)
-    result = run(setup_of(table, world), 10.0)
+    result = run(scene_of(table, world), 10.0)
     heading = result.heading_deg()
     assert abs(heading[-1] - heading[0] + 270.0) < 3.0
 

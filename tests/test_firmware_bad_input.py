@@ -11,13 +11,13 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.cli.common import load
-from tablebot.codegen.random_table import random_inputs, random_table
 from tablebot.diagnostics import TableBotError
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.framing import Decoder, encode
+from tablebot.formats.robopro_program import rewrite
 from tablebot.machine import compile_table
 from tablebot.robot import load_robot
-from tablebot.rpp import rewrite
+from tablebot.testing.random_tables import random_inputs, random_table
 from tablebot.trace import load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]

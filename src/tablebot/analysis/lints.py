@@ -11,12 +11,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from tablebot import robopro
 from tablebot.analysis.finding import SEVERITIES, Finding
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Graph, Model
 from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
 from tablebot.diagnostics import Diagnostic
+from tablebot.formats import robopro_lists as robopro
 from tablebot.machine import NO_ROW, Machine, first_match
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table

@@ -48,7 +48,7 @@ def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[st
 
 
 def format_table(table: Table) -> str:
-    """CSV text that :func:`tablebot.tablefile.parse_table` reads back into the same machine."""
+    """CSV text that :func:`tablebot.formats.table_read.parse_table` reads back into the same machine."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     signed = signed_motors(table)

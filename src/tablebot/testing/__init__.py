@@ -1,0 +1,1 @@
+"""Generators for tests and benchmarks: random tables and recorded inputs."""
