@@ -1,0 +1,114 @@
+"""Writing output files safely: to a temporary name in the same folder, renamed into place only when complete.
+
+A full disk, a crash or Ctrl-C therefore never leaves a truncated file that looks whole, and never
+destroys the previous version before the new one is ready.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import IO
+
+
+def _temporary(path: Path, mode: str, encoding: str | None, newline: str | None) -> tuple[IO, Path]:
+    """An open temporary file beside ``path`` (same folder, so the rename is atomic) and its name."""
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
+    except BaseException:
+        os.close(fd)
+        os.unlink(name)
+        raise
+    return stream, Path(name)
+
+
+@contextmanager
+def atomic_write(path: str | Path, mode: str = "w", encoding: str | None = "utf-8",
+                 newline: str | None = None) -> Iterator[IO]:
+    """Open ``path`` for writing through a temporary file that replaces it only if the block completes.
+
+    An OSError raised while writing names ``path`` (a full disk reports no file name of its own).
+    """
+    path = Path(path)
+    stream, temp = _temporary(path, mode, None if "b" in mode else encoding, None if "b" in mode else newline)
+    try:
+        with stream:
+            yield stream
+        _keep_mode(path, temp)
+        os.replace(temp, path)
+    except BaseException as exc:
+        temp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(path)
+        raise
+
+
+def write_text(path: str | Path, text: str, encoding: str = "utf-8", newline: str | None = None) -> Path:
+    with atomic_write(path, "w", encoding=encoding, newline=newline) as f:
+        f.write(text)
+    return Path(path)
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    with atomic_write(path, "wb") as f:
+        f.write(data)
+    return Path(path)
+
+
+def _keep_mode(path: Path, temp: Path) -> None:
+    """The new file gets the old one's permissions, or the usual ones for a new file (mkstemp makes 0600)."""
+    try:
+        mode = path.stat().st_mode & 0o777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.chmod(temp, mode)
+
+
+class PendingFile:
+    """A file written over time (a live trace): open under a temporary name, then :meth:`commit` it
+    to its final name or :meth:`keep_partial` under a name that says it is incomplete."""
+
+    def __init__(self, path: str | Path, encoding: str = "utf-8"):
+        self.path = Path(path)
+        self.stream, self.temp = _temporary(self.path, "w", encoding, "\n")
+        self.closed_as: Path | None = None
+
+    def commit(self) -> Path:
+        """Close and rename into place (replacing the previous file)."""
+        return self._finish(self.path)
+
+    def keep_partial(self) -> Path:
+        """Close and rename to ``NAME.partial.EXT``: the final name keeps the previous complete run."""
+        return self._finish(partial_name(self.path))
+
+    def discard(self) -> None:
+        if self.closed_as is None:
+            self.stream.close()
+            self.temp.unlink(missing_ok=True)
+            self.closed_as = self.temp
+
+    def _finish(self, target: Path) -> Path:
+        if self.closed_as is not None:
+            return self.closed_as
+        try:
+            self.stream.close()
+            _keep_mode(target, self.temp)
+            os.replace(self.temp, target)
+        except OSError as exc:
+            self.temp.unlink(missing_ok=True)
+            if exc.filename is None:
+                exc.filename = str(target)
+            raise
+        self.closed_as = target
+        return target
+
+
+def partial_name(path: Path) -> Path:
+    """``trace.jsonl`` -> ``trace.partial.jsonl``."""
+    return path.with_name(f"{path.stem}.partial{path.suffix}")

@@ -1,0 +1,383 @@
+"""The run loop: one engine driving one robot through the :class:`RobotIO` seam, paced by a clock,
+observed by sinks, guarded by a watchdog. Every way a table meets a robot goes through :func:`run`.
+"""
+
+# Per tick: wait for the clock, read the robot, step the engine, write the outputs, tell the sinks.
+# A robot that can run many ticks in compiled code (the simulator) offers ``advance`` and gets whole
+# blocks instead; the sinks see the same columns either way. Whatever ends the run (its length,
+# Ctrl-C, SIGTERM, a failing or stalled tick, a lost link, a bug), the robot's outputs are stopped
+# first, then the link is closed, then the sinks are told why.
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+from tablebot.engine import Engine
+
+
+@dataclass(frozen=True)
+class Reading:
+    """What a robot senses at the start of a tick."""
+
+    mask: int  # the inputs that read 1, in the machine's event layout (Machine.input_bits)
+    pulses: tuple[int, ...] = ()  # encoder pulses per robot counter since the last reading
+    extra: Mapping[str, Any] | None = None  # fields the trace appends after the core ones (pose, raw values)
+
+
+class LinkLost(Exception):
+    """The robot stopped answering (or answered nonsense): the run must end, outputs stopped."""
+
+
+@runtime_checkable
+class RobotIO(Protocol):
+    """One robot: ``open`` (connect, configure, outputs off), then per tick ``read`` and ``write``;
+    ``stop`` (outputs off now: idempotent, never raises) and ``close`` (release the link) end it."""
+
+    def open(self) -> None: ...
+
+    def read(self) -> Reading: ...
+
+    def write(self, outputs: Sequence[int]) -> None: ...
+
+    def stop(self) -> None: ...
+
+    def close(self) -> None: ...
+
+
+@runtime_checkable
+class BlockIO(Protocol):
+    """A robot that can advance itself and the engine many ticks at once (in compiled code)."""
+
+    def advance(self, engine: Engine, ticks: int) -> TickBlock: ...
+
+
+@dataclass
+class TickBlock:
+    """Consecutive ticks as columns: what the robot read, what the engine did, extra per-tick fields.
+
+    Columns are lists or numpy arrays; ``outputs``, ``counters`` and ``pulses`` have one row per tick.
+    """
+
+    start: int  # the tick number of the first row
+    masks: Sequence[int]
+    pulses: Sequence[Sequence[int]]
+    events: Sequence[int]
+    rows: Sequence[int]  # -1: no row fired
+    states: Sequence[int]  # state indices (Machine.states)
+    timers: Sequence[int]
+    outputs: Sequence[Sequence[int]]
+    counters: Sequence[Sequence[int]]
+    extra: dict[str, Sequence[Any]] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.events)
+
+    @staticmethod
+    def of_tick(engine: Engine, reading: Reading, extra: Mapping[str, Any] | None = None) -> TickBlock:
+        """The tick the engine just made, after ``reading``."""
+        fields = {**(reading.extra or {}), **(extra or {})}
+        return TickBlock(engine.tick - 1, [reading.mask], [reading.pulses], [engine.event], [engine.row],
+                         [engine.state], [engine.timer], [engine.outputs], [tuple(engine.counters)],
+                         {k: [v] for k, v in fields.items()})
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What sinks learn when the run starts."""
+
+    engine: Engine
+    tick_s: float
+    target: str  # "sim", "txt://192.168.7.2", ...
+    ticks: int | None  # planned length, None = until stopped
+
+
+#: Why a run ended, and the process exit code each reason gives.
+EXIT_CODES = {"done": 0, "stopped": 0, "error": 1, "link_lost": 3, "watchdog": 4, "behind": 5,
+              "interrupted": 130, "terminated": 143}
+
+
+@dataclass(frozen=True)
+class RunEnd:
+    reason: str  # a key of EXIT_CODES
+    ticks: int  # ticks completed
+    message: str = ""
+    late_ticks: int = 0
+    worst_late_s: float = 0.0
+
+    @property
+    def complete(self) -> bool:
+        """Whether the run did what was asked: its whole length, or until the user stopped an open-ended run."""
+        return self.reason in ("done", "stopped")
+
+    @property
+    def exit_code(self) -> int:
+        return EXIT_CODES[self.reason]
+
+
+class Sink(Protocol):
+    """Observes a run: ``start`` once, ``block`` per batch of ticks, ``end`` once (always, even after a fault)."""
+
+    def start(self, info: RunInfo) -> None: ...
+
+    def block(self, block: TickBlock) -> None: ...
+
+    def end(self, end: RunEnd) -> None: ...
+
+
+# --- clocks ---------------------------------------------------------------------------------------
+
+
+class Clock(Protocol):
+    """When each tick may start. ``wait(tick)`` blocks until then and returns how late it is (s)."""
+
+    free_running: bool
+
+    def start(self) -> None: ...
+
+    def wait(self, tick: int) -> float: ...
+
+
+class SimulatedClock:
+    """Simulated time: no waiting, never late (the simulator runs as fast as it can)."""
+
+    free_running = True
+
+    def start(self) -> None:
+        pass
+
+    def wait(self, tick: int) -> float:
+        return 0.0
+
+
+class RealTimeClock:
+    """Wall-clock pacing: tick k starts ``k * tick_s`` after the start; with ``sleep=False`` the robot's
+    own link sets the pace (a TXT answers every 10 ms) and the clock only measures lateness."""
+
+    free_running = False
+
+    def __init__(self, tick_s: float, sleep: bool = True, now: Callable[[], float] = time.monotonic):
+        self.tick_s, self.sleep, self.now = tick_s, sleep, now
+        self.t0 = 0.0
+
+    def start(self) -> None:
+        self.t0 = self.now()
+
+    def wait(self, tick: int) -> float:
+        due = self.t0 + tick * self.tick_s
+        ahead = due - self.now()
+        if ahead > 0 and self.sleep:
+            time.sleep(ahead)
+            return 0.0
+        return max(0.0, -ahead)
+
+
+# --- watchdog -------------------------------------------------------------------------------------
+
+
+class WatchdogTimeout(Exception):
+    """A tick's I/O did not finish within the watchdog's deadline."""
+
+
+class Watchdog:
+    """Bounds each tick's robot I/O: past ``deadline_s`` the tick is abandoned and the run ends.
+
+    In the main thread a SIGALRM timer interrupts even a blocking call; elsewhere a timer thread
+    stops the robot's outputs at the deadline and the loop ends when the call returns.
+    """
+
+    def __init__(self, deadline_s: float | None):
+        self.deadline_s = deadline_s
+        self._use_signal = False
+        self._timer: threading.Timer | None = None
+        self.fired = False
+        self._on_fire: Callable[[], None] = lambda: None
+
+    @contextmanager
+    def installed(self, on_fire: Callable[[], None]) -> Iterator[None]:
+        self._on_fire = on_fire
+        self._use_signal = (self.deadline_s is not None and hasattr(signal, "setitimer")
+                            and threading.current_thread() is threading.main_thread())
+        previous = signal.signal(signal.SIGALRM, self._alarm) if self._use_signal else None
+        try:
+            yield
+        finally:
+            self.disarm()
+            if self._use_signal:
+                signal.signal(signal.SIGALRM, previous)
+
+    def arm(self) -> None:
+        if self.deadline_s is None:
+            return
+        if self._use_signal:
+            signal.setitimer(signal.ITIMER_REAL, self.deadline_s)
+        else:
+            self._timer = threading.Timer(self.deadline_s, self._thread_fire)
+            self._timer.daemon = True
+            self._timer.start()
+
+    def disarm(self) -> None:
+        if self._use_signal:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        elif self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        if self.fired:
+            raise WatchdogTimeout(self._message())
+
+    def _message(self) -> str:
+        return f"a tick's robot I/O took longer than the watchdog's {1000 * (self.deadline_s or 0):g} ms"
+
+    def _alarm(self, signum: int, frame: Any) -> None:
+        self.fired = True
+        raise WatchdogTimeout(self._message())
+
+    def _thread_fire(self) -> None:
+        self.fired = True
+        self._on_fire()
+
+
+class Terminated(Exception):
+    """SIGTERM arrived: end the run as Ctrl-C would."""
+
+
+@contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise Terminated("terminated by SIGTERM")
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+# --- the loop -------------------------------------------------------------------------------------
+
+
+@dataclass
+class Lateness:
+    """Ticks that started late (by more than half a tick), the worst delay, and the limit that ends a run."""
+
+    tick_s: float
+    behind_limit_s: float | None = None
+    count: int = 0
+    worst_s: float = 0.0
+
+    def note(self, late_s: float) -> None:
+        if late_s > self.tick_s / 2:
+            self.count += 1
+        self.worst_s = max(self.worst_s, late_s)
+        if self.behind_limit_s is not None and late_s > self.behind_limit_s:
+            raise _Behind(f"the run fell {1000 * late_s:.0f} ms behind its clock (limit "
+                          f"{1000 * self.behind_limit_s:.0f} ms): the table's timers would stretch")
+
+
+class _Behind(Exception):
+    pass
+
+
+BLOCK_TICKS = 4096  # ticks per block on the compiled path: few Python round trips, bounded memory
+
+
+def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Sequence[Sink] = (),
+        ticks: int | None = None, watchdog: Watchdog | None = None, target: str = "",
+        behind_limit_s: float | None = None, block_ticks: int = BLOCK_TICKS) -> RunEnd:
+    """Drive ``robot`` with ``engine`` for ``ticks`` ticks (None: until stopped) and return why it ended.
+
+    The robot's outputs are stopped and its link closed on every way out; sinks always get ``end``.
+    A bug (any other exception) is re-raised after that, so it is never silent.
+    """
+    clock = clock or SimulatedClock()
+    watchdog = watchdog or Watchdog(None)
+    tick_s = engine.machine.table.robot.tick_ms / 1000
+    late = Lateness(tick_s, behind_limit_s)
+    info = RunInfo(engine, tick_s, target, ticks)
+    started: list[Sink] = []
+    end: RunEnd | None = None
+    bug: BaseException | None = None
+    try:
+        with _sigterm_raises(), watchdog.installed(robot.stop):
+            robot.open()
+            for sink in sinks:
+                sink.start(info)
+                started.append(sink)
+            clock.start()
+            if clock.free_running and isinstance(robot, BlockIO):
+                _run_blocks(engine, robot, started, ticks, block_ticks)
+            else:
+                _run_ticks(engine, robot, clock, started, ticks, watchdog, late)
+            end = RunEnd("done" if ticks is not None else "stopped", engine.tick)
+    except KeyboardInterrupt:
+        end = RunEnd("stopped" if ticks is None else "interrupted", engine.tick, "stopped by Ctrl-C")
+    except Terminated as exc:
+        end = RunEnd("terminated", engine.tick, str(exc))
+    except WatchdogTimeout as exc:
+        end = RunEnd("watchdog", engine.tick, str(exc))
+    except LinkLost as exc:
+        end = RunEnd("link_lost", engine.tick, str(exc))
+    except _Behind as exc:
+        end = RunEnd("behind", engine.tick, str(exc))
+    except BaseException as exc:
+        end, bug = RunEnd("error", engine.tick, f"{type(exc).__name__}: {exc}"), exc
+    finally:
+        _shut_down(robot)
+        final = end or RunEnd("error", engine.tick, "the run ended without a reason")
+        final = RunEnd(final.reason, final.ticks, final.message, late.count, late.worst_s)
+        for sink in started:
+            sink.end(final)
+    if bug is not None:
+        raise bug
+    return final
+
+
+def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
+               watchdog: Watchdog, late: Lateness) -> None:
+    """One tick at a time: the path of real robots and of the real-time rehearsal."""
+    while ticks is None or engine.tick < ticks:
+        delay = clock.wait(engine.tick)
+        late.note(delay)
+        watchdog.arm()
+        reading = robot.read()
+        outputs = engine.step(reading.mask, reading.pulses)
+        robot.write(outputs)
+        watchdog.disarm()
+        block = TickBlock.of_tick(engine, reading, {"late_ms": round(1000 * delay, 3)} if not clock.free_running
+                                  else None)
+        for sink in sinks:
+            sink.block(block)
+
+
+def _run_blocks(engine: Engine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None, block_ticks: int) -> None:
+    """Many ticks per call: the compiled simulator."""
+    while ticks is None or engine.tick < ticks:
+        n = block_ticks if ticks is None else min(block_ticks, ticks - engine.tick)
+        block = robot.advance(engine, n)
+        for sink in sinks:
+            sink.block(block)
+
+
+def _shut_down(robot: RobotIO) -> None:
+    """Outputs off, then the link closed; a second Ctrl-C or SIGTERM meanwhile cannot skip either."""
+    old = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            old[sig] = signal.signal(sig, signal.SIG_IGN)
+    try:
+        for step in (robot.stop, robot.close):
+            with contextlib.suppress(Exception):  # stopping must go on to closing whatever the robot says
+                step()
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
