@@ -87,6 +87,6 @@ def test_turn_drift_script_writes_plot_and_tables(tmp_path: Path, capsys) -> Non
 
 
 def test_sim_benchmark_runs(capsys) -> None:
-    load_script("sim").main(["--repeat", "1", "--seconds", "5"])
+    load_script("sim").main(["--repeat", "1", "--seconds", "5", "--no-commands"])
     out = capsys.readouterr().out
-    assert "engine + physics" in out and "engine only" in out and "× real time" in out
+    assert "compiled block path" in out and "tick by tick" in out and "× real time" in out

@@ -264,10 +264,44 @@ def test_batch_results_as_lists_and_arrays():
     np.array([0, I3 | I4, 0, 0], dtype=np.uint8),
     np.array([0, I3 | I4, 0, 0], dtype=np.int32),
     np.array([0, I3 | I4, 0, 0, 99], dtype=np.int64)[:4],
-    [0, I3 | I4 | 256, 0, 0],  # bits above the table's events are ignored, as step does
+    [0, I3 | I4 | T, 0, 0],  # T's bit is the engine's to make: ignored, as step does
 ])
 def test_batch_accepts_any_integer_sequence(masks):
     assert bumberbot().run(masks).rows == [7, 0, NO_ROW, NO_ROW]
+
+
+@pytest.mark.parametrize("jit", [None, False])
+@pytest.mark.parametrize("bad", [-1, 64, 256, 1 << 40])
+def test_masks_beyond_the_tables_events_are_refused(bad, jit):
+    """Issue 14: a negative or too-wide mask is a ValueError naming the valid range and the inputs."""
+    with pytest.raises(ValueError, match=r"0\.\.63.*I3=16") if jit is False else pytest.raises(ValueError,
+                                                                                            match=r"0\.\.63"):
+        bumberbot().run([0, bad], jit=jit)
+    engine = bumberbot()
+    with pytest.raises(ValueError, match=rf"input mask {bad} .*0\.\.63.*I3=16, I4=8, I5=4, I7=2, I8=1"):
+        engine.step(bad)
+    assert engine.tick == 0  # refused before anything changed
+
+
+@pytest.mark.parametrize("inputs, message", [
+    ({"i3": 1}, r"unknown input 'i3'; the inputs are I3=16, I4=8"),
+    ({"I3": 2}, r"input 'I3': 2 is not 0 or 1"),
+    ({"I3": 0.5}, r"input 'I3': 0.5 is not 0 or 1"),
+    ("I3", r"not str"),
+    (1.0, r"not float"),
+    (True, r"not bool"),
+    (None, r"not NoneType"),
+])
+def test_wrong_inputs_name_the_offending_key_and_the_valid_ones(inputs, message):
+    with pytest.raises(ValueError, match=message):
+        bumberbot().step(inputs)
+
+
+def test_pulses_must_fit_the_counters(tmp_path):
+    engine = bumberbot()
+    engine.step(0)
+    with pytest.raises(ValueError, match=r"pulses: 2 values for 0 counters"):
+        engine.step(0, (1, 2))
 
 
 def test_step_accepts_numpy_integers():

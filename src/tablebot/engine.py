@@ -7,7 +7,7 @@ matching row of the current state fires. The engine knows nothing of files, hard
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -79,13 +79,11 @@ class Engine:
     def __init__(self, machine: Machine):
         self.machine = machine
         # Hot-loop constants, read once here instead of through properties on every tick.
-        self._input_mask = machine.input_mask
         self._timer_bit = machine.timer_bit
         self._counter_bits = machine.counter_bits if any(machine.counter_bits) else ()
-        self._rows = machine.rows
-        self._flat = machine.flat
-        self._width = len(machine.table.events)
-        self._lookup = machine.lookup  # tables too wide for the flat list
+        self._not_input = ~machine.input_mask  # any of these bits in an int mask: not a valid input mask
+        self._n_counters = len(machine.counter_bits)
+        self._hits = _transitions(machine)
         self.reset()
 
     def reset(self) -> None:
@@ -100,128 +98,133 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def events_of(self, inputs: int | Mapping[str, int]) -> int:
-        """Input bits in the machine's event layout, from a mask or from ``{name: 0/1}``."""
-        if isinstance(inputs, Mapping):
-            bits = self.machine.input_bits
-            return sum(bits[name] for name, value in inputs.items() if value and name in bits)
-        return int(inputs) & self._input_mask  # also numpy integers
-
     def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] = ()) -> tuple[int, ...]:
-        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick."""
-        # type(...) is int: the common case skips events_of's isinstance checks (this runs per tick)
-        events = inputs & self._input_mask if type(inputs) is int else self.events_of(inputs)
+        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick.
+
+        The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python: the fired row's
+        next state, timer and outputs are looked up whole in a table precomputed per state.
+        """
+        if type(inputs) is not int or inputs & self._not_input:  # the common case costs one test
+            inputs = self.events_of(inputs)
+        timer = self.timer
         if self.tick:
-            if self.timer:
-                self.timer -= 1
-            if len(pulses):  # len, not truth: pulses may be a numpy array
+            if timer:
+                timer -= 1
+            if pulses is not _NONE:
                 self._count_down(pulses)
         self.tick += 1
-        if not self.timer:
-            events |= self._timer_bit
+        if not timer:
+            inputs |= self._timer_bit
         if self._counter_bits:
-            events |= self._counter_events()
-        self.event = events
-        flat = self._flat
-        index = flat[self.state << self._width | events] if flat is not None else self._lookup(self.state, events)
-        self.row = index
-        if index != NO_ROW:
-            self._fire(self._rows[index])
-        return self.outputs
+            inputs |= self._counter_events()
+        self.event = inputs
+        hit = self._hits[self.state][inputs]
+        if hit is None:
+            self.row = NO_ROW
+            self.timer = timer
+            return self.outputs
+        self.row, self.state, self.timer, outputs, keeps, loads = hit
+        if keeps:
+            outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
+        self.outputs = outputs
+        if loads:
+            self.counters = [old if new is None else new for old, new in zip(self.counters, loads, strict=True)]
+        return outputs
+
+    def events_of(self, inputs: int | Mapping[str, int]) -> int:
+        """Input bits in the machine's event layout, from a mask or from ``{name: 0/1}``.
+
+        Raises ValueError for an unknown name, a value other than 0/1, a negative mask or a mask with
+        bits beyond the table's events (T's and the counters' bits are ignored: the engine makes them).
+        """
+        m = self.machine
+        if isinstance(inputs, Mapping):
+            return _mask_of_names(m, inputs)
+        if isinstance(inputs, bool) or not isinstance(inputs, int | np.integer):
+            raise ValueError(f"inputs must be an int mask or a mapping of input names, not {type(inputs).__name__}")
+        value = int(inputs)
+        width = len(m.table.events)
+        if value < 0 or value >> width:
+            raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
+                             f"(0..{(1 << width) - 1}); its inputs are {_bits_text(m)}")
+        return value & m.input_mask
 
     def _count_down(self, pulses: Sequence[int]) -> None:
+        if len(pulses) != self._n_counters:
+            if not len(pulses):
+                return
+            raise ValueError(f"pulses: {len(pulses)} values for {self._n_counters} counters "
+                             f"({', '.join(self.machine.table.robot.counter_names) or 'none'})")
         counters = self.counters
         for i, count in enumerate(pulses):
+            if count < 0:
+                raise ValueError(f"pulses: {count} for counter {i + 1} is negative")
             counters[i] = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
-
-    def _fire(self, row: CompiledRow) -> None:
-        if row.keeps:
-            self.outputs = tuple(old if new is None else new
-                                 for old, new in zip(self.outputs, row.outputs, strict=True))
-        else:
-            self.outputs = row.outputs  # type: ignore[assignment]  # no None in a row that keeps nothing
-        self.timer = row.timer
-        if row.loads:
-            self.counters = [old if new is None else new for old, new in zip(self.counters, row.loads, strict=True)]
-        self.state = row.next
 
     def _counter_events(self) -> int:
         """Cn bits of the counters at zero (0 when no counter is an event column)."""
-        if not self._counter_bits:
-            return 0
         return sum(b for b, c in zip(self._counter_bits, self.counters, strict=True) if c == 0)
 
     # --- the batch path ------------------------------------------------------------------------
 
-    def run(self, masks: Sequence[int] | np.ndarray, *, jit: bool | None = None) -> Batch:
+    def run(self, masks: Sequence[int] | np.ndarray, pulses: Sequence[Sequence[int]] | np.ndarray | None = None, *,
+            jit: bool | None = None) -> Batch:
         """Many ticks in one call, inputs as event-layout bitmasks; same semantics as ``step``.
 
-        No pulses arrive on this path: counters are loaded by rows but never count down. With numba
-        (``jit`` None or True) the loop runs compiled over the machine's arrays; ``jit=False``, a
-        table wider than FLAT_BITS events, or no numba, run the same loop in Python.
+        ``pulses`` (one row per mask, a value per counter) count the counters down; without them the
+        counters are loaded by rows but never count down. With numba
+        (``jit`` None or True) the loop runs compiled (:func:`tablebot.tick.tick` over the machine's
+        arrays); ``jit=False``, a table wider than FLAT_BITS events, or no numba step in Python.
         """
-        kernel = _kernel() if jit is not False and self.machine.arrays is not None else None
-        if kernel is None:
-            if jit:
-                raise RuntimeError("the compiled batch path needs numba and at most FLAT_BITS event columns")
-            return self._run_python(masks)
-        return self._run_compiled(kernel, self.machine.arrays, masks)  # type: ignore[arg-type]
+        arrays = self.machine.arrays
+        if jit is not False and arrays is not None:
+            from tablebot import kernels
 
-    def _run_compiled(self, kernel: Callable[..., Any], arrays: MachineArrays, masks: Sequence[int]) -> Batch:
-        masks = _mask_array(masks)
+            if kernels.available():
+                return self._run_compiled(arrays, _mask_array(masks, len(self.machine.table.events)),
+                                          self._pulse_array(pulses, len(masks)))
+        if jit:
+            raise RuntimeError("the compiled batch path needs numba and at most FLAT_BITS event columns")
+        return self._run_python(masks, pulses)
+
+    def _pulse_array(self, pulses: Sequence[Sequence[int]] | np.ndarray | None, ticks: int) -> np.ndarray:
+        n = self._n_counters
+        if pulses is None:
+            return np.zeros((0, n), dtype=np.int64)
+        array = np.asarray(pulses, dtype=np.int64).reshape(-1, n) if n else np.zeros((len(pulses), 0), np.int64)
+        if len(array) != ticks or (array.size and array.min() < 0):
+            raise ValueError(f"pulses: need one row of {n} counts (0 or more) per mask, {ticks} rows")
+        return array
+
+    def _run_compiled(self, arrays: MachineArrays, masks: np.ndarray, pulses: np.ndarray) -> Batch:
+        from tablebot import kernels
+        from tablebot.tick import registers
+
         n = len(masks)
         columns = np.empty((4, n), dtype=np.int32)  # half the memory traffic of int64; values fit easily
+        regs = registers(self.tick, self.state, self.timer, self.event, self.row)
         outputs = np.array(self.outputs, dtype=np.int64)
         counters = np.array(self.counters, dtype=np.int64)
-        a = arrays
-        self.state, self.timer = kernel(
-            masks, self._input_mask, self._timer_bit, a.lookup, a.next, a.timer, a.outputs, a.keep, a.loads,
-            a.load_set, a.counter_bits, self.state, self.timer, self.tick == 0, outputs, counters, columns)
-        self._finish(n, tuple(outputs.tolist()), counters.tolist())
-        if n:
-            self.event, self.row = int(columns[0, -1]), int(columns[1, -1])
+        kernels.batch(masks, pulses, regs, outputs, counters, arrays.program, columns)
+        self._sync(regs, outputs, counters)
         return Batch(*columns)
 
-    def _run_python(self, masks: Sequence[int]) -> Batch:
-        """The batch loop without numba: step's semantics with the per-tick work inlined."""
-        rows, input_mask, timer_bit = self._rows, self._input_mask, self._timer_bit
-        flat, width, lookup = self._flat, self._width, self._lookup
-        state, timer, first, outputs = self.state, self.timer, self.tick == 0, self.outputs
-        counter_bits = self._counter_events()
-        events_out: list[int] = []
-        rows_out: list[int] = []
-        states_out: list[int] = []
-        timers_out: list[int] = []
-        for mask in masks:
-            if first:
-                first = False
-            elif timer:
-                timer -= 1
-            events = (int(mask) & input_mask) | counter_bits
-            if not timer:
-                events |= timer_bit
-            index = flat[state << width | events] if flat is not None else lookup(state, events)
-            if index != NO_ROW:
-                row = rows[index]
-                outputs = (tuple(o if n is None else n for o, n in zip(outputs, row.outputs, strict=True))
-                           if row.keeps else row.outputs)
-                timer, state = row.timer, row.next
-                if row.loads:
-                    self.counters = [c if n is None else n for c, n in zip(self.counters, row.loads, strict=True)]
-                    counter_bits = self._counter_events()
-            events_out.append(events)
-            rows_out.append(index)
-            states_out.append(state)
-            timers_out.append(timer)
-        self.state, self.timer = state, timer
-        self._finish(len(events_out), outputs, self.counters)  # type: ignore[arg-type]
-        if events_out:
-            self.event, self.row = events_out[-1], rows_out[-1]
-        return Batch(events_out, rows_out, states_out, timers_out)
+    def _sync(self, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray) -> None:
+        """Take the registers a compiled loop left (tick.TICK, STATE, ...) as this engine's state."""
+        self.tick, self.state, self.timer, self.event, self.row = (int(v) for v in regs[:5])
+        self.outputs = tuple(outputs.tolist())
+        self.counters = counters.tolist()
 
-    def _finish(self, ticks: int, outputs: tuple[int, ...], counters: list[int]) -> None:
-        self.tick += ticks
-        self.outputs, self.counters = outputs, counters
+    def _run_python(self, masks: Sequence[int], pulses: Sequence[Sequence[int]] | np.ndarray | None) -> Batch:
+        """The batch loop without numba: ``step`` per tick, collecting the columns."""
+        columns: tuple[list[int], ...] = ([], [], [], [])
+        step = self.step
+        per_tick = self._pulse_array(pulses, len(masks)).tolist() if pulses is not None else None
+        for i, mask in enumerate(masks):
+            step(mask, per_tick[i] if per_tick is not None else _NONE)
+            for column, value in zip(columns, (self.event, self.row, self.state, self.timer), strict=True):
+                column.append(value)
+        return Batch(*columns)
 
     # --- saving and resuming -------------------------------------------------------------------
 
@@ -261,6 +264,59 @@ class Engine:
         self.counters, self.outputs = counter_values, output_values
 
 
+_NONE: tuple[int, ...] = ()  # step's default pulses: "no counters to count down" in one identity test
+
+#: What fires: (row index, next state, timer, outputs (None = keep), keeps any, counter loads or ()).
+Hit = tuple[int, int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
+
+
+def _hit(row: CompiledRow) -> Hit:
+    return row.index, row.next, row.timer, row.outputs, row.keeps, row.loads if any(
+        v is not None for v in row.loads) else ()
+
+
+def _transitions(machine: Machine) -> list[Any]:
+    """Per state, the hit for every full event mask: a list (tables up to FLAT_BITS events) or a
+    dict that fills itself from the state's first-match lookup (wider tables)."""
+    hits = [_hit(row) for row in machine.rows]
+    width = len(machine.table.events)
+    if machine.flat is not None:
+        flat, size = machine.flat, 1 << width
+        return [[None if (i := flat[s * size + e]) == NO_ROW else hits[i] for e in range(size)]
+                for s in range(len(machine.states))]
+    return [_WideHits(machine.dispatch[s], hits) for s in range(len(machine.states))]
+
+
+class _WideHits(dict[int, Any]):
+    """One state of a wide table: full event mask -> hit, computed on first use and cached."""
+
+    def __init__(self, dispatch: Any, hits: list[Hit]):
+        super().__init__()
+        self.dispatch, self.hits = dispatch, hits
+
+    def __missing__(self, events: int) -> Hit | None:
+        index = self.dispatch[events & self.dispatch.relevant]
+        self[events] = hit = None if index == NO_ROW else self.hits[index]
+        return hit
+
+
+def _mask_of_names(machine: Machine, inputs: Mapping[str, int]) -> int:
+    bits = machine.input_bits
+    mask = 0
+    for name, value in inputs.items():
+        if name not in bits:
+            raise ValueError(f"unknown input {name!r}; the inputs are {_bits_text(machine)}")
+        if value not in (0, 1) or not isinstance(value, int | np.integer):
+            raise ValueError(f"input {name!r}: {value!r} is not 0 or 1")
+        if value:
+            mask |= bits[name]
+    return mask
+
+
+def _bits_text(machine: Machine) -> str:
+    return ", ".join(f"{name}={bit}" for name, bit in machine.input_bits.items()) or "none"
+
+
 def _count(snapshot: Mapping[str, Any], key: str) -> int:
     """A snapshot's tick or timer: present, an integer, not negative."""
     if key not in snapshot:
@@ -273,70 +329,24 @@ def _count(snapshot: Mapping[str, Any], key: str) -> int:
     return value
 
 
-# --- the compiled batch loop ----------------------------------------------------------------------
+# --- masks for the compiled loop ------------------------------------------------------------------
 
-def _mask_array(masks: Sequence[int] | np.ndarray) -> np.ndarray:
-    """Masks as a contiguous uint8 or int64 array (the two types the kernel is compiled for).
+def _mask_array(masks: Sequence[int] | np.ndarray, width: int) -> np.ndarray:
+    """Masks as a contiguous uint8 or int64 array (the two types the kernel is compiled for), each
+    checked to be a mask of ``width`` event columns.
 
     A list of masks below 256 (any table with at most eight event columns) goes through
     ``bytearray``, about 2 ns per tick, where ``np.array(list)`` costs about 17.
     """
     if isinstance(masks, np.ndarray):
-        return np.ascontiguousarray(masks, dtype=np.uint8 if masks.dtype == np.uint8 else np.int64)
-    try:
-        return np.frombuffer(bytearray(masks), dtype=np.uint8)
-    except (TypeError, ValueError):  # a mask of 256 or more (or a negative one): the general path
-        return np.asarray(masks, dtype=np.int64)
-
-
-_KERNEL: list[Callable[..., Any] | None] = []
-
-
-def _kernel() -> Callable[..., Any] | None:
-    """The numba-compiled batch loop, built on first use (importing numba costs ~0.2 s, compiling
-    ~1 s, cached on disk after); None when numba is not installed."""
-    if not _KERNEL:
+        array = np.ascontiguousarray(masks, dtype=np.uint8 if masks.dtype == np.uint8 else np.int64)
+    else:
         try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a dependency, but the engine works without it
-            _KERNEL.append(None)
-        else:
-            _KERNEL.append(numba.njit(cache=True, nogil=True)(_batch_loop))
-    return _KERNEL[0]
-
-
-def _batch_loop(masks, input_mask, timer_bit, lookup, nxt, timers, new_outputs, keep, loads, load_set,
-                counter_bits, state, timer, first, outputs, counters, columns):  # type: ignore[no-untyped-def]
-    """Engine.step's semantics over arrays (see MachineArrays); writes events, rows, states, timers
-    per tick into ``columns`` and updates ``outputs``/``counters`` in place; returns (state, timer)."""
-    present = 0
-    for c in range(counters.shape[0]):
-        if counters[c] == 0:
-            present |= counter_bits[c]
-    for i in range(masks.shape[0]):
-        if first:
-            first = False
-        elif timer > 0:
-            timer -= 1
-        events = (masks[i] & input_mask) | present
-        if timer == 0:
-            events |= timer_bit
-        row = lookup[state, events]
-        if row >= 0:
-            for k in range(outputs.shape[0]):
-                if not keep[row, k]:
-                    outputs[k] = new_outputs[row, k]
-            timer = timers[row]
-            state = nxt[row]
-            if counters.shape[0]:
-                present = 0
-                for c in range(counters.shape[0]):
-                    if load_set[row, c]:
-                        counters[c] = loads[row, c]
-                    if counters[c] == 0:
-                        present |= counter_bits[c]
-        columns[0, i] = events
-        columns[1, i] = row
-        columns[2, i] = state
-        columns[3, i] = timer
-    return state, timer
+            array = np.frombuffer(bytearray(masks), dtype=np.uint8)
+        except (TypeError, ValueError):  # a mask of 256 or more (or a negative one): the general path
+            array = np.asarray(masks, dtype=np.int64)
+    if len(array) and (array.min() < 0 or int(array.max()) >> width):
+        bad = next(int(v) for v in array.tolist() if v < 0 or v >> width)
+        raise ValueError(f"input mask {bad} is not a mask of this table's {width} event columns "
+                         f"(0..{(1 << width) - 1})")
+    return array

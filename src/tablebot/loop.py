@@ -75,6 +75,7 @@ class TickBlock:
     outputs: Sequence[Sequence[int]]
     counters: Sequence[Sequence[int]]
     extra: dict[str, Sequence[Any]] = field(default_factory=dict)
+    raw: Any = None  # the robot's own per-tick record, if it keeps one (the simulator: its state rows)
 
     def __len__(self) -> int:
         return len(self.events)

@@ -144,6 +144,14 @@ class MachineArrays:
     loads: np.ndarray
     load_set: np.ndarray
     counter_bits: np.ndarray
+    input_mask: int = 0
+    timer_bit: int = 0
+
+    @property
+    def program(self) -> tuple:
+        """The arrays in the order :func:`tablebot.tick.tick` unpacks them."""
+        return (self.input_mask, self.timer_bit, self.lookup, self.next, self.timer, self.outputs, self.keep,
+                self.loads, self.load_set, self.counter_bits)
 
     @staticmethod
     def of(machine: Machine) -> MachineArrays:
@@ -161,6 +169,7 @@ class MachineArrays:
             load_set=np.array([[v is not None for v in row.loads] for row in rows],
                               dtype=np.bool_).reshape(len(rows), n_counters),
             counter_bits=np.array(machine.counter_bits, dtype=np.int64).reshape(n_counters),
+            input_mask=machine.input_mask, timer_bit=machine.timer_bit,
         )
 
 

@@ -18,8 +18,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from tablebot.jit import njit
 from tablebot.sim.layout import (
     AMPS,
     B_FL,
@@ -97,6 +97,27 @@ def point_segment_distance(px, py, ax, ay, bx, by):
     t = 0.0 if length2 == 0.0 else ((px - ax) * ex + (py - ay) * ey) / length2
     t = min(1.0, max(0.0, t))
     return math.hypot(px - ax - t * ex, py - ay - t * ey)
+
+
+@njit(cache=True)
+def might_be_near(px, py, verts, a, b, pbound, k, reach):
+    """Whether convex piece verts[a:b] may come within ``reach`` of point p (the broad phase).
+
+    Never wrong in the other direction: a piece it rules out is farther than ``reach`` (with a 1 µm
+    margin over rounding), so skipping it changes no result. Its bounding circle is tested first (the
+    test the narrow phase always had); a wall or segment is then tested by its squared distance.
+    """
+    if math.hypot(pbound[k, 0] - px, pbound[k, 1] - py) > pbound[k, 2] + reach:
+        return False
+    if b - a != 2:
+        return True
+    ax, ay = verts[a, 0], verts[a, 1]
+    ex, ey = verts[a + 1, 0] - ax, verts[a + 1, 1] - ay
+    length2 = ex * ex + ey * ey
+    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, ((px - ax) * ex + (py - ay) * ey) / length2))
+    dx, dy = px - ax - t * ex, py - ay - t * ey
+    margin = reach + 1e-6
+    return dx * dx + dy * dy <= margin * margin
 
 
 @njit(cache=True)
@@ -229,7 +250,7 @@ def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
     reach = bounding_radius(p)
     best = (0.0, 0.0, 0.0, 0.0, 0.0)
     for k in range(pstart.shape[0] - 1):
-        if math.hypot(pbound[k, 0] - s[X], pbound[k, 1] - s[Y]) > pbound[k, 2] + reach:
+        if not might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
             continue
         hit = piece_contact(s, corners, verts, pstart[k], pstart[k + 1])
         if hit[0] > best[0]:
@@ -251,6 +272,9 @@ def resolve(s, p, corners, verts, pstart, pbound, circles):
     against a wall swings square to it; the touching point is clamped to the body.
     """
     s[CONTACT] = 0.0
+    near, near_circles = broad_phase(s, bounding_radius(p), verts, pstart, pbound, circles)
+    if not near and not near_circles:  # in the open nothing can overlap the body (most ticks)
+        return
     for _ in range(RESOLVE_ITERATIONS):
         body_corners(s, p, corners)
         depth, dx, dy, px, py = deepest_contact(s, p, corners, verts, pstart, pbound, circles)
@@ -273,14 +297,14 @@ def resolve(s, p, corners, verts, pstart, pbound, circles):
 
 
 @njit(cache=True)
-def near_plate(s, p, x0, y0, x1, y1, verts, pstart, pbound, circles):
-    """Whether anything lies within the switch travel of a bumper plate given in the body frame."""
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
+def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near_circles):
+    """Whether anything lies within the switch travel ``gap`` of a bumper plate given in the body frame
+    (``c``, ``sn``: the heading's cosine and sine; ``near``/``near_circles``: bits of the pieces and
+    circles the broad phase kept, the 63rd bit standing for every piece from the 63rd on)."""
     ax, ay = s[X] + c * x0 - sn * y0, s[Y] + sn * x0 + c * y0
     bx, by = s[X] + c * x1 - sn * y1, s[Y] + sn * x1 + c * y1
-    gap, reach = p[P_GAP], bounding_radius(p) + p[P_GAP]
     for k in range(pstart.shape[0] - 1):
-        if math.hypot(pbound[k, 0] - s[X], pbound[k, 1] - s[Y]) > pbound[k, 2] + reach:
+        if not near >> min(k, 62) & 1:
             continue
         a, b = pstart[k], pstart[k + 1]
         n_edges = 1 if b - a == 2 else b - a
@@ -289,20 +313,40 @@ def near_plate(s, p, x0, y0, x1, y1, verts, pstart, pbound, circles):
             if segment_distance(ax, ay, bx, by, verts[j0, 0], verts[j0, 1], verts[j1, 0], verts[j1, 1]) <= gap:
                 return True
     for k in range(circles.shape[0]):
-        if point_segment_distance(circles[k, 0], circles[k, 1], ax, ay, bx, by) <= circles[k, 2] + gap:
+        if near_circles >> min(k, 62) & 1 and point_segment_distance(
+                circles[k, 0], circles[k, 1], ax, ay, bx, by) <= circles[k, 2] + gap:
             return True
     return False
 
 
 @njit(cache=True)
+def broad_phase(s, reach, verts, pstart, pbound, circles):
+    """Bits of the pieces and of the circles that may lie within ``reach`` of the robot's centre (exact:
+    what it rules out is farther); pieces and circles from the 63rd on share bit 62 and are kept."""
+    near = np.int64(0)
+    for k in range(pstart.shape[0] - 1):
+        if k >= 62 or might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
+            near |= np.int64(1) << min(k, 62)
+    near_circles = np.int64(0)
+    for k in range(circles.shape[0]):
+        if k >= 62 or math.hypot(circles[k, 0] - s[X], circles[k, 1] - s[Y]) <= circles[k, 2] + reach + 1e-6:
+            near_circles |= np.int64(1) << min(k, 62)
+    return near, near_circles
+
+
+@njit(cache=True)
 def sense_bumpers(s, p, verts, pstart, pbound, circles):
     """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and rear."""
-    f, r, w, ov, wrap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP]
-    fr = (near_plate(s, p, f, -w, f, ov, verts, pstart, pbound, circles)
-          or near_plate(s, p, f - wrap, -w, f, -w, verts, pstart, pbound, circles))
-    fl = (near_plate(s, p, f, -ov, f, w, verts, pstart, pbound, circles)
-          or near_plate(s, p, f - wrap, w, f, w, verts, pstart, pbound, circles))
-    rear = near_plate(s, p, r, -w, r, w, verts, pstart, pbound, circles)
+    f, r, w, ov, wrap, gap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP], p[P_GAP]
+    near, near_c = broad_phase(s, bounding_radius(p) + gap, verts, pstart, pbound, circles)
+    fr = fl = rear = False
+    if near or near_c:  # in the open (most ticks) no plate can touch anything
+        c, sn = math.cos(s[TH]), math.sin(s[TH])
+        fr = (near_plate(s, c, sn, gap, f, -w, f, ov, verts, pstart, near, circles, near_c)
+              or near_plate(s, c, sn, gap, f - wrap, -w, f, -w, verts, pstart, near, circles, near_c))
+        fl = (near_plate(s, c, sn, gap, f, -ov, f, w, verts, pstart, near, circles, near_c)
+              or near_plate(s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near, circles, near_c))
+        rear = near_plate(s, c, sn, gap, r, -w, r, w, verts, pstart, near, circles, near_c)
     s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
 
 
@@ -411,31 +455,25 @@ def input_mask(s, bits):
 
 
 @njit(cache=True)
+def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, move, corners):
+    """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
+    sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2)."""
+    if move:
+        x0, y0 = s[X], s[Y]
+        cmd = (right, left)
+        drive(s, cmd, p, z)
+        resolve(s, p, corners, verts, pstart, pbound, circles)
+        s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
+    sense_bumpers(s, p, verts, pstart, pbound, circles)
+    s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
+    s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
+    s[MASK] = input_mask(s, bits)
+
+
+@njit(cache=True)
 def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move):
     """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
     corners = np.empty((4, 2))
     for i in range(S.shape[0]):
-        s, p, z = S[i], P[i], Z[i]
-        if move:
-            x0, y0 = s[X], s[Y]
-            drive(s, cmd[i], p, z)
-            resolve(s, p, corners, verts, pstart, pbound, circles)
-            s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-        sense_bumpers(s, p, verts, pstart, pbound, circles)
-        s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
-        s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
-        s[MASK] = input_mask(s, bits)
-
-
-@njit(cache=True)
-def step_one(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb, j, bits, hist, t, pcols, pulses):
-    """The single-robot runner's tick: move (unless t == 0) and sense robot 0, log its row at ``hist[t]``.
-
-    Returns the input mask for the engine's next tick and fills ``pulses[k]`` with the pulses of the
-    state column ``pcols[k]`` (-1: none) for the engine's counters; ``Zb[j]`` is this tick's noise.
-    """
-    step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Zb[j], bits, t > 0)
-    hist[t, :] = S[0, :]
-    for k in range(pcols.shape[0]):
-        pulses[k] = 0 if pcols[k] < 0 else int(S[0, pcols[k]])
-    return int(S[0, MASK])
+        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, Z[i], bits, move,
+                corners)

@@ -1,45 +1,50 @@
-"""The simulation loop: the core engine ticks, the physics core moves and senses, and the run is logged.
-Tick t: the engine reads the inputs sensed at the start of the tick, fires its row, and the motors
-then run for one tick.
+"""A simulated run: the run loop driving a :class:`~tablebot.sim.robot.SimRobot`, with a sink that
+keeps the run's history for the summary and the pictures (and any other sinks, such as the trace).
 """
 
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import IO, Any
+from typing import IO
 
 import numpy as np
 
-from tablebot import trace
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
+from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
+from tablebot.loop import run as run_loop
 from tablebot.sim import layout as L
-from tablebot.sim.params import terminal_volts
-from tablebot.sim.physics import step_one
+from tablebot.sim.robot import SimRobot
 from tablebot.sim.scene import Scene
-from tablebot.trace import TickInput, replay
+from tablebot.trace import TickInput, block_lines
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
-NOISE_BLOCK = 4096  # ticks of noise drawn at once: one Generator call instead of one per tick
-CHUNK = 2000  # ticks between progress reports
 
 
 @dataclass
 class Result:
-    """A finished run. ``hist[t]`` is the robot at the start of tick t (what the engine sensed then);
-    ``events[t]`` is the event set the engine saw in tick t, ``states[t]``/``outputs[t]`` its state index
-    and outputs after tick t."""
+    """A finished run. ``hist[t]`` is the robot at the start of tick t (what the engine sensed then;
+    one more row than ticks: the robot after the last tick); the other columns have a row per tick:
+    the inputs read, the event set, the fired row (-1: none), and state index, timer, outputs,
+    counters after the tick."""
 
     scene: Scene
     seed: int
-    hist: np.ndarray  # (ticks + 1, N_STATE)
-    states: np.ndarray  # (ticks,) int
-    events: np.ndarray  # (ticks,) int
-    outputs: np.ndarray  # (ticks, n_outputs) int
-    pulses: np.ndarray  # (ticks, n_counters) int
+    hist: np.ndarray  # (ticks + 1, N_STATE), float64 or float32
+    masks: np.ndarray  # (ticks,)
+    events: np.ndarray
+    rows: np.ndarray
+    states: np.ndarray
+    timers: np.ndarray
+    outputs: np.ndarray  # (ticks, n_outputs)
+    counters: np.ndarray  # (ticks, n_counters)
+    pulses: np.ndarray  # (ticks, n_counters)
+    collision_rows: list[int]  # hist rows where each collision began (the first MAX_COLLISIONS of them)
+    collision_count: int  # all collisions
+    reached_row: int | None  # the first hist row within reach of a lamp
+    end: RunEnd
     wall_s: float  # how long the loop took; shown to people, never written into result files
 
     @property
@@ -50,10 +55,6 @@ class Result:
     def tick_s(self) -> float:
         return self.scene.tick_s
 
-    @property
-    def masks(self) -> np.ndarray:
-        return self.hist[:-1, L.MASK].astype(np.int64)
-
     def inputs(self) -> list[TickInput]:
         """The engine's inputs per tick, as recorded: replaying them gives the same run."""
         pulses = self.pulses.tolist()
@@ -61,18 +62,64 @@ class Result:
 
     def heading_deg(self) -> np.ndarray:
         """Unwrapped heading in degrees per hist row (a turn of 270° reads 270, not -90)."""
-        return np.degrees(self.hist[:, L.TH])
+        return np.degrees(self.hist[:, L.TH].astype(np.float64))
 
 
-def initial_state(scene: Scene, rng: np.random.Generator) -> np.ndarray:
-    S = np.zeros((1, L.N_STATE))
-    x, y, heading = scene.world.start
-    S[0, L.X], S[0, L.Y], S[0, L.TH] = x, y, math.radians(heading)
-    S[0, L.SOC] = charge = scene.params["battery"]["charge"]
-    S[0, L.VBAT] = terminal_volts(scene.params, charge, ())
-    spread = scene.params["noise"]["motor_spread"]
-    S[0, L.GAIN_R], S[0, L.GAIN_L] = 1.0 + spread * rng.standard_normal(2)
-    return S
+class History:
+    """A sink that keeps every tick of a simulated run (robot rows as ``dtype``: float32 halves the
+    memory of an hour's run and is plenty for pictures; the trace is written from the exact values)."""
+
+    def __init__(self, robot: SimRobot, dtype: type = np.float64):
+        self.robot, self.dtype = robot, dtype
+        self.blocks: list[TickBlock] = []
+        self.ended: RunEnd | None = None
+
+    def start(self, info: RunInfo) -> None:
+        self.first = self.robot.s.astype(self.dtype)
+
+    def block(self, block: TickBlock) -> None:
+        raw = block.raw if block.raw is not None else np.asarray([self.robot.s])  # one tick: the robot before it
+        self.blocks.append(TickBlock(block.start, *(np.asarray(c, dtype=np.int32) for c in (
+            block.masks, block.pulses, block.events, block.rows, block.states, block.timers, block.outputs,
+            block.counters)), raw=np.asarray(raw, dtype=self.dtype)))
+
+    def end(self, end: RunEnd) -> None:
+        self.ended = end
+
+    def result(self, scene: Scene, seed: int, wall_s: float) -> Result:
+        robot, blocks = self.robot, self.blocks
+        n_out, n_c = len(scene.machine.output_names), len(scene.table.robot.counters)
+        rows = [b.raw for b in blocks] if blocks and blocks[0].raw is not None else []
+
+        def column(name: str, width: int | None = None) -> np.ndarray:
+            parts = [np.asarray(getattr(b, name)) for b in blocks]
+            shape = (0,) if width is None else (0, width)
+            return np.concatenate(parts) if parts else np.zeros(shape, dtype=np.int32)
+
+        hist = np.concatenate([*rows, robot.s[None, :].astype(self.dtype)]) if rows else robot.s[None, :].copy()
+        return Result(scene=scene, seed=seed, hist=hist, masks=column("masks"), events=column("events"),
+                      rows=column("rows"), states=column("states"), timers=column("timers"),
+                      outputs=column("outputs", n_out),
+                      counters=column("counters", n_c),
+                      pulses=column("pulses", n_c),
+                      collision_rows=robot.collisions, collision_count=robot.collision_count,
+                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)
+
+
+class Progress:
+    """A sink that reports ticks done (every block) to a callback."""
+
+    def __init__(self, report: Callable[[int], None]):
+        self.report = report
+
+    def start(self, info: RunInfo) -> None:
+        pass
+
+    def block(self, block: TickBlock) -> None:
+        self.report(block.start + len(block))
+
+    def end(self, end: RunEnd) -> None:
+        pass
 
 
 def ticks_for(scene: Scene, seconds: float) -> int:
@@ -84,72 +131,32 @@ def ticks_for(scene: Scene, seconds: float) -> int:
     return ticks
 
 
-def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None) -> Result:
-    """Simulate ``seconds`` of robot time; ``progress(ticks_done)`` is called every few thousand ticks.
+def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
+        sinks: Sequence[Sink] = (), history: type = np.float64) -> Result:
+    """Simulate ``seconds`` of robot time through the run loop; ``progress(ticks_done)`` is called
+    after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens.
 
-    Everything random comes from one numpy Generator seeded with ``seed``, and nothing depends on the
-    wall clock, so a table, world and seed always give the same trace bytes.
+    Everything random comes from the robot's numpy Generator seeded with ``seed``, and nothing depends
+    on the wall clock, so a table, world and seed always give the same trace bytes.
     """
     ticks = ticks_for(scene, seconds)
-    rng = np.random.default_rng(seed)
-    S = initial_state(scene, rng)
-    geo, P, bits = scene.geometry, scene.P, scene.bits
-    args = (P, geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
-    cmd = np.zeros((1, 2), dtype=np.int64)
-    hist = np.zeros((ticks + 1, L.N_STATE))
-    noise = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE))
-    engine = Engine(scene.machine)
-    right, left = scene.drive
-    pcols = np.array(scene.pulse_columns, dtype=np.int64)
-    pulse_out = np.zeros(len(pcols), dtype=np.int64)
-    states = np.zeros(ticks, dtype=np.int64)
-    events = np.zeros(ticks, dtype=np.int64)
-    outputs: list[tuple[int, ...]] = []
-    pulse_log: list[list[int]] = []
-    mask = step_one(S, cmd, *args, noise, 0, bits, hist, 0, pcols, pulse_out)
-    pulses: list[int] = pulse_out.tolist()  # tolist: plain ints for the engine (and its JSON)
-    j, started = 1, time.perf_counter()
-    for first in range(0, ticks, CHUNK):
-        for t in range(first, min(ticks, first + CHUNK)):
-            if j == NOISE_BLOCK:
-                noise, j = rng.standard_normal((NOISE_BLOCK, 1, L.N_NOISE)), 0
-            out = engine.step(mask, pulses)
-            states[t], events[t] = engine.state, engine.event
-            outputs.append(out)
-            pulse_log.append(pulses)
-            cmd[0, 0], cmd[0, 1] = out[right], out[left]
-            mask = step_one(S, cmd, *args, noise, j, bits, hist, t + 1, pcols, pulse_out)
-            pulses = pulse_out.tolist()
-            j += 1
-        if progress:
-            progress(min(ticks, first + CHUNK))
-    wall = time.perf_counter() - started
-    return Result(scene=scene, seed=seed, hist=hist, states=states, events=events,
-                  outputs=np.array(outputs, dtype=np.int64).reshape(ticks, -1),
-                  pulses=np.array(pulse_log, dtype=np.int64).reshape(ticks, len(pcols)), wall_s=wall)
+    robot = SimRobot(scene, seed)
+    keep = History(robot, history)
+    extra = [Progress(progress)] if progress else []
+    started = time.perf_counter()
+    run_loop(Engine(scene.machine), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")
+    return keep.result(scene, seed, time.perf_counter() - started)
 
 
-# --- trace ---------------------------------------------------------------------------------------
+def block_of(result: Result) -> TickBlock:
+    """The whole run as one block of ticks, with the simulator's trace fields."""
+    from tablebot.sim.robot import trace_columns
 
-
-def trace_lines(result: Result) -> Iterator[dict[str, Any]]:
-    """The core trace of the run (replayed from the recorded inputs) plus pose and raw sensor values.
-
-    Added per line: ``x``, ``y`` (m), ``heading`` (degrees, -180..180) at the start of the tick, the
-    light each phototransistor received (``<input>_light``, 1.0 = threshold) and the battery volts.
-    """
-    wiring = result.scene.params.wiring
-    light_r, light_l = f"{wiring['light_right']}_light", f"{wiring['light_left']}_light"
-    hist = result.hist
-    for t, line in enumerate(replay(result.scene.machine, result.inputs())):
-        row = hist[t]
-        heading = (math.degrees(row[L.TH]) + 180.0) % 360.0 - 180.0
-        line.update({"x": round(float(row[L.X]), 5), "y": round(float(row[L.Y]), 5),
-                     "heading": round(heading, 3), light_r: round(float(row[L.LIGHT_R]), 4),
-                     light_l: round(float(row[L.LIGHT_L]), 4), "battery_v": round(float(row[L.VBAT]), 4)})
-        yield line
+    return TickBlock(0, result.masks, result.pulses, result.events, result.rows, result.states, result.timers,
+                     result.outputs, result.counters, trace_columns(result.scene, result.hist[:-1]))
 
 
 def write_trace(result: Result, stream: IO[str]) -> int:
-    """Write the run's trace as JSON Lines (the core's writer); returns the number of ticks."""
-    return trace.write_trace(trace_lines(result), stream)
+    """Write the run's trace as JSON Lines (what ``tablebot sim`` writes live); returns the number of ticks."""
+    stream.writelines(block_lines(block_of(result), result.scene.machine))
+    return result.ticks

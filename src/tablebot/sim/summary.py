@@ -1,7 +1,7 @@
 """What a run amounts to: first light seen, lamp reached, collisions, distance, time per state.
 
-Computed from a :class:`~tablebot.sim.runner.Result` alone, so the CLI, the plots and the tests
-agree on one set of numbers.
+Computed from a :class:`~tablebot.sim.runner.Result`, so the CLI, the plots and the tests agree on one
+set of numbers; collisions and the lamp are counted by the simulated robot as it runs (sim.kernel.observe).
 """
 
 from __future__ import annotations
@@ -13,8 +13,6 @@ import numpy as np
 from tablebot.robot import StateId
 from tablebot.sim import layout as L
 from tablebot.sim.runner import Result
-
-DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
 
 
 @dataclass(frozen=True)
@@ -52,49 +50,32 @@ def light_bits(result: Result) -> int:
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 
-def contact_flags(result: Result) -> np.ndarray:
-    """Per hist row: any bumper closed or any body contact."""
-    h = result.hist
-    return (h[:, L.BUMP_FR] + h[:, L.BUMP_FL] + h[:, L.BUMP_REAR] + h[:, L.CONTACT]) > 0
-
-
-def collision_starts(result: Result) -> np.ndarray:
-    """Hist rows where a collision begins (rising edges of contact, touches within the debounce merged)."""
-    touching = contact_flags(result)
-    rises = np.flatnonzero(touching[1:] & ~touching[:-1]) + 1
-    if touching[0]:
-        rises = np.concatenate(([0], rises))
-    gap = max(1, round(DEBOUNCE_S / result.tick_s))
-    # touching ticks in the `gap` rows before each rise: none means a new collision
-    before = np.concatenate(([0], np.cumsum(touching)))
-    recent = before[rises] - before[np.maximum(0, rises - gap)]
-    return rises[recent == 0]
-
-
 def first(mask: np.ndarray) -> int | None:
     hits = np.flatnonzero(mask)
     return int(hits[0]) if len(hits) else None
 
 
+def time_per_state(states: np.ndarray, names: tuple[StateId, ...], tick_s: float) -> dict[StateId, float]:
+    """Seconds spent in each state (the state after each tick), in order of first visit."""
+    seconds: dict[StateId, float] = {}
+    order, first_seen = np.unique(states, return_index=True)
+    counts = np.bincount(states, minlength=len(names))
+    for index in order[np.argsort(first_seen)].tolist():
+        seconds[names[index]] = float(counts[index] * tick_s)
+    return seconds
+
+
 def summarise(result: Result) -> Summary:
+    """The run's numbers: first light from the inputs read, time per state from the states after each
+    tick, and the collisions and lamp reached that the simulated robot counted as it went."""
     tick_s, h = result.tick_s, result.hist
     light = first((result.masks & light_bits(result)) != 0)
-    lamps = result.scene.geometry.lamps
-    reached = None
-    if len(lamps):
-        dist = np.min(np.hypot(h[:, L.X, None] - lamps[None, :, 0], h[:, L.Y, None] - lamps[None, :, 1]), axis=1)
-        reached = first(dist <= result.scene.world.reach)
-    starts = collision_starts(result)
-    states = result.scene.machine.states
-    seconds: dict[StateId, float] = {}
-    order, first_seen = np.unique(result.states, return_index=True)
-    counts = np.bincount(result.states, minlength=len(states))
-    for index in order[np.argsort(first_seen)].tolist():
-        seconds[states[index]] = float(counts[index] * tick_s)
+    reached = result.reached_row
     return Summary(
         seconds=result.ticks * tick_s,
         first_light_s=None if light is None else light * tick_s,
         reached_s=None if reached is None else reached * tick_s,
-        collisions=len(starts), collision_ticks=tuple(starts.tolist()),
-        distance_m=float(h[-1, L.DIST]), state_seconds=seconds,
+        collisions=result.collision_count, collision_ticks=tuple(result.collision_rows),
+        distance_m=float(h[-1, L.DIST]), state_seconds=time_per_state(result.states, result.scene.machine.states,
+                                                                      tick_s),
         battery_start_v=float(h[0, L.VBAT]), battery_end_v=float(h[-1, L.VBAT]))

@@ -1,0 +1,5 @@
+"""``python -m tablebot``: the command line."""
+
+from tablebot.cli import main
+
+main()

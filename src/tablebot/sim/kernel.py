@@ -1,0 +1,127 @@
+"""The simulator's compiled loop: per tick, the engine's tick rule and one robot's physics, in numba.
+
+One robot's loop (:func:`run_robot`) is what ``tablebot sim`` runs; a fleet runs the same function
+for many robots, so robot k of a fleet and a single simulated robot cannot differ.
+"""
+
+# Per tick t of robot i: the robot's state row ``s`` is the robot at the start of tick t (what its
+# sensors read); the engine ticks on that mask and those pulses; the motors then run for one tick
+# (physics.advance) and the sensors read again for tick t + 1. Every random number comes in through
+# ``noise`` (drawn by the caller from the robot's own numpy Generator), so nothing here is random.
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tablebot.jit import njit
+from tablebot.kernels import tick_compiled
+from tablebot.sim.layout import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, X, Y
+from tablebot.sim.physics import advance
+from tablebot.tick import EVENT, ROW, STATE, TIMER
+
+# --- the integer record of each tick: ints[t, :] -------------------------------------------------
+I_MASK, I_EVENT, I_ROW, I_STATE, I_TIMER = 0, 1, 2, 3, 4
+I_OUTPUTS = 5  # then one column per output, then per counter its value, then per counter its pulses
+
+# --- what the robot's own rows amount to: acc[:] (float64), folded in as each row is made --------
+A_REACHED = 0  # the first robot row within reach of a lamp (-1: none yet)
+A_COLLISIONS = 1  # collisions so far (touches closer together than the debounce are one)
+A_TOUCHING = 2  # 1 when the last row was touching something
+A_LAST_TOUCH = 3  # the last row that touched something (NEVER: none yet)
+A_ROWS = 4  # robot rows seen (the start row included)
+A_REACH = 5  # metres: the lamp counts as reached this close (set by the caller)
+A_DEBOUNCE = 6  # rows: touches within this many rows belong to the last collision (set by the caller)
+N_ACC = 7
+NEVER = -1e18
+
+
+def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
+    acc = np.zeros(N_ACC)
+    acc[A_REACHED] = -1.0
+    acc[A_LAST_TOUCH] = NEVER
+    acc[A_REACH], acc[A_DEBOUNCE] = reach, debounce_rows
+    return acc
+
+
+@njit(nogil=True)
+def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
+    """Fold one robot row into the running summary: reaching a lamp and the start of each collision
+    (a rise of any bumper or contact with no touch in the debounce rows before it)."""
+    row = acc[A_ROWS]
+    acc[A_ROWS] = row + 1.0
+    if acc[A_REACHED] < 0.0:
+        for k in range(lamps.shape[0]):
+            if math.hypot(s[X] - lamps[k, 0], s[Y] - lamps[k, 1]) <= acc[A_REACH]:
+                acc[A_REACHED] = row
+                break
+    touching = s[BUMP_FR] + s[BUMP_FL] + s[BUMP_REAR] + s[CONTACT] > 0.0
+    if touching:
+        if acc[A_TOUCHING] == 0.0 and acc[A_LAST_TOUCH] < row - acc[A_DEBOUNCE]:
+            n = int(acc[A_COLLISIONS])
+            if n < collisions.shape[0]:
+                collisions[n] = int(row)
+            acc[A_COLLISIONS] = n + 1
+        acc[A_LAST_TOUCH] = row
+    acc[A_TOUCHING] = 1.0 if touching else 0.0
+
+
+@njit(nogil=True)
+def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, program, regs, outputs, counters, bits,
+              drive, pcols, noise, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
+    """Run one robot for ``noise.shape[0]`` ticks (``noise[t]`` moves it in tick t).
+
+    Writes the robot at the start of each tick into ``hist`` (when it has rows) and each tick's
+    integer record into ``ints`` (when it has rows), and folds every new robot row into
+    ``acc``/``collisions`` (see :func:`observe`).
+    """
+    n_out, n_counters = outputs.shape[0], counters.shape[0]
+    pulses = np.zeros(n_counters, dtype=np.int64)
+    corners = np.empty((4, 2))
+    for t in range(noise.shape[0]):
+        if hist.shape[0]:
+            hist[t, :] = s
+        mask = int(s[MASK])
+        for c in range(n_counters):
+            pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
+        tick_compiled(regs, outputs, counters, mask, pulses, program)
+        if ints.shape[0]:
+            _record(ints, t, mask, regs, outputs, counters, pulses)
+        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps,
+                noise[t], bits, True, corners)
+        observe(s, lamps, acc, collisions)
+    return n_out
+
+
+@njit(nogil=True)
+def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-untyped-def]
+    ints[t, I_MASK] = mask
+    ints[t, I_EVENT] = regs[EVENT]
+    ints[t, I_ROW] = regs[ROW]
+    ints[t, I_STATE] = regs[STATE]
+    ints[t, I_TIMER] = regs[TIMER]
+    k = I_OUTPUTS
+    for j in range(outputs.shape[0]):
+        ints[t, k] = outputs[j]
+        k += 1
+    for j in range(counters.shape[0]):
+        ints[t, k] = counters[j]
+        k += 1
+    for j in range(pulses.shape[0]):
+        ints[t, k] = pulses[j]
+        k += 1
+
+
+@njit(nogil=True)
+def sense(s, p, verts, pstart, pbound, edges, circles, lamps, z, bits):  # type: ignore[no-untyped-def]
+    """Read the sensors without moving (the start of a run)."""
+    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, z, bits, False, np.empty((4, 2)))
+
+
+@njit(nogil=True)
+def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, acc,
+         collisions):  # type: ignore[no-untyped-def]
+    """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, True, np.empty((4, 2)))
+    observe(s, lamps, acc, collisions)
