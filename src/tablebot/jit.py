@@ -31,13 +31,19 @@ def cache_dir() -> str:
     return os.path.join(platformdirs.user_cache_dir("tablebot"), f"numba-{tag}-{sources_digest()}")
 
 
+#: Files whose constants compiled code reads, though they hold no compiled function themselves.
+COMPILED_CONSTANTS = ("tick.py", "layout.py")
+
+
 def sources_digest() -> str:
-    """A short digest of every tablebot source file's name, size and modification time."""
+    """A short digest of the tablebot sources that end up in compiled code (every file that compiles a
+    function, and the constants they read)."""
     root = Path(__file__).resolve().parent
     digest = hashlib.sha1()
     for path in sorted(root.rglob("*.py")):
-        stat = path.stat()
-        digest.update(f"{path.relative_to(root)}:{stat.st_size}:{stat.st_mtime_ns};".encode())
+        text = path.read_bytes()
+        if b"njit" in text or path.name in COMPILED_CONSTANTS:
+            digest.update(str(path.relative_to(root)).encode() + b"\0" + text)
     return digest.hexdigest()[:12]
 
 

@@ -8,7 +8,6 @@ each lamp's level and each counter's value. Extra fields (a simulator's pose) ma
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -165,15 +164,16 @@ def _int_columns(rows: Any, width: int, n: int) -> list[list[int]]:
     """Per column, the values of a (ticks, width) table given as an array or as a list of tuples."""
     if not width:
         return []
-    table = rows.tolist() if hasattr(rows, "tolist") else [list(r) for r in rows]
-    return [list(column) for column in zip(*table, strict=True)] if n else [[] for _ in range(width)]
+    if isinstance(rows, np.ndarray):
+        return [rows[:, k].tolist() for k in range(width)]
+    return [list(column) for column in zip(*rows, strict=True)] if n else [[] for _ in range(width)]
 
 
 def _json_column(column: Any) -> list[str]:
-    """JSON text of each value: floats as ``json`` writes them (their repr), others through ``json``."""
+    """JSON text of each value: finite floats as ``json`` writes them (their repr), others through ``json``."""
     values = _ints(column)
-    if all(type(v) is float and math.isfinite(v) for v in values):
-        return list(map(float.__repr__, values))
+    if values and set(map(type, values)) == {float} and np.isfinite(np.asarray(values)).all():
+        return repr(values)[1:-1].split(", ")  # one C call makes every float's repr, as json writes it
     return [json.dumps(v, ensure_ascii=False) for v in values]
 
 

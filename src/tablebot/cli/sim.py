@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
@@ -28,15 +27,23 @@ def sim_cmd(
     out: Path = typer.Option(Path("out/sim"), "--out", help="Folder for trace.jsonl and the pictures."),
     view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif, an animation of the run."),
+    plots: bool = typer.Option(True, "--plots/--no-plots", help="Write trajectory.png and timeline.png."),
     charge: float | None = typer.Option(None, "--battery", min=0.0, max=1.0,
                                         help="Battery charge at the start, 0..1 (overrides the world)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no summary."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
-    """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif)."""
+    """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif).
+
+    The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
+    the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
+    """
+    import numpy as np
+
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import run, ticks_for
     from tablebot.sim.summary import summarise
+    from tablebot.trace import TraceFile
 
     if view:
         from tablebot.sim.animate import check_display
@@ -46,9 +53,12 @@ def sim_cmd(
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks)
+    trace = TraceFile(out / "trace.jsonl")
+    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32)
+    if not result.end.complete:
+        _stopped(result, trace.written)
     summary = summarise(result)
-    written = _write_files(result, summary, out, gif)
+    written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
     if not quiet:
         _report(result, summary, written)
     if view:
@@ -56,15 +66,21 @@ def sim_cmd(
         show(result, summary)
 
 
-def _write_files(result: Result, summary: Summary, out: Path, gif: bool) -> list[Path]:
-    """trace.jsonl, the two pictures and, with ``gif``, the animation."""
-    from tablebot.sim import plots
-    from tablebot.sim.runner import write_trace
+def _stopped(result: Result, kept: Path | None) -> None:
+    """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
+    err_console.print(f"{result.end.message or result.end.reason} after {result.ticks:,} ticks; "
+                      f"kept {kept} (the previous run's files are untouched)", soft_wrap=True, markup=False)
+    raise typer.Exit(result.end.exit_code)
 
-    with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
-        write_trace(result, stream)
-    written = [out / "trace.jsonl", plots.trajectory(result, summary, out / "trajectory.png"),
-               plots.timeline(result, summary, out / "timeline.png")]
+
+def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: bool) -> list[Path]:
+    """trajectory.png and timeline.png (unless ``plots`` is off) and, with ``gif``, the animation."""
+    written = []
+    if plots:
+        from tablebot.sim import plots as pictures
+
+        written += [pictures.trajectory(result, summary, out / "trajectory.png"),
+                    pictures.timeline(result, summary, out / "timeline.png")]
     if gif:
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))
@@ -76,18 +92,22 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
     from tablebot.sim.draw import state_names
 
     for line in summary.lines(state_names(result.scene.table)):
-        console.print(line)
+        console.print(line, markup=False)
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
     console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
     for path in written:
-        err_console.print(f"wrote {path}")
+        err_console.print(f"wrote {path}", markup=False)
 
 
-def _run_with_progress(run, scene, seconds: float, seed: int, ticks: int | None):  # type: ignore[no-untyped-def]
+def _run_with_progress(run, scene, seconds: float, seed: int, ticks: int | None, trace,  # type: ignore[no-untyped-def]
+                       history: type):
     """``run`` with a progress bar of ``ticks`` on a terminal (None: quiet)."""
     if ticks is None or not sys.stderr.isatty():
-        return run(scene, seconds, seed)
+        return run(scene, seconds, seed, sinks=[trace], history=history)
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
-        return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done))
+        return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
+                   history=history)

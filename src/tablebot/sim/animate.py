@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from tablebot.diagnostics import fail
+from tablebot.files import atomic_write
 from tablebot.sim import layout as L
 from tablebot.sim.draw import RobotArtist, draw_world, state_colours, state_label, state_names
 from tablebot.sim.plots import subtitle_of, title_of
@@ -99,7 +100,9 @@ def write_gif(result: Result, summary: Summary, path: Path) -> Path:
         frames.append(frame)
     palette = frames[-1].quantize(colors=255, method=Image.Quantize.MEDIANCUT)
     indexed = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
-    indexed[0].save(path, save_all=True, append_images=indexed[1:], duration=round(1000 / GIF_FPS), loop=0)
+    with atomic_write(path, "wb") as stream:
+        indexed[0].save(stream, format="GIF", save_all=True, append_images=indexed[1:],
+                        duration=round(1000 / GIF_FPS), loop=0)
     return path
 
 

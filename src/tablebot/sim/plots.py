@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from tablebot.files import atomic_write
 from tablebot.sim import layout as L
 from tablebot.sim.draw import (
     COLLISION,
@@ -32,6 +33,8 @@ from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
 
 DPI = 150
+PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels
+LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
 
 
 def title_of(result: Result) -> str:
@@ -57,10 +60,9 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     draw_world(ax, world)
     machine, h = result.scene.machine, result.hist
     colours = state_colours(machine.states)
-    pts = h[:, [L.X, L.Y]]
-    segments = np.stack((pts[:-1], pts[1:]), axis=1)
-    lines = LineCollection(segments, colors=[colours[s] for s in result.states.tolist()], linewidths=2.2,
-                           capstyle="round", zorder=4)
+    pieces, piece_states = path_pieces(h[:, [L.X, L.Y]].astype(np.float64), result.states, PATH_STEP_M)
+    lines = LineCollection(pieces, colors=[colours[s] for s in piece_states], linewidths=2.2,
+                           capstyle="round", joinstyle="round", zorder=4)
     ax.add_collection(lines)
     # spins in place draw no line: a dot where each state begins shows them
     change = np.flatnonzero(np.diff(result.states)) + 1
@@ -71,8 +73,42 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.06, ha="left", y=0.975)
     fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
     _legend(fig, result, summary)
-    fig.savefig(path, facecolor="white")
+    return save(fig, path)
+
+
+def save(fig: Figure, path: Path) -> Path:
+    """Write the figure as PNG under a temporary name, renamed into place when complete."""
+    with atomic_write(path, "wb") as stream:
+        fig.savefig(stream, format="png", facecolor="white")
     return path
+
+
+def path_pieces(xy: np.ndarray, states: np.ndarray, step: float) -> tuple[list[np.ndarray], list[int]]:
+    """The path cut where the state changes (segment t, from row t to t + 1, has the state after tick t),
+    each piece thinned to points about ``step`` apart along it (ends kept): what a picture can show."""
+    ticks = len(states)
+    change = np.flatnonzero(np.diff(states)) + 1
+    starts, ends = np.concatenate(([0], change)), np.concatenate((change, [ticks]))
+    travelled = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))))
+    bucket = np.floor(travelled / step)
+    keep = np.concatenate(([True], bucket[1:] != bucket[:-1]))
+    pieces, piece_states = [], []
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        inner = np.flatnonzero(keep[a + 1:b]) + a + 1
+        rows = np.concatenate(([a], inner, [b]))
+        pieces.append(xy[rows])
+        piece_states.append(int(states[a]))
+    return pieces, piece_states
+
+
+def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """A long series drawn as the low and high value of each of ``bins`` time bins (a line zigzagging
+    between them), which looks like every point plotted; short series are returned as they are."""
+    if len(y) <= 2 * bins:
+        return t, y
+    edges = np.linspace(0, len(y), bins + 1).astype(np.int64)
+    low, high = np.minimum.reduceat(y, edges[:-1]), np.maximum.reduceat(y, edges[:-1])
+    return np.repeat(t[edges[:-1]], 2), np.column_stack((low, high)).ravel()
 
 
 def _markers(ax, result: Result, summary: Summary) -> None:
@@ -156,8 +192,7 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
     fig.text(0.07, 0.935, subtitle_of(summary) + "   (red lines: collisions, dashed: first light)",
              fontsize=10, color="#444")
     fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
-    fig.savefig(path, facecolor="white")
-    return path
+    return save(fig, path)
 
 
 def _state_panel(ax, result: Result) -> None:
@@ -170,9 +205,11 @@ def _state_panel(ax, result: Result) -> None:
     starts = np.concatenate(([0], change))
     ends = np.concatenate((change, [result.ticks]))
     tick = result.tick_s
+    spans: dict[int, list[tuple[float, float]]] = {}
     for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
-        s = int(result.states[a])
-        ax.broken_barh([(a * tick, (b - a) * tick)], (rows[s] - 0.4, 0.8), facecolors=colours[s])
+        spans.setdefault(int(result.states[a]), []).append((a * tick, (b - a) * tick))
+    for s, runs in spans.items():  # one call per state, not per visit: an hour has thousands
+        ax.broken_barh(runs, (rows[s] - 0.4, 0.8), facecolors=colours[s])
     ax.set_yticks(range(len(visited)))
     ax.set_yticklabels([state_label(machine.states[s], names) for s in visited], fontsize=8)
     ax.set_ylim(-0.7, len(visited) - 0.3)
@@ -188,7 +225,9 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
         style = "-" if k < n_motors else ":"
         label = f"{name} ({labels[name]})" if labels.get(name) else name
         wide = k == 0  # the first drawn wide and pale, so equal speeds show both lines
-        ax.step(t, result.outputs[:, k], where="post", lw=3.2 if wide else 1.3, alpha=0.55 if wide else 1.0,
+        values = result.outputs[:, k]
+        steps = np.concatenate(([0], np.flatnonzero(np.diff(values)) + 1, [len(values) - 1]))  # where it changes
+        ax.step(t[steps], values[steps], where="post", lw=3.2 if wide else 1.3, alpha=0.55 if wide else 1.0,
                 ls=style, label=label)
     ax.axhline(0, color="#999", lw=0.6)
     ax.set_ylim(-8.9, 8.9)
@@ -217,8 +256,8 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
 
 def _light_panel(ax, result: Result, t: np.ndarray) -> None:
     h, wiring = result.hist[:-1], result.scene.params.wiring
-    ax.plot(t, h[:, L.LIGHT_R], lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
-    ax.plot(t, h[:, L.LIGHT_L], lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
+    ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
+    ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
     ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
     ax.set_yscale("symlog", linthresh=0.1)
     ax.set_ylim(0, max(10.0, float(h[:, [L.LIGHT_R, L.LIGHT_L]].max()) * 1.5))

@@ -66,44 +66,47 @@ class Result:
 
 
 class History:
-    """A sink that keeps every tick of a simulated run (robot rows as ``dtype``: float32 halves the
-    memory of an hour's run and is plenty for pictures; the trace is written from the exact values)."""
+    """A sink that keeps every tick of a simulated run in arrays sized for the planned run (robot rows as
+    ``dtype``: float32 halves the memory of an hour's run and is plenty for pictures; the trace is
+    written from the exact values)."""
+
+    COLUMNS = ("masks", "events", "rows", "states", "timers", "outputs", "counters", "pulses")
 
     def __init__(self, robot: SimRobot, dtype: type = np.float64):
         self.robot, self.dtype = robot, dtype
-        self.blocks: list[TickBlock] = []
         self.ended: RunEnd | None = None
+        self.done = 0
 
     def start(self, info: RunInfo) -> None:
-        self.first = self.robot.s.astype(self.dtype)
+        machine = info.engine.machine
+        ticks = info.ticks or 0
+        n_out, n_c = len(machine.output_names), len(machine.counter_bits)
+        self.hist = np.zeros((ticks + 1, L.N_STATE), dtype=self.dtype)
+        self.hist[0] = self.robot.s
+        small = np.int16 if len(machine.states) < 32768 and len(machine.rows) < 32768 else np.int32
+        self.columns = {"masks": np.zeros(ticks, np.int32), "events": np.zeros(ticks, np.int32),
+                        "rows": np.zeros(ticks, small), "states": np.zeros(ticks, small),
+                        "timers": np.zeros(ticks, np.int32), "outputs": np.zeros((ticks, n_out), np.int8),
+                        "counters": np.zeros((ticks, n_c), np.int32), "pulses": np.zeros((ticks, n_c), np.int32)}
 
     def block(self, block: TickBlock) -> None:
-        raw = block.raw if block.raw is not None else np.asarray([self.robot.s])  # one tick: the robot before it
-        self.blocks.append(TickBlock(block.start, *(np.asarray(c, dtype=np.int32) for c in (
-            block.masks, block.pulses, block.events, block.rows, block.states, block.timers, block.outputs,
-            block.counters)), raw=np.asarray(raw, dtype=self.dtype)))
+        a, b = block.start, block.start + len(block)
+        for name in self.COLUMNS:
+            self.columns[name][a:b] = getattr(block, name)
+        if block.raw is not None:  # the robot at the start of each tick; the one after the last comes below
+            self.hist[a:b] = block.raw
+        self.hist[b] = self.robot.s
+        self.done = b
 
     def end(self, end: RunEnd) -> None:
         self.ended = end
 
     def result(self, scene: Scene, seed: int, wall_s: float) -> Result:
-        robot, blocks = self.robot, self.blocks
-        n_out, n_c = len(scene.machine.output_names), len(scene.table.robot.counters)
-        rows = [b.raw for b in blocks] if blocks and blocks[0].raw is not None else []
-
-        def column(name: str, width: int | None = None) -> np.ndarray:
-            parts = [np.asarray(getattr(b, name)) for b in blocks]
-            shape = (0,) if width is None else (0, width)
-            return np.concatenate(parts) if parts else np.zeros(shape, dtype=np.int32)
-
-        hist = np.concatenate([*rows, robot.s[None, :].astype(self.dtype)]) if rows else robot.s[None, :].copy()
-        return Result(scene=scene, seed=seed, hist=hist, masks=column("masks"), events=column("events"),
-                      rows=column("rows"), states=column("states"), timers=column("timers"),
-                      outputs=column("outputs", n_out),
-                      counters=column("counters", n_c),
-                      pulses=column("pulses", n_c),
+        robot, n = self.robot, self.done
+        cut = {name: column[:n] for name, column in self.columns.items()}  # a run cut short keeps what ran
+        return Result(scene=scene, seed=seed, hist=self.hist[: n + 1], **cut,
                       collision_rows=robot.collisions, collision_count=robot.collision_count,
-                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)
+                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)  # type: ignore[arg-type]
 
 
 class Progress:
