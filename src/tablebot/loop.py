@@ -244,24 +244,40 @@ class Watchdog:
         self._on_fire()
 
 
+class StopRequest:
+    """Ctrl-C (SIGINT) and SIGTERM during a run only ask it to stop: the loop stops between ticks (or
+    blocks), so every tick it reports has reached every sink and no sink sees half a block. A second
+    Ctrl-C interrupts at once (a robot call that never returns cannot hold the user hostage)."""
+
+    def __init__(self) -> None:
+        self.signal: int | None = None
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        if self.signal is not None and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        self.signal = self.signal or signum
+
+    def check(self) -> None:
+        if self.signal == signal.SIGTERM:
+            raise Terminated("terminated by SIGTERM")
+        if self.signal is not None:
+            raise KeyboardInterrupt
+
+    @contextmanager
+    def installed(self) -> Iterator[StopRequest]:
+        if threading.current_thread() is not threading.main_thread():
+            yield self
+            return
+        previous = {sig: signal.signal(sig, self) for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            yield self
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+
 class Terminated(Exception):
     """SIGTERM arrived: end the run as Ctrl-C would."""
-
-
-@contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        raise Terminated("terminated by SIGTERM")
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 # --- the loop -------------------------------------------------------------------------------------
@@ -309,16 +325,16 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
     end: RunEnd | None = None
     bug: BaseException | None = None
     try:
-        with _sigterm_raises(), watchdog.installed(robot.stop):
+        with StopRequest().installed() as stop, watchdog.installed(robot.stop):
             robot.open()
             for sink in sinks:
                 sink.start(info)
                 started.append(sink)
             clock.start()
             if clock.free_running and isinstance(robot, BlockIO):
-                _run_blocks(engine, robot, started, ticks, block_ticks)
+                _run_blocks(engine, robot, started, ticks, block_ticks, stop)
             else:
-                _run_ticks(engine, robot, clock, started, ticks, watchdog, late)
+                _run_ticks(engine, robot, clock, started, ticks, watchdog, late, stop)
             end = RunEnd("done" if ticks is not None else "stopped", engine.tick)
     except KeyboardInterrupt:
         end = RunEnd("stopped" if ticks is None else "interrupted", engine.tick, "stopped by Ctrl-C")
@@ -344,9 +360,10 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
 
 
 def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
-               watchdog: Watchdog, late: Lateness) -> None:
+               watchdog: Watchdog, late: Lateness, stop: StopRequest) -> None:
     """One tick at a time: the path of real robots and of the real-time rehearsal."""
     while ticks is None or engine.tick < ticks:
+        stop.check()
         delay = clock.wait(engine.tick)
         late.note(delay)
         watchdog.arm()
@@ -360,9 +377,11 @@ def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sin
             sink.block(block)
 
 
-def _run_blocks(engine: Engine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None, block_ticks: int) -> None:
+def _run_blocks(engine: Engine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None, block_ticks: int,
+                stop: StopRequest) -> None:
     """Many ticks per call: the compiled simulator."""
     while ticks is None or engine.tick < ticks:
+        stop.check()
         n = block_ticks if ticks is None else min(block_ticks, ticks - engine.tick)
         block = robot.advance(engine, n)
         for sink in sinks:
