@@ -24,6 +24,23 @@ EXAMPLES = [(BUMBERBOT / "table.csv", None), (ROOT / "examples" / "bumberbot-cou
                                               BUMBERBOT / "arena.toml")]
 
 
+class Lines:
+    """A sink keeping the trace lines (without the real-time fields, which only the tick path has)."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def start(self, info) -> None:  # type: ignore[no-untyped-def]
+        self.machine = info.engine.machine
+
+    def block(self, block: TickBlock) -> None:
+        block.extra = {k: v for k, v in block.extra.items() if k != "late_ms"}
+        self.lines.extend(block_lines(block, self.machine))
+
+    def end(self, end) -> None:  # type: ignore[no-untyped-def]
+        pass
+
+
 class TickByTick(SimulatedClock):
     free_running = False  # the loop then reads, steps and writes one tick at a time
 
@@ -49,18 +66,9 @@ def test_tick_by_tick_and_compiled_runs_are_the_same_run(table: Path, world: Pat
     scene = scene_of(table, world)
     traces = []
     for clock in (TickByTick(), SimulatedClock()):
-        lines: list[str] = []
-
-        class Keep:
-            def start(self, info): self.machine = info.engine.machine  # noqa: E704
-            def block(self, block: TickBlock):  # the real-time fields aside, every byte must agree
-                block.extra = {k: v for k, v in block.extra.items() if k != "late_ms"}
-                lines.extend(block_lines(block, self.machine))
-            def end(self, end): pass  # noqa: E704
-
-        robot = SimRobot(scene, 9)
-        run_loop(Engine(scene.machine), robot, clock=clock, sinks=[Keep()], ticks=3000)
-        traces.append((lines, robot.s.tolist(), robot.collisions, robot.reached_row))
+        keep, robot = Lines(), SimRobot(scene, 9)
+        run_loop(Engine(scene.machine), robot, clock=clock, sinks=[keep], ticks=3000)
+        traces.append((keep.lines, robot.s.tolist(), robot.collisions, robot.reached_row))
     assert traces[0] == traces[1]
 
 
