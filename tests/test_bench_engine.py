@@ -22,7 +22,7 @@ def test_contestants_agree_on_a_short_run(capsys):
     bench = load_benchmark()
     bench.main(["--ticks", "3000", "--repeats", "1", "--transitions-ticks", "500"])  # asserts agreement
     out = capsys.readouterr().out
-    for name in ("batch", "step", "linear scan", "bare loop", "transitions", "targets"):
+    for name in ("batch", "step", "bare step", "linear scan", "bare loop", "transitions", "targets", "closed loop"):
         assert name in out
 
 
@@ -32,6 +32,6 @@ def test_contestants_match_the_engine_tick_for_tick_state():
     masks = bench.random_masks(machine, 5000)
     assert any(masks) and max(masks) < 32
     expected = bench.engine_step(machine, masks)
-    for run in (bench.engine_batch, bench.linear_scan, bench.bare_loop):
+    for run in (bench.engine_batch, bench.linear_scan, bench.bare_loop, bench.bare_step):
         assert run(machine, masks) == expected
     assert bench.transitions_run(machine, masks[:700]) == bench.engine_step(machine, masks[:700])
