@@ -13,9 +13,10 @@ from hypothesis import strategies as st
 from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
 from tablebot.firmware.board_header import timer_setting, ubrr
-from tablebot.firmware.boards import load_board, wire
+from tablebot.firmware.boards import load_board, read_robot_boards, wire
 from tablebot.firmware.build import build
 from tablebot.firmware.emulate import build_harness, emulate, pins_csv
+from tablebot.formats.tomlfile import Source
 from tablebot.machine import compile_table
 from tablebot.robot import BUMBERBOT, Counter, Robot
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
@@ -108,7 +109,14 @@ def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed,
 # --- boards and wiring --------------------------------------------------------------------------
 
 def _robot(**changes) -> Robot:
-    return Robot(**{**BUMBERBOT.__dict__, **changes})
+    """The BumberBot with ``changes``; a ``sections`` board table is read as a robot file's would be."""
+    robot = Robot(**{**BUMBERBOT.__dict__, **changes, "sections": {}})
+    boards = changes.get("sections", {}).get("board")
+    if boards is not None:
+        src = Source("robot.toml", "", {"board": boards})
+        robot.sections["board"] = read_robot_boards(src, boards, robot)
+        src.raise_if_any()
+    return robot
 
 
 def test_bumberbot_wiring_on_both_boards():

@@ -6,6 +6,7 @@ BumberBot is built in so that the seed table reads with no side file at all.
 
 from __future__ import annotations
 
+import importlib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,11 +16,23 @@ from tablebot.formats.tomlfile import Source, Where
 
 StateId = int | str
 
-#: Sections of a robot file that belong to other stages (simulator, checker, hardware);
-#: the core keeps them as plain data and does not interpret them.
-FOREIGN_SECTIONS = ("sim", "wiring", "properties", "board")
+#: Sections of a robot file that belong to other stages, each with the reader (``module:function``)
+#: that checks it and returns its typed value; a reader is imported only when its section is present,
+#: so reading a robot file never loads the simulator. Every section is read when the file is, so all
+#: its mistakes show at once, whichever command runs. Reader: ``(src, data, robot) -> value``.
+SECTION_READERS: dict[str, str] = {
+    "sim": "tablebot.sim.params:read_robot_sim",
+    "board": "tablebot.firmware.boards:read_robot_boards",
+    "properties": "tablebot.analysis.properties:read_robot_properties",
+}
+FOREIGN_SECTIONS = tuple(SECTION_READERS)
 TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
-KNOWN_KEYS = (*TOP_KEYS, "inputs", "motors", "counters", "lamps", "states", *FOREIGN_SECTIONS)
+CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states")
+KNOWN_KEYS = (*TOP_KEYS, *CORE_SECTIONS, *FOREIGN_SECTIONS)
+#: Sections people write in the wrong file: the hint says where they belong.
+MISPLACED = {"wiring": "the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)",
+             **{s: f"simulator parameters go in [sim.{s}] in a robot file" for s in
+                ("body", "motor", "battery", "encoder", "light", "noise")}}
 NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: A state name as tables and robot files write it (a state is otherwise a whole number 0 or more).
 STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
@@ -95,13 +108,17 @@ def find_robot_file(table_path: Path) -> Path | None:
     return None
 
 
-def load_robot(path: Path) -> Robot:
+def load_robot(path: str | Path) -> Robot:
     """Read a robot TOML file, reporting every problem with its line."""
+    path = Path(path)
     src = Source.read(path, "see the robot file format in the README")
     data = src.data
     for key in data:
         if key not in KNOWN_KEYS:
-            _error(src, ("", None, key), f"unknown key {key!r}", f"known keys: {', '.join(KNOWN_KEYS)}")
+            what = "section" if isinstance(data[key], dict) else "key"
+            _error(src, ("", None, key), f"unknown {what} {key!r}",
+                   MISPLACED.get(key, f"known keys: {', '.join(TOP_KEYS)}; sections: "
+                                      f"{', '.join(CORE_SECTIONS + FOREIGN_SECTIONS)}"))
     inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = _counters(src, motors)
     _distinct(src, {"inputs": inputs, "motors": motors, "lamps": lamps, "counters": {c.name: "" for c in counters}})
@@ -118,12 +135,24 @@ def load_robot(path: Path) -> Robot:
     if not isinstance(name, str):
         _error(src, ("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
     src.raise_if_any()
-    return Robot(
+    robot = Robot(
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
         initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms,
-        labels={**inputs, **motors, **lamps}, state_names=states,
-        sections={k: data[k] for k in FOREIGN_SECTIONS if k in data}, source=str(path), toml=src,
+        labels={**inputs, **motors, **lamps}, state_names=states, source=str(path), toml=src,
     )
+    robot.sections.update(_foreign_sections(src, robot))
+    return robot
+
+
+def _foreign_sections(src: Source, robot: Robot) -> dict[str, Any]:
+    """Each stage's section, read by its own reader (see SECTION_READERS); all problems at once."""
+    typed = {}
+    for key, where in SECTION_READERS.items():
+        if key in src.data:
+            module, function = where.split(":")
+            typed[key] = getattr(importlib.import_module(module), function)(src, src.data[key], robot)
+    src.raise_if_any()
+    return typed
 
 
 def _error(src: Source, where: Where, message: str, hint: str) -> None:

@@ -83,6 +83,12 @@ def find_property_files(table_path: Path) -> list[Path]:
     return []
 
 
+def read_robot_properties(src: Source, entries: Any, robot: Any) -> Any:
+    """A robot file's ``[properties]`` as written: each property is checked against the table when
+    ``tablebot check`` reads it (a property names the table's inputs and outputs)."""
+    return entries
+
+
 def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
     """The robot file's ``[properties]`` plus every file given; all problems are reported at once."""
     robot = machine.table.robot

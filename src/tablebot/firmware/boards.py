@@ -66,15 +66,37 @@ class Wiring:
         return taken | set(self.lamps.values())
 
 
-def _overrides(robot: Robot, board: Board, src: Source) -> tuple[dict[str, str], frozenset[str]]:
-    """The robot file's ``[board.NAME]``: terminal per robot name, and the active-high inputs."""
+@dataclass(frozen=True)
+class BoardMap:
+    """A robot file's ``[board.NAME]``: a terminal per robot name, and the inputs that are active high."""
+
+    terminals: dict[str, str]
+    active_high: frozenset[str]
+
+
+def read_robot_boards(src: Source, boards: Any, robot: Robot) -> dict[str, BoardMap]:
+    """``[board.NAME]`` sections of a robot file, checked (errors go to ``src``): known boards, names the
+    robot has, terminals the board has, ``active_high`` a list of inputs. Conflicts between terminals
+    are found when the robot is wired onto the board (``tablebot build``)."""
+    if not isinstance(boards, dict):
+        src.error(("", None, "board"), "[board] must hold one table per board, like [board.uno]",
+                  f"boards: {', '.join(BOARDS)}")
+        return {}
+    maps = {}
+    for name, mine in boards.items():
+        where = (f"board.{name}", None, None) if src.line(f"board.{name}") else ("board", None, name)
+        if name not in BOARDS:
+            src.error(where, f"[board.{name}]: unknown board {name!r}", f"boards: {', '.join(BOARDS)}")
+        elif not isinstance(mine, dict):
+            src.error(where, f"[board.{name}] must be a table of NAME = \"TERMINAL\"",
+                      'for example: I3 = "D4"')
+        else:
+            maps[name] = _board_map(src, load_board(name), mine, robot)
+    return maps
+
+
+def _board_map(src: Source, board: Board, mine: dict[str, Any], robot: Robot) -> BoardMap:
     section = f"board.{board.name}"
-    boards = robot.sections.get("board", {})
-    mine = boards.get(board.name, {}) if isinstance(boards, dict) else {}
-    if not isinstance(mine, dict):
-        src.error(("board", None, board.name), f"[{section}] must be a table of NAME = \"TERMINAL\"",
-                  'for example: I3 = "D4"')
-        return {}, frozenset()
     active_high = mine.get("active_high", [])
     if not isinstance(active_high, list) or not all(isinstance(n, str) for n in active_high):
         src.error((section, None, "active_high"), f"[{section}] active_high must be a list of input names",
@@ -84,7 +106,7 @@ def _overrides(robot: Robot, board: Board, src: Source) -> tuple[dict[str, str],
         if name not in robot.inputs:
             src.error((section, None, "active_high"), f"[{section}] active_high names {name!r}, not an input",
                       f"inputs are {', '.join(robot.inputs) or 'none'}")
-    maps = {}
+    terminals = {}
     for name, terminal in mine.items():
         if name == "active_high":
             continue
@@ -95,8 +117,25 @@ def _overrides(robot: Robot, board: Board, src: Source) -> tuple[dict[str, str],
             src.error((section, None, name), f"[{section}] {name} must be a terminal name, not {terminal!r}",
                       f'write it in quotes, for example: {name} = "{_example(board, robot, name)}"')
         else:
-            maps[name] = terminal
-    return maps, frozenset(active_high)
+            kind, choices = _kind_of(board, robot, name)
+            if terminal not in choices:
+                src.error((section, None, name), f"{kind} {name} cannot use {terminal!r} on the {board.name} board",
+                          _unknown_terminal_hint(kind, terminal, choices))
+            terminals[name] = terminal
+    return BoardMap(terminals, frozenset(active_high))
+
+
+def _kind_of(board: Board, robot: Robot, name: str) -> tuple[str, tuple[str, ...]]:
+    """What sort of signal ``name`` is on the robot, and the board's terminals for that sort."""
+    kinds = (("input", robot.inputs, board.inputs), ("motor", robot.motors, board.motors),
+             ("lamp", robot.lamps, board.lamps), ("counter", robot.counter_names, board.counters))
+    return next((kind, tuple(terminals)) for kind, names, terminals in kinds if name in names)
+
+
+def _overrides(robot: Robot, board: Board) -> tuple[dict[str, str], frozenset[str]]:
+    """The robot file's ``[board.NAME]`` for this board (checked when the robot file was read)."""
+    mine = robot.sections.get("board", {}).get(board.name)
+    return (mine.terminals, mine.active_high) if mine is not None else ({}, frozenset())
 
 
 def _example(board: Board, robot: Robot, name: str) -> str:
@@ -149,7 +188,7 @@ def _assign(kind: str, names: tuple[str, ...], terminals: tuple[str, ...], maps:
 def wire(robot: Robot, board: Board) -> Wiring:
     """Assign every robot signal to a terminal, reporting all conflicts at once."""
     src = robot.file_source()
-    maps, active_high = _overrides(robot, board, src)
+    maps, active_high = _overrides(robot, board)
     taken: set[str] = set()
     inputs = _assign("input", robot.inputs, tuple(board.inputs), maps, taken, board, src)
     motors = _assign("motor", robot.motors, tuple(board.motors), maps, set(), board, src)

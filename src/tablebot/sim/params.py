@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tablebot.formats.tomlfile import Source, known_keys, number, table_of
 from tablebot.sim import layout as L
-from tablebot.sim.physics import duty, pack_volts
 
 Number = int | float
 
@@ -108,6 +108,32 @@ def check_layer(src: Source, data: dict[str, Any], prefix: str = "") -> dict[str
     return layer
 
 
+@dataclass(frozen=True)
+class SimSection:
+    """A robot file's ``[sim]``: its parameter layer (``[sim.battery]`` ...) and its default world."""
+
+    layer: dict[str, dict[str, Any]]
+    world: Path | None
+
+
+def read_robot_sim(src: Source, sim: Any, robot: Any) -> SimSection:
+    """``[sim]`` of a robot file, checked (errors go to ``src``): parameter sections and ``world``."""
+    if not isinstance(sim, dict):
+        src.error(("", None, "sim"), "[sim] must be a table", "write [sim.battery] etc.")
+        return SimSection({}, None)
+    known_keys(src, ("sim", None), sim, (*SECTIONS, "world"))
+    layer = check_layer(src, sim, prefix="sim.")
+    world = sim.get("world")
+    path = Path(src.path).parent / world if isinstance(world, str) else None
+    if world is not None and not isinstance(world, str):
+        src.error(("sim", None, "world"), "sim.world must be a file name", 'for example: world = "arena.toml"')
+    elif path is not None and not path.is_file():
+        src.error(("sim", None, "world"), f"sim.world: {path} is not a file",
+                  "name a world file, relative to the robot file's folder")
+        path = None
+    return SimSection(layer, path)
+
+
 def _parameter_value(src: Source, name: str, key: str, value: Any) -> Number | None:
     """A number within the parameter's range (an integer where its default is one), else None after an error."""
     default, low, high, _ = DEFAULTS[name.rsplit(".", 1)[-1]][key]  # [battery] or [sim.battery]
@@ -160,6 +186,8 @@ def spin_speed(params: Params) -> float:
 
 def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> float:
     """Battery volts under the load of motors at these speed levels, by the physics core's formula."""
+    from tablebot.sim.physics import duty, pack_volts  # numba: only when a simulation is put together
+
     b, m = params["battery"], params["motor"]
     amps = b["idle_amps"] + b["motor_amps"] * sum(duty(v, m["levels"]) for v in levels)
     return pack_volts(b["full_volts"], b["empty_volts"], charge, amps, b["internal_ohms"])
@@ -173,6 +201,8 @@ def speed_per_volt(params: Params) -> float:
         return float(m["speed_per_volt"])
     level = m["spin_level"]
     volts = terminal_volts(params, 1.0, (level, level))
+    from tablebot.sim.physics import duty
+
     drive = duty(level, m["levels"]) * volts - m["friction_volts"]
     if drive <= 0:
         raise ValueError("the calibration spin's speed level cannot overcome friction_volts")

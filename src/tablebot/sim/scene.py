@@ -14,15 +14,12 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
-from tablebot.formats.tomlfile import known_keys
 from tablebot.machine import Machine
 from tablebot.robot import Robot
 from tablebot.sim import layout as L
 from tablebot.sim.params import (
     INPUT_ROLES,
-    SECTIONS,
     Params,
-    check_layer,
     merged,
     param_row,
     problems,
@@ -57,24 +54,10 @@ class Scene:
 
 
 def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
-    """The robot file's ``[sim]`` parameter sections, checked, and its default world (``sim.world``)."""
+    """The robot file's ``[sim]`` parameter sections (checked when the robot file was read) and its
+    default world (``sim.world``)."""
     sim = robot.sections.get("sim")
-    if not sim:
-        return {}, None
-    src = robot.file_source()
-    if not isinstance(sim, dict):
-        raise fail(robot.source, "[sim] must be a table", "write [sim.battery] etc.", src.line("", None, "sim"))
-    known_keys(src, ("sim", None), sim, (*SECTIONS, "world"))
-    layer = check_layer(src, sim, prefix="sim.")
-    world = sim.get("world")
-    path = Path(robot.source).parent / world if isinstance(world, str) else None
-    if world is not None and not isinstance(world, str):
-        src.error(("sim", None, "world"), "sim.world must be a file name", 'for example: world = "arena.toml"')
-    elif path is not None and not path.is_file():
-        src.error(("sim", None, "world"), f"sim.world: {path} is not a file",
-                  "name a world file, relative to the robot file's folder")
-    src.raise_if_any()
-    return layer, path
+    return (sim.layer, sim.world) if sim is not None else ({}, None)
 
 
 def find_world(table: Table, world_path: Path | None, robot_world: Path | None) -> World:

@@ -15,7 +15,6 @@ import numpy as np
 
 from tablebot.formats.tomlfile import Source, Where, known_keys, label, number, point, table_of
 from tablebot.sim.params import SECTIONS, check_layer
-from tablebot.sim.physics import point_segment_distance
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", *SECTIONS)
@@ -285,6 +284,14 @@ def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes
                       "reach the robot", "move the lamp into the open")
 
 
+def _distance_to_segment(p: Point, a: Point, b: Point) -> float:
+    """Distance from p to segment ab (for checking a world file; the simulator has its own compiled one)."""
+    ex, ey = b[0] - a[0], b[1] - a[1]
+    length2 = ex * ex + ey * ey
+    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / length2))
+    return math.hypot(p[0] - a[0] - t * ex, p[1] - a[1] - t * ey)
+
+
 def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circles: list[Circle]) -> str | None:
     """Where ``at`` is shut in: inside a box or a circle, or on a wall line; None when in the open."""
     for k, box in enumerate(boxes):
@@ -293,7 +300,7 @@ def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circ
     for k, circle in enumerate(circles):
         if math.dist(circle.at, at) < circle.radius:
             return f"inside [[circle]] #{k + 1}"
-    if any(point_segment_distance(*at, *a, *b) < ON_A_WALL for a, b in lines):
+    if any(_distance_to_segment(at, a, b) < ON_A_WALL for a, b in lines):
         return "on a wall"
     return None
 
