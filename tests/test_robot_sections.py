@@ -45,7 +45,8 @@ def test_every_section_is_checked_when_the_file_is_read(tmp_path: Path, extra: s
 
 
 def test_sections_are_typed(tmp_path: Path) -> None:
-    (tmp_path / "arena.toml").write_text('[arena]\nwalls = [[0, 0], [1, 0], [1, 1], [0, 1]]\n[start]\nat = [0.5, 0.5]\n')
+    room = '[arena]\nwalls = [[0, 0], [1, 0], [1, 1], [0, 1]]\n[start]\nat = [0.5, 0.5]\n'
+    (tmp_path / "arena.toml").write_text(room)
     path = tmp_path / "robot.toml"
     path.write_text(BASE + '[sim]\nworld = "arena.toml"\n[sim.battery]\ncharge = 0.5\n[board.uno]\nI3 = "D4"\n')
     robot = load_robot(path)
