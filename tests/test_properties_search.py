@@ -9,11 +9,11 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tablebot.analysis.check import write_inputs
 from tablebot.analysis.conditions import parse_condition
 from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
 from tablebot.analysis.prove import check_property, first_violation, monitor_of, search
+from tablebot.formats.inputs_csv import write_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 from tablebot.robot import Robot

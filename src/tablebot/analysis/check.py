@@ -3,7 +3,6 @@ counterexample CSVs (inputs files that ``tablebot trace`` replays)."""
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,8 +14,9 @@ from tablebot.analysis.model import Model, ModelTooLarge
 from tablebot.analysis.properties import Property
 from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
+from tablebot.formats.inputs_csv import write_inputs
 from tablebot.machine import Machine
-from tablebot.trace import TickInput, replay
+from tablebot.trace import replay
 
 
 @dataclass
@@ -72,22 +72,6 @@ def write_counterexamples(report: CheckReport, outdir: Path) -> None:
             path = outdir / f"{result.prop.name}.csv"
             write_inputs(report.machine, result.inputs, path)
             report.counterexamples[result.prop.name] = path
-
-
-def write_inputs(machine: Machine, ticks: Sequence[TickInput], path: Path) -> None:
-    """An inputs CSV as ``tablebot trace --inputs`` reads it: input names (then counter pulses),
-    one row per tick, 1 for pressed and blank for 0."""
-    robot = machine.table.robot
-    names = list(machine.input_bits)
-    counters = list(robot.counter_names)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", encoding="utf-8", newline="") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow([*names, *counters])
-        for tick in ticks:
-            cells = ["1" if tick.mask & machine.input_bits[n] else "" for n in names]
-            cells += [str(p) if p else "" for p in tick.pulses]
-            writer.writerow(cells)
 
 
 def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:

@@ -13,10 +13,10 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tablebot.analysis.check import write_inputs
 from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
+from tablebot.formats.inputs_csv import write_inputs
 from tablebot.machine import Machine
 from tablebot.trace import TickInput, replay, write_trace
 

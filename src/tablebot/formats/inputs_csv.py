@@ -1,0 +1,107 @@
+"""Recorded inputs as CSV: a header of input names (and counter names for pulses), one row per tick.
+
+The reader and the writer of the format ``tablebot trace --inputs`` reads and ``check`` and ``tests``
+write (counterexamples, golden sequences).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from tablebot.diagnostics import Collector, fail
+from tablebot.files import write_text
+from tablebot.formats.csvtext import Cell, cells_beyond, headerless, read_text, split_records
+from tablebot.machine import Machine
+from tablebot.table import TIMER_EVENT
+
+
+@dataclass(frozen=True)
+class TickInput:
+    """What the robot read in one tick: input bits in event layout, and pulses per counter."""
+
+    mask: int
+    pulses: tuple[int, ...] = ()
+
+
+def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
+    """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0."""
+    path = Path(path)
+    records = split_records(read_text(path), str(path))
+    while records and records[0].is_blank():  # blank lines above the header (below it, a blank row is a tick)
+        records.pop(0)
+    if not records:
+        raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
+    out = Collector(path)
+    columns = _columns(records[0].cells, machine, out)
+    ticks = [_tick(record.cells, columns, machine, out) for record in records[1:]]
+    out.raise_if_any()
+    return ticks
+
+
+def _columns(header: Sequence[Cell], machine: Machine, out: Collector) -> list[tuple[str, str]]:
+    """(kind, name) per header cell: ``input``, ``pulses`` (a counter), ``tick`` or ``blank`` (read
+    but ignored), or ``bad`` (already reported)."""
+    robot = machine.table.robot
+    columns: list[tuple[str, str]] = []
+    seen: dict[str, Cell] = {}
+    for cell in header:
+        name = cell.text.strip()
+        kind = ("input" if name in robot.inputs else "pulses" if name in robot.counter_names
+                else "tick" if name == "tick" else "blank" if not name else "bad")
+        if name == TIMER_EVENT:
+            out.error(cell.line, cell.column, "T is never an input: the engine makes it from the timer",
+                      "remove the T column")
+        elif kind == "bad":
+            out.error(cell.line, cell.column, f"unknown input {name!r} for robot {robot.name}",
+                      f"inputs are {', '.join(robot.inputs)}; counters (pulses per tick) are "
+                      f"{', '.join(robot.counter_names) or 'none'}")
+        elif name in seen:
+            out.error(cell.line, cell.column, f"column {name!r} appears twice (first at column {seen[name].column})",
+                      "delete or rename one of them")
+            kind = "bad"
+        if name:
+            seen.setdefault(name, cell)
+        columns.append((kind, name))
+    return columns
+
+
+def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machine, out: Collector) -> TickInput:
+    robot = machine.table.robot
+    mask = 0
+    pulses = [0] * len(robot.counter_names)
+    for (kind, name), cell in zip(columns, cells, strict=False):
+        text = cell.text.strip()
+        if kind in ("bad", "tick") or not text:
+            continue
+        if kind == "blank":
+            headerless(cell, out)
+        elif not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
+            want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
+            out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
+        elif kind == "input":
+            mask |= machine.input_bits.get(name, 0) if text == "1" else 0
+        else:
+            pulses[robot.counter_names.index(name)] = int(text)
+    cells_beyond(cells, len(columns), out)
+    return TickInput(mask, tuple(pulses))
+
+
+def write_inputs(machine: Machine, ticks: Sequence[TickInput], path: Path) -> Path:
+    """Write ``ticks`` as an inputs CSV (1 for an input that reads 1, blank for 0; pulses per counter)."""
+    return write_text(path, format_inputs(machine, ticks))
+
+
+def format_inputs(machine: Machine, ticks: Sequence[TickInput]) -> str:
+    names = list(machine.input_bits)
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow([*names, *machine.table.robot.counter_names])
+    for tick in ticks:
+        cells = ["1" if tick.mask & machine.input_bits[n] else "" for n in names]
+        cells += [str(p) if p else "" for p in tick.pulses]
+        writer.writerow(cells)
+    return buffer.getvalue()
