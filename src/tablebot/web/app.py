@@ -15,7 +15,7 @@ from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
 from tablebot.web.session import Hub, Session
@@ -28,6 +28,10 @@ MAX_MESSAGE_BYTES = 2 * 1024 * 1024  # an edit is a cell; a whole table is at mo
 #: Scripts and styles only from this server; nothing from the internet.
 CSP = ("default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
        "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
+
+
+class Gone(Exception):
+    """The tab closed its WebSocket: stop talking to it."""
 
 
 def create_app(root: Path, table: str | None = None) -> Starlette:
@@ -64,7 +68,12 @@ def create_app(root: Path, table: str | None = None) -> Starlette:
 
         async def send(message: dict[str, Any]) -> None:
             async with lock:
-                await websocket.send_text(json.dumps(message, separators=(",", ":")))
+                if websocket.application_state != WebSocketState.CONNECTED:
+                    raise Gone
+                try:
+                    await websocket.send_text(json.dumps(message, separators=(",", ":")))
+                except (WebSocketDisconnect, RuntimeError, OSError) as exc:  # the tab went away mid-send
+                    raise Gone from exc
 
         session = Session(workspace, hub, send)
         hub.sessions.add(session)
@@ -73,7 +82,7 @@ def create_app(root: Path, table: str | None = None) -> Starlette:
             while True:
                 text = await websocket.receive_text()
                 await _answer(session, text)
-        except WebSocketDisconnect:
+        except (WebSocketDisconnect, Gone):
             pass
         finally:
             ticker.cancel()
@@ -97,6 +106,8 @@ async def _answer(session: Session, text: str) -> None:
         return
     try:
         await session.handle(message)
+    except Gone:
+        raise
     except Exception as exc:  # a bug: say so on the page and keep serving
         await session.error(f"internal error: {type(exc).__name__}: {exc}")
 
@@ -107,7 +118,39 @@ async def _frames(session: Session) -> None:
         await asyncio.sleep(FRAME_S)
         try:
             await session.frame()
+        except Gone:
+            return
         except Exception as exc:
             with contextlib.suppress(Exception):  # the socket itself may be what failed
                 await session.error(f"the live view stopped: {type(exc).__name__}: {exc}")
             return
+
+
+class Background:
+    """The studio served from a thread (tests, benchmarks): ``url`` while running, :meth:`stop` to end."""
+
+    def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0):
+        import socket
+        import threading
+
+        import uvicorn
+
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.bind((host, port))
+        self.sock.listen(64)
+        self.url = f"http://{host}:{self.sock.getsockname()[1]}/"
+        config = uvicorn.Config(create_app(root, table), log_level="warning", ws_max_size=MAX_MESSAGE_BYTES,
+                                lifespan="off")
+        self.server = uvicorn.Server(config)
+        self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]}, daemon=True)
+        self.thread.start()
+        while not self.server.started:
+            if not self.thread.is_alive():
+                raise RuntimeError("the studio server did not start")
+            threading.Event().wait(0.02)
+
+    def stop(self) -> None:
+        self.server.should_exit = True
+        self.thread.join(10)
+        self.sock.close()
