@@ -33,7 +33,7 @@
   const timeline = new TB.Timeline($("timeline"), (i) => player.seek(i));
   const stateCol = () => (state.analysis ? state.analysis.columns.findIndex(c => c.kind === "state") : -1);
   const player = new TB.Player({ arena, grid, diagram, timeline, status: $("status"), slider: $("scrub"), stateCol,
-    onEnd: () => { $("tplay").textContent = "▶ Play"; } });
+    onEnd: () => { $("tplay").textContent = "▶ Play"; }, onSeek: (t) => renderInputs(t.event) });
   const checks = new TB.Checks({ problems: $("problems"), findings: $("findings"), properties: $("properties"),
     showInfo: $("show-info") }, {
     select: (rows, col) => {
@@ -138,7 +138,8 @@
       const held = state.held[name];
       const live = mask !== undefined && (mask & machine.input_bits[name]);
       b.className = "input" + (live ? " live" : "") + (held === true ? " held-on" : held === false ? " held-off" : "");
-      b.textContent = name + (held === true ? " ✋on" : held === false ? " ✋off" : "");
+      b.textContent = name + (held === true ? ": held on" : held === false ? ": held off" : "");
+      b.disabled = state.mode !== "live";
       b.title = (machine.labels[name] || name) + ": click to hold it on, again to hold it off, again to let the sensor decide";
       b.addEventListener("click", () => {
         const next = held === undefined ? true : held === true ? false : null;
