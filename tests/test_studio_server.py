@@ -53,7 +53,8 @@ def test_malformed_messages_get_error_replies_and_the_server_goes_on(studio: tup
     bad = ["not json", "[1, 2]", {"op": 5}, {"op": "explode"}, {"op": "edit", "row": 0, "col": 0, "value": "x"},
            {"op": "open", "path": 7}, {"op": "sim", "action": "play"}, {"op": "open", "path": "table.csv"},
            {"op": "edit", "row": "zero", "col": 1, "value": "1"}, {"op": "edit", "row": 999, "col": 1, "value": "1"},
-           {"op": "sim", "action": "speed", "speed": "warp"}, {"op": "sim", "action": "hold", "input": "I99", "on": True},
+           {"op": "sim", "action": "speed", "speed": "warp"},
+           {"op": "sim", "action": "hold", "input": "I99", "on": True},
            {"op": "sim", "action": "reset", "seed": -4}, {"op": "sim", "action": "reset", "charge": "full"}]
     replies = talk(server.url, [*bad, {"op": "files"}], until="files", limit=40)
     errors = [r["message"] for r in replies if r["type"] == "error"]
@@ -96,7 +97,8 @@ def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background,
     reply = json.load(urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=good)))
     assert reply["type"] == "trace" and reply["columns"]["state"] == [1]
     with pytest.raises(urllib.error.HTTPError) as err:
-        urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=good + b'{"tick":1}\n'))
+        bad = good + b'{"tick":1}\n'
+        urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=bad))
     assert err.value.code == 400
     assert "t.jsonl:2:1: error: a trace line needs state" in json.load(err.value)["message"]
 

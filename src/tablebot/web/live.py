@@ -15,7 +15,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from tablebot.engine import Engine
-from tablebot.loop import Reading, RobotIO, RunEnd, RunInfo, TickBlock, run
+from tablebot.loop import Reading, RunEnd, RunInfo, TickBlock, run
+from tablebot.sim import layout as L
+from tablebot.sim.robot import SimRobot, light_keys
 from tablebot.sim.scene import Scene
 
 PATH_STEP_M = 0.005  # a path point every 5 mm (or at a state change): what the eye can see
@@ -88,10 +90,12 @@ class PageClock:
 
 
 class HandInputs:
-    """Wraps the robot: inputs the user holds by hand (while paused) replace what the sensors read."""
+    """Wraps the simulated robot: inputs the user holds by hand (while paused) replace what the sensors
+    read; each reading also carries the bumper switches and light levels the arena draws."""
 
-    def __init__(self, robot: RobotIO):
+    def __init__(self, robot: SimRobot):
         self.robot = robot
+        self.light_keys = light_keys(robot.scene)
         self.forced: dict[int, bool] = {}  # input bit -> held on (True) or off (False)
         self.script: list[int] = []  # whole masks to read next (a counterexample), one per tick
 
@@ -105,7 +109,11 @@ class HandInputs:
             mask = self.script.pop(0)
         for bit, on in self.forced.items():
             mask = mask | bit if on else mask & ~bit
-        return Reading(mask, reading.pulses, {**(reading.extra or {}), "sensed": reading.mask})
+        s = self.robot.s
+        extra = {**(reading.extra or {}), "sensed": reading.mask,
+                 "bumpers": int(s[L.BUMP_FR] > 0) | int(s[L.BUMP_FL] > 0) << 1 | int(s[L.BUMP_REAR] > 0) << 2,
+                 "light": (float(s[L.LIGHT_R]), float(s[L.LIGHT_L]))}
+        return Reading(mask, reading.pulses, extra)
 
     def write(self, outputs: Sequence[int]) -> None:
         self.robot.write(outputs)
@@ -188,7 +196,7 @@ class FrameSink:
 class LiveRun:
     """A simulated robot running a table in a thread, through the loop, until :meth:`close`."""
 
-    def __init__(self, scene: Scene, robot: RobotIO, speed: str = "1", paused: bool = True,
+    def __init__(self, scene: Scene, robot: SimRobot, speed: str = "1", paused: bool = True,
                  on_end: Callable[[RunEnd], None] | None = None):
         self.scene = scene
         self.engine = Engine(scene.machine)

@@ -13,7 +13,8 @@ import graphviz
 from tablebot.analysis.diagram import to_graphviz
 from tablebot.diagnostics import TableBotError
 from tablebot.machine import Machine
-from tablebot.sim.scene import find_world, prepare, robot_layer
+from tablebot.sim.robot import SimRobot
+from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
 from tablebot.sim.world import World
 from tablebot.table import Table
 from tablebot.web.live import SPEEDS, LiveRun
@@ -160,7 +161,7 @@ class Arena:
                  "prev_state": latest.prev_state, "timer": latest.timer, "event": latest.event, "mask": latest.mask,
                  "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"], "path": data["path"],
                  "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
-                 "bumpers": extra.get("bumpers", 0), "light": [extra.get("light_r"), extra.get("light_l")],
+                 "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
                  "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}
         if run.paused:
             frame["why"] = explain(self.table, self.machine, latest.prev_state, latest.event)
@@ -191,13 +192,7 @@ def studio_diagram(table: Table) -> str:
         return ""
 
 
-def _robot(scene: Any, seed: int) -> Any:
-    """The simulated robot as a RobotIO: ``tablebot.sim.robot.SimRobot`` once it exists, else the stand-in."""
-    try:
-        from tablebot.sim.robot import SimRobot  # type: ignore[import-not-found]
-    except ImportError:
-        from tablebot.web.simio import SimIO
-        return SimIO(scene, seed)
-    robot = SimRobot(scene)
+def _robot(scene: Scene, seed: int) -> SimRobot:
+    robot = SimRobot(scene, record_history=False)
     robot.reset(seed=seed)
     return robot
