@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tablebot.engine import Engine
-from tablebot.loop import Reading, RunEnd, RunInfo, TickBlock, run
+from tablebot.loop import Reading, RunEnd, RunInfo, Sink, TickBlock, run
 from tablebot.sim import layout as L
 from tablebot.sim.robot import SimRobot, light_keys
 from tablebot.sim.scene import Scene
@@ -197,11 +197,12 @@ class LiveRun:
     """A simulated robot running a table in a thread, through the loop, until :meth:`close`."""
 
     def __init__(self, scene: Scene, robot: SimRobot, speed: str = "1", paused: bool = True,
-                 on_end: Callable[[RunEnd], None] | None = None):
+                 on_end: Callable[[RunEnd], None] | None = None, sinks: Sequence[Sink] = ()):
         self.scene = scene
         self.engine = Engine(scene.machine)
         self.robot = HandInputs(robot)
         self.sink = FrameSink()
+        self.sinks = [self.sink, *sinks]
         self.clock = PageClock(SPEEDS[speed], scene.tick_s, paused)
         self.speed = speed
         self.error: str | None = None
@@ -211,7 +212,7 @@ class LiveRun:
 
     def _run(self) -> None:
         try:
-            end = run(self.engine, self.robot, clock=self.clock, sinks=[self.sink], target="studio")
+            end = run(self.engine, self.robot, clock=self.clock, sinks=self.sinks, target="studio")
         except Exception as exc:  # a bug: shown on the page rather than lost in a thread
             self.error = f"{type(exc).__name__}: {exc}"
             return
