@@ -217,3 +217,43 @@ def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
     page.wait_for_function("() => document.querySelector('#trace-pick').value.startsWith('counterexample')")
     assert page.locator("#status").inner_text().startswith("tick")
     tab.shot("counterexample")
+
+
+def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path,
+                                                                  shots: Path) -> None:
+    from tablebot.cli.common import load
+    from tablebot.sim.runner import block_of, run
+    from tablebot.sim.scene import scene_for
+    from tablebot.trace import block_lines
+    from tablebot.web.replay import write_html
+
+    folder = tmp_path / "bot"
+    shutil.copytree(EXAMPLE, folder)
+    table_csv = folder / "table.csv"
+    hostile = '</script><script>window.pwned=1</script><img src=x onerror="window.pwned=2">'
+    table_csv.write_text(table_csv.read_text().replace("Seek - Turn", hostile.replace('"', '""').join('""')))
+    table, machine = load(folder)
+    scene = scene_for(table, machine)
+    result = run(scene, 30.0, 1)
+    page_file = write_html(tmp_path / "run.html", block_lines(block_of(result), machine), scene.world, table,
+                           params=scene.params)
+    text = page_file.read_text()
+    assert text.lower().count("</script") == 2
+    assert "http:" not in text.replace("http://www.w3.org/", "") and "https:" not in text  # SVG namespaces
+    context = browser.new_context(viewport={"width": 1366, "height": 768})  # type: ignore[attr-defined]
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.route("**/*", lambda route: route.abort() if not route.request.url.startswith("file:") else route.continue_())
+    page.goto(page_file.as_uri())
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')")
+    assert page.locator("table.grid tbody tr").count() == 37
+    assert page.locator('td[data-row="7"][data-col="0"] input').input_value() == hostile
+    page.locator("#scrub").fill("2000")
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 2000')")
+    assert page.locator("#diagram g.node.current").count() == 1
+    assert page.evaluate("() => window.pwned === undefined")
+    page.screenshot(path=str(shots / "replay-file.png"))
+    context.close()
+    assert errors == []

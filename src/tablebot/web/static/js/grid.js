@@ -32,7 +32,7 @@ TB.Grid = class {
     const changed = JSON.stringify(columns.map(c => c.kind)) !== JSON.stringify(this.columns.map(c => c.kind));
     this.columns = columns;
     if (tickMs) this.tickMs = tickMs;
-    if (changed) this.render();
+    if (changed && this.header) this.render();
   }
 
   kind(col) { return (this.columns[col] || {}).kind || "unknown"; }
