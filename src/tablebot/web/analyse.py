@@ -83,6 +83,12 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysi
     return Analysis(table, machine, report, data)
 
 
+def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
+    """What the grid shows when the robot file itself does not read: its errors, the columns unknown."""
+    return {"ok": False, "columns": [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()],
+            "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics], "ms": 0}
+
+
 def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
     robot = table.robot
     return {

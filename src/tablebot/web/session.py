@@ -13,7 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import TableBotError
-from tablebot.web.analyse import Analysis, analyse, explain, robot_for
+from tablebot.robot import Robot
+from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot_for
 from tablebot.web.document import CsvDocument
 from tablebot.web.simulate import Arena, ArenaSettings
 from tablebot.web.tracefile import read_trace_bytes, trace_columns
@@ -44,6 +45,8 @@ class Session:
     version: str | None = None  # digest of the file on disk this draft started from
     dirty: bool = False
     analysis: Analysis | None = None
+    robot: Robot | None = None  # the table's robot file, read when the table is opened
+    robot_error: TableBotError | None = None
     arena: Arena = field(default_factory=Arena)
 
     # --- dispatch --------------------------------------------------------------------------------------
@@ -79,6 +82,10 @@ class Session:
         except OSError as exc:
             raise ValueError(f"cannot read {self.workspace.relative(path)}: {exc.strerror}") from None
         doc = CsvDocument.from_bytes(data, self.workspace.relative(path))
+        try:
+            self.robot, self.robot_error = await asyncio.to_thread(robot_for, path), None
+        except TableBotError as exc:  # the grid still opens; the robot file's errors are listed
+            self.robot, self.robot_error = None, exc
         self.path, self.doc, self.version, self.dirty = path, doc, digest(data), False
         self.arena.close()
         self.arena = Arena()
@@ -92,8 +99,13 @@ class Session:
 
     async def reanalyse(self, seq: Any) -> None:
         assert self.doc is not None and self.path is not None
-        robot = await asyncio.to_thread(robot_for, self.path)
-        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, robot, self.workspace.relative(self.path))
+        if self.robot is None:
+            assert self.robot_error is not None
+            await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
+                             **robot_failed(self.robot_error, self.doc)})
+            return
+        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot,
+                                                self.workspace.relative(self.path))
         await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
                          **self.analysis.data})
         if self.analysis.table is not None:
