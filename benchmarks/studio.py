@@ -107,6 +107,7 @@ def live_view(folder: Path) -> None:
             page = browser.new_page(viewport={"width": 1366, "height": 768})
             page.goto(server.url)
             page.wait_for_function("() => document.querySelector('#counts').textContent.includes('states')")
+            page.wait_for_selector("#play:not([disabled])")
             print("live view in Chromium, BumberBot in its arena (100 ticks per robot second)")
             for speed, label in (("10", "10x"), ("max", "max")):
                 _measure(page, speed, label)

@@ -84,6 +84,7 @@ class Tab:
         self.page.goto(url)
         self.page.wait_for_selector("table.grid tbody tr")
         self.page.wait_for_function("() => document.querySelector('#counts').textContent.includes('states')")
+        self.page.wait_for_selector("#play:not([disabled])")  # the robot is in its arena
 
     def cell(self, row: int, col: int):  # type: ignore[no-untyped-def]
         return self.page.locator(f'td[data-row="{row}"][data-col="{col}"]')

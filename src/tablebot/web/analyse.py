@@ -8,7 +8,7 @@ and hints are the CLI's.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -64,7 +64,9 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysi
     table = machine = report = None
     diagnostics: list[dict[str, Any]] = []
     try:
-        table = table_read.parse_table(text, display, robot)
+        # the parser names the file as the page shows it; the table keeps its real path, where the
+        # simulator looks for the arena beside it
+        table = replace(table_read.parse_table(text, display, robot), path=str(path))
         machine = compile_table(table)
         props = load_properties(machine, find_property_files(path))
         report = run_check(machine, props)

@@ -75,6 +75,7 @@
     diagram(m) { diagram.setSvg(m.svg); if (state.frame) diagram.highlight(state.frame.state_id); },
     arena(m) {
       const note = $("arena-note");
+      $("play").disabled = !m.ok;
       if (!m.ok) { note.textContent = m.problem; note.hidden = false; return; }
       note.hidden = true;
       state.world = m.world; state.tickMs = m.tick_ms;
