@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
-import errno
-import socket
-import webbrowser
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import err_console, guarded
 from tablebot.diagnostics import fail
+
+if TYPE_CHECKING:
+    import socket
 
 LOCAL = "127.0.0.1"
 
@@ -26,6 +27,8 @@ def studio_cmd(
     no_browser: bool = typer.Option(False, "--no-browser", help="Do not open a browser."),
 ) -> None:
     """Edit a table in the browser, see its checks as you type, and watch the robot run it live."""
+    import webbrowser
+
     import uvicorn
 
     from tablebot.web.app import MAX_MESSAGE_BYTES, create_app
@@ -59,6 +62,9 @@ def _root_and_table(where: Path) -> tuple[Path, str | None]:
 
 
 def _bind(address: str, port: int) -> socket.socket:
+    import errno
+    import socket
+
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
