@@ -113,3 +113,19 @@ def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None
     (d,) = edited["diagnostics"]
     assert (d["row"], d["col"], d["line"], d["column"]) == (4, 9, 6, 32)
     assert d["message"] == "M1_speed: 9 is out of range 0..8" and d["hint"] == "write a whole number from 0 to 8"
+
+
+def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    replies = talk(server.url, [{"op": "open", "path": "table.csv"},
+                                {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"},
+                                {"op": "sim", "action": "step"}], until="frame", limit=20)
+    control = next(r for r in replies if r["type"] == "control")
+    assert control["paused"] and control["scripted"] == 54
+    frame = replies[-1]
+    # the first tick is explained in the initial state 2: its rows are on lines 6 to 9 and 25 to 27
+    fired = [w["line"] for w in frame["why"] if w["status"] == "fired"]
+    assert frame["tick"] == 0 and len(fired) == 1 and fired[0] in (6, 7, 8, 9, 25, 26, 27)
+    assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
+    replies = talk(server.url, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
+    assert replies[0]["message"] == "fix the table's errors first"

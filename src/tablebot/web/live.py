@@ -151,7 +151,8 @@ class FrameSink:
         self.ticks_seen = 0
 
     def start(self, info: RunInfo) -> None:
-        pass
+        with self._lock:
+            self.latest.state = info.engine.state  # the state before the first tick (why it fired)
 
     def block(self, block: TickBlock) -> None:
         extra = block.extra
@@ -163,8 +164,7 @@ class FrameSink:
                     self._fired.append([block.start + k, row])
                 if "x" in extra:
                     self._add_point(float(extra["x"][k]), float(extra["y"][k]), state)
-                latest.prev_state = latest.state if latest.tick >= 0 else state
-                latest.state = state
+                latest.prev_state, latest.state = latest.state, state
             k = len(block) - 1
             latest.tick, latest.timer, latest.event = block.start + k, int(block.timers[k]), int(block.events[k])
             latest.mask, latest.row = int(block.masks[k]), int(block.rows[k])

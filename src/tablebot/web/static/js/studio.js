@@ -111,6 +111,10 @@
       if (!state.machine) { banner("open a table that reads before playing a trace", "bad"); return; }
       player.load(m.columns, state.machine, m.at_tick);
       renderWhy([]);
+      const note = $("arena-note");
+      note.hidden = "x" in m.columns;
+      note.textContent = "this trace has no robot pose (a replay, a counterexample or a real robot): "
+        + "the table, the diagram and the timeline follow it; the arena cannot";
     },
     files(m) { fillPicks(m); },
     saved(m) { setDirty(false); banner(`saved ${m.path} (the previous version is ${m.backup})`, "good"); },
@@ -207,6 +211,7 @@
     $("trace-controls").hidden = mode !== "trace";
     $("timeline").hidden = mode !== "trace";
     player.pause();
+    if (mode === "live") $("arena-note").hidden = true;
     arena.replayPath = null;
     arena.clearPath();
     if (mode === "live") { renderInputs(); } else { send({ op: "sim", action: "pause" }); }
