@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Set up everything tablebot needs on a fresh Debian-like machine: system packages (graphviz for
-# diagrams, avr-gcc/avr-libc/simavr for firmware and its emulation) and a virtual environment.
+# diagrams, avr-gcc/avr-libc/simavr for firmware and its emulation, chromium for the studio's browser
+# tests) and a virtual environment.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config)
+SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config chromium)
 missing=()
 for pkg in "${SYSTEM_PACKAGES[@]}"; do
   dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")

@@ -1,0 +1,185 @@
+"""What the studio shows about a table as it is edited: the parser's errors on their cells, ``check``'s
+findings and property results on their rows, and why each row of a state did or did not fire.
+
+Everything comes from the same code as the CLI (``formats.table_read``, ``analysis``), so the words
+and hints are the CLI's.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from tablebot.analysis.check import CheckReport, run_check
+from tablebot.analysis.names import state_label
+from tablebot.analysis.properties import find_property_files, load_properties
+from tablebot.diagnostics import Diagnostic, TableBotError
+from tablebot.formats import table_read
+from tablebot.machine import NO_ROW, Machine, compile_table
+from tablebot.robot import BUMBERBOT, Robot, find_robot_file, load_robot
+from tablebot.table import Table
+from tablebot.web.document import CsvDocument
+
+#: Column kinds the grid draws differently (see table_read.Column.kind).
+FLAG_KINDS = ("event", "dir")
+
+
+def robot_for(table_path: Path) -> Robot:
+    """The robot a table file runs on, as the CLI finds it (a side file, else the built-in BumberBot)."""
+    side = find_robot_file(table_path)
+    return load_robot(side) if side else BUMBERBOT
+
+
+@dataclass
+class Analysis:
+    """One edit's verdict: the parsed table (None while it has errors) and what to show where."""
+
+    table: Table | None
+    machine: Machine | None
+    report: CheckReport | None
+    data: dict[str, Any] = field(default_factory=dict)
+
+
+def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
+    """Per header cell: its kind for the grid (event, dir, speed, signed, timer, state, ...) and a label."""
+    out = []
+    for text in header:
+        name = table_read._normalise(text)  # the parser's own reading of a header cell
+        kind_name = table_read._classify(name, robot) if name else None
+        kind, base = kind_name if kind_name else ("unknown", name)
+        label = robot.labels.get(base, "timer ran out" if base == "T" else "")
+        out.append({"kind": kind, "name": base, "label": label})
+    return out
+
+
+def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysis:
+    """Parse the document's text as the CLI would, then check it; located results for the grid."""
+    started = time.perf_counter()
+    text = doc.text()
+    places = _cell_places(doc)
+    lines = {line: grid for grid, line in enumerate(_row_lines(doc))}
+    header_line = _header_line(doc)
+    table = machine = report = None
+    diagnostics: list[dict[str, Any]] = []
+    try:
+        # the parser names the file as the page shows it; the table keeps its real path, where the
+        # simulator looks for the arena beside it
+        table = replace(table_read.parse_table(text, display, robot), path=str(path))
+        machine = compile_table(table)
+        props = load_properties(machine, find_property_files(path))
+        report = run_check(machine, props)
+    except TableBotError as exc:
+        diagnostics = [_locate(d, display, places, lines, header_line) for d in exc.diagnostics]
+    data: dict[str, Any] = {
+        "ok": table is not None and not diagnostics,
+        "diagnostics": diagnostics,
+        "columns": columns_of(doc.header_values(), robot),
+    }
+    if table is not None and machine is not None:
+        data["machine"] = machine_json(table, machine)
+    if report is not None:
+        data.update(_report_json(report, lines))
+    data["ms"] = round(1000 * (time.perf_counter() - started), 2)
+    return Analysis(table, machine, report, data)
+
+
+def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
+    """What the grid shows when the robot file itself does not read: its errors, the columns unknown."""
+    return {"ok": False, "columns": [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()],
+            "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics], "ms": 0}
+
+
+def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
+    robot = table.robot
+    return {
+        "states": [{"id": str(s), "label": state_label(table, s)} for s in machine.states],
+        "rows": len(table.rows), "events": list(table.events), "inputs": list(table.input_events),
+        "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
+        "motors": list(robot.motors), "tick_ms": robot.tick_ms, "initial_state": str(robot.initial_state),
+        "robot": robot.name, "labels": dict(robot.labels),
+    }
+
+
+def _report_json(report: CheckReport, lines: dict[int, int]) -> dict[str, Any]:
+    findings = [{"code": f.code, "severity": f.severity, "message": f.message, "hint": f.hint,
+                 "lines": list(f.lines), "rows": [lines[n] for n in f.lines if n in lines]} for f in report.findings]
+    props = []
+    for result in report.results:
+        prop = result.prop
+        props.append({"name": prop.name, "text": prop.text, "claim": prop.claim(), "status": result.status,
+                      "level": prop.level, "note": prop.note, "detail": result.detail,
+                      "severity": report.severity_of(result), "ticks": len(result.inputs),
+                      "at_tick": result.at_tick, "example": prop.kind == "reachable"})
+    return {"findings": findings, "properties": props, "counts": report.counts(), "situations": report.situations}
+
+
+# --- placing diagnostics ------------------------------------------------------------------------------
+
+def _cell_places(doc: CsvDocument) -> dict[tuple[int, int], tuple[int, int]]:
+    """(line, column) of each cell -> (grid row, column); the header is grid row -1."""
+    places: dict[tuple[int, int], tuple[int, int]] = {}
+    grid_of = {index: row for row, index in enumerate(doc.row_ids)}
+    for index, (record, where) in enumerate(zip(doc.records, doc.positions(), strict=True)):
+        row = -1 if record.kind == "header" else grid_of.get(index)
+        if row is None:
+            continue
+        for column, place in enumerate(where):
+            places[place] = (row, column)
+    return places
+
+
+def _row_lines(doc: CsvDocument) -> list[int]:
+    starts = doc.record_lines()
+    return [starts[index] for index in doc.row_ids]
+
+
+def _header_line(doc: CsvDocument) -> int | None:
+    starts = doc.record_lines()
+    return next((starts[i] for i, r in enumerate(doc.records) if r.kind == "header"), None)
+
+
+def _locate(d: Diagnostic, display: str, places: dict[tuple[int, int], tuple[int, int]],
+            lines: dict[int, int], header_line: int | None) -> dict[str, Any]:
+    """A diagnostic with the grid cell (or row) it belongs to; problems of other files have none."""
+    row = column = None
+    if d.path == display and d.line is not None:
+        if d.column is not None and (d.line, d.column) in places:
+            row, column = places[(d.line, d.column)]
+        elif d.line == header_line:
+            row = -1
+        else:
+            row = lines.get(d.line)
+    return {"file": d.path, "line": d.line, "column": d.column, "message": d.message, "hint": d.hint,
+            "severity": d.severity, "text": d.render(), "row": row, "col": column}
+
+
+# --- why a row fired ---------------------------------------------------------------------------------
+
+def explain(table: Table, machine: Machine, state: int, events: int) -> list[dict[str, Any]]:
+    """For each row of ``state`` (an index), in table order: fired, or why not, given the event mask."""
+    out = []
+    fired = machine.lookup(state, events)
+    names = table.events
+    for compiled in machine.rows:
+        if compiled.state != state:
+            continue
+        row = table.rows[compiled.index]
+        missing = [e for e in names if compiled.mask & table.bit(e) and not events & table.bit(e)]
+        if compiled.index == fired:
+            why = f"row {compiled.index + 1} (line {row.line}) fired: " + (
+                f"it needs {' + '.join(e for e in names if e in row.events)}, all present" if row.events
+                else "it needs nothing")
+            status = "fired"
+        elif missing:
+            why = f"row {compiled.index + 1} (line {row.line}) did not fire: it needs {' + '.join(missing)}"
+            status = "missing"
+        else:
+            why = (f"row {compiled.index + 1} (line {row.line}) did not fire: row {fired + 1} comes first "
+                   "and matches too")
+            status = "shadowed"
+        out.append({"row": compiled.index, "status": status, "why": why, "line": row.line})
+    if fired == NO_ROW:
+        out.append({"row": None, "status": "none", "why": "no row fired: nothing changes this tick"})
+    return out

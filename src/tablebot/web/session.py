@@ -1,0 +1,245 @@
+"""One browser tab's session: its table draft, the checks of every edit, saving, and its live robot.
+
+Messages in and out are plain JSON objects (``op`` in, ``type`` out); :meth:`Session.handle` answers
+one message and never raises for bad input: the page gets an ``error`` reply instead.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tablebot.diagnostics import TableBotError
+from tablebot.robot import Robot
+from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot_for
+from tablebot.web.document import CsvDocument
+from tablebot.web.simulate import Arena, ArenaSettings
+from tablebot.web.tracefile import read_trace_bytes, trace_columns
+from tablebot.web.workspace import ChangedOnDisk, OutsideFolder, Workspace, digest, save_table
+
+Send = Callable[[dict[str, Any]], Awaitable[None]]
+
+
+class Hub:
+    """Which sessions have which file open, so that a save reaches the other tabs."""
+
+    def __init__(self) -> None:
+        self.sessions: set[Session] = set()
+
+    async def saved(self, by: Session, path: Path, version: str) -> None:
+        for other in list(self.sessions):
+            if other is not by and other.path == path:
+                await other.saved_elsewhere(version)
+
+
+@dataclass(eq=False)  # sessions are compared (and hashed) by identity
+class Session:
+    workspace: Workspace
+    hub: Hub
+    send: Send
+    path: Path | None = None
+    doc: CsvDocument | None = None
+    version: str | None = None  # digest of the file on disk this draft started from
+    dirty: bool = False
+    analysis: Analysis | None = None
+    robot: Robot | None = None  # the table's robot file, read when the table is opened
+    robot_error: TableBotError | None = None
+    arena: Arena = field(default_factory=Arena)
+
+    # --- dispatch --------------------------------------------------------------------------------------
+
+    async def handle(self, message: Any) -> None:
+        if not isinstance(message, dict) or not isinstance(message.get("op"), str):
+            await self.error('a message must be a JSON object with an "op"')
+            return
+        handler = HANDLERS.get(message["op"])
+        if handler is None:
+            await self.error(f"unknown op {message['op']!r}")
+            return
+        try:
+            await handler(self, message)
+        except TableBotError as exc:
+            await self.send({"type": "error", "message": exc.diagnostics[0].message if exc.diagnostics else str(exc),
+                             "text": str(exc), "op": message["op"]})
+        except (OutsideFolder, ValueError, TypeError, KeyError) as exc:
+            await self.error(str(exc), message["op"])
+
+    async def error(self, text: str, op: str = "") -> None:
+        await self.send({"type": "error", "message": text, "op": op})
+
+    def close(self) -> None:
+        self.arena.close()
+
+    # --- the table -------------------------------------------------------------------------------------
+
+    async def open_table(self, message: dict[str, Any]) -> None:
+        path = self.workspace.resolve(_text(message, "path"))
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            raise ValueError(f"cannot read {self.workspace.relative(path)}: {exc.strerror}") from None
+        doc = CsvDocument.from_bytes(data, self.workspace.relative(path))
+        try:
+            self.robot, self.robot_error = await asyncio.to_thread(robot_for, path), None
+        except TableBotError as exc:  # the grid still opens; the robot file's errors are listed
+            self.robot, self.robot_error = None, exc
+        self.path, self.doc, self.version, self.dirty = path, doc, digest(data), False
+        self.arena.close()
+        self.arena = Arena()
+        await self.send({"type": "table", "path": self.workspace.relative(path), "header": doc.header_values(),
+                         "grid": doc.grid(), "lines": _grid_lines(doc), "version": self.version,
+                         "dialect": {"delimiter": doc.dialect.delimiter, "encoding": doc.dialect.encoding,
+                                     "newline": repr(doc.dialect.newline)[1:-1]}})
+        await self.reanalyse(None)
+        if self.analysis and self.analysis.table is not None:
+            await self.reset_arena({})
+
+    async def reanalyse(self, seq: Any) -> None:
+        assert self.doc is not None and self.path is not None
+        if self.robot is None:
+            assert self.robot_error is not None
+            await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
+                             **robot_failed(self.robot_error, self.doc)})
+            return
+        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot,
+                                                self.workspace.relative(self.path))
+        await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
+                         **self.analysis.data})
+        if self.analysis.table is not None:
+            svg = await asyncio.to_thread(self.arena.diagram, self.analysis.table)
+            await self.send({"type": "diagram", "svg": svg})
+
+    def _need_doc(self) -> CsvDocument:
+        if self.doc is None:
+            raise ValueError("open a table first")
+        return self.doc
+
+    async def edit(self, message: dict[str, Any]) -> None:
+        doc = self._need_doc()
+        doc.set_cell(_int(message, "row"), _int(message, "col"), _text(message, "value", allow_empty=True))
+        self.dirty = True
+        await self.reanalyse(message.get("seq"))
+
+    async def insert_row(self, message: dict[str, Any]) -> None:
+        doc = self._need_doc()
+        row = doc.insert_row(_int(message, "after"))
+        self.dirty = True
+        await self.send({"type": "grid", "grid": doc.grid(), "focus": row})
+        await self.reanalyse(message.get("seq"))
+
+    async def delete_row(self, message: dict[str, Any]) -> None:
+        doc = self._need_doc()
+        doc.delete_row(_int(message, "row"))
+        self.dirty = True
+        await self.send({"type": "grid", "grid": doc.grid()})
+        await self.reanalyse(message.get("seq"))
+
+    async def save(self, message: dict[str, Any]) -> None:
+        doc = self._need_doc()
+        assert self.path is not None
+        expected = None if message.get("force") is True else self.version
+        try:
+            version = await asyncio.to_thread(save_table, self.path, doc.to_bytes(), expected)
+        except ChangedOnDisk as exc:
+            await self.send({"type": "conflict", "message": f"{exc}: saving now would overwrite those changes",
+                             "hint": "reload to see them (your edits are lost), or save anyway (theirs are lost)"})
+            return
+        self.version, self.dirty = version, False
+        await self.send({"type": "saved", "version": version, "path": self.workspace.relative(self.path),
+                         "backup": self.workspace.relative(self.path) + ".bak"})
+        await self.hub.saved(self, self.path, version)
+
+    async def saved_elsewhere(self, version: str) -> None:
+        """Another tab saved this file: reload it when this tab has no edits of its own, else say so."""
+        if self.dirty:
+            await self.send({"type": "conflict", "message": "another tab saved this table; yours has unsaved edits",
+                             "hint": "reload to take theirs, or save anyway to keep yours"})
+            return
+        assert self.path is not None
+        await self.open_table({"path": self.workspace.relative(self.path), "reason": "saved in another tab"})
+        await self.send({"type": "notice", "message": "reloaded: the table was saved in another tab"})
+
+    # --- the arena -------------------------------------------------------------------------------------
+
+    async def reset_arena(self, message: dict[str, Any]) -> None:
+        if self.analysis is None or self.analysis.table is None or self.analysis.machine is None:
+            raise ValueError("fix the table's errors first: the robot runs only a table that reads")
+        settings = ArenaSettings.of(message, self.arena.settings)
+        info = await asyncio.to_thread(self.arena.reset, self.analysis.table, self.analysis.machine, settings)
+        await self.send({"type": "arena", **info})
+
+    async def control(self, message: dict[str, Any]) -> None:
+        action = _text(message, "action")
+        if action == "reset":
+            await self.reset_arena(message)
+            return
+        self.arena.control(action, message)
+        await self.send({"type": "control", **self.arena.status()})
+
+    async def frame(self) -> None:
+        """Send what the live robot did since the last frame (called by the app's timer)."""
+        frame = self.arena.frame(explain)
+        if frame is not None:
+            await self.send(frame)
+
+    # --- traces ----------------------------------------------------------------------------------------
+
+    async def open_trace(self, message: dict[str, Any]) -> None:
+        path = self.workspace.resolve(_text(message, "path"))
+        data = await asyncio.to_thread(path.read_bytes)
+        await self.send_trace(data, self.workspace.relative(path))
+
+    async def send_trace(self, data: bytes, name: str) -> None:
+        lines = await asyncio.to_thread(read_trace_bytes, data, name)
+        await self.send({"type": "trace", "name": name, "columns": trace_columns(lines)})
+
+    async def counterexample(self, message: dict[str, Any]) -> None:
+        """A property's counterexample: replayed on the table (trace player) or scripted into the arena."""
+        if self.analysis is None or self.analysis.report is None:
+            raise ValueError("fix the table's errors first")
+        name = _text(message, "name")
+        result = next((r for r in self.analysis.report.results if r.prop.name == name), None)
+        if result is None or not result.inputs:
+            raise ValueError(f"property {name!r} has no counterexample")
+        if message.get("where") == "arena":
+            await self.reset_arena({})
+            self.arena.control("script", {"masks": [t.mask for t in result.inputs]})
+            await self.send({"type": "control", **self.arena.status()})
+            return
+        from tablebot.trace import replay
+        lines = list(replay(self.analysis.report.machine, result.inputs))
+        await self.send({"type": "trace", "name": f"counterexample: {name}", "columns": trace_columns(lines),
+                         "at_tick": result.at_tick})
+
+
+def _grid_lines(doc: CsvDocument) -> list[int]:
+    starts = doc.record_lines()
+    return [starts[i] for i in doc.row_ids]
+
+
+def _text(message: dict[str, Any], key: str, allow_empty: bool = False) -> str:
+    value = message.get(key)
+    if not isinstance(value, str) or (not value and not allow_empty):
+        raise ValueError(f'"{key}" must be text')
+    return value
+
+
+def _int(message: dict[str, Any], key: str) -> int:
+    value = message.get(key)
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise ValueError(f'"{key}" must be a whole number')
+    return value
+
+
+async def _list(session: Session, message: dict[str, Any]) -> None:
+    await session.send({"type": "files", **session.workspace.listing()})
+
+
+HANDLERS: dict[str, Callable[[Session, dict[str, Any]], Awaitable[None]]] = {
+    "open": Session.open_table, "edit": Session.edit, "insert_row": Session.insert_row,
+    "delete_row": Session.delete_row, "save": Session.save, "sim": Session.control,
+    "trace": Session.open_trace, "counterexample": Session.counterexample, "files": _list,
+}

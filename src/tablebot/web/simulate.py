@@ -1,0 +1,198 @@
+"""A tab's arena: the world (with the start pose and lamp the user moved), its settings (seed, battery,
+speed), the live run of the table in it, and the frames the page draws."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
+
+import graphviz
+
+from tablebot.analysis.diagram import to_graphviz
+from tablebot.diagnostics import TableBotError
+from tablebot.machine import Machine
+from tablebot.sim.robot import SimRobot
+from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
+from tablebot.sim.world import World
+from tablebot.table import Table
+from tablebot.web.live import SPEEDS, LiveRun
+from tablebot.web.worldview import moved, world_json
+
+MAX_SEED = 2**31 - 1
+
+
+def _number(message: dict[str, Any], key: str, low: float, high: float) -> float | None:
+    value = message.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ValueError(f'"{key}" must be a number')
+    if not low <= value <= high:
+        raise ValueError(f'"{key}" must be from {low:g} to {high:g}')
+    return float(value)
+
+
+@dataclass(frozen=True)
+class ArenaSettings:
+    seed: int = 1
+    charge: float | None = None  # None: the world's (or robot's) battery charge
+    start: tuple[float, float, float] | None = None  # None: the world's start pose
+    lamp: tuple[float, float] | None = None
+    speed: str = "1"
+    paused: bool = True
+
+    @classmethod
+    def of(cls, message: dict[str, Any], old: ArenaSettings) -> ArenaSettings:
+        """The settings a reset message asks for; what it leaves out stays as it was."""
+        seed = _number(message, "seed", 0, MAX_SEED)
+        charge = _number(message, "charge", 0.0, 1.0)
+        start, lamp = old.start, old.lamp
+        if "start" in message:
+            x, y, heading = (_number({"v": v}, "v", -1e3, 1e3) for v in _triple(message["start"]))
+            start = (x, y, heading)  # type: ignore[assignment]
+        if "lamp" in message:
+            pair = message["lamp"]
+            if not isinstance(pair, list) or len(pair) != 2:
+                raise ValueError('"lamp" must be [x, y]')
+            lamp = (_number({"v": pair[0]}, "v", -1e3, 1e3), _number({"v": pair[1]}, "v", -1e3, 1e3))  # type: ignore
+        speed = message.get("speed", old.speed)
+        if speed not in SPEEDS:
+            raise ValueError(f"speed must be one of {', '.join(SPEEDS)}")
+        paused = message.get("paused", old.paused)
+        return cls(int(seed) if seed is not None else old.seed, charge if charge is not None else old.charge,
+                   start, lamp, speed, bool(paused))
+
+
+def _triple(value: Any) -> list[Any]:
+    if not isinstance(value, list) or len(value) != 3:
+        raise ValueError('"start" must be [x, y, heading]')
+    return value
+
+
+class Arena:
+    """The live robot of one tab (None until the table reads)."""
+
+    def __init__(self) -> None:
+        self.settings = ArenaSettings()
+        self.run: LiveRun | None = None
+        self.table: Table | None = None
+        self.machine: Machine | None = None
+        self._diagram: tuple[Any, str] | None = None
+        self.problem: str | None = None
+
+    def reset(self, table: Table, machine: Machine, settings: ArenaSettings) -> dict[str, Any]:
+        """Start the table over in the world with ``settings``; a world problem is reported, not raised."""
+        self.close()
+        self.settings, self.table, self.machine = settings, table, machine
+        try:
+            layer, robot_world = robot_layer(table.robot)
+            base: World = find_world(table, None, robot_world)
+            world = moved(base, settings.start, settings.lamp)
+            overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}
+            scene = prepare(table, machine, world, layer, overrides)
+        except TableBotError as exc:
+            self.problem = str(exc)
+            return {"ok": False, "problem": self.problem}
+        self.problem = None
+        self.run = LiveRun(scene, _robot(scene, settings.seed), settings.speed, settings.paused)
+        return {"ok": True, "world": world_json(world, scene.params), "tick_ms": table.robot.tick_ms,
+                "settings": {"seed": settings.seed, "charge": scene.params["battery"]["charge"],
+                             "speed": settings.speed, "start": list(world.start)}, **self.status()}
+
+    def control(self, action: str, message: dict[str, Any]) -> None:
+        run = self.run
+        if run is None:
+            raise ValueError(self.problem or "the robot is not running: fix the table first")
+        if action == "play":
+            run.play()
+        elif action == "pause":
+            run.pause()
+        elif action == "step":
+            run.step()
+        elif action == "speed":
+            speed = message.get("speed")
+            if speed not in SPEEDS:
+                raise ValueError(f"speed must be one of {', '.join(SPEEDS)}")
+            run.set_speed(speed)
+            self.settings = replace(self.settings, speed=speed)
+        elif action == "hold":
+            self._hold(run, message)
+        elif action == "script":
+            masks = message.get("masks")
+            if not isinstance(masks, list) or not all(isinstance(m, int) for m in masks):
+                raise ValueError('"masks" must be a list of whole numbers')
+            run.pause()
+            run.play_script(masks)
+        else:
+            raise ValueError(f"unknown action {action!r}")
+
+    def _hold(self, run: LiveRun, message: dict[str, Any]) -> None:
+        assert self.machine is not None
+        name, on = message.get("input"), message.get("on")
+        bits = self.machine.input_bits
+        if name not in bits:
+            raise ValueError(f"unknown input {name!r}: the robot's inputs are {', '.join(bits)}")
+        if on not in (True, False, None):
+            raise ValueError('"on" must be true, false or null')
+        run.hold(bits[name], on)
+
+    def status(self) -> dict[str, Any]:
+        run = self.run
+        if run is None:
+            return {"running": False, "paused": True, "speed": self.settings.speed, "held": {}}
+        bits = self.machine.input_bits if self.machine else {}
+        held = {name: run.robot.forced[bit] for name, bit in bits.items() if bit in run.robot.forced}
+        return {"running": run.running, "paused": run.paused, "speed": run.speed, "held": held,
+                "scripted": len(run.robot.script), "error": run.error}
+
+    def frame(self, explain: Callable[..., list[dict[str, Any]]]) -> dict[str, Any] | None:
+        run = self.run
+        if run is None or self.table is None or self.machine is None:
+            return None
+        data = run.sink.frame()
+        if data is None:
+            return None
+        latest = data["latest"]
+        states = self.machine.states
+        extra = latest.extra or {}
+        frame = {"type": "frame", "tick": latest.tick, "state": latest.state, "state_id": str(states[latest.state]),
+                 "prev_state": latest.prev_state, "timer": latest.timer, "event": latest.event, "mask": latest.mask,
+                 "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"], "path": data["path"],
+                 "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
+                 "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
+                 "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}
+        if run.paused:
+            frame["why"] = explain(self.table, self.machine, latest.prev_state, latest.event)
+        return frame
+
+    def diagram(self, table: Table) -> str:
+        """The state diagram as SVG text (cached per table; Graphviz takes tens of milliseconds)."""
+        key = (table.rows, table.events, table.robot)
+        if self._diagram is None or self._diagram[0] != key:
+            svg = studio_diagram(table)
+            self._diagram = (key, svg)
+        return self._diagram[1]
+
+    def close(self) -> None:
+        if self.run is not None:
+            self.run.close()
+            self.run = None
+
+
+def studio_diagram(table: Table) -> str:
+    """The CLI's diagram without its title and legend (the page shows both); "" without Graphviz."""
+    graph = to_graphviz(table)
+    graph.graph_attr.update(label="", ranksep="0.5", nodesep="0.25")
+    graph.body[:] = [line for line in graph.body if "__legend" not in line]  # the grid's header says it all
+    try:
+        return graph.pipe(format="svg").decode("utf-8")
+    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError):
+        return ""
+
+
+def _robot(scene: Scene, seed: int) -> SimRobot:
+    robot = SimRobot(scene, record_history=False)
+    robot.reset(seed=seed)
+    return robot

@@ -1,0 +1,59 @@
+"""Trace files (``sim``, a real robot run, firmware ``monitor``) read into columns for the trace player,
+with a located error for a line that is not a trace line."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from typing import Any
+
+from tablebot.diagnostics import Collector, fail
+
+#: An hour of BumberBot simulation is ~40 MB of JSON Lines.
+MAX_TRACE_BYTES = 64 * 1024 * 1024
+REQUIRED = ("tick", "state")
+#: Columns the player draws when a trace has them (core fields, then the simulator's pose).
+KNOWN = ("tick", "event", "row", "state", "timer", "x", "y", "heading", "battery_v")
+
+
+def trace_columns(lines: Iterable[dict[str, Any]]) -> dict[str, list[Any]]:
+    """Trace lines as columns: every key that any line has (missing values are null)."""
+    rows = list(lines)
+    keys: dict[str, None] = {}
+    for line in rows:
+        for key in line:
+            keys.setdefault(key, None)
+    return {key: [line.get(key) for line in rows] for key in keys}
+
+
+def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
+    """Parse JSON Lines; every bad line is reported (the first ten) with its number."""
+    if len(data) > MAX_TRACE_BYTES:
+        raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_TRACE_BYTES:,}",
+                   "cut the run shorter (--seconds) or open a part of it")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise fail(name, f"byte {exc.start} is not UTF-8 text", "a trace is JSON Lines text") from None
+    out = Collector(name)
+    lines: list[dict[str, Any]] = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if not raw.strip():
+            continue
+        try:
+            value = json.loads(raw)
+        except json.JSONDecodeError as exc:
+            out.error(number, exc.colno, f"not JSON: {exc.msg}", "each line of a trace is one JSON object")
+        else:
+            missing = [k for k in REQUIRED if not isinstance(value, dict) or k not in value]
+            if missing:
+                out.error(number, 1, f"a trace line needs {' and '.join(missing)}",
+                          "open a trace.jsonl written by tablebot sim, trace, run or monitor")
+            else:
+                lines.append(value)
+        if len(out.items) >= 10:
+            break
+    out.raise_if_any()
+    if not lines:
+        raise fail(name, "the trace has no lines", "open a trace.jsonl written by tablebot")
+    return lines

@@ -1,0 +1,131 @@
+"""The studio's server without a browser: a real server on a real socket, spoken to over WebSocket and HTTP.
+Bad messages get error replies and never end the server; nothing outside the folder is served."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import shutil
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import websockets
+
+from core_helpers import EXAMPLE
+from tablebot.web.app import Background
+
+
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Background, Path]]:
+    root = tmp_path_factory.mktemp("studio-server") / "bumberbot"
+    shutil.copytree(EXAMPLE, root)
+    (root.parent / "secret.csv").write_text("state,next\n1,1\n")
+    server = Background(root)
+    yield server, root
+    server.stop()
+
+
+def talk(url: str, messages: list[Any], until: str, limit: int = 20, seq: int | None = None) -> list[dict[str, Any]]:
+    """Send the messages (text as is, anything else as JSON) and collect replies up to one of type ``until``
+    (with ``seq``, if given)."""
+
+    async def run() -> list[dict[str, Any]]:
+        replies: list[dict[str, Any]] = []
+        async with websockets.connect(url.replace("http", "ws") + "ws", max_size=2**24) as ws:
+            for message in messages:
+                await ws.send(message if isinstance(message, str) else json.dumps(message))
+            while len(replies) < limit:
+                reply = json.loads(await asyncio.wait_for(ws.recv(), 10))
+                replies.append(reply)
+                if reply["type"] == until and (seq is None or reply.get("seq") == seq):
+                    break
+        return replies
+
+    return asyncio.run(run())
+
+
+def test_malformed_messages_get_error_replies_and_the_server_goes_on(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    bad = ["not json", "[1, 2]", {"op": 5}, {"op": "explode"}, {"op": "edit", "row": 0, "col": 0, "value": "x"},
+           {"op": "open", "path": 7}, {"op": "sim", "action": "play"}, {"op": "open", "path": "table.csv"},
+           {"op": "edit", "row": "zero", "col": 1, "value": "1"}, {"op": "edit", "row": 999, "col": 1, "value": "1"},
+           {"op": "sim", "action": "speed", "speed": "warp"},
+           {"op": "sim", "action": "hold", "input": "I99", "on": True},
+           {"op": "sim", "action": "reset", "seed": -4}, {"op": "sim", "action": "reset", "charge": "full"}]
+    replies = talk(server.url, [*bad, {"op": "files"}], until="files", limit=40)
+    errors = [r["message"] for r in replies if r["type"] == "error"]
+    assert errors[:7] == ["not JSON: Expecting value", 'a message must be a JSON object with an "op"',
+                          'a message must be a JSON object with an "op"', "unknown op 'explode'",
+                          "open a table first", '"path" must be text',
+                          "the robot is not running: fix the table first"]
+    assert errors[7:] == ['"row" must be a whole number', "there is no row 1000", "speed must be one of 1, 10, max",
+                          "unknown input 'I99': the robot's inputs are I3, I4, I5, I7, I8",
+                          '"seed" must be from 0 to 2.14748e+09', '"charge" must be a number']
+    assert replies[-1]["type"] == "files" and "table.csv" in replies[-1]["tables"]
+    assert "trace.jsonl" not in replies[-1]["tables"]
+
+
+@pytest.mark.parametrize("path", ["../secret.csv", "/etc/passwd", "sub/../../secret.csv", "link.csv"])
+def test_nothing_outside_the_folder_is_opened(studio: tuple[Background, Path], path: str) -> None:
+    server, root = studio
+    link = root / "link.csv"
+    if not link.exists():
+        link.symlink_to(root.parent / "secret.csv")
+    replies = talk(server.url, [{"op": "open", "path": path}, {"op": "trace", "path": path}], until="error", limit=1)
+    assert replies[0]["type"] == "error" and "outside the served folder" in replies[0]["message"]
+
+
+def test_static_files_stay_in_the_package(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    for path in ("static/../app.py", "static/%2e%2e/app.py", "static/..%2fapp.py", "table.csv"):
+        with pytest.raises(urllib.error.HTTPError) as err:
+            urllib.request.urlopen(server.url + path)
+        assert err.value.code == 404
+    page = urllib.request.urlopen(server.url)
+    assert "script-src 'self'" in page.headers["Content-Security-Policy"]
+    assert b"http" not in urllib.request.urlopen(server.url + "static/js/studio.js").read().replace(
+        b"location.protocol === \"https:\"", b"")  # no script is fetched from anywhere else
+
+
+def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    good = b'{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}\n'
+    reply = json.load(urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=good)))
+    assert reply["type"] == "trace" and reply["columns"]["state"] == [1]
+    with pytest.raises(urllib.error.HTTPError) as err:
+        bad = good + b'{"tick":1}\n'
+        urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=bad))
+    assert err.value.code == 400
+    assert "t.jsonl:2:1: error: a trace line needs state" in json.load(err.value)["message"]
+
+
+def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    replies = talk(server.url, [{"op": "open", "path": "table.csv"},
+                                {"op": "edit", "row": 4, "col": 9, "value": "9", "seq": 1}], until="analysis", seq=1)
+    first, edited = (r for r in replies if r["type"] == "analysis")
+    assert first["ok"] and first["machine"]["rows"] == 37 and len(first["machine"]["states"]) == 10
+    assert not edited["ok"] and "machine" not in edited
+    (d,) = edited["diagnostics"]
+    assert (d["row"], d["col"], d["line"], d["column"]) == (4, 9, 6, 32)
+    assert d["message"] == "M1_speed: 9 is out of range 0..8" and d["hint"] == "write a whole number from 0 to 8"
+
+
+def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, Path]) -> None:
+    server, _ = studio
+    replies = talk(server.url, [{"op": "open", "path": "table.csv"},
+                                {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"},
+                                {"op": "sim", "action": "step"}], until="frame", limit=20)
+    control = next(r for r in replies if r["type"] == "control")
+    assert control["paused"] and control["scripted"] == 54
+    frame = replies[-1]
+    # the first tick is explained in the initial state 2: its rows are on lines 6 to 9 and 25 to 27
+    fired = [w["line"] for w in frame["why"] if w["status"] == "fired"]
+    assert frame["tick"] == 0 and len(fired) == 1 and fired[0] in (6, 7, 8, 9, 25, 26, 27)
+    assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
+    replies = talk(server.url, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
+    assert replies[0]["message"] == "fix the table's errors first"
