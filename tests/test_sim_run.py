@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -134,3 +135,15 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
     assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_ON) and robot.glows[0].get_alpha() > 0
     robot.update(1.0, 1.0, 0.0, lamps=(0,))
     assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_OFF) and robot.glows[0].get_alpha() == 0
+
+
+def test_cli_html_replay_is_one_self_contained_page(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "5", "--out", str(out), "--html",
+                                      "--no-plots", "-q"])
+    assert result.exit_code == 0, result.output
+    page = (out / "run.html").read_text(encoding="utf-8")
+    assert page.startswith("<!doctype html>") and "default-src 'none'" in page
+    assert not re.search(r"""(src|href|url)\s*[=(]\s*["']?https?:""", page)  # nothing fetched (SVG namespaces aside)
+    first = (out / "trace.jsonl").read_text(encoding="utf-8").splitlines()[0]
+    assert json.loads(first)["tick"] == 0 and '"battery_v"' in page

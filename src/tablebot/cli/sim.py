@@ -28,12 +28,14 @@ def sim_cmd(
     view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif, an animation of the run."),
     plots: bool = typer.Option(True, "--plots/--no-plots", help="Write trajectory.png and timeline.png."),
+    html: bool = typer.Option(False, "--html", help="Also write run.html: the run replayed in any browser, "
+                              "no server needed (arena, timeline, table and state diagram)."),
     charge: float | None = typer.Option(None, "--battery", min=0.0, max=1.0,
                                         help="Battery charge at the start, 0..1 (overrides the world)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no summary."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
-    """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif).
+    """Simulate the robot running TABLE: trace.jsonl, trajectory.png, timeline.png (and run.gif, run.html).
 
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
@@ -59,6 +61,8 @@ def sim_cmd(
         _stopped(result, trace.written)
     summary = summarise(result)
     written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
+    if html:
+        written.append(_replay_page(result, out / "run.html"))
     if not quiet:
         _report(result, summary, written)
     if view:
@@ -85,6 +89,17 @@ def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: boo
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))
     return written
+
+
+def _replay_page(result: Result, path: Path) -> Path:
+    """A self-contained HTML page that replays the run (to send to a pupil, or put on a class page)."""
+    from tablebot.sim.runner import block_of
+    from tablebot.trace import block_lines
+    from tablebot.web.replay import write_html
+
+    scene = result.scene
+    lines = block_lines(block_of(result), scene.machine)
+    return write_html(path, lines, scene.world, scene.table, params=scene.params)
 
 
 def _report(result: Result, summary: Summary, written: list[Path]) -> None:
