@@ -122,23 +122,25 @@ def linear_scan(machine: Machine, masks: Sequence[int]) -> Result:
     return machine.states[scan.state], scan.timer, scan.outputs
 
 
-def bare_tables(machine: Machine) -> list[dict[int, tuple[int, int, tuple[int | None, ...], bool]]]:
-    """Per state: full event mask -> (next, timer, outputs, keeps), for every mask that fires a row."""
+def bare_tables(machine: Machine) -> list[dict[int, tuple[int, int, int, tuple[int | None, ...], bool]]]:
+    """Per state: full event mask -> (row, next, timer, outputs, keeps), for every mask that fires a row."""
     width = len(machine.table.events)
-    tables: list[dict[int, tuple[int, int, tuple[int | None, ...], bool]]] = []
+    tables: list[dict[int, tuple[int, int, int, tuple[int | None, ...], bool]]] = []
     for state in range(len(machine.states)):
         rows = [row for row in machine.rows if row.state == state]
-        tables.append({events: (row.next, row.timer, row.outputs, row.keeps)
+        tables.append({events: (row.index, row.next, row.timer, row.outputs, row.keeps)
                        for events in range(1 << width) if (row := first_match(rows, events)) is not None})
     return tables
 
 
 class BareStep:
-    """The dispatch dicts behind a ``step`` method: the least a closed-loop Python engine must do per tick."""
+    """The dispatch dicts behind a ``step`` method doing the engine's job per tick (count down, look up,
+    apply; keep tick, state, timer, outputs, and the event set and fired row a trace needs), with
+    nothing else: no input checks, no counters. The least a closed-loop Python engine must do."""
 
     def __init__(self, machine: Machine):
         self.tables, self.timer_bit = bare_tables(machine), machine.timer_bit
-        self.state, self.timer, self.tick = machine.initial_state, machine.initial_timer, 0
+        self.state, self.timer, self.tick, self.event, self.row = machine.initial_state, machine.initial_timer, 0, 0, -1
         self.outputs: tuple[int | None, ...] = (0,) * len(machine.output_names)
 
     def step(self, mask: int) -> tuple[int | None, ...]:
@@ -146,9 +148,13 @@ class BareStep:
         if self.tick and timer:
             timer -= 1
         self.tick += 1
-        hit = self.tables[self.state].get(mask | self.timer_bit if timer == 0 else mask)
-        if hit is not None:
-            self.state, timer, new, keeps = hit
+        events = mask | self.timer_bit if timer == 0 else mask
+        self.event = events
+        hit = self.tables[self.state].get(events)
+        if hit is None:
+            self.row = -1
+        else:
+            self.row, self.state, timer, new, keeps = hit
             self.outputs = tuple(o if n is None else n for o, n in zip(self.outputs, new, strict=True)) if keeps \
                 else new
         self.timer = timer
@@ -173,7 +179,7 @@ def bare_loop(machine: Machine, masks: Sequence[int]) -> Result:
             timer -= 1
         hit = tables[state].get(mask | t_bit if timer == 0 else mask)
         if hit is not None:
-            state, timer, new, keeps = hit
+            _, state, timer, new, keeps = hit
             out = tuple(o if n is None else n for o, n in zip(out, new, strict=True)) if keeps else new
     return machine.states[state], timer, out
 
