@@ -3,14 +3,14 @@ between the same two states merged), coloured by the motion they start; Graphviz
 
 from __future__ import annotations
 
-import html
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import graphviz
 
 from tablebot.analysis.names import state_label
 from tablebot.diagnostics import fail
+from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
@@ -113,32 +113,44 @@ def _sides(table: Table) -> tuple[int, int] | None:
 
 def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
     robot = table.robot
-    graph = graphviz.Digraph(robot.name, graph_attr={
+    ids = state_ids(table.states, dot_id)
+    # Every user text goes into HTML-like labels (<…>): the only Graphviz strings without escapes of their own.
+    graph = graphviz.Digraph("tablebot", graph_attr={
         "rankdir": "TB", "fontname": "Helvetica", "fontsize": "11", "nodesep": "0.35", "ranksep": "0.9",
-        "labelloc": "t", "label": f"{robot.name}: {table.path}", "pad": "0.2"})
+        "labelloc": "t", "label": f"<{dot_label(f'{robot.name}: {table.path}')}>", "pad": "0.2"})
     graph.attr("node", shape="box", style="rounded,filled", fillcolor="#f4f4f4", fontname="Helvetica",
                fontsize="12", color="#555555")
     graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
     graph.node("__start", "", shape="circle", style="filled", fillcolor="black", width="0.18")
     for state in table.states:
         label = state_label(table, state)
-        title = f"<<b>{html.escape(str(state))}</b>" + (f"<br/>{html.escape(label)}>" if label else ">")
+        title = f"<<b>{dot_label(str(state))}</b>" + (f"<br/>{dot_label(label)}>" if label else ">")
         initial = state == robot.initial_state
-        graph.node(_id(state), title, penwidth="2.5" if initial else "1",
+        graph.node(ids[state], title, penwidth="2.5" if initial else "1",
                    fillcolor="#fff7d6" if initial else "#f4f4f4")
-    graph.edge("__start", _id(robot.initial_state), label=f" start, timer {robot.initial_timer}")
+    graph.edge("__start", ids[robot.initial_state], label=f"< start, timer {robot.initial_timer}>")
     for edge in edges(table):
         first = edge.lines[0][1].motion
         same = all(a.motion == first for _, a in edge.lines)
-        graph.edge(_id(edge.source), _id(edge.target), label=_html_label(edge, colour),
+        graph.edge(ids[edge.source], ids[edge.target], label=_html_label(edge, colour),
                    color=COLOURS[first] if colour and same else "#666666",
                    penwidth="1.6" if colour and same else "1.0")
     graph.node("__legend", _legend(table, colour), shape="plain", fontsize="9")
     return graph
 
 
-def _id(state: StateId) -> str:
-    return f"s_{state}"
+def state_ids(states: Sequence[StateId], safe: Callable[[str], str]) -> dict[StateId, str]:
+    """Diagram ids (``s_20``, ``s_seek``) made safe by ``safe``; states whose names differ only in
+    characters an id cannot hold (``a.b``, ``a-b``) get a number to stay apart."""
+    ids: dict[StateId, str] = {}
+    for state in states:
+        base = safe(f"s_{state}")
+        mid, count = base, 1
+        while mid in ids.values():
+            count += 1
+            mid = f"{base}_{count}"
+        ids[state] = mid
+    return ids
 
 
 def _html_label(edge: Edge, colour: bool) -> str:
@@ -147,18 +159,18 @@ def _html_label(edge: Edge, colour: bool) -> str:
     rows = []
     for cond, act in edge.lines:
         timer = f" · {act.timer}" if act.timer and not shared else ""
-        text = f"<b>{html.escape(cond)}</b> → {html.escape(act.text)}{html.escape(timer)}"
+        text = f"<b>{dot_label(cond)}</b> → {dot_label(act.text)}{dot_label(timer)}"
         if colour:
             text = f'<font color="{COLOURS[act.motion]}">{text}</font>'
         rows.append(text)
     if shared and next(iter(timers)):
-        rows.append(f"timer {html.escape(next(iter(timers)))}")
+        rows.append(f"timer {dot_label(next(iter(timers)))}")
     return "<" + "<br/>".join(rows) + ">"
 
 
 def _legend(table: Table, colour: bool) -> str:
     robot = table.robot
-    cells = [f"<b>{html.escape(name)}</b> {html.escape(robot.labels.get(name, ''))}"
+    cells = [f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}"
              for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
     cells.insert(0, "<b>T</b> timer ran out")
     cells.append("times: timer loaded by the row")
@@ -189,35 +201,21 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
 
 def to_mermaid(table: Table) -> str:
     """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""
-    ids = _mermaid_ids(table.states)
+    ids = state_ids(table.states, _mermaid_id)
     out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {ids[table.robot.initial_state]}"]
     for state in table.states:
         label = state_label(table, state)
-        name = f"{state}: {label}" if label else str(state)
-        out.append(f'    state "{_mermaid_text(name)}" as {ids[state]}')
+        name = f"{state} - {label}" if label else str(state)
+        out.append(f'    state "{mermaid_label(name)}" as {ids[state]}')
     for edge in edges(table):
         parts = []
         for cond, act in edge.lines:
             timer = f" {act.timer}" if act.timer else ""
             parts.append(f"{cond} / {act.text}{timer}")
-        out.append(f"    {ids[edge.source]} --> {ids[edge.target]}: {_mermaid_text('; '.join(parts))}")
+        out.append(f"    {ids[edge.source]} --> {ids[edge.target]}: {mermaid_label(', '.join(parts))}")
     return "\n".join(out) + "\n"
 
 
-def _mermaid_ids(states: Sequence[StateId]) -> dict[StateId, str]:
-    """Mermaid ids (``s_20``, ``s_seek``): ASCII letters, digits and ``_``, so names that differ only
-    in other characters (``a.b``, ``a-b``) get a number to stay apart."""
-    ids: dict[StateId, str] = {}
-    for state in states:
-        base = "s_" + "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in str(state))
-        mid, count = base, 1
-        while mid in ids.values():
-            count += 1
-            mid = f"{base}_{count}"
-        ids[state] = mid
-    return ids
-
-
-def _mermaid_text(text: str) -> str:
-    # Mermaid reads ':' and quotes as syntax inside labels; '#' starts an entity.
-    return text.replace('"', "'").replace(":", " -").replace("#", "no.")
+def _mermaid_id(text: str) -> str:
+    """Mermaid ids: ASCII letters, digits and ``_``."""
+    return "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in text)

@@ -8,7 +8,6 @@ from enum import StrEnum
 from pathlib import Path
 
 import typer
-from rich.markup import escape
 
 from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
 from tablebot.analysis.diagram import FORMATS, render
@@ -32,6 +31,7 @@ from tablebot.cli.common import (
     writing,
 )
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.escape import terminal
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
 
@@ -90,8 +90,8 @@ def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | 
 def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
     machine = report.machine
     table = machine.table
-    console.print(f"[bold]{escape(table.path)}[/bold]: {len(table.rows)} rows, {len(machine.states)} states, "
-                  f"robot {escape(table.robot.name)}; {report.situations} situations explored")
+    console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
+                  f"robot {terminal(table.robot.name)}; {report.situations} situations explored")
     hidden: dict[str, int] = {}
     for finding in report.findings:
         if finding.severity == "info" and not verbose:
@@ -100,7 +100,7 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
         _print_finding(table.path, finding)
     if report.results:
         sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
-        console.print(f"\n[bold]properties[/bold] ({escape(sources)}):")
+        console.print(f"\n[bold]properties[/bold] ({terminal(sources)}):")
         for result in report.results:
             _print_result(report, result, table_arg, verbose)
     counts = report.counts()
@@ -114,9 +114,10 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
 def _print_finding(path: str, finding: Finding) -> None:
     where = f"{path}:{finding.lines[0]}" if finding.lines else path
     colour = COLOURS[finding.severity]
-    console.print(f"[bold]{escape(where)}[/bold]: [{colour}]{finding.severity}[/{colour}]: {escape(finding.message)}")
+    console.print(f"[bold]{terminal(where)}:[/bold] [{colour}]{finding.severity}[/{colour}]: "
+                  f"{terminal(finding.message)}")
     if finding.hint:
-        console.print(f"    [dim]hint:[/dim] {escape(finding.hint)}")
+        console.print(f"    [dim]hint:[/dim] {terminal(finding.hint)}")
 
 
 def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool) -> None:
@@ -124,25 +125,25 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
     marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
              "unknown": "[yellow]unknown [/yellow]"}
     level = f" [dim]({prop.level})[/dim]" if result.status == "violated" and prop.level != "error" else ""
-    console.print(f"  {marks[result.status]} [bold]{escape(prop.name)}[/bold]{level}: {escape(prop.text)}")
+    console.print(f"  {marks[result.status]} [bold]{terminal(prop.name)}[/bold]{level}: {terminal(prop.text)}")
     if verbose or result.failed:
-        console.print(f"           [dim]{escape(prop.claim())}; {result.explored} situations[/dim]")
+        console.print(f"           [dim]{terminal(prop.claim())}; {result.explored} situations[/dim]")
     if result.detail:
-        console.print(f"           {escape(result.detail)}")
+        console.print(f"           {terminal(result.detail)}")
     if prop.note and result.failed:
-        console.print(f"           note: {escape(prop.note)}")
+        console.print(f"           note: {terminal(prop.note)}")
     if not result.inputs:
         return
     path = report.counterexamples.get(prop.name)
     kind = "example" if prop.kind == "reachable" else "counterexample"
     shortest = "shortest " if result.exact else ""
-    written = f", written to {escape(str(path))}" if path else " (not written)"
+    written = f", written to {terminal(str(path))}" if path else " (not written)"
     console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks{written}")
     if path:
-        console.print(f"           replay: tablebot trace {escape(str(table_arg))} --inputs {escape(str(path))}")
+        console.print(f"           replay: tablebot trace {terminal(str(table_arg))} --inputs {terminal(str(path))}")
     if result.failed or verbose:
         for line in story(report.machine, result):
-            console.print(f"             {escape(line)}")
+            console.print(f"             {terminal(line)}")
 
 
 @app.command("tests")
@@ -158,14 +159,14 @@ def tests_cmd(
     golden = generate(machine)
     write_golden(golden, out_folder(out, "--out"))
     for seq in golden.sequences:
-        console.print(f"wrote {escape(str(out / seq.inputs_name))} and {escape(seq.trace_name)} "
+        console.print(f"wrote {terminal(str(out / seq.inputs_name))} and {terminal(seq.trace_name)} "
                       f"({len(seq.inputs)} ticks, {len(seq.rows)} rows)")
     table_rows = machine.table.rows
     console.print(f"row coverage: {len(golden.covered)} of {len(table_rows)} rows fired "
                   f"({len(golden.fireable)} can fire at all)")
     for index, reason in sorted(golden.reasons.items()):
-        console.print(f"  line {table_rows[index].line}: not covered: {escape(reason)}")
-    console.print(f"wrote {escape(str(out / 'coverage.json'))}")
+        console.print(f"  line {table_rows[index].line}: not covered: {terminal(reason)}")
+    console.print(f"wrote {terminal(str(out / 'coverage.json'))}")
 
 
 @app.command("diagram")
@@ -195,4 +196,4 @@ def diagram_cmd(
         return
     with writing(out):
         out_file(out, "--out", make_folder=True).write_bytes(data)
-    err_console.print(f"wrote {out} ({fmt}, {len(data)} bytes)")
+    err_console.print(f"wrote {terminal(str(out))} ({fmt}, {len(data)} bytes)")

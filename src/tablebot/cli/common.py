@@ -13,17 +13,18 @@ from typing import Any, TypeVar
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.escape import terminal
 from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import load_robot
 from tablebot.table import Table
 
 F = TypeVar("F", bound=Callable[..., Any])
-err_console = Console(stderr=True, highlight=False)
-console = Console(highlight=False, soft_wrap=True)
+# emoji=False: a ':x:' in user text prints as it is (tablebot.escape.terminal escapes the markup).
+err_console = Console(stderr=True, highlight=False, emoji=False)
+console = Console(highlight=False, soft_wrap=True, emoji=False)
 
 TABLE_ARG = typer.Argument(..., help="Table file (CSV or TSV) or a folder holding table.csv.")
 ROBOT_OPT = typer.Option(None, "--robot", help="Robot TOML file (default: NAME.toml or robot.toml beside the table).")
@@ -99,10 +100,10 @@ def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
 def print_diagnostic(d: Diagnostic) -> None:
     """Coloured on a terminal, plain text when piped (rich decides)."""
     colour = {"error": "red", "warning": "yellow"}.get(d.severity, "cyan")
-    err_console.print(f"[bold]{escape(d.location())}[/bold]: [{colour}]{d.severity}[/{colour}]: "
-                      f"{escape(d.message)}", soft_wrap=True)
+    err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{d.severity}[/{colour}]: "
+                      f"{terminal(d.message)}", soft_wrap=True)
     if d.hint:
-        err_console.print(f"    [dim]hint:[/dim] {escape(d.hint)}", soft_wrap=True)
+        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}", soft_wrap=True)
 
 
 def guarded(func: F) -> F:

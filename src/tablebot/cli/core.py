@@ -20,6 +20,7 @@ from tablebot.cli.common import (
     out_folder,
     writing,
 )
+from tablebot.escape import terminal
 from tablebot.examples import example_path
 from tablebot.formats import robopro_lists as robopro
 from tablebot.formats.table_write import format_table
@@ -47,7 +48,7 @@ def import_cmd(
     else:
         with writing(out):
             out_file(out, "--out").write_text(text, encoding="utf-8")
-        err_console.print(f"wrote {out} ({len(table.rows)} rows; descriptions are not in the lists)")
+        err_console.print(f"wrote {terminal(str(out))} ({len(table.rows)} rows; descriptions are not in the lists)")
 
 
 @app.command("trace")
@@ -66,7 +67,7 @@ def trace_cmd(
         return
     with writing(out), out_file(out, "--out").open("w", encoding="utf-8") as stream:
         count = write_trace(replay(machine, ticks), stream)
-    err_console.print(f"wrote {out} ({count} ticks)")
+    err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")
 
 
 @app.command("demo")
@@ -87,5 +88,5 @@ def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder fo
     console.print(f"BumberBot: {len(lines)} ticks ({len(lines) * machine.table.robot.tick_ms / 1000:.1f} s), "
                   f"{fired} rows fired")
     for state, count in visits.items():
-        console.print(f"  state {state!s:>4}: {count * machine.table.robot.tick_ms / 1000:6.2f} s")
-    console.print(f"wrote {out / 'trace.jsonl'}")
+        console.print(f"  state {terminal(str(state)):>4}: {count * machine.table.robot.tick_ms / 1000:6.2f} s")
+    console.print(f"wrote {terminal(str(out / 'trace.jsonl'))}")

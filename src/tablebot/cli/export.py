@@ -11,6 +11,7 @@ from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.codegen import generate
 from tablebot.diagnostics import fail
+from tablebot.escape import terminal
 from tablebot.formats import robopro_lists as robopro
 from tablebot.formats import robopro_program as rpp
 from tablebot.table import Table
@@ -54,14 +55,14 @@ def export_cmd(
     if to == Target.c:
         source = generate(machine, lookup.value)  # before the folder is made: a refused table leaves none
         for path in source.write(out_folder(outdir, "OUTDIR")):
-            console.print(f"wrote {path}")
+            console.print(f"wrote {terminal(str(path))}")
         lookup_kind = "dense" if source.layout.dense else "scan"
         console.print(f"lookup: {lookup_kind}, {source.layout.lookup_bytes} bytes; "
                       f"table hash 0x{source.layout.table_hash:08x}")
         return
     lists = robopro.encode(parsed)
     for path in robopro.write_lists(lists, out_folder(outdir, "OUTDIR")):
-        console.print(f"wrote {path}")
+        console.print(f"wrote {terminal(str(path))}")
 
 
 def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tuple[str, str, str]) -> None:
@@ -74,7 +75,8 @@ def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tup
         raise fail("--event-list", "the three list names must differ", "give each list its own name")
     out = out_folder(outdir, "OUTDIR") / into.name if outdir else None
     written, from_csv = rpp.write_lists(into, named, out)
-    console.print(f"wrote {written} (lists {', '.join(named)}: {len(lists.event)} values each)")
+    console.print(f"wrote {terminal(str(written))} (lists {terminal(', '.join(named))}: "
+                  f"{len(lists.event)} values each)")
     for name in from_csv:
-        err_console.print(f"warning: list {name} loads its values from a CSV file in ROBO Pro "
+        err_console.print(f"warning: list {terminal(name)} loads its values from a CSV file in ROBO Pro "
                           "(initcsvcolumn), which replaces the values written here")

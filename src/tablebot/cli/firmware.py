@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shlex
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -12,6 +11,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
 from tablebot.diagnostics import fail
+from tablebot.escape import shell_word, terminal
 from tablebot.firmware.boards import load_board
 from tablebot.firmware.build import Firmware, build
 from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
@@ -34,8 +34,9 @@ def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) 
     assert wiring is not None
     pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
                      for n, t in kind.items())
-    console.print(f"wrote {firmware.hex} and {firmware.elf} for {firmware.board.title}")
-    console.print(f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {pins}")
+    console.print(f"wrote {terminal(str(firmware.hex))} and {terminal(str(firmware.elf))} "
+                  f"for {terminal(firmware.board.title)}")
+    console.print(f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {terminal(pins)}")
     console.print(f"trace: {firmware.board.uart}, {firmware.board.baud} baud 8N1")
     return firmware
 
@@ -69,7 +70,7 @@ def flash_cmd(
     else:
         hexfile = _build(table, board, out, robot).hex
     command = avrdude_command(load_board(board.value), hexfile, port, baud, programmer)
-    console.print(shlex.join(command))
+    console.print(terminal(" ".join(shell_word(word) for word in command)))
     if dry_run:
         return
     if board.value in NOTES:
@@ -104,4 +105,4 @@ def monitor_cmd(
     else:
         with out_file(out, "--out").open("w", encoding="utf-8") as stream:
             count = monitor(machine, chunks, stream, source, ticks, warn)
-        err_console.print(f"wrote {out} ({count} ticks)")
+        err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")

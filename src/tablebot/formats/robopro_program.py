@@ -3,13 +3,14 @@ Only the lists' ``<init value="…">`` children and ``N`` change: the file is ed
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from tablebot.diagnostics import Collector, fail
+from tablebot.escape import xml_attr
+from tablebot.files import write_bytes
 
 LIST_CLASS = "ftProDataArray1D"
 DEFAULT_NAMES = ("Event", "Action", "Timer")
@@ -104,9 +105,9 @@ def _init_texts(text: str, element: ListElement, values: Sequence[int]) -> tuple
             separator = newline + _line_indent(text, first_start)
         # an init without a value (<init/>) has no form to copy: take ROBO Pro's own
         form = VALUE_RE.sub('value="\x00"', sample, count=1) if VALUE_RE.search(sample) else DEFAULT_INIT
-        return first_start, element.inits[-1][1], separator.join(form.replace("\x00", str(v)) for v in values)
+        return first_start, element.inits[-1][1], separator.join(form.replace("\x00", xml_attr(str(v))) for v in values)
     indent = _line_indent(text, element.close)
-    lines = "".join(f'{indent}    {DEFAULT_INIT.replace(chr(0), str(v))}{newline}' for v in values)
+    lines = "".join(f'{indent}    {DEFAULT_INIT.replace(chr(0), xml_attr(str(v)))}{newline}' for v in values)
     line_start = text.rfind("\n", 0, element.close) + 1
     if text[line_start:element.close].strip() == "" and line_start > 0:
         return line_start, line_start, lines  # the closing tag has its own line: insert above it
@@ -179,7 +180,5 @@ def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None 
         raise fail(rpp, "not a ROBO Pro program (no <cvg> document element)", "give a .rpp file", 1, 1)
     new = rewrite(text, lists, rpp)
     target = out or rpp
-    tmp = target.with_name(target.name + ".tmp")
-    tmp.write_bytes(new.encode(encoding))
-    os.replace(tmp, target)  # all or nothing: a failed write leaves the program as it was
+    write_bytes(target, new.encode(encoding))  # all or nothing: a failed write leaves the program as it was
     return target, csv_loaded(new, list(lists))
