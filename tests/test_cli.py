@@ -93,8 +93,10 @@ def test_check_reports_every_problem_located(tmp_path):
 
 
 def test_check_undecodable_file(tmp_path):
+    """Binary data (a NUL byte) that is not UTF-8 is refused where its first bad byte is; text that is
+    not UTF-8 is read as Windows-1252 instead (see test_safety_loaders)."""
     path = tmp_path / "t.csv"
-    path.write_bytes(b"state,T,I3,M1_speed,next\n1,1,\xff,3,1\n")
+    path.write_bytes(b"state,T,I3,M1_speed,next\n1,1,\xff\x00,3,1\n")
     result = invoke("check", path)
     assert result.exit_code == 2
     (m,) = assert_located_errors(result.stderr, 1)

@@ -294,9 +294,10 @@ def test_undecodable_bytes_give_line_and_column_of_the_bad_byte(tmp_path):
 
 
 def test_every_bad_line_of_undecodable_file_is_reported(tmp_path):
+    """A binary file (the NUL byte) is not read as Windows-1252: each line with bad bytes is reported."""
     path = tmp_path / "table.csv"
     (tmp_path / "robot.toml").write_text(MINI_ROBOT)
-    path.write_bytes(HEADER.encode() + b"\n\xe9t\xe9,1,1,,,,3,,3,10,1\nok,1,,,,,,,,,1\n\xff,1,,,,,,,,,1\n")
+    path.write_bytes(HEADER.encode() + b"\n\xe9t\xe9,1,1,,,,3,,3,10,1\nok\x00,1,,,,,,,,,1\n\xff,1,,,,,,,,,1\n")
     assert [(d.line, d.column) for d in problems(path)] == [(2, 1), (4, 1)]
 
 

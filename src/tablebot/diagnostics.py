@@ -1,11 +1,14 @@
 """Problems found in user files, each with a place (file, line, column), a message and a hint.
 
-Every loader collects all of a file's problems before failing, so a user fixes them in one go.
+Every loader collects all of a file's problems before failing, so a user fixes them in one go; a note
+(not a problem, such as an assumed text encoding) goes out through :func:`notify`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import warnings
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -63,3 +66,25 @@ def fail(path: str | Path, message: str, hint: str = "", line: int | None = None
          column: int | None = None) -> TableBotError:
     """Build (not raise) an error with a single diagnostic."""
     return TableBotError([Diagnostic(str(path), line, column, message, hint)])
+
+
+_note_sinks: list[Callable[[Diagnostic], None]] = []
+
+
+def notify(note: Diagnostic) -> None:
+    """Tell the user something that is not a problem but may surprise them (a file read in an assumed
+    encoding): printed by the CLI as it comes, a Python warning for other callers."""
+    if _note_sinks:
+        _note_sinks[-1](note)
+    else:
+        warnings.warn(note.render(), UserWarning, stacklevel=3)
+
+
+@contextmanager
+def notes_to(sink: Callable[[Diagnostic], None]) -> Iterator[None]:
+    """Send the notes of the block to ``sink`` (the CLI prints them as they come)."""
+    _note_sinks.append(sink)
+    try:
+        yield
+    finally:
+        _note_sinks.remove(sink)

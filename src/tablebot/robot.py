@@ -214,7 +214,7 @@ def _counters(src: Source, motors: dict[str, str]) -> list[Counter]:
         if isinstance(value, dict) and set(value) != {"motor"}:
             _error(src, ("counters", None, name), f"counter {name} may only say motor = \"M1\", not "
                    f"{', '.join(sorted(set(value) - {'motor'})) or 'nothing'}", f'write {name} = "M1"')
-        elif motor not in motors:
+        elif not isinstance(motor, str) or motor not in motors:  # a list or table is no motor name (nor hashable)
             _error(src, ("counters", None, name), f"counter {name} counts motor {motor!r}, which is not in [motors]",
                    f'write {name} = "M1" with a motor name from [motors]')
         counters.append(Counter(name, str(motor)))

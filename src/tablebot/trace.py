@@ -138,8 +138,28 @@ def write_trace(lines: Iterable[dict[str, Any]], stream: IO[str]) -> int:
     return count
 
 
+#: The largest trace file read back: a simulated hour at 10 ms ticks is about 60 MB of JSON Lines.
+MAX_TRACE_BYTES = 512 * 1024 * 1024
+
+
 def read_trace(path: str | Path) -> list[dict[str, Any]]:
-    """Every tick line of a trace file (an ``end`` record, written when a run was cut short, is skipped)."""
-    with open(path, encoding="utf-8") as f:
-        lines = [json.loads(line) for line in f if line.strip()]
-    return [line for line in lines if "end" not in line]
+    """Every tick line of a trace file (an ``end`` record, written when a run was cut short, is skipped);
+    a line that is not a JSON object is a located error."""
+    path = Path(path)
+    text = read_text(path, "a trace is UTF-8 JSON Lines as tablebot writes it", MAX_TRACE_BYTES, spreadsheet=False)
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if not raw.strip():
+            continue
+        try:
+            line = json.loads(raw)
+        except (ValueError, RecursionError) as exc:  # RecursionError: nesting deeper than the parser's stack
+            column = getattr(exc, "colno", 1)
+            raise fail(path, f"line {number} is not JSON: {getattr(exc, 'msg', 'nested too deeply')}",
+                       "a trace has one JSON object per line, as tablebot trace writes it", number, column) from None
+        if not isinstance(line, dict):
+            raise fail(path, f"line {number} is JSON but not an object {{...}}",
+                       "a trace has one JSON object per line, as tablebot trace writes it", number, 1)
+        if "end" not in line:
+            lines.append(line)
+    return lines

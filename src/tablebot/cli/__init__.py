@@ -1,8 +1,33 @@
 """Command-line interface: one module per group of commands, all registered on one Typer app."""
 
+from __future__ import annotations
+
+import os
+import sys
+import traceback
+
 from tablebot.cli import analysis, core, export, firmware, sim, studio  # noqa: F401  (importing registers the commands)
 from tablebot.cli.app import app
 
+#: Exit code of an internal error (a tablebot bug), apart from 1 (warnings) and 2 (bad input).
+INTERNAL_ERROR = 3
+DEBUG_ENV = "TABLEBOT_DEBUG"
+
 
 def main() -> None:
-    app()
+    """Run the app; an exception no command expected is a tablebot bug: one line says so and how to see
+    the whole traceback (TABLEBOT_DEBUG=1), never a traceback by default."""
+    try:
+        app()
+    except (SystemExit, KeyboardInterrupt):
+        raise
+    except BaseException as exc:
+        if os.environ.get(DEBUG_ENV, "") not in ("", "0"):
+            traceback.print_exc()
+        else:
+            where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+            place = f" at {os.path.basename(where.filename)}:{where.lineno}" if where else ""
+            print(f"tablebot: internal error: {type(exc).__name__}{place}: {str(exc)[:200]!r}; this is a bug in "
+                  f"tablebot: please report it with the command and the files it read "
+                  f"(run again with {DEBUG_ENV}=1 to see the traceback)", file=sys.stderr)
+        sys.exit(INTERNAL_ERROR)

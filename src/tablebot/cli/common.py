@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 import typer
 from rich.console import Console
 
-from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.diagnostics import Diagnostic, TableBotError, fail, notes_to
 from tablebot.escape import terminal
 from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
@@ -112,7 +112,8 @@ def guarded(func: F) -> F:
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            return func(*args, **kwargs)
+            with notes_to(print_diagnostic):
+                return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:
                 print_diagnostic(d)

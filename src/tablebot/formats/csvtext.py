@@ -1,7 +1,8 @@
 """Text files read with located errors, and spreadsheet text as records of cells that remember their place.
 
-Handles what spreadsheets save: UTF-8 with or without BOM (or UTF-16 with its BOM), CRLF or LF, comma, semicolon or tab
-separators and RFC 4180 quoting; every cell keeps its 1-based line and column for error messages.
+Handles what spreadsheets save: UTF-8 with or without BOM (or UTF-16 with its BOM, or Windows-1252 with a note), CRLF or
+LF, comma, semicolon or tab separators and RFC 4180 quoting; every cell keeps its 1-based line and column for errors.
+Every file is read up to a size limit, so no input (not even /dev/zero) can exhaust memory.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
+from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail, notify
 
 #: The line Excel may put above the header to name the delimiter: ``sep=;``.
 SEP_RE = re.compile(r"^\s*sep=([,;\t])\s*$")
@@ -38,16 +39,50 @@ class Record:
 
 #: What to do about a file that is not UTF-8 text, for files a spreadsheet saves.
 CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
+#: The largest file a loader reads, by default: a 100,000-row table is about 5 MB, an hour of recorded
+#: inputs at 10 ms ticks about 6 MB. Anything larger is almost surely the wrong file (or /dev/zero).
+MAX_TEXT_BYTES = 64 * 1024 * 1024
+#: Bytes that no text file holds (NUL and the other C0 controls but tab and line ends): binary data.
+BINARY_RE = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
+#: A well-formed UTF-8 sequence of two or more bytes: a file that has one is UTF-8 with a few bad bytes,
+#: not Windows-1252 (where such pairs, like "Ã©", almost never occur in real text).
+UTF8_MULTIBYTE_RE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|[\xf0-\xf4][\x80-\xbf]{3}")
 
 
-def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT) -> str:
-    """Decode a file as UTF-8 (BOM allowed); if it is not, report where (see :func:`_bad_bytes`)."""
+def size_text(limit: int) -> str:
+    """``64 MB``, ``512 KB``: a limit as people read it."""
+    for unit, size in (("GB", 1 << 30), ("MB", 1 << 20), ("KB", 1 << 10)):
+        if limit >= size:
+            return f"{limit / size:g} {unit}"
+    return f"{limit} bytes"
+
+
+def read_bytes(path: Path, limit: int | None = None) -> bytes:
+    """A file's bytes, refusing a folder, an unreadable file and anything over ``limit`` bytes (read no
+    further than that: a device such as /dev/zero never ends); the default limit is MAX_TEXT_BYTES."""
+    limit = MAX_TEXT_BYTES if limit is None else limit
     if path.is_dir():
         raise fail(path, "this is a folder, not a file", "give the path of a file")
     try:
-        data = path.read_bytes()
+        with path.open("rb") as stream:
+            data = stream.read(limit + 1)
     except OSError as exc:
         raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
+    if len(data) > limit:
+        raise fail(path, f"the file is larger than {size_text(limit)}, the most tablebot reads of such a file",
+                   "is this the right file? split it, or give a smaller one")
+    return data
+
+
+def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT, limit: int | None = None,
+              spreadsheet: bool = True) -> str:
+    """Decode a file as UTF-8 (BOM allowed; UTF-16 with its BOM too).
+
+    A ``spreadsheet`` file (CSV) that is not UTF-8 but is text, with no UTF-8 sequence in it at all, is
+    read as Windows-1252 (Latin-1 where that has no character): what a German or French Excel saves as
+    "CSV"; a note says so. Otherwise the bad bytes are reported where they are (see :func:`_bad_bytes`).
+    """
+    data = read_bytes(path, limit)
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):  # Excel's "Unicode Text" save
         try:
             return data.decode("utf-16")
@@ -56,7 +91,30 @@ def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT) -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
+        if spreadsheet and not BINARY_RE.search(data) and not UTF8_MULTIBYTE_RE.search(data):
+            return _legacy(path, data)
         raise TableBotError(_bad_bytes(path, data, encoding_hint)) from None
+
+
+def _legacy(path: Path, data: bytes) -> str:
+    """Text in Excel's Western European code page, with a note naming the encoding assumed."""
+    try:
+        text, name = data.decode("cp1252"), "Windows-1252"
+    except UnicodeDecodeError:  # cp1252 leaves five bytes undefined; Latin-1 has them all
+        text, name = data.decode("latin-1"), "Latin-1 (ISO-8859-1)"
+    bad = _bad_bytes(path, data, "")[0]
+    notify(Diagnostic(str(path), bad.line, bad.column, f"not UTF-8 (byte 0x{data[_first_bad(data)]:02x}); read as "
+                      f"{name}, as a Western European Excel saves 'CSV'",
+                      f"if characters look wrong, {CSV_ENCODING_HINT}", "note"))
+    return text
+
+
+def _first_bad(data: bytes) -> int:
+    try:
+        data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        return exc.start + (3 if data.startswith(codecs.BOM_UTF8) else 0)
+    return 0
 
 
 def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:

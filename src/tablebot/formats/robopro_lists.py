@@ -158,6 +158,11 @@ def _read_list(path: Path) -> list[int]:
     return values
 
 
+def _digits(text: str) -> bool:
+    """ASCII digits only: str.isdigit() also takes '²', which int() refuses."""
+    return text.isascii() and text.isdigit()
+
+
 def _read_names(directory: Path) -> dict[int, StateId]:
     """states.csv as export writes it: a header, then ``number,name`` per named state."""
     path = directory / STATES_FILE
@@ -168,10 +173,10 @@ def _read_names(directory: Path) -> dict[int, StateId]:
         cells = [cell.text.strip() for cell in record.cells]
         if record.is_blank():
             continue
-        if len(cells) < 2 or not cells[0].isdigit() or not (cells[1].isdigit() or STATE_RE.match(cells[1])):
+        if len(cells) < 2 or not _digits(cells[0]) or not (_digits(cells[1]) or STATE_RE.match(cells[1])):
             raise fail(path, f"expected number,name, not {','.join(cells)!r}",
                        "export writes one named state per line, like: 1,seek", record.line, 1)
-        number, name = int(cells[0]), int(cells[1]) if cells[1].isdigit() else cells[1]  # as tables read it
+        number, name = int(cells[0]), int(cells[1]) if _digits(cells[1]) else cells[1]  # as tables read it
         if number in names or name in names.values():
             raise fail(path, f"state number {number} or name {name!r} is given twice",
                        "each number names one state and each name one number", record.line, 1)

@@ -11,6 +11,7 @@ from pathlib import Path
 from tablebot.diagnostics import Collector, fail
 from tablebot.escape import xml_attr
 from tablebot.files import write_bytes
+from tablebot.formats.csvtext import read_bytes
 
 LIST_CLASS = "ftProDataArray1D"
 DEFAULT_NAMES = ("Event", "Action", "Timer")
@@ -72,7 +73,7 @@ def find_lists(text: str) -> list[ListElement]:
             if "N" in attrs:
                 value, a, b = attrs["N"]
                 element.n_span = (m.start(3) + a, m.start(3) + b)
-                element.n_value = int(value) if value.strip().lstrip("-").isdigit() else 0
+                element.n_value = int(value) if re.fullmatch(r"\s*-?[0-9]+\s*", value) else 0
             element.csv_column = attrs.get("initcsvcolumn", ("-1",))[0]
             lists.append(element)
         elif tag == "init" and isinstance(parent, ListElement):
@@ -163,10 +164,7 @@ def csv_loaded(text: str, names: Sequence[str]) -> list[str]:
 
 def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None = None) -> tuple[Path, list[str]]:
     """Rewrite ``rpp`` (or write the result to ``out``); returns the path and lists loaded from CSV."""
-    try:
-        data = rpp.read_bytes()
-    except OSError as exc:
-        raise fail(rpp, f"cannot read: {exc.strerror}", "give an existing ROBO Pro .rpp file") from None
+    data = read_bytes(rpp)
     encoding = file_encoding(data)
     try:
         text = data.decode(encoding)

@@ -19,14 +19,24 @@ HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 Where = tuple[str, int | None, str | None]  # (section path, index in an array of tables, key)
 
 
+#: A robot, world or property file is a few KB; a megabyte is surely the wrong file.
+MAX_TOML_BYTES = 1024 * 1024
+#: Deeper nesting of arrays and inline tables than any tablebot file needs (the parser recurses).
+MAX_DEPTH = 32
+
+
 def read_toml(path: Path, hint: str) -> tuple[dict[str, Any], str]:
     """The data and text of a TOML file; unreadable bytes and syntax errors raise located errors."""
-    text = read_text(path, "save the file as UTF-8 text")
+    text = read_text(path, "save the file as UTF-8 text", MAX_TOML_BYTES, spreadsheet=False)
     return loads(path, text, hint), text
 
 
 def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
     """Parse TOML text; a syntax error names its line and column and gives ``hint``."""
+    deep = too_deep(text)
+    if deep:
+        raise fail(path, f"arrays or inline tables nested more than {MAX_DEPTH} levels deep",
+                   "no tablebot file nests that deep: is this the right file?", *deep)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -38,6 +48,42 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
             line, col = len(lines), len(lines[-1]) + 1
         message = re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc))
         raise fail(path, f"TOML syntax: {message}", hint, line, col) from None
+    except RecursionError:  # nesting that too_deep() did not count (it is a safety net, not the parser)
+        raise fail(path, "nested too deeply to read", "no tablebot file nests that deep: is this the right file?",
+                   1, 1) from None
+
+
+def too_deep(text: str) -> tuple[int, int] | None:
+    """(line, column) where ``[``/``{`` brackets outside strings and comments first nest deeper than
+    MAX_DEPTH, else None. A header line's ``[[x]]`` counts too, which never reaches the limit."""
+    depth, quote = 0, ""
+    line, column = 1, 0
+    i, n = 0, len(text)
+    while i < n:
+        ch = text[i]
+        column += 1
+        if ch == "\n":
+            line, column = line + 1, 0
+            if quote in ('"', "'"):
+                quote = ""  # a one-line string never spans lines (the parser reports it)
+        elif quote:
+            if text.startswith(quote, i) and (quote[0] == "'" or text[i - 1] != "\\"):
+                i += len(quote) - 1
+                quote = ""
+        elif ch == "#":
+            while i + 1 < n and text[i + 1] != "\n":
+                i += 1
+        elif ch in "\"'":
+            quote = ch * 3 if text.startswith(ch * 3, i) else ch
+            i += len(quote) - 1
+        elif ch in "[{":
+            depth += 1
+            if depth > MAX_DEPTH:
+                return line, column
+        elif ch in "]}":
+            depth = max(0, depth - 1)
+        i += 1
+    return None
 
 
 class Source:
