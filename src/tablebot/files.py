@@ -7,15 +7,42 @@ destroys the previous version before the new one is ready.
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
+from tablebot import guard
+
+
+def _target(path: str | Path) -> Path:
+    """Where ``path`` really is: a symbolic link is written through (renaming onto it would replace the
+    link itself with a file)."""
+    path = Path(path)
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def is_special(path: Path) -> bool:
+    """A device, pipe or socket (``/dev/stdout``, ``/dev/full``, a FIFO): written directly, never replaced
+    by a rename (that would put a regular file where the device was)."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return False
+    return not stat.S_ISREG(mode) and not stat.S_ISDIR(mode)
+
+
+def _open_direct(path: Path, mode: str, encoding: str | None, newline: str | None) -> IO:
+    guard.writing(path)
+    return open(path, mode, encoding=None if "b" in mode else encoding, newline=None if "b" in mode else newline)
+
 
 def _temporary(path: Path, mode: str, encoding: str | None, newline: str | None) -> tuple[IO, Path]:
-    """An open temporary file beside ``path`` (same folder, so the rename is atomic) and its name."""
+    """An open temporary file beside ``path`` (same folder, so the rename is atomic) and its name; the
+    command's guard first refuses a path it must not write over (see :mod:`tablebot.guard`)."""
+    guard.writing(path)
     fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
@@ -33,7 +60,15 @@ def atomic_write(path: str | Path, mode: str = "w", encoding: str | None = "utf-
 
     An OSError raised while writing names ``path`` (a full disk reports no file name of its own).
     """
-    path = Path(path)
+    path = _target(path)
+    if is_special(path):
+        try:
+            with _open_direct(path, mode, encoding, newline) as stream:
+                yield stream
+        except OSError as exc:
+            exc.filename = str(path) if exc.filename is None else exc.filename
+            raise
+        return
     stream, temp = _temporary(path, mode, None if "b" in mode else encoding, None if "b" in mode else newline)
     try:
         with stream:
@@ -44,6 +79,26 @@ def atomic_write(path: str | Path, mode: str = "w", encoding: str | None = "utf-
         temp.unlink(missing_ok=True)
         if isinstance(exc, OSError) and exc.filename is None:
             exc.filename = str(path)
+        raise
+
+
+@contextmanager
+def replacing(path: str | Path) -> Iterator[Path]:
+    """A temporary name beside ``path`` for a tool that writes its output file itself (a compiler's
+    ``-o``); renamed to ``path`` if the block completes, removed if not."""
+    path = _target(path)
+    if is_special(path):
+        guard.writing(path)
+        yield path
+        return
+    stream, temp = _temporary(path, "wb", None, None)
+    stream.close()
+    try:
+        yield temp
+        _keep_mode(path, temp)
+        os.replace(temp, path)
+    except BaseException:
+        temp.unlink(missing_ok=True)
         raise
 
 
@@ -75,8 +130,12 @@ class PendingFile:
     to its final name or :meth:`keep_partial` under a name that says it is incomplete."""
 
     def __init__(self, path: str | Path, encoding: str = "utf-8"):
-        self.path = Path(path)
-        self.stream, self.temp = _temporary(self.path, "w", encoding, "\n")
+        self.path = _target(path)
+        self.direct = is_special(self.path)  # a device or pipe is written as it comes, never renamed onto
+        if self.direct:
+            self.stream, self.temp = _open_direct(self.path, "w", encoding, "\n"), self.path
+        else:
+            self.stream, self.temp = _temporary(self.path, "w", encoding, "\n")
         self.closed_as: Path | None = None
 
     def commit(self) -> Path:
@@ -90,14 +149,20 @@ class PendingFile:
     def discard(self) -> None:
         if self.closed_as is None:
             self.stream.close()
-            self.temp.unlink(missing_ok=True)
+            if not self.direct:
+                self.temp.unlink(missing_ok=True)
             self.closed_as = self.temp
 
     def _finish(self, target: Path) -> Path:
         if self.closed_as is not None:
             return self.closed_as
+        if self.direct:
+            target = self.path
         try:
             self.stream.close()
+            if self.direct:
+                self.closed_as = target
+                return target
             _keep_mode(target, self.temp)
             os.replace(self.temp, target)
         except OSError as exc:

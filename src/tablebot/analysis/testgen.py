@@ -16,6 +16,7 @@ from pathlib import Path
 from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
+from tablebot.files import atomic_write, write_text
 from tablebot.formats.inputs_csv import write_inputs
 from tablebot.machine import Machine
 from tablebot.trace import TickInput, replay, write_trace
@@ -115,9 +116,9 @@ def write_golden(golden: GoldenSet, out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     for seq in golden.sequences:
         write_inputs(machine, seq.inputs, out / seq.inputs_name)
-        with (out / seq.trace_name).open("w", encoding="utf-8") as stream:
+        with atomic_write(out / seq.trace_name) as stream:
             write_trace(replay(machine, seq.inputs), stream)
-    (out / "coverage.json").write_text(json.dumps(coverage(golden), indent=2) + "\n", encoding="utf-8")
+    write_text(out / "coverage.json", json.dumps(coverage(golden), indent=2) + "\n")
 
 
 def coverage(golden: GoldenSet) -> dict:

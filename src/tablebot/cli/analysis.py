@@ -19,6 +19,7 @@ from tablebot.analysis.prove import Result
 from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli.app import app
 from tablebot.cli.common import (
+    FORCE_OPT,
     ROBOT_OPT,
     TABLE_ARG,
     console,
@@ -28,10 +29,10 @@ from tablebot.cli.common import (
     out_file,
     out_folder,
     resolve_table_path,
-    writing,
 )
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.escape import terminal
+from tablebot.files import write_bytes
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
 
@@ -52,7 +53,9 @@ def check_cmd(
     strict: bool = typer.Option(False, "--strict", help="Exit with 1 when there are warnings."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="List every info finding (overlaps, ignored inputs)."),
     fmt: Format = typer.Option(Format.text, "--format", help="text, or json for machines."),
-    cex_dir: Path = typer.Option(Path("out/check"), "--counterexamples", help="Folder for counterexample CSVs."),
+    cex_dir: Path | None = typer.Option(None, "--counterexamples", help="Folder to write counterexample "
+                                        "CSVs into (created if missing); without it, check writes nothing."),
+    force: bool = FORCE_OPT,
 ) -> None:
     """Check a table: rows that never fire, overlaps, unreachable states, loops, properties.
 
@@ -65,11 +68,12 @@ def check_cmd(
     files = properties or find_property_files(resolve_table_path(table))
     report = run_check(machine, load_properties(machine, files), tuple(target))
     report.property_files = files
-    unsaved = _save_counterexamples(report, cex_dir) if any(r.inputs for r in report.results) else None
+    found = any(r.inputs for r in report.results)
+    unsaved = _save_counterexamples(report, cex_dir) if cex_dir is not None and found else None
     if fmt == Format.json:
         sys.stdout.write(json.dumps(report_json(report, strict), indent=2) + "\n")
     else:
-        _print_report(report, table, verbose)
+        _print_report(report, table, verbose, cex_dir is not None)
     if unsaved is not None:  # reported after the report, which a folder problem must not cost the user
         raise unsaved
     raise typer.Exit(report.exit_code(strict))
@@ -87,7 +91,7 @@ def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | 
     return None
 
 
-def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
+def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: bool) -> None:
     machine = report.machine
     table = machine.table
     console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
@@ -102,7 +106,7 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool) -> None:
         sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
         console.print(f"\n[bold]properties[/bold] ({terminal(sources)}):")
         for result in report.results:
-            _print_result(report, result, table_arg, verbose)
+            _print_result(report, result, table_arg, verbose, saving)
     counts = report.counts()
     tail = ""
     if hidden:
@@ -120,7 +124,7 @@ def _print_finding(path: str, finding: Finding) -> None:
         console.print(f"    [dim]hint:[/dim] {terminal(finding.hint)}")
 
 
-def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool) -> None:
+def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:
     prop = result.prop
     marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
              "unknown": "[yellow]unknown [/yellow]"}
@@ -137,7 +141,8 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
     path = report.counterexamples.get(prop.name)
     kind = "example" if prop.kind == "reachable" else "counterexample"
     shortest = "shortest " if result.exact else ""
-    written = f", written to {terminal(str(path))}" if path else " (not written)"
+    written = (f", written to {terminal(str(path))}" if path else " (not written)" if saving
+               else " (--counterexamples DIR saves it)")
     console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks{written}")
     if path:
         console.print(f"           replay: tablebot trace {terminal(str(table_arg))} --inputs {terminal(str(path))}")
@@ -152,6 +157,7 @@ def tests_cmd(
     table: Path = TABLE_ARG,
     out: Path = typer.Option(..., "--out", help="Folder for the golden tests (created if missing)."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Generate golden tests: input CSVs that together fire every row that can fire, each with its
     expected trace (JSON Lines), plus coverage.json."""
@@ -178,6 +184,7 @@ def diagram_cmd(
     out: Path | None = typer.Option(None, "--out", help="File to write (default: standard output)."),
     colour: bool = typer.Option(True, "--colour/--no-colour", help="Colour edges by motion."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Draw the state diagram (the document's Figure 1) from the table."""
     option = "--format"
@@ -194,6 +201,5 @@ def diagram_cmd(
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
         return
-    with writing(out):
-        out_file(out, "--out", make_folder=True).write_bytes(data)
+    write_bytes(out_file(out, "--out", make_folder=True), data)
     err_console.print(f"wrote {terminal(str(out))} ({fmt}, {len(data)} bytes)")

@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 import typer
 from rich.console import Console
 
+from tablebot import guard
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notes_to
 from tablebot.escape import terminal
 from tablebot.formats.table_read import load_table
@@ -28,6 +29,8 @@ console = Console(highlight=False, soft_wrap=True, emoji=False)
 
 TABLE_ARG = typer.Argument(..., help="Table file (CSV or TSV) or a folder holding table.csv.")
 ROBOT_OPT = typer.Option(None, "--robot", help="Robot TOML file (default: NAME.toml or robot.toml beside the table).")
+FORCE_OPT = typer.Option(False, "--force", help="Replace an existing table or robot file (the old one is kept as "
+                         "NAME.bak); without it such a file is never replaced.")
 
 
 #: Per errno of a failed read or write: what the user can do about it.
@@ -112,7 +115,7 @@ def guarded(func: F) -> F:
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with notes_to(print_diagnostic):
+            with notes_to(print_diagnostic), guard.command(force=bool(kwargs.get("force", False))):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:

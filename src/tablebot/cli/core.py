@@ -10,6 +10,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import (
+    FORCE_OPT,
     ROBOT_OPT,
     TABLE_ARG,
     console,
@@ -18,10 +19,10 @@ from tablebot.cli.common import (
     load,
     out_file,
     out_folder,
-    writing,
 )
 from tablebot.escape import terminal
 from tablebot.examples import example_path
+from tablebot.files import atomic_write, write_text
 from tablebot.formats import robopro_lists as robopro
 from tablebot.formats.table_write import format_table
 from tablebot.robot import BUMBERBOT, load_robot
@@ -39,6 +40,7 @@ def import_cmd(
     source: Source = typer.Option(..., "--from", help="What the folder holds."),
     out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output)."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
@@ -46,8 +48,7 @@ def import_cmd(
     if out is None:
         sys.stdout.write(text)
     else:
-        with writing(out):
-            out_file(out, "--out").write_text(text, encoding="utf-8")
+        write_text(out_file(out, "--out"), text)
         err_console.print(f"wrote {terminal(str(out))} ({len(table.rows)} rows; descriptions are not in the lists)")
 
 
@@ -58,6 +59,7 @@ def trace_cmd(
     inputs: Path = typer.Option(..., "--inputs", help="Inputs CSV: header of input names, one row per tick."),
     out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Replay recorded inputs through the engine and write the trace, one JSON line per tick."""
     _, machine = load(table, robot)
@@ -65,7 +67,7 @@ def trace_cmd(
     if out is None:
         write_trace(replay(machine, ticks), sys.stdout)
         return
-    with writing(out), out_file(out, "--out").open("w", encoding="utf-8") as stream:
+    with atomic_write(out_file(out, "--out")) as stream:
         count = write_trace(replay(machine, ticks), stream)
     err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")
 
@@ -79,7 +81,7 @@ def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder fo
     ticks = load_inputs(folder / "inputs.csv", machine)
     out_folder(out, "--out")
     lines = list(replay(machine, ticks))
-    with (out / "trace.jsonl").open("w", encoding="utf-8") as stream:
+    with atomic_write(out / "trace.jsonl") as stream:
         write_trace(lines, stream)
     visits: dict[object, int] = {}
     for line in lines:

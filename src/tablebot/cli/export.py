@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.codegen import generate
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
@@ -44,6 +44,7 @@ def export_cmd(
     lookup: Lookup = typer.Option(Lookup.auto, "--lookup", help="c: first-match lookup, dense (O(1) table) or "
                                   "scan (rows per state); auto takes dense while it needs at most 8 KB."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
     parsed, machine = load(table, robot)

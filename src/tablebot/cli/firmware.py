@@ -9,9 +9,20 @@ from pathlib import Path
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_file, out_folder
+from tablebot.cli.common import (
+    FORCE_OPT,
+    ROBOT_OPT,
+    TABLE_ARG,
+    console,
+    err_console,
+    guarded,
+    load,
+    out_file,
+    out_folder,
+)
 from tablebot.diagnostics import fail
 from tablebot.escape import shell_word, terminal
+from tablebot.files import PendingFile
 from tablebot.firmware.boards import load_board
 from tablebot.firmware.build import Firmware, build
 from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
@@ -92,6 +103,7 @@ def monitor_cmd(
     seconds: float | None = typer.Option(None, "--seconds", min=0.001,
                                          help="Stop a serial port after this many seconds."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Decode a firmware's trace stream into the core's JSON Lines trace, one line per tick."""
     _, machine = load(table, robot)
@@ -103,6 +115,11 @@ def monitor_cmd(
     if out is None:
         count = monitor(machine, chunks, sys.stdout, source, ticks, warn)
     else:
-        with out_file(out, "--out").open("w", encoding="utf-8") as stream:
-            count = monitor(machine, chunks, stream, source, ticks, warn)
+        pending = PendingFile(out_file(out, "--out"))
+        try:
+            count = monitor(machine, chunks, pending.stream, source, ticks, warn)
+        except BaseException:  # Ctrl-C on a serial port: keep what came, under a name that says so
+            err_console.print(f"kept the ticks so far in {terminal(str(pending.keep_partial()))}")
+            raise
+        pending.commit()
         err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from tablebot.codegen.layout import KEEP, Layout, plan
 from tablebot.escape import c_comment
+from tablebot.files import write_text
 from tablebot.machine import Machine
 
 ENGINE_FILES = ("tb_engine.h", "tb_engine.c")
@@ -26,9 +27,7 @@ class CSource:
         outdir.mkdir(parents=True, exist_ok=True)
         written = []
         for name, text in self.files.items():
-            path = outdir / name
-            path.write_text(text, encoding="utf-8")
-            written.append(path)
+            written.append(write_text(outdir / name, text))
         return written
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 from tablebot.codegen import generate
 from tablebot.codegen.layout import Layout
 from tablebot.diagnostics import fail
+from tablebot.files import replacing, write_text
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import Board, Wiring, load_board, wire
 from tablebot.machine import Machine
@@ -56,9 +57,9 @@ def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "a
     wiring = None
     if main == FIRMWARE_MAIN:
         wiring = wire(machine.table.robot, board)
-        (srcdir / "tb_board.h").write_text(board_header(machine, wiring, source.layout), encoding="utf-8")
-        (srcdir / f"board_{board.name}.h").write_text(c_source(f"board_{board.name}.h"), encoding="utf-8")
-    (srcdir / main).write_text(c_source(main), encoding="utf-8")
+        write_text(srcdir / "tb_board.h", board_header(machine, wiring, source.layout))
+        write_text(srcdir / f"board_{board.name}.h", c_source(f"board_{board.name}.h"))
+    write_text(srcdir / main, c_source(main))
     return wiring, source.layout
 
 
@@ -85,8 +86,10 @@ def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto",
     stem = "tablebot" if main == FIRMWARE_MAIN else "bench"
     elf, hexfile = outdir / f"{stem}.elf", outdir / f"{stem}.hex"
     sources = [str(srcdir / name) for name in (main, "tb_engine.c", "tb_table.c")]
-    _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS, f"-I{srcdir}",
-          "-Wl,--gc-sections", "-o", str(elf), *sources], "avr-gcc")
-    _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(elf), str(hexfile)], "avr-objcopy")
+    with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
+        _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS, f"-I{srcdir}",
+              "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
+    with replacing(hexfile) as temp:
+        _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(elf), str(temp)], "avr-objcopy")
     flash, ram = sizes(elf)
     return Firmware(elf, hexfile, board, wiring, layout, flash, ram)

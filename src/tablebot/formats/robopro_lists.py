@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
+from tablebot.files import atomic_write, write_text
 from tablebot.formats.csvtext import read_text, split_records
 from tablebot.robot import STATE_RE, Robot, StateId
 from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table, missing_states
@@ -122,12 +123,10 @@ def write_lists(lists: Lists, outdir: Path) -> list[Path]:
     outdir.mkdir(parents=True, exist_ok=True)
     written = []
     for name, values in zip(LIST_FILES, (lists.event, lists.action, lists.timer), strict=True):
-        path = outdir / name
-        path.write_text("".join(f"{v}\n" for v in values), encoding="utf-8")
-        written.append(path)
+        written.append(write_text(outdir / name, "".join(f"{v}\n" for v in values)))
     if any(not isinstance(s, int) for s in lists.numbers):
         path = outdir / STATES_FILE
-        with path.open("w", encoding="utf-8", newline="") as f:
+        with atomic_write(path, newline="") as f:
             writer = csv.writer(f, lineterminator="\n")
             writer.writerow(["number", "name"])
             named = [(n, s) for s, n in lists.numbers.items() if not isinstance(s, int)]  # ints are their number

@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tablebot import guard
 from tablebot.diagnostics import Collector, fail
 from tablebot.escape import xml_attr
 from tablebot.files import write_bytes
@@ -178,5 +179,7 @@ def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None 
         raise fail(rpp, "not a ROBO Pro program (no <cvg> document element)", "give a .rpp file", 1, 1)
     new = rewrite(text, lists, rpp)
     target = out or rpp
+    if out is None:
+        guard.rewrite(rpp)  # the program is updated in place, as asked; its old version stays as .bak
     write_bytes(target, new.encode(encoding))  # all or nothing: a failed write leaves the program as it was
     return target, csv_loaded(new, list(lists))

@@ -1,0 +1,129 @@
+"""What one command may write over: never a file it read, and never a table or robot file unless the user
+said ``--force`` (then the old file is kept as ``NAME.bak``).
+
+The CLI opens one :func:`command` scope per command; every loader reads through ``formats.csvtext``,
+which calls :func:`read`, and every writer writes through ``tablebot.files``, which calls :func:`writing`
+first. Outside a scope (library use) nothing is refused.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tablebot.diagnostics import fail
+
+#: Files a user writes by hand: tablebot never writes TOML, and a CSV with state and next columns is a table.
+USER_SUFFIXES = {".toml"}
+TABLE_SUFFIXES = {".csv", ".tsv", ".txt"}
+STATE_COLUMNS = {"state", "st"}
+NEXT_COLUMNS = {"next", "next_state", "next state"}
+
+
+@dataclass
+class Scope:
+    """The files one command read (by real path and by inode), and whether it may replace user files."""
+
+    force: bool = False
+    paths: set[str] = field(default_factory=set)
+    inodes: set[tuple[int, int]] = field(default_factory=set)
+    replaced: set[str] = field(default_factory=set)
+
+
+_scope: ContextVar[Scope | None] = ContextVar("tablebot_guard_scope", default=None)
+
+
+@contextmanager
+def command(force: bool = False) -> Iterator[Scope]:
+    """The scope of one command: reads are remembered, writes checked against them."""
+    token = _scope.set(Scope(force))
+    try:
+        yield _scope.get()  # type: ignore[misc]
+    finally:
+        _scope.reset(token)
+
+
+def read(path: str | Path) -> None:
+    """Remember that the current command read ``path``."""
+    scope = _scope.get()
+    if scope is None:
+        return
+    scope.paths.add(os.path.realpath(path))
+    try:
+        info = os.stat(path)
+    except OSError:
+        return
+    scope.inodes.add((info.st_dev, info.st_ino))
+
+
+def _is_input(scope: Scope, path: Path) -> bool:
+    if os.path.realpath(path) in scope.paths:
+        return True
+    try:
+        info = os.stat(path)
+    except OSError:
+        return False
+    return (info.st_dev, info.st_ino) in scope.inodes  # a hard link or another spelling of the same file
+
+
+def writing(path: str | Path) -> None:
+    """Called before ``path`` is written: refuse an input of this command; refuse to replace a user file
+    without --force, and with it keep the old one as ``NAME.bak`` first."""
+    scope = _scope.get()
+    if scope is None:
+        return
+    path = Path(path)
+    if _is_input(scope, path):
+        raise fail(path, "this command reads this file, so it will not write over it",
+                   "write the output to another file")
+    key = os.path.realpath(path)
+    if key in scope.replaced or not path.is_file() or not is_user_file(path):
+        return
+    if not scope.force:
+        raise fail(path, f"{path.name} exists and is a {kind(path)} file: it is not replaced without --force",
+                   f"write to another file, or add --force (the old file is then kept as {path.name}.bak)")
+    shutil.copy2(path, path.with_name(path.name + ".bak"))
+    scope.replaced.add(key)
+
+
+def rewrite(path: str | Path) -> None:
+    """Let the current command write over ``path`` although it read it (an edit in place, such as a
+    ROBO Pro program taking new lists); the old file is kept as ``NAME.bak``."""
+    scope = _scope.get()
+    if scope is None:
+        return
+    path = Path(path)
+    scope.paths.discard(os.path.realpath(path))
+    try:
+        info = os.stat(path)
+    except OSError:
+        return
+    scope.inodes.discard((info.st_dev, info.st_ino))
+    shutil.copy2(path, path.with_name(path.name + ".bak"))
+    scope.replaced.add(os.path.realpath(path))
+
+
+def kind(path: Path) -> str:
+    return "robot or settings" if path.suffix.lower() in USER_SUFFIXES else "table"
+
+
+def is_user_file(path: Path) -> bool:
+    """A TOML file, or a CSV whose header (first filled line) has a state and a next column."""
+    suffix = path.suffix.lower()
+    if suffix in USER_SUFFIXES:
+        return True
+    if suffix not in TABLE_SUFFIXES:
+        return False
+    try:
+        with path.open("rb") as stream:
+            head = stream.read(4096).decode("utf-8", "replace")
+    except OSError:
+        return False
+    first = next((line for line in head.splitlines() if line.strip() and not line.startswith("sep=")), "")
+    cells = {cell.strip().strip('"').lower() for cell in first.replace("\t", ",").replace(";", ",").split(",")}
+    return bool(cells & STATE_COLUMNS and cells & NEXT_COLUMNS)
