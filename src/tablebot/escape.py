@@ -129,6 +129,12 @@ def python_string(text: str) -> str:
     return ascii(text)
 
 
+def plain(text: str) -> str:
+    """User text for plain terminal output (no markup: a pipe, a log, ``rich.text.Text``): control
+    characters (an ANSI escape, a bell, NUL) shown as ``\\xNN``; tabs and line ends stay."""
+    return _CONTROL_RE.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
 def terminal(text: str) -> str:
     """User text for a rich console line: markup (``[bold]``) escaped, and control characters (an ANSI
     escape, a bell, NUL) shown as ``\\xNN`` instead of acting on the terminal; tabs and line ends stay.
@@ -138,6 +144,6 @@ def terminal(text: str) -> str:
     are no markup to escape: tablebot's consoles (``tablebot.cli.common``) are made with ``emoji=False``,
     so print user text only through them.
     """
-    text = _CONTROL_RE.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+    text = plain(text)
     # n backslashes before a tag-like '[' become 2n+1: n literal ones, then a literal '['.
     return _RICH_TAG_RE.sub(lambda m: "\\" * (2 * len(m.group(1)) + 1) + "[", text)

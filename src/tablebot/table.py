@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 from tablebot.robot import Robot, StateId
 
@@ -57,12 +58,35 @@ class Table:
             seen.setdefault(row.next, None)
         return tuple(seen)
 
+    @cached_property
+    def rows_by_state(self) -> dict[StateId, tuple[Row, ...]]:
+        """Each state's rows in table order (built once: analysis asks per state, per finding)."""
+        by_state: dict[StateId, list[Row]] = {}
+        for row in self.rows:
+            by_state.setdefault(row.state, []).append(row)
+        return {state: tuple(rows) for state, rows in by_state.items()}
+
+    @cached_property
+    def memo(self) -> dict[str, Any]:
+        """Values derived once per table by later stages (the analysis's state and event names), so a
+        100,000-row table is not scanned again for every finding."""
+        return {}
+
+    @cached_property
+    def bits(self) -> dict[str, int]:
+        """Each event's bit in the event mask: the first event column is the highest bit."""
+        return {event: 1 << (len(self.events) - 1 - i) for i, event in enumerate(self.events)}
+
     def bit(self, event: str) -> int:
         """The bit of an event in the event mask: the first event column is the highest bit."""
-        return 1 << (len(self.events) - 1 - self.events.index(event))
+        try:
+            return self.bits[event]
+        except KeyError:
+            raise ValueError(f"{event!r} is not an event column of this table") from None
 
     def mask(self, events: frozenset[str] | set[str]) -> int:
-        return sum(self.bit(e) for e in events)
+        bits = self.bits
+        return sum(bits[e] for e in events)
 
     @property
     def input_events(self) -> tuple[str, ...]:

@@ -40,7 +40,7 @@ def find_all(machine: Machine, graph: Graph | None = None, targets: tuple[str, .
 
 
 def rows_of(table: Table, state: StateId) -> list[Row]:
-    return [r for r in table.rows if r.state == state]
+    return list(table.rows_by_state.get(state, ()))
 
 
 def _same_effect(a: Row, b: Row) -> bool:
@@ -55,10 +55,15 @@ def shadowed_rows(table: Table) -> list[Finding]:
     found = []
     for state in table.states:
         rows = rows_of(table, state)
+        first_with: dict[int, int] = {}  # each distinct event mask -> its first row (index in rows)
         for i, row in enumerate(rows):
-            earlier = next((q for q in rows[:i] if q.events <= row.events), None)
-            if earlier is None:
+            mask = table.mask(row.events)
+            # the first earlier row whose events are a subset: compare distinct masks, not every earlier row
+            covering = [k for m, k in first_with.items() if m & mask == m]
+            first_with.setdefault(mask, i)
+            if not covering:
                 continue
+            earlier = rows[min(covering)]
             needs = (f"needs only {events_text(table, earlier.events)}, so it always wins first"
                      if earlier.events else "needs no event at all, so it fires first every time")
             found.append(Finding(
@@ -77,14 +82,29 @@ def overlaps(table: Table) -> list[Finding]:
     for state in table.states:
         rows = rows_of(table, state)
         masks = [table.mask(r.events) for r in rows]
+        first_with: dict[int, int] = {}
+        for i, mask in enumerate(masks):
+            first_with.setdefault(mask, i)
+
+        def winner(events: int, first_with: dict[int, int] = first_with) -> int:
+            """The row that fires for ``events``: the first one whose mask is a subset."""
+            return min(k for m, k in first_with.items() if m & events == m)
+
+        # Only a row that wins its own events can win a pair; per later mask, which of those do.
+        candidates = [i for i, mask in enumerate(masks) if winner(mask) == i]
+        partners: dict[int, list[int]] = {}
         for j, later in enumerate(rows):
-            for i, first in enumerate(rows[:j]):
-                if first.events <= later.events or _same_effect(first, later):
-                    continue  # shadowing is its own finding; same effect means order cannot matter
+            mask = masks[j]
+            if mask not in partners:
+                partners[mask] = [i for i in candidates if masks[i] & mask != masks[i]
+                                  and winner(masks[i] | mask) == i]
+            for i in partners[mask]:
+                if i >= j:
+                    break
+                first = rows[i]
+                if _same_effect(first, later):
+                    continue  # same effect means order cannot matter
                 both = first.events | later.events
-                winner = next(k for k in range(j + 1) if masks[k] & table.mask(both) == masks[k])
-                if winner != i:
-                    continue  # an even earlier row takes this event set: the pair never competes
                 kind = "specific before general" if later.events <= first.events else "neither contains the other"
                 found.append(Finding(
                     "overlap", "info",

@@ -11,10 +11,17 @@ from tablebot.table import TIMER_EVENT, Row, Table
 def state_label(table: Table, state: StateId) -> str:
     """A state's name: from the robot file's ``[states]``, else the description of the row that
     fires on ``T`` alone (what the state does until its time is up), else of its first row."""
+    labels = table.memo.setdefault("state_labels", {})
+    if state not in labels:
+        labels[state] = _label(table, state)
+    return labels[state]
+
+
+def _label(table: Table, state: StateId) -> str:
     named = table.robot.state_names.get(state)
     if named:
         return named
-    rows = [r for r in table.rows if r.state == state]
+    rows = table.rows_by_state.get(state, ())
     for row in rows:
         if row.events == frozenset({TIMER_EVENT}) and row.description:
             return row.description
@@ -29,20 +36,29 @@ def state_text(table: Table, state: StateId) -> str:
 
 def event_name(table: Table, name: str) -> str:
     """``I3 (front-right bumper)``, ``T (timer ran out)``."""
+    names = table.memo.setdefault("event_names", {})
+    if name not in names:
+        names[name] = _event_name(table, name)
+    return names[name]
+
+
+def _event_name(table: Table, name: str) -> str:
     if name == TIMER_EVENT:
         return "T (timer ran out)"
     label = table.robot.labels.get(name)
-    if name in table.robot.counter_names:
+    if table.robot.counters and name in table.robot.counter_names:
         return f"{name} (counter at 0)"
     return f"{name} ({label})" if label else name
 
 
 def events_text(table: Table, events: Iterable[str], short: bool = False) -> str:
     """Events in column order joined with "and"; ``nothing`` for none."""
-    ordered = [e for e in table.events if e in set(events)]
-    if not ordered:
-        return "nothing"
-    return " and ".join(ordered if short else [event_name(table, e) for e in ordered])
+    texts = table.memo.setdefault("events_text", {})
+    key = (frozenset(events), short)
+    if key not in texts:
+        ordered = [e for e in table.events if e in key[0]]
+        texts[key] = " and ".join(ordered if short else [event_name(table, e) for e in ordered]) or "nothing"
+    return texts[key]
 
 
 def mask_events(table: Table, mask: int) -> list[str]:

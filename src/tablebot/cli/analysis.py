@@ -8,6 +8,7 @@ from enum import StrEnum
 from pathlib import Path
 
 import typer
+from rich.text import Text
 
 from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
 from tablebot.analysis.diagram import FORMATS, render
@@ -31,10 +32,12 @@ from tablebot.cli.common import (
     resolve_table_path,
 )
 from tablebot.diagnostics import TableBotError, fail
-from tablebot.escape import terminal
+from tablebot.escape import plain, terminal
 from tablebot.files import write_bytes
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
+#: Findings are printed this many lines at a time (a 100,000-row table can have as many findings).
+PRINT_BATCH = 2000
 
 
 class Format(StrEnum):
@@ -97,11 +100,13 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: b
     console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
                   f"robot {terminal(table.robot.name)}; {report.situations} situations explored")
     hidden: dict[str, int] = {}
+    shown = []
     for finding in report.findings:
         if finding.severity == "info" and not verbose:
             hidden[finding.code] = hidden.get(finding.code, 0) + 1
             continue
-        _print_finding(table.path, finding)
+        shown.append(finding)
+    _print_findings(table.path, shown)
     if report.results:
         sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
         console.print(f"\n[bold]properties[/bold] ({terminal(sources)}):")
@@ -115,13 +120,27 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: b
                   f"{plural(counts['info'], 'note')}{tail}")
 
 
-def _print_finding(path: str, finding: Finding) -> None:
-    where = f"{path}:{finding.lines[0]}" if finding.lines else path
-    colour = COLOURS[finding.severity]
-    console.print(f"[bold]{terminal(where)}:[/bold] [{colour}]{finding.severity}[/{colour}]: "
-                  f"{terminal(finding.message)}")
-    if finding.hint:
-        console.print(f"    [dim]hint:[/dim] {terminal(finding.hint)}")
+def _print_findings(path: str, findings: list[Finding]) -> None:
+    """Findings as styled text (no markup to parse) in batches; plain lines straight to a pipe: a large
+    table can have 100,000 findings, and rich's cost is per line and per call."""
+    terminal_out = console.is_terminal
+    batch: list[Text] = []
+    for finding in findings:
+        where = f"{path}:{finding.lines[0]}" if finding.lines else path
+        line = [(plain(where) + ":", "bold"), (" ", ""), (finding.severity, COLOURS[finding.severity]),
+                (": " + plain(finding.message), "")]
+        if finding.hint:
+            line += [("\n    ", ""), ("hint:", "dim"), (" " + plain(finding.hint), "")]
+        if not terminal_out:
+            sys.stdout.write("".join(text for text, _ in line) + "\n")
+            continue
+        batch.append(Text.assemble(*line))
+        if len(batch) == PRINT_BATCH:
+            console.print(Text("\n").join(batch))
+            batch = []
+    if batch:
+        console.print(Text("\n").join(batch))
+    sys.stdout.flush()
 
 
 def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:

@@ -12,6 +12,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from tablebot import guard
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail, notify
@@ -22,8 +23,9 @@ SEP_RE = re.compile(r"^\s*sep=([,;\t])\s*$")
 MAX_BAD_LINES = 10
 
 
-@dataclass(frozen=True)
-class Cell:
+class Cell(NamedTuple):
+    """One cell's text and where it starts (a tuple: a long table has millions of them)."""
+
     text: str
     line: int
     column: int
@@ -158,12 +160,21 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
         text = text.replace(first, "", 1)
     if delimiter is None:
         delimiter = excel[1] if excel else detect_delimiter(first)
+    stop = re.compile(f"[{re.escape(delimiter)}\n]")
     records: list[Record] = []
     cells: list[Cell] = []
     line, column, i = 1, 1, 0
     record_line = 1
     n = len(text)
     while i <= n:
+        if not cells:  # a record starts: a whole line without quotes is split at once (the usual case)
+            end = text.find("\n", i)
+            end = n if end < 0 else end
+            if '"' not in text[i:end]:
+                records.append(Record(line, _split_line(text[i:end], delimiter, line)))
+                i, line = end + 1, line + 1
+                record_line = line
+                continue
         start_line, start_col = line, column
         if i < n and text[i] == '"':
             value, i, line, column = _quoted(text, i, line, column, path)
@@ -172,9 +183,8 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
                 i += 1
                 column += 1
         else:
-            j = i
-            while j < n and text[j] not in (delimiter, "\n"):
-                j += 1
+            found = stop.search(text, i)  # the cell's end, found in C: a long table has millions of characters
+            j = found.start() if found else n
             value = text[i:j]
             column += j - i
             i = j
@@ -193,6 +203,16 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
     if records and len(records[-1].cells) == 1 and not records[-1].cells[0].text:
         records.pop()  # the empty "record" after the final newline
     return records
+
+
+def _split_line(text: str, delimiter: str, line: int) -> tuple[Cell, ...]:
+    cells = []
+    column = 1
+    make = Cell._make  # tuple.__new__ itself: no Python-level constructor per cell
+    for value in text.split(delimiter):
+        cells.append(make((value, line, column)))
+        column += len(value) + 1
+    return tuple(cells)
 
 
 def _quoted(text: str, i: int, line: int, column: int, path: str) -> tuple[str, int, int, int]:

@@ -7,7 +7,7 @@ as ``file:line:column: message`` with a hint. Loading never executes anything fr
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -58,7 +58,12 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     header, body = records[0], records[1:]
     columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
-    rows = _number([row for record in body for row in [_row(record, columns, robot, out)] if row is not None])
+    memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
+    rows: list[Row] = []
+    for record in body:
+        row = _row(record, columns, robot, out, memo, len(rows), rows[-1].description if rows else "")
+        if row is not None:
+            rows.append(row)
     if not rows and not out.items:
         out.error(header.line + 1, 1, "the table has a header but no rows",
                   "add one row per transition below the header")
@@ -188,8 +193,10 @@ NUMBERS: dict[str, tuple[int, int, int | None, bool]] = {
 }
 
 
-def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) -> Row | None:
-    """The row of one record, or None when its state or next state is unreadable.
+def _row(record: Record, columns: list[Column], robot: Robot, out: Collector,
+         memo: dict[tuple[int, str], Any], index: int, above: str) -> Row | None:
+    """The row of one record (the ``index``-th, 0-based; a blank description continues ``above``, the
+    one of the row before), or None when its state or next state is unreadable.
 
     A row with other bad cells is still returned (with the bad cells at their blank value) so that
     its state counts as having rows; the collected errors stop the table from being used.
@@ -197,17 +204,33 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector) ->
     cells = list(record.cells[: len(columns)])
     end = (cells[-1].column + len(cells[-1].text) + 1) if cells else 1
     cells += [Cell("", record.line, end)] * (len(columns) - len(cells))
-    values = {(c.kind, c.name): _value(c, cell, out) for c, cell in zip(columns, cells, strict=True)}
+    values = {(c.kind, c.name): _cached(i, c, cell, out, memo) for i, (c, cell) in enumerate(zip(columns, cells,
+                                                                                               strict=True))}
     cells_beyond(record.cells, len(columns), out)
     state, nxt = values.get(("state", "state")), values.get(("next", "next"))
     if state is None or nxt is None:
         return None
-    return Row(index=-1, line=record.line, description=values.get(("description", "description")) or "",
+    return Row(index=index, line=record.line, description=values.get(("description", "description")) or above,
                state=state, events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
                motors=tuple(_motor(motor, values) for motor in robot.motors),
                timer=values.get(("timer", "timer")) or 0, next=nxt,
-               counters=tuple(values.get(("load", c)) for c in robot.counter_names),
+               counters=tuple(values.get(("load", c.name)) for c in robot.counters),
                lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
+
+
+def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any]) -> Any:
+    """:func:`_value`, remembered per column and text: a long table repeats the same few cell texts.
+    A cell with an error is never remembered, so every bad cell is reported at its own place."""
+    if column.kind == "description":
+        return cell.text.strip()
+    key = (index, cell.text)
+    if key in memo:
+        return memo[key]
+    errors = len(out.items)
+    value = _value(column, cell, out)
+    if len(out.items) == errors:
+        memo[key] = value
+    return value
 
 
 def _value(column: Column, cell: Cell, out: Collector) -> Any:
@@ -235,16 +258,6 @@ def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:
     if speed == DOC_KEEP_SPEED:
         return None
     return -speed if values.get(("dir", motor)) else speed
-
-
-def _number(rows: list[Row]) -> list[Row]:
-    """Give rows their 0-based index and let a blank description continue the one above."""
-    numbered: list[Row] = []
-    description = ""
-    for index, row in enumerate(rows):
-        description = row.description or description
-        numbered.append(replace(row, index=index, description=description))
-    return numbered
 
 
 def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[Column],
