@@ -1,16 +1,24 @@
-"""How long `tablebot check` takes: the BumberBot with its shipped properties (target < 1 s) and a
-random 50-state, 500-row table with four properties (target < 10 s). Prints medians.
+"""How long `tablebot check` takes: the BumberBot with its shipped properties (target < 1 s), a
+random 50-state, 500-row table with four properties (target < 10 s), and how the findings of a
+table scale: `tablebot check` run as a whole process on tables of 1,000, 10,000 and 100,000 rows
+(100 rows per state; 1,000 states at 100,000 rows; target < 10 s), with the growth reported as the
+slope of log(time) over log(rows) (1 = linear). Prints medians.
 
-    .venv/bin/python benchmarks/check.py [--repeat N] [--seed S]
+    .venv/bin/python benchmarks/check.py [--repeat N] [--seed S] [--no-scaling]
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
+import math
+import os
 import random
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -73,10 +81,64 @@ def check_once(machine: Machine, props: list[Property]) -> str:
     return f"[{report.situations} situations; {status}]"
 
 
+SCALE_ROWS = (1_000, 10_000, 100_000)
+ROWS_PER_STATE = 100
+SCALE_TARGET = 10.0
+
+
+def scale_csv(rows: int, seed: int) -> str:
+    """A BumberBot table of ``rows`` rows, 100 per state: each row needs one or two events, sets
+    speeds from a few values (or keeps them), loads a timer and goes to any state."""
+    rng = random.Random(seed)
+    lines = ["description,state," + ",".join(EVENTS) + ",M1,M2,timer,next"]
+    states = rows // ROWS_PER_STATE
+    for state in range(1, states + 1):
+        for k in range(ROWS_PER_STATE):
+            events = set(rng.sample(EVENTS, rng.choice((1, 1, 2))))
+            motors = [rng.choice(("3", "-3", "0", "=", "5")) for _ in range(2)]
+            cells = ["1" if e in events else "" for e in EVENTS]
+            lines.append(f"row {state}.{k},{state},{','.join(cells)},{motors[0]},{motors[1]},"
+                         f"{rng.randint(0, 300)},{rng.randint(1, states)}")
+    return "\n".join(lines) + "\n"
+
+
+def check_process(path: Path) -> float:
+    """Seconds of one `tablebot check TABLE` process (start-up, loading, findings, printing to a pipe)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "tablebot.cli", "check", str(path)], capture_output=True,
+                          env=env, check=False)
+    elapsed = time.perf_counter() - start
+    if done.returncode not in (0, 1):
+        raise SystemExit(f"tablebot check failed on {path}:\n{done.stderr.decode()}")
+    return elapsed
+
+
+def scaling(seed: int, repeat: int) -> bool:
+    """Time check on each size; print medians and the log-log slope between sizes and overall."""
+    medians = []
+    with tempfile.TemporaryDirectory() as folder:
+        for rows in SCALE_ROWS:
+            path = Path(folder) / f"t{rows}.csv"
+            path.write_text(scale_csv(rows, seed), encoding="utf-8")
+            times = [check_process(path) for _ in range(repeat)]
+            medians.append(statistics.median(times))
+            print(f"check, {rows:>7,} rows, {rows // ROWS_PER_STATE:>5,} states (whole process)  median "
+                  f"{medians[-1]:7.2f} s  (min {min(times):.2f}, max {max(times):.2f}, n={repeat})")
+    logs = [(math.log(r), math.log(t)) for r, t in zip(SCALE_ROWS, medians, strict=True)]
+    steps = [(b[1] - a[1]) / (b[0] - a[0]) for a, b in itertools.pairwise(logs)]
+    overall = (logs[-1][1] - logs[0][1]) / (logs[-1][0] - logs[0][0])
+    print(f"growth: slope {' then '.join(f'{s:.2f}' for s in steps)} (overall {overall:.2f}; 1 = linear, "
+          f"2 = quadratic); 100k/10k time ratio {medians[-1] / medians[-2]:.1f}x for 10x the rows")
+    print(f"target (100,000 rows < {SCALE_TARGET:g} s): {'met' if medians[-1] < SCALE_TARGET else 'MISSED'}")
+    return medians[-1] < SCALE_TARGET
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--no-scaling", action="store_true", help="skip the 1k/10k/100k-row process timings")
     args = parser.parse_args()
 
     def bumberbot() -> str:  # loading included: this is what `tablebot check examples/bumberbot` does
@@ -91,6 +153,8 @@ def main() -> int:
     large = timed("random 50 states, 500 rows, 4 properties", random_50, max(3, args.repeat // 2))
     ok = small < 1.0 and large < 10.0
     print(f"targets (< 1 s, < 10 s): {'met' if ok else 'MISSED'}")
+    if not args.no_scaling:
+        ok = scaling(args.seed, max(1, args.repeat // 2)) and ok
     return 0 if ok else 1
 
 

@@ -3,7 +3,7 @@ counterexample CSVs (inputs files that ``tablebot trace`` replays)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -54,11 +54,18 @@ class CheckReport:
         return 1 if strict and counts["warning"] else 0
 
 
-def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = ()) -> CheckReport:
+def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = (),
+              step: Callable[[str], None] = lambda what: None) -> CheckReport:
+    """Explore, find, prove; ``step`` is told what starts next (a progress display)."""
     try:
+        step("exploring the situations")
         graph = Model(machine).explore()
+        step("looking for findings")
         findings = find_all(machine, graph, targets)
-        results = [check_property(p, machine) for p in props]
+        results = []
+        for prop in props:
+            step(f"property {prop.name}")
+            results.append(check_property(prop, machine))
     except ModelTooLarge as exc:
         raise fail(machine.table.path, f"too large to explore: {exc}",
                    "split the table, or give states fewer inputs to look at") from None

@@ -23,6 +23,7 @@ from tablebot.cli.common import (
     FORCE_OPT,
     ROBOT_OPT,
     TABLE_ARG,
+    Stages,
     console,
     err_console,
     guarded,
@@ -67,9 +68,13 @@ def check_cmd(
     for name in target:
         if name not in TARGETS:
             raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(TARGETS)}")
-    _, machine = load(table, robot)
-    files = properties or find_property_files(resolve_table_path(table))
-    report = run_check(machine, load_properties(machine, files), tuple(target))
+    with Stages(total=3) as stages:
+        stages.step(f"reading {table}")
+        _, machine = load(table, robot)
+        files = properties or find_property_files(resolve_table_path(table))
+        props = load_properties(machine, files)
+        stages.progress.update(stages.task, total=3 + len(props))
+        report = run_check(machine, props, tuple(target), stages.step)
     report.property_files = files
     found = any(r.inputs for r in report.results)
     unsaved = _save_counterexamples(report, cex_dir) if cex_dir is not None and found else None

@@ -6,6 +6,7 @@ import errno
 import functools
 import os
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -98,6 +99,37 @@ def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
     robot = load_robot(robot_path) if robot_path else None
     table = load_table(resolve_table_path(path), robot)
     return table, compile_table(table)
+
+
+class Stages:
+    """A progress bar on a terminal's stderr for a command made of steps, shown only once it has taken
+    longer than ``delay`` seconds (a quick run prints nothing extra); use as a context manager."""
+
+    def __init__(self, total: int, delay: float = 1.0):
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                 TimeElapsedColumn(), console=err_console, transient=True)
+        self.task = self.progress.add_task("reading", total=total)
+        self.timer = threading.Timer(delay, self.progress.start)
+        self.timer.daemon = True
+        self.started = False
+
+    def __enter__(self) -> Stages:
+        if err_console.is_terminal:
+            self.timer.start()
+        return self
+
+    def step(self, what: str) -> None:
+        """The next step begins (the previous one is done)."""
+        if self.started:
+            self.progress.advance(self.task)
+        self.started = True
+        self.progress.update(self.task, description=terminal(what))
+
+    def __exit__(self, *exc: object) -> None:
+        self.timer.cancel()
+        self.progress.stop()
 
 
 def print_diagnostic(d: Diagnostic) -> None:
