@@ -15,8 +15,10 @@ from typing import IO, Any
 
 import numpy as np
 
+from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.files import PendingFile
+from tablebot.formats.csvtext import read_text
 from tablebot.formats.inputs_csv import TickInput, load_inputs  # noqa: F401  (load_inputs: for callers)
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW, Machine
