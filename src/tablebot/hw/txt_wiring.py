@@ -172,10 +172,12 @@ def suggest(robot: Robot, machine: Machine) -> str:
             terminal = name if name in free[kind] else (free[kind][0] if free[kind] else "?")
             if terminal in free[kind]:
                 free[kind].remove(terminal)
-            value = (f'{{ terminal = "{terminal}", mode = "switch", pressed = 1 }}' if kind == "input"
-                     else f'"{terminal}"')
-            lines.append(f"    {name} = {value}")
-    return "\n".join(lines)
+            label = robot.labels.get(name, "").lower()
+            mode = ('mode = "phototransistor", lit = 1' if "photo" in label or "light" in label
+                    else 'mode = "switch", pressed = 1')
+            lines.append(f'{name} = {{ terminal = "{terminal}", {mode} }}' if kind == "input"
+                         else f'{name} = "{terminal}"')
+    return "\n".join(f"        {line}" for line in lines)
 
 
 def _error(src: Source, line: int | None, message: str, hint: str) -> None:
