@@ -1,6 +1,7 @@
 """The trace of a live run, written as it happens: the core trace line of every tick plus the wall-clock
-time, each counter's pulses and what else the robot reported; a run that did not finish normally ends
-with ``{"end": REASON, "tick": N, "why": ...}``. A summary of the run goes beside it.
+time, each counter's pulses and what else the robot reported. A run that did not finish normally ends
+with ``{"end": REASON, "tick": N, "why": ...}``, N being the tick it ended in (the first one not traced).
+A summary of the run goes beside it.
 
 Files go through :class:`tablebot.files.PendingFile`: a complete run becomes ``trace.jsonl``, a planned
 run cut short ``trace.partial.jsonl``; the previous complete run's files are never overwritten by a
@@ -59,6 +60,7 @@ class TraceSink:
         self.written: list[Path] = []
         self.visits: dict[Any, int] = {}
         self.fired = 0
+        self.count = 0  # tick lines written
         self.started = 0.0
 
     def start(self, info: RunInfo) -> None:
@@ -72,6 +74,7 @@ class TraceSink:
         lines = tick_lines(machine, block, self.clock())
         self.file.stream.write("".join(dumps(line) + "\n" for line in lines))
         self.file.stream.flush()  # a crash keeps every tick written so far (in the temporary file)
+        self.count += len(lines)
         for line in lines:
             self.visits[line["state"]] = self.visits.get(line["state"], 0) + 1
             self.fired += line["row"] is not None
@@ -80,7 +83,8 @@ class TraceSink:
         if self.file is None or self.info is None:
             return
         if end.reason != "done":
-            self.file.stream.write(dumps({END_KEY: end.reason, "tick": end.ticks, "why": end.message}) + "\n")
+            # "tick": the tick the run ended in, the first one the trace does not have
+            self.file.stream.write(dumps({END_KEY: end.reason, "tick": self.count, "why": end.message}) + "\n")
         trace = self.file.commit() if end.complete else self.file.keep_partial()
         summary = self.folder / "summary.json"
         summary = summary if end.complete else partial_name(summary)
