@@ -62,6 +62,7 @@ def run_cmd(
                                               "reply that end the run as link_lost (default: 5 ticks)."),
     behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when a tick starts this "
                                        "many seconds late, rather than stretch the table's timers (0: never)."),
+    seed: int = typer.Option(1, "--seed", min=0, help="sim: the seed of all simulated noise (as tablebot sim)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
@@ -74,7 +75,7 @@ def run_cmd(
     if out is not None:
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
     bot, device, clock = (_txt(machine, target, link_timeout or 5 * tick_s) if target.kind == "txt"
-                          else _sim(machine, target))
+                          else _sim(machine, target, seed))
     end = _drive(machine, bot, device, clock, ticks, out, behind_limit or None, quiet)
     if end.exit_code:
         raise typer.Exit(end.exit_code)
@@ -103,18 +104,17 @@ def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[Robot
     return bot, f"{status.device} {status.version_text}", PacedClock(machine.table.robot.tick_ms / 1000)
 
 
-def _sim(machine: Machine, target: Target) -> tuple[RobotIO, str, Any]:
+def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, Any]:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
-    try:
-        from tablebot.sim.robot import SimRobot  # type: ignore[import-not-found]
-    except ImportError:
-        raise fail("--on", "this tablebot cannot run the simulator through `run` yet",
-                   "use `tablebot sim` meanwhile") from None
     from tablebot.hw.pacing import PacedClock
     from tablebot.sim import scene as sim_scene
+    from tablebot.sim.robot import SimRobot
 
     scene = sim_scene.scene_for(machine.table, machine, target.world)
-    return SimRobot(scene), "simulated", PacedClock(machine.table.robot.tick_ms / 1000)
+    bot = SimRobot(scene, seed)
+    bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
+    bot.reset(seed=seed)
+    return bot, f"simulated, seed {seed}", PacedClock(machine.table.robot.tick_ms / 1000)
 
 
 def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int | None, out: Path | None,
@@ -122,13 +122,13 @@ def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int |
     """The loop with its sinks: the live view first (so it always ends first and restores the terminal)."""
     from tablebot.engine import Engine
     from tablebot.hw.live_view import LiveView
-    from tablebot.hw.run_trace import TraceSink
+    from tablebot.hw.run_trace import RunTrace
     from tablebot.loop import run
 
     sinks: list[Any] = []
     if not quiet and err_console.is_terminal:
         sinks.append(LiveView(err_console, device))
-    trace = TraceSink(out) if out is not None else None
+    trace = RunTrace(out) if out is not None else None
     if trace is not None:
         sinks.append(trace)
     target = getattr(bot, "target", "sim")
@@ -149,6 +149,6 @@ def _report(end: RunEnd, machine: Machine, trace: Any) -> None:
     console.print(escape(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"), highlight=False)
     if end.late_ticks:
         console.print(f"{end.late_ticks} ticks started late (worst {1000 * end.worst_late_s:.1f} ms)")
-    for path in getattr(trace, "written", []):
+    for path in trace.files if trace is not None else []:
         err_console.print(escape(f"wrote {path}"), highlight=False)
     sys.stdout.flush()

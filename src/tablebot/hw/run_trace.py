@@ -1,103 +1,79 @@
-"""The trace of a live run, written as it happens: the core trace line of every tick plus the wall-clock
-time, each counter's pulses and what else the robot reported. A run that did not finish normally ends
-with ``{"end": REASON, "tick": N, "why": ...}``, N being the tick it ended in (the first one not traced).
-A summary of the run goes beside it.
-
-Files go through :class:`tablebot.files.PendingFile`: a complete run becomes ``trace.jsonl``, a planned
-run cut short ``trace.partial.jsonl``; the previous complete run's files are never overwritten by a
-partial one.
+"""The trace of a live run, written as it happens: :class:`tablebot.trace.TraceFile` (the core trace line
+of every tick; ``trace.jsonl`` when complete, ``trace.partial.jsonl`` ending with an ``end`` record when
+cut short) plus each tick's wall-clock time and each counter's pulses, flushed tick by tick, and a
+summary of the run beside it.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from tablebot.files import PendingFile, partial_name, write_text
+from tablebot.files import partial_name, write_text
 from tablebot.loop import RunEnd, RunInfo, TickBlock
-from tablebot.machine import NO_ROW, Machine
-from tablebot.trace import dumps
+from tablebot.machine import NO_ROW
+from tablebot.trace import TraceFile
 
-#: Keys a run trace adds after the core ones (besides ``<counter>_pulses`` and the robot's own extras).
-WALL_KEY = "wall"
-END_KEY = "end"
+WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
 
 
 def pulses_key(counter: str) -> str:
     return f"{counter}_pulses"
 
 
-def tick_lines(machine: Machine, block: TickBlock, wall: float | None = None) -> list[dict[str, Any]]:
-    """One trace line per tick of ``block``: the core keys exactly as :func:`tablebot.trace.record` writes
-    them, then ``wall`` (Unix time, ms), ``<counter>_pulses``, then the block's extra columns."""
-    names, counters = machine.output_names, machine.table.robot.counter_names
-    lines = []
-    for i in range(len(block)):
-        row = int(block.rows[i])
-        line: dict[str, Any] = {"tick": block.start + i, "event": int(block.events[i]),
-                                "row": None if row == NO_ROW else row,
-                                "state": machine.states[int(block.states[i])], "timer": int(block.timers[i])}
-        line.update(zip(names, (int(v) for v in block.outputs[i]), strict=True))
-        line.update(zip(counters, (int(v) for v in block.counters[i]), strict=True))
-        if wall is not None:
-            line[WALL_KEY] = round(wall, 3)
-        line.update({pulses_key(c): int(p) for c, p in zip(counters, block.pulses[i], strict=True)})
-        line.update({key: column[i] for key, column in block.extra.items()})
-        lines.append(line)
-    return lines
-
-
-class TraceSink:
+class RunTrace(TraceFile):
     """Writes ``trace.jsonl`` and ``summary.json`` into ``folder`` while the run goes."""
 
     def __init__(self, folder: Path, clock: Callable[[], float] = time.time):
+        super().__init__(folder / "trace.jsonl")
         self.folder, self.clock = folder, clock
-        self.file: PendingFile | None = None
         self.info: RunInfo | None = None
-        self.written: list[Path] = []
-        self.visits: dict[Any, int] = {}
+        self.visits: dict[int, int] = {}  # state index -> ticks
         self.fired = 0
-        self.count = 0  # tick lines written
         self.started = 0.0
 
     def start(self, info: RunInfo) -> None:
+        super().start(info)
         self.info = info
-        self.file = PendingFile(self.folder / "trace.jsonl")
         self.started = time.monotonic()
 
     def block(self, block: TickBlock) -> None:
-        assert self.file is not None and self.info is not None
-        machine = self.info.engine.machine
-        lines = tick_lines(machine, block, self.clock())
-        self.file.stream.write("".join(dumps(line) + "\n" for line in lines))
-        self.file.stream.flush()  # a crash keeps every tick written so far (in the temporary file)
-        self.count += len(lines)
-        for line in lines:
-            self.visits[line["state"]] = self.visits.get(line["state"], 0) + 1
-            self.fired += line["row"] is not None
+        n = len(block)
+        counters = self.machine.table.robot.counter_names
+        extra: dict[str, Any] = {WALL_KEY: [round(self.clock(), 3)] * n}
+        extra.update({pulses_key(c): [int(p[i]) for p in block.pulses] for i, c in enumerate(counters)})
+        extra.update(block.extra)
+        super().block(dataclasses.replace(block, extra=extra))
+        self.file.stream.flush()  # a crash keeps every tick so far (in the temporary file)
+        for state, row in zip(block.states, block.rows, strict=True):
+            self.visits[int(state)] = self.visits.get(int(state), 0) + 1
+            self.fired += int(row) != NO_ROW
 
     def end(self, end: RunEnd) -> None:
-        if self.file is None or self.info is None:
+        if self.info is None:
             return
-        if end.reason != "done":
-            # "tick": the tick the run ended in, the first one the trace does not have
-            self.file.stream.write(dumps({END_KEY: end.reason, "tick": self.count, "why": end.message}) + "\n")
-        trace = self.file.commit() if end.complete else self.file.keep_partial()
+        super().end(end)
+        assert self.written is not None
         summary = self.folder / "summary.json"
-        summary = summary if end.complete else partial_name(summary)
-        write_text(summary, json.dumps(self.summary(end, trace), indent=2, ensure_ascii=False) + "\n")
-        self.written = [trace, summary]
+        summary = summary if self.written.name == self.path.name else partial_name(summary)
+        write_text(summary, json.dumps(self.summary(end), indent=2, ensure_ascii=False) + "\n")
+        self.summary_written = summary
 
-    def summary(self, end: RunEnd, trace: Path) -> dict[str, Any]:
+    @property
+    def files(self) -> list[Path]:
+        return [p for p in (self.written, getattr(self, "summary_written", None)) if p is not None]
+
+    def summary(self, end: RunEnd) -> dict[str, Any]:
         """What the run did, as plain JSON."""
-        assert self.info is not None
-        tick_s = self.info.tick_s
+        assert self.info is not None and self.written is not None
+        tick_s, states = self.info.tick_s, self.machine.states
         return {
             "target": self.info.target,
-            "table": self.info.engine.machine.table.path,
+            "table": self.machine.table.path,
             "ended": end.reason,
             "exit_code": end.exit_code,
             "why": end.message,
@@ -107,6 +83,6 @@ class TraceSink:
             "late_ticks": end.late_ticks,
             "worst_late_ms": round(1000 * end.worst_late_s, 3),
             "rows_fired": self.fired,
-            "seconds_per_state": {str(state): round(n * tick_s, 3) for state, n in self.visits.items()},
-            "trace": trace.name,
+            "seconds_per_state": {str(states[s]): round(n * tick_s, 3) for s, n in self.visits.items()},
+            "trace": self.written.name,
         }
