@@ -152,3 +152,20 @@ def _report(end: RunEnd, machine: Machine, trace: Any) -> None:
     for path in trace.files if trace is not None else []:
         err_console.print(escape(f"wrote {path}"), highlight=False)
     sys.stdout.flush()
+
+
+@app.command("upload")
+@guarded
+def upload_cmd(
+    folder: Path = typer.Argument(..., help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
+    to: str = typer.Option(..., "--to", help="The TXT 4.0: txt4://192.168.7.2 (USB), txt4://HOST[:PORT]."),
+    key: str = typer.Option(..., "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO Pro "
+                            "Coding asks for it)."),
+    start: bool = typer.Option(True, "--start/--no-start", help="Start the program once it is uploaded."),
+) -> None:
+    """Install an exported TXT 4.0 program on the controller through its REST API, and start it."""
+    from tablebot.hw.txt4_upload import upload
+
+    if not folder.is_dir():
+        raise fail(folder, "no such folder", "give the folder `tablebot export --to txt4` wrote")
+    upload(folder, to, key, start, say=lambda text: console.print(escape(text), highlight=False))
