@@ -135,8 +135,13 @@ def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int |
     if not quiet:
         err_console.print(escape(f"running {machine.table.path} on {target} ({device}); Ctrl-C stops it"),
                           highlight=False)
-    end = run(Engine(machine), bot, clock=clock, sinks=sinks, ticks=ticks, target=target,
-              behind_limit_s=behind_limit_s)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
+    try:
+        end = run(Engine(machine), bot, clock=clock, sinks=sinks, ticks=ticks, target=target,
+                  behind_limit_s=behind_limit_s)
+    finally:
+        sys.setswitchinterval(switch)
     if not quiet:
         _report(end, machine, trace)
     return end
