@@ -38,7 +38,7 @@ def bumberbot() -> Machine:
     return compile_table(load_table(EXAMPLE / "table.csv"))
 
 
-def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple = (), timeout_s: float = 0.05,
+def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple = (), timeout_s: float = 0.15,
           behind_limit_s: float | None = None) -> RunEnd:
     robot = TxtRobot(txt_wiring(machine), "127.0.0.1", fake.port, link_timeout_s=timeout_s)
     robot.connect()
@@ -178,7 +178,7 @@ def test_a_faulty_link_ends_the_run_as_link_lost_with_the_outputs_zeroed_where_t
         fault: str, flavour: dict) -> None:
     with FakeTxt(fault=(fault, 15), **flavour) as fake:
         started = time.monotonic()
-        end = drive(bumberbot(), fake, ticks=100)
+        end = drive(bumberbot(), fake, ticks=100, timeout_s=0.1)
         took = time.monotonic() - started
     assert end.reason == "link_lost" and end.exit_code == 3 and 13 <= end.ticks <= 15, end
     assert took < 2.0
@@ -197,7 +197,7 @@ def test_a_closed_socket_ends_the_run_as_link_lost(flavour: dict) -> None:
 
 def test_a_late_reply_within_the_deadline_is_a_late_tick_not_a_lost_link() -> None:
     with FakeTxt(fault=("late", 10), late_s=0.03) as fake:
-        end = drive(bumberbot(), fake, ticks=30, timeout_s=0.1)
+        end = drive(bumberbot(), fake, ticks=30, timeout_s=0.2)
     assert end.reason == "done" and end.late_ticks >= 1 and end.worst_late_s > 0.02
 
 
