@@ -65,29 +65,40 @@ def test_polarity_and_thresholds_decide_what_the_table_reads(tmp_path: Path) -> 
     assert wiring.raw([0, 19, 5001, 0, 0, 0, 0, 999]) == {"I4_raw": 19, "I5_raw": 5001, "I8_raw": 999}
 
 
-def test_every_problem_of_the_section_is_reported_at_once_with_its_line(tmp_path: Path) -> None:
+def check_found(found: list[str], path: Path, expect: list[tuple[int, str, str]]) -> None:
+    for line, message, hint in expect:
+        assert any(f.startswith(f"{path}:{line}:1: error: {message}") and hint in f for f in found), (message, found)
+    assert len(found) == len(expect)
+
+
+def test_every_mistake_in_the_section_is_reported_at_once_with_its_line_when_the_robot_file_is_read(
+        tmp_path: Path) -> None:
     text = ROBOT
-    for old, new in [("tick_ms = 10 ", "tick_ms = 5 "), ('terminal = "I4"', 'terminal = "I9"'),
+    for old, new in [('terminal = "I4"', 'terminal = "I9"'),
                      ('terminal = "I5", mode = "switch", pressed = 1', 'terminal = "I3", mode = "switch"'),
                      ('I8 = { terminal = "I8", mode = "phototransistor", lit = 1 }', 'X1 = "I1"'),
                      ('M2 = "M2"', 'M2 = "m1"')]:
         text = text.replace(old, new)
-    path = tmp_path / "robot.toml"
     found = errors(tmp_path, text)
-    expect = [
+    check_found(found, tmp_path / "robot.toml", [
         (line_of(text, 'I4 = { terminal = "I9"'), "input I4: the TXT has no input terminal 'I9'", "I1..I8"),
         (line_of(text, 'I5 = { terminal = "I3"'), "input I5: terminal I3 is already used by I3", "of its own"),
         (line_of(text, 'I5 = { terminal = "I3"'), "[txt] I5: say what the table reads while the push-button is pressed",
          "pressed = 1 is the usual wiring"),
-        (line_of(text, 'I8 = "left phototransistor"'), "input I8 is used by the table but not wired to the TXT",
-         "add it to [txt]"),
         (line_of(text, 'M2 = "m1"'), "motor M2: the TXT has no motor terminal 'm1'", "write 'M1'"),
         (line_of(text, 'X1 = "I1"'), "[txt] wires 'X1', which robot BumberBot does not have", "wire the robot's"),
+    ])
+
+
+def test_what_the_table_needs_and_the_section_lacks_is_reported_with_its_line(tmp_path: Path) -> None:
+    text = ROBOT.replace("tick_ms = 10 ", "tick_ms = 5 ").replace(
+        'I8 = { terminal = "I8", mode = "phototransistor", lit = 1 }\n', "").replace('M2 = "M2"\n', "")
+    check_found(errors(tmp_path, text), tmp_path / "robot.toml", [
+        (line_of(text, 'I8 = "left phototransistor"'), "input I8 is used by the table but not wired to the TXT",
+         'I8 = { terminal = "I1", mode = "switch", pressed = 1 }'),
+        (line_of(text, 'M2 = "left motor"'), "motor M2 is used by the table but not wired to the TXT", 'M2 = "M1"'),
         (line_of(text, "tick_ms = 5"), "tick_ms = 5 is shorter than the TXT's exchange", "tick_ms = 10"),
-    ]
-    for line, message, hint in expect:
-        assert any(f.startswith(f"{path}:{line}:1: error: {message}") and hint in f for f in found), (message, found)
-    assert len(found) == len(expect)
+    ])
 
 
 @pytest.mark.parametrize(("entry", "message"), [

@@ -131,7 +131,8 @@ def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
         if not isinstance(data, dict) or "end" in data:
             break
         values = [data.get(key) for key in keys]
-        bad = [key for key, v in zip(keys, values, strict=True) if isinstance(v, bool) or not isinstance(v, int) or v < 0]
+        bad = [key for key, v in zip(keys, values, strict=True)
+               if isinstance(v, bool) or not isinstance(v, int) or v < 0]
         if bad:
             out.error(number, 1, f"this trace line has no whole-number {bad[0]}",
                       "replay a trace that a run of this table recorded (tablebot run --out)")

@@ -19,13 +19,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tablebot.formats.tomlfile import Source
 from tablebot.hw import txt_wire as wire
-from tablebot.machine import Machine
-from tablebot.robot import Robot
 from tablebot.table import MAX_LAMP, MAX_SPEED
+
+if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
+    from tablebot.machine import Machine
+    from tablebot.robot import Robot
 
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
 PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 = PWM 512
@@ -129,29 +131,74 @@ class TxtWiring:
         return {f"{inp.name}_raw": universal[inp.terminal] for inp in self.inputs if not inp.digital}
 
 
+@dataclass(frozen=True)
+class TxtSection:
+    """``[txt]`` as the robot file says it, checked on its own (terminals the TXT has, each used once, modes
+    and polarities stated, names the robot has); :func:`txt_wiring` checks it against a table."""
+
+    inputs: dict[str, InputWire]
+    outputs: dict[str, OutputWire]
+    counters: dict[str, int]  # name -> terminal 0..3
+
+
+def read_robot_txt(src: Source, section: Any, robot: Robot) -> TxtSection:
+    """The robot file's ``[txt]`` (a reader of :data:`tablebot.robot.SECTION_READERS`): errors go to ``src``
+    with their lines; an entry with a mistake is left out."""
+    found = TxtSection({}, {}, {})
+    if not isinstance(section, dict):
+        _error(src, src.line("", None, "txt"), "[txt] must be a table of NAME = terminal", 'for example: M1 = "M1"')
+        return found
+    reader = _Reader(robot, src, section)
+    for name in section:
+        if name in robot.inputs:
+            wired: Any = reader.input(name)
+            into: dict[str, Any] = found.inputs
+        elif name in robot.motors or name in robot.lamps:
+            wired, into = reader.output(name), found.outputs
+        elif name in robot.counter_names:
+            wired, into = reader.counter(name), found.counters
+        else:
+            reader.error(name, f"[txt] wires {name!r}, which robot {robot.name} does not have",
+                         "wire the robot's inputs, motors, lamps and counters (names from the robot file)")
+            continue
+        if wired is not None:
+            into[name] = wired
+    return found
+
+
 def txt_wiring(machine: Machine) -> TxtWiring:
-    """The ``[txt]`` wiring of the table's robot, checked against what the table needs; every problem is
-    reported at once with its robot-file line."""
+    """The ``[txt]`` wiring of the table's robot, checked against what the table needs (every input it
+    reads, every motor, lamp and counter; a tick the TXT can keep); every problem at once, with its line."""
     robot = machine.table.robot
     src = robot.file_source()
     section = robot.sections.get("txt")
     if section is None:
         raise_missing(robot, machine)
-    if not isinstance(section, dict):
-        _error(src, None, "[txt] must be a table of NAME = terminal", 'for example: M1 = "M1"')
+    if not isinstance(section, TxtSection):  # a Robot made in code, holding the section's raw data
+        section = read_robot_txt(src, section, robot)
         src.raise_if_any()
-    reader = _Reader(robot, src, section)  # type: ignore[arg-type]
-    # Every input the table uses must be wired; one it does not use is still checked when [txt] names it.
-    read = {name: reader.input(name) for name in robot.inputs if name in machine.input_bits or name in section}
-    inputs = tuple(w for name in machine.input_bits if (w := read[name]) is not None)
-    outputs = tuple(w for name in machine.output_names if (w := reader.output(name)) is not None)
-    counters = tuple(t for name in robot.counter_names if (t := reader.counter(name)) is not None)
-    reader.check_unknown()
+    wired = {**section.inputs, **section.outputs, **section.counters}
+    for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
+                        ("counter", robot.counter_names)):
+        for name in names:
+            if name not in wired:
+                _unwired(src, robot, kind, name)
     if robot.tick_ms < MIN_TICK_MS:
         _error(src, robot.line("", "tick_ms"), f"tick_ms = {robot.tick_ms} is shorter than the TXT's exchange "
                f"(one every {MIN_TICK_MS} ms)", f"use tick_ms = {MIN_TICK_MS} or more to run on a TXT")
     src.raise_if_any()
-    return TxtWiring(inputs, tuple(machine.input_bits[w.name] for w in inputs), outputs, counters)
+    inputs = tuple(section.inputs[name] for name in machine.input_bits)
+    return TxtWiring(inputs, tuple(machine.input_bits[w.name] for w in inputs),
+                     tuple(section.outputs[name] for name in machine.output_names),
+                     tuple(section.counters[name] for name in robot.counter_names))
+
+
+def _unwired(src: Source, robot: Robot, kind: str, name: str) -> None:
+    """A name the table needs that [txt] does not wire: reported at its line in [inputs], [motors], ..."""
+    example = (f'{name} = {{ terminal = "I1", mode = "switch", pressed = 1 }}' if kind == "input"
+               else f'{name} = "{KINDS[kind]}1"')
+    _error(src, robot.line(f"{kind}s", name) or src.line("txt"), f"{kind} {name} is used by the table but not "
+           "wired to the TXT", f"add it to [txt], for example: {example}")
 
 
 def raise_missing(robot: Robot, machine: Machine) -> None:
@@ -197,18 +244,6 @@ class _Reader:
     def error(self, name: str, message: str, hint: str) -> None:
         _error(self.src, self.line(name), message, hint)
 
-    def entry(self, name: str, kind: str) -> Any:
-        """The raw value for ``name``, or None after reporting that the table needs it."""
-        if name in self.section:
-            return self.section[name]
-        section = {"input": "inputs", "motor": "motors", "lamp": "lamps", "counter": "counters"}[kind]
-        example = (f'{name} = {{ terminal = "I1", mode = "switch", pressed = 1 }}' if kind == "input"
-                   else f'{name} = "{KINDS[kind]}1"')
-        _error(self.src, self.robot.line(section, name) or self.src.line("txt"),
-               f"{kind} {name} is used by the table but not wired to the TXT",
-               f"add it to [txt], for example: {example}")
-        return None
-
     def terminal(self, name: str, kind: str, value: Any) -> int | None:
         """``"I3"`` -> 2 for kind input (M for motors, O for lamps, C for counters), or None after an error."""
         prefix, count = KINDS[kind], COUNT[kind]
@@ -240,9 +275,7 @@ class _Reader:
         return index
 
     def input(self, name: str) -> InputWire | None:
-        value = self.entry(name, "input")
-        if value is None:
-            return None
+        value = self.section[name]
         if not isinstance(value, dict):
             self.error(name, f"[txt] {name} must say its terminal, mode and polarity",
                        f'for example: {name} = {{ terminal = "I3", mode = "switch", pressed = 1 }}')
@@ -289,9 +322,7 @@ class _Reader:
 
     def output(self, name: str) -> OutputWire | None:
         kind = "motor" if name in self.robot.motors else "lamp"
-        value = self.entry(name, kind)
-        if value is None:
-            return None
+        value = self.section[name]
         reverse = False
         if isinstance(value, dict) and kind == "motor":
             for key in value:
@@ -307,15 +338,7 @@ class _Reader:
         return None if terminal is None else OutputWire(name, kind, terminal, reverse)
 
     def counter(self, name: str) -> int | None:
-        value = self.entry(name, "counter")
-        return None if value is None else self.terminal(name, "counter", value)
-
-    def check_unknown(self) -> None:
-        robot = self.robot
-        for name in self.section:
-            if name not in (*robot.inputs, *robot.motors, *robot.lamps, *robot.counter_names):
-                self.error(name, f"[txt] wires {name!r}, which robot {robot.name} does not have",
-                           "wire the robot's inputs, motors, lamps and counters (names from the robot file)")
+        return self.terminal(name, "counter", self.section[name])
 
 
 def _names(kind: str) -> list[str]:
