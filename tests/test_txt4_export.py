@@ -216,3 +216,41 @@ def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch
              "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
     robot = txt4_runtime.Txt4Robot(table, factories, motor)
     assert robot.read() == (1 | 4 | 8 | 16, [])
+
+
+class CountingRobot:
+    def __init__(self) -> None:
+        self.writes: list[list[int]] = []
+        self.stops = 0
+
+    def read(self) -> tuple[int, list[int]]:
+        return 0, []
+
+    def write(self, outputs: list[int]) -> None:
+        self.writes.append(list(outputs))
+
+    def stop(self) -> None:
+        self.stops += 1
+
+
+def test_the_on_board_loop_stops_when_it_falls_behind_or_is_interrupted() -> None:
+    from tablebot.hw import txt4_runtime
+
+    machine = compile_table(load_table(EXAMPLE / "table.csv"))
+    workspace = export_txt4(machine)
+    table = ast.literal_eval(workspace.files["lib/tablebot_program.py"].split("\nTABLE = ", 1)[1])
+    clock = iter([0.0, 0.0, 0.01, 0.02, 0.7, 0.7, 0.7])  # a 0.7 s stall before tick 3
+    robot, said = CountingRobot(), []
+    reason = txt4_runtime.run(table, robot, 10, now=lambda: next(clock), sleep=lambda s: None, log=said.append)
+    assert reason == "behind"
+    assert len(robot.writes) == 3 and robot.stops == 1 and "stopping rather than stretching" in said[0]
+
+    class Interrupted(CountingRobot):
+        def read(self) -> tuple[int, list[int]]:
+            if len(self.writes) == 4:
+                raise KeyboardInterrupt
+            return 0, []
+
+    robot = Interrupted()
+    assert txt4_runtime.run(table, robot, None, sleep=lambda s: None, log=said.append) == "stopped"
+    assert robot.stops == 1 and "stopped after 4 ticks" in said[-1]

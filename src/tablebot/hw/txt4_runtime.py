@@ -16,6 +16,8 @@ from __future__ import annotations
 import contextlib
 import signal
 import time
+from collections.abc import Callable
+from typing import Any
 
 PWM_STEP = 64  # speed or lamp level 8 = PWM 512
 BEHIND_LIMIT_S = 0.5  # a tick this late stops the robot rather than stretch the table's timers
@@ -73,7 +75,7 @@ class Txt4Robot:
                ("voltage", "create_color_sensor", "get_voltage"),
                ("resistance", "create_ntc_resistor", "get_resistance"))
 
-    def __init__(self, table: dict, factory, motor_class):
+    def __init__(self, table: dict, factory: Any, motor_class: Any):
         self.table, self.motor_class = table, motor_class
         factory.init()
         factory.init_input_factory()
@@ -161,7 +163,8 @@ class Terminated(Exception):
     """SIGTERM (ROBO Pro Coding's stop, or ``DELETE /api/v1/stop``) arrived."""
 
 
-def run(table: dict, robot, ticks: int | None = None, now=time.monotonic, sleep=time.sleep, log=print) -> str:
+def run(table: dict, robot: Txt4Robot, ticks: int | None = None, now: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep, log: Callable[..., None] = print) -> str:
     """Run the table until ``ticks`` (None: until stopped); the outputs are stopped on every way out.
     Ticks are paced on a fixed grid; a tick later than half a tick restarts the grid (counted as late),
     one later than BEHIND_LIMIT_S ends the run. Returns why it ended."""
