@@ -1,4 +1,4 @@
-"""The ``export`` command: a table for another system (ROBO Pro lists, a ROBO Pro program, C)."""
+"""The ``export`` command: a table for another system (ROBO Pro lists, a ROBO Pro program, C, a TXT 4.0 program)."""
 
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ class Target(StrEnum):
     robopro = "robopro"
     robopro_rpp = "robopro-rpp"
     c = "c"
+    txt4 = "txt4"
 
 
 class Lookup(StrEnum):
@@ -36,7 +37,8 @@ def export_cmd(
     outdir: Path | None = typer.Argument(None, help="Folder to write into (created if missing); "
                                          "for robopro-rpp, where to put the program instead of rewriting it."),
     to: Target = typer.Option(..., "--to", help="robopro: the three lists as CSV; robopro-rpp: the lists "
-                              "written into a ROBO Pro program (--into); c: portable C99 engine + table."),
+                              "written into a ROBO Pro program (--into); c: portable C99 engine + table; "
+                              "txt4: a program that runs the table on a TXT 4.0 itself (then: tablebot upload)."),
     into: Path | None = typer.Option(None, "--into", help="robopro-rpp: the ROBO Pro program (.rpp) to update."),
     event_list: str = typer.Option(rpp.DEFAULT_NAMES[0], "--event-list", help="robopro-rpp: the event list's name."),
     action_list: str = typer.Option(rpp.DEFAULT_NAMES[1], "--action-list", help="robopro-rpp: the action list's name."),
@@ -60,6 +62,15 @@ def export_cmd(
         lookup_kind = "dense" if source.layout.dense else "scan"
         console.print(f"lookup: {lookup_kind}, {source.layout.lookup_bytes} bytes; "
                       f"table hash 0x{source.layout.table_hash:08x}")
+        return
+    if to == Target.txt4:
+        from tablebot.hw.txt4_export import export_txt4
+
+        workspace = export_txt4(machine)  # a table that does not fit is refused before anything is written
+        for path in workspace.write(out_folder(outdir, "OUTDIR")):
+            console.print(f"wrote {path}", markup=False)
+        console.print(f"upload and start it: tablebot upload {outdir} --to txt4://192.168.7.2 --key API_KEY",
+                      markup=False)
         return
     lists = robopro.encode(parsed)
     for path in robopro.write_lists(lists, out_folder(outdir, "OUTDIR")):

@@ -1,4 +1,5 @@
-"""Recorded inputs as CSV: a header of input names (and counter names for pulses), one row per tick.
+"""Recorded inputs as CSV: a header of input names (and counter names for pulses), one row per tick
+(and, for replaying a recorded run, a run's JSON Lines trace).
 
 The reader and the writer of the format ``tablebot trace --inputs`` reads and ``check`` and ``tests``
 write (counterexamples, golden sequences).
@@ -8,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,9 +30,13 @@ class TickInput:
 
 
 def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
-    """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0."""
+    """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0; or a
+    run's trace (JSON Lines, see :func:`trace_inputs`)."""
     path = Path(path)
-    records = split_records(read_text(path), str(path))
+    text = read_text(path)
+    if path.suffix.lower() == ".jsonl" or text.lstrip().startswith("{"):
+        return trace_inputs(path, text, machine)
+    records = split_records(text, str(path))
     while records and records[0].is_blank():  # blank lines above the header (below it, a blank row is a tick)
         records.pop(0)
     if not records:
@@ -105,3 +111,32 @@ def format_inputs(machine: Machine, ticks: Sequence[TickInput]) -> str:
         cells += [str(p) if p else "" for p in tick.pulses]
         writer.writerow(cells)
     return buffer.getvalue()
+
+
+def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
+    """The inputs a recorded run gave the engine (``tablebot run --out``, ``tablebot sim``): per line, the
+    input bits of ``event`` and each counter's ``<counter>_pulses``; an ``{"end": ...}`` record ends it.
+    Replaying them with the same table takes the same decisions."""
+    out = Collector(path)
+    keys = ("event", *(f"{c}_pulses" for c in machine.table.robot.counter_names))
+    ticks: list[TickInput] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            data = json.loads(line)
+        except json.JSONDecodeError as exc:
+            out.error(number, exc.colno, f"not a trace line: {exc.msg}", "each line must be one JSON object")
+            continue
+        if not isinstance(data, dict) or "end" in data:
+            break
+        values = [data.get(key) for key in keys]
+        bad = [key for key, v in zip(keys, values, strict=True)
+               if isinstance(v, bool) or not isinstance(v, int) or v < 0]
+        if bad:
+            out.error(number, 1, f"this trace line has no whole-number {bad[0]}",
+                      "replay a trace that a run of this table recorded (tablebot run --out)")
+            continue
+        ticks.append(TickInput(values[0] & machine.input_mask, tuple(values[1:])))
+    out.raise_if_any()
+    return ticks

@@ -1,0 +1,176 @@
+"""The ``run`` command: drive a real robot (a TXT, or a TXT 4.0 running ftrobopy_server) or the simulator
+in real time through the run loop, with a live view, a live trace, and outputs off on every way out."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+from rich.markup import escape
+
+from tablebot.cli.app import app
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.diagnostics import fail
+
+if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when the command runs
+    from tablebot.loop import RobotIO, RunEnd
+    from tablebot.machine import Machine
+
+TARGET_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT, txt://auto, sim or sim:WORLD.toml"
+CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
+                "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
+
+
+@dataclass(frozen=True)
+class Target:
+    kind: str  # "txt" or "sim"
+    host: str | None = None  # None: txt://auto
+    port: int = 65000
+    world: Path | None = None
+
+
+def parse_target(text: str) -> Target:
+    """``txt://HOST[:PORT]``, ``txt://auto``, ``sim`` or ``sim:WORLD``; anything else is a located error."""
+    if text == "sim" or text.startswith("sim:"):
+        world = text[4:]
+        return Target("sim", world=Path(world) if world else None)
+    if not text.startswith("txt://"):
+        raise fail("--on", f"unknown target {text!r}", TARGET_HINT)
+    rest = text[len("txt://"):].rstrip("/")
+    if rest == "auto":
+        return Target("txt")
+    host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
+    if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
+        raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", TARGET_HINT)
+    return Target("txt", host, int(port) if port else 65000)
+
+
+@app.command("run")
+@guarded
+def run_cmd(
+    table: Path = TABLE_ARG,
+    on: str = typer.Option(..., "--on", help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), "
+                           "txt://auto (USB, Wi-Fi, Bluetooth addresses), or sim[:WORLD] (the simulator, in "
+                           "real time)."),
+    seconds: float | None = typer.Option(None, "--seconds", min=0.01, help="Run length; without it, until Ctrl-C."),
+    out: Path | None = typer.Option(None, "--out", help="Folder for trace.jsonl and summary.json, written as the "
+                                    "run goes (a planned run cut short leaves trace.partial.jsonl)."),
+    link_timeout: float | None = typer.Option(None, "--link-timeout", min=0.001, help="Seconds without a valid "
+                                              "reply that end the run as link_lost (default: 5 ticks)."),
+    behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when a tick starts this "
+                                       "many seconds late, rather than stretch the table's timers (0: never)."),
+    seed: int = typer.Option(1, "--seed", min=0, help="sim: the seed of all simulated noise (as tablebot sim)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Run TABLE on a real robot (or the simulator, in real time): outputs off on Ctrl-C, SIGTERM, any error
+    and at the end; a lost link ends the run with exit code 3."""
+    target = parse_target(on)
+    parsed, machine = load(table, robot)
+    tick_s = parsed.robot.tick_ms / 1000
+    ticks = None if seconds is None else max(1, round(seconds / tick_s))
+    if out is not None:
+        out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
+    bot, device, clock = (_txt(machine, target, link_timeout or 5 * tick_s) if target.kind == "txt"
+                          else _sim(machine, target, seed))
+    end = _drive(machine, bot, device, clock, ticks, out, behind_limit or None, quiet)
+    if end.exit_code:
+        raise typer.Exit(end.exit_code)
+
+
+def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[RobotIO, str, Any]:
+    """The wiring checked (nothing moves if the table does not fit), then the controller found and asked
+    who it is. The TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once, so the
+    clock paces ticks too (it only sleeps when a tick is early; see hw/pacing.py)."""
+    from tablebot.hw.pacing import PacedClock
+    from tablebot.hw.txt_link import AUTO_HOSTS, find_controller
+    from tablebot.hw.txt_robot import TxtRobot
+    from tablebot.hw.txt_wiring import txt_wiring
+    from tablebot.loop import LinkLost
+
+    wiring = txt_wiring(machine)
+    host = target.host or find_controller(AUTO_HOSTS, target.port)
+    if host is None:
+        raise fail("--on", f"txt://auto found no controller at {', '.join(AUTO_HOSTS)} (port {target.port})",
+                   CONNECT_HINT)
+    bot = TxtRobot(wiring, host, target.port, link_timeout_s=link_timeout_s)
+    try:
+        status = bot.connect()
+    except LinkLost as exc:
+        raise fail("--on", str(exc), CONNECT_HINT) from None
+    return bot, f"{status.device} {status.version_text}", PacedClock(machine.table.robot.tick_ms / 1000)
+
+
+def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, Any]:
+    """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
+    from tablebot.hw.pacing import PacedClock
+    from tablebot.sim import scene as sim_scene
+    from tablebot.sim.robot import SimRobot
+
+    scene = sim_scene.scene_for(machine.table, machine, target.world)
+    bot = SimRobot(scene, seed)
+    bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
+    bot.reset(seed=seed)
+    return bot, f"simulated, seed {seed}", PacedClock(machine.table.robot.tick_ms / 1000)
+
+
+def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int | None, out: Path | None,
+           behind_limit_s: float | None, quiet: bool) -> RunEnd:
+    """The loop with its sinks: the live view first (so it always ends first and restores the terminal)."""
+    from tablebot.engine import Engine
+    from tablebot.hw.live_view import LiveView
+    from tablebot.hw.run_trace import RunTrace
+    from tablebot.loop import run
+
+    sinks: list[Any] = []
+    if not quiet and err_console.is_terminal:
+        sinks.append(LiveView(err_console, device))
+    trace = RunTrace(out) if out is not None else None
+    if trace is not None:
+        sinks.append(trace)
+    target = getattr(bot, "target", "sim")
+    if not quiet:
+        err_console.print(escape(f"running {machine.table.path} on {target} ({device}); Ctrl-C stops it"),
+                          highlight=False)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
+    try:
+        end = run(Engine(machine), bot, clock=clock, sinks=sinks, ticks=ticks, target=target,
+                  behind_limit_s=behind_limit_s)
+    finally:
+        sys.setswitchinterval(switch)
+    if not quiet:
+        _report(end, machine, trace)
+    return end
+
+
+def _report(end: RunEnd, machine: Machine, trace: Any) -> None:
+    """How the run ended on stdout; the files written on stderr."""
+    seconds = end.ticks * machine.table.robot.tick_ms / 1000
+    why = f" — {end.message}" if end.message else ""
+    console.print(escape(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"), highlight=False)
+    if end.late_ticks:
+        console.print(f"{end.late_ticks} ticks started late (worst {1000 * end.worst_late_s:.1f} ms)")
+    for path in trace.files if trace is not None else []:
+        err_console.print(escape(f"wrote {path}"), highlight=False)
+    sys.stdout.flush()
+
+
+@app.command("upload")
+@guarded
+def upload_cmd(
+    folder: Path = typer.Argument(..., help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
+    to: str = typer.Option(..., "--to", help="The TXT 4.0: txt4://192.168.7.2 (USB), txt4://HOST[:PORT]."),
+    key: str = typer.Option(..., "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO Pro "
+                            "Coding asks for it)."),
+    start: bool = typer.Option(True, "--start/--no-start", help="Start the program once it is uploaded."),
+) -> None:
+    """Install an exported TXT 4.0 program on the controller through its REST API, and start it."""
+    from tablebot.hw.txt4_upload import upload
+
+    if not folder.is_dir():
+        raise fail(folder, "no such folder", "give the folder `tablebot export --to txt4` wrote")
+    upload(folder, to, key, start, say=lambda text: console.print(escape(text), highlight=False))

@@ -1,0 +1,120 @@
+"""A live terminal view of a running robot (rich): the state and its name, the inputs lit, a bar per motor,
+lamp levels, counters, the robot's time and how many ticks ran late. Redrawn four times a second from the
+latest tick by rich's own thread; the run loop never waits for the terminal."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.columns import Columns
+from rich.console import Console, Group
+from rich.control import strip_control_codes
+from rich.live import Live
+from rich.panel import Panel
+from rich.table import Table
+from rich.text import Text
+
+from tablebot.loop import RunEnd, RunInfo, TickBlock
+from tablebot.table import MAX_SPEED
+
+BAR = 8  # characters per motor direction
+
+
+def plain(text: str) -> str:
+    """User text (labels, state names) made safe for the terminal: no escape or control characters.
+    Rich ``Text`` never reads markup, so brackets stay brackets."""
+    return strip_control_codes(text).replace("\x1b", "")
+
+
+def motor_bar(speed: int) -> Text:
+    """``[    ████|        ] +4``: backward to the left of the bar's middle, forward to the right."""
+    n = min(BAR, round(abs(speed) * BAR / MAX_SPEED))
+    left = " " * (BAR - n) + "█" * n if speed < 0 else " " * BAR
+    right = "█" * n + " " * (BAR - n) if speed > 0 else " " * BAR
+    colour = "green" if speed > 0 else "red" if speed < 0 else "dim"
+    bar = Text("[")
+    bar.append(left, style=colour)
+    bar.append("|")
+    bar.append(right, style=colour)
+    bar.append(f"] {speed:+d}" if speed else "]  0")
+    return bar
+
+
+class LiveView:
+    """A :class:`tablebot.loop.Sink` drawing the run on ``console`` (give it stderr so stdout stays clean)."""
+
+    def __init__(self, console: Console, device: str = ""):
+        self.console, self.device = console, device
+        self.info: RunInfo | None = None
+        self.last: dict[str, Any] = {}
+        self.live: Live | None = None
+        self.late = 0
+
+    def start(self, info: RunInfo) -> None:
+        self.info = info
+        # A redraw takes a few ms of the interpreter: four a second keep the run loop's ticks on time.
+        self.live = Live(self, console=self.console, refresh_per_second=4, transient=False)
+        self.live.start()
+
+    def block(self, block: TickBlock) -> None:
+        i = len(block) - 1
+        late = block.extra.get("late_ms")
+        if late is not None and self.info is not None:
+            self.late += sum(1 for ms in late if ms > 500 * self.info.tick_s)
+        self.last = {"tick": block.start + i, "mask": int(block.masks[i]), "state": int(block.states[i]),
+                     "timer": int(block.timers[i]), "outputs": tuple(block.outputs[i]),
+                     "counters": tuple(block.counters[i]), "late_ms": None if late is None else late[i]}
+
+    def end(self, end: RunEnd) -> None:
+        if self.live is not None:
+            self.live.stop()
+            self.live = None
+
+    def __rich__(self) -> Panel:
+        assert self.info is not None
+        machine = self.info.engine.machine
+        robot = machine.table.robot
+        last = self.last
+        title = Text(f"tablebot run — {plain(self.info.target)}" + (f" ({plain(self.device)})" if self.device else ""))
+        if not last:
+            return Panel(Text("connecting…", style="dim"), title=title, title_align="left")
+        state = machine.states[last["state"]]
+        head = Text(f"state {plain(str(state))}", style="bold")
+        name = robot.state_names.get(state)
+        if name:
+            head.append(f"  {plain(name)}", style="cyan")
+        seconds = (last["tick"] + 1) * self.info.tick_s
+        head.append(f"   timer {last['timer']}   t {seconds:8.2f} s   tick {last['tick']}")
+        return Panel(Group(head, self._inputs(last["mask"]), self._outputs(last), self._lateness(last)),
+                     title=title, title_align="left")
+
+    def _inputs(self, mask: int) -> Columns:
+        """One cell per input the table reads, lit while it reads 1; cells wrap to the terminal's width."""
+        machine = self.info.engine.machine  # type: ignore[union-attr]
+        cells = []
+        for name, bit in machine.input_bits.items():
+            lit = bool(mask & bit)
+            cell = Text(f"{'●' if lit else '○'} {plain(name)}", style="bold yellow" if lit else "dim")
+            label = machine.table.robot.labels.get(name)
+            if label:
+                cell.append(f" ({plain(label)})", style="yellow" if lit else "dim")
+            cells.append(cell)
+        return Columns(cells, padding=(0, 3))
+
+    def _outputs(self, last: dict[str, Any]) -> Table:
+        machine = self.info.engine.machine  # type: ignore[union-attr]
+        robot = machine.table.robot
+        grid = Table.grid(padding=(0, 2))
+        for name, value in zip(machine.output_names, last["outputs"], strict=True):
+            label = Text(f"{plain(name)} {plain(robot.labels.get(name, ''))}".strip())
+            shown = motor_bar(int(value)) if name in robot.motors else Text(f"{'▮' * int(value):<8} {value}")
+            grid.add_row(label, shown)
+        for name, value in zip(robot.counter_names, last["counters"], strict=True):
+            grid.add_row(Text(plain(name)), Text(f"{value} pulses to go"))
+        return grid
+
+    def _lateness(self, last: dict[str, Any]) -> Text:
+        if last["late_ms"] is None:
+            return Text("")
+        style = "red" if self.late else "dim"
+        return Text(f"ticks late {self.late}   this tick {last['late_ms']:.1f} ms late", style=style)
