@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import functools
 import operator
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -15,14 +14,11 @@ from tablebot.analysis.finding import SEVERITIES, Finding
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Graph, Model
 from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
-from tablebot.diagnostics import Diagnostic
-from tablebot.formats import robopro_lists as robopro
+from tablebot.formats.targets import TARGETS
 from tablebot.machine import NO_ROW, Machine, first_match
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
-#: Export targets and the function that lists what of a table the target cannot hold.
-TARGETS: dict[str, Callable[[Table], list[Diagnostic]]] = {"robopro": robopro.fit_problems}
 MAX_IGNORED_BITS = 16
 
 
@@ -34,7 +30,7 @@ def find_all(machine: Machine, graph: Graph | None = None, targets: tuple[str, .
     found = [*shadowed, *overlaps(table), *ignored_inputs(machine), *zero_time_loops(graph)]
     found += reachability(machine, graph, {f.lines[0] for f in shadowed})
     for target in targets:
-        found += encoding(table, target)
+        found += encoding(machine, target)
     order = {s: i for i, s in enumerate(SEVERITIES)}
     return sorted(found, key=lambda f: (f.lines[0] if f.lines else 0, order[f.severity], f.code))
 
@@ -256,7 +252,11 @@ def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> s
 
 # --- export limits ----------------------------------------------------------------------------------
 
-def encoding(table: Table, target: str) -> list[Finding]:
-    """What an export target cannot hold, as errors (``tablebot export`` would refuse the table)."""
-    return [Finding(f"encoding-{target}", "error", f"{target}: {d.message}",
-                    (d.line,) if d.line is not None else (), d.hint) for d in TARGETS[target](table)]
+def encoding(machine: Machine, target: str) -> list[Finding]:
+    """What an export target cannot hold, as errors (its exporter would refuse the table): the fit
+    check of :data:`tablebot.formats.targets.TARGETS`."""
+    table_path = machine.table.path
+    return [Finding(f"encoding-{target}", "error",
+                    f"{target}: {d.message}" + ("" if d.path == table_path else f" ({d.location()})"),
+                    (d.line,) if d.line is not None and d.path == table_path else (), d.hint)
+            for d in TARGETS[target].problems(machine)]

@@ -13,7 +13,6 @@ from rich.text import Text
 from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
 from tablebot.analysis.diagram import FORMATS, render
 from tablebot.analysis.finding import Finding
-from tablebot.analysis.lints import TARGETS
 from tablebot.analysis.names import plural
 from tablebot.analysis.properties import find_property_files, load_properties
 from tablebot.analysis.prove import Result
@@ -35,6 +34,7 @@ from tablebot.cli.common import (
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.escape import plain, terminal
 from tablebot.files import write_bytes
+from tablebot.formats.targets import TARGETS
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
 #: Findings are printed this many lines at a time (a 100,000-row table can have as many findings).
@@ -53,7 +53,8 @@ def check_cmd(
     robot: Path | None = ROBOT_OPT,
     properties: list[Path] = typer.Option([], "--properties", "-p", help="Property file(s) (default: "
                                           "NAME.properties.toml or properties.toml beside the table)."),
-    target: list[str] = typer.Option([], "--target", help=f"Export target to check limits for: {', '.join(TARGETS)}."),
+    target: list[str] = typer.Option([], "--target", help="Export target whose limits to check (repeatable): "
+                                     f"{', '.join(TARGETS)}."),
     strict: bool = typer.Option(False, "--strict", help="Exit with 1 when there are warnings."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="List every info finding (overlaps, ignored inputs)."),
     fmt: Format = typer.Option(Format.text, "--format", help="text, or json for machines."),

@@ -1,0 +1,56 @@
+"""The registry of export targets: one fit check per target, shared by ``export`` and ``check --target``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from core_helpers import EXAMPLE, ROOT, example_machine, machine_of
+from tablebot.cli.app import app
+from tablebot.codegen.layout import MAX_EVENTS
+from tablebot.formats.targets import TARGETS
+
+WIDE_ROBOT = ('name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'I{i} = ""\n' for i in range(MAX_EVENTS))
+              + '[motors]\nM1 = ""\n')
+WIDE_TABLE = f"state,T,{','.join(f'I{i}' for i in range(MAX_EVENTS))},M1,timer,next\n1,1{',' * MAX_EVENTS},1,5,1\n"
+
+
+@pytest.mark.parametrize("name", sorted(TARGETS))
+def test_the_bumberbot_fits_every_target(name: str) -> None:
+    assert TARGETS[name].problems(example_machine()) == []
+
+
+def test_a_table_too_wide_for_c_is_refused_by_c_and_the_boards_alike(tmp_path: Path) -> None:
+    machine = machine_of(tmp_path, WIDE_TABLE, WIDE_ROBOT)
+    for name in ("c", "uno", "ftduino"):
+        problems = TARGETS[name].problems(machine)
+        assert problems and f"the C engine holds at most {MAX_EVENTS}" in problems[0].message, name
+
+
+def test_check_target_reports_what_export_refuses(tmp_path: Path) -> None:
+    table = tmp_path / "table.csv"
+    machine_of(tmp_path, WIDE_TABLE, WIDE_ROBOT)
+    runner = CliRunner()
+    checked = runner.invoke(app, ["check", str(table), "--target", "c"])
+    exported = runner.invoke(app, ["export", str(table), str(tmp_path / "c"), "--to", "c"])
+    assert checked.exit_code == 2 and exported.exit_code == 2
+    assert f"c: {MAX_EVENTS + 1} event columns" in checked.output
+    assert f"{MAX_EVENTS + 1} event columns; the C engine holds at most {MAX_EVENTS}" in exported.output
+    assert not (tmp_path / "c").exists()
+
+
+def test_a_robot_without_txt_wiring_does_not_fit_the_txt_targets() -> None:
+    from tablebot.cli.common import load
+
+    _, machine = load(ROOT / "examples" / "bumberbot-counters")
+    for name in ("txt", "txt4"):
+        problems = TARGETS[name].problems(machine)
+        assert any("has no [txt] section" in p.message for p in problems), name
+
+
+def test_unknown_target_names_the_known_ones() -> None:
+    result = CliRunner().invoke(app, ["check", str(EXAMPLE), "--target", "arduino"])
+    assert result.exit_code == 2 and "unknown export target 'arduino'" in result.output
+    assert all(name in result.output for name in TARGETS)
