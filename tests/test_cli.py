@@ -229,3 +229,12 @@ def test_trace_into_a_closed_pipe_stops_quietly():
     assert proc.wait(timeout=60) == 0
     assert first.startswith(b'{"tick":0,')
     assert stderr == ""
+
+
+def test_the_command_line_loads_no_heavy_library_until_a_command_runs() -> None:
+    """`tablebot --help` must be quick: no numpy, numba, matplotlib, web server, HTTP or graphviz at import."""
+    code = ("import sys, tablebot.cli; heavy = ('numpy', 'numba', 'matplotlib', 'starlette', 'uvicorn', 'httpx', "
+            "'graphviz', 'serial', 'dask', 'tablebot.engine', 'tablebot.sim', 'tablebot.analysis'); "
+            "print(sorted({m for m in sys.modules for h in heavy if m == h or m.startswith(h + '.')}))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"

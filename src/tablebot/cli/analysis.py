@@ -6,17 +6,11 @@ import json
 import sys
 from enum import StrEnum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.text import Text
 
-from tablebot.analysis.check import CheckReport, report_json, run_check, story, write_counterexamples
-from tablebot.analysis.diagram import FORMATS, render
-from tablebot.analysis.finding import Finding
-from tablebot.analysis.names import plural
-from tablebot.analysis.properties import find_property_files, load_properties
-from tablebot.analysis.prove import Result
-from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli.app import app
 from tablebot.cli.common import (
     FORCE_OPT,
@@ -33,8 +27,15 @@ from tablebot.cli.common import (
 )
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.escape import plain, terminal
-from tablebot.files import write_bytes
 from tablebot.formats.targets import TARGETS
+
+if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --help` stays quick
+    from tablebot.analysis.check import CheckReport
+    from tablebot.analysis.finding import Finding
+    from tablebot.analysis.prove import Result
+
+#: The diagram formats (tablebot.analysis.diagram.FORMATS, which a test keeps equal).
+FORMATS = ("svg", "png", "dot", "mermaid")
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
 #: Findings are printed this many lines at a time (a 100,000-row table can have as many findings).
@@ -66,6 +67,9 @@ def check_cmd(
 
     Exit code 0 when clean, 1 for warnings with --strict, 2 for errors.
     """
+    from tablebot.analysis.check import report_json, run_check
+    from tablebot.analysis.properties import find_property_files, load_properties
+
     for name in target:
         if name not in TARGETS:
             raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(TARGETS)}")
@@ -90,6 +94,8 @@ def check_cmd(
 
 def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | None:
     """Write the counterexample CSVs; returns (not raises) the error of a folder that cannot take them."""
+    from tablebot.analysis.check import write_counterexamples
+
     try:
         write_counterexamples(report, out_folder(folder, "--counterexamples"))
     except TableBotError as exc:
@@ -101,6 +107,8 @@ def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | 
 
 
 def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: bool) -> None:
+    from tablebot.analysis.names import plural
+
     machine = report.machine
     table = machine.table
     console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
@@ -150,6 +158,8 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
 
 
 def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:
+    from tablebot.analysis.check import story
+
     prop = result.prop
     marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
              "unknown": "[yellow]unknown [/yellow]"}
@@ -186,6 +196,8 @@ def tests_cmd(
 ) -> None:
     """Generate golden tests: input CSVs that together fire every row that can fire, each with its
     expected trace (JSON Lines), plus coverage.json."""
+    from tablebot.analysis.testgen import generate, write_golden
+
     _, machine = load(table, robot)
     golden = generate(machine)
     write_golden(golden, out_folder(out, "--out"))
@@ -220,6 +232,9 @@ def diagram_cmd(
     if fmt not in FORMATS:
         raise fail(option, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)} "
                    "(--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, .mmd)")
+    from tablebot.analysis.diagram import render
+    from tablebot.files import write_bytes
+
     parsed, _ = load(table, robot)
     data = render(parsed, fmt, colour)
     if out is None:

@@ -10,7 +10,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import typer
 from rich.console import Console
@@ -18,10 +18,10 @@ from rich.console import Console
 from tablebot import guard
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notes_to
 from tablebot.escape import terminal
-from tablebot.formats.table_read import load_table
-from tablebot.machine import Machine, compile_table
-from tablebot.robot import load_robot
-from tablebot.table import Table
+
+if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
+    from tablebot.machine import Machine
+    from tablebot.table import Table
 
 F = TypeVar("F", bound=Callable[..., Any])
 # emoji=False: a ':x:' in user text prints as it is (tablebot.escape.terminal escapes the markup).
@@ -96,6 +96,10 @@ def writing(path: Path) -> Iterator[None]:
 
 
 def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
+    from tablebot.formats.table_read import load_table
+    from tablebot.machine import compile_table
+    from tablebot.robot import load_robot
+
     robot = load_robot(robot_path) if robot_path else None
     table = load_table(resolve_table_path(path), robot)
     return table, compile_table(table)

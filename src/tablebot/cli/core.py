@@ -21,12 +21,6 @@ from tablebot.cli.common import (
     out_folder,
 )
 from tablebot.escape import terminal
-from tablebot.examples import example_path
-from tablebot.files import atomic_write, write_text
-from tablebot.formats import robopro_lists as robopro
-from tablebot.formats.table_write import format_table
-from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.trace import load_inputs, replay, write_trace
 
 
 class Source(StrEnum):
@@ -43,6 +37,11 @@ def import_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
+    from tablebot.files import write_text
+    from tablebot.formats import robopro_lists as robopro
+    from tablebot.formats.table_write import format_table
+    from tablebot.robot import BUMBERBOT, load_robot
+
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
     text = format_table(table)
     if out is None:
@@ -62,6 +61,9 @@ def trace_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Replay recorded inputs through the engine and write the trace, one JSON line per tick."""
+    from tablebot.files import atomic_write
+    from tablebot.trace import load_inputs, replay, write_trace
+
     _, machine = load(table, robot)
     ticks = load_inputs(inputs, machine)
     if out is None:
@@ -76,6 +78,10 @@ def trace_cmd(
 @guarded
 def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for the trace.")) -> None:
     """Replay the BumberBot on its built-in recorded inputs and summarise what it did."""
+    from tablebot.examples import example_path
+    from tablebot.files import atomic_write
+    from tablebot.trace import load_inputs, replay, write_trace
+
     folder = example_path("bumberbot")
     _, machine = load(folder / "table.csv")
     ticks = load_inputs(folder / "inputs.csv", machine)

@@ -4,17 +4,18 @@ from __future__ import annotations
 
 from enum import StrEnum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
-from tablebot.codegen import generate
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
-from tablebot.formats import robopro_lists as robopro
 from tablebot.formats import robopro_program as rpp
-from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.table import Table
 
 
 class Target(StrEnum):
@@ -49,6 +50,8 @@ def export_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
+    from tablebot.formats import robopro_lists as robopro
+
     parsed, machine = load(table, robot)
     if to == Target.robopro_rpp:
         _export_rpp(parsed, outdir, into, (event_list, action_list, timer_list))
@@ -56,6 +59,8 @@ def export_cmd(
     if outdir is None:
         raise fail("OUTDIR", f"--to {to.value} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
     if to == Target.c:
+        from tablebot.codegen import generate
+
         source = generate(machine, lookup.value)  # before the folder is made: a refused table leaves none
         for path in source.write(out_folder(outdir, "OUTDIR")):
             console.print(f"wrote {terminal(str(path))}")
@@ -79,6 +84,8 @@ def export_cmd(
 
 def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tuple[str, str, str]) -> None:
     """The three lists written into a ROBO Pro program: ``into`` itself, or its copy in ``outdir``."""
+    from tablebot.formats import robopro_lists as robopro
+
     if into is None:
         raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
     lists = robopro.encode(table)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from enum import StrEnum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -22,11 +23,9 @@ from tablebot.cli.common import (
 )
 from tablebot.diagnostics import fail
 from tablebot.escape import shell_word, terminal
-from tablebot.files import PendingFile
-from tablebot.firmware.boards import load_board
-from tablebot.firmware.build import Firmware, build
-from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
-from tablebot.firmware.monitor import chunks_from, monitor
+
+if TYPE_CHECKING:  # the firmware tools are imported when a command runs: `--help` stays quick
+    from tablebot.firmware.build import Firmware
 
 
 class BoardName(StrEnum):
@@ -39,6 +38,8 @@ OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: bu
 
 
 def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
+    from tablebot.firmware.build import build
+
     _, machine = load(table, robot)
     firmware = build(machine, board.value, out_folder(out or Path("build") / "firmware" / board.value, "--out"))
     wiring = firmware.wiring
@@ -73,6 +74,9 @@ def flash_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Write the firmware to a board with avrdude (untested here: no board is attached to CI)."""
+    from tablebot.firmware.boards import load_board
+    from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
+
     if not port.strip():
         raise fail("--port", "the port is empty", "give the board's serial port, such as /dev/ttyACM0 or COM3")
     if table.suffix.lower() == ".hex":
@@ -106,6 +110,9 @@ def monitor_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Decode a firmware's trace stream into the core's JSON Lines trace, one line per tick."""
+    from tablebot.files import PendingFile
+    from tablebot.firmware.monitor import chunks_from, monitor
+
     _, machine = load(table, robot)
     chunks = chunks_from(source, baud, seconds)
 
