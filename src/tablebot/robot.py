@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.formats.tomlfile import Source, Where
+from tablebot.sensors import Sensor, parse_sensors
 
 StateId = int | str
 
@@ -28,12 +29,12 @@ SECTION_READERS: dict[str, str] = {
 }
 FOREIGN_SECTIONS = tuple(SECTION_READERS)
 TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
-CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states")
+CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
 KNOWN_KEYS = (*TOP_KEYS, *CORE_SECTIONS, *FOREIGN_SECTIONS)
 #: Sections people write in the wrong file: the hint says where they belong.
 MISPLACED = {"wiring": "the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)",
              **{s: f"simulator parameters go in [sim.{s}] in a robot file" for s in
-                ("body", "motor", "battery", "encoder", "light", "noise")}}
+                ("body", "motor", "battery", "encoder", "light", "distance", "noise")}}
 NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: A state name as tables and robot files write it (a state is otherwise a whole number 0 or more).
 STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
@@ -66,6 +67,8 @@ class Robot:
     initial_state: StateId = 1
     initial_timer: int = 0
     tick_ms: int = 10
+    #: What drives each input that is not a plain switch (``[sensors]``; see :mod:`tablebot.sensors`).
+    sensors: tuple[Sensor, ...] = ()
     labels: dict[str, str] = field(default_factory=dict, compare=False)
     state_names: dict[StateId, str] = field(default_factory=dict, compare=False)
     sections: dict[str, Any] = field(default_factory=dict, compare=False)
@@ -122,6 +125,7 @@ def load_robot(path: str | Path) -> Robot:
                                       f"{', '.join(CORE_SECTIONS + FOREIGN_SECTIONS)}"))
     inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = _counters(src, motors)
+    sensors = parse_sensors(src, inputs)
     _distinct(src, {"inputs": inputs, "motors": motors, "lamps": lamps, "counters": {c.name: "" for c in counters}})
     if not motors and not lamps:
         src.out.error(None, None, "the robot has no [motors] and no [lamps]",
@@ -138,7 +142,7 @@ def load_robot(path: str | Path) -> Robot:
     src.raise_if_any()
     robot = Robot(
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
-        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms,
+        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms, sensors=sensors,
         labels={**inputs, **motors, **lamps}, state_names=states, source=str(path), toml=src,
     )
     robot.sections.update(_foreign_sections(src, robot))

@@ -68,7 +68,7 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True)
-def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, program, regs, outputs, counters, bits,
+def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
               drive, pcols, noise, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
     """Run one robot for ``noise.shape[0]`` ticks (``noise[t]`` moves it in tick t).
 
@@ -88,7 +88,7 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, program, regs,
         tick_compiled(regs, outputs, counters, mask, pulses, program)
         if ints.shape[0]:
             _record(ints, t, mask, regs, outputs, counters, pulses)
-        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps,
+        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines,
                 noise[t], bits, True, corners)
         observe(s, lamps, acc, collisions)
     return n_out
@@ -114,14 +114,14 @@ def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-
 
 
 @njit(nogil=True)
-def sense(s, p, verts, pstart, pbound, edges, circles, lamps, z, bits):  # type: ignore[no-untyped-def]
+def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits):  # type: ignore[no-untyped-def]
     """Read the sensors without moving (the start of a run)."""
-    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, z, bits, False, np.empty((4, 2)))
+    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)))
 
 
 @njit(nogil=True)
-def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, acc,
+def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, acc,
          collisions):  # type: ignore[no-untyped-def]
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, True, np.empty((4, 2)))
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)))
     observe(s, lamps, acc, collisions)

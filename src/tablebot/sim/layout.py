@@ -16,7 +16,11 @@ LIGHT_R, LIGHT_L = 15, 16  # light received by the phototransistors, in threshol
 BUMP_FR, BUMP_FL, BUMP_REAR = 17, 18, 19  # bumper switches 0/1
 CONTACT = 20  # 1 when the body touched something in the last tick (any side)
 MASK = 21  # the input mask the engine will read, in its event layout
-N_STATE = 22
+#: Declared sensors (robot file [sensors]) fill slots 0..MAX_SENSORS-1, one per input at most.
+#: Their readings: metres for distance sensors, 1/0 for line sensors, light units for light sensors.
+MAX_SENSORS = 8  # a fischertechnik controller has eight universal inputs I1..I8
+READING = 22  # S[READING + k] is slot k's reading
+N_STATE = READING + MAX_SENSORS
 
 # --- parameters P[i, :] (one row per robot, so a batch may mix robots and battery levels) --------
 P_DT = 0  # seconds per tick
@@ -31,7 +35,16 @@ P_PPR = 20  # encoder pulses per wheel turn
 P_LX, P_LY, P_TOE = 21, 22, 23  # light sensor position (forward, ± sideways) and outward toe, rad
 P_COS_FOV, P_EXP, P_DMIN = 24, 25, 26  # cosine of the field-of-view half angle, cos^k exponent, m
 P_NMOTOR, P_NLIGHT = 27, 28  # per-tick noise: relative sd of motor speed and of light readings
-N_PARAM = 29
+P_DRANGE, P_DMIN_RANGE, P_DBEAM, P_DRES = 29, 30, 31, 32  # distance sensors: range, blind zone, m; half beam, rad;
+#                                                          resolution, m
+P_SENSOR = 33  # slot k's fields start at P_SENSOR + k * SENSOR_FIELDS
+F_KIND, F_X, F_Y, F_AIM, F_ON, F_OFF, F_SIGN = 0, 1, 2, 3, 4, 5, 6  # kind (K_*), position (m, body frame), aim (rad),
+#   the reading at which the event turns on and the one at which it turns off, +1 above / -1 below
+SENSOR_FIELDS = 7
+N_PARAM = P_SENSOR + MAX_SENSORS * SENSOR_FIELDS
+
+# --- sensor kinds in F_KIND ----------------------------------------------------------------------
+K_NONE, K_LINE, K_DISTANCE, K_LIGHT = 0, 1, 2, 3
 
 # --- noise Z[tick, i, :] ------------------------------------------------------------------------
 Z_MOTOR_R, Z_MOTOR_L, Z_LIGHT_R, Z_LIGHT_L = 0, 1, 2, 3
@@ -39,4 +52,5 @@ N_NOISE = 4
 
 # --- input bits B[:] in the engine's event layout (0 = not wired) -------------------------------
 B_FR, B_FL, B_REAR, B_LIGHT_R, B_LIGHT_L = 0, 1, 2, 3, 4
-N_BITS = 5
+B_SENSOR = 5  # B[B_SENSOR + k] is the event bit of sensor slot k (B may stop short: no more sensors)
+N_BITS = B_SENSOR + MAX_SENSORS

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.formats.tomlfile import Source, known_keys, number, table_of
+from tablebot.sensors import Sensor
 from tablebot.sim import layout as L
 
 Number = int | float
@@ -65,6 +66,17 @@ DEFAULTS: dict[str, dict[str, tuple[Any, Number, Number, str]]] = {
         "half_response": (20.0, 0.5, 89.0, "degrees off its axis at which a sensor gets half the light"),
         "field_of_view": (40.0, 1.0, 90.0, "degrees off axis beyond which it sees nothing (lens tube)"),
         "near": (0.05, 0.001, 1.0, "m; closer lamps count as this close (no infinite readings)"),
+    },
+    "distance": {
+        # The fischertechnik ROBO TX ultrasonic distance sensor (art. 133009) reports whole centimetres:
+        # harbaum/ftduino manual, section 9.2.16 ("liefert den Messwert ... in Zentimetern", values 0 to
+        # 1023 cm, refreshed about twice a second on the ftDuino); ftrobopy's ultrasonic().distance()
+        # returns cm as an integer. No published figure for its beam or useful range was found: those
+        # below are typical of 40 kHz ultrasonic rangers and marked as estimates.
+        "range": (4.0, 0.05, 10.23, "m beyond which nothing echoes and it reads this value (estimate)"),
+        "blind": (0.03, 0.0, 1.0, "m closer than which it cannot measure and reads this value (estimate)"),
+        "beam": (15.0, 0.5, 60.0, "degrees, half the opening angle of the beam (estimate: 30 degrees wide)"),
+        "resolution": (0.01, 0.0001, 0.5, "m per step of the reading: whole centimetres (ftDuino manual 9.2.16)"),
     },
     "noise": {
         "motor_spread": (0.02, 0.0, 0.5, "relative sd of each motor's speed factor, drawn once per run"),
@@ -168,6 +180,8 @@ def problems(params: Params) -> list[tuple[str, str, str]]:
     bat, body = params["battery"], params["body"]
     if bat["empty_volts"] >= bat["full_volts"]:
         found.append(("battery", "empty_volts", "empty_volts must be below full_volts"))
+    if params["distance"]["blind"] >= params["distance"]["range"]:
+        found.append(("distance", "blind", "blind must be below range"))
     if body["bumper_overlap"] > body["half_width"]:
         found.append(("body", "bumper_overlap", "bumper_overlap must not exceed half_width"))
     try:
@@ -216,8 +230,8 @@ def top_speed(params: Params) -> float:
     return speed_per_volt(params) * max(0.0, volts - params["motor"]["friction_volts"])
 
 
-def param_row(params: Params, tick_s: float) -> np.ndarray:
-    """The packed row the physics core reads (layout ``P_*``)."""
+def param_row(params: Params, tick_s: float, sensors: tuple[Sensor, ...] = ()) -> np.ndarray:
+    """The packed row the physics core reads (layout ``P_*``), with ``sensors`` in slots 0, 1, ..."""
     body, motor, bat, light, noise = (params[s] for s in ("body", "motor", "battery", "light", "noise"))
     p = np.zeros(L.N_PARAM)
     p[L.P_DT] = tick_s
@@ -238,4 +252,25 @@ def param_row(params: Params, tick_s: float) -> np.ndarray:
     p[L.P_EXP] = math.log(0.5) / math.log(math.cos(math.radians(light["half_response"])))
     p[L.P_DMIN] = light["near"]
     p[L.P_NMOTOR], p[L.P_NLIGHT] = noise["motor"], noise["light"]
+    dist = params["distance"]
+    p[L.P_DRANGE], p[L.P_DMIN_RANGE] = dist["range"], dist["blind"]
+    p[L.P_DBEAM], p[L.P_DRES] = math.radians(dist["beam"]), dist["resolution"]
+    for k, sensor in enumerate(sensors[: L.MAX_SENSORS]):
+        p[L.P_SENSOR + k * L.SENSOR_FIELDS: L.P_SENSOR + (k + 1) * L.SENSOR_FIELDS] = sensor_fields(sensor)
     return p
+
+
+KIND_CODES = {"line": L.K_LINE, "distance": L.K_DISTANCE, "light": L.K_LIGHT}
+
+
+def sensor_fields(sensor: Sensor) -> list[float]:
+    """One sensor slot (layout ``F_*``): a line sensor is "above 0.5" of its 1/0 reading."""
+    fields = [0.0] * L.SENSOR_FIELDS
+    fields[L.F_KIND] = KIND_CODES[sensor.kind]
+    fields[L.F_X], fields[L.F_Y], fields[L.F_AIM] = sensor.at[0], sensor.at[1], math.radians(sensor.angle)
+    if sensor.kind == "line":
+        fields[L.F_ON], fields[L.F_OFF], fields[L.F_SIGN] = 0.5, 0.5, 1.0
+    else:
+        fields[L.F_ON], fields[L.F_OFF] = sensor.switch_points()
+        fields[L.F_SIGN] = -1.0 if sensor.direction == "below" else 1.0
+    return fields

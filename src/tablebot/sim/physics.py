@@ -6,7 +6,8 @@ robot and a batch of thousands (which do not see each other) share this code.
 # World geometry (built by tablebot.sim.world): ``verts`` (V, 2) and ``pstart`` (P+1,) are convex
 # pieces (a wall or segment is a 2-vertex piece, a box a 4-vertex one); ``pbound`` (P, 3) their
 # bounding circles; ``edges`` (E, 4) every piece's edges for ray casts; ``circles`` (C, 4) = x, y, r,
-# lamp index or -1; ``lamps`` (L, 3) = x, y, intensity.
+# lamp index or -1; ``lamps`` (L, 3) = x, y, intensity; ``lines`` (K, 5) = x0, y0, x1, y1, half width of
+# each straight piece of tape on the floor (seen by floor sensors only).
 #
 # No shapely or pymunk: both work object by object from Python, which would not batch over thousands
 # of robots; the few primitives needed (separating axes for convex pieces, segment distances, ray
@@ -20,6 +21,12 @@ import math
 import numpy as np
 
 from tablebot.jit import njit
+from tablebot.sim.geometry import (  # noqa: F401  (segments_cross, shadowed: re-exported, they lived here)
+    point_segment_distance,
+    segment_distance,
+    segments_cross,
+    shadowed,
+)
 from tablebot.sim.layout import (
     AMPS,
     B_FL,
@@ -42,10 +49,7 @@ from tablebot.sim.layout import (
     P_ALPHA,
     P_BASE,
     P_CAP,
-    P_COS_FOV,
-    P_DMIN,
     P_DT,
-    P_EXP,
     P_FRONT,
     P_GAP,
     P_GYR2,
@@ -82,21 +86,13 @@ from tablebot.sim.layout import (
     X,
     Y,
 )
+from tablebot.sim.sensing import light_from, sense_declared, sensor_events
 
+NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
 TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)
 
-# --- small geometry ------------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def point_segment_distance(px, py, ax, ay, bx, by):
-    """Distance from point p to segment ab."""
-    ex, ey = bx - ax, by - ay
-    length2 = ex * ex + ey * ey
-    t = 0.0 if length2 == 0.0 else ((px - ax) * ex + (py - ay) * ey) / length2
-    t = min(1.0, max(0.0, t))
-    return math.hypot(px - ax - t * ex, py - ay - t * ey)
+# --- the broad phase and the body ------------------------------------------------------------------------------
 
 
 @njit(cache=True)
@@ -118,25 +114,6 @@ def might_be_near(px, py, verts, a, b, pbound, k, reach):
     dx, dy = px - ax - t * ex, py - ay - t * ey
     margin = reach + 1e-6
     return dx * dx + dy * dy <= margin * margin
-
-
-@njit(cache=True)
-def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
-    """Whether segments ab and cd intersect (touching counts)."""
-    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
-    d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
-    d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
-    return d1 * d2 <= 0.0 and d3 * d4 <= 0.0 and not (d1 == 0.0 and d2 == 0.0)
-
-
-@njit(cache=True)
-def segment_distance(ax, ay, bx, by, cx, cy, dx, dy):
-    """Distance between segments ab and cd (0 when they cross)."""
-    if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
-        return 0.0
-    return min(point_segment_distance(ax, ay, cx, cy, dx, dy), point_segment_distance(bx, by, cx, cy, dx, dy),
-               point_segment_distance(cx, cy, ax, ay, bx, by), point_segment_distance(dx, dy, ax, ay, bx, by))
 
 
 @njit(cache=True)
@@ -351,43 +328,9 @@ def sense_bumpers(s, p, verts, pstart, pbound, circles):
 
 
 @njit(cache=True)
-def shadowed(sx, sy, lx, ly, lamp, edges, circles):
-    """Whether a wall, obstacle edge or circle blocks the straight line from sensor to lamp."""
-    for k in range(edges.shape[0]):
-        if segments_cross(sx, sy, lx, ly, edges[k, 0], edges[k, 1], edges[k, 2], edges[k, 3]):
-            return True
-    for k in range(circles.shape[0]):
-        if int(circles[k, 3]) != lamp and point_segment_distance(
-                circles[k, 0], circles[k, 1], sx, sy, lx, ly) < circles[k, 2]:
-            return True
-    return False
-
-
-@njit(cache=True)
 def light_at(s, p, side, edges, circles, lamps):
-    """Light one phototransistor receives: sum of intensity / d² × cos(angle)^k over unshadowed lamps.
-
-    The response fades to zero over the last quarter of the field of view (a lens tube's edge).
-    """
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
-    lx, ly = p[P_LX], side * p[P_LY]
-    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly
-    aim = s[TH] + side * p[P_TOE]
-    ax, ay = math.cos(aim), math.sin(aim)
-    total = 0.0
-    for k in range(lamps.shape[0]):
-        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
-        d = math.hypot(dx, dy)
-        cosine = 1.0 if d == 0.0 else (dx * ax + dy * ay) / d
-        if cosine <= p[P_COS_FOV]:
-            continue
-        d = max(d, p[P_DMIN])
-        # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
-        taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
-        value = lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
-        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):
-            total += value
-    return total
+    """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
+    return light_from(s, p, p[P_LX], side * p[P_LY], side * p[P_TOE], edges, circles, lamps)
 
 
 # --- motors, battery, motion ---------------------------------------------------------------------
@@ -455,7 +398,19 @@ def input_mask(s, bits):
 
 
 @njit(cache=True)
-def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, bits, move, corners):
+def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits):
+    """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
+    declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask)."""
+    sense_bumpers(s, p, verts, pstart, pbound, circles)
+    s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
+    s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
+    sense_declared(s, p, edges, circles, lamps, lines)
+    previous = int(s[MASK])
+    s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
+
+
+@njit(cache=True)
+def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, move, corners):
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2)."""
     if move:
@@ -464,16 +419,13 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, z, 
         drive(s, cmd, p, z)
         resolve(s, p, corners, verts, pstart, pbound, circles)
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-    sense_bumpers(s, p, verts, pstart, pbound, circles)
-    s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
-    s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
-    s[MASK] = input_mask(s, bits)
+    sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits)
 
 
 @njit(cache=True)
-def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move):
+def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move, lines=NO_LINES):
     """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
     corners = np.empty((4, 2))
     for i in range(S.shape[0]):
-        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, Z[i], bits, move,
-                corners)
+        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, lines, Z[i], bits,
+                move, corners)

@@ -43,7 +43,7 @@ class Scene:
     params: Params
     geometry: Geometry
     P: np.ndarray  # (1, N_PARAM)
-    bits: np.ndarray  # (N_BITS,) event bits of the sensors, 0 = not wired
+    bits: np.ndarray  # event bits of the BumberBot roles (B_*), then of each declared sensor; 0 = not wired
     drive: tuple[int, int]  # output indices of the right and left motor
     pulse_columns: tuple[int, ...]  # per robot counter: state column of its motor's pulses, -1 = none
     lamp_outputs: tuple[int, ...]  # output indices of the robot's lamps
@@ -51,6 +51,20 @@ class Scene:
     @property
     def tick_s(self) -> float:
         return self.table.robot.tick_ms / 1000
+
+
+#: Trace key suffix, scale and decimals of each declared sensor kind's reading (0 decimals: an integer).
+TRACE_FORMS = {"distance": ("cm", 100.0, 1), "light": ("light", 1.0, 4), "line": ("line", 1.0, 0)}
+
+
+def sensor_columns(scene: Scene) -> list[tuple[str, int, float, int]]:
+    """What a trace adds for each declared sensor: (key, state column, scale, decimals), e.g. the distance
+    sensor I3 as ``"I3_cm": 23.0``, a light sensor as ``"I4_light": 1.2345``, a line sensor as ``"I1_line": 1``."""
+    columns = []
+    for k, sensor in enumerate(scene.table.robot.sensors[: L.MAX_SENSORS]):
+        suffix, scale, decimals = TRACE_FORMS[sensor.kind]
+        columns.append((f"{sensor.name}_{suffix}", L.READING + k, scale, decimals))
+    return columns
 
 
 def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
@@ -89,12 +103,15 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
                             for section, key, message, hint in found)
     _check_tick(params, table.robot)
     tick_s = table.robot.tick_ms / 1000
-    P = param_row(params, tick_s)[None, :]
+    _check_sensor_count(table.robot)
+    P = param_row(params, tick_s, table.robot.sensors)[None, :]
     geo = geometry(world)
     _check_start(world, geo, P)
     outputs = machine.output_names
     robot = table.robot
-    bits = np.array([machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES], dtype=np.int64)
+    # the BumberBot roles' bits, then one per declared sensor (sensor slot k at B_SENSOR + k)
+    bits = np.array([machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES]
+                    + [machine.input_bits.get(sensor.name, 0) for sensor in robot.sensors], dtype=np.int64)
     motor_roles = {params.wiring["right_motor"]: "right_motor", params.wiring["left_motor"]: "left_motor"}
     columns = tuple(SIDE_COLUMNS[motor_roles[c.motor]] if c.motor in motor_roles else -1 for c in robot.counters)
     return Scene(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
@@ -116,8 +133,11 @@ def _locate(section: str, key: str, world: World, robot: Robot,
 
 
 def _unwire_absent_sensors(params: Params, robot: Robot) -> Params:
-    """Sensor roles left at the BumberBot's wiring stay unconnected on a robot without that input."""
-    wiring = {role: name if role.endswith("motor") or role in params.wired or name in robot.inputs else ""
+    """Sensor roles left at the BumberBot's wiring stay unconnected on a robot without that input, or
+    whose input is a sensor the robot file declares in [sensors]."""
+    declared = {s.name for s in robot.sensors}
+    wiring = {role: name if role.endswith("motor") or role in params.wired
+              or (name in robot.inputs and name not in declared) else ""
               for role, name in params.wiring.items()}
     return replace(params, wiring=wiring)
 
@@ -139,11 +159,22 @@ def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, st
         errors.append(("wiring", role, f"wiring: {role} = {name!r} is not {'a' if motor else 'an'} {kind} of "
                        f"robot {robot.name}", f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} "
                        f"in the world or [sim.wiring] in the robot file{unwired}"))
+    declared = {s.name: s for s in robot.sensors}
+    for role, name in params.wiring.items():
+        if name in declared:
+            errors.append(("wiring", role, f"wiring: {role} = {name!r}, but {name} is declared in [sensors] as a "
+                           f"{declared[name].model} sensor", f"wire {role} to another input, or to \"none\""))
     right, left = params.wiring["right_motor"], params.wiring["left_motor"]
     if right == left and right in robot.motors:
         errors.append(("wiring", "left_motor", f"wiring: right_motor and left_motor are both {right}",
                        "the simulated robot drives two wheels: give each its own motor"))
     return errors
+
+
+def _check_sensor_count(robot: Robot) -> None:
+    if len(robot.sensors) > L.MAX_SENSORS:
+        raise fail(robot.source, f"the simulator models at most {L.MAX_SENSORS} sensors in [sensors], and robot "
+                   f"{robot.name} declares {len(robot.sensors)}", "declare fewer sensors", robot.line("sensors"))
 
 
 def _check_tick(params: Params, robot: Robot) -> None:

@@ -6,6 +6,7 @@ sections of a robot file's ``[sim]`` ([body], [motor], [battery], ...), which wi
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +18,8 @@ from tablebot.formats.tomlfile import Source, Where, known_keys, label, number, 
 from tablebot.sim.params import SECTIONS, check_layer
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
-TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", *SECTIONS)
+TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", "line", *SECTIONS)
+TAPE_WIDTH = 0.019  # metres: a line's default width, that of common PVC insulating tape (15 or 19 mm)
 Point = tuple[float, float]
 
 
@@ -54,6 +56,21 @@ class Segment:
 
 
 @dataclass(frozen=True)
+class Line:
+    """A line on the floor (tape) that floor sensors see: a polyline of ``width``, closed into a loop or not.
+    It does not block the robot, its light or its distance sensors."""
+
+    points: tuple[Point, ...]
+    width: float = TAPE_WIDTH
+    closed: bool = False
+
+    def segments(self) -> list[tuple[Point, Point]]:
+        pts = list(self.points)
+        ends = pts[1:] + (pts[:1] if self.closed else [])
+        return list(zip(pts, ends, strict=False))
+
+
+@dataclass(frozen=True)
 class World:
     """A checked world; ``params`` holds its parameter sections, ``line`` finds a key's line for errors."""
 
@@ -64,6 +81,7 @@ class World:
     boxes: tuple[Box, ...] = ()
     circles: tuple[Circle, ...] = ()
     segments: tuple[Segment, ...] = ()
+    lines: tuple[Line, ...] = ()
     reach: float = 0.25  # the lamp counts as found when the axle centre is this close
     params: dict[str, dict[str, Any]] = field(default_factory=dict)
     path: str = "<world>"
@@ -83,6 +101,7 @@ class Geometry:
     edges: np.ndarray
     circles: np.ndarray
     lamps: np.ndarray
+    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))  # (K, 5): x0, y0, x1, y1, half width
 
 
 DEFAULT_WORLD = """\
@@ -119,15 +138,17 @@ def parse_world(src: Source) -> World:
     boxes = _many(src, data, "box", _box)
     circles = _many(src, data, "circle", _circle)
     segments = _many(src, data, "segment", _segment)
+    lines = _many(src, data, "line", _line)
     params = check_layer(src, data)
     if walls and start:
         _inside(src, walls, [("start", None, "at", start[:2])]
-                + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)])
+                + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)]
+                + [("line", i, "points", _first_outside(walls, line.points)) for i, line in enumerate(lines)])
     if walls:
         _lamps_in_the_open(src, walls, lamps, boxes, circles, segments)
     src.raise_if_any()
     return World(name=str(name), walls=tuple(walls), start=start, lamps=tuple(lamps),  # type: ignore[arg-type]
-                 boxes=tuple(boxes), circles=tuple(circles), segments=tuple(segments),
+                 boxes=tuple(boxes), circles=tuple(circles), segments=tuple(segments), lines=tuple(lines),
                  reach=float(reach or 0.25), params=params, path=src.path, source=src)
 
 
@@ -235,6 +256,29 @@ def _segment(src: Source, i: int, t: dict[str, Any]) -> Segment | None:
     return None if a is None or b is None else Segment(a, b)
 
 
+def _line(src: Source, i: int, t: dict[str, Any]) -> Line | None:
+    known_keys(src, ("line", i), t, ("points", "width", "closed"))
+    where = ("line", i, "points")
+    raw = t.get("points")
+    if not isinstance(raw, list) or len(raw) < 2:
+        src.error(where, f"[[line]] #{i + 1} needs points = [[x, y], [x, y], ...] (at least two)",
+                  "list the corners of the tape in order, in metres")
+        return None
+    points = [point(src, where, p) for p in raw]
+    width = number(src, ("line", i, "width"), t.get("width", TAPE_WIDTH), 0.001, 1.0)
+    closed = t.get("closed", False)
+    if not isinstance(closed, bool):
+        src.error(("line", i, "closed"), f"[[line]] #{i + 1} closed must be true or false, not {closed!r}",
+                  "closed = true joins the last point back to the first")
+        return None
+    if any(p is None for p in points) or width is None:
+        return None
+    if any(a == b for a, b in itertools.pairwise(points)):
+        src.error(where, f"[[line]] #{i + 1} repeats a point: a piece of no length", "remove the repeated point")
+        return None
+    return Line(tuple(points), float(width), closed)  # type: ignore[arg-type]
+
+
 def _area(poly: list[Point]) -> float:
     return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1], strict=True))
 
@@ -264,6 +308,11 @@ def inside(poly: tuple[Point, ...] | list[Point], p: Point) -> bool:
         if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
             result = not result
     return result
+
+
+def _first_outside(walls: list[Point], points: tuple[Point, ...]) -> Point:
+    """The first point of a line outside the walls (or its first point, inside: nothing to report)."""
+    return next((p for p in points if not inside(walls, p)), points[0])
 
 
 def _inside(src: Source, walls: list[Point], places: list[tuple[str, int | None, str, Point]]) -> None:
@@ -326,7 +375,9 @@ def geometry(world: World) -> Geometry:
     circles += [(lamp.at[0], lamp.at[1], lamp.radius, float(k))
                 for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
     lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
+    lines = [(a[0], a[1], b[0], b[1], line.width / 2) for line in world.lines for a, b in line.segments()]
     return Geometry(verts=verts, pstart=pstart, pbound=pbound,
                     edges=np.array(edges, dtype=np.float64).reshape(-1, 4),
                     circles=np.array(circles, dtype=np.float64).reshape(-1, 4),
-                    lamps=np.array(lamps, dtype=np.float64).reshape(-1, 3))
+                    lamps=np.array(lamps, dtype=np.float64).reshape(-1, 3),
+                    lines=np.array(lines, dtype=np.float64).reshape(-1, 5))

@@ -1,0 +1,191 @@
+"""The physics of the robot file's declared sensors ([sensors]): tape under a floor sensor, an ultrasonic
+echo inside a beam, light at any point of the body, and the threshold events with their hysteresis.
+
+Each is a compiled function of one robot's state row ``s``, its parameter row ``p`` (sensor slots in
+:mod:`tablebot.sim.layout`) and the world's arrays, so any loop over robots can call them.
+"""
+
+from __future__ import annotations
+
+import math
+
+from tablebot.jit import njit
+from tablebot.sim.geometry import point_segment_distance, shadowed
+from tablebot.sim.layout import (
+    B_SENSOR,
+    F_AIM,
+    F_KIND,
+    F_OFF,
+    F_ON,
+    F_SIGN,
+    F_X,
+    F_Y,
+    K_DISTANCE,
+    K_LIGHT,
+    K_LINE,
+    MAX_SENSORS,
+    P_COS_FOV,
+    P_DBEAM,
+    P_DMIN,
+    P_DMIN_RANGE,
+    P_DRANGE,
+    P_DRES,
+    P_EXP,
+    P_SENSOR,
+    READING,
+    SENSOR_FIELDS,
+    TH,
+    X,
+    Y,
+)
+
+
+@njit(cache=True)
+def light_from(s, p, lx, ly, turn, edges, circles, lamps):
+    """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
+    sum of intensity / d² × cos(angle)^k over unshadowed lamps.
+
+    The response fades to zero over the last quarter of the field of view (a lens tube's edge).
+    """
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly
+    aim = s[TH] + turn
+    ax, ay = math.cos(aim), math.sin(aim)
+    total = 0.0
+    for k in range(lamps.shape[0]):
+        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
+        d = math.hypot(dx, dy)
+        cosine = 1.0 if d == 0.0 else (dx * ax + dy * ay) / d
+        if cosine <= p[P_COS_FOV]:
+            continue
+        d = max(d, p[P_DMIN])
+        # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
+        taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
+        value = lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
+        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):
+            total += value
+    return total
+
+
+@njit(cache=True)
+def on_a_line(x, y, lines):
+    """1.0 when the floor point (x, y) lies on a piece of tape (within its half width of its middle), else 0.0."""
+    for k in range(lines.shape[0]):
+        if point_segment_distance(x, y, lines[k, 0], lines[k, 1], lines[k, 2], lines[k, 3]) <= lines[k, 4]:
+            return 1.0
+    return 0.0
+
+
+@njit(cache=True)
+def beam_segment(ux, uy, cb, sb, ax, ay, bx, by):
+    """Distance from the beam's apex (the origin) to the nearest point of segment ab inside the beam.
+
+    (ux, uy) is the beam's axis, cb and sb the cosine and sine of its half angle; a and b are relative to
+    the apex. The segment is clipped to the two half planes whose intersection is the beam (Liang-Barsky),
+    then the nearest point of what remains is exact. Returns inf when no part lies inside.
+    """
+    fa, ga = ax * ux + ay * uy, ux * ay - uy * ax  # forward and leftward coordinates
+    fb, gb = bx * ux + by * uy, ux * by - uy * bx
+    t0, t1 = 0.0, 1.0
+    for sign in (1.0, -1.0):  # inside: sin(half) * forward - sign * cos(half) * leftward >= 0
+        ha, hb = sb * fa - sign * cb * ga, sb * fb - sign * cb * gb
+        if ha < 0.0 and hb < 0.0:
+            return math.inf
+        if ha < 0.0:
+            t0 = max(t0, ha / (ha - hb))
+        elif hb < 0.0:
+            t1 = min(t1, ha / (ha - hb))
+    if t0 > t1:
+        return math.inf
+    return point_segment_distance(0.0, 0.0, ax + t0 * (bx - ax), ay + t0 * (by - ay),
+                                  ax + t1 * (bx - ax), ay + t1 * (by - ay))
+
+
+@njit(cache=True)
+def beam_circle(ux, uy, cb, sb, cx, cy, radius):
+    """Distance from the beam's apex to the nearest point of a disc (centre relative to the apex) inside the beam.
+
+    The nearest point of the disc lies towards its centre; when the centre is outside the beam the
+    nearest point inside lies on one of the beam's two edge rays. Returns inf when the beam misses it.
+    """
+    d = math.hypot(cx, cy)
+    if d <= radius:
+        return 0.0
+    forward, left = cx * ux + cy * uy, ux * cy - uy * cx
+    if forward > 0.0 and abs(left) * cb <= forward * sb:
+        return d - radius
+    best = math.inf
+    for sign in (1.0, -1.0):
+        rx, ry = ux * cb - sign * uy * sb, uy * cb + sign * ux * sb  # the edge ray's direction
+        along = rx * cx + ry * cy
+        disc = along * along - (d * d - radius * radius)
+        if disc >= 0.0 and along - math.sqrt(disc) >= 0.0:
+            best = min(best, along - math.sqrt(disc))
+    return best
+
+
+@njit(cache=True)
+def echo(sx, sy, aim, p, edges, circles):
+    """An ultrasonic sensor's reading in metres: the nearest wall, obstacle edge or circle inside its beam.
+
+    Rounded to the sensor's resolution and never below its blind zone; with nothing in range it reads
+    the range itself. Every surface echoes (no glancing-angle misses): see params.py's [distance].
+    """
+    ux, uy = math.cos(aim), math.sin(aim)
+    cb, sb = math.cos(p[P_DBEAM]), math.sin(p[P_DBEAM])
+    best = p[P_DRANGE]
+    hit = False
+    for k in range(edges.shape[0]):
+        ax, ay, bx, by = edges[k, 0] - sx, edges[k, 1] - sy, edges[k, 2] - sx, edges[k, 3] - sy
+        if point_segment_distance(0.0, 0.0, ax, ay, bx, by) >= best:
+            continue
+        d = beam_segment(ux, uy, cb, sb, ax, ay, bx, by)
+        if d < best:
+            best, hit = d, True
+    for k in range(circles.shape[0]):
+        cx, cy = circles[k, 0] - sx, circles[k, 1] - sy
+        if math.hypot(cx, cy) - circles[k, 2] >= best:
+            continue
+        d = beam_circle(ux, uy, cb, sb, cx, cy, circles[k, 2])
+        if d < best:
+            best, hit = d, True
+    if not hit:
+        return p[P_DRANGE]
+    return max(p[P_DMIN_RANGE], round(best / p[P_DRES]) * p[P_DRES])
+
+
+@njit(cache=True)
+def sense_declared(s, p, edges, circles, lamps, lines):
+    """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units."""
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    for k in range(MAX_SENSORS):
+        base = P_SENSOR + k * SENSOR_FIELDS
+        kind = p[base + F_KIND]
+        if kind == 0.0:
+            continue
+        bx, by = p[base + F_X], p[base + F_Y]
+        if kind == K_LIGHT:
+            s[READING + k] = light_from(s, p, bx, by, p[base + F_AIM], edges, circles, lamps)
+            continue
+        sx, sy = s[X] + c * bx - sn * by, s[Y] + sn * bx + c * by
+        if kind == K_LINE:
+            s[READING + k] = on_a_line(sx, sy, lines)
+        elif kind == K_DISTANCE:
+            s[READING + k] = echo(sx, sy, s[TH] + p[base + F_AIM], p, edges, circles)
+
+
+@njit(cache=True)
+def sensor_events(s, p, bits, previous):
+    """The event bits of the declared sensors: a reading past its threshold turns the event on; once on, it
+    stays on until the reading is back past the threshold by the hysteresis (``previous`` = last mask)."""
+    mask = 0
+    for k in range(min(MAX_SENSORS, bits.shape[0] - B_SENSOR)):
+        bit = bits[B_SENSOR + k]
+        base = P_SENSOR + k * SENSOR_FIELDS
+        if bit == 0 or p[base + F_KIND] == 0.0:
+            continue
+        level = p[base + F_OFF] if previous & bit else p[base + F_ON]
+        value = s[READING + k]
+        if (value > level) if p[base + F_SIGN] > 0.0 else (value < level):
+            mask |= bit
+    return mask
