@@ -79,3 +79,18 @@ def test_command_mermaid_to_stdout_and_bad_format():
     assert result.exit_code == 0 and "s_3 --> s_1: T / spin left L-3 R3 300 ms" in result.stdout
     bad = runner.invoke(app, ["diagram", str(FIX / "bump.csv"), "--format", "gif"])
     assert bad.exit_code == 2 and "unknown diagram format" in bad.stderr
+
+
+def test_a_fallback_row_reads_otherwise_and_descriptions_never_name_states(tmp_path):
+    robot = (FIX / "robot.toml").read_text()
+    (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
+    (tmp_path / "t.csv").write_text("description,state,T,A,B,M1,M2,timer,next\n"
+                                    "search,1,,1,,3,3,0,2\n"
+                                    "search – give up,1,,,,0,0,0,1\n"
+                                    "wait,2,,,,0,0,0,1\n", encoding="utf-8")
+    table = load_table(tmp_path / "t.csv")
+    by_pair = {(e.source, e.target): e for e in edges(table)}
+    assert by_pair[(1, 1)].lines[0][0] == "otherwise"  # tried after the row that needs A
+    assert by_pair[(2, 1)].lines[0][0] == "always"  # state 2's only row
+    mermaid = to_mermaid(table)
+    assert 'state "1" as s_1' in mermaid and "give up" not in mermaid.split("s_1 --> s_2")[0]

@@ -37,23 +37,31 @@ class Edge:
 def edges(table: Table) -> list[Edge]:
     """One edge per (state, next) pair; rows with the same action are merged into one condition."""
     groups: dict[tuple[StateId, StateId], list[Row]] = {}
+    first: dict[StateId, int] = {}
     for row in table.rows:
         groups.setdefault((row.state, row.next), []).append(row)
+        first.setdefault(row.state, row.index)
     result = []
     for (source, target), rows in groups.items():
         by_action: dict[Action, list[frozenset[str]]] = {}
+        fallback: dict[Action, bool] = {}
         for row in rows:
-            by_action.setdefault(action(table, row), []).append(row.events)
-        lines = tuple((condition(table, sets), act) for act, sets in by_action.items())
+            act = action(table, row)
+            by_action.setdefault(act, []).append(row.events)
+            fallback[act] = fallback.get(act, False) or (not row.events and row.index > first[row.state])
+        lines = tuple((condition(table, sets, fallback[act]), act) for act, sets in by_action.items())
         result.append(Edge(source, target, lines))
     return result
 
 
-def condition(table: Table, event_sets: Sequence[frozenset[str]]) -> str:
-    """``I3 or I4`` for rows {I3,I4}, {I3}, {I4}: a set that contains another adds nothing."""
+def condition(table: Table, event_sets: Sequence[frozenset[str]], otherwise: bool = False) -> str:
+    """``I3 or I4`` for rows {I3,I4}, {I3}, {I4}: a set that contains another adds nothing. A row that
+    needs no event reads "always" when it is its state's first row, and "otherwise" (``otherwise``) when
+    earlier rows of its state are tried first."""
     minimal = [s for s in event_sets if not any(o < s for o in event_sets)]
     unique = list(dict.fromkeys(minimal))
-    parts = ["+".join(e if e != TIMER_EVENT else "T" for e in table.events if e in s) or "always" for s in unique]
+    empty = "otherwise" if otherwise else "always"
+    parts = ["+".join(e if e != TIMER_EVENT else "T" for e in table.events if e in s) or empty for s in unique]
     return " or ".join(parts)
 
 

@@ -9,23 +9,12 @@ from tablebot.table import TIMER_EVENT, Row, Table
 
 
 def state_label(table: Table, state: StateId) -> str:
-    """A state's name: from the robot file's ``[states]``, else the description of the row that
-    fires on ``T`` alone (what the state does until its time is up), else of its first row."""
-    labels = table.memo.setdefault("state_labels", {})
-    if state not in labels:
-        labels[state] = _label(table, state)
-    return labels[state]
+    """A state's name from the robot file's ``[states]``, else "" (the state is then known by its number).
 
-
-def _label(table: Table, state: StateId) -> str:
-    named = table.robot.state_names.get(state)
-    if named:
-        return named
-    rows = table.rows_by_state.get(state, ())
-    for row in rows:
-        if row.events == frozenset({TIMER_EVENT}) and row.description:
-            return row.description
-    return next((r.description for r in rows if r.description), "")
+    Row descriptions are never used: some tables describe the state a row leaves, others the action it
+    starts, and a blank description continues the one above, so "search – give up" would name a state.
+    """
+    return table.robot.state_names.get(state, "")
 
 
 def state_text(table: Table, state: StateId) -> str:

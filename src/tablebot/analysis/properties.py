@@ -24,13 +24,13 @@ from typing import Any
 
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
 from tablebot.diagnostics import Collector, TableBotError
+from tablebot.durations import DurationError, to_ticks
 from tablebot.formats.tomlfile import Source
 from tablebot.machine import Machine
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
 LEVELS = ("error", "warning")
-DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(ticks?|ms|s)\s*$")
 PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
 HINT = "see the property format in docs/checking.md"
 #: A property's name names its counterexample file, so it must stay a plain file name.
@@ -190,13 +190,11 @@ def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collec
         return 0
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
         return value
-    match = DURATION_RE.match(value) if isinstance(value, str) else None
-    if match is None:
+    if not isinstance(value, str):
         out.error(line, None, f"property {name}: within = {value!r} is not a duration", hint)
         return 0
-    number, unit = float(match[1]), match[2]
-    ticks = number if unit.startswith("tick") else number * (1000 if unit == "s" else 1) / tick_ms
-    if abs(ticks - round(ticks)) > 1e-9:
-        out.error(line, None, f"property {name}: {value} is not a whole number of {tick_ms} ms ticks", hint)
+    try:
+        return to_ticks(value, tick_ms)
+    except DurationError as exc:
+        out.error(line, None, f"property {name}: within = {exc.message}", exc.hint)
         return 0
-    return round(ticks)

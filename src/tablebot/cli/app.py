@@ -1,4 +1,5 @@
-"""The ``tablebot`` command-line application object that every command module registers on."""
+"""The ``tablebot`` command-line application object that every command module registers on, with the
+options every invocation shares: ``--version``, ``-h``/``--help`` and shell completion."""
 
 import typer
 
@@ -6,6 +7,33 @@ app = typer.Typer(
     name="tablebot",
     help="Robot behaviour written as a table: check it, trace it, simulate it, export it.",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,  # --install-completion / --show-completion for bash, zsh, fish, PowerShell
     pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},  # inherited by every command
 )
+
+
+def version() -> str:
+    """The installed distribution's version (the package's own when run from a source tree)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as dist_version
+
+    try:
+        return dist_version("tablebot")
+    except PackageNotFoundError:
+        from tablebot import __version__
+        return __version__
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"tablebot {version()}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    show_version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                      help="Print tablebot's version and exit."),
+) -> None:
+    """Robot behaviour written as a table: check it, trace it, simulate it, export it."""

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import Collector, Diagnostic, fail
+from tablebot.durations import DurationError, to_ticks
 from tablebot.formats.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.robot import (
     BUMBERBOT,
@@ -29,6 +30,7 @@ KEEP_WORDS = {"=", "keep", "k"}
 ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
 FIXED = ("description", "state", "timer", "next")
 INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
+TIME_RE = re.compile(r"[A-Za-z]\s*$")  # a timer cell that ends in a unit (500ms, 0.5 s, 3 ticks) is a duration
 
 
 @dataclass(frozen=True)
@@ -166,6 +168,8 @@ def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int 
 def _range_hint(low: int, high: int, keep: bool) -> str:
     if (low, high) == (0, 1):  # event and direction cells: a flag, not a quantity
         return "write 1 or 0 (a blank cell is 0)"
+    if (low, high, keep) == (0, MAX_TIMER, False):  # the timer: ticks or a time
+        return f"write a whole number of ticks from 0 to {high}, or a time such as 500ms or 0.5s"
     return f"write a whole number from {low} to {high}" + (", or = to keep it as it is" if keep else "")
 
 
@@ -204,8 +208,8 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector,
     cells = list(record.cells[: len(columns)])
     end = (cells[-1].column + len(cells[-1].text) + 1) if cells else 1
     cells += [Cell("", record.line, end)] * (len(columns) - len(cells))
-    values = {(c.kind, c.name): _cached(i, c, cell, out, memo) for i, (c, cell) in enumerate(zip(columns, cells,
-                                                                                               strict=True))}
+    values = {(c.kind, c.name): _cached(i, c, cell, out, memo, robot.tick_ms)
+              for i, (c, cell) in enumerate(zip(columns, cells, strict=True))}
     cells_beyond(record.cells, len(columns), out)
     state, nxt = values.get(("state", "state")), values.get(("next", "next"))
     if state is None or nxt is None:
@@ -218,7 +222,8 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector,
                lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
 
 
-def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any]) -> Any:
+def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any],
+            tick_ms: int) -> Any:
     """:func:`_value`, remembered per column and text: a long table repeats the same few cell texts.
     A cell with an error is never remembered, so every bad cell is reported at its own place."""
     if column.kind == "description":
@@ -227,17 +232,19 @@ def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[t
     if key in memo:
         return memo[key]
     errors = len(out.items)
-    value = _value(column, cell, out)
+    value = _value(column, cell, out, tick_ms)
     if len(out.items) == errors:
         memo[key] = value
     return value
 
 
-def _value(column: Column, cell: Cell, out: Collector) -> Any:
+def _value(column: Column, cell: Cell, out: Collector, tick_ms: int) -> Any:
     """What one cell says: text (description), a state, a number or None (keep); errors go to ``out``."""
     kind, text = column.kind, cell.text.strip()
     if kind == "description":
         return text
+    if kind == "timer" and TIME_RE.search(text):
+        return _timer(cell, tick_ms, out)
     if kind in ("state", "next"):
         return _state(cell, "next state" if kind == "next" else "state", out)
     if kind in NUMBERS:
@@ -248,6 +255,21 @@ def _value(column: Column, cell: Cell, out: Collector) -> Any:
     if not column.name:  # an ignored column with a name was reported in the header
         headerless(cell, out)
     return None
+
+
+def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
+    """A timer cell written as a time (``500ms``, ``0.5s``, ``3 ticks``): whole ticks, or 0 after an error."""
+    text = cell.text.strip()
+    try:
+        ticks = to_ticks(text, tick_ms)
+    except DurationError as exc:
+        out.error(cell.line, cell.column, f"timer: {exc.message}", exc.hint)
+        return 0
+    if ticks > MAX_TIMER:
+        out.error(cell.line, cell.column, f"timer: {text} is {ticks} ticks, more than the timer holds ({MAX_TIMER})",
+                  f"the longest timer is {MAX_TIMER} ticks ({MAX_TIMER * tick_ms / 1000:g} s at {tick_ms} ms a tick)")
+        return 0
+    return ticks
 
 
 def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:

@@ -1,0 +1,54 @@
+"""Durations people write (``50``, ``500ms``, ``0.5 s``, ``3 ticks``) as whole engine ticks.
+
+One home for the rule, shared by the table's timer cells and the properties' ``within``: a duration
+must be a whole number of ticks, and when it is not, the nearest values that are get named.
+Arithmetic is exact (fractions), so ``0.1 s`` at 10 ms is 10 ticks, not 9.999….
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from fractions import Fraction
+
+DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d*)?|\.\d+)\s*(ticks?|ms|s)?\s*$", re.IGNORECASE)
+MS_PER = {"ms": 1, "s": 1000}
+
+
+class DurationError(ValueError):
+    """A duration that cannot be read or is no whole number of ticks; ``hint`` says what to write."""
+
+    def __init__(self, message: str, hint: str):
+        super().__init__(message)
+        self.message, self.hint = message, hint
+
+
+def is_duration(text: str) -> bool:
+    """Whether ``text`` is written like a duration (a number, optionally with ms, s or ticks)."""
+    return DURATION_RE.match(text) is not None
+
+
+def to_ticks(text: str, tick_ms: int) -> int:
+    """The whole ticks ``text`` stands for (a bare number counts ticks); raises :class:`DurationError`."""
+    match = DURATION_RE.match(text)
+    if match is None:
+        raise DurationError(f"{text.strip()!r} is not a duration",
+                            f"write ticks (50) or a time: 500ms, 0.5s (one tick is {tick_ms} ms)")
+    amount, unit = Fraction(match[1]), (match[2] or "ticks").lower()
+    ticks = amount if unit.startswith("tick") else amount * MS_PER[unit] / tick_ms
+    if ticks.denominator == 1:
+        return int(ticks)
+    shown = text.strip()
+    if unit.startswith("tick"):
+        raise DurationError(f"{shown} is not a whole number of ticks",
+                            f"nearest: {math.floor(ticks)} or {math.ceil(ticks)} (one tick is {tick_ms} ms)")
+    below, above = (nearest(t, unit, tick_ms) for t in (math.floor(ticks), math.ceil(ticks)))
+    raise DurationError(f"{shown} is not a whole number of {tick_ms} ms ticks",
+                        f"nearest: {below} or {above}")
+
+
+def nearest(ticks: int, unit: str, tick_ms: int) -> str:
+    """``500ms (50 ticks)``: a tick count shown in the unit the user wrote."""
+    amount = Fraction(ticks * tick_ms, MS_PER[unit])
+    number = str(amount.numerator) if amount.denominator == 1 else f"{float(amount):g}"
+    return f"{number}{unit} ({ticks} tick{'s' * (ticks != 1)})"
