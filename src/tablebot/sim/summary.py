@@ -1,4 +1,4 @@
-"""What a run amounts to: first light seen, lamp reached, collisions, distance, time per state.
+"""What a run amounts to: first light seen, lamp reached, laps of a track, collisions, distance, time per state.
 
 Computed from a :class:`~tablebot.sim.runner.Result`, so the CLI, the plots and the tests agree on one
 set of numbers; collisions and the lamp are counted by the simulated robot as it runs (sim.kernel.observe).
@@ -13,6 +13,9 @@ import numpy as np
 from tablebot.robot import StateId
 from tablebot.sim import layout as L
 from tablebot.sim.runner import Result
+from tablebot.sim.track import laps
+
+LAP_STRIDE = 5  # robot rows per sample for counting laps (the robot moves well under 1 cm a tick)
 
 
 @dataclass(frozen=True)
@@ -26,16 +29,20 @@ class Summary:
     state_seconds: dict[StateId, float]  # in order of first visit
     battery_start_v: float
     battery_end_v: float
+    laps: float | None = None  # net laps round the world's closed [[line]], if it has one
+    lamps: bool = True  # whether the world has lamps (else the light lines say nothing)
 
     def lines(self, names: dict[StateId, str] | None = None) -> list[str]:
         """Human-readable summary lines."""
         names = names or {}
         def when(value: float | None) -> str:
             return "never" if value is None else f"{value:.2f} s"
-        out = [f"simulated {self.seconds:.1f} s",
-               f"first light seen: {when(self.first_light_s)}",
-               f"lamp reached:     {when(self.reached_s)}",
-               f"collisions:       {self.collisions}",
+        out = [f"simulated {self.seconds:.1f} s"]
+        if self.lamps:
+            out += [f"first light seen: {when(self.first_light_s)}", f"lamp reached:     {when(self.reached_s)}"]
+        if self.laps is not None:
+            out.append(f"laps of the line: {self.laps:.2f}")
+        out += [f"collisions:       {self.collisions}",
                f"distance driven:  {self.distance_m:.2f} m",
                f"battery:          {self.battery_start_v:.2f} V -> {self.battery_end_v:.2f} V",
                "time per state:"]
@@ -78,4 +85,6 @@ def summarise(result: Result) -> Summary:
         collisions=result.collision_count, collision_ticks=tuple(result.collision_rows),
         distance_m=float(h[-1, L.DIST]), state_seconds=time_per_state(result.states, result.scene.machine.states,
                                                                       tick_s),
-        battery_start_v=float(h[0, L.VBAT]), battery_end_v=float(h[-1, L.VBAT]))
+        battery_start_v=float(h[0, L.VBAT]), battery_end_v=float(h[-1, L.VBAT]),
+        laps=laps(result.scene.world, h[::LAP_STRIDE, L.X], h[::LAP_STRIDE, L.Y]),
+        lamps=bool(result.scene.world.lamps))
