@@ -19,7 +19,7 @@ from PIL import Image
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write
 from tablebot.sim import layout as L
-from tablebot.sim.draw import RobotArtist, draw_world, state_colours, state_label, state_names
+from tablebot.sim.draw import RobotArtist, draw_world, sensor_readings, state_colours, state_label, state_names
 from tablebot.sim.plots import subtitle_of, title_of
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -46,7 +46,7 @@ class Player:
         self.colours = colours[result.states[np.minimum(ticks[:-1], max(0, result.ticks - 1))]]
         self.trail = LineCollection([], linewidths=1.8, zorder=4)
         self.ax.add_collection(self.trail)
-        self.robot = RobotArtist(self.ax, scene.params, len(scene.lamp_outputs))
+        self.robot = RobotArtist(self.ax, scene.params, len(scene.lamp_outputs), sensors=scene.table.robot.sensors)
         self.names = state_names(scene.table)
         self.hud = self.ax.text(1.0, 1.02, "", transform=self.ax.transAxes, va="bottom", ha="right", fontsize=9,
                                 family="monospace", zorder=20)
@@ -63,7 +63,8 @@ class Player:
         self.robot.update(h[L.X], h[L.Y], h[L.TH],
                           bumpers=(h[L.BUMP_FR] > 0, h[L.BUMP_FL] > 0, h[L.BUMP_REAR] > 0),
                           lights=(h[L.LIGHT_R] >= 1, h[L.LIGHT_L] >= 1),
-                          lamps=tuple(int(last[i]) for i in scene.lamp_outputs))
+                          lamps=tuple(int(last[i]) for i in scene.lamp_outputs),
+                          readings=sensor_readings(h, scene.table.robot.sensors))
         state = scene.machine.states[r.states[max(0, t - 1)]] if r.ticks else scene.table.robot.initial_state
         names = scene.machine.output_names
         n_motors = scene.machine.n_motors

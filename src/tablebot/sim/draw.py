@@ -1,4 +1,5 @@
-"""Drawing pieces shared by the pictures and the animation: arena, obstacles, lamp, the robot, state colours.
+"""Drawing pieces shared by the pictures and the animation: arena, tape, obstacles, lamps with their bases,
+the robot with its sensors, where a collision touched, state colours.
 
 Only matplotlib artists on a given Axes; no figure or backend is chosen here, so headless use
 never touches a display.
@@ -6,22 +7,28 @@ never touches a display.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import PatchCollection
 from matplotlib.patches import Circle as CirclePatch
-from matplotlib.patches import Polygon, Wedge
+from matplotlib.patches import Polygon, Rectangle, Wedge
 
 from tablebot.robot import StateId
+from tablebot.sensors import Sensor
+from tablebot.sim import layout as L
 from tablebot.sim.params import Params
-from tablebot.sim.world import World
+from tablebot.sim.world import Geometry, World
 from tablebot.table import Table
 
 FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
 COLLISION, LIGHT_SEEN, REACHED = "#e8413a", "#f0a500", "#20bf6b"
+TAPE, BEAM, BEAM_NEAR = "#1e1e1e", "#4a90d9", "#1f5fa8"
+TOUCH_M = 0.001  # outline points this much farther than the nearest still touch (a face flat on a wall)
 # tab10 without its red (red marks collisions) and with darker extras after it
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#e377c2", "#7f7f7f",
            "#bcbd22", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd", "#31a354")
@@ -54,6 +61,7 @@ def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
                                  linewidth=1.2, hatch="//", zorder=2))
     for seg in world.segments:
         ax.plot(*zip(seg.start, seg.end, strict=True), color=WALL, linewidth=3, solid_capstyle="round", zorder=2)
+    draw_tape(ax, world)
     for lamp in world.lamps:
         if lamp_glow:
             for k, radius in enumerate((0.45, 0.3, 0.18)):
@@ -64,9 +72,11 @@ def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
                                linestyle="--", linewidth=1, alpha=0.6, zorder=1)
             ax.add_patch(ring)
             ring.set_clip_path(floor)
-        if lamp.radius > 0:
-            ax.add_patch(CirclePatch(lamp.at, lamp.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, zorder=2))
-        ax.plot(*lamp.at, marker="*", markersize=20, color=LAMP_ON, markeredgecolor="#b8860b", zorder=12)
+        if lamp.radius > 0:  # the lamp's base is an obstacle the robot bumps into: drawn as one, to scale
+            ax.add_patch(CirclePatch(lamp.at, lamp.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, linewidth=1.2,
+                                     hatch="//", zorder=2))
+        ax.plot(*lamp.at, marker="*", markersize=9 if lamp.radius > 0 else 16, color=LAMP_ON,
+                markeredgecolor="#b8860b", zorder=12)
     xs, ys = zip(*world.walls, strict=True)
     pad = 0.05 * max(max(xs) - min(xs), max(ys) - min(ys))
     ax.set_xlim(min(xs) - pad, max(xs) + pad)
@@ -76,6 +86,53 @@ def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
     ax.set_ylabel("y (m)")
 
 
+def draw_tape(ax: Axes, world: World) -> None:
+    """Each [[line]] to scale: a band of its width along every piece, round at the corners."""
+    patches: list = []
+    for line in world.lines:
+        half = line.width / 2
+        for (x0, y0), (x1, y1) in line.segments():
+            angle = math.degrees(math.atan2(y1 - y0, x1 - x0))
+            length = math.hypot(x1 - x0, y1 - y0)
+            c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+            patches.append(Rectangle((x0 + s * half, y0 - c * half), length, line.width, angle=angle))
+        patches += [CirclePatch(p, half) for p in line.points]
+    if patches:
+        ax.add_collection(PatchCollection(patches, facecolor=TAPE, edgecolor="none", zorder=0.5))
+
+
+def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta: float) -> tuple[float, float]:
+    """Where the robot at this pose touches the world: the point of the wall, obstacle or lamp base nearest to
+    its body's outline (sampled every 2 mm); a face lying flat against a wall touches along a stretch,
+    marked at its middle."""
+    body = params["body"]
+    f, r, w = body["front"], -body["rear"], body["half_width"]
+    corners = np.array([(f, -w), (f, w), (r, w), (r, -w), (f, -w)])
+    outline = np.concatenate([np.linspace(a, b, max(2, int(math.hypot(*(b - a)) / 0.002)), endpoint=False)
+                              for a, b in itertools.pairwise(corners)])
+    pts = _transform(outline, x, y, theta)[:, None, :]  # (M, 1, 2)
+    best, where = math.inf, (x, y)
+    if len(geometry.edges):
+        a, b = geometry.edges[None, :, :2], geometry.edges[None, :, 2:]
+        ab = b - a
+        t = np.clip(((pts - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)[..., None]
+        near = a + t * ab  # (M, E, 2): each sample's nearest point on each edge
+        gap = np.hypot(*(pts - near).transpose(2, 0, 1))
+        edge = int(np.unravel_index(np.argmin(gap), gap.shape)[1])
+        best = float(gap[:, edge].min())
+        touching = gap[:, edge] <= best + TOUCH_M
+        where = tuple(near[touching, edge].mean(axis=0))
+    if len(geometry.circles):
+        centres, radii = geometry.circles[None, :, :2], geometry.circles[None, :, 2]
+        off = pts - centres
+        dist = np.hypot(off[..., 0], off[..., 1])
+        gap = dist - radii
+        k = np.unravel_index(np.argmin(gap), gap.shape)
+        if gap[k] < best:
+            where = tuple(centres[0, k[1]] + off[k] / max(float(dist[k]), 1e-12) * radii[0, k[1]])
+    return float(where[0]), float(where[1])
+
+
 def _transform(points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:
     c, s = math.cos(theta), math.sin(theta)
     return np.column_stack((x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]))
@@ -83,12 +140,14 @@ def _transform(points: np.ndarray, x: float, y: float, theta: float) -> np.ndarr
 
 @dataclass
 class RobotArtist:
-    """The robot drawn to scale: body, front bumper halves, rear bumper, sensor cones, lit lamps."""
+    """The robot drawn to scale: body, the bumpers and phototransistor cones it has wired, its declared
+    sensors (floor spots dark over tape, distance beams as far as they reach, light cones), lit lamps."""
 
     ax: Axes
     params: Params
     n_lamps: int = 0
     alpha: float = 1.0
+    sensors: tuple[Sensor, ...] = ()
 
     def __post_init__(self) -> None:
         b, light = self.params["body"], self.params["light"]
@@ -115,15 +174,29 @@ class RobotArtist:
                                   zorder=z + 3) for _ in range(self.n_lamps)]
         self.glows = [CirclePatch((0, 0), 0.04, facecolor=LAMP_ON, lw=0, alpha=0.0, zorder=z + 2)
                       for _ in range(self.n_lamps)]
+        wiring = self.params.wiring  # a bumper or phototransistor not wired to an input is not drawn
+        for patch, role in zip([*self.bumpers, *self.cones], ("front_right", "front_left", "rear", "light_right",
+                                                             "light_left"), strict=True):
+            patch.set_visible(bool(wiring.get(role)))
         self.heading = self.ax.plot([], [], color=WALL, lw=1.5, alpha=self.alpha, zorder=z + 1)[0]
-        for patch in (self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps):
+        self.declared = [self._sensor_patch(sensor, z) for sensor in self.sensors]
+        for patch in (self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps, *self.declared):
             self.ax.add_patch(patch)
 
+    def _sensor_patch(self, sensor: Sensor, z: int) -> Polygon | Wedge:
+        if sensor.kind == "line":  # a 12 mm spot on the body, dark while it sees tape
+            return Polygon(np.zeros((4, 2)), closed=True, facecolor="white", edgecolor=TAPE, lw=0.8,
+                           alpha=self.alpha, zorder=z + 4)
+        colour = BEAM if sensor.kind == "distance" else LAMP_ON
+        return Wedge((0, 0), 0.01, 0, 1, facecolor=colour, alpha=0.2 * self.alpha, lw=0, zorder=z - 1)
+
     def artists(self) -> list:
-        return [self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps, self.heading]
+        return [self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps, *self.declared, self.heading]
 
     def update(self, x: float, y: float, theta: float, bumpers: tuple[bool, bool, bool] = (False,) * 3,
-               lights: tuple[bool, bool] = (False, False), lamps: tuple[int, ...] = ()) -> None:
+               lights: tuple[bool, bool] = (False, False), lamps: tuple[int, ...] = (),
+               readings: tuple[float, ...] = ()) -> None:
+        """Move to (x, y, theta); ``readings`` are the declared sensors' (``sensor_readings``)."""
         self.body.set_xy(_transform(self.body_pts, x, y, theta))
         for patch, pts, on in zip(self.bumpers, self.bump_pts, bumpers, strict=True):
             patch.set_xy(_transform(pts, x, y, theta))
@@ -142,3 +215,34 @@ class RobotArtist:
             glow.set_alpha(0.25 + 0.4 * min(level, 8) / 8 if level else 0.0)  # brighter for higher levels
         nose = _transform(np.array([(0.0, 0.0), (self.body_pts[0, 0] * 0.8, 0.0)]), x, y, theta)
         self.heading.set_data(nose[:, 0], nose[:, 1])
+        values = tuple(readings) + (0.0,) * (len(self.sensors) - len(readings))
+        for patch, sensor, value in zip(self.declared, self.sensors, values, strict=True):
+            self._update_sensor(patch, sensor, value, x, y, theta)
+
+    def _update_sensor(self, patch: Polygon | Wedge, sensor: Sensor, value: float, x: float, y: float,
+                       theta: float) -> None:
+        at = np.array(sensor.at)
+        if isinstance(patch, Polygon):
+            spot = at + np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)]) * 0.006
+            patch.set_xy(_transform(spot, x, y, theta))
+            patch.set_facecolor(TAPE if value > 0.5 else "white")
+            return
+        cx, cy = _transform(at[None, :], x, y, theta)[0]
+        aim = math.degrees(theta) + sensor.angle
+        on = value < sensor.threshold if sensor.direction == "below" else value > sensor.threshold
+        if sensor.kind == "distance":  # the beam as far as the echo came from
+            half = self.params["distance"]["beam"]
+            patch.set_radius(max(value, 0.005))
+            patch.set_facecolor(BEAM_NEAR if on else BEAM)
+        else:
+            half = self.params["light"]["half_response"]
+            patch.set_radius(0.25)
+        patch.set_center((cx, cy))
+        patch.set_theta1(aim - half)
+        patch.set_theta2(aim + half)
+        patch.set_alpha((0.45 if on else 0.18) * self.alpha)
+
+
+def sensor_readings(row: np.ndarray, sensors: tuple[Sensor, ...]) -> tuple[float, ...]:
+    """The declared sensors' readings in a robot row of the run's history."""
+    return tuple(float(row[L.READING + k]) for k in range(min(len(sensors), L.MAX_SENSORS)))

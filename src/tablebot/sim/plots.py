@@ -5,7 +5,6 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -18,13 +17,17 @@ from matplotlib.patches import Patch
 from tablebot.files import atomic_write
 from tablebot.sim import layout as L
 from tablebot.sim.draw import (
+    BEAM,
     COLLISION,
     LAMP_ON,
     LIGHT_SEEN,
     REACHED,
+    TAPE,
     WALL,
     RobotArtist,
+    contact_point,
     draw_world,
+    sensor_readings,
     state_colours,
     state_label,
     state_names,
@@ -34,6 +37,7 @@ from tablebot.sim.summary import Summary
 
 DPI = 150
 PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels
+SPIN_M, SPIN_DEG = 0.01, 15.0  # a state that moves the robot less and turns it more is a spin: drawn as a dot
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
 
 
@@ -45,8 +49,13 @@ def title_of(result: Result) -> str:
 def subtitle_of(summary: Summary) -> str:
     def when(v: float | None) -> str:
         return "never" if v is None else f"{v:.1f} s"
-    return (f"light first seen: {when(summary.first_light_s)}   ·   lamp reached: {when(summary.reached_s)}   ·   "
-            f"{summary.collisions} collision{'s' * (summary.collisions != 1)}   ·   {summary.distance_m:.2f} m driven")
+    parts = []
+    if summary.lamps:
+        parts += [f"light first seen: {when(summary.first_light_s)}", f"lamp reached: {when(summary.reached_s)}"]
+    if summary.laps is not None:
+        parts.append(f"{summary.laps:.2f} laps of the line")
+    parts += [f"{summary.collisions} collision{'s' * (summary.collisions != 1)}", f"{summary.distance_m:.2f} m driven"]
+    return "   ·   ".join(parts)
 
 
 def trajectory(result: Result, summary: Summary, path: Path) -> Path:
@@ -64,9 +73,9 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     lines = LineCollection(pieces, colors=[colours[s] for s in piece_states], linewidths=2.2,
                            capstyle="round", joinstyle="round", zorder=4)
     ax.add_collection(lines)
-    # spins in place draw no line: a dot where each state begins shows them
-    change = np.flatnonzero(np.diff(result.states)) + 1
-    ax.scatter(h[change, L.X], h[change, L.Y], s=18, c=[colours[s] for s in result.states[change].tolist()],
+    # spins in place draw no line: a dot where such a state begins shows them
+    spins = spin_starts(h, result.states)
+    ax.scatter(h[spins, L.X], h[spins, L.Y], s=18, c=[colours[s] for s in result.states[spins].tolist()],
                edgecolors="white", linewidths=0.6, zorder=5)
     _markers(ax, result, summary)
     _robot_poses(ax, result)
@@ -74,6 +83,16 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
     _legend(fig, result, summary)
     return save(fig, path)
+
+
+def spin_starts(h: np.ndarray, states: np.ndarray) -> np.ndarray:
+    """Rows where a state begins that turns the robot on the spot: its stretch of the run moves the axle
+    less than SPIN_M but turns it more than SPIN_DEG (a line follower's quick state changes are no spins)."""
+    change = np.flatnonzero(np.diff(states)) + 1
+    starts, ends = np.concatenate(([0], change)), np.concatenate((change, [len(states)]))
+    moved = np.hypot(h[ends, L.X] - h[starts, L.X], h[ends, L.Y] - h[starts, L.Y])
+    turned = np.degrees(np.abs(h[ends, L.TH].astype(np.float64) - h[starts, L.TH]))
+    return starts[(moved < SPIN_M) & (turned > SPIN_DEG)]
 
 
 def save(fig: Figure, path: Path) -> Path:
@@ -112,13 +131,11 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
 
 
 def _markers(ax, result: Result, summary: Summary) -> None:
-    h, front = result.hist, result.scene.params["body"]["front"]
-    for row in summary.collision_ticks:
-        x, y, th = h[row, L.X], h[row, L.Y], h[row, L.TH]
-        # mark the bumper side that touched: the nose for front hits, the tail for rear ones
-        reach = -result.scene.params["body"]["rear"] if h[row, L.BUMP_REAR] > 0 else front
-        ax.plot(x + reach * math.cos(th), y + reach * math.sin(th), marker="X", markersize=11, color=COLLISION,
-                markeredgecolor="white", markeredgewidth=1.2, zorder=9)
+    h, scene = result.hist, result.scene
+    for row in summary.collision_ticks:  # where the body touched the wall or obstacle
+        x, y = contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
+        ax.plot(x, y, marker="X", markersize=11, color=COLLISION, markeredgecolor="white", markeredgewidth=1.2,
+                zorder=9)
     tick = result.tick_s
     if summary.first_light_s is not None:
         row = round(summary.first_light_s / tick)
@@ -132,15 +149,15 @@ def _markers(ax, result: Result, summary: Summary) -> None:
 def _robot_poses(ax, result: Result) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
     h, scene = result.hist, result.scene
-    n_lamps = len(scene.lamp_outputs)
-    start = RobotArtist(ax, scene.params, n_lamps, alpha=0.35)
-    start.update(h[0, L.X], h[0, L.Y], h[0, L.TH])
-    end = RobotArtist(ax, scene.params, n_lamps)
+    n_lamps, sensors = len(scene.lamp_outputs), scene.table.robot.sensors
+    start = RobotArtist(ax, scene.params, n_lamps, alpha=0.35, sensors=sensors)
+    start.update(h[0, L.X], h[0, L.Y], h[0, L.TH], readings=sensor_readings(h[0], sensors))
+    end = RobotArtist(ax, scene.params, n_lamps, sensors=sensors)
     last = result.outputs[-1] if result.ticks else ()
     end.update(h[-1, L.X], h[-1, L.Y], h[-1, L.TH],
                bumpers=(h[-1, L.BUMP_FR] > 0, h[-1, L.BUMP_FL] > 0, h[-1, L.BUMP_REAR] > 0),
                lights=(h[-1, L.LIGHT_R] >= 1, h[-1, L.LIGHT_L] >= 1),
-               lamps=tuple(int(last[i]) for i in scene.lamp_outputs))
+               lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(h[-1], sensors))
 
 
 def _legend(fig: Figure, result: Result, summary: Summary) -> None:
@@ -153,33 +170,52 @@ def _legend(fig: Figure, result: Result, summary: Summary) -> None:
     states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
                                bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
     states_legend._legend_box.align = "left"
+    fig.legend(handles=legend_marks(result), loc="lower left", bbox_to_anchor=(0.70, 0.08), frameon=False, fontsize=9)
+
+
+def legend_marks(result: Result) -> list:
+    """What the trajectory's marks mean: only those this world and robot can show."""
+    world, kinds = result.scene.world, {s.kind for s in result.scene.table.robot.sensors}
     marks = [Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
-                    label="collision (bumper side)"),
-             Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
-                    label="light first seen"),
-             Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
-                    label=f"lamp reached (≤ {result.scene.world.reach:g} m)"),
+                    label="collision (where it touched)"),
              Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
-                    label="a state begins (spins show as dots)"),
-             Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=15, label="lamp"),
-             Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)"),
-             Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle")]
-    fig.legend(handles=marks, loc="lower left", bbox_to_anchor=(0.70, 0.08), frameon=False, fontsize=9)
+                    label="a state begins with a turn on the spot")]
+    if world.lamps:
+        marks[1:1] = [Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
+                             label="light first seen"),
+                      Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
+                             label=f"lamp reached (≤ {world.reach:g} m)")]
+        marks += [Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=11,
+                         label="lamp, on its base (an obstacle)"),
+                  Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)")]
+    if world.lines:
+        marks.append(Patch(facecolor=TAPE, label="tape on the floor"))
+    if "line" in kinds:
+        marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
+                            label="floor sensor (dark over tape)"))
+    if "distance" in kinds:
+        marks.append(Patch(facecolor=BEAM, alpha=0.45, label="distance beam, out to the echo"))
+    marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
+    return marks
 
 
 # --- timeline ------------------------------------------------------------------------------------
 
 
 def timeline(result: Result, summary: Summary, path: Path) -> Path:
-    """State, motor speeds (and lamps), event bits and light readings against time."""
+    """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
+    light, declared light and distance sensors) against time."""
     t = np.arange(result.ticks) * result.tick_s
-    fig = Figure(figsize=(12, 9), dpi=DPI)
+    readings = reading_panels(result)
+    fig = Figure(figsize=(12, 7.2 + 1.8 * len(readings)), dpi=DPI)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.6, 1.6, 1.3], "hspace": 0.12})
+    ratios = [2.2, 1.6, 1.6] + [1.3] * len(readings)
+    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios, "hspace": 0.12})
     _state_panel(axes[0], result)
     _output_panel(axes[1], result, t)
     _event_panel(axes[2], result, t)
-    _light_panel(axes[3], result, t)
+    for ax, panel in zip(axes[3:], readings, strict=True):
+        panel(ax, result, t)
     for ax in axes:
         for row in summary.collision_ticks:
             ax.axvline(row * result.tick_s, color=COLLISION, lw=0.8, alpha=0.5, zorder=0)
@@ -189,8 +225,8 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
     axes[-1].set_xlabel("time (s)")
     axes[-1].set_xlim(0, max(t[-1], result.tick_s))
     fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.07, ha="left", y=0.975)
-    fig.text(0.07, 0.935, subtitle_of(summary) + "   (red lines: collisions, dashed: first light)",
-             fontsize=10, color="#444")
+    key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
+    fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
     fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
     return save(fig, path)
 
@@ -254,7 +290,49 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.set_ylabel("events")
 
 
+def reading_panels(result: Result) -> list:
+    """The reading panels this robot needs: light (wired phototransistors or declared light sensors),
+    distance (declared distance sensors). Line sensors read 1 or 0: the event panel shows them."""
+    wiring, kinds = result.scene.params.wiring, {s.kind for s in result.scene.table.robot.sensors}
+    panels = []
+    if wiring.get("light_right") or wiring.get("light_left") or "light" in kinds:
+        panels.append(_light_panel)
+    if "distance" in kinds:
+        panels.append(_distance_panel)
+    return panels
+
+
+def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> list[float]:
+    """Plot each declared sensor of ``kind`` (reading × ``scale``) with its threshold; returns the thresholds."""
+    h, levels = result.hist[:-1], []
+    for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
+        if sensor.kind != kind:
+            continue
+        line = ax.plot(*envelope(t, h[:, L.READING + k] * scale, LIGHT_BINS), lw=1.1,
+                       label=f"{sensor.name} {result.scene.table.robot.labels.get(sensor.name, '')}".strip())[0]
+        on, off = sensor.switch_points()
+        ax.axhline(on * scale, color=line.get_color(), lw=1, ls="--")
+        if off != on:
+            ax.axhline(off * scale, color=line.get_color(), lw=0.8, ls=":")
+        levels += [on * scale, off * scale]
+    return levels
+
+
+def _distance_panel(ax, result: Result, t: np.ndarray) -> None:
+    levels = _declared(ax, result, t, "distance", 100.0)
+    ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
+    ax.set_ylabel("distance (cm)\n-- on, ·· off")
+    ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
+
+
 def _light_panel(ax, result: Result, t: np.ndarray) -> None:
+    wiring = result.scene.params.wiring
+    if not (wiring.get("light_right") or wiring.get("light_left")):  # declared light sensors only
+        _declared(ax, result, t, "light", 1.0)
+        ax.set_yscale("symlog", linthresh=0.1)
+        ax.set_ylabel("light\n(× threshold)")
+        ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
+        return
     h, wiring = result.hist[:-1], result.scene.params.wiring
     ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
     ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
