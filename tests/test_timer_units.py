@@ -65,3 +65,10 @@ def test_durations_are_exact() -> None:
     assert to_ticks("0.1s", 10) == 10 and to_ticks("0.3 s", 10) == 30 and to_ticks("655.35s", 10) == 65535
     with pytest.raises(DurationError):
         to_ticks("0.1s", 3)
+
+
+def test_comment_lines_below_the_header_are_ignored() -> None:
+    header = "state,T,I3,M1_speed,M2_speed,timer,next"
+    text = f"{header}\n# an example: 2,1,1,4,4,500ms,2\n2,1,,2,2,10,2\n  #another, with, commas\n2,,1,0,0,0,2\n"
+    table = parse_table(text, "<mem>", BUMBERBOT)
+    assert [(row.line, row.timer) for row in table.rows] == [(3, 10), (5, 0)]  # lines keep their numbers

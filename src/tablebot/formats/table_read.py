@@ -57,7 +57,7 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     if not records:
         raise fail(path, "the table is empty", "the first line must be a header such as "
                    "description,state,T,I3,M1_dir,M1_speed,timer,next", 1, 1)
-    header, body = records[0], records[1:]
+    header, body = records[0], [record for record in records[1:] if not is_comment(record)]
     columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
     memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
@@ -72,6 +72,12 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     _check_states(rows, robot, out, columns, body)
     out.raise_if_any()
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
+
+
+def is_comment(record: Record) -> bool:
+    """A line below the header whose first cell starts with ``#`` is a comment for people (``tablebot new``
+    writes an example row that way); the table ignores it. Before the header it would be read as the header."""
+    return bool(record.cells) and record.cells[0].text.lstrip().startswith("#")
 
 
 # --- header -------------------------------------------------------------------------------------

@@ -1,0 +1,82 @@
+"""`tablebot new`: every template gives a folder that check, sim and tests accept; names can be your own."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from tablebot.cli import app
+from tablebot.formats.table_read import load_table
+
+runner = CliRunner()
+
+
+def invoke(*args: str) -> str:
+    result = runner.invoke(app, [str(a) for a in args])
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+@pytest.mark.parametrize("template", ["empty", "bumberbot", "line-follower", "obstacle-avoider"])
+def test_every_template_passes_check_sim_and_tests(tmp_path: Path, template: str) -> None:
+    folder = tmp_path / "mine"
+    out = invoke("new", folder, "--from", template)
+    assert sorted(p.name for p in folder.iterdir()) == ["arena.toml", "properties.toml", "robot.toml", "table.csv"]
+    assert "tablebot sim" in out
+    check = invoke("check", folder, "--counterexamples", tmp_path / "ce")
+    assert "holds" in check and "0 errors" in check
+    invoke("sim", folder, "--seconds", "3", "--out", tmp_path / "sim", "--no-plots", "-q")
+    assert (tmp_path / "sim" / "trace.jsonl").read_text().count("\n") == 300
+    invoke("tests", folder, "--out", tmp_path / "golden")
+    assert json.loads((tmp_path / "golden" / "coverage.json").read_text())["rows_covered"] > 0
+
+
+def test_the_empty_template_uses_your_names_and_shows_an_example_row(tmp_path: Path) -> None:
+    folder = tmp_path / "rover"
+    invoke("new", folder, "--inputs", "Bump=front bumper,Dark", "--motors", "R,L=left wheel")
+    text = (folder / "table.csv").read_text()
+    assert text.splitlines()[0] == "description,state,T,Bump,Dark,R,L,timer,next"
+    assert "\n# when Bump reads 1" in text  # the commented example row, ignored by the reader
+    table = load_table(folder / "table.csv")
+    assert len(table.rows) == 2 and table.robot.name == "rover"
+    assert table.robot.labels == {"Bump": "front bumper", "Dark": "input 2", "R": "right motor", "L": "left wheel"}
+    assert "when = \"R == 0 and L == 0\"" in (folder / "properties.toml").read_text()
+
+
+def test_a_renamed_bumberbot_runs_exactly_like_the_bumberbot(tmp_path: Path) -> None:
+    invoke("new", tmp_path / "a", "--from", "bumberbot")
+    invoke("new", tmp_path / "b", "--from", "bumberbot", "--inputs", "I1,I2,I3,I4,I5", "--motors", "A,B")
+    for name in "ab":
+        invoke("sim", tmp_path / name, "--seconds", "20", "--out", tmp_path / f"sim-{name}", "--no-plots", "-q")
+    original = (tmp_path / "sim-a" / "trace.jsonl").read_text()
+    renamed = (tmp_path / "sim-b" / "trace.jsonl").read_text()
+    for old, new in (('"M1"', '"A"'), ('"M2"', '"B"'), ('"I7_light"', '"I4_light"'), ('"I8_light"', '"I5_light"')):
+        original = original.replace(old, new)
+    assert renamed == original  # the same bumpers and light sensors, wired under their new names
+
+
+@pytest.mark.parametrize(("args", "words"), [
+    (["--from", "line-follower", "--inputs", "I1"], "template has 2 inputs (I1, I2); --inputs gives 1"),
+    (["--inputs", "T,X"], "'T' cannot name a column"),
+    (["--motors", "M1,M1"], "M1 given twice"),
+    (["--from", "rocket"], "Invalid value for '--from'"),
+])
+def test_bad_options_are_named(tmp_path: Path, args: list[str], words: str) -> None:
+    result = runner.invoke(app, ["new", str(tmp_path / "x"), *args])
+    assert result.exit_code == 2 and words in result.output
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_folder_with_anything_in_it_is_refused(tmp_path: Path) -> None:
+    folder = tmp_path / "busy"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine", encoding="utf-8")
+    result = runner.invoke(app, ["new", str(folder)])
+    assert result.exit_code == 2 and "this folder is not empty" in result.output
+    assert [p.name for p in folder.iterdir()] == ["notes.txt"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    invoke("new", empty)  # an empty folder is fine
