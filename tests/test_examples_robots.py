@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -67,3 +68,26 @@ def test_the_examples_keep_their_properties(example: str, tmp_path: Path) -> Non
                                       str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert result.output.count("holds") == 5 and "VIOLATED" not in result.output
+
+
+@pytest.mark.parametrize("example", ["line-follower", "obstacle-avoider"])
+def test_declared_sensors_are_traced_alike_tick_by_tick_and_compiled(example: str) -> None:
+    """Their readings join the trace (I1_line 0/1, I1_cm whole centimetres), and the real-time path and the
+    compiled block path give the same bytes."""
+    from tablebot.engine import Engine
+    from tablebot.loop import SimulatedClock
+    from tablebot.loop import run as run_loop
+    from tablebot.sim.robot import SimRobot
+    from test_sim_live import Lines, TickByTick
+
+    scene = scene_of(EXAMPLES / example / "table.csv")
+    traces = []
+    for clock in (TickByTick(), SimulatedClock()):
+        keep, robot = Lines(), SimRobot(scene, 2)
+        run_loop(Engine(scene.machine), robot, clock=clock, sinks=[keep], ticks=1500)
+        traces.append(keep.lines)
+    assert traces[0] == traces[1]
+    first = json.loads(traces[0][0])
+    suffix = "line" if example == "line-follower" else "cm"
+    assert [k for k in first if k.startswith("I")] == [f"I1_{suffix}", f"I2_{suffix}"]
+    assert "_light" not in first  # no phototransistors, no light fields

@@ -15,7 +15,7 @@ from tablebot.loop import Reading, TickBlock
 from tablebot.sim import kernel as K
 from tablebot.sim import layout as L
 from tablebot.sim.params import terminal_volts
-from tablebot.sim.scene import Scene
+from tablebot.sim.scene import Scene, sensor_columns, sensor_fields, sensor_trace_columns
 from tablebot.tick import registers
 from tablebot.trace import exact_round
 
@@ -130,10 +130,9 @@ class SimRobot:
     def trace_fields(self, s: np.ndarray) -> dict[str, float]:
         """Pose at the start of the tick, the light each phototransistor received (1.0 = threshold), volts."""
         heading = (math.degrees(s[L.TH]) + 180.0) % 360.0 - 180.0
-        right, left = self.light_keys
         return {"x": round(float(s[L.X]), 5), "y": round(float(s[L.Y]), 5), "heading": round(heading, 3),
-                right: round(float(s[L.LIGHT_R]), 4), left: round(float(s[L.LIGHT_L]), 4),
-                "battery_v": round(float(s[L.VBAT]), 4)}
+                **{key: round(float(s[column]), 4) for key, column in wired_lights(self.scene)},
+                "battery_v": round(float(s[L.VBAT]), 4), **sensor_fields(self.scene, s)}
 
     # --- what the run amounts to (see sim.summary) ------------------------------------------------------
 
@@ -158,14 +157,21 @@ def light_keys(scene: Scene) -> tuple[str, str]:
     return f"{wiring['light_right']}_light", f"{wiring['light_left']}_light"
 
 
+def wired_lights(scene: Scene) -> list[tuple[str, int]]:
+    """(trace key, state column) of the phototransistors wired to inputs: a robot without them gets no
+    light fields (not two fields both called ``_light``)."""
+    wiring = scene.params.wiring
+    return [(f"{wiring[role]}_light", column) for role, column in (("light_right", L.LIGHT_R),
+                                                                     ("light_left", L.LIGHT_L)) if wiring[role]]
+
+
 def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list[float]]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
-    right, left = light_keys(scene)
     heading = (np.degrees(hist[:, L.TH]) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
     return {"x": exact_round(hist[:, L.X], 5), "y": exact_round(hist[:, L.Y], 5), "heading": exact_round(heading, 3),
-            right: exact_round(hist[:, L.LIGHT_R], 4), left: exact_round(hist[:, L.LIGHT_L], 4),
-            "battery_v": exact_round(hist[:, L.VBAT], 4)}
+            **{key: exact_round(hist[:, column], 4) for key, column in wired_lights(scene)},
+            "battery_v": exact_round(hist[:, L.VBAT], 4), **sensor_trace_columns(scene, hist)}
 
 
 class LazyColumns(Mapping[str, Sequence[float]]):
@@ -173,7 +179,8 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __init__(self, scene: Scene, hist: np.ndarray):
         self.scene, self.hist = scene, hist
-        self.keys_ = ("x", "y", "heading", *light_keys(scene), "battery_v")
+        self.keys_ = ("x", "y", "heading", *(key for key, _ in wired_lights(scene)), "battery_v",
+                      *(c[0] for c in sensor_columns(scene)))
         self._columns: dict[str, list[float]] | None = None
 
     def __getitem__(self, key: str) -> Sequence[float]:
