@@ -39,7 +39,7 @@ def test_the_empty_template_uses_your_names_and_shows_an_example_row(tmp_path: P
     invoke("new", folder, "--inputs", "Bump=front bumper,Dark", "--motors", "R,L=left wheel")
     text = (folder / "table.csv").read_text()
     assert text.splitlines()[0] == "description,state,T,Bump,Dark,R,L,timer,next"
-    assert "\n# when Bump reads 1" in text  # the commented example row, ignored by the reader
+    assert "\n# Bump reads 1 while driving" in text  # the commented example row, ignored by the reader
     table = load_table(folder / "table.csv")
     assert len(table.rows) == 2 and table.robot.name == "rover"
     assert table.robot.labels == {"Bump": "front bumper", "Dark": "input 2", "R": "right motor", "L": "left wheel"}
@@ -80,3 +80,20 @@ def test_a_folder_with_anything_in_it_is_refused(tmp_path: Path) -> None:
     empty = tmp_path / "empty"
     empty.mkdir()
     invoke("new", empty)  # an empty folder is fine
+
+
+def test_the_empty_robots_example_row_and_sensor_work_once_uncommented(tmp_path: Path) -> None:
+    """The tutorial's second step: the robot that bumped into a wall turns away from it instead."""
+    folder = tmp_path / "mine"
+    invoke("new", folder)
+    bumped = invoke("sim", folder, "--out", tmp_path / "before", "--no-plots")
+    assert "collisions:       0" not in bumped  # it drives into a wall
+    robot = (folder / "robot.toml").read_text()
+    robot = robot.replace("# [sensors]", "[sensors]")
+    robot = robot.replace('# I1 = { sensor = "distance"', 'I1 = { sensor = "distance"')
+    (folder / "robot.toml").write_text(robot, encoding="utf-8")
+    table = (folder / "table.csv").read_text().replace("# I1 reads 1 while driving", "I1 reads 1 while driving")
+    (folder / "table.csv").write_text(table, encoding="utf-8")
+    turned = invoke("sim", folder, "--out", tmp_path / "after", "--no-plots")
+    assert "collisions:       0" in turned
+    assert "holds" in invoke("check", folder, "--counterexamples", tmp_path / "ce")

@@ -130,7 +130,8 @@ def _relabel(robot_toml: str, labels: dict[str, str]) -> str:
 
 
 def empty(name: str, inputs: list[Named], motors: list[Named]) -> Template:
-    """A robot of the given inputs and motors, a table that drives it round in squares, an empty room."""
+    """A robot of the given inputs and motors, a table that drives it straight on and turns now and then
+    (into the walls, until its first input is made a sensor), an empty room."""
     notes = () if len(motors) >= 2 else (
         "the simulator drives two wheels: `tablebot sim` needs two motors in [motors] (check and tests work now)",)
     inputs_toml = "".join(f'{n} = "{label or "input " + str(k + 1)}"\n' for k, (n, label) in enumerate(inputs))
@@ -153,14 +154,15 @@ def _empty_table(inputs: list[Named], motors: list[Named]) -> str:
         cells += [str(speeds[k]) if k < len(speeds) else "0" for k in range(len(drives))]
         return ",".join([*cells, timer, str(nxt)])
 
-    example = row(f"# when {names[0]} reads 1: back up for 0.5 s", 1, "", {names[0]: "1"}, [-4, -4], "500ms", 2) \
-        if names else "# a row: description,state,T,inputs...,motors...,timer,next"
+    example = row(f"# {names[0]} reads 1 while driving: turn away for 1 s", 2, "", {names[0]: "1"}, [5, -5],
+                  "1s", 1) if names else "# description,state,T,inputs...,motors...,timer,next"
     return "\n".join([header,
-                      "# Each row: in this state, when the marked events are present, set the motors, load the "
-                      "timer, go to next.",
+                      "# A row fires in its state when its marked events are present: it sets the motors and loads "
+                      "the timer and the robot goes to the next state (the first such row of a state wins)",
+                      "# Remove the # of the next line to use it (it must come before the other state 2 row):",
                       example,
-                      row("drive straight on", 1, "1", {}, [4, 4], "2s", 2),
-                      row("turn on the spot", 2, "1", {}, [4, -4], "0.5s", 1)]) + "\n"
+                      row("start driving", 1, "1", {}, [6, 6], "8s", 2),
+                      row("time to turn", 2, "1", {}, [5, -5], "0.7s", 1)]) + "\n"
 
 
 ROBOT = """\
@@ -174,9 +176,9 @@ initial_timer = 0
 {inputs}
 [motors]              # each motor is a column: -8..8, 0 stops, = keeps
 {motors}
-[states]              # names for people (diagrams, pictures, reports)
-1 = "drive"
-2 = "turn"
+[states]              # names for people: what the robot does while in each state
+1 = "turning"         # (the start: the timer is 0, so "start driving" fires at once)
+2 = "driving"
 
 # What drives an input in the simulator (uncomment and adapt; docs/tutorial.md explains):
 # [sensors]
