@@ -49,6 +49,8 @@ def test_the_empty_template_uses_your_names_and_shows_an_example_row(tmp_path: P
 def test_a_renamed_bumberbot_runs_exactly_like_the_bumberbot(tmp_path: Path) -> None:
     invoke("new", tmp_path / "a", "--from", "bumberbot")
     invoke("new", tmp_path / "b", "--from", "bumberbot", "--inputs", "I1,I2,I3,I4,I5", "--motors", "A,B")
+    robot = (tmp_path / "b" / "robot.toml").read_text()
+    assert 'A = "M1"' in robot and 'I1 = { terminal = "I3"' in robot  # your names on the template's terminals
     for name in "ab":
         invoke("sim", tmp_path / name, "--seconds", "20", "--out", tmp_path / f"sim-{name}", "--no-plots", "-q")
     original = (tmp_path / "sim-a" / "trace.jsonl").read_text()

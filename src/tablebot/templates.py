@@ -26,6 +26,7 @@ PURPOSE = {"table.csv": "the behaviour: one row per transition (open it in a spr
 BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                    "rear": "I5", "light_right": "I7", "light_left": "I8"}
 Named = tuple[str, str]  # (name, label; "" keeps the template's label)
+HARDWARE_SECTIONS = ("txt", "board")  # robot-file sections that wire the table's names to terminals
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,7 @@ def renamed(template: str, files: dict[str, str], inputs: list[Named], motors: l
         labels.update({n: label for n, label in given if label})
     if not mapping and not labels:
         return Template(files)
-    out = {"robot.toml": _rename_words(files["robot.toml"], mapping),
+    out = {"robot.toml": _rename_robot(files["robot.toml"], mapping),
            "properties.toml": _rename_words(files["properties.toml"], mapping),
            "table.csv": _rename_header(files["table.csv"], mapping), "arena.toml": files["arena.toml"]}
     out["robot.toml"] = _relabel(out["robot.toml"], labels)
@@ -113,6 +114,26 @@ def _rename_words(text: str, mapping: dict[str, str]) -> str:
     if not mapping:
         return text
     return _word_re(mapping).sub(lambda m: mapping[m[1]], text)
+
+
+def _rename_robot(text: str, mapping: dict[str, str]) -> str:
+    """The robot file renamed; in a controller's wiring section ([txt], [board]) only the names the table
+    uses (the keys), never the terminals they are wired to: your names on the template's terminals."""
+    if not mapping:
+        return text
+    words, section, out = _word_re(mapping), "", []
+    for line in text.splitlines(keepends=True):
+        header = re.match(r"^\s*\[+\s*([^\]]+?)\s*\]", line)
+        if header:
+            section = header[1].split(".")[0]
+        if section in HARDWARE_SECTIONS and not header:
+            key = re.match(r"^(\s*)([A-Za-z][A-Za-z0-9]*)(\s*=)", line)
+            if key and key[2] in mapping:
+                line = f"{key[1]}{mapping[key[2]]}{key[3]}{line[key.end():]}"
+            out.append(line)
+        else:
+            out.append(words.sub(lambda m: mapping[m[1]], line))
+    return "".join(out)
 
 
 def _rename_header(table: str, mapping: dict[str, str]) -> str:
