@@ -14,15 +14,11 @@ app = typer.Typer(
 
 
 def version() -> str:
-    """The installed distribution's version (the package's own when run from a source tree)."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as dist_version
+    """The running code's version (``tablebot.__version__``, kept equal to pyproject's): an installed
+    distribution's metadata can be older than a source tree on the path."""
+    from tablebot import __version__
 
-    try:
-        return dist_version("tablebot")
-    except PackageNotFoundError:
-        from tablebot import __version__
-        return __version__
+    return __version__
 
 
 def _print_version(value: bool) -> None:
