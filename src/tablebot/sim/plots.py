@@ -132,10 +132,11 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
 
 def _markers(ax, result: Result, summary: Summary) -> None:
     h, scene = result.hist, result.scene
-    for row in summary.collision_ticks:  # where the body touched the wall or obstacle
-        x, y = contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
-        ax.plot(x, y, marker="X", markersize=11, color=COLLISION, markeredgecolor="white", markeredgewidth=1.2,
-                zorder=9)
+    touched = [contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
+               for row in summary.collision_ticks]  # where the body touched the wall or obstacle
+    if touched:  # one artist for all of them: an hour can have hundreds
+        ax.plot(*zip(*touched, strict=True), ls="", marker="X", markersize=11, color=COLLISION,
+                markeredgecolor="white", markeredgewidth=1.2, zorder=9)
     tick = result.tick_s
     if summary.first_light_s is not None:
         row = round(summary.first_light_s / tick)
@@ -216,9 +217,11 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
     _event_panel(axes[2], result, t)
     for ax, panel in zip(axes[3:], readings, strict=True):
         panel(ax, result, t)
+    collisions = np.array(summary.collision_ticks) * result.tick_s
     for ax in axes:
-        for row in summary.collision_ticks:
-            ax.axvline(row * result.tick_s, color=COLLISION, lw=0.8, alpha=0.5, zorder=0)
+        if len(collisions):  # one artist per panel for all of them
+            ax.vlines(collisions, 0, 1, transform=ax.get_xaxis_transform(), color=COLLISION, lw=0.8, alpha=0.5,
+                      zorder=0)
         if summary.first_light_s is not None:
             ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
         ax.grid(axis="x", alpha=0.3)
