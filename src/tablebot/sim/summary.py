@@ -13,6 +13,7 @@ import numpy as np
 from tablebot.robot import StateId
 from tablebot.sim import layout as L
 from tablebot.sim.runner import Result
+from tablebot.sim.scene import Scene
 from tablebot.sim.track import laps
 
 LAP_STRIDE = 5  # robot rows per sample for counting laps (the robot moves well under 1 cm a tick)
@@ -52,8 +53,9 @@ class Summary:
         return out
 
 
-def light_bits(result: Result) -> int:
-    bits = result.scene.bits
+def light_bits(result: Result | Scene) -> int:
+    """The input bits of the light sensors (of a run or of its scene)."""
+    bits = (result.scene if isinstance(result, Result) else result).bits
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 
@@ -64,12 +66,19 @@ def first(mask: np.ndarray) -> int | None:
 
 def time_per_state(states: np.ndarray, names: tuple[StateId, ...], tick_s: float) -> dict[StateId, float]:
     """Seconds spent in each state (the state after each tick), in order of first visit."""
-    seconds: dict[StateId, float] = {}
-    order, first_seen = np.unique(states, return_index=True)
-    counts = np.bincount(states, minlength=len(names))
-    for index in order[np.argsort(first_seen)].tolist():
-        seconds[names[index]] = float(counts[index] * tick_s)
-    return seconds
+    first_seen = np.full(len(names), -1, dtype=np.int64)
+    order, where = np.unique(states, return_index=True)
+    first_seen[order] = where
+    return seconds_per_state(np.bincount(states, minlength=len(names)), first_seen, names, tick_s)
+
+
+def seconds_per_state(counts: np.ndarray, first_seen: np.ndarray, names: tuple[StateId, ...],
+                      tick_s: float) -> dict[StateId, float]:
+    """Seconds per state from its tick count and the tick it was first seen (-1: never), in order of
+    first visit (a fleet keeps only these two per robot)."""
+    visited = np.flatnonzero(first_seen >= 0)
+    order = visited[np.argsort(first_seen[visited], kind="stable")]
+    return {names[index]: float(counts[index] * tick_s) for index in order.tolist()}
 
 
 def summarise(result: Result) -> Summary:

@@ -1,0 +1,241 @@
+"""Many simulated robots of one table in one world, advanced together in compiled code (sim.fleet_kernel).
+
+Each robot is set up by :class:`~tablebot.sim.robot.SimRobot` itself (start row, gains, first reading,
+its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does, so robot k
+of a fleet gives the trace ``tablebot sim`` gives for the same table, world, start, battery and seed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from tablebot.engine import Engine
+from tablebot.loop import RunEnd, TickBlock
+from tablebot.machine import Machine
+from tablebot.sim import kernel as K
+from tablebot.sim import layout as L
+from tablebot.sim.fleet_kernel import NO_TICK, run_fleet
+from tablebot.sim.robot import SimRobot
+from tablebot.sim.runner import Result
+from tablebot.sim.scene import Scene, _check_start, prepare
+from tablebot.sim.summary import Summary, light_bits, seconds_per_state
+from tablebot.sim.world import World
+from tablebot.table import Table
+from tablebot.tick import STATE, registers
+from tablebot.trace import block_lines
+
+BLOCK_TICKS = 256  # ticks per compiled call: each robot's noise for one block is drawn before it
+FLEET_COLLISIONS = 16  # collision starts remembered per robot (the count goes on beyond)
+Pose = tuple[float, float, float]  # x, y (m), heading (degrees)
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """One robot of a fleet: its seed, where it starts (None: the world's start), its ``[sim]``
+    parameter overrides as ``((section, key, value), ...)`` (``("battery", "charge", 0.6)``: the battery)
+    and which program variant of the fleet it runs (0: the table as it is)."""
+
+    seed: int
+    start: Pose | None = None
+    params: tuple[tuple[str, str, float], ...] = ()
+    variant: int = 0
+
+    def overrides(self) -> dict[str, dict[str, Any]]:
+        out: dict[str, dict[str, Any]] = {}
+        for section, key, value in self.params:
+            out.setdefault(section, {})[key] = value
+        return out
+
+
+@dataclass
+class Variants:
+    """Program variants: per variant every row's timer and counter loads (the rest of the table is shared)."""
+
+    timers: np.ndarray  # (V, rows) int64
+    loads: np.ndarray  # (V, rows, counters) int64
+
+    @staticmethod
+    def of(machine: Machine) -> Variants:
+        arrays = machine.arrays
+        assert arrays is not None
+        return Variants(arrays.timer[None, :].copy(), arrays.loads[None, :, :].copy())
+
+
+@dataclass
+class FleetSummary:
+    """Per robot, what a sweep needs: arrays indexed by robot (``NO_TICK``/-1: never)."""
+
+    ticks: int
+    tick_s: float
+    states: tuple[Any, ...]  # the machine's states (indices in final_state and counts)
+    first_light: np.ndarray  # tick whose reading first held a light bit
+    reached: np.ndarray  # robot row that first came within reach of a lamp
+    collisions: np.ndarray
+    distance_m: np.ndarray
+    battery_start_v: np.ndarray
+    battery_end_v: np.ndarray
+    final_state: np.ndarray  # state index after the last tick
+    counts: np.ndarray  # (N, states): ticks spent in each state (the state after each tick)
+    first_visit: np.ndarray  # (N, states): first tick after which the robot was in that state
+    collision_rows: np.ndarray  # (N, FLEET_COLLISIONS): the first collision starts
+
+    def __len__(self) -> int:
+        return len(self.first_light)
+
+    def summary(self, i: int) -> Summary:
+        """Robot i's numbers as :func:`tablebot.sim.summary.summarise` gives them for a single run."""
+        def seconds(tick: int) -> float | None:
+            return None if tick < 0 else tick * self.tick_s
+        count = int(self.collisions[i])
+        return Summary(seconds=self.ticks * self.tick_s, first_light_s=seconds(int(self.first_light[i])),
+                       reached_s=seconds(int(self.reached[i])), collisions=count,
+                       collision_ticks=tuple(self.collision_rows[i, : min(count, FLEET_COLLISIONS)].tolist()),
+                       distance_m=float(self.distance_m[i]),
+                       state_seconds=seconds_per_state(self.counts[i], self.first_visit[i], self.states, self.tick_s),
+                       battery_start_v=float(self.battery_start_v[i]), battery_end_v=float(self.battery_end_v[i]))
+
+
+@dataclass
+class Trace:
+    """A traced robot's run, kept block by block (its SimRobot makes the blocks, as in ``tablebot sim``)."""
+
+    robot: SimRobot
+    blocks: list[TickBlock] = field(default_factory=list)
+    rows: list[np.ndarray] = field(default_factory=list)  # robot rows at the start of each tick
+
+
+class Fleet:
+    """N robots of one table in one world (each with its own seed, start, parameters and program variant)."""
+
+    def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
+                 robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
+                 variants: Variants | None = None):
+        if machine.arrays is None:
+            raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
+        self.machine, self.specs = machine, list(specs)
+        self.variants = variants or Variants.of(machine)
+        scenes: dict[tuple, Scene] = {}
+        self.scenes: list[Scene] = []
+        for spec in self.specs:
+            if spec.params not in scenes:
+                scenes[spec.params] = prepare(table, machine, world, robot_params, spec.overrides())
+            self.scenes.append(with_start(scenes[spec.params], spec.start))
+        first = self.scenes[0]
+        for scene in scenes.values():
+            if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
+                                                                           first.pulse_columns):
+                raise ValueError("robots of one fleet must share their wiring")
+        self.tick_s, self.t0 = first.tick_s, 0
+        self._setup(traced)
+
+    def _setup(self, traced: Sequence[int]) -> None:
+        """Each robot's rows, made by SimRobot (which draws its gains and first reading from its Generator)."""
+        n, engine = len(self.specs), Engine(self.machine)
+        n_out, n_c = len(engine.outputs), len(engine.counters)
+        self.S, self.P = np.zeros((n, L.N_STATE)), np.zeros((n, self.scenes[0].P.shape[1]))
+        self.acc, self.collisions = np.zeros((n, K.N_ACC)), np.zeros((n, FLEET_COLLISIONS), dtype=np.int64)
+        self.regs = np.tile(registers(engine.tick, engine.state, engine.timer, engine.event, engine.row), (n, 1))
+        self.outputs = np.tile(np.array(engine.outputs, dtype=np.int64), (n, 1)).reshape(n, n_out)
+        self.counters = np.tile(np.array(engine.counters, dtype=np.int64), (n, 1)).reshape(n, n_c)
+        self.rngs: list[np.random.Generator] = []
+        self.traces: dict[int, Trace] = {}
+        self.traced = np.full(n, -1, dtype=np.int64)
+        for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
+            robot = SimRobot(scene, spec.seed, record_history=i in traced)
+            self.S[i], self.P[i], self.acc[i] = robot.s, scene.P[0], robot.acc
+            self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
+            self.rngs.append(robot.rng)
+            if i in traced:
+                self.traced[i] = len(self.traces)
+                self.traces[i] = Trace(robot)
+        robot = self.traces[min(self.traces)].robot if self.traces else SimRobot(self.scenes[0], 0, False)
+        self.world = robot._world
+        self.bits, self.drive, self.pcols = self.scenes[0].bits, robot._drive, robot._pcols
+        self.light_bits = light_bits(self.scenes[0])
+        self.variant = np.array([spec.variant for spec in self.specs], dtype=np.int64)
+        self.battery_start_v = self.S[:, L.VBAT].copy()
+        n_states = len(self.machine.states)
+        self.counts = np.zeros((n, n_states), dtype=np.int64)
+        self.first_visit = np.full((n, n_states), NO_TICK, dtype=np.int64)
+        self.first_light = np.full(n, NO_TICK, dtype=np.int64)
+        self.width = K.I_OUTPUTS + n_out + 2 * n_c
+
+    def __len__(self) -> int:
+        return len(self.specs)
+
+    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS) -> None:
+        """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block."""
+        done = 0
+        while done < ticks:
+            b = min(block_ticks, ticks - done)
+            self.step_block(self.draw_noise(b))
+            done += b
+            if progress:
+                progress(done)
+
+    def draw_noise(self, ticks: int) -> np.ndarray:
+        """The next ``ticks`` rows of every robot's noise stream (SimRobot._noise, robot by robot)."""
+        noise = np.empty((len(self.specs), ticks, L.N_NOISE))
+        for i, rng in enumerate(self.rngs):
+            rng.standard_normal(out=noise[i])
+        return noise
+
+    def step_block(self, noise: np.ndarray) -> None:
+        """Advance every robot ``noise.shape[1]`` ticks with the given noise rows."""
+        ticks, n_traced = noise.shape[1], len(self.traces)
+        hist = np.zeros((n_traced, ticks, self.S.shape[1]))
+        ints = np.zeros((n_traced, ticks, self.width), dtype=np.int64)
+        v = self.variants
+        run_fleet(self.S, self.P, self.world, self.machine.arrays.program, v.timers, v.loads, self.variant,  # type: ignore[union-attr]
+                  self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, noise, self.acc,
+                  self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
+                  self.traced, hist, ints)
+        for i, trace in self.traces.items():
+            slot = self.traced[i]
+            n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
+            trace.blocks.append(trace.robot._block(self.t0, ints[slot], hist[slot], n_out, n_c))
+            trace.rows.append(hist[slot])
+        self.t0 += ticks
+
+    # --- what the run amounts to --------------------------------------------------------------------
+
+    def summary(self) -> FleetSummary:
+        return FleetSummary(
+            ticks=self.t0, tick_s=self.tick_s, states=self.machine.states, first_light=self.first_light.copy(),
+            reached=self.acc[:, K.A_REACHED].astype(np.int64), collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
+            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
+            battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
+            first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy())
+
+    def trace_lines(self, i: int) -> list[str]:
+        """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
+        return [line for block in self.traces[i].blocks for line in block_lines(block, self.machine)]
+
+    def result(self, i: int) -> Result:
+        """Robot i's whole run as the single-robot runner's :class:`Result` (for its pictures)."""
+        trace = self.traces[i]
+        blocks, robot = trace.blocks, trace.robot
+        def column(name: str) -> np.ndarray:
+            return np.concatenate([np.asarray(getattr(b, name)) for b in blocks])
+        hist = np.concatenate([*trace.rows, self.S[i][None, :]])
+        count = int(self.acc[i, K.A_COLLISIONS])
+        reached = int(self.acc[i, K.A_REACHED])
+        return Result(scene=robot.scene, seed=robot.seed, hist=hist, masks=column("masks"), events=column("events"),
+                      rows=column("rows"), states=column("states"), timers=column("timers"),
+                      outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),
+                      collision_rows=self.collisions[i, : min(count, FLEET_COLLISIONS)].tolist(),
+                      collision_count=count, reached_row=None if reached < 0 else reached,
+                      end=RunEnd("done", self.t0), wall_s=0.0)
+
+
+def with_start(scene: Scene, start: Pose | None) -> Scene:
+    """The scene with the robot starting at ``start`` (checked free of walls and obstacles)."""
+    if start is None:
+        return scene
+    world = replace(scene.world, start=tuple(float(v) for v in start))
+    _check_start(world, scene.geometry, scene.P)
+    return replace(scene, world=world)
