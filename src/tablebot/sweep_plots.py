@@ -1,0 +1,154 @@
+"""A sweep's pictures: ``outcomes.png`` (success rate and time-to-light per grid value), ``starts.png``
+(start positions coloured by outcome) and the best and worst runs' trajectories (``best.png``, ``worst.png``).
+
+Drawn on the Agg canvas directly (no display needed), from the result rows; the best and worst runs are
+run again as traced robots of a small fleet, which gives exactly the runs the sweep made.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from tablebot.sim.draw import REACHED, draw_world
+from tablebot.sim.plots import save
+from tablebot.sweep_run import Plan
+
+NEVER = "#b2bec3"
+Row = dict[str, Any]
+
+
+def number(value: Any) -> float | None:
+    return None if value in (None, "") else float(value)
+
+
+def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, list[Row]]]]]:
+    """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
+    axes = [a for a in plan.spec.axes if len(a.values) > 1] or []
+    if len(plan.spec.worlds) > 1:
+        out = [("world", [(Path(w).stem or "default", [r for r in rows if r["world"] == w]) for w in plan.spec.worlds])]
+    else:
+        out = []
+    for axis in axes:
+        labelled = []
+        for value in axis.values:
+            label = ":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
+            if axis.key == "start":
+                key = tuple(value) if isinstance(value, tuple) else None
+                chosen = [r for r in rows if key is None or tuple(float(r[c]) for c in axis.columns) == key]
+            else:
+                chosen = [r for r in rows if float(r[axis.key]) == float(value)]
+            labelled.append((label, chosen))
+        out.append((axis.key, labelled))
+    return out or [("all runs", [("all", list(rows))])]
+
+
+def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
+    """Per grid axis: the share of runs that reached the lamp, and the time to first light (box plot)."""
+    panels = groups(plan, rows)
+    fig = Figure(figsize=(11, 3.6 * len(panels) + 0.8), dpi=120)
+    FigureCanvasAgg(fig)
+    seconds = plan.spec.ticks * plan.scenes[0].tick_s
+    for k, (key, values) in enumerate(panels):
+        left, right = fig.add_subplot(len(panels), 2, 2 * k + 1), fig.add_subplot(len(panels), 2, 2 * k + 2)
+        labels = [label for label, _ in values]
+        rates = [np.mean([int(r["reached"]) for r in chosen]) if chosen else 0.0 for _, chosen in values]
+        bars = left.bar(labels, [100 * r for r in rates], color=REACHED)
+        left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_, c) in zip(rates, values, strict=True)],
+                       fontsize=8)
+        left.set_ylim(0, 118)
+        left.set_ylabel("reached the lamp (%)")
+        left.set_xlabel(key)
+        times = [[t for r in chosen if (t := number(r["first_light_s"])) is not None] for _, chosen in values]
+        never = [sum(number(r["first_light_s"]) is None for r in chosen) for _, chosen in values]
+        right.boxplot([t or [math.nan] for t in times], tick_labels=labels, showfliers=True)
+        for i, t in enumerate(times):
+            jitter = np.random.default_rng(i).uniform(-0.15, 0.15, len(t))  # fixed: the picture is reproducible
+            right.scatter(np.full(len(t), i + 1.0) + jitter, t, s=6, alpha=0.35, color="#f0a500", zorder=3)
+            right.text(i + 1, seconds * 1.02, f"never: {never[i]}", ha="center", fontsize=8, color="#636e72")
+        right.set_ylim(0, seconds * 1.1)
+        right.set_ylabel("time to first light (s)")
+        right.set_xlabel(key)
+    fig.suptitle(f"{plan.table.robot.name}: {len(rows):,} runs of {seconds:g} s", fontsize=13, fontweight="bold")
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    return save(fig, path)
+
+
+def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
+    """Start positions in the (first) world: each start coloured by the time it took to reach the lamp,
+    grey when it never did; with many runs, a hexagon heat map of the success rate instead."""
+    world_rows = [r for r in rows if r["world"] == plan.spec.worlds[0]]
+    world = plan.worlds[0]
+    fig = Figure(figsize=(9, 7), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_axes((0.08, 0.08, 0.78, 0.84))
+    draw_world(ax, world, lamp_glow=False)
+    xs = np.array([float(r["start_x"]) for r in world_rows])
+    ys = np.array([float(r["start_y"]) for r in world_rows])
+    reached = np.array([int(r["reached"]) for r in world_rows])
+    if len(world_rows) > 600:
+        cells = ax.hexbin(xs, ys, C=reached * 100.0, reduce_C_function=np.mean, gridsize=24, cmap="RdYlGn",
+                          vmin=0, vmax=100, alpha=0.85, zorder=3, mincnt=1)
+        fig.colorbar(cells, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label="reached the lamp (% of starts here)")
+    else:
+        times = np.array([number(r["reached_s"]) or math.nan for r in world_rows])
+        headings = np.radians([float(r["start_heading"]) for r in world_rows])
+        ok = ~np.isnan(times)
+        ax.quiver(xs, ys, np.cos(headings), np.sin(headings), color="#2d3436", alpha=0.5, scale=40, width=0.003,
+                  zorder=3)
+        ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label="never reached the lamp")
+        dots = ax.scatter(xs[ok], ys[ok], c=times[ok], s=30, cmap="viridis_r", edgecolors="white", linewidths=0.5,
+                          zorder=5)
+        if ok.any():
+            fig.colorbar(dots, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label="time to reach the lamp (s)")
+        ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"Start positions in {world.name}: {int(reached.sum())} of {len(world_rows)} reached the lamp",
+                 fontsize=12, fontweight="bold")
+    return save(fig, path)
+
+
+def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
+    """The best run reached the lamp soonest; the worst never reached it (most collisions, then latest light),
+    else reached it last."""
+    if not rows:
+        return None, None
+    def cost(r: Row) -> tuple[float, ...]:
+        reached = number(r["reached_s"])
+        light = number(r["first_light_s"])
+        return (math.inf if reached is None else reached, int(r["collisions"]), math.inf if light is None else light,
+                int(r["run"]))
+    ordered = sorted(rows, key=cost)
+    return ordered[0], ordered[-1] if len(ordered) > 1 else None
+
+
+def trajectories(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
+    """``best.png`` and ``worst.png``: the two runs again, traced, drawn as ``tablebot sim`` draws a run."""
+    from tablebot.sim.fleet import Fleet
+    from tablebot.sim.plots import trajectory
+    from tablebot.sim.summary import summarise
+    from tablebot.sweep import runs
+
+    written = []
+    for name, row in zip(("best", "worst"), best_and_worst(rows), strict=True):
+        if row is None:
+            continue
+        run = runs(plan.spec, int(row["run"]), int(row["run"]) + 1)[0]
+        fleet = Fleet(plan.table, plan.machine, plan.worlds[run.world], [plan.robot(run)], plan.robot_params,
+                      traced=[0])
+        fleet.run(plan.spec.ticks)
+        result = fleet.result(0)
+        written.append(trajectory(result, summarise(result), folder / f"{name}.png"))
+    return written
+
+
+def write_all(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
+    if not rows:
+        return []
+    return [outcomes(plan, rows, folder / "outcomes.png"), starts(plan, rows, folder / "starts.png"),
+            *trajectories(plan, rows, folder)]

@@ -1,0 +1,176 @@
+"""Running a sweep: its runs cut into jobs for a backend, each finished chunk written at once as a part
+file, the parts merged into ``results.csv`` (one row per run, in run order).
+
+An interrupted sweep keeps its parts (and writes ``results.partial.csv``); the same command run again
+finds ``spec.json`` unchanged and runs only the chunks that have no part yet.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tablebot.diagnostics import TableBotError, fail
+from tablebot.files import write_text
+from tablebot.machine import Machine
+from tablebot.sim.fleet import FleetSummary, RobotSpec, with_start
+from tablebot.sim.fleet_work import Job
+from tablebot.sim.scene import Scene, prepare
+from tablebot.sim.world import World
+from tablebot.sweep import Run, SweepSpec, chunks, param_of, random_start, runs
+from tablebot.table import Table
+
+PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
+RESULT_COLUMNS = ("seconds", "first_light_s", "reached", "reached_s", "collisions", "distance_m",
+                  "battery_start_v", "battery_end_v", "final_state")
+
+
+@dataclass
+class Plan:
+    """A checked sweep: the spec, the table, its worlds and robot parameters, ready to cut into jobs."""
+
+    spec: SweepSpec
+    table: Table
+    machine: Machine
+    worlds: list[World]
+    robot_params: dict[str, Any]
+
+    def __post_init__(self) -> None:
+        self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+
+    def columns(self) -> list[str]:
+        axes = [c for axis in self.spec.axes for c in axis.columns]
+        start = [] if any(axis.key == "start" for axis in self.spec.axes) else ["start_x", "start_y", "start_heading"]
+        states = [f"time_{state}_s" for state in self.machine.states]
+        return ["run", "world", "seed", *axes, *start, *RESULT_COLUMNS, *states]
+
+    def robot(self, run: Run) -> RobotSpec:
+        """The fleet robot of one run (a random start drawn for its seed, checked free)."""
+        params, start = [], None
+        for axis, value in zip(self.spec.axes, run.values, strict=True):
+            if axis.key == "start":
+                start = random_start(run.seed, self.worlds[run.world].walls, self._free(run.world)) \
+                    if value == "random" else tuple(value)
+            else:
+                params.append((*param_of(axis.key), value))
+        return RobotSpec(seed=run.seed, start=start, params=tuple(params))
+
+    def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
+        def free(pose: tuple[float, float, float]) -> bool:
+            try:
+                with_start(self.scenes[world], pose)
+            except TableBotError:
+                return False
+            return True
+        return free
+
+    def jobs(self, skip: set[tuple[int, int]] = frozenset()) -> list[Job]:  # type: ignore[assignment]
+        out = []
+        for a, b in chunks(self.spec):
+            if (a, b) in skip:
+                continue
+            chunk = runs(self.spec, a, b)
+            robots = [self.robot(run) for run in chunk]
+            try:
+                for robot, run in zip(robots, chunk, strict=True):
+                    if robot.start is not None:
+                        with_start(self.scenes[run.world], robot.start)
+            except TableBotError as exc:
+                raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}", "choose a free start pose") \
+                    from None
+            out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
+                           first=a, info={"stop": b}))
+        return out
+
+    def rows(self, job: Job, summary: FleetSummary) -> list[dict[str, Any]]:
+        """One result row per robot of a finished chunk."""
+        out = []
+        for k, run in enumerate(runs(self.spec, job.first, job.info["stop"])):
+            s = summary.summary(k)
+            row: dict[str, Any] = {"run": run.index, "world": self.spec.worlds[run.world], "seed": run.seed}
+            start = None
+            for axis, value in zip(self.spec.axes, run.values, strict=True):
+                if axis.key == "start":
+                    start = self.robot(run).start
+                    row.update(zip(axis.columns, start, strict=True))  # type: ignore[arg-type]
+                else:
+                    row[axis.key] = value
+            if not any(axis.key == "start" for axis in self.spec.axes):
+                row.update(zip(("start_x", "start_y", "start_heading"), self.worlds[run.world].start, strict=True))
+            row.update(seconds=round(s.seconds, 6), first_light_s=_time(s.first_light_s),
+                       reached=int(s.reached_s is not None), reached_s=_time(s.reached_s), collisions=s.collisions,
+                       distance_m=round(s.distance_m, 6),
+                       battery_start_v=round(s.battery_start_v, 6), battery_end_v=round(s.battery_end_v, 6),
+                       final_state=self.machine.states[int(summary.final_state[k])])
+            row.update({f"time_{state}_s": round(s.state_seconds.get(state, 0.0), 6) for state in self.machine.states})
+            out.append(row)
+        return out
+
+
+def _time(value: float | None) -> float | None:
+    return None if value is None else round(value, 6)
+
+
+# --- the output folder ------------------------------------------------------------------------------
+
+
+class Store:
+    """``DIR/spec.json``, ``DIR/parts/runs-A-B.csv`` per finished chunk, ``DIR/results.csv`` at the end."""
+
+    def __init__(self, folder: Path, plan: Plan):
+        self.folder, self.plan = folder, plan
+        self.parts = folder / "parts"
+
+    def open(self) -> set[tuple[int, int]]:
+        """Check the folder holds this spec's sweep (or none) and return the chunks already finished."""
+        spec_file = self.folder / "spec.json"
+        text = self.plan.spec.to_json()
+        if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
+            raise fail(self.folder, "--out holds the results of a different sweep (another table, world, grid, "
+                       "seeds or length)", "give --out a new folder, or delete this one to start over")
+        self.parts.mkdir(parents=True, exist_ok=True)
+        if not spec_file.exists():
+            write_text(spec_file, text)
+        wanted = set(chunks(self.plan.spec))
+        found = {(int(m[1]), int(m[2])) for p in self.parts.iterdir() if (m := PART_RE.match(p.name))}
+        return found & wanted
+
+    def write_part(self, job: Job, rows: Sequence[dict[str, Any]]) -> Path:
+        name = f"runs-{job.first:07d}-{job.info['stop']:07d}.csv"
+        return write_text(self.parts / name, csv_text(self.plan.columns(), rows))
+
+    def merge(self, complete: bool) -> tuple[Path, int]:
+        """All finished parts in run order as ``results.csv`` (or ``results.partial.csv`` when not complete)."""
+        columns = self.plan.columns()
+        body: list[str] = []
+        count = 0
+        for a, b in chunks(self.plan.spec):
+            part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
+            if part.exists():
+                lines = part.read_text(encoding="utf-8").splitlines(keepends=True)[1:]
+                body += lines
+                count += len(lines)
+        name = "results.csv" if complete else "results.partial.csv"
+        path = write_text(self.folder / name, csv_text(columns, []) + "".join(body))
+        if complete:
+            (self.folder / "results.partial.csv").unlink(missing_ok=True)
+        return path, count
+
+
+def csv_text(columns: Sequence[str], rows: Sequence[dict[str, Any]]) -> str:
+    """Rows as CSV text: floats as Python writes them (exact), blank for "never"."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+def read_results(path: Path) -> list[dict[str, str]]:
+    with open(path, encoding="utf-8", newline="") as f:
+        return list(csv.DictReader(f))
