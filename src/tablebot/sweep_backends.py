@@ -112,7 +112,7 @@ def run_dask(jobs: Sequence[Job], done: Done, address: str) -> dict[str, Any]:
         futures = [client.submit(run_job, job, pure=False, key=f"tablebot-chunk-{job.first}-{k}")
                    for k, job in enumerate(jobs)]
         try:
-            for future in as_completed(futures):
+            for future in as_completed(futures, loop=client.loop):
                 done(*future.result())
         except BaseException:
             client.cancel(futures)
@@ -136,4 +136,9 @@ def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
             slot = f"{host}-{rank}".replace(":", "_").replace("/", "_")
             futures.append(client.submit(warm_worker, job, slot, len(addresses), workers=[address],
                                          allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}"))
-    return {"workers": len(workers), "warm": client.gather(futures)}
+    try:
+        warmed = client.gather(futures)
+    except Exception as exc:  # a scheduler or worker without tablebot (or another version of it)
+        raise fail("--scheduler", f"the Dask cluster could not run tablebot's fleet: {type(exc).__name__}: {exc}",
+                   "install the same tablebot (and Python) on the scheduler and every worker") from None
+    return {"workers": len(workers), "warm": warmed}

@@ -19,6 +19,7 @@ from tablebot.machine import Machine
 from tablebot.sim import kernel as K
 from tablebot.sim import layout as L
 from tablebot.sim.fleet_kernel import NO_TICK, run_fleet
+from tablebot.sim.fleet_work import Pose, RobotSpec, Variants
 from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import Result
 from tablebot.sim.scene import Scene, _check_start, prepare
@@ -30,39 +31,6 @@ from tablebot.trace import block_lines
 
 BLOCK_TICKS = 256  # ticks per compiled call: each robot's noise for one block is drawn before it
 FLEET_COLLISIONS = 16  # collision starts remembered per robot (the count goes on beyond)
-Pose = tuple[float, float, float]  # x, y (m), heading (degrees)
-
-
-@dataclass(frozen=True)
-class RobotSpec:
-    """One robot of a fleet: its seed, where it starts (None: the world's start), its ``[sim]``
-    parameter overrides as ``((section, key, value), ...)`` (``("battery", "charge", 0.6)``: the battery)
-    and which program variant of the fleet it runs (0: the table as it is)."""
-
-    seed: int
-    start: Pose | None = None
-    params: tuple[tuple[str, str, float], ...] = ()
-    variant: int = 0
-
-    def overrides(self) -> dict[str, dict[str, Any]]:
-        out: dict[str, dict[str, Any]] = {}
-        for section, key, value in self.params:
-            out.setdefault(section, {})[key] = value
-        return out
-
-
-@dataclass
-class Variants:
-    """Program variants: per variant every row's timer and counter loads (the rest of the table is shared)."""
-
-    timers: np.ndarray  # (V, rows) int64
-    loads: np.ndarray  # (V, rows, counters) int64
-
-    @staticmethod
-    def of(machine: Machine) -> Variants:
-        arrays = machine.arrays
-        assert arrays is not None
-        return Variants(arrays.timer[None, :].copy(), arrays.loads[None, :, :].copy())
 
 
 @dataclass
