@@ -1,0 +1,147 @@
+"""``tablebot sweep``: result rows, resume after an interrupt, the same rows from a real Dask cluster,
+and bad specs as clear errors naming the option."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from tablebot.cli import app
+from tablebot.cli.common import load
+from tablebot.sim.fleet import Fleet, RobotSpec
+from tablebot.sim.scene import robot_layer, scene_for
+from tablebot.sweep_run import read_results
+from test_sim_helpers import BUMBERBOT
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+
+
+def sweep(*args: str) -> tuple[int, str]:
+    result = CliRunner().invoke(app, ["sweep", str(BUMBERBOT), *args])
+    return result.exit_code, result.output
+
+
+def env() -> dict[str, str]:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
+
+
+def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "battery=1.0,0.6", "--seeds", "3..5", "--seconds", "8", "--workers", "1",
+                         "--out", str(out), "--no-plots")
+    assert code == 0, output
+    rows = read_results(out / "results.csv")
+    assert [(r["run"], r["battery"], r["seed"]) for r in rows] == [
+        ("0", "1.0", "3"), ("1", "1.0", "4"), ("2", "1.0", "5"),
+        ("3", "0.6", "3"), ("4", "0.6", "4"), ("5", "0.6", "5")]
+    table, machine = load(BUMBERBOT)
+    fleet = Fleet(table, machine, scene_for(table, machine).world,
+                  [RobotSpec(seed=5, params=(("battery", "charge", 0.6),))], robot_layer(table.robot)[0])
+    fleet.run(800)
+    alone = fleet.summary().summary(0)
+    assert float(rows[5]["distance_m"]) == round(alone.distance_m, 6)
+    assert int(rows[5]["collisions"]) == alone.collisions
+    assert float(rows[5]["battery_end_v"]) == round(alone.battery_end_v, 6)
+    before = {p.name: p.stat().st_mtime_ns for p in (out / "parts").iterdir()}
+    code, output = sweep("--grid", "battery=1.0,0.6", "--seeds", "3..5", "--seconds", "8", "--workers", "1",
+                         "--out", str(out), "--no-plots")
+    assert code == 0, output
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "parts").iterdir()} == before  # nothing ran again
+    code, output = sweep("--seeds", "3..5", "--seconds", "9", "--out", str(out), "--no-plots")
+    assert code == 2 and "--out holds the results of a different sweep" in output
+
+
+def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",
+               "0..255", "--seconds", "40", "--workers", "2", "--out", str(out), "--no-plots"]
+    proc = subprocess.Popen(command, env=env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not ((out / "parts").is_dir() and any((out / "parts").iterdir())):
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "run the same command again to resume" in err
+    kept = read_results(out / "results.partial.csv")
+    assert 0 < len(kept) < 256 and not (out / "results.csv").exists()
+    parts = {p.name: p.read_bytes() for p in (out / "parts").iterdir()}
+    done = subprocess.run(command, env=env(), capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rows = read_results(out / "results.csv")
+    assert [int(r["run"]) for r in rows] == list(range(256))
+    assert {r["run"]: r for r in kept}.items() <= {r["run"]: r for r in rows}.items()
+    assert all((out / "parts" / name).read_bytes() == data for name, data in parts.items())
+    assert not (out / "results.partial.csv").exists()
+
+
+@pytest.fixture
+def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
+    """A real Dask scheduler and two single-threaded workers on this machine (separate processes)."""
+    pytest.importorskip("distributed")
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    file = tmp_path / "scheduler.json"
+    procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                               "--scheduler-file", str(file)], env=env(), stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.monotonic() + 60
+        while not file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        address = json.loads(file.read_text())["address"]
+        for _ in range(2):
+            procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
+                                           "--nthreads", "1", "--no-dashboard"], env=env(),
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from distributed import Client
+        with Client(address, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        for proc in procs:
+            proc.wait(timeout=30)
+
+
+def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask_cluster: str) -> None:
+    spec = ["--grid", "battery=1.0,0.7", "--grid", "start=random", "--seeds", "0..23", "--seconds", "10",
+            "--no-plots"]
+    code, output = sweep(*spec, "--out", str(tmp_path / "local"), "--backend", "local", "--workers", "2")
+    assert code == 0, output
+    code, output = sweep(*spec, "--out", str(tmp_path / "dask"), "--scheduler", dask_cluster)
+    assert code == 0, output
+    local = (tmp_path / "local" / "results.csv").read_bytes()
+    assert local == (tmp_path / "dask" / "results.csv").read_bytes()
+    assert local.count(b"\n") == 49
+
+
+@pytest.mark.parametrize(("args", "option", "words"), [
+    (["--grid", "wheels=2,3", "--robots", "2"], "--grid", "unknown key 'wheels'"),
+    (["--grid", "battery=1.0,1.5", "--robots", "2"], "--grid", "battery: 1.5 is out of range"),
+    (["--grid", "start=1:2", "--robots", "2"], "--grid", "start: '1:2' is not a pose"),
+    (["--grid", "start=0.05:0.05:0", "--robots", "2"], "--grid", "overlaps a wall"),
+    (["--grid", "battery", "--robots", "2"], "--grid", "is not KEY=VALUES"),
+    (["--seeds", "9..3"], "--seeds", "--seeds 9..3 is an empty range"),
+    (["--seeds", "a..b"], "--seeds", "is not a seed or a range"),
+    (["--seeds", "0..3", "--robots", "4"], "--robots", "not both"),
+    ([], "--seeds", "say which runs to make"),
+    (["--robots", "2", "--backend", "dask"], "--backend", "needs a scheduler"),
+    (["--robots", "2", "--backend", "cloud"], "--backend", "unknown backend"),
+])
+def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list[str], option: str,
+                                                      words: str) -> None:
+    code, output = sweep(*args, "--out", str(tmp_path / "s"))
+    assert code == 2, output
+    assert output.startswith(f"{option}: error:") and words in output, output
+    assert "Traceback" not in output
