@@ -43,39 +43,84 @@ def run_jobs(jobs: Sequence[Job], done: Done, backend: str = "local", address: s
              workers: int | None = None) -> dict[str, Any]:
     """Run every job, calling ``done(job, summary)`` as each finishes (in the order they finish);
     returns what the backend says about itself (workers, their cache folders)."""
-    if not jobs:
-        return {"workers": 0}
-    if backend == "dask":
-        return run_dask(jobs, done, address or "")
-    return run_local(jobs, done, workers)
+    with Runner(backend, address, workers) as runner:
+        runner.run(jobs, done)
+        return runner.info
 
 
-# --- this machine -----------------------------------------------------------------------------------
+class Runner:
+    """A backend kept open over many batches of jobs (a tuning run sends one batch per generation):
+    the local worker processes or the Dask client start, and warm up, once."""
 
+    def __init__(self, backend: str = "local", address: str | None = None, workers: int | None = None):
+        self.backend, self.address, self.workers = backend, address, workers
+        self.pool: Any = None
+        self.client: Any = None
+        self.info: dict[str, Any] = {"workers": 0}
 
-def run_local(jobs: Sequence[Job], done: Done, workers: int | None = None) -> dict[str, Any]:
-    """One process per core (``workers``: how many), each running whole chunks single-threaded. This
-    process compiles the kernel into the user's numba cache first, so the workers only read it."""
-    workers = max(1, min(workers or os.cpu_count() or 1, len(jobs)))
-    if workers == 1:
-        for job in jobs:
-            done(*run_job(job))
-        return {"workers": 1, "processes": "this one"}
-    import multiprocessing
+    def __enter__(self) -> Runner:
+        return self
 
-    warm(jobs[0])
-    context = multiprocessing.get_context("spawn")  # never fork a process that holds numba's threads
-    pool = context.Pool(workers, initializer=_ignore_interrupts)
-    try:
-        for job, summary in pool.imap_unordered(run_job, [replace(j, threads=1) for j in jobs]):
+    def __exit__(self, kind: object, *rest: object) -> None:
+        self.close(failed=kind is not None)
+
+    def run(self, jobs: Sequence[Job], done: Done) -> None:
+        if not jobs:
+            return
+        if self.backend == "dask":
+            self._run_dask(jobs, done)
+        else:
+            self._run_local(jobs, done)
+
+    def close(self, failed: bool = False) -> None:
+        if self.pool is not None:
+            if failed:
+                self.pool.terminate()  # Ctrl-C: the workers stop at once; what finished was handed over already
+            else:
+                self.pool.close()
+            self.pool.join()
+            self.pool = None
+        if self.client is not None:
+            self.client.close()
+            self.client = None
+
+    # --- this machine: one process per core (``workers``), each running whole chunks single-threaded
+
+    def _run_local(self, jobs: Sequence[Job], done: Done) -> None:
+        workers = max(1, self.workers or os.cpu_count() or 1)
+        if workers == 1 or (len(jobs) == 1 and self.pool is None):
+            self.info = {"workers": 1, "processes": "this one"}
+            for job in jobs:
+                done(*run_job(job))
+            return
+        if self.pool is None:
+            import multiprocessing
+
+            warm(jobs[0])  # this process fills the user's numba cache first: the workers only read it
+            context = multiprocessing.get_context("spawn")  # never fork a process that holds numba's threads
+            self.pool = context.Pool(workers, initializer=_ignore_interrupts)
+            self.info = {"workers": workers, "processes": "local"}
+        for job, summary in self.pool.imap_unordered(run_job, [replace(j, threads=1) for j in jobs]):
             done(job, summary)
-        pool.close()
-    except BaseException:
-        pool.terminate()  # Ctrl-C: the workers stop at once; what finished was handed over already
-        raise
-    finally:
-        pool.join()
-    return {"workers": workers, "processes": "local"}
+
+    # --- a Dask cluster: each chunk one task
+
+    def _run_dask(self, jobs: Sequence[Job], done: Done) -> None:
+        """Every worker first warms the kernel in a cache folder of its own (one compile per worker,
+        never two processes writing one folder); then the chunks go out."""
+        from distributed import as_completed
+
+        if self.client is None:
+            self.client = connect(self.address or "")
+            self.info = warm_cluster(self.client, jobs[0])
+        client = self.client
+        futures = [client.submit(run_job, job, pure=False) for job in jobs]
+        try:
+            for future in as_completed(futures, loop=client.loop):
+                done(*future.result())
+        except BaseException:
+            client.cancel(futures)
+            raise
 
 
 def _ignore_interrupts() -> None:
@@ -99,27 +144,6 @@ def connect(address: str) -> Any:
     except (OSError, TimeoutError) as exc:
         raise fail("--scheduler", f"cannot reach the Dask scheduler at {address}: {exc}",
                    "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
-
-
-def run_dask(jobs: Sequence[Job], done: Done, address: str) -> dict[str, Any]:
-    """Each chunk one task. Every worker first warms the kernel in a cache folder of its own (one
-    compile per worker, never two processes writing one folder); then the chunks go out."""
-    from distributed import as_completed
-
-    client = connect(address)
-    try:
-        info = warm_cluster(client, jobs[0])
-        futures = [client.submit(run_job, job, pure=False, key=f"tablebot-chunk-{job.first}-{k}")
-                   for k, job in enumerate(jobs)]
-        try:
-            for future in as_completed(futures, loop=client.loop):
-                done(*future.result())
-        except BaseException:
-            client.cancel(futures)
-            raise
-        return info
-    finally:
-        client.close()
 
 
 def warm_cluster(client: Any, job: Job) -> dict[str, Any]:

@@ -7,7 +7,7 @@ import os
 import sys
 import traceback
 
-from tablebot.cli import analysis, core, export, firmware, fleet, new, run, sim, studio  # noqa: F401  (importing registers the commands)
+from tablebot.cli import analysis, core, export, firmware, fleet, new, run, sim, studio, tune  # noqa: F401  (importing registers the commands)
 from tablebot.cli.app import app
 
 #: Exit code of an internal error (a tablebot bug), apart from 1 (warnings) and 2 (bad input).

@@ -50,6 +50,7 @@ class FleetSummary:
     counts: np.ndarray  # (N, states): ticks spent in each state (the state after each tick)
     first_visit: np.ndarray  # (N, states): first tick after which the robot was in that state
     collision_rows: np.ndarray  # (N, FLEET_COLLISIONS): the first collision starts
+    final_pose: np.ndarray  # (N, 3): x, y (m) and heading (radians, unwrapped) after the last tick
 
     def __len__(self) -> int:
         return len(self.first_light)
@@ -177,7 +178,8 @@ class Fleet:
             reached=self.acc[:, K.A_REACHED].astype(np.int64), collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
             distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
             battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
-            first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy())
+            first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
+            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy())
 
     def trace_lines(self, i: int) -> list[str]:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""

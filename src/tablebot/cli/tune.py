@@ -1,0 +1,198 @@
+"""The ``tune`` command: choose timer values (and counter loads) that make a table do best over a fixed
+scenario set, then check the result on fresh seeds; writes the tuned table as a new file."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from tablebot.cli.app import app
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
+from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, make_plan
+
+if TYPE_CHECKING:
+    from tablebot.sweep_run import Plan
+    from tablebot.tune import Cell, Evaluator
+
+METRICS = ("time_to_lamp", "time_to_light", "collisions", "lamp_distance")
+
+
+@app.command("tune")
+@guarded
+def tune_cmd(
+    table: Path = TABLE_ARG,
+    cells: str = typer.Option(..., "--cells", help='Cells to tune: "line 5 timer, line 9 timer" (file lines; '
+                              'a range: "line 5 timer=100..2000"; counter loads: "line 12 C1_load").'),
+    objective: str = typer.Option("time_to_lamp", "--objective", help="What to make smallest: time_to_lamp, "
+                                  "time_to_light, collisions or lamp_distance (means over the scenarios)."),
+    budget: int = typer.Option(300, "--budget", min=1, help="Most candidates to evaluate."),
+    method: str = typer.Option("auto", "--method", help="grid, cma (CMA-ES with integer margin) or auto: "
+                               "grid for one or two cells, else cma."),
+    world: list[Path] | None = WORLD_OPT,
+    grid: list[str] | None = typer.Option(None, "--grid", help='Scenario grid as in sweep (default: '
+                                          '"start=random").'),
+    seeds: str = typer.Option("0..15", "--seeds", help="Seeds of the scenario set every candidate runs."),
+    check_seeds: str = typer.Option("1000..1063", "--check-seeds", help="Fresh seeds for the before/after check."),
+    seconds: float = typer.Option(60.0, "--seconds", min=0.01, max=3600, help="Simulated time of each run."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed of CMA-ES itself."),
+    backend: str = BACKEND_OPT,
+    scheduler: str | None = SCHEDULER_OPT,
+    workers: int | None = WORKERS_OPT,
+    out: Path = typer.Option(Path("out/tune"), "--out", help="Folder for the tuned table, report.md and "
+                             "convergence.png."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no report on the terminal."),
+    robot: Path | None = ROBOT_OPT,
+) -> None:
+    """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
+    runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    from tablebot.sweep import parse_seeds
+    from tablebot.sweep_backends import Runner, choose
+    from tablebot.tune import Evaluator, best, parse_cells, search_cma, search_grid
+
+    if objective not in METRICS:
+        from tablebot.diagnostics import fail
+        raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
+    if method not in ("auto", "grid", "cma"):
+        from tablebot.diagnostics import fail
+        raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
+    chosen, address = choose(backend, scheduler)
+    plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
+    check = make_plan(table, robot, world or [], grid or ["start=random"], check_seeds, None, seconds)
+    parse_seeds(check_seeds, None)
+    tuned_cells = parse_cells(cells, plan.table)
+    out_folder(out, "--out")
+    target = tuned_path(Path(plan.table.path), out)
+    method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
+    started = time.perf_counter()
+    with Runner(chosen, address, workers) as runner, Bar(budget, quiet) as bar:
+        evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance)
+        baseline = tuple(c.value for c in tuned_cells)
+        evaluate([baseline])
+        if method == "grid":
+            search_grid(evaluate, budget)
+        else:
+            search_cma(evaluate, budget, seed)
+        winner, _ = best(evaluate.history)
+        before_after = evaluate.measure([baseline, winner], check, METRICS)
+    written = [write_tuned(plan, tuned_cells, winner, target),
+               write_evaluations(evaluate, out / "evaluations.csv"),
+               convergence(evaluate, method, out / "convergence.png"),
+               write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
+                            time.perf_counter() - started)]
+    if not quiet:
+        console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
+        for path in written:
+            err_console.print(f"wrote {path}", markup=False)
+
+
+def tuned_path(table: Path, out: Path) -> Path:
+    """``OUT/NAME.tuned.csv``: never the input itself."""
+    path = out / f"{table.stem}.tuned{table.suffix or '.csv'}"
+    if path.resolve() == table.resolve():
+        from tablebot.diagnostics import fail
+        raise fail("--out", f"the tuned table would replace its input {table}", "give --out another folder")
+    return path
+
+
+def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Path) -> Path:
+    """The input table byte for byte, but for the tuned cells (its delimiter, quoting and line ends kept)."""
+    from tablebot.files import write_bytes
+    from tablebot.web.document import CsvDocument
+
+    source = Path(plan.table.path)
+    doc = CsvDocument.from_bytes(source.read_bytes(), str(source))
+    header = [h.strip().lower() for h in doc.header_values()]
+    lines = doc.record_lines()
+    for cell, value in zip(cells, values, strict=True):
+        grid_row = next(g for g, index in enumerate(doc.row_ids) if lines[index] == cell.line)
+        doc.set_cell(grid_row, header.index(cell.column.lower()), str(value))
+    return write_bytes(path, doc.to_bytes())
+
+
+def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
+    from tablebot.files import write_text
+    from tablebot.sweep_run import csv_text
+
+    columns = ["evaluation", *(c.label for c in evaluate.cells), evaluate.objective]
+    rows = [{"evaluation": k, **dict(zip(columns[1:-1], values, strict=True)), evaluate.objective: value}
+            for k, (values, value) in enumerate(evaluate.history)]
+    return write_text(path, csv_text(columns, rows))
+
+
+def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
+    """Every evaluation's objective and the best so far; for one cell also the objective against its value."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from tablebot.sim.plots import save
+
+    values = np.array([v for _, v in evaluate.history])
+    one = len(evaluate.cells) == 1
+    fig = Figure(figsize=(11 if one else 7, 4.2), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 2 if one else 1, 1)
+    ax.scatter(np.arange(len(values)), values, s=8, alpha=0.4, color="#636e72", label="candidate")
+    ax.plot(np.minimum.accumulate(values), color="#20bf6b", linewidth=2, label="best so far")
+    ax.axhline(values[0], color="#e8413a", linestyle="--", linewidth=1, label="the table as it was")
+    ax.set_xlabel("evaluation")
+    ax.set_ylabel(evaluate.objective)
+    ax.set_title(f"{method}: {len(values)} candidates", fontsize=11)
+    ax.legend(fontsize=8)
+    if one:
+        side = fig.add_subplot(1, 2, 2)
+        xs = np.array([c[0] for c, _ in evaluate.history])
+        order = np.argsort(xs)
+        side.plot(xs[order], values[order], color="#1f77b4", linewidth=1)
+        side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
+        side.set_xlabel(f"{evaluate.cells[0].label} (ticks)")
+        side.set_ylabel(evaluate.objective)
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
+                 before_after: dict[str, list[float]], path: Path, wall_s: float) -> Path:
+    from tablebot.files import write_text
+
+    spec, cells = plan.spec, evaluate.cells
+    seconds = spec.ticks * plan.scenes[0].tick_s
+    scenario = f"{spec.total} scenarios ({len(spec.seeds)} seeds" + "".join(
+        f" × {len(a.values)} {a.key}" for a in spec.axes) + f" × {len(spec.worlds)} world(s), {seconds:g} s each)"
+    lines = [f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}", "",
+             f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
+             "| cell | before | after |", "|---|---|---|"]
+    lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
+    lines += ["", f"Checked on {check.spec.total} fresh scenarios (seeds {check.spec.seeds[0]}.."
+              f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
+    for metric, (a, b) in before_after.items():
+        lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
+    return write_text(path, "\n".join(lines) + "\n")
+
+
+class Bar:
+    """Progress over the budget of candidates (on a terminal)."""
+
+    def __init__(self, total: int, quiet: bool):
+        self.total, self.quiet = total, quiet or not err_console.is_terminal
+
+    def __enter__(self) -> Bar:
+        if not self.quiet:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self.bar = Progress(TextColumn("candidates"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                                console=err_console, transient=True)
+            self.bar.__enter__()
+            self.task = self.bar.add_task("tune", total=self.total)
+        return self
+
+    def advance(self, count: int) -> None:
+        if not self.quiet:
+            self.bar.update(self.task, advance=count)
+
+    def __exit__(self, *exc: Any) -> None:
+        if not self.quiet:
+            self.bar.__exit__(None, None, None)
