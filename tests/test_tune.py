@@ -1,0 +1,108 @@
+"""``tablebot tune``: the known optimum of a table whose best timer is computable by hand (grid and
+CMA-ES), the tuned table as a new file differing only in the tuned cells, and bad cells named."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from tablebot.cli import app
+from tablebot.sim.params import merged, top_speed
+
+ROBOT = """\
+name = "TestBot"
+tick_ms = 10
+initial_state = 1
+[inputs]
+I3 = "front-right bumper"
+[motors]
+M1 = "right motor"
+M2 = "left motor"
+"""
+#: A hall with a lamp hanging in the air 1 m straight ahead of the start; exact physics (no noise).
+HALL = """\
+name = "hall"
+[arena]
+walls = [[0, 0], [3, 0], [3, 3], [0, 3]]
+[start]
+at = [0.5, 1.5]
+heading = 0
+[[lamp]]
+at = [1.5, 1.5]
+radius = 0
+[noise]
+motor_spread = 0
+motor = 0
+light = 0
+"""
+DISTANCE_M = 1.0
+
+
+def hand_optimum() -> float:
+    """Full speed ahead for X ticks, then stop: a first-order motor lag loses at the start exactly what
+    it coasts at the end, so the robot ends X · v · dt ahead, v the steady top speed on a full battery.
+    The lamp is 1 m ahead: X = 1 m / (v · 10 ms)."""
+    quiet = merged({"noise": {"motor_spread": 0.0, "motor": 0.0, "light": 0.0}})
+    return DISTANCE_M / (top_speed(quiet) * 0.010)
+
+
+def tune(tmp_path: Path, rows: list[str], *args: str) -> tuple[int, str, Path]:
+    (tmp_path / "robot.toml").write_text(ROBOT, encoding="utf-8")
+    table = tmp_path / "table.csv"
+    table.write_text("\r\n".join(["description,state,T,I3,M1,M2,timer,next", *rows]) + "\r\n", encoding="utf-8")
+    (tmp_path / "hall.toml").write_text(HALL, encoding="utf-8")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["tune", str(table), "--world", str(tmp_path / "hall.toml"), "--grid",
+                                      "battery=1.0", "--seeds", "0..1", "--check-seeds", "7..8", "--seconds", "9",
+                                      "--objective", "lamp_distance", "--workers", "1", "--out", str(out), *args])
+    return result.exit_code, result.output, out
+
+
+def test_the_grid_finds_the_stopping_time_computed_by_hand(tmp_path: Path) -> None:
+    code, output, out = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer=0..800",
+                             "--budget", "1000")
+    assert code == 0, output
+    best = round(hand_optimum())
+    tuned = (out / "table.tuned.csv").read_bytes()
+    assert tuned == (tmp_path / "table.csv").read_bytes().replace(b",500,", f",{best},".encode())  # only that cell
+    assert (tmp_path / "table.csv").read_bytes().count(b",500,") == 1  # the input is untouched
+    assert f"| line 2 timer | 500 | {best} |" in output
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "grid, 801 candidates" in report
+    assert (out / "convergence.png").stat().st_size > 10_000
+
+
+def test_cma_es_finds_the_optimum_of_two_timers_that_add_up(tmp_path: Path) -> None:
+    """Two legs of full speed ahead: any X1 + X2 equal to the hand optimum is best."""
+    code, output, out = tune(tmp_path, ['leg one,1,1,,8,8,100,2', 'leg two,2,1,,8,8,100,3', 'stop,3,1,,0,0,0,3'],
+                             "--cells", "line 2 timer=0..600, line 3 timer=0..600", "--method", "cma",
+                             "--budget", "400", "--seed", "3")
+    assert code == 0, output
+    lines = (out / "table.tuned.csv").read_text(encoding="utf-8").splitlines()
+    total = int(lines[1].split(",")[6]) + int(lines[2].split(",")[6])
+    assert abs(total - hand_optimum()) <= 2.5, lines
+    assert "cma," in (out / "report.md").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize(("cells", "words"), [
+    ("line 2 M1", "'line 2 M1' is not a timer or a counter load"),
+    ("line 9 timer", "line 9 of table.csv is not a row of the table"),
+    ("row 2 timer", "does not name a cell"),
+    ("line 2 timer=9..3", "the range must be LOW..HIGH"),
+    ("line 2 timer, line 2 timer", "names line 2 timer twice"),
+    ("", "names no cell"),
+])
+def test_bad_cells_are_clear_errors_naming_the_option(tmp_path: Path, cells: str, words: str) -> None:
+    code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", cells)
+    assert code == 2, output
+    assert output.startswith("--cells: error:") and words in output, output
+
+
+def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
+    for args, option in ((["--objective", "speed"], "--objective"), (["--method", "bayes"], "--method")):
+        code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer",
+                               *args)
+        assert code == 2 and output.startswith(f"{option}: error:"), output
+
