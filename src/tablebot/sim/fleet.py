@@ -85,39 +85,46 @@ class Fleet:
                  variants: Variants | None = None):
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
-        self.machine, self.specs = machine, list(specs)
+        self.table, self.machine, self.world_file, self.robot_params = table, machine, world, robot_params
+        self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
-        scenes: dict[tuple, Scene] = {}
-        self.scenes: list[Scene] = []
-        for spec in self.specs:
-            if spec.params not in scenes:
-                scenes[spec.params] = prepare(table, machine, world, robot_params, spec.overrides())
-            self.scenes.append(with_start(scenes[spec.params], spec.start))
-        first = self.scenes[0]
-        for scene in scenes.values():
+        self._scenes: dict[tuple, Scene] = {}
+        self.scenes = [self.scene_of(spec) for spec in self.specs]
+        self.tick_s, self.t0 = self.scenes[0].tick_s, 0
+        self._setup(traced)
+
+    def scene_of(self, spec: RobotSpec) -> Scene:
+        """The robot's scene: the table in the world with its parameters (made once per parameter set)
+        and its start; every robot of a fleet must be wired alike."""
+        if spec.params not in self._scenes:
+            scene = prepare(self.table, self.machine, self.world_file, self.robot_params, spec.overrides())
+            first = next(iter(self._scenes.values()), scene)
             if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
                                                                            first.pulse_columns):
                 raise ValueError("robots of one fleet must share their wiring")
-        self.tick_s, self.t0 = first.tick_s, 0
-        self._setup(traced)
+            self._scenes[spec.params] = scene
+        return with_start(self._scenes[spec.params], spec.start)
 
     def _setup(self, traced: Sequence[int]) -> None:
-        """Each robot's rows, made by SimRobot (which draws its gains and first reading from its Generator)."""
+        """Every robot's rows (see :meth:`place`), and what the fleet shares."""
         n, engine = len(self.specs), Engine(self.machine)
-        n_out, n_c = len(engine.outputs), len(engine.counters)
+        n_out, n_c, n_states = len(engine.outputs), len(engine.counters), len(self.machine.states)
+        self.initial = (registers(engine.tick, engine.state, engine.timer, engine.event, engine.row),
+                        np.array(engine.outputs, dtype=np.int64), np.array(engine.counters, dtype=np.int64))
         self.S, self.P = np.zeros((n, L.N_STATE)), np.zeros((n, self.scenes[0].P.shape[1]))
         self.acc, self.collisions = np.zeros((n, K.N_ACC)), np.zeros((n, FLEET_COLLISIONS), dtype=np.int64)
-        self.regs = np.tile(registers(engine.tick, engine.state, engine.timer, engine.event, engine.row), (n, 1))
-        self.outputs = np.tile(np.array(engine.outputs, dtype=np.int64), (n, 1)).reshape(n, n_out)
-        self.counters = np.tile(np.array(engine.counters, dtype=np.int64), (n, 1)).reshape(n, n_c)
-        self.rngs: list[np.random.Generator] = []
+        self.regs = np.zeros((n, len(self.initial[0])), dtype=np.int64)
+        self.outputs, self.counters = np.zeros((n, n_out), dtype=np.int64), np.zeros((n, n_c), dtype=np.int64)
+        self.counts = np.zeros((n, n_states), dtype=np.int64)
+        self.first_visit = np.full((n, n_states), NO_TICK, dtype=np.int64)
+        self.first_light = np.full(n, NO_TICK, dtype=np.int64)
+        self.variant = np.array([spec.variant for spec in self.specs], dtype=np.int64)
+        self.battery_start_v = np.zeros(n)
+        self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
-            robot = SimRobot(scene, spec.seed, record_history=i in traced)
-            self.S[i], self.P[i], self.acc[i] = robot.s, scene.P[0], robot.acc
-            self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
-            self.rngs.append(robot.rng)
+            robot = self.place(i, spec, scene, record=i in traced)
             if i in traced:
                 self.traced[i] = len(self.traces)
                 self.traces[i] = Trace(robot)
@@ -125,13 +132,21 @@ class Fleet:
         self.world = robot._world
         self.bits, self.drive, self.pcols = self.scenes[0].bits, robot._drive, robot._pcols
         self.light_bits = light_bits(self.scenes[0])
-        self.variant = np.array([spec.variant for spec in self.specs], dtype=np.int64)
-        self.battery_start_v = self.S[:, L.VBAT].copy()
-        n_states = len(self.machine.states)
-        self.counts = np.zeros((n, n_states), dtype=np.int64)
-        self.first_visit = np.full((n, n_states), NO_TICK, dtype=np.int64)
-        self.first_light = np.full(n, NO_TICK, dtype=np.int64)
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
+
+    def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False) -> SimRobot:
+        """Put robot i at its start as SimRobot sets a robot up (its gains and first reading drawn from its
+        own Generator, which then gives its noise), with a fresh engine; returns that SimRobot."""
+        scene = scene or self.scene_of(spec)
+        robot = SimRobot(scene, spec.seed, record_history=record)
+        self.specs[i] = spec
+        self.S[i], self.P[i], self.acc[i] = robot.s, scene.P[0], robot.acc
+        self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
+        self.regs[i], self.outputs[i], self.counters[i] = self.initial
+        self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
+        self.variant[i], self.battery_start_v[i] = spec.variant, robot.s[L.VBAT]
+        self.rngs[i] = robot.rng
+        return robot
 
     def __len__(self) -> int:
         return len(self.specs)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tablebot.jit import njit, prange
-from tablebot.sim.kernel import I_MASK, I_STATE, run_robot
+from tablebot.sim.kernel import I_MASK, I_STATE, move, run_robot
 
 NO_TICK = -1  # "never" in first_visit / first_light
 
@@ -53,3 +53,11 @@ def run_fleet(S, P, world, program, timers, loads, variant, regs, outputs, count
         run_robot(S[i], P[i], *world, own, regs[i], outputs[i], counters[i], bits, drive, pcols, noise[i],
                   rows, record, acc[i], collisions[i])
         fold(record, t0, light_bits, counts, first_visit, first_light, i)
+
+
+@njit(nogil=True, parallel=True)
+def move_fleet(S, P, world, commands, noise, bits, acc, collisions):  # type: ignore[no-untyped-def]
+    """One tick of physics for every robot with the motor levels ``commands[i]`` (right, left) given
+    from outside (a learned controller): ``sim.kernel.move`` on each robot's rows."""
+    for i in prange(S.shape[0]):
+        move(S[i], commands[i, 0], commands[i, 1], P[i], *world, noise[i], bits, acc[i], collisions[i])
