@@ -28,6 +28,7 @@ def test_the_env_passes_gymnasiums_checker() -> None:
 def test_with_the_table_in_charge_the_env_runs_as_tablebot_sim() -> None:
     env = TableBotEnv(seconds=10.0, battery=0.7)
     obs, info = env.reset(seed=11)
+    assert info["seed"] == 11
     seen, rewards = [obs], []
     for _ in range(800):
         obs, reward, terminated, truncated, _ = env.step(None)
