@@ -33,6 +33,7 @@ OBJECTIVES = {
     "time_to_light": "mean seconds until a light sensor first sees the lamp (never: the whole run)",
     "collisions": "mean number of collisions",
     "lamp_distance": "mean distance (m) from the robot to the nearest lamp when the run ends",
+    "missed_lamp": "the share of runs that never reach the lamp",
 }
 
 
@@ -122,6 +123,8 @@ def losses(objective: str, s: FleetSummary, plan: Plan, world: int) -> np.ndarra
         return np.where(s.first_light < 0, seconds, s.first_light * s.tick_s)
     if objective == "collisions":
         return s.collisions.astype(float)
+    if objective == "missed_lamp":
+        return (s.reached < 0).astype(float)
     lamps = np.array([lamp.at for lamp in plan.worlds[world].lamps] or [(math.inf, math.inf)])
     pose = s.final_pose
     return np.min(np.hypot(pose[:, None, 0] - lamps[None, :, 0], pose[:, None, 1] - lamps[None, :, 1]), axis=1)

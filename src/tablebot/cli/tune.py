@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from tablebot.sweep_run import Plan
     from tablebot.tune import Cell, Evaluator
 
-METRICS = ("time_to_lamp", "time_to_light", "collisions", "lamp_distance")
+METRICS = ("time_to_lamp", "time_to_light", "collisions", "lamp_distance", "missed_lamp")
 
 
 @app.command("tune")
@@ -27,7 +27,8 @@ def tune_cmd(
     cells: str = typer.Option(..., "--cells", help='Cells to tune: "line 5 timer, line 9 timer" (file lines; '
                               'a range: "line 5 timer=100..2000"; counter loads: "line 12 C1_load").'),
     objective: str = typer.Option("time_to_lamp", "--objective", help="What to make smallest: time_to_lamp, "
-                                  "time_to_light, collisions or lamp_distance (means over the scenarios)."),
+                                  "time_to_light, collisions, lamp_distance or missed_lamp (means over the "
+                                  "scenarios)."),
     budget: int = typer.Option(300, "--budget", min=1, help="Most candidates to evaluate."),
     method: str = typer.Option("auto", "--method", help="grid, cma (CMA-ES with integer margin) or auto: "
                                "grid for one or two cells, else cma."),
@@ -131,10 +132,10 @@ def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
     from tablebot.sim.plots import save
 
     values = np.array([v for _, v in evaluate.history])
-    one = len(evaluate.cells) == 1
-    fig = Figure(figsize=(11 if one else 7, 4.2), dpi=120)
+    one, two = len(evaluate.cells) == 1, len(evaluate.cells) == 2
+    fig = Figure(figsize=(11 if one or two else 7, 4.2), dpi=120)
     FigureCanvasAgg(fig)
-    ax = fig.add_subplot(1, 2 if one else 1, 1)
+    ax = fig.add_subplot(1, 2 if one or two else 1, 1)
     ax.scatter(np.arange(len(values)), values, s=8, alpha=0.4, color="#636e72", label="candidate")
     ax.plot(np.minimum.accumulate(values), color="#20bf6b", linewidth=2, label="best so far")
     ax.axhline(values[0], color="#e8413a", linestyle="--", linewidth=1, label="the table as it was")
@@ -150,6 +151,18 @@ def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
         side.set_xlabel(f"{evaluate.cells[0].label} (ticks)")
         side.set_ylabel(evaluate.objective)
+    if two:
+        side = fig.add_subplot(1, 2, 2)
+        points = np.array([c for c, _ in evaluate.history])
+        dots = side.scatter(points[:, 0], points[:, 1], c=values, cmap="viridis_r", s=30, marker="s")
+        fig.colorbar(dots, ax=side, label=evaluate.objective)
+        a, b = evaluate.cells
+        best = points[int(np.argmin(values))]
+        side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label="as it was")
+        side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
+        side.set_xlabel(a.label)
+        side.set_ylabel(b.label)
+        side.legend(fontsize=8)
     fig.tight_layout()
     return save(fig, path)
 
