@@ -7,6 +7,7 @@ tables in random worlds with random seeds, starts, batteries and parameters.
 from __future__ import annotations
 
 import random
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,20 @@ def test_robot_k_of_a_fleet_writes_the_trace_tablebot_sim_writes(tmp_path: Path)
     fleet = Fleet(table, machine, scene.world, specs, robot_layer(table.robot)[0], traced=[2])
     fleet.run(2000)
     assert "".join(fleet.trace_lines(2)) == (out / "trace.jsonl").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("example", ["bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider"])
+def test_every_shipped_robot_runs_alike_alone_and_in_a_fleet(example: str) -> None:
+    """Counters, tape on the floor and declared sensors (line, distance) come along: one shared loop."""
+    table, machine = load(BUMBERBOT.parent / example)
+    scene = scene_for(table, machine)
+    specs = [RobotSpec(seed=s) for s in (4, 5)]
+    fleet = Fleet(table, machine, scene.world, specs, robot_layer(table.robot)[0], traced=[0, 1])
+    fleet.run(1500)
+    for k, spec in enumerate(specs):
+        alone = run(scene, 15.0, spec.seed)
+        assert "".join(fleet.trace_lines(k)) == trace_text(alone)
+        assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
 
 
 def random_world(rng: random.Random) -> str:
@@ -74,7 +89,6 @@ def test_random_tables_worlds_and_seeds_run_alike_alone_and_in_a_fleet(case: int
     for k, spec in enumerate(specs):
         scene = prepare(table, machine, world, None, spec.overrides())
         if spec.start is not None:
-            from dataclasses import replace
             scene = replace(scene, world=replace(world, start=spec.start))
         alone = run(scene, 9.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
@@ -106,7 +120,6 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
     fleet = Fleet(table, machine, world, [RobotSpec(seed=3, variant=1), RobotSpec(seed=3)], traced=[0, 1],
                   variants=variants)
     fleet.run(1200)
-    from dataclasses import replace
     rows = tuple(replace(row, timer=300) if row.index == 3 else row for row in table.rows)
     edited = replace(table, rows=rows)
     alone = run(scene_for(edited, compile_table(edited)), 12.0, 3)

@@ -51,12 +51,14 @@ class FleetSummary:
     first_visit: np.ndarray  # (N, states): first tick after which the robot was in that state
     collision_rows: np.ndarray  # (N, FLEET_COLLISIONS): the first collision starts
     final_pose: np.ndarray  # (N, 3): x, y (m) and heading (radians, unwrapped) after the last tick
+    lamps: bool = True  # whether the world has lamps (as in sim.summary.Summary)
 
     def __len__(self) -> int:
         return len(self.first_light)
 
     def summary(self, i: int) -> Summary:
-        """Robot i's numbers as :func:`tablebot.sim.summary.summarise` gives them for a single run."""
+        """Robot i's numbers as :func:`tablebot.sim.summary.summarise` gives them for a single run, but for
+        laps round a track (they need the whole path, which a fleet does not keep: None)."""
         def seconds(tick: int) -> float | None:
             return None if tick < 0 else tick * self.tick_s
         count = int(self.collisions[i])
@@ -65,7 +67,8 @@ class FleetSummary:
                        collision_ticks=tuple(self.collision_rows[i, : min(count, FLEET_COLLISIONS)].tolist()),
                        distance_m=float(self.distance_m[i]),
                        state_seconds=seconds_per_state(self.counts[i], self.first_visit[i], self.states, self.tick_s),
-                       battery_start_v=float(self.battery_start_v[i]), battery_end_v=float(self.battery_end_v[i]))
+                       battery_start_v=float(self.battery_start_v[i]), battery_end_v=float(self.battery_end_v[i]),
+                       lamps=self.lamps)
 
 
 @dataclass
@@ -194,7 +197,7 @@ class Fleet:
             distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
             battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
             first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
-            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy())
+            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_file.lamps))
 
     def trace_lines(self, i: int) -> list[str]:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
