@@ -11,12 +11,11 @@ for many robots, so robot k of a fleet and a single simulated robot cannot diffe
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from tablebot.jit import njit
 from tablebot.kernels import tick_compiled
+from tablebot.sim.geometry import within
 from tablebot.sim.layout import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, X, Y
 from tablebot.sim.physics import advance
 from tablebot.tick import EVENT, ROW, STATE, TIMER
@@ -53,7 +52,7 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
     acc[A_ROWS] = row + 1.0
     if acc[A_REACHED] < 0.0:
         for k in range(lamps.shape[0]):
-            if math.hypot(s[X] - lamps[k, 0], s[Y] - lamps[k, 1]) <= acc[A_REACH]:
+            if within(s[X] - lamps[k, 0], s[Y] - lamps[k, 1], acc[A_REACH]):
                 acc[A_REACHED] = row
                 break
     touching = s[BUMP_FR] + s[BUMP_FL] + s[BUMP_REAR] + s[CONTACT] > 0.0

@@ -23,9 +23,12 @@ import numpy as np
 from tablebot.jit import njit
 from tablebot.sim.geometry import (  # noqa: F401  (segments_cross, shadowed: re-exported, they lived here)
     point_segment_distance,
+    point_segment_within,
     segment_distance,
     segments_cross,
+    segments_within,
     shadowed,
+    within,
 )
 from tablebot.sim.layout import (
     AMPS,
@@ -103,7 +106,7 @@ def might_be_near(px, py, verts, a, b, pbound, k, reach):
     margin over rounding), so skipping it changes no result. Its bounding circle is tested first (the
     test the narrow phase always had); a wall or segment is then tested by its squared distance.
     """
-    if math.hypot(pbound[k, 0] - px, pbound[k, 1] - py) > pbound[k, 2] + reach:
+    if not within(pbound[k, 0] - px, pbound[k, 1] - py, pbound[k, 2] + reach):
         return False
     if b - a != 2:
         return True
@@ -233,7 +236,7 @@ def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
         if hit[0] > best[0]:
             best = hit
     for k in range(circles.shape[0]):
-        if math.hypot(circles[k, 0] - s[X], circles[k, 1] - s[Y]) > circles[k, 2] + reach:
+        if not within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach):
             continue
         hit = circle_contact(s, p, circles[k, 0], circles[k, 1], circles[k, 2])
         if hit[0] > best[0]:
@@ -287,11 +290,11 @@ def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near
         n_edges = 1 if b - a == 2 else b - a
         for j in range(n_edges):
             j0, j1 = a + j, a + (j + 1) % (b - a)
-            if segment_distance(ax, ay, bx, by, verts[j0, 0], verts[j0, 1], verts[j1, 0], verts[j1, 1]) <= gap:
+            if segments_within(ax, ay, bx, by, verts[j0, 0], verts[j0, 1], verts[j1, 0], verts[j1, 1], gap):
                 return True
     for k in range(circles.shape[0]):
-        if near_circles >> min(k, 62) & 1 and point_segment_distance(
-                circles[k, 0], circles[k, 1], ax, ay, bx, by) <= circles[k, 2] + gap:
+        if near_circles >> min(k, 62) & 1 and point_segment_within(
+                circles[k, 0], circles[k, 1], ax, ay, bx, by, circles[k, 2] + gap):
             return True
     return False
 
@@ -306,7 +309,7 @@ def broad_phase(s, reach, verts, pstart, pbound, circles):
             near |= np.int64(1) << min(k, 62)
     near_circles = np.int64(0)
     for k in range(circles.shape[0]):
-        if k >= 62 or math.hypot(circles[k, 0] - s[X], circles[k, 1] - s[Y]) <= circles[k, 2] + reach + 1e-6:
+        if k >= 62 or within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach + 1e-6):
             near_circles |= np.int64(1) << min(k, 62)
     return near, near_circles
 

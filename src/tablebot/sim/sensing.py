@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_distance, shadowed
+from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
 from tablebot.sim.layout import (
     B_SENSOR,
     F_AIM,
@@ -61,9 +61,8 @@ def light_from(s, p, lx, ly, turn, edges, circles, lamps):
         d = max(d, p[P_DMIN])
         # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
         taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
-        value = lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
-        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):
-            total += value
+        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):  # first: it spares the power
+            total += lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
     return total
 
 
@@ -71,7 +70,7 @@ def light_from(s, p, lx, ly, turn, edges, circles, lamps):
 def on_a_line(x, y, lines):
     """1.0 when the floor point (x, y) lies on a piece of tape (within its half width of its middle), else 0.0."""
     for k in range(lines.shape[0]):
-        if point_segment_distance(x, y, lines[k, 0], lines[k, 1], lines[k, 2], lines[k, 3]) <= lines[k, 4]:
+        if point_segment_within(x, y, lines[k, 0], lines[k, 1], lines[k, 2], lines[k, 3], lines[k, 4]):
             return 1.0
     return 0.0
 
