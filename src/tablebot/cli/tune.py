@@ -162,7 +162,7 @@ def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
         side.set_xlabel(a.label)
         side.set_ylabel(b.label)
-        side.legend(fontsize=8)
+        side.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
     fig.tight_layout()
     return save(fig, path)
 
@@ -173,8 +173,10 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
 
     spec, cells = plan.spec, evaluate.cells
     seconds = spec.ticks * plan.scenes[0].tick_s
-    scenario = f"{spec.total} scenarios ({len(spec.seeds)} seeds" + "".join(
-        f" × {len(a.values)} {a.key}" for a in spec.axes) + f" × {len(spec.worlds)} world(s), {seconds:g} s each)"
+    axes = "".join(" × random starts" if a.values == ("random",) else f" × {len(a.values)} {a.key}"
+                   for a in spec.axes)
+    scenario = (f"{spec.total} scenarios ({len(spec.seeds)} seeds{axes} × {len(spec.worlds)} world(s), "
+                f"{seconds:g} s each)")
     lines = [f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}", "",
              f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
              "| cell | before | after |", "|---|---|---|"]
