@@ -105,7 +105,8 @@ def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: 
     for key, values in groups(plan, rows):
         for label, chosen in values:
             reached = sum(int(r["reached"]) for r in chosen)
-            console.print(f"{key} {label}: {reached}/{len(chosen)} reached the lamp", markup=False)
+            name = key if key == "all runs" else f"{key} {label}"
+            console.print(f"{name}: {reached}/{len(chosen)} reached the lamp", markup=False)
     if ran:
         rate = ran * plan.spec.ticks / max(wall_s, 1e-9)
         console.print(f"[dim]({ran:,} runs in {wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
