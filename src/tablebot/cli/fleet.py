@@ -102,11 +102,17 @@ def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: 
     written = [path, *(write_all(plan, rows, out) if plots else [])]
     if quiet:
         return
+    lamps = any(world.lamps for world in plan.worlds)
     for key, values in groups(plan, rows):
         for label, chosen in values:
-            reached = sum(int(r["reached"]) for r in chosen)
             name = key if key == "all runs" else f"{key} {label}"
-            console.print(f"{name}: {reached}/{len(chosen)} reached the lamp", markup=False)
+            if lamps:
+                line = f"{sum(int(r['reached']) for r in chosen)}/{len(chosen)} reached the lamp"
+            else:
+                collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
+                metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
+                line = f"{len(chosen)} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run"
+            console.print(f"{name}: {line}", markup=False)
     if ran:
         rate = ran * plan.spec.ticks / max(wall_s, 1e-9)
         console.print(f"[dim]({ran:,} runs in {wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
