@@ -65,6 +65,78 @@ def fleet(n: int, ticks: int) -> tuple[float, float]:
     return n * ticks / (time.perf_counter() - started), setup
 
 
+def breakdown(repeat: int) -> dict[str, float]:
+    """Nanoseconds per robot-tick of each part of the shared physics, on one core, over the robot rows of
+    a recorded 300 s BumberBot run (each part called on every row; its share is what it costs a tick)."""
+    import numpy as np
+
+    from tablebot.cli.common import load
+    from tablebot.jit import njit
+    from tablebot.sim import physics as ph
+    from tablebot.sim.runner import run
+    from tablebot.sim.scene import scene_for
+
+    table, machine = load(EXAMPLE)
+    scene = scene_for(table, machine)
+    rows = run(scene, 300.0, 1).hist.astype(np.float64)
+    g, p = scene.geometry, scene.P[0]
+
+    @njit
+    def copy_only(rows):  # type: ignore[no-untyped-def]
+        s = rows[0].copy()
+        for i in range(rows.shape[0]):
+            s[:] = rows[i]
+
+    @njit
+    def motors(rows, p):  # type: ignore[no-untyped-def]
+        z, s = np.zeros(4), rows[0].copy()
+        for i in range(rows.shape[0]):
+            s[:] = rows[i]
+            ph.drive(s, (2, -2), p, z)
+
+    @njit
+    def contacts(rows, p, verts, pstart, pbound, circles):  # type: ignore[no-untyped-def]
+        corners, s = np.empty((4, 2)), rows[0].copy()
+        for i in range(rows.shape[0]):
+            s[:] = rows[i]
+            ph.resolve(s, p, corners, verts, pstart, pbound, circles)
+
+    @njit
+    def bumpers(rows, p, verts, pstart, pbound, circles):  # type: ignore[no-untyped-def]
+        s = rows[0].copy()
+        for i in range(rows.shape[0]):
+            s[:] = rows[i]
+            ph.sense_bumpers(s, p, verts, pstart, pbound, circles)
+
+    @njit
+    def light(rows, p, edges, circles, lamps):  # type: ignore[no-untyped-def]
+        total = 0.0
+        for i in range(rows.shape[0]):
+            total += ph.light_at(rows[i], p, -1.0, edges, circles, lamps) + ph.light_at(rows[i], p, 1.0, edges,
+                                                                                          circles, lamps)
+        return total
+
+    def ns(function, *args) -> float:  # type: ignore[no-untyped-def]
+        function(*args)
+        best = []
+        for _ in range(max(3, repeat)):
+            started = time.perf_counter()
+            function(*args)
+            best.append(time.perf_counter() - started)
+        return statistics.median(best) / len(rows) * 1e9
+
+    base = ns(copy_only, rows)
+    rng, noise = np.random.default_rng(0), np.empty((len(rows), 4))
+    started = time.perf_counter()
+    rng.standard_normal(out=noise)
+    noise_ns = (time.perf_counter() - started) / len(rows) * 1e9
+    return {"light (2 phototransistors)": ns(light, rows, p, g.edges, g.circles, g.lamps),
+            "bumpers (broad phase + plates)": ns(bumpers, rows, p, g.verts, g.pstart, g.pbound, g.circles) - base,
+            "contacts (broad phase + push out)": ns(contacts, rows, p, g.verts, g.pstart, g.pbound, g.circles) - base,
+            "motors, battery, motion": ns(motors, rows, p) - base,
+            "noise (4 normals, numpy Generator)": noise_ns}
+
+
 def sweep_plan(robots: int, seconds: float):  # type: ignore[no-untyped-def]
     from tablebot.cli.fleet import make_plan
 
@@ -142,6 +214,10 @@ def main() -> None:
         print(f"fleet of {n:>6,} ({ticks:>5} ticks):    {rate / 1e6:6.2f} M robot-ticks/s   {rate / base:5.2f}× "
               f"the single loop   (setting up the robots: {setup:.2f} s)")
     print("target: 10 M robot-ticks/s on 2 cores")
+    parts = breakdown(args.repeat)
+    print(f"where one robot-tick goes (one core, ns; the whole tick: {1e9 / base:.0f} ns in the single loop):")
+    for name, value in parts.items():
+        print(f"  {name:<36} {value:6.0f}")
     if not args.no_dask:
         robots = 1_000 if args.quick else 10_000
         local, dask = dask_vs_local(robots, args.sweep_seconds, args.repeat)

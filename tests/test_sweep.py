@@ -63,7 +63,7 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
 def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",
-               "0..255", "--seconds", "40", "--workers", "2", "--out", str(out), "--no-plots"]
+               "0..255", "--seconds", "120", "--workers", "2", "--out", str(out), "--no-plots"]
     proc = subprocess.Popen(command, env=env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not ((out / "parts").is_dir() and any((out / "parts").iterdir())):

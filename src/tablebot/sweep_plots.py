@@ -30,11 +30,11 @@ def number(value: Any) -> float | None:
 
 def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, list[Row]]]]]:
     """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
-    axes = [a for a in plan.spec.axes if len(a.values) > 1] or []
+    axes = [a for a in plan.spec.axes if len(a.values) > 1]
+    out = []
     if len(plan.spec.worlds) > 1:
-        out = [("world", [(Path(w).stem or "default", [r for r in rows if r["world"] == w]) for w in plan.spec.worlds])]
-    else:
-        out = []
+        out.append(("world", [(Path(w).stem or "default", [r for r in rows if r["world"] == w])
+                              for w in plan.spec.worlds]))
     for axis in axes:
         labelled = []
         for value in axis.values:

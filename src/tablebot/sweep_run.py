@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import io
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -69,7 +69,8 @@ class Plan:
             return True
         return free
 
-    def jobs(self, skip: set[tuple[int, int]] = frozenset()) -> list[Job]:  # type: ignore[assignment]
+    def jobs(self, skip: Collection[tuple[int, int]] = ()) -> list[Job]:
+        """A job per chunk of the spec that is not in ``skip`` (chunks already finished)."""
         out = []
         for a, b in chunks(self.spec):
             if (a, b) in skip:

@@ -88,7 +88,7 @@ class Fleet:
                  variants: Variants | None = None):
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
-        self.table, self.machine, self.world_file, self.robot_params = table, machine, world, robot_params
+        self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
         self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
         self._scenes: dict[tuple, Scene] = {}
@@ -100,7 +100,7 @@ class Fleet:
         """The robot's scene: the table in the world with its parameters (made once per parameter set)
         and its start; every robot of a fleet must be wired alike."""
         if spec.params not in self._scenes:
-            scene = prepare(self.table, self.machine, self.world_file, self.robot_params, spec.overrides())
+            scene = prepare(self.table, self.machine, self.world_model, self.robot_params, spec.overrides())
             first = next(iter(self._scenes.values()), scene)
             if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
                                                                            first.pulse_columns):
@@ -131,6 +131,7 @@ class Fleet:
             if i in traced:
                 self.traced[i] = len(self.traces)
                 self.traces[i] = Trace(robot)
+        # the world, wiring and trace blocks as SimRobot packs them: shared, never rebuilt here
         robot = self.traces[min(self.traces)].robot if self.traces else SimRobot(self.scenes[0], 0, False)
         self.world = robot._world
         self.bits, self.drive, self.pcols = self.scenes[0].bits, robot._drive, robot._pcols
@@ -197,7 +198,7 @@ class Fleet:
             distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
             battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
             first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
-            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_file.lamps))
+            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_model.lamps))
 
     def trace_lines(self, i: int) -> list[str]:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
