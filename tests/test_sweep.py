@@ -145,3 +145,12 @@ def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list
     assert code == 2, output
     assert output.startswith(f"{option}: error:") and words in output, output
     assert "Traceback" not in output
+
+
+def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed: importing fails
+    code, output = sweep("--robots", "2", "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "s"))
+    assert code == 2, output
+    assert output.startswith("--backend: error: --backend dask: Dask is not installed")
+    assert "pip install 'tablebot[cluster]'" in output

@@ -106,3 +106,33 @@ def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
                                *args)
         assert code == 2 and output.startswith(f"{option}: error:"), output
 
+
+
+def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
+    """Line 5 of the counters BumberBot loads C1 with 107 pulses (its 270° spin): tuned to 40 pulses, a
+    fleet robot runs exactly as that table written with 40 and run alone."""
+    from dataclasses import replace
+
+    from tablebot.cli.common import load
+    from tablebot.cli.fleet import make_plan
+    from tablebot.machine import compile_table
+    from tablebot.sim.fleet import Fleet, RobotSpec
+    from tablebot.sim.runner import run
+    from tablebot.sim.scene import scene_for
+    from tablebot.tune import parse_cells, variants_of
+    from test_sim_helpers import BUMBERBOT, trace_text
+
+    example = BUMBERBOT.parent / "bumberbot-counters"
+    plan = make_plan(example, None, [], [], "0", None, 5.0)
+    cells = parse_cells("line 5 C1_load=10..200", plan.table)
+    assert (cells[0].column, cells[0].value, cells[0].low, cells[0].high) == ("C1_load", 107, 10, 200)
+    fleet = Fleet(plan.table, plan.machine, plan.worlds[0], [RobotSpec(seed=2, variant=1)], plan.robot_params,
+                  traced=[0], variants=variants_of(plan, cells, [(107,), (40,)]))
+    fleet.run(500)
+    table, _ = load(example)
+    rows = tuple(replace(r, counters=(40, *r.counters[1:])) if r.line == 5 else r for r in table.rows)
+    edited = replace(table, rows=rows)
+    alone = run(scene_for(edited, compile_table(edited)), 5.0, 2)
+    assert "".join(fleet.trace_lines(0)) == trace_text(alone)
+    with pytest.raises(Exception, match="leaves C1 alone"):
+        parse_cells("line 2 C1_load", plan.table)

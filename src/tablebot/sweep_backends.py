@@ -108,11 +108,11 @@ class Runner:
     def _run_dask(self, jobs: Sequence[Job], done: Done) -> None:
         """Every worker first warms the kernel in a cache folder of its own (one compile per worker,
         never two processes writing one folder); then the chunks go out."""
+        if self.client is None:
+            self.client = connect(self.address or "")  # first: it says what to install when Dask is missing
+            self.info = warm_cluster(self.client, jobs[0])
         from distributed import as_completed
 
-        if self.client is None:
-            self.client = connect(self.address or "")
-            self.info = warm_cluster(self.client, jobs[0])
         client = self.client
         futures = [client.submit(run_job, job, pure=False) for job in jobs]
         try:
