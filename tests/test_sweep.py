@@ -154,3 +154,16 @@ def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,
     assert code == 2, output
     assert output.startswith("--backend: error: --backend dask: Dask is not installed")
     assert "pip install 'tablebot[cluster]'" in output
+
+
+def test_a_table_too_wide_for_the_compiled_fleet_is_a_clear_error(tmp_path: Path) -> None:
+    inputs = [f"I{k}" for k in range(1, 11)]
+    robot = ('name = "Wide"\ntick_ms = 10\ninitial_state = 1\n[inputs]\n' + "".join(f'{i} = "switch"\n' for i in inputs)
+             + '[motors]\nM1 = "right motor"\nM2 = "left motor"\n')
+    (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
+    header = ",".join(["description", "state", "T", *inputs, "M1", "M2", "timer", "next"])
+    (tmp_path / "table.csv").write_text(header + "\ngo,1,1," + "," * 10 + "4,4,10,1\n", encoding="utf-8")
+    result = CliRunner().invoke(app, ["sweep", str(tmp_path / "table.csv"), "--robots", "2", "--out",
+                                      str(tmp_path / "s")])
+    assert result.exit_code == 2, result.output
+    assert "the table has 11 event columns; the compiled fleet takes at most 10" in result.output

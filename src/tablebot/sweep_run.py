@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import TableBotError, fail
-from tablebot.files import write_text
+from tablebot.files import atomic_write, write_text
 from tablebot.machine import Machine
 from tablebot.sim.fleet import FleetSummary, RobotSpec, with_start
 from tablebot.sim.fleet_work import Job
@@ -146,18 +146,20 @@ class Store:
         return write_text(self.parts / name, csv_text(self.plan.columns(), rows))
 
     def merge(self, complete: bool) -> tuple[Path, int]:
-        """All finished parts in run order as ``results.csv`` (or ``results.partial.csv`` when not complete)."""
-        columns = self.plan.columns()
-        body: list[str] = []
+        """All finished parts in run order as ``results.csv`` (or ``results.partial.csv`` when not complete),
+        streamed part by part (a sweep of millions of runs is never held in memory whole)."""
         count = 0
-        for a, b in chunks(self.plan.spec):
-            part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
-            if part.exists():
-                lines = part.read_text(encoding="utf-8").splitlines(keepends=True)[1:]
-                body += lines
-                count += len(lines)
-        name = "results.csv" if complete else "results.partial.csv"
-        path = write_text(self.folder / name, csv_text(columns, []) + "".join(body))
+        path = self.folder / ("results.csv" if complete else "results.partial.csv")
+        with atomic_write(path) as out:
+            out.write(csv_text(self.plan.columns(), []))
+            for a, b in chunks(self.plan.spec):
+                part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
+                if part.exists():
+                    with open(part, encoding="utf-8") as f:
+                        next(f)  # its header
+                        for line in f:
+                            out.write(line)
+                            count += 1
         if complete:
             (self.folder / "results.partial.csv").unlink(missing_ok=True)
         return path, count

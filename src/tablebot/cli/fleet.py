@@ -82,6 +82,12 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
     axes = parse_grid(grid)
     seed_list = parse_seeds(seeds, robots)
     parsed, machine = load(table, robot)
+    if machine.arrays is None:
+        from tablebot.diagnostics import fail
+        from tablebot.machine import FLAT_BITS
+
+        raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
+                   f"{FLAT_BITS}", "simulate it one robot at a time with tablebot sim, or use fewer inputs")
     layer, robot_world = robot_layer(parsed.robot)
     loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
     paths = [str(w) for w in worlds] or [loaded[0].path]
