@@ -37,9 +37,13 @@ def env() -> dict[str, str]:
 def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     code, output = sweep("--grid", "battery=1.0,0.6", "--seeds", "3..5", "--seconds", "8", "--workers", "1",
-                         "--out", str(out), "--no-plots")
+                         "--out", str(out), "--no-plots", "--trace", "4")
     assert code == 0, output
     rows = read_results(out / "results.csv")
+    alone = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "8", "--seed", "4", "--battery", "0.6",
+                                     "--no-plots", "--quiet", "--out", str(tmp_path / "sim")])
+    assert alone.exit_code == 0, alone.output
+    assert (out / "trace-4.jsonl").read_bytes() == (tmp_path / "sim" / "trace.jsonl").read_bytes()
     assert [(r["run"], r["battery"], r["seed"]) for r in rows] == [
         ("0", "1.0", "3"), ("1", "1.0", "4"), ("2", "1.0", "5"),
         ("3", "0.6", "3"), ("4", "0.6", "4"), ("5", "0.6", "5")]
@@ -138,6 +142,7 @@ def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask
     ([], "--seeds", "say which runs to make"),
     (["--robots", "2", "--backend", "dask"], "--backend", "needs a scheduler"),
     (["--robots", "2", "--backend", "cloud"], "--backend", "unknown backend"),
+    (["--robots", "2", "--trace", "2"], "--trace", "--trace 2: the sweep has runs 0..1"),
 ])
 def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list[str], option: str,
                                                       words: str) -> None:

@@ -129,20 +129,14 @@ def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
 
 def trajectories(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
     """``best.png`` and ``worst.png``: the two runs again, traced, drawn as ``tablebot sim`` draws a run."""
-    from tablebot.sim.fleet import Fleet
     from tablebot.sim.plots import trajectory
     from tablebot.sim.summary import summarise
-    from tablebot.sweep import runs
 
     written = []
     for name, row in zip(("best", "worst"), best_and_worst(rows), strict=True):
         if row is None:
             continue
-        run = runs(plan.spec, int(row["run"]), int(row["run"]) + 1)[0]
-        fleet = Fleet(plan.table, plan.machine, plan.worlds[run.world], [plan.robot(run)], plan.robot_params,
-                      traced=[0])
-        fleet.run(plan.spec.ticks)
-        result = fleet.result(0)
+        result = plan.traced(int(row["run"])).result(0)
         written.append(trajectory(result, summarise(result), folder / f"{name}.png"))
     return written
 

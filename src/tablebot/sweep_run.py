@@ -18,7 +18,7 @@ from typing import Any
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.files import atomic_write, write_text
 from tablebot.machine import Machine
-from tablebot.sim.fleet import FleetSummary, RobotSpec, with_start
+from tablebot.sim.fleet import Fleet, FleetSummary, RobotSpec, with_start
 from tablebot.sim.fleet_work import Job
 from tablebot.sim.scene import Scene, prepare
 from tablebot.sim.world import World
@@ -87,6 +87,21 @@ class Plan:
             out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
                            first=a, info={"stop": b}))
         return out
+
+    def traced(self, index: int) -> Fleet:
+        """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
+        from tablebot.sim.fleet import Fleet
+
+        run = runs(self.spec, index, index + 1)[0]
+        fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
+                      traced=[0])
+        fleet.run(self.spec.ticks)
+        return fleet
+
+    def write_traces(self, indices: Sequence[int], folder: Path) -> list[Path]:
+        """``trace-RUN.jsonl`` of each run: the trace ``tablebot sim`` writes for that robot."""
+        return [write_text(folder / f"trace-{index}.jsonl", "".join(self.traced(index).trace_lines(0)))
+                for index in indices]
 
     def rows(self, job: Job, summary: FleetSummary) -> list[dict[str, Any]]:
         """One result row per robot of a finished chunk."""

@@ -39,6 +39,8 @@ def sweep_cmd(
     workers: int | None = WORKERS_OPT,
     out: Path = typer.Option(Path("out/sweep"), "--out", help="Folder for results.csv, its parts and pictures."),
     plots: bool = typer.Option(True, "--plots/--no-plots", help="Write outcomes.png, starts.png, best.png, worst.png."),
+    trace: str | None = typer.Option(None, "--trace", help="Runs to write whole as OUT/trace-RUN.jsonl (the trace "
+                                     "tablebot sim writes for that robot): run numbers, e.g. 0,17 or 0..9."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no summary."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
@@ -49,6 +51,7 @@ def sweep_cmd(
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
+    traced = trace_runs(trace, plan.spec.total)
     out_folder(out, "--out")
     store = Store(out, plan)
     finished = store.open()
@@ -67,7 +70,26 @@ def sweep_cmd(
                               "command again to resume", markup=False, soft_wrap=True)
             raise typer.Exit(130) from None
     path, count = store.merge(complete=True)
-    report(plan, path, out, plots, quiet, time.perf_counter() - started, total - already)
+    traces = plan.write_traces(traced, out)
+    report(plan, path, out, plots, quiet, time.perf_counter() - started, total - already, traces)
+
+
+def trace_runs(text: str | None, total: int) -> list[int]:
+    """The run numbers of ``--trace`` (as --seeds reads numbers), each one of the sweep's runs."""
+    from tablebot.diagnostics import TableBotError, fail
+    from tablebot.sweep import parse_seeds
+
+    if text is None:
+        return []
+    try:
+        chosen = parse_seeds(text, None)
+    except TableBotError as exc:  # the same words, about --trace
+        raise fail("--trace", exc.diagnostics[0].message.replace("--seeds", "--trace"),
+                   "give run numbers: 0,17 or 0..9") from None
+    beyond = [k for k in chosen if k >= total]
+    if beyond:
+        raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")
+    return list(chosen)
 
 
 def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[str], seeds: str | None,
@@ -99,13 +121,14 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
     return Plan(spec, parsed, machine, loaded, layer)
 
 
-def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: float, ran: int) -> None:
+def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: float, ran: int,
+           traces: list[Path]) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
     from tablebot.sweep_plots import groups, write_all
     from tablebot.sweep_run import read_results
 
     rows = read_results(path)
-    written = [path, *(write_all(plan, rows, out) if plots else [])]
+    written = [path, *traces, *(write_all(plan, rows, out) if plots else [])]
     if quiet:
         return
     lamps = any(world.lamps for world in plan.worlds)
