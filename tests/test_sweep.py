@@ -172,3 +172,35 @@ def test_a_table_too_wide_for_the_compiled_fleet_is_a_clear_error(tmp_path: Path
                                       str(tmp_path / "s")])
     assert result.exit_code == 2, result.output
     assert "the table has 11 event columns; the compiled fleet takes at most 10" in result.output
+
+
+def test_a_cluster_worker_warms_the_kernel_in_a_cache_folder_of_its_own(tmp_path: Path) -> None:
+    """A worker started without NUMBA_CACHE_DIR keeps its compiled kernels in worker-SLOT of the user's
+    tablebot cache. The folder is seeded here with this process's cache, so the worker only loads (no
+    compile, no file written): a worker of a real cluster compiles there once, alone."""
+    import pickle
+    import shutil
+
+    from tablebot import jit
+    from tablebot.cli.fleet import make_plan
+
+    home = tmp_path / "cache"
+    shared = Path(jit.cache_dir())
+    version = f"py{sys.version_info.major}{sys.version_info.minor}"
+    mine = home / "tablebot" / f"numba-{version}-{jit.sources_digest()}" / "worker-testhost-0"
+    for folder in shared.iterdir():
+        if folder.is_dir() and not folder.name.startswith("worker-"):
+            shutil.copytree(folder, mine / folder.name)
+    before = sorted(p.relative_to(mine) for p in mine.rglob("*"))
+    plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)
+    (tmp_path / "job.pickle").write_bytes(pickle.dumps(plan.jobs()[0]))
+    code = ("import json, pickle, sys; from tablebot.sim.fleet_work import warm_worker; "
+            "job = pickle.load(open(sys.argv[1], 'rb')); print(json.dumps(warm_worker(job, 'testhost-0', 2)))")
+    worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
+    worker_env["XDG_CACHE_HOME"] = str(home)
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    info = json.loads(done.stdout.strip().splitlines()[-1])
+    assert info["cache"] == str(mine) and info["threads"] == max(1, (os.cpu_count() or 1) // 2)
+    assert sorted(p.relative_to(mine) for p in mine.rglob("*")) == before  # loaded, not compiled

@@ -104,7 +104,10 @@ def warm_worker(job: Job, slot: str, share: int = 1) -> dict[str, Any]:
     """On a cluster worker: choose a cache folder of its own (``worker-SLOT`` in the user's numba cache
     for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code already loaded
     here; then compile or load the kernel once, before any chunk runs (concurrent compiles into one
-    cache folder race: numba issues #4807, #10128)."""
+    cache folder race: numba issues #4807, #10128). Its chunks then use 1/``share`` of the machine's
+    cores (``share``: the workers on this machine)."""
+    global _worker_threads
+    _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
     given = bool(os.environ.get("NUMBA_CACHE_DIR"))
     from tablebot import jit  # numba, and the default cache folder (per user, Python and sources)
 
