@@ -49,6 +49,8 @@ class SweepSpec:
     axes: tuple[Axis, ...]
     seeds: tuple[int, ...]
     ticks: int
+    robot_digest: str = ""  # the robot file (its [sim] parameters shape every run)
+    code: str = ""  # the simulator's sources (tablebot.jit.sources_digest): other code, other runs
 
     def to_json(self) -> str:
         return json.dumps(asdict(self), indent=1, sort_keys=True) + "\n"

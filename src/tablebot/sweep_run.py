@@ -147,8 +147,9 @@ class Store:
         spec_file = self.folder / "spec.json"
         text = self.plan.spec.to_json()
         if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
-            raise fail(self.folder, "--out holds the results of a different sweep (another table, world, grid, "
-                       "seeds or length)", "give --out a new folder, or delete this one to start over")
+            raise fail(self.folder, "--out holds the results of a different sweep (another table, robot file, "
+                       "world, grid, seeds, length or simulator version)",
+                       "give --out a new folder, or delete this one to start over")
         self.parts.mkdir(parents=True, exist_ok=True)
         if not spec_file.exists():
             write_text(spec_file, text)

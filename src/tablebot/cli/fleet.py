@@ -95,6 +95,7 @@ def trace_runs(text: str | None, total: int) -> list[int]:
 def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[str], seeds: str | None,
               robots: int | None, seconds: float) -> Plan:
     """The table, its worlds and the checked options as a plan of runs."""
+    from tablebot.jit import sources_digest
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.scene import find_world, prepare, robot_layer
     from tablebot.sim.world import load_world
@@ -115,9 +116,11 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
     paths = [str(w) for w in worlds] or [loaded[0].path]
     ticks = ticks_for(prepare(parsed, machine, loaded[0], layer), seconds)
     files = [Path(p) if Path(p).is_file() else None for p in paths]
+    robot_file = Path(parsed.robot.source)
     spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=digest(Path(parsed.path)),
                      worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
-                     seeds=seed_list, ticks=ticks)
+                     seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
+                     code=sources_digest())
     return Plan(spec, parsed, machine, loaded, layer)
 
 
