@@ -7,7 +7,13 @@ import os
 import sys
 import traceback
 
-from tablebot.cli import analysis, core, export, firmware, fleet, new, run, sim, studio, tune  # noqa: F401  (importing registers the commands)
+# Typer draws help with rich when it can, and that costs a third of `tablebot --help` (rich's Markdown
+# renderer is imported for it): plain help unless the user asks with TYPER_USE_RICH=1. Typer reads the
+# variable once, when it is first imported, which is just below.
+os.environ.setdefault("TYPER_USE_RICH", "0")
+
+# Importing a module registers its commands; `tablebot --help` lists them in this order.
+from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, fleet, tune  # noqa: F401, I001
 from tablebot.cli.app import app
 
 #: Exit code of an internal error (a tablebot bug), apart from 1 (warnings) and 2 (bad input).
