@@ -9,6 +9,8 @@ each lamp's level and each counter's value. Extra fields (a simulator's pose) ma
 from __future__ import annotations
 
 import json
+import queue
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
@@ -108,20 +110,56 @@ def _json_column(column: Any) -> list[str]:
 
 class TraceFile:
     """A sink that writes the trace while the run goes: under a temporary name, renamed to ``path`` when
-    the run is complete, or to ``NAME.partial.jsonl`` (ending with an ``end`` record saying why) when not."""
+    the run is complete, or to ``NAME.partial.jsonl`` (ending with an ``end`` record saying why) when not.
 
-    def __init__(self, path: str | Path):
+    With ``background``, blocks are formatted and written by a thread of their own, while the next
+    block is computed (the compiled simulator releases the GIL); ``end`` waits for it, and an error
+    it met (a full disk) is raised there or at the next block.
+    """
+
+    def __init__(self, path: str | Path, background: bool = False):
         self.path = Path(path)
+        self.background = background
         self.written: Path | None = None
+        self._queue: queue.Queue[TickBlock | None] | None = None
+        self._failed: BaseException | None = None
 
     def start(self, info: RunInfo) -> None:
         self.machine = info.engine.machine
         self.file = PendingFile(self.path)
+        if self.background:
+            self._queue = queue.Queue(maxsize=4)  # bounded: memory stays a few blocks whatever the disk does
+            self._thread = threading.Thread(target=self._drain, name="trace writer", daemon=True)
+            self._thread.start()
 
     def block(self, block: TickBlock) -> None:
+        if self._queue is None:
+            self._write(block)
+            return
+        if self._failed is not None:
+            raise self._failed
+        self._queue.put(block)
+
+    def _write(self, block: TickBlock) -> None:
         self.file.stream.writelines(block_lines(block, self.machine))
 
+    def _drain(self) -> None:
+        assert self._queue is not None
+        while (block := self._queue.get()) is not None:
+            if self._failed is None:
+                try:
+                    self._write(block)
+                except BaseException as exc:  # raised in the loop's thread, at the next block or at the end
+                    self._failed = exc
+
     def end(self, end: RunEnd) -> None:
+        if self._queue is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._queue = None
+            if self._failed is not None:
+                self.file.discard()
+                raise self._failed
         if end.complete and end.reason == "done":
             self.written = self.file.commit()
             return

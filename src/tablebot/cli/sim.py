@@ -55,7 +55,7 @@ def sim_cmd(
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    trace = TraceFile(out / "trace.jsonl")
+    trace = TraceFile(out / "trace.jsonl", background=True)
     result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32)
     if not result.end.complete:
         _stopped(result, trace.written)
