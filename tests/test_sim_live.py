@@ -121,3 +121,22 @@ def test_sigterm_stops_the_run_the_same_way(tmp_path: Path) -> None:
     assert proc.returncode == 143, err
     assert json.loads((out / "trace.partial.jsonl").read_text().splitlines()[-1])["end"] == "terminated"
     assert not (out / "trace.jsonl").exists()
+
+
+def test_a_disk_that_fills_up_under_the_trace_is_a_clear_error_and_leaves_nothing(tmp_path: Path) -> None:
+    """A real write failure (the process may write files of at most 1 MB): the background trace writer's
+    error reaches the command, which names the file; no half trace and no temporary file are left."""
+    import resource
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1 << 20, 1 << 20))
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit then fails with EFBIG
+
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--out", str(out), "-q",
+                           "--seconds", "600", "--no-plots"], capture_output=True, text=True, preexec_fn=small_files,
+                          timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert f"{out / 'trace.jsonl'}: error: cannot write or read: File too large" in proc.stderr
+    assert "Traceback" not in proc.stderr and list(out.iterdir()) == []

@@ -352,11 +352,23 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
         _shut_down(robot)
         final = end or RunEnd("error", engine.tick, "the run ended without a reason")
         final = RunEnd(final.reason, final.ticks, final.message, late.count, late.worst_s)
-        for sink in started:
-            sink.end(final)
+        failed = _end_sinks(started, final)
     if bug is not None:
         raise bug
+    if failed is not None:  # a sink could not finish (a full disk under the trace): after every sink has ended
+        raise failed
     return final
+
+
+def _end_sinks(sinks: Sequence[Sink], end: RunEnd) -> Exception | None:
+    """Tell every sink the run ended, even when one of them fails; returns the first failure."""
+    first = None
+    for sink in sinks:
+        try:
+            sink.end(end)
+        except Exception as exc:
+            first = first or exc
+    return first
 
 
 def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,

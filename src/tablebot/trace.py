@@ -150,6 +150,8 @@ class TraceFile:
                 try:
                     self._write(block)
                 except BaseException as exc:  # raised in the loop's thread, at the next block or at the end
+                    if isinstance(exc, OSError) and exc.filename is None:
+                        exc.filename = str(self.path)  # a full disk names no file of its own
                     self._failed = exc
 
     def end(self, end: RunEnd) -> None:
