@@ -140,3 +140,14 @@ def test_a_disk_that_fills_up_under_the_trace_is_a_clear_error_and_leaves_nothin
     assert proc.returncode == 2, proc.stderr
     assert f"{out / 'trace.jsonl'}: error: cannot write or read: File too large" in proc.stderr
     assert "Traceback" not in proc.stderr and list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("example", ["bumberbot", "line-follower"])
+def test_a_run_that_keeps_no_robot_rows_sums_up_the_same(example: str) -> None:
+    """Without pictures only the first and last robot rows and a thinned path are kept: same summary."""
+    from tablebot.sim.summary import summarise
+
+    scene = scene_of(ROOT / "examples" / example / "table.csv")
+    full, lean = run(scene, 90.0, seed=2), run(scene, 90.0, seed=2, rows=False)
+    assert lean.hist is None and summarise(lean) == summarise(full)
+    assert (lean.path == full.hist[::5, :2]).all()

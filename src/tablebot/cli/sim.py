@@ -56,7 +56,8 @@ def sim_cmd(
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     trace = TraceFile(out / "trace.jsonl", background=True)
-    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32)
+    rows = plots or gif or view or html  # every robot row is kept only for what draws the run
+    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32, rows)
     if not result.end.complete:
         _stopped(result, trace.written)
     summary = summarise(result)
@@ -115,14 +116,14 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
 
 
 def _run_with_progress(run, scene, seconds: float, seed: int, ticks: int | None, trace,  # type: ignore[no-untyped-def]
-                       history: type):
+                       history: type, rows: bool):
     """``run`` with a progress bar of ``ticks`` on a terminal (None: quiet)."""
     if ticks is None or not sys.stderr.isatty():
-        return run(scene, seconds, seed, sinks=[trace], history=history)
+        return run(scene, seconds, seed, sinks=[trace], history=history, rows=rows)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
         return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
-                   history=history)
+                   history=history, rows=rows)

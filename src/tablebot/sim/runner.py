@@ -21,6 +21,7 @@ from tablebot.sim.scene import Scene
 from tablebot.trace import TickInput, block_lines
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
+PATH_STRIDE = 5  # robot rows per point of the thinned path (the robot moves well under 1 cm a tick)
 
 
 @dataclass
@@ -32,7 +33,9 @@ class Result:
 
     scene: Scene
     seed: int
-    hist: np.ndarray  # (ticks + 1, N_STATE), float64 or float32
+    hist: np.ndarray | None  # (ticks + 1, N_STATE), float64 or float32; None when not kept (no pictures)
+    ends: np.ndarray  # (2, N_STATE): the robot before the first tick and after the last
+    path: np.ndarray  # (rows, 2): x, y of every PATH_STRIDE-th robot row (for the summary's laps)
     masks: np.ndarray  # (ticks,)
     events: np.ndarray
     rows: np.ndarray
@@ -68,12 +71,13 @@ class Result:
 class History:
     """A sink that keeps every tick of a simulated run in arrays sized for the planned run (robot rows as
     ``dtype``: float32 halves the memory of an hour's run and is plenty for pictures; the trace is
-    written from the exact values)."""
+    written from the exact values). With ``rows=False`` it keeps the per-tick columns, the first and
+    last robot rows and a thinned path, but not every robot row (a run without pictures)."""
 
     COLUMNS = ("masks", "events", "rows", "states", "timers", "outputs", "counters", "pulses")
 
-    def __init__(self, robot: SimRobot, dtype: type = np.float64):
-        self.robot, self.dtype = robot, dtype
+    def __init__(self, robot: SimRobot, dtype: type = np.float64, rows: bool = True):
+        self.robot, self.dtype, self.rows = robot, dtype, rows
         self.ended: RunEnd | None = None
         self.done = 0
 
@@ -81,8 +85,10 @@ class History:
         machine = info.engine.machine
         ticks = info.ticks or 0
         n_out, n_c = len(machine.output_names), len(machine.counter_bits)
-        self.hist = np.zeros((ticks + 1, L.N_STATE), dtype=self.dtype)
-        self.hist[0] = self.robot.s
+        self.hist = np.zeros((ticks + 1 if self.rows else 0, L.N_STATE), dtype=self.dtype)
+        self.first = self.robot.s.copy()
+        self.path = np.zeros((ticks // PATH_STRIDE + 1, 2))
+        self._keep_row(0, self.robot.s)
         small = np.int16 if len(machine.states) < 32768 and len(machine.rows) < 32768 else np.int32
         self.columns = {"masks": np.zeros(ticks, np.int32), "events": np.zeros(ticks, np.int32),
                         "rows": np.zeros(ticks, small), "states": np.zeros(ticks, small),
@@ -94,9 +100,19 @@ class History:
         for name in self.COLUMNS:
             self.columns[name][a:b] = getattr(block, name)
         if block.raw is not None:  # the robot at the start of each tick; the one after the last comes below
-            self.hist[a:b] = block.raw
-        self.hist[b] = self.robot.s
+            if self.rows:
+                self.hist[a:b] = block.raw
+            first = -(-a // PATH_STRIDE) * PATH_STRIDE  # the first row of the block on the path's stride
+            points = block.raw[first - a::PATH_STRIDE][:, [L.X, L.Y]]
+            self.path[first // PATH_STRIDE:first // PATH_STRIDE + len(points)] = points
+        self._keep_row(b, self.robot.s)
         self.done = b
+
+    def _keep_row(self, row: int, s: np.ndarray) -> None:
+        if self.rows:
+            self.hist[row] = s
+        if row % PATH_STRIDE == 0 and row // PATH_STRIDE < len(self.path):
+            self.path[row // PATH_STRIDE] = s[[L.X, L.Y]]
 
     def end(self, end: RunEnd) -> None:
         self.ended = end
@@ -104,7 +120,8 @@ class History:
     def result(self, scene: Scene, seed: int, wall_s: float) -> Result:
         robot, n = self.robot, self.done
         cut = {name: column[:n] for name, column in self.columns.items()}  # a run cut short keeps what ran
-        return Result(scene=scene, seed=seed, hist=self.hist[: n + 1], **cut,
+        return Result(scene=scene, seed=seed, hist=self.hist[: n + 1] if self.rows else None,
+                      ends=np.stack((self.first, robot.s)), path=self.path[: n // PATH_STRIDE + 1], **cut,
                       collision_rows=robot.collisions, collision_count=robot.collision_count,
                       reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)  # type: ignore[arg-type]
 
@@ -135,7 +152,7 @@ def ticks_for(scene: Scene, seconds: float) -> int:
 
 
 def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
-        sinks: Sequence[Sink] = (), history: type = np.float64) -> Result:
+        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool = True) -> Result:
     """Simulate ``seconds`` of robot time through the run loop; ``progress(ticks_done)`` is called
     after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens.
 
@@ -144,7 +161,7 @@ def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], N
     """
     ticks = ticks_for(scene, seconds)
     robot = SimRobot(scene, seed)
-    keep = History(robot, history)
+    keep = History(robot, history, rows)
     extra = [Progress(progress)] if progress else []
     started = time.perf_counter()
     run_loop(Engine(scene.machine), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")

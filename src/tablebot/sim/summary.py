@@ -16,8 +16,6 @@ from tablebot.sim.runner import Result
 from tablebot.sim.scene import Scene
 from tablebot.sim.track import laps
 
-LAP_STRIDE = 5  # robot rows per sample for counting laps (the robot moves well under 1 cm a tick)
-
 
 @dataclass(frozen=True)
 class Summary:
@@ -84,7 +82,7 @@ def seconds_per_state(counts: np.ndarray, first_seen: np.ndarray, names: tuple[S
 def summarise(result: Result) -> Summary:
     """The run's numbers: first light from the inputs read, time per state from the states after each
     tick, and the collisions and lamp reached that the simulated robot counted as it went."""
-    tick_s, h = result.tick_s, result.hist
+    tick_s, at_start, at_end = result.tick_s, result.ends[0], result.ends[1]
     light = first((result.masks & light_bits(result)) != 0)
     reached = result.reached_row
     return Summary(
@@ -92,8 +90,8 @@ def summarise(result: Result) -> Summary:
         first_light_s=None if light is None else light * tick_s,
         reached_s=None if reached is None else reached * tick_s,
         collisions=result.collision_count, collision_ticks=tuple(result.collision_rows),
-        distance_m=float(h[-1, L.DIST]), state_seconds=time_per_state(result.states, result.scene.machine.states,
+        distance_m=float(at_end[L.DIST]), state_seconds=time_per_state(result.states, result.scene.machine.states,
                                                                       tick_s),
-        battery_start_v=float(h[0, L.VBAT]), battery_end_v=float(h[-1, L.VBAT]),
-        laps=laps(result.scene.world, h[::LAP_STRIDE, L.X], h[::LAP_STRIDE, L.Y]),
+        battery_start_v=float(at_start[L.VBAT]), battery_end_v=float(at_end[L.VBAT]),
+        laps=laps(result.scene.world, result.path[:, 0], result.path[:, 1]),
         lamps=bool(result.scene.world.lamps))
