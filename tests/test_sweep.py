@@ -204,3 +204,16 @@ def test_a_cluster_worker_warms_the_kernel_in_a_cache_folder_of_its_own(tmp_path
     info = json.loads(done.stdout.strip().splitlines()[-1])
     assert info["cache"] == str(mine) and info["threads"] == max(1, (os.cpu_count() or 1) // 2)
     assert sorted(p.relative_to(mine) for p in mine.rglob("*")) == before  # loaded, not compiled
+
+
+def test_a_sweep_draws_its_pictures(tmp_path: Path) -> None:
+    """Outcomes, start positions, and the best and worst runs' trajectories (rerun alone, drawn like sim's)."""
+    from PIL import Image
+
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "start=random", "--seeds", "0..5", "--seconds", "20", "--workers", "1",
+                         "--out", str(out))
+    assert code == 0, output
+    for name in ("outcomes", "starts", "best", "worst"):
+        with Image.open(out / f"{name}.png") as image:
+            assert image.format == "PNG" and image.width > 600, name

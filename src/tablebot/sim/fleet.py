@@ -21,7 +21,7 @@ from tablebot.sim import layout as L
 from tablebot.sim.fleet_kernel import NO_TICK, run_fleet
 from tablebot.sim.fleet_work import Pose, RobotSpec, Variants
 from tablebot.sim.robot import SimRobot
-from tablebot.sim.runner import Result
+from tablebot.sim.runner import PATH_STRIDE, Result
 from tablebot.sim.scene import Scene, _check_start, prepare
 from tablebot.sim.summary import Summary, light_bits, seconds_per_state
 from tablebot.sim.world import World
@@ -213,7 +213,8 @@ class Fleet:
         hist = np.concatenate([*trace.rows, self.S[i][None, :]])
         count = int(self.acc[i, K.A_COLLISIONS])
         reached = int(self.acc[i, K.A_REACHED])
-        return Result(scene=robot.scene, seed=robot.seed, hist=hist, masks=column("masks"), events=column("events"),
+        return Result(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
+                      path=hist[::PATH_STRIDE, [L.X, L.Y]], masks=column("masks"), events=column("events"),
                       rows=column("rows"), states=column("states"), timers=column("timers"),
                       outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),
                       collision_rows=self.collisions[i, : min(count, FLEET_COLLISIONS)].tolist(),
