@@ -177,7 +177,7 @@ def test_a_run_trace_that_cannot_be_replayed_is_a_located_error(tmp_path: Path) 
     bad.write_text('{"tick":0,"event":32}\n{"tick":1,"event":\n{"tick":2}\n')
     result = invoke("trace", EXAMPLE, "--inputs", bad)
     assert result.exit_code == 2
-    assert f"{bad}:2:" in result.output and "not a trace line" in result.output
+    assert f"{bad}:2:" in result.output and "line 2 is not JSON" in result.output
     assert f"{bad}:3:1: error: this trace line has no whole-number event" in result.output
     counters = ROOT / "examples" / "bumberbot-counters"
     result = invoke("trace", counters, "--inputs", tmp_path / "trace.jsonl")

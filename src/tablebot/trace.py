@@ -17,7 +17,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import Collector
 from tablebot.engine import Engine
 from tablebot.files import PendingFile
 from tablebot.formats.csvtext import read_text
@@ -189,19 +189,43 @@ def read_trace(path: str | Path) -> list[dict[str, Any]]:
     a line that is not a JSON object is a located error."""
     path = Path(path)
     text = read_text(path, "a trace is UTF-8 JSON Lines as tablebot writes it", MAX_TRACE_BYTES, spreadsheet=False)
-    lines = []
+    return parse_trace(text, path)
+
+
+#: Located errors reported before a bad trace is given up on.
+MAX_TRACE_ERRORS = 10
+
+
+def parse_trace(text: str, path: str | Path, required: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """The tick lines of a trace's text, stopping at an ``end`` record; every line that is not a JSON
+    object (or lacks a ``required`` key) is a located error, all of them (up to ten) reported at once."""
+    out = Collector(path)
+    lines = [line for _, line in trace_records(text, out, required)]
+    out.raise_if_any()
+    return lines
+
+
+def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> Iterator[tuple[int, dict[str, Any]]]:
+    """(line number, tick line) of a trace's text up to an ``end`` record; a bad line goes to ``out``.
+    The one reader of trace lines: ``tablebot trace --inputs RUN.jsonl``, the studio's player and
+    :func:`read_trace` all go through it."""
+    hint = "a trace has one JSON object per line, as tablebot sim, trace, run or monitor write it"
     for number, raw in enumerate(text.splitlines(), start=1):
+        if len(out.items) >= MAX_TRACE_ERRORS:
+            return
         if not raw.strip():
             continue
         try:
             line = json.loads(raw)
         except (ValueError, RecursionError) as exc:  # RecursionError: nesting deeper than the parser's stack
-            column = getattr(exc, "colno", 1)
-            raise fail(path, f"line {number} is not JSON: {getattr(exc, 'msg', 'nested too deeply')}",
-                       "a trace has one JSON object per line, as tablebot trace writes it", number, column) from None
+            out.error(number, getattr(exc, "colno", 1),
+                      f"line {number} is not JSON: {getattr(exc, 'msg', 'nested too deeply')}", hint)
+            continue
         if not isinstance(line, dict):
-            raise fail(path, f"line {number} is JSON but not an object {{...}}",
-                       "a trace has one JSON object per line, as tablebot trace writes it", number, 1)
-        if "end" not in line:
-            lines.append(line)
-    return lines
+            out.error(number, 1, f"line {number} is JSON but not an object {{...}}", hint)
+        elif "end" in line:
+            return
+        elif missing := [key for key in required if key not in line]:
+            out.error(number, 1, f"a trace line needs {' and '.join(missing)}", hint)
+        else:
+            yield number, line

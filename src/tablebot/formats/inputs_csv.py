@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -117,19 +116,12 @@ def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
     """The inputs a recorded run gave the engine (``tablebot run --out``, ``tablebot sim``): per line, the
     input bits of ``event`` and each counter's ``<counter>_pulses``; an ``{"end": ...}`` record ends it.
     Replaying them with the same table takes the same decisions."""
+    from tablebot.trace import trace_records  # the one reader of trace lines (trace imports this module)
+
     out = Collector(path)
     keys = ("event", *(f"{c}_pulses" for c in machine.table.robot.counter_names))
     ticks: list[TickInput] = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            data = json.loads(line)
-        except json.JSONDecodeError as exc:
-            out.error(number, exc.colno, f"not a trace line: {exc.msg}", "each line must be one JSON object")
-            continue
-        if not isinstance(data, dict) or "end" in data:
-            break
+    for number, data in trace_records(text, out):
         values = [data.get(key) for key in keys]
         bad = [key for key, v in zip(keys, values, strict=True)
                if isinstance(v, bool) or not isinstance(v, int) or v < 0]

@@ -3,11 +3,11 @@ with a located error for a line that is not a trace line."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable
 from typing import Any
 
-from tablebot.diagnostics import Collector, fail
+from tablebot.diagnostics import fail
+from tablebot.trace import parse_trace
 
 #: An hour of BumberBot simulation is ~40 MB of JSON Lines.
 MAX_TRACE_BYTES = 64 * 1024 * 1024
@@ -27,7 +27,8 @@ def trace_columns(lines: Iterable[dict[str, Any]]) -> dict[str, list[Any]]:
 
 
 def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
-    """Parse JSON Lines; every bad line is reported (the first ten) with its number."""
+    """Parse JSON Lines (through the one trace reader, :func:`tablebot.trace.parse_trace`); every bad line
+    is reported (the first ten) with its number."""
     if len(data) > MAX_TRACE_BYTES:
         raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_TRACE_BYTES:,}",
                    "cut the run shorter (--seconds) or open a part of it")
@@ -35,25 +36,7 @@ def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise fail(name, f"byte {exc.start} is not UTF-8 text", "a trace is JSON Lines text") from None
-    out = Collector(name)
-    lines: list[dict[str, Any]] = []
-    for number, raw in enumerate(text.splitlines(), start=1):
-        if not raw.strip():
-            continue
-        try:
-            value = json.loads(raw)
-        except json.JSONDecodeError as exc:
-            out.error(number, exc.colno, f"not JSON: {exc.msg}", "each line of a trace is one JSON object")
-        else:
-            missing = [k for k in REQUIRED if not isinstance(value, dict) or k not in value]
-            if missing:
-                out.error(number, 1, f"a trace line needs {' and '.join(missing)}",
-                          "open a trace.jsonl written by tablebot sim, trace, run or monitor")
-            else:
-                lines.append(value)
-        if len(out.items) >= 10:
-            break
-    out.raise_if_any()
+    lines = parse_trace(text, name, REQUIRED)
     if not lines:
         raise fail(name, "the trace has no lines", "open a trace.jsonl written by tablebot")
     return lines
