@@ -20,6 +20,22 @@ MAX_LAMP = 8
 TIMER_EVENT = "T"
 
 
+def from_direction_speed(direction: int, speed: int) -> int | None:
+    """The document's motor form (direction 0 forward / 1 backward, speed 0-8, 7 = keep) as a signed
+    speed, None for keep (the direction then does not matter). The one home of that encoding, with
+    :func:`to_direction_speed`: the table reader, the table writer and the ROBO Pro lists use them."""
+    if speed == DOC_KEEP_SPEED:
+        return None
+    return -speed if direction else speed
+
+
+def to_direction_speed(speed: int | None) -> tuple[int, int]:
+    """A signed speed (None: keep) in the document's form: (direction, speed), keep as speed 7."""
+    if speed is None:
+        return 0, DOC_KEEP_SPEED
+    return (1 if speed < 0 else 0), abs(speed)
+
+
 @dataclass(frozen=True)
 class Row:
     """One transition; ``index`` is 0-based in the table as written, ``line`` is the file line.
@@ -87,6 +103,20 @@ class Table:
     def mask(self, events: frozenset[str] | set[str]) -> int:
         bits = self.bits
         return sum(bits[e] for e in events)
+
+    def state_name(self, state: StateId) -> str:
+        """A state's name from the robot file's ``[states]``, else "" (the state is then known by its number).
+
+        The one home of state labels. Row descriptions are never used: some tables describe the state a
+        row leaves, others the action it starts, and a blank description continues the one above, so
+        "search – give up" would name a state.
+        """
+        return self.robot.state_names.get(state, "")
+
+    def state_title(self, state: StateId) -> str:
+        """``2 · Seek: turn`` (named) or ``state 2``: how pictures and views title a state."""
+        name = self.state_name(state)
+        return f"{state} · {name}" if name else f"state {state}"
 
     @property
     def input_events(self) -> tuple[str, ...]:

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 
 import graphviz
 
-from tablebot.analysis.names import state_label
 from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.robot import StateId
@@ -131,7 +130,7 @@ def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
     graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
     graph.node("__start", "", shape="circle", style="filled", fillcolor="black", width="0.18")
     for state in table.states:
-        label = state_label(table, state)
+        label = table.state_name(state)
         title = f"<<b>{dot_label(str(state))}</b>" + (f"<br/>{dot_label(label)}>" if label else ">")
         initial = state == robot.initial_state
         graph.node(ids[state], title, penwidth="2.5" if initial else "1",
@@ -212,7 +211,7 @@ def to_mermaid(table: Table) -> str:
     ids = state_ids(table.states, _mermaid_id)
     out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {ids[table.robot.initial_state]}"]
     for state in table.states:
-        label = state_label(table, state)
+        label = table.state_name(state)
         name = f"{state} - {label}" if label else str(state)
         out.append(f'    state "{mermaid_label(name)}" as {ids[state]}')
     for edge in edges(table):

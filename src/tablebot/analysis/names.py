@@ -8,18 +8,9 @@ from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
 
-def state_label(table: Table, state: StateId) -> str:
-    """A state's name from the robot file's ``[states]``, else "" (the state is then known by its number).
-
-    Row descriptions are never used: some tables describe the state a row leaves, others the action it
-    starts, and a blank description continues the one above, so "search – give up" would name a state.
-    """
-    return table.robot.state_names.get(state, "")
-
-
 def state_text(table: Table, state: StateId) -> str:
     """``state 20 (Collision Entry)``."""
-    label = state_label(table, state)
+    label = table.state_name(state)
     return f"state {state} ({label})" if label else f"state {state}"
 
 

@@ -105,9 +105,7 @@ def _replay_page(result: Result, path: Path) -> Path:
 
 def _report(result: Result, summary: Summary, written: list[Path]) -> None:
     """The summary on standard output, the files written on standard error."""
-    from tablebot.sim.draw import state_names
-
-    for line in summary.lines(state_names(result.scene.table)):
+    for line in summary.lines(result.scene.table.robot.state_names):
         console.print(line, markup=False)
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
     console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")

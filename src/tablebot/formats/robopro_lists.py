@@ -17,7 +17,15 @@ from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.files import atomic_write, write_text
 from tablebot.formats.csvtext import read_text, split_records
 from tablebot.robot import STATE_RE, Robot, StateId
-from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table, missing_states
+from tablebot.table import (
+    DOC_KEEP_SPEED,
+    TIMER_EVENT,
+    Row,
+    Table,
+    from_direction_speed,
+    missing_states,
+    to_direction_speed,
+)
 
 STATE_WEIGHT = 64
 NEXT_WEIGHT = 256
@@ -49,13 +57,6 @@ def number_states(table: Table) -> dict[StateId, int]:
     return numbers
 
 
-def _motor_fields(speed: int | None) -> tuple[int, int]:
-    """(direction, speed) of a signed speed; keep is the document's speed 7."""
-    if speed is None:
-        return 0, DOC_KEEP_SPEED
-    return (1 if speed < 0 else 0), abs(speed)
-
-
 def event_layout(robot: Robot) -> tuple[str, ...]:
     """The list's event bits, highest first: T, then the robot's inputs in robot-file order.
 
@@ -69,7 +70,7 @@ def event_layout(robot: Robot) -> tuple[str, ...]:
 def encode_row(table: Table, row: Row, numbers: dict[StateId, int]) -> tuple[int, int, int]:
     layout = event_layout(table.robot)
     events = sum(1 << (len(layout) - 1 - layout.index(e)) for e in row.events)
-    motors = [_motor_fields(s) for s in row.motors] + [(0, 0)] * (MAX_MOTORS - len(row.motors))
+    motors = [to_direction_speed(s) for s in row.motors] + [(0, 0)] * (MAX_MOTORS - len(row.motors))
     (d1, s1), (d2, s2) = motors
     action = numbers[row.next] * NEXT_WEIGHT + d1 * 128 + s1 * 16 + d2 * 8 + s2
     return numbers[row.state] * STATE_WEIGHT + events, action, row.timer
@@ -197,7 +198,7 @@ def decode(lists: Lists, robot: Robot, events: tuple[str, ...] | None = None, pa
                        index + 1, 1)
         nxt, low = divmod(action, NEXT_WEIGHT)
         fields = [(low >> 7) & 1, (low >> 4) & 7, (low >> 3) & 1, low & 7]
-        motors = tuple(None if speed == DOC_KEEP_SPEED else (-speed if direction else speed)
+        motors = tuple(from_direction_speed(direction, speed)
                        for direction, speed in ((fields[0], fields[1]), (fields[2], fields[3])))
         required = frozenset(e for i, e in enumerate(events) if bits & (1 << (len(events) - 1 - i)))
         rows.append(Row(index=index, line=index + 1, description="", state=names.get(state, state),

@@ -24,7 +24,15 @@ from tablebot.robot import (
     find_robot_file,
     load_robot,
 )
-from tablebot.table import DOC_KEEP_SPEED, MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table, missing_states
+from tablebot.table import (
+    MAX_LAMP,
+    MAX_SPEED,
+    TIMER_EVENT,
+    Row,
+    Table,
+    from_direction_speed,
+    missing_states,
+)
 
 KEEP_WORDS = {"=", "keep", "k"}
 ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
@@ -282,10 +290,7 @@ def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:
     """The signed speed (None = keep) from either the document's dir+speed form or a signed cell."""
     if ("signed", motor) in values:
         return values[("signed", motor)]
-    speed = values.get(("speed", motor)) or 0
-    if speed == DOC_KEEP_SPEED:
-        return None
-    return -speed if values.get(("dir", motor)) else speed
+    return from_direction_speed(values.get(("dir", motor)) or 0, values.get(("speed", motor)) or 0)
 
 
 def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[Column],

@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import io
 
-from tablebot.table import DOC_KEEP_SPEED, Row, Table
+from tablebot.table import DOC_KEEP_SPEED, Row, Table, to_direction_speed
 
 
 def signed_motors(table: Table) -> frozenset[str]:
@@ -29,9 +29,8 @@ def header(table: Table, signed: frozenset[str]) -> list[str]:
 def _motor_cells(speed: int | None, signed: bool) -> list[str]:
     if signed:
         return ["=" if speed is None else str(speed)]
-    if speed is None:
-        return ["", str(DOC_KEEP_SPEED)]
-    return ["1" if speed < 0 else "", str(abs(speed))]
+    direction, level = to_direction_speed(speed)
+    return ["1" if direction else "", str(level)]
 
 
 def _keep(value: int | None) -> str:

@@ -19,7 +19,7 @@ from PIL import Image
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write
 from tablebot.sim import layout as L
-from tablebot.sim.draw import RobotArtist, draw_world, sensor_readings, state_colours, state_label, state_names
+from tablebot.sim.draw import RobotArtist, draw_world, sensor_readings, state_colours
 from tablebot.sim.plots import subtitle_of, title_of
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -47,7 +47,6 @@ class Player:
         self.trail = LineCollection([], linewidths=1.8, zorder=4)
         self.ax.add_collection(self.trail)
         self.robot = RobotArtist(self.ax, scene.params, len(scene.lamp_outputs), sensors=scene.table.robot.sensors)
-        self.names = state_names(scene.table)
         self.hud = self.ax.text(1.0, 1.02, "", transform=self.ax.transAxes, va="bottom", ha="right", fontsize=9,
                                 family="monospace", zorder=20)
         self.speed = speed
@@ -71,7 +70,7 @@ class Player:
         outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {'on ' + str(int(v)) if v else 'off'}"
                             for k, (n, v) in enumerate(zip(names, last, strict=True)))
         speed = f"   ({self.speed:g}× speed)" if self.speed != 1 else ""
-        self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{state_label(state, self.names)}   {outputs}")
+        self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{scene.table.state_title(state)}   {outputs}")
         return [self.trail, self.hud, *self.robot.artists()]
 
 

@@ -22,7 +22,6 @@ from tablebot.sensors import Sensor
 from tablebot.sim import layout as L
 from tablebot.sim.params import Params
 from tablebot.sim.world import Geometry, World
-from tablebot.table import Table
 
 FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
@@ -37,16 +36,6 @@ PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#e
 def state_colours(states: tuple[StateId, ...]) -> list[str]:
     """One colour per state index, stable across the pictures of a table."""
     return [PALETTE[i % len(PALETTE)] for i in range(len(states))]
-
-
-def state_names(table: Table) -> dict[StateId, str]:
-    """Names from the robot file's [states] (row descriptions are not used: some tables describe the
-    state a row leaves, others the action it starts)."""
-    return dict(table.robot.state_names)
-
-
-def state_label(state: StateId, names: dict[StateId, str]) -> str:
-    return f"{state} · {names[state]}" if state in names else f"state {state}"
 
 
 def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:

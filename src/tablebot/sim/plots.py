@@ -29,8 +29,6 @@ from tablebot.sim.draw import (
     draw_world,
     sensor_readings,
     state_colours,
-    state_label,
-    state_names,
 )
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -163,10 +161,9 @@ def _robot_poses(ax, result: Result) -> None:
 
 def _legend(fig: Figure, result: Result, summary: Summary) -> None:
     machine = result.scene.machine
-    names = state_names(result.scene.table)
     colours = state_colours(machine.states)
     handles = [Patch(color=colours[machine.states.index(state)],
-                     label=f"{state_label(state, names)}  ({secs:.1f} s)")
+                     label=f"{result.scene.table.state_title(state)}  ({secs:.1f} s)")
                for state, secs in summary.state_seconds.items()]
     states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
                                bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
@@ -236,7 +233,6 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
 
 def _state_panel(ax, result: Result) -> None:
     machine = result.scene.machine
-    names = state_names(result.scene.table)
     colours = state_colours(machine.states)
     visited = sorted(set(result.states.tolist()))
     rows = {s: k for k, s in enumerate(visited)}
@@ -250,7 +246,7 @@ def _state_panel(ax, result: Result) -> None:
     for s, runs in spans.items():  # one call per state, not per visit: an hour has thousands
         ax.broken_barh(runs, (rows[s] - 0.4, 0.8), facecolors=colours[s])
     ax.set_yticks(range(len(visited)))
-    ax.set_yticklabels([state_label(machine.states[s], names) for s in visited], fontsize=8)
+    ax.set_yticklabels([result.scene.table.state_title(machine.states[s]) for s in visited], fontsize=8)
     ax.set_ylim(-0.7, len(visited) - 0.3)
     ax.invert_yaxis()
     ax.set_ylabel("state")

@@ -32,7 +32,7 @@ class Summary:
     lamps: bool = True  # whether the world has lamps (else the light lines say nothing)
 
     def lines(self, names: dict[StateId, str] | None = None) -> list[str]:
-        """Human-readable summary lines."""
+        """Human-readable summary lines (``names``: the robot's [states], see Table.state_name)."""
         names = names or {}
         def when(value: float | None) -> str:
             return "never" if value is None else f"{value:.2f} s"

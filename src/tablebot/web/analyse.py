@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.analysis.check import CheckReport, run_check
-from tablebot.analysis.names import state_label
 from tablebot.analysis.properties import find_property_files, load_properties
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
@@ -94,7 +93,7 @@ def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
 def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
     robot = table.robot
     return {
-        "states": [{"id": str(s), "label": state_label(table, s)} for s in machine.states],
+        "states": [{"id": str(s), "label": table.state_name(s)} for s in machine.states],
         "rows": len(table.rows), "events": list(table.events), "inputs": list(table.input_events),
         "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
         "motors": list(robot.motors), "tick_ms": robot.tick_ms, "initial_state": str(robot.initial_state),
