@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 import websockets
 
-from core_helpers import EXAMPLE
+from core_helpers import EXAMPLE, ROOT
 from tablebot.web.app import Background
 
 
@@ -129,3 +129,16 @@ def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, P
     assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
     replies = talk(server.url, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
     assert replies[0]["message"] == "fix the table's errors first"
+
+
+def test_the_arena_gets_the_tape_and_light_cones_only_for_a_robot_that_has_them() -> None:
+    """A line follower's world carries its tape; its robot has no phototransistors, so no light cones."""
+    from tablebot.cli.common import load
+    from tablebot.sim.scene import scene_for
+    from tablebot.web.worldview import world_json
+
+    for name, tape, light in (("line-follower", True, False), ("bumberbot", False, True)):
+        table, machine = load(ROOT / "examples" / name)
+        scene = scene_for(table, machine)
+        data = world_json(scene.world, scene.params)
+        assert bool(data["tape"]) == tape and ("light" in data) == light, name

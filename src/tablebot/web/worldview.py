@@ -17,6 +17,8 @@ def world_json(world: World, params: Params | None = None) -> dict[str, Any]:
         "boxes": [[list(c) for c in box.corners()] for box in world.boxes],
         "circles": [[*c.at, c.radius] for c in world.circles],
         "segments": [[*s.start, *s.end] for s in world.segments],
+        "tape": [{"points": [list(p) for p in line.points], "width": line.width, "closed": line.closed}
+                 for line in world.lines],
         "lamps": [{"at": list(lamp.at), "intensity": lamp.intensity, "radius": lamp.radius} for lamp in world.lamps],
         "start": list(world.start),
         "reach": world.reach,
@@ -25,8 +27,9 @@ def world_json(world: World, params: Params | None = None) -> dict[str, Any]:
         body, light = params["body"], params["light"]
         data["body"] = {"front": body["front"], "rear": body["rear"], "half_width": body["half_width"],
                         "overlap": body["bumper_overlap"]}
-        data["light"] = {"forward": light["forward"], "sideways": light["sideways"], "toe_out": light["toe_out"],
-                         "half_response": light["half_response"]}
+        if params.wiring.get("light_right") or params.wiring.get("light_left"):  # only a robot that has them
+            data["light"] = {"forward": light["forward"], "sideways": light["sideways"], "toe_out": light["toe_out"],
+                             "half_response": light["half_response"]}
         data["charge"] = params["battery"]["charge"]
     return data
 

@@ -110,6 +110,13 @@ TB.Arena = class {
     const w = this.world, s = this.scale, r = this.ratio;
     this._poly(g, w.walls); g.fillStyle = "#f6f3ec"; g.fill();
     g.lineWidth = 4 * r; g.strokeStyle = "#2f3640"; g.stroke();
+    g.lineJoin = "round"; g.strokeStyle = "#26282b";  // tape on the floor, at its true width
+    for (const tape of (w.tape || [])) {
+      g.lineWidth = Math.max(1, tape.width * s); g.beginPath();
+      tape.points.forEach((p, i) => { const [x, y] = this.toScreen(p[0], p[1]); i ? g.lineTo(x, y) : g.moveTo(x, y); });
+      if (tape.closed) g.closePath();
+      g.stroke();
+    }
     g.fillStyle = "#a4b0be"; g.strokeStyle = "#57606f"; g.lineWidth = 1.5 * r;
     for (const box of w.boxes) { this._poly(g, box); g.fill(); g.stroke(); }
     for (const [x, y, rad] of w.circles) {
@@ -155,9 +162,9 @@ TB.Arena = class {
     const at = (px, py) => this.toScreen(x + c * px - s * py, y + s * px + c * py);
     const shape = (pts) => { g.beginPath(); pts.forEach((p, i) => { const q = at(p[0], p[1]); i ? g.lineTo(q[0], q[1]) : g.moveTo(q[0], q[1]); }); g.closePath(); };
     const f = b.front, rr = -b.rear, w = b.half_width, ov = b.overlap, t = 0.014;
-    // light cones: brighter when the sensor sees the lamp
-    const fov = L.half_response * Math.PI / 180, toe = L.toe_out * Math.PI / 180;
-    [[-1, 0], [1, 1]].forEach(([side, k]) => {
+    // light cones (a robot with phototransistors): brighter when the sensor sees the lamp
+    const fov = L ? L.half_response * Math.PI / 180 : 0, toe = L ? L.toe_out * Math.PI / 180 : 0;
+    (L ? [[-1, 0], [1, 1]] : []).forEach(([side, k]) => {
       const [cx, cy] = at(L.forward, side * L.sideways);
       const aim = -(th + side * toe), len = 0.25 * this.scale;
       g.fillStyle = this.light[k] >= 1 ? "rgba(255, 200, 0, 0.55)" : "rgba(255, 211, 42, 0.18)";

@@ -99,3 +99,24 @@ TB.Player = class {
     requestAnimationFrame(this._frame);
   }
 };
+
+// The trace player's buttons (play/pause, scrub, speed) and the page's A−/A+ zoom, wired the same way on
+// the studio and on a replay page.
+TB.wirePlayerControls = function ($, player) {
+  $("tplay").addEventListener("click", () => {
+    if (player.playing) { player.pause(); $("tplay").textContent = "▶ Play"; } else { player.play(); $("tplay").textContent = "❚❚ Pause"; }
+  });
+  $("scrub").addEventListener("input", (e) => player.seek(+e.target.value));
+  document.querySelectorAll("[data-tspeed]").forEach(b => b.addEventListener("click", () => {
+    player.speed = +b.dataset.tspeed;
+    if (player.playing) player.play(player.speed);
+    document.querySelectorAll("[data-tspeed]").forEach(o => o.classList.toggle("on", o === b));
+  }));
+};
+
+TB.wireZoom = function ($, arena) {
+  let zoom = 1;
+  const setZoom = (z) => { zoom = Math.max(0.8, Math.min(1.6, z)); document.documentElement.style.setProperty("--zoom", zoom); arena.resize(); };
+  $("smaller").addEventListener("click", () => setZoom(zoom - 0.1));
+  $("bigger").addEventListener("click", () => setZoom(zoom + 0.1));
+};

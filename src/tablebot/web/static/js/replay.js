@@ -33,19 +33,8 @@
   const player = new TB.Player({ arena, grid, diagram, timeline, status: $("status"), slider: $("scrub"),
     stateCol: () => stateCol, onEnd: () => { $("tplay").textContent = "▶ Play"; }, onSeek: (t) => renderInputs(t.event) });
   player.load(data.trace, machine, 0);
-  $("tplay").addEventListener("click", () => {
-    if (player.playing) { player.pause(); $("tplay").textContent = "▶ Play"; } else { player.play(); $("tplay").textContent = "❚❚ Pause"; }
-  });
-  $("scrub").addEventListener("input", (e) => player.seek(+e.target.value));
-  document.querySelectorAll("[data-tspeed]").forEach(b => b.addEventListener("click", () => {
-    player.speed = +b.dataset.tspeed;
-    if (player.playing) player.play(player.speed);
-    document.querySelectorAll("[data-tspeed]").forEach(o => o.classList.toggle("on", o === b));
-  }));
-  let zoom = 1;
-  const setZoom = (z) => { zoom = Math.max(0.8, Math.min(1.6, z)); document.documentElement.style.setProperty("--zoom", zoom); arena.resize(); };
-  $("smaller").addEventListener("click", () => setZoom(zoom - 0.1));
-  $("bigger").addEventListener("click", () => setZoom(zoom + 0.1));
+  TB.wirePlayerControls($, player);
+  TB.wireZoom($, arena);
   (function paint() { arena.draw(); requestAnimationFrame(paint); })();
   TB.replay = player;
 })();

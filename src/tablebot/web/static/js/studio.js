@@ -250,19 +250,8 @@
     const m = await reply.json();
     (on[m.type] || on.error)(m);
   });
-  $("tplay").addEventListener("click", () => {
-    if (player.playing) { player.pause(); $("tplay").textContent = "▶ Play"; } else { player.play(); $("tplay").textContent = "❚❚ Pause"; }
-  });
-  $("scrub").addEventListener("input", (e) => player.seek(+e.target.value));
-  document.querySelectorAll("[data-tspeed]").forEach(b => b.addEventListener("click", () => {
-    player.speed = +b.dataset.tspeed;
-    if (player.playing) player.play(player.speed);
-    document.querySelectorAll("[data-tspeed]").forEach(o => o.classList.toggle("on", o === b));
-  }));
-  let zoom = 1;
-  const setZoom = (z) => { zoom = Math.max(0.8, Math.min(1.6, z)); document.documentElement.style.setProperty("--zoom", zoom); arena.resize(); };
-  $("smaller").addEventListener("click", () => setZoom(zoom - 0.1));
-  $("bigger").addEventListener("click", () => setZoom(zoom + 0.1));
+  TB.wirePlayerControls($, player);
+  TB.wireZoom($, arena);
   document.addEventListener("keydown", (e) => {
     if ((e.ctrlKey || e.metaKey) && e.key === "s") { e.preventDefault(); send({ op: "save" }); }
   });
