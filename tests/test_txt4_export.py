@@ -254,3 +254,24 @@ def test_the_on_board_loop_stops_when_it_falls_behind_or_is_interrupted() -> Non
     robot = Interrupted()
     assert txt4_runtime.run(table, robot, None, sleep=lambda s: None, log=said.append) == "stopped"
     assert robot.stops == 1 and "stopped after 4 ticks" in said[-1]
+
+
+def test_the_on_board_program_keeps_the_declared_hysteresis(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An ultrasonic input below 25 cm with 5 cm hysteresis: on at 24, still on at 29, off at 30."""
+    from tablebot.hw import txt4_runtime
+
+    script = tmp_path / "script.json"
+    rows = [[cm, 0, 0, 0, 0, 0, 0, 0] for cm in (40, 24, 29, 30, 24)]
+    script.write_text(json.dumps({"inputs": rows, "counts": [[0, 0, 0, 0]] * len(rows)}))
+    monkeypatch.setenv("TABLEBOT_STUB_SCRIPT", str(script))
+    monkeypatch.setenv("TABLEBOT_STUB_LOG", str(tmp_path / "calls.jsonl"))
+    monkeypatch.syspath_prepend(str(STUB))
+    for name in [m for m in sys.modules if m.startswith("fischertechnik")]:
+        monkeypatch.delitem(sys.modules, name)
+    factories = importlib.import_module("fischertechnik.factories")
+    motor = importlib.import_module("fischertechnik.controller.Motor").Motor
+    table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "ultrasonic", "bit": 1, "invert": False,
+                         "below": 25, "above": None, "hysteresis": 5}],
+             "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
+    robot = txt4_runtime.Txt4Robot(table, factories, motor)
+    assert [robot.read()[0] for _ in rows] == [0, 1, 1, 0, 1]

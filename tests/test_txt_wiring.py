@@ -135,3 +135,40 @@ def test_tablebot_run_refuses_before_connecting(tmp_path: Path) -> None:
         result = CliRunner().invoke(app, ["run", str(tmp_path), "--on", f"txt://127.0.0.1:{fake.port}"])
         assert fake.connections == 0  # nothing moved: the controller was never even contacted
     assert result.exit_code == 2 and "motor M2: the TXT has no motor terminal 'M5'" in result.output
+
+
+def test_declared_distance_sensors_give_the_txt_their_threshold_and_hysteresis() -> None:
+    """[sensors] I1 = distance below 25 cm, hysteresis 5 cm; [txt] I1 in ultrasonic mode: the TXT's
+    centimetres are read against that one declaration, so the table reads what the simulator reads."""
+    from core_helpers import ROOT
+
+    wiring = txt_wiring(compile_table(load_table(ROOT / "examples" / "obstacle-avoider" / "table.csv")))
+    right, left = wiring.inputs
+    assert (left.below, left.hysteresis) == (25, 5)
+    assert (right.mode, right.below, right.hysteresis) == ("ultrasonic", 25, 5)
+    bit = wiring.bits[0]
+    seen, mask = [], 0
+    for cm in (40, 30, 25, 24, 26, 29, 30, 24):  # on below 25; once on, off only from 30
+        mask = wiring.mask([cm, 400, 0, 0, 0, 0, 0, 0], mask)
+        seen.append(int(bool(mask & bit)))
+    assert seen == [0, 0, 0, 1, 1, 1, 0, 1]
+    assert wiring.config().inputs[0] == wire.InputConfig(wire.InputMode.ULTRASONIC, False)
+
+
+@pytest.mark.parametrize("entry, message", [
+    ('I1 = { terminal = "I1", mode = "ultrasonic", below = 20 }', "its threshold is declared in [sensors]"),
+    ('I1 = { terminal = "I1", mode = "voltage" }', "cannot be read in voltage mode"),
+])
+def test_a_txt_entry_that_contradicts_the_sensor_declaration_is_refused(tmp_path: Path, entry: str,
+                                                                       message: str) -> None:
+    from core_helpers import ROOT
+
+    folder = ROOT / "examples" / "obstacle-avoider"
+    text = (folder / "robot.toml").read_text(encoding="utf-8")
+    text = text.replace('I1 = { terminal = "I1", mode = "ultrasonic" }', entry)
+    (tmp_path / "table.csv").write_text((folder / "table.csv").read_text(encoding="utf-8"), encoding="utf-8")
+    (tmp_path / "robot.toml").write_text(text, encoding="utf-8")
+    with pytest.raises(TableBotError) as info:
+        load_table(tmp_path / "table.csv")
+    found = [d.render() for d in info.value.diagnostics]
+    assert any(message in e and f"robot.toml:{line_of(text, entry)}:" in e for e in found), found

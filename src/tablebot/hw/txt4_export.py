@@ -80,8 +80,8 @@ def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
         "input_mask": machine.input_mask, "timer_bit": machine.timer_bit, "counter_bits": list(machine.counter_bits),
         "n_outputs": len(machine.output_names), "rows": per_state,
         "inputs": [{"name": w.name, "terminal": w.terminal + 1, "mode": w.mode, "invert": w.invert,
-                    "below": w.below, "above": w.above, "bit": bit} for w, bit in zip(wiring.inputs, wiring.bits,
-                                                                                       strict=True)],
+                    "below": w.below, "above": w.above, "hysteresis": w.hysteresis, "bit": bit}
+                   for w, bit in zip(wiring.inputs, wiring.bits, strict=True)],
         "motors": [{"name": out.name, "output": i, "terminal": out.terminal + 1, "reverse": out.reverse,
                     "encoder": out.name in counted} for i, out in motors],
         "lamps": [{"name": out.name, "output": i, "terminal": out.terminal + 1}

@@ -108,19 +108,22 @@ class Txt4Robot:
         time.sleep(0.1)  # as ROBO Pro Coding programs do after initialized()
         self.counts = [device.get_count() for device in self.counters]
         self.sent: list = [None] * table["n_outputs"]
+        self.last_mask = 0
 
     def read(self) -> tuple:
         mask = 0
         for read, inp in self.inputs:
             value = read()
+            slack = inp.get("hysteresis", 0) if self.last_mask & inp["bit"] else 0  # once on, stays on longer
             if inp["below"] is not None:
-                on = value < inp["below"]
+                on = value < inp["below"] + slack
             elif inp["above"] is not None:
-                on = value > inp["above"]
+                on = value > inp["above"] - slack
             else:
                 on = bool(value) != inp["invert"]
             if on:
                 mask |= inp["bit"]
+        self.last_mask = mask
         pulses = []
         for i in range(len(self.counters)):
             count = self.counters[i].get_count()

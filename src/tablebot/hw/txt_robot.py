@@ -107,7 +107,8 @@ class TxtRobot:
         return max(0.2, 2 * self.link.reply_timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
-        return Reading(self.wiring.mask(reply.universal), self._pulses(reply.counter_values),
+        previous = self._reading.mask if self._reading is not None else 0  # hysteresis remembers last tick
+        return Reading(self.wiring.mask(reply.universal, previous), self._pulses(reply.counter_values),
                        self.wiring.raw(reply.universal) or None)
 
     def _pulses(self, values: Sequence[int]) -> tuple[int, ...]:

@@ -25,6 +25,9 @@ from tablebot.formats.tomlfile import Source
 from tablebot.hw import txt_wire as wire
 from tablebot.table import MAX_LAMP, MAX_SPEED
 
+if TYPE_CHECKING:
+    from tablebot.sensors import Sensor
+
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
     from tablebot.machine import Machine
     from tablebot.robot import Robot
@@ -59,6 +62,7 @@ class InputWire:
     invert: bool = False
     below: int | None = None
     above: int | None = None
+    hysteresis: int = 0  # analog: once on, stays on until the value is this far back past the limit
 
     @property
     def digital(self) -> bool:
@@ -68,13 +72,15 @@ class InputWire:
         mode = DIGITAL_MODES[self.mode][0] if self.digital else ANALOG_MODES[self.mode][0]
         return wire.InputConfig(mode, self.digital)
 
-    def reads(self, raw: int) -> int:
-        """What the table sees (0/1) for the controller's raw value."""
+    def reads(self, raw: int, was_on: bool = False) -> int:
+        """What the table sees (0/1) for the controller's raw value (``was_on``: what it saw last tick,
+        for the hysteresis)."""
         if self.digital:
             return int(bool(raw)) ^ int(self.invert)
+        slack = self.hysteresis if was_on else 0
         if self.below is not None:
-            return int(raw < self.below)
-        return int(self.above is not None and raw > self.above)
+            return int(raw < self.below + slack)
+        return int(self.above is not None and raw > self.above - slack)
 
 
 @dataclass(frozen=True)
@@ -118,11 +124,11 @@ class TxtWiring:
             pwm[forward if speed > 0 else backward] = min(MAX_SPEED, abs(speed)) * PWM_STEP
         return pwm
 
-    def mask(self, universal: Sequence[int]) -> int:
-        """The engine's input bits for one reply's I1..I8."""
+    def mask(self, universal: Sequence[int], previous: int = 0) -> int:
+        """The engine's input bits for one reply's I1..I8 (``previous``: last tick's bits, for hysteresis)."""
         mask = 0
         for inp, bit in zip(self.inputs, self.bits, strict=True):
-            if inp.reads(universal[inp.terminal]):
+            if inp.reads(universal[inp.terminal], bool(previous & bit)):
                 mask |= bit
         return mask
 
@@ -306,9 +312,12 @@ class _Reader:
             return None
         return (reads == 0,)
 
-    def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None] | None:
+    def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None, int] | None:
         unit, most = ANALOG_MODES[mode][1], ANALOG_MODES[mode][2]
         limits = {k: value[k] for k in ("below", "above") if k in value}
+        declared = next((s for s in self.robot.sensors if s.name == name), None)
+        if declared is not None and declared.kind != "line":
+            return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
             self.error(name, f"[txt] {name}: a {mode} input needs exactly one of below = N or above = N ({unit})",
                        f"the table reads 1 while the value is below (or above) N, for example: below = {most // 50}")
@@ -318,7 +327,29 @@ class _Reader:
             self.error(name, f"[txt] {name}: {key} must be a whole number 0..{most} ({unit}), not {limit!r}",
                        f"for example: {key} = {most // 50}")
             return None
-        return (False, limit if key == "below" else None, limit if key == "above" else None)
+        return (False, limit if key == "below" else None, limit if key == "above" else None, 0)
+
+    def _declared(self, name: str, mode: str, sensor: Sensor, limits: dict[str, Any]
+                  ) -> tuple[bool, int | None, int | None, int] | None:
+        """Threshold and hysteresis from the input's ``[sensors]`` declaration, the one the simulator
+        uses, so the table reads the same on the robot: a distance sensor in ultrasonic mode, in cm."""
+        if limits:
+            self.error(name, f"[txt] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
+                       f"remove {', '.join(limits)} here: the simulator and the TXT read the one declaration")
+            return None
+        if sensor.kind != "distance" or mode != "ultrasonic":
+            self.error(name, f"[txt] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
+                       f"{mode} mode with its declared threshold",
+                       'wire a distance sensor as mode = "ultrasonic"; a light sensor as mode = "phototransistor" '
+                       "(threshold 1) or give its calibrated threshold in [txt] and drop it from [sensors]")
+            return None
+        limit, slack = round(sensor.threshold * 100, 6), round(sensor.hysteresis * 100, 6)
+        if limit != int(limit) or slack != int(slack):
+            self.error(name, f"[txt] {name}: the TXT measures whole centimetres; [sensors] says "
+                       f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")
+            return None
+        below = sensor.direction == "below"
+        return (False, int(limit) if below else None, None if below else int(limit), int(slack))
 
     def output(self, name: str) -> OutputWire | None:
         kind = "motor" if name in self.robot.motors else "lamp"
