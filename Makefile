@@ -12,4 +12,4 @@ test: setup
 	.venv/bin/ruff check .
 
 bench: setup
-	for b in engine sim check mcu turn_drift studio fleet; do .venv/bin/python benchmarks/$$b.py || exit 1; done
+	status=0; for b in engine sim check mcu turn_drift studio fleet; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
