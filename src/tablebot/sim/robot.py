@@ -15,7 +15,7 @@ from tablebot.loop import Reading, TickBlock
 from tablebot.sim import kernel as K
 from tablebot.sim import layout as L
 from tablebot.sim.params import terminal_volts
-from tablebot.sim.scene import Scene, sensor_columns, sensor_fields, sensor_trace_columns
+from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
 from tablebot.trace import exact_round
 
@@ -38,6 +38,7 @@ class SimRobot:
         self._drive = np.array(scene.drive, dtype=np.int64)
         self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
         self.light_keys = light_keys(scene)
+        self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
         self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
         self.reset(seed=seed)
 
@@ -127,12 +128,16 @@ class SimRobot:
 
     # --- what the trace adds to each tick -----------------------------------------------------------
 
-    def trace_fields(self, s: np.ndarray) -> dict[str, float]:
-        """Pose at the start of the tick, the light each phototransistor received (1.0 = threshold), volts."""
-        heading = (math.degrees(s[L.TH]) + 180.0) % 360.0 - 180.0
-        return {"x": round(float(s[L.X]), 5), "y": round(float(s[L.Y]), 5), "heading": round(heading, 3),
-                **{key: round(float(s[column]), 4) for key, column in wired_lights(self.scene)},
-                "battery_v": round(float(s[L.VBAT]), 4), **sensor_fields(self.scene, s)}
+    def trace_fields(self, s: np.ndarray) -> dict[str, float | int]:
+        """Pose at the start of the tick, the light each phototransistor received (1.0 = threshold), volts,
+        and each declared sensor's reading: :func:`trace_layout`, for one robot row."""
+        fields: dict[str, float | int] = {}
+        for key, column, scale, decimals in self._layout:
+            value = float(s[column])
+            if column == L.TH:
+                value = (math.degrees(value) + 180.0) % 360.0 - 180.0
+            fields[key] = int(value) if decimals == 0 else round(value * scale, decimals)
+        return fields
 
     # --- what the run amounts to (see sim.summary) ------------------------------------------------------
 
@@ -165,13 +170,24 @@ def wired_lights(scene: Scene) -> list[tuple[str, int]]:
                                                                      ("light_left", L.LIGHT_L)) if wiring[role]]
 
 
-def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list[float]]:
+def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
+    """What the simulator adds to each trace line, and from where: (key, state column, scale, decimals;
+    0 decimals = a whole number). The heading is the column's radians as degrees in -180..180."""
+    return (("x", L.X, 1.0, 5), ("y", L.Y, 1.0, 5), ("heading", L.TH, 1.0, 3),
+            *((key, column, 1.0, 4) for key, column in wired_lights(scene)), ("battery_v", L.VBAT, 1.0, 4),
+            *sensor_columns(scene))
+
+
+def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
-    heading = (np.degrees(hist[:, L.TH]) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
-    return {"x": exact_round(hist[:, L.X], 5), "y": exact_round(hist[:, L.Y], 5), "heading": exact_round(heading, 3),
-            **{key: exact_round(hist[:, column], 4) for key, column in wired_lights(scene)},
-            "battery_v": exact_round(hist[:, L.VBAT], 4), **sensor_trace_columns(scene, hist)}
+    columns: dict[str, list] = {}
+    for key, column, scale, decimals in trace_layout(scene):
+        values = hist[:, column].astype(np.float64)
+        if column == L.TH:
+            values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
+        columns[key] = values.astype(np.int64).tolist() if decimals == 0 else exact_round(values * scale, decimals)
+    return columns
 
 
 class LazyColumns(Mapping[str, Sequence[float]]):
@@ -179,8 +195,7 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __init__(self, scene: Scene, hist: np.ndarray):
         self.scene, self.hist = scene, hist
-        self.keys_ = ("x", "y", "heading", *(key for key, _ in wired_lights(scene)), "battery_v",
-                      *(c[0] for c in sensor_columns(scene)))
+        self.keys_ = tuple(key for key, *_ in trace_layout(scene))
         self._columns: dict[str, list[float]] | None = None
 
     def __getitem__(self, key: str) -> Sequence[float]:

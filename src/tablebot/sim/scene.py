@@ -67,21 +67,6 @@ def sensor_columns(scene: Scene) -> list[tuple[str, int, float, int]]:
     return columns
 
 
-def sensor_fields(scene: Scene, s: np.ndarray) -> dict[str, float | int]:
-    """The declared sensors' trace fields of one robot row (see :func:`sensor_columns`)."""
-    return {key: (int(s[column]) if decimals == 0 else round(float(s[column]) * scale, decimals))
-            for key, column, scale, decimals in sensor_columns(scene)}
-
-
-def sensor_trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
-    """:func:`sensor_fields` for every row of ``hist``, with the same rounding (the trace's bytes agree)."""
-    from tablebot.trace import exact_round
-
-    return {key: (hist[:, column].astype(np.int64).tolist() if decimals == 0
-                  else exact_round(hist[:, column].astype(np.float64) * scale, decimals))
-            for key, column, scale, decimals in sensor_columns(scene)}
-
-
 def robot_layer(robot: Robot) -> tuple[dict[str, Any], Path | None]:
     """The robot file's ``[sim]`` parameter sections (checked when the robot file was read) and its
     default world (``sim.world``)."""
