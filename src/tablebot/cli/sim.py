@@ -56,14 +56,14 @@ def sim_cmd(
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     trace = TraceFile(out / "trace.jsonl", background=True)
-    rows = plots or gif or view or html  # every robot row is kept only for what draws the run
+    rows = plots or gif or view  # every robot row is kept only for what draws the run
     result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32, rows)
     if not result.end.complete:
         _stopped(result, trace.written)
     summary = summarise(result)
     written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
     if html:
-        written.append(_replay_page(result, out / "run.html"))
+        written.append(_replay_page(result, trace.written, out / "run.html"))
     if not quiet:
         _report(result, summary, written)
     if view:
@@ -92,14 +92,13 @@ def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: boo
     return written
 
 
-def _replay_page(result: Result, path: Path) -> Path:
-    """A self-contained HTML page that replays the run (to send to a pupil, or put on a class page)."""
-    from tablebot.sim.runner import block_of
-    from tablebot.trace import block_lines
+def _replay_page(result: Result, trace: Path, path: Path) -> Path:
+    """A self-contained HTML page that replays the run from the trace just written (to send to a pupil,
+    or put on a class page)."""
     from tablebot.web.replay import write_html
 
     scene = result.scene
-    lines = block_lines(block_of(result), scene.machine)
+    lines = trace.read_text(encoding="utf-8").splitlines()
     return write_html(path, lines, scene.world, scene.table, params=scene.params)
 
 
