@@ -202,7 +202,7 @@ class Watchdog:
 
     @contextmanager
     def installed(self, on_fire: Callable[[], None]) -> Iterator[None]:
-        self._on_fire = on_fire
+        self._on_fire, self.fired = on_fire, False  # a watchdog may guard one run after another
         self._use_signal = (self.deadline_s is not None and hasattr(signal, "setitimer")
                             and threading.current_thread() is threading.main_thread())
         previous = signal.signal(signal.SIGALRM, self._alarm) if self._use_signal else None

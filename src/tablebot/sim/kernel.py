@@ -75,7 +75,7 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
     integer record into ``ints`` (when it has rows), and folds every new robot row into
     ``acc``/``collisions`` (see :func:`observe`).
     """
-    n_out, n_counters = outputs.shape[0], counters.shape[0]
+    n_counters = counters.shape[0]
     pulses = np.zeros(n_counters, dtype=np.int64)
     corners = np.empty((4, 2))
     for t in range(noise.shape[0]):
@@ -90,7 +90,6 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
         advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines,
                 noise[t], bits, True, corners)
         observe(s, lamps, acc, collisions)
-    return n_out
 
 
 @njit(nogil=True)
