@@ -16,8 +16,9 @@ os.environ.setdefault("TYPER_USE_RICH", "0")
 from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, fleet, tune  # noqa: F401, I001
 from tablebot.cli.app import app
 
-#: Exit code of an internal error (a tablebot bug), apart from 1 (warnings) and 2 (bad input).
-INTERNAL_ERROR = 3
+#: Exit code of an internal error (a tablebot bug): sysexits' EX_SOFTWARE, apart from 1 (warnings), 2 (bad
+#: input) and the run's own codes (tablebot.loop.EXIT_CODES: 3 is a lost link).
+INTERNAL_ERROR = 70
 DEBUG_ENV = "TABLEBOT_DEBUG"
 
 
