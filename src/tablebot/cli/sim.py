@@ -13,7 +13,9 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
     from tablebot.sim.runner import Result
+    from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
+    from tablebot.trace import TraceFile
 
 
 @app.command("sim")
@@ -40,10 +42,8 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
-    import numpy as np
-
     from tablebot.sim import scene as sim_scene
-    from tablebot.sim.runner import run, ticks_for
+    from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
     from tablebot.trace import TraceFile
 
@@ -57,7 +57,7 @@ def sim_cmd(
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     trace = TraceFile(out / "trace.jsonl", background=True)
     rows = plots or gif or view  # every robot row is kept only for what draws the run
-    result = _run_with_progress(run, scene, seconds, seed, None if quiet else ticks, trace, np.float32, rows)
+    result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
     if not result.end.complete:
         _stopped(result, trace.written)
     summary = summarise(result)
@@ -112,15 +112,20 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
         err_console.print(f"wrote {path}", markup=False)
 
 
-def _run_with_progress(run, scene, seconds: float, seed: int, ticks: int | None, trace,  # type: ignore[no-untyped-def]
-                       history: type, rows: bool):
-    """``run`` with a progress bar of ``ticks`` on a terminal (None: quiet)."""
+def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,
+              rows: bool) -> Result:
+    """The run, with a progress bar of ``ticks`` on a terminal (None: quiet); history in float32 (half
+    the memory, plenty for pictures: the trace is written from the exact values)."""
+    import numpy as np
+
+    from tablebot.sim.runner import run
+
     if ticks is None or not sys.stderr.isatty():
-        return run(scene, seconds, seed, sinks=[trace], history=history, rows=rows)
+        return run(scene, seconds, seed, sinks=[trace], history=np.float32, rows=rows)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
         return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
-                   history=history, rows=rows)
+                   history=np.float32, rows=rows)
