@@ -67,6 +67,11 @@ def test_a_run_writes_a_live_trace_that_tablebot_trace_replays_to_the_same_decis
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["ended"] == "done" and summary["ticks"] == 80 and summary["trace"] == "trace.jsonl"
     assert summary["target"] == f"txt://127.0.0.1:{fake.port}"
+    visited = list(dict.fromkeys(str(line["state"]) for line in lines))  # in order of first visit
+    assert list(summary["seconds_per_state"]) == visited
+    assert summary["seconds_per_state"] == {s: round(0.01 * sum(str(x["state"]) == s for x in lines), 3)
+                                            for s in visited}
+    assert summary["rows_fired"] == sum(line["row"] is not None for line in lines)
     assert not (tmp_path / "trace.partial.jsonl").exists()
 
 

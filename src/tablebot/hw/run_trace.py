@@ -13,9 +13,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from tablebot.files import partial_name, write_text
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW
+from tablebot.sim.summary import seconds_per_state
 from tablebot.trace import TraceFile
 
 WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
@@ -32,13 +35,17 @@ class RunTrace(TraceFile):
         super().__init__(folder / "trace.jsonl")
         self.folder, self.clock = folder, clock
         self.info: RunInfo | None = None
-        self.visits: dict[int, int] = {}  # state index -> ticks
+        self.counts: list[int] = []  # per state index: ticks after which the robot was in it
+        self.first_seen: list[int] = []  # per state index: the first such tick (-1: never)
         self.fired = 0
         self.started = 0.0
+        self.summary_written: Path | None = None
 
     def start(self, info: RunInfo) -> None:
         super().start(info)
         self.info = info
+        self.counts = [0] * len(self.machine.states)
+        self.first_seen = [-1] * len(self.machine.states)
         self.started = time.monotonic()
 
     def block(self, block: TickBlock) -> None:
@@ -49,8 +56,10 @@ class RunTrace(TraceFile):
         extra.update(block.extra)
         super().block(dataclasses.replace(block, extra=extra))
         self.file.stream.flush()  # a crash keeps every tick so far (in the temporary file)
-        for state, row in zip(block.states, block.rows, strict=True):
-            self.visits[int(state)] = self.visits.get(int(state), 0) + 1
+        for tick, (state, row) in enumerate(zip(block.states, block.rows, strict=True), start=block.start):
+            self.counts[state] += 1
+            if self.first_seen[state] < 0:
+                self.first_seen[state] = tick
             self.fired += int(row) != NO_ROW
 
     def end(self, end: RunEnd) -> None:
@@ -65,12 +74,13 @@ class RunTrace(TraceFile):
 
     @property
     def files(self) -> list[Path]:
-        return [p for p in (self.written, getattr(self, "summary_written", None)) if p is not None]
+        return [p for p in (self.written, self.summary_written) if p is not None]
 
     def summary(self, end: RunEnd) -> dict[str, Any]:
         """What the run did, as plain JSON."""
         assert self.info is not None and self.written is not None
-        tick_s, states = self.info.tick_s, self.machine.states
+        tick_s = self.info.tick_s
+        per_state = seconds_per_state(np.array(self.counts), np.array(self.first_seen), self.machine.states, tick_s)
         return {
             "target": self.info.target,
             "table": self.machine.table.path,
@@ -83,6 +93,6 @@ class RunTrace(TraceFile):
             "late_ticks": end.late_ticks,
             "worst_late_ms": round(1000 * end.worst_late_s, 3),
             "rows_fired": self.fired,
-            "seconds_per_state": {str(states[s]): round(n * tick_s, 3) for s, n in self.visits.items()},
+            "seconds_per_state": {str(state): round(seconds, 3) for state, seconds in per_state.items()},
             "trace": self.written.name,
         }
