@@ -187,3 +187,23 @@ def test_a_run_trace_that_cannot_be_replayed_is_a_located_error(tmp_path: Path) 
     counters = ROOT / "examples" / "bumberbot-counters"
     result = invoke("trace", counters, "--inputs", tmp_path / "trace.jsonl")
     assert f"{bad}:1:1: error: this trace line has no whole-number C1_pulses" in result.output
+
+
+def test_the_live_view_lets_no_control_character_of_a_label_reach_the_terminal(tmp_path: Path) -> None:
+    """A NUL, a shift-out (switches a VT100's character set) and a one-byte C1 CSI act on a terminal as an
+    ESC does; none of them reaches it, while the label's brackets stay as written."""
+    robot = (EXAMPLE / "robot.toml").read_text().replace('I3 = "front-right bumper"',
+                                                         'I3 = "front\\u0000\\u000e\\u009b31m [right]"')
+    (tmp_path / "robot.toml").write_text(robot)
+    (tmp_path / "table.csv").write_text((EXAMPLE / "table.csv").read_text())
+    machine = compile_table(load_table(tmp_path / "table.csv"))
+    engine = Engine(machine)
+    engine.step(0)
+    console = Console(record=True, width=110, force_terminal=True, color_system=None)
+    view = LiveView(console)
+    view.info = RunInfo(engine, 0.01, "txt://127.0.0.1:65000", None)
+    view.block(TickBlock.of_tick(engine, Reading(0)))
+    console.print(view)
+    text = console.export_text()
+    assert "○ I3 (front31m [right])" in text
+    assert not any((0 <= ord(c) < 32 and c != "\n") or 0x7F <= ord(c) <= 0x9F for c in text), repr(text)

@@ -4,26 +4,29 @@ latest tick by rich's own thread; the run loop never waits for the terminal."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from rich.columns import Columns
 from rich.console import Console, Group
-from rich.control import strip_control_codes
 from rich.live import Live
 from rich.panel import Panel
 from rich.table import Table
 from rich.text import Text
 
-from tablebot.loop import RunEnd, RunInfo, TickBlock
+from tablebot.loop import Lateness, RunEnd, RunInfo, TickBlock
 from tablebot.table import MAX_SPEED
 
 BAR = 8  # characters per motor direction
+#: C0 controls but tab and line feed, DEL and C1 controls: a NUL, a shift-out (\x0e switches a VT100's
+#: character set) or a C1 CSI (\x9b, a one-byte ESC [) would act on the terminal.
+_CONTROLS_RE = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 
 
 def plain(text: str) -> str:
-    """User text (labels, state names) made safe for the terminal: no escape or control characters.
+    """User text (labels, state names) made safe for the terminal: every control character removed.
     Rich ``Text`` never reads markup, so brackets stay brackets."""
-    return strip_control_codes(text).replace("\x1b", "")
+    return _CONTROLS_RE.sub("", text)
 
 
 def motor_bar(speed: int) -> Text:
@@ -48,7 +51,7 @@ class LiveView:
         self.info: RunInfo | None = None
         self.last: dict[str, Any] = {}
         self.live: Live | None = None
-        self.late = 0
+        self.lateness: Lateness | None = None  # the run loop's rule for a late tick, counted from each block
 
     def start(self, info: RunInfo) -> None:
         self.info = info
@@ -60,7 +63,9 @@ class LiveView:
         i = len(block) - 1
         late = block.extra.get("late_ms")
         if late is not None and self.info is not None:
-            self.late += sum(1 for ms in late if ms > 500 * self.info.tick_s)
+            self.lateness = self.lateness or Lateness(self.info.tick_s)
+            for ms in late:
+                self.lateness.note(ms / 1000)
         self.last = {"tick": block.start + i, "mask": int(block.masks[i]), "state": int(block.states[i]),
                      "timer": int(block.timers[i]), "outputs": tuple(block.outputs[i]),
                      "counters": tuple(block.counters[i]), "late_ms": None if late is None else late[i]}
@@ -73,14 +78,13 @@ class LiveView:
     def __rich__(self) -> Panel:
         assert self.info is not None
         machine = self.info.engine.machine
-        robot = machine.table.robot
         last = self.last
         title = Text(f"tablebot run — {plain(self.info.target)}" + (f" ({plain(self.device)})" if self.device else ""))
         if not last:
             return Panel(Text("connecting…", style="dim"), title=title, title_align="left")
         state = machine.states[last["state"]]
         head = Text(f"state {plain(str(state))}", style="bold")
-        name = robot.state_names.get(state)
+        name = machine.table.state_name(state)
         if name:
             head.append(f"  {plain(name)}", style="cyan")
         seconds = (last["tick"] + 1) * self.info.tick_s
@@ -116,5 +120,6 @@ class LiveView:
     def _lateness(self, last: dict[str, Any]) -> Text:
         if last["late_ms"] is None:
             return Text("")
-        style = "red" if self.late else "dim"
-        return Text(f"ticks late {self.late}   this tick {last['late_ms']:.1f} ms late", style=style)
+        count = self.lateness.count if self.lateness is not None else 0
+        style = "red" if count else "dim"
+        return Text(f"ticks late {count}   this tick {last['late_ms']:.1f} ms late", style=style)
