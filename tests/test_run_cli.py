@@ -207,3 +207,11 @@ def test_the_live_view_lets_no_control_character_of_a_label_reach_the_terminal(t
     text = console.export_text()
     assert "○ I3 (front31m [right])" in text
     assert not any((0 <= ord(c) < 32 and c != "\n") or 0x7F <= ord(c) <= 0x9F for c in text), repr(text)
+
+
+def test_what_the_controller_calls_itself_reaches_the_terminal_as_text() -> None:
+    """The device name comes off the network: an escape sequence in it is shown, markup is not read."""
+    with FakeTxt(device="\x1b[2J[red]TX") as fake:
+        result = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.05")
+    assert result.exit_code == 0, result.output
+    assert "(\\x1b[2J[red]TX 4.6.6); Ctrl-C stops it" in result.output and "\x1b" not in result.output

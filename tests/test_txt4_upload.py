@@ -55,3 +55,7 @@ def test_a_wrong_key_an_unreachable_controller_and_a_bad_folder_are_located_erro
     assert bad_url.exit_code == 2 and "is not txt4://HOST" in bad_url.output
     not_exported = runner.invoke(app, ["upload", str(tmp_path), "--to", "txt4://127.0.0.1", "--key", "SECRET"])
     assert not_exported.exit_code == 2 and "not a program written by `tablebot export --to txt4`" in not_exported.output
+    a_file = runner.invoke(app, ["upload", str(program / "BumberBot.py"), "--to", "txt4://127.0.0.1", "--key", "K"])
+    assert a_file.exit_code == 2 and "BumberBot.py: error: is a file, not a folder" in a_file.output
+    missing = runner.invoke(app, ["upload", str(tmp_path / "nope"), "--to", "txt4://127.0.0.1", "--key", "K"])
+    assert missing.exit_code == 2 and "nope: error: no such folder" in missing.output

@@ -6,17 +6,18 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
-from rich.markup import escape
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.diagnostics import fail
+from tablebot.escape import terminal
 
 if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when the command runs
-    from tablebot.loop import RobotIO, RunEnd
+    from tablebot.hw.run_trace import RunTrace
+    from tablebot.loop import RobotIO, RunEnd, Sink
     from tablebot.machine import Machine
 
 TARGET_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT, txt://auto, sim or sim:WORLD.toml"
@@ -74,18 +75,16 @@ def run_cmd(
     ticks = None if seconds is None else max(1, round(seconds / tick_s))
     if out is not None:
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
-    bot, device, clock = (_txt(machine, target, link_timeout or 5 * tick_s) if target.kind == "txt"
+    bot, where, device = (_txt(machine, target, link_timeout or 5 * tick_s) if target.kind == "txt"
                           else _sim(machine, target, seed))
-    end = _drive(machine, bot, device, clock, ticks, out, behind_limit or None, quiet)
+    end = _drive(machine, bot, where, device, ticks, out, behind_limit or None, quiet)
     if end.exit_code:
         raise typer.Exit(end.exit_code)
 
 
-def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[RobotIO, str, Any]:
-    """The wiring checked (nothing moves if the table does not fit), then the controller found and asked
-    who it is. The TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once, so the
-    clock paces ticks too (it only sleeps when a tick is early; see hw/pacing.py)."""
-    from tablebot.hw.pacing import PacedClock
+def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[RobotIO, str, str]:
+    """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
+    fit), then the controller found and asked who it is."""
     from tablebot.hw.txt_link import AUTO_HOSTS, find_controller
     from tablebot.hw.txt_robot import TxtRobot
     from tablebot.hw.txt_wiring import txt_wiring
@@ -101,12 +100,11 @@ def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[Robot
         status = bot.connect()
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
-    return bot, f"{status.device} {status.version_text}", PacedClock(machine.table.robot.tick_ms / 1000)
+    return bot, bot.target, f"{status.device} {status.version_text}"
 
 
-def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, Any]:
+def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, str]:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
-    from tablebot.hw.pacing import PacedClock
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.robot import SimRobot
 
@@ -114,32 +112,33 @@ def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, Any
     bot = SimRobot(scene, seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
     bot.reset(seed=seed)
-    return bot, f"simulated, seed {seed}", PacedClock(machine.table.robot.tick_ms / 1000)
+    return bot, "sim", f"simulated, seed {seed}"
 
 
-def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int | None, out: Path | None,
+def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int | None, out: Path | None,
            behind_limit_s: float | None, quiet: bool) -> RunEnd:
-    """The loop with its sinks: the live view first (so it always ends first and restores the terminal)."""
+    """The loop with its sinks: the live view first (so it always ends first and restores the terminal).
+    A TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once and the simulator
+    never waits, so the clock paces ticks too (it only sleeps when a tick is early; see hw/pacing.py)."""
     from tablebot.engine import Engine
     from tablebot.hw.live_view import LiveView
+    from tablebot.hw.pacing import PacedClock
     from tablebot.hw.run_trace import RunTrace
     from tablebot.loop import run
 
-    sinks: list[Any] = []
+    sinks: list[Sink] = []
     if not quiet and err_console.is_terminal:
         sinks.append(LiveView(err_console, device))
     trace = RunTrace(out) if out is not None else None
     if trace is not None:
         sinks.append(trace)
-    target = getattr(bot, "target", "sim")
     if not quiet:
-        err_console.print(escape(f"running {machine.table.path} on {target} ({device}); Ctrl-C stops it"),
-                          highlight=False)
+        err_console.print(terminal(f"running {machine.table.path} on {target} ({device}); Ctrl-C stops it"))
     switch = sys.getswitchinterval()
     sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
     try:
-        end = run(Engine(machine), bot, clock=clock, sinks=sinks, ticks=ticks, target=target,
-                  behind_limit_s=behind_limit_s)
+        end = run(Engine(machine), bot, clock=PacedClock(machine.table.robot.tick_ms / 1000), sinks=sinks,
+                  ticks=ticks, target=target, behind_limit_s=behind_limit_s)
     finally:
         sys.setswitchinterval(switch)
     if not quiet:
@@ -147,15 +146,16 @@ def _drive(machine: Machine, bot: RobotIO, device: str, clock: Any, ticks: int |
     return end
 
 
-def _report(end: RunEnd, machine: Machine, trace: Any) -> None:
+def _report(end: RunEnd, machine: Machine, trace: RunTrace | None) -> None:
     """How the run ended on stdout; the files written on stderr."""
     seconds = end.ticks * machine.table.robot.tick_ms / 1000
     why = f" — {end.message}" if end.message else ""
-    console.print(escape(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"), highlight=False)
+    console.print(terminal(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"))
     if end.late_ticks:
-        console.print(f"{end.late_ticks} ticks started late (worst {1000 * end.worst_late_s:.1f} ms)")
+        ticks = "tick" if end.late_ticks == 1 else "ticks"
+        console.print(f"{end.late_ticks} {ticks} started late (worst {1000 * end.worst_late_s:.1f} ms)")
     for path in trace.files if trace is not None else []:
-        err_console.print(escape(f"wrote {path}"), highlight=False)
+        err_console.print(terminal(f"wrote {path}"))
     sys.stdout.flush()
 
 
@@ -172,5 +172,6 @@ def upload_cmd(
     from tablebot.hw.txt4_upload import upload
 
     if not folder.is_dir():
-        raise fail(folder, "no such folder", "give the folder `tablebot export --to txt4` wrote")
-    upload(folder, to, key, start, say=lambda text: console.print(escape(text), highlight=False))
+        raise fail(folder, "is a file, not a folder" if folder.exists() else "no such folder",
+                   "give the folder `tablebot export --to txt4` wrote")
+    upload(folder, to, key, start, say=lambda text: console.print(terminal(text)))
