@@ -212,3 +212,22 @@ def test_a_txt_slower_than_the_tick_shows_late_ticks_but_does_not_fall_behind() 
     with FakeTxt(drift_s=0.001) as fake:  # 11 ms per exchange: the grid starts again every few ticks
         end = drive(bumberbot(), fake, ticks=60, behind_limit_s=0.05)
     assert end.reason == "done" and end.late_ticks >= 3, end  # shown, but a slow link never adds up to "behind"
+
+
+def test_the_paced_clock_sleeps_to_a_fixed_grid_and_starts_it_again_after_a_stall() -> None:
+    now, slept = [100.0], []
+
+    def sleep(seconds: float) -> None:
+        slept.append(round(seconds, 6))
+        now[0] += seconds
+
+    clock = PacedClock(0.01, now=lambda: now[0], sleep=sleep)
+    clock.start()
+    assert clock.wait(0) == 0.0 and slept == []  # due at once: no sleep, not late
+    now[0] += 0.004
+    assert clock.wait(1) == 0.0 and slept == [0.006]  # early: sleeps to the grid, no drift
+    now[0] += 0.013  # tick 2 starts 3 ms late: less than half a tick, the grid stays
+    assert round(clock.wait(2), 6) == 0.003 and clock.wait(3) == 0.0 and slept[-1] == 0.007
+    now[0] += 0.05  # a stall: tick 4 starts 40 ms late, and the grid starts again from it
+    assert round(clock.wait(4), 6) == 0.04
+    assert clock.wait(5) == 0.0 and slept[-1] == 0.01  # one tick after the late one, not 40 ms behind

@@ -16,8 +16,7 @@ from collections.abc import Callable
 
 class PacedClock:
     """A :class:`tablebot.loop.Clock`: ``wait(tick)`` sleeps until the tick is due and returns how late it
-    started (seconds); ``stretch`` is the time lost to late ticks so far (the table's timers ran that much
-    slower than the wall clock)."""
+    started (seconds)."""
 
     free_running = False
 
@@ -25,10 +24,9 @@ class PacedClock:
                  sleep: Callable[[float], None] = time.sleep):
         self.tick_s, self.now, self.sleep = tick_s, now, sleep
         self.anchor, self.anchor_tick = 0.0, 0
-        self.stretch = 0.0
 
     def start(self) -> None:
-        self.anchor, self.anchor_tick, self.stretch = self.now(), 0, 0.0
+        self.anchor, self.anchor_tick = self.now(), 0
 
     def wait(self, tick: int) -> float:
         due = self.anchor + (tick - self.anchor_tick) * self.tick_s
@@ -39,5 +37,4 @@ class PacedClock:
         late = -ahead
         if late > self.tick_s / 2:  # a stall, or a link slower than the tick: the grid starts again here
             self.anchor, self.anchor_tick = due + late, tick
-            self.stretch += late
         return late

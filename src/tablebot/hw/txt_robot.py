@@ -31,7 +31,6 @@ class TxtRobot:
         self.link = TxtLink(host, port, reply_timeout_s=link_timeout_s)
         self.client_name = client_name
         self.status: wire.Status | None = None
-        self.exchanges = 0  # ExchangeData requests answered
         self._reading: Reading | None = None
         self._counts: list[int] = []
         self._stopped = False
@@ -60,7 +59,6 @@ class TxtRobot:
         self.link.update_config(self.wiring.config())
         with self._lock:
             first = self.link.exchange(ZERO)
-        self.exchanges += 1
         self._counts = [first.counter_values[t] for t in self.wiring.counters]
         self._reading = self._reading_of(first)
 
@@ -73,7 +71,6 @@ class TxtRobot:
         pwm = ZERO if self._stopped else self.wiring.pwm(outputs)
         with self._lock:
             reply = self.link.exchange(pwm)
-        self.exchanges += 1
         self._reading = self._reading_of(reply)
 
     def stop(self) -> None:
