@@ -25,12 +25,10 @@ from tablebot.formats.tomlfile import Source
 from tablebot.hw import txt_wire as wire
 from tablebot.table import MAX_LAMP, MAX_SPEED
 
-if TYPE_CHECKING:
-    from tablebot.sensors import Sensor
-
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
     from tablebot.machine import Machine
     from tablebot.robot import Robot
+    from tablebot.sensors import Sensor
 
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
 PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 = PWM 512
@@ -218,7 +216,7 @@ def raise_missing(robot: Robot, machine: Machine) -> None:
 def suggest(robot: Robot, machine: Machine) -> str:
     """A ``[txt]`` section for ``robot`` (names that are TXT terminals keep them; inputs as push-buttons)."""
     lines = ["[txt]"]
-    free = {kind: [f"{prefix}{i + 1}" for i in range(COUNT[kind])] for kind, prefix in KINDS.items()}
+    free = {kind: _names(kind) for kind in KINDS}
     for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
                         ("counter", robot.counter_names)):
         for name in names:
@@ -252,8 +250,7 @@ class _Reader:
 
     def terminal(self, name: str, kind: str, value: Any) -> int | None:
         """``"I3"`` -> 2 for kind input (M for motors, O for lamps, C for counters), or None after an error."""
-        prefix, count = KINDS[kind], COUNT[kind]
-        names = [f"{prefix}{i + 1}" for i in range(count)]
+        names = _names(kind)
         if value is None:
             self.error(name, f"[txt] {name}: which terminal is it wired to?",
                        f'say it with terminal = "{names[0]}" (one of {names[0]}..{names[-1]})')
@@ -270,14 +267,14 @@ class _Reader:
             return None
         index = names.index(value)
         space = "output" if kind in ("motor", "lamp") else kind
-        for used in ([(space, 2 * index), (space, 2 * index + 1)] if kind == "motor" else [(space, index)]):
+        needs = [(space, 2 * index), (space, 2 * index + 1)] if kind == "motor" else [(space, index)]
+        for used in needs:
             if used in self.taken:
                 self.error(name, f"{kind} {name}: terminal {value} is already used by {self.taken[used]}"
                            + (" (a motor drives both outputs of its pair)" if space == "output" else ""),
                            f"give {name} a terminal of its own in [txt]")
                 return None
-        for used in ([(space, 2 * index), (space, 2 * index + 1)] if kind == "motor" else [(space, index)]):
-            self.taken[used] = name
+        self.taken.update(dict.fromkeys(needs, name))
         return index
 
     def input(self, name: str) -> InputWire | None:
