@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import pytest
 from hypothesis import given, settings
@@ -193,11 +194,12 @@ def test_python_string_is_a_literal_that_reads_back_exactly(text: str) -> None:
     assert ast.literal_eval(literal) == text
 
 
-def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def stub_robot(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, table: dict, inputs: list[list[int]]) -> Any:
+    """The runtime's robot for ``table`` in this process, on a fresh import of the stub serving ``inputs``."""
     from tablebot.hw import txt4_runtime
 
     script = tmp_path / "script.json"
-    script.write_text(json.dumps({"inputs": [[1, 1, 19, 6000, 900, 0, 0, 0]], "counts": [[0, 0, 0, 0]]}))
+    script.write_text(json.dumps({"inputs": inputs, "counts": [[0, 0, 0, 0]] * len(inputs)}))
     monkeypatch.setenv("TABLEBOT_STUB_SCRIPT", str(script))
     monkeypatch.setenv("TABLEBOT_STUB_LOG", str(tmp_path / "calls.jsonl"))
     monkeypatch.syspath_prepend(str(STUB))
@@ -205,7 +207,10 @@ def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch
         monkeypatch.delitem(sys.modules, name)
     factories = importlib.import_module("fischertechnik.factories")
     motor = importlib.import_module("fischertechnik.controller.Motor").Motor
+    return txt4_runtime.Txt4Robot(table, factories, motor)
 
+
+def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     def wire(terminal: int, mode: str, bit: int, **how: object) -> dict:
         return {"name": f"X{terminal}", "terminal": terminal, "mode": mode, "bit": bit,
                 "invert": how.get("invert", False), "below": how.get("below"), "above": how.get("above")}
@@ -214,7 +219,7 @@ def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch
                         wire(3, "ultrasonic", 4, below=20), wire(4, "voltage", 8, above=5000),
                         wire(5, "resistance", 16, below=1000)],
              "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
-    robot = txt4_runtime.Txt4Robot(table, factories, motor)
+    robot = stub_robot(tmp_path, monkeypatch, table, [[1, 1, 19, 6000, 900, 0, 0, 0]])
     assert robot.read() == (1 | 4 | 8 | 16, [])
 
 
@@ -258,20 +263,9 @@ def test_the_on_board_loop_stops_when_it_falls_behind_or_is_interrupted() -> Non
 
 def test_the_on_board_program_keeps_the_declared_hysteresis(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """An ultrasonic input below 25 cm with 5 cm hysteresis: on at 24, still on at 29, off at 30."""
-    from tablebot.hw import txt4_runtime
-
-    script = tmp_path / "script.json"
     rows = [[cm, 0, 0, 0, 0, 0, 0, 0] for cm in (40, 24, 29, 30, 24)]
-    script.write_text(json.dumps({"inputs": rows, "counts": [[0, 0, 0, 0]] * len(rows)}))
-    monkeypatch.setenv("TABLEBOT_STUB_SCRIPT", str(script))
-    monkeypatch.setenv("TABLEBOT_STUB_LOG", str(tmp_path / "calls.jsonl"))
-    monkeypatch.syspath_prepend(str(STUB))
-    for name in [m for m in sys.modules if m.startswith("fischertechnik")]:
-        monkeypatch.delitem(sys.modules, name)
-    factories = importlib.import_module("fischertechnik.factories")
-    motor = importlib.import_module("fischertechnik.controller.Motor").Motor
     table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "ultrasonic", "bit": 1, "invert": False,
                          "below": 25, "above": None, "hysteresis": 5}],
              "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
-    robot = txt4_runtime.Txt4Robot(table, factories, motor)
+    robot = stub_robot(tmp_path, monkeypatch, table, rows)
     assert [robot.read()[0] for _ in rows] == [0, 1, 1, 0, 1]

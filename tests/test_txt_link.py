@@ -124,7 +124,7 @@ def test_auto_takes_the_first_address_that_answers() -> None:
 
 
 def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture) -> None:
-    ftrobopy = pytest.importorskip("ftrobopy")
+    import ftrobopy  # a dev dependency (pyproject.toml): missing, this fails rather than skips
     with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True) as fake, warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)  # ftrobopy uses Thread.setDaemon
         txt = ftrobopy.ftrobopy("127.0.0.1", fake.port)
