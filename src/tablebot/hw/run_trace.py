@@ -18,7 +18,6 @@ import numpy as np
 from tablebot.files import partial_name, write_text
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW
-from tablebot.sim.summary import seconds_per_state
 from tablebot.trace import TraceFile
 
 WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
@@ -78,6 +77,8 @@ class RunTrace(TraceFile):
 
     def summary(self, end: RunEnd) -> dict[str, Any]:
         """What the run did, as plain JSON."""
+        from tablebot.sim.summary import seconds_per_state  # imports the simulator (numba): only once a run is over
+
         assert self.info is not None and self.written is not None
         tick_s = self.info.tick_s
         per_state = seconds_per_state(np.array(self.counts), np.array(self.first_seen), self.machine.states, tick_s)
