@@ -20,10 +20,9 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.engine import Engine
 from tablebot.formats.table_read import load_table
-from tablebot.hw.pacing import PacedClock
 from tablebot.hw.txt_robot import TxtRobot
 from tablebot.hw.txt_wiring import txt_wiring
-from tablebot.loop import RunEnd, TickBlock, run
+from tablebot.loop import RealTimeClock, RunEnd, TickBlock, run
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import load_robot
 from tablebot.table import Table
@@ -42,7 +41,7 @@ def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple 
           behind_limit_s: float | None = None) -> RunEnd:
     robot = TxtRobot(txt_wiring(machine), "127.0.0.1", fake.port, link_timeout_s=timeout_s)
     robot.connect()
-    clock = PacedClock(machine.table.robot.tick_ms / 1000)
+    clock = RealTimeClock(machine.table.robot.tick_ms / 1000)
     end = run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="txt",
               behind_limit_s=behind_limit_s)
     fake_settles(fake)
@@ -223,7 +222,7 @@ def test_the_paced_clock_sleeps_to_a_fixed_grid_and_starts_it_again_after_a_stal
         slept.append(round(seconds, 6))
         now[0] += seconds
 
-    clock = PacedClock(0.01, now=lambda: now[0], sleep=sleep)
+    clock = RealTimeClock(0.01, now=lambda: now[0], sleep=sleep)
     clock.start()
     assert clock.wait(0) == 0.0 and slept == []  # due at once: no sleep, not late
     now[0] += 0.004

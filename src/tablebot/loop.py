@@ -158,25 +158,35 @@ class SimulatedClock:
 
 
 class RealTimeClock:
-    """Wall-clock pacing: tick k starts ``k * tick_s`` after the start; with ``sleep=False`` the robot's
-    own link sets the pace (a TXT answers every 10 ms) and the clock only measures lateness."""
+    """Wall-clock pacing: ticks are due on a grid ``tick_s`` apart, and ``wait`` sleeps until the tick is due.
+
+    A link that paces itself (a TXT answers every 10 ms) is not slowed, and one that answers at once
+    (ftrobopy_server on a TXT 4.0, the simulator) is paced without drift. A tick more than half a tick
+    late is reported late and the grid starts again from it: a link that cannot catch up after a stall
+    is not counted late on every later tick, and a single stall longer than the run's behind-limit ends
+    the run (see :class:`Lateness`).
+    """
 
     free_running = False
 
-    def __init__(self, tick_s: float, sleep: bool = True, now: Callable[[], float] = time.monotonic):
-        self.tick_s, self.sleep, self.now = tick_s, sleep, now
-        self.t0 = 0.0
+    def __init__(self, tick_s: float, now: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep):
+        self.tick_s, self.now, self.sleep = tick_s, now, sleep
+        self.anchor, self.anchor_tick = 0.0, 0
 
     def start(self) -> None:
-        self.t0 = self.now()
+        self.anchor, self.anchor_tick = self.now(), 0
 
     def wait(self, tick: int) -> float:
-        due = self.t0 + tick * self.tick_s
+        due = self.anchor + (tick - self.anchor_tick) * self.tick_s
         ahead = due - self.now()
-        if ahead > 0 and self.sleep:
-            time.sleep(ahead)
+        if ahead > 0:
+            self.sleep(ahead)
             return 0.0
-        return max(0.0, -ahead)
+        late = -ahead
+        if late > self.tick_s / 2:  # a stall, or a link slower than the tick: the grid starts again here
+            self.anchor, self.anchor_tick = due + late, tick
+        return late
 
 
 # --- watchdog -------------------------------------------------------------------------------------

@@ -119,12 +119,11 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
            behind_limit_s: float | None, quiet: bool) -> RunEnd:
     """The loop with its sinks: the live view first (so it always ends first and restores the terminal).
     A TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once and the simulator
-    never waits, so the clock paces ticks too (it only sleeps when a tick is early; see hw/pacing.py)."""
+    never waits, so the clock paces ticks too (it only sleeps when a tick is early; see loop.RealTimeClock)."""
     from tablebot.engine import Engine
     from tablebot.hw.live_view import LiveView
-    from tablebot.hw.pacing import PacedClock
     from tablebot.hw.run_trace import RunTrace
-    from tablebot.loop import run
+    from tablebot.loop import RealTimeClock, run
 
     sinks: list[Sink] = []
     if not quiet and err_console.is_terminal:
@@ -137,7 +136,7 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
     switch = sys.getswitchinterval()
     sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
     try:
-        end = run(Engine(machine), bot, clock=PacedClock(machine.table.robot.tick_ms / 1000), sinks=sinks,
+        end = run(Engine(machine), bot, clock=RealTimeClock(machine.table.robot.tick_ms / 1000), sinks=sinks,
                   ticks=ticks, target=target, behind_limit_s=behind_limit_s)
     finally:
         sys.setswitchinterval(switch)
