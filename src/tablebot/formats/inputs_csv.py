@@ -112,6 +112,11 @@ def format_inputs(machine: Machine, ticks: Sequence[TickInput]) -> str:
     return buffer.getvalue()
 
 
+def pulses_key(counter: str) -> str:
+    """The field of a run's trace that records counter ``counter``'s encoder pulses in each tick."""
+    return f"{counter}_pulses"
+
+
 def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
     """The inputs a recorded run gave the engine (``tablebot run --out``, ``tablebot sim``): per line, the
     input bits of ``event`` and each counter's ``<counter>_pulses``; an ``{"end": ...}`` record ends it.
@@ -119,7 +124,7 @@ def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
     from tablebot.trace import trace_records  # the one reader of trace lines (trace imports this module)
 
     out = Collector(path)
-    keys = ("event", *(f"{c}_pulses" for c in machine.table.robot.counter_names))
+    keys = ("event", *(pulses_key(c) for c in machine.table.robot.counter_names))
     ticks: list[TickInput] = []
     for number, data in trace_records(text, out):
         values = [data.get(key) for key in keys]

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.files import partial_name, write_text
+from tablebot.formats.inputs_csv import pulses_key
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW
 from tablebot.trace import TraceFile
@@ -23,8 +24,6 @@ from tablebot.trace import TraceFile
 WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
 
 
-def pulses_key(counter: str) -> str:
-    return f"{counter}_pulses"
 
 
 class RunTrace(TraceFile):
