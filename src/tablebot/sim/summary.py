@@ -7,14 +7,17 @@ set of numbers; collisions and the lamp are counted by the simulated robot as it
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from tablebot.robot import StateId
 from tablebot.sim import layout as L
-from tablebot.sim.runner import Result
-from tablebot.sim.scene import Scene
 from tablebot.sim.track import laps
+
+if TYPE_CHECKING:  # only types: time per state is wanted beside a real robot's run, without the simulator
+    from tablebot.sim.runner import Result
+    from tablebot.sim.scene import Scene
 
 
 @dataclass(frozen=True)
@@ -53,7 +56,7 @@ class Summary:
 
 def light_bits(result: Result | Scene) -> int:
     """The input bits of the light sensors (of a run or of its scene)."""
-    bits = (result.scene if isinstance(result, Result) else result).bits
+    bits = getattr(result, "scene", result).bits  # a Result has a scene; a Scene is one
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 
