@@ -23,11 +23,6 @@ class DurationError(ValueError):
         self.message, self.hint = message, hint
 
 
-def is_duration(text: str) -> bool:
-    """Whether ``text`` is written like a duration (a number, optionally with ms, s or ticks)."""
-    return DURATION_RE.match(text) is not None
-
-
 def to_ticks(text: str, tick_ms: int) -> int:
     """The whole ticks ``text`` stands for (a bare number counts ticks); raises :class:`DurationError`."""
     match = DURATION_RE.match(text)

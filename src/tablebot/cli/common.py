@@ -7,8 +7,7 @@ import functools
 import os
 import sys
 import threading
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -82,17 +81,6 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
         raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
                    f"give {option} a file in an existing folder")
     return path
-
-
-@contextmanager
-def writing(path: Path) -> Iterator[None]:
-    """Name ``path`` in an OSError raised while writing it: a full disk or a failing device names no file."""
-    try:
-        yield
-    except OSError as exc:
-        if exc.filename is None:
-            exc.filename = str(path)
-        raise
 
 
 def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
