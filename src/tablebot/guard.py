@@ -54,21 +54,22 @@ def read(path: str | Path) -> None:
     if scope is None:
         return
     scope.paths.add(os.path.realpath(path))
+    inode = _inode(path)
+    if inode is not None:
+        scope.inodes.add(inode)
+
+
+def _inode(path: str | Path) -> tuple[int, int] | None:
+    """The file's (device, inode): the same for a hard link or any other spelling of it; None if absent."""
     try:
         info = os.stat(path)
     except OSError:
-        return
-    scope.inodes.add((info.st_dev, info.st_ino))
+        return None
+    return info.st_dev, info.st_ino
 
 
 def _is_input(scope: Scope, path: Path) -> bool:
-    if os.path.realpath(path) in scope.paths:
-        return True
-    try:
-        info = os.stat(path)
-    except OSError:
-        return False
-    return (info.st_dev, info.st_ino) in scope.inodes  # a hard link or another spelling of the same file
+    return os.path.realpath(path) in scope.paths or _inode(path) in scope.inodes
 
 
 def writing(path: str | Path) -> None:
@@ -87,8 +88,7 @@ def writing(path: str | Path) -> None:
     if not scope.force:
         raise fail(path, f"{path.name} exists and is a {kind(path)} file: it is not replaced without --force",
                    f"write to another file, or add --force (the old file is then kept as {path.name}.bak)")
-    shutil.copy2(path, path.with_name(path.name + ".bak"))
-    scope.replaced.add(key)
+    _back_up(scope, path)
 
 
 def rewrite(path: str | Path) -> None:
@@ -99,11 +99,15 @@ def rewrite(path: str | Path) -> None:
         return
     path = Path(path)
     scope.paths.discard(os.path.realpath(path))
-    try:
-        info = os.stat(path)
-    except OSError:
+    inode = _inode(path)
+    if inode is None:
         return
-    scope.inodes.discard((info.st_dev, info.st_ino))
+    scope.inodes.discard(inode)
+    _back_up(scope, path)
+
+
+def _back_up(scope: Scope, path: Path) -> None:
+    """Keep ``path`` as ``NAME.bak`` once per command: a second write of it replaces the first's output."""
     shutil.copy2(path, path.with_name(path.name + ".bak"))
     scope.replaced.add(os.path.realpath(path))
 
