@@ -137,6 +137,29 @@ def test_a_device_is_written_not_replaced(tmp_path):
     os.close(reader)
 
 
+@pytest.mark.parametrize("header", [
+    b"\xef\xbb\xbfstate,T,I3,timer,next\n",  # Excel's "CSV UTF-8": a BOM before the first column
+    b"sep=;\nDescription;St;T;I3;Timer;Next-State\n",  # aliases, another delimiter, Excel's sep= line
+    b'"state"\t"T"\t"next"\n',  # quoted cells, tabs
+    "state,T,I3,timer,next\n".encode("utf-16"),  # Excel's "Unicode Text"
+])
+def test_every_spelling_of_a_table_header_is_protected(tmp_path, header):
+    """Reproduced: a table saved with a BOM before its state column was replaced without --force."""
+    table = tmp_path / "mine.csv"
+    table.write_bytes(header)
+    assert guard.is_user_file(table)
+    with guard.command(), pytest.raises(TableBotError, match="not replaced without --force"):
+        write_text(table, "x")
+    assert table.read_bytes() == header
+
+
+@pytest.mark.parametrize("text", ["a,b\n1,2\n", "state,M1\n1,2\n", "", '"state,next\n'])
+def test_other_csv_files_are_not_tables(tmp_path, text):
+    other = tmp_path / "data.csv"
+    other.write_text(text)
+    assert not guard.is_user_file(other)
+
+
 def test_a_symlink_is_written_through(tmp_path):
     real = tmp_path / "real.jsonl"
     real.write_text("old")

@@ -8,6 +8,7 @@ first. Outside a scope (library use) nothing is refused.
 
 from __future__ import annotations
 
+import codecs
 import os
 import shutil
 from collections.abc import Iterator
@@ -16,13 +17,13 @@ from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import TableBotError, fail
 
 #: Files a user writes by hand: tablebot never writes TOML, and a CSV with state and next columns is a table.
 USER_SUFFIXES = {".toml"}
 TABLE_SUFFIXES = {".csv", ".tsv", ".txt"}
-STATE_COLUMNS = {"state", "st"}
-NEXT_COLUMNS = {"next", "next_state", "next state"}
+#: How much of a CSV file is read to find its header.
+HEAD_BYTES = 4096
 
 
 @dataclass
@@ -117,17 +118,34 @@ def kind(path: Path) -> str:
 
 
 def is_user_file(path: Path) -> bool:
-    """A TOML file, or a CSV whose header (first filled line) has a state and a next column."""
+    """A TOML file, or a CSV whose header has a state and a next column as the table reader reads it
+    (any delimiter, quotes, a BOM, a ``sep=`` line, aliases such as ``Next-State``)."""
     suffix = path.suffix.lower()
     if suffix in USER_SUFFIXES:
         return True
     if suffix not in TABLE_SUFFIXES:
         return False
+    # Imported here: both read files through this module.
+    from tablebot.formats.csvtext import split_records
+    from tablebot.formats.table_read import is_table_header
+
+    head = _head(path)
+    try:
+        records = split_records(head[: head.rfind("\n") + 1] or head, str(path))  # whole lines only
+    except TableBotError:
+        return False  # a quote never closed in the first lines: no table the reader would take
+    header = next((record for record in records if not record.is_blank()), None)
+    return header is not None and is_table_header(cell.text for cell in header.cells)
+
+
+def _head(path: Path) -> str:
+    """The first HEAD_BYTES of a file as text, decoded as the table reader does (UTF-8 or UTF-16 with its
+    BOM; a bad byte is only replaced: this decides whether a file is a table, not what it says)."""
     try:
         with path.open("rb") as stream:
-            head = stream.read(4096).decode("utf-8", "replace")
+            data = stream.read(HEAD_BYTES)
     except OSError:
-        return False
-    first = next((line for line in head.splitlines() if line.strip() and not line.startswith("sep=")), "")
-    cells = {cell.strip().strip('"').lower() for cell in first.replace("\t", ",").replace(";", ",").split(",")}
-    return bool(cells & STATE_COLUMNS and cells & NEXT_COLUMNS)
+        return ""
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return data.decode("utf-16", "replace")
+    return data.decode("utf-8-sig", "replace")

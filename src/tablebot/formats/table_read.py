@@ -7,6 +7,7 @@ as ``file:line:column: message`` with a hint. Loading never executes anything fr
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -95,6 +96,12 @@ def _normalise(name: str) -> str:
     low = key.lower()
     low = ALIASES.get(low, low)
     return low if low in FIXED else key
+
+
+def is_table_header(cells: Iterable[str]) -> bool:
+    """Whether header cells name a state and a next column (spelled any way :func:`parse_table` takes)."""
+    names = {_normalise(text) for text in cells}
+    return "state" in names and "next" in names
 
 
 def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
