@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -97,6 +98,15 @@ def test_bumberbot_shipped_properties(tmp_path):
                       "back_to_seeking": "holds", "can_follow_light": "holds", "front_bumper_stops": "violated"}
     assert result.exit_code == 0  # the found bug is shipped as a warning ...
     assert check(EXAMPLE, "--strict", out=tmp_path).exit_code == 1  # ... which --strict turns into 1
+
+
+def test_the_replay_line_can_be_pasted_into_a_shell(tmp_path):
+    """A folder with a space in its name: the printed command must still name it as one word."""
+    out = tmp_path / "my counterexamples"
+    line = next(text for text in check(EXAMPLE, out=out).stdout.splitlines()
+                if "replay:" in text and "front_bumper_stops" in text)
+    assert shlex.split(line.split("replay:", 1)[1]) == ["tablebot", "trace", str(EXAMPLE), "--inputs",
+                                                        str(out / "front_bumper_stops.csv")]
 
 
 def test_bumberbot_text_tells_the_story(tmp_path):

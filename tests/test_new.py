@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -32,6 +33,13 @@ def test_every_template_passes_check_sim_and_tests(tmp_path: Path, template: str
     assert (tmp_path / "sim" / "trace.jsonl").read_text().count("\n") == 300
     invoke("tests", folder, "--out", tmp_path / "golden")
     assert json.loads((tmp_path / "golden" / "coverage.json").read_text())["rows_covered"] > 0
+
+
+def test_the_next_commands_can_be_pasted_into_a_shell(tmp_path: Path) -> None:
+    folder = tmp_path / "my robot"
+    out = invoke("new", folder)
+    commands = [shlex.split(line) for line in out.split("next:", 1)[1].splitlines() if line.strip()]
+    assert commands == [["tablebot", command, str(folder)] for command in ("check", "sim", "diagram")]
 
 
 def test_the_empty_template_uses_your_names_and_shows_an_example_row(tmp_path: Path) -> None:

@@ -26,7 +26,7 @@ from tablebot.cli.common import (
     resolve_table_path,
 )
 from tablebot.diagnostics import TableBotError, fail
-from tablebot.escape import plain, terminal
+from tablebot.escape import plain, shell_word, terminal
 from tablebot.formats.targets import TARGETS
 
 if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --help` stays quick
@@ -180,7 +180,8 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
                else " (--counterexamples DIR saves it)")
     console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks{written}")
     if path:
-        console.print(f"           replay: tablebot trace {terminal(str(table_arg))} --inputs {terminal(str(path))}")
+        command = " ".join(shell_word(str(word)) for word in ("tablebot", "trace", table_arg, "--inputs", path))
+        console.print(f"           replay: {terminal(command)}")
     if result.failed or verbose:
         for line in story(report.machine, result):
             console.print(f"             {terminal(line)}")

@@ -11,7 +11,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.diagnostics import fail
-from tablebot.escape import terminal
+from tablebot.escape import shell_word, terminal
 from tablebot.formats import robopro_program as rpp
 
 if TYPE_CHECKING:
@@ -73,9 +73,9 @@ def export_cmd(
 
         workspace = export_txt4(machine)  # a table that does not fit is refused before anything is written
         for path in workspace.write(out_folder(outdir, "OUTDIR")):
-            console.print(f"wrote {path}", markup=False)
-        console.print(f"upload and start it: tablebot upload {outdir} --to txt4://192.168.7.2 --key API_KEY",
-                      markup=False)
+            console.print(f"wrote {terminal(str(path))}")
+        console.print(f"upload and start it: tablebot upload {terminal(shell_word(str(outdir)))} "
+                      "--to txt4://192.168.7.2 --key API_KEY")
         return
     lists = robopro.encode(parsed)
     for path in robopro.write_lists(lists, out_folder(outdir, "OUTDIR")):

@@ -22,7 +22,7 @@ from tablebot.cli.common import (
     out_folder,
 )
 from tablebot.diagnostics import fail
-from tablebot.escape import shell_word, terminal
+from tablebot.escape import plain, shell_word, terminal
 
 if TYPE_CHECKING:  # the firmware tools are imported when a command runs: `--help` stays quick
     from tablebot.firmware.build import Firmware
@@ -117,7 +117,7 @@ def monitor_cmd(
     chunks = chunks_from(source, baud, seconds)
 
     def warn(text: str) -> None:
-        err_console.print(text, markup=False, soft_wrap=True)
+        err_console.print(plain(text), markup=False, soft_wrap=True)  # the source is the user's words
 
     if out is None:
         count = monitor(machine, chunks, sys.stdout, source, ticks, warn)

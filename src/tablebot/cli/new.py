@@ -6,10 +6,10 @@ from enum import StrEnum
 from pathlib import Path
 
 import typer
-from rich.markup import escape
 
 from tablebot.cli.app import app
 from tablebot.cli.common import console, guarded
+from tablebot.escape import shell_word, terminal
 
 
 class From(StrEnum):
@@ -37,11 +37,11 @@ def new_cmd(
                           templates.parse_names(motors, "--motors"))
     written = templates.write_folder(folder, made)
     source = "an empty robot" if template is From.empty else f"the {template.value} example"
-    console.print(f"created {escape(str(folder))} from {source}:")
+    console.print(f"created {terminal(str(folder))} from {source}:")
     for path in written:
-        console.print(f"  {escape(str(path)):<36} {escape(templates.PURPOSE[path.name])}")
+        console.print(f"  {terminal(str(path)):<36} {terminal(templates.PURPOSE[path.name])}")
     for note in made.notes:
-        console.print(f"[yellow]note:[/yellow] {escape(note)}")
+        console.print(f"[yellow]note:[/yellow] {terminal(note)}")
     console.print("next:")
-    for command in ("check", "sim", "diagram"):
-        console.print(f"  tablebot {command} {escape(str(folder))}")
+    for command in ("check", "sim", "diagram"):  # lines to paste: the folder quoted for a shell
+        console.print(f"  tablebot {command} {terminal(shell_word(str(folder)))}")
