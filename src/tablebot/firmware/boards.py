@@ -60,11 +60,6 @@ class Wiring:
     counters: dict[str, str]
     active_high: frozenset[str] = frozenset()
 
-    def used_outputs(self) -> set[str]:
-        """ftDuino O terminals taken by motors and lamps."""
-        taken = {o for m in self.motors.values() for o in self.board.motors[m].split()}
-        return taken | set(self.lamps.values())
-
 
 @dataclass(frozen=True)
 class BoardMap:
@@ -126,10 +121,11 @@ def _board_map(src: Source, board: Board, mine: dict[str, Any], robot: Robot) ->
 
 
 def _kind_of(board: Board, robot: Robot, name: str) -> tuple[str, tuple[str, ...]]:
-    """What sort of signal ``name`` is on the robot, and the board's terminals for that sort."""
+    """What sort of signal ``name`` is on the robot, and the board's terminals for that sort (("", ())
+    for a name the robot does not have)."""
     kinds = (("input", robot.inputs, board.inputs), ("motor", robot.motors, board.motors),
              ("lamp", robot.lamps, board.lamps), ("counter", robot.counter_names, board.counters))
-    return next((kind, tuple(terminals)) for kind, names, terminals in kinds if name in names)
+    return next(((kind, tuple(terminals)) for kind, names, terminals in kinds if name in names), ("", ()))
 
 
 def _overrides(robot: Robot, board: Board) -> tuple[dict[str, str], frozenset[str]]:
@@ -140,9 +136,7 @@ def _overrides(robot: Robot, board: Board) -> tuple[dict[str, str], frozenset[st
 
 def _example(board: Board, robot: Robot, name: str) -> str:
     """A terminal of the board for the kind of signal ``name`` is, for hints."""
-    kinds = ((robot.inputs, board.inputs), (robot.motors, board.motors), (robot.lamps, board.lamps),
-             (robot.counter_names, board.counters))
-    terminals = next((tuple(terminals) for names, terminals in kinds if name in names), ())
+    terminals = _kind_of(board, robot, name)[1]
     return terminals[0] if terminals else "?"
 
 
