@@ -50,7 +50,8 @@ def point_segment_within(px, py, ax, ay, bx, by, r, strict=False):
 
 @njit(cache=True)
 def segments_within(ax, ay, bx, by, cx, cy, dx, dy, r):
-    """``segment_distance(ax, ay, bx, by, cx, cy, dx, dy) <= r``: the same answer, by :func:`within`."""
+    """Whether segments ab and cd come within ``r`` of each other (0 apart when they cross): the nearest
+    of the four endpoint-to-segment distances, each tested by :func:`within`."""
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
     return (point_segment_within(ax, ay, cx, cy, dx, dy, r) or point_segment_within(bx, by, cx, cy, dx, dy, r)
@@ -65,16 +66,6 @@ def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
     d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
     d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
     return d1 * d2 <= 0.0 and d3 * d4 <= 0.0 and not (d1 == 0.0 and d2 == 0.0)
-
-
-@njit(cache=True)
-def segment_distance(ax, ay, bx, by, cx, cy, dx, dy):
-    """Distance between segments ab and cd (0 when they cross)."""
-    if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
-        return 0.0
-    return min(point_segment_distance(ax, ay, cx, cy, dx, dy), point_segment_distance(bx, by, cx, cy, dx, dy),
-               point_segment_distance(cx, cy, ax, ay, bx, by), point_segment_distance(dx, dy, ax, ay, bx, by))
-
 
 
 @njit(cache=True)

@@ -21,15 +21,7 @@ import math
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import (  # noqa: F401  (segments_cross, shadowed: re-exported, they lived here)
-    point_segment_distance,
-    point_segment_within,
-    segment_distance,
-    segments_cross,
-    segments_within,
-    shadowed,
-    within,
-)
+from tablebot.sim.geometry import point_segment_within, segments_within, within
 from tablebot.sim.layout import (
     AMPS,
     B_FL,
