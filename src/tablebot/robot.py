@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tablebot.formats.tomlfile import Source, Where
+from tablebot.formats.tomlfile import Source
 from tablebot.sensors import Sensor, parse_sensors
 
 StateId = int | str
@@ -120,9 +120,9 @@ def load_robot(path: str | Path) -> Robot:
     for key in data:
         if key not in KNOWN_KEYS:
             what = "section" if isinstance(data[key], dict) else "key"
-            _error(src, ("", None, key), f"unknown {what} {key!r}",
-                   MISPLACED.get(key, f"known keys: {', '.join(TOP_KEYS)}; sections: "
-                                      f"{', '.join(CORE_SECTIONS + FOREIGN_SECTIONS)}"))
+            src.key_error(("", None, key), f"unknown {what} {key!r}",
+                      MISPLACED.get(key, f"known keys: {', '.join(TOP_KEYS)}; sections: "
+                                         f"{', '.join(CORE_SECTIONS + FOREIGN_SECTIONS)}"))
     inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = _counters(src, motors)
     sensors = parse_sensors(src, inputs)
@@ -138,7 +138,7 @@ def load_robot(path: str | Path) -> Robot:
     states = _state_names(src)
     name = data.get("name", path.stem)
     if not isinstance(name, str):
-        _error(src, ("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
+        src.key_error(("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
     src.raise_if_any()
     robot = Robot(
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
@@ -160,12 +160,6 @@ def _foreign_sections(src: Source, robot: Robot) -> dict[str, Any]:
     return typed
 
 
-def _error(src: Source, where: Where, message: str, hint: str) -> None:
-    """A robot-file problem at the start of its line (TOML keys start lines)."""
-    line = src.line(*where)
-    src.out.error(line, None if line is None else 1, message, hint)
-
-
 def _names(src: Source, key: str) -> dict[str, str]:
     """A ``[inputs]``-style table of NAME = "label" pairs (or a list of names)."""
     section = src.data.get(key)
@@ -174,13 +168,13 @@ def _names(src: Source, key: str) -> dict[str, str]:
     if isinstance(section, list):
         section = {str(name): "" for name in section}
     if not isinstance(section, dict):
-        _error(src, ("", None, key), f"[{key}] must be a table of NAME = \"label\"",
-               'for example: I3 = "front-right bumper"')
+        src.key_error(("", None, key), f"[{key}] must be a table of NAME = \"label\"",
+                  'for example: I3 = "front-right bumper"')
         return {}
     for name, label in section.items():
         if _good_name(src, key, name) and not isinstance(label, str):
-            _error(src, (key, None, name), f"[{key}] {name}: the label must be text, not {label!r}",
-                   f'write it in quotes: {name} = "what it is"')
+            src.key_error((key, None, name), f"[{key}] {name}: the label must be text, not {label!r}",
+                      f'write it in quotes: {name} = "what it is"')
     return {name: str(label) for name, label in section.items()}
 
 
@@ -189,8 +183,8 @@ def _good_name(src: Source, key: str, name: str) -> bool:
     if _misplaced(src, key, name):
         return False
     if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-        _error(src, (key, None, name), f"bad {key} name {name!r}",
-               "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
+        src.key_error((key, None, name), f"bad {key} name {name!r}",
+                  "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
         return False
     return True
 
@@ -200,8 +194,8 @@ def _misplaced(src: Source, section: str, key: str) -> bool:
     in that section); reported if so."""
     if key not in TOP_KEYS:
         return False
-    _error(src, (section, None, key), f"{key} is inside [{section}]",
-           f"move {key} = … above the first [section]: every key below [{section}] belongs to it")
+    src.key_error((section, None, key), f"{key} is inside [{section}]",
+              f"move {key} = … above the first [section]: every key below [{section}] belongs to it")
     return True
 
 
@@ -209,19 +203,19 @@ def _counters(src: Source, motors: dict[str, str]) -> list[Counter]:
     """``[counters]``: C1 = "M1" (or C1 = {motor = "M1"}), each counting one motor's encoder."""
     section = src.data.get("counters") or {}
     if not isinstance(section, dict):
-        _error(src, ("", None, "counters"), "[counters] must be a table of C1 = \"M1\"",
-               "each counter names the motor whose encoder it counts")
+        src.key_error(("", None, "counters"), "[counters] must be a table of C1 = \"M1\"",
+                  "each counter names the motor whose encoder it counts")
         return []
     counters = []
     for name, value in section.items():
         _good_name(src, "counters", name)
         motor = value.get("motor") if isinstance(value, dict) else value
         if isinstance(value, dict) and set(value) != {"motor"}:
-            _error(src, ("counters", None, name), f"counter {name} may only say motor = \"M1\", not "
-                   f"{', '.join(sorted(set(value) - {'motor'})) or 'nothing'}", f'write {name} = "M1"')
+            src.key_error(("counters", None, name), f"counter {name} may only say motor = \"M1\", not "
+                      f"{', '.join(sorted(set(value) - {'motor'})) or 'nothing'}", f'write {name} = "M1"')
         elif not isinstance(motor, str) or motor not in motors:  # a list or table is no motor name (nor hashable)
-            _error(src, ("counters", None, name), f"counter {name} counts motor {motor!r}, which is not in [motors]",
-                   f'write {name} = "M1" with a motor name from [motors]')
+            src.key_error(("counters", None, name), f"counter {name} counts motor {motor!r}, which is not in [motors]",
+                      f'write {name} = "M1" with a motor name from [motors]')
         counters.append(Counter(name, str(motor)))
     return counters
 
@@ -232,8 +226,8 @@ def _distinct(src: Source, sections: dict[str, dict[str, str]]) -> None:
     for key, names in sections.items():
         for name in names:
             if name in first and first[name] != key:
-                _error(src, (first[name], None, name), f"name {name} is used twice ([{first[name]}] and [{key}])",
-                       "inputs, motors, counters and lamps need distinct names")
+                src.key_error((first[name], None, name), f"name {name} is used twice ([{first[name]}] and [{key}])",
+                          "inputs, motors, counters and lamps need distinct names")
             first.setdefault(name, key)
 
 
@@ -241,7 +235,7 @@ def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], want: s
     """A top-level whole number within ``bounds`` (``default`` when absent or after reporting why not)."""
     value = src.data.get(key, default)
     if not isinstance(value, int) or isinstance(value, bool) or not bounds[0] <= value <= bounds[1]:
-        _error(src, ("", None, key), f"{key} must be {want}, not {value!r}", hint)
+        src.key_error(("", None, key), f"{key} must be {want}, not {value!r}", hint)
         return default
     return value
 
@@ -264,8 +258,8 @@ def _initial_state(src: Source) -> StateId:
         return 0
     state = _state_id(src.data["initial_state"])
     if state is None:
-        _error(src, ("", None, "initial_state"), f"initial_state {src.data['initial_state']!r} is not a state",
-               STATE_HINT)
+        src.key_error(("", None, "initial_state"), f"initial_state {src.data['initial_state']!r} is not a state",
+                  STATE_HINT)
         return 0
     return state
 
@@ -274,8 +268,8 @@ def _state_names(src: Source) -> dict[StateId, str]:
     """``[states]``: NUMBER = "name", the names people read for the table's states."""
     section = src.data.get("states") or {}
     if not isinstance(section, dict):
-        _error(src, ("", None, "states"), "[states] must be a table of NUMBER = \"name\"",
-               'for example: 20 = "collision"')
+        src.key_error(("", None, "states"), "[states] must be a table of NUMBER = \"name\"",
+                  'for example: 20 = "collision"')
         return {}
     names: dict[StateId, str] = {}
     for key, label in section.items():
@@ -283,10 +277,10 @@ def _state_names(src: Source) -> dict[StateId, str]:
         if _misplaced(src, "states", key):
             continue
         if state is None:
-            _error(src, ("states", None, key), f"[states] {key!r} is not a state", STATE_HINT)
+            src.key_error(("states", None, key), f"[states] {key!r} is not a state", STATE_HINT)
         elif not isinstance(label, str):
-            _error(src, ("states", None, key), f"[states] {key}: the name must be text, not {label!r}",
-                   f'write it in quotes: {key} = "seek"')
+            src.key_error(("states", None, key), f"[states] {key}: the name must be text, not {label!r}",
+                      f'write it in quotes: {key} = "seek"')
         else:
             names[state] = label
     return names

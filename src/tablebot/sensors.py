@@ -78,8 +78,8 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
     if section is None:
         return ()
     if not isinstance(section, dict):
-        _error(src, ("", None, "sensors"), "[sensors] must be a table of INPUT = { sensor = ... }",
-               'for example: I1 = { sensor = "line", at = [0.1, 0.01] }')
+        src.key_error(("", None, "sensors"), "[sensors] must be a table of INPUT = { sensor = ... }",
+                  'for example: I1 = { sensor = "line", at = [0.1, 0.01] }')
         return ()
     found = [_sensor(src, name, value, inputs) for name, value in section.items()]
     return tuple(s for s in found if s is not None)
@@ -88,21 +88,21 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
 def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Sensor | None:
     where = ("sensors", None, name)
     if name not in inputs:
-        _error(src, where, f"[sensors] {name} is not an input of the robot",
-               f"add {name} to [inputs] first (its column in the table is the sensor's event)")
+        src.key_error(where, f"[sensors] {name} is not an input of the robot",
+                  f"add {name} to [inputs] first (its column in the table is the sensor's event)")
         return None
     if not isinstance(value, dict):
-        _error(src, where, f"[sensors] {name} must be a table like {{ sensor = \"distance\", ... }}, not {value!r}",
-               f'for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}')
+        src.key_error(where, f"[sensors] {name} must be a table like {{ sensor = \"distance\", ... }}, not {value!r}",
+                  f'for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}')
         return None
     unknown = sorted(set(value) - set(KEYS))
     if unknown:
-        _error(src, where, f"[sensors] {name}: unknown key{'s' * (len(unknown) > 1)} {', '.join(unknown)}",
-               f"known keys: {', '.join(KEYS)}")
+        src.key_error(where, f"[sensors] {name}: unknown key{'s' * (len(unknown) > 1)} {', '.join(unknown)}",
+                  f"known keys: {', '.join(KEYS)}")
     model = value.get("sensor")
     if model not in KINDS:
-        _error(src, where, f"[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows",
-               f"write sensor = one of {', '.join(repr(k) for k in KINDS)}")
+        src.key_error(where, f"[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows",
+                  f"write sensor = one of {', '.join(repr(k) for k in KINDS)}")
         return None
     at = _at(src, name, value.get("at"))
     angle = _angle(src, name, value)
@@ -123,16 +123,16 @@ def _line(src: Source, name: str, model: str, value: dict[str, Any], at: tuple[f
     """A floor sensor reads the floor straight below it: no threshold, no direction."""
     extra = [k for k in ("below", "above", "hysteresis", "angle") if k in value]
     if extra:
-        _error(src, ("sensors", None, name), f"[sensors] {name}: a line sensor has no {', '.join(extra)}",
-               "it reads 1 over a line and 0 elsewhere; give only sensor and at")
+        src.key_error(("sensors", None, name), f"[sensors] {name}: a line sensor has no {', '.join(extra)}",
+                  "it reads 1 over a line and 0 elsewhere; give only sensor and at")
     return None if at is None or angle is None or extra else Sensor(name, model, at)
 
 
 def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
     ok = isinstance(value, list) and len(value) == 2 and all(is_number(v) and abs(v) <= MAX_OFFSET for v in value)
     if not ok:
-        _error(src, ("sensors", None, name), f"[sensors] {name}: at must be [forward, left] in metres from the axle "
-               f"centre, not {value!r}", f"for example: at = [0.12, 0] (each within ±{MAX_OFFSET:g} m)")
+        src.key_error(("sensors", None, name), f"[sensors] {name}: at must be [forward, left] in metres from the axle "
+                  f"centre, not {value!r}", f"for example: at = [0.12, 0] (each within ±{MAX_OFFSET:g} m)")
         return None
     return float(value[0]), float(value[1])
 
@@ -140,8 +140,8 @@ def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
 def _angle(src: Source, name: str, value: dict[str, Any]) -> float | None:
     angle = value.get("angle", 0.0)
     if not is_number(angle) or not -180 <= angle <= 180:
-        _error(src, ("sensors", None, name), f"[sensors] {name}: angle must be degrees from -180 to 180, "
-               f"not {angle!r}", "0 points straight ahead, positive to the left")
+        src.key_error(("sensors", None, name), f"[sensors] {name}: angle must be degrees from -180 to 180, "
+                  f"not {angle!r}", "0 points straight ahead, positive to the left")
         return None
     return float(angle)
 
@@ -151,9 +151,9 @@ def _threshold(src: Source, name: str, model: str, value: dict[str, Any]) -> tup
     given = [k for k in ("below", "above") if k in value]
     if len(given) != 1:
         example = '"20 cm"' if KINDS[model] == "distance" else "1.5"
-        _error(src, ("sensors", None, name), f"[sensors] {name}: a {model} sensor needs "
-               f"{'one of below or above, not both' if given else 'a threshold'}",
-               f"write below = {example} (the event is 1 while the reading is below it) or above = {example}")
+        src.key_error(("sensors", None, name), f"[sensors] {name}: a {model} sensor needs "
+                  f"{'one of below or above, not both' if given else 'a threshold'}",
+                  f"write below = {example} (the event is 1 while the reading is below it) or above = {example}")
         return None
     direction = given[0]
     raw = value[direction]
@@ -175,22 +175,17 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> float | No
             return 0.0
         match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
         if match is None:
-            _error(src, where, f"[sensors] {name}: {key} must be a length with its unit, not {raw!r}",
-                   f'write it in quotes with mm, cm or m: {key} = "20 cm"')
+            src.key_error(where, f"[sensors] {name}: {key} must be a length with its unit, not {raw!r}",
+                      f'write it in quotes with mm, cm or m: {key} = "20 cm"')
             return None
         metres = float(match[1]) * LENGTH_UNITS[match[2]]
     else:
         if not is_number(raw):
-            _error(src, where, f"[sensors] {name}: {key} must be a light level (a number), not {raw!r}",
-                   f"1 is the level at which a phototransistor switches: {key} = 1.5")
+            src.key_error(where, f"[sensors] {name}: {key} must be a light level (a number), not {raw!r}",
+                      f"1 is the level at which a phototransistor switches: {key} = 1.5")
             return None
         metres = float(raw)
     if metres < 0 or not math.isfinite(metres):
-        _error(src, where, f"[sensors] {name}: {key} must not be negative", f"write {key} as 0 or more")
+        src.key_error(where, f"[sensors] {name}: {key} must not be negative", f"write {key} as 0 or more")
         return None
     return metres
-
-
-def _error(src: Source, where: tuple[str, int | None, str], message: str, hint: str) -> None:
-    line = src.line(*where)
-    src.out.error(line, None if line is None else 1, message, hint)

@@ -127,6 +127,11 @@ class Source:
     def error(self, where: Where, message: str, hint: str = "") -> None:
         self.out.error(self.line(*where), None, message, hint)
 
+    def key_error(self, where: Where, message: str, hint: str = "") -> None:
+        """:meth:`error` at column 1 of the line found: the key ``where`` names starts that line."""
+        line = self.line(*where)
+        self.out.error(line, None if line is None else 1, message, hint)
+
     def raise_if_any(self) -> None:
         self.out.raise_if_any()
 
