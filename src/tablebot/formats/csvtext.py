@@ -94,31 +94,24 @@ def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT, limit: int | N
             pass  # not UTF-16 after all: report it as bad UTF-8 below
     try:
         return data.decode("utf-8-sig")
-    except UnicodeDecodeError:
+    except UnicodeDecodeError as exc:
         if spreadsheet and not BINARY_RE.search(data) and not UTF8_MULTIBYTE_RE.search(data):
-            return _legacy(path, data)
+            return _legacy(path, data, exc.start + (3 if data.startswith(codecs.BOM_UTF8) else 0))
         raise TableBotError(_bad_bytes(path, data, encoding_hint)) from None
 
 
-def _legacy(path: Path, data: bytes) -> str:
-    """Text in Excel's Western European code page, with a note naming the encoding assumed."""
+def _legacy(path: Path, data: bytes, first_bad: int) -> str:
+    """Text in Excel's Western European code page, with a note naming the encoding assumed and the first
+    byte (at ``first_bad``) that is not UTF-8."""
     try:
         text, name = data.decode("cp1252"), "Windows-1252"
     except UnicodeDecodeError:  # cp1252 leaves five bytes undefined; Latin-1 has them all
         text, name = data.decode("latin-1"), "Latin-1 (ISO-8859-1)"
     bad = _bad_bytes(path, data, "")[0]
-    notify(Diagnostic(str(path), bad.line, bad.column, f"not UTF-8 (byte 0x{data[_first_bad(data)]:02x}); read as "
+    notify(Diagnostic(str(path), bad.line, bad.column, f"not UTF-8 (byte 0x{data[first_bad]:02x}); read as "
                       f"{name}, as a Western European Excel saves 'CSV'",
                       f"if characters look wrong, {CSV_ENCODING_HINT}", "note"))
     return text
-
-
-def _first_bad(data: bytes) -> int:
-    try:
-        data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        return exc.start + (3 if data.startswith(codecs.BOM_UTF8) else 0)
-    return 0
 
 
 def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:
