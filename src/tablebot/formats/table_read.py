@@ -260,10 +260,9 @@ def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[t
 
 
 def _value(column: Column, cell: Cell, out: Collector, tick_ms: int) -> Any:
-    """What one cell says: text (description), a state, a number or None (keep); errors go to ``out``."""
+    """What one cell says (never a description: :func:`_cached` takes those as they are): a state, a
+    number or None (keep); errors go to ``out``."""
     kind, text = column.kind, cell.text.strip()
-    if kind == "description":
-        return text
     if kind == "timer" and TIME_RE.search(text):
         return _timer(cell, tick_ms, out)
     if kind in ("state", "next"):
