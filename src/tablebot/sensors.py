@@ -115,7 +115,7 @@ def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Senso
     hysteresis = _amount(src, name, "hysteresis", value.get("hysteresis", 0), KINDS[model])
     if hysteresis is None:
         return None
-    return Sensor(name, model, at, angle, direction, level, hysteresis, unit)
+    return Sensor(name, model, at, angle, direction, level, hysteresis[0], unit)
 
 
 def _line(src: Source, name: str, model: str, value: dict[str, Any], at: tuple[float, float] | None,
@@ -156,29 +156,24 @@ def _threshold(src: Source, name: str, model: str, value: dict[str, Any]) -> tup
                   f"write below = {example} (the event is 1 while the reading is below it) or above = {example}")
         return None
     direction = given[0]
-    raw = value[direction]
-    unit = _unit_of(raw) if KINDS[model] == "distance" else ""
-    level = _amount(src, name, direction, raw, KINDS[model])
-    return None if level is None else (direction, level, unit)
+    amount = _amount(src, name, direction, value[direction], KINDS[model])
+    return None if amount is None else (direction, *amount)
 
 
-def _unit_of(raw: Any) -> str:
-    match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
-    return match[2] if match else "cm"
-
-
-def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> float | None:
-    """A threshold or hysteresis: a length with its unit for distances, a plain number for light."""
+def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> tuple[float, str] | None:
+    """A threshold or hysteresis and the unit written: a length with its unit for distances (the value in
+    metres; a bare 0 counts as cm), a plain number for light (unit "")."""
     where = ("sensors", None, name)
+    unit = ""
     if kind == "distance":
         if raw == 0:
-            return 0.0
+            return 0.0, "cm"
         match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
         if match is None:
             src.key_error(where, f"[sensors] {name}: {key} must be a length with its unit, not {raw!r}",
                       f'write it in quotes with mm, cm or m: {key} = "20 cm"')
             return None
-        metres = float(match[1]) * LENGTH_UNITS[match[2]]
+        metres, unit = float(match[1]) * LENGTH_UNITS[match[2]], match[2]
     else:
         if not is_number(raw):
             src.key_error(where, f"[sensors] {name}: {key} must be a light level (a number), not {raw!r}",
@@ -188,4 +183,4 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> float | No
     if metres < 0 or not math.isfinite(metres):
         src.key_error(where, f"[sensors] {name}: {key} must not be negative", f"write {key} as 0 or more")
         return None
-    return metres
+    return metres, unit
