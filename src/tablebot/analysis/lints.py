@@ -45,21 +45,33 @@ def _same_effect(a: Row, b: Row) -> bool:
 
 # --- row order --------------------------------------------------------------------------------------
 
+def _first_rows(masks: list[int]) -> dict[int, int]:
+    """Each distinct event mask of a state's rows -> the first of its rows with that mask."""
+    first: dict[int, int] = {}
+    for i, mask in enumerate(masks):
+        first.setdefault(mask, i)
+    return first
+
+
+def _winner(first_with: dict[int, int], events: int) -> int:
+    """The row that fires for ``events`` (one of the rows' masks, or a union of them): the first whose
+    mask is a subset. Compares distinct masks, not every row: a long table repeats a few masks."""
+    return min(k for m, k in first_with.items() if m & events == m)
+
+
 def shadowed_rows(table: Table) -> list[Finding]:
     """A row can never fire if an earlier row of its state needs a subset of its events: whenever
     this row's events are all present, so are the earlier row's, and the earlier row wins."""
     found = []
     for state in table.states:
         rows = rows_of(table, state)
-        first_with: dict[int, int] = {}  # each distinct event mask -> its first row (index in rows)
+        masks = [table.mask(r.events) for r in rows]
+        first_with = _first_rows(masks)
         for i, row in enumerate(rows):
-            mask = table.mask(row.events)
-            # the first earlier row whose events are a subset: compare distinct masks, not every earlier row
-            covering = [k for m, k in first_with.items() if m & mask == m]
-            first_with.setdefault(mask, i)
-            if not covering:
+            winner = _winner(first_with, masks[i])
+            if winner == i:
                 continue
-            earlier = rows[min(covering)]
+            earlier = rows[winner]
             needs = (f"needs only {events_text(table, earlier.events)}, so it always wins first"
                      if earlier.events else "needs no event at all, so it fires first every time")
             found.append(Finding(
@@ -78,22 +90,15 @@ def overlaps(table: Table) -> list[Finding]:
     for state in table.states:
         rows = rows_of(table, state)
         masks = [table.mask(r.events) for r in rows]
-        first_with: dict[int, int] = {}
-        for i, mask in enumerate(masks):
-            first_with.setdefault(mask, i)
-
-        def winner(events: int, first_with: dict[int, int] = first_with) -> int:
-            """The row that fires for ``events``: the first one whose mask is a subset."""
-            return min(k for m, k in first_with.items() if m & events == m)
-
+        first_with = _first_rows(masks)
         # Only a row that wins its own events can win a pair; per later mask, which of those do.
-        candidates = [i for i, mask in enumerate(masks) if winner(mask) == i]
+        candidates = [i for i, mask in enumerate(masks) if _winner(first_with, mask) == i]
         partners: dict[int, list[int]] = {}
         for j, later in enumerate(rows):
             mask = masks[j]
             if mask not in partners:
                 partners[mask] = [i for i in candidates if masks[i] & mask != masks[i]
-                                  and winner(masks[i] | mask) == i]
+                                  and _winner(first_with, masks[i] | mask) == i]
             for i in partners[mask]:
                 if i >= j:
                     break
