@@ -78,7 +78,7 @@ def check_cmd(
         _, machine = load(table, robot)
         files = properties or find_property_files(resolve_table_path(table))
         props = load_properties(machine, files)
-        stages.progress.update(stages.task, total=3 + len(props))
+        stages.expect(3 + len(props))  # reading, exploring, findings, then one step per property
         report = run_check(machine, props, tuple(target), stages.step)
     report.property_files = files
     found = any(r.inputs for r in report.results)

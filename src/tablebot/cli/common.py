@@ -119,6 +119,10 @@ class Stages:
         self.started = True
         self.progress.update(self.task, description=terminal(what))
 
+    def expect(self, total: int) -> None:
+        """How many steps there are, once that is known (a check learns it after reading the properties)."""
+        self.progress.update(self.task, total=total)
+
     def __exit__(self, *exc: object) -> None:
         self.timer.cancel()
         self.progress.stop()
