@@ -3,7 +3,7 @@ between the same two states merged), coloured by the motion they start; Graphviz
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import graphviz
@@ -120,7 +120,7 @@ def _sides(table: Table) -> tuple[int, int] | None:
 
 def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
     robot = table.robot
-    ids = state_ids(table.states, dot_id)
+    ids = state_ids(table.states)
     # Every user text goes into HTML-like labels (<…>): the only Graphviz strings without escapes of their own.
     graph = graphviz.Digraph("tablebot", graph_attr={
         "rankdir": "TB", "fontname": "Helvetica", "fontsize": "11", "nodesep": "0.35", "ranksep": "0.9",
@@ -146,12 +146,13 @@ def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
     return graph
 
 
-def state_ids(states: Sequence[StateId], safe: Callable[[str], str]) -> dict[StateId, str]:
-    """Diagram ids (``s_20``, ``s_seek``) made safe by ``safe``; states whose names differ only in
-    characters an id cannot hold (``a.b``, ``a-b``) get a number to stay apart."""
+def state_ids(states: Sequence[StateId]) -> dict[StateId, str]:
+    """Diagram ids (``s_20``, ``s_seek``): ASCII letters, digits and ``_`` (:func:`escape.dot_id`), which
+    Graphviz and Mermaid both take as they are; states whose names differ only in characters an id
+    cannot hold (``a.b``, ``a-b``) get a number to stay apart."""
     ids: dict[StateId, str] = {}
     for state in states:
-        base = safe(f"s_{state}")
+        base = dot_id(f"s_{state}")
         mid, count = base, 1
         while mid in ids.values():
             count += 1
@@ -208,7 +209,7 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
 
 def to_mermaid(table: Table) -> str:
     """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""
-    ids = state_ids(table.states, _mermaid_id)
+    ids = state_ids(table.states)
     out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {ids[table.robot.initial_state]}"]
     for state in table.states:
         label = table.state_name(state)
@@ -221,8 +222,3 @@ def to_mermaid(table: Table) -> str:
             parts.append(f"{cond} / {act.text}{timer}")
         out.append(f"    {ids[edge.source]} --> {ids[edge.target]}: {mermaid_label(', '.join(parts))}")
     return "\n".join(out) + "\n"
-
-
-def _mermaid_id(text: str) -> str:
-    """Mermaid ids: ASCII letters, digits and ``_``."""
-    return "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in text)
