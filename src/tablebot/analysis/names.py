@@ -26,7 +26,7 @@ def _event_name(table: Table, name: str) -> str:
     if name == TIMER_EVENT:
         return "T (timer ran out)"
     label = table.robot.labels.get(name)
-    if table.robot.counters and name in table.robot.counter_names:
+    if name in table.robot.counter_names:  # (each name is worked out once per table: see event_name)
         return f"{name} (counter at 0)"
     return f"{name} ({label})" if label else name
 

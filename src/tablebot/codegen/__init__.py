@@ -25,10 +25,7 @@ class CSource:
 
     def write(self, outdir: Path) -> list[Path]:
         outdir.mkdir(parents=True, exist_ok=True)
-        written = []
-        for name, text in self.files.items():
-            written.append(write_text(outdir / name, text))
-        return written
+        return [write_text(outdir / name, text) for name, text in self.files.items()]
 
 
 def template(name: str) -> str:
@@ -135,7 +132,7 @@ def _action(machine: Machine, layout: Layout, index: int) -> str:
     outputs = " ".join(f"{n}={'keep' if v is None else v}" for n, v in zip(machine.output_names, row.outputs,
                                                                            strict=True))
     note = c_comment(f"row {index}, line {source.line}: {source.description} -> {machine.states[row.next]}, "
-                        f"timer {row.timer}, {outputs}")
+                     f"timer {row.timer}, {outputs}")
     values = ", ".join(f"0x{b:02x}" for b in action_bytes(machine, layout, index))
     return f"    {values}, /* {note} */"
 
