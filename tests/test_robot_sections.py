@@ -61,3 +61,10 @@ def test_reading_robot_and_world_files_does_not_load_the_simulator() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                           cwd=Path(__file__).resolve().parents[1])
     assert done.stdout.strip() == "[]"
+
+
+def test_mistakes_in_the_core_and_in_a_stages_section_are_reported_together(tmp_path: Path) -> None:
+    """A lamp label that is no text and a bad [sim.battery] value: both in one run, not the second only
+    after fixing the first."""
+    found = errors(tmp_path, "[lamps]\nL1 = 5\n[sim.battery]\ncharge = 5\n")
+    assert any("the label must be text" in e for e in found) and any("charge" in e for e in found), found

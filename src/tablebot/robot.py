@@ -139,7 +139,8 @@ def load_robot(path: str | Path) -> Robot:
     name = data.get("name", path.stem)
     if not isinstance(name, str):
         src.key_error(("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
-    src.raise_if_any()
+    # The other stages' sections are read even when the core has mistakes, so that every mistake of the
+    # file shows in one go; their readers see the names that did read.
     robot = Robot(
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
         initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms, sensors=sensors,
