@@ -27,7 +27,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 err_console = Console(stderr=True, highlight=False, emoji=False)
 console = Console(highlight=False, soft_wrap=True, emoji=False)
 
-TABLE_ARG = typer.Argument(..., help="Table file (CSV or TSV) or a folder holding table.csv.")
+TABLE_ARG = typer.Argument(..., metavar="TABLE", help="Table file (CSV or TSV) or a folder holding table.csv.")
 ROBOT_OPT = typer.Option(None, "--robot", help="Robot TOML file (default: NAME.toml or robot.toml beside the table).")
 FORCE_OPT = typer.Option(False, "--force", help="Replace an existing table or robot file (the old one is kept as "
                          "NAME.bak); without it such a file is never replaced.")

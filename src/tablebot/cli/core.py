@@ -30,7 +30,7 @@ class Source(StrEnum):
 @app.command("import")
 @guarded
 def import_cmd(
-    directory: Path = typer.Argument(..., help="Folder with event.csv, action.csv, timer.csv."),
+    directory: Path = typer.Argument(..., metavar="FOLDER", help="Folder with event.csv, action.csv, timer.csv."),
     source: Source = typer.Option(..., "--from", help="What the folder holds."),
     out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output)."),
     robot: Path | None = ROBOT_OPT,

@@ -35,7 +35,7 @@ class Lookup(StrEnum):
 @guarded
 def export_cmd(
     table: Path = TABLE_ARG,
-    outdir: Path | None = typer.Argument(None, help="Folder to write into (created if missing); "
+    outdir: Path | None = typer.Argument(None, metavar="OUTDIR", help="Folder to write into (created if missing); "
                                          "for robopro-rpp, where to put the program instead of rewriting it."),
     to: Target = typer.Option(..., "--to", help="robopro: the three lists as CSV; robopro-rpp: the lists "
                               "written into a ROBO Pro program (--into); c: portable C99 engine + table; "

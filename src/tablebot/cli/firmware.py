@@ -64,7 +64,8 @@ def build_cmd(table: Path = TABLE_ARG, board: BoardName = BOARD_OPT, out: Path |
 @app.command("flash")
 @guarded
 def flash_cmd(
-    table: Path = typer.Argument(..., help="Table (built first) or a firmware .hex built by `tablebot build`."),
+    table: Path = typer.Argument(..., metavar="TABLE_OR_HEX",
+                                help="Table (built first) or a firmware .hex built by `tablebot build`."),
     board: BoardName = BOARD_OPT,
     port: str = typer.Option(..., "--port", help="Serial port of the board's bootloader (/dev/ttyACM0, COM3)."),
     out: Path | None = OUT_OPT,
@@ -99,7 +100,8 @@ def flash_cmd(
 @app.command("monitor")
 @guarded
 def monitor_cmd(
-    source: str = typer.Argument(..., help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."),
+    source: str = typer.Argument(..., metavar="PORT_OR_FILE",
+                                help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."),
     table: Path = typer.Option(..., "--table", help="The table the firmware was built from (names states)."),
     out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
     baud: int = typer.Option(115200, "--baud", min=1, help="Serial speed of the trace stream."),

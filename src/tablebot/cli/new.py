@@ -22,7 +22,7 @@ class From(StrEnum):
 @app.command("new")
 @guarded
 def new_cmd(
-    folder: Path = typer.Argument(..., help="The folder to create (it must not exist, or be empty)."),
+    folder: Path = typer.Argument(..., metavar="FOLDER", help="The folder to create (it must not exist, or be empty)."),
     template: From = typer.Option(From.empty, "--from", help="Start from a shipped example, or from an empty robot."),
     inputs: list[str] = typer.Option([], "--inputs", help="Your input names, comma separated, each optionally "
                                      "NAME=label (I1,I2 or \"I1=left bumper\"); with --from an example, they "

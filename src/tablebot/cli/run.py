@@ -161,7 +161,8 @@ def _report(end: RunEnd, machine: Machine, trace: RunTrace | None) -> None:
 @app.command("upload")
 @guarded
 def upload_cmd(
-    folder: Path = typer.Argument(..., help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
+    folder: Path = typer.Argument(..., metavar="OUTDIR",
+                                 help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
     to: str = typer.Option(..., "--to", help="The TXT 4.0: txt4://192.168.7.2 (USB), txt4://HOST[:PORT]."),
     key: str = typer.Option(..., "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO Pro "
                             "Coding asks for it)."),
