@@ -20,12 +20,13 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import fail
+from tablebot.sim.fleet_work import Pose
 from tablebot.sim.params import DEFAULTS
+from tablebot.sim.world import inside
 
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000
 RANGE_RE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
-Pose = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -139,11 +140,14 @@ def known_keys() -> list[str]:
 
 def param_of(key: str) -> tuple[str, str]:
     """The [sim] section and key a grid key sets."""
-    return ("battery", "charge") if key == "battery" else tuple(key.split(".", 1))  # type: ignore[return-value]
+    if key == "battery":
+        return "battery", "charge"
+    section, _, name = key.partition(".")
+    return section, name
 
 
 def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
-    section, _, name = ("battery", ".", "charge") if key == "battery" else key.partition(".")
+    section, name = param_of(key)
     if section not in DEFAULTS or name not in DEFAULTS[section]:
         raise fail("--grid", f"--grid: unknown key {key!r}",
                    "use battery, start, or a simulator parameter such as motor.friction_volts, noise.light "
@@ -221,17 +225,7 @@ def random_start(seed: int, walls: Sequence[tuple[float, float]], free: Any) -> 
     for _ in range(10_000):
         x, y = rng.uniform(min(xs), max(xs)), rng.uniform(min(ys), max(ys))
         pose = (round(float(x), 4), round(float(y), 4), round(float(rng.uniform(-180.0, 180.0)), 2))
-        if inside(x, y, walls) and free(pose):
+        if inside(walls, (x, y)) and free(pose):
             return pose
     raise fail("--grid", "start=random: found no free start pose in the world", "give the world more free floor")
 
-
-def inside(x: float, y: float, polygon: Sequence[tuple[float, float]]) -> bool:
-    """Whether (x, y) lies inside the polygon (even-odd rule)."""
-    found = False
-    n = len(polygon)
-    for k in range(n):
-        (ax, ay), (bx, by) = polygon[k], polygon[(k + 1) % n]
-        if (ay > y) != (by > y) and x < ax + (y - ay) * (bx - ax) / (by - ay):
-            found = not found
-    return found
