@@ -82,13 +82,14 @@ def digest(path: Path | None) -> str:
 # --- options ----------------------------------------------------------------------------------------
 
 
-def parse_seeds(text: str | None, robots: int | None) -> tuple[int, ...]:
-    """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1."""
+def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -> tuple[int, ...]:
+    """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1.
+    Errors name ``option`` (the same numbers are read for --check-seeds and --trace)."""
     if text is not None and robots is not None:
-        raise fail("--robots", "give --robots or --seeds, not both", "--robots N is short for --seeds 0..N-1")
+        raise fail("--robots", f"give --robots or {option}, not both", f"--robots N is short for {option} 0..N-1")
     if text is None:
         if robots is None:
-            raise fail("--seeds", "say which runs to make", "give --seeds 0..99 or --robots 100")
+            raise fail(option, "say which runs to make", f"give {option} 0..99 or --robots 100")
         if robots < 1:
             raise fail("--robots", f"--robots {robots}: there must be at least one robot", "give --robots 1 or more")
         return tuple(range(robots))
@@ -98,21 +99,21 @@ def parse_seeds(text: str | None, robots: int | None) -> tuple[int, ...]:
         if found:
             low, high = int(found[1]), int(found[2])
             if high < low:
-                raise fail("--seeds", f"--seeds {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
+                raise fail(option, f"{option} {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
             seeds.extend(range(low, high + 1))
         elif part.strip().isdigit():
             seeds.append(int(part))
         else:
-            raise fail("--seeds", f"--seeds: {part.strip()!r} is not a seed or a range",
+            raise fail(option, f"{option}: {part.strip()!r} is not a seed or a range",
                        "write whole numbers and ranges: 0..999 or 1,5,9 or 0..9,20")
         if len(seeds) > MAX_RUNS:
-            raise fail("--seeds", f"--seeds gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
+            raise fail(option, f"{option} gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
     if not seeds:
-        raise fail("--seeds", "--seeds names no seed", "give --seeds 0..99")
+        raise fail(option, f"{option} names no seed", f"give {option} 0..99")
     if min(seeds) < 0:
-        raise fail("--seeds", "--seeds: a seed is never negative", "give seeds from 0 on")
+        raise fail(option, f"{option}: a seed is never negative", "give seeds from 0 on")
     if len(set(seeds)) != len(seeds):
-        raise fail("--seeds", "--seeds names a seed twice", "name each seed once")
+        raise fail(option, f"{option} names a seed twice", "name each seed once")
     return tuple(seeds)
 
 

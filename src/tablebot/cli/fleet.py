@@ -82,10 +82,9 @@ def trace_runs(text: str | None, total: int) -> list[int]:
     if text is None:
         return []
     try:
-        chosen = parse_seeds(text, None)
-    except TableBotError as exc:  # the same words, about --trace
-        raise fail("--trace", exc.diagnostics[0].message.replace("--seeds", "--trace"),
-                   "give run numbers: 0,17 or 0..9") from None
+        chosen = parse_seeds(text, None, "--trace")
+    except TableBotError as exc:  # the words of --seeds, with a hint about run numbers
+        raise fail("--trace", exc.diagnostics[0].message, "give run numbers: 0,17 or 0..9") from None
     beyond = [k for k in chosen if k >= total]
     if beyond:
         raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")

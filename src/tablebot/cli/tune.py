@@ -4,6 +4,7 @@ scenario set, then check the result on fresh seeds; writes the tuned table as a 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -61,8 +62,7 @@ def tune_cmd(
         raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
-    check = make_plan(table, robot, world or [], grid or ["start=random"], check_seeds, None, seconds)
-    parse_seeds(check_seeds, None)
+    check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     tuned_cells = parse_cells(cells, plan.table)
     out_folder(out, "--out")
     target = tuned_path(Path(plan.table.path), out)
