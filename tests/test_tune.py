@@ -48,11 +48,11 @@ def hand_optimum() -> float:
     return DISTANCE_M / (top_speed(quiet) * 0.010)
 
 
-def tune(tmp_path: Path, rows: list[str], *args: str) -> tuple[int, str, Path]:
+def tune(tmp_path: Path, rows: list[str], *args: str, world: str = HALL) -> tuple[int, str, Path]:
     (tmp_path / "robot.toml").write_text(ROBOT, encoding="utf-8")
     table = tmp_path / "table.csv"
     table.write_text("\r\n".join(["description,state,T,I3,M1,M2,timer,next", *rows]) + "\r\n", encoding="utf-8")
-    (tmp_path / "hall.toml").write_text(HALL, encoding="utf-8")
+    (tmp_path / "hall.toml").write_text(world, encoding="utf-8")
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["tune", str(table), "--world", str(tmp_path / "hall.toml"), "--grid",
                                       "battery=1.0", "--seeds", "0..1", "--check-seeds", "7..8", "--seconds", "9",
@@ -107,6 +107,21 @@ def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
                                *args)
         assert code == 2 and output.startswith(f"{option}: error:"), output
         assert "--seeds" not in output, output  # the option given, not the one whose words it shares
+
+
+def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) -> None:
+    """Every candidate would tie (never reached): the objective is named, collisions still tune."""
+    dark = HALL.replace("[[lamp]]\nat = [1.5, 1.5]\nradius = 0\n", "")
+    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", world=dark)
+    assert code == 2, output
+    assert output.startswith("--objective: error: --objective lamp_distance needs a lamp, and the scenarios' "
+                             "world (hall) has none"), output
+    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", "--objective", "collisions",
+                             world=dark)
+    assert code == 0, output
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "| collisions (objective) |" in report and "lamp_distance" not in report
 
 
 def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:

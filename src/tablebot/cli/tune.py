@@ -50,18 +50,18 @@ def tune_cmd(
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
     runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    from tablebot.diagnostics import fail
     from tablebot.sweep import parse_seeds
     from tablebot.sweep_backends import Runner, choose
     from tablebot.tune import Evaluator, best, parse_cells, search_cma, search_grid
 
     if objective not in METRICS:
-        from tablebot.diagnostics import fail
         raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
     if method not in ("auto", "grid", "cma"):
-        from tablebot.diagnostics import fail
         raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
+    metrics = measurable(plan, objective)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     tuned_cells = parse_cells(cells, plan.table)
     out_folder(out, "--out")
@@ -77,7 +77,7 @@ def tune_cmd(
         else:
             search_cma(evaluate, budget, seed)
         winner, _ = best(evaluate.history)
-        before_after = evaluate.measure([baseline, winner], check, METRICS)
+        before_after = evaluate.measure([baseline, winner], check, metrics)
     written = [write_tuned(plan, tuned_cells, winner, target),
                write_evaluations(evaluate, out / "evaluations.csv"),
                convergence(evaluate, method, out / "convergence.png"),
@@ -87,6 +87,20 @@ def tune_cmd(
         console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
         for path in written:
             err_console.print(f"wrote {path}", markup=False)
+
+
+def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
+    """The metrics the scenarios' worlds give a meaning: all of them once a world has a lamp, else only
+    collisions (in a room without lamps every candidate would tie on a lamp objective)."""
+    if any(world.lamps for world in plan.worlds):
+        return METRICS
+    if objective != "collisions":
+        from tablebot.diagnostics import fail
+
+        names = ", ".join(world.name for world in plan.worlds)
+        raise fail("--objective", f"--objective {objective} needs a lamp, and the scenarios' world ({names}) has none",
+                   "tune for --objective collisions, or give --world a world with a [[lamp]]")
+    return ("collisions",)
 
 
 def tuned_path(table: Path, out: Path) -> Path:
