@@ -109,6 +109,20 @@ def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
         assert "--seeds" not in output, output  # the option given, not the one whose words it shares
 
 
+def test_a_second_run_replaces_the_tuned_table_only_with_force(tmp_path: Path) -> None:
+    """Refused before the search (nothing else rewritten), as every command refuses to replace a table."""
+    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3")
+    assert code == 0, output
+    before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3")
+    assert code == 2 and output.startswith(f"{out / 'table.tuned.csv'}: error:") and "--force" in output, output
+    assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3", "--force")
+    assert code == 0, output
+    assert (out / "table.tuned.csv.bak").read_bytes() == (out / "table.tuned.csv").read_bytes()
+
+
 def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) -> None:
     """Every candidate would tie (never reached): the objective is named, collisions still tune."""
     dark = HALL.replace("[[lamp]]\nat = [1.5, 1.5]\nradius = 0\n", "")

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
+from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
 from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, make_plan
 
 if TYPE_CHECKING:
@@ -47,9 +47,11 @@ def tune_cmd(
                              "convergence.png."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no report on the terminal."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
     runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    from tablebot import guard
     from tablebot.diagnostics import fail
     from tablebot.sweep import parse_seeds
     from tablebot.sweep_backends import Runner, choose
@@ -66,6 +68,7 @@ def tune_cmd(
     tuned_cells = parse_cells(cells, plan.table)
     out_folder(out, "--out")
     target = tuned_path(Path(plan.table.path), out)
+    guard.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     started = time.perf_counter()
     with Runner(chosen, address, workers) as runner, Bar(budget, quiet) as bar:
