@@ -3,6 +3,8 @@ CMA-ES), the tuned table as a new file differing only in the tuned cells, and ba
 
 from __future__ import annotations
 
+import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -72,6 +74,13 @@ def test_the_grid_finds_the_stopping_time_computed_by_hand(tmp_path: Path) -> No
     report = (out / "report.md").read_text(encoding="utf-8")
     assert "grid, 801 candidates" in report
     assert (out / "convergence.png").stat().st_size > 10_000
+    command = shlex.split(report.rsplit("`", 2)[1])  # the report's last line: how to simulate the tuned table
+    assert command[:3] == ["tablebot", "sim", str(out / "table.tuned.csv")]
+    assert command[3:] == ["--robot", str(tmp_path / "robot.toml"), "--world", str(tmp_path / "hall.toml")]
+    ran = CliRunner().invoke(app, [*command[1:], "--seconds", "1", "--no-plots", "--out", str(tmp_path / "sim")])
+    assert ran.exit_code == 0, ran.output
+    first = json.loads((tmp_path / "sim" / "trace.jsonl").read_text(encoding="utf-8").splitlines()[0])
+    assert (first["x"], first["y"], first["heading"]) == (0.5, 1.5, 0.0)  # the hall's start, not an empty room's
 
 
 def test_cma_es_finds_the_optimum_of_two_timers_that_add_up(tmp_path: Path) -> None:

@@ -85,7 +85,7 @@ def tune_cmd(
                write_evaluations(evaluate, out / "evaluations.csv"),
                convergence(evaluate, method, out / "convergence.png"),
                write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
-                            time.perf_counter() - started)]
+                            time.perf_counter() - started, target)]
     if not quiet:
         console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
         for path in written:
@@ -185,7 +185,7 @@ def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
 
 
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
-                 before_after: dict[str, list[float]], path: Path, wall_s: float) -> Path:
+                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path) -> Path:
     from tablebot.files import write_text
 
     spec, cells = plan.spec, evaluate.cells
@@ -202,7 +202,20 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
               f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
     for metric, (a, b) in before_after.items():
         lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
+    lines += ["", f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
     return write_text(path, "\n".join(lines) + "\n")
+
+
+def sim_command(plan: Plan, tuned: Path) -> str:
+    """``tablebot sim`` of the tuned table with the robot file and world it was tuned with: beside it in
+    OUT there are neither, and on its own it would get the built-in BumberBot in an empty room."""
+    from tablebot.escape import shell_word
+
+    words = ["tablebot", "sim", str(tuned)]
+    for option, given in (("--robot", plan.table.robot.source), ("--world", plan.spec.worlds[0])):
+        if Path(given).is_file():
+            words += [option, given]
+    return " ".join(shell_word(word) for word in words)
 
 
 class Bar:
