@@ -132,6 +132,19 @@ def test_a_second_run_replaces_the_tuned_table_only_with_force(tmp_path: Path) -
     assert (out / "table.tuned.csv.bak").read_bytes() == (out / "table.tuned.csv").read_bytes()
 
 
+def test_a_timer_written_in_seconds_is_tuned_in_seconds(tmp_path: Path) -> None:
+    """``5s`` tuned to N ticks is written N × 10 ms in seconds: a bare N would read as N ticks, far less."""
+    from tablebot.durations import to_ticks
+
+    code, output, out = tune(tmp_path, ['go,1,1,,8,8,5s,2', 'stop,2,1,,0,0,0,2'], "--cells",
+                             "line 2 timer=100..800", "--budget", "4")
+    assert code == 0, output
+    cell = (out / "table.tuned.csv").read_text(encoding="utf-8").splitlines()[1].split(",")[6]
+    after = int(next(line for line in output.splitlines() if line.startswith("| line 2 timer |")).split("|")[3])
+    assert cell.endswith("s") and not cell.endswith("ms") and to_ticks(cell, 10) == after, (cell, after)
+    assert "Timers count ticks of 10 ms" in output
+
+
 def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) -> None:
     """Every candidate would tie (never reached): the objective is named, collisions still tune."""
     dark = HALL.replace("[[lamp]]\nat = [1.5, 1.5]\nradius = 0\n", "")

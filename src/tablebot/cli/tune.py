@@ -124,10 +124,29 @@ def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Pa
     doc = CsvDocument.from_bytes(source.read_bytes(), str(source))
     header = [h.strip().lower() for h in doc.header_values()]
     lines = doc.record_lines()
+    grid = doc.grid()
     for cell, value in zip(cells, values, strict=True):
         grid_row = next(g for g, index in enumerate(doc.row_ids) if lines[index] == cell.line)
-        doc.set_cell(grid_row, header.index(cell.column.lower()), str(value))
+        column = header.index(cell.column.lower())
+        text = str(value) if cell.counter is not None else \
+            as_written(grid[grid_row][column], value, plan.table.robot.tick_ms)
+        doc.set_cell(grid_row, column, text)
     return write_bytes(path, doc.to_bytes())
+
+
+def as_written(old: str, ticks: int, tick_ms: int) -> str:
+    """A tuned timer in the unit its cell was written in: ``300ms`` tuned to 45 ticks of 10 ms is
+    ``450ms`` (not ``45``, which reads as a shorter time), ``0.5 s`` stays seconds, a bare number counts ticks."""
+    from decimal import Decimal
+
+    from tablebot.durations import DURATION_RE, MS_PER
+
+    match = DURATION_RE.match(old)
+    if match is None:
+        return str(ticks)
+    unit = (match[2] or "").lower()
+    number = format(Decimal(ticks * tick_ms) / MS_PER[unit], "f") if unit in MS_PER else str(ticks)
+    return old[:match.start(1)] + number + old[match.end(1):]
 
 
 def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
@@ -198,6 +217,9 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
              f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
              "| cell | before | after |", "|---|---|---|"]
     lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
+    if any(c.counter is None for c in cells):
+        lines += ["", f"Timers count ticks of {plan.table.robot.tick_ms} ms (the tuned table writes each in its "
+                  "cell's own unit)."]
     lines += ["", f"Checked on {check.spec.total} fresh scenarios (seeds {check.spec.seeds[0]}.."
               f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
     for metric, (a, b) in before_after.items():
