@@ -64,6 +64,24 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
     assert code == 2 and "--out holds the results of a different sweep" in output
 
 
+def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
+    """Random starts as the plan draws them (the traced run begins there), given poses as given."""
+    from tablebot.cli.fleet import make_plan
+    from tablebot.sweep import runs
+
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "start=random,0.5:0.5:20", "--seeds", "0..2", "--seconds", "1", "--workers", "1",
+                         "--out", str(out), "--no-plots", "--trace", "1")
+    assert code == 0, output
+    rows = read_results(out / "results.csv")
+    starts = [(float(r["start_x"]), float(r["start_y"]), float(r["start_heading"])) for r in rows]
+    plan = make_plan(BUMBERBOT, None, [], ["start=random"], "0..2", None, 1.0)
+    assert starts[:3] == [plan.robot(run).start for run in runs(plan.spec)]
+    assert len(set(starts[:3])) == 3 and starts[3:] == [(0.5, 0.5, 20.0)] * 3
+    first = json.loads((out / "trace-1.jsonl").read_text(encoding="utf-8").splitlines()[0])
+    assert (first["x"], first["y"], first["heading"]) == starts[1]
+
+
 def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",

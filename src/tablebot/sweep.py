@@ -26,6 +26,7 @@ from tablebot.sim.world import inside
 
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000
+START_COLUMNS = ("start_x", "start_y", "start_heading")  # a run's start pose in its result row
 RANGE_RE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
 
 
@@ -38,7 +39,7 @@ class Axis:
 
     @property
     def columns(self) -> tuple[str, ...]:
-        return ("start_x", "start_y", "start_heading") if self.key == "start" else (self.key,)
+        return START_COLUMNS if self.key == "start" else (self.key,)
 
 
 @dataclass(frozen=True)
