@@ -6,13 +6,13 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, make_plan
+from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
 
 if TYPE_CHECKING:
     from tablebot.sweep_run import Plan
@@ -71,7 +71,7 @@ def tune_cmd(
     guard.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     started = time.perf_counter()
-    with Runner(chosen, address, workers) as runner, Bar(budget, quiet) as bar:
+    with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
         evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance)
         baseline = tuple(c.value for c in tuned_cells)
         evaluate([baseline])
@@ -238,28 +238,3 @@ def sim_command(plan: Plan, tuned: Path) -> str:
         if Path(given).is_file():
             words += [option, given]
     return " ".join(shell_word(word) for word in words)
-
-
-class Bar:
-    """Progress over the budget of candidates (on a terminal)."""
-
-    def __init__(self, total: int, quiet: bool):
-        self.total, self.quiet = total, quiet or not err_console.is_terminal
-
-    def __enter__(self) -> Bar:
-        if not self.quiet:
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-            self.bar = Progress(TextColumn("candidates"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                                console=err_console, transient=True)
-            self.bar.__enter__()
-            self.task = self.bar.add_task("tune", total=self.total)
-        return self
-
-    def advance(self, count: int) -> None:
-        if not self.quiet:
-            self.bar.update(self.task, advance=count)
-
-    def __exit__(self, *exc: Any) -> None:
-        if not self.quiet:
-            self.bar.__exit__(None, None, None)
