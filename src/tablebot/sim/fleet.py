@@ -121,20 +121,19 @@ class Fleet:
         self.counts = np.zeros((n, n_states), dtype=np.int64)
         self.first_visit = np.full((n, n_states), NO_TICK, dtype=np.int64)
         self.first_light = np.full(n, NO_TICK, dtype=np.int64)
-        self.variant = np.array([spec.variant for spec in self.specs], dtype=np.int64)
+        self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
             robot = self.place(i, spec, scene, record=i in traced)
+            if i == 0:  # the world and wiring as SimRobot packs them: shared by all, never rebuilt here
+                self.world, self.drive, self.pcols = robot._world, robot._drive, robot._pcols
             if i in traced:
                 self.traced[i] = len(self.traces)
                 self.traces[i] = Trace(robot)
-        # the world, wiring and trace blocks as SimRobot packs them: shared, never rebuilt here
-        robot = self.traces[min(self.traces)].robot if self.traces else SimRobot(self.scenes[0], 0, False)
-        self.world = robot._world
-        self.bits, self.drive, self.pcols = self.scenes[0].bits, robot._drive, robot._pcols
+        self.bits = self.scenes[0].bits
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
@@ -182,9 +181,9 @@ class Fleet:
                   self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, noise, self.acc,
                   self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
                   self.traced, hist, ints)
+        n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]
-            n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
             trace.blocks.append(trace.robot._block(self.t0, ints[slot], hist[slot], n_out, n_c))
             trace.rows.append(hist[slot])
         self.t0 += ticks
