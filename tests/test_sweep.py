@@ -110,7 +110,7 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
 @pytest.fixture
 def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
     """A real Dask scheduler and two single-threaded workers on this machine (separate processes)."""
-    pytest.importorskip("distributed")
+    pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")
     dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
     file = tmp_path / "scheduler.json"
     procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
