@@ -80,6 +80,8 @@ def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     assert len(set(starts[:3])) == 3 and starts[3:] == [(0.5, 0.5, 20.0)] * 3
     first = json.loads((out / "trace-1.jsonl").read_text(encoding="utf-8").splitlines()[0])
     assert (first["x"], first["y"], first["heading"]) == starts[1]
+    counted = [line.split(": ")[1].split()[0] for line in output.splitlines() if line.startswith("start ")]
+    assert [c.split("/")[1] for c in counted] == ["3", "3"], output  # random starts are not every start
 
 
 def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:

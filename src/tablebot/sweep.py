@@ -203,6 +203,14 @@ def runs(spec: SweepSpec, first: int = 0, stop: int | None = None) -> list[Run]:
     return out
 
 
+def value_index(spec: SweepSpec, index: int, axis: int) -> int:
+    """Which of ``spec.axes[axis]``'s values run ``index`` has (in the order of :func:`runs`: the last
+    axis turns fastest)."""
+    combo = index % spec.runs_per_world // len(spec.seeds)
+    after = math.prod(len(a.values) for a in spec.axes[axis + 1:])
+    return combo // after % len(spec.axes[axis].values)
+
+
 def chunks(spec: SweepSpec, size: int | None = None) -> list[tuple[int, int]]:
     """The spec's runs cut into chunks ``[a, b)`` that never span two worlds. The size depends on the
     spec alone (never on the machine), so a resumed sweep finds the same chunks."""
