@@ -84,6 +84,17 @@ def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     assert [c.split("/")[1] for c in counted] == ["3", "3"], output  # random starts are not every start
 
 
+def test_worlds_are_told_apart_by_name(tmp_path: Path) -> None:
+    """Two files both called arena.toml: the summary (and outcomes.png) name each world, its own runs."""
+    other = BUMBERBOT.parent / "obstacle-avoider" / "arena.toml"
+    code, output = sweep("--world", str(BUMBERBOT / "arena.toml"), "--world", str(other), "--seeds", "0..1",
+                         "--seconds", "1", "--workers", "1", "--out", str(tmp_path / "s"), "--no-plots")
+    assert code == 0, output
+    worlds = [line.split(": ")[0] for line in output.splitlines() if line.startswith("world ")]
+    assert worlds == ["world BumberBot arena", "world cluttered room"], output
+    assert output.count("/2 ") == 2, output
+
+
 def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",

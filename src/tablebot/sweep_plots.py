@@ -33,8 +33,10 @@ def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, l
     """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
     out = []
     if len(plan.spec.worlds) > 1:
-        out.append(("world", [(Path(w).stem or "default", [r for r in rows if r["world"] == w])
-                              for w in plan.spec.worlds]))
+        by_world: list[list[Row]] = [[] for _ in plan.worlds]
+        for r in rows:
+            by_world[int(r["run"]) // plan.spec.runs_per_world].append(r)
+        out.append(("world", list(zip(world_labels(plan), by_world, strict=True))))
     for k, axis in enumerate(plan.spec.axes):
         if len(axis.values) < 2:
             continue
@@ -45,6 +47,12 @@ def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, l
                   for value in axis.values]
         out.append((axis.key, list(zip(labels, chosen, strict=True))))
     return out or [("all runs", [("all", list(rows))])]
+
+
+def world_labels(plan: Plan) -> list[str]:
+    """Each world's name, numbered where two share one (two files both called arena.toml, say)."""
+    names = [world.name for world in plan.worlds]
+    return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]
 
 
 def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
