@@ -151,8 +151,7 @@ def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) ->
     rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
     code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", world=dark)
     assert code == 2, output
-    assert output.startswith("--objective: error: --objective lamp_distance needs a lamp, and the scenarios' "
-                             "world (hall) has none"), output
+    assert output.startswith("--objective: error: --objective lamp_distance needs a lamp, and hall has none"), output
     code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", "--objective", "collisions",
                              world=dark)
     assert code == 0, output

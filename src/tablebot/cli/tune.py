@@ -93,17 +93,17 @@ def tune_cmd(
 
 
 def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
-    """The metrics the scenarios' worlds give a meaning: all of them once a world has a lamp, else only
-    collisions (in a room without lamps every candidate would tie on a lamp objective)."""
-    if any(world.lamps for world in plan.worlds):
-        return METRICS
-    if objective != "collisions":
+    """The metrics the scenarios' worlds give a meaning. Without a lamp anywhere only collisions (every
+    candidate would tie on the others); the distance to the nearest lamp needs one in every world."""
+    dark = [world.name for world in plan.worlds if not world.lamps]
+    usable = METRICS if not dark else ("collisions",) if len(dark) == len(plan.worlds) else \
+        tuple(m for m in METRICS if m != "lamp_distance")
+    if objective not in usable:
         from tablebot.diagnostics import fail
 
-        names = ", ".join(world.name for world in plan.worlds)
-        raise fail("--objective", f"--objective {objective} needs a lamp, and the scenarios' world ({names}) has none",
-                   "tune for --objective collisions, or give --world a world with a [[lamp]]")
-    return ("collisions",)
+        raise fail("--objective", f"--objective {objective} needs a lamp, and {', '.join(dark)} has none",
+                   f"tune for {' or '.join(f'--objective {m}' for m in usable)}, or give every --world a [[lamp]]")
+    return usable
 
 
 def tuned_path(table: Path, out: Path) -> Path:
