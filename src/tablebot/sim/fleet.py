@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
@@ -24,7 +25,7 @@ from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import PATH_STRIDE, Result
 from tablebot.sim.scene import Scene, _check_start, prepare
 from tablebot.sim.summary import Summary, light_bits, seconds_per_state
-from tablebot.sim.world import World
+from tablebot.sim.world import World, inside
 from tablebot.table import Table
 from tablebot.tick import STATE, registers
 from tablebot.trace import block_lines
@@ -222,9 +223,14 @@ class Fleet:
 
 
 def with_start(scene: Scene, start: Pose | None) -> Scene:
-    """The scene with the robot starting at ``start`` (checked free of walls and obstacles)."""
+    """The scene with the robot starting at ``start`` (checked inside the walls, as a world file's [start]
+    is, and free of walls and obstacles)."""
     if start is None:
         return scene
     world = replace(scene.world, start=tuple(float(v) for v in start))
+    x, y, heading = world.start
+    if world.walls and not inside(world.walls, (x, y)):
+        raise fail(world.path, f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the "
+                   "arena walls", "choose a start inside the [arena] walls")
     _check_start(world, scene.geometry, scene.P)
     return replace(scene, world=world)
