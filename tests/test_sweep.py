@@ -182,6 +182,7 @@ def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list
     assert code == 2, output
     assert output.startswith(f"{option}: error:") and words in output, output
     assert "Traceback" not in output
+    assert not (tmp_path / "s").exists()  # nothing written: the mended command is no "different sweep"
 
 
 def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,

@@ -111,7 +111,7 @@ def test_bad_cells_are_clear_errors_naming_the_option(tmp_path: Path, cells: str
 
 def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
     for args, option in ((["--objective", "speed"], "--objective"), (["--method", "bayes"], "--method"),
-                         (["--check-seeds", "9..3"], "--check-seeds")):
+                         (["--check-seeds", "9..3"], "--check-seeds"), (["--grid", "start=0.05:1.5:0"], "--grid")):
         code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer",
                                *args)
         assert code == 2 and output.startswith(f"{option}: error:"), output

@@ -42,6 +42,7 @@ class Plan:
 
     def __post_init__(self) -> None:
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+        self._check_starts()
 
     def columns(self) -> list[str]:
         axes = [c for axis in self.spec.axes for c in axis.columns]
@@ -72,7 +73,6 @@ class Plan:
     def jobs(self, skip: Collection[tuple[int, int]] = ()) -> list[Job]:
         """A job per chunk of the spec that is not in ``skip`` (chunks already finished); its info keeps
         each robot's start (None: the world's) for the result rows."""
-        self._check_starts()
         out = []
         for a, b in chunks(self.spec):
             if (a, b) in skip:
@@ -84,16 +84,16 @@ class Plan:
         return out
 
     def _check_starts(self) -> None:
-        """Every ``--grid start`` pose is free in every world: checked once here, not per seed (random
-        starts are drawn free)."""
+        """Every ``--grid start`` pose is free in every world: checked once, before anything is written or
+        run, not per seed (random starts are drawn free)."""
         poses = [tuple(v) for axis in self.spec.axes if axis.key == "start" for v in axis.values if v != "random"]
         for scene in self.scenes:
             for pose in poses:
                 try:
                     with_start(scene, pose)
-                except TableBotError as exc:
-                    raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}", "choose a free start pose") \
-                        from None
+                except TableBotError as exc:  # the world's words, about the option
+                    raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
+                               "choose a start pose inside the walls, clear of walls and obstacles") from None
 
     def traced(self, index: int) -> Fleet:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
