@@ -195,7 +195,7 @@ class Fleet:
         return FleetSummary(
             ticks=self.t0, tick_s=self.tick_s, states=self.machine.states, first_light=self.first_light.copy(),
             reached=self.acc[:, K.A_REACHED].astype(np.int64), collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
-            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
+            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v.copy(),
             battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
             first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
             final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_model.lamps))
