@@ -167,6 +167,8 @@ def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask
     (["--grid", "start=1:2", "--robots", "2"], "--grid", "start: '1:2' is not a pose"),
     (["--grid", "start=0.05:0.05:0", "--robots", "2"], "--grid", "overlaps a wall"),
     (["--grid", "start=9:9:0", "--robots", "2"], "--grid", "(9, 9, heading 0°) lies outside the arena walls"),
+    (["--grid", "body.half_width=0.09,0.01", "--robots", "2"], "--grid",
+     "--grid body.half_width=0.01: bumper_overlap must not exceed half_width"),
     (["--grid", "battery", "--robots", "2"], "--grid", "is not KEY=VALUES"),
     (["--seeds", "9..3"], "--seeds", "--seeds 9..3 is an empty range"),
     (["--seeds", "a..b"], "--seeds", "is not a seed or a range"),

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import re
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
@@ -42,6 +43,7 @@ class Plan:
 
     def __post_init__(self) -> None:
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+        self._check_params()
         self._check_starts()
 
     def columns(self) -> list[str]:
@@ -82,6 +84,22 @@ class Plan:
             out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
                            first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
         return out
+
+    def _check_params(self) -> None:
+        """Every combination of ``--grid`` parameters makes a scene in every world (the simulator's limits,
+        the tick, the robot's body at the world's start), checked here before anything is written or run:
+        a worker would blame the robot file for a value the grid set."""
+        axes = [axis for axis in self.spec.axes if axis.key != "start"]
+        for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
+            overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
+                                                                                          strict=True))).overrides()
+            for world in self.worlds:
+                try:
+                    prepare(self.table, self.machine, world, self.robot_params, overrides)
+                except TableBotError as exc:
+                    setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
+                    raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
+                               "choose --grid values the simulated robot can take") from None
 
     def _check_starts(self) -> None:
         """Every ``--grid start`` pose is free in every world: checked once, before anything is written or
