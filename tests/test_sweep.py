@@ -84,6 +84,17 @@ def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     assert [c.split("/")[1] for c in counted] == ["3", "3"], output  # random starts are not every start
 
 
+def test_a_random_start_fits_every_body_of_the_grid(tmp_path: Path) -> None:
+    """Drawn once per seed for every grid value (common random numbers), so free for the widest body too."""
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "start=random", "--grid", "body.half_width=0.09,0.2", "--robots", "60",
+                         "--seconds", "0.1", "--workers", "1", "--out", str(out), "--no-plots")
+    assert code == 0, output
+    rows = read_results(out / "results.csv")
+    starts = [(r["seed"], r["start_x"], r["start_y"], r["start_heading"]) for r in rows]
+    assert starts[:60] == starts[60:] and len(set(starts)) == 60
+
+
 def test_worlds_are_told_apart_by_name(tmp_path: Path) -> None:
     """Two files both called arena.toml: the summary (and outcomes.png) name each world, its own runs."""
     other = BUMBERBOT.parent / "obstacle-avoider" / "arena.toml"

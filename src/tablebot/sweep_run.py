@@ -43,7 +43,7 @@ class Plan:
 
     def __post_init__(self) -> None:
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
-        self._check_params()
+        self.bodies: list[list[Scene]] = self._check_params()
         self._check_starts()
 
     def columns(self) -> list[str]:
@@ -64,9 +64,12 @@ class Plan:
         return RobotSpec(seed=run.seed, start=start, params=tuple(params))
 
     def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
+        """Whether a pose is a free start in the world for every robot body of the grid (a random start
+        serves every grid value of its seed)."""
         def free(pose: tuple[float, float, float]) -> bool:
             try:
-                with_start(self.scenes[world], pose)
+                for scene in self.bodies[world]:
+                    with_start(scene, pose)
             except TableBotError:
                 return False
             return True
@@ -85,33 +88,38 @@ class Plan:
                            first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
         return out
 
-    def _check_params(self) -> None:
+    def _check_params(self) -> list[list[Scene]]:
         """Every combination of ``--grid`` parameters makes a scene in every world (the simulator's limits,
         the tick, the robot's body at the world's start), checked here before anything is written or run:
-        a worker would blame the robot file for a value the grid set."""
+        a worker would blame the robot file for a value the grid set. Returns per world a scene for each
+        robot body the grid gives (the starts must fit them all)."""
         axes = [axis for axis in self.spec.axes if axis.key != "start"]
+        bodies = [{_body(scene): scene} for scene in self.scenes]
         for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
             overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
                                                                                           strict=True))).overrides()
-            for world in self.worlds:
+            for world, found in zip(self.worlds, bodies, strict=True):
                 try:
-                    prepare(self.table, self.machine, world, self.robot_params, overrides)
+                    scene = prepare(self.table, self.machine, world, self.robot_params, overrides)
                 except TableBotError as exc:
                     setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
                     raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
                                "choose --grid values the simulated robot can take") from None
+                found.setdefault(_body(scene), scene)
+        return [list(found.values()) for found in bodies]
 
     def _check_starts(self) -> None:
-        """Every ``--grid start`` pose is free in every world: checked once, before anything is written or
-        run, not per seed (random starts are drawn free)."""
+        """Every ``--grid start`` pose is free in every world for every robot body: checked once, before
+        anything is written or run, not per seed (random starts are drawn free)."""
         poses = [tuple(v) for axis in self.spec.axes if axis.key == "start" for v in axis.values if v != "random"]
-        for scene in self.scenes:
-            for pose in poses:
-                try:
-                    with_start(scene, pose)
-                except TableBotError as exc:  # the world's words, about the option
-                    raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
-                               "choose a start pose inside the walls, clear of walls and obstacles") from None
+        for scenes in self.bodies:
+            for scene in scenes:
+                for pose in poses:
+                    try:
+                        with_start(scene, pose)
+                    except TableBotError as exc:  # the world's words, about the option
+                        raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
+                                   "choose a start pose inside the walls, clear of walls and obstacles") from None
 
     def traced(self, index: int) -> Fleet:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
@@ -144,6 +152,11 @@ class Plan:
             row.update({f"time_{state}_s": round(s.state_seconds.get(state, 0.0), 6) for state in self.machine.states})
             out.append(row)
         return out
+
+
+def _body(scene: Scene) -> tuple:
+    """What decides whether a start pose is free for the robot: its body's measures."""
+    return tuple(sorted(scene.params["body"].items()))
 
 
 def _time(value: float | None) -> float | None:
