@@ -143,32 +143,37 @@ def sweep_plan(robots: int, seconds: float):  # type: ignore[no-untyped-def]
     return make_plan(EXAMPLE, None, [], [], None, robots, seconds)
 
 
-def sweep_seconds(plan, backend: str, address: str | None) -> float:  # type: ignore[no-untyped-def]
-    """Wall seconds of the sweep's runs through a backend (results collected, no files written)."""
-    from tablebot.sweep_backends import run_jobs
-
+def sweep_seconds(plan, runner) -> float:  # type: ignore[no-untyped-def]
+    """Wall seconds of the sweep's runs through an open backend (results collected, no files written)."""
     rows: list[int] = []
     started = time.perf_counter()
-    run_jobs(plan.jobs(), lambda job, summary: rows.append(len(summary)), backend, address)
+    runner.run(plan.jobs(), lambda job, summary: rows.append(len(summary)))
     elapsed = time.perf_counter() - started
     assert sum(rows) == plan.spec.total
     return elapsed
 
 
-def dask_vs_local(robots: int, seconds: float, repeat: int) -> tuple[list[float], list[float]]:
+def dask_vs_local(robots: int, seconds: float, repeat: int) -> tuple[list[float], list[float], int]:
+    """Wall seconds of each repeat through the local backend and through Dask, and the robot-ticks of one.
+
+    Each backend stays open over the repeats (as through one command): the local worker processes start
+    and load the kernels once, as the Dask workers do, so the ratio is the scheduling overhead alone."""
     from distributed import LocalCluster
+
+    from tablebot.sweep_backends import Runner
 
     plan = sweep_plan(robots, seconds)
     small = sweep_plan(64, 1.0)
     local, dask = [], []
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as cluster:
-        sweep_seconds(small, "dask", cluster.scheduler_address)  # warm: workers load the kernel
-        sweep_seconds(small, "local", None)
+                      silence_logs=logging.ERROR) as cluster, Runner("local", workers=2) as on_local, \
+            Runner("dask", cluster.scheduler_address) as on_dask:
+        sweep_seconds(small, on_dask)  # warm: the workers load the kernel
+        sweep_seconds(small, on_local)  # warm: the worker processes start and load it
         for _ in range(repeat):
-            local.append(sweep_seconds(plan, "local", None))
-            dask.append(sweep_seconds(plan, "dask", cluster.scheduler_address))
-    return local, dask
+            local.append(sweep_seconds(plan, on_local))
+            dask.append(sweep_seconds(plan, on_dask))
+    return local, dask, plan.spec.total * plan.spec.ticks
 
 
 def peak_memory(robots: int, seconds: float) -> tuple[float, float]:
@@ -220,8 +225,7 @@ def main() -> None:
         print(f"  {name:<36} {value:6.0f}")
     if not args.no_dask:
         robots = 1_000 if args.quick else 10_000
-        local, dask = dask_vs_local(robots, args.sweep_seconds, args.repeat)
-        ticks = robots * round(args.sweep_seconds * 100)
+        local, dask, ticks = dask_vs_local(robots, args.sweep_seconds, args.repeat)
         a, b = statistics.median(local), statistics.median(dask)
         print(f"sweep of {robots:,} robots × {args.sweep_seconds:g} s: local backend {a:.2f} s "
               f"({ticks / a / 1e6:.2f} M robot-ticks/s), Dask 2 workers {b:.2f} s ({ticks / b / 1e6:.2f} M/s): "

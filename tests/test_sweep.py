@@ -64,6 +64,48 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
     assert code == 2 and "--out holds the results of a different sweep" in output
 
 
+def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
+    """Random starts as the plan draws them (the traced run begins there), given poses as given."""
+    from tablebot.cli.fleet import make_plan
+    from tablebot.sweep import runs
+
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "start=random,0.5:0.5:20", "--seeds", "0..2", "--seconds", "1", "--workers", "1",
+                         "--out", str(out), "--no-plots", "--trace", "1")
+    assert code == 0, output
+    rows = read_results(out / "results.csv")
+    starts = [(float(r["start_x"]), float(r["start_y"]), float(r["start_heading"])) for r in rows]
+    plan = make_plan(BUMBERBOT, None, [], ["start=random"], "0..2", None, 1.0)
+    assert starts[:3] == [plan.robot(run).start for run in runs(plan.spec)]
+    assert len(set(starts[:3])) == 3 and starts[3:] == [(0.5, 0.5, 20.0)] * 3
+    first = json.loads((out / "trace-1.jsonl").read_text(encoding="utf-8").splitlines()[0])
+    assert (first["x"], first["y"], first["heading"]) == starts[1]
+    counted = [line.split(": ")[1].split()[0] for line in output.splitlines() if line.startswith("start ")]
+    assert [c.split("/")[1] for c in counted] == ["3", "3"], output  # random starts are not every start
+
+
+def test_a_random_start_fits_every_body_of_the_grid(tmp_path: Path) -> None:
+    """Drawn once per seed for every grid value (common random numbers), so free for the widest body too."""
+    out = tmp_path / "s"
+    code, output = sweep("--grid", "start=random", "--grid", "body.half_width=0.09,0.2", "--robots", "60",
+                         "--seconds", "0.1", "--workers", "1", "--out", str(out), "--no-plots")
+    assert code == 0, output
+    rows = read_results(out / "results.csv")
+    starts = [(r["seed"], r["start_x"], r["start_y"], r["start_heading"]) for r in rows]
+    assert starts[:60] == starts[60:] and len(set(starts)) == 60
+
+
+def test_worlds_are_told_apart_by_name(tmp_path: Path) -> None:
+    """Two files both called arena.toml: the summary (and outcomes.png) name each world, its own runs."""
+    other = BUMBERBOT.parent / "obstacle-avoider" / "arena.toml"
+    code, output = sweep("--world", str(BUMBERBOT / "arena.toml"), "--world", str(other), "--seeds", "0..1",
+                         "--seconds", "1", "--workers", "1", "--out", str(tmp_path / "s"), "--no-plots")
+    assert code == 0, output
+    worlds = [line.split(": ")[0] for line in output.splitlines() if line.startswith("world ")]
+    assert worlds == ["world BumberBot arena", "world cluttered room"], output
+    assert output.count("/2 ") == 2, output
+
+
 def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",
@@ -92,7 +134,7 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
 @pytest.fixture
 def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
     """A real Dask scheduler and two single-threaded workers on this machine (separate processes)."""
-    pytest.importorskip("distributed")
+    pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")
     dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
     file = tmp_path / "scheduler.json"
     procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
@@ -135,6 +177,9 @@ def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask
     (["--grid", "battery=1.0,1.5", "--robots", "2"], "--grid", "battery: 1.5 is out of range"),
     (["--grid", "start=1:2", "--robots", "2"], "--grid", "start: '1:2' is not a pose"),
     (["--grid", "start=0.05:0.05:0", "--robots", "2"], "--grid", "overlaps a wall"),
+    (["--grid", "start=9:9:0", "--robots", "2"], "--grid", "(9, 9, heading 0°) lies outside the arena walls"),
+    (["--grid", "body.half_width=0.09,0.01", "--robots", "2"], "--grid",
+     "--grid body.half_width=0.01: bumper_overlap must not exceed half_width"),
     (["--grid", "battery", "--robots", "2"], "--grid", "is not KEY=VALUES"),
     (["--seeds", "9..3"], "--seeds", "--seeds 9..3 is an empty range"),
     (["--seeds", "a..b"], "--seeds", "is not a seed or a range"),
@@ -150,6 +195,7 @@ def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list
     assert code == 2, output
     assert output.startswith(f"{option}: error:") and words in output, output
     assert "Traceback" not in output
+    assert not (tmp_path / "s").exists()  # nothing written: the mended command is no "different sweep"
 
 
 def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,

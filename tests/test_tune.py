@@ -3,6 +3,8 @@ CMA-ES), the tuned table as a new file differing only in the tuned cells, and ba
 
 from __future__ import annotations
 
+import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -48,11 +50,11 @@ def hand_optimum() -> float:
     return DISTANCE_M / (top_speed(quiet) * 0.010)
 
 
-def tune(tmp_path: Path, rows: list[str], *args: str) -> tuple[int, str, Path]:
+def tune(tmp_path: Path, rows: list[str], *args: str, world: str = HALL) -> tuple[int, str, Path]:
     (tmp_path / "robot.toml").write_text(ROBOT, encoding="utf-8")
     table = tmp_path / "table.csv"
     table.write_text("\r\n".join(["description,state,T,I3,M1,M2,timer,next", *rows]) + "\r\n", encoding="utf-8")
-    (tmp_path / "hall.toml").write_text(HALL, encoding="utf-8")
+    (tmp_path / "hall.toml").write_text(world, encoding="utf-8")
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["tune", str(table), "--world", str(tmp_path / "hall.toml"), "--grid",
                                       "battery=1.0", "--seeds", "0..1", "--check-seeds", "7..8", "--seconds", "9",
@@ -72,6 +74,13 @@ def test_the_grid_finds_the_stopping_time_computed_by_hand(tmp_path: Path) -> No
     report = (out / "report.md").read_text(encoding="utf-8")
     assert "grid, 801 candidates" in report
     assert (out / "convergence.png").stat().st_size > 10_000
+    command = shlex.split(report.rsplit("`", 2)[1])  # the report's last line: how to simulate the tuned table
+    assert command[:3] == ["tablebot", "sim", str(out / "table.tuned.csv")]
+    assert command[3:] == ["--robot", str(tmp_path / "robot.toml"), "--world", str(tmp_path / "hall.toml")]
+    ran = CliRunner().invoke(app, [*command[1:], "--seconds", "1", "--no-plots", "--out", str(tmp_path / "sim")])
+    assert ran.exit_code == 0, ran.output
+    first = json.loads((tmp_path / "sim" / "trace.jsonl").read_text(encoding="utf-8").splitlines()[0])
+    assert (first["x"], first["y"], first["heading"]) == (0.5, 1.5, 0.0)  # the hall's start, not an empty room's
 
 
 def test_cma_es_finds_the_optimum_of_two_timers_that_add_up(tmp_path: Path) -> None:
@@ -101,11 +110,53 @@ def test_bad_cells_are_clear_errors_naming_the_option(tmp_path: Path, cells: str
 
 
 def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
-    for args, option in ((["--objective", "speed"], "--objective"), (["--method", "bayes"], "--method")):
+    for args, option in ((["--objective", "speed"], "--objective"), (["--method", "bayes"], "--method"),
+                         (["--check-seeds", "9..3"], "--check-seeds"), (["--grid", "start=0.05:1.5:0"], "--grid")):
         code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer",
                                *args)
         assert code == 2 and output.startswith(f"{option}: error:"), output
+        assert "--seeds" not in output, output  # the option given, not the one whose words it shares
 
+
+def test_a_second_run_replaces_the_tuned_table_only_with_force(tmp_path: Path) -> None:
+    """Refused before the search (nothing else rewritten), as every command refuses to replace a table."""
+    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3")
+    assert code == 0, output
+    before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3")
+    assert code == 2 and output.startswith(f"{out / 'table.tuned.csv'}: error:") and "--force" in output, output
+    assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3", "--force")
+    assert code == 0, output
+    assert (out / "table.tuned.csv.bak").read_bytes() == (out / "table.tuned.csv").read_bytes()
+
+
+def test_a_timer_written_in_seconds_is_tuned_in_seconds(tmp_path: Path) -> None:
+    """``5s`` tuned to N ticks is written N × 10 ms in seconds: a bare N would read as N ticks, far less."""
+    from tablebot.durations import to_ticks
+
+    code, output, out = tune(tmp_path, ['go,1,1,,8,8,5s,2', 'stop,2,1,,0,0,0,2'], "--cells",
+                             "line 2 timer=100..800", "--budget", "4")
+    assert code == 0, output
+    cell = (out / "table.tuned.csv").read_text(encoding="utf-8").splitlines()[1].split(",")[6]
+    after = int(next(line for line in output.splitlines() if line.startswith("| line 2 timer |")).split("|")[3])
+    assert cell.endswith("s") and not cell.endswith("ms") and to_ticks(cell, 10) == after, (cell, after)
+    assert "Timers count ticks of 10 ms" in output
+
+
+def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) -> None:
+    """Every candidate would tie (never reached): the objective is named, collisions still tune."""
+    dark = HALL.replace("[[lamp]]\nat = [1.5, 1.5]\nradius = 0\n", "")
+    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", world=dark)
+    assert code == 2, output
+    assert output.startswith("--objective: error: --objective lamp_distance needs a lamp, and hall has none"), output
+    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", "--objective", "collisions",
+                             world=dark)
+    assert code == 0, output
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "| collisions (objective) |" in report and "lamp_distance" not in report
 
 
 def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:

@@ -49,15 +49,14 @@ class Setup:
         from tablebot.cli.common import load
         from tablebot.examples import example_path
         from tablebot.sim.runner import ticks_for
-        from tablebot.sim.scene import find_world, robot_layer, scene_for
+        from tablebot.sim.scene import find_world, prepare, robot_layer
 
         self.table, self.machine = load(Path(table) if table else example_path("bumberbot"),
                                         Path(robot) if robot else None)
         self.robot_params, robot_world = robot_layer(self.table.robot)
         self.world = find_world(self.table, Path(world) if world else None, robot_world)
         self.params = (("battery", "charge", float(battery)),) if battery is not None else ()
-        overrides = {"battery": {"charge": float(battery)}} if battery is not None else None
-        self.scene = scene_for(self.table, self.machine, Path(world) if world else None, overrides)
+        self.scene = prepare(self.table, self.machine, self.world, self.robot_params, self.spec(0).overrides())
         self.ticks = ticks_for(self.scene, seconds)
         levels = int(self.scene.params["motor"]["levels"])
         self.action_space = spaces.MultiDiscrete([2 * levels + 1, 2 * levels + 1], start=[-levels, -levels],
@@ -105,8 +104,6 @@ class TableBotEnv(gym.Env):
         return self._observation(), {"seed": robot_seed}
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        from tablebot.sim import kernel as K
-
         if action is None:  # the table drives: the engine ticks on what the robot reads
             reading = self.robot.read()
             outputs = self.engine.step(reading.mask, reading.pulses)
@@ -116,10 +113,10 @@ class TableBotEnv(gym.Env):
             outputs[self.drive[0]], outputs[self.drive[1]] = int(levels[0]), int(levels[1])
         self.robot.write(outputs)
         self.ticks += 1
-        reached = self.robot.acc[K.A_REACHED] >= 0
+        reached = self.robot.reached_row is not None
         info = {"state": self.setup.machine.states[self.engine.state], "collisions": self.robot.collision_count}
-        return (self._observation(), -self.setup.scene.tick_s, bool(reached), bool(self.ticks >= self.setup.ticks
-                                                                                    and not reached), info)
+        return self._observation(), -self.setup.scene.tick_s, reached, self.ticks >= self.setup.ticks and not reached, \
+            info
 
     def _observation(self) -> np.ndarray:
         return observe(self.robot.s[None, :])[0]
@@ -220,7 +217,6 @@ class NoiseRows:
         out = self.rows[np.arange(len(self.at)), self.at]
         self.at += 1
         return out
-
 
 
 if ENV_ID not in gym.registry:

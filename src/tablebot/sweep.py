@@ -20,12 +20,14 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import fail
+from tablebot.sim.fleet_work import Pose
 from tablebot.sim.params import DEFAULTS
+from tablebot.sim.world import inside
 
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000
+START_COLUMNS = ("start_x", "start_y", "start_heading")  # a run's start pose in its result row
 RANGE_RE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
-Pose = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,7 @@ class Axis:
 
     @property
     def columns(self) -> tuple[str, ...]:
-        return ("start_x", "start_y", "start_heading") if self.key == "start" else (self.key,)
+        return START_COLUMNS if self.key == "start" else (self.key,)
 
 
 @dataclass(frozen=True)
@@ -81,13 +83,14 @@ def digest(path: Path | None) -> str:
 # --- options ----------------------------------------------------------------------------------------
 
 
-def parse_seeds(text: str | None, robots: int | None) -> tuple[int, ...]:
-    """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1."""
+def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -> tuple[int, ...]:
+    """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1.
+    Errors name ``option`` (the same numbers are read for --check-seeds and --trace)."""
     if text is not None and robots is not None:
-        raise fail("--robots", "give --robots or --seeds, not both", "--robots N is short for --seeds 0..N-1")
+        raise fail("--robots", f"give --robots or {option}, not both", f"--robots N is short for {option} 0..N-1")
     if text is None:
         if robots is None:
-            raise fail("--seeds", "say which runs to make", "give --seeds 0..99 or --robots 100")
+            raise fail(option, "say which runs to make", f"give {option} 0..99 or --robots 100")
         if robots < 1:
             raise fail("--robots", f"--robots {robots}: there must be at least one robot", "give --robots 1 or more")
         return tuple(range(robots))
@@ -97,21 +100,21 @@ def parse_seeds(text: str | None, robots: int | None) -> tuple[int, ...]:
         if found:
             low, high = int(found[1]), int(found[2])
             if high < low:
-                raise fail("--seeds", f"--seeds {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
+                raise fail(option, f"{option} {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
             seeds.extend(range(low, high + 1))
         elif part.strip().isdigit():
             seeds.append(int(part))
         else:
-            raise fail("--seeds", f"--seeds: {part.strip()!r} is not a seed or a range",
+            raise fail(option, f"{option}: {part.strip()!r} is not a seed or a range",
                        "write whole numbers and ranges: 0..999 or 1,5,9 or 0..9,20")
         if len(seeds) > MAX_RUNS:
-            raise fail("--seeds", f"--seeds gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
+            raise fail(option, f"{option} gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
     if not seeds:
-        raise fail("--seeds", "--seeds names no seed", "give --seeds 0..99")
+        raise fail(option, f"{option} names no seed", f"give {option} 0..99")
     if min(seeds) < 0:
-        raise fail("--seeds", "--seeds: a seed is never negative", "give seeds from 0 on")
+        raise fail(option, f"{option}: a seed is never negative", "give seeds from 0 on")
     if len(set(seeds)) != len(seeds):
-        raise fail("--seeds", "--seeds names a seed twice", "name each seed once")
+        raise fail(option, f"{option} names a seed twice", "name each seed once")
     return tuple(seeds)
 
 
@@ -139,11 +142,14 @@ def known_keys() -> list[str]:
 
 def param_of(key: str) -> tuple[str, str]:
     """The [sim] section and key a grid key sets."""
-    return ("battery", "charge") if key == "battery" else tuple(key.split(".", 1))  # type: ignore[return-value]
+    if key == "battery":
+        return "battery", "charge"
+    section, _, name = key.partition(".")
+    return section, name
 
 
 def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
-    section, _, name = ("battery", ".", "charge") if key == "battery" else key.partition(".")
+    section, name = param_of(key)
     if section not in DEFAULTS or name not in DEFAULTS[section]:
         raise fail("--grid", f"--grid: unknown key {key!r}",
                    "use battery, start, or a simulator parameter such as motor.friction_volts, noise.light "
@@ -197,6 +203,14 @@ def runs(spec: SweepSpec, first: int = 0, stop: int | None = None) -> list[Run]:
     return out
 
 
+def value_index(spec: SweepSpec, index: int, axis: int) -> int:
+    """Which of ``spec.axes[axis]``'s values run ``index`` has (in the order of :func:`runs`: the last
+    axis turns fastest)."""
+    combo = index % spec.runs_per_world // len(spec.seeds)
+    after = math.prod(len(a.values) for a in spec.axes[axis + 1:])
+    return combo // after % len(spec.axes[axis].values)
+
+
 def chunks(spec: SweepSpec, size: int | None = None) -> list[tuple[int, int]]:
     """The spec's runs cut into chunks ``[a, b)`` that never span two worlds. The size depends on the
     spec alone (never on the machine), so a resumed sweep finds the same chunks."""
@@ -221,17 +235,7 @@ def random_start(seed: int, walls: Sequence[tuple[float, float]], free: Any) -> 
     for _ in range(10_000):
         x, y = rng.uniform(min(xs), max(xs)), rng.uniform(min(ys), max(ys))
         pose = (round(float(x), 4), round(float(y), 4), round(float(rng.uniform(-180.0, 180.0)), 2))
-        if inside(x, y, walls) and free(pose):
+        if inside(walls, (x, y)) and free(pose):
             return pose
     raise fail("--grid", "start=random: found no free start pose in the world", "give the world more free floor")
 
-
-def inside(x: float, y: float, polygon: Sequence[tuple[float, float]]) -> bool:
-    """Whether (x, y) lies inside the polygon (even-odd rule)."""
-    found = False
-    n = len(polygon)
-    for k in range(n):
-        (ax, ay), (bx, by) = polygon[k], polygon[(k + 1) % n]
-        if (ay > y) != (by > y) and x < ax + (y - ay) * (bx - ax) / (by - ay):
-            found = not found
-    return found

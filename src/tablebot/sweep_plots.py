@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from tablebot.sim.draw import REACHED, draw_world
 from tablebot.sim.plots import save
+from tablebot.sweep import value_index
 from tablebot.sweep_run import Plan
 
 NEVER = "#b2bec3"
@@ -30,23 +31,28 @@ def number(value: Any) -> float | None:
 
 def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, list[Row]]]]]:
     """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
-    axes = [a for a in plan.spec.axes if len(a.values) > 1]
     out = []
     if len(plan.spec.worlds) > 1:
-        out.append(("world", [(Path(w).stem or "default", [r for r in rows if r["world"] == w])
-                              for w in plan.spec.worlds]))
-    for axis in axes:
-        labelled = []
-        for value in axis.values:
-            label = ":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
-            if axis.key == "start":
-                key = tuple(value) if isinstance(value, tuple) else None
-                chosen = [r for r in rows if key is None or tuple(float(r[c]) for c in axis.columns) == key]
-            else:
-                chosen = [r for r in rows if float(r[axis.key]) == float(value)]
-            labelled.append((label, chosen))
-        out.append((axis.key, labelled))
+        by_world: list[list[Row]] = [[] for _ in plan.worlds]
+        for r in rows:
+            by_world[int(r["run"]) // plan.spec.runs_per_world].append(r)
+        out.append(("world", list(zip(world_labels(plan), by_world, strict=True))))
+    for k, axis in enumerate(plan.spec.axes):
+        if len(axis.values) < 2:
+            continue
+        chosen: list[list[Row]] = [[] for _ in axis.values]  # by the run's value (a random start has no other mark)
+        for r in rows:
+            chosen[value_index(plan.spec, int(r["run"]), k)].append(r)
+        labels = [":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
+                  for value in axis.values]
+        out.append((axis.key, list(zip(labels, chosen, strict=True))))
     return out or [("all runs", [("all", list(rows))])]
+
+
+def world_labels(plan: Plan) -> list[str]:
+    """Each world's name, numbered where two share one (two files both called arena.toml, say)."""
+    names = [world.name for world in plan.worlds]
+    return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]
 
 
 def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import re
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
@@ -22,7 +23,7 @@ from tablebot.sim.fleet import Fleet, FleetSummary, RobotSpec, with_start
 from tablebot.sim.fleet_work import Job
 from tablebot.sim.scene import Scene, prepare
 from tablebot.sim.world import World
-from tablebot.sweep import Run, SweepSpec, chunks, param_of, random_start, runs
+from tablebot.sweep import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
 from tablebot.table import Table
 
 PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
@@ -42,10 +43,12 @@ class Plan:
 
     def __post_init__(self) -> None:
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+        self.bodies: list[list[Scene]] = self._check_params()
+        self._check_starts()
 
     def columns(self) -> list[str]:
         axes = [c for axis in self.spec.axes for c in axis.columns]
-        start = [] if any(axis.key == "start" for axis in self.spec.axes) else ["start_x", "start_y", "start_heading"]
+        start = [] if any(axis.key == "start" for axis in self.spec.axes) else list(START_COLUMNS)
         states = [f"time_{state}_s" for state in self.machine.states]
         return ["run", "world", "seed", *axes, *start, *RESULT_COLUMNS, *states]
 
@@ -61,37 +64,65 @@ class Plan:
         return RobotSpec(seed=run.seed, start=start, params=tuple(params))
 
     def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
+        """Whether a pose is a free start in the world for every robot body of the grid (a random start
+        serves every grid value of its seed)."""
         def free(pose: tuple[float, float, float]) -> bool:
             try:
-                with_start(self.scenes[world], pose)
+                for scene in self.bodies[world]:
+                    with_start(scene, pose)
             except TableBotError:
                 return False
             return True
         return free
 
     def jobs(self, skip: Collection[tuple[int, int]] = ()) -> list[Job]:
-        """A job per chunk of the spec that is not in ``skip`` (chunks already finished)."""
+        """A job per chunk of the spec that is not in ``skip`` (chunks already finished); its info keeps
+        each robot's start (None: the world's) for the result rows."""
         out = []
         for a, b in chunks(self.spec):
             if (a, b) in skip:
                 continue
             chunk = runs(self.spec, a, b)
             robots = [self.robot(run) for run in chunk]
-            try:
-                for robot, run in zip(robots, chunk, strict=True):
-                    if robot.start is not None:
-                        with_start(self.scenes[run.world], robot.start)
-            except TableBotError as exc:
-                raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}", "choose a free start pose") \
-                    from None
             out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
-                           first=a, info={"stop": b}))
+                           first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
         return out
+
+    def _check_params(self) -> list[list[Scene]]:
+        """Every combination of ``--grid`` parameters makes a scene in every world (the simulator's limits,
+        the tick, the robot's body at the world's start), checked here before anything is written or run:
+        a worker would blame the robot file for a value the grid set. Returns per world a scene for each
+        robot body the grid gives (the starts must fit them all)."""
+        axes = [axis for axis in self.spec.axes if axis.key != "start"]
+        bodies = [{_body(scene): scene} for scene in self.scenes]
+        for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
+            overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
+                                                                                          strict=True))).overrides()
+            for world, found in zip(self.worlds, bodies, strict=True):
+                try:
+                    scene = prepare(self.table, self.machine, world, self.robot_params, overrides)
+                except TableBotError as exc:
+                    setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
+                    raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
+                               "choose --grid values the simulated robot can take") from None
+                found.setdefault(_body(scene), scene)
+        return [list(found.values()) for found in bodies]
+
+    def _check_starts(self) -> None:
+        """Every ``--grid start`` pose is free in every world for every robot body: checked once, before
+        anything is written or run, not per seed (random starts are drawn free)."""
+        poses = [tuple(v) for axis in self.spec.axes if axis.key == "start" for v in axis.values if v != "random"]
+        for scenes in self.bodies:
+            for scene in scenes:
+                for pose in poses:
+                    try:
+                        with_start(scene, pose)
+                    except TableBotError as exc:  # the world's words, about the option
+                        raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
+                                   "choose a start pose inside the walls, clear of walls and obstacles") from None
 
     def traced(self, index: int) -> Fleet:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
-        from tablebot.sim.fleet import Fleet
-
         run = runs(self.spec, index, index + 1)[0]
         fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
                       traced=[0])
@@ -104,20 +135,15 @@ class Plan:
                 for index in indices]
 
     def rows(self, job: Job, summary: FleetSummary) -> list[dict[str, Any]]:
-        """One result row per robot of a finished chunk."""
+        """One result row per robot of a finished chunk (its start as :meth:`jobs` kept it)."""
         out = []
         for k, run in enumerate(runs(self.spec, job.first, job.info["stop"])):
             s = summary.summary(k)
-            row: dict[str, Any] = {"run": run.index, "world": self.spec.worlds[run.world], "seed": run.seed}
-            start = None
-            for axis, value in zip(self.spec.axes, run.values, strict=True):
-                if axis.key == "start":
-                    start = self.robot(run).start
-                    row.update(zip(axis.columns, start, strict=True))  # type: ignore[arg-type]
-                else:
-                    row[axis.key] = value
-            if not any(axis.key == "start" for axis in self.spec.axes):
-                row.update(zip(("start_x", "start_y", "start_heading"), self.worlds[run.world].start, strict=True))
+            start = job.info["starts"][k] or self.worlds[run.world].start
+            row: dict[str, Any] = {"run": run.index, "world": self.spec.worlds[run.world], "seed": run.seed,
+                                   **dict(zip(START_COLUMNS, start, strict=True))}
+            row.update((axis.key, value) for axis, value in zip(self.spec.axes, run.values, strict=True)
+                       if axis.key != "start")
             row.update(seconds=round(s.seconds, 6), first_light_s=_time(s.first_light_s),
                        reached=int(s.reached_s is not None), reached_s=_time(s.reached_s), collisions=s.collisions,
                        distance_m=round(s.distance_m, 6),
@@ -126,6 +152,11 @@ class Plan:
             row.update({f"time_{state}_s": round(s.state_seconds.get(state, 0.0), 6) for state in self.machine.states})
             out.append(row)
         return out
+
+
+def _body(scene: Scene) -> tuple:
+    """What decides whether a start pose is free for the robot: its body's measures."""
+    return tuple(sorted(scene.params["body"].items()))
 
 
 def _time(value: float | None) -> float | None:

@@ -25,6 +25,7 @@ from tablebot.table import Table
 
 if TYPE_CHECKING:
     from tablebot.sim.fleet import FleetSummary
+    from tablebot.sweep_backends import Runner
 
 CELL_RE = re.compile(r"^line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$", re.IGNORECASE)
 ROBOTS_PER_JOB = 512
@@ -132,12 +133,12 @@ def losses(objective: str, s: FleetSummary, plan: Plan, world: int) -> np.ndarra
 
 @dataclass
 class Evaluator:
-    """Runs candidates on the scenario set of ``plan`` through ``runner`` (a sweep_backends.Runner)."""
+    """Runs candidates on the scenario set of ``plan`` through ``runner``."""
 
     plan: Plan
     cells: Sequence[Cell]
     objective: str
-    runner: object
+    runner: Runner
     history: list[tuple[tuple[int, ...], float]] = field(default_factory=list)
     cache: dict[tuple[int, ...], float] = field(default_factory=dict)
     on_eval: Callable[[int], None] | None = None
@@ -164,7 +165,7 @@ class Evaluator:
             for metric in metrics:
                 np.add.at(sums[metric], np.asarray(job.info["variants"]), losses(metric, summary, plan,
                                                                                    job.info["world"]))
-        self.runner.run(jobs, done)  # type: ignore[attr-defined]
+        self.runner.run(jobs, done)
         return {metric: (total / plan.spec.total).tolist() for metric, total in sums.items()}
 
 

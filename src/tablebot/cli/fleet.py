@@ -58,7 +58,7 @@ def sweep_cmd(
     jobs = plan.jobs(skip=finished)
     total, already = plan.spec.total, sum(b - a for a, b in finished)
     started = time.perf_counter()
-    with SweepProgress(total, already, plan.spec.ticks, quiet) as progress:
+    with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
         def done(job: Any, summary: Any) -> None:
             store.write_part(job, plan.rows(job, summary))
             progress.advance(len(summary))
@@ -82,10 +82,9 @@ def trace_runs(text: str | None, total: int) -> list[int]:
     if text is None:
         return []
     try:
-        chosen = parse_seeds(text, None)
-    except TableBotError as exc:  # the same words, about --trace
-        raise fail("--trace", exc.diagnostics[0].message.replace("--seeds", "--trace"),
-                   "give run numbers: 0,17 or 0..9") from None
+        chosen = parse_seeds(text, None, "--trace")
+    except TableBotError as exc:  # the words of --seeds, with a hint about run numbers
+        raise fail("--trace", exc.diagnostics[0].message, "give run numbers: 0,17 or 0..9") from None
     beyond = [k for k in chosen if k >= total]
     if beyond:
         raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")
@@ -152,32 +151,36 @@ def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: 
         err_console.print(f"wrote {p}", markup=False)
 
 
-class SweepProgress:
-    """A rich progress bar of robots done, robot-ticks per second and the time left (on a terminal)."""
+class Bar:
+    """A rich progress bar of ``label`` done out of ``total`` and the time left (on a terminal only); given
+    the robot-ticks of one item (``ticks``), also the robot-ticks per second."""
 
-    def __init__(self, total: int, done: int, ticks: int, quiet: bool):
-        self.total, self.done, self.ticks = total, done, ticks
+    def __init__(self, label: str, total: int, quiet: bool, done: int = 0, ticks: int | None = None):
+        self.label, self.total, self.done, self.ticks = label, total, done, ticks
         self.quiet = quiet or not err_console.is_terminal
         self.started = time.perf_counter()
         self.new = 0
 
-    def __enter__(self) -> SweepProgress:
+    def __enter__(self) -> Bar:
         if not self.quiet:
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-            self.bar = Progress(TextColumn("robots"), BarColumn(), MofNCompleteColumn(),
-                                TextColumn("{task.fields[rate]}"), TimeRemainingColumn(), console=err_console,
-                                transient=True)
+            rate = [TextColumn("{task.fields[rate]}")] if self.ticks else []
+            self.bar = Progress(TextColumn(self.label), BarColumn(), MofNCompleteColumn(), *rate,
+                                TimeRemainingColumn(), console=err_console, transient=True)
             self.bar.__enter__()
-            self.task = self.bar.add_task("sweep", total=self.total, completed=self.done, rate="")
+            self.task = self.bar.add_task(self.label, total=self.total, completed=self.done, rate="")
         return self
 
-    def advance(self, robots: int) -> None:
-        self.new += robots
+    def advance(self, count: int) -> None:
+        self.new += count
         if self.quiet:
             return
-        rate = self.new * self.ticks / max(time.perf_counter() - self.started, 1e-9)
-        self.bar.update(self.task, advance=robots, rate=f"{rate / 1e6:.2f} M robot-ticks/s")
+        rate = ""
+        if self.ticks:
+            per_s = self.new * self.ticks / max(time.perf_counter() - self.started, 1e-9)
+            rate = f"{per_s / 1e6:.2f} M robot-ticks/s"
+        self.bar.update(self.task, advance=count, rate=rate)
 
     def __exit__(self, *exc: object) -> None:
         if not self.quiet:

@@ -4,14 +4,15 @@ scenario set, then check the result on fresh seeds; writes the tuned table as a 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, make_plan
+from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
+from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
 
 if TYPE_CHECKING:
     from tablebot.sweep_run import Plan
@@ -46,29 +47,31 @@ def tune_cmd(
                              "convergence.png."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no report on the terminal."),
     robot: Path | None = ROBOT_OPT,
+    force: bool = FORCE_OPT,
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
     runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    from tablebot import guard
+    from tablebot.diagnostics import fail
     from tablebot.sweep import parse_seeds
     from tablebot.sweep_backends import Runner, choose
     from tablebot.tune import Evaluator, best, parse_cells, search_cma, search_grid
 
     if objective not in METRICS:
-        from tablebot.diagnostics import fail
         raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
     if method not in ("auto", "grid", "cma"):
-        from tablebot.diagnostics import fail
         raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
-    check = make_plan(table, robot, world or [], grid or ["start=random"], check_seeds, None, seconds)
-    parse_seeds(check_seeds, None)
+    metrics = measurable(plan, objective)
+    check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     tuned_cells = parse_cells(cells, plan.table)
     out_folder(out, "--out")
     target = tuned_path(Path(plan.table.path), out)
+    guard.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     started = time.perf_counter()
-    with Runner(chosen, address, workers) as runner, Bar(budget, quiet) as bar:
+    with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
         evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance)
         baseline = tuple(c.value for c in tuned_cells)
         evaluate([baseline])
@@ -77,16 +80,30 @@ def tune_cmd(
         else:
             search_cma(evaluate, budget, seed)
         winner, _ = best(evaluate.history)
-        before_after = evaluate.measure([baseline, winner], check, METRICS)
+        before_after = evaluate.measure([baseline, winner], check, metrics)
     written = [write_tuned(plan, tuned_cells, winner, target),
                write_evaluations(evaluate, out / "evaluations.csv"),
                convergence(evaluate, method, out / "convergence.png"),
                write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
-                            time.perf_counter() - started)]
+                            time.perf_counter() - started, target)]
     if not quiet:
         console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
         for path in written:
             err_console.print(f"wrote {path}", markup=False)
+
+
+def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
+    """The metrics the scenarios' worlds give a meaning. Without a lamp anywhere only collisions (every
+    candidate would tie on the others); the distance to the nearest lamp needs one in every world."""
+    dark = [world.name for world in plan.worlds if not world.lamps]
+    usable = METRICS if not dark else ("collisions",) if len(dark) == len(plan.worlds) else \
+        tuple(m for m in METRICS if m != "lamp_distance")
+    if objective not in usable:
+        from tablebot.diagnostics import fail
+
+        raise fail("--objective", f"--objective {objective} needs a lamp, and {', '.join(dark)} has none",
+                   f"tune for {' or '.join(f'--objective {m}' for m in usable)}, or give every --world a [[lamp]]")
+    return usable
 
 
 def tuned_path(table: Path, out: Path) -> Path:
@@ -107,10 +124,29 @@ def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Pa
     doc = CsvDocument.from_bytes(source.read_bytes(), str(source))
     header = [h.strip().lower() for h in doc.header_values()]
     lines = doc.record_lines()
+    grid = doc.grid()
     for cell, value in zip(cells, values, strict=True):
         grid_row = next(g for g, index in enumerate(doc.row_ids) if lines[index] == cell.line)
-        doc.set_cell(grid_row, header.index(cell.column.lower()), str(value))
+        column = header.index(cell.column.lower())
+        text = str(value) if cell.counter is not None else \
+            as_written(grid[grid_row][column], value, plan.table.robot.tick_ms)
+        doc.set_cell(grid_row, column, text)
     return write_bytes(path, doc.to_bytes())
+
+
+def as_written(old: str, ticks: int, tick_ms: int) -> str:
+    """A tuned timer in the unit its cell was written in: ``300ms`` tuned to 45 ticks of 10 ms is
+    ``450ms`` (not ``45``, which reads as a shorter time), ``0.5 s`` stays seconds, a bare number counts ticks."""
+    from decimal import Decimal
+
+    from tablebot.durations import DURATION_RE, MS_PER
+
+    match = DURATION_RE.match(old)
+    if match is None:
+        return str(ticks)
+    unit = (match[2] or "").lower()
+    number = format(Decimal(ticks * tick_ms) / MS_PER[unit], "f") if unit in MS_PER else str(ticks)
+    return old[:match.start(1)] + number + old[match.end(1):]
 
 
 def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
@@ -168,7 +204,7 @@ def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
 
 
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
-                 before_after: dict[str, list[float]], path: Path, wall_s: float) -> Path:
+                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path) -> Path:
     from tablebot.files import write_text
 
     spec, cells = plan.spec, evaluate.cells
@@ -181,33 +217,24 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
              f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
              "| cell | before | after |", "|---|---|---|"]
     lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
+    if any(c.counter is None for c in cells):
+        lines += ["", f"Timers count ticks of {plan.table.robot.tick_ms} ms (the tuned table writes each in its "
+                  "cell's own unit)."]
     lines += ["", f"Checked on {check.spec.total} fresh scenarios (seeds {check.spec.seeds[0]}.."
               f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
     for metric, (a, b) in before_after.items():
         lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
+    lines += ["", f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
     return write_text(path, "\n".join(lines) + "\n")
 
 
-class Bar:
-    """Progress over the budget of candidates (on a terminal)."""
+def sim_command(plan: Plan, tuned: Path) -> str:
+    """``tablebot sim`` of the tuned table with the robot file and world it was tuned with: beside it in
+    OUT there are neither, and on its own it would get the built-in BumberBot in an empty room."""
+    from tablebot.escape import shell_word
 
-    def __init__(self, total: int, quiet: bool):
-        self.total, self.quiet = total, quiet or not err_console.is_terminal
-
-    def __enter__(self) -> Bar:
-        if not self.quiet:
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-            self.bar = Progress(TextColumn("candidates"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                                console=err_console, transient=True)
-            self.bar.__enter__()
-            self.task = self.bar.add_task("tune", total=self.total)
-        return self
-
-    def advance(self, count: int) -> None:
-        if not self.quiet:
-            self.bar.update(self.task, advance=count)
-
-    def __exit__(self, *exc: Any) -> None:
-        if not self.quiet:
-            self.bar.__exit__(None, None, None)
+    words = ["tablebot", "sim", str(tuned)]
+    for option, given in (("--robot", plan.table.robot.source), ("--world", plan.spec.worlds[0])):
+        if Path(given).is_file():
+            words += [option, given]
+    return " ".join(shell_word(word) for word in words)

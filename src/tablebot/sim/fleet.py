@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
@@ -24,7 +25,7 @@ from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import PATH_STRIDE, Result
 from tablebot.sim.scene import Scene, _check_start, prepare
 from tablebot.sim.summary import Summary, light_bits, seconds_per_state
-from tablebot.sim.world import World
+from tablebot.sim.world import World, inside
 from tablebot.table import Table
 from tablebot.tick import STATE, registers
 from tablebot.trace import block_lines
@@ -121,20 +122,19 @@ class Fleet:
         self.counts = np.zeros((n, n_states), dtype=np.int64)
         self.first_visit = np.full((n, n_states), NO_TICK, dtype=np.int64)
         self.first_light = np.full(n, NO_TICK, dtype=np.int64)
-        self.variant = np.array([spec.variant for spec in self.specs], dtype=np.int64)
+        self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
             robot = self.place(i, spec, scene, record=i in traced)
+            if i == 0:  # the world and wiring as SimRobot packs them: shared by all, never rebuilt here
+                self.world, self.drive, self.pcols = robot._world, robot._drive, robot._pcols
             if i in traced:
                 self.traced[i] = len(self.traces)
                 self.traces[i] = Trace(robot)
-        # the world, wiring and trace blocks as SimRobot packs them: shared, never rebuilt here
-        robot = self.traces[min(self.traces)].robot if self.traces else SimRobot(self.scenes[0], 0, False)
-        self.world = robot._world
-        self.bits, self.drive, self.pcols = self.scenes[0].bits, robot._drive, robot._pcols
+        self.bits = self.scenes[0].bits
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
@@ -182,9 +182,9 @@ class Fleet:
                   self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, noise, self.acc,
                   self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
                   self.traced, hist, ints)
+        n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]
-            n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
             trace.blocks.append(trace.robot._block(self.t0, ints[slot], hist[slot], n_out, n_c))
             trace.rows.append(hist[slot])
         self.t0 += ticks
@@ -195,7 +195,7 @@ class Fleet:
         return FleetSummary(
             ticks=self.t0, tick_s=self.tick_s, states=self.machine.states, first_light=self.first_light.copy(),
             reached=self.acc[:, K.A_REACHED].astype(np.int64), collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
-            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v,
+            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v.copy(),
             battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
             first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
             final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_model.lamps))
@@ -223,9 +223,14 @@ class Fleet:
 
 
 def with_start(scene: Scene, start: Pose | None) -> Scene:
-    """The scene with the robot starting at ``start`` (checked free of walls and obstacles)."""
+    """The scene with the robot starting at ``start`` (checked inside the walls, as a world file's [start]
+    is, and free of walls and obstacles)."""
     if start is None:
         return scene
     world = replace(scene.world, start=tuple(float(v) for v in start))
+    x, y, heading = world.start
+    if world.walls and not inside(world.walls, (x, y)):
+        raise fail(world.path, f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the "
+                   "arena walls", "choose a start inside the [arena] walls")
     _check_start(world, scene.geometry, scene.P)
     return replace(scene, world=world)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 import socket
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -86,14 +86,12 @@ def run_job(job: Job) -> tuple[Job, FleetSummary]:
     fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
                   variants=job.variants)
     fleet.run(job.ticks)
-    light = Job(job.table, job.world, job.robot_params, [], job.ticks, job.first, None, job.threads, job.info)
-    return light, fleet.summary()
+    return replace(job, specs=[], variants=None), fleet.summary()
 
 
 def warm(job: Job) -> float:
     """Compile (or load from the cache) the fleet kernel on one robot for one tick; returns the seconds."""
     import time
-    from dataclasses import replace
 
     started = time.perf_counter()
     run_job(replace(job, specs=job.specs[:1], ticks=1))
