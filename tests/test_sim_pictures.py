@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import shutil
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from tablebot.sim.draw import RobotArtist, contact_point, draw_world
 from tablebot.sim.plots import legend_marks, reading_panels
 from tablebot.sim.runner import run
 from test_sim_declared import sensor_scene
-from test_sim_helpers import ROOT, room, scene_of
+from test_sim_helpers import BUMBERBOT, ROOT, room, scene_of
 
 
 @pytest.mark.parametrize(("pose", "where"), [
@@ -59,3 +60,19 @@ def test_the_robot_shows_its_own_sensors_and_not_the_bumberbots(tmp_path: Path) 
     labels = [h.get_label() for h in legend_marks(run(scene, 1.0))]
     assert "distance beam, out to the echo" in labels and "light first seen" not in labels
     assert [p.__name__ for p in reading_panels(run(scene, 1.0))] == ["_distance_panel"]
+
+
+def test_names_with_dollar_signs_are_drawn_as_written(tmp_path: Path) -> None:
+    """matplotlib reads text between two $ as maths: a robot called 'cost $\\frac{ room $' crashed the
+    pictures. Every picture is drawn with literal text (sim.draw.literal_text)."""
+    from typer.testing import CliRunner
+
+    from tablebot.cli.app import app
+
+    shutil.copytree(BUMBERBOT, tmp_path / "bot")
+    robot = tmp_path / "bot" / "robot.toml"
+    robot.write_text(robot.read_text().replace('name = "BumberBot"', 'name = "cost $\\\\frac{ room $"'))
+    result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "2", "--out", str(tmp_path / "o"),
+                                      "-q", "--gif"])
+    assert result.exit_code == 0, result.output
+    assert all((tmp_path / "o" / n).stat().st_size > 1000 for n in ("trajectory.png", "timeline.png", "run.gif"))

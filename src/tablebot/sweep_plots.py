@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from tablebot.sim.draw import REACHED, draw_world
+from tablebot.sim.draw import REACHED, draw_world, literal_text
 from tablebot.sim.plots import save
 from tablebot.sweep import value_index
 from tablebot.sweep_run import Plan
@@ -55,6 +55,7 @@ def world_labels(plan: Plan) -> list[str]:
     return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]
 
 
+@literal_text()
 def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     """Per grid axis: the share of runs that reached the lamp, and the time to first light (box plot)."""
     panels = groups(plan, rows)
@@ -86,6 +87,7 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     return save(fig, path)
 
 
+@literal_text()
 def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     """Start positions in the (first) world: each start coloured by the time it took to reach the lamp,
     grey when it never did; with many runs, a hexagon heat map of the success rate instead."""
@@ -133,6 +135,7 @@ def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
     return ordered[0], ordered[-1] if len(ordered) > 1 else None
 
 
+@literal_text()
 def trajectories(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
     """``best.png`` and ``worst.png``: the two runs again, traced, drawn as ``tablebot sim`` draws a run."""
     from tablebot.sim.plots import trajectory

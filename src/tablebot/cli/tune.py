@@ -160,6 +160,14 @@ def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
 
 
 def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
+    """The convergence picture, its text drawn as written (see tablebot.sim.draw.literal_text)."""
+    from tablebot.sim.draw import literal_text
+
+    with literal_text():
+        return _convergence(evaluate, method, path)
+
+
+def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
     """Every evaluation's objective and the best so far; for one cell also the objective against its value."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg

@@ -19,7 +19,7 @@ from PIL import Image
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write
 from tablebot.sim import layout as L
-from tablebot.sim.draw import RobotArtist, draw_world, sensor_readings, state_colours
+from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings, state_colours
 from tablebot.sim.plots import subtitle_of, title_of
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -74,6 +74,7 @@ class Player:
         return [self.trail, self.hud, *self.robot.artists()]
 
 
+@literal_text()
 def write_gif(result: Result, summary: Summary, path: Path) -> Path:
     """An animated gif, at most GIF_MAX_FRAMES frames (long runs are sped up).
 
@@ -115,6 +116,7 @@ def check_display() -> None:
                    f"{plt.get_backend()!r})", "run without --view and open the pictures, or use --gif")
 
 
+@literal_text()
 def show(result: Result, summary: Summary) -> None:
     """A live window playing the run in real time."""
     import matplotlib.pyplot as plt

@@ -10,7 +10,9 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import Any
 
+import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import PatchCollection
@@ -22,6 +24,13 @@ from tablebot.sensors import Sensor
 from tablebot.sim import layout as L
 from tablebot.sim.params import Params
 from tablebot.sim.world import Geometry, World
+
+
+#: Every picture is drawn inside this: user text (a robot's name, a state's, a label) is drawn as written.
+#: matplotlib would read text between two ``$`` as maths, and fail on it or draw formulae: this is the
+#: pictures' escape, one switch for all their text (decorate each function that makes a figure).
+def literal_text() -> Any:
+    return matplotlib.rc_context({"text.parse_math": False})
 
 FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"

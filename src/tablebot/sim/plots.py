@@ -27,6 +27,7 @@ from tablebot.sim.draw import (
     RobotArtist,
     contact_point,
     draw_world,
+    literal_text,
     sensor_readings,
     state_colours,
 )
@@ -56,6 +57,7 @@ def subtitle_of(summary: Summary) -> str:
     return "   ·   ".join(parts)
 
 
+@literal_text()
 def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
     world = result.scene.world
@@ -200,6 +202,7 @@ def legend_marks(result: Result) -> list:
 # --- timeline ------------------------------------------------------------------------------------
 
 
+@literal_text()
 def timeline(result: Result, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
     light, declared light and distance sensors) against time."""
