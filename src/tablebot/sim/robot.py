@@ -81,7 +81,7 @@ class SimRobot:
     def read(self) -> Reading:
         s = self.s
         pulses = tuple(0 if c < 0 else int(s[c]) for c in self._pcols.tolist())
-        return Reading(int(s[L.MASK]), pulses, self.trace_fields(s))
+        return Reading(int(s[L.MASK]), pulses, RowFields(self, s.copy()))
 
     def write(self, outputs: Sequence[int]) -> None:
         right, left = (0, 0) if self.stopped else (outputs[self.scene.drive[0]], outputs[self.scene.drive[1]])
@@ -188,6 +188,29 @@ def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
             values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
         columns[key] = values.astype(np.int64).tolist() if decimals == 0 else exact_round(values * scale, decimals)
     return columns
+
+
+class RowFields(Mapping[str, Any]):
+    """The trace fields of one robot row (:meth:`SimRobot.trace_fields`), worked out only when asked for:
+    a Gymnasium step or a fleet's set-up reads the mask and the pulses alone."""
+
+    def __init__(self, robot: SimRobot, s: np.ndarray):
+        self.robot, self.s = robot, s
+        self._fields: dict[str, float | int] | None = None
+
+    def _all(self) -> dict[str, float | int]:
+        if self._fields is None:
+            self._fields = self.robot.trace_fields(self.s)
+        return self._fields
+
+    def __getitem__(self, key: str) -> float | int:
+        return self._all()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._all())
+
+    def __len__(self) -> int:
+        return len(self._all())
 
 
 class LazyColumns(Mapping[str, Sequence[float]]):
