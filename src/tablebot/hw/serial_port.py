@@ -91,7 +91,12 @@ class SerialPort:
         """Exactly ``size`` bytes by ``deadline``, or LinkLost naming ``what`` was awaited."""
         data = bytearray()
         while len(data) < size:
-            data += self.read_some(size - len(data), deadline, what)
+            try:
+                data += self.read_some(size - len(data), deadline, what)
+            except LinkLost as exc:
+                if data and "no answer" in str(exc):
+                    raise LinkLost(f"{exc} (only {len(data)} of {size} bytes came)") from None
+                raise
         return bytes(data)
 
     def read_some(self, most: int, deadline: float, what: str) -> bytes:
@@ -144,13 +149,13 @@ class SerialPort:
     def _wait(self, fd: int, deadline: float, *, writing: bool, what: str) -> None:
         left = deadline - time.monotonic()
         if left <= 0:
-            raise LinkLost(f"no answer from {self.device}: waited in vain for {what}")
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
         try:
             ready = select.select([], [fd], [], left) if writing else select.select([fd], [], [], left)
         except (OSError, ValueError) as exc:  # the descriptor was closed under us
             raise LinkLost(f"{self.device} was closed ({exc})") from None
         if not any(ready):
-            raise LinkLost(f"no answer from {self.device}: waited {1000 * left:.0f} ms in vain for {what}")
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
 
     def _lost(self, exc: OSError) -> LinkLost:
         return LinkLost(f"lost {self.device}: {exc.strerror or exc} (was it unplugged?)")
