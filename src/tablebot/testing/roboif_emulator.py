@@ -72,7 +72,7 @@ class RoboifEmulator(PtyDevice):
         a, b, c = out[2], out[3], out[4]
         pwm = [a & 7, a >> 3 & 7, a >> 6 | (b & 1) << 2, b >> 1 & 7, b >> 4 & 7, b >> 7 | (c & 3) << 1,
                c >> 2 & 7, c >> 5 & 7]
-        self.note("exchange", outputs=out[1], pwm=pwm, extensions=list(out[5:17]), n=n)
+        self.note("exchange", outputs=out[1], pwm=pwm, extensions=list(out[5:17]), n=n, raw=out)
         levels, analog = self.script(n)
         reply = bytearray(21)
         reply[0] = sum(1 << i for i, level in enumerate(levels) if level)

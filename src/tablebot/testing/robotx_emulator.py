@@ -97,7 +97,7 @@ class RobotxEmulator(PtyDevice):
     def _config(self, tid: int, sid: int, count: int, data: bytes) -> None:
         ta = data[4:]
         self.note("config", tid=tid, sid=sid, ta=int.from_bytes(data[:4], "little"), motors=list(ta[0:4]),
-                  uni=list(ta[4:12]), cnt=list(ta[12:16]), size=len(ta))
+                  uni=list(ta[4:12]), cnt=list(ta[12:16]), size=len(ta), raw=ta)
         self._reply(105, tid, [b""])
 
     def _exchange(self, tid: int, sid: int, count: int, data: bytes) -> None:
@@ -105,7 +105,7 @@ class RobotxEmulator(PtyDevice):
         self.exchanges += 1
         out = data[4:]
         duty = list(struct.unpack_from("<8h", out, 12)) if len(out) >= 28 else []
-        self.note("exchange", tid=tid, sid=sid, duty=duty, size=len(out), n=n)
+        self.note("exchange", tid=tid, sid=sid, duty=duty, size=len(out), n=n, raw=out)
         uni, counts = self.script(n)
         levels = [0, 0, 0, 0]
         payload = struct.pack("<8h", *uni) + bytes(levels) + struct.pack("<4H", *[c & 0xFFFF for c in counts])
