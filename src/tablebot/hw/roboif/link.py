@@ -114,3 +114,18 @@ class RoboifLink:
     def _discard_owed(self, deadline: float) -> None:
         while self._owed > 0:
             self._owed -= len(self.port.read_some(self._owed, deadline, "a reply still owed"))
+
+
+def find(ports: Sequence[PortInfo] | None = None, timeout_s: float = 0.5) -> str | None:
+    """The first candidate port whose device answers the greeting as a ROBO Interface (then bid farewell)."""
+    for port in candidates(ports):
+        link = RoboifLink(port.device, setup_timeout_s=timeout_s)
+        try:
+            link.connect()
+            link.hello()
+            return port.device
+        except LinkLost:
+            continue
+        finally:
+            link.close()
+    return None

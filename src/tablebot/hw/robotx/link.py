@@ -165,3 +165,17 @@ class RobotxLink:
             with contextlib.suppress(wire.WireError):
                 self._read_frame(deadline, "a reply still owed", skip_junk=True)
             self._owed -= 1
+
+
+def find(ports: Sequence[PortInfo] | None = None, timeout_s: float = 0.5) -> tuple[str, wire.Info] | None:
+    """The first candidate port that answers fish.X1 (an echo, then who it is), with what it said."""
+    for port in candidates(ports):
+        link = RobotxLink(port.device, setup_timeout_s=timeout_s)
+        try:
+            link.connect()
+            return port.device, link.hello()
+        except LinkLost:
+            continue
+        finally:
+            link.close()
+    return None
