@@ -25,7 +25,8 @@ def robot_on(emulator: RobotxEmulator, machine=None, timeout_s: float = 0.15) ->
 
 
 def test_a_frame_is_as_the_pc_programming_manual_draws_it() -> None:
-    frame = wire.encode(wire.Frame(wire.Command.EXCHANGE, tid=0x1234, sid=7, areas=((0, wire.output([512] + [0] * 7)),)))
+    duty = wire.output([512] + [0] * 7)
+    frame = wire.encode(wire.Frame(wire.Command.EXCHANGE, tid=0x1234, sid=7, areas=((0, duty),)))
     assert frame[:2] == b"\x02\x55" and frame[-1] == 0x03
     assert int.from_bytes(frame[2:4], "big") == 20 + 4 + 44 == len(frame) - 7  # length (H,L): header + payload
     assert frame[4:8] == (2).to_bytes(4, "little") and frame[8:12] == (1).to_bytes(4, "little")  # FROM, TO (L,H)
@@ -77,7 +78,10 @@ def test_counters_count_pulses_and_a_wiring_of_every_kind_configures_and_drives_
     machine = bumberbot("robotx", wiring, "bumberbot-counters")
     counts = [0, 3, 3, 9, 65530, 4, 2]  # up 3, 0, 6; far back (a reset: 0); up 10 across the 16-bit wrap; back
     record = Record()
-    with RobotxEmulator(lambda n: ([0, 10 if n % 2 else 50, 0, 1, 0, 0, 0, 0], [counts[min(n, 6)], 0, 2 * n, 0])) as emu:
+    def script(n: int) -> tuple[list[int], list[int]]:
+        return [0, 10 if n % 2 else 50, 0, 1, 0, 0, 0, 0], [counts[min(n, 6)], 0, 2 * n, 0]
+
+    with RobotxEmulator(script) as emu:
         end = drive(machine, robot_on(emu, machine), ticks=7, sinks=(record,))
         settle(emu)
     assert end.reason == "done"
