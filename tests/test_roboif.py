@@ -12,8 +12,8 @@ import pytest
 from controller_helpers import BUMBER_WIRING, Record, StopAt, bumberbot, drive, eventually
 from tablebot.diagnostics import TableBotError
 from tablebot.hw.roboif import link as roboif_link
-from tablebot.hw.roboif import wire
-from tablebot.hw.roboif.robot import RoboifRobot
+from tablebot.hw.roboif import protocol as wire
+from tablebot.hw.roboif.controller import RoboifRobot
 from tablebot.hw.roboif.wiring import roboif_wiring
 from tablebot.hw.serial_port import PortInfo
 from tablebot.loop import LinkLost

@@ -12,8 +12,8 @@ import pytest
 
 from controller_helpers import BUMBER_WIRING, Record, StopAt, bumberbot, drive, eventually, settle
 from tablebot.hw.robotx import link as robotx_link
-from tablebot.hw.robotx import wire
-from tablebot.hw.robotx.robot import RobotxRobot
+from tablebot.hw.robotx import protocol as wire
+from tablebot.hw.robotx.controller import RobotxRobot
 from tablebot.hw.robotx.wiring import robotx_wiring
 from tablebot.hw.serial_port import PortInfo
 from tablebot.loop import LinkLost

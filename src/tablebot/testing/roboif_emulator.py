@@ -2,7 +2,7 @@
 since no interface is here.
 
 Written from ``nxdefiant/libroboint`` (``lib/libroboint.c``: ``OpenFtCommDevice``, ``FtThread``,
-``CloseFtDevice``; ``lib/roboint.h``: the transfer area), independently of :mod:`tablebot.hw.roboif.wire`: the
+``CloseFtDevice``; ``lib/roboint.h``: the transfer area), independently of :mod:`tablebot.hw.roboif.protocol`: the
 greeting "\\xA1ft-Robo-ON-V1" is answered with 0x5E and four more bytes (libroboint reads five and checks only
 the first, so the other four are zeros here), each 17-byte exchange 0xF2 with 21 bytes, the farewell 0xA2
 with 0x5D. ``baud=38400`` makes it as slow as the real serial line (10 bits a byte, both ways). It records

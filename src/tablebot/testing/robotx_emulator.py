@@ -1,7 +1,7 @@
 """A FAKE ROBO TX Controller on a pseudo-terminal, answering the "fish.X1" online protocol; for tests and
 benchmarks, since no controller is here.
 
-Written from the published sources, independently of :mod:`tablebot.hw.robotx.wire` (so that a wrong layout
+Written from the published sources, independently of :mod:`tablebot.hw.robotx.protocol` (so that a wrong layout
 in one shows up against the other): the frame of fischertechnik's PC programming manual (ch. 13.1, copy in
 ``ski7777/fttxpy`` ``TXC-Programming/``), and the device side of ``fischertechniker/ROBO-Pro-for-ftDuino``
 (``fishx1.ino``: a byte-by-byte parser, replies with the request's code + 100, the request's TID echoed, a new

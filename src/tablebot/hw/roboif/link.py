@@ -4,7 +4,7 @@ deadline, the farewell.
 The exchange reply carries no header or checksum, so a reply can only be judged by its size and timing:
 too few bytes by the deadline, bytes before a request was sent, or bytes beyond the 21 expected are each a
 lost link (the stream is out of step and nothing after it can be trusted). Every failure becomes
-:class:`tablebot.loop.LinkLost` with a sentence saying what happened. Source: see :mod:`tablebot.hw.roboif.wire`.
+:class:`tablebot.loop.LinkLost` with a sentence saying what happened. Source: see :mod:`tablebot.hw.roboif.protocol`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import contextlib
 import time
 from collections.abc import Sequence
 
-from tablebot.hw.roboif import wire
+from tablebot.hw.roboif import protocol as wire
 from tablebot.hw.serial_port import PortInfo, SerialPort, serial_ports
 from tablebot.loop import LinkLost
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.formats.tomlfile import Source
 from tablebot.hw import wiring
-from tablebot.hw.roboif import wire
+from tablebot.hw.roboif import protocol as wire
 from tablebot.table import MAX_LAMP, MAX_SPEED
 
 if TYPE_CHECKING:

@@ -4,7 +4,7 @@ that stays in step when Ctrl-C cuts a request or a reply short.
 
 Every failure (no port, silence, garbage, a bad checksum, a wrong answer, a new session, a pulled cable)
 becomes :class:`tablebot.loop.LinkLost` with a sentence saying what happened; nothing here prints or
-starts threads. Sources: see :mod:`tablebot.hw.robotx.wire`.
+starts threads. Sources: see :mod:`tablebot.hw.robotx.protocol`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import contextlib
 import time
 from collections.abc import Sequence
 
-from tablebot.hw.robotx import wire
-from tablebot.hw.robotx.wire import Command, Frame
+from tablebot.hw.robotx import protocol as wire
+from tablebot.hw.robotx.protocol import Command, Frame
 from tablebot.hw.serial_port import PortInfo, SerialPort, serial_ports
 from tablebot.loop import LinkLost
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Sequence
 
-from tablebot.hw.roboif import wire
+from tablebot.hw.roboif import protocol as wire
 from tablebot.hw.roboif.link import RoboifLink
 from tablebot.hw.roboif.wiring import RoboifWiring
 from tablebot.loop import LinkLost, Reading

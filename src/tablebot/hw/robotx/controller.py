@@ -11,7 +11,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Sequence
 
-from tablebot.hw.robotx import wire
+from tablebot.hw.robotx import protocol as wire
 from tablebot.hw.robotx.link import RobotxLink
 from tablebot.hw.robotx.wiring import RobotxWiring
 from tablebot.loop import LinkLost, Reading
