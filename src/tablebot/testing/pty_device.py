@@ -48,6 +48,15 @@ class PtyDevice:
     def names(self) -> list[str]:
         return [r.name for r in list(self.log)]
 
+    def wait_for(self, name: str, count: int, timeout_s: float = 10.0) -> bool:
+        """Whether ``count`` requests called ``name`` arrived within ``timeout_s``."""
+        deadline = time.monotonic() + timeout_s
+        while len(self.requests(name)) < count:
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.01)
+        return True
+
     def note(self, name: str, **fields: Any) -> None:
         self.log.append(Request(time.monotonic(), name, fields))
 
