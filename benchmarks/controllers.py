@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -123,6 +124,8 @@ def main() -> None:
     names = args.only.split(",")
     print(f"tablebot run examples/bumberbot --on TARGET --seconds {args.seconds:g} (whole command, fresh process; "
           "targets are emulators: no controller is here)")
+    print(f"load average at the start: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (a loaded machine "
+          "stretches every gap: compare ratios)")
     print(f"{'target':<14}{'exch/s':>8}{'gap median':>12}{'p95':>8}{'max':>8}{'late':>6}   link alone")
     base: dict[str, Any] | None = None
     for name in names:
