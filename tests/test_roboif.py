@@ -157,3 +157,26 @@ def test_auto_greets_every_port_but_those_of_other_controllers() -> None:
     with RoboifEmulator() as emu, RoboifEmulator(greeting_reply=b"\r\n>") as other:
         assert roboif_link.find([PortInfo(other.device), PortInfo(emu.device)], timeout_s=0.2) == emu.device
         assert eventually(lambda: emu.names() == ["hello", "bye"])
+
+
+def test_a_reply_cut_short_by_ctrl_c_is_skipped_and_the_next_exchange_is_in_step() -> None:
+    import signal
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    with RoboifEmulator(lambda n: ([n % 2] + [0] * 7, {"AX": n}), baud=2400) as emu:  # a reply takes ~90 ms
+        link = roboif_link.RoboifLink(emu.device, reply_timeout_s=0.5)
+        link.connect()
+        link.hello()
+        previous = signal.signal(signal.SIGALRM, interrupt)
+        try:
+            signal.setitimer(signal.ITIMER_REAL, 0.03)
+            with pytest.raises(KeyboardInterrupt):
+                link.exchange(0, [0] * 8)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, previous)
+        got = link.exchange(1, [7] + [0] * 7)
+        link.close()
+    assert got.digital == 1 and got.analog["AX"] == 1  # the second exchange's own reply

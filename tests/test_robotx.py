@@ -157,3 +157,27 @@ def test_auto_finds_the_controller_by_its_usb_id_then_checks_it_answers_fish_x1(
         found = robotx_link.find([PortInfo(other.device, 0x221D, 0x1000), PortInfo(emu.device, 0x221D, 0x1000)],
                                  timeout_s=0.2)
     assert found is not None and found[0] == emu.device and found[1].device == "ROBO TX-000"
+
+
+def test_a_reply_cut_short_by_ctrl_c_is_skipped_and_the_next_exchange_is_in_step() -> None:
+    import signal
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    with RobotxEmulator(lambda n: ([n % 2, 0, 0, 0, 0, 0, 0, 0], [n, 0, 0, 0]), delay_s=0.05) as emu:
+        link = robotx_link.RobotxLink(emu.device, reply_timeout_s=0.5)
+        link.connect()
+        link.hello()
+        previous = signal.signal(signal.SIGALRM, interrupt)
+        try:
+            signal.setitimer(signal.ITIMER_REAL, 0.02)  # while the reply is still on its way
+            with pytest.raises(KeyboardInterrupt):
+                link.exchange([0] * 8)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, previous)
+        got = link.exchange([64] * 8)  # the owed reply is read and dropped first
+        link.close()
+    assert got.counter_values[0] == 1 and got.universal[0] == 1  # the second exchange's own reply
+    assert [r.fields["tid"] for r in emu.requests("exchange")] == [3, 4]
