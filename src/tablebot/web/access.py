@@ -168,17 +168,17 @@ class Gate:
 
 
 async def _deny(scope: Scope, send: Send, reason: str) -> None:
-    """403 with the reason as plain text; a WebSocket upgrade is refused before it is accepted."""
+    """403 with the reason as plain text; a WebSocket upgrade is refused before it is accepted.
+
+    (Not the ASGI "websocket.http.response" extension: uvicorn's sans-I/O WebSocket protocol logs that
+    as a handshake never completed.)"""
     body = (reason + "\n").encode("utf-8")
     headers = [(b"content-type", b"text/plain; charset=utf-8"), (b"content-length", str(len(body)).encode()),
                (b"cache-control", b"no-store"), *HEADERS]
     if scope["type"] == "http":
         await send({"type": "http.response.start", "status": 403, "headers": headers})
         await send({"type": "http.response.body", "body": body})
-    elif "websocket.http.response" in scope.get("extensions", {}):
-        await send({"type": "websocket.http.response.start", "status": 403, "headers": headers})
-        await send({"type": "websocket.http.response.body", "body": body})
-    else:  # the server answers an upgrade closed before acceptance with 403 itself
+    else:  # an upgrade closed before acceptance: the server answers 403 (a page cannot read the reason anyway)
         await send({"type": "websocket.close", "code": 1008})
 
 
