@@ -58,7 +58,9 @@ function socket() {
     const s = new WebSocket(target.replace("http", "ws") + "/ws");
     s.onopen = () => {
       opened = true;
-      for (const path of ["secret.env", ".git/config", "hook.py", "table.csv"]) s.send(JSON.stringify({ op: "open", path }));
+      for (const path of ["secret.env", ".git/config", "hook.py", "table.csv"]) {
+        s.send(JSON.stringify({ op: "open", path }));
+      }
       s.send(JSON.stringify({ op: "edit", row: 0, col: 0, value: "pwned" }));
       s.send(JSON.stringify({ op: "save", force: true }));
       s.send("[".repeat(100000));
@@ -156,7 +158,7 @@ def attacker(studio: Background) -> Iterator[str]:
     page = ATTACK_PAGE.replace("TARGET", json.dumps(studio.origin)).encode()
 
     class Handler(BaseHTTPRequestHandler):
-        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        def do_GET(self) -> None:
             self.send_response(200)
             self.send_header("Content-Type", "text/html; charset=utf-8")
             self.end_headers()
