@@ -18,11 +18,11 @@ from rich.console import Console
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE
-from tablebot.cli import app
 from tablebot import registry
-from tablebot.hw.txt.backend import ADDRESS_HINT, parse_address
+from tablebot.cli import app
 from tablebot.engine import Engine
 from tablebot.formats.table_read import load_table
+from tablebot.hw.txt.backend import ADDRESS_HINT, parse_address
 from tablebot.loop import Reading, RunInfo, TickBlock
 from tablebot.machine import compile_table
 from tablebot.sinks.live_view import LiveView
