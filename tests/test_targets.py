@@ -78,7 +78,7 @@ def test_a_back_end_registers_once_and_says_what_it_is() -> None:
     assert registry.register(c) is c  # registering the same one again is harmless
     with pytest.raises(ValueError, match="two back-ends"):
         registry.register(registry.Backend("c", "export", "another", export=c.export))
-    with pytest.raises(ValueError, match="export .* or open"):
+    with pytest.raises(ValueError, match=r"export .* or open"):
         registry.register(registry.Backend("neither", "export", "nothing"))
     with pytest.raises(ValueError, match="only a live back-end opens"):
         registry.register(registry.Backend("wrong", "export", "x", open=registry.get("sim").open))
