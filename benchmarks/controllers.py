@@ -100,8 +100,8 @@ def link_alone(name: str, exchanges: int = 500) -> float:
 def _robot(name: str, machine: Any, address: str) -> Any:
     device = address.split("://", 1)[1]
     if name == "txt":
-        from tablebot.hw.txt_robot import TxtRobot
-        from tablebot.hw.txt_wiring import txt_wiring
+        from tablebot.hw.txt.controller import TxtRobot
+        from tablebot.hw.txt.wiring import txt_wiring
 
         host, port = device.rsplit(":", 1)
         return TxtRobot(txt_wiring(machine), host, int(port), link_timeout_s=1.0)

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from tablebot.formats.tomlfile import Source
+from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
     from tablebot.machine import Machine
@@ -180,6 +180,8 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
         _error(src, None, f"robot {robot.name} has no [{spec.section}] section: tablebot does not know how it is "
                f"wired to the {spec.controller}", "add one to the robot file, for example:\n" +
                suggest(spec, robot, machine))
+        for name in robot.counter_names if not spec.counters else ():
+            _unwired(spec, src, robot, "counter", name)
         src.raise_if_any()
     if not isinstance(section, Section):  # a Robot made in code, holding the section's raw data
         section = read_section(spec, src, section, robot)
@@ -218,7 +220,7 @@ def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
     free = {kind: list(spec.names(kind)) for kind in ("input", "motor", "lamp", "counter")}
     free["input"] = list(spec.digital_inputs)
     for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
-                        ("counter", robot.counter_names)):
+                        ("counter", robot.counter_names if spec.counters else ())):
         for name in names:
             terminal = name if name in free[kind] else (free[kind][0] if free[kind] else "?")
             if terminal in free[kind]:

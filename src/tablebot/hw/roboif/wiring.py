@@ -11,10 +11,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from tablebot.formats.tomlfile import Source
 from tablebot.hw import wiring
 from tablebot.hw.roboif import protocol as wire
 from tablebot.table import MAX_LAMP, MAX_SPEED
+from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
