@@ -54,8 +54,14 @@ class Repaired:
         return not self.failing
 
 
-def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, max_steps: int = 30) -> Repaired:
-    """Add guard rows until every property holds (or no proposal helps, or ``max_steps`` rows are in)."""
+PREFERENCES = ("keep", "copy")
+
+
+def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, prefer: str = "keep",
+           max_steps: int = 30) -> Repaired:
+    """Add guard rows until every property holds (or no proposal helps, or ``max_steps`` rows are in).
+    Among guard rows that mend equally well, ``prefer`` decides: "keep" (keep going while pressed) or
+    "copy" (do what another row does for those inputs); evolve seeds its archive with both repairs."""
     current = candidate
     report = prover.report(compile_table(to_table(current, base)))
     done = Repaired(current, failing=verdict_of(report).failed)
@@ -65,7 +71,7 @@ def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, max_
         target = next((r for r in report.results if r.status != "holds" and r.inputs), None)
         if target is None:
             return done  # nothing to read a repair from (an unknown result, or a zero-time loop)
-        proposals = guard_proposals(current, report.machine, target, space)
+        proposals = guard_proposals(current, report.machine, target, space, prefer)
         done.proposals += len(proposals)
         scored = []
         for k, (mended, step) in enumerate(proposals):
@@ -93,8 +99,8 @@ def score(report: CheckReport, name: str) -> tuple[int, int]:
     return len(failing), -(len(target.inputs) if target is not None else 10**9)
 
 
-def guard_proposals(candidate: Candidate, machine: Machine, result: Result,
-                    space: Space) -> list[tuple[Candidate, Step]]:
+def guard_proposals(candidate: Candidate, machine: Machine, result: Result, space: Space,
+                    prefer: str = "keep") -> list[tuple[Candidate, Step]]:
     """Candidates with one guard row added where the counterexample goes wrong (see the module doc)."""
     table = machine.table
     lines = list(replay(machine, result.inputs))
@@ -109,7 +115,7 @@ def guard_proposals(candidate: Candidate, machine: Machine, result: Result,
         pressed = {name for name, bit in machine.input_bits.items() if lines[k]["event"] & bit}
         guard = (pressed & watched) or pressed
         for events in _event_sets(guard, table):
-            for gene in _actions(table, state, events, result.prop.name):
+            for gene in _actions(table, state, events, result.prop.name, prefer):
                 for at in _places(candidate, state, lines[k]["row"], table):
                     mended = (*candidate[:at], gene, *candidate[at:])
                     if (mended_key := tuple(g.effect() for g in mended)) in seen:
@@ -128,25 +134,27 @@ def _event_sets(guard: set[str], table: Table) -> list[frozenset[str]]:
     return sets
 
 
-def _actions(table: Table, state: StateId, events: frozenset[str], prop: str) -> list[Gene]:
+def _actions(table: Table, state: StateId, events: frozenset[str], prop: str, prefer: str) -> list[Gene]:
     """Guard rows for ``events`` in ``state``: what other rows do for such inputs, or keep going a while."""
     donors = [row for row in table.rows if row.events and row.events <= events]
-    genes: dict[tuple, Gene] = {}
+    copies: dict[tuple, Gene] = {}
+    keeps: dict[tuple, Gene] = {}
     when = condition(table, [events])
     for row in donors:
         what = action(table, row)
         text = f"{when}: {what.text}{', ' + what.timer if what.timer else ''} (guard for {prop})"
         gene = Gene(state, events, row.motors, row.timer, row.next, text, row.counters, row.lamps,
                     note=f"guard for {prop}, doing what line {row.line} does")
-        genes.setdefault(gene.effect(), gene)
+        copies.setdefault(gene.effect(), gene)
     keep = (None,) * len(table.robot.motors)
     lamps = (None,) * len(table.robot.lamps)
     counters = (None,) * len(table.robot.counter_names)
     for ticks in STAY_TIMERS:
         gene = Gene(state, events, keep, ticks, state, f"{when}: keep going (guard for {prop})", counters, lamps,
                     note=f"guard for {prop}: keep the motors while {when}")
-        genes.setdefault(gene.effect(), gene)
-    return list(genes.values())
+        keeps.setdefault(gene.effect(), gene)
+    first, second = (keeps, copies) if prefer == "keep" else (copies, keeps)
+    return [*first.values(), *second.values()]
 
 
 def _places(candidate: Candidate, state: StateId, fired: int | None, table: Table) -> list[int]:
