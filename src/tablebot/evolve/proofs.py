@@ -18,7 +18,7 @@ from tablebot.analysis.check import CheckReport, run_check
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
-from tablebot.analysis.prove import check_property
+from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
@@ -81,6 +81,13 @@ class Prover:
     def report(self, machine: Machine) -> CheckReport:
         """The whole ``check`` of one machine (findings and every property, counterexamples included)."""
         return run_check(machine, self.properties(machine))
+
+    def results(self, machine: Machine) -> tuple[list[Result], bool]:
+        """Every property's result (counterexamples included) and whether a zero-time loop traps the
+        robot: what a repair weighs, without check's other findings."""
+        results = [check_property(prop, machine) for prop in self.properties(machine)]
+        stuck = any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
+        return results, stuck
 
     def verdict(self, table: Table) -> tuple[str, Verdict]:
         """The candidate's canonical key and verdict (proved now, or from the cache)."""

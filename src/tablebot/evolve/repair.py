@@ -7,20 +7,19 @@ goes wrong (for ``when … within D``: the last D + 1 ticks), and proposes a gua
 state the robot was in (or just before the row that fired there): needing the pressed inputs the
 property watches (each alone, and all together), doing what some row of the table already does for
 those inputs (the BumberBot's "Collision detection": stop, pause, go to 20) or keeping the motors for a
-few ticks while they stay pressed. Every proposal is checked; the one that leaves the fewest properties
-broken wins (then the one whose counterexample grew longest: the hole moved further away), until
-every property holds.
+few ticks while they stay pressed. Proposals are tried in that order; the first that mends its
+counterexample, leaves the property's next counterexample no shorter (the hole moved further away) and
+breaks no other property is kept, until every property holds.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from tablebot.analysis.check import CheckReport
 from tablebot.analysis.diagram import action, condition
-from tablebot.analysis.prove import Result, first_violation
+from tablebot.analysis.prove import Result, check_property, first_violation
 from tablebot.evolve.operators import Space
-from tablebot.evolve.proofs import Prover, verdict_of
+from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, to_table
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import StateId
@@ -63,8 +62,9 @@ def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, pref
     Among guard rows that mend equally well, ``prefer`` decides: "keep" (keep going while pressed) or
     "copy" (do what another row does for those inputs); evolve seeds its archive with both repairs."""
     current = candidate
-    report = prover.report(compile_table(to_table(current, base)))
-    done = Repaired(current, failing=verdict_of(report).failed)
+    machine = compile_table(to_table(current, base))
+    report = Weighed(machine, *prover.results(machine))
+    done = Repaired(current, failing=report.failing)
     for _ in range(max_steps):
         if done.ok:
             return done
@@ -73,30 +73,52 @@ def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, pref
             return done  # nothing to read a repair from (an unknown result, or a zero-time loop)
         proposals = guard_proposals(current, report.machine, target, space, prefer)
         done.proposals += len(proposals)
-        scored = []
-        for k, (mended, step) in enumerate(proposals):
-            machine = compile_table(to_table(mended, base))
-            if first_violation(target.prop, machine, replay(machine, target.inputs)) is not None:
-                continue  # it does not even mend the counterexample it was made for
-            mended_report = prover.report(machine)
-            scored.append((score(mended_report, target.prop.name), k, mended, mended_report, step))
-        if not scored:
-            return done  # no guard row mends it: stop, and say what still fails
-        (broken, length), _, best, best_report, step = min(scored, key=lambda item: (item[0], item[1]))
-        was_broken, was_length = score(report, target.prop.name)
-        if broken > was_broken or (broken == was_broken and length > was_length):
-            return done  # every mend breaks something else, or makes the hole nearer
-        current, report = best, best_report
-        done = Repaired(current, [*done.steps, step], verdict_of(report).failed, done.proposals)
+        found = None
+        for mended, step in proposals:
+            found = weigh(mended, base, prover, target, report)
+            if found is not None:
+                current, report = mended, found
+                done = Repaired(current, [*done.steps, step], report.failing, done.proposals)
+                break
+        if found is None:
+            return done  # no guard row mends it without breaking something else: say what still fails
     return done
 
 
-def score(report: CheckReport, name: str) -> tuple[int, int]:
+@dataclass(frozen=True)
+class Weighed:
+    """A machine's property results and whether a zero-time loop traps it."""
+
+    machine: Machine
+    results: list[Result]
+    stuck: bool
+
+    @property
+    def failing(self) -> tuple[str, ...]:
+        return (*(r.prop.name for r in self.results if r.status != "holds"), *(("zero-time-loop",) * self.stuck))
+
+
+def weigh(mended: Candidate, base: Table, prover: Prover, target: Result, before: Weighed) -> Weighed | None:
+    """The mended table's results when it is a step forward: it mends the counterexample it was made for,
+    the property's next counterexample is no shorter (or it holds), and no other property breaks."""
+    machine = compile_table(to_table(mended, base))
+    if first_violation(target.prop, machine, replay(machine, target.inputs)) is not None:
+        return None
+    again = check_property(target.prop, machine)
+    if again.status != "holds" and len(again.inputs) < len(target.inputs):
+        return None
+    results, stuck = prover.results(machine)
+    after = Weighed(machine, results, stuck)
+    if score(after, target.prop.name) > score(before, target.prop.name) or \
+            set(after.failing) - set(before.failing):
+        return None
+    return after
+
+
+def score(report: Weighed, name: str) -> tuple[int, int]:
     """Fewer broken properties first; then a longer counterexample for the property being repaired."""
-    failing = [r for r in report.results if r.status != "holds"]
-    failing += [f for f in report.findings if f.severity == "error"]  # type: ignore[misc]
     target = next((r for r in report.results if r.prop.name == name and r.status != "holds"), None)
-    return len(failing), -(len(target.inputs) if target is not None else 10**9)
+    return len(report.failing), -(len(target.inputs) if target is not None else 10**9)
 
 
 def guard_proposals(candidate: Candidate, machine: Machine, result: Result, space: Space,

@@ -176,11 +176,13 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
                  fontsize=11)
     side = fig.add_subplot(1, 2, 2)
     xs = [h["evaluated"] for h in history]
-    side.plot(xs, [h["best"] for h in history], color="#20bf6b", linewidth=2, label=f"best {objective.name}")
+    side.plot(xs, [h["best"] for h in history], color="#20bf6b", linewidth=2, drawstyle="steps-post",
+              label=f"best {objective.name}")
     side.set_xlabel("tables evaluated on the fleet")
     side.set_ylabel(f"best {objective.name}")
     twin = side.twinx()
-    twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", label="cells filled")
+    twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
+              label="cells filled")
     twin.set_ylabel("cells filled (%)")
     side.legend(loc="upper left", fontsize=8)
     twin.legend(loc="lower right", fontsize=8)
