@@ -41,7 +41,7 @@ def same_results(a: Path, b: Path) -> None:
 @pytest.fixture(scope="module")
 def line_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("line") / "local"
-    code, output = evolve(str(LINE), "--out", str(out), *LINE_RUN, "--backend", "local", "--workers", "2")
+    code, output = evolve(str(LINE), "--out", str(out), *LINE_RUN, "--backend", "local", "--workers", "1")
     assert code == 0, output
     return out
 
@@ -83,25 +83,32 @@ def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_r
     same_results(line_run, tmp_path / "dask")
 
 
-@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT])
-def test_a_stopped_run_keeps_what_ran_and_the_same_command_resumes(tmp_path: Path, line_run: Path,
-                                                                   stop: signal.Signals) -> None:
-    out = tmp_path / "cut"
-    command = [sys.executable, "-m", "tablebot", "evolve", str(LINE), "--out", str(out), *LINE_RUN,
-               "--backend", "local", "--workers", "2"]
+def stop_when_some_ran(command: list[str], records: Path, stop: signal.Signals, at_least: int) -> list[str]:
+    """Start the command, send ``stop`` once ``at_least`` tables are recorded; returns the records kept."""
     proc = subprocess.Popen(command, env=env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    records = out / "evaluations.jsonl"
     deadline = time.monotonic() + 180
-    while not (records.exists() and len(records.read_text().splitlines()) >= 4):
+    while not (records.exists() and len(records.read_text().splitlines()) >= at_least):
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
         time.sleep(0.02)
     proc.send_signal(stop)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == (143 if stop == signal.SIGTERM else 130), err
     assert "run the same command again to resume" in err and "Traceback" not in err
-    kept = records.read_text().splitlines()
-    assert 4 <= len(kept) < 18 and not (out / "report.md").exists()
-    done = subprocess.run(command, env=env(), capture_output=True, text=True, timeout=300)
+    return records.read_text().splitlines()
+
+
+def test_sigterm_and_ctrl_c_keep_what_ran_and_the_same_command_resumes(tmp_path: Path, line_run: Path) -> None:
+    """Cut by SIGTERM (two worker processes), then by Ctrl-C (this process alone), then run to the end:
+    the same tables and numbers as the run never cut, whatever ran where."""
+    out = tmp_path / "cut"
+    command = [sys.executable, "-m", "tablebot", "evolve", str(LINE), "--out", str(out), *LINE_RUN, "--backend",
+               "local"]
+    records = out / "evaluations.jsonl"
+    first = stop_when_some_ran([*command, "--workers", "2"], records, signal.SIGTERM, 4)
+    assert 4 <= len(first) < 18 and not (out / "report.md").exists()
+    second = stop_when_some_ran([*command, "--workers", "1"], records, signal.SIGINT, len(first) + 3)
+    assert second[: len(first)] == first and len(second) < 18
+    done = subprocess.run([*command, "--workers", "1"], env=env(), capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert records.read_text().splitlines()[: len(kept)] == kept  # what ran before is kept, not run again
+    assert records.read_text().splitlines()[: len(second)] == second  # what ran before is kept, not run again
     same_results(line_run, out)
