@@ -120,7 +120,7 @@ def test_bad_options_are_clear_errors_naming_the_option(tmp_path: Path, args: li
 
 def test_a_property_naming_a_file_line_is_refused(tmp_path: Path) -> None:
     props = tmp_path / "p.toml"
-    props.write_text('[seek]\ntext = "x"\nnever = "line == 5 and I3"\n', encoding="utf-8")
+    props.write_text('[seek]\ntext = "x"\nnever = "I3 and line==5"\n', encoding="utf-8")
     code, output = evolve(str(BUMBERBOT), "--out", str(tmp_path / "o"), "--properties", str(props))
     assert code == 2, output
     assert "property seek names a file line" in output and "p.toml" in output

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -129,12 +130,15 @@ def verdict_of(report: CheckReport) -> Verdict:
     return Verdict(not failed, tuple(dict.fromkeys(failed)))
 
 
+LINE_WORD = re.compile(r"(?<![\w.-])line(?![\w.-])")  # the condition language's ``line`` (conditions.TOKEN_RE)
+
+
 def refuse_line_conditions(prover: Prover, machine: Machine) -> None:
     """Properties that name file lines (``line == 14``) lose their meaning once rows are added, removed
     or moved: refused before the search starts, naming the property."""
     for prop in prover.properties(machine):
         texts = [c.text for c in (prop.cond, prop.when, prop.then) if c is not None]
-        if any("line" in text.replace("(", " ").replace(")", " ").split() for text in texts):
+        if any(LINE_WORD.search(text) for text in texts):
             where = f"{prop.source}:{prop.line}" if prop.line else prop.source
             raise fail(where, f"property {prop.name} names a file line; evolve adds, removes and moves rows, so "
                        "a line number would name another row", "write the property with states, events and "
