@@ -74,8 +74,18 @@ def _row(gene: Gene) -> Row:
                gene.lamps)
 
 
+def pruned(candidate: Candidate, base: Table) -> Candidate:
+    """Without the rows that can fire in no situation at all (an earlier row of their state always wins):
+    the same machine (the same canonical form), a shorter table to read."""
+    machine = compile_table(to_table(candidate, base))
+    fires = set(machine.flat or range(len(candidate)))
+    return tuple(gene for index, gene in enumerate(candidate) if index in fires)
+
+
 def as_table(candidate: Candidate, base: Table, path: Path) -> Table:
-    """The candidate as the table that will be written to ``path`` (rows on their new lines)."""
+    """The candidate as the table that will be written to ``path`` (rows on their new lines; rows that
+    can never fire left out)."""
+    candidate = pruned(candidate, base)
     described = tuple(Gene(g.state, g.events, g.motors, g.timer, g.next, describe(g, base), g.counters, g.lamps,
                            g.origin, g.note) for g in candidate)
     return renumbered(to_table(described, base, str(path)))
