@@ -23,11 +23,12 @@ from tablebot.evolve.measures import Descriptor
 Breed = Callable[[Sequence[str], np.random.Generator, int], list[str]]
 
 
-def make_archive(descriptors: Sequence[Descriptor], worst: float = 0.0) -> GridArchive:
+def make_archive(descriptors: Sequence[Descriptor], worst: float = 0.0, seed: int = 0) -> GridArchive:
     """A grid of ``cells`` per descriptor over its range; solutions are candidate keys. ``worst``: the
     lowest objective (as maximised) a run can have, so the QD score counts every elite as a gain."""
     return GridArchive(solution_dim=(), dims=[d.cells for d in descriptors],
-                       ranges=[(d.low, d.high) for d in descriptors], solution_dtype=object, qd_score_offset=worst)
+                       ranges=[(d.low, d.high) for d in descriptors], solution_dtype=object, qd_score_offset=worst,
+                       seed=seed)  # pyribs draws with it only in sample_elites, which evolve does not call
 
 
 class TableEmitter(EmitterBase):

@@ -194,6 +194,10 @@ def fresh_section(outcome: Outcome, objective: Measure, check: Any, fresh: Fresh
             lines.append("(The starting table breaks a property: every table evolve keeps is proved to satisfy them "
                          "all, so the fair comparison for the search itself is against the repaired table.)")
     score = {key: fitness(objective, means[objective.name]) for key, means in fresh.means.items()}
-    gain = score[best[0]] - score[start] if best else 0.0
-    lines += ["", "Better than the starting table on fresh seeds: " + ("yes" if gain > 0 else "no") + "."]
+    if not best:
+        return [*lines, "", "Better than the starting table on fresh seeds: no table was kept."]
+    change = paired(objective, fresh.values[start][objective.name], fresh.values[best[0]][objective.name])
+    verdict = "no" if score[best[0]] <= score[start] else \
+        "yes, beyond two standard errors" if change.endswith(": better") else "on the mean only, not clearly"
+    lines += ["", f"Better than the starting table on fresh seeds: {verdict}."]
     return lines

@@ -98,7 +98,7 @@ class Prover:
         key = canonical(machine)
         if key in self.verdicts:
             self.hits += 1
-            return key, self.verdicts[key]
+            return key, self.counted(self.verdicts[key])
         started = time.perf_counter()
         verdict = self.prove(machine)
         self.seconds += time.perf_counter() - started
@@ -107,7 +107,15 @@ class Prover:
         if self.cache_path is not None:
             with open(self.cache_path, "a", encoding="utf-8") as f:  # one line per proof: a cut run keeps them
                 f.write(json.dumps({"key": key, "ok": verdict.ok, "failed": list(verdict.failed)}) + "\n")
-        return key, verdict
+        return key, self.counted(verdict)
+
+    def counted(self, verdict: Verdict) -> Verdict:
+        """Count a failed verdict for the property that failed, whether proved now or read from the cache:
+        the order properties are tried in then follows the calls alone, so a resumed run (its verdicts read
+        from the folder) names the same first failing property as a run never stopped."""
+        if not verdict.ok:
+            self.failures[verdict.failed[0]] = self.failures.get(verdict.failed[0], 0) + 1
+        return verdict
 
 
     def prove(self, machine: Machine) -> Verdict:
@@ -117,7 +125,6 @@ class Prover:
         props = sorted(self.properties(machine), key=lambda p: -self.failures.get(p.name, 0))
         for prop in props:
             if check_property(prop, machine).status != "holds":
-                self.failures[prop.name] = self.failures.get(prop.name, 0) + 1
                 return Verdict(False, (prop.name,))
         stuck = [f for f in zero_time_loops(Model(machine).explore()) if f.severity == "error"]
         return Verdict(False, ("zero-time-loop",)) if stuck else Verdict(True)

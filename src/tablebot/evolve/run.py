@@ -193,7 +193,7 @@ class Evolution:
         self.evaluate(list(dict.fromkeys([start_key, *seeds])))
         objective = self.settings.objective
         worst = 0.0 if objective.better == "high" else -default_range(objective.name, self.seconds)[1]
-        archive = qd.make_archive(self.settings.descriptors, worst)
+        archive = qd.make_archive(self.settings.descriptors, worst, self.settings.seed)
         self.offer(archive, seeds)
         emitter = qd.TableEmitter(archive, self.breed, self.settings.batch, self.settings.seed)
         history = [self.snapshot(archive)]
