@@ -42,7 +42,8 @@ function showFrames(store, views) {
       byId("status").textContent = describeTick(machine, { tick: m.tick, state: m.state_id, timer: m.timer,
         event: m.event, row: m.row, outputs });
     }
-    store.set({ why: m.why || [], mask: m.mask });
+    const why = m.why || [];  // repeated in every frame while paused: redrawn only when it says something new
+    store.set({ mask: m.mask, ...(JSON.stringify(why) === JSON.stringify(store.get().why) ? {} : { why }) });
   });
 }
 
@@ -56,25 +57,38 @@ function showWhy(store, views) {
   });
 }
 
-function inputButton(store, send, name, mask) {
-  const { machine, held: holds, mode } = store.get(), held = holds[name];
-  const live = mask !== undefined && (mask & machine.input_bits[name]);
-  const b = make("button", { type: "button", disabled: mode !== "live",
-    className: "input" + (live ? " live" : "") + (held === true ? " held-on" : held === false ? " held-off" : ""),
-    title: (machine.labels[name] || name) + ": click to hold it on, again to hold it off, again to let the sensor decide" },
-  name + (held === true ? ": held on" : held === false ? ": held off" : ""));
+const HELD_WORDS = { true: ": held on", false: ": held off" };
+const HELD_CLASSES = { true: " held-on", false: " held-off" };
+
+function inputButton(store, send, name) {
+  const b = make("button", { type: "button" });
   b.dataset.input = name;
-  b.addEventListener("click", () => {
+  b.addEventListener("click", () => {  // on, then off, then the sensor decides again
+    const held = store.get().held[name];
     send({ op: "sim", action: "hold", input: name, on: held === undefined ? true : held === true ? false : null });
   });
   return b;
 }
 
-// The robot's inputs: lit when on, held on or off by hand while the robot is live.
+function paintInputs(buttons, { machine, held, mode, mask }) {
+  for (const [name, b] of buttons) {
+    const live = mask !== undefined && (mask & machine.input_bits[name]);
+    b.className = "input" + (live ? " live" : "") + (HELD_CLASSES[held[name]] || "");
+    b.textContent = name + (HELD_WORDS[held[name]] || "");
+    b.disabled = mode !== "live";
+    b.title = (machine.labels[name] || name) + ": click to hold it on, again to hold it off, again to let the sensor decide";
+  }
+}
+
+// The robot's inputs: lit when on, held on or off by hand while the robot is live. The buttons are made
+// once per machine and repainted in place (a button that is clicked must not be replaced meanwhile).
 function showInputs(store, send) {
-  store.on(["machine", "held", "mode", "mask"], ({ machine, mask }) => {
-    byId("inputs").replaceChildren(...(machine ? machine.inputs.map((name) => inputButton(store, send, name, mask)) : []));
+  let buttons = new Map();
+  store.on(["machine"], ({ machine }) => {
+    buttons = new Map((machine ? machine.inputs : []).map((name) => [name, inputButton(store, send, name)]));
+    byId("inputs").replaceChildren(...buttons.values());
   });
+  store.on(["machine", "held", "mode", "mask"], (state) => { if (state.machine) paintInputs(buttons, state); });
 }
 
 function showControls(store) {
