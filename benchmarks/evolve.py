@@ -75,11 +75,11 @@ def children(count: int) -> tuple[object, list[tuple[str, object]], object]:
 
 
 def inner(repeat: int, count: int, seconds: float) -> None:
-    from tablebot.cli.fleet import make_plan
+    from tablebot.cli.sweep import make_plan
     from tablebot.evolve.evaluate import Evaluator
-    from tablebot.sim.fleet_work import Job, run_job
-    from tablebot.sweep import runs
-    from tablebot.sweep_backends import Runner
+    from tablebot.fleet.backends import Runner
+    from tablebot.fleet.spec import runs
+    from tablebot.fleet.work import Job, run_job
 
     plan = make_plan(EXAMPLE, None, [], ["start=random"], "0..15", None, seconds)
     _, tables, _ = children(count)

@@ -13,7 +13,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
 
 
 class Terminated(Exception):
@@ -63,8 +63,8 @@ def evolve_cmd(
     tables that satisfy every property of the robot (proved by check), run them on the fleet, and keep an
     archive of the best tables that behave differently. Ctrl-C keeps what was run; the same command resumes."""
     from tablebot.diagnostics import fail
-    from tablebot.sweep import parse_seeds
-    from tablebot.sweep_backends import choose
+    from tablebot.fleet.backends import choose
+    from tablebot.fleet.spec import parse_seeds
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
@@ -111,7 +111,7 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
 
 def _spec(plan: Any, setup: dict[str, Any]) -> dict[str, Any]:
     """What makes two runs the same run (a resumed one must be): the scenarios, properties and options."""
-    from tablebot.sweep import digest
+    from tablebot.fleet.spec import digest
 
     s, limits = setup["settings"], setup["space"].limits
     return {"scenarios": plan.spec.to_json(), "properties": {str(f): digest(Path(f)) for f in setup["files"]},
@@ -128,7 +128,7 @@ def _run(plan: Any, check: Any, setup: dict[str, Any], out: Path, backend: str, 
     from tablebot.evolve.outputs import write_all
     from tablebot.evolve.proofs import Prover
     from tablebot.evolve.run import Evolution, Store
-    from tablebot.sweep_backends import Runner
+    from tablebot.fleet.backends import Runner
 
     settings = setup["settings"]
     store = Store(out, _spec(plan, setup))

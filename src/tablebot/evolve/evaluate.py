@@ -19,14 +19,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tablebot.evolve.measures import MEASURES, STATE_SHARE
-from tablebot.sim.fleet_work import Job
+from tablebot.fleet.work import Job
 from tablebot.table import Table
 
 if TYPE_CHECKING:
-    from tablebot.sim.fleet import Fleet
+    from tablebot.fleet.backends import Runner
+    from tablebot.fleet.plan import Plan
+    from tablebot.fleet.run import Fleet
     from tablebot.sim.world import World
-    from tablebot.sweep_backends import Runner
-    from tablebot.sweep_run import Plan
 
 STRIDE = 20  # ticks between pose samples (0.2 s at 10 ms: a robot moves at most 6 cm)
 CELL_M = 0.10  # floor squares for area_covered
@@ -42,9 +42,9 @@ class EvalJob(Job):
 
 def run_eval(job: EvalJob) -> tuple[EvalJob, dict[str, np.ndarray]]:
     """Run the job's robots as one fleet; per robot, every measure (a worker's entry point)."""
+    from tablebot.fleet import work as fleet_work
+    from tablebot.fleet.run import Fleet
     from tablebot.machine import compile_table
-    from tablebot.sim import fleet_work
-    from tablebot.sim.fleet import Fleet
 
     threads = job.threads or fleet_work._worker_threads
     if threads is not None:
@@ -79,7 +79,7 @@ class Poses:
         self.sample()
 
     def sample(self) -> None:
-        from tablebot.sim import layout as L
+        from tablebot.sim import columns as L
 
         s = self.fleet.S
         x, y = s[:, L.X], s[:, L.Y]
@@ -135,7 +135,7 @@ class Evaluator:
 
     def jobs(self, key: str, table: Table, plan: Plan | None = None) -> list[EvalJob]:
         """One candidate's jobs: its robots per world, at most ROBOTS_PER_JOB to a job."""
-        from tablebot.sweep import runs
+        from tablebot.fleet.spec import runs
 
         plan = plan or self.plan
         scenarios = runs(plan.spec)

@@ -100,7 +100,7 @@ def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover,
 
 
 def write_evaluations(outcome: Outcome, settings: Settings, path: Path) -> Path:
-    from tablebot.sweep_run import csv_text
+    from tablebot.fleet.plan import csv_text
 
     names = [settings.objective.name, *(d.name for d in settings.descriptors if d.name != settings.objective.name)]
     in_archive = {key for key, *_ in qd.elites(outcome.archive)}

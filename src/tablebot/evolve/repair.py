@@ -22,9 +22,9 @@ from tablebot.evolve.operators import Space
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, to_table
 from tablebot.machine import Machine, compile_table
+from tablebot.replay import replay
 from tablebot.robot import StateId
 from tablebot.table import Table
-from tablebot.trace import replay
 
 STAY_TIMERS = (1, 10)  # ticks a "keep going while pressed" guard waits before looking again
 
