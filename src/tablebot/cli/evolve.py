@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import signal
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +14,16 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+
+
+@dataclass(frozen=True)
+class Setup:
+    """The checked options: the search's settings, what may change, the property files, the measures kept."""
+
+    settings: Any  # tablebot.evolve.run.Settings (imported when the command runs: --help stays quick)
+    space: Any  # tablebot.evolve.operators.Space
+    files: list[Path]
+    names: list[str]
 
 
 class Terminated(Exception):
@@ -79,7 +89,7 @@ def evolve_cmd(
 
 def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int, budget: int, batch: int, seed: int,
            max_rows: int | None, freeze_state: list[str], freeze_cell: list[str],
-           properties: list[Path] | None) -> dict[str, Any]:
+           properties: list[Path] | None) -> Setup:
     """Every option checked against the table and its worlds, before anything is written."""
     from tablebot.analysis.properties import find_property_files
     from tablebot.diagnostics import fail
@@ -105,16 +115,15 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     names = [n for n in measures.allowed(plan.worlds) if n != "lamp_distance" or n == measure.name]
     names += [d.name for d in chosen if d.name not in names]
     settings = Settings(measure, tuple(chosen), budget, batch, seed)
-    return {"settings": settings, "space": Space(base.states, base.robot.motors, limits), "files": files,
-            "names": names}
+    return Setup(settings, Space(base.states, base.robot.motors, limits), files, names)
 
 
-def _spec(plan: Any, setup: dict[str, Any]) -> dict[str, Any]:
+def _spec(plan: Any, setup: Setup) -> dict[str, Any]:
     """What makes two runs the same run (a resumed one must be): the scenarios, properties and options."""
     from tablebot.fleet.spec import digest
 
-    s, limits = setup["settings"], setup["space"].limits
-    return {"scenarios": plan.spec.to_json(), "properties": {str(f): digest(Path(f)) for f in setup["files"]},
+    s, limits = setup.settings, setup.space.limits
+    return {"scenarios": plan.spec.to_json(), "properties": {str(f): digest(Path(f)) for f in setup.files},
             "objective": s.objective.name, "descriptors": [[d.name, d.low, d.high, d.cells] for d in s.descriptors],
             "batch": s.batch, "seed": s.seed, "max_rows": limits.max_rows,
             "frozen_states": sorted(map(str, limits.frozen_states)),
@@ -122,7 +131,7 @@ def _spec(plan: Any, setup: dict[str, Any]) -> dict[str, Any]:
             "timer_max": limits.timer_max}
 
 
-def _run(plan: Any, check: Any, setup: dict[str, Any], out: Path, backend: str, address: str | None,
+def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: str | None,
          workers: int | None, quiet: bool) -> None:
     from tablebot.evolve.evaluate import Evaluator
     from tablebot.evolve.outputs import write_all
@@ -130,19 +139,19 @@ def _run(plan: Any, check: Any, setup: dict[str, Any], out: Path, backend: str, 
     from tablebot.evolve.run import Evolution, Store
     from tablebot.fleet.backends import Runner
 
-    settings = setup["settings"]
+    settings = setup.settings
     store = Store(out, _spec(plan, setup))
-    prover = Prover(setup["files"], store.proofs)
+    prover = Prover(setup.files, store.proofs)
     previous = signal.signal(signal.SIGTERM, _terminated)
     started = time.perf_counter()
     evolution = None
     try:
         with Runner(backend, address, workers) as runner, Bar("tables", settings.budget, quiet) as bar:
-            evaluator = Evaluator(plan, runner, setup["names"])
-            evolution = Evolution(plan.table, setup["space"], settings, prover, evaluator, store,
+            evaluator = Evaluator(plan, runner, setup.names)
+            evolution = Evolution(plan.table, setup.space, settings, prover, evaluator, store,
                                   on_eval=bar.advance, on_repair=lambda repairs: _said_repairs(repairs, quiet))
             outcome = evolution.run()
-            written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup["names"],
+            written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup.names,
                                 plan.spec.worlds[0])
     except (KeyboardInterrupt, Terminated) as exc:
         kept = len(evolution.store.open()) if evolution else 0
