@@ -75,7 +75,7 @@ def export_cmd(
         for path in workspace.write(out_folder(outdir, "OUTDIR")):
             console.print(f"wrote {terminal(str(path))}")
         console.print(f"upload and start it: tablebot upload {terminal(shell_word(str(outdir)))} "
-                      "--to txt4://192.168.7.2 --key API_KEY")
+                      "--to txt4://192.168.7.2 (it asks for the API key the TXT 4.0 shows)")
         return
     lists = robopro.encode(parsed)
     for path in robopro.write_lists(lists, out_folder(outdir, "OUTDIR")):
