@@ -273,3 +273,20 @@ def test_the_on_board_program_keeps_the_declared_hysteresis(tmp_path: Path, monk
              "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
     robot = stub_robot(tmp_path, monkeypatch, table, rows)
     assert [robot.read()[0] for _ in rows] == [0, 1, 1, 0, 1]
+
+
+def test_the_line_follower_program_reads_its_track_sensor(tmp_path: Path) -> None:
+    """create_trail_follower(...).get_state(): 0 over the line (fischertechnik's FTS program), so I1/I2 read 1 there."""
+    machine = compile_table(load_table(EXAMPLE.parent / "line-follower" / "table.csv"))
+    workspace = export_txt4(machine)
+    workspace.write(tmp_path)
+    assert "create_trail_follower" in workspace.files["lib/tablebot_program.py"]
+    inputs = [[0, 0] + [0] * 6] * 5 + [[1, 0] + [0] * 6] * 5 + [[0, 1] + [0] * 6] * 5
+    calls, done = run_on_stub(tmp_path, workspace.name, inputs)
+    assert done.returncode == 0, done.stderr
+    bits = machine.input_bits
+    masks = [(0 if u[0] else bits["I1"]) | (0 if u[1] else bits["I2"]) for u in inputs]
+    expected = list(replay(machine, [TickInput(m) for m in masks]))
+    seen = outputs_per_tick(calls, len(inputs))
+    assert [(s.get("M1"), s.get("M2")) for s in seen] == [(motor(e["M1"]), motor(e["M2"])) for e in expected]
+    assert {(3 * 64, CCW), (6 * 64, CCW)} <= {s.get("M1") for s in seen}  # it steered both ways

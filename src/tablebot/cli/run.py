@@ -34,19 +34,18 @@ class Target:
 
 
 def parse_target(text: str) -> Target:
-    """``txt://HOST[:PORT]``, ``txt://auto``, ``sim`` or ``sim:WORLD``; anything else is a located error."""
+    """``txt://HOST[:PORT]``, ``txt://auto[:PORT]``, ``sim`` or ``sim:WORLD``; anything else is a located
+    error."""
     if text == "sim" or text.startswith("sim:"):
         world = text[4:]
         return Target("sim", world=Path(world) if world else None)
     if not text.startswith("txt://"):
         raise fail("--on", f"unknown target {text!r}", TARGET_HINT)
     rest = text[len("txt://"):].rstrip("/")
-    if rest == "auto":
-        return Target("txt")
     host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
     if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
         raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", TARGET_HINT)
-    return Target("txt", host, int(port) if port else 65000)
+    return Target("txt", None if host == "auto" else host, int(port) if port else 65000)
 
 
 @app.command("run")
@@ -84,20 +83,23 @@ def run_cmd(
 
 def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[RobotIO, str, str]:
     """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
-    fit), then the controller found and asked who it is."""
-    from tablebot.hw.txt_link import AUTO_HOSTS, find_controller
-    from tablebot.hw.txt_robot import TxtRobot
+    fit), then the controller found (an address counts when it answers as a TXT) and asked who it is."""
+    from tablebot.hw import txt_link
+    from tablebot.hw.txt_robot import FirmwareTooOld, TxtRobot
     from tablebot.hw.txt_wiring import txt_wiring
     from tablebot.loop import LinkLost
 
     wiring = txt_wiring(machine)
-    host = target.host or find_controller(AUTO_HOSTS, target.port)
+    host = target.host
     if host is None:
-        raise fail("--on", f"txt://auto found no controller at {', '.join(AUTO_HOSTS)} (port {target.port})",
-                   CONNECT_HINT)
+        host, tried = txt_link.find_controller(txt_link.AUTO_HOSTS, target.port)
+        if host is None:
+            raise fail("--on", "txt://auto found no TXT: " + "; ".join(tried), CONNECT_HINT)
     bot = TxtRobot(wiring, host, target.port, link_timeout_s=link_timeout_s)
     try:
         status = bot.connect()
+    except FirmwareTooOld as exc:
+        raise fail("--on", str(exc), "update the TXT's firmware to 4.6.6 or later") from None
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
     return bot, bot.target, f"{status.device} {status.version_text}"
