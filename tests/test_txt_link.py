@@ -211,9 +211,12 @@ def test_against_a_server_that_reads_each_request_with_one_recv_every_request_ar
     assert all(r.whole for r in fake.requests()) and len(fake.requests("ExchangeData")) == 200
 
 
-def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture) -> None:
+@pytest.mark.parametrize("single_recv", [False, True], ids=["txt", "ftrobopy_server"])
+def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture,
+                                                                             single_recv: bool) -> None:
     import ftrobopy  # a dev dependency (pyproject.toml): missing, this fails rather than skips
-    with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True) as fake, warnings.catch_warnings():
+    with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True, single_recv=single_recv) as fake, \
+            warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)  # ftrobopy uses Thread.setDaemon
         txt = ftrobopy.ftrobopy("127.0.0.1", fake.port)
         motor = txt.motor(1)
@@ -231,5 +234,5 @@ def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(ca
     config = fake.requests("UpdateConfig")[-1].fields
     assert config["motors"][0] == 1 and config["inputs"][2] == (1, 1)
     assert any(r.fields["pwm"][:2] == [300, 0] for r in fake.requests("ExchangeData"))
-    assert "StopOnline" in fake.names()
+    assert "StopOnline" in fake.names() and all(r.whole for r in fake.requests())
     assert "TXT-fake" in capsys.readouterr().out  # ftrobopy prints what it connected to
