@@ -22,7 +22,7 @@ from core_helpers import EXAMPLE
 from tablebot.cli import app
 from tablebot.engine import Engine
 from tablebot.escape import python_string
-from tablebot.hw.txt4_export import export_txt4
+from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_inputs, random_table

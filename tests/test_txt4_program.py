@@ -21,11 +21,12 @@ from typing import Any
 import pytest
 
 from core_helpers import EXAMPLE
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
-from tablebot.hw import txt4_runtime
-from tablebot.hw.txt4_export import export_txt4
+from tablebot.hw.txt4 import runtime as txt4_runtime
+from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import compile_table
-from tablebot.trace import TickInput, replay
+from tablebot.replay import replay
 from test_txt_robot import wired_random_machine
 
 STUB = Path(__file__).resolve().parent / "txt4_stub"
