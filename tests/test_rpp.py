@@ -12,8 +12,8 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from tablebot.formats import robopro_lists as robopro
-from tablebot.formats.robopro_program import find_lists, rewrite, write_lists
+from tablebot.robopro import lists as robopro
+from tablebot.robopro.rpp_edit import find_lists, rewrite, write_lists
 from tablebot.formats.table_read import load_table
 
 ROOT = Path(__file__).resolve().parents[1]

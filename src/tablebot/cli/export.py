@@ -12,7 +12,7 @@ from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.diagnostics import fail
 from tablebot.escape import shell_word, terminal
-from tablebot.formats import robopro_program as rpp
+from tablebot.robopro import rpp_edit as rpp
 
 if TYPE_CHECKING:
     from tablebot.table import Table
@@ -50,7 +50,7 @@ def export_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
-    from tablebot.formats import robopro_lists as robopro
+    from tablebot.robopro import lists as robopro
 
     parsed, machine = load(table, robot)
     if to == Target.robopro_rpp:
@@ -84,7 +84,7 @@ def export_cmd(
 
 def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tuple[str, str, str]) -> None:
     """The three lists written into a ROBO Pro program: ``into`` itself, or its copy in ``outdir``."""
-    from tablebot.formats import robopro_lists as robopro
+    from tablebot.robopro import lists as robopro
 
     if into is None:
         raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")

@@ -53,7 +53,7 @@ def refused(action: Callable[[], object]) -> list[Diagnostic]:
 
 
 def robopro_fit(machine: Machine) -> list[Diagnostic]:
-    from tablebot.formats.robopro_lists import fit_problems
+    from tablebot.robopro.lists import fit_problems
 
     return fit_problems(machine.table)
 
