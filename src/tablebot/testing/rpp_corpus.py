@@ -13,14 +13,23 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import sys
 import xml.etree.ElementTree as ET
 from collections import defaultdict
 from collections.abc import Iterable
 from pathlib import Path
 
-VOCABULARY = Path(__file__).resolve().parents[1] / "robopro" / "vocabulary.json"
+from tablebot.robopro.vocabulary import (
+    DECIMAL_RE,
+    INT_RE,
+    INTERFACE_PINS,
+    MATRIX_RE,
+    TEXT,
+    VOCABULARY,
+    key,
+    pin_signature,
+)
+
 REPO = Path(__file__).resolve().parents[3]
 
 #: Attributes whose values are a program's data, not its vocabulary: positions, ids, names, texts,
@@ -39,17 +48,9 @@ FREE: dict[str, frozenset[str]] = {
     "wxDocviewStringProperty": frozenset({"value"}),
     "wxCanvasRect": frozenset({"width", "height"}),
     "init": frozenset({"value", "value0", "value1", "value2"}),
-    "title": frozenset({"#text"}),
+    "title": frozenset({TEXT}),
 }
-#: Elements whose pins name a subprogram's own inputs and outputs: their pin names and places are free.
-INTERFACE_PINS = frozenset({"ftProSubroutineRef", "ftProSubroutineSymbol", "ftProSubroutineFlowIn",
-                            "ftProSubroutineFlowOut", "ftProSubroutineDataIn", "ftProSubroutineDataOut"})
-#: The pseudo-attribute under which an element's own text (``<roboprover>04060600</roboprover>``) is kept.
-TEXT = "#text"
 PIN_CLASSES = frozenset({"ftProObjectPin", "wxCanvasPin"})
-INT_RE = re.compile(r"-?\d+")
-DECIMAL_RE = re.compile(r"-?\d+(\.\d+)?")
-MATRIX_RE = re.compile(r"matrix\( 1 0 0 1 -?\d+(\.\d+)? -?\d+(\.\d+)? \)")
 
 
 def corpus_dir() -> Path | None:
@@ -81,15 +82,6 @@ def value_kind(values: Iterable[str]) -> dict[str, object]:
     return {"kind": "text"}
 
 
-def pin_signature(kind: str, pin: ET.Element) -> tuple[str, ...]:
-    """What a pin says about its element: its name, class, id and place (only class and size for a
-    subprogram's interface, whose pins its author names and places)."""
-    size = (pin.get("width", ""), pin.get("height", ""), pin.get("orientation", ""))
-    if kind in INTERFACE_PINS:
-        return (pin.get("pinclass", ""), *size)
-    return (pin.get("name", ""), pin.get("pinclass", ""), pin.get("pinid", ""), pin.get("transform", ""), *size)
-
-
 class Reader:
     """Accumulates the facts of many documents (one pass each, by iterparse)."""
 
@@ -116,7 +108,7 @@ class Reader:
         self.files += 1
 
     def _element(self, element: ET.Element, parent: ET.Element | None) -> None:
-        kind = self.key(element)
+        kind = key(element)
         attributes = element.attrib
         self.orders[kind].add(tuple(attributes))
         for name, value in attributes.items():
@@ -124,18 +116,14 @@ class Reader:
         if element.tag != "o" and element.text and element.text.strip():
             self.values[kind][TEXT].add(element.text.strip())
         if parent is not None:
-            self.children[self.key(parent)].add(kind)
-        pins = tuple(pin_signature(kind, c) for c in element if c.get("classname") == "ftProObjectPin")
+            self.children[key(parent)].add(kind)
+        pins = tuple(tuple(pin_signature(kind, c)) for c in element if c.get("classname") == "ftProObjectPin")
         if kind in INTERFACE_PINS:  # any number of author-named pins: each pin on its own
             self.pins[kind].update((pin,) for pin in pins)
         elif pins or kind.startswith("ftPro"):
             self.pins[kind].add(pins)
         if parent is None:
-            self.headers.add(tuple(self.key(c) for c in element))
-
-    @staticmethod
-    def key(element: ET.Element) -> str:
-        return element.get("classname", element.tag) if element.tag == "o" else element.tag
+            self.headers.add(tuple(key(c) for c in element))
 
     def vocabulary(self) -> dict[str, object]:
         elements: dict[str, object] = {}
