@@ -26,6 +26,7 @@ SECTION_READERS: dict[str, str] = {
     "board": "tablebot.firmware.boards:read_robot_boards",
     "properties": "tablebot.analysis.properties:read_robot_properties",
     "txt": "tablebot.hw.txt_wiring:read_robot_txt",
+    "robopro": "tablebot.robopro.wiring:read_robot_robopro",
 }
 FOREIGN_SECTIONS = tuple(SECTION_READERS)
 TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
