@@ -163,6 +163,7 @@ class Run:
         self.counts: dict[int, int] = {}
         self.exits: list[tuple[str, str]] = []
         self.steps = 0
+        self._memo: dict[tuple, object] = {}  # per element and pin: what the wiring says, worked out once
         self._flow = self._main()
 
     def tick(self, digital: dict[int, int], counts: dict[int, int]) -> Tick:
@@ -203,7 +204,11 @@ class Run:
 
     def _outputs(self, element: ET.Element) -> dict[str, str]:
         """Flow output pin id by pin name (and by pin id as text)."""
-        found = {}
+        key = ("outs", id(element))
+        if key in self._memo:
+            return self._memo[key]  # type: ignore[return-value]
+        found: dict[str, str] = {}
+        self._memo[key] = found
         for p in element.findall("o"):
             if p.get("pinclass") == "flowobjectoutput":
                 found[p.get("name", "")] = p.get("id", "")
@@ -253,10 +258,11 @@ class Run:
     # --- data -------------------------------------------------------------------------------------
 
     def _data_pin(self, element: ET.Element, name: str | None, pinclass: str) -> ET.Element | None:
-        for p in element.findall("o"):
-            if p.get("pinclass") == pinclass and (name is None or p.get("name") == name):
-                return p
-        return None
+        key = ("pin", id(element), name, pinclass)
+        if key not in self._memo:
+            self._memo[key] = next((p for p in element.findall("o") if p.get("pinclass") == pinclass
+                                    and (name is None or p.get("name") == name)), None)
+        return self._memo[key]  # type: ignore[return-value]
 
     def _input(self, sub: str, element: ET.Element, name: str | None) -> int:
         pin = self._data_pin(element, name, "dataobjectinput")
@@ -265,43 +271,64 @@ class Run:
         return self._net_value(sub, pin.get("id", ""))
 
     def _net_value(self, sub: str, pin_id: str) -> int:
-        pins = self.program.pins[sub]
-        sources = [p for p in pins.members.get(pins.net.get(pin_id, -1), ())
-                   if pins.pin[p].get("pinclass") == "dataobjectoutput"]
-        if len(sources) != 1:
-            raise InterpreterError(f"{sub}: a data input has {len(sources)} sources")
-        return self._value(sub, sources[0])
+        return self._reader(sub, pin_id)()
 
-    def _value(self, sub: str, pin_id: str) -> int:
+    def _reader(self, sub: str, pin_id: str) -> Callable[[], int]:
+        """A function giving the value at data input ``pin_id`` now, built once from the wiring."""
+        key = ("reader", sub, pin_id)
+        if key not in self._memo:
+            pins = self.program.pins[sub]
+            sources = [p for p in pins.members.get(pins.net.get(pin_id, -1), ())
+                       if pins.pin[p].get("pinclass") == "dataobjectoutput"]
+            if len(sources) != 1:
+                raise InterpreterError(f"{sub}: a data input has {len(sources)} sources")
+            self._memo[key] = self._source(sub, sources[0])
+        return self._memo[key]  # type: ignore[return-value]
+
+    def _source(self, sub: str, pin_id: str) -> Callable[[], int]:
+        """A function giving the value output ``pin_id`` gives now."""
         pins = self.program.pins[sub]
         element, pin = pins.owner[pin_id], pins.pin[pin_id]
         kind = element.get("classname")
         if kind == "ftProDataVariable":
-            return self.variables.setdefault(element.get("name", ""), int(element.get("init", "0")))
+            name, init = element.get("name", ""), int(element.get("init", "0"))
+            return lambda: self.variables.setdefault(name, init)
         if kind == "ftProDataConst":
-            return int(element.get("value", "0"))
+            value = int(element.get("value", "0"))
+            return lambda: value
         if kind == "ftProDataIn":
             code = int(element.get("input", "0"))
             if 160 <= code <= 167:
-                return self.digital.get(code - 159, 0)
+                return lambda: self.digital.get(code - 159, 0)
             if 176 <= code <= 179:
-                return self.counts.get(code - 175, 0)
+                return lambda: self.counts.get(code - 175, 0)
             raise InterpreterError(f"input {code} is not one this interpreter knows")
         if kind == "ftProDataOprt":
-            operation = element.get("operation", "")
-            if operation not in OPERATIONS or element.get("N") != "2":
-                raise InterpreterError(f"operator {operation!r} is not one this interpreter runs")
-            a, b = self._input(sub, element, "A"), self._input(sub, element, "B")
+            return self._operator(sub, element)
+        if kind == "ftProDataArray1D" and pin.get("pinid") == "2":
+            def read() -> int:
+                values, index = self._list(element), self._index(sub, element)
+                if not 0 <= index < len(values):
+                    raise InterpreterError(f"list {element.get('name')}: index {index} outside 0..{len(values) - 1}")
+                return values[index]
+            return read
+        raise InterpreterError(f"{kind} gives no value this interpreter knows")
+
+    def _operator(self, sub: str, element: ET.Element) -> Callable[[], int]:
+        operation = element.get("operation", "")
+        if operation not in OPERATIONS or element.get("N") != "2":
+            raise InterpreterError(f"operator {operation!r} is not one this interpreter runs")
+        pin_a, pin_b = (self._data_pin(element, n, "dataobjectinput") for n in ("A", "B"))
+        assert pin_a is not None and pin_b is not None
+        a_of, b_of = self._reader(sub, pin_a.get("id", "")), self._reader(sub, pin_b.get("id", ""))
+        apply = OPERATIONS[operation]
+
+        def compute() -> int:
+            a, b = a_of(), b_of()
             if operation in ("SHR", "SHL") and (a < 0 or b < 0):
                 raise InterpreterError(f"{operation} of {a} by {b}: a negative shift is ambiguous here")
-            return _int(OPERATIONS[operation](a, b), f"{a} {operation} {b}")
-        if kind == "ftProDataArray1D" and pin.get("pinid") == "2":
-            values = self._list(element)
-            index = self._index(sub, element)
-            if not 0 <= index < len(values):
-                raise InterpreterError(f"list {element.get('name')}: index {index} outside 0..{len(values) - 1}")
-            return values[index]
-        raise InterpreterError(f"{kind} gives no value this interpreter knows")
+            return _int(apply(a, b), f"{a} {operation} {b}")
+        return compute
 
     def _list(self, element: ET.Element) -> list[int]:
         name = element.get("globalname") or element.get("name", "")
@@ -310,14 +337,18 @@ class Run:
         return self.lists[name]
 
     def _index(self, sub: str, element: ET.Element) -> int:
-        pin = next(p for p in element.findall("o") if p.get("pinclass") == "dataobjectinput"
-                   and p.get("pinid") == "1")
-        pins = self.program.pins[sub]
-        wired = [p for p in pins.members.get(pins.net.get(pin.get("id", ""), -1), ())
-                 if pins.pin[p].get("pinclass") == "dataobjectoutput"
-                 and pins.owner[p].get("classname") != "ftProDataMssg"]
-        if wired:
-            return self._net_value(sub, pin.get("id", ""))
+        key = ("index", id(element))
+        if key not in self._memo:
+            pin = next(p for p in element.findall("o") if p.get("pinclass") == "dataobjectinput"
+                       and p.get("pinid") == "1")
+            pins = self.program.pins[sub]
+            wired = [p for p in pins.members.get(pins.net.get(pin.get("id", ""), -1), ())
+                     if pins.pin[p].get("pinclass") == "dataobjectoutput"
+                     and pins.owner[p].get("classname") != "ftProDataMssg"]
+            self._memo[key] = pin.get("id", "") if wired else None
+        wired_pin = self._memo[key]
+        if wired_pin is not None:
+            return self._net_value(sub, wired_pin)  # type: ignore[arg-type]
         return self.index.get(element.get("name", ""), 0)
 
     def _send(self, sub: str, message: ET.Element) -> None:
@@ -325,12 +356,16 @@ class Run:
         data_in = self._data_pin(message, None, "dataobjectinput")
         value = self._net_value(sub, data_in.get("id", "")) if data_in is not None and data_in.get("resolveid") \
             else int(message.get("value", "0"))
-        out = self._data_pin(message, None, "dataobjectoutput")
-        assert out is not None
+        key = ("targets", id(message))
         pins = self.program.pins[sub]
-        for target in pins.members.get(pins.net.get(out.get("id", ""), -1), ()):
-            if pins.pin[target].get("pinclass") == "dataobjectinput":
-                self._receive(pins.owner[target], pins.pin[target], command, value)
+        if key not in self._memo:
+            out = self._data_pin(message, None, "dataobjectoutput")
+            assert out is not None
+            net = pins.members.get(pins.net.get(out.get("id", ""), -1), ())
+            self._memo[key] = [(pins.owner[t], pins.pin[t]) for t in net
+                               if pins.pin[t].get("pinclass") == "dataobjectinput"]
+        for element, pin in self._memo[key]:  # type: ignore[attr-defined]
+            self._receive(element, pin, command, value)
 
     def _receive(self, element: ET.Element, pin: ET.Element, command: str, value: int) -> None:
         kind = element.get("classname")

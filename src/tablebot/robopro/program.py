@@ -139,7 +139,7 @@ def determine_action(b: Builder) -> Sub:
     (step_on,), wire = s.side(missing.pins[3], [lambda x, y: el.message(x, y, "+", 1)],
                               extra=lambda e: b.send(s, e, "ROW"), rejoin=False)
     assert wire is not None
-    ex, ey = state.pins[3].at
+    _ex, ey = state.pins[3].at
     sx, sy = wire.points[1]
     s.canvas.join(state.pins[3], wire, (sx, sy + 4), via=[(sx + 8, ey), (sx + 8, sy + 4)])
     s.step(lambda x, y: el.flow_out(x, y, FOUND, 2))
@@ -257,4 +257,4 @@ def generate(table, rule: Rule = "always") -> str:
     return document(b.ids, p, [b.subs[n] for n in (MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN)])
 
 
-__all__ = ["RULES", "Rule", "TableBotError", "generate", "element_text", "wire_text"]
+__all__ = ["RULES", "Rule", "TableBotError", "element_text", "generate", "wire_text"]

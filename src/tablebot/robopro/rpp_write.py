@@ -8,6 +8,7 @@ another wire ends at a ``dynamic`` pin placed on that wire, as ROBO Pro stores c
 
 from __future__ import annotations
 
+import itertools
 import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -157,7 +158,7 @@ def _straight(wire: Wire) -> Wire:
 def _on(points: Sequence[Point], at: Point) -> bool:
     x, y = at
     return any(min(x0, x1) <= x <= max(x0, x1) and min(y0, y1) <= y <= max(y0, y1)
-               for (x0, y0), (x1, y1) in zip(points, points[1:], strict=False))
+               for (x0, y0), (x1, y1) in itertools.pairwise(points))
 
 
 # --- text ------------------------------------------------------------------------------------------
@@ -181,8 +182,8 @@ def open_tag(indent: str, head: Sequence[tuple[str, str]], at: Point | None, tai
 def properties(indent: str, pairs: Sequence[tuple[str, str]]) -> str:
     if not pairs:
         return ""
-    items = "".join(f'{indent}        <o classname="wxDocviewStringProperty" {attrs_text([("name", k), ("value", v)])}>\n'
-                    f"{indent}        </o>\n" for k, v in pairs)
+    items = "".join(f'{indent}        <o classname="wxDocviewStringProperty" '
+                    f'{attrs_text([("name", k), ("value", v)])}>\n{indent}        </o>\n' for k, v in pairs)
     return f"{indent}    \n{indent}    <properties>\n{items}{indent}    </properties>\n{indent}    \n"
 
 

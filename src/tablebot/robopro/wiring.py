@@ -56,11 +56,17 @@ def _default(name: str, kind: str, robot: Robot) -> int | None:
 
 
 class _Reader:
-    def __init__(self, src: Source, robot: Robot):
+    """Reads entries; errors go to the robot file's collector, or (for a robot made in code) to a list."""
+
+    def __init__(self, src: Source | None, robot: Robot):
         self.src, self.robot = src, robot
+        self.errors: list[tuple[str, str, str]] = []
 
     def error(self, key: str, message: str, hint: str) -> None:
-        self.src.key_error(("robopro", None, key), f"[robopro] {message}", hint)
+        if self.src is None:
+            self.errors.append((key, f"[robopro] {message}", hint))
+        else:
+            self.src.key_error(("robopro", None, key), f"[robopro] {message}", hint)
 
     def entry(self, name: str, value: Any, kind: str, extra: dict[str, tuple[Any, ...]]) -> tuple[int, dict] | None:
         """A terminal (``"I3"``) or a table ``{terminal = "I3", key = value}`` with ``extra``'s keys."""
@@ -110,12 +116,13 @@ def read_robot_robopro(src: Source, section: Any, robot: Robot) -> Wiring:
 def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = None,
               controller: str = "robo-interface") -> Wiring:
     """The wiring ``section`` says, defaults filled in; names that cannot be wired are listed in
-    ``problems`` (and reported through ``reader`` when one is given)."""
+    ``problems`` (mistakes in the section itself go through ``reader``)."""
     inputs, motors, counters, problems = {}, {}, {}, []
+    reader = reader or _Reader(None, robot)
     for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names)):
         extra = {"input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}}[kind]
         for name in names:
-            if reader is not None and name in section:
+            if name in section:
                 got = reader.entry(name, section[name], kind, extra)
             else:  # unwired names are the export's problem, not the robot file's
                 terminal = _default(name, kind, robot)
@@ -133,7 +140,7 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
             else:
                 counters[name] = terminal
     return Wiring(controller if controller in CONTROLLERS else "robo-interface", inputs, motors, counters,
-                  tuple(problems))
+                  tuple(problems) + tuple(reader.errors))
 
 
 def wiring(robot: Robot) -> Wiring:
@@ -141,4 +148,5 @@ def wiring(robot: Robot) -> Wiring:
     section = robot.sections.get("robopro")
     if isinstance(section, Wiring):
         return section
-    return wiring_of(robot, section if isinstance(section, dict) else {})
+    section = section if isinstance(section, dict) else {}
+    return wiring_of(robot, section, controller=str(section.get("controller", "robo-interface")))
