@@ -14,8 +14,8 @@ from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.framing import Decoder, encode
-from tablebot.robopro.rpp_edit import rewrite
 from tablebot.machine import compile_table
+from tablebot.robopro.rpp_edit import rewrite
 from tablebot.robot import load_robot
 from tablebot.testing.random_tables import random_inputs, random_table
 from tablebot.trace import load_inputs, replay

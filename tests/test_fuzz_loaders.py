@@ -24,10 +24,10 @@ from typer.testing import CliRunner
 from tablebot.analysis.properties import load_properties
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from tablebot.robopro.lists import read_table
-from tablebot.robopro.rpp_edit import write_lists
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
+from tablebot.robopro.lists import read_table
+from tablebot.robopro.rpp_edit import write_lists
 from tablebot.robot import BUMBERBOT, load_robot
 from tablebot.sim.world import load_world
 from tablebot.trace import load_inputs, read_trace

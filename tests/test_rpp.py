@@ -12,9 +12,9 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.table_read import load_table
 from tablebot.robopro import lists as robopro
 from tablebot.robopro.rpp_edit import find_lists, rewrite, write_lists
-from tablebot.formats.table_read import load_table
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

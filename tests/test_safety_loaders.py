@@ -15,8 +15,8 @@ from core_helpers import EXAMPLE, MINI_ROBOT, write_table
 from tablebot.cli import INTERNAL_ERROR, app, main
 from tablebot.diagnostics import TableBotError, notes_to
 from tablebot.formats import csvtext
-from tablebot.robopro.lists import read_lists
 from tablebot.formats.table_read import load_table
+from tablebot.robopro.lists import read_lists
 from tablebot.robot import load_robot
 from tablebot.trace import read_trace
 

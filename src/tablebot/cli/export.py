@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 class Target(StrEnum):
     robopro = "robopro"
     robopro_rpp = "robopro-rpp"
+    robopro_program = "robopro-program"
     c = "c"
     txt4 = "txt4"
 
@@ -38,7 +39,8 @@ def export_cmd(
     outdir: Path | None = typer.Argument(None, metavar="OUTDIR", help="Folder to write into (created if missing); "
                                          "for robopro-rpp, where to put the program instead of rewriting it."),
     to: Target = typer.Option(..., "--to", help="robopro: the three lists as CSV; robopro-rpp: the lists "
-                              "written into a ROBO Pro program (--into); c: portable C99 engine + table; "
+                              "written into a ROBO Pro program (--into); robopro-program: a whole ROBO Pro program "
+                              "that runs the table; c: portable C99 engine + table; "
                               "txt4: a program that runs the table on a TXT 4.0 itself (then: tablebot upload)."),
     into: Path | None = typer.Option(None, "--into", help="robopro-rpp: the ROBO Pro program (.rpp) to update."),
     event_list: str = typer.Option(rpp.DEFAULT_NAMES[0], "--event-list", help="robopro-rpp: the event list's name."),
@@ -58,6 +60,14 @@ def export_cmd(
         return
     if outdir is None:
         raise fail("OUTDIR", f"--to {to.value} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
+    if to == Target.robopro_program:
+        from tablebot.files import write_text
+        from tablebot.robopro.program import file_name, generate
+
+        text = generate(parsed)  # a table that does not fit is refused before the folder is made
+        path = write_text(out_folder(outdir, "OUTDIR") / file_name(parsed), text)
+        console.print(f"wrote {terminal(str(path))}: open it in ROBO Pro 4.x")
+        return
     if to == Target.c:
         from tablebot.codegen import generate
 

@@ -34,6 +34,8 @@ TARGETS: dict[str, Target] = {t.name: t for t in (
            "tablebot.formats.targets:robopro_fit"),
     Target("robopro-rpp", "the three lists written into a ROBO Pro program",
            "tablebot.formats.targets:robopro_fit"),
+    Target("robopro-program", "a whole ROBO Pro program running the table (the document's engine)",
+           "tablebot.robopro.fit:machine_problems"),
     Target("c", "a portable C99 engine and the table as const data", "tablebot.formats.targets:c_fit"),
     Target("uno", "AVR firmware for an Arduino Uno with the Motor Shield Rev3", "tablebot.formats.targets:uno_fit"),
     Target("ftduino", "AVR firmware for the ftDuino", "tablebot.formats.targets:ftduino_fit"),

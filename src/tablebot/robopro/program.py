@@ -12,14 +12,16 @@ detected"), ``"always"`` looks up as on any pass (a row that requires no event m
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Literal
 
-from tablebot.diagnostics import TableBotError
 from tablebot.robopro import elements as el
+from tablebot.robopro.document import document
 from tablebot.robopro.fit import Plan, plan
-from tablebot.robopro.rpp_write import Canvas, Element, Ids, caption, element_text, new_guid, wire_text
-from tablebot.robopro.sheet import Const, Count, Input, ListAt, Op, Sheet, Tree, Var
+from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption, new_guid
+from tablebot.robopro.sheet import Const, Count, Input, Join, ListAt, Op, Sheet, Tree, Var
+from tablebot.table import Table
 
 Rule = Literal["document", "always"]
 RULES: tuple[Rule, ...] = ("document", "always")
@@ -207,9 +209,7 @@ def count_down(b: Builder) -> Sub:
     return b.finish(COUNTDOWN, s, [(EXIT, 2)], "One tick later: TM and the counters count down")
 
 
-def _left_join(pin):
-    from tablebot.robopro.sheet import Join
-
+def _left_join(pin: Pin) -> Join:
     return Join(pin, pin.at[1])
 
 
@@ -238,12 +238,12 @@ def main_program(b: Builder) -> Sub:
     assert loop_wire is not None
     s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
     for n, line in enumerate(p.table_notes()):
-        s.canvas.comments.append(caption(INDENT, b.ids(), line, (COLUMN + 160, 8 + 4 * n), size=2,
+        s.canvas.comments.append(caption(INDENT, b.ids(), line, (s.right + 40, 8 + 4 * n), size=2,
                                          align="336", linespace="0"))
     return b.finish(MAIN, s, [], p.summary(), inputs=[])
 
 
-def generate(table, rule: Rule = "always") -> str:
+def generate(table: Table, rule: Rule = "always") -> str:
     """The whole .rpp text for ``table``; raises :class:`TableBotError` when the table does not fit."""
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, not {rule!r}")
@@ -252,9 +252,9 @@ def generate(table, rule: Rule = "always") -> str:
     for build in (detect_event, determine_action, execute_action, count_down):
         build(b)
     main_program(b)
-    from tablebot.robopro.document import document
-
     return document(b.ids, p, [b.subs[n] for n in (MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN)])
 
 
-__all__ = ["RULES", "Rule", "TableBotError", "element_text", "generate", "wire_text"]
+def file_name(table: Table) -> str:
+    """``BumberBot.rpp``: the robot's name, in characters any file system takes."""
+    return (re.sub(r"[^A-Za-z0-9_-]+", "_", table.robot.name).strip("_") or "engine") + ".rpp"
