@@ -58,9 +58,10 @@ def _fits(rule: dict[str, Any], value: str, series: tuple[range, ...] = ()) -> b
     return True
 
 
-def _element_problems(element: ET.Element, parent: ET.Element | None, where: str) -> list[str]:
+def _element_problems(element: ET.Element, parent: ET.Element | None, where: str,
+                      elements: dict[str, Any]) -> list[str]:
     kind = key(element)
-    known = vocabulary()["elements"].get(kind)
+    known = elements.get(kind)
     if known is None:
         return [f"{where}: element {kind!r} appears in no real program"]
     problems = []
@@ -74,7 +75,8 @@ def _element_problems(element: ET.Element, parent: ET.Element | None, where: str
         rule = known["attributes"].get(name)
         if rule is None or not _fits(rule, value, SERIES.get((kind, name), ())):
             problems.append(f"{where}: {kind} {name}={value!r} is not a value real programs use")
-    if parent is not None and kind not in vocabulary()["elements"][key(parent)]["children"]:
+    holder = elements.get(key(parent)) if parent is not None else None
+    if holder is not None and kind not in holder["children"]:
         problems.append(f"{where}: {kind} inside {key(parent)}: no real program nests them so")
     pins = [pin_signature(kind, c) for c in element if c.get("classname") == "ftProObjectPin"]
     allowed = known.get("pins")
@@ -87,20 +89,22 @@ def _element_problems(element: ET.Element, parent: ET.Element | None, where: str
     return problems
 
 
-def problems(text: str) -> list[str]:
-    """Everything in an .rpp document that real programs do not show, and every broken invariant."""
+def problems(text: str, known: dict[str, Any] | None = None) -> list[str]:
+    """Everything in an .rpp document that real programs do not show (``known``: a vocabulary, by default
+    the committed one), and every broken invariant."""
+    known = known or vocabulary()
     found: list[str] = []
     first_line = text.split("\n", 1)[0].strip()
-    if first_line not in vocabulary()["declarations"]:
+    if first_line not in known["declarations"]:
         found.append(f"line 1: XML declaration {first_line!r} is not the one real programs have")
     root = ET.fromstring(text.encode("utf-8"))
     header = [key(c) for c in root]
-    if header not in vocabulary()["headers"]:
+    if header not in known["headers"]:
         found.append(f"document header {header} differs from every real program's")
     parents = {child: parent for parent in root.iter() for child in parent}
     for number, element in enumerate(root.iter()):
         where = f"element {number} ({element.get('name') or element.get('id') or key(element)})"
-        found += _element_problems(element, parents.get(element), where)
+        found += _element_problems(element, parents.get(element), where, known["elements"])
     return found + invariant_problems(root)
 
 
