@@ -171,8 +171,9 @@ def test_inits_without_a_value_are_replaced_not_copied_blank() -> None:
             '<o classname="ftProDataArray1D" name="Action" N="1"><init value="0"/></o>\n'
             '<o classname="ftProDataArray1D" name="Timer" N="1"></o></cvg>')
     new = rewrite(text, LISTS)
-    assert '<init value="1"></init>' in new and '<init value="2"></init>' in new and "<init/>" not in new
-    assert '<init value="3"/>' in new and '<init value="6"></init>' in new
+    # ROBO Pro's own form (issue 20): <init value="…"> and </init> on lines of their own
+    assert '<init value="1">\n</init>' in new and '<init value="2">\n</init>' in new and "<init/>" not in new
+    assert '<init value="3"/>' in new and '<init value="6">\n    </init>' in new
 
 
 def test_a_list_written_as_an_empty_element_is_a_clear_error() -> None:

@@ -106,6 +106,8 @@ def _export_rpp(table: Table, outdir: Path | None, into: Path | None, names: tup
     written, from_csv = rpp.write_lists(into, named, out)
     console.print(f"wrote {terminal(str(written))} (lists {terminal(', '.join(named))}: "
                   f"{len(lists.event)} values each)")
-    for name in from_csv:
-        err_console.print(f"warning: list {terminal(name)} loads its values from a CSV file in ROBO Pro "
-                          "(initcsvcolumn), which replaces the values written here")
+    for name, column in from_csv.items():
+        err_console.print(f"warning: list {terminal(name)} loads its values from column {column} of a CSV file when "
+                          "the program starts (its load-from-CSV setting), which replaces the values written here; "
+                          "turn that off in the list's properties in ROBO Pro, or load the lists from "
+                          "`tablebot export --to robopro` CSV files instead")
