@@ -5,6 +5,7 @@ vocabulary; against the corpus itself in test_robopro_corpus.py)."""
 
 from __future__ import annotations
 
+import itertools
 import random
 import xml.etree.ElementTree as ET
 from dataclasses import replace
@@ -226,3 +227,54 @@ def test_rows_and_state_numbers():
     assert p.events == ("T", "I3", "I4", "I5", "I7", "I8") and p.shift == 6
     assert [p.encode(r) for r in table.rows[:1]] == [(88, 5120, 50)]
     assert isinstance(table.rows[0], Row)
+
+
+# --- the layout ---------------------------------------------------------------------------------------------
+
+def wire_segments(text: str) -> dict[str, list[tuple[str, tuple[int, int], tuple[int, int]]]]:
+    found = {}
+    for function in ET.fromstring(text.encode()).iter("o"):
+        if function.get("classname") == "ftProSubroutineFunction":
+            segments = []
+            for wire in function.findall("o"):
+                if wire.get("classname") in ("ftProFlowWire", "ftProDataWire"):
+                    points = [(int(p.get("x")), int(p.get("y"))) for p in wire.findall("xy")]
+                    segments += [(wire.get("id"), a, b) for a, b in itertools.pairwise(points)]
+            found[function.get("name")] = segments
+    return found
+
+
+def crossing(one: tuple, other: tuple) -> bool:
+    """Two wire segments cross inside both, or run along each other."""
+    (_, a1, b1), (_, a2, b2) = one, other
+    if (a1[1] == b1[1]) != (a2[1] == b2[1]):
+        (ha, hb), (va, vb) = ((a1, b1), (a2, b2)) if a1[1] == b1[1] else ((a2, b2), (a1, b1))
+        return min(ha[0], hb[0]) < va[0] < max(ha[0], hb[0]) and min(va[1], vb[1]) < ha[1] < max(va[1], vb[1])
+    span = 0 if a1[1] == b1[1] else 1  # both horizontal: they span x; both vertical: y
+    if a1[1 - span] != a2[1 - span]:
+        return False
+    low = max(min(a1[span], b1[span]), min(a2[span], b2[span]))
+    return min(max(a1[span], b1[span]), max(a2[span], b2[span])) > low
+
+
+def test_crossing_sees_crossings():
+    assert crossing(("a", (0, 4), (8, 4)), ("b", (4, 0), (4, 8)))
+    assert crossing(("a", (0, 4), (8, 4)), ("b", (4, 4), (12, 4)))  # along each other
+    assert not crossing(("a", (0, 4), (8, 4)), ("b", (8, 0), (8, 8)))  # meeting at an end
+    assert not crossing(("a", (0, 4), (8, 4)), ("b", (0, 8), (8, 8)))
+
+
+@pytest.mark.parametrize("which", ["bumberbot-document", "counters", "random"])
+def test_wires_do_not_cross_and_everything_sits_on_the_grid(which):
+    if which == "bumberbot-document":
+        text = generate(load_table(EXAMPLE / "table.csv"), "document")
+    elif which == "counters":
+        text = generate(load_table(COUNTERS / "table.csv"))
+    else:
+        table = random_table(random.Random(11), Shape(states=3, rows=8, inputs=3, counters=2))
+        text = generate(fitting(table, {"controller": "tx"}))
+    for name, segments in wire_segments(text).items():
+        crossed = [(a[0], b[0]) for n, a in enumerate(segments) for b in segments[n + 1:]
+                   if a[0] != b[0] and crossing(a, b)]
+        assert crossed == [], f"{name}: wires cross"
+        assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
