@@ -8,7 +8,7 @@ from __future__ import annotations
 import itertools
 import random
 import xml.etree.ElementTree as ET
-from dataclasses import replace
+from dataclasses import astuple, replace
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -20,6 +20,7 @@ from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import load_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import NO_ROW, Machine, compile_table, first_match
+from tablebot.robopro.executor import run
 from tablebot.robopro.fit import plan, problems
 from tablebot.robopro.interpret import InterpreterError, Program, Run
 from tablebot.robopro.program import generate
@@ -74,35 +75,11 @@ def engine_ticks(machine: Machine, inputs: list[TickInput]) -> list[tuple]:
 
 
 def program_ticks(table: Table, text: str, inputs: list[TickInput], rule: str) -> list[tuple]:
-    """Run the program on the same inputs and read its decisions back in the engine's terms."""
-    p = plan(table, rule)
-    machine = compile_table(table)
-    index_of = {p.numbers[s]: i for i, s in enumerate(machine.states)}
-    run = Run(Program(text))
-    counts = {c: 0 for c in p.wiring.counters.values()}
-    out = []
-    for given_input in inputs:
-        digital = {}
-        for name, (terminal, active) in p.wiring.inputs.items():
-            present = name in table.events and bool(given_input.mask & table.bit(name))
-            digital[terminal] = int(present) if active else int(not present)
-        for (_, counter), pulses in zip(p.wiring.counters.items(), given_input.pulses, strict=True):
-            counts[counter] += pulses
-        tick = run.tick(digital, counts)
-        v = tick.variables
-        fired = (EXECUTE_EXIT in tick.exits)
-        event = sum(table.bit(name) for name in table.events if v["EV"] & p.bits[name])
-        motors = []
-        for motor in table.robot.motors:
-            output, forward = p.wiring.motors[motor]
-            command, speed = tick.motors[output]
-            motors.append(speed if command == forward else -speed)
-        counters = tuple(v.get(name, 0) for name in table.robot.counter_names)
-        out.append((event, v["ROW"] if fired else NO_ROW, index_of[v["ST"]], v["TM"], tuple(motors), counters))
-    return out
+    """The generated program's decisions (the executor runs ``generate(table, rule)``, which is ``text``)."""
+    assert generate(table, rule) == text  # the same table and rule give the same bytes
+    return [astuple(d) for d in run(table, inputs, rule)]
 
 
-EXECUTE_EXIT = ("ExecuteAction", "Exit")
 
 
 def fitting(table: Table, sections: dict) -> Table:
