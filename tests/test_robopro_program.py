@@ -255,3 +255,20 @@ def test_wires_do_not_cross_and_everything_sits_on_the_grid(which):
                    if a[0] != b[0] and crossing(a, b)]
         assert crossed == [], f"{name}: wires cross"
         assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
+
+
+def test_hostile_texts_stay_text(tmp_path):
+    """Descriptions, state names, labels and the robot name that end tags and attributes stay text: the
+    file parses, keeps to the vocabulary, and shows each text as written."""
+    from hostile import HOSTILE, INJECTED, write_project
+
+    table = load_table(write_project(tmp_path / "p"))
+    text = generate(table)
+    root = ET.fromstring(text.encode())
+    assert vocabulary_problems(text) == []
+    assert not any(element.tag.startswith("evil") for element in root.iter())
+    shown = "\n".join(o.get("text", "") for o in root.iter("o")) + root.findtext("title", "")
+    for hostile in HOSTILE[2:4] + HOSTILE[9:]:
+        assert hostile in shown
+    assert "<evil" not in text and INJECTED[2] == "<evil"
+    assert run(table, [TickInput(0, ())] * 3)  # and it runs
