@@ -22,7 +22,9 @@ INTERFACE_PINS = frozenset({"ftProSubroutineRef", "ftProSubroutineSymbol", "ftPr
 
 #: Numbering rules real programs show in part, and the generator extends: the corpus has inputs I1–I4 as
 #: ``ftProDataIn input`` 160–163 (the TeachIn robots) and the counts of counters C1 and C3 as 176 and 178 (its
-#: ROBO TX variant's encoder motors); the same series give I5–I8 (164–167) and C2, C4 (177, 179).
+#: ROBO TX variant's encoder motors); the same series give I5–I8 (164–167) and C2, C4 (177, 179). Real
+#: programs outside the corpus agree: olagino/roproparser's test/Teleskop.rpp (GitHub) reads I5–I8 as
+#: 164–167 in the same digital mode.
 SERIES: dict[tuple[str, str], tuple[range, ...]] = {("ftProDataIn", "input"): (range(160, 168), range(176, 180))}
 
 
