@@ -85,7 +85,7 @@ class Builder:
 
     def finish(self, name: str, sheet: Sheet, outputs: list[tuple[str, int]], documentation: str,
                inputs: list[tuple[str, int]] | None = None) -> Sub:
-        x = sheet.right + 24  # comments right of every lane
+        x = max(sheet.right, sheet.lanes) + 24  # comments right of every lane
         for y, text in sheet.notes:
             sheet.canvas.comments.append(caption(INDENT, self.ids(), text, (x, y), size=3, align="336",
                                                  linespace="0"))
@@ -238,7 +238,7 @@ def main_program(b: Builder) -> Sub:
     assert loop_wire is not None
     s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
     for n, line in enumerate(p.table_notes()):
-        s.canvas.comments.append(caption(INDENT, b.ids(), line, (s.right + 40, 8 + 4 * n), size=2,
+        s.canvas.comments.append(caption(INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2,
                                          align="336", linespace="0"))
     return b.finish(MAIN, s, [], p.summary(), inputs=[])
 

@@ -83,7 +83,8 @@ class Sheet:
         self.y = 0  # lowest y used so far in the column
         self.joins: list[Join] = []
         self.held: list[Join] = []  # joins that land further down than the next step
-        self.right = x + SIDE  # rightmost x used so far (lanes go beyond it)
+        self.right = x + SIDE  # rightmost x elements use so far (lanes go beyond it)
+        self.lanes = 0  # rightmost lane used so far
         self.last_wire: Wire | None = None  # the flow wire into the latest step
         self.sides = x  # x of the rightmost side column
         self.notes: list[tuple[int, str]] = []  # (y, text): comments beside the column, placed at the end
@@ -167,22 +168,25 @@ class Sheet:
         return element
 
     def _join_all(self, wire: Wire, x: int, y_in: int) -> None:
-        """Every pending join ends on ``wire`` above the input at (x, y_in). The first join takes the
-        outermost lane and the lowest point, each later one a lane further in and a point higher, so no
-        two cross."""
+        """Every pending join ends on ``wire`` above the input at (x, y_in). A lone side column's exit goes
+        straight down and left; otherwise the first join takes the outermost lane and the lowest point,
+        each later one a lane further in and a point higher, so no two cross."""
         count = len(self.joins)
+        base = max(self.right, self.lanes)  # beyond every element and every lane drawn so far
         for n, join in enumerate(self.joins):
-            lane = self.right + 8 * (count - n)
+            lane = base + 8 * (count - n)
             at = (x, y_in - 4 - 8 * n)
             px, py = join.pin.at
             if join.pin.dx > 0 and join.pin.dy == 0:  # a branch's exit to the right
                 via = [(lane, py), (lane, at[1])]
-            elif px < x:  # an exit left of the column: straight down, then right
+            elif px < x or count == 1:  # straight down, then across to the column
                 via = [(px, at[1])]
             else:
                 via = [(px, py + 4), (lane, py + 4), (lane, at[1])]
+                self.lanes = max(self.lanes, lane)
+            if join.pin.dx > 0 and join.pin.dy == 0:
+                self.lanes = max(self.lanes, lane)
             self.canvas.join(join.pin, wire, at, via=via)
-        self.right += 8 * count
         self.joins = []
 
     def side(self, exit_pin: Pin, makers: list[Callable[[int, int], Element]],
@@ -231,8 +235,9 @@ class Sheet:
         self.notes.append((y, text))
 
     def lane(self) -> int:
-        self.right += 8
-        return self.right
+        """A lane right of every element and every lane so far (for a flow that spans many steps)."""
+        self.lanes = max(self.right, self.lanes) + 8
+        return self.lanes
 
     def loop_back(self, pin: Pin, onto: Wire, at: Point) -> None:
         """A flow from ``pin`` back up to ``at`` on the column's wire ``onto``, by the rightmost lane."""
