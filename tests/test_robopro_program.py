@@ -272,3 +272,21 @@ def test_hostile_texts_stay_text(tmp_path):
         assert hostile in shown
     assert "<evil" not in text and INJECTED[2] == "<evil"
     assert run(table, [TickInput(0, ())] * 3)  # and it runs
+
+
+def test_the_commands(tmp_path):
+    from typer.testing import CliRunner
+
+    from tablebot.cli import app
+
+    runner = CliRunner()
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-program", str(out)])
+    assert result.exit_code == 0, result.output
+    assert lists_of((out / "BumberBot.rpp").read_text(encoding="utf-8"))["Event"][0] == 88
+    refused = tmp_path / "refused"
+    result = runner.invoke(app, ["export", str(ROOT / "examples" / "line-follower"), "--to", "robopro-program",
+                                 str(refused)])
+    assert result.exit_code == 2 and "line sensor" in result.output and not refused.exists()
+    result = runner.invoke(app, ["check", str(ROOT / "examples" / "line-follower"), "--target", "robopro-program"])
+    assert result.exit_code == 2 and "robopro-program: input I1 is a line sensor" in " ".join(result.output.split())
