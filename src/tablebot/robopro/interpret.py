@@ -20,7 +20,9 @@ only as a table of contents, "RoboPro-En", sections 5.4 Timers, 5.6 Lists, 5.7 O
   input on its output's wire: ``=``, ``+``, ``-`` to a variable; ``cw``, ``ccw`` (speed) and ``Stop`` to a
   motor (olagino/roproparser); ``=`` to a list's I input sets its index.
 * ``ftProDataVariable`` (value at its output), ``ftProDataConst``, ``ftProDataIn`` (``input`` 160 + n − 1
-  reads In, 176 + n − 1 the count of Cn), ``ftProDataOutDual``: as the corpus wires them.
+  reads In, 176 + n − 1 the count of Cn), ``ftProDataOutDual``: as the corpus wires them. A variable of
+  ``scope`` 1 is global, one value for every copy of its name (olagino/roproparser; in the corpus, names
+  used in several subprograms are scope 1 for 121 names and scope 0 for 9); the generator uses only those.
 * ``ftProDataArray1D``: R gives the value at the index its I input gives (a wired variable, or the last
   ``=`` sent to I); values are the ``init`` children: the corpus's lists.
 * ``ftProDataOprt`` ``+ - AND OR XOR SHL SHR`` on 16-bit integers; a result beyond −32768…32767 is an
