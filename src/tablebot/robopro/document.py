@@ -3,15 +3,26 @@ canvas layers, and per subprogram its function, symbol, panel, display and camer
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from tablebot.escape import xml_text
 from tablebot.robopro import elements as el
-from tablebot.robopro.rpp_write import FLAGS, HIT, Ids, Pin, attrs_text, element_text, pin_text, wire_text
+from tablebot.robopro.rpp_write import (
+    FLAGS,
+    HIT,
+    Canvas,
+    Ids,
+    Pin,
+    attrs_text,
+    element_text,
+    new_guid,
+    pin_text,
+    wire_text,
+)
 
 if TYPE_CHECKING:
     from tablebot.robopro.fit import Plan
-    from tablebot.robopro.program import Sub
 
 ROBOPRO_VERSION = "04060600"  # the newest ROBO Pro of the corpus (4.6.6)
 #: ftProModule newtype per controller: 3 in the TeachIn robot's ROBO TX variant, 4 in its TXT variant
@@ -21,6 +32,21 @@ MODULE_TYPE = {"robo-interface": "3", "tx": "3", "txt": "4"}
 LAYERS = (("layer default", None, "GREY", "BLACK", ' pixelwidth="true" width="1"'),
           ("layer data wires", "1", "#E67300", "#E67300", ' width="0.5"'),
           ("layer flow wires", "2", "#14007D", "#14007D", ' width="0.5"'))
+
+
+@dataclass
+class Sub:
+    """A subprogram: its name, drawing and flow pins (name, uniqueID) for its symbol."""
+
+    name: str
+    canvas: Canvas
+    inputs: list[tuple[str, int]]
+    outputs: list[tuple[str, int]]
+    documentation: str
+
+    @property
+    def guid(self) -> str:
+        return new_guid(self.name)
 
 
 def header(title: str) -> str:

@@ -13,13 +13,12 @@ detected"), ``"always"`` looks up as on any pass (a row that requires no event m
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import Literal
 
 from tablebot.robopro import elements as el
-from tablebot.robopro.document import document
+from tablebot.robopro.document import Sub, document
 from tablebot.robopro.fit import Plan, plan
-from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption, new_guid
+from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption
 from tablebot.robopro.sheet import Const, Count, Input, Join, ListAt, Op, Sheet, Tree, Var
 from tablebot.table import Table
 
@@ -30,21 +29,6 @@ MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN = ("Main program", "DetectEvent", "D
 ENTRY, EXIT, FOUND, NONE = "Entry", "Exit", "Found", "None"
 COLUMN = 136  # x of every subprogram's flow column
 INDENT = "            "  # elements inside a subprogram
-
-
-@dataclass
-class Sub:
-    """A subprogram: its name, drawing and flow pins (name, uniqueID) for its symbol."""
-
-    name: str
-    canvas: Canvas
-    inputs: list[tuple[str, int]]
-    outputs: list[tuple[str, int]]
-    documentation: str
-
-    @property
-    def guid(self) -> str:
-        return new_guid(self.name)
 
 
 class Builder:
