@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from core_helpers import EXAMPLE, ROOT
 from tablebot.diagnostics import TableBotError
 from tablebot.engine import Engine
-from tablebot.formats.inputs_csv import load_inputs
+from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import NO_ROW, Machine, compile_table, first_match
 from tablebot.robopro.executor import run
@@ -27,7 +27,6 @@ from tablebot.robopro.program import generate
 from tablebot.robopro.vocabulary import problems as vocabulary_problems
 from tablebot.table import Row, Table
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import TickInput
 
 COUNTERS = ROOT / "examples" / "bumberbot-counters"
 

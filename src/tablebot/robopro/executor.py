@@ -7,12 +7,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import NO_ROW, compile_table
 from tablebot.robopro.fit import plan
 from tablebot.robopro.interpret import Program, Run
 from tablebot.robopro.program import EXECUTE, EXIT, Rule, generate
 from tablebot.table import Table
-from tablebot.trace import TickInput
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from tablebot.formats.tomlfile import Source
 from tablebot.robot import Robot
+from tablebot.tomlfile import Source
 
 CONTROLLERS = ("robo-interface", "tx", "txt")
 TERMINALS = {"input": ("I", 8), "motor": ("M", 4), "counter": ("C", 4)}
