@@ -289,3 +289,16 @@ def test_the_commands(tmp_path):
     assert result.exit_code == 2 and "line sensor" in result.output and not refused.exists()
     result = runner.invoke(app, ["check", str(ROOT / "examples" / "line-follower"), "--target", "robopro-program"])
     assert result.exit_code == 2 and "robopro-program: input I1 is a line sensor" in " ".join(result.output.split())
+
+
+def test_a_wrong_robopro_section_is_a_located_error(tmp_path):
+    from tablebot.robot import load_robot
+
+    (tmp_path / "robot.toml").write_text(
+        'name = "W"\ninitial_state = 1\n[inputs]\nI3 = "a"\n[motors]\nM1 = "m"\n[robopro]\ncontroller = "nxt"\n'
+        'I3 = "I9"\nM1 = { output = "M1", forward = "left" }\nX1 = "I1"\n')
+    with pytest.raises(TableBotError) as info:
+        load_robot(tmp_path / "robot.toml")
+    found = {(d.line, d.message.split(":")[0]) for d in info.value.diagnostics}
+    assert {line for line, _ in found} == {8, 9, 10, 11}
+    assert any("forward = 'left'" in d.message for d in info.value.diagnostics)
