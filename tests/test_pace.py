@@ -212,9 +212,9 @@ def test_the_judgement_warns_when_the_link_takes_more_than_half_the_tick_and_loc
         judge(machine, LinkTime("t://x", "one exchange", 0.015), accept_slow=False)
     (problem,) = refused.value.diagnostics
     assert (problem.path, problem.line) == (str(EXAMPLE / "robot.toml"), 4)
-    assert "about 50 % slow" in problem.message and "tick_ms = 50" in problem.hint
+    assert "at least 50 % slow" in problem.message and "tick_ms = 50" in problem.hint
     (accepted,) = judge(machine, LinkTime("t://x", "one exchange", 0.015), accept_slow=True)
-    assert "timers will run about 50 % slow" in accepted
+    assert "timers will run at least 50 % slow" in accepted
     builtin = compile_table(dataclasses.replace(machine.table, robot=dataclasses.replace(machine.table.robot,
                                                                                           toml=None)))
     with pytest.raises(TableBotError) as on:

@@ -90,7 +90,7 @@ def judge(machine: Machine, link: LinkTime, accept_slow: bool) -> tuple[str, ...
     if need <= REFUSE_ABOVE * tick_s:
         return (f"{link.target}: {took}, {need / tick_s:.0%} of the table's {robot.tick_ms} ms tick: ticks will "
                 f"start late when this machine or the link is busy (tick_ms = {suggested} would leave room)",)
-    slow = f"about {100 * (need / tick_s - 1):.0f} % slow" if need > tick_s else "slow"
+    slow = f"at least {100 * (need / tick_s - 1):.0f} % slow" if need > tick_s else "slow"
     if accept_slow:
         return (f"{link.target}: {took}, more than the table's {robot.tick_ms} ms tick can hold: running anyway "
                 f"(--behind-limit 0), so the table's timers will run {slow}",)
