@@ -17,6 +17,7 @@ from rich.console import Console
 from tablebot import guard
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notes_to
 from tablebot.escape import terminal
+from tablebot.interrupts import Terminated, sigterm_raises
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
     from tablebot.machine import Machine
@@ -143,7 +144,7 @@ def guarded(func: F) -> F:
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with notes_to(print_diagnostic), guard.command(force=bool(kwargs.get("force", False))):
+            with sigterm_raises(), notes_to(print_diagnostic), guard.command(force=bool(kwargs.get("force", False))):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:
@@ -160,5 +161,8 @@ def guarded(func: F) -> F:
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
             raise typer.Exit(130) from None
+        except Terminated:
+            print("terminated", file=sys.stderr)
+            raise typer.Exit(143) from None
 
     return wrapper  # type: ignore[return-value]
