@@ -42,6 +42,7 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
+    from tablebot.fileset import file_set
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
@@ -55,15 +56,17 @@ def sim_cmd(
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    trace = TraceFile(out / "trace.jsonl", background=True)
     rows = plots or gif or view  # every robot row is kept only for what draws the run
-    result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+    with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
+        trace = TraceFile(out / "trace.jsonl", background=True)
+        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+        if result.end.complete:
+            summary = summarise(result)
+            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
+            if html:
+                written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
         _stopped(result, trace.written)
-    summary = summarise(result)
-    written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
-    if html:
-        written.append(_replay_page(result, trace.written, out / "run.html"))
     if not quiet:
         _report(result, summary, written)
     if view:
@@ -95,10 +98,11 @@ def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: boo
 def _replay_page(result: Result, trace: Path, path: Path) -> Path:
     """A self-contained HTML page that replays the run from the trace just written (to send to a pupil,
     or put on a class page)."""
+    from tablebot.fileset import current
     from tablebot.web.replay import write_html
 
     scene = result.scene
-    lines = trace.read_text(encoding="utf-8").splitlines()
+    lines = current(trace).read_text(encoding="utf-8").splitlines()  # not in place yet: its set is being written
     return write_html(path, lines, scene.world, scene.table, params=scene.params)
 
 
