@@ -45,9 +45,13 @@ def sweep_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
-    OUT/results.csv, with pictures. Ctrl-C keeps every finished chunk; the same command again resumes."""
+    OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
+    resumes."""
+    from tablebot.fileset import current, file_set
+    from tablebot.interrupts import INTERRUPTS
     from tablebot.sweep_backends import choose, run_jobs
-    from tablebot.sweep_run import Store
+    from tablebot.sweep_plots import write_all
+    from tablebot.sweep_run import Store, read_results
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
@@ -64,14 +68,26 @@ def sweep_cmd(
             progress.advance(len(summary))
         try:
             run_jobs(jobs, done, chosen, address, workers)
-        except KeyboardInterrupt:
-            path, count = store.merge(complete=False)
-            err_console.print(f"interrupted: {count:,} of {total:,} runs finished, kept in {path}; run the same "
-                              "command again to resume", markup=False, soft_wrap=True)
-            raise typer.Exit(130) from None
-    path, count = store.merge(complete=True)
-    traces = plan.write_traces(traced, out)
-    report(plan, path, out, plots, quiet, time.perf_counter() - started, total - already, traces)
+        except INTERRUPTS as exc:
+            stopped(store, total, exc)
+    wall_s = time.perf_counter() - started
+    with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
+        path, _ = store.merge(complete=True)
+        rows = read_results(current(path))
+        written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
+    if not quiet:
+        report(plan, rows, written, wall_s, total - already)
+
+
+def stopped(store: Any, total: int, why: BaseException) -> None:
+    """Ctrl-C or SIGTERM: the finished chunks merged into results.partial.csv, then exit 130 (143)."""
+    from tablebot.interrupts import Terminated
+
+    path, count = store.merge(complete=False)
+    word = "terminated" if isinstance(why, Terminated) else "interrupted"
+    err_console.print(f"{word}: {count:,} of {total:,} runs finished, kept in {path}; run the same "
+                      "command again to resume", markup=False, soft_wrap=True)
+    raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 
 def trace_runs(text: str | None, total: int) -> list[int]:
@@ -123,16 +139,10 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
     return Plan(spec, parsed, machine, loaded, layer)
 
 
-def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: float, ran: int,
-           traces: list[Path]) -> None:
+def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: float, ran: int) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
-    from tablebot.sweep_plots import groups, write_all
-    from tablebot.sweep_run import read_results
+    from tablebot.sweep_plots import groups
 
-    rows = read_results(path)
-    written = [path, *traces, *(write_all(plan, rows, out) if plots else [])]
-    if quiet:
-        return
     lamps = any(world.lamps for world in plan.worlds)
     for key, values in groups(plan, rows):
         for label, chosen in values:
