@@ -50,9 +50,12 @@ def tune_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
-    runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table.
+    Ctrl-C (or SIGTERM) keeps every evaluation made; the same command again resumes."""
     from tablebot import guard
     from tablebot.diagnostics import fail
+    from tablebot.fileset import current, file_set
+    from tablebot.interrupts import INTERRUPTS
     from tablebot.sweep import parse_seeds
     from tablebot.sweep_backends import Runner, choose
     from tablebot.tune import Evaluator, best, parse_cells, search_cma, search_grid
@@ -70,26 +73,87 @@ def tune_cmd(
     target = tuned_path(Path(plan.table.path), out)
     guard.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
+    journal = Journal(out / JOURNAL, plan, tuned_cells, objective)
+    known = journal.load()
     started = time.perf_counter()
-    with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
-        evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance)
-        baseline = tuple(c.value for c in tuned_cells)
-        evaluate([baseline])
-        if method == "grid":
-            search_grid(evaluate, budget)
-        else:
-            search_cma(evaluate, budget, seed)
-        winner, _ = best(evaluate.history)
-        before_after = evaluate.measure([baseline, winner], check, metrics)
-    written = [write_tuned(plan, tuned_cells, winner, target),
-               write_evaluations(evaluate, out / "evaluations.csv"),
-               convergence(evaluate, method, out / "convergence.png"),
-               write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
-                            time.perf_counter() - started, target)]
+    try:
+        with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
+            evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance, known=known,
+                                 on_record=journal.save)
+            baseline = tuple(c.value for c in tuned_cells)
+            evaluate([baseline])
+            if method == "grid":
+                search_grid(evaluate, budget)
+            else:
+                search_cma(evaluate, budget, seed)
+            winner, _ = best(evaluate.history)
+            before_after = evaluate.measure([baseline, winner], check, metrics)
+    except INTERRUPTS as exc:
+        journal.stopped(exc)
+    with file_set(out, remove=[JOURNAL]):  # the tuned table, evaluations, picture and report: all at once
+        written = [write_tuned(plan, tuned_cells, winner, target),
+                   write_evaluations(evaluate, out / "evaluations.csv"),
+                   convergence(evaluate, method, out / "convergence.png"),
+                   write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
+                                time.perf_counter() - started, target)]
+        text = current(out / "report.md").read_text(encoding="utf-8")
     if not quiet:
-        console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
+        console.print(text, markup=False)
         for path in written:
             err_console.print(f"wrote {path}", markup=False)
+
+
+JOURNAL = "evaluations.partial.json"
+
+
+class Journal:
+    """``OUT/evaluations.partial.json``: every evaluation so far, rewritten (atomically) after each batch,
+    with what they were measured on. The same command run again takes them instead of running them."""
+
+    def __init__(self, path: Path, plan: Plan, cells: list[Cell], objective: str):
+        self.path = path
+        self.tuning = {"spec": plan.spec.to_json(), "cells": [c.label for c in cells], "objective": objective}
+        self.count = 0
+
+    def load(self) -> dict[tuple[int, ...], float]:
+        """The evaluations of an interrupted run of this tuning (none if there is none); another tuning's
+        are refused, as sweep refuses another sweep's folder."""
+        import json
+
+        from tablebot.diagnostics import fail
+
+        if not self.path.exists():
+            return {}
+        try:
+            saved = json.loads(self.path.read_text(encoding="utf-8"))
+            same = saved["tuning"] == self.tuning
+            known = {tuple(int(v) for v in values): float(value) for values, value in saved["evaluations"]}
+        except (ValueError, KeyError, TypeError):
+            same, known = False, {}
+        if not same:
+            raise fail(self.path, "--out holds the evaluations of an interrupted tuning of another table, robot "
+                       "file, world, scenario set, cells or objective", f"give --out a new folder, or delete "
+                       f"{self.path.name} to start over")
+        self.count = len(known)
+        return known
+
+    def save(self, history: list[tuple[tuple[int, ...], float]]) -> None:
+        import json
+
+        from tablebot.files import write_text
+
+        self.count = len(history)
+        evaluations = [[list(values), value] for values, value in history]
+        write_text(self.path, json.dumps({"tuning": self.tuning, "evaluations": evaluations}) + "\n")
+
+    def stopped(self, why: BaseException) -> None:
+        """Ctrl-C or SIGTERM: say what was kept, then exit 130 (143)."""
+        from tablebot.interrupts import Terminated
+
+        word = "terminated" if isinstance(why, Terminated) else "interrupted"
+        kept = f"{self.count} evaluations kept in {self.path}" if self.count else "no evaluation had finished"
+        err_console.print(f"{word}: {kept}; run the same command again to resume", markup=False, soft_wrap=True)
+        raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 
 def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
