@@ -38,8 +38,10 @@ def _raise_terminated(signum: int, frame: Any) -> None:
 
 @contextmanager
 def sigterm_raises() -> Iterator[None]:
-    """While the block runs, SIGTERM raises :class:`Terminated` (Python's default would end the process
-    at once: no temporary file removed, no terminal restored, nothing kept)."""
+    """One command: while it runs, SIGTERM raises :class:`Terminated` (Python's default would end the
+    process at once: no temporary file removed, no terminal restored, nothing kept); the fault hook
+    counts its steps from the command's start."""
+    _fault[:] = [None, 0]
     if not _main_thread():
         yield
         return
@@ -75,7 +77,7 @@ _fault: list[Any] = [None, 0]  # the hook's setting as last read, and the steps 
 
 def fault_point() -> None:
     """One file step; with ``TABLEBOT_FAULT=N[:SIGNAL]`` set, the N-th sends SIGNAL to this process.
-    The count starts again whenever the setting changes (a test process runs many commands)."""
+    The count starts again with each command and whenever the setting changes."""
     spec = os.environ.get(FAULT_ENV)
     if not spec:
         return

@@ -75,6 +75,9 @@ def tune_cmd(
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     journal = Journal(out / JOURNAL, plan, tuned_cells, objective)
     known = journal.load()
+    if known and not quiet:
+        err_console.print(f"resuming: {len(known)} evaluations from {journal.path} are not run again",
+                          markup=False, soft_wrap=True)
     started = time.perf_counter()
     try:
         with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
