@@ -240,6 +240,7 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from tablebot.escape import picture
     from tablebot.sim.plots import save
 
     values = np.array([v for _, v in evaluate.history])
@@ -260,7 +261,7 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         order = np.argsort(xs)
         side.plot(xs[order], values[order], color="#1f77b4", linewidth=1)
         side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
-        side.set_xlabel(f"{evaluate.cells[0].label} (ticks)")
+        side.set_xlabel(picture(f"{evaluate.cells[0].label} (ticks)"))
         side.set_ylabel(evaluate.objective)
     if two:
         side = fig.add_subplot(1, 2, 2)
@@ -271,8 +272,8 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         best = points[int(np.argmin(values))]
         side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label="as it was")
         side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
-        side.set_xlabel(a.label)
-        side.set_ylabel(b.label)
+        side.set_xlabel(picture(a.label))
+        side.set_ylabel(picture(b.label))
         side.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
     fig.tight_layout()
     return save(fig, path)
