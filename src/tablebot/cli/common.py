@@ -25,7 +25,8 @@ if TYPE_CHECKING:  # the table machinery is imported when a command loads a tabl
 
 F = TypeVar("F", bound=Callable[..., Any])
 # emoji=False: a ':x:' in user text prints as it is (tablebot.escape.terminal escapes the markup).
-err_console = Console(stderr=True, highlight=False, emoji=False)
+# soft_wrap: rich never breaks a line itself (into a pipe it would at 80 columns, splitting URLs and paths).
+err_console = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)
 console = Console(highlight=False, soft_wrap=True, emoji=False)
 
 TABLE_ARG = typer.Argument(..., metavar="TABLE", help="Table file (CSV or TSV) or a folder holding table.csv.")
@@ -130,12 +131,16 @@ class Stages:
 
 
 def print_diagnostic(d: Diagnostic) -> None:
-    """Coloured on a terminal, plain text when piped (rich decides)."""
+    """Coloured on a terminal, plain text when piped (rich decides). The message and hint are one line
+    each (a line break in a name is shown as \\n: it cannot forge a line of its own); a tool's output
+    follows, each of its lines marked as part of this diagnostic."""
     colour = {"error": "red", "warning": "yellow"}.get(d.severity, "cyan")
     err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{d.severity}[/{colour}]: "
-                      f"{terminal(d.message)}", soft_wrap=True)
+                      f"{terminal(d.message)}")
     if d.hint:
-        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}", soft_wrap=True)
+        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}")
+    for line in d.detail.splitlines():
+        err_console.print(f"    [dim]|[/dim] {terminal(line)}")
 
 
 def guarded(func: F) -> F:

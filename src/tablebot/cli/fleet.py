@@ -11,6 +11,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.escape import plain
 
 if TYPE_CHECKING:
     from tablebot.sweep_run import Plan
@@ -85,8 +86,8 @@ def stopped(store: Any, total: int, why: BaseException) -> None:
 
     path, count = store.merge(complete=False)
     word = "terminated" if isinstance(why, Terminated) else "interrupted"
-    err_console.print(f"{word}: {count:,} of {total:,} runs finished, kept in {path}; run the same "
-                      "command again to resume", markup=False, soft_wrap=True)
+    err_console.print(f"{word}: {count:,} of {total:,} runs finished, kept in {plain(str(path))}; run the same "
+                      "command again to resume", markup=False)
     raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 
@@ -153,12 +154,12 @@ def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: 
                 collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
                 metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
                 line = f"{len(chosen)} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run"
-            console.print(f"{name}: {line}", markup=False)
+            console.print(plain(f"{name}: {line}"), markup=False)
     if ran:
         rate = ran * plan.spec.ticks / max(wall_s, 1e-9)
         console.print(f"[dim]({ran:,} runs in {wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
     for p in written:
-        err_console.print(f"wrote {p}", markup=False)
+        err_console.print(f"wrote {plain(str(p))}", markup=False)
 
 
 class Bar:

@@ -10,6 +10,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
     from tablebot.sim.runner import Result
@@ -77,7 +78,7 @@ def sim_cmd(
 def _stopped(result: Result, kept: Path | None) -> None:
     """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
     err_console.print(f"{result.end.message or result.end.reason} after {result.ticks:,} ticks; "
-                      f"kept {kept} (the previous run's files are untouched)", soft_wrap=True, markup=False)
+                      f"kept {plain(str(kept))} (the previous run's files are untouched)", markup=False)
     raise typer.Exit(result.end.exit_code)
 
 
@@ -109,11 +110,11 @@ def _replay_page(result: Result, trace: Path, path: Path) -> Path:
 def _report(result: Result, summary: Summary, written: list[Path]) -> None:
     """The summary on standard output, the files written on standard error."""
     for line in summary.lines(result.scene.table.robot.state_names):
-        console.print(line, markup=False)
+        console.print(plain(line), markup=False)
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
     console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
     for path in written:
-        err_console.print(f"wrote {path}", markup=False)
+        err_console.print(f"wrote {plain(str(path))}", markup=False)
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,

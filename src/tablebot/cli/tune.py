@@ -13,6 +13,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
 from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.escape import plain
 
 if TYPE_CHECKING:
     from tablebot.sweep_run import Plan
@@ -76,8 +77,8 @@ def tune_cmd(
     journal = Journal(out / JOURNAL, plan, tuned_cells, objective)
     known = journal.load()
     if known and not quiet:
-        err_console.print(f"resuming: {len(known)} evaluations from {journal.path} are not run again",
-                          markup=False, soft_wrap=True)
+        err_console.print(f"resuming: {len(known)} evaluations from {plain(str(journal.path))} are not run again",
+                          markup=False)
     started = time.perf_counter()
     try:
         with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
@@ -101,9 +102,10 @@ def tune_cmd(
                                 time.perf_counter() - started, target)]
         text = current(out / "report.md").read_text(encoding="utf-8")
     if not quiet:
-        console.print(text, markup=False)
+        for line in text.splitlines():  # the report names the table and its cells: user text
+            console.print(plain(line), markup=False)
         for path in written:
-            err_console.print(f"wrote {path}", markup=False)
+            err_console.print(f"wrote {plain(str(path))}", markup=False)
 
 
 JOURNAL = "evaluations.partial.json"
@@ -154,8 +156,9 @@ class Journal:
         from tablebot.interrupts import Terminated
 
         word = "terminated" if isinstance(why, Terminated) else "interrupted"
-        kept = f"{self.count} evaluations kept in {self.path}" if self.count else "no evaluation had finished"
-        err_console.print(f"{word}: {kept}; run the same command again to resume", markup=False, soft_wrap=True)
+        kept = f"{self.count} evaluations kept in {plain(str(self.path))}" if self.count else \
+            "no evaluation had finished"
+        err_console.print(f"{word}: {kept}; run the same command again to resume", markup=False)
         raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 

@@ -67,7 +67,7 @@ def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "a
 def _run(command: list[str], what: str) -> str:
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(command[0], f"{what} failed:\n{done.stderr.strip()}", "report this as a tablebot bug")
+        raise fail(command[0], f"{what} failed", "report this as a tablebot bug", detail=done.stderr.strip())
     return done.stdout
 
 
