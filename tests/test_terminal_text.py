@@ -4,6 +4,7 @@ the command line speaks tablebot's words."""
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -98,3 +99,69 @@ def test_a_deeply_nested_property_is_a_located_error_and_a_long_flat_one_works(b
     code, output = invoke("check", bot)
     assert code == 0, output
     assert "VIOLATED flat" in output and "holds    every" in output
+
+
+@pytest.mark.parametrize(("args", "words"), [
+    (["new", "x", "--from", "nothing"], "--from: error: 'nothing' is not one of the choices of --from\n"
+                                        "    hint: use one of: bumberbot, line-follower, obstacle-avoider, empty"),
+    (["export", str(EXAMPLE), "out", "--to", "cc"], "--to: error: 'cc' is not one of the choices of --to\n"
+                                                    "    hint: use one of: robopro, robopro-rpp, c, txt4"),
+    (["export", str(EXAMPLE), "out"], "--to: error: --to is missing\n    hint: give --to one of: robopro,"),
+    (["sim", str(EXAMPLE), "--seconds", "abc"], "--seconds: error: 'abc' is not a number"),
+    (["sim", str(EXAMPLE), "--seconds", "9999"], "--seconds: error: --seconds 9999 is out of range\n"
+                                                 "    hint: give --seconds a value from 0.01 to 3600"),
+    (["sim", str(EXAMPLE), "--sed", "3"], "--sed: error: --sed is not an option of this command\n"
+                                          "    hint: did you mean --seconds or --seed?"),
+    (["chek", str(EXAMPLE)], "chek: error: 'chek' is not a tablebot command\n    hint: did you mean check?"),
+    (["new"], "FOLDER: error: FOLDER is missing"),
+])
+def test_a_wrong_command_line_is_answered_in_tablebots_words(args: list[str], words: str) -> None:
+    """`new x --from nothing` answered "Invalid value for '--from': Value error, 'nothing' is not one of ..."."""
+    code, output = invoke(*args)
+    assert code == 2 and words in output, output
+    assert "Value error" not in output and "Input should be" not in output and "Usage:" not in output
+
+
+def test_export_offers_no_force_and_never_suggests_it(tmp_path: Path) -> None:
+    """export --force was offered but changed nothing an export writes."""
+    assert not re.search(r"^\s+--force", invoke("export", "-h")[1], re.MULTILINE)
+    (tmp_path / "event.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())  # a table of yours, named like a list
+    code, output = invoke("export", EXAMPLE, tmp_path, "--to", "robopro")
+    assert code == 2 and "event.csv exists and is a table file: this command never replaces it" in output
+    assert "--force" not in output
+    assert (tmp_path / "event.csv").read_bytes() == (EXAMPLE / "table.csv").read_bytes()
+
+
+def test_the_first_simulation_says_it_is_compiling(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from tablebot import jit
+
+    invoke("sim", EXAMPLE, "--seconds", "0.5", "--no-plots", "-q", "--out", tmp_path / "first")  # compiled now
+    code, output = invoke("sim", EXAMPLE, "--seconds", "0.5", "--no-plots", "-q", "--out", tmp_path / "warm")
+    assert code == 0 and "compiling" not in output  # in the cache: nothing to say
+    monkeypatch.setattr(jit, "compiled", lambda *functions: False)  # as on a machine that never ran it
+    code, output = invoke("sim", EXAMPLE, "--seconds", "0.5", "--no-plots", "-q", "--out", tmp_path / "cold")
+    assert code == 0 and "compiling the simulator for this machine (first run only" in output
+
+
+def test_compiled_tells_a_cached_function_from_one_still_to_compile(tmp_path: Path) -> None:
+    """Against numba's real on-disk cache, in a process of its own with an empty cache folder."""
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "tiny.py").write_text("from tablebot.jit import njit\n\n@njit\ndef add(x):\n    return x + 1\n")
+    script = ("import tiny; from tablebot.jit import compiled\n"
+              "print(compiled(tiny.add)); tiny.add(1); print(compiled(tiny.add))\n")
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": os.pathsep.join([str(tmp_path), str(root / "src")])}
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120)
+    assert done.stdout.split() == ["False", "True"], done.stderr
+
+
+def test_demo_replays_into_a_folder_of_its_own(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`tablebot demo` wrote its replay trace into out/demo, beside the pictures `make demo` simulates."""
+    monkeypatch.chdir(tmp_path)
+    code, output = invoke("demo")
+    assert code == 0, output
+    assert (tmp_path / "out" / "replay" / "trace.jsonl").is_file() and not (tmp_path / "out" / "demo").exists()

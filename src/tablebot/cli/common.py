@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import inspect
 import os
 import sys
 import threading
@@ -130,6 +131,16 @@ class Stages:
         self.progress.stop()
 
 
+def say_compiling(what: str, *functions: Any) -> None:
+    """One line on stderr when ``functions`` (numba's) are about to be compiled, not loaded from the cache:
+    the first run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
+    from tablebot.jit import compiled
+
+    if not compiled(*functions):
+        err_console.print(f"compiling {what} for this machine (first run only, about half a minute; later runs "
+                          "start at once)…", highlight=False)
+
+
 def print_diagnostic(d: Diagnostic) -> None:
     """Coloured on a terminal, plain text when piped (rich decides). The message and hint are one line
     each (a line break in a name is shown as \\n: it cannot forge a line of its own); a tool's output
@@ -146,10 +157,12 @@ def print_diagnostic(d: Diagnostic) -> None:
 def guarded(func: F) -> F:
     """Run a command so that user errors print as file:line:column messages and exit with 2."""
 
+    offered = "force" in inspect.signature(func).parameters  # a guard's message suggests --force only then
+
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with sigterm_raises(), notes_to(print_diagnostic), guard.command(force=bool(kwargs.get("force", False))):
+            with sigterm_raises(), notes_to(print_diagnostic), guard.command(bool(kwargs.get("force", False)), offered):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:

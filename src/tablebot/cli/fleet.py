@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder, say_compiling
 from tablebot.escape import plain
 
 if TYPE_CHECKING:
@@ -62,6 +62,10 @@ def sweep_cmd(
     finished = store.open()
     jobs = plan.jobs(skip=finished)
     total, already = plan.spec.total, sum(b - a for a, b in finished)
+    if chosen == "local" and jobs:
+        from tablebot.sim.fleet_kernel import run_fleet
+
+        say_compiling("the fleet simulator", run_fleet)
     started = time.perf_counter()
     with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
         def done(job: Any, summary: Any) -> None:

@@ -106,10 +106,13 @@ def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[Robot
 
 def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, str]:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
+    from tablebot.cli.common import say_compiling
+    from tablebot.sim import kernel
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.robot import SimRobot
 
     scene = sim_scene.scene_for(machine.table, machine, target.world)
+    say_compiling("the simulator", kernel.move)
     bot = SimRobot(scene, seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
     bot.reset(seed=seed)

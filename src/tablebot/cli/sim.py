@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder, say_compiling
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
@@ -58,6 +58,9 @@ def sim_cmd(
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     rows = plots or gif or view  # every robot row is kept only for what draws the run
+    from tablebot.sim.kernel import run_robot
+
+    say_compiling("the simulator", run_robot)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
         result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)

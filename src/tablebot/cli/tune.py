@@ -11,7 +11,16 @@ from typing import TYPE_CHECKING
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
+from tablebot.cli.common import (
+    FORCE_OPT,
+    ROBOT_OPT,
+    TABLE_ARG,
+    console,
+    err_console,
+    guarded,
+    out_folder,
+    say_compiling,
+)
 from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
 from tablebot.escape import plain
 
@@ -76,6 +85,10 @@ def tune_cmd(
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     journal = Journal(out / JOURNAL, plan, tuned_cells, objective)
     known = journal.load()
+    if chosen == "local":
+        from tablebot.sim.fleet_kernel import run_fleet
+
+        say_compiling("the fleet simulator", run_fleet)
     if known and not quiet:
         err_console.print(f"resuming: {len(known)} evaluations from {plain(str(journal.path))} are not run again",
                           markup=False)
