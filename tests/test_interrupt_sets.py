@@ -274,3 +274,17 @@ def test_real_signals_during_sim_leave_the_old_run_or_the_new(bot, tmp_path):
         outcomes.append("new" if changed else "old")
         assert proc.returncode == (130 if sig == signal.SIGINT else 143), err
     assert outcomes[0] == "old"  # the second may find the pictures drawn and the swap held: then new
+
+
+@pytest.mark.parametrize(("cause", "code", "word"), [("KeyboardInterrupt", 130, "interrupted"),
+                                                    ("Terminated", 143, "terminated")])
+def test_an_interrupt_inside_an_import_ends_as_the_interrupt(cause, code, word):
+    """Seen with SIGTERM while matplotlib imported its compiled font module: pybind11 turned the interrupt
+    into ImportError('initialization failed'), reported as an internal error, then the interpreter aborted
+    on its way out."""
+    script = ("from tablebot.cli.common import guarded\nfrom tablebot.interrupts import Terminated\n"
+              f"def command():\n    raise ImportError('initialization failed') from {cause}()\n"
+              "guarded(command)()\n")
+    done = subprocess.run([sys.executable, "-c", script], env={**os.environ, "PYTHONPATH": str(ROOT / "src")},
+                          capture_output=True, text=True, timeout=60)
+    assert (done.returncode, done.stderr.strip()) == (code, word)

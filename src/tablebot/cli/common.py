@@ -154,6 +154,22 @@ def print_diagnostic(d: Diagnostic) -> None:
         err_console.print(f"    [dim]|[/dim] {terminal(line)}")
 
 
+def _interrupted_import(exc: ImportError) -> None:
+    """Ctrl-C or SIGTERM that landed while a compiled module was being imported comes back as an
+    ImportError (pybind11's "initialization failed", caused by the interrupt): end as the interrupt would,
+    at once: the half-made module cannot be finalized safely (it aborts the interpreter on the way out),
+    and every clean-up of the command has already run on the way here."""
+    cause: BaseException | None = exc
+    while cause is not None and not isinstance(cause, KeyboardInterrupt | Terminated):
+        cause = cause.__cause__ or cause.__context__
+    if cause is None:
+        return
+    print("interrupted" if isinstance(cause, KeyboardInterrupt) else "terminated", file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(130 if isinstance(cause, KeyboardInterrupt) else 143)
+
+
 def guarded(func: F) -> F:
     """Run a command so that user errors print as file:line:column messages and exit with 2."""
 
@@ -182,5 +198,8 @@ def guarded(func: F) -> F:
         except Terminated:
             print("terminated", file=sys.stderr)
             raise typer.Exit(143) from None
+        except ImportError as exc:
+            _interrupted_import(exc)
+            raise
 
     return wrapper  # type: ignore[return-value]

@@ -61,6 +61,7 @@ def sim_cmd(
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
+    _import_drawing(plots, gif, html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
         result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
@@ -76,6 +77,17 @@ def sim_cmd(
     if view:
         from tablebot.sim.animate import show
         show(result, summary)
+
+
+def _import_drawing(plots: bool, gif: bool, html: bool) -> None:
+    """The picture modules (matplotlib, PIL), imported before the run rather than after it: Ctrl-C while a
+    compiled module is being imported surfaces as an ImportError, and matplotlib's takes a good second."""
+    import importlib
+
+    wanted = [("tablebot.sim.plots", plots), ("tablebot.sim.animate", gif), ("tablebot.web.replay", html)]
+    for module, used in wanted:
+        if used:
+            importlib.import_module(module)
 
 
 def _stopped(result: Result, kept: Path | None) -> None:
