@@ -30,7 +30,7 @@ SHOW_CURSOR, HIDE_CURSOR = b"\x1b[?25h", b"\x1b[?25l"
 def test_sigterm_ends_a_sweep_as_ctrl_c_does_and_gives_the_terminal_its_cursor_back(tmp_path: Path) -> None:
     out = tmp_path / "s"
     command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",
-               "0..31", "--seconds", "300", "--workers", "2", "--out", str(out), "--no-plots"]
+               "0..31", "--seconds", "200", "--workers", "2", "--out", str(out), "--no-plots"]
     main, terminal = pty.openpty()  # stderr a terminal: the progress bar is drawn (and hides the cursor)
     proc = subprocess.Popen(command, env=ENV, stdout=subprocess.PIPE, stderr=terminal, stdin=subprocess.DEVNULL)
     os.close(terminal)
