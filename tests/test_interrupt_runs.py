@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.interrupts import FAULT_ENV
-from tablebot.sweep_run import read_results
+from tablebot.fleet.plan import read_results
 from test_sim_helpers import BUMBERBOT
 from test_tune import HALL, ROBOT
 

@@ -28,7 +28,6 @@ from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tablebot import guard
 from tablebot.diagnostics import fail
 from tablebot.interrupts import fault_point, held
 
@@ -177,9 +176,8 @@ def _files(stage: Path) -> list[str]:
 def _commit(fs: FileSet) -> None:
     """Check every target, write the journal, then rename each file into place with signals held."""
     names = _files(fs.stage)
-    for name in names:  # everything that could refuse comes before the first rename
-        target = fs.folder / name
-        guard.writing(target)
+    for name in names:  # everything that could refuse comes before the first rename (each file passed the
+        target = fs.folder / name  # command's overwrite guard when tablebot.files wrote it into the stage)
         if target.is_dir() and not target.is_symlink():
             raise fail(target, "a folder stands where this file is to be written", "move the folder away")
         target.parent.mkdir(parents=True, exist_ok=True)

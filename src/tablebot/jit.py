@@ -32,7 +32,7 @@ def cache_dir() -> str:
 
 
 #: Files whose constants compiled code reads, though they hold no compiled function themselves.
-COMPILED_CONSTANTS = ("tick.py", "layout.py")
+COMPILED_CONSTANTS = ("tick.py", "columns.py")
 
 
 def sources_digest() -> str:
@@ -68,6 +68,14 @@ def compiled(*functions: Any) -> bool:
         if not os.path.exists(index):
             return False
     return True
+
+
+def say_compiling(what: str, *functions: Any) -> None:
+    """One line on stderr when ``functions`` are about to be compiled, not loaded from the cache: the first
+    run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
+    if not compiled(*functions):
+        print(f"compiling {what} for this machine (first run only, about half a minute; later runs start at "
+              "once)…", file=sys.stderr, flush=True)
 
 
 def njit(*args: Any, **kwargs: Any) -> Callable[..., Any]:

@@ -9,14 +9,14 @@ from typing import TYPE_CHECKING
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder, say_compiling
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
     from tablebot.sim.runner import Result
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
-    from tablebot.trace import TraceFile
+    from tablebot.sinks.trace_file import TraceFile
 
 
 @app.command("sim")
@@ -47,7 +47,7 @@ def sim_cmd(
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
-    from tablebot.trace import TraceFile
+    from tablebot.sinks.trace_file import TraceFile
 
     if view:
         from tablebot.sim.animate import check_display
@@ -58,6 +58,7 @@ def sim_cmd(
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     rows = plots or gif or view  # every robot row is kept only for what draws the run
+    from tablebot.jit import say_compiling
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)

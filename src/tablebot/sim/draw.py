@@ -20,7 +20,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon, Rectangle, Wedge
 
 from tablebot.sensors import Sensor
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.params import Params
 from tablebot.sim.world import Geometry, World
 

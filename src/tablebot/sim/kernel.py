@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.kernels import tick_compiled
+from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, X, Y
 from tablebot.sim.geometry import within
-from tablebot.sim.layout import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, X, Y
 from tablebot.sim.physics import advance
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 

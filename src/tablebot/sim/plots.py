@@ -17,7 +17,7 @@ from matplotlib.patches import Patch
 from tablebot.colours import state_colours
 from tablebot.escape import picture
 from tablebot.files import atomic_write
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
     COLLISION,

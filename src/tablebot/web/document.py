@@ -1,7 +1,7 @@
 """A table file as the studio edits it: every cell keeps its exact source text, so saving writes the
 file back byte for byte except the cells that were edited (delimiter, quoting, BOM, line ends kept).
 
-Cell values and (line, column) positions follow :func:`tablebot.formats.csvtext.split_records`, so a
+Cell values and (line, column) positions follow :func:`tablebot.csvtext.split_records`, so a
 diagnostic from the real parser lands on the cell the user sees.
 """
 
@@ -10,8 +10,8 @@ from __future__ import annotations
 import codecs
 from dataclasses import dataclass, field
 
+from tablebot.csvtext import SEP_RE, detect_delimiter, split_records
 from tablebot.diagnostics import fail
-from tablebot.formats.csvtext import SEP_RE, detect_delimiter, split_records
 from tablebot.web.errors import Refused
 
 #: A table larger than this is not a table a person edits in a grid.

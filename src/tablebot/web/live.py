@@ -16,9 +16,9 @@ from typing import Any
 
 from tablebot.engine import Engine
 from tablebot.loop import Reading, RunEnd, RunInfo, Sink, TickBlock, run
-from tablebot.sim import layout as L
-from tablebot.sim.robot import SimRobot, light_keys
+from tablebot.sim import columns as L
 from tablebot.sim.scene import Scene
+from tablebot.sim.simrobot import SimRobot, light_keys
 from tablebot.web.errors import INTERNAL, log
 
 PATH_STEP_M = 0.005  # a path point every 5 mm (or at a state change): what the eye can see

@@ -216,7 +216,7 @@ class Session:
             self.arena.control("script", {"masks": [t.mask for t in result.inputs]})
             await self.send({"type": "control", **self.arena.status()})
             return
-        from tablebot.trace import replay
+        from tablebot.replay import replay
         lines = list(replay(self.analysis.report.machine, result.inputs))
         await self.send({"type": "trace", "name": f"counterexample: {name}", "columns": trace_columns(lines),
                          "at_tick": result.at_tick})

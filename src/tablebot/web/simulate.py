@@ -13,8 +13,8 @@ import graphviz
 from tablebot.analysis.diagram import to_graphviz
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.machine import Machine
-from tablebot.sim.robot import SimRobot
 from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
+from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.world import World
 from tablebot.table import Table
 from tablebot.web.errors import Refused

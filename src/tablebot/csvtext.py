@@ -1,0 +1,249 @@
+"""Text files read with located errors, and spreadsheet text as records of cells that remember their place.
+
+Handles what spreadsheets save: UTF-8 with or without BOM (or UTF-16 with its BOM, or Windows-1252 with a note), CRLF or
+LF, comma, semicolon or tab separators and RFC 4180 quoting; every cell keeps its 1-based line and column for errors.
+Every file is read up to a size limit, so no input (not even /dev/zero) can exhaust memory.
+"""
+
+from __future__ import annotations
+
+import codecs
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+from tablebot import overwrite
+from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail, notify
+
+#: The line Excel may put above the header to name the delimiter: ``sep=;``.
+SEP_RE = re.compile(r"^\s*sep=([,;\t])\s*$")
+#: A binary file would give thousands of bad lines; the first few say enough.
+MAX_BAD_LINES = 10
+
+
+class Cell(NamedTuple):
+    """One cell's text and where it starts (a tuple: a long table has millions of them)."""
+
+    text: str
+    line: int
+    column: int
+
+
+@dataclass(frozen=True)
+class Record:
+    line: int
+    cells: tuple[Cell, ...]
+
+    def is_blank(self) -> bool:
+        return all(not c.text.strip() for c in self.cells)
+
+
+#: What to do about a file that is not UTF-8 text, for files a spreadsheet saves.
+CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
+#: The largest file a loader reads, by default: a 100,000-row table is about 5 MB, an hour of recorded
+#: inputs at 10 ms ticks about 6 MB. Anything larger is almost surely the wrong file (or /dev/zero).
+MAX_TEXT_BYTES = 64 * 1024 * 1024
+#: Bytes that no text file holds (NUL and the other C0 controls but tab and line ends): binary data.
+BINARY_RE = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
+#: A well-formed UTF-8 sequence of two or more bytes: a file that has one is UTF-8 with a few bad bytes,
+#: not Windows-1252 (where such pairs, like "Ã©", almost never occur in real text).
+UTF8_MULTIBYTE_RE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|[\xf0-\xf4][\x80-\xbf]{3}")
+
+
+def size_text(limit: int) -> str:
+    """``64 MB``, ``512 KB``: a limit as people read it."""
+    for unit, size in (("GB", 1 << 30), ("MB", 1 << 20), ("KB", 1 << 10)):
+        if limit >= size:
+            return f"{limit / size:g} {unit}"
+    return f"{limit} bytes"
+
+
+def read_bytes(path: Path, limit: int | None = None) -> bytes:
+    """A file's bytes, refusing a folder, an unreadable file and anything over ``limit`` bytes (read no
+    further than that: a device such as /dev/zero never ends); the default limit is MAX_TEXT_BYTES."""
+    limit = MAX_TEXT_BYTES if limit is None else limit
+    if path.is_dir():
+        raise fail(path, "this is a folder, not a file", "give the path of a file")
+    try:
+        with path.open("rb") as stream:
+            data = stream.read(limit + 1)
+    except OSError as exc:
+        raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
+    overwrite.read(path)
+    if len(data) > limit:
+        raise fail(path, f"the file is larger than {size_text(limit)}, the most tablebot reads of such a file",
+                   "is this the right file? split it, or give a smaller one")
+    return data
+
+
+def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT, limit: int | None = None,
+              spreadsheet: bool = True) -> str:
+    """Decode a file as UTF-8 (BOM allowed; UTF-16 with its BOM too).
+
+    A ``spreadsheet`` file (CSV) that is not UTF-8 but is text, with no UTF-8 sequence in it at all, is
+    read as Windows-1252 (Latin-1 where that has no character): what a German or French Excel saves as
+    "CSV"; a note says so. Otherwise the bad bytes are reported where they are (see :func:`_bad_bytes`).
+    """
+    data = read_bytes(path, limit)
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):  # Excel's "Unicode Text" save
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError:
+            pass  # not UTF-16 after all: report it as bad UTF-8 below
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        if spreadsheet and not BINARY_RE.search(data) and not UTF8_MULTIBYTE_RE.search(data):
+            return _legacy(path, data, exc.start + (3 if data.startswith(codecs.BOM_UTF8) else 0))
+        raise TableBotError(_bad_bytes(path, data, encoding_hint)) from None
+
+
+def _legacy(path: Path, data: bytes, first_bad: int) -> str:
+    """Text in Excel's Western European code page, with a note naming the encoding assumed and the first
+    byte (at ``first_bad``) that is not UTF-8."""
+    try:
+        text, name = data.decode("cp1252"), "Windows-1252"
+    except UnicodeDecodeError:  # cp1252 leaves five bytes undefined; Latin-1 has them all
+        text, name = data.decode("latin-1"), "Latin-1 (ISO-8859-1)"
+    bad = _bad_bytes(path, data, "")[0]
+    notify(Diagnostic(str(path), bad.line, bad.column, f"not UTF-8 (byte 0x{data[first_bad]:02x}); read as "
+                      f"{name}, as a Western European Excel saves 'CSV'",
+                      f"if characters look wrong, {CSV_ENCODING_HINT}", "note"))
+    return text
+
+
+def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:
+    """One diagnostic per line holding undecodable bytes, at its first bad byte (columns in characters)."""
+    found: list[Diagnostic] = []
+    start = 3 if data.startswith(b"\xef\xbb\xbf") else 0  # the BOM is not a character of line 1
+    for number, raw in enumerate(re.split(rb"\r\n|\r|\n", data[start:]), start=1):
+        try:
+            raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            column = len(raw[: exc.start].decode("utf-8")) + 1
+            found.append(Diagnostic(str(path), number, column, f"byte 0x{raw[exc.start]:02x} is not UTF-8 text",
+                                    hint))
+            if len(found) == MAX_BAD_LINES:
+                break
+    return found
+
+
+def detect_delimiter(first_line: str) -> str:
+    """Tab if the header has one, else semicolon if it has one and no comma, else comma."""
+    if "\t" in first_line:
+        return "\t"
+    if ";" in first_line and "," not in first_line:
+        return ";"
+    return ","
+
+
+def _first_filled_line(text: str) -> str:
+    """The first line with any text (the header), so blank lines above it do not hide its delimiter."""
+    return next((line for line in text.split("\n") if line.strip()), "")
+
+
+def split_records(text: str, path: str, delimiter: str | None = None) -> list[Record]:
+    """Split CSV text into records; a quoted cell may hold delimiters, quotes ("") and newlines."""
+    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    first = _first_filled_line(text)
+    excel = SEP_RE.match(first)
+    if excel:  # Excel's "sep=;" line names the delimiter; blanked, so that line numbers stay
+        text = text.replace(first, "", 1)
+    if delimiter is None:
+        delimiter = excel[1] if excel else detect_delimiter(first)
+    stop = re.compile(f"[{re.escape(delimiter)}\n]")
+    records: list[Record] = []
+    cells: list[Cell] = []
+    line, column, i = 1, 1, 0
+    record_line = 1
+    n = len(text)
+    while i <= n:
+        if not cells:  # a record starts: a whole line without quotes is split at once (the usual case)
+            end = text.find("\n", i)
+            end = n if end < 0 else end
+            if '"' not in text[i:end]:
+                records.append(Record(line, _split_line(text[i:end], delimiter, line)))
+                i, line = end + 1, line + 1
+                record_line = line
+                continue
+        start_line, start_col = line, column
+        if i < n and text[i] == '"':
+            value, i, line, column = _quoted(text, i, line, column, path)
+            while i < n and text[i] not in (delimiter, "\n"):  # stray text after a closing quote
+                value += text[i]
+                i += 1
+                column += 1
+        else:
+            found = stop.search(text, i)  # the cell's end, found in C: a long table has millions of characters
+            j = found.start() if found else n
+            value = text[i:j]
+            column += j - i
+            i = j
+        cells.append(Cell(value, start_line, start_col))
+        if i < n and text[i] == delimiter:
+            i += 1
+            column += 1
+            continue
+        # end of record (newline or end of text)
+        records.append(Record(record_line, tuple(cells)))
+        cells = []
+        i += 1
+        line += 1
+        column = 1
+        record_line = line
+    if records and len(records[-1].cells) == 1 and not records[-1].cells[0].text:
+        records.pop()  # the empty "record" after the final newline
+    return records
+
+
+def _split_line(text: str, delimiter: str, line: int) -> tuple[Cell, ...]:
+    cells = []
+    column = 1
+    make = Cell._make  # tuple.__new__ itself: no Python-level constructor per cell
+    for value in text.split(delimiter):
+        cells.append(make((value, line, column)))
+        column += len(value) + 1
+    return tuple(cells)
+
+
+def _quoted(text: str, i: int, line: int, column: int, path: str) -> tuple[str, int, int, int]:
+    start_line, start_col = line, column
+    out: list[str] = []
+    i += 1
+    column += 1
+    n = len(text)
+    while i < n:
+        ch = text[i]
+        if ch == '"':
+            if i + 1 < n and text[i + 1] == '"':
+                out.append('"')
+                i += 2
+                column += 2
+                continue
+            return "".join(out), i + 1, line, column + 1
+        out.append(ch)
+        if ch == "\n":
+            line += 1
+            column = 1
+        else:
+            column += 1
+        i += 1
+    raise fail(path, "a quoted cell is never closed", 'add the closing " (write "" for a quote inside)',
+               start_line, start_col)
+
+
+def cells_beyond(cells: Sequence[Cell], width: int, out: Collector) -> None:
+    """Report the filled cells right of a ``width``-column header (a spreadsheet shows them; nothing reads them)."""
+    for cell in cells[width:]:
+        if cell.text.strip():
+            out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is beyond the last column",
+                      "remove it or add a header for it")
+
+
+def headerless(cell: Cell, out: Collector) -> None:
+    """Report a filled cell in a column whose header is blank."""
+    if cell.text.strip():
+        out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is in a column with no header",
+                  "name the column in the header, or clear the cell")

@@ -1,0 +1,226 @@
+"""Running a sweep: its runs cut into jobs for a backend, each finished chunk written at once as a part
+file, the parts merged into ``results.csv`` (one row per run, in run order).
+
+An interrupted sweep keeps its parts (and writes ``results.partial.csv``); the same command run again
+finds ``spec.json`` unchanged and runs only the chunks that have no part yet.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import itertools
+import re
+from collections.abc import Callable, Collection, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tablebot.diagnostics import TableBotError, fail
+from tablebot.files import atomic_write, remove, write_text
+from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
+from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
+from tablebot.fleet.work import Job
+from tablebot.machine import Machine
+from tablebot.sim.scene import Scene, prepare
+from tablebot.sim.world import World
+from tablebot.table import Table
+
+PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
+RESULT_COLUMNS = ("seconds", "first_light_s", "reached", "reached_s", "collisions", "distance_m",
+                  "battery_start_v", "battery_end_v", "final_state")
+
+
+@dataclass
+class Plan:
+    """A checked sweep: the spec, the table, its worlds and robot parameters, ready to cut into jobs."""
+
+    spec: SweepSpec
+    table: Table
+    machine: Machine
+    worlds: list[World]
+    robot_params: dict[str, Any]
+
+    def __post_init__(self) -> None:
+        self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+        self.bodies: list[list[Scene]] = self._check_params()
+        self._check_starts()
+
+    def columns(self) -> list[str]:
+        axes = [c for axis in self.spec.axes for c in axis.columns]
+        start = [] if any(axis.key == "start" for axis in self.spec.axes) else list(START_COLUMNS)
+        states = [f"time_{state}_s" for state in self.machine.states]
+        return ["run", "world", "seed", *axes, *start, *RESULT_COLUMNS, *states]
+
+    def robot(self, run: Run) -> RobotSpec:
+        """The fleet robot of one run (a random start drawn for its seed, checked free)."""
+        params, start = [], None
+        for axis, value in zip(self.spec.axes, run.values, strict=True):
+            if axis.key == "start":
+                start = random_start(run.seed, self.worlds[run.world].walls, self._free(run.world)) \
+                    if value == "random" else tuple(value)
+            else:
+                params.append((*param_of(axis.key), value))
+        return RobotSpec(seed=run.seed, start=start, params=tuple(params))
+
+    def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
+        """Whether a pose is a free start in the world for every robot body of the grid (a random start
+        serves every grid value of its seed)."""
+        def free(pose: tuple[float, float, float]) -> bool:
+            try:
+                for scene in self.bodies[world]:
+                    with_start(scene, pose)
+            except TableBotError:
+                return False
+            return True
+        return free
+
+    def jobs(self, skip: Collection[tuple[int, int]] = ()) -> list[Job]:
+        """A job per chunk of the spec that is not in ``skip`` (chunks already finished); its info keeps
+        each robot's start (None: the world's) for the result rows."""
+        out = []
+        for a, b in chunks(self.spec):
+            if (a, b) in skip:
+                continue
+            chunk = runs(self.spec, a, b)
+            robots = [self.robot(run) for run in chunk]
+            out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
+                           first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
+        return out
+
+    def _check_params(self) -> list[list[Scene]]:
+        """Every combination of ``--grid`` parameters makes a scene in every world (the simulator's limits,
+        the tick, the robot's body at the world's start), checked here before anything is written or run:
+        a worker would blame the robot file for a value the grid set. Returns per world a scene for each
+        robot body the grid gives (the starts must fit them all)."""
+        axes = [axis for axis in self.spec.axes if axis.key != "start"]
+        bodies = [{_body(scene): scene} for scene in self.scenes]
+        for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
+            overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
+                                                                                          strict=True))).overrides()
+            for world, found in zip(self.worlds, bodies, strict=True):
+                try:
+                    scene = prepare(self.table, self.machine, world, self.robot_params, overrides)
+                except TableBotError as exc:
+                    setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
+                    raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
+                               "choose --grid values the simulated robot can take") from None
+                found.setdefault(_body(scene), scene)
+        return [list(found.values()) for found in bodies]
+
+    def _check_starts(self) -> None:
+        """Every ``--grid start`` pose is free in every world for every robot body: checked once, before
+        anything is written or run, not per seed (random starts are drawn free)."""
+        poses = [tuple(v) for axis in self.spec.axes if axis.key == "start" for v in axis.values if v != "random"]
+        for scenes in self.bodies:
+            for scene in scenes:
+                for pose in poses:
+                    try:
+                        with_start(scene, pose)
+                    except TableBotError as exc:  # the world's words, about the option
+                        raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
+                                   "choose a start pose inside the walls, clear of walls and obstacles") from None
+
+    def traced(self, index: int) -> Fleet:
+        """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
+        run = runs(self.spec, index, index + 1)[0]
+        fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
+                      traced=[0])
+        fleet.run(self.spec.ticks)
+        return fleet
+
+    def write_traces(self, indices: Sequence[int], folder: Path) -> list[Path]:
+        """``trace-RUN.jsonl`` of each run: the trace ``tablebot sim`` writes for that robot."""
+        return [write_text(folder / f"trace-{index}.jsonl", "".join(self.traced(index).trace_lines(0)))
+                for index in indices]
+
+    def rows(self, job: Job, summary: FleetSummary) -> list[dict[str, Any]]:
+        """One result row per robot of a finished chunk (its start as :meth:`jobs` kept it)."""
+        out = []
+        for k, run in enumerate(runs(self.spec, job.first, job.info["stop"])):
+            s = summary.summary(k)
+            start = job.info["starts"][k] or self.worlds[run.world].start
+            row: dict[str, Any] = {"run": run.index, "world": self.spec.worlds[run.world], "seed": run.seed,
+                                   **dict(zip(START_COLUMNS, start, strict=True))}
+            row.update((axis.key, value) for axis, value in zip(self.spec.axes, run.values, strict=True)
+                       if axis.key != "start")
+            row.update(seconds=round(s.seconds, 6), first_light_s=_time(s.first_light_s),
+                       reached=int(s.reached_s is not None), reached_s=_time(s.reached_s), collisions=s.collisions,
+                       distance_m=round(s.distance_m, 6),
+                       battery_start_v=round(s.battery_start_v, 6), battery_end_v=round(s.battery_end_v, 6),
+                       final_state=self.machine.states[int(summary.final_state[k])])
+            row.update({f"time_{state}_s": round(s.state_seconds.get(state, 0.0), 6) for state in self.machine.states})
+            out.append(row)
+        return out
+
+
+def _body(scene: Scene) -> tuple:
+    """What decides whether a start pose is free for the robot: its body's measures."""
+    return tuple(sorted(scene.params["body"].items()))
+
+
+def _time(value: float | None) -> float | None:
+    return None if value is None else round(value, 6)
+
+
+# --- the output folder ------------------------------------------------------------------------------
+
+
+class Store:
+    """``DIR/spec.json``, ``DIR/parts/runs-A-B.csv`` per finished chunk, ``DIR/results.csv`` at the end."""
+
+    def __init__(self, folder: Path, plan: Plan):
+        self.folder, self.plan = folder, plan
+        self.parts = folder / "parts"
+
+    def open(self) -> set[tuple[int, int]]:
+        """Check the folder holds this spec's sweep (or none) and return the chunks already finished."""
+        spec_file = self.folder / "spec.json"
+        text = self.plan.spec.to_json()
+        if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
+            raise fail(self.folder, "--out holds the results of a different sweep (another table, robot file, "
+                       "world, grid, seeds, length or simulator version)",
+                       "give --out a new folder, or delete this one to start over")
+        self.parts.mkdir(parents=True, exist_ok=True)
+        if not spec_file.exists():
+            write_text(spec_file, text)
+        wanted = set(chunks(self.plan.spec))
+        found = {(int(m[1]), int(m[2])) for p in self.parts.iterdir() if (m := PART_RE.match(p.name))}
+        return found & wanted
+
+    def write_part(self, job: Job, rows: Sequence[dict[str, Any]]) -> Path:
+        name = f"runs-{job.first:07d}-{job.info['stop']:07d}.csv"
+        return write_text(self.parts / name, csv_text(self.plan.columns(), rows))
+
+    def merge(self, complete: bool) -> tuple[Path, int]:
+        """All finished parts in run order as ``results.csv`` (or ``results.partial.csv`` when not complete),
+        streamed part by part (a sweep of millions of runs is never held in memory whole)."""
+        count = 0
+        path = self.folder / ("results.csv" if complete else "results.partial.csv")
+        with atomic_write(path) as out:
+            out.write(csv_text(self.plan.columns(), []))
+            for a, b in chunks(self.plan.spec):
+                part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
+                if part.exists():
+                    with open(part, encoding="utf-8") as f:
+                        next(f)  # its header
+                        for line in f:
+                            out.write(line)
+                            count += 1
+        if complete:
+            remove(self.folder / "results.partial.csv")  # with the new results, when they are in a set
+        return path, count
+
+
+def csv_text(columns: Sequence[str], rows: Sequence[dict[str, Any]]) -> str:
+    """Rows as CSV text: floats as Python writes them (exact), blank for "never"."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+def read_results(path: Path) -> list[dict[str, str]]:
+    with open(path, encoding="utf-8", newline="") as f:
+        return list(csv.DictReader(f))

@@ -1,0 +1,241 @@
+"""What a sweep runs: the options of ``tablebot sweep`` checked into a spec, the spec expanded into runs
+(worlds × grid values × seeds), runs grouped into chunks (the unit of work), and one result row per run.
+
+The spec is plain data (saved as ``spec.json`` beside the results) so that re-running the same command
+finds what already ran and resumes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tablebot.diagnostics import fail
+from tablebot.fleet.robots import Pose
+from tablebot.sim.params import DEFAULTS
+from tablebot.sim.world import inside
+
+START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
+MAX_RUNS = 10_000_000
+START_COLUMNS = ("start_x", "start_y", "start_heading")  # a run's start pose in its result row
+RANGE_RE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One ``--grid`` key and its values: ``battery``, ``start`` (poses or "random") or ``section.key``."""
+
+    key: str
+    values: tuple[Any, ...]
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        return START_COLUMNS if self.key == "start" else (self.key,)
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    table: str  # the table file's text digest and name: a changed table is another sweep
+    table_digest: str
+    worlds: tuple[str, ...]  # world files ("" = the table's default world)
+    world_digests: tuple[str, ...]
+    axes: tuple[Axis, ...]
+    seeds: tuple[int, ...]
+    ticks: int
+    robot_digest: str = ""  # the robot file (its [sim] parameters shape every run)
+    code: str = ""  # the simulator's sources (tablebot.jit.sources_digest): other code, other runs
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), indent=1, sort_keys=True) + "\n"
+
+    @property
+    def runs_per_world(self) -> int:
+        return math.prod(len(axis.values) for axis in self.axes) * len(self.seeds)
+
+    @property
+    def total(self) -> int:
+        return len(self.worlds) * self.runs_per_world
+
+
+@dataclass(frozen=True)
+class Run:
+    """One robot of the sweep: its row number, world, grid values (``None`` start: the world's) and seed."""
+
+    index: int
+    world: int
+    values: tuple[Any, ...]  # one per axis
+    seed: int
+
+
+def digest(path: Path | None) -> str:
+    return "" if path is None else hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+# --- options ----------------------------------------------------------------------------------------
+
+
+def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -> tuple[int, ...]:
+    """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1.
+    Errors name ``option`` (the same numbers are read for --check-seeds and --trace)."""
+    if text is not None and robots is not None:
+        raise fail("--robots", f"give --robots or {option}, not both", f"--robots N is short for {option} 0..N-1")
+    if text is None:
+        if robots is None:
+            raise fail(option, "say which runs to make", f"give {option} 0..99 or --robots 100")
+        if robots < 1:
+            raise fail("--robots", f"--robots {robots}: there must be at least one robot", "give --robots 1 or more")
+        return tuple(range(robots))
+    seeds: list[int] = []
+    for part in (p for p in text.split(",") if p.strip()):
+        found = RANGE_RE.match(part)
+        if found:
+            low, high = int(found[1]), int(found[2])
+            if high < low:
+                raise fail(option, f"{option} {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
+            seeds.extend(range(low, high + 1))
+        elif part.strip().isdigit():
+            seeds.append(int(part))
+        else:
+            raise fail(option, f"{option}: {part.strip()!r} is not a seed or a range",
+                       "write whole numbers and ranges: 0..999 or 1,5,9 or 0..9,20")
+        if len(seeds) > MAX_RUNS:
+            raise fail(option, f"{option} gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
+    if not seeds:
+        raise fail(option, f"{option} names no seed", f"give {option} 0..99")
+    if min(seeds) < 0:
+        raise fail(option, f"{option}: a seed is never negative", "give seeds from 0 on")
+    if len(set(seeds)) != len(seeds):
+        raise fail(option, f"{option} names a seed twice", "name each seed once")
+    return tuple(seeds)
+
+
+def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
+    """Each ``--grid KEY=V1,V2,...``: battery (0..1), start (random or x:y:heading poses) or a [sim]
+    parameter as section.key (``motor.friction_volts=0.2,0.4``)."""
+    axes: list[Axis] = []
+    for item in items:
+        key, sep, values = item.partition("=")
+        key = key.strip().lower()
+        cells = [v.strip() for v in values.split(",") if v.strip()]
+        if not sep or not key:
+            raise fail("--grid", f"--grid {item!r} is not KEY=VALUES", 'write --grid "battery=1.0,0.8,0.6"')
+        if not cells:
+            raise fail("--grid", f"--grid {key}= has no values", f'write --grid "{key}=V1,V2"')
+        if key in (a.key for a in axes):
+            raise fail("--grid", f"--grid names {key} twice", "give each key once, with all its values")
+        axes.append(Axis(key, _start_values(cells) if key == "start" else _numbers(key, cells)))
+    return tuple(axes)
+
+
+def known_keys() -> list[str]:
+    return ["battery", "start", *(f"{section}.{key}" for section, keys in DEFAULTS.items() for key in keys)]
+
+
+def param_of(key: str) -> tuple[str, str]:
+    """The [sim] section and key a grid key sets."""
+    if key == "battery":
+        return "battery", "charge"
+    section, _, name = key.partition(".")
+    return section, name
+
+
+def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
+    section, name = param_of(key)
+    if section not in DEFAULTS or name not in DEFAULTS[section]:
+        raise fail("--grid", f"--grid: unknown key {key!r}",
+                   "use battery, start, or a simulator parameter such as motor.friction_volts, noise.light "
+                   f"(all: {', '.join(known_keys()[2:])})")
+    default, low, high, _ = DEFAULTS[section][name]
+    out = []
+    for cell in cells:
+        try:
+            value = float(cell)
+        except ValueError:
+            raise fail("--grid", f"--grid {key}: {cell!r} is not a number", f"write numbers from {low} to {high}") \
+                from None
+        if not low <= value <= high or (isinstance(default, int) and value != int(value)):
+            kind = "a whole number" if isinstance(default, int) else "a number"
+            raise fail("--grid", f"--grid {key}: {cell} is out of range", f"write {kind} from {low} to {high}")
+        out.append(int(value) if isinstance(default, int) else value)
+    return tuple(out)
+
+
+def _start_values(cells: list[str]) -> tuple[Any, ...]:
+    out: list[Any] = []
+    for cell in cells:
+        if cell.lower() == "random":
+            out.append("random")
+            continue
+        parts = cell.split(":")
+        try:
+            pose = tuple(float(p) for p in parts)
+        except ValueError:
+            pose = ()
+        if len(pose) != 3 or not all(math.isfinite(v) for v in pose):
+            raise fail("--grid", f"--grid start: {cell!r} is not a pose", 'write start=random or start=X:Y:HEADING '
+                       '(metres, metres, degrees), e.g. "start=0.35:0.35:20,1.0:0.5:90"')
+        out.append(pose)
+    return tuple(out)
+
+
+# --- runs -------------------------------------------------------------------------------------------
+
+
+def runs(spec: SweepSpec, first: int = 0, stop: int | None = None) -> list[Run]:
+    """Runs ``first`` to ``stop`` of the spec, in order: world, then each grid value, then seed."""
+    stop = spec.total if stop is None else stop
+    combos = list(itertools.product(*(axis.values for axis in spec.axes)))
+    per_world = len(combos) * len(spec.seeds)
+    out = []
+    for index in range(first, stop):
+        world, rest = divmod(index, per_world)
+        combo, seed = divmod(rest, len(spec.seeds))
+        out.append(Run(index, world, combos[combo], spec.seeds[seed]))
+    return out
+
+
+def value_index(spec: SweepSpec, index: int, axis: int) -> int:
+    """Which of ``spec.axes[axis]``'s values run ``index`` has (in the order of :func:`runs`: the last
+    axis turns fastest)."""
+    combo = index % spec.runs_per_world // len(spec.seeds)
+    after = math.prod(len(a.values) for a in spec.axes[axis + 1:])
+    return combo // after % len(spec.axes[axis].values)
+
+
+def chunks(spec: SweepSpec, size: int | None = None) -> list[tuple[int, int]]:
+    """The spec's runs cut into chunks ``[a, b)`` that never span two worlds. The size depends on the
+    spec alone (never on the machine), so a resumed sweep finds the same chunks."""
+    size = size or chunk_size(spec.total)
+    out = []
+    for world in range(len(spec.worlds)):
+        start, stop = world * spec.runs_per_world, (world + 1) * spec.runs_per_world
+        out += [(a, min(a + size, stop)) for a in range(start, stop, size)]
+    return out
+
+
+def chunk_size(total: int) -> int:
+    """About 32 chunks (enough to spread over the workers and show progress), 8 to 512 robots each."""
+    return max(8, min(512, -(-total // 32)))
+
+
+def random_start(seed: int, walls: Sequence[tuple[float, float]], free: Any) -> Pose:
+    """A start pose drawn for ``seed`` (the same for every grid value: common random numbers): uniform
+    inside the walls with any heading, redrawn until ``free(pose)`` says the body touches nothing."""
+    rng = np.random.default_rng([seed, START_STREAM])
+    xs, ys = [p[0] for p in walls], [p[1] for p in walls]
+    for _ in range(10_000):
+        x, y = rng.uniform(min(xs), max(xs)), rng.uniform(min(ys), max(ys))
+        pose = (round(float(x), 4), round(float(y), 4), round(float(rng.uniform(-180.0, 180.0)), 2))
+        if inside(walls, (x, y)) and free(pose):
+            return pose
+    raise fail("--grid", "start=random: found no free start pose in the world", "give the world more free floor")
+

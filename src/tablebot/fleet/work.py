@@ -1,0 +1,88 @@
+"""The unit of work of sweeps and tuning: a chunk of robots of one table in one world, run as one fleet
+in whichever process gets it (this one, a local worker process, a Dask worker).
+
+Nothing compiled is imported at the top: a Dask worker that unpickles :func:`run_job` must be able to
+choose its numba cache folder (:func:`warm_worker`) before the first compiled module loads.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+from tablebot.fleet.robots import RobotSpec, Variants
+
+if TYPE_CHECKING:
+    from tablebot.fleet.run import FleetSummary
+    from tablebot.sim.world import World
+    from tablebot.table import Table
+
+COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
+_worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
+
+
+@dataclass
+class Job:
+    """Robots ``first`` .. ``first + len(specs) - 1`` of a sweep (or one generation of a tuning run)."""
+
+    table: Table
+    world: World
+    robot_params: dict[str, Any]
+    specs: list[RobotSpec]
+    ticks: int
+    first: int = 0
+    variants: Variants | None = None
+    threads: int | None = None  # numba threads for this job (None: numba's default)
+    info: dict[str, Any] = field(default_factory=dict)  # what the caller needs back with the result
+
+
+def run_job(job: Job) -> tuple[Job, FleetSummary]:
+    """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary."""
+    from tablebot.fleet.run import Fleet
+    from tablebot.machine import compile_table
+
+    threads = job.threads or _worker_threads
+    if threads is not None:  # per calling thread in numba: set for each job
+        import numba
+
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
+                  variants=job.variants)
+    fleet.run(job.ticks)
+    return replace(job, specs=[], variants=None), fleet.summary()
+
+
+def warm(job: Job) -> float:
+    """Compile (or load from the cache) the fleet kernel on one robot for one tick; returns the seconds."""
+    import time
+
+    started = time.perf_counter()
+    run_job(replace(job, specs=job.specs[:1], ticks=1))
+    return time.perf_counter() - started
+
+
+def warm_worker(job: Job, slot: str, share: int = 1) -> dict[str, Any]:
+    """On a cluster worker: choose a cache folder of its own (``worker-SLOT`` in the user's numba cache
+    for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code already loaded
+    here; then compile or load the kernel once, before any chunk runs (concurrent compiles into one
+    cache folder race: numba issues #4807, #10128). Its chunks then use 1/``share`` of the machine's
+    cores (``share``: the workers on this machine)."""
+    global _worker_threads
+    _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
+    given = bool(os.environ.get("NUMBA_CACHE_DIR"))
+    from tablebot import jit  # numba, and the default cache folder (per user, Python and sources)
+
+    if not given and not any(name in sys.modules for name in COMPILED):
+        import numba
+
+        folder = os.path.join(jit.cache_dir(), f"worker-{slot}")
+        os.environ[jit.ENV] = folder
+        numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
+    seconds = warm(job)
+    import numba
+
+    return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR, "seconds": seconds,
+            "threads": _worker_threads}

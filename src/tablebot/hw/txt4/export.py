@@ -1,0 +1,112 @@
+"""``tablebot export --to txt4``: a ROBO Pro Coding workspace that runs the table on a TXT 4.0 by itself:
+``NAME.py`` starts ``lib/tablebot_program.py``, which is :mod:`tablebot.hw.txt4.runtime` with the compiled
+table and the robot file's ``[txt]`` wiring appended as plain data (no numpy, no tablebot on the
+controller). Text from the user's files reaches the program only as escaped string literals.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import uuid
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from tablebot.escape import python_string
+from tablebot.files import write_text
+from tablebot.fileset import file_set
+from tablebot.hw.txt.wiring import TxtWiring, txt_wiring
+from tablebot.machine import Machine
+
+PROGRAM = "lib/tablebot_program.py"
+LAUNCHER = '''\
+# Runs a tablebot table on this TXT 4.0; written by `tablebot export --to txt4` (see lib/tablebot_program.py).
+from lib.tablebot_program import main
+
+main()
+'''
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """The files of one ROBO Pro Coding workspace, by path relative to its folder."""
+
+    name: str
+    files: dict[str, str]
+
+    def write(self, folder: Path) -> list[Path]:
+        """The workspace into ``folder``, replacing the previous one's files at once."""
+        with file_set(folder):
+            return [write_text(folder / relative, text, newline="\n") for relative, text in self.files.items()]
+
+
+def workspace_name(machine: Machine) -> str:
+    """The robot's name as a workspace name: letters, digits and ``_`` (it is a file name and a URL part)."""
+    name = re.sub(r"[^A-Za-z0-9_]+", "_", machine.table.robot.name).strip("_")
+    return name if name and not name[0].isdigit() else f"tablebot_{name}".rstrip("_")
+
+
+def export_txt4(machine: Machine) -> Workspace:
+    """The workspace for ``machine``; a table that does not fit the TXT's terminals is refused (its
+    robot-file line named) before anything is written."""
+    wiring = txt_wiring(machine)
+    name = workspace_name(machine)
+    data = table_data(machine, wiring)
+    runtime = resources.files("tablebot.hw.txt4").joinpath("runtime.py").read_text(encoding="utf-8")
+    program = f"{runtime}\n\n# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
+    digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
+    project = {"name": name, "mode": "ADVANCED", "uuid": str(uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))}
+    return Workspace(name, {f"{name}.py": LAUNCHER, "lib/__init__.py": "", PROGRAM: program,
+                            ".project.json": json.dumps(project, indent=2) + "\n"})
+
+
+def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
+    """The compiled table and its wiring as plain data for :mod:`tablebot.hw.txt4.runtime`."""
+    table, robot = machine.table, machine.table.robot
+    per_state: list[list[list[Any]]] = [[] for _ in machine.states]
+    for row in machine.rows:
+        per_state[row.state].append([row.index, row.mask, row.next, row.timer, list(row.outputs), list(row.loads)])
+    motors = [(i, out) for i, out in enumerate(wiring.outputs) if out.kind == "motor"]
+    counted = {c.motor for c in robot.counters}
+    terminal_of = {out.name: out.terminal + 1 for _, out in motors}
+    return {
+        "name": robot.name, "source": table.path, "tick_ms": robot.tick_ms,
+        "states": list(machine.states), "initial_state": machine.initial_state, "initial_timer": machine.initial_timer,
+        "input_mask": machine.input_mask, "timer_bit": machine.timer_bit, "counter_bits": list(machine.counter_bits),
+        "n_outputs": len(machine.output_names), "rows": per_state,
+        "inputs": [{"name": w.name, "terminal": w.terminal + 1, "mode": w.mode, "invert": w.invert,
+                    "below": w.below, "above": w.above, "hysteresis": w.hysteresis, "bit": bit}
+                   for w, bit in zip(wiring.inputs, wiring.bits, strict=True)],
+        "motors": [{"name": out.name, "output": i, "terminal": out.terminal + 1, "reverse": out.reverse,
+                    "encoder": out.name in counted} for i, out in motors],
+        "lamps": [{"name": out.name, "output": i, "terminal": out.terminal + 1}
+                  for i, out in enumerate(wiring.outputs) if out.kind == "lamp"],
+        "counters": [{"name": c.name, "terminal": t + 1, "motor": terminal_of.get(c.motor)}
+                     for c, t in zip(robot.counters, wiring.counters, strict=True)],
+    }
+
+
+def literal(value: Any, depth: int = 0) -> str:
+    """``value`` (None, bools, ints, strings, lists, dicts) as Python source; strings through
+    :func:`tablebot.escape.python_string`. Top-level entries and rows go one per line."""
+    if value is None or isinstance(value, bool):
+        return repr(value)
+    if isinstance(value, int):
+        return repr(int(value))
+    if isinstance(value, str):
+        return python_string(value)
+    if isinstance(value, list | tuple):
+        items = [literal(v, depth + 1) for v in value]
+        if depth < 2 and any(isinstance(v, list | dict) for v in value):
+            pad = "    " * (depth + 1)
+            return "[\n" + "".join(f"{pad}{item},\n" for item in items) + "    " * depth + "]"
+        return "[" + ", ".join(items) + "]"
+    if isinstance(value, dict):
+        items = [f"{literal(k)}: {literal(v, depth + 1)}" for k, v in value.items()]
+        if depth == 0:
+            return "{\n" + "".join(f"    {item},\n" for item in items) + "}"
+        return "{" + ", ".join(items) + "}"
+    raise TypeError(f"no Python literal for {type(value).__name__}")

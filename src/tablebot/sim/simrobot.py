@@ -1,0 +1,233 @@
+"""The simulated robot behind the RobotIO seam: tick by tick for real-time runs, or many ticks at once
+in compiled code (engine and physics together) for ``tablebot sim``; both give the same run.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from tablebot.engine import Engine
+from tablebot.formats.trace_lines import exact_round
+from tablebot.loop import Reading, TickBlock
+from tablebot.sim import columns as L
+from tablebot.sim import kernel as K
+from tablebot.sim.params import terminal_volts
+from tablebot.sim.scene import Scene, sensor_columns
+from tablebot.tick import registers
+
+DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
+MAX_COLLISIONS = 4096  # collision starts remembered for the pictures (the count goes on beyond)
+
+
+class SimRobot:
+    """One differential-drive robot in a scene's world, seeded: the same seed gives the same run.
+
+    Gymnasium-style ``reset(seed=...)`` puts it back at the start; the RobotIO methods drive it one
+    tick at a time; :meth:`advance` runs the engine and the physics for many ticks in compiled code.
+    """
+
+    def __init__(self, scene: Scene, seed: int = 1, record_history: bool = True):
+        self.scene = scene
+        self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
+        g = scene.geometry
+        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines)
+        self._drive = np.array(scene.drive, dtype=np.int64)
+        self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
+        self.light_keys = light_keys(scene)
+        self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
+        self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
+        self.reset(seed=seed)
+
+    # --- Gymnasium-style life cycle ---------------------------------------------------------------
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Reading, dict]:
+        """Back to the world's start pose with a fresh battery draw and noise stream (``seed``: the
+        robot's Generator, as ``tablebot sim --seed``); returns the first reading and an info dict."""
+        if seed is not None:
+            self.seed = seed
+        self.rng = np.random.default_rng(self.seed)
+        self.s = self._start_row()
+        self.acc = K.new_accumulator(self.scene.world.reach, max(1, round(DEBOUNCE_S / self.scene.tick_s)))
+        self.collision_rows[:] = 0
+        self.stopped = False
+        K.sense(self.s, self.scene.P[0], *self._world, self._noise(1)[0], self.scene.bits)
+        K.observe(self.s, self._world[5], self.acc, self.collision_rows)
+        return self.read(), {"seed": self.seed}
+
+    def _start_row(self) -> np.ndarray:
+        scene = self.scene
+        s = np.zeros(L.N_STATE)
+        x, y, heading = scene.world.start
+        s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
+        s[L.SOC] = charge = scene.params["battery"]["charge"]
+        s[L.VBAT] = terminal_volts(scene.params, charge, ())
+        spread = scene.params["noise"]["motor_spread"]
+        s[L.GAIN_R], s[L.GAIN_L] = 1.0 + spread * self.rng.standard_normal(2)
+        return s
+
+    def _noise(self, ticks: int) -> np.ndarray:
+        """The next ``ticks`` rows of this robot's noise stream (one stream, however it is cut)."""
+        return self.rng.standard_normal((ticks, L.N_NOISE))
+
+    # --- RobotIO: one tick at a time ----------------------------------------------------------
+
+    def open(self) -> None:
+        self.stopped = False
+
+    def read(self) -> Reading:
+        s = self.s
+        pulses = tuple(0 if c < 0 else int(s[c]) for c in self._pcols.tolist())
+        return Reading(int(s[L.MASK]), pulses, RowFields(self, s.copy()))
+
+    def write(self, outputs: Sequence[int]) -> None:
+        right, left = (0, 0) if self.stopped else (outputs[self.scene.drive[0]], outputs[self.scene.drive[1]])
+        K.move(self.s, right, left, self.scene.P[0], *self._world, self._noise(1)[0], self.scene.bits, self.acc,
+               self.collision_rows)
+
+    def stop(self) -> None:
+        """The motors get no more power (a real robot would coast to a halt the same way)."""
+        self.stopped = True
+
+    def close(self) -> None:
+        pass
+
+    # --- many ticks at once -----------------------------------------------------------------------
+
+    def advance(self, engine: Engine, ticks: int) -> TickBlock:
+        """Run ``engine`` on this robot for ``ticks`` ticks in compiled code; the engine ends where
+        ``ticks`` calls of ``read``/``step``/``write`` would have left it."""
+        machine = engine.machine
+        arrays = machine.arrays
+        if arrays is None:
+            raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
+        regs = registers(engine.tick, engine.state, engine.timer, engine.event, engine.row)
+        outputs = np.array(engine.outputs, dtype=np.int64)
+        counters = np.array(engine.counters, dtype=np.int64)
+        n_out, n_c = len(outputs), len(counters)
+        ints = np.zeros((ticks, K.I_OUTPUTS + n_out + 2 * n_c), dtype=np.int64)
+        hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
+        start = engine.tick
+        K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
+                    self.scene.bits, self._drive, self._pcols, self._noise(ticks), hist, ints, self.acc,
+                    self.collision_rows)
+        engine._sync(regs, outputs, counters)
+        return self._block(start, ints, hist, n_out, n_c)
+
+    def _block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
+        o, c = K.I_OUTPUTS, K.I_OUTPUTS + n_out  # outputs, then counters, then pulses
+        block = TickBlock(start, ints[:, K.I_MASK], ints[:, c + n_c:], ints[:, K.I_EVENT], ints[:, K.I_ROW],
+                          ints[:, K.I_STATE], ints[:, K.I_TIMER], ints[:, o:c], ints[:, c:c + n_c])
+        if len(hist):
+            block.extra = LazyColumns(self.scene, hist)
+            block.raw = hist
+        return block
+
+    # --- what the trace adds to each tick -----------------------------------------------------------
+
+    def trace_fields(self, s: np.ndarray) -> dict[str, float | int]:
+        """Pose at the start of the tick, the light each phototransistor received (1.0 = threshold), volts,
+        and each declared sensor's reading: :func:`trace_layout`, for one robot row."""
+        fields: dict[str, float | int] = {}
+        for key, column, scale, decimals in self._layout:
+            value = float(s[column])
+            if column == L.TH:
+                value = (math.degrees(value) + 180.0) % 360.0 - 180.0
+            fields[key] = int(value) if decimals == 0 else round(value * scale, decimals)
+        return fields
+
+    # --- what the run amounts to (see sim.summary) ------------------------------------------------------
+
+    @property
+    def collisions(self) -> list[int]:
+        """Robot rows (row t: the start of tick t) where each collision began (the first MAX_COLLISIONS)."""
+        return self.collision_rows[: min(int(self.acc[K.A_COLLISIONS]), MAX_COLLISIONS)].tolist()
+
+    @property
+    def collision_count(self) -> int:
+        return int(self.acc[K.A_COLLISIONS])
+
+    @property
+    def reached_row(self) -> int | None:
+        row = int(self.acc[K.A_REACHED])
+        return None if row < 0 else row
+
+
+def light_keys(scene: Scene) -> tuple[str, str]:
+    """The trace's names for the light each phototransistor received: ``I7_light`` and ``I8_light``."""
+    wiring = scene.params.wiring
+    return f"{wiring['light_right']}_light", f"{wiring['light_left']}_light"
+
+
+def wired_lights(scene: Scene) -> list[tuple[str, int]]:
+    """(trace key, state column) of the phototransistors wired to inputs: a robot without them gets no
+    light fields (not two fields both called ``_light``)."""
+    wiring = scene.params.wiring
+    return [(f"{wiring[role]}_light", column) for role, column in (("light_right", L.LIGHT_R),
+                                                                     ("light_left", L.LIGHT_L)) if wiring[role]]
+
+
+def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
+    """What the simulator adds to each trace line, and from where: (key, state column, scale, decimals;
+    0 decimals = a whole number). The heading is the column's radians as degrees in -180..180."""
+    return (("x", L.X, 1.0, 5), ("y", L.Y, 1.0, 5), ("heading", L.TH, 1.0, 3),
+            *((key, column, 1.0, 4) for key, column in wired_lights(scene)), ("battery_v", L.VBAT, 1.0, 4),
+            *sensor_columns(scene))
+
+
+def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
+    """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
+    ``round`` does (so the bytes are those of the one-tick path)."""
+    columns: dict[str, list] = {}
+    for key, column, scale, decimals in trace_layout(scene):
+        values = hist[:, column].astype(np.float64)
+        if column == L.TH:
+            values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
+        columns[key] = values.astype(np.int64).tolist() if decimals == 0 else exact_round(values * scale, decimals)
+    return columns
+
+
+class RowFields(Mapping[str, Any]):
+    """The trace fields of one robot row (:meth:`SimRobot.trace_fields`), worked out only when asked for:
+    a Gymnasium step or a fleet's set-up reads the mask and the pulses alone."""
+
+    def __init__(self, robot: SimRobot, s: np.ndarray):
+        self.robot, self.s = robot, s
+        self._fields: dict[str, float | int] | None = None
+
+    def _all(self) -> dict[str, float | int]:
+        if self._fields is None:
+            self._fields = self.robot.trace_fields(self.s)
+        return self._fields
+
+    def __getitem__(self, key: str) -> float | int:
+        return self._all()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._all())
+
+    def __len__(self) -> int:
+        return len(self._all())
+
+
+class LazyColumns(Mapping[str, Sequence[float]]):
+    """The trace fields of a block, made only when a sink asks for them (most runs keep no trace)."""
+
+    def __init__(self, scene: Scene, hist: np.ndarray):
+        self.scene, self.hist = scene, hist
+        self.keys_ = tuple(key for key, *_ in trace_layout(scene))
+        self._columns: dict[str, list[float]] | None = None
+
+    def __getitem__(self, key: str) -> Sequence[float]:
+        if self._columns is None:
+            self._columns = trace_columns(self.scene, self.hist)
+        return self._columns[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.keys_)
+
+    def __len__(self) -> int:
+        return len(self.keys_)

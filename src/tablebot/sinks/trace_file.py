@@ -1,0 +1,120 @@
+"""The trace written while a run goes (a sink of :mod:`tablebot.loop`): the lines of each block of ticks, made
+column-wise, in the format of :mod:`tablebot.formats.trace_lines`."""
+
+from __future__ import annotations
+
+import json
+import queue
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tablebot.files import PendingFile
+from tablebot.formats.trace_lines import dumps
+from tablebot.loop import RunEnd, RunInfo, TickBlock
+from tablebot.machine import Machine
+
+
+def block_lines(block: TickBlock, machine: Machine) -> list[str]:
+    """The trace lines of a block of ticks, newline included: the bytes :func:`dumps` gives for
+    :func:`record` plus the block's extra fields, made column-wise (a simulated hour in well under a second)."""
+    names = [json.dumps(state, ensure_ascii=False) for state in machine.states]
+    columns = [*machine.output_names, *machine.table.robot.counter_names]
+    template = ('{"tick":%d,"event":%d,"row":%s,"state":%s,"timer":%d'
+                + "".join(f",{json.dumps(name)}:%d" for name in columns)
+                + "".join(f",{json.dumps(key, ensure_ascii=False)}:%s" for key in block.extra) + "}\n")
+    n = len(block)
+    values = [range(block.start, block.start + n), _ints(block.events),
+              ["null" if r < 0 else str(r) for r in _ints(block.rows)],
+              [names[s] for s in _ints(block.states)], _ints(block.timers)]
+    values += _int_columns(block.outputs, len(machine.output_names), n)
+    values += _int_columns(block.counters, len(machine.table.robot.counter_names), n)
+    values += [_json_column(column) for column in block.extra.values()]
+    return [template % row for row in zip(*values, strict=True)]
+
+
+def _ints(column: Any) -> list[int]:
+    return column.tolist() if hasattr(column, "tolist") else list(column)
+
+
+def _int_columns(rows: Any, width: int, n: int) -> list[list[int]]:
+    """Per column, the values of a (ticks, width) table given as an array or as a list of tuples."""
+    if not width:
+        return []
+    if isinstance(rows, np.ndarray):
+        return [rows[:, k].tolist() for k in range(width)]
+    return [list(column) for column in zip(*rows, strict=True)] if n else [[] for _ in range(width)]
+
+
+def _json_column(column: Any) -> list[str]:
+    """JSON text of each value: finite floats as ``json`` writes them (their repr), others through ``json``."""
+    values = _ints(column)
+    if values and set(map(type, values)) == {float} and np.isfinite(np.asarray(values)).all():
+        return repr(values)[1:-1].split(", ")  # one C call makes every float's repr, as json writes it
+    return [json.dumps(v, ensure_ascii=False) for v in values]
+
+
+class TraceFile:
+    """A sink that writes the trace while the run goes: under a temporary name, renamed to ``path`` when
+    the run is complete, or to ``NAME.partial.jsonl`` (ending with an ``end`` record saying why) when not.
+
+    With ``background``, blocks are formatted and written by a thread of their own, while the next
+    block is computed (the compiled simulator releases the GIL); ``end`` waits for it, and an error
+    it met (a full disk) is raised there or at the next block.
+    """
+
+    def __init__(self, path: str | Path, background: bool = False):
+        self.path = Path(path)
+        self.background = background
+        self.written: Path | None = None
+        self._queue: queue.Queue[TickBlock | None] | None = None
+        self._failed: BaseException | None = None
+
+    def start(self, info: RunInfo) -> None:
+        self.machine = info.engine.machine
+        self.file = PendingFile(self.path)
+        if self.background:
+            self._queue = queue.Queue(maxsize=4)  # bounded: memory stays a few blocks whatever the disk does
+            self._thread = threading.Thread(target=self._drain, name="trace writer", daemon=True)
+            self._thread.start()
+
+    def block(self, block: TickBlock) -> None:
+        if self._queue is None:
+            self._write(block)
+            return
+        if self._failed is not None:
+            raise self._failed
+        self._queue.put(block)
+
+    def _write(self, block: TickBlock) -> None:
+        self.file.stream.writelines(block_lines(block, self.machine))
+
+    def _drain(self) -> None:
+        assert self._queue is not None
+        while (block := self._queue.get()) is not None:
+            if self._failed is None:
+                try:
+                    self._write(block)
+                except BaseException as exc:  # raised in the loop's thread, at the next block or at the end
+                    if isinstance(exc, OSError) and exc.filename is None:
+                        exc.filename = str(self.path)  # a full disk names no file of its own
+                    self._failed = exc
+
+    def end(self, end: RunEnd) -> None:
+        if self._queue is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._queue = None
+            if self._failed is not None:
+                self.file.discard()
+                raise self._failed
+        if end.complete and end.reason == "done":
+            self.written = self.file.commit()
+            return
+        record = {"end": end.reason, "tick": end.ticks, "why": end.message}
+        if end.late_ticks:
+            record.update(late_ticks=end.late_ticks, worst_late_ms=round(1000 * end.worst_late_s, 1))
+        self.file.stream.write(dumps(record) + "\n")
+        self.written = self.file.commit() if end.complete else self.file.keep_partial()
