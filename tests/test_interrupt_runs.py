@@ -17,8 +17,8 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from tablebot.cli import app
-from tablebot.interrupts import FAULT_ENV
 from tablebot.fleet.plan import read_results
+from tablebot.interrupts import FAULT_ENV
 from test_sim_helpers import BUMBERBOT
 from test_tune import HALL, ROBOT
 
