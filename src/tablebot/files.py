@@ -249,7 +249,12 @@ HEAD_BYTES = 4096
 
 
 def writing(path: str | Path) -> None:
-    """Called before ``path`` is written: the current command's overwrite guard may refuse it."""
+    """Called before ``path`` is written: the current command's overwrite guard may refuse it. A file the
+    open set already removes (a table a previous run of the command wrote) is no user's file to protect."""
+    owner = fileset.owner(Path(path))
+    if owner is not None and owner.dropping(Path(path)):
+        overwrite.writing(path, lambda _: False)  # still never one of the command's own inputs
+        return
     overwrite.writing(path, is_user_file)
 
 

@@ -53,6 +53,11 @@ class FileSet:
             return None
         return Path(os.path.relpath(parent, self.folder)) / path.name
 
+    def dropping(self, path: Path) -> bool:
+        """Whether the set has already been told to remove ``path`` (so writing it anew replaces nobody's file)."""
+        relative = self.relative(path)
+        return relative is not None and relative.as_posix() in self.removals
+
     def remove(self, path: Path) -> None:
         """``path`` goes when the set is swapped in (unless the set writes it)."""
         relative = self.relative(path)
