@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
@@ -141,7 +142,7 @@ def test_a_serial_link_too_slow_for_the_tick_ends_the_run_as_behind_with_every_o
     # Driven past the pre-run check, as a link that slows down during a run would be.
     machine = wired_bumberbot("roboif")
     with RoboifEmulator(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], {}), baud=19200) as emu:
-        robot = RoboifRobot(roboif_wiring(machine), emu.device, link_timeout_s=0.5)
+        robot = RoboifRobot(roboif_wiring(machine), emu.device, link_timeout_s=2.0)  # behind, not lost, if busy
         end = drive(machine, robot, ticks=500, behind_limit_s=0.3)
         assert eventually(lambda: emu.names()[-1:] == ["bye"], timeout_s=3)
     assert end.reason == "behind" and end.ticks < 200 and "cannot keep the table's 10 ms tick" in end.message
@@ -166,8 +167,7 @@ def test_the_robo_interface_at_38400_baud_is_refused_for_a_10_ms_tick_naming_wha
     assert done.returncode == 2 and "Traceback" not in said
     assert f"{EXAMPLE / 'robot.toml'}:4:1: error: roboif://{emu.device}: one exchange with the ROBO Interface" in said
     assert "its 38 bytes alone take 9.9 ms on the 38400-baud line" in said and "(tick_ms = 10)" in said
-    assert "give tick_ms = 50 (every timer of this table is a whole number of such ticks)" in said \
-        or "give tick_ms = 25 (every timer of this table is a whole number of such ticks)" in said
+    assert re.search(r"give tick_ms = \d+", said)  # 25 at 10 to 12.5 ms an exchange (test_the_suggested_tick...)
     assert "500ms for a timer of 50" in said and "--behind-limit 0" in said and "a ROBO TX or a TXT" in said
     exchanges = emu.requests("exchange")  # the timing only: every output off, then the farewell
     assert emu.names() == ["hello", *["exchange"] * PROBES, "bye"]
@@ -176,7 +176,8 @@ def test_the_robo_interface_at_38400_baud_is_refused_for_a_10_ms_tick_naming_wha
 
 def test_the_robo_interface_at_38400_baud_runs_with_slow_timers_accepted_or_with_a_longer_tick(tmp_path: Path) -> None:
     with RoboifEmulator(baud=38400) as emu:
-        accepted = spawn(str(EXAMPLE), "--on", f"roboif://{emu.device}", "--seconds", "0.2", "--behind-limit", "0")
+        accepted = spawn(str(EXAMPLE), "--on", f"roboif://{emu.device}", "--seconds", "0.2", "--behind-limit", "0",
+                         "--link-timeout", "0.5")
     assert accepted.returncode == 0, accepted.stderr
     assert "warning:" in accepted.stderr and "timers will run" in " ".join(accepted.stderr.split())
     robot = tmp_path / "robot.toml"

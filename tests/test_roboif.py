@@ -148,7 +148,7 @@ def test_at_38400_baud_an_exchange_takes_the_whole_10_ms_tick() -> None:
     refused before it starts otherwise, tests/test_pace.py) the ticks run late, every few ticks."""
     assert round(wire.EXCHANGE_LINE_S, 4) == 0.0099
     with RoboifEmulator(baud=38400) as emu:
-        end = drive(bumberbot("roboif"), robot_on(emu), ticks=40)
+        end = drive(bumberbot("roboif"), robot_on(emu), ticks=100)
     assert end.reason == "done" and end.late_ticks >= 1
 
 
