@@ -22,7 +22,9 @@ from tablebot.sim.runner import run
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
-from tablebot.testing.random_tables import Shape, random_table
+from tablebot.replay import replay
+from tablebot.robot import MATCHES
+from tablebot.testing.random_tables import Shape, random_table, with_match
 from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
 
@@ -125,3 +127,24 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
     alone = run(scene_for(edited, compile_table(edited)), 12.0, 3)
     assert "".join(fleet.trace_lines(0)) == trace_text(alone)
     assert "".join(fleet.trace_lines(1)) != trace_text(alone)
+
+
+@pytest.mark.parametrize("match", MATCHES)
+def test_the_compiled_simulator_and_the_fleet_follow_the_tables_matching_rule(match: str) -> None:
+    """A random table in a random world on which the two rules drive different runs: the compiled loop,
+    alone and as robot 0 of a fleet, takes ``Engine.step``'s decisions over the inputs it sensed."""
+    rng = random.Random(5)  # a table and world where the two rules part on 268 of 400 ticks
+    table = random_table(rng, Shape(states=4, rows=14, inputs=8, max_timer=300, event_density=0.25,
+                                    no_event_chance=0.3))
+    world = parse_world(Source.parse("<random>", random_world(rng)))
+    runs = {rule: run(prepare(t, compile_table(t), world), 4.0, 3) for rule in MATCHES
+            for t in [with_match(table, rule)]}
+    assert runs["document"].rows.tolist() != runs["always"].rows.tolist()  # the rules part here
+    alone = runs[match]
+    machine = alone.scene.machine
+    replayed = list(replay(machine, alone.inputs()))
+    assert [-1 if line["row"] is None else line["row"] for line in replayed] == alone.rows.tolist()
+    assert [machine.state_index(line["state"]) for line in replayed] == alone.states.tolist()
+    fleet = Fleet(alone.scene.table, machine, world, [RobotSpec(seed=3)], traced=[0])
+    fleet.run(400)
+    assert "".join(fleet.trace_lines(0)) == trace_text(alone)
