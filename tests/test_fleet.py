@@ -18,12 +18,12 @@ from tablebot.cli import app
 from tablebot.cli.common import load
 from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
+from tablebot.replay import replay
+from tablebot.robot import MATCHES
 from tablebot.sim.runner import run
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
-from tablebot.replay import replay
-from tablebot.robot import MATCHES
 from tablebot.testing.random_tables import Shape, random_table, with_match
 from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
