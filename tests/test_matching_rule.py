@@ -185,3 +185,14 @@ def test_new_robots_write_the_rule_down(tmp_path: Path, template: str, match: st
     assert result.exit_code == 0, result.output
     robot = load_robot(tmp_path / "bot" / "robot.toml")
     assert robot.says_match and robot.match == match
+
+
+def test_the_robopro_program_is_generated_for_the_robot_files_rule(tmp_path: Path) -> None:
+    """export --to robopro-program takes the rule from the robot file: the document's test of EV, or none."""
+    for match in ("document", "always"):
+        out = tmp_path / "out" / match
+        result = runner.invoke(app, ["export", str(folder(tmp_path / match, match)), "--to", "robopro-program",
+                                     str(out)])
+        assert result.exit_code == 0, result.output
+        text = (out / "Cruiser.rpp").read_text(encoding="utf-8")
+        assert ("if an event is detected (EV &gt; 0)" in text) == (match == "document")
