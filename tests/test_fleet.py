@@ -65,6 +65,8 @@ def random_world(rng: random.Random) -> str:
     lx, ly = spot()
     bx, by = spot()
     cx, cy = spot()
+    while (cx - lx) ** 2 + (cy - ly) ** 2 < 0.15 ** 2:  # a lamp inside the circle is refused (its light is hidden)
+        cx, cy = spot()
     return (f'name = "random"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
             f"[start]\nat = [0.5, 0.5]\nheading = {rng.uniform(-180, 180)}\n"
             f"[[lamp]]\nat = [{lx}, {ly}]\nintensity = {rng.uniform(1, 5)}\n"
