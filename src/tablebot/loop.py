@@ -328,7 +328,7 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
     """
     clock = clock or SimulatedClock()
     watchdog = watchdog or Watchdog(None)
-    tick_s = engine.machine.table.robot.tick_ms / 1000
+    tick_s = engine.machine.table.robot.tick_s
     late = Lateness(tick_s, behind_limit_s)
     info = RunInfo(engine, tick_s, target, ticks)
     started: list[Sink] = []
