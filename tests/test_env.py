@@ -14,7 +14,7 @@ from gymnasium.wrappers.vector import NormalizeObservation  # noqa: E402
 
 from tablebot.cli.common import load  # noqa: E402
 from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv, observe  # noqa: E402
-from tablebot.sim.runner import run  # noqa: E402
+from tablebot.sim.runner import simulate  # noqa: E402
 from tablebot.sim.scene import scene_for  # noqa: E402
 from test_sim_helpers import BUMBERBOT  # noqa: E402
 
@@ -38,7 +38,7 @@ def test_with_the_table_in_charge_the_env_runs_as_tablebot_sim() -> None:
         if terminated:
             break
     table, machine = load(BUMBERBOT)
-    alone = run(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
+    alone = simulate(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
     np.testing.assert_array_equal(np.array(seen), observe(alone.hist))
     assert sum(rewards) == pytest.approx(-len(rewards) * 0.01)
 

@@ -18,7 +18,7 @@ from tablebot.cli import app
 from tablebot.cli.common import load
 from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
@@ -50,7 +50,7 @@ def test_every_shipped_robot_runs_alike_alone_and_in_a_fleet(example: str) -> No
     fleet = Fleet(table, machine, scene.world, specs, robot_layer(table.robot)[0], traced=[0, 1])
     fleet.run(1500)
     for k, spec in enumerate(specs):
-        alone = run(scene, 15.0, spec.seed)
+        alone = simulate(scene, 15.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
         assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
 
@@ -90,7 +90,7 @@ def test_random_tables_worlds_and_seeds_run_alike_alone_and_in_a_fleet(case: int
         scene = prepare(table, machine, world, None, spec.overrides())
         if spec.start is not None:
             scene = replace(scene, world=replace(world, start=spec.start))
-        alone = run(scene, 9.0, spec.seed)
+        alone = simulate(scene, 9.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
         assert summary.summary(k) == summarise(alone)
 
@@ -122,6 +122,6 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
     fleet.run(1200)
     rows = tuple(replace(row, timer=300) if row.index == 3 else row for row in table.rows)
     edited = replace(table, rows=rows)
-    alone = run(scene_for(edited, compile_table(edited)), 12.0, 3)
+    alone = simulate(scene_for(edited, compile_table(edited)), 12.0, 3)
     assert "".join(fleet.trace_lines(0)) == trace_text(alone)
     assert "".join(fleet.trace_lines(1)) != trace_text(alone)

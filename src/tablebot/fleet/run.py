@@ -21,7 +21,7 @@ from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
-from tablebot.sim.runner import PATH_STRIDE, Result
+from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.scene import Scene, _check_start, prepare
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.summary import Summary, light_bits
@@ -205,8 +205,8 @@ class Fleet:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
         return [line for block in self.traces[i].blocks for line in block_lines(block, self.machine)]
 
-    def result(self, i: int) -> Result:
-        """Robot i's whole run as the single-robot runner's :class:`Result` (for its pictures)."""
+    def result(self, i: int) -> SimRun:
+        """Robot i's whole run as the single-robot runner's :class:`SimRun` (for its pictures)."""
         trace = self.traces[i]
         blocks, robot = trace.blocks, trace.robot
         def column(name: str) -> np.ndarray:
@@ -214,7 +214,7 @@ class Fleet:
         hist = np.concatenate([*trace.rows, self.S[i][None, :]])
         count = int(self.acc[i, K.A_COLLISIONS])
         reached = int(self.acc[i, K.A_REACHED])
-        return Result(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
+        return SimRun(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
                       path=hist[::PATH_STRIDE, [L.X, L.Y]], masks=column("masks"), events=column("events"),
                       rows=column("rows"), states=column("states"), timers=column("timers"),
                       outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),

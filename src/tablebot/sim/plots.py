@@ -31,7 +31,7 @@ from tablebot.sim.draw import (
     sensor_readings,
     state_colours,
 )
-from tablebot.sim.runner import Result
+from tablebot.sim.runner import SimRun
 from tablebot.sim.summary import Summary
 
 DPI = 150
@@ -40,7 +40,7 @@ SPIN_M, SPIN_DEG = 0.01, 15.0  # a state that moves the robot less and turns it 
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
 
 
-def title_of(result: Result) -> str:
+def title_of(result: SimRun) -> str:
     robot, world = result.scene.table.robot.name, result.scene.world.name
     return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
 
@@ -58,7 +58,7 @@ def subtitle_of(summary: Summary) -> str:
 
 
 @literal_text()
-def trajectory(result: Result, summary: Summary, path: Path) -> Path:
+def trajectory(result: SimRun, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
     world = result.scene.world
     xs, ys = zip(*world.walls, strict=True)
@@ -130,7 +130,7 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
     return np.repeat(t[edges[:-1]], 2), np.column_stack((low, high)).ravel()
 
 
-def _markers(ax, result: Result, summary: Summary) -> None:
+def _markers(ax, result: SimRun, summary: Summary) -> None:
     h, scene = result.hist, result.scene
     touched = [contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
                for row in summary.collision_ticks]  # where the body touched the wall or obstacle
@@ -147,7 +147,7 @@ def _markers(ax, result: Result, summary: Summary) -> None:
         ax.plot(h[row, L.X], h[row, L.Y], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
 
 
-def _robot_poses(ax, result: Result) -> None:
+def _robot_poses(ax, result: SimRun) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
     h, scene = result.hist, result.scene
     n_lamps, sensors = len(scene.lamp_outputs), scene.table.robot.sensors
@@ -161,7 +161,7 @@ def _robot_poses(ax, result: Result) -> None:
                lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(h[-1], sensors))
 
 
-def _legend(fig: Figure, result: Result, summary: Summary) -> None:
+def _legend(fig: Figure, result: SimRun, summary: Summary) -> None:
     machine = result.scene.machine
     colours = state_colours(machine.states)
     handles = [Patch(color=colours[machine.states.index(state)],
@@ -173,7 +173,7 @@ def _legend(fig: Figure, result: Result, summary: Summary) -> None:
     fig.legend(handles=legend_marks(result), loc="lower left", bbox_to_anchor=(0.70, 0.08), frameon=False, fontsize=9)
 
 
-def legend_marks(result: Result) -> list:
+def legend_marks(result: SimRun) -> list:
     """What the trajectory's marks mean: only those this world and robot can show."""
     world, kinds = result.scene.world, {s.kind for s in result.scene.table.robot.sensors}
     marks = [Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
@@ -203,7 +203,7 @@ def legend_marks(result: Result) -> list:
 
 
 @literal_text()
-def timeline(result: Result, summary: Summary, path: Path) -> Path:
+def timeline(result: SimRun, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
     light, declared light and distance sensors) against time."""
     t = np.arange(result.ticks) * result.tick_s
@@ -234,7 +234,7 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
     return save(fig, path)
 
 
-def _state_panel(ax, result: Result) -> None:
+def _state_panel(ax, result: SimRun) -> None:
     machine = result.scene.machine
     colours = state_colours(machine.states)
     visited = sorted(set(result.states.tolist()))
@@ -255,7 +255,7 @@ def _state_panel(ax, result: Result) -> None:
     ax.set_ylabel("state")
 
 
-def _output_panel(ax, result: Result, t: np.ndarray) -> None:
+def _output_panel(ax, result: SimRun, t: np.ndarray) -> None:
     names = result.scene.machine.output_names
     n_motors = result.scene.machine.n_motors
     labels = result.scene.table.robot.labels
@@ -274,7 +274,7 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
 
 
-def _event_panel(ax, result: Result, t: np.ndarray) -> None:
+def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
     table = result.scene.table
     ev = result.events
     labels = table.robot.labels
@@ -292,7 +292,7 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.set_ylabel("events")
 
 
-def reading_panels(result: Result) -> list:
+def reading_panels(result: SimRun) -> list:
     """The reading panels this robot needs: light (wired phototransistors or declared light sensors),
     distance (declared distance sensors). Line sensors read 1 or 0: the event panel shows them."""
     wiring, kinds = result.scene.params.wiring, {s.kind for s in result.scene.table.robot.sensors}
@@ -304,7 +304,7 @@ def reading_panels(result: Result) -> list:
     return panels
 
 
-def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> list[float]:
+def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> list[float]:
     """Plot each declared sensor of ``kind`` (reading × ``scale``) with its threshold; returns the thresholds."""
     h, levels = result.hist[:-1], []
     for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
@@ -320,14 +320,14 @@ def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> lis
     return levels
 
 
-def _distance_panel(ax, result: Result, t: np.ndarray) -> None:
+def _distance_panel(ax, result: SimRun, t: np.ndarray) -> None:
     levels = _declared(ax, result, t, "distance", 100.0)
     ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
     ax.set_ylabel("distance (cm)\n-- on, ·· off")
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
 
-def _light_panel(ax, result: Result, t: np.ndarray) -> None:
+def _light_panel(ax, result: SimRun, t: np.ndarray) -> None:
     wiring = result.scene.params.wiring
     if not (wiring.get("light_right") or wiring.get("light_left")):  # declared light sensors only
         _declared(ax, result, t, "light", 1.0)

@@ -178,7 +178,7 @@ def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
             *sensor_columns(scene))
 
 
-def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
+def field_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
     columns: dict[str, list] = {}
@@ -223,7 +223,7 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __getitem__(self, key: str) -> Sequence[float]:
         if self._columns is None:
-            self._columns = trace_columns(self.scene, self.hist)
+            self._columns = field_columns(self.scene, self.hist)
         return self._columns[key]
 
     def __iter__(self) -> Iterator[str]:
