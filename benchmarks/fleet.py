@@ -138,7 +138,7 @@ def breakdown(repeat: int) -> dict[str, float]:
 
 
 def sweep_plan(robots: int, seconds: float):  # type: ignore[no-untyped-def]
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
 
     return make_plan(EXAMPLE, None, [], [], None, robots, seconds)
 

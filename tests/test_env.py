@@ -13,7 +13,8 @@ from gymnasium.vector import AutoresetMode  # noqa: E402
 from gymnasium.wrappers.vector import NormalizeObservation  # noqa: E402
 
 from tablebot.cli.common import load  # noqa: E402
-from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv, observe  # noqa: E402
+from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv  # noqa: E402
+from tablebot.sim.observation import Observation  # noqa: E402
 from tablebot.sim.runner import simulate  # noqa: E402
 from tablebot.sim.scene import scene_for  # noqa: E402
 from test_sim_helpers import BUMBERBOT  # noqa: E402
@@ -39,7 +40,7 @@ def test_with_the_table_in_charge_the_env_runs_as_tablebot_sim() -> None:
             break
     table, machine = load(BUMBERBOT)
     alone = simulate(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
-    np.testing.assert_array_equal(np.array(seen), observe(alone.hist))
+    np.testing.assert_array_equal(np.array(seen), Observation.of(alone.scene)(alone.hist))
     assert sum(rewards) == pytest.approx(-len(rewards) * 0.01)
 
 

@@ -165,7 +165,7 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from dataclasses import replace
 
     from tablebot.cli.common import load
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.run import Fleet, RobotSpec
     from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table

@@ -15,6 +15,7 @@ from tablebot.formats.trace_lines import exact_round
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
+from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
@@ -40,6 +41,7 @@ class SimRobot:
         self.light_keys = light_keys(scene)
         self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
         self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
+        self._observation: Observation | None = None
         self.reset(seed=seed)
 
     # --- Gymnasium-style life cycle ---------------------------------------------------------------
@@ -154,6 +156,12 @@ class SimRobot:
     def reached_row(self) -> int | None:
         row = int(self.acc[K.A_REACHED])
         return None if row < 0 else row
+
+    def observation(self) -> np.ndarray:
+        """What a learning agent sees of the robot now (:class:`tablebot.sim.observation.Observation`)."""
+        if self._observation is None:
+            self._observation = Observation.of(self.scene)
+        return self._observation(self.s[None, :])[0]
 
 
 def light_keys(scene: Scene) -> tuple[str, str]:
