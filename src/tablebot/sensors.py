@@ -59,6 +59,10 @@ class Sensor:
         back = self.hysteresis if self.direction == "below" else -self.hysteresis
         return self.threshold, self.threshold + back
 
+    def event(self, reading: float, was_on: bool) -> bool:
+        """Whether the input reads 1 for ``reading`` (``was_on``: whether it read 1 last tick)."""
+        return threshold_event(reading, self.direction == "above", *self.switch_points(), was_on)
+
     def describe(self) -> str:
         """``distance below 20 cm (hysteresis 5 cm)`` — the declaration in words, for reports."""
         if self.kind == "line":
@@ -70,6 +74,19 @@ class Sensor:
         if not self.unit:
             return f"{value:g}"
         return f"{value / LENGTH_UNITS[self.unit]:g} {self.unit}"
+
+
+def threshold_event(reading: float, above: bool, on_at: float, off_at: float, was_on: bool) -> bool:
+    """THE threshold rule, with its hysteresis: the event is on while the reading is past ``on_at`` (above it,
+    or below it) and, once on, stays on until the reading is back past ``off_at`` (``on_at`` moved back by the
+    hysteresis; ``was_on``: the event last tick).
+
+    The one rule for every analog input: the simulator compiles this function into its sensing
+    (``sim.sensing``), the TXT's wiring calls it (``hw.txt.wiring``), and the TXT 4.0 program, a standalone
+    file, carries a copy that ``tests/test_rules.py`` proves equal to it.
+    """
+    level = off_at if was_on else on_at
+    return reading > level if above else reading < level
 
 
 def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tablebot.hw.txt import protocol as wire
-from tablebot.table import MAX_LAMP, MAX_SPEED
+from tablebot.sensors import threshold_event
+from tablebot.table import MAX_SPEED
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
@@ -31,7 +32,15 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
     from tablebot.sensors import Sensor
 
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
-PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 = PWM 512
+PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 (MAX_SPEED = MAX_LAMP) = PWM 512
+
+
+def level_pwm(level: int) -> int:
+    """A motor's speed (its size) or a lamp's level, 0..8, as the TXT family's PWM 0..512 (a level beyond 8 is 8,
+    one below 0 is off): THE scaling of the TXT and the TXT 4.0, whose standalone program carries a copy that
+    ``tests/test_rules.py`` proves equal to this one."""
+    return max(0, min(MAX_SPEED, level)) * PWM_STEP
+
 
 #: mode -> (the controller's input mode, digital?, the polarity key, its meaning)
 DIGITAL_MODES = {
@@ -75,10 +84,11 @@ class InputWire:
         for the hysteresis)."""
         if self.digital:
             return int(bool(raw)) ^ int(self.invert)
-        slack = self.hysteresis if was_on else 0
         if self.below is not None:
-            return int(raw < self.below + slack)
-        return int(self.above is not None and raw > self.above - slack)
+            return int(threshold_event(raw, False, self.below, self.below + self.hysteresis, was_on))
+        if self.above is not None:
+            return int(threshold_event(raw, True, self.above, self.above - self.hysteresis, was_on))
+        return 0
 
 
 @dataclass(frozen=True)
@@ -115,11 +125,11 @@ class TxtWiring:
         pwm = [0] * wire.N_OUTPUTS
         for out, value in zip(self.outputs, outputs, strict=True):
             if out.kind == "lamp":
-                pwm[out.terminal] = max(0, min(MAX_LAMP, value)) * PWM_STEP
+                pwm[out.terminal] = level_pwm(value)
                 continue
             speed = -value if out.reverse else value
             forward, backward = 2 * out.terminal, 2 * out.terminal + 1
-            pwm[forward if speed > 0 else backward] = min(MAX_SPEED, abs(speed)) * PWM_STEP
+            pwm[forward if speed > 0 else backward] = level_pwm(abs(speed))
         return pwm
 
     def mask(self, universal: Sequence[int], previous: int = 0) -> int:
