@@ -5,6 +5,7 @@ driving the program's robot (against the stub of the ``fischertechnik`` calls, t
 
 from __future__ import annotations
 
+import ast
 import json
 import random
 from pathlib import Path
@@ -12,7 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from core_helpers import EXAMPLE
+from tablebot.engine import Engine
+from tablebot.formats.table_read import load_table
 from tablebot.hw.txt.wiring import PWM_STEP, InputWire, OutputWire, TxtWiring, level_pwm
+from tablebot.hw.txt4.export import export_txt4
+from tablebot.loop import Reading, RealTimeClock, run
+from tablebot.machine import compile_table
 from tablebot.sensors import Sensor, threshold_event
 from tablebot.sim import columns as L
 from tablebot.sim.params import sensor_fields
@@ -104,3 +111,82 @@ def test_the_txt4_program_scales_speeds_and_lamps_as_the_txt(tmp_path: Path, mon
                 set_to[call["device"]] = 0
         seen.append({**set_to, "tick": tick})
     assert seen == expected
+
+
+class SimulatedTime:
+    """A clock both loops read: ``now`` is the simulated time, ``sleep`` advances it (and is noted)."""
+
+    def __init__(self) -> None:
+        self.t, self.sleeps = 0.0, []
+
+    def now(self) -> float:
+        return self.t
+
+    def sleep(self, seconds: float) -> None:
+        self.sleeps.append(round(seconds, 9))
+        self.t += seconds
+
+
+class LinkRobot:
+    """A robot whose link takes ``delays[n]`` seconds to answer read ``n``, which reads ``masks[n]``; it notes
+    when each write arrives and what it says. ``read`` answers in the TXT 4.0 program's form (mask, pulses)."""
+
+    def __init__(self, time: SimulatedTime, masks: list[int], delays: list[float]):
+        self.time, self.masks, self.delays = time, masks, delays
+        self.n, self.writes, self.stops = 0, [], 0
+
+    def read(self) -> tuple[int, list[int]]:
+        self.time.t += self.delays[self.n]
+        self.n += 1
+        return self.masks[self.n - 1], []
+
+    def write(self, outputs: list[int]) -> None:
+        self.writes.append((round(self.time.t, 9), tuple(outputs)))
+
+    def stop(self) -> None:
+        self.stops += 1
+
+    def open(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+class LoopRobot(LinkRobot):
+    """The same robot behind the RobotIO seam of tablebot.loop."""
+
+    def read(self) -> Reading:  # type: ignore[override]
+        mask, pulses = super().read()
+        return Reading(mask, tuple(pulses))
+
+
+STALLS = {"a quick link": {}, "a 0.3 s stall": {5: 0.3}, "a 0.7 s stall": {5: 0.7},
+          "a link slower than the tick": dict.fromkeys(range(60), 0.013),
+          "a jittery link": {n: random.Random(n).uniform(0.0, 0.02) for n in range(60)}}
+
+
+@pytest.mark.parametrize("case", STALLS)
+def test_the_txt4_programs_loop_paces_stops_and_falls_behind_as_the_run_loop(case: str) -> None:
+    """The TXT 4.0 program runs its own loop (it has no tablebot); driven with the same robot and the same
+    simulated time as :func:`tablebot.loop.run` with a real-time clock and the program's behind-limit, it
+    sleeps the same, writes the same outputs at the same moments, counts the same late ticks and ends for
+    the same reason (both re-anchor a late tick's grid on the moment it started: the loop as due + late, the
+    program by reading the clock again, equal to 1e-9 s)."""
+    from tablebot.hw.txt4 import runtime as txt4_runtime
+
+    machine = compile_table(load_table(EXAMPLE / "table.csv"))
+    table = ast.literal_eval(export_txt4(machine).files["lib/tablebot_program.py"].split("\nTABLE = ", 1)[1])
+    rng = random.Random(3)
+    masks = [sum(b for b in machine.input_bits.values() if rng.random() < 0.15) for _ in range(60)]
+    delays = [STALLS[case].get(n, 0.002) for n in range(60)]
+    program_time, loop_time, said = SimulatedTime(), SimulatedTime(), []
+    program_robot, loop_robot = LinkRobot(program_time, masks, delays), LoopRobot(loop_time, masks, delays)
+    reason = txt4_runtime.run(table, program_robot, 60, now=program_time.now, sleep=program_time.sleep, log=said.append)
+    clock = RealTimeClock(machine.table.robot.tick_s, now=loop_time.now, sleep=loop_time.sleep)
+    end = run(Engine(machine), loop_robot, clock=clock, ticks=60, behind_limit_s=txt4_runtime.BEHIND_LIMIT_S)
+    assert (reason, program_robot.writes, program_time.sleeps, program_robot.stops) == \
+        (end.reason, loop_robot.writes, loop_time.sleeps, loop_robot.stops)
+    assert f"({end.late_ticks} late)" in said[-1]
+    assert end.reason == ("behind" if case == "a 0.7 s stall" else "done")
+    assert end.late_ticks > 0 or case == "a quick link"

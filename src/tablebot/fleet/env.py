@@ -24,6 +24,7 @@ try:
 except ImportError as exc:  # pragma: no cover - gymnasium is an extra
     raise ImportError("tablebot.fleet.env needs Gymnasium: pip install 'tablebot[research]'") from exc
 
+from tablebot.loop import exchange
 from tablebot.sim.observation import BUILT_IN
 
 ENV_ID = "tablebot/TableBot-v0"
@@ -92,14 +93,13 @@ class TableBotEnv(gym.Env):
         return self._observation(), {"seed": robot_seed}
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        if action is None:  # the table drives: the engine ticks on what the robot reads
-            reading = self.robot.read()
-            outputs = self.engine.step(reading.mask, reading.pulses)
+        if action is None:  # the table drives: the engine ticks on what the robot reads, as in the run loop
+            exchange(self.engine, self.robot)
         else:
             levels = np.asarray(action, dtype=np.int64).reshape(2)
             outputs = [0] * len(self.engine.outputs)
             outputs[self.drive[0]], outputs[self.drive[1]] = int(levels[0]), int(levels[1])
-        self.robot.write(outputs)
+            self.robot.write(outputs)
         self.ticks += 1
         reached = self.robot.reached_row is not None
         info = {"state": self.setup.machine.states[self.engine.state], "collisions": self.robot.collision_count}
