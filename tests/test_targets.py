@@ -60,10 +60,11 @@ def test_unknown_target_names_the_known_ones() -> None:
 def test_the_commands_choices_are_the_registered_back_ends() -> None:
     """--to, --board, --on and check --target list exactly what is registered, in its order."""
     runner = CliRunner()
-    assert registry.names("export") == ["robopro", "robopro-rpp", "c", "txt4"]
+    assert registry.names("export") == ["robopro", "robopro-rpp", "robopro-program", "c", "txt4"]
     assert registry.names("board") == ["uno", "ftduino"]
     assert registry.names("live") == ["txt", "sim"]
-    assert registry.check_targets() == ["robopro", "robopro-rpp", "c", "uno", "ftduino", "txt", "txt4"]
+    assert registry.check_targets() == ["robopro", "robopro-rpp", "robopro-program", "c", "uno", "ftduino", "txt",
+                                        "txt4"]
     from tablebot.cli.export import Target
     from tablebot.cli.firmware import BoardName
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 def load_all() -> None:
     """Import every back-end module (in the order commands list them) and the analysis's section."""
     # The order is the order of --to, --board, --on and check --target: keep it (noqa: not sorted).
-    from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp
+    from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp, robopro-program; [robopro]
     from tablebot.codegen import backend as _c  # c
     from tablebot.firmware import backend as _boards  # uno, ftduino; [board]
     from tablebot.hw.txt import backend as _txt  # txt; [txt]

@@ -38,8 +38,8 @@ def import_cmd(
 ) -> None:
     """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
     from tablebot.files import write_text
-    from tablebot.formats import robopro_lists as robopro
     from tablebot.formats.table_write import format_table
+    from tablebot.robopro import lists as robopro
     from tablebot.robot import BUMBERBOT, load_robot
 
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)

@@ -12,7 +12,7 @@ from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
-from tablebot.formats import robopro_program as rpp
+from tablebot.robopro import rpp_edit as rpp
 
 #: ``--to``'s choices: every registered export back-end.
 Target = StrEnum("Target", {b.name: b.name for b in registry.backends("export")})  # type: ignore[misc]

@@ -122,14 +122,17 @@ def upload_cmd(
     folder: Path = typer.Argument(..., metavar="OUTDIR",
                                  help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
     to: str = typer.Option(..., "--to", help="The TXT 4.0: txt4://192.168.7.2 (USB), txt4://HOST[:PORT]."),
-    key: str = typer.Option(..., "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO Pro "
-                            "Coding asks for it)."),
+    key: str | None = typer.Option(None, "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO "
+                                   "Pro Coding asks for it). Visible to other users in the process list: prefer "
+                                   "$TABLEBOT_TXT4_KEY, --key-file, or the prompt (asked when neither is given)."),
+    key_file: Path | None = typer.Option(None, "--key-file", help="A file holding the API key on one line."),
     start: bool = typer.Option(True, "--start/--no-start", help="Start the program once it is uploaded."),
 ) -> None:
     """Install an exported TXT 4.0 program on the controller through its REST API, and start it."""
-    from tablebot.hw.txt4.upload import upload
+    from tablebot.hw.txt4.upload import api_key, base_url, terminal_prompt, upload, workspace_files
 
     if not folder.is_dir():
         raise fail(folder, "is a file, not a folder" if folder.exists() else "no such folder",
                    "give the folder `tablebot export --to txt4` wrote")
-    upload(folder, to, key, start, say=lambda text: console.print(terminal(text)))
+    base_url(to), workspace_files(folder)  # a wrong --to or folder is said before the key is asked for
+    upload(folder, to, api_key(key, key_file, terminal_prompt()), start, say=lambda text: console.print(terminal(text)))

@@ -64,13 +64,15 @@ class Runner:
     def __exit__(self, kind: object, *rest: object) -> None:
         self.close(failed=kind is not None)
 
-    def run(self, jobs: Sequence[Job], done: Done) -> None:
+    def run(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]] = run_job) -> None:
+        """Run every job with ``fn`` (default: the fleet's :func:`run_job`; evolve measures more per robot),
+        handing each result to ``done`` as it comes back."""
         if not jobs:
             return
         if self.backend == "dask":
-            self._run_dask(jobs, done)
+            self._run_dask(jobs, done, fn)
         else:
-            self._run_local(jobs, done)
+            self._run_local(jobs, done, fn)
 
     def close(self, failed: bool = False) -> None:
         if self.pool is not None:
@@ -86,12 +88,12 @@ class Runner:
 
     # --- this machine: one process per core (``workers``), each running whole chunks single-threaded
 
-    def _run_local(self, jobs: Sequence[Job], done: Done) -> None:
+    def _run_local(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         workers = max(1, self.workers or os.cpu_count() or 1)
         if workers == 1 or (len(jobs) == 1 and self.pool is None):
             self.info = {"workers": 1, "processes": "this one"}
             for job in jobs:
-                done(*run_job(job))
+                done(*fn(job))
             return
         if self.pool is None:
             import multiprocessing
@@ -100,12 +102,12 @@ class Runner:
             context = multiprocessing.get_context("spawn")  # never fork a process that holds numba's threads
             self.pool = context.Pool(workers, initializer=_ignore_interrupts)
             self.info = {"workers": workers, "processes": "local"}
-        for job, summary in self.pool.imap_unordered(run_job, [replace(j, threads=1) for j in jobs]):
+        for job, summary in self.pool.imap_unordered(fn, [replace(j, threads=1) for j in jobs]):
             done(job, summary)
 
     # --- a Dask cluster: each chunk one task
 
-    def _run_dask(self, jobs: Sequence[Job], done: Done) -> None:
+    def _run_dask(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         """Every worker first warms the kernel in a cache folder of its own (one compile per worker,
         never two processes writing one folder); then the chunks go out."""
         if self.client is None:
@@ -114,7 +116,7 @@ class Runner:
         from distributed import as_completed
 
         client = self.client
-        futures = [client.submit(run_job, job, pure=False) for job in jobs]
+        futures = [client.submit(fn, job, pure=False) for job in jobs]
         try:
             for future in as_completed(futures, loop=client.loop):
                 done(*future.result())

@@ -1,11 +1,10 @@
-// A timeline strip: the state at each tick as a coloured band, the fired rows as ticks, and a cursor.
-"use strict";
-window.TB = window.TB || {};
+// A timeline strip: the state at each tick as a coloured band, and a cursor; click or drag to seek.
+import { stateColour } from "../lib/colours.js";
 
-TB.Timeline = class {
+export class Timeline {
   constructor(canvas, onSeek) {
     this.canvas = canvas;
-    this.states = [];   // state index per tick (-1: not in the table)
+    this.states = [];  // state index per tick (-1: not in the table)
     this.cursor = 0;
     this.onSeek = onSeek;
     canvas.addEventListener("pointerdown", (e) => this._seek(e));
@@ -13,7 +12,7 @@ TB.Timeline = class {
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 
-  setStates(states, labels) { this.states = states; this.labels = labels || []; this.draw(); }
+  setStates(states) { this.states = states; this.draw(); }
 
   setCursor(index) { this.cursor = index; this.draw(); }
 
@@ -30,13 +29,11 @@ TB.Timeline = class {
     const g = c.getContext("2d"), n = this.states.length, W = c.width, H = c.height;
     g.fillStyle = "#f1f3f5"; g.fillRect(0, 0, W, H);
     if (!n) return;
-    // one pixel column per bucket of ticks: the state most of the bucket spent in
-    for (let px = 0; px < W; px++) {
-      const t = Math.min(n - 1, Math.floor(px / W * n));
-      g.fillStyle = TB.stateColour(this.states[t]);
+    for (let px = 0; px < W; px++) {  // one pixel column per bucket of ticks
+      g.fillStyle = stateColour(this.states[Math.min(n - 1, Math.floor(px / W * n))]);
       g.fillRect(px, 0, 1, H * 0.78);
     }
     const x = (n > 1 ? this.cursor / (n - 1) : 0) * (W - 2) + 1;
     g.fillStyle = "#000"; g.fillRect(x - ratio, 0, 2 * ratio, H);
   }
-};
+}

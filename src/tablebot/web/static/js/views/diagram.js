@@ -1,12 +1,11 @@
 // The state diagram: Graphviz's SVG of the table (made by the server), with the current state highlighted.
-"use strict";
-window.TB = window.TB || {};
 
-TB.Diagram = class {
+export class Diagram {
   constructor(holder) {
     this.holder = holder;
     this.nodes = new Map();  // state id (text) -> the node's <g>
     this.current = null;
+    holder.addEventListener("click", () => holder.classList.toggle("big"));
   }
 
   // svgText comes from Graphviz, which the server gave only escaped labels; it is parsed as SVG
@@ -16,8 +15,7 @@ TB.Diagram = class {
     this.nodes.clear();
     this.current = null;
     if (!svgText) return;
-    const doc = new DOMParser().parseFromString(svgText, "image/svg+xml");
-    const svg = doc.documentElement;
+    const svg = new DOMParser().parseFromString(svgText, "image/svg+xml").documentElement;
     if (svg.nodeName !== "svg") return;
     svg.removeAttribute("width"); svg.removeAttribute("height");
     svg.setAttribute("preserveAspectRatio", "xMidYMin meet");
@@ -35,4 +33,4 @@ TB.Diagram = class {
     const node = this.nodes.get(stateId);
     if (node) node.classList.add("current");
   }
-};
+}
