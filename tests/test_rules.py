@@ -24,7 +24,7 @@ from tablebot.sensors import Sensor, threshold_event
 from tablebot.sim import columns as L
 from tablebot.sim.params import sensor_fields
 from tablebot.sim.sensing import sensor_events
-from test_txt4_export import stub_robot
+from test_txt4_program import stub_robot
 
 
 def walk(rng: random.Random, low: int, high: int, ticks: int) -> list[int]:
