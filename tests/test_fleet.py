@@ -22,6 +22,7 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
+from tablebot.testing.executors import random_world
 from tablebot.testing.random_tables import Shape, random_table
 from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
@@ -53,22 +54,6 @@ def test_every_shipped_robot_runs_alike_alone_and_in_a_fleet(example: str) -> No
         alone = simulate(scene, 15.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
         assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
-
-
-def random_world(rng: random.Random) -> str:
-    """A room with a lamp, a box and a pot in random places (away from the start at (0.5, 0.5)), maybe noise."""
-    size = rng.uniform(2.0, 3.5)
-    def spot() -> tuple[float, float]:
-        return rng.uniform(1.2, size - 0.3), rng.uniform(1.2, size - 0.3)
-    lx, ly = spot()
-    bx, by = spot()
-    cx, cy = spot()
-    return (f'name = "random"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
-            f"[start]\nat = [0.5, 0.5]\nheading = {rng.uniform(-180, 180)}\n"
-            f"[[lamp]]\nat = [{lx}, {ly}]\nintensity = {rng.uniform(1, 5)}\n"
-            f"[[box]]\nat = [{bx}, {by}]\nsize = [0.3, 0.2]\nangle = {rng.uniform(0, 90)}\n"
-            f"[[circle]]\nat = [{cx}, {cy}]\nradius = 0.1\n"
-            f"[noise]\nlight = {rng.choice([0.0, 0.05, 0.2])}\nmotor = {rng.choice([0.0, 0.01, 0.05])}\n")
 
 
 @pytest.mark.parametrize("case", range(4))
