@@ -28,7 +28,8 @@ from tablebot.loop import exchange
 from tablebot.sim.observation import BUILT_IN
 
 ENV_ID = "tablebot/TableBot-v0"
-#: The observation vector, in order (see :class:`tablebot.sim.observation.Observation`).
+#: The observation vector's first part, in order; every declared sensor's reading follows (the names of a
+#: robot's whole vector: ``env.observation_names``; see :class:`tablebot.sim.observation.Observation`).
 OBSERVATION = tuple(name for name, _ in BUILT_IN)
 
 
@@ -57,6 +58,7 @@ class Setup:
         self.action_space = spaces.MultiDiscrete([2 * levels + 1, 2 * levels + 1], start=[-levels, -levels],
                                                  dtype=np.int64)
         observation = Observation.of(self.scene)
+        self.observation_names = observation.names
         self.observation_space = spaces.Box(observation.low, observation.high, dtype=np.float64)
 
     def spec(self, seed: int) -> Any:

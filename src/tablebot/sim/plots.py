@@ -5,7 +5,9 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -15,6 +17,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from tablebot.files import atomic_write
+from tablebot.sensors import SENSOR_KINDS, SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
@@ -175,7 +178,7 @@ def _legend(fig: Figure, result: SimRun, summary: Summary) -> None:
 
 def legend_marks(result: SimRun) -> list:
     """What the trajectory's marks mean: only those this world and robot can show."""
-    world, kinds = result.scene.world, {s.kind for s in result.scene.table.robot.sensors}
+    world, drawn = result.scene.world, [k.draw for k in declared_kinds(result)]
     marks = [Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
                     label="collision (where it touched)"),
              Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
@@ -190,10 +193,10 @@ def legend_marks(result: SimRun) -> list:
                   Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)")]
     if world.lines:
         marks.append(Patch(facecolor=TAPE, label="tape on the floor"))
-    if "line" in kinds:
+    if "spot" in drawn:
         marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
                             label="floor sensor (dark over tape)"))
-    if "distance" in kinds:
+    if "beam" in drawn:
         marks.append(Patch(facecolor=BEAM, alpha=0.45, label="distance beam, out to the echo"))
     marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
     return marks
@@ -292,16 +295,23 @@ def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
     ax.set_ylabel("events")
 
 
+def declared_kinds(result: SimRun) -> list[SensorKind]:
+    """The kinds of the robot's declared sensors, each once, in the order they are registered."""
+    kinds = {s.kind for s in result.scene.table.robot.sensors}
+    return [kind for name, kind in SENSOR_KINDS.items() if name in kinds]
+
+
 def reading_panels(result: SimRun) -> list:
-    """The reading panels this robot needs: light (wired phototransistors or declared light sensors),
-    distance (declared distance sensors). Line sensors read 1 or 0: the event panel shows them."""
-    wiring, kinds = result.scene.params.wiring, {s.kind for s in result.scene.table.robot.sensors}
-    panels = []
-    if wiring.get("light_right") or wiring.get("light_left") or "light" in kinds:
-        panels.append(_light_panel)
-    if "distance" in kinds:
-        panels.append(_distance_panel)
-    return panels
+    """The reading panels this robot needs, in their places: light (wired phototransistors, or declared light
+    sensors), then each declared kind's panel (``SensorKind.panel``). A kind without a panel (a line sensor
+    reads 1 or 0) shows on the event panel."""
+    wiring = result.scene.params.wiring
+    builtin = bool(wiring.get("light_right") or wiring.get("light_left"))
+    panels: list[tuple[int, Any]] = [(0, _light_panel)] if builtin else []
+    for kind in declared_kinds(result):
+        if kind.panel is not None and not (builtin and kind.panel.position == 0):
+            panels.append((kind.panel.position, _panel_of(kind)))
+    return [panel for _, panel in sorted(panels, key=lambda p: p[0])]
 
 
 def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> list[float]:
@@ -320,21 +330,29 @@ def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> lis
     return levels
 
 
-def _distance_panel(ax, result: SimRun, t: np.ndarray) -> None:
-    levels = _declared(ax, result, t, "distance", 100.0)
-    ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
-    ax.set_ylabel("distance (cm)\n-- on, ·· off")
+def _panel_of(kind: SensorKind) -> Callable[..., None]:
+    """The panel of one declared kind, named after it (``_distance_panel``)."""
+    def panel(ax, result: SimRun, t: np.ndarray) -> None:
+        _kind_panel(ax, result, t, kind)
+    panel.__name__ = f"_{kind.name}_panel"
+    return panel
+
+
+def _kind_panel(ax, result: SimRun, t: np.ndarray, kind: SensorKind) -> None:
+    """The declared sensors of one kind, each with its thresholds (``SensorKind.panel``)."""
+    panel = kind.panel
+    assert panel is not None
+    levels = _declared(ax, result, t, kind.name, panel.scale)
+    if panel.log:
+        ax.set_yscale("symlog", linthresh=0.1)
+    else:
+        ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
+    ax.set_ylabel(panel.label)
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
 
 def _light_panel(ax, result: SimRun, t: np.ndarray) -> None:
-    wiring = result.scene.params.wiring
-    if not (wiring.get("light_right") or wiring.get("light_left")):  # declared light sensors only
-        _declared(ax, result, t, "light", 1.0)
-        ax.set_yscale("symlog", linthresh=0.1)
-        ax.set_ylabel("light\n(× threshold)")
-        ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
-        return
+    """The BumberBot's wired phototransistors against their threshold."""
     h, wiring = result.hist[:-1], result.scene.params.wiring
     ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
     ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")

@@ -53,16 +53,12 @@ class Scene:
         return self.table.robot.tick_s
 
 
-#: Trace key suffix, scale and decimals of each declared sensor kind's reading (0 decimals: an integer).
-TRACE_FORMS = {"distance": ("cm", 100.0, 1), "light": ("light", 1.0, 4), "line": ("line", 1.0, 0)}
-
-
 def sensor_columns(scene: Scene) -> list[tuple[str, int, float, int]]:
     """What a trace adds for each declared sensor: (key, state column, scale, decimals), e.g. the distance
     sensor I3 as ``"I3_cm": 23.0``, a light sensor as ``"I4_light": 1.2345``, a line sensor as ``"I1_line": 1``."""
     columns = []
     for k, sensor in enumerate(scene.table.robot.sensors[: L.MAX_SENSORS]):
-        suffix, scale, decimals = TRACE_FORMS[sensor.kind]
+        suffix, scale, decimals = sensor.sensor_kind.trace
         columns.append((f"{sensor.name}_{suffix}", L.READING + k, scale, decimals))
     return columns
 

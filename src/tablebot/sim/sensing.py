@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 from tablebot.jit import njit
-from tablebot.sensors import threshold_event
+from tablebot.sensors import SENSOR_KINDS, threshold_event
 from tablebot.sim.columns import (
     B_SENSOR,
     F_AIM,
@@ -20,9 +20,6 @@ from tablebot.sim.columns import (
     F_SIGN,
     F_X,
     F_Y,
-    K_DISTANCE,
-    K_LIGHT,
-    K_LINE,
     MAX_SENSORS,
     P_COS_FOV,
     P_DBEAM,
@@ -41,6 +38,8 @@ from tablebot.sim.columns import (
 from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
 
 threshold = njit(inline="always")(threshold_event)  # the rule of every analog input, compiled in
+#: The codes of the kinds whose physics is here (tablebot.sensors.SENSOR_KINDS): a branch each below.
+K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "distance", "light"))
 
 
 @njit(cache=True)

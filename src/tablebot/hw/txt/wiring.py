@@ -334,7 +334,7 @@ class _Reader:
         unit, most = ANALOG_MODES[mode][1], ANALOG_MODES[mode][2]
         limits = {k: value[k] for k in ("below", "above") if k in value}
         declared = next((s for s in self.robot.sensors if s.name == name), None)
-        if declared is not None and declared.kind != "line":
+        if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
             self.error(name, f"[txt] {name}: a {mode} input needs exactly one of below = N or above = N ({unit})",
@@ -355,13 +355,14 @@ class _Reader:
             self.error(name, f"[txt] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
                        f"remove {', '.join(limits)} here: the simulator and the TXT read the one declaration")
             return None
-        if sensor.kind != "distance" or mode != "ultrasonic":
+        scale = sensor.sensor_kind.modes.get(mode)  # from the declaration's units into the mode's
+        if scale is None:
             self.error(name, f"[txt] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
                        f"{mode} mode with its declared threshold",
                        'wire a distance sensor as mode = "ultrasonic"; a light sensor as mode = "phototransistor" '
                        "(threshold 1) or give its calibrated threshold in [txt] and drop it from [sensors]")
             return None
-        limit, slack = round(sensor.threshold * 100, 6), round(sensor.hysteresis * 100, 6)
+        limit, slack = round(sensor.threshold * scale, 6), round(sensor.hysteresis * scale, 6)
         if limit != int(limit) or slack != int(slack):
             self.error(name, f"[txt] {name}: the TXT measures whole centimetres; [sensors] says "
                        f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")
