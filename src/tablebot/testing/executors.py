@@ -4,7 +4,8 @@ An executor runs a compiled machine on a :class:`Case` (recorded inputs: the inp
 pulses of every tick) and returns a :class:`Run`: the inputs it read and one core trace line per tick
 (``tick``, ``event``, ``row``, ``state``, ``timer``, each output, each counter: what
 :func:`tablebot.replay.record` writes). Most replay the case's inputs; the simulator and the fleet sense
-their own (a random table in a random world) and report what they read. :func:`differences` replays the
+their own (a random table in a small busy room, or a shipped example in its own world) and report what they
+read. :func:`differences` replays the
 inputs an executor read through ``Engine.step`` and names the first tick and field where it disagrees.
 
 A new executor is one :func:`register` call; ``tests/test_executors.py`` runs every registered one on the
