@@ -15,4 +15,4 @@ test: setup
 	node_modules/.bin/eslint src/tablebot/web/static eslint.config.js
 
 bench: setup
-	status=0; for b in engine sim check mcu turn_drift studio fleet evolve; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
+	status=0; for b in engine sim check mcu turn_drift studio fleet evolve controllers; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status

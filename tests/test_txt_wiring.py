@@ -17,7 +17,9 @@ from tablebot.hw.txt.wiring import txt_wiring
 from tablebot.machine import compile_table
 from txt_fake import FakeTxt
 
-ROBOT = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
+#: The example's robot file up to its [txt] wiring (the other controllers' sections after it are not the TXT's).
+FULL = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
+ROBOT = FULL[: FULL.index("\n# The same wiring on the seed's own controllers") + 1]
 TXT_START = ROBOT.index("[txt]")
 
 

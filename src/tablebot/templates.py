@@ -26,7 +26,7 @@ PURPOSE = {"table.csv": "the behaviour: one row per transition (open it in a spr
 BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                    "rear": "I5", "light_right": "I7", "light_left": "I8"}
 Named = tuple[str, str]  # (name, label; "" keeps the template's label)
-HARDWARE_SECTIONS = ("txt", "board")  # robot-file sections that wire the table's names to terminals
+HARDWARE_SECTIONS = ("txt", "robotx", "roboif", "board")  # robot-file sections that wire the table's names to terminals
 
 
 @dataclass(frozen=True)
@@ -117,7 +117,7 @@ def _rename_words(text: str, mapping: dict[str, str]) -> str:
 
 
 def _rename_robot(text: str, mapping: dict[str, str]) -> str:
-    """The robot file renamed; in a controller's wiring section ([txt], [board]) only the names the table
+    """The robot file renamed; in a controller's wiring section ([txt], [board], ...) only the names the table
     uses (the keys), never the terminals they are wired to: your names on the template's terminals."""
     if not mapping:
         return text
