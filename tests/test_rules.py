@@ -1,5 +1,5 @@
 """Each rule once: the threshold with hysteresis (tablebot.sensors.threshold_event) and the TXT family's PWM
-scaling (tablebot.hw.txt.wiring.level_pwm) are functions the simulator and the TXT call; the TXT 4.0 program is
+scaling (tablebot.hw.txt.wiring.level_pwm) are functions the simulator and the controllers call; the TXT 4.0 program is
 a standalone file shipped to the controller, so it carries its own copies, proven equal to them here by
 driving the program's robot (against the stub of the ``fischertechnik`` calls, tests/txt4_stub)."""
 
@@ -16,8 +16,9 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.engine import Engine
 from tablebot.formats.table_read import load_table
-from tablebot.hw.txt.wiring import PWM_STEP, InputWire, OutputWire, TxtWiring, level_pwm
+from tablebot.hw.txt.wiring import InputWire, OutputWire, TxtWiring, level_pwm
 from tablebot.hw.txt4.export import export_txt4
+from tablebot.hw.wiring import InputWire as SerialInputWire
 from tablebot.loop import Reading, RealTimeClock, run
 from tablebot.machine import compile_table
 from tablebot.sensors import Sensor, threshold_event
@@ -62,6 +63,8 @@ def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(tmp_path: Path,
     wire = InputWire("I1", 0, "ultrasonic", below=None if above else limit, above=limit if above else None,
                      hysteresis=hysteresis)
     assert events(lambda v, on: wire.reads(v, on), readings) == the_rule  # the TXT
+    serial = SerialInputWire("I1", "I1", "ultrasonic", below=wire.below, above=wire.above, hysteresis=hysteresis)
+    assert events(lambda v, on: serial.reads(v, on), readings) == the_rule  # the ROBO TX and ROBO Interface
 
     p = np.zeros(L.N_PARAM)  # the simulator's compiled sensing, readings in metres
     p[L.P_SENSOR: L.P_SENSOR + L.SENSOR_FIELDS] = sensor_fields(sensor)
@@ -84,7 +87,7 @@ def test_the_txt4_program_scales_speeds_and_lamps_as_the_txt(tmp_path: Path, mon
     """Every level -10..10 on a motor, a reversed motor and a lamp: the PWM the TXT 4.0 program sets is the
     one the TXT's wiring sends, both :func:`level_pwm`."""
     levels = list(range(-10, 11))
-    assert [level_pwm(v) for v in levels] == [max(0, min(8, v)) * PWM_STEP for v in levels]
+    assert [level_pwm(v) for v in levels] == [max(0, min(8, v)) * 64 for v in levels]  # level 8 = PWM 512
     table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "switch", "bit": 1, "invert": False, "below": None,
                          "above": None}],
              "motors": [{"name": "A", "output": 0, "terminal": 1, "reverse": False, "encoder": False},

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tablebot.hw.txt import protocol as wire
+from tablebot.hw.wiring import level_duty
 from tablebot.sensors import threshold_event
-from tablebot.table import MAX_SPEED
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
@@ -33,14 +33,13 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
     from tablebot.sensors import Sensor
 
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
-PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 (MAX_SPEED = MAX_LAMP) = PWM 512
 
 
 def level_pwm(level: int) -> int:
     """A motor's speed (its size) or a lamp's level, 0..8, as the TXT family's PWM 0..512 (a level beyond 8 is 8,
-    one below 0 is off): THE scaling of the TXT and the TXT 4.0, whose standalone program carries a copy that
-    ``tests/test_rules.py`` proves equal to this one."""
-    return max(0, min(MAX_SPEED, level)) * PWM_STEP
+    one below 0 is off; :func:`tablebot.hw.wiring.level_duty`): THE scaling of the TXT and the TXT 4.0, whose
+    standalone program carries a copy that ``tests/test_rules.py`` proves equal to this one."""
+    return level_duty(level, wire.MAX_PWM)
 
 
 #: mode -> (the controller's input mode (digital), the polarity key, its meaning, the controller's reading
