@@ -22,7 +22,7 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
-from tablebot.testing.executors import random_world
+from tablebot.testing.harness import random_world
 from tablebot.testing.random_tables import Shape, random_table
 from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
