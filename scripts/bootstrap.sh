@@ -22,14 +22,19 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
 fi
 
+# Each step says what it does before it starts: the first set-up takes minutes, and must not look hung.
 PYTHON=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
+  echo "creating .venv (a Python virtual environment for tablebot) with $PYTHON"
   "$PYTHON" -m venv .venv
 fi
 if [ ! -f .venv/.installed ] || [ pyproject.toml -nt .venv/.installed ]; then
+  echo "installing tablebot and its Python packages into .venv (numpy, numba, matplotlib, typer, rich, dask,"
+  echo "  playwright, ...; see pyproject.toml): a few minutes the first time"
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e '.[dev]'
   touch .venv/.installed
+  echo "installed; .venv/bin/tablebot --help lists the commands"
 fi
 
 # ESLint for the studio's front end, exactly as package-lock.json pins it (node_modules/ is not in git).

@@ -238,15 +238,15 @@ def _empty_properties(motors: list[str]) -> str:
 
 
 def write_folder(folder: Path, template: Template) -> list[Path]:
-    """Write the template's files into ``folder`` (created; it must be empty), each atomically."""
+    """Write the template's files into ``folder`` (it must not exist, or be empty): the folder appears
+    with all of them at once, or not at all."""
     from tablebot.files import write_text
+    from tablebot.fileset import new_folder
 
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         what = "this is a file, not a folder" if not folder.is_dir() else "this folder is not empty"
         raise fail(folder, what, "give the name of a new folder (tablebot new never writes over files)")
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name in FILES:
-        write_text(folder / name, template.files[name])
-        written.append(folder / name)
-    return written
+    with new_folder(folder) as stage:
+        for name in FILES:
+            write_text(stage / name, template.files[name])
+    return [folder / name for name in FILES]

@@ -55,7 +55,8 @@ def run_cmd(
     behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when a tick starts this "
                                        "many seconds late, rather than stretch the table's timers (0: never)."),
     seed: int = typer.Option(1, "--seed", min=0, help="sim: the seed of all simulated noise (as tablebot sim)."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary (a run that fails still "
+                               "says why)."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Run TABLE on a real robot (or the simulator, in real time): outputs off on Ctrl-C, SIGTERM, any error
@@ -100,6 +101,11 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
         sys.setswitchinterval(switch)
     if not quiet:
         _report(end, machine, trace)
+    elif end.exit_code:  # quiet hides the live view and the summary, never why a run failed
+        why = f" — {end.message}" if end.message else ""
+        err_console.print(terminal(f"ran {end.ticks} ticks: {end.reason}{why}"))
+        for path in trace.files if trace is not None else []:
+            err_console.print(terminal(f"kept {path}"))
     return end
 
 

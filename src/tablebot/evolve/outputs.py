@@ -18,7 +18,8 @@ from tablebot.evolve.measures import Measure, fitness
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.report import Written, heat_map, measure_rows, paired, sim_command, write_table
 from tablebot.evolve.run import Outcome, Settings
-from tablebot.files import write_text
+from tablebot.files import remove, write_text
+from tablebot.fileset import current, file_set
 from tablebot.table import Table
 
 BEST = 3  # best tables written (elites of the best cells)
@@ -61,17 +62,25 @@ def forget_own(out: Path) -> None:
     for name, digest in json.loads(manifest.read_text(encoding="utf-8")).items():
         path = out / name
         if path.is_file() and hashlib.sha256(path.read_bytes()).hexdigest() == digest:
-            path.unlink()
+            remove(path)  # inside write_all's set: gone when the new tables are swapped in
 
 
 def remember_own(out: Path, paths: Sequence[Path]) -> Path:
-    digests = {str(p.relative_to(out)): hashlib.sha256(p.read_bytes()).hexdigest() for p in paths if p.is_file()}
+    digests = {str(p.relative_to(out)): hashlib.sha256(current(p).read_bytes()).hexdigest() for p in paths
+               if current(p).is_file()}  # the files as written into the set, before it is swapped in
     return write_text(out / MANIFEST, json.dumps(digests, indent=1, sort_keys=True) + "\n")
 
 
 def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
               out: Path, names: Sequence[str], world: str) -> list[Path]:
-    """Every table, check report, the heat map, evaluations.csv and report.md; returns the paths written."""
+    """Every table, check report, the heat map, evaluations.csv and report.md, replacing the previous run's
+    all at once (tablebot.fileset); returns the paths written."""
+    with file_set(out):
+        return _write_all(outcome, settings, base, prover, evaluator, check, out, names, world)
+
+
+def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
+               out: Path, names: Sequence[str], world: str) -> list[Path]:
     forget_own(out)
     best = best_keys(outcome)
     start, seeds = outcome.start_key, outcome.seeds
@@ -83,7 +92,6 @@ def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover,
     for k, key in enumerate(best):
         written.append(write_table(outcome.candidates[key], base, out / f"best-{k + 1}.csv", prover,
                                    f"best-{k + 1}", key))
-    (out / "elites").mkdir(exist_ok=True)
     for key, _, _, cell in qd.elites(outcome.archive):
         name = "cell-" + "-".join(f"{c:02d}" for c in cell)
         written.append(write_table(outcome.candidates[key], base, out / "elites" / f"{name}.csv", prover,

@@ -16,6 +16,7 @@ from pathlib import Path
 from tablebot.csvtext import read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.files import atomic_write, write_text
+from tablebot.fileset import file_set
 from tablebot.robot import STATE_RE, Robot, StateId
 from tablebot.table import (
     DOC_KEEP_SPEED,
@@ -120,19 +121,21 @@ def encode(table: Table) -> Lists:
 
 
 def write_lists(lists: Lists, outdir: Path) -> list[Path]:
-    """Write event.csv, action.csv, timer.csv (one value per line) and states.csv for names."""
-    outdir.mkdir(parents=True, exist_ok=True)
+    """Write event.csv, action.csv, timer.csv (one value per line) and states.csv for names, replacing the
+    previous lists at once (an earlier states.csv goes when these states have no names: import would
+    read it back onto the wrong table)."""
     written = []
-    for name, values in zip(LIST_FILES, (lists.event, lists.action, lists.timer), strict=True):
-        written.append(write_text(outdir / name, "".join(f"{v}\n" for v in values)))
-    if any(not isinstance(s, int) for s in lists.numbers):
-        path = outdir / STATES_FILE
-        with atomic_write(path, newline="") as f:
-            writer = csv.writer(f, lineterminator="\n")
-            writer.writerow(["number", "name"])
-            named = [(n, s) for s, n in lists.numbers.items() if not isinstance(s, int)]  # ints are their number
-            writer.writerows(sorted(named))
-        written.append(path)
+    with file_set(outdir, remove=[STATES_FILE]):
+        for name, values in zip(LIST_FILES, (lists.event, lists.action, lists.timer), strict=True):
+            written.append(write_text(outdir / name, "".join(f"{v}\n" for v in values)))
+        if any(not isinstance(s, int) for s in lists.numbers):
+            path = outdir / STATES_FILE
+            with atomic_write(path, newline="") as f:
+                writer = csv.writer(f, lineterminator="\n")
+                writer.writerow(["number", "name"])
+                named = [(n, s) for s, n in lists.numbers.items() if not isinstance(s, int)]  # ints are their number
+                writer.writerows(sorted(named))
+            written.append(path)
     return written
 
 

@@ -17,6 +17,7 @@ from typing import Any
 
 from tablebot.escape import python_string
 from tablebot.files import write_text
+from tablebot.fileset import file_set
 from tablebot.hw.txt.wiring import TxtWiring, txt_wiring
 from tablebot.machine import Machine
 
@@ -37,12 +38,9 @@ class Workspace:
     files: dict[str, str]
 
     def write(self, folder: Path) -> list[Path]:
-        written = []
-        for relative, text in self.files.items():
-            path = folder / relative
-            path.parent.mkdir(parents=True, exist_ok=True)
-            written.append(write_text(path, text, newline="\n"))
-        return written
+        """The workspace into ``folder``, replacing the previous one's files at once."""
+        with file_set(folder):
+            return [write_text(folder / relative, text, newline="\n") for relative, text in self.files.items()]
 
 
 def workspace_name(machine: Machine) -> str:
