@@ -50,12 +50,12 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def _write_sim_trace(root: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import run, write_trace
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
 
     table, machine = load(root)
     with (root / "trace.jsonl").open("w", encoding="utf-8") as f:
-        write_trace(run(scene_for(table, machine), 20.0, 1), f)
+        simulate(scene_for(table, machine), 20.0, 1).write_trace(f)
 
 
 @pytest.fixture(scope="module")
@@ -280,7 +280,7 @@ def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
 def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path,
                                                                   shots: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import block_of, run
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
     from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
@@ -292,8 +292,8 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     table_csv.write_text(table_csv.read_text().replace("Seek - Turn", hostile.replace('"', '""').join('""')))
     table, machine = load(folder)
     scene = scene_for(table, machine)
-    result = run(scene, 30.0, 1)
-    page_file = write_html(tmp_path / "run.html", block_lines(block_of(result), machine), scene.world, table,
+    result = simulate(scene, 30.0, 1)
+    page_file = write_html(tmp_path / "run.html", block_lines(result.block(), machine), scene.world, table,
                            params=scene.params)
     text = page_file.read_text()
     assert text.lower().count("</script") == 2

@@ -43,7 +43,7 @@ def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple 
           behind_limit_s: float | None = None) -> RunEnd:
     robot = TxtRobot(txt_wiring(machine), "127.0.0.1", fake.port, link_timeout_s=timeout_s)
     robot.connect()
-    clock = RealTimeClock(machine.table.robot.tick_ms / 1000)
+    clock = RealTimeClock(machine.table.robot.tick_s)
     end = run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="txt",
               behind_limit_s=behind_limit_s)
     fake_settles(fake)

@@ -373,7 +373,7 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
     """
     clock = clock or SimulatedClock()
     watchdog = watchdog or Watchdog(None)
-    tick_s = engine.machine.table.robot.tick_ms / 1000
+    tick_s = engine.machine.table.robot.tick_s
     late = Lateness(tick_s)
     pace = Pace(tick_s, behind_limit_s) if behind_limit_s else None
     info = RunInfo(engine, tick_s, target, ticks)
@@ -427,6 +427,15 @@ def _end_sinks(sinks: Sequence[Sink], end: RunEnd) -> Exception | None:
     return first
 
 
+def exchange(engine: Engine, robot: RobotIO) -> Reading:
+    """One tick's work with a robot: read it, step the engine on what it read, write the outputs; returns the
+    reading. The loop does this every tick (inside the watchdog); so does the Gymnasium env when the table
+    drives, so that a tick means the same everywhere."""
+    reading = robot.read()
+    robot.write(engine.step(reading.mask, reading.pulses))
+    return reading
+
+
 def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
                watchdog: Watchdog, late: Lateness, pace: Pace | None, stop: StopRequest) -> None:
     """One tick at a time: the path of real robots and of the real-time rehearsal."""
@@ -437,9 +446,7 @@ def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sin
         if pace is not None:
             pace.note(engine.tick, clock.behind_s)
         watchdog.arm()
-        reading = robot.read()
-        outputs = engine.step(reading.mask, reading.pulses)
-        robot.write(outputs)
+        reading = exchange(engine, robot)
         watchdog.disarm()
         block = TickBlock.of_tick(engine, reading, {"late_ms": round(1000 * delay, 3)} if not clock.free_running
                                   else None)

@@ -15,6 +15,7 @@ from tablebot.formats.trace_lines import exact_round
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
+from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
@@ -40,6 +41,7 @@ class SimRobot:
         self.light_keys = light_keys(scene)
         self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
         self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
+        self._observation: Observation | None = None
         self.reset(seed=seed)
 
     # --- Gymnasium-style life cycle ---------------------------------------------------------------
@@ -155,6 +157,12 @@ class SimRobot:
         row = int(self.acc[K.A_REACHED])
         return None if row < 0 else row
 
+    def observation(self) -> np.ndarray:
+        """What a learning agent sees of the robot now (:class:`tablebot.sim.observation.Observation`)."""
+        if self._observation is None:
+            self._observation = Observation.of(self.scene)
+        return self._observation(self.s[None, :])[0]
+
 
 def light_keys(scene: Scene) -> tuple[str, str]:
     """The trace's names for the light each phototransistor received: ``I7_light`` and ``I8_light``."""
@@ -178,7 +186,7 @@ def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
             *sensor_columns(scene))
 
 
-def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
+def field_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
     columns: dict[str, list] = {}
@@ -223,7 +231,7 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __getitem__(self, key: str) -> Sequence[float]:
         if self._columns is None:
-            self._columns = trace_columns(self.scene, self.hist)
+            self._columns = field_columns(self.scene, self.hist)
         return self._columns[key]
 
     def __iter__(self) -> Iterator[str]:
