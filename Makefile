@@ -15,8 +15,8 @@ demo: setup
 # pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
 # once first), then the wall-clock ones (marked realtime there) alone.
 test: setup
-	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime"
-	.venv/bin/python -m pytest -n 0 -m realtime
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15
+	.venv/bin/python -m pytest -n 0 -m realtime --durations=5
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .
 	node_modules/.bin/eslint src/tablebot/web/static eslint.config.js

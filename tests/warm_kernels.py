@@ -3,7 +3,8 @@
 Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
 take, on the smallest input that reaches each kernel with the argument types the tests give it:
 ``sim`` (one robot's loop, the tick-by-tick robot, the engine's batch loop on both mask types) and
-``fleet`` (the fleet loop, the env's physics-only loop, pyribs' archive). Numba caches one machine
+``fleet`` (the fleet loop, the env's physics-only loop) and ``archive`` (pyribs' grid archive, which
+compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache). Numba caches one machine
 code per argument types, so a kernel reached here with other types than a test's is compiled again
 by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
 """
@@ -50,7 +51,15 @@ def warm_fleet() -> None:
     env.close()
 
 
-PARTS = {"sim": warm_sim, "fleet": warm_fleet}
+def warm_archive() -> None:
+    from tablebot.evolve.archive import add, make_archive
+    from tablebot.evolve.measures import Descriptor
+
+    for descriptors in ([Descriptor("a", 0.0, 1.0, 4)], [Descriptor("a", 0.0, 1.0, 4), Descriptor("b", 0.0, 1.0, 4)]):
+        add(make_archive(descriptors), ["x", "y"], [1.0, 2.0], [[0.2] * len(descriptors), [0.7] * len(descriptors)])
+
+
+PARTS = {"sim": warm_sim, "fleet": warm_fleet, "archive": warm_archive}
 
 if __name__ == "__main__":
     for name in sys.argv[1:] or list(PARTS):
