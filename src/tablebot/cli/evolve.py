@@ -3,7 +3,6 @@ a quality-diversity archive of tables that behave differently, written as tables
 
 from __future__ import annotations
 
-import signal
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -24,10 +23,7 @@ class Setup:
     space: Any  # tablebot.evolve.operators.Space
     files: list[Path]
     names: list[str]
-
-
-class Terminated(Exception):
-    """SIGTERM arrived: stop as Ctrl-C does (what was evaluated is kept), exit 143."""
+    replay: Any = None  # tablebot.evolve.report.Replay: what the report's commands need
 
 
 @app.command("evolve")
@@ -84,6 +80,7 @@ def evolve_cmd(
         raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, freeze_state or [],
                    freeze_cell or [], properties)
+    setup = replace(setup, replay=_replay(plan, seeds, grid or ["start=random"], out))
     out_folder(out, "--out")
     _run(plan, check, setup, out, chosen, address, workers, quiet)
 
@@ -119,6 +116,13 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     return Setup(settings, Space(base.states, base.robot.motors, limits), files, names)
 
 
+def _replay(plan: Any, seeds: str, grid: list[str], out: Path) -> Any:
+    from tablebot.evolve.report import Replay
+
+    return Replay(plan.table.robot.source, tuple(map(str, plan.spec.worlds)), plan.spec.ticks * plan.scenes[0].tick_s,
+                  seeds, tuple(grid), out)
+
+
 def _spec(plan: Any, setup: Setup) -> dict[str, Any]:
     """What makes two runs the same run (a resumed one must be): the scenarios, properties and options."""
     from tablebot.fleet.spec import digest
@@ -139,11 +143,11 @@ def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: 
     from tablebot.evolve.proofs import Prover
     from tablebot.evolve.run import Evolution, Store
     from tablebot.fleet.backends import Runner
+    from tablebot.interrupts import INTERRUPTS, Terminated
 
     settings = setup.settings
     store = Store(out, _spec(plan, setup))
     prover = Prover(setup.files, store.proofs)
-    previous = signal.signal(signal.SIGTERM, _terminated)
     started = time.perf_counter()
     evolution = None
     try:
@@ -153,22 +157,32 @@ def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: 
                                   on_eval=bar.advance, on_repair=lambda repairs: _said_repairs(repairs, quiet))
             outcome = evolution.run()
             written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup.names,
-                                plan.spec.worlds[0])
-    except (KeyboardInterrupt, Terminated) as exc:
+                                setup.replay)
+    except INTERRUPTS as exc:  # SIGTERM raises Terminated while a command runs (cli.common.guarded)
         kept = len(evolution.store.open()) if evolution else 0
         err_console.print(f"{'terminated' if isinstance(exc, Terminated) else 'interrupted'}: {kept} tables "
                           f"evaluated so far are kept in {out}; run the same command again to resume",
                           markup=False, soft_wrap=True)
         raise typer.Exit(143 if isinstance(exc, Terminated) else 130) from None
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     if not quiet:
         console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
-        rate = evaluator.robot_ticks / max(outcome.counts.fleet_s, 1e-9)
-        console.print(f"({len(outcome.order)} tables in {time.perf_counter() - started:.0f} s; the fleet ran "
-                      f"{rate / 1e6:.2f} M robot-ticks/s while it ran)", markup=False)
+        console.print(_pace(outcome, plan, time.perf_counter() - started), markup=False)
         for path in written:
             err_console.print(f"wrote {path}", markup=False)
+
+
+def _pace(outcome: Any, plan: Any, wall: float) -> str:
+    """The run's pace: tables and robot-ticks of the search per second of the fleet's time (the fresh-seed
+    check after it not counted); a resumed run says how many tables it took from the folder."""
+    counts = outcome.counts
+    said = f"({len(outcome.order)} tables in {wall:.0f} s"
+    if counts.resumed:
+        said += f", {counts.resumed} of them from the earlier run in this folder"
+    if counts.evaluated and counts.fleet_s > 0:
+        ticks = counts.evaluated * plan.spec.total * plan.spec.ticks
+        said += (f"; the search ran {counts.evaluated / counts.fleet_s:.1f} tables/s, "
+                 f"{ticks / counts.fleet_s / 1e6:.2f} M robot-ticks/s on the fleet")
+    return said + ")"
 
 
 def _said_repairs(repairs: list[Any], quiet: bool) -> None:
@@ -178,7 +192,3 @@ def _said_repairs(repairs: list[Any], quiet: bool) -> None:
         state = "mended it" if r.ok else f"could not mend {', '.join(r.failing)}"
         err_console.print(f"repair {k + 1}: the starting table breaks a property; {len(r.steps)} guard rows "
                           f"{state}", markup=False)
-
-
-def _terminated(signum: int, frame: object) -> None:
-    raise Terminated()

@@ -119,15 +119,54 @@ def check_text(report: CheckReport, prover: Prover) -> str:
     return "\n".join(lines) + "\n"
 
 
-def sim_command(path: Path, base: Table, world: str, seed: int | None = None) -> str:
-    """``tablebot sim`` of a written table with the robot file and world it was evolved with (beside it in
-    OUT there are neither, and on its own it would be read as the built-in BumberBot)."""
-    words = ["tablebot", "sim", str(path)]
-    for option, given in (("--robot", base.robot.source), ("--world", world)):
-        if given and Path(given).is_file():
-            words += [option, str(given)]
-    if seed is not None:
-        words += ["--seed", str(seed)]
+@dataclass(frozen=True)
+class Replay:
+    """How the written tables were run, for the commands that run one again: the robot file, every world,
+    the seconds of each run, the search's ``--seeds`` and ``--grid``, and the output folder."""
+
+    robot: str | None
+    worlds: tuple[str, ...]
+    seconds: float
+    seeds: str
+    grid: tuple[str, ...]
+    out: Path
+
+
+def _files_given(replay: Replay, worlds: Sequence[str]) -> list[str]:
+    """``--robot`` and ``--world`` for the files the search read (beside a written table in OUT there are
+    neither, and on its own the table would be read as the built-in BumberBot)."""
+    words = ["--robot", str(replay.robot)] if replay.robot and Path(replay.robot).is_file() else []
+    for world in worlds:
+        if world and Path(world).is_file():
+            words += ["--world", str(world)]
+    return words
+
+
+def world_names(worlds: Sequence[str]) -> list[str]:
+    """A short name per world (its file's stem; numbered when two stems are the same)."""
+    stems = [Path(w).stem or "world" for w in worlds]
+    return [stem if stems.count(stem) == 1 else f"{k + 1}-{stem}" for k, stem in enumerate(stems)]
+
+
+def sim_commands(path: Path, label: str, replay: Replay) -> list[tuple[str, str]]:
+    """Per world of the search, its name and the ``tablebot sim`` of a written table there, as long as the
+    search ran it, into its own folder under ``OUT/sim`` (so no run writes over another's)."""
+    names = world_names(replay.worlds)
+    found = []
+    for world, name in zip(replay.worlds, names, strict=True):
+        out = replay.out / "sim" / label if len(replay.worlds) == 1 else replay.out / "sim" / label / name
+        words = ["tablebot", "sim", str(path), *_files_given(replay, [world]), "--seconds", f"{replay.seconds:g}",
+                 "--out", str(out)]
+        found.append((name, " ".join(shell_word(word) for word in words)))
+    return found
+
+
+def sweep_command(path: Path, label: str, replay: Replay) -> str:
+    """``tablebot sweep`` of a written table on every world and scenario the search ran it on."""
+    words = ["tablebot", "sweep", str(path), *_files_given(replay, replay.worlds), "--seeds", replay.seeds]
+    for grid in replay.grid:
+        words += ["--grid", grid]
+    words += ["--seconds", f"{replay.seconds:g}", "--out", str(replay.out / "sweep" / label)]
     return " ".join(shell_word(word) for word in words)
 
 
