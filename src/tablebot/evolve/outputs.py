@@ -158,11 +158,12 @@ def tables_section(outcome: Outcome, objective: Measure, written: list[Written],
                 "search scenarios)")
         commands = sim_commands(w.path, w.label, replay)
         if several:
-            lines += [f"{head}:", *(f"  - {name}: `{command}`" for name, command in commands)]
+            lines += [f"{head}:", *(f"  - in {world}: `{command}`"
+                                    for world, (_, command) in zip(replay.worlds, commands, strict=True))]
         else:
             lines.append(f"{head}: `{commands[0][1]}`")
     if written:
-        first = written[0]
+        first = next((w for w in written if w.label == "best-1"), written[0])
         lines += ["", f"Run a table on every scenario and world it was evolved on at once (`{first.label}` here; "
                   "any table above in its place):", "", f"`{sweep_command(first.path, first.label, replay)}`"]
     return lines
