@@ -79,7 +79,7 @@ def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_r
                                                           dask_cluster: str) -> None:  # noqa: F811
     code, output = evolve(str(LINE), "--out", str(tmp_path / "dask"), *LINE_RUN, "--scheduler", dask_cluster)
     assert code == 0, output
-    assert "# Evolving table.csv: laps (high is better)" in output
+    assert "# Evolving line-follower/table.csv: laps (high is better)" in output
     same_results(line_run, tmp_path / "dask")
 
 

@@ -43,7 +43,8 @@ def evolve_cmd(
                                            'collision_share).'),
     cells: int = typer.Option(8, "--cells", min=2, max=100, help="Archive cells per descriptor."),
     budget: int = typer.Option(200, "--budget", min=1, help="Most tables to run on the fleet (the start included)."),
-    batch: int = typer.Option(16, "--batch", min=1, help="Tables asked for per generation."),
+    batch: int | None = typer.Option(None, "--batch", min=1, help="Tables asked for per generation (default: 16, "
+                                     "or the budget when it is smaller)."),
     seeds: str = typer.Option("0..15", "--seeds", help="Seeds of the scenarios every table runs."),
     check_seeds: str = typer.Option("1000..1063", "--check-seeds", help="Fresh seeds for the before/after report."),
     grid: list[str] | None = typer.Option(None, "--grid", help='Scenario grid as in sweep (default: "start=random").'),
@@ -76,11 +77,13 @@ def evolve_cmd(
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
+    batch = min(16, budget) if batch is None else batch
     if batch > budget:
         raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, freeze_state or [],
                    freeze_cell or [], properties)
     setup = replace(setup, replay=_replay(plan, seeds, grid or ["start=random"], out))
+    _own_folder(out, plan, setup.files)
     out_folder(out, "--out")
     _run(plan, check, setup, out, chosen, address, workers, quiet)
 
@@ -99,7 +102,8 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     base = plan.table
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
     measure = measures.check_objective(objective or measures.default_objective(plan.worlds), plan.worlds)
-    chosen = measures.parse_descriptors(descriptors or measures.default_descriptors(plan.worlds), plan.worlds,
+    text = measures.default_descriptors(plan.worlds) if descriptors is None else descriptors
+    chosen = measures.parse_descriptors(text, plan.worlds,
                                         base.states, seconds, cells)
     rows = max_rows or space.default_max_rows(base)
     if rows < len(base.rows):
@@ -114,6 +118,22 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     names += [d.name for d in chosen if d.name not in names]
     settings = Settings(measure, tuple(chosen), budget, batch, seed)
     return Setup(settings, Space(base.states, base.robot.motors, limits), files, names)
+
+
+def _own_folder(out: Path, plan: Any, properties: list[Path]) -> None:
+    """--out must not be a folder the run reads from: its tables, reports and records would lie among the
+    robot's own files (and a table named best-1.csv there would be a user's)."""
+    from tablebot.diagnostics import fail
+
+    inputs = [Path(plan.table.path), *(Path(w) for w in plan.spec.worlds if w), *properties]
+    if plan.table.robot.source:
+        inputs.append(Path(plan.table.robot.source))
+    here = out.resolve()
+    for path in inputs:
+        if path.is_file() and path.resolve().parent == here:
+            raise fail("--out", f"--out {out} is the folder of {path.name}, which evolve reads: its tables, reports "
+                       "and records would lie among the robot's own files", "give --out a folder of its own, such as "
+                       "out/evolve")
 
 
 def _replay(plan: Any, seeds: str, grid: list[str], out: Path) -> Any:

@@ -131,10 +131,13 @@ def report_text(outcome: Outcome, settings: Settings, base: Table, prover: Prove
     objective = settings.objective
     plan = evaluator.plan
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
-    lines = [f"# Evolving {Path(base.path).name}: {objective.name} ({objective.better} is better)", "",
+    where, generations = Path(base.path), outcome.counts.generations
+    lines = [f"# Evolving {where.parent.name}/{where.name}: {objective.name} ({objective.better} is better)", "",
              f"{len(outcome.order)} tables run on the fleet, each on {plan.spec.total} scenarios "
-             f"({len(plan.spec.seeds)} seeds × {len(plan.spec.worlds)} world(s), {seconds:g} s each), "
-             f"{outcome.counts.generations} generations of up to {settings.batch}, seed {settings.seed}; "
+             f"({len(plan.spec.seeds)} seeds × {len(plan.spec.worlds)} world(s)"
+             f"{''.join(f', --grid {g}' for g in replay.grid)}, {seconds:g} s each), "
+             f"{generations} generation{'' if generations == 1 else 's'} of up to {settings.batch}, "
+             f"seed {settings.seed}; "
              f"{outcome.seconds:.0f} s.", ""]
     lines += start_section(outcome, base)
     lines += search_section(outcome, prover)

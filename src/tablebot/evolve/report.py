@@ -209,7 +209,8 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         ax.set_ylabel(f"{second.name}")
         if start is not None:
             ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
-                    color="#e8413a", markersize=12, mew=2.5, label="the starting table")
+                    color="#e8413a", markersize=12, mew=2.5, label="the starting table",
+                    clip_on=False)  # on the grid's edge (a value beyond the range) it shows whole
             ax.legend(fontsize=8, loc="upper right")
     else:
         width = (first.high - first.low) / first.cells
