@@ -43,8 +43,8 @@ def evolve_cmd(
                                            'collision_share).'),
     cells: int = typer.Option(8, "--cells", min=2, max=100, help="Archive cells per descriptor."),
     budget: int = typer.Option(200, "--budget", min=1, help="Most tables to run on the fleet (the start included)."),
-    batch: int | None = typer.Option(None, "--batch", min=1, help="Tables asked for per generation (default: 16, "
-                                     "or the budget when it is smaller)."),
+    batch: int | None = typer.Option(None, "--batch", min=1, help="Tables asked for per generation "
+                                     "(default: 16; a last generation takes what the budget has room for)."),
     seeds: str = typer.Option("0..15", "--seeds", help="Seeds of the scenarios every table runs."),
     check_seeds: str = typer.Option("1000..1063", "--check-seeds", help="Fresh seeds for the before/after report."),
     grid: list[str] | None = typer.Option(None, "--grid", help='Scenario grid as in sweep (default: "start=random").'),
@@ -77,9 +77,9 @@ def evolve_cmd(
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
-    batch = min(16, budget) if batch is None else batch
-    if batch > budget:
+    if batch is not None and batch > budget:
         raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
+    batch = batch or 16  # a budget below it takes what it has room for (the batch stays one, for resuming)
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, freeze_state or [],
                    freeze_cell or [], properties)
     setup = replace(setup, replay=_replay(plan, seeds, grid or ["start=random"], out))
