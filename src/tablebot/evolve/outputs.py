@@ -106,8 +106,9 @@ def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover
         written.append(write_table(outcome.candidates[key], base, out / "elites" / f"{name}.csv", prover,
                                    f"elites/{name}", key))
     start_at = tuple(outcome.means[start][d.name] for d in settings.descriptors)
+    label = "the starting table" if outcome.start_verdict.ok else "the starting table (breaks a property: not kept)"
     paths = [heat_map(outcome.archive, settings.descriptors, settings.objective, outcome.history, start_at,
-                      out / "archive.png"),
+                      out / "archive.png", label),
              write_evaluations(outcome, settings, out / "evaluations.csv")]
     text = report_text(outcome, settings, base, prover, evaluator, check, fresh, written, best, names, replay)
     paths.append(write_text(out / "report.md", text))

@@ -174,15 +174,15 @@ def sweep_command(path: Path, label: str, replay: Replay) -> str:
 
 
 def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-             start: tuple[float, ...] | None, path: Path) -> Path:
+             start: tuple[float, ...] | None, path: Path, start_label: str = "the starting table") -> Path:
     from tablebot.sim.draw import literal_text
 
     with literal_text():
-        return _heat_map(archive, descriptors, objective, history, start, path)
+        return _heat_map(archive, descriptors, objective, history, start, path, start_label)
 
 
 def _heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-              start: tuple[float, ...] | None, path: Path) -> Path:
+              start: tuple[float, ...] | None, path: Path, start_label: str) -> Path:
     """Left: each cell's elite coloured by its objective (the start marked); right: the best objective
     and the cells filled as the evaluations went on."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -209,18 +209,19 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         ax.set_ylabel(f"{second.name}")
         if start is not None:
             ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
-                    color="#e8413a", markersize=12, mew=2.5, label="the starting table",
+                    color="#e8413a", markersize=12, mew=2.5, label=start_label,
                     clip_on=False)  # on the grid's edge (a value beyond the range) it shows whole
-            ax.legend(fontsize=8, loc="upper right")
+            ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)  # off the cells
     else:
         width = (first.high - first.low) / first.cells
         lefts = [first.low + c[0] * width for c in cells]
         ax.bar(lefts, values, width=width * 0.9, align="edge", color="#20bf6b")
-        ax.set_ylabel(objective.name)
+        ax.set_xlim(first.low, first.high)  # the whole range, empty cells too
+        ax.set_ylabel(f"{objective.name} ({objective.better} is better)")
         if start is not None:
             ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--",
-                       label="the starting table")
-            ax.legend(fontsize=8)
+                       label=start_label)
+            ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)
     ax.set_xlabel(first.name)
     ax.set_title(f"archive: {len(values)} elites in {int(np.prod([d.cells for d in descriptors]))} cells",
                  fontsize=11)
@@ -234,8 +235,9 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
     twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
               label="cells filled")
     twin.set_ylabel("cells filled (%)")
-    side.legend(loc="upper left", fontsize=8)
-    twin.legend(loc="lower right", fontsize=8)
+    (lines, labels), (more_lines, more_labels) = side.get_legend_handles_labels(), twin.get_legend_handles_labels()
+    side.legend(lines + more_lines, labels + more_labels, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                fontsize=8, frameon=False)  # under the axes: inside, each legend covered one of the two lines
     side.set_title("search", fontsize=11)
     fig.tight_layout()
     return save(fig, path)
