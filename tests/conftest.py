@@ -66,6 +66,13 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     os.environ[SHARED] = shared  # the workers start after this hook, with this environment
 
 
+def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
+    """`-m realtime` (the serial pass) does not import the other ninety modules only to deselect them."""
+    if config.option.markexpr == "realtime" and collection_path.suffix == ".py":
+        return collection_path.stem.startswith("test_") and collection_path.stem not in REALTIME
+    return None
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
         module = item.path.stem
