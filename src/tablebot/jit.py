@@ -57,9 +57,18 @@ if not numba.config.CACHE_DIR:  # numba was imported before us: its cache locato
 prange = numba.prange
 
 
-def njit(*args: Any, **kwargs: Any) -> Callable[..., Any]:
-    """``numba.njit`` with the on-disk cache on: ``@njit`` or ``@njit(parallel=True)``."""
+def njit(*args: Any, refcounts: bool = True, **kwargs: Any) -> Callable[..., Any]:
+    """``numba.njit`` with the on-disk cache on: ``@njit`` or ``@njit(parallel=True)``.
+
+    ``refcounts=False`` compiles the function without numba's reference counting (its ``_nrt`` option):
+    every array a compiled function receives or slices is otherwise counted with an atomic increment and
+    decrement, and in the simulator's per-tick functions -- small, many, each handed a dozen arrays -- those
+    were half of a tick's time. Such a function must not create arrays (it cannot free them); it may use
+    the arrays it is given, and views of them, freely.
+    """
     kwargs.setdefault("cache", True)
+    if not refcounts:
+        kwargs["_nrt"] = False
     if args and callable(args[0]) and len(args) == 1 and not kwargs.keys() - {"cache"}:
         return numba.njit(cache=kwargs["cache"])(args[0])
     return numba.njit(*args, **kwargs)

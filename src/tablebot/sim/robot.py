@@ -14,6 +14,7 @@ from tablebot.engine import Engine
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import kernel as K
 from tablebot.sim import layout as L
+from tablebot.sim.normals import bitgen_address
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
@@ -21,6 +22,7 @@ from tablebot.trace import exact_round
 
 DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
 MAX_COLLISIONS = 4096  # collision starts remembered for the pictures (the count goes on beyond)
+NO_NOISE = np.empty((0, L.N_NOISE))  # advance: the compiled loop draws each tick's noise from the robot's Generator
 
 
 class SimRobot:
@@ -112,8 +114,8 @@ class SimRobot:
         hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
         start = engine.tick
         K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
-                    self.scene.bits, self._drive, self._pcols, self._noise(ticks), hist, ints, self.acc,
-                    self.collision_rows)
+                    self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
+                    self.acc, self.collision_rows)
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
