@@ -1,4 +1,5 @@
-# The two commands of the README: `make demo` and `make test`; both set themselves up first.
+# The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff); both set
+# themselves up first.
 .PHONY: setup demo test bench
 
 setup:
@@ -9,6 +10,7 @@ demo: setup
 
 test: setup
 	.venv/bin/python -m pytest
+	.venv/bin/lint-imports
 	.venv/bin/ruff check .
 
 bench: setup

@@ -38,8 +38,8 @@ def single_robot(ticks: int) -> float:
     from tablebot.cli.common import load
     from tablebot.engine import Engine
     from tablebot.loop import run as run_loop
-    from tablebot.sim.robot import SimRobot
     from tablebot.sim.scene import scene_for
+    from tablebot.sim.simrobot import SimRobot
 
     table, machine = load(EXAMPLE)
     scene = scene_for(table, machine)
@@ -52,7 +52,7 @@ def single_robot(ticks: int) -> float:
 def fleet(n: int, ticks: int) -> tuple[float, float]:
     """Robot-ticks/s of n robots in one in-process fleet, and the seconds to set the fleet up."""
     from tablebot.cli.common import load
-    from tablebot.sim.fleet import Fleet, RobotSpec
+    from tablebot.fleet.run import Fleet, RobotSpec
     from tablebot.sim.scene import robot_layer, scene_for
 
     table, machine = load(EXAMPLE)
@@ -138,7 +138,7 @@ def breakdown(repeat: int) -> dict[str, float]:
 
 
 def sweep_plan(robots: int, seconds: float):  # type: ignore[no-untyped-def]
-    from tablebot.cli.fleet import make_plan
+    from tablebot.cli.sweep import make_plan
 
     return make_plan(EXAMPLE, None, [], [], None, robots, seconds)
 
@@ -160,7 +160,7 @@ def dask_vs_local(robots: int, seconds: float, repeat: int) -> tuple[list[float]
     and load the kernels once, as the Dask workers do, so the ratio is the scheduling overhead alone."""
     from distributed import LocalCluster
 
-    from tablebot.sweep_backends import Runner
+    from tablebot.fleet.backends import Runner
 
     plan = sweep_plan(robots, seconds)
     small = sweep_plan(64, 1.0)

@@ -24,10 +24,11 @@ from typing import Any
 
 from tablebot.firmware.build import BENCH_MAIN, build
 from tablebot.firmware.emulate import bench_steps, build_harness, emulate, summary
+from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
+from tablebot.replay import replay
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import TickInput, load_inputs, replay
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
 STEP_TARGET, FLASH_TARGET, RAM_TARGET = 100, 4096, 256

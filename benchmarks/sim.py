@@ -32,9 +32,9 @@ from pathlib import Path
 from tablebot.cli.common import load
 from tablebot.engine import Engine
 from tablebot.loop import run as run_loop
-from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import run
 from tablebot.sim.scene import scene_for
+from tablebot.sim.simrobot import SimRobot
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

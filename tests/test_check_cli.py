@@ -12,9 +12,11 @@ from typer.testing import CliRunner
 from tablebot.analysis.properties import load_properties
 from tablebot.analysis.prove import first_violation
 from tablebot.cli import app
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.formats.table_read import load_table
+from tablebot.formats.trace_lines import read_trace
 from tablebot.machine import compile_table
-from tablebot.trace import load_inputs, read_trace, replay
+from tablebot.replay import replay
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

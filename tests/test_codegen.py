@@ -14,12 +14,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tablebot.cli.common import load
-from tablebot.codegen import ENGINE_FILES, generate, template
 from tablebot.codegen.host import build_host, run_host
-from tablebot.codegen.layout import DENSE_LIMIT_BYTES, plan, reachable, unsigned_for
+from tablebot.codegen.packing import DENSE_LIMIT_BYTES, plan, reachable, unsigned_for
+from tablebot.codegen.source import ENGINE_FILES, generate, template
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import compile_table
+from tablebot.replay import replay
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

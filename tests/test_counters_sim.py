@@ -11,7 +11,7 @@ import pytest
 
 from tablebot.sim.runner import run
 from tablebot.sim.summary import summarise
-from tablebot.sim.sweep import turns
+from tablebot.sim.turn_drift import turns
 from test_sim_helpers import ROOT, scene_of, trace_text
 
 EXAMPLE = ROOT / "examples" / "bumberbot-counters"

@@ -9,8 +9,9 @@ import pytest
 
 from core_helpers import EXAMPLE, MINI_ROBOT, example_machine, machine_of
 from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import NO_ROW
-from tablebot.trace import load_inputs, record
+from tablebot.replay import record
 
 I3, I4, I5, I7, I8, T = 16, 8, 4, 2, 1, 32
 

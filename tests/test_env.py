@@ -6,14 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-gym = pytest.importorskip("gymnasium", reason="tablebot.env needs the research extra (gymnasium; the dev extra has it)")
+gym = pytest.importorskip("gymnasium", reason="tablebot.fleet.env needs the research extra (gymnasium)")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from gymnasium.vector import AutoresetMode  # noqa: E402
 from gymnasium.wrappers.vector import NormalizeObservation  # noqa: E402
 
 from tablebot.cli.common import load  # noqa: E402
-from tablebot.env import ENV_ID, TableBotEnv, TableBotVectorEnv, observe  # noqa: E402
+from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv, observe  # noqa: E402
 from tablebot.sim.runner import run  # noqa: E402
 from tablebot.sim.scene import scene_for  # noqa: E402
 from test_sim_helpers import BUMBERBOT  # noqa: E402

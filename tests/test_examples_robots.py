@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tablebot.cli import app
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.runner import run
 from tablebot.sim.summary import summarise
 from test_sim_helpers import ROOT, scene_of
@@ -77,7 +77,7 @@ def test_declared_sensors_are_traced_alike_tick_by_tick_and_compiled(example: st
     from tablebot.engine import Engine
     from tablebot.loop import SimulatedClock
     from tablebot.loop import run as run_loop
-    from tablebot.sim.robot import SimRobot
+    from tablebot.sim.simrobot import SimRobot
     from test_sim_live import Lines, TickByTick
 
     scene = scene_of(EXAMPLES / example / "table.csv")

@@ -16,11 +16,12 @@ from tablebot.firmware.board_header import timer_setting, ubrr
 from tablebot.firmware.boards import load_board, read_robot_boards, wire
 from tablebot.firmware.build import build
 from tablebot.firmware.emulate import build_harness, emulate, pins_csv
-from tablebot.formats.tomlfile import Source
+from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.machine import compile_table
+from tablebot.replay import replay
 from tablebot.robot import BUMBERBOT, Counter, Robot
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import TickInput, load_inputs, replay
+from tablebot.tomlfile import Source
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

@@ -14,11 +14,12 @@ from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.framing import Decoder, encode
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.formats.robopro_program import rewrite
 from tablebot.machine import compile_table
+from tablebot.replay import replay
 from tablebot.robot import load_robot
 from tablebot.testing.random_tables import random_inputs, random_table
-from tablebot.trace import load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

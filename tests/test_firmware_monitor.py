@@ -12,13 +12,14 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.cli.common import load
-from tablebot.codegen.layout import plan
+from tablebot.codegen.packing import plan
 from tablebot.firmware.boards import load_board
 from tablebot.firmware.flash import avrdude_command
 from tablebot.firmware.framing import SYNC, Decoder, encode, hello_frame, tick_frame
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import compile_table
+from tablebot.replay import replay
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import load_inputs, replay
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

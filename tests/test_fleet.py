@@ -16,14 +16,14 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.cli.common import load
-from tablebot.formats.tomlfile import Source
+from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
-from tablebot.sim.fleet import Fleet, RobotSpec, Variants
 from tablebot.sim.runner import run
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
 from tablebot.testing.random_tables import Shape, random_table
+from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
 
 

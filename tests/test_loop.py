@@ -9,10 +9,11 @@ import pytest
 
 from core_helpers import EXAMPLE
 from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
 from tablebot.loop import LinkLost, Reading, RealTimeClock, RunEnd, RunInfo, TickBlock, Watchdog, run
 from tablebot.machine import compile_table
-from tablebot.trace import TickInput, replay
+from tablebot.replay import replay
 
 
 def bumberbot() -> Engine:

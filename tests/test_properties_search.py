@@ -13,12 +13,12 @@ from tablebot.analysis.conditions import parse_condition
 from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
 from tablebot.analysis.prove import check_property, first_violation, monitor_of, search
-from tablebot.formats.inputs_csv import write_inputs
+from tablebot.formats.inputs_csv import TickInput, load_inputs, write_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
+from tablebot.replay import replay
 from tablebot.robot import Robot
 from tablebot.table import Row, Table
-from tablebot.trace import TickInput, load_inputs, replay
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

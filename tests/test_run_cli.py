@@ -18,13 +18,14 @@ from rich.console import Console
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE
+from tablebot import registry
 from tablebot.cli import app
-from tablebot.cli.run import Target, parse_target
 from tablebot.engine import Engine
 from tablebot.formats.table_read import load_table
-from tablebot.hw.live_view import LiveView
+from tablebot.hw.txt.backend import ADDRESS_HINT, parse_address
 from tablebot.loop import Reading, RunInfo, TickBlock
 from tablebot.machine import compile_table
+from tablebot.sinks.live_view import LiveView
 from txt_fake import FakeTxt
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -138,10 +139,11 @@ def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(tmp_path:
 
 
 def test_targets_are_parsed_or_refused_with_the_option_named() -> None:
-    assert parse_target("txt://192.168.7.2") == Target("txt", "192.168.7.2", 65000)
-    assert parse_target("txt://10.0.0.9:6500") == Target("txt", "10.0.0.9", 6500)
-    assert parse_target("txt://auto") == Target("txt", None, 65000)
-    assert parse_target("sim:arena.toml") == Target("sim", world=Path("arena.toml"))
+    assert parse_address("txt://192.168.7.2", ADDRESS_HINT) == ("192.168.7.2", 65000)
+    assert parse_address("txt://10.0.0.9:6500", ADDRESS_HINT) == ("10.0.0.9", 6500)
+    assert parse_address("txt://auto", ADDRESS_HINT) == (None, 65000)
+    assert registry.live_for("sim:arena.toml") is registry.get("sim")
+    assert registry.live_for("txt://auto") is registry.get("txt") and registry.live_for("usb") is None
     for bad in ("usb", "txt://", "txt://host:99999", "txt://host:x"):
         result = invoke("run", EXAMPLE, "--on", bad)
         assert result.exit_code == 2 and result.output.startswith("--on: error:"), (bad, result.output)

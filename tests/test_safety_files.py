@@ -11,7 +11,8 @@ import pytest
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE
-from tablebot import guard
+from tablebot import files
+from tablebot import overwrite as guard
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from tablebot.files import PendingFile, atomic_write, replacing, write_text
@@ -147,7 +148,7 @@ def test_every_spelling_of_a_table_header_is_protected(tmp_path, header):
     """Reproduced: a table saved with a BOM before its state column was replaced without --force."""
     table = tmp_path / "mine.csv"
     table.write_bytes(header)
-    assert guard.is_user_file(table)
+    assert files.is_user_file(table)
     with guard.command(), pytest.raises(TableBotError, match="not replaced without --force"):
         write_text(table, "x")
     assert table.read_bytes() == header
@@ -157,7 +158,7 @@ def test_every_spelling_of_a_table_header_is_protected(tmp_path, header):
 def test_other_csv_files_are_not_tables(tmp_path, text):
     other = tmp_path / "data.csv"
     other.write_text(text)
-    assert not guard.is_user_file(other)
+    assert not files.is_user_file(other)
 
 
 def test_a_symlink_is_written_through(tmp_path):

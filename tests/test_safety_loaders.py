@@ -12,13 +12,13 @@ import pytest
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE, MINI_ROBOT, write_table
+from tablebot import csvtext
 from tablebot.cli import INTERNAL_ERROR, app, main
 from tablebot.diagnostics import TableBotError, notes_to
-from tablebot.formats import csvtext
 from tablebot.formats.robopro_lists import read_lists
 from tablebot.formats.table_read import load_table
+from tablebot.formats.trace_lines import read_trace
 from tablebot.robot import load_robot
-from tablebot.trace import read_trace
 
 runner = CliRunner()
 HEADER = "description,state,T,A,B,M1,M2,timer,next"
@@ -75,8 +75,8 @@ def test_dev_zero_stops_at_the_size_limit():
 @pytest.mark.parametrize("loader", ["table", "robot", "inputs", "trace"])
 def test_every_kind_of_input_has_a_size_limit(tmp_path, monkeypatch, loader):
     monkeypatch.setattr(csvtext, "MAX_TEXT_BYTES", 1000)
-    monkeypatch.setattr("tablebot.formats.tomlfile.MAX_TOML_BYTES", 1000)
-    monkeypatch.setattr("tablebot.trace.MAX_TRACE_BYTES", 1000)
+    monkeypatch.setattr("tablebot.tomlfile.MAX_TOML_BYTES", 1000)
+    monkeypatch.setattr("tablebot.formats.trace_lines.MAX_TRACE_BYTES", 1000)
     path = tmp_path / "big"
     path.write_text("#" * 1001)
     calls = {"table": lambda: load_table(path), "robot": lambda: load_robot(path), "trace": lambda: read_trace(path),

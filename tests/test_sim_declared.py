@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.physics import light_at, sense
 from tablebot.sim.runner import run
 from tablebot.sim.scene import Scene

@@ -13,11 +13,13 @@ from pathlib import Path
 import pytest
 
 from tablebot.engine import Engine
+from tablebot.formats.trace_lines import dumps
 from tablebot.loop import SimulatedClock, TickBlock
 from tablebot.loop import run as run_loop
-from tablebot.sim.robot import SimRobot
+from tablebot.replay import replay
 from tablebot.sim.runner import run
-from tablebot.trace import TraceFile, block_lines, dumps, replay
+from tablebot.sim.simrobot import SimRobot
+from tablebot.sinks.trace_file import TraceFile, block_lines
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 
 EXAMPLES = [(BUMBERBOT / "table.csv", None), (ROOT / "examples" / "bumberbot-counters" / "table.csv",

@@ -9,7 +9,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.params import Params, speed_per_volt, terminal_volts
 from tablebot.sim.runner import run
 from tablebot.sim.world import inside

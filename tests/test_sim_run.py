@@ -12,9 +12,9 @@ from typer.testing import CliRunner
 
 from tablebot.cli.app import app
 from tablebot.engine import Engine
+from tablebot.replay import record
 from tablebot.sim.runner import run
 from tablebot.sim.summary import summarise
-from tablebot.trace import record
 from test_sim_helpers import BUMBERBOT, room, scene_of, trace_text
 
 CORE_KEYS = ["tick", "event", "row", "state", "timer", "M1", "M2"]

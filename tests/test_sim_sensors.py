@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.runner import run
 from test_sim_helpers import BUMBERBOT, STRAIGHT, bot, room, scene_of, write_bot
 

@@ -225,7 +225,7 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     from tablebot.cli.common import load
     from tablebot.sim.runner import block_of, run
     from tablebot.sim.scene import scene_for
-    from tablebot.trace import block_lines
+    from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
 
     folder = tmp_path / "bot"

@@ -10,9 +10,9 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.cli.common import load
 from tablebot.loop import RunEnd, RunInfo, TickBlock
-from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import run as sim_run
 from tablebot.sim.scene import scene_for
+from tablebot.sim.simrobot import SimRobot
 from tablebot.web.live import LiveRun, PageClock
 
 

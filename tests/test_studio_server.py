@@ -29,13 +29,15 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Backgroun
     server.stop()
 
 
-def talk(url: str, messages: list[Any], until: str, limit: int = 20, seq: int | None = None) -> list[dict[str, Any]]:
-    """Send the messages (text as is, anything else as JSON) and collect replies up to one of type ``until``
-    (with ``seq``, if given)."""
+def talk(server: Background, messages: list[Any], until: str, limit: int = 20,
+         seq: int | None = None) -> list[dict[str, Any]]:
+    """Send the messages (text as is, anything else as JSON) as the studio's page would (its Origin and
+    token cookie) and collect replies up to one of type ``until`` (with ``seq``, if given)."""
 
     async def run() -> list[dict[str, Any]]:
         replies: list[dict[str, Any]] = []
-        async with websockets.connect(url.replace("http", "ws") + "ws", max_size=2**24) as ws:
+        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
+                                      additional_headers=server.headers) as ws:
             for message in messages:
                 await ws.send(message if isinstance(message, str) else json.dumps(message))
             while len(replies) < limit:
@@ -48,6 +50,11 @@ def talk(url: str, messages: list[Any], until: str, limit: int = 20, seq: int | 
     return asyncio.run(run())
 
 
+def get(server: Background, path: str, data: bytes | None = None) -> urllib.request.Request:
+    """A request as the studio's page makes it (its Origin and token cookie)."""
+    return urllib.request.Request(f"{server.origin}/{path}", data=data, headers=server.headers)
+
+
 def test_malformed_messages_get_error_replies_and_the_server_goes_on(studio: tuple[Background, Path]) -> None:
     server, _ = studio
     bad = ["not json", "[1, 2]", {"op": 5}, {"op": "explode"}, {"op": "edit", "row": 0, "col": 0, "value": "x"},
@@ -56,7 +63,7 @@ def test_malformed_messages_get_error_replies_and_the_server_goes_on(studio: tup
            {"op": "sim", "action": "speed", "speed": "warp"},
            {"op": "sim", "action": "hold", "input": "I99", "on": True},
            {"op": "sim", "action": "reset", "seed": -4}, {"op": "sim", "action": "reset", "charge": "full"}]
-    replies = talk(server.url, [*bad, {"op": "files"}], until="files", limit=40)
+    replies = talk(server, [*bad, {"op": "files"}], until="files", limit=40)
     errors = [r["message"] for r in replies if r["type"] == "error"]
     assert errors[:7] == ["not JSON: Expecting value", 'a message must be a JSON object with an "op"',
                           'a message must be a JSON object with an "op"', "unknown op 'explode'",
@@ -75,7 +82,7 @@ def test_nothing_outside_the_folder_is_opened(studio: tuple[Background, Path], p
     link = root / "link.csv"
     if not link.exists():
         link.symlink_to(root.parent / "secret.csv")
-    replies = talk(server.url, [{"op": "open", "path": path}, {"op": "trace", "path": path}], until="error", limit=1)
+    replies = talk(server, [{"op": "open", "path": path}, {"op": "trace", "path": path}], until="error", limit=1)
     assert replies[0]["type"] == "error" and "outside the served folder" in replies[0]["message"]
 
 
@@ -83,29 +90,29 @@ def test_static_files_stay_in_the_package(studio: tuple[Background, Path]) -> No
     server, _ = studio
     for path in ("static/../app.py", "static/%2e%2e/app.py", "static/..%2fapp.py", "table.csv"):
         with pytest.raises(urllib.error.HTTPError) as err:
-            urllib.request.urlopen(server.url + path)
+            urllib.request.urlopen(get(server, path))
         assert err.value.code == 404
     page = urllib.request.urlopen(server.url)
     assert "script-src 'self'" in page.headers["Content-Security-Policy"]
-    assert b"http" not in urllib.request.urlopen(server.url + "static/js/studio.js").read().replace(
+    assert b"http" not in urllib.request.urlopen(get(server, "static/js/studio.js")).read().replace(
         b"location.protocol === \"https:\"", b"")  # no script is fetched from anywhere else
 
 
 def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background, Path]) -> None:
     server, _ = studio
     good = b'{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}\n'
-    reply = json.load(urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=good)))
+    reply = json.load(urllib.request.urlopen(get(server, "api/trace?name=t.jsonl", good)))
     assert reply["type"] == "trace" and reply["columns"]["state"] == [1]
     with pytest.raises(urllib.error.HTTPError) as err:
         bad = good + b'{"tick":1}\n'
-        urllib.request.urlopen(urllib.request.Request(server.url + "api/trace?name=t.jsonl", data=bad))
+        urllib.request.urlopen(get(server, "api/trace?name=t.jsonl", bad))
     assert err.value.code == 400
     assert "t.jsonl:2:1: error: a trace line needs state" in json.load(err.value)["message"]
 
 
 def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None:
     server, _ = studio
-    replies = talk(server.url, [{"op": "open", "path": "table.csv"},
+    replies = talk(server, [{"op": "open", "path": "table.csv"},
                                 {"op": "edit", "row": 4, "col": 9, "value": "9", "seq": 1}], until="analysis", seq=1)
     first, edited = (r for r in replies if r["type"] == "analysis")
     assert first["ok"] and first["machine"]["rows"] == 37 and len(first["machine"]["states"]) == 10
@@ -117,7 +124,7 @@ def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None
 
 def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, Path]) -> None:
     server, _ = studio
-    replies = talk(server.url, [{"op": "open", "path": "table.csv"},
+    replies = talk(server, [{"op": "open", "path": "table.csv"},
                                 {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"},
                                 {"op": "sim", "action": "step"}], until="frame", limit=20)
     control = next(r for r in replies if r["type"] == "control")
@@ -127,7 +134,7 @@ def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, P
     fired = [w["line"] for w in frame["why"] if w["status"] == "fired"]
     assert frame["tick"] == 0 and len(fired) == 1 and fired[0] in (6, 7, 8, 9, 25, 26, 27)
     assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
-    replies = talk(server.url, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
+    replies = talk(server, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
     assert replies[0]["message"] == "fix the table's errors first"
 
 

@@ -16,9 +16,9 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.cli.common import load
-from tablebot.sim.fleet import Fleet, RobotSpec
+from tablebot.fleet.plan import read_results
+from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.sim.scene import robot_layer, scene_for
-from tablebot.sweep_run import read_results
 from test_sim_helpers import BUMBERBOT
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,8 +66,8 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
 
 def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     """Random starts as the plan draws them (the traced run begins there), given poses as given."""
-    from tablebot.cli.fleet import make_plan
-    from tablebot.sweep import runs
+    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.spec import runs
 
     out = tmp_path / "s"
     code, output = sweep("--grid", "start=random,0.5:0.5:20", "--seeds", "0..2", "--seconds", "1", "--workers", "1",
@@ -228,7 +228,7 @@ def test_a_cluster_worker_warms_the_kernel_in_a_cache_folder_of_its_own(tmp_path
     import shutil
 
     from tablebot import jit
-    from tablebot.cli.fleet import make_plan
+    from tablebot.cli.sweep import make_plan
 
     home = tmp_path / "cache"
     shared = Path(jit.cache_dir())
@@ -240,7 +240,7 @@ def test_a_cluster_worker_warms_the_kernel_in_a_cache_folder_of_its_own(tmp_path
     before = sorted(p.relative_to(mine) for p in mine.rglob("*"))
     plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)
     (tmp_path / "job.pickle").write_bytes(pickle.dumps(plan.jobs()[0]))
-    code = ("import json, pickle, sys; from tablebot.sim.fleet_work import warm_worker; "
+    code = ("import json, pickle, sys; from tablebot.fleet.work import warm_worker; "
             "job = pickle.load(open(sys.argv[1], 'rb')); print(json.dumps(warm_worker(job, 'testhost-0', 2)))")
     worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
     worker_env["XDG_CACHE_HOME"] = str(home)

@@ -1,4 +1,5 @@
-"""The registry of export targets: one fit check per target, shared by ``export`` and ``check --target``."""
+"""The registry of back-ends: one fit check per target, shared by ``export`` and ``check --target``; the CLI's
+choices come from it."""
 
 from __future__ import annotations
 
@@ -8,24 +9,24 @@ import pytest
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE, ROOT, example_machine, machine_of
+from tablebot import registry
 from tablebot.cli.app import app
-from tablebot.codegen.layout import MAX_EVENTS
-from tablebot.formats.targets import TARGETS
+from tablebot.codegen.packing import MAX_EVENTS
 
 WIDE_ROBOT = ('name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'I{i} = ""\n' for i in range(MAX_EVENTS))
               + '[motors]\nM1 = ""\n')
 WIDE_TABLE = f"state,T,{','.join(f'I{i}' for i in range(MAX_EVENTS))},M1,timer,next\n1,1{',' * MAX_EVENTS},1,5,1\n"
 
 
-@pytest.mark.parametrize("name", sorted(TARGETS))
+@pytest.mark.parametrize("name", registry.check_targets())
 def test_the_bumberbot_fits_every_target(name: str) -> None:
-    assert TARGETS[name].problems(example_machine()) == []
+    assert registry.get(name).problems(example_machine()) == []
 
 
 def test_a_table_too_wide_for_c_is_refused_by_c_and_the_boards_alike(tmp_path: Path) -> None:
     machine = machine_of(tmp_path, WIDE_TABLE, WIDE_ROBOT)
     for name in ("c", "uno", "ftduino"):
-        problems = TARGETS[name].problems(machine)
+        problems = registry.get(name).problems(machine)
         assert problems and f"the C engine holds at most {MAX_EVENTS}" in problems[0].message, name
 
 
@@ -46,11 +47,38 @@ def test_a_robot_without_txt_wiring_does_not_fit_the_txt_targets() -> None:
 
     _, machine = load(ROOT / "examples" / "bumberbot-counters")
     for name in ("txt", "txt4"):
-        problems = TARGETS[name].problems(machine)
+        problems = registry.get(name).problems(machine)
         assert any("has no [txt] section" in p.message for p in problems), name
 
 
 def test_unknown_target_names_the_known_ones() -> None:
     result = CliRunner().invoke(app, ["check", str(EXAMPLE), "--target", "arduino"])
     assert result.exit_code == 2 and "unknown export target 'arduino'" in result.output
-    assert all(name in result.output for name in TARGETS)
+    assert all(name in result.output for name in registry.check_targets())
+
+
+def test_the_commands_choices_are_the_registered_back_ends() -> None:
+    """--to, --board, --on and check --target list exactly what is registered, in its order."""
+    runner = CliRunner()
+    assert registry.names("export") == ["robopro", "robopro-rpp", "c", "txt4"]
+    assert registry.names("board") == ["uno", "ftduino"]
+    assert registry.names("live") == ["txt", "sim"]
+    assert registry.check_targets() == ["robopro", "robopro-rpp", "c", "uno", "ftduino", "txt", "txt4"]
+    from tablebot.cli.export import Target
+    from tablebot.cli.firmware import BoardName
+
+    assert [t.value for t in Target] == registry.names("export")
+    assert [b.value for b in BoardName] == registry.names("board")
+    on = runner.invoke(app, ["run", str(EXAMPLE), "--on", "nowhere://x"])
+    assert on.exit_code == 2 and "txt://auto, sim or sim:WORLD.toml" in on.output
+
+
+def test_a_back_end_registers_once_and_says_what_it_is() -> None:
+    c = registry.get("c")
+    assert registry.register(c) is c  # registering the same one again is harmless
+    with pytest.raises(ValueError, match="two back-ends"):
+        registry.register(registry.Backend("c", "export", "another", export=c.export))
+    with pytest.raises(ValueError, match=r"export .* or open"):
+        registry.register(registry.Backend("neither", "export", "nothing"))
+    with pytest.raises(ValueError, match="only a live back-end opens"):
+        registry.register(registry.Backend("wrong", "export", "x", open=registry.get("sim").open))

@@ -9,9 +9,11 @@ from typer.testing import CliRunner
 
 from tablebot.analysis.testgen import generate, write_golden
 from tablebot.cli import app
+from tablebot.formats.inputs_csv import load_inputs
 from tablebot.formats.table_read import load_table
+from tablebot.formats.trace_lines import dumps
 from tablebot.machine import compile_table
-from tablebot.trace import dumps, load_inputs, replay
+from tablebot.replay import replay
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

@@ -10,9 +10,11 @@ import pytest
 
 from core_helpers import COUNTER_ROBOT, EXAMPLE, example_machine, write_table
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.formats.table_read import load_table
+from tablebot.formats.trace_lines import dumps, read_trace, write_trace
 from tablebot.machine import compile_table
-from tablebot.trace import TickInput, dumps, load_inputs, read_trace, replay, write_trace
+from tablebot.replay import replay
 
 
 def trace_of(tmp_path, inputs_text: str, machine=None) -> list[dict]:

@@ -165,12 +165,12 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from dataclasses import replace
 
     from tablebot.cli.common import load
-    from tablebot.cli.fleet import make_plan
+    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.run import Fleet, RobotSpec
+    from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table
-    from tablebot.sim.fleet import Fleet, RobotSpec
     from tablebot.sim.runner import run
     from tablebot.sim.scene import scene_for
-    from tablebot.tune import parse_cells, variants_of
     from test_sim_helpers import BUMBERBOT, trace_text
 
     example = BUMBERBOT.parent / "bumberbot-counters"

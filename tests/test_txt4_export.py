@@ -25,12 +25,13 @@ from core_helpers import EXAMPLE
 from tablebot.cli import app
 from tablebot.engine import Engine
 from tablebot.escape import python_string
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
-from tablebot.hw.txt4_export import export_txt4
+from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import Machine, compile_table
+from tablebot.replay import replay
 from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_inputs, random_table
-from tablebot.trace import TickInput, replay
 from test_txt_robot import wired_random_machine
 
 STUB = Path(__file__).resolve().parent / "txt4_stub"
@@ -196,7 +197,7 @@ def test_python_string_is_a_literal_that_reads_back_exactly(text: str) -> None:
 
 def stub_robot(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, table: dict, inputs: list[list[int]]) -> Any:
     """The runtime's robot for ``table`` in this process, on a fresh import of the stub serving ``inputs``."""
-    from tablebot.hw import txt4_runtime
+    from tablebot.hw.txt4 import runtime as txt4_runtime
 
     script = tmp_path / "script.json"
     script.write_text(json.dumps({"inputs": inputs, "counts": [[0, 0, 0, 0]] * len(inputs)}))
@@ -239,7 +240,7 @@ class CountingRobot:
 
 
 def test_the_on_board_loop_stops_when_it_falls_behind_or_is_interrupted() -> None:
-    from tablebot.hw import txt4_runtime
+    from tablebot.hw.txt4 import runtime as txt4_runtime
 
     machine = compile_table(load_table(EXAMPLE / "table.csv"))
     workspace = export_txt4(machine)

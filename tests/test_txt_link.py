@@ -9,9 +9,9 @@ import warnings
 
 import pytest
 
-from tablebot.hw import txt_wire as wire
-from tablebot.hw.txt_link import TxtLink, find_controller
-from tablebot.hw.txt_wire import Command
+from tablebot.hw.txt import protocol as wire
+from tablebot.hw.txt.link import TxtLink, find_controller
+from tablebot.hw.txt.protocol import Command
 from tablebot.loop import LinkLost
 from txt_fake import FakeTxt
 

@@ -19,15 +19,16 @@ import pytest
 
 from core_helpers import EXAMPLE
 from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
-from tablebot.hw.txt_robot import TxtRobot
-from tablebot.hw.txt_wiring import txt_wiring
+from tablebot.hw.txt.controller import TxtRobot
+from tablebot.hw.txt.wiring import txt_wiring
 from tablebot.loop import RealTimeClock, RunEnd, TickBlock, run
 from tablebot.machine import Machine, compile_table
+from tablebot.replay import replay
 from tablebot.robot import load_robot
 from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_table
-from tablebot.trace import TickInput, replay
 from txt_fake import FakeTxt
 
 FLAVOURS = {"txt": {"period_s": 0.01}, "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000}}

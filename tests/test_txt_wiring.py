@@ -12,8 +12,8 @@ from core_helpers import EXAMPLE
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.table_read import load_table
-from tablebot.hw import txt_wire as wire
-from tablebot.hw.txt_wiring import txt_wiring
+from tablebot.hw.txt import protocol as wire
+from tablebot.hw.txt.wiring import txt_wiring
 from tablebot.machine import compile_table
 from txt_fake import FakeTxt
 

@@ -1,7 +1,7 @@
 """A fake fischertechnik TXT for the tests: a real TCP server (in a thread) speaking the online protocol.
 
 Written from the published header (fischertechnik/txt_demo_c_online, ftProInterface2013SocketCom.h and
-FtShmemTxt.h) independently of tablebot.hw.txt_wire, so that a wrong layout in one shows up against the
+FtShmemTxt.h) independently of tablebot.hw.txt.protocol, so that a wrong layout in one shows up against the
 other (and unmodified ftrobopy keeps this fake honest). It records every request with its time, serves
 inputs from a script, paces exchanges like a TXT ("the interface sends the response 10ms after it sent
 the previous response") or answers at once like ftrobopy_server on a TXT 4.0, and injects faults.

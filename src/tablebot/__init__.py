@@ -6,7 +6,6 @@ Data flows one way: table file (formats.table_read) -> parsed table (table) -> c
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -18,13 +17,30 @@ if TYPE_CHECKING:
 __all__ = ["Engine", "Machine", "Row", "Table", "compile_table", "load_table"]
 __version__ = "0.2.0"
 
-#: Where each public name lives; imported on first use, so `import tablebot` (and `tablebot --help`)
-#: does not load numpy.
-_HOMES = {"Engine": "tablebot.engine", "Machine": "tablebot.machine", "compile_table": "tablebot.machine",
-          "Row": "tablebot.table", "Table": "tablebot.table", "load_table": "tablebot.formats.table_read"}
 
 
 def __getattr__(name: str) -> Any:
-    if name in _HOMES:
-        return getattr(importlib.import_module(_HOMES[name]), name)
+    """The public names, imported on first use, so `import tablebot` (and `tablebot --help`) does not load numpy."""
+    if name == "Engine":
+        from tablebot.engine import Engine
+
+        return Engine
+    if name in ("Machine", "compile_table"):
+        from tablebot import machine
+
+        return getattr(machine, name)
+    if name in ("Row", "Table"):
+        from tablebot import table
+
+        return getattr(table, name)
+    if name == "load_table":
+        from tablebot.formats.table_read import load_table
+
+        return load_table
     raise AttributeError(f"module 'tablebot' has no attribute {name!r}")
+
+
+# Every back-end registers itself and its robot-file section (light modules: nothing heavy loads here).
+from tablebot.catalog import load_all  # noqa: E402
+
+load_all()

@@ -209,7 +209,7 @@ class Engine:
         """
         arrays = self.machine.arrays
         if jit is not False and arrays is not None:
-            from tablebot import kernels
+            from tablebot import engine_batch as kernels
 
             if kernels.available():
                 return self._run_compiled(arrays, _mask_array(masks, len(self.machine.table.events)),
@@ -228,7 +228,7 @@ class Engine:
         return array
 
     def _run_compiled(self, arrays: MachineArrays, masks: np.ndarray, pulses: np.ndarray) -> Batch:
-        from tablebot import kernels
+        from tablebot import engine_batch as kernels
         from tablebot.tick import registers
 
         n = len(masks)

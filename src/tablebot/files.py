@@ -6,6 +6,8 @@ destroys the previous version before the new one is ready.
 
 from __future__ import annotations
 
+import codecs
+import errno
 import os
 import stat
 import tempfile
@@ -14,7 +16,48 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
-from tablebot import guard
+from tablebot import overwrite
+from tablebot.csvtext import split_records
+from tablebot.diagnostics import TableBotError, fail
+from tablebot.table import is_table_header
+
+#: Per errno of a failed read or write: what the user can do about it.
+OS_HINTS = {
+    errno.EEXIST: "a file stands where a folder is needed: choose another path",
+    errno.ENOTDIR: "a file stands where a folder is needed: choose another path",
+    errno.EISDIR: "a folder stands where a file is needed: give a file name",
+    errno.ENOENT: "the folder does not exist: create it or choose another path",
+    errno.EACCES: "you may not write there: choose another path or change its permissions",
+    errno.EPERM: "you may not write there: choose another path or change its permissions",
+    errno.EROFS: "the disk is read-only: choose another path",
+    errno.ENOSPC: "the disk is full: free some space or choose another disk",
+}
+
+
+def out_folder(path: Path, option: str) -> Path:
+    """The folder an option names for writing into, created (with its parents) if missing."""
+    if path.exists() and not path.is_dir():
+        raise fail(path, f"{option} names a file, not a folder", f"give {option} a folder (it is created if missing)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise fail(exc.filename or path, f"cannot create the folder for {option}: {exc.strerror}",
+                   OS_HINTS.get(exc.errno or 0, f"give {option} another folder")) from None
+    return path
+
+
+def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
+    """The file an option names for writing (an existing file is replaced); its folder must exist,
+    unless ``make_folder`` says to create it."""
+    if path.is_dir():
+        raise fail(path, f"{option} names a folder, not a file", f"give {option} a file name")
+    if make_folder:
+        out_folder(path.parent, option)
+    elif not path.parent.is_dir():
+        what = "is not a folder" if path.parent.exists() else "does not exist"
+        raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
+                   f"give {option} a file in an existing folder")
+    return path
 
 
 def _target(path: str | Path) -> Path:
@@ -35,14 +78,14 @@ def is_special(path: Path) -> bool:
 
 
 def _open_direct(path: Path, mode: str, encoding: str | None, newline: str | None) -> IO:
-    guard.writing(path)
+    writing(path)
     return open(path, mode, encoding=None if "b" in mode else encoding, newline=None if "b" in mode else newline)
 
 
 def _temporary(path: Path, mode: str, encoding: str | None, newline: str | None) -> tuple[IO, Path]:
     """An open temporary file beside ``path`` (same folder, so the rename is atomic) and its name; the
-    command's guard first refuses a path it must not write over (see :mod:`tablebot.guard`)."""
-    guard.writing(path)
+    command's guard first refuses a path it must not write over (see :mod:`tablebot.overwrite`)."""
+    writing(path)
     fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
@@ -88,7 +131,7 @@ def replacing(path: str | Path) -> Iterator[Path]:
     ``-o``); renamed to ``path`` if the block completes, removed if not."""
     path = _target(path)
     if is_special(path):
-        guard.writing(path)
+        writing(path)
         yield path
         return
     stream, temp = _temporary(path, "wb", None, None)
@@ -177,3 +220,44 @@ class PendingFile:
 def partial_name(path: Path) -> Path:
     """``trace.jsonl`` -> ``trace.partial.jsonl``."""
     return path.with_name(f"{path.stem}.partial{path.suffix}")
+
+
+#: Files the table reader would take: a CSV with state and next columns is a table.
+TABLE_SUFFIXES = {".csv", ".tsv", ".txt"}
+#: How much of a CSV file is read to find its header.
+HEAD_BYTES = 4096
+
+
+def writing(path: str | Path) -> None:
+    """Called before ``path`` is written: the current command's overwrite guard may refuse it."""
+    overwrite.writing(path, is_user_file)
+
+
+def is_user_file(path: Path) -> bool:
+    """A TOML file, or a CSV whose header has a state and a next column as the table reader reads it
+    (any delimiter, quotes, a BOM, a ``sep=`` line, aliases such as ``Next-State``)."""
+    suffix = path.suffix.lower()
+    if suffix in overwrite.USER_SUFFIXES:
+        return True
+    if suffix not in TABLE_SUFFIXES:
+        return False
+    head = _head(path)
+    try:
+        records = split_records(head[: head.rfind("\n") + 1] or head, str(path))  # whole lines only
+    except TableBotError:
+        return False  # a quote never closed in the first lines: no table the reader would take
+    header = next((record for record in records if not record.is_blank()), None)
+    return header is not None and is_table_header(cell.text for cell in header.cells)
+
+
+def _head(path: Path) -> str:
+    """The first HEAD_BYTES of a file as text, decoded as the table reader does (UTF-8 or UTF-16 with its
+    BOM; a bad byte is only replaced: this decides whether a file is a table, not what it says)."""
+    try:
+        with path.open("rb") as stream:
+            data = stream.read(HEAD_BYTES)
+    except OSError:
+        return ""
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return data.decode("utf-16", "replace")
+    return data.decode("utf-8-sig", "replace")

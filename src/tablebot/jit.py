@@ -32,7 +32,7 @@ def cache_dir() -> str:
 
 
 #: Files whose constants compiled code reads, though they hold no compiled function themselves.
-COMPILED_CONSTANTS = ("tick.py", "layout.py")
+COMPILED_CONSTANTS = ("tick.py", "columns.py")
 
 
 def sources_digest() -> str:

@@ -6,31 +6,40 @@ BumberBot is built in so that the seed table reads with no side file at all.
 
 from __future__ import annotations
 
-import importlib
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tablebot.formats.tomlfile import Source
 from tablebot.sensors import Sensor, parse_sensors
+from tablebot.tomlfile import Source
 
 StateId = int | str
-
-#: Sections of a robot file that belong to other stages, each with the reader (``module:function``)
-#: that checks it and returns its typed value; a reader is imported only when its section is present,
-#: so reading a robot file never loads the simulator. Every section is read when the file is, so all
-#: its mistakes show at once, whichever command runs. Reader: ``(src, data, robot) -> value``.
-SECTION_READERS: dict[str, str] = {
-    "sim": "tablebot.sim.params:read_robot_sim",
-    "board": "tablebot.firmware.boards:read_robot_boards",
-    "properties": "tablebot.analysis.properties:read_robot_properties",
-    "txt": "tablebot.hw.txt_wiring:read_robot_txt",
-}
-FOREIGN_SECTIONS = tuple(SECTION_READERS)
 TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
 CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
-KNOWN_KEYS = (*TOP_KEYS, *CORE_SECTIONS, *FOREIGN_SECTIONS)
+
+#: Reads one section of a robot file that belongs to a later stage: ``(src, data, robot) -> value``, the
+#: section checked and typed; problems go to ``src``'s collector with their lines.
+SectionReader = Callable[[Source, Any, "Robot"], Any]
+#: Sections of a robot file that belong to other stages (``[sim]``, ``[board]``, ``[properties]``, ``[txt]``,
+#: ...), each with its reader. The stages register them (:func:`register_section`, called by
+#: :func:`tablebot.registry.register` for back-ends), so this module imports none of them; importing
+#: ``tablebot`` registers every one (:func:`tablebot.catalog.load_all`). Every section is read when the
+#: file is, so all its mistakes show at once, whichever command runs.
+SECTION_READERS: dict[str, SectionReader] = {}
+
+
+def register_section(name: str, reader: SectionReader) -> None:
+    """Let ``[name]`` in a robot file be read by ``reader`` (once per name)."""
+    known = SECTION_READERS.get(name)
+    if known is not None and known is not reader:
+        raise ValueError(f"robot-file section [{name}] has two readers")
+    if name in TOP_KEYS or name in CORE_SECTIONS:
+        raise ValueError(f"[{name}] is a section of the robot itself")
+    SECTION_READERS[name] = reader
+
+
 #: Sections people write in the wrong file: the hint says where they belong.
 MISPLACED = {"wiring": "the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)",
              **{s: f"simulator parameters go in [sim.{s}] in a robot file" for s in
@@ -78,6 +87,11 @@ class Robot:
     toml: Source | None = field(default=None, compare=False, repr=False)
 
     @property
+    def tick_s(self) -> float:
+        """One tick in seconds."""
+        return self.tick_ms / 1000
+
+    @property
     def counter_names(self) -> tuple[str, ...]:
         return tuple(c.name for c in self.counters)
 
@@ -118,11 +132,11 @@ def load_robot(path: str | Path) -> Robot:
     src = Source.read(path, "see the robot file format in the README")
     data = src.data
     for key in data:
-        if key not in KNOWN_KEYS:
+        if key not in TOP_KEYS and key not in CORE_SECTIONS and key not in SECTION_READERS:
             what = "section" if isinstance(data[key], dict) else "key"
             src.key_error(("", None, key), f"unknown {what} {key!r}",
                       MISPLACED.get(key, f"known keys: {', '.join(TOP_KEYS)}; sections: "
-                                         f"{', '.join(CORE_SECTIONS + FOREIGN_SECTIONS)}"))
+                                         f"{', '.join((*CORE_SECTIONS, *SECTION_READERS))}"))
     inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = _counters(src, motors)
     sensors = parse_sensors(src, inputs)
@@ -153,10 +167,9 @@ def load_robot(path: str | Path) -> Robot:
 def _foreign_sections(src: Source, robot: Robot) -> dict[str, Any]:
     """Each stage's section, read by its own reader (see SECTION_READERS); all problems at once."""
     typed = {}
-    for key, where in SECTION_READERS.items():
+    for key, reader in SECTION_READERS.items():
         if key in src.data:
-            module, function = where.split(":")
-            typed[key] = getattr(importlib.import_module(module), function)(src, src.data[key], robot)
+            typed[key] = reader(src, src.data[key], robot)
     src.raise_if_any()
     return typed
 

@@ -17,7 +17,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from tablebot.formats.tomlfile import Source, is_number
+from tablebot.tomlfile import Source, is_number
 
 #: What each ``sensor =`` word is simulated as: a floor (track) sensor, an ultrasonic ray cast, or light.
 KINDS = {"line": "line", "distance": "distance", "ultrasonic": "distance",

@@ -6,7 +6,8 @@ A row says: in this state, when these events are all present, set these outputs,
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import re
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -18,6 +19,9 @@ DOC_KEEP_SPEED = 7
 MAX_SPEED = 8
 MAX_LAMP = 8
 TIMER_EVENT = "T"
+#: The fixed columns of a table, and the other spellings the reader takes for them.
+FIXED = ("description", "state", "timer", "next")
+ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
 
 
 def from_direction_speed(direction: int, speed: int) -> int | None:
@@ -142,3 +146,18 @@ def missing_states(rows: Sequence[Row], robot: Robot) -> list[MissingState]:
     found += [(None, ("states", str(state)), f"state {state!r} is named in {robot.source} but has no rows",
                "add rows for it or remove it from [states]") for state in robot.state_names if state not in with_rows]
     return found
+
+
+def normalise_header(name: str) -> str:
+    """A header cell as the table reader reads it: a fixed column (any case, alias, spaces or dashes) by its
+    own name, any other name as written (spaces and dashes made ``_``)."""
+    key = re.sub(r"[\s-]+", "_", name.strip())
+    low = key.lower()
+    low = ALIASES.get(low, low)
+    return low if low in FIXED else key
+
+
+def is_table_header(cells: Iterable[str]) -> bool:
+    """Whether header cells name a state and a next column (spelled any way :func:`parse_table` takes)."""
+    names = {normalise_header(text) for text in cells}
+    return "state" in names and "next" in names

@@ -16,7 +16,7 @@ from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
 from tablebot.formats.inputs_csv import write_inputs
 from tablebot.machine import Machine
-from tablebot.trace import replay
+from tablebot.replay import replay
 
 
 @dataclass

@@ -10,11 +10,11 @@ import operator
 from dataclasses import dataclass, field
 from typing import Any
 
+from tablebot import registry
 from tablebot.analysis.finding import SEVERITIES, Finding
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Graph, Model
 from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
-from tablebot.formats.targets import TARGETS
 from tablebot.machine import NO_ROW, Machine, first_match
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
@@ -259,9 +259,9 @@ def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> s
 
 def encoding(machine: Machine, target: str) -> list[Finding]:
     """What an export target cannot hold, as errors (its exporter would refuse the table): the fit
-    check of :data:`tablebot.formats.targets.TARGETS`."""
+    check of its back-end (:mod:`tablebot.registry`)."""
     table_path = machine.table.path
     return [Finding(f"encoding-{target}", "error",
                     f"{target}: {d.message}" + ("" if d.path == table_path else f" ({d.location()})"),
                     (d.line,) if d.line is not None and d.path == table_path else (), d.hint)
-            for d in TARGETS[target].problems(machine)]
+            for d in registry.get(target).problems(machine)]

@@ -28,10 +28,9 @@ from dataclasses import dataclass
 from typing import TypeVar
 
 from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import NO_ROW, Machine
-from tablebot.trace import TickInput
 
-#: (state index, timer class, bits of the counters that are 0, outputs, first tick not yet made)
 Node = tuple[int, int, int, tuple[int, ...], bool]
 #: One tick: (event mask, counters driven to 0 by pulses this tick, fired row or -1, node after)
 Tick = tuple[int, int, int, Node]

@@ -25,8 +25,8 @@ from typing import Any
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
 from tablebot.diagnostics import Collector, TableBotError
 from tablebot.durations import DurationError, to_ticks
-from tablebot.formats.tomlfile import Source
 from tablebot.machine import Machine
+from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
@@ -81,12 +81,6 @@ def find_property_files(table_path: Path) -> list[Path]:
         if candidate.is_file():
             return [candidate]
     return []
-
-
-def read_robot_properties(src: Source, entries: Any, robot: Any) -> Any:
-    """A robot file's ``[properties]`` as written: each property is checked against the table when
-    ``tablebot check`` reads it (a property names the table's inputs and outputs)."""
-    return entries
 
 
 def load_properties(machine: Machine, files: list[Path]) -> list[Property]:

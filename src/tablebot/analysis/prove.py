@@ -18,8 +18,9 @@ from typing import Any
 from tablebot.analysis.conditions import Obs
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.analysis.properties import Property
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import NO_ROW, Machine
-from tablebot.trace import TickInput, replay
+from tablebot.replay import replay
 
 VIOLATION = None  # a monitor step returning this means the property is broken at this tick
 EXACT_BUDGET = 300_000  # about 2-3 s of searching before falling back

@@ -17,11 +17,11 @@ from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write, write_text
-from tablebot.formats.inputs_csv import write_inputs
+from tablebot.formats.inputs_csv import TickInput, write_inputs
+from tablebot.formats.trace_lines import write_trace
 from tablebot.machine import Machine
-from tablebot.trace import TickInput, replay, write_trace
+from tablebot.replay import replay
 
-#: A sequence stops looking for more rows after this many model steps (waits count once).
 MAX_STEPS = 400
 REASON_CODES = ("shadowed-row", "unreachable-state", "timer-never-expires", "row-never-fires")
 

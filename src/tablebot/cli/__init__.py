@@ -13,7 +13,7 @@ import traceback
 os.environ.setdefault("TYPER_USE_RICH", "0")
 
 # Importing a module registers its commands; `tablebot --help` lists them in this order.
-from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, fleet, tune  # noqa: F401, I001
+from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune  # noqa: F401, I001
 from tablebot.cli.app import app
 
 #: Exit code of an internal error (a tablebot bug): sysexits' EX_SOFTWARE, apart from 1 (warnings), 2 (bad

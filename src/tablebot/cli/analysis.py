@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import typer
 from rich.text import Text
 
+from tablebot import registry
 from tablebot.cli.app import app
 from tablebot.cli.common import (
     FORCE_OPT,
@@ -27,7 +28,6 @@ from tablebot.cli.common import (
 )
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.escape import plain, shell_word, terminal
-from tablebot.formats.targets import TARGETS
 
 if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --help` stays quick
     from tablebot.analysis.check import CheckReport
@@ -55,7 +55,7 @@ def check_cmd(
     properties: list[Path] = typer.Option([], "--properties", "-p", help="Property file(s) (default: "
                                           "NAME.properties.toml or properties.toml beside the table)."),
     target: list[str] = typer.Option([], "--target", help="Export target whose limits to check (repeatable): "
-                                     f"{', '.join(TARGETS)}."),
+                                     f"{', '.join(registry.check_targets())}."),
     strict: bool = typer.Option(False, "--strict", help="Exit with 1 when there are warnings."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="List every info finding (overlaps, ignored inputs)."),
     fmt: Format = typer.Option(Format.text, "--format", help="text, or json for machines."),
@@ -70,9 +70,10 @@ def check_cmd(
     from tablebot.analysis.check import report_json, run_check
     from tablebot.analysis.properties import find_property_files, load_properties
 
+    known = registry.check_targets()
     for name in target:
-        if name not in TARGETS:
-            raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(TARGETS)}")
+        if name not in known:
+            raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(known)}")
     with Stages(total=3) as stages:
         stages.step(f"reading {table}")
         _, machine = load(table, robot)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import errno
 import functools
 import os
 import sys
@@ -14,9 +13,11 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import typer
 from rich.console import Console
 
-from tablebot import guard
-from tablebot.diagnostics import Diagnostic, TableBotError, fail, notes_to
+from tablebot import overwrite
+from tablebot.diagnostics import Diagnostic, TableBotError, notes_to
 from tablebot.escape import terminal
+from tablebot.files import OS_HINTS, out_file, out_folder  # noqa: F401  (re-exported for the commands)
+from tablebot.formats.table_read import resolve_table_path
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
     from tablebot.machine import Machine
@@ -33,54 +34,6 @@ FORCE_OPT = typer.Option(False, "--force", help="Replace an existing table or ro
                          "NAME.bak); without it such a file is never replaced.")
 
 
-#: Per errno of a failed read or write: what the user can do about it.
-OS_HINTS = {
-    errno.EEXIST: "a file stands where a folder is needed: choose another path",
-    errno.ENOTDIR: "a file stands where a folder is needed: choose another path",
-    errno.EISDIR: "a folder stands where a file is needed: give a file name",
-    errno.ENOENT: "the folder does not exist: create it or choose another path",
-    errno.EACCES: "you may not write there: choose another path or change its permissions",
-    errno.EPERM: "you may not write there: choose another path or change its permissions",
-    errno.EROFS: "the disk is read-only: choose another path",
-    errno.ENOSPC: "the disk is full: free some space or choose another disk",
-}
-
-
-def resolve_table_path(path: Path) -> Path:
-    """A folder stands for the table.csv inside it, so ``tablebot trace examples/bumberbot`` works."""
-    if path.is_dir():
-        for name in ("table.csv", "table.tsv"):
-            if (path / name).is_file():
-                return path / name
-        raise fail(path, "this folder holds no table.csv or table.tsv",
-                   "give the table file itself, or a folder that holds table.csv")
-    return path
-
-
-def out_folder(path: Path, option: str) -> Path:
-    """The folder an option names for writing into, created (with its parents) if missing."""
-    if path.exists() and not path.is_dir():
-        raise fail(path, f"{option} names a file, not a folder", f"give {option} a folder (it is created if missing)")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise fail(exc.filename or path, f"cannot create the folder for {option}: {exc.strerror}",
-                   OS_HINTS.get(exc.errno or 0, f"give {option} another folder")) from None
-    return path
-
-
-def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
-    """The file an option names for writing (an existing file is replaced); its folder must exist,
-    unless ``make_folder`` says to create it."""
-    if path.is_dir():
-        raise fail(path, f"{option} names a folder, not a file", f"give {option} a file name")
-    if make_folder:
-        out_folder(path.parent, option)
-    elif not path.parent.is_dir():
-        what = "is not a folder" if path.parent.exists() else "does not exist"
-        raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
-                   f"give {option} a file in an existing folder")
-    return path
 
 
 def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
@@ -143,7 +96,7 @@ def guarded(func: F) -> F:
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with notes_to(print_diagnostic), guard.command(force=bool(kwargs.get("force", False))):
+            with notes_to(print_diagnostic), overwrite.command(force=bool(kwargs.get("force", False))):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:

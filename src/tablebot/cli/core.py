@@ -62,7 +62,9 @@ def trace_cmd(
 ) -> None:
     """Replay recorded inputs through the engine and write the trace, one JSON line per tick."""
     from tablebot.files import atomic_write
-    from tablebot.trace import load_inputs, replay, write_trace
+    from tablebot.formats.inputs_csv import load_inputs
+    from tablebot.formats.trace_lines import write_trace
+    from tablebot.replay import replay
 
     _, machine = load(table, robot)
     ticks = load_inputs(inputs, machine)
@@ -80,7 +82,9 @@ def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder fo
     """Replay the BumberBot on its built-in recorded inputs and summarise what it did."""
     from tablebot.examples import example_path
     from tablebot.files import atomic_write
-    from tablebot.trace import load_inputs, replay, write_trace
+    from tablebot.formats.inputs_csv import load_inputs
+    from tablebot.formats.trace_lines import write_trace
+    from tablebot.replay import replay
 
     folder = example_path("bumberbot")
     _, machine = load(folder / "table.csv")

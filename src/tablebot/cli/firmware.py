@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from tablebot import registry
 from tablebot.cli.app import app
 from tablebot.cli.common import (
     FORCE_OPT,
@@ -19,7 +20,6 @@ from tablebot.cli.common import (
     guarded,
     load,
     out_file,
-    out_folder,
 )
 from tablebot.diagnostics import fail
 from tablebot.escape import plain, shell_word, terminal
@@ -28,29 +28,22 @@ if TYPE_CHECKING:  # the firmware tools are imported when a command runs: `--hel
     from tablebot.firmware.build import Firmware
 
 
-class BoardName(StrEnum):
-    uno = "uno"
-    ftduino = "ftduino"
+#: ``--board``'s choices: every registered board back-end.
+BoardName = StrEnum("BoardName", {b.name: b.name for b in registry.backends("board")})  # type: ignore[misc]
 
-
-BOARD_OPT = typer.Option(..., "--board", help="uno (Arduino Uno + Motor Shield Rev3) or ftduino.")
+BOARD_OPT = typer.Option(..., "--board", help=" or ".join(f"{b.name} ({b.help})" if b.help else b.name
+                                                         for b in registry.backends("board")) + ".")
 OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: build/firmware/BOARD).")
 
 
 def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
-    from tablebot.firmware.build import build
-
     _, machine = load(table, robot)
-    firmware = build(machine, board.value, out_folder(out or Path("build") / "firmware" / board.value, "--out"))
-    wiring = firmware.wiring
-    assert wiring is not None
-    pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
-                     for n, t in kind.items())
-    console.print(f"wrote {terminal(str(firmware.hex))} and {terminal(str(firmware.elf))} "
-                  f"for {terminal(firmware.board.title)}")
-    console.print(f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {terminal(pins)}")
-    console.print(f"trace: {firmware.board.uart}, {firmware.board.baud} baud 8N1")
-    return firmware
+    backend = registry.get(board.value)
+    assert backend.export is not None
+    done = backend.export(machine, out, {})
+    for line in done.lines:
+        console.print(terminal(line))
+    return done.value
 
 
 @app.command("build")

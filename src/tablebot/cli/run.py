@@ -4,58 +4,49 @@ in real time through the run loop, with a live view, a live trace, and outputs o
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
 
+from tablebot import registry
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
 
 if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when the command runs
-    from tablebot.hw.run_trace import RunTrace
     from tablebot.loop import RobotIO, RunEnd, Sink
     from tablebot.machine import Machine
+    from tablebot.sinks.run_trace import RunTrace
 
-TARGET_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT, txt://auto, sim or sim:WORLD.toml"
-CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
-                "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
-
-
-@dataclass(frozen=True)
-class Target:
-    kind: str  # "txt" or "sim"
-    host: str | None = None  # None: txt://auto
-    port: int = 65000
-    world: Path | None = None
+def _address_hint() -> str:
+    """Every address form of every live back-end: ``write --on txt://HOST:PORT, ..., sim or sim:WORLD.toml``."""
+    forms = [form for backend in registry.backends("live") for form in backend.addresses]
+    return "write --on " + (", ".join(forms[:-1]) + " or " + forms[-1] if len(forms) > 1 else "".join(forms))
 
 
-def parse_target(text: str) -> Target:
-    """``txt://HOST[:PORT]``, ``txt://auto``, ``sim`` or ``sim:WORLD``; anything else is a located error."""
-    if text == "sim" or text.startswith("sim:"):
-        world = text[4:]
-        return Target("sim", world=Path(world) if world else None)
-    if not text.startswith("txt://"):
+TARGET_HINT = _address_hint()
+
+
+def live_backend(text: str) -> registry.Backend:
+    """The live back-end ``--on`` names; anything else is a located error."""
+    backend = registry.live_for(text)
+    if backend is None:
         raise fail("--on", f"unknown target {text!r}", TARGET_HINT)
-    rest = text[len("txt://"):].rstrip("/")
-    if rest == "auto":
-        return Target("txt")
-    host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
-    if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
-        raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", TARGET_HINT)
-    return Target("txt", host, int(port) if port else 65000)
+    return backend
+
+
+def _on_help() -> str:
+    helps = [b.help for b in registry.backends("live")]
+    return (", ".join(helps[:-1]) + ", or " + helps[-1] if len(helps) > 1 else "".join(helps)) + "."
 
 
 @app.command("run")
 @guarded
 def run_cmd(
     table: Path = TABLE_ARG,
-    on: str = typer.Option(..., "--on", help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), "
-                           "txt://auto (USB, Wi-Fi, Bluetooth addresses), or sim[:WORLD] (the simulator, in "
-                           "real time)."),
+    on: str = typer.Option(..., "--on", help=_on_help()),
     seconds: float | None = typer.Option(None, "--seconds", min=0.01, help="Run length; without it, until Ctrl-C."),
     out: Path | None = typer.Option(None, "--out", help="Folder for trace.jsonl and summary.json, written as the "
                                     "run goes (a planned run cut short leaves trace.partial.jsonl)."),
@@ -69,50 +60,17 @@ def run_cmd(
 ) -> None:
     """Run TABLE on a real robot (or the simulator, in real time): outputs off on Ctrl-C, SIGTERM, any error
     and at the end; a lost link ends the run with exit code 3."""
-    target = parse_target(on)
+    backend = live_backend(on)
     parsed, machine = load(table, robot)
-    tick_s = parsed.robot.tick_ms / 1000
+    tick_s = parsed.robot.tick_s
     ticks = None if seconds is None else max(1, round(seconds / tick_s))
     if out is not None:
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
-    bot, where, device = (_txt(machine, target, link_timeout or 5 * tick_s) if target.kind == "txt"
-                          else _sim(machine, target, seed))
-    end = _drive(machine, bot, where, device, ticks, out, behind_limit or None, quiet)
+    assert backend.open is not None
+    opened = backend.open(machine, on, {"link_timeout_s": link_timeout, "seed": seed, "hint": TARGET_HINT})
+    end = _drive(machine, opened.robot, opened.where, opened.device, ticks, out, behind_limit or None, quiet)
     if end.exit_code:
         raise typer.Exit(end.exit_code)
-
-
-def _txt(machine: Machine, target: Target, link_timeout_s: float) -> tuple[RobotIO, str, str]:
-    """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
-    fit), then the controller found and asked who it is."""
-    from tablebot.hw.txt_link import AUTO_HOSTS, find_controller
-    from tablebot.hw.txt_robot import TxtRobot
-    from tablebot.hw.txt_wiring import txt_wiring
-    from tablebot.loop import LinkLost
-
-    wiring = txt_wiring(machine)
-    host = target.host or find_controller(AUTO_HOSTS, target.port)
-    if host is None:
-        raise fail("--on", f"txt://auto found no controller at {', '.join(AUTO_HOSTS)} (port {target.port})",
-                   CONNECT_HINT)
-    bot = TxtRobot(wiring, host, target.port, link_timeout_s=link_timeout_s)
-    try:
-        status = bot.connect()
-    except LinkLost as exc:
-        raise fail("--on", str(exc), CONNECT_HINT) from None
-    return bot, bot.target, f"{status.device} {status.version_text}"
-
-
-def _sim(machine: Machine, target: Target, seed: int) -> tuple[RobotIO, str, str]:
-    """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
-    from tablebot.sim import scene as sim_scene
-    from tablebot.sim.robot import SimRobot
-
-    scene = sim_scene.scene_for(machine.table, machine, target.world)
-    bot = SimRobot(scene, seed)
-    bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
-    bot.reset(seed=seed)
-    return bot, "sim", f"simulated, seed {seed}"
 
 
 def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int | None, out: Path | None,
@@ -121,9 +79,9 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
     A TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once and the simulator
     never waits, so the clock paces ticks too (it only sleeps when a tick is early; see loop.RealTimeClock)."""
     from tablebot.engine import Engine
-    from tablebot.hw.live_view import LiveView
-    from tablebot.hw.run_trace import RunTrace
     from tablebot.loop import RealTimeClock, run
+    from tablebot.sinks.live_view import LiveView
+    from tablebot.sinks.run_trace import RunTrace
 
     sinks: list[Sink] = []
     if not quiet and err_console.is_terminal:
@@ -136,7 +94,7 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
     switch = sys.getswitchinterval()
     sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
     try:
-        end = run(Engine(machine), bot, clock=RealTimeClock(machine.table.robot.tick_ms / 1000), sinks=sinks,
+        end = run(Engine(machine), bot, clock=RealTimeClock(machine.table.robot.tick_s), sinks=sinks,
                   ticks=ticks, target=target, behind_limit_s=behind_limit_s)
     finally:
         sys.setswitchinterval(switch)
@@ -147,7 +105,7 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
 
 def _report(end: RunEnd, machine: Machine, trace: RunTrace | None) -> None:
     """How the run ended on stdout; the files written on stderr."""
-    seconds = end.ticks * machine.table.robot.tick_ms / 1000
+    seconds = end.ticks * machine.table.robot.tick_s
     why = f" — {end.message}" if end.message else ""
     console.print(terminal(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"))
     if end.late_ticks:
@@ -169,7 +127,7 @@ def upload_cmd(
     start: bool = typer.Option(True, "--start/--no-start", help="Start the program once it is uploaded."),
 ) -> None:
     """Install an exported TXT 4.0 program on the controller through its REST API, and start it."""
-    from tablebot.hw.txt4_upload import upload
+    from tablebot.hw.txt4.upload import upload
 
     if not folder.is_dir():
         raise fail(folder, "is a file, not a folder" if folder.exists() else "no such folder",

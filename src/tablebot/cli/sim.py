@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the
     from tablebot.sim.runner import Result
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
-    from tablebot.trace import TraceFile
+    from tablebot.sinks.trace_file import TraceFile
 
 
 @app.command("sim")
@@ -45,7 +45,7 @@ def sim_cmd(
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
-    from tablebot.trace import TraceFile
+    from tablebot.sinks.trace_file import TraceFile
 
     if view:
         from tablebot.sim.animate import check_display

@@ -10,6 +10,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import err_console, guarded
 from tablebot.diagnostics import fail
+from tablebot.escape import terminal
 
 if TYPE_CHECKING:
     import socket
@@ -20,35 +21,59 @@ LOCAL = "127.0.0.1"
 @app.command("studio")
 @guarded
 def studio_cmd(
-    where: Path = typer.Argument(Path("."), help="A folder (its table.csv opens first) or a table file."),
+    where: Path = typer.Argument(Path("."), metavar="FOLDER", help="A folder (its table.csv opens first) or a "
+                                 "table file."),
     port: int = typer.Option(8765, "--port", min=0, max=65535, help="Port to serve on (0: any free port)."),
     host: str | None = typer.Option(None, "--host", help="Serve on this address instead of 127.0.0.1, "
-                                    "e.g. 0.0.0.0 for the whole network (anyone who reaches it can edit tables)."),
+                                    "e.g. 0.0.0.0 for the whole network (anyone with the printed address and its "
+                                    "token can read and change the folder's tables)."),
     no_browser: bool = typer.Option(False, "--no-browser", help="Do not open a browser."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every request (the token shown as "
+                                 "[token])."),
 ) -> None:
-    """Edit a table in the browser, see its checks as you type, and watch the robot run it live."""
+    """Edit a table in the browser, see its checks as you type, and watch the robot run it live.
+
+    The address printed (and opened) carries a secret token made at each start: only a page opened from
+    it can use the studio."""
     import webbrowser
+    from urllib.parse import quote
 
-    import uvicorn
-
-    from tablebot.web.app import MAX_MESSAGE_BYTES, create_app
+    from tablebot.web.access import WILDCARDS, Access
+    from tablebot.web.app import create_app, server
 
     root, table = _root_and_table(where)
     address = host or LOCAL
     sock = _bind(address, port)
-    actual = sock.getsockname()[1]
-    if host and host not in (LOCAL, "localhost", "::1"):
-        err_console.print(f"[bold red]warning:[/bold red] serving {root} on {host}:{actual}: anyone who can reach "
-                          "this machine can read the folder's tables and traces and change its tables")
-    shown = LOCAL if address in ("0.0.0.0", "::") else address
-    url = f"http://{shown}:{actual}/" + (f"?table={table}" if table else "")
-    err_console.print(f"tablebot studio: serving {root} at {url}  (Ctrl-C stops)")
-    config = uvicorn.Config(create_app(root, table), log_level="warning", ws_max_size=MAX_MESSAGE_BYTES,
-                            lifespan="off")
-    server = uvicorn.Server(config)
+    access = Access.serving(address, sock.getsockname()[1])
+    if not _loopback(address):
+        _warn_network(root, address, access.port)
+    shown = LOCAL if address in WILDCARDS else address
+    url = access.url(shown, f"table={quote(table)}" if table else "")
+    err_console.print(f"tablebot studio: serving {terminal(str(root))} at", soft_wrap=True)
+    err_console.print(f"  {url}", soft_wrap=True, markup=False)  # whole, never wrapped: it is the key
+    err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
+    uvicorn_server = server(create_app(root, access, table), access, "info" if verbose else "warning")
     if not no_browser:
         webbrowser.open(url)
-    server.run(sockets=[sock])
+    uvicorn_server.run(sockets=[sock])
+
+
+def _loopback(address: str) -> bool:
+    """Whether only this machine reaches ``address`` (127.x.x.x, ::1, localhost)."""
+    import ipaddress
+
+    try:
+        return ipaddress.ip_address(address.strip("[]")).is_loopback
+    except ValueError:
+        return address.lower() == "localhost"
+
+
+def _warn_network(root: Path, address: str, port: int) -> None:
+    err_console.print(
+        f"[bold red]warning:[/bold red] serving {terminal(str(root))} on {terminal(address)}:{port}, not only "
+        "to this machine: anyone who can reach it and has the address below (with its token) can read the "
+        "folder's tables, robot and world files and traces, and change its tables. The connection is plain "
+        "HTTP: anyone who can watch the network can see the token.", soft_wrap=True)
 
 
 def _root_and_table(where: Path) -> tuple[Path, str | None]:
@@ -65,6 +90,7 @@ def _bind(address: str, port: int) -> socket.socket:
     import errno
     import socket
 
+    address = address.strip("[]")  # an IPv6 literal as in a URL
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)

@@ -12,11 +12,11 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.fleet import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
 
 if TYPE_CHECKING:
-    from tablebot.sweep_run import Plan
-    from tablebot.tune import Cell, Evaluator
+    from tablebot.fleet.plan import Plan
+    from tablebot.fleet.tune import Cell, Evaluator
 
 METRICS = ("time_to_lamp", "time_to_light", "collisions", "lamp_distance", "missed_lamp")
 
@@ -51,11 +51,11 @@ def tune_cmd(
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
     runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
-    from tablebot import guard
+    from tablebot import files
     from tablebot.diagnostics import fail
-    from tablebot.sweep import parse_seeds
-    from tablebot.sweep_backends import Runner, choose
-    from tablebot.tune import Evaluator, best, parse_cells, search_cma, search_grid
+    from tablebot.fleet.backends import Runner, choose
+    from tablebot.fleet.spec import parse_seeds
+    from tablebot.fleet.tune import Evaluator, best, parse_cells, search_cma, search_grid
 
     if objective not in METRICS:
         raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
@@ -68,7 +68,7 @@ def tune_cmd(
     tuned_cells = parse_cells(cells, plan.table)
     out_folder(out, "--out")
     target = tuned_path(Path(plan.table.path), out)
-    guard.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
+    files.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     started = time.perf_counter()
     with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
@@ -151,7 +151,7 @@ def as_written(old: str, ticks: int, tick_ms: int) -> str:
 
 def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
     from tablebot.files import write_text
-    from tablebot.sweep_run import csv_text
+    from tablebot.fleet.plan import csv_text
 
     columns = ["evaluation", *(c.label for c in evaluate.cells), evaluate.objective]
     rows = [{"evaluation": k, **dict(zip(columns[1:-1], values, strict=True)), evaluate.objective: value}

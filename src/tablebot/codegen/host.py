@@ -9,10 +9,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from tablebot.codegen import HOST_RUNNER, generate, template_path
+from tablebot.codegen.source import HOST_RUNNER, generate, template_path
 from tablebot.diagnostics import fail
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import NO_ROW, Machine
-from tablebot.trace import TickInput
 
 WARNINGS = ("-Wall", "-Wextra", "-std=c99", "-pedantic", "-Werror")
 
@@ -38,7 +38,7 @@ def build_host(machine: Machine, outdir: Path, lookup: str = "auto") -> Path:
 
 def trace_line(machine: Machine, tick: int, event: int, row: int, state: int, timer: int,
                outputs: Sequence[int], counters: Sequence[int]) -> dict[str, Any]:
-    """A core trace line (see :func:`tablebot.trace.record`) from raw engine values."""
+    """A core trace line (see :func:`tablebot.formats.trace_lines.record`) from raw engine values."""
     line: dict[str, Any] = {"tick": tick, "event": event, "row": None if row == NO_ROW else row,
                             "state": machine.states[state], "timer": timer}
     line.update(zip(machine.output_names, outputs, strict=True))

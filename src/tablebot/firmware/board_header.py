@@ -4,7 +4,7 @@ encoder counting), the tick timer and UART settings, and the trace frame size.
 
 from __future__ import annotations
 
-from tablebot.codegen.layout import Layout
+from tablebot.codegen.packing import Layout
 from tablebot.diagnostics import fail
 from tablebot.escape import c_comment
 from tablebot.firmware.boards import Wiring

@@ -10,8 +10,8 @@ from importlib import resources
 from typing import Any
 
 from tablebot.diagnostics import fail
-from tablebot.formats.tomlfile import Source
 from tablebot.robot import Robot
+from tablebot.tomlfile import Source
 
 BOARDS = ("uno", "ftduino")
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from tablebot.codegen import generate
-from tablebot.codegen.layout import Layout
+from tablebot.codegen.packing import Layout
+from tablebot.codegen.source import generate
 from tablebot.diagnostics import fail
 from tablebot.files import replacing, write_text
 from tablebot.firmware.board_header import board_header

@@ -18,8 +18,8 @@ from tablebot.diagnostics import fail
 from tablebot.firmware.boards import Wiring
 from tablebot.firmware.build import Firmware
 from tablebot.firmware.framing import Decoder, Hello
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine
-from tablebot.trace import TickInput
 
 ADC_OPEN_MV = 5000  # an open ftDuino input: pulled up to 5 V
 ADC_CLOSED_MV = 0

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tablebot.codegen.host import trace_line
-from tablebot.codegen.layout import Layout, plan
+from tablebot.codegen.packing import Layout, plan
 from tablebot.machine import NO_ROW, Machine
 
 # A frame is 0x7E TYPE PAYLOAD CHECK; CHECK makes the 8-bit sum of TYPE, PAYLOAD and CHECK zero.

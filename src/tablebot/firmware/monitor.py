@@ -10,11 +10,11 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from tablebot.codegen.layout import plan
+from tablebot.codegen.packing import plan
 from tablebot.diagnostics import fail
 from tablebot.firmware.framing import Decoder
+from tablebot.formats.trace_lines import dumps
 from tablebot.machine import Machine
-from tablebot.trace import dumps
 
 CHUNK = 4096
 MAX_WARNINGS = 20  # a stream of garbage would otherwise print a warning per sync byte

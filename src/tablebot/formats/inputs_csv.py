@@ -12,12 +12,22 @@ import io
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
+from tablebot.csvtext import Cell, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, fail
 from tablebot.files import write_text
-from tablebot.formats.csvtext import Cell, cells_beyond, headerless, read_text, split_records
-from tablebot.machine import Machine
-from tablebot.table import TIMER_EVENT
+from tablebot.formats.trace_lines import trace_records
+from tablebot.table import TIMER_EVENT, Table
+
+
+class Events(Protocol):
+    """What reading inputs needs of a compiled machine (:class:`tablebot.machine.Machine` is one): the bit
+    of each input in the event mask, and the table with its robot."""
+
+    input_bits: dict[str, int]
+    input_mask: int
+    table: Table
 
 
 @dataclass(frozen=True)
@@ -28,7 +38,7 @@ class TickInput:
     pulses: tuple[int, ...] = ()
 
 
-def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
+def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     """Read an inputs CSV: a header of input (and counter-pulse) names, one row per tick, blank = 0; or a
     run's trace (JSON Lines, see :func:`trace_inputs`)."""
     path = Path(path)
@@ -47,7 +57,7 @@ def load_inputs(path: str | Path, machine: Machine) -> list[TickInput]:
     return ticks
 
 
-def _columns(header: Sequence[Cell], machine: Machine, out: Collector) -> list[tuple[str, str]]:
+def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tuple[str, str]]:
     """(kind, name) per header cell: ``input``, ``pulses`` (a counter), ``tick`` or ``blank`` (read
     but ignored), or ``bad`` (already reported)."""
     robot = machine.table.robot
@@ -74,7 +84,7 @@ def _columns(header: Sequence[Cell], machine: Machine, out: Collector) -> list[t
     return columns
 
 
-def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machine, out: Collector) -> TickInput:
+def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events, out: Collector) -> TickInput:
     robot = machine.table.robot
     mask = 0
     pulses = [0] * len(robot.counter_names)
@@ -95,12 +105,12 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Machin
     return TickInput(mask, tuple(pulses))
 
 
-def write_inputs(machine: Machine, ticks: Sequence[TickInput], path: Path) -> Path:
+def write_inputs(machine: Events, ticks: Sequence[TickInput], path: Path) -> Path:
     """Write ``ticks`` as an inputs CSV (1 for an input that reads 1, blank for 0; pulses per counter)."""
     return write_text(path, format_inputs(machine, ticks))
 
 
-def format_inputs(machine: Machine, ticks: Sequence[TickInput]) -> str:
+def format_inputs(machine: Events, ticks: Sequence[TickInput]) -> str:
     names = list(machine.input_bits)
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -117,11 +127,10 @@ def pulses_key(counter: str) -> str:
     return f"{counter}_pulses"
 
 
-def trace_inputs(path: Path, text: str, machine: Machine) -> list[TickInput]:
+def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
     """The inputs a recorded run gave the engine (``tablebot run --out``, ``tablebot sim``): per line, the
     input bits of ``event`` and each counter's ``<counter>_pulses``; an ``{"end": ...}`` record ends it.
     Replaying them with the same table takes the same decisions."""
-    from tablebot.trace import trace_records  # the one reader of trace lines (trace imports this module)
 
     out = Collector(path)
     keys = ("event", *(pulses_key(c) for c in machine.table.robot.counter_names))

@@ -13,9 +13,9 @@ import csv
 from dataclasses import dataclass
 from pathlib import Path
 
+from tablebot.csvtext import read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.files import atomic_write, write_text
-from tablebot.formats.csvtext import read_text, split_records
 from tablebot.robot import STATE_RE, Robot, StateId
 from tablebot.table import (
     DOC_KEEP_SPEED,

@@ -8,11 +8,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tablebot import guard
+from tablebot import overwrite as guard
+from tablebot.csvtext import read_bytes
 from tablebot.diagnostics import Collector, fail
 from tablebot.escape import xml_attr
 from tablebot.files import write_bytes
-from tablebot.formats.csvtext import read_bytes
 
 LIST_CLASS = "ftProDataArray1D"
 DEFAULT_NAMES = ("Event", "Action", "Timer")

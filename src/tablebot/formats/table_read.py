@@ -7,14 +7,13 @@ as ``file:line:column: message`` with a hint. Loading never executes anything fr
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
 from tablebot.durations import DurationError, to_ticks
-from tablebot.formats.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,
@@ -26,6 +25,7 @@ from tablebot.robot import (
     load_robot,
 )
 from tablebot.table import (
+    FIXED,
     MAX_LAMP,
     MAX_SPEED,
     TIMER_EVENT,
@@ -33,11 +33,10 @@ from tablebot.table import (
     Table,
     from_direction_speed,
     missing_states,
+    normalise_header,
 )
 
 KEEP_WORDS = {"=", "keep", "k"}
-ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
-FIXED = ("description", "state", "timer", "next")
 INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
 TIME_RE = re.compile(r"[A-Za-z]\s*$")  # a timer cell that ends in a unit (500ms, 0.5 s, 3 ticks) is a duration
 
@@ -91,19 +90,6 @@ def is_comment(record: Record) -> bool:
 
 # --- header -------------------------------------------------------------------------------------
 
-def _normalise(name: str) -> str:
-    key = re.sub(r"[\s-]+", "_", name.strip())
-    low = key.lower()
-    low = ALIASES.get(low, low)
-    return low if low in FIXED else key
-
-
-def is_table_header(cells: Iterable[str]) -> bool:
-    """Whether header cells name a state and a next column (spelled any way :func:`parse_table` takes)."""
-    names = {_normalise(text) for text in cells}
-    return "state" in names and "next" in names
-
-
 def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
     if name in FIXED:
         return name, name
@@ -128,7 +114,7 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
                        *(f"{m}_dir/{m}_speed or {m}" for m in robot.motors), *robot.lamps,
                        *(f"{c}_load" for c in robot.counter_names)])
     for cell in record.cells:
-        name = _normalise(cell.text)
+        name = normalise_header(cell.text)
         if not name:
             columns.append(Column("ignore", "", cell))
             continue
@@ -324,3 +310,14 @@ def _robot_error(out: Collector, robot: Robot, where: tuple[str, str], columns: 
         return
     state = next((c.cell for c in columns if c.kind == "state"), None)
     out.error(state.line if state else 1, state.column if state else 1, message, hint)
+
+
+def resolve_table_path(path: Path) -> Path:
+    """A folder stands for the table.csv inside it, so ``tablebot trace examples/bumberbot`` works."""
+    if path.is_dir():
+        for name in ("table.csv", "table.tsv"):
+            if (path / name).is_file():
+                return path / name
+        raise fail(path, "this folder holds no table.csv or table.tsv",
+                   "give the table file itself, or a folder that holds table.csv")
+    return path

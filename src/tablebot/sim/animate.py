@@ -18,7 +18,7 @@ from PIL import Image
 
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings, state_colours
 from tablebot.sim.plots import subtitle_of, title_of
 from tablebot.sim.runner import Result

@@ -21,7 +21,7 @@ from matplotlib.patches import Polygon, Rectangle, Wedge
 
 from tablebot.robot import StateId
 from tablebot.sensors import Sensor
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.params import Params
 from tablebot.sim.world import Geometry, World
 

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.kernels import tick_compiled
+from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.geometry import within
-from tablebot.sim.layout import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.normals import standard_normal
 from tablebot.sim.physics import advance, new_near, reaches
 from tablebot.tick import EVENT, ROW, STATE, TIMER

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.formats.tomlfile import Source, known_keys, number, table_of
 from tablebot.sensors import Sensor
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
+from tablebot.tomlfile import Source, known_keys, number, table_of
 
 Number = int | float
 

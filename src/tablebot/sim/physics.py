@@ -1,5 +1,5 @@
 """All geometry and physics of the simulator: motors and battery, kinematics, collisions, bumpers, light.
-It works on numpy arrays of N robots (layout in :mod:`tablebot.sim.layout`), compiled with numba, so one
+It works on numpy arrays of N robots (layout in :mod:`tablebot.sim.columns`), compiled with numba, so one
 robot and a batch of thousands (which do not see each other) share this code.
 """
 
@@ -21,8 +21,7 @@ import math
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_within, segments_within, within
-from tablebot.sim.layout import (
+from tablebot.sim.columns import (
     AMPS,
     B_FL,
     B_FR,
@@ -81,6 +80,7 @@ from tablebot.sim.layout import (
     X,
     Y,
 )
+from tablebot.sim.geometry import point_segment_within, segments_within, within
 from tablebot.sim.sensing import light_from, sense_declared, sensor_events
 
 NO_LINES = np.zeros((0, 5))  # a world without tape on its floor

@@ -15,7 +15,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from tablebot.files import atomic_write
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
     COLLISION,

@@ -1,4 +1,4 @@
-"""A simulated run: the run loop driving a :class:`~tablebot.sim.robot.SimRobot`, with a sink that
+"""A simulated run: the run loop driving a :class:`~tablebot.sim.simrobot.SimRobot`, with a sink that
 keeps the run's history for the summary and the pictures (and any other sinks, such as the trace).
 """
 
@@ -13,12 +13,13 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
 from tablebot.loop import run as run_loop
-from tablebot.sim import layout as L
-from tablebot.sim.robot import SimRobot
+from tablebot.sim import columns as L
 from tablebot.sim.scene import Scene
-from tablebot.trace import TickInput, block_lines
+from tablebot.sim.simrobot import SimRobot
+from tablebot.sinks.trace_file import block_lines
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
 PATH_STRIDE = 5  # robot rows per point of the thinned path (the robot moves well under 1 cm a tick)
@@ -170,7 +171,7 @@ def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], N
 
 def block_of(result: Result) -> TickBlock:
     """The whole run as one block of ticks, with the simulator's trace fields."""
-    from tablebot.sim.robot import trace_columns
+    from tablebot.sim.simrobot import trace_columns
 
     return TickBlock(0, result.masks, result.pulses, result.events, result.rows, result.states, result.timers,
                      result.outputs, result.counters, trace_columns(result.scene, result.hist[:-1]))

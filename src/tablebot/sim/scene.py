@@ -16,7 +16,7 @@ import numpy as np
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.robot import Robot
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.params import (
     INPUT_ROLES,
     Params,

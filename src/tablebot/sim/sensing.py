@@ -2,7 +2,7 @@
 echo inside a beam, light at any point of the body, and the threshold events with their hysteresis.
 
 Each is a compiled function of one robot's state row ``s``, its parameter row ``p`` (sensor slots in
-:mod:`tablebot.sim.layout`) and the world's arrays, so any loop over robots can call them.
+:mod:`tablebot.sim.columns`) and the world's arrays, so any loop over robots can call them.
 """
 
 from __future__ import annotations
@@ -10,8 +10,7 @@ from __future__ import annotations
 import math
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
-from tablebot.sim.layout import (
+from tablebot.sim.columns import (
     B_SENSOR,
     F_AIM,
     F_KIND,
@@ -38,6 +37,7 @@ from tablebot.sim.layout import (
     X,
     Y,
 )
+from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
 
 
 @njit(cache=True, refcounts=False)

@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tablebot.robot import StateId
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.track import laps
+from tablebot.sinks.run_trace import seconds_per_state
 
 if TYPE_CHECKING:  # only types: time per state is wanted beside a real robot's run, without the simulator
     from tablebot.sim.runner import Result
@@ -71,15 +72,6 @@ def time_per_state(states: np.ndarray, names: tuple[StateId, ...], tick_s: float
     order, where = np.unique(states, return_index=True)
     first_seen[order] = where
     return seconds_per_state(np.bincount(states, minlength=len(names)), first_seen, names, tick_s)
-
-
-def seconds_per_state(counts: np.ndarray, first_seen: np.ndarray, names: tuple[StateId, ...],
-                      tick_s: float) -> dict[StateId, float]:
-    """Seconds per state from its tick count and the tick it was first seen (-1: never), in order of
-    first visit (a fleet keeps only these two per robot)."""
-    visited = np.flatnonzero(first_seen >= 0)
-    order = visited[np.argsort(first_seen[visited], kind="stable")]
-    return {names[index]: float(counts[index] * tick_s) for index in order.tolist()}
 
 
 def summarise(result: Result) -> Summary:

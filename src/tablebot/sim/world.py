@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.formats.tomlfile import Source, Where, known_keys, label, number, point, table_of
 from tablebot.sim.params import SECTIONS, check_layer
+from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", "line", *SECTIONS)

@@ -6,9 +6,9 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass
 
+from tablebot.formats.inputs_csv import TickInput
 from tablebot.robot import Counter, Robot, StateId
 from tablebot.table import MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table
-from tablebot.trace import TickInput
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
 from tablebot.machine import NO_ROW, Machine, compile_table
 from tablebot.robot import BUMBERBOT, Robot, find_robot_file, load_robot
-from tablebot.table import Table
+from tablebot.table import Table, normalise_header
 from tablebot.web.document import CsvDocument
 
 #: Column kinds the grid draws differently (see table_read.Column.kind).
@@ -45,7 +45,7 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
     """Per header cell: its kind for the grid (event, dir, speed, signed, timer, state, ...) and a label."""
     out = []
     for text in header:
-        name = table_read._normalise(text)  # the parser's own reading of a header cell
+        name = normalise_header(text)  # the parser's own reading of a header cell
         kind_name = table_read._classify(name, robot) if name else None
         kind, base = kind_name if kind_name else ("unknown", name)
         label = robot.labels.get(base, "timer ran out" if base == "T" else "")

@@ -1,5 +1,5 @@
 """The studio's web server: the page and its scripts from the package, one WebSocket per tab, trace
-uploads; it serves one folder and nothing outside it.
+uploads; it serves one folder and nothing outside it, and only to its own page (see :mod:`.access`).
 """
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import uvicorn
 from starlette.applications import Starlette
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
@@ -18,6 +19,8 @@ from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
+from tablebot.web.access import Access, Gate, hide_token_in_logs
+from tablebot.web.errors import INTERNAL, log
 from tablebot.web.session import Hub, Session
 from tablebot.web.tracefile import MAX_TRACE_BYTES, read_trace_bytes, trace_columns
 from tablebot.web.workspace import Workspace
@@ -34,18 +37,22 @@ class Gone(Exception):
     """The tab closed its WebSocket: stop talking to it."""
 
 
-def create_app(root: Path, table: str | None = None) -> Starlette:
-    """The studio for folder ``root``; ``table`` (relative to it) opens first."""
+def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
+    """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first."""
     workspace = Workspace(root)
     hub = Hub()
 
     async def index(request: Request) -> Response:
         response = FileResponse(STATIC / "index.html", headers={"Content-Security-Policy": CSP,
                                                                 "Cache-Control": "no-store"})
+        if access.has_token(None, request.query_params.get("token")):  # the first visit: the page keeps it
+            response.headers.append("Set-Cookie", access.set_cookie())
         return response
 
     async def config(request: Request) -> Response:
-        return JSONResponse({"table": table, "folder": workspace.root.name, **workspace.listing()})
+        listing = await asyncio.to_thread(workspace.listing)
+        return JSONResponse({"table": table, "folder": workspace.root.name, **listing},
+                            headers={"Cache-Control": "no-store"})
 
     async def upload_trace(request: Request) -> Response:
         """A trace file from the user's computer (the body), size-limited while it arrives."""
@@ -60,6 +67,9 @@ def create_app(root: Path, table: str | None = None) -> Starlette:
             lines = await asyncio.to_thread(read_trace_bytes, bytes(body), name)
         except TableBotError as exc:
             return JSONResponse({"type": "error", "message": str(exc)}, status_code=400)
+        except Exception:  # a bug: the page gets the studio's words, the terminal the traceback
+            log.exception("an uploaded trace failed")
+            return JSONResponse({"type": "error", "message": INTERNAL}, status_code=500)
         return JSONResponse({"type": "trace", "name": name, "columns": trace_columns(lines)})
 
     async def socket(websocket: WebSocket) -> None:
@@ -80,8 +90,13 @@ def create_app(root: Path, table: str | None = None) -> Starlette:
         ticker = asyncio.create_task(_frames(session))
         try:
             while True:
-                text = await websocket.receive_text()
-                await _answer(session, text)
+                message = await websocket.receive()
+                if message["type"] == "websocket.disconnect":
+                    break
+                if message.get("text") is None:
+                    await session.error("a message must be JSON text, not binary data")
+                    continue
+                await _answer(session, message["text"])
         except (WebSocketDisconnect, Gone):
             pass
         finally:
@@ -91,7 +106,7 @@ def create_app(root: Path, table: str | None = None) -> Starlette:
 
     routes = [Route("/", index), Route("/api/config", config), Route("/api/trace", upload_trace, methods=["POST"]),
               WebSocketRoute("/ws", socket), Mount("/static", StaticFiles(directory=STATIC), name="static")]
-    return Starlette(routes=routes)
+    return Gate(Starlette(routes=routes), access)
 
 
 async def _answer(session: Session, text: str) -> None:
@@ -104,12 +119,16 @@ async def _answer(session: Session, text: str) -> None:
     except json.JSONDecodeError as exc:
         await session.error(f"not JSON: {exc.msg}")
         return
+    except RecursionError:
+        await session.error("the message is nested too deeply: the page never sends such a message")
+        return
     try:
         await session.handle(message)
     except Gone:
         raise
-    except Exception as exc:  # a bug: say so on the page and keep serving
-        await session.error(f"internal error: {type(exc).__name__}: {exc}")
+    except Exception:  # a bug: the page is told so, the terminal gets the traceback, the server goes on
+        log.exception("a message from the page failed")
+        await session.error(INTERNAL)
 
 
 async def _frames(session: Session) -> None:
@@ -120,29 +139,39 @@ async def _frames(session: Session) -> None:
             await session.frame()
         except Gone:
             return
-        except Exception as exc:
+        except Exception:
+            log.exception("the live view stopped")
             with contextlib.suppress(Exception):  # the socket itself may be what failed
-                await session.error(f"the live view stopped: {type(exc).__name__}: {exc}")
+                await session.error("the live view stopped: " + INTERNAL)
             return
 
 
-class Background:
-    """The studio served from a thread (tests, benchmarks): ``url`` while running, :meth:`stop` to end."""
+def server(app: Gate, access: Access, log_level: str = "warning") -> uvicorn.Server:
+    """A uvicorn server for the studio (run it with ``sockets=[...]``); the token never reaches its logs."""
+    config = uvicorn.Config(app, log_level=log_level, access_log=log_level in ("info", "debug", "trace"),
+                            ws_max_size=MAX_MESSAGE_BYTES, lifespan="off")
+    hide_token_in_logs(access.token)  # uvicorn configured its loggers just now, in Config()
+    return uvicorn.Server(config)
 
-    def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0):
+
+class Background:
+    """The studio served from a thread (tests, benchmarks): ``url`` (with its token) while running,
+    ``origin`` and ``headers`` (what its own page would send) for other clients, :meth:`stop` to end."""
+
+    def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
+                 log_level: str = "warning"):
         import socket
         import threading
-
-        import uvicorn
 
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         self.sock.bind((host, port))
         self.sock.listen(64)
-        self.url = f"http://{host}:{self.sock.getsockname()[1]}/"
-        config = uvicorn.Config(create_app(root, table), log_level="warning", ws_max_size=MAX_MESSAGE_BYTES,
-                                lifespan="off")
-        self.server = uvicorn.Server(config)
+        self.access = Access.serving(host, self.sock.getsockname()[1])
+        self.origin = f"http://{host}:{self.access.port}"
+        self.url = self.access.url(host)
+        self.headers = {"Origin": self.origin, "Cookie": f"{self.access.cookie}={self.access.token}"}
+        self.server = server(create_app(root, self.access, table), self.access, log_level)
         self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]}, daemon=True)
         self.thread.start()
         while not self.server.started:

@@ -1,7 +1,7 @@
 """A table file as the studio edits it: every cell keeps its exact source text, so saving writes the
 file back byte for byte except the cells that were edited (delimiter, quoting, BOM, line ends kept).
 
-Cell values and (line, column) positions follow :func:`tablebot.formats.csvtext.split_records`, so a
+Cell values and (line, column) positions follow :func:`tablebot.csvtext.split_records`, so a
 diagnostic from the real parser lands on the cell the user sees.
 """
 
@@ -10,8 +10,9 @@ from __future__ import annotations
 import codecs
 from dataclasses import dataclass, field
 
+from tablebot.csvtext import SEP_RE, detect_delimiter, split_records
 from tablebot.diagnostics import fail
-from tablebot.formats.csvtext import SEP_RE, detect_delimiter, split_records
+from tablebot.web.errors import Refused
 
 #: A table larger than this is not a table a person edits in a grid.
 MAX_TABLE_BYTES = 1_000_000
@@ -57,12 +58,18 @@ class CsvDocument:
         if len(data) > MAX_TABLE_BYTES:
             raise fail(path, f"the file has {len(data):,} bytes; the studio edits tables up to "
                        f"{MAX_TABLE_BYTES:,}", "edit it in a spreadsheet or split it")
-        if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-            text, encoding = data.decode("utf-16"), "utf-16"
-        elif data.startswith(codecs.BOM_UTF8):
-            text, encoding = data[3:].decode("utf-8"), "utf-8-sig"
-        else:
-            text, encoding = data.decode("utf-8"), "utf-8"
+        try:
+            if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+                text, encoding = data.decode("utf-16"), "utf-16"
+            elif data.startswith(codecs.BOM_UTF8):
+                text, encoding = data[3:].decode("utf-8"), "utf-8-sig"
+            else:
+                text, encoding = data.decode("utf-8"), "utf-8"
+        except UnicodeDecodeError as exc:
+            line = data[: exc.start].count(b"\n") + 1
+            raise fail(path, f"byte {exc.start} is not {exc.encoding.upper()} text: the studio edits tables saved "
+                       "as UTF-8 or UTF-16", "save it as UTF-8 (Excel: CSV UTF-8), or edit it in a spreadsheet",
+                       line) from None
         return cls.from_text(text, encoding, path)
 
     @classmethod
@@ -121,10 +128,10 @@ class CsvDocument:
     def set_cell(self, row: int, column: int, value: str) -> None:
         """Set one cell of a grid row (``row`` -1: the header); other cells keep their bytes."""
         if len(value) > MAX_CELL_CHARS:
-            raise ValueError(f"a cell holds at most {MAX_CELL_CHARS} characters")
+            raise Refused(f"a cell holds at most {MAX_CELL_CHARS} characters")
         record = self._record(row)
         if column < 0 or column > max(len(self.header_values()), len(record.cells)):
-            raise ValueError(f"there is no column {column + 1}")
+            raise Refused(f"there is no column {column + 1}")
         while len(record.cells) <= column:
             record.cells.append(RawCell("", ""))
         old = record.cells[column]
@@ -135,7 +142,7 @@ class CsvDocument:
     def insert_row(self, after: int, values: list[str] | None = None) -> int:
         """A new grid row after grid row ``after`` (-1: first); returns its grid index."""
         if after < -1 or after >= len(self.row_ids):
-            raise ValueError(f"there is no row {after + 1}")
+            raise Refused(f"there is no row {after + 1}")
         width = len(self.header_values())
         values = (values or []) + [""] * max(0, width - len(values or []))
         cells = [RawCell(self._encode(v, False), v) for v in values]
@@ -158,13 +165,13 @@ class CsvDocument:
 
     def _check_row(self, row: int) -> int:
         if not 0 <= row < len(self.row_ids):
-            raise ValueError(f"there is no row {row + 1}")
+            raise Refused(f"there is no row {row + 1}")
         return row
 
     def _record(self, row: int) -> RawRecord:
         if row == -1:
             if self.header is None:
-                raise ValueError("the table has no header")
+                raise Refused("the table has no header")
             return self.header
         return self.records[self.row_ids[self._check_row(row)]]
 
@@ -276,4 +283,4 @@ def _quoted_end(text: str, i: int) -> tuple[int, str]:
             return i + 1, "".join(out).replace("\r\n", "\n").replace("\r", "\n")
         out.append(ch)
         i += 1
-    raise ValueError("a quoted cell is never closed")
+    raise Refused("a quoted cell is never closed")

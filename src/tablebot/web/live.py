@@ -16,9 +16,10 @@ from typing import Any
 
 from tablebot.engine import Engine
 from tablebot.loop import Reading, RunEnd, RunInfo, Sink, TickBlock, run
-from tablebot.sim import layout as L
-from tablebot.sim.robot import SimRobot, light_keys
+from tablebot.sim import columns as L
 from tablebot.sim.scene import Scene
+from tablebot.sim.simrobot import SimRobot, light_keys
+from tablebot.web.errors import INTERNAL, log
 
 PATH_STEP_M = 0.005  # a path point every 5 mm (or at a state change): what the eye can see
 MAX_FIRED = 200  # fired rows kept between two frames
@@ -213,8 +214,9 @@ class LiveRun:
     def _run(self) -> None:
         try:
             end = run(self.engine, self.robot, clock=self.clock, sinks=self.sinks, target="studio")
-        except Exception as exc:  # a bug: shown on the page rather than lost in a thread
-            self.error = f"{type(exc).__name__}: {exc}"
+        except Exception:  # a bug: the page says so, the terminal gets the traceback
+            log.exception("the live robot stopped")
+            self.error = INTERNAL
             return
         if self._on_end:
             self._on_end(end)

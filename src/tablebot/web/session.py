@@ -8,17 +8,18 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Awaitable, Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import TableBotError
 from tablebot.robot import Robot
 from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot_for
-from tablebot.web.document import CsvDocument
+from tablebot.web.document import MAX_TABLE_BYTES, CsvDocument
+from tablebot.web.errors import Refused
 from tablebot.web.simulate import Arena, ArenaSettings
-from tablebot.web.tracefile import read_trace_bytes, trace_columns
-from tablebot.web.workspace import ChangedOnDisk, OutsideFolder, Workspace, digest, save_table
+from tablebot.web.tracefile import MAX_TRACE_BYTES, read_trace_bytes, trace_columns
+from tablebot.web.workspace import ChangedOnDisk, Kind, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
 
@@ -29,10 +30,10 @@ class Hub:
     def __init__(self) -> None:
         self.sessions: set[Session] = set()
 
-    async def saved(self, by: Session, path: Path, version: str) -> None:
+    async def saved(self, by: Session, file: Opened) -> None:
         for other in list(self.sessions):
-            if other is not by and other.path == path:
-                await other.saved_elsewhere(version)
+            if other is not by and other.opened is not None and other.opened.name == file.name:
+                await other.saved_elsewhere(file)
 
 
 @dataclass(eq=False)  # sessions are compared (and hashed) by identity
@@ -40,9 +41,8 @@ class Session:
     workspace: Workspace
     hub: Hub
     send: Send
-    path: Path | None = None
+    opened: Opened | None = None  # the table file as read (or last saved): a save writes only this file
     doc: CsvDocument | None = None
-    version: str | None = None  # digest of the file on disk this draft started from
     dirty: bool = False
     analysis: Analysis | None = None
     robot: Robot | None = None  # the table's robot file, read when the table is opened
@@ -64,8 +64,18 @@ class Session:
         except TableBotError as exc:
             await self.send({"type": "error", "message": exc.diagnostics[0].message if exc.diagnostics else str(exc),
                              "text": str(exc), "op": message["op"]})
-        except (OutsideFolder, ValueError, TypeError, KeyError) as exc:
+        except Refused as exc:
             await self.error(str(exc), message["op"])
+
+    @property
+    def path(self) -> Path | None:
+        """Where the open table is (the robot file, world and properties are looked for beside it)."""
+        return None if self.opened is None else self.workspace.root / self.opened.name
+
+    @property
+    def version(self) -> str | None:
+        """Digest of the file on disk this draft started from."""
+        return None if self.opened is None else self.opened.version
 
     async def error(self, text: str, op: str = "") -> None:
         await self.send({"type": "error", "message": text, "op": op})
@@ -76,20 +86,17 @@ class Session:
     # --- the table -------------------------------------------------------------------------------------
 
     async def open_table(self, message: dict[str, Any]) -> None:
-        path = self.workspace.resolve(_text(message, "path"))
-        try:
-            data = path.read_bytes()
-        except OSError as exc:
-            raise ValueError(f"cannot read {self.workspace.relative(path)}: {exc.strerror}") from None
-        doc = CsvDocument.from_bytes(data, self.workspace.relative(path))
+        opened = await asyncio.to_thread(self.workspace.read, _text(message, "path"), Kind.TABLE, MAX_TABLE_BYTES)
+        doc = CsvDocument.from_bytes(opened.data, opened.name)
+        path = self.workspace.root / opened.name
         try:
             self.robot, self.robot_error = await asyncio.to_thread(robot_for, path), None
         except TableBotError as exc:  # the grid still opens; the robot file's errors are listed
             self.robot, self.robot_error = None, exc
-        self.path, self.doc, self.version, self.dirty = path, doc, digest(data), False
+        self.opened, self.doc, self.dirty = opened, doc, False
         self.arena.close()
         self.arena = Arena()
-        await self.send({"type": "table", "path": self.workspace.relative(path), "header": doc.header_values(),
+        await self.send({"type": "table", "path": opened.name, "header": doc.header_values(),
                          "grid": doc.grid(), "lines": _grid_lines(doc), "version": self.version,
                          "dialect": {"delimiter": doc.dialect.delimiter, "encoding": doc.dialect.encoding,
                                      "newline": repr(doc.dialect.newline)[1:-1]}})
@@ -98,14 +105,13 @@ class Session:
             await self.reset_arena({})
 
     async def reanalyse(self, seq: Any) -> None:
-        assert self.doc is not None and self.path is not None
+        assert self.doc is not None and self.path is not None and self.opened is not None
         if self.robot is None:
             assert self.robot_error is not None
             await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
                              **robot_failed(self.robot_error, self.doc)})
             return
-        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot,
-                                                self.workspace.relative(self.path))
+        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot, self.opened.name)
         await self.send({"type": "analysis", "seq": seq, "dirty": self.dirty, "lines": _grid_lines(self.doc),
                          **self.analysis.data})
         if self.analysis.table is not None:
@@ -114,7 +120,7 @@ class Session:
 
     def _need_doc(self) -> CsvDocument:
         if self.doc is None:
-            raise ValueError("open a table first")
+            raise Refused("open a table first")
         return self.doc
 
     async def edit(self, message: dict[str, Any]) -> None:
@@ -138,35 +144,37 @@ class Session:
         await self.reanalyse(message.get("seq"))
 
     async def save(self, message: dict[str, Any]) -> None:
+        """Save the draft over the file this session opened, and only that file (see Workspace.save)."""
         doc = self._need_doc()
-        assert self.path is not None
-        expected = None if message.get("force") is True else self.version
+        assert self.opened is not None
         try:
-            version = await asyncio.to_thread(save_table, self.path, doc.to_bytes(), expected)
+            saved = await asyncio.to_thread(self.workspace.save, self.opened, doc.to_bytes(),
+                                            message.get("force") is True)
         except ChangedOnDisk as exc:
             await self.send({"type": "conflict", "message": f"{exc}: saving now would overwrite those changes",
                              "hint": "reload to see them (your edits are lost), or save anyway (theirs are lost)"})
             return
-        self.version, self.dirty = version, False
-        await self.send({"type": "saved", "version": version, "path": self.workspace.relative(self.path),
-                         "backup": self.workspace.relative(self.path) + ".bak"})
-        await self.hub.saved(self, self.path, version)
+        self.opened, self.dirty = saved, False
+        await self.send({"type": "saved", "version": saved.version, "path": saved.name,
+                         "backup": saved.name + ".bak"})
+        await self.hub.saved(self, saved)
 
-    async def saved_elsewhere(self, version: str) -> None:
+    async def saved_elsewhere(self, file: Opened) -> None:
         """Another tab saved this file: reload it when this tab has no edits of its own, else say so."""
-        if self.dirty:
+        assert self.opened is not None
+        if self.dirty:  # the file on disk is now the one the other tab wrote: a forced save may replace it
+            self.opened = replace(self.opened, identity=file.identity, mode=file.mode)
             await self.send({"type": "conflict", "message": "another tab saved this table; yours has unsaved edits",
                              "hint": "reload to take theirs, or save anyway to keep yours"})
             return
-        assert self.path is not None
-        await self.open_table({"path": self.workspace.relative(self.path), "reason": "saved in another tab"})
+        await self.open_table({"path": file.name, "reason": "saved in another tab"})
         await self.send({"type": "notice", "message": "reloaded: the table was saved in another tab"})
 
     # --- the arena -------------------------------------------------------------------------------------
 
     async def reset_arena(self, message: dict[str, Any]) -> None:
         if self.analysis is None or self.analysis.table is None or self.analysis.machine is None:
-            raise ValueError("fix the table's errors first: the robot runs only a table that reads")
+            raise Refused("fix the table's errors first: the robot runs only a table that reads")
         settings = ArenaSettings.of(message, self.arena.settings)
         info = await asyncio.to_thread(self.arena.reset, self.analysis.table, self.analysis.machine, settings)
         await self.send({"type": "arena", **info})
@@ -188,9 +196,8 @@ class Session:
     # --- traces ----------------------------------------------------------------------------------------
 
     async def open_trace(self, message: dict[str, Any]) -> None:
-        path = self.workspace.resolve(_text(message, "path"))
-        data = await asyncio.to_thread(path.read_bytes)
-        await self.send_trace(data, self.workspace.relative(path))
+        opened = await asyncio.to_thread(self.workspace.read, _text(message, "path"), Kind.TRACE, MAX_TRACE_BYTES)
+        await self.send_trace(opened.data, opened.name)
 
     async def send_trace(self, data: bytes, name: str) -> None:
         lines = await asyncio.to_thread(read_trace_bytes, data, name)
@@ -199,17 +206,17 @@ class Session:
     async def counterexample(self, message: dict[str, Any]) -> None:
         """A property's counterexample: replayed on the table (trace player) or scripted into the arena."""
         if self.analysis is None or self.analysis.report is None:
-            raise ValueError("fix the table's errors first")
+            raise Refused("fix the table's errors first")
         name = _text(message, "name")
         result = next((r for r in self.analysis.report.results if r.prop.name == name), None)
         if result is None or not result.inputs:
-            raise ValueError(f"property {name!r} has no counterexample")
+            raise Refused(f"property {name!r} has no counterexample")
         if message.get("where") == "arena":
             await self.reset_arena({})
             self.arena.control("script", {"masks": [t.mask for t in result.inputs]})
             await self.send({"type": "control", **self.arena.status()})
             return
-        from tablebot.trace import replay
+        from tablebot.replay import replay
         lines = list(replay(self.analysis.report.machine, result.inputs))
         await self.send({"type": "trace", "name": f"counterexample: {name}", "columns": trace_columns(lines),
                          "at_tick": result.at_tick})
@@ -223,19 +230,19 @@ def _grid_lines(doc: CsvDocument) -> list[int]:
 def _text(message: dict[str, Any], key: str, allow_empty: bool = False) -> str:
     value = message.get(key)
     if not isinstance(value, str) or (not value and not allow_empty):
-        raise ValueError(f'"{key}" must be text')
+        raise Refused(f'"{key}" must be text')
     return value
 
 
 def _int(message: dict[str, Any], key: str) -> int:
     value = message.get(key)
     if not isinstance(value, int) or isinstance(value, bool):
-        raise ValueError(f'"{key}" must be a whole number')
+        raise Refused(f'"{key}" must be a whole number')
     return value
 
 
 async def _list(session: Session, message: dict[str, Any]) -> None:
-    await session.send({"type": "files", **session.workspace.listing()})
+    await session.send({"type": "files", **await asyncio.to_thread(session.workspace.listing)})
 
 
 HANDLERS: dict[str, Callable[[Session, dict[str, Any]], Awaitable[None]]] = {

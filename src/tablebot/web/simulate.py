@@ -11,12 +11,13 @@ from typing import Any
 import graphviz
 
 from tablebot.analysis.diagram import to_graphviz
-from tablebot.diagnostics import TableBotError
+from tablebot.diagnostics import TableBotError, fail
 from tablebot.machine import Machine
-from tablebot.sim.robot import SimRobot
 from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
+from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.world import World
 from tablebot.table import Table
+from tablebot.web.errors import Refused
 from tablebot.web.live import SPEEDS, LiveRun
 from tablebot.web.worldview import moved, world_json
 
@@ -28,9 +29,9 @@ def _number(message: dict[str, Any], key: str, low: float, high: float) -> float
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f'"{key}" must be a number')
+        raise Refused(f'"{key}" must be a number')
     if not low <= value <= high:
-        raise ValueError(f'"{key}" must be from {low:g} to {high:g}')
+        raise Refused(f'"{key}" must be from {low:g} to {high:g}')
     return float(value)
 
 
@@ -55,11 +56,11 @@ class ArenaSettings:
         if "lamp" in message:
             pair = message["lamp"]
             if not isinstance(pair, list) or len(pair) != 2:
-                raise ValueError('"lamp" must be [x, y]')
+                raise Refused('"lamp" must be [x, y]')
             lamp = (_number({"v": pair[0]}, "v", -1e3, 1e3), _number({"v": pair[1]}, "v", -1e3, 1e3))  # type: ignore
         speed = message.get("speed", old.speed)
         if speed not in SPEEDS:
-            raise ValueError(f"speed must be one of {', '.join(SPEEDS)}")
+            raise Refused(f"speed must be one of {', '.join(SPEEDS)}")
         paused = message.get("paused", old.paused)
         return cls(int(seed) if seed is not None else old.seed, charge if charge is not None else old.charge,
                    start, lamp, speed, bool(paused))
@@ -67,7 +68,7 @@ class ArenaSettings:
 
 def _triple(value: Any) -> list[Any]:
     if not isinstance(value, list) or len(value) != 3:
-        raise ValueError('"start" must be [x, y, heading]')
+        raise Refused('"start" must be [x, y, heading]')
     return value
 
 
@@ -88,6 +89,9 @@ class Arena:
         self.settings, self.table, self.machine = settings, table, machine
         try:
             layer, robot_world = robot_layer(table.robot)
+            if robot_world is not None and robot_world.exists() and not robot_world.is_file():
+                raise fail(robot_world, "the robot's world is not a regular file (a folder, pipe or device)",
+                           "name a world .toml file in the robot file's [sim] section")
             base: World = find_world(table, None, robot_world)
             world = moved(base, settings.start, settings.lamp)
             overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}
@@ -104,7 +108,7 @@ class Arena:
     def control(self, action: str, message: dict[str, Any]) -> None:
         run = self.run
         if run is None:
-            raise ValueError(self.problem or "the robot is not running: fix the table first")
+            raise Refused(self.problem or "the robot is not running: fix the table first")
         if action == "play":
             run.play()
         elif action == "pause":
@@ -114,28 +118,28 @@ class Arena:
         elif action == "speed":
             speed = message.get("speed")
             if speed not in SPEEDS:
-                raise ValueError(f"speed must be one of {', '.join(SPEEDS)}")
+                raise Refused(f"speed must be one of {', '.join(SPEEDS)}")
             run.set_speed(speed)
             self.settings = replace(self.settings, speed=speed)
         elif action == "hold":
             self._hold(run, message)
         elif action == "script":
             masks = message.get("masks")
-            if not isinstance(masks, list) or not all(isinstance(m, int) for m in masks):
-                raise ValueError('"masks" must be a list of whole numbers')
+            if not isinstance(masks, list) or not all(type(m) is int and 0 <= m < 2**31 for m in masks):
+                raise Refused('"masks" must be a list of whole numbers')
             run.pause()
             run.play_script(masks)
         else:
-            raise ValueError(f"unknown action {action!r}")
+            raise Refused(f"unknown action {action!r}")
 
     def _hold(self, run: LiveRun, message: dict[str, Any]) -> None:
         assert self.machine is not None
         name, on = message.get("input"), message.get("on")
         bits = self.machine.input_bits
         if name not in bits:
-            raise ValueError(f"unknown input {name!r}: the robot's inputs are {', '.join(bits)}")
+            raise Refused(f"unknown input {name!r}: the robot's inputs are {', '.join(bits)}")
         if on not in (True, False, None):
-            raise ValueError('"on" must be true, false or null')
+            raise Refused('"on" must be true, false or null')
         run.hold(bits[name], on)
 
     def status(self) -> dict[str, Any]:

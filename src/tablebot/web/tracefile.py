@@ -7,9 +7,8 @@ from collections.abc import Iterable
 from typing import Any
 
 from tablebot.diagnostics import fail
-from tablebot.trace import parse_trace
+from tablebot.formats.trace_lines import parse_trace
 
-#: An hour of BumberBot simulation is ~40 MB of JSON Lines.
 MAX_TRACE_BYTES = 64 * 1024 * 1024
 REQUIRED = ("tick", "state")
 #: Columns the player draws when a trace has them (core fields, then the simulator's pose).
@@ -27,7 +26,7 @@ def trace_columns(lines: Iterable[dict[str, Any]]) -> dict[str, list[Any]]:
 
 
 def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
-    """Parse JSON Lines (through the one trace reader, :func:`tablebot.trace.parse_trace`); every bad line
+    """Parse JSON Lines (through the one trace reader, :func:`tablebot.formats.trace_lines.parse_trace`); every bad line
     is reported (the first ten) with its number."""
     if len(data) > MAX_TRACE_BYTES:
         raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_TRACE_BYTES:,}",

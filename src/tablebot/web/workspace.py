@@ -1,119 +1,305 @@
-"""The folder the studio serves: paths inside it only, the tables and traces it holds, and saving a
-table safely (previous version kept as a backup, never over a file that changed on disk meanwhile).
+"""The folder the studio serves: which of its files the page may name (tables and traces, never a
+dotfile, a dot-folder or any other kind of file), reading them without ever blocking on a pipe or a
+device, and saving a table safely.
+
+Every file is reached from the folder through directory descriptors opened without following links
+(``O_NOFOLLOW``), so a link swapped in while the studio works never leads it outside the folder. A save
+writes only the file the session opened (same device and inode), keeps the previous version as
+``NAME.bak``, and refuses a file that changed on disk unless the page says to overwrite it.
 """
 
 from __future__ import annotations
 
+import codecs
+import contextlib
+import enum
+import errno
 import hashlib
 import os
-import shutil
+import secrets
+import stat
+from collections.abc import Iterator
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
-from tablebot.diagnostics import fail
-from tablebot.files import write_bytes
+from tablebot.web.errors import Refused
 
 TABLE_SUFFIXES = (".csv", ".tsv")
 TRACE_SUFFIXES = (".jsonl",)
-SKIP_DIRS = {".git", ".venv", "node_modules", "__pycache__", ".backup"}
+SKIP_DIRS = {"node_modules", "__pycache__"}  # besides every folder whose name starts with a dot
 MAX_LISTED = 500  # files listed for the open menus; a home folder is not a project
 BACKUP_SUFFIX = ".bak"
+HEAD_BYTES = 4096  # read to tell a table from another CSV
+MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table the studio opened is 1 MB at most)
+READ_FLAGS = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_NOCTTY | os.O_CLOEXEC
+DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 
 
-class OutsideFolder(ValueError):
-    """A path that is not inside the served folder."""
+class Kind(enum.Enum):
+    """The kinds of file the page may name, by suffix."""
+
+    TABLE = TABLE_SUFFIXES
+    TRACE = TRACE_SUFFIXES
 
 
 def digest(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()[:16]
 
 
+@dataclass(frozen=True)
+class Opened:
+    """A file as the studio read it: its name in the folder, which file it is, and its bytes."""
+
+    name: str  # where it really is, relative to the folder (links inside the folder resolved)
+    identity: tuple[int, int]  # (st_dev, st_ino): a save writes only this file
+    data: bytes
+    mode: int  # permission bits, kept by a save
+
+    @property
+    def version(self) -> str:
+        return digest(self.data)
+
+
+class ChangedOnDisk(Exception):
+    """The file was changed by someone else since the page loaded it (a save may overwrite it if asked)."""
+
+    def __init__(self, name: str, how: str = "changed"):
+        super().__init__(f"{name} was {how} on disk since you opened it")
+        self.name = name
+
+
 @dataclass
 class Workspace:
-    """The served folder; every path the page names is resolved (and refused) here."""
+    """The served folder; every name the page sends is checked (and refused) here."""
 
     root: Path
 
     def __post_init__(self) -> None:
         self.root = self.root.resolve()
 
-    def resolve(self, name: str) -> Path:
-        """The file ``name`` (relative to the folder) names; anything outside the folder is refused."""
-        if not isinstance(name, str) or not name or "\x00" in name or len(name) > 1000:
-            raise OutsideFolder("no file name given")
-        candidate = Path(name)
-        if candidate.is_absolute() or ".." in candidate.parts:
-            raise OutsideFolder(f"{name!r} is outside the served folder")
-        path = (self.root / candidate).resolve()  # follows symbolic links: a link out of the folder is refused
-        if not path.is_relative_to(self.root):
-            raise OutsideFolder(f"{name!r} is outside the served folder")
-        return path
+    # --- names -----------------------------------------------------------------------------------------
 
-    def relative(self, path: Path) -> str:
-        return path.resolve().relative_to(self.root).as_posix()
+    def locate(self, name: object, kind: Kind) -> str:
+        """The file ``name`` (relative to the folder) really is, as a relative name, if the page may open
+        it: inside the folder, of ``kind``, no part starting with a dot (before and after links)."""
+        if not isinstance(name, str) or not name or "\x00" in name or len(name) > 1000:
+            raise Refused("no file name given")
+        given = PurePosixPath(name.replace("\\", "/"))
+        shown = _shown(name)
+        if given.is_absolute() or ".." in given.parts:
+            raise Refused(f"{shown} is outside the served folder")
+        _check_name(given, kind, shown)
+        try:
+            real = (self.root / given).resolve()
+        except (OSError, RuntimeError):  # a loop of links
+            raise Refused(f"{shown} cannot be opened: its links go round in a circle") from None
+        if not real.is_relative_to(self.root):
+            raise Refused(f"{shown} is outside the served folder (a link leads out of it)")
+        inside = PurePosixPath(real.relative_to(self.root).as_posix())
+        _check_name(inside, kind, shown)
+        return inside.as_posix()
+
+    # --- reading ---------------------------------------------------------------------------------------
+
+    def read(self, name: object, kind: Kind, limit: int) -> Opened:
+        """Read a file the page named: a regular file of ``kind`` in the folder, at most ``limit`` bytes
+        (a table must also look like one: its header names state and next)."""
+        real = self.locate(name, kind)
+        with self._file(real) as (fd, info):
+            if info.st_size > limit:
+                raise Refused(f"{real} has {info.st_size:,} bytes; the studio opens such files up to {limit:,}")
+            data = _read_all(fd, limit)
+        if kind is Kind.TABLE and not _looks_like_table(data[:HEAD_BYTES]):
+            raise Refused(f"{real} is not a table: its first line names no state and next column")
+        return Opened(real, (info.st_dev, info.st_ino), data, stat.S_IMODE(info.st_mode))
+
+    @contextlib.contextmanager
+    def _file(self, real: str) -> Iterator[tuple[int, os.stat_result]]:
+        """An open descriptor of the regular file ``real`` (a relative name from :meth:`locate`)."""
+        parent, leaf = _split(real)
+        with self._folder(parent, real) as folder:
+            try:
+                fd = os.open(leaf, READ_FLAGS, dir_fd=folder)
+            except OSError as exc:
+                raise _refusal(exc, real) from None
+            try:
+                info = os.fstat(fd)
+                if not stat.S_ISREG(info.st_mode):
+                    raise Refused(f"{real} is not a regular file (a folder, pipe or device): the studio skips it")
+                yield fd, info
+            finally:
+                os.close(fd)
+
+    @contextlib.contextmanager
+    def _folder(self, parts: tuple[str, ...], real: str) -> Iterator[int]:
+        """A descriptor of a folder inside the served one, reached without following any link."""
+        fd = os.open(self.root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+        try:
+            for part in parts:
+                try:
+                    inner = os.open(part, DIR_FLAGS, dir_fd=fd)
+                except OSError as exc:
+                    raise _refusal(exc, real) from None
+                os.close(fd)
+                fd = inner
+            yield fd
+        finally:
+            os.close(fd)
+
+    # --- saving ----------------------------------------------------------------------------------------
+
+    def save(self, opened: Opened, data: bytes, force: bool) -> Opened:
+        """Write ``data`` over the file ``opened`` came from, keeping what is there as ``NAME.bak``.
+
+        Refused if the name now leads to another file or outside the folder; :class:`ChangedOnDisk` if
+        its content changed since (unless ``force``). Returns the file as now written."""
+        if self.locate(opened.name, Kind.TABLE) != opened.name:
+            raise Refused(f"{opened.name} now leads to another file: reload it before saving")
+        parent, leaf = _split(opened.name)
+        with self._folder(parent, opened.name) as folder:
+            current, mode = self._current(folder, leaf, opened)
+            if current is None and not force:
+                raise ChangedOnDisk(opened.name, "deleted")
+            if current is not None and digest(current) != opened.version and not force:
+                raise ChangedOnDisk(opened.name)
+            try:
+                if current is not None:
+                    _write_at(folder, leaf + BACKUP_SUFFIX, current, mode)
+                identity = _write_at(folder, leaf, data, mode)
+            except OSError as exc:
+                raise Refused(f"{opened.name} was not saved: {exc.strerror or 'the system refused'} "
+                              "(check the folder's permissions and free space)") from None
+        return Opened(opened.name, identity, data, mode)
+
+    def _current(self, folder: int, leaf: str, opened: Opened) -> tuple[bytes | None, int]:
+        """What is on disk now under the opened name (None: nothing), if it is still the opened file."""
+        try:
+            fd = os.open(leaf, READ_FLAGS, dir_fd=folder)
+        except FileNotFoundError:
+            return None, opened.mode
+        except OSError as exc:
+            raise _refusal(exc, opened.name) from None
+        try:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode) or (info.st_dev, info.st_ino) != opened.identity:
+                raise Refused(f"{opened.name} is no longer the file you opened (it was replaced or moved on "
+                              "disk): reload it, then edit and save again")
+            return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode)
+        finally:
+            os.close(fd)
+
+    # --- listing ---------------------------------------------------------------------------------------
 
     def listing(self) -> dict[str, list[str]]:
-        """Tables and traces in the folder (and its subfolders), relative names, sorted."""
+        """Tables and traces in the folder (and its subfolders), relative names, sorted; never blocks."""
         tables: list[str] = []
         traces: list[str] = []
         count = 0
         for folder, dirs, files in os.walk(self.root):
             dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.startswith("."))
             for name in sorted(files):
-                suffix = Path(name).suffix.lower()
-                if suffix not in TABLE_SUFFIXES + TRACE_SUFFIXES or name.startswith("."):
-                    continue
                 rel = (Path(folder) / name).relative_to(self.root).as_posix()
-                if suffix in TRACE_SUFFIXES:
-                    traces.append(rel)
-                elif _looks_like_table(Path(folder) / name):
-                    tables.append(rel)
+                kind = self._listable(rel)
+                if kind is None:
+                    continue
+                (tables if kind is Kind.TABLE else traces).append(rel)
                 count += 1
                 if count >= MAX_LISTED:
                     return {"tables": tables, "traces": traces}
         return {"tables": tables, "traces": traces}
 
+    def _listable(self, rel: str) -> Kind | None:
+        suffix = PurePosixPath(rel).suffix.lower()
+        kind = Kind.TABLE if suffix in TABLE_SUFFIXES else Kind.TRACE if suffix in TRACE_SUFFIXES else None
+        if kind is None or PurePosixPath(rel).name.startswith("."):
+            return None
+        try:
+            real = self.locate(rel, kind)
+            if kind is Kind.TRACE:
+                with self._file(real):
+                    return kind
+            with self._file(real) as (fd, _):
+                return kind if _looks_like_table(os.read(fd, HEAD_BYTES)) else None
+        except (Refused, OSError):
+            return None
 
-def _looks_like_table(path: Path) -> bool:
-    """A CSV whose header names state and next (inputs CSVs and counterexamples are not tables)."""
+
+# --- helpers ---------------------------------------------------------------------------------------------
+
+def _shown(name: str) -> str:
+    """A name from the page as a message shows it (quoted, control characters escaped, cut short)."""
+    return repr(name[:200])
+
+
+def _check_name(path: PurePosixPath, kind: Kind, shown: str) -> None:
+    if any(part.startswith(".") for part in path.parts):
+        raise Refused(f"{shown}: the studio does not open hidden files or folders (names starting with a dot)")
+    if path.suffix.lower() not in kind.value:
+        what = "a table" if kind is Kind.TABLE else "a trace"
+        raise Refused(f"{shown} is not {what}: the studio opens {' and '.join(kind.value)} files here")
+
+
+def _split(real: str) -> tuple[tuple[str, ...], str]:
+    parts = PurePosixPath(real).parts
+    return parts[:-1], parts[-1]
+
+
+def _refusal(exc: OSError, name: str) -> Refused:
+    """An OS error on the way to ``name``, in the studio's words."""
+    if exc.errno in (errno.ELOOP, errno.ENOTDIR, errno.EMLINK):
+        return Refused(f"{name} changed while the studio was opening it (a link appeared on its way): "
+                       "nothing was read or written; try again")
+    if exc.errno == errno.ENXIO:  # a socket
+        return Refused(f"{name} is not a regular file (a folder, pipe or device): the studio skips it")
+    if exc.errno == errno.ENOENT:
+        return Refused(f"there is no file {name} in the folder (moved or deleted?)")
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return Refused(f"{name} may not be read: check its permissions")
+    return Refused(f"{name} cannot be opened: {exc.strerror or 'the system refused'}")
+
+
+def _read_all(fd: int, limit: int) -> bytes:
+    chunks: list[bytes] = []
+    size = 0
+    while size <= limit:
+        chunk = os.read(fd, 1 << 20)
+        if not chunk:
+            break
+        chunks.append(chunk)
+        size += len(chunk)
+    if size > limit:
+        raise Refused(f"the file grew past {limit:,} bytes while the studio read it")
+    return b"".join(chunks)
+
+
+def _looks_like_table(head: bytes) -> bool:
+    """A header that names state and next (inputs CSVs and counterexamples are not tables)."""
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        text = head[: len(head) // 2 * 2].decode("utf-16", "replace")
+    else:
+        text = head.decode("utf-8", "replace")
+    text = text.lower()
+    return "state" in text and "next" in text
+
+
+def _write_at(folder: int, leaf: str, data: bytes, mode: int) -> tuple[int, int]:
+    """Write ``leaf`` in the open ``folder`` through a temporary file renamed onto it (a link there is
+    replaced, never written through); returns the new file's (device, inode)."""
+    temp = f".{leaf}.{secrets.token_hex(4)}.tmp"
+    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600, dir_fd=folder)
     try:
-        with path.open("rb") as f:
-            head = f.read(4096).decode("utf-8", "replace").lower()
-    except OSError:
-        return False
-    return "state" in head and "next" in head
-
-
-def backup_path(path: Path) -> Path:
-    return path.with_name(path.name + BACKUP_SUFFIX)
-
-
-def save_table(path: Path, data: bytes, expected: str | None) -> str:
-    """Write ``data`` over ``path`` if the file on disk is still the version ``expected`` (its digest;
-    None = overwrite whatever is there), keeping that version as ``NAME.bak``; returns the new digest."""
-    try:
-        current = path.read_bytes()
-    except FileNotFoundError:
-        current = None
-    except OSError as exc:
-        raise fail(path, f"cannot read: {exc.strerror}", "check the file's permissions") from None
-    if expected is not None and (current is None or digest(current) != expected):
-        raise ChangedOnDisk(path)
-    try:
-        if current is not None:
-            backup = backup_path(path)
-            write_bytes(backup, current)
-            shutil.copymode(path, backup)
-        write_bytes(path, data)
-    except OSError as exc:
-        raise fail(exc.filename or path, f"not saved: {exc.strerror or exc}",
-                   "check the folder's permissions and free space") from None
-    return digest(data)
-
-
-class ChangedOnDisk(Exception):
-    """The file was changed by someone else since the page loaded it."""
-
-    def __init__(self, path: Path):
-        super().__init__(f"{path.name} was changed on disk since you opened it")
-        self.path = path
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+            os.fchmod(fd, mode)
+            os.fsync(fd)
+            info = os.fstat(fd)
+        finally:
+            os.close(fd)
+        os.replace(temp, leaf, src_dir_fd=folder, dst_dir_fd=folder)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temp, dir_fd=folder)
+        raise
+    return info.st_dev, info.st_ino

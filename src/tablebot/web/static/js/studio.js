@@ -247,7 +247,8 @@
     const file = e.target.files[0];
     if (!file) return;
     const reply = await fetch("/api/trace?name=" + encodeURIComponent(file.name), { method: "POST", body: file });
-    const m = await reply.json();
+    const m = (reply.headers.get("content-type") || "").startsWith("application/json")
+      ? await reply.json() : { type: "error", message: await reply.text() };
     (on[m.type] || on.error)(m);
   });
   TB.wirePlayerControls($, player);
@@ -267,7 +268,15 @@
   requestAnimationFrame(paint);
 
   async function start() {
-    const config = await (await fetch("/api/config")).json();
+    // the token came in the address (the server keeps it in an HttpOnly cookie): out of sight and history
+    const params = new URLSearchParams(location.search);
+    if (params.has("token")) {
+      params.delete("token");
+      history.replaceState(null, "", location.pathname + (params.toString() ? "?" + params : ""));
+    }
+    const reply = await fetch("/api/config");
+    if (!reply.ok) { banner(await reply.text(), "bad"); return; }
+    const config = await reply.json();
     fillPicks(config);
     const wanted = new URLSearchParams(location.search).get("table") || config.table || config.tables[0];
     socket = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");

@@ -1,5 +1,5 @@
 """``tablebot export --to txt4``: a ROBO Pro Coding workspace that runs the table on a TXT 4.0 by itself:
-``NAME.py`` starts ``lib/tablebot_program.py``, which is :mod:`tablebot.hw.txt4_runtime` with the compiled
+``NAME.py`` starts ``lib/tablebot_program.py``, which is :mod:`tablebot.hw.txt4.runtime` with the compiled
 table and the robot file's ``[txt]`` wiring appended as plain data (no numpy, no tablebot on the
 controller). Text from the user's files reaches the program only as escaped string literals.
 """
@@ -17,7 +17,7 @@ from typing import Any
 
 from tablebot.escape import python_string
 from tablebot.files import write_text
-from tablebot.hw.txt_wiring import TxtWiring, txt_wiring
+from tablebot.hw.txt.wiring import TxtWiring, txt_wiring
 from tablebot.machine import Machine
 
 PROGRAM = "lib/tablebot_program.py"
@@ -57,7 +57,7 @@ def export_txt4(machine: Machine) -> Workspace:
     wiring = txt_wiring(machine)
     name = workspace_name(machine)
     data = table_data(machine, wiring)
-    runtime = resources.files("tablebot.hw").joinpath("txt4_runtime.py").read_text(encoding="utf-8")
+    runtime = resources.files("tablebot.hw.txt4").joinpath("runtime.py").read_text(encoding="utf-8")
     program = f"{runtime}\n\n# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
     digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
     project = {"name": name, "mode": "ADVANCED", "uuid": str(uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))}
@@ -66,7 +66,7 @@ def export_txt4(machine: Machine) -> Workspace:
 
 
 def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
-    """The compiled table and its wiring as plain data for :mod:`tablebot.hw.txt4_runtime`."""
+    """The compiled table and its wiring as plain data for :mod:`tablebot.hw.txt4.runtime`."""
     table, robot = machine.table, machine.table.robot
     per_state: list[list[list[Any]]] = [[] for _ in machine.states]
     for row in machine.rows:

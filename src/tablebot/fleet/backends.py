@@ -12,10 +12,10 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import fail
-from tablebot.sim.fleet_work import Job, run_job, warm, warm_worker
+from tablebot.fleet.work import Job, run_job, warm, warm_worker
 
 if TYPE_CHECKING:
-    from tablebot.sim.fleet import FleetSummary
+    from tablebot.fleet.run import FleetSummary
 
 Done = Callable[[Job, "FleetSummary"], None]
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"

@@ -16,10 +16,10 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from tablebot.fleet.plan import Plan
+from tablebot.fleet.spec import value_index
 from tablebot.sim.draw import REACHED, draw_world, literal_text
 from tablebot.sim.plots import save
-from tablebot.sweep import value_index
-from tablebot.sweep_run import Plan
 
 NEVER = "#b2bec3"
 Row = dict[str, Any]

@@ -10,12 +10,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tablebot.formats.table_read import load_table
-from tablebot.formats.tomlfile import Source
 from tablebot.machine import compile_table
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 from tablebot.sim.runner import run
 from tablebot.sim.scene import prepare, robot_layer
 from tablebot.sim.world import World, parse_world
+from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.
 OPEN_ROOM = """\

@@ -1,6 +1,6 @@
 """Many simulated robots of one table in one world, advanced together in compiled code (sim.fleet_kernel).
 
-Each robot is set up by :class:`~tablebot.sim.robot.SimRobot` itself (start row, gains, first reading,
+Each robot is set up by :class:`~tablebot.sim.simrobot.SimRobot` itself (start row, gains, first reading,
 its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does (inside the
 compiled loop, sim.normals), so robot k of a fleet gives the trace ``tablebot sim`` gives for the same
 table, world, start, battery and seed.
@@ -16,21 +16,22 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
+from tablebot.fleet.kernel import NO_TICK, parallel, run_fleet, run_fleet_serial
+from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
+from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
-from tablebot.sim import layout as L
-from tablebot.sim.fleet_kernel import NO_TICK, parallel, run_fleet, run_fleet_serial
-from tablebot.sim.fleet_work import Pose, RobotSpec, Variants
 from tablebot.sim.normals import bitgen_address
-from tablebot.sim.robot import SimRobot
 from tablebot.sim.runner import PATH_STRIDE, Result
 from tablebot.sim.scene import Scene, _check_start, prepare
-from tablebot.sim.summary import Summary, light_bits, seconds_per_state
+from tablebot.sim.simrobot import SimRobot
+from tablebot.sim.summary import Summary, light_bits
 from tablebot.sim.world import World, inside
+from tablebot.sinks.run_trace import seconds_per_state
+from tablebot.sinks.trace_file import block_lines
 from tablebot.table import Table
 from tablebot.tick import STATE, registers
-from tablebot.trace import block_lines
 
 BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced robots' blocks kept, per block)
 FLEET_COLLISIONS = 16  # collision starts remembered per robot (the count goes on beyond)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import fail
-from tablebot.sim.fleet_work import Pose
+from tablebot.fleet.robots import Pose
 from tablebot.sim.params import DEFAULTS
 from tablebot.sim.world import inside
 

@@ -21,9 +21,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from tablebot.formats.tomlfile import Source
-from tablebot.hw import txt_wire as wire
+from tablebot.hw.txt import protocol as wire
 from tablebot.table import MAX_LAMP, MAX_SPEED
+from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
     from tablebot.machine import Machine

@@ -1,4 +1,4 @@
-"""The trace of a live run, written as it happens: :class:`tablebot.trace.TraceFile` (the core trace line
+"""The trace of a live run, written as it happens: :class:`tablebot.sinks.trace_file.TraceFile` (the core trace line
 of every tick; ``trace.jsonl`` when complete, ``trace.partial.jsonl`` ending with an ``end`` record when
 cut short) plus each tick's wall-clock time and each counter's pulses, flushed tick by tick, and a
 summary of the run beside it.
@@ -19,7 +19,8 @@ from tablebot.files import partial_name, write_text
 from tablebot.formats.inputs_csv import pulses_key
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW
-from tablebot.trace import TraceFile
+from tablebot.robot import StateId
+from tablebot.sinks.trace_file import TraceFile
 
 WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
 
@@ -76,8 +77,6 @@ class RunTrace(TraceFile):
 
     def summary(self, end: RunEnd) -> dict[str, Any]:
         """What the run did, as plain JSON."""
-        from tablebot.sim.summary import seconds_per_state  # imports the simulator (numba): only once a run is over
-
         assert self.info is not None and self.written is not None
         tick_s = self.info.tick_s
         per_state = seconds_per_state(np.array(self.counts), np.array(self.first_seen), self.machine.states, tick_s)
@@ -96,3 +95,12 @@ class RunTrace(TraceFile):
             "seconds_per_state": {str(state): round(seconds, 3) for state, seconds in per_state.items()},
             "trace": self.written.name,
         }
+
+
+def seconds_per_state(counts: np.ndarray, first_seen: np.ndarray, names: tuple[StateId, ...],
+                      tick_s: float) -> dict[StateId, float]:
+    """Seconds per state from its tick count and the tick it was first seen (-1: never), in order of
+    first visit (a fleet keeps only these two per robot)."""
+    visited = np.flatnonzero(first_seen >= 0)
+    order = visited[np.argsort(first_seen[visited], kind="stable")]
+    return {names[index]: float(counts[index] * tick_s) for index in order.tolist()}

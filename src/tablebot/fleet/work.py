@@ -13,49 +13,15 @@ import sys
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
+from tablebot.fleet.robots import RobotSpec, Variants
 
 if TYPE_CHECKING:
-    from tablebot.machine import Machine
-    from tablebot.sim.fleet import FleetSummary
+    from tablebot.fleet.run import FleetSummary
     from tablebot.sim.world import World
     from tablebot.table import Table
 
-Pose = tuple[float, float, float]  # x, y (m), heading (degrees)
-COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.kernels")
+COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
 _worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
-
-
-@dataclass(frozen=True)
-class RobotSpec:
-    """One robot of a fleet: its seed, where it starts (None: the world's start), its ``[sim]``
-    parameter overrides as ``((section, key, value), ...)`` (``("battery", "charge", 0.6)``: the battery)
-    and which program variant of the fleet it runs (0: the table as it is)."""
-
-    seed: int
-    start: Pose | None = None
-    params: tuple[tuple[str, str, float], ...] = ()
-    variant: int = 0
-
-    def overrides(self) -> dict[str, dict[str, Any]]:
-        out: dict[str, dict[str, Any]] = {}
-        for section, key, value in self.params:
-            out.setdefault(section, {})[key] = value
-        return out
-
-
-@dataclass
-class Variants:
-    """Program variants: per variant every row's timer and counter loads (the rest of the table is shared)."""
-
-    timers: np.ndarray  # (V, rows) int64
-    loads: np.ndarray  # (V, rows, counters) int64
-
-    @staticmethod
-    def of(machine: Machine) -> Variants:
-        arrays = machine.arrays
-        assert arrays is not None, "the compiled simulator needs a table of at most FLAT_BITS event columns"
-        return Variants(arrays.timer[None, :].copy(), arrays.loads[None, :, :].copy())
 
 
 @dataclass
@@ -75,8 +41,8 @@ class Job:
 
 def run_job(job: Job) -> tuple[Job, FleetSummary]:
     """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary."""
+    from tablebot.fleet.run import Fleet
     from tablebot.machine import compile_table
-    from tablebot.sim.fleet import Fleet
 
     threads = job.threads or _worker_threads
     if threads is not None:  # per calling thread in numba: set for each job

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
-from tablebot import guard
+from tablebot import overwrite
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail, notify
 
 #: The line Excel may put above the header to name the delimiter: ``sep=;``.
@@ -71,7 +71,7 @@ def read_bytes(path: Path, limit: int | None = None) -> bytes:
             data = stream.read(limit + 1)
     except OSError as exc:
         raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
-    guard.read(path)
+    overwrite.read(path)
     if len(data) > limit:
         raise fail(path, f"the file is larger than {size_text(limit)}, the most tablebot reads of such a file",
                    "is this the right file? split it, or give a smaller one")

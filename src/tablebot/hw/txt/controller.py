@@ -12,10 +12,10 @@ from __future__ import annotations
 import threading
 from collections.abc import Sequence
 
-from tablebot.hw import txt_wire as wire
-from tablebot.hw.txt_link import TxtLink
-from tablebot.hw.txt_wire import Command
-from tablebot.hw.txt_wiring import TxtWiring
+from tablebot.hw.txt import protocol as wire
+from tablebot.hw.txt.link import TxtLink
+from tablebot.hw.txt.protocol import Command
+from tablebot.hw.txt.wiring import TxtWiring
 from tablebot.loop import LinkLost, Reading
 
 ZERO = [0] * wire.N_OUTPUTS

@@ -12,8 +12,8 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
-from tablebot.formats.csvtext import read_text
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 Where = tuple[str, int | None, str | None]  # (section path, index in an array of tables, key)

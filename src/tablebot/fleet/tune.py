@@ -17,15 +17,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tablebot.diagnostics import fail
+from tablebot.fleet.plan import Plan
+from tablebot.fleet.robots import Variants
+from tablebot.fleet.spec import runs
+from tablebot.fleet.work import Job
 from tablebot.robot import MAX_TIMER
-from tablebot.sim.fleet_work import Job, Variants
-from tablebot.sweep import runs
-from tablebot.sweep_run import Plan
 from tablebot.table import Table
 
 if TYPE_CHECKING:
-    from tablebot.sim.fleet import FleetSummary
-    from tablebot.sweep_backends import Runner
+    from tablebot.fleet.backends import Runner
+    from tablebot.fleet.run import FleetSummary
 
 CELL_RE = re.compile(r"^line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$", re.IGNORECASE)
 ROBOTS_PER_JOB = 512

@@ -12,8 +12,8 @@ import socket
 import time
 from collections.abc import Sequence
 
-from tablebot.hw import txt_wire as wire
-from tablebot.hw.txt_wire import Command
+from tablebot.hw.txt import protocol as wire
+from tablebot.hw.txt.protocol import Command
 from tablebot.loop import LinkLost
 
 #: Where a TXT answers: USB, Wi-Fi access point, Bluetooth (the order ``txt://auto`` tries them in).

@@ -11,14 +11,14 @@ from typing import Any
 import numpy as np
 
 from tablebot.engine import Engine
+from tablebot.formats.trace_lines import exact_round
 from tablebot.loop import Reading, TickBlock
+from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
-from tablebot.sim import layout as L
 from tablebot.sim.normals import bitgen_address
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
-from tablebot.trace import exact_round
 
 DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
 MAX_COLLISIONS = 4096  # collision starts remembered for the pictures (the count goes on beyond)

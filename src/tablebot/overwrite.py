@@ -1,29 +1,25 @@
 """What one command may write over: never a file it read, and never a table or robot file unless the user
 said ``--force`` (then the old file is kept as ``NAME.bak``).
 
-The CLI opens one :func:`command` scope per command; every loader reads through ``formats.csvtext``,
-which calls :func:`read`, and every writer writes through ``tablebot.files``, which calls :func:`writing`
+The CLI opens one :func:`command` scope per command; every loader reads through :mod:`tablebot.csvtext`,
+which calls :func:`read`, and every writer writes through :mod:`tablebot.files`, which calls :func:`writing`
 first. Outside a scope (library use) nothing is refused.
 """
 
 from __future__ import annotations
 
-import codecs
 import os
 import shutil
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tablebot.diagnostics import TableBotError, fail
+from tablebot.diagnostics import fail
 
 #: Files a user writes by hand: tablebot never writes TOML, and a CSV with state and next columns is a table.
 USER_SUFFIXES = {".toml"}
-TABLE_SUFFIXES = {".csv", ".tsv", ".txt"}
-#: How much of a CSV file is read to find its header.
-HEAD_BYTES = 4096
 
 
 @dataclass
@@ -73,9 +69,10 @@ def _is_input(scope: Scope, path: Path) -> bool:
     return os.path.realpath(path) in scope.paths or _inode(path) in scope.inodes
 
 
-def writing(path: str | Path) -> None:
+def writing(path: str | Path, is_user_file: Callable[[Path], bool]) -> None:
     """Called before ``path`` is written: refuse an input of this command; refuse to replace a user file
-    without --force, and with it keep the old one as ``NAME.bak`` first."""
+    without --force, and with it keep the old one as ``NAME.bak`` first. ``is_user_file`` says whether a
+    file is one a user writes by hand (:func:`tablebot.files.is_user_file`)."""
     scope = _scope.get()
     if scope is None:
         return
@@ -115,37 +112,3 @@ def _back_up(scope: Scope, path: Path) -> None:
 
 def kind(path: Path) -> str:
     return "robot or settings" if path.suffix.lower() in USER_SUFFIXES else "table"
-
-
-def is_user_file(path: Path) -> bool:
-    """A TOML file, or a CSV whose header has a state and a next column as the table reader reads it
-    (any delimiter, quotes, a BOM, a ``sep=`` line, aliases such as ``Next-State``)."""
-    suffix = path.suffix.lower()
-    if suffix in USER_SUFFIXES:
-        return True
-    if suffix not in TABLE_SUFFIXES:
-        return False
-    # Imported here: both read files through this module.
-    from tablebot.formats.csvtext import split_records
-    from tablebot.formats.table_read import is_table_header
-
-    head = _head(path)
-    try:
-        records = split_records(head[: head.rfind("\n") + 1] or head, str(path))  # whole lines only
-    except TableBotError:
-        return False  # a quote never closed in the first lines: no table the reader would take
-    header = next((record for record in records if not record.is_blank()), None)
-    return header is not None and is_table_header(cell.text for cell in header.cells)
-
-
-def _head(path: Path) -> str:
-    """The first HEAD_BYTES of a file as text, decoded as the table reader does (UTF-8 or UTF-16 with its
-    BOM; a bad byte is only replaced: this decides whether a file is a table, not what it says)."""
-    try:
-        with path.open("rb") as stream:
-            data = stream.read(HEAD_BYTES)
-    except OSError:
-        return ""
-    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-        return data.decode("utf-16", "replace")
-    return data.decode("utf-8-sig", "replace")

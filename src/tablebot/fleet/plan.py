@@ -18,12 +18,12 @@ from typing import Any
 
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.files import atomic_write, write_text
+from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
+from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
+from tablebot.fleet.work import Job
 from tablebot.machine import Machine
-from tablebot.sim.fleet import Fleet, FleetSummary, RobotSpec, with_start
-from tablebot.sim.fleet_work import Job
 from tablebot.sim.scene import Scene, prepare
 from tablebot.sim.world import World
-from tablebot.sweep import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
 from tablebot.table import Table
 
 PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")

@@ -13,7 +13,7 @@ from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
 
 if TYPE_CHECKING:
-    from tablebot.sweep_run import Plan
+    from tablebot.fleet.plan import Plan
 
 WORLD_OPT = typer.Option(None, "--world", help="World TOML; repeat for several worlds (default: the table's arena).")
 BACKEND_OPT = typer.Option("auto", "--backend", help="local (this machine's cores) or dask (a cluster); auto: "
@@ -46,8 +46,8 @@ def sweep_cmd(
 ) -> None:
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
     OUT/results.csv, with pictures. Ctrl-C keeps every finished chunk; the same command again resumes."""
-    from tablebot.sweep_backends import choose, run_jobs
-    from tablebot.sweep_run import Store
+    from tablebot.fleet.backends import choose, run_jobs
+    from tablebot.fleet.plan import Store
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
@@ -77,7 +77,7 @@ def sweep_cmd(
 def trace_runs(text: str | None, total: int) -> list[int]:
     """The run numbers of ``--trace`` (as --seeds reads numbers), each one of the sweep's runs."""
     from tablebot.diagnostics import TableBotError, fail
-    from tablebot.sweep import parse_seeds
+    from tablebot.fleet.spec import parse_seeds
 
     if text is None:
         return []
@@ -94,12 +94,12 @@ def trace_runs(text: str | None, total: int) -> list[int]:
 def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[str], seeds: str | None,
               robots: int | None, seconds: float) -> Plan:
     """The table, its worlds and the checked options as a plan of runs."""
+    from tablebot.fleet.plan import Plan
+    from tablebot.fleet.spec import SweepSpec, digest, parse_grid, parse_seeds
     from tablebot.jit import sources_digest
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.scene import find_world, prepare, robot_layer
     from tablebot.sim.world import load_world
-    from tablebot.sweep import SweepSpec, digest, parse_grid, parse_seeds
-    from tablebot.sweep_run import Plan
 
     axes = parse_grid(grid)
     seed_list = parse_seeds(seeds, robots)
@@ -126,8 +126,8 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
 def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: float, ran: int,
            traces: list[Path]) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
-    from tablebot.sweep_plots import groups, write_all
-    from tablebot.sweep_run import read_results
+    from tablebot.fleet.plan import read_results
+    from tablebot.fleet.plots import groups, write_all
 
     rows = read_results(path)
     written = [path, *traces, *(write_all(plan, rows, out) if plots else [])]

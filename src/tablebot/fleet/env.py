@@ -1,5 +1,5 @@
 """Gymnasium environments of a simulated tablebot robot: :class:`TableBotEnv` (one robot, built on
-:class:`~tablebot.sim.robot.SimRobot`) and :class:`TableBotVectorEnv` (many robots in the compiled fleet),
+:class:`~tablebot.sim.simrobot.SimRobot`) and :class:`TableBotVectorEnv` (many robots in the compiled fleet),
 registered as ``tablebot/TableBot-v0``.
 
 Observation: pose and sensor readings (see :data:`OBSERVATION`). Action: the two drive motors' signed
@@ -22,9 +22,9 @@ try:
     from gymnasium.vector import AutoresetMode, VectorEnv
     from gymnasium.vector.utils import batch_space
 except ImportError as exc:  # pragma: no cover - gymnasium is an extra
-    raise ImportError("tablebot.env needs Gymnasium: pip install 'tablebot[research]'") from exc
+    raise ImportError("tablebot.fleet.env needs Gymnasium: pip install 'tablebot[research]'") from exc
 
-from tablebot.sim import layout as L
+from tablebot.sim import columns as L
 
 ENV_ID = "tablebot/TableBot-v0"
 #: The observation vector, in order.
@@ -46,13 +46,16 @@ class Setup:
 
     def __init__(self, table: str | Path | None, world: str | Path | None, robot: str | Path | None,
                  seconds: float, battery: float | None):
-        from tablebot.cli.common import load
         from tablebot.examples import example_path
+        from tablebot.formats.table_read import load_table, resolve_table_path
+        from tablebot.machine import compile_table
+        from tablebot.robot import load_robot
         from tablebot.sim.runner import ticks_for
         from tablebot.sim.scene import find_world, prepare, robot_layer
 
-        self.table, self.machine = load(Path(table) if table else example_path("bumberbot"),
-                                        Path(robot) if robot else None)
+        path = resolve_table_path(Path(table) if table else example_path("bumberbot"))
+        self.table = load_table(path, load_robot(robot) if robot else None)
+        self.machine = compile_table(self.table)
         self.robot_params, robot_world = robot_layer(self.table.robot)
         self.world = find_world(self.table, Path(world) if world else None, robot_world)
         self.params = (("battery", "charge", float(battery)),) if battery is not None else ()
@@ -71,13 +74,13 @@ class Setup:
         self.observation_space = spaces.Box(low, high, dtype=np.float64)
 
     def spec(self, seed: int) -> Any:
-        from tablebot.sim.fleet_work import RobotSpec
+        from tablebot.fleet.robots import RobotSpec
 
         return RobotSpec(seed=seed, params=self.params)
 
 
 class TableBotEnv(gym.Env):
-    """One simulated robot (a :class:`~tablebot.sim.robot.SimRobot`): ``reset(seed=s)`` then ``step(None)``
+    """One simulated robot (a :class:`~tablebot.sim.simrobot.SimRobot`): ``reset(seed=s)`` then ``step(None)``
     ticks give exactly the run of ``tablebot sim --seed s``."""
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
@@ -85,7 +88,7 @@ class TableBotEnv(gym.Env):
     def __init__(self, table: str | Path | None = None, world: str | Path | None = None, seconds: float = 60.0,
                  battery: float | None = None, robot: str | Path | None = None, render_mode: str | None = None):
         from tablebot.engine import Engine
-        from tablebot.sim.robot import SimRobot
+        from tablebot.sim.simrobot import SimRobot
 
         self.setup = Setup(table, world, robot, seconds, battery)
         self.action_space, self.observation_space = self.setup.action_space, self.setup.observation_space
@@ -133,7 +136,7 @@ class TableBotVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 8, table: str | Path | None = None, world: str | Path | None = None,
                  seconds: float = 60.0, battery: float | None = None, robot: str | Path | None = None,
                  render_mode: str | None = None):
-        from tablebot.sim.fleet import Fleet
+        from tablebot.fleet.run import Fleet
 
         self.setup = Setup(table, world, robot, seconds, battery)
         self.num_envs, self.render_mode = num_envs, render_mode
@@ -172,8 +175,8 @@ class TableBotVectorEnv(VectorEnv):
         self.ticks[k], self.done[k] = 0, False
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
+        from tablebot.fleet.kernel import move_fleet
         from tablebot.sim import kernel as K
-        from tablebot.sim.fleet_kernel import move_fleet
 
         fleet, again = self.fleet, self.done.copy()
         noise = self.noise.next()
@@ -220,4 +223,5 @@ class NoiseRows:
 
 
 if ENV_ID not in gym.registry:
-    gym.register(ENV_ID, entry_point="tablebot.env:TableBotEnv", vector_entry_point="tablebot.env:TableBotVectorEnv")
+    gym.register(ENV_ID, entry_point="tablebot.fleet.env:TableBotEnv",
+                 vector_entry_point="tablebot.fleet.env:TableBotVectorEnv")

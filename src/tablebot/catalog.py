@@ -1,0 +1,23 @@
+"""Every back-end tablebot has, imported once so that each registers itself (:mod:`tablebot.registry`) and its
+robot-file section can be read (:data:`tablebot.robot.SECTION_READERS`).
+
+Importing ``tablebot`` calls :func:`load_all`, so a robot file's ``[sim]``, ``[board]``, ``[txt]`` and
+``[properties]`` are known to every command and every library use. Each module it imports is light (what
+it needs to run is imported when it runs). A new back-end adds its one line here.
+"""
+
+from __future__ import annotations
+
+
+def load_all() -> None:
+    """Import every back-end module (in the order commands list them) and the analysis's section."""
+    # The order is the order of --to, --board, --on and check --target: keep it (noqa: not sorted).
+    from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp
+    from tablebot.codegen import backend as _c  # c
+    from tablebot.firmware import backend as _boards  # uno, ftduino; [board]
+    from tablebot.hw.txt import backend as _txt  # txt; [txt]
+    from tablebot.hw.txt4 import backend as _txt4  # txt4
+    from tablebot.sim import backend as _sim  # sim; [sim]
+    from tablebot.analysis import section as _properties  # [properties]
+
+    del _robopro, _c, _boards, _txt, _txt4, _sim, _properties

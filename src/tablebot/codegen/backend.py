@@ -1,0 +1,36 @@
+"""``export --to c``: the portable C99 engine and the table as const data, registered as a back-end."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from tablebot.diagnostics import Diagnostic
+from tablebot.files import out_folder
+from tablebot.registry import Backend, Exported, Options, refused, register
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+
+def fit(machine: Machine) -> list[Diagnostic]:
+    """What the C engine's data layout cannot hold (also the base of every board's fit)."""
+    from tablebot.codegen.packing import check_fits, plan
+
+    return refused(lambda: check_fits(machine)) or refused(lambda: plan(machine))
+
+
+def export(machine: Machine, out: Path | None, options: Options) -> Exported:
+    from tablebot.codegen.source import generate
+
+    assert out is not None
+    source = generate(machine, options.get("lookup", "auto"))  # before the folder is made: a refused table leaves none
+    files = tuple(source.write(out_folder(out, "OUTDIR")))
+    kind = "dense" if source.layout.dense else "scan"
+    return Exported(files, (*(f"wrote {path}" for path in files),
+                            f"lookup: {kind}, {source.layout.lookup_bytes} bytes; "
+                            f"table hash 0x{source.layout.table_hash:08x}"))
+
+
+C = register(Backend("c", "export", "a portable C99 engine and the table as const data",
+                     help="portable C99 engine + table", fit=fit, export=export))

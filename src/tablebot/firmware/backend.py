@@ -1,0 +1,57 @@
+"""``build --board uno`` and ``--board ftduino``: AVR firmware running the table, registered as back-ends; the
+robot file's ``[board.NAME]`` sections are read here."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from tablebot.codegen import backend as c
+from tablebot.diagnostics import Diagnostic
+from tablebot.files import out_folder
+from tablebot.registry import Backend, Exported, Options, refused, register
+from tablebot.robot import Robot
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+
+def read_section(src: Source, data: Any, robot: Robot) -> Any:
+    from tablebot.firmware.boards import read_robot_boards
+
+    return read_robot_boards(src, data, robot)
+
+
+def fit_for(board: str) -> Any:
+    def fit(machine: Machine) -> list[Diagnostic]:
+        from tablebot.firmware.boards import load_board, wire
+
+        return c.fit(machine) or refused(lambda: wire(machine.table.robot, load_board(board)))
+
+    return fit
+
+
+def export_for(board: str) -> Any:
+    def export(machine: Machine, out: Path | None, options: Options) -> Exported:
+        from tablebot.firmware.build import build
+
+        firmware = build(machine, board, out_folder(out or Path("build") / "firmware" / board, "--out"))
+        wiring = firmware.wiring
+        assert wiring is not None
+        pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
+                         for n, t in kind.items())
+        return Exported((firmware.hex, firmware.elf), (
+            f"wrote {firmware.hex} and {firmware.elf} for {firmware.board.title}",
+            f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {pins}",
+            f"trace: {firmware.board.uart}, {firmware.board.baud} baud 8N1"), value=firmware)
+
+    return export
+
+
+UNO = register(Backend("uno", "board", "AVR firmware for an Arduino Uno with the Motor Shield Rev3",
+                       help="Arduino Uno + Motor Shield Rev3", fit=fit_for("uno"), section="board",
+                       read_section=read_section, export=export_for("uno")))
+FTDUINO = register(Backend("ftduino", "board", "AVR firmware for the ftDuino",
+                           fit=fit_for("ftduino"), section="board", read_section=read_section,
+                           export=export_for("ftduino")))

@@ -1,0 +1,98 @@
+"""JSON Lines traces: the format every tablebot tool writes and compares, its writer and its one reader
+(recorded inputs are read by :mod:`tablebot.formats.inputs_csv`).
+
+A trace line is one tick: ``tick``, ``event`` (bitmask, first event column highest), ``row``
+(0-based fired row or null), ``state`` and ``timer`` after the tick, each motor's signed speed,
+each lamp's level and each counter's value. Extra fields (a simulator's pose) may follow.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from tablebot.csvtext import read_text
+from tablebot.diagnostics import Collector
+
+
+def dumps(line: dict[str, Any]) -> str:
+    """One trace line as compact JSON: the same line always gives the same bytes."""
+    return json.dumps(line, separators=(",", ":"), ensure_ascii=False)
+
+
+def exact_round(values: Any, digits: int) -> list[float]:
+    """``[round(v, digits) for v in values]`` for a float array, vectorised (Python's ``round`` rounds the
+    exact binary value half to even; numpy's ``round`` scales first, which can tip a near-half case the
+    other way, so those few values are rounded by Python)."""
+    array = np.asarray(values, dtype=np.float64)
+    scaled = array * 10.0**digits
+    rounded = np.rint(scaled) / 10.0**digits  # k / 10^d: IEEE division gives the double nearest k·10^-d
+    fraction = np.abs(scaled - np.floor(scaled) - 0.5)
+    doubtful = np.flatnonzero((fraction < 1e-6) | ~np.isfinite(scaled) | (np.abs(scaled) > 2.0**52))
+    out = rounded.tolist()
+    for i in doubtful.tolist():
+        out[i] = round(float(array[i]), digits)
+    return out
+
+
+def write_trace(lines: Iterable[dict[str, Any]], stream: IO[str]) -> int:
+    count = 0
+    for line in lines:
+        stream.write(dumps(line) + "\n")
+        count += 1
+    return count
+
+
+#: The largest trace file read back: a simulated hour at 10 ms ticks is about 60 MB of JSON Lines.
+MAX_TRACE_BYTES = 512 * 1024 * 1024
+
+
+def read_trace(path: str | Path) -> list[dict[str, Any]]:
+    """Every tick line of a trace file (an ``end`` record, written when a run was cut short, is skipped);
+    a line that is not a JSON object is a located error."""
+    path = Path(path)
+    text = read_text(path, "a trace is UTF-8 JSON Lines as tablebot writes it", MAX_TRACE_BYTES, spreadsheet=False)
+    return parse_trace(text, path)
+
+
+#: Located errors reported before a bad trace is given up on.
+MAX_TRACE_ERRORS = 10
+
+
+def parse_trace(text: str, path: str | Path, required: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """The tick lines of a trace's text, stopping at an ``end`` record; every line that is not a JSON
+    object (or lacks a ``required`` key) is a located error, all of them (up to ten) reported at once."""
+    out = Collector(path)
+    lines = [line for _, line in trace_records(text, out, required)]
+    out.raise_if_any()
+    return lines
+
+
+def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> Iterator[tuple[int, dict[str, Any]]]:
+    """(line number, tick line) of a trace's text up to an ``end`` record; a bad line goes to ``out``.
+    The one reader of trace lines: ``tablebot trace --inputs RUN.jsonl``, the studio's player and
+    :func:`read_trace` all go through it."""
+    hint = "a trace has one JSON object per line, as tablebot sim, trace, run or monitor write it"
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if len(out.items) >= MAX_TRACE_ERRORS:
+            return
+        if not raw.strip():
+            continue
+        try:
+            line = json.loads(raw)
+        except (ValueError, RecursionError) as exc:  # RecursionError: nesting deeper than the parser's stack
+            out.error(number, getattr(exc, "colno", 1),
+                      f"line {number} is not JSON: {getattr(exc, 'msg', 'nested too deeply')}", hint)
+            continue
+        if not isinstance(line, dict):
+            out.error(number, 1, f"line {number} is JSON but not an object {{...}}", hint)
+        elif "end" in line:
+            return
+        elif missing := [key for key in required if key not in line]:
+            out.error(number, 1, f"a trace line needs {' and '.join(missing)}", hint)
+        else:
+            yield number, line

@@ -1,0 +1,73 @@
+"""``run --on txt://HOST[:PORT]`` (a TXT, or a TXT 4.0 running ftrobopy_server) and ``txt://auto``, registered as
+a live back-end; the robot file's ``[txt]`` wiring is read here (the TXT 4.0 export uses the same section)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from tablebot.diagnostics import Diagnostic, fail
+from tablebot.registry import Backend, Opened, Options, refused, register
+from tablebot.robot import Robot
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+PORT = 65000
+ADDRESSES = ("txt://192.168.7.2 (USB)", "txt://HOST:PORT", "txt://auto")
+ADDRESS_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto"
+CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
+                "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
+
+
+def read_section(src: Source, data: Any, robot: Robot) -> Any:
+    from tablebot.hw.txt.wiring import read_robot_txt
+
+    return read_robot_txt(src, data, robot)
+
+
+def fit(machine: Machine) -> list[Diagnostic]:
+    """What the TXT's terminals cannot hold (its ``[txt]`` wiring checked against the table)."""
+    from tablebot.hw.txt.wiring import txt_wiring
+
+    return refused(lambda: txt_wiring(machine))
+
+
+def parse_address(text: str, hint: str) -> tuple[str | None, int]:
+    """``txt://HOST[:PORT]`` -> (HOST, PORT); ``txt://auto`` -> (None, 65000); anything else a located error."""
+    if not text.startswith("txt://"):
+        raise fail("--on", f"unknown target {text!r}", hint)
+    rest = text[len("txt://"):].rstrip("/")
+    if rest == "auto":
+        return None, PORT
+    host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
+    if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
+        raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", hint)
+    return host, int(port) if port else PORT
+
+
+def open_txt(machine: Machine, address: str, options: Options) -> Opened:
+    """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
+    fit), then the controller found and asked who it is."""
+    from tablebot.hw.txt.controller import TxtRobot
+    from tablebot.hw.txt.link import AUTO_HOSTS, find_controller
+    from tablebot.hw.txt.wiring import txt_wiring
+    from tablebot.loop import LinkLost
+
+    host, port = parse_address(address, options.get("hint", ADDRESS_HINT))
+    wiring = txt_wiring(machine)
+    host = host or find_controller(AUTO_HOSTS, port)
+    if host is None:
+        raise fail("--on", f"txt://auto found no controller at {', '.join(AUTO_HOSTS)} (port {port})", CONNECT_HINT)
+    bot = TxtRobot(wiring, host, port, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
+    try:
+        status = bot.connect()
+    except LinkLost as exc:
+        raise fail("--on", str(exc), CONNECT_HINT) from None
+    return Opened(bot, bot.target, f"{status.device} {status.version_text}")
+
+
+TXT = register(Backend("txt", "live", "a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",
+                       help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), txt://auto (USB, "
+                       "Wi-Fi, Bluetooth addresses)", fit=fit, section="txt", read_section=read_section,
+                       open=open_txt, addresses=ADDRESSES))

@@ -1,0 +1,38 @@
+"""``run --on sim`` or ``sim:WORLD``: the simulator as a live robot, paced in real time, registered as a
+back-end; the robot file's ``[sim]`` section is read here."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from tablebot.registry import Backend, Opened, Options, register
+from tablebot.robot import Robot
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+
+def read_section(src: Source, data: Any, robot: Robot) -> Any:
+    from tablebot.sim.params import read_robot_sim
+
+    return read_robot_sim(src, data, robot)
+
+
+def open_sim(machine: Machine, address: str, options: Options) -> Opened:
+    """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
+    from tablebot.sim.scene import scene_for
+    from tablebot.sim.simrobot import SimRobot
+
+    world = address.partition(":")[2]
+    seed = int(options.get("seed", 1))
+    bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None), seed)
+    bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
+    bot.reset(seed=seed)
+    return Opened(bot, "sim", f"simulated, seed {seed}")
+
+
+SIM = register(Backend("sim", "live", "the simulator, driven in real time by `tablebot run`",
+                       help="sim[:WORLD] (the simulator, in real time)", section="sim", read_section=read_section,
+                       open=open_sim, addresses=("sim", "sim:WORLD.toml")))

@@ -1,0 +1,215 @@
+"""Who may talk to the studio: only the page it served. Every HTTP request and WebSocket upgrade passes
+:class:`Gate`, which answers 403 before any route runs unless the ``Host`` is a name the studio serves,
+the ``Origin`` (when the browser sends one) is the studio's own, the request was not started by another
+site, and it carries the secret token made at this start.
+
+The rules follow Jupyter's server (``jupyter_server/base/handlers.py``: ``check_host``, ``check_origin``,
+token login): a page on another origin cannot read or change the folder, and DNS rebinding (a foreign name
+that resolves to 127.0.0.1) meets the ``Host`` check. The token reaches the page once, in the address the
+studio prints (``/?token=...``); the page keeps it as an HttpOnly, SameSite=Strict cookie named after the
+port, and logs show it as ``[token]``.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+import secrets
+import socket
+from collections.abc import Awaitable, Callable, MutableMapping
+from dataclasses import dataclass, field
+from typing import Any
+from urllib.parse import parse_qs
+
+Scope = MutableMapping[str, Any]
+Message = MutableMapping[str, Any]
+Receive = Callable[[], Awaitable[Message]]
+Send = Callable[[Message], Awaitable[None]]
+ASGIApp = Callable[[Scope, Receive, Send], Awaitable[None]]
+
+LOCAL_NAMES = ("127.0.0.1", "localhost", "[::1]")
+WILDCARDS = ("0.0.0.0", "::", "[::]")
+#: Sec-Fetch-Site values of requests the studio's own page makes (or the user typed): anything else was
+#: started by another page, even one on this machine's other ports ("same-site").
+OWN_FETCHES = ("same-origin", "none")
+#: Sent with every answer: no sniffing JSON as script, no framing, no address (with its token) in a Referer.
+HEADERS = [(b"x-content-type-options", b"nosniff"), (b"x-frame-options", b"DENY"),
+           (b"referrer-policy", b"no-referrer")]
+
+
+def host_name(address: str) -> str:
+    """An address as it appears in a Host header or URL (an IPv6 literal in brackets), lower case."""
+    address = address.strip().lower()
+    if ":" in address and not address.startswith("["):
+        return f"[{address}]"
+    return address
+
+
+def _is_ip(name: str) -> bool:
+    try:
+        ipaddress.ip_address(name.strip("[]"))
+    except ValueError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class Access:
+    """The studio's key and the names it answers to, made once per start."""
+
+    port: int
+    names: frozenset[str]  # host names as in a Host header (IPv6 in brackets), lower case
+    any_ip: bool = False  # serving every interface: any IP literal names this machine too
+    token: str = field(default_factory=lambda: secrets.token_urlsafe(32), repr=False)
+
+    @classmethod
+    def serving(cls, address: str, port: int, token: str | None = None) -> Access:
+        """The access rules for a studio bound to ``address`` (as given to ``--host``) and ``port``."""
+        names = set(LOCAL_NAMES)
+        wildcard = address.strip() in WILDCARDS
+        if wildcard:  # what people on the network type: this machine's names (IP literals are allowed below)
+            hostname = socket.gethostname().lower()
+            names |= {hostname, f"{hostname}.local", socket.getfqdn().lower()}
+        else:
+            names.add(host_name(address))
+        extra = {"token": token} if token else {}
+        return cls(port, frozenset(names), wildcard, **extra)
+
+    @property
+    def cookie(self) -> str:
+        """The cookie's name: one per port, since browsers share cookies between a host's ports."""
+        return f"tablebot-studio-{self.port}"
+
+    def set_cookie(self) -> str:
+        return f"{self.cookie}={self.token}; HttpOnly; SameSite=Strict; Path=/"
+
+    def url(self, shown: str, query: str = "") -> str:
+        """The address to print and open: the studio's page with the token."""
+        return f"http://{host_name(shown)}:{self.port}/?token={self.token}" + (f"&{query}" if query else "")
+
+    # --- the checks -----------------------------------------------------------------------------------
+
+    def serves(self, host: str) -> bool:
+        """Whether ``host`` (a Host header) names this studio: a served name and the studio's port."""
+        name, _, port = host.lower().rpartition(":")
+        if not name or "]" in port:  # no port given (port 80), or a bare IPv6 literal
+            name, port = host.lower(), "80"
+        if port != str(self.port):
+            return False
+        return name in self.names or (self.any_ip and _is_ip(name))
+
+    def has_token(self, cookie: str | None, query_token: str | None = None) -> bool:
+        """The token, from the page's cookie or (first visit) from the address."""
+        given = query_token if query_token is not None else _cookie_value(cookie or "", self.cookie)
+        return given is not None and secrets.compare_digest(given.encode(), self.token.encode())
+
+    def refusal(self, scope: Scope) -> str | None:
+        """Why the request is refused (the studio's words), or None to let it through."""
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
+        host = headers.get("host", "")
+        if not self.serves(host):
+            return (f"refused: this studio does not answer to the address {host[:100]!r} "
+                    "(open the address that tablebot studio printed)")
+        origin = headers.get("origin")
+        if origin is not None and origin.lower() != f"http://{host.lower()}":
+            return f"refused: a page from {origin[:100]!r} may not use this studio"
+        query_token = _first_token(scope)
+        first_visit = scope["type"] == "http" and scope.get("method") == "GET" and scope.get("path") == "/" \
+            and query_token is not None
+        fetch_site = headers.get("sec-fetch-site")
+        if fetch_site is not None and fetch_site not in OWN_FETCHES and not first_visit:
+            return f"refused: the request was started by another page ({fetch_site[:20]})"
+        if not self.has_token(headers.get("cookie"), query_token if first_visit else None):
+            return ("refused: the studio's key is missing or out of date: open the address that tablebot "
+                    "studio printed (…/?token=…); each start makes a new one")
+        return None
+
+
+def _cookie_value(header: str, name: str) -> str | None:
+    for part in header.split(";"):
+        key, _, value = part.strip().partition("=")
+        if key == name:
+            return value
+    return None
+
+
+def _first_token(scope: Scope) -> str | None:
+    query = scope.get("query_string", b"").decode("latin-1")
+    values = parse_qs(query).get("token")
+    return values[0] if values else None
+
+
+class Gate:
+    """ASGI middleware: every request and WebSocket upgrade is checked by :meth:`Access.refusal` first,
+    and every answer gets :data:`HEADERS`."""
+
+    def __init__(self, app: ASGIApp, access: Access):
+        self.app = app
+        self.access = access
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        reason = self.access.refusal(scope)
+        if reason is not None:
+            await _deny(scope, send, reason)
+            return
+        if scope["type"] == "websocket":
+            await self.app(scope, receive, send)
+            return
+
+        async def with_headers(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                message["headers"] = [*message.get("headers", []), *HEADERS]
+            await send(message)
+
+        await self.app(scope, receive, with_headers)
+
+
+async def _deny(scope: Scope, send: Send, reason: str) -> None:
+    """403 with the reason as plain text; a WebSocket upgrade is refused before it is accepted.
+
+    (Not the ASGI "websocket.http.response" extension: uvicorn's sans-I/O WebSocket protocol logs that
+    as a handshake never completed.)"""
+    body = (reason + "\n").encode("utf-8")
+    headers = [(b"content-type", b"text/plain; charset=utf-8"), (b"content-length", str(len(body)).encode()),
+               (b"cache-control", b"no-store"), *HEADERS]
+    if scope["type"] == "http":
+        await send({"type": "http.response.start", "status": 403, "headers": headers})
+        await send({"type": "http.response.body", "body": body})
+    else:  # an upgrade closed before acceptance: the server answers 403 (a page cannot read the reason anyway)
+        await send({"type": "websocket.close", "code": 1008})
+
+
+class HideToken(logging.Filter):
+    """Writes every studio token of this process as ``[token]`` in log records (uvicorn's request lines
+    show query strings)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.tokens: set[str] = set()
+
+    def _hide(self, text: str) -> str:
+        for token in self.tokens:
+            text = text.replace(token, "[token]")
+        return text
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if isinstance(record.msg, str):
+            record.msg = self._hide(record.msg)
+        if isinstance(record.args, tuple):
+            record.args = tuple(self._hide(a) if isinstance(a, str) else a for a in record.args)
+        return True
+
+
+_HIDE = HideToken()
+
+
+def hide_token_in_logs(token: str) -> None:
+    """Hide ``token`` in uvicorn's logs (call after uvicorn has configured its loggers)."""
+    _HIDE.tokens.add(token)
+    for name in ("uvicorn.access", "uvicorn.error", "uvicorn"):
+        logger = logging.getLogger(name)
+        if _HIDE not in logger.filters:
+            logger.addFilter(_HIDE)

@@ -1,0 +1,453 @@
+"""The studio trusts only its own page (issue 18, section 1), tested over real HTTP and WebSocket connections
+to a real server: the Host, the Origin and the token are checked before any route runs; the page may name
+only tables and traces of the folder (no dotfile, no other kind, nothing outside); a save writes only the
+file the session opened; bad messages, pipes and devices neither end a connection nor block the server; and
+the command itself (a real process) hides its token in its logs, warns on a network address and stops on
+Ctrl-C. The same attacks from a page in a real Chromium are in test_studio_attacks.py.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import stat
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import websockets
+
+from core_helpers import EXAMPLE
+from tablebot.web.app import Background
+from tablebot.web.errors import Refused
+from tablebot.web.workspace import Kind, Workspace
+
+SECRET = "API_KEY=do-not-leak-4711\n"
+HOOK = "print('the page wrote this')\n"
+PYTHON_WORDS = ("Errno", "Traceback", "subpath", "Error:", "errno", "object has no attribute")
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    """A BumberBot folder with things a page must never reach: a secret, code, a git folder, a file
+    outside, hidden tables, and links leading out of the folder or into a hidden one."""
+    root = tmp_path / "bot"
+    shutil.copytree(EXAMPLE, root)
+    (root / "secret.env").write_text(SECRET)
+    (root / "hook.py").write_text(HOOK)
+    (root / "notes.txt").write_text("state,next\n")
+    (root / "data.csv").write_text("name,password\nadmin,hunter2\n")  # a CSV, but not a table
+    (root / ".git").mkdir()
+    (root / ".git" / "config").write_text("[remote]\nurl = secret\n")
+    (root / ".git" / "table.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
+    (root / ".hidden.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
+    (root / "sub" / ".private").mkdir(parents=True)
+    (root / "sub" / ".private" / "t.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
+    (root / "victim.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
+    (tmp_path / "outside.csv").write_text("state,next\n1,1\n")
+    (root / "out.csv").symlink_to(tmp_path / "outside.csv")
+    (root / "into-git.csv").symlink_to(root / ".git" / "table.csv")
+    return root
+
+
+@pytest.fixture
+def studio(folder: Path) -> Iterator[Background]:
+    server = Background(folder, "table.csv")
+    yield server
+    server.stop()
+
+
+def http(server: Background, path: str, headers: dict[str, str] | None = None, data: bytes | None = None,
+         timeout: float = 10) -> tuple[int, bytes]:
+    """Status and body of a request to the studio; ``headers`` replace the page's own."""
+    request = urllib.request.Request(f"{server.origin}/{path}", data=data,
+                                     headers=server.headers if headers is None else headers)
+    try:
+        with urllib.request.urlopen(request, timeout=timeout) as reply:
+            return reply.status, reply.read()
+    except urllib.error.HTTPError as err:
+        return err.code, err.read()
+
+
+async def _session(server: Background, messages: list[Any], replies_wanted: int,
+                   headers: dict[str, str] | None = None) -> list[dict[str, Any]]:
+    async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
+                                  additional_headers=server.headers if headers is None else headers) as ws:
+        for message in messages:
+            await ws.send(message if isinstance(message, str) else json.dumps(message))
+        return [json.loads(await asyncio.wait_for(ws.recv(), 20)) for _ in range(replies_wanted)]
+
+
+def talk(server: Background, messages: list[Any], until: str, limit: int = 40) -> list[dict[str, Any]]:
+    """Send ``messages`` as the page would; replies up to the first of type ``until``."""
+
+    async def run() -> list[dict[str, Any]]:
+        replies: list[dict[str, Any]] = []
+        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
+                                      additional_headers=server.headers) as ws:
+            for message in messages:
+                await ws.send(message if isinstance(message, str) else json.dumps(message))
+            while len(replies) < limit:
+                replies.append(json.loads(await asyncio.wait_for(ws.recv(), 20)))
+                if replies[-1]["type"] == until:
+                    break
+        return replies
+
+    return asyncio.run(run())
+
+
+def upgrade_status(server: Background, headers: dict[str, str]) -> int:
+    """The status a WebSocket upgrade with ``headers`` gets (101 when accepted), its bytes written by hand so
+    that the Host header is exactly the one given."""
+    lines = ["GET /ws HTTP/1.1", "Upgrade: websocket", "Connection: Upgrade", "Sec-WebSocket-Version: 13",
+             "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ=="]
+    headers = {"Host": f"127.0.0.1:{server.access.port}", **headers}
+    lines += [f"{key}: {value}" for key, value in headers.items()]
+    with socket.create_connection(("127.0.0.1", server.access.port), timeout=10) as conn:
+        conn.sendall(("\r\n".join(lines) + "\r\n\r\n").encode("latin-1"))
+        status_line = conn.makefile("rb").readline().decode("latin-1")
+    return int(status_line.split()[1])
+
+
+# --- Host, Origin, token ------------------------------------------------------------------------------------
+
+def test_the_page_and_every_api_need_the_token(studio: Background) -> None:
+    origin_only = {"Origin": studio.origin}
+    for path in ("", "api/config", "static/js/studio.js", "static/studio.css"):
+        status, body = http(studio, path, origin_only)
+        assert status == 403 and b"the studio's key is missing" in body, path
+        assert http(studio, path)[0] == 200, path  # with the page's cookie
+    wrong = {**studio.headers, "Cookie": f"{studio.access.cookie}={'x' * len(studio.access.token)}"}
+    assert http(studio, "api/config", wrong)[0] == 403
+    other_port = {**studio.headers, "Cookie": f"tablebot-studio-1={studio.access.token}"}
+    assert http(studio, "api/config", other_port)[0] == 403  # the cookie is named after this studio's port
+    assert http(studio, "api/trace?name=t.jsonl", origin_only, b'{"tick":0,"state":1}\n')[0] == 403
+    assert http(studio, f"api/config?token={studio.access.token}", origin_only)[0] == 403  # only / takes it
+    assert upgrade_status(studio, origin_only) == 403
+    assert upgrade_status(studio, studio.headers) == 101
+
+
+def test_the_first_visit_sets_an_http_only_strict_cookie(studio: Background) -> None:
+    request = urllib.request.Request(studio.url, headers={"Sec-Fetch-Site": "cross-site"})  # a link elsewhere
+    with urllib.request.urlopen(request) as reply:
+        cookie = reply.headers["Set-Cookie"]
+        assert reply.headers["Referrer-Policy"] == "no-referrer" and reply.headers["X-Frame-Options"] == "DENY"
+    assert cookie == f"{studio.access.cookie}={studio.access.token}; HttpOnly; SameSite=Strict; Path=/"
+    assert http(studio, "?token=wrong", {})[0] == 403
+
+
+@pytest.mark.parametrize("host", ["attacker.example:{port}", "attacker.example", "127.0.0.1:1", "localhost.evil:{port}",
+                                  "10.0.0.8:{port}", ""])
+def test_a_host_the_studio_does_not_serve_is_refused_before_any_route(studio: Background, host: str) -> None:
+    """DNS rebinding: a foreign name resolving to 127.0.0.1 reaches the server with its own Host header."""
+    headers = {**studio.headers, "Host": host.format(port=studio.access.port),
+               "Origin": "http://" + host.format(port=studio.access.port)}
+    for path in ("", "api/config", "static/js/studio.js", "no/such/route"):
+        status, body = http(studio, path, headers)
+        assert status == 403 and b"does not answer to the address" in body, (host, path)
+    assert upgrade_status(studio, headers) == 403
+
+
+@pytest.mark.parametrize("name", ["127.0.0.1", "localhost", "LOCALHOST"])
+def test_the_local_names_are_served(studio: Background, name: str) -> None:
+    host = f"{name}:{studio.access.port}"
+    assert http(studio, "api/config", {**studio.headers, "Host": host, "Origin": f"http://{host}"})[0] == 200
+
+
+@pytest.mark.parametrize("origin", ["http://attacker.example", "http://127.0.0.1:1", "null", "https://127.0.0.1:{port}",
+                                    "http://localhost:{port}"])
+def test_a_foreign_origin_is_refused(studio: Background, origin: str) -> None:
+    headers = {**studio.headers, "Origin": origin.format(port=studio.access.port)}
+    status, body = http(studio, "api/config", headers)
+    assert status == 403 and b"may not use this studio" in body
+    assert http(studio, "api/trace?name=t.jsonl", headers, b'{"tick":0,"state":1}\n')[0] == 403
+    assert upgrade_status(studio, headers) == 403
+
+
+@pytest.mark.parametrize("site", ["same-site", "cross-site"])
+def test_a_request_another_page_started_is_refused(studio: Background, site: str) -> None:
+    """Browsers share cookies between a host's ports: a page on 127.0.0.1:OTHER sends the studio's cookie
+    with an <img> or <iframe> (no Origin header); Sec-Fetch-Site tells."""
+    status, body = http(studio, "api/config", {"Cookie": studio.headers["Cookie"], "Sec-Fetch-Site": site})
+    assert status == 403 and b"started by another page" in body
+    assert http(studio, "", {"Cookie": studio.headers["Cookie"], "Sec-Fetch-Site": site})[0] == 403
+
+
+# --- what the page may name ----------------------------------------------------------------------------------
+
+REFUSED = {
+    "secret.env": "is not a table", "hook.py": "is not a table", "notes.txt": "is not a table",
+    "data.csv": "is not a table", ".git/config": "hidden files", ".git/table.csv": "hidden files",
+    ".hidden.csv": "hidden files", "sub/.private/t.csv": "hidden files", "./.hidden.csv": "hidden files",
+    "into-git.csv": "hidden files", "out.csv": "outside the served folder", "../outside.csv": "outside the served",
+    "/etc/passwd": "outside the served folder", "sub/../../outside.csv": "outside the served folder",
+}
+
+
+def test_only_tables_and_traces_of_the_folder_open(studio: Background, folder: Path) -> None:
+    names = list(REFUSED)
+    replies = talk(studio, [*({"op": "open", "path": n} for n in names),
+                            *({"op": "trace", "path": n} for n in ("secret.env", "table.csv", ".t.jsonl")),
+                            {"op": "files"}], until="files")
+    errors = [r for r in replies if r["type"] == "error"]
+    assert [r["type"] for r in replies] == ["error"] * (len(names) + 3) + ["files"]
+    for name, reply in zip(names, errors, strict=False):
+        assert REFUSED[name] in reply["message"], (name, reply)
+    assert "is not a trace" in errors[-3]["message"] and "is not a trace" in errors[-2]["message"]
+    assert "hidden files" in errors[-1]["message"]
+    text = json.dumps(replies)
+    assert "do-not-leak" not in text and "the page wrote" not in text and "hunter2" not in text
+    assert not [w for w in PYTHON_WORDS if w in text]
+    assert str(folder.parent) not in text  # no path of the machine, only names in the folder
+    listed = replies[-1]
+    assert listed["tables"] == ["table.csv", "victim.csv"] and listed["traces"] == []
+
+
+def test_a_table_opens_and_saves_through_a_link_inside_the_folder(studio: Background, folder: Path) -> None:
+    (folder / "latest.csv").symlink_to("victim.csv")
+    replies = talk(studio, [{"op": "open", "path": "latest.csv"}, {"op": "edit", "row": 3, "col": 12, "value": "901"},
+                            {"op": "save"}], until="saved")
+    assert replies[0]["path"] == "victim.csv" and replies[-1]["type"] == "saved"
+    assert b",901," in (folder / "victim.csv").read_bytes() and (folder / "latest.csv").is_symlink()
+
+
+# --- saving: only the file this session opened ------------------------------------------------------------
+
+def _swap_then_save(studio: Background, swap: Any, force: bool = True) -> list[dict[str, Any]]:
+    async def run() -> list[dict[str, Any]]:
+        async with websockets.connect(studio.origin.replace("http", "ws") + "/ws",
+                                      additional_headers=studio.headers, max_size=2**24) as ws:
+            await ws.send(json.dumps({"op": "open", "path": "victim.csv"}))
+            await _until(ws, "analysis")
+            await ws.send(json.dumps({"op": "edit", "row": 3, "col": 12, "value": "777", "seq": 1}))
+            await _until(ws, "analysis")
+            swap()
+            await ws.send(json.dumps({"op": "save", "force": force}))
+            reply = await _until(ws, "error", "saved", "conflict")
+            await ws.send(json.dumps({"op": "files"}))  # the connection lives on
+            return [reply, await _until(ws, "files")]
+
+    return asyncio.run(run())
+
+
+async def _until(ws: Any, *types: str) -> dict[str, Any]:
+    while True:
+        reply = json.loads(await asyncio.wait_for(ws.recv(), 20))
+        if reply["type"] in types:
+            return reply
+
+
+def test_a_link_swapped_in_after_opening_is_never_written_through(studio: Background, folder: Path) -> None:
+    """The audit's attack: open victim.csv, replace it by a link to a file outside, save with force."""
+    outside = folder.parent / "outside.csv"
+    before = outside.read_bytes()
+
+    def swap() -> None:
+        (folder / "victim.csv").unlink()
+        (folder / "victim.csv").symlink_to(outside)
+
+    reply, _ = _swap_then_save(studio, swap)
+    assert reply["type"] == "error" and "outside the served folder" in reply["message"]
+    assert outside.read_bytes() == before
+    assert not (folder / "victim.csv.bak").exists()  # nothing from outside leaks into a backup
+    assert not [p for p in folder.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_a_file_replaced_after_opening_is_not_overwritten(studio: Background, folder: Path) -> None:
+    def swap() -> None:
+        (folder / "other.csv").write_bytes(b"state,next\n1,1\n")
+        os.replace(folder / "other.csv", folder / "victim.csv")
+
+    reply, _ = _swap_then_save(studio, swap)
+    assert reply["type"] == "error" and "no longer the file you opened" in reply["message"]
+    assert (folder / "victim.csv").read_bytes() == b"state,next\n1,1\n"
+
+
+def test_a_link_to_another_table_in_the_folder_is_not_written(studio: Background, folder: Path) -> None:
+    table = (folder / "table.csv").read_bytes()
+
+    def swap() -> None:
+        (folder / "victim.csv").unlink()
+        (folder / "victim.csv").symlink_to("table.csv")
+
+    reply, _ = _swap_then_save(studio, swap)
+    assert reply["type"] == "error" and "now leads to another file" in reply["message"]
+    assert (folder / "table.csv").read_bytes() == table and not (folder / "table.csv.bak").exists()
+
+
+def test_a_changed_file_asks_first_and_a_forced_save_keeps_a_backup(studio: Background, folder: Path) -> None:
+    victim = folder / "victim.csv"
+    changed = victim.read_bytes().replace(b",895,", b",896,")
+    reply, _ = _swap_then_save(studio, lambda: victim.write_bytes(changed), force=False)
+    assert reply["type"] == "conflict" and victim.read_bytes() == changed
+    mode = stat.S_IMODE(victim.stat().st_mode)
+    reply, _ = _swap_then_save(studio, lambda: victim.chmod(0o640))
+    assert reply["type"] == "saved" and b",777," in victim.read_bytes()
+    assert (folder / "victim.csv.bak").read_bytes() == changed and stat.S_IMODE(victim.stat().st_mode) == 0o640
+    assert mode != 0o640
+
+
+def test_a_race_between_check_and_write_meets_no_follow(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The link appears after the name was checked (here: the check is made to pass regardless): the
+    file and its folder are opened without following links, so nothing outside is read or written."""
+    workspace = Workspace(folder)
+    outside = folder.parent / "outside.csv"
+    before = outside.read_bytes()
+    (folder / "sub" / "t.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
+    for name, swap in (("victim.csv", lambda: _relink(folder / "victim.csv", outside)),
+                       ("sub/t.csv", lambda: _relink(folder / "sub", folder.parent))):
+        opened = workspace.read(name, Kind.TABLE, 10**6)
+        swap()
+        monkeypatch.setattr(Workspace, "locate", lambda self, n, kind: n)
+        with pytest.raises(Refused, match="changed while the studio was opening it"):
+            workspace.save(opened, b"state,next\n2,2\n", force=True)
+        monkeypatch.undo()
+    assert outside.read_bytes() == before and not (folder.parent / "outside.csv.bak").exists()
+    assert not (folder.parent / "t.csv").exists() and not (folder.parent / "t.csv.bak").exists()
+    assert not (folder / "victim.csv.bak").exists()
+
+
+def _relink(path: Path, target: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink()
+    path.symlink_to(target)
+
+
+# --- messages that must not end the connection ---------------------------------------------------------------
+
+def test_a_message_nested_100000_deep_is_an_error_and_the_connection_lives(studio: Background) -> None:
+    deep = "[" * 100_000 + "]" * 100_000
+    replies = talk(studio, [deep, '{"op": "open", "path": ' + "[" * 100_000, b"\x00binary".decode(),
+                            {"op": "files"}], until="files")
+    assert [r["type"] for r in replies] == ["error", "error", "error", "files"]
+    assert "nested too deeply" in replies[0]["message"]
+    status, body = http(studio, "api/trace?name=deep.jsonl", data=b'{"tick":0,"state":1}\n' + deep.encode() + b"\n")
+    assert status == 400 and b"deep.jsonl:2:1" in body and b"nested too deeply" in body
+
+
+def test_a_binary_frame_is_an_error_and_the_connection_lives(studio: Background) -> None:
+    async def run() -> list[dict[str, Any]]:
+        async with websockets.connect(studio.origin.replace("http", "ws") + "/ws",
+                                      additional_headers=studio.headers) as ws:
+            await ws.send(b"\x01\x02")
+            await ws.send(json.dumps({"op": "files"}))
+            return [json.loads(await ws.recv()), json.loads(await ws.recv())]
+
+    first, second = asyncio.run(run())
+    assert first["message"] == "a message must be JSON text, not binary data" and second["type"] == "files"
+
+
+def test_a_table_that_is_not_utf8_is_refused_in_the_studios_words(studio: Background, folder: Path) -> None:
+    (folder / "bad.csv").write_bytes(b"state,next\n1,1\xff\n")
+    replies = talk(studio, [{"op": "open", "path": "bad.csv"}, {"op": "files"}], until="files")
+    assert replies[0]["type"] == "error" and "byte 14 is not UTF-8 text" in replies[0]["message"]
+    assert not [w for w in PYTHON_WORDS if w in json.dumps(replies)]
+
+
+# --- pipes, sockets, devices -------------------------------------------------------------------------------
+
+def _can_mknod(tmp: Path) -> bool:
+    try:
+        os.mknod(tmp / "probe", stat.S_IFCHR | 0o600, os.makedev(1, 5))
+    except OSError:
+        return False
+    return True
+
+
+def _specials(folder: Path) -> list[str]:
+    os.mkfifo(folder / "notes.csv")
+    os.mkfifo(folder / "pipe.jsonl")
+    (folder / "dir.csv").mkdir()
+    unix = socket.socket(socket.AF_UNIX)
+    unix.bind(str(folder / "sock.csv"))
+    names = ["notes.csv", "pipe.jsonl", "dir.csv", "sock.csv"]
+    if _can_mknod(folder):
+        os.mknod(folder / "zero.csv", stat.S_IFCHR | 0o600, os.makedev(1, 5))  # /dev/zero: it never ends
+        names.append("zero.csv")
+    return names
+
+
+def test_pipes_sockets_and_devices_are_skipped_without_blocking(studio: Background, folder: Path) -> None:
+    names = _specials(folder)
+    started = time.monotonic()
+    status, body = http(studio, "api/config", timeout=10)
+    assert status == 200 and time.monotonic() - started < 5
+    listed = json.loads(body)
+    assert not set(names) & set(listed["tables"] + listed["traces"])
+    messages = [{"op": "trace" if n.endswith(".jsonl") else "open", "path": n} for n in names]
+    replies = talk(studio, [*messages, {"op": "files"}], until="files")
+    assert [r["type"] for r in replies] == ["error"] * len(names) + ["files"]
+    assert all("is not a regular file (a folder, pipe or device)" in r["message"] for r in replies[:-1]), replies
+
+
+# --- the command as a process ----------------------------------------------------------------------------
+
+def _start(*args: str) -> tuple[subprocess.Popen[str], str]:
+    """``tablebot studio ARGS`` as a user runs it; the address it printed."""
+    process = subprocess.Popen([sys.executable, "-m", "tablebot.cli", "studio", *args, "--port", "0", "--no-browser"],
+                               stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    assert process.stderr is not None
+    lines = []
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        line = process.stderr.readline()
+        lines.append(line)
+        found = re.search(r"http://\S+/\?token=\S+", line)
+        if found:
+            return process, found[0] + "\n" + "".join(lines)
+        assert line or process.poll() is None, "".join(lines)
+    raise AssertionError("no address printed: " + "".join(lines))
+
+
+def test_the_command_hides_its_token_in_logs_and_ctrl_c_stops_it_with_a_pipe_in_the_folder(folder: Path) -> None:
+    os.mkfifo(folder / "notes.csv")
+    process, printed = _start(str(folder), "--verbose")
+    url = printed.splitlines()[0]
+    token = url.split("token=")[1].split("&")[0]
+    port = int(url.split(":")[2].split("/")[0])
+    try:
+        with urllib.request.urlopen(url, timeout=10) as reply:  # the first visit, as the browser makes it
+            cookie = reply.headers["Set-Cookie"].split(";")[0]
+        request = urllib.request.Request(f"http://127.0.0.1:{port}/api/config", headers={"Cookie": cookie})
+        with urllib.request.urlopen(request, timeout=10) as reply:
+            assert "notes.csv" not in json.loads(reply.read())["tables"]
+        with pytest.raises(urllib.error.HTTPError):
+            urllib.request.urlopen(f"http://127.0.0.1:{port}/api/config?token={token}", timeout=10)
+    finally:
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=20)  # Ctrl-C stops it: no hang on the pipe
+    log = printed + out + err
+    assert process.returncode is not None
+    assert log.count(token) == 2, log  # the printed address (kept twice above), never a log line
+    assert re.search(r'"GET /\?token=\[token\]&table=table.csv HTTP/1.1" 200', log), log
+    assert re.search(r'"GET /api/config\?token=\[token\] HTTP/1.1" 403', log), log
+
+
+def test_serving_the_network_warns_that_the_token_opens_the_folder(folder: Path) -> None:
+    process, printed = _start(str(folder), "--host", "0.0.0.0")
+    try:
+        port = int(printed.splitlines()[0].split(":")[2].split("/")[0])
+        assert printed.splitlines()[0].startswith("http://127.0.0.1:")
+        with pytest.raises(urllib.error.HTTPError) as err:  # still only with the token
+            urllib.request.urlopen(f"http://127.0.0.1:{port}/api/config", timeout=10)
+        assert err.value.code == 403
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.communicate(timeout=20)
+    text = " ".join(printed.split())
+    assert "warning: serving" in text and "0.0.0.0" in text
+    assert "anyone who can reach it and has the address below (with its token) can read the folder's tables, robot " \
+           "and world files and traces, and change its tables" in text
