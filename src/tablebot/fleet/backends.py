@@ -64,6 +64,14 @@ class Runner:
     def __exit__(self, kind: object, *rest: object) -> None:
         self.close(failed=kind is not None)
 
+    def slots(self) -> int:
+        """How many jobs the backend runs at once: its worker processes (or the cluster's worker threads)."""
+        if self.backend == "dask":
+            if self.client is None:
+                return 1
+            return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
+        return max(1, self.workers or os.cpu_count() or 1)
+
     def run(self, jobs: Sequence[Job], done: Done) -> None:
         if not jobs:
             return
@@ -106,8 +114,8 @@ class Runner:
     # --- a Dask cluster: each chunk one task
 
     def _run_dask(self, jobs: Sequence[Job], done: Done) -> None:
-        """Every worker first warms the kernel in a cache folder of its own (one compile per worker,
-        never two processes writing one folder); then the chunks go out."""
+        """Every worker first warms the kernel in a cache folder of its own, from this process's compiled
+        code (a fresh worker loads it instead of compiling again); then the chunks go out."""
         if self.client is None:
             self.client = connect(self.address or "")  # first: it says what to install when Dask is missing
             self.info = warm_cluster(self.client, jobs[0])
@@ -147,10 +155,15 @@ def connect(address: str) -> Any:
 
 
 def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
-    """Warm every worker (pinned to it), with a cache slot named by its host and its rank there."""
+    """Warm every worker (pinned to it), with a cache slot named by its host and its rank there, from this
+    process's compiled code: compiled (or loaded) here once, sent to every worker once."""
     workers = client.scheduler_info(n_workers=-1)["workers"]
     if not workers:
         raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
+    from tablebot import jit
+
+    warm(job, both=True)  # both kernels: a worker alone on its machine runs chunks on all its cores
+    files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
     by_host: dict[str, list[str]] = defaultdict(list)
     for address, worker in sorted(workers.items()):
         by_host[worker.get("host", address)].append(address)
@@ -158,7 +171,7 @@ def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
     for host, addresses in by_host.items():
         for rank, address in enumerate(addresses):
             slot = f"{host}-{rank}".replace(":", "_").replace("/", "_")
-            futures.append(client.submit(warm_worker, job, slot, len(addresses), workers=[address],
+            futures.append(client.submit(warm_worker, job, slot, len(addresses), files, workers=[address],
                                          allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}"))
     try:
         warmed = client.gather(futures)

@@ -160,12 +160,14 @@ class Fleet:
     def __len__(self) -> int:
         return len(self.specs)
 
-    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS) -> None:
-        """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block."""
+    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS,
+            threads: bool | None = None) -> None:
+        """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block. ``threads``: run on
+        numba's thread pool (True) or on this thread (False); None: the pool when the work is worth it."""
         done = 0
         while done < ticks:
             b = min(block_ticks, ticks - done)
-            self.step_block(ticks=b)
+            self.step_block(ticks=b, threads=threads)
             done += b
             if progress:
                 progress(done)
@@ -177,9 +179,11 @@ class Fleet:
             rng.standard_normal(out=noise[i])
         return noise
 
-    def step_block(self, noise: np.ndarray | None = None, ticks: int | None = None) -> None:
+    def step_block(self, noise: np.ndarray | None = None, ticks: int | None = None,
+                   threads: bool | None = None) -> None:
         """Advance every robot ``noise.shape[1]`` ticks with the given noise rows, or ``ticks`` ticks with
-        noise each robot draws from its own Generator as it goes (the same numbers :meth:`draw_noise` gives)."""
+        noise each robot draws from its own Generator as it goes (the same numbers :meth:`draw_noise` gives);
+        ``threads`` as in :meth:`run`."""
         if noise is None:
             assert ticks is not None, "give the noise rows or the ticks"
             noise = np.empty((len(self.specs), 0, L.N_NOISE))
@@ -189,7 +193,8 @@ class Fleet:
         hist = np.zeros((n_traced, ticks, self.S.shape[1]))
         ints = np.zeros((n_traced, ticks, self.width), dtype=np.int64)
         v = self.variants
-        kernel = run_fleet if parallel(len(self.specs), ticks) else run_fleet_serial
+        pool = parallel(len(self.specs), ticks) if threads is None else threads
+        kernel = run_fleet if pool else run_fleet_serial
         kernel(self.S, self.P, self.world, self.machine.arrays.program, v.timers, v.loads, self.variant,  # type: ignore[union-attr]
                self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, ticks, noise, self.bitgens,
                self.acc, self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,

@@ -55,21 +55,30 @@ def run_job(job: Job) -> tuple[Job, FleetSummary]:
     return replace(job, specs=[], variants=None), fleet.summary()
 
 
-def warm(job: Job) -> float:
-    """Compile (or load from the cache) the fleet kernel on one robot for one tick; returns the seconds."""
+def warm(job: Job, both: bool = False) -> float:
+    """Compile (or load from the cache) the fleet kernel on one robot for one tick -- on this thread, and
+    with ``both`` on numba's thread pool too; returns the seconds."""
     import time
 
+    from tablebot.fleet.run import Fleet
+    from tablebot.machine import compile_table
+
     started = time.perf_counter()
-    run_job(replace(job, specs=job.specs[:1], ticks=1))
+    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs[:1], job.robot_params,
+                  variants=job.variants)
+    for threads in (False, True) if both else (False,):
+        fleet.run(1, threads=threads)
     return time.perf_counter() - started
 
 
-def warm_worker(job: Job, slot: str, share: int = 1) -> dict[str, Any]:
+def warm_worker(job: Job, slot: str, share: int = 1,
+                files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
     """On a cluster worker: choose a cache folder of its own (``worker-SLOT`` in the user's numba cache
     for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code already loaded
-    here; then compile or load the kernel once, before any chunk runs (concurrent compiles into one
-    cache folder race: numba issues #4807, #10128). Its chunks then use 1/``share`` of the machine's
-    cores (``share``: the workers on this machine)."""
+    here; put the client's compiled code there (``files``, from :func:`tablebot.jit.cache_files`: a fresh
+    worker then loads it instead of compiling); then load (or compile) the kernel once, before any chunk
+    runs (concurrent compiles into one cache folder race: numba issues #4807, #10128). Its chunks then
+    use 1/``share`` of the machine's cores (``share``: the workers on this machine)."""
     global _worker_threads
     _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
     given = bool(os.environ.get("NUMBA_CACHE_DIR"))
@@ -81,8 +90,9 @@ def warm_worker(job: Job, slot: str, share: int = 1) -> dict[str, Any]:
         folder = os.path.join(jit.cache_dir(), f"worker-{slot}")
         os.environ[jit.ENV] = folder
         numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
-    seconds = warm(job)
+    installed = jit.install_cache_files(files) if files else 0
+    seconds = warm(job, both=_worker_threads > 1)
     import numba
 
     return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR, "seconds": seconds,
-            "threads": _worker_threads}
+            "threads": _worker_threads, "installed": installed}
