@@ -46,7 +46,7 @@ def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
     return acc
 
 
-@njit(nogil=True, refcounts=False)
+@njit(nogil=True, refcounts=False, inline="always")
 def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
     """Fold one robot row into the running summary: reaching a lamp and the start of each collision
     (a rise of any bumper or contact with no touch in the debounce rows before it)."""

@@ -70,7 +70,7 @@ def _next_double(typingctx, function, state):  # type: ignore[no-untyped-def]
     return types.float64(types.uint64, types.uint64), codegen
 
 
-@njit(nogil=True, refcounts=False)
+@njit(nogil=True, refcounts=False, inline="always")
 def standard_normal(bitgen):  # type: ignore[no-untyped-def]
     """One draw of ``Generator.standard_normal()`` from the Generator whose ``bitgen_t`` is at ``bitgen``
     (numpy's ``random_standard_normal``, line for line)."""

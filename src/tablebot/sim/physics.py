@@ -93,7 +93,7 @@ NEAR_MARGIN = 0.05
 # --- the broad phase and the body ------------------------------------------------------------------------------
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def might_be_near(px, py, verts, a, b, pbound, k, reach):
     """Whether convex piece verts[a:b] may come within ``reach`` of point p (the broad phase).
 
@@ -120,7 +120,7 @@ def new_near(pstart, circles):
     return np.zeros(2 + pstart.shape[0] - 1 + circles.shape[0], dtype=np.int64), np.zeros(3)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def refresh_near(x, y, reach, verts, pstart, pbound, circles, near, centre):
     """Keep ``near`` the list of the pieces and circles that may come within ``reach`` of the robot's centre
     (x, y) -- near[0] pieces, then near[1] circles, their indices from near[2] on, in index order -- remade
@@ -150,7 +150,7 @@ def refresh_near(x, y, reach, verts, pstart, pbound, circles, near, centre):
     centre[0], centre[1], centre[2] = x, y, 1.0
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def body_corners_at(s, p, c, sn, out):
     """The body rectangle's corners in world coordinates (front-right, front-left, rear-left, rear-right),
     given the heading's cosine ``c`` and sine ``sn``."""
@@ -166,12 +166,12 @@ def body_corners(s, p, out):
     body_corners_at(s, p, math.cos(s[TH]), math.sin(s[TH]), out)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def bounding_radius(p):
     return math.hypot(max(p[P_FRONT], p[P_REAR]), p[P_HALF_W])
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def reaches(p):
     """The bounding radius (the contacts' broad phase), and the reach a candidate list must serve (the
     bumpers': the radius plus the switch travel), computed as every caller computes them."""
@@ -310,7 +310,7 @@ def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
     return deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near)[0]
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre):
     """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn);
     returns whether it moved the robot. ``reach``/``wide``: :func:`reaches`; ``near``/``centre``: the
@@ -369,7 +369,7 @@ def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near
     return False
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def broad_phase(s, reach, verts, pstart, pbound, circles, near):
     """Bits of the pieces and of the circles of candidate list ``near`` that may lie within ``reach`` of the
     robot's centre (exact: what it rules out is farther); pieces and circles from the 63rd on share bit 62
@@ -388,7 +388,7 @@ def broad_phase(s, reach, verts, pstart, pbound, circles, near):
     return bits, bits_circles
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre):
     """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and
     rear; ``c``/``sn``: the heading's cosine and sine; the rest as :func:`resolve`'s."""
@@ -405,7 +405,7 @@ def sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near
     s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def light_side(s, c, sn, p, side, edges, circles, lamps):
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
     ``sn``: the heading's cosine and sine)."""
@@ -421,19 +421,19 @@ def light_at(s, p, side, edges, circles, lamps):
 # --- motors, battery, motion ---------------------------------------------------------------------
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def duty(level, levels):
     """The fraction of full power a speed level gives (the table's 1..8 are PWM duty level/8)."""
     return min(1.0, abs(level) / levels)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def pack_volts(full, empty, charge, amps, ohms):
     """Battery terminal volts: open-circuit volts fall linearly with the charge and sag with the current."""
     return empty + (full - empty) * charge - amps * ohms
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def motor(s, p, level, volts, gain, speed, enc, pul, noise):
     """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
@@ -447,7 +447,7 @@ def motor(s, p, level, volts, gain, speed, enc, pul, noise):
     s[pul] = math.floor(s[enc]) - math.floor(before)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def drive(s, cmd, p, z):
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
     dt = p[P_DT]
@@ -465,7 +465,7 @@ def drive(s, cmd, p, z):
     s[TH] += turn
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def input_mask(s, bits):
     """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
     mask = 0
@@ -482,7 +482,7 @@ def input_mask(s, bits):
     return mask
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre):
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
@@ -504,7 +504,7 @@ def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits):
     sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, move, corners, reach,
             wide, near, centre):
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,

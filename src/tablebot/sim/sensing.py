@@ -40,7 +40,7 @@ from tablebot.sim.columns import (
 from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps):
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
     sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine).
@@ -175,7 +175,7 @@ def sense_declared(s, c, sn, p, edges, circles, lamps, lines):
             s[READING + k] = echo(sx, sy, s[TH] + p[base + F_AIM], p, edges, circles)
 
 
-@njit(cache=True, refcounts=False)
+@njit(cache=True, refcounts=False, inline="always")
 def sensor_events(s, p, bits, previous):
     """The event bits of the declared sensors: a reading past its threshold turns the event on; once on, it
     stays on until the reading is back past the threshold by the hysteresis (``previous`` = last mask)."""
