@@ -19,7 +19,7 @@ from tablebot.jit import njit
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.geometry import within
 from tablebot.sim.normals import standard_normal
-from tablebot.sim.physics import advance, new_near, reaches
+from tablebot.sim.physics import advance, aim_turns, new_near, reaches
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -80,15 +80,17 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
     """
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
     run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits, drive,
               pcols, ticks, noise, bitgen, hist, ints, acc, collisions, np.zeros(counters.shape[0], dtype=np.int64),
-              np.empty((4, 2)), reach, wide, near, centre, np.empty(N_NOISE))
+              np.empty((4, 2)), reach, wide, near, centre, turns, np.empty(N_NOISE))
 
 
 @njit(nogil=True, refcounts=False)
 def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
               drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, pulses, corners, reach, wide, near,
-              centre, z):  # type: ignore[no-untyped-def]
+              centre, turns, z):  # type: ignore[no-untyped-def]
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
     n_counters = counters.shape[0]
     for t in range(ticks):
@@ -108,7 +110,7 @@ def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
             for k in range(N_NOISE):
                 z[k] = standard_normal(bitgen)
         advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, z,
-                bits, True, corners, reach, wide, near, centre)
+                bits, True, corners, reach, wide, near, centre, turns)
         observe(s, lamps, acc, collisions)
 
 
@@ -136,8 +138,10 @@ def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits):  
     """Read the sensors without moving (the start of a run)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
     advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)), reach,
-            wide, near, centre)
+            wide, near, centre, turns)
 
 
 @njit(nogil=True)
@@ -146,6 +150,8 @@ def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines,
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
     advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)),
-            reach, wide, near, centre)
+            reach, wide, near, centre, turns)
     observe(s, lamps, acc, collisions)
