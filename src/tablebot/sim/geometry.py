@@ -48,10 +48,26 @@ def point_segment_within(px, py, ax, ay, bx, by, r, strict=False):
     return within(px - ax - t * ex, py - ay - t * ey, r, strict)
 
 
+#: Metres by which both ends of a segment must clear the line through another, beyond the distance asked
+#: about, for :func:`segments_within` to answer without its four distances (rounding is ~1e-15 m here).
+LINE_MARGIN = 1e-9
+
+
 @njit(cache=True, refcounts=False)
 def segments_within(ax, ay, bx, by, cx, cy, dx, dy, r):
     """Whether segments ab and cd come within ``r`` of each other (0 apart when they cross): the nearest
-    of the four endpoint-to-segment distances, each tested by :func:`within`."""
+    of the four endpoint-to-segment distances, each tested by :func:`within`.
+
+    First the sides of a and b against the line through cd (the products :func:`segments_cross` starts
+    with): when both lie on one side, farther from the line than ``r`` by LINE_MARGIN, all of ab is, so
+    neither segment comes within ``r`` of the other and the four distances would all say so."""
+    ex, ey = dx - cx, dy - cy
+    d3 = ex * (ay - cy) - ey * (ax - cx)
+    d4 = ex * (by - cy) - ey * (bx - cx)
+    if d3 * d4 > 0.0:
+        clear = (r + LINE_MARGIN) * (r + LINE_MARGIN) * (ex * ex + ey * ey)
+        if d3 * d3 > clear and d4 * d4 > clear:
+            return False
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
     return (point_segment_within(ax, ay, cx, cy, dx, dy, r) or point_segment_within(bx, by, cx, cy, dx, dy, r)
