@@ -20,7 +20,7 @@ BACKEND_OPT = typer.Option("auto", "--backend", help="local (this machine's core
                            "dask when a scheduler is named, else local.")
 SCHEDULER_OPT = typer.Option(None, "--scheduler", help="Dask scheduler address, tcp://HOST:8786 (or set "
                              "DASK_SCHEDULER_ADDRESS).")
-WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local processes (default: one per core).")
+WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local worker threads (default: one per core).")
 
 
 @app.command("sweep")

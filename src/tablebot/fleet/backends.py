@@ -1,11 +1,12 @@
-"""Where the chunks of a sweep or a tuning run go: this machine's cores (one process per core, each
-running whole chunks) or a Dask cluster (each chunk one task). Both hand every finished chunk to a
+"""Where the chunks of a sweep or a tuning run go: this machine's cores (a thread per core in this process,
+each running whole chunks) or a Dask cluster (each chunk one task). Both hand every finished chunk to a
 callback as it comes back, so an interrupted run keeps what finished.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -50,12 +51,13 @@ def run_jobs(jobs: Sequence[Job], done: Done, backend: str = "local", address: s
 
 class Runner:
     """A backend kept open over many batches of jobs (a tuning run sends one batch per generation):
-    the local worker processes or the Dask client start, and warm up, once."""
+    the local worker threads or the Dask client start, and warm up, once."""
 
     def __init__(self, backend: str = "local", address: str | None = None, workers: int | None = None):
         self.backend, self.address, self.workers = backend, address, workers
         self.pool: Any = None
         self.client: Any = None
+        self.stop = threading.Event()  # set on Ctrl-C: local chunks end at their next block, unfinished
         self.info: dict[str, Any] = {"workers": 0}
 
     def __enter__(self) -> Runner:
@@ -65,7 +67,7 @@ class Runner:
         self.close(failed=kind is not None)
 
     def slots(self) -> int:
-        """How many jobs the backend runs at once: its worker processes (or the cluster's worker threads)."""
+        """How many jobs the backend runs at once: its worker threads (or the cluster's)."""
         if self.backend == "dask":
             if self.client is None:
                 return 1
@@ -83,33 +85,41 @@ class Runner:
     def close(self, failed: bool = False) -> None:
         if self.pool is not None:
             if failed:
-                self.pool.terminate()  # Ctrl-C: the workers stop at once; what finished was handed over already
-            else:
-                self.pool.close()
-            self.pool.join()
+                self.stop.set()  # Ctrl-C: running chunks end within a block; what finished was handed over already
+            self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
         if self.client is not None:
             self.client.close()
             self.client = None
 
-    # --- this machine: one process per core (``workers``), each running whole chunks single-threaded
+    # --- this machine: a thread per core (``workers``), each running whole chunks single-threaded
+    #
+    # Threads, not processes: the compiled fleet loop releases the GIL, so two threads run two chunks on two
+    # cores, and this process's compiled code serves both -- no worker processes to start, no Python, numpy and
+    # numba to import again in each, no jobs and summaries to pickle across (seconds of a short sweep's time).
 
     def _run_local(self, jobs: Sequence[Job], done: Done) -> None:
         workers = max(1, self.workers or os.cpu_count() or 1)
-        if workers == 1 or (len(jobs) == 1 and self.pool is None):
-            self.info = {"workers": 1, "processes": "this one"}
+        if workers == 1 or len(jobs) == 1:  # numba's own threads share each chunk's robots out
+            self.info = {"workers": 1, "threads": "numba's"}
             for job in jobs:
-                done(*run_job(job))
+                done(*run_job(job, self.stop))
             return
         if self.pool is None:
-            import multiprocessing
+            from concurrent.futures import ThreadPoolExecutor
 
-            warm(jobs[0])  # this process fills the user's numba cache first: the workers only read it
-            context = multiprocessing.get_context("spawn")  # never fork a process that holds numba's threads
-            self.pool = context.Pool(workers, initializer=_ignore_interrupts)
-            self.info = {"workers": workers, "processes": "local"}
-        for job, summary in self.pool.imap_unordered(run_job, [replace(j, threads=1) for j in jobs]):
-            done(job, summary)
+            self.pool = ThreadPoolExecutor(workers, thread_name_prefix="tablebot-fleet")
+            self.info = {"workers": workers, "threads": "local"}
+        from concurrent.futures import as_completed
+
+        futures = [self.pool.submit(run_job, replace(job, threads=1), self.stop) for job in jobs]
+        try:
+            for future in as_completed(futures):
+                done(*future.result())
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
 
     # --- a Dask cluster: each chunk one task
 
@@ -129,13 +139,6 @@ class Runner:
         except BaseException:
             client.cancel(futures)
             raise
-
-
-def _ignore_interrupts() -> None:
-    """Workers leave Ctrl-C to the parent, which stops them (no half-written results, no tracebacks)."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 # --- a Dask cluster ---------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import socket
 import sys
+import threading
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -39,10 +40,19 @@ class Job:
     info: dict[str, Any] = field(default_factory=dict)  # what the caller needs back with the result
 
 
-def run_job(job: Job) -> tuple[Job, FleetSummary]:
-    """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary."""
+class Stopped(Exception):
+    """A chunk given up between two blocks because its run was stopped (Ctrl-C)."""
+
+
+def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSummary]:
+    """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary. With
+    ``stop``, the chunk is given up (:class:`Stopped`) at the first block after it is set."""
     from tablebot.fleet.run import Fleet
     from tablebot.machine import compile_table
+
+    def check(_ticks: int) -> None:
+        if stop is not None and stop.is_set():
+            raise Stopped
 
     threads = job.threads or _worker_threads
     if threads is not None:  # per calling thread in numba: set for each job
@@ -51,7 +61,7 @@ def run_job(job: Job) -> tuple[Job, FleetSummary]:
         numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
                   variants=job.variants)
-    fleet.run(job.ticks)
+    fleet.run(job.ticks, progress=check)
     return replace(job, specs=[], variants=None), fleet.summary()
 
 

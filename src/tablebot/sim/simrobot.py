@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.engine import Engine
-from tablebot.formats.trace_lines import exact_round
+from tablebot.formats.trace_lines import exact_round_array
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
@@ -183,12 +183,18 @@ def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
 def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
-    columns: dict[str, list] = {}
+    return {key: values.tolist() for key, (values, _) in number_columns(scene, hist).items()}
+
+
+def number_columns(scene: Scene, hist: np.ndarray) -> dict[str, tuple[np.ndarray, int]]:
+    """:func:`trace_columns` as arrays, with their decimals (0: whole numbers, an int64 array)."""
+    columns: dict[str, tuple[np.ndarray, int]] = {}
     for key, column, scale, decimals in trace_layout(scene):
         values = hist[:, column].astype(np.float64)
         if column == L.TH:
             values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
-        columns[key] = values.astype(np.int64).tolist() if decimals == 0 else exact_round(values * scale, decimals)
+        columns[key] = ((values.astype(np.int64), 0) if decimals == 0
+                        else (exact_round_array(values * scale, decimals), decimals))
     return columns
 
 
@@ -233,3 +239,9 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __len__(self) -> int:
         return len(self.keys_)
+
+    def number_columns(self) -> list[tuple[str, np.ndarray, int]]:
+        """(key, values, decimals) of every field in order, the values as arrays: what the compiled trace
+        writer (tablebot.sinks.trace_text) takes."""
+        columns = number_columns(self.scene, self.hist)
+        return [(key, *columns[key]) for key in self.keys_]
