@@ -110,6 +110,8 @@ def live_view(folder: Path) -> None:
             page.goto(server.url)
             page.wait_for_function("() => document.querySelector('#counts').textContent.includes('states')")
             page.wait_for_selector("#play:not([disabled])")
+            # the page's counters live in a module (no globals): take a handle on the same instance
+            page.evaluate("import('/static/js/studio/stats.js').then((m) => { window.stats = m.stats; })")
             print("live view in Chromium, BumberBot in its arena (100 ticks per robot second)")
             for speed, label in (("10", "10x"), ("max", "max")):
                 _measure(page, speed, label)
@@ -123,11 +125,11 @@ def _measure(page, speed: str, label: str, seconds: float = 6.0) -> None:  # typ
     page.wait_for_timeout(500)
     page.click(f'[data-speed="{speed}"]')
     page.click("#play")
-    page.wait_for_function("() => TB.stats.ticks > 50")
-    start = page.evaluate("() => ({t: performance.now(), tick: TB.stats.ticks, frames: TB.stats.frames})")
+    page.wait_for_function("() => stats.ticks > 50")
+    start = page.evaluate("() => ({t: performance.now(), tick: stats.ticks, frames: stats.frames})")
     page.wait_for_timeout(seconds * 1000)
-    end = page.evaluate("() => ({t: performance.now(), tick: TB.stats.ticks, frames: TB.stats.frames, "
-                        "draw: TB.stats.drawMs})")
+    end = page.evaluate("() => ({t: performance.now(), tick: stats.ticks, frames: stats.frames, "
+                        "draw: stats.drawMs})")
     page.click("#play")  # pause
     wall = (end["t"] - start["t"]) / 1000
     ticks = end["tick"] - start["tick"]

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Set up everything tablebot needs on a fresh Debian-like machine: system packages (graphviz for
 # diagrams, avr-gcc/avr-libc/simavr for firmware and its emulation, chromium for the studio's browser
-# tests) and a virtual environment.
+# tests, node and npm for the studio's JavaScript linter), a virtual environment, and ESLint from npm.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -10,6 +10,7 @@ missing=()
 for pkg in "${SYSTEM_PACKAGES[@]}"; do
   dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")
 done
+command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)  # any node with npm will do (Debian's, or another)
 if [ ${#missing[@]} -gt 0 ]; then
   if command -v apt-get >/dev/null 2>&1; then
     SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -21,12 +22,22 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
 fi
 
+# Each step says what it does before it starts: the first set-up takes minutes, and must not look hung.
 PYTHON=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
+  echo "creating .venv (a Python virtual environment for tablebot) with $PYTHON"
   "$PYTHON" -m venv .venv
 fi
 if [ ! -f .venv/.installed ] || [ pyproject.toml -nt .venv/.installed ]; then
+  echo "installing tablebot and its Python packages into .venv (numpy, numba, matplotlib, typer, rich, dask,"
+  echo "  playwright, ...; see pyproject.toml): a few minutes the first time"
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e '.[dev]'
   touch .venv/.installed
+  echo "installed; .venv/bin/tablebot --help lists the commands"
+fi
+
+# ESLint for the studio's front end, exactly as package-lock.json pins it (node_modules/ is not in git).
+if [ ! -f node_modules/.package-lock.json ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
+  npm ci --no-audit --no-fund --loglevel=error
 fi

@@ -46,7 +46,8 @@ def test_motion_words(motors, words, kind):
 def test_dot_source_marks_the_initial_state_and_labels_states():
     source = render(BB, "dot").decode()
     assert source.count("s_2 [label=<<b>2</b><br/>Seek: turn>") == 1
-    assert "\t__start -> s_2 [" in source and "penwidth=2.5" in source
+    assert "\t__start -> s_2 [" in source  # the initial state drawn wider, in its colour from the pictures
+    assert 's_2 [label=<<b>2</b><br/>Seek: turn> color="#ff7f0e" fillcolor="#fff7d6" penwidth=3]' in source
     for state in BB.states:
         assert f"s_{state} [" in source
     assert "I3 or I4" in source and "#c62828" in source  # reverse edges are red

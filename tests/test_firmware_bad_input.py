@@ -15,9 +15,9 @@ from tablebot.diagnostics import TableBotError
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.framing import Decoder, encode
 from tablebot.formats.inputs_csv import load_inputs
-from tablebot.formats.robopro_program import rewrite
 from tablebot.machine import compile_table
 from tablebot.replay import replay
+from tablebot.robopro.rpp_edit import rewrite
 from tablebot.robot import load_robot
 from tablebot.testing.random_tables import random_inputs, random_table
 
@@ -172,8 +172,9 @@ def test_inits_without_a_value_are_replaced_not_copied_blank() -> None:
             '<o classname="ftProDataArray1D" name="Action" N="1"><init value="0"/></o>\n'
             '<o classname="ftProDataArray1D" name="Timer" N="1"></o></cvg>')
     new = rewrite(text, LISTS)
-    assert '<init value="1"></init>' in new and '<init value="2"></init>' in new and "<init/>" not in new
-    assert '<init value="3"/>' in new and '<init value="6"></init>' in new
+    # ROBO Pro's own form (issue 20): <init value="…"> and </init> on lines of their own
+    assert '<init value="1">\n</init>' in new and '<init value="2">\n</init>' in new and "<init/>" not in new
+    assert '<init value="3"/>' in new and '<init value="6">\n    </init>' in new
 
 
 def test_a_list_written_as_an_empty_element_is_a_clear_error() -> None:

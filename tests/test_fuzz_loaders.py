@@ -25,11 +25,11 @@ from tablebot.analysis.properties import load_properties
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.inputs_csv import load_inputs
-from tablebot.formats.robopro_lists import read_table
-from tablebot.formats.robopro_program import write_lists
 from tablebot.formats.table_read import load_table
 from tablebot.formats.trace_lines import read_trace
 from tablebot.machine import compile_table
+from tablebot.robopro.lists import read_table
+from tablebot.robopro.rpp_edit import write_lists
 from tablebot.robot import BUMBERBOT, load_robot
 from tablebot.sim.world import load_world
 

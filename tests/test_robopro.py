@@ -9,9 +9,9 @@ import pytest
 
 from core_helpers import EXAMPLE, MINI_ROBOT, SEED_TSV, example_machine, write_table
 from tablebot.diagnostics import TableBotError
-from tablebot.formats import robopro_lists as robopro
 from tablebot.formats.table_read import load_table, parse_table
 from tablebot.machine import compile_table
+from tablebot.robopro import lists as robopro
 from tablebot.robot import BUMBERBOT
 
 

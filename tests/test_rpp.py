@@ -12,15 +12,15 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
-from tablebot.formats import robopro_lists as robopro
-from tablebot.formats.robopro_program import find_lists, rewrite, write_lists
 from tablebot.formats.table_read import load_table
+from tablebot.robopro import lists as robopro
+from tablebot.robopro.rpp_edit import find_lists, rewrite, write_lists
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 FIXTURES = Path(__file__).resolve().parent / "fixtures" / "rpp"
 runner = CliRunner()
-INITS = re.compile(rb"""(\s*<init\b[^>]*?(?:/>|></init>))+""")
+INITS = re.compile(rb"""(\s*<init\b[^>]*?(?:/>|>\s*</init>))+""")
 N_ATTR = re.compile(rb'\bN="\d+"')
 
 
@@ -67,9 +67,11 @@ def test_inits_keep_the_programs_layout(tmp_path, lists):
     write_lists(program, {"Event": lists.event, "Action": lists.action, "Timer": lists.timer})
     text = program.read_text()
     assert '                <init value="88"></init>\n                <init value="80"></init>\n' in text
-    # the empty Timer list gets its inits on their own lines, one step deeper than its closing tag
-    assert '</o>\n                <init value="50"></init>\n' in text
-    assert '<init value="500"></init>\n            </o>\n            <o classname="ftProDataArray1D" id="140"' in text
+    # the empty Timer list gets its inits as real files lay them out: <init value="…"> and </init> on lines
+    # of their own, one step deeper than its closing tag
+    assert '</o>\n                <init value="50">\n                </init>\n' in text
+    assert '<init value="500">\n                </init>\n            </o>\n            ' \
+           '<o classname="ftProDataArray1D" id="140"' in text
     again = program.read_bytes()
     write_lists(program, {"Event": lists.event, "Action": lists.action, "Timer": lists.timer})
     assert program.read_bytes() == again  # writing the same lists again changes nothing
@@ -81,7 +83,7 @@ def test_latin1_crlf_program_with_other_names(tmp_path):
     result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program),
                                  "--event-list", "Ereignis", "--action-list", "Aktion", "--timer-list", "Zeit"])
     assert result.exit_code == 0, result.output
-    assert "Zeit loads its values from a CSV file" in result.output
+    assert "Zeit loads its values from column" in " ".join(result.output.split())
     after = program.read_bytes()
     assert "Maschine für Tabellen".encode("latin-1") in after
     assert b"\n" not in after.replace(b"\r\n", b"")  # no bare LF was introduced
@@ -110,10 +112,17 @@ def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path):
     assert program.read_bytes() == before
 
 
-def test_two_lists_of_one_name_are_refused():
-    text = '<cvg><o classname="ftProDataArray1D" name="Event" N="1"></o>\n' \
-           '<o classname="ftProDataArray1D" name="Event" N="1"></o></cvg>'
-    with pytest.raises(TableBotError, match="2 lists are named 'Event'"):
+def test_a_global_list_is_written_in_every_subprogram_that_has_it():
+    text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
+            '<o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o></cvg>')
+    assert [[int(i.get("value")) for i in o.findall("init")] for o in ET.fromstring(rewrite(text, {"Event": [4, 5]}))
+            .iter("o")] == [[4, 5], [4, 5]]
+
+
+def test_two_different_lists_of_one_name_are_refused():
+    text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
+            '<o classname="ftProDataArray1D" name="Event" globalname="Other" N="1"></o></cvg>')
+    with pytest.raises(TableBotError, match="2 different lists are named 'Event'"):
         rewrite(text, {"Event": [1]})
 
 

@@ -217,3 +217,37 @@ def test_what_the_controller_calls_itself_reaches_the_terminal_as_text() -> None
         result = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.05")
     assert result.exit_code == 0, result.output
     assert "(\\x1b[2J[red]TX 4.6.6); Ctrl-C stops it" in result.output and "\x1b" not in result.output
+
+
+def test_auto_runs_on_the_address_that_answers_as_a_txt(monkeypatch: pytest.MonkeyPatch) -> None:
+    """txt://auto with the controller addresses replaced by loopback ones (never the real ones): an HTTP
+    server that answers garbage with an HTTP error on one, nothing on another, the fake TXT on a third."""
+    from tablebot.hw.txt import link as txt_link
+    from test_txt_link import Listener
+
+    with FakeTxt(host="127.0.0.9") as fake:
+        other = Listener("127.0.0.7", fake.port, "400")
+        try:
+            monkeypatch.setattr(txt_link, "AUTO_HOSTS", ("127.0.0.7", "127.0.0.8", "127.0.0.9"))
+            result = invoke("run", EXAMPLE, "--on", f"txt://auto:{fake.port}", "--seconds", "0.05",
+                            "--link-timeout", "1")
+            monkeypatch.setattr(txt_link, "AUTO_HOSTS", ("127.0.0.7", "127.0.0.8"))
+            none = invoke("run", EXAMPLE, "--on", f"txt://auto:{fake.port}", "--seconds", "0.05")
+        finally:
+            other.close()
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.output.split())  # the console wraps long lines where the checkout's path makes it
+    assert f"on txt://127.0.0.9:{fake.port}" in said and "(TXT-fake 4.6.6)" in said
+    assert none.exit_code == 2 and "--on: error: txt://auto found no TXT: 127.0.0.7: malformed reply" in none.output
+    assert "127.0.0.8: cannot connect" in none.output
+
+
+def test_firmware_older_than_4_6_6_is_refused_before_anything_moves() -> None:
+    """As fischertechnik's online client refuses it (BeginTransfer: GetVersion() < 0x04060600)."""
+    with FakeTxt(version=0x04060500) as fake:
+        result = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.05")
+        time.sleep(0.05)
+    assert result.exit_code == 2
+    assert "runs firmware 4.6.5 (0x04060500); the online protocol needs 4.6.6 or later" in result.output
+    assert "update the TXT's firmware to 4.6.6 or later" in result.output
+    assert fake.names() == ["QueryStatus", "closed"]  # never went online

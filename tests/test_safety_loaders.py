@@ -15,9 +15,9 @@ from core_helpers import EXAMPLE, MINI_ROBOT, write_table
 from tablebot import csvtext
 from tablebot.cli import INTERNAL_ERROR, app, main
 from tablebot.diagnostics import TableBotError, notes_to
-from tablebot.formats.robopro_lists import read_lists
 from tablebot.formats.table_read import load_table
 from tablebot.formats.trace_lines import read_trace
+from tablebot.robopro.lists import read_lists
 from tablebot.robot import load_robot
 
 runner = CliRunner()
@@ -57,7 +57,7 @@ def test_counter_given_a_list_is_a_located_error(tmp_path):
 
 
 def test_states_csv_with_a_superscript_digit(tmp_path):
-    """Reproduced: '²'.isdigit() is True but int('²') is a ValueError (robopro_lists)."""
+    """Reproduced: '²'.isdigit() is True but int('²') is a ValueError (robopro.lists)."""
     for name, text in (("event.csv", "97\n"), ("action.csv", "512\n"), ("timer.csv", "0\n")):
         (tmp_path / name).write_text(text)
     (tmp_path / "states.csv").write_text("number,name\n²,seek\n", encoding="utf-8")

@@ -94,7 +94,7 @@ def test_ctrl_c_keeps_the_previous_run_and_a_partial_trace(tmp_path: Path) -> No
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     proc = subprocess.Popen([*sim, "--seconds", "3600"], stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
-    while not any(p.name.startswith(".trace.jsonl.") for p in out.iterdir()):  # the live trace has begun
+    while not any(p.name.startswith(".trace.jsonl.") for p in out.rglob("*")):  # the live trace has begun
         assert time.monotonic() < deadline and proc.poll() is None
         time.sleep(0.01)
     time.sleep(0.05)
@@ -115,7 +115,7 @@ def test_sigterm_stops_the_run_the_same_way(tmp_path: Path) -> None:
     proc = subprocess.Popen([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--out", str(out), "-q",
                              "--seconds", "3600"], stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60
-    while not out.is_dir() or not any(p.name.startswith(".trace.jsonl.") for p in out.iterdir()):
+    while not out.is_dir() or not any(p.name.startswith(".trace.jsonl.") for p in out.rglob("*")):
         assert time.monotonic() < deadline and proc.poll() is None
         time.sleep(0.01)
     os.kill(proc.pid, signal.SIGTERM)

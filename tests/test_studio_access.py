@@ -124,7 +124,7 @@ def upgrade_status(server: Background, headers: dict[str, str]) -> int:
 
 def test_the_page_and_every_api_need_the_token(studio: Background) -> None:
     origin_only = {"Origin": studio.origin}
-    for path in ("", "api/config", "static/js/studio.js", "static/studio.css"):
+    for path in ("", "api/config", "static/js/studio/main.js", "static/studio.css"):
         status, body = http(studio, path, origin_only)
         assert status == 403 and b"the studio's key is missing" in body, path
         assert http(studio, path)[0] == 200, path  # with the page's cookie
@@ -153,7 +153,7 @@ def test_a_host_the_studio_does_not_serve_is_refused_before_any_route(studio: Ba
     """DNS rebinding: a foreign name resolving to 127.0.0.1 reaches the server with its own Host header."""
     headers = {**studio.headers, "Host": host.format(port=studio.access.port),
                "Origin": "http://" + host.format(port=studio.access.port)}
-    for path in ("", "api/config", "static/js/studio.js", "no/such/route"):
+    for path in ("", "api/config", "static/js/studio/main.js", "no/such/route"):
         status, body = http(studio, path, headers)
         assert status == 403 and b"does not answer to the address" in body, (host, path)
     assert upgrade_status(studio, headers) == 403

@@ -85,6 +85,8 @@ class Tab:
         self.page.wait_for_selector("table.grid tbody tr")
         self.page.wait_for_function("() => document.querySelector('#counts').textContent.includes('states')")
         self.page.wait_for_selector("#play:not([disabled])")  # the robot is in its arena
+        # the page's counters live in a module (the page has no globals): the test takes a handle on them
+        self.page.evaluate("import('/static/js/studio/stats.js').then((m) => { window.stats = m.stats; })")
 
     def cell(self, row: int, col: int):  # type: ignore[no-untyped-def]
         return self.page.locator(f'td[data-row="{row}"][data-col="{col}"]')
@@ -144,21 +146,21 @@ def test_play_leaves_state_2_for_1_within_a_second_of_robot_time(tab: Tab) -> No
         return status.includes('state 1 (') && node && node.textContent === 's_1' && status; }""").json_value()
     tick = int(re.match(r"tick (\d+)", seen)[1])  # type: ignore[index]
     assert tick < 100  # state 1 was reached within 100 ticks = 1 s of robot time
-    page.wait_for_function("() => TB.stats.ticks > 150")
+    page.wait_for_function("() => stats.ticks > 150")
     tab.shot("live")
 
 
 def test_paused_hold_i3_and_step_fires_a_collision_row(tab: Tab) -> None:
     page = tab.page
     page.click("#play")
-    page.wait_for_function("() => TB.stats.ticks > 20")
+    page.wait_for_function("() => stats.ticks > 20")
     page.click("#play")  # pause
     page.wait_for_selector("#step:not([disabled])")
     page.click('#inputs button[data-input="I3"]')
     page.wait_for_selector('#inputs button[data-input="I3"].held-on')
-    before = page.evaluate("TB.stats.ticks")
+    before = page.evaluate("stats.ticks")
     page.click("#step")
-    page.wait_for_function(f"() => TB.stats.ticks > {before}")
+    page.wait_for_function(f"() => stats.ticks > {before}")
     page.wait_for_function("() => document.querySelector('#status').textContent.includes('state 20')")
     fired = page.locator("#why li.why-fired").inner_text()
     # the robot may be seeking (state 1 or 2) or following the light (11): each has its own I3 row

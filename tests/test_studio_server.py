@@ -94,8 +94,13 @@ def test_static_files_stay_in_the_package(studio: tuple[Background, Path]) -> No
         assert err.value.code == 404
     page = urllib.request.urlopen(server.url)
     assert "script-src 'self'" in page.headers["Content-Security-Policy"]
-    assert b"http" not in urllib.request.urlopen(get(server, "static/js/studio.js")).read().replace(
-        b"location.protocol === \"https:\"", b"")  # no script is fetched from anywhere else
+    from tablebot.web.app import STATIC
+
+    modules = sorted(p.relative_to(STATIC).as_posix() for p in (STATIC / "js").rglob("*.js"))
+    assert "js/studio/main.js" in modules and len(modules) > 10
+    for module in modules:  # no script is fetched from anywhere else
+        text = urllib.request.urlopen(get(server, "static/" + module)).read()
+        assert b"http" not in text.replace(b'location.protocol === "https:"', b""), module
 
 
 def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background, Path]) -> None:

@@ -60,17 +60,20 @@ def test_unknown_target_names_the_known_ones() -> None:
 def test_the_commands_choices_are_the_registered_back_ends() -> None:
     """--to, --board, --on and check --target list exactly what is registered, in its order."""
     runner = CliRunner()
-    assert registry.names("export") == ["robopro", "robopro-rpp", "c", "txt4"]
+    assert registry.names("export") == ["robopro", "robopro-rpp", "robopro-program", "c", "txt4"]
     assert registry.names("board") == ["uno", "ftduino"]
-    assert registry.names("live") == ["txt", "sim"]
-    assert registry.check_targets() == ["robopro", "robopro-rpp", "c", "uno", "ftduino", "txt", "txt4"]
+    assert registry.names("live") == ["txt", "robotx", "roboif", "sim"]
+    assert registry.check_targets() == ["robopro", "robopro-rpp", "robopro-program", "c", "uno", "ftduino", "txt",
+                                        "robotx", "roboif",
+                                        "txt4"]
     from tablebot.cli.export import Target
     from tablebot.cli.firmware import BoardName
 
     assert [t.value for t in Target] == registry.names("export")
     assert [b.value for b in BoardName] == registry.names("board")
     on = runner.invoke(app, ["run", str(EXAMPLE), "--on", "nowhere://x"])
-    assert on.exit_code == 2 and "txt://auto, sim or sim:WORLD.toml" in on.output
+    assert on.exit_code == 2 and "robotx://auto" in on.output and "roboif://auto" in on.output
+    assert "sim or sim:WORLD.toml" in on.output
 
 
 def test_a_back_end_registers_once_and_says_what_it_is() -> None:

@@ -8,8 +8,8 @@ import pytest
 from core_helpers import MINI_ROBOT, column_of, find, problems, write_table
 from tablebot.diagnostics import TableBotError
 from tablebot.durations import DurationError, to_ticks
-from tablebot.formats.robopro_lists import encode
 from tablebot.formats.table_read import parse_table
+from tablebot.robopro.lists import encode
 from tablebot.robot import BUMBERBOT, Robot
 
 ROBOT7 = "name = \"Seven\"\ntick_ms = 7\ninitial_state = 1\n[inputs]\nA = \"a\"\n[motors]\nM1 = \"m\"\n"

@@ -3,7 +3,13 @@
 
 from __future__ import annotations
 
+import http.server
+import os
+import signal
+import socket
+import socketserver
 import struct
+import threading
 import time
 import warnings
 
@@ -117,15 +123,100 @@ def test_connect_errors_say_where() -> None:
         TxtLink("no-such-txt.invalid").connect(timeout_s=0.5)
 
 
-def test_auto_takes_the_first_address_that_answers() -> None:
-    with FakeTxt() as fake:  # listens on 127.0.0.1 only: 127.0.0.2 refuses
-        assert find_controller(("127.0.0.2", "127.0.0.1"), fake.port, timeout_s=0.5) == "127.0.0.1"
-        assert find_controller(("127.0.0.2", "127.0.0.3"), fake.port, timeout_s=0.2) is None
+class Listener:
+    """Something else on the TXT's port at ``host``: an HTTP server (Python's own, which waits for a
+    request line), or a server that answers whatever comes with an HTTP error at once, as many do."""
+
+    def __init__(self, host: str, port: int, kind: str):
+        if kind == "http":
+            self.server: socketserver.BaseServer = http.server.ThreadingHTTPServer((host, port),
+                                                                                  http.server.BaseHTTPRequestHandler)
+        else:
+            self.server = socketserver.ThreadingTCPServer((host, port), BadRequest)
+        self.server.daemon_threads = True  # type: ignore[attr-defined]
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+
+    def close(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()  # type: ignore[attr-defined]
 
 
-def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture) -> None:
+class BadRequest(socketserver.BaseRequestHandler):
+    def handle(self) -> None:
+        self.request.recv(64)
+        self.request.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+
+
+def test_auto_takes_the_first_address_that_answers_as_a_txt() -> None:
+    """Loopback addresses only: an HTTP server on .2, one that answers garbage with an HTTP error on .3,
+    nothing on .4, the fake TXT on .5 -- only .5 counts, and each of the others says what it did."""
+    with FakeTxt(host="127.0.0.5") as fake:
+        port = fake.port
+        others = [Listener("127.0.0.2", port, "http"), Listener("127.0.0.3", port, "400")]
+        try:
+            hosts = ("127.0.0.2", "127.0.0.3", "127.0.0.4", "127.0.0.5")
+            started = time.monotonic()
+            found, tried = find_controller(hosts, port, timeout_s=0.3)
+            took = time.monotonic() - started
+            none, tried_none = find_controller(hosts[:3], port, timeout_s=0.3)
+        finally:
+            for other in others:
+                other.close()
+    assert found == "127.0.0.5" and none is None
+    assert tried == tried_none
+    assert tried[0].startswith("127.0.0.2: no answer from 127.0.0.2")
+    assert tried[1] == (f"127.0.0.3: malformed reply from 127.0.0.3:{port}: QUERY_STATUS: "
+                        "wrong response id 0x50545448 (expected 0xBAC9723E)")
+    assert tried[2].startswith(f"127.0.0.4: cannot connect to 127.0.0.4:{port}")
+    assert took < 1.0  # asked at once, not one after the other
+    assert fake.names()[0] == "QueryStatus"
+
+
+def test_a_request_goes_out_whole_even_when_ctrl_c_comes_in_the_middle_of_sending_it() -> None:
+    """A real socket whose peer reads late, so that sendall blocks part way; SIGINT arrives then. The
+    KeyboardInterrupt comes after the last byte went out, never between two pieces of a request."""
+    payload = bytes(range(256)) * 16384  # 4 MiB: more than the socket buffers hold
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        link = TxtLink("127.0.0.1", server.getsockname()[1])
+        link.connect()
+        peer, _ = server.accept()
+        received = bytearray()
+
+        def read_late() -> None:
+            time.sleep(0.3)
+            while len(received) < len(payload) and (chunk := peer.recv(1 << 16)):
+                received.extend(chunk)
+
+        reader = threading.Thread(target=read_late)
+        reader.start()
+        threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGINT)).start()
+        with pytest.raises(KeyboardInterrupt):
+            link._send(payload, time.monotonic() + 10, Command.EXCHANGE_DATA)
+            time.sleep(1)  # where the interrupt lands if the send was not cut
+        reader.join(10)
+        peer.close()
+        link.close()
+    assert bytes(received) == payload
+
+
+def test_against_a_server_that_reads_each_request_with_one_recv_every_request_arrives_whole() -> None:
+    """ftrobopy_server's reading (txt_fake single_recv): a stream of exchanges, every one a recv of its own."""
+    with FakeTxt(numbered, period_s=0, single_recv=True) as fake:
+        link = online(fake)
+        replies = [link.exchange([i, 0, 0, 0, 0, 0, 0, 0]) for i in range(200)]
+        link.stop_online()
+        link.close()
+        time.sleep(0.05)
+    assert [r.universal[0] for r in replies] == list(range(200))
+    assert all(r.whole for r in fake.requests()) and len(fake.requests("ExchangeData")) == 200
+
+
+@pytest.mark.parametrize("single_recv", [False, True], ids=["txt", "ftrobopy_server"])
+def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture,
+                                                                             single_recv: bool) -> None:
     import ftrobopy  # a dev dependency (pyproject.toml): missing, this fails rather than skips
-    with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True) as fake, warnings.catch_warnings():
+    with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True, single_recv=single_recv) as fake, \
+            warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)  # ftrobopy uses Thread.setDaemon
         txt = ftrobopy.ftrobopy("127.0.0.1", fake.port)
         motor = txt.motor(1)
@@ -143,5 +234,5 @@ def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(ca
     config = fake.requests("UpdateConfig")[-1].fields
     assert config["motors"][0] == 1 and config["inputs"][2] == (1, 1)
     assert any(r.fields["pwm"][:2] == [300, 0] for r in fake.requests("ExchangeData"))
-    assert "StopOnline" in fake.names()
+    assert "StopOnline" in fake.names() and all(r.whole for r in fake.requests())
     assert "TXT-fake" in capsys.readouterr().out  # ftrobopy prints what it connected to

@@ -31,7 +31,8 @@ from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_table
 from txt_fake import FakeTxt
 
-FLAVOURS = {"txt": {"period_s": 0.01}, "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000}}
+FLAVOURS = {"txt": {"period_s": 0.01},
+            "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000, "single_recv": True}}
 
 
 def bumberbot() -> Machine:
@@ -46,6 +47,7 @@ def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple 
     end = run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="txt",
               behind_limit_s=behind_limit_s)
     fake_settles(fake)
+    assert all(r.whole for r in fake.requests()), "a request arrived in pieces"
     return end
 
 

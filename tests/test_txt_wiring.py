@@ -17,7 +17,9 @@ from tablebot.hw.txt.wiring import txt_wiring
 from tablebot.machine import compile_table
 from txt_fake import FakeTxt
 
-ROBOT = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
+#: The example's robot file up to its [txt] wiring (the other controllers' sections after it are not the TXT's).
+FULL = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
+ROBOT = FULL[: FULL.index("\n# The same wiring on the seed's own controllers") + 1]
 TXT_START = ROBOT.index("[txt]")
 
 
@@ -172,3 +174,34 @@ def test_a_txt_entry_that_contradicts_the_sensor_declaration_is_refused(tmp_path
         load_table(tmp_path / "table.csv")
     found = [d.render() for d in info.value.diagnostics]
     assert any(message in e and f"robot.toml:{line_of(text, entry)}:" in e for e in found), found
+
+
+def test_the_line_follower_reads_its_track_sensor_in_digital_voltage_mode() -> None:
+    """ftrobopy's trailfollower() configures (voltage, digital) -- ftrobopy_server's ft::TrailFollower --
+    and reads 1 for a reported 1 or more than 600 mV (a light floor), else 0 (the dark line)."""
+    machine = compile_table(load_table(EXAMPLE.parent / "line-follower" / "table.csv"))
+    wiring = txt_wiring(machine)
+    assert [(w.name, w.terminal, w.mode, w.invert) for w in wiring.inputs] == [("I1", 0, "trail", True),
+                                                                                ("I2", 1, "trail", True)]
+    assert wiring.config().inputs[:3] == (wire.InputConfig(wire.InputMode.VOLTAGE, True),
+                                          wire.InputConfig(wire.InputMode.VOLTAGE, True), wire.InputConfig())
+    i1, i2 = machine.input_bits["I1"], machine.input_bits["I2"]
+    assert wiring.mask([0, 0] + [0] * 6) == i1 | i2  # both spots over the line
+    assert wiring.mask([1, 0] + [0] * 6) == i2
+    assert wiring.mask([1200, 150] + [0] * 6) == i2  # millivolts, as ftrobopy allows for
+    assert wiring.mask([1, 1] + [0] * 6) == 0
+    with FakeTxt(lambda n: ([1, 0, 0, 0, 0, 0, 0, 0], [0] * 4), period_s=0) as fake:
+        result = CliRunner().invoke(app, ["run", str(EXAMPLE.parent / "line-follower"), "--on",
+                                          f"txt://127.0.0.1:{fake.port}", "--seconds", "0.1", "--link-timeout", "1"])
+    assert result.exit_code == 0, result.output
+    assert fake.requests("UpdateConfig")[0].fields["inputs"][:3] == [(0, 1), (0, 1), (1, 1)]
+    assert fake.requests("ExchangeData")[-2].fields["pwm"][:4] == [3 * 64, 0, 6 * 64, 0]  # line on the right
+
+
+def test_a_trail_input_says_what_it_reads_over_the_line(tmp_path: Path) -> None:
+    robot = ROBOT.replace('I3 = { terminal = "I3", mode = "switch", pressed = 1 }',
+                          'I3 = { terminal = "I3", mode = "trail", pressed = 1 }')
+    found = errors(tmp_path, robot)
+    assert any("unknown key 'pressed' for mode 'trail'" in e for e in found), found
+    assert any("say what the table reads while the track sensor's spot is over the dark line: dark = 1" in e
+               for e in found), found

@@ -5,6 +5,12 @@ FtShmemTxt.h) independently of tablebot.hw.txt.protocol, so that a wrong layout 
 other (and unmodified ftrobopy keeps this fake honest). It records every request with its time, serves
 inputs from a script, paces exchanges like a TXT ("the interface sends the response 10ms after it sent
 the previous response") or answers at once like ftrobopy_server on a TXT 4.0, and injects faults.
+
+``single_recv=True`` reads as ftrobopy_server does (ftrobopy/ftrobopy_server, ``src/ftrobopy_server.cpp``,
+its ``while (connected)`` loop): one ``recv`` into a 1024-byte buffer per request, the command id from its
+first four bytes and every field from fixed offsets of that buffer (bytes a short read did not bring are
+left over from earlier requests); an unknown id is answered 0x01020304 and the connection closed. A
+request split across reads is then misread, as there: each request is logged with ``whole``.
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ class Request:
     t: float  # time.monotonic() when it was read
     name: str
     fields: dict[str, Any] = field(default_factory=dict)
+    whole: bool = True  # single_recv: the request came in one recv, exactly
 
 
 def still(n: int) -> tuple[list[int], list[int]]:
@@ -48,15 +55,17 @@ class FakeTxt:
 
     def __init__(self, script: Script = still, period_s: float = 0.01, device: str = "TXT-fake",
                  version: int = 0x04060600, fault: tuple[str, int] | None = None, late_s: float = 0.2,
-                 i2c: bool = False, drift_s: float = 0.0):
+                 i2c: bool = False, drift_s: float = 0.0, host: str = "127.0.0.1", port: int = 0,
+                 single_recv: bool = False):
         self.script, self.period_s, self.device, self.version = script, period_s, device, version
+        self.single_recv = single_recv
         self.drift_s = drift_s  # added to every period: a TXT whose exchanges take a little longer
         self.fault, self.late_s = fault, late_s
         self.log: list[Request] = []
         self.exchanges = 0
         self.connections = 0
         self._stop = threading.Event()
-        self._server, self._i2c = self._listen(i2c)
+        self._server, self._i2c = self._listen(i2c, host, port)
         self.port = self._server.getsockname()[1]
         self._threads = [threading.Thread(target=self._serve, daemon=True)]
         if self._i2c is not None:
@@ -104,18 +113,19 @@ class FakeTxt:
     # --- the server -------------------------------------------------------------------------------
 
     @staticmethod
-    def _listen(i2c: bool) -> tuple[socket.socket, socket.socket | None]:
-        """A listening socket on a free port (and, for ftrobopy, one on port + 2, its I2C channel)."""
+    def _listen(i2c: bool, host: str, port: int) -> tuple[socket.socket, socket.socket | None]:
+        """A listening socket on ``host``, on ``port`` or a free one (and, for ftrobopy, one on port + 2,
+        its I2C channel)."""
         for _ in range(50):
             main = socket.socket()
             main.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            main.bind(("127.0.0.1", 0))
+            main.bind((host, port))
             if not i2c:
                 main.listen()
                 return main, None
             extra = socket.socket()
             try:
-                extra.bind(("127.0.0.1", main.getsockname()[1] + 2))
+                extra.bind((host, main.getsockname()[1] + 2))
             except OSError:
                 main.close()
                 extra.close()
@@ -160,26 +170,51 @@ class FakeTxt:
             data += chunk
         return data
 
+    def _next(self, conn: socket.socket, buffer: bytearray) -> tuple[int, bytes, bool] | None:
+        """The next request: (command id, the bytes after it, whether it came whole); None when closed."""
+        if self.single_recv:  # one recv per request, fields from the persistent buffer
+            try:
+                chunk = conn.recv(len(buffer))
+            except OSError:
+                return None
+            if not chunk:
+                return None
+            buffer[:len(chunk)] = chunk
+            (command,) = struct.unpack_from("<I", buffer)
+            extra = COMMANDS[command][1] if command in COMMANDS else 0
+            return command, bytes(buffer[4:4 + extra]), len(chunk) == 4 + extra
+        head = self._read(conn, 4)
+        if head is None:
+            return None
+        (command,) = struct.unpack("<I", head)
+        extra = COMMANDS[command][1] if command in COMMANDS else 0
+        body = self._read(conn, extra) if extra else b""
+        return None if body is None else (command, body, True)
+
     def _session(self, conn: socket.socket) -> None:
         last_reply = 0.0
         silent = False
+        buffer = bytearray(1024)
+        previous = ""
         while True:
-            head = self._read(conn, 4)
-            if head is None:
+            got = self._next(conn, buffer)
+            if got is None:
                 return
-            (command,) = struct.unpack("<I", head)
+            command, body, whole = got
             if command not in COMMANDS:
-                self.log.append(Request(time.monotonic(), f"unknown 0x{command:08X}"))
+                self.log.append(Request(time.monotonic(), f"unknown 0x{command:08X}", whole=whole))
+                if self.single_recv:
+                    conn.sendall(struct.pack("<I", 0x01020304))
                 return
-            name, extra, response = COMMANDS[command]
-            body = self._read(conn, extra) if extra else b""
-            if body is None:
-                return
-            request = Request(time.monotonic(), name, self._fields(name, body))
+            name, _, response = COMMANDS[command]
+            request = Request(time.monotonic(), name, self._fields(name, body), whole)
             self.log.append(request)
+            previous, before = name, previous
             if name != "ExchangeData":
                 if not silent:
                     conn.sendall(self._reply(name, response))
+                if self.single_recv and name == "StopOnline" and before != "QueryStatus":
+                    return  # ftrobopy_server ends the connection (right after QueryStatus: ftScratchTXT's way)
                 continue
             number = self.exchanges
             kind = self.fault[0] if self.fault and number >= self.fault[1] else None

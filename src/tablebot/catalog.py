@@ -12,12 +12,14 @@ from __future__ import annotations
 def load_all() -> None:
     """Import every back-end module (in the order commands list them) and the analysis's section."""
     # The order is the order of --to, --board, --on and check --target: keep it (noqa: not sorted).
-    from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp
+    from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp, robopro-program; [robopro]
     from tablebot.codegen import backend as _c  # c
     from tablebot.firmware import backend as _boards  # uno, ftduino; [board]
     from tablebot.hw.txt import backend as _txt  # txt; [txt]
+    from tablebot.hw.robotx import backend as _robotx  # robotx; [robotx]
+    from tablebot.hw.roboif import backend as _roboif  # roboif; [roboif]
     from tablebot.hw.txt4 import backend as _txt4  # txt4
     from tablebot.sim import backend as _sim  # sim; [sim]
     from tablebot.analysis import section as _properties  # [properties]
 
-    del _robopro, _c, _boards, _txt, _txt4, _sim, _properties
+    del _robopro, _c, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties

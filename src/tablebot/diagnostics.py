@@ -23,6 +23,7 @@ class Diagnostic:
     message: str
     hint: str = ""
     severity: str = "error"
+    detail: str = ""  # a tool's own output (a compiler's errors), shown below the message, line by line
 
     def location(self) -> str:
         parts = [self.path]
@@ -36,6 +37,8 @@ class Diagnostic:
         text = f"{self.location()}: {self.severity}: {self.message}"
         if self.hint:
             text += f"\n    hint: {self.hint}"
+        for line in self.detail.splitlines():
+            text += f"\n    | {line}"
         return text
 
 
@@ -63,9 +66,9 @@ class Collector:
 
 
 def fail(path: str | Path, message: str, hint: str = "", line: int | None = None,
-         column: int | None = None) -> TableBotError:
-    """Build (not raise) an error with a single diagnostic."""
-    return TableBotError([Diagnostic(str(path), line, column, message, hint)])
+         column: int | None = None, detail: str = "") -> TableBotError:
+    """Build (not raise) an error with a single diagnostic (one line: a tool's output goes in ``detail``)."""
+    return TableBotError([Diagnostic(str(path), line, column, message, hint, detail=detail)])
 
 
 _note_sinks: list[Callable[[Diagnostic], None]] = []

@@ -129,15 +129,27 @@ def python_string(text: str) -> str:
     return ascii(text)
 
 
+_LINE_BREAKS = {"\n": "\\n", "\r": "\\r", "\x85": "\\x85", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+_TERMINAL_RE = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f\u2028\u2029]")
+
+
 def plain(text: str) -> str:
-    """User text for plain terminal output (no markup: a pipe, a log, ``rich.text.Text``): control
-    characters (an ANSI escape, a bell, NUL) shown as ``\\xNN``; tabs and line ends stay."""
-    return _CONTROL_RE.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+    """User text for plain terminal output (no markup: a pipe, a log, ``rich.text.Text``), on the line it
+    is printed in: line breaks shown as ``\\n`` (a name cannot start a forged line of its own) and other
+    control characters (an ANSI escape, a bell, NUL) as ``\\xNN``; tabs stay."""
+    return _TERMINAL_RE.sub(lambda m: _LINE_BREAKS.get(m.group()) or f"\\x{ord(m.group()):02x}", text)
+
+
+def picture(text: str) -> str:
+    """User text for a picture (matplotlib): on one line, every character printable (a control character
+    would draw a missing glyph: shown as ``\\xNN``, line breaks as ``\\n``). The pictures are drawn with
+    maths parsing off (``tablebot.sim.draw.literal_text``), so a ``$`` stays a ``$``."""
+    return plain(text)
 
 
 def terminal(text: str) -> str:
-    """User text for a rich console line: markup (``[bold]``) escaped, and control characters (an ANSI
-    escape, a bell, NUL) shown as ``\\xNN`` instead of acting on the terminal; tabs and line ends stay.
+    """User text for a rich console line: markup (``[bold]``) escaped, line breaks shown as ``\\n`` and
+    control characters (an ANSI escape, a bell, NUL) as ``\\xNN`` instead of acting on the terminal; tabs stay.
 
     Rich reads backslashes just before a tag as escapes, so a template must not put a markup tag right
     after user text (end it with a plain character, as ``[bold]{path}:[/bold]``). Emoji codes (``:x:``)

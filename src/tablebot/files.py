@@ -1,7 +1,8 @@
 """Writing output files safely: to a temporary name in the same folder, renamed into place only when complete.
 
 A full disk, a crash or Ctrl-C therefore never leaves a truncated file that looks whole, and never
-destroys the previous version before the new one is ready.
+destroys the previous version before the new one is ready. Inside a :func:`tablebot.fileset.file_set`
+the finished file waits in the set's staging folder until the whole set is swapped in.
 """
 
 from __future__ import annotations
@@ -16,9 +17,10 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
-from tablebot import overwrite
+from tablebot import fileset, overwrite
 from tablebot.csvtext import split_records
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.interrupts import fault_point
 from tablebot.table import is_table_header
 
 #: Per errno of a failed read or write: what the user can do about it.
@@ -82,11 +84,13 @@ def _open_direct(path: Path, mode: str, encoding: str | None, newline: str | Non
     return open(path, mode, encoding=None if "b" in mode else encoding, newline=None if "b" in mode else newline)
 
 
-def _temporary(path: Path, mode: str, encoding: str | None, newline: str | None) -> tuple[IO, Path]:
-    """An open temporary file beside ``path`` (same folder, so the rename is atomic) and its name; the
-    command's guard first refuses a path it must not write over (see :mod:`tablebot.overwrite`)."""
+def _temporary(path: Path, where: Path, mode: str, encoding: str | None,
+               newline: str | None) -> tuple[IO, Path]:
+    """An open temporary file beside ``where`` (same folder, so the rename is atomic: ``where`` is ``path``,
+    or its place in a set's staging folder) and its name; the command's guard first refuses a path it must
+    not write over (see :mod:`tablebot.overwrite`)."""
     writing(path)
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, name = tempfile.mkstemp(prefix=f".{where.name}.", suffix=".tmp", dir=where.parent)
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
     except BaseException:
@@ -112,17 +116,19 @@ def atomic_write(path: str | Path, mode: str = "w", encoding: str | None = "utf-
             exc.filename = str(path) if exc.filename is None else exc.filename
             raise
         return
-    stream, temp = _temporary(path, mode, None if "b" in mode else encoding, None if "b" in mode else newline)
+    where = fileset.staged(path)
+    stream, temp = _temporary(path, where, mode, None if "b" in mode else encoding, None if "b" in mode else newline)
     try:
         with stream:
             yield stream
         _keep_mode(path, temp)
-        os.replace(temp, path)
+        os.replace(temp, where)
     except BaseException as exc:
         temp.unlink(missing_ok=True)
         if isinstance(exc, OSError) and exc.filename is None:
             exc.filename = str(path)
         raise
+    fault_point()
 
 
 @contextmanager
@@ -134,15 +140,17 @@ def replacing(path: str | Path) -> Iterator[Path]:
         writing(path)
         yield path
         return
-    stream, temp = _temporary(path, "wb", None, None)
+    where = fileset.staged(path)
+    stream, temp = _temporary(path, where, "wb", None, None)
     stream.close()
     try:
         yield temp
         _keep_mode(path, temp)
-        os.replace(temp, path)
+        os.replace(temp, where)
     except BaseException:
         temp.unlink(missing_ok=True)
         raise
+    fault_point()
 
 
 def write_text(path: str | Path, text: str, encoding: str = "utf-8", newline: str | None = None) -> Path:
@@ -155,6 +163,15 @@ def write_bytes(path: str | Path, data: bytes) -> Path:
     with atomic_write(path, "wb") as f:
         f.write(data)
     return Path(path)
+
+
+def remove(path: str | Path) -> None:
+    """Remove ``path``: at once, or, inside a set that holds it, when the new set is swapped in."""
+    owner = fileset.owner(Path(path))
+    if owner is not None:
+        owner.remove(Path(path))
+    else:
+        Path(path).unlink(missing_ok=True)
 
 
 def _keep_mode(path: Path, temp: Path) -> None:
@@ -178,11 +195,12 @@ class PendingFile:
         if self.direct:
             self.stream, self.temp = _open_direct(self.path, "w", encoding, "\n"), self.path
         else:
-            self.stream, self.temp = _temporary(self.path, "w", encoding, "\n")
+            self.stream, self.temp = _temporary(self.path, fileset.staged(self.path), "w", encoding, "\n")
         self.closed_as: Path | None = None
 
     def commit(self) -> Path:
-        """Close and rename into place (replacing the previous file)."""
+        """Close and rename into place (replacing the previous file; inside a set that holds it, when the
+        set is swapped in: the set open now, which need not be the one open when the file was begun)."""
         return self._finish(self.path)
 
     def keep_partial(self) -> Path:
@@ -197,6 +215,7 @@ class PendingFile:
             self.closed_as = self.temp
 
     def _finish(self, target: Path) -> Path:
+        """Close and rename to ``target`` (or its place in a set's staging folder); returns ``target``."""
         if self.closed_as is not None:
             return self.closed_as
         if self.direct:
@@ -207,13 +226,14 @@ class PendingFile:
                 self.closed_as = target
                 return target
             _keep_mode(target, self.temp)
-            os.replace(self.temp, target)
+            os.replace(self.temp, fileset.staged(target))
         except OSError as exc:
             self.temp.unlink(missing_ok=True)
             if exc.filename is None:
                 exc.filename = str(target)
             raise
         self.closed_as = target
+        fault_point()
         return target
 
 
@@ -229,7 +249,12 @@ HEAD_BYTES = 4096
 
 
 def writing(path: str | Path) -> None:
-    """Called before ``path`` is written: the current command's overwrite guard may refuse it."""
+    """Called before ``path`` is written: the current command's overwrite guard may refuse it. A file the
+    open set already removes (a table a previous run of the command wrote) is no user's file to protect."""
+    owner = fileset.owner(Path(path))
+    if owner is not None and owner.dropping(Path(path)):
+        overwrite.writing(path, lambda _: False)  # still never one of the command's own inputs
+        return
     overwrite.writing(path, is_user_file)
 
 

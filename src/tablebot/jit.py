@@ -66,6 +66,27 @@ if not numba.config.CACHE_DIR:  # numba was imported before us: its cache locato
 prange = numba.prange
 
 
+def compiled(*functions: Any) -> bool:
+    """Whether each of ``functions`` (made with :func:`njit`) has machine code in the on-disk cache: if one
+    has not, its first call compiles it (tens of seconds for the simulator), which a user should be told."""
+    for function in functions:
+        try:
+            index = function._cache._cache_file._index_path  # numba's FunctionCache: <cache>/<module>.<name>-<line>.nbi
+        except AttributeError:  # another numba: assume compiled rather than announce what may not happen
+            continue
+        if not os.path.exists(index):
+            return False
+    return True
+
+
+def say_compiling(what: str, *functions: Any) -> None:
+    """One line on stderr when ``functions`` are about to be compiled, not loaded from the cache: the first
+    run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
+    if not compiled(*functions):
+        print(f"compiling {what} for this machine (first run only, about half a minute; later runs start at "
+              "once)…", file=sys.stderr, flush=True)
+
+
 def njit(*args: Any, refcounts: bool = True, **kwargs: Any) -> Callable[..., Any]:
     """``numba.njit`` with the on-disk cache on: ``@njit`` or ``@njit(parallel=True)``.
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
 from tablebot.engine import Engine
+from tablebot.interrupts import Terminated
 
 
 @dataclass(frozen=True)
@@ -284,10 +285,6 @@ class StopRequest:
         finally:
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
-
-
-class Terminated(Exception):
-    """SIGTERM arrived: end the run as Ctrl-C would."""
 
 
 # --- the loop -------------------------------------------------------------------------------------

@@ -27,6 +27,7 @@ class Scope:
     """The files one command read (by real path and by inode), and whether it may replace user files."""
 
     force: bool = False
+    offered: bool = True  # whether the command has a --force at all (else no message suggests it)
     paths: set[str] = field(default_factory=set)
     inodes: set[tuple[int, int]] = field(default_factory=set)
     replaced: set[str] = field(default_factory=set)
@@ -36,9 +37,9 @@ _scope: ContextVar[Scope | None] = ContextVar("tablebot_guard_scope", default=No
 
 
 @contextmanager
-def command(force: bool = False) -> Iterator[Scope]:
+def command(force: bool = False, offered: bool = True) -> Iterator[Scope]:
     """The scope of one command: reads are remembered, writes checked against them."""
-    token = _scope.set(Scope(force))
+    token = _scope.set(Scope(force, offered))
     try:
         yield _scope.get()  # type: ignore[misc]
     finally:
@@ -83,6 +84,9 @@ def writing(path: str | Path, is_user_file: Callable[[Path], bool]) -> None:
     key = os.path.realpath(path)
     if key in scope.replaced or not path.is_file() or not is_user_file(path):
         return
+    if not scope.force and not scope.offered:
+        raise fail(path, f"{path.name} exists and is a {kind(path)} file: this command never replaces it",
+                   "write into another folder, or move the file away")
     if not scope.force:
         raise fail(path, f"{path.name} exists and is a {kind(path)} file: it is not replaced without --force",
                    f"write to another file, or add --force (the old file is then kept as {path.name}.bak)")

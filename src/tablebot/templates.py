@@ -26,7 +26,7 @@ PURPOSE = {"table.csv": "the behaviour: one row per transition (open it in a spr
 BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                    "rear": "I5", "light_right": "I7", "light_left": "I8"}
 Named = tuple[str, str]  # (name, label; "" keeps the template's label)
-HARDWARE_SECTIONS = ("txt", "board")  # robot-file sections that wire the table's names to terminals
+HARDWARE_SECTIONS = ("txt", "robotx", "roboif", "board")  # robot-file sections that wire the table's names to terminals
 
 
 @dataclass(frozen=True)
@@ -117,7 +117,7 @@ def _rename_words(text: str, mapping: dict[str, str]) -> str:
 
 
 def _rename_robot(text: str, mapping: dict[str, str]) -> str:
-    """The robot file renamed; in a controller's wiring section ([txt], [board]) only the names the table
+    """The robot file renamed; in a controller's wiring section ([txt], [board], ...) only the names the table
     uses (the keys), never the terminals they are wired to: your names on the template's terminals."""
     if not mapping:
         return text
@@ -238,15 +238,15 @@ def _empty_properties(motors: list[str]) -> str:
 
 
 def write_folder(folder: Path, template: Template) -> list[Path]:
-    """Write the template's files into ``folder`` (created; it must be empty), each atomically."""
+    """Write the template's files into ``folder`` (it must not exist, or be empty): the folder appears
+    with all of them at once, or not at all."""
     from tablebot.files import write_text
+    from tablebot.fileset import new_folder
 
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         what = "this is a file, not a folder" if not folder.is_dir() else "this folder is not empty"
         raise fail(folder, what, "give the name of a new folder (tablebot new never writes over files)")
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name in FILES:
-        write_text(folder / name, template.files[name])
-        written.append(folder / name)
-    return written
+    with new_folder(folder) as stage:
+        for name in FILES:
+            write_text(stage / name, template.files[name])
+    return [folder / name for name in FILES]

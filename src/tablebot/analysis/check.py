@@ -73,12 +73,17 @@ def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, .
 
 
 def write_counterexamples(report: CheckReport, outdir: Path) -> None:
-    """Write each counterexample (and each ``reachable`` witness) as ``outdir/NAME.csv``."""
-    for result in report.results:
-        if result.inputs:
-            path = outdir / f"{result.prop.name}.csv"
-            write_inputs(report.machine, result.inputs, path)
-            report.counterexamples[result.prop.name] = path
+    """Write each counterexample (and each ``reachable`` witness) as ``outdir/NAME.csv``, all at once."""
+    from tablebot.fileset import file_set
+
+    written = {}
+    with file_set(outdir):
+        for result in report.results:
+            if result.inputs:
+                path = outdir / f"{result.prop.name}.csv"
+                write_inputs(report.machine, result.inputs, path)
+                written[result.prop.name] = path
+    report.counterexamples.update(written)
 
 
 def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:

@@ -24,6 +24,9 @@ TOKEN_RE = re.compile(r"\s*(?:(?P<num>-?\d+)|(?P<op>==|!=|<=|>=|<|>|\(|\)|\[|\]|
 COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
            ">": operator.gt, ">=": operator.ge}
 KEYWORDS = {"and", "or", "not", "in", "true", "false", "state", "line", "fired"}
+#: Parentheses and ``not`` nest at most this deep: the parser (and ``not``) recurse once per level, and a
+#: condition a person writes never comes near it.
+MAX_DEPTH = 50
 
 
 class ConditionError(ValueError):
@@ -66,11 +69,19 @@ def _tokens(text: str) -> list[str]:
 
 
 class _Parser:
-    """Recursive descent: or > and > not > atom; builds closures as it goes."""
+    """Recursive descent: or > and > not > atom; builds closures as it goes (a chain of ``and`` or ``or``
+    as one closure over all its terms, so a thousand terms do not nest a thousand calls)."""
 
     def __init__(self, tokens: list[str], machine: Machine):
         self.tokens, self.pos, self.machine = tokens, 0, machine
         self.input_bits = 0
+        self.depth = 0
+
+    def deeper(self) -> None:
+        """One more level of parentheses or ``not``: refused past MAX_DEPTH."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise ConditionError(f"the condition nests parentheses or 'not' more than {MAX_DEPTH} deep")
 
     def peek(self) -> str | None:
         return self.tokens[self.pos] if self.pos < len(self.tokens) else None
@@ -89,30 +100,34 @@ class _Parser:
             raise ConditionError(f"expected {token!r} but found {found!r}")
 
     def expression(self) -> Predicate:
-        left = self.conjunction()
+        terms = [self.conjunction()]
         while self.peek() == "or":
             self.take()
-            left = _or(left, self.conjunction())
-        return left
+            terms.append(self.conjunction())
+        return _any(terms)
 
     def conjunction(self) -> Predicate:
-        left = self.negation()
+        terms = [self.negation()]
         while self.peek() == "and":
             self.take()
-            left = _and(left, self.negation())
-        return left
+            terms.append(self.negation())
+        return _all(terms)
 
     def negation(self) -> Predicate:
         if self.peek() == "not":
             self.take()
+            self.deeper()
             inner = self.negation()
+            self.depth -= 1
             return lambda e, r, s, o: not inner(e, r, s, o)
         return self.atom()
 
     def atom(self) -> Predicate:
         token = self.take("a condition")
         if token == "(":
+            self.deeper()
             inner = self.expression()
+            self.depth -= 1
             self.expect(")")
             return inner
         if token in ("true", "false"):
@@ -207,9 +222,13 @@ class _Parser:
         return bit
 
 
-def _and(a: Predicate, b: Predicate) -> Predicate:
-    return lambda e, r, s, o: a(e, r, s, o) and b(e, r, s, o)
+def _all(terms: list[Predicate]) -> Predicate:
+    if len(terms) == 1:
+        return terms[0]
+    return lambda e, r, s, o: all(term(e, r, s, o) for term in terms)
 
 
-def _or(a: Predicate, b: Predicate) -> Predicate:
-    return lambda e, r, s, o: a(e, r, s, o) or b(e, r, s, o)
+def _any(terms: list[Predicate]) -> Predicate:
+    if len(terms) == 1:
+        return terms[0]
+    return lambda e, r, s, o: any(term(e, r, s, o) for term in terms)

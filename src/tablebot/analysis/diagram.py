@@ -8,12 +8,14 @@ from dataclasses import dataclass
 
 import graphviz
 
+from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
 FORMATS = ("svg", "png", "dot", "mermaid")
+PNG_DPI = 150  # Graphviz's default 72 dpi draws 9-point labels a few pixels high
 COLOURS = {"forward": "#2e7d32", "reverse": "#c62828", "turn": "#1565c0", "stop": "#222222", "keep": "#888888"}
 
 
@@ -129,11 +131,12 @@ def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
                fontsize="12", color="#555555")
     graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
     graph.node("__start", "", shape="circle", style="filled", fillcolor="black", width="0.18")
-    for state in table.states:
+    colours = state_colours(table.states)  # each state's colour in the pictures of a run
+    for state, state_colour in zip(table.states, colours, strict=True):
         label = table.state_name(state)
         title = f"<<b>{dot_label(str(state))}</b>" + (f"<br/>{dot_label(label)}>" if label else ">")
         initial = state == robot.initial_state
-        graph.node(ids[state], title, penwidth="2.5" if initial else "1",
+        graph.node(ids[state], title, penwidth="3" if initial else "2", color=state_colour,
                    fillcolor="#fff7d6" if initial else "#f4f4f4")
     graph.edge("__start", ids[robot.initial_state], label=f"< start, timer {robot.initial_timer}>")
     for edge in edges(table):
@@ -182,6 +185,7 @@ def _legend(table: Table, colour: bool) -> str:
              for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
     cells.insert(0, "<b>T</b> timer ran out")
     cells.append("times: timer loaded by the row")
+    cells.append("state border: its colour in the run's pictures")
     if colour:
         cells += [f'<font color="{c}">■ {m}</font>' for m, c in COLOURS.items()]
     body = "".join(f'<tr><td align="left">{c}</td></tr>' for c in cells)
@@ -195,6 +199,8 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
     graph = to_graphviz(table, colour)
     if fmt == "dot":
         return graph.source.encode()
+    if fmt == "png":
+        graph.attr(dpi=str(PNG_DPI))
     try:
         return graph.pipe(format=fmt)
     except graphviz.ExecutableNotFound:

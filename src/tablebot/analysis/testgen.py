@@ -17,6 +17,7 @@ from tablebot.analysis.lints import find_all
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.diagnostics import fail
 from tablebot.files import atomic_write, write_text
+from tablebot.fileset import file_set
 from tablebot.formats.inputs_csv import TickInput, write_inputs
 from tablebot.formats.trace_lines import write_trace
 from tablebot.machine import Machine
@@ -113,12 +114,12 @@ def _reasons(machine: Machine, graph: Graph, golden: GoldenSet) -> dict[int, str
 def write_golden(golden: GoldenSet, out: Path) -> None:
     """``seq-NN.csv`` (inputs) and ``seq-NN.jsonl`` (expected trace) per sequence, and coverage.json."""
     machine = golden.machine
-    out.mkdir(parents=True, exist_ok=True)
-    for seq in golden.sequences:
-        write_inputs(machine, seq.inputs, out / seq.inputs_name)
-        with atomic_write(out / seq.trace_name) as stream:
-            write_trace(replay(machine, seq.inputs), stream)
-    write_text(out / "coverage.json", json.dumps(coverage(golden), indent=2) + "\n")
+    with file_set(out):  # the tests replace the previous ones at once
+        for seq in golden.sequences:
+            write_inputs(machine, seq.inputs, out / seq.inputs_name)
+            with atomic_write(out / seq.trace_name) as stream:
+                write_trace(replay(machine, seq.inputs), stream)
+        write_text(out / "coverage.json", json.dumps(coverage(golden), indent=2) + "\n")
 
 
 def coverage(golden: GoldenSet) -> dict:

@@ -13,8 +13,9 @@ import traceback
 os.environ.setdefault("TYPER_USE_RICH", "0")
 
 # Importing a module registers its commands; `tablebot --help` lists them in this order.
-from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune  # noqa: F401, I001
+from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune, evolve  # noqa: F401, I001
 from tablebot.cli.app import app
+from tablebot.interrupts import Terminated
 
 #: Exit code of an internal error (a tablebot bug): sysexits' EX_SOFTWARE, apart from 1 (warnings), 2 (bad
 #: input) and the run's own codes (tablebot.loop.EXIT_CODES: 3 is a lost link).
@@ -32,6 +33,8 @@ def main() -> None:
         app()
     except (SystemExit, KeyboardInterrupt):
         raise
+    except Terminated:  # SIGTERM outside a command's own handling (the commands end with 143 themselves)
+        sys.exit(143)
     except BaseException as exc:
         if os.environ.get(DEBUG_ENV, "") not in ("", "0"):
             traceback.print_exc()

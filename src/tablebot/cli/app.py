@@ -3,8 +3,12 @@ options every invocation shares: ``--version``, ``-h``/``--help`` and shell comp
 
 import typer
 
+from tablebot.cli.usage import Group
+
 app = typer.Typer(
     name="tablebot",
+    cls=Group,  # a wrong option is answered in tablebot's words, with the choices
+    rich_markup_mode=None,  # errors through OptionError.show, and plain help, wherever typer finds rich
     help="Robot behaviour written as a table: check it, trace it, simulate it, export it.",
     no_args_is_help=True,
     add_completion=True,  # --install-completion / --show-completion for bash, zsh, fish, PowerShell

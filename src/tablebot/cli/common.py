@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import inspect
 import os
 import sys
 import threading
@@ -18,6 +19,7 @@ from tablebot.diagnostics import Diagnostic, TableBotError, notes_to
 from tablebot.escape import terminal
 from tablebot.files import OS_HINTS, out_file, out_folder  # noqa: F401  (re-exported for the commands)
 from tablebot.formats.table_read import resolve_table_path
+from tablebot.interrupts import Terminated, sigterm_raises
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
     from tablebot.machine import Machine
@@ -25,7 +27,8 @@ if TYPE_CHECKING:  # the table machinery is imported when a command loads a tabl
 
 F = TypeVar("F", bound=Callable[..., Any])
 # emoji=False: a ':x:' in user text prints as it is (tablebot.escape.terminal escapes the markup).
-err_console = Console(stderr=True, highlight=False, emoji=False)
+# soft_wrap: rich never breaks a line itself (into a pipe it would at 80 columns, splitting URLs and paths).
+err_console = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)
 console = Console(highlight=False, soft_wrap=True, emoji=False)
 
 TABLE_ARG = typer.Argument(..., metavar="TABLE", help="Table file (CSV or TSV) or a folder holding table.csv.")
@@ -82,21 +85,44 @@ class Stages:
 
 
 def print_diagnostic(d: Diagnostic) -> None:
-    """Coloured on a terminal, plain text when piped (rich decides)."""
+    """Coloured on a terminal, plain text when piped (rich decides). The message and hint are one line
+    each (a line break in a name is shown as \\n: it cannot forge a line of its own); a tool's output
+    follows, each of its lines marked as part of this diagnostic."""
     colour = {"error": "red", "warning": "yellow"}.get(d.severity, "cyan")
     err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{d.severity}[/{colour}]: "
-                      f"{terminal(d.message)}", soft_wrap=True)
+                      f"{terminal(d.message)}")
     if d.hint:
-        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}", soft_wrap=True)
+        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}")
+    for line in d.detail.splitlines():
+        err_console.print(f"    [dim]|[/dim] {terminal(line)}")
+
+
+def _interrupted_import(exc: ImportError) -> None:
+    """Ctrl-C or SIGTERM that landed while a compiled module was being imported comes back as an
+    ImportError (pybind11's "initialization failed", caused by the interrupt): end as the interrupt would,
+    at once: the half-made module cannot be finalized safely (it aborts the interpreter on the way out),
+    and every clean-up of the command has already run on the way here."""
+    cause: BaseException | None = exc
+    while cause is not None and not isinstance(cause, KeyboardInterrupt | Terminated):
+        cause = cause.__cause__ or cause.__context__
+    if cause is None:
+        return
+    print("interrupted" if isinstance(cause, KeyboardInterrupt) else "terminated", file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(130 if isinstance(cause, KeyboardInterrupt) else 143)
 
 
 def guarded(func: F) -> F:
     """Run a command so that user errors print as file:line:column messages and exit with 2."""
 
+    offered = "force" in inspect.signature(func).parameters  # a guard's message suggests --force only then
+
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with notes_to(print_diagnostic), overwrite.command(force=bool(kwargs.get("force", False))):
+            with sigterm_raises(), notes_to(print_diagnostic), overwrite.command(bool(kwargs.get("force", False)),
+                                                                                   offered):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:
@@ -113,5 +139,11 @@ def guarded(func: F) -> F:
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
             raise typer.Exit(130) from None
+        except Terminated:
+            print("terminated", file=sys.stderr)
+            raise typer.Exit(143) from None
+        except ImportError as exc:
+            _interrupted_import(exc)
+            raise
 
     return wrapper  # type: ignore[return-value]

@@ -38,8 +38,8 @@ def import_cmd(
 ) -> None:
     """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
     from tablebot.files import write_text
-    from tablebot.formats import robopro_lists as robopro
     from tablebot.formats.table_write import format_table
+    from tablebot.robopro import lists as robopro
     from tablebot.robot import BUMBERBOT, load_robot
 
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
@@ -78,7 +78,8 @@ def trace_cmd(
 
 @app.command("demo")
 @guarded
-def demo_cmd(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for the trace.")) -> None:
+def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder for the replayed trace (its own: "
+                                      "make demo fills out/demo with a simulated run's trace and pictures).")) -> None:
     """Replay the BumberBot on its built-in recorded inputs and summarise what it did."""
     from tablebot.examples import example_path
     from tablebot.files import atomic_write

@@ -9,10 +9,10 @@ import typer
 
 from tablebot import registry
 from tablebot.cli.app import app
-from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
-from tablebot.formats import robopro_program as rpp
+from tablebot.robopro import rpp_edit as rpp
 
 #: ``--to``'s choices: every registered export back-end.
 Target = StrEnum("Target", {b.name: b.name for b in registry.backends("export")})  # type: ignore[misc]
@@ -39,9 +39,12 @@ def export_cmd(
     lookup: Lookup = typer.Option(Lookup.auto, "--lookup", help="c: first-match lookup, dense (O(1) table) or "
                                   "scan (rows per state); auto takes dense while it needs at most 8 KB."),
     robot: Path | None = ROBOT_OPT,
-    force: bool = FORCE_OPT,
 ) -> None:
-    """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source."""
+    """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source.
+
+    Its files replace an earlier export's in OUTDIR, all at once; a table or robot file of yours that has
+    one of their names is never replaced (choose another OUTDIR).
+    """
     backend = registry.get(to.value)
     _, machine = load(table, robot)
     if outdir is None and backend.needs_out:

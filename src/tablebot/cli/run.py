@@ -55,7 +55,8 @@ def run_cmd(
     behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when a tick starts this "
                                        "many seconds late, rather than stretch the table's timers (0: never)."),
     seed: int = typer.Option(1, "--seed", min=0, help="sim: the seed of all simulated noise (as tablebot sim)."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary (a run that fails still "
+                               "says why)."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Run TABLE on a real robot (or the simulator, in real time): outputs off on Ctrl-C, SIGTERM, any error
@@ -100,6 +101,11 @@ def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int 
         sys.setswitchinterval(switch)
     if not quiet:
         _report(end, machine, trace)
+    elif end.exit_code:  # quiet hides the live view and the summary, never why a run failed
+        why = f" — {end.message}" if end.message else ""
+        err_console.print(terminal(f"ran {end.ticks} ticks: {end.reason}{why}"))
+        for path in trace.files if trace is not None else []:
+            err_console.print(terminal(f"kept {path}"))
     return end
 
 
@@ -122,14 +128,17 @@ def upload_cmd(
     folder: Path = typer.Argument(..., metavar="OUTDIR",
                                  help="A folder written by `tablebot export TABLE OUTDIR --to txt4`."),
     to: str = typer.Option(..., "--to", help="The TXT 4.0: txt4://192.168.7.2 (USB), txt4://HOST[:PORT]."),
-    key: str = typer.Option(..., "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO Pro "
-                            "Coding asks for it)."),
+    key: str | None = typer.Option(None, "--key", help="The controller's API key (shown on the TXT 4.0, as ROBO "
+                                   "Pro Coding asks for it). Visible to other users in the process list: prefer "
+                                   "$TABLEBOT_TXT4_KEY, --key-file, or the prompt (asked when neither is given)."),
+    key_file: Path | None = typer.Option(None, "--key-file", help="A file holding the API key on one line."),
     start: bool = typer.Option(True, "--start/--no-start", help="Start the program once it is uploaded."),
 ) -> None:
     """Install an exported TXT 4.0 program on the controller through its REST API, and start it."""
-    from tablebot.hw.txt4.upload import upload
+    from tablebot.hw.txt4.upload import api_key, base_url, terminal_prompt, upload, workspace_files
 
     if not folder.is_dir():
         raise fail(folder, "is a file, not a folder" if folder.exists() else "no such folder",
                    "give the folder `tablebot export --to txt4` wrote")
-    upload(folder, to, key, start, say=lambda text: console.print(terminal(text)))
+    base_url(to), workspace_files(folder)  # a wrong --to or folder is said before the key is asked for
+    upload(folder, to, api_key(key, key_file, terminal_prompt()), start, say=lambda text: console.print(terminal(text)))

@@ -10,6 +10,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
     from tablebot.sim.runner import Result
@@ -42,6 +43,7 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
+    from tablebot.fileset import file_set
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
@@ -55,15 +57,22 @@ def sim_cmd(
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    trace = TraceFile(out / "trace.jsonl", background=True)
     rows = plots or gif or view  # every robot row is kept only for what draws the run
-    result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+    from tablebot.jit import say_compiling
+    from tablebot.sim.kernel import run_robot
+
+    say_compiling("the simulator", run_robot)
+    _import_drawing(plots, gif, html)
+    with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
+        trace = TraceFile(out / "trace.jsonl", background=True)
+        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+        if result.end.complete:
+            summary = summarise(result)
+            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
+            if html:
+                written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
         _stopped(result, trace.written)
-    summary = summarise(result)
-    written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
-    if html:
-        written.append(_replay_page(result, trace.written, out / "run.html"))
     if not quiet:
         _report(result, summary, written)
     if view:
@@ -71,10 +80,21 @@ def sim_cmd(
         show(result, summary)
 
 
+def _import_drawing(plots: bool, gif: bool, html: bool) -> None:
+    """The picture modules (matplotlib, PIL), imported before the run rather than after it: Ctrl-C while a
+    compiled module is being imported surfaces as an ImportError, and matplotlib's takes a good second."""
+    import importlib
+
+    wanted = [("tablebot.sim.plots", plots), ("tablebot.sim.animate", gif), ("tablebot.web.replay", html)]
+    for module, used in wanted:
+        if used:
+            importlib.import_module(module)
+
+
 def _stopped(result: Result, kept: Path | None) -> None:
     """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
     err_console.print(f"{result.end.message or result.end.reason} after {result.ticks:,} ticks; "
-                      f"kept {kept} (the previous run's files are untouched)", soft_wrap=True, markup=False)
+                      f"kept {plain(str(kept))} (the previous run's files are untouched)", markup=False)
     raise typer.Exit(result.end.exit_code)
 
 
@@ -95,21 +115,22 @@ def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: boo
 def _replay_page(result: Result, trace: Path, path: Path) -> Path:
     """A self-contained HTML page that replays the run from the trace just written (to send to a pupil,
     or put on a class page)."""
+    from tablebot.fileset import current
     from tablebot.web.replay import write_html
 
     scene = result.scene
-    lines = trace.read_text(encoding="utf-8").splitlines()
+    lines = current(trace).read_text(encoding="utf-8").splitlines()  # not in place yet: its set is being written
     return write_html(path, lines, scene.world, scene.table, params=scene.params)
 
 
 def _report(result: Result, summary: Summary, written: list[Path]) -> None:
     """The summary on standard output, the files written on standard error."""
     for line in summary.lines(result.scene.table.robot.state_names):
-        console.print(line, markup=False)
+        console.print(plain(line), markup=False)
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
     console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
     for path in written:
-        err_console.print(f"wrote {path}", markup=False)
+        err_console.print(f"wrote {plain(str(path))}", markup=False)
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,

@@ -51,6 +51,11 @@ def studio_cmd(
     url = access.url(shown, f"table={quote(table)}" if table else "")
     err_console.print(f"tablebot studio: serving {terminal(str(root))} at", soft_wrap=True)
     err_console.print(f"  {url}", soft_wrap=True, markup=False)  # whole, never wrapped: it is the key
+    if address in WILDCARDS:
+        import socket
+
+        other = access.url(socket.gethostname(), f"table={quote(table)}" if table else "")
+        err_console.print(f"  {other}  (from other machines)", soft_wrap=True, markup=False)
     err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
     uvicorn_server = server(create_app(root, access, table), access, "info" if verbose else "warning")
     if not no_browser:

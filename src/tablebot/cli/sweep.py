@@ -11,6 +11,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.escape import plain
 
 if TYPE_CHECKING:
     from tablebot.fleet.plan import Plan
@@ -45,9 +46,13 @@ def sweep_cmd(
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
-    OUT/results.csv, with pictures. Ctrl-C keeps every finished chunk; the same command again resumes."""
+    OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
+    resumes."""
+    from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import choose, run_jobs
-    from tablebot.fleet.plan import Store
+    from tablebot.fleet.plan import Store, read_results
+    from tablebot.fleet.plots import write_all
+    from tablebot.interrupts import INTERRUPTS
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
@@ -57,6 +62,11 @@ def sweep_cmd(
     finished = store.open()
     jobs = plan.jobs(skip=finished)
     total, already = plan.spec.total, sum(b - a for a, b in finished)
+    if chosen == "local" and jobs:
+        from tablebot.fleet.kernel import run_fleet, run_fleet_serial
+        from tablebot.jit import say_compiling
+
+        say_compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one chunk: threaded
     started = time.perf_counter()
     with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
         def done(job: Any, summary: Any) -> None:
@@ -64,14 +74,26 @@ def sweep_cmd(
             progress.advance(len(summary))
         try:
             run_jobs(jobs, done, chosen, address, workers)
-        except KeyboardInterrupt:
-            path, count = store.merge(complete=False)
-            err_console.print(f"interrupted: {count:,} of {total:,} runs finished, kept in {path}; run the same "
-                              "command again to resume", markup=False, soft_wrap=True)
-            raise typer.Exit(130) from None
-    path, count = store.merge(complete=True)
-    traces = plan.write_traces(traced, out)
-    report(plan, path, out, plots, quiet, time.perf_counter() - started, total - already, traces)
+        except INTERRUPTS as exc:
+            stopped(store, total, exc)
+    wall_s = time.perf_counter() - started
+    with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
+        path, _ = store.merge(complete=True)
+        rows = read_results(current(path))
+        written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
+    if not quiet:
+        report(plan, rows, written, wall_s, total - already)
+
+
+def stopped(store: Any, total: int, why: BaseException) -> None:
+    """Ctrl-C or SIGTERM: the finished chunks merged into results.partial.csv, then exit 130 (143)."""
+    from tablebot.interrupts import Terminated
+
+    path, count = store.merge(complete=False)
+    word = "terminated" if isinstance(why, Terminated) else "interrupted"
+    err_console.print(f"{word}: {count:,} of {total:,} runs finished, kept in {plain(str(path))}; run the same "
+                      "command again to resume", markup=False)
+    raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 
 def trace_runs(text: str | None, total: int) -> list[int]:
@@ -123,16 +145,10 @@ def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[st
     return Plan(spec, parsed, machine, loaded, layer)
 
 
-def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: float, ran: int,
-           traces: list[Path]) -> None:
+def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: float, ran: int) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
-    from tablebot.fleet.plan import read_results
-    from tablebot.fleet.plots import groups, write_all
+    from tablebot.fleet.plots import groups
 
-    rows = read_results(path)
-    written = [path, *traces, *(write_all(plan, rows, out) if plots else [])]
-    if quiet:
-        return
     lamps = any(world.lamps for world in plan.worlds)
     for key, values in groups(plan, rows):
         for label, chosen in values:
@@ -143,12 +159,12 @@ def report(plan: Plan, path: Path, out: Path, plots: bool, quiet: bool, wall_s: 
                 collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
                 metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
                 line = f"{len(chosen)} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run"
-            console.print(f"{name}: {line}", markup=False)
+            console.print(plain(f"{name}: {line}"), markup=False)
     if ran:
         rate = ran * plan.spec.ticks / max(wall_s, 1e-9)
         console.print(f"[dim]({ran:,} runs in {wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
     for p in written:
-        err_console.print(f"wrote {p}", markup=False)
+        err_console.print(f"wrote {plain(str(p))}", markup=False)
 
 
 class Bar:

@@ -13,6 +13,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.escape import plain
 
 if TYPE_CHECKING:
     from tablebot.fleet.plan import Plan
@@ -50,12 +51,15 @@ def tune_cmd(
     force: bool = FORCE_OPT,
 ) -> None:
     """Tune TABLE's timers (and counter loads) for an objective over a fixed scenario set (every candidate
-    runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table."""
+    runs the same seeds, starts and batteries), check the best on fresh seeds, and write it as a new table.
+    Ctrl-C (or SIGTERM) keeps every evaluation made; the same command again resumes."""
     from tablebot import files
     from tablebot.diagnostics import fail
+    from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import Runner, choose
     from tablebot.fleet.spec import parse_seeds
     from tablebot.fleet.tune import Evaluator, best, parse_cells, search_cma, search_grid
+    from tablebot.interrupts import INTERRUPTS
 
     if objective not in METRICS:
         raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
@@ -70,26 +74,97 @@ def tune_cmd(
     target = tuned_path(Path(plan.table.path), out)
     files.writing(target)  # a tuned table of an earlier run needs --force: say so now, not after the search
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
+    journal = Journal(out / JOURNAL, plan, tuned_cells, objective)
+    known = journal.load()
+    if chosen == "local":
+        from tablebot.fleet.kernel import run_fleet
+        from tablebot.jit import say_compiling
+
+        say_compiling("the fleet simulator", run_fleet)
+    if known and not quiet:
+        err_console.print(f"resuming: {len(known)} evaluations from {plain(str(journal.path))} are not run again",
+                          markup=False)
     started = time.perf_counter()
-    with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
-        evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance)
-        baseline = tuple(c.value for c in tuned_cells)
-        evaluate([baseline])
-        if method == "grid":
-            search_grid(evaluate, budget)
-        else:
-            search_cma(evaluate, budget, seed)
-        winner, _ = best(evaluate.history)
-        before_after = evaluate.measure([baseline, winner], check, metrics)
-    written = [write_tuned(plan, tuned_cells, winner, target),
-               write_evaluations(evaluate, out / "evaluations.csv"),
-               convergence(evaluate, method, out / "convergence.png"),
-               write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
-                            time.perf_counter() - started, target)]
+    try:
+        with Runner(chosen, address, workers) as runner, Bar("candidates", budget, quiet) as bar:
+            evaluate = Evaluator(plan, tuned_cells, objective, runner, on_eval=bar.advance, known=known,
+                                 on_record=journal.save)
+            baseline = tuple(c.value for c in tuned_cells)
+            evaluate([baseline])
+            if method == "grid":
+                search_grid(evaluate, budget)
+            else:
+                search_cma(evaluate, budget, seed)
+            winner, _ = best(evaluate.history)
+            before_after = evaluate.measure([baseline, winner], check, metrics)
+    except INTERRUPTS as exc:
+        journal.stopped(exc)
+    with file_set(out, remove=[JOURNAL]):  # the tuned table, evaluations, picture and report: all at once
+        written = [write_tuned(plan, tuned_cells, winner, target),
+                   write_evaluations(evaluate, out / "evaluations.csv"),
+                   convergence(evaluate, method, out / "convergence.png"),
+                   write_report(plan, check, evaluate, method, winner, before_after, out / "report.md",
+                                time.perf_counter() - started, target)]
+        text = current(out / "report.md").read_text(encoding="utf-8")
     if not quiet:
-        console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
+        for line in text.splitlines():  # the report names the table and its cells: user text
+            console.print(plain(line), markup=False)
         for path in written:
-            err_console.print(f"wrote {path}", markup=False)
+            err_console.print(f"wrote {plain(str(path))}", markup=False)
+
+
+JOURNAL = "evaluations.partial.json"
+
+
+class Journal:
+    """``OUT/evaluations.partial.json``: every evaluation so far, rewritten (atomically) after each batch,
+    with what they were measured on. The same command run again takes them instead of running them."""
+
+    def __init__(self, path: Path, plan: Plan, cells: list[Cell], objective: str):
+        self.path = path
+        self.tuning = {"spec": plan.spec.to_json(), "cells": [c.label for c in cells], "objective": objective}
+        self.count = 0
+
+    def load(self) -> dict[tuple[int, ...], float]:
+        """The evaluations of an interrupted run of this tuning (none if there is none); another tuning's
+        are refused, as sweep refuses another sweep's folder."""
+        import json
+
+        from tablebot.diagnostics import fail
+
+        if not self.path.exists():
+            return {}
+        try:
+            saved = json.loads(self.path.read_text(encoding="utf-8"))
+            same = saved["tuning"] == self.tuning
+            known = {tuple(int(v) for v in values): float(value) for values, value in saved["evaluations"]}
+        except (ValueError, KeyError, TypeError):
+            same, known = False, {}
+        if not same:
+            raise fail(self.path, "--out holds the evaluations of an interrupted tuning of another table, robot "
+                       "file, world, scenario set, cells or objective", f"give --out a new folder, or delete "
+                       f"{self.path.name} to start over")
+        self.count = len(known)
+        return known
+
+    def save(self, history: list[tuple[tuple[int, ...], float]]) -> None:
+        import json
+
+        from tablebot.files import write_text
+
+        self.count = len(history)
+        evaluations = [[list(values), value] for values, value in history]
+        write_text(self.path, json.dumps({"tuning": self.tuning, "evaluations": evaluations}) + "\n")
+
+    def stopped(self, why: BaseException) -> None:
+        """Ctrl-C or SIGTERM: say what was kept, then exit 130 (143)."""
+        from tablebot.interrupts import Terminated
+
+        word = "terminated" if isinstance(why, Terminated) else "interrupted"
+        kept = f"{self.count} evaluations kept in {plain(str(self.path))}" if self.count else \
+            "no evaluation had finished"
+        err_console.print(f"{word}: {kept}; run the same command again to resume", markup=False)
+        raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
 
 
 def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
@@ -173,6 +248,7 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from tablebot.escape import picture
     from tablebot.sim.plots import save
 
     values = np.array([v for _, v in evaluate.history])
@@ -193,7 +269,7 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         order = np.argsort(xs)
         side.plot(xs[order], values[order], color="#1f77b4", linewidth=1)
         side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
-        side.set_xlabel(f"{evaluate.cells[0].label} (ticks)")
+        side.set_xlabel(picture(f"{evaluate.cells[0].label} (ticks)"))
         side.set_ylabel(evaluate.objective)
     if two:
         side = fig.add_subplot(1, 2, 2)
@@ -204,8 +280,8 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
         best = points[int(np.argmin(values))]
         side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label="as it was")
         side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
-        side.set_xlabel(a.label)
-        side.set_ylabel(b.label)
+        side.set_xlabel(picture(a.label))
+        side.set_ylabel(picture(b.label))
         side.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
     fig.tight_layout()
     return save(fig, path)

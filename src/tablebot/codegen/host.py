@@ -32,7 +32,7 @@ def build_host(machine: Machine, outdir: Path, lookup: str = "auto") -> Path:
     command = [find_compiler(), *WARNINGS, "-O1", f"-I{outdir}", "-o", str(exe), *sources]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(outdir, f"the generated C does not compile:\n{done.stderr}", "report this as a tablebot bug")
+        raise fail(outdir, "the generated C does not compile", "report this as a tablebot bug", detail=done.stderr)
     return exe
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from tablebot.codegen.packing import KEEP, Layout, plan
 from tablebot.escape import c_comment
 from tablebot.files import write_text
+from tablebot.fileset import file_set
 from tablebot.machine import Machine
 
 ENGINE_FILES = ("tb_engine.h", "tb_engine.c")
@@ -24,8 +25,9 @@ class CSource:
     layout: Layout
 
     def write(self, outdir: Path) -> list[Path]:
-        outdir.mkdir(parents=True, exist_ok=True)
-        return [write_text(outdir / name, text) for name, text in self.files.items()]
+        """The files into ``outdir``, replacing the previous ones at once."""
+        with file_set(outdir):
+            return [write_text(outdir / name, text) for name, text in self.files.items()]
 
 
 def template(name: str) -> str:

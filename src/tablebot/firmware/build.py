@@ -13,6 +13,7 @@ from tablebot.codegen.packing import Layout
 from tablebot.codegen.source import generate
 from tablebot.diagnostics import fail
 from tablebot.files import replacing, write_text
+from tablebot.fileset import current, file_set
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import Board, Wiring, load_board, wire
 from tablebot.machine import Machine
@@ -66,7 +67,7 @@ def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "a
 def _run(command: list[str], what: str) -> str:
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(command[0], f"{what} failed:\n{done.stderr.strip()}", "report this as a tablebot bug")
+        raise fail(command[0], f"{what} failed", "report this as a tablebot bug", detail=done.stderr.strip())
     return done.stdout
 
 
@@ -81,15 +82,16 @@ def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto",
     """Generate, compile and link; ``outdir`` gets ``src/``, ``NAME.elf`` and ``NAME.hex``."""
     board = load_board(board_name)
     srcdir = outdir / "src"
-    srcdir.mkdir(parents=True, exist_ok=True)
-    wiring, layout = write_sources(machine, board, srcdir, lookup, main)
     stem = "tablebot" if main == FIRMWARE_MAIN else "bench"
     elf, hexfile = outdir / f"{stem}.elf", outdir / f"{stem}.hex"
-    sources = [str(srcdir / name) for name in (main, "tb_engine.c", "tb_table.c")]
-    with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
-        _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS, f"-I{srcdir}",
-              "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
-    with replacing(hexfile) as temp:
-        _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(elf), str(temp)], "avr-objcopy")
-    flash, ram = sizes(elf)
+    with file_set(outdir):  # sources, .elf and .hex replace the previous build's at once
+        wiring, layout = write_sources(machine, board, srcdir, lookup, main)
+        # until the set is swapped in, the tools read the files where they are being written
+        sources = [str(current(srcdir / name)) for name in (main, "tb_engine.c", "tb_table.c")]
+        with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
+            _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS,
+                  f"-I{current(srcdir)}", "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
+        with replacing(hexfile) as temp:
+            _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(current(elf)), str(temp)], "avr-objcopy")
+        flash, ram = sizes(current(elf))
     return Firmware(elf, hexfile, board, wiring, layout, flash, ram)

@@ -53,7 +53,7 @@ def build_harness(where: Path | None = None) -> Path:
                "-lsimavr", "-lelf", "-o", str(exe) + ".tmp"]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail("harness", f"compiling the harness failed:\n{done.stderr}", "check libsimavr-dev")
+        raise fail("harness", "compiling the harness failed", "check libsimavr-dev", detail=done.stderr)
     os.replace(str(exe) + ".tmp", exe)  # atomic: parallel test workers may race here
     return exe
 

@@ -74,13 +74,15 @@ class Runner:
             return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
         return max(1, self.workers or os.cpu_count() or 1)
 
-    def run(self, jobs: Sequence[Job], done: Done) -> None:
+    def run(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]] = run_job) -> None:
+        """Run every job with ``fn`` (default: the fleet's :func:`run_job`; evolve measures more per robot),
+        handing each result to ``done`` as it comes back."""
         if not jobs:
             return
         if self.backend == "dask":
-            self._run_dask(jobs, done)
+            self._run_dask(jobs, done, fn)
         else:
-            self._run_local(jobs, done)
+            self._run_local(jobs, done, fn)
 
     def close(self, failed: bool = False) -> None:
         if self.pool is not None:
@@ -92,18 +94,22 @@ class Runner:
             self.client.close()
             self.client = None
 
+    def _call(self, fn: Callable[..., tuple[Job, Any]], job: Job) -> tuple[Job, Any]:
+        """``fn(job)``; the fleet's own run_job also stops at its next block when the run is stopped."""
+        return fn(job, self.stop) if fn is run_job else fn(job)
+
     # --- this machine: a thread per core (``workers``), each running whole chunks single-threaded
     #
     # Threads, not processes: the compiled fleet loop releases the GIL, so two threads run two chunks on two
     # cores, and this process's compiled code serves both -- no worker processes to start, no Python, numpy and
     # numba to import again in each, no jobs and summaries to pickle across (seconds of a short sweep's time).
 
-    def _run_local(self, jobs: Sequence[Job], done: Done) -> None:
+    def _run_local(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         workers = max(1, self.workers or os.cpu_count() or 1)
         if workers == 1 or len(jobs) == 1:  # numba's own threads share each chunk's robots out
             self.info = {"workers": 1, "threads": "numba's"}
             for job in jobs:
-                done(*run_job(job, self.stop))
+                done(*self._call(fn, job))
             return
         if self.pool is None:
             from concurrent.futures import ThreadPoolExecutor
@@ -112,7 +118,7 @@ class Runner:
             self.info = {"workers": workers, "threads": "local"}
         from concurrent.futures import as_completed
 
-        futures = [self.pool.submit(run_job, replace(job, threads=1), self.stop) for job in jobs]
+        futures = [self.pool.submit(self._call, fn, replace(job, threads=1)) for job in jobs]
         try:
             for future in as_completed(futures):
                 done(*future.result())
@@ -123,7 +129,7 @@ class Runner:
 
     # --- a Dask cluster: each chunk one task
 
-    def _run_dask(self, jobs: Sequence[Job], done: Done) -> None:
+    def _run_dask(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         """Every worker first warms the kernel in a cache folder of its own, from this process's compiled
         code (a fresh worker loads it instead of compiling again); then the chunks go out."""
         if self.client is None:
@@ -132,7 +138,7 @@ class Runner:
         from distributed import as_completed
 
         client = self.client
-        futures = [client.submit(run_job, job, pure=False) for job in jobs]
+        futures = [client.submit(fn, job, pure=False) for job in jobs]
         try:
             for future in as_completed(futures, loop=client.loop):
                 done(*future.result())

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import TableBotError, fail
-from tablebot.files import atomic_write, write_text
+from tablebot.files import atomic_write, remove, write_text
 from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
 from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
 from tablebot.fleet.work import Job
@@ -217,7 +217,7 @@ class Store:
                             out.write(line)
                             count += 1
         if complete:
-            (self.folder / "results.partial.csv").unlink(missing_ok=True)
+            remove(self.folder / "results.partial.csv")  # with the new results, when they are in a set
         return path, count
 
 

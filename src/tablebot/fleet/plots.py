@@ -16,6 +16,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from tablebot.escape import picture
 from tablebot.fleet.plan import Plan
 from tablebot.fleet.spec import value_index
 from tablebot.sim.draw import REACHED, draw_world, literal_text
@@ -64,7 +65,7 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
     for k, (key, values) in enumerate(panels):
         left, right = fig.add_subplot(len(panels), 2, 2 * k + 1), fig.add_subplot(len(panels), 2, 2 * k + 2)
-        labels = [label for label, _ in values]
+        labels = [picture(label) for label, _ in values]
         rates = [np.mean([int(r["reached"]) for r in chosen]) if chosen else 0.0 for _, chosen in values]
         bars = left.bar(labels, [100 * r for r in rates], color=REACHED)
         left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_, c) in zip(rates, values, strict=True)],
@@ -82,7 +83,8 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
         right.set_ylim(0, seconds * 1.1)
         right.set_ylabel("time to first light (s)")
         right.set_xlabel(key)
-    fig.suptitle(f"{plan.table.robot.name}: {len(rows):,} runs of {seconds:g} s", fontsize=13, fontweight="bold")
+    fig.suptitle(f"{picture(plan.table.robot.name)}: {len(rows):,} runs of {seconds:g} s", fontsize=13,
+                 fontweight="bold")
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     return save(fig, path)
 
@@ -110,14 +112,16 @@ def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
         ok = ~np.isnan(times)
         ax.quiver(xs, ys, np.cos(headings), np.sin(headings), color="#2d3436", alpha=0.5, scale=40, width=0.003,
                   zorder=3)
-        ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label="never reached the lamp")
+        if (~ok).any():  # the legend says only what the picture shows
+            ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label="never reached the lamp")
         dots = ax.scatter(xs[ok], ys[ok], c=times[ok], s=30, cmap="viridis_r", edgecolors="white", linewidths=0.5,
                           zorder=5)
         if ok.any():
             fig.colorbar(dots, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label="time to reach the lamp (s)")
-        ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"Start positions in {world.name}: {int(reached.sum())} of {len(world_rows)} reached the lamp",
-                 fontsize=12, fontweight="bold")
+        if (~ok).any():
+            ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"Start positions in {picture(world.name)}: {int(reached.sum())} of {len(world_rows)} reached "
+                 "the lamp", fontsize=12, fontweight="bold")
     return save(fig, path)
 
 

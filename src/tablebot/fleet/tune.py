@@ -133,24 +133,39 @@ def losses(objective: str, s: FleetSummary, plan: Plan, world: int) -> np.ndarra
     return np.min(np.hypot(pose[:, None, 0] - lamps[None, :, 0], pose[:, None, 1] - lamps[None, :, 1]), axis=1)
 
 
+History = list[tuple[tuple[int, ...], float]]
+
+
 @dataclass
 class Evaluator:
-    """Runs candidates on the scenario set of ``plan`` through ``runner``."""
+    """Runs candidates on the scenario set of ``plan`` through ``runner``.
+
+    ``known`` holds values measured before (an interrupted run's evaluations): such a candidate is not run
+    again, so the same search resumed takes the same steps, at once, up to where it stopped.
+    ``on_record(history)`` is called after each batch that ran something new (to keep it on disk).
+    """
 
     plan: Plan
     cells: Sequence[Cell]
     objective: str
     runner: Runner
-    history: list[tuple[tuple[int, ...], float]] = field(default_factory=list)
+    history: History = field(default_factory=list)
     cache: dict[tuple[int, ...], float] = field(default_factory=dict)
     on_eval: Callable[[int], None] | None = None
+    known: dict[tuple[int, ...], float] = field(default_factory=dict)
+    on_record: Callable[[History], None] | None = None
 
     def __call__(self, candidates: Sequence[Sequence[int]]) -> list[float]:
         wanted = [tuple(int(v) for v in c) for c in candidates]
         new = list(dict.fromkeys(c for c in wanted if c not in self.cache))
-        for candidate, value in zip(new, self.measure(new, self.plan)[self.objective], strict=True):
+        to_run = [c for c in new if c not in self.known]
+        measured = dict(zip(to_run, self.measure(to_run, self.plan)[self.objective], strict=True))
+        for candidate in new:
+            value = measured[candidate] if candidate in measured else self.known[candidate]
             self.cache[candidate] = value
             self.history.append((candidate, value))
+        if to_run and self.on_record:
+            self.on_record(self.history)
         if new and self.on_eval:
             self.on_eval(len(new))
         return [self.cache[c] for c in wanted]
@@ -162,14 +177,15 @@ class Evaluator:
         if not candidates:
             return {metric: [] for metric in metrics}
         jobs = jobs_for(plan, variants_of(plan, self.cells, candidates), len(candidates), self.runner.slots())
-        found: dict[int, dict[str, np.ndarray]] = {}
+        finished: dict[tuple[int, int], dict[str, np.ndarray]] = {}
         def done(job: Job, summary: FleetSummary) -> None:
-            found[job.info["index"]] = {metric: losses(metric, summary, plan, job.info["world"]) for metric in metrics}
+            finished[job.info["world"], job.first] = {m: losses(m, summary, plan, job.info["world"]) for m in metrics}
         self.runner.run(jobs, done)
         sums = {metric: np.zeros(len(candidates)) for metric in metrics}
-        for job in jobs:  # summed in job order, whatever order they finished in: the same sums every run
+        for job in jobs:  # summed in job order, not in the order the workers finished: the same sums every time
+            robots = finished[job.info["world"], job.first]
             for metric in metrics:
-                np.add.at(sums[metric], np.asarray(job.info["variants"]), found[job.info["index"]][metric])
+                np.add.at(sums[metric], np.asarray(job.info["variants"]), robots[metric])
         return {metric: (total / plan.spec.total).tolist() for metric, total in sums.items()}
 
 
@@ -189,8 +205,7 @@ def jobs_for(plan: Plan, variants: Variants, count: int, slots: int = 1) -> list
         for a, b in split(len(specs), slots):
             chunk = specs[a:b]
             jobs.append(Job(plan.table, plan.worlds[world], plan.robot_params, chunk, plan.spec.ticks, first=a,
-                            variants=variants, info={"world": world, "variants": [s.variant for s in chunk],
-                                                     "index": len(jobs)}))
+                            variants=variants, info={"world": world, "variants": [s.variant for s in chunk]}))
     return jobs
 
 

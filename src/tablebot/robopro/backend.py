@@ -1,5 +1,6 @@
-"""``export --to robopro`` (the document's three lists as CSV) and ``--to robopro-rpp`` (the lists written into
-a ROBO Pro program), registered as export back-ends."""
+"""``export --to robopro`` (the document's three lists as CSV), ``--to robopro-rpp`` (the lists written into
+a ROBO Pro program) and ``--to robopro-program`` (the document's whole engine as a ROBO Pro program, with the
+table in it), registered as export back-ends, with the robot file's ``[robopro]`` section."""
 
 from __future__ import annotations
 
@@ -8,45 +9,67 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.files import out_folder
-from tablebot.formats.robopro_program import DEFAULT_NAMES
 from tablebot.registry import Backend, Exported, Options, register
+from tablebot.robopro.rpp_edit import DEFAULT_NAMES
+from tablebot.robopro.wiring import read_robot_robopro
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
 
+
 def fit(machine: Machine) -> list[Diagnostic]:
-    from tablebot.formats.robopro_lists import fit_problems
+    from tablebot.robopro.lists import fit_problems
 
     return fit_problems(machine.table)
 
 
 def export_lists(machine: Machine, out: Path | None, options: Options) -> Exported:
-    from tablebot.formats import robopro_lists
+    from tablebot.robopro import lists
 
     assert out is not None
-    lists = robopro_lists.encode(machine.table)
-    files = tuple(robopro_lists.write_lists(lists, out_folder(out, "OUTDIR")))
+    encoded = lists.encode(machine.table)
+    files = tuple(lists.write_lists(encoded, out_folder(out, "OUTDIR")))
     return Exported(files, tuple(f"wrote {path}" for path in files))
 
 
 def export_rpp(machine: Machine, out: Path | None, options: Options) -> Exported:
     """The three lists written into a ROBO Pro program: ``--into`` itself, or its copy in ``out``."""
-    from tablebot.formats import robopro_lists
-    from tablebot.formats import robopro_program as rpp
+    from tablebot.robopro import lists
+    from tablebot.robopro import rpp_edit as rpp
 
     into: Path | None = options.get("into")
     names = tuple(options.get("lists", DEFAULT_NAMES))
     if into is None:
         raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
-    lists = robopro_lists.encode(machine.table)
-    named = dict(zip(names, (lists.event, lists.action, lists.timer), strict=True))
+    encoded = lists.encode(machine.table)
+    named = dict(zip(names, (encoded.event, encoded.action, encoded.timer), strict=True))
     if len(named) < 3:
         raise fail("--event-list", "the three list names must differ", "give each list its own name")
     target = out_folder(out, "OUTDIR") / into.name if out else None
     written, from_csv = rpp.write_lists(into, named, target)
-    return Exported((written,), (f"wrote {written} (lists {', '.join(named)}: {len(lists.event)} values each)",),
-                    tuple(f"list {name} loads its values from a CSV file in ROBO Pro (initcsvcolumn), which "
-                          "replaces the values written here" for name in from_csv))
+    return Exported((written,), (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),
+                    tuple(f"list {name} loads its values from column {column} of a CSV file when the program starts "
+                          "(its load-from-CSV setting), which replaces the values written here; turn that off in "
+                          "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
+                          "CSV files instead" for name, column in from_csv.items()))
+
+
+def program_fit(machine: Machine) -> list[Diagnostic]:
+    from tablebot.robopro.fit import problems
+
+    return problems(machine.table)
+
+
+def export_program(machine: Machine, out: Path | None, options: Options) -> Exported:
+    """The whole engine as one .rpp, named after the robot; a table that does not fit is refused before the
+    folder is made."""
+    from tablebot.files import write_text
+    from tablebot.robopro.program import file_name, generate
+
+    assert out is not None
+    text = generate(machine.table)
+    path = write_text(out_folder(out, "OUTDIR") / file_name(machine.table), text)
+    return Exported((path,), (f"wrote {path}: open it in ROBO Pro 4.x",))
 
 
 ROBOPRO = register(Backend("robopro", "export", "the document's three ROBO Pro lists (event, action, timer)",
@@ -54,3 +77,7 @@ ROBOPRO = register(Backend("robopro", "export", "the document's three ROBO Pro l
 ROBOPRO_RPP = register(Backend("robopro-rpp", "export", "the three lists written into a ROBO Pro program",
                                help="the lists written into a ROBO Pro program (--into)", fit=fit, export=export_rpp,
                                needs_out=False))
+ROBOPRO_PROGRAM = register(Backend(
+    "robopro-program", "export", "a whole ROBO Pro program running the table (the document's engine)",
+    help="a whole ROBO Pro program that runs the table", fit=program_fit, export=export_program,
+    section="robopro", read_section=read_robot_robopro))

@@ -16,10 +16,12 @@ from matplotlib.colors import to_rgba_array
 from matplotlib.figure import Figure
 from PIL import Image
 
+from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
+from tablebot.escape import picture
 from tablebot.files import atomic_write
 from tablebot.sim import columns as L
-from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings, state_colours
+from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings
 from tablebot.sim.plots import subtitle_of, title_of
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -70,7 +72,8 @@ class Player:
         outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {'on ' + str(int(v)) if v else 'off'}"
                             for k, (n, v) in enumerate(zip(names, last, strict=True)))
         speed = f"   ({self.speed:g}× speed)" if self.speed != 1 else ""
-        self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{scene.table.state_title(state)}   {outputs}")
+        now = picture(f"{scene.table.state_title(state)}   {outputs}")
+        self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{now}")
         return [self.trail, self.hud, *self.robot.artists()]
 
 

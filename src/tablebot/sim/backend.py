@@ -22,11 +22,14 @@ def read_section(src: Source, data: Any, robot: Robot) -> Any:
 
 def open_sim(machine: Machine, address: str, options: Options) -> Opened:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
+    from tablebot.jit import say_compiling
+    from tablebot.sim import kernel
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
     world = address.partition(":")[2]
     seed = int(options.get("seed", 1))
+    say_compiling("the simulator", kernel.move)
     bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None), seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
     bot.reset(seed=seed)

@@ -1,5 +1,5 @@
 """Drawing pieces shared by the pictures and the animation: arena, tape, obstacles, lamps with their bases,
-the robot with its sensors, where a collision touched, state colours.
+the robot with its sensors, where a collision touched (state colours: :mod:`tablebot.colours`).
 
 Only matplotlib artists on a given Axes; no figure or backend is chosen here, so headless use
 never touches a display.
@@ -19,7 +19,6 @@ from matplotlib.collections import PatchCollection
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon, Rectangle, Wedge
 
-from tablebot.robot import StateId
 from tablebot.sensors import Sensor
 from tablebot.sim import columns as L
 from tablebot.sim.params import Params
@@ -36,15 +35,8 @@ FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
 COLLISION, LIGHT_SEEN, REACHED = "#e8413a", "#f0a500", "#20bf6b"
 TAPE, BEAM, BEAM_NEAR = "#1e1e1e", "#4a90d9", "#1f5fa8"
+TAPE_FILL = "#a8a49c"  # the tape on the floor: grey, not black, so a path driven along it shows on top
 TOUCH_M = 0.001  # outline points this much farther than the nearest still touch (a face flat on a wall)
-# tab10 without its red (red marks collisions) and with darker extras after it
-PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#e377c2", "#7f7f7f",
-           "#bcbd22", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd", "#31a354")
-
-
-def state_colours(states: tuple[StateId, ...]) -> list[str]:
-    """One colour per state index, stable across the pictures of a table."""
-    return [PALETTE[i % len(PALETTE)] for i in range(len(states))]
 
 
 def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
@@ -96,7 +88,7 @@ def draw_tape(ax: Axes, world: World) -> None:
             patches.append(Rectangle((x0 + s * half, y0 - c * half), length, line.width, angle=angle))
         patches += [CirclePatch(p, half) for p in line.points]
     if patches:
-        ax.add_collection(PatchCollection(patches, facecolor=TAPE, edgecolor="none", zorder=0.5))
+        ax.add_collection(PatchCollection(patches, facecolor=TAPE_FILL, edgecolor="none", zorder=0.5))
 
 
 def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta: float) -> tuple[float, float]:

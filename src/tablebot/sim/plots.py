@@ -14,6 +14,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from tablebot.colours import state_colours
+from tablebot.escape import picture
 from tablebot.files import atomic_write
 from tablebot.sim import columns as L
 from tablebot.sim.draw import (
@@ -23,13 +25,13 @@ from tablebot.sim.draw import (
     LIGHT_SEEN,
     REACHED,
     TAPE,
+    TAPE_FILL,
     WALL,
     RobotArtist,
     contact_point,
     draw_world,
     literal_text,
     sensor_readings,
-    state_colours,
 )
 from tablebot.sim.runner import Result
 from tablebot.sim.summary import Summary
@@ -41,7 +43,7 @@ LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and hig
 
 
 def title_of(result: Result) -> str:
-    robot, world = result.scene.table.robot.name, result.scene.world.name
+    robot, world = picture(result.scene.table.robot.name), picture(result.scene.world.name)
     return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
 
 
@@ -60,6 +62,11 @@ def subtitle_of(summary: Summary) -> str:
 @literal_text()
 def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
+    return save(trajectory_figure(result, summary), path)
+
+
+@literal_text()
+def trajectory_figure(result: Result, summary: Summary) -> Figure:
     world = result.scene.world
     xs, ys = zip(*world.walls, strict=True)
     aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
@@ -81,8 +88,8 @@ def trajectory(result: Result, summary: Summary, path: Path) -> Path:
     _robot_poses(ax, result)
     fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.06, ha="left", y=0.975)
     fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
-    _legend(fig, result, summary)
-    return save(fig, path)
+    _legend(fig, result, summary, len(spins) > 0)
+    return fig
 
 
 def spin_starts(h: np.ndarray, states: np.ndarray) -> np.ndarray:
@@ -161,41 +168,50 @@ def _robot_poses(ax, result: Result) -> None:
                lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(h[-1], sensors))
 
 
-def _legend(fig: Figure, result: Result, summary: Summary) -> None:
+def _legend(fig: Figure, result: Result, summary: Summary, spins: bool) -> None:
+    """The states the run was in (their colours and time), and the marks this picture shows."""
     machine = result.scene.machine
     colours = state_colours(machine.states)
     handles = [Patch(color=colours[machine.states.index(state)],
-                     label=f"{result.scene.table.state_title(state)}  ({secs:.1f} s)")
-               for state, secs in summary.state_seconds.items()]
+                     label=picture(f"{result.scene.table.state_title(state)}  ({secs:.1f} s)"))
+               for state, secs in summary.state_seconds.items() if secs > 0]
     states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
                                bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
     states_legend._legend_box.align = "left"
-    fig.legend(handles=legend_marks(result), loc="lower left", bbox_to_anchor=(0.70, 0.08), frameon=False, fontsize=9)
+    fig.legend(handles=legend_marks(result, summary, spins), loc="lower left", bbox_to_anchor=(0.70, 0.08),
+               frameon=False, fontsize=9)
 
 
-def legend_marks(result: Result) -> list:
-    """What the trajectory's marks mean: only those this world and robot can show."""
+def legend_marks(result: Result, summary: Summary, spins: bool) -> list:
+    """What the trajectory's marks mean: only those it shows (a collision, first light, a spin that
+    happened; the world's lamps, tape and obstacles; the robot's floor sensors and beams)."""
     world, kinds = result.scene.world, {s.kind for s in result.scene.table.robot.sensors}
-    marks = [Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
-                    label="collision (where it touched)"),
-             Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
-                    label="a state begins with a turn on the spot")]
+    marks = []
+    if summary.collision_ticks:
+        marks.append(Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
+                            label="collision (where it touched)"))
+    if world.lamps and summary.first_light_s is not None:
+        marks.append(Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
+                            label="light first seen"))
+    if world.lamps and summary.reached_s is not None:
+        marks.append(Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
+                            label=f"lamp reached (≤ {world.reach:g} m)"))
+    if spins:
+        marks.append(Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
+                            label="a state begins with a turn on the spot"))
     if world.lamps:
-        marks[1:1] = [Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
-                             label="light first seen"),
-                      Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
-                             label=f"lamp reached (≤ {world.reach:g} m)")]
         marks += [Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=11,
                          label="lamp, on its base (an obstacle)"),
                   Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)")]
     if world.lines:
-        marks.append(Patch(facecolor=TAPE, label="tape on the floor"))
+        marks.append(Patch(facecolor=TAPE_FILL, label="tape on the floor"))
     if "line" in kinds:
         marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
                             label="floor sensor (dark over tape)"))
     if "distance" in kinds:
         marks.append(Patch(facecolor=BEAM, alpha=0.45, label="distance beam, out to the echo"))
-    marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
+    if world.boxes or world.circles:
+        marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
     return marks
 
 
@@ -206,6 +222,11 @@ def legend_marks(result: Result) -> list:
 def timeline(result: Result, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
     light, declared light and distance sensors) against time."""
+    return save(timeline_figure(result, summary), path)
+
+
+@literal_text()
+def timeline_figure(result: Result, summary: Summary) -> Figure:
     t = np.arange(result.ticks) * result.tick_s
     readings = reading_panels(result)
     fig = Figure(figsize=(12, 7.2 + 1.8 * len(readings)), dpi=DPI)
@@ -231,7 +252,7 @@ def timeline(result: Result, summary: Summary, path: Path) -> Path:
     key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
     fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
     fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
-    return save(fig, path)
+    return fig
 
 
 def _state_panel(ax, result: Result) -> None:
@@ -249,7 +270,7 @@ def _state_panel(ax, result: Result) -> None:
     for s, runs in spans.items():  # one call per state, not per visit: an hour has thousands
         ax.broken_barh(runs, (rows[s] - 0.4, 0.8), facecolors=colours[s])
     ax.set_yticks(range(len(visited)))
-    ax.set_yticklabels([result.scene.table.state_title(machine.states[s]) for s in visited], fontsize=8)
+    ax.set_yticklabels([picture(result.scene.table.state_title(machine.states[s])) for s in visited], fontsize=8)
     ax.set_ylim(-0.7, len(visited) - 0.3)
     ax.invert_yaxis()
     ax.set_ylabel("state")
@@ -261,7 +282,7 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
     labels = result.scene.table.robot.labels
     for k, name in enumerate(names):
         style = "-" if k < n_motors else ":"
-        label = f"{name} ({labels[name]})" if labels.get(name) else name
+        label = picture(f"{name} ({labels[name]})" if labels.get(name) else name)
         wide = k == 0  # the first drawn wide and pale, so equal speeds show both lines
         values = result.outputs[:, k]
         steps = np.concatenate(([0], np.flatnonzero(np.diff(values)) + 1, [len(values) - 1]))  # where it changes
@@ -285,8 +306,8 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
         runs = [(a * tick, max((b - a) * tick, least)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
         ax.broken_barh(runs, (k - 0.38, 0.76), facecolors="#2f3640")
     ax.set_yticks(range(len(table.events)))
-    ax.set_yticklabels([f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}" for n in table.events],
-                       fontsize=8)
+    ax.set_yticklabels([picture(f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}")
+                        for n in table.events], fontsize=8)
     ax.set_ylim(-0.7, len(table.events) - 0.3)
     ax.invert_yaxis()
     ax.set_ylabel("events")
@@ -310,8 +331,8 @@ def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> lis
     for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
         if sensor.kind != kind:
             continue
-        line = ax.plot(*envelope(t, h[:, L.READING + k] * scale, LIGHT_BINS), lw=1.1,
-                       label=f"{sensor.name} {result.scene.table.robot.labels.get(sensor.name, '')}".strip())[0]
+        label = f"{sensor.name} {result.scene.table.robot.labels.get(sensor.name, '')}".strip()
+        line = ax.plot(*envelope(t, h[:, L.READING + k] * scale, LIGHT_BINS), lw=1.1, label=picture(label))[0]
         on, off = sensor.switch_points()
         ax.axhline(on * scale, color=line.get_color(), lw=1, ls="--")
         if off != on:
@@ -331,15 +352,27 @@ def _light_panel(ax, result: Result, t: np.ndarray) -> None:
     wiring = result.scene.params.wiring
     if not (wiring.get("light_right") or wiring.get("light_left")):  # declared light sensors only
         _declared(ax, result, t, "light", 1.0)
-        ax.set_yscale("symlog", linthresh=0.1)
+        _light_scale(ax)
         ax.set_ylabel("light\n(× threshold)")
         ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
         return
     h, wiring = result.hist[:-1], result.scene.params.wiring
-    ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22", label=f"{wiring['light_right']} right")
-    ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad", label=f"{wiring['light_left']} left")
+    ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22",
+            label=picture(f"{wiring['light_right']} right"))
+    ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad",
+            label=picture(f"{wiring['light_left']} left"))
     ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
-    ax.set_yscale("symlog", linthresh=0.1)
+    _light_scale(ax)
     ax.set_ylim(0, max(10.0, float(h[:, [L.LIGHT_R, L.LIGHT_L]].max()) * 1.5))
     ax.set_ylabel("light\n(× threshold)")
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
+
+
+def _light_scale(ax) -> None:
+    """Light on a symmetric log scale (0, then 0.1 to 100s), its ticks written as plain numbers: the
+    pictures draw text with maths parsing off (for user text), so matplotlib's 10^n labels would print
+    as raw TeX."""
+    from matplotlib.ticker import FuncFormatter
+
+    ax.set_yscale("symlog", linthresh=0.1)
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.files import partial_name, write_text
+from tablebot.fileset import file_set
 from tablebot.formats.inputs_csv import pulses_key
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import NO_ROW
@@ -62,13 +63,16 @@ class RunTrace(TraceFile):
             self.fired += int(row) != NO_ROW
 
     def end(self, end: RunEnd) -> None:
+        """The trace and its summary replace the previous run's together (the trace was written beside
+        them as the run went, so a crash still leaves its ticks in the temporary file)."""
         if self.info is None:
             return
-        super().end(end)
-        assert self.written is not None
-        summary = self.folder / "summary.json"
-        summary = summary if self.written.name == self.path.name else partial_name(summary)
-        write_text(summary, json.dumps(self.summary(end), indent=2, ensure_ascii=False) + "\n")
+        with file_set(self.folder):
+            super().end(end)
+            assert self.written is not None
+            summary = self.folder / "summary.json"
+            summary = summary if self.written.name == self.path.name else partial_name(summary)
+            write_text(summary, json.dumps(self.summary(end), indent=2, ensure_ascii=False) + "\n")
         self.summary_written = summary
 
     @property

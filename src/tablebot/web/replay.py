@@ -1,5 +1,6 @@
 """A run as one self-contained HTML file (no server, nothing fetched): the arena, the timeline, the
-table and the state diagram, replayed by the studio's own drawing scripts, to send to a pupil.
+table and the state diagram, replayed by the studio's own drawing modules (bundled into the page), to
+send to a pupil.
 
 ``tablebot sim ... --html`` writes it; :func:`write_html` takes the run's trace lines, its world and
 its table.
@@ -21,13 +22,14 @@ from tablebot.sim.params import Params
 from tablebot.sim.world import World
 from tablebot.table import Table
 from tablebot.web.analyse import columns_of, machine_json
+from tablebot.web.bundle import bundle
 from tablebot.web.document import CsvDocument
 from tablebot.web.simulate import studio_diagram
 from tablebot.web.tracefile import trace_columns
 from tablebot.web.worldview import world_json
 
 STATIC = Path(__file__).parent / "static"
-SCRIPTS = ("arena.js", "timeline.js", "diagram.js", "grid.js", "player.js", "replay.js")
+ENTRY = "replay/main.js"  # under static/js; it and the modules it imports are inlined as one script
 #: Decimals kept per column: what the eye can see (0.1 mm, 0.1°), an eighth of the file size.
 ROUNDING = {"x": 4, "y": 4, "heading": 1, "battery_v": 2}
 
@@ -72,7 +74,7 @@ def render_html(data: dict[str, Any]) -> str:
     """The page: the replay template with the stylesheet, the scripts and the data inlined."""
     template = (STATIC / "replay.html").read_text(encoding="utf-8")
     style = (STATIC / "studio.css").read_text(encoding="utf-8")
-    scripts = "\n".join((STATIC / "js" / name).read_text(encoding="utf-8") for name in SCRIPTS)
+    scripts = bundle(STATIC / "js", ENTRY)
     for part in (style, scripts):
         if "</" + "script" in part.lower() or "</" + "style" in part.lower():
             raise ValueError("an inlined script or stylesheet would end its element")  # a bug in the package files

@@ -84,7 +84,7 @@ class Workspace:
         it: inside the folder, of ``kind``, no part starting with a dot (before and after links)."""
         if not isinstance(name, str) or not name or "\x00" in name or len(name) > 1000:
             raise Refused("no file name given")
-        given = PurePosixPath(name.replace("\\", "/"))
+        given = PurePosixPath(name)
         shown = _shown(name)
         if given.is_absolute() or ".." in given.parts:
             raise Refused(f"{shown} is outside the served folder")

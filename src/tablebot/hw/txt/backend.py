@@ -15,6 +15,7 @@ if TYPE_CHECKING:
 
 PORT = 65000
 ADDRESSES = ("txt://192.168.7.2 (USB)", "txt://HOST:PORT", "txt://auto")
+FIRMWARE_HINT = "update the TXT's firmware to 4.6.6 or later"
 ADDRESS_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto"
 CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
                 "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
@@ -34,34 +35,36 @@ def fit(machine: Machine) -> list[Diagnostic]:
 
 
 def parse_address(text: str, hint: str) -> tuple[str | None, int]:
-    """``txt://HOST[:PORT]`` -> (HOST, PORT); ``txt://auto`` -> (None, 65000); anything else a located error."""
+    """``txt://HOST[:PORT]`` -> (HOST, PORT); ``txt://auto[:PORT]`` -> (None, PORT or 65000); anything else
+    a located error."""
     if not text.startswith("txt://"):
         raise fail("--on", f"unknown target {text!r}", hint)
     rest = text[len("txt://"):].rstrip("/")
-    if rest == "auto":
-        return None, PORT
     host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
     if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
         raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", hint)
-    return host, int(port) if port else PORT
+    return None if host == "auto" else host, int(port) if port else PORT
 
 
 def open_txt(machine: Machine, address: str, options: Options) -> Opened:
     """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
-    fit), then the controller found and asked who it is."""
-    from tablebot.hw.txt.controller import TxtRobot
-    from tablebot.hw.txt.link import AUTO_HOSTS, find_controller
+    fit), then the controller found (an address counts when it answers as a TXT) and asked who it is."""
+    from tablebot.hw.txt import link
+    from tablebot.hw.txt.controller import FirmwareTooOld, TxtRobot
     from tablebot.hw.txt.wiring import txt_wiring
     from tablebot.loop import LinkLost
 
     host, port = parse_address(address, options.get("hint", ADDRESS_HINT))
     wiring = txt_wiring(machine)
-    host = host or find_controller(AUTO_HOSTS, port)
     if host is None:
-        raise fail("--on", f"txt://auto found no controller at {', '.join(AUTO_HOSTS)} (port {port})", CONNECT_HINT)
+        host, tried = link.find_controller(link.AUTO_HOSTS, port)
+        if host is None:
+            raise fail("--on", "txt://auto found no TXT: " + "; ".join(tried), CONNECT_HINT)
     bot = TxtRobot(wiring, host, port, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
     try:
         status = bot.connect()
+    except FirmwareTooOld as exc:
+        raise fail("--on", str(exc), FIRMWARE_HINT) from None
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
     return Opened(bot, bot.target, f"{status.device} {status.version_text}")

@@ -22,6 +22,10 @@ ZERO = [0] * wire.N_OUTPUTS
 COUNTER_WRAP = 1 << 16
 
 
+class FirmwareTooOld(LinkLost):
+    """The controller answered, with firmware older than fischertechnik's own online client accepts."""
+
+
 class TxtRobot:
     """The robot behind ``host:port``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
@@ -41,9 +45,15 @@ class TxtRobot:
         return f"txt://{self.link.where}"
 
     def connect(self, timeout_s: float = 3.0) -> wire.Status:
-        """Open the TCP connection and ask the controller who it is (nothing moves yet)."""
+        """Open the TCP connection and ask the controller who it is (nothing moves yet); firmware older
+        than 4.6.6 is refused before going online, as fischertechnik's online client refuses it."""
         self.link.connect(timeout_s)
         self.status = self.link.query_status()
+        if self.status.version < wire.MIN_VERSION:
+            self.link.close()
+            raise FirmwareTooOld(f"{self.status.device} at {self.link.where} runs firmware "
+                                 f"{self.status.version_text} (0x{self.status.version:08X}); the online protocol "
+                                 "needs 4.6.6 or later, as fischertechnik's own online client checks")
         return self.status
 
     # --- RobotIO ----------------------------------------------------------------------------------

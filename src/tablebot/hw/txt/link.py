@@ -1,5 +1,11 @@
-"""The client side of the TXT online protocol: one TCP connection, one request at a time, a deadline on
-every reply, and a stream that stays in step even when Ctrl-C cuts a request or a reply in half.
+"""The client side of the TXT online protocol: one TCP connection, one request at a time, each request
+sent whole, a deadline on every reply, and a stream that stays in step even when Ctrl-C cuts a reply short.
+
+Whole requests matter: ftrobopy_server (ftrobopy/ftrobopy_server, ``src/ftrobopy_server.cpp``) reads each
+request with a single ``recv`` and takes its first four bytes as the command id; the rest of a request
+that arrived in two pieces would be read as a command of its own (answered 0x01020304, connection
+closed) and the first piece parsed with stale bytes. So a request goes out in one ``sendall`` with
+SIGINT and SIGTERM held until it is out, never as a remainder resumed later.
 
 Every failure (refused, silent, late, closed, malformed, wrong response id) becomes
 :class:`tablebot.loop.LinkLost` with a sentence saying what happened; nothing here prints or starts threads.
@@ -8,9 +14,12 @@ Every failure (refused, silent, late, closed, malformed, wrong response id) beco
 from __future__ import annotations
 
 import contextlib
+import signal
 import socket
+import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 from tablebot.hw.txt import protocol as wire
 from tablebot.hw.txt.protocol import Command
@@ -23,15 +32,41 @@ KEEP_ALIVE_S = 1.0
 SETUP_TIMEOUT_S = 2.0  # QueryStatus, StartOnline, UpdateConfig, StopOnline
 
 
-def find_controller(hosts: Sequence[str] = AUTO_HOSTS, port: int = wire.PORT, timeout_s: float = 0.5) -> str | None:
-    """The first of ``hosts`` that accepts a connection on ``port`` (each tried for ``timeout_s``)."""
-    for host in hosts:
-        try:
-            with socket.create_connection((host, port), timeout=timeout_s):
-                return host
-        except OSError:
-            continue
-    return None
+def probe(host: str, port: int = wire.PORT, timeout_s: float = 0.5) -> wire.Status | str:
+    """Whether ``host`` answers the TXT handshake (QueryStatus): its status, or what it did instead."""
+    link = TxtLink(host, port, setup_timeout_s=timeout_s)
+    try:
+        link.connect(timeout_s)
+        return link.query_status()
+    except LinkLost as exc:
+        return str(exc)
+    finally:
+        link.close()
+
+
+def find_controller(hosts: Sequence[str] = AUTO_HOSTS, port: int = wire.PORT,
+                    timeout_s: float = 0.5) -> tuple[str | None, list[str]]:
+    """The first of ``hosts`` that answers as a TXT (all asked at once, each for ``timeout_s``), and what
+    each of the others did. A server that merely accepts the connection does not count."""
+    with ThreadPoolExecutor(max_workers=max(1, len(hosts))) as pool:
+        answers = list(pool.map(lambda host: probe(host, port, timeout_s), hosts))
+    found = next((host for host, answer in zip(hosts, answers, strict=True) if isinstance(answer, wire.Status)),
+                 None)
+    return found, [f"{host}: {answer}" for host, answer in zip(hosts, answers, strict=True)
+                   if not isinstance(answer, wire.Status)]
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM wait (in this thread) until the block is done: Ctrl-C cannot cut a request."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        yield  # Python runs signal handlers in the main thread only: nothing can interrupt this one
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 class TxtLink:
@@ -45,9 +80,9 @@ class TxtLink:
         self.online = False  # StartOnline was sent and StopOnline was not
         self.config_id = 0
         self.last_reply = 0.0  # time.monotonic() of the last whole reply
-        self._unsent = b""  # the rest of a request a signal cut short: sent before anything else
         self._owed = 0  # bytes of replies still to come (a reply a signal cut short, or one given up on)
         self._trusted = True  # False after a malformed reply: later bytes cannot be parsed reliably
+        self._sendable = True  # False once a request may have gone out in part: nothing more can follow it
 
     @property
     def where(self) -> str:
@@ -106,14 +141,12 @@ class TxtLink:
     def send_best_effort(self, command: Command, payload: bytes, timeout_s: float) -> bool:
         """Send ``payload`` even after a fault, then read what replies come within ``timeout_s`` without
         trusting them; True if the whole request went out. Never raises (this is how outputs get stopped)."""
-        if self.sock is None:
+        if self.sock is None or not self._sendable:
             return False
         deadline = time.monotonic() + timeout_s
         try:
-            self._flush(deadline, command)
             self._owed += wire.REPLY_SIZE[command]
-            self._unsent = payload
-            self._flush(deadline, command)
+            self._send(payload, deadline, command)
         except LinkLost:
             return False
         with contextlib.suppress(LinkLost):
@@ -128,26 +161,29 @@ class TxtLink:
         if not self._trusted:
             raise LinkLost(f"{self.where} sent a malformed reply earlier: its replies cannot be trusted")
         deadline = time.monotonic() + timeout_s
-        self._flush(deadline, command)  # the rest of a request a signal interrupted: its reply is owed
-        self._discard_owed(deadline, command)
-        self._owed = wire.REPLY_SIZE[command]
-        self._unsent = payload
-        self._flush(deadline, command)
+        self._discard_owed(deadline, command)  # the rest of a reply a signal cut short, or one given up on
+        self._owed = wire.REPLY_SIZE[command]  # owed from the moment the request may be out
+        self._send(payload, deadline, command)
         data = self._receive(wire.REPLY_SIZE[command], deadline, command, timeout_s)
         self.last_reply = time.monotonic()
         return data
 
-    def _flush(self, deadline: float, command: Command) -> None:
+    def _send(self, payload: bytes, deadline: float, command: Command) -> None:
+        """The whole request in one ``sendall``, signals held; a request that may have gone out in part
+        leaves the connection unusable (what follows would be misread)."""
+        if not self._sendable:
+            raise LinkLost(f"{self.where}: a request went out in part earlier; nothing more can be sent")
         sock = self._socket()
-        while self._unsent:
-            sock.settimeout(self._remaining(deadline, command, "sending"))
+        sock.settimeout(self._remaining(deadline, command, "sending"))
+        with signals_held():
             try:
-                sent = sock.send(self._unsent)
+                sock.sendall(payload)
             except TimeoutError:
+                self._sendable = False
                 raise LinkLost(f"{self.where} did not take {command.name} in time (its buffer is full)") from None
             except OSError as exc:
+                self._sendable = False
                 raise self._lost(exc, command) from None
-            self._unsent = self._unsent[sent:]
 
     def _discard_owed(self, deadline: float, command: Command) -> None:
         while self._owed > 0:

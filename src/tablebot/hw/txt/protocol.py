@@ -20,6 +20,9 @@ N_MOTORS = 4  # M1..M4: motor n drives O(2n-1) forward and O(2n) backward
 N_INPUTS = 8  # I1..I8
 N_COUNTERS = 4  # C1..C4
 MAX_PWM = 512
+#: fischertechnik's own online client refuses older firmware: ``BeginTransfer`` in
+#: SolutionOnLineSamples/Common/ftProInterface2013TransferAreaCom.cpp, ``if( GetVersion()<0x04060600 )``.
+MIN_VERSION = 0x04060600
 
 
 class Command(IntEnum):

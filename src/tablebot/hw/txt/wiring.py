@@ -6,6 +6,7 @@ is wired to, how each input measures, and what the table reads (a switch's polar
     [txt]
     I3 = { terminal = "I3", mode = "switch", pressed = 1 }        # the table reads 1 while pressed
     I7 = { terminal = "I7", mode = "phototransistor", lit = 1 }   # ... 1 while it sees light
+    I1 = { terminal = "I1", mode = "trail", dark = 1 }            # ... 1 over the dark line
     US = { terminal = "I1", mode = "ultrasonic", below = 20 }     # ... 1 closer than 20 cm
     M1 = "M1"                                                     # or { terminal = "M1", reverse = true }
     C1 = "C1"
@@ -33,11 +34,17 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
 PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 = PWM 512
 
-#: mode -> (the controller's input mode, digital?, the polarity key, its meaning)
+#: mode -> (the controller's input mode (digital), the polarity key, its meaning, the controller's reading
+#: then). A track sensor is read in digital voltage mode, 1 over a light floor and 0 over the dark line, as
+#: ftrobopy's ``trailfollower`` reads it (ftrobopy.py) and ftrobopy_server maps mode (0, digital) to
+#: ``ft::TrailFollower``; ROBO Pro Coding's ``create_trail_follower(...).get_state()`` reads 0 on the line
+#: (fischertechnik's FTS program, ORBIS-Modellfabrik ``integrations/TXT-FTS/.../lib/line_follower.py``).
 DIGITAL_MODES = {
-    "switch": (wire.InputMode.RESISTANCE, "pressed", "while the push-button is pressed"),
-    "phototransistor": (wire.InputMode.RESISTANCE, "lit", "while the phototransistor sees light"),
+    "switch": (wire.InputMode.RESISTANCE, "pressed", "while the push-button is pressed", 1),
+    "phototransistor": (wire.InputMode.RESISTANCE, "lit", "while the phototransistor sees light", 1),
+    "trail": (wire.InputMode.VOLTAGE, "dark", "while the track sensor's spot is over the dark line", 0),
 }
+TRAIL_LIGHT_MV = 600  # ftrobopy: a trail sensor reporting millivolts reads light above 600 mV
 #: mode -> (the controller's input mode, unit, largest value)
 ANALOG_MODES = {
     "resistance": (wire.InputMode.RESISTANCE, "ohm", 15000),
@@ -73,6 +80,8 @@ class InputWire:
     def reads(self, raw: int, was_on: bool = False) -> int:
         """What the table sees (0/1) for the controller's raw value (``was_on``: what it saw last tick,
         for the hysteresis)."""
+        if self.mode == "trail":  # 0/1, or millivolts: as ftrobopy's trailfollower().state() reads it
+            return int(raw == 1 or raw > TRAIL_LIGHT_MV) ^ int(self.invert)
         if self.digital:
             return int(bool(raw)) ^ int(self.invert)
         slack = self.hysteresis if was_on else 0
@@ -224,7 +233,8 @@ def suggest(robot: Robot, machine: Machine) -> str:
             if terminal in free[kind]:
                 free[kind].remove(terminal)
             label = robot.labels.get(name, "").lower()
-            mode = ('mode = "phototransistor", lit = 1' if "photo" in label or "light" in label
+            mode = ('mode = "trail", dark = 1' if "track" in label or "trail" in label
+                    else 'mode = "phototransistor", lit = 1' if "photo" in label or "light" in label
                     else 'mode = "switch", pressed = 1')
             lines.append(f'{name} = {{ terminal = "{terminal}", {mode} }}' if kind == "input"
                          else f'{name} = "{terminal}"')
@@ -286,7 +296,8 @@ class _Reader:
         mode = value.get("mode")
         if mode not in MODES:
             self.error(name, f"[txt] {name}: mode must be one of {', '.join(MODES)}, not {mode!r}",
-                       'a push-button is mode = "switch"; a phototransistor mode = "phototransistor"')
+                       'a push-button is mode = "switch", a phototransistor mode = "phototransistor", '
+                       'a track sensor mode = "trail"')
             return None
         known = ("terminal", "mode", DIGITAL_MODES[mode][1]) if mode in DIGITAL_MODES else ("terminal", "mode",
                                                                                           "below", "above")
@@ -300,14 +311,14 @@ class _Reader:
         return InputWire(name, terminal, mode, *polarity)
 
     def _digital(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool] | None:
-        key, meaning = DIGITAL_MODES[mode][1], DIGITAL_MODES[mode][2]
+        _, key, meaning, reported = DIGITAL_MODES[mode]
         reads = value.get(key)
         if reads not in (0, 1) or isinstance(reads, bool):
             self.error(name, f"[txt] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0"
                        + ("" if reads is None else f", not {reads!r}"),
                        f"{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')")
             return None
-        return (reads == 0,)
+        return (reads != reported,)
 
     def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None, int] | None:
         unit, most = ANALOG_MODES[mode][1], ANALOG_MODES[mode][2]

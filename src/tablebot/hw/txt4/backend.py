@@ -23,7 +23,7 @@ def export(machine: Machine, out: Path | None, options: Options) -> Exported:
     files = tuple(workspace.write(out_folder(out, "OUTDIR")))
     return Exported(files, (*(f"wrote {path}" for path in files),
                             f"upload and start it: tablebot upload {shell_word(str(out))} "
-                            "--to txt4://192.168.7.2 --key API_KEY"))
+                            "--to txt4://192.168.7.2 (it asks for the API key the TXT 4.0 shows)"))
 
 
 TXT4 = register(Backend("txt4", "export", "a program that runs the table on a TXT 4.0 by itself",

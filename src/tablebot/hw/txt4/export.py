@@ -17,6 +17,7 @@ from typing import Any
 
 from tablebot.escape import python_string
 from tablebot.files import write_text
+from tablebot.fileset import file_set
 from tablebot.hw.txt.wiring import TxtWiring, txt_wiring
 from tablebot.machine import Machine
 
@@ -37,12 +38,9 @@ class Workspace:
     files: dict[str, str]
 
     def write(self, folder: Path) -> list[Path]:
-        written = []
-        for relative, text in self.files.items():
-            path = folder / relative
-            path.parent.mkdir(parents=True, exist_ok=True)
-            written.append(write_text(path, text, newline="\n"))
-        return written
+        """The workspace into ``folder``, replacing the previous one's files at once."""
+        with file_set(folder):
+            return [write_text(folder / relative, text, newline="\n") for relative, text in self.files.items()]
 
 
 def workspace_name(machine: Machine) -> str:
@@ -60,9 +58,19 @@ def export_txt4(machine: Machine) -> Workspace:
     runtime = resources.files("tablebot.hw.txt4").joinpath("runtime.py").read_text(encoding="utf-8")
     program = f"{runtime}\n\n# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
     digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
-    project = {"name": name, "mode": "ADVANCED", "uuid": str(uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))}
     return Workspace(name, {f"{name}.py": LAUNCHER, "lib/__init__.py": "", PROGRAM: program,
-                            ".project.json": json.dumps(project, indent=2) + "\n"})
+                            ".project.json": project_json(name, uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))})
+
+
+def project_json(name: str, project_uuid: uuid.UUID) -> str:
+    """``.project.json`` as ROBO Pro Coding writes it: these five keys in this order, on one line, no final
+    newline (OliverBerger-ORBIS/ORBIS-Modellfabrik, ``integrations/TXT-*/workspaces/*/.project.json``).
+    Mode ``PROFESSIONAL`` is ROBO Pro Coding's Python mode (``FF_AI_24V``: Python files only); an
+    ``ADVANCED`` project is edited in blocks and carries ``NAME.blockly`` beside ``NAME.py``, which a
+    program written as Python has not."""
+    project = {"uuid": str(project_uuid), "name": name, "mode": "PROFESSIONAL", "version": "1.0",
+               "controller": "TXT4"}
+    return json.dumps(project, separators=(",", ":"))
 
 
 def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:

@@ -7,20 +7,28 @@ table as ``TABLE``; it needs only the standard library (Python 3.7 or later) and
 The tick rule is tablebot's (tablebot.engine), written out again here because the controller has no
 tablebot; the tests prove the two equal tick for tick on random tables.
 
-Not tried on a real TXT 4.0 (none was at hand): the ``fischertechnik`` calls are the ones Open Roberta's
-TXT 4.0 generator emits (Txt4PythonVisitor); the tests run this file against a stub of exactly those calls.
+Not tried on a real TXT 4.0 (none was at hand). The ``fischertechnik`` calls are the ones Open Roberta's
+TXT 4.0 generator emits (Txt4PythonVisitor) and real ROBO Pro Coding programs make (OliverBerger-ORBIS/
+ORBIS-Modellfabrik, ``integrations/TXT-*/workspaces/*/lib/controller.py``); what they do is read from the
+package's own sources (6.4.2, in leosdad/ft-rc-vehicle, folder ``fischertechnik/``). The tests run this
+file against a stub written from those sources (tests/txt4_stub) and, when pointed at a checkout,
+under harbaum/SofTXT.
 """
 
 from __future__ import annotations
 
+import atexit
 import contextlib
+import os
 import signal
+import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
 PWM_STEP = 64  # speed or lamp level 8 = PWM 512
 BEHIND_LIMIT_S = 0.5  # a tick this late stops the robot rather than stretch the table's timers
+HANDOVER_S = 1.0  # how long a SIGTERM handled in the main thread waits for the run's thread to stop
 TABLE: dict = {}  # the exported table (appended by ``tablebot export --to txt4``)
 
 
@@ -66,17 +74,21 @@ class Engine:
 
 
 class Txt4Robot:
-    """The table's inputs, motors, lamps and counters on this controller's terminals."""
+    """The table's inputs, motors, lamps and counters on this controller's terminals. ``stop`` may be
+    called from another thread than ``read``/``write`` (a SIGTERM handled in the main thread)."""
 
-    #: mode -> (the input factory's create call, the device's reading call), as Open Roberta emits them
+    #: mode -> (the input factory's create call, the device's reading call), as ROBO Pro Coding emits them
     READERS = (("switch", "create_mini_switch", "get_state"),
                ("phototransistor", "create_photo_transistor", "is_bright"),
+               ("trail", "create_trail_follower", "get_state"),
                ("ultrasonic", "create_ultrasonic_distance_meter", "get_distance"),
                ("voltage", "create_color_sensor", "get_voltage"),
                ("resistance", "create_ntc_resistor", "get_resistance"))
 
     def __init__(self, table: dict, factory: Any, motor_class: Any):
         self.table, self.motor_class = table, motor_class
+        self.lock = threading.Lock()
+        self.stopped = False
         factory.init()
         factory.init_input_factory()
         if table["lamps"]:
@@ -100,84 +112,133 @@ class Txt4Robot:
             self.lamps[lamp["terminal"]] = factory.output_factory.create_led(txt, lamp["terminal"])
         self.counters = []
         for counter in table["counters"]:
-            device = factory.counter_factory.create_encodermotor_counter(txt, counter["terminal"])
-            if counter["motor"] is not None:
+            if counter["motor"] is None:  # Txt4Counter: get_count() is the input's own count
+                device = factory.counter_factory.create_counter(txt, counter["terminal"])
+            else:  # Txt4EncodermotorCounter: get_count() is the motor's distance (never read it unset)
+                device = factory.counter_factory.create_encodermotor_counter(txt, counter["terminal"])
                 device.set_motor(self.motors[counter["motor"]])
             self.counters.append(device)
         factory.initialized()
         time.sleep(0.1)  # as ROBO Pro Coding programs do after initialized()
         self.counts = [device.get_count() for device in self.counters]
+        self.carry = [0] * len(self.counters)  # pulses counted just before a motor restarted its count
         self.sent: list = [None] * table["n_outputs"]
         self.last_mask = 0
 
     def read(self) -> tuple:
         mask = 0
         for read, inp in self.inputs:
-            value = read()
-            slack = inp.get("hysteresis", 0) if self.last_mask & inp["bit"] else 0  # once on, stays on longer
-            if inp["below"] is not None:
-                on = value < inp["below"] + slack
-            elif inp["above"] is not None:
-                on = value > inp["above"] - slack
-            else:
-                on = bool(value) != inp["invert"]
-            if on:
+            if _reads(inp, read(), bool(self.last_mask & inp["bit"])):
                 mask |= inp["bit"]
         self.last_mask = mask
         pulses = []
         for i in range(len(self.counters)):
-            count = self.counters[i].get_count()
-            pulses.append(max(0, count - self.counts[i]))  # a count that went back was reset: no pulses
-            self.counts[i] = count
+            pulses.append(self.carry[i] + self._counted(i))
+            self.carry[i] = 0
         return mask, pulses
+
+    def _counted(self, i: int) -> int:
+        """Pulses since counter ``i`` was last read. A motor's distance counts up from 0 again at each
+        start, whichever way it turns, so a count below the last one is what came after a restart."""
+        count = self.counters[i].get_count()
+        last, self.counts[i] = self.counts[i], count
+        return count - last if count >= last else count
 
     def write(self, outputs: list) -> None:
         """Only what changed is sent: a motor's speed and direction, a lamp's brightness."""
-        for motor in self.table["motors"]:
-            value = outputs[motor["output"]]
-            if value == self.sent[motor["output"]]:
-                continue
-            self.sent[motor["output"]] = value
-            device = self.motors[motor["terminal"]]
-            speed = -value if motor["reverse"] else value
-            if speed == 0:
-                device.stop()
-                continue
-            device.set_speed(min(8, abs(speed)) * PWM_STEP, self.motor_class.CCW if speed > 0 else self.motor_class.CW)
-            device.start()
-        for lamp in self.table["lamps"]:
-            value = outputs[lamp["output"]]
-            if value != self.sent[lamp["output"]]:
-                self.sent[lamp["output"]] = value
-                self.lamps[lamp["terminal"]].set_brightness(max(0, min(8, value)) * PWM_STEP)
+        with self.lock:
+            if self.stopped:
+                return
+            for motor in self.table["motors"]:
+                value = outputs[motor["output"]]
+                if value != self.sent[motor["output"]]:
+                    self.sent[motor["output"]] = value
+                    self._drive(motor, -value if motor["reverse"] else value)
+            for lamp in self.table["lamps"]:
+                value = outputs[lamp["output"]]
+                if value != self.sent[lamp["output"]]:
+                    self.sent[lamp["output"]] = value
+                    self.lamps[lamp["terminal"]].set_brightness(max(0, min(8, value)) * PWM_STEP)
+
+    def _drive(self, motor: dict, speed: int) -> None:
+        device = self.motors[motor["terminal"]]
+        if speed == 0:
+            device.stop()
+            return
+        for i, counter in enumerate(self.table["counters"]):
+            if counter["motor"] == motor["terminal"]:  # its distance restarts at 0: keep what it counted
+                self.carry[i] += self._counted(i)
+                self.counts[i] = 0
+        device.set_speed(min(8, abs(speed)) * PWM_STEP, self.motor_class.CCW if speed > 0 else self.motor_class.CW)
+        device.start()
 
     def stop(self) -> None:
-        """Every motor stopped, every lamp off; one failing call does not keep the others from happening."""
-        for device in self.motors.values():
-            with contextlib.suppress(Exception):
-                device.stop()
-        for device in self.lamps.values():
-            with contextlib.suppress(Exception):
-                device.set_brightness(0)
-        self.sent = [None] * len(self.sent)
+        """Every motor stopped, every lamp off; one failing call does not keep the others from happening.
+        Waits briefly for a write in progress in another thread, then stops anyway."""
+        got = self.lock.acquire(timeout=0.2)
+        try:
+            self.stopped = True
+            for device in self.motors.values():
+                with contextlib.suppress(Exception):
+                    device.stop()
+            for device in self.lamps.values():
+                with contextlib.suppress(Exception):
+                    device.set_brightness(0)
+            self.sent = [None] * len(self.sent)
+        finally:
+            if got:
+                self.lock.release()
+
+
+def _reads(inp: dict, value: Any, was_on: bool) -> bool:
+    """What the table reads for one input's value: a digital input's state (closed, lit, a light floor
+    under a trail sensor) flipped by ``invert``; an analog value against ``below``/``above``, with
+    hysteresis once on."""
+    slack = inp.get("hysteresis", 0) if was_on else 0
+    if inp["below"] is not None:
+        return value < inp["below"] + slack
+    if inp["above"] is not None:
+        return value > inp["above"] - slack
+    return bool(value) != inp["invert"]
 
 
 class Terminated(Exception):
     """SIGTERM (ROBO Pro Coding's stop, or ``DELETE /api/v1/stop``) arrived."""
 
 
-def run(table: dict, robot: Txt4Robot, ticks: int | None = None, now: Callable[[], float] = time.monotonic,
-        sleep: Callable[[float], None] = time.sleep, log: Callable[..., None] = print) -> str:
+class Stop:
+    """A request to end the run, from any thread: a signal handler, ``atexit``, a caller."""
+
+    def __init__(self) -> None:
+        self.requested = threading.Event()
+        self.done = threading.Event()  # set once the run has stopped the outputs and said so
+        self.reason = ""
+
+    def request(self, reason: str) -> None:
+        self.reason = self.reason or reason
+        self.requested.set()
+
+
+def say(*words: object) -> None:
+    """Print at once: a runner reading our output through a pipe or pty sees each line as it happens."""
+    print(*words, flush=True)
+
+
+def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], Any] | None = None, log: Callable[..., None] = say,
+        stop: Stop | None = None) -> str:
     """Run the table until ``ticks`` (None: until stopped); the outputs are stopped on every way out.
     Ticks are paced on a fixed grid; a tick later than half a tick restarts the grid (counted as late),
     one later than BEHIND_LIMIT_S ends the run. Returns why it ended."""
+    stop = stop or Stop()
+    pause = sleep or stop.requested.wait
     engine, tick_s = Engine(table), table["tick_ms"] / 1000
     anchor, anchor_tick, late_ticks, reason = now(), 0, 0, "done"
     try:
         while ticks is None or engine.tick < ticks:
             ahead = anchor + (engine.tick - anchor_tick) * tick_s - now()
             if ahead > 0:
-                sleep(ahead)
+                pause(ahead)
             elif -ahead > tick_s / 2:
                 late_ticks += 1
                 if -ahead > BEHIND_LIMIT_S:
@@ -186,29 +247,121 @@ def run(table: dict, robot: Txt4Robot, ticks: int | None = None, now: Callable[[
                         "stretching the table's timers")
                     break
                 anchor, anchor_tick = now(), engine.tick
+            if stop.requested.is_set():
+                reason = stop.reason
+                break
             mask, pulses = robot.read()
             robot.write(engine.step(mask, pulses))
     except KeyboardInterrupt:
         reason = "stopped"
-    except Terminated:
+    except (Terminated, SystemExit):  # SystemExit: the package's own SIGTERM handler (sys.exit) got there
         reason = "terminated"
+    except BaseException:
+        reason = "error"
+        raise
     finally:
+        stop.request(reason)  # from now on a signal only waits for this
         robot.stop()
-    log(f"tablebot: {reason} after {engine.tick} ticks ({late_ticks} late); outputs off")
+        with contextlib.suppress(Exception):
+            log(f"tablebot: {reason} after {engine.tick} ticks ({late_ticks} late); outputs off")
+        stop.done.set()
     return reason
+
+
+class Guard:
+    """Ends the run with its outputs off however the program is ended: SIGTERM to the process (in the
+    main thread, or in the runner's thread when the program runs in a worker thread, as harbaum/SofTXT's
+    run.py runs it), the interpreter exiting (``atexit``), and -- in :func:`run` -- Ctrl-C, the end of the
+    thread and any exception."""
+
+    def __init__(self, stop: Stop):
+        self.stop = stop
+        self.robot: Any = None  # set once it is built: a stop before then has nothing to switch off
+        self.previous: Any = signal.SIG_DFL
+
+    def install(self) -> str:
+        """Take SIGTERM over (after ``fischertechnik.factories`` installed its own on import); returns a
+        sentence saying how SIGTERM is handled."""
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGTERM, self.in_run_thread)
+            return "tablebot: SIGTERM stops the outputs"
+        # Only the main thread may set a signal handler: ask it to, at its next Python step.
+        if _in_main_thread(self._install_for_worker):
+            return "tablebot: running in a worker thread; the main thread hands SIGTERM over"
+        return "tablebot: warning: running in a worker thread and SIGTERM cannot be caught here"
+
+    def attach(self, robot: Any) -> None:
+        """The robot to stop; its exit hook runs before the package's own (registered when the controller
+        was made: atexit runs the last registered first)."""
+        self.robot = robot
+        atexit.register(self.at_exit)
+
+    def in_run_thread(self, signum: int, frame: Any) -> None:
+        if not self.stop.requested.is_set():  # a second SIGTERM while stopping must not cut the stop short
+            self.stop.request("terminated")
+            raise Terminated()
+
+    def _install_for_worker(self) -> None:
+        self.previous = signal.signal(signal.SIGTERM, self.for_worker)
+
+    def for_worker(self, signum: int, frame: Any) -> None:
+        """In the main thread while the run is in another: stop it, wait for its outputs-off, then end
+        as SIGTERM would have ended the process without us."""
+        self.stop.request("terminated")
+        if not self.stop.done.wait(HANDOVER_S) and self.robot is not None:
+            self.robot.stop()
+        previous, self.previous = self.previous, signal.SIG_DFL
+        signal.signal(signum, previous)
+        if previous == signal.SIG_DFL:
+            os.kill(os.getpid(), signum)
+        elif callable(previous):
+            previous(signum, frame)
+
+    def at_exit(self) -> None:
+        if not self.stop.done.is_set():
+            self.stop.request("exit")
+            if not self.stop.done.wait(HANDOVER_S) and self.robot is not None:
+                self.robot.stop()
+
+
+_PENDING: list = []  # ctypes callbacks must outlive the call
+
+
+def _in_main_thread(func: Callable[[], None]) -> bool:
+    """Have the main thread call ``func`` at its next Python step (CPython's ``Py_AddPendingCall``,
+    which runs pending calls in the main thread only)."""
+    try:
+        import ctypes
+
+        callback_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p)
+
+        def call(_: Any) -> int:
+            with contextlib.suppress(Exception):
+                func()
+            return 0
+
+        callback = callback_type(call)
+        _PENDING.append(callback)
+        add = ctypes.pythonapi.Py_AddPendingCall
+        add.argtypes, add.restype = [callback_type, ctypes.c_void_p], ctypes.c_int
+        return add(callback, None) == 0
+    except (ImportError, AttributeError, OSError):
+        return False
 
 
 def main(table: dict | None = None) -> str:
     """On the controller: build the robot with the ``fischertechnik`` package and run until stopped."""
     table = TABLE if table is None else table
-
-    def terminate(signum: int, frame: object) -> None:
-        raise Terminated()
-
-    with contextlib.suppress(ValueError):  # not the main thread (a runner that starts programs in a thread)
-        signal.signal(signal.SIGTERM, terminate)
-    import fischertechnik.factories as txt_factory
+    import fischertechnik.factories as txt_factory  # installs its own SIGTERM handler (sys.exit) when imported
     from fischertechnik.controller.Motor import Motor
 
-    print("tablebot: running", table["name"], "from", table["source"], "-", len(table["states"]), "states")
-    return run(table, Txt4Robot(table, txt_factory, Motor))
+    say("tablebot: running", table["name"], "from", table["source"], "-", len(table["states"]), "states")
+    stop = Stop()
+    guard = Guard(stop)
+    say(guard.install())
+    try:
+        guard.attach(Txt4Robot(table, txt_factory, Motor))
+    except Terminated:
+        say("tablebot: terminated while setting up; nothing was started")
+        return "terminated"
+    return run(table, guard.robot, stop=stop)

@@ -1,16 +1,28 @@
 """``tablebot upload``: put an exported TXT 4.0 program onto the controller and start it, through the REST
-API ROBO Pro Coding uses (header ``X-API-KEY``; routes as harbaum/SofTXT's ``txt-4.0.py`` serves them:
-ping, stop, create a workspace, send its files as multipart form data, start the application).
+API ROBO Pro Coding uses.
 
-Not tried on a real TXT 4.0 (none was at hand): the routes, the header and the form layout come from
-SofTXT, a software stand-in for the controller; the HTTP port of a real controller is assumed to be 80
-(SofTXT has to be told ``:8000``). The tests use a fake server of these routes over real HTTP.
+Where each part comes from (none was tried on a real TXT 4.0; see docs/controllers.md):
+
+- ``GET /api/v1/ping``, ``DELETE /api/v1/stop``, ``POST /api/v1/workspaces/NAME/files`` (multipart form
+  data, a part per file, the file's path in the workspace as the part's filename) and ``POST
+  /api/v1/application/NAME/start``: harbaum/SofTXT ``txt-4.0.py``, a software TXT 4.0 that serves what
+  ROBO Pro Coding asks of the controller; the start route also in Computer-Vision-Group-Siegen/
+  cvtxtclient ``js-ui/cat_ctrl.js``. SofTXT makes the workspace folder when the files arrive; no
+  source shows a separate "create workspace" call, so none is made.
+- Paths start with ``/`` (``/lib/tablebot_program.py``): SofTXT strips a leading ``/``, written for
+  what ROBO Pro Coding sends (*inferred*).
+- The key in the header ``X-API-KEY``: cvtxtclient (``cvtxtclient/api/controller.py`` ``get_headers``,
+  ``js-ui/cat_ctrl.js``), a client of the real controller's API. SofTXT checks no key.
+- Port 80: cvtxtclient's page talks to ``http://txt40.local/api/v1/`` (no port). SofTXT listens on 8000
+  (give ``txt4://HOST:8000``).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import re
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -19,7 +31,10 @@ import httpx
 from tablebot.diagnostics import fail
 
 DEFAULT_PORT = 80
+KEY_ENV = "TABLEBOT_TXT4_KEY"
 URL_HINT = "write --to txt4://192.168.7.2 (USB), txt4://192.168.8.2 (Wi-Fi) or txt4://HOST:PORT"
+KEY_HINT = (f"give the key the TXT 4.0 shows (the one ROBO Pro Coding asks for) in ${KEY_ENV}, with "
+            "--key-file FILE, at the prompt (run it in a terminal), or with --key KEY")
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
@@ -31,8 +46,31 @@ def base_url(target: str) -> str:
     return f"http://{match[1]}:{match[2] or DEFAULT_PORT}"
 
 
+def api_key(key: str | None, key_file: Path | None, prompt: Callable[[], str] | None) -> str:
+    """The key from ``--key``, ``--key-file``, ``$TABLEBOT_TXT4_KEY`` or ``prompt`` (None: not a terminal),
+    first found first; ``--key`` puts it in the process list and the shell's history, the others do not."""
+    if key is not None and key_file is not None:
+        raise fail("--key", "give the key once: --key or --key-file, not both", KEY_HINT)
+    if key_file is not None:
+        try:
+            key = key_file.read_text(encoding="utf-8").strip()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise fail(key_file, f"cannot read the key file: {getattr(exc, 'strerror', None) or exc}",
+                       "the file holds the key the TXT 4.0 shows, on one line") from None
+        if not key:
+            raise fail(key_file, "the key file is empty", "write the key the TXT 4.0 shows into it")
+    key = key if key is not None else os.environ.get(KEY_ENV) or None
+    if key is None and prompt is not None:
+        key = prompt().strip()
+    if not key:
+        raise fail("--key", "no API key", KEY_HINT)
+    if not key.isprintable() or len(key) > 256:
+        raise fail("--key", "the API key holds control characters or is too long", KEY_HINT)
+    return key
+
+
 def workspace_files(folder: Path) -> tuple[str, dict[str, bytes]]:
-    """The workspace's name (from ``.project.json``) and its files by relative path."""
+    """The workspace's name (from ``.project.json``) and its files by path in the workspace (``/...``)."""
     project = folder / ".project.json"
     try:
         name = json.loads(project.read_text(encoding="utf-8")).get("name")
@@ -41,26 +79,25 @@ def workspace_files(folder: Path) -> tuple[str, dict[str, bytes]]:
     if not isinstance(name, str) or not NAME_RE.match(name):
         raise fail(folder, "this folder is not a program written by `tablebot export --to txt4`",
                    "export one first: tablebot export TABLE OUTDIR --to txt4")
-    files = {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*"))
+    files = {"/" + p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*"))
              if p.is_file() and "__pycache__" not in p.parts}
     return name, files
 
 
 def upload(folder: Path, target: str, key: str, start: bool = True, timeout_s: float = 10.0,
            say: Callable[[str], None] = print) -> str:
-    """Stop whatever runs, create the workspace, send its files, start it; returns the workspace name."""
+    """Stop whatever runs, send the workspace's files, start it; returns the workspace name."""
     url = base_url(target)
     name, files = workspace_files(folder)
     with httpx.Client(base_url=url, headers={"X-API-KEY": key}, timeout=timeout_s) as client:
         _call(client, "GET", "/api/v1/ping", target)
         _call(client, "DELETE", "/api/v1/stop", target)
-        _call(client, "POST", "/api/v1/workspaces", target, params={"workspace_name": name})
         form = [("files", (path, data, "text/plain")) for path, data in files.items()]
         _call(client, "POST", f"/api/v1/workspaces/{name}/files", target, files=form)
         say(f"uploaded {len(files)} files to workspace {name} on {target}")
         if start:
             _call(client, "POST", f"/api/v1/application/{name}/start", target)
-            say(f"started {name}; stop it on the controller, or: DELETE {url}/api/v1/stop")
+            say(f"started {name}; stop it on the controller, or: curl -X DELETE {url}/api/v1/stop")
     return name
 
 
@@ -75,8 +112,17 @@ def _call(client: httpx.Client, method: str, path: str, target: str, **kwargs: o
                    "is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?") from None
     if response.status_code in (401, 403):
         raise fail("--key", f"{target} refused the API key ({response.status_code} on {method} {path})",
-                   "use the key the TXT 4.0 shows in its settings (the one ROBO Pro Coding asks for)")
+                   "the TXT 4.0 shows a new key now and then: read it again from its display")
     if response.status_code >= 400:
         raise fail("--to", f"{target} answered {response.status_code} to {method} {path}",
                    "check that it is a TXT 4.0 with the ROBO Pro Coding interface switched on")
     return response
+
+
+def terminal_prompt() -> Callable[[], str] | None:
+    """A hidden prompt for the key when stdin is a terminal, else None (never wait on a pipe)."""
+    if not sys.stdin.isatty():
+        return None
+    import typer
+
+    return lambda: typer.prompt("API key of the TXT 4.0 (shown on its display)", hide_input=True)

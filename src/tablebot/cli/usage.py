@@ -1,0 +1,133 @@
+"""A wrong option or argument answered as every other tablebot error: ``--from: error: 'nothing' is not
+one of the choices`` with a hint naming them, not in the option parser's words (typer's and pydantic's
+"Value error, ... is not one of", "Input should be a valid number")."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Sequence
+from enum import Enum
+from typing import IO, Any
+
+from typer._click.exceptions import (
+    BadParameter,
+    ClickException,
+    MissingParameter,
+    NoArgsIsHelpError,
+    NoSuchOption,
+    UsageError,
+)
+from typer.core import TyperGroup
+
+from tablebot.diagnostics import Diagnostic
+
+
+class Group(TyperGroup):
+    """tablebot's command group: the commands' usage errors come out in tablebot's words."""
+
+    def invoke(self, ctx: Any) -> Any:
+        given = [*ctx._protected_args, *ctx.args]  # the command line, for the value a user gave
+        try:
+            return super().invoke(ctx)
+        except NoArgsIsHelpError:
+            raise
+        except UsageError as exc:
+            raise OptionError(explain(exc, given)) from None
+
+    def resolve_command(self, ctx: Any, args: list[str]) -> Any:
+        name = args[0] if args else ""
+        if name and not name.startswith("-") and self.get_command(ctx, name) is None:
+            near = difflib.get_close_matches(name, self.list_commands(ctx), n=2)
+            hint = f"did you mean {' or '.join(near)}? " if near else ""
+            raise OptionError(Diagnostic(name, None, None, f"{name!r} is not a tablebot command",
+                                         f"{hint}tablebot -h lists the commands"))
+        return super().resolve_command(ctx, args)
+
+
+class OptionError(ClickException):
+    """A usage error as a tablebot diagnostic (exit code 2, as a bad file)."""
+
+    exit_code = 2
+
+    def __init__(self, diagnostic: Diagnostic):
+        super().__init__(diagnostic.message)
+        self.diagnostic = diagnostic
+
+    def show(self, file: IO[Any] | None = None) -> None:
+        from tablebot.cli.common import print_diagnostic
+
+        print_diagnostic(self.diagnostic)
+
+
+def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
+    """What was wrong with the command line, and what to write instead."""
+    command = f"tablebot {exc.ctx.info_name} -h" if exc.ctx is not None and exc.ctx.info_name else "tablebot -h"
+    if not isinstance(exc, BadParameter | NoSuchOption):  # an extra argument, say
+        return Diagnostic("tablebot", None, None, exc.message.rstrip("."), f"{command} says how to call it")
+    if isinstance(exc, NoSuchOption):
+        near = f"did you mean {' or '.join(sorted(exc.possibilities))}? " if exc.possibilities else ""
+        return Diagnostic(exc.option_name, None, None, f"{exc.option_name} is not an option of this command",
+                          f"{near}{command} lists the options")
+    param = exc.param
+    name = _name(param)
+    choices = _choices(param)
+    if isinstance(exc, MissingParameter):
+        hint = f"give {name} one of: {', '.join(choices)}" if choices else f"{command} says what {name} takes"
+        return Diagnostic(name, None, None, f"{name} is missing", hint)
+    value = _value(given, param)
+    shown = repr(value) if value is not None else "the value given"
+    if choices:
+        return Diagnostic(name, None, None, f"{shown} is not one of the choices of {name}",
+                          f"use one of: {', '.join(choices)}")
+    number = _number_kind(param)
+    if number and value is not None and not _parses(value, number):
+        return Diagnostic(name, None, None, f"{shown} is not a number",
+                          "give a whole number" if number is int else "give a number, such as 2 or 0.5")
+    if number:
+        low, high = getattr(param, "min", None), getattr(param, "max", None)
+        limits = f"from {low} to {high}" if low is not None and high is not None else \
+            f"of at least {low}" if low is not None else f"of at most {high}"
+        return Diagnostic(name, None, None, f"{name} {value} is out of range", f"give {name} a value {limits}")
+    message = exc.message.removeprefix("Value error, ")
+    return Diagnostic(name, None, None, f"{shown}: {message}", f"{command} says what {name} takes")
+
+
+def _name(param: Any) -> str:
+    """An option by its flag (``--from``), an argument by its metavar (``FOLDER``)."""
+    if param is None:
+        return "tablebot"
+    if getattr(param, "param_type_name", "") == "argument":
+        return param.metavar or (param.name or "").upper()
+    return "/".join(param.opts) if param.opts else param.name or "tablebot"
+
+
+def _choices(param: Any) -> list[str]:
+    descriptor = getattr(param, "type_descriptor", None)
+    found = getattr(descriptor, "choices", None) or ()
+    return [str(c.value) if isinstance(c, Enum) else str(c) for c in found]
+
+
+def _number_kind(param: Any) -> type | None:
+    annotation = getattr(getattr(param, "type_descriptor", None), "annotation", None)
+    return annotation if annotation in (int, float) else None
+
+
+def _parses(text: str, kind: type) -> bool:
+    try:
+        kind(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _value(given: Sequence[str], param: Any) -> str | None:
+    """The text the user wrote for ``param`` (its last use), if it was an option given on the line."""
+    found = None
+    opts = tuple(getattr(param, "opts", ()) or ())
+    for k, word in enumerate(given):
+        for opt in opts:
+            if word == opt and k + 1 < len(given):
+                found = given[k + 1]
+            elif word.startswith(opt + "="):
+                found = word[len(opt) + 1:]
+    return found

@@ -1,0 +1,152 @@
+"""Proving candidates: every property of the robot (its file's ``[properties]`` and the property files
+``check`` would read), proved exhaustively by ``tablebot check``'s own search, and no error-level
+finding (a zero-time loop nothing can leave). Verdicts are cached on the compiled machine's canonical
+form, so a candidate that behaves like one already proved (rows reordered where they never overlap,
+a shadowed row added, descriptions changed) is never proved twice; the cache is a JSON Lines file, so
+a resumed run proves nothing again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tablebot.analysis.check import CheckReport, run_check
+from tablebot.analysis.loops import zero_time_loops
+from tablebot.analysis.model import Model
+from tablebot.analysis.properties import Property, load_properties
+from tablebot.analysis.prove import Result, check_property
+from tablebot.diagnostics import fail
+from tablebot.machine import Machine, compile_table
+from tablebot.table import Table
+
+
+def canonical(machine: Machine) -> str:
+    """A digest of what the machine does: per state (by name), for every combination of the events, the
+    effect of the row that fires (outputs, timer, counter loads, next state) or nothing; plus the start.
+    Row order, descriptions and file lines do not enter it; states enter by name (properties name them)."""
+    flat = machine.flat
+    if flat is None:
+        raise ValueError("canonical form needs a table of at most FLAT_BITS event columns")
+    width = 1 << len(machine.table.events)
+    rows = machine.rows
+    def effect(index: int) -> list | None:
+        if index < 0:
+            return None
+        row = rows[index]
+        return [str(machine.states[row.next]), row.timer, list(row.outputs), list(row.loads)]
+    per_state = {str(state): [effect(flat[s * width + e]) for e in range(width)]
+                 for s, state in enumerate(machine.states)}
+    data = {"events": list(machine.table.events), "outputs": list(machine.output_names),
+            "start": [str(machine.states[machine.initial_state]), machine.initial_timer],
+            "states": dict(sorted(per_state.items()))}
+    return hashlib.sha256(json.dumps(data, separators=(",", ":")).encode()).hexdigest()[:24]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Whether a candidate may be kept; ``failed`` names what broke (properties, error findings)."""
+
+    ok: bool
+    failed: tuple[str, ...] = ()
+
+
+@dataclass
+class Prover:
+    """Proves candidates against the properties of ``files`` (plus the robot file's), caching verdicts by
+    canonical form in ``cache_path`` (JSON Lines; None: in memory only)."""
+
+    files: Sequence[Path]
+    cache_path: Path | None = None
+    verdicts: dict[str, Verdict] = field(default_factory=dict)
+    proved: int = 0  # proofs actually run (not served from the cache)
+    hits: int = 0
+    seconds: float = 0.0
+    failures: dict[str, int] = field(default_factory=dict)  # proofs each property failed (ordering only)
+
+    def __post_init__(self) -> None:
+        if self.cache_path is not None and self.cache_path.exists():
+            for line in self.cache_path.read_text(encoding="utf-8").splitlines():
+                if line.strip():
+                    item = json.loads(line)
+                    self.verdicts[item["key"]] = Verdict(item["ok"], tuple(item["failed"]))
+
+    def properties(self, machine: Machine) -> list[Property]:
+        """The properties read against this machine (its states and outputs)."""
+        return load_properties(machine, list(self.files))
+
+    def report(self, machine: Machine) -> CheckReport:
+        """The whole ``check`` of one machine (findings and every property, counterexamples included)."""
+        return run_check(machine, self.properties(machine))
+
+    def results(self, machine: Machine) -> tuple[list[Result], bool]:
+        """Every property's result (counterexamples included) and whether a zero-time loop traps the
+        robot: what a repair weighs, without check's other findings."""
+        results = [check_property(prop, machine) for prop in self.properties(machine)]
+        stuck = any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
+        return results, stuck
+
+    def verdict(self, table: Table) -> tuple[str, Verdict]:
+        """The candidate's canonical key and verdict (proved now, or from the cache)."""
+        import time
+
+        machine = compile_table(table)
+        key = canonical(machine)
+        if key in self.verdicts:
+            self.hits += 1
+            return key, self.counted(self.verdicts[key])
+        started = time.perf_counter()
+        verdict = self.prove(machine)
+        self.seconds += time.perf_counter() - started
+        self.proved += 1
+        self.verdicts[key] = verdict
+        if self.cache_path is not None:
+            with open(self.cache_path, "a", encoding="utf-8") as f:  # one line per proof: a cut run keeps them
+                f.write(json.dumps({"key": key, "ok": verdict.ok, "failed": list(verdict.failed)}) + "\n")
+        return key, self.counted(verdict)
+
+    def counted(self, verdict: Verdict) -> Verdict:
+        """Count a failed verdict for the property that failed, whether proved now or read from the cache:
+        the order properties are tried in then follows the calls alone, so a resumed run (its verdicts read
+        from the folder) names the same first failing property as a run never stopped."""
+        if not verdict.ok:
+            self.failures[verdict.failed[0]] = self.failures.get(verdict.failed[0], 0) + 1
+        return verdict
+
+
+    def prove(self, machine: Machine) -> Verdict:
+        """Every property in turn, the one that failed most often so far first, stopping at the first
+        that fails; then the zero-time loops no input can leave (``check``'s only error-level finding
+        about behaviour). A property "fails" when ``check`` does not prove it (violated or unknown)."""
+        props = sorted(self.properties(machine), key=lambda p: -self.failures.get(p.name, 0))
+        for prop in props:
+            if check_property(prop, machine).status != "holds":
+                return Verdict(False, (prop.name,))
+        stuck = [f for f in zero_time_loops(Model(machine).explore()) if f.severity == "error"]
+        return Verdict(False, ("zero-time-loop",)) if stuck else Verdict(True)
+
+
+def verdict_of(report: CheckReport) -> Verdict:
+    """Kept only when every property holds (whatever its level) and no finding is an error."""
+    failed = [r.prop.name for r in report.results if r.status != "holds"]
+    failed += [f.code for f in report.findings if f.severity == "error"]
+    return Verdict(not failed, tuple(dict.fromkeys(failed)))
+
+
+LINE_WORD = re.compile(r"(?<![\w.-])line(?![\w.-])")  # the condition language's ``line`` (conditions.TOKEN_RE)
+
+
+def refuse_line_conditions(prover: Prover, machine: Machine) -> None:
+    """Properties that name file lines (``line == 14``) lose their meaning once rows are added, removed
+    or moved: refused before the search starts, naming the property."""
+    for prop in prover.properties(machine):
+        texts = [c.text for c in (prop.cond, prop.when, prop.then) if c is not None]
+        if any(LINE_WORD.search(text) for text in texts):
+            where = f"{prop.source}:{prop.line}" if prop.line else prop.source
+            raise fail(where, f"property {prop.name} names a file line; evolve adds, removes and moves rows, so "
+                       "a line number would name another row", "write the property with states, events and "
+                       "outputs instead of line (or give evolve other properties with --properties)")

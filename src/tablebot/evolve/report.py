@@ -1,0 +1,228 @@
+"""What a person gets from a run: the best tables and the archive's elites written as tables (with
+descriptions that say what evolution changed, and the robot's state names), each with its ``check``
+report; the archive's heat map; and ``report.md``: the repair, the search, and the best tables against
+the starting one on fresh seeds, with the ``tablebot sim`` command that runs each.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tablebot.analysis.check import CheckReport
+from tablebot.analysis.diagram import action, condition
+from tablebot.escape import shell_word
+from tablebot.evolve.measures import MEASURES, STATE_SHARE, Measure, fitness
+from tablebot.evolve.proofs import Prover
+from tablebot.evolve.space import Candidate, Gene, renumbered, to_table
+from tablebot.files import write_text
+from tablebot.formats.table_write import format_table
+from tablebot.machine import compile_table
+from tablebot.table import Row, Table
+
+
+@dataclass(frozen=True)
+class Written:
+    """A table written by the run: what it is, where, and whether every property holds in it."""
+
+    label: str
+    key: str
+    path: Path
+    check: Path
+    holds: bool
+
+
+# --- tables ------------------------------------------------------------------------------------------
+
+
+def describe(gene: Gene, base: Table) -> str:
+    """A row's description: the starting row's own words, with what evolution changed said after them;
+    an added row says what it needs and does."""
+    table = base
+    original = next((row for row in base.rows if row.line == gene.origin), None)
+    if original is None:
+        if gene.description and gene.note.startswith("guard"):
+            return gene.description
+        what = action(table, _row(gene))
+        timer = f", {what.timer}" if what.timer else ""
+        goes = f" -> {table.state_title(gene.next)}"
+        return f"{condition(table, [gene.events])}: {what.text}{timer}{goes} (added: {gene.note or 'new row'})"
+    changes = []
+    for name, old, new in zip(table.robot.motors, original.motors, gene.motors, strict=True):
+        if old != new:
+            changes.append(f"{name} {_speed(old)}->{_speed(new)}")
+    if original.timer != gene.timer:
+        changes.append(f"timer {original.timer}->{gene.timer}")
+    if original.next != gene.next:
+        changes.append(f"next {original.next}->{gene.next}")
+    if original.state != gene.state:
+        changes.append(f"moved from state {original.state}")
+    text = original.description or f"line {original.line}"
+    return f"{text} (evolved: {', '.join(changes)})" if changes else original.description
+
+
+def _speed(value: int | None) -> str:
+    return "keep" if value is None else f"{value:+d}"
+
+
+def _row(gene: Gene) -> Row:
+    return Row(0, 0, gene.description, gene.state, gene.events, gene.motors, gene.timer, gene.next, gene.counters,
+               gene.lamps)
+
+
+def pruned(candidate: Candidate, base: Table) -> Candidate:
+    """Without the rows that can fire in no situation at all (an earlier row of their state always wins):
+    the same machine (the same canonical form), a shorter table to read."""
+    machine = compile_table(to_table(candidate, base))
+    fires = set(machine.flat or range(len(candidate)))
+    return tuple(gene for index, gene in enumerate(candidate) if index in fires)
+
+
+def as_table(candidate: Candidate, base: Table, path: Path) -> Table:
+    """The candidate as the table that will be written to ``path`` (rows on their new lines; rows that
+    can never fire left out)."""
+    candidate = pruned(candidate, base)
+    described = tuple(Gene(g.state, g.events, g.motors, g.timer, g.next, describe(g, base), g.counters, g.lamps,
+                           g.origin, g.note) for g in candidate)
+    return renumbered(to_table(described, base, str(path)))
+
+
+def write_table(candidate: Candidate, base: Table, path: Path, prover: Prover, label: str, key: str) -> Written:
+    """The table (``formats.table_write``, the document's layout) and its check report beside it."""
+    table = as_table(candidate, base, path)
+    write_text(path, format_table(table))
+    report = prover.report(compile_table(table))
+    check = path.with_suffix(".check.txt")
+    write_text(check, check_text(report, prover))
+    return Written(label, key, path, check, all(r.status == "holds" for r in report.results))
+
+
+def check_text(report: CheckReport, prover: Prover) -> str:
+    """``tablebot check``'s report in plain text: every property and every finding, by file line."""
+    table, machine = report.machine.table, report.machine
+    sources = ", ".join(str(f) for f in prover.files) or "none"
+    lines = [f"{Path(table.path).name}: {len(table.rows)} rows, {len(machine.states)} states, "
+             f"{report.situations} situations explored", "", f"properties (the robot file's and {sources}):"]
+    marks = {"holds": "holds   ", "violated": "VIOLATED", "unknown": "UNKNOWN "}
+    for result in report.results:
+        lines.append(f"  {marks[result.status]} {result.prop.name}: {result.prop.text}")
+        lines.append(f"           {result.prop.claim()}")
+    lines += ["", "findings:"]
+    lines += [f"  {Path(table.path).name}:{','.join(map(str, f.lines)) or '-'}: {f.severity}: {f.message}"
+              for f in report.findings] or ["  none"]
+    counts = report.counts()
+    lines += ["", f"{counts['error']} errors, {counts['warning']} warnings, {counts['info']} notes"]
+    return "\n".join(lines) + "\n"
+
+
+def sim_command(path: Path, base: Table, world: str, seed: int | None = None) -> str:
+    """``tablebot sim`` of a written table with the robot file and world it was evolved with (beside it in
+    OUT there are neither, and on its own it would be read as the built-in BumberBot)."""
+    words = ["tablebot", "sim", str(path)]
+    for option, given in (("--robot", base.robot.source), ("--world", world)):
+        if given and Path(given).is_file():
+            words += [option, str(given)]
+    if seed is not None:
+        words += ["--seed", str(seed)]
+    return " ".join(shell_word(word) for word in words)
+
+
+# --- the archive's picture ------------------------------------------------------------------------------
+
+
+def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
+             start: tuple[float, ...] | None, path: Path) -> Path:
+    from tablebot.sim.draw import literal_text
+
+    with literal_text():
+        return _heat_map(archive, descriptors, objective, history, start, path)
+
+
+def _heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
+              start: tuple[float, ...] | None, path: Path) -> Path:
+    """Left: each cell's elite coloured by its objective (the start marked); right: the best objective
+    and the cells filled as the evaluations went on."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from tablebot.sim.plots import save
+
+    data = archive.data(["objective", "index"])  # type: ignore[attr-defined]
+    cells = archive.int_to_grid_index(data["index"]) if len(data["index"]) else np.zeros((0, len(descriptors)))  # type: ignore[attr-defined]
+    values = np.array([fitness(objective, v) for v in data["objective"]])
+    fig = Figure(figsize=(12, 4.8), dpi=110)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 2, 1)
+    cmap = "viridis_r" if objective.better == "low" else "viridis"
+    first = descriptors[0]
+    if len(descriptors) == 2:
+        second = descriptors[1]
+        grid = np.full((second.cells, first.cells), np.nan)
+        for (i, j), v in zip(cells, values, strict=True):
+            grid[j, i] = v
+        image = ax.imshow(grid, origin="lower", cmap=cmap, aspect="auto",
+                          extent=(first.low, first.high, second.low, second.high))
+        fig.colorbar(image, ax=ax, label=f"{objective.name} ({objective.better} is better)")
+        ax.set_ylabel(f"{second.name}")
+        if start is not None:
+            ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
+                    color="#e8413a", markersize=12, mew=2.5, label="the starting table")
+            ax.legend(fontsize=8, loc="upper right")
+    else:
+        width = (first.high - first.low) / first.cells
+        lefts = [first.low + c[0] * width for c in cells]
+        ax.bar(lefts, values, width=width * 0.9, align="edge", color="#20bf6b")
+        ax.set_ylabel(objective.name)
+        if start is not None:
+            ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--",
+                       label="the starting table")
+            ax.legend(fontsize=8)
+    ax.set_xlabel(first.name)
+    ax.set_title(f"archive: {len(values)} elites in {int(np.prod([d.cells for d in descriptors]))} cells",
+                 fontsize=11)
+    side = fig.add_subplot(1, 2, 2)
+    xs = [h["evaluated"] for h in history]
+    side.plot(xs, [h["best"] for h in history], color="#20bf6b", linewidth=2, drawstyle="steps-post",
+              label=f"best {objective.name}")
+    side.set_xlabel("tables evaluated on the fleet")
+    side.set_ylabel(f"best {objective.name}")
+    twin = side.twinx()
+    twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
+              label="cells filled")
+    twin.set_ylabel("cells filled (%)")
+    side.legend(loc="upper left", fontsize=8)
+    twin.legend(loc="lower right", fontsize=8)
+    side.set_title("search", fontsize=11)
+    fig.tight_layout()
+    return save(fig, path)
+
+
+# --- report.md --------------------------------------------------------------------------------------------
+
+
+def measure_rows(names: Sequence[str], columns: Sequence[tuple[str, dict[str, float]]],
+                 objective: Measure) -> list[str]:
+    """A markdown table: one row per measure, one column per table compared."""
+    lines = ["| mean over the fresh scenarios | " + " | ".join(label for label, _ in columns) + " |",
+             "|---" * (len(columns) + 1) + "|"]
+    for name in names:
+        text = MEASURES[name].text if name in MEASURES else f"share of the time in state {name[len(STATE_SHARE):]}"
+        mark = f" (objective, {objective.better} is better)" if name == objective.name else ""
+        lines.append(f"| {name}{mark}: {text} | " + " | ".join(f"{means[name]:.3f}" for _, means in columns) + " |")
+    return lines
+
+
+def paired(objective: Measure, before: np.ndarray, after: np.ndarray) -> str:
+    """The change in the objective, scenario by scenario (common random numbers), with two standard errors."""
+    diff = np.asarray(after, dtype=float) - np.asarray(before, dtype=float)
+    n = len(diff)
+    se = float(np.std(diff, ddof=1) / math.sqrt(n)) if n > 1 else float("nan")
+    mean = float(np.mean(diff))
+    better = mean < 0 if objective.better == "low" else mean > 0
+    clear = abs(mean) > 2 * se if n > 1 else False
+    verdict = ("better" if better else "worse") if clear else "no clear difference"
+    return f"{mean:+.3f} ± {2 * se:.3f} (two standard errors over {n} paired scenarios): {verdict}"

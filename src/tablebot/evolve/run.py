@@ -1,0 +1,267 @@
+"""The evolve loop: prove (and if need be repair) the starting table, seed the archive with it, then
+generation after generation ask the emitter for proved children, run them on the fleet, and offer them
+to the archive, until the budget of fleet evaluations is spent.
+
+Resuming: the whole run is a function of its inputs and seed; only proofs and fleet evaluations cost
+time, and both are written to the output folder as they finish (``proofs.jsonl``,
+``evaluations.jsonl``). The same command run again replays the loop from the start with those answers
+(no proof and no robot run again) and goes on where it stopped, with the same children it would have
+asked for had it never stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections import Counter
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tablebot.diagnostics import fail
+from tablebot.evolve import archive as qd
+from tablebot.evolve.evaluate import Evaluator, Means
+from tablebot.evolve.measures import Descriptor, Measure, default_range, fitness
+from tablebot.evolve.operators import Space, vary
+from tablebot.evolve.proofs import Prover, Verdict
+from tablebot.evolve.repair import PREFERENCES, Repaired, Step, repair
+from tablebot.evolve.space import Candidate, Gene, start, to_table
+from tablebot.files import write_text
+from tablebot.table import Table
+
+TRIES_PER_CHILD = 30  # variations tried per child asked for before a generation gives up on it
+STALLED = 5  # generations in a row without a single new proved child end the search
+
+
+@dataclass(frozen=True)
+class Settings:
+    objective: Measure
+    descriptors: tuple[Descriptor, ...]
+    budget: int  # fleet evaluations, the start's included
+    batch: int  # children asked for per generation
+    seed: int
+
+
+@dataclass
+class Counts:
+    """What the search did: children varied, discarded by a failed proof (per property), duplicates of
+    tables already seen, evaluations run and served from the folder (a resumed run), generations."""
+
+    varied: int = 0
+    discarded: Counter = field(default_factory=Counter)
+    duplicates: int = 0
+    evaluated: int = 0
+    resumed: int = 0
+    generations: int = 0
+    repair_s: float = 0.0  # seconds spent repairing the start
+    fleet_s: float = 0.0  # seconds waiting for the fleet
+
+
+@dataclass
+class Outcome:
+    start_key: str
+    start_verdict: Verdict
+    repairs: list[Repaired]  # one per repair preference, when the start broke a property
+    seeds: list[str]  # what the archive started from: the start, or its repairs
+    archive: Any
+    candidates: dict[str, Candidate]
+    means: dict[str, Means]
+    order: list[str]  # keys in the order they were evaluated
+    counts: Counts
+    history: list[dict[str, float]]
+    seconds: float = 0.0
+
+
+class Store:
+    """The output folder's record of the run: ``spec.json`` (what is searched: another spec in the same
+    folder is refused) and ``evaluations.jsonl`` (one line per evaluated candidate, as it finishes)."""
+
+    def __init__(self, folder: Path, spec: dict[str, Any]):
+        self.folder, self.spec = folder, json.dumps(spec, indent=1, sort_keys=True) + "\n"
+        self.path = folder / "evaluations.jsonl"
+        self.proofs = folder / "proofs.jsonl"
+
+    def open(self) -> dict[str, Means]:
+        spec_file = self.folder / "spec.json"
+        if spec_file.exists() and spec_file.read_text(encoding="utf-8") != self.spec:
+            raise fail(self.folder, "--out holds another evolve run (another table, robot file, world, properties, "
+                       "scenarios, objective, descriptors, limits or seed)",
+                       "give --out a new folder, or delete this one to start over")
+        if not spec_file.exists():
+            write_text(spec_file, self.spec)
+        found: dict[str, Means] = {}
+        if self.path.exists():
+            for line in self.path.read_text(encoding="utf-8").splitlines():
+                try:
+                    item = json.loads(line)
+                except json.JSONDecodeError:
+                    continue  # a line cut by a kill: that candidate runs again
+                found[item["key"]] = item["means"]
+        return found
+
+    def repairs(self) -> list[Repaired] | None:
+        """The repairs an earlier run of this folder found (``repairs.json``), or None."""
+        path = self.folder / "repairs.json"
+        if not path.exists():
+            return None
+        return [repaired_from_json(item) for item in json.loads(path.read_text(encoding="utf-8"))]
+
+    def keep_repairs(self, repairs: Sequence[Repaired]) -> None:
+        write_text(self.folder / "repairs.json", json.dumps([repaired_to_json(r) for r in repairs], indent=1) + "\n")
+
+    def record(self, key: str, means: Means) -> None:
+        with open(self.path, "a", encoding="utf-8") as f:
+            f.write(json.dumps({"key": key, "means": means}, sort_keys=True) + "\n")
+
+
+def gene_to_json(gene: Gene) -> dict[str, Any]:
+    return {"state": gene.state, "events": sorted(gene.events), "motors": list(gene.motors), "timer": gene.timer,
+            "next": gene.next, "description": gene.description, "counters": list(gene.counters),
+            "lamps": list(gene.lamps), "origin": gene.origin, "note": gene.note}
+
+
+def gene_from_json(item: dict[str, Any]) -> Gene:
+    return Gene(item["state"], frozenset(item["events"]), tuple(item["motors"]), item["timer"], item["next"],
+                item["description"], tuple(item["counters"]), tuple(item["lamps"]), item["origin"], item["note"])
+
+
+def repaired_to_json(r: Repaired) -> dict[str, Any]:
+    return {"candidate": [gene_to_json(g) for g in r.candidate], "failing": list(r.failing),
+            "proposals": r.proposals, "steps": [{"prop": s.prop, "state": s.state, "gene": gene_to_json(s.gene),
+                                                 "ticks": s.counterexample_ticks} for s in r.steps]}
+
+
+def repaired_from_json(item: dict[str, Any]) -> Repaired:
+    steps = [Step(s["prop"], s["state"], gene_from_json(s["gene"]), s["ticks"]) for s in item["steps"]]
+    return Repaired(tuple(gene_from_json(g) for g in item["candidate"]), steps, tuple(item["failing"]),
+                    item["proposals"])
+
+
+@dataclass
+class Evolution:
+    """One run: the starting table, what may change, the settings, and where proofs and runs happen."""
+
+    base: Table
+    space: Space
+    settings: Settings
+    prover: Prover
+    evaluator: Evaluator
+    store: Store
+    on_eval: Callable[[int], None] = lambda n: None
+    on_repair: Callable[[list[Repaired]], None] = lambda r: None
+
+    def __post_init__(self) -> None:
+        plan = self.evaluator.plan
+        self.seconds = plan.spec.ticks * plan.scenes[0].tick_s
+        self.known = self.store.open()
+        self.candidates: dict[str, Candidate] = {}
+        self.means: dict[str, Means] = {}
+        self.order: list[str] = []
+        self.counts = Counts()
+
+    # --- the loop ------------------------------------------------------------------------------------
+
+    def run(self) -> Outcome:
+        started = time.perf_counter()
+        first = start(self.base)
+        start_key, verdict = self.prover.verdict(to_table(first, self.base))
+        self.candidates[start_key] = first
+        repairs: list[Repaired] = []
+        seeds = [start_key]
+        if not verdict.ok:
+            began = time.perf_counter()
+            repairs = self.store.repairs()
+            if repairs is None:
+                repairs = [repair(first, self.base, self.prover, self.space, prefer) for prefer in PREFERENCES]
+                self.store.keep_repairs(repairs)
+            self.counts.repair_s = time.perf_counter() - began
+            self.on_repair(repairs)
+            mended = [r for r in repairs if r.ok]
+            if not mended:
+                failing = sorted({name for r in repairs for name in r.failing})
+                raise fail(self.base.path, f"the table breaks {', '.join(verdict.failed)}, and evolve found no guard "
+                           f"rows that mend it ({', '.join(failing)} still fail)", "mend the table by hand "
+                           "(tablebot check shows the counterexample), or give evolve the properties it must keep "
+                           "with --properties")
+            seeds = []
+            for r in mended:
+                key, _ = self.prover.verdict(to_table(r.candidate, self.base))
+                self.candidates.setdefault(key, r.candidate)
+                seeds.append(key)
+        seeds = list(dict.fromkeys(seeds))
+        self.evaluate(list(dict.fromkeys([start_key, *seeds])))
+        objective = self.settings.objective
+        worst = 0.0 if objective.better == "high" else -default_range(objective.name, self.seconds)[1]
+        archive = qd.make_archive(self.settings.descriptors, worst, self.settings.seed)
+        self.offer(archive, seeds)
+        emitter = qd.TableEmitter(archive, self.breed, self.settings.batch, self.settings.seed)
+        history = [self.snapshot(archive)]
+        stalled = 0
+        while len(self.order) < self.settings.budget and stalled < STALLED:
+            keys = [str(k) for k in emitter.ask()][: self.settings.budget - len(self.order)]
+            self.counts.generations += 1
+            stalled = 0 if keys else stalled + 1
+            if keys:
+                self.evaluate(keys)
+                self.offer(archive, keys)
+                history.append(self.snapshot(archive))
+        return Outcome(start_key, verdict, repairs, seeds, archive, self.candidates, self.means, self.order,
+                       self.counts, history, time.perf_counter() - started)
+
+    def breed(self, parents: Sequence[str], rng: Any, count: int) -> list[str]:
+        """Up to ``count`` children of the parents that are proved and behave unlike any table seen."""
+        out: list[str] = []
+        for _ in range(count * TRIES_PER_CHILD):
+            if len(out) == count:
+                break
+            parent = self.candidates[parents[int(rng.integers(len(parents)))]]
+            other = self.candidates[parents[int(rng.integers(len(parents)))]]
+            child = vary(parent, self.space, rng, other if other is not parent else None)
+            if child is None:
+                continue
+            self.counts.varied += 1
+            key, verdict = self.prover.verdict(to_table(child, self.base))
+            if not verdict.ok:
+                self.counts.discarded[verdict.failed[0]] += 1
+            elif key in self.candidates:
+                self.counts.duplicates += 1
+            else:
+                self.candidates[key] = child
+                out.append(key)
+        return out
+
+    def evaluate(self, keys: Sequence[str]) -> None:
+        """Means of every measure for each key: from the folder when an earlier run evaluated it, else on
+        the fleet (each written to the folder as it finishes)."""
+        new = []
+        for key in keys:
+            if key in self.known:
+                self.means[key] = self.known[key]
+                self.counts.resumed += 1
+                self.on_eval(1)
+            else:
+                new.append(key)
+
+        def done(key: str, means: Means, _values: Any) -> None:
+            self.store.record(key, means)
+            self.means[key] = means
+            self.counts.evaluated += 1
+            self.on_eval(1)
+
+        if new:
+            began = time.perf_counter()
+            self.evaluator.run([(key, to_table(self.candidates[key], self.base)) for key in new], done)
+            self.counts.fleet_s += time.perf_counter() - began
+        self.order += list(keys)
+
+    def offer(self, archive: Any, keys: Sequence[str]) -> None:
+        objective = [fitness(self.settings.objective, self.means[k][self.settings.objective.name]) for k in keys]
+        measures = [[self.means[k][d.name] for d in self.settings.descriptors] for k in keys]
+        qd.add(archive, keys, objective, measures)
+
+    def snapshot(self, archive: Any) -> dict[str, float]:
+        stats = archive.stats
+        best = fitness(self.settings.objective, float(stats.obj_max)) if stats.num_elites else float("nan")
+        return {"evaluated": len(self.order), "best": best, "elites": int(stats.num_elites),
+                "coverage": float(stats.coverage), "qd_score": float(stats.qd_score)}

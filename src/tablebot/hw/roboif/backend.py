@@ -1,0 +1,60 @@
+"""``run --on roboif://DEVICE`` and ``roboif://auto``: the ROBO Interface driven live over its serial online
+protocol, registered as a live back-end; the robot file's ``[roboif]`` wiring is read here."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from tablebot.diagnostics import Diagnostic, fail
+from tablebot.hw.serial_address import parse_serial_address
+from tablebot.registry import Backend, Opened, Options, refused, register
+from tablebot.robot import Robot
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+ADDRESSES = ("roboif://auto", "roboif:///dev/ttyUSB0 (its serial port)", "roboif://COM1")
+ADDRESS_HINT = "write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)"
+CONNECT_HINT = ("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
+                "serial port only, not on its USB port (docs/controllers.md)")
+
+
+def read_section(src: Source, data: Any, robot: Robot) -> Any:
+    from tablebot.hw.roboif.wiring import read_robot_roboif
+
+    return read_robot_roboif(src, data, robot)
+
+
+def fit(machine: Machine) -> list[Diagnostic]:
+    """What the ROBO Interface cannot hold (its ``[roboif]`` wiring checked against the table)."""
+    from tablebot.hw.roboif.wiring import roboif_wiring
+
+    return refused(lambda: roboif_wiring(machine))
+
+
+def open_roboif(machine: Machine, address: str, options: Options) -> Opened:
+    """The wiring checked (nothing is opened if the table does not fit), the port found, and the interface
+    greeted: it must answer as a ROBO Interface."""
+    from tablebot.hw.roboif.controller import RoboifRobot
+    from tablebot.hw.roboif.link import find
+    from tablebot.hw.roboif.wiring import roboif_wiring
+    from tablebot.loop import LinkLost
+
+    device = parse_serial_address(address, "roboif", options.get("hint", ADDRESS_HINT))
+    wiring = roboif_wiring(machine)
+    if device is None:
+        device = find()
+        if device is None:
+            raise fail("--on", "roboif://auto found no serial port that answers as a ROBO Interface", CONNECT_HINT)
+    bot = RoboifRobot(wiring, device, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
+    try:
+        bot.connect()
+    except LinkLost as exc:
+        raise fail("--on", str(exc), CONNECT_HINT) from None
+    return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)")
+
+
+ROBOIF = register(Backend("roboif", "live", "a ROBO Interface driven live over its serial port by `tablebot run`",
+                          help="roboif://DEVICE (a ROBO Interface on its serial port), roboif://auto", fit=fit,
+                          section="roboif", read_section=read_section, open=open_roboif, addresses=ADDRESSES))

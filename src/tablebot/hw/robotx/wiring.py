@@ -1,0 +1,78 @@
+"""The robot file's ``[robotx]`` section: the table's inputs, motors, lamps and counters on a ROBO TX
+Controller's terminals (read by :mod:`tablebot.hw.wiring`), and what that wiring means on the wire:
+the TA_CONFIG to send, the duty of O1..O8 for the engine's outputs, the table's bits for a TA_INPUT."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from tablebot.hw import wiring
+from tablebot.hw.robotx import protocol as wire
+from tablebot.table import MAX_LAMP, MAX_SPEED
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+    from tablebot.robot import Robot
+
+INPUTS = tuple(f"I{i + 1}" for i in range(wire.N_INPUTS))
+#: ROBO_TX_FW.h: MODE_U 10 V (mV up to U_MAX 9999), MODE_R 5 kOhm (R_MAX 4999), ultrasonic (cm, up to 1023).
+TERMINALS = wiring.Terminals(
+    section="robotx", controller="ROBO TX Controller", digital_inputs=INPUTS,
+    analog={"resistance": wiring.Analog("ohm", 4999, INPUTS), "voltage": wiring.Analog("mV", 9999, INPUTS),
+            "ultrasonic": wiring.Analog("cm", 1023, INPUTS)},
+    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
+    counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)), min_tick_ms=10,
+    tick_reason="ftMscLib exchanges the transfer area every 10 ms", distance_mode="ultrasonic")
+MODES = {"switch": (wire.InputMode.RESISTANCE, True), "phototransistor": (wire.InputMode.RESISTANCE, True),
+         "resistance": (wire.InputMode.RESISTANCE, False), "voltage": (wire.InputMode.VOLTAGE, False),
+         "ultrasonic": (wire.InputMode.ULTRASONIC, False)}
+DUTY_STEP = wire.MAX_DUTY // MAX_SPEED  # speed or lamp level 8 = duty 512
+
+
+def read_robot_robotx(src: Source, section: Any, robot: Robot) -> wiring.Section:
+    """``[robotx]`` (a robot-file section reader)."""
+    return wiring.read_section(TERMINALS, src, section, robot)
+
+
+def robotx_wiring(machine: Machine) -> RobotxWiring:
+    """The table's wiring on a ROBO TX, checked (every problem at once, with its robot-file line)."""
+    return RobotxWiring(wiring.wiring_for(TERMINALS, machine))
+
+
+class RobotxWiring:
+    """A checked wiring and what it means in fish.X1 payloads."""
+
+    def __init__(self, wired: wiring.Wiring):
+        self.wired = wired
+        self.counters = tuple(TERMINALS.counters.index(c) for c in wired.counters)
+
+    def config(self) -> wire.Config:
+        """TA_CONFIG: pairs with a lamp are single outputs, every other pair a motor; unused inputs stay
+        digital 5 kOhm (as fttxpy configures them); counters in mode 1."""
+        lamp_pairs = {(int(o.terminal[1:]) - 1) // 2 for o in self.wired.outputs if o.kind == "lamp"}
+        inputs = [(wire.InputMode.RESISTANCE, True)] * wire.N_INPUTS
+        for inp in self.wired.inputs:
+            inputs[INPUTS.index(inp.terminal)] = MODES[inp.mode]
+        return wire.Config(motors=tuple(i not in lamp_pairs for i in range(wire.N_MOTORS)), inputs=tuple(inputs))
+
+    def duty(self, outputs: Sequence[int]) -> list[int]:
+        """O1..O8 duty for the engine's outputs: motor Mn forward on O(2n-1), backward on O(2n)."""
+        duty = [0] * wire.N_OUTPUTS
+        for terminal, level in self.wired.levels(outputs).items():
+            index = int(terminal[1:]) - 1
+            if terminal[0] == "O":
+                duty[index] = max(0, min(MAX_LAMP, level)) * DUTY_STEP
+            elif level:
+                duty[2 * index + (level < 0)] = min(MAX_SPEED, abs(level)) * DUTY_STEP
+        return duty
+
+    def values(self, inputs: wire.Inputs) -> dict[str, int]:
+        return dict(zip(INPUTS, inputs.universal, strict=True))
+
+    def mask(self, inputs: wire.Inputs, previous: int = 0) -> int:
+        return self.wired.mask(self.values(inputs), previous)
+
+    def raw(self, inputs: wire.Inputs) -> dict[str, int]:
+        return self.wired.raw(self.values(inputs))

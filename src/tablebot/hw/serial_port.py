@@ -1,0 +1,166 @@
+"""A serial device for a controller's online protocol: opened raw and exclusive with pyserial, then read and
+written byte-exact against deadlines, so that silence, a short reply or a pulled cable becomes
+:class:`tablebot.loop.LinkLost` with a sentence saying what happened (never a hang, never a traceback).
+
+Bytes go through the port's own file descriptor (pyserial leaves it non-blocking): a request that Ctrl-C
+cuts short keeps its unsent rest here (:attr:`SerialPort.unsent`), so the link can finish it before
+anything else and the device never sees half a request followed by another.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import time
+from dataclasses import dataclass
+
+import serial
+from serial.tools import list_ports
+
+from tablebot.loop import LinkLost
+
+#: How long a read waits at most when a caller passes no deadline (seconds).
+DEFAULT_WAIT_S = 1.0
+
+
+@dataclass(frozen=True)
+class PortInfo:
+    """One serial port as the system lists it (USB ids are None for a port that is not on USB)."""
+
+    device: str
+    vid: int | None = None
+    pid: int | None = None
+    product: str = ""
+    description: str = ""
+
+    @property
+    def usb_id(self) -> str:
+        return "" if self.vid is None or self.pid is None else f"{self.vid:04x}:{self.pid:04x}"
+
+
+def serial_ports() -> list[PortInfo]:
+    """Every serial port the system lists (pyserial's ``list_ports``), sorted by device name."""
+    ports = [PortInfo(p.device, p.vid, p.pid, p.product or "", p.description or "") for p in list_ports.comports()]
+    return sorted(ports, key=lambda p: p.device)
+
+
+class SerialPort:
+    """``device`` opened at ``baudrate`` 8N1, no flow control, exclusive (a second program cannot interleave)."""
+
+    def __init__(self, device: str, baudrate: int):
+        self.device, self.baudrate = device, baudrate
+        self.port: serial.Serial | None = None
+        self.unsent = b""  # the rest of a write that a signal cut short
+
+    @property
+    def is_open(self) -> bool:
+        return self.port is not None
+
+    def open(self) -> None:
+        try:
+            self.port = serial.Serial(self.device, self.baudrate, timeout=0, write_timeout=0, exclusive=True)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise LinkLost(f"cannot open {self.device}: {_reason(exc)}") from None
+        self.port.reset_input_buffer()
+
+    def close(self) -> None:
+        """Close the port (never raises)."""
+        port, self.port, self.unsent = self.port, None, b""
+        if port is not None:
+            with contextlib.suppress(Exception):
+                port.close()
+
+    # --- bytes ------------------------------------------------------------------------------------
+
+    def write(self, data: bytes, deadline: float) -> None:
+        """Send ``data`` whole (after the rest of an earlier cut-short write), or raise LinkLost."""
+        self.unsent += data
+        fd = self._fd()
+        while self.unsent:
+            self._wait(fd, deadline, writing=True, what="the device to take our request")
+            try:
+                sent = os.write(fd, self.unsent)
+            except BlockingIOError:
+                continue
+            except OSError as exc:
+                raise self._lost(exc) from None
+            self.unsent = self.unsent[sent:]
+
+    def read(self, size: int, deadline: float, what: str) -> bytes:
+        """Exactly ``size`` bytes by ``deadline``, or LinkLost naming ``what`` was awaited."""
+        data = bytearray()
+        while len(data) < size:
+            try:
+                data += self.read_some(size - len(data), deadline, what)
+            except LinkLost as exc:
+                if data and "no answer" in str(exc):
+                    raise LinkLost(f"{exc} (only {len(data)} of {size} bytes came)") from None
+                raise
+        return bytes(data)
+
+    def read_some(self, most: int, deadline: float, what: str) -> bytes:
+        """1..``most`` bytes as soon as any arrive, by ``deadline``."""
+        fd = self._fd()
+        while True:
+            self._wait(fd, deadline, writing=False, what=what)
+            try:
+                chunk = os.read(fd, most)
+            except BlockingIOError:
+                continue
+            except OSError as exc:
+                raise self._lost(exc) from None
+            if not chunk:  # readable but nothing: the other end hung up
+                raise LinkLost(f"{self.device} was disconnected (waiting for {what})")
+            return chunk
+
+    def pending(self) -> bytes:
+        """Whatever has already arrived, without waiting (b"" if nothing; LinkLost if the device is gone)."""
+        fd = self._fd()
+        if not select.select([fd], [], [], 0)[0]:
+            return b""
+        try:
+            chunk = os.read(fd, 4096)
+        except BlockingIOError:
+            return b""
+        except OSError as exc:
+            raise self._lost(exc) from None
+        if not chunk:
+            raise LinkLost(f"{self.device} was disconnected")
+        return chunk
+
+    def drain(self, quiet_s: float, deadline: float) -> int:
+        """Read and drop bytes until none came for ``quiet_s`` (or ``deadline``); how many were dropped."""
+        dropped = 0
+        while time.monotonic() < deadline:
+            try:
+                dropped += len(self.read_some(4096, min(deadline, time.monotonic() + quiet_s), "quiet"))
+            except LinkLost:
+                break
+        return dropped
+
+    # --- helpers ----------------------------------------------------------------------------------
+
+    def _fd(self) -> int:
+        if self.port is None:
+            raise LinkLost(f"{self.device} is not open")
+        return self.port.fd
+
+    def _wait(self, fd: int, deadline: float, *, writing: bool, what: str) -> None:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
+        try:
+            ready = select.select([], [fd], [], left) if writing else select.select([fd], [], [], left)
+        except (OSError, ValueError) as exc:  # the descriptor was closed under us
+            raise LinkLost(f"{self.device} was closed ({exc})") from None
+        if not any(ready):
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
+
+    def _lost(self, exc: OSError) -> LinkLost:
+        return LinkLost(f"lost {self.device}: {exc.strerror or exc} (was it unplugged?)")
+
+
+def _reason(exc: BaseException) -> str:
+    text = str(exc)
+    return text.split(": ", 1)[-1] if "could not open port" in text else text

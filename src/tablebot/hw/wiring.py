@@ -1,0 +1,383 @@
+"""A controller's wiring section of the robot file (``[robotx]``, ``[roboif]``): which terminal each input,
+motor, lamp and counter of the table is wired to, how each input measures and what the table reads.
+One reader for every serial controller, driven by what the controller offers (:class:`Terminals`)::
+
+    [robotx]
+    I3 = { terminal = "I3", mode = "switch", pressed = 1 }       # the table reads 1 while pressed
+    I7 = { terminal = "I7", mode = "phototransistor", lit = 1 }  # ... 1 while it sees light
+    US = { terminal = "I1", mode = "ultrasonic", below = 20 }    # ... 1 closer than 20 cm
+    M1 = "M1"                                                    # or { terminal = "M1", reverse = true }
+    L1 = "O5"
+    C1 = "C1"
+
+A table that needs something the controller cannot give is refused before anything moves (before the
+controller is even opened), every problem at once, each with its robot-file line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from tablebot.tomlfile import Source
+
+if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
+    from tablebot.machine import Machine
+    from tablebot.robot import Robot
+    from tablebot.sensors import Sensor
+
+#: Digital modes: mode -> (the polarity key, what it means)
+DIGITAL = {"switch": ("pressed", "while the push-button is pressed"),
+           "phototransistor": ("lit", "while the phototransistor sees light")}
+
+
+@dataclass(frozen=True)
+class Analog:
+    """An analog mode: its unit, the largest value, and the terminals that can measure it."""
+
+    unit: str
+    most: int
+    terminals: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Terminals:
+    """What a controller offers its wiring section."""
+
+    section: str  # the robot file's section: "robotx"
+    controller: str  # how messages name it: "ROBO TX Controller"
+    digital_inputs: tuple[str, ...]  # terminals a switch or phototransistor can be wired to
+    analog: dict[str, Analog]  # mode -> what it measures and where
+    motors: tuple[str, ...]
+    lamps: tuple[str, ...]
+    counters: tuple[str, ...]
+    min_tick_ms: int
+    tick_reason: str  # why a shorter tick cannot be kept
+    distance_mode: str | None = None  # the analog mode that reads a [sensors] distance declaration (in cm)
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        extra = [t for a in self.analog.values() for t in a.terminals if t not in self.digital_inputs]
+        return (*self.digital_inputs, *dict.fromkeys(extra))
+
+    @property
+    def modes(self) -> tuple[str, ...]:
+        return (*DIGITAL, *self.analog)
+
+    def names(self, kind: str) -> tuple[str, ...]:
+        return {"input": self.inputs, "motor": self.motors, "lamp": self.lamps, "counter": self.counters}[kind]
+
+
+@dataclass(frozen=True)
+class InputWire:
+    """A table input on ``terminal``. Digital modes read 1 for a closed contact or a lit phototransistor
+    (``invert`` flips that); analog modes compare against ``below`` or ``above``, with a hysteresis."""
+
+    name: str
+    terminal: str
+    mode: str
+    invert: bool = False
+    below: int | None = None
+    above: int | None = None
+    hysteresis: int = 0
+
+    @property
+    def digital(self) -> bool:
+        return self.mode in DIGITAL
+
+    def reads(self, raw: int, was_on: bool = False) -> int:
+        """What the table sees (0/1) for the controller's value (``was_on``: last tick's, for the hysteresis)."""
+        if self.digital:
+            return int(bool(raw)) ^ int(self.invert)
+        slack = self.hysteresis if was_on else 0
+        if self.below is not None:
+            return int(raw < self.below + slack)
+        return int(self.above is not None and raw > self.above - slack)
+
+
+@dataclass(frozen=True)
+class OutputWire:
+    """A motor on ``terminal`` (``M1``: forward on its first output) or a lamp on a single output (``O5``)."""
+
+    name: str
+    kind: str  # "motor" or "lamp"
+    terminal: str
+    reverse: bool = False
+
+
+@dataclass(frozen=True)
+class Section:
+    """The section as the robot file says it, checked on its own; :func:`wiring_for` checks it against a table."""
+
+    inputs: dict[str, InputWire]
+    outputs: dict[str, OutputWire]
+    counters: dict[str, str]  # name -> terminal
+
+
+@dataclass(frozen=True)
+class Wiring:
+    """A table's signals on a controller: inputs with their event bits, outputs in the engine's order,
+    counter terminals in the robot's order."""
+
+    inputs: tuple[InputWire, ...]
+    bits: tuple[int, ...]
+    outputs: tuple[OutputWire, ...]
+    counters: tuple[str, ...]
+
+    def mask(self, values: dict[str, int], previous: int = 0) -> int:
+        """The engine's input bits for the controller's values by terminal (``previous``: last tick's bits)."""
+        mask = 0
+        for inp, bit in zip(self.inputs, self.bits, strict=True):
+            if inp.reads(values[inp.terminal], bool(previous & bit)):
+                mask |= bit
+        return mask
+
+    def raw(self, values: dict[str, int]) -> dict[str, int]:
+        """The measured value of each analog input (for the trace)."""
+        return {f"{inp.name}_raw": values[inp.terminal] for inp in self.inputs if not inp.digital}
+
+    def levels(self, outputs: Sequence[int]) -> dict[str, int]:
+        """Each output's signed level by terminal: a motor's speed -8..8 (``reverse`` applied), a lamp's 0..8."""
+        return {out.terminal: -value if out.reverse else value
+                for out, value in zip(self.outputs, outputs, strict=True)}
+
+
+def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Section:
+    """The robot file's section for ``spec`` (a robot-file section reader): errors go to ``src`` with their
+    lines; an entry with a mistake is left out."""
+    found = Section({}, {}, {})
+    if not isinstance(section, dict):
+        _error(src, src.line("", None, spec.section), f"[{spec.section}] must be a table of NAME = terminal",
+               'for example: M1 = "M1"')
+        return found
+    reader = _Reader(spec, robot, src, section)
+    for name in section:
+        into: dict[str, Any]
+        if name in robot.inputs:
+            wired: Any = reader.input(name)
+            into = found.inputs
+        elif name in robot.motors or name in robot.lamps:
+            wired, into = reader.output(name), found.outputs
+        elif name in robot.counter_names:
+            wired, into = reader.terminal(name, "counter", section[name]), found.counters
+        else:
+            reader.error(name, f"[{spec.section}] wires {name!r}, which robot {robot.name} does not have",
+                         "wire the robot's inputs, motors, lamps and counters (names from the robot file)")
+            continue
+        if wired is not None:
+            into[name] = wired
+    return found
+
+
+def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
+    """The wiring of the table's robot, checked against what the table needs (every input it reads, every
+    motor, lamp and counter; a tick the controller can keep); every problem at once, with its line."""
+    robot = machine.table.robot
+    src = robot.file_source()
+    section = robot.sections.get(spec.section)
+    if section is None:
+        _error(src, None, f"robot {robot.name} has no [{spec.section}] section: tablebot does not know how it is "
+               f"wired to the {spec.controller}", "add one to the robot file, for example:\n" +
+               suggest(spec, robot, machine))
+        for name in robot.counter_names if not spec.counters else ():
+            _unwired(spec, src, robot, "counter", name)
+        src.raise_if_any()
+    if not isinstance(section, Section):  # a Robot made in code, holding the section's raw data
+        section = read_section(spec, src, section, robot)
+        src.raise_if_any()
+    wired = {**section.inputs, **section.outputs, **section.counters}
+    for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
+                        ("counter", robot.counter_names)):
+        for name in names:
+            if name not in wired:
+                _unwired(spec, src, robot, kind, name)
+    if robot.tick_ms < spec.min_tick_ms:
+        _error(src, robot.line("", "tick_ms"), f"tick_ms = {robot.tick_ms} is shorter than the {spec.controller} "
+               f"can keep ({spec.tick_reason})", f"use tick_ms = {spec.min_tick_ms} or more to run on it")
+    src.raise_if_any()
+    inputs = tuple(section.inputs[name] for name in machine.input_bits)
+    return Wiring(inputs, tuple(machine.input_bits[w.name] for w in inputs),
+                  tuple(section.outputs[name] for name in machine.output_names),
+                  tuple(section.counters[name] for name in robot.counter_names))
+
+
+def _unwired(spec: Terminals, src: Source, robot: Robot, kind: str, name: str) -> None:
+    if kind == "counter" and not spec.counters:
+        _error(src, robot.line("counters", name) or src.line(spec.section), f"counter {name}: the {spec.controller} "
+               "has no counter inputs", "run this table on a controller with counters (ROBO TX, TXT)")
+        return
+    first = spec.names(kind)[0]
+    example = (f'{name} = {{ terminal = "{first}", mode = "switch", pressed = 1 }}' if kind == "input"
+               else f'{name} = "{first}"')
+    _error(src, robot.line(f"{kind}s", name) or src.line(spec.section), f"{kind} {name} is used by the table but "
+           f"not wired to the {spec.controller}", f"add it to [{spec.section}], for example: {example}")
+
+
+def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
+    """A section for ``robot`` (names that are terminals keep them; inputs as push-buttons)."""
+    lines = [f"[{spec.section}]"]
+    free = {kind: list(spec.names(kind)) for kind in ("input", "motor", "lamp", "counter")}
+    free["input"] = list(spec.digital_inputs)
+    for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
+                        ("counter", robot.counter_names if spec.counters else ())):
+        for name in names:
+            terminal = name if name in free[kind] else (free[kind][0] if free[kind] else "?")
+            if terminal in free[kind]:
+                free[kind].remove(terminal)
+            label = robot.labels.get(name, "").lower()
+            mode = ('mode = "phototransistor", lit = 1' if "photo" in label or "light" in label
+                    else 'mode = "switch", pressed = 1')
+            lines.append(f'{name} = {{ terminal = "{terminal}", {mode} }}' if kind == "input"
+                         else f'{name} = "{terminal}"')
+    return "\n".join(f"        {line}" for line in lines)
+
+
+def _error(src: Source, line: int | None, message: str, hint: str) -> None:
+    src.out.error(line, None if line is None else 1, message, hint)
+
+
+class _Reader:
+    """Reads the section's entries one robot name at a time, remembering terminals already taken."""
+
+    def __init__(self, spec: Terminals, robot: Robot, src: Source, section: dict[str, Any]):
+        self.spec, self.robot, self.src, self.section = spec, robot, src, section
+        self.taken: dict[tuple[str, str], str] = {}  # (input/output/counter, terminal) -> name
+
+    def line(self, name: str) -> int | None:
+        key = self.spec.section
+        return self.src.line(key, None, name) or self.src.line(f"{key}.{name}") or self.src.line(key)
+
+    def error(self, name: str, message: str, hint: str) -> None:
+        _error(self.src, self.line(name), message, hint)
+
+    def terminal(self, name: str, kind: str, value: Any, allowed: Sequence[str] | None = None) -> str | None:
+        """``value`` checked as a terminal of ``kind`` (one of ``allowed`` if given), or None after an error."""
+        key, names = self.spec.section, list(allowed if allowed is not None else self.spec.names(kind))
+        if not names:
+            self.error(name, f"{kind} {name}: the {self.spec.controller} has no {kind} terminals",
+                       f"remove {name} from [{key}]")
+            return None
+        if value is None:
+            self.error(name, f"[{key}] {name}: which terminal is it wired to?",
+                       f'say it with terminal = "{names[0]}" (one of {", ".join(names)})')
+            return None
+        if not isinstance(value, str):
+            self.error(name, f"[{key}] {name}: the terminal must be text like {names[0]!r}, not {value!r}",
+                       f'write it in quotes: {name} = "{names[0]}"')
+            return None
+        if value not in names:
+            same = [n for n in names if n.lower() == value.strip().lower()]
+            hint = (f"terminal names are case-sensitive: write {same[0]!r}" if same
+                    else f"the {self.spec.controller}'s terminals for this are {', '.join(names)}")
+            self.error(name, f"{kind} {name}: the {self.spec.controller} has no {kind} terminal {value!r}", hint)
+            return None
+        return value if self._take(name, kind, value) else None
+
+    def _take(self, name: str, kind: str, value: str) -> bool:
+        """Claim ``value``'s pins: a motor Mn takes its pair of outputs O(2n-1) and O(2n)."""
+        if kind == "motor":
+            n = int(value[1:])
+            needs = [("output", f"O{2 * n - 1}"), ("output", f"O{2 * n}")]
+        else:
+            needs = [("output" if kind == "lamp" else kind, value)]
+        for used in needs:
+            if used in self.taken:
+                self.error(name, f"{kind} {name}: terminal {value} is already used by {self.taken[used]}"
+                           + (" (a motor drives both outputs of its pair)" if used[0] == "output" else ""),
+                           f"give {name} a terminal of its own in [{self.spec.section}]")
+                return False
+        self.taken.update(dict.fromkeys(needs, name))
+        return True
+
+    def input(self, name: str) -> InputWire | None:
+        key, value = self.spec.section, self.section[name]
+        if not isinstance(value, dict):
+            self.error(name, f"[{key}] {name} must say its terminal, mode and polarity",
+                       f'for example: {name} = {{ terminal = "{self.spec.digital_inputs[0]}", mode = "switch", '
+                       "pressed = 1 }")
+            return None
+        mode = value.get("mode")
+        if mode not in self.spec.modes:
+            self.error(name, f"[{key}] {name}: mode must be one of {', '.join(self.spec.modes)}, not {mode!r}",
+                       'a push-button is mode = "switch"; a phototransistor mode = "phototransistor"')
+            return None
+        known = ("terminal", "mode", DIGITAL[mode][0]) if mode in DIGITAL else ("terminal", "mode", "below", "above")
+        for k in value:
+            if k not in known:
+                self.error(name, f"[{key}] {name}: unknown key {k!r} for mode {mode!r}", f"keys: {', '.join(known)}")
+        allowed = self.spec.digital_inputs if mode in DIGITAL else self.spec.analog[mode].terminals
+        default = name if name in allowed else None
+        terminal = self.terminal(name, "input", value.get("terminal", default), allowed)
+        polarity = self._digital(name, mode, value) if mode in DIGITAL else self._analog(name, mode, value)
+        if terminal is None or polarity is None:
+            return None
+        return InputWire(name, terminal, mode, *polarity)
+
+    def _digital(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool] | None:
+        key, meaning = DIGITAL[mode]
+        reads = value.get(key)
+        if reads not in (0, 1) or isinstance(reads, bool):
+            self.error(name, f"[{self.spec.section}] {name}: say what the table reads {meaning}: {key} = 1 or "
+                       f"{key} = 0" + ("" if reads is None else f", not {reads!r}"),
+                       f"{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')")
+            return None
+        return (reads == 0,)
+
+    def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None, int] | None:
+        analog, key = self.spec.analog[mode], self.spec.section
+        limits = {k: value[k] for k in ("below", "above") if k in value}
+        declared = next((s for s in self.robot.sensors if s.name == name), None)
+        if declared is not None and declared.kind != "line":
+            return self._declared(name, mode, declared, limits)
+        if len(limits) != 1:
+            self.error(name, f"[{key}] {name}: a {mode} input needs exactly one of below = N or above = N "
+                       f"({analog.unit})", "the table reads 1 while the value is below (or above) N, for example: "
+                       f"below = {analog.most // 50}")
+            return None
+        (which, limit), = limits.items()
+        if isinstance(limit, bool) or not isinstance(limit, int) or not 0 <= limit <= analog.most:
+            self.error(name, f"[{key}] {name}: {which} must be a whole number 0..{analog.most} ({analog.unit}), "
+                       f"not {limit!r}", f"for example: {which} = {analog.most // 50}")
+            return None
+        return (False, limit if which == "below" else None, limit if which == "above" else None, 0)
+
+    def _declared(self, name: str, mode: str, sensor: Sensor, limits: dict[str, Any]
+                  ) -> tuple[bool, int | None, int | None, int] | None:
+        """Threshold and hysteresis from the input's ``[sensors]`` declaration (the one the simulator uses), so
+        the table reads the same on the robot: only a distance sensor in the controller's distance mode (cm)."""
+        key = self.spec.section
+        if limits:
+            self.error(name, f"[{key}] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
+                       f"remove {', '.join(limits)} here: the simulator and the controller read the one declaration")
+            return None
+        if sensor.kind != "distance" or mode != self.spec.distance_mode:
+            where = (f'wire a distance sensor as mode = "{self.spec.distance_mode}"; ' if self.spec.distance_mode
+                     else f"the {self.spec.controller} measures no distance in cm; ")
+            self.error(name, f"[{key}] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
+                       f"{mode} mode with its declared threshold", where + "or give a calibrated threshold here in "
+                       "the controller's units and drop the input from [sensors]")
+            return None
+        limit, slack = round(sensor.threshold * 100, 6), round(sensor.hysteresis * 100, 6)
+        if limit != int(limit) or slack != int(slack):
+            self.error(name, f"[{key}] {name}: the {self.spec.controller} measures whole centimetres; [sensors] says "
+                       f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")
+            return None
+        below = sensor.direction == "below"
+        return (False, int(limit) if below else None, None if below else int(limit), int(slack))
+
+    def output(self, name: str) -> OutputWire | None:
+        kind = "motor" if name in self.robot.motors else "lamp"
+        value, reverse = self.section[name], False
+        if isinstance(value, dict) and kind == "motor":
+            for k in value:
+                if k not in ("terminal", "reverse"):
+                    self.error(name, f"[{self.spec.section}] {name}: unknown key {k!r}", "keys: terminal, reverse")
+            reverse = value.get("reverse", False)
+            if not isinstance(reverse, bool):
+                self.error(name, f"[{self.spec.section}] {name}: reverse must be true or false, not {reverse!r}",
+                           "reverse = true swaps the motor's forward and backward")
+                reverse = False
+            value = value.get("terminal", name if name in self.spec.motors else None)
+        terminal = self.terminal(name, kind, value)
+        return None if terminal is None else OutputWire(name, kind, terminal, reverse)

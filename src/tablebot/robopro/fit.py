@@ -1,0 +1,215 @@
+"""What the generated ROBO Pro program holds of a table (``Plan``: states numbered, the lists encoded, the
+robot wired) and every reason a table does not fit it (``problems``, which ``check --target
+robopro-program`` reports and the export refuses on).
+
+Encoding, the document's generalised to counters: event = state · 2^B + the event bits, B = number of
+events (T, the robot's inputs, then its counters; T highest), so the BumberBot's first row is the
+document's 88 (B = 6); action = next · 256 + M1dir · 128 + M1speed · 16 + M2dir · 8 + M2speed (speed 7 =
+keep) — the document's word; timer = ticks; one list per counter of loads, −1 = leave it alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+from tablebot.diagnostics import Collector, Diagnostic, TableBotError
+from tablebot.robopro.lists import NEXT_WEIGHT, number_states
+from tablebot.robopro.wiring import Wiring, wiring
+from tablebot.robot import StateId
+from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table, to_direction_speed
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
+
+MAX_VALUE = 32767  # ROBO Pro integers are 16-bit signed
+MAX_MOTORS = 2  # the document's action word
+MAX_NEXT = MAX_VALUE // NEXT_WEIGHT
+MAX_WAIT_MS = 32767  # a Wait in ms; longer ticks need whole tens of ms (the 10 ms scale)
+DOC_BITS = 6
+
+
+@dataclass(frozen=True)
+class Plan:
+    table: Table
+    wiring: Wiring
+    rule: str
+    numbers: dict[StateId, int]
+
+    @cached_property
+    def events(self) -> tuple[str, ...]:
+        """The event bits, highest first: T, the robot's inputs, its counters."""
+        return (TIMER_EVENT, *self.table.robot.inputs, *self.table.robot.counter_names)
+
+    @property
+    def shift(self) -> int:
+        return len(self.events)
+
+    @property
+    def mask(self) -> int:
+        return (1 << self.shift) - 1
+
+    @cached_property
+    def bits(self) -> dict[str, int]:
+        return {name: 1 << (self.shift - 1 - i) for i, name in enumerate(self.events)}
+
+    def encode(self, row: Row) -> tuple[int, int, int]:
+        events = sum(self.bits[e] for e in row.events)
+        motors = [to_direction_speed(m) for m in row.motors] + [(0, 0)] * (MAX_MOTORS - len(row.motors))
+        (d1, s1), (d2, s2) = motors[:MAX_MOTORS]
+        action = self.numbers[row.next] * NEXT_WEIGHT + d1 * 128 + s1 * 16 + d2 * 8 + s2
+        return (self.numbers[row.state] << self.shift) + events, action, row.timer
+
+    @cached_property
+    def _lists(self) -> tuple[tuple[int, ...], ...]:
+        return tuple(zip(*(self.encode(row) for row in self.table.rows), strict=True))  # type: ignore[arg-type]
+
+    @property
+    def event(self) -> tuple[int, ...]:
+        return self._lists[0]
+
+    @property
+    def action(self) -> tuple[int, ...]:
+        return self._lists[1]
+
+    @property
+    def timer(self) -> tuple[int, ...]:
+        return self._lists[2]
+
+    @cached_property
+    def loads(self) -> dict[str, tuple[int, ...]]:
+        names = self.table.robot.counter_names
+        return {name: tuple(-1 if row.counters[i] is None else row.counters[i] for row in self.table.rows)
+                for i, name in enumerate(names)}
+
+    @property
+    def initial_state(self) -> int:
+        return self.numbers[self.table.robot.initial_state]
+
+    @property
+    def initial_timer(self) -> int:
+        return self.table.robot.initial_timer
+
+    def event_note(self, name: str) -> str:
+        label = "the timer ran out (TM = 0)" if name == TIMER_EVENT else self.table.robot.labels.get(name, "")
+        if name in self.wiring.counters:
+            label = f"counter C{self.wiring.counters[name]} reached 0"
+        elif name in self.wiring.inputs:
+            terminal, active = self.wiring.inputs[name]
+            label = f"I{terminal} reads {active}" + (f": {label}" if label else "")
+        return f"{name} (+{self.bits[name]}): {label}"
+
+    def bit_text(self) -> str:
+        return ", ".join(f"{name}={bit}" for name, bit in self.bits.items())
+
+    def table_notes(self) -> list[str]:
+        """The table as ROBO Pro shows text: a line per state name, then a line per row of the lists."""
+        table = self.table
+        lines = [f"{table.robot.name}: the transition table in the lists Event, Action, Timer",
+                 f"event = state * {1 << self.shift} + {self.bit_text()};  action = next * 256 + "
+                 "M1dir * 128 + M1speed * 16 + M2dir * 8 + M2speed (speed 7 = keep);  timer = ticks of "
+                 f"{table.robot.tick_ms} ms"]
+        lines += [f"state {self.numbers[s]}: {table.state_name(s) or s}" for s in table.states
+                  if table.state_name(s) or not isinstance(s, int)]
+        for row, (event, action, timer) in zip(table.rows, zip(self.event, self.action, self.timer, strict=True),
+                                                strict=True):
+            loads = "".join(f", {n} load {self.loads[n][row.index]}" for n in self.loads)
+            lines.append(f"row {row.index} (list index {row.index}): {event} / {action} / {timer}{loads}"
+                         f"  {row.description}")
+        return lines
+
+    def summary(self) -> str:
+        robot = self.table.robot
+        rule = ("if an event is detected: a tick with no event looks up no row" if self.rule == "document"
+                else "a row with no required events always matches")
+        return (f"Generated by tablebot from {self.table.path} for {robot.name} ({self.wiring.controller}). "
+                f"Main loop: DetectEvent, DetermineAction, ExecuteAction, a Wait of one tick "
+                f"({robot.tick_ms} ms), CountDown. Rule: {rule}.")
+
+
+def problems(table: Table, rule: str = "always") -> list[Diagnostic]:
+    """Every reason ``table`` does not fit the generated program, located in the table or robot file."""
+    robot = table.robot
+    out = Collector(table.path)
+    wired = wiring(robot)
+    where = robot.source if robot.toml else table.path
+
+    def robot_error(message: str, hint: str, section: str = "", key: str | None = None) -> None:
+        line = robot.line(section, key) if robot.toml else None
+        out.items.append(Diagnostic(where, line, None if line is None else 1, message, hint))
+
+    if robot.lamps:
+        robot_error(f"the robot has lamps ({', '.join(robot.lamps)}); no real ROBO Pro program of the corpus "
+                    "has a lamp output element to copy", "export a table for a robot without lamps", "lamps")
+    if len(robot.motors) > MAX_MOTORS:
+        robot_error(f"{len(robot.motors)} motors; the document's action word holds M1 and M2 only",
+                    "use a robot with at most two motors", "motors")
+    for sensor in robot.sensors:
+        why = ("fischertechnik's IR track sensor needs ROBO Pro's digital 10 V input mode, which no program of "
+               "the corpus uses" if sensor.model == "line" else "its threshold is not generated")
+        robot_error(f"input {sensor.name} is a {sensor.model} sensor: the program reads inputs as digital switches "
+                    f"(digital 5 kOhm, as a push-button or a phototransistor) and {why}",
+                    f"leave {sensor.name} out of [sensors] if it is a switch-like input", "sensors", sensor.name)
+    if robot.counters and wired.controller == "robo-interface":
+        robot_error("the robot has counters, and the ROBO Interface has no counter inputs",
+                    'set controller = "tx" or "txt" in [robopro]', "robopro", "controller")
+    for name, message, hint in wired.problems:
+        robot_error(message, hint, "robopro", name)
+    for kind, used in (("input", {n: t for n, (t, _) in wired.inputs.items()}),
+                       ("motor", {n: t for n, (t, _) in wired.motors.items()}), ("counter", wired.counters)):
+        seen: dict[int, str] = {}
+        for name, terminal in used.items():
+            if terminal in seen:
+                robot_error(f"{kind}s {seen[terminal]} and {name} are wired to the same terminal",
+                            "give each its own terminal in [robopro]", "robopro", name)
+            seen.setdefault(terminal, name)
+    _row_problems(table, out)
+    if robot.tick_ms > MAX_WAIT_MS and robot.tick_ms % 10:
+        robot_error(f"tick_ms = {robot.tick_ms}: a ROBO Pro Wait holds up to {MAX_WAIT_MS} ms, or whole tens of ms",
+                    "use a tick of at most 32767 ms or a multiple of 10 ms", "", "tick_ms")
+    if robot.initial_timer > MAX_VALUE:
+        robot_error(f"initial_timer = {robot.initial_timer} is over {MAX_VALUE}", "ROBO Pro integers are 16-bit",
+                    "", "initial_timer")
+    return out.items
+
+
+def _row_problems(table: Table, out: Collector) -> None:
+    shift = 1 + len(table.robot.inputs) + len(table.robot.counters)
+    max_state = (MAX_VALUE >> shift) if shift < 15 else 0
+    numbers = number_states(table)
+    if shift >= 15:
+        out.error(1, 1, f"{shift} events (T, inputs and counters) leave no bits for the state in a 16-bit word",
+                  "use fewer inputs or counters")
+        return
+    for row in table.rows:
+        for what, state, limit in (("state", row.state, max_state), ("next state", row.next, min(MAX_NEXT, max_state))):
+            if numbers[state] > limit:
+                out.error(row.line, None, f"row {row.index}: {what} {state!r} is number {numbers[state]}, over "
+                          f"{limit}", f"with {shift} event bits the 16-bit lists hold states 0..{limit}")
+        if row.timer > MAX_VALUE:
+            out.error(row.line, None, f"row {row.index}: timer {row.timer} is over {MAX_VALUE}",
+                      "ROBO Pro integers are 16-bit signed")
+        for motor, speed in zip(table.robot.motors, row.motors, strict=True):
+            if speed is not None and abs(speed) >= DOC_KEEP_SPEED:
+                out.error(row.line, None, f"row {row.index}: {motor} speed {abs(speed)} does not fit the action word",
+                          "the document's speeds are 0..6 (7 means keep): use 6 or less")
+        for name, load in zip(table.robot.counter_names, row.counters, strict=True):
+            if load is not None and load > MAX_VALUE:
+                out.error(row.line, None, f"row {row.index}: {name} load {load} is over {MAX_VALUE}",
+                          "ROBO Pro integers are 16-bit signed")
+    if numbers[table.robot.initial_state] > max_state:
+        out.error(1, 1, f"initial state {table.robot.initial_state!r} is number {numbers[table.robot.initial_state]},"
+                  f" over {max_state}", "number the states lower")
+
+
+def machine_problems(machine: Machine) -> list[Diagnostic]:
+    """``check --target robopro-program``: :func:`problems` of the machine's table."""
+    return problems(machine.table)
+
+
+def plan(table: Table, rule: str = "always") -> Plan:
+    found = problems(table, rule)
+    if found:
+        raise TableBotError(found)
+    return Plan(table, wiring(table.robot), rule, number_states(table))

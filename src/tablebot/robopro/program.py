@@ -1,0 +1,244 @@
+"""The document's whole engine as a ROBO Pro program, generated from a table: the main loop
+DetectEvent → DetermineAction → ExecuteAction over the lists Event, Action and Timer (pre-filled with the
+table's encoding), with native bitwise operators, paced by a Wait of one tick (``tick_ms``).
+
+The program follows the engine's tick rule exactly (the interpreter in :mod:`tablebot.robopro.interpret`
+proves it on random tables): after the first pass the timer TM counts down by one per pass and each
+counter by the pulses its input counted; EV holds T, the inputs reading their active level and each Cn at
+0; the first row of the Event list whose state is ST and whose event bits are all in EV fires. ``rule``
+says what happens on a pass whose EV is empty: ``"document"`` looks up no row ("if an event is
+detected"), ``"always"`` looks up as on any pass (a row that requires no event matches).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Literal
+
+from tablebot.robopro import elements as el
+from tablebot.robopro.document import Sub, document
+from tablebot.robopro.fit import Plan, plan
+from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption
+from tablebot.robopro.sheet import Const, Count, Input, Join, ListAt, Op, Sheet, Tree, Var
+from tablebot.table import Table
+
+Rule = Literal["document", "always"]
+RULES: tuple[Rule, ...] = ("document", "always")
+MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN = ("Main program", "DetectEvent", "DetermineAction", "ExecuteAction",
+                                               "CountDown")
+ENTRY, EXIT, FOUND, NONE = "Entry", "Exit", "Found", "None"
+COLUMN = 136  # x of every subprogram's flow column
+INDENT = "            "  # elements inside a subprogram
+
+
+class Builder:
+    """Builds the subprograms of one plan, sharing one id counter."""
+
+    def __init__(self, p: Plan):
+        self.p = p
+        self.ids = Ids()
+        self.inits = {"ST": p.initial_state, "TM": p.initial_timer}
+        self.subs: dict[str, Sub] = {}
+
+    def sheet(self) -> Sheet:
+        return Sheet(Canvas(self.ids), COLUMN, self.inits, INDENT)
+
+    def send(self, sheet: Sheet, element: Element, target: str | int) -> Element:
+        """Wire a command element's output to a variable (by name) or a motor (by output number) on its right."""
+        out = element.pin(0)
+        x, y = out.at
+        made = el.variable(x + 12, y, target, self.inits.get(target, 0)) if isinstance(target, str) \
+            else el.motor(x + 12, y, target)
+        sheet.canvas.add(made)
+        sheet.canvas.connect(out, made.pins_of("dataobjectinput")[0])
+        return made
+
+    def assign(self, sheet: Sheet, target: str | int, command: str, value: int | None = None,
+               data: Tree | None = None) -> Element:
+        element = sheet.step(lambda x, y: el.message(x, y, command, value), data=data)
+        self.send(sheet, element, target)
+        return element
+
+    def side_send(self, sheet: Sheet, exit_pin, target: str | int, command: str, value: int | None = None,
+                  data: Tree | None = None, hold: bool = False) -> None:
+        sheet.side(exit_pin, [lambda x, y: el.message(x, y, command, value)], data=[data],
+                   extra=lambda e: self.send(sheet, e, target), hold=hold)
+
+    def note(self, sheet: Sheet, element: Element, text: str) -> None:
+        sheet.note(element.y, text)
+
+    def finish(self, name: str, sheet: Sheet, outputs: list[tuple[str, int]], documentation: str,
+               inputs: list[tuple[str, int]] | None = None) -> Sub:
+        x = max(sheet.right, sheet.lanes) + 24  # comments right of every lane
+        for y, text in sheet.notes:
+            sheet.canvas.comments.append(caption(INDENT, self.ids(), text, (x, y), size=3, align="336",
+                                                 linespace="0"))
+        sub = Sub(name, sheet.canvas, inputs if inputs is not None else [(ENTRY, 1)], outputs, documentation)
+        self.subs[name] = sub
+        return sub
+
+    def call(self, sheet: Sheet, name: str, dx: int = 0, release: bool = False) -> Element:
+        sub = self.subs[name]
+        pins, width, height = el.symbol_pins(sub.inputs, sub.outputs)
+        return sheet.step(lambda x, y: el.call(x, y, name, sub.guid, pins, width, height, INDENT, self.ids()),
+                          dx=dx, release=release)
+
+
+# --- the subprograms ---------------------------------------------------------------------------------
+
+def detect_event(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+    b.assign(s, "EV", "=", 0)
+    for name in p.events:
+        bit = p.bits[name]
+        if name == "T":
+            test, add_when_yes = Var("TM"), False
+        elif name in p.wiring.counters:
+            test, add_when_yes = Var(name), False
+        else:
+            terminal, active = p.wiring.inputs[name]
+            test, add_when_yes = Input(terminal), bool(active)
+        branch = s.step(lambda x, y, yes=add_when_yes: el.branch(x, y, yes_down=not yes), data=test)
+        b.side_send(s, branch.pins[3], "EV", "+", bit)
+        b.note(s, branch, p.event_note(name))
+    s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
+    return b.finish(DETECT, s, [(EXIT, 2)], "EV := the events of this tick, one bit each: " + p.bit_text())
+
+
+def determine_action(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+    b.assign(s, "ROW", "=", 0)
+    more = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var("ROW"), Const(len(p.event))))
+    loop_wire, loop_in = s.last_wire, more.pins[1].at
+    s.side(more.pins[3], [lambda x, y: el.flow_out(x, y, NONE, 3)], rejoin=False)
+    b.note(s, more, f"rows left? (ROW < {len(p.event)})")
+    b.assign(s, "E", "=", data=ListAt("Event", p.event, Var("ROW")))
+    state = s.step(lambda x, y: el.branch(x, y, yes_down=False),
+                   data=Op("XOR", Op("SHR", Var("E"), Const(p.shift)), Var("ST")))
+    b.note(s, state, f"row's state (E SHR {p.shift}) is not ST?")
+    need = Op("AND", Var("E"), Const(p.mask))
+    missing = s.step(lambda x, y: el.branch(x, y, yes_down=False),
+                     data=Op("XOR", Op("AND", need, Var("EV")), need))
+    b.note(s, missing, f"an event of the row (E AND {p.mask}) missing from EV?")
+    (step_on,), wire = s.side(missing.pins[3], [lambda x, y: el.message(x, y, "+", 1)],
+                              extra=lambda e: b.send(s, e, "ROW"), rejoin=False)
+    assert wire is not None
+    _ex, ey = state.pins[3].at
+    sx, sy = wire.points[1]
+    s.canvas.join(state.pins[3], wire, (sx, sy + 4), via=[(sx + 8, ey), (sx + 8, sy + 4)])
+    s.step(lambda x, y: el.flow_out(x, y, FOUND, 2))
+    assert loop_wire is not None
+    s.loop_back(step_on.pin(2), loop_wire, (loop_in[0], loop_in[1] - 4))
+    return b.finish(DETERMINE, s, [(FOUND, 2), (NONE, 3)],
+                    "ROW := the first row of the Event list whose state is ST and whose events are all in EV")
+
+
+def execute_action(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+    b.assign(s, "ACT", "=", data=ListAt("Action", p.action, Var("ROW")))
+    b.assign(s, "TM", "=", data=ListAt("Timer", p.timer, Var("ROW")))
+    first = b.assign(s, "ST", "=", data=Op("SHR", Var("ACT"), Const(8)))
+    b.note(s, first, "next state: ACT SHR 8")
+    for motor, (speed_shift, dir_shift) in zip(p.table.robot.motors, ((4, 7), (0, 3)), strict=False):
+        output, forward = p.wiring.motors[motor]
+        backward = "ccw" if forward == "cw" else "cw"
+        field = Op("SHR", Var("ACT"), Const(speed_shift)) if speed_shift else Var("ACT")
+        speed = b.assign(s, "SPEED", "=", data=Op("AND", field, Const(7)))
+        b.note(s, speed, f"{motor}: SPEED = (ACT SHR {speed_shift}) AND 7")
+        keep = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var("SPEED"), Const(7)))
+        b.note(s, keep, f"{motor}: speed 7 keeps the motor as it is")
+        s.side(keep.pins[3], [], hold=True)
+        moving = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var("SPEED"))
+        b.note(s, moving, f"{motor}: speed 0 stops it")
+        b.side_send(s, moving.pins[3], output, "Stop", -32768, hold=True)
+        direction = s.step(lambda x, y: el.branch(x, y, yes_down=False),
+                           data=Op("AND", Op("SHR", Var("ACT"), Const(dir_shift)), Const(1)))
+        b.note(s, direction, f"{motor}: direction (ACT SHR {dir_shift}) AND 1: 1 = backward ({backward}), "
+                             f"0 = forward ({forward})")
+        b.side_send(s, direction.pins[3], output, backward, data=Var("SPEED"), hold=True)
+        b.assign(s, output, forward, data=Var("SPEED"))
+        s.release()
+    for name in p.wiring.counters:
+        b.assign(s, "CL", "=", data=ListAt(f"{name} load", p.loads[name], Var("ROW")))
+        load = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Op("+", Var("CL"), Const(1)))
+        b.note(s, load, f"{name}: a load of -1 leaves the counter alone")
+        b.side_send(s, load.pins[3], name, "=", data=Var("CL"))
+    s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
+    return b.finish(EXECUTE, s, [(EXIT, 2)],
+                    "The action of row ROW: motors (speed 7 keeps), TM from the Timer list, ST := next state")
+
+
+def count_down(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+    timer = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Var("TM"))
+    b.note(s, timer, "TM counts down to 0, one per tick")
+    b.side_send(s, timer.pins[3], "TM", "-", 1)
+    for name, counter in p.wiring.counters.items():
+        now, last = f"{name} now", f"{name} last"
+        b.assign(s, now, "=", data=Count(counter))
+        cmp = s.step(el.compare)
+        pulses = Op("-", Var(now), Var(last))
+        s.feed(Var(name), cmp.pin("A"))
+        s.feed(pulses, cmp.pin("B"))
+        b.note(s, cmp, f"{name} counts down by the pulses since the last tick, never below 0")
+        s.joins.append(_left_join(cmp.pin("<")))
+        b.assign(s, name, "=", 0)
+        b.side_send(s, cmp.pin(">"), name, "=", data=Op("-", Var(name), pulses))
+        b.assign(s, last, "=", data=Var(now))
+    s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
+    return b.finish(COUNTDOWN, s, [(EXIT, 2)], "One tick later: TM and the counters count down")
+
+
+def _left_join(pin: Pin) -> Join:
+    return Join(pin, pin.at[1])
+
+
+def main_program(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.start(COLUMN, 8))
+    b.assign(s, "ST", "=", p.initial_state)
+    b.assign(s, "TM", "=", p.initial_timer)
+    for motor in p.table.robot.motors:
+        b.assign(s, p.wiring.motors[motor][0], "Stop", -32768)
+    for name, counter in p.wiring.counters.items():
+        b.assign(s, name, "=", 0)
+        b.assign(s, f"{name} last", "=", data=Count(counter))
+    detect = b.call(s, DETECT)
+    loop_wire, loop_in = s.last_wire, detect.pins[0].at
+    if p.rule == "document":
+        any_event = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var("EV"))
+        b.note(s, any_event, "if an event is detected (EV > 0)")
+        s.side(any_event.pins[3], [], hold=True)
+    determine = b.call(s, DETERMINE, dx=4)
+    s.held.append(_left_join(determine.pin(NONE)))
+    b.call(s, EXECUTE)
+    tick = s.step(lambda x, y: el.wait(x, y, p.table.robot.tick_ms), release=True)
+    b.note(s, tick, f"one tick: {p.table.robot.tick_ms} ms")
+    countdown = b.call(s, COUNTDOWN)
+    assert loop_wire is not None
+    s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
+    for n, line in enumerate(p.table_notes()):
+        s.canvas.comments.append(caption(INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2,
+                                         align="336", linespace="0"))
+    return b.finish(MAIN, s, [], p.summary(), inputs=[])
+
+
+def generate(table: Table, rule: Rule = "always") -> str:
+    """The whole .rpp text for ``table``; raises :class:`TableBotError` when the table does not fit."""
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {RULES}, not {rule!r}")
+    p = plan(table, rule)
+    b = Builder(p)
+    for build in (detect_event, determine_action, execute_action, count_down):
+        build(b)
+    main_program(b)
+    return document(b.ids, p, [b.subs[n] for n in (MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN)])
+
+
+def file_name(table: Table) -> str:
+    """``BumberBot.rpp``: the robot's name, in characters any file system takes."""
+    return (re.sub(r"[^A-Za-z0-9_-]+", "_", table.robot.name).strip("_") or "engine") + ".rpp"

@@ -1,0 +1,152 @@
+"""The robot file's ``[robopro]`` section: which controller the generated ROBO Pro program is for, and which
+terminal each of the robot's inputs, motors and counters is wired to.
+
+```toml
+[robopro]
+controller = "robo-interface"          # the document's; or "tx", "txt"
+I3 = "I3"                               # an input's terminal, or { terminal = "I3", active = 0 }
+M1 = { output = "M1", forward = "cw" }  # a motor's output, and the command that drives it forward
+C1 = "C1"                               # a counter's terminal (ROBO TX and TXT only)
+```
+
+Everything has a default, so the section may be left out: an input named I1…I8, a motor named M1…M4 and a
+counter named C1…C4 use the terminal of that name; a counter otherwise uses the counter of its motor's
+number; ``active = 1`` (the event is present while the input reads 1) and ``forward = "cw"``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+from tablebot.robot import Robot
+from tablebot.tomlfile import Source
+
+CONTROLLERS = ("robo-interface", "tx", "txt")
+TERMINALS = {"input": ("I", 8), "motor": ("M", 4), "counter": ("C", 4)}
+COMMANDS = ("cw", "ccw")
+DEFAULT = object()
+
+
+@dataclass(frozen=True)
+class Wiring:
+    """Terminal numbers (1-based) per robot name, plus each input's active level and each motor's
+    forward command."""
+
+    controller: str = "robo-interface"
+    inputs: dict[str, tuple[int, int]] = field(default_factory=dict)  # name -> (terminal, active level)
+    motors: dict[str, tuple[int, str]] = field(default_factory=dict)  # name -> (output, forward command)
+    counters: dict[str, int] = field(default_factory=dict)  # name -> counter
+    problems: tuple[tuple[str, str, str], ...] = ()  # (robot name, message, hint) of names left unwired
+
+
+def _terminal(text: Any, kind: str) -> int | None:
+    letter, count = TERMINALS[kind]
+    match = re.fullmatch(rf"{letter}([1-9])", text) if isinstance(text, str) else None
+    return int(match[1]) if match and int(match[1]) <= count else None
+
+
+def _default(name: str, kind: str, robot: Robot) -> int | None:
+    found = _terminal(name, kind)
+    if found is None and kind == "counter":
+        motor = next((c.motor for c in robot.counters if c.name == name), "")
+        found = _terminal(motor.replace("M", "C", 1), kind)
+    return found
+
+
+class _Reader:
+    """Reads entries; errors go to the robot file's collector, or (for a robot made in code) to a list."""
+
+    def __init__(self, src: Source | None, robot: Robot):
+        self.src, self.robot = src, robot
+        self.errors: list[tuple[str, str, str]] = []
+
+    def error(self, key: str, message: str, hint: str) -> None:
+        if self.src is None:
+            self.errors.append((key, f"[robopro] {message}", hint))
+        else:
+            self.src.key_error(("robopro", None, key), f"[robopro] {message}", hint)
+
+    def entry(self, name: str, value: Any, kind: str, extra: dict[str, tuple[Any, ...]]) -> tuple[int, dict] | None:
+        """A terminal (``"I3"``) or a table ``{terminal = "I3", key = value}`` with ``extra``'s keys."""
+        letter, count = TERMINALS[kind]
+        word = "output" if kind == "motor" else "terminal"
+        options: dict[str, Any] = {}
+        if isinstance(value, dict):
+            unknown = sorted(set(value) - {word, *extra})
+            if unknown:
+                self.error(name, f"{name}: unknown key {', '.join(unknown)}",
+                           f"a {kind} takes {word}{''.join(', ' + k for k in extra)}")
+                return None
+            options = {k: value[k] for k in extra if k in value}
+            value = value.get(word, DEFAULT)
+        terminal = _default(name, kind, self.robot) if value is DEFAULT else _terminal(value, kind)
+        if terminal is None:
+            shown = "no terminal" if value is DEFAULT else repr(value)
+            self.error(name, f"{name}: {shown} is not a {kind} terminal of the controller",
+                       f'write {word} = "{letter}1" … "{letter}{count}"')
+            return None
+        for key, allowed in extra.items():
+            if key in options and options[key] not in allowed:
+                self.error(name, f"{name}: {key} = {options[key]!r} is not one of {', '.join(map(repr, allowed))}",
+                           f"write {key} = {allowed[0]!r}")
+                return None
+        return terminal, options
+
+
+def read_robot_robopro(src: Source, section: Any, robot: Robot) -> Wiring:
+    """``[robopro]`` of a robot file (a reader of :data:`tablebot.robot.SECTION_READERS`); errors go to
+    ``src`` with their lines."""
+    if not isinstance(section, dict):
+        src.key_error(("", None, "robopro"), "[robopro] must be a table", 'for example: controller = "txt"')
+        return wiring_of(robot, {})
+    reader = _Reader(src, robot)
+    controller = section.get("controller", "robo-interface")
+    if controller not in CONTROLLERS:
+        reader.error("controller", f"controller = {controller!r} is not one ROBO Pro drives here",
+                     f"write controller = one of {', '.join(map(repr, CONTROLLERS))}")
+    for name in section:
+        if name != "controller" and name not in (*robot.inputs, *robot.motors, *robot.counter_names):
+            reader.error(name, f"wires {name!r}, which robot {robot.name} does not have",
+                         "wire the robot's inputs, motors and counters (names from the robot file)")
+    return wiring_of(robot, section, reader, str(controller))
+
+
+def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = None,
+              controller: str = "robo-interface") -> Wiring:
+    """The wiring ``section`` says, defaults filled in; names that cannot be wired are listed in
+    ``problems`` (mistakes in the section itself go through ``reader``)."""
+    inputs, motors, counters, problems = {}, {}, {}, []
+    reader = reader or _Reader(None, robot)
+    for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names)):
+        extra = {"input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}}[kind]
+        for name in names:
+            if name in section:
+                got = reader.entry(name, section[name], kind, extra)
+            else:  # unwired names are the export's problem, not the robot file's
+                terminal = _default(name, kind, robot)
+                got = (terminal, {}) if terminal is not None and name not in section else None
+            if got is None:
+                letter, count = TERMINALS[kind]
+                problems.append((name, f"{kind} {name} is wired to no terminal of the controller",
+                                 f'add to [robopro]: {name} = "{letter}1" (one of {letter}1…{letter}{count})'))
+                continue
+            terminal, options = got
+            if kind == "input":
+                inputs[name] = (terminal, int(options.get("active", 1)))
+            elif kind == "motor":
+                motors[name] = (terminal, str(options.get("forward", "cw")))
+            else:
+                counters[name] = terminal
+    return Wiring(controller if controller in CONTROLLERS else "robo-interface", inputs, motors, counters,
+                  tuple(problems) + tuple(reader.errors))
+
+
+def wiring(robot: Robot) -> Wiring:
+    """The robot's ROBO Pro wiring: its ``[robopro]`` section as read with the file, else the defaults."""
+    section = robot.sections.get("robopro")
+    if isinstance(section, Wiring):
+        return section
+    section = section if isinstance(section, dict) else {}
+    return wiring_of(robot, section, controller=str(section.get("controller", "robo-interface")))

@@ -1,0 +1,37 @@
+// The stand-alone replay page: the data is in the page itself; the same views as the studio's trace player.
+import { byId, make } from "../lib/dom.js";
+import { Arena } from "../views/arena.js";
+import { Diagram } from "../views/diagram.js";
+import { Grid } from "../views/grid.js";
+import { Player, wirePlayerControls, wireZoom } from "../views/player.js";
+import { Timeline } from "../views/timeline.js";
+
+function showInputs(machine, mask) {
+  byId("inputs").replaceChildren(...machine.inputs.map((name) => make("span", {
+    className: "input" + (mask & machine.input_bits[name] ? " live" : ""), title: machine.labels[name] || name }, name)));
+}
+
+function replay(data) {
+  document.title = data.title + " · tablebot replay";
+  byId("title").textContent = data.title;
+  const grid = new Grid(byId("grid"), { readOnly: true });
+  grid.setColumns(data.table.columns, data.machine.tick_ms);
+  grid.setTable(data.table.header, data.table.grid, data.table.lines);
+  const arena = new Arena(byId("arena"), null);
+  arena.setWorld(data.world);
+  const diagram = new Diagram(byId("diagram"));
+  diagram.setSvg(data.diagram);
+  const stateCol = data.table.columns.findIndex((c) => c.kind === "state");
+  const timeline = new Timeline(byId("timeline"), (i) => player.seek(i));
+  const player = new Player({ arena, grid, diagram, timeline, status: byId("status"), slider: byId("scrub"),
+    stateCol: () => stateCol, onEnd: () => { byId("tplay").textContent = "▶ Play"; },
+    onSeek: (t) => showInputs(data.machine, t.event) });
+  player.load(data.trace, data.machine, 0);
+  wirePlayerControls(player);
+  wireZoom(arena);
+  const paint = () => { arena.draw(); requestAnimationFrame(paint); };
+  paint();
+}
+
+const holder = byId("tb-data");
+if (holder) replay(JSON.parse(holder.textContent));

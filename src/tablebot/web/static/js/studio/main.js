@@ -1,0 +1,55 @@
+// The studio page: one store, one WebSocket, the views and panels wired to them.
+import { createStore } from "../lib/store.js";
+import { wirePlayerControls, wireZoom } from "../views/player.js";
+import { banner } from "./banner.js";
+import { wireControls } from "./controls.js";
+import { createLink } from "./link.js";
+import { messageHandlers } from "./messages.js";
+import { showPanels } from "./panels.js";
+import { stats } from "./stats.js";
+import { createViews } from "./views.js";
+
+const store = createStore({
+  path: null, files: { tables: [], traces: [] }, machine: null, analysis: null, seq: 0, editSent: 0,
+  mode: "live", frame: null, clickMode: "start", speed: "1", paused: true, held: {}, runError: null,
+  world: null, tickMs: 10, dirty: null /* no table yet: neither saved nor not */, selectedRow: null, mask: undefined, why: [], arenaOk: false,
+});
+const link = createLink();
+const views = createViews(store, link.send);
+const handlers = messageHandlers(store, views, link.send);
+const receive = (m) => { if (handlers[m.type]) handlers[m.type](m); };
+
+showPanels(store, views, link.send);
+wireControls(store, link.send, receive);
+wirePlayerControls(views.player);
+wireZoom(views.arena);
+
+function paint() {
+  const t0 = performance.now();
+  views.arena.draw();
+  stats.drawMs = performance.now() - t0;
+  requestAnimationFrame(paint);
+}
+
+// The token came in the address (the server keeps it in an HttpOnly cookie): out of sight and history.
+function forgetToken() {
+  const params = new URLSearchParams(location.search);
+  if (!params.has("token")) return params;
+  params.delete("token");
+  history.replaceState(null, "", location.pathname + (params.toString() ? "?" + params : ""));
+  return params;
+}
+
+async function start() {
+  const params = forgetToken();
+  const reply = await fetch("/api/config");
+  if (!reply.ok) { banner(await reply.text(), "bad"); return; }
+  const config = await reply.json();
+  store.set({ files: config });
+  const wanted = params.get("table") || config.table || config.tables[0];
+  link.open(wanted ? { op: "open", path: wanted } : null, receive,
+    () => banner("the studio server stopped: restart tablebot studio and reload", "bad"));
+}
+
+requestAnimationFrame(paint);
+start();

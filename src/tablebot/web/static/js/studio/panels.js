@@ -1,0 +1,151 @@
+// The parts of the page drawn from the store: each function subscribes to the keys it shows.
+import { addOption, all, byId, make } from "../lib/dom.js";
+import { describeTick } from "../views/player.js";
+import { banner } from "./banner.js";
+import { arenaNote } from "./messages.js";
+import { stateColumn } from "./views.js";
+
+function countsText(m) {
+  const c = m.counts || {};
+  if (!m.ok) return [`${m.diagnostics.length} problem${m.diagnostics.length === 1 ? "" : "s"}: the table does not read`, "bad"];
+  const text = `${m.machine.rows} rows · ${m.machine.states.length} states · ${c.error || 0} errors · ${c.warning || 0} warnings`;
+  return [text, c.error ? "bad" : c.warning ? "warn" : "good"];
+}
+
+// The checks of the latest edit: on the grid's cells and rows, in the checks panel and the toolbar.
+function showAnalysis(store, views) {
+  store.on(["analysis"], ({ analysis: m, machine, tickMs }) => {
+    views.grid.lines = m.lines;
+    views.grid.setColumns(m.columns, m.machine ? m.machine.tick_ms : (machine ? machine.tick_ms : tickMs));
+    views.grid.setDiagnostics(m.diagnostics);
+    views.grid.setFindings(m.findings || []);
+    views.checks.render(m);
+    const [text, kind] = countsText(m);
+    byId("counts").textContent = text;
+    byId("counts").className = "counts " + kind;
+    byId("analysis-time").textContent = `checked in ${m.ms} ms`;
+  });
+}
+
+// The live robot: arena, lit row and state, status line, why the rows fired.
+function showFrames(store, views) {
+  store.on(["frame"], ({ frame: m, mode, machine }) => {
+    if (!m || mode !== "live") return;
+    views.arena.addPath(m.path);
+    views.arena.setRobot(m.pose, m.bumpers, m.light);
+    const row = m.fired.length ? m.fired[m.fired.length - 1][1] : (m.paused ? m.row : views.grid.firedRow);
+    views.grid.setLive(row, m.state_id, stateColumn(store));
+    views.diagram.highlight(m.state_id);
+    const outputs = {};
+    (machine ? machine.outputs : []).forEach((name, i) => { outputs[name] = m.outputs[i]; });
+    if (machine) {
+      byId("status").textContent = describeTick(machine, { tick: m.tick, state: m.state_id, timer: m.timer,
+        event: m.event, row: m.row, outputs });
+    }
+    const why = m.why || [];  // repeated in every frame while paused: redrawn only when it says something new
+    store.set({ mask: m.mask, ...(JSON.stringify(why) === JSON.stringify(store.get().why) ? {} : { why }) });
+  });
+}
+
+function showWhy(store, views) {
+  store.on(["why"], ({ why }) => {
+    byId("why").replaceChildren(...why.map((item) => {
+      const li = make("li", { className: "why-" + item.status }, item.why);
+      if (item.row !== null) li.addEventListener("click", () => views.grid.select([item.row]));
+      return li;
+    }));
+  });
+}
+
+const HELD_WORDS = { true: ": held on", false: ": held off" };
+const HELD_CLASSES = { true: " held-on", false: " held-off" };
+
+function inputButton(store, send, name) {
+  const b = make("button", { type: "button" });
+  b.dataset.input = name;
+  b.addEventListener("click", () => {  // on, then off, then the sensor decides again
+    const held = store.get().held[name];
+    send({ op: "sim", action: "hold", input: name, on: held === undefined ? true : held === true ? false : null });
+  });
+  return b;
+}
+
+function paintInputs(buttons, { machine, held, mode, mask }) {
+  for (const [name, b] of buttons) {
+    const live = mask !== undefined && (mask & machine.input_bits[name]);
+    b.className = "input" + (live ? " live" : "") + (HELD_CLASSES[held[name]] || "");
+    b.textContent = name + (HELD_WORDS[held[name]] || "");
+    b.disabled = mode !== "live";
+    b.title = (machine.labels[name] || name) + ": click to hold it on, again to hold it off, again to let the sensor decide";
+  }
+}
+
+// The robot's inputs: lit when on, held on or off by hand while the robot is live. The buttons are made
+// once per machine and repainted in place (a button that is clicked must not be replaced meanwhile).
+function showInputs(store, send) {
+  let buttons = new Map();
+  store.on(["machine"], ({ machine }) => {
+    buttons = new Map((machine ? machine.inputs : []).map((name) => [name, inputButton(store, send, name)]));
+    byId("inputs").replaceChildren(...buttons.values());
+  });
+  store.on(["machine", "held", "mode", "mask"], (state) => { if (state.machine) paintInputs(buttons, state); });
+}
+
+function showControls(store) {
+  store.on(["paused", "speed"], ({ paused, speed }) => {
+    byId("play").textContent = paused ? "▶ Play" : "❚❚ Pause";
+    byId("step").disabled = !paused;
+    for (const b of all("[data-speed]")) b.classList.toggle("on", b.dataset.speed === speed);
+  });
+  store.on(["arenaOk"], ({ arenaOk }) => { byId("play").disabled = !arenaOk; });
+  store.on(["runError"], ({ runError }) => { if (runError) banner("the live robot stopped: " + runError, "bad"); });
+  store.on(["clickMode"], ({ clickMode }) => {
+    for (const b of all("[data-click]")) b.classList.toggle("on", b.dataset.click === clickMode);
+  });
+}
+
+function showFile(store) {
+  store.on(["dirty"], ({ dirty }) => {
+    byId("save-state").textContent = dirty ? "unsaved edits" : "saved";
+    byId("save").classList.toggle("primary", dirty);
+  });
+  store.on(["path"], ({ path }) => {
+    byId("table-pick").value = path;
+    document.title = `${path} · tablebot studio`;
+  });
+  store.on(["files"], ({ files, path }) => {
+    const tables = byId("table-pick"), traces = byId("trace-pick");
+    tables.replaceChildren();
+    traces.replaceChildren(make("option", { value: "" }, "choose a trace…"));
+    files.tables.forEach((t) => addOption(tables, t));
+    files.traces.forEach((t) => addOption(traces, t));
+    if (path) tables.value = path;
+  });
+}
+
+// Live robot or trace player: the controls, the timeline and what the arena shows.
+function showMode(store, views, send) {
+  store.on(["mode"], ({ mode }) => {
+    byId("mode-live").classList.toggle("on", mode === "live");
+    byId("mode-trace").classList.toggle("on", mode === "trace");
+    byId("live-controls").hidden = mode !== "live";
+    byId("trace-controls").hidden = mode !== "trace";
+    byId("timeline").hidden = mode !== "trace";
+    views.player.pause();
+    if (mode === "live") arenaNote("");
+    else send({ op: "sim", action: "pause" });
+    views.arena.replayPath = null;
+    views.arena.clearPath();
+    views.arena.resize();
+  });
+}
+
+export function showPanels(store, views, send) {
+  showAnalysis(store, views);
+  showFrames(store, views);
+  showWhy(store, views);
+  showInputs(store, send);
+  showControls(store);
+  showFile(store);
+  showMode(store, views, send);
+}

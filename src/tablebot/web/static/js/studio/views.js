@@ -1,0 +1,68 @@
+// The studio's views (grid, arena, diagram, timeline, trace player, checks), made once and wired to the
+// store and the server: what the user does in a view becomes a message or a change of state.
+import { byId } from "../lib/dom.js";
+import { Arena } from "../views/arena.js";
+import { Checks } from "../views/checks.js";
+import { Diagram } from "../views/diagram.js";
+import { Grid } from "../views/grid.js";
+import { Player } from "../views/player.js";
+import { Timeline } from "../views/timeline.js";
+
+/** The column of the grid that holds the state (-1 while the table does not read). */
+export function stateColumn(store) {
+  const analysis = store.get().analysis;
+  return analysis ? analysis.columns.findIndex((c) => c.kind === "state") : -1;
+}
+
+function makeGrid(store, send) {
+  const grid = new Grid(byId("grid"), {
+    onEdit: (row, col, value) => {
+      const seq = store.get().seq + 1;
+      store.set({ seq, editSent: performance.now() });
+      send({ op: "edit", row, col, value, seq });
+    },
+  });
+  byId("grid").addEventListener("focusin", (e) => {
+    const td = e.target.closest("td[data-row]");
+    if (td) store.set({ selectedRow: +td.dataset.row });
+  });
+  return grid;
+}
+
+// A click in the arena moves the start pose (a drag also aims it) or the lamp, and starts over.
+function makeArena(store, send) {
+  return new Arena(byId("arena"), (x, y, heading) => {
+    const { mode, clickMode, world } = store.get();
+    if (mode !== "live") return;
+    if (clickMode === "lamp") send({ op: "sim", action: "reset", lamp: [x, y] });
+    else send({ op: "sim", action: "reset", start: [x, y, heading === null ? world.start[2] : heading] });
+  });
+}
+
+function makeChecks(store, send, grid) {
+  const els = { problems: byId("problems"), findings: byId("findings"), properties: byId("properties"),
+    showInfo: byId("show-info") };
+  return new Checks(els, {
+    select: (rows, col) => {
+      grid.select(rows);
+      if (col !== undefined && col !== null) grid.focusCell(rows[0], col);
+    },
+    counterexample: (name, where) => {
+      if (where === "table") store.set({ mode: "trace" });
+      send({ op: "counterexample", name, where });
+    },
+  });
+}
+
+export function createViews(store, send) {
+  const grid = makeGrid(store, send);
+  const arena = makeArena(store, send);
+  const diagram = new Diagram(byId("diagram"));
+  const views = { grid, arena, diagram };
+  views.timeline = new Timeline(byId("timeline"), (i) => views.player.seek(i));
+  views.player = new Player({ arena, grid, diagram, timeline: views.timeline, status: byId("status"),
+    slider: byId("scrub"), stateCol: () => stateColumn(store),
+    onEnd: () => { byId("tplay").textContent = "▶ Play"; }, onSeek: (t) => store.set({ mask: t.event }) });
+  views.checks = makeChecks(store, send, grid);
+  return views;
+}

@@ -1,0 +1,77 @@
+// The checks panel: the parser's errors, check's findings and the property results, each clickable to
+// select its rows; a broken property's counterexample can be played on the table or in the arena.
+import { button, make } from "../lib/dom.js";
+
+const hasRow = (d) => d.row !== null && d.row !== undefined;
+
+export class Checks {
+  constructor(els, actions) {
+    this.els = els;          // {problems, findings, properties, showInfo}
+    this.actions = actions;  // {select(rows, col), counterexample(name, where)}
+    this.data = null;
+    els.showInfo.addEventListener("change", () => this.render(this.data));
+  }
+
+  _item(list, severity, text, hint, onClick) {
+    const li = make("li", { className: "sev-" + severity }, make("span", { className: "tag" }, severity), " ", text);
+    if (hint) li.append(make("div", { className: "hint" }, "hint: " + hint));
+    if (onClick) {
+      li.tabIndex = 0;
+      li.addEventListener("click", onClick);
+      li.addEventListener("keydown", (e) => { if (e.key === "Enter") onClick(); });
+    }
+    list.append(li);
+    return li;
+  }
+
+  render(data) {
+    this.data = data;
+    const { problems, findings, properties } = this.els;
+    for (const list of [problems, findings, properties]) list.textContent = "";
+    if (!data) return;
+    this._problems(data.diagnostics || []);
+    this._findings(data.findings || []);
+    for (const p of data.properties || []) this._property(properties, p);
+    const quiet = !(data.findings || []).some((f) => f.severity !== "info") && !(data.properties || []).some((p) => p.severity);
+    if (data.ok && quiet) findings.prepend(make("li", { className: "sev-ok" }, "no errors, no warnings"));
+  }
+
+  _problems(diagnostics) {
+    for (const d of diagnostics) {
+      const where = d.line ? `${d.file}:${d.line}${d.column ? ":" + d.column : ""}: ` : `${d.file}: `;
+      this._item(this.els.problems, d.severity, where + d.message, d.hint,
+        hasRow(d) ? () => this.actions.select([d.row], d.col) : null);
+    }
+  }
+
+  _findings(all) {
+    const shown = all.filter((f) => this.els.showInfo.checked || f.severity !== "info");
+    for (const f of shown) {
+      const where = f.lines.length ? `line ${f.lines.join(", ")}: ` : "";
+      this._item(this.els.findings, f.severity, where + f.message, f.hint,
+        f.rows.length ? () => this.actions.select(f.rows) : null);
+    }
+    const hidden = all.length - shown.length;
+    if (hidden) this.els.findings.append(make("li", { className: "muted" }, `${hidden} notes (overlaps, ignored inputs) hidden`));
+  }
+
+  _property(list, p) {
+    const holds = p.status === "holds";
+    const word = p.status === "violated" ? "VIOLATED" : "unknown";
+    const li = this._item(list, holds ? "holds" : p.severity || "info", `${holds ? "" : word + ": "}${p.name}: ${p.text}`,
+      holds ? "" : p.note, null);
+    li.title = p.claim;
+    if (p.detail) li.append(make("div", { className: "hint" }, p.detail));
+    if (p.ticks) li.append(this._replayBar(p));
+  }
+
+  _replayBar(p) {
+    const bar = make("div", { className: "cex" }, `${p.example ? "example" : "counterexample"}: ${p.ticks} ticks `);
+    for (const [where, label] of [["table", "▶ on the table"], ["arena", "▶ in the arena"]]) {
+      const b = button(label, (e) => { e.stopPropagation(); this.actions.counterexample(p.name, where); });
+      b.dataset.where = where;
+      bar.append(b);
+    }
+    return bar;
+  }
+}

@@ -1,0 +1,253 @@
+// The table as an editable grid: one input per cell, event and direction cells as toggles, the timer with
+// its time beside it; errors on their cells, findings on their rows, the fired row and current state lit.
+// User text only ever reaches the page through textContent and input values, never as HTML.
+import { make } from "../lib/dom.js";
+
+const RANK = { error: 3, warning: 2, info: 1 };
+const TOGGLES = ["event", "dir"];
+const MOVES = { ArrowUp: -1, ArrowDown: 1, Enter: 1 };
+
+/** A timer's ticks as time ("8.95 s", "500 ms"); "" for anything else. */
+function timeText(value, tickMs) {
+  const v = value.trim();
+  if (!/^\d+$/.test(v) || +v <= 0) return "";
+  const ms = +v * tickMs;
+  return ms >= 1000 ? (ms / 1000).toFixed(ms % 1000 ? 2 : 0).replace(/\.?0+$/, "") + " s" : ms + " ms";
+}
+
+export class Grid {
+  constructor(holder, { onEdit = () => {}, readOnly = false } = {}) {
+    this.holder = holder;
+    this.onEdit = onEdit;
+    this.readOnly = readOnly;
+    this.note = make("div", { className: "cell-note", hidden: true });
+    this.columns = [];
+    this.values = [];
+    this.errors = new Map();  // "row:col" -> diagnostic (row -1: the header)
+    this.timers = new Map();
+    this.tickMs = 10;
+    this.focused = null;
+    this.lastEdited = null;
+    this.firedRow = undefined;
+  }
+
+  setTable(header, rows, lines) {
+    this.header = header;
+    this.values = rows.map((r) => r.slice());
+    this.lines = lines || rows.map((_, i) => i + 2);
+    this.render();
+  }
+
+  setColumns(columns, tickMs) {
+    const changed = JSON.stringify(columns.map((c) => c.kind)) !== JSON.stringify(this.columns.map((c) => c.kind));
+    this.columns = columns;
+    if (tickMs) this.tickMs = tickMs;
+    if (changed && this.header) this.render();
+  }
+
+  kind(col) { return (this.columns[col] || {}).kind || "unknown"; }
+
+  render() {
+    const table = make("table", { className: "grid" });
+    const head = table.createTHead().insertRow();
+    head.append(make("th", { className: "num", title: "the line in the file" }, "line"));
+    this.header.forEach((name, col) => head.append(this._headCell(name, col)));
+    const body = table.createTBody();
+    this.values.forEach((row, r) => body.append(this._row(row, r)));
+    this.holder.replaceChildren(table, this.note);
+    this.table = table;
+    this.firedRow = undefined;
+    this.liveState = undefined;
+    this._paintErrors();
+  }
+
+  _headCell(name, col) {
+    const th = make("th", { className: "k-" + this.kind(col) });
+    th.dataset.col = col;
+    name.split("_").forEach((part, i) => {  // M1_speed may break after the underscore: narrow columns
+      if (i) th.append("_", make("wbr"));
+      th.append(part);
+    });
+    const label = (this.columns[col] || {}).label || "";
+    if (label) {
+      th.append(make("small", {}, label));
+      th.title = name + ": " + label;
+    }
+    return th;
+  }
+
+  _row(values, r) {
+    const tr = make("tr");
+    tr.dataset.row = r;
+    tr.append(make("td", { className: "num", title: `row ${r + 1}, line ${this.lines[r]} of the file` },
+      String(this.lines[r])));
+    values.forEach((value, c) => tr.append(this._cell(value, r, c)));
+    return tr;
+  }
+
+  _cell(value, r, c) {
+    const kind = this.kind(c);
+    const td = make("td", { className: "k-" + kind });
+    td.dataset.row = r; td.dataset.col = c;
+    td.append(TOGGLES.includes(kind) ? this._toggleButton(value, r, c, kind) : this._input(value, r, c, kind));
+    if (kind === "timer") td.append(make("span", { className: "ms" }, timeText(value, this.tickMs)));
+    return td;
+  }
+
+  _toggleButton(value, r, c, kind) {
+    const b = make("button", { type: "button", className: "flag", disabled: this.readOnly });
+    this._flag(b, value, kind);
+    b.addEventListener("click", () => this._toggle(r, c, b));
+    b.addEventListener("focus", () => this._focus(r, c));
+    return b;
+  }
+
+  _input(value, r, c, kind) {
+    const input = make("input", { value, spellcheck: false, readOnly: this.readOnly });
+    input.setAttribute("aria-label", (this.header[c] || "") + " of row " + (r + 1));
+    if (kind !== "description" && kind !== "unknown") input.inputMode = kind === "state" || kind === "next" ? "text" : "numeric";
+    input.addEventListener("input", () => this._typed(r, c, input.value));
+    input.addEventListener("focus", () => this._focus(r, c));
+    input.addEventListener("keydown", (e) => this._keys(e, r, c));
+    return input;
+  }
+
+  _flag(button, value, kind) {
+    const v = value.trim(), on = v === "1";
+    button.setAttribute("aria-pressed", on ? "true" : "false");
+    button.textContent = kind === "dir" ? (on ? "back" : "") : (on ? "1" : "");
+    if (kind === "dir") button.title = on ? "1 = backward" : "blank = forward";
+    if (kind === "event" && v && !on && v !== "0") button.textContent = v;
+  }
+
+  _toggle(r, c, button) {
+    const on = this.values[r][c].trim() === "1";
+    // off is written as the column writes it elsewhere: "0" if the file uses 0s, else a blank cell
+    const zero = this.values.some((row) => row[c].trim() === "0") ? "0" : "";
+    const value = on ? zero : "1";
+    this.values[r][c] = value;
+    this._flag(button, value, this.kind(c));
+    this.lastEdited = [r, c];
+    this.onEdit(r, c, value);
+  }
+
+  _typed(r, c, value) {
+    this.values[r][c] = value;
+    this.lastEdited = [r, c];
+    if (this.kind(c) === "timer") this.td(r, c).querySelector(".ms").textContent = timeText(value, this.tickMs);
+    clearTimeout(this.timers.get(r + ":" + c));
+    this.timers.set(r + ":" + c, setTimeout(() => this.onEdit(r, c, value), 120));
+  }
+
+  _keys(e, r, c) {
+    const move = MOVES[e.key];
+    if (move === undefined || !this.td(r + move, c)) return;
+    e.preventDefault();
+    this.focusCell(r + move, c);
+  }
+
+  _focus(r, c) { this.focused = [r, c]; this._showNote(); }
+
+  td(r, c) { return this.table && this.table.querySelector(`td[data-row="${r}"][data-col="${c}"]`); }
+
+  _tr(r) { return this.table && this.table.querySelector(`tr[data-row="${r}"]`); }
+
+  /** Put the cursor into a cell (its input or toggle). */
+  focusCell(r, c) {
+    const control = this.td(r, c) && this.td(r, c).querySelector("input,button");
+    if (control) control.focus();
+  }
+
+  // --- what the checks say -------------------------------------------------------------------------------
+
+  setDiagnostics(diagnostics) {
+    this.errors.clear();
+    for (const d of diagnostics) {
+      if (d.row === null || d.row === undefined) continue;
+      const key = d.row + ":" + (d.col === null || d.col === undefined ? "row" : d.col);
+      if (!this.errors.has(key)) this.errors.set(key, d);
+    }
+    this._paintErrors();
+  }
+
+  _errorPlace(key) {
+    const [r, c] = key.split(":");
+    if (r === "-1") return this.table.querySelector(`th[data-col="${c}"]`) || this.table.tHead.rows[0].cells[0];
+    return c === "row" ? (this._tr(r) || {}).firstChild : this.td(r, c);
+  }
+
+  _paintErrors() {
+    if (!this.table) return;
+    for (const el of this.table.querySelectorAll(".err")) { el.classList.remove("err"); el.removeAttribute("data-error"); }
+    for (const [key, d] of this.errors) {
+      const el = this._errorPlace(key);
+      if (!el) continue;
+      el.classList.add("err");
+      el.dataset.error = d.message + (d.hint ? "\nhint: " + d.hint : "");
+      el.title = d.text;
+    }
+    this._showNote();
+  }
+
+  _errorAt(place) {
+    return place && (this.errors.get(place[0] + ":" + place[1]) || this.errors.get(place[0] + ":row"));
+  }
+
+  // The located error of the focused cell (else of the cell last edited) in a note under it.
+  _showNote() {
+    const pick = [this.focused, this.lastEdited].find((p) => this._errorAt(p));
+    const td = pick && this.table && this.td(pick[0], pick[1]);
+    if (!td) { this.note.hidden = true; return; }
+    const d = this._errorAt(pick);
+    this.note.replaceChildren(make("b", {}, `line ${d.line}${d.column ? ", column " + d.column : ""}: `), d.message);
+    if (d.hint) this.note.append(make("div", { className: "hint" }, "hint: " + d.hint));
+    this.note.hidden = false;
+    this.note.style.left = Math.max(0, td.offsetLeft - 4) + "px";
+    this.note.style.top = (td.offsetTop + td.offsetHeight + 2) + "px";
+  }
+
+  setFindings(findings) {
+    if (!this.table) return;
+    const worst = new Map();
+    for (const f of findings) {
+      for (const r of f.rows) {
+        const prev = worst.get(r);
+        if (!prev || RANK[f.severity] > RANK[prev.severity]) worst.set(r, f);
+      }
+    }
+    this.table.querySelectorAll("tbody tr").forEach((tr) => {
+      const f = worst.get(+tr.dataset.row);
+      tr.firstChild.dataset.finding = f ? f.severity : "";
+    });
+  }
+
+  select(rows) {
+    if (!this.table) return;
+    this.table.querySelectorAll("tr.selected").forEach((tr) => tr.classList.remove("selected"));
+    rows.forEach((r, i) => {
+      const tr = this._tr(r);
+      if (!tr) return;
+      tr.classList.add("selected");
+      if (i === 0) tr.scrollIntoView({ block: "nearest" });
+    });
+  }
+
+  // The row that fired this tick (-1: none) and the state the machine is in (its id as text).
+  setLive(row, stateId, stateCol) {
+    if (!this.table) return;
+    if (this.firedRow !== row) {
+      const old = this._tr(this.firedRow);
+      if (old) old.classList.remove("fired");
+      const tr = this._tr(row);
+      if (tr) { tr.classList.add("fired"); tr.scrollIntoView({ block: "nearest" }); }
+      this.firedRow = row;
+    }
+    if (this.liveState !== stateId) {
+      this.liveState = stateId;
+      this.table.querySelectorAll("tbody tr").forEach((tr) => {
+        const v = stateCol >= 0 ? (this.values[+tr.dataset.row] || [])[stateCol] : null;
+        tr.classList.toggle("in-state", v !== null && v !== undefined && v.trim() === stateId);
+      });
+    }
+  }
+}

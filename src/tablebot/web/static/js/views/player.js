@@ -1,0 +1,138 @@
+// The trace player: a trace's columns (tick, event, row, state, timer, outputs, pose...) scrubbed and
+// played through the same views as the live robot: arena, grid, diagram, timeline and the status line.
+import { all, byId } from "../lib/dom.js";
+
+const seconds = (ticks, machine) => (ticks * machine.tick_ms / 1000).toFixed(2) + " s";
+
+/** One tick as a line a person reads; t: {tick, state, timer, event, row, outputs: {name: value}}. */
+export function describeTick(machine, t) {
+  const parts = [`tick ${t.tick}`, seconds(t.tick, machine)];
+  const st = machine.states.find((s) => s.id === String(t.state));
+  parts.push(`state ${t.state}` + (st && st.label ? ` (${st.label})` : ""));
+  if (t.timer !== undefined && t.timer !== null) parts.push(`timer ${t.timer} (${seconds(t.timer, machine)})`);
+  parts.push(t.row === null || t.row === undefined || t.row < 0 ? "no row fired" : `row ${t.row + 1} fired`);
+  if (t.event !== undefined && t.event !== null) {
+    const names = machine.events.filter((e, i) => t.event & (1 << (machine.events.length - 1 - i)));
+    parts.push("events: " + (names.join(" + ") || "none"));
+  }
+  if (t.outputs) parts.push(Object.entries(t.outputs).map(([k, v]) => `${k} ${v}`).join(" "));
+  return parts.join(" · ");
+}
+
+/** The path a trace drew: a point every 5 mm or at a state change, [x, y, stateIndex]. */
+function tracePath(columns, stateIndex) {
+  const pts = [];
+  let last = null;
+  for (let i = 0; i < columns.tick.length; i++) {
+    const x = columns.x[i], y = columns.y[i], s = stateIndex[i];
+    if (x === null || y === null) continue;
+    if (!last || last[2] !== s || Math.hypot(x - last[0], y - last[1]) > 0.005) { last = [x, y, s]; pts.push(last); }
+  }
+  return pts;
+}
+
+export class Player {
+  constructor(views) {
+    this.views = views;  // {arena, grid, diagram, timeline, status, slider, stateCol(), onEnd(), onSeek(t)}
+    this.columns = null;
+    this.n = 0;
+    this.index = 0;
+    this.playing = false;
+    this.speed = 1;
+    this._frame = this._frame.bind(this);
+  }
+
+  load(columns, machine, atTick) {
+    this.columns = columns;
+    this.machine = machine;
+    this.n = columns.tick.length;
+    const ids = machine.states.map((s) => s.id);
+    this.stateIndex = columns.state.map((s) => ids.indexOf(String(s)));
+    this.outputNames = machine.outputs.filter((name) => name in columns);
+    this.lightKeys = Object.keys(columns).filter((k) => k.endsWith("_light"));  // right, then left
+    this.views.timeline.setStates(this.stateIndex);
+    this.views.slider.max = Math.max(0, this.n - 1);
+    const arena = this.views.arena;
+    if (arena && "x" in columns) {
+      arena.replayPath = tracePath(columns, this.stateIndex);
+      arena.clearPath();
+      arena.addPath(arena.replayPath);
+    }
+    this.seek(atTick ? Math.min(atTick, this.n - 1) : 0);
+  }
+
+  tickAt(i) {
+    const c = this.columns, outputs = {};
+    for (const name of this.outputNames) outputs[name] = c[name][i];
+    const at = (name) => (c[name] ? c[name][i] : null);
+    return { tick: c.tick[i], state: c.state[i], timer: at("timer"), event: at("event"), row: at("row"), outputs };
+  }
+
+  seek(i) {
+    if (!this.n) return;
+    this.index = Math.max(0, Math.min(this.n - 1, i));
+    const t = this.tickAt(this.index), v = this.views;
+    v.slider.value = this.index;
+    v.timeline.setCursor(this.index);
+    v.status.textContent = describeTick(this.machine, t);
+    v.diagram.highlight(String(t.state));
+    v.grid.setLive(t.row === null ? -1 : t.row, String(t.state), v.stateCol());
+    this._pose();
+    if (v.onSeek) v.onSeek(t, this.index);
+  }
+
+  _pose() {
+    const c = this.columns, i = this.index, arena = this.views.arena;
+    if (!arena || !("x" in c) || c.x[i] === null) return;
+    arena.setRobot([c.x[i], c.y[i], c.heading[i]], c.bumpers ? c.bumpers[i] : 0, this.lightKeys.map((k) => c[k][i]));
+  }
+
+  play(speed) {
+    this.speed = speed || this.speed;
+    if (this.index >= this.n - 1) this.seek(0);
+    this.playing = true;
+    this.started = performance.now();
+    this.from = this.index;
+    requestAnimationFrame(this._frame);
+  }
+
+  pause() { this.playing = false; }
+
+  _frame(now) {
+    if (!this.playing) return;
+    const ms = now - this.started;
+    const ticks = this.speed === 0 ? 40 * ms : ms / this.machine.tick_ms * this.speed;
+    const i = this.from + Math.floor(ticks);
+    this.seek(i);
+    if (i >= this.n - 1) { this.playing = false; if (this.views.onEnd) this.views.onEnd(); return; }
+    requestAnimationFrame(this._frame);
+  }
+}
+
+/** The trace player's buttons (play/pause, scrub, speed), wired the same on the studio and a replay page. */
+export function wirePlayerControls(player) {
+  byId("tplay").addEventListener("click", () => {
+    if (player.playing) player.pause(); else player.play();
+    byId("tplay").textContent = player.playing ? "❚❚ Pause" : "▶ Play";
+  });
+  byId("scrub").addEventListener("input", (e) => player.seek(+e.target.value));
+  for (const b of all("[data-tspeed]")) {
+    b.addEventListener("click", () => {
+      player.speed = +b.dataset.tspeed;
+      if (player.playing) player.play(player.speed);
+      for (const o of all("[data-tspeed]")) o.classList.toggle("on", o === b);
+    });
+  }
+}
+
+/** The page's A−/A+ zoom. */
+export function wireZoom(arena) {
+  let zoom = 1;
+  const setZoom = (z) => {
+    zoom = Math.max(0.8, Math.min(1.6, z));
+    document.documentElement.style.setProperty("--zoom", zoom);
+    arena.resize();
+  };
+  byId("smaller").addEventListener("click", () => setZoom(zoom - 0.1));
+  byId("bigger").addEventListener("click", () => setZoom(zoom + 0.1));
+}
