@@ -20,7 +20,7 @@ from tablebot.codegen.source import ENGINE_FILES, generate, template
 from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import compile_table
 from tablebot.replay import replay
-from tablebot.testing.random_tables import Shape, random_inputs, random_table
+from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
@@ -49,6 +49,15 @@ def test_random_tables_host_c_equals_python(tmp_path_factory, seed, lookup, lamp
     ticks = random_inputs(rng, table, 150)
     exe = build_host(machine, tmp_path_factory.mktemp("host"), lookup)
     assert run_host(exe, machine, ticks) == list(replay(machine, ticks))
+
+
+@pytest.mark.parametrize("match", ["document", "always"])
+@pytest.mark.parametrize("lookup", ["dense", "scan"])
+def test_both_matching_rules_in_c_on_tables_where_they_part(tmp_path, match, lookup):
+    """Tables and inputs on which the two rules take different decisions: C follows the table's own."""
+    table, ticks = random_case(random.Random(f"c-{match}"), Shape(states=3, rows=9, counters=1, match=match))
+    machine = compile_table(table)
+    assert run_host(build_host(machine, tmp_path, lookup), machine, ticks) == list(replay(machine, ticks))
 
 
 def test_wide_table_uses_16_bit_rows_and_scan(tmp_path):

@@ -20,7 +20,7 @@ from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 from tablebot.robot import BUMBERBOT, Counter, Robot
-from tablebot.testing.random_tables import Shape, random_inputs, random_table
+from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 from tablebot.tomlfile import Source
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,6 +105,19 @@ def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed,
     run = emulate(firmware, machine, ticks, work / "run", harness)
     assert run.problems == []
     assert run.trace == list(replay(machine, ticks))
+
+
+@pytest.mark.parametrize("match", ["document", "always"])
+def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness, tmp_path, match):
+    """Under emulation the firmware follows the table's rule where the two part (the scan lookup carries
+    the rule as code, the dense one as data)."""
+    table, ticks = random_case(random.Random(f"fw-{match}"), Shape(states=3, rows=9, inputs=3, counters=1,
+                                                                     match=match), ticks=120)
+    machine = compile_table(table)
+    for lookup in ("scan", "dense"):
+        run = emulate(build(machine, "uno", tmp_path / lookup / "fw", lookup), machine, ticks, tmp_path / lookup,
+                      harness)
+        assert run.problems == [] and run.trace == list(replay(machine, ticks))
 
 
 # --- boards and wiring --------------------------------------------------------------------------

@@ -4,6 +4,7 @@ found BumberBot bug, and the abstraction checked against the exact model on rand
 from __future__ import annotations
 
 import random
+from dataclasses import replace
 from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings
@@ -17,7 +18,7 @@ from tablebot.formats.inputs_csv import TickInput, load_inputs, write_inputs
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 from tablebot.replay import replay
-from tablebot.robot import Robot
+from tablebot.robot import MATCHES, Robot
 from tablebot.table import Row, Table
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
@@ -152,7 +153,23 @@ def tables(draw) -> Table:
             motors = (draw(st.integers(-2, 2)), draw(st.sampled_from([None, -1, 0, 1])))
             rows.append(Row(len(rows), len(rows) + 2, "", state, events, motors,
                             draw(st.integers(0, 6)), draw(st.integers(1, n))))
-    return Table(ROBOT, EVENTS, tuple(rows), "<random>")
+    robot = replace(ROBOT, match=draw(st.sampled_from(MATCHES)))  # the document's: no event, no row
+    return Table(robot, EVENTS, tuple(rows), "<random>")
+
+
+@settings(max_examples=80, deadline=None)
+@given(tables())
+def test_the_model_offers_every_row_any_inputs_can_fire(table):
+    """Per state and timer context, the model's input classes reach every outcome some input set gives
+    (under the document's rule, an input the state's rows never use still matters on its own)."""
+    machine = compile_table(table)
+    model = Model(machine)
+    every_input_set = range(machine.input_mask + 1)
+    for state in range(len(machine.states)):
+        for context in (0, machine.timer_bit):
+            offered = {row for _, row in model.classes(state, context)}
+            assert offered == {machine.lookup(state, inputs | context) for inputs in every_input_set
+                               if not inputs & ~machine.input_mask}
 
 
 CONDITIONS = ["A", "state == 1", "state == 2", "M1 > 0", "M2 < 0", "T", "fired", "not A and M1 == 0"]

@@ -26,7 +26,7 @@ from tablebot.robopro.interpret import InterpreterError, Program, Run
 from tablebot.robopro.program import generate
 from tablebot.robopro.vocabulary import problems as vocabulary_problems
 from tablebot.table import Row, Table
-from tablebot.testing.random_tables import Shape, random_inputs, random_table
+from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table, with_match
 
 COUNTERS = ROOT / "examples" / "bumberbot-counters"
 
@@ -129,7 +129,7 @@ def test_counters_reach_the_program():
     assert vocabulary_problems(text) == []
     rng = random.Random(4)
     inputs = random_inputs(rng, table, 300, density=0.05, max_pulses=3)
-    assert program_ticks(table, text, inputs, "always") == engine_ticks(compile_table(table), inputs)
+    assert program_ticks(table, text, inputs, table.robot.match) == engine_ticks(compile_table(table), inputs)
 
 
 # --- random tables ----------------------------------------------------------------------------------------
@@ -146,13 +146,22 @@ WIRINGS = st.fixed_dictionaries({"controller": st.sampled_from(["tx", "txt"])}, 
 def test_random_tables_tick_for_tick(seed, counters, inputs, rule, sections):
     rng = random.Random(seed)
     shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, max_timer=4, max_load=5)
-    table = fitting(random_table(rng, shape), sections)
+    table = with_match(fitting(random_table(rng, shape), sections), rule)
     ticks = random_inputs(rng, table, 50, density=0.25, max_pulses=2)
     machine = compile_table(table)
     expected = reference(machine, ticks, rule)
-    if rule == "always":
-        assert expected == engine_ticks(machine, ticks)  # the reference is the engine's rule
+    assert expected == engine_ticks(machine, ticks)  # the reference is the engine's rule, the table's match
     assert program_ticks(table, generate(table, rule), ticks, rule) == expected
+
+
+@pytest.mark.parametrize("rule", ["document", "always"])
+def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule):
+    """Generated for the table's own rule (the robot file's match, no rule given), on tables and inputs where
+    the two rules take different decisions: the program takes the engine's."""
+    table, ticks = random_case(random.Random(f"robopro-{rule}"),
+                               Shape(states=3, rows=8, inputs=2, counters=1, max_timer=4, max_load=5, match=rule))
+    table = fitting(table, {"controller": "txt"})  # the TXT counts pulses; the ROBO Interface has no counters
+    assert [astuple(d) for d in run(table, ticks)] == engine_ticks(compile_table(table), ticks)
 
 
 def test_the_rules_differ_where_the_document_says():

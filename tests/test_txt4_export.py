@@ -25,7 +25,7 @@ from tablebot.escape import python_string
 from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
-from tablebot.testing.random_tables import Shape, random_inputs, random_table
+from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 
 
 def load_program(folder: Path) -> ModuleType:
@@ -59,6 +59,21 @@ def test_the_exported_engine_takes_the_python_engines_decisions_tick_for_tick(tm
     program = load_program(tmp_path)
     ours, theirs = Engine(machine), program.Engine(program.TABLE)
     for tick in random_inputs(rng, machine.table, 400, max_pulses=3):
+        ours.step(tick.mask, tick.pulses)
+        theirs.step(tick.mask, list(tick.pulses))
+        assert (theirs.state, theirs.timer, theirs.event, theirs.row) == (ours.state, ours.timer, ours.event, ours.row)
+        assert (tuple(theirs.outputs), theirs.counters) == (ours.outputs, ours.counters)
+
+
+@pytest.mark.parametrize("match", ["document", "always"])
+def test_the_exported_engine_follows_the_tables_matching_rule(tmp_path: Path, match: str) -> None:
+    """On a table and inputs where the two rules part, the program takes the engine's decisions."""
+    table, ticks = random_case(random.Random(f"txt4-{match}"), Shape(states=3, rows=9, counters=1, match=match))
+    machine = with_txt_section(table)
+    export_txt4(machine).write(tmp_path)
+    program = load_program(tmp_path)
+    ours, theirs = Engine(machine), program.Engine(program.TABLE)
+    for tick in ticks:
         ours.step(tick.mask, tick.pulses)
         theirs.step(tick.mask, list(tick.pulses))
         assert (theirs.state, theirs.timer, theirs.event, theirs.row) == (ours.state, ours.timer, ours.event, ours.row)

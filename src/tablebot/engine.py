@@ -2,7 +2,8 @@
 
 Per tick: after the first tick the timer counts down (never below 0) and each counter counts down
 by its pulses; the event set is the inputs that read 1 plus T (and each Cn) at 0; the first
-matching row of the current state fires. The engine knows nothing of files, hardware or time.
+matching row of the current state fires (:meth:`tablebot.machine.Machine.lookup`, which also decides a
+tick with no event by the table's rule). The engine knows nothing of files, hardware or time.
 """
 
 from __future__ import annotations
@@ -315,18 +316,18 @@ def _transitions(machine: Machine) -> list[Any]:
         flat, size = machine.flat, 1 << width
         return [[None if (i := flat[s * size + e]) == NO_ROW else hits[i] for e in range(size)]
                 for s in range(len(machine.states))]
-    return [_WideHits(machine.dispatch[s], hits) for s in range(len(machine.states))]
+    return [_WideHits(machine, s, hits) for s in range(len(machine.states))]
 
 
 class _WideHits(dict[int, Any]):
     """One state of a wide table: full event mask -> hit, computed on first use and cached."""
 
-    def __init__(self, dispatch: Any, hits: list[Hit]):
+    def __init__(self, machine: Machine, state: int, hits: list[Hit]):
         super().__init__()
-        self.dispatch, self.hits = dispatch, hits
+        self.machine, self.state, self.hits = machine, state, hits
 
     def __missing__(self, events: int) -> Hit | None:
-        index = self.dispatch[events & self.dispatch.relevant]
+        index = self.machine.lookup(self.state, events)
         self[events] = hit = None if index == NO_ROW else self.hits[index]
         return hit
 

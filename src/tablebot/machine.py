@@ -1,8 +1,10 @@
 """The compiled machine: a parsed table turned into integer masks and per-state lookup maps.
 
-This module owns the event-matching rule (:func:`first_match`): the first row of the current
-state, in table order, whose required events are a subset of the present events fires.
-Compilation precomputes that rule per state so that a tick costs O(1) in the number of rows.
+This module owns the event-matching rule (:meth:`Machine.lookup`): the first row of the current
+state, in table order, whose required events are a subset of the present events fires
+(:func:`first_match`), except that under the document's rule (the robot file's ``match``) a tick with no
+event at all looks up no row. Compilation precomputes that rule per state, so a tick costs O(1) in the
+number of rows and every loop that indexes the precomputed lookups follows the table's rule for free.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from tablebot.robot import StateId
+from tablebot.robot import MATCH_DOCUMENT, StateId
 from tablebot.table import TIMER_EVENT, Table
 
 #: Per state, lookups are precomputed for every combination of the bits its rows use when there
@@ -40,7 +42,8 @@ class CompiledRow:
 
 
 def first_match(rows: Sequence[CompiledRow], events: int) -> CompiledRow | None:
-    """THE matching rule: the first row whose required event bits are all in ``events``."""
+    """The first row whose required event bits are all in ``events`` (the rule within one state; the
+    document's "if an event is detected" is :meth:`Machine.lookup`'s)."""
     for row in rows:
         if row.mask & events == row.mask:
             return row
@@ -48,7 +51,8 @@ def first_match(rows: Sequence[CompiledRow], events: int) -> CompiledRow | None:
 
 
 class Dispatch(dict[int, int]):
-    """One state's map from (events masked to the bits its rows use) to the row that fires."""
+    """One state's map from (events masked to the bits its rows use) to the first match; key 0 is then
+    every event set with none of those bits, so the empty set's answer is :meth:`Machine.lookup`'s."""
 
     def __init__(self, rows: Sequence[CompiledRow]):
         super().__init__()
@@ -83,6 +87,8 @@ class Machine:
     input_bits: dict[str, int]
     initial_state: int
     initial_timer: int
+    #: The document's rule: a tick with no event at all looks up no row (robot file ``match = "document"``).
+    needs_event: bool = False
 
     @property
     def output_names(self) -> tuple[str, ...]:
@@ -101,7 +107,10 @@ class Machine:
         return self.states.index(state)
 
     def lookup(self, state: int, events: int) -> int:
-        """Index of the row that fires in ``state`` for ``events``, or -1; O(1) after compilation."""
+        """Index of the row that fires in ``state`` for ``events`` (a full event mask), or -1; O(1) after
+        compilation. THE matching rule: every other lookup (:attr:`flat`, the arrays, C) is made from it."""
+        if not events and self.needs_event:  # the document: a row is looked up only if an event is detected
+            return NO_ROW
         dispatch = self.dispatch[state]
         return dispatch[events & dispatch.relevant]
 
@@ -112,7 +121,11 @@ class Machine:
         width = len(self.table.events)
         if width > FLAT_BITS:
             return None
-        return [dispatch[events & dispatch.relevant] for dispatch in self.dispatch for events in range(1 << width)]
+        size = 1 << width
+        flat = [dispatch[events & dispatch.relevant] for dispatch in self.dispatch for events in range(size)]
+        for state in range(len(self.states)):  # the empty event set is where the two rules differ
+            flat[state * size] = self.lookup(state, 0)
+        return flat
 
     @cached_property
     def arrays(self) -> MachineArrays | None:
@@ -122,10 +135,13 @@ class Machine:
         return MachineArrays.of(self)
 
     def signature(self) -> tuple:
-        """What defines behaviour (not descriptions or file lines): equal signatures, equal machines."""
+        """What defines behaviour (not descriptions or file lines): equal signatures, equal machines. The
+        document's rule is part of it only where it can matter (a row that requires no event), so a table's
+        signature, and the C engine's table hash made from it, is what it was before the rule was a choice."""
+        rule = ("needs an event",) if self.needs_event and any(not r.mask for r in self.rows) else ()
         return (self.states, self.table.events, self.timer_bit, self.counter_bits,
                 tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
-                self.initial_state, self.initial_timer, self.output_names)
+                self.initial_state, self.initial_timer, self.output_names, *rule)
 
 
 @dataclass(frozen=True)
@@ -194,4 +210,5 @@ def compile_table(table: Table) -> Machine:
         counter_bits=tuple(bit(c) if c in table.events else 0 for c in robot.counter_names),
         input_bits={name: bit(name) for name in table.input_events},
         initial_state=index[robot.initial_state], initial_timer=robot.initial_timer,
+        needs_event=robot.match == MATCH_DOCUMENT,
     )

@@ -16,7 +16,7 @@ from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
 StateId = int | str
-TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer")
+TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer", "match")
 CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
 
 #: Reads one section of a robot file that belongs to a later stage: ``(src, data, robot) -> value``, the
@@ -51,6 +51,16 @@ STATE_HINT = "use a number, or a name that starts with A-Z or _ (then letters, d
 #: Timer loads and the initial timer are 16-bit tick counts; one tick lasts at most a minute.
 MAX_TIMER = 65535
 MAX_TICK_MS = 60_000
+#: ``match``: what a row that requires no event does on a tick with no event at all (no input reads 1, T
+#: absent, no counter at 0). "document": nothing fires, as in the document's engine, which looks a row up
+#: only "if an event is detected"; "always": such a row matches every event set, the empty one too.
+MATCH_DOCUMENT, MATCH_ALWAYS = "document", "always"
+MATCHES = (MATCH_DOCUMENT, MATCH_ALWAYS)
+#: A robot file that does not say: tablebot's rule from before the key existed, so that no existing table
+#: silently changes (``tablebot check`` says when the choice matters). The built-in BumberBot follows the document.
+DEFAULT_MATCH = MATCH_ALWAYS
+MATCH_HINT = ('match = "document": a row that requires no event fires only on a tick with some event, as in the '
+              'document\'s engine; match = "always": it fires on every tick, even one with no event at all')
 RESERVED_NAMES = {"T", "description", "state", "timer", "next"}
 #: Header names the table parser reads case-insensitively as fixed columns (aliases included).
 RESERVED_LOWER = {"description", "desc", "state", "st", "timer", "next"}
@@ -76,6 +86,8 @@ class Robot:
     initial_state: StateId = 1
     initial_timer: int = 0
     tick_ms: int = 10
+    #: The matching rule for rows that require no event (MATCHES; see MATCH_DOCUMENT).
+    match: str = DEFAULT_MATCH
     #: What drives each input that is not a plain switch (``[sensors]``; see :mod:`tablebot.sensors`).
     sensors: tuple[Sensor, ...] = ()
     labels: dict[str, str] = field(default_factory=dict, compare=False)
@@ -95,6 +107,11 @@ class Robot:
     def counter_names(self) -> tuple[str, ...]:
         return tuple(c.name for c in self.counters)
 
+    @property
+    def says_match(self) -> bool:
+        """Whether the robot's own file chose the matching rule (the built-in robot's is the document's)."""
+        return self.toml is not None and "match" in self.toml.data
+
     def line(self, section: str, key: str | None = None) -> int | None:
         """Line of ``[section] key`` (top-level keys: section "") in the robot file, if it has one."""
         return self.toml.line(section, None, key) if self.toml else None
@@ -112,6 +129,7 @@ BUMBERBOT = Robot(
     initial_state=2,
     initial_timer=0,
     tick_ms=10,
+    match=MATCH_DOCUMENT,
     labels={"I3": "front-right bumper", "I4": "front-left bumper", "I5": "rear bumper",
             "I7": "right phototransistor", "I8": "left phototransistor",
             "M1": "right motor", "M2": "left motor"},
@@ -149,6 +167,7 @@ def load_robot(path: str | Path) -> Robot:
     initial_timer = _whole(src, "initial_timer", 0, (0, MAX_TIMER), f"a whole number 0..{MAX_TIMER}",
                            "the timer counts ticks; 0 means it has expired")
     initial_state = _initial_state(src)
+    match = _match(src)
     states = _state_names(src)
     name = data.get("name", path.stem)
     if not isinstance(name, str):
@@ -157,7 +176,7 @@ def load_robot(path: str | Path) -> Robot:
     # file shows in one go; their readers see the names that did read.
     robot = Robot(
         name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
-        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms, sensors=sensors,
+        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms, match=match, sensors=sensors,
         labels={**inputs, **motors, **lamps}, state_names=states, source=str(path), toml=src,
     )
     robot.sections.update(_foreign_sections(src, robot))
@@ -252,6 +271,16 @@ def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], want: s
         src.key_error(("", None, key), f"{key} must be {want}, not {value!r}", hint)
         return default
     return value
+
+
+def _match(src: Source) -> str:
+    """``match = "document"`` or ``"always"`` (DEFAULT_MATCH when the file does not say)."""
+    value = src.data.get("match", DEFAULT_MATCH)
+    if value not in MATCHES:
+        src.key_error(("", None, "match"), f'match must be "{MATCH_DOCUMENT}" or "{MATCH_ALWAYS}", not {value!r}',
+                      MATCH_HINT)
+        return DEFAULT_MATCH
+    return str(value)
 
 
 def _state_id(value: Any) -> StateId | None:

@@ -128,6 +128,48 @@ class Table:
         return tuple(e for e in self.events if e in self.robot.inputs)
 
 
+@dataclass(frozen=True)
+class NoEventRow:
+    """The first row of a state that requires no event (a later one never fires), and what can bring a tick
+    with no event at all in that state: the one place the two matching rules (the robot file's ``match``)
+    part. There ``always`` fires the row and ``document`` fires nothing."""
+
+    row: Row
+    #: Why a tick with no event can come in the row's state; "" when it cannot (T is there on every tick).
+    quiet: str
+
+
+def no_event_rows(table: Table) -> list[NoEventRow]:
+    """Per state with a row that requires no event, that row and whether the matching rule can matter there.
+
+    A tick in a state has T whenever the timer is 0 on it: when T is an event column, the robot never starts
+    in the state with a timer above 0, and every row that leads into it loads the timer with 0 or 1 (1 has
+    counted down to 0 by the next tick), the event set is never empty there and both rules agree. Anything
+    else (inputs, counters) is assumed to be able to stay silent, so "can come" may be said of a state that
+    never sees such a tick (one never reached, say), never the other way round.
+    """
+    found = []
+    for state, rows in table.rows_by_state.items():
+        row = next((r for r in rows if not r.events), None)
+        if row is not None:
+            found.append(NoEventRow(row, _quiet_tick(table, state)))
+    return found
+
+
+def _quiet_tick(table: Table, state: StateId) -> str:
+    robot = table.robot
+    if TIMER_EVENT not in table.events:
+        counters = " and no counter is at 0" if set(robot.counter_names) & set(table.events) else ""
+        return f"the table has no T column, so a tick on which no input reads 1{counters} has no event"
+    if state == robot.initial_state and robot.initial_timer > 0:
+        return f"the robot starts in it with timer {robot.initial_timer}, and T is absent until that runs out"
+    slow = [r for r in table.rows if r.next == state and r.timer > 1]
+    if not slow:
+        return ""
+    more = f" (and {len(slow) - 1} more rows)" if len(slow) > 1 else ""
+    return f"line {slow[0].line} leads into it with timer {slow[0].timer}{more}, and T is absent until that runs out"
+
+
 #: A state that is used but has no rows: (the row whose next state it is, or None when the robot
 #: file names it; where the robot file names it, as (section, key); message; hint).
 MissingState = tuple[Row | None, tuple[str, str], str, str]

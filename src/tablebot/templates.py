@@ -192,6 +192,8 @@ name = "{name}"
 tick_ms = 10          # one engine tick; the table's timer counts these (or write 500ms, 0.5s)
 initial_state = 1
 initial_timer = 0
+match = "document"    # a row that requires no event fires only on a tick with some event, as in the
+                      # document's engine; "always": on every tick, even one with no event at all
 
 [inputs]              # each input is an event column of the table: 1 = it reads 1
 {inputs}

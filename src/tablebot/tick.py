@@ -21,7 +21,8 @@ def tick(regs, outputs, counters, inputs, pulses, program):  # type: ignore[no-u
     1. after the first tick the timer counts down (never below 0) and each counter by its pulses;
     2. the events are the inputs that read 1, plus T when the timer is 0, plus Cn when counter n is 0;
     3. the first row of the current state whose required events are all present fires (precomputed
-       into ``lookup[state, events]``);
+       into ``lookup[state, events]`` by :meth:`tablebot.machine.Machine.lookup`, so the table's rule for a
+       tick with no event at all, the robot file's ``match``, is in ``lookup[state, 0]``: no flag here);
     4. it sets each output it does not keep, loads the timer and the counters it names, and moves on.
     """
     input_mask, timer_bit, lookup, nxt, timers, new_outputs, keep, loads, load_set, counter_bits = program

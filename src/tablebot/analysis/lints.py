@@ -1,6 +1,7 @@
 """What ``tablebot check`` finds in a table without any properties: rows that can never fire,
 order-dependent overlaps, unreachable states, dead ends, zero-time loops, timers that never run
-out, ignored inputs and export limits. Each finding names rows by their line in the file.
+out, ignored inputs, rows that require no event (what the matching rule does with them) and export
+limits. Each finding names rows by their line in the file.
 """
 
 from __future__ import annotations
@@ -8,14 +9,14 @@ from __future__ import annotations
 import functools
 import operator
 from dataclasses import dataclass, field
-from typing import Any
 
 from tablebot import registry
 from tablebot.analysis.finding import SEVERITIES, Finding
 from tablebot.analysis.loops import zero_time_loops
+from tablebot.analysis.matching import no_event_findings
 from tablebot.analysis.model import Graph, Model
 from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
-from tablebot.machine import NO_ROW, Machine, first_match
+from tablebot.machine import NO_ROW, Machine
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
@@ -27,7 +28,7 @@ def find_all(machine: Machine, graph: Graph | None = None, targets: tuple[str, .
     table = machine.table
     graph = graph or Model(machine).explore()
     shadowed = shadowed_rows(table)
-    found = [*shadowed, *overlaps(table), *ignored_inputs(machine), *zero_time_loops(graph)]
+    found = [*shadowed, *overlaps(table), *ignored_inputs(machine), *zero_time_loops(graph), *no_event_findings(table)]
     found += reachability(machine, graph, {f.lines[0] for f in shadowed})
     for target in targets:
         found += encoding(machine, target)
@@ -122,8 +123,7 @@ def ignored_inputs(machine: Machine) -> list[Finding]:
     table = machine.table
     found = []
     for index, state in enumerate(machine.states):
-        dispatch = machine.dispatch[index]
-        ignored = [name for name, bit in machine.input_bits.items() if _never_matters(dispatch, bit)]
+        ignored = [name for name, bit in machine.input_bits.items() if _never_matters(machine, index, bit)]
         if not ignored or not rows_of(table, state):
             continue
         names = ", ".join(event_name(table, n) for n in ignored)
@@ -133,15 +133,16 @@ def ignored_inputs(machine: Machine) -> list[Finding]:
     return found
 
 
-def _never_matters(dispatch: Any, bit: int) -> bool:
-    if not dispatch.relevant & bit:
-        return True
-    relevant = dispatch.relevant
+def _never_matters(machine: Machine, state: int, bit: int) -> bool:
+    relevant = machine.dispatch[state].relevant
+    if not relevant & bit:  # unless it alone makes a tick with no other event fire a row (the document's rule)
+        return machine.lookup(state, bit) == machine.lookup(state, 0)
     if relevant.bit_count() > MAX_IGNORED_BITS:
         return False
+    lookup = machine.lookup
     sub = relevant
     while True:
-        if dispatch[sub] != dispatch[sub ^ bit]:
+        if lookup(state, sub) != lookup(state, sub ^ bit):
             return False
         if sub == 0:
             return True
@@ -245,9 +246,11 @@ def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> s
         missing = [e for e in mask_events(table, needs) if not any(c & table.bit(e) for c in contexts)]
         return (f"row on line {row.line} can never fire: it needs {events_text(table, missing)}, "
                 f"which never happens while the robot is in {where}")
-    rows = machine.dispatch[index].rows
-    winners = {first_match(rows, c | (mask & machine.input_mask)) for c in fits}
-    lines = sorted(table.rows[w.index].line for w in winners if w is not None)
+    winners = {machine.lookup(index, c | (mask & machine.input_mask)) for c in fits}
+    lines = sorted(table.rows[w].line for w in winners if w != NO_ROW)
+    if not lines:  # it needs no event, and no event ever comes here: the document's rule looks up no row
+        return (f"row on line {row.line} can never fire: it requires no event, and in {where} no event ever "
+                'comes, so under match = "document" no row is looked up there')
     always = functools.reduce(operator.and_, fits) & ~needs
     also = events_text(table, mask_events(table, always))
     because = f" (in {where} there is always {also} as well)" if always else ""

@@ -105,14 +105,18 @@ class Model:
         if cached is not None:
             return cached
         m = self.machine
-        dispatch = m.dispatch[state]
-        bits = (dispatch.relevant | self.watch) & m.input_mask
+        bits = (m.dispatch[state].relevant | self.watch) & m.input_mask
+        if m.needs_event and not context and m.input_mask & ~bits:
+            # Under the document's rule whether any event is present matters too: the lowest input the
+            # rows do not use stands for "some other input reads 1".
+            spare = m.input_mask & ~bits
+            bits |= spare & -spare
         if bits.bit_count() > MAX_ENUMERATED_BITS:
             raise ModelTooLarge(f"state {m.states[state]} depends on {bits.bit_count()} inputs")
         seen: dict[tuple[int, int], int] = {}
         for inputs in sorted(_subsets(bits), key=lambda x: (x.bit_count(), x)):
             events = inputs | context
-            row = dispatch[events & dispatch.relevant]
+            row = m.lookup(state, events)
             seen.setdefault((row, inputs & self.watch), events)
         result = [(events, row) for (row, _), events in seen.items()]
         self._classes[key] = result

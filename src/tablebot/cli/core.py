@@ -21,6 +21,7 @@ from tablebot.cli.common import (
     out_folder,
 )
 from tablebot.escape import terminal
+from tablebot.table import Table
 
 
 class Source(StrEnum):
@@ -43,12 +44,29 @@ def import_cmd(
     from tablebot.robot import BUMBERBOT, load_robot
 
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
+    for line in _rule_warnings(table):
+        err_console.print(f"warning: {terminal(line)}")
     text = format_table(table)
     if out is None:
         sys.stdout.write(text)
     else:
         write_text(out_file(out, "--out"), text)
         err_console.print(f"wrote {terminal(str(out))} ({len(table.rows)} rows; descriptions are not in the lists)")
+
+
+def _rule_warnings(table: Table) -> list[str]:
+    """The lists ran in the document's engine; a robot whose rule is "always" would run a row that requires no
+    event differently wherever a tick with no event can come."""
+    from tablebot.robot import MATCH_DOCUMENT
+    from tablebot.table import no_event_rows
+
+    if table.robot.match == MATCH_DOCUMENT:
+        return []
+    return [f"line {f.row.line} of the lists requires no event: the document's engine, which ran these lists, "
+            f"fires nothing on a tick with no event, but {table.robot.source} follows match = \"always\" (it fires "
+            f"the row there), and such a tick can come in state {f.row.state!r} ({f.quiet}); write "
+            f"match = \"document\" in {table.robot.source} to run the table as the lists ran"
+            for f in no_event_rows(table) if f.quiet]
 
 
 @app.command("trace")

@@ -98,6 +98,7 @@ def config_header(machine: Machine, layout: Layout) -> str:
         f"#define TB_COUNTER_BITS {counter_bits}",
         f"#define TB_INITIAL_STATE {machine.initial_state}u",
         f"#define TB_INITIAL_TIMER {machine.initial_timer}u",
+        f"#define TB_NEEDS_EVENT {int(machine.needs_event)}",
         f"#define TB_LOOKUP_DENSE {int(layout.dense)}",
         f"#define TB_N_SCAN {max(1, len(layout.scan))}",
         "",

@@ -28,8 +28,9 @@ class Decision:
     counters: tuple[int, ...]
 
 
-def run(table: Table, inputs: Sequence[TickInput], rule: Rule = "always") -> list[Decision]:
-    """Run ``table``'s generated program on ``inputs`` (the input mask and the counters' pulses per tick)."""
+def run(table: Table, inputs: Sequence[TickInput], rule: Rule | None = None) -> list[Decision]:
+    """Run ``table``'s generated program on ``inputs`` (the input mask and the counters' pulses per tick), under
+    ``rule`` (default: the table's own, the robot file's ``match``)."""
     p = plan(table, rule)
     index_of = {p.numbers[s]: i for i, s in enumerate(compile_table(table).states)}
     machine = Run(Program(generate(table, rule)))

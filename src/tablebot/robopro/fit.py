@@ -128,7 +128,7 @@ class Plan:
                 f"({robot.tick_ms} ms), CountDown. Rule: {rule}.")
 
 
-def problems(table: Table, rule: str = "always") -> list[Diagnostic]:
+def problems(table: Table, rule: str | None = None) -> list[Diagnostic]:
     """Every reason ``table`` does not fit the generated program, located in the table or robot file."""
     robot = table.robot
     out = Collector(table.path)
@@ -208,8 +208,9 @@ def machine_problems(machine: Machine) -> list[Diagnostic]:
     return problems(machine.table)
 
 
-def plan(table: Table, rule: str = "always") -> Plan:
+def plan(table: Table, rule: str | None = None) -> Plan:
+    """What the generator needs; ``rule`` defaults to the table's own (the robot file's ``match``)."""
     found = problems(table, rule)
     if found:
         raise TableBotError(found)
-    return Plan(table, wiring(table.robot), rule, number_states(table))
+    return Plan(table, wiring(table.robot), rule or table.robot.match, number_states(table))

@@ -17,7 +17,7 @@ from tablebot.csvtext import read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.files import atomic_write, write_text
 from tablebot.fileset import file_set
-from tablebot.robot import STATE_RE, Robot, StateId
+from tablebot.robot import MATCH_DOCUMENT, STATE_RE, Robot, StateId
 from tablebot.table import (
     DOC_KEEP_SPEED,
     TIMER_EVENT,
@@ -25,6 +25,7 @@ from tablebot.table import (
     Table,
     from_direction_speed,
     missing_states,
+    no_event_rows,
     to_direction_speed,
 )
 
@@ -107,7 +108,28 @@ def fit_problems(table: Table) -> list[Diagnostic]:
             if speed is not None and abs(speed) >= DOC_KEEP_SPEED:
                 out.error(row.line, None, f"row {row.index}: {motor} speed {abs(speed)} does not fit",
                           "the document's speeds are 0..6 (7 means keep): use 6 or less")
+    _rule_problems(table, out)
     return out.items
+
+
+def _rule_problems(table: Table, out: Collector) -> None:
+    """The lists are run by the document's engine, which looks a row up only if an event is detected: a row
+    that requires no event, in a table that fires it on a tick with no event (``match = "always"``) where such
+    a tick can come, would drive another robot there."""
+    robot = table.robot
+    if robot.match == MATCH_DOCUMENT:
+        return
+    said = (f'match = "always" in {robot.source}' if robot.says_match
+            else f'{robot.source} does not say match, so "always"')
+    for found in no_event_rows(table):
+        if found.quiet:
+            out.error(found.row.line, None,
+                      f"row {found.row.index} requires no event and the table fires it even on a tick with no event "
+                      f"at all ({said}), which can come in state {found.row.state!r}: {found.quiet}; the document's "
+                      "engine, which runs these lists, looks a row up only if an event is detected, so there it "
+                      "would do nothing",
+                      f'write match = "document" in {robot.source} if the robot should do nothing on such a tick '
+                      "(tablebot then runs it so too), or give the row an event to wait for")
 
 
 def encode(table: Table) -> Lists:

@@ -7,7 +7,8 @@ proves it on random tables): after the first pass the timer TM counts down by on
 counter by the pulses its input counted; EV holds T, the inputs reading their active level and each Cn at
 0; the first row of the Event list whose state is ST and whose event bits are all in EV fires. ``rule``
 says what happens on a pass whose EV is empty: ``"document"`` looks up no row ("if an event is
-detected"), ``"always"`` looks up as on any pass (a row that requires no event matches).
+detected"), ``"always"`` looks up as on any pass (a row that requires no event matches); by default the
+table's own rule, the robot file's ``match``.
 """
 
 from __future__ import annotations
@@ -227,8 +228,10 @@ def main_program(b: Builder) -> Sub:
     return b.finish(MAIN, s, [], p.summary(), inputs=[])
 
 
-def generate(table: Table, rule: Rule = "always") -> str:
-    """The whole .rpp text for ``table``; raises :class:`TableBotError` when the table does not fit."""
+def generate(table: Table, rule: Rule | None = None) -> str:
+    """The whole .rpp text for ``table`` under ``rule`` (default: the table's own, the robot file's ``match``);
+    raises :class:`TableBotError` when the table does not fit."""
+    rule = rule or table.robot.match  # type: ignore[assignment]
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, not {rule!r}")
     p = plan(table, rule)

@@ -174,6 +174,10 @@ def explain(table: Table, machine: Machine, state: int, events: int) -> list[dic
         elif missing:
             why = f"row {compiled.index + 1} (line {row.line}) did not fire: it needs {' + '.join(missing)}"
             status = "missing"
+        elif fired == NO_ROW:  # it needs nothing, yet nothing fired: the document's rule on a tick with no event
+            why = (f"row {compiled.index + 1} (line {row.line}) did not fire: no event this tick, and with "
+                   'match = "document" no row is looked up then')
+            status = "missing"
         else:
             why = (f"row {compiled.index + 1} (line {row.line}) did not fire: row {fired + 1} comes first "
                    "and matches too")

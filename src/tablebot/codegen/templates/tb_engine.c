@@ -22,12 +22,19 @@ void tb_init(tb_engine_t *e)
 tb_row_t tb_lookup_row(tb_state_t state, tb_event_t events)
 {
 #if TB_LOOKUP_DENSE
-    /* One table entry per (state, event set): the first match was decided at generation. */
+    /* One table entry per (state, event set): the first match, and the rule for no event, were
+     * decided at generation. */
     return TB_RD_ROW(&tb_lookup[((TB_INDEX_T)state << TB_N_EVENTS) | events]);
 #else
     /* The state's rows in table order, unreachable ones dropped at generation. */
     uint16_t i = TB_RD16(&tb_scan_start[state]);
-    uint16_t end = TB_RD16(&tb_scan_start[state + 1]);
+    uint16_t end;
+#if TB_NEEDS_EVENT
+    /* The document's engine looks a row up only if an event is detected. */
+    if (!events)
+        return TB_NO_ROW;
+#endif
+    end = TB_RD16(&tb_scan_start[state + 1]);
     for (; i < end; i++) {
         tb_event_t mask = TB_RD_EVENT(&tb_scan_mask[i]);
         if ((events & mask) == mask)

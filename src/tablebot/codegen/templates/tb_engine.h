@@ -8,7 +8,8 @@
  *     counter n is 0 (event columns in table order, first column = highest bit);
  *   - the first row of the current state whose required events are all present fires:
  *     outputs (TB_KEEP = leave as it is), timer load, counter loads, next state.
- *     No matching row: nothing changes.
+ *     No matching row: nothing changes. With TB_NEEDS_EVENT (the robot file's
+ *     match = "document") a tick with no event at all looks up no row, as in the document.
  * tb_config.h and tb_table.c are generated per table; this file and tb_engine.c are not.
  */
 #ifndef TB_ENGINE_H

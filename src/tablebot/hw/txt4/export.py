@@ -86,6 +86,7 @@ def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
         "name": robot.name, "source": table.path, "tick_ms": robot.tick_ms,
         "states": list(machine.states), "initial_state": machine.initial_state, "initial_timer": machine.initial_timer,
         "input_mask": machine.input_mask, "timer_bit": machine.timer_bit, "counter_bits": list(machine.counter_bits),
+        "match": robot.match,
         "n_outputs": len(machine.output_names), "rows": per_state,
         "inputs": [{"name": w.name, "terminal": w.terminal + 1, "mode": w.mode, "invert": w.invert,
                     "below": w.below, "above": w.above, "hysteresis": w.hysteresis, "bit": bit}

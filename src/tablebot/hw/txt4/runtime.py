@@ -34,12 +34,14 @@ TABLE: dict = {}  # the exported table (appended by ``tablebot export --to txt4`
 
 class Engine:
     """One tick of the table: timer and counters count down, events are the inputs read plus T and each
-    counter at zero, the first row of the state whose required events are all present fires."""
+    counter at zero, the first row of the state whose required events are all present fires (with the
+    robot file's match = "document", a tick with no event at all looks up no row)."""
 
     def __init__(self, table: dict):
         self.rows = table["rows"]  # per state: [index, required, next, timer, outputs, loads] (None: keep)
         self.input_mask, self.timer_bit = table["input_mask"], table["timer_bit"]
         self.counter_bits = table["counter_bits"]
+        self.needs_event = table["match"] == "document"
         self.state, self.timer = table["initial_state"], table["initial_timer"]
         self.counters = [0] * len(self.counter_bits)
         self.outputs = [0] * table["n_outputs"]
@@ -59,6 +61,8 @@ class Engine:
             if self.counters[i] == 0:
                 events |= self.counter_bits[i]
         self.event, self.row = events, -1
+        if not events and self.needs_event:  # the document: a row is looked up only if an event is detected
+            return self.outputs
         for index, required, following, timer, outputs, loads in self.rows[self.state]:
             if required & events == required:
                 self.row = index
