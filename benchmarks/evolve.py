@@ -75,9 +75,9 @@ def children(count: int) -> tuple[object, list[tuple[str, object]], object]:
 
 
 def inner(repeat: int, count: int, seconds: float) -> None:
-    from tablebot.cli.sweep import make_plan
     from tablebot.evolve.evaluate import Evaluator
     from tablebot.fleet.backends import Runner
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.spec import runs
     from tablebot.fleet.work import Job, run_job
 

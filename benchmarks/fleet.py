@@ -73,12 +73,12 @@ def breakdown(repeat: int) -> dict[str, float]:
     from tablebot.cli.common import load
     from tablebot.jit import njit
     from tablebot.sim import physics as ph
-    from tablebot.sim.runner import run
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
 
     table, machine = load(EXAMPLE)
     scene = scene_for(table, machine)
-    rows = run(scene, 300.0, 1).hist.astype(np.float64)
+    rows = simulate(scene, 300.0, 1).hist.astype(np.float64)
     g, p = scene.geometry, scene.P[0]
 
     @njit
@@ -138,7 +138,7 @@ def breakdown(repeat: int) -> dict[str, float]:
 
 
 def sweep_plan(robots: int, seconds: float):  # type: ignore[no-untyped-def]
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
 
     return make_plan(EXAMPLE, None, [], [], None, robots, seconds)
 

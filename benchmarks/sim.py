@@ -32,7 +32,7 @@ from pathlib import Path
 from tablebot.cli.common import load
 from tablebot.engine import Engine
 from tablebot.loop import run as run_loop
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 
@@ -63,7 +63,7 @@ def tick_by_tick_seconds(scene, ticks: int, seed: int) -> float:  # type: ignore
 
 
 def engine_seconds(scene, seconds: float, seed: int) -> float:  # type: ignore[no-untyped-def]
-    result = run(scene, seconds, seed)
+    result = simulate(scene, seconds, seed)
     inputs = [(t.mask, t.pulses) for t in result.inputs()]
     step = Engine(scene.machine).step
     start = time.perf_counter()
@@ -111,7 +111,7 @@ def inner(repeat: int, seconds: float) -> float:
     table, machine = load(EXAMPLE)
     scene = scene_for(table, machine)
     ticks = round(seconds / scene.tick_s)
-    run(scene, 1.0)  # compile, or load numba's cached compilation
+    simulate(scene, 1.0)  # compile, or load numba's cached compilation
     loop = median_of(repeat, lambda: loop_seconds(scene, ticks, 1))
     short = min(seconds, 60.0)  # the tick-by-tick baseline is slow: a minute of it, scaled
     one = median_of(repeat, lambda: tick_by_tick_seconds(scene, round(short / scene.tick_s), 1)) * seconds / short

@@ -21,7 +21,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from tablebot.cli.common import load
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.turn_drift import Turn, turns
@@ -45,7 +45,7 @@ class Level:
 def lamp_times(folder: Path, charge: float, seeds: list[int]) -> list[float | None]:
     table, machine = load(folder)
     scene = scene_for(table, machine, overrides={"battery": {"charge": charge}})
-    return [summarise(run(scene, 120.0, seed)).reached_s for seed in seeds]
+    return [summarise(simulate(scene, 120.0, seed)).reached_s for seed in seeds]
 
 
 def measure(charges: list[float], seeds: list[int]) -> list[Level]:

@@ -70,7 +70,7 @@ class StopAt(Record):
 def drive(machine: Machine, robot: Any, ticks: int | None = 30, sinks: tuple = (),
           behind_limit_s: float | None = None) -> RunEnd:
     robot.connect()
-    clock = RealTimeClock(machine.table.robot.tick_ms / 1000)
+    clock = RealTimeClock(machine.table.robot.tick_s)
     return run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="test",
                behind_limit_s=behind_limit_s)
 

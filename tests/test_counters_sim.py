@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from tablebot.sim.turn_drift import turns
 from test_sim_helpers import ROOT, scene_of, trace_text
@@ -40,7 +40,7 @@ def test_the_counted_turn_stays_within_3_degrees_of_90() -> None:
 
 def test_the_counter_event_fires_on_the_tick_the_encoder_pulses_reach_the_load() -> None:
     scene = scene_of(TURN / "counted.csv", None)
-    result = run(scene, 4.0)
+    result = simulate(scene, 4.0)
     lines = [json.loads(line) for line in trace_text(result).splitlines()]
     assert lines[0]["row"] == 0 and lines[0]["C1"] == lines[0]["C2"] == 35  # loaded on tick 0
     pulses = result.pulses[:, 0].cumsum()  # pulses of C1's motor handed to the engine, tick by tick
@@ -52,7 +52,7 @@ def test_the_counter_event_fires_on_the_tick_the_encoder_pulses_reach_the_load()
 def spin_degrees(folder: Path, charge: float) -> float:
     """Degrees turned during the BumberBot's first 270° spin (state 2, entered from state 1)."""
     scene = scene_of(folder / "table.csv", None, battery={"charge": charge})
-    result = run(scene, 20.0, seed=1)
+    result = simulate(scene, 20.0, seed=1)
     states = [scene.machine.states[s] for s in result.states.tolist()]
     begin = next(t for t in range(1, len(states)) if states[t] == 2 and states[t - 1] == 1)
     end = next(t for t in range(begin, len(states)) if states[t] != 2)
@@ -69,8 +69,8 @@ def test_the_counters_bumberbot_spins_270_degrees_whatever_the_battery(charge: f
 
 def test_a_drained_bumberbot_finds_the_lamp_only_with_counters() -> None:
     drained = {"battery": {"charge": 0.2}}
-    timed = summarise(run(scene_of(ROOT / "examples" / "bumberbot" / "table.csv", None, **drained), 120.0))
-    counted = summarise(run(scene_of(EXAMPLE / "table.csv", None, **drained), 120.0))
+    timed = summarise(simulate(scene_of(ROOT / "examples" / "bumberbot" / "table.csv", None, **drained), 120.0))
+    counted = summarise(simulate(scene_of(EXAMPLE / "table.csv", None, **drained), 120.0))
     assert timed.reached_s is None
     assert counted.reached_s is not None
 

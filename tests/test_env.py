@@ -13,8 +13,9 @@ from gymnasium.vector import AutoresetMode  # noqa: E402
 from gymnasium.wrappers.vector import NormalizeObservation  # noqa: E402
 
 from tablebot.cli.common import load  # noqa: E402
-from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv, observe  # noqa: E402
-from tablebot.sim.runner import run  # noqa: E402
+from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv  # noqa: E402
+from tablebot.sim.observation import Observation  # noqa: E402
+from tablebot.sim.runner import simulate  # noqa: E402
 from tablebot.sim.scene import scene_for  # noqa: E402
 from test_sim_helpers import BUMBERBOT  # noqa: E402
 
@@ -38,8 +39,8 @@ def test_with_the_table_in_charge_the_env_runs_as_tablebot_sim() -> None:
         if terminated:
             break
     table, machine = load(BUMBERBOT)
-    alone = run(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
-    np.testing.assert_array_equal(np.array(seen), observe(alone.hist))
+    alone = simulate(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
+    np.testing.assert_array_equal(np.array(seen), Observation.of(alone.scene)(alone.hist))
     assert sum(rewards) == pytest.approx(-len(rewards) * 0.01)
 
 
@@ -82,3 +83,29 @@ def test_the_vector_env_lets_the_table_drive_every_robot() -> None:
         np.testing.assert_array_equal(truncated, [s[3] for s in steps])
         if terminated.any():
             break
+
+
+@pytest.mark.parametrize(("example", "declared"), [("obstacle-avoider", ("I1_cm", "I2_cm")),
+                                                    ("line-follower", ("I1_line", "I2_line"))])
+def test_the_observation_carries_each_declared_sensor_as_its_trace_writes_it(example: str,
+                                                                             declared: tuple[str, ...]) -> None:
+    """A robot's declared sensors follow the BumberBot's part, named and scaled as in its trace, inside the
+    space (each kind's bounds), alike in the single env and in the fleet's."""
+    path = BUMBERBOT.parent / example
+    env = TableBotEnv(table=path, seconds=3.0)
+    assert env.setup.observation_names[-2:] == declared and len(env.setup.observation_names) == 12
+    obs, _ = env.reset(seed=3)
+    seen = [obs]
+    for _ in range(299):
+        obs, *_ = env.step(None)
+        seen.append(obs)
+    table, machine = load(path)
+    trace = simulate(scene_for(table, machine), 3.0, 3).block().extra
+    got = np.array(seen)[:, 10:]
+    for k, name in enumerate(declared):
+        np.testing.assert_allclose(got[:, k], trace[name], atol=0.05 if name.endswith("_cm") else 0)
+    assert len({tuple(row) for row in got.tolist()}) > 1  # the readings really changed
+    assert all(env.observation_space.contains(o) for o in seen)
+    venv = TableBotVectorEnv(num_envs=2, table=path, seconds=3.0)
+    first, _ = venv.reset(seed=3)
+    np.testing.assert_array_equal(first[0], seen[0])

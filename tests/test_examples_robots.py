@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.sim import columns as L
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import ROOT, scene_of
 
@@ -21,7 +21,7 @@ DEFAULT_SECONDS = 120.0  # tablebot sim's default run
 
 @pytest.fixture(scope="module")
 def follower():
-    return run(scene_of(EXAMPLES / "line-follower" / "table.csv"), DEFAULT_SECONDS, seed=1)
+    return simulate(scene_of(EXAMPLES / "line-follower" / "table.csv"), DEFAULT_SECONDS, seed=1)
 
 
 def test_the_line_follower_drives_two_laps_without_touching_anything(follower) -> None:
@@ -54,7 +54,7 @@ def test_the_floor_sensors_read_the_tape_under_them(follower) -> None:
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_the_obstacle_avoider_drives_a_minute_without_touching_anything(seed: int) -> None:
-    result = run(scene_of(EXAMPLES / "obstacle-avoider" / "table.csv"), 60.0, seed=seed)
+    result = simulate(scene_of(EXAMPLES / "obstacle-avoider" / "table.csv"), 60.0, seed=seed)
     summary = summarise(result)
     assert summary.collisions == 0
     assert summary.distance_m > 4.0  # it drove about, not just turned on the spot

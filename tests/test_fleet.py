@@ -20,10 +20,11 @@ from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 from tablebot.robot import MATCHES
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
 from tablebot.sim.world import parse_world
+from tablebot.testing.harness import random_world
 from tablebot.testing.random_tables import Shape, random_table, with_match
 from tablebot.tomlfile import Source
 from test_sim_helpers import BUMBERBOT, trace_text
@@ -52,27 +53,9 @@ def test_every_shipped_robot_runs_alike_alone_and_in_a_fleet(example: str) -> No
     fleet = Fleet(table, machine, scene.world, specs, robot_layer(table.robot)[0], traced=[0, 1])
     fleet.run(1500)
     for k, spec in enumerate(specs):
-        alone = run(scene, 15.0, spec.seed)
+        alone = simulate(scene, 15.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
         assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
-
-
-def random_world(rng: random.Random) -> str:
-    """A room with a lamp, a box and a pot in random places (away from the start at (0.5, 0.5)), maybe noise."""
-    size = rng.uniform(2.0, 3.5)
-    def spot() -> tuple[float, float]:
-        return rng.uniform(1.2, size - 0.3), rng.uniform(1.2, size - 0.3)
-    lx, ly = spot()
-    bx, by = spot()
-    cx, cy = spot()
-    while (cx - lx) ** 2 + (cy - ly) ** 2 < 0.15 ** 2:  # a lamp inside the circle is refused (its light is hidden)
-        cx, cy = spot()
-    return (f'name = "random"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
-            f"[start]\nat = [0.5, 0.5]\nheading = {rng.uniform(-180, 180)}\n"
-            f"[[lamp]]\nat = [{lx}, {ly}]\nintensity = {rng.uniform(1, 5)}\n"
-            f"[[box]]\nat = [{bx}, {by}]\nsize = [0.3, 0.2]\nangle = {rng.uniform(0, 90)}\n"
-            f"[[circle]]\nat = [{cx}, {cy}]\nradius = 0.1\n"
-            f"[noise]\nlight = {rng.choice([0.0, 0.05, 0.2])}\nmotor = {rng.choice([0.0, 0.01, 0.05])}\n")
 
 
 @pytest.mark.parametrize("case", range(4))
@@ -94,7 +77,7 @@ def test_random_tables_worlds_and_seeds_run_alike_alone_and_in_a_fleet(case: int
         scene = prepare(table, machine, world, None, spec.overrides())
         if spec.start is not None:
             scene = replace(scene, world=replace(world, start=spec.start))
-        alone = run(scene, 9.0, spec.seed)
+        alone = simulate(scene, 9.0, spec.seed)
         assert "".join(fleet.trace_lines(k)) == trace_text(alone)
         assert summary.summary(k) == summarise(alone)
 
@@ -126,7 +109,7 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
     fleet.run(1200)
     rows = tuple(replace(row, timer=300) if row.index == 3 else row for row in table.rows)
     edited = replace(table, rows=rows)
-    alone = run(scene_for(edited, compile_table(edited)), 12.0, 3)
+    alone = simulate(scene_for(edited, compile_table(edited)), 12.0, 3)
     assert "".join(fleet.trace_lines(0)) == trace_text(alone)
     assert "".join(fleet.trace_lines(1)) != trace_text(alone)
 
@@ -139,7 +122,7 @@ def test_the_compiled_simulator_and_the_fleet_follow_the_tables_matching_rule(ma
     table = random_table(rng, Shape(states=4, rows=14, inputs=8, max_timer=300, event_density=0.25,
                                     no_event_chance=0.3))
     world = parse_world(Source.parse("<random>", random_world(rng)))
-    runs = {rule: run(prepare(t, compile_table(t), world), 4.0, 3) for rule in MATCHES
+    runs = {rule: simulate(prepare(t, compile_table(t), world), 4.0, 3) for rule in MATCHES
             for t in [with_match(table, rule)]}
     assert runs["document"].rows.tolist() != runs["always"].rows.tolist()  # the rules part here
     alone = runs[match]

@@ -18,7 +18,7 @@ from tablebot.diagnostics import TableBotError
 from tablebot.formats.table_read import load_table
 from tablebot.machine import NO_ROW, compile_table
 from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.table import no_event_rows
 from tablebot.testing.random_tables import with_match
@@ -93,7 +93,7 @@ def test_the_shipped_robots_say_their_rule_and_the_two_newer_ones_drive_alike_un
         found = no_event_rows(table)
         assert len(found) == rows and all(f.quiet == "" for f in found)  # T on every tick of those states
         other = with_match(table, "document")
-        runs = [trace_text(run(scene_for(t, compile_table(t)), 20.0, 1)) for t in (table, other)]
+        runs = [trace_text(simulate(scene_for(t, compile_table(t)), 20.0, 1)) for t in (table, other)]
         assert runs[0] == runs[1]
 
 

@@ -20,7 +20,7 @@ from tablebot.colours import PALETTE, state_colours
 from tablebot.sim import plots
 from tablebot.sim.animate import Player
 from tablebot.sim.draw import literal_text
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 
@@ -52,7 +52,7 @@ def drawn(figure_of, *args):
 
 def test_the_light_panel_labels_render_and_its_y_label_is_in_view() -> None:
     """The symlog ticks printed as raw '$\\mathdefault{10^{3}}$' and pushed the y-label out of the picture."""
-    result = run(scene_of(BUMBERBOT / "table.csv"), 40.0)
+    result = simulate(scene_of(BUMBERBOT / "table.csv"), 40.0)
     fig = drawn(plots.timeline_figure, result, summarise(result))
     light = fig.axes[-1]
     ticks = [t.get_text() for t in light.get_yticklabels() if t.get_text()]
@@ -72,7 +72,7 @@ def test_a_state_keeps_its_colour_in_every_picture_of_a_table(tmp_path: Path) ->
         (folder / "robot.toml").write_text(TUTORIAL_ROBOT)
         (folder / "table.csv").write_text(text)
         scene = scene_of(folder / "table.csv")
-        result = run(scene, 20.0)
+        result = simulate(scene, 20.0)
         summary = summarise(result)
         trajectory = drawn(plots.trajectory_figure, result, summary)
         for handle in trajectory.legends[0].legend_handles:
@@ -110,12 +110,12 @@ def test_legends_list_only_what_the_picture_shows(tmp_path: Path) -> None:
     (empty / "robot.toml").write_text(TUTORIAL_ROBOT.replace('2 = "driving"\n', ""))
     (empty / "table.csv").write_text("description,state,T,I1,M1,M2,timer,next\nspin,1,1,,0,0,0,1\n")
     (empty / "arena.toml").write_text('[arena]\nwalls = [[0, 0], [2, 0], [2, 2], [0, 2]]\n[start]\nat = [1, 1]\n')
-    result = run(scene_of(empty / "table.csv"), 5.0)
+    result = simulate(scene_of(empty / "table.csv"), 5.0)
     fig = drawn(plots.trajectory_figure, result, summarise(result))
     states, marks = ([t.get_text() for t in legend.get_texts()] for legend in fig.legends)
     assert states == ["1 · turning  (5.0 s)"]  # the one state it was in
     assert marks == []  # no collision, no spin, no lamp, no obstacle, no tape: nothing to explain
-    result = run(scene_of(BUMBERBOT / "table.csv"), 60.0)
+    result = simulate(scene_of(BUMBERBOT / "table.csv"), 60.0)
     fig = drawn(plots.trajectory_figure, result, summarise(result))
     marks = [t.get_text() for t in fig.legends[1].get_texts()]
     assert "collision (where it touched)" in marks and "light first seen" in marks
@@ -123,7 +123,7 @@ def test_legends_list_only_what_the_picture_shows(tmp_path: Path) -> None:
 
 
 def test_a_followed_line_shows_its_path_above_the_tape() -> None:
-    result = run(scene_of(ROOT / "examples" / "line-follower" / "table.csv"), 20.0)
+    result = simulate(scene_of(ROOT / "examples" / "line-follower" / "table.csv"), 20.0)
     fig = drawn(plots.trajectory_figure, result, summarise(result))
     ax = fig.axes[0]
     (tape,) = [c for c in ax.collections if isinstance(c, PatchCollection)]

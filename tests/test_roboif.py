@@ -143,10 +143,12 @@ def test_a_device_that_does_not_answer_the_greeting_as_a_robo_interface_is_refus
         assert "exchange" not in emu.names()  # nothing was switched on
 
 
-def test_at_38400_baud_a_10_ms_tick_is_at_the_wires_limit() -> None:
-    """17 + 21 bytes at 10 bits a byte take 9.9 ms: ticks run late now and then, never behind."""
+def test_at_38400_baud_an_exchange_takes_the_whole_10_ms_tick() -> None:
+    """17 + 21 bytes at 10 bits a byte take 9.9 ms: with slow timers accepted (no behind limit; the run itself is
+    refused before it starts otherwise, tests/test_pace.py) the ticks run late, every few ticks."""
+    assert round(wire.EXCHANGE_LINE_S, 4) == 0.0099
     with RoboifEmulator(baud=38400) as emu:
-        end = drive(bumberbot("roboif"), robot_on(emu), ticks=40, behind_limit_s=0.3)
+        end = drive(bumberbot("roboif"), robot_on(emu), ticks=100)
     assert end.reason == "done" and end.late_ticks >= 1
 
 

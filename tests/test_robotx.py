@@ -126,10 +126,12 @@ def test_every_fault_ends_the_run_as_link_lost_with_zero_duty_sent_where_the_lin
     assert stopped
 
 
-def test_a_slow_device_gives_late_ticks_and_one_too_slow_ends_the_run_as_behind() -> None:
+def test_a_slow_device_falls_behind_and_one_stall_too_long_ends_the_run_as_behind() -> None:
     with RobotxEmulator(delay_s=0.013) as emu:  # each reply 13 ms after the request: slower than the 10 ms tick
-        end = drive(bumberbot("robotx"), robot_on(emu), ticks=40, behind_limit_s=0.2)
-    assert end.reason == "done" and end.late_ticks >= 3
+        end = drive(bumberbot("robotx"), robot_on(emu), ticks=400, behind_limit_s=0.2)
+        settle(emu)
+    assert end.reason == "behind" and end.late_ticks >= 3 and "cannot keep the table's 10 ms tick" in end.message
+    assert emu.requests("exchange")[-1].fields["duty"] == [0] * 8
     with RobotxEmulator(fault=("late", 10), late_s=0.3) as emu:
         end = drive(bumberbot("robotx"), robot_on(emu, timeout_s=1.0), ticks=30, behind_limit_s=0.2)
         settle(emu)

@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE
 from tablebot.cli import app
+from tablebot.hw.link_speed import PROBES
 from tablebot.testing.roboif_emulator import RoboifEmulator
 from tablebot.testing.robotx_emulator import RobotxEmulator
 
@@ -31,7 +32,7 @@ def bumps(kind: str, seed: int = 3):
     held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
             for _ in range(200)]
     other = [0, 0, 0, 0] if kind == "robotx" else {}
-    return lambda n: (held[(n // 7) % len(held)], other)
+    return lambda n: (held[(max(0, n - PROBES) // 7) % len(held)], other)  # the same inputs whatever timing came first
 
 
 def emulator(kind: str, **options):
@@ -71,18 +72,21 @@ def test_a_run_as_a_process_writes_a_trace_that_tablebot_trace_replays_to_the_sa
     assert [json.loads(line) for line in replayed.output.splitlines()] == [{k: x[k] for k in CORE} for x in lines]
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["ended"] == "done" and summary["target"] == f"{kind}://{emu.device}"
-    exchanges = emu.requests("exchange")
-    assert len(exchanges) == 82 and off(kind, exchanges[-1]) and not all(off(kind, r) for r in exchanges)
+    exchanges = emu.requests("exchange")  # the link timed with every output off, then outputs off at open,
+    assert len(exchanges) == PROBES + 82  # one per tick and outputs off at the end
+    assert all(off(kind, r) for r in exchanges[:PROBES + 1]) and off(kind, exchanges[-1])
+    assert not all(off(kind, r) for r in exchanges)
+    assert "warning" not in err  # the emulators answer at full speed: the 10 ms tick fits
 
 
 @pytest.mark.parametrize(("kind", "fault"), [("robotx", "bad_crc"), ("roboif", "silent")])
 def test_a_lost_link_ends_the_process_with_exit_3_a_link_lost_record_and_the_outputs_off(tmp_path: Path, kind: str,
                                                                                          fault: str) -> None:
-    with emulator(kind, fault=(fault, 20)) as emu:
+    with emulator(kind, fault=(fault, PROBES + 20)) as emu:  # tick 20's exchange, after the link was timed
         process = spawn(["run", str(EXAMPLE), "--on", f"{kind}://{emu.device}", "--seconds", "5", "--out",
                          str(tmp_path), "--link-timeout", "0.2"])
         out, err = process.communicate(timeout=60)
-        stopped = emu.wait_for("exchange", 22, timeout_s=2) and off(kind, emu.requests("exchange")[-1])
+        stopped = emu.wait_for("exchange", PROBES + 22, timeout_s=2) and off(kind, emu.requests("exchange")[-1])
     assert process.returncode == 3 and "link_lost" in out and "Traceback" not in err + out
     lines = read_trace(tmp_path / "trace.partial.jsonl")
     assert lines[-1]["end"] == "link_lost" and lines[-1]["tick"] == 20
@@ -97,7 +101,7 @@ def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(tmp_path:
         process = spawn(["run", str(EXAMPLE), "--on", f"{kind}://{emu.device}", "--seconds", "30", "--out",
                          str(tmp_path), "--link-timeout", "0.3"])
         try:
-            assert emu.wait_for("exchange", 30, timeout_s=30)
+            assert emu.wait_for("exchange", PROBES + 30, timeout_s=30)
             process.send_signal(sig)
             out, err = process.communicate(timeout=30)
         finally:

@@ -158,12 +158,12 @@ def test_setup_helper_still_builds(tmp_path: Path) -> None:
 
 def test_the_motors_do_not_depend_on_the_tables_tick(tmp_path: Path) -> None:
     """The calibration spin is 8.95 s of the document's 10 ms ticks: at 20 ms, 448 ticks turn 270° too."""
-    from tablebot.sim.runner import run
+    from tablebot.sim.runner import simulate
 
     robot = ROBOT.replace("tick_ms = 10", "tick_ms = 20")
     rows = ["spin,1,1,,,,,,-2,2,448,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,0,3"]
     table, world = write_bot(tmp_path, rows, room(), robot)
-    result = run(scene_of(table, world), 10.0)
+    result = simulate(scene_of(table, world), 10.0)
     heading = result.heading_deg()
     assert abs(heading[-1] - heading[0] + 270.0) < 3.0
 

@@ -11,7 +11,7 @@ import pytest
 
 from tablebot.sim import columns as L
 from tablebot.sim.physics import light_at, sense
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import Scene
 from tablebot.sim.sensing import sensor_events
 from test_sim_helpers import room, scene_of
@@ -144,7 +144,7 @@ def test_thresholds_switch_with_the_declared_hysteresis(tmp_path: Path) -> None:
 
 def test_the_robot_turns_back_at_the_declared_thresholds(tmp_path: Path) -> None:
     scene = sensor_scene(tmp_path, room(start=(2.5, 1.5, 0)))  # the sensor 38 cm from the wall
-    result = run(scene, 12.0)
+    result = simulate(scene, 12.0)
     h, events, bit = result.hist, result.events, scene.machine.input_bits["I3"]
     readings = np.round(h[:-1, L.READING + 2] * 100).astype(int)
     on = (events & bit) != 0

@@ -12,7 +12,7 @@ import pytest
 
 from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
-from tablebot.sim.runner import Result, run, write_trace
+from tablebot.sim.runner import SimRun, simulate
 from tablebot.sim.scene import Scene, scene_for
 from tablebot.sim.world import load_world
 
@@ -75,9 +75,9 @@ def world_errors(tmp_path: Path, text: str) -> list[str]:
     return [d.render() for d in info.value.diagnostics]
 
 
-def trace_text(result: Result) -> str:
+def trace_text(result: SimRun) -> str:
     buf = io.StringIO()
-    write_trace(result, buf)
+    result.write_trace(buf)
     return buf.getvalue()
 
 
@@ -89,7 +89,7 @@ SPIN = ["spin,1,1,,,,,,-2,2,895,2", "stop,2,1,,,,,,0,0,0,3", "rest,3,1,,,,,,0,0,
 
 def test_builders_give_a_runnable_setup(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room())
-    result = run(scene, 0.5)
+    result = simulate(scene, 0.5)
     assert result.ticks == 50
     assert scene.drive == (0, 1)
     assert trace_text(result).count("\n") == 50

@@ -17,7 +17,7 @@ from tablebot.formats.trace_lines import dumps
 from tablebot.loop import SimulatedClock, TickBlock
 from tablebot.loop import run as run_loop
 from tablebot.replay import replay
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sinks.trace_file import TraceFile, block_lines
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
@@ -52,7 +52,7 @@ def test_the_live_trace_is_the_replayed_trace(tmp_path: Path, table: Path, world
     """What the old runner wrote by replaying the engine over the recorded inputs, the sink writes live."""
     scene = scene_of(table, world)
     sink = TraceFile(tmp_path / "trace.jsonl")
-    result = run(scene, 60.0, seed=4, sinks=[sink])
+    result = simulate(scene, 60.0, seed=4, sinks=[sink])
     live = (tmp_path / "trace.jsonl").read_text(encoding="utf-8").splitlines()
     robot = SimRobot(scene, 4)
     replayed = []
@@ -150,6 +150,6 @@ def test_a_run_that_keeps_no_robot_rows_sums_up_the_same(example: str) -> None:
     from tablebot.sim.summary import summarise
 
     scene = scene_of(ROOT / "examples" / example / "table.csv")
-    full, lean = run(scene, 90.0, seed=2), run(scene, 90.0, seed=2, rows=False)
+    full, lean = simulate(scene, 90.0, seed=2), simulate(scene, 90.0, seed=2, rows=False)
     assert lean.hist is None and summarise(lean) == summarise(full)
     assert (lean.path == full.hist[::5, :2]).all()

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from tablebot.sim import columns as L
 from tablebot.sim.params import Params, speed_per_volt, terminal_volts
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.world import inside
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
 
@@ -33,14 +33,14 @@ def pulses_for_turn(params: Params, degrees: float) -> float:
 def turned(tmp_path: Path, charge: float, noise: bool = False, seed: int = 1) -> float:
     """Degrees the SPIN table turns (negative = clockwise) from a battery charge."""
     scene = bot(tmp_path, SPIN, room(noise=noise), battery={"charge": charge})
-    result = run(scene, 10.0, seed)
+    result = simulate(scene, 10.0, seed)
     heading = result.heading_deg()
     return float(heading[-1] - heading[0])
 
 
 def test_straight_run_covers_speed_times_time(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(0.4, 1.5, 0)))
-    result = run(scene, 6.0)
+    result = simulate(scene, 6.0)
     expected = wheel_speed(scene.params, 4, 1.0, (4, 4)) * 5.0
     h = result.hist
     assert abs(math.hypot(h[-1, L.X] - h[0, L.X], h[-1, L.Y] - h[0, L.Y]) - h[-1, L.DIST]) < 1e-9
@@ -63,7 +63,7 @@ def test_the_same_spin_turns_less_on_a_drained_battery(tmp_path: Path) -> None:
 
 def test_encoders_count_63_and_a_third_pulses_per_wheel_turn(tmp_path: Path) -> None:
     scene = bot(tmp_path, SPIN, room())
-    result = run(scene, 10.0)
+    result = simulate(scene, 10.0)
     h = result.hist
     assert h[-1, L.DIST] < 1e-9  # a spin in place drives the centre nowhere
     expected = pulses_for_turn(scene.params, -result.heading_deg()[-1])
@@ -74,7 +74,7 @@ def test_encoders_count_63_and_a_third_pulses_per_wheel_turn(tmp_path: Path) -> 
 
 def test_battery_drains_and_sags_under_load(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room())
-    h = run(scene, 6.0).hist
+    h = simulate(scene, 6.0).hist
     assert h[-1, L.SOC] < h[0, L.SOC] == 1.0
     driving, stopped = h[100, L.VBAT], h[-1, L.VBAT]
     assert stopped > driving  # motors draw current through the internal resistance
@@ -82,7 +82,7 @@ def test_battery_drains_and_sags_under_load(tmp_path: Path) -> None:
 
 def test_driving_into_a_wall_stops_at_the_wall(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(2.7, 1.5, 0)))
-    h = run(scene, 6.0).hist
+    h = simulate(scene, 6.0).hist
     front = scene.params["body"]["front"]
     assert abs(h[-1, L.X] + front - 3.0) < 1e-6  # pushed out exactly to the wall
     assert h[-1, L.DIST] < 0.2
@@ -96,7 +96,7 @@ def test_the_robot_never_leaves_the_room(tmp_path_factory, heading: float, right
     rows = [f"go,1,1,,,,,,{right},{left},3000,1"]
     extra = "[[box]]\nat = [0.9, 0.9]\nsize = [0.3, 0.3]\nangle = 20\n[[circle]]\nat = [0.3, 0.3]\nradius = 0.08"
     scene = bot(tmp, rows, room(start=(0.6, 0.6, heading), size=1.2, extra=extra, noise=True))
-    h = run(scene, 20.0, seed=3).hist
+    h = simulate(scene, 20.0, seed=3).hist
     walls = scene.world.walls
     assert all(inside(walls, (x, y)) for x, y in h[::50, [L.X, L.Y]])
     box_centre = np.array([0.9, 0.9])

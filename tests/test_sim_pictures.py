@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from tablebot.sim.draw import RobotArtist, contact_point, draw_world
 from tablebot.sim.plots import legend_marks, reading_panels
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_declared import sensor_scene
 from test_sim_helpers import BUMBERBOT, ROOT, room, scene_of
@@ -58,10 +58,10 @@ def test_the_robot_shows_its_own_sensors_and_not_the_bumberbots(tmp_path: Path) 
     assert not any(p.get_visible() for p in robot.bumpers + robot.cones)  # no bumpers, no phototransistors
     near, far = robot.declared
     assert (near.r, far.r) == (pytest.approx(0.2), pytest.approx(0.6))  # each beam reaches its echo
-    result = run(scene, 1.0)
+    result = simulate(scene, 1.0)
     labels = [h.get_label() for h in legend_marks(result, summarise(result), spins=False)]
     assert "distance beam, out to the echo" in labels and "light first seen" not in labels
-    assert [p.__name__ for p in reading_panels(run(scene, 1.0))] == ["_distance_panel"]
+    assert [p.__name__ for p in reading_panels(simulate(scene, 1.0))] == ["_distance_panel"]
 
 
 def test_names_with_dollar_signs_are_drawn_as_written(tmp_path: Path) -> None:

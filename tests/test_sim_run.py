@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from tablebot.cli.app import app
 from tablebot.engine import Engine
 from tablebot.replay import record
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, room, scene_of, trace_text
 
@@ -22,7 +22,7 @@ CORE_KEYS = ["tick", "event", "row", "state", "timer", "M1", "M2"]
 
 @pytest.fixture(scope="module")
 def arena_run():
-    return run(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+    return simulate(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
 
 
 def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run) -> None:
@@ -37,17 +37,17 @@ def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run)
 def test_the_lamp_is_found_with_other_seeds_too() -> None:
     scene = scene_of(BUMBERBOT / "table.csv")
     for seed in (2, 3):
-        assert summarise(run(scene, 120.0, seed=seed)).reached_s is not None
+        assert summarise(simulate(scene, 120.0, seed=seed)).reached_s is not None
 
 
 def test_same_seed_same_trace_bytes(arena_run) -> None:
-    again = run(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
+    again = simulate(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
     assert trace_text(again) == trace_text(arena_run)
 
 
 def test_another_seed_another_trace() -> None:
     scene = scene_of(BUMBERBOT / "table.csv")
-    assert trace_text(run(scene, 20.0, seed=1)) != trace_text(run(scene, 20.0, seed=2))
+    assert trace_text(simulate(scene, 20.0, seed=1)) != trace_text(simulate(scene, 20.0, seed=2))
 
 
 def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run) -> None:
@@ -126,7 +126,7 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(LAMP_ROBOT, encoding="utf-8")
     (tmp_path / "table.csv").write_text(LAMP_TABLE, encoding="utf-8")
     scene = scene_of(tmp_path / "table.csv")
-    result = run(scene, 1.2)
+    result = simulate(scene, 1.2)
     assert scene.lamp_outputs == (2,)
     assert result.outputs[:, 2].tolist() == [8] * 50 + [0] * 50 + [8] * 20
     ax = Figure().add_subplot()

@@ -7,15 +7,19 @@ BumberBot. Screenshots of every view go to ``studio-screens`` under pytest's tem
 
 from __future__ import annotations
 
+import csv
+import json
 import os
 import re
 import shutil
+from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from core_helpers import EXAMPLE
+from tablebot.colours import state_colours
 
 playwright = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
 CHROMIUM = Path("/usr/bin/chromium")
@@ -29,6 +33,11 @@ from tablebot.web.app import Background  # noqa: E402
 FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
 TIMER_COL, M1_SPEED_COL = 12, 9
+# what the browser drew: the timeline's top row of pixels (RGBA), and each state's border in the diagram
+TIMELINE = """() => { const c = document.querySelector('#timeline');
+  return Array.from(c.getContext('2d').getImageData(0, 1, c.width, 1).data); }"""
+BORDERS = """() => [...document.querySelectorAll('#diagram g.node')].map((g) => [g.querySelector('title').textContent,
+  getComputedStyle(g.querySelector('path, polygon, ellipse')).stroke])"""
 
 
 @pytest.fixture(scope="module")
@@ -41,12 +50,12 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def _write_sim_trace(root: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import run, write_trace
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
 
     table, machine = load(root)
     with (root / "trace.jsonl").open("w", encoding="utf-8") as f:
-        write_trace(run(scene_for(table, machine), 20.0, 1), f)
+        simulate(scene_for(table, machine), 20.0, 1).write_trace(f)
 
 
 @pytest.fixture(scope="module")
@@ -107,6 +116,31 @@ def tab(browser: object, server: Background, shots: Path, request: pytest.Fixtur
     page = Tab(browser, server.url, shots, request.node.name.removeprefix("test_"))
     yield page
     page.close()
+
+
+def drawn_colours(page: object, ticks: list[str], cursor: int) -> dict[str, set[str]]:
+    """The colours the page drew for each state: over its ticks in the timeline (``ticks``: the state of each
+    tick of the trace shown; the cursor, at tick ``cursor``, left out) and as its border in the diagram."""
+    pixels = page.evaluate(TIMELINE)  # type: ignore[attr-defined]
+    band = [_hex(pixels[i:i + 3]) for i in range(0, len(pixels), 4)]
+    drawn: dict[str, set[str]] = defaultdict(set)
+    at = cursor / max(1, len(ticks) - 1) * (len(band) - 2) + 1
+    for x, colour in enumerate(band):  # pixel column x shows tick floor(x / width * ticks), as the page draws it
+        if abs(x - at) > 3:
+            drawn[ticks[min(len(ticks) - 1, int(x / len(band) * len(ticks)))]].add(colour)
+    for title, stroke in page.evaluate(BORDERS):  # type: ignore[attr-defined]
+        if title.startswith("s_"):
+            drawn[title[2:]].add(_hex([int(v) for v in re.findall(r"\d+", stroke)[:3]]))
+    return drawn
+
+
+def _hex(rgb: list[int]) -> str:
+    return "#" + "".join(f"{v:02x}" for v in rgb)
+
+
+def pictures_colours(states: tuple[object, ...]) -> dict[str, set[str]]:
+    """Each state's colour in the PNGs of a run (tablebot.colours)."""
+    return {str(s): {c} for s, c in zip(states, state_colours(states), strict=True)}
 
 
 def test_the_bumberbot_loads_with_37_rows_and_10_states(tab: Tab) -> None:
@@ -214,6 +248,27 @@ def test_a_trace_file_plays_in_the_player(tab: Tab) -> None:
     tab.shot("trace")
 
 
+def test_a_state_has_its_pictures_colour_and_keeps_it_when_rows_move(tab: Tab, folder: Path) -> None:
+    """The first collision rows of states 1 and 2 (alike but for their state) swap places: the same motions,
+    but the table now names state 2 first. The page still draws each state in its colour in the PNGs."""
+    from tablebot.cli.common import load
+
+    page = tab.page
+    rows = list(csv.reader((folder / "table.csv").open(encoding="utf-8")))[1:]
+    for row, other in ((0, 4), (4, 0)):
+        for col, (mine, theirs) in enumerate(zip(rows[row], rows[other], strict=True)):
+            if mine != theirs:
+                tab.cell(row, col).locator("input").fill(theirs)
+    page.wait_for_timeout(300)  # a typed cell is sent 120 ms after its last key; the trace is asked for after it
+    page.click("#mode-trace")
+    page.select_option("#trace-pick", "trace.jsonl")
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')")
+    ticks = [str(json.loads(line)["state"]) for line in (folder / "trace.jsonl").open(encoding="utf-8")]
+    assert page.locator('td[data-row="0"][data-col="1"] input').input_value() == "2" and {"1", "2"} <= set(ticks)
+    assert drawn_colours(page, ticks, 0) == pictures_colours(load(folder)[1].states)
+    tab.shot("colours")
+
+
 def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
     page = tab.page
     page.locator("#properties li", has_text="front_bumper_stops").locator('button[data-where="table"]').click()
@@ -225,7 +280,7 @@ def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
 def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path,
                                                                   shots: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import block_of, run
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
     from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
@@ -237,8 +292,8 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     table_csv.write_text(table_csv.read_text().replace("Seek - Turn", hostile.replace('"', '""').join('""')))
     table, machine = load(folder)
     scene = scene_for(table, machine)
-    result = run(scene, 30.0, 1)
-    page_file = write_html(tmp_path / "run.html", block_lines(block_of(result), machine), scene.world, table,
+    result = simulate(scene, 30.0, 1)
+    page_file = write_html(tmp_path / "run.html", block_lines(result.block(), machine), scene.world, table,
                            params=scene.params)
     text = page_file.read_text()
     assert text.lower().count("</script") == 2
@@ -257,6 +312,8 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 2000')")
     assert page.locator("#diagram g.node.current").count() == 1
     assert page.evaluate("() => window.pwned === undefined")
+    ticks = [str(machine.states[i]) for i in result.states]
+    assert drawn_colours(page, ticks, 2000) == pictures_colours(machine.states)
     page.screenshot(path=str(shots / "replay-file.png"))
     context.close()
     assert errors == []

@@ -10,7 +10,7 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.cli.common import load
 from tablebot.loop import RunEnd, RunInfo, TickBlock
-from tablebot.sim.runner import run as sim_run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 from tablebot.web.live import LiveRun, PageClock
@@ -50,7 +50,7 @@ def scene():  # type: ignore[no-untyped-def]
 
 def test_the_live_run_is_the_sim_commands_run(scene) -> None:  # type: ignore[no-untyped-def]
     ticks = 3000
-    expected = sim_run(scene, ticks * scene.tick_s, seed=3)
+    expected = simulate(scene, ticks * scene.tick_s, seed=3)
     sink = Rows()
     live = LiveRun(scene, SimRobot(scene, seed=3, record_history=False), speed="max", paused=False, sinks=[sink])
     wait_until(lambda: len(sink.rows) >= ticks)

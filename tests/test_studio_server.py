@@ -138,6 +138,7 @@ def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, P
     # the first tick is explained in the initial state 2: its rows are on lines 6 to 9 and 25 to 27
     fired = [w["line"] for w in frame["why"] if w["status"] == "fired"]
     assert frame["tick"] == 0 and len(fired) == 1 and fired[0] in (6, 7, 8, 9, 25, 26, 27)
+    assert [point[2] for point in frame["path"]] == [frame["state_id"]]  # by id: an edit may reorder the states
     assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
     replies = talk(server, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
     assert replies[0]["message"] == "fix the table's errors first"

@@ -66,7 +66,7 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
 
 def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     """Random starts as the plan draws them (the traced run begins there), given poses as given."""
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.spec import runs
 
     out = tmp_path / "s"
@@ -227,7 +227,7 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     import pickle
 
     from tablebot import jit
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.work import warm
 
     plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)

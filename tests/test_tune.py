@@ -165,11 +165,11 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from dataclasses import replace
 
     from tablebot.cli.common import load
-    from tablebot.cli.sweep import make_plan
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.run import Fleet, RobotSpec
     from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table
-    from tablebot.sim.runner import run
+    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
     from test_sim_helpers import BUMBERBOT, trace_text
 
@@ -183,7 +183,7 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     table, _ = load(example)
     rows = tuple(replace(r, counters=(40, *r.counters[1:])) if r.line == 5 else r for r in table.rows)
     edited = replace(table, rows=rows)
-    alone = run(scene_for(edited, compile_table(edited)), 5.0, 2)
+    alone = simulate(scene_for(edited, compile_table(edited)), 5.0, 2)
     assert "".join(fleet.trace_lines(0)) == trace_text(alone)
     with pytest.raises(Exception, match="leaves C1 alone"):
         parse_cells("line 2 C1_load", plan.table)

@@ -240,6 +240,15 @@ def test_the_on_board_loop_stops_when_it_falls_behind_is_interrupted_asked_or_fa
     assert reason == "behind"
     assert len(robot.writes) == 3 and robot.stops == 1 and "stopping rather than stretching" in said[0]
 
+    ticks = iter(range(10_000))  # every tick 14.3 ms against the table's 10: never one stall, always too slow
+    robot = CountingRobot()
+    reason = txt4_runtime.run(table, robot, 1000, now=lambda: 0.0143 * next(ticks), sleep=lambda s: None,
+                              log=said.append)
+    assert reason == "behind" and 110 <= len(robot.writes) <= 120 and "fell 0.50 s behind" in said[-2]
+    ticks = iter(range(10_000))
+    assert txt4_runtime.run(table, CountingRobot(), 500, now=lambda: 0.0105 * next(ticks), sleep=lambda s: None,
+                            log=said.append) == "done"  # 5 % slow: within the limit
+
     class Interrupted(CountingRobot):
         def read(self) -> tuple[int, list[int]]:
             if len(self.writes) == 4:

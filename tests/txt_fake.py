@@ -56,8 +56,9 @@ class FakeTxt:
     def __init__(self, script: Script = still, period_s: float = 0.01, device: str = "TXT-fake",
                  version: int = 0x04060600, fault: tuple[str, int] | None = None, late_s: float = 0.2,
                  i2c: bool = False, drift_s: float = 0.0, host: str = "127.0.0.1", port: int = 0,
-                 single_recv: bool = False):
+                 single_recv: bool = False, latency_s: float = 0.0):
         self.script, self.period_s, self.device, self.version = script, period_s, device, version
+        self.latency_s = latency_s  # before every reply: a controller far away (a bad Wi-Fi)
         self.single_recv = single_recv
         self.drift_s = drift_s  # added to every period: a TXT whose exchanges take a little longer
         self.fault, self.late_s = fault, late_s
@@ -210,6 +211,8 @@ class FakeTxt:
             request = Request(time.monotonic(), name, self._fields(name, body), whole)
             self.log.append(request)
             previous, before = name, previous
+            if self.latency_s:
+                time.sleep(self.latency_s)
             if name != "ExchangeData":
                 if not silent:
                     conn.sendall(self._reply(name, response))

@@ -15,6 +15,12 @@ DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d*)?|\.\d+)\s*(ticks?|ms|s)?\s*$", re.I
 MS_PER = {"ms": 1, "s": 1000}
 
 
+def seconds(ticks: float, tick_ms: int) -> float:
+    """``ticks`` ticks of ``tick_ms`` in seconds: the one place a tick count becomes seconds
+    (multiplied before dividing, so a whole number of milliseconds stays exact)."""
+    return ticks * tick_ms / 1000
+
+
 class DurationError(ValueError):
     """A duration that cannot be read or is no whole number of ticks; ``hint`` says what to write."""
 

@@ -85,8 +85,6 @@ class Engine:
         self._not_input = ~machine.input_mask  # any of these bits in an int mask: not a valid input mask
         self._n_counters = len(machine.counter_bits)
         self._hits = _transitions(machine)
-        if self._n_counters:
-            self.step = self._step_counting  # type: ignore[method-assign]
         self.reset()
 
     def reset(self) -> None:
@@ -105,8 +103,10 @@ class Engine:
         """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick.
 
         The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python: the fired row's
-        next state, timer and outputs are looked up whole in a table precomputed per state. (A machine
-        with counters steps through :meth:`_step_counting`, bound in ``__init__``.)
+        next state, timer, outputs and counter loads are looked up whole in a table precomputed per
+        state (:func:`_transitions`), so which rows match, and in what order, is decided once, by
+        :mod:`tablebot.machine`. One function for tables with and without counters: a table without
+        them pays two falsy tests.
         """
         if inputs.__class__ is not int or inputs & self._not_input:  # the common case costs one test
             inputs = self.events_of(inputs)
@@ -120,34 +120,7 @@ class Engine:
                 self._count_down(pulses)
         if not timer:
             inputs |= self._timer_bit
-        self.event = inputs
-        hit = self._hits[self.state][inputs]
-        if hit is None:
-            self.row = NO_ROW
-            self.timer = timer
-            return self.outputs
-        self.row, self.state, self.timer, outputs, keeps, _ = hit
-        if keeps:
-            outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
-        self.outputs = outputs
-        return outputs
-
-    def _step_counting(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] = ()) -> tuple[int, ...]:
-        """:meth:`step` for a machine with counters: they count down by their pulses, and Cn is an event
-        while counter n is 0."""
-        if inputs.__class__ is not int or inputs & self._not_input:
-            inputs = self.events_of(inputs)
-        timer = self.timer
-        tick = self.tick
-        self.tick = tick + 1
-        if tick:
-            if timer:
-                timer -= 1
-            if pulses is not _NONE:
-                self._count_down(pulses)
-        if not timer:
-            inputs |= self._timer_bit
-        if self._counter_bits:
+        if self._counter_bits:  # () unless a counter is an event column
             inputs |= self._counter_events()
         self.event = inputs
         hit = self._hits[self.state][inputs]
@@ -159,7 +132,7 @@ class Engine:
         if keeps:
             outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
         self.outputs = outputs
-        if loads:
+        if loads:  # () unless the row loads a counter
             self.counters = [old if new is None else new for old, new in zip(self.counters, loads, strict=True)]
         return outputs
 

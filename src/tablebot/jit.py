@@ -33,8 +33,8 @@ def cache_dir() -> str:
     return os.path.join(platformdirs.user_cache_dir("tablebot"), f"numba-{tag}-{sources_digest()}")
 
 
-#: Files whose constants compiled code reads, though they hold no compiled function themselves.
-COMPILED_CONSTANTS = ("tick.py", "columns.py")
+#: Files whose functions or constants compiled code reads, though they compile nothing themselves.
+COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py")
 
 
 ROOT = Path(__file__).resolve().parent  # the tablebot package

@@ -11,9 +11,11 @@ observed by sinks, guarded by a watchdog. Every way a table meets a robot goes t
 from __future__ import annotations
 
 import contextlib
+import itertools
 import signal
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -137,9 +139,12 @@ class Sink(Protocol):
 
 
 class Clock(Protocol):
-    """When each tick may start. ``wait(tick)`` blocks until then and returns how late it is (s)."""
+    """When each tick may start. ``wait(tick)`` blocks until then and returns how late it is (s);
+    ``behind_s`` is then how far the table's time (ticks × tick) trails the wall clock since ``start``
+    (0 for a clock that has no wall clock to trail)."""
 
     free_running: bool
+    behind_s: float
 
     def start(self) -> None: ...
 
@@ -150,6 +155,7 @@ class SimulatedClock:
     """Simulated time: no waiting, never late (the simulator runs as fast as it can)."""
 
     free_running = True
+    behind_s = 0.0
 
     def start(self) -> None:
         pass
@@ -163,9 +169,8 @@ class RealTimeClock:
 
     A link that paces itself (a TXT answers every 10 ms) is not slowed, and one that answers at once
     (ftrobopy_server on a TXT 4.0, the simulator) is paced without drift. A tick more than half a tick
-    late is reported late and the grid starts again from it: a link that cannot catch up after a stall
-    is not counted late on every later tick, and a single stall longer than the run's behind-limit ends
-    the run (see :class:`Lateness`).
+    late is reported late and the grid starts again from it: a stall is never made up by a burst of ticks.
+    What the grid lets slip is kept in ``behind_s``, which :class:`Pace` judges over a window.
     """
 
     free_running = False
@@ -173,20 +178,23 @@ class RealTimeClock:
     def __init__(self, tick_s: float, now: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep):
         self.tick_s, self.now, self.sleep = tick_s, now, sleep
-        self.anchor, self.anchor_tick = 0.0, 0
+        self.origin, self.anchor, self.anchor_tick = 0.0, 0.0, 0
+        self.behind_s = 0.0
 
     def start(self) -> None:
-        self.anchor, self.anchor_tick = self.now(), 0
+        self.origin = self.anchor = self.now()
+        self.anchor_tick, self.behind_s = 0, 0.0
 
     def wait(self, tick: int) -> float:
         due = self.anchor + (tick - self.anchor_tick) * self.tick_s
-        ahead = due - self.now()
-        if ahead > 0:
-            self.sleep(ahead)
-            return 0.0
-        late = -ahead
+        now = self.now()
+        if due > now:
+            self.sleep(due - now)
+            now = due
+        late = now - due
+        self.behind_s = now - self.origin - tick * self.tick_s
         if late > self.tick_s / 2:  # a stall, or a link slower than the tick: the grid starts again here
-            self.anchor, self.anchor_tick = due + late, tick
+            self.anchor, self.anchor_tick = now, tick
         return late
 
 
@@ -292,10 +300,10 @@ class StopRequest:
 
 @dataclass
 class Lateness:
-    """Ticks that started late (by more than half a tick), the worst delay, and the limit that ends a run."""
+    """Ticks that started late (by more than half a tick) and the worst delay: what the live view and the
+    summary show."""
 
     tick_s: float
-    behind_limit_s: float | None = None
     count: int = 0
     worst_s: float = 0.0
 
@@ -303,9 +311,49 @@ class Lateness:
         if late_s > self.tick_s / 2:
             self.count += 1
         self.worst_s = max(self.worst_s, late_s)
-        if self.behind_limit_s is not None and late_s > self.behind_limit_s:
-            raise _Behind(f"the run fell {1000 * late_s:.0f} ms behind its clock (limit "
-                          f"{1000 * self.behind_limit_s:.0f} ms): the table's timers would stretch")
+
+
+#: The window :class:`Pace` judges a run over (s): the table's time may fall at most the behind-limit
+#: behind the wall clock within any this long. With the default limit of 0.5 s: one stall of 0.5 s, or
+#: ticks 10 % longer than the table's tick on average.
+BEHIND_WINDOW_S = 5.0
+
+
+class Pace:
+    """Whether the run keeps the table's tick: the run ends as ``behind`` when the table's time falls more
+    than ``limit_s`` behind the wall clock within any ``window_s`` — one long stall, or a robot whose every
+    tick is a little too slow (which the clock's restarted grid would otherwise hide while the table's
+    timers run slow). ``note`` takes each tick's number and the clock's ``behind_s``."""
+
+    def __init__(self, tick_s: float, limit_s: float, window_s: float = BEHIND_WINDOW_S):
+        self.tick_s, self.limit_s, self.window_s = tick_s, limit_s, window_s
+        self._ticks: deque[tuple[int, float]] = deque()  # (tick, wall time since start) of recent ticks
+
+    def note(self, tick: int, behind_s: float) -> None:
+        wall = tick * self.tick_s + behind_s
+        ticks = self._ticks
+        ticks.append((tick, wall))
+        while len(ticks) > 1 and ticks[1][1] <= wall - self.window_s:  # the first stays at or before the window
+            ticks.popleft()
+        first_tick, first_wall = ticks[0]
+        fell = (wall - first_wall) - (tick - first_tick) * self.tick_s
+        if fell > self.limit_s:
+            raise _Behind(self._message(fell, tick - first_tick, wall - first_wall))
+
+    def _message(self, fell: float, ticks: int, wall: float) -> str:
+        longest = max(b[1] - a[1] for a, b in itertools.pairwise(self._ticks))
+        limit = f"limit {self.limit_s:g} s within any {self.window_s:g} s"
+        if longest - self.tick_s >= fell / 2:  # mostly one gap: a stall, not a slow robot
+            return (f"the run fell {fell:.2f} s behind the wall clock ({limit}): one tick started "
+                    f"{1000 * longest:.0f} ms after the one before it (the robot's link or this machine stalled), "
+                    "and the table's timers would stretch by as much")
+        ms, mean = 1000 * self.tick_s, 1000 * wall / ticks
+        slow = 100 * (mean / ms - 1)
+        return (f"the robot cannot keep the table's {ms:g} ms tick: over the last {wall:.1f} s its ticks took "
+                f"{mean:.1f} ms on average, so the table's timers would run {slow:.0f} % slow ({fell:.2f} s behind "
+                f"the wall clock; {limit}). Give the robot file a longer tick_ms (write the table's timers as "
+                "times, such as 500ms, so they keep their length) or use a faster link; --behind-limit 0 runs on "
+                "with slow timers")
 
 
 class _Behind(Exception):
@@ -325,8 +373,9 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
     """
     clock = clock or SimulatedClock()
     watchdog = watchdog or Watchdog(None)
-    tick_s = engine.machine.table.robot.tick_ms / 1000
-    late = Lateness(tick_s, behind_limit_s)
+    tick_s = engine.machine.table.robot.tick_s
+    late = Lateness(tick_s)
+    pace = Pace(tick_s, behind_limit_s) if behind_limit_s else None
     info = RunInfo(engine, tick_s, target, ticks)
     started: list[Sink] = []
     end: RunEnd | None = None
@@ -341,7 +390,7 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
             if clock.free_running and isinstance(robot, BlockIO):
                 _run_blocks(engine, robot, started, ticks, block_ticks, stop)
             else:
-                _run_ticks(engine, robot, clock, started, ticks, watchdog, late, stop)
+                _run_ticks(engine, robot, clock, started, ticks, watchdog, late, pace, stop)
             end = RunEnd("done" if ticks is not None else "stopped", engine.tick)
     except KeyboardInterrupt:
         end = RunEnd("stopped" if ticks is None else "interrupted", engine.tick, "stopped by Ctrl-C")
@@ -378,17 +427,26 @@ def _end_sinks(sinks: Sequence[Sink], end: RunEnd) -> Exception | None:
     return first
 
 
+def exchange(engine: Engine, robot: RobotIO) -> Reading:
+    """One tick's work with a robot: read it, step the engine on what it read, write the outputs; returns the
+    reading. The loop does this every tick (inside the watchdog); so does the Gymnasium env when the table
+    drives, so that a tick means the same everywhere."""
+    reading = robot.read()
+    robot.write(engine.step(reading.mask, reading.pulses))
+    return reading
+
+
 def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
-               watchdog: Watchdog, late: Lateness, stop: StopRequest) -> None:
+               watchdog: Watchdog, late: Lateness, pace: Pace | None, stop: StopRequest) -> None:
     """One tick at a time: the path of real robots and of the real-time rehearsal."""
     while ticks is None or engine.tick < ticks:
         stop.check()
         delay = clock.wait(engine.tick)
         late.note(delay)
+        if pace is not None:
+            pace.note(engine.tick, clock.behind_s)
         watchdog.arm()
-        reading = robot.read()
-        outputs = engine.step(reading.mask, reading.pulses)
-        robot.write(outputs)
+        reading = exchange(engine, robot)
         watchdog.disarm()
         block = TickBlock.of_tick(engine, reading, {"late_ms": round(1000 * delay, 3)} if not clock.free_running
                                   else None)

@@ -44,11 +44,13 @@ class Exported:
 @dataclass(frozen=True)
 class Opened:
     """A live robot ready to run: the :class:`~tablebot.loop.RobotIO`, where it is and what it is (for the
-    live view and the run's summary)."""
+    live view and the run's summary), and what the user should know before it moves (a link that keeps the
+    table's tick only just: :mod:`tablebot.hw.link_speed`)."""
 
     robot: RobotIO
     where: str
     device: str
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

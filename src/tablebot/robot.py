@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tablebot import durations
 from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
@@ -101,7 +102,11 @@ class Robot:
     @property
     def tick_s(self) -> float:
         """One tick in seconds."""
-        return self.tick_ms / 1000
+        return durations.seconds(1, self.tick_ms)
+
+    def seconds(self, ticks: float) -> float:
+        """``ticks`` ticks in seconds (:func:`tablebot.durations.seconds`)."""
+        return durations.seconds(ticks, self.tick_ms)
 
     @property
     def counter_names(self) -> tuple[str, ...]:

@@ -14,19 +14,86 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from tablebot.tomlfile import Source, is_number
 
-#: What each ``sensor =`` word is simulated as: a floor (track) sensor, an ultrasonic ray cast, or light.
-KINDS = {"line": "line", "distance": "distance", "ultrasonic": "distance",
-         "phototransistor": "light", "photoresistor": "light", "light": "light"}
 KEYS = ("sensor", "at", "angle", "below", "above", "hysteresis")
 #: Lengths accept these units (the value is kept in metres); light levels are plain numbers.
 LENGTH_UNITS = {"mm": 0.001, "cm": 0.01, "m": 1.0}
 LENGTH_RE = re.compile(r"^\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+))\s*(mm|cm|m)\s*$")
 MAX_OFFSET = 2.0  # metres: a sensor further than this from the axle centre is a typo, not a robot
+
+
+# --- sensor kinds -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Panel:
+    """A kind's panel in the timeline picture: its axis label, the scale of the reading on it, a log axis (else
+    the axis reaches three times the thresholds), and its place among the panels."""
+
+    label: str
+    scale: float
+    log: bool
+    position: int
+
+
+@dataclass(frozen=True)
+class SensorKind:
+    """One kind of sensor the simulator models, and everything that follows from it: the words that declare
+    it, how its thresholds are written, its code in the simulator (whose physics, ``sim/sensing.py``, has a
+    branch per code), its trace field, how pictures draw it, its reading panel, the controller input modes
+    that read it with its declared threshold, and its place in a learning agent's observation.
+
+    Adding a kind: register one here, its physics in ``sim/sensing.py`` (and its parameters, if it has any, in
+    ``sim/params.py``); every other stage reads this object.
+    """
+
+    name: str  # what the simulator models
+    words: tuple[str, ...]  # the ``sensor =`` words that declare it
+    code: int  # its code in the simulator's parameter row (sim.columns.F_KIND); 0 is "no sensor"
+    units: str  # "length" (written with mm, cm or m, kept in metres), "level" (a plain number), "" (no threshold)
+    example: str  # a threshold as a robot file writes it ("" when it has none)
+    reads: str  # what it reads, in words: "1 over a line"; for a thresholded kind, what its level means
+    trace: tuple[str, float, int]  # trace key suffix, scale of the reading, decimals (0: a whole number)
+    draw: str  # "spot" (a floor spot, dark while it reads 1), "beam" (out to its echo), "cone" (its field of view)
+    spread: tuple[str, str] | None = None  # the [sim] parameter of its drawn half angle (degrees)
+    panel: Panel | None = None  # its reading panel in the timeline (None: the event panel shows it)
+    modes: Mapping[str, float] = field(default_factory=dict)  # controller input mode -> scale from its units
+    high: Callable[[Mapping[str, Any], float], float] = lambda params, light: 1.0  # its observation's upper bound
+    # (params: the simulator's parameters, light: the most light a sensor can get in the world)
+
+
+#: Every sensor kind, by name, in the order their words are listed to people.
+SENSOR_KINDS: dict[str, SensorKind] = {}
+
+
+def register_kind(kind: SensorKind) -> SensorKind:
+    if kind.code <= 0 or any(k.code == kind.code for k in SENSOR_KINDS.values() if k.name != kind.name):
+        raise ValueError(f"sensor kind {kind.name}: code {kind.code} is taken or not above 0")
+    SENSOR_KINDS[kind.name] = kind
+    return kind
+
+
+register_kind(SensorKind(
+    "line", ("line",), 1, "", "", "1 over a line", ("line", 1.0, 0), "spot"))
+register_kind(SensorKind(
+    "distance", ("distance", "ultrasonic"), 2, "length", '"20 cm"', "", ("cm", 100.0, 1), "beam",
+    spread=("distance", "beam"), panel=Panel("distance (cm)\n-- on, ·· off", 100.0, False, 1),
+    modes={"ultrasonic": 100.0}, high=lambda params, light: params["distance"]["range"]))
+register_kind(SensorKind(
+    "light", ("phototransistor", "photoresistor", "light"), 3, "level", "1.5",
+    "1 is the level at which a phototransistor switches", ("light", 1.0, 4), "cone",
+    spread=("light", "half_response"), panel=Panel("light\n(× threshold)", 1.0, True, 0),
+    high=lambda params, light: light))
+
+
+def word_kinds() -> dict[str, str]:
+    """Each ``sensor =`` word and the kind it declares, in the order they are listed to people."""
+    return {word: kind.name for kind in SENSOR_KINDS.values() for word in kind.words}
 
 
 @dataclass(frozen=True)
@@ -51,18 +118,26 @@ class Sensor:
 
     @property
     def kind(self) -> str:
-        """What the simulator models: ``line``, ``distance`` or ``light``."""
-        return KINDS[self.model]
+        """What the simulator models: ``line``, ``distance`` or ``light`` (:attr:`sensor_kind`'s name)."""
+        return word_kinds()[self.model]
+
+    @property
+    def sensor_kind(self) -> SensorKind:
+        return SENSOR_KINDS[self.kind]
 
     def switch_points(self) -> tuple[float, float]:
         """The reading at which the event turns on, and the one at which it turns off again."""
         back = self.hysteresis if self.direction == "below" else -self.hysteresis
         return self.threshold, self.threshold + back
 
+    def event(self, reading: float, was_on: bool) -> bool:
+        """Whether the input reads 1 for ``reading`` (``was_on``: whether it read 1 last tick)."""
+        return threshold_event(reading, self.direction == "above", *self.switch_points(), was_on)
+
     def describe(self) -> str:
         """``distance below 20 cm (hysteresis 5 cm)`` — the declaration in words, for reports."""
-        if self.kind == "line":
-            return f"{self.model} sensor: 1 over a line"
+        if not self.sensor_kind.units:
+            return f"{self.model} sensor: {self.sensor_kind.reads}"
         text = f"{self.model} {self.direction} {self._show(self.threshold)}"
         return text + (f" (hysteresis {self._show(self.hysteresis)})" if self.hysteresis else "")
 
@@ -70,6 +145,19 @@ class Sensor:
         if not self.unit:
             return f"{value:g}"
         return f"{value / LENGTH_UNITS[self.unit]:g} {self.unit}"
+
+
+def threshold_event(reading: float, above: bool, on_at: float, off_at: float, was_on: bool) -> bool:
+    """THE threshold rule, with its hysteresis: the event is on while the reading is past ``on_at`` (above it,
+    or below it) and, once on, stays on until the reading is back past ``off_at`` (``on_at`` moved back by the
+    hysteresis; ``was_on``: the event last tick).
+
+    The one rule for every analog input: the simulator compiles this function into its sensing
+    (``sim.sensing``), the TXT's wiring calls it (``hw.txt.wiring``), and the TXT 4.0 program, a standalone
+    file, carries a copy that ``tests/test_rules.py`` proves equal to it.
+    """
+    level = off_at if was_on else on_at
+    return reading > level if above else reading < level
 
 
 def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
@@ -100,31 +188,33 @@ def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Senso
         src.key_error(where, f"[sensors] {name}: unknown key{'s' * (len(unknown) > 1)} {', '.join(unknown)}",
                   f"known keys: {', '.join(KEYS)}")
     model = value.get("sensor")
-    if model not in KINDS:
+    words = word_kinds()
+    if model not in words:
         src.key_error(where, f"[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows",
-                  f"write sensor = one of {', '.join(repr(k) for k in KINDS)}")
+                  f"write sensor = one of {', '.join(repr(k) for k in words)}")
         return None
+    kind = SENSOR_KINDS[words[model]]
     at = _at(src, name, value.get("at"))
     angle = _angle(src, name, value)
-    if KINDS[model] == "line":
-        return _line(src, name, model, value, at, angle)
-    threshold = _threshold(src, name, model, value)
+    if not kind.units:
+        return _unthresholded(src, name, model, kind, value, at, angle)
+    threshold = _threshold(src, name, model, kind, value)
     if at is None or angle is None or threshold is None:
         return None
     direction, level, unit = threshold
-    hysteresis = _amount(src, name, "hysteresis", value.get("hysteresis", 0), KINDS[model])
+    hysteresis = _amount(src, name, "hysteresis", value.get("hysteresis", 0), kind)
     if hysteresis is None:
         return None
     return Sensor(name, model, at, angle, direction, level, hysteresis[0], unit)
 
 
-def _line(src: Source, name: str, model: str, value: dict[str, Any], at: tuple[float, float] | None,
-          angle: float | None) -> Sensor | None:
-    """A floor sensor reads the floor straight below it: no threshold, no direction."""
+def _unthresholded(src: Source, name: str, model: str, kind: SensorKind, value: dict[str, Any],
+                   at: tuple[float, float] | None, angle: float | None) -> Sensor | None:
+    """A kind without a threshold (a floor sensor reads the floor straight below it): no direction, no angle."""
     extra = [k for k in ("below", "above", "hysteresis", "angle") if k in value]
     if extra:
-        src.key_error(("sensors", None, name), f"[sensors] {name}: a line sensor has no {', '.join(extra)}",
-                  "it reads 1 over a line and 0 elsewhere; give only sensor and at")
+        src.key_error(("sensors", None, name), f"[sensors] {name}: a {kind.name} sensor has no {', '.join(extra)}",
+                  f"it reads {kind.reads} and 0 elsewhere; give only sensor and at")
     return None if at is None or angle is None or extra else Sensor(name, model, at)
 
 
@@ -146,26 +236,27 @@ def _angle(src: Source, name: str, value: dict[str, Any]) -> float | None:
     return float(angle)
 
 
-def _threshold(src: Source, name: str, model: str, value: dict[str, Any]) -> tuple[str, float, str] | None:
+def _threshold(src: Source, name: str, model: str, kind: SensorKind,
+               value: dict[str, Any]) -> tuple[str, float, str] | None:
     """(below|above, threshold in metres or light units, unit written)."""
     given = [k for k in ("below", "above") if k in value]
     if len(given) != 1:
-        example = '"20 cm"' if KINDS[model] == "distance" else "1.5"
+        example = kind.example
         src.key_error(("sensors", None, name), f"[sensors] {name}: a {model} sensor needs "
                   f"{'one of below or above, not both' if given else 'a threshold'}",
                   f"write below = {example} (the event is 1 while the reading is below it) or above = {example}")
         return None
     direction = given[0]
-    amount = _amount(src, name, direction, value[direction], KINDS[model])
+    amount = _amount(src, name, direction, value[direction], kind)
     return None if amount is None else (direction, *amount)
 
 
-def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> tuple[float, str] | None:
-    """A threshold or hysteresis and the unit written: a length with its unit for distances (the value in
-    metres; a bare 0 counts as cm), a plain number for light (unit "")."""
+def _amount(src: Source, name: str, key: str, raw: Any, kind: SensorKind) -> tuple[float, str] | None:
+    """A threshold or hysteresis and the unit written: a length with its unit (the value in metres; a bare 0
+    counts as cm), or a plain level (unit "")."""
     where = ("sensors", None, name)
     unit = ""
-    if kind == "distance":
+    if kind.units == "length":
         if raw == 0:
             return 0.0, "cm"
         match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
@@ -176,8 +267,8 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: str) -> tuple[floa
         metres, unit = float(match[1]) * LENGTH_UNITS[match[2]], match[2]
     else:
         if not is_number(raw):
-            src.key_error(where, f"[sensors] {name}: {key} must be a light level (a number), not {raw!r}",
-                      f"1 is the level at which a phototransistor switches: {key} = 1.5")
+            src.key_error(where, f"[sensors] {name}: {key} must be a {kind.name} level (a number), not {raw!r}",
+                      f"{kind.reads}: {key} = {kind.example}")
             return None
         metres = float(raw)
     if metres < 0 or not math.isfinite(metres):

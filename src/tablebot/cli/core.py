@@ -116,8 +116,8 @@ def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder 
     for line in lines:
         visits[line["state"]] = visits.get(line["state"], 0) + 1
     fired = sum(1 for line in lines if line["row"] is not None)
-    console.print(f"BumberBot: {len(lines)} ticks ({len(lines) * machine.table.robot.tick_ms / 1000:.1f} s), "
+    console.print(f"BumberBot: {len(lines)} ticks ({machine.table.robot.seconds(len(lines)):.1f} s), "
                   f"{fired} rows fired")
     for state, count in visits.items():
-        console.print(f"  state {terminal(str(state)):>4}: {count * machine.table.robot.tick_ms / 1000:6.2f} s")
+        console.print(f"  state {terminal(str(state)):>4}: {machine.table.robot.seconds(count):6.2f} s")
     console.print(f"wrote {terminal(str(out / 'trace.jsonl'))}")

@@ -13,7 +13,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,7 @@ def evolve_cmd(
     archive of the best tables that behave differently. Ctrl-C keeps what was run; the same command resumes."""
     from tablebot.diagnostics import fail
     from tablebot.fleet.backends import choose
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.spec import parse_seeds
 
     chosen, address = choose(backend, scheduler)

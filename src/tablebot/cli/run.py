@@ -52,8 +52,10 @@ def run_cmd(
                                     "run goes (a planned run cut short leaves trace.partial.jsonl)."),
     link_timeout: float | None = typer.Option(None, "--link-timeout", min=0.001, help="Seconds without a valid "
                                               "reply that end the run as link_lost (default: 5 ticks)."),
-    behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when a tick starts this "
-                                       "many seconds late, rather than stretch the table's timers (0: never)."),
+    behind_limit: float = typer.Option(0.5, "--behind-limit", min=0.0, help="End the run when the table's time "
+                                       "falls this many seconds behind the wall clock within any 5 s (a stall, or "
+                                       "a robot too slow for the tick), rather than let its timers run slow. 0: "
+                                       "never, and run on a link too slow for the tick."),
     seed: int = typer.Option(1, "--seed", min=0, help="sim: the seed of all simulated noise (as tablebot sim)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live view and no summary (a run that fails still "
                                "says why)."),
@@ -68,7 +70,10 @@ def run_cmd(
     if out is not None:
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
     assert backend.open is not None
-    opened = backend.open(machine, on, {"link_timeout_s": link_timeout, "seed": seed, "hint": TARGET_HINT})
+    opened = backend.open(machine, on, {"link_timeout_s": link_timeout, "seed": seed, "hint": TARGET_HINT,
+                                        "behind_limit_s": behind_limit})
+    for warning in opened.warnings:
+        err_console.print(terminal(f"warning: {warning}"))
     end = _drive(machine, opened.robot, opened.where, opened.device, ticks, out, behind_limit or None, quiet)
     if end.exit_code:
         raise typer.Exit(end.exit_code)

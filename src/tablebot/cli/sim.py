@@ -13,7 +13,7 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
-    from tablebot.sim.runner import Result
+    from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
     from tablebot.sinks.trace_file import TraceFile
@@ -116,14 +116,14 @@ def _import_drawing(plots: bool, gif: bool, html: bool) -> _Imports:
     return _Imports([module for module, used in wanted if used])
 
 
-def _stopped(result: Result, kept: Path | None) -> None:
+def _stopped(result: SimRun, kept: Path | None) -> None:
     """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
     err_console.print(f"{result.end.message or result.end.reason} after {result.ticks:,} ticks; "
                       f"kept {plain(str(kept))} (the previous run's files are untouched)", markup=False)
     raise typer.Exit(result.end.exit_code)
 
 
-def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: bool) -> list[Path]:
+def _pictures(result: SimRun, summary: Summary, out: Path, plots: bool, gif: bool) -> list[Path]:
     """trajectory.png and timeline.png (unless ``plots`` is off) and, with ``gif``, the animation."""
     written = []
     if plots:
@@ -137,7 +137,7 @@ def _pictures(result: Result, summary: Summary, out: Path, plots: bool, gif: boo
     return written
 
 
-def _replay_page(result: Result, trace: Path, path: Path) -> Path:
+def _replay_page(result: SimRun, trace: Path, path: Path) -> Path:
     """A self-contained HTML page that replays the run from the trace just written (to send to a pupil,
     or put on a class page)."""
     from tablebot.fileset import current
@@ -148,7 +148,7 @@ def _replay_page(result: Result, trace: Path, path: Path) -> Path:
     return write_html(path, lines, scene.world, scene.table, params=scene.params)
 
 
-def _report(result: Result, summary: Summary, written: list[Path]) -> None:
+def _report(result: SimRun, summary: Summary, written: list[Path]) -> None:
     """The summary on standard output, the files written on standard error."""
     for line in summary.lines(result.scene.table.robot.state_names):
         console.print(plain(line), markup=False)
@@ -159,19 +159,19 @@ def _report(result: Result, summary: Summary, written: list[Path]) -> None:
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,
-              rows: bool) -> Result:
+              rows: bool) -> SimRun:
     """The run, with a progress bar of ``ticks`` on a terminal (None: quiet); history in float32 (half
     the memory, plenty for pictures: the trace is written from the exact values)."""
     import numpy as np
 
-    from tablebot.sim.runner import run
+    from tablebot.sim.runner import simulate
 
     if ticks is None or not sys.stderr.isatty():
-        return run(scene, seconds, seed, sinks=[trace], history=np.float32, rows=rows)
+        return simulate(scene, seconds, seed, sinks=[trace], history=np.float32, rows=rows)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
-        return run(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
+        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
                    history=np.float32, rows=rows)

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
 from tablebot.escape import plain
 
 if TYPE_CHECKING:
@@ -50,7 +50,7 @@ def sweep_cmd(
     resumes."""
     from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import choose, run_jobs
-    from tablebot.fleet.plan import Store, read_results
+    from tablebot.fleet.plan import Store, make_plan, read_results
     from tablebot.fleet.plots import write_all
     from tablebot.interrupts import INTERRUPTS
 
@@ -111,38 +111,6 @@ def trace_runs(text: str | None, total: int) -> list[int]:
     if beyond:
         raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")
     return list(chosen)
-
-
-def make_plan(table: Path, robot: Path | None, worlds: list[Path], grid: list[str], seeds: str | None,
-              robots: int | None, seconds: float) -> Plan:
-    """The table, its worlds and the checked options as a plan of runs."""
-    from tablebot.fleet.plan import Plan
-    from tablebot.fleet.spec import SweepSpec, digest, parse_grid, parse_seeds
-    from tablebot.jit import sources_digest
-    from tablebot.sim.runner import ticks_for
-    from tablebot.sim.scene import find_world, prepare, robot_layer
-    from tablebot.sim.world import load_world
-
-    axes = parse_grid(grid)
-    seed_list = parse_seeds(seeds, robots)
-    parsed, machine = load(table, robot)
-    if machine.arrays is None:
-        from tablebot.diagnostics import fail
-        from tablebot.machine import FLAT_BITS
-
-        raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
-                   f"{FLAT_BITS}", "simulate it one robot at a time with tablebot sim, or use fewer inputs")
-    layer, robot_world = robot_layer(parsed.robot)
-    loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
-    paths = [str(w) for w in worlds] or [loaded[0].path]
-    ticks = ticks_for(prepare(parsed, machine, loaded[0], layer), seconds)
-    files = [Path(p) if Path(p).is_file() else None for p in paths]
-    robot_file = Path(parsed.robot.source)
-    spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=digest(Path(parsed.path)),
-                     worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
-                     seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
-                     code=sources_digest())
-    return Plan(spec, parsed, machine, loaded, layer)
 
 
 def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: float, ran: int) -> None:

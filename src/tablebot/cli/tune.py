@@ -12,7 +12,7 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar, make_plan
+from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:
@@ -57,6 +57,7 @@ def tune_cmd(
     from tablebot.diagnostics import fail
     from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import Runner, choose
+    from tablebot.fleet.plan import make_plan
     from tablebot.fleet.spec import parse_seeds
     from tablebot.fleet.tune import Evaluator, best, parse_cells, search_cma, search_grid
     from tablebot.interrupts import INTERRUPTS

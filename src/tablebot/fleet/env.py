@@ -24,21 +24,13 @@ try:
 except ImportError as exc:  # pragma: no cover - gymnasium is an extra
     raise ImportError("tablebot.fleet.env needs Gymnasium: pip install 'tablebot[research]'") from exc
 
-from tablebot.sim import columns as L
+from tablebot.loop import exchange
+from tablebot.sim.observation import BUILT_IN
 
 ENV_ID = "tablebot/TableBot-v0"
-#: The observation vector, in order.
-OBSERVATION = ("x", "y", "cos_heading", "sin_heading", "light_right", "light_left", "bump_front_right",
-               "bump_front_left", "bump_rear", "battery_v")
-COLUMNS = [L.X, L.Y, L.TH, L.TH, L.LIGHT_R, L.LIGHT_L, L.BUMP_FR, L.BUMP_FL, L.BUMP_REAR, L.VBAT]
-
-
-def observe(S: np.ndarray) -> np.ndarray:
-    """The observations of robot rows ``S`` (N, N_STATE): pose as x, y, cos and sin of the heading, then
-    the light each phototransistor receives (1 = threshold), the bumpers (0/1) and the battery volts."""
-    obs = S[:, COLUMNS].copy()
-    obs[:, 2], obs[:, 3] = np.cos(S[:, L.TH]), np.sin(S[:, L.TH])
-    return obs
+#: The observation vector's first part, in order; every declared sensor's reading follows (the names of a
+#: robot's whole vector: ``env.observation_names``; see :class:`tablebot.sim.observation.Observation`).
+OBSERVATION = tuple(name for name, _ in BUILT_IN)
 
 
 class Setup:
@@ -50,6 +42,7 @@ class Setup:
         from tablebot.formats.table_read import load_table, resolve_table_path
         from tablebot.machine import compile_table
         from tablebot.robot import load_robot
+        from tablebot.sim.observation import Observation
         from tablebot.sim.runner import ticks_for
         from tablebot.sim.scene import find_world, prepare, robot_layer
 
@@ -64,14 +57,9 @@ class Setup:
         levels = int(self.scene.params["motor"]["levels"])
         self.action_space = spaces.MultiDiscrete([2 * levels + 1, 2 * levels + 1], start=[-levels, -levels],
                                                  dtype=np.int64)
-        xs, ys = zip(*self.world.walls, strict=True)
-        top_volts = float(self.scene.params["battery"]["full_volts"]) + 1.0
-        # the most light a sensor can get: every lamp at the nearest distance counted, with noise to spare
-        near = self.scene.params["light"]["near"]
-        light = 10.0 * max(1.0, sum(lamp.intensity for lamp in self.world.lamps)) / near**2
-        low = np.array([min(xs) - 1, min(ys) - 1, -1, -1, 0, 0, 0, 0, 0, 0], dtype=np.float64)
-        high = np.array([max(xs) + 1, max(ys) + 1, 1, 1, light, light, 1, 1, 1, top_volts], dtype=np.float64)
-        self.observation_space = spaces.Box(low, high, dtype=np.float64)
+        observation = Observation.of(self.scene)
+        self.observation_names = observation.names
+        self.observation_space = spaces.Box(observation.low, observation.high, dtype=np.float64)
 
     def spec(self, seed: int) -> Any:
         from tablebot.fleet.robots import RobotSpec
@@ -107,14 +95,13 @@ class TableBotEnv(gym.Env):
         return self._observation(), {"seed": robot_seed}
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        if action is None:  # the table drives: the engine ticks on what the robot reads
-            reading = self.robot.read()
-            outputs = self.engine.step(reading.mask, reading.pulses)
+        if action is None:  # the table drives: the engine ticks on what the robot reads, as in the run loop
+            exchange(self.engine, self.robot)
         else:
             levels = np.asarray(action, dtype=np.int64).reshape(2)
             outputs = [0] * len(self.engine.outputs)
             outputs[self.drive[0]], outputs[self.drive[1]] = int(levels[0]), int(levels[1])
-        self.robot.write(outputs)
+            self.robot.write(outputs)
         self.ticks += 1
         reached = self.robot.reached_row is not None
         info = {"state": self.setup.machine.states[self.engine.state], "collisions": self.robot.collision_count}
@@ -122,7 +109,7 @@ class TableBotEnv(gym.Env):
             info
 
     def _observation(self) -> np.ndarray:
-        return observe(self.robot.s[None, :])[0]
+        return self.robot.observation()
 
 
 class TableBotVectorEnv(VectorEnv):
@@ -148,7 +135,6 @@ class TableBotVectorEnv(VectorEnv):
         self.fleet = Fleet(s.table, s.machine, s.world, [s.spec(k) for k in range(num_envs)], s.robot_params)
         self.ticks = np.zeros(num_envs, dtype=np.int64)
         self.done = np.zeros(num_envs, dtype=bool)
-        self.noise = NoiseRows(self.fleet)
         self.generators: list[np.random.Generator] = []
 
     def reset(self, *, seed: int | list[int] | None = None,
@@ -167,59 +153,24 @@ class TableBotVectorEnv(VectorEnv):
         self.generators = [seeding.np_random(s)[0] for s in seeds]
         for k, robot_seed in enumerate(seeds):
             self._reset_one(k, robot_seed)
-        return observe(self.fleet.S), {"seed": np.array(seeds)}
+        return self.fleet.observations(), {"seed": np.array(seeds)}
 
     def _reset_one(self, k: int, seed: int) -> None:
-        self.fleet.place(k, self.setup.spec(seed))
-        self.noise.refill(k)
+        self.fleet.restart(k, self.setup.spec(seed))
         self.ticks[k], self.done[k] = 0, False
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
-        from tablebot.fleet.kernel import move_fleet
-        from tablebot.sim import kernel as K
-
         fleet, again = self.fleet, self.done.copy()
-        noise = self.noise.next()
-        if actions is None:
-            fleet.step_block(noise[:, None, :])
-        else:
-            commands = np.asarray(actions, dtype=np.int64).reshape(self.num_envs, 2)
-            move_fleet(fleet.S, fleet.P, fleet.world, commands, noise, fleet.bits, fleet.acc, fleet.collisions)
+        fleet.tick(None if actions is None else np.asarray(actions, dtype=np.int64).reshape(self.num_envs, 2))
         self.ticks += 1
-        reached = fleet.acc[:, K.A_REACHED] >= 0
+        reached = fleet.reached()
         terminated = reached & ~again
         truncated = (self.ticks >= self.setup.ticks) & ~reached & ~again
         rewards = np.where(again, 0.0, -self.setup.scene.tick_s)
         for k in np.flatnonzero(again).tolist():  # next-step autoreset: whatever it did this step is dropped
             self._reset_one(k, int(self.generators[k].integers(2**31)))
         self.done = terminated | truncated
-        return observe(fleet.S), rewards, terminated, truncated, {}
-
-
-class NoiseRows:
-    """Each robot's noise stream, drawn ahead in blocks from its own Generator (as SimRobot draws it, one
-    row a tick) and handed out a row per step."""
-
-    BLOCK = 256
-
-    def __init__(self, fleet: Any):
-        self.fleet = fleet
-        n = len(fleet)
-        self.rows = np.empty((n, self.BLOCK, L.N_NOISE))
-        self.at = np.zeros(n, dtype=np.int64)
-        for k in range(n):
-            self.refill(k)
-
-    def refill(self, k: int) -> None:
-        self.fleet.rngs[k].standard_normal(out=self.rows[k])
-        self.at[k] = 0
-
-    def next(self) -> np.ndarray:
-        for k in np.flatnonzero(self.at >= self.BLOCK).tolist():
-            self.refill(k)
-        out = self.rows[np.arange(len(self.at)), self.at]
-        self.at += 1
-        return out
+        return fleet.observations(), rewards, terminated, truncated, {}
 
 
 if ENV_ID not in gym.registry:

@@ -167,6 +167,40 @@ class Plan:
         return out
 
 
+def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Sequence[str], seeds: str | None,
+              robots: int | None, seconds: float) -> Plan:
+    """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
+    as a plan of runs; every mistake is a located error before anything is written."""
+    from tablebot.fleet.spec import SweepSpec, digest, parse_grid, parse_seeds
+    from tablebot.formats.table_read import load_table, resolve_table_path
+    from tablebot.jit import sources_digest
+    from tablebot.machine import FLAT_BITS, compile_table
+    from tablebot.robot import load_robot
+    from tablebot.sim.runner import ticks_for
+    from tablebot.sim.scene import find_world, robot_layer
+    from tablebot.sim.world import load_world
+
+    axes = parse_grid(list(grid))
+    seed_list = parse_seeds(seeds, robots)
+    robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them
+    parsed = load_table(resolve_table_path(table), robot_file_given)
+    machine = compile_table(parsed)
+    if machine.arrays is None:
+        raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
+                   f"{FLAT_BITS}", "simulate it one robot at a time with tablebot sim, or use fewer inputs")
+    layer, robot_world = robot_layer(parsed.robot)
+    loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
+    paths = [str(w) for w in worlds] or [loaded[0].path]
+    ticks = ticks_for(prepare(parsed, machine, loaded[0], layer), seconds)
+    files = [Path(p) if Path(p).is_file() else None for p in paths]
+    robot_file = Path(parsed.robot.source)
+    spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=digest(Path(parsed.path)),
+                     worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
+                     seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
+                     code=sources_digest())
+    return Plan(spec, parsed, machine, loaded, layer)
+
+
 def _body(scene: Scene) -> tuple:
     """What decides whether a start pose is free for the robot: its body's measures."""
     return tuple(sorted(scene.params["body"].items()))

@@ -16,14 +16,15 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
-from tablebot.fleet.kernel import NO_TICK, parallel, run_fleet, run_fleet_serial
+from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
 from tablebot.sim.normals import bitgen_address
-from tablebot.sim.runner import PATH_STRIDE, Result
+from tablebot.sim.observation import Observation
+from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.scene import Scene, _check_start, prepare
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.summary import Summary, light_bits
@@ -98,6 +99,8 @@ class Fleet:
         self._scenes: dict[tuple, Scene] = {}
         self.scenes = [self.scene_of(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
+        self._tick_noise: NoiseRows | None = None
+        self._observation: Observation | None = None
         self._setup(traced)
 
     def scene_of(self, spec: RobotSpec) -> Scene:
@@ -206,6 +209,40 @@ class Fleet:
             trace.rows.append(hist[slot])
         self.t0 += ticks
 
+    # --- tick by tick (the Gymnasium vector environment) -------------------------------------------
+
+    def tick(self, commands: np.ndarray | None = None) -> None:
+        """Advance every robot one tick: its table drives it, or, given ``commands`` (N, 2: signed motor levels
+        right, left), they drive its motors and its engine does not tick (a learned controller).
+
+        The noise comes a row at a time from each robot's stream, as :meth:`run` draws it a block at a time;
+        a fleet is driven by one of the two, never both."""
+        if self._tick_noise is None:
+            self._tick_noise = NoiseRows(self)
+        noise = self._tick_noise.next()
+        if commands is None:
+            self.step_block(noise[:, None, :])
+        else:
+            move_fleet(self.S, self.P, self.world, np.asarray(commands, dtype=np.int64).reshape(len(self), 2), noise,
+                       self.bits, self.acc, self.collisions)
+
+    def restart(self, i: int, spec: RobotSpec) -> None:
+        """Robot i starts again as ``spec`` says (:meth:`place`), its noise stream with it."""
+        self.place(i, spec)
+        if self._tick_noise is not None:
+            self._tick_noise.refill(i)
+
+    def reached(self) -> np.ndarray:
+        """Per robot, whether it has come within reach of a lamp."""
+        return self.acc[:, K.A_REACHED] >= 0
+
+    def observations(self) -> np.ndarray:
+        """What a learning agent sees of every robot now, a row each (:class:`~tablebot.sim.observation.Observation`
+        of the fleet's scene)."""
+        if self._observation is None:
+            self._observation = Observation.of(self.scenes[0])
+        return self._observation(self.S)
+
     # --- what the run amounts to --------------------------------------------------------------------
 
     def summary(self) -> FleetSummary:
@@ -221,8 +258,8 @@ class Fleet:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
         return [line for block in self.traces[i].blocks for line in block_lines(block, self.machine)]
 
-    def result(self, i: int) -> Result:
-        """Robot i's whole run as the single-robot runner's :class:`Result` (for its pictures)."""
+    def result(self, i: int) -> SimRun:
+        """Robot i's whole run as the single-robot runner's :class:`SimRun` (for its pictures)."""
         trace = self.traces[i]
         blocks, robot = trace.blocks, trace.robot
         def column(name: str) -> np.ndarray:
@@ -230,13 +267,39 @@ class Fleet:
         hist = np.concatenate([*trace.rows, self.S[i][None, :]])
         count = int(self.acc[i, K.A_COLLISIONS])
         reached = int(self.acc[i, K.A_REACHED])
-        return Result(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
+        return SimRun(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
                       path=hist[::PATH_STRIDE, [L.X, L.Y]], masks=column("masks"), events=column("events"),
                       rows=column("rows"), states=column("states"), timers=column("timers"),
                       outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),
                       collision_rows=self.collisions[i, : min(count, FLEET_COLLISIONS)].tolist(),
                       collision_count=count, reached_row=None if reached < 0 else reached,
                       end=RunEnd("done", self.t0), wall_s=0.0)
+
+
+class NoiseRows:
+    """Each robot's noise stream, drawn ahead in blocks from its own Generator (as SimRobot draws it, one
+    row a tick) and handed out a row per tick."""
+
+    BLOCK = 256
+
+    def __init__(self, fleet: Fleet):
+        self.fleet = fleet
+        n = len(fleet)
+        self.rows = np.empty((n, self.BLOCK, L.N_NOISE))
+        self.at = np.zeros(n, dtype=np.int64)
+        for k in range(n):
+            self.refill(k)
+
+    def refill(self, k: int) -> None:
+        self.fleet.rngs[k].standard_normal(out=self.rows[k])
+        self.at[k] = 0
+
+    def next(self) -> np.ndarray:
+        for k in np.flatnonzero(self.at >= self.BLOCK).tolist():
+            self.refill(k)
+        out = self.rows[np.arange(len(self.at)), self.at]
+        self.at += 1
+        return out
 
 
 def with_start(scene: Scene, start: Pose | None) -> Scene:

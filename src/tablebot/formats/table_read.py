@@ -13,7 +13,7 @@ from typing import Any
 
 from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, Diagnostic, fail
-from tablebot.durations import DurationError, to_ticks
+from tablebot.durations import DurationError, seconds, to_ticks
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,
@@ -273,7 +273,7 @@ def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
         return 0
     if ticks > MAX_TIMER:
         out.error(cell.line, cell.column, f"timer: {text} is {ticks} ticks, more than the timer holds ({MAX_TIMER})",
-                  f"the longest timer is {MAX_TIMER} ticks ({MAX_TIMER * tick_ms / 1000:g} s at {tick_ms} ms a tick)")
+                  f"the longest timer is {MAX_TIMER} ticks ({seconds(MAX_TIMER, tick_ms):g} s at {tick_ms} ms a tick)")
         return 0
     return ticks
 

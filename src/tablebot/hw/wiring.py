@@ -20,6 +20,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from tablebot.sensors import threshold_event
+from tablebot.table import MAX_SPEED
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
@@ -54,7 +56,8 @@ class Terminals:
     counters: tuple[str, ...]
     min_tick_ms: int
     tick_reason: str  # why a shorter tick cannot be kept
-    distance_mode: str | None = None  # the analog mode that reads a [sensors] distance declaration (in cm)
+    distance_mode: str | None = None  # the analog mode a [sensors] distance declaration is read in (for hints;
+    #                                   which modes read a kind's threshold is the kind's: SensorKind.modes)
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -67,6 +70,14 @@ class Terminals:
 
     def names(self, kind: str) -> tuple[str, ...]:
         return {"input": self.inputs, "motor": self.motors, "lamp": self.lamps, "counter": self.counters}[kind]
+
+
+def level_duty(level: int, most: int) -> int:
+    """A motor's speed (its size) or a lamp's level, 0..8, as ``most`` / 8 per level (a level beyond 8 is 8, one
+    below 0 is off): the scaling of the controllers whose outputs take 0..``most`` in eight equal steps (the TXT
+    and TXT 4.0's PWM and the ROBO TX's duty, both 0..512). The ROBO Interface's is its own
+    (``hw.roboif.wiring.level_pwm``)."""
+    return max(0, min(MAX_SPEED, level)) * (most // MAX_SPEED)
 
 
 @dataclass(frozen=True)
@@ -90,10 +101,11 @@ class InputWire:
         """What the table sees (0/1) for the controller's value (``was_on``: last tick's, for the hysteresis)."""
         if self.digital:
             return int(bool(raw)) ^ int(self.invert)
-        slack = self.hysteresis if was_on else 0
         if self.below is not None:
-            return int(raw < self.below + slack)
-        return int(self.above is not None and raw > self.above - slack)
+            return int(threshold_event(raw, False, self.below, self.below + self.hysteresis, was_on))
+        if self.above is not None:
+            return int(threshold_event(raw, True, self.above, self.above - self.hysteresis, was_on))
+        return 0
 
 
 @dataclass(frozen=True)
@@ -328,7 +340,7 @@ class _Reader:
         analog, key = self.spec.analog[mode], self.spec.section
         limits = {k: value[k] for k in ("below", "above") if k in value}
         declared = next((s for s in self.robot.sensors if s.name == name), None)
-        if declared is not None and declared.kind != "line":
+        if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
             self.error(name, f"[{key}] {name}: a {mode} input needs exactly one of below = N or above = N "
@@ -351,14 +363,15 @@ class _Reader:
             self.error(name, f"[{key}] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
                        f"remove {', '.join(limits)} here: the simulator and the controller read the one declaration")
             return None
-        if sensor.kind != "distance" or mode != self.spec.distance_mode:
+        scale = sensor.sensor_kind.modes.get(mode)  # from the declaration's units into the mode's
+        if scale is None or mode not in self.spec.analog:
             where = (f'wire a distance sensor as mode = "{self.spec.distance_mode}"; ' if self.spec.distance_mode
                      else f"the {self.spec.controller} measures no distance in cm; ")
             self.error(name, f"[{key}] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
                        f"{mode} mode with its declared threshold", where + "or give a calibrated threshold here in "
                        "the controller's units and drop the input from [sensors]")
             return None
-        limit, slack = round(sensor.threshold * 100, 6), round(sensor.hysteresis * 100, 6)
+        limit, slack = round(sensor.threshold * scale, 6), round(sensor.hysteresis * scale, 6)
         if limit != int(limit) or slack != int(slack):
             self.error(name, f"[{key}] {name}: the {self.spec.controller} measures whole centimetres; [sensors] says "
                        f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")

@@ -23,7 +23,7 @@ from tablebot.files import atomic_write
 from tablebot.sim import columns as L
 from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings
 from tablebot.sim.plots import subtitle_of, title_of
-from tablebot.sim.runner import Result
+from tablebot.sim.runner import SimRun
 from tablebot.sim.summary import Summary
 
 GIF_FPS = 10
@@ -33,7 +33,7 @@ GIF_MAX_FRAMES = 240  # longer runs play faster: a 120 s run becomes a 24 s gif 
 class Player:
     """Draws frame k of a run onto a figure; shared by the gif writer and the live window."""
 
-    def __init__(self, fig: Figure, result: Result, summary: Summary, ticks_per_frame: int, speed: float):
+    def __init__(self, fig: Figure, result: SimRun, summary: Summary, ticks_per_frame: int, speed: float):
         self.result, self.step = result, ticks_per_frame
         scene = result.scene
         self.ax = fig.add_axes((0.08, 0.08, 0.9, 0.78))
@@ -78,7 +78,7 @@ class Player:
 
 
 @literal_text()
-def write_gif(result: Result, summary: Summary, path: Path) -> Path:
+def write_gif(result: SimRun, summary: Summary, path: Path) -> Path:
     """An animated gif, at most GIF_MAX_FRAMES frames (long runs are sped up).
 
     The arena is drawn once and each frame only redraws the moving artists on a copy of it (blitting).
@@ -120,7 +120,7 @@ def check_display() -> None:
 
 
 @literal_text()
-def show(result: Result, summary: Summary) -> None:
+def show(result: SimRun, summary: Summary) -> None:
     """A live window playing the run in real time."""
     import matplotlib.pyplot as plt
 

@@ -43,8 +43,7 @@ F_KIND, F_X, F_Y, F_AIM, F_ON, F_OFF, F_SIGN = 0, 1, 2, 3, 4, 5, 6  # kind (K_*)
 SENSOR_FIELDS = 7
 N_PARAM = P_SENSOR + MAX_SENSORS * SENSOR_FIELDS
 
-# --- sensor kinds in F_KIND ----------------------------------------------------------------------
-K_NONE, K_LINE, K_DISTANCE, K_LIGHT = 0, 1, 2, 3
+# --- sensor kinds in F_KIND: tablebot.sensors.SensorKind.code (0 = no sensor in the slot) -------------
 
 # --- noise Z[tick, i, :] ------------------------------------------------------------------------
 Z_MOTOR_R, Z_MOTOR_L, Z_LIGHT_R, Z_LIGHT_L = 0, 1, 2, 3

@@ -206,10 +206,11 @@ class RobotArtist:
             self.ax.add_patch(patch)
 
     def _sensor_patch(self, sensor: Sensor, z: int) -> Polygon | Wedge:
-        if sensor.kind == "line":  # a 12 mm spot on the body, dark while it sees tape
+        """How its kind is drawn (``SensorKind.draw``): a spot, a beam or a cone."""
+        if sensor.sensor_kind.draw == "spot":  # a 12 mm spot on the body, dark while it reads 1 (over tape)
             return Polygon(np.zeros((4, 2)), closed=True, facecolor="white", edgecolor=TAPE, lw=0.8,
                            alpha=self.alpha, zorder=z + 4)
-        colour = BEAM if sensor.kind == "distance" else LAMP_ON
+        colour = BEAM if sensor.sensor_kind.draw == "beam" else LAMP_ON
         return Wedge((0, 0), 0.01, 0, 1, facecolor=colour, alpha=0.2 * self.alpha, lw=0, zorder=z - 1)
 
     def artists(self) -> list:
@@ -252,12 +253,13 @@ class RobotArtist:
         cx, cy = _transform(at[None, :], x, y, theta)[0]
         aim = math.degrees(theta) + sensor.angle
         on = value < sensor.threshold if sensor.direction == "below" else value > sensor.threshold
-        if sensor.kind == "distance":  # the beam as far as the echo came from
-            half = self.params["distance"]["beam"]
+        kind = sensor.sensor_kind
+        section, key = kind.spread or ("light", "half_response")
+        half = self.params[section][key]
+        if kind.draw == "beam":  # the beam as far as the echo came from
             patch.set_radius(max(value, 0.005))
             patch.set_facecolor(BEAM_NEAR if on else BEAM)
         else:
-            half = self.params["light"]["half_response"]
             patch.set_radius(0.25)
         patch.set_center((cx, cy))
         patch.set_theta1(aim - half)

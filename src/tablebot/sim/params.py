@@ -260,15 +260,14 @@ def param_row(params: Params, tick_s: float, sensors: tuple[Sensor, ...] = ()) -
     return p
 
 
-KIND_CODES = {"line": L.K_LINE, "distance": L.K_DISTANCE, "light": L.K_LIGHT}
-
-
 def sensor_fields(sensor: Sensor) -> list[float]:
-    """One sensor slot (layout ``F_*``): a line sensor is "above 0.5" of its 1/0 reading."""
+    """One sensor slot (layout ``F_*``): a kind without a threshold (a line sensor) is "above 0.5" of its 1/0
+    reading."""
     fields = [0.0] * L.SENSOR_FIELDS
-    fields[L.F_KIND] = KIND_CODES[sensor.kind]
+    kind = sensor.sensor_kind
+    fields[L.F_KIND] = kind.code
     fields[L.F_X], fields[L.F_Y], fields[L.F_AIM] = sensor.at[0], sensor.at[1], math.radians(sensor.angle)
-    if sensor.kind == "line":
+    if not kind.units:
         fields[L.F_ON], fields[L.F_OFF], fields[L.F_SIGN] = 0.5, 0.5, 1.0
     else:
         fields[L.F_ON], fields[L.F_OFF] = sensor.switch_points()

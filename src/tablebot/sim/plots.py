@@ -5,7 +5,9 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -17,6 +19,7 @@ from matplotlib.patches import Patch
 from tablebot.colours import state_colours
 from tablebot.escape import picture
 from tablebot.files import atomic_write
+from tablebot.sensors import SENSOR_KINDS, SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
@@ -33,7 +36,7 @@ from tablebot.sim.draw import (
     literal_text,
     sensor_readings,
 )
-from tablebot.sim.runner import Result
+from tablebot.sim.runner import SimRun
 from tablebot.sim.summary import Summary
 
 DPI = 150
@@ -43,7 +46,7 @@ SPIN_M, SPIN_DEG = 0.01, 15.0  # a state that moves the robot less and turns it 
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
 
 
-def title_of(result: Result) -> str:
+def title_of(result: SimRun) -> str:
     robot, world = picture(result.scene.table.robot.name), picture(result.scene.world.name)
     return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
 
@@ -61,13 +64,13 @@ def subtitle_of(summary: Summary) -> str:
 
 
 @literal_text()
-def trajectory(result: Result, summary: Summary, path: Path) -> Path:
+def trajectory(result: SimRun, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
     return save(trajectory_figure(result, summary), path)
 
 
 @literal_text()
-def trajectory_figure(result: Result, summary: Summary) -> Figure:
+def trajectory_figure(result: SimRun, summary: Summary) -> Figure:
     world = result.scene.world
     xs, ys = zip(*world.walls, strict=True)
     aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
@@ -138,7 +141,7 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
     return np.repeat(t[edges[:-1]], 2), np.column_stack((low, high)).ravel()
 
 
-def _markers(ax, result: Result, summary: Summary) -> None:
+def _markers(ax, result: SimRun, summary: Summary) -> None:
     h, scene = result.hist, result.scene
     touched = [contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
                for row in summary.collision_ticks]  # where the body touched the wall or obstacle
@@ -155,7 +158,7 @@ def _markers(ax, result: Result, summary: Summary) -> None:
         ax.plot(h[row, L.X], h[row, L.Y], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
 
 
-def _robot_poses(ax, result: Result) -> None:
+def _robot_poses(ax, result: SimRun) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
     h, scene = result.hist, result.scene
     n_lamps, sensors = len(scene.lamp_outputs), scene.table.robot.sensors
@@ -169,7 +172,7 @@ def _robot_poses(ax, result: Result) -> None:
                lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(h[-1], sensors))
 
 
-def _legend(fig: Figure, result: Result, summary: Summary, spins: bool) -> None:
+def _legend(fig: Figure, result: SimRun, summary: Summary, spins: bool) -> None:
     """The states the run was in (their colours and time), and the marks this picture shows."""
     machine = result.scene.machine
     colours = state_colours(machine.states)
@@ -183,10 +186,10 @@ def _legend(fig: Figure, result: Result, summary: Summary, spins: bool) -> None:
                frameon=False, fontsize=9)
 
 
-def legend_marks(result: Result, summary: Summary, spins: bool) -> list:
+def legend_marks(result: SimRun, summary: Summary, spins: bool) -> list:
     """What the trajectory's marks mean: only those it shows (a collision, first light, a spin that
     happened; the world's lamps, tape and obstacles; the robot's floor sensors and beams)."""
-    world, kinds = result.scene.world, {s.kind for s in result.scene.table.robot.sensors}
+    world, drawn = result.scene.world, [k.draw for k in declared_kinds(result)]
     marks = []
     if summary.collision_ticks:
         marks.append(Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
@@ -206,10 +209,10 @@ def legend_marks(result: Result, summary: Summary, spins: bool) -> list:
                   Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)")]
     if world.lines:
         marks.append(Patch(facecolor=TAPE_FILL, label="tape on the floor"))
-    if "line" in kinds:
+    if "spot" in drawn:
         marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
                             label="floor sensor (dark over tape)"))
-    if "distance" in kinds:
+    if "beam" in drawn:
         marks.append(Patch(facecolor=BEAM, alpha=0.45, label="distance beam, out to the echo"))
     if world.boxes or world.circles:
         marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
@@ -220,14 +223,14 @@ def legend_marks(result: Result, summary: Summary, spins: bool) -> list:
 
 
 @literal_text()
-def timeline(result: Result, summary: Summary, path: Path) -> Path:
+def timeline(result: SimRun, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
     light, declared light and distance sensors) against time."""
     return save(timeline_figure(result, summary), path)
 
 
 @literal_text()
-def timeline_figure(result: Result, summary: Summary) -> Figure:
+def timeline_figure(result: SimRun, summary: Summary) -> Figure:
     t = np.arange(result.ticks) * result.tick_s
     readings = reading_panels(result)
     fig = Figure(figsize=(12, 7.2 + 1.8 * len(readings)), dpi=DPI)
@@ -256,7 +259,7 @@ def timeline_figure(result: Result, summary: Summary) -> Figure:
     return fig
 
 
-def _state_panel(ax, result: Result) -> None:
+def _state_panel(ax, result: SimRun) -> None:
     machine = result.scene.machine
     colours = state_colours(machine.states)
     visited = sorted(set(result.states.tolist()))
@@ -277,7 +280,7 @@ def _state_panel(ax, result: Result) -> None:
     ax.set_ylabel("state")
 
 
-def _output_panel(ax, result: Result, t: np.ndarray) -> None:
+def _output_panel(ax, result: SimRun, t: np.ndarray) -> None:
     names = result.scene.machine.output_names
     n_motors = result.scene.machine.n_motors
     labels = result.scene.table.robot.labels
@@ -296,7 +299,7 @@ def _output_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
 
 
-def _event_panel(ax, result: Result, t: np.ndarray) -> None:
+def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
     table = result.scene.table
     ev = result.events
     labels = table.robot.labels
@@ -314,19 +317,26 @@ def _event_panel(ax, result: Result, t: np.ndarray) -> None:
     ax.set_ylabel("events")
 
 
-def reading_panels(result: Result) -> list:
-    """The reading panels this robot needs: light (wired phototransistors or declared light sensors),
-    distance (declared distance sensors). Line sensors read 1 or 0: the event panel shows them."""
-    wiring, kinds = result.scene.params.wiring, {s.kind for s in result.scene.table.robot.sensors}
-    panels = []
-    if wiring.get("light_right") or wiring.get("light_left") or "light" in kinds:
-        panels.append(_light_panel)
-    if "distance" in kinds:
-        panels.append(_distance_panel)
-    return panels
+def declared_kinds(result: SimRun) -> list[SensorKind]:
+    """The kinds of the robot's declared sensors, each once, in the order they are registered."""
+    kinds = {s.kind for s in result.scene.table.robot.sensors}
+    return [kind for name, kind in SENSOR_KINDS.items() if name in kinds]
 
 
-def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> list[float]:
+def reading_panels(result: SimRun) -> list:
+    """The reading panels this robot needs, in their places: light (wired phototransistors, or declared light
+    sensors), then each declared kind's panel (``SensorKind.panel``). A kind without a panel (a line sensor
+    reads 1 or 0) shows on the event panel."""
+    wiring = result.scene.params.wiring
+    builtin = bool(wiring.get("light_right") or wiring.get("light_left"))
+    panels: list[tuple[int, Any]] = [(0, _light_panel)] if builtin else []
+    for kind in declared_kinds(result):
+        if kind.panel is not None and not (builtin and kind.panel.position == 0):
+            panels.append((kind.panel.position, _panel_of(kind)))
+    return [panel for _, panel in sorted(panels, key=lambda p: p[0])]
+
+
+def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> list[float]:
     """Plot each declared sensor of ``kind`` (reading × ``scale``) with its threshold; returns the thresholds."""
     h, levels = result.hist[:-1], []
     for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
@@ -342,35 +352,43 @@ def _declared(ax, result: Result, t: np.ndarray, kind: str, scale: float) -> lis
     return levels
 
 
-def _distance_panel(ax, result: Result, t: np.ndarray) -> None:
-    levels = _declared(ax, result, t, "distance", 100.0)
-    ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
-    ax.set_ylabel("distance (cm)\n-- on, ·· off")
+def _panel_of(kind: SensorKind) -> Callable[..., None]:
+    """The panel of one declared kind, named after it (``_distance_panel``)."""
+    def panel(ax, result: SimRun, t: np.ndarray) -> None:
+        _kind_panel(ax, result, t, kind)
+    panel.__name__ = f"_{kind.name}_panel"
+    return panel
+
+
+def _kind_panel(ax, result: SimRun, t: np.ndarray, kind: SensorKind) -> None:
+    """The declared sensors of one kind, each with its thresholds (``SensorKind.panel``)."""
+    panel = kind.panel
+    assert panel is not None
+    levels = _declared(ax, result, t, kind.name, panel.scale)
+    if panel.log:
+        _log_scale(ax)
+    else:
+        ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
+    ax.set_ylabel(panel.label)
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
 
-def _light_panel(ax, result: Result, t: np.ndarray) -> None:
-    wiring = result.scene.params.wiring
-    if not (wiring.get("light_right") or wiring.get("light_left")):  # declared light sensors only
-        _declared(ax, result, t, "light", 1.0)
-        _light_scale(ax)
-        ax.set_ylabel("light\n(× threshold)")
-        ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
-        return
+def _light_panel(ax, result: SimRun, t: np.ndarray) -> None:
+    """The BumberBot's wired phototransistors against their threshold."""
     h, wiring = result.hist[:-1], result.scene.params.wiring
     ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22",
             label=picture(f"{wiring['light_right']} right"))
     ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad",
             label=picture(f"{wiring['light_left']} left"))
     ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
-    _light_scale(ax)
+    _log_scale(ax)
     ax.set_ylim(0, max(10.0, float(h[:, [L.LIGHT_R, L.LIGHT_L]].max()) * 1.5))
     ax.set_ylabel("light\n(× threshold)")
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
 
-def _light_scale(ax) -> None:
-    """Light on a symmetric log scale (0, then 0.1 to 100s), its ticks written as plain numbers: the
+def _log_scale(ax) -> None:
+    """A reading (light) on a symmetric log scale (0, then 0.1 to 100s), its ticks written as plain numbers: the
     pictures draw text with maths parsing off (for user text), so matplotlib's 10^n labels would print
     as raw TeX."""
     from matplotlib.ticker import FuncFormatter

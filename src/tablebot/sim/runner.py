@@ -26,7 +26,7 @@ PATH_STRIDE = 5  # robot rows per point of the thinned path (the robot moves wel
 
 
 @dataclass
-class Result:
+class SimRun:
     """A finished run. ``hist[t]`` is the robot at the start of tick t (what the engine sensed then;
     one more row than ticks: the robot after the last tick); the other columns have a row per tick:
     the inputs read, the event set, the fired row (-1: none), and state index, timer, outputs,
@@ -63,6 +63,18 @@ class Result:
         """The engine's inputs per tick, as recorded: replaying them gives the same run."""
         pulses = self.pulses.tolist()
         return [TickInput(int(m), tuple(p)) for m, p in zip(self.masks.tolist(), pulses, strict=True)]
+
+    def block(self) -> TickBlock:
+        """The whole run as one block of ticks, with the simulator's trace fields."""
+        from tablebot.sim.simrobot import field_columns
+
+        return TickBlock(0, self.masks, self.pulses, self.events, self.rows, self.states, self.timers,
+                         self.outputs, self.counters, field_columns(self.scene, self.hist[:-1]))
+
+    def write_trace(self, stream: IO[str]) -> int:
+        """Write the run's trace as JSON Lines (what ``tablebot sim`` writes live); returns the number of ticks."""
+        stream.writelines(block_lines(self.block(), self.scene.machine))
+        return self.ticks
 
     def heading_deg(self) -> np.ndarray:
         """Unwrapped heading in degrees per hist row (a turn of 270° reads 270, not -90)."""
@@ -118,10 +130,10 @@ class History:
     def end(self, end: RunEnd) -> None:
         self.ended = end
 
-    def result(self, scene: Scene, seed: int, wall_s: float) -> Result:
+    def result(self, scene: Scene, seed: int, wall_s: float) -> SimRun:
         robot, n = self.robot, self.done
         cut = {name: column[:n] for name, column in self.columns.items()}  # a run cut short keeps what ran
-        return Result(scene=scene, seed=seed, hist=self.hist[: n + 1] if self.rows else None,
+        return SimRun(scene=scene, seed=seed, hist=self.hist[: n + 1] if self.rows else None,
                       ends=np.stack((self.first, robot.s)), path=self.path[: n // PATH_STRIDE + 1], **cut,
                       collision_rows=robot.collisions, collision_count=robot.collision_count,
                       reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)  # type: ignore[arg-type]
@@ -152,8 +164,8 @@ def ticks_for(scene: Scene, seconds: float) -> int:
     return ticks
 
 
-def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
-        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool = True) -> Result:
+def simulate(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
+        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool = True) -> SimRun:
     """Simulate ``seconds`` of robot time through the run loop; ``progress(ticks_done)`` is called
     after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens.
 
@@ -167,17 +179,3 @@ def run(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], N
     started = time.perf_counter()
     run_loop(Engine(scene.machine), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")
     return keep.result(scene, seed, time.perf_counter() - started)
-
-
-def block_of(result: Result) -> TickBlock:
-    """The whole run as one block of ticks, with the simulator's trace fields."""
-    from tablebot.sim.simrobot import trace_columns
-
-    return TickBlock(0, result.masks, result.pulses, result.events, result.rows, result.states, result.timers,
-                     result.outputs, result.counters, trace_columns(result.scene, result.hist[:-1]))
-
-
-def write_trace(result: Result, stream: IO[str]) -> int:
-    """Write the run's trace as JSON Lines (what ``tablebot sim`` writes live); returns the number of ticks."""
-    stream.writelines(block_lines(block_of(result), result.scene.machine))
-    return result.ticks

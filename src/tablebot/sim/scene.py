@@ -50,11 +50,7 @@ class Scene:
 
     @property
     def tick_s(self) -> float:
-        return self.table.robot.tick_ms / 1000
-
-
-#: Trace key suffix, scale and decimals of each declared sensor kind's reading (0 decimals: an integer).
-TRACE_FORMS = {"distance": ("cm", 100.0, 1), "light": ("light", 1.0, 4), "line": ("line", 1.0, 0)}
+        return self.table.robot.tick_s
 
 
 def sensor_columns(scene: Scene) -> list[tuple[str, int, float, int]]:
@@ -62,7 +58,7 @@ def sensor_columns(scene: Scene) -> list[tuple[str, int, float, int]]:
     sensor I3 as ``"I3_cm": 23.0``, a light sensor as ``"I4_light": 1.2345``, a line sensor as ``"I1_line": 1``."""
     columns = []
     for k, sensor in enumerate(scene.table.robot.sensors[: L.MAX_SENSORS]):
-        suffix, scale, decimals = TRACE_FORMS[sensor.kind]
+        suffix, scale, decimals = sensor.sensor_kind.trace
         columns.append((f"{sensor.name}_{suffix}", L.READING + k, scale, decimals))
     return columns
 
@@ -102,7 +98,7 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
         raise TableBotError(Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
                             for section, key, message, hint in found)
     _check_tick(params, table.robot)
-    tick_s = table.robot.tick_ms / 1000
+    tick_s = table.robot.tick_s
     _check_sensor_count(table.robot)
     P = param_row(params, tick_s, table.robot.sensors)[None, :]
     geo = geometry(world)
@@ -180,7 +176,7 @@ def _check_sensor_count(robot: Robot) -> None:
 def _check_tick(params: Params, robot: Robot) -> None:
     """The robot moves once per tick: a coarse tick would carry it through thin walls unnoticed."""
     top = top_speed(params)
-    step = top * robot.tick_ms / 1000
+    step = robot.seconds(top)
     if step > MAX_STEP_M:
         raise fail(robot.source, f"tick_ms = {robot.tick_ms} is too coarse for the simulator: the robot would move "
                    f"up to {100 * step:.0f} cm per tick, through thin walls",

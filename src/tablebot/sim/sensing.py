@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from tablebot.jit import njit
+from tablebot.sensors import SENSOR_KINDS, threshold_event
 from tablebot.sim.columns import (
     B_SENSOR,
     F_AIM,
@@ -19,9 +20,6 @@ from tablebot.sim.columns import (
     F_SIGN,
     F_X,
     F_Y,
-    K_DISTANCE,
-    K_LIGHT,
-    K_LINE,
     MAX_SENSORS,
     P_COS_FOV,
     P_DBEAM,
@@ -38,6 +36,10 @@ from tablebot.sim.columns import (
     Y,
 )
 from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
+
+threshold = njit(inline="always")(threshold_event)  # the rule of every analog input, compiled in
+#: The codes of the kinds whose physics is here (tablebot.sensors.SENSOR_KINDS): a branch each below.
+K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "distance", "light"))
 
 
 @njit(cache=True, refcounts=False, inline="always")
@@ -207,16 +209,15 @@ def sense_declared(s, c, sn, p, edges, circles, lamps, lines):
 
 @njit(cache=True, refcounts=False, inline="always")
 def sensor_events(s, p, bits, previous):
-    """The event bits of the declared sensors: a reading past its threshold turns the event on; once on, it
-    stays on until the reading is back past the threshold by the hysteresis (``previous`` = last mask)."""
+    """The event bits of the declared sensors (:func:`tablebot.sensors.threshold_event`: a reading past its
+    threshold turns the event on; once on, it stays on until the reading is back past the threshold by the
+    hysteresis; ``previous`` = last mask)."""
     mask = 0
     for k in range(min(MAX_SENSORS, bits.shape[0] - B_SENSOR)):
         bit = bits[B_SENSOR + k]
         base = P_SENSOR + k * SENSOR_FIELDS
         if bit == 0 or p[base + F_KIND] == 0.0:
             continue
-        level = p[base + F_OFF] if previous & bit else p[base + F_ON]
-        value = s[READING + k]
-        if (value > level) if p[base + F_SIGN] > 0.0 else (value < level):
+        if threshold(s[READING + k], p[base + F_SIGN] > 0.0, p[base + F_ON], p[base + F_OFF], (previous & bit) != 0):
             mask |= bit
     return mask

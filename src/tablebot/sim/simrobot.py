@@ -16,6 +16,7 @@ from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
 from tablebot.sim.normals import bitgen_address
+from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
 from tablebot.tick import registers
@@ -42,6 +43,7 @@ class SimRobot:
         self.light_keys = light_keys(scene)
         self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
         self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
+        self._observation: Observation | None = None
         self.reset(seed=seed)
 
     # --- Gymnasium-style life cycle ---------------------------------------------------------------
@@ -157,6 +159,12 @@ class SimRobot:
         row = int(self.acc[K.A_REACHED])
         return None if row < 0 else row
 
+    def observation(self) -> np.ndarray:
+        """What a learning agent sees of the robot now (:class:`tablebot.sim.observation.Observation`)."""
+        if self._observation is None:
+            self._observation = Observation.of(self.scene)
+        return self._observation(self.s[None, :])[0]
+
 
 def light_keys(scene: Scene) -> tuple[str, str]:
     """The trace's names for the light each phototransistor received: ``I7_light`` and ``I8_light``."""
@@ -180,14 +188,14 @@ def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
             *sensor_columns(scene))
 
 
-def trace_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
+def field_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
     return {key: values.tolist() for key, (values, _) in number_columns(scene, hist).items()}
 
 
 def number_columns(scene: Scene, hist: np.ndarray) -> dict[str, tuple[np.ndarray, int]]:
-    """:func:`trace_columns` as arrays, with their decimals (0: whole numbers, an int64 array)."""
+    """:func:`field_columns` as arrays, with their decimals (0: whole numbers, an int64 array)."""
     columns: dict[str, tuple[np.ndarray, int]] = {}
     for key, column, scale, decimals in trace_layout(scene):
         values = hist[:, column].astype(np.float64)
@@ -231,7 +239,7 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __getitem__(self, key: str) -> Sequence[float]:
         if self._columns is None:
-            self._columns = trace_columns(self.scene, self.hist)
+            self._columns = field_columns(self.scene, self.hist)
         return self._columns[key]
 
     def __iter__(self) -> Iterator[str]:

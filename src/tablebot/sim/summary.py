@@ -1,6 +1,6 @@
 """What a run amounts to: first light seen, lamp reached, laps of a track, collisions, distance, time per state.
 
-Computed from a :class:`~tablebot.sim.runner.Result`, so the CLI, the plots and the tests agree on one
+Computed from a :class:`~tablebot.sim.runner.SimRun`, so the CLI, the plots and the tests agree on one
 set of numbers; collisions and the lamp are counted by the simulated robot as it runs (sim.kernel.observe).
 """
 
@@ -17,7 +17,7 @@ from tablebot.sim.track import laps
 from tablebot.sinks.run_trace import seconds_per_state
 
 if TYPE_CHECKING:  # only types: time per state is wanted beside a real robot's run, without the simulator
-    from tablebot.sim.runner import Result
+    from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
 
 
@@ -55,9 +55,9 @@ class Summary:
         return out
 
 
-def light_bits(result: Result | Scene) -> int:
+def light_bits(result: SimRun | Scene) -> int:
     """The input bits of the light sensors (of a run or of its scene)."""
-    bits = getattr(result, "scene", result).bits  # a Result has a scene; a Scene is one
+    bits = getattr(result, "scene", result).bits  # a SimRun has a scene; a Scene is one
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 
@@ -74,7 +74,7 @@ def time_per_state(states: np.ndarray, names: tuple[StateId, ...], tick_s: float
     return seconds_per_state(np.bincount(states, minlength=len(names)), first_seen, names, tick_s)
 
 
-def summarise(result: Result) -> Summary:
+def summarise(result: SimRun) -> Summary:
     """The run's numbers: first light from the inputs read, time per state from the states after each
     tick, and the collisions and lamp reached that the simulated robot counted as it went."""
     tick_s, at_start, at_end = result.tick_s, result.ends[0], result.ends[1]

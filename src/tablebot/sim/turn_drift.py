@@ -12,7 +12,7 @@ from pathlib import Path
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 from tablebot.sim import columns as L
-from tablebot.sim.runner import run
+from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer
 from tablebot.sim.world import World, parse_world
 from tablebot.tomlfile import Source
@@ -51,7 +51,7 @@ def turns(table_path: Path, charges: list[float], seeds: list[int], seconds: flo
     for charge in charges:
         scene = prepare(table, machine, world, layer, {"battery": {"charge": charge}})
         for seed in seeds:
-            result = run(scene, seconds, seed)
+            result = simulate(scene, seconds, seed)
             heading = result.heading_deg()
             found.append(Turn(charge, seed, float(heading[-1] - heading[0]), float(result.hist[1, L.VBAT])))
     return found

@@ -30,6 +30,7 @@ class Shape:
     keep_chance: float = 0.2  # chance that an output cell is "keep"
     no_event_chance: float = 0.1  # chance that a row requires no event at all (where the two rules differ)
     match: str | None = None  # the matching rule (robot.MATCHES); None: drawn
+    max_speed: int = MAX_SPEED  # the fastest motor speed a row sets (the document's program holds 0..6)
 
 
 def _state_ids(rng: random.Random, n: int) -> list[StateId]:
@@ -48,7 +49,7 @@ def _row(rng: random.Random, shape: Shape, robot: Robot, events: tuple[str, ...]
     elif not required:  # otherwise conditional rows, so that states are left
         required.add(rng.choice(events))
     return Row(index=-1, line=-1, description="random", state=state, events=frozenset(required),
-               motors=tuple(out(-MAX_SPEED, MAX_SPEED) for _ in robot.motors),
+               motors=tuple(out(-shape.max_speed, shape.max_speed) for _ in robot.motors),
                timer=rng.randint(0, shape.max_timer), next=rng.choice(states),
                counters=tuple(None if rng.random() < 0.5 else rng.randint(0, shape.max_load)
                               for _ in robot.counters),

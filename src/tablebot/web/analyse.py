@@ -14,6 +14,7 @@ from typing import Any
 
 from tablebot.analysis.check import CheckReport, run_check
 from tablebot.analysis.properties import find_property_files, load_properties
+from tablebot.colours import state_colours
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
 from tablebot.machine import NO_ROW, Machine, compile_table
@@ -91,9 +92,13 @@ def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
 
 
 def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
+    """The machine as the page needs it; each state carries its colour from ``tablebot.colours``, the one
+    the PNGs of a run give it (the page only looks colours up, so the two can never disagree)."""
     robot = table.robot
+    colours = state_colours(machine.states)
     return {
-        "states": [{"id": str(s), "label": table.state_name(s)} for s in machine.states],
+        "states": [{"id": str(s), "label": table.state_name(s), "colour": c}
+                   for s, c in zip(machine.states, colours, strict=True)],
         "rows": len(table.rows), "events": list(table.events), "inputs": list(table.input_events),
         "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
         "motors": list(robot.motors), "tick_ms": robot.tick_ms, "initial_state": str(robot.initial_state),

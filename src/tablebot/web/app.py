@@ -22,7 +22,7 @@ from tablebot.diagnostics import TableBotError
 from tablebot.web.access import Access, Gate, hide_token_in_logs
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.session import Hub, Session
-from tablebot.web.tracefile import MAX_TRACE_BYTES, read_trace_bytes, trace_columns
+from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
 from tablebot.web.workspace import Workspace
 
 STATIC = Path(__file__).parent / "static"
@@ -60,8 +60,8 @@ def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
         body = bytearray()
         async for chunk in request.stream():
             body += chunk
-            if len(body) > MAX_TRACE_BYTES:
-                return JSONResponse({"type": "error", "message": f"the trace is larger than {MAX_TRACE_BYTES:,} "
+            if len(body) > MAX_PLAYER_TRACE_BYTES:
+                return JSONResponse({"type": "error", "message": f"the trace is larger than {MAX_PLAYER_TRACE_BYTES:,} "
                                      "bytes", "hint": "cut the run shorter"}, status_code=413)
         try:
             lines = await asyncio.to_thread(read_trace_bytes, bytes(body), name)

@@ -34,6 +34,7 @@ class PageClock:
     """Paces ticks at ``speed`` × real time (0 = no waiting); holds while paused; releases single steps."""
 
     free_running = False  # one tick at a time, so that pausing and stepping act between ticks
+    behind_s = 0.0  # the page sets the pace (paused, stepped, 10x): never judged against the wall clock
 
     def __init__(self, speed: float, tick_s: float, paused: bool):
         self.tick_s = tick_s

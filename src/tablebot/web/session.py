@@ -18,7 +18,7 @@ from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot
 from tablebot.web.document import MAX_TABLE_BYTES, CsvDocument
 from tablebot.web.errors import Refused
 from tablebot.web.simulate import Arena, ArenaSettings
-from tablebot.web.tracefile import MAX_TRACE_BYTES, read_trace_bytes, trace_columns
+from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
 from tablebot.web.workspace import ChangedOnDisk, Kind, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
@@ -196,7 +196,8 @@ class Session:
     # --- traces ----------------------------------------------------------------------------------------
 
     async def open_trace(self, message: dict[str, Any]) -> None:
-        opened = await asyncio.to_thread(self.workspace.read, _text(message, "path"), Kind.TRACE, MAX_TRACE_BYTES)
+        opened = await asyncio.to_thread(self.workspace.read, _text(message, "path"), Kind.TRACE,
+                                         MAX_PLAYER_TRACE_BYTES)
         await self.send_trace(opened.data, opened.name)
 
     async def send_trace(self, data: bytes, name: str) -> None:

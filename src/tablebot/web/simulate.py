@@ -163,7 +163,9 @@ class Arena:
         extra = latest.extra or {}
         frame = {"type": "frame", "tick": latest.tick, "state": latest.state, "state_id": str(states[latest.state]),
                  "prev_state": latest.prev_state, "timer": latest.timer, "event": latest.event, "mask": latest.mask,
-                 "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"], "path": data["path"],
+                 "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"],
+                 # by state id: the page colours a point by its state, and an edit may reorder the states
+                 "path": [[x, y, str(states[int(s)])] for x, y, s in data["path"]],
                  "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
                  "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
                  "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}

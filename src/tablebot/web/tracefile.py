@@ -9,7 +9,9 @@ from typing import Any
 from tablebot.diagnostics import fail
 from tablebot.formats.trace_lines import parse_trace
 
-MAX_TRACE_BYTES = 64 * 1024 * 1024
+#: The largest trace the browser's player opens (it holds every column in the page); tablebot itself reads
+#: traces up to :data:`tablebot.formats.trace_lines.MAX_TRACE_BYTES`.
+MAX_PLAYER_TRACE_BYTES = 64 * 1024 * 1024
 REQUIRED = ("tick", "state")
 #: Columns the player draws when a trace has them (core fields, then the simulator's pose).
 KNOWN = ("tick", "event", "row", "state", "timer", "x", "y", "heading", "battery_v")
@@ -28,8 +30,8 @@ def trace_columns(lines: Iterable[dict[str, Any]]) -> dict[str, list[Any]]:
 def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
     """Parse JSON Lines (through the one trace reader, :func:`tablebot.formats.trace_lines.parse_trace`); every bad line
     is reported (the first ten) with its number."""
-    if len(data) > MAX_TRACE_BYTES:
-        raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_TRACE_BYTES:,}",
+    if len(data) > MAX_PLAYER_TRACE_BYTES:
+        raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_PLAYER_TRACE_BYTES:,}",
                    "cut the run shorter (--seconds) or open a part of it")
     try:
         text = data.decode("utf-8-sig")

@@ -18,6 +18,8 @@ ADDRESSES = ("roboif://auto", "roboif:///dev/ttyUSB0 (its serial port)", "roboif
 ADDRESS_HINT = "write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)"
 CONNECT_HINT = ("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
                 "serial port only, not on its USB port (docs/controllers.md)")
+FASTER = ("a ROBO TX or a TXT on its USB cable: the interface's serial port runs at 38400 baud only, and tablebot "
+          "does not drive its USB port")
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -34,9 +36,11 @@ def fit(machine: Machine) -> list[Diagnostic]:
 
 
 def open_roboif(machine: Machine, address: str, options: Options) -> Opened:
-    """The wiring checked (nothing is opened if the table does not fit), the port found, and the interface
-    greeted: it must answer as a ROBO Interface."""
-    from tablebot.hw.roboif.controller import RoboifRobot
+    """The wiring checked (nothing is opened if the table does not fit), the port found, the interface greeted
+    (it must answer as a ROBO Interface), and its exchange timed against the table's tick."""
+    from tablebot.hw.link_speed import check_link
+    from tablebot.hw.roboif import protocol as wire
+    from tablebot.hw.roboif.controller import OFF, RoboifRobot
     from tablebot.hw.roboif.link import find
     from tablebot.hw.roboif.wiring import roboif_wiring
     from tablebot.loop import LinkLost
@@ -52,7 +56,11 @@ def open_roboif(machine: Machine, address: str, options: Options) -> Opened:
         bot.connect()
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
-    return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)")
+    line = (f"its {wire.REQUEST_BYTES + wire.REPLY_BYTES} bytes alone take {1000 * wire.EXCHANGE_LINE_S:.1f} ms "
+            f"on the {wire.BAUD}-baud line")
+    warnings = check_link(bot, machine, options, lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
+                          "one exchange with the ROBO Interface", line=line, faster=FASTER, connect_hint=CONNECT_HINT)
+    return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)", warnings)
 
 
 ROBOIF = register(Backend("roboif", "live", "a ROBO Interface driven live over its serial port by `tablebot run`",

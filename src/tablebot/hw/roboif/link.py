@@ -70,18 +70,19 @@ class RoboifLink:
         self._expect_quiet("after the greeting's answer", settle_s=0.005)
         return reply
 
-    def exchange(self, directions: int, pwm: Sequence[int]) -> wire.Inputs:
-        """Send the outputs, get the inputs back."""
+    def exchange(self, directions: int, pwm: Sequence[int], timeout_s: float | None = None) -> wire.Inputs:
+        """Send the outputs, get the inputs back (within ``timeout_s``; default: the reply timeout of a run)."""
         if not self._trusted:
             raise LinkLost(f"{self.device} was out of step earlier: its replies cannot be trusted")
-        deadline = time.monotonic() + self.reply_timeout_s
+        timeout_s = timeout_s or self.reply_timeout_s
+        deadline = time.monotonic() + timeout_s
         self.port.write(b"", deadline)  # the rest of a request a signal cut short: its reply is owed
         self._discard_owed(deadline)
         self._expect_quiet("before a request was sent")
         self._owed += wire.REPLY_BYTES
         self.port.write(wire.exchange(directions, list(pwm)), deadline)
         data = self.port.read(wire.REPLY_BYTES, deadline, f"the {wire.REPLY_BYTES}-byte reply within "
-                              f"{1000 * self.reply_timeout_s:.0f} ms")
+                              f"{1000 * timeout_s:.0f} ms")
         self._owed -= wire.REPLY_BYTES
         self._expect_quiet(f"beyond the {wire.REPLY_BYTES}-byte reply")
         return wire.decode(data)

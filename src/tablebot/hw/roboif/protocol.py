@@ -23,6 +23,8 @@ EXCHANGE = 0xF2
 REQUEST_BYTES, REPLY_BYTES = 17, 21
 N_INPUTS, N_OUTPUTS, N_MOTORS = 8, 8, 4
 MAX_PWM = 7  # three bits per output
+#: The time one exchange needs on the line alone: request and reply, 10 bits a byte (8N1) at 38400 baud.
+EXCHANGE_LINE_S = (REQUEST_BYTES + REPLY_BYTES) * 10 / BAUD
 
 
 class WireError(ValueError):

@@ -18,6 +18,7 @@ ADDRESSES = ("robotx://auto", "robotx:///dev/ttyACM0 (USB)", "robotx:///dev/rfco
 ADDRESS_HINT = "write --on robotx://auto, robotx:///dev/ttyACM0 (USB), robotx:///dev/rfcomm0 (Bluetooth) or robotx://COM3"
 CONNECT_HINT = ("is the ROBO TX on and connected? Over USB it is a serial port /dev/ttyACM* (USB id 221d:1000); over "
                 "Bluetooth pair it and bind an rfcomm device first (docs/controllers.md)")
+FASTER = "the ROBO TX on its USB cable, robotx:///dev/ttyACM0, rather than Bluetooth"
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -35,8 +36,9 @@ def fit(machine: Machine) -> list[Diagnostic]:
 
 def open_robotx(machine: Machine, address: str, options: Options) -> Opened:
     """The wiring checked (nothing is opened if the table does not fit), the port found, and the controller
-    asked who it is: it must answer fish.X1."""
-    from tablebot.hw.robotx.controller import RobotxRobot
+    asked who it is (it must answer fish.X1), and its exchange timed against the table's tick."""
+    from tablebot.hw.link_speed import check_link
+    from tablebot.hw.robotx.controller import ZERO, RobotxRobot
     from tablebot.hw.robotx.link import find
     from tablebot.hw.robotx.wiring import robotx_wiring
     from tablebot.loop import LinkLost
@@ -53,7 +55,9 @@ def open_robotx(machine: Machine, address: str, options: Options) -> Opened:
         info = bot.connect()
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
-    return Opened(bot, bot.target, f"{info.device} {info.version_text}")
+    warnings = check_link(bot, machine, options, lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
+                          "one exchange with the ROBO TX", faster=FASTER, connect_hint=CONNECT_HINT)
+    return Opened(bot, bot.target, f"{info.device} {info.version_text}", warnings)
 
 
 ROBOTX = register(Backend("robotx", "live", "a ROBO TX Controller driven live over fish.X1 by `tablebot run`",

@@ -72,10 +72,11 @@ class RobotxLink:
         self.online = True  # from here on the controller may drive outputs
         self._request(Command.CONFIG, ((wire.TA_LOCAL, wire.config(config)),), self.setup_timeout_s)
 
-    def exchange(self, duty: Sequence[int]) -> wire.Inputs:
-        """Send O1..O8's duty, get the inputs back."""
+    def exchange(self, duty: Sequence[int], timeout_s: float | None = None) -> wire.Inputs:
+        """Send O1..O8's duty, get the inputs back (within ``timeout_s``; default: the reply timeout of a run)."""
         self.online = True
-        reply = self._request(Command.EXCHANGE, ((wire.TA_LOCAL, wire.output(list(duty))),), self.reply_timeout_s)
+        reply = self._request(Command.EXCHANGE, ((wire.TA_LOCAL, wire.output(list(duty))),),
+                              timeout_s or self.reply_timeout_s)
         return wire.decode_inputs(self._area(reply, Command.EXCHANGE, wire.INPUT_BYTES))
 
     def send_best_effort(self, duty: Sequence[int], timeout_s: float) -> bool:

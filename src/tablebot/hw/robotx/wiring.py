@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.hw import wiring
 from tablebot.hw.robotx import protocol as wire
-from tablebot.table import MAX_LAMP, MAX_SPEED
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:
@@ -28,7 +27,6 @@ TERMINALS = wiring.Terminals(
 MODES = {"switch": (wire.InputMode.RESISTANCE, True), "phototransistor": (wire.InputMode.RESISTANCE, True),
          "resistance": (wire.InputMode.RESISTANCE, False), "voltage": (wire.InputMode.VOLTAGE, False),
          "ultrasonic": (wire.InputMode.ULTRASONIC, False)}
-DUTY_STEP = wire.MAX_DUTY // MAX_SPEED  # speed or lamp level 8 = duty 512
 
 
 def read_robot_robotx(src: Source, section: Any, robot: Robot) -> wiring.Section:
@@ -63,9 +61,9 @@ class RobotxWiring:
         for terminal, level in self.wired.levels(outputs).items():
             index = int(terminal[1:]) - 1
             if terminal[0] == "O":
-                duty[index] = max(0, min(MAX_LAMP, level)) * DUTY_STEP
+                duty[index] = wiring.level_duty(level, wire.MAX_DUTY)
             elif level:
-                duty[2 * index + (level < 0)] = min(MAX_SPEED, abs(level)) * DUTY_STEP
+                duty[2 * index + (level < 0)] = wiring.level_duty(abs(level), wire.MAX_DUTY)
         return duty
 
     def values(self, inputs: wire.Inputs) -> dict[str, int]:

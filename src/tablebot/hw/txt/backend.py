@@ -19,6 +19,7 @@ FIRMWARE_HINT = "update the TXT's firmware to 4.6.6 or later"
 ADDRESS_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto"
 CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
                 "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
+FASTER = "the TXT on its USB cable, txt://192.168.7.2, rather than Wi-Fi or Bluetooth"
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -48,7 +49,9 @@ def parse_address(text: str, hint: str) -> tuple[str | None, int]:
 
 def open_txt(machine: Machine, address: str, options: Options) -> Opened:
     """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
-    fit), then the controller found (an address counts when it answers as a TXT) and asked who it is."""
+    fit), then the controller found (an address counts when it answers as a TXT), asked who it is, and its
+    round trip timed against the table's tick."""
+    from tablebot.hw.link_speed import check_link
     from tablebot.hw.txt import link
     from tablebot.hw.txt.controller import FirmwareTooOld, TxtRobot
     from tablebot.hw.txt.wiring import txt_wiring
@@ -67,7 +70,11 @@ def open_txt(machine: Machine, address: str, options: Options) -> Opened:
         raise fail("--on", str(exc), FIRMWARE_HINT) from None
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
-    return Opened(bot, bot.target, f"{status.device} {status.version_text}")
+    # Before going online only QueryStatus can be asked; it costs the network's round trip, as each exchange
+    # does (a TXT then paces exchanges at 10 ms on its own side).
+    warnings = check_link(bot, machine, options, bot.link.query_status, "a round trip to the controller",
+                          faster=FASTER, connect_hint=CONNECT_HINT)
+    return Opened(bot, bot.target, f"{status.device} {status.version_text}", warnings)
 
 
 TXT = register(Backend("txt", "live", "a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tablebot.hw.txt import protocol as wire
-from tablebot.table import MAX_LAMP, MAX_SPEED
+from tablebot.hw.wiring import level_duty
+from tablebot.sensors import threshold_event
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
@@ -32,7 +33,14 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
     from tablebot.sensors import Sensor
 
 MIN_TICK_MS = 10  # the TXT answers one exchange every 10 ms: a shorter tick cannot be kept
-PWM_STEP = wire.MAX_PWM // MAX_SPEED  # speed or lamp level 8 = PWM 512
+
+
+def level_pwm(level: int) -> int:
+    """A motor's speed (its size) or a lamp's level, 0..8, as the TXT family's PWM 0..512 (a level beyond 8 is 8,
+    one below 0 is off; :func:`tablebot.hw.wiring.level_duty`): THE scaling of the TXT and the TXT 4.0, whose
+    standalone program carries a copy that ``tests/test_rules.py`` proves equal to this one."""
+    return level_duty(level, wire.MAX_PWM)
+
 
 #: mode -> (the controller's input mode (digital), the polarity key, its meaning, the controller's reading
 #: then). A track sensor is read in digital voltage mode, 1 over a light floor and 0 over the dark line, as
@@ -84,10 +92,11 @@ class InputWire:
             return int(raw == 1 or raw > TRAIL_LIGHT_MV) ^ int(self.invert)
         if self.digital:
             return int(bool(raw)) ^ int(self.invert)
-        slack = self.hysteresis if was_on else 0
         if self.below is not None:
-            return int(raw < self.below + slack)
-        return int(self.above is not None and raw > self.above - slack)
+            return int(threshold_event(raw, False, self.below, self.below + self.hysteresis, was_on))
+        if self.above is not None:
+            return int(threshold_event(raw, True, self.above, self.above - self.hysteresis, was_on))
+        return 0
 
 
 @dataclass(frozen=True)
@@ -124,11 +133,11 @@ class TxtWiring:
         pwm = [0] * wire.N_OUTPUTS
         for out, value in zip(self.outputs, outputs, strict=True):
             if out.kind == "lamp":
-                pwm[out.terminal] = max(0, min(MAX_LAMP, value)) * PWM_STEP
+                pwm[out.terminal] = level_pwm(value)
                 continue
             speed = -value if out.reverse else value
             forward, backward = 2 * out.terminal, 2 * out.terminal + 1
-            pwm[forward if speed > 0 else backward] = min(MAX_SPEED, abs(speed)) * PWM_STEP
+            pwm[forward if speed > 0 else backward] = level_pwm(abs(speed))
         return pwm
 
     def mask(self, universal: Sequence[int], previous: int = 0) -> int:
@@ -324,7 +333,7 @@ class _Reader:
         unit, most = ANALOG_MODES[mode][1], ANALOG_MODES[mode][2]
         limits = {k: value[k] for k in ("below", "above") if k in value}
         declared = next((s for s in self.robot.sensors if s.name == name), None)
-        if declared is not None and declared.kind != "line":
+        if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
             self.error(name, f"[txt] {name}: a {mode} input needs exactly one of below = N or above = N ({unit})",
@@ -345,13 +354,14 @@ class _Reader:
             self.error(name, f"[txt] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
                        f"remove {', '.join(limits)} here: the simulator and the TXT read the one declaration")
             return None
-        if sensor.kind != "distance" or mode != "ultrasonic":
+        scale = sensor.sensor_kind.modes.get(mode)  # from the declaration's units into the mode's
+        if scale is None:
             self.error(name, f"[txt] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
                        f"{mode} mode with its declared threshold",
                        'wire a distance sensor as mode = "ultrasonic"; a light sensor as mode = "phototransistor" '
                        "(threshold 1) or give its calibrated threshold in [txt] and drop it from [sensors]")
             return None
-        limit, slack = round(sensor.threshold * 100, 6), round(sensor.hysteresis * 100, 6)
+        limit, slack = round(sensor.threshold * scale, 6), round(sensor.hysteresis * scale, 6)
         if limit != int(limit) or slack != int(slack):
             self.error(name, f"[txt] {name}: the TXT measures whole centimetres; [sensors] says "
                        f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")

@@ -18,6 +18,7 @@ under harbaum/SofTXT.
 from __future__ import annotations
 
 import atexit
+import collections
 import contextlib
 import os
 import signal
@@ -27,7 +28,8 @@ from collections.abc import Callable
 from typing import Any
 
 PWM_STEP = 64  # speed or lamp level 8 = PWM 512
-BEHIND_LIMIT_S = 0.5  # a tick this late stops the robot rather than stretch the table's timers
+BEHIND_LIMIT_S = 0.5  # the table's time may fall this far behind the wall clock within BEHIND_WINDOW_S,
+BEHIND_WINDOW_S = 5.0  # else the robot stops rather than stretch the table's timers (as tablebot.loop.Pace)
 HANDOVER_S = 1.0  # how long a SIGTERM handled in the main thread waits for the run's thread to stop
 TABLE: dict = {}  # the exported table (appended by ``tablebot export --to txt4``)
 
@@ -232,25 +234,32 @@ def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], flo
         sleep: Callable[[float], Any] | None = None, log: Callable[..., None] = say,
         stop: Stop | None = None) -> str:
     """Run the table until ``ticks`` (None: until stopped); the outputs are stopped on every way out.
-    Ticks are paced on a fixed grid; a tick later than half a tick restarts the grid (counted as late),
-    one later than BEHIND_LIMIT_S ends the run. Returns why it ended."""
+    Ticks are paced on a fixed grid; a tick later than half a tick restarts the grid (counted as late); the
+    table's time falling more than BEHIND_LIMIT_S behind the wall clock within BEHIND_WINDOW_S (one stall,
+    or every tick a little too slow) ends the run. Returns why it ended."""
     stop = stop or Stop()
     pause = sleep or stop.requested.wait
     engine, tick_s = Engine(table), table["tick_ms"] / 1000
     anchor, anchor_tick, late_ticks, reason = now(), 0, 0, "done"
+    recent = collections.deque([(0, anchor)])  # (tick, when it started) over the last BEHIND_WINDOW_S
     try:
         while ticks is None or engine.tick < ticks:
-            ahead = anchor + (engine.tick - anchor_tick) * tick_s - now()
-            if ahead > 0:
-                pause(ahead)
-            elif -ahead > tick_s / 2:
+            due, started = anchor + (engine.tick - anchor_tick) * tick_s, now()
+            if due > started:
+                pause(due - started)
+                started = due
+            if started - due > tick_s / 2:
                 late_ticks += 1
-                if -ahead > BEHIND_LIMIT_S:
-                    reason = "behind"
-                    log(f"tablebot: tick {engine.tick} started {-1000 * ahead:.0f} ms late: stopping rather than "
-                        "stretching the table's timers")
-                    break
-                anchor, anchor_tick = now(), engine.tick
+                anchor, anchor_tick = started, engine.tick
+            recent.append((engine.tick, started))
+            while len(recent) > 1 and recent[1][1] <= started - BEHIND_WINDOW_S:
+                recent.popleft()
+            fell = started - recent[0][1] - (engine.tick - recent[0][0]) * tick_s
+            if fell > BEHIND_LIMIT_S:
+                reason = "behind"
+                log(f"tablebot: the table's time fell {fell:.2f} s behind the wall clock by tick {engine.tick}: "
+                    "stopping rather than stretching the table's timers")
+                break
             if stop.requested.is_set():
                 reason = stop.reason
                 break

@@ -1,10 +1,15 @@
-// One colour per state, the same in the arena's path, the timeline and (by index) every picture.
+// Each state's colour, as the server gave it (tablebot.colours, the same as in every PNG of the table):
+// the page only looks it up, by state id, in the machine the store holds.
 
-const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#e377c2", "#7f7f7f",
-  "#bcbd22", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173", "#3182bd", "#31a354"];
+const NONE = "#999999";  // a state the table does not have (a trace of another table, or no state)
+const byMachine = new WeakMap();  // machine -> Map(state id -> colour)
 
-/** The colour of the state with this index (grey for none). */
-export function stateColour(index) {
-  if (index === null || index === undefined || index < 0) return "#999999";
-  return PALETTE[index % PALETTE.length];
+/** A function from a state id to its colour, read from the store's current `machine`. */
+export function stateColours(store) {
+  return (id) => {
+    const machine = store.get().machine;
+    if (!machine) return NONE;
+    if (!byMachine.has(machine)) byMachine.set(machine, new Map(machine.states.map((s) => [s.id, s.colour])));
+    return byMachine.get(machine).get(String(id)) || NONE;
+  };
 }

@@ -1,5 +1,7 @@
 // The stand-alone replay page: the data is in the page itself; the same views as the studio's trace player.
+import { stateColours } from "../lib/colours.js";
 import { byId, make } from "../lib/dom.js";
+import { createStore } from "../lib/store.js";
 import { Arena } from "../views/arena.js";
 import { Diagram } from "../views/diagram.js";
 import { Grid } from "../views/grid.js";
@@ -17,12 +19,13 @@ function replay(data) {
   const grid = new Grid(byId("grid"), { readOnly: true });
   grid.setColumns(data.table.columns, data.machine.tick_ms);
   grid.setTable(data.table.header, data.table.grid, data.table.lines);
-  const arena = new Arena(byId("arena"), null);
+  const colourOf = stateColours(createStore({ machine: data.machine }));
+  const arena = new Arena(byId("arena"), colourOf, null);
   arena.setWorld(data.world);
   const diagram = new Diagram(byId("diagram"));
   diagram.setSvg(data.diagram);
   const stateCol = data.table.columns.findIndex((c) => c.kind === "state");
-  const timeline = new Timeline(byId("timeline"), (i) => player.seek(i));
+  const timeline = new Timeline(byId("timeline"), colourOf, (i) => player.seek(i));
   const player = new Player({ arena, grid, diagram, timeline, status: byId("status"), slider: byId("scrub"),
     stateCol: () => stateCol, onEnd: () => { byId("tplay").textContent = "▶ Play"; },
     onSeek: (t) => showInputs(data.machine, t.event) });

@@ -1,5 +1,6 @@
 // The studio's views (grid, arena, diagram, timeline, trace player, checks), made once and wired to the
 // store and the server: what the user does in a view becomes a message or a change of state.
+import { stateColours } from "../lib/colours.js";
 import { byId } from "../lib/dom.js";
 import { Arena } from "../views/arena.js";
 import { Checks } from "../views/checks.js";
@@ -31,7 +32,7 @@ function makeGrid(store, send) {
 
 // A click in the arena moves the start pose (a drag also aims it) or the lamp, and starts over.
 function makeArena(store, send) {
-  return new Arena(byId("arena"), (x, y, heading) => {
+  return new Arena(byId("arena"), stateColours(store), (x, y, heading) => {
     const { mode, clickMode, world } = store.get();
     if (mode !== "live") return;
     if (clickMode === "lamp") send({ op: "sim", action: "reset", lamp: [x, y] });
@@ -54,15 +55,23 @@ function makeChecks(store, send, grid) {
   });
 }
 
+// An edit may give the states other colours (a state added that asks for a taken one): what a trace drew
+// is drawn again; the live path keeps what it drew (the page keeps no copy of it).
+function repaintStates({ arena, timeline }) {
+  timeline.draw();
+  if (arena.replayPath) { arena.clearPath(); arena.addPath(arena.replayPath); }
+}
+
 export function createViews(store, send) {
   const grid = makeGrid(store, send);
   const arena = makeArena(store, send);
   const diagram = new Diagram(byId("diagram"));
   const views = { grid, arena, diagram };
-  views.timeline = new Timeline(byId("timeline"), (i) => views.player.seek(i));
+  views.timeline = new Timeline(byId("timeline"), stateColours(store), (i) => views.player.seek(i));
   views.player = new Player({ arena, grid, diagram, timeline: views.timeline, status: byId("status"),
     slider: byId("scrub"), stateCol: () => stateColumn(store),
     onEnd: () => { byId("tplay").textContent = "▶ Play"; }, onSeek: (t) => store.set({ mask: t.event }) });
   views.checks = makeChecks(store, send, grid);
+  store.on(["machine"], () => repaintStates(views));
   return views;
 }

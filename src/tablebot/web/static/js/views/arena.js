@@ -1,12 +1,12 @@
 // The arena: the world, the robot (body, bumpers, light cones) and its path coloured by state, on a canvas.
 // Shared by the studio and the stand-alone replay file.
-import { stateColour } from "../lib/colours.js";
 
 const WALL = "#2f3640", FLOOR = "#f6f3ec", BLOCK = "#a4b0be", BLOCK_EDGE = "#57606f";
 
 export class Arena {
-  constructor(canvas, onClick) {
+  constructor(canvas, colourOf, onClick) {
     this.canvas = canvas;
+    this.colourOf = colourOf;  // state id -> colour
     this.ctx = canvas.getContext("2d");
     this.pathLayer = document.createElement("canvas");
     this.world = null;
@@ -62,7 +62,7 @@ export class Arena {
     this.dirty = true;
   }
 
-  // points: [[x, y, stateIndex], ...] in metres; drawn once onto the path layer (never redrawn per frame).
+  // points: [[x, y, stateId], ...] in metres; drawn once onto the path layer (never redrawn per frame).
   addPath(points) {
     if (!this.world || !points.length) return;
     const g = this.pathLayer.getContext("2d");
@@ -71,7 +71,7 @@ export class Arena {
     for (const p of points) {
       if (last) {
         const [ax, ay] = this.toScreen(last[0], last[1]), [bx, by] = this.toScreen(p[0], p[1]);
-        g.strokeStyle = stateColour(p[2]);
+        g.strokeStyle = this.colourOf(p[2]);
         g.beginPath(); g.moveTo(ax, ay); g.lineTo(bx, by); g.stroke();
       }
       last = p;

@@ -19,12 +19,12 @@ export function describeTick(machine, t) {
   return parts.join(" · ");
 }
 
-/** The path a trace drew: a point every 5 mm or at a state change, [x, y, stateIndex]. */
-function tracePath(columns, stateIndex) {
+/** The path a trace drew: a point every 5 mm or at a state change, [x, y, stateId]. */
+function tracePath(columns, stateIds) {
   const pts = [];
   let last = null;
   for (let i = 0; i < columns.tick.length; i++) {
-    const x = columns.x[i], y = columns.y[i], s = stateIndex[i];
+    const x = columns.x[i], y = columns.y[i], s = stateIds[i];
     if (x === null || y === null) continue;
     if (!last || last[2] !== s || Math.hypot(x - last[0], y - last[1]) > 0.005) { last = [x, y, s]; pts.push(last); }
   }
@@ -46,15 +46,14 @@ export class Player {
     this.columns = columns;
     this.machine = machine;
     this.n = columns.tick.length;
-    const ids = machine.states.map((s) => s.id);
-    this.stateIndex = columns.state.map((s) => ids.indexOf(String(s)));
+    this.stateIds = columns.state.map(String);
     this.outputNames = machine.outputs.filter((name) => name in columns);
     this.lightKeys = Object.keys(columns).filter((k) => k.endsWith("_light"));  // right, then left
-    this.views.timeline.setStates(this.stateIndex);
+    this.views.timeline.setStates(this.stateIds);
     this.views.slider.max = Math.max(0, this.n - 1);
     const arena = this.views.arena;
     if (arena && "x" in columns) {
-      arena.replayPath = tracePath(columns, this.stateIndex);
+      arena.replayPath = tracePath(columns, this.stateIds);
       arena.clearPath();
       arena.addPath(arena.replayPath);
     }

@@ -1,10 +1,10 @@
 // A timeline strip: the state at each tick as a coloured band, and a cursor; click or drag to seek.
-import { stateColour } from "../lib/colours.js";
 
 export class Timeline {
-  constructor(canvas, onSeek) {
+  constructor(canvas, colourOf, onSeek) {
     this.canvas = canvas;
-    this.states = [];  // state index per tick (-1: not in the table)
+    this.colourOf = colourOf;  // state id -> colour
+    this.states = [];  // state id per tick
     this.cursor = 0;
     this.onSeek = onSeek;
     canvas.addEventListener("pointerdown", (e) => this._seek(e));
@@ -30,7 +30,7 @@ export class Timeline {
     g.fillStyle = "#f1f3f5"; g.fillRect(0, 0, W, H);
     if (!n) return;
     for (let px = 0; px < W; px++) {  // one pixel column per bucket of ticks
-      g.fillStyle = stateColour(this.states[Math.min(n - 1, Math.floor(px / W * n))]);
+      g.fillStyle = this.colourOf(this.states[Math.min(n - 1, Math.floor(px / W * n))]);
       g.fillRect(px, 0, 1, H * 0.78);
     }
     const x = (n > 1 ? this.cursor / (n - 1) : 0) * (W - 2) + 1;

@@ -1,0 +1,296 @@
+"""The executors of this tablebot, registered in the differential harness (:mod:`tablebot.testing.harness`):
+Engine.step, Engine.run (compiled), the simulator, the fleet, the host C engine, the AVR firmware under
+simavr, the TXT 4.0 program against its stub, the ROBO Pro program in its interpreter, and the live serial
+controllers against their emulators (:mod:`tablebot.testing.serial_executors`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+from tablebot.engine import Engine
+from tablebot.formats.inputs_csv import TickInput
+from tablebot.machine import Machine, compile_table
+from tablebot.replay import record
+from tablebot.table import Table
+from tablebot.testing.harness import CORE, Case, Executor, Run, busy_world, fits_controller, register, wired_for
+from tablebot.testing.serial_executors import SERIAL_EXECUTORS
+
+
+def _engine_step(case: Case, workdir: Path) -> Run:
+    engine = Engine(case.machine)
+    lines = []
+    for tick in case.inputs:
+        engine.step(tick.mask, tick.pulses)
+        lines.append(record(engine))
+    return Run(list(case.inputs), lines)
+
+
+def _engine_run(case: Case, workdir: Path) -> Run:
+    """``Engine.run``, compiled: its columns per tick, and the outputs and counters it leaves after the last."""
+    m = case.machine
+    engine = Engine(m)
+    n = len(m.table.robot.counters)
+    pulses = [list(t.pulses) + [0] * (n - len(t.pulses)) for t in case.inputs]
+    batch = engine.run([t.mask for t in case.inputs], pulses, jit=True)
+    lines: list[dict[str, Any]] = [
+        {"tick": i, "event": e, "row": None if r < 0 else r, "state": m.states[s], "timer": t}
+        for i, (e, r, s, t) in enumerate(zip(batch.events, batch.rows, batch.states, batch.timers, strict=True))]
+    if lines:
+        last = record(engine)
+        lines[-1].update({k: v for k, v in last.items() if k not in CORE})
+    return Run(list(case.inputs), lines)
+
+
+def _sim_lines(machine: Machine, run: Any) -> Run:
+    """A simulated run's (:class:`tablebot.sim.runner.SimRun`) inputs and decisions as trace lines."""
+    from tablebot.codegen.host import trace_line
+
+    inputs = run.inputs()
+    lines = [trace_line(machine, i, int(run.events[i]), int(run.rows[i]), int(run.states[i]), int(run.timers[i]),
+                        run.outputs[i].tolist(), run.counters[i].tolist()) for i in range(run.ticks)]
+    return Run(inputs, lines)
+
+
+def _busy_world(seed: int) -> Any:
+    """The first of the seed's busy rooms the simulator accepts."""
+    from tablebot.diagnostics import TableBotError
+    from tablebot.sim.world import parse_world
+    from tablebot.tomlfile import Source
+
+    rng = random.Random(seed)
+    while True:
+        try:
+            return parse_world(Source.parse("<busy room>", busy_world(rng)))
+        except TableBotError:
+            continue
+
+
+def _world_and_layer(case: Case) -> tuple[Any, dict[str, Any] | None]:
+    """Where a simulated executor runs the case: its robot's own world and [sim], or a busy random room."""
+    from tablebot.sim.scene import find_world, robot_layer
+
+    table = case.machine.table
+    if case.own_world:
+        layer, robot_world = robot_layer(table.robot)
+        return find_world(table, None, robot_world), layer
+    return _busy_world(case.seed), None
+
+
+#: Ticks a simulated executor runs (at least).
+SIM_TICKS = 1500
+
+
+def _simulator(case: Case, workdir: Path) -> Run:
+    """``tablebot sim``'s path: the run loop handing blocks to ``SimRobot.advance`` (the compiled kernel)."""
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import prepare
+
+    world, layer = _world_and_layer(case)
+    scene = prepare(case.machine.table, case.machine, world, layer)
+    ticks = max(SIM_TICKS, len(case.inputs))
+    return _sim_lines(case.machine, simulate(scene, ticks * scene.tick_s, case.seed))
+
+
+def _fleet(case: Case, workdir: Path) -> Run:
+    """Robot 1 of a fleet of three (``fleet.kernel.run_fleet``), traced."""
+    from tablebot.fleet.robots import RobotSpec
+    from tablebot.fleet.run import Fleet
+
+    world, layer = _world_and_layer(case)
+    specs = [RobotSpec(seed=case.seed + k) for k in range(3)]
+    fleet = Fleet(case.machine.table, case.machine, world, specs, layer, traced=[1])
+    fleet.run(max(SIM_TICKS, len(case.inputs)), block_ticks=97)
+    return _sim_lines(case.machine, fleet.result(1))
+
+
+def example_case(name: str, seconds: float = 20.0, seed: int = 1) -> Case:
+    """A shipped example with the inputs its simulated robot read in ``seconds`` (every other executor replays
+    them; the simulated ones run it in its own world)."""
+    from tablebot.examples import example_path
+    from tablebot.formats.table_read import load_table, resolve_table_path
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import scene_for
+
+    table = load_table(resolve_table_path(example_path(name)))
+    machine = compile_table(table)
+    run = simulate(scene_for(table, machine), seconds, seed)
+    return Case(machine, tuple(run.inputs()), seed, own_world=True)
+
+
+def _sim_fits(machine: Machine) -> bool:
+    return machine.arrays is not None and set(machine.table.robot.motors) >= {"M1", "M2"}
+
+
+def _host_c(case: Case, workdir: Path) -> Run:
+    from tablebot.codegen.host import build_host, run_host
+
+    exe = build_host(case.machine, workdir / "host")
+    return Run(list(case.inputs), run_host(exe, case.machine, case.inputs))
+
+
+def _no_compiler() -> str | None:
+    return None if shutil.which("cc") or shutil.which("gcc") else "no C compiler (gcc)"
+
+
+BOARD = "uno"
+
+
+def _avr_firmware(case: Case, workdir: Path) -> Run:
+    from tablebot.firmware.build import build
+    from tablebot.firmware.emulate import emulate
+
+    firmware = build(case.machine, BOARD, workdir / "fw")
+    run = emulate(firmware, case.machine, case.inputs, workdir / "run")
+    if run.problems:
+        raise AssertionError(f"the firmware's stream: {run.problems}")
+    return Run(list(case.inputs), run.trace)
+
+
+def _no_avr() -> str | None:
+    from tablebot.diagnostics import TableBotError
+    from tablebot.firmware.emulate import build_harness
+
+    if not shutil.which("avr-gcc"):
+        return "no avr-gcc (scripts/bootstrap.sh installs gcc-avr)"
+    try:
+        build_harness()
+    except TableBotError as exc:
+        return exc.diagnostics[0].message
+    return None
+
+
+def _fits_uno(machine: Machine) -> bool:
+    robot = machine.table.robot
+    return (len(robot.inputs) + len(robot.lamps) <= 8 and len(robot.motors) <= 2 and len(robot.counters) <= 2
+            and len(machine.states) <= 255)
+
+
+#: The stub of the ``fischertechnik`` package the TXT 4.0 program is run against (a checkout's tests/txt4_stub,
+#: or the folder this variable names).
+TXT4_STUB = "TABLEBOT_TXT4_STUB"
+TXT4_DRIVER = """\
+import json, sys
+from lib import tablebot_program as program
+import fischertechnik.factories as factories
+from fischertechnik.controller.Motor import Motor
+
+robot = program.Txt4Robot(program.TABLE, factories, Motor)
+engine = program.Engine(program.TABLE)
+seen = []
+for _ in range(int(sys.argv[1])):
+    mask, pulses = robot.read()
+    outputs = engine.step(mask, pulses)
+    robot.write(outputs)
+    seen.append([mask, list(pulses), engine.event, engine.row, engine.state, engine.timer, list(engine.outputs),
+                 list(engine.counters)])
+robot.stop()
+print(json.dumps(seen))
+"""
+
+
+def _txt4_stub() -> Path:
+    given = os.environ.get(TXT4_STUB)
+    return Path(given) if given else Path(__file__).resolve().parents[3] / "tests" / "txt4_stub"
+
+
+def _txt4_program(case: Case, workdir: Path) -> Run:
+    """``export --to txt4``'s program, as the controller runs it (``python -S``: no numpy, no tablebot) against
+    the stub: its robot reads the inputs off the stub's terminals and counters, its engine steps, its robot
+    writes; its own pacing loop is proven equal to ``loop.run`` in tests/test_rules.py."""
+    from tablebot.codegen.host import trace_line
+    from tablebot.hw.txt4.export import export_txt4
+
+    m = wired_for(case.machine.table, "txt")
+    folder = workdir / "txt4"
+    export_txt4(m).write(folder)
+    (folder / "driver.py").write_text(TXT4_DRIVER, encoding="utf-8")
+    terminals = [int(name[1:]) - 1 for name in m.input_bits]
+    script = {"inputs": [[0] * 8 for _ in range(len(case.inputs) + 1)],
+              "pulses": [[0, 0, 0, 0] for _ in range(len(case.inputs) + 1)]}
+    for row, pulses, tick in zip(script["inputs"], script["pulses"], case.inputs, strict=False):
+        for terminal, bit in zip(terminals, m.input_bits.values(), strict=True):
+            row[terminal] = int(bool(tick.mask & bit))
+        pulses[: len(tick.pulses)] = list(tick.pulses)
+    (folder / "script.json").write_text(json.dumps(script), encoding="utf-8")
+    env = {"PATH": os.environ.get("PATH", ""), "PYTHONPATH": str(_txt4_stub()),
+           "TABLEBOT_STUB_SCRIPT": str(folder / "script.json"), "TABLEBOT_STUB_LOG": str(folder / "calls.jsonl")}
+    done = subprocess.run([sys.executable, "-S", "driver.py", str(len(case.inputs))], cwd=folder, env=env,
+                          capture_output=True, text=True, timeout=120, check=False)
+    if done.returncode:
+        raise AssertionError(f"the TXT 4.0 program failed: {done.stderr}")
+    seen = json.loads(done.stdout.splitlines()[-1])
+    return Run([TickInput(mask, tuple(pulses)) for mask, pulses, *_ in seen],
+               [trace_line(m, i, *values[2:]) for i, values in enumerate(seen)])
+
+
+def _no_txt4_stub() -> str | None:
+    stub = _txt4_stub()
+    return None if (stub / "fischertechnik").is_dir() else f"no fischertechnik stub at {stub} (set {TXT4_STUB})"
+
+
+def _fits_txt(machine: Machine) -> bool:
+    return fits_controller(machine)
+
+
+def wired_for_robopro(table: Table) -> Table:
+    """A table's robot with a ``[robopro]`` section for a TXT (the controller whose program has counters)."""
+    return dataclasses.replace(table, robot=dataclasses.replace(
+        table.robot, sections={**table.robot.sections, "robopro": {"controller": "txt"}}))
+
+
+#: Ticks the ROBO Pro interpreter runs of a case at most: it interprets every element (about 1 ms a tick here).
+ROBOPRO_TICKS = 1200
+
+
+def _robopro_program(case: Case, workdir: Path) -> Run:
+    """``export --to robopro-program``'s program in the element interpreter (``tablebot.robopro.executor``), on
+    the case's first ROBOPRO_TICKS ticks."""
+    from tablebot.codegen.host import trace_line
+    from tablebot.robopro.executor import run
+
+    m = case.machine
+    inputs = list(case.inputs[:ROBOPRO_TICKS])
+    decisions = run(wired_for_robopro(m.table), inputs, case.rule)  # type: ignore[arg-type]
+    return Run(inputs, [trace_line(m, i, d.event, d.row, d.state, d.timer, d.outputs, d.counters)
+                                   for i, d in enumerate(decisions)])
+
+
+def _fits_robopro(machine: Machine) -> bool:
+    from tablebot.robopro.fit import problems
+
+    return not problems(wired_for_robopro(machine.table), "always")
+
+
+def register_all() -> None:
+    """The executors of this tablebot, each once."""
+    for executor in (
+        Executor("python step", _engine_step, what="Engine.step: one tick in Python (the path of real robots)"),
+        Executor("engine batch", _engine_run, fits=lambda m: m.arrays is not None,
+                 what="Engine.run: tick.tick compiled by numba over recorded masks"),
+        Executor("simulator", _simulator, fits=_sim_fits,
+                 what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.kernel, compiled)"),
+        Executor("fleet", _fleet, fits=_sim_fits, what="a robot of a fleet (fleet.kernel.run_fleet, compiled)"),
+        Executor("host C", _host_c, missing=_no_compiler,
+                 what="the generated C engine compiled for this computer (codegen.host)"),
+        Executor("AVR firmware", _avr_firmware, missing=_no_avr, fits=_fits_uno,
+                 what="the Uno firmware under simavr, its UART trace decoded"),
+        Executor("TXT 4.0 program", _txt4_program, missing=_no_txt4_stub, fits=_fits_txt,
+                 what="export --to txt4's standalone program against the fischertechnik stub"),
+        # It knows the document's rule too; the reference (Engine.step) does not yet, so only "always" is checked.
+        Executor("ROBO Pro program", _robopro_program, fits=_fits_robopro,
+                 what="export --to robopro-program in the ROBO Pro element interpreter"),
+        *SERIAL_EXECUTORS,
+    ):
+        register(executor)
+
+
+register_all()
