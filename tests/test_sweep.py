@@ -238,9 +238,10 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     version = f"py{sys.version_info.major}{sys.version_info.minor}"
     mine = home / "tablebot" / f"numba-{version}-{jit.sources_digest()}" / "worker-testhost-0"
     (tmp_path / "job.pickle").write_bytes(pickle.dumps((job, files)))
-    code = ("import json, os, pickle, sys; from tablebot.fleet.work import warm_worker; "
+    code = ("import json, os, pickle, sys; from tablebot.fleet.work import job_threads, warm_worker; "
             "job, files = pickle.load(open(sys.argv[1], 'rb')); "
-            "print(json.dumps(warm_worker(job, 'testhost-0', os.cpu_count(), files)))")
+            "info = warm_worker(job, 'testhost-0', os.cpu_count(), files); "
+            "print(json.dumps({**info, 'job_threads': job_threads(job)}))")
     worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
     worker_env["XDG_CACHE_HOME"] = str(home)
     done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
@@ -248,6 +249,7 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     assert done.returncode == 0, done.stderr
     info = json.loads(done.stdout.strip().splitlines()[-1])
     assert info["cache"] == str(mine) and info["threads"] == 1
+    assert info["job_threads"] == 1  # a job without threads of its own takes the worker's share of the cores
     sent = sorted(name for named in files.values() for name in named)
     assert info["installed"] == len(sent) > 0
     landed = sorted(p.name for p in mine.rglob("*") if p.is_file())
@@ -255,6 +257,28 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     for relative, named in files.items():
         folder = next(p for p in mine.iterdir() if p.name.startswith((Path(relative).parent.name or "tablebot") + "_"))
         assert all((folder / name).read_bytes() == data for name, data in named.items())
+
+
+def test_a_job_with_threads_of_its_own_runs_on_them() -> None:
+    """What a job runs on is the fleet's to say and set (evolve's jobs ask it too); numba keeps the count per
+    calling thread, and this process is no cluster worker, so a job without threads leaves it alone."""
+    from dataclasses import replace
+
+    import numba
+
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import job_threads, use_threads
+
+    job = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0).jobs()[0]
+    before = numba.get_num_threads()
+    try:
+        assert job_threads(job) is None and job_threads(replace(job, threads=1)) == 1
+        use_threads(replace(job, threads=1))
+        assert numba.get_num_threads() == 1
+        use_threads(job)
+        assert numba.get_num_threads() == 1
+    finally:
+        numba.set_num_threads(before)
 
 
 def test_a_sweep_draws_its_pictures(tmp_path: Path) -> None:

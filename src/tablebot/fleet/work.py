@@ -54,15 +54,27 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
         if stop is not None and stop.is_set():
             raise Stopped
 
-    threads = job.threads or _worker_threads
-    if threads is not None:  # per calling thread in numba: set for each job
-        import numba
-
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    use_threads(job)
     fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
                   variants=job.variants)
     fleet.run(job.ticks, progress=check)
     return replace(job, specs=[], variants=None), fleet.summary()
+
+
+def job_threads(job: Job) -> int | None:
+    """The numba threads ``job`` runs on in this process: its own ``threads``, else this cluster worker's
+    share of its machine's cores (set by :func:`warm_worker`), else None (numba's default)."""
+    return job.threads or _worker_threads
+
+
+def use_threads(job: Job) -> None:
+    """Give the calling thread :func:`job_threads` numba threads (numba keeps the count per calling thread,
+    so each job sets it again); with None, the thread keeps what it has."""
+    threads = job_threads(job)
+    if threads is not None:
+        import numba
+
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
 def warm(job: Job, both: bool = False) -> float:
