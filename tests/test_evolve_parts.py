@@ -3,6 +3,7 @@ canonical form, the repair of the BumberBot's front_bumper_stops, and bad option
 
 from __future__ import annotations
 
+import shutil
 from dataclasses import replace
 from pathlib import Path
 
@@ -110,6 +111,7 @@ def evolve(*args: str) -> tuple[int, str]:
     (["--freeze-state", "7"], "the table has no state 7"),
     (["--max-rows", "10"], "--max-rows 10 is fewer than the 37 rows"),
     (["--batch", "50", "--budget", "10"], "--batch 50 is more than --budget 10"),
+    (["--descriptors", ""], "--descriptors needs one or two descriptors, not 0"),
 ])
 def test_bad_options_are_clear_errors_naming_the_option(tmp_path: Path, args: list[str], words: str) -> None:
     code, output = evolve(str(BUMBERBOT), "--out", str(tmp_path / "o"), "--seeds", "0..1", *args)
@@ -124,3 +126,13 @@ def test_a_property_naming_a_file_line_is_refused(tmp_path: Path) -> None:
     code, output = evolve(str(BUMBERBOT), "--out", str(tmp_path / "o"), "--properties", str(props))
     assert code == 2, output
     assert "property seek names a file line" in output and "p.toml" in output
+
+
+def test_out_may_not_be_the_folder_the_table_is_read_from(tmp_path: Path) -> None:
+    """It was taken: examples/bumberbot filled with tables, reports and records beside the robot's files."""
+    bot = tmp_path / "bot"
+    shutil.copytree(BUMBERBOT.parent, bot)
+    before = sorted(p.name for p in bot.iterdir())
+    code, output = evolve(str(bot / "table.csv"), "--out", str(bot), "--seeds", "0..1")
+    assert code == 2 and "--out" in output and "is the folder of table.csv" in output, output
+    assert sorted(p.name for p in bot.iterdir()) == before

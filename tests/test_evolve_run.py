@@ -79,7 +79,7 @@ def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_r
                                                           dask_cluster: str) -> None:  # noqa: F811
     code, output = evolve(str(LINE), "--out", str(tmp_path / "dask"), *LINE_RUN, "--scheduler", dask_cluster)
     assert code == 0, output
-    assert "# Evolving table.csv: laps (high is better)" in output
+    assert "# Evolving line-follower/table.csv: laps (high is better)" in output
     same_results(line_run, tmp_path / "dask")
 
 
@@ -112,3 +112,30 @@ def test_sigterm_and_ctrl_c_keep_what_ran_and_the_same_command_resumes(tmp_path:
     assert done.returncode == 0, done.stderr
     assert records.read_text().splitlines()[: len(second)] == second  # what ran before is kept, not run again
     same_results(line_run, out)
+
+
+def test_the_report_gives_a_working_command_for_every_world(tmp_path: Path) -> None:
+    """Evolved over two worlds, each table gets a ``tablebot sim`` per world (each into its own folder) and
+    one ``tablebot sweep`` runs a table on every world and scenario of the search: each of them runs."""
+    other = tmp_path / "other place"
+    other.mkdir()
+    (other / "arena.toml").write_text((LINE / "arena.toml").read_text().replace('name = "oval track"',
+                                                                                'name = "second track"'))
+    out = tmp_path / "out dir"
+    code, output = evolve(str(LINE), "--world", str(LINE / "arena.toml"), "--world", str(other / "arena.toml"),
+                          "--out", str(out), "--seeds", "0..1", "--check-seeds", "5..5", "--seconds", "1",
+                          "--budget", "3", "--batch", "2", "--workers", "1", "-q")
+    assert code == 0, output
+    report = (out / "report.md").read_text(encoding="utf-8")
+    block = report.split("- `best-1.csv`")[1].split("\n- ")[0]
+    commands = [shlex.split(line.split("`")[1]) for line in block.splitlines()[1:3]]
+    assert [c[c.index("--world") + 1] for c in commands] == [str(LINE / "arena.toml"), str(other / "arena.toml")]
+    sweep = shlex.split(report.split("any table above in its place):\n\n`")[1].split("`")[0])
+    assert sweep[:3] == ["tablebot", "sweep", str(out / "best-1.csv")] and sweep.count("--world") == 2
+    for words in [*commands, sweep]:
+        result = CliRunner().invoke(app, [*words[1:], "--no-plots", "-q"])
+        assert result.exit_code == 0, (words, result.output)
+    names = {p.parent.relative_to(out).as_posix() for p in out.rglob("trace.jsonl")}
+    assert names == {"sim/best-1/1-arena", "sim/best-1/2-arena"}
+    results = (out / "sweep" / "best-1" / "results.csv").read_text().splitlines()
+    assert len(results) == 1 + 2 * 2  # two seeds in each world

@@ -289,3 +289,37 @@ def test_an_interrupt_inside_an_import_ends_as_the_interrupt(cause, code, word):
     done = subprocess.run([sys.executable, "-c", script], env={**os.environ, "PYTHONPATH": str(ROOT / "src")},
                           capture_output=True, text=True, timeout=60)
     assert (done.returncode, done.stderr.strip()) == (code, word)
+
+
+def test_evolve_leaves_the_old_tables_or_the_new_and_resumes(tmp_path):
+    """Over an earlier, smaller run (--budget 3) the same search continued (--budget 6) is cut at its first
+    and last file written and its first and last rename: the folder holds the earlier run's tables, check
+    reports, heat map and report, or the continued run's, whole; the records a resume needs (ignored here)
+    keep the work, and the same command then finishes with the tables of a run never cut."""
+    bot = tmp_path / "lf"
+    shutil.copytree(ROOT / "examples" / "line-follower", bot)
+    out, ref = tmp_path / "ev", tmp_path / "ref"
+    command = ["evolve", bot, "--out", out, "--batch", "2", "--seeds", "0..1", "--check-seeds", "10..11",
+               "--seconds", "2", "--workers", "1", "-q"]
+    records = ["spec.json", "evaluations.jsonl", "proofs.jsonl"]  # what a resume needs, appended as work finishes
+    assert invoke([*command, "--budget", "3"]) == 0
+    (out / USER_FILE).write_text("mine\n")
+    shutil.copytree(out, ref)
+    assert invoke([str(ref) if a == out else a for a in command] + ["--budget", "6"]) == 0
+    new = snapshot(ref, records)
+    del new[USER_FILE]
+    assert len(new) == 8 and "elites" in {name.split("/")[0] for name in new}  # 2 tables, their checks, 4 more
+    outcomes = []
+    for n in (1, 8, 9, 16, 99):  # 8 files written into the staging folder, then 8 renamed into place
+        name = "INT" if n % 2 else "TERM"
+        before = snapshot(out, records)
+        code = invoke([*command, "--budget", "6"], f"{n}:{name}")
+        if code == 0:
+            outcomes.append("done")
+            break
+        assert code == (130 if name == "INT" else 143)
+        outcomes.append(check_outcome(out, before, snapshot(out, records), new, loose=["report.md"]))
+    assert outcomes == ["old", "old", "new", "new", "done"]
+    evaluated = (out / "evaluations.jsonl").read_text().splitlines()
+    assert len(evaluated) == len(set(evaluated)) == 6  # no table run twice across the cut runs
+    assert (out / "evaluations.csv").read_bytes() == (ref / "evaluations.csv").read_bytes()

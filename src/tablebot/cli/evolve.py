@@ -3,7 +3,6 @@ a quality-diversity archive of tables that behave differently, written as tables
 
 from __future__ import annotations
 
-import signal
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -24,10 +23,7 @@ class Setup:
     space: Any  # tablebot.evolve.operators.Space
     files: list[Path]
     names: list[str]
-
-
-class Terminated(Exception):
-    """SIGTERM arrived: stop as Ctrl-C does (what was evaluated is kept), exit 143."""
+    replay: Any = None  # tablebot.evolve.report.Replay: what the report's commands need
 
 
 @app.command("evolve")
@@ -47,7 +43,8 @@ def evolve_cmd(
                                            'collision_share).'),
     cells: int = typer.Option(8, "--cells", min=2, max=100, help="Archive cells per descriptor."),
     budget: int = typer.Option(200, "--budget", min=1, help="Most tables to run on the fleet (the start included)."),
-    batch: int = typer.Option(16, "--batch", min=1, help="Tables asked for per generation."),
+    batch: int | None = typer.Option(None, "--batch", min=1, help="Tables asked for per generation "
+                                     "(default: 16; a last generation takes what the budget has room for)."),
     seeds: str = typer.Option("0..15", "--seeds", help="Seeds of the scenarios every table runs."),
     check_seeds: str = typer.Option("1000..1063", "--check-seeds", help="Fresh seeds for the before/after report."),
     grid: list[str] | None = typer.Option(None, "--grid", help='Scenario grid as in sweep (default: "start=random").'),
@@ -80,10 +77,13 @@ def evolve_cmd(
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or ["start=random"], seeds, None, seconds)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
-    if batch > budget:
+    if batch is not None and batch > budget:
         raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
+    batch = batch or 16  # a budget below it takes what it has room for (the batch stays one, for resuming)
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, freeze_state or [],
                    freeze_cell or [], properties)
+    setup = replace(setup, replay=_replay(plan, seeds, grid or ["start=random"], out))
+    _own_folder(out, plan, setup.files)
     out_folder(out, "--out")
     _run(plan, check, setup, out, chosen, address, workers, quiet)
 
@@ -102,7 +102,8 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     base = plan.table
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
     measure = measures.check_objective(objective or measures.default_objective(plan.worlds), plan.worlds)
-    chosen = measures.parse_descriptors(descriptors or measures.default_descriptors(plan.worlds), plan.worlds,
+    text = measures.default_descriptors(plan.worlds) if descriptors is None else descriptors
+    chosen = measures.parse_descriptors(text, plan.worlds,
                                         base.states, seconds, cells)
     rows = max_rows or space.default_max_rows(base)
     if rows < len(base.rows):
@@ -117,6 +118,29 @@ def _setup(plan: Any, objective: str | None, descriptors: str | None, cells: int
     names += [d.name for d in chosen if d.name not in names]
     settings = Settings(measure, tuple(chosen), budget, batch, seed)
     return Setup(settings, Space(base.states, base.robot.motors, limits), files, names)
+
+
+def _own_folder(out: Path, plan: Any, properties: list[Path]) -> None:
+    """--out must not be a folder the run reads from: its tables, reports and records would lie among the
+    robot's own files (and a table named best-1.csv there would be a user's)."""
+    from tablebot.diagnostics import fail
+
+    inputs = [Path(plan.table.path), *(Path(w) for w in plan.spec.worlds if w), *properties]
+    if plan.table.robot.source:
+        inputs.append(Path(plan.table.robot.source))
+    here = out.resolve()
+    for path in inputs:
+        if path.is_file() and path.resolve().parent == here:
+            raise fail("--out", f"--out {out} is the folder of {path.name}, which evolve reads: its tables, reports "
+                       "and records would lie among the robot's own files", "give --out a folder of its own, such as "
+                       "out/evolve")
+
+
+def _replay(plan: Any, seeds: str, grid: list[str], out: Path) -> Any:
+    from tablebot.evolve.report import Replay
+
+    return Replay(plan.table.robot.source, tuple(map(str, plan.spec.worlds)), plan.spec.ticks * plan.scenes[0].tick_s,
+                  seeds, tuple(grid), out)
 
 
 def _spec(plan: Any, setup: Setup) -> dict[str, Any]:
@@ -139,11 +163,11 @@ def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: 
     from tablebot.evolve.proofs import Prover
     from tablebot.evolve.run import Evolution, Store
     from tablebot.fleet.backends import Runner
+    from tablebot.interrupts import INTERRUPTS, Terminated
 
     settings = setup.settings
     store = Store(out, _spec(plan, setup))
     prover = Prover(setup.files, store.proofs)
-    previous = signal.signal(signal.SIGTERM, _terminated)
     started = time.perf_counter()
     evolution = None
     try:
@@ -153,22 +177,32 @@ def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: 
                                   on_eval=bar.advance, on_repair=lambda repairs: _said_repairs(repairs, quiet))
             outcome = evolution.run()
             written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup.names,
-                                plan.spec.worlds[0])
-    except (KeyboardInterrupt, Terminated) as exc:
+                                setup.replay)
+    except INTERRUPTS as exc:  # SIGTERM raises Terminated while a command runs (cli.common.guarded)
         kept = len(evolution.store.open()) if evolution else 0
         err_console.print(f"{'terminated' if isinstance(exc, Terminated) else 'interrupted'}: {kept} tables "
                           f"evaluated so far are kept in {out}; run the same command again to resume",
                           markup=False, soft_wrap=True)
         raise typer.Exit(143 if isinstance(exc, Terminated) else 130) from None
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     if not quiet:
         console.print((out / "report.md").read_text(encoding="utf-8"), markup=False)
-        rate = evaluator.robot_ticks / max(outcome.counts.fleet_s, 1e-9)
-        console.print(f"({len(outcome.order)} tables in {time.perf_counter() - started:.0f} s; the fleet ran "
-                      f"{rate / 1e6:.2f} M robot-ticks/s while it ran)", markup=False)
+        console.print(_pace(outcome, plan, time.perf_counter() - started), markup=False)
         for path in written:
             err_console.print(f"wrote {path}", markup=False)
+
+
+def _pace(outcome: Any, plan: Any, wall: float) -> str:
+    """The run's pace: tables and robot-ticks of the search per second of the fleet's time (the fresh-seed
+    check after it not counted); a resumed run says how many tables it took from the folder."""
+    counts = outcome.counts
+    said = f"({len(outcome.order)} tables in {wall:.0f} s"
+    if counts.resumed:
+        said += f", {counts.resumed} of them from the earlier run in this folder"
+    if counts.evaluated and counts.fleet_s > 0:
+        ticks = counts.evaluated * plan.spec.total * plan.spec.ticks
+        said += (f"; the search ran {counts.evaluated / counts.fleet_s:.1f} tables/s, "
+                 f"{ticks / counts.fleet_s / 1e6:.2f} M robot-ticks/s on the fleet")
+    return said + ")"
 
 
 def _said_repairs(repairs: list[Any], quiet: bool) -> None:
@@ -178,7 +212,3 @@ def _said_repairs(repairs: list[Any], quiet: bool) -> None:
         state = "mended it" if r.ok else f"could not mend {', '.join(r.failing)}"
         err_console.print(f"repair {k + 1}: the starting table breaks a property; {len(r.steps)} guard rows "
                           f"{state}", markup=False)
-
-
-def _terminated(signum: int, frame: object) -> None:
-    raise Terminated()

@@ -16,7 +16,16 @@ from tablebot.evolve import archive as qd
 from tablebot.evolve.evaluate import Evaluator, Means
 from tablebot.evolve.measures import Measure, fitness
 from tablebot.evolve.proofs import Prover
-from tablebot.evolve.report import Written, heat_map, measure_rows, paired, sim_command, write_table
+from tablebot.evolve.report import (
+    Replay,
+    Written,
+    heat_map,
+    measure_rows,
+    paired,
+    sim_commands,
+    sweep_command,
+    write_table,
+)
 from tablebot.evolve.run import Outcome, Settings
 from tablebot.files import remove, write_text
 from tablebot.fileset import current, file_set
@@ -72,15 +81,15 @@ def remember_own(out: Path, paths: Sequence[Path]) -> Path:
 
 
 def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-              out: Path, names: Sequence[str], world: str) -> list[Path]:
+              out: Path, names: Sequence[str], replay: Replay) -> list[Path]:
     """Every table, check report, the heat map, evaluations.csv and report.md, replacing the previous run's
     all at once (tablebot.fileset); returns the paths written."""
     with file_set(out):
-        return _write_all(outcome, settings, base, prover, evaluator, check, out, names, world)
+        return _write_all(outcome, settings, base, prover, evaluator, check, out, names, replay)
 
 
 def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-               out: Path, names: Sequence[str], world: str) -> list[Path]:
+               out: Path, names: Sequence[str], replay: Replay) -> list[Path]:
     forget_own(out)
     best = best_keys(outcome)
     start, seeds = outcome.start_key, outcome.seeds
@@ -97,10 +106,11 @@ def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover
         written.append(write_table(outcome.candidates[key], base, out / "elites" / f"{name}.csv", prover,
                                    f"elites/{name}", key))
     start_at = tuple(outcome.means[start][d.name] for d in settings.descriptors)
+    label = "the starting table" if outcome.start_verdict.ok else "the starting table (breaks a property: not kept)"
     paths = [heat_map(outcome.archive, settings.descriptors, settings.objective, outcome.history, start_at,
-                      out / "archive.png"),
+                      out / "archive.png", label),
              write_evaluations(outcome, settings, out / "evaluations.csv")]
-    text = report_text(outcome, settings, base, prover, evaluator, check, fresh, written, best, names, world)
+    text = report_text(outcome, settings, base, prover, evaluator, check, fresh, written, best, names, replay)
     paths.append(write_text(out / "report.md", text))
     tables = [p for w in written for p in (w.path, w.check)]
     remember_own(out, tables)
@@ -118,28 +128,49 @@ def write_evaluations(outcome: Outcome, settings: Settings, path: Path) -> Path:
 
 
 def report_text(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-                fresh: Fresh, written: list[Written], best: list[str], names: Sequence[str], world: str) -> str:
+                fresh: Fresh, written: list[Written], best: list[str], names: Sequence[str], replay: Replay) -> str:
     objective = settings.objective
     plan = evaluator.plan
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
-    lines = [f"# Evolving {Path(base.path).name}: {objective.name} ({objective.better} is better)", "",
+    where, generations = Path(base.path), outcome.counts.generations
+    lines = [f"# Evolving {where.parent.name}/{where.name}: {objective.name} ({objective.better} is better)", "",
              f"{len(outcome.order)} tables run on the fleet, each on {plan.spec.total} scenarios "
-             f"({len(plan.spec.seeds)} seeds × {len(plan.spec.worlds)} world(s), {seconds:g} s each), "
-             f"{outcome.counts.generations} generations of up to {settings.batch}, seed {settings.seed}; "
+             f"({len(plan.spec.seeds)} seeds × {len(plan.spec.worlds)} world(s)"
+             f"{''.join(f', --grid {g}' for g in replay.grid)}, {seconds:g} s each), "
+             f"{generations} generation{'' if generations == 1 else 's'} of up to {settings.batch}, "
+             f"seed {settings.seed}; "
              f"{outcome.seconds:.0f} s.", ""]
     lines += start_section(outcome, base)
     lines += search_section(outcome, prover)
     lines += archive_section(outcome, settings)
     lines += fresh_section(outcome, objective, check, fresh, best, names)
-    lines += ["", "## The tables", "",
-              "Each is written in the document's layout with its `check` report beside it (`NAME.check.txt`); "
-              "rows evolution changed say so in their description. Simulate one as it was evolved:", ""]
+    lines += tables_section(outcome, objective, written, replay)
+    return "\n".join(lines) + "\n"
+
+
+def tables_section(outcome: Outcome, objective: Measure, written: list[Written], replay: Replay) -> list[str]:
+    """Every table written, with the ``tablebot sim`` that runs it in each world (a folder of its own
+    under OUT/sim for each), and the ``tablebot sweep`` that runs one on all the search's scenarios."""
+    several = len(replay.worlds) > 1
+    lines = ["", "## The tables", "",
+             "Each is written in the document's layout with its `check` report beside it (`NAME.check.txt`); "
+             "rows evolution changed say so in their description. Simulate one as it was evolved"
+             + (f", in each of the {len(replay.worlds)} worlds:" if several else ":"), ""]
     for w in written:
         status = "every property holds" if w.holds else "A PROPERTY FAILS"
-        objective_value = outcome.means[w.key][objective.name]
-        lines.append(f"- `{w.path.name if '/' not in w.label else w.label + '.csv'}` ({status}; {objective.name} "
-                     f"{objective_value:.3f} on the search scenarios): `{sim_command(w.path, base, world)}`")
-    return "\n".join(lines) + "\n"
+        head = (f"- `{w.label}.csv` ({status}; {objective.name} {outcome.means[w.key][objective.name]:.3f} on the "
+                "search scenarios)")
+        commands = sim_commands(w.path, w.label, replay)
+        if several:
+            lines += [f"{head}:", *(f"  - in {world}: `{command}`"
+                                    for world, (_, command) in zip(replay.worlds, commands, strict=True))]
+        else:
+            lines.append(f"{head}: `{commands[0][1]}`")
+    if written:
+        first = next((w for w in written if w.label == "best-1"), written[0])
+        lines += ["", f"Run a table on every scenario and world it was evolved on at once (`{first.label}` here; "
+                  "any table above in its place):", "", f"`{sweep_command(first.path, first.label, replay)}`"]
+    return lines
 
 
 def start_section(outcome: Outcome, base: Table) -> list[str]:

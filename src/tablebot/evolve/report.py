@@ -119,15 +119,54 @@ def check_text(report: CheckReport, prover: Prover) -> str:
     return "\n".join(lines) + "\n"
 
 
-def sim_command(path: Path, base: Table, world: str, seed: int | None = None) -> str:
-    """``tablebot sim`` of a written table with the robot file and world it was evolved with (beside it in
-    OUT there are neither, and on its own it would be read as the built-in BumberBot)."""
-    words = ["tablebot", "sim", str(path)]
-    for option, given in (("--robot", base.robot.source), ("--world", world)):
-        if given and Path(given).is_file():
-            words += [option, str(given)]
-    if seed is not None:
-        words += ["--seed", str(seed)]
+@dataclass(frozen=True)
+class Replay:
+    """How the written tables were run, for the commands that run one again: the robot file, every world,
+    the seconds of each run, the search's ``--seeds`` and ``--grid``, and the output folder."""
+
+    robot: str | None
+    worlds: tuple[str, ...]
+    seconds: float
+    seeds: str
+    grid: tuple[str, ...]
+    out: Path
+
+
+def _files_given(replay: Replay, worlds: Sequence[str]) -> list[str]:
+    """``--robot`` and ``--world`` for the files the search read (beside a written table in OUT there are
+    neither, and on its own the table would be read as the built-in BumberBot)."""
+    words = ["--robot", str(replay.robot)] if replay.robot and Path(replay.robot).is_file() else []
+    for world in worlds:
+        if world and Path(world).is_file():
+            words += ["--world", str(world)]
+    return words
+
+
+def world_names(worlds: Sequence[str]) -> list[str]:
+    """A short name per world (its file's stem; numbered when two stems are the same)."""
+    stems = [Path(w).stem or "world" for w in worlds]
+    return [stem if stems.count(stem) == 1 else f"{k + 1}-{stem}" for k, stem in enumerate(stems)]
+
+
+def sim_commands(path: Path, label: str, replay: Replay) -> list[tuple[str, str]]:
+    """Per world of the search, its name and the ``tablebot sim`` of a written table there, as long as the
+    search ran it, into its own folder under ``OUT/sim`` (so no run writes over another's)."""
+    names = world_names(replay.worlds)
+    found = []
+    for world, name in zip(replay.worlds, names, strict=True):
+        out = replay.out / "sim" / label if len(replay.worlds) == 1 else replay.out / "sim" / label / name
+        words = ["tablebot", "sim", str(path), *_files_given(replay, [world]), "--seconds", f"{replay.seconds:g}",
+                 "--out", str(out)]
+        found.append((name, " ".join(shell_word(word) for word in words)))
+    return found
+
+
+def sweep_command(path: Path, label: str, replay: Replay) -> str:
+    """``tablebot sweep`` of a written table on every world and scenario the search ran it on."""
+    words = ["tablebot", "sweep", str(path), *_files_given(replay, replay.worlds), "--seeds", replay.seeds]
+    for grid in replay.grid:
+        words += ["--grid", grid]
+    words += ["--seconds", f"{replay.seconds:g}", "--out", str(replay.out / "sweep" / label)]
     return " ".join(shell_word(word) for word in words)
 
 
@@ -135,15 +174,15 @@ def sim_command(path: Path, base: Table, world: str, seed: int | None = None) ->
 
 
 def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-             start: tuple[float, ...] | None, path: Path) -> Path:
+             start: tuple[float, ...] | None, path: Path, start_label: str = "the starting table") -> Path:
     from tablebot.sim.draw import literal_text
 
     with literal_text():
-        return _heat_map(archive, descriptors, objective, history, start, path)
+        return _heat_map(archive, descriptors, objective, history, start, path, start_label)
 
 
 def _heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-              start: tuple[float, ...] | None, path: Path) -> Path:
+              start: tuple[float, ...] | None, path: Path, start_label: str) -> Path:
     """Left: each cell's elite coloured by its objective (the start marked); right: the best objective
     and the cells filled as the evaluations went on."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -170,17 +209,19 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         ax.set_ylabel(f"{second.name}")
         if start is not None:
             ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
-                    color="#e8413a", markersize=12, mew=2.5, label="the starting table")
-            ax.legend(fontsize=8, loc="upper right")
+                    color="#e8413a", markersize=12, mew=2.5, label=start_label,
+                    clip_on=False)  # on the grid's edge (a value beyond the range) it shows whole
+            ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)  # off the cells
     else:
         width = (first.high - first.low) / first.cells
         lefts = [first.low + c[0] * width for c in cells]
         ax.bar(lefts, values, width=width * 0.9, align="edge", color="#20bf6b")
-        ax.set_ylabel(objective.name)
+        ax.set_xlim(first.low, first.high)  # the whole range, empty cells too
+        ax.set_ylabel(f"{objective.name} ({objective.better} is better)")
         if start is not None:
             ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--",
-                       label="the starting table")
-            ax.legend(fontsize=8)
+                       label=start_label)
+            ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)
     ax.set_xlabel(first.name)
     ax.set_title(f"archive: {len(values)} elites in {int(np.prod([d.cells for d in descriptors]))} cells",
                  fontsize=11)
@@ -194,8 +235,9 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
     twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
               label="cells filled")
     twin.set_ylabel("cells filled (%)")
-    side.legend(loc="upper left", fontsize=8)
-    twin.legend(loc="lower right", fontsize=8)
+    (lines, labels), (more_lines, more_labels) = side.get_legend_handles_labels(), twin.get_legend_handles_labels()
+    side.legend(lines + more_lines, labels + more_labels, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                fontsize=8, frameon=False)  # under the axes: inside, each legend covered one of the two lines
     side.set_title("search", fontsize=11)
     fig.tight_layout()
     return save(fig, path)
