@@ -280,11 +280,11 @@ def main() -> int:
     print(f"  numba threading layer {threading_layer()}, OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}")
 
     if not args.no_evolve:
-        budget, evolve_s = (4, 5.0) if args.quick else (16, 10.0)
+        budget, evolve_s = (16, 2.0) if args.quick else (32, 10.0)  # whole() runs --batch 16
         runs = [evolve_rates(budget, evolve_s) for _ in range(args.repeat)]
         print(f"evolve --budget {budget} --seeds 0..15 --seconds {evolve_s:g}, whole process: "
               f"{med(r['wall'] for r in runs):.2f} s, {med(r['tables/s'] for r in runs):.2f} candidates/s, "
-              f"{med(r['robot-ticks/s'] for r in runs) / 1e6:.2f} M robot-ticks/s (waiting for the fleet "
+              f"{med(r['robot-ticks/s'] for r in runs) / 1e3:,.0f} k robot-ticks/s (waiting for the fleet "
               f"{med(r['fleet'] for r in runs):.2f} s, proofs {med(r['proofs'] for r in runs):.2f} s)")
     if not args.no_memory:
         robots, seconds = (1_000, 10.0) if args.quick else (10_000, 60.0)
