@@ -97,3 +97,33 @@ def test_light_falls_with_distance_squared(tmp_path: Path) -> None:
         readings.append(simulate(scene_of(table, world), 0.1).hist[0, L.LIGHT_R])
     assert abs(readings[0] - 2.0 / 0.5**2) < 1e-9  # intensity 2 straight on at 0.5 m
     assert abs(readings[0] / readings[1] - 4.0) < 1e-9
+
+
+def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path: Path) -> None:
+    """physics.light_side first asks sensing.no_lamp_in_view (no cos/sin of the aim, no hypot) and answers 0.0
+    when it says every lamp is out of view: that must be exactly light_from's answer, also for lamps a hair
+    inside or outside the field of view's edge and for headings after thousands of turns."""
+    import math
+
+    from tablebot.sim.physics import light_at
+    from tablebot.sim.sensing import light_from
+
+    scene = bumberbot_in(tmp_path, room(extra="[[lamp]]\nat = [2.0, 1.5]\nintensity = 3.0\n"))
+    p, g = scene.P[0], scene.geometry
+    fov = math.acos(p[L.P_COS_FOV])
+    rng = np.random.default_rng(3)
+    s, hidden = np.zeros(L.N_STATE), 0
+    for k in range(6000):
+        side = -1.0 if k % 2 else 1.0
+        s[L.X], s[L.Y] = rng.uniform(0.3, 2.7), rng.uniform(0.3, 2.7)
+        turns = rng.integers(-2000, 2000) * 2 * math.pi
+        # aim at the lamp, then off by the field of view plus or minus a hair (or anything)
+        sx, sy = s[L.X] + p[L.P_LX], s[L.Y] + side * p[L.P_LY]
+        towards = math.atan2(1.5 - sy, 2.0 - sx) - side * p[L.P_TOE]
+        off = fov * rng.choice([-1.0, 1.0]) + rng.choice([0.0, 1e-13, -1e-13, 1e-9, -1e-9, rng.uniform(-3, 3)])
+        s[L.TH] = towards + off + turns
+        c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
+        exact = light_from(s, c, sn, p, p[L.P_LX], side * p[L.P_LY], side * p[L.P_TOE], g.edges, g.circles, g.lamps)
+        assert light_at(s, p, side, g.edges, g.circles, g.lamps) == exact
+        hidden += exact == 0.0
+    assert 1000 < hidden < 5000  # both sides of the edge were tried

@@ -220,36 +220,65 @@ def test_a_table_too_wide_for_the_compiled_fleet_is_a_clear_error(tmp_path: Path
     assert "the table has 11 event columns; the compiled fleet takes at most 10" in result.output
 
 
-def test_a_cluster_worker_warms_the_kernel_in_a_cache_folder_of_its_own(tmp_path: Path) -> None:
+def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: Path) -> None:
     """A worker started without NUMBA_CACHE_DIR keeps its compiled kernels in worker-SLOT of the user's
-    tablebot cache. The folder is seeded here with this process's cache, so the worker only loads (no
-    compile, no file written): a worker of a real cluster compiles there once, alone."""
+    tablebot cache. A fresh one (an empty cache) is sent this process's compiled code with the warm-up
+    task and loads it: every file it was sent lands there, and nothing else (it compiled nothing)."""
     import pickle
-    import shutil
 
     from tablebot import jit
     from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import warm
 
+    plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)
+    job = plan.jobs()[0]
+    warm(job)  # this process's cache holds the kernel a worker of one thread runs
+    files = jit.cache_files()
     home = tmp_path / "cache"
-    shared = Path(jit.cache_dir())
     version = f"py{sys.version_info.major}{sys.version_info.minor}"
     mine = home / "tablebot" / f"numba-{version}-{jit.sources_digest()}" / "worker-testhost-0"
-    for folder in shared.iterdir():
-        if folder.is_dir() and not folder.name.startswith("worker-"):
-            shutil.copytree(folder, mine / folder.name)
-    before = sorted(p.relative_to(mine) for p in mine.rglob("*"))
-    plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)
-    (tmp_path / "job.pickle").write_bytes(pickle.dumps(plan.jobs()[0]))
-    code = ("import json, pickle, sys; from tablebot.fleet.work import warm_worker; "
-            "job = pickle.load(open(sys.argv[1], 'rb')); print(json.dumps(warm_worker(job, 'testhost-0', 2)))")
+    (tmp_path / "job.pickle").write_bytes(pickle.dumps((job, files)))
+    code = ("import json, os, pickle, sys; from tablebot.fleet.work import job_threads, warm_worker; "
+            "job, files = pickle.load(open(sys.argv[1], 'rb')); "
+            "info = warm_worker(job, 'testhost-0', os.cpu_count(), files); "
+            "print(json.dumps({**info, 'job_threads': job_threads(job)}))")
     worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
     worker_env["XDG_CACHE_HOME"] = str(home)
     done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
-                          capture_output=True, text=True, timeout=120)
+                          capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     info = json.loads(done.stdout.strip().splitlines()[-1])
-    assert info["cache"] == str(mine) and info["threads"] == max(1, (os.cpu_count() or 1) // 2)
-    assert sorted(p.relative_to(mine) for p in mine.rglob("*")) == before  # loaded, not compiled
+    assert info["cache"] == str(mine) and info["threads"] == 1
+    assert info["job_threads"] == 1  # a job without threads of its own takes the worker's share of the cores
+    sent = sorted(name for named in files.values() for name in named)
+    assert info["installed"] == len(sent) > 0
+    landed = sorted(p.name for p in mine.rglob("*") if p.is_file())
+    assert landed == sent  # loaded, not compiled: a compile would have added or rewritten files
+    for relative, named in files.items():
+        folder = next(p for p in mine.iterdir() if p.name.startswith((Path(relative).parent.name or "tablebot") + "_"))
+        assert all((folder / name).read_bytes() == data for name, data in named.items())
+
+
+def test_a_job_with_threads_of_its_own_runs_on_them() -> None:
+    """What a job runs on is the fleet's to say and set (evolve's jobs ask it too); numba keeps the count per
+    calling thread, and this process is no cluster worker, so a job without threads leaves it alone."""
+    from dataclasses import replace
+
+    import numba
+
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import job_threads, use_threads
+
+    job = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0).jobs()[0]
+    before = numba.get_num_threads()
+    try:
+        assert job_threads(job) is None and job_threads(replace(job, threads=1)) == 1
+        use_threads(replace(job, threads=1))
+        assert numba.get_num_threads() == 1
+        use_threads(job)
+        assert numba.get_num_threads() == 1
+    finally:
+        numba.set_num_threads(before)
 
 
 def test_a_sweep_draws_its_pictures(tmp_path: Path) -> None:

@@ -125,3 +125,37 @@ def test_inputs_pulses_must_be_counts(tmp_path, value):
     machine = compile_table(load_table(write_table(tmp_path, table, COUNTER_ROBOT)))
     (d,) = inputs_error(tmp_path, f"C1\n{value}\n", machine)
     assert "pulse count" in d.message and (d.line, d.column) == (2, 1)
+
+
+def test_the_compiled_trace_writer_writes_pythons_bytes() -> None:
+    """sinks.trace_text writes a simulator block's lines in compiled code: every number as Python writes it
+    (json: repr of the rounded double, exponent form below 1e-4, -0.0, ties rounded half to even on the
+    binary value), state names as JSON (quotes, non-ASCII), rows null when none fired."""
+    import numpy as np
+
+    from tablebot.formats.trace_lines import exact_round_array
+    from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_bytes, json_names
+
+    rng = np.random.default_rng(4)
+    n = 20_000
+    hairs = rng.choice([0.0, 5e-6, -5e-6, 4.99999e-6], n // 4)  # ties and near-ties at five places
+    raw = np.concatenate([rng.uniform(-3, 3, n // 4), rng.uniform(-1e-4, 1e-4, n // 4),
+                          rng.integers(-10**6, 10**6, n // 4) / 10**5 + hairs,
+                          rng.choice([0.0, -0.0, 1e-5, -1e-5, 9.5e-5, 1e-4, 123456.78912, -7.0, 0.5, 2.5e-6], n // 4)])
+    states = ["Seek", 29, "Dreh\u00fcng \"rechts\"", "\u2028x"]
+    names = json_names(states)
+    ints = rng.integers(-(2**40), 2**40, n)
+    rows = rng.integers(-1, 30, n)
+    which = rng.integers(0, len(states), n)
+    for places in (1, 3, 4, 5, 6):
+        rounded = exact_round_array(raw, places)
+        text = block_bytes([b'{"t":', b',"row":', b',"state":', b',"x":', b"}\n"], [INT, ROW, STATE, DECIMAL],
+                           [ints, rows, which, rounded], [0, 0, 0, places], names)
+        assert text is not None
+        expected = "".join(json.dumps({"t": int(i), "row": None if r < 0 else int(r), "state": states[s], "x": x},
+                                      separators=(",", ":"), ensure_ascii=False) + "\n"
+                           for i, r, s, x in zip(ints, rows, which, rounded.tolist(), strict=True))
+        assert text.decode() == expected
+    # what it cannot write the Python way, it leaves to Python
+    assert block_bytes([b"", b"\n"], [DECIMAL], [np.array([np.inf])], [3], []) is None
+    assert block_bytes([b"", b"\n"], [DECIMAL], [np.array([2.0**60])], [3], []) is None

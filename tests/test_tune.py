@@ -187,3 +187,12 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     assert "".join(fleet.trace_lines(0)) == trace_text(alone)
     with pytest.raises(Exception, match="leaves C1 alone"):
         parse_cells("line 2 C1_load", plan.table)
+
+
+def test_generations_are_cut_into_even_jobs_for_the_workers() -> None:
+    from tablebot.fleet.tune import split
+
+    assert split(528, 2) == [(0, 264), (264, 528)]  # not 512 + 16: one worker would wait on the other
+    assert [b - a for a, b in split(1100, 2)] == [275] * 4  # 3 jobs would leave a worker idle half the time
+    assert split(512, 2) == [(0, 512)] and split(40, 8) == [(0, 40)]  # one job: it runs on every core at once
+    assert all(b - a <= 512 for a, b in split(100_000, 3)) and split(100_000, 3)[-1][1] == 100_000

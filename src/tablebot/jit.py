@@ -9,6 +9,8 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
+import uuid
+from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -35,19 +37,31 @@ def cache_dir() -> str:
 COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py")
 
 
+ROOT = Path(__file__).resolve().parent  # the tablebot package
+
+
 def sources_digest() -> str:
     """A short digest of the tablebot sources that end up in compiled code (every file that compiles a
     function, and the constants they read)."""
-    root = Path(__file__).resolve().parent
     digest = hashlib.sha1()
-    for path in sorted(root.rglob("*.py")):
+    for path in sorted(ROOT.rglob("*.py")):
         text = path.read_bytes()
         if b"njit" in text or path.name in COMPILED_CONSTANTS:
-            digest.update(str(path.relative_to(root)).encode() + b"\0" + text)
+            digest.update(str(path.relative_to(ROOT)).encode() + b"\0" + text)
     return digest.hexdigest()[:12]
 
 
+def compiled_sources() -> list[Path]:
+    """The tablebot source files that define compiled functions."""
+    return [path for path in sorted(ROOT.rglob("*.py")) if b"njit" in path.read_bytes()]
+
+
 os.environ.setdefault(ENV, cache_dir())  # before numba's first import, which reads its configuration
+# numba's OpenMP threads wait for their next job asleep, not spinning: a fleet's call is milliseconds of work,
+# against the microseconds of a wake-up, and a spinning thread takes a core from whoever runs meanwhile (the
+# calling thread's Python between blocks, small fleets run on it alone, other programs) -- on a busy 2-core
+# machine a 1-robot fleet's tick took 31 us with spinning threads, 0.9 us without. Read when OpenMP starts.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 import numba  # noqa: E402  (after the cache folder is set)
 
@@ -78,9 +92,81 @@ def say_compiling(what: str, *functions: Any) -> None:
               "once)…", file=sys.stderr, flush=True)
 
 
-def njit(*args: Any, **kwargs: Any) -> Callable[..., Any]:
-    """``numba.njit`` with the on-disk cache on: ``@njit`` or ``@njit(parallel=True)``."""
+def njit(*args: Any, refcounts: bool = True, **kwargs: Any) -> Callable[..., Any]:
+    """``numba.njit`` with the on-disk cache on: ``@njit`` or ``@njit(parallel=True)``.
+
+    ``refcounts=False`` compiles the function without numba's reference counting (its ``_nrt`` option):
+    every array a compiled function receives or slices is otherwise counted with an atomic increment and
+    decrement, and in the simulator's per-tick functions -- small, many, each handed a dozen arrays -- those
+    were half of a tick's time. Such a function must not create arrays (it cannot free them); it may use
+    the arrays it is given, and views of them, freely.
+
+    The simulator's per-tick functions are also made with ``inline="always"`` (numba inlines them into
+    their caller before compiling it): numba hands each array to a call as seven machine words, and the
+    physics' calls of a dozen arrays each cost more than the small functions' own work (a BumberBot tick
+    ~630 -> ~420 ns). Inlining everything down to the geometry would take ten times as long to compile
+    and run no faster, so the leaves stay calls.
+    """
     kwargs.setdefault("cache", True)
+    if not refcounts:
+        kwargs["_nrt"] = False
     if args and callable(args[0]) and len(args) == 1 and not kwargs.keys() - {"cache"}:
         return numba.njit(cache=kwargs["cache"])(args[0])
     return numba.njit(*args, **kwargs)
+
+
+# --- handing compiled code to another process (a fresh cluster worker) -------------------------------------------
+#
+# numba keeps each function's machine code in its cache folder as an index (FUNCTION-LINE.pyXY.nbi: which
+# signature and CPU is in which data file, stamped with a hash of the source file's bytes) and data files
+# (FUNCTION-LINE.pyXY.N.nbc); the folder is named after the source file's directory. Nothing in them names
+# the path, so the files of one install serve another install of the same sources: copied into the folder
+# numba looks in there, they load instead of compiling (a worker of another CPU model, or with other sources,
+# finds no matching entry and compiles as before).
+
+
+def _cache_folder(source: Path) -> Path:
+    from numba.core.caching import UserProvidedCacheLocator
+
+    return Path(numba.config.CACHE_DIR) / UserProvidedCacheLocator.get_suitable_cache_subpath(str(source))
+
+
+def cache_files() -> dict[str, dict[str, bytes]]:
+    """tablebot's compiled code in this process's numba cache: per source file (relative to the package),
+    every index and data file by name."""
+    out: dict[str, dict[str, bytes]] = {}
+    for source in compiled_sources():
+        folder = _cache_folder(source)
+        if not folder.is_dir():
+            continue
+        found = {path.name: path.read_bytes() for path in folder.iterdir()
+                 if path.name.startswith(source.stem + ".") and path.suffix in (".nbi", ".nbc")}
+        if found:
+            out[source.relative_to(ROOT).as_posix()] = found
+    return out
+
+
+def install_cache_files(files: dict[str, dict[str, bytes]]) -> int:
+    """Put another process's compiled code (:func:`cache_files`) into this process's numba cache, for every
+    function this cache has no index of (an index here is never replaced, nor its data files touched);
+    returns the files written. Each file is written under a temporary name and renamed into place, data
+    files before their index, so a process loading meanwhile sees a whole function or none."""
+    written = 0
+    for relative, found in files.items():
+        source = ROOT / relative
+        if not source.is_file():
+            continue
+        folder = _cache_folder(source)
+        folder.mkdir(parents=True, exist_ok=True)
+        functions: dict[str, list[str]] = defaultdict(list)
+        for name in found:
+            functions[name[:-4] if name.endswith(".nbi") else name.rsplit(".", 2)[0]].append(name)
+        for function, names in functions.items():
+            if (folder / f"{function}.nbi").exists():
+                continue
+            for name in sorted(names, key=lambda n: n.endswith(".nbi")):  # the index last
+                temporary = folder / f"{name}.{uuid.uuid4().hex[:12]}.tmp"
+                temporary.write_bytes(found[name])
+                os.replace(temporary, folder / name)
+                written += 1
+    return written

@@ -62,10 +62,11 @@ def sim_cmd(
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
-    _import_drawing(plots, gif, html)
+    drawing = _import_drawing(plots, gif, html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
         result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+        drawing.join()
         if result.end.complete:
             summary = summarise(result)
             written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
@@ -80,15 +81,39 @@ def sim_cmd(
         show(result, summary)
 
 
-def _import_drawing(plots: bool, gif: bool, html: bool) -> None:
-    """The picture modules (matplotlib, PIL), imported before the run rather than after it: Ctrl-C while a
-    compiled module is being imported surfaces as an ImportError, and matplotlib's takes a good second."""
-    import importlib
+class _Imports:
+    """The picture modules (matplotlib, PIL) imported by a thread of their own while the robot runs: the
+    run's compiled loop leaves the other core (and the GIL) to them, so their half second or more costs
+    nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut an import short (a
+    compiled module interrupted mid-import surfaces as an ImportError). :meth:`join` waits for them and
+    raises what an import raised."""
 
+    def __init__(self, modules: list[str]):
+        import threading
+
+        self.modules, self.failed = modules, None
+        self.thread = threading.Thread(target=self._run, name="picture imports", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        import importlib
+
+        try:
+            for module in self.modules:
+                importlib.import_module(module)
+        except BaseException as exc:  # raised in the main thread by join
+            self.failed = exc
+
+    def join(self) -> None:
+        self.thread.join()
+        if self.failed is not None:
+            raise self.failed
+
+
+def _import_drawing(plots: bool, gif: bool, html: bool) -> _Imports:
+    """Start importing the picture modules the run will need (see :class:`_Imports`)."""
     wanted = [("tablebot.sim.plots", plots), ("tablebot.sim.animate", gif), ("tablebot.web.replay", html)]
-    for module, used in wanted:
-        if used:
-            importlib.import_module(module)
+    return _Imports([module for module, used in wanted if used])
 
 
 def _stopped(result: SimRun, kept: Path | None) -> None:

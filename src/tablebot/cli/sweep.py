@@ -21,7 +21,7 @@ BACKEND_OPT = typer.Option("auto", "--backend", help="local (this machine's core
                            "dask when a scheduler is named, else local.")
 SCHEDULER_OPT = typer.Option(None, "--scheduler", help="Dask scheduler address, tcp://HOST:8786 (or set "
                              "DASK_SCHEDULER_ADDRESS).")
-WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local processes (default: one per core).")
+WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local worker threads (default: one per core).")
 
 
 @app.command("sweep")
@@ -63,10 +63,10 @@ def sweep_cmd(
     jobs = plan.jobs(skip=finished)
     total, already = plan.spec.total, sum(b - a for a, b in finished)
     if chosen == "local" and jobs:
-        from tablebot.fleet.kernel import run_fleet
+        from tablebot.fleet.kernel import run_fleet, run_fleet_serial
         from tablebot.jit import say_compiling
 
-        say_compiling("the fleet simulator", run_fleet)
+        say_compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one chunk: threaded
     started = time.perf_counter()
     with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
         def done(job: Any, summary: Any) -> None:

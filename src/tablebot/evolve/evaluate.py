@@ -42,15 +42,11 @@ class EvalJob(Job):
 
 def run_eval(job: EvalJob) -> tuple[EvalJob, dict[str, np.ndarray]]:
     """Run the job's robots as one fleet; per robot, every measure (a worker's entry point)."""
-    from tablebot.fleet import work as fleet_work
     from tablebot.fleet.run import Fleet
+    from tablebot.fleet.work import use_threads
     from tablebot.machine import compile_table
 
-    threads = job.threads or fleet_work._worker_threads
-    if threads is not None:
-        import numba
-
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    use_threads(job)
     fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params)
     poses = Poses(fleet, job.world)
     fleet.run(job.ticks, progress=lambda done: poses.sample(), block_ticks=job.stride)

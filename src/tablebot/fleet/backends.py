@@ -1,11 +1,12 @@
-"""Where the chunks of a sweep or a tuning run go: this machine's cores (one process per core, each
-running whole chunks) or a Dask cluster (each chunk one task). Both hand every finished chunk to a
+"""Where the chunks of a sweep or a tuning run go: this machine's cores (a thread per core in this process,
+each running whole chunks) or a Dask cluster (each chunk one task). Both hand every finished chunk to a
 callback as it comes back, so an interrupted run keeps what finished.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -50,12 +51,13 @@ def run_jobs(jobs: Sequence[Job], done: Done, backend: str = "local", address: s
 
 class Runner:
     """A backend kept open over many batches of jobs (a tuning run sends one batch per generation):
-    the local worker processes or the Dask client start, and warm up, once."""
+    the local worker threads or the Dask client start, and warm up, once."""
 
     def __init__(self, backend: str = "local", address: str | None = None, workers: int | None = None):
         self.backend, self.address, self.workers = backend, address, workers
         self.pool: Any = None
         self.client: Any = None
+        self.stop = threading.Event()  # set on Ctrl-C: local chunks end at their next block, unfinished
         self.info: dict[str, Any] = {"workers": 0}
 
     def __enter__(self) -> Runner:
@@ -63,6 +65,14 @@ class Runner:
 
     def __exit__(self, kind: object, *rest: object) -> None:
         self.close(failed=kind is not None)
+
+    def slots(self) -> int:
+        """How many jobs the backend runs at once: its worker threads (or the cluster's)."""
+        if self.backend == "dask":
+            if self.client is None:
+                return 1
+            return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
+        return max(1, self.workers or os.cpu_count() or 1)
 
     def run(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]] = run_job) -> None:
         """Run every job with ``fn`` (default: the fleet's :func:`run_job`; evolve measures more per robot),
@@ -77,39 +87,51 @@ class Runner:
     def close(self, failed: bool = False) -> None:
         if self.pool is not None:
             if failed:
-                self.pool.terminate()  # Ctrl-C: the workers stop at once; what finished was handed over already
-            else:
-                self.pool.close()
-            self.pool.join()
+                self.stop.set()  # Ctrl-C: running chunks end within a block; what finished was handed over already
+            self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
         if self.client is not None:
             self.client.close()
             self.client = None
 
-    # --- this machine: one process per core (``workers``), each running whole chunks single-threaded
+    def _call(self, fn: Callable[..., tuple[Job, Any]], job: Job) -> tuple[Job, Any]:
+        """``fn(job)``; the fleet's own run_job also stops at its next block when the run is stopped."""
+        return fn(job, self.stop) if fn is run_job else fn(job)
+
+    # --- this machine: a thread per core (``workers``), each running whole chunks single-threaded
+    #
+    # Threads, not processes: the compiled fleet loop releases the GIL, so two threads run two chunks on two
+    # cores, and this process's compiled code serves both -- no worker processes to start, no Python, numpy and
+    # numba to import again in each, no jobs and summaries to pickle across (seconds of a short sweep's time).
 
     def _run_local(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         workers = max(1, self.workers or os.cpu_count() or 1)
-        if workers == 1 or (len(jobs) == 1 and self.pool is None):
-            self.info = {"workers": 1, "processes": "this one"}
+        if workers == 1 or len(jobs) == 1:  # numba's own threads share each chunk's robots out
+            self.info = {"workers": 1, "threads": "numba's"}
             for job in jobs:
-                done(*fn(job))
+                done(*self._call(fn, job))
             return
         if self.pool is None:
-            import multiprocessing
+            from concurrent.futures import ThreadPoolExecutor
 
-            warm(jobs[0])  # this process fills the user's numba cache first: the workers only read it
-            context = multiprocessing.get_context("spawn")  # never fork a process that holds numba's threads
-            self.pool = context.Pool(workers, initializer=_ignore_interrupts)
-            self.info = {"workers": workers, "processes": "local"}
-        for job, summary in self.pool.imap_unordered(fn, [replace(j, threads=1) for j in jobs]):
-            done(job, summary)
+            self.pool = ThreadPoolExecutor(workers, thread_name_prefix="tablebot-fleet")
+            self.info = {"workers": workers, "threads": "local"}
+        from concurrent.futures import as_completed
+
+        futures = [self.pool.submit(self._call, fn, replace(job, threads=1)) for job in jobs]
+        try:
+            for future in as_completed(futures):
+                done(*future.result())
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
 
     # --- a Dask cluster: each chunk one task
 
     def _run_dask(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
-        """Every worker first warms the kernel in a cache folder of its own (one compile per worker,
-        never two processes writing one folder); then the chunks go out."""
+        """Every worker first warms the kernel in a cache folder of its own, from this process's compiled
+        code (a fresh worker loads it instead of compiling again); then the chunks go out."""
         if self.client is None:
             self.client = connect(self.address or "")  # first: it says what to install when Dask is missing
             self.info = warm_cluster(self.client, jobs[0])
@@ -123,13 +145,6 @@ class Runner:
         except BaseException:
             client.cancel(futures)
             raise
-
-
-def _ignore_interrupts() -> None:
-    """Workers leave Ctrl-C to the parent, which stops them (no half-written results, no tracebacks)."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 # --- a Dask cluster ---------------------------------------------------------------------------------
@@ -149,10 +164,15 @@ def connect(address: str) -> Any:
 
 
 def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
-    """Warm every worker (pinned to it), with a cache slot named by its host and its rank there."""
+    """Warm every worker (pinned to it), with a cache slot named by its host and its rank there, from this
+    process's compiled code: compiled (or loaded) here once, sent to every worker once."""
     workers = client.scheduler_info(n_workers=-1)["workers"]
     if not workers:
         raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
+    from tablebot import jit
+
+    warm(job, both=True)  # both kernels: a worker alone on its machine runs chunks on all its cores
+    files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
     by_host: dict[str, list[str]] = defaultdict(list)
     for address, worker in sorted(workers.items()):
         by_host[worker.get("host", address)].append(address)
@@ -160,7 +180,7 @@ def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
     for host, addresses in by_host.items():
         for rank, address in enumerate(addresses):
             slot = f"{host}-{rank}".replace(":", "_").replace("/", "_")
-            futures.append(client.submit(warm_worker, job, slot, len(addresses), workers=[address],
+            futures.append(client.submit(warm_worker, job, slot, len(addresses), files, workers=[address],
                                          allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}"))
     try:
         warmed = client.gather(futures)

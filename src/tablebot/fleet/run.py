@@ -1,8 +1,9 @@
 """Many simulated robots of one table in one world, advanced together in compiled code (sim.fleet_kernel).
 
 Each robot is set up by :class:`~tablebot.sim.simrobot.SimRobot` itself (start row, gains, first reading,
-its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does, so robot k
-of a fleet gives the trace ``tablebot sim`` gives for the same table, world, start, battery and seed.
+its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does (inside the
+compiled loop, sim.normals), so robot k of a fleet gives the trace ``tablebot sim`` gives for the same
+table, world, start, battery and seed.
 """
 
 from __future__ import annotations
@@ -15,12 +16,13 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
-from tablebot.fleet.kernel import NO_TICK, move_fleet, run_fleet
+from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
+from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.scene import Scene, _check_start, prepare
@@ -32,7 +34,7 @@ from tablebot.sinks.trace_file import block_lines
 from tablebot.table import Table
 from tablebot.tick import STATE, registers
 
-BLOCK_TICKS = 256  # ticks per compiled call: each robot's noise for one block is drawn before it
+BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced robots' blocks kept, per block)
 FLEET_COLLISIONS = 16  # collision starts remembered per robot (the count goes on beyond)
 
 
@@ -129,6 +131,7 @@ class Fleet:
         self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
+        self.bitgens = np.zeros(n, dtype=np.uint64)  # where each robot's Generator keeps its C bit generator
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
@@ -154,17 +157,20 @@ class Fleet:
         self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
         self.variant[i], self.battery_start_v[i] = spec.variant, robot.s[L.VBAT]
         self.rngs[i] = robot.rng
+        self.bitgens[i] = bitgen_address(robot.rng)
         return robot
 
     def __len__(self) -> int:
         return len(self.specs)
 
-    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS) -> None:
-        """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block."""
+    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS,
+            threads: bool | None = None) -> None:
+        """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block. ``threads``: run on
+        numba's thread pool (True) or on this thread (False); None: the pool when the work is worth it."""
         done = 0
         while done < ticks:
             b = min(block_ticks, ticks - done)
-            self.step_block(self.draw_noise(b))
+            self.step_block(ticks=b, threads=threads)
             done += b
             if progress:
                 progress(done)
@@ -176,16 +182,26 @@ class Fleet:
             rng.standard_normal(out=noise[i])
         return noise
 
-    def step_block(self, noise: np.ndarray) -> None:
-        """Advance every robot ``noise.shape[1]`` ticks with the given noise rows."""
-        ticks, n_traced = noise.shape[1], len(self.traces)
+    def step_block(self, noise: np.ndarray | None = None, ticks: int | None = None,
+                   threads: bool | None = None) -> None:
+        """Advance every robot ``noise.shape[1]`` ticks with the given noise rows, or ``ticks`` ticks with
+        noise each robot draws from its own Generator as it goes (the same numbers :meth:`draw_noise` gives);
+        ``threads`` as in :meth:`run`."""
+        if noise is None:
+            assert ticks is not None, "give the noise rows or the ticks"
+            noise = np.empty((len(self.specs), 0, L.N_NOISE))
+        else:
+            ticks = noise.shape[1]
+        n_traced = len(self.traces)
         hist = np.zeros((n_traced, ticks, self.S.shape[1]))
         ints = np.zeros((n_traced, ticks, self.width), dtype=np.int64)
         v = self.variants
-        run_fleet(self.S, self.P, self.world, self.machine.arrays.program, v.timers, v.loads, self.variant,  # type: ignore[union-attr]
-                  self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, noise, self.acc,
-                  self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
-                  self.traced, hist, ints)
+        pool = parallel(len(self.specs), ticks) if threads is None else threads
+        kernel = run_fleet if pool else run_fleet_serial
+        kernel(self.S, self.P, self.world, self.machine.arrays.program, v.timers, v.loads, self.variant,  # type: ignore[union-attr]
+               self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, ticks, noise, self.bitgens,
+               self.acc, self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
+               self.traced, hist, ints)
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]

@@ -7,6 +7,7 @@ grid (every value when the budget allows); more with CMA-ES with margin for inte
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections.abc import Callable, Sequence
@@ -175,7 +176,7 @@ class Evaluator:
         metrics = tuple(metrics) or (self.objective,)
         if not candidates:
             return {metric: [] for metric in metrics}
-        jobs = jobs_for(plan, variants_of(plan, self.cells, candidates), len(candidates))
+        jobs = jobs_for(plan, variants_of(plan, self.cells, candidates), len(candidates), self.runner.slots())
         finished: dict[tuple[int, int], dict[str, np.ndarray]] = {}
         def done(job: Job, summary: FleetSummary) -> None:
             finished[job.info["world"], job.first] = {m: losses(m, summary, plan, job.info["world"]) for m in metrics}
@@ -188,8 +189,11 @@ class Evaluator:
         return {metric: (total / plan.spec.total).tolist() for metric, total in sums.items()}
 
 
-def jobs_for(plan: Plan, variants: Variants, count: int) -> list[Job]:
-    """Every candidate on every scenario, cut into jobs of about ROBOTS_PER_JOB robots within one world."""
+def jobs_for(plan: Plan, variants: Variants, count: int, slots: int = 1) -> list[Job]:
+    """Every candidate on every scenario, cut into jobs within one world: at most ROBOTS_PER_JOB robots each,
+    as many jobs as that needs rounded up to a multiple of ``slots`` (the workers that run them at once),
+    and sizes that differ by one robot at most, so that no worker waits on another's last job (528 robots
+    on two workers: 264 + 264, not 512 + 16)."""
     from dataclasses import replace
 
     jobs: list[Job] = []
@@ -198,11 +202,20 @@ def jobs_for(plan: Plan, variants: Variants, count: int) -> list[Job]:
     for world in range(len(plan.spec.worlds)):
         mine = [(run, robot) for run, robot in zip(scenarios, robots, strict=True) if run.world == world]
         specs = [replace(robot, variant=v) for v in range(count) for _, robot in mine]
-        for a in range(0, len(specs), ROBOTS_PER_JOB):
-            chunk = specs[a:a + ROBOTS_PER_JOB]
+        for a, b in split(len(specs), slots):
+            chunk = specs[a:b]
             jobs.append(Job(plan.table, plan.worlds[world], plan.robot_params, chunk, plan.spec.ticks, first=a,
                             variants=variants, info={"world": world, "variants": [s.variant for s in chunk]}))
     return jobs
+
+
+def split(robots: int, slots: int, most: int = ROBOTS_PER_JOB) -> list[tuple[int, int]]:
+    """Robots 0..robots-1 cut into ranges [a, b) of at most ``most``, as many as that needs rounded up to a
+    multiple of ``slots`` (the workers that run them at once), sizes within one robot of each other."""
+    parts = max(1, -(-robots // most))
+    if parts > 1:
+        parts = min(robots, -(-parts // slots) * slots)
+    return list(itertools.pairwise(k * robots // parts for k in range(parts + 1)))
 
 
 # --- search ------------------------------------------------------------------------------------------

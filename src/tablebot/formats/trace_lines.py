@@ -28,15 +28,19 @@ def exact_round(values: Any, digits: int) -> list[float]:
     """``[round(v, digits) for v in values]`` for a float array, vectorised (Python's ``round`` rounds the
     exact binary value half to even; numpy's ``round`` scales first, which can tip a near-half case the
     other way, so those few values are rounded by Python)."""
+    return exact_round_array(values, digits).tolist()
+
+
+def exact_round_array(values: Any, digits: int) -> np.ndarray:
+    """:func:`exact_round` as an array."""
     array = np.asarray(values, dtype=np.float64)
     scaled = array * 10.0**digits
     rounded = np.rint(scaled) / 10.0**digits  # k / 10^d: IEEE division gives the double nearest k·10^-d
     fraction = np.abs(scaled - np.floor(scaled) - 0.5)
     doubtful = np.flatnonzero((fraction < 1e-6) | ~np.isfinite(scaled) | (np.abs(scaled) > 2.0**52))
-    out = rounded.tolist()
     for i in doubtful.tolist():
-        out[i] = round(float(array[i]), digits)
-    return out
+        rounded[i] = round(float(array[i]), digits)
+    return rounded
 
 
 def write_trace(lines: Iterable[dict[str, Any]], stream: IO[str]) -> int:

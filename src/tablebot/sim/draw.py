@@ -7,6 +7,7 @@ never touches a display.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -97,13 +98,15 @@ def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta:
     marked at its middle."""
     body = params["body"]
     f, r, w = body["front"], -body["rear"], body["half_width"]
-    corners = np.array([(f, -w), (f, w), (r, w), (r, -w), (f, -w)])
-    outline = np.concatenate([np.linspace(a, b, max(2, int(math.hypot(*(b - a)) / 0.002)), endpoint=False)
-                              for a, b in itertools.pairwise(corners)])
-    pts = _transform(outline, x, y, theta)[:, None, :]  # (M, 1, 2)
+    pts = _transform(_outline(f, r, w), x, y, theta)[:, None, :]  # (M, 1, 2)
     best, where = math.inf, (x, y)
-    if len(geometry.edges):
-        a, b = geometry.edges[None, :, :2], geometry.edges[None, :, 2:]
+    # only edges and circles that can hold the nearest point (or one within TOUCH_M of it) are sampled: every
+    # outline point lies within ``reach`` of the centre, so a feature farther than the nearest one by more
+    # than 2 reach + TOUCH_M (and a micrometre for rounding) is farther from every point of the outline
+    reach = math.hypot(max(f, -r), w)
+    edges = _near_features(geometry.edges, x, y, 2 * reach + TOUCH_M + 1e-6)
+    if len(edges):
+        a, b = geometry.edges[None, edges, :2], geometry.edges[None, edges, 2:]
         ab = b - a
         t = np.clip(((pts - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)[..., None]
         near = a + t * ab  # (M, E, 2): each sample's nearest point on each edge
@@ -112,8 +115,9 @@ def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta:
         best = float(gap[:, edge].min())
         touching = gap[:, edge] <= best + TOUCH_M
         where = tuple(near[touching, edge].mean(axis=0))
-    if len(geometry.circles):
-        centres, radii = geometry.circles[None, :, :2], geometry.circles[None, :, 2]
+    circles = _near_circles(geometry.circles, x, y, 2 * reach + 1e-6)
+    if len(circles):
+        centres, radii = geometry.circles[None, circles, :2], geometry.circles[None, circles, 2]
         off = pts - centres
         dist = np.hypot(off[..., 0], off[..., 1])
         gap = dist - radii
@@ -121,6 +125,34 @@ def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta:
         if gap[k] < best:
             where = tuple(centres[0, k[1]] + off[k] / max(float(dist[k]), 1e-12) * radii[0, k[1]])
     return float(where[0]), float(where[1])
+
+
+@functools.lru_cache(maxsize=8)
+def _outline(f: float, r: float, w: float) -> np.ndarray:
+    """The body's outline in its own frame, a point every 2 mm (made once per body, not per collision)."""
+    corners = np.array([(f, -w), (f, w), (r, w), (r, -w), (f, -w)])
+    outline = np.concatenate([np.linspace(a, b, max(2, int(math.hypot(*(b - a)) / 0.002)), endpoint=False)
+                              for a, b in itertools.pairwise(corners)])
+    outline.flags.writeable = False
+    return outline
+
+
+def _near_features(edges: np.ndarray, x: float, y: float, slack: float) -> np.ndarray:
+    """Indices (in order) of the edges no farther from (x, y) than the nearest one plus ``slack``."""
+    if not len(edges):
+        return np.zeros(0, dtype=np.int64)
+    a, ab = edges[:, :2], edges[:, 2:] - edges[:, :2]
+    t = np.clip(((np.array([x, y]) - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)
+    distance = np.hypot(*(np.array([x, y]) - a - t[:, None] * ab).T)
+    return np.flatnonzero(distance <= distance.min() + slack)
+
+
+def _near_circles(circles: np.ndarray, x: float, y: float, slack: float) -> np.ndarray:
+    """Indices (in order) of the circles whose rim is no farther from (x, y) than the nearest rim plus ``slack``."""
+    if not len(circles):
+        return np.zeros(0, dtype=np.int64)
+    distance = np.hypot(circles[:, 0] - x, circles[:, 1] - y) - circles[:, 2]
+    return np.flatnonzero(distance <= distance.min() + slack)
 
 
 def _transform(points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:

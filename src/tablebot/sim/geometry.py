@@ -12,7 +12,7 @@ import math
 from tablebot.jit import njit
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def point_segment_distance(px, py, ax, ay, bx, by):
     """Distance from point p to segment ab."""
     ex, ey = bx - ax, by - ay
@@ -28,7 +28,7 @@ FAR = 1.0 + 1e-12
 TINY = 1e-100  # below this, r² loses precision (underflow): such radii always take the exact path
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def within(dx, dy, r, strict=False):
     """``math.hypot(dx, dy) <= r`` (``< r`` when ``strict``): exactly that answer, but hypot (about 15 ns
     here, five times a square root) runs only when the squared distance does not already show that the
@@ -38,7 +38,7 @@ def within(dx, dy, r, strict=False):
     return math.hypot(dx, dy) < r if strict else math.hypot(dx, dy) <= r
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def point_segment_within(px, py, ax, ay, bx, by, r, strict=False):
     """``point_segment_distance(px, py, ax, ay, bx, by) <= r`` (``< r`` when ``strict``), by :func:`within`."""
     ex, ey = bx - ax, by - ay
@@ -48,27 +48,46 @@ def point_segment_within(px, py, ax, ay, bx, by, r, strict=False):
     return within(px - ax - t * ex, py - ay - t * ey, r, strict)
 
 
-@njit(cache=True)
+#: Metres by which both ends of a segment must clear the line through another, beyond the distance asked
+#: about, for :func:`segments_within` to answer without its four distances (rounding is ~1e-15 m here).
+LINE_MARGIN = 1e-9
+
+
+@njit(cache=True, refcounts=False)
 def segments_within(ax, ay, bx, by, cx, cy, dx, dy, r):
     """Whether segments ab and cd come within ``r`` of each other (0 apart when they cross): the nearest
-    of the four endpoint-to-segment distances, each tested by :func:`within`."""
+    of the four endpoint-to-segment distances, each tested by :func:`within`.
+
+    First the sides of a and b against the line through cd (the products :func:`segments_cross` starts
+    with): when both lie on one side, farther from the line than ``r`` by LINE_MARGIN, all of ab is, so
+    neither segment comes within ``r`` of the other and the four distances would all say so."""
+    ex, ey = dx - cx, dy - cy
+    d3 = ex * (ay - cy) - ey * (ax - cx)
+    d4 = ex * (by - cy) - ey * (bx - cx)
+    if d3 * d4 > 0.0:
+        clear = (r + LINE_MARGIN) * (r + LINE_MARGIN) * (ex * ex + ey * ey)
+        if d3 * d3 > clear and d4 * d4 > clear:
+            return False
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
     return (point_segment_within(ax, ay, cx, cy, dx, dy, r) or point_segment_within(bx, by, cx, cy, dx, dy, r)
             or point_segment_within(cx, cy, ax, ay, bx, by, r) or point_segment_within(dx, dy, ax, ay, bx, by, r))
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
-    """Whether segments ab and cd intersect (touching counts)."""
-    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    """Whether segments ab and cd intersect (touching counts). The sides of a and b against line cd are
+    compared first: most pairs are refused there, before the sides of c and d are worked out."""
     d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
     d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
-    return d1 * d2 <= 0.0 and d3 * d4 <= 0.0 and not (d1 == 0.0 and d2 == 0.0)
+    if not d3 * d4 <= 0.0:
+        return False
+    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    return d1 * d2 <= 0.0 and not (d1 == 0.0 and d2 == 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def shadowed(sx, sy, lx, ly, lamp, edges, circles):
     """Whether a wall, obstacle edge or circle blocks the straight line from sensor to lamp."""
     for k in range(edges.shape[0]):

@@ -6,8 +6,9 @@ for many robots, so robot k of a fleet and a single simulated robot cannot diffe
 
 # Per tick t of robot i: the robot's state row ``s`` is the robot at the start of tick t (what its
 # sensors read); the engine ticks on that mask and those pulses; the motors then run for one tick
-# (physics.advance) and the sensors read again for tick t + 1. Every random number comes in through
-# ``noise`` (drawn by the caller from the robot's own numpy Generator), so nothing here is random.
+# (physics.advance) and the sensors read again for tick t + 1. Every random number comes from the robot's
+# own numpy Generator: given as ``noise`` rows, or drawn here from that Generator's C bit generator
+# (sim.normals, the same numbers numpy's standard_normal gives), one row of N_NOISE a tick either way.
 
 from __future__ import annotations
 
@@ -15,9 +16,10 @@ import numpy as np
 
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, X, Y
+from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.geometry import within
-from tablebot.sim.physics import advance
+from tablebot.sim.normals import standard_normal
+from tablebot.sim.physics import advance, aim_turns, new_near, reaches
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -44,7 +46,7 @@ def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
     return acc
 
 
-@njit(nogil=True)
+@njit(nogil=True, refcounts=False, inline="always")
 def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
     """Fold one robot row into the running summary: reaching a lamp and the start of each collision
     (a rise of any bumper or contact with no touch in the debounce rows before it)."""
@@ -68,31 +70,51 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
 
 @njit(nogil=True)
 def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
-              drive, pcols, noise, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
-    """Run one robot for ``noise.shape[0]`` ticks (``noise[t]`` moves it in tick t).
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
+    """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
+    rows, by a row drawn from the numpy Generator whose ``bitgen_t`` is at ``bitgen`` (sim.normals).
 
     Writes the robot at the start of each tick into ``hist`` (when it has rows) and each tick's
     integer record into ``ints`` (when it has rows), and folds every new robot row into
     ``acc``/``collisions`` (see :func:`observe`).
     """
+    near, centre = new_near(pstart, circles)
+    reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
+    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits, drive,
+              pcols, ticks, noise, bitgen, hist, ints, acc, collisions, np.zeros(counters.shape[0], dtype=np.int64),
+              np.empty((4, 2)), reach, wide, near, centre, turns, np.empty(N_NOISE))
+
+
+@njit(nogil=True, refcounts=False)
+def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, pulses, corners, reach, wide, near,
+              centre, turns, z):  # type: ignore[no-untyped-def]
+    """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
     n_counters = counters.shape[0]
-    pulses = np.zeros(n_counters, dtype=np.int64)
-    corners = np.empty((4, 2))
-    for t in range(noise.shape[0]):
+    for t in range(ticks):
         if hist.shape[0]:
-            hist[t, :] = s
+            for j in range(s.shape[0]):
+                hist[t, j] = s[j]
         mask = int(s[MASK])
         for c in range(n_counters):
             pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
         tick_compiled(regs, outputs, counters, mask, pulses, program)
         if ints.shape[0]:
             _record(ints, t, mask, regs, outputs, counters, pulses)
-        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines,
-                noise[t], bits, True, corners)
+        if noise.shape[0]:
+            for k in range(N_NOISE):
+                z[k] = noise[t, k]
+        else:
+            for k in range(N_NOISE):
+                z[k] = standard_normal(bitgen)
+        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, z,
+                bits, True, corners, reach, wide, near, centre, turns)
         observe(s, lamps, acc, collisions)
 
 
-@njit(nogil=True)
+@njit(nogil=True, refcounts=False)
 def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-untyped-def]
     ints[t, I_MASK] = mask
     ints[t, I_EVENT] = regs[EVENT]
@@ -114,12 +136,22 @@ def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-
 @njit(nogil=True)
 def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits):  # type: ignore[no-untyped-def]
     """Read the sensors without moving (the start of a run)."""
-    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)))
+    near, centre = new_near(pstart, circles)
+    reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
+    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)), reach,
+            wide, near, centre, turns)
 
 
 @njit(nogil=True)
 def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, acc,
          collisions):  # type: ignore[no-untyped-def]
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)))
+    near, centre = new_near(pstart, circles)
+    reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)),
+            reach, wide, near, centre, turns)
     observe(s, lamps, acc, collisions)

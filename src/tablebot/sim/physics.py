@@ -81,16 +81,19 @@ from tablebot.sim.columns import (
     Y,
 )
 from tablebot.sim.geometry import point_segment_within, segments_within, within
-from tablebot.sim.sensing import light_from, sense_declared, sensor_events
+from tablebot.sim.sensing import light_from, no_lamp_in_view, sense_declared, sensor_events
 
 NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
 TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)
+#: Metres beyond the bumpers' reach within which pieces are kept as candidates (:func:`refresh_near`): the list
+#: serves every tick until the robot is half this far from where it was made (about ten ticks at full speed).
+NEAR_MARGIN = 0.05
 
 # --- the broad phase and the body ------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def might_be_near(px, py, verts, a, b, pbound, k, reach):
     """Whether convex piece verts[a:b] may come within ``reach`` of point p (the broad phase).
 
@@ -112,32 +115,82 @@ def might_be_near(px, py, verts, a, b, pbound, k, reach):
 
 
 @njit(cache=True)
-def body_corners(s, p, out):
-    """The body rectangle's corners in world coordinates: front-right, front-left, rear-left, rear-right."""
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
+def new_near(pstart, circles):
+    """Scratch space of one robot's candidate list (see :func:`refresh_near`): the list, and where it was made."""
+    return np.zeros(2 + pstart.shape[0] - 1 + circles.shape[0], dtype=np.int64), np.zeros(3)
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def refresh_near(x, y, reach, verts, pstart, pbound, circles, near, centre):
+    """Keep ``near`` the list of the pieces and circles that may come within ``reach`` of the robot's centre
+    (x, y) -- near[0] pieces, then near[1] circles, their indices from near[2] on, in index order -- remade
+    only when the robot is half NEAR_MARGIN away from where it was made (``centre``: x, y, 1 when made).
+
+    Exact: the list is made for ``reach + NEAR_MARGIN``, so what it leaves out is farther than ``reach`` by
+    centimetres, far beyond rounding, wherever the robot is until the list is remade; the callers still apply
+    their own exact broad-phase test to every candidate, so they decide as if they had scanned every piece.
+    Pieces and circles from the 63rd on are always listed (the bumpers' bit masks keep them all).
+    """
+    dx, dy = x - centre[0], y - centre[1]
+    half = 0.5 * NEAR_MARGIN
+    if centre[2] > 0.0 and dx * dx + dy * dy < half * half:
+        return
+    wide = reach + NEAR_MARGIN
+    n = 0
+    for k in range(pstart.shape[0] - 1):
+        if k >= 62 or might_be_near(x, y, verts, pstart[k], pstart[k + 1], pbound, k, wide):
+            near[2 + n] = k
+            n += 1
+    m = 0
+    for k in range(circles.shape[0]):
+        if k >= 62 or within(circles[k, 0] - x, circles[k, 1] - y, circles[k, 2] + wide + 1e-6):
+            near[2 + n + m] = k
+            m += 1
+    near[0], near[1] = n, m
+    centre[0], centre[1], centre[2] = x, y, 1.0
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def body_corners_at(s, p, c, sn, out):
+    """The body rectangle's corners in world coordinates (front-right, front-left, rear-left, rear-right),
+    given the heading's cosine ``c`` and sine ``sn``."""
     f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
     for k, (bx, by) in enumerate(((f, -w), (f, w), (r, w), (r, -w))):
         out[k, 0] = s[X] + c * bx - sn * by
         out[k, 1] = s[Y] + sn * bx + c * by
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
+def body_corners(s, p, out):
+    """The body rectangle's corners in world coordinates: front-right, front-left, rear-left, rear-right."""
+    body_corners_at(s, p, math.cos(s[TH]), math.sin(s[TH]), out)
+
+
+@njit(cache=True, refcounts=False, inline="always")
 def bounding_radius(p):
     return math.hypot(max(p[P_FRONT], p[P_REAR]), p[P_HALF_W])
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def reaches(p):
+    """The bounding radius (the contacts' broad phase), and the reach a candidate list must serve (the
+    bumpers': the radius plus the switch travel), computed as every caller computes them."""
+    reach = bounding_radius(p)
+    return reach, max(reach, reach + p[P_GAP])
 
 
 # --- contacts ------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
-def piece_contact(s, corners, verts, a, b):
-    """Separating-axis test of the body against convex piece verts[a:b].
+@njit(cache=True, refcounts=False)
+def piece_contact(ux, uy, corners, verts, a, b):
+    """Separating-axis test of the body (heading cosine ``ux`` and sine ``uy``, corners ``corners``) against
+    convex piece verts[a:b].
 
     Returns (depth, dx, dy, px, py): push the robot by depth along (dx, dy); (px, py) is where they
     touch. depth <= 0 means apart. Piece axes are tried first so that a face-to-face touch is taken
     on the piece's normal and its contact point lies between the touching corners.
     """
-    ux, uy = math.cos(s[TH]), math.sin(s[TH])
     k = b - a
     n_piece = 1 if k == 2 else k
     best, dx, dy, robot_axis = 1e300, 0.0, 0.0, False
@@ -188,10 +241,9 @@ def piece_contact(s, corners, verts, a, b):
     return best, dx, dy, px / count, py / count
 
 
-@njit(cache=True)
-def circle_contact(s, p, cx, cy, radius):
-    """Body rectangle against a circle; same result convention as :func:`piece_contact`."""
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
+@njit(cache=True, refcounts=False)
+def circle_contact(s, p, c, sn, cx, cy, radius):
+    """Body rectangle (heading cosine ``c``, sine ``sn``) against a circle; the result as :func:`piece_contact`'s."""
     rx, ry = cx - s[X], cy - s[Y]
     bx, by = c * rx + sn * ry, -sn * rx + c * ry  # circle centre in the body frame
     f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
@@ -216,44 +268,69 @@ def circle_contact(s, p, cx, cy, radius):
             s[X] + c * qx - sn * qy, s[Y] + sn * qx + c * qy)
 
 
+@njit(cache=True, refcounts=False)
+def deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near):
+    """The deepest overlap of the body with the pieces and circles of candidate list ``near`` that the
+    broad phase keeps for ``reach`` (bounding circles prune the rest), scanned in index order; and the
+    heading's cosine and sine (worked out, with the corners, only when something is that near).
+    """
+    best = (0.0, 0.0, 0.0, 0.0, 0.0)
+    c = sn = 0.0
+    ready = False
+    n = near[0]
+    for j in range(n):
+        k = near[2 + j]
+        if not might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
+            continue
+        if not ready:
+            c, sn, ready = math.cos(s[TH]), math.sin(s[TH]), True
+            body_corners_at(s, p, c, sn, corners)
+        hit = piece_contact(c, sn, corners, verts, pstart[k], pstart[k + 1])
+        if hit[0] > best[0]:
+            best = hit
+    for j in range(near[1]):
+        k = near[2 + n + j]
+        if not within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach):
+            continue
+        if not ready:
+            c, sn, ready = math.cos(s[TH]), math.sin(s[TH]), True
+            body_corners_at(s, p, c, sn, corners)
+        hit = circle_contact(s, p, c, sn, circles[k, 0], circles[k, 1], circles[k, 2])
+        if hit[0] > best[0]:
+            best = hit
+    return best, c, sn
+
+
 @njit(cache=True)
 def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
     """The deepest overlap of the body with any piece or circle (bounding circles prune the rest)."""
-    reach = bounding_radius(p)
-    best = (0.0, 0.0, 0.0, 0.0, 0.0)
-    for k in range(pstart.shape[0] - 1):
-        if not might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
-            continue
-        hit = piece_contact(s, corners, verts, pstart[k], pstart[k + 1])
-        if hit[0] > best[0]:
-            best = hit
-    for k in range(circles.shape[0]):
-        if not within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach):
-            continue
-        hit = circle_contact(s, p, circles[k, 0], circles[k, 1], circles[k, 2])
-        if hit[0] > best[0]:
-            best = hit
-    return best
+    near, centre = new_near(pstart, circles)
+    reach, wide = reaches(p)
+    refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
+    return deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near)[0]
 
 
-@njit(cache=True)
-def resolve(s, p, corners, verts, pstart, pbound, circles):
-    """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn).
+@njit(cache=True, refcounts=False, inline="always")
+def resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre):
+    """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn);
+    returns whether it moved the robot. ``reach``/``wide``: :func:`reaches`; ``near``/``centre``: the
+    robot's candidate list (:func:`refresh_near`).
 
     A corner touching first turns the robot about it, as a real robot pushing one bumper corner
     against a wall swings square to it; the touching point is clamped to the body.
     """
     s[CONTACT] = 0.0
-    near, near_circles = broad_phase(s, bounding_radius(p), verts, pstart, pbound, circles)
-    if not near and not near_circles:  # in the open nothing can overlap the body (most ticks)
-        return
+    moved = False
     for _ in range(RESOLVE_ITERATIONS):
-        body_corners(s, p, corners)
-        depth, dx, dy, px, py = deepest_contact(s, p, corners, verts, pstart, pbound, circles)
+        refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
+        if near[0] == 0 and near[1] == 0:  # in the open nothing can overlap the body (most ticks)
+            return moved
+        hit, c, sn = deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near)
+        depth, dx, dy, px, py = hit
         if depth <= 0.0:
-            return
+            return moved
         s[CONTACT] = 1.0
-        c, sn = math.cos(s[TH]), math.sin(s[TH])
+        moved = True
         rx, ry = px - s[X], py - s[Y]
         bx = min(p[P_FRONT], max(-p[P_REAR], c * rx + sn * ry))
         by = min(p[P_HALF_W], max(-p[P_HALF_W], -sn * rx + c * ry))
@@ -263,12 +340,13 @@ def resolve(s, p, corners, verts, pstart, pbound, circles):
         s[X] += dx * depth / weight
         s[Y] += dy * depth / weight
         s[TH] += arm / p[P_GYR2] * depth / weight
+    return moved
 
 
 # --- sensing -------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near_circles):
     """Whether anything lies within the switch travel ``gap`` of a bumper plate given in the body frame
     (``c``, ``sn``: the heading's cosine and sine; ``near``/``near_circles``: bits of the pieces and
@@ -291,59 +369,85 @@ def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near
     return False
 
 
-@njit(cache=True)
-def broad_phase(s, reach, verts, pstart, pbound, circles):
-    """Bits of the pieces and of the circles that may lie within ``reach`` of the robot's centre (exact:
-    what it rules out is farther); pieces and circles from the 63rd on share bit 62 and are kept."""
-    near = np.int64(0)
-    for k in range(pstart.shape[0] - 1):
+@njit(cache=True, refcounts=False, inline="always")
+def broad_phase(s, reach, verts, pstart, pbound, circles, near):
+    """Bits of the pieces and of the circles of candidate list ``near`` that may lie within ``reach`` of the
+    robot's centre (exact: what it rules out is farther); pieces and circles from the 63rd on share bit 62
+    and are kept. The same bits as a scan of every piece, since the list leaves out only far ones."""
+    bits = np.int64(0)
+    n = near[0]
+    for j in range(n):
+        k = near[2 + j]
         if k >= 62 or might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
-            near |= np.int64(1) << min(k, 62)
-    near_circles = np.int64(0)
-    for k in range(circles.shape[0]):
+            bits |= np.int64(1) << min(k, 62)
+    bits_circles = np.int64(0)
+    for j in range(near[1]):
+        k = near[2 + n + j]
         if k >= 62 or within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach + 1e-6):
-            near_circles |= np.int64(1) << min(k, 62)
-    return near, near_circles
+            bits_circles |= np.int64(1) << min(k, 62)
+    return bits, bits_circles
 
 
-@njit(cache=True)
-def sense_bumpers(s, p, verts, pstart, pbound, circles):
-    """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and rear."""
+@njit(cache=True, refcounts=False, inline="always")
+def sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre):
+    """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and
+    rear; ``c``/``sn``: the heading's cosine and sine; the rest as :func:`resolve`'s."""
     f, r, w, ov, wrap, gap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP], p[P_GAP]
-    near, near_c = broad_phase(s, bounding_radius(p) + gap, verts, pstart, pbound, circles)
+    refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
+    near_p, near_c = broad_phase(s, reach + gap, verts, pstart, pbound, circles, near)
     fr = fl = rear = False
-    if near or near_c:  # in the open (most ticks) no plate can touch anything
-        c, sn = math.cos(s[TH]), math.sin(s[TH])
-        fr = (near_plate(s, c, sn, gap, f, -w, f, ov, verts, pstart, near, circles, near_c)
-              or near_plate(s, c, sn, gap, f - wrap, -w, f, -w, verts, pstart, near, circles, near_c))
-        fl = (near_plate(s, c, sn, gap, f, -ov, f, w, verts, pstart, near, circles, near_c)
-              or near_plate(s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near, circles, near_c))
-        rear = near_plate(s, c, sn, gap, r, -w, r, w, verts, pstart, near, circles, near_c)
+    if near_p or near_c:  # in the open (most ticks) no plate can touch anything
+        fr = (near_plate(s, c, sn, gap, f, -w, f, ov, verts, pstart, near_p, circles, near_c)
+              or near_plate(s, c, sn, gap, f - wrap, -w, f, -w, verts, pstart, near_p, circles, near_c))
+        fl = (near_plate(s, c, sn, gap, f, -ov, f, w, verts, pstart, near_p, circles, near_c)
+              or near_plate(s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near_p, circles, near_c))
+        rear = near_plate(s, c, sn, gap, r, -w, r, w, verts, pstart, near_p, circles, near_c)
     s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def light_side(s, c, sn, p, side, ct, st, edges, circles, lamps):
+    """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
+    ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`). Most
+    ticks no lamp is in its field of view: :func:`sim.sensing.no_lamp_in_view` says so cheaply."""
+    lx, ly = p[P_LX], side * p[P_LY]
+    if no_lamp_in_view(s, c, sn, p, lx, ly, ct, st, lamps):
+        return 0.0  # what light_from returns when every lamp is out of view
+    return light_from(s, c, sn, p, lx, ly, side * p[P_TOE], edges, circles, lamps)
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def aim_turns(p, out):
+    """``out``: cosine and sine of the right phototransistor's turn from the heading, then the left one's."""
+    out[0], out[1] = math.cos(-1.0 * p[P_TOE]), math.sin(-1.0 * p[P_TOE])
+    out[2], out[3] = math.cos(1.0 * p[P_TOE]), math.sin(1.0 * p[P_TOE])
 
 
 @njit(cache=True)
 def light_at(s, p, side, edges, circles, lamps):
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
-    return light_from(s, p, p[P_LX], side * p[P_LY], side * p[P_TOE], edges, circles, lamps)
+    turns = np.empty(4)
+    aim_turns(p, turns)
+    k = 0 if side < 0.0 else 2
+    return light_side(s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps)
 
 
 # --- motors, battery, motion ---------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def duty(level, levels):
     """The fraction of full power a speed level gives (the table's 1..8 are PWM duty level/8)."""
     return min(1.0, abs(level) / levels)
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def pack_volts(full, empty, charge, amps, ohms):
     """Battery terminal volts: open-circuit volts fall linearly with the charge and sag with the current."""
     return empty + (full - empty) * charge - amps * ohms
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def motor(s, p, level, volts, gain, speed, enc, pul, noise):
     """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
@@ -357,7 +461,7 @@ def motor(s, p, level, volts, gain, speed, enc, pul, noise):
     s[pul] = math.floor(s[enc]) - math.floor(before)
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def drive(s, cmd, p, z):
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
     dt = p[P_DT]
@@ -375,7 +479,7 @@ def drive(s, cmd, p, z):
     s[TH] += turn
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def input_mask(s, bits):
     """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
     mask = 0
@@ -392,35 +496,55 @@ def input_mask(s, bits):
     return mask
 
 
-@njit(cache=True)
-def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits):
+@njit(cache=True, refcounts=False, inline="always")
+def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns):
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
-    declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask)."""
-    sense_bumpers(s, p, verts, pstart, pbound, circles)
-    s[LIGHT_R] = max(0.0, light_at(s, p, -1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
-    s[LIGHT_L] = max(0.0, light_at(s, p, 1.0, edges, circles, lamps) * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
-    sense_declared(s, p, edges, circles, lamps, lines)
+    declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
+    cosine and sine are worked out once for all of them."""
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
+    right = light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps)
+    s[LIGHT_R] = max(0.0, right * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
+    left = light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps)
+    s[LIGHT_L] = max(0.0, left * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
+    sense_declared(s, c, sn, p, edges, circles, lamps, lines)
     previous = int(s[MASK])
     s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
 
 
 @njit(cache=True)
-def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, move, corners):
+def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits):
+    """:func:`sense_near` on its own (a candidate list made for this one call)."""
+    near, centre = new_near(pstart, circles)
+    reach, wide = reaches(p)
+    turns = np.empty(4)
+    aim_turns(p, turns)
+    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns)
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, move, corners, reach,
+            wide, near, centre, turns):
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
-    sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2)."""
+    sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2); ``reach``, ``wide``:
+    :func:`reaches`; ``near`` and ``centre`` the robot's candidate list (:func:`new_near`), kept from tick to tick;
+    ``turns``: :func:`aim_turns`."""
     if move:
         x0, y0 = s[X], s[Y]
         cmd = (right, left)
         drive(s, cmd, p, z)
-        resolve(s, p, corners, verts, pstart, pbound, circles)
+        resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-    sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits)
+    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns)
 
 
 @njit(cache=True)
 def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move, lines=NO_LINES):
     """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
-    corners = np.empty((4, 2))
+    corners, turns = np.empty((4, 2)), np.empty(4)
     for i in range(S.shape[0]):
+        near, centre = new_near(pstart, circles)
+        reach, wide = reaches(P[i])
+        aim_turns(P[i], turns)
         advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, lines, Z[i], bits,
-                move, corners)
+                move, corners, reach, wide, near, centre, turns)

@@ -108,7 +108,7 @@ def spin_starts(h: np.ndarray, states: np.ndarray) -> np.ndarray:
 def save(fig: Figure, path: Path) -> Path:
     """Write the figure as PNG under a temporary name, renamed into place when complete."""
     with atomic_write(path, "wb") as stream:
-        fig.savefig(stream, format="png", facecolor="white")
+        fig.savefig(stream, format="png", facecolor="white")  # Pillow's own zlib level: the same bytes as ever
     return path
 
 

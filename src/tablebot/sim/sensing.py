@@ -42,22 +42,24 @@ threshold = njit(inline="always")(threshold_event)  # the rule of every analog i
 K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "distance", "light"))
 
 
-@njit(cache=True)
-def light_from(s, p, lx, ly, turn, edges, circles, lamps):
+@njit(cache=True, refcounts=False, inline="always")
+def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps):
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
-    sum of intensity / d² × cos(angle)^k over unshadowed lamps.
+    sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine).
 
     The response fades to zero over the last quarter of the field of view (a lens tube's edge).
     """
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
     sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly
     aim = s[TH] + turn
     ax, ay = math.cos(aim), math.sin(aim)
     total = 0.0
     for k in range(lamps.shape[0]):
         dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
+        ahead = dx * ax + dy * ay
+        if ahead <= 0.0 and p[P_COS_FOV] >= 0.0 and (dx != 0.0 or dy != 0.0):
+            continue  # behind the sensor: its cosine (ahead / d, d > 0) is <= 0 <= cos_fov, no hypot needed
         d = math.hypot(dx, dy)
-        cosine = 1.0 if d == 0.0 else (dx * ax + dy * ay) / d
+        cosine = 1.0 if d == 0.0 else ahead / d
         if cosine <= p[P_COS_FOV]:
             continue
         d = max(d, p[P_DMIN])
@@ -68,7 +70,37 @@ def light_from(s, p, lx, ly, turn, edges, circles, lamps):
     return total
 
 
-@njit(cache=True)
+#: How far the aim's direction worked out by the angle-sum rule (:func:`no_lamp_in_view`) may be from the one
+#: light_from takes from cos/sin of the summed angle: rounding of the sum (an ulp of the heading, which is
+#: never wrapped: 1e-12 after thousands of turns) and of the products, with orders of magnitude to spare.
+AIM_SLACK = 1e-9
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def no_lamp_in_view(s, c, sn, p, lx, ly, ct, st, lamps):
+    """Whether every lamp is surely outside the field of view of a sensor at (lx, ly) in the body frame whose
+    aim is turned from the heading by an angle of cosine ``ct`` and sine ``st`` (``c``, ``sn``: the heading's)
+    -- decided with neither the aim's own cos/sin nor a hypot, both dearer than the test. True only when
+    no rounding can make it wrong: light_from would then skip every lamp (and return 0.0); in doubt, False.
+    """
+    cos_fov = p[P_COS_FOV]
+    if cos_fov < 0.0:
+        return False
+    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly  # as light_from places the sensor
+    ax, ay = c * ct - sn * st, sn * ct + c * st  # the aim: cos and sin of heading + turn, to within AIM_SLACK
+    for k in range(lamps.shape[0]):
+        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
+        size = abs(dx) + abs(dy)  # at least the distance d, at most 1.5 d
+        if size == 0.0:
+            return False
+        # light_from's dot product (d times the cosine) is below this bound, whatever the rounding
+        top = dx * ax + dy * ay + 2.0 * AIM_SLACK * size
+        if top > 0.0 and top * top > cos_fov * cos_fov * (dx * dx + dy * dy) * (1.0 - AIM_SLACK):
+            return False  # maybe in view: light_from decides
+    return True
+
+
+@njit(cache=True, refcounts=False)
 def on_a_line(x, y, lines):
     """1.0 when the floor point (x, y) lies on a piece of tape (within its half width of its middle), else 0.0."""
     for k in range(lines.shape[0]):
@@ -77,7 +109,7 @@ def on_a_line(x, y, lines):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def beam_segment(ux, uy, cb, sb, ax, ay, bx, by):
     """Distance from the beam's apex (the origin) to the nearest point of segment ab inside the beam.
 
@@ -102,7 +134,7 @@ def beam_segment(ux, uy, cb, sb, ax, ay, bx, by):
                                   ax + t1 * (bx - ax), ay + t1 * (by - ay))
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def beam_circle(ux, uy, cb, sb, cx, cy, radius):
     """Distance from the beam's apex to the nearest point of a disc (centre relative to the apex) inside the beam.
 
@@ -125,7 +157,7 @@ def beam_circle(ux, uy, cb, sb, cx, cy, radius):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False)
 def echo(sx, sy, aim, p, edges, circles):
     """An ultrasonic sensor's reading in metres: the nearest wall, obstacle edge or circle inside its beam.
 
@@ -155,10 +187,10 @@ def echo(sx, sy, aim, p, edges, circles):
     return max(p[P_DMIN_RANGE], round(best / p[P_DRES]) * p[P_DRES])
 
 
-@njit(cache=True)
-def sense_declared(s, p, edges, circles, lamps, lines):
-    """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units."""
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
+@njit(cache=True, refcounts=False)
+def sense_declared(s, c, sn, p, edges, circles, lamps, lines):
+    """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
+    (``c``, ``sn``: the heading's cosine and sine)."""
     for k in range(MAX_SENSORS):
         base = P_SENSOR + k * SENSOR_FIELDS
         kind = p[base + F_KIND]
@@ -166,7 +198,7 @@ def sense_declared(s, p, edges, circles, lamps, lines):
             continue
         bx, by = p[base + F_X], p[base + F_Y]
         if kind == K_LIGHT:
-            s[READING + k] = light_from(s, p, bx, by, p[base + F_AIM], edges, circles, lamps)
+            s[READING + k] = light_from(s, c, sn, p, bx, by, p[base + F_AIM], edges, circles, lamps)
             continue
         sx, sy = s[X] + c * bx - sn * by, s[Y] + sn * bx + c * by
         if kind == K_LINE:
@@ -175,7 +207,7 @@ def sense_declared(s, p, edges, circles, lamps, lines):
             s[READING + k] = echo(sx, sy, s[TH] + p[base + F_AIM], p, edges, circles)
 
 
-@njit(cache=True)
+@njit(cache=True, refcounts=False, inline="always")
 def sensor_events(s, p, bits, previous):
     """The event bits of the declared sensors (:func:`tablebot.sensors.threshold_event`: a reading past its
     threshold turns the event on; once on, it stays on until the reading is back past the threshold by the

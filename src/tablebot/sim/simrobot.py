@@ -11,10 +11,11 @@ from typing import Any
 import numpy as np
 
 from tablebot.engine import Engine
-from tablebot.formats.trace_lines import exact_round
+from tablebot.formats.trace_lines import exact_round_array
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
+from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
@@ -22,6 +23,7 @@ from tablebot.tick import registers
 
 DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
 MAX_COLLISIONS = 4096  # collision starts remembered for the pictures (the count goes on beyond)
+NO_NOISE = np.empty((0, L.N_NOISE))  # advance: the compiled loop draws each tick's noise from the robot's Generator
 
 
 class SimRobot:
@@ -114,8 +116,8 @@ class SimRobot:
         hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
         start = engine.tick
         K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
-                    self.scene.bits, self._drive, self._pcols, self._noise(ticks), hist, ints, self.acc,
-                    self.collision_rows)
+                    self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
+                    self.acc, self.collision_rows)
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
@@ -189,12 +191,18 @@ def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
 def field_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
     """:meth:`SimRobot.trace_fields` for every row of ``hist``, as columns, rounded exactly as Python's
     ``round`` does (so the bytes are those of the one-tick path)."""
-    columns: dict[str, list] = {}
+    return {key: values.tolist() for key, (values, _) in number_columns(scene, hist).items()}
+
+
+def number_columns(scene: Scene, hist: np.ndarray) -> dict[str, tuple[np.ndarray, int]]:
+    """:func:`field_columns` as arrays, with their decimals (0: whole numbers, an int64 array)."""
+    columns: dict[str, tuple[np.ndarray, int]] = {}
     for key, column, scale, decimals in trace_layout(scene):
         values = hist[:, column].astype(np.float64)
         if column == L.TH:
             values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
-        columns[key] = values.astype(np.int64).tolist() if decimals == 0 else exact_round(values * scale, decimals)
+        columns[key] = ((values.astype(np.int64), 0) if decimals == 0
+                        else (exact_round_array(values * scale, decimals), decimals))
     return columns
 
 
@@ -239,3 +247,9 @@ class LazyColumns(Mapping[str, Sequence[float]]):
 
     def __len__(self) -> int:
         return len(self.keys_)
+
+    def number_columns(self) -> list[tuple[str, np.ndarray, int]]:
+        """(key, values, decimals) of every field in order, the values as arrays: what the compiled trace
+        writer (tablebot.sinks.trace_text) takes."""
+        columns = number_columns(self.scene, self.hist)
+        return [(key, *columns[key]) for key in self.keys_]

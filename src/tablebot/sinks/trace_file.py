@@ -16,10 +16,52 @@ from tablebot.formats.trace_lines import dumps
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.machine import Machine
 
+#: Ticks from which a simulator's block is written by compiled code (sinks.trace_text), not by Python.
+COMPILED_FROM = 256
+
+
+def block_text(block: TickBlock, machine: Machine) -> str:
+    """The trace lines of a block of ticks, as one text: :func:`block_lines` joined. A long block of the
+    simulator's (numpy columns, its extra fields offering ``number_columns``) is written by compiled code."""
+    if len(block) >= COMPILED_FROM and hasattr(block.extra, "number_columns"):
+        text = _compiled_text(block, machine)
+        if text is not None:
+            return text
+    return "".join(_python_lines(block, machine))
+
 
 def block_lines(block: TickBlock, machine: Machine) -> list[str]:
     """The trace lines of a block of ticks, newline included: the bytes :func:`dumps` gives for
     :func:`record` plus the block's extra fields, made column-wise (a simulated hour in well under a second)."""
+    text = block_text(block, machine)
+    return [line + "\n" for line in text.split("\n")[:-1]]  # no JSON text holds a raw newline
+
+
+def _compiled_text(block: TickBlock, machine: Machine) -> str | None:
+    from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_bytes, json_names
+
+    n_out, n_count = len(machine.output_names), len(machine.table.robot.counter_names)
+    arrays = (block.events, block.rows, block.states, block.timers, block.outputs, block.counters)
+    if not all(isinstance(a, np.ndarray) for a in arrays):
+        return None
+    extra = block.extra.number_columns()  # type: ignore[attr-defined]
+    keys = ["tick", "event", "row", "state", "timer", *machine.output_names, *machine.table.robot.counter_names]
+    pieces = [("{" if k == 0 else ",") + json.dumps(key, ensure_ascii=False) + ":" for k, key in enumerate(keys)]
+    pieces += ["," + json.dumps(key, ensure_ascii=False) + ":" for key, _, _ in extra]
+    kinds = [INT, INT, ROW, STATE, INT] + [INT] * (n_out + n_count)
+    n = len(block)
+    columns = [np.arange(block.start, block.start + n), block.events, block.rows, block.states, block.timers]
+    columns += [block.outputs[:, k] for k in range(n_out)] + [block.counters[:, k] for k in range(n_count)]
+    decimals = [0] * len(kinds)
+    for _, values, places in extra:
+        kinds.append(INT if places == 0 else DECIMAL)
+        columns.append(values)
+        decimals.append(places)
+    text = block_bytes([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states))
+    return None if text is None else text.decode("utf-8")
+
+
+def _python_lines(block: TickBlock, machine: Machine) -> list[str]:
     names = [json.dumps(state, ensure_ascii=False) for state in machine.states]
     columns = [*machine.output_names, *machine.table.robot.counter_names]
     template = ('{"tick":%d,"event":%d,"row":%s,"state":%s,"timer":%d'
@@ -89,7 +131,7 @@ class TraceFile:
         self._queue.put(block)
 
     def _write(self, block: TickBlock) -> None:
-        self.file.stream.writelines(block_lines(block, self.machine))
+        self.file.stream.write(block_text(block, self.machine))
 
     def _drain(self) -> None:
         assert self._queue is not None
