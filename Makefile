@@ -2,14 +2,21 @@
 # both set themselves up first.
 .PHONY: setup demo test bench
 
+# Python keeps its compiled bytecode (in __pycache__, which git ignores): without it every one of the
+# hundred tablebot processes the tests start compiles numpy, numba and tablebot again, seconds each.
+unexport PYTHONDONTWRITEBYTECODE
+
 setup:
 	@./scripts/bootstrap.sh
 
 demo: setup
 	.venv/bin/tablebot sim examples/bumberbot --out out/demo
 
+# pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
+# once first), then the wall-clock ones (marked realtime there) alone.
 test: setup
-	.venv/bin/python -m pytest
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15
+	.venv/bin/python -m pytest -n 0 -m realtime --durations=5
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .
 	node_modules/.bin/eslint src/tablebot/web/static eslint.config.js

@@ -1,0 +1,66 @@
+"""Compile (or load) every numba kernel the tests run, once, before pytest-xdist starts its workers.
+
+Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
+take, on the smallest input that reaches each kernel with the argument types the tests give it:
+``sim`` (one robot's loop, the tick-by-tick robot, the engine's batch loop on both mask types) and
+``fleet`` (the fleet loop, the env's physics-only loop) and ``archive`` (pyribs' grid archive, which
+compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache). Numba caches one machine
+code per argument types, so a kernel reached here with other types than a test's is compiled again
+by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+def warm_sim() -> None:
+    from tablebot.cli.common import load
+    from tablebot.engine import Engine
+    from tablebot.loop import SimulatedClock
+    from tablebot.loop import run as run_loop
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import scene_for
+    from tablebot.sim.simrobot import SimRobot
+
+    table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
+    scene = scene_for(table, machine)
+    simulate(scene, 0.05, 1)
+    robot = SimRobot(scene, 1)
+    robot.reset(seed=1)
+    run_loop(Engine(machine), robot, clock=SimulatedClock(), sinks=[], ticks=3)
+    for dtype in (np.uint8, np.int64):  # the two mask types the batch kernel is compiled for
+        Engine(machine).run(np.zeros(3, dtype=dtype))
+
+
+def warm_fleet() -> None:
+    from tablebot.fleet.env import TableBotVectorEnv
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import warm
+
+    warm(make_plan(EXAMPLES / "bumberbot" / "table.csv", None, [], [], "0", None, 1.0).jobs()[0])
+    env = TableBotVectorEnv(num_envs=2, seconds=0.05)
+    env.reset(seed=1)
+    env.step(np.zeros((2, 2)))
+    env.close()
+
+
+def warm_archive() -> None:
+    from tablebot.evolve.archive import add, make_archive
+    from tablebot.evolve.measures import Descriptor
+
+    for descriptors in ([Descriptor("a", 0.0, 1.0, 4)], [Descriptor("a", 0.0, 1.0, 4), Descriptor("b", 0.0, 1.0, 4)]):
+        add(make_archive(descriptors), ["x", "y"], [1.0, 2.0], [[0.2] * len(descriptors), [0.7] * len(descriptors)])
+
+
+PARTS = {"sim": warm_sim, "fleet": warm_fleet, "archive": warm_archive}
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or list(PARTS):
+        PARTS[name]()
