@@ -88,7 +88,7 @@ def say_compiling(what: str, *functions: Any) -> None:
     """One line on stderr when ``functions`` are about to be compiled, not loaded from the cache: the first
     run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
     if not compiled(*functions):
-        print(f"compiling {what} for this machine (first run only, about half a minute; later runs start at "
+        print(f"compiling {what} for this machine (first run only, about a minute; later runs start at "
               "once)…", file=sys.stderr, flush=True)
 
 
