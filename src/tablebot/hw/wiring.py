@@ -99,13 +99,21 @@ class InputWire:
 
     def reads(self, raw: int, was_on: bool = False) -> int:
         """What the table sees (0/1) for the controller's value (``was_on``: last tick's, for the hysteresis)."""
-        if self.digital:
-            return int(bool(raw)) ^ int(self.invert)
-        if self.below is not None:
-            return int(threshold_event(raw, False, self.below, self.below + self.hysteresis, was_on))
-        if self.above is not None:
-            return int(threshold_event(raw, True, self.above, self.above - self.hysteresis, was_on))
-        return 0
+        return input_event(self, raw, was_on)
+
+
+def input_event(wire: Any, raw: int, was_on: bool) -> int:
+    """What the table sees (0/1) for a controller input's value, every controller's rule: a digital input
+    is its value (inverted when the wiring says so); an analog one goes through the threshold with
+    hysteresis (``sensors.threshold_event``) of its ``below`` or ``above`` limit; one with neither reads 0.
+    ``wire`` is any controller's input wire (``digital``, ``invert``, ``below``, ``above``, ``hysteresis``)."""
+    if wire.digital:
+        return int(bool(raw)) ^ int(wire.invert)
+    if wire.below is not None:
+        return int(threshold_event(raw, False, wire.below, wire.below + wire.hysteresis, was_on))
+    if wire.above is not None:
+        return int(threshold_event(raw, True, wire.above, wire.above - wire.hysteresis, was_on))
+    return 0
 
 
 @dataclass(frozen=True)

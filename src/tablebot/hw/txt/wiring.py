@@ -23,8 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tablebot.hw.txt import protocol as wire
-from tablebot.hw.wiring import level_duty
-from tablebot.sensors import threshold_event
+from tablebot.hw.wiring import input_event, level_duty
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
@@ -90,13 +89,7 @@ class InputWire:
         for the hysteresis)."""
         if self.mode == "trail":  # 0/1, or millivolts: as ftrobopy's trailfollower().state() reads it
             return int(raw == 1 or raw > TRAIL_LIGHT_MV) ^ int(self.invert)
-        if self.digital:
-            return int(bool(raw)) ^ int(self.invert)
-        if self.below is not None:
-            return int(threshold_event(raw, False, self.below, self.below + self.hysteresis, was_on))
-        if self.above is not None:
-            return int(threshold_event(raw, True, self.above, self.above - self.hysteresis, was_on))
-        return 0
+        return input_event(self, raw, was_on)
 
 
 @dataclass(frozen=True)
