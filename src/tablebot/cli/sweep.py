@@ -51,8 +51,10 @@ def sweep_cmd(
     from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import choose, run_jobs
     from tablebot.fleet.plan import Store, make_plan, read_results
-    from tablebot.fleet.plots import write_all
     from tablebot.interrupts import INTERRUPTS
+
+    if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
+        from tablebot.fleet.plots import write_all
 
     chosen, address = choose(backend, scheduler)
     plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
@@ -115,7 +117,7 @@ def trace_runs(text: str | None, total: int) -> list[int]:
 
 def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: float, ran: int) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
-    from tablebot.fleet.plots import groups
+    from tablebot.fleet.plan import groups
 
     lamps = any(world.lamps for world in plan.worlds)
     for key, values in groups(plan, rows):

@@ -21,7 +21,7 @@ import numpy as np
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.files import atomic_write, remove, write_text
 from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
-from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs
+from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs, value_index
 from tablebot.fleet.work import Job
 from tablebot.formats.trace_lines import exact_round
 from tablebot.machine import Machine
@@ -268,3 +268,32 @@ def csv_text(columns: Sequence[str], rows: Sequence[dict[str, Any]]) -> str:
 def read_results(path: Path) -> list[dict[str, str]]:
     with open(path, encoding="utf-8", newline="") as f:
         return list(csv.DictReader(f))
+
+
+# How a sweep's results are grouped, for its report and its pictures (here, not in the picture module, so that
+# a sweep without pictures never loads matplotlib).
+def groups(plan: Plan, rows: Sequence[dict[str, Any]]) -> list[tuple[str, list[tuple[str, list[dict[str, Any]]]]]]:
+    """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
+    out = []
+    if len(plan.spec.worlds) > 1:
+        by_world: list[list[dict[str, Any]]] = [[] for _ in plan.worlds]
+        for r in rows:
+            by_world[int(r["run"]) // plan.spec.runs_per_world].append(r)
+        out.append(("world", list(zip(world_labels(plan), by_world, strict=True))))
+    for k, axis in enumerate(plan.spec.axes):
+        if len(axis.values) < 2:
+            continue
+        # by the run's value (a random start has no other mark)
+        chosen: list[list[dict[str, Any]]] = [[] for _ in axis.values]
+        for r in rows:
+            chosen[value_index(plan.spec, int(r["run"]), k)].append(r)
+        labels = [":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
+                  for value in axis.values]
+        out.append((axis.key, list(zip(labels, chosen, strict=True))))
+    return out or [("all runs", [("all", list(rows))])]
+
+
+def world_labels(plan: Plan) -> list[str]:
+    """Each world's name, numbered where two share one (two files both called arena.toml, say)."""
+    names = [world.name for world in plan.worlds]
+    return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]

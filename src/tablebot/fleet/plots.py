@@ -17,8 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from tablebot.escape import picture
-from tablebot.fleet.plan import Plan
-from tablebot.fleet.spec import value_index
+from tablebot.fleet.plan import Plan, groups
 from tablebot.sim.draw import REACHED, draw_world, literal_text
 from tablebot.sim.plots import save
 
@@ -28,32 +27,6 @@ Row = dict[str, Any]
 
 def number(value: Any) -> float | None:
     return None if value in (None, "") else float(value)
-
-
-def groups(plan: Plan, rows: Sequence[Row]) -> list[tuple[str, list[tuple[str, list[Row]]]]]:
-    """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
-    out = []
-    if len(plan.spec.worlds) > 1:
-        by_world: list[list[Row]] = [[] for _ in plan.worlds]
-        for r in rows:
-            by_world[int(r["run"]) // plan.spec.runs_per_world].append(r)
-        out.append(("world", list(zip(world_labels(plan), by_world, strict=True))))
-    for k, axis in enumerate(plan.spec.axes):
-        if len(axis.values) < 2:
-            continue
-        chosen: list[list[Row]] = [[] for _ in axis.values]  # by the run's value (a random start has no other mark)
-        for r in rows:
-            chosen[value_index(plan.spec, int(r["run"]), k)].append(r)
-        labels = [":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
-                  for value in axis.values]
-        out.append((axis.key, list(zip(labels, chosen, strict=True))))
-    return out or [("all runs", [("all", list(rows))])]
-
-
-def world_labels(plan: Plan) -> list[str]:
-    """Each world's name, numbered where two share one (two files both called arena.toml, say)."""
-    names = [world.name for world in plan.worlds]
-    return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]
 
 
 @literal_text()
