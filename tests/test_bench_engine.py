@@ -11,7 +11,7 @@ SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "engine.py"
 
 
 def load_benchmark():
-    pytest.importorskip("transitions")
+    pytest.importorskip("transitions", reason="the engine benchmark compares with the transitions library (dev extra)")
     spec = importlib.util.spec_from_file_location("bench_engine", SCRIPT)
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     spec.loader.exec_module(module)  # type: ignore[union-attr]

@@ -8,9 +8,9 @@ off, so tick 0 has inputs too. The ROBO Interface has no counters.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Sequence
 
+from tablebot.hw.exchange import ExchangeRobot
 from tablebot.hw.roboif import protocol as wire
 from tablebot.hw.roboif.link import RoboifLink
 from tablebot.hw.roboif.wiring import RoboifWiring
@@ -19,16 +19,14 @@ from tablebot.loop import LinkLost, Reading
 OFF = (0, [0] * wire.N_OUTPUTS)
 
 
-class RoboifRobot:
+class RoboifRobot(ExchangeRobot):
     """The ROBO Interface on serial ``device``; a reply missing for ``link_timeout_s`` ends the run."""
 
     def __init__(self, wiring: RoboifWiring, device: str, *, link_timeout_s: float = 0.05):
         self.wiring = wiring
         self.link = RoboifLink(device, reply_timeout_s=link_timeout_s)
         self.greeting = b""
-        self._reading: Reading | None = None
-        self._stopped = False
-        self._lock = threading.Lock()  # the watchdog may call stop() from its timer thread
+        super().__init__()
 
     @property
     def target(self) -> str:
@@ -49,38 +47,24 @@ class RoboifRobot:
     def open(self) -> None:
         if not self.link.port.is_open:
             self.connect()
-        self._stopped = False
-        with self._lock:
-            first = self.link.exchange(*OFF)
-        self._reading = self._reading_of(first)
-
-    def read(self) -> Reading:
-        if self._reading is None:
-            raise LinkLost(f"{self.target} is not online (open() was not called or failed)")
-        return self._reading
-
-    def write(self, outputs: Sequence[int]) -> None:
-        bits, pwm = OFF if self._stopped else self.wiring.outputs(outputs)
-        with self._lock:
-            reply = self.link.exchange(bits, pwm)
-        self._reading = self._reading_of(reply)
-
-    def stop(self) -> None:
-        """Every output off in the very next exchange (even after a fault); never raises."""
-        self._stopped = True
-        if not self._lock.acquire(timeout=max(0.05, 2 * self.link.reply_timeout_s)):
-            return  # another thread is mid-exchange: the loop calls stop() again when it returns
-        try:
-            if self.link.online:
-                self.link.send_best_effort(*OFF, max(0.2, 2 * self.link.reply_timeout_s))
-        except Exception:
-            pass
-        finally:
-            self._lock.release()
+        self._first_exchange()
 
     def close(self) -> None:
         """The farewell (after :meth:`stop`'s exchange with every output off), then the port closed."""
         self.link.close()
+
+    # --- ExchangeRobot's hooks ----------------------------------------------------------------------
+
+    OFF = OFF
+
+    def _command(self, outputs: Sequence[int]) -> tuple[int, list[int]]:
+        return self.wiring.outputs(outputs)
+
+    def _exchange(self, command: tuple[int, list[int]]) -> wire.Inputs:
+        return self.link.exchange(*command)
+
+    def _send_off(self, timeout_s: float) -> None:
+        self.link.send_best_effort(*OFF, timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
         previous = self._reading.mask if self._reading is not None else 0

@@ -8,29 +8,25 @@ tick. ``open`` configures the inputs and makes a first exchange with every outpu
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Sequence
 
+from tablebot.hw.exchange import ExchangeRobot
 from tablebot.hw.robotx import protocol as wire
 from tablebot.hw.robotx.link import RobotxLink
 from tablebot.hw.robotx.wiring import RobotxWiring
 from tablebot.loop import LinkLost, Reading
 
 ZERO = [0] * wire.N_OUTPUTS
-COUNTER_WRAP = 1 << 16
 
 
-class RobotxRobot:
+class RobotxRobot(ExchangeRobot):
     """The ROBO TX on serial ``device``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
     def __init__(self, wiring: RobotxWiring, device: str, *, link_timeout_s: float = 0.05):
         self.wiring = wiring
         self.link = RobotxLink(device, reply_timeout_s=link_timeout_s)
         self.info: wire.Info | None = None
-        self._reading: Reading | None = None
-        self._counts: list[int] = []
-        self._stopped = False
-        self._lock = threading.Lock()  # the watchdog may call stop() from its timer thread
+        super().__init__()
 
     @property
     def target(self) -> str:
@@ -52,54 +48,27 @@ class RobotxRobot:
         """Configure inputs and outputs, then make a first exchange with every output off."""
         if not self.link.port.is_open:
             self.connect()
-        self._stopped = False
         self.link.configure(self.wiring.config())
-        with self._lock:
-            first = self.link.exchange(ZERO)
-        self._counts = [first.counter_values[t] for t in self.wiring.counters]
-        self._reading = self._reading_of(first)
-
-    def read(self) -> Reading:
-        if self._reading is None:
-            raise LinkLost(f"{self.target} is not online (open() was not called or failed)")
-        return self._reading
-
-    def write(self, outputs: Sequence[int]) -> None:
-        duty = ZERO if self._stopped else self.wiring.duty(outputs)
-        with self._lock:
-            reply = self.link.exchange(duty)
-        self._reading = self._reading_of(reply)
-
-    def stop(self) -> None:
-        """Zero duty on every output in the very next exchange (even after a fault); never raises."""
-        self._stopped = True
-        if not self._lock.acquire(timeout=max(0.05, 2 * self.link.reply_timeout_s)):
-            return  # another thread is mid-exchange: the loop calls stop() again when it returns
-        try:
-            if self.link.online:
-                self.link.send_best_effort(ZERO, max(0.2, 2 * self.link.reply_timeout_s))
-        except Exception:
-            pass
-        finally:
-            self._lock.release()
+        self._first_exchange(self.wiring.counters)
 
     def close(self) -> None:
         """Close the port (fish.X1 has no "go offline" command: the zero exchange of :meth:`stop` came first)."""
         self.link.close()
 
-    # --- inputs -----------------------------------------------------------------------------------
+    # --- ExchangeRobot's hooks ----------------------------------------------------------------------
+
+    OFF = ZERO
+
+    def _command(self, outputs: Sequence[int]) -> list[int]:
+        return self.wiring.duty(outputs)
+
+    def _exchange(self, command: list[int]) -> wire.Inputs:
+        return self.link.exchange(command)
+
+    def _send_off(self, timeout_s: float) -> None:
+        self.link.send_best_effort(ZERO, timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
         previous = self._reading.mask if self._reading is not None else 0  # hysteresis remembers last tick
-        return Reading(self.wiring.mask(reply, previous), self._pulses(reply.counter_values),
+        return Reading(self.wiring.mask(reply, previous), self._pulses(reply.counter_values, self.wiring.counters),
                        self.wiring.raw(reply) or None)
-
-    def _pulses(self, values: Sequence[int]) -> tuple[int, ...]:
-        """Pulses per robot counter since the last reply: counts go up in 16 bits; a count that went back (the
-        counter was reset) gives 0 and a new start."""
-        pulses = []
-        for i, terminal in enumerate(self.wiring.counters):
-            step = (values[terminal] - self._counts[i]) % COUNTER_WRAP
-            pulses.append(0 if step >= COUNTER_WRAP // 2 else step)
-            self._counts[i] = values[terminal]
-        return tuple(pulses)

@@ -9,9 +9,9 @@ off, so tick 0 has inputs too.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Sequence
 
+from tablebot.hw.exchange import ExchangeRobot
 from tablebot.hw.txt import protocol as wire
 from tablebot.hw.txt.link import TxtLink
 from tablebot.hw.txt.protocol import Command
@@ -19,14 +19,13 @@ from tablebot.hw.txt.wiring import TxtWiring
 from tablebot.loop import LinkLost, Reading
 
 ZERO = [0] * wire.N_OUTPUTS
-COUNTER_WRAP = 1 << 16
 
 
 class FirmwareTooOld(LinkLost):
     """The controller answered, with firmware older than fischertechnik's own online client accepts."""
 
 
-class TxtRobot:
+class TxtRobot(ExchangeRobot):
     """The robot behind ``host:port``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
     def __init__(self, wiring: TxtWiring, host: str, port: int = wire.PORT, *, link_timeout_s: float = 0.05,
@@ -35,10 +34,7 @@ class TxtRobot:
         self.link = TxtLink(host, port, reply_timeout_s=link_timeout_s)
         self.client_name = client_name
         self.status: wire.Status | None = None
-        self._reading: Reading | None = None
-        self._counts: list[int] = []
-        self._stopped = False
-        self._lock = threading.Lock()  # the watchdog may call stop() from its timer thread
+        super().__init__()
 
     @property
     def target(self) -> str:
@@ -64,37 +60,9 @@ class TxtRobot:
             self.connect()
         else:
             self.link.keep_alive()
-        self._stopped = False
         self.link.start_online(self.client_name)
         self.link.update_config(self.wiring.config())
-        with self._lock:
-            first = self.link.exchange(ZERO)
-        self._counts = [first.counter_values[t] for t in self.wiring.counters]
-        self._reading = self._reading_of(first)
-
-    def read(self) -> Reading:
-        if self._reading is None:
-            raise LinkLost(f"{self.target} is not online (open() was not called or failed)")
-        return self._reading
-
-    def write(self, outputs: Sequence[int]) -> None:
-        pwm = ZERO if self._stopped else self.wiring.pwm(outputs)
-        with self._lock:
-            reply = self.link.exchange(pwm)
-        self._reading = self._reading_of(reply)
-
-    def stop(self) -> None:
-        """Zero PWM on every output in the very next exchange (even after a fault); never raises."""
-        self._stopped = True
-        if not self._lock.acquire(timeout=max(0.05, 2 * self.link.reply_timeout_s)):
-            return  # another thread is mid-exchange: the loop calls stop() again when it returns
-        try:
-            if self.link.online:
-                self.link.send_best_effort(Command.EXCHANGE_DATA, wire.exchange(ZERO), self._shutdown_s)
-        except Exception:
-            pass
-        finally:
-            self._lock.release()
+        self._first_exchange(self.wiring.counters)
 
     def close(self) -> None:
         """StopOnline (after :meth:`stop`'s zero exchange), then close the socket; never raises."""
@@ -106,24 +74,20 @@ class TxtRobot:
         finally:
             self.link.close()
 
-    # --- inputs -----------------------------------------------------------------------------------
+    # --- ExchangeRobot's hooks ----------------------------------------------------------------------
 
-    @property
-    def _shutdown_s(self) -> float:
-        """How long stopping waits for each reply: enough for a live link, short for a dead one."""
-        return max(0.2, 2 * self.link.reply_timeout_s)
+    OFF = ZERO
+
+    def _command(self, outputs: Sequence[int]) -> list[int]:
+        return self.wiring.pwm(outputs)
+
+    def _exchange(self, command: list[int]) -> wire.Inputs:
+        return self.link.exchange(command)
+
+    def _send_off(self, timeout_s: float) -> None:
+        self.link.send_best_effort(Command.EXCHANGE_DATA, wire.exchange(ZERO), timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
         previous = self._reading.mask if self._reading is not None else 0  # hysteresis remembers last tick
-        return Reading(self.wiring.mask(reply.universal, previous), self._pulses(reply.counter_values),
-                       self.wiring.raw(reply.universal) or None)
-
-    def _pulses(self, values: Sequence[int]) -> tuple[int, ...]:
-        """Pulses per robot counter since the last reply: the TXT counts up in 16 bits; a count that went
-        back (the counter was reset) gives 0 and a new start."""
-        pulses = []
-        for i, terminal in enumerate(self.wiring.counters):
-            step = (values[terminal] - self._counts[i]) % COUNTER_WRAP
-            pulses.append(0 if step >= COUNTER_WRAP // 2 else step)
-            self._counts[i] = values[terminal]
-        return tuple(pulses)
+        pulses = self._pulses(reply.counter_values, self.wiring.counters)
+        return Reading(self.wiring.mask(reply.universal, previous), pulses, self.wiring.raw(reply.universal) or None)
