@@ -16,6 +16,7 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
+from tablebot.fleet.generators import generators
 from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.loop import RunEnd, TickBlock
@@ -26,7 +27,7 @@ from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.scene import Scene, _check_start, prepare
-from tablebot.sim.simrobot import SimRobot
+from tablebot.sim.simrobot import SimRobot, Starter, world_arrays
 from tablebot.sim.summary import Summary, light_bits
 from tablebot.sim.world import World, inside
 from tablebot.sinks.run_trace import seconds_per_state
@@ -134,31 +135,52 @@ class Fleet:
         self.bitgens = np.zeros(n, dtype=np.uint64)  # where each robot's Generator keeps its C bit generator
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
+        self._starters: dict[tuple, Starter] = {}
+        first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
+        self.world = world_arrays(first)
+        self.drive, self.pcols = np.array(first.drive, dtype=np.int64), np.array(first.pulse_columns, dtype=np.int64)
+        self.regs[:], self.outputs[:], self.counters[:] = self.initial
+        rngs = generators([spec.seed for spec in self.specs])  # default_rng(seed) each, made at once
         for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
-            robot = self.place(i, spec, scene, record=i in traced)
-            if i == 0:  # the world and wiring as SimRobot packs them: shared by all, never rebuilt here
-                self.world, self.drive, self.pcols = robot._world, robot._drive, robot._pcols
-            if i in traced:
+            robot = self.place(i, spec, scene, record=i in traced, fresh=True, rng=rngs[i])
+            if robot is not None:
                 self.traced[i] = len(self.traces)
                 self.traces[i] = Trace(robot)
         self.bits = self.scenes[0].bits
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
-    def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False) -> SimRobot:
+    def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False,
+              fresh: bool = False, rng: np.random.Generator | None = None) -> SimRobot | None:
         """Put robot i at its start as SimRobot sets a robot up (its gains and first reading drawn from its
-        own Generator, which then gives its noise), with a fresh engine; returns that SimRobot."""
+        own Generator, which then gives its noise: :class:`Starter`), with a fresh engine (``fresh``: its rows
+        are still as :meth:`_setup` made them). With ``record`` (a traced robot) it is a SimRobot, returned;
+        others are written straight into the fleet's rows (a SimRobot each was most of a sweep's set-up),
+        with ``rng`` if given (``default_rng(spec.seed)``, made beforehand)."""
         scene = scene or self.scene_of(spec)
-        robot = SimRobot(scene, spec.seed, record_history=record)
         self.specs[i] = spec
-        self.S[i], self.P[i], self.acc[i] = robot.s, scene.P[0], robot.acc
-        self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
-        self.regs[i], self.outputs[i], self.counters[i] = self.initial
-        self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
-        self.variant[i], self.battery_start_v[i] = spec.variant, robot.s[L.VBAT]
-        self.rngs[i] = robot.rng
-        self.bitgens[i] = bitgen_address(robot.rng)
+        self.P[i] = scene.P[0]
+        if record:
+            robot = SimRobot(scene, spec.seed, record_history=True)
+            self.S[i], self.acc[i] = robot.s, robot.acc
+            self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
+            rng = robot.rng
+        else:
+            robot, rng = None, rng if rng is not None else np.random.default_rng(spec.seed)
+            self.starter(spec, scene).start(scene.world.start, rng, self.S[i], self.acc[i], self.collisions[i])
+        if not fresh:
+            self.regs[i], self.outputs[i], self.counters[i] = self.initial
+            self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
+        self.variant[i], self.battery_start_v[i] = spec.variant, self.S[i, L.VBAT]
+        self.rngs[i] = rng
+        self.bitgens[i] = bitgen_address(rng)
         return robot
+
+    def starter(self, spec: RobotSpec, scene: Scene) -> Starter:
+        """How robots with ``spec``'s parameters start (one per parameter set, as their scenes)."""
+        if spec.params not in self._starters:
+            self._starters[spec.params] = Starter(scene)
+        return self._starters[spec.params]
 
     def __len__(self) -> int:
         return len(self.specs)

@@ -36,8 +36,7 @@ class SimRobot:
     def __init__(self, scene: Scene, seed: int = 1, record_history: bool = True):
         self.scene = scene
         self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
-        g = scene.geometry
-        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines)
+        self._world = world_arrays(scene)
         self._drive = np.array(scene.drive, dtype=np.int64)
         self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
         self.light_keys = light_keys(scene)
@@ -54,24 +53,10 @@ class SimRobot:
         if seed is not None:
             self.seed = seed
         self.rng = np.random.default_rng(self.seed)
-        self.s = self._start_row()
-        self.acc = K.new_accumulator(self.scene.world.reach, max(1, round(DEBOUNCE_S / self.scene.tick_s)))
-        self.collision_rows[:] = 0
+        self.s, self.acc = np.zeros(L.N_STATE), np.zeros(K.N_ACC)
         self.stopped = False
-        K.sense(self.s, self.scene.P[0], *self._world, self._noise(1)[0], self.scene.bits)
-        K.observe(self.s, self._world[5], self.acc, self.collision_rows)
+        Starter(self.scene).start(self.scene.world.start, self.rng, self.s, self.acc, self.collision_rows)
         return self.read(), {"seed": self.seed}
-
-    def _start_row(self) -> np.ndarray:
-        scene = self.scene
-        s = np.zeros(L.N_STATE)
-        x, y, heading = scene.world.start
-        s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
-        s[L.SOC] = charge = scene.params["battery"]["charge"]
-        s[L.VBAT] = terminal_volts(scene.params, charge, ())
-        spread = scene.params["noise"]["motor_spread"]
-        s[L.GAIN_R], s[L.GAIN_L] = 1.0 + spread * self.rng.standard_normal(2)
-        return s
 
     def _noise(self, ticks: int) -> np.ndarray:
         """The next ``ticks`` rows of this robot's noise stream (one stream, however it is cut)."""
@@ -164,6 +149,40 @@ class SimRobot:
         if self._observation is None:
             self._observation = Observation.of(self.scene)
         return self._observation(self.s[None, :])[0]
+
+
+def world_arrays(scene: Scene) -> tuple[np.ndarray, ...]:
+    """The scene's walls, obstacles, lamps and lines as the compiled code takes them."""
+    g = scene.geometry
+    return g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines
+
+
+class Starter:
+    """How a robot of one scene begins a run (its start row, accumulator and first sensor reading), with
+    what every robot of the scene shares worked out once: a fleet starts thousands of robots with one,
+    writing into its own rows, without a SimRobot each."""
+
+    def __init__(self, scene: Scene):
+        params = scene.params
+        self.world, self.p, self.bits = world_arrays(scene), scene.P[0], scene.bits
+        self.row = np.zeros(L.N_STATE)  # all but the pose and the motor gains
+        self.row[L.SOC] = charge = params["battery"]["charge"]
+        self.row[L.VBAT] = terminal_volts(params, charge, ())
+        self.spread = params["noise"]["motor_spread"]
+        self.acc = K.new_accumulator(scene.world.reach, max(1, round(DEBOUNCE_S / scene.tick_s)))
+
+    def start(self, pose: Sequence[float], rng: np.random.Generator, s: np.ndarray, acc: np.ndarray,
+              collisions: np.ndarray) -> None:
+        """Fill ``s``, ``acc`` and ``collisions`` for a robot starting at ``pose`` (x, y, heading in degrees)
+        whose Generator is ``rng``: its motor gains are its first two draws, its first reading's noise the next row."""
+        x, y, heading = pose
+        s[:] = self.row
+        s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
+        s[L.GAIN_R], s[L.GAIN_L] = 1.0 + self.spread * rng.standard_normal(2)
+        acc[:] = self.acc
+        collisions[:] = 0
+        K.sense(s, self.p, *self.world, rng.standard_normal((1, L.N_NOISE))[0], self.bits)
+        K.observe(s, self.world[5], acc, collisions)
 
 
 def light_keys(scene: Scene) -> tuple[str, str]:
