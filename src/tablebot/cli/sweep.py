@@ -72,7 +72,7 @@ def sweep_cmd(
     started = time.perf_counter()
     with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
         def done(job: Any, summary: Any) -> None:
-            store.write_part(job, plan.rows(job, summary))
+            store.write_part(job, plan.part_text(job, summary))
             progress.advance(len(summary))
         try:
             run_jobs(jobs, done, chosen, address, workers)
