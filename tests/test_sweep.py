@@ -292,3 +292,50 @@ def test_a_sweep_draws_its_pictures(tmp_path: Path) -> None:
     for name in ("outcomes", "starts", "best", "worst"):
         with Image.open(out / f"{name}.png") as image:
             assert image.format == "PNG" and image.width > 600, name
+
+
+def test_result_rows_are_what_csv_writes_for_each_robots_own_numbers(tmp_path: Path) -> None:
+    """results.csv (built column by column) against a row per robot, as dicts through csv.DictWriter, of the
+    fleet's own numbers rounded by Python's round: two worlds (one behind a path csv must quote), a grid."""
+    import csv
+    import io
+    import shutil
+
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.spec import runs
+
+    quoted = tmp_path / 'a "b", c' / "arena.toml"
+    quoted.parent.mkdir()
+    shutil.copy(BUMBERBOT.parent / "obstacle-avoider" / "arena.toml", quoted)
+    worlds, grid = [BUMBERBOT / "arena.toml", quoted], ["battery=1.0,0.55"]
+    code, output = sweep(*(a for w in worlds for a in ("--world", str(w))), "--grid", grid[0], "--seeds", "0..4",
+                         "--seconds", "3", "--out", str(tmp_path / "s"), "--no-plots")
+    assert code == 0, output
+    plan = make_plan(BUMBERBOT, None, worlds, grid, "0..4", None, 3.0)
+    tick_s = plan.machine.table.robot.tick_s
+    def when(tick: int) -> float | None:
+        return None if tick < 0 else round(tick * tick_s, 6)
+    rows = []
+    for world in range(2):
+        chosen = [run for run in runs(plan.spec) if run.world == world]
+        fleet = Fleet(plan.table, plan.machine, plan.worlds[world], [plan.robot(run) for run in chosen],
+                      plan.robot_params)
+        fleet.run(plan.spec.ticks)
+        s = fleet.summary()
+        for k, run in enumerate(chosen):
+            rows.append({"run": run.index, "world": plan.spec.worlds[world], "seed": run.seed, "battery": run.values[0],
+                         **dict(zip(("start_x", "start_y", "start_heading"), plan.worlds[world].start, strict=True)),
+                         "seconds": round(s.ticks * tick_s, 6), "first_light_s": when(s.first_light[k]),
+                         "reached": int(s.reached[k] >= 0), "reached_s": when(s.reached[k]),
+                         "collisions": int(s.collisions[k]), "distance_m": round(float(s.distance_m[k]), 6),
+                         "battery_start_v": round(float(s.battery_start_v[k]), 6),
+                         "battery_end_v": round(float(s.battery_end_v[k]), 6),
+                         "final_state": plan.machine.states[s.final_state[k]],
+                         **{f"time_{state}_s": round(float(s.counts[k, j]) * tick_s, 6)
+                            for j, state in enumerate(plan.machine.states)}})
+    expected = io.StringIO()
+    writer = csv.DictWriter(expected, plan.columns(), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    assert (tmp_path / "s" / "results.csv").read_text(encoding="utf-8") == expected.getvalue()
+    assert '"' in expected.getvalue()
