@@ -49,7 +49,7 @@ def sweep_cmd(
     OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
     resumes."""
     from tablebot.fileset import current, file_set
-    from tablebot.fleet.backends import choose, run_jobs
+    from tablebot.fleet.backends import Runner, choose
     from tablebot.fleet.plan import Store, make_plan, read_results
     from tablebot.interrupts import INTERRUPTS
 
@@ -57,27 +57,30 @@ def sweep_cmd(
         from tablebot.fleet.plots import write_all
 
     chosen, address = choose(backend, scheduler)
-    plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
-    traced = trace_runs(trace, plan.spec.total)
-    out_folder(out, "--out")
-    store = Store(out, plan)
-    finished = store.open()
-    jobs = plan.jobs(skip=finished)
-    total, already = plan.spec.total, sum(b - a for a, b in finished)
-    if chosen == "local" and jobs:
-        from tablebot.fleet.kernel import run_fleet, run_fleet_serial
-        from tablebot.jit import say_compiling
+    with Runner(chosen, address, workers) as runner:
+        runner.start()  # a cluster's workers start up while this process plans
+        plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
+        traced = trace_runs(trace, plan.spec.total)
+        out_folder(out, "--out")
+        store = Store(out, plan)
+        finished = store.open()
+        jobs = plan.jobs(skip=finished)
+        total, already = plan.spec.total, sum(b - a for a, b in finished)
+        if chosen == "local" and jobs:
+            from tablebot.fleet.kernel import run_fleet, run_fleet_serial
+            from tablebot.jit import say_compiling
 
-        say_compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one chunk: threaded
-    started = time.perf_counter()
-    with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
-        def done(job: Any, summary: Any) -> None:
-            store.write_part(job, plan.part_text(job, summary))
-            progress.advance(len(summary))
-        try:
-            run_jobs(jobs, done, chosen, address, workers)
-        except INTERRUPTS as exc:
-            stopped(store, total, exc)
+            say_compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one: threaded
+        started = time.perf_counter()
+        with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
+            def done(job: Any, summary: Any) -> None:
+                store.write_part(job, plan.part_text(job, summary))
+                progress.advance(len(summary))
+            try:
+                runner.run(jobs, done)
+            except INTERRUPTS as exc:
+                runner.close(failed=True)
+                stopped(store, total, exc)
     wall_s = time.perf_counter() - started
     with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
         path, _ = store.merge(complete=True)

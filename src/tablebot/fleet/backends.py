@@ -13,7 +13,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import fail
-from tablebot.fleet.work import Job, run_job, warm, warm_worker
+from tablebot.fleet.work import Job, ready_worker, run_job, warm, warm_worker
 
 if TYPE_CHECKING:
     from tablebot.fleet.run import FleetSummary
@@ -40,15 +40,6 @@ def choose(backend: str, scheduler: str | None) -> tuple[str, str | None]:
     return backend, address if backend == "dask" else None
 
 
-def run_jobs(jobs: Sequence[Job], done: Done, backend: str = "local", address: str | None = None,
-             workers: int | None = None) -> dict[str, Any]:
-    """Run every job, calling ``done(job, summary)`` as each finishes (in the order they finish);
-    returns what the backend says about itself (workers, their cache folders)."""
-    with Runner(backend, address, workers) as runner:
-        runner.run(jobs, done)
-        return runner.info
-
-
 class Runner:
     """A backend kept open over many batches of jobs (a tuning run sends one batch per generation):
     the local worker threads or the Dask client start, and warm up, once."""
@@ -59,6 +50,9 @@ class Runner:
         self.client: Any = None
         self.stop = threading.Event()  # set on Ctrl-C: local chunks end at their next block, unfinished
         self.info: dict[str, Any] = {"workers": 0}
+        self._opening: threading.Thread | None = None  # connecting to the cluster (see start)
+        self._lock, self._closed = threading.Lock(), False
+        self._opened: dict[str, Any] = {}  # what the opening thread sent the workers, or the error it met
 
     def __enter__(self) -> Runner:
         return self
@@ -74,6 +68,37 @@ class Runner:
             return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
         return max(1, self.workers or os.cpu_count() or 1)
 
+    def start(self) -> None:
+        """Begin opening the backend while the caller still plans: for Dask, connect on a thread and send
+        every worker the start-up that needs no job (imports, this process's compiled code, numba's
+        compiler: :func:`~tablebot.fleet.work.ready_worker`); :meth:`run` waits for it. A fresh worker
+        spent seconds on that after the client had planned, connected and warmed up."""
+        if self.backend != "dask" or self.client is not None or self._opening is not None:
+            return
+        self._opening = threading.Thread(target=self._open, name="tablebot-dask-connect", daemon=True)
+        self._opening.start()
+
+    def _open(self) -> None:
+        try:
+            client = connect(self.address or "")  # first: it says what to install when Dask is missing
+            with self._lock:
+                if self._closed:  # the caller gave up meanwhile (a mistake in its options, Ctrl-C)
+                    client.close()
+                    return
+                self.client = client
+            self._opened = ready_cluster(client)
+        except BaseException as exc:  # raised again in the caller's thread, by _connected
+            self._opened = {"failed": exc}
+
+    def _connected(self) -> Any:
+        """The Dask client, once :meth:`start`'s thread is through (its error raised here)."""
+        self.start()
+        assert self._opening is not None
+        self._opening.join()
+        if "failed" in self._opened:
+            raise self._opened["failed"]
+        return self.client
+
     def run(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]] = run_job) -> None:
         """Run every job with ``fn`` (default: the fleet's :func:`run_job`; evolve measures more per robot),
         handing each result to ``done`` as it comes back."""
@@ -85,14 +110,18 @@ class Runner:
             self._run_local(jobs, done, fn)
 
     def close(self, failed: bool = False) -> None:
+        """Stop the local threads or close the Dask client. A connection still being made is not waited
+        for: its thread closes the client it gets (an unreachable scheduler takes its whole timeout)."""
         if self.pool is not None:
             if failed:
                 self.stop.set()  # Ctrl-C: running chunks end within a block; what finished was handed over already
             self.pool.shutdown(wait=True, cancel_futures=True)
             self.pool = None
-        if self.client is not None:
-            self.client.close()
-            self.client = None
+        with self._lock:
+            self._closed = True
+            client, self.client = self.client, None
+        if client is not None:
+            client.close()
 
     def _call(self, fn: Callable[..., tuple[Job, Any]], job: Job) -> tuple[Job, Any]:
         """``fn(job)``; the fleet's own run_job also stops at its next block when the run is stopped."""
@@ -132,9 +161,8 @@ class Runner:
     def _run_dask(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
         """Every worker first warms the kernel in a cache folder of its own, from this process's compiled
         code (a fresh worker loads it instead of compiling again); then the chunks go out."""
-        if self.client is None:
-            self.client = connect(self.address or "")  # first: it says what to install when Dask is missing
-            self.info = warm_cluster(self.client, jobs[0])
+        if not self.info.get("warm"):
+            self.info = warm_cluster(self._connected(), jobs[0], self._opened)
         from distributed import as_completed
 
         client = self.client
@@ -163,28 +191,56 @@ def connect(address: str) -> Any:
                    "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
 
 
-def warm_cluster(client: Any, job: Job) -> dict[str, Any]:
-    """Warm every worker (pinned to it), with a cache slot named by its host and its rank there, from this
-    process's compiled code: compiled (or loaded) here once, sent to every worker once."""
+def slots(client: Any) -> list[tuple[str, str, int]]:
+    """Every worker's address, its cache slot (named by its host and its rank there) and how many workers
+    share its host."""
     workers = client.scheduler_info(n_workers=-1)["workers"]
-    if not workers:
-        raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
-    from tablebot import jit
-
-    warm(job, both=True)  # both kernels: a worker alone on its machine runs chunks on all its cores
-    files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
     by_host: dict[str, list[str]] = defaultdict(list)
     for address, worker in sorted(workers.items()):
         by_host[worker.get("host", address)].append(address)
-    futures = []
-    for host, addresses in by_host.items():
-        for rank, address in enumerate(addresses):
-            slot = f"{host}-{rank}".replace(":", "_").replace("/", "_")
-            futures.append(client.submit(warm_worker, job, slot, len(addresses), files, workers=[address],
-                                         allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}"))
+    return [(address, f"{host}-{rank}".replace(":", "_").replace("/", "_"), len(addresses))
+            for host, addresses in by_host.items() for rank, address in enumerate(addresses)]
+
+
+def compiled_files() -> dict[str, dict[str, bytes]] | None:
+    """This process's compiled fleet code (both kernels: a worker alone on its machine runs chunks on all
+    its cores), read from the cache without loading it; None if it is not compiled yet."""
+    from tablebot import jit
+    from tablebot.fleet.kernel import run_fleet, run_fleet_serial
+
+    return jit.cache_files() if jit.compiled(run_fleet, run_fleet_serial) else None
+
+
+def ready_cluster(client: Any) -> dict[str, Any]:
+    """Send every worker :func:`~tablebot.fleet.work.ready_worker` (pinned to it) with this process's
+    compiled code, if it has any yet; returns the files sent (a future held by every worker) and the
+    tasks, not waited for: the chunks wait for :func:`warm_cluster`."""
+    files = compiled_files()
+    scattered = client.scatter(files, broadcast=True, hash=False) if files else None
+    futures = [client.submit(ready_worker, slot, share, scattered, workers=[address], allow_other_workers=False,
+                             pure=False, key=f"tablebot-ready-{slot}") for address, slot, share in slots(client)]
+    return {"files": scattered, "ready": futures}
+
+
+def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Warm every worker (pinned to it) on ``job``: it loads the compiled kernel, from this process's
+    compiled code, compiled (or loaded) here first if :func:`ready_cluster` (``opened``) had none to send."""
+    opened = opened or {}
+    places = slots(client)
+    if not places:
+        raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
+    files = opened.get("files")
+    if files is None:  # nothing compiled to send early: compile here once, rather than on every worker
+        from tablebot import jit
+
+        warm(job, both=True)
+        files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
+    futures = [client.submit(warm_worker, job, slot, share, files, workers=[address], allow_other_workers=False,
+                             pure=False, key=f"tablebot-warm-{slot}") for address, slot, share in places]
     try:
+        client.gather(opened.get("ready", []))
         warmed = client.gather(futures)
     except Exception as exc:  # a scheduler or worker without tablebot (or another version of it)
         raise fail("--scheduler", f"the Dask cluster could not run tablebot's fleet: {type(exc).__name__}: {exc}",
                    "install the same tablebot (and Python) on the scheduler and every worker") from None
-    return {"workers": len(workers), "warm": warmed}
+    return {"workers": len(places), "warm": warmed}

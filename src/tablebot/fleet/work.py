@@ -22,6 +22,8 @@ if TYPE_CHECKING:
     from tablebot.table import Table
 
 COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
+CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
+MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
 _worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
 
 
@@ -54,11 +56,23 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
         if stop is not None and stop.is_set():
             raise Stopped
 
-    use_threads(job)
+    threads = job_threads(job)
+    if threads != 1:  # one thread: the calling thread alone, without numba's pool (not even started)
+        use_threads(job)
     fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
                   variants=job.variants)
-    fleet.run(job.ticks, progress=check)
+    fleet.run(job.ticks, progress=check, threads=False if threads == 1 else None, block_ticks=block_ticks(job))
     return replace(job, specs=[], variants=None), fleet.summary()
+
+
+def block_ticks(job: Job) -> int:
+    """Ticks per compiled call of a chunk: about a tenth of a second of one core's work (BLOCK_TICKS at
+    least), so a chunk on a thread comes back for the GIL (and to see a Ctrl-C) a few times, not every 256
+    ticks; the whole chunk at once when that is little more."""
+    from tablebot.fleet.run import BLOCK_TICKS
+
+    ticks = max(BLOCK_TICKS, min(CALL_ROBOT_TICKS // max(1, len(job.specs)), MAX_BLOCK_TICKS))
+    return job.ticks if job.ticks <= ticks * 5 // 4 else ticks
 
 
 def job_threads(job: Job) -> int | None:
@@ -93,15 +107,18 @@ def warm(job: Job, both: bool = False) -> float:
     return time.perf_counter() - started
 
 
-def warm_worker(job: Job, slot: str, share: int = 1,
-                files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
-    """On a cluster worker: choose a cache folder of its own (``worker-SLOT`` in the user's numba cache
-    for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code already loaded
-    here; put the client's compiled code there (``files``, from :func:`tablebot.jit.cache_files`: a fresh
-    worker then loads it instead of compiling); then load (or compile) the kernel once, before any chunk
-    runs (concurrent compiles into one cache folder race: numba issues #4807, #10128). Its chunks then
-    use 1/``share`` of the machine's cores (``share``: the workers on this machine)."""
+def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
+    """On a cluster worker, before it sees a job: choose a cache folder of its own (``worker-SLOT`` in the
+    user's numba cache for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code
+    already loaded here; put the client's compiled code there (``files``, from
+    :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling); import the
+    compiled modules and load numba's compiler (what a fresh worker's first chunk spent seconds on). Needs
+    no job, so the client sends it as soon as it is connected, while it still plans. Its chunks then use
+    1/``share`` of the machine's cores (``share``: the workers on this machine). Idempotent."""
+    import time
+
     global _worker_threads
+    started = time.perf_counter()
     _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
     given = bool(os.environ.get("NUMBA_CACHE_DIR"))
     from tablebot import jit  # numba, and the default cache folder (per user, Python and sources)
@@ -113,8 +130,25 @@ def warm_worker(job: Job, slot: str, share: int = 1,
         os.environ[jit.ENV] = folder
         numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
     installed = jit.install_cache_files(files) if files else 0
-    seconds = warm(job, both=_worker_threads > 1)
     import numba
 
-    return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR, "seconds": seconds,
-            "threads": _worker_threads, "installed": installed}
+    import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls)
+
+    try:  # numba loads its compiler's registries on the first compile or cache load; here, not in a chunk
+        from numba.core.registry import cpu_target
+
+        cpu_target.typing_context.refresh()
+        cpu_target.target_context.refresh()
+    except (ImportError, AttributeError):  # another numba: the first load does it, as before
+        pass
+    return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR,
+            "threads": _worker_threads, "installed": installed, "ready_s": time.perf_counter() - started}
+
+
+def warm_worker(job: Job, slot: str, share: int = 1,
+                files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
+    """On a cluster worker: :func:`ready_worker` (if it has not run), then load (or compile) the kernel
+    once, before any chunk runs (concurrent compiles into one cache folder race: numba issues #4807,
+    #10128)."""
+    info = ready_worker(slot, share, files)
+    return {**info, "seconds": warm(job, both=(_worker_threads or 1) > 1)}
