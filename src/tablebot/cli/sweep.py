@@ -50,7 +50,7 @@ def sweep_cmd(
     resumes."""
     from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import Runner, choose
-    from tablebot.fleet.plan import Store, make_plan, read_results
+    from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
     from tablebot.interrupts import INTERRUPTS
 
     if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
@@ -84,7 +84,7 @@ def sweep_cmd(
     wall_s = time.perf_counter() - started
     with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
         path, _ = store.merge(complete=True)
-        rows = read_results(current(path))
+        rows = read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
         written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
     if not quiet:
         report(plan, rows, written, wall_s, total - already)

@@ -238,9 +238,9 @@ def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) ->
     futures = [client.submit(warm_worker, job, slot, share, files, workers=[address], allow_other_workers=False,
                              pure=False, key=f"tablebot-warm-{slot}") for address, slot, share in places]
     try:
-        client.gather(opened.get("ready", []))
+        ready = client.gather(opened.get("ready", []))
         warmed = client.gather(futures)
     except Exception as exc:  # a scheduler or worker without tablebot (or another version of it)
         raise fail("--scheduler", f"the Dask cluster could not run tablebot's fleet: {type(exc).__name__}: {exc}",
                    "install the same tablebot (and Python) on the scheduler and every worker") from None
-    return {"workers": len(places), "warm": warmed}
+    return {"workers": len(places), "ready": ready, "warm": warmed}

@@ -8,6 +8,7 @@ table, world, start, battery and seed.
 
 from __future__ import annotations
 
+from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -141,40 +142,48 @@ class Fleet:
         self.drive, self.pcols = np.array(first.drive, dtype=np.int64), np.array(first.pulse_columns, dtype=np.int64)
         self.regs[:], self.outputs[:], self.counters[:] = self.initial
         rngs = generators([spec.seed for spec in self.specs])  # default_rng(seed) each, made at once
-        for i, (spec, scene) in enumerate(zip(self.specs, self.scenes, strict=True)):
-            robot = self.place(i, spec, scene, record=i in traced, fresh=True, rng=rngs[i])
-            if robot is not None:
+        by_params: dict[tuple, list[int]] = defaultdict(list)  # untraced robots, by parameter set
+        recorded = set(traced)
+        for i, spec in enumerate(self.specs):
+            if i in recorded:
                 self.traced[i] = len(self.traces)
-                self.traces[i] = Trace(robot)
+                self.traces[i] = Trace(self.place(i, spec, self.scenes[i], record=True))  # type: ignore[arg-type]
+            else:
+                by_params[spec.params].append(i)
+        for rows in by_params.values():
+            self._start(rows, [rngs[i] for i in rows], self.scenes[rows[0]], [self.scenes[i].world.start for i in rows])
         self.bits = self.scenes[0].bits
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
-    def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False,
-              fresh: bool = False, rng: np.random.Generator | None = None) -> SimRobot | None:
+    def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False) -> SimRobot | None:
         """Put robot i at its start as SimRobot sets a robot up (its gains and first reading drawn from its
-        own Generator, which then gives its noise: :class:`Starter`), with a fresh engine (``fresh``: its rows
-        are still as :meth:`_setup` made them). With ``record`` (a traced robot) it is a SimRobot, returned;
-        others are written straight into the fleet's rows (a SimRobot each was most of a sweep's set-up),
-        with ``rng`` if given (``default_rng(spec.seed)``, made beforehand)."""
+        own Generator, which then gives its noise: :class:`Starter`), with a fresh engine. With ``record``
+        (a traced robot) it is a SimRobot, returned."""
         scene = scene or self.scene_of(spec)
         self.specs[i] = spec
-        self.P[i] = scene.P[0]
-        if record:
-            robot = SimRobot(scene, spec.seed, record_history=True)
-            self.S[i], self.acc[i] = robot.s, robot.acc
-            self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
-            rng = robot.rng
-        else:
-            robot, rng = None, rng if rng is not None else np.random.default_rng(spec.seed)
-            self.starter(spec, scene).start(scene.world.start, rng, self.S[i], self.acc[i], self.collisions[i])
-        if not fresh:
-            self.regs[i], self.outputs[i], self.counters[i] = self.initial
-            self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
-        self.variant[i], self.battery_start_v[i] = spec.variant, self.S[i, L.VBAT]
-        self.rngs[i] = rng
-        self.bitgens[i] = bitgen_address(rng)
+        self.regs[i], self.outputs[i], self.counters[i] = self.initial
+        self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
+        if not record:
+            self._start([i], [np.random.default_rng(spec.seed)], scene, [scene.world.start])
+            return None
+        robot = SimRobot(scene, spec.seed, record_history=True)
+        self.S[i], self.acc[i], self.P[i] = robot.s, robot.acc, scene.P[0]
+        self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
+        self.variant[i], self.battery_start_v[i] = spec.variant, robot.s[L.VBAT]
+        self.rngs[i], self.bitgens[i] = robot.rng, bitgen_address(robot.rng)
         return robot
+
+    def _start(self, rows: list[int], rngs: list[np.random.Generator], scene: Scene, starts: list[Pose]) -> None:
+        """Robots ``rows`` (of one parameter set, that of ``scene``) at their ``starts``, each with its
+        Generator (``default_rng(seed)``), written straight into the fleet's rows: a SimRobot each was
+        most of a sweep's set-up."""
+        self.starter(self.specs[rows[0]], scene).start(starts, rngs, rows, self.S, self.acc, self.collisions)
+        self.P[rows] = scene.P[0]
+        self.variant[rows] = [self.specs[i].variant for i in rows]
+        self.battery_start_v[rows] = self.S[rows, L.VBAT]
+        for i, rng in zip(rows, rngs, strict=True):
+            self.rngs[i], self.bitgens[i] = rng, bitgen_address(rng)
 
     def starter(self, spec: RobotSpec, scene: Scene) -> Starter:
         """How robots with ``spec``'s parameters start (one per parameter set, as their scenes)."""

@@ -53,9 +53,10 @@ class SimRobot:
         if seed is not None:
             self.seed = seed
         self.rng = np.random.default_rng(self.seed)
-        self.s, self.acc = np.zeros(L.N_STATE), np.zeros(K.N_ACC)
+        S, acc = np.zeros((1, L.N_STATE)), np.zeros((1, K.N_ACC))
+        Starter(self.scene).start([self.scene.world.start], [self.rng], [0], S, acc, self.collision_rows[None, :])
+        self.s, self.acc = S[0], acc[0]
         self.stopped = False
-        Starter(self.scene).start(self.scene.world.start, self.rng, self.s, self.acc, self.collision_rows)
         return self.read(), {"seed": self.seed}
 
     def _noise(self, ticks: int) -> np.ndarray:
@@ -171,18 +172,21 @@ class Starter:
         self.spread = params["noise"]["motor_spread"]
         self.acc = K.new_accumulator(scene.world.reach, max(1, round(DEBOUNCE_S / scene.tick_s)))
 
-    def start(self, pose: Sequence[float], rng: np.random.Generator, s: np.ndarray, acc: np.ndarray,
-              collisions: np.ndarray) -> None:
-        """Fill ``s``, ``acc`` and ``collisions`` for a robot starting at ``pose`` (x, y, heading in degrees)
-        whose Generator is ``rng``: its motor gains are its first two draws, its first reading's noise the next row."""
-        x, y, heading = pose
-        s[:] = self.row
-        s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
-        s[L.GAIN_R], s[L.GAIN_L] = 1.0 + self.spread * rng.standard_normal(2)
-        acc[:] = self.acc
-        collisions[:] = 0
-        K.sense(s, self.p, *self.world, rng.standard_normal((1, L.N_NOISE))[0], self.bits)
-        K.observe(s, self.world[5], acc, collisions)
+    def start(self, poses: Sequence[Sequence[float]], rngs: Sequence[np.random.Generator], rows: Sequence[int],
+              S: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+        """Fill rows ``rows`` of ``S``, ``acc`` and ``collisions`` for robots starting at ``poses`` (x, y,
+        heading in degrees) whose Generators are ``rngs``: each robot's motor gains are its first two
+        draws, its first reading's noise the next row (one draw of both: the same numbers)."""
+        draws = np.array([rng.standard_normal(2 + L.N_NOISE) for rng in rngs]).reshape(len(rows), 2 + L.N_NOISE)
+        S[rows] = self.row
+        S[rows, L.X:L.TH + 1] = [(x, y, math.radians(heading)) for x, y, heading in poses]
+        S[rows, L.GAIN_R] = 1.0 + self.spread * draws[:, 0]
+        S[rows, L.GAIN_L] = 1.0 + self.spread * draws[:, 1]
+        acc[rows] = self.acc
+        collisions[rows] = 0
+        for k, i in enumerate(rows):
+            K.sense(S[i], self.p, *self.world, draws[k, 2:], self.bits)
+            K.observe(S[i], self.world[5], acc[i], collisions[i])
 
 
 def light_keys(scene: Scene) -> tuple[str, str]:
