@@ -30,17 +30,15 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
     from tablebot.sensors import Sensor
 
 
-
 @dataclass(frozen=True)
 class Digital:
-    """A digital mode: its polarity key, what is wired (for hints), what the key means, what the controller
-    reads then (the table reads ``key``'s value) and the words of an input's label that suggest the mode."""
+    """A digital mode: the robot file says with ``key`` what the table reads ``meaning``."""
 
-    key: str
-    device: str
-    meaning: str
-    reports: int = 1
-    words: tuple[str, ...] = ()
+    key: str  # "pressed"
+    device: str  # what is wired, for hints: "a push-button"
+    meaning: str  # "while the push-button is pressed"
+    reports: int = 1  # the controller's reading while so (a track sensor's over the line is 0)
+    words: tuple[str, ...] = ()  # words of an input's label that suggest this mode for a section to paste
 
 
 #: The digital modes every controller offers (a controller may add its own: :attr:`Terminals.digital_modes`)
