@@ -35,6 +35,7 @@ import argparse
 import contextlib
 import hashlib
 import os
+import resource
 import socket
 import statistics
 import subprocess
@@ -51,11 +52,18 @@ TARGET_FRESH = 0.8  # a fresh Dask cluster's speed as a share of the local run's
 TARGET_HOUR_S = 2.0  # sim --seconds 3600 with pictures
 
 
+CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() process: steadier than wall on a busy machine
+
+
 def tablebot(*args: str, env: dict[str, str] | None = None) -> float:
-    """Wall seconds of ``python -m tablebot ARGS`` as a fresh process (it must succeed)."""
+    """Wall seconds of ``python -m tablebot ARGS`` as a fresh process (it must succeed); its CPU seconds go
+    to ``CPU_S``."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=env, capture_output=True, text=True)
     elapsed = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU_S.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
     if done.returncode:
         raise SystemExit(f"tablebot {' '.join(args)} failed:\n{done.stderr}")
     return elapsed
@@ -239,13 +247,16 @@ def main() -> int:
 
     ticks = round(seconds / 0.010)
     work = robots * ticks
+    CPU_S.clear()
     walls = [sweep_process(robots, seconds) for _ in range(args.repeat)]
+    cpu = med(CPU_S)
     kernels = [kernel_rate(robots, ticks) for _ in range(args.repeat)]
     rate, inner = work / med(walls), med(kernels)
     ok = rate >= TARGET_SWEEP
     missed += not ok
     print(f"sweep --robots {robots:,} --seconds {seconds:g}, whole process: {med(walls):.2f} s = {rate / 1e6:.2f} M "
-          f"robot-ticks/s ({' '.join(f'{w:.2f}' for w in walls)} s)  target >= {TARGET_SWEEP / 1e6:g} M  {verdict(ok)}")
+          f"robot-ticks/s ({' '.join(f'{w:.2f}' for w in walls)} s; {cpu:.2f} s CPU)  "
+          f"target >= {TARGET_SWEEP / 1e6:g} M  {verdict(ok)}")
     print(f"  the kernel alone (in-process fleet, warm): {inner / 1e6:.2f} M robot-ticks/s; the process runs at "
           f"{rate / inner:.2f}x the kernel's speed (the rest: start-up, planning, results)")
 
