@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import LineCollection
+from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -244,8 +244,7 @@ def timeline_figure(result: SimRun, summary: Summary) -> Figure:
     collisions = np.array(summary.collision_ticks) * result.tick_s
     for ax in axes:
         if len(collisions):  # one artist per panel for all of them
-            ax.vlines(collisions, 0, 1, transform=ax.get_xaxis_transform(), color=COLLISION, lw=0.8, alpha=0.5,
-                      zorder=0)
+            _vlines(ax, collisions)
         if summary.first_light_s is not None:
             ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
         ax.grid(axis="x", alpha=0.3)
@@ -258,6 +257,30 @@ def timeline_figure(result: SimRun, summary: Summary) -> Figure:
     return fig
 
 
+def _vlines(ax, x: np.ndarray) -> None:
+    """Red lines across the panel at times ``x``: what ``ax.vlines(x, 0, 1, transform=<x axis>)`` draws,
+    without its data limits (a quarter second for an hour's collisions; every panel's limits are set)."""
+    segments = np.zeros((len(x), 2, 2))
+    segments[:, :, 0] = x[:, None]
+    segments[:, 1, 1] = 1.0
+    ax.add_collection(LineCollection(segments, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0,
+                                     transform=ax.get_xaxis_transform()), autolim=False)
+
+
+def _bars(ax, starts: np.ndarray, widths: np.ndarray, bottom: float, height: float, colour: str) -> None:
+    """What ``ax.broken_barh(zip(starts, widths), (bottom, height), facecolors=colour)`` draws, its
+    rectangles made by numpy instead of one by one (an hour has thousands; the panels' limits are set)."""
+    if not len(starts):
+        return
+    x0 = np.asarray(starts, dtype=np.float64)
+    x1 = x0 + np.asarray(widths, dtype=np.float64)
+    y0, y1 = bottom, bottom + height
+    corners = np.empty((len(x0), 4, 2))
+    corners[:, :, 0] = np.column_stack((x0, x0, x1, x1))
+    corners[:, :, 1] = (y0, y1, y1, y0)
+    ax.add_collection(PolyCollection(corners, facecolors=colour), autolim=False)
+
+
 def _state_panel(ax, result: SimRun) -> None:
     machine = result.scene.machine
     colours = state_colours(machine.states)
@@ -266,12 +289,10 @@ def _state_panel(ax, result: SimRun) -> None:
     change = np.flatnonzero(np.diff(result.states)) + 1
     starts = np.concatenate(([0], change))
     ends = np.concatenate((change, [result.ticks]))
-    tick = result.tick_s
-    spans: dict[int, list[tuple[float, float]]] = {}
-    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
-        spans.setdefault(int(result.states[a]), []).append((a * tick, (b - a) * tick))
-    for s, runs in spans.items():  # one call per state, not per visit: an hour has thousands
-        ax.broken_barh(runs, (rows[s] - 0.4, 0.8), facecolors=colours[s])
+    tick, state = result.tick_s, result.states[starts]
+    for s in dict.fromkeys(state.tolist()):  # one artist per state (in order of first visit), not per visit
+        mine = state == s
+        _bars(ax, starts[mine] * tick, (ends[mine] - starts[mine]) * tick, rows[s] - 0.4, 0.8, colours[s])
     ax.set_yticks(range(len(visited)))
     ax.set_yticklabels([picture(result.scene.table.state_title(machine.states[s])) for s in visited], fontsize=8)
     ax.set_ylim(-0.7, len(visited) - 0.3)
@@ -306,8 +327,8 @@ def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
     for k, name in enumerate(table.events):
         on = np.concatenate(([False], (ev & table.bit(name)) != 0, [False])).astype(np.int8)
         edges = np.flatnonzero(np.diff(on))
-        runs = [(a * tick, max((b - a) * tick, least)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
-        ax.broken_barh(runs, (k - 0.38, 0.76), facecolors="#2f3640")
+        a, b = edges[::2], edges[1::2]
+        _bars(ax, a * tick, np.maximum((b - a) * tick, least), k - 0.38, 0.76, "#2f3640")
     ax.set_yticks(range(len(table.events)))
     ax.set_yticklabels([picture(f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}")
                         for n in table.events], fontsize=8)
