@@ -5,9 +5,10 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 
 from __future__ import annotations
 
+import io
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -36,6 +37,7 @@ from tablebot.sim.draw import (
     literal_text,
     sensor_readings,
 )
+from tablebot.sim.forked import Forked
 from tablebot.sim.runner import SimRun
 from tablebot.sim.summary import Summary
 
@@ -105,11 +107,33 @@ def spin_starts(h: np.ndarray, states: np.ndarray) -> np.ndarray:
     return starts[(moved < SPIN_M) & (turned > SPIN_DEG)]
 
 
+def trajectory_and_timeline(result: SimRun, summary: Summary, folder: Path) -> list[Path]:
+    """trajectory.png and timeline.png in ``folder``, drawn at once: the timeline by a forked copy of this
+    process on the other core (:mod:`tablebot.sim.forked`), the trajectory here; both files are written
+    here, in that order, each under a temporary name renamed into place."""
+    with Forked(lambda: png_bytes(timeline_figure(result, summary))) as timeline_png:
+        drawn = [trajectory(result, summary, folder / "trajectory.png")]
+        with atomic_write(folder / "timeline.png", "wb") as stream:
+            stream.write(timeline_png.result())
+    return [*drawn, folder / "timeline.png"]
+
+
 def save(fig: Figure, path: Path) -> Path:
     """Write the figure as PNG under a temporary name, renamed into place when complete."""
     with atomic_write(path, "wb") as stream:
-        fig.savefig(stream, format="png", facecolor="white")  # Pillow's own zlib level: the same bytes as ever
+        _write_png(fig, stream)
     return path
+
+
+def png_bytes(fig: Figure) -> bytes:
+    """The figure as PNG, the bytes :func:`save` writes."""
+    stream = io.BytesIO()
+    _write_png(fig, stream)
+    return stream.getvalue()
+
+
+def _write_png(fig: Figure, stream: IO[bytes]) -> None:
+    fig.savefig(stream, format="png", facecolor="white")  # Pillow's own zlib level: the same bytes as ever
 
 
 def path_pieces(xy: np.ndarray, states: np.ndarray, step: float) -> tuple[list[np.ndarray], list[int]]:
