@@ -132,8 +132,12 @@ def png_bytes(fig: Figure) -> bytes:
     return stream.getvalue()
 
 
+#: zlib's fastest level: the same pixels as Pillow's default (6) in two thirds of the time, files ~25 % larger
+PNG_LEVEL = 1
+
+
 def _write_png(fig: Figure, stream: IO[bytes]) -> None:
-    fig.savefig(stream, format="png", facecolor="white")  # Pillow's own zlib level: the same bytes as ever
+    fig.savefig(stream, format="png", facecolor="white", pil_kwargs={"compress_level": PNG_LEVEL})
 
 
 def path_pieces(xy: np.ndarray, states: np.ndarray, step: float) -> tuple[list[np.ndarray], list[int]]:
