@@ -71,6 +71,41 @@ if not numba.config.CACHE_DIR:  # numba was imported before us: its cache locato
 prange = numba.prange
 
 
+def _load_cached_code_directly() -> None:
+    """Let numba load a function's machine code from its cache without first readying its whole compiler.
+
+    Before each load from the cache numba "refreshes" its compiler: it imports its ~200 modules of typing and
+    lowering rules (and scipy.linalg, to see whether BLAS is there) and installs them -- 0.6-0.8 s of every
+    tablebot process that runs a robot, on this 2-core machine, against ~10 ms for the load itself. Running
+    machine code needs none of it: only numba's runtime for arrays (initialised here, as the refresh would),
+    and the parallel back-end, which the cached code starts itself (its ``reload_init``). A function not in
+    the cache, or one whose load fails, takes numba's own path (the refresh, then the load or a compile, and
+    every compile refreshes by itself), so a load can only be faster, never different: the same machine code
+    runs either way.
+    """
+    from numba.core.caching import Cache
+    from numba.core.runtime import nrt
+
+    original = Cache.load_overload
+    if getattr(original, "direct", False) or not hasattr(Cache, "_load_overload") \
+            or not hasattr(nrt.rtsys, "initialize"):
+        return  # done already, or another numba: keep its own path
+
+    def load_overload(self: Any, sig: Any, target_context: Any) -> Any:
+        try:
+            nrt.rtsys.initialize(target_context)
+            loaded = self._load_overload(sig, target_context)
+        except Exception:  # whatever failed, numba's own path tries again and reports it
+            loaded = None
+        return loaded if loaded is not None else original(self, sig, target_context)
+
+    load_overload.direct = True  # type: ignore[attr-defined]
+    Cache.load_overload = load_overload  # type: ignore[method-assign]
+
+
+_load_cached_code_directly()
+
+
 def compiled(*functions: Any) -> bool:
     """Whether each of ``functions`` (made with :func:`njit`) has machine code in the on-disk cache: if one
     has not, its first call compiles it (tens of seconds for the simulator), which a user should be told."""
