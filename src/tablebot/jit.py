@@ -13,6 +13,7 @@ import uuid
 from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 ENV = "NUMBA_CACHE_DIR"
@@ -63,7 +64,30 @@ os.environ.setdefault(ENV, cache_dir())  # before numba's first import, which re
 # machine a 1-robot fleet's tick took 31 us with spinning threads, 0.9 us without. Read when OpenMP starts.
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-import numba  # noqa: E402  (after the cache folder is set)
+
+
+def _import_numba() -> ModuleType:
+    """numba, imported without importing scipy.
+
+    numba's ``__init__`` imports scipy only to check that it is not older than 1.0 (skipped when scipy is
+    absent), and that import is a tenth of numba's own; nothing tablebot compiles uses scipy. scipy stays
+    importable as ever: whoever needs it (evolve's archive) imports it as usual, and a compile that uses
+    BLAS has numba import it then.
+    """
+    if "numba" in sys.modules or "scipy" in sys.modules:
+        import numba
+
+        return numba
+    sys.modules["scipy"] = None  # type: ignore[assignment]  (`import scipy` raises ImportError meanwhile)
+    try:
+        import numba
+    finally:
+        if "scipy" in sys.modules and sys.modules["scipy"] is None:
+            del sys.modules["scipy"]
+    return numba
+
+
+numba = _import_numba()  # after the cache folder is set
 
 if not numba.config.CACHE_DIR:  # numba was imported before us: its cache locator reads this at use
     numba.config.CACHE_DIR = os.environ[ENV]
