@@ -29,7 +29,8 @@ def test_duty_in_python_has_the_compiled_bits(level: int, levels: int) -> None:
 @given(full=VOLTS, empty=VOLTS, charge=st.floats(0.0, 1.0), amps=st.floats(0.0, 20.0), ohms=st.floats(0.0, 20.0))
 def test_pack_volts_in_python_has_the_compiled_bits(full: float, empty: float, charge: float, amps: float,
                                                     ohms: float) -> None:
-    assert bits(pack_volts.py_func(full, empty, charge, amps, ohms)) == bits(pack_volts(full, empty, charge, amps, ohms))
+    args = (full, empty, charge, amps, ohms)
+    assert bits(pack_volts.py_func(*args)) == bits(pack_volts(*args))
 
 
 @settings(max_examples=50, deadline=None)
