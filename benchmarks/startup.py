@@ -65,12 +65,22 @@ def inner_seconds(name: str, output: str) -> float | None:
     return None
 
 
+# The command line run in a child that prints, on exit, the top-level packages it imported.
+MODULES = """
+import atexit, sys
+atexit.register(lambda: print('PACKAGES', *sorted({m.split('.')[0] for m in list(sys.modules)})))
+sys.argv = ['tablebot', *sys.argv[1:]]
+from tablebot.cli import main
+main()
+"""
+
+
 def imported(args: list[str]) -> list[str]:
-    """Which of :data:`HEAVY` the command imports (one run under ``-X importtime``)."""
+    """Which of :data:`HEAVY` the command imports."""
     with tempfile.TemporaryDirectory() as out:
-        argv = [sys.executable, "-X", "importtime", "-m", "tablebot", *[a.replace("OUT", out) for a in args]]
+        argv = [sys.executable, "-c", MODULES, *[a.replace("OUT", out) for a in args]]
         done = subprocess.run(argv, cwd=ROOT, env=child_env(), capture_output=True, text=True)
-    found = set(re.findall(r"\|\s+([\w]+)(?:\.|\s*$)", done.stderr, flags=re.M))
+    found = next((line.split()[1:] for line in done.stdout.splitlines() if line.startswith("PACKAGES")), [])
     return [name for name in HEAVY if name in found]
 
 
@@ -102,7 +112,8 @@ import typer._adapters; lap("typer's pydantic (imported when it parses options)"
 import numpy; lap("import numpy")
 import tablebot.jit; lap("import numba (tablebot.jit)")
 from tablebot.fleet.plan import make_plan; lap("import the fleet (plan, run, kernel modules)")
-plan = make_plan(sys.argv[1], None, [], [], None, 10000, 10.0)
+from pathlib import Path
+plan = make_plan(Path(sys.argv[1]), None, [], [], None, 10000, 10.0)
 lap("plan 10,000 runs (scene checks: first compiled code, numba's runtime)")
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.sim.scene import robot_layer
@@ -149,8 +160,8 @@ def main() -> int:
         floor = floor if floor is not None else wall
         around = f"{wall - run:7.2f}" if run is not None else f"{'':7}"
         heavy = ", ".join(imported(cmd)) if cmd else ""
-        print(f"{name:<18} {wall:7.2f} {cpu:7.2f} {run if run is not None else '':>7.6} {around}  {heavy or '-'}"
-              .replace(" 0.0000 ", "        "))
+        shown = f"{run:7.2f}" if run is not None else f"{'':7}"
+        print(f"{name:<18} {wall:7.2f} {cpu:7.2f} {shown} {around}  {heavy or '-'}")
     print(f"(run s: the run as the command reports it; around = wall - run: start-up, planning, files. The "
           f"interpreter alone is {floor:.3f} s.)")
 
