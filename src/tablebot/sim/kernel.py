@@ -69,7 +69,7 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True)
-def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
+def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
               drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
     rows, by a row drawn from the numpy Generator whose ``bitgen_t`` is at ``bitgen`` (sim.normals).
@@ -82,13 +82,14 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits, drive,
-              pcols, ticks, noise, bitgen, hist, ints, acc, collisions, np.zeros(counters.shape[0], dtype=np.int64),
-              np.empty((4, 2)), reach, wide, near, centre, turns, np.empty(N_NOISE))
+    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions,
+              np.zeros(counters.shape[0], dtype=np.int64), np.empty((4, 2)), reach, wide, near, centre, turns,
+              np.empty(N_NOISE))
 
 
 @njit(nogil=True, refcounts=False)
-def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
+def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
               drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, pulses, corners, reach, wide, near,
               centre, turns, z):  # type: ignore[no-untyped-def]
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
@@ -109,8 +110,8 @@ def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
         else:
             for k in range(N_NOISE):
                 z[k] = standard_normal(bitgen)
-        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, z,
-                bits, True, corners, reach, wide, near, centre, turns)
+        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, shade,
+                z, bits, True, corners, reach, wide, near, centre, turns)
         observe(s, lamps, acc, collisions)
 
 
@@ -134,24 +135,24 @@ def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-
 
 
 @njit(nogil=True)
-def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits):  # type: ignore[no-untyped-def]
+def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits):  # type: ignore[no-untyped-def]
     """Read the sensors without moving (the start of a run)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)), reach,
-            wide, near, centre, turns)
+    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, False, np.empty((4, 2)),
+            reach, wide, near, centre, turns)
 
 
 @njit(nogil=True)
-def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, acc,
+def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, acc,
          collisions):  # type: ignore[no-untyped-def]
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)),
-            reach, wide, near, centre, turns)
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, True,
+            np.empty((4, 2)), reach, wide, near, centre, turns)
     observe(s, lamps, acc, collisions)

@@ -37,7 +37,7 @@ class SimRobot:
         self.scene = scene
         self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
         g = scene.geometry
-        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines)
+        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines, g.shade)
         self._drive = np.array(scene.drive, dtype=np.int64)
         self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
         self.light_keys = light_keys(scene)
