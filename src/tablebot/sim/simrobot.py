@@ -117,7 +117,7 @@ class SimRobot:
         start = engine.tick
         K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
                     self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
-                    self.acc, self.collision_rows)
+                    self.acc, self.collision_rows, *K.NO_TALLY)
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
