@@ -11,7 +11,7 @@ engine's tick rule. A part's loop copies each row first; that copy is timed alon
 
 Times are CPU time (``process_time``: what this process ran, not what others on a shared machine took), the
 median of the repeats. With ``--baseline REF`` the same measurement runs on the git revision REF's sources
-(exported to a temporary folder, compiled into their own numba cache) in a fresh process, alternating with
+(exported once into the temporary folder, compiled into their own numba cache) in a fresh process, alternating with
 this tree's, ``--rounds`` times each: the ratios (this tree / the baseline) are the figures to read on a busy
 machine. Without it, each part is also shown as a share of the whole tick.
 """
@@ -19,6 +19,7 @@ machine. Without it, each part is also shown as a share of the whole tick.
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import math
 import os
@@ -91,7 +92,8 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
         "contacts": ns("contacts", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, np.empty((4, 2)),
                        *near_centre) - copy,
         "motors": ns("motors", rows, p, s, np.zeros(4)) - copy,
-        "declared sensors": ns("declared", rows, p, g.edges, g.circles, g.lamps, g.lines, s) - copy,
+        "declared sensors": ns("declared", rows, p, g.edges, g.circles, g.lamps, g.lines, s,
+                               "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func)) - copy,
         "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s)
         - copy,
         "noise (4 normals)": ns("noise", rows.shape[0], fleet.bitgens[0]),
@@ -179,10 +181,10 @@ def _loops() -> dict[str, Any]:
         return s[0]
 
     @fast
-    def declared(rows, p, edges, circles, lamps, lines, s):  # type: ignore[no-untyped-def]
+    def declared(rows, p, edges, circles, lamps, lines, s, skip):  # type: ignore[no-untyped-def]
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            if p[L.P_SENSOR + L.F_KIND] != 0.0:  # as the kernel does: no pass without declared sensors
+            if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
                 sense_declared(s, math.cos(s[L.TH]), math.sin(s[L.TH]), p, edges, circles, lamps, lines)
         return s[0]
 
@@ -212,11 +214,18 @@ def _loops() -> dict[str, Any]:
     return dict(locals())
 
 
-def baseline_sources(ref: str, folder: str) -> str:
-    """REF's src/ exported into ``folder`` (git archive): the tree a fresh process imports as the baseline."""
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", ref, "src"], check=True, capture_output=True)
-    subprocess.run(["tar", "-x", "-C", folder], input=archive.stdout, check=True)
-    return os.path.join(folder, "src")
+def baseline_sources(ref: str) -> str:
+    """REF's src/ exported (git archive) into a folder named after its commit, kept in the temporary folder so
+    that its compiled code (numba caches by source path) serves the next run: the tree the baseline imports."""
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", f"{ref}^{{commit}}"], check=True,
+                            capture_output=True, text=True).stdout.strip()
+    folder = Path(tempfile.gettempdir()) / f"tablebot-kernel-baseline-{commit[:12]}"
+    if not (folder / "src").is_dir():
+        partial = Path(tempfile.mkdtemp(prefix=folder.name + "."))
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit, "src"], check=True, capture_output=True)
+        subprocess.run(["tar", "-x", "-C", str(partial)], input=archive.stdout, check=True)
+        partial.rename(folder)  # whole or not at all
+    return str(folder / "src")
 
 
 def child(example: str, repeats: int, src: str | None) -> dict[str, float]:
@@ -259,14 +268,13 @@ def main() -> None:
           f"on {os.cpu_count()} cores; example {args.example}")
     now: dict[str, list[float]] = {}
     base: dict[str, list[float]] = {}
-    with tempfile.TemporaryDirectory() as folder:
-        src = baseline_sources(args.baseline, folder) if args.baseline else None
-        for _ in range(args.rounds):
-            if src:
-                for part, value in child(args.example, args.repeats, src).items():
-                    base.setdefault(part, []).append(value)
-            for part, value in child(args.example, args.repeats, None).items():
-                now.setdefault(part, []).append(value)
+    src = baseline_sources(args.baseline) if args.baseline else None
+    for _ in range(args.rounds):
+        if src:
+            for part, value in child(args.example, args.repeats, src).items():
+                base.setdefault(part, []).append(value)
+        for part, value in child(args.example, args.repeats, None).items():
+            now.setdefault(part, []).append(value)
     report(now, base or None)
 
 
