@@ -37,7 +37,7 @@ class SimRobot:
         self.scene = scene
         self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
         g = scene.geometry
-        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines)
+        self._world = (g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines, g.shade)
         self._drive = np.array(scene.drive, dtype=np.int64)
         self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
         self.light_keys = light_keys(scene)
@@ -117,7 +117,7 @@ class SimRobot:
         start = engine.tick
         K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
                     self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
-                    self.acc, self.collision_rows)
+                    self.acc, self.collision_rows, *K.NO_TALLY)
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
