@@ -1,12 +1,14 @@
 """The simulator's shortcuts in its geometry give the plain tests' answers exactly: sim.geometry.segments_within
-refuses segments clear of each other's line before its four distances, and must agree with them always."""
+refuses segments clear of each other's line before its four distances, and sim.shadows tests only the pieces
+its grid lists: both must agree with the plain tests always."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_within, segments_cross, segments_within
+from tablebot.sim.geometry import point_segment_within, segments_cross, segments_within, shadowed
+from tablebot.sim.shadows import shadowed_near
 
 
 @njit
@@ -49,3 +51,64 @@ def test_segments_within_agrees_with_the_plain_test_on_the_threshold_and_on_the_
     bad, near = disagreements(cases)
     assert bad == 0
     assert n // 10 < near < n - n // 10  # both answers were asked for
+
+
+@njit
+def shadow_disagreements(points, lamps, edges, circles, shade):  # type: ignore[no-untyped-def]
+    bad, dark = 0, 0
+    for k in range(lamps.shape[0]):
+        for j in range(points.shape[0]):
+            x, y = points[j, 0], points[j, 1]
+            answer = shadowed(x, y, lamps[k, 0], lamps[k, 1], k, edges, circles)
+            bad += answer != shadowed_near(x, y, lamps[k, 0], lamps[k, 1], k, edges, circles, shade)
+            dark += answer
+    return bad, dark
+
+
+def test_the_shadow_grid_gives_every_shadow_test_the_full_scans_answer() -> None:
+    """sim.shadows lists per cell only the pieces that may shadow each lamp: its answer must be the scan of every
+    piece, also on the lines through a lamp and a corner, on an edge's own line, just off both, and beyond
+    the grid -- in a world with two lamps (one in line with a box's side, one with no base), a hanging
+    circle and a partition."""
+    from tablebot.sim.world import geometry, parse_world
+    from tablebot.tomlfile import Source
+
+    world = parse_world(Source.parse("<w>", """
+[arena]
+walls = [[0, 0], [3, 0], [3, 2], [1.5, 2.6], [0, 2]]
+[start]
+at = [0.3, 0.3]
+[[lamp]]
+at = [2.5, 0.5]
+[[lamp]]
+at = [1.0, 1.2]
+radius = 0
+[[box]]
+at = [2.0, 1.0]
+size = [0.4, 0.4]
+[[box]]
+at = [1.0, 0.6]
+size = [0.3, 0.2]
+angle = 20
+[[circle]]
+at = [0.6, 1.6]
+radius = 0.15
+[[segment]]
+from = [1.5, 2.6]
+to = [1.5, 1.9]
+"""))
+    g = geometry(world)
+    assert g.shade.shape[0] > 0
+    rng = np.random.default_rng(11)
+    points = [rng.uniform(-0.3, 3.3, size=(20_000, 2))]
+    ends = np.concatenate([g.edges[:, :2], g.edges[:, 2:], g.circles[:, :2]])
+    for lamp in g.lamps[:, :2]:  # on the lines from each lamp through each corner (and a hair off them)
+        t = rng.uniform(-1.5, 2.5, size=(ends.shape[0], 300, 1))
+        line = lamp + t * (ends[:, None, :] - lamp)
+        points += [line.reshape(-1, 2), line.reshape(-1, 2) + rng.choice([-1e-12, 1e-12, 1e-9], size=(1, 2))]
+    for e in g.edges:  # on each edge's own line
+        t = rng.uniform(-1.0, 2.0, size=(300, 1))
+        points.append(e[:2] + t * (e[2:] - e[:2]))
+    bad, dark = shadow_disagreements(np.concatenate(points), g.lamps, g.edges, g.circles, g.shade)
+    assert bad == 0
+    assert dark > 10_000  # shadows were cast (the boxes, the circle, the partition, the walls' corner)

@@ -100,8 +100,8 @@ def test_light_falls_with_distance_squared(tmp_path: Path) -> None:
 
 
 def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path: Path) -> None:
-    """physics.light_side first asks sensing.no_lamp_in_view (no cos/sin of the aim, no hypot) and answers 0.0
-    when it says every lamp is out of view: that must be exactly light_from's answer, also for lamps a hair
+    """physics.light_side (sensing.light_turned) first rules out lamps surely out of view (no cos/sin of the aim,
+    no hypot) or in shadow: its answer must be exactly light_from's, also for lamps a hair
     inside or outside the field of view's edge and for headings after thousands of turns."""
     import math
 
@@ -125,5 +125,6 @@ def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path:
         c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
         exact = light_from(s, c, sn, p, p[L.P_LX], side * p[L.P_LY], side * p[L.P_TOE], g.edges, g.circles, g.lamps)
         assert light_at(s, p, side, g.edges, g.circles, g.lamps) == exact
+        assert light_at(s, p, side, g.edges, g.circles, g.lamps, g.shade) == exact  # the shadow grid
         hidden += exact == 0.0
     assert 1000 < hidden < 5000  # both sides of the edge were tried

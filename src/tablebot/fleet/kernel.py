@@ -2,32 +2,18 @@
 (the very loop ``tablebot sim`` runs) on its own rows, then folded into per-robot summary counters.
 """
 
-# Nothing here simulates anything itself: the tick rule, the physics and the collision/lamp
-# accumulators are those of sim.kernel. What the fleet adds is the loop over robots, the per-robot
-# program (a tuned table's timers and counter loads), and folding each block of tick records into
-# counts (time per state, first visit of each state, first light) so no tick needs to be kept.
+# Nothing here simulates anything itself: the tick rule, the physics, the collision/lamp accumulators and
+# the tally of each tick (time per state, first visit of each state, first light: sim.kernel.tally, so no
+# tick needs to be kept) are those of sim.kernel. What the fleet adds is the loop over robots and the
+# per-robot program (a tuned table's timers and counter loads).
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
-from tablebot.jit import njit, prange
-from tablebot.sim.kernel import I_MASK, I_STATE, move, run_robot
-
-NO_TICK = -1  # "never" in first_visit / first_light
-
-
-@njit(nogil=True, refcounts=False)
-def fold(ints, t0, light_bits, counts, first_visit, first_light, i):  # type: ignore[no-untyped-def]
-    """Add a block of tick records (``ints``, tick ``t0`` first) to robot ``i``'s counters."""
-    for t in range(ints.shape[0]):
-        state = ints[t, I_STATE]
-        counts[i, state] += 1
-        if first_visit[i, state] == NO_TICK:
-            first_visit[i, state] = t0 + t
-        if first_light[i] == NO_TICK and ints[t, I_MASK] & light_bits:
-            first_light[i] = t0 + t
+from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
+from tablebot.sim.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
+from tablebot.sim.kernel import move, run_robot
 
 
 @njit(nogil=True)
@@ -41,11 +27,11 @@ def run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, coun
     slot = traced[i]
     if slot >= 0:
         rows, record = hist[slot], ints[slot]
-    else:
-        rows, record = np.empty((0, S.shape[1])), np.empty((ticks, ints.shape[2]), dtype=np.int64)
+    else:  # neither rows nor tick records: the tally is all a robot leaves
+        rows, record = np.empty((0, S.shape[1])), np.empty((0, ints.shape[2]), dtype=np.int64)
     run_robot(S[i], P[i], *world, own, regs[i], outputs[i], counters[i], bits, drive, pcols, ticks, noise[i],
-              bitgens[i], rows, record, acc[i], collisions[i])
-    fold(record, t0, light_bits, counts, first_visit, first_light, i)
+              bitgens[i], rows, record, acc[i], collisions[i], counts[i], first_visit[i], first_light[i:i + 1],
+              light_bits, t0)
 
 
 @njit(nogil=True, parallel=True)

@@ -36,6 +36,9 @@ A_REACH = 5  # metres: the lamp counts as reached this close (set by the caller)
 A_DEBOUNCE = 6  # rows: touches within this many rows belong to the last collision (set by the caller)
 N_ACC = 7
 NEVER = -1e18
+NO_TICK = -1  # "never" in a tally's first visits and first light
+#: run_robot's tally arguments when nothing is tallied (a single robot: its tick records say it all).
+NO_TALLY = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0, 0)
 
 
 def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
@@ -68,29 +71,43 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
     acc[A_TOUCHING] = 1.0 if touching else 0.0
 
 
+@njit(nogil=True, refcounts=False, inline="always")
+def tally(counts, first_visit, first_light, light_bits, state, mask, tick):  # type: ignore[no-untyped-def]
+    """Count a tick that ends in ``state`` (ticks per state, the first tick in each) and note the first tick
+    whose input ``mask`` has any of ``light_bits``: what a fleet keeps of a robot's ticks."""
+    counts[state] += 1
+    if first_visit[state] == NO_TICK:
+        first_visit[state] = tick
+    if first_light[0] == NO_TICK and mask & light_bits:
+        first_light[0] = tick
+
+
 @njit(nogil=True)
-def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
-              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions):  # type: ignore[no-untyped-def]
+def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
+              light_bits, t0):  # type: ignore[no-untyped-def]
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
     rows, by a row drawn from the numpy Generator whose ``bitgen_t`` is at ``bitgen`` (sim.normals).
 
     Writes the robot at the start of each tick into ``hist`` (when it has rows) and each tick's
-    integer record into ``ints`` (when it has rows), and folds every new robot row into
-    ``acc``/``collisions`` (see :func:`observe`).
+    integer record into ``ints`` (when it has rows), folds every new robot row into
+    ``acc``/``collisions`` (see :func:`observe`), and, when ``counts`` has room, tallies each tick (numbered
+    from ``t0``) into ``counts``/``first_visit``/``first_light`` (see :func:`tally`; ``NO_TALLY``: none).
     """
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits, drive,
-              pcols, ticks, noise, bitgen, hist, ints, acc, collisions, np.zeros(counters.shape[0], dtype=np.int64),
-              np.empty((4, 2)), reach, wide, near, centre, turns, np.empty(N_NOISE))
+    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
+              light_bits, t0, np.zeros(counters.shape[0], dtype=np.int64), np.empty((4, 2)), reach, wide, near,
+              centre, turns, np.empty(N_NOISE))
 
 
 @njit(nogil=True, refcounts=False)
-def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program, regs, outputs, counters, bits,
-              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, pulses, corners, reach, wide, near,
-              centre, turns, z):  # type: ignore[no-untyped-def]
+def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
+              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
+              light_bits, t0, pulses, corners, reach, wide, near, centre, turns, z):  # type: ignore[no-untyped-def]
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
     n_counters = counters.shape[0]
     for t in range(ticks):
@@ -103,18 +120,20 @@ def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, program
         tick_compiled(regs, outputs, counters, mask, pulses, program)
         if ints.shape[0]:
             _record(ints, t, mask, regs, outputs, counters, pulses)
+        if counts.shape[0]:
+            tally(counts, first_visit, first_light, light_bits, regs[STATE], mask, t0 + t)
         if noise.shape[0]:
             for k in range(N_NOISE):
                 z[k] = noise[t, k]
         else:
             for k in range(N_NOISE):
                 z[k] = standard_normal(bitgen)
-        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, z,
-                bits, True, corners, reach, wide, near, centre, turns)
+        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, shade,
+                z, bits, True, corners, reach, wide, near, centre, turns)
         observe(s, lamps, acc, collisions)
 
 
-@njit(nogil=True, refcounts=False)
+@njit(nogil=True, refcounts=False, inline="always")
 def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-untyped-def]
     ints[t, I_MASK] = mask
     ints[t, I_EVENT] = regs[EVENT]
@@ -134,24 +153,24 @@ def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-
 
 
 @njit(nogil=True)
-def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits):  # type: ignore[no-untyped-def]
+def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits):  # type: ignore[no-untyped-def]
     """Read the sensors without moving (the start of a run)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, False, np.empty((4, 2)), reach,
-            wide, near, centre, turns)
+    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, False, np.empty((4, 2)),
+            reach, wide, near, centre, turns)
 
 
 @njit(nogil=True)
-def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, acc,
+def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, acc,
          collisions):  # type: ignore[no-untyped-def]
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, True, np.empty((4, 2)),
-            reach, wide, near, centre, turns)
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, True,
+            np.empty((4, 2)), reach, wide, near, centre, turns)
     observe(s, lamps, acc, collisions)

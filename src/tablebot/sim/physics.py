@@ -35,6 +35,7 @@ from tablebot.sim.columns import (
     DIST,
     ENC_L,
     ENC_R,
+    F_KIND,
     GAIN_L,
     GAIN_R,
     LIGHT_L,
@@ -60,6 +61,7 @@ from tablebot.sim.columns import (
     P_PPR,
     P_REAR,
     P_RINT,
+    P_SENSOR,
     P_TOE,
     P_VEMPTY,
     P_VF,
@@ -81,7 +83,8 @@ from tablebot.sim.columns import (
     Y,
 )
 from tablebot.sim.geometry import point_segment_within, segments_within, within
-from tablebot.sim.sensing import light_from, no_lamp_in_view, sense_declared, sensor_events
+from tablebot.sim.sensing import light_turned, sense_declared, sensor_events
+from tablebot.sim.shadows import NO_SHADE
 
 NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
@@ -406,14 +409,12 @@ def sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_side(s, c, sn, p, side, ct, st, edges, circles, lamps):
+def light_side(s, c, sn, p, side, ct, st, edges, circles, lamps, shade):
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
-    ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`). Most
-    ticks no lamp is in its field of view: :func:`sim.sensing.no_lamp_in_view` says so cheaply."""
-    lx, ly = p[P_LX], side * p[P_LY]
-    if no_lamp_in_view(s, c, sn, p, lx, ly, ct, st, lamps):
-        return 0.0  # what light_from returns when every lamp is out of view
-    return light_from(s, c, sn, p, lx, ly, side * p[P_TOE], edges, circles, lamps)
+    ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
+    the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
+    :func:`sim.sensing.light_turned` rules such lamps out cheaply, with light_from's answer."""
+    return light_turned(s, c, sn, p, p[P_LX], side * p[P_LY], side * p[P_TOE], ct, st, edges, circles, lamps, shade)
 
 
 @njit(cache=True, refcounts=False, inline="always")
@@ -424,12 +425,13 @@ def aim_turns(p, out):
 
 
 @njit(cache=True)
-def light_at(s, p, side, edges, circles, lamps):
+def light_at(s, p, side, edges, circles, lamps, shade=NO_SHADE):
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
     turns = np.empty(4)
     aim_turns(p, turns)
     k = 0 if side < 0.0 else 2
-    return light_side(s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps)
+    return light_side(s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps,
+                      shade)
 
 
 # --- motors, battery, motion ---------------------------------------------------------------------
@@ -497,34 +499,37 @@ def input_mask(s, bits):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns):
+def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
+               turns):
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
     c, sn = math.cos(s[TH]), math.sin(s[TH])
     sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
-    right = light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps)
+    right = light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade)
     s[LIGHT_R] = max(0.0, right * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
-    left = light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps)
+    left = light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade)
     s[LIGHT_L] = max(0.0, left * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
-    sense_declared(s, c, sn, p, edges, circles, lamps, lines)
+    if p[P_SENSOR + F_KIND] != 0.0:  # declared sensors fill the slots from the first: none declared, no pass
+        sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade)
     previous = int(s[MASK])
     s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
 
 
 @njit(cache=True)
-def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits):
+def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, shade=NO_SHADE):
     """:func:`sense_near` on its own (a candidate list made for this one call)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns)
+    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
+               turns)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, z, bits, move, corners, reach,
-            wide, near, centre, turns):
+def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
+            reach, wide, near, centre, turns):
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2); ``reach``, ``wide``:
     :func:`reaches`; ``near`` and ``centre`` the robot's candidate list (:func:`new_near`), kept from tick to tick;
@@ -535,16 +540,17 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lin
         drive(s, cmd, p, z)
         resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, reach, wide, near, centre, turns)
+    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
+               turns)
 
 
 @njit(cache=True)
-def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move, lines=NO_LINES):
+def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move, lines=NO_LINES, shade=NO_SHADE):
     """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
     corners, turns = np.empty((4, 2)), np.empty(4)
     for i in range(S.shape[0]):
         near, centre = new_near(pstart, circles)
         reach, wide = reaches(P[i])
         aim_turns(P[i], turns)
-        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, lines, Z[i], bits,
-                move, corners, reach, wide, near, centre, turns)
+        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, lines, shade, Z[i],
+                bits, move, corners, reach, wide, near, centre, turns)

@@ -35,7 +35,8 @@ from tablebot.sim.columns import (
     X,
     Y,
 )
-from tablebot.sim.geometry import point_segment_distance, point_segment_within, shadowed
+from tablebot.sim.geometry import point_segment_distance, point_segment_within
+from tablebot.sim.shadows import NO_SHADE, shadowed_near
 
 threshold = njit(inline="always")(threshold_event)  # the rule of every analog input, compiled in
 #: The codes of the kinds whose physics is here (tablebot.sensors.SENSOR_KINDS): a branch each below.
@@ -43,9 +44,10 @@ K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "dis
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps):
+def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps, shade=NO_SHADE):
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
-    sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine).
+    sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine;
+    ``shade``: the world's shadow grid, sim.shadows).
 
     The response fades to zero over the last quarter of the field of view (a lens tube's edge).
     """
@@ -62,42 +64,70 @@ def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps):
         cosine = 1.0 if d == 0.0 else ahead / d
         if cosine <= p[P_COS_FOV]:
             continue
-        d = max(d, p[P_DMIN])
-        # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
-        taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
-        if not shadowed(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles):  # first: it spares the power
-            total += lamps[k, 2] * cosine ** p[P_EXP] * taper / (d * d)
+        if not shadowed_near(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles, shade):  # first: spares the power
+            total += lamp_light(p, lamps[k, 2], cosine, d)
     return total
 
 
-#: How far the aim's direction worked out by the angle-sum rule (:func:`no_lamp_in_view`) may be from the one
+@njit(cache=True, refcounts=False, inline="always")
+def lamp_light(p, intensity, cosine, d):
+    """What one unshadowed lamp in view gives at distance ``d`` and ``cosine`` off the sensor's axis."""
+    d = max(d, p[P_DMIN])
+    # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
+    taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
+    return intensity * cosine ** p[P_EXP] * taper / (d * d)
+
+
+@njit(cache=True, refcounts=False, inline="always")
+def light_turned(s, c, sn, p, lx, ly, turn, ct, st, edges, circles, lamps, shade):
+    """:func:`light_from`'s answer, for a sensor whose turn from the heading has cosine ``ct`` and sine ``st``:
+    each lamp is first ruled out cheaply when surely out of view (:func:`out_of_view`) or in shadow, and only
+    the lamps left are worked out as light_from does (the aim's cos/sin and the hypot only for them).
+    Exact: a lamp out of view or shadowed adds nothing there either, and the others add the same terms in
+    the same order."""
+    cos_fov = p[P_COS_FOV]
+    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly  # as light_from places the sensor
+    bx, by = c * ct - sn * st, sn * ct + c * st  # the aim, to within AIM_SLACK
+    ax = ay = 0.0
+    aimed = False
+    total = 0.0
+    for k in range(lamps.shape[0]):
+        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
+        if cos_fov >= 0.0 and out_of_view(dx, dy, bx, by, cos_fov):
+            continue
+        if shadowed_near(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles, shade):
+            continue
+        if not aimed:
+            aim = s[TH] + turn
+            ax, ay, aimed = math.cos(aim), math.sin(aim), True
+        ahead = dx * ax + dy * ay
+        if ahead <= 0.0 and cos_fov >= 0.0 and (dx != 0.0 or dy != 0.0):
+            continue
+        d = math.hypot(dx, dy)
+        cosine = 1.0 if d == 0.0 else ahead / d
+        if cosine <= cos_fov:
+            continue
+        total += lamp_light(p, lamps[k, 2], cosine, d)
+    return total
+
+
+#: How far the aim's direction worked out by the angle-sum rule (:func:`light_turned`) may be from the one
 #: light_from takes from cos/sin of the summed angle: rounding of the sum (an ulp of the heading, which is
 #: never wrapped: 1e-12 after thousands of turns) and of the products, with orders of magnitude to spare.
 AIM_SLACK = 1e-9
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def no_lamp_in_view(s, c, sn, p, lx, ly, ct, st, lamps):
-    """Whether every lamp is surely outside the field of view of a sensor at (lx, ly) in the body frame whose
-    aim is turned from the heading by an angle of cosine ``ct`` and sine ``st`` (``c``, ``sn``: the heading's)
-    -- decided with neither the aim's own cos/sin nor a hypot, both dearer than the test. True only when
-    no rounding can make it wrong: light_from would then skip every lamp (and return 0.0); in doubt, False.
-    """
-    cos_fov = p[P_COS_FOV]
-    if cos_fov < 0.0:
+def out_of_view(dx, dy, ax, ay, cos_fov):
+    """Whether a lamp at (dx, dy) from a sensor whose aim is (ax, ay) to within AIM_SLACK is surely outside
+    its field of view (``cos_fov`` >= 0) -- decided with neither the aim's own cos/sin nor a hypot, both
+    dearer than the test. True only when no rounding can make it wrong: light_from then skips the lamp."""
+    size = abs(dx) + abs(dy)  # at least the distance d, at most 1.5 d
+    if size == 0.0:
         return False
-    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly  # as light_from places the sensor
-    ax, ay = c * ct - sn * st, sn * ct + c * st  # the aim: cos and sin of heading + turn, to within AIM_SLACK
-    for k in range(lamps.shape[0]):
-        dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
-        size = abs(dx) + abs(dy)  # at least the distance d, at most 1.5 d
-        if size == 0.0:
-            return False
-        # light_from's dot product (d times the cosine) is below this bound, whatever the rounding
-        top = dx * ax + dy * ay + 2.0 * AIM_SLACK * size
-        if top > 0.0 and top * top > cos_fov * cos_fov * (dx * dx + dy * dy) * (1.0 - AIM_SLACK):
-            return False  # maybe in view: light_from decides
-    return True
+    # light_from's dot product (d times the cosine) is below this bound, whatever the rounding
+    top = dx * ax + dy * ay + 2.0 * AIM_SLACK * size
+    return not (top > 0.0 and top * top > cos_fov * cos_fov * (dx * dx + dy * dy) * (1.0 - AIM_SLACK))
 
 
 @njit(cache=True, refcounts=False)
@@ -188,9 +218,9 @@ def echo(sx, sy, aim, p, edges, circles):
 
 
 @njit(cache=True, refcounts=False)
-def sense_declared(s, c, sn, p, edges, circles, lamps, lines):
+def sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade=NO_SHADE):
     """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
-    (``c``, ``sn``: the heading's cosine and sine)."""
+    (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.shadows)."""
     for k in range(MAX_SENSORS):
         base = P_SENSOR + k * SENSOR_FIELDS
         kind = p[base + F_KIND]
@@ -198,7 +228,7 @@ def sense_declared(s, c, sn, p, edges, circles, lamps, lines):
             continue
         bx, by = p[base + F_X], p[base + F_Y]
         if kind == K_LIGHT:
-            s[READING + k] = light_from(s, c, sn, p, bx, by, p[base + F_AIM], edges, circles, lamps)
+            s[READING + k] = light_from(s, c, sn, p, bx, by, p[base + F_AIM], edges, circles, lamps, shade)
             continue
         sx, sy = s[X] + c * bx - sn * by, s[Y] + sn * bx + c * by
         if kind == K_LINE:

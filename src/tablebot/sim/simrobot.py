@@ -103,7 +103,7 @@ class SimRobot:
         start = engine.tick
         K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
                     self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
-                    self.acc, self.collision_rows)
+                    self.acc, self.collision_rows, *K.NO_TALLY)
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
@@ -155,7 +155,7 @@ class SimRobot:
 def world_arrays(scene: Scene) -> tuple[np.ndarray, ...]:
     """The scene's walls, obstacles, lamps and lines as the compiled code takes them."""
     g = scene.geometry
-    return g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines
+    return g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines, g.shade
 
 
 class Starter:

@@ -102,6 +102,7 @@ class Geometry:
     circles: np.ndarray
     lamps: np.ndarray
     lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))  # (K, 5): x0, y0, x1, y1, half width
+    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # which pieces may shadow a lamp (sim.shadows)
 
 
 DEFAULT_WORLD = """\
@@ -376,8 +377,11 @@ def geometry(world: World) -> Geometry:
                 for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
     lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
     lines = [(a[0], a[1], b[0], b[1], line.width / 2) for line in world.lines for a, b in line.segments()]
-    return Geometry(verts=verts, pstart=pstart, pbound=pbound,
-                    edges=np.array(edges, dtype=np.float64).reshape(-1, 4),
-                    circles=np.array(circles, dtype=np.float64).reshape(-1, 4),
-                    lamps=np.array(lamps, dtype=np.float64).reshape(-1, 3),
-                    lines=np.array(lines, dtype=np.float64).reshape(-1, 5))
+    from tablebot.sim.shadows import shade_grid  # compiled code: loaded only when a world is packed for it
+
+    edge_array = np.array(edges, dtype=np.float64).reshape(-1, 4)
+    circle_array = np.array(circles, dtype=np.float64).reshape(-1, 4)
+    lamp_array = np.array(lamps, dtype=np.float64).reshape(-1, 3)
+    return Geometry(verts=verts, pstart=pstart, pbound=pbound, edges=edge_array, circles=circle_array,
+                    lamps=lamp_array, lines=np.array(lines, dtype=np.float64).reshape(-1, 5),
+                    shade=shade_grid(edge_array, circle_array, lamp_array))
