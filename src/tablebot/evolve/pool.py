@@ -36,9 +36,11 @@ Statuses = tuple[dict[int, bool], bool | None]
 class Answer(Protocol):
     def get(self) -> Any: ...
 
+    def drop(self) -> None: ...
+
 
 class Later:
-    """A task run here, when its answer is first asked for."""
+    """A task run here, when its answer is first asked for (or never, when nobody asks)."""
 
     def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]):
         self.fn, self.args = fn, args
@@ -48,6 +50,22 @@ class Later:
         if not self.done:
             self.value, self.done = self.fn(*self.args), True
         return self.value
+
+    def drop(self) -> None:
+        pass
+
+
+class Answered:
+    """A worker's answer (a future), asked for with :meth:`get`; :meth:`drop` when it is not wanted."""
+
+    def __init__(self, future: Any):
+        self.future = future
+
+    def get(self) -> Any:
+        return self.future.result()
+
+    def drop(self) -> None:
+        self.future.cancel()  # not started yet: it never will be (a running one finishes unheard)
 
 
 @dataclass(frozen=True)
@@ -61,16 +79,21 @@ class Context:
 
 class Workers:
     """``count`` worker processes (default: one per core) knowing the property files and the starting
-    table; with a count of 1 none, and tasks run here. Use as a context manager: the workers end with it."""
+    table; with a count of 1 none, and tasks run here. Use as a context manager: the workers end with it.
+
+    They come from a fork server, so, as for any ``multiprocessing`` program, the main module must be
+    importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
 
     def __init__(self, files: Sequence[Path], base: Table, count: int | None = None):
         self.count = max(1, count if count is not None else os.cpu_count() or 1)
         self.context = Context(Prover(list(files)), base)
         self.pool: Any = None
         if self.count > 1:
+            from concurrent.futures import ProcessPoolExecutor
+
             spawner = multiprocessing.get_context("forkserver")
-            spawner.set_forkserver_preload([__name__])  # the fork server imports the analysis once for all
-            self.pool = spawner.Pool(self.count, _start, (list(files), base))
+            spawner.set_forkserver_preload([__name__, "tablebot.cli"])  # imported once, in the fork server
+            self.pool = ProcessPoolExecutor(self.count, spawner, initializer=_start, initargs=(list(files), base))
 
     def __enter__(self) -> Workers:
         return self
@@ -79,10 +102,18 @@ class Workers:
         self.close()
 
     def close(self) -> None:
-        if self.pool is not None:
-            self.pool.terminate()  # every answer the run needed is in: anything still running was speculative
-            self.pool.join()
-            self.pool = None
+        """End the workers now: every answer the run needed is in, and anything still running was
+        speculative (or the run was stopped)."""
+        if self.pool is None:
+            return
+        pool, self.pool = self.pool, None
+        stop = getattr(pool, "terminate_workers", None)  # Python 3.14
+        if stop is not None:
+            stop()
+        else:
+            for process in list(getattr(pool, "_processes", {}).values()):
+                process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
 
     def window(self, needed: int) -> int:
         """How many proofs to have under way when ``needed`` more children that hold are wanted: every
@@ -95,7 +126,7 @@ class Workers:
         function of this module."""
         if self.pool is None:
             return Later(fn, (self.context, *args))
-        return self.pool.apply_async(_run, (fn, args))
+        return Answered(self.pool.submit(_run, fn, args))
 
 
 Ahead = tuple[Candidate | None, Machine | None, str, Answer | None]
@@ -109,6 +140,16 @@ def proved_ahead(workers: Workers, prover: Prover, children: Iterator[Candidate 
     handed out (None children: a variation that gave nothing, handed out as they come)."""
     queue: deque[Ahead] = deque()
     sent: dict[str, Answer] = {}
+    try:
+        yield from _ahead(workers, prover, children, window, queue, sent)
+    finally:  # the caller has what it wanted: proofs not started are dropped
+        for *_, answer in queue:
+            if answer is not None:
+                answer.drop()
+
+
+def _ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None], window: Callable[[], int],
+           queue: deque[Ahead], sent: dict[str, Answer]) -> Iterator[Ahead]:
     while True:
         while len(queue) < window():
             child = next(children, _END)

@@ -15,6 +15,7 @@ import json
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -228,22 +229,26 @@ class Evolution:
         proved here, until ``count`` are in (the variations depend on ``rng`` alone, not on the verdicts)."""
         out: list[str] = []
         children = self.variations(parents, rng, count * TRIES_PER_CHILD)
-        for child, machine, key, found in proved_ahead(self.workers, self.prover, children,
-                                                       lambda: self.workers.window(count - len(out))):
-            if len(out) == count:
-                break
-            if child is None or machine is None:
-                continue
-            self.counts.varied += 1
-            key, verdict = self.prover.decide(machine, key, found)
-            if not verdict.ok:
-                self.counts.discarded[verdict.failed[0]] += 1
-            elif key in self.candidates:
-                self.counts.duplicates += 1
-            else:
-                self.candidates[key] = child
-                out.append(key)
+        ahead = proved_ahead(self.workers, self.prover, children, lambda: self.workers.window(count - len(out)))
+        with closing(ahead):  # closed at the end: proofs not started are dropped
+            for child, machine, key, found in ahead:
+                if len(out) == count:
+                    break
+                if child is not None and machine is not None:
+                    self.take(child, machine, key, found, out)
         return out
+
+    def take(self, child: Candidate, machine: Any, key: str, found: Any, out: list[str]) -> None:
+        """Count one varied child, and keep it (in ``out``) when it is proved and new."""
+        self.counts.varied += 1
+        key, verdict = self.prover.decide(machine, key, found)
+        if not verdict.ok:
+            self.counts.discarded[verdict.failed[0]] += 1
+        elif key in self.candidates:
+            self.counts.duplicates += 1
+        else:
+            self.candidates[key] = child
+            out.append(key)
 
     def variations(self, parents: Sequence[str], rng: Any, tries: int) -> Iterator[Candidate | None]:
         """``tries`` children of parents drawn from ``parents`` (None where a variation gave nothing)."""
