@@ -14,6 +14,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import sys
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
@@ -92,7 +93,7 @@ class Workers:
             from concurrent.futures import ProcessPoolExecutor
 
             spawner = multiprocessing.get_context("forkserver")
-            spawner.set_forkserver_preload([__name__, "tablebot.cli"])  # imported once, in the fork server
+            spawner.set_forkserver_preload(preload())  # imported once, in the fork server, not in each worker
             self.pool = ProcessPoolExecutor(self.count, spawner, initializer=_start, initargs=(list(files), base))
 
     def __enter__(self) -> Workers:
@@ -115,11 +116,10 @@ class Workers:
                 process.terminate()
         pool.shutdown(wait=True, cancel_futures=True)
 
-    def window(self, needed: int) -> int:
-        """How many proofs to have under way when ``needed`` more children that hold are wanted: every
-        worker busy, and as many again queued while that many more may be needed (past the last child
-        wanted, a proof is wasted)."""
-        return 1 if self.pool is None else self.count + min(self.count, max(0, needed - 1))
+    def window(self) -> int:
+        """How many proofs to have under way: one per worker (past the last child a generation wants,
+        each is wasted work)."""
+        return self.count if self.pool is not None else 1
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Answer:
         """``fn(context, *args)`` in a worker (or here, when its answer is asked for); ``fn`` must be a
@@ -168,6 +168,15 @@ def _ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None
         if not queue:
             return
         yield queue.popleft()
+
+
+def preload() -> list[str]:
+    """What the fork server imports for its workers: the tasks' modules, and the main module's imports when
+    a worker runs the main module again (a script by path, as the ``tablebot`` command is: its guard keeps
+    it from running, but it imports the command line)."""
+    main = sys.modules.get("__main__")
+    script = getattr(main, "__spec__", None) is None and getattr(main, "__file__", None)
+    return [__name__, "tablebot.evolve.repair", "tablebot.evolve.report", *(["tablebot.cli"] if script else [])]
 
 
 # --- in a worker --------------------------------------------------------------------------------------

@@ -229,7 +229,7 @@ class Evolution:
         proved here, until ``count`` are in (the variations depend on ``rng`` alone, not on the verdicts)."""
         out: list[str] = []
         children = self.variations(parents, rng, count * TRIES_PER_CHILD)
-        ahead = proved_ahead(self.workers, self.prover, children, lambda: self.workers.window(count - len(out)))
+        ahead = proved_ahead(self.workers, self.prover, children, self.workers.window)
         with closing(ahead):  # closed at the end: proofs not started are dropped
             for child, machine, key, found in ahead:
                 if len(out) == count:
