@@ -16,9 +16,9 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.engine import Engine
 from tablebot.formats.table_read import load_table
-from tablebot.hw.txt.wiring import InputWire, OutputWire, TxtWiring, level_pwm
+from tablebot.hw.txt.wiring import TxtWiring, level_pwm
 from tablebot.hw.txt4.export import export_txt4
-from tablebot.hw.wiring import InputWire as SerialInputWire
+from tablebot.hw.wiring import InputWire, OutputWire, Wiring
 from tablebot.loop import Reading, RealTimeClock, run
 from tablebot.machine import compile_table
 from tablebot.sensors import Sensor, threshold_event
@@ -60,11 +60,11 @@ def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(tmp_path: Path,
     the_rule = events(lambda v, on: threshold_event(v, above, limit, off, on), readings)
     assert True in the_rule and False in the_rule  # the walk crossed the threshold both ways
 
-    wire = InputWire("I1", 0, "ultrasonic", below=None if above else limit, above=limit if above else None,
+    wire = InputWire("I1", "I1", "ultrasonic", False, below=None if above else limit, above=limit if above else None,
                      hysteresis=hysteresis)
-    assert events(lambda v, on: wire.reads(v, on), readings) == the_rule  # the TXT
-    serial = SerialInputWire("I1", "I1", "ultrasonic", below=wire.below, above=wire.above, hysteresis=hysteresis)
-    assert events(lambda v, on: serial.reads(v, on), readings) == the_rule  # the ROBO TX and ROBO Interface
+    assert events(lambda v, on: wire.reads(v, on), readings) == the_rule  # the TXT, the ROBO TX and ROBO Interface
+    txt = TxtWiring(Wiring((wire,), (1,), (), ()))
+    assert events(lambda v, on: txt.mask([v] + [0] * 7, on), readings) == the_rule  # as the TXT's replies reach it
 
     p = np.zeros(L.N_PARAM)  # the simulator's compiled sensing, readings in metres
     p[L.P_SENSOR: L.P_SENSOR + L.SENSOR_FIELDS] = sensor_fields(sensor)
@@ -94,8 +94,8 @@ def test_the_txt4_program_scales_speeds_and_lamps_as_the_txt(tmp_path: Path, mon
                         {"name": "B", "output": 1, "terminal": 2, "reverse": True, "encoder": False}],
              "lamps": [{"name": "L", "output": 2, "terminal": 5}], "counters": [], "n_outputs": 3}
     robot = stub_robot(tmp_path, monkeypatch, table, [[0] * 8] * (len(levels) + 1))
-    txt = TxtWiring((), (), (OutputWire("A", "motor", 0), OutputWire("B", "motor", 1, reverse=True),
-                             OutputWire("L", "lamp", 4)), ())
+    txt = TxtWiring(Wiring((), (), (OutputWire("A", "motor", "M1"), OutputWire("B", "motor", "M2", reverse=True),
+                                    OutputWire("L", "lamp", "O5")), ()))
     expected = []
     for tick, level in enumerate(levels):
         robot.read()

@@ -37,14 +37,14 @@ def line_of(text: str, needle: str) -> int:
 
 def test_the_bumberbot_is_wired_as_the_document_says() -> None:
     wiring = txt_wiring(compile_table(load_table(EXAMPLE / "table.csv")))
-    assert [(w.name, f"I{w.terminal + 1}", w.mode) for w in wiring.inputs] == [
+    assert [(w.name, w.terminal, w.mode) for w in wiring.wired.inputs] == [
         ("I3", "I3", "switch"), ("I4", "I4", "switch"), ("I5", "I5", "switch"),
         ("I7", "I7", "phototransistor"), ("I8", "I8", "phototransistor")]
-    assert [(w.name, f"M{w.terminal + 1}") for w in wiring.outputs] == [("M1", "M1"), ("M2", "M2")]
+    assert [(w.name, w.terminal) for w in wiring.wired.outputs] == [("M1", "M1"), ("M2", "M2")]
     assert wiring.pwm((4, -8)) == [256, 0, 0, 512, 0, 0, 0, 0]
     assert wiring.pwm((0, 0)) == [0] * 8
     closed = [0, 0, 1, 0, 0, 0, 1, 0]  # I3 pressed, I7 lit
-    assert wiring.mask(closed) == wiring.bits[0] | wiring.bits[3]
+    assert wiring.mask(closed) == wiring.wired.bits[0] | wiring.wired.bits[3]
     assert wiring.config() == wire.Config()  # exactly the TXT's default configuration
 
 
@@ -58,7 +58,7 @@ def test_polarity_and_thresholds_decide_what_the_table_reads(tmp_path: Path) -> 
     (tmp_path / "table.csv").write_text((EXAMPLE / "table.csv").read_text(encoding="utf-8"), encoding="utf-8")
     (tmp_path / "robot.toml").write_text(text, encoding="utf-8")
     wiring = txt_wiring(compile_table(load_table(tmp_path / "table.csv")))
-    i3, i4, i5, i7, i8 = wiring.bits
+    i3, i4, i5, i7, i8 = wiring.wired.bits
     assert wiring.mask([0, 100, 0, 1, 0, 0, 0, 2000]) == i3
     assert wiring.mask([1, 19, 5001, 0, 0, 0, 0, 999]) == i4 | i5 | i7 | i8
     assert wiring.config().inputs[1] == wire.InputConfig(wire.InputMode.ULTRASONIC, False)
@@ -83,7 +83,8 @@ def test_every_mistake_in_the_section_is_reported_at_once_with_its_line_when_the
         text = text.replace(old, new)
     found = errors(tmp_path, text)
     check_found(found, tmp_path / "robot.toml", [
-        (line_of(text, 'I4 = { terminal = "I9"'), "input I4: the TXT has no input terminal 'I9'", "I1..I8"),
+        (line_of(text, 'I4 = { terminal = "I9"'), "input I4: the TXT has no input terminal 'I9'",
+         "the TXT's terminals for this are I1, I2, I3, I4, I5, I6, I7, I8"),
         (line_of(text, 'I5 = { terminal = "I3"'), "input I5: terminal I3 is already used by I3", "of its own"),
         (line_of(text, 'I5 = { terminal = "I3"'), "[txt] I5: say what the table reads while the push-button is pressed",
          "pressed = 1 is the usual wiring"),
@@ -99,13 +100,16 @@ def test_what_the_table_needs_and_the_section_lacks_is_reported_with_its_line(tm
         (line_of(text, 'I8 = "left phototransistor"'), "input I8 is used by the table but not wired to the TXT",
          'I8 = { terminal = "I1", mode = "switch", pressed = 1 }'),
         (line_of(text, 'M2 = "left motor"'), "motor M2 is used by the table but not wired to the TXT", 'M2 = "M1"'),
-        (line_of(text, "tick_ms = 5"), "tick_ms = 5 is shorter than the TXT's exchange", "tick_ms = 10"),
+        (line_of(text, "tick_ms = 5"), "tick_ms = 5 is shorter than the TXT can keep (it answers one exchange "
+         "every 10 ms)", "use tick_ms = 10 or more"),
     ])
 
 
 @pytest.mark.parametrize(("entry", "message"), [
     ('I3 = "I3"', "[txt] I3 must say its terminal, mode and polarity"),
-    ('I3 = { terminal = "I3", mode = "button", pressed = 1 }', "mode must be one of switch, phototransistor"),
+    ('I3 = { terminal = "I3", mode = "button", pressed = 1 }', "mode must be one of switch, phototransistor, trail, "
+     'resistance, voltage, ultrasonic, not \'button\'\n    hint: a push-button is mode = "switch"; a phototransistor '
+     'is mode = "phototransistor"; a track sensor is mode = "trail"'),
     ('I3 = { terminal = "I3", mode = "switch", pressed = true }', "pressed = 1 or pressed = 0, not True"),
     ('I3 = { terminal = "I3", mode = "switch", pressed = 1, lit = 1 }', "unknown key 'lit' for mode 'switch'"),
     ('I3 = { terminal = "I3", mode = "ultrasonic" }', "needs exactly one of below = N or above = N (cm)"),
@@ -128,6 +132,13 @@ def test_a_robot_without_a_txt_section_gets_one_to_paste(tmp_path: Path) -> None
     (found,) = errors(tmp_path, ROBOT[:TXT_START])
     assert "robot BumberBot has no [txt] section" in found
     assert 'I7 = { terminal = "I7", mode = "phototransistor", lit = 1 }' in found and 'M2 = "M2"' in found
+    follower = EXAMPLE.parent / "line-follower"
+    robot = (follower / "robot.toml").read_text(encoding="utf-8")
+    (tmp_path / "robot.toml").write_text(robot[: robot.index("[txt]")], encoding="utf-8")
+    (tmp_path / "table.csv").write_text((follower / "table.csv").read_text(encoding="utf-8"), encoding="utf-8")
+    with pytest.raises(TableBotError) as info:  # inputs labelled "track sensor" are offered the trail mode
+        txt_wiring(compile_table(load_table(tmp_path / "table.csv")))
+    assert 'I2 = { terminal = "I2", mode = "trail", dark = 1 }' in info.value.diagnostics[0].render()
 
 
 def test_tablebot_run_refuses_before_connecting(tmp_path: Path) -> None:
@@ -145,10 +156,10 @@ def test_declared_distance_sensors_give_the_txt_their_threshold_and_hysteresis()
     from core_helpers import ROOT
 
     wiring = txt_wiring(compile_table(load_table(ROOT / "examples" / "obstacle-avoider" / "table.csv")))
-    right, left = wiring.inputs
+    right, left = wiring.wired.inputs
     assert (left.below, left.hysteresis) == (25, 5)
     assert (right.mode, right.below, right.hysteresis) == ("ultrasonic", 25, 5)
-    bit = wiring.bits[0]
+    bit = wiring.wired.bits[0]
     seen, mask = [], 0
     for cm in (40, 30, 25, 24, 26, 29, 30, 24):  # on below 25; once on, off only from 30
         mask = wiring.mask([cm, 400, 0, 0, 0, 0, 0, 0], mask)
@@ -181,8 +192,8 @@ def test_the_line_follower_reads_its_track_sensor_in_digital_voltage_mode() -> N
     and reads 1 for a reported 1 or more than 600 mV (a light floor), else 0 (the dark line)."""
     machine = compile_table(load_table(EXAMPLE.parent / "line-follower" / "table.csv"))
     wiring = txt_wiring(machine)
-    assert [(w.name, w.terminal, w.mode, w.invert) for w in wiring.inputs] == [("I1", 0, "trail", True),
-                                                                                ("I2", 1, "trail", True)]
+    assert [(w.name, w.terminal, w.mode, w.invert) for w in wiring.wired.inputs] == [("I1", "I1", "trail", True),
+                                                                                      ("I2", "I2", "trail", True)]
     assert wiring.config().inputs[:3] == (wire.InputConfig(wire.InputMode.VOLTAGE, True),
                                           wire.InputConfig(wire.InputMode.VOLTAGE, True), wire.InputConfig())
     i1, i2 = machine.input_bits["I1"], machine.input_bits["I2"]

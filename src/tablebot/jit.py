@@ -13,6 +13,7 @@ import uuid
 from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 ENV = "NUMBA_CACHE_DIR"
@@ -63,12 +64,70 @@ os.environ.setdefault(ENV, cache_dir())  # before numba's first import, which re
 # machine a 1-robot fleet's tick took 31 us with spinning threads, 0.9 us without. Read when OpenMP starts.
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-import numba  # noqa: E402  (after the cache folder is set)
+
+
+def _import_numba() -> ModuleType:
+    """numba, imported without importing scipy.
+
+    numba's ``__init__`` imports scipy only to check that it is not older than 1.0 (skipped when scipy is
+    absent), and that import is a tenth of numba's own; nothing tablebot compiles uses scipy. scipy stays
+    importable as ever: whoever needs it (evolve's archive) imports it as usual, and a compile that uses
+    BLAS has numba import it then.
+    """
+    if "numba" in sys.modules or "scipy" in sys.modules:
+        import numba
+
+        return numba
+    sys.modules["scipy"] = None  # type: ignore[assignment]  (`import scipy` raises ImportError meanwhile)
+    try:
+        import numba
+    finally:
+        if "scipy" in sys.modules and sys.modules["scipy"] is None:
+            del sys.modules["scipy"]
+    return numba
+
+
+numba = _import_numba()  # after the cache folder is set
 
 if not numba.config.CACHE_DIR:  # numba was imported before us: its cache locator reads this at use
     numba.config.CACHE_DIR = os.environ[ENV]
 
 prange = numba.prange
+
+
+def _load_cached_code_directly() -> None:
+    """Let numba load a function's machine code from its cache without first readying its whole compiler.
+
+    Before each load from the cache numba "refreshes" its compiler: it imports its ~200 modules of typing and
+    lowering rules (and scipy.linalg, to see whether BLAS is there) and installs them -- 0.6-0.8 s of every
+    tablebot process that runs a robot, on this 2-core machine, against ~10 ms for the load itself. Running
+    machine code needs none of it: only numba's runtime for arrays (initialised here, as the refresh would),
+    and the parallel back-end, which the cached code starts itself (its ``reload_init``). A function not in
+    the cache, or one whose load fails, takes numba's own path (the refresh, then the load or a compile, and
+    every compile refreshes by itself), so a load can only be faster, never different: the same machine code
+    runs either way.
+    """
+    from numba.core.caching import Cache
+    from numba.core.runtime import nrt
+
+    original = Cache.load_overload
+    if getattr(original, "direct", False) or not hasattr(Cache, "_load_overload") \
+            or not hasattr(nrt.rtsys, "initialize"):
+        return  # done already, or another numba: keep its own path
+
+    def load_overload(self: Any, sig: Any, target_context: Any) -> Any:
+        try:
+            nrt.rtsys.initialize(target_context)
+            loaded = self._load_overload(sig, target_context)
+        except Exception:  # whatever failed, numba's own path tries again and reports it
+            loaded = None
+        return loaded if loaded is not None else original(self, sig, target_context)
+
+    load_overload.direct = True  # type: ignore[attr-defined]
+    Cache.load_overload = load_overload  # type: ignore[method-assign]
+
+
+_load_cached_code_directly()
 
 
 def compiled(*functions: Any) -> bool:

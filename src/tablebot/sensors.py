@@ -153,7 +153,7 @@ def threshold_event(reading: float, above: bool, on_at: float, off_at: float, wa
     hysteresis; ``was_on``: the event last tick).
 
     The one rule for every analog input: the simulator compiles this function into its sensing
-    (``sim.sensing``), the TXT's wiring calls it (``hw.txt.wiring``), and the TXT 4.0 program, a standalone
+    (``sim.sensing``), every controller's wiring calls it (``hw.wiring``), and the TXT 4.0 program, a standalone
     file, carries a copy that ``tests/test_rules.py`` proves equal to it.
     """
     level = off_at if was_on else on_at

@@ -141,8 +141,7 @@ def _pictures(result: SimRun, summary: Summary, out: Path, plots: bool, gif: boo
     if plots:
         from tablebot.sim import plots as pictures
 
-        written += [pictures.trajectory(result, summary, out / "trajectory.png"),
-                    pictures.timeline(result, summary, out / "timeline.png")]
+        written += pictures.trajectory_and_timeline(result, summary, out)
     if gif:
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))

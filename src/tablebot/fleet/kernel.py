@@ -9,10 +9,9 @@
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
-from tablebot.jit import njit, prange
+from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
 from tablebot.sim.kernel import I_MASK, I_STATE, move, run_robot
 
 NO_TICK = -1  # "never" in first_visit / first_light

@@ -1,6 +1,6 @@
-"""A controller's wiring section of the robot file (``[robotx]``, ``[roboif]``): which terminal each input,
-motor, lamp and counter of the table is wired to, how each input measures and what the table reads.
-One reader for every serial controller, driven by what the controller offers (:class:`Terminals`)::
+"""A controller's wiring section of the robot file (``[txt]``, ``[robotx]``, ``[roboif]``): which terminal each
+input, motor, lamp and counter of the table is wired to, how each input measures and what the table reads.
+One reader for every controller, driven by what the controller offers (:class:`Terminals`)::
 
     [robotx]
     I3 = { terminal = "I3", mode = "switch", pressed = 1 }       # the table reads 1 while pressed
@@ -17,7 +17,7 @@ controller is even opened), every problem at once, each with its robot-file line
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from tablebot.sensors import threshold_event
@@ -29,9 +29,22 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
     from tablebot.robot import Robot
     from tablebot.sensors import Sensor
 
-#: Digital modes: mode -> (the polarity key, what it means)
-DIGITAL = {"switch": ("pressed", "while the push-button is pressed"),
-           "phototransistor": ("lit", "while the phototransistor sees light")}
+
+@dataclass(frozen=True)
+class Digital:
+    """A digital mode: the robot file says with ``key`` what the table reads ``meaning``."""
+
+    key: str  # "pressed"
+    device: str  # what is wired, for hints: "a push-button"
+    meaning: str  # "while the push-button is pressed"
+    reports: int = 1  # the controller's reading while so (a track sensor's over the line is 0)
+    words: tuple[str, ...] = ()  # words of an input's label that suggest this mode for a section to paste
+
+
+#: The digital modes every controller offers (a controller may add its own: :attr:`Terminals.digital_modes`)
+DIGITAL = {"switch": Digital("pressed", "a push-button", "while the push-button is pressed"),
+           "phototransistor": Digital("lit", "a phototransistor", "while the phototransistor sees light",
+                                      words=("photo", "light"))}
 
 
 @dataclass(frozen=True)
@@ -49,7 +62,7 @@ class Terminals:
 
     section: str  # the robot file's section: "robotx"
     controller: str  # how messages name it: "ROBO TX Controller"
-    digital_inputs: tuple[str, ...]  # terminals a switch or phototransistor can be wired to
+    digital_inputs: tuple[str, ...]  # terminals an input in a digital mode can be wired to
     analog: dict[str, Analog]  # mode -> what it measures and where
     motors: tuple[str, ...]
     lamps: tuple[str, ...]
@@ -58,6 +71,7 @@ class Terminals:
     tick_reason: str  # why a shorter tick cannot be kept
     distance_mode: str | None = None  # the analog mode a [sensors] distance declaration is read in (for hints;
     #                                   which modes read a kind's threshold is the kind's: SensorKind.modes)
+    digital_modes: dict[str, Digital] = field(default_factory=lambda: dict(DIGITAL))
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -66,7 +80,7 @@ class Terminals:
 
     @property
     def modes(self) -> tuple[str, ...]:
-        return (*DIGITAL, *self.analog)
+        return (*self.digital_modes, *self.analog)
 
     def names(self, kind: str) -> tuple[str, ...]:
         return {"input": self.inputs, "motor": self.motors, "lamp": self.lamps, "counter": self.counters}[kind]
@@ -82,20 +96,17 @@ def level_duty(level: int, most: int) -> int:
 
 @dataclass(frozen=True)
 class InputWire:
-    """A table input on ``terminal``. Digital modes read 1 for a closed contact or a lit phototransistor
-    (``invert`` flips that); analog modes compare against ``below`` or ``above``, with a hysteresis."""
+    """A table input on ``terminal``. A digital one reads what the controller reports (``invert`` flips it);
+    an analog one compares against ``below`` or ``above``, with a hysteresis."""
 
     name: str
     terminal: str
     mode: str
+    digital: bool
     invert: bool = False
     below: int | None = None
     above: int | None = None
     hysteresis: int = 0
-
-    @property
-    def digital(self) -> bool:
-        return self.mode in DIGITAL
 
     def reads(self, raw: int, was_on: bool = False) -> int:
         """What the table sees (0/1) for the controller's value (``was_on``: last tick's, for the hysteresis)."""
@@ -245,12 +256,16 @@ def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
             terminal = name if name in free[kind] else (free[kind][0] if free[kind] else "?")
             if terminal in free[kind]:
                 free[kind].remove(terminal)
-            label = robot.labels.get(name, "").lower()
-            mode = ('mode = "phototransistor", lit = 1' if "photo" in label or "light" in label
-                    else 'mode = "switch", pressed = 1')
-            lines.append(f'{name} = {{ terminal = "{terminal}", {mode} }}' if kind == "input"
-                         else f'{name} = "{terminal}"')
+            lines.append(f'{name} = {{ terminal = "{terminal}", {_suggested_mode(spec, robot, name)} }}'
+                         if kind == "input" else f'{name} = "{terminal}"')
     return "\n".join(f"        {line}" for line in lines)
+
+
+def _suggested_mode(spec: Terminals, robot: Robot, name: str) -> str:
+    """The digital mode an input's label suggests (the controller's last, most specific, whose words it has)."""
+    label = robot.labels.get(name, "").lower()
+    mode = next((m for m, d in reversed(spec.digital_modes.items()) if any(w in label for w in d.words)), "switch")
+    return f'mode = "{mode}", {spec.digital_modes[mode].key} = 1'
 
 
 def _error(src: Source, line: int | None, message: str, hint: str) -> None:
@@ -320,29 +335,29 @@ class _Reader:
         mode = value.get("mode")
         if mode not in self.spec.modes:
             self.error(name, f"[{key}] {name}: mode must be one of {', '.join(self.spec.modes)}, not {mode!r}",
-                       'a push-button is mode = "switch"; a phototransistor mode = "phototransistor"')
+                       "; ".join(f'{d.device} is mode = "{m}"' for m, d in self.spec.digital_modes.items()))
             return None
-        known = ("terminal", "mode", DIGITAL[mode][0]) if mode in DIGITAL else ("terminal", "mode", "below", "above")
+        digital = self.spec.digital_modes.get(mode)
+        known = ("terminal", "mode", digital.key) if digital else ("terminal", "mode", "below", "above")
         for k in value:
             if k not in known:
                 self.error(name, f"[{key}] {name}: unknown key {k!r} for mode {mode!r}", f"keys: {', '.join(known)}")
-        allowed = self.spec.digital_inputs if mode in DIGITAL else self.spec.analog[mode].terminals
+        allowed = self.spec.digital_inputs if digital else self.spec.analog[mode].terminals
         default = name if name in allowed else None
         terminal = self.terminal(name, "input", value.get("terminal", default), allowed)
-        polarity = self._digital(name, mode, value) if mode in DIGITAL else self._analog(name, mode, value)
+        polarity = self._digital(name, digital, value) if digital else self._analog(name, mode, value)
         if terminal is None or polarity is None:
             return None
-        return InputWire(name, terminal, mode, *polarity)
+        return InputWire(name, terminal, mode, digital is not None, *polarity)
 
-    def _digital(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool] | None:
-        key, meaning = DIGITAL[mode]
-        reads = value.get(key)
+    def _digital(self, name: str, mode: Digital, value: dict[str, Any]) -> tuple[bool] | None:
+        reads = value.get(mode.key)
         if reads not in (0, 1) or isinstance(reads, bool):
-            self.error(name, f"[{self.spec.section}] {name}: say what the table reads {meaning}: {key} = 1 or "
-                       f"{key} = 0" + ("" if reads is None else f", not {reads!r}"),
-                       f"{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')")
+            self.error(name, f"[{self.spec.section}] {name}: say what the table reads {mode.meaning}: {mode.key} = 1 "
+                       f"or {mode.key} = 0" + ("" if reads is None else f", not {reads!r}"),
+                       f"{mode.key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')")
             return None
-        return (reads == 0,)
+        return (reads != mode.reports,)
 
     def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None, int] | None:
         analog, key = self.spec.analog[mode], self.spec.section

@@ -6,6 +6,7 @@ world file's sections of the same names.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -198,10 +199,21 @@ def spin_speed(params: Params) -> float:
     return radians / (m["spin_ticks"] * SPIN_TICK_S) * params["body"]["wheel_base"] / 2
 
 
+def _formulas() -> tuple[Callable[..., float], Callable[..., float]]:
+    """The physics core's ``duty`` and ``pack_volts``, run as the plain Python they are written in.
+
+    Planning calls each a few times per scene; called compiled, each would first load its machine code
+    (tens of ms in a fresh process). Compiled without fast-math, the same arithmetic gives the same bits
+    in Python (tests/test_sim_params_formulas.py).
+    """
+    from tablebot.sim.physics import duty, pack_volts  # numba is imported, never run, for these
+
+    return duty.py_func, pack_volts.py_func
+
+
 def terminal_volts(params: Params, charge: float, levels: tuple[int, ...]) -> float:
     """Battery volts under the load of motors at these speed levels, by the physics core's formula."""
-    from tablebot.sim.physics import duty, pack_volts  # numba: only when a simulation is put together
-
+    duty, pack_volts = _formulas()
     b, m = params["battery"], params["motor"]
     amps = b["idle_amps"] + b["motor_amps"] * sum(duty(v, m["levels"]) for v in levels)
     return pack_volts(b["full_volts"], b["empty_volts"], charge, amps, b["internal_ohms"])
@@ -215,8 +227,7 @@ def speed_per_volt(params: Params) -> float:
         return float(m["speed_per_volt"])
     level = m["spin_level"]
     volts = terminal_volts(params, 1.0, (level, level))
-    from tablebot.sim.physics import duty
-
+    duty, _ = _formulas()
     drive = duty(level, m["levels"]) * volts - m["friction_volts"]
     if drive <= 0:
         raise ValueError("the calibration spin's speed level cannot overcome friction_volts")

@@ -79,25 +79,31 @@ def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
     per_state: list[list[list[Any]]] = [[] for _ in machine.states]
     for row in machine.rows:
         per_state[row.state].append([row.index, row.mask, row.next, row.timer, list(row.outputs), list(row.loads)])
-    motors = [(i, out) for i, out in enumerate(wiring.outputs) if out.kind == "motor"]
+    wired = wiring.wired
+    motors = [(i, out) for i, out in enumerate(wired.outputs) if out.kind == "motor"]
     counted = {c.motor for c in robot.counters}
-    terminal_of = {out.name: out.terminal + 1 for _, out in motors}
+    terminal_of = {out.name: _number(out.terminal) for _, out in motors}
     return {
         "name": robot.name, "source": table.path, "tick_ms": robot.tick_ms,
         "states": list(machine.states), "initial_state": machine.initial_state, "initial_timer": machine.initial_timer,
         "input_mask": machine.input_mask, "timer_bit": machine.timer_bit, "counter_bits": list(machine.counter_bits),
         "match": robot.match,
         "n_outputs": len(machine.output_names), "rows": per_state,
-        "inputs": [{"name": w.name, "terminal": w.terminal + 1, "mode": w.mode, "invert": w.invert,
+        "inputs": [{"name": w.name, "terminal": _number(w.terminal), "mode": w.mode, "invert": w.invert,
                     "below": w.below, "above": w.above, "hysteresis": w.hysteresis, "bit": bit}
-                   for w, bit in zip(wiring.inputs, wiring.bits, strict=True)],
-        "motors": [{"name": out.name, "output": i, "terminal": out.terminal + 1, "reverse": out.reverse,
+                   for w, bit in zip(wired.inputs, wired.bits, strict=True)],
+        "motors": [{"name": out.name, "output": i, "terminal": _number(out.terminal), "reverse": out.reverse,
                     "encoder": out.name in counted} for i, out in motors],
-        "lamps": [{"name": out.name, "output": i, "terminal": out.terminal + 1}
-                  for i, out in enumerate(wiring.outputs) if out.kind == "lamp"],
-        "counters": [{"name": c.name, "terminal": t + 1, "motor": terminal_of.get(c.motor)}
-                     for c, t in zip(robot.counters, wiring.counters, strict=True)],
+        "lamps": [{"name": out.name, "output": i, "terminal": _number(out.terminal)}
+                  for i, out in enumerate(wired.outputs) if out.kind == "lamp"],
+        "counters": [{"name": c.name, "terminal": _number(t), "motor": terminal_of.get(c.motor)}
+                     for c, t in zip(robot.counters, wired.counters, strict=True)],
     }
+
+
+def _number(terminal: str) -> int:
+    """A terminal's number, as the TXT 4.0's factories take it: ``"I3"`` -> 3."""
+    return int(terminal[1:])
 
 
 def literal(value: Any, depth: int = 0) -> str:

@@ -1,0 +1,91 @@
+"""The forked copy that draws one of a run's pictures on the other core (tablebot.sim.forked): its answer, its
+errors, and no process left behind on any way out, the sim command's interrupts included."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from core_helpers import EXAMPLE
+from tablebot.cli import app
+from tablebot.interrupts import FAULT_ENV
+from tablebot.sim import forked
+from tablebot.sim.forked import Forked
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
+                                reason="the copy is forked on Linux with two cores or more (elsewhere the work "
+                                       "runs in place, tested by test_without_a_copy_the_work_runs_here)")
+
+
+def copies() -> list[int]:
+    """Our forked copies still in the process table (running or unreaped), by the name they give themselves."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            status = (entry / "status").read_text()
+        except OSError:
+            continue
+        fields = dict(line.split(":\t", 1) for line in status.splitlines() if ":\t" in line)
+        if fields.get("Name", "").strip() == forked.NAME.decode() and int(fields["PPid"]) == os.getpid():
+            found.append(int(entry.name))
+    return found
+
+
+def test_the_answer_comes_from_another_process():
+    me = os.getpid()
+    with Forked(lambda: str(os.getpid()).encode()) as copy:
+        assert copy.pid is not None
+        assert int(copy.result()) not in (me, 0)
+    assert copies() == []
+
+
+def test_an_error_in_the_copy_is_raised_here():
+    def work() -> bytes:
+        raise ValueError("no picture today")
+    with Forked(work) as copy, pytest.raises(ValueError, match="no picture today"):
+        copy.result()
+    assert copies() == []
+
+
+def test_leaving_without_the_answer_kills_the_copy_at_once():
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt), Forked(lambda: time.sleep(60) or b"late") as copy:
+        while copies() != [copy.pid]:  # the copy names itself just after the fork
+            assert time.monotonic() - started < 10
+            time.sleep(0.01)
+        raise KeyboardInterrupt
+    assert copies() == [] and time.monotonic() - started < 30
+
+
+def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here():
+    me = os.getpid()
+    with Forked(lambda: b"here" if os.getpid() == me else time.sleep(60) or b"there") as copy:
+        os.kill(copy.pid, signal.SIGKILL)
+        assert copy.result() == b"here"
+    assert copies() == []
+
+
+def test_without_a_copy_the_work_runs_here(monkeypatch):
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)
+    with Forked(lambda: str(os.getpid()).encode()) as copy:
+        assert copy.pid is None and int(copy.result()) == os.getpid()
+
+
+@pytest.mark.parametrize("fault", ["2:INT", "3:TERM"])
+def test_sim_interrupted_while_drawing_leaves_no_process(tmp_path, fault):
+    """Step 2 is trajectory.png written (the copy may still draw the timeline), step 3 timeline.png."""
+    shutil.copytree(EXAMPLE, tmp_path / "bot")
+    result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "20", "-q", "--out",
+                                      str(tmp_path / "out")], env={FAULT_ENV: fault})
+    assert result.exit_code == (130 if fault.endswith("INT") else 143), result.output
+    assert copies() == []
+    assert not list((tmp_path / "out").glob("*.png"))

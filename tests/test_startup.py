@@ -1,0 +1,77 @@
+"""What a fresh tablebot process loads before it works: compiled code straight from numba's cache (not numba's
+whole compiler), numba without scipy, and commands that need neither numba nor pictures import neither.
+Timings live in benchmarks/startup.py; these tests pin down what is imported, which a change can break."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "bumberbot"
+
+# Runs the command line in this process, then prints the top-level packages it imported (on exit, also after
+# SystemExit).
+CLI_MODULES = """
+import atexit, json, sys
+atexit.register(lambda: print(json.dumps(sorted({m.split('.')[0] for m in sys.modules}))))
+sys.argv = ['tablebot', *sys.argv[1:]]
+from tablebot.cli import main
+main()
+"""
+
+
+def python(code: str, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-c", code, *args], cwd=ROOT, capture_output=True, text=True,
+                          env={**os.environ, **(env or {})}, timeout=300)
+
+
+def packages_of(*args: str) -> set[str]:
+    """The top-level packages ``tablebot ARGS`` imports."""
+    done = python(CLI_MODULES, *args)
+    assert done.returncode in (0, 1), done.stderr
+    return set(json.loads(done.stdout.strip().splitlines()[-1]))
+
+
+def test_a_cached_function_loads_without_numba_s_compiler_and_scipy(tmp_path: Path) -> None:
+    cache = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    compile_it = "from tablebot.sim.physics import duty; print(duty(3, 8))"
+    first = python(compile_it, env=cache)
+    assert first.returncode == 0, first.stderr
+    load_it = """
+import sys
+from tablebot.sim.physics import duty
+print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_misses.values()))
+print(sorted(m for m in ('numba.np.arraymath', 'numba.np.linalg', 'scipy', 'scipy.linalg') if m in sys.modules))
+"""
+    second = python(load_it, env=cache)
+    assert second.returncode == 0, second.stderr
+    result, hits, misses, *_ = second.stdout.split()
+    assert result == first.stdout.strip() == "0.375"
+    assert (hits, misses) == ("1", "0"), second.stdout  # loaded from the cache, not compiled
+    assert second.stdout.splitlines()[1] == "[]"  # numba's rules and scipy were never imported
+
+
+def test_numba_comes_without_scipy_and_scipy_still_imports() -> None:
+    done = python("import sys, tablebot.jit; print('scipy' in sys.modules); "
+                  "import scipy.linalg; print(scipy.linalg.__name__)")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "scipy.linalg"]
+
+
+def test_check_imports_neither_numba_nor_pictures() -> None:
+    assert not packages_of("check", str(EXAMPLE)) & {"numba", "llvmlite", "matplotlib", "scipy", "dask"}
+
+
+def test_a_sweep_without_pictures_imports_neither_matplotlib_nor_scipy(tmp_path: Path) -> None:
+    def sweep(out: str) -> set[str]:
+        return packages_of("sweep", str(EXAMPLE), "--robots", "4", "--seconds", "0.1", "--no-plots", "--quiet",
+                           "--out", str(tmp_path / out))
+
+    sweep("first")  # on a cold cache this one compiles (numba's whole compiler, scipy included)
+    found = sweep("second")
+    assert "numba" in found  # it did run the fleet
+    assert not found & {"matplotlib", "scipy"}
