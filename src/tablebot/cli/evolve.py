@@ -159,7 +159,7 @@ def _spec(plan: Any, setup: Setup) -> dict[str, Any]:
 def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: str | None,
          workers: int | None, quiet: bool) -> None:
     from tablebot.evolve.evaluate import Evaluator
-    from tablebot.evolve.outputs import write_all
+    from tablebot.evolve.pool import Workers
     from tablebot.evolve.proofs import Prover
     from tablebot.evolve.run import Evolution, Store
     from tablebot.fleet.backends import Runner
@@ -171,13 +171,16 @@ def _run(plan: Any, check: Any, setup: Setup, out: Path, backend: str, address: 
     started = time.perf_counter()
     evolution = None
     try:
-        with Runner(backend, address, workers) as runner, Bar("tables", settings.budget, quiet) as bar:
+        with Workers(setup.files, plan.table, workers) as provers, Runner(backend, address, workers) as runner, \
+                Bar("tables", settings.budget, quiet) as bar:
             evaluator = Evaluator(plan, runner, setup.names)
-            evolution = Evolution(plan.table, setup.space, settings, prover, evaluator, store,
+            evolution = Evolution(plan.table, setup.space, settings, prover, evaluator, store, provers,
                                   on_eval=bar.advance, on_repair=lambda repairs: _said_repairs(repairs, quiet))
             outcome = evolution.run()
+            from tablebot.evolve.outputs import write_all  # after the run: it imports pyribs, which the run does
+
             written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup.names,
-                                setup.replay)
+                                setup.replay, provers)
     except INTERRUPTS as exc:  # SIGTERM raises Terminated while a command runs (cli.common.guarded)
         kept = len(evolution.store.open()) if evolution else 0
         err_console.print(f"{'terminated' if isinstance(exc, Terminated) else 'interrupted'}: {kept} tables "

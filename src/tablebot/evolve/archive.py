@@ -14,10 +14,9 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from ribs.archives import GridArchive
-from ribs.emitters import EmitterBase
 
 from tablebot.evolve.measures import Descriptor
+from tablebot.evolve.pyribs import EmitterBase, GridArchive
 
 #: breed(parents, rng, count) -> up to ``count`` new children's keys (proved, not seen before)
 Breed = Callable[[Sequence[str], np.random.Generator, int], list[str]]

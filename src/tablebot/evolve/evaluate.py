@@ -1,8 +1,11 @@
 """Candidates on the fleet: every candidate runs every scenario of the plan (seeds × grid values × worlds,
-the same for all: common random numbers), one fleet per candidate and world (a fleet shares one
-program), on this machine's cores or a Dask cluster. Each job returns per robot every measure; a
-candidate's value is the mean over its scenarios, summed in scenario order, so the numbers are the
-same bits whichever backend ran which job in whichever order.
+the same for all: common random numbers), on this machine's cores or a Dask cluster. A batch of
+candidates runs as few large fleets as keep every slot of the backend busy: a fleet runs one table, so
+the candidates of a job are put side by side in one *joint* table (:func:`joint`), each under states of
+its own, and each robot starts in its candidate's start state: a robot only ever reaches its own
+candidate's rows, so it drives exactly as in a fleet of that candidate alone. Each job returns per robot
+every measure; a candidate's value is the mean over its scenarios, summed in scenario order, so the
+numbers are the same bits whichever backend ran which robots in which job in whichever order.
 
 Measures the fleet's summary does not keep (laps, floor covered, time in contact) come from the robots'
 poses sampled every ``stride`` ticks as the fleet runs (the fleet's noise is drawn robot by robot, so
@@ -11,6 +14,7 @@ cutting the run into short blocks changes no robot's path).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -25,32 +29,67 @@ from tablebot.table import Table
 if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
     from tablebot.fleet.plan import Plan
+    from tablebot.fleet.robots import RobotSpec
     from tablebot.fleet.run import Fleet
+    from tablebot.machine import Machine
     from tablebot.sim.world import World
 
 STRIDE = 20  # ticks between pose samples (0.2 s at 10 ms: a robot moves at most 6 cm)
 CELL_M = 0.10  # floor squares for area_covered
-ROBOTS_PER_JOB = 512
+ROBOTS_PER_JOB = 512  # most robots in one job (a job is one fleet: it returns only when all are done)
+
+
+@dataclass(frozen=True)
+class Part:
+    """One candidate's robots in a job, in the job's order: its key and each robot's scenario index."""
+
+    key: str
+    scenarios: tuple[int, ...]
 
 
 @dataclass
 class EvalJob(Job):
-    """A fleet job of one candidate in one world, measuring everything ``measures`` needs."""
+    """A fleet job in one world of the robots of one or more candidates (``table``: their joint table,
+    the robots in the order of ``parts``), measuring everything ``measures`` needs."""
 
     stride: int = STRIDE
+    parts: tuple[Part, ...] = ()
+
+
+def joint(tables: Sequence[Table]) -> Table:
+    """The candidates' rows side by side as one table, candidate k's states renamed ``(k, state)`` (so no
+    row of one can ever lead into another's); it starts in candidate 0's start state (:func:`starts`)."""
+    robot = tables[0].robot
+    rows = []
+    for k, table in enumerate(tables):
+        rows += [replace(row, index=len(rows) + i, state=(k, row.state), next=(k, row.next))
+                 for i, row in enumerate(table.rows)]
+    return Table(replace(robot, initial_state=(0, robot.initial_state)), tables[0].events, tuple(rows),
+                 tables[0].path)
+
+
+def starts(machine: Machine, parts: int) -> np.ndarray:
+    """Per candidate of a joint machine, the index of its own start state."""
+    start = machine.table.robot.initial_state[1]  # type: ignore[index]
+    return np.array([machine.state_index((k, start)) for k in range(parts)], dtype=np.int64)
 
 
 def run_eval(job: EvalJob) -> tuple[EvalJob, dict[str, np.ndarray]]:
-    """Run the job's robots as one fleet; per robot, every measure (a worker's entry point)."""
+    """Run the job's robots as one fleet of the joint table, each robot started in its own candidate's
+    start state; per robot, every measure (a worker's entry point)."""
     from tablebot.fleet.run import Fleet
     from tablebot.fleet.work import use_threads
     from tablebot.machine import compile_table
+    from tablebot.tick import STATE
 
     use_threads(job)
-    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params)
+    machine = compile_table(job.table)
+    fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params)
+    owner = np.repeat(np.arange(len(job.parts)), [len(part.scenarios) for part in job.parts])
+    fleet.regs[:, STATE] = starts(machine, len(job.parts))[owner]  # the engine's registers before its first tick
     poses = Poses(fleet, job.world)
     fleet.run(job.ticks, progress=lambda done: poses.sample(), block_ticks=job.stride)
-    return replace(job, specs=[]), measure_all(fleet, job.world, poses)
+    return replace(job, specs=[]), measure_all(fleet, job.world, poses, owner)
 
 
 class Poses:
@@ -93,8 +132,9 @@ class Poses:
             self.arc = arc
 
 
-def measure_all(fleet: Fleet, world: World, poses: Poses) -> dict[str, np.ndarray]:
-    """Every measure per robot (those the world cannot give are left out)."""
+def measure_all(fleet: Fleet, world: World, poses: Poses, owner: np.ndarray) -> dict[str, np.ndarray]:
+    """Every measure per robot (those the world cannot give are left out); ``owner``: each robot's
+    candidate in the joint table (its share of time per state is read from that candidate's states)."""
     s = fleet.summary()
     seconds = s.ticks * s.tick_s
     out = {"collisions": s.collisions.astype(float), "collision_share": poses.touching / poses.samples,
@@ -112,12 +152,23 @@ def measure_all(fleet: Fleet, world: World, poses: Poses) -> dict[str, np.ndarra
     if poses.loop is not None:
         out["laps"] = poses.laps.copy()
     total = np.maximum(1, s.counts.sum(axis=1))
-    for k, state in enumerate(s.states):
-        out[f"{STATE_SHARE}{state}"] = s.counts[:, k] / total
+    column: dict[str, np.ndarray] = {}  # per state: its column in the joint table for each candidate
+    for j, (k, state) in enumerate(s.states):
+        column.setdefault(f"{STATE_SHARE}{state}", np.zeros(int(owner.max()) + 1, dtype=np.int64))[k] = j
+    robots = np.arange(len(owner))
+    for name, columns in column.items():
+        out[name] = s.counts[robots, columns[owner]] / total
     return out
 
 
 Means = dict[str, float]
+Scenario = tuple[int, int, "RobotSpec"]  # world, scenario index, the fleet robot
+
+
+def cuts(n: int, count: int) -> list[tuple[int, int]]:
+    """``range(n)`` cut into ``count`` runs of consecutive items, their lengths at most one apart."""
+    bounds = [k * n // count for k in range(count + 1)]
+    return [(a, b) for a, b in itertools.pairwise(bounds) if b > a]
 
 
 @dataclass
@@ -129,46 +180,70 @@ class Evaluator:
     names: Sequence[str]
     robot_ticks: int = 0  # robot-ticks simulated so far (throughput)
 
-    def jobs(self, key: str, table: Table, plan: Plan | None = None) -> list[EvalJob]:
-        """One candidate's jobs: its robots per world, at most ROBOTS_PER_JOB to a job."""
+    def __post_init__(self) -> None:
+        self._scenarios: dict[int, tuple[Plan, list[Scenario]]] = {}
+
+    def scenarios(self, plan: Plan) -> list[Scenario]:
+        """Every scenario of ``plan`` with its fleet robot, in scenario order (drawn once per plan: every
+        candidate runs the same robots)."""
         from tablebot.fleet.spec import runs
 
+        held = self._scenarios.get(id(plan))
+        if held is None or held[0] is not plan:
+            held = self._scenarios[id(plan)] = (plan, [(r.world, r.index, plan.robot(r)) for r in runs(plan.spec)])
+        return held[1]
+
+    def jobs(self, candidates: Sequence[tuple[str, Table]], plan: Plan | None = None) -> list[EvalJob]:
+        """The candidates' robots (candidate by candidate, each in scenario order) cut into as many jobs
+        as the backend has slots (or a multiple, at most ROBOTS_PER_JOB robots a job), each cut again
+        where its robots change world."""
         plan = plan or self.plan
-        scenarios = runs(plan.spec)
+        robots = [(k, *scenario) for k in range(len(candidates)) for scenario in self.scenarios(plan)]
+        slots = self.runner.slots()
+        count = slots * math.ceil(len(robots) / (slots * ROBOTS_PER_JOB))
         jobs = []
-        for world in range(len(plan.spec.worlds)):
-            mine = [run for run in scenarios if run.world == world]
-            for a in range(0, len(mine), ROBOTS_PER_JOB):
-                chunk = mine[a:a + ROBOTS_PER_JOB]
-                jobs.append(EvalJob(table, plan.worlds[world], plan.robot_params, [plan.robot(r) for r in chunk],
-                                    plan.spec.ticks, first=chunk[0].index, info={"key": key}))
+        for a, b in cuts(len(robots), count):
+            chunk = robots[a:b]
+            for world in dict.fromkeys(r[1] for r in chunk):
+                jobs.append(self.job(candidates, [r for r in chunk if r[1] == world], plan, world))
         return jobs
+
+    @staticmethod
+    def job(candidates: Sequence[tuple[str, Table]], robots: list[tuple[int, int, int, RobotSpec]], plan: Plan,
+            world: int) -> EvalJob:
+        """One fleet of ``robots`` (candidate, world, scenario index, robot), all in ``world``."""
+        order = list(dict.fromkeys(r[0] for r in robots))
+        parts = tuple(Part(candidates[k][0], tuple(r[2] for r in robots if r[0] == k)) for k in order)
+        specs = [r[3] for k in order for r in robots if r[0] == k]
+        return EvalJob(joint([candidates[k][1] for k in order]), plan.worlds[world], plan.robot_params, specs,
+                       plan.spec.ticks, first=robots[0][2], parts=parts)
 
     def run(self, candidates: Sequence[tuple[str, Table]], done: Callable[[str, Means, dict[str, np.ndarray]], None],
             plan: Plan | None = None) -> None:
-        """Evaluate every candidate; ``done(key, means, values)`` as soon as all of one candidate's jobs are
-        in (``values``: per measure, each scenario's number in scenario order)."""
+        """Evaluate every candidate; ``done(key, means, values)`` as soon as all of one candidate's robots
+        are in (``values``: per measure, each scenario's number in scenario order)."""
         plan = plan or self.plan
         total = plan.spec.total
-        values: dict[str, dict[str, np.ndarray]] = {}
+        candidates = list(dict(candidates).items())  # each key once
+        jobs = self.jobs(candidates, plan)
+        values = {key: {name: np.full(total, np.nan) for name in self.names} for key, _ in candidates}
         waiting: dict[str, int] = {}
-        jobs = []
-        for key, table in candidates:
-            mine = self.jobs(key, table, plan)
-            waiting[key] = len(mine)
-            values[key] = {name: np.full(total, np.nan) for name in self.names}
-            jobs += mine
+        for job in jobs:
+            for part in job.parts:
+                waiting[part.key] = waiting.get(part.key, 0) + 1
 
         def finished(job: Any, measured: dict[str, np.ndarray]) -> None:
-            key = job.info["key"]
-            n = len(next(iter(measured.values())))
-            for name in self.names:
-                values[key][name][job.first:job.first + n] = measured[name]
-            self.robot_ticks += n * plan.spec.ticks
-            waiting[key] -= 1
-            if waiting[key] == 0:
-                mine = values.pop(key)
-                done(key, {name: float(np.sum(v) / total) for name, v in mine.items()}, mine)
+            at = 0
+            for part in job.parts:
+                n, where = len(part.scenarios), list(part.scenarios)
+                for name in self.names:
+                    values[part.key][name][where] = measured[name][at:at + n]
+                at += n
+                self.robot_ticks += n * plan.spec.ticks
+                waiting[part.key] -= 1
+                if waiting[part.key] == 0:
+                    mine = values.pop(part.key)
+                    done(part.key, {name: float(np.sum(v) / total) for name, v in mine.items()}, mine)
 
         self.runner.run(jobs, finished, run_eval)  # type: ignore[call-arg]
 

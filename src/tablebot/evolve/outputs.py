@@ -15,10 +15,12 @@ import numpy as np
 from tablebot.evolve import archive as qd
 from tablebot.evolve.evaluate import Evaluator, Means
 from tablebot.evolve.measures import Measure, fitness
+from tablebot.evolve.pool import Workers, check_report
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.report import (
     Replay,
     Written,
+    as_table,
     heat_map,
     measure_rows,
     paired,
@@ -81,30 +83,28 @@ def remember_own(out: Path, paths: Sequence[Path]) -> Path:
 
 
 def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-              out: Path, names: Sequence[str], replay: Replay) -> list[Path]:
+              out: Path, names: Sequence[str], replay: Replay, workers: Workers) -> list[Path]:
     """Every table, check report, the heat map, evaluations.csv and report.md, replacing the previous run's
     all at once (tablebot.fileset); returns the paths written."""
     with file_set(out):
-        return _write_all(outcome, settings, base, prover, evaluator, check, out, names, replay)
+        return _write_all(outcome, settings, base, prover, evaluator, check, out, names, replay, workers)
 
 
 def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-               out: Path, names: Sequence[str], replay: Replay) -> list[Path]:
+               out: Path, names: Sequence[str], replay: Replay, workers: Workers) -> list[Path]:
     forget_own(out)
     best = best_keys(outcome)
     start, seeds = outcome.start_key, outcome.seeds
+    tables = [("repaired" if k == 0 else f"repaired-{k + 1}", key)
+              for k, key in enumerate(seeds if outcome.repairs else [])]
+    tables += [(f"best-{k + 1}", key) for k, key in enumerate(best)]
+    tables += [("elites/cell-" + "-".join(f"{c:02d}" for c in cell), key)
+               for key, _, _, cell in qd.elites(outcome.archive)]
+    ready = [as_table(outcome.candidates[key], base, out / f"{label}.csv") for label, key in tables]
+    checks = [workers.submit(check_report, table) for table in ready]  # in the workers while the fleet runs
     fresh = measure_fresh(evaluator, check, outcome, [start, *seeds, *best], base)
-    written: list[Written] = []
-    for k, key in enumerate(seeds if outcome.repairs else []):
-        label = "repaired" if k == 0 else f"repaired-{k + 1}"
-        written.append(write_table(outcome.candidates[key], base, out / f"{label}.csv", prover, label, key))
-    for k, key in enumerate(best):
-        written.append(write_table(outcome.candidates[key], base, out / f"best-{k + 1}.csv", prover,
-                                   f"best-{k + 1}", key))
-    for key, _, _, cell in qd.elites(outcome.archive):
-        name = "cell-" + "-".join(f"{c:02d}" for c in cell)
-        written.append(write_table(outcome.candidates[key], base, out / "elites" / f"{name}.csv", prover,
-                                   f"elites/{name}", key))
+    written = [write_table(table, label, key, answer.get())
+               for (label, key), table, answer in zip(tables, ready, checks, strict=True)]
     start_at = tuple(outcome.means[start][d.name] for d in settings.descriptors)
     label = "the starting table" if outcome.start_verdict.ok else "the starting table (breaks a property: not kept)"
     paths = [heat_map(outcome.archive, settings.descriptors, settings.objective, outcome.history, start_at,
@@ -112,8 +112,7 @@ def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover
              write_evaluations(outcome, settings, out / "evaluations.csv")]
     text = report_text(outcome, settings, base, prover, evaluator, check, fresh, written, best, names, replay)
     paths.append(write_text(out / "report.md", text))
-    tables = [p for w in written for p in (w.path, w.check)]
-    remember_own(out, tables)
+    remember_own(out, [p for w in written for p in (w.path, w.check)])
     return [*paths, *(w.path for w in written)]
 
 

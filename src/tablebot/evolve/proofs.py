@@ -14,6 +14,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from tablebot.analysis.check import CheckReport, run_check
 from tablebot.analysis.loops import zero_time_loops
@@ -67,6 +68,7 @@ class Prover:
     hits: int = 0
     seconds: float = 0.0
     failures: dict[str, int] = field(default_factory=dict)  # proofs each property failed (ordering only)
+    names: list[str] = field(default_factory=list)  # the property list's names, as last read
 
     def __post_init__(self) -> None:
         if self.cache_path is not None and self.cache_path.exists():
@@ -92,15 +94,20 @@ class Prover:
 
     def verdict(self, table: Table) -> tuple[str, Verdict]:
         """The candidate's canonical key and verdict (proved now, or from the cache)."""
+        machine = compile_table(table)
+        return self.decide(machine, canonical(machine))
+
+    def decide(self, machine: Machine, key: str, found: Any = None) -> tuple[str, Verdict]:
+        """The verdict of a machine of canonical ``key``: from the cache, or proved now, using what a worker
+        found (``found``: an answer of :func:`tablebot.evolve.pool.statuses`, or None)."""
         import time
 
-        machine = compile_table(table)
-        key = canonical(machine)
         if key in self.verdicts:
             self.hits += 1
             return key, self.counted(self.verdicts[key])
         started = time.perf_counter()
-        verdict = self.prove(machine)
+        known, stuck = found.get() if found is not None else ({}, None)
+        verdict = self.prove(machine, known, stuck)
         self.seconds += time.perf_counter() - started
         self.proved += 1
         self.verdicts[key] = verdict
@@ -117,16 +124,30 @@ class Prover:
             self.failures[verdict.failed[0]] = self.failures.get(verdict.failed[0], 0) + 1
         return verdict
 
+    def order(self, machine: Machine | None = None) -> list[int]:
+        """Places in the property list, in the order they are tried now: the one that failed most often so
+        far first (ties in list order). The list's names are read once (from ``machine`` if need be): every
+        candidate has the same properties."""
+        if not self.names and machine is not None:
+            self.names = [p.name for p in self.properties(machine)]
+        names = self.names
+        return sorted(range(len(names)), key=lambda k: -self.failures.get(names[k], 0))
 
-    def prove(self, machine: Machine) -> Verdict:
-        """Every property in turn, the one that failed most often so far first, stopping at the first
-        that fails; then the zero-time loops no input can leave (``check``'s only error-level finding
-        about behaviour). A property "fails" when ``check`` does not prove it (violated or unknown)."""
-        props = sorted(self.properties(machine), key=lambda p: -self.failures.get(p.name, 0))
-        for prop in props:
-            if check_property(prop, machine).status != "holds":
-                return Verdict(False, (prop.name,))
-        stuck = [f for f in zero_time_loops(Model(machine).explore()) if f.severity == "error"]
+    def prove(self, machine: Machine, known: dict[int, bool] | None = None, stuck: bool | None = None) -> Verdict:
+        """Every property in turn (:meth:`order`), stopping at the first that fails; then the zero-time loops
+        no input can leave (``check``'s only error-level finding about behaviour). A property "fails" when
+        ``check`` does not prove it (violated or unknown). ``known``: properties (by place) already proved
+        or refuted elsewhere; ``stuck``: whether a zero-time loop traps it, when already looked at."""
+        props = self.properties(machine)
+        self.names = [p.name for p in props]
+        for index in self.order():
+            holds = (known or {}).get(index)
+            if holds is None:
+                holds = check_property(props[index], machine).status == "holds"
+            if not holds:
+                return Verdict(False, (props[index].name,))
+        if stuck is None:
+            stuck = any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
         return Verdict(False, ("zero-time-loop",)) if stuck else Verdict(True)
 
 

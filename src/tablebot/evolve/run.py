@@ -14,18 +14,20 @@ from __future__ import annotations
 import json
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 from tablebot.diagnostics import fail
-from tablebot.evolve import archive as qd
 from tablebot.evolve.evaluate import Evaluator, Means
 from tablebot.evolve.measures import Descriptor, Measure, default_range, fitness
 from tablebot.evolve.operators import Space, vary
+from tablebot.evolve.pool import Workers, proved_ahead, repaired
 from tablebot.evolve.proofs import Prover, Verdict
-from tablebot.evolve.repair import PREFERENCES, Repaired, Step, repair
+from tablebot.evolve.repair import PREFERENCES, Repaired, Step
 from tablebot.evolve.space import Candidate, Gene, start, to_table
 from tablebot.files import write_text
 from tablebot.table import Table
@@ -138,6 +140,14 @@ def repaired_from_json(item: dict[str, Any]) -> Repaired:
                     item["proposals"])
 
 
+def qd_module() -> ModuleType:
+    """:mod:`tablebot.evolve.archive`, imported when first needed: it imports pyribs (pandas, scikit-learn,
+    compiled numba functions: seconds), which a run does while its workers repair the start."""
+    from tablebot.evolve import archive
+
+    return archive
+
+
 @dataclass
 class Evolution:
     """One run: the starting table, what may change, the settings, and where proofs and runs happen."""
@@ -148,6 +158,7 @@ class Evolution:
     prover: Prover
     evaluator: Evaluator
     store: Store
+    workers: Workers
     on_eval: Callable[[int], None] = lambda n: None
     on_repair: Callable[[list[Repaired]], None] = lambda r: None
 
@@ -173,7 +184,9 @@ class Evolution:
             began = time.perf_counter()
             repairs = self.store.repairs()
             if repairs is None:
-                repairs = [repair(first, self.base, self.prover, self.space, prefer) for prefer in PREFERENCES]
+                answers = [self.workers.submit(repaired, first, self.space, prefer) for prefer in PREFERENCES]
+                qd_module()  # pyribs' seconds of imports while the workers repair
+                repairs = [answer.get() for answer in answers]
                 self.store.keep_repairs(repairs)
             self.counts.repair_s = time.perf_counter() - began
             self.on_repair(repairs)
@@ -191,6 +204,7 @@ class Evolution:
                 seeds.append(key)
         seeds = list(dict.fromkeys(seeds))
         self.evaluate(list(dict.fromkeys([start_key, *seeds])))
+        qd = qd_module()
         objective = self.settings.objective
         worst = 0.0 if objective.better == "high" else -default_range(objective.name, self.seconds)[1]
         archive = qd.make_archive(self.settings.descriptors, worst, self.settings.seed)
@@ -210,26 +224,38 @@ class Evolution:
                        self.counts, history, time.perf_counter() - started)
 
     def breed(self, parents: Sequence[str], rng: Any, count: int) -> list[str]:
-        """Up to ``count`` children of the parents that are proved and behave unlike any table seen."""
+        """Up to ``count`` children of the parents that are proved and behave unlike any table seen. The
+        children are varied in order and proved ahead in the workers; each is then taken in order, as if
+        proved here, until ``count`` are in (the variations depend on ``rng`` alone, not on the verdicts)."""
         out: list[str] = []
-        for _ in range(count * TRIES_PER_CHILD):
-            if len(out) == count:
-                break
+        children = self.variations(parents, rng, count * TRIES_PER_CHILD)
+        ahead = proved_ahead(self.workers, self.prover, children, self.workers.window)
+        with closing(ahead):  # closed at the end: proofs not started are dropped
+            for child, machine, key, found in ahead:
+                if len(out) == count:
+                    break
+                if child is not None and machine is not None:
+                    self.take(child, machine, key, found, out)
+        return out
+
+    def take(self, child: Candidate, machine: Any, key: str, found: Any, out: list[str]) -> None:
+        """Count one varied child, and keep it (in ``out``) when it is proved and new."""
+        self.counts.varied += 1
+        key, verdict = self.prover.decide(machine, key, found)
+        if not verdict.ok:
+            self.counts.discarded[verdict.failed[0]] += 1
+        elif key in self.candidates:
+            self.counts.duplicates += 1
+        else:
+            self.candidates[key] = child
+            out.append(key)
+
+    def variations(self, parents: Sequence[str], rng: Any, tries: int) -> Iterator[Candidate | None]:
+        """``tries`` children of parents drawn from ``parents`` (None where a variation gave nothing)."""
+        for _ in range(tries):
             parent = self.candidates[parents[int(rng.integers(len(parents)))]]
             other = self.candidates[parents[int(rng.integers(len(parents)))]]
-            child = vary(parent, self.space, rng, other if other is not parent else None)
-            if child is None:
-                continue
-            self.counts.varied += 1
-            key, verdict = self.prover.verdict(to_table(child, self.base))
-            if not verdict.ok:
-                self.counts.discarded[verdict.failed[0]] += 1
-            elif key in self.candidates:
-                self.counts.duplicates += 1
-            else:
-                self.candidates[key] = child
-                out.append(key)
-        return out
+            yield vary(parent, self.space, rng, other if other is not parent else None)
 
     def evaluate(self, keys: Sequence[str]) -> None:
         """Means of every measure for each key: from the folder when an earlier run evaluated it, else on
@@ -258,7 +284,7 @@ class Evolution:
     def offer(self, archive: Any, keys: Sequence[str]) -> None:
         objective = [fitness(self.settings.objective, self.means[k][self.settings.objective.name]) for k in keys]
         measures = [[self.means[k][d.name] for d in self.settings.descriptors] for k in keys]
-        qd.add(archive, keys, objective, measures)
+        qd_module().add(archive, keys, objective, measures)
 
     def snapshot(self, archive: Any) -> dict[str, float]:
         stats = archive.stats

@@ -1,0 +1,226 @@
+"""Proving in worker processes: the proofs of a generation's children, the repairs and the written tables'
+``check`` reports run on the machine's other cores while this process goes on (proofs are pure Python:
+threads would wait for one another).
+
+Workers only compute; every decision stays with the caller, which asks for the answers in the order the
+search needs them, so a run with workers makes the same choices, counts and files as a run without.
+Workers come from a fork server (a clean process: no fork of this one's threads), ignore Ctrl-C (this
+process stops them) and are ended with the run. With one worker or none (``--workers 1``), every task
+runs here, when its answer is asked for, so a task nobody asks for costs nothing.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import sys
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from tablebot.analysis.loops import zero_time_loops
+from tablebot.analysis.model import Model
+from tablebot.analysis.prove import check_property
+from tablebot.evolve.proofs import Prover, canonical
+from tablebot.evolve.space import Candidate, to_table
+from tablebot.machine import Machine, compile_table
+from tablebot.table import Table
+
+#: Per property tried (by its place in the property list), whether it holds; then, when all of them
+#: hold, whether a zero-time loop traps the robot (None: not looked at).
+Statuses = tuple[dict[int, bool], bool | None]
+
+
+class Answer(Protocol):
+    def get(self) -> Any: ...
+
+    def drop(self) -> None: ...
+
+
+class Later:
+    """A task run here, when its answer is first asked for (or never, when nobody asks)."""
+
+    def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]):
+        self.fn, self.args = fn, args
+        self.done, self.value = False, None
+
+    def get(self) -> Any:
+        if not self.done:
+            self.value, self.done = self.fn(*self.args), True
+        return self.value
+
+    def drop(self) -> None:
+        pass
+
+
+class Answered:
+    """A worker's answer (a future), asked for with :meth:`get`; :meth:`drop` when it is not wanted."""
+
+    def __init__(self, future: Any):
+        self.future = future
+
+    def get(self) -> Any:
+        return self.future.result()
+
+    def drop(self) -> None:
+        self.future.cancel()  # not started yet: it never will be (a running one finishes unheard)
+
+
+@dataclass(frozen=True)
+class Context:
+    """What every task needs: a prover of the run's property files (no cache: the run keeps that) and the
+    starting table (candidates become tables of its robot and columns)."""
+
+    prover: Prover
+    base: Table
+
+
+class Workers:
+    """``count`` worker processes (default: one per core) knowing the property files and the starting
+    table; with a count of 1 none, and tasks run here. Use as a context manager: the workers end with it.
+
+    They come from a fork server, so, as for any ``multiprocessing`` program, the main module must be
+    importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
+
+    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None):
+        self.count = max(1, count if count is not None else os.cpu_count() or 1)
+        self.context = Context(Prover(list(files)), base)
+        self.pool: Any = None
+        if self.count > 1:
+            from concurrent.futures import ProcessPoolExecutor
+
+            spawner = multiprocessing.get_context("forkserver")
+            spawner.set_forkserver_preload(preload())  # imported once, in the fork server, not in each worker
+            self.pool = ProcessPoolExecutor(self.count, spawner, initializer=_start, initargs=(list(files), base))
+
+    def __enter__(self) -> Workers:
+        return self
+
+    def __exit__(self, kind: object, *rest: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """End the workers now: every answer the run needed is in, and anything still running was
+        speculative (or the run was stopped)."""
+        if self.pool is None:
+            return
+        pool, self.pool = self.pool, None
+        stop = getattr(pool, "terminate_workers", None)  # Python 3.14
+        if stop is not None:
+            stop()
+        else:
+            for process in list(getattr(pool, "_processes", {}).values()):
+                process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+
+    def window(self) -> int:
+        """How many proofs to have under way: one per worker (past the last child a generation wants,
+        each is wasted work)."""
+        return self.count if self.pool is not None else 1
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Answer:
+        """``fn(context, *args)`` in a worker (or here, when its answer is asked for); ``fn`` must be a
+        function of this module."""
+        if self.pool is None:
+            return Later(fn, (self.context, *args))
+        return Answered(self.pool.submit(_run, fn, args))
+
+
+Ahead = tuple[Candidate | None, Machine | None, str, Answer | None]
+_END = object()
+
+
+def proved_ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None],
+                 window: Callable[[], int]) -> Iterator[Ahead]:
+    """The children in order, each with its machine, its canonical key and, unless the prover knows that
+    key already, the answer of its proof, started in a worker up to ``window()`` children ahead of the one
+    handed out (None children: a variation that gave nothing, handed out as they come)."""
+    queue: deque[Ahead] = deque()
+    sent: dict[str, Answer] = {}
+    try:
+        yield from _ahead(workers, prover, children, window, queue, sent)
+    finally:  # the caller has what it wanted: proofs not started are dropped
+        for *_, answer in queue:
+            if answer is not None:
+                answer.drop()
+
+
+def _ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None], window: Callable[[], int],
+           queue: deque[Ahead], sent: dict[str, Answer]) -> Iterator[Ahead]:
+    while True:
+        while len(queue) < window():
+            child = next(children, _END)
+            if child is _END:
+                break
+            if child is None:
+                queue.append((None, None, "", None))
+                continue
+            machine = compile_table(to_table(child, workers.context.base))  # type: ignore[arg-type]
+            key = canonical(machine)
+            answer = None
+            if key not in prover.verdicts:
+                answer = sent.get(key) or workers.submit(statuses, child, prover.order(machine))
+                sent[key] = answer
+            queue.append((child, machine, key, answer))  # type: ignore[arg-type]
+        if not queue:
+            return
+        yield queue.popleft()
+
+
+def preload() -> list[str]:
+    """What the fork server imports for its workers: the tasks' modules, and the main module's imports when
+    a worker runs the main module again (a script by path, as the ``tablebot`` command is: its guard keeps
+    it from running, but it imports the command line)."""
+    main = sys.modules.get("__main__")
+    script = getattr(main, "__spec__", None) is None and getattr(main, "__file__", None)
+    return [__name__, "tablebot.evolve.repair", "tablebot.evolve.report", *(["tablebot.cli"] if script else [])]
+
+
+# --- in a worker --------------------------------------------------------------------------------------
+
+_context: Context | None = None
+
+
+def _start(files: list[Path], base: Table) -> None:
+    global _context
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the run stops us
+    _context = Context(Prover(files), base)
+
+
+def _run(fn: Callable[..., Any], args: tuple[Any, ...]) -> Any:
+    assert _context is not None
+    return fn(_context, *args)
+
+
+# --- the tasks ----------------------------------------------------------------------------------------
+
+
+def statuses(context: Context, candidate: Candidate, order: Sequence[int]) -> Statuses:
+    """The candidate's properties in ``order`` (places in its property list) until one does not hold
+    (``check``'s proof, as :meth:`Prover.prove` runs it); when all hold, whether a zero-time loop traps it."""
+    machine = compile_table(to_table(candidate, context.base))
+    props = context.prover.properties(machine)
+    known: dict[int, bool] = {}
+    for index in order:
+        known[index] = check_property(props[index], machine).status == "holds"
+        if not known[index]:
+            return known, None
+    return known, any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
+
+
+def repaired(context: Context, candidate: Candidate, space: Any, prefer: str) -> Any:
+    """:func:`tablebot.evolve.repair.repair` of the candidate."""
+    from tablebot.evolve.repair import repair
+
+    return repair(candidate, context.base, context.prover, space, prefer)
+
+
+def check_report(context: Context, table: Table) -> tuple[str, bool]:
+    """The table's ``check`` report as text, and whether every property holds in it."""
+    from tablebot.evolve.report import check_text
+
+    report = context.prover.report(compile_table(table))
+    return check_text(report, context.prover), all(r.status == "holds" for r in report.results)
