@@ -12,7 +12,10 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
-from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, Bar
+from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORLD_OPT, Bar
+
+EVOLVE_WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local worker threads for the fleet, and prover "
+                                  "processes (default: one per core; 1 proves in this process).")
 
 
 @dataclass(frozen=True)
@@ -62,7 +65,7 @@ def evolve_cmd(
     seed: int = typer.Option(0, "--seed", min=0, help="Seed of the search itself."),
     backend: str = BACKEND_OPT,
     scheduler: str | None = SCHEDULER_OPT,
-    workers: int | None = WORKERS_OPT,
+    workers: int | None = EVOLVE_WORKERS_OPT,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no report on the terminal."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
