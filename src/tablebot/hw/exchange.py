@@ -69,6 +69,10 @@ class ExchangeRobot:
         self._counts = [first.counter_values[t] for t in counters]
         self._reading = self._reading_of(first)
 
+    def _previous_mask(self) -> int:
+        """Last tick's input bits (0 before the first reply): an analog input's hysteresis remembers them."""
+        return self._reading.mask if self._reading is not None else 0
+
     def _pulses(self, values: Sequence[int], counters: Sequence[int]) -> tuple[int, ...]:
         """Pulses per robot counter since the last reply: a count that went back (the counter was reset) gives
         0 and a new start."""

@@ -67,5 +67,5 @@ class RoboifRobot(ExchangeRobot):
         self.link.send_best_effort(*OFF, timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
-        previous = self._reading.mask if self._reading is not None else 0
+        previous = self._previous_mask()
         return Reading(self.wiring.mask(reply, previous), (), self.wiring.raw(reply) or None)

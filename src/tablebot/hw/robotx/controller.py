@@ -69,6 +69,6 @@ class RobotxRobot(ExchangeRobot):
         self.link.send_best_effort(ZERO, timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
-        previous = self._reading.mask if self._reading is not None else 0  # hysteresis remembers last tick
+        previous = self._previous_mask()
         return Reading(self.wiring.mask(reply, previous), self._pulses(reply.counter_values, self.wiring.counters),
                        self.wiring.raw(reply) or None)

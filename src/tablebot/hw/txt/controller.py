@@ -88,6 +88,6 @@ class TxtRobot(ExchangeRobot):
         self.link.send_best_effort(Command.EXCHANGE_DATA, wire.exchange(ZERO), timeout_s)
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
-        previous = self._reading.mask if self._reading is not None else 0  # hysteresis remembers last tick
+        previous = self._previous_mask()
         pulses = self._pulses(reply.counter_values, self.wiring.counters)
         return Reading(self.wiring.mask(reply.universal, previous), pulses, self.wiring.raw(reply.universal) or None)
