@@ -74,22 +74,23 @@ class Engine:
 
     The public attributes ``tick``, ``state`` (index into ``machine.states``), ``timer``, ``counters``,
     ``outputs`` (signed motor speeds, then lamp levels), ``event`` and ``row`` (of the last tick) are
-    the whole runtime state; everything starting with ``_`` is a copy of the machine kept for speed.
+    the whole runtime state. ``tick``, ``timer`` and ``counters`` are properties over the form
+    :meth:`step` keeps them in (a deadline instead of a counting timer, the lookups for the counters
+    now at 0): read and assign them as plain attributes; ``counters`` reads as a copy. Everything
+    else starting with ``_`` is the machine, precomputed for speed.
     """
 
     def __init__(self, machine: Machine):
         self.machine = machine
-        # Hot-loop constants, read once here instead of through properties on every tick.
-        self._timer_bit = machine.timer_bit
+        self._width = len(machine.table.events)
         self._counter_bits = machine.counter_bits if any(machine.counter_bits) else ()
-        self._not_input = ~machine.input_mask  # any of these bits in an int mask: not a valid input mask
         self._n_counters = len(machine.counter_bits)
-        self._hits = _transitions(machine)
+        self._lookups = _Lookups(machine)
         self.reset()
 
     def reset(self) -> None:
         m = self.machine
-        self.tick = 0
+        self._tick = 0
         self.state = m.initial_state
         self.timer = m.initial_timer
         self.counters = [0] * len(m.counter_bits)
@@ -99,43 +100,43 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] = ()) -> tuple[int, ...]:
+    def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] | None = None) -> tuple[int, ...]:
         """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick.
 
-        The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python: the fired row's
-        next state, timer, outputs and counter loads are looked up whole in a table precomputed per
-        state (:func:`_transitions`), so which rows match, and in what order, is decided once, by
-        :mod:`tablebot.machine`. One function for tables with and without counters: a table without
-        them pays two falsy tests.
+        The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python. Which rows match,
+        and in what order, is decided once, by :mod:`tablebot.machine`: per state, a list indexed by
+        the input mask gives the tick's event set, fired row and the row's whole effect (next state,
+        timer, outputs, counter loads; :class:`_Lookups`). There is such a list for a running timer
+        and one for a timer at 0 (T present), for the counters now at 0 (their Cn bits). The timer is
+        kept as ``_deadline``, the tick count at which it reaches 0 when counted down by one a tick
+        after the first, so a tick compares two integers instead of counting down and storing.
+
+        The lookup also checks the input: a mask with bits beyond the table's events falls off the
+        end of the list, and the bits of T and of the counters map to the entry without them.
+        Anything but a plain non-negative int (a bool, numpy integer, mapping, ...) goes through
+        :meth:`events_of`, which converts it or refuses it.
         """
-        # the common case costs one test; type(x) is a call CPython specialises (about half the time of
-        # reading x.__class__, a descriptor lookup), and bools and numpy integers go through events_of
-        if type(inputs) is not int or inputs & self._not_input:
+        if type(inputs) is not int or inputs < 0:  # type() is a call CPython specialises, x.__class__ is not
             inputs = self.events_of(inputs)
-        timer = self.timer
-        tick = self.tick
-        self.tick = tick + 1
-        if tick:
-            if timer:
-                timer -= 1
-            if pulses is not _NONE:
-                self._count_down(pulses)
-        if not timer:
-            inputs |= self._timer_bit
-        if self._counter_bits:  # () unless a counter is an event column
-            inputs |= self._counter_events()
-        self.event = inputs
-        hit = self._hits[self.state][inputs]
-        if hit is None:
-            self.row = NO_ROW
-            self.timer = timer
+        tick = self._tick + 1
+        if pulses is not None and pulses is not _NONE:  # () and None: nothing to count (one identity test each)
+            self._count_down(pulses, tick, inputs)
+        try:
+            self.event, self.row, effect = (self._running if tick < self._deadline
+                                            else self._at_zero)[self.state][inputs]
+        except IndexError:
+            self.events_of(inputs)  # refuses a mask beyond the table's events (nothing has changed yet)
+            raise  # a state out of range: not the input's fault
+        self._tick = tick
+        if effect is None:  # no row fired: nothing else changes (the deadline already counts the timer down)
             return self.outputs
-        self.row, self.state, self.timer, outputs, keeps, loads = hit
+        self.state, timer, outputs, keeps, loads = effect
+        self._deadline = tick + timer
         if keeps:
             outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
         self.outputs = outputs
         if loads:  # () unless the row loads a counter
-            self.counters = [old if new is None else new for old, new in zip(self.counters, loads, strict=True)]
+            self.counters = [old if new is None else new for old, new in zip(self._counters, loads, strict=True)]
         return outputs
 
     def events_of(self, inputs: int | Mapping[str, int]) -> int:
@@ -150,27 +151,62 @@ class Engine:
         if isinstance(inputs, bool) or not isinstance(inputs, int | np.integer):
             raise ValueError(f"inputs must be an int mask or a mapping of input names, not {type(inputs).__name__}")
         value = int(inputs)
-        width = len(m.table.events)
+        width = self._width
         if value < 0 or value >> width:
             raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
                              f"(0..{(1 << width) - 1}); its inputs are {_bits_text(m)}")
         return value & m.input_mask
 
-    def _count_down(self, pulses: Sequence[int]) -> None:
+    def _count_down(self, pulses: Sequence[int], tick: int, inputs: int) -> None:
+        """Each counter down by its pulses, from the second tick on; the mask and the pulses are checked
+        first, so a refused tick changes nothing."""
+        if tick == 1:
+            return
+        if inputs >> self._width:
+            self.events_of(inputs)  # raises
         if len(pulses) != self._n_counters:
             if not len(pulses):
                 return
             raise ValueError(f"pulses: {len(pulses)} values for {self._n_counters} counters "
                              f"({', '.join(self.machine.table.robot.counter_names) or 'none'})")
-        counters = self.counters
         for i, count in enumerate(pulses):
             if count < 0:
                 raise ValueError(f"pulses: {count} for counter {i + 1} is negative")
-            counters[i] = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
+        # int: numpy counts would leak into JSON
+        self.counters = [max(0, old - int(count)) for old, count in zip(self._counters, pulses, strict=True)]
 
-    def _counter_events(self) -> int:
-        """Cn bits of the counters at zero (0 when no counter is an event column)."""
-        return sum(b for b, c in zip(self._counter_bits, self.counters, strict=True) if c == 0)
+    # --- the state step keeps in its own form --------------------------------------------------
+
+    @property
+    def tick(self) -> int:
+        return self._tick
+
+    @tick.setter
+    def tick(self, value: int) -> None:
+        timer = self.timer
+        self._tick = value
+        self.timer = timer
+
+    @property
+    def timer(self) -> int:
+        # the deadline counts from tick 1: the first tick does not count the timer down
+        return max(0, self._deadline - max(self._tick, 1))
+
+    @timer.setter
+    def timer(self, value: int) -> None:
+        self._deadline = max(self._tick, 1) + value
+
+    @property
+    def counters(self) -> list[int]:
+        return list(self._counters)
+
+    @counters.setter
+    def counters(self, values: Sequence[int]) -> None:
+        """Set the counters, and choose the lookups for the Cn bits of those at 0 (they change only here)."""
+        self._counters = list(values)
+        zero = sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0) \
+            if self._counter_bits else 0  # () when no counter is an event column
+        self._running, self._at_zero = self._lookups[zero]
 
     # --- the batch path ------------------------------------------------------------------------
 
@@ -228,7 +264,7 @@ class Engine:
         step = self.step
         per_tick = self._pulse_array(pulses, len(masks)).tolist() if pulses is not None else None
         for i, mask in enumerate(masks):
-            step(mask, per_tick[i] if per_tick is not None else _NONE)
+            step(mask, None if per_tick is None else per_tick[i])
             for column, value in zip(columns, (self.event, self.row, self.state, self.timer), strict=True):
                 column.append(value)
         return Batch(*columns)
@@ -271,40 +307,68 @@ class Engine:
         self.counters, self.outputs = counter_values, output_values
 
 
-_NONE: tuple[int, ...] = ()  # step's default pulses: "no counters to count down" in one identity test
+_NONE: tuple[int, ...] = ()  # pulses that count nothing (callers pass it for counterless robots)
 
-#: What fires: (row index, next state, timer, outputs (None = keep), keeps any, counter loads or ()).
-Hit = tuple[int, int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
-
-
-def _hit(row: CompiledRow) -> Hit:
-    return row.index, row.next, row.timer, row.outputs, row.keeps, row.loads if any(
-        v is not None for v in row.loads) else ()
+#: What a fired row does: (next state, timer, outputs (None = keep), keeps any, counter loads or ()).
+Effect = tuple[int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
+#: A tick's outcome for one input mask: (event set, fired row or -1, the row's effect or None).
+Entry = tuple[int, int, Effect | None]
 
 
-def _transitions(machine: Machine) -> list[Any]:
-    """Per state, the hit for every full event mask: a list (tables up to FLAT_BITS events) or a
-    dict that fills itself from the state's first-match lookup (wider tables)."""
-    hits = [_hit(row) for row in machine.rows]
-    width = len(machine.table.events)
-    if machine.flat is not None:
-        flat, size = machine.flat, 1 << width
-        return [[None if (i := flat[s * size + e]) == NO_ROW else hits[i] for e in range(size)]
-                for s in range(len(machine.states))]
-    return [_WideHits(machine, s, hits) for s in range(len(machine.states))]
+def _effect(row: CompiledRow) -> Effect:
+    return row.next, row.timer, row.outputs, row.keeps, row.loads if any(v is not None for v in row.loads) else ()
 
 
-class _WideHits(dict[int, Any]):
-    """One state of a wide table: full event mask -> hit, computed on first use and cached."""
+class _Lookups(dict[int, tuple[list[Any], list[Any]]]):
+    """Cn bits of the counters at 0 -> (per state for a running timer, per state for a timer at 0) the
+    lookup input mask -> :data:`Entry`; made on first use of each set of Cn bits (0 alone without counters).
 
-    def __init__(self, machine: Machine, state: int, hits: list[Hit]):
+    A state's lookup is a list over every mask of the table's event columns (tables up to FLAT_BITS
+    events), or a dict that fills itself from :meth:`Machine.lookup` (wider tables); either raises
+    IndexError for a mask beyond the event columns. A mask's T and Cn bits are ignored, as
+    :meth:`Engine.events_of` ignores them: the engine makes those events.
+    """
+
+    def __init__(self, machine: Machine):
         super().__init__()
-        self.machine, self.state, self.hits = machine, state, hits
+        self.machine = machine
+        self.effects = [_effect(row) for row in machine.rows]
+        self.entries: dict[tuple[int, int], Entry] = {}  # one tuple per (event set, row), shared
 
-    def __missing__(self, events: int) -> Hit | None:
-        index = self.machine.lookup(self.state, events)
-        self[events] = hit = None if index == NO_ROW else self.hits[index]
-        return hit
+    def __missing__(self, zero_counters: int) -> tuple[list[Any], list[Any]]:
+        self[zero_counters] = pair = (self.states(zero_counters), self.states(zero_counters | self.machine.timer_bit))
+        return pair
+
+    def states(self, present: int) -> list[Any]:
+        """Per state, the lookup when the engine's own events ``present`` (bits of T, Cn) are in the set."""
+        m = self.machine
+        if m.flat is None:
+            return [_WideEntries(self, state, present) for state in range(len(m.states))]
+        size, keep, flat = 1 << len(m.table.events), m.input_mask, m.flat
+        return [[self.entry(events := mask & keep | present, flat[state * size + events]) for mask in range(size)]
+                for state in range(len(m.states))]
+
+    def entry(self, events: int, row: int) -> Entry:
+        found = self.entries.get((events, row))
+        if found is None:
+            found = self.entries[events, row] = (events, row, None if row == NO_ROW else self.effects[row])
+        return found
+
+
+class _WideEntries(dict[int, Entry]):
+    """One state's lookup in a table wider than FLAT_BITS events: input mask -> entry, made on first use."""
+
+    def __init__(self, lookups: _Lookups, state: int, present: int):
+        super().__init__()
+        self.lookups, self.state, self.present = lookups, state, present
+
+    def __missing__(self, mask: int) -> Entry:
+        m = self.lookups.machine
+        if mask >> len(m.table.events):
+            raise IndexError(mask)  # as the list of a narrower table would
+        events = mask & m.input_mask | self.present
+        self[mask] = entry = self.lookups.entry(events, m.lookup(self.state, events))
+        return entry
 
 
 def _mask_of_names(machine: Machine, inputs: Mapping[str, int]) -> int:
