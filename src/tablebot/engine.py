@@ -124,9 +124,8 @@ class Engine:
         try:
             self.event, self.row, effect = (self._running if tick < self._deadline
                                             else self._at_zero)[self.state][inputs]
-        except IndexError:
-            self.events_of(inputs)  # refuses a mask beyond the table's events (nothing has changed yet)
-            raise  # a state out of range: not the input's fault
+        except IndexError:  # the state's list is not made yet, or the mask is beyond the table's events
+            self.event, self.row, effect = self._entry(tick, inputs)
         self._tick = tick
         if effect is None:  # no row fired: nothing else changes (the deadline already counts the timer down)
             return self.outputs
@@ -156,6 +155,16 @@ class Engine:
             raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
                              f"(0..{(1 << width) - 1}); its inputs are {_bits_text(m)}")
         return value & m.input_mask
+
+    def _entry(self, tick: int, inputs: int) -> Entry:
+        """:meth:`step`'s lookup when it raised IndexError: the state's list is made on its first tick,
+        and a mask beyond the table's events is refused here, before anything has changed."""
+        present = self._zero_counters if tick < self._deadline else self._zero_counters | self.machine.timer_bit
+        try:
+            return self._lookups.made(present, self.state)[inputs]
+        except IndexError:
+            self.events_of(inputs)  # raises for a mask beyond the table's events
+            raise  # a state out of range: not the input's fault
 
     def _count_down(self, pulses: Sequence[int], tick: int, inputs: int) -> None:
         """Each counter down by its pulses, from the second tick on; the mask and the pulses are checked
@@ -206,7 +215,8 @@ class Engine:
         self._counters = list(values)
         zero = sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0) \
             if self._counter_bits else 0  # () when no counter is an event column
-        self._running, self._at_zero = self._lookups[zero]
+        self._zero_counters = zero
+        self._running, self._at_zero = self._lookups[zero], self._lookups[zero | self.machine.timer_bit]
 
     # --- the batch path ------------------------------------------------------------------------
 
@@ -319,40 +329,48 @@ def _effect(row: CompiledRow) -> Effect:
     return row.next, row.timer, row.outputs, row.keeps, row.loads if any(v is not None for v in row.loads) else ()
 
 
-class _Lookups(dict[int, tuple[list[Any], list[Any]]]):
-    """Cn bits of the counters at 0 -> (per state for a running timer, per state for a timer at 0) the
-    lookup input mask -> :data:`Entry`; made on first use of each set of Cn bits (0 alone without counters).
+class _Lookups(dict[int, list[Any]]):
+    """The engine's own events present (bits of T and of the counters at 0) -> per state, the lookup
+    input mask -> :data:`Entry`.
 
     A state's lookup is a list over every mask of the table's event columns (tables up to FLAT_BITS
-    events), or a dict that fills itself from :meth:`Machine.lookup` (wider tables); either raises
-    IndexError for a mask beyond the event columns. A mask's T and Cn bits are ignored, as
-    :meth:`Engine.events_of` ignores them: the engine makes those events.
+    events), empty until :meth:`made` on the first tick that needs it, or a dict that fills itself from
+    :meth:`Machine.lookup` (wider tables); either raises IndexError for a mask beyond the event
+    columns. A mask's T and Cn bits are ignored, as :meth:`Engine.events_of` ignores them: the engine
+    makes those events.
     """
 
     def __init__(self, machine: Machine):
         super().__init__()
         self.machine = machine
         self.effects = [_effect(row) for row in machine.rows]
-        self.entries: dict[tuple[int, int], Entry] = {}  # one tuple per (event set, row), shared
+        self.idle: dict[int, Entry] = {}  # the entry of an event set that fires no row, shared by all states
 
-    def __missing__(self, zero_counters: int) -> tuple[list[Any], list[Any]]:
-        self[zero_counters] = pair = (self.states(zero_counters), self.states(zero_counters | self.machine.timer_bit))
-        return pair
-
-    def states(self, present: int) -> list[Any]:
-        """Per state, the lookup when the engine's own events ``present`` (bits of T, Cn) are in the set."""
+    def __missing__(self, present: int) -> list[Any]:
         m = self.machine
-        if m.flat is None:
-            return [_WideEntries(self, state, present) for state in range(len(m.states))]
-        size, keep, flat = 1 << len(m.table.events), m.input_mask, m.flat
-        return [[self.entry(events := mask & keep | present, flat[state * size + events]) for mask in range(size)]
-                for state in range(len(m.states))]
+        self[present] = lookups = [[] if m.flat is not None else _WideEntries(self, state, present)
+                                   for state in range(len(m.states))]
+        return lookups
+
+    def made(self, present: int, state: int) -> list[Entry] | _WideEntries:
+        """The lookup of ``state`` when ``present`` are in the event set, its list made if still empty."""
+        lookup = self[present][state]
+        if isinstance(lookup, list) and not lookup:
+            m = self.machine
+            width = len(m.table.events)
+            keep, flat, base = m.input_mask, m.flat, state << width
+            entries: dict[int, Entry] = {}  # masks that differ only in T or Cn bits share an entry
+            for mask in range(1 << width):
+                events = mask & keep | present
+                if (entry := entries.get(events)) is None:
+                    entry = entries[events] = self.entry(events, flat[base + events])  # type: ignore[index]
+                lookup.append(entry)
+        return lookup
 
     def entry(self, events: int, row: int) -> Entry:
-        found = self.entries.get((events, row))
-        if found is None:
-            found = self.entries[events, row] = (events, row, None if row == NO_ROW else self.effects[row])
-        return found
+        if row == NO_ROW:
+            return self.idle.setdefault(events, (events, NO_ROW, None))
+        return events, row, self.effects[row]
 
 
 class _WideEntries(dict[int, Entry]):
