@@ -101,20 +101,23 @@ class Engine:
     # --- the tick ------------------------------------------------------------------------------
 
     def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] | None = None) -> tuple[int, ...]:
-        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick.
+        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (None or
+        () when there are none).
 
-        The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python. Which rows match,
-        and in what order, is decided once, by :mod:`tablebot.machine`: per state, a list indexed by
-        the input mask gives the tick's event set, fired row and the row's whole effect (next state,
-        timer, outputs, counter loads; :class:`_Lookups`). There is such a list for a running timer
-        and one for a timer at 0 (T present), for the counters now at 0 (their Cn bits). The timer is
-        kept as ``_deadline``, the tick count at which it reaches 0 when counted down by one a tick
-        after the first, so a tick compares two integers instead of counting down and storing.
+        The rule of :func:`tablebot.tick.tick`, step by step, in the form that costs Python least a tick:
 
-        The lookup also checks the input: a mask with bits beyond the table's events falls off the
-        end of the list, and the bits of T and of the counters map to the entry without them.
-        Anything but a plain non-negative int (a bool, numpy integer, mapping, ...) goes through
-        :meth:`events_of`, which converts it or refuses it.
+        1. the timer is kept as ``_deadline``, the tick count at which counting it down by one a tick
+           (after the first) brings it to 0: T is present from then on, and ``timer`` is worked out when
+           read. The counters count down by their pulses in :meth:`_count_down`;
+        2. and 3. per state, a list indexed by the input mask gives the tick's event set (the mask's T
+           and Cn bits dropped, the engine's own added), the row that fires and its effect, all made
+           from :meth:`tablebot.machine.Machine.lookup` (:class:`_Lookups`): a list for a running timer
+           and one for a timer at 0, for the counters now at 0 (chosen when the counters change);
+        4. the effect sets the state, timer, outputs (merging kept ones) and counter loads.
+
+        The lookup checks the mask as well: one beyond the table's event columns falls off the end of
+        its list. Anything but a non-negative int (a bool, numpy integer, mapping, ...) goes through
+        :meth:`events_of`, which converts or refuses it. A refused tick changes nothing.
         """
         if type(inputs) is not int or inputs < 0:  # type() is a call CPython specialises, x.__class__ is not
             inputs = self.events_of(inputs)
