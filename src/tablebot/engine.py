@@ -176,16 +176,22 @@ class Engine:
             return
         if inputs >> self._width:
             self.events_of(inputs)  # raises
-        if len(pulses) != self._n_counters:
+        counters = self._counters
+        if len(pulses) != len(counters):
             if not len(pulses):
                 return
-            raise ValueError(f"pulses: {len(pulses)} values for {self._n_counters} counters "
+            raise ValueError(f"pulses: {len(pulses)} values for {len(counters)} counters "
                              f"({', '.join(self.machine.table.robot.counter_names) or 'none'})")
+        if min(pulses, default=0) < 0:
+            i = next(i for i, count in enumerate(pulses) if count < 0)
+            raise ValueError(f"pulses: {pulses[i]} for counter {i + 1} is negative")
+        reached_zero = False
         for i, count in enumerate(pulses):
-            if count < 0:
-                raise ValueError(f"pulses: {count} for counter {i + 1} is negative")
-        # int: numpy counts would leak into JSON
-        self.counters = [max(0, old - int(count)) for old, count in zip(self._counters, pulses, strict=True)]
+            if count and counters[i]:
+                counters[i] = left = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
+                reached_zero = reached_zero or not left
+        if reached_zero:  # a Cn event appears: other lookups (counting down never takes one away)
+            self._choose_lookups()
 
     # --- the state step keeps in its own form --------------------------------------------------
 
@@ -214,8 +220,12 @@ class Engine:
 
     @counters.setter
     def counters(self, values: Sequence[int]) -> None:
-        """Set the counters, and choose the lookups for the Cn bits of those at 0 (they change only here)."""
         self._counters = list(values)
+        self._choose_lookups()
+
+    def _choose_lookups(self) -> None:
+        """The lookups for the Cn bits of the counters at 0; called whenever a counter may have reached
+        or left 0, so that a tick needs no counter test."""
         zero = sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0) \
             if self._counter_bits else 0  # () when no counter is an event column
         self._zero_counters = zero
