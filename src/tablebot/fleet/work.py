@@ -11,13 +11,15 @@ import os
 import socket
 import sys
 import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.fleet.robots import RobotSpec, Variants
 
 if TYPE_CHECKING:
-    from tablebot.fleet.run import FleetSummary
+    from tablebot.fleet.run import FleetSummary, Prepared
+    from tablebot.machine import Machine
     from tablebot.sim.world import World
     from tablebot.table import Table
 
@@ -25,6 +27,9 @@ COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batc
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
 MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
 _worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
+SHARED_KEPT = 8  # tables × worlds × robot layers whose compiled table and scenes a process keeps
+_shared: OrderedDict[tuple[int, int, int], tuple[Any, ...]] = OrderedDict()
+_shared_lock = threading.Lock()
 
 
 @dataclass
@@ -50,7 +55,6 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
     """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary. With
     ``stop``, the chunk is given up (:class:`Stopped`) at the first block after it is set."""
     from tablebot.fleet.run import Fleet
-    from tablebot.machine import compile_table
 
     def check(_ticks: int) -> None:
         if stop is not None and stop.is_set():
@@ -59,10 +63,30 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
     threads = job_threads(job)
     if threads != 1:  # one thread: the calling thread alone, without numba's pool (not even started)
         use_threads(job)
-    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
-                  variants=job.variants)
+    machine, prepared = shared(job)
+    fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params, variants=job.variants,
+                  prepared=prepared)
     fleet.run(job.ticks, progress=check, threads=False if threads == 1 else None, block_ticks=block_ticks(job))
     return replace(job, specs=[], variants=None), fleet.summary()
+
+
+def shared(job: Job) -> tuple[Machine, Prepared]:
+    """The job's compiled table and prepared scenes, made once per process for each table, world and robot
+    layer (the same objects: a local sweep's chunks all hold its plan's, and a cluster worker's chunks get
+    them as one shared piece of data, see :mod:`tablebot.fleet.backends`). Keyed by identity: an entry holds
+    its objects, so no other object can take their ids while it is kept."""
+    from tablebot.fleet.run import Prepared
+    from tablebot.machine import compile_table
+
+    key = (id(job.table), id(job.world), id(job.robot_params))
+    with _shared_lock:
+        found = _shared.get(key)
+        if found is None:
+            found = _shared[key] = (job.table, job.world, job.robot_params, compile_table(job.table), Prepared())
+            while len(_shared) > SHARED_KEPT:
+                _shared.popitem(last=False)
+        _shared.move_to_end(key)
+    return found[3], found[4]
 
 
 def block_ticks(job: Job) -> int:
@@ -97,11 +121,11 @@ def warm(job: Job, both: bool = False) -> float:
     import time
 
     from tablebot.fleet.run import Fleet
-    from tablebot.machine import compile_table
 
     started = time.perf_counter()
-    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs[:1], job.robot_params,
-                  variants=job.variants)
+    machine, prepared = shared(job)
+    fleet = Fleet(job.table, machine, job.world, job.specs[:1], job.robot_params, variants=job.variants,
+                  prepared=prepared)
     for threads in (False, True) if both else (False,):
         fleet.run(1, threads=threads)
     return time.perf_counter() - started
@@ -112,9 +136,11 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
     user's numba cache for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code
     already loaded here; put the client's compiled code there (``files``, from
     :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling); import the
-    compiled modules and load numba's compiler (what a fresh worker's first chunk spent seconds on). Needs
-    no job, so the client sends it as soon as it is connected, while it still plans. Its chunks then use
-    1/``share`` of the machine's cores (``share``: the workers on this machine). Idempotent."""
+    compiled modules. Not numba's compiler: cached code loads without it (tablebot.jit), and readying it
+    here cost a fresh worker ~0.5 s of CPU (its typing and lowering rules, and scipy.linalg) taken from the
+    chunks on a shared machine. Needs no job, so the client sends it as soon as it is connected, while it
+    still plans. Its chunks then use 1/``share`` of the machine's cores (``share``: the workers on this
+    machine). Idempotent."""
     import time
 
     global _worker_threads
@@ -134,13 +160,6 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
 
     import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls)
 
-    try:  # numba loads its compiler's registries on the first compile or cache load; here, not in a chunk
-        from numba.core.registry import cpu_target
-
-        cpu_target.typing_context.refresh()
-        cpu_target.target_context.refresh()
-    except (ImportError, AttributeError):  # another numba: the first load does it, as before
-        pass
     return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR,
             "threads": _worker_threads, "installed": installed, "ready_s": time.perf_counter() - started}
 
