@@ -13,7 +13,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import fail
-from tablebot.fleet.work import Job, ready_worker, run_job, warm, warm_worker
+from tablebot.fleet.work import Common, Job, ready_worker, run_common, run_job, warm, warm_worker
 
 if TYPE_CHECKING:
     from tablebot.fleet.run import FleetSummary
@@ -166,12 +166,13 @@ class Runner:
         from distributed import as_completed
 
         client = self.client
-        futures = [client.submit(fn, job, pure=False) for job in jobs]
+        sent = submit_all(client, jobs, fn)
         try:
-            for future in as_completed(futures, loop=client.loop):
-                done(*future.result())
+            for future in as_completed(list(sent), loop=client.loop):
+                job, result = future.result()
+                done(sent[future].fill(job) if sent[future] is not None else job, result)
         except BaseException:
-            client.cancel(futures)
+            client.cancel(list(sent))
             raise
 
 
@@ -189,6 +190,26 @@ def connect(address: str) -> Any:
     except (OSError, TimeoutError) as exc:
         raise fail("--scheduler", f"cannot reach the Dask scheduler at {address}: {exc}",
                    "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
+
+
+def submit_all(client: Any, jobs: Sequence[Job], fn: Callable[[Any], tuple[Job, Any]]) -> dict[Any, Common | None]:
+    """A task per job; jobs that share their table, world and robot layer (a sweep's chunks of one world)
+    get them from one piece of data sent to every worker first (:func:`~tablebot.fleet.work.run_common`):
+    each chunk is then a few kilobytes of seeds, not its table and world again, and a worker prepares their
+    scenes once. Returns each task's future and what it shares (None: the job went whole)."""
+    groups: dict[tuple[int, int, int], list[Job]] = defaultdict(list)
+    for job in jobs:
+        groups[id(job.table), id(job.world), id(job.robot_params)].append(job)
+    sent: dict[Any, Common | None] = {}
+    for group in groups.values():
+        if len(group) == 1:
+            sent[client.submit(fn, group[0], pure=False)] = None
+            continue
+        common = Common.of(group[0])
+        data = client.scatter(common, broadcast=True, hash=False)
+        for job in group:
+            sent[client.submit(run_common, fn, data, common.strip(job), pure=False)] = common
+    return sent
 
 
 def slots(client: Any) -> list[tuple[str, str, int]]:

@@ -12,6 +12,7 @@ import socket
 import sys
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -45,6 +46,34 @@ class Job:
     variants: Variants | None = None
     threads: int | None = None  # numba threads for this job (None: numba's default)
     info: dict[str, Any] = field(default_factory=dict)  # what the caller needs back with the result
+
+
+@dataclass(frozen=True)
+class Common:
+    """What jobs of one run share -- their table, world and robot layer -- sent to each cluster worker once
+    (:func:`run_common`), not pickled into every chunk."""
+
+    table: Table
+    world: World
+    robot_params: dict[str, Any]
+
+    @staticmethod
+    def of(job: Job) -> Common:
+        return Common(job.table, job.world, job.robot_params)
+
+    def strip(self, job: Job) -> Job:
+        """The job without what it shares (None in its place: put back by :meth:`fill`)."""
+        return replace(job, table=None, world=None, robot_params=None)  # type: ignore[arg-type]
+
+    def fill(self, job: Job) -> Job:
+        return replace(job, table=self.table, world=self.world, robot_params=self.robot_params)
+
+
+def run_common(fn: Callable[[Job], tuple[Job, Any]], common: Common, job: Job) -> tuple[Job, Any]:
+    """On a cluster worker: ``fn`` of the job with what it shares put back -- the same objects for every chunk
+    on this worker, so :func:`shared` prepares its scenes once -- and the job returned without them."""
+    done, result = fn(common.fill(job))
+    return common.strip(done), result
 
 
 class Stopped(Exception):
