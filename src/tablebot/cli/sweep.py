@@ -84,7 +84,8 @@ def sweep_cmd(
     wall_s = time.perf_counter() - started
     with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
         path, _ = store.merge(complete=True)
-        rows = read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
+        rows = [] if quiet and not plots else \
+            read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
         written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
     if not quiet:
         report(plan, rows, written, wall_s, total - already)

@@ -11,6 +11,7 @@ import csv
 import functools
 import io
 import itertools
+import operator
 import re
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
@@ -326,7 +327,8 @@ def read_results(path: Path, columns: Sequence[str] | None = None) -> list[dict[
         reader = csv.reader(f)
         header = next(reader)
         places = [header.index(column) for column in columns]
-        return [dict(zip(columns, [row[k] for k in places], strict=True)) for row in reader]
+        cells = operator.itemgetter(*places, *places[:1])  # two at least: a tuple, the last one dropped by zip
+        return [dict(zip(columns, cells(row), strict=False)) for row in reader]
 
 
 # How a sweep's results are grouped, for its report and its pictures (here, not in the picture module, so that

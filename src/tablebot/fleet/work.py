@@ -118,6 +118,26 @@ def shared(job: Job) -> tuple[Machine, Prepared]:
     return found[3], found[4]
 
 
+def preload(*functions: Any) -> int:
+    """Load the machine code of compiled ``functions`` from numba's cache now: every overload the cache
+    holds for this machine and these sources. Meant for a thread while the caller plans -- loading is mostly
+    LLVM linking the code, which leaves the GIL -- instead of in the first chunk, while the other thread waits
+    for numba's compiler lock. What the cache lacks is left to compile at its first call, as ever. Returns
+    how many overloads it loaded (this uses numba's cache internals: another numba loads nothing here)."""
+    loaded = 0
+    for function in functions:
+        try:
+            cache, codegen = function._cache, function.targetctx.codegen()
+            keys = list(cache._cache_file._load_index())
+            wanted = [key[0] for key in keys if cache._index_key(key[0], codegen) == key]
+        except Exception:  # another numba, or no index: the first call loads (or compiles) as before
+            continue
+        for signature in wanted:
+            function.compile(signature)
+            loaded += 1
+    return loaded
+
+
 def block_ticks(job: Job) -> int:
     """Ticks per compiled call of a chunk: about a tenth of a second of one core's work (BLOCK_TICKS at
     least), so a chunk on a thread comes back for the GIL (and to see a Ctrl-C) a few times, not every 256
