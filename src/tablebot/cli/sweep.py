@@ -48,17 +48,18 @@ def sweep_cmd(
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
     OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
     resumes."""
-    from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import Runner, choose
-    from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
-    from tablebot.interrupts import INTERRUPTS
-
-    if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
-        from tablebot.fleet.plots import write_all
 
     chosen, address = choose(backend, scheduler)
     with Runner(chosen, address, workers) as runner:
-        runner.start()  # a cluster's workers start up while this process plans
+        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
+        from tablebot.fileset import current, file_set
+        from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
+        from tablebot.interrupts import INTERRUPTS
+
+        if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
+            from tablebot.fleet.plots import write_all
+        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
         plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
         traced = trace_runs(trace, plan.spec.total)
         out_folder(out, "--out")

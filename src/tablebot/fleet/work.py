@@ -180,16 +180,20 @@ def warm(job: Job, both: bool = False) -> float:
     return time.perf_counter() - started
 
 
-def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
+def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None,
+                 load: bool = True) -> dict[str, Any]:
     """On a cluster worker, before it sees a job: choose a cache folder of its own (``worker-SLOT`` in the
-    user's numba cache for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code
-    already loaded here; put the client's compiled code there (``files``, from
-    :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling); import the
-    compiled modules. Not numba's compiler: cached code loads without it (tablebot.jit), and readying it
-    here cost a fresh worker ~0.5 s of CPU (its typing and lowering rules, and scipy.linalg) taken from the
-    chunks on a shared machine. Needs no job, so the client sends it as soon as it is connected, while it
-    still plans. Its chunks then use 1/``share`` of the machine's cores (``share``: the workers on this
-    machine). Idempotent."""
+    user's numba cache for tablebot) unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code is
+    already loaded here, and import the compiled modules; put the client's compiled code in their folder
+    (``files``, from :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling);
+    with ``load``, load the machine code a chunk runs (:func:`preload`). Needs no job, so the client sends it
+    as soon as it is connected: first without files or loading (the imports, while the client itself still
+    imports and plans), then with them. Its chunks use 1/``share`` of the machine's cores (``share``: the
+    workers on this machine). Idempotent.
+
+    numba's compiler is not readied: cached code loads without it (tablebot.jit), and readying it cost a
+    fresh worker ~0.5 s of CPU (its typing and lowering rules, and scipy.linalg), taken from the chunks on a
+    machine whose cores the workers share."""
     import time
 
     global _worker_threads
@@ -204,13 +208,26 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
         folder = os.path.join(jit.cache_dir(), f"worker-{slot}")
         os.environ[jit.ENV] = folder
         numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
-    installed = jit.install_cache_files(files) if files else 0
     import numba
 
-    import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls)
+    import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls: their cache folder is set)
 
+    installed = jit.install_cache_files(files) if files else 0  # read by each function at its first load
+    loaded = preload(*chunk_functions(_worker_threads)) if load else 0
     return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR,
-            "threads": _worker_threads, "installed": installed, "ready_s": time.perf_counter() - started}
+            "threads": _worker_threads, "installed": installed, "loaded": loaded,
+            "ready_s": time.perf_counter() - started}
+
+
+def chunk_functions(threads: int | None) -> tuple[Any, ...]:
+    """The compiled functions a chunk calls: the start check of a scene, a robot's first reading, and the fleet
+    loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
+    calling thread)."""
+    from tablebot.fleet.kernel import run_fleet, run_fleet_serial
+    from tablebot.sim import kernel, physics
+
+    loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
+    return (physics.body_corners, physics.deepest_contact, kernel.sense, kernel.observe, *loops)
 
 
 def warm_worker(job: Job, slot: str, share: int = 1,
