@@ -257,6 +257,21 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     for relative, named in files.items():
         folder = next(p for p in mine.iterdir() if p.name.startswith((Path(relative).parent.name or "tablebot") + "_"))
         assert all((folder / name).read_bytes() == data for name, data in named.items())
+    # as a sweep readies a worker: its imports first, without code; then the code, which it loads, before any job
+    code = ("import json, pickle, sys; from tablebot.fleet.work import chunk_functions, ready_worker; "
+            "job, files = pickle.load(open(sys.argv[1], 'rb')); first = ready_worker('testhost-1', 2, None, False); "
+            "functions = chunk_functions(1); before = [len(f.overloads) for f in functions]; "
+            "second = ready_worker('testhost-1', 2, files); "
+            "print(json.dumps([first, second, before, [len(f.overloads) for f in functions]]))")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    first, second, before, after = json.loads(done.stdout.strip().splitlines()[-1])
+    assert first["cache"] == second["cache"] == str(mine.parent / "worker-testhost-1")
+    assert (first["installed"], first["loaded"]) == (0, 0) and before == [0] * len(before)
+    assert second["installed"] == len(sent) and second["loaded"] == len(after) and after == [1] * len(after)
+    landed = sorted(p.name for p in (mine.parent / "worker-testhost-1").rglob("*") if p.is_file())
+    assert landed == sent  # loaded, not compiled
 
 
 def test_a_job_with_threads_of_its_own_runs_on_them() -> None:
