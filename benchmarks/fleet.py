@@ -12,6 +12,8 @@ is the kernel can be told apart:
 * **Dask**: the same sweep through ``--scheduler`` to a cluster of 2 single-threaded worker processes
   started for it with an empty cache (*fresh*: they are sent this machine's compiled code), then again
   (*warm*), as speed ratios to the local sweep of the same repeat. Target: fresh >= 0.8x the local run.
+  Then the same with workers started with tablebot's preload (``--preload tablebot.fleet.worker``: numba
+  imported as a worker starts), reported beside: the target's verdict stays on plain ``dask worker``.
 * **one robot**: ``tablebot sim examples/bumberbot --seconds 3600`` with its two pictures, beside the same
   command ``--no-plots`` (the loop and the trace); the trace must be byte-identical either way. Target:
   under 2 s with pictures.
@@ -120,7 +122,11 @@ def free_port() -> int:
 
 class FreshCluster:
     """A Dask scheduler and 2 single-threaded workers on loopback, the workers with an empty cache folder
-    (as on machines that never ran tablebot)."""
+    (as on machines that never ran tablebot); with ``preload``, started with tablebot's preload
+    (``--preload tablebot.fleet.worker``: numba imported as the worker starts, no compiled code)."""
+
+    def __init__(self, preload: bool = False):
+        self.preload = preload
 
     def __enter__(self) -> str:
         self.home = tempfile.TemporaryDirectory()
@@ -132,7 +138,7 @@ class FreshCluster:
                                         "--port", str(port), "--no-dashboard"], env=child_env(),
                                        **quiet)]  # type: ignore[call-overload]
         worker = [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads", "1",
-                  "--no-dashboard"]
+                  "--no-dashboard", *(["--preload", "tablebot.fleet.worker"] if self.preload else [])]
         self.procs += [subprocess.Popen(worker, env=worker_env, **quiet)  # type: ignore[call-overload]
                        for _ in range(2)]
         from distributed import Client
@@ -160,16 +166,17 @@ class FreshCluster:
         self.home.cleanup()
 
 
-def dask_ratios(robots: int, seconds: float, repeat: int) -> tuple[list[float], list[float], list[float],
-                                                                  dict[str, list[float]]]:
-    """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat); and
-    the CPU seconds of each (for Dask: the client's and the cluster's processes' together)."""
+def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False) -> tuple[
+        list[float], list[float], list[float], dict[str, list[float]]]:
+    """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat, its
+    workers started with tablebot's preload or not); and the CPU seconds of each (for Dask: the client's and
+    the cluster's processes' together)."""
     local, fresh, warm = [], [], []
     cpu: dict[str, list[float]] = {"local": [], "fresh": [], "warm": []}
     for _ in range(repeat):
         local.append(sweep_process(robots, seconds))
         cpu["local"].append(CPU_S[-1])
-        cluster = FreshCluster()
+        cluster = FreshCluster(preload)
         with cluster as address:
             for walls, name in ((fresh, "fresh"), (warm, "warm")):
                 before = cluster.cpu()
@@ -305,6 +312,11 @@ def main() -> int:
               f"{med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}, the cluster's processes included)")
         print(f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
               f"{w_ratio:.2f}x")
+        local, fresh, warm, cpu = dask_ratios(robots, seconds, args.repeat, preload=True)
+        print(f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
+              f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
+              f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
+              f"{med(cpu['local']):.2f}, fresh {med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}")
 
     with_pics = [sim_hour(hour, True) for _ in range(args.repeat)]
     without = [sim_hour(hour, False) for _ in range(args.repeat)]

@@ -28,6 +28,7 @@ COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batc
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
 MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
 _worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
+cache_dir_given: bool | None = None  # whether the user set NUMBA_CACHE_DIR (told by fleet.worker, a Dask preload)
 SHARED_KEPT = 8  # tables × worlds × robot layers whose compiled table and scenes a process keeps
 _shared: OrderedDict[tuple[int, int, int], tuple[Any, ...]] = OrderedDict()
 _shared_lock = threading.Lock()
@@ -199,7 +200,7 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
     global _worker_threads
     started = time.perf_counter()
     _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
-    given = bool(os.environ.get("NUMBA_CACHE_DIR"))
+    given = bool(os.environ.get("NUMBA_CACHE_DIR")) if cache_dir_given is None else cache_dir_given
     from tablebot import jit  # numba, and the default cache folder (per user, Python and sources)
 
     if not given and not any(name in sys.modules for name in COMPILED):
