@@ -152,6 +152,7 @@ class Runner:
         for: its thread closes the client it gets (an unreachable scheduler takes its whole timeout)."""
         if self._loading is not None:  # a fraction of a second: not left loading while the process ends
             self._loading.join()
+        self._imported.set()  # a connecting thread still waiting for the caller's imports goes on, and ends
         if self.pool is not None:
             if failed:
                 self.stop.set()  # Ctrl-C: running chunks end within a block; what finished was handed over already
