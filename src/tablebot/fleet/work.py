@@ -1,8 +1,8 @@
 """The unit of work of sweeps and tuning: a chunk of robots of one table in one world, run as one fleet
-in whichever process gets it (this one, a local worker process, a Dask worker).
+in whichever thread or process gets it (one of this process's threads, a Dask worker).
 
 Nothing compiled is imported at the top: a Dask worker that unpickles :func:`run_job` must be able to
-choose its numba cache folder (:func:`warm_worker`) before the first compiled module loads.
+choose its numba cache folder (:func:`ready_worker`) before the first compiled module loads.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
 MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
-_worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
+_worker_threads: int | None = None  # set by ready_worker: this worker's share of its machine's cores
 cache_dir_given: bool | None = None  # whether the user set NUMBA_CACHE_DIR (told by fleet.worker, a Dask preload)
 SHARED_KEPT = 8  # tables × worlds × robot layers whose compiled table and scenes a process keeps
 _shared: OrderedDict[tuple[int, int, int], tuple[Any, ...]] = OrderedDict()
