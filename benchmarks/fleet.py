@@ -12,6 +12,8 @@ is the kernel can be told apart:
 * **Dask**: the same sweep through ``--scheduler`` to a cluster of 2 single-threaded worker processes
   started for it with an empty cache (*fresh*: they are sent this machine's compiled code), then again
   (*warm*), as speed ratios to the local sweep of the same repeat. Target: fresh >= 0.8x the local run.
+  Then the same with workers started with tablebot's preload (``--preload tablebot.fleet.worker``: numba
+  imported as a worker starts), reported beside: the target's verdict stays on plain ``dask worker``.
 * **one robot**: ``tablebot sim examples/bumberbot --seconds 3600`` with its two pictures, beside the same
   command ``--no-plots`` (the loop and the trace); the trace must be byte-identical either way. Target:
   under 2 s with pictures.
@@ -25,7 +27,8 @@ is the kernel can be told apart:
 * **evolve**: ``tablebot evolve examples/bumberbot`` (a small budget) as a whole process: candidates/s and
   robot-ticks/s of the search (from benchmarks/evolve.py).
 
-Medians of the repeats, ratios against baselines of the same run. The machine this was written on has
+Every child process runs without PYTHONDONTWRITEBYTECODE (see ``child_env``): bytecode as an installed
+tablebot has it. Medians of the repeats, ratios against baselines of the same run. The machine this was written on has
 2 cores shared with other engineers' runs: figures move by tens of percent; the load average is printed.
 """
 
@@ -55,12 +58,27 @@ TARGET_HOUR_S = 2.0  # sim --seconds 3600 with pictures
 CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() process: steadier than wall on a busy machine
 
 
+def child_env(**changes: str | None) -> dict[str, str]:
+    """This process's environment for a child, without PYTHONDONTWRITEBYTECODE (as benchmarks/startup.py):
+    bytecode files are written and read as a user's would be -- with it set, an editable install compiles
+    every tablebot module from source again in every process (~0.2 s of a sweep's start-up that no user
+    of an installed tablebot has). ``changes``: variables to set (None: to remove)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    for key, value in changes.items():
+        if value is None:
+            env.pop(key, None)
+        else:
+            env[key] = value
+    return env
+
+
 def tablebot(*args: str, env: dict[str, str] | None = None) -> float:
     """Wall seconds of ``python -m tablebot ARGS`` as a fresh process (it must succeed); its CPU seconds go
     to ``CPU_S``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=env, capture_output=True, text=True)
+    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=env or child_env(),
+                          capture_output=True, text=True)
     elapsed = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     CPU_S.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
@@ -104,19 +122,23 @@ def free_port() -> int:
 
 class FreshCluster:
     """A Dask scheduler and 2 single-threaded workers on loopback, the workers with an empty cache folder
-    (as on machines that never ran tablebot)."""
+    (as on machines that never ran tablebot); with ``preload``, started with tablebot's preload
+    (``--preload tablebot.fleet.worker``: numba imported as the worker starts, no compiled code)."""
+
+    def __init__(self, preload: bool = False):
+        self.preload = preload
 
     def __enter__(self) -> str:
         self.home = tempfile.TemporaryDirectory()
         port = free_port()
         self.address = f"tcp://127.0.0.1:{port}"
         quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-        worker_env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-        worker_env["XDG_CACHE_HOME"] = self.home.name
+        worker_env = child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=self.home.name)
         self.procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                                        "--port", str(port), "--no-dashboard"], **quiet)]  # type: ignore[call-overload]
+                                        "--port", str(port), "--no-dashboard"], env=child_env(),
+                                       **quiet)]  # type: ignore[call-overload]
         worker = [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads", "1",
-                  "--no-dashboard"]
+                  "--no-dashboard", *(["--preload", "tablebot.fleet.worker"] if self.preload else [])]
         self.procs += [subprocess.Popen(worker, env=worker_env, **quiet)  # type: ignore[call-overload]
                        for _ in range(2)]
         from distributed import Client
@@ -124,6 +146,17 @@ class FreshCluster:
         with Client(self.address, timeout="60s") as client:
             client.wait_for_workers(2, timeout=120)
         return self.address
+
+    def cpu(self) -> float:
+        """CPU seconds (user + system) so far of the scheduler and the workers (their nannies' children too)."""
+        import psutil
+
+        total = 0.0
+        for proc in self.procs:
+            with contextlib.suppress(psutil.Error):
+                parent = psutil.Process(proc.pid)
+                total += sum(sum(p.cpu_times()[:2]) for p in [parent, *parent.children(recursive=True)])
+        return total
 
     def __exit__(self, *exc: object) -> None:
         for proc in self.procs:
@@ -133,15 +166,23 @@ class FreshCluster:
         self.home.cleanup()
 
 
-def dask_ratios(robots: int, seconds: float, repeat: int) -> tuple[list[float], list[float], list[float]]:
-    """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat)."""
+def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False) -> tuple[
+        list[float], list[float], list[float], dict[str, list[float]]]:
+    """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat, its
+    workers started with tablebot's preload or not); and the CPU seconds of each (for Dask: the client's and
+    the cluster's processes' together)."""
     local, fresh, warm = [], [], []
+    cpu: dict[str, list[float]] = {"local": [], "fresh": [], "warm": []}
     for _ in range(repeat):
         local.append(sweep_process(robots, seconds))
-        with FreshCluster() as address:
-            fresh.append(sweep_process(robots, seconds, "--scheduler", address))
-            warm.append(sweep_process(robots, seconds, "--scheduler", address))
-    return local, fresh, warm
+        cpu["local"].append(CPU_S[-1])
+        cluster = FreshCluster(preload)
+        with cluster as address:
+            for walls, name in ((fresh, "fresh"), (warm, "warm")):
+                before = cluster.cpu()
+                walls.append(sweep_process(robots, seconds, "--scheduler", address))
+                cpu[name].append(CPU_S[-1] + cluster.cpu() - before)
+    return local, fresh, warm, cpu
 
 
 # --- one robot ---------------------------------------------------------------------------------------------
@@ -261,15 +302,21 @@ def main() -> int:
           f"{rate / inner:.2f}x the kernel's speed (the rest: start-up, planning, results)")
 
     if not args.no_dask:
-        local, fresh, warm = dask_ratios(robots, seconds, args.repeat)
+        local, fresh, warm, cpu = dask_ratios(robots, seconds, args.repeat)
         f_ratio = med(a / b for a, b in zip(local, fresh, strict=True))
         w_ratio = med(a / b for a, b in zip(local, warm, strict=True))
         ok = f_ratio >= TARGET_FRESH
         missed += not ok
         print(f"Dask, 2 single-threaded workers: local {med(local):.2f} s, fresh cluster {med(fresh):.2f} s, "
-              f"warm {med(warm):.2f} s (whole sweep processes)")
+              f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpu['local']):.2f}, fresh "
+              f"{med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}, the cluster's processes included)")
         print(f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
               f"{w_ratio:.2f}x")
+        local, fresh, warm, cpu = dask_ratios(robots, seconds, args.repeat, preload=True)
+        print(f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
+              f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
+              f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
+              f"{med(cpu['local']):.2f}, fresh {med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}")
 
     with_pics = [sim_hour(hour, True) for _ in range(args.repeat)]
     without = [sim_hour(hour, False) for _ in range(args.repeat)]

@@ -83,3 +83,21 @@ def test_a_sweep_without_pictures_imports_neither_matplotlib_nor_scipy(tmp_path:
     found = sweep("second")
     assert "numba" in found  # it did run the fleet
     assert not found & {"matplotlib", "scipy"}
+
+
+def test_preload_loads_what_the_cache_holds_before_the_first_call_and_compiles_nothing(tmp_path: Path) -> None:
+    """fleet.work.preload (a sweep loads its compiled code on a thread while it plans): a function the cache
+    holds is loaded without a call, from the cache; one it does not hold is left alone, not compiled."""
+    cache = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    first = python("from tablebot.sim.physics import duty; print(duty(3, 8))", env=cache)
+    assert first.returncode == 0, first.stderr
+    load_it = """
+from tablebot.fleet.work import preload
+from tablebot.sim.physics import body_corners, duty
+print(preload(duty), len(duty.overloads), preload(body_corners), len(body_corners.overloads))
+print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_misses.values()))
+"""
+    second = python(load_it, env=cache)
+    assert second.returncode == 0, second.stderr
+    assert second.stdout.splitlines()[0] == "1 1 0 0"  # duty loaded before any call; body_corners not compiled
+    assert second.stdout.splitlines()[1] == "0.375 1 0"  # from the cache

@@ -133,7 +133,8 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
 
 @pytest.fixture
 def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
-    """A real Dask scheduler and two single-threaded workers on this machine (separate processes)."""
+    """A real Dask scheduler and two single-threaded workers on this machine (separate processes), one of
+    them started with tablebot's preload (tablebot.fleet.worker), one plain."""
     pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")
     dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
     file = tmp_path / "scheduler.json"
@@ -145,9 +146,9 @@ def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
         while not file.exists() and time.monotonic() < deadline:
             time.sleep(0.1)
         address = json.loads(file.read_text())["address"]
-        for _ in range(2):
+        for preload in ([], ["--preload", "tablebot.fleet.worker"]):
             procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                           "--nthreads", "1", "--no-dashboard"], env=env(),
+                                           "--nthreads", "1", "--no-dashboard", *preload], env=env(),
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         from distributed import Client
         with Client(address, timeout="30s") as client:
@@ -257,6 +258,32 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     for relative, named in files.items():
         folder = next(p for p in mine.iterdir() if p.name.startswith((Path(relative).parent.name or "tablebot") + "_"))
         assert all((folder / name).read_bytes() == data for name, data in named.items())
+    # as a sweep readies a worker: its imports first, without code; then the code, which it loads, before any job
+    code = ("import json, pickle, sys; from tablebot.fleet.work import chunk_functions, ready_worker; "
+            "job, files = pickle.load(open(sys.argv[1], 'rb')); first = ready_worker('testhost-1', 2, None, False); "
+            "functions = chunk_functions(1); before = [len(f.overloads) for f in functions]; "
+            "second = ready_worker('testhost-1', 2, files); "
+            "print(json.dumps([first, second, before, [len(f.overloads) for f in functions]]))")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    first, second, before, after = json.loads(done.stdout.strip().splitlines()[-1])
+    assert first["cache"] == second["cache"] == str(mine.parent / "worker-testhost-1")
+    assert (first["installed"], first["loaded"]) == (0, 0) and before == [0] * len(before)
+    assert second["installed"] == len(sent) and second["loaded"] == len(after) and after == [1] * len(after)
+    landed = sorted(p.name for p in (mine.parent / "worker-testhost-1").rglob("*") if p.is_file())
+    assert landed == sent  # loaded, not compiled
+    # a worker started with tablebot's preload has numba before the client comes, and still gets its own folder
+    code = ("import json, pickle, sys; from tablebot.fleet.worker import dask_setup; dask_setup(); "
+            "early = 'numba' in sys.modules; from tablebot.fleet.work import ready_worker; "
+            "job, files = pickle.load(open(sys.argv[1], 'rb')); ready_worker('testhost-2', 2, None, False); "
+            "print(json.dumps([early, ready_worker('testhost-2', 2, files)]))")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    early, info = json.loads(done.stdout.strip().splitlines()[-1])
+    assert early and info["cache"] == str(mine.parent / "worker-testhost-2") and info["loaded"] == len(after)
+    assert sorted(p.name for p in (mine.parent / "worker-testhost-2").rglob("*") if p.is_file()) == sent
 
 
 def test_a_job_with_threads_of_its_own_runs_on_them() -> None:

@@ -48,17 +48,19 @@ def sweep_cmd(
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
     OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
     resumes."""
-    from tablebot.fileset import current, file_set
     from tablebot.fleet.backends import Runner, choose
-    from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
-    from tablebot.interrupts import INTERRUPTS
 
-    if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
-        from tablebot.fleet.plots import write_all
-
+    quick_exit()
     chosen, address = choose(backend, scheduler)
     with Runner(chosen, address, workers) as runner:
-        runner.start()  # a cluster's workers start up while this process plans
+        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
+        from tablebot.fileset import current, file_set
+        from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
+        from tablebot.interrupts import INTERRUPTS
+
+        if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
+            from tablebot.fleet.plots import write_all
+        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
         plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
         traced = trace_runs(trace, plan.spec.total)
         out_folder(out, "--out")
@@ -84,10 +86,23 @@ def sweep_cmd(
     wall_s = time.perf_counter() - started
     with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
         path, _ = store.merge(complete=True)
-        rows = read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
+        rows = [] if quiet and not plots else \
+            read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
         written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
     if not quiet:
         report(plan, rows, written, wall_s, total - already)
+
+
+def quick_exit() -> None:
+    """At exit, the interpreter's last garbage collections skip every object there is by then (gc.freeze, as
+    the last exit handler): after numba and LLVM have loaded, those collections walk their object graphs for
+    0.1-0.2 s of every sweep's exit, to free memory the process is about to give back whole. Files are all
+    written and closed by then; exit handlers and weakref finalizers still run."""
+    import atexit
+    import gc
+
+    atexit.unregister(gc.freeze)  # once, however many sweeps one process runs (tests)
+    atexit.register(gc.freeze)
 
 
 def stopped(store: Any, total: int, why: BaseException) -> None:

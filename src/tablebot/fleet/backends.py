@@ -5,6 +5,7 @@ callback as it comes back, so an interrupted run keeps what finished.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 from collections import defaultdict
@@ -13,7 +14,17 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import fail
-from tablebot.fleet.work import Job, ready_worker, run_job, warm, warm_worker
+from tablebot.fleet.work import (
+    Common,
+    Job,
+    chunk_functions,
+    preload,
+    ready_worker,
+    run_common,
+    run_job,
+    warm,
+    warm_worker,
+)
 
 if TYPE_CHECKING:
     from tablebot.fleet.run import FleetSummary
@@ -53,6 +64,10 @@ class Runner:
         self._opening: threading.Thread | None = None  # connecting to the cluster (see start)
         self._lock, self._closed = threading.Lock(), False
         self._opened: dict[str, Any] = {}  # what the opening thread sent the workers, or the error it met
+        self._imported = threading.Event()  # the caller's fleet modules are imported (see start)
+        self._imported.set()
+        self._dask_imported = threading.Event()  # the opening thread has imported Dask (or failed to)
+        self._loading: threading.Thread | None = None  # loading this process's compiled code (see imported)
 
     def __enter__(self) -> Runner:
         return self
@@ -68,27 +83,50 @@ class Runner:
             return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
         return max(1, self.workers or os.cpu_count() or 1)
 
-    def start(self) -> None:
+    def start(self, imported: bool = True) -> None:
         """Begin opening the backend while the caller still plans: for Dask, connect on a thread and send
-        every worker the start-up that needs no job (imports, this process's compiled code, numba's
-        compiler: :func:`~tablebot.fleet.work.ready_worker`); :meth:`run` waits for it. A fresh worker
-        spent seconds on that after the client had planned, connected and warmed up."""
+        every worker the start-up that needs no job (:func:`~tablebot.fleet.work.ready_worker`: imports, then
+        this process's compiled code, loaded there); :meth:`run` waits for it. A caller that has not imported
+        the fleet's modules yet says so (``imported=False``) and calls :meth:`imported` when it has: the
+        workers start importing meanwhile, and this process's compiled code is read only then (two threads
+        importing the same modules at once could meet half-made ones)."""
+        if not imported:
+            self._imported.clear()
         if self.backend != "dask" or self.client is not None or self._opening is not None:
             return
         self._opening = threading.Thread(target=self._open, name="tablebot-dask-connect", daemon=True)
         self._opening.start()
+        # Dask's own import (~0.5 s of Python) first, alone: the workers get their start-up that much sooner
+        # than if it shared the GIL with the caller's imports; the connection itself then waits on the network.
+        self._dask_imported.wait()
+
+    def imported(self) -> None:
+        """The caller has imported the fleet (see :meth:`start`); locally, this process's compiled code starts
+        loading on a thread while the caller plans (:func:`~tablebot.fleet.work.preload`: mostly LLVM, which
+        leaves the GIL), instead of in the first chunks, the second thread waiting for numba's lock."""
+        self._imported.set()
+        if self.backend == "local" and self._loading is None:
+            threads = 1 if max(1, self.workers or os.cpu_count() or 1) > 1 else None  # as _run_local runs them
+            self._loading = threading.Thread(target=preload_quietly, args=(threads,), name="tablebot-load",
+                                             daemon=True)
+            self._loading.start()
 
     def _open(self) -> None:
         try:
+            with contextlib.suppress(ImportError):  # connect says what to install
+                import distributed  # noqa: F401
+            self._dask_imported.set()
             client = connect(self.address or "")  # first: it says what to install when Dask is missing
             with self._lock:
                 if self._closed:  # the caller gave up meanwhile (a mistake in its options, Ctrl-C)
                     client.close()
                     return
                 self.client = client
-            self._opened = ready_cluster(client)
+            self._opened = ready_cluster(client, self._imported)
         except BaseException as exc:  # raised again in the caller's thread, by _connected
             self._opened = {"failed": exc}
+        finally:
+            self._dask_imported.set()
 
     def _connected(self) -> Any:
         """The Dask client, once :meth:`start`'s thread is through (its error raised here)."""
@@ -112,6 +150,9 @@ class Runner:
     def close(self, failed: bool = False) -> None:
         """Stop the local threads or close the Dask client. A connection still being made is not waited
         for: its thread closes the client it gets (an unreachable scheduler takes its whole timeout)."""
+        if self._loading is not None:  # a fraction of a second: not left loading while the process ends
+            self._loading.join()
+        self._imported.set()  # a connecting thread still waiting for the caller's imports goes on, and ends
         if self.pool is not None:
             if failed:
                 self.stop.set()  # Ctrl-C: running chunks end within a block; what finished was handed over already
@@ -166,12 +207,13 @@ class Runner:
         from distributed import as_completed
 
         client = self.client
-        futures = [client.submit(fn, job, pure=False) for job in jobs]
+        sent = submit_all(client, jobs, fn)
         try:
-            for future in as_completed(futures, loop=client.loop):
-                done(*future.result())
+            for future in as_completed(list(sent), loop=client.loop):
+                job, result = future.result()
+                done(sent[future].fill(job) if sent[future] is not None else job, result)
         except BaseException:
-            client.cancel(futures)
+            client.cancel(list(sent))
             raise
 
 
@@ -191,6 +233,26 @@ def connect(address: str) -> Any:
                    "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
 
 
+def submit_all(client: Any, jobs: Sequence[Job], fn: Callable[[Any], tuple[Job, Any]]) -> dict[Any, Common | None]:
+    """A task per job; jobs that share their table, world and robot layer (a sweep's chunks of one world)
+    get them from one piece of data sent to every worker first (:func:`~tablebot.fleet.work.run_common`):
+    each chunk is then a few kilobytes of seeds, not its table and world again, and a worker prepares their
+    scenes once. Returns each task's future and what it shares (None: the job went whole)."""
+    groups: dict[tuple[int, int, int], list[Job]] = defaultdict(list)
+    for job in jobs:
+        groups[id(job.table), id(job.world), id(job.robot_params)].append(job)
+    sent: dict[Any, Common | None] = {}
+    for group in groups.values():
+        if len(group) == 1:
+            sent[client.submit(fn, group[0], pure=False)] = None
+            continue
+        common = Common.of(group[0])
+        data = client.scatter(common, broadcast=True, hash=False)
+        for job in group:
+            sent[client.submit(run_common, fn, data, common.strip(job), pure=False)] = common
+    return sent
+
+
 def slots(client: Any) -> list[tuple[str, str, int]]:
     """Every worker's address, its cache slot (named by its host and its rank there) and how many workers
     share its host."""
@@ -202,6 +264,13 @@ def slots(client: Any) -> list[tuple[str, str, int]]:
             for host, addresses in by_host.items() for rank, address in enumerate(addresses)]
 
 
+def preload_quietly(threads: int | None) -> None:
+    """:func:`~tablebot.fleet.work.preload` the functions a chunk calls on ``threads`` (any error left for
+    the first call to meet and report, as it would have without this)."""
+    with contextlib.suppress(Exception):
+        preload(*chunk_functions(threads))
+
+
 def compiled_files() -> dict[str, dict[str, bytes]] | None:
     """This process's compiled fleet code (both kernels: a worker alone on its machine runs chunks on all
     its cores), read from the cache without loading it; None if it is not compiled yet."""
@@ -211,32 +280,49 @@ def compiled_files() -> dict[str, dict[str, bytes]] | None:
     return jit.cache_files() if jit.compiled(run_fleet, run_fleet_serial) else None
 
 
-def ready_cluster(client: Any) -> dict[str, Any]:
-    """Send every worker :func:`~tablebot.fleet.work.ready_worker` (pinned to it) with this process's
-    compiled code, if it has any yet; returns the files sent (a future held by every worker) and the
-    tasks, not waited for: the chunks wait for :func:`warm_cluster`."""
+def ready_cluster(client: Any, imported: threading.Event | None = None) -> dict[str, Any]:
+    """Send every worker :func:`~tablebot.fleet.work.ready_worker` (pinned to it): its imports at once, then,
+    once this process has imported the fleet (``imported``), its compiled code to load, if it has any yet.
+    Returns the files sent (a future held by every worker), the workers and the tasks, not waited for: the
+    chunks wait for :func:`warm_cluster`."""
+    places = slots(client)
+    futures = [client.submit(ready_worker, slot, share, None, False, workers=[address], allow_other_workers=False,
+                             pure=False, key=f"tablebot-import-{slot}") for address, slot, share in places]
+    if imported is not None:
+        imported.wait()
     files = compiled_files()
     scattered = client.scatter(files, broadcast=True, hash=False) if files else None
-    futures = [client.submit(ready_worker, slot, share, scattered, workers=[address], allow_other_workers=False,
-                             pure=False, key=f"tablebot-ready-{slot}") for address, slot, share in slots(client)]
-    return {"files": scattered, "ready": futures}
+    if scattered is not None:
+        futures += send_ready(client, places, scattered)
+    return {"files": scattered, "ready": futures, "places": {address for address, _, _ in places}}
+
+
+def send_ready(client: Any, places: Sequence[tuple[str, str, int]], files: Any) -> list[Any]:
+    """:func:`~tablebot.fleet.work.ready_worker` with the compiled code ``files`` (scattered) to each worker
+    of ``places``, pinned to it."""
+    return [client.submit(ready_worker, slot, share, files, workers=[address], allow_other_workers=False,
+                          pure=False, key=f"tablebot-ready-{slot}") for address, slot, share in places]
 
 
 def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Warm every worker (pinned to it) on ``job``: it loads the compiled kernel, from this process's
-    compiled code, compiled (or loaded) here first if :func:`ready_cluster` (``opened``) had none to send."""
+    """Every worker ready before the first chunk: its compiled code loaded (:func:`ready_cluster`'s tasks,
+    and the same for a worker that joined since); or, if this process had no compiled code to send, compiled
+    here once on ``job`` and sent with a warm-up on it (pinned to each worker)."""
     opened = opened or {}
     places = slots(client)
     if not places:
         raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
     files = opened.get("files")
-    if files is None:  # nothing compiled to send early: compile here once, rather than on every worker
+    if files is not None:
+        futures = send_ready(client, [p for p in places if p[0] not in opened.get("places", ())], files)
+    else:  # nothing compiled to send early: compile here once, rather than on every worker
         from tablebot import jit
 
         warm(job, both=True)
         files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
-    futures = [client.submit(warm_worker, job, slot, share, files, workers=[address], allow_other_workers=False,
-                             pure=False, key=f"tablebot-warm-{slot}") for address, slot, share in places]
+        futures = [client.submit(warm_worker, job, slot, share, files, workers=[address],
+                                 allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}")
+                   for address, slot, share in places]
     try:
         ready = client.gather(opened.get("ready", []))
         warmed = client.gather(futures)

@@ -11,6 +11,7 @@ import csv
 import functools
 import io
 import itertools
+import operator
 import re
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
@@ -83,13 +84,32 @@ class Plan:
         """A job per chunk of the spec that is not in ``skip`` (chunks already finished); its info keeps
         each robot's start (None: the world's) for the result rows."""
         out = []
+        combos = list(itertools.product(*(axis.values for axis in self.spec.axes)))
         for a, b in chunks(self.spec):
             if (a, b) in skip:
                 continue
-            chunk = runs(self.spec, a, b)
-            robots = [self.robot(run) for run in chunk]
-            out.append(Job(self.table, self.worlds[chunk[0].world], self.robot_params, robots, self.spec.ticks,
-                           first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
+            robots = self._robots(a, b, combos)
+            out.append(Job(self.table, self.worlds[a // self.spec.runs_per_world], self.robot_params, robots,
+                           self.spec.ticks, first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
+        return out
+
+    def _robots(self, a: int, b: int, combos: Sequence[tuple[Any, ...]]) -> list[RobotSpec]:
+        """:meth:`robot` of runs ``a`` .. ``b - 1`` (as :func:`runs` orders them): the parameters and fixed
+        start of a grid combination worked out once for all its seeds, a random start drawn per seed."""
+        spec, out = self.spec, []
+        count = len(spec.seeds)
+        index = a
+        while index < b:
+            world, rest = divmod(index, spec.runs_per_world)
+            combo, k = divmod(rest, count)
+            stop, values = min(b, index + count - k), combos[combo]
+            seeds = spec.seeds[k: k + stop - index]
+            if "random" in values:
+                out += [self.robot(Run(index + j, world, values, seed)) for j, seed in enumerate(seeds)]
+            else:
+                first = self.robot(Run(index, world, values, seeds[0]))
+                out += [RobotSpec(seed, first.start, first.params) for seed in seeds]
+            index = stop
         return out
 
     def _check_params(self) -> list[list[Scene]]:
@@ -307,7 +327,8 @@ def read_results(path: Path, columns: Sequence[str] | None = None) -> list[dict[
         reader = csv.reader(f)
         header = next(reader)
         places = [header.index(column) for column in columns]
-        return [dict(zip(columns, [row[k] for k in places], strict=True)) for row in reader]
+        cells = operator.itemgetter(*places, *places[:1])  # two at least: a tuple, the last one dropped by zip
+        return [dict(zip(columns, cells(row), strict=False)) for row in reader]
 
 
 # How a sweep's results are grouped, for its report and its pictures (here, not in the picture module, so that

@@ -79,6 +79,17 @@ class FleetSummary:
 
 
 @dataclass
+class Prepared:
+    """What fleets of one table in one world with one robot layer share, by parameter set: the scene
+    (:func:`~tablebot.sim.scene.prepare`: the world's pieces and shadow grid, milliseconds each) and how its
+    robots start. A sweep's chunks in one process share one instead of preparing them again per chunk
+    (:func:`tablebot.fleet.work.shared`); scenes and starters are only read once made."""
+
+    scenes: dict[tuple, Scene] = field(default_factory=dict)
+    starters: dict[tuple, Starter] = field(default_factory=dict)
+
+
+@dataclass
 class Trace:
     """A traced robot's run, kept block by block (its SimRobot makes the blocks, as in ``tablebot sim``)."""
 
@@ -92,13 +103,14 @@ class Fleet:
 
     def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
                  robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
-                 variants: Variants | None = None):
+                 variants: Variants | None = None, prepared: Prepared | None = None):
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
         self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
-        self._scenes: dict[tuple, Scene] = {}
+        self._prepared = prepared or Prepared()
+        self._scenes = self._prepared.scenes
         self.scenes = [self.scene_of(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
         self._tick_noise: NoiseRows | None = None
@@ -136,7 +148,6 @@ class Fleet:
         self.bitgens = np.zeros(n, dtype=np.uint64)  # where each robot's Generator keeps its C bit generator
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
-        self._starters: dict[tuple, Starter] = {}
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
         self.world = world_arrays(first)
         self.drive, self.pcols = np.array(first.drive, dtype=np.int64), np.array(first.pulse_columns, dtype=np.int64)
@@ -187,9 +198,10 @@ class Fleet:
 
     def starter(self, spec: RobotSpec, scene: Scene) -> Starter:
         """How robots with ``spec``'s parameters start (one per parameter set, as their scenes)."""
-        if spec.params not in self._starters:
-            self._starters[spec.params] = Starter(scene)
-        return self._starters[spec.params]
+        starters = self._prepared.starters
+        if spec.params not in starters:
+            starters[spec.params] = Starter(scene)
+        return starters[spec.params]
 
     def __len__(self) -> int:
         return len(self.specs)

@@ -1,8 +1,8 @@
 """The unit of work of sweeps and tuning: a chunk of robots of one table in one world, run as one fleet
-in whichever process gets it (this one, a local worker process, a Dask worker).
+in whichever thread or process gets it (one of this process's threads, a Dask worker).
 
 Nothing compiled is imported at the top: a Dask worker that unpickles :func:`run_job` must be able to
-choose its numba cache folder (:func:`warm_worker`) before the first compiled module loads.
+choose its numba cache folder (:func:`ready_worker`) before the first compiled module loads.
 """
 
 from __future__ import annotations
@@ -11,20 +11,27 @@ import os
 import socket
 import sys
 import threading
+from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from tablebot.fleet.robots import RobotSpec, Variants
 
 if TYPE_CHECKING:
-    from tablebot.fleet.run import FleetSummary
+    from tablebot.fleet.run import FleetSummary, Prepared
+    from tablebot.machine import Machine
     from tablebot.sim.world import World
     from tablebot.table import Table
 
 COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
 MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
-_worker_threads: int | None = None  # set by warm_worker: this worker's share of its machine's cores
+_worker_threads: int | None = None  # set by ready_worker: this worker's share of its machine's cores
+cache_dir_given: bool | None = None  # whether the user set NUMBA_CACHE_DIR (told by fleet.worker, a Dask preload)
+SHARED_KEPT = 8  # tables × worlds × robot layers whose compiled table and scenes a process keeps
+_shared: OrderedDict[tuple[int, int, int], tuple[Any, ...]] = OrderedDict()
+_shared_lock = threading.Lock()
 
 
 @dataclass
@@ -42,6 +49,34 @@ class Job:
     info: dict[str, Any] = field(default_factory=dict)  # what the caller needs back with the result
 
 
+@dataclass(frozen=True)
+class Common:
+    """What jobs of one run share -- their table, world and robot layer -- sent to each cluster worker once
+    (:func:`run_common`), not pickled into every chunk."""
+
+    table: Table
+    world: World
+    robot_params: dict[str, Any]
+
+    @staticmethod
+    def of(job: Job) -> Common:
+        return Common(job.table, job.world, job.robot_params)
+
+    def strip(self, job: Job) -> Job:
+        """The job without what it shares (None in its place: put back by :meth:`fill`)."""
+        return replace(job, table=None, world=None, robot_params=None)  # type: ignore[arg-type]
+
+    def fill(self, job: Job) -> Job:
+        return replace(job, table=self.table, world=self.world, robot_params=self.robot_params)
+
+
+def run_common(fn: Callable[[Job], tuple[Job, Any]], common: Common, job: Job) -> tuple[Job, Any]:
+    """On a cluster worker: ``fn`` of the job with what it shares put back -- the same objects for every chunk
+    on this worker, so :func:`shared` prepares its scenes once -- and the job returned without them."""
+    done, result = fn(common.fill(job))
+    return common.strip(done), result
+
+
 class Stopped(Exception):
     """A chunk given up between two blocks because its run was stopped (Ctrl-C)."""
 
@@ -50,7 +85,6 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
     """Run the chunk as one fleet; returns the job (without its robots) and the fleet's summary. With
     ``stop``, the chunk is given up (:class:`Stopped`) at the first block after it is set."""
     from tablebot.fleet.run import Fleet
-    from tablebot.machine import compile_table
 
     def check(_ticks: int) -> None:
         if stop is not None and stop.is_set():
@@ -59,10 +93,50 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
     threads = job_threads(job)
     if threads != 1:  # one thread: the calling thread alone, without numba's pool (not even started)
         use_threads(job)
-    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs, job.robot_params,
-                  variants=job.variants)
+    machine, prepared = shared(job)
+    fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params, variants=job.variants,
+                  prepared=prepared)
     fleet.run(job.ticks, progress=check, threads=False if threads == 1 else None, block_ticks=block_ticks(job))
     return replace(job, specs=[], variants=None), fleet.summary()
+
+
+def shared(job: Job) -> tuple[Machine, Prepared]:
+    """The job's compiled table and prepared scenes, made once per process for each table, world and robot
+    layer (the same objects: a local sweep's chunks all hold its plan's, and a cluster worker's chunks get
+    them as one shared piece of data, see :mod:`tablebot.fleet.backends`). Keyed by identity: an entry holds
+    its objects, so no other object can take their ids while it is kept."""
+    from tablebot.fleet.run import Prepared
+    from tablebot.machine import compile_table
+
+    key = (id(job.table), id(job.world), id(job.robot_params))
+    with _shared_lock:
+        found = _shared.get(key)
+        if found is None:
+            found = _shared[key] = (job.table, job.world, job.robot_params, compile_table(job.table), Prepared())
+            while len(_shared) > SHARED_KEPT:
+                _shared.popitem(last=False)
+        _shared.move_to_end(key)
+    return found[3], found[4]
+
+
+def preload(*functions: Any) -> int:
+    """Load the machine code of compiled ``functions`` from numba's cache now: every overload the cache
+    holds for this machine and these sources. Meant for a thread while the caller plans -- loading is mostly
+    LLVM linking the code, which leaves the GIL -- instead of in the first chunk, while the other thread waits
+    for numba's compiler lock. What the cache lacks is left to compile at its first call, as ever. Returns
+    how many overloads it loaded (this uses numba's cache internals: another numba loads nothing here)."""
+    loaded = 0
+    for function in functions:
+        try:
+            cache, codegen = function._cache, function.targetctx.codegen()
+            keys = list(cache._cache_file._load_index())
+            wanted = [key[0] for key in keys if cache._index_key(key[0], codegen) == key]
+        except Exception:  # another numba, or no index: the first call loads (or compiles) as before
+            continue
+        for signature in wanted:
+            function.compile(signature)
+            loaded += 1
+    return loaded
 
 
 def block_ticks(job: Job) -> int:
@@ -97,30 +171,36 @@ def warm(job: Job, both: bool = False) -> float:
     import time
 
     from tablebot.fleet.run import Fleet
-    from tablebot.machine import compile_table
 
     started = time.perf_counter()
-    fleet = Fleet(job.table, compile_table(job.table), job.world, job.specs[:1], job.robot_params,
-                  variants=job.variants)
+    machine, prepared = shared(job)
+    fleet = Fleet(job.table, machine, job.world, job.specs[:1], job.robot_params, variants=job.variants,
+                  prepared=prepared)
     for threads in (False, True) if both else (False,):
         fleet.run(1, threads=threads)
     return time.perf_counter() - started
 
 
-def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
+def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None,
+                 load: bool = True) -> dict[str, Any]:
     """On a cluster worker, before it sees a job: choose a cache folder of its own (``worker-SLOT`` in the
-    user's numba cache for tablebot), unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code
-    already loaded here; put the client's compiled code there (``files``, from
-    :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling); import the
-    compiled modules and load numba's compiler (what a fresh worker's first chunk spent seconds on). Needs
-    no job, so the client sends it as soon as it is connected, while it still plans. Its chunks then use
-    1/``share`` of the machine's cores (``share``: the workers on this machine). Idempotent."""
+    user's numba cache for tablebot) unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code is
+    already loaded here, and import the compiled modules; put the client's compiled code in their folder
+    (``files``, from :func:`tablebot.jit.cache_files`: a fresh worker then loads it instead of compiling);
+    with ``load``, load the machine code a chunk runs (:func:`preload`). Needs no job, so the client sends it
+    as soon as it is connected: first without files or loading (the imports, while the client itself still
+    imports and plans), then with them. Its chunks use 1/``share`` of the machine's cores (``share``: the
+    workers on this machine). Idempotent.
+
+    numba's compiler is not readied: cached code loads without it (tablebot.jit), and readying it cost a
+    fresh worker ~0.5 s of CPU (its typing and lowering rules, and scipy.linalg), taken from the chunks on a
+    machine whose cores the workers share."""
     import time
 
     global _worker_threads
     started = time.perf_counter()
     _worker_threads = max(1, (os.cpu_count() or 1) // max(1, share))
-    given = bool(os.environ.get("NUMBA_CACHE_DIR"))
+    given = bool(os.environ.get("NUMBA_CACHE_DIR")) if cache_dir_given is None else cache_dir_given
     from tablebot import jit  # numba, and the default cache folder (per user, Python and sources)
 
     if not given and not any(name in sys.modules for name in COMPILED):
@@ -129,20 +209,26 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
         folder = os.path.join(jit.cache_dir(), f"worker-{slot}")
         os.environ[jit.ENV] = folder
         numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
-    installed = jit.install_cache_files(files) if files else 0
     import numba
 
-    import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls)
+    import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls: their cache folder is set)
 
-    try:  # numba loads its compiler's registries on the first compile or cache load; here, not in a chunk
-        from numba.core.registry import cpu_target
-
-        cpu_target.typing_context.refresh()
-        cpu_target.target_context.refresh()
-    except (ImportError, AttributeError):  # another numba: the first load does it, as before
-        pass
+    installed = jit.install_cache_files(files) if files else 0  # read by each function at its first load
+    loaded = preload(*chunk_functions(_worker_threads)) if load else 0
     return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR,
-            "threads": _worker_threads, "installed": installed, "ready_s": time.perf_counter() - started}
+            "threads": _worker_threads, "installed": installed, "loaded": loaded,
+            "ready_s": time.perf_counter() - started}
+
+
+def chunk_functions(threads: int | None) -> tuple[Any, ...]:
+    """The compiled functions a chunk calls: the start check of a scene, a robot's first reading, and the fleet
+    loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
+    calling thread)."""
+    from tablebot.fleet.kernel import run_fleet, run_fleet_serial
+    from tablebot.sim import kernel, physics
+
+    loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
+    return (physics.body_corners, physics.deepest_contact, kernel.sense, kernel.observe, *loops)
 
 
 def warm_worker(job: Job, slot: str, share: int = 1,
