@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import atexit
 import gc
 import os
 import sys
@@ -29,6 +30,12 @@ def main() -> None:
     # A run builds large tables of small objects and then exits: at the default threshold (700) the
     # cyclic collector re-scans them thousands of times, half the time of checking a 100,000-row table.
     gc.set_threshold(100_000, 50, 100)
+    # At exit the interpreter's last collections walk every object there is: after numba and LLVM have
+    # loaded, 0.1-0.3 s of a sim's or sweep's exit, to free memory the process is about to give back whole.
+    # gc.freeze as the last exit handler (registered first) takes them out of those walks; every file is
+    # written and closed by then, and the other exit handlers and weakref finalizers still run.
+    atexit.unregister(gc.freeze)  # once, however many times one process calls main (tests)
+    atexit.register(gc.freeze)
     try:
         app()
     except (SystemExit, KeyboardInterrupt):

@@ -50,7 +50,6 @@ def sweep_cmd(
     resumes."""
     from tablebot.fleet.backends import Runner, choose
 
-    quick_exit()
     chosen, address = choose(backend, scheduler)
     with Runner(chosen, address, workers) as runner:
         runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
@@ -91,18 +90,6 @@ def sweep_cmd(
         written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
     if not quiet:
         report(plan, rows, written, wall_s, total - already)
-
-
-def quick_exit() -> None:
-    """At exit, the interpreter's last garbage collections skip every object there is by then (gc.freeze, as
-    the last exit handler): after numba and LLVM have loaded, those collections walk their object graphs for
-    0.1-0.2 s of every sweep's exit, to free memory the process is about to give back whole. Files are all
-    written and closed by then; exit handlers and weakref finalizers still run."""
-    import atexit
-    import gc
-
-    atexit.unregister(gc.freeze)  # once, however many sweeps one process runs (tests)
-    atexit.register(gc.freeze)
 
 
 def stopped(store: Any, total: int, why: BaseException) -> None:
