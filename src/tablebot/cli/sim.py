@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -14,6 +15,7 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
+    from tablebot.sim.painter import Painter
     from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
@@ -44,6 +46,17 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
+    from tablebot.sim.painter import Painter
+
+    # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
+    # while this process imports numba and runs the robot, and draws the pictures when the run is over
+    with Painter() if plots else contextlib.nullcontext() as painter:
+        _sim(table, world, seconds, seed, out, view, gif, painter, html, charge, quiet, robot)
+
+
+def _sim(table: Path, world: Path | None, seconds: float, seed: int, out: Path, view: bool, gif: bool,
+         painter: Painter | None, html: bool, charge: float | None, quiet: bool, robot: Path | None) -> None:
+    """The command, once the painter is on its way."""
     from tablebot.fileset import file_set
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
@@ -58,19 +71,21 @@ def sim_cmd(
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    rows = plots or gif or view  # every robot row is kept only for what draws the run
+    rows = painter is not None or gif or view  # every robot row is kept only for what draws the run
     from tablebot.jit import say_compiling
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
-    drawing = _import_drawing(plots, gif, html)
+    if painter is not None:
+        painter.start(scene, ticks, seed)
+    drawing = _import_drawing(gif, html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
         result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
         drawing.join()
         if result.end.complete:
             summary = summarise(result)
-            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
+            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, painter, gif)
             if html:
                 written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
@@ -83,9 +98,9 @@ def sim_cmd(
 
 
 class _Imports:
-    """The picture modules (matplotlib, PIL) imported by a thread of their own while the robot runs: the
-    run's compiled loop leaves the other core (and the GIL) to them, so their half second or more costs
-    nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut an import short (a
+    """The modules of the animation and the replay page (matplotlib, PIL) imported by a thread of their own
+    while the robot runs: the run's compiled loop leaves the other core (and the GIL) to them, so their half
+    second or more costs nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut an import short (a
     compiled module interrupted mid-import surfaces as an ImportError). :meth:`join` waits for them and
     raises what an import raised."""
 
@@ -109,17 +124,14 @@ class _Imports:
             raise self.failed
 
 
-def _import_drawing(plots: bool, gif: bool, html: bool) -> _Imports:
-    """Start importing the picture modules the run will need (see :class:`_Imports`)."""
-    wanted = [(_load_plots, plots), (_load_animate, gif), (_load_replay, html)]
+def _import_drawing(gif: bool, html: bool) -> _Imports:
+    """Start importing the modules the run's animation and replay page will need (see :class:`_Imports`;
+    the pictures are the painter's)."""
+    wanted = [(_load_animate, gif), (_load_replay, html)]
     return _Imports([load for load, used in wanted if used])
 
 
 # Plain import statements (not module names as strings), so that import-linter sees these imports too.
-def _load_plots() -> None:
-    import tablebot.sim.plots  # noqa: F401
-
-
 def _load_animate() -> None:
     import tablebot.sim.animate  # noqa: F401
 
@@ -135,13 +147,10 @@ def _stopped(result: SimRun, kept: Path | None) -> None:
     raise typer.Exit(result.end.exit_code)
 
 
-def _pictures(result: SimRun, summary: Summary, out: Path, plots: bool, gif: bool) -> list[Path]:
-    """trajectory.png and timeline.png (unless ``plots`` is off) and, with ``gif``, the animation."""
-    written = []
-    if plots:
-        from tablebot.sim import plots as pictures
-
-        written += pictures.trajectory_and_timeline(result, summary, out)
+def _pictures(result: SimRun, summary: Summary, out: Path, painter: Painter | None, gif: bool) -> list[Path]:
+    """trajectory.png and timeline.png (drawn by the painter, when there is one) and, with ``gif``, the
+    animation."""
+    written = painter.draw(result, summary, out) if painter is not None else []
     if gif:
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))

@@ -6,10 +6,12 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 from __future__ import annotations
 
 import io
+import pickle
 from collections.abc import Callable
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
+import matplotlib.image
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
@@ -32,24 +34,36 @@ from tablebot.sim.draw import (
     TAPE_FILL,
     WALL,
     RobotArtist,
-    contact_point,
+    contact_points,
     draw_world,
     literal_text,
     sensor_readings,
 )
-from tablebot.sim.forked import Forked
-from tablebot.sim.runner import SimRun
+from tablebot.sim.forked import Forked, Inbox
+from tablebot.sim.painter import RunView, SceneView
 from tablebot.sim.summary import Summary
 
+if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
+    from tablebot.sim.runner import SimRun
+    from tablebot.sim.scene import Scene
+
+    Run = SimRun | RunView
+
 DPI = 150
+PATH_Z = 4  # the path's z-order: everything the arena draws is below it
 PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels
 SPIN_M, SPIN_DEG = 0.01, 15.0  # a state that moves the robot less and turns it more is a spin: drawn as a dot
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
 
 
-def title_of(result: SimRun) -> str:
-    robot, world = picture(result.scene.table.robot.name), picture(result.scene.world.name)
-    return f"{robot} in {world} — {result.ticks * result.tick_s:g} s, seed {result.seed}"
+def title_of(result: Run) -> str:
+    return title(result.scene, result.ticks, result.seed)
+
+
+def title(scene: SceneView | Scene, ticks: int, seed: int) -> str:
+    """The pictures' title: the robot, the world, the run's length and seed (all known before the run)."""
+    robot, world = picture(scene.table.robot.name), picture(scene.world.name)
+    return f"{robot} in {world} — {ticks * scene.tick_s:g} s, seed {seed}"
 
 
 def subtitle_of(summary: Summary) -> str:
@@ -65,57 +79,105 @@ def subtitle_of(summary: Summary) -> str:
 
 
 @literal_text()
-def trajectory(result: SimRun, summary: Summary, path: Path) -> Path:
+def trajectory(result: Run, summary: Summary, path: Path) -> Path:
     """The arena with the path coloured by state, collisions, first light and lamp reached marked."""
     return save(trajectory_figure(result, summary), path)
 
 
 @literal_text()
-def trajectory_figure(result: SimRun, summary: Summary) -> Figure:
-    world = result.scene.world
-    xs, ys = zip(*world.walls, strict=True)
-    aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
-    fig = Figure(figsize=(11, max(4.5, 7.2 * aspect + 1.2)), dpi=DPI)
-    FigureCanvasAgg(fig)
-    ax = fig.add_axes((0.06, 0.08, 0.62, 0.8))
-    draw_world(ax, world)
-    machine, h = result.scene.machine, result.hist
-    colours = state_colours(machine.states)
-    pieces, piece_states = path_pieces(h[:, [L.X, L.Y]].astype(np.float64), result.states, PATH_STEP_M)
-    lines = LineCollection(pieces, colors=[colours[s] for s in piece_states], linewidths=2.2,
-                           capstyle="round", joinstyle="round", zorder=4)
-    ax.add_collection(lines)
-    # spins in place draw no line: a dot where such a state begins shows them
-    spins = spin_starts(h, result.states)
-    ax.scatter(h[spins, L.X], h[spins, L.Y], s=18, c=[colours[s] for s in result.states[spins].tolist()],
-               edgecolors="white", linewidths=0.6, zorder=5)
-    _markers(ax, result, summary)
-    _robot_poses(ax, result)
-    fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.06, ha="left", y=0.975)
-    fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
-    _legend(fig, result, summary, len(spins) > 0)
-    return fig
+def trajectory_figure(result: Run, summary: Summary) -> Figure:
+    result = RunView.of(result)
+    return TrajectoryPicture(result.scene, result.ticks, result.seed).finish(result, summary).fig
 
 
-def spin_starts(h: np.ndarray, states: np.ndarray) -> np.ndarray:
+class TrajectoryPicture:
+    """The trajectory in two steps: the arena and the title, known before the run (a painter draws them while
+    the robot runs: :meth:`render_arena`), then the run on top (:meth:`finish`, :meth:`png`). The pixels
+    are those of the whole figure drawn at once: everything drawn after the arena is above it (z-order),
+    clipped to the axes or outside them, where the arena's tick labels and title are not."""
+
+    def __init__(self, scene: SceneView | Scene, ticks: int, seed: int):
+        world = scene.world
+        xs, ys = zip(*world.walls, strict=True)
+        aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
+        self.fig = Figure(figsize=(11, max(4.5, 7.2 * aspect + 1.2)), dpi=DPI)
+        FigureCanvasAgg(self.fig)
+        self.ax = self.fig.add_axes((0.06, 0.08, 0.62, 0.8))
+        draw_world(self.ax, world)
+        self.title = self.fig.suptitle(title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.06, ha="left",
+                                       y=0.975)
+        self.arena: list[Any] | None = None  # the axes' artists drawn by render_arena, once it ran
+
+    def render_arena(self) -> None:
+        """Draw everything below the path (floor, tape, obstacles, walls, axes, ticks, title) into the
+        canvas now; :meth:`png` draws the rest on top."""
+        below = [a for a in self.ax.get_children() if a.get_zorder() < PATH_Z]
+        later = [a for a in self.ax.get_children() if a not in below]  # the lamps' stars: above the robot
+        for artist in later:
+            artist.set_animated(True)  # left out of this draw
+        self.fig.canvas.draw()
+        for artist in later:
+            artist.set_animated(False)
+        self.arena = below
+
+    def finish(self, result: RunView, summary: Summary) -> TrajectoryPicture:
+        """Add the run: its path coloured by state, spins, collisions, first light, lamp reached, the robot
+        at its start and end, the summary line and the legends."""
+        ax, fig = self.ax, self.fig
+        colours = state_colours(result.scene.machine.states)
+        x, y = result.column(L.X), result.column(L.Y)
+        pieces, piece_states = path_pieces(np.column_stack((x, y)).astype(np.float64), result.states, PATH_STEP_M)
+        ax.add_collection(LineCollection(pieces, colors=[colours[s] for s in piece_states], linewidths=2.2,
+                                         capstyle="round", joinstyle="round", zorder=PATH_Z))
+        # spins in place draw no line: a dot where such a state begins shows them
+        spins = spin_starts(x, y, result.column(L.TH), result.states)
+        ax.scatter(x[spins], y[spins], s=18, c=[colours[s] for s in result.states[spins].tolist()],
+                   edgecolors="white", linewidths=0.6, zorder=5)
+        _markers(ax, result, summary)
+        _robot_poses(ax, result)
+        fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
+        _legend(fig, result, summary, len(spins) > 0)
+        return self
+
+    def png(self) -> bytes:
+        """The picture as PNG: the bytes :func:`png_bytes` gives for the whole figure."""
+        if self.arena is None:
+            return png_bytes(self.fig)
+        renderer = self.fig.canvas.get_renderer()
+        # what Axes.draw and Figure.draw would draw after the arena, in their order (by z-order, stably)
+        rest = sorted((a for a in self.ax.get_children() if a not in self.arena), key=lambda a: a.get_zorder())
+        assert not rest or min(a.get_zorder() for a in rest) >= max(a.get_zorder() for a in self.arena)
+        for artist in rest:
+            artist.draw(renderer)
+        texts = [t for t in self.fig.texts if t is not self.title]  # the title was drawn with the arena
+        for artist in sorted([*texts, *self.fig.legends], key=lambda a: a.get_zorder()):
+            artist.draw(renderer)
+        return _encoded(self.fig)
+
+
+def spin_starts(x: np.ndarray, y: np.ndarray, heading: np.ndarray, states: np.ndarray) -> np.ndarray:
     """Rows where a state begins that turns the robot on the spot: its stretch of the run moves the axle
     less than SPIN_M but turns it more than SPIN_DEG (a line follower's quick state changes are no spins)."""
     change = np.flatnonzero(np.diff(states)) + 1
     starts, ends = np.concatenate(([0], change)), np.concatenate((change, [len(states)]))
-    moved = np.hypot(h[ends, L.X] - h[starts, L.X], h[ends, L.Y] - h[starts, L.Y])
-    turned = np.degrees(np.abs(h[ends, L.TH].astype(np.float64) - h[starts, L.TH]))
+    moved = np.hypot(x[ends] - x[starts], y[ends] - y[starts])
+    turned = np.degrees(np.abs(heading[ends].astype(np.float64) - heading[starts]))
     return starts[(moved < SPIN_M) & (turned > SPIN_DEG)]
 
 
-def trajectory_and_timeline(result: SimRun, summary: Summary, folder: Path) -> list[Path]:
-    """trajectory.png and timeline.png in ``folder``, drawn at once: the timeline by a forked copy of this
-    process on the other core (:mod:`tablebot.sim.forked`), the trajectory here; both files are written
-    here, in that order, each under a temporary name renamed into place."""
-    with Forked(lambda: png_bytes(timeline_figure(result, summary))) as timeline_png:
-        drawn = [trajectory(result, summary, folder / "trajectory.png")]
-        with atomic_write(folder / "timeline.png", "wb") as stream:
-            stream.write(timeline_png.result())
-    return [*drawn, folder / "timeline.png"]
+@literal_text()
+def paint(inbox: Inbox) -> bytes:
+    """The painter's work (:mod:`tablebot.sim.painter`): given the scene, the run's length and seed as the
+    run starts, it draws what they fix (the arena, the panels); given the run and its summary, it draws
+    the rest of both pictures at once (the timeline by a fork of itself on the other core:
+    :mod:`tablebot.sim.forked`) and returns their PNG bytes, pickled, trajectory first."""
+    scene, ticks, seed = inbox.get()
+    trajectory = TrajectoryPicture(scene, ticks, seed)
+    trajectory.render_arena()
+    result, summary = inbox.get()
+    with Forked(lambda _: png_bytes(timeline_figure(result, summary))) as timeline_png:
+        trajectory_png = trajectory.finish(result, summary).png()
+        return pickle.dumps((trajectory_png, timeline_png.result()), protocol=5)
 
 
 def save(fig: Figure, path: Path) -> Path:
@@ -129,6 +191,14 @@ def png_bytes(fig: Figure) -> bytes:
     """The figure as PNG, the bytes :func:`save` writes."""
     stream = io.BytesIO()
     _write_png(fig, stream)
+    return stream.getvalue()
+
+
+def _encoded(fig: Figure) -> bytes:
+    """The figure's canvas, as drawn, encoded as PNG as :func:`png_bytes` encodes it (matplotlib's print_png)."""
+    stream = io.BytesIO()
+    matplotlib.image.imsave(stream, fig.canvas.buffer_rgba(), format="png", origin="upper", dpi=fig.dpi,
+                            pil_kwargs={"compress_level": PNG_LEVEL})
     return stream.getvalue()
 
 
@@ -168,38 +238,38 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
     return np.repeat(t[edges[:-1]], 2), np.column_stack((low, high)).ravel()
 
 
-def _markers(ax, result: SimRun, summary: Summary) -> None:
-    h, scene = result.hist, result.scene
-    touched = [contact_point(scene.geometry, scene.params, float(h[row, L.X]), float(h[row, L.Y]), float(h[row, L.TH]))
-               for row in summary.collision_ticks]  # where the body touched the wall or obstacle
-    if touched:  # one artist for all of them: an hour can have hundreds
-        ax.plot(*zip(*touched, strict=True), ls="", marker="X", markersize=11, color=COLLISION,
+def _markers(ax, result: RunView, summary: Summary) -> None:
+    scene, rows = result.scene, list(summary.collision_ticks)
+    x, y, heading = result.column(L.X), result.column(L.Y), result.column(L.TH)
+    if rows:  # where the body touched the wall or obstacle; one artist for all of them: an hour has hundreds
+        poses = np.column_stack((x[rows], y[rows], heading[rows])).astype(np.float64)
+        touched = contact_points(scene.geometry, scene.params, poses)
+        ax.plot(touched[:, 0], touched[:, 1], ls="", marker="X", markersize=11, color=COLLISION,
                 markeredgecolor="white", markeredgewidth=1.2, zorder=9)
     tick = result.tick_s
     if summary.first_light_s is not None:
         row = round(summary.first_light_s / tick)
-        ax.plot(h[row, L.X], h[row, L.Y], marker="o", markersize=12, color=LIGHT_SEEN, markeredgecolor=WALL,
-                zorder=9)
+        ax.plot(x[row], y[row], marker="o", markersize=12, color=LIGHT_SEEN, markeredgecolor=WALL, zorder=9)
     if summary.reached_s is not None:
         row = round(summary.reached_s / tick)
-        ax.plot(h[row, L.X], h[row, L.Y], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
+        ax.plot(x[row], y[row], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
 
 
-def _robot_poses(ax, result: SimRun) -> None:
+def _robot_poses(ax, result: RunView) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
-    h, scene = result.hist, result.scene
+    (first, last_row), scene = result.ends, result.scene
     n_lamps, sensors = len(scene.lamp_outputs), scene.table.robot.sensors
     start = RobotArtist(ax, scene.params, n_lamps, alpha=0.35, sensors=sensors)
-    start.update(h[0, L.X], h[0, L.Y], h[0, L.TH], readings=sensor_readings(h[0], sensors))
+    start.update(first[L.X], first[L.Y], first[L.TH], readings=sensor_readings(first, sensors))
     end = RobotArtist(ax, scene.params, n_lamps, sensors=sensors)
     last = result.outputs[-1] if result.ticks else ()
-    end.update(h[-1, L.X], h[-1, L.Y], h[-1, L.TH],
-               bumpers=(h[-1, L.BUMP_FR] > 0, h[-1, L.BUMP_FL] > 0, h[-1, L.BUMP_REAR] > 0),
-               lights=(h[-1, L.LIGHT_R] >= 1, h[-1, L.LIGHT_L] >= 1),
-               lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(h[-1], sensors))
+    end.update(last_row[L.X], last_row[L.Y], last_row[L.TH],
+               bumpers=(last_row[L.BUMP_FR] > 0, last_row[L.BUMP_FL] > 0, last_row[L.BUMP_REAR] > 0),
+               lights=(last_row[L.LIGHT_R] >= 1, last_row[L.LIGHT_L] >= 1),
+               lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(last_row, sensors))
 
 
-def _legend(fig: Figure, result: SimRun, summary: Summary, spins: bool) -> None:
+def _legend(fig: Figure, result: RunView, summary: Summary, spins: bool) -> None:
     """The states the run was in (their colours and time), and the marks this picture shows."""
     machine = result.scene.machine
     colours = state_colours(machine.states)
@@ -213,7 +283,7 @@ def _legend(fig: Figure, result: SimRun, summary: Summary, spins: bool) -> None:
                frameon=False, fontsize=9)
 
 
-def legend_marks(result: SimRun, summary: Summary, spins: bool) -> list:
+def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
     """What the trajectory's marks mean: only those it shows (a collision, first light, a spin that
     happened; the world's lamps, tape and obstacles; the robot's floor sensors and beams)."""
     world, drawn = result.scene.world, [k.draw for k in declared_kinds(result)]
@@ -250,14 +320,15 @@ def legend_marks(result: SimRun, summary: Summary, spins: bool) -> list:
 
 
 @literal_text()
-def timeline(result: SimRun, summary: Summary, path: Path) -> Path:
+def timeline(result: Run, summary: Summary, path: Path) -> Path:
     """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
     light, declared light and distance sensors) against time."""
     return save(timeline_figure(result, summary), path)
 
 
 @literal_text()
-def timeline_figure(result: SimRun, summary: Summary) -> Figure:
+def timeline_figure(result: Run, summary: Summary) -> Figure:
+    result = RunView.of(result)
     t = np.arange(result.ticks) * result.tick_s
     readings = reading_panels(result)
     fig = Figure(figsize=(12, 7.2 + 1.8 * len(readings)), dpi=DPI)
@@ -309,7 +380,7 @@ def _bars(ax, starts: np.ndarray, widths: np.ndarray, bottom: float, height: flo
     ax.add_collection(PolyCollection(corners, facecolors=colour), autolim=False)
 
 
-def _state_panel(ax, result: SimRun) -> None:
+def _state_panel(ax, result: Run) -> None:
     machine = result.scene.machine
     colours = state_colours(machine.states)
     visited = sorted(set(result.states.tolist()))
@@ -328,7 +399,7 @@ def _state_panel(ax, result: SimRun) -> None:
     ax.set_ylabel("state")
 
 
-def _output_panel(ax, result: SimRun, t: np.ndarray) -> None:
+def _output_panel(ax, result: Run, t: np.ndarray) -> None:
     names = result.scene.machine.output_names
     n_motors = result.scene.machine.n_motors
     labels = result.scene.table.robot.labels
@@ -347,7 +418,7 @@ def _output_panel(ax, result: SimRun, t: np.ndarray) -> None:
     ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
 
 
-def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
+def _event_panel(ax, result: Run, t: np.ndarray) -> None:
     table = result.scene.table
     ev = result.events
     labels = table.robot.labels
@@ -365,13 +436,13 @@ def _event_panel(ax, result: SimRun, t: np.ndarray) -> None:
     ax.set_ylabel("events")
 
 
-def declared_kinds(result: SimRun) -> list[SensorKind]:
+def declared_kinds(result: Run) -> list[SensorKind]:
     """The kinds of the robot's declared sensors, each once, in the order they are registered."""
     kinds = {s.kind for s in result.scene.table.robot.sensors}
     return [kind for name, kind in SENSOR_KINDS.items() if name in kinds]
 
 
-def reading_panels(result: SimRun) -> list:
+def reading_panels(result: Run) -> list:
     """The reading panels this robot needs, in their places: light (wired phototransistors, or declared light
     sensors), then each declared kind's panel (``SensorKind.panel``). A kind without a panel (a line sensor
     reads 1 or 0) shows on the event panel."""
@@ -384,14 +455,15 @@ def reading_panels(result: SimRun) -> list:
     return [panel for _, panel in sorted(panels, key=lambda p: p[0])]
 
 
-def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> list[float]:
+def _declared(ax, result: Run, t: np.ndarray, kind: str, scale: float) -> list[float]:
     """Plot each declared sensor of ``kind`` (reading × ``scale``) with its threshold; returns the thresholds."""
-    h, levels = result.hist[:-1], []
+    levels = []
     for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
         if sensor.kind != kind:
             continue
         label = f"{sensor.name} {result.scene.table.robot.labels.get(sensor.name, '')}".strip()
-        line = ax.plot(*envelope(t, h[:, L.READING + k] * scale, LIGHT_BINS), lw=1.1, label=picture(label))[0]
+        reading = result.column(L.READING + k)[:-1] * scale
+        line = ax.plot(*envelope(t, reading, LIGHT_BINS), lw=1.1, label=picture(label))[0]
         on, off = sensor.switch_points()
         ax.axhline(on * scale, color=line.get_color(), lw=1, ls="--")
         if off != on:
@@ -402,13 +474,13 @@ def _declared(ax, result: SimRun, t: np.ndarray, kind: str, scale: float) -> lis
 
 def _panel_of(kind: SensorKind) -> Callable[..., None]:
     """The panel of one declared kind, named after it (``_distance_panel``)."""
-    def panel(ax, result: SimRun, t: np.ndarray) -> None:
+    def panel(ax, result: Run, t: np.ndarray) -> None:
         _kind_panel(ax, result, t, kind)
     panel.__name__ = f"_{kind.name}_panel"
     return panel
 
 
-def _kind_panel(ax, result: SimRun, t: np.ndarray, kind: SensorKind) -> None:
+def _kind_panel(ax, result: Run, t: np.ndarray, kind: SensorKind) -> None:
     """The declared sensors of one kind, each with its thresholds (``SensorKind.panel``)."""
     panel = kind.panel
     assert panel is not None
@@ -421,16 +493,15 @@ def _kind_panel(ax, result: SimRun, t: np.ndarray, kind: SensorKind) -> None:
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
 
-def _light_panel(ax, result: SimRun, t: np.ndarray) -> None:
+def _light_panel(ax, result: Run, t: np.ndarray) -> None:
     """The BumberBot's wired phototransistors against their threshold."""
-    h, wiring = result.hist[:-1], result.scene.params.wiring
-    ax.plot(*envelope(t, h[:, L.LIGHT_R], LIGHT_BINS), lw=1.1, color="#e67e22",
-            label=picture(f"{wiring['light_right']} right"))
-    ax.plot(*envelope(t, h[:, L.LIGHT_L], LIGHT_BINS), lw=1.1, color="#8e44ad",
-            label=picture(f"{wiring['light_left']} left"))
+    wiring = result.scene.params.wiring
+    right, left = result.column(L.LIGHT_R)[:-1], result.column(L.LIGHT_L)[:-1]
+    ax.plot(*envelope(t, right, LIGHT_BINS), lw=1.1, color="#e67e22", label=picture(f"{wiring['light_right']} right"))
+    ax.plot(*envelope(t, left, LIGHT_BINS), lw=1.1, color="#8e44ad", label=picture(f"{wiring['light_left']} left"))
     ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
     _log_scale(ax)
-    ax.set_ylim(0, max(10.0, float(h[:, [L.LIGHT_R, L.LIGHT_L]].max()) * 1.5))
+    ax.set_ylim(0, max(10.0, float(max(right.max(), left.max())) * 1.5))
     ax.set_ylabel("light\n(× threshold)")
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 
