@@ -71,17 +71,16 @@ def _sim(table: Path, world: Path | None, seconds: float, seed: int, out: Path, 
     scene = sim_scene.scene_for(parsed, machine, world, overrides)
     ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    rows = painter is not None or gif or view  # every robot row is kept only for what draws the run
     from tablebot.jit import say_compiling
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
-    if painter is not None:
-        painter.start(scene, ticks, seed)
+    # the robot rows are kept only for what draws the run: the painter needs some columns, an animation all
+    rows = painter.start(scene, ticks, seed, every_row=gif or view) if painter is not None else gif or view
     drawing = _import_drawing(gif, html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
-        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows, painter)
         drawing.join()
         if result.end.complete:
             summary = summarise(result)
@@ -100,9 +99,9 @@ def _sim(table: Path, world: Path | None, seconds: float, seed: int, out: Path, 
 class _Imports:
     """The modules of the animation and the replay page (matplotlib, PIL) imported by a thread of their own
     while the robot runs: the run's compiled loop leaves the other core (and the GIL) to them, so their half
-    second or more costs nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut an import short (a
-    compiled module interrupted mid-import surfaces as an ImportError). :meth:`join` waits for them and
-    raises what an import raised."""
+    second or more costs nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut
+    an import short (a compiled module interrupted mid-import surfaces as an ImportError). :meth:`join`
+    waits for them and raises what an import raised."""
 
     def __init__(self, modules: list[Callable[[], None]]):
         import threading
@@ -179,19 +178,22 @@ def _report(result: SimRun, summary: Summary, written: list[Path]) -> None:
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,
-              rows: bool) -> SimRun:
+              rows: bool | tuple[int, ...], painter: Painter | None) -> SimRun:
     """The run, with a progress bar of ``ticks`` on a terminal (None: quiet); history in float32 (half
-    the memory, plenty for pictures: the trace is written from the exact values)."""
+    the memory, plenty for pictures: the trace is written from the exact values), the pictured part of
+    it in memory the painter shares, which learns how far the run is as it goes."""
     import numpy as np
 
     from tablebot.sim.runner import simulate
 
+    sinks = [trace] if painter is None else [trace, painter.sink]
+    kept = {"history": np.float32, "rows": rows} | ({} if painter is None else {"zeros": painter.zeros})
     if ticks is None or not sys.stderr.isatty():
-        return simulate(scene, seconds, seed, sinks=[trace], history=np.float32, rows=rows)
+        return simulate(scene, seconds, seed, sinks=sinks, **kept)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
-        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
-                   history=np.float32, rows=rows)
+        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=sinks,
+                        **kept)

@@ -1,18 +1,23 @@
 """The run's two pictures drawn by a painter: a copy of this process forked as the command starts, which
-imports matplotlib on the other core while this one imports the simulator and runs the robot, then draws
-both pictures at once (itself one, a fork of itself the other) and hands their PNG bytes back.
+imports matplotlib on the other core while this one imports the simulator; it draws the arena as soon as
+it knows the scene, the path as the robot drives it, and the rest of both pictures when the run is over
+(itself the trajectory, a fork of itself the timeline), handing their PNG bytes back.
 
+The run's columns the pictures draw are kept in memory this process maps before the fork and shares with
+the painter (:class:`Shared`): nothing is copied to it; it is told, block by block, how far the run is.
 This module imports neither matplotlib nor the simulator, nor even numpy, so that the painter is forked
-as early as can be: what it gets is plain data (:class:`RunView`), and the drawing itself is
-:func:`tablebot.sim.plots.paint`.
+as early as can be; the drawing itself is :class:`tablebot.sim.plots.Painting`.
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import mmap
 import pickle
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from tablebot.files import atomic_write
 from tablebot.sim import columns as L
@@ -21,6 +26,7 @@ from tablebot.sim.forked import Forked, Inbox
 if TYPE_CHECKING:  # only types: see the module
     import numpy as np
 
+    from tablebot.loop import RunEnd, RunInfo, TickBlock
     from tablebot.machine import Machine
     from tablebot.sim.params import Params
     from tablebot.sim.runner import SimRun
@@ -31,6 +37,8 @@ if TYPE_CHECKING:  # only types: see the module
 
 #: The pictures' file names, in the order they are written.
 PICTURES = ("trajectory.png", "timeline.png")
+#: The run's arrays (runner.History's names) the pictures draw: kept in shared memory when they fit.
+PICTURED = ("hist", "states", "outputs", "events")
 
 
 @dataclass(frozen=True)
@@ -58,11 +66,11 @@ class SceneView:
 @dataclass(frozen=True)
 class RunView:
     """A finished run as its pictures see it: the scene's plain parts, the per-tick columns they draw, and
-    only the columns of the robot rows they draw (a tenth of an hour's rows), in the rows' precision."""
+    the columns of the robot rows they draw, in the rows' precision."""
 
     scene: SceneView
     seed: int
-    rows: np.ndarray  # (ticks + 1, len(columns)): hist[:, columns] of the run
+    rows: np.ndarray  # (ticks + 1, len(columns)): those columns of the run's hist
     columns: tuple[int, ...]  # the sim.columns held by ``rows``
     ends: np.ndarray  # (2, N_STATE): the robot before the first tick and after the last, in the rows' dtype
     states: np.ndarray
@@ -75,8 +83,9 @@ class RunView:
             return result
         assert result.hist is not None, "a run drawn keeps its robot rows (simulate with rows=True)"
         wanted = picture_columns(result.scene.table)
-        return cls(SceneView.of(result.scene), result.seed, result.hist[:, wanted], wanted,
-                   result.hist[[0, -1]], result.states, result.outputs, result.events)
+        rows = result.hist if result.hist_columns == wanted else result.hist[:, _indices(result, wanted)]
+        return cls(SceneView.of(result.scene), result.seed, rows, wanted, _ends(result), result.states,
+                   result.outputs, result.events)
 
     @property
     def ticks(self) -> int:
@@ -97,23 +106,92 @@ def picture_columns(table: Table) -> tuple[int, ...]:
     return (L.X, L.Y, L.TH, L.LIGHT_R, L.LIGHT_L, *sensors)
 
 
-class Painter:
-    """Starts the painter now (see the module); :meth:`start` tells it the run about to start, :meth:`draw`
-    hands it the finished run and writes the two pictures. Use it as a context manager: leaving the block
-    kills the painter (and its fork) if they still run. Without a second core or ``fork``, the pictures
-    are drawn here, one after the other."""
+def _indices(result: SimRun, wanted: tuple[int, ...]) -> list[int]:
+    held = result.hist_columns or tuple(range(L.N_STATE))
+    return [held.index(c) for c in wanted]
+
+
+def _ends(result: SimRun) -> np.ndarray:
+    """The first and last robot rows, whole, in the precision of the run's rows (as hist[0] and hist[-1])."""
+    assert result.hist is not None
+    return result.ends.astype(result.hist.dtype)
+
+
+class Shared:
+    """Anonymous memory mapped before the painter is forked, so that both processes see it: arrays made
+    here by this process (:meth:`zeros`) are read in place by the painter (:meth:`arrays`), which learns
+    where they are from a small message. What does not fit goes to ordinary memory."""
+
+    SIZE = 64 << 20  # an hour's pictured columns take about 25 MB; address space only, until written
+    _NORESERVE = getattr(mmap, "MAP_NORESERVE", 0x4000)  # Linux's value: no swap reserved for untouched pages
 
     def __init__(self) -> None:
-        self.copy = Forked(_paint)
+        self.memory = mmap.mmap(-1, self.SIZE, flags=mmap.MAP_SHARED | self._NORESERVE)
+        self.used = 0
+        self.made: dict[str, tuple[int, tuple[int, ...], str]] = {}  # name: offset, shape, dtype
 
-    def start(self, scene: Scene, ticks: int, seed: int) -> None:
-        """The run about to start: the painter draws what it fixes (the arena, the title) while it runs."""
-        self.copy.send((SceneView.of(scene), ticks, seed))
+    def zeros(self, name: str, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+        """A zeroed array for runner.History: shared when it is pictured and fits, else numpy's own."""
+        import numpy as np
+
+        dtype = np.dtype(dtype)
+        size = int(np.prod(shape)) * dtype.itemsize
+        at = -(-self.used // 64) * 64
+        if name not in PICTURED or name in self.made or at + size > self.SIZE:
+            return np.zeros(shape, dtype)
+        self.used = at + size
+        self.made[name] = (at, tuple(shape), dtype.str)
+        return np.ndarray(shape, dtype, buffer=self.memory, offset=at)
+
+    def arrays(self, made: dict[str, tuple[int, tuple[int, ...], str]]) -> dict[str, np.ndarray]:
+        """The arrays another process made with :meth:`zeros` (``made`` is its :attr:`made`)."""
+        import numpy as np
+
+        return {name: np.ndarray(shape, np.dtype(dtype), buffer=self.memory, offset=at)
+                for name, (at, shape, dtype) in made.items()}
+
+
+class Painter:
+    """Starts the painter now (see the module). Then: :meth:`start` tells it the run about to start; the
+    run's History keeps its columns with :meth:`zeros` and the run has :meth:`sink` among its sinks;
+    :meth:`draw` hands it the finished run and writes the two pictures. Use it as a context manager:
+    leaving the block kills the painter (and its fork) if they still run. Without a second core or
+    ``fork``, the pictures are drawn here, one after the other, when the run is over."""
+
+    def __init__(self) -> None:
+        self.shared: Shared | None = None
+        with contextlib.suppress(OSError):  # no memory to map: the painter gets the arrays when the run is over
+            self.shared = Shared()
+        self.copy = Forked(functools.partial(_paint, self.shared))
+
+    def start(self, scene: Scene, ticks: int, seed: int, every_row: bool = False) -> bool | tuple[int, ...]:
+        """The run about to start: the painter draws what it fixes (the arena, the title) while it runs.
+        Returns what of the robot rows the run's History keeps (its ``rows``): the columns the pictures
+        draw, or, with ``every_row`` (an animation will be drawn too), all of them."""
+        kept = tuple(range(L.N_STATE)) if every_row else picture_columns(scene.table)
+        self.copy.send(("start", SceneView.of(scene), ticks, seed, kept))
+        return True if every_row else kept
+
+    def zeros(self, name: str, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+        """Where runner.History keeps each array (runner.Zeros)."""
+        if self.shared is None:
+            import numpy as np
+
+            return np.zeros(shape, dtype)
+        return self.shared.zeros(name, shape, dtype)
+
+    @property
+    def sink(self) -> _Progress:
+        """A sink of the run (after its History): tells the painter how far the run is, block by block."""
+        return _Progress(self)
 
     def draw(self, result: SimRun, summary: Summary, folder: Path) -> list[Path]:
         """trajectory.png and timeline.png in ``folder``, in that order, each written under a temporary name
         and renamed into place (the painter writes no file)."""
-        self.copy.send((RunView.of(result), summary))
+        made = self.shared.made if self.shared is not None else {}
+        unshared = {name: getattr(result, name) for name in PICTURED if name not in made}
+        columns = result.hist_columns or tuple(range(L.N_STATE))
+        self.copy.send(("done", result.ticks, columns, _ends(result), summary, unshared))
         drawn = pickle.loads(self.copy.result())
         paths = [folder / name for name in PICTURES]
         for path, png in zip(paths, drawn, strict=True):
@@ -131,8 +209,39 @@ class Painter:
         self.close()
 
 
-def _paint(inbox: Inbox) -> bytes:
-    """The painter's work: matplotlib imported (and warmed up) before the run arrives."""
-    from tablebot.sim.plots import paint
+class _Progress:
+    """A sink that tells the painter where the run's shared arrays are, then how far the run is."""
 
-    return paint(inbox)
+    def __init__(self, painter: Painter):
+        self.painter = painter
+
+    def start(self, info: RunInfo) -> None:
+        shared = self.painter.shared
+        self.painter.copy.send(("arrays", dict(shared.made) if shared is not None else {}))
+
+    def block(self, block: TickBlock) -> None:
+        self.painter.copy.send(("rows", block.start + len(block)))
+
+    def end(self, end: RunEnd) -> None:
+        pass
+
+
+def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
+    """The painter's work: the messages of :class:`Painter`, in order, turned into the pictures' PNG bytes
+    (pickled, trajectory first)."""
+    from tablebot.sim.plots import Painting  # matplotlib: imported at once, while this process waits
+
+    _, scene, ticks, seed, kept = inbox.get()
+    painting = Painting(scene, ticks, seed)
+    arrays: dict[str, np.ndarray] = {}
+    while (message := inbox.get())[0] != "done":
+        if message[0] == "arrays" and shared is not None:
+            arrays = shared.arrays(message[1])
+        elif message[0] == "rows" and "hist" in arrays and "states" in arrays:  # the path so far
+            hist = arrays["hist"]
+            painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], message[1])
+    _, ticks, columns, ends, summary, unshared = message
+    arrays.update(unshared)
+    run = RunView(scene, seed, arrays["hist"][: ticks + 1], columns, ends, arrays["states"][:ticks],
+                  arrays["outputs"][:ticks], arrays["events"][:ticks])
+    return pickle.dumps(painting.finish(run, summary), protocol=5)

@@ -6,7 +6,6 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 from __future__ import annotations
 
 import io
-import pickle
 from collections.abc import Callable
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
@@ -39,7 +38,7 @@ from tablebot.sim.draw import (
     literal_text,
     sensor_readings,
 )
-from tablebot.sim.forked import Forked, Inbox
+from tablebot.sim.forked import Forked
 from tablebot.sim.painter import RunView, SceneView
 from tablebot.sim.summary import Summary
 
@@ -91,10 +90,11 @@ def trajectory_figure(result: Run, summary: Summary) -> Figure:
 
 
 class TrajectoryPicture:
-    """The trajectory in two steps: the arena and the title, known before the run (a painter draws them while
-    the robot runs: :meth:`render_arena`), then the run on top (:meth:`finish`, :meth:`png`). The pixels
-    are those of the whole figure drawn at once: everything drawn after the arena is above it (z-order),
-    clipped to the axes or outside them, where the arena's tick labels and title are not."""
+    """The trajectory in steps: the arena and the title, known before the run (a painter draws them at once:
+    :meth:`render_arena`), the path as the run goes (:meth:`grow`), then the rest of the run on top
+    (:meth:`finish`, :meth:`png`). The pixels are those of the whole figure drawn at once: each step draws
+    above the one before (z-order), and the title and tick labels lie outside the axes, where nothing later
+    draws (all of the run is clipped to the axes, the summary line and legends are outside them)."""
 
     def __init__(self, scene: SceneView | Scene, ticks: int, seed: int):
         world = scene.world
@@ -106,11 +106,13 @@ class TrajectoryPicture:
         draw_world(self.ax, world)
         self.title = self.fig.suptitle(title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.06, ha="left",
                                        y=0.975)
-        self.arena: list[Any] | None = None  # the axes' artists drawn by render_arena, once it ran
+        self.colours = state_colours(scene.machine.states)
+        self.path = PathPieces()
+        self.drawn: list[Any] | None = None  # what is in the canvas already, once render_arena ran
 
     def render_arena(self) -> None:
         """Draw everything below the path (floor, tape, obstacles, walls, axes, ticks, title) into the
-        canvas now; :meth:`png` draws the rest on top."""
+        canvas now; :meth:`grow` and :meth:`png` draw the rest on top."""
         below = [a for a in self.ax.get_children() if a.get_zorder() < PATH_Z]
         later = [a for a in self.ax.get_children() if a not in below]  # the lamps' stars: above the robot
         for artist in later:
@@ -118,17 +120,29 @@ class TrajectoryPicture:
         self.fig.canvas.draw()
         for artist in later:
             artist.set_animated(False)
-        self.arena = below
+        self.drawn = below
+
+    def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int) -> None:
+        """Draw the pieces of the path complete once robot rows 0..done and ``states[:done]`` are known."""
+        assert self.drawn is not None, "the path is drawn as it grows only over the arena (render_arena)"
+        pieces = self._add_path(*self.path.grow(x, y, states, done))
+        if pieces is not None:
+            pieces.draw(self.fig.canvas.get_renderer())
+            self.drawn.append(pieces)
+
+    def _add_path(self, pieces: list[np.ndarray], piece_states: list[int]) -> LineCollection | None:
+        if not pieces:
+            return None
+        lines = LineCollection(pieces, colors=[self.colours[s] for s in piece_states], linewidths=2.2,
+                               capstyle="round", joinstyle="round", zorder=PATH_Z)
+        return self.ax.add_collection(lines, autolim=False)  # the arena set the limits
 
     def finish(self, result: RunView, summary: Summary) -> TrajectoryPicture:
-        """Add the run: its path coloured by state, spins, collisions, first light, lamp reached, the robot
-        at its start and end, the summary line and the legends."""
-        ax, fig = self.ax, self.fig
-        colours = state_colours(result.scene.machine.states)
+        """Add the rest of the run: the path's last pieces, spins, collisions, first light, lamp reached,
+        the robot at its start and end, the summary line and the legends."""
+        ax, fig, colours = self.ax, self.fig, self.colours
         x, y = result.column(L.X), result.column(L.Y)
-        pieces, piece_states = path_pieces(np.column_stack((x, y)).astype(np.float64), result.states, PATH_STEP_M)
-        ax.add_collection(LineCollection(pieces, colors=[colours[s] for s in piece_states], linewidths=2.2,
-                                         capstyle="round", joinstyle="round", zorder=PATH_Z))
+        self._add_path(*self.path.grow(x, y, result.states, result.ticks, last=True))
         # spins in place draw no line: a dot where such a state begins shows them
         spins = spin_starts(x, y, result.column(L.TH), result.states)
         ax.scatter(x[spins], y[spins], s=18, c=[colours[s] for s in result.states[spins].tolist()],
@@ -141,18 +155,39 @@ class TrajectoryPicture:
 
     def png(self) -> bytes:
         """The picture as PNG: the bytes :func:`png_bytes` gives for the whole figure."""
-        if self.arena is None:
+        if self.drawn is None:
             return png_bytes(self.fig)
         renderer = self.fig.canvas.get_renderer()
-        # what Axes.draw and Figure.draw would draw after the arena, in their order (by z-order, stably)
-        rest = sorted((a for a in self.ax.get_children() if a not in self.arena), key=lambda a: a.get_zorder())
-        assert not rest or min(a.get_zorder() for a in rest) >= max(a.get_zorder() for a in self.arena)
+        # what Axes.draw and Figure.draw would draw after what is drawn, in their order (by z-order, stably)
+        rest = sorted((a for a in self.ax.get_children() if a not in self.drawn), key=lambda a: a.get_zorder())
+        assert not rest or min(a.get_zorder() for a in rest) >= max(a.get_zorder() for a in self.drawn)
         for artist in rest:
             artist.draw(renderer)
         texts = [t for t in self.fig.texts if t is not self.title]  # the title was drawn with the arena
         for artist in sorted([*texts, *self.fig.legends], key=lambda a: a.get_zorder()):
             artist.draw(renderer)
         return _encoded(self.fig)
+
+
+class Painting:
+    """Both pictures as the painter (:mod:`tablebot.sim.painter`) draws them: what the scene fixes at once,
+    the path as the run goes (:meth:`grow`), the rest when it is over (:meth:`finish`: the timeline by a
+    fork of this process on the other core, :mod:`tablebot.sim.forked`)."""
+
+    def __init__(self, scene: SceneView, ticks: int, seed: int):
+        with literal_text():
+            self.trajectory = TrajectoryPicture(scene, ticks, seed)
+            self.trajectory.render_arena()
+
+    def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int) -> None:
+        with literal_text():
+            self.trajectory.grow(x, y, states, done)
+
+    @literal_text()
+    def finish(self, result: RunView, summary: Summary) -> tuple[bytes, bytes]:
+        """The two pictures' PNG bytes, trajectory first."""
+        with Forked(lambda _: png_bytes(timeline_figure(result, summary))) as timeline_png:
+            return self.trajectory.finish(result, summary).png(), timeline_png.result()
 
 
 def spin_starts(x: np.ndarray, y: np.ndarray, heading: np.ndarray, states: np.ndarray) -> np.ndarray:
@@ -163,21 +198,6 @@ def spin_starts(x: np.ndarray, y: np.ndarray, heading: np.ndarray, states: np.nd
     moved = np.hypot(x[ends] - x[starts], y[ends] - y[starts])
     turned = np.degrees(np.abs(heading[ends].astype(np.float64) - heading[starts]))
     return starts[(moved < SPIN_M) & (turned > SPIN_DEG)]
-
-
-@literal_text()
-def paint(inbox: Inbox) -> bytes:
-    """The painter's work (:mod:`tablebot.sim.painter`): given the scene, the run's length and seed as the
-    run starts, it draws what they fix (the arena, the panels); given the run and its summary, it draws
-    the rest of both pictures at once (the timeline by a fork of itself on the other core:
-    :mod:`tablebot.sim.forked`) and returns their PNG bytes, pickled, trajectory first."""
-    scene, ticks, seed = inbox.get()
-    trajectory = TrajectoryPicture(scene, ticks, seed)
-    trajectory.render_arena()
-    result, summary = inbox.get()
-    with Forked(lambda _: png_bytes(timeline_figure(result, summary))) as timeline_png:
-        trajectory_png = trajectory.finish(result, summary).png()
-        return pickle.dumps((trajectory_png, timeline_png.result()), protocol=5)
 
 
 def save(fig: Figure, path: Path) -> Path:
@@ -210,22 +230,45 @@ def _write_png(fig: Figure, stream: IO[bytes]) -> None:
     fig.savefig(stream, format="png", facecolor="white", pil_kwargs={"compress_level": PNG_LEVEL})
 
 
-def path_pieces(xy: np.ndarray, states: np.ndarray, step: float) -> tuple[list[np.ndarray], list[int]]:
-    """The path cut where the state changes (segment t, from row t to t + 1, has the state after tick t),
-    each piece thinned to points about ``step`` apart along it (ends kept): what a picture can show."""
-    ticks = len(states)
-    change = np.flatnonzero(np.diff(states)) + 1
-    starts, ends = np.concatenate(([0], change)), np.concatenate((change, [ticks]))
-    travelled = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))))
-    bucket = np.floor(travelled / step)
-    keep = np.concatenate(([True], bucket[1:] != bucket[:-1]))
-    pieces, piece_states = [], []
-    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
-        inner = np.flatnonzero(keep[a + 1:b]) + a + 1
-        rows = np.concatenate(([a], inner, [b]))
-        pieces.append(xy[rows])
-        piece_states.append(int(states[a]))
-    return pieces, piece_states
+class PathPieces:
+    """The run's path cut where the state changes (segment t, from row t to t + 1, has the state after tick
+    t), each piece thinned to points about ``step`` apart along it (ends kept): what a picture can show.
+    Made as the run goes: each :meth:`grow` gives the pieces completed since the last, the same pieces
+    (to the last bit) as the whole run's rows would give at once."""
+
+    def __init__(self, step: float = PATH_STEP_M):
+        self.step = step
+        self.start = 0  # the first row of the piece not given yet
+        self.known = 0  # the rows whose thinning is known: 0..known
+        self.travelled = 0.0  # the distance along the path to row ``known``
+        self.kept: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]  # the rows a piece keeps inside it, in order
+
+    def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int,
+             last: bool = False) -> tuple[list[np.ndarray], list[int]]:
+        """The pieces complete once robot rows 0..done (``x``, ``y``) and ``states[:done]`` are known (with
+        ``last``, the run is over: ``done`` is its length, and the last piece ends there)."""
+        if done > self.known:
+            xy = np.column_stack((x[self.known:done + 1], y[self.known:done + 1])).astype(np.float64)
+            travelled = np.cumsum(np.concatenate(([self.travelled], np.hypot(*np.diff(xy, axis=0).T))))
+            bucket = np.floor(travelled / self.step)  # a row is kept where the path enters the next step
+            self.kept.append(np.flatnonzero(bucket[1:] != bucket[:-1]) + self.known + 1)
+            self.known, self.travelled = done, float(travelled[-1])
+        change = np.flatnonzero(np.diff(states[self.start:done])) + self.start + 1
+        ends = np.concatenate((change, [done])) if last else change
+        if not len(ends):
+            return [], []
+        starts = np.concatenate(([self.start], ends[:-1]))
+        self.start = int(ends[-1])
+        kept = np.concatenate(self.kept)
+        self.kept = [kept]
+        inner_from, inner_to = np.searchsorted(kept, starts, "right"), np.searchsorted(kept, ends, "left")
+        rows = [np.concatenate(([a], kept[i:j], [b]))
+                for a, b, i, j in zip(starts.tolist(), ends.tolist(), inner_from.tolist(), inner_to.tolist(),
+                                      strict=True)]
+        every = np.concatenate(rows)
+        xy = np.column_stack((x[every], y[every])).astype(np.float64)
+        pieces = np.split(xy, np.cumsum([len(r) for r in rows[:-1]]))
+        return pieces, states[starts].tolist()
 
 
 def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
