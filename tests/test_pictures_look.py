@@ -168,7 +168,7 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
         warnings.simplefilter("always")
         patch.setattr(os, "cpu_count", lambda: 1)  # no painter: both pictures drawn in this process, seen here
         patch.setattr(plots, "png_bytes", keeping(plots.png_bytes))
-        patch.setattr(plots, "_encoded", keeping(plots._encoded))
+        patch.setattr(plots, "encoded", keeping(plots.encoded))
         result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "3", "-q", "--gif",
                                           "--out", str(tmp_path / "o")])
     assert result.exit_code == 0, result.output

@@ -1,27 +1,23 @@
-"""The run's pictures: ``trajectory.png`` (the path in the arena, coloured by state) and ``timeline.png``.
+"""The run's pictures: ``trajectory.png`` (the path in the arena, coloured by state, drawn here) and
+``timeline.png`` (:mod:`tablebot.sim.timeline`), and the two drawn at once by a painter (:class:`Painting`).
 
 Figures are drawn with the Agg canvas directly, never through pyplot, so they need no display.
 """
 
 from __future__ import annotations
 
-import io
-from collections.abc import Callable
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any
 
-import matplotlib.image
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
-from tablebot.files import atomic_write
-from tablebot.sensors import SENSOR_KINDS, SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
@@ -40,41 +36,27 @@ from tablebot.sim.draw import (
 )
 from tablebot.sim.forked import Forked
 from tablebot.sim.painter import RunView, SceneView
+from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, imported from here by other modules)
+    DPI,
+    PNG_LEVEL,
+    declared_kinds,
+    encoded,
+    png_bytes,
+    save,
+    subtitle_of,
+    title,
+    title_of,
+)
 from tablebot.sim.summary import Summary
+from tablebot.sim.timeline import envelope, reading_panels, timeline, timeline_figure  # noqa: F401
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
-    from tablebot.sim.runner import SimRun
+    from tablebot.sim.picture import Run
     from tablebot.sim.scene import Scene
 
-    Run = SimRun | RunView
-
-DPI = 150
 PATH_Z = 4  # the path's z-order: everything the arena draws is below it
 PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels
 SPIN_M, SPIN_DEG = 0.01, 15.0  # a state that moves the robot less and turns it more is a spin: drawn as a dot
-LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
-
-
-def title_of(result: Run) -> str:
-    return title(result.scene, result.ticks, result.seed)
-
-
-def title(scene: SceneView | Scene, ticks: int, seed: int) -> str:
-    """The pictures' title: the robot, the world, the run's length and seed (all known before the run)."""
-    robot, world = picture(scene.table.robot.name), picture(scene.world.name)
-    return f"{robot} in {world} — {ticks * scene.tick_s:g} s, seed {seed}"
-
-
-def subtitle_of(summary: Summary) -> str:
-    def when(v: float | None) -> str:
-        return "never" if v is None else f"{v:.1f} s"
-    parts = []
-    if summary.lamps:
-        parts += [f"light first seen: {when(summary.first_light_s)}", f"lamp reached: {when(summary.reached_s)}"]
-    if summary.laps is not None:
-        parts.append(f"{summary.laps:.2f} laps of the line")
-    parts += [f"{summary.collisions} collision{'s' * (summary.collisions != 1)}", f"{summary.distance_m:.2f} m driven"]
-    return "   ·   ".join(parts)
 
 
 @literal_text()
@@ -166,7 +148,7 @@ class TrajectoryPicture:
         texts = [t for t in self.fig.texts if t is not self.title]  # the title was drawn with the arena
         for artist in sorted([*texts, *self.fig.legends], key=lambda a: a.get_zorder()):
             artist.draw(renderer)
-        return _encoded(self.fig)
+        return encoded(self.fig)
 
 
 class Painting:
@@ -198,36 +180,6 @@ def spin_starts(x: np.ndarray, y: np.ndarray, heading: np.ndarray, states: np.nd
     moved = np.hypot(x[ends] - x[starts], y[ends] - y[starts])
     turned = np.degrees(np.abs(heading[ends].astype(np.float64) - heading[starts]))
     return starts[(moved < SPIN_M) & (turned > SPIN_DEG)]
-
-
-def save(fig: Figure, path: Path) -> Path:
-    """Write the figure as PNG under a temporary name, renamed into place when complete."""
-    with atomic_write(path, "wb") as stream:
-        _write_png(fig, stream)
-    return path
-
-
-def png_bytes(fig: Figure) -> bytes:
-    """The figure as PNG, the bytes :func:`save` writes."""
-    stream = io.BytesIO()
-    _write_png(fig, stream)
-    return stream.getvalue()
-
-
-def _encoded(fig: Figure) -> bytes:
-    """The figure's canvas, as drawn, encoded as PNG as :func:`png_bytes` encodes it (matplotlib's print_png)."""
-    stream = io.BytesIO()
-    matplotlib.image.imsave(stream, fig.canvas.buffer_rgba(), format="png", origin="upper", dpi=fig.dpi,
-                            pil_kwargs={"compress_level": PNG_LEVEL})
-    return stream.getvalue()
-
-
-#: zlib's fastest level: the same pixels as Pillow's default (6) in two thirds of the time, files ~25 % larger
-PNG_LEVEL = 1
-
-
-def _write_png(fig: Figure, stream: IO[bytes]) -> None:
-    fig.savefig(stream, format="png", facecolor="white", pil_kwargs={"compress_level": PNG_LEVEL})
 
 
 class PathPieces:
@@ -269,16 +221,6 @@ class PathPieces:
         xy = np.column_stack((x[every], y[every])).astype(np.float64)
         pieces = np.split(xy, np.cumsum([len(r) for r in rows[:-1]]))
         return pieces, states[starts].tolist()
-
-
-def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
-    """A long series drawn as the low and high value of each of ``bins`` time bins (a line zigzagging
-    between them), which looks like every point plotted; short series are returned as they are."""
-    if len(y) <= 2 * bins:
-        return t, y
-    edges = np.linspace(0, len(y), bins + 1).astype(np.int64)
-    low, high = np.minimum.reduceat(y, edges[:-1]), np.maximum.reduceat(y, edges[:-1])
-    return np.repeat(t[edges[:-1]], 2), np.column_stack((low, high)).ravel()
 
 
 def _markers(ax, result: RunView, summary: Summary) -> None:
@@ -357,203 +299,3 @@ def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
     if world.boxes or world.circles:
         marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
     return marks
-
-
-# --- timeline ------------------------------------------------------------------------------------
-
-
-@literal_text()
-def timeline(result: Run, summary: Summary, path: Path) -> Path:
-    """State, motor speeds (and lamps), event bits, and the analog readings behind them (the BumberBot's
-    light, declared light and distance sensors) against time."""
-    return save(timeline_figure(result, summary), path)
-
-
-@literal_text()
-def timeline_figure(result: Run, summary: Summary) -> Figure:
-    result = RunView.of(result)
-    t = np.arange(result.ticks) * result.tick_s
-    readings = reading_panels(result)
-    fig = Figure(figsize=(12, 7.2 + 1.8 * len(readings)), dpi=DPI)
-    FigureCanvasAgg(fig)
-    ratios = [2.2, 1.6, 1.6] + [1.3] * len(readings)
-    axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios, "hspace": 0.12})
-    _state_panel(axes[0], result)
-    _output_panel(axes[1], result, t)
-    _event_panel(axes[2], result, t)
-    for ax, panel in zip(axes[3:], readings, strict=True):
-        panel(ax, result, t)
-    collisions = np.array(summary.collision_ticks) * result.tick_s
-    for ax in axes:
-        if len(collisions):  # one artist per panel for all of them
-            _vlines(ax, collisions)
-        if summary.first_light_s is not None:
-            ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
-        ax.grid(axis="x", alpha=0.3)
-    axes[-1].set_xlabel("time (s)")
-    axes[-1].set_xlim(0, max(t[-1], result.tick_s))
-    fig.suptitle(title_of(result), fontsize=15, fontweight="bold", x=0.07, ha="left", y=0.975)
-    key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
-    fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
-    fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
-    return fig
-
-
-def _vlines(ax, x: np.ndarray) -> None:
-    """Red lines across the panel at times ``x``: what ``ax.vlines(x, 0, 1, transform=<x axis>)`` draws,
-    without its data limits (a quarter second for an hour's collisions; every panel's limits are set)."""
-    segments = np.zeros((len(x), 2, 2))
-    segments[:, :, 0] = x[:, None]
-    segments[:, 1, 1] = 1.0
-    ax.add_collection(LineCollection(segments, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0,
-                                     transform=ax.get_xaxis_transform()), autolim=False)
-
-
-def _bars(ax, starts: np.ndarray, widths: np.ndarray, bottom: float, height: float, colour: str) -> None:
-    """What ``ax.broken_barh(zip(starts, widths), (bottom, height), facecolors=colour)`` draws, its
-    rectangles made by numpy instead of one by one (an hour has thousands; the panels' limits are set)."""
-    if not len(starts):
-        return
-    x0 = np.asarray(starts, dtype=np.float64)
-    x1 = x0 + np.asarray(widths, dtype=np.float64)
-    y0, y1 = bottom, bottom + height
-    corners = np.empty((len(x0), 4, 2))
-    corners[:, :, 0] = np.column_stack((x0, x0, x1, x1))
-    corners[:, :, 1] = (y0, y1, y1, y0)
-    ax.add_collection(PolyCollection(corners, facecolors=colour), autolim=False)
-
-
-def _state_panel(ax, result: Run) -> None:
-    machine = result.scene.machine
-    colours = state_colours(machine.states)
-    visited = sorted(set(result.states.tolist()))
-    rows = {s: k for k, s in enumerate(visited)}
-    change = np.flatnonzero(np.diff(result.states)) + 1
-    starts = np.concatenate(([0], change))
-    ends = np.concatenate((change, [result.ticks]))
-    tick, state = result.tick_s, result.states[starts]
-    for s in dict.fromkeys(state.tolist()):  # one artist per state (in order of first visit), not per visit
-        mine = state == s
-        _bars(ax, starts[mine] * tick, (ends[mine] - starts[mine]) * tick, rows[s] - 0.4, 0.8, colours[s])
-    ax.set_yticks(range(len(visited)))
-    ax.set_yticklabels([picture(result.scene.table.state_title(machine.states[s])) for s in visited], fontsize=8)
-    ax.set_ylim(-0.7, len(visited) - 0.3)
-    ax.invert_yaxis()
-    ax.set_ylabel("state")
-
-
-def _output_panel(ax, result: Run, t: np.ndarray) -> None:
-    names = result.scene.machine.output_names
-    n_motors = result.scene.machine.n_motors
-    labels = result.scene.table.robot.labels
-    for k, name in enumerate(names):
-        style = "-" if k < n_motors else ":"
-        label = picture(f"{name} ({labels[name]})" if labels.get(name) else name)
-        wide = k == 0  # the first drawn wide and pale, so equal speeds show both lines
-        values = result.outputs[:, k]
-        steps = np.concatenate(([0], np.flatnonzero(np.diff(values)) + 1, [len(values) - 1]))  # where it changes
-        ax.step(t[steps], values[steps], where="post", lw=3.2 if wide else 1.3, alpha=0.55 if wide else 1.0,
-                ls=style, label=label)
-    ax.axhline(0, color="#999", lw=0.6)
-    ax.set_ylim(-8.9, 8.9)
-    ax.set_yticks([-8, -4, 0, 4, 8])
-    ax.set_ylabel("motor speed\n(+ forward)")
-    ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
-
-
-def _event_panel(ax, result: Run, t: np.ndarray) -> None:
-    table = result.scene.table
-    ev = result.events
-    labels = table.robot.labels
-    tick, least = result.tick_s, result.ticks * result.tick_s / 500  # one-tick events stay visible
-    for k, name in enumerate(table.events):
-        on = np.concatenate(([False], (ev & table.bit(name)) != 0, [False])).astype(np.int8)
-        edges = np.flatnonzero(np.diff(on))
-        a, b = edges[::2], edges[1::2]
-        _bars(ax, a * tick, np.maximum((b - a) * tick, least), k - 0.38, 0.76, "#2f3640")
-    ax.set_yticks(range(len(table.events)))
-    ax.set_yticklabels([picture(f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}")
-                        for n in table.events], fontsize=8)
-    ax.set_ylim(-0.7, len(table.events) - 0.3)
-    ax.invert_yaxis()
-    ax.set_ylabel("events")
-
-
-def declared_kinds(result: Run) -> list[SensorKind]:
-    """The kinds of the robot's declared sensors, each once, in the order they are registered."""
-    kinds = {s.kind for s in result.scene.table.robot.sensors}
-    return [kind for name, kind in SENSOR_KINDS.items() if name in kinds]
-
-
-def reading_panels(result: Run) -> list:
-    """The reading panels this robot needs, in their places: light (wired phototransistors, or declared light
-    sensors), then each declared kind's panel (``SensorKind.panel``). A kind without a panel (a line sensor
-    reads 1 or 0) shows on the event panel."""
-    wiring = result.scene.params.wiring
-    builtin = bool(wiring.get("light_right") or wiring.get("light_left"))
-    panels: list[tuple[int, Any]] = [(0, _light_panel)] if builtin else []
-    for kind in declared_kinds(result):
-        if kind.panel is not None and not (builtin and kind.panel.position == 0):
-            panels.append((kind.panel.position, _panel_of(kind)))
-    return [panel for _, panel in sorted(panels, key=lambda p: p[0])]
-
-
-def _declared(ax, result: Run, t: np.ndarray, kind: str, scale: float) -> list[float]:
-    """Plot each declared sensor of ``kind`` (reading × ``scale``) with its threshold; returns the thresholds."""
-    levels = []
-    for k, sensor in enumerate(result.scene.table.robot.sensors[: L.MAX_SENSORS]):
-        if sensor.kind != kind:
-            continue
-        label = f"{sensor.name} {result.scene.table.robot.labels.get(sensor.name, '')}".strip()
-        reading = result.column(L.READING + k)[:-1] * scale
-        line = ax.plot(*envelope(t, reading, LIGHT_BINS), lw=1.1, label=picture(label))[0]
-        on, off = sensor.switch_points()
-        ax.axhline(on * scale, color=line.get_color(), lw=1, ls="--")
-        if off != on:
-            ax.axhline(off * scale, color=line.get_color(), lw=0.8, ls=":")
-        levels += [on * scale, off * scale]
-    return levels
-
-
-def _panel_of(kind: SensorKind) -> Callable[..., None]:
-    """The panel of one declared kind, named after it (``_distance_panel``)."""
-    def panel(ax, result: Run, t: np.ndarray) -> None:
-        _kind_panel(ax, result, t, kind)
-    panel.__name__ = f"_{kind.name}_panel"
-    return panel
-
-
-def _kind_panel(ax, result: Run, t: np.ndarray, kind: SensorKind) -> None:
-    """The declared sensors of one kind, each with its thresholds (``SensorKind.panel``)."""
-    panel = kind.panel
-    assert panel is not None
-    levels = _declared(ax, result, t, kind.name, panel.scale)
-    if panel.log:
-        _log_scale(ax)
-    else:
-        ax.set_ylim(0, max(levels) * 3)  # the range where the table's thresholds act, not the far wall
-    ax.set_ylabel(panel.label)
-    ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
-
-
-def _light_panel(ax, result: Run, t: np.ndarray) -> None:
-    """The BumberBot's wired phototransistors against their threshold."""
-    wiring = result.scene.params.wiring
-    right, left = result.column(L.LIGHT_R)[:-1], result.column(L.LIGHT_L)[:-1]
-    ax.plot(*envelope(t, right, LIGHT_BINS), lw=1.1, color="#e67e22", label=picture(f"{wiring['light_right']} right"))
-    ax.plot(*envelope(t, left, LIGHT_BINS), lw=1.1, color="#8e44ad", label=picture(f"{wiring['light_left']} left"))
-    ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
-    _log_scale(ax)
-    ax.set_ylim(0, max(10.0, float(max(right.max(), left.max())) * 1.5))
-    ax.set_ylabel("light\n(× threshold)")
-    ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
-
-
-def _log_scale(ax) -> None:
-    """A reading (light) on a symmetric log scale (0, then 0.1 to 100s), its ticks written as plain numbers: the
-    pictures draw text with maths parsing off (for user text), so matplotlib's 10^n labels would print
-    as raw TeX."""
-    from matplotlib.ticker import FuncFormatter
-
-    ax.set_yscale("symlog", linthresh=0.1)
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
