@@ -16,10 +16,10 @@ from tablebot.files import atomic_write
 from tablebot.sensors import SENSOR_KINDS, SensorKind
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
-    from tablebot.sim.painter import RunView, SceneView
     from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
+    from tablebot.sim.view import RunView, SceneView
 
     Run = SimRun | RunView
 

@@ -35,7 +35,6 @@ from tablebot.sim.draw import (
     sensor_readings,
 )
 from tablebot.sim.forked import Forked
-from tablebot.sim.painter import RunView, SceneView
 from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, imported from here by other modules)
     DPI,
     PNG_LEVEL,
@@ -49,6 +48,7 @@ from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, importe
 )
 from tablebot.sim.summary import Summary
 from tablebot.sim.timeline import envelope, reading_panels, timeline, timeline_figure  # noqa: F401
+from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
     from tablebot.sim.picture import Run

@@ -22,8 +22,8 @@ from tablebot.escape import picture
 from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
-from tablebot.sim.painter import RunView, SceneView
 from tablebot.sim.picture import DPI, declared_kinds, save, subtitle_of, title
+from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:
     from tablebot.sim.picture import Run
