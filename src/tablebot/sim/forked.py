@@ -44,6 +44,14 @@ class Inbox:
             return self.messages.pop(0)
         return _read_message(self.pipe)
 
+    def waiting(self) -> bool:
+        """Whether another message is already there (:meth:`get` would not wait)."""
+        if self.pipe is None:
+            return bool(self.messages)
+        import select
+
+        return bool(select.select([self.pipe], [], [], 0)[0])
+
 
 class Forked:
     """``work(inbox)`` started in a forked copy of this process; :meth:`send` hands it messages, :meth:`result`

@@ -157,8 +157,8 @@ def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
     while (message := inbox.get())[0] != "done":
         if message[0] == "arrays" and shared is not None:
             arrays = shared.arrays(message[1])
-        elif message[0] == "rows" and "hist" in arrays and "states" in arrays:  # the path so far
-            hist = arrays["hist"]
+        elif message[0] == "rows" and "hist" in arrays and "states" in arrays and not inbox.waiting():
+            hist = arrays["hist"]  # the path so far (when more news is waiting, the next draws it)
             painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], message[1])
     _, ticks, columns, ends, summary, unshared = message
     arrays.update(unshared)

@@ -5,10 +5,14 @@ and how a figure becomes PNG bytes (with the Agg canvas directly, never through 
 from __future__ import annotations
 
 import io
+import struct
+import zlib
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
+import matplotlib
 import matplotlib.image
+import numpy as np
 from matplotlib.figure import Figure
 
 from tablebot.escape import picture
@@ -72,12 +76,42 @@ def png_bytes(fig: Figure) -> bytes:
 
 
 def encoded(fig: Figure) -> bytes:
-    """The figure's canvas, as drawn so far, encoded as PNG as :func:`png_bytes` encodes it (matplotlib's
-    print_png): the bytes :func:`png_bytes` gives when the canvas holds what a whole draw would."""
-    stream = io.BytesIO()
-    matplotlib.image.imsave(stream, fig.canvas.buffer_rgba(), format="png", origin="upper", dpi=fig.dpi,
-                            pil_kwargs={"compress_level": PNG_LEVEL})
-    return stream.getvalue()
+    """The figure's canvas, as drawn so far, as PNG: the pixels :func:`png_bytes` gives when the canvas holds
+    what a whole draw would, in half the time (see :func:`png_of`)."""
+    return png_of(np.asarray(fig.canvas.buffer_rgba()), fig.dpi)
+
+
+def drawn_png(fig: Figure) -> bytes:
+    """The figure drawn and encoded as PNG: the pixels of :func:`png_bytes`, sooner (see :func:`png_of`)."""
+    fig.canvas.draw()
+    return encoded(fig)
+
+
+#: The Software note matplotlib writes into its PNGs, written into ours too.
+SOFTWARE = f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/"
+
+
+def png_of(rgba: np.ndarray, dpi: float) -> bytes:
+    """An (height, width, 4) uint8 image as PNG: each row filtered as the difference from the row above
+    (PNG's "Up"), at zlib's fastest level. Pillow's encoder, which matplotlib's savefig uses, makes the
+    same pixels, files of the same size, in twice the time (it tries the five filters on every row)."""
+    height, width, _ = rgba.shape
+    rows = np.empty((height, 1 + 4 * width), dtype=np.uint8)
+    rows[:, 0] = 2  # Up
+    flat = rgba.reshape(height, 4 * width)
+    rows[0, 1:] = flat[0]
+    np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])  # modulo 256, as PNG's filters are
+    per_metre = int(dpi / 0.0254 + 0.5)
+    return b"".join((b"\x89PNG\r\n\x1a\n",
+                     _chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)),
+                     _chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+                     _chunk(b"tEXt", b"Software\0" + SOFTWARE.encode("latin-1")),
+                     _chunk(b"IDAT", zlib.compress(rows, PNG_LEVEL)),
+                     _chunk(b"IEND", b"")))
+
+
+def _chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
 
 
 def _write_png(fig: Figure, stream: IO[bytes]) -> None:

@@ -39,6 +39,7 @@ from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, importe
     DPI,
     PNG_LEVEL,
     declared_kinds,
+    drawn_png,
     encoded,
     png_bytes,
     save,
@@ -47,7 +48,13 @@ from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, importe
     title_of,
 )
 from tablebot.sim.summary import Summary
-from tablebot.sim.timeline import envelope, reading_panels, timeline, timeline_figure  # noqa: F401
+from tablebot.sim.timeline import (  # noqa: F401 (the timeline's, imported from here by other modules)
+    TimelinePicture,
+    envelope,
+    reading_panels,
+    timeline,
+    timeline_figure,
+)
 from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
@@ -152,14 +159,16 @@ class TrajectoryPicture:
 
 
 class Painting:
-    """Both pictures as the painter (:mod:`tablebot.sim.painter`) draws them: what the scene fixes at once,
-    the path as the run goes (:meth:`grow`), the rest when it is over (:meth:`finish`: the timeline by a
-    fork of this process on the other core, :mod:`tablebot.sim.forked`)."""
+    """Both pictures as the painter (:mod:`tablebot.sim.painter`) draws them: what the scene fixes at once
+    (the arena drawn, the timeline's panels made), the path as the run goes (:meth:`grow`), the rest when
+    it is over (:meth:`finish`: the timeline by a fork of this process on the other core,
+    :mod:`tablebot.sim.forked`)."""
 
     def __init__(self, scene: SceneView, ticks: int, seed: int):
         with literal_text():
             self.trajectory = TrajectoryPicture(scene, ticks, seed)
             self.trajectory.render_arena()
+            self.timeline = TimelinePicture(scene, ticks, seed)
 
     def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int) -> None:
         with literal_text():
@@ -168,7 +177,7 @@ class Painting:
     @literal_text()
     def finish(self, result: RunView, summary: Summary) -> tuple[bytes, bytes]:
         """The two pictures' PNG bytes, trajectory first."""
-        with Forked(lambda _: png_bytes(timeline_figure(result, summary))) as timeline_png:
+        with Forked(lambda _: drawn_png(self.timeline.finish(result, summary).fig)) as timeline_png:
             return self.trajectory.finish(result, summary).png(), timeline_png.result()
 
 
