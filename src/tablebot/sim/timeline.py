@@ -7,6 +7,7 @@ limits, the title), which a painter makes while the robot runs, then the run dra
 
 from __future__ import annotations
 
+import pickle
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -22,7 +23,8 @@ from tablebot.escape import picture
 from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
-from tablebot.sim.picture import DPI, declared_kinds, save, subtitle_of, title
+from tablebot.sim.forked import Forked
+from tablebot.sim.picture import DPI, declared_kinds, deflated, drawn_png, png_of_parts, save, subtitle_of, title
 from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:
@@ -94,6 +96,46 @@ class TimelinePicture:
         self.fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
         return self
 
+    def png(self) -> bytes:
+        """The finished picture as PNG, drawn and compressed in two bands at once: the lower panels by a
+        fork of this process on the other core (:mod:`tablebot.sim.forked`), the upper ones here. The
+        band's edge runs through the blank gap between two panels, so each band's pixels are those of the
+        whole figure drawn at once; when either finds a pixel of the other's rows not blank (or the gap
+        not blank), the whole figure is drawn here instead."""
+        edge = self._edge()
+        with Forked(lambda _: pickle.dumps(self._band(edge, lower=True))) as lower:
+            upper = self._band(edge, lower=False)
+            below = pickle.loads(lower.result())
+        width, height = self.fig.canvas.get_width_height(physical=True)
+        if upper is None or below is None:
+            for artist in [*self.axes, *self.fig.texts]:
+                artist.set_visible(True)
+            return drawn_png(self.fig)
+        return png_of_parts([upper, below], width, height, self.fig.dpi)
+
+    def _edge(self) -> int:
+        """The pixel row (from the top) where the lower band begins: midway between the two middle panels."""
+        split = len(self.axes) // 2
+        above, below = self.axes[split - 1].get_position(), self.axes[split].get_position()
+        height = self.fig.bbox.height
+        return round(height - (above.y0 + below.y1) / 2 * height)
+
+    def _band(self, edge: int, lower: bool) -> tuple[bytes, int, int] | None:
+        """Draw one band's panels (the lower ones and the time axis, or the upper ones and the titles) and
+        compress its rows as a part of the PNG (:func:`~tablebot.sim.picture.deflated`); None when the
+        other band's rows, or the gap row above the edge, are not blank."""
+        split = len(self.axes) // 2
+        for artist in [*self.axes[:split], *self.fig.texts] if lower else self.axes[split:]:
+            artist.set_visible(False)
+        self.fig.canvas.draw()
+        pixels = np.asarray(self.fig.canvas.buffer_rgba())
+        others = pixels[:edge] if lower else pixels[edge - 1:]  # the gap row above the edge must be blank
+        if not (others == 255).all():
+            return None
+        if lower:
+            return deflated(pixels[edge:], pixels[edge - 1], last=True)
+        return deflated(pixels[:edge], None, last=False)
+
 
 def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
     """A long series drawn as the low and high value of each of ``bins`` time bins (a line zigzagging
@@ -106,13 +148,41 @@ def envelope(t: np.ndarray, y: np.ndarray, bins: int) -> tuple[np.ndarray, np.nd
 
 
 def _vlines(ax: Axes, x: np.ndarray) -> None:
-    """Red lines across the panel at times ``x``: what ``ax.vlines(x, 0, 1, transform=<x axis>)`` draws,
-    without its data limits (a quarter second for an hour's collisions; every panel's limits are set)."""
-    segments = np.zeros((len(x), 2, 2))
-    segments[:, :, 0] = x[:, None]
-    segments[:, 1, 1] = 1.0
-    ax.add_collection(LineCollection(segments, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0,
+    """Red lines across the panel at times ``x`` (in order): what ``ax.vlines(x, 0, 1, transform=<x axis>)``
+    draws, without its data limits (every panel's limits are set), and drawn as a few paths instead of
+    one per line (an hour has hundreds): lines far enough apart to share no pixel go in one path, broken
+    by NaN, which draws the same pixels; each line comes after every earlier line it touches."""
+    segments = np.full((len(x), 3, 2), np.nan)
+    segments[:, :2, 0] = x[:, None]
+    segments[:, 0, 1], segments[:, 1, 1] = 0.0, 1.0
+    paths = [np.concatenate(segments[layer])[:-1] for layer in _apart(ax.transData.transform(
+        np.column_stack((x, np.zeros(len(x)))))[:, 0])]
+    ax.add_collection(LineCollection(paths, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0,
                                      transform=ax.get_xaxis_transform()), autolim=False)
+
+
+APART_PX = 4.0  # a 0.8-point line at 150 dpi, snapped to the pixel grid and smoothed, covers under 3 pixels
+PATH_LINES = 300  # Agg snaps a path of straight lines to pixels only up to 1024 vertices (3 per line here)
+
+
+def _apart(pixels: np.ndarray) -> list[list[int]]:
+    """The lines at ``pixels`` (increasing) in layers: a line goes one layer above the highest layer of the
+    earlier lines less than APART_PX from it, so lines in one layer share no pixel and lines that do are
+    drawn in their order; a layer holds at most PATH_LINES lines."""
+    layers: list[list[int]] = []
+    layer_of: list[int] = []
+    near = 0  # the first earlier line that may be less than APART_PX away
+    for k, at in enumerate(pixels.tolist()):
+        while at - pixels[near] >= APART_PX:
+            near += 1
+        above = max(layer_of[near:k], default=-1) + 1
+        while above < len(layers) and len(layers[above]) >= PATH_LINES:
+            above += 1
+        if above == len(layers):
+            layers.append([])
+        layers[above].append(k)
+        layer_of.append(above)
+    return layers
 
 
 def _bars(ax: Axes, starts: np.ndarray, widths: np.ndarray, bottom: float, height: float, colour: str) -> None:
