@@ -14,7 +14,9 @@ from __future__ import annotations
 import contextlib
 import functools
 import mmap
+import os
 import pickle
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -43,10 +45,11 @@ class Shared:
     where they are from a small message. What does not fit goes to ordinary memory."""
 
     SIZE = 64 << 20  # an hour's pictured columns take about 25 MB; address space only, until written
-    _NORESERVE = getattr(mmap, "MAP_NORESERVE", 0x4000)  # Linux's value: no swap reserved for untouched pages
 
     def __init__(self) -> None:
-        self.memory = mmap.mmap(-1, self.SIZE, flags=mmap.MAP_SHARED | self._NORESERVE)
+        # no swap is reserved for the pages not written (Linux's MAP_NORESERVE, which Python does not name)
+        unreserved = getattr(mmap, "MAP_NORESERVE", 0x4000 if sys.platform.startswith("linux") else 0)
+        self.memory = mmap.mmap(-1, self.SIZE, flags=mmap.MAP_SHARED | unreserved)
         self.used = 0
         self.made: dict[str, tuple[int, tuple[int, ...], str]] = {}  # name: offset, shape, dtype
 
@@ -80,8 +83,9 @@ class Painter:
 
     def __init__(self) -> None:
         self.shared: Shared | None = None
-        with contextlib.suppress(OSError):  # no memory to map: the painter gets the arrays when the run is over
-            self.shared = Shared()
+        if hasattr(os, "fork"):  # (else the work is done here: nothing to share)
+            with contextlib.suppress(OSError, ValueError):  # no memory to map: the arrays go when the run is over
+                self.shared = Shared()
         self.copy = Forked(functools.partial(_paint, self.shared))
 
     def start(self, scene: Scene, ticks: int, seed: int, every_row: bool = False) -> bool | tuple[int, ...]:

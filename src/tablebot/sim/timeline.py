@@ -108,8 +108,6 @@ class TimelinePicture:
             below = pickle.loads(lower.result())
         width, height = self.fig.canvas.get_width_height(physical=True)
         if upper is None or below is None:
-            for artist in [*self.axes, *self.fig.texts]:
-                artist.set_visible(True)
             return drawn_png(self.fig)
         return png_of_parts([upper, below], width, height, self.fig.dpi)
 
@@ -125,9 +123,14 @@ class TimelinePicture:
         compress its rows as a part of the PNG (:func:`~tablebot.sim.picture.deflated`); None when the
         other band's rows, or the gap row above the edge, are not blank."""
         split = len(self.axes) // 2
-        for artist in [*self.axes[:split], *self.fig.texts] if lower else self.axes[split:]:
+        theirs = [*self.axes[:split], *self.fig.texts] if lower else self.axes[split:]
+        for artist in theirs:
             artist.set_visible(False)
-        self.fig.canvas.draw()
+        try:
+            self.fig.canvas.draw()
+        finally:  # (without a fork, the other band is drawn next, in this process)
+            for artist in theirs:
+                artist.set_visible(True)
         pixels = np.asarray(self.fig.canvas.buffer_rgba())
         others = pixels[:edge] if lower else pixels[edge - 1:]  # the gap row above the edge must be blank
         if not (others == 255).all():
