@@ -165,10 +165,10 @@ class Painting:
     :mod:`tablebot.sim.forked`)."""
 
     def __init__(self, scene: SceneView, ticks: int, seed: int):
-        with literal_text():
+        with literal_text():  # the timeline first: when the run ends early, its fork can start at once
+            self.timeline = TimelinePicture(scene, ticks, seed)
             self.trajectory = TrajectoryPicture(scene, ticks, seed)
             self.trajectory.render_arena()
-            self.timeline = TimelinePicture(scene, ticks, seed)
 
     def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int) -> None:
         with literal_text():

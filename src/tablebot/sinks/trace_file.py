@@ -27,11 +27,13 @@ def block_text(block: TickBlock, machine: Machine) -> str:
     return text.decode("utf-8") if isinstance(text, bytes) else text
 
 
-def block_bytes_of(block: TickBlock, machine: Machine) -> bytes | str:
+def block_bytes_of(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray] | None = None,
+                   ) -> bytes | memoryview | str:
     """:func:`block_text` as the compiled code made it (UTF-8 bytes: an hour's 59 MB need no decoding when
-    they go straight to a file), or as text when Python made it."""
+    they go straight to a file; with ``scratch``, a view of its memory, good until its next block), or as
+    text when Python made it."""
     if len(block) >= COMPILED_FROM and hasattr(block.extra, "number_columns"):
-        text = _compiled_text(block, machine)
+        text = _compiled_text(block, machine, scratch)
         if text is not None:
             return text
     return "".join(_python_lines(block, machine))
@@ -44,7 +46,8 @@ def block_lines(block: TickBlock, machine: Machine) -> list[str]:
     return [line + "\n" for line in text.split("\n")[:-1]]  # no JSON text holds a raw newline
 
 
-def _compiled_text(block: TickBlock, machine: Machine) -> bytes | None:
+def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray] | None,
+                   ) -> bytes | memoryview | None:
     from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_bytes, json_names
 
     n_out, n_count = len(machine.output_names), len(machine.table.robot.counter_names)
@@ -64,7 +67,8 @@ def _compiled_text(block: TickBlock, machine: Machine) -> bytes | None:
         kinds.append(INT if places == 0 else DECIMAL)
         columns.append(values)
         decimals.append(places)
-    return block_bytes([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states))
+    return block_bytes([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states),
+                       scratch)
 
 
 def _python_lines(block: TickBlock, machine: Machine) -> list[str]:
@@ -125,6 +129,7 @@ class TraceFile:
         self.written: Path | None = None
         self._queue: queue.Queue[TickBlock | None] | None = None
         self._failed: BaseException | None = None
+        self._scratch: dict[str, np.ndarray] = {}  # the formatting's arrays, reused block after block
 
     def start(self, info: RunInfo) -> None:
         self.machine = info.engine.machine
@@ -143,12 +148,12 @@ class TraceFile:
         self._queue.put(block)
 
     def _write(self, block: TickBlock) -> None:
-        text, stream = block_bytes_of(block, self.machine), self.file.stream
-        if isinstance(text, bytes) and _utf8_as_written(stream):  # past the text layer (flushed) as it is
+        text, stream = block_bytes_of(block, self.machine, self._scratch), self.file.stream
+        if not isinstance(text, str) and _utf8_as_written(stream):  # past the text layer (flushed) as it is
             stream.flush()  # first so that the order of the lines holds
             stream.buffer.write(text)
         else:
-            stream.write(text if isinstance(text, str) else text.decode("utf-8"))
+            stream.write(text if isinstance(text, str) else bytes(text).decode("utf-8"))
 
     def _drain(self) -> None:
         assert self._queue is not None

@@ -25,22 +25,35 @@ POW10 = np.array([10.0**d for d in range(16)])
 DIGITS = 20  # at most, for an int64 with its sign
 
 
+def _reused(scratch: dict[str, np.ndarray], name: str, size: int, dtype: type) -> np.ndarray:
+    """A flat array of at least ``size`` items kept in ``scratch`` from one block to the next (its content is
+    whatever the last block left), so that each block's few megabytes are not fresh memory to map again."""
+    array = scratch.get(name)
+    if array is None or len(array) < size:
+        array = scratch[name] = np.empty(max(size, 2 * len(array) if array is not None else 0), dtype)
+    return array
+
+
 def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
-                decimals: Sequence[int], names: Sequence[bytes]) -> bytes | None:
+                decimals: Sequence[int], names: Sequence[bytes], scratch: dict[str, np.ndarray] | None = None,
+                ) -> bytes | memoryview | None:
     """The lines of a block: field f of each line is ``pieces[f]``, then the value of ``columns[f]`` for that
     line, written as ``kinds[f]`` says (DECIMAL: rounded to ``decimals[f]`` places; STATE: ``names[value]``);
-    ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module)."""
-    n = len(columns[0]) if columns else 0
-    ints = np.zeros((n, len(kinds)), dtype=np.int64)
-    floats = np.zeros((n, len(kinds)))
+    ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module). With
+    ``scratch`` (a writer's own dict, one block at a time), its arrays are reused and the lines are a view
+    of its memory, good until its next block."""
+    own = {} if scratch is None else scratch
+    n, width = (len(columns[0]) if columns else 0), len(kinds)
+    ints = _reused(own, "ints", n * width, np.int64)[: n * width].reshape(n, width)
+    floats = _reused(own, "floats", n * width, np.float64)[: n * width].reshape(n, width)
+    decimal = np.array(kinds) == DECIMAL
     for f, (kind, column) in enumerate(zip(kinds, columns, strict=True)):
         if kind == DECIMAL:
             floats[:, f] = column
         else:
             ints[:, f] = column
-    if (ints == np.iinfo(np.int64).min).any():
+    if (ints[:, ~decimal] == np.iinfo(np.int64).min).any():
         return None
-    decimal = np.array(kinds) == DECIMAL
     if decimal.any():
         values = floats[:, decimal]
         places = np.array(decimals)[decimal]
@@ -51,10 +64,10 @@ def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
     name_bytes = np.frombuffer(b"".join(names) or b" ", dtype=np.uint8)
     name_ends = np.cumsum([len(name) for name in names]).astype(np.int64)
     widest = max((len(name) for name in names), default=0) + DIGITS + 8
-    out = np.empty(n * (len(piece_bytes) + widest * len(kinds)), dtype=np.uint8)
+    out = _reused(own, "out", n * (len(piece_bytes) + widest * width), np.uint8)
     used = _lines(out, piece_bytes, piece_ends, np.array(kinds, dtype=np.int64), ints, floats,
                   np.array(decimals, dtype=np.int64), name_bytes, name_ends)
-    return out[:used].tobytes()
+    return memoryview(out)[:used] if scratch is not None else out[:used].tobytes()
 
 
 @njit(nogil=True, refcounts=False)
