@@ -88,10 +88,10 @@ def test_a_timeline_whose_bands_cannot_part_is_drawn_whole(monkeypatch: pytest.M
     result = simulate(scene, 30.0, 1, history=np.float32)
     summary, run = summarise(result), RunView.of(result)
     with literal_text():
-        picture = TimelinePicture(run.scene, run.ticks, run.seed).finish(run, summary)
+        picture = TimelinePicture(run.scene, run.ticks, run.seed)
         middle = picture.axes[1].get_window_extent()
         monkeypatch.setattr(picture, "_edge", lambda: round(picture.fig.bbox.height - (middle.y0 + middle.y1) / 2))
-        drawn = picture.png()
+        drawn = picture.png(run, summary)
     assert np.array_equal(pixels(drawn), pixels(plots.png_bytes(plots.timeline_figure(result, summary))))
 
 

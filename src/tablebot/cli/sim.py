@@ -46,6 +46,8 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
+    import numpy  # noqa: F401 (before the fork: both processes need it, one import serves them)
+
     from tablebot.sim.painter import Painter
 
     # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core

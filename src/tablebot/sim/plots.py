@@ -177,7 +177,7 @@ class Painting:
     @literal_text()
     def finish(self, result: RunView, summary: Summary) -> tuple[bytes, bytes]:
         """The two pictures' PNG bytes, trajectory first."""
-        with Forked(lambda _: self.timeline.finish(result, summary).png()) as timeline_png:
+        with Forked(lambda _: self.timeline.png(result, summary)) as timeline_png:
             return self.trajectory.finish(result, summary).png(), timeline_png.result()
 
 

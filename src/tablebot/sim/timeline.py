@@ -8,7 +8,7 @@ limits, the title), which a painter makes while the robot runs, then the run dra
 from __future__ import annotations
 
 import pickle
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -77,38 +77,47 @@ class TimelinePicture:
         self.axes[-1].set_xlim(0, max((ticks - 1) * scene.tick_s, scene.tick_s))
         fig.suptitle(title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.07, ha="left", y=0.975)
         fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
+        self.finished: set[int] = set()  # the panels the run is drawn into
 
-    def finish(self, result: RunView, summary: Summary) -> TimelinePicture:
-        """Draw the run into the panels, mark its collisions and first light, and add the summary line."""
-        axes, t = self.axes, np.arange(result.ticks) * result.tick_s
-        _state_panel(axes[0], result)
-        _output_panel(axes[1], result, t)
-        _event_panel(axes[2], result)
-        for ax, panel in zip(axes[3:], self.readings, strict=True):
-            panel.draw(ax, result, t)
-        collisions = np.array(summary.collision_ticks) * result.tick_s
-        for ax in axes:
+    def finish(self, result: RunView, summary: Summary, panels: Sequence[int] | None = None) -> TimelinePicture:
+        """Draw the run into the panels (or only into ``panels``, by number: the summary line goes with the
+        first), marking its collisions and first light."""
+        t, collisions = np.arange(result.ticks) * result.tick_s, np.array(summary.collision_ticks) * result.tick_s
+        for k in range(len(self.axes)) if panels is None else panels:
+            if k in self.finished:
+                continue
+            ax = self.axes[k]
+            if k == 0:
+                _state_panel(ax, result)
+            elif k == 1:
+                _output_panel(ax, result, t)
+            elif k == 2:
+                _event_panel(ax, result)
+            else:
+                self.readings[k - 3].draw(ax, result, t)
             if len(collisions):  # one artist per panel for all of them
                 _vlines(ax, collisions)
             if summary.first_light_s is not None:
                 ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
-        key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
-        self.fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
+            if k == 0:
+                key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
+                self.fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
+            self.finished.add(k)
         return self
 
-    def png(self) -> bytes:
-        """The finished picture as PNG, drawn and compressed in two bands at once: the lower panels by a
-        fork of this process on the other core (:mod:`tablebot.sim.forked`), the upper ones here. The
+    def png(self, result: RunView, summary: Summary) -> bytes:
+        """The run drawn into the panels, as PNG, drawn and compressed in two bands at once: the lower panels
+        by a fork of this process on the other core (:mod:`tablebot.sim.forked`), the upper ones here. The
         band's edge runs through the blank gap between two panels, so each band's pixels are those of the
         whole figure drawn at once; when either finds a pixel of the other's rows not blank (or the gap
         not blank), the whole figure is drawn here instead."""
         edge = self._edge()
-        with Forked(lambda _: pickle.dumps(self._band(edge, lower=True))) as lower:
-            upper = self._band(edge, lower=False)
+        with Forked(lambda _: pickle.dumps(self._band(result, summary, edge, lower=True))) as lower:
+            upper = self._band(result, summary, edge, lower=False)
             below = pickle.loads(lower.result())
-        width, height = self.fig.canvas.get_width_height(physical=True)
         if upper is None or below is None:
-            return drawn_png(self.fig)
+            return drawn_png(self.finish(result, summary).fig)
+        width, height = self.fig.canvas.get_width_height(physical=True)
         return png_of_parts([upper, below], width, height, self.fig.dpi)
 
     def _edge(self) -> int:
@@ -118,11 +127,13 @@ class TimelinePicture:
         height = self.fig.bbox.height
         return round(height - (above.y0 + below.y1) / 2 * height)
 
-    def _band(self, edge: int, lower: bool) -> tuple[bytes, int, int] | None:
-        """Draw one band's panels (the lower ones and the time axis, or the upper ones and the titles) and
-        compress its rows as a part of the PNG (:func:`~tablebot.sim.picture.deflated`); None when the
-        other band's rows, or the gap row above the edge, are not blank."""
+    def _band(self, result: RunView, summary: Summary, edge: int, lower: bool) -> tuple[bytes, int, int] | None:
+        """Draw the run into one band's panels (the lower ones and the time axis, or the upper ones and the
+        titles), draw them, and compress the band's rows as a part of the PNG
+        (:func:`~tablebot.sim.picture.deflated`); None when the other band's rows, or the gap row above the
+        edge, are not blank."""
         split = len(self.axes) // 2
+        self.finish(result, summary, range(split, len(self.axes)) if lower else range(split))
         theirs = [*self.axes[:split], *self.fig.texts] if lower else self.axes[split:]
         for artist in theirs:
             artist.set_visible(False)
