@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -53,11 +54,27 @@ def sim_cmd(
     # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
     # while this process imports numba and runs the robot, and draws the pictures when the run is over
     with Painter() if plots else contextlib.nullcontext() as painter:
-        _sim(table, world, seconds, seed, out, view, gif, painter, html, charge, quiet, robot)
+        _sim(_Run(table, world, seconds, seed, out, view, gif, html, charge, quiet, robot), painter)
 
 
-def _sim(table: Path, world: Path | None, seconds: float, seed: int, out: Path, view: bool, gif: bool,
-         painter: Painter | None, html: bool, charge: float | None, quiet: bool, robot: Path | None) -> None:
+@dataclass(frozen=True)
+class _Run:
+    """The command's options but ``--plots`` (the painter, or its absence, says that)."""
+
+    table: Path
+    world: Path | None
+    seconds: float
+    seed: int
+    out: Path
+    view: bool
+    gif: bool
+    html: bool
+    charge: float | None
+    quiet: bool
+    robot: Path | None
+
+
+def _sim(run: _Run, painter: Painter | None) -> None:
     """The command, once the painter is on its way."""
     from tablebot.fileset import file_set
     from tablebot.sim import scene as sim_scene
@@ -65,35 +82,37 @@ def _sim(table: Path, world: Path | None, seconds: float, seed: int, out: Path, 
     from tablebot.sim.summary import summarise
     from tablebot.sinks.trace_file import TraceFile
 
-    if view:
+    out, seed = run.out, run.seed
+    if run.view:
         from tablebot.sim.animate import check_display
         check_display()
-    parsed, machine = load(table, robot)
-    overrides = {"battery": {"charge": charge}} if charge is not None else {}
-    scene = sim_scene.scene_for(parsed, machine, world, overrides)
-    ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
+    parsed, machine = load(run.table, run.robot)
+    overrides = {"battery": {"charge": run.charge}} if run.charge is not None else {}
+    scene = sim_scene.scene_for(parsed, machine, run.world, overrides)
+    ticks = ticks_for(scene, run.seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
     from tablebot.jit import say_compiling
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
     # the robot rows are kept only for what draws the run: the painter needs some columns, an animation all
-    rows = painter.start(scene, ticks, seed, every_row=gif or view) if painter is not None else gif or view
-    drawing = _import_drawing(gif, html)
+    every_row = run.gif or run.view
+    rows = painter.start(scene, ticks, seed, every_row=every_row) if painter is not None else every_row
+    drawing = _import_drawing(run.gif, run.html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
-        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows, painter)
+        result = _simulate(scene, run.seconds, seed, None if run.quiet else ticks, trace, rows, painter)
         drawing.join()
         if result.end.complete:
             summary = summarise(result)
-            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, painter, gif)
-            if html:
+            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, painter, run.gif)
+            if run.html:
                 written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
         _stopped(result, trace.written)
-    if not quiet:
+    if not run.quiet:
         _report(result, summary, written)
-    if view:
+    if run.view:
         from tablebot.sim.animate import show
         show(result, summary)
 
