@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Sequence
+from concurrent.futures import Executor
 
 import numpy as np
 
@@ -35,14 +36,25 @@ def _reused(scratch: dict[str, np.ndarray], name: str, size: int, dtype: type) -
 
 
 def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
-                decimals: Sequence[int], names: Sequence[bytes], scratch: dict[str, np.ndarray] | None = None,
-                ) -> bytes | memoryview | None:
+                decimals: Sequence[int], names: Sequence[bytes]) -> bytes | None:
     """The lines of a block: field f of each line is ``pieces[f]``, then the value of ``columns[f]`` for that
     line, written as ``kinds[f]`` says (DECIMAL: rounded to ``decimals[f]`` places; STATE: ``names[value]``);
-    ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module). With
-    ``scratch`` (a writer's own dict, one block at a time), its arrays are reused and the lines are a view
-    of its memory, good until its next block."""
-    own = {} if scratch is None else scratch
+    ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module)."""
+    views = block_views(pieces, kinds, columns, decimals, names, {})
+    return None if views is None else b"".join(views)
+
+
+SPLIT_FROM = 1024  # lines from which a helper thread writes the second half of a block at the same time
+
+
+def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
+                decimals: Sequence[int], names: Sequence[bytes], scratch: dict[str, np.ndarray],
+                helper: Executor | None = None) -> list[memoryview] | None:
+    """:func:`block_bytes` as views of ``scratch``'s memory (a writer's own dict of arrays, reused from one
+    block to the next: the views are good until its next block), in one piece or, with ``helper`` (a
+    thread) and a long block, two: the second half's lines written by ``helper`` meanwhile (the compiled
+    writer leaves the GIL, so the halves take the two cores)."""
+    own = scratch
     n, width = (len(columns[0]) if columns else 0), len(kinds)
     ints = _reused(own, "ints", n * width, np.int64)[: n * width].reshape(n, width)
     floats = _reused(own, "floats", n * width, np.float64)[: n * width].reshape(n, width)
@@ -64,10 +76,19 @@ def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
     name_bytes = np.frombuffer(b"".join(names) or b" ", dtype=np.uint8)
     name_ends = np.cumsum([len(name) for name in names]).astype(np.int64)
     widest = max((len(name) for name in names), default=0) + DIGITS + 8
-    out = _reused(own, "out", n * (len(piece_bytes) + widest * width), np.uint8)
-    used = _lines(out, piece_bytes, piece_ends, np.array(kinds, dtype=np.int64), ints, floats,
-                  np.array(decimals, dtype=np.int64), name_bytes, name_ends)
-    return memoryview(out)[:used] if scratch is not None else out[:used].tobytes()
+    line = len(piece_bytes) + widest * width  # the most a line can take
+    fixed = (piece_bytes, piece_ends, np.array(kinds, dtype=np.int64))
+    names_at = (np.array(decimals, dtype=np.int64), name_bytes, name_ends)
+    half = n // 2 if helper is not None and n >= SPLIT_FROM else n
+    out = _reused(own, "out", half * line, np.uint8)
+    later = None
+    if half < n:
+        second = _reused(own, "second", (n - half) * line, np.uint8)
+        later = helper.submit(_lines, second, *fixed, ints[half:], floats[half:], *names_at)  # type: ignore[union-attr]
+    views = [memoryview(out)[:_lines(out, *fixed, ints[:half], floats[:half], *names_at)]]
+    if later is not None:
+        views.append(memoryview(second)[:later.result()])
+    return views
 
 
 @njit(nogil=True, refcounts=False)
