@@ -158,12 +158,14 @@ def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
     _, scene, ticks, seed, kept = inbox.get()
     painting = Painting(scene, ticks, seed)
     arrays: dict[str, np.ndarray] = {}
+    drawn = 0  # the rows of the path drawn so far
     while (message := inbox.get())[0] != "done":
         if message[0] == "arrays" and shared is not None:
             arrays = shared.arrays(message[1])
-        elif message[0] == "rows" and "hist" in arrays and "states" in arrays and not inbox.waiting():
-            hist = arrays["hist"]  # the path so far (when more news is waiting, the next draws it)
-            painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], message[1])
+        elif message[0] == "rows" and "hist" in arrays and "states" in arrays and message[1] - drawn >= ticks // 8 \
+                and not inbox.waiting():  # the path so far, an eighth of the run at a time (more news: the next)
+            hist, drawn = arrays["hist"], message[1]
+            painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], drawn)
     _, ticks, columns, ends, summary, unshared = message
     arrays.update(unshared)
     run = RunView(scene, seed, arrays["hist"][: ticks + 1], columns, ends, arrays["states"][:ticks],
