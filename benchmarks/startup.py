@@ -11,7 +11,7 @@ Two parts, both fresh processes (``python -m tablebot``, as a user runs it):
   inside (what the command itself reports: the simulated speed, "runs in N s"), so start-up and the rest
   around the run read as the difference. Which of numba, scipy, matplotlib, pydantic each command imports.
 * **phases**: one fresh process doing a sweep's start-up step by step, each step timed: the imports (tablebot,
-  its command line, typer's pydantic, numpy, numba), planning 10,000 runs (it loads the compiled code the scene
+  its command line, numpy, numba), planning 10,000 runs (it loads the compiled code the scene
   checks use, and starts numba's runtime), and a one-robot fleet's first tick (loads the fleet kernel).
 
 CPU seconds move less than wall seconds on a shared machine (2 cores, other engineers' runs): both are
@@ -108,7 +108,6 @@ def lap(name):
     now = time.perf_counter(); print(f"{name}\t{now - t[0]:.4f}"); t[0] = now
 import tablebot; lap("import tablebot (every back-end registers)")
 import tablebot.cli; lap("import tablebot.cli (typer, rich, every command)")
-import typer._adapters; lap("typer's pydantic (imported when it parses options)")
 import numpy; lap("import numpy")
 import tablebot.jit; lap("import numba (tablebot.jit)")
 from tablebot.fleet.plan import make_plan; lap("import the fleet (plan, run, kernel modules)")

@@ -1,13 +1,14 @@
-"""The test session under pytest-xdist: numba's kernels compiled once before the workers start, each worker
+"""The test session under pytest-xdist: numba's kernels compiled once while the first tests run, each worker
 given a numba cache folder of its own seeded from that one, and the tests that measure the wall clock kept
 out of the parallel pass.
 
 Two processes compiling into one numba cache folder at once race (numba issues #4807 and #10128: a
 half-written cache file can crash the reader), and two workers compiling the same kernels would
-also spend the same half minute twice. So the main pytest process runs ``tests/warm_kernels.py``
-into the shared folder first; each worker then copies it into a folder of its own, where whatever a
-test compiles that the warm-up did not reach stays that worker's. Without ``-n`` nothing changes:
-the one process compiles on demand, as before.
+also spend the same minute twice. So the main pytest process starts ``tests/warm_kernels.py`` into the
+shared folder and, while it compiles (about a minute and a half on two cores, one of them), the workers run
+the modules that need no kernel (KERNEL_FREE, run first); a worker's first other test waits for the warm-up
+and copies the shared folder into the worker's own, where whatever a test compiles that the warm-up did not
+reach stays that worker's. Without ``-n`` nothing changes: the one process compiles on demand, as before.
 """
 
 from __future__ import annotations
@@ -17,13 +18,16 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = "TABLEBOT_TEST_NUMBA_SHARED"  # the warmed folder, handed from the main process to its workers
+WARMED = "TABLEBOT_TEST_NUMBA_WARMED"  # a file the main process writes when the warm-up has ended: "ok" or its errors
 
 #: Modules whose tests hold a controller, a link or a page to the wall clock (10 ms ticks, replies due within
 #: 50 ms, a tick that must come late or not): marked ``realtime``. `make test` runs them in a pass of their
@@ -33,7 +37,24 @@ REALTIME = {"test_txt_robot", "test_pace", "test_roboif", "test_robotx", "test_r
             "test_txt4_softxt", "test_txt4_upload", "test_rules"}
 #: Modules that drive Chromium: one browser at a time (one xdist worker), beside the other worker's tests.
 BROWSER = {"test_studio_browser", "test_studio_attacks"}
-_gone = sorted(m for m in REALTIME | BROWSER if not (ROOT / "tests" / f"{m}.py").exists())
+#: Modules that run no simulator kernel (measured: run alone on an empty numba cache, they compile nothing, or only
+#: a small function of their own in seconds: the batch engine, the trace writer, a noise filler). They run first,
+#: while the kernels compile; a module wrongly listed here is not wrong, only slow (it compiles the kernels itself),
+#: and the session's summary names it.
+KERNEL_FREE = {
+    "test_bench_engine", "test_check_cli", "test_check_findings", "test_check_scaling", "test_cli_basics",
+    "test_codegen", "test_core_bad_input", "test_counters", "test_diagram", "test_docs_paths", "test_escape",
+    "test_evolve_pyribs", "test_firmware", "test_firmware_bad_input", "test_firmware_monitor",
+    "test_fleet_generators", "test_fuzz_loaders", "test_injection", "test_properties_language",
+    "test_properties_search", "test_robopro", "test_robopro_corpus", "test_robopro_program", "test_robot_sections",
+    "test_rpp", "test_rpp_real_files", "test_run_cli", "test_safety_files", "test_safety_loaders",
+    "test_sensors_bad_input", "test_sim_normals", "test_sim_params_formulas", "test_studio_bundle",
+    "test_studio_document", "test_tablefile", "test_targets", "test_testgen", "test_timer_units", "test_trace",
+    "test_txt4_export",
+}
+#: Kernels big enough that compiling them in a kernel-free module means the module is not one (see KERNEL_FREE).
+BIG_KERNELS = ("kernel.run_ticks", "kernel.move", "kernel.sense", "kernel.run_fleet")
+_gone = sorted(m for m in REALTIME | BROWSER | KERNEL_FREE if not (ROOT / "tests" / f"{m}.py").exists())
 if _gone:  # a renamed module would silently join the parallel pass
     raise pytest.UsageError(f"tests/conftest.py names test modules that do not exist: {', '.join(_gone)}")
 
@@ -44,26 +65,68 @@ def _parallel(config: pytest.Config) -> bool:
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionstart(session: pytest.Session) -> None:
-    """In the main process of a parallel run, before xdist starts its workers: warm the shared cache."""
+    """In the main process of a parallel run, before xdist starts its workers: start warming the shared cache."""
     config = session.config
     if hasattr(config, "workerinput") or not _parallel(config):
         return
     from tablebot import jit  # sets NUMBA_CACHE_DIR (unless given): the folder every run of tablebot uses
 
     shared = jit.cache_dir()
-    started = time.monotonic()
-    env = {**os.environ, "NUMBA_CACHE_DIR": shared}
-    # Two processes, one per core, that write disjoint cache files: the fleet's loop calls the simulator's
-    # (so those two go one after the other), pyribs' archive shares nothing with them.
-    parts = [subprocess.Popen([sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names], env=env, cwd=ROOT,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-             for names in (["sim", "fleet"], ["archive"])]
-    errors = [err for proc in parts for err in [proc.communicate()[1]] if proc.returncode != 0]
-    said = f"numba kernels warmed in {shared} in {time.monotonic() - started:.0f} s"
-    if errors:  # the tests that run the kernels will fail with the real error; say it here too
-        said += ", but the warm-up failed:\n" + "\n".join(err[-3000:] for err in errors)
-    config.get_terminal_writer().line(said)  # type: ignore[attr-defined]
-    os.environ[SHARED] = shared  # the workers start after this hook, with this environment
+    marker = Path(tempfile.mkdtemp(prefix="tablebot-numba-warmed-")) / "warmed"
+    config.stash[_WARMUP] = _WarmUp(shared, marker)
+    os.environ[SHARED], os.environ[WARMED] = shared, str(marker)  # the workers start after this hook
+
+
+class _WarmUp:
+    """The kernels compiled into ``shared`` by two processes, one per core, that write disjoint cache files (the
+    fleet's loop calls the simulator's, so those two go one after the other; pyribs' archive shares nothing with
+    them); a thread writes ``marker`` when both have ended, "ok" or their errors."""
+
+    def __init__(self, shared: str, marker: Path):
+        self.shared, self.marker, self.started = shared, marker, time.monotonic()
+        self.seconds: float | None = None
+        env = {**os.environ, "NUMBA_CACHE_DIR": shared}
+        self.parts = [subprocess.Popen([sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names], env=env,
+                                       cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                      for names in (["sim", "fleet"], ["archive"])]
+        self.thread = threading.Thread(target=self._wait, name="numba warm-up", daemon=True)
+        self.thread.start()
+
+    def _wait(self) -> None:
+        errors = [err for proc in self.parts for err in [proc.communicate()[1]] if proc.returncode != 0]
+        self.seconds = time.monotonic() - self.started
+        temporary = self.marker.with_suffix(".tmp")
+        temporary.write_text("\n".join(err[-3000:] for err in errors) if errors else "ok", encoding="utf-8")
+        temporary.replace(self.marker)
+
+    def said(self) -> str:
+        self.thread.join()
+        text = self.marker.read_text(encoding="utf-8")
+        shutil.rmtree(self.marker.parent, ignore_errors=True)
+        said = f"numba kernels warmed in {self.shared} in {self.seconds:.0f} s, while the kernel-free tests ran"
+        # the tests that run the kernels fail with the real error; say it here too
+        return said if text == "ok" else f"{said}, but the warm-up failed:\n{text}"
+
+
+_WARMUP = pytest.StashKey[_WarmUp]()
+
+
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    if _WARMUP in config.stash:
+        terminalreporter.write_line(config.stash[_WARMUP].said())
+    slow = config.stash.get(_NOT_FREE, None)
+    if slow:
+        terminalreporter.write_line("KERNEL_FREE in tests/conftest.py names modules that compiled a simulator kernel "
+                                    f"before the warm-up ended (take them out): {', '.join(sorted(slow))}")
+
+
+_NOT_FREE = pytest.StashKey[set[str]]()
+
+
+def pytest_testnodedown(node: Any, error: Any) -> None:
+    """A worker's report of kernel-free modules that were not (see _Worker.check), gathered for the summary."""
+    found = getattr(node, "workeroutput", {}).get("not_kernel_free", [])
+    node.config.stash.setdefault(_NOT_FREE, set()).update(found)
 
 
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
@@ -74,6 +137,7 @@ def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool 
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    items.sort(key=lambda item: item.path.stem not in KERNEL_FREE)  # stable: each part keeps its order
     for item in items:
         module = item.path.stem
         if module in REALTIME:
@@ -89,14 +153,68 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def _own_numba_cache(config: pytest.Config) -> None:
-    """In an xdist worker: a numba cache folder of its own, a copy of the warmed one, set before any
-    tablebot module is imported (``tablebot.jit`` reads ``NUMBA_CACHE_DIR`` once, at import)."""
-    shared = os.environ.get(SHARED)
+    """In an xdist worker: a numba cache folder of its own, set before any tablebot module is imported
+    (``tablebot.jit`` reads ``NUMBA_CACHE_DIR`` once, at import), filled from the warmed one before the worker's
+    first test that is not kernel-free (:class:`_Worker`)."""
+    shared, marker = os.environ.get(SHARED), os.environ.get(WARMED)
     worker = os.environ.get("PYTEST_XDIST_WORKER")
-    if not (shared and worker):
+    if not (shared and marker and worker):
         return
     own = Path(tempfile.mkdtemp(prefix=f"tablebot-numba-{worker}-"))
-    if Path(shared).is_dir():
-        shutil.copytree(shared, own, dirs_exist_ok=True, ignore=shutil.ignore_patterns("worker-*"))
     os.environ["NUMBA_CACHE_DIR"] = str(own)
+    config.pluginmanager.register(_Worker(config, Path(shared), Path(marker), own), "tablebot-numba-worker")
     config.add_cleanup(lambda: shutil.rmtree(own, ignore_errors=True))
+
+
+class _Worker:
+    """A worker's side of the warm-up: before its first test outside KERNEL_FREE, wait for the warm-up to end
+    and copy the warmed cache into the worker's own folder; until then, note a kernel-free module that compiled
+    a simulator kernel itself (it is not kernel-free: the main process's summary names it)."""
+
+    WAIT_S = 1800  # a warm-up that never ends: the tests go on and compile what they need themselves
+
+    def __init__(self, config: pytest.Config, shared: Path, marker: Path, own: Path):
+        self.config, self.shared, self.marker, self.own = config, shared, marker, own
+        self.ready = False
+        self.not_free: set[str] = set()
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_runtest_setup(self, item: pytest.Item) -> None:
+        if self.ready or item.path.stem in KERNEL_FREE:
+            return
+        deadline = time.monotonic() + self.WAIT_S
+        while not self.marker.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        self.ready = True
+        _copy_new_files(self.shared, self.own)
+
+    def pytest_runtest_teardown(self, item: pytest.Item) -> None:
+        if not self.ready and any(next(self.own.rglob(f"{name}-*.nbi"), None) for name in BIG_KERNELS):
+            self.not_free.add(item.path.stem)
+
+    def pytest_sessionfinish(self) -> None:
+        self.config.workeroutput["not_kernel_free"] = sorted(self.not_free)  # type: ignore[attr-defined]
+
+
+def _copy_new_files(source: Path, target: Path) -> None:
+    """Each file of ``source`` that ``target`` lacks, under a temporary name renamed into place (an index after the
+    data files it names), so a test's process loading meanwhile sees a whole function or none; a function this
+    worker compiled itself keeps its own files."""
+    if not source.is_dir():
+        return
+    files = sorted((p for p in source.rglob("*") if p.is_file()
+                    and not any(part.startswith("worker-") for part in p.relative_to(source).parts)),
+                   key=lambda p: p.suffix == ".nbi")
+    for path in files:
+        destination = target / path.relative_to(source)
+        if destination.exists() or (path.suffix == ".nbc" and _indexed(destination)):
+            continue
+        destination.parent.mkdir(parents=True, exist_ok=True)
+        temporary = destination.with_name(destination.name + ".copying")
+        shutil.copyfile(path, temporary)
+        temporary.replace(destination)
+
+
+def _indexed(data_file: Path) -> bool:
+    """Whether this worker has its own index for the function a data file (NAME-LINE.pyXY.N.nbc) belongs to."""
+    return data_file.with_name(data_file.name.rsplit(".", 2)[0] + ".nbi").exists()

@@ -74,22 +74,23 @@ class Engine:
 
     The public attributes ``tick``, ``state`` (index into ``machine.states``), ``timer``, ``counters``,
     ``outputs`` (signed motor speeds, then lamp levels), ``event`` and ``row`` (of the last tick) are
-    the whole runtime state; everything starting with ``_`` is a copy of the machine kept for speed.
+    the whole runtime state. ``tick``, ``timer`` and ``counters`` are properties over the form
+    :meth:`step` keeps them in (a deadline instead of a counting timer, the lookups for the counters
+    now at 0): read and assign them as plain attributes; ``counters`` reads as a copy. Everything
+    else starting with ``_`` is the machine, precomputed for speed.
     """
 
     def __init__(self, machine: Machine):
         self.machine = machine
-        # Hot-loop constants, read once here instead of through properties on every tick.
-        self._timer_bit = machine.timer_bit
+        self._width = len(machine.table.events)
         self._counter_bits = machine.counter_bits if any(machine.counter_bits) else ()
-        self._not_input = ~machine.input_mask  # any of these bits in an int mask: not a valid input mask
         self._n_counters = len(machine.counter_bits)
-        self._hits = _transitions(machine)
+        self._lookups = _Lookups(machine)
         self.reset()
 
     def reset(self) -> None:
         m = self.machine
-        self.tick = 0
+        self._tick = 0
         self.state = m.initial_state
         self.timer = m.initial_timer
         self.counters = [0] * len(m.counter_bits)
@@ -99,43 +100,45 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] = ()) -> tuple[int, ...]:
-        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick.
+    def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] | None = None) -> tuple[int, ...]:
+        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (None or
+        () when there are none).
 
-        The rule of :func:`tablebot.tick.tick`, specialised for one tick in Python: the fired row's
-        next state, timer, outputs and counter loads are looked up whole in a table precomputed per
-        state (:func:`_transitions`), so which rows match, and in what order, is decided once, by
-        :mod:`tablebot.machine`. One function for tables with and without counters: a table without
-        them pays two falsy tests.
+        The rule of :func:`tablebot.tick.tick`, step by step, in the form that costs Python least a tick:
+
+        1. the timer is kept as ``_deadline``, the tick count at which counting it down by one a tick
+           (after the first) brings it to 0: T is present from then on, and ``timer`` is worked out when
+           read. The counters count down by their pulses in :meth:`_count_down`;
+        2. and 3. per state, a list indexed by the input mask gives the tick's event set (the mask's T
+           and Cn bits dropped, the engine's own added), the row that fires and its effect, all made
+           from :meth:`tablebot.machine.Machine.lookup` (:class:`_Lookups`): a list for a running timer
+           and one for a timer at 0, for the counters now at 0 (chosen when the counters change);
+        4. the effect sets the state, timer, outputs (merging kept ones) and counter loads.
+
+        The lookup checks the mask as well: one beyond the table's event columns falls off the end of
+        its list. Anything but a non-negative int (a bool, numpy integer, mapping, ...) goes through
+        :meth:`events_of`, which converts or refuses it. A refused tick changes nothing.
         """
-        # the common case costs one test; type(x) is a call CPython specialises (about half the time of
-        # reading x.__class__, a descriptor lookup), and bools and numpy integers go through events_of
-        if type(inputs) is not int or inputs & self._not_input:
+        if type(inputs) is not int or inputs < 0:  # type() is a call CPython specialises, x.__class__ is not
             inputs = self.events_of(inputs)
-        timer = self.timer
-        tick = self.tick
-        self.tick = tick + 1
-        if tick:
-            if timer:
-                timer -= 1
-            if pulses is not _NONE:
-                self._count_down(pulses)
-        if not timer:
-            inputs |= self._timer_bit
-        if self._counter_bits:  # () unless a counter is an event column
-            inputs |= self._counter_events()
-        self.event = inputs
-        hit = self._hits[self.state][inputs]
-        if hit is None:
-            self.row = NO_ROW
-            self.timer = timer
+        tick = self._tick + 1
+        if pulses is not None and pulses is not _NONE:  # () and None: nothing to count (one identity test each)
+            self._count_down(pulses, tick, inputs)
+        try:
+            self.event, self.row, effect = (self._running if tick < self._deadline
+                                            else self._at_zero)[self.state][inputs]
+        except IndexError:  # the state's list is not made yet, or the mask is beyond the table's events
+            self.event, self.row, effect = self._entry(tick, inputs)
+        self._tick = tick
+        if effect is None:  # no row fired: nothing else changes (the deadline already counts the timer down)
             return self.outputs
-        self.row, self.state, self.timer, outputs, keeps, loads = hit
+        self.state, timer, outputs, keeps, loads = effect
+        self._deadline = tick + timer
         if keeps:
             outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
         self.outputs = outputs
         if loads:  # () unless the row loads a counter
-            self.counters = [old if new is None else new for old, new in zip(self.counters, loads, strict=True)]
+            self.counters = [old if new is None else new for old, new in zip(self._counters, loads, strict=True)]
         return outputs
 
     def events_of(self, inputs: int | Mapping[str, int]) -> int:
@@ -150,27 +153,83 @@ class Engine:
         if isinstance(inputs, bool) or not isinstance(inputs, int | np.integer):
             raise ValueError(f"inputs must be an int mask or a mapping of input names, not {type(inputs).__name__}")
         value = int(inputs)
-        width = len(m.table.events)
+        width = self._width
         if value < 0 or value >> width:
             raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
                              f"(0..{(1 << width) - 1}); its inputs are {_bits_text(m)}")
         return value & m.input_mask
 
-    def _count_down(self, pulses: Sequence[int]) -> None:
-        if len(pulses) != self._n_counters:
+    def _entry(self, tick: int, inputs: int) -> Entry:
+        """:meth:`step`'s lookup when it raised IndexError: the state's list is made on its first tick,
+        and a mask beyond the table's events is refused here, before anything has changed."""
+        present = self._zero_counters if tick < self._deadline else self._zero_counters | self.machine.timer_bit
+        try:
+            return self._lookups.made(present, self.state)[inputs]
+        except IndexError:
+            self.events_of(inputs)  # raises for a mask beyond the table's events
+            raise  # a state out of range: not the input's fault
+
+    def _count_down(self, pulses: Sequence[int], tick: int, inputs: int) -> None:
+        """Each counter down by its pulses, from the second tick on; the mask and the pulses are checked
+        first, so a refused tick changes nothing."""
+        if tick == 1:
+            return
+        if inputs >> self._width:
+            self.events_of(inputs)  # raises
+        counters = self._counters
+        if len(pulses) != len(counters):
             if not len(pulses):
                 return
-            raise ValueError(f"pulses: {len(pulses)} values for {self._n_counters} counters "
+            raise ValueError(f"pulses: {len(pulses)} values for {len(counters)} counters "
                              f"({', '.join(self.machine.table.robot.counter_names) or 'none'})")
-        counters = self.counters
+        if min(pulses, default=0) < 0:
+            i = next(i for i, count in enumerate(pulses) if count < 0)
+            raise ValueError(f"pulses: {pulses[i]} for counter {i + 1} is negative")
+        reached_zero = False
         for i, count in enumerate(pulses):
-            if count < 0:
-                raise ValueError(f"pulses: {count} for counter {i + 1} is negative")
-            counters[i] = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
+            if count and counters[i]:
+                counters[i] = left = max(0, counters[i] - int(count))  # int: numpy counts would leak into JSON
+                reached_zero = reached_zero or not left
+        if reached_zero:  # a Cn event appears: other lookups (counting down never takes one away)
+            self._choose_lookups()
 
-    def _counter_events(self) -> int:
-        """Cn bits of the counters at zero (0 when no counter is an event column)."""
-        return sum(b for b, c in zip(self._counter_bits, self.counters, strict=True) if c == 0)
+    # --- the state step keeps in its own form --------------------------------------------------
+
+    @property
+    def tick(self) -> int:
+        return self._tick
+
+    @tick.setter
+    def tick(self, value: int) -> None:
+        timer = self.timer
+        self._tick = value
+        self.timer = timer
+
+    @property
+    def timer(self) -> int:
+        # the deadline counts from tick 1: the first tick does not count the timer down
+        return max(0, self._deadline - max(self._tick, 1))
+
+    @timer.setter
+    def timer(self, value: int) -> None:
+        self._deadline = max(self._tick, 1) + value
+
+    @property
+    def counters(self) -> list[int]:
+        return list(self._counters)
+
+    @counters.setter
+    def counters(self, values: Sequence[int]) -> None:
+        self._counters = list(values)
+        self._choose_lookups()
+
+    def _choose_lookups(self) -> None:
+        """The lookups for the Cn bits of the counters at 0; called whenever a counter may have reached
+        or left 0, so that a tick needs no counter test."""
+        zero = sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0) \
+            if self._counter_bits else 0  # () when no counter is an event column
+        self._zero_counters = zero
+        self._running, self._at_zero = self._lookups[zero], self._lookups[zero | self.machine.timer_bit]
 
     # --- the batch path ------------------------------------------------------------------------
 
@@ -228,7 +287,7 @@ class Engine:
         step = self.step
         per_tick = self._pulse_array(pulses, len(masks)).tolist() if pulses is not None else None
         for i, mask in enumerate(masks):
-            step(mask, per_tick[i] if per_tick is not None else _NONE)
+            step(mask, None if per_tick is None else per_tick[i])
             for column, value in zip(columns, (self.event, self.row, self.state, self.timer), strict=True):
                 column.append(value)
         return Batch(*columns)
@@ -271,40 +330,76 @@ class Engine:
         self.counters, self.outputs = counter_values, output_values
 
 
-_NONE: tuple[int, ...] = ()  # step's default pulses: "no counters to count down" in one identity test
+_NONE: tuple[int, ...] = ()  # pulses that count nothing (callers pass it for counterless robots)
 
-#: What fires: (row index, next state, timer, outputs (None = keep), keeps any, counter loads or ()).
-Hit = tuple[int, int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
-
-
-def _hit(row: CompiledRow) -> Hit:
-    return row.index, row.next, row.timer, row.outputs, row.keeps, row.loads if any(
-        v is not None for v in row.loads) else ()
+#: What a fired row does: (next state, timer, outputs (None = keep), keeps any, counter loads or ()).
+Effect = tuple[int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
+#: A tick's outcome for one input mask: (event set, fired row or -1, the row's effect or None).
+Entry = tuple[int, int, Effect | None]
 
 
-def _transitions(machine: Machine) -> list[Any]:
-    """Per state, the hit for every full event mask: a list (tables up to FLAT_BITS events) or a
-    dict that fills itself from the state's first-match lookup (wider tables)."""
-    hits = [_hit(row) for row in machine.rows]
-    width = len(machine.table.events)
-    if machine.flat is not None:
-        flat, size = machine.flat, 1 << width
-        return [[None if (i := flat[s * size + e]) == NO_ROW else hits[i] for e in range(size)]
-                for s in range(len(machine.states))]
-    return [_WideHits(machine, s, hits) for s in range(len(machine.states))]
+def _effect(row: CompiledRow) -> Effect:
+    return row.next, row.timer, row.outputs, row.keeps, row.loads if any(v is not None for v in row.loads) else ()
 
 
-class _WideHits(dict[int, Any]):
-    """One state of a wide table: full event mask -> hit, computed on first use and cached."""
+class _Lookups(dict[int, list[Any]]):
+    """The engine's own events present (bits of T and of the counters at 0) -> per state, the lookup
+    input mask -> :data:`Entry`.
 
-    def __init__(self, machine: Machine, state: int, hits: list[Hit]):
+    A state's lookup is a list over every mask of the table's event columns (tables up to FLAT_BITS
+    events), empty until :meth:`made` on the first tick that needs it, or a dict that fills itself from
+    :meth:`Machine.lookup` (wider tables); either raises IndexError for a mask beyond the event
+    columns. A mask's T and Cn bits are ignored, as :meth:`Engine.events_of` ignores them: the engine
+    makes those events.
+    """
+
+    def __init__(self, machine: Machine):
         super().__init__()
-        self.machine, self.state, self.hits = machine, state, hits
+        self.machine = machine
+        self.effects = [_effect(row) for row in machine.rows]
+        self.idle: dict[int, Entry] = {}  # the entry of an event set that fires no row, shared by all states
 
-    def __missing__(self, events: int) -> Hit | None:
-        index = self.machine.lookup(self.state, events)
-        self[events] = hit = None if index == NO_ROW else self.hits[index]
-        return hit
+    def __missing__(self, present: int) -> list[Any]:
+        m = self.machine
+        self[present] = lookups = [[] if m.flat is not None else _WideEntries(self, state, present)
+                                   for state in range(len(m.states))]
+        return lookups
+
+    def made(self, present: int, state: int) -> list[Entry] | _WideEntries:
+        """The lookup of ``state`` when ``present`` are in the event set, its list made if still empty."""
+        lookup = self[present][state]
+        if isinstance(lookup, list) and not lookup:
+            m = self.machine
+            width = len(m.table.events)
+            keep, flat, base = m.input_mask, m.flat, state << width
+            entries: dict[int, Entry] = {}  # masks that differ only in T or Cn bits share an entry
+            for mask in range(1 << width):
+                events = mask & keep | present
+                if (entry := entries.get(events)) is None:
+                    entry = entries[events] = self.entry(events, flat[base + events])  # type: ignore[index]
+                lookup.append(entry)
+        return lookup
+
+    def entry(self, events: int, row: int) -> Entry:
+        if row == NO_ROW:
+            return self.idle.setdefault(events, (events, NO_ROW, None))
+        return events, row, self.effects[row]
+
+
+class _WideEntries(dict[int, Entry]):
+    """One state's lookup in a table wider than FLAT_BITS events: input mask -> entry, made on first use."""
+
+    def __init__(self, lookups: _Lookups, state: int, present: int):
+        super().__init__()
+        self.lookups, self.state, self.present = lookups, state, present
+
+    def __missing__(self, mask: int) -> Entry:
+        m = self.lookups.machine
+        if mask >> len(m.table.events):
+            raise IndexError(mask)  # as the list of a narrower table would
+        events = mask & m.input_mask | self.present
+        self[mask] = entry = self.lookups.entry(events, m.lookup(self.state, events))
+        return entry
 
 
 def _mask_of_names(machine: Machine, inputs: Mapping[str, int]) -> int:

@@ -1,6 +1,6 @@
 """A wrong option or argument answered as every other tablebot error: ``--from: error: 'nothing' is not
-one of the choices`` with a hint naming them, not in the option parser's words (typer's and pydantic's
-"Value error, ... is not one of", "Input should be a valid number")."""
+one of the choices`` with a hint naming them, not in the option parser's words (click's "'x' is not a valid
+float range", "Invalid value for '--seconds'")."""
 
 from __future__ import annotations
 
@@ -17,6 +17,8 @@ from typer._click.exceptions import (
     NoSuchOption,
     UsageError,
 )
+from typer._click.types import FloatParamType, IntParamType
+from typer._types import TyperChoice
 from typer.core import TyperGroup
 
 from tablebot.diagnostics import Diagnostic
@@ -84,11 +86,11 @@ def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
         return Diagnostic(name, None, None, f"{shown} is not a number",
                           "give a whole number" if number is int else "give a number, such as 2 or 0.5")
     if number:
-        low, high = getattr(param, "min", None), getattr(param, "max", None)
+        low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
         limits = f"from {low} to {high}" if low is not None and high is not None else \
             f"of at least {low}" if low is not None else f"of at most {high}"
         return Diagnostic(name, None, None, f"{name} {value} is out of range", f"give {name} a value {limits}")
-    message = exc.message.removeprefix("Value error, ")
+    message = exc.message
     return Diagnostic(name, None, None, f"{shown}: {message}", f"{command} says what {name} takes")
 
 
@@ -102,14 +104,15 @@ def _name(param: Any) -> str:
 
 
 def _choices(param: Any) -> list[str]:
-    descriptor = getattr(param, "type_descriptor", None)
-    found = getattr(descriptor, "choices", None) or ()
+    kind = getattr(param, "type", None)
+    found = kind.choices if isinstance(kind, TyperChoice) else ()
     return [str(c.value) if isinstance(c, Enum) else str(c) for c in found]
 
 
 def _number_kind(param: Any) -> type | None:
-    annotation = getattr(getattr(param, "type_descriptor", None), "annotation", None)
-    return annotation if annotation in (int, float) else None
+    """int or float for an option click parses as a number (a range is a subclass), else None."""
+    kind = getattr(param, "type", None)
+    return int if isinstance(kind, IntParamType) else float if isinstance(kind, FloatParamType) else None
 
 
 def _parses(text: str, kind: type) -> bool:
