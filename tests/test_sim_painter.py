@@ -227,3 +227,24 @@ def test_without_a_second_core_the_command_draws_its_pictures_itself(tmp_path: P
     trajectory, timeline = whole_figures(tmp_path / "bot", 60)
     assert np.array_equal(pixels(tmp_path / "out" / "trajectory.png"), trajectory)
     assert np.array_equal(pixels(tmp_path / "out" / "timeline.png"), timeline)
+
+
+@pytest.mark.parametrize("case", ["no shared memory", "every row kept (an animation too)"])
+def test_the_pictures_are_the_same_whatever_the_painter_is_handed(tmp_path: Path, case: str,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without memory to share, the arrays go to the painter when the run is over; with --gif the run keeps
+    every column of every robot row, and the painter draws from those."""
+    from tablebot.sim import painter
+
+    def refuse(self: painter.Shared) -> None:
+        raise OSError("no memory to map")
+
+    args = ["--gif"] if case.startswith("every") else []
+    if case == "no shared memory":
+        monkeypatch.setattr(painter.Shared, "__init__", refuse)
+    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "40", "-q", "--out", str(tmp_path / "out"),
+                                      *args])
+    assert result.exit_code == 0, result.output
+    trajectory, timeline = whole_figures(BUMBERBOT, 40)
+    assert np.array_equal(pixels(tmp_path / "out" / "trajectory.png"), trajectory)
+    assert np.array_equal(pixels(tmp_path / "out" / "timeline.png"), timeline)
