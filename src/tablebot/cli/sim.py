@@ -49,12 +49,16 @@ def sim_cmd(
     """
     import numpy  # noqa: F401 (before the fork: both processes need it, one import serves them)
 
-    from tablebot.sim.painter import Painter
-
     # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
     # while this process imports numba and runs the robot, and draws the pictures when the run is over
-    with Painter() if plots else contextlib.nullcontext() as painter:
+    with _painter() if plots else contextlib.nullcontext() as painter:
         _sim(_Run(table, world, seconds, seed, out, view, gif, html, charge, quiet, robot), painter)
+
+
+def _painter() -> Painter:
+    from tablebot.sim.painter import Painter
+
+    return Painter()
 
 
 @dataclass(frozen=True)
