@@ -35,11 +35,9 @@ from tablebot.sim.draw import (
     sensor_readings,
 )
 from tablebot.sim.forked import Forked
-from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, imported from here by other modules)
+from tablebot.sim.picture import (  # noqa: F401 (title_of: other modules import it from here)
     DPI,
-    PNG_LEVEL,
     declared_kinds,
-    drawn_png,
     encoded,
     png_bytes,
     save,
@@ -48,9 +46,8 @@ from tablebot.sim.picture import (  # noqa: F401 (the pictures' helpers, importe
     title_of,
 )
 from tablebot.sim.summary import Summary
-from tablebot.sim.timeline import (  # noqa: F401 (the timeline's, imported from here by other modules)
+from tablebot.sim.timeline import (  # noqa: F401 (the timeline's public functions, imported from here too)
     TimelinePicture,
-    envelope,
     reading_panels,
     timeline,
     timeline_figure,
