@@ -4,6 +4,7 @@ path shows above the tape, diagrams are sharp, and user text is drawn printable 
 
 from __future__ import annotations
 
+import os
 import shutil
 import warnings
 from pathlib import Path
@@ -157,13 +158,17 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
     text = robot.read_text().replace('name = "BumberBot"', 'name = "Bot\\nFAKE \\u0007\\u001b[31m $x^2$"')
     robot.write_text(text.replace('1 = "Seek: drive straight"', '1 = "drive\\r\\u0000"'))
     figures = []
-    save = plots.save
-    def keep(fig, path):
-        figures.append(fig)
-        return save(fig, path)
+
+    def keeping(encode):
+        def keep(fig):
+            figures.append(fig)
+            return encode(fig)
+        return keep
     with warnings.catch_warnings(record=True) as caught, pytest.MonkeyPatch.context() as patch:
         warnings.simplefilter("always")
-        patch.setattr(plots, "save", keep)
+        patch.setattr(os, "cpu_count", lambda: 1)  # no painter: both pictures drawn in this process, seen here
+        patch.setattr(plots, "png_bytes", keeping(plots.png_bytes))
+        patch.setattr(plots, "encoded", keeping(plots.encoded))
         result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "3", "-q", "--gif",
                                           "--out", str(tmp_path / "o")])
     assert result.exit_code == 0, result.output

@@ -4,12 +4,14 @@ errors, and no process left behind on any way out, the sim command's interrupts 
 from __future__ import annotations
 
 import os
+import pickle
 import shutil
 import signal
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -42,14 +44,14 @@ def copies() -> list[int]:
 
 def test_the_answer_comes_from_another_process():
     me = os.getpid()
-    with Forked(lambda: str(os.getpid()).encode()) as copy:
+    with Forked(lambda _: str(os.getpid()).encode()) as copy:
         assert copy.pid is not None
         assert int(copy.result()) not in (me, 0)
     assert copies() == []
 
 
 def test_an_error_in_the_copy_is_raised_here():
-    def work() -> bytes:
+    def work(_: forked.Inbox) -> bytes:
         raise ValueError("no picture today")
     with Forked(work) as copy, pytest.raises(ValueError, match="no picture today"):
         copy.result()
@@ -58,7 +60,7 @@ def test_an_error_in_the_copy_is_raised_here():
 
 def test_leaving_without_the_answer_kills_the_copy_at_once():
     started = time.monotonic()
-    with pytest.raises(KeyboardInterrupt), Forked(lambda: time.sleep(60) or b"late") as copy:
+    with pytest.raises(KeyboardInterrupt), Forked(lambda _: time.sleep(60) or b"late") as copy:
         while copies() != [copy.pid]:  # the copy names itself just after the fork
             assert time.monotonic() - started < 10
             time.sleep(0.01)
@@ -68,15 +70,56 @@ def test_leaving_without_the_answer_kills_the_copy_at_once():
 
 def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here():
     me = os.getpid()
-    with Forked(lambda: b"here" if os.getpid() == me else time.sleep(60) or b"there") as copy:
+    with Forked(lambda _: b"here" if os.getpid() == me else time.sleep(60) or b"there") as copy:
         os.kill(copy.pid, signal.SIGKILL)
         assert copy.result() == b"here"
     assert copies() == []
 
 
+def test_messages_reach_the_copy_in_order_with_their_arrays():
+    rows = np.arange(300_000, dtype=np.float32).reshape(-1, 3)  # larger than the pipe: written as it is read
+
+    def work(inbox: forked.Inbox) -> bytes:
+        first, second = inbox.get(), inbox.get()
+        return pickle.dumps((os.getpid(), first, float(second["rows"].sum()), second["rows"].dtype.str))
+
+    with Forked(work) as copy:
+        copy.send("the scene")
+        copy.send({"rows": rows})
+        pid, first, total, dtype = pickle.loads(copy.result())
+    assert pid != os.getpid() and (first, total, dtype) == ("the scene", float(rows.sum()), rows.dtype.str)
+    assert copies() == []
+
+
+def test_a_copy_that_died_gets_its_messages_here():
+    me = os.getpid()
+
+    def work(inbox: forked.Inbox) -> bytes:
+        if os.getpid() != me:
+            os._exit(3)  # dies before reading anything
+        return inbox.get() + inbox.get()
+
+    with Forked(work) as copy:
+        deadline = time.monotonic() + 30
+        while Path(f"/proc/{copy.pid}/stat").read_text().split(")")[-1].split()[0] != "Z":  # dead, not reaped
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        copy.send(b"big " * 400_000)  # more than the pipe holds: the dead reader is noticed
+        copy.send(b"end")
+        assert copy.result() == b"big " * 400_000 + b"end"
+
+
+def test_a_copy_waiting_for_a_message_never_sent_leaves_quietly():
+    with Forked(lambda inbox: inbox.get()) as copy:
+        pid = copy.pid
+        with pytest.raises(RuntimeError, match="never sent"):
+            copy.result()  # the copy read the end of its messages and left: the work ran here, and asked again
+    assert copies() == [] and pid is not None
+
+
 def test_without_a_copy_the_work_runs_here(monkeypatch):
     monkeypatch.setattr(os, "cpu_count", lambda: 1)
-    with Forked(lambda: str(os.getpid()).encode()) as copy:
+    with Forked(lambda _: str(os.getpid()).encode()) as copy:
         assert copy.pid is None and int(copy.result()) == os.getpid()
 
 

@@ -61,7 +61,7 @@ def test_the_robot_shows_its_own_sensors_and_not_the_bumberbots(tmp_path: Path) 
     result = simulate(scene, 1.0)
     labels = [h.get_label() for h in legend_marks(result, summarise(result), spins=False)]
     assert "distance beam, out to the echo" in labels and "light first seen" not in labels
-    assert [p.__name__ for p in reading_panels(simulate(scene, 1.0))] == ["_distance_panel"]
+    assert [p.name for p in reading_panels(simulate(scene, 1.0))] == ["distance"]
 
 
 def test_names_with_dollar_signs_are_drawn_as_written(tmp_path: Path) -> None:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,6 +16,7 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
+    from tablebot.sim.painter import Painter
     from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
@@ -44,50 +47,86 @@ def sim_cmd(
     The trace is written while the robot runs; every file appears only when complete. Ctrl-C stops
     the run, keeps what ran as trace.partial.jsonl and leaves the previous run's files as they were.
     """
+    import numpy  # noqa: F401 (before the fork: both processes need it, one import serves them)
+
+    # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
+    # while this process imports numba and runs the robot, and draws the pictures when the run is over
+    with _painter() if plots else contextlib.nullcontext() as painter:
+        _sim(_Run(table, world, seconds, seed, out, view, gif, html, charge, quiet, robot), painter)
+
+
+def _painter() -> Painter:
+    from tablebot.sim.painter import Painter
+
+    return Painter()
+
+
+@dataclass(frozen=True)
+class _Run:
+    """The command's options but ``--plots`` (the painter, or its absence, says that)."""
+
+    table: Path
+    world: Path | None
+    seconds: float
+    seed: int
+    out: Path
+    view: bool
+    gif: bool
+    html: bool
+    charge: float | None
+    quiet: bool
+    robot: Path | None
+
+
+def _sim(run: _Run, painter: Painter | None) -> None:
+    """The command, once the painter is on its way."""
     from tablebot.fileset import file_set
     from tablebot.sim import scene as sim_scene
     from tablebot.sim.runner import ticks_for
     from tablebot.sim.summary import summarise
     from tablebot.sinks.trace_file import TraceFile
 
-    if view:
+    out, seed = run.out, run.seed
+    if run.view:
         from tablebot.sim.animate import check_display
         check_display()
-    parsed, machine = load(table, robot)
-    overrides = {"battery": {"charge": charge}} if charge is not None else {}
-    scene = sim_scene.scene_for(parsed, machine, world, overrides)
-    ticks = ticks_for(scene, seconds)  # refuses too long a run before anything is written
+    parsed, machine = load(run.table, run.robot)
+    overrides = {"battery": {"charge": run.charge}} if run.charge is not None else {}
+    scene = sim_scene.scene_for(parsed, machine, run.world, overrides)
+    ticks = ticks_for(scene, run.seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    rows = plots or gif or view  # every robot row is kept only for what draws the run
     from tablebot.jit import say_compiling
     from tablebot.sim.kernel import run_robot
 
     say_compiling("the simulator", run_robot)
-    drawing = _import_drawing(plots, gif, html)
+    # the robot rows are kept only for what draws the run: the painter needs some columns, an animation all
+    every_row = run.gif or run.view
+    rows = painter.start(scene, ticks, seed, every_row=every_row) if painter is not None else every_row
+    drawing = _import_drawing(run.gif, run.html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
-        result = _simulate(scene, seconds, seed, None if quiet else ticks, trace, rows)
+        result = _simulate(scene, run.seconds, seed, None if run.quiet else ticks, trace, rows, painter)
         drawing.join()
         if result.end.complete:
             summary = summarise(result)
-            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, plots, gif)
-            if html:
+            written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, painter, run.gif)
+            if run.html:
                 written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
         _stopped(result, trace.written)
-    if not quiet:
+    if not run.quiet:
         _report(result, summary, written)
-    if view:
+    if run.view:
         from tablebot.sim.animate import show
         show(result, summary)
 
 
 class _Imports:
-    """The picture modules (matplotlib, PIL) imported by a thread of their own while the robot runs: the
-    run's compiled loop leaves the other core (and the GIL) to them, so their half second or more costs
-    nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut an import short (a
-    compiled module interrupted mid-import surfaces as an ImportError). :meth:`join` waits for them and
-    raises what an import raised."""
+    """The modules of the animation and the replay page (matplotlib, PIL) imported by a thread of their own
+    while the robot runs: the run's compiled loop leaves the other core (and the GIL) to them, so their half
+    second or more costs nothing, and Ctrl-C, which Python delivers to the main thread only, can never cut
+    an import short (a compiled module interrupted mid-import surfaces as an ImportError). :meth:`join`
+    waits for them and raises what an import raised."""
 
     def __init__(self, modules: list[Callable[[], None]]):
         import threading
@@ -109,17 +148,14 @@ class _Imports:
             raise self.failed
 
 
-def _import_drawing(plots: bool, gif: bool, html: bool) -> _Imports:
-    """Start importing the picture modules the run will need (see :class:`_Imports`)."""
-    wanted = [(_load_plots, plots), (_load_animate, gif), (_load_replay, html)]
+def _import_drawing(gif: bool, html: bool) -> _Imports:
+    """Start importing the modules the run's animation and replay page will need (see :class:`_Imports`;
+    the pictures are the painter's)."""
+    wanted = [(_load_animate, gif), (_load_replay, html)]
     return _Imports([load for load, used in wanted if used])
 
 
 # Plain import statements (not module names as strings), so that import-linter sees these imports too.
-def _load_plots() -> None:
-    import tablebot.sim.plots  # noqa: F401
-
-
 def _load_animate() -> None:
     import tablebot.sim.animate  # noqa: F401
 
@@ -135,13 +171,10 @@ def _stopped(result: SimRun, kept: Path | None) -> None:
     raise typer.Exit(result.end.exit_code)
 
 
-def _pictures(result: SimRun, summary: Summary, out: Path, plots: bool, gif: bool) -> list[Path]:
-    """trajectory.png and timeline.png (unless ``plots`` is off) and, with ``gif``, the animation."""
-    written = []
-    if plots:
-        from tablebot.sim import plots as pictures
-
-        written += pictures.trajectory_and_timeline(result, summary, out)
+def _pictures(result: SimRun, summary: Summary, out: Path, painter: Painter | None, gif: bool) -> list[Path]:
+    """trajectory.png and timeline.png (drawn by the painter, when there is one) and, with ``gif``, the
+    animation."""
+    written = painter.draw(result, summary, out) if painter is not None else []
     if gif:
         from tablebot.sim.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))
@@ -170,19 +203,22 @@ def _report(result: SimRun, summary: Summary, written: list[Path]) -> None:
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,
-              rows: bool) -> SimRun:
+              rows: bool | tuple[int, ...], painter: Painter | None) -> SimRun:
     """The run, with a progress bar of ``ticks`` on a terminal (None: quiet); history in float32 (half
-    the memory, plenty for pictures: the trace is written from the exact values)."""
+    the memory, plenty for pictures: the trace is written from the exact values), the pictured part of
+    it in memory the painter shares, which learns how far the run is as it goes."""
     import numpy as np
 
     from tablebot.sim.runner import simulate
 
+    sinks = [trace] if painter is None else [trace, painter.sink]
+    kept = {"history": np.float32, "rows": rows} | ({} if painter is None else {"zeros": painter.zeros})
     if ticks is None or not sys.stderr.isatty():
-        return simulate(scene, seconds, seed, sinks=[trace], history=np.float32, rows=rows)
+        return simulate(scene, seconds, seed, sinks=sinks, **kept)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task("sim", total=ticks)
-        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=[trace],
-                   history=np.float32, rows=rows)
+        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=sinks,
+                        **kept)

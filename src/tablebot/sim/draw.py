@@ -93,38 +93,87 @@ def draw_tape(ax: Axes, world: World) -> None:
 
 
 def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta: float) -> tuple[float, float]:
-    """Where the robot at this pose touches the world: the point of the wall, obstacle or lamp base nearest to
-    its body's outline (sampled every 2 mm); a face lying flat against a wall touches along a stretch,
-    marked at its middle."""
+    """Where the robot at this pose touches the world (see :func:`contact_points`)."""
+    (cx, cy), = contact_points(geometry, params, np.array([[x, y, theta]]))
+    return float(cx), float(cy)
+
+
+def contact_points(geometry: Geometry, params: Params, poses: np.ndarray) -> np.ndarray:
+    """Where the robot at each pose (x, y, theta rows) touches the world: the point of the wall, obstacle or
+    lamp base nearest to its body's outline (sampled every 2 mm); a face lying flat against a wall touches
+    along a stretch, marked at its middle. All poses at once (an hour has hundreds of collisions), a few
+    hundred at a time; each pose's point is the one the pose alone gives, to the last bit."""
     body = params["body"]
     f, r, w = body["front"], -body["rear"], body["half_width"]
-    pts = _transform(_outline(f, r, w), x, y, theta)[:, None, :]  # (M, 1, 2)
-    best, where = math.inf, (x, y)
+    outline = _outline(f, r, w)
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    found = np.empty((len(poses), 2))
+    step = max(1, (1 << 18) // len(outline))
+    for at in range(0, len(poses), step):
+        found[at:at + step] = _touching(geometry, outline, math.hypot(max(f, -r), w), poses[at:at + step])
+    return found
+
+
+def _touching(geometry: Geometry, outline: np.ndarray, reach: float, poses: np.ndarray) -> np.ndarray:
+    n = len(poses)
+    x, y = poses[:, 0], poses[:, 1]
+    # cos and sin of each heading as math gives them (numpy's vector versions may differ in the last bit)
+    c = np.array([math.cos(theta) for theta in poses[:, 2].tolist()])[:, None]
+    s = np.array([math.sin(theta) for theta in poses[:, 2].tolist()])[:, None]
+    px = (x[:, None] + c * outline[:, 0] - s * outline[:, 1])[:, :, None]  # (N, M, 1)
+    py = (y[:, None] + s * outline[:, 0] + c * outline[:, 1])[:, :, None]
+    where, best, rows = poses[:, :2].copy(), np.full(n, math.inf), np.arange(n)
     # only edges and circles that can hold the nearest point (or one within TOUCH_M of it) are sampled: every
     # outline point lies within ``reach`` of the centre, so a feature farther than the nearest one by more
     # than 2 reach + TOUCH_M (and a micrometre for rounding) is farther from every point of the outline
-    reach = math.hypot(max(f, -r), w)
-    edges = _near_features(geometry.edges, x, y, 2 * reach + TOUCH_M + 1e-6)
-    if len(edges):
-        a, b = geometry.edges[None, edges, :2], geometry.edges[None, edges, 2:]
-        ab = b - a
-        t = np.clip(((pts - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)[..., None]
-        near = a + t * ab  # (M, E, 2): each sample's nearest point on each edge
-        gap = np.hypot(*(pts - near).transpose(2, 0, 1))
-        edge = int(np.unravel_index(np.argmin(gap), gap.shape)[1])
-        best = float(gap[:, edge].min())
-        touching = gap[:, edge] <= best + TOUCH_M
-        where = tuple(near[touching, edge].mean(axis=0))
-    circles = _near_circles(geometry.circles, x, y, 2 * reach + 1e-6)
-    if len(circles):
-        centres, radii = geometry.circles[None, circles, :2], geometry.circles[None, circles, 2]
-        off = pts - centres
-        dist = np.hypot(off[..., 0], off[..., 1])
-        gap = dist - radii
-        k = np.unravel_index(np.argmin(gap), gap.shape)
-        if gap[k] < best:
-            where = tuple(centres[0, k[1]] + off[k] / max(float(dist[k]), 1e-12) * radii[0, k[1]])
-    return float(where[0]), float(where[1])
+    edges = _near(_edge_distances(geometry.edges, x, y), 2 * reach + TOUCH_M + 1e-6)  # (N, K): indices
+    if edges.shape[1]:
+        e = geometry.edges[edges][:, None]  # (N, 1, K, 4)
+        ax, ay, bx, by = e[..., 0], e[..., 1], e[..., 2], e[..., 3]
+        abx, aby = bx - ax, by - ay
+        t = np.clip(((px - ax) * abx + (py - ay) * aby) / np.maximum(abx * abx + aby * aby, 1e-18), 0.0, 1.0)
+        nx, ny = ax + t * abx, ay + t * aby  # (N, M, K): each sample's nearest point on each edge
+        gap = np.hypot(px - nx, py - ny)
+        edge = gap.reshape(n, -1).argmin(axis=1) % gap.shape[2]  # the first nearest, as argmin over (M, K)
+        gaps = gap[rows, :, edge]  # (N, M): each pose's gaps to its nearest edge
+        best = gaps.min(axis=1)
+        touching = gaps <= best[:, None] + TOUCH_M
+        points = np.stack((nx[rows, :, edge], ny[rows, :, edge]), axis=-1)  # (N, M, 2)
+        for k in range(n):  # the middle of each stretch, summed in the order numpy sums it alone
+            where[k] = points[k, touching[k]].mean(axis=0)
+    circles = _near(np.hypot(geometry.circles[:, 0] - x[:, None], geometry.circles[:, 1] - y[:, None])
+                    - geometry.circles[:, 2], 2 * reach + 1e-6)
+    if circles.shape[1]:
+        held = geometry.circles[circles][:, None]  # (N, 1, K, 3)
+        ox, oy = px - held[..., 0], py - held[..., 1]
+        dist = np.hypot(ox, oy)
+        gap = dist - held[..., 2]
+        m, k = np.divmod(gap.reshape(n, -1).argmin(axis=1), gap.shape[2])
+        closer = gap[rows, m, k] < best
+        off = np.stack((ox[rows, m, k], oy[rows, m, k]), axis=-1)
+        centre, radius = held[rows, 0, k, :2], held[rows, 0, k, 2]
+        rim = centre + off / np.maximum(dist[rows, m, k], 1e-12)[:, None] * radius[:, None]
+        where[closer] = rim[closer]
+    return where
+
+
+def _edge_distances(edges: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """(N, E): the distance from each (x, y) to each edge."""
+    a, ab = edges[:, :2], edges[:, 2:] - edges[:, :2]
+    dx, dy = x[:, None] - a[:, 0], y[:, None] - a[:, 1]
+    t = np.clip((dx * ab[:, 0] + dy * ab[:, 1]) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)
+    return np.hypot(dx - t * ab[:, 0], dy - t * ab[:, 1])
+
+
+def _near(distance: np.ndarray, slack: float) -> np.ndarray:
+    """(N, K): per row, the indices (in order) of the features no farther than the nearest plus ``slack``,
+    padded at the end by repeating the last (a repeat never wins an argmin over the one it repeats)."""
+    if not distance.shape[1]:
+        return np.zeros((len(distance), 0), dtype=np.int64)
+    near = distance <= distance.min(axis=1, keepdims=True) + slack
+    order = np.sort(np.where(near, np.arange(near.shape[1]), near.shape[1]), axis=1)[:, :near.sum(axis=1).max()]
+    last = order[np.arange(len(order)), near.sum(axis=1) - 1]
+    return np.where(order == near.shape[1], last[:, None], order)
 
 
 @functools.lru_cache(maxsize=8)
@@ -135,24 +184,6 @@ def _outline(f: float, r: float, w: float) -> np.ndarray:
                               for a, b in itertools.pairwise(corners)])
     outline.flags.writeable = False
     return outline
-
-
-def _near_features(edges: np.ndarray, x: float, y: float, slack: float) -> np.ndarray:
-    """Indices (in order) of the edges no farther from (x, y) than the nearest one plus ``slack``."""
-    if not len(edges):
-        return np.zeros(0, dtype=np.int64)
-    a, ab = edges[:, :2], edges[:, 2:] - edges[:, :2]
-    t = np.clip(((np.array([x, y]) - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-18), 0.0, 1.0)
-    distance = np.hypot(*(np.array([x, y]) - a - t[:, None] * ab).T)
-    return np.flatnonzero(distance <= distance.min() + slack)
-
-
-def _near_circles(circles: np.ndarray, x: float, y: float, slack: float) -> np.ndarray:
-    """Indices (in order) of the circles whose rim is no farther from (x, y) than the nearest rim plus ``slack``."""
-    if not len(circles):
-        return np.zeros(0, dtype=np.int64)
-    distance = np.hypot(circles[:, 0] - x, circles[:, 1] - y) - circles[:, 2]
-    return np.flatnonzero(distance <= distance.min() + slack)
 
 
 def _transform(points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:

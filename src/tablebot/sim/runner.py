@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 
@@ -24,6 +24,14 @@ from tablebot.sinks.trace_file import block_lines
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
 PATH_STRIDE = 5  # robot rows per point of the thinned path (the robot moves well under 1 cm a tick)
 
+#: Where History keeps a column: ``zeros(name, shape, dtype)`` gives a zeroed array (numpy's by default; a
+#: painter's gives memory it shares, for the pictures drawn while the robot runs).
+Zeros = Callable[[str, tuple[int, ...], Any], np.ndarray]
+
+
+def _zeros(name: str, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    return np.zeros(shape, dtype)
+
 
 @dataclass
 class SimRun:
@@ -35,6 +43,7 @@ class SimRun:
     scene: Scene
     seed: int
     hist: np.ndarray | None  # (ticks + 1, N_STATE), float64 or float32; None when not kept (no pictures)
+    #: (or, with ``hist_columns``, only those columns of each row: what the pictures draw)
     ends: np.ndarray  # (2, N_STATE): the robot before the first tick and after the last
     path: np.ndarray  # (rows, 2): x, y of every PATH_STRIDE-th robot row (for the summary's laps)
     masks: np.ndarray  # (ticks,)
@@ -50,10 +59,16 @@ class SimRun:
     reached_row: int | None  # the first hist row within reach of a lamp
     end: RunEnd
     wall_s: float  # how long the loop took; shown to people, never written into result files
+    hist_columns: tuple[int, ...] | None = None  # the sim.columns hist holds (None: all of them)
 
     @property
     def ticks(self) -> int:
         return len(self.states)
+
+    def column(self, column: int) -> np.ndarray:
+        """One column (sim.columns) of every robot row."""
+        assert self.hist is not None, "the run kept no robot rows (simulate with rows=True)"
+        return self.hist[:, column if self.hist_columns is None else self.hist_columns.index(column)]
 
     @property
     def tick_s(self) -> float:
@@ -68,6 +83,7 @@ class SimRun:
         """The whole run as one block of ticks, with the simulator's trace fields."""
         from tablebot.sim.simrobot import field_columns
 
+        assert self.hist is not None and self.hist_columns is None, "the trace needs every robot row"
         return TickBlock(0, self.masks, self.pulses, self.events, self.rows, self.states, self.timers,
                          self.outputs, self.counters, field_columns(self.scene, self.hist[:-1]))
 
@@ -78,19 +94,25 @@ class SimRun:
 
     def heading_deg(self) -> np.ndarray:
         """Unwrapped heading in degrees per hist row (a turn of 270° reads 270, not -90)."""
-        return np.degrees(self.hist[:, L.TH].astype(np.float64))
+        return np.degrees(self.column(L.TH).astype(np.float64))
 
 
 class History:
     """A sink that keeps every tick of a simulated run in arrays sized for the planned run (robot rows as
     ``dtype``: float32 halves the memory of an hour's run and is plenty for pictures; the trace is
     written from the exact values). With ``rows=False`` it keeps the per-tick columns, the first and
-    last robot rows and a thinned path, but not every robot row (a run without pictures)."""
+    last robot rows and a thinned path, but not every robot row (a run without pictures); with a tuple
+    of columns (sim.columns), only those columns of every row (what the pictures draw). Each array is
+    made by ``zeros`` (see :data:`Zeros`)."""
 
     COLUMNS = ("masks", "events", "rows", "states", "timers", "outputs", "counters", "pulses")
 
-    def __init__(self, robot: SimRobot, dtype: type = np.float64, rows: bool = True):
-        self.robot, self.dtype, self.rows = robot, dtype, rows
+    def __init__(self, robot: SimRobot, dtype: type = np.float64, rows: bool | tuple[int, ...] = True,
+                 zeros: Zeros = _zeros):
+        self.robot, self.dtype, self.zeros = robot, dtype, zeros
+        self.rows = bool(rows)
+        self.kept = None if isinstance(rows, bool) else tuple(rows)  # the columns kept (None: all)
+        self._kept = np.array(self.kept or (), dtype=np.intp)
         self.ended: RunEnd | None = None
         self.done = 0
 
@@ -98,15 +120,16 @@ class History:
         machine = info.engine.machine
         ticks = info.ticks or 0
         n_out, n_c = len(machine.output_names), len(machine.counter_bits)
-        self.hist = np.zeros((ticks + 1 if self.rows else 0, L.N_STATE), dtype=self.dtype)
+        width = L.N_STATE if self.kept is None else len(self.kept)
+        self.hist = self.zeros("hist", (ticks + 1 if self.rows else 0, width), self.dtype)
         self.first = self.robot.s.copy()
         self.path = np.zeros((ticks // PATH_STRIDE + 1, 2))
         self._keep_row(0, self.robot.s)
         small = np.int16 if len(machine.states) < 32768 and len(machine.rows) < 32768 else np.int32
-        self.columns = {"masks": np.zeros(ticks, np.int32), "events": np.zeros(ticks, np.int32),
-                        "rows": np.zeros(ticks, small), "states": np.zeros(ticks, small),
-                        "timers": np.zeros(ticks, np.int32), "outputs": np.zeros((ticks, n_out), np.int8),
-                        "counters": np.zeros((ticks, n_c), np.int32), "pulses": np.zeros((ticks, n_c), np.int32)}
+        shapes = {"masks": ((ticks,), np.int32), "events": ((ticks,), np.int32), "rows": ((ticks,), small),
+                  "states": ((ticks,), small), "timers": ((ticks,), np.int32), "outputs": ((ticks, n_out), np.int8),
+                  "counters": ((ticks, n_c), np.int32), "pulses": ((ticks, n_c), np.int32)}
+        self.columns = {name: self.zeros(name, shape, dtype) for name, (shape, dtype) in shapes.items()}
 
     def block(self, block: TickBlock) -> None:
         a, b = block.start, block.start + len(block)
@@ -114,7 +137,7 @@ class History:
             self.columns[name][a:b] = getattr(block, name)
         if block.raw is not None:  # the robot at the start of each tick; the one after the last comes below
             if self.rows:
-                self.hist[a:b] = block.raw
+                self.hist[a:b] = block.raw if self.kept is None else block.raw[:, self._kept]
             first = -(-a // PATH_STRIDE) * PATH_STRIDE  # the first row of the block on the path's stride
             points = block.raw[first - a::PATH_STRIDE][:, [L.X, L.Y]]
             self.path[first // PATH_STRIDE:first // PATH_STRIDE + len(points)] = points
@@ -123,7 +146,7 @@ class History:
 
     def _keep_row(self, row: int, s: np.ndarray) -> None:
         if self.rows:
-            self.hist[row] = s
+            self.hist[row] = s if self.kept is None else s[self._kept]
         if row % PATH_STRIDE == 0 and row // PATH_STRIDE < len(self.path):
             self.path[row // PATH_STRIDE] = s[[L.X, L.Y]]
 
@@ -136,7 +159,8 @@ class History:
         return SimRun(scene=scene, seed=seed, hist=self.hist[: n + 1] if self.rows else None,
                       ends=np.stack((self.first, robot.s)), path=self.path[: n // PATH_STRIDE + 1], **cut,
                       collision_rows=robot.collisions, collision_count=robot.collision_count,
-                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s)  # type: ignore[arg-type]
+                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s,  # type: ignore[arg-type]
+                      hist_columns=self.kept)
 
 
 class Progress:
@@ -165,16 +189,18 @@ def ticks_for(scene: Scene, seconds: float) -> int:
 
 
 def simulate(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
-        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool = True) -> SimRun:
+        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool | tuple[int, ...] = True,
+        zeros: Zeros = _zeros) -> SimRun:
     """Simulate ``seconds`` of robot time through the run loop; ``progress(ticks_done)`` is called
-    after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens.
+    after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens, after the
+    run's :class:`History` (made with ``history``, ``rows`` and ``zeros``) has kept each block.
 
     Everything random comes from the robot's numpy Generator seeded with ``seed``, and nothing depends
     on the wall clock, so a table, world and seed always give the same trace bytes.
     """
     ticks = ticks_for(scene, seconds)
     robot = SimRobot(scene, seed)
-    keep = History(robot, history, rows)
+    keep = History(robot, history, rows, zeros)
     extra = [Progress(progress)] if progress else []
     started = time.perf_counter()
     run_loop(Engine(scene.machine), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import queue
 import threading
+from concurrent.futures import Executor, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -30,10 +31,18 @@ def block_text(block: TickBlock, machine: Machine) -> str:
 def block_bytes_of(block: TickBlock, machine: Machine) -> bytes | str:
     """:func:`block_text` as the compiled code made it (UTF-8 bytes: an hour's 59 MB need no decoding when
     they go straight to a file), or as text when Python made it."""
+    views = block_views_of(block, machine, {})
+    return b"".join(views) if isinstance(views, list) else views
+
+
+def block_views_of(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray],
+                   helper: Executor | None = None) -> list[memoryview] | str:
+    """:func:`block_bytes_of` as the views of ``scratch``'s memory the compiled code made (see
+    trace_text.block_views), or as text when Python made it."""
     if len(block) >= COMPILED_FROM and hasattr(block.extra, "number_columns"):
-        text = _compiled_text(block, machine)
-        if text is not None:
-            return text
+        views = _compiled_text(block, machine, scratch, helper)
+        if views is not None:
+            return views
     return "".join(_python_lines(block, machine))
 
 
@@ -44,8 +53,9 @@ def block_lines(block: TickBlock, machine: Machine) -> list[str]:
     return [line + "\n" for line in text.split("\n")[:-1]]  # no JSON text holds a raw newline
 
 
-def _compiled_text(block: TickBlock, machine: Machine) -> bytes | None:
-    from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_bytes, json_names
+def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray],
+                   helper: Executor | None) -> list[memoryview] | None:
+    from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_views, json_names
 
     n_out, n_count = len(machine.output_names), len(machine.table.robot.counter_names)
     arrays = (block.events, block.rows, block.states, block.timers, block.outputs, block.counters)
@@ -64,7 +74,8 @@ def _compiled_text(block: TickBlock, machine: Machine) -> bytes | None:
         kinds.append(INT if places == 0 else DECIMAL)
         columns.append(values)
         decimals.append(places)
-    return block_bytes([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states))
+    return block_views([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states),
+                       scratch, helper)
 
 
 def _python_lines(block: TickBlock, machine: Machine) -> list[str]:
@@ -115,8 +126,9 @@ class TraceFile:
     the run is complete, or to ``NAME.partial.jsonl`` (ending with an ``end`` record saying why) when not.
 
     With ``background``, blocks are formatted and written by a thread of their own, while the next
-    block is computed (the compiled simulator releases the GIL); ``end`` waits for it, and an error
-    it met (a full disk) is raised there or at the next block.
+    block is computed (the compiled simulator releases the GIL), with a second thread writing half of each
+    long block's lines meanwhile (the writing takes longer than the simulating); ``end`` waits for them,
+    and an error met (a full disk) is raised there or at the next block.
     """
 
     def __init__(self, path: str | Path, background: bool = False):
@@ -125,12 +137,15 @@ class TraceFile:
         self.written: Path | None = None
         self._queue: queue.Queue[TickBlock | None] | None = None
         self._failed: BaseException | None = None
+        self._scratch: dict[str, np.ndarray] = {}  # the formatting's arrays, reused block after block
+        self._helper: ThreadPoolExecutor | None = None
 
     def start(self, info: RunInfo) -> None:
         self.machine = info.engine.machine
         self.file = PendingFile(self.path)
         if self.background:
             self._queue = queue.Queue(maxsize=4)  # bounded: memory stays a few blocks whatever the disk does
+            self._helper = ThreadPoolExecutor(1, thread_name_prefix="trace lines")
             self._thread = threading.Thread(target=self._drain, name="trace writer", daemon=True)
             self._thread.start()
 
@@ -143,12 +158,15 @@ class TraceFile:
         self._queue.put(block)
 
     def _write(self, block: TickBlock) -> None:
-        text, stream = block_bytes_of(block, self.machine), self.file.stream
-        if isinstance(text, bytes) and _utf8_as_written(stream):  # past the text layer (flushed) as it is
+        text, stream = block_views_of(block, self.machine, self._scratch, self._helper), self.file.stream
+        if isinstance(text, str):
+            stream.write(text)
+        elif _utf8_as_written(stream):  # past the text layer (flushed) as it is
             stream.flush()  # first so that the order of the lines holds
-            stream.buffer.write(text)
+            for view in text:
+                stream.buffer.write(view)
         else:
-            stream.write(text if isinstance(text, str) else text.decode("utf-8"))
+            stream.write(b"".join(text).decode("utf-8"))
 
     def _drain(self) -> None:
         assert self._queue is not None
@@ -166,6 +184,8 @@ class TraceFile:
             self._queue.put(None)
             self._thread.join()
             self._queue = None
+            if self._helper is not None:
+                self._helper.shutdown()
             if self._failed is not None:
                 self.file.discard()
                 raise self._failed

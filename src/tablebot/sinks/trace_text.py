@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Sequence
+from concurrent.futures import Executor
 
 import numpy as np
 
@@ -25,22 +26,46 @@ POW10 = np.array([10.0**d for d in range(16)])
 DIGITS = 20  # at most, for an int64 with its sign
 
 
+def _reused(scratch: dict[str, np.ndarray], name: str, size: int, dtype: type) -> np.ndarray:
+    """A flat array of at least ``size`` items kept in ``scratch`` from one block to the next (its content is
+    whatever the last block left), so that each block's few megabytes are not fresh memory to map again."""
+    array = scratch.get(name)
+    if array is None or len(array) < size:
+        array = scratch[name] = np.empty(max(size, 2 * len(array) if array is not None else 0), dtype)
+    return array
+
+
 def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
                 decimals: Sequence[int], names: Sequence[bytes]) -> bytes | None:
     """The lines of a block: field f of each line is ``pieces[f]``, then the value of ``columns[f]`` for that
     line, written as ``kinds[f]`` says (DECIMAL: rounded to ``decimals[f]`` places; STATE: ``names[value]``);
     ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module)."""
-    n = len(columns[0]) if columns else 0
-    ints = np.zeros((n, len(kinds)), dtype=np.int64)
-    floats = np.zeros((n, len(kinds)))
+    views = block_views(pieces, kinds, columns, decimals, names, {})
+    return None if views is None else b"".join(views)
+
+
+SPLIT_FROM = 1024  # lines from which a helper thread writes the second half of a block at the same time
+
+
+def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
+                decimals: Sequence[int], names: Sequence[bytes], scratch: dict[str, np.ndarray],
+                helper: Executor | None = None) -> list[memoryview] | None:
+    """:func:`block_bytes` as views of ``scratch``'s memory (a writer's own dict of arrays, reused from one
+    block to the next: the views are good until its next block), in one piece or, with ``helper`` (a
+    thread) and a long block, two: the second half's lines written by ``helper`` meanwhile (the compiled
+    writer leaves the GIL, so the halves take the two cores)."""
+    own = scratch
+    n, width = (len(columns[0]) if columns else 0), len(kinds)
+    ints = _reused(own, "ints", n * width, np.int64)[: n * width].reshape(n, width)
+    floats = _reused(own, "floats", n * width, np.float64)[: n * width].reshape(n, width)
+    decimal = np.array(kinds) == DECIMAL
     for f, (kind, column) in enumerate(zip(kinds, columns, strict=True)):
         if kind == DECIMAL:
             floats[:, f] = column
         else:
             ints[:, f] = column
-    if (ints == np.iinfo(np.int64).min).any():
+    if (ints[:, ~decimal] == np.iinfo(np.int64).min).any():
         return None
-    decimal = np.array(kinds) == DECIMAL
     if decimal.any():
         values = floats[:, decimal]
         places = np.array(decimals)[decimal]
@@ -51,10 +76,19 @@ def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
     name_bytes = np.frombuffer(b"".join(names) or b" ", dtype=np.uint8)
     name_ends = np.cumsum([len(name) for name in names]).astype(np.int64)
     widest = max((len(name) for name in names), default=0) + DIGITS + 8
-    out = np.empty(n * (len(piece_bytes) + widest * len(kinds)), dtype=np.uint8)
-    used = _lines(out, piece_bytes, piece_ends, np.array(kinds, dtype=np.int64), ints, floats,
-                  np.array(decimals, dtype=np.int64), name_bytes, name_ends)
-    return out[:used].tobytes()
+    line = len(piece_bytes) + widest * width  # the most a line can take
+    fixed = (piece_bytes, piece_ends, np.array(kinds, dtype=np.int64))
+    names_at = (np.array(decimals, dtype=np.int64), name_bytes, name_ends)
+    half = n // 2 if helper is not None and n >= SPLIT_FROM else n
+    out = _reused(own, "out", half * line, np.uint8)
+    later = None
+    if half < n:
+        second = _reused(own, "second", (n - half) * line, np.uint8)
+        later = helper.submit(_lines, second, *fixed, ints[half:], floats[half:], *names_at)  # type: ignore[union-attr]
+    views = [memoryview(out)[:_lines(out, *fixed, ints[:half], floats[:half], *names_at)]]
+    if later is not None:
+        views.append(memoryview(second)[:later.result()])
+    return views
 
 
 @njit(nogil=True, refcounts=False)
