@@ -1,17 +1,27 @@
 """numpy's standard normal drawn inside compiled code from a robot's own numpy Generator, bit for bit.
 
 A compiled loop over thousands of robots cannot call each robot's ``Generator.standard_normal`` (one
-Python call per robot and block, on one core, into an array as large as the fleet); instead it calls
-the Generator's own C bit generator through the pointers numpy publishes for this purpose (the
-``bitgen_t`` struct of ``numpy/random/bitgen.h``: state, next_uint64, next_uint32, next_double), and
-turns the bits into normals with numpy's ziggurat (``random_standard_normal`` in numpy's
-``distributions.c``, as numba ports it). The Generator's state advances exactly as numpy's own draws
-advance it, so a run may mix the two; ``tests/test_sim_normals.py`` proves the numbers identical.
+Python call per robot and block, on one core, into an array as large as the fleet); instead it draws the
+Generator's bits itself and turns them into normals with numpy's ziggurat (``random_standard_normal`` in
+numpy's ``distributions.c``, as numba ports it). The Generator's state advances exactly as numpy's own
+draws advance it, so a run may mix the two; ``tests/test_sim_normals.py`` proves the numbers identical.
 """
+
+# The bits come one of two ways, chosen per Generator when its handle is made (:func:`bitgen_address`):
+# - numpy's PCG64 (what default_rng makes): its 128-bit LCG is stepped inline, in LLVM's i128 arithmetic,
+#   on the generator's own state in memory (numpy/random/src/pcg64/pcg64.h: pcg64_next64 =
+#   pcg_setseq_128_xsl_rr_64_random_r; next_double = uint64_to_double of numpy/random/_common.pxd). A call
+#   through numpy's function pointer cannot be inlined and was ~12 ns of each normal.
+# - any other bit generator: through the function pointers numpy publishes for this purpose (the ``bitgen_t``
+#   struct of numpy/random/bitgen.h: state, next_uint64, next_uint32, next_double).
+# The inline path depends on the memory layout of numpy's PCG64 object, which numpy does not promise: it is
+# taken only once :func:`pcg64_inline` has checked this numpy's layout and arithmetic against numpy's own
+# draws; a numpy that differs costs speed (the function-pointer path), never a wrong number.
 
 from __future__ import annotations
 
 import ctypes
+import sys
 
 import numpy as np
 from llvmlite import ir
@@ -30,14 +40,94 @@ _capsule_pointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
 
 WORD = 8  # bytes per field of bitgen_t (pointers, on the 64-bit platforms numba supports)
 _NEXT_UINT64, _NEXT_DOUBLE = 1, 3  # field numbers in bitgen_t (0 is the state)
+INLINE = 1  # bit 0 of a handle: the address is of a PCG64's pcg64_random_t, stepped inline (addresses are even)
+
+# PCG_DEFAULT_MULTIPLIER_128 of numpy/random/src/pcg64/pcg64.h
+PCG64_MULTIPLIER = (2549297995355413924 << 64) + 4865540595714422341
+_MASK128 = (1 << 128) - 1
+_inline_offset: int | bool | None = False  # pcg64_inline's verdict: False until checked, then an offset or None
+
+
+def _word_at(address: int) -> int:
+    return ctypes.c_uint64.from_address(address).value
+
+
+def _bitgen_t(bit_generator: object) -> int:
+    return int(_capsule_pointer(bit_generator.capsule, b"BitGenerator"))  # type: ignore[attr-defined]
+
+
+def _pcg64_words(bit_generator: np.random.PCG64) -> int:
+    """Where ``bit_generator``'s ``pcg64_random_t`` is, as numpy's own next_uint64 finds it: bitgen_t.state
+    points at a ``pcg64_state``, whose first field points at the ``pcg64_random_t``."""
+    return _word_at(_word_at(_bitgen_t(bit_generator)))
+
+
+def _step(state: int, inc: int) -> tuple[int, int]:
+    """numpy's PCG64 step and XSL-RR output (pcg64.h), in Python's integers: (new state, next64)."""
+    state = (state * PCG64_MULTIPLIER + inc) & _MASK128
+    rot, word = state >> 122, ((state >> 64) ^ state) & 0xFFFFFFFFFFFFFFFF
+    return state, ((word >> rot) | (word << (-rot & 63))) & 0xFFFFFFFFFFFFFFFF
+
+
+def pcg64_inline() -> int | None:
+    """The offset of a ``numpy.random.PCG64``'s ``pcg64_random_t`` from the object's address, when this numpy
+    keeps it as the inline path reads it; None when not (checked once a process, on throwaway generators).
+
+    Checked: the words sit inside the object (a member, so at the same offset in every PCG64), they hold
+    state then increment as little-endian 128-bit integers (what ``PCG64.state`` reports), and numpy's own
+    next_uint64 and next_double (``random_raw``, ``Generator.random``) give what the inline step gives
+    and leave those words as it leaves them. Only such a numpy, on a 64-bit little-endian machine, gets
+    the inline path."""
+    global _inline_offset
+    if _inline_offset is not False:
+        return _inline_offset  # type: ignore[return-value]
+    _inline_offset = None
+    try:
+        if sys.byteorder == "little" and ctypes.sizeof(ctypes.c_void_p) == WORD and _layout_holds():
+            probe = np.random.PCG64(20240611)
+            _inline_offset = _pcg64_words(probe) - id(probe)
+    except Exception:  # whatever this numpy does differently: the function-pointer path
+        _inline_offset = None
+    return _inline_offset
+
+
+def _layout_holds() -> bool:
+    """The checks of :func:`pcg64_inline`, on two throwaway generators."""
+    probes = [np.random.PCG64(seed) for seed in (20240611, 2**100 + 3)]
+    offsets = {_pcg64_words(probe) - id(probe) for probe in probes}
+    if len(offsets) != 1 or not 0 < next(iter(offsets)) <= type(probes[0]).__basicsize__ - 4 * WORD:
+        return False
+    for probe in probes:
+        words = _pcg64_words(probe)
+        for _ in range(3):
+            state, inc = probe.state["state"]["state"], probe.state["state"]["inc"]
+            memory = [_word_at(words + k * WORD) for k in range(4)]
+            if memory != [state & 2**64 - 1, state >> 64, inc & 2**64 - 1, inc >> 64]:
+                return False
+            after, expected = _step(state, inc)
+            if int(probe.random_raw()) != expected:
+                return False
+            after, expected = _step(after, inc)
+            if np.random.Generator(probe).random() != (expected >> 11) * (1.0 / 9007199254740992.0):
+                return False
+            if _word_at(words) | _word_at(words + WORD) << 64 != after:
+                return False
+    return True
 
 
 def bitgen_address(rng: np.random.Generator) -> np.uint64:
-    """The address of ``rng``'s ``bitgen_t``, for :func:`standard_normal`. The caller keeps ``rng`` alive
-    while compiled code uses it, and no other thread draws from it meanwhile."""
+    """The handle :func:`standard_normal` draws ``rng``'s numbers through: when ``rng``'s bit generator is
+    exactly numpy's PCG64 and :func:`pcg64_inline` holds, the address of its state words with bit 0 set
+    (stepped inline), else the address of its ``bitgen_t``. The caller keeps ``rng`` alive while compiled code
+    uses it, and no other thread draws from it meanwhile."""
+    bit_generator = rng.bit_generator
+    if type(bit_generator) is np.random.PCG64:
+        offset = pcg64_inline()
+        if offset is not None:
+            return np.uint64(id(bit_generator) + offset + INLINE)  # a member: no pointer to follow per robot
     if ctypes.sizeof(ctypes.c_void_p) != WORD:
         raise RuntimeError("drawing numpy's normals in compiled code needs a 64-bit platform")
-    return np.uint64(_capsule_pointer(rng.bit_generator.capsule, b"BitGenerator"))
+    return np.uint64(_bitgen_t(bit_generator))
 
 
 def bitgen_addresses(rngs: list[np.random.Generator]) -> np.ndarray:
@@ -70,16 +160,48 @@ def _next_double(typingctx, function, state):  # type: ignore[no-untyped-def]
     return types.float64(types.uint64, types.uint64), codegen
 
 
+@intrinsic
+def _pcg64_next64(typingctx, address):  # type: ignore[no-untyped-def]
+    """numpy's ``pcg64_next64`` on the ``pcg64_random_t`` (state, inc: 128-bit each) at ``address``
+    (numpy/random/src/pcg64/pcg64.h, pcg_setseq_128_xsl_rr_64_random_r): state = state * multiplier + inc,
+    stored back; the output is the XSL-RR of the new state."""
+    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+        i64, i128 = ir.IntType(64), ir.IntType(128)
+        words = builder.inttoptr(args[0], i128.as_pointer())
+        inc_words = builder.gep(words, [ir.Constant(ir.IntType(32), 1)])
+        state = builder.add(builder.mul(builder.load(words, align=8), ir.Constant(i128, PCG64_MULTIPLIER)),
+                            builder.load(inc_words, align=8))
+        builder.store(state, words, align=8)
+        xored = builder.xor(builder.trunc(builder.lshr(state, ir.Constant(i128, 64)), i64), builder.trunc(state, i64))
+        rot = builder.trunc(builder.lshr(state, ir.Constant(i128, 122)), i64)
+        back = builder.and_(builder.neg(rot), ir.Constant(i64, 63))  # pcg_rotr_64: (v >> rot) | (v << (-rot & 63))
+        return builder.or_(builder.lshr(xored, rot), builder.shl(xored, back))
+    return types.uint64(types.uint64), codegen
+
+
+@njit(nogil=True, refcounts=False, inline="always")
+def _next64(handle):  # type: ignore[no-untyped-def]
+    """The bit generator's next_uint64 (see :func:`bitgen_address` for ``handle``)."""
+    if handle & np.uint64(INLINE):
+        return _pcg64_next64(handle - np.uint64(INLINE))
+    return _next_uint64(_word(handle + np.uint64(_NEXT_UINT64 * WORD)), _word(handle))
+
+
+@njit(nogil=True, refcounts=False, inline="always")
+def _next_uniform(handle):  # type: ignore[no-untyped-def]
+    """The bit generator's next_double: for PCG64 numpy's ``uint64_to_double`` of next_uint64 (_common.pxd)."""
+    if handle & np.uint64(INLINE):
+        return float(_pcg64_next64(handle - np.uint64(INLINE)) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+    return _next_double(_word(handle + np.uint64(_NEXT_DOUBLE * WORD)), _word(handle))
+
+
 @njit(nogil=True, refcounts=False, inline="always")
 def standard_normal(bitgen):  # type: ignore[no-untyped-def]
-    """One draw of ``Generator.standard_normal()`` from the Generator whose ``bitgen_t`` is at ``bitgen``
-    (numpy's ``random_standard_normal``, line for line)."""
-    base = np.uint64(bitgen)
-    state = _word(base)
-    next_uint64 = _word(base + np.uint64(_NEXT_UINT64 * WORD))
-    next_double = _word(base + np.uint64(_NEXT_DOUBLE * WORD))
+    """One draw of ``Generator.standard_normal()`` from the Generator whose handle (:func:`bitgen_address`)
+    is ``bitgen`` (numpy's ``random_standard_normal``, line for line)."""
+    handle = np.uint64(bitgen)
     while True:
-        r = _next_uint64(next_uint64, state)
+        r = _next64(handle)
         idx = r & np.uint64(0xFF)
         r >>= np.uint64(8)
         sign = r & np.uint64(1)
@@ -91,11 +213,11 @@ def standard_normal(bitgen):  # type: ignore[no-untyped-def]
             return x  # 99.3 % of the draws end here
         if idx == 0:  # the tail beyond the last layer
             while True:
-                xx = -ziggurat_nor_inv_r * np.log1p(-_next_double(next_double, state))
-                yy = -np.log1p(-_next_double(next_double, state))
+                xx = -ziggurat_nor_inv_r * np.log1p(-_next_uniform(handle))
+                yy = -np.log1p(-_next_uniform(handle))
                 if yy + yy > xx * xx:
                     return -(ziggurat_nor_r + xx) if (rabs >> np.uint64(8)) & np.uint64(1) else ziggurat_nor_r + xx
-        elif ((fi_double[idx - np.uint64(1)] - fi_double[idx]) * _next_double(next_double, state) + fi_double[idx]
+        elif ((fi_double[idx - np.uint64(1)] - fi_double[idx]) * _next_uniform(handle) + fi_double[idx]
               < np.exp(-0.5 * x * x)):
             return x
 
