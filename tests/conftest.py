@@ -78,9 +78,10 @@ def pytest_sessionstart(session: pytest.Session) -> None:
 
 
 class _WarmUp:
-    """The kernels compiled into ``shared`` by two processes, one per core, that write disjoint cache files (the
-    fleet's loop calls the simulator's, so those two go one after the other; pyribs' archive shares nothing with
-    them); a thread writes ``marker`` when both have ended, "ok" or their errors."""
+    """The kernels compiled into ``shared`` by two processes, one per core, of about a minute each: the robot's
+    loop, then the fleet's, which calls it; the tick-by-tick robot and the batch engine, then pyribs' archive
+    (these share with the loops only small functions, which both may compile: numba writes a cache file whole,
+    by renaming it into place). A thread writes ``marker`` when both have ended, "ok" or their errors."""
 
     def __init__(self, shared: str, marker: Path):
         self.shared, self.marker, self.started = shared, marker, time.monotonic()
@@ -88,7 +89,7 @@ class _WarmUp:
         env = {**os.environ, "NUMBA_CACHE_DIR": shared}
         self.parts = [subprocess.Popen([sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names], env=env,
                                        cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-                      for names in (["sim", "fleet"], ["archive"])]
+                      for names in (["loop", "fleet"], ["tick", "archive"])]
         self.thread = threading.Thread(target=self._wait, name="numba warm-up", daemon=True)
         self.thread.start()
 

@@ -101,28 +101,3 @@ def test_the_robot_never_leaves_the_room(tmp_path_factory, heading: float, right
     assert all(inside(walls, (x, y)) for x, y in h[::50, [L.X, L.Y]])
     box_centre = np.array([0.9, 0.9])
     assert np.min(np.hypot(*(h[:, [L.X, L.Y]] - box_centre).T)) > 0.15  # never inside the box
-
-
-def test_a_batch_of_robots_moves_exactly_like_robots_one_by_one(tmp_path: Path) -> None:
-    """The physics core is vectorised over rows: what the batch simulator will build on."""
-    from tablebot.sim.physics import step
-
-    scene = bot(tmp_path, STRAIGHT, room(extra="[[circle]]\nat = [2.2, 1.5]\nradius = 0.2\n"))
-    geo = scene.geometry
-    world = (geo.verts, geo.pstart, geo.pbound, geo.edges, geo.circles, geo.lamps)
-    n = 4
-    S = np.zeros((n, L.N_STATE))
-    S[:, L.X], S[:, L.Y], S[:, L.TH] = [1.5, 1.0, 2.0, 0.5], [1.5, 2.0, 0.6, 0.4], [0.0, 1.0, 2.0, 3.0]
-    S[:, L.SOC], S[:, L.GAIN_R], S[:, L.GAIN_L] = [1.0, 0.7, 0.4, 0.1], 1.0, 1.0
-    cmd = np.array([[8, 8], [-3, 5], [2, -2], [-6, -6]], dtype=np.int64)
-    P = np.repeat(scene.P, n, axis=0)
-    bits = scene.bits
-    rng = np.random.default_rng(7)
-    alone = S.copy()
-    for _ in range(800):
-        Z = rng.standard_normal((n, L.N_NOISE)) * 0.1
-        step(S, cmd, P, *world, Z, bits, True)
-        for i in range(n):
-            step(alone[i:i + 1], cmd[i:i + 1], P[i:i + 1], *world, Z[i:i + 1], bits, True)
-    assert np.array_equal(S, alone)
-    assert len({round(v, 6) for v in S[:, L.X]}) == n  # and they did different things

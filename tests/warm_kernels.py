@@ -2,8 +2,8 @@
 
 Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
 take, on the smallest input that reaches each kernel with the argument types the tests give it:
-``sim`` (one robot's loop, the tick-by-tick robot, the engine's batch loop on both mask types) and
-``fleet`` (the fleet loop, the env's physics-only loop) and ``archive`` (pyribs' grid archive, which
+``loop`` (one robot's loop), ``fleet`` (the fleet loop, which calls it, and the env's physics-only loop),
+``tick`` (the tick-by-tick robot, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid archive, which
 compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache). Numba caches one machine
 code per argument types, so a kernel reached here with other types than a test's is compiled again
 by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
@@ -20,19 +20,28 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
 
-def warm_sim() -> None:
+def warm_loop() -> None:
+    """One robot's compiled loop (``tablebot sim``'s), which the fleet's loop calls too."""
+    from tablebot.cli.common import load
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import scene_for
+
+    table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
+    simulate(scene_for(table, machine), 0.05, 1)
+
+
+def warm_tick() -> None:
+    """The tick-by-tick robot (the live loop's path) and the engine's batch loop on both mask types: they share
+    no compiled function with the loop but small ones, so another process compiles them meanwhile."""
     from tablebot.cli.common import load
     from tablebot.engine import Engine
     from tablebot.loop import SimulatedClock
     from tablebot.loop import run as run_loop
-    from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
     table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
-    scene = scene_for(table, machine)
-    simulate(scene, 0.05, 1)
-    robot = SimRobot(scene, 1)
+    robot = SimRobot(scene_for(table, machine), 1)
     robot.reset(seed=1)
     run_loop(Engine(machine), robot, clock=SimulatedClock(), sinks=[], ticks=3)
     for dtype in (np.uint8, np.int64):  # the two mask types the batch kernel is compiled for
@@ -59,7 +68,7 @@ def warm_archive() -> None:
         add(make_archive(descriptors), ["x", "y"], [1.0, 2.0], [[0.2] * len(descriptors), [0.7] * len(descriptors)])
 
 
-PARTS = {"sim": warm_sim, "fleet": warm_fleet, "archive": warm_archive}
+PARTS = {"loop": warm_loop, "fleet": warm_fleet, "tick": warm_tick, "archive": warm_archive}
 
 if __name__ == "__main__":
     for name in sys.argv[1:] or list(PARTS):

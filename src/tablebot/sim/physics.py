@@ -542,15 +542,3 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lin
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
     sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
                turns)
-
-
-@njit(cache=True)
-def step(S, cmd, P, verts, pstart, pbound, edges, circles, lamps, Z, bits, move, lines=NO_LINES, shade=NO_SHADE):
-    """Advance every robot one tick (when ``move``) and sense: fills the MASK column of each row of S."""
-    corners, turns = np.empty((4, 2)), np.empty(4)
-    for i in range(S.shape[0]):
-        near, centre = new_near(pstart, circles)
-        reach, wide = reaches(P[i])
-        aim_turns(P[i], turns)
-        advance(S[i], cmd[i, 0], cmd[i, 1], P[i], verts, pstart, pbound, edges, circles, lamps, lines, shade, Z[i],
-                bits, move, corners, reach, wide, near, centre, turns)
