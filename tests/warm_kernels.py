@@ -3,10 +3,10 @@
 Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
 take, on the smallest input that reaches each kernel with the argument types the tests give it:
 ``loop`` (one robot's loop), ``fleet`` (the fleet loop, which calls it, and the env's physics-only loop),
-``tick`` (the tick-by-tick robot, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid archive, which
-compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache). Numba caches one machine
-code per argument types, so a kernel reached here with other types than a test's is compiled again
-by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
+``tick`` (the tick-by-tick robot, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid
+archive, which compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache).
+Numba caches one machine code per argument types, so a kernel reached here with other types than a test's is
+compiled again by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
 """
 
 from __future__ import annotations
