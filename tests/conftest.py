@@ -79,9 +79,10 @@ def pytest_sessionstart(session: pytest.Session) -> None:
 
 class _WarmUp:
     """The kernels compiled into ``shared`` by two processes, one per core, of about a minute each: the robot's
-    loop, then the fleet's, which calls it; the tick-by-tick robot and the batch engine, then pyribs' archive
-    (these share with the loops only small functions, which both may compile: numba writes a cache file whole,
-    by renaming it into place). A thread writes ``marker`` when both have ended, "ok" or their errors."""
+    loop, then the fleet's, which calls it; the tick-by-tick robot (physics.advance_called, which the fleet's
+    first reading then loads), the env and the batch engine, then pyribs' archive. A function both reach may
+    be compiled by both: numba writes a cache file whole, by renaming it into place. A thread writes
+    ``marker`` when both have ended, "ok" or their errors."""
 
     def __init__(self, shared: str, marker: Path):
         self.shared, self.marker, self.started = shared, marker, time.monotonic()

@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 
 from tablebot.sim import columns as L
-from tablebot.sim.physics import light_at, sense
+from tablebot.sim.kernel import sense
+from tablebot.sim.physics import light_at
 from tablebot.sim.runner import simulate
 from tablebot.sim.scene import Scene
 from tablebot.sim.sensing import sensor_events
+from tablebot.sim.simrobot import world_arrays
 from test_sim_helpers import room, scene_of
 
 SENSORS = """\
@@ -53,9 +55,7 @@ def read_at(scene: Scene, x: float, y: float, heading: float) -> np.ndarray:
     """The robot's state row after sensing at a pose (no motion)."""
     s = np.zeros(L.N_STATE)
     s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
-    g = scene.geometry
-    sense(s, scene.P[0], np.zeros(L.N_NOISE), g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines,
-          scene.bits)
+    sense(s, scene.P[0], *world_arrays(scene), np.zeros(L.N_NOISE), scene.bits)  # the simulator's own first reading
     return s
 
 

@@ -2,8 +2,8 @@
 
 Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
 take, on the smallest input that reaches each kernel with the argument types the tests give it:
-``loop`` (one robot's loop), ``fleet`` (the fleet loop, which calls it, and the env's physics-only loop),
-``tick`` (the tick-by-tick robot, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid
+``loop`` (one robot's loop), ``fleet`` (the fleet loop, which calls it), ``tick`` (the tick-by-tick robot,
+the env's physics-only loop, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid
 archive, which compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache).
 Numba caches one machine code per argument types, so a kernel reached here with other types than a test's is
 compiled again by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
@@ -21,43 +21,49 @@ EXAMPLES = ROOT / "examples"
 
 
 def warm_loop() -> None:
-    """One robot's compiled loop (``tablebot sim``'s), which the fleet's loop calls too."""
-    from tablebot.cli.common import load
-    from tablebot.sim.runner import simulate
-    from tablebot.sim.scene import scene_for
-
-    table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
-    simulate(scene_for(table, machine), 0.05, 1)
-
-
-def warm_tick() -> None:
-    """The tick-by-tick robot (the live loop's path) and the engine's batch loop on both mask types: they share
-    no compiled function with the loop but small ones, so another process compiles them meanwhile."""
+    """One robot's compiled loop (``tablebot sim``'s, and the run loop's block path)."""
     from tablebot.cli.common import load
     from tablebot.engine import Engine
     from tablebot.loop import SimulatedClock
     from tablebot.loop import run as run_loop
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import scene_for
+    from tablebot.sim.simrobot import SimRobot
+
+    table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
+    scene = scene_for(table, machine)
+    simulate(scene, 0.05, 1)
+    run_loop(Engine(machine), SimRobot(scene, 1), clock=SimulatedClock(), sinks=[], ticks=3)
+
+
+def warm_fleet() -> None:
+    """The fleet's loop, which calls one robot's (``loop`` first), and a robot's first reading, which calls
+    physics.advance_called (by then in the cache: ``tick`` compiles it first)."""
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import warm
+
+    warm(make_plan(EXAMPLES / "bumberbot" / "table.csv", None, [], [], "0", None, 1.0).jobs()[0])
+
+
+def warm_tick() -> None:
+    """What runs a tick at a time from Python: a robot's tick (physics.advance_called, compiled once for all of
+    them), the Gymnasium env's physics-only loop, and the engine's batch loop on both mask types."""
+    from tablebot.cli.common import load
+    from tablebot.engine import Engine
+    from tablebot.fleet.env import TableBotVectorEnv
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
     table, machine = load(EXAMPLES / "bumberbot" / "table.csv")
     robot = SimRobot(scene_for(table, machine), 1)
     robot.reset(seed=1)
-    run_loop(Engine(machine), robot, clock=SimulatedClock(), sinks=[], ticks=3)
-    for dtype in (np.uint8, np.int64):  # the two mask types the batch kernel is compiled for
-        Engine(machine).run(np.zeros(3, dtype=dtype))
-
-
-def warm_fleet() -> None:
-    from tablebot.fleet.env import TableBotVectorEnv
-    from tablebot.fleet.plan import make_plan
-    from tablebot.fleet.work import warm
-
-    warm(make_plan(EXAMPLES / "bumberbot" / "table.csv", None, [], [], "0", None, 1.0).jobs()[0])
+    robot.write([0] * len(machine.output_names))
     env = TableBotVectorEnv(num_envs=2, seconds=0.05)
     env.reset(seed=1)
     env.step(np.zeros((2, 2)))
     env.close()
+    for dtype in (np.uint8, np.int64):  # the two mask types the batch kernel is compiled for
+        Engine(machine).run(np.zeros(3, dtype=dtype))
 
 
 def warm_archive() -> None:

@@ -19,7 +19,7 @@ from tablebot.jit import njit
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.geometry import within
 from tablebot.sim.normals import standard_normal
-from tablebot.sim.physics import advance, aim_turns, new_near, reaches
+from tablebot.sim.physics import advance, advance_called, aim_turns, new_near, reaches
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -159,8 +159,8 @@ def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, b
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, False, np.empty((4, 2)),
-            reach, wide, near, centre, turns)
+    advance_called(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, False,
+                   np.empty((4, 2)), reach, wide, near, centre, turns)
 
 
 @njit(nogil=True)
@@ -171,6 +171,6 @@ def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines,
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, True,
-            np.empty((4, 2)), reach, wide, near, centre, turns)
+    advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, True,
+                   np.empty((4, 2)), reach, wide, near, centre, turns)
     observe(s, lamps, acc, collisions)

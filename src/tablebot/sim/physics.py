@@ -516,17 +516,6 @@ def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, sha
     s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
 
 
-@njit(cache=True)
-def sense(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, bits, shade=NO_SHADE):
-    """:func:`sense_near` on its own (a candidate list made for this one call)."""
-    near, centre = new_near(pstart, circles)
-    reach, wide = reaches(p)
-    turns = np.empty(4)
-    aim_turns(p, turns)
-    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
-               turns)
-
-
 @njit(cache=True, refcounts=False, inline="always")
 def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
             reach, wide, near, centre, turns):
@@ -542,3 +531,13 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lin
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
     sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
                turns)
+
+
+@njit(cache=True, refcounts=False)
+def advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move,
+                   corners, reach, wide, near, centre, turns):
+    """:func:`advance` compiled once as a function of its own, for the callers that run a tick at a time from
+    Python (sim.kernel.move and sense): a call costs them nothing they would notice, where each inlined copy
+    took numba ~20 s to compile. The loops that run many ticks inline :func:`advance` itself."""
+    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
+            reach, wide, near, centre, turns)
