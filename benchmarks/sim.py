@@ -81,7 +81,10 @@ def command(args: list[str]) -> tuple[float, float, float, float]:
     it and every process it started."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
+    # bytecode written and read as an installed tablebot's is (as benchmarks/fleet.py and startup.py): with
+    # PYTHONDONTWRITEBYTECODE set, an editable install compiles every edited module again in every run
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
     private = [0.0]
     sampler = threading.Thread(target=_sample_private, args=(proc.pid, private), daemon=True)
     sampler.start()
