@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -264,10 +265,7 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
             "functions = chunk_functions(1); before = [len(f.overloads) for f in functions]; "
             "second = ready_worker('testhost-1', 2, files); "
             "print(json.dumps([first, second, before, [len(f.overloads) for f in functions]]))")
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    first, second, before, after = json.loads(done.stdout.strip().splitlines()[-1])
+    first, second, before, after = worker_says(code, tmp_path / "job.pickle", worker_env)
     assert first["cache"] == second["cache"] == str(mine.parent / "worker-testhost-1")
     assert (first["installed"], first["loaded"]) == (0, 0) and before == [0] * len(before)
     assert second["installed"] == len(sent) and second["loaded"] == len(after) and after == [1] * len(after)
@@ -278,13 +276,17 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
             "early = 'numba' in sys.modules; from tablebot.fleet.work import ready_worker; "
             "job, files = pickle.load(open(sys.argv[1], 'rb')); ready_worker('testhost-2', 2, None, False); "
             "print(json.dumps([early, ready_worker('testhost-2', 2, files)]))")
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    early, info = json.loads(done.stdout.strip().splitlines()[-1])
+    early, info = worker_says(code, tmp_path / "job.pickle", worker_env)
     assert early and info["cache"] == str(mine.parent / "worker-testhost-2") and info["loaded"] == len(after)
     assert sorted(p.name for p in (mine.parent / "worker-testhost-2").rglob("*") if p.is_file()) == sent
 
+
+
+def worker_says(code: str, job: Path, env: dict[str, str]) -> Any:
+    """What a fresh process, as a worker, prints last (JSON) after running ``code`` on the pickled job."""
+    done = subprocess.run([sys.executable, "-c", code, str(job)], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.strip().splitlines()[-1])
 
 def test_a_job_with_threads_of_its_own_runs_on_them() -> None:
     """What a job runs on is the fleet's to say and set (evolve's jobs ask it too); numba keeps the count per
