@@ -72,12 +72,12 @@ def child_env(**changes: str | None) -> dict[str, str]:
     return env
 
 
-def tablebot(*args: str, env: dict[str, str] | None = None) -> float:
+def tablebot(*args: str) -> float:
     """Wall seconds of ``python -m tablebot ARGS`` as a fresh process (it must succeed); its CPU seconds go
     to ``CPU_S``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=env or child_env(),
+    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=child_env(),
                           capture_output=True, text=True)
     elapsed = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -24,6 +24,8 @@ if [ ${#missing[@]} -gt 0 ]; then
     ( $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" ) \
       >"$apt_log" 2>&1 &
     apt_pid=$!
+    # a Python step that fails (set -e) must not leave apt running unseen, holding dpkg's lock for the next try
+    trap 'if [ -n "$apt_pid" ]; then wait "$apt_pid" || cat "$apt_log" >&2; rm -f "$apt_log"; fi' EXIT
   else
     echo "warning: cannot install ${missing[*]} (no apt-get); diagram and firmware tests will fail" >&2
   fi
@@ -48,7 +50,8 @@ if [ ! -f .venv/.installed ] || [ pyproject.toml -nt .venv/.installed ]; then
 fi
 
 if [ -n "$apt_pid" ]; then
-  if ! wait "$apt_pid"; then
+  pid=$apt_pid; apt_pid=""  # waited for here: the exit trap has nothing left to do
+  if ! wait "$pid"; then
     cat "$apt_log" >&2
     echo "error: installing the system packages failed (above); run this script again once apt-get works" >&2
     rm -f "$apt_log"

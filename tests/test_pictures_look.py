@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.colours import PALETTE, state_colours
-from tablebot.sim import plots
+from tablebot.sim import plots, timeline
 from tablebot.sim.animate import Player
 from tablebot.sim.draw import literal_text
 from tablebot.sim.runner import simulate
@@ -168,10 +168,17 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
         warnings.simplefilter("always")
         patch.setattr(os, "cpu_count", lambda: 1)  # no painter: both pictures drawn in this process, seen here
         patch.setattr(plots, "png_bytes", keeping(plots.png_bytes))
-        patch.setattr(plots, "encoded", keeping(plots.encoded))
+        patch.setattr(plots, "encoded", keeping(plots.encoded))  # the trajectory's PNG
+        finish = timeline.TimelinePicture.finish  # the timeline's PNG is put together from bands: seen as drawn
+
+        def finishing(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+            figures.append(self.fig)
+            return finish(self, *args, **kwargs)
+        patch.setattr(timeline.TimelinePicture, "finish", finishing)
         result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "3", "-q", "--gif",
                                           "--out", str(tmp_path / "o")])
     assert result.exit_code == 0, result.output
+    assert len({id(fig) for fig in figures}) >= 2, "both pictures' figures are looked at"
     assert not [w for w in caught if "missing from" in str(w.message)], [str(w.message) for w in caught]
     texts = [t.get_text() for fig in figures for t in fig.findobj(Text)]
     assert any("Bot\\nFAKE \\x07\\x1b[31m $x^2$ in" in t for t in texts)

@@ -246,10 +246,7 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
             "print(json.dumps({**info, 'job_threads': job_threads(job)}))")
     worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
     worker_env["XDG_CACHE_HOME"] = str(home)
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.pickle")], env=worker_env,
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    info = json.loads(done.stdout.strip().splitlines()[-1])
+    info = worker_says(code, tmp_path / "job.pickle", worker_env)
     assert info["cache"] == str(mine) and info["threads"] == 1
     assert info["job_threads"] == 1  # a job without threads of its own takes the worker's share of the cores
     sent = sorted(name for named in files.values() for name in named)
@@ -281,12 +278,12 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     assert sorted(p.name for p in (mine.parent / "worker-testhost-2").rglob("*") if p.is_file()) == sent
 
 
-
 def worker_says(code: str, job: Path, env: dict[str, str]) -> Any:
     """What a fresh process, as a worker, prints last (JSON) after running ``code`` on the pickled job."""
     done = subprocess.run([sys.executable, "-c", code, str(job)], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout.strip().splitlines()[-1])
+
 
 def test_a_job_with_threads_of_its_own_runs_on_them() -> None:
     """What a job runs on is the fleet's to say and set (evolve's jobs ask it too); numba keeps the count per

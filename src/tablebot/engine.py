@@ -93,7 +93,7 @@ class Engine:
         self._tick = 0
         self.state = m.initial_state
         self.timer = m.initial_timer
-        self.counters = [0] * len(m.counter_bits)
+        self.counters = [0] * self._n_counters
         self.outputs: tuple[int, ...] = (0,) * len(m.output_names)
         self.event = 0
         self.row = NO_ROW
@@ -122,7 +122,7 @@ class Engine:
         if type(inputs) is not int or inputs < 0:  # type() is a call CPython specialises, x.__class__ is not
             inputs = self.events_of(inputs)
         tick = self._tick + 1
-        if pulses is not None and pulses is not _NONE:  # () and None: nothing to count (one identity test each)
+        if pulses is not None and pulses is not _NONE:  # None, and the () of callers without counters: nothing
             self._count_down(pulses, tick, inputs)
         try:
             self.event, self.row, effect = (self._running if tick < self._deadline
@@ -138,7 +138,8 @@ class Engine:
             outputs = tuple(old if new is None else new for old, new in zip(self.outputs, outputs, strict=True))
         self.outputs = outputs
         if loads:  # () unless the row loads a counter
-            self.counters = [old if new is None else new for old, new in zip(self._counters, loads, strict=True)]
+            self._counters = [old if new is None else new for old, new in zip(self._counters, loads, strict=True)]
+            self._choose_lookups()
         return outputs
 
     def events_of(self, inputs: int | Mapping[str, int]) -> int:
@@ -174,7 +175,7 @@ class Engine:
         first, so a refused tick changes nothing."""
         if tick == 1:
             return
-        if inputs >> self._width:
+        if inputs >> self._width:  # the lookup checks the mask only after the counters have changed: check it now
             self.events_of(inputs)  # raises
         counters = self._counters
         if len(pulses) != len(counters):
@@ -247,7 +248,7 @@ class Engine:
             from tablebot import engine_batch as kernels
 
             if kernels.available():
-                return self._run_compiled(arrays, _mask_array(masks, len(self.machine.table.events)),
+                return self._run_compiled(arrays, _mask_array(masks, self._width),
                                           self._pulse_array(pulses, len(masks)))
         if jit:
             raise RuntimeError("the compiled batch path needs numba and at most FLAT_BITS event columns")
@@ -330,7 +331,9 @@ class Engine:
         self.counters, self.outputs = counter_values, output_values
 
 
-_NONE: tuple[int, ...] = ()  # pulses that count nothing (callers pass it for counterless robots)
+# pulses that count nothing: a caller's () is this very object in CPython (one empty tuple), so step skips it
+# with an identity test; any other empty sequence reaches _count_down, which counts nothing either
+_NONE: tuple[int, ...] = ()
 
 #: What a fired row does: (next state, timer, outputs (None = keep), keeps any, counter loads or ()).
 Effect = tuple[int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]

@@ -145,7 +145,7 @@ class Fleet:
         self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
-        self.bitgens = np.zeros(n, dtype=np.uint64)  # where each robot's Generator keeps its C bit generator
+        self.bitgens = np.zeros(n, dtype=np.uint64)  # each robot's Generator's handle (sim.normals.bitgen_address)
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)

@@ -87,7 +87,7 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, 
               drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
               light_bits, t0):  # type: ignore[no-untyped-def]
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
-    rows, by a row drawn from the numpy Generator whose ``bitgen_t`` is at ``bitgen`` (sim.normals).
+    rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.normals.bitgen_address).
 
     Writes the robot at the start of each tick into ``hist`` (when it has rows) and each tick's
     integer record into ``ints`` (when it has rows), folds every new robot row into

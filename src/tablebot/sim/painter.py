@@ -114,8 +114,7 @@ class Painter:
         and renamed into place (the painter writes no file)."""
         made = self.shared.made if self.shared is not None else {}
         unshared = {name: getattr(result, name) for name in PICTURED if name not in made}
-        columns = result.hist_columns or tuple(range(L.N_STATE))
-        self.copy.send(("done", result.ticks, columns, ends_of(result), summary, unshared))
+        self.copy.send(("done", result.ticks, ends_of(result), summary, unshared))
         drawn = pickle.loads(self.copy.result())
         paths = [folder / name for name in PICTURES]
         for path, png in zip(paths, drawn, strict=True):
@@ -166,8 +165,9 @@ def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
                 and not inbox.waiting():  # the path so far, an eighth of the run at a time (more news: the next)
             hist, drawn = arrays["hist"], message[1]
             painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], drawn)
-    _, ticks, columns, ends, summary, unshared = message
+    _, ticks, ends, summary, unshared = message
     arrays.update(unshared)
-    run = RunView(scene, seed, arrays["hist"][: ticks + 1], columns, ends, arrays["states"][:ticks],
+    # the run's History kept the columns start chose (kept)
+    run = RunView(scene, seed, arrays["hist"][: ticks + 1], kept, ends, arrays["states"][:ticks],
                   arrays["outputs"][:ticks], arrays["events"][:ticks])
     return pickle.dumps(painting.finish(run, summary), protocol=5)

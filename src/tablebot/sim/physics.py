@@ -536,8 +536,9 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lin
 @njit(cache=True, refcounts=False)
 def advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move,
                    corners, reach, wide, near, centre, turns):
-    """:func:`advance` compiled once as a function of its own, for the callers that run a tick at a time from
-    Python (sim.kernel.move and sense): a call costs them nothing they would notice, where each inlined copy
-    took numba ~20 s to compile. The loops that run many ticks inline :func:`advance` itself."""
+    """:func:`advance` compiled once as a function of its own, for sim.kernel.move and sense: the tick-by-tick
+    robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
+    where a call per robot-tick costs little beside the rest of a controller's step, and each inlined copy
+    took numba ~20 s to compile. The loops that run the table too (run_robot) inline :func:`advance` itself."""
     advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
             reach, wide, near, centre, turns)

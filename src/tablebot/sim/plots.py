@@ -49,7 +49,6 @@ from tablebot.sim.summary import Summary
 from tablebot.sim.timeline import (  # noqa: F401 (the timeline's public functions, imported from here too)
     TimelinePicture,
     reading_panels,
-    timeline,
     timeline_figure,
 )
 from tablebot.sim.view import RunView, SceneView
@@ -141,8 +140,7 @@ class TrajectoryPicture:
 
     def png(self) -> bytes:
         """The picture as PNG: the bytes :func:`png_bytes` gives for the whole figure."""
-        if self.drawn is None:
-            return png_bytes(self.fig)
+        assert self.drawn is not None, "the rest is drawn over the arena (render_arena)"
         renderer = self.fig.canvas.get_renderer()
         # what Axes.draw and Figure.draw would draw after what is drawn, in their order (by z-order, stably)
         rest = sorted((a for a in self.ax.get_children() if a not in self.drawn), key=lambda a: a.get_zorder())

@@ -65,10 +65,15 @@ class SimRun:
     def ticks(self) -> int:
         return len(self.states)
 
+    @property
+    def held(self) -> tuple[int, ...]:
+        """The sim.columns each row of ``hist`` holds, in order."""
+        return self.hist_columns or tuple(range(L.N_STATE))
+
     def column(self, column: int) -> np.ndarray:
         """One column (sim.columns) of every robot row."""
         assert self.hist is not None, "the run kept no robot rows (simulate with rows=True)"
-        return self.hist[:, column if self.hist_columns is None else self.hist_columns.index(column)]
+        return self.hist[:, self.held.index(column)]
 
     @property
     def tick_s(self) -> float:

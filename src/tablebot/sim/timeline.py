@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import pickle
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
@@ -24,7 +23,7 @@ from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
 from tablebot.sim.forked import Forked
-from tablebot.sim.picture import DPI, declared_kinds, deflated, drawn_png, png_of_parts, save, subtitle_of, title
+from tablebot.sim.picture import DPI, declared_kinds, deflated, drawn_png, png_of_parts, subtitle_of, title
 from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:
@@ -32,12 +31,6 @@ if TYPE_CHECKING:
     from tablebot.sim.summary import Summary
 
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
-
-
-@literal_text()
-def timeline(result: Run, summary: Summary, path: Path) -> Path:
-    """The timeline of a run, written to ``path``."""
-    return save(timeline_figure(result, summary), path)
 
 
 @literal_text()

@@ -85,8 +85,7 @@ def picture_columns(table: Table) -> tuple[int, ...]:
 
 
 def _indices(result: SimRun, wanted: tuple[int, ...]) -> list[int]:
-    held = result.hist_columns or tuple(range(L.N_STATE))
-    return [held.index(c) for c in wanted]
+    return [result.held.index(c) for c in wanted]
 
 
 def ends_of(result: SimRun) -> np.ndarray:
