@@ -159,7 +159,10 @@ def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, b
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance_called(s, 0, 0, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, False,
+    # not the constants 0 and False: numba would compile advance_called again for their literal types
+    # (half a minute), since move passes variables
+    still, moving = np.int64(0), np.bool_(False)
+    advance_called(s, still, still, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, moving,
                    np.empty((4, 2)), reach, wide, near, centre, turns)
 
 
@@ -171,6 +174,6 @@ def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines,
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, True,
-                   np.empty((4, 2)), reach, wide, near, centre, turns)
+    advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits,
+                   np.bool_(True), np.empty((4, 2)), reach, wide, near, centre, turns)  # not True: see sense
     observe(s, lamps, acc, collisions)
