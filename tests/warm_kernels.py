@@ -11,10 +11,9 @@ compiled again by that test; conftest gives each worker a cache folder of its ow
 
 from __future__ import annotations
 
-import contextlib
 import sys
-from collections.abc import Iterator
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 
@@ -28,6 +27,7 @@ def warm_loop() -> None:
     from tablebot.engine import Engine
     from tablebot.loop import SimulatedClock
     from tablebot.loop import run as run_loop
+    from tablebot.sim import kernel
     from tablebot.sim.runner import simulate
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
@@ -37,21 +37,9 @@ def warm_loop() -> None:
     # A robot's first reading (kernel.sense) calls physics.advance_called, which the part beside this one
     # ("tick") compiles first; skipped here while the loop compiles, so that the two parts do not both spend
     # half a minute on it (the readings are wrong, the argument types the same: only the cache matters)
-    with _no_first_reading():
+    with mock.patch.object(kernel, "sense", lambda *args: None):
         simulate(scene, 0.05, 1)
     run_loop(Engine(machine), SimRobot(scene, 1), clock=SimulatedClock(), sinks=[], ticks=3)
-
-
-@contextlib.contextmanager
-def _no_first_reading() -> Iterator[None]:
-    from tablebot.sim import kernel
-
-    sense = kernel.sense
-    kernel.sense = lambda *args: None
-    try:
-        yield
-    finally:
-        kernel.sense = sense
 
 
 def warm_fleet() -> None:

@@ -81,6 +81,11 @@ class Runner:
             if self.client is None:
                 return 1
             return sum(w.get("nthreads", 1) for w in self.client.scheduler_info(n_workers=-1)["workers"].values()) or 1
+        return self._local_workers
+
+    @property
+    def _local_workers(self) -> int:
+        """The threads a local run has: ``--workers``, else one per core."""
         return max(1, self.workers or os.cpu_count() or 1)
 
     def start(self, imported: bool = True) -> None:
@@ -106,7 +111,7 @@ class Runner:
         leaves the GIL), instead of in the first chunks, the second thread waiting for numba's lock."""
         self._imported.set()
         if self.backend == "local" and self._loading is None:
-            threads = 1 if max(1, self.workers or os.cpu_count() or 1) > 1 else None  # as _run_local runs them
+            threads = 1 if self._local_workers > 1 else None  # as _run_local runs them
             self._loading = threading.Thread(target=preload_quietly, args=(threads,), name="tablebot-load",
                                              daemon=True)
             self._loading.start()
@@ -175,7 +180,7 @@ class Runner:
     # numba to import again in each, no jobs and summaries to pickle across (seconds of a short sweep's time).
 
     def _run_local(self, jobs: Sequence[Job], done: Done, fn: Callable[[Any], tuple[Job, Any]]) -> None:
-        workers = max(1, self.workers or os.cpu_count() or 1)
+        workers = self._local_workers
         if workers == 1 or len(jobs) == 1:  # numba's own threads share each chunk's robots out
             self.info = {"workers": 1, "threads": "numba's"}
             for job in jobs:
@@ -286,8 +291,7 @@ def ready_cluster(client: Any, imported: threading.Event | None = None) -> dict[
     Returns the files sent (a future held by every worker), the workers and the tasks, not waited for: the
     chunks wait for :func:`warm_cluster`."""
     places = slots(client)
-    futures = [client.submit(ready_worker, slot, share, None, False, workers=[address], allow_other_workers=False,
-                             pure=False, key=f"tablebot-import-{slot}") for address, slot, share in places]
+    futures = send_ready(client, places, None)
     if imported is not None:
         imported.wait()
     files = compiled_files()
@@ -298,10 +302,11 @@ def ready_cluster(client: Any, imported: threading.Event | None = None) -> dict[
 
 
 def send_ready(client: Any, places: Sequence[tuple[str, str, int]], files: Any) -> list[Any]:
-    """:func:`~tablebot.fleet.work.ready_worker` with the compiled code ``files`` (scattered) to each worker
-    of ``places``, pinned to it."""
-    return [client.submit(ready_worker, slot, share, files, workers=[address], allow_other_workers=False,
-                          pure=False, key=f"tablebot-ready-{slot}") for address, slot, share in places]
+    """:func:`~tablebot.fleet.work.ready_worker` to each worker of ``places``, pinned to it: with the compiled
+    code ``files`` (scattered) to load, or, with None, its imports alone."""
+    load, step = (False, "import") if files is None else (True, "ready")
+    return [client.submit(ready_worker, slot, share, files, load, workers=[address], allow_other_workers=False,
+                          pure=False, key=f"tablebot-{step}-{slot}") for address, slot, share in places]
 
 
 def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) -> dict[str, Any]:

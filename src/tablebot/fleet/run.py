@@ -110,7 +110,6 @@ class Fleet:
         self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
         self._prepared = prepared or Prepared()
-        self._scenes = self._prepared.scenes
         self.scenes = [self.scene_of(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
         self._tick_noise: NoiseRows | None = None
@@ -120,14 +119,15 @@ class Fleet:
     def scene_of(self, spec: RobotSpec) -> Scene:
         """The robot's scene: the table in the world with its parameters (made once per parameter set)
         and its start; every robot of a fleet must be wired alike."""
-        if spec.params not in self._scenes:
+        scenes = self._prepared.scenes
+        if spec.params not in scenes:
             scene = prepare(self.table, self.machine, self.world_model, self.robot_params, spec.overrides())
-            first = next(iter(self._scenes.values()), scene)
+            first = next(iter(scenes.values()), scene)
             if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
                                                                            first.pulse_columns):
                 raise ValueError("robots of one fleet must share their wiring")
-            self._scenes[spec.params] = scene
-        return with_start(self._scenes[spec.params], spec.start)
+            scenes[spec.params] = scene
+        return with_start(scenes[spec.params], spec.start)
 
     def _setup(self, traced: Sequence[int]) -> None:
         """Every robot's rows (see :meth:`place`), and what the fleet shares."""
