@@ -93,7 +93,8 @@ def test_preload_loads_what_the_cache_holds_before_the_first_call_and_compiles_n
     assert first.returncode == 0, first.stderr
     load_it = """
 from tablebot.fleet.work import preload
-from tablebot.sim.physics import body_corners, duty
+from tablebot.sim.contacts import body_corners
+from tablebot.sim.physics import duty
 print(preload(duty), len(duty.overloads), preload(body_corners), len(body_corners.overloads))
 print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_misses.values()))
 """

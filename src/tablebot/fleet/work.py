@@ -225,10 +225,10 @@ def chunk_functions(threads: int | None) -> tuple[Any, ...]:
     loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
     calling thread)."""
     from tablebot.fleet.kernel import run_fleet, run_fleet_serial
-    from tablebot.sim import kernel, physics
+    from tablebot.sim import contacts, kernel
 
     loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
-    return (physics.body_corners, physics.deepest_contact, kernel.sense, kernel.observe, *loops)
+    return (contacts.body_corners, contacts.deepest_contact, kernel.sense, kernel.observe, *loops)
 
 
 def warm_worker(job: Job, slot: str, share: int = 1,

@@ -17,9 +17,10 @@ import numpy as np
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
+from tablebot.sim.contacts import new_near, reaches
 from tablebot.sim.geometry import within
 from tablebot.sim.normals import standard_normal
-from tablebot.sim.physics import advance, advance_called, aim_turns, new_near, reaches
+from tablebot.sim.physics import advance, advance_called, aim_turns
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------

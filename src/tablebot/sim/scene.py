@@ -17,6 +17,7 @@ from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
+from tablebot.sim.contacts import body_corners, deepest_contact
 from tablebot.sim.params import (
     INPUT_ROLES,
     Params,
@@ -25,7 +26,6 @@ from tablebot.sim.params import (
     problems,
     top_speed,
 )
-from tablebot.sim.physics import body_corners, deepest_contact
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
 
