@@ -45,7 +45,7 @@ class Diagnostic:
 class TableBotError(Exception):
     """Raised with every problem of an input; the CLI prints them and exits with code 2."""
 
-    def __init__(self, diagnostics: Iterable[Diagnostic]):
+    def __init__(self, diagnostics: Iterable[Diagnostic]) -> None:
         self.diagnostics = tuple(diagnostics)
         super().__init__("\n".join(d.render() for d in self.diagnostics))
 
@@ -53,7 +53,7 @@ class TableBotError(Exception):
 class Collector:
     """Gathers diagnostics for one file so a loader can report all of them at once."""
 
-    def __init__(self, path: str | Path):
+    def __init__(self, path: str | Path) -> None:
         self.path = str(path)
         self.items: list[Diagnostic] = []
 

@@ -24,7 +24,7 @@ def seconds(ticks: float, tick_ms: int) -> float:
 class DurationError(ValueError):
     """A duration that cannot be read or is no whole number of ticks; ``hint`` says what to write."""
 
-    def __init__(self, message: str, hint: str):
+    def __init__(self, message: str, hint: str) -> None:
         super().__init__(message)
         self.message, self.hint = message, hint
 

@@ -25,7 +25,8 @@ class Batch:
 
     FIELDS = ("events", "rows", "states", "timers")
 
-    def __init__(self, events: Sequence[int], rows: Sequence[int], states: Sequence[int], timers: Sequence[int]):
+    def __init__(self, events: Sequence[int], rows: Sequence[int], states: Sequence[int],
+                 timers: Sequence[int]) -> None:
         self._columns: dict[str, Sequence[int]] = dict(zip(self.FIELDS, (events, rows, states, timers), strict=True))
 
     def _list(self, name: str) -> list[int]:
@@ -80,7 +81,7 @@ class Engine:
     else starting with ``_`` is the machine, precomputed for speed.
     """
 
-    def __init__(self, machine: Machine):
+    def __init__(self, machine: Machine) -> None:
         self.machine = machine
         self._width = len(machine.table.events)
         self._counter_bits = machine.counter_bits if any(machine.counter_bits) else ()
@@ -356,7 +357,7 @@ class _Lookups(dict[int, list[Any]]):
     makes those events.
     """
 
-    def __init__(self, machine: Machine):
+    def __init__(self, machine: Machine) -> None:
         super().__init__()
         self.machine = machine
         self.effects = [_effect(row) for row in machine.rows]
@@ -392,7 +393,7 @@ class _Lookups(dict[int, list[Any]]):
 class _WideEntries(dict[int, Entry]):
     """One state's lookup in a table wider than FLAT_BITS events: input mask -> entry, made on first use."""
 
-    def __init__(self, lookups: _Lookups, state: int, present: int):
+    def __init__(self, lookups: _Lookups, state: int, present: int) -> None:
         super().__init__()
         self.lookups, self.state, self.present = lookups, state, present
 

@@ -189,7 +189,7 @@ class PendingFile:
     """A file written over time (a live trace): open under a temporary name, then :meth:`commit` it
     to its final name or :meth:`keep_partial` under a name that says it is incomplete."""
 
-    def __init__(self, path: str | Path, encoding: str = "utf-8"):
+    def __init__(self, path: str | Path, encoding: str = "utf-8") -> None:
         self.path = _target(path)
         self.direct = is_special(self.path)  # a device or pipe is written as it comes, never renamed onto
         if self.direct:

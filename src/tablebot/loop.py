@@ -176,7 +176,7 @@ class RealTimeClock:
     free_running = False
 
     def __init__(self, tick_s: float, now: Callable[[], float] = time.monotonic,
-                 sleep: Callable[[float], None] = time.sleep):
+                 sleep: Callable[[float], None] = time.sleep) -> None:
         self.tick_s, self.now, self.sleep = tick_s, now, sleep
         self.origin, self.anchor, self.anchor_tick = 0.0, 0.0, 0
         self.behind_s = 0.0
@@ -212,7 +212,7 @@ class Watchdog:
     stops the robot's outputs at the deadline and the loop ends when the call returns.
     """
 
-    def __init__(self, deadline_s: float | None):
+    def __init__(self, deadline_s: float | None) -> None:
         self.deadline_s = deadline_s
         self._use_signal = False
         self._timer: threading.Timer | None = None
@@ -325,7 +325,7 @@ class Pace:
     tick is a little too slow (which the clock's restarted grid would otherwise hide while the table's
     timers run slow). ``note`` takes each tick's number and the clock's ``behind_s``."""
 
-    def __init__(self, tick_s: float, limit_s: float, window_s: float = BEHIND_WINDOW_S):
+    def __init__(self, tick_s: float, limit_s: float, window_s: float = BEHIND_WINDOW_S) -> None:
         self.tick_s, self.limit_s, self.window_s = tick_s, limit_s, window_s
         self._ticks: deque[tuple[int, float]] = deque()  # (tick, wall time since start) of recent ticks
 

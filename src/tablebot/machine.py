@@ -54,7 +54,7 @@ class Dispatch(dict[int, int]):
     """One state's map from (events masked to the bits its rows use) to the first match; key 0 is then
     every event set with none of those bits, so the empty set's answer is :meth:`Machine.lookup`'s."""
 
-    def __init__(self, rows: Sequence[CompiledRow]):
+    def __init__(self, rows: Sequence[CompiledRow]) -> None:
         super().__init__()
         self.rows = tuple(rows)
         self.relevant = 0

@@ -15,7 +15,8 @@ TICK, STATE, TIMER, EVENT, ROW = 0, 1, 2, 3, 4
 N_REGS = 5
 
 
-def tick(regs, outputs, counters, inputs, pulses, program):  # type: ignore[no-untyped-def]
+def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: int, pulses: np.ndarray,
+         program: tuple) -> int:
     """One tick of the document's engine; returns the fired row (-1: none).
 
     1. after the first tick the timer counts down (never below 0) and each counter by its pulses;

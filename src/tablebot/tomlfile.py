@@ -89,7 +89,7 @@ def too_deep(text: str) -> tuple[int, int] | None:
 class Source:
     """A parsed TOML file and its text, for error locations."""
 
-    def __init__(self, path: str | Path, text: str, data: dict[str, Any]):
+    def __init__(self, path: str | Path, text: str, data: dict[str, Any]) -> None:
         self.path, self.text, self.data = str(path), text, data
         self.out = Collector(self.path)
         self._lines = text.splitlines()

@@ -72,7 +72,7 @@ class _Parser:
     """Recursive descent: or > and > not > atom; builds closures as it goes (a chain of ``and`` or ``or``
     as one closure over all its terms, so a thousand terms do not nest a thousand calls)."""
 
-    def __init__(self, tokens: list[str], machine: Machine):
+    def __init__(self, tokens: list[str], machine: Machine) -> None:
         self.tokens, self.pos, self.machine = tokens, 0, machine
         self.input_bits = 0
         self.depth = 0

@@ -57,7 +57,7 @@ class Monitor:
 
 
 class Never(Monitor):
-    def __init__(self, bad: Any):
+    def __init__(self, bad: Any) -> None:
         self.bad = bad
 
     def step(self, state: Any, obs: Obs) -> Any:
@@ -69,7 +69,7 @@ class Respond(Monitor):
 
     start = -1
 
-    def __init__(self, when: Any, then: Any, within: int):
+    def __init__(self, when: Any, then: Any, within: int) -> None:
         self.when, self.then, self.within = when, then, within
 
     def step(self, age: Any, obs: Obs) -> Any:

@@ -53,7 +53,7 @@ class Stages:
     """A progress bar on a terminal's stderr for a command made of steps, shown only once it has taken
     longer than ``delay`` seconds (a quick run prints nothing extra); use as a context manager."""
 
-    def __init__(self, total: int, delay: float = 1.0):
+    def __init__(self, total: int, delay: float = 1.0) -> None:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
         self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),

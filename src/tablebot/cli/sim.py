@@ -128,7 +128,7 @@ class _Imports:
     an import short (a compiled module interrupted mid-import surfaces as an ImportError). :meth:`join`
     waits for them and raises what an import raised."""
 
-    def __init__(self, modules: list[Callable[[], None]]):
+    def __init__(self, modules: list[Callable[[], None]]) -> None:
         import threading
 
         self.modules, self.failed = modules, None

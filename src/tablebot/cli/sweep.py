@@ -146,7 +146,7 @@ class Bar:
     """A rich progress bar of ``label`` done out of ``total`` and the time left (on a terminal only); given
     the robot-ticks of one item (``ticks``), also the robot-ticks per second."""
 
-    def __init__(self, label: str, total: int, quiet: bool, done: int = 0, ticks: int | None = None):
+    def __init__(self, label: str, total: int, quiet: bool, done: int = 0, ticks: int | None = None) -> None:
         self.label, self.total, self.done, self.ticks = label, total, done, ticks
         self.quiet = quiet or not err_console.is_terminal
         self.started = time.perf_counter()

@@ -121,7 +121,7 @@ class Journal:
     """``OUT/evaluations.partial.json``: every evaluation so far, rewritten (atomically) after each batch,
     with what they were measured on. The same command run again takes them instead of running them."""
 
-    def __init__(self, path: Path, plan: Plan, cells: list[Cell], objective: str):
+    def __init__(self, path: Path, plan: Plan, cells: list[Cell], objective: str) -> None:
         self.path = path
         self.tuning = {"spec": plan.spec.to_json(), "cells": [c.label for c in cells], "objective": objective}
         self.count = 0

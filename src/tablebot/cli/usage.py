@@ -51,7 +51,7 @@ class OptionError(ClickException):
 
     exit_code = 2
 
-    def __init__(self, diagnostic: Diagnostic):
+    def __init__(self, diagnostic: Diagnostic) -> None:
         super().__init__(diagnostic.message)
         self.diagnostic = diagnostic
 

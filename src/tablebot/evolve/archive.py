@@ -34,7 +34,7 @@ class TableEmitter(EmitterBase):
     """Asks for ``batch`` children of elites chosen uniformly from the archive (MAP-Elites' selection);
     ``breed`` varies, proves and deduplicates them."""
 
-    def __init__(self, archive: GridArchive, breed: Breed, batch: int, seed: int):
+    def __init__(self, archive: GridArchive, breed: Breed, batch: int, seed: int) -> None:
         super().__init__(archive, solution_dim=archive.solution_dim, bounds=None, lower_bounds=None,
                          upper_bounds=None)
         self.breed, self.batch, self.seed = breed, batch, seed

@@ -95,7 +95,7 @@ def run_eval(job: EvalJob) -> tuple[EvalJob, dict[str, np.ndarray]]:
 class Poses:
     """What the robots' sampled poses add up to: laps round the loop, floor squares visited, contact."""
 
-    def __init__(self, fleet: Fleet, world: World):
+    def __init__(self, fleet: Fleet, world: World) -> None:
         from tablebot.sim.track import loop_of
 
         self.fleet, self.n = fleet, len(fleet)

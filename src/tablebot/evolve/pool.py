@@ -43,7 +43,7 @@ class Answer(Protocol):
 class Later:
     """A task run here, when its answer is first asked for (or never, when nobody asks)."""
 
-    def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]):
+    def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
         self.fn, self.args = fn, args
         self.done, self.value = False, None
 
@@ -59,7 +59,7 @@ class Later:
 class Answered:
     """A worker's answer (a future), asked for with :meth:`get`; :meth:`drop` when it is not wanted."""
 
-    def __init__(self, future: Any):
+    def __init__(self, future: Any) -> None:
         self.future = future
 
     def get(self) -> Any:
@@ -85,7 +85,7 @@ class Workers:
     They come from a fork server, so, as for any ``multiprocessing`` program, the main module must be
     importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
 
-    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None):
+    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None) -> None:
         self.count = max(1, count if count is not None else os.cpu_count() or 1)
         self.context = Context(Prover(list(files)), base)
         self.pool: Any = None

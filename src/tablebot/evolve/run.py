@@ -79,7 +79,7 @@ class Store:
     """The output folder's record of the run: ``spec.json`` (what is searched: another spec in the same
     folder is refused) and ``evaluations.jsonl`` (one line per evaluated candidate, as it finishes)."""
 
-    def __init__(self, folder: Path, spec: dict[str, Any]):
+    def __init__(self, folder: Path, spec: dict[str, Any]) -> None:
         self.folder, self.spec = folder, json.dumps(spec, indent=1, sort_keys=True) + "\n"
         self.path = folder / "evaluations.jsonl"
         self.proofs = folder / "proofs.jsonl"

@@ -55,7 +55,7 @@ class Runner:
     """A backend kept open over many batches of jobs (a tuning run sends one batch per generation):
     the local worker threads or the Dask client start, and warm up, once."""
 
-    def __init__(self, backend: str = "local", address: str | None = None, workers: int | None = None):
+    def __init__(self, backend: str = "local", address: str | None = None, workers: int | None = None) -> None:
         self.backend, self.address, self.workers = backend, address, workers
         self.pool: Any = None
         self.client: Any = None

@@ -37,7 +37,7 @@ class Setup:
     """The table, world and parameters an environment runs, loaded once (errors as in ``tablebot sim``)."""
 
     def __init__(self, table: str | Path | None, world: str | Path | None, robot: str | Path | None,
-                 seconds: float, battery: float | None):
+                 seconds: float, battery: float | None) -> None:
         from tablebot.examples import example_path
         from tablebot.formats.table_read import load_table, resolve_table_path
         from tablebot.machine import compile_table
@@ -74,7 +74,7 @@ class TableBotEnv(gym.Env):
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
 
     def __init__(self, table: str | Path | None = None, world: str | Path | None = None, seconds: float = 60.0,
-                 battery: float | None = None, robot: str | Path | None = None, render_mode: str | None = None):
+                 battery: float | None = None, robot: str | Path | None = None, render_mode: str | None = None) -> None:
         from tablebot.engine import Engine
         from tablebot.sim.simrobot import SimRobot
 
@@ -122,7 +122,7 @@ class TableBotVectorEnv(VectorEnv):
 
     def __init__(self, num_envs: int = 8, table: str | Path | None = None, world: str | Path | None = None,
                  seconds: float = 60.0, battery: float | None = None, robot: str | Path | None = None,
-                 render_mode: str | None = None):
+                 render_mode: str | None = None) -> None:
         from tablebot.fleet.run import Fleet
 
         self.setup = Setup(table, world, robot, seconds, battery)

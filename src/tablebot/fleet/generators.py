@@ -32,7 +32,7 @@ class _Words(ISeedSequence):
 
     __slots__ = ("words",)
 
-    def __init__(self, words: np.ndarray):
+    def __init__(self, words: np.ndarray) -> None:
         self.words = words
 
     def generate_state(self, n_words: int, dtype: type = np.uint32) -> np.ndarray:

@@ -17,9 +17,12 @@ from tablebot.sim.kernel import move, run_robot
 
 
 @njit(nogil=True)
-def run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols, ticks,
-            noise, bitgens, acc, collisions, light_bits, t0, counts, first_visit, first_light, traced, hist,
-            ints):  # type: ignore[no-untyped-def]
+def run_one(i: int, S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple, timers: np.ndarray,
+            loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray,
+            bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgens: np.ndarray,
+            acc: np.ndarray, collisions: np.ndarray, light_bits: int, t0: int, counts: np.ndarray,
+            first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray, hist: np.ndarray,
+            ints: np.ndarray) -> None:
     """Robot i of :func:`run_fleet`."""
     input_mask, timer_bit, lookup, nxt, _, new_outputs, keep, _, load_set, counter_bits = program
     v = variant[i]
@@ -35,9 +38,12 @@ def run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, coun
 
 
 @njit(nogil=True, parallel=True)
-def run_fleet(S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols, ticks,
-              noise, bitgens, acc, collisions, light_bits, t0, counts, first_visit, first_light, traced, hist,
-              ints):  # type: ignore[no-untyped-def]
+def run_fleet(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple,
+              timers: np.ndarray, loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray,
+              counters: np.ndarray, bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int,
+              noise: np.ndarray, bitgens: np.ndarray, acc: np.ndarray, collisions: np.ndarray, light_bits: int,
+              t0: int, counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray,
+              hist: np.ndarray, ints: np.ndarray) -> None:
     """Advance every robot ``ticks`` ticks: robot i runs ``run_robot`` on row i of each per-robot array, with
     its program variant's timers and counter loads (``variant[i]``), its noise rows ``noise[i]`` or, when
     they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.normals).
@@ -51,9 +57,12 @@ def run_fleet(S, P, world, program, timers, loads, variant, regs, outputs, count
 
 
 @njit(nogil=True)
-def run_fleet_serial(S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols,
-                     ticks, noise, bitgens, acc, collisions, light_bits, t0, counts, first_visit, first_light, traced,
-                     hist, ints):  # type: ignore[no-untyped-def]
+def run_fleet_serial(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple,
+                     timers: np.ndarray, loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray,
+                     counters: np.ndarray, bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int,
+                     noise: np.ndarray, bitgens: np.ndarray, acc: np.ndarray, collisions: np.ndarray, light_bits: int,
+                     t0: int, counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray,
+                     hist: np.ndarray, ints: np.ndarray) -> None:
     """:func:`run_fleet` on this thread alone (small fleets, single-threaded workers: no thread pool to wake)."""
     for i in range(S.shape[0]):
         run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols, ticks,
@@ -61,13 +70,15 @@ def run_fleet_serial(S, P, world, program, timers, loads, variant, regs, outputs
 
 
 @njit(nogil=True, parallel=True)
-def move_parallel(S, P, world, commands, noise, bits, acc, collisions):  # type: ignore[no-untyped-def]
+def move_parallel(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+                  bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     for i in prange(S.shape[0]):
         move(S[i], commands[i, 0], commands[i, 1], P[i], *world, noise[i], bits, acc[i], collisions[i])
 
 
 @njit(nogil=True)
-def move_serial(S, P, world, commands, noise, bits, acc, collisions):  # type: ignore[no-untyped-def]
+def move_serial(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+                bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     for i in range(S.shape[0]):
         move(S[i], commands[i, 0], commands[i, 1], P[i], *world, noise[i], bits, acc[i], collisions[i])
 
@@ -83,7 +94,8 @@ def parallel(robots: int, ticks: int) -> bool:
     return robots > 1 and robots * ticks >= PARALLEL_WORK and numba.get_num_threads() > 1
 
 
-def move_fleet(S, P, world, commands, noise, bits, acc, collisions):  # type: ignore[no-untyped-def]
+def move_fleet(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+               bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """One tick of physics for every robot with the motor levels ``commands[i]`` (right, left) given
     from outside (a learned controller): ``sim.kernel.move`` on each robot's rows."""
     kernel = move_parallel if parallel(S.shape[0], 1) else move_serial

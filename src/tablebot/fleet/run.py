@@ -103,7 +103,7 @@ class Fleet:
 
     def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
                  robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
-                 variants: Variants | None = None, prepared: Prepared | None = None):
+                 variants: Variants | None = None, prepared: Prepared | None = None) -> None:
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
@@ -325,7 +325,7 @@ class NoiseRows:
 
     BLOCK = 256
 
-    def __init__(self, fleet: Fleet):
+    def __init__(self, fleet: Fleet) -> None:
         self.fleet = fleet
         n = len(fleet)
         self.rows = np.empty((n, self.BLOCK, L.N_NOISE))

@@ -48,7 +48,7 @@ def serial_ports() -> list[PortInfo]:
 class SerialPort:
     """``device`` opened at ``baudrate`` 8N1, no flow control, exclusive (a second program cannot interleave)."""
 
-    def __init__(self, device: str, baudrate: int):
+    def __init__(self, device: str, baudrate: int) -> None:
         self.device, self.baudrate = device, baudrate
         self.port: serial.Serial | None = None
         self.unsent = b""  # the rest of a write that a signal cut short

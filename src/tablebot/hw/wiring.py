@@ -275,7 +275,7 @@ def _error(src: Source, line: int | None, message: str, hint: str) -> None:
 class _Reader:
     """Reads the section's entries one robot name at a time, remembering terminals already taken."""
 
-    def __init__(self, spec: Terminals, robot: Robot, src: Source, section: dict[str, Any]):
+    def __init__(self, spec: Terminals, robot: Robot, src: Source, section: dict[str, Any]) -> None:
         self.spec, self.robot, self.src, self.section = spec, robot, src, section
         self.taken: dict[tuple[str, str], str] = {}  # (input/output/counter, terminal) -> name
 

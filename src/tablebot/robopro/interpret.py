@@ -132,7 +132,7 @@ def _pins(function: ET.Element) -> Pins:
 class Program:
     """A parsed .rpp: its subprograms (function element and pins), ready to run."""
 
-    def __init__(self, text: str):
+    def __init__(self, text: str) -> None:
         root = ET.fromstring(text.encode("utf-8"))
         self.functions = {f.get("name", ""): f for f in root.iter("o")
                           if f.get("classname") == "ftProSubroutineFunction"}
@@ -155,7 +155,7 @@ class Run:
     """The program running against scripted inputs: ``digital[n]`` is terminal In's level, ``counts[n]``
     counter Cn's count."""
 
-    def __init__(self, program: Program):
+    def __init__(self, program: Program) -> None:
         self.program = program
         self.variables: dict[str, int] = {}
         self.lists: dict[str, list[int]] = {}

@@ -35,7 +35,7 @@ INDENT = "            "  # elements inside a subprogram
 class Builder:
     """Builds the subprograms of one plan, sharing one id counter."""
 
-    def __init__(self, p: Plan):
+    def __init__(self, p: Plan) -> None:
         self.p = p
         self.ids = Ids()
         self.inits = {"ST": p.initial_state, "TM": p.initial_timer}
@@ -60,7 +60,7 @@ class Builder:
         self.send(sheet, element, target)
         return element
 
-    def side_send(self, sheet: Sheet, exit_pin, target: str | int, command: str, value: int | None = None,
+    def side_send(self, sheet: Sheet, exit_pin: Pin, target: str | int, command: str, value: int | None = None,
                   data: Tree | None = None, hold: bool = False) -> None:
         sheet.side(exit_pin, [lambda x, y: el.message(x, y, command, value)], data=[data],
                    extra=lambda e: self.send(sheet, e, target), hold=hold)

@@ -24,7 +24,7 @@ Point = tuple[int, int]
 class Ids:
     """Ids as ROBO Pro writes them: positive, unique in the document."""
 
-    def __init__(self, start: int = 100_000):
+    def __init__(self, start: int = 100_000) -> None:
         self.next = start
 
     def __call__(self) -> int:
@@ -109,7 +109,7 @@ class WirePin:
 class Canvas:
     """One subprogram's drawing: its elements and wires; ids come from the document's counter."""
 
-    def __init__(self, ids: Ids):
+    def __init__(self, ids: Ids) -> None:
         self.ids = ids
         self.elements: list[Element] = []
         self.wires: list[Wire] = []

@@ -77,7 +77,7 @@ class Join:
 class Sheet:
     """A subprogram being laid out: a column at ``x`` whose flow continues from ``tail``."""
 
-    def __init__(self, canvas: Canvas, x: int, inits: dict[str, int], indent: str):
+    def __init__(self, canvas: Canvas, x: int, inits: dict[str, int], indent: str) -> None:
         self.canvas, self.x, self.inits, self.indent = canvas, x, inits, indent
         self.tail: Pin | None = None
         self.y = 0  # lowest y used so far in the column

@@ -58,7 +58,7 @@ def _default(name: str, kind: str, robot: Robot) -> int | None:
 class _Reader:
     """Reads entries; errors go to the robot file's collector, or (for a robot made in code) to a list."""
 
-    def __init__(self, src: Source | None, robot: Robot):
+    def __init__(self, src: Source | None, robot: Robot) -> None:
         self.src, self.robot = src, robot
         self.errors: list[tuple[str, str, str]] = []
 

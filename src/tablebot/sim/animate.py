@@ -33,7 +33,7 @@ GIF_MAX_FRAMES = 240  # longer runs play faster: a 120 s run becomes a 24 s gif 
 class Player:
     """Draws frame k of a run onto a figure; shared by the gif writer and the live window."""
 
-    def __init__(self, fig: Figure, result: SimRun, summary: Summary, ticks_per_frame: int, speed: float):
+    def __init__(self, fig: Figure, result: SimRun, summary: Summary, ticks_per_frame: int, speed: float) -> None:
         self.result, self.step = result, ticks_per_frame
         scene = result.scene
         self.ax = fig.add_axes((0.08, 0.08, 0.9, 0.78))

@@ -45,7 +45,8 @@ NEAR_MARGIN = 0.05
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def might_be_near(px, py, verts, a, b, pbound, k, reach):
+def might_be_near(px: float, py: float, verts: np.ndarray, a: int, b: int, pbound: np.ndarray, k: int,
+                  reach: float) -> bool:
     """Whether convex piece verts[a:b] may come within ``reach`` of point p (the broad phase).
 
     Never wrong in the other direction: a piece it rules out is farther than ``reach`` (with a 1 µm
@@ -66,13 +67,14 @@ def might_be_near(px, py, verts, a, b, pbound, k, reach):
 
 
 @njit(cache=True)
-def new_near(pstart, circles):
+def new_near(pstart: np.ndarray, circles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Scratch space of one robot's candidate list (see :func:`refresh_near`): the list, and where it was made."""
     return np.zeros(2 + pstart.shape[0] - 1 + circles.shape[0], dtype=np.int64), np.zeros(3)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def refresh_near(x, y, reach, verts, pstart, pbound, circles, near, centre):
+def refresh_near(x: float, y: float, reach: float, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+                 circles: np.ndarray, near: np.ndarray, centre: np.ndarray) -> None:
     """Keep ``near`` the list of the pieces and circles that may come within ``reach`` of the robot's centre
     (x, y) -- near[0] pieces, then near[1] circles, their indices from near[2] on, in index order -- remade
     only when the robot is half NEAR_MARGIN away from where it was made (``centre``: x, y, 1 when made).
@@ -102,7 +104,7 @@ def refresh_near(x, y, reach, verts, pstart, pbound, circles, near, centre):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def body_corners_at(s, p, c, sn, out):
+def body_corners_at(s: np.ndarray, p: np.ndarray, c: float, sn: float, out: np.ndarray) -> None:
     """The body rectangle's corners in world coordinates (front-right, front-left, rear-left, rear-right),
     given the heading's cosine ``c`` and sine ``sn``."""
     f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
@@ -112,18 +114,18 @@ def body_corners_at(s, p, c, sn, out):
 
 
 @njit(cache=True, refcounts=False)
-def body_corners(s, p, out):
+def body_corners(s: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     """The body rectangle's corners in world coordinates: front-right, front-left, rear-left, rear-right."""
     body_corners_at(s, p, math.cos(s[TH]), math.sin(s[TH]), out)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def bounding_radius(p):
+def bounding_radius(p: np.ndarray) -> float:
     return math.hypot(max(p[P_FRONT], p[P_REAR]), p[P_HALF_W])
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def reaches(p):
+def reaches(p: np.ndarray) -> tuple[float, float]:
     """The bounding radius (the contacts' broad phase), and the reach a candidate list must serve (the
     bumpers': the radius plus the switch travel), computed as every caller computes them."""
     reach = bounding_radius(p)
@@ -134,7 +136,8 @@ def reaches(p):
 
 
 @njit(cache=True, refcounts=False)
-def piece_contact(ux, uy, corners, verts, a, b):
+def piece_contact(ux: float, uy: float, corners: np.ndarray, verts: np.ndarray, a: int,
+                  b: int) -> tuple[float, float, float, float, float]:
     """Separating-axis test of the body (heading cosine ``ux`` and sine ``uy``, corners ``corners``) against
     convex piece verts[a:b].
 
@@ -193,7 +196,8 @@ def piece_contact(ux, uy, corners, verts, a, b):
 
 
 @njit(cache=True, refcounts=False)
-def circle_contact(s, p, c, sn, cx, cy, radius):
+def circle_contact(s: np.ndarray, p: np.ndarray, c: float, sn: float, cx: float, cy: float,
+                   radius: float) -> tuple[float, float, float, float, float]:
     """Body rectangle (heading cosine ``c``, sine ``sn``) against a circle; the result as :func:`piece_contact`'s."""
     rx, ry = cx - s[X], cy - s[Y]
     bx, by = c * rx + sn * ry, -sn * rx + c * ry  # circle centre in the body frame
@@ -220,7 +224,9 @@ def circle_contact(s, p, c, sn, cx, cy, radius):
 
 
 @njit(cache=True, refcounts=False)
-def deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near):
+def deepest_near(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+                 pbound: np.ndarray, circles: np.ndarray, reach: float,
+                 near: np.ndarray) -> tuple[tuple[float, float, float, float, float], float, float]:
     """The deepest overlap of the body with the pieces and circles of candidate list ``near`` that the
     broad phase keeps for ``reach`` (bounding circles prune the rest), scanned in index order; and the
     heading's cosine and sine (worked out, with the corners, only when something is that near).
@@ -253,7 +259,8 @@ def deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near):
 
 
 @njit(cache=True)
-def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
+def deepest_contact(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+                    pbound: np.ndarray, circles: np.ndarray) -> tuple[float, float, float, float, float]:
     """The deepest overlap of the body with any piece or circle (bounding circles prune the rest)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
@@ -262,7 +269,9 @@ def deepest_contact(s, p, corners, verts, pstart, pbound, circles):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre):
+def resolve(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+            pbound: np.ndarray, circles: np.ndarray, reach: float, wide: float, near: np.ndarray,
+            centre: np.ndarray) -> bool:
     """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn);
     returns whether it moved the robot. ``reach``/``wide``: :func:`reaches`; ``near``/``centre``: the
     robot's candidate list (:func:`refresh_near`).
@@ -298,7 +307,8 @@ def resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, ce
 
 
 @njit(cache=True, refcounts=False)
-def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near_circles):
+def near_plate(s: np.ndarray, c: float, sn: float, gap: float, x0: float, y0: float, x1: float, y1: float,
+               verts: np.ndarray, pstart: np.ndarray, near: int, circles: np.ndarray, near_circles: int) -> bool:
     """Whether anything lies within the switch travel ``gap`` of a bumper plate given in the body frame
     (``c``, ``sn``: the heading's cosine and sine; ``near``/``near_circles``: bits of the pieces and
     circles the broad phase kept, the 63rd bit standing for every piece from the 63rd on)."""
@@ -321,7 +331,8 @@ def near_plate(s, c, sn, gap, x0, y0, x1, y1, verts, pstart, near, circles, near
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def broad_phase(s, reach, verts, pstart, pbound, circles, near):
+def broad_phase(s: np.ndarray, reach: float, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+                circles: np.ndarray, near: np.ndarray) -> tuple[int, int]:
     """Bits of the pieces and of the circles of candidate list ``near`` that may lie within ``reach`` of the
     robot's centre (exact: what it rules out is farther); pieces and circles from the 63rd on share bit 62
     and are kept. The same bits as a scan of every piece, since the list leaves out only far ones."""
@@ -340,7 +351,9 @@ def broad_phase(s, reach, verts, pstart, pbound, circles, near):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre):
+def sense_bumpers(s: np.ndarray, p: np.ndarray, c: float, sn: float, verts: np.ndarray, pstart: np.ndarray,
+                  pbound: np.ndarray, circles: np.ndarray, reach: float, wide: float, near: np.ndarray,
+                  centre: np.ndarray) -> None:
     """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and
     rear; ``c``/``sn``: the heading's cosine and sine; the rest as :func:`resolve`'s."""
     f, r, w, ov, wrap, gap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP], p[P_GAP]

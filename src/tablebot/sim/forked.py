@@ -34,7 +34,7 @@ _LENGTHS = struct.Struct("<QQ")  # a message's frame: the pickle's length, how m
 class Inbox:
     """The messages :meth:`Forked.send` hands the work, in order: :meth:`get` waits for the next one."""
 
-    def __init__(self, pipe: int | None = None, messages: Sequence[object] = ()):
+    def __init__(self, pipe: int | None = None, messages: Sequence[object] = ()) -> None:
         self.pipe, self.messages = pipe, list(messages)
 
     def get(self) -> Any:
@@ -60,7 +60,7 @@ class Forked:
     system) is replaced the same way. Use it as a context manager: leaving the block without the result
     kills the copy."""
 
-    def __init__(self, work: Callable[[Inbox], bytes]):
+    def __init__(self, work: Callable[[Inbox], bytes]) -> None:
         self.work = work
         self.sent: list[object] = []
         self.pid: int | None = None

@@ -8,12 +8,16 @@ segments, segment crossings, and whether anything blocks a straight line of sigh
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from tablebot.jit import njit
 
+if TYPE_CHECKING:
+    import numpy as np
+
 
 @njit(cache=True, refcounts=False)
-def point_segment_distance(px, py, ax, ay, bx, by):
+def point_segment_distance(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
     """Distance from point p to segment ab."""
     ex, ey = bx - ax, by - ay
     length2 = ex * ex + ey * ey
@@ -29,7 +33,7 @@ TINY = 1e-100  # below this, r² loses precision (underflow): such radii always 
 
 
 @njit(cache=True, refcounts=False)
-def within(dx, dy, r, strict=False):
+def within(dx: float, dy: float, r: float, strict: bool = False) -> bool:
     """``math.hypot(dx, dy) <= r`` (``< r`` when ``strict``): exactly that answer, but hypot (about 15 ns
     here, five times a square root) runs only when the squared distance does not already show that the
     point is farther. Most tests of a broad phase, a bumper or a lamp are far misses."""
@@ -39,7 +43,8 @@ def within(dx, dy, r, strict=False):
 
 
 @njit(cache=True, refcounts=False)
-def point_segment_within(px, py, ax, ay, bx, by, r, strict=False):
+def point_segment_within(px: float, py: float, ax: float, ay: float, bx: float, by: float, r: float,
+                         strict: bool = False) -> bool:
     """``point_segment_distance(px, py, ax, ay, bx, by) <= r`` (``< r`` when ``strict``), by :func:`within`."""
     ex, ey = bx - ax, by - ay
     length2 = ex * ex + ey * ey
@@ -54,7 +59,8 @@ LINE_MARGIN = 1e-9
 
 
 @njit(cache=True, refcounts=False)
-def segments_within(ax, ay, bx, by, cx, cy, dx, dy, r):
+def segments_within(ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float,
+                    r: float) -> bool:
     """Whether segments ab and cd come within ``r`` of each other (0 apart when they cross): the nearest
     of the four endpoint-to-segment distances, each tested by :func:`within`.
 
@@ -75,7 +81,7 @@ def segments_within(ax, ay, bx, by, cx, cy, dx, dy, r):
 
 
 @njit(cache=True, refcounts=False)
-def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
+def segments_cross(ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float) -> bool:
     """Whether segments ab and cd intersect (touching counts). The sides of a and b against line cd are
     compared first: most pairs are refused there, before the sides of c and d are worked out."""
     d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
@@ -88,7 +94,8 @@ def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
 
 
 @njit(cache=True, refcounts=False)
-def shadowed(sx, sy, lx, ly, lamp, edges, circles):
+def shadowed(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray,
+             circles: np.ndarray) -> bool:
     """Whether a wall, obstacle edge or circle blocks the straight line from sensor to lamp."""
     for k in range(edges.shape[0]):
         if segments_cross(sx, sy, lx, ly, edges[k, 0], edges[k, 1], edges[k, 2], edges[k, 3]):

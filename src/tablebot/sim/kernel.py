@@ -51,7 +51,7 @@ def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
+def observe(s: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """Fold one robot row into the running summary: reaching a lamp and the start of each collision
     (a rise of any bumper or contact with no touch in the debounce rows before it)."""
     row = acc[A_ROWS]
@@ -73,7 +73,8 @@ def observe(s, lamps, acc, collisions):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def tally(counts, first_visit, first_light, light_bits, state, mask, tick):  # type: ignore[no-untyped-def]
+def tally(counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, state: int, mask: int,
+          tick: int) -> None:
     """Count a tick that ends in ``state`` (ticks per state, the first tick in each) and note the first tick
     whose input ``mask`` has any of ``light_bits``: what a fleet keeps of a robot's ticks."""
     counts[state] += 1
@@ -84,9 +85,12 @@ def tally(counts, first_visit, first_light, light_bits, state, mask, tick):  # t
 
 
 @njit(nogil=True)
-def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
-              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
-              light_bits, t0):  # type: ignore[no-untyped-def]
+def run_robot(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+              edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
+              program: tuple, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, bits: np.ndarray,
+              drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgen: np.uint64,
+              hist: np.ndarray, ints: np.ndarray, acc: np.ndarray, collisions: np.ndarray, counts: np.ndarray,
+              first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, t0: int) -> None:
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
     rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.normals.bitgen_address).
 
@@ -106,9 +110,14 @@ def run_robot(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, 
 
 
 @njit(nogil=True, refcounts=False)
-def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
-              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
-              light_bits, t0, pulses, corners, reach, wide, near, centre, turns, z):  # type: ignore[no-untyped-def]
+def run_ticks(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+              edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
+              program: tuple, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, bits: np.ndarray,
+              drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgen: np.uint64,
+              hist: np.ndarray, ints: np.ndarray, acc: np.ndarray, collisions: np.ndarray, counts: np.ndarray,
+              first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, t0: int, pulses: np.ndarray,
+              corners: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
+              turns: np.ndarray, z: np.ndarray) -> None:
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
     n_counters = counters.shape[0]
     for t in range(ticks):
@@ -135,7 +144,8 @@ def run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, 
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-untyped-def]
+def _record(ints: np.ndarray, t: int, mask: int, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray,
+            pulses: np.ndarray) -> None:
     ints[t, I_MASK] = mask
     ints[t, I_EVENT] = regs[EVENT]
     ints[t, I_ROW] = regs[ROW]
@@ -154,7 +164,9 @@ def _record(ints, t, mask, regs, outputs, counters, pulses):  # type: ignore[no-
 
 
 @njit(nogil=True)
-def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits):  # type: ignore[no-untyped-def]
+def sense(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray, edges: np.ndarray,
+          circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray, z: np.ndarray,
+          bits: np.ndarray) -> None:
     """Read the sensors without moving (the start of a run)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
@@ -168,8 +180,9 @@ def sense(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, b
 
 
 @njit(nogil=True)
-def move(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, acc,
-         collisions):  # type: ignore[no-untyped-def]
+def move(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+         pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
+         shade: np.ndarray, z: np.ndarray, bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import ctypes
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 from llvmlite import ir
@@ -33,6 +34,13 @@ from numba.extending import intrinsic
 from numba.np.random._constants import fi_double, ki_double, wi_double, ziggurat_nor_inv_r, ziggurat_nor_r
 
 from tablebot.jit import njit
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from numba.core.base import BaseContext
+    from numba.core.typing import Signature
+    from numba.core.typing.context import BaseContext as TypingContext
 
 _capsule_pointer = ctypes.pythonapi.PyCapsule_GetPointer
 _capsule_pointer.restype = ctypes.c_void_p
@@ -135,37 +143,39 @@ def bitgen_addresses(rngs: list[np.random.Generator]) -> np.ndarray:
 
 
 @intrinsic
-def _word(typingctx, address):  # type: ignore[no-untyped-def]
+def _word(typingctx: TypingContext, address: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
     """The 64-bit word stored at ``address``."""
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+    def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         return builder.load(builder.inttoptr(args[0], ir.IntType(64).as_pointer()))
     return types.uint64(types.uint64), codegen
 
 
 @intrinsic
-def _next_uint64(typingctx, function, state):  # type: ignore[no-untyped-def]
+def _next_uint64(typingctx: TypingContext, function: types.Type,
+                 state: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
     """Call the bit generator's ``uint64_t next_uint64(void *state)`` at address ``function``."""
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+    def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         kind = ir.FunctionType(ir.IntType(64), [ir.IntType(64)])
         return builder.call(builder.inttoptr(args[0], kind.as_pointer()), [args[1]])
     return types.uint64(types.uint64, types.uint64), codegen
 
 
 @intrinsic
-def _next_double(typingctx, function, state):  # type: ignore[no-untyped-def]
+def _next_double(typingctx: TypingContext, function: types.Type,
+                 state: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
     """Call the bit generator's ``double next_double(void *state)`` at address ``function``."""
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+    def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         kind = ir.FunctionType(ir.DoubleType(), [ir.IntType(64)])
         return builder.call(builder.inttoptr(args[0], kind.as_pointer()), [args[1]])
     return types.float64(types.uint64, types.uint64), codegen
 
 
 @intrinsic
-def _pcg64_next64(typingctx, address):  # type: ignore[no-untyped-def]
+def _pcg64_next64(typingctx: TypingContext, address: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
     """numpy's ``pcg64_next64`` on the ``pcg64_random_t`` (state, inc: 128-bit each) at ``address``
     (numpy/random/src/pcg64/pcg64.h, pcg_setseq_128_xsl_rr_64_random_r): state = state * multiplier + inc,
     stored back; the output is the XSL-RR of the new state."""
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+    def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         i64, i128 = ir.IntType(64), ir.IntType(128)
         words = builder.inttoptr(args[0], i128.as_pointer())
         inc_words = builder.gep(words, [ir.Constant(ir.IntType(32), 1)])
@@ -180,7 +190,7 @@ def _pcg64_next64(typingctx, address):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _next64(handle):  # type: ignore[no-untyped-def]
+def _next64(handle: np.uint64) -> np.uint64:
     """The bit generator's next_uint64 (see :func:`bitgen_address` for ``handle``)."""
     if handle & np.uint64(INLINE):
         return _pcg64_next64(handle - np.uint64(INLINE))
@@ -188,7 +198,7 @@ def _next64(handle):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _next_uniform(handle):  # type: ignore[no-untyped-def]
+def _next_uniform(handle: np.uint64) -> float:
     """The bit generator's next_double: for PCG64 numpy's ``uint64_to_double`` of next_uint64 (_common.pxd)."""
     if handle & np.uint64(INLINE):
         return float(_pcg64_next64(handle - np.uint64(INLINE)) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
@@ -196,7 +206,7 @@ def _next_uniform(handle):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def standard_normal(bitgen):  # type: ignore[no-untyped-def]
+def standard_normal(bitgen: np.uint64) -> float:
     """One draw of ``Generator.standard_normal()`` from the Generator whose handle (:func:`bitgen_address`)
     is ``bitgen`` (numpy's ``random_standard_normal``, line for line)."""
     handle = np.uint64(bitgen)
@@ -223,7 +233,7 @@ def standard_normal(bitgen):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False)
-def fill(bitgen, out):  # type: ignore[no-untyped-def]
+def fill(bitgen: np.uint64, out: np.ndarray) -> None:
     """``Generator.standard_normal(out=out)`` for a one-dimensional ``out``."""
     for k in range(out.shape[0]):
         out[k] = standard_normal(bitgen)

@@ -135,7 +135,7 @@ class Painter:
 class _Progress:
     """A sink that tells the painter where the run's shared arrays are, then how far the run is."""
 
-    def __init__(self, painter: Painter):
+    def __init__(self, painter: Painter) -> None:
         self.painter = painter
 
     def start(self, info: RunInfo) -> None:

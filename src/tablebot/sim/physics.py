@@ -79,7 +79,8 @@ NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 # --- light ---------------------------------------------------------------------------------------
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_side(s, c, sn, p, side, ct, st, edges, circles, lamps, shade):
+def light_side(s: np.ndarray, c: float, sn: float, p: np.ndarray, side: float, ct: float, st: float,
+               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
     ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
     the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
@@ -88,14 +89,15 @@ def light_side(s, c, sn, p, side, ct, st, edges, circles, lamps, shade):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def aim_turns(p, out):
+def aim_turns(p: np.ndarray, out: np.ndarray) -> None:
     """``out``: cosine and sine of the right phototransistor's turn from the heading, then the left one's."""
     out[0], out[1] = math.cos(-1.0 * p[P_TOE]), math.sin(-1.0 * p[P_TOE])
     out[2], out[3] = math.cos(1.0 * p[P_TOE]), math.sin(1.0 * p[P_TOE])
 
 
 @njit(cache=True)
-def light_at(s, p, side, edges, circles, lamps, shade=NO_SHADE):
+def light_at(s: np.ndarray, p: np.ndarray, side: float, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
+             shade: np.ndarray = NO_SHADE) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
     turns = np.empty(4)
     aim_turns(p, turns)
@@ -108,19 +110,20 @@ def light_at(s, p, side, edges, circles, lamps, shade=NO_SHADE):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def duty(level, levels):
+def duty(level: int, levels: float) -> float:
     """The fraction of full power a speed level gives (the table's 1..8 are PWM duty level/8)."""
     return min(1.0, abs(level) / levels)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def pack_volts(full, empty, charge, amps, ohms):
+def pack_volts(full: float, empty: float, charge: float, amps: float, ohms: float) -> float:
     """Battery terminal volts: open-circuit volts fall linearly with the charge and sag with the current."""
     return empty + (full - empty) * charge - amps * ohms
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def motor(s, p, level, volts, gain, speed, enc, pul, noise):
+def motor(s: np.ndarray, p: np.ndarray, level: int, volts: float, gain: int, speed: int, enc: int, pul: int,
+          noise: float) -> None:
     """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
     The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
@@ -134,7 +137,7 @@ def motor(s, p, level, volts, gain, speed, enc, pul, noise):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def drive(s, cmd, p, z):
+def drive(s: np.ndarray, cmd: tuple[int, int], p: np.ndarray, z: np.ndarray) -> None:
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
     dt = p[P_DT]
     amps = p[P_IIDLE] + p[P_IMOTOR] * (duty(cmd[0], p[P_LEVELS]) + duty(cmd[1], p[P_LEVELS]))
@@ -152,7 +155,7 @@ def drive(s, cmd, p, z):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def input_mask(s, bits):
+def input_mask(s: np.ndarray, bits: np.ndarray) -> int:
     """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
     mask = 0
     if s[BUMP_FR] > 0.0:
@@ -169,8 +172,10 @@ def input_mask(s, bits):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
-               turns):
+def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
+               bits: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
+               turns: np.ndarray) -> None:
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
@@ -187,8 +192,10 @@ def sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, sha
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
-            reach, wide, near, centre, turns):
+def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+            pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
+            shade: np.ndarray, z: np.ndarray, bits: np.ndarray, move: bool, corners: np.ndarray, reach: float,
+            wide: float, near: np.ndarray, centre: np.ndarray, turns: np.ndarray) -> None:
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2); ``reach``, ``wide``:
     :func:`~tablebot.sim.contacts.reaches`; ``near`` and ``centre`` the robot's candidate list
@@ -205,8 +212,10 @@ def advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lin
 
 
 @njit(cache=True, refcounts=False)
-def advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move,
-                   corners, reach, wide, near, centre, turns):
+def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
+                   pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
+                   shade: np.ndarray, z: np.ndarray, bits: np.ndarray, move: bool, corners: np.ndarray,
+                   reach: float, wide: float, near: np.ndarray, centre: np.ndarray, turns: np.ndarray) -> None:
     """:func:`advance` compiled once as a function of its own, for sim.kernel.move and sense: the tick-by-tick
     robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
     where a call per robot-tick costs little beside the rest of a controller's step, and each inlined copy

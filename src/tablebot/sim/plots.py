@@ -54,6 +54,8 @@ from tablebot.sim.timeline import (  # noqa: F401 (the timeline's public functio
 from tablebot.sim.view import RunView, SceneView
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
+    from matplotlib.axes import Axes
+
     from tablebot.sim.picture import Run
     from tablebot.sim.scene import Scene
 
@@ -81,7 +83,7 @@ class TrajectoryPicture:
     above the one before (z-order), and the title and tick labels lie outside the axes, where nothing later
     draws (all of the run is clipped to the axes, the summary line and legends are outside them)."""
 
-    def __init__(self, scene: SceneView | Scene, ticks: int, seed: int):
+    def __init__(self, scene: SceneView | Scene, ticks: int, seed: int) -> None:
         world = scene.world
         xs, ys = zip(*world.walls, strict=True)
         aspect = (max(ys) - min(ys)) / max(1e-9, max(xs) - min(xs))
@@ -159,7 +161,7 @@ class Painting:
     it is over (:meth:`finish`: the timeline by a fork of this process on the other core,
     :mod:`tablebot.sim.forked`)."""
 
-    def __init__(self, scene: SceneView, ticks: int, seed: int):
+    def __init__(self, scene: SceneView, ticks: int, seed: int) -> None:
         with literal_text():  # the timeline first: when the run ends early, its fork can start at once
             self.timeline = TimelinePicture(scene, ticks, seed)
             self.trajectory = TrajectoryPicture(scene, ticks, seed)
@@ -192,7 +194,7 @@ class PathPieces:
     Made as the run goes: each :meth:`grow` gives the pieces completed since the last, the same pieces
     (to the last bit) as the whole run's rows would give at once."""
 
-    def __init__(self, step: float = PATH_STEP_M):
+    def __init__(self, step: float = PATH_STEP_M) -> None:
         self.step = step
         self.start = 0  # the first row of the piece not given yet
         self.known = 0  # the rows whose thinning is known: 0..known
@@ -227,7 +229,7 @@ class PathPieces:
         return pieces, states[starts].tolist()
 
 
-def _markers(ax, result: RunView, summary: Summary) -> None:
+def _markers(ax: Axes, result: RunView, summary: Summary) -> None:
     scene, rows = result.scene, list(summary.collision_ticks)
     x, y, heading = result.column(L.X), result.column(L.Y), result.column(L.TH)
     if rows:  # where the body touched the wall or obstacle; one artist for all of them: an hour has hundreds
@@ -244,7 +246,7 @@ def _markers(ax, result: RunView, summary: Summary) -> None:
         ax.plot(x[row], y[row], marker="D", markersize=11, color=REACHED, markeredgecolor=WALL, zorder=9)
 
 
-def _robot_poses(ax, result: RunView) -> None:
+def _robot_poses(ax: Axes, result: RunView) -> None:
     """The robot at its start (faded) and at its end, with its lamps as they were last set."""
     (first, last_row), scene = result.ends, result.scene
     n_lamps, sensors = len(scene.lamp_outputs), scene.table.robot.sensors

@@ -113,7 +113,7 @@ class History:
     COLUMNS = ("masks", "events", "rows", "states", "timers", "outputs", "counters", "pulses")
 
     def __init__(self, robot: SimRobot, dtype: type = np.float64, rows: bool | tuple[int, ...] = True,
-                 zeros: Zeros = _zeros):
+                 zeros: Zeros = _zeros) -> None:
         self.robot, self.dtype, self.zeros = robot, dtype, zeros
         self.rows = bool(rows)
         self.kept = None if isinstance(rows, bool) else tuple(rows)  # the columns kept (None: all)
@@ -171,7 +171,7 @@ class History:
 class Progress:
     """A sink that reports ticks done (every block) to a callback."""
 
-    def __init__(self, report: Callable[[int], None]):
+    def __init__(self, report: Callable[[int], None]) -> None:
         self.report = report
 
     def start(self, info: RunInfo) -> None:

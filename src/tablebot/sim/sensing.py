@@ -8,6 +8,7 @@ Each is a compiled function of one robot's state row ``s``, its parameter row ``
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from tablebot.jit import njit
 from tablebot.sensors import SENSOR_KINDS, threshold_event
@@ -38,13 +39,17 @@ from tablebot.sim.columns import (
 from tablebot.sim.geometry import point_segment_distance, point_segment_within
 from tablebot.sim.shadows import NO_SHADE, shadowed_near
 
+if TYPE_CHECKING:
+    import numpy as np
+
 threshold = njit(inline="always")(threshold_event)  # the rule of every analog input, compiled in
 #: The codes of the kinds whose physics is here (tablebot.sensors.SENSOR_KINDS): a branch each below.
 K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "distance", "light"))
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps, shade=NO_SHADE):
+def light_from(s: np.ndarray, c: float, sn: float, p: np.ndarray, lx: float, ly: float, turn: float,
+               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray = NO_SHADE) -> float:
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
     sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine;
     ``shade``: the world's shadow grid, sim.shadows).
@@ -70,7 +75,7 @@ def light_from(s, c, sn, p, lx, ly, turn, edges, circles, lamps, shade=NO_SHADE)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def lamp_light(p, intensity, cosine, d):
+def lamp_light(p: np.ndarray, intensity: float, cosine: float, d: float) -> float:
     """What one unshadowed lamp in view gives at distance ``d`` and ``cosine`` off the sensor's axis."""
     d = max(d, p[P_DMIN])
     # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
@@ -79,7 +84,8 @@ def lamp_light(p, intensity, cosine, d):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_turned(s, c, sn, p, lx, ly, turn, ct, st, edges, circles, lamps, shade):
+def light_turned(s: np.ndarray, c: float, sn: float, p: np.ndarray, lx: float, ly: float, turn: float, ct: float,
+                 st: float, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray) -> float:
     """:func:`light_from`'s answer, for a sensor whose turn from the heading has cosine ``ct`` and sine ``st``:
     each lamp is first ruled out cheaply when surely out of view (:func:`out_of_view`) or in shadow, and only
     the lamps left are worked out as light_from does (the aim's cos/sin and the hypot only for them).
@@ -118,7 +124,7 @@ AIM_SLACK = 1e-9
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def out_of_view(dx, dy, ax, ay, cos_fov):
+def out_of_view(dx: float, dy: float, ax: float, ay: float, cos_fov: float) -> bool:
     """Whether a lamp at (dx, dy) from a sensor whose aim is (ax, ay) to within AIM_SLACK is surely outside
     its field of view (``cos_fov`` >= 0) -- decided with neither the aim's own cos/sin nor a hypot, both
     dearer than the test. True only when no rounding can make it wrong: light_from then skips the lamp."""
@@ -131,7 +137,7 @@ def out_of_view(dx, dy, ax, ay, cos_fov):
 
 
 @njit(cache=True, refcounts=False)
-def on_a_line(x, y, lines):
+def on_a_line(x: float, y: float, lines: np.ndarray) -> float:
     """1.0 when the floor point (x, y) lies on a piece of tape (within its half width of its middle), else 0.0."""
     for k in range(lines.shape[0]):
         if point_segment_within(x, y, lines[k, 0], lines[k, 1], lines[k, 2], lines[k, 3], lines[k, 4]):
@@ -140,7 +146,7 @@ def on_a_line(x, y, lines):
 
 
 @njit(cache=True, refcounts=False)
-def beam_segment(ux, uy, cb, sb, ax, ay, bx, by):
+def beam_segment(ux: float, uy: float, cb: float, sb: float, ax: float, ay: float, bx: float, by: float) -> float:
     """Distance from the beam's apex (the origin) to the nearest point of segment ab inside the beam.
 
     (ux, uy) is the beam's axis, cb and sb the cosine and sine of its half angle; a and b are relative to
@@ -165,7 +171,7 @@ def beam_segment(ux, uy, cb, sb, ax, ay, bx, by):
 
 
 @njit(cache=True, refcounts=False)
-def beam_circle(ux, uy, cb, sb, cx, cy, radius):
+def beam_circle(ux: float, uy: float, cb: float, sb: float, cx: float, cy: float, radius: float) -> float:
     """Distance from the beam's apex to the nearest point of a disc (centre relative to the apex) inside the beam.
 
     The nearest point of the disc lies towards its centre; when the centre is outside the beam the
@@ -188,7 +194,7 @@ def beam_circle(ux, uy, cb, sb, cx, cy, radius):
 
 
 @njit(cache=True, refcounts=False)
-def echo(sx, sy, aim, p, edges, circles):
+def echo(sx: float, sy: float, aim: float, p: np.ndarray, edges: np.ndarray, circles: np.ndarray) -> float:
     """An ultrasonic sensor's reading in metres: the nearest wall, obstacle edge or circle inside its beam.
 
     Rounded to the sensor's resolution and never below its blind zone; with nothing in range it reads
@@ -218,7 +224,8 @@ def echo(sx, sy, aim, p, edges, circles):
 
 
 @njit(cache=True, refcounts=False)
-def sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade=NO_SHADE):
+def sense_declared(s: np.ndarray, c: float, sn: float, p: np.ndarray, edges: np.ndarray, circles: np.ndarray,
+                   lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray = NO_SHADE) -> None:
     """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
     (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.shadows)."""
     for k in range(MAX_SENSORS):
@@ -238,7 +245,7 @@ def sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade=NO_SHADE):
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sensor_events(s, p, bits, previous):
+def sensor_events(s: np.ndarray, p: np.ndarray, bits: np.ndarray, previous: int) -> int:
     """The event bits of the declared sensors (:func:`tablebot.sensors.threshold_event`: a reading past its
     threshold turns the event on; once on, it stays on until the reading is back past the threshold by the
     hysteresis; ``previous`` = last mask)."""

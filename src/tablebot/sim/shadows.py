@@ -95,7 +95,8 @@ def _circle_may_block(corners: np.ndarray, lamp: np.ndarray, circle: np.ndarray,
 
 
 @njit(cache=True, refcounts=False)
-def shadowed_near(sx, sy, lx, ly, lamp, edges, circles, shade):
+def shadowed_near(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray, circles: np.ndarray,
+                  shade: np.ndarray) -> bool:
     """:func:`tablebot.sim.geometry.shadowed`'s answer, testing only the pieces the grid ``shade`` lists for
     the sensor's cell (every piece when there is no grid or the sensor is outside it)."""
     if shade.shape[0] == 0:

@@ -33,7 +33,7 @@ class SimRobot:
     tick at a time; :meth:`advance` runs the engine and the physics for many ticks in compiled code.
     """
 
-    def __init__(self, scene: Scene, seed: int = 1, record_history: bool = True):
+    def __init__(self, scene: Scene, seed: int = 1, record_history: bool = True) -> None:
         self.scene = scene
         self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
         self._world = world_arrays(scene)
@@ -163,7 +163,7 @@ class Starter:
     what every robot of the scene shares worked out once: a fleet starts thousands of robots with one,
     writing into its own rows, without a SimRobot each."""
 
-    def __init__(self, scene: Scene):
+    def __init__(self, scene: Scene) -> None:
         params = scene.params
         self.world, self.p, self.bits = world_arrays(scene), scene.P[0], scene.bits
         self.row = np.zeros(L.N_STATE)  # all but the pose and the motor gains
@@ -233,7 +233,7 @@ class RowFields(Mapping[str, Any]):
     """The trace fields of one robot row (:meth:`SimRobot.trace_fields`), worked out only when asked for:
     a Gymnasium step or a fleet's set-up reads the mask and the pulses alone."""
 
-    def __init__(self, robot: SimRobot, s: np.ndarray):
+    def __init__(self, robot: SimRobot, s: np.ndarray) -> None:
         self.robot, self.s = robot, s
         self._fields: dict[str, float | int] | None = None
 
@@ -255,7 +255,7 @@ class RowFields(Mapping[str, Any]):
 class LazyColumns(Mapping[str, Sequence[float]]):
     """The trace fields of a block, made only when a sink asks for them (most runs keep no trace)."""
 
-    def __init__(self, scene: Scene, hist: np.ndarray):
+    def __init__(self, scene: Scene, hist: np.ndarray) -> None:
         self.scene, self.hist = scene, hist
         self.keys_ = tuple(key for key, *_ in trace_layout(scene))
         self._columns: dict[str, list[float]] | None = None

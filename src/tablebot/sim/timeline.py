@@ -52,7 +52,7 @@ class TimelinePicture:
     as the object is), then the run (:meth:`finish`). Artists go in in the order of a figure made at once,
     so the pixels are the same."""
 
-    def __init__(self, scene: SceneView, ticks: int, seed: int):
+    def __init__(self, scene: SceneView, ticks: int, seed: int) -> None:
         self.scene = scene
         self.readings = reading_panels(scene)
         self.fig = fig = Figure(figsize=(12, 7.2 + 1.8 * len(self.readings)), dpi=DPI)

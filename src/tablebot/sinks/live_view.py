@@ -46,7 +46,7 @@ def motor_bar(speed: int) -> Text:
 class LiveView:
     """A :class:`tablebot.loop.Sink` drawing the run on ``console`` (give it stderr so stdout stays clean)."""
 
-    def __init__(self, console: Console, device: str = ""):
+    def __init__(self, console: Console, device: str = "") -> None:
         self.console, self.device = console, device
         self.info: RunInfo | None = None
         self.last: dict[str, Any] = {}

@@ -31,7 +31,7 @@ WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was writt
 class RunTrace(TraceFile):
     """Writes ``trace.jsonl`` and ``summary.json`` into ``folder`` while the run goes."""
 
-    def __init__(self, folder: Path, clock: Callable[[], float] = time.time):
+    def __init__(self, folder: Path, clock: Callable[[], float] = time.time) -> None:
         super().__init__(folder / "trace.jsonl")
         self.folder, self.clock = folder, clock
         self.info: RunInfo | None = None

@@ -131,7 +131,7 @@ class TraceFile:
     and an error met (a full disk) is raised there or at the next block.
     """
 
-    def __init__(self, path: str | Path, background: bool = False):
+    def __init__(self, path: str | Path, background: bool = False) -> None:
         self.path = Path(path)
         self.background = background
         self.written: Path | None = None

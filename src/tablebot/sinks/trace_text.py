@@ -92,7 +92,8 @@ def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
 
 
 @njit(nogil=True, refcounts=False)
-def _lines(out, pieces, piece_ends, kinds, ints, floats, decimals, names, name_ends):  # type: ignore[no-untyped-def]
+def _lines(out: np.ndarray, pieces: np.ndarray, piece_ends: np.ndarray, kinds: np.ndarray, ints: np.ndarray,
+           floats: np.ndarray, decimals: np.ndarray, names: np.ndarray, name_ends: np.ndarray) -> int:
     at = 0
     for t in range(ints.shape[0]):
         start = 0
@@ -115,7 +116,7 @@ def _lines(out, pieces, piece_ends, kinds, ints, floats, decimals, names, name_e
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _copy(out, at, source, a, b):  # type: ignore[no-untyped-def]
+def _copy(out: np.ndarray, at: int, source: np.ndarray, a: int, b: int) -> int:
     for k in range(a, b):
         out[at] = source[k]
         at += 1
@@ -123,7 +124,7 @@ def _copy(out, at, source, a, b):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _digits(out, at, value, width):  # type: ignore[no-untyped-def]
+def _digits(out: np.ndarray, at: int, value: int, width: int) -> int:
     """The decimal digits of ``value`` >= 0, at least ``width`` of them (leading zeros); returns the end."""
     count, power = 1, 10
     while count < 19 and value >= power:
@@ -138,7 +139,7 @@ def _digits(out, at, value, width):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _whole(out, at, value):  # type: ignore[no-untyped-def]
+def _whole(out: np.ndarray, at: int, value: int) -> int:
     """``str(value)`` of an int64 (but its most negative value, which block_bytes leaves to Python)."""
     if value < 0:
         out[at] = 45  # -
@@ -148,7 +149,7 @@ def _whole(out, at, value):  # type: ignore[no-untyped-def]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _decimal(out, at, value, places):  # type: ignore[no-untyped-def]
+def _decimal(out: np.ndarray, at: int, value: float, places: int) -> int:
     """``repr(value)`` of the double nearest k / 10^places (see the module), |k| < LARGEST."""
     if value < 0.0 or (value == 0.0 and math.copysign(1.0, value) < 0.0):
         out[at] = 45  # -

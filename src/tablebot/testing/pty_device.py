@@ -29,7 +29,7 @@ class PtyDevice:
 
     ``baud`` > 0 paces replies like a serial line at that rate (10 bits a byte); 0 writes them at once."""
 
-    def __init__(self, baud: int = 0):
+    def __init__(self, baud: int = 0) -> None:
         self.baud = baud
         self.master, self._slave = os.openpty()
         tty.setraw(self._slave)  # no echo, no line editing, until the client configures it

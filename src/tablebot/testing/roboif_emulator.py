@@ -31,7 +31,7 @@ class RoboifEmulator(PtyDevice):
     replaces the answer to the greeting (a device that is not a ROBO Interface)."""
 
     def __init__(self, script: Script = still, *, fault: tuple[str, int] | None = None, late_s: float = 0.3,
-                 baud: int = 0, greeting_reply: bytes = b"\x5e\x00\x00\x00\x00"):
+                 baud: int = 0, greeting_reply: bytes = b"\x5e\x00\x00\x00\x00") -> None:
         self.script, self.fault, self.late_s = script, fault, late_s
         self.greeting_reply = greeting_reply
         self.exchanges = 0

@@ -31,7 +31,7 @@ class RobotxEmulator(PtyDevice):
     every reply (a slow link); ``junk`` is written before the first reply (a shell prompt)."""
 
     def __init__(self, script: Script = still, *, device_name: str = "ROBO TX-000", fault: tuple[str, int] | None
-                 = None, delay_s: float = 0.0, late_s: float = 0.3, junk: bytes = b""):
+                 = None, delay_s: float = 0.0, late_s: float = 0.3, junk: bytes = b"") -> None:
         self.script, self.device_name, self.fault = script, device_name, fault
         self.delay_s, self.late_s, self.junk = delay_s, late_s, junk
         self.exchanges = 0

@@ -143,7 +143,7 @@ class Gate:
     """ASGI middleware: every request and WebSocket upgrade is checked by :meth:`Access.refusal` first,
     and every answer gets :data:`HEADERS`."""
 
-    def __init__(self, app: ASGIApp, access: Access):
+    def __init__(self, app: ASGIApp, access: Access) -> None:
         self.app = app
         self.access = access
 

@@ -159,7 +159,7 @@ class Background:
     ``origin`` and ``headers`` (what its own page would send) for other clients, :meth:`stop` to end."""
 
     def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
-                 log_level: str = "warning"):
+                 log_level: str = "warning") -> None:
         import socket
         import threading
 

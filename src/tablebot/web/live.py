@@ -36,7 +36,7 @@ class PageClock:
     free_running = False  # one tick at a time, so that pausing and stepping act between ticks
     behind_s = 0.0  # the page sets the pace (paused, stepped, 10x): never judged against the wall clock
 
-    def __init__(self, speed: float, tick_s: float, paused: bool):
+    def __init__(self, speed: float, tick_s: float, paused: bool) -> None:
         self.tick_s = tick_s
         self.speed = speed
         self.paused = paused
@@ -95,7 +95,7 @@ class HandInputs:
     """Wraps the simulated robot: inputs the user holds by hand (while paused) replace what the sensors
     read; each reading also carries the bumper switches and light levels the arena draws."""
 
-    def __init__(self, robot: SimRobot):
+    def __init__(self, robot: SimRobot) -> None:
         self.robot = robot
         self.light_keys = light_keys(robot.scene)
         self.forced: dict[int, bool] = {}  # input bit -> held on (True) or off (False)
@@ -199,7 +199,7 @@ class LiveRun:
     """A simulated robot running a table in a thread, through the loop, until :meth:`close`."""
 
     def __init__(self, scene: Scene, robot: SimRobot, speed: str = "1", paused: bool = True,
-                 on_end: Callable[[RunEnd], None] | None = None, sinks: Sequence[Sink] = ()):
+                 on_end: Callable[[RunEnd], None] | None = None, sinks: Sequence[Sink] = ()) -> None:
         self.scene = scene
         self.engine = Engine(scene.machine)
         self.robot = HandInputs(robot)

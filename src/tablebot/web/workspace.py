@@ -63,7 +63,7 @@ class Opened:
 class ChangedOnDisk(Exception):
     """The file was changed by someone else since the page loaded it (a save may overwrite it if asked)."""
 
-    def __init__(self, name: str, how: str = "changed"):
+    def __init__(self, name: str, how: str = "changed") -> None:
         super().__init__(f"{name} was {how} on disk since you opened it")
         self.name = name
 

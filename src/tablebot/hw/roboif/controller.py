@@ -22,7 +22,7 @@ OFF = (0, [0] * wire.N_OUTPUTS)
 class RoboifRobot(ExchangeRobot):
     """The ROBO Interface on serial ``device``; a reply missing for ``link_timeout_s`` ends the run."""
 
-    def __init__(self, wiring: RoboifWiring, device: str, *, link_timeout_s: float = 0.05):
+    def __init__(self, wiring: RoboifWiring, device: str, *, link_timeout_s: float = 0.05) -> None:
         self.wiring = wiring
         self.link = RoboifLink(device, reply_timeout_s=link_timeout_s)
         self.greeting = b""

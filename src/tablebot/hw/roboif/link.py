@@ -33,7 +33,7 @@ def candidates(ports: Sequence[PortInfo] | None = None) -> list[PortInfo]:
 class RoboifLink:
     """The ROBO Interface on serial ``device``; an exchange must be answered within ``reply_timeout_s``."""
 
-    def __init__(self, device: str, reply_timeout_s: float = 0.05, setup_timeout_s: float = SETUP_TIMEOUT_S):
+    def __init__(self, device: str, reply_timeout_s: float = 0.05, setup_timeout_s: float = SETUP_TIMEOUT_S) -> None:
         self.device = device
         self.reply_timeout_s, self.setup_timeout_s = reply_timeout_s, setup_timeout_s
         self.port = SerialPort(device, wire.BAUD)

@@ -49,7 +49,7 @@ def level_pwm(level: int) -> int:
 class RoboifWiring:
     """A checked wiring and what it means in exchange bytes."""
 
-    def __init__(self, wired: wiring.Wiring):
+    def __init__(self, wired: wiring.Wiring) -> None:
         self.wired = wired
         self.counters: tuple[int, ...] = ()
 

@@ -22,7 +22,7 @@ ZERO = [0] * wire.N_OUTPUTS
 class RobotxRobot(ExchangeRobot):
     """The ROBO TX on serial ``device``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
-    def __init__(self, wiring: RobotxWiring, device: str, *, link_timeout_s: float = 0.05):
+    def __init__(self, wiring: RobotxWiring, device: str, *, link_timeout_s: float = 0.05) -> None:
         self.wiring = wiring
         self.link = RobotxLink(device, reply_timeout_s=link_timeout_s)
         self.info: wire.Info | None = None

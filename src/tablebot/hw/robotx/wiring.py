@@ -42,7 +42,7 @@ def robotx_wiring(machine: Machine) -> RobotxWiring:
 class RobotxWiring:
     """A checked wiring and what it means in fish.X1 payloads."""
 
-    def __init__(self, wired: wiring.Wiring):
+    def __init__(self, wired: wiring.Wiring) -> None:
         self.wired = wired
         self.counters = tuple(TERMINALS.counters.index(c) for c in wired.counters)
 

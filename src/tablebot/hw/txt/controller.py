@@ -29,7 +29,7 @@ class TxtRobot(ExchangeRobot):
     """The robot behind ``host:port``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
     def __init__(self, wiring: TxtWiring, host: str, port: int = wire.PORT, *, link_timeout_s: float = 0.05,
-                 client_name: str = "tablebot"):
+                 client_name: str = "tablebot") -> None:
         self.wiring = wiring
         self.link = TxtLink(host, port, reply_timeout_s=link_timeout_s)
         self.client_name = client_name

@@ -73,7 +73,7 @@ class TxtLink:
     """A connection to ``host:port``. Exchanges must be answered within ``reply_timeout_s``."""
 
     def __init__(self, host: str, port: int = wire.PORT, reply_timeout_s: float = 0.05,
-                 setup_timeout_s: float = SETUP_TIMEOUT_S):
+                 setup_timeout_s: float = SETUP_TIMEOUT_S) -> None:
         self.host, self.port = host, port
         self.reply_timeout_s, self.setup_timeout_s = reply_timeout_s, setup_timeout_s
         self.sock: socket.socket | None = None

@@ -71,7 +71,7 @@ def txt_wiring(machine: Machine) -> TxtWiring:
 class TxtWiring:
     """A checked wiring and what it means in the TXT's online protocol."""
 
-    def __init__(self, wired: wiring.Wiring):
+    def __init__(self, wired: wiring.Wiring) -> None:
         self.wired = wired
         self.counters = tuple(TERMINALS.counters.index(c) for c in wired.counters)  # terminal 0..3 of each
         self.trails = {inp.terminal for inp in wired.inputs if inp.mode == "trail"}

@@ -39,7 +39,7 @@ class Engine:
     counter at zero, the first row of the state whose required events are all present fires (with the
     robot file's match = "document", a tick with no event at all looks up no row)."""
 
-    def __init__(self, table: dict):
+    def __init__(self, table: dict) -> None:
         self.rows = table["rows"]  # per state: [index, required, next, timer, outputs, loads] (None: keep)
         self.input_mask, self.timer_bit = table["input_mask"], table["timer_bit"]
         self.counter_bits = table["counter_bits"]
@@ -91,7 +91,7 @@ class Txt4Robot:
                ("voltage", "create_color_sensor", "get_voltage"),
                ("resistance", "create_ntc_resistor", "get_resistance"))
 
-    def __init__(self, table: dict, factory: Any, motor_class: Any):
+    def __init__(self, table: dict, factory: Any, motor_class: Any) -> None:
         self.table, self.motor_class = table, motor_class
         self.lock = threading.Lock()
         self.stopped = False
@@ -287,7 +287,7 @@ class Guard:
     run.py runs it), the interpreter exiting (``atexit``), and -- in :func:`run` -- Ctrl-C, the end of the
     thread and any exception."""
 
-    def __init__(self, stop: Stop):
+    def __init__(self, stop: Stop) -> None:
         self.stop = stop
         self.robot: Any = None  # set once it is built: a stop before then has nothing to switch off
         self.previous: Any = signal.SIG_DFL
