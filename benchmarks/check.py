@@ -21,6 +21,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tablebot.analysis.check import run_check
 from tablebot.analysis.conditions import parse_condition
@@ -29,6 +30,11 @@ from tablebot.formats.table_read import load_table
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import BUMBERBOT
 from tablebot.table import Row, Table
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from tablebot.analysis.conditions import Condition
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
@@ -51,7 +57,7 @@ def random_table(seed: int, states: int = 50, rows_per_state: int = 10) -> Table
 
 
 def random_properties(machine: Machine) -> list[Property]:
-    def cond(text: str):
+    def cond(text: str) -> Condition:
         return parse_condition(text, machine)
 
     return [
@@ -63,7 +69,7 @@ def random_properties(machine: Machine) -> list[Property]:
     ]
 
 
-def timed(label: str, run, repeat: int) -> float:
+def timed(label: str, run: Callable[[], str], repeat: int) -> float:
     times = []
     for _ in range(repeat):
         start = time.perf_counter()

@@ -102,7 +102,7 @@ class LinearScan:
     """The document's algorithm, one call per tick: scan the state's rows in order for the first whose
     bits are present."""
 
-    def __init__(self, machine: Machine):
+    def __init__(self, machine: Machine) -> None:
         self.per_state = [[row for row in machine.rows if row.state == s] for s in range(len(machine.states))]
         self.timer_bit = machine.timer_bit
         self.state, self.timer, self.tick = machine.initial_state, machine.initial_timer, 0
@@ -143,7 +143,7 @@ class BareStep:
     apply; keep tick, state, timer, outputs, and the event set and fired row a trace needs), with
     nothing else: no input checks, no counters. The least a closed-loop Python engine must do."""
 
-    def __init__(self, machine: Machine):
+    def __init__(self, machine: Machine) -> None:
         self.tables, self.timer_bit = bare_tables(machine), machine.timer_bit
         self.state, self.timer, self.tick, self.event, self.row = machine.initial_state, machine.initial_timer, 0, 0, -1
         self.outputs: tuple[int | None, ...] = (0,) * len(machine.output_names)
@@ -192,7 +192,7 @@ def bare_loop(machine: Machine, masks: Sequence[int]) -> Result:
 class Bot:
     """The model ``transitions`` drives: the timer, outputs and this tick's events live here."""
 
-    def __init__(self, machine: Machine):
+    def __init__(self, machine: Machine) -> None:
         self.timer = machine.initial_timer
         self.outputs: tuple[int | None, ...] = (0,) * len(machine.output_names)
         self.events = 0

@@ -125,7 +125,7 @@ class FreshCluster:
     (as on machines that never ran tablebot); with ``preload``, started with tablebot's preload
     (``--preload tablebot.fleet.worker``: numba imported as the worker starts, no compiled code)."""
 
-    def __init__(self, preload: bool = False):
+    def __init__(self, preload: bool = False) -> None:
         self.preload = preload
 
     def __enter__(self) -> str:

@@ -29,7 +29,10 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 WHOLE = "whole kernel"
@@ -117,25 +120,26 @@ def _loops() -> dict[str, Any]:
     fast = njit(refcounts=False, cache=False)
 
     @fast
-    def put(s, rows, i):  # type: ignore[no-untyped-def]
+    def put(s: np.ndarray, rows: np.ndarray, i: int) -> None:
         for j in range(s.shape[0]):
             s[j] = rows[i, j]
 
     @fast
-    def copy(rows, s):  # type: ignore[no-untyped-def]
+    def copy(rows: np.ndarray, s: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
         return s[0]
 
     @fast
-    def trig(rows):  # type: ignore[no-untyped-def]
+    def trig(rows: np.ndarray) -> float:
         t = 0.0
         for i in range(rows.shape[0]):
             t += math.cos(rows[i, L.TH]) + math.sin(rows[i, L.TH])
         return t
 
     @fast
-    def light_shade(rows, p, edges, circles, lamps, turns, shade):  # type: ignore[no-untyped-def]
+    def light_shade(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
+                    turns: np.ndarray, shade: np.ndarray) -> float:
         total = 0.0
         ph.aim_turns(p, turns)
         for i in range(rows.shape[0]):
@@ -146,7 +150,8 @@ def _loops() -> dict[str, Any]:
         return total
 
     @fast
-    def light(rows, p, edges, circles, lamps, turns):  # type: ignore[no-untyped-def]  # trees without a grid
+    def light(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
+              turns: np.ndarray) -> float:  # trees without a grid
         total = 0.0
         ph.aim_turns(p, turns)
         for i in range(rows.shape[0]):
@@ -157,7 +162,8 @@ def _loops() -> dict[str, Any]:
         return total
 
     @fast
-    def bumpers(rows, p, verts, pstart, pbound, circles, s, near, centre):  # type: ignore[no-untyped-def]
+    def bumpers(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+                circles: np.ndarray, s: np.ndarray, near: np.ndarray, centre: np.ndarray) -> float:
         reach, wide = ph.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
@@ -166,7 +172,9 @@ def _loops() -> dict[str, Any]:
         return s[0]
 
     @fast
-    def contacts(rows, p, verts, pstart, pbound, circles, s, corners, near, centre):  # type: ignore[no-untyped-def]
+    def contacts(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+                 circles: np.ndarray, s: np.ndarray, corners: np.ndarray, near: np.ndarray,
+                 centre: np.ndarray) -> float:
         reach, wide = ph.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
@@ -174,14 +182,15 @@ def _loops() -> dict[str, Any]:
         return s[0]
 
     @fast
-    def motors(rows, p, s, z):  # type: ignore[no-untyped-def]
+    def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, z: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
             ph.drive(s, (2, -2), p, z)
         return s[0]
 
     @fast
-    def declared(rows, p, edges, circles, lamps, lines, s, skip):  # type: ignore[no-untyped-def]
+    def declared(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
+                 lines: np.ndarray, s: np.ndarray, skip: bool) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
             if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
@@ -189,14 +198,14 @@ def _loops() -> dict[str, Any]:
         return s[0]
 
     @fast
-    def observe(rows, lamps, acc, collisions, s):  # type: ignore[no-untyped-def]
+    def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
             K.observe(s, lamps, acc, collisions)
         return s[0]
 
     @fast
-    def noise(n, bitgen):  # type: ignore[no-untyped-def]
+    def noise(n: int, bitgen: np.uint64) -> float:
         t = 0.0
         for _ in range(n):
             for _ in range(4):
@@ -204,7 +213,8 @@ def _loops() -> dict[str, Any]:
         return t
 
     @fast
-    def engine(rows, regs, outputs, counters, pulses, program):  # type: ignore[no-untyped-def]
+    def engine(rows: np.ndarray, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, pulses: np.ndarray,
+               program: np.ndarray) -> int:
         t = 0
         for i in range(rows.shape[0]):
             tick_compiled(regs, outputs, counters, int(rows[i, L.MASK]), pulses, program)

@@ -31,6 +31,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tablebot.cli.common import load
 from tablebot.engine import Engine
@@ -39,12 +40,17 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from tablebot.sim.scene import Scene
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 TABLEBOT = [sys.executable, "-m", "tablebot"]
 
 
-def loop_seconds(scene, ticks: int, seed: int) -> float:  # type: ignore[no-untyped-def]
+def loop_seconds(scene: Scene, ticks: int, seed: int) -> float:
     """Wall seconds of the run loop on the compiled path (no history kept: the loop alone)."""
     robot, engine = SimRobot(scene, seed, record_history=False), Engine(scene.machine)
     start = time.perf_counter()
@@ -52,7 +58,7 @@ def loop_seconds(scene, ticks: int, seed: int) -> float:  # type: ignore[no-unty
     return time.perf_counter() - start
 
 
-def tick_by_tick_seconds(scene, ticks: int, seed: int) -> float:  # type: ignore[no-untyped-def]
+def tick_by_tick_seconds(scene: Scene, ticks: int, seed: int) -> float:
     """The same loop, one tick at a time from Python: the baseline (the path a real robot takes)."""
     robot, engine = SimRobot(scene, seed), Engine(scene.machine)
     from tablebot.loop import SimulatedClock
@@ -65,7 +71,7 @@ def tick_by_tick_seconds(scene, ticks: int, seed: int) -> float:  # type: ignore
     return time.perf_counter() - start
 
 
-def engine_seconds(scene, seconds: float, seed: int) -> float:  # type: ignore[no-untyped-def]
+def engine_seconds(scene: Scene, seconds: float, seed: int) -> float:
     result = simulate(scene, seconds, seed)
     inputs = [(t.mask, t.pulses) for t in result.inputs()]
     step = Engine(scene.machine).step
@@ -113,7 +119,7 @@ def _sample_private(pid: int, peak: list[float]) -> None:
         time.sleep(0.01)
 
 
-def median_of(repeat: int, measure) -> float:  # type: ignore[no-untyped-def]
+def median_of(repeat: int, measure: Callable[[], float]) -> float:
     return statistics.median(measure() for _ in range(repeat))
 
 

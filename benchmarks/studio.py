@@ -20,6 +20,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import websockets
 
@@ -34,11 +35,17 @@ from tablebot.web.analyse import analyse, robot_for  # noqa: E402
 from tablebot.web.app import Background  # noqa: E402
 from tablebot.web.document import CsvDocument  # noqa: E402
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from playwright.sync_api import Page
+    from websockets.asyncio.client import ClientConnection
+
 EXAMPLE = ROOT / "examples" / "bumberbot"
 REPEATS = 30
 
 
-def median_ms(func, repeats: int = REPEATS) -> float:  # type: ignore[no-untyped-def]
+def median_ms(func: Callable[[], object], repeats: int = REPEATS) -> float:
     times = []
     for _ in range(repeats):
         started = time.perf_counter()
@@ -87,7 +94,7 @@ async def round_trips(server: Background) -> float:
         return 1000 * statistics.median(times)
 
 
-async def _until(ws, wanted) -> dict:  # type: ignore[no-untyped-def]
+async def _until(ws: ClientConnection, wanted: Callable[[dict], bool]) -> dict:
     while True:
         message = json.loads(await asyncio.wait_for(ws.recv(), 30))
         if wanted(message):
@@ -120,7 +127,7 @@ def live_view(folder: Path) -> None:
         server.stop()
 
 
-def _measure(page, speed: str, label: str, seconds: float = 6.0) -> None:  # type: ignore[no-untyped-def]
+def _measure(page: Page, speed: str, label: str, seconds: float = 6.0) -> None:
     page.click("#reset")
     page.wait_for_timeout(500)
     page.click(f'[data-speed="{speed}"]')

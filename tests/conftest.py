@@ -84,7 +84,7 @@ class _WarmUp:
     be compiled by both: numba writes a cache file whole, by renaming it into place. A thread writes
     ``marker`` when both have ended, "ok" or their errors."""
 
-    def __init__(self, shared: str, marker: Path):
+    def __init__(self, shared: str, marker: Path) -> None:
         self.shared, self.marker, self.started = shared, marker, time.monotonic()
         self.seconds: float | None = None
         env = {**os.environ, "NUMBA_CACHE_DIR": shared}
@@ -175,7 +175,7 @@ class _Worker:
 
     WAIT_S = 1800  # a warm-up that never ends: the tests go on and compile what they need themselves
 
-    def __init__(self, config: pytest.Config, shared: Path, marker: Path, own: Path):
+    def __init__(self, config: pytest.Config, shared: Path, marker: Path, own: Path) -> None:
         self.config, self.shared, self.marker, self.own = config, shared, marker, own
         self.ready = False
         self.not_free: set[str] = set()

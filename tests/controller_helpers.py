@@ -50,7 +50,7 @@ class Record:
 class StopAt(Record):
     """Ends the run its own way at a given tick: Ctrl-C, SIGTERM to this process, or a bug."""
 
-    def __init__(self, tick: int, how: str):
+    def __init__(self, tick: int, how: str) -> None:
         super().__init__()
         self.tick, self.how = tick, how
 

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from types import ModuleType
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "engine.py"
 
 
-def load_benchmark():
+def load_benchmark() -> ModuleType:
     pytest.importorskip("transitions", reason="the engine benchmark compares with the transitions library (dev extra)")
     spec = importlib.util.spec_from_file_location("bench_engine", SCRIPT)
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
@@ -18,7 +22,7 @@ def load_benchmark():
     return module
 
 
-def test_contestants_agree_on_a_short_run(capsys):
+def test_contestants_agree_on_a_short_run(capsys: pytest.CaptureFixture[str]) -> None:
     bench = load_benchmark()
     bench.main(["--ticks", "3000", "--repeats", "1", "--transitions-ticks", "500"])  # asserts agreement
     out = capsys.readouterr().out
@@ -26,7 +30,7 @@ def test_contestants_agree_on_a_short_run(capsys):
         assert name in out
 
 
-def test_contestants_match_the_engine_tick_for_tick_state():
+def test_contestants_match_the_engine_tick_for_tick_state() -> None:
     bench = load_benchmark()
     machine = bench.compile_table(bench.load_table(bench.EXAMPLE))
     masks = bench.random_masks(machine, 5000)

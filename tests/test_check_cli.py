@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import shlex
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -18,12 +19,15 @@ from tablebot.formats.trace_lines import read_trace
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 
+if TYPE_CHECKING:
+    from click.testing import Result
+
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
 runner = CliRunner()
 
 
-def check(*args: object, out: Path):
+def check(*args: object, out: Path) -> Result:
     result = runner.invoke(app, ["check", *map(str, args), "--counterexamples", str(out)])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
     return result
@@ -35,12 +39,12 @@ def check(*args: object, out: Path):
     ("stuckloop.csv", False, 2), ("stuckloop.csv", True, 2),
     ("bump.csv", False, 2),  # an error-level property is violated
 ])
-def test_exit_codes(tmp_path, name, strict, code):
+def test_exit_codes(tmp_path: Path, name: str, strict: bool, code: int) -> None:
     result = check(FIX / name, *(["--strict"] if strict else []), out=tmp_path)
     assert result.exit_code == code, result.output
 
 
-def test_text_output_names_lines_and_hides_notes(tmp_path):
+def test_text_output_names_lines_and_hides_notes(tmp_path: Path) -> None:
     result = check(FIX / "shadowed.csv", out=tmp_path)
     assert f"{FIX / 'shadowed.csv'}:4: warning: row on line 4 can never fire" in result.stdout
     assert "overlap" in result.stdout and "--verbose lists them" in result.stdout
@@ -48,7 +52,7 @@ def test_text_output_names_lines_and_hides_notes(tmp_path):
     assert "both match" in verbose.stdout and "does not react to" in verbose.stdout
 
 
-def test_json_output(tmp_path):
+def test_json_output(tmp_path: Path) -> None:
     result = check(FIX / "bump.csv", "--format", "json", out=tmp_path)
     data = json.loads(result.stdout)
     assert data["exit_code"] == 2 == result.exit_code
@@ -59,7 +63,7 @@ def test_json_output(tmp_path):
     assert data["counts"]["error"] == 2  # bump_stops and no_spin_in_1
 
 
-def test_counterexample_replays_with_tablebot_trace(tmp_path):
+def test_counterexample_replays_with_tablebot_trace(tmp_path: Path) -> None:
     """The CSV check writes is read by `tablebot trace` and shows the violation at the last tick."""
     check(FIX / "bump.csv", out=tmp_path)
     csv_path = tmp_path / "bump_stops.csv"
@@ -73,7 +77,7 @@ def test_counterexample_replays_with_tablebot_trace(tmp_path):
     assert first_violation(prop, machine, replay(machine, load_inputs(csv_path, machine))) == 51
 
 
-def test_target_robopro(tmp_path):
+def test_target_robopro(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text((FIX / "robot.toml").read_text())
     table = tmp_path / "t.csv"
     table.write_text((FIX / "shadowed.csv").read_text().replace(",3,3,100,2", ",8,3,100,2", 1))
@@ -83,7 +87,7 @@ def test_target_robopro(tmp_path):
     assert check(table, "--target", "nonsense", out=tmp_path).exit_code == 2
 
 
-def test_bad_property_file_is_a_located_error(tmp_path):
+def test_bad_property_file_is_a_located_error(tmp_path: Path) -> None:
     props = tmp_path / "p.toml"
     props.write_text('[ok]\nnever = "state == 2"\n\n[bad]\nnever = "M7 > 0"\n')
     result = check(FIX / "bump.csv", "--properties", props, out=tmp_path)
@@ -92,7 +96,7 @@ def test_bad_property_file_is_a_located_error(tmp_path):
     assert "Traceback" not in result.output
 
 
-def test_bumberbot_shipped_properties(tmp_path):
+def test_bumberbot_shipped_properties(tmp_path: Path) -> None:
     result = check(EXAMPLE, "--format", "json", out=tmp_path)
     data = json.loads(result.stdout)
     status = {p["name"]: p["status"] for p in data["properties"]}
@@ -102,7 +106,7 @@ def test_bumberbot_shipped_properties(tmp_path):
     assert check(EXAMPLE, "--strict", out=tmp_path).exit_code == 1  # ... which --strict turns into 1
 
 
-def test_the_replay_line_can_be_pasted_into_a_shell(tmp_path):
+def test_the_replay_line_can_be_pasted_into_a_shell(tmp_path: Path) -> None:
     """A folder with a space in its name: the printed command must still name it as one word."""
     out = tmp_path / "my counterexamples"
     line = next(text for text in check(EXAMPLE, out=out).stdout.splitlines()
@@ -111,7 +115,7 @@ def test_the_replay_line_can_be_pasted_into_a_shell(tmp_path):
                                                         str(out / "front_bumper_stops.csv")]
 
 
-def test_bumberbot_text_tells_the_story(tmp_path):
+def test_bumberbot_text_tells_the_story(tmp_path: Path) -> None:
     result = check(EXAMPLE, out=tmp_path)
     out = result.stdout
     assert "VIOLATED front_bumper_stops" in out and "shortest counterexample: 54 ticks" in out

@@ -59,7 +59,7 @@ def random_table(seed: int, states: int, per_state: int) -> Table:
 
 @settings(max_examples=40, derandomize=True, deadline=None)
 @given(st.integers(0, 10**6), st.integers(1, 4), st.integers(1, 30))
-def test_same_findings_as_the_pairwise_search(seed, states, per_state):
+def test_same_findings_as_the_pairwise_search(seed: int, states: int, per_state: int) -> None:
     table = random_table(seed, states, per_state)
     assert [(f.lines[0], f.lines[1]) for f in shadowed_rows(table)] == reference_shadowed(table)
     got = [(f.lines[0], f.lines[1], f.message) for f in overlaps(table)]

@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -16,6 +17,9 @@ from core_helpers import EXAMPLE, MINI_ROBOT, SEED_TSV, column_of, example_machi
 from tablebot.cli import app
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
+
+if TYPE_CHECKING:
+    from click.testing import Result
 
 runner = CliRunner()
 LOCATED = re.compile(r"^(?P<path>\S.*?):(?P<line>\d+):(?P<column>\d+): error: .+$")
@@ -28,7 +32,7 @@ next,1,1,,,3,3,10,7
 """
 
 
-def invoke(*args: object):
+def invoke(*args: object) -> Result:
     """Run the app in-process; anything but a clean exit (an escaped exception) fails the test."""
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
@@ -50,18 +54,18 @@ def assert_located_errors(stderr: str, count: int) -> list[re.Match]:
 # --- help ---------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("command", [[], ["check"], ["export"], ["import"], ["trace"], ["demo"]])
-def test_help(command):
+def test_help(command: list[str]) -> None:
     result = invoke(*command, "--help")
     assert result.exit_code == 0, result.output
     assert "Usage" in result.output and "--help" in result.output
 
 
-def test_no_arguments_shows_help():
+def test_no_arguments_shows_help() -> None:
     result = invoke()
     assert "check" in result.output and "trace" in result.output
 
 
-def test_usage_error_exits_2():
+def test_usage_error_exits_2() -> None:
     result = invoke("check")
     assert result.exit_code == 2
     assert "Traceback" not in result.output
@@ -69,19 +73,19 @@ def test_usage_error_exits_2():
 
 # --- check --------------------------------------------------------------------------------------------
 
-def test_check_seed_tsv(tmp_path):
+def test_check_seed_tsv(tmp_path: Path) -> None:
     shutil.copy(SEED_TSV, tmp_path / "bumberbot-table.tsv")
     result = invoke("check", tmp_path / "bumberbot-table.tsv")
     assert result.exit_code == 0, result.output
     assert "37 rows, 10 states" in result.stdout and "BumberBot" in result.stdout
 
 
-def test_check_a_folder_means_its_table():
+def test_check_a_folder_means_its_table() -> None:
     result = invoke("check", EXAMPLE)
     assert result.exit_code == 0 and "table.csv" in result.stdout
 
 
-def test_check_reports_every_problem_located(tmp_path):
+def test_check_reports_every_problem_located(tmp_path: Path) -> None:
     path = write_table(tmp_path, BAD_TABLE, MINI_ROBOT)
     result = invoke("check", path)
     assert result.exit_code == 2
@@ -93,7 +97,7 @@ def test_check_reports_every_problem_located(tmp_path):
     assert result.stdout == ""
 
 
-def test_check_undecodable_file(tmp_path):
+def test_check_undecodable_file(tmp_path: Path) -> None:
     """Binary data (a NUL byte) that is not UTF-8 is refused where its first bad byte is; text that is
     not UTF-8 is read as Windows-1252 instead (see test_safety_loaders)."""
     path = tmp_path / "t.csv"
@@ -104,7 +108,7 @@ def test_check_undecodable_file(tmp_path):
     assert (m["line"], m["column"]) == ("2", "5")
 
 
-def test_check_with_explicit_robot(tmp_path):
+def test_check_with_explicit_robot(tmp_path: Path) -> None:
     table = write_table(tmp_path, "state,T,A,M1,timer,next\n1,,1,0,5,2\n1,1,,3,10,2\n2,1,,-3,10,1\n")
     (tmp_path / "mini.toml").write_text(MINI_ROBOT)
     assert invoke("check", table).exit_code == 2  # the built-in BumberBot has no input A
@@ -113,13 +117,13 @@ def test_check_with_explicit_robot(tmp_path):
     assert "robot Mini" in result.stdout
 
 
-def test_check_missing_file(tmp_path):
+def test_check_missing_file(tmp_path: Path) -> None:
     result = invoke("check", tmp_path / "nope.csv")
     assert result.exit_code == 2
     assert "cannot read" in result.stderr and "Traceback" not in result.output
 
 
-def test_real_command_is_plain_when_piped(tmp_path):
+def test_real_command_is_plain_when_piped(tmp_path: Path) -> None:
     """The installed script, in a subprocess: stderr is a pipe, so no colour codes, and exit code 2."""
     path = write_table(tmp_path, BAD_TABLE, MINI_ROBOT)
     script = Path(sys.executable).parent / "tablebot"
@@ -131,7 +135,7 @@ def test_real_command_is_plain_when_piped(tmp_path):
 
 # --- export and import --------------------------------------------------------------------------------
 
-def test_export_then_import_round_trip(tmp_path):
+def test_export_then_import_round_trip(tmp_path: Path) -> None:
     out = tmp_path / "lists"
     result = invoke("export", EXAMPLE / "table.csv", out, "--to", "robopro")
     assert result.exit_code == 0, result.output
@@ -145,7 +149,7 @@ def test_export_then_import_round_trip(tmp_path):
     assert back.signature() == example_machine().signature()
 
 
-def test_import_to_standard_output(tmp_path):
+def test_import_to_standard_output(tmp_path: Path) -> None:
     invoke("export", EXAMPLE, tmp_path, "--to", "robopro")
     result = invoke("import", tmp_path, "--from", "robopro")
     assert result.exit_code == 0
@@ -153,7 +157,7 @@ def test_import_to_standard_output(tmp_path):
     assert result.stdout.splitlines()[1] == ",1,,1,1,,,,,0,,0,50,20"
 
 
-def test_export_named_states(tmp_path):
+def test_export_named_states(tmp_path: Path) -> None:
     robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "go"')
     table = write_table(tmp_path, "state,T,M1,M2,timer,next\ngo,1,3,3,9,stop\nstop,1,0,0,9,go\n", robot)
     assert invoke("export", table, tmp_path / "l", "--to", "robopro").exit_code == 0
@@ -163,7 +167,7 @@ def test_export_named_states(tmp_path):
     assert [line.split(",")[1] for line in result.stdout.splitlines()[1:]] == ["go", "stop"]
 
 
-def test_export_refuses_what_does_not_fit(tmp_path):
+def test_export_refuses_what_does_not_fit(tmp_path: Path) -> None:
     table = write_table(tmp_path, "state,T,M1,M2,timer,next\n1,1,8,3,40000,1\n", MINI_ROBOT)
     result = invoke("export", table, tmp_path / "l", "--to", "robopro")
     assert result.exit_code == 2
@@ -171,21 +175,21 @@ def test_export_refuses_what_does_not_fit(tmp_path):
     assert not (tmp_path / "l").exists()
 
 
-def test_export_into_a_file_is_an_error_not_a_traceback(tmp_path):
+def test_export_into_a_file_is_an_error_not_a_traceback(tmp_path: Path) -> None:
     (tmp_path / "afile").write_text("")
     result = invoke("export", EXAMPLE, tmp_path / "afile", "--to", "robopro")
     assert result.exit_code == 2
     assert ("afile" in result.stderr and result.exception is None) or isinstance(result.exception, SystemExit)
 
 
-def test_import_errors(tmp_path):
+def test_import_errors(tmp_path: Path) -> None:
     result = invoke("import", tmp_path, "--from", "robopro")
     assert result.exit_code == 2 and "list file not found" in result.stderr
 
 
 # --- trace and demo -----------------------------------------------------------------------------------
 
-def test_trace_to_stdout_and_file_are_the_same_bytes(tmp_path):
+def test_trace_to_stdout_and_file_are_the_same_bytes(tmp_path: Path) -> None:
     inputs = EXAMPLE / "inputs.csv"
     to_stdout = invoke("trace", EXAMPLE, "--inputs", inputs)
     assert to_stdout.exit_code == 0
@@ -197,7 +201,7 @@ def test_trace_to_stdout_and_file_are_the_same_bytes(tmp_path):
     assert len(a.splitlines()) == 3000
 
 
-def test_trace_bad_inputs(tmp_path):
+def test_trace_bad_inputs(tmp_path: Path) -> None:
     (tmp_path / "in.csv").write_text("I3,T\n1,\n")
     result = invoke("trace", EXAMPLE, "--inputs", tmp_path / "in.csv")
     assert result.exit_code == 2
@@ -205,12 +209,12 @@ def test_trace_bad_inputs(tmp_path):
     assert (m["line"], m["column"]) == ("1", "4")
 
 
-def test_trace_into_a_missing_folder(tmp_path):
+def test_trace_into_a_missing_folder(tmp_path: Path) -> None:
     result = invoke("trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out", tmp_path / "no" / "t.jsonl")
     assert result.exit_code == 2 and "Traceback" not in result.output
 
 
-def test_demo_writes_the_trace_of_the_example(tmp_path):
+def test_demo_writes_the_trace_of_the_example(tmp_path: Path) -> None:
     result = invoke("demo", "--out", tmp_path)
     assert result.exit_code == 0, result.output
     assert "BumberBot: 3000 ticks (30.0 s)" in result.stdout
@@ -218,7 +222,7 @@ def test_demo_writes_the_trace_of_the_example(tmp_path):
     assert (tmp_path / "trace.jsonl").read_text() == expected
 
 
-def test_trace_into_a_closed_pipe_stops_quietly():
+def test_trace_into_a_closed_pipe_stops_quietly() -> None:
     """`tablebot trace ... | head -1`: the reader leaving early is no error."""
     command = [sys.executable, "-c", "from tablebot.cli import main; main()", "trace", str(EXAMPLE),
                "--inputs", str(EXAMPLE / "inputs.csv")]

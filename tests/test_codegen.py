@@ -8,6 +8,7 @@ import re
 import shutil
 import subprocess
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -22,18 +23,23 @@ from tablebot.machine import compile_table
 from tablebot.replay import replay
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 
+if TYPE_CHECKING:
+    from tablebot.formats.inputs_csv import TickInput
+    from tablebot.machine import Machine
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 
 
 @pytest.fixture(scope="module")
-def bumberbot():
+def bumberbot() -> tuple[Machine, list[TickInput]]:
     _, machine = load(EXAMPLE)
     return machine, load_inputs(EXAMPLE / "inputs.csv", machine)
 
 
 @pytest.mark.parametrize("lookup", ["dense", "scan"])
-def test_bumberbot_host_c_equals_python(bumberbot, lookup, tmp_path):
+def test_bumberbot_host_c_equals_python(bumberbot: tuple[Machine, list[TickInput]], lookup: str,
+                                        tmp_path: Path) -> None:
     machine, ticks = bumberbot
     exe = build_host(machine, tmp_path, lookup)
     assert run_host(exe, machine, ticks) == list(replay(machine, ticks))
@@ -42,7 +48,8 @@ def test_bumberbot_host_c_equals_python(bumberbot, lookup, tmp_path):
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seed=st.integers(0, 2**32 - 1), lookup=st.sampled_from(["dense", "scan"]),
        lamps=st.integers(0, 2), counters=st.integers(0, 3), states=st.integers(1, 7))
-def test_random_tables_host_c_equals_python(tmp_path_factory, seed, lookup, lamps, counters, states):
+def test_random_tables_host_c_equals_python(tmp_path_factory: pytest.TempPathFactory, seed: int, lookup: str,
+                                            lamps: int, counters: int, states: int) -> None:
     rng = random.Random(seed)
     table = random_table(rng, Shape(states=states, rows=states * 3, lamps=lamps, counters=counters))
     machine = compile_table(table)
@@ -53,14 +60,14 @@ def test_random_tables_host_c_equals_python(tmp_path_factory, seed, lookup, lamp
 
 @pytest.mark.parametrize("match", ["document", "always"])
 @pytest.mark.parametrize("lookup", ["dense", "scan"])
-def test_both_matching_rules_in_c_on_tables_where_they_part(tmp_path, match, lookup):
+def test_both_matching_rules_in_c_on_tables_where_they_part(tmp_path: Path, match: str, lookup: str) -> None:
     """Tables and inputs on which the two rules take different decisions: C follows the table's own."""
     table, ticks = random_case(random.Random(f"c-{match}"), Shape(states=3, rows=9, counters=1, match=match))
     machine = compile_table(table)
     assert run_host(build_host(machine, tmp_path, lookup), machine, ticks) == list(replay(machine, ticks))
 
 
-def test_wide_table_uses_16_bit_rows_and_scan(tmp_path):
+def test_wide_table_uses_16_bit_rows_and_scan(tmp_path: Path) -> None:
     rng = random.Random(7)
     table = random_table(rng, Shape(states=60, rows=300, inputs=9, counters=1))
     machine = compile_table(table)
@@ -78,7 +85,7 @@ def _avr_gcc_compiles(folder: Path) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize("shape", [Shape(), Shape(lamps=2, counters=2, states=9), Shape(states=1, rows=1)])
 @pytest.mark.parametrize("lookup", ["dense", "scan"])
-def test_generated_c_is_warning_free_for_avr_gcc(tmp_path, shape, lookup):
+def test_generated_c_is_warning_free_for_avr_gcc(tmp_path: Path, shape: Shape, lookup: str) -> None:
     assert shutil.which("avr-gcc"), "avr-gcc is needed (scripts/bootstrap.sh installs gcc-avr)"
     machine = compile_table(random_table(random.Random(3), shape))
     generate(machine, lookup).write(tmp_path)
@@ -86,7 +93,7 @@ def test_generated_c_is_warning_free_for_avr_gcc(tmp_path, shape, lookup):
     assert done.returncode == 0, done.stderr
 
 
-def test_export_c_cli_writes_engine_and_table(tmp_path):
+def test_export_c_cli_writes_engine_and_table(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
     from tablebot.cli import app
@@ -100,7 +107,7 @@ def test_export_c_cli_writes_engine_and_table(tmp_path):
     assert _avr_gcc_compiles(tmp_path).returncode == 0
 
 
-def test_export_c_cli_reports_a_bad_table(tmp_path):
+def test_export_c_cli_reports_a_bad_table(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
     from tablebot.cli import app
@@ -112,29 +119,29 @@ def test_export_c_cli_reports_a_bad_table(tmp_path):
     assert re.search(r"table\.csv:2:\d+: error: timer", result.output)
 
 
-def test_engine_sources_have_no_heap_and_no_float():
+def test_engine_sources_have_no_heap_and_no_float() -> None:
     for name in (*ENGINE_FILES, "host_run.c"):
         code = re.sub(r"/\*.*?\*/", "", template(name), flags=re.S)
         assert not re.search(r"\b(malloc|calloc|realloc|free|float|double)\b", code), name
 
 
-def test_table_data_is_const_and_progmem_on_avr(tmp_path):
+def test_table_data_is_const_and_progmem_on_avr(tmp_path: Path) -> None:
     _, machine = load(EXAMPLE)
     source = generate(machine)
     assert "TB_ROM const uint8_t tb_actions" in source.files["tb_table.c"]
     assert "#define TB_ROM PROGMEM" in source.files["tb_engine.h"]
 
 
-def test_unreachable_rows_are_dropped_from_the_scan():
+def test_unreachable_rows_are_dropped_from_the_scan() -> None:
     # row 1 needs a superset of row 0's events: it can never fire; row 2 needs other events
     assert reachable([(0b01, 0), (0b11, 1), (0b10, 2), (0, 3), (0b100, 4)]) == [(0b01, 0), (0b10, 2), (0, 3)]
 
 
-def test_integer_widths():
+def test_integer_widths() -> None:
     assert unsigned_for(255).size == 1 and unsigned_for(256).size == 2 and unsigned_for(70000).size == 4
 
 
-def test_auto_lookup_is_dense_for_the_bumberbot():
+def test_auto_lookup_is_dense_for_the_bumberbot() -> None:
     _, machine = load(EXAMPLE)
     layout = plan(machine)
     assert layout.dense and layout.lookup_bytes == 10 * 64 <= DENSE_LIMIT_BYTES

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -11,8 +12,12 @@ from core_helpers import COUNTER_ROBOT, EXAMPLE, column_of, example_machine, mac
 from tablebot.engine import Engine
 from tablebot.machine import NO_ROW
 
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from pathlib import Path
 
-def rows_fired(engine: Engine, ticks: int, pulses=(1, 0)) -> list[int]:
+
+def rows_fired(engine: Engine, ticks: int, pulses: Sequence[int] = (1, 0)) -> list[int]:
     fired = []
     for _ in range(ticks):
         engine.step(0, pulses)
@@ -30,13 +35,13 @@ idle,3,,,,=,=,,0,3
 """
 
 
-def test_counter_event_fires_on_the_tick_the_counter_reaches_zero(tmp_path):
+def test_counter_event_fires_on_the_tick_the_counter_reaches_zero(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, COUNT_DOWN, COUNTER_ROBOT))
     assert rows_fired(engine, 5) == [0, NO_ROW, NO_ROW, 1, 2]  # 3 pulses after the load
     assert engine.counters == [0, 0] and engine.outputs[:2] == (0, 0)
 
 
-def test_counter_counts_its_own_motors_pulses_and_never_below_zero(tmp_path):
+def test_counter_counts_its_own_motors_pulses_and_never_below_zero(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, COUNT_DOWN, COUNTER_ROBOT))
     engine.step(0, (0, 0))
     engine.step(0, (0, 9))  # pulses of M2 do not touch C1
@@ -45,7 +50,7 @@ def test_counter_counts_its_own_motors_pulses_and_never_below_zero(tmp_path):
     assert engine.counters == [0, 0] and engine.row == 1
 
 
-def test_pulses_as_a_numpy_array(tmp_path):
+def test_pulses_as_a_numpy_array(tmp_path: Path) -> None:
     import numpy as np
     engine = Engine(machine_of(tmp_path, COUNT_DOWN, COUNTER_ROBOT))
     for pulses in ([0, 0], np.array([1, 0]), np.array([2, 0], dtype=np.int64)):
@@ -55,7 +60,7 @@ def test_pulses_as_a_numpy_array(tmp_path):
     assert json.loads(json.dumps(engine.snapshot()))["counters"] == {"C1": 0, "C2": 0}
 
 
-def test_counters_ignore_pulses_on_the_first_tick(tmp_path):
+def test_counters_ignore_pulses_on_the_first_tick(tmp_path: Path) -> None:
     """Like the timer: a count-down starts after the first tick."""
     table = "state,T,C1,M1,C1_load,timer,next\n1,,1,1,=,0,1\n"
     engine = Engine(machine_of(tmp_path, table, COUNTER_ROBOT))
@@ -74,7 +79,7 @@ wait C1 again,6,,1,1,1,,0,6
 """
 
 
-def test_a_row_that_loads_a_counter_and_rows_that_leave_it(tmp_path):
+def test_a_row_that_loads_a_counter_and_rows_that_leave_it(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, LOAD_AND_LEAVE, COUNTER_ROBOT))
     # tick 0 loads 5; ticks 2 and 4 fire rows that leave C1 alone, so it reaches 0 on tick 5
     assert rows_fired(engine, 6) == [0, NO_ROW, 1, NO_ROW, 2, 3]
@@ -82,7 +87,7 @@ def test_a_row_that_loads_a_counter_and_rows_that_leave_it(tmp_path):
     assert rows_fired(engine, 2, pulses=(0, 0)) == [4, 5]
 
 
-def test_loads_on_the_batch_path(tmp_path):
+def test_loads_on_the_batch_path(tmp_path: Path) -> None:
     """No pulses on the batch path: a loaded counter holds, a counter loaded with 0 fires."""
     engine = Engine(machine_of(tmp_path, LOAD_AND_LEAVE, COUNTER_ROBOT))
     batch = engine.run([0] * 8)
@@ -92,7 +97,7 @@ def test_loads_on_the_batch_path(tmp_path):
     assert engine.run([0, 0, 0]).rows == [3, 4, 5]
 
 
-def test_counter_state_survives_snapshot(tmp_path):
+def test_counter_state_survives_snapshot(tmp_path: Path) -> None:
     machine = machine_of(tmp_path, LOAD_AND_LEAVE, COUNTER_ROBOT)
     engine = Engine(machine)
     rows_fired(engine, 3)
@@ -120,14 +125,14 @@ def to_signed(text: str, keep: str = "=") -> str:
 
 
 @pytest.mark.parametrize("keep", ["=", "keep", "Keep", "k"])
-def test_signed_and_direction_forms_give_identical_machines(tmp_path, keep):
+def test_signed_and_direction_forms_give_identical_machines(tmp_path: Path, keep: str) -> None:
     signed = to_signed((EXAMPLE / "table.csv").read_text(), keep)
     assert "M1_dir" not in signed and keep in signed
     machine = machine_of(tmp_path, signed, (EXAMPLE / "robot.toml").read_text())
     assert machine.signature() == example_machine().signature()
 
 
-def test_one_motor_in_each_form(tmp_path):
+def test_one_motor_in_each_form(tmp_path: Path) -> None:
     text = (EXAMPLE / "table.csv").read_text()
     signed = to_signed(text).splitlines()
     mixed = []
@@ -149,7 +154,7 @@ set again,4,1,0,,0,0,0,0,0,0,4
 """
 
 
-def test_keep_semantics_for_every_output(tmp_path):
+def test_keep_semantics_for_every_output(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, KEEP_ALL, COUNTER_ROBOT))
     snapshots = []
     for _ in range(4):
@@ -163,7 +168,7 @@ def test_keep_semantics_for_every_output(tmp_path):
     ]
 
 
-def test_blank_motor_cell_stops_but_blank_lamp_keeps(tmp_path):
+def test_blank_motor_cell_stops_but_blank_lamp_keeps(tmp_path: Path) -> None:
     table = "state,T,M1,M2,L1,timer,next\n1,1,5,5,6,0,2\n2,1,,,,0,2\n"
     engine = Engine(machine_of(tmp_path, table, COUNTER_ROBOT))
     engine.step(0, (0, 0))
@@ -188,7 +193,7 @@ HEADER = "description,state,T,C1,M1,M2_dir,M2_speed,L1,C1_load,timer,next"
     ("a,1,1,,0,,0,,65536,0,1", 8, r"C1_load: 65536 is out of range"),
     ("a,1,1,2,0,,0,,,0,1", 3, r"event C1: 2 is out of range 0\.\.1"),
 ])
-def test_out_of_range_values_are_located(tmp_path, line, index, pattern):
+def test_out_of_range_values_are_located(tmp_path: Path, line: str, index: int, pattern: str) -> None:
     diagnostics = problems(write_table(tmp_path, HEADER + "\n" + line + "\n", COUNTER_ROBOT))
     assert len(diagnostics) == 1, [d.message for d in diagnostics]
     d = diagnostics[0]
@@ -197,7 +202,7 @@ def test_out_of_range_values_are_located(tmp_path, line, index, pattern):
     assert str(d.render()).startswith(f"{tmp_path / 'table.csv'}:2:{column_of(line, index)}: error: ")
 
 
-def test_signed_error_hint_mentions_keep(tmp_path):
+def test_signed_error_hint_mentions_keep(tmp_path: Path) -> None:
     (d,) = problems(write_table(tmp_path, HEADER + "\na,1,1,,x,,0,,,0,1\n", COUNTER_ROBOT))
     assert "keep" in d.hint
 
@@ -207,14 +212,14 @@ def test_signed_error_hint_mentions_keep(tmp_path):
     "state,T,M1_speed,M1,timer,next",
     "state,T,M1_dir,M1,timer,next",
 ])
-def test_mixed_forms_for_one_motor(tmp_path, header):
+def test_mixed_forms_for_one_motor(tmp_path: Path, header: str) -> None:
     diagnostics = problems(write_table(tmp_path, header + "\n1,1,1,1,1,0,1\n", COUNTER_ROBOT))
     hits = [d for d in diagnostics if "both as M1 and as M1_dir/M1_speed" in d.message]
     assert len(hits) == 1
     assert (hits[0].line, hits[0].column) == (1, column_of(header, header.split(",").index("M1")))
 
 
-def test_counter_columns_need_a_counter_in_the_robot(tmp_path):
+def test_counter_columns_need_a_counter_in_the_robot(tmp_path: Path) -> None:
     header = "state,T,C3,C3_load,M1,timer,next"
     diagnostics = problems(write_table(tmp_path, header + "\n1,1,,,1,0,1\n", COUNTER_ROBOT))
     assert [(d.line, d.column) for d in diagnostics] == [(1, column_of(header, 2)), (1, column_of(header, 3))]

@@ -6,6 +6,7 @@ import importlib.util
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -14,11 +15,14 @@ from tablebot.sim.summary import summarise
 from tablebot.sim.turn_drift import turns
 from test_sim_helpers import ROOT, scene_of, trace_text
 
+if TYPE_CHECKING:
+    from types import ModuleType
+
 EXAMPLE = ROOT / "examples" / "bumberbot-counters"
 TURN = EXAMPLE / "turn90"
 
 
-def load_script(name: str):
+def load_script(name: str) -> ModuleType:
     spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     sys.modules[name] = module  # its dataclasses look their module up
@@ -75,7 +79,7 @@ def test_a_drained_bumberbot_finds_the_lamp_only_with_counters() -> None:
     assert counted.reached_s is not None
 
 
-def test_turn_drift_script_writes_plot_and_tables(tmp_path: Path, capsys) -> None:
+def test_turn_drift_script_writes_plot_and_tables(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     script = load_script("turn_drift")
     assert script.main(["--out", str(tmp_path), "--seeds", "1"]) == 0
     out = capsys.readouterr().out
@@ -86,7 +90,7 @@ def test_turn_drift_script_writes_plot_and_tables(tmp_path: Path, capsys) -> Non
     assert len(rows) == 12 and rows[0].startswith("charge,volts,timed_mean")
 
 
-def test_sim_benchmark_runs(capsys) -> None:
+def test_sim_benchmark_runs(capsys: pytest.CaptureFixture[str]) -> None:
     load_script("sim").main(["--repeat", "1", "--seconds", "5", "--no-commands"])
     out = capsys.readouterr().out
     assert "compiled block path" in out and "tick by tick" in out and "× real time" in out

@@ -19,7 +19,7 @@ runner = CliRunner()
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="the Graphviz program is not installed")
 
 
-def test_parallel_rows_are_merged():
+def test_parallel_rows_are_merged() -> None:
     by_pair = {(e.source, e.target): e for e in edges(BB)}
     assert len(by_pair) == 20  # 37 rows, 20 distinct (state, next) pairs
     (stop,) = by_pair[(1, 20)].lines
@@ -28,7 +28,7 @@ def test_parallel_rows_are_merged():
     assert by_pair[(22, 29)].lines[0][0] == "T or I5"
 
 
-def test_condition_drops_sets_that_add_nothing():
+def test_condition_drops_sets_that_add_nothing() -> None:
     sets = [frozenset({"I3", "I4"}), frozenset({"I3"}), frozenset({"I4"})]
     assert condition(BB, sets) == "I3 or I4"
     assert condition(BB, [frozenset()]) == "always"
@@ -39,11 +39,11 @@ def test_condition_drops_sets_that_add_nothing():
     ((None, None), "keep", "keep"), ((-2, 2), "spin right L2 R-2", "turn"),  # M1 is the right motor
     ((1, 5), "curve right L5 R1", "turn"), ((-3, -2), "back, turn right L-2 R-3", "reverse"),
 ])
-def test_motion_words(motors, words, kind):
+def test_motion_words(motors: tuple[int | None, int | None], words: str, kind: str) -> None:
     assert motion_of(BB, motors) == (words, kind)
 
 
-def test_dot_source_marks_the_initial_state_and_labels_states():
+def test_dot_source_marks_the_initial_state_and_labels_states() -> None:
     source = render(BB, "dot").decode()
     assert source.count("s_2 [label=<<b>2</b><br/>Seek: turn>") == 1
     assert "\t__start -> s_2 [" in source  # the initial state drawn wider, in its colour from the pictures
@@ -53,7 +53,7 @@ def test_dot_source_marks_the_initial_state_and_labels_states():
     assert "I3 or I4" in source and "#c62828" in source  # reverse edges are red
 
 
-def test_mermaid():
+def test_mermaid() -> None:
     text = to_mermaid(BB)
     assert text.startswith("stateDiagram-v2\n") and "[*] --> s_2" in text
     assert "s_1 --> s_20: I3 or I4 / stop 500 ms" in text
@@ -61,28 +61,28 @@ def test_mermaid():
 
 
 @needs_dot
-def test_png_and_svg(tmp_path):
+def test_png_and_svg(tmp_path: Path) -> None:
     assert render(BB, "png").startswith(b"\x89PNG")
     svg = render(BB, "svg").decode()
     assert "<svg" in svg and "Collision entry" in svg
 
 
 @needs_dot
-def test_command_infers_the_format_from_the_file_name(tmp_path):
+def test_command_infers_the_format_from_the_file_name(tmp_path: Path) -> None:
     out = tmp_path / "bb.png"
     result = runner.invoke(app, ["diagram", str(EXAMPLE), "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert out.read_bytes().startswith(b"\x89PNG")
 
 
-def test_command_mermaid_to_stdout_and_bad_format():
+def test_command_mermaid_to_stdout_and_bad_format() -> None:
     result = runner.invoke(app, ["diagram", str(FIX / "bump.csv"), "--format", "mermaid"])
     assert result.exit_code == 0 and "s_3 --> s_1: T / spin left L-3 R3 300 ms" in result.stdout
     bad = runner.invoke(app, ["diagram", str(FIX / "bump.csv"), "--format", "gif"])
     assert bad.exit_code == 2 and "unknown diagram format" in bad.stderr
 
 
-def test_a_fallback_row_reads_otherwise_and_descriptions_never_name_states(tmp_path):
+def test_a_fallback_row_reads_otherwise_and_descriptions_never_name_states(tmp_path: Path) -> None:
     robot = (FIX / "robot.toml").read_text()
     (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
     (tmp_path / "t.csv").write_text("description,state,T,A,B,M1,M2,timer,next\n"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
@@ -12,6 +13,12 @@ from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import NO_ROW
 from tablebot.replay import record
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from tablebot.formats.inputs_csv import TickInput
+    from tablebot.machine import Machine
 
 I3, I4, I5, I7, I8, T = 16, 8, 4, 2, 1, 32
 
@@ -31,13 +38,13 @@ def run(engine: Engine, masks: list[int]) -> list[tuple[int, int, object, int, t
 
 # --- the BumberBot, as the document describes it ------------------------------------------------------
 
-def test_first_tick_timer_zero_fires_seek_turn():
+def test_first_tick_timer_zero_fires_seek_turn() -> None:
     engine = bumberbot()
     assert engine.snapshot() == {"tick": 0, "state": 2, "timer": 0, "counters": {}, "outputs": {"M1": 0, "M2": 0}}
     assert run(engine, [0]) == [(T, 7, 1, 500, (4, 4))]
 
 
-def test_timer_counts_down_only_after_the_first_tick_and_fires_after_its_value():
+def test_timer_counts_down_only_after_the_first_tick_and_fires_after_its_value() -> None:
     engine = bumberbot()
     trace = run(engine, [0] * 502)
     assert [t[3] for t in trace[:4]] == [500, 499, 498, 497]
@@ -47,7 +54,7 @@ def test_timer_counts_down_only_after_the_first_tick_and_fires_after_its_value()
     assert trace[501][1:4] == (NO_ROW, 2, 894)
 
 
-def test_timer_zero_row_lets_t_fire_on_the_very_next_tick():
+def test_timer_zero_row_lets_t_fire_on_the_very_next_tick() -> None:
     engine = bumberbot()
     trace = run(engine, [0, I3 | I4] + [0] * 51)
     assert trace[1] == (I3 | I4, 0, 20, 50, (0, 0))  # collision: stop, 50 ticks
@@ -55,7 +62,7 @@ def test_timer_zero_row_lets_t_fire_on_the_very_next_tick():
     assert trace[52] == (T, 12, 1, 500, (4, 4))  # T at once: Collision Fake (no bumper pressed)
 
 
-def test_first_match_in_table_order_and_extra_events_do_not_matter():
+def test_first_match_in_table_order_and_extra_events_do_not_matter() -> None:
     engine = bumberbot()
     run(engine, [0])  # now state 1, timer 500
     assert run(engine, [I3 | I4 | I7 | I8 | I5])[0][1:3] == (0, 20)  # both bumpers: row 0, not row 1 or 2
@@ -70,7 +77,7 @@ def test_first_match_in_table_order_and_extra_events_do_not_matter():
     assert run(engine, [I7])[0][1:] == (21, 11, 125, (1, 5))
 
 
-def test_no_match_changes_nothing_but_the_timer():
+def test_no_match_changes_nothing_but_the_timer() -> None:
     engine = bumberbot()
     run(engine, [0, I7])  # state 11, timer 125, (1, 5)
     before = engine.snapshot()
@@ -79,13 +86,13 @@ def test_no_match_changes_nothing_but_the_timer():
     assert after["state"] == before["state"] and after["outputs"] == before["outputs"]
 
 
-def test_t_is_never_an_input():
+def test_t_is_never_an_input() -> None:
     engine = bumberbot()
     run(engine, [0])
     assert run(engine, [T | I8]) == [(I8, 22, 11, 125, (5, 1))]
 
 
-def test_inputs_as_names_or_mask_are_the_same():
+def test_inputs_as_names_or_mask_are_the_same() -> None:
     by_mask, by_name = bumberbot(), bumberbot()
     by_mask.step(0)
     by_name.step({})
@@ -93,7 +100,7 @@ def test_inputs_as_names_or_mask_are_the_same():
     assert by_mask.snapshot() == by_name.snapshot()
 
 
-def test_step_returns_outputs_and_reset_starts_over():
+def test_step_returns_outputs_and_reset_starts_over() -> None:
     engine = bumberbot()
     assert engine.step() == (4, 4)
     engine.reset()
@@ -112,19 +119,19 @@ keep M2 only,4,1,,,,6,1,7,0,4
 """
 
 
-def test_speed_seven_keeps_the_motor_and_its_direction(tmp_path):
+def test_speed_seven_keeps_the_motor_and_its_direction(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, KEEP_TABLE, MINI_ROBOT))
     assert [engine.step() for _ in range(4)] == [(-3, 5), (-3, 5), (-3, 0), (6, 0)]
 
 
-def test_row_without_events_fires_every_tick(tmp_path):
+def test_row_without_events_fires_every_tick(tmp_path: Path) -> None:
     table = "state,A,M1,M2,timer,next\n1,1,8,8,9,1\n1,,1,1,3,1\n"
     engine = Engine(machine_of(tmp_path, table, MINI_ROBOT))
     assert [(engine.step({"A": a}), engine.row, engine.timer) for a in (0, 1, 0, 1)] == [
         ((1, 1), 1, 3), ((8, 8), 0, 9), ((1, 1), 1, 3), ((8, 8), 0, 9)]
 
 
-def test_initial_timer_from_the_robot(tmp_path):
+def test_initial_timer_from_the_robot(tmp_path: Path) -> None:
     robot = MINI_ROBOT.replace("initial_timer = 0", "initial_timer = 3")
     engine = Engine(machine_of(tmp_path, "state,T,M1,timer,next\n1,1,5,0,1\n", robot))
     assert [(engine.step(), engine.timer, engine.row) for _ in range(5)] == [
@@ -137,7 +144,7 @@ def test_initial_timer_from_the_robot(tmp_path):
     (2, [0, NO_ROW, 0, NO_ROW, 0, NO_ROW]),
     (3, [0, NO_ROW, NO_ROW, 0, NO_ROW, NO_ROW]),
 ])
-def test_a_timer_of_n_fires_t_n_ticks_later(tmp_path, timer, fired):
+def test_a_timer_of_n_fires_t_n_ticks_later(tmp_path: Path, timer: int, fired: list[int]) -> None:
     engine = Engine(machine_of(tmp_path, f"state,T,M1,timer,next\n1,1,=,{timer},1\n", MINI_ROBOT))
     rows = []
     for _ in range(6):
@@ -146,7 +153,7 @@ def test_a_timer_of_n_fires_t_n_ticks_later(tmp_path, timer, fired):
     assert rows == fired
 
 
-def test_table_without_t_column_never_sees_the_timer(tmp_path):
+def test_table_without_t_column_never_sees_the_timer(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, "state,A,M1,timer,next\n1,1,2,0,1\n", MINI_ROBOT))
     assert engine.machine.timer_bit == 0
     engine.step()
@@ -157,12 +164,12 @@ def test_table_without_t_column_never_sees_the_timer(tmp_path):
 
 # --- snapshot and restore -----------------------------------------------------------------------------
 
-def example_ticks():
+def example_ticks() -> tuple[Machine, list[TickInput]]:
     machine = example_machine()
     return machine, load_inputs(EXAMPLE / "inputs.csv", machine)
 
 
-def trace_lines(engine: Engine, ticks) -> list[str]:
+def trace_lines(engine: Engine, ticks: list[TickInput]) -> list[str]:
     lines = []
     for tick in ticks:
         engine.step(tick.mask, tick.pulses)
@@ -171,7 +178,7 @@ def trace_lines(engine: Engine, ticks) -> list[str]:
 
 
 @pytest.mark.parametrize("split", [0, 1, 137, 1001, 2999])
-def test_snapshot_restore_resumes_exactly(split):
+def test_snapshot_restore_resumes_exactly(split: int) -> None:
     machine, ticks = example_ticks()
     whole = trace_lines(Engine(machine), ticks)
     first = Engine(machine)
@@ -182,7 +189,7 @@ def test_snapshot_restore_resumes_exactly(split):
     assert head + trace_lines(second, ticks[split:]) == whole
 
 
-def test_restore_rewinds_a_running_engine():
+def test_restore_rewinds_a_running_engine() -> None:
     machine, ticks = example_ticks()
     engine = Engine(machine)
     trace_lines(engine, ticks[:700])
@@ -192,7 +199,7 @@ def test_restore_rewinds_a_running_engine():
     assert trace_lines(engine, ticks[700:900]) == again
 
 
-def test_snapshot_is_plain_json():
+def test_snapshot_is_plain_json() -> None:
     engine = bumberbot()
     run(engine, [0, I7])
     snap = engine.snapshot()
@@ -200,7 +207,7 @@ def test_snapshot_is_plain_json():
     assert snap == {"tick": 2, "state": 11, "timer": 125, "counters": {}, "outputs": {"M1": 1, "M2": 5}}
 
 
-def test_snapshot_names_named_states(tmp_path):
+def test_snapshot_names_named_states(tmp_path: Path) -> None:
     robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "go"')
     engine = Engine(machine_of(tmp_path, "state,T,M1,timer,next\ngo,1,3,2,stop\nstop,1,0,0,go\n", robot))
     engine.step()
@@ -218,14 +225,14 @@ def test_snapshot_names_named_states(tmp_path):
     ({"counters": {"C1": 0}}, "must name exactly"),
     ({"timer": "soon"}, "timer"),
 ])
-def test_restore_refuses_a_snapshot_that_does_not_fit(change, pattern):
+def test_restore_refuses_a_snapshot_that_does_not_fit(change: dict[str, object], pattern: str) -> None:
     engine = bumberbot()
     with pytest.raises(ValueError, match=pattern):
         engine.restore({**engine.snapshot(), **change})
 
 
 @pytest.mark.parametrize("missing", ["tick", "state", "timer"])
-def test_restore_names_a_missing_field(missing):
+def test_restore_names_a_missing_field(missing: str) -> None:
     engine = bumberbot()
     snap = engine.snapshot()
     del snap[missing]
@@ -233,7 +240,7 @@ def test_restore_names_a_missing_field(missing):
         engine.restore(snap)
 
 
-def test_failed_restore_leaves_the_engine_as_it_was():
+def test_failed_restore_leaves_the_engine_as_it_was() -> None:
     engine = bumberbot()
     run(engine, [0, I7])
     before = engine.snapshot()
@@ -244,7 +251,7 @@ def test_failed_restore_leaves_the_engine_as_it_was():
 
 # --- the batch path -----------------------------------------------------------------------------------
 
-def test_batch_results_as_lists_and_arrays():
+def test_batch_results_as_lists_and_arrays() -> None:
     engine = bumberbot()
     batch = engine.run([0, I7, 0, I5])
     assert batch.events == [T, I7, 0, I5]
@@ -267,13 +274,13 @@ def test_batch_results_as_lists_and_arrays():
     np.array([0, I3 | I4, 0, 0, 99], dtype=np.int64)[:4],
     [0, I3 | I4 | T, 0, 0],  # T's bit is the engine's to make: ignored, as step does
 ])
-def test_batch_accepts_any_integer_sequence(masks):
+def test_batch_accepts_any_integer_sequence(masks: list[int] | tuple[int, ...] | np.ndarray) -> None:
     assert bumberbot().run(masks).rows == [7, 0, NO_ROW, NO_ROW]
 
 
 @pytest.mark.parametrize("jit", [None, False])
 @pytest.mark.parametrize("bad", [-1, 64, 256, 1 << 40])
-def test_masks_beyond_the_tables_events_are_refused(bad, jit):
+def test_masks_beyond_the_tables_events_are_refused(bad: int, jit: bool | None) -> None:
     """Issue 14: a negative or too-wide mask is a ValueError naming the valid range and the inputs."""
     with pytest.raises(ValueError, match=r"0\.\.63.*I3=16") if jit is False else pytest.raises(ValueError,
                                                                                             match=r"0\.\.63"):
@@ -293,31 +300,31 @@ def test_masks_beyond_the_tables_events_are_refused(bad, jit):
     (True, r"not bool"),
     (None, r"not NoneType"),
 ])
-def test_wrong_inputs_name_the_offending_key_and_the_valid_ones(inputs, message):
+def test_wrong_inputs_name_the_offending_key_and_the_valid_ones(inputs: object, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         bumberbot().step(inputs)
 
 
-def test_pulses_must_fit_the_counters(tmp_path):
+def test_pulses_must_fit_the_counters(tmp_path: Path) -> None:
     engine = bumberbot()
     engine.step(0)
     with pytest.raises(ValueError, match=r"pulses: 2 values for 0 counters"):
         engine.step(0, (1, 2))
 
 
-def test_step_accepts_numpy_integers():
+def test_step_accepts_numpy_integers() -> None:
     engine = bumberbot()
     engine.step(np.uint8(0))
     assert engine.step(np.int64(I7)) == (1, 5)
 
 
-def test_empty_batch_changes_nothing():
+def test_empty_batch_changes_nothing() -> None:
     engine = bumberbot()
     assert len(engine.run([])) == 0
     assert engine.snapshot()["tick"] == 0 and engine.event == 0 and engine.row == NO_ROW
 
 
-def wide_engine(tmp_path, inputs: int) -> Engine:
+def wide_engine(tmp_path: Path, inputs: int) -> Engine:
     names = [f"I{i}" for i in range(inputs)]
     robot = 'name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'{n} = ""\n' for n in names)
     robot += '[motors]\nM1 = ""\n'
@@ -329,7 +336,7 @@ def wide_engine(tmp_path, inputs: int) -> Engine:
 
 
 @pytest.mark.parametrize("inputs", [10, 14])
-def test_wide_tables_batch_and_step_agree(tmp_path, inputs):
+def test_wide_tables_batch_and_step_agree(tmp_path: Path, inputs: int) -> None:
     """10 event columns: flat lookup, masks over 255 (int64 path); 14: no flat table, Python batch."""
     engine = wide_engine(tmp_path, inputs)
     assert (engine.machine.flat is None) == (inputs > 10)

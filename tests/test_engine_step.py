@@ -4,12 +4,17 @@ made on a state's first tick, and tick/timer/counters read and assigned as plain
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pytest
 
 from core_helpers import COUNTER_ROBOT, MINI_ROBOT, example_machine, machine_of
 from tablebot.engine import Engine
 from tablebot.machine import FLAT_BITS, NO_ROW
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 I3, I4, I5, I7, I8, T = 16, 8, 4, 2, 1, 32
 RANGE = r"is not a mask of this table's 6 event columns \(0\.\.63\); its inputs are I3=16, I4=8, I5=4, I7=2, I8=1"
@@ -50,7 +55,7 @@ BAD_INPUTS = [
 
 @pytest.mark.parametrize("ticks_before", [0, 1, 2, 500, 510], ids=lambda n: f"after{n}")
 @pytest.mark.parametrize(("bad", "message"), BAD_INPUTS, ids=lambda v: repr(v)[:20])
-def test_a_refused_input_names_what_is_wrong_and_changes_nothing(bad, message, ticks_before):
+def test_a_refused_input_names_what_is_wrong_and_changes_nothing(bad: object, message: str, ticks_before: int) -> None:
     """Fresh (no lookup made yet), timer running, timer at 0 (tick 500: T fires), in a new state (510)."""
     engine = Engine(example_machine())
     for _ in range(ticks_before):
@@ -66,7 +71,7 @@ def test_a_refused_input_names_what_is_wrong_and_changes_nothing(bad, message, t
     assert whole_state(engine) == whole_state(again)
 
 
-def test_refused_pulses_change_nothing_not_even_the_tick(tmp_path):
+def test_refused_pulses_change_nothing_not_even_the_tick(tmp_path: Path) -> None:
     counting = Engine(machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,1,,5,3,2,1\n1,,1,0,=,0,1\n",
                                  COUNTER_ROBOT))
     counting.step(0, (0, 0))
@@ -89,7 +94,7 @@ def test_refused_pulses_change_nothing_not_even_the_tick(tmp_path):
     assert whole_state(plain) == before
 
 
-def test_no_pulses_as_none_empty_tuple_or_empty_list():
+def test_no_pulses_as_none_empty_tuple_or_empty_list() -> None:
     trace = []
     for pulses in (None, (), [], np.zeros(0, dtype=np.int64)):
         engine = Engine(example_machine())
@@ -101,7 +106,7 @@ def test_no_pulses_as_none_empty_tuple_or_empty_list():
 
 
 @pytest.mark.parametrize("ticks_before", [0, 1, 500])
-def test_the_engines_own_bits_in_a_mask_are_ignored_by_every_input_kind(ticks_before):
+def test_the_engines_own_bits_in_a_mask_are_ignored_by_every_input_kind(ticks_before: int) -> None:
     """T in a mask is neither an event nor a refusal, whether the state's lookup is made or not."""
     results = []
     for inputs in (I8 | T, I8, np.int64(I8 | T), np.uint8(I8), {"I8": 1}):
@@ -113,7 +118,7 @@ def test_the_engines_own_bits_in_a_mask_are_ignored_by_every_input_kind(ticks_be
     assert results[0][1] & ~T == I8
 
 
-def test_counter_bits_in_a_mask_are_ignored(tmp_path):
+def test_counter_bits_in_a_mask_are_ignored(tmp_path: Path) -> None:
     machine = machine_of(tmp_path, "state,T,C1,A,M1,C1_load,timer,next\n1,1,,,5,3,9,2\n2,,1,,6,=,0,1\n"
                                    "2,,,1,7,=,0,1\n", COUNTER_ROBOT)
     c1, a = machine.table.bit("C1"), machine.input_bits["A"]
@@ -124,7 +129,7 @@ def test_counter_bits_in_a_mask_are_ignored(tmp_path):
     assert with_bit.row == NO_ROW and with_bit.counters == [3, 0]  # C1 is still 3: the mask's C1 bit did not fire
 
 
-def test_wide_table_refuses_and_ignores_like_a_flat_one(tmp_path):
+def test_wide_table_refuses_and_ignores_like_a_flat_one(tmp_path: Path) -> None:
     inputs = FLAT_BITS + 2
     names = [f"I{i}" for i in range(inputs)]
     robot = 'name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'{n} = ""\n' for n in names)
@@ -150,7 +155,7 @@ def test_wide_table_refuses_and_ignores_like_a_flat_one(tmp_path):
 TIMER_TABLE = "state,T,A,M1,timer,next\n1,1,,5,4,1\n1,,1,6,2,1\n"
 
 
-def test_timer_reads_as_counted_down_and_assigns(tmp_path):
+def test_timer_reads_as_counted_down_and_assigns(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, TIMER_TABLE, MINI_ROBOT))
     assert (engine.tick, engine.timer) == (0, 0)
     engine.step()
@@ -169,7 +174,7 @@ def test_timer_reads_as_counted_down_and_assigns(tmp_path):
     assert engine.row == 0
 
 
-def test_assigning_tick_keeps_the_timer(tmp_path):
+def test_assigning_tick_keeps_the_timer(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, TIMER_TABLE, MINI_ROBOT))
     engine.step()
     engine.step()
@@ -183,7 +188,7 @@ def test_assigning_tick_keeps_the_timer(tmp_path):
     assert (engine.tick, engine.timer, engine.row) == (1, 2, NO_ROW)
 
 
-def test_the_first_tick_after_restoring_tick_0_does_not_count_down(tmp_path):
+def test_the_first_tick_after_restoring_tick_0_does_not_count_down(tmp_path: Path) -> None:
     engine = Engine(machine_of(tmp_path, TIMER_TABLE, MINI_ROBOT))
     engine.restore({**engine.snapshot(), "tick": 0, "timer": 1})
     engine.step()
@@ -192,7 +197,7 @@ def test_the_first_tick_after_restoring_tick_0_does_not_count_down(tmp_path):
     assert (engine.timer, engine.row) == (4, 0)
 
 
-def test_counters_assign_and_read_as_a_copy(tmp_path):
+def test_counters_assign_and_read_as_a_copy(tmp_path: Path) -> None:
     machine = machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,,1,7,=,0,1\n1,1,,=,=,0,1\n",
                          COUNTER_ROBOT)
     engine = Engine(machine)

@@ -8,6 +8,7 @@ import shlex
 import shutil
 import subprocess
 import xml.etree.ElementTree as ET
+from typing import TYPE_CHECKING
 
 import pytest
 from rich.console import Console
@@ -28,13 +29,16 @@ from tablebot.escape import (
     xml_text,
 )
 
+if TYPE_CHECKING:
+    from pathlib import Path
+
 TEXTS = (*HOSTILE, "", "plain", "a\tb\r\nc", "\\" * 3, "??=??(??)", "x" * 300, "\ufffe\ud800lone")
 needs_gcc = pytest.mark.skipif(shutil.which("gcc") is None, reason="no C compiler")
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="the Graphviz program is not installed")
 
 
 @needs_gcc
-def test_c_string_and_comment_compile_and_print_back(tmp_path):
+def test_c_string_and_comment_compile_and_print_back(tmp_path: Path) -> None:
     """gcc -std=c99 (trigraphs on) -Wall -Werror: each string prints its UTF-8 bytes; comments vanish."""
     texts = [t for t in TEXTS if "\ud800" not in t]
     body = "\n".join(f"    /* {c_comment(t)} */ put({c_string(t)}, {len(t.encode())});" for t in texts)
@@ -49,14 +53,14 @@ def test_c_string_and_comment_compile_and_print_back(tmp_path):
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_c_comment_is_one_inert_line(text):
+def test_c_comment_is_one_inert_line(text: str) -> None:
     safe = c_comment(text)
     assert "*/" not in safe and "/*" not in safe and "??" not in safe and "\\" not in safe
     assert safe.isascii() and safe.isprintable()
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_xml_text_and_attr_parse_back(text):
+def test_xml_text_and_attr_parse_back(text: str) -> None:
     expected = "".join(REPLACEMENT if c in "\ufffe\ud800" or (ord(c) < 32 and c not in "\t\r\n") else c
                        for c in text)
     root = ET.fromstring(f"<r a=\"{xml_attr(text)}\" b='{xml_attr(text)}'>{xml_text(text)}</r>".encode(
@@ -73,16 +77,16 @@ class _Collect(html.parser.HTMLParser):
         self.data = ""
         self.attrs: list[tuple[str, str | None]] = []
 
-    def handle_starttag(self, tag, attrs):
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
         self.tags.append(tag)
         self.attrs += attrs
 
-    def handle_data(self, data):
+    def handle_data(self, data: str) -> None:
         self.data += data
 
 
 @pytest.mark.parametrize("text", [t for t in TEXTS if "\ud800" not in t])
-def test_html_text_parses_back(text):
+def test_html_text_parses_back(text: str) -> None:
     parser = _Collect()
     parser.feed(f'<p title="{html_text(text)}">{html_text(text)}</p>')
     parser.close()
@@ -93,7 +97,7 @@ def test_html_text_parses_back(text):
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_shell_word_reads_back(text):
+def test_shell_word_reads_back(text: str) -> None:
     word = shell_word(text)
     if "\ud800" in text:  # no command line can carry a lone surrogate: the word still quotes it whole
         assert shlex.split(word) == [text]
@@ -104,13 +108,13 @@ def test_shell_word_reads_back(text):
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_python_string_evaluates_back(text):
+def test_python_string_evaluates_back(text: str) -> None:
     literal = python_string(text)
     assert literal.isascii() and ast.literal_eval(literal) == text
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_terminal_prints_literally(text):
+def test_terminal_prints_literally(text: str) -> None:
     console = Console(emoji=False, highlight=False, width=1000, force_terminal=False)
     with console.capture() as captured:
         console.print(f"[bold]<{terminal(text)}>[/bold]")
@@ -124,13 +128,13 @@ def test_terminal_prints_literally(text):
 
 
 @pytest.mark.parametrize("text", TEXTS)
-def test_mermaid_label_has_no_syntax(text):
+def test_mermaid_label_has_no_syntax(text: str) -> None:
     label = mermaid_label(text)
     assert not any(c in label for c in ':;\n\r"`<>&#%{}') and "direction " not in label.lower()
 
 
 @needs_dot
-def test_dot_ids_and_labels_parse_back():
+def test_dot_ids_and_labels_parse_back() -> None:
     lines = ["digraph g {"]
     for i, text in enumerate(TEXTS):
         if "\ud800" in text:
@@ -145,7 +149,7 @@ def test_dot_ids_and_labels_parse_back():
     assert not [e for e in svg.iter() if e.tag.endswith("evil")]
 
 
-def test_dot_id_is_a_plain_identifier():
+def test_dot_id_is_a_plain_identifier() -> None:
     for text in (*TEXTS, "node", "123", "<html>"):
         ident = dot_id(text)
         assert ident and (ident[0].isalpha() or ident[0] == "_") and all(c.isalnum() or c == "_" for c in ident)

@@ -17,6 +17,6 @@ print(light, GridArchive is pyribs.GridArchive, EmitterBase is pyribs.EmitterBas
 """
 
 
-def test_the_two_classes_come_alone_and_stay_the_packages_own():
+def test_the_two_classes_come_alone_and_stay_the_packages_own() -> None:
     done = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, check=True)
     assert done.stdout.split() == ["[]", "True", "True", "True"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
@@ -15,28 +16,31 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import ROOT, scene_of
 
+if TYPE_CHECKING:
+    from tablebot.sim.runner import SimRun
+
 EXAMPLES = ROOT / "examples"
 DEFAULT_SECONDS = 120.0  # tablebot sim's default run
 
 
 @pytest.fixture(scope="module")
-def follower():
+def follower() -> SimRun:
     return simulate(scene_of(EXAMPLES / "line-follower" / "table.csv"), DEFAULT_SECONDS, seed=1)
 
 
-def test_the_line_follower_drives_two_laps_without_touching_anything(follower) -> None:
+def test_the_line_follower_drives_two_laps_without_touching_anything(follower: SimRun) -> None:
     summary = summarise(follower)
     assert summary.laps is not None and summary.laps >= 2.0
     assert summary.collisions == 0
 
 
-def test_the_hairpin_needs_the_recovery_rows(follower) -> None:
+def test_the_hairpin_needs_the_recovery_rows(follower: SimRun) -> None:
     states = follower.scene.machine.states
     spun = {states[s] for s in follower.states.tolist()} & {4, 5}  # lost left / lost right
     assert spun, "the tight curve was followed by steering alone: it is not tight enough"
 
 
-def test_the_floor_sensors_read_the_tape_under_them(follower) -> None:
+def test_the_floor_sensors_read_the_tape_under_them(follower: SimRun) -> None:
     """Every tick, each sensor's reading is 1 exactly when its spot lies within the tape's half width."""
     from tablebot.sim.geometry import point_segment_distance
 

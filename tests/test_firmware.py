@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import random
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -23,23 +24,29 @@ from tablebot.robot import BUMBERBOT, Counter, Robot
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 from tablebot.tomlfile import Source
 
+if TYPE_CHECKING:
+    from typing import Any
+
+    from tablebot.machine import Machine
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 STEP_TARGET = 100  # cycles per engine step, worst case (issue 6)
 
 
 @pytest.fixture(scope="module")
-def harness(tmp_path_factory):
+def harness(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return build_harness(tmp_path_factory.mktemp("harness"))
 
 
 @pytest.fixture(scope="module")
-def bumberbot():
+def bumberbot() -> tuple[Machine, list[TickInput]]:
     _, machine = load(EXAMPLE)
     return machine, load_inputs(EXAMPLE / "inputs.csv", machine)
 
 
-def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot, harness, tmp_path):
+def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
+                                                      tmp_path: Path) -> None:
     machine, ticks = bumberbot
     firmware = build(machine, "uno", tmp_path / "fw")
     run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
@@ -52,7 +59,8 @@ def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot, harness, tmp_pa
     assert firmware.hex.read_text().startswith(":")
 
 
-def test_bumberbot_on_ftduino_equals_python(bumberbot, harness, tmp_path):
+def test_bumberbot_on_ftduino_equals_python(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
+                                            tmp_path: Path) -> None:
     machine, ticks = bumberbot
     firmware = build(machine, "ftduino", tmp_path / "fw")
     run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
@@ -61,7 +69,7 @@ def test_bumberbot_on_ftduino_equals_python(bumberbot, harness, tmp_path):
 
 
 @pytest.mark.parametrize("board", ["uno", "ftduino"])
-def test_counters_example_with_encoder_pulses(board, harness, tmp_path):
+def test_counters_example_with_encoder_pulses(board: str, harness: Path, tmp_path: Path) -> None:
     table, machine = load(ROOT / "examples" / "bumberbot-counters")
     ticks = random_inputs(random.Random(1), table, 800, density=0.03, max_pulses=3)
     firmware = build(machine, board, tmp_path / "fw")
@@ -71,7 +79,8 @@ def test_counters_example_with_encoder_pulses(board, harness, tmp_path):
     assert run.problems == [] and run.trace == expected
 
 
-def test_remapped_active_high_inputs_under_emulation(bumberbot, harness, tmp_path):
+def test_remapped_active_high_inputs_under_emulation(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
+                                                     tmp_path: Path) -> None:
     machine, ticks = bumberbot
     robot = _robot(sections={"board": {"uno": {"I7": "A2", "I8": "A3", "M1": "B", "active_high": ["I7", "I8"]}}})
     table = load(EXAMPLE)[0]
@@ -92,8 +101,9 @@ def _fits(board: str, shape: Shape) -> bool:
 @given(seed=st.integers(0, 2**32 - 1), board=st.sampled_from(["uno", "uno", "ftduino"]),
        inputs=st.integers(0, 4), motors=st.integers(1, 2), lamps=st.integers(0, 2), counters=st.integers(0, 2),
        lookup=st.sampled_from(["auto", "scan"]))
-def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed, board, inputs, motors, lamps,
-                                                counters, lookup):
+def test_random_tables_in_firmware_equal_python(tmp_path_factory: pytest.TempPathFactory, harness: Path, seed: int,
+                                                board: str, inputs: int, motors: int, lamps: int, counters: int,
+                                                lookup: str) -> None:
     shape = Shape(states=5, rows=15, inputs=inputs, motors=motors, lamps=lamps, counters=counters)
     assert _fits(board, shape)
     rng = random.Random(seed)
@@ -108,7 +118,7 @@ def test_random_tables_in_firmware_equal_python(tmp_path_factory, harness, seed,
 
 
 @pytest.mark.parametrize("match", ["document", "always"])
-def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness, tmp_path, match):
+def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness: Path, tmp_path: Path, match: str) -> None:
     """Under emulation the firmware follows the table's rule where the two part (the scan lookup carries
     the rule as code, the dense one as data)."""
     table, ticks = random_case(random.Random(f"fw-{match}"), Shape(states=3, rows=9, inputs=3, counters=1,
@@ -122,7 +132,7 @@ def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness, tmp_
 
 # --- boards and wiring --------------------------------------------------------------------------
 
-def _robot(**changes) -> Robot:
+def _robot(**changes: Any) -> Robot:
     """The BumberBot with ``changes``; a ``sections`` board table is read as a robot file's would be."""
     robot = Robot(**{**BUMBERBOT.__dict__, **changes, "sections": {}})
     boards = changes.get("sections", {}).get("board")
@@ -133,7 +143,7 @@ def _robot(**changes) -> Robot:
     return robot
 
 
-def test_bumberbot_wiring_on_both_boards():
+def test_bumberbot_wiring_on_both_boards() -> None:
     uno = wire(BUMBERBOT, load_board("uno"))
     assert uno.inputs == {"I3": "D2", "I4": "D4", "I5": "D5", "I7": "D6", "I8": "D7"}
     assert uno.motors == {"M1": "A", "M2": "B"}
@@ -142,20 +152,20 @@ def test_bumberbot_wiring_on_both_boards():
     assert ftduino.motors == {"M1": "M1", "M2": "M2"}
 
 
-def test_robot_file_maps_terminals_and_polarity():
+def test_robot_file_maps_terminals_and_polarity() -> None:
     robot = _robot(sections={"board": {"uno": {"I7": "A2", "M1": "B", "active_high": ["I8"]}}})
     wiring = wire(robot, load_board("uno"))
     assert wiring.inputs["I7"] == "A2" and wiring.motors == {"M1": "B", "M2": "A"}
     assert wiring.active_high == frozenset({"I8"})
 
 
-def test_too_many_motors_for_the_uno_is_refused():
+def test_too_many_motors_for_the_uno_is_refused() -> None:
     robot = _robot(motors=("M1", "M2", "M3"))
     with pytest.raises(TableBotError, match="no free terminal for motor M3"):
         wire(robot, load_board("uno"))
 
 
-def test_ftduino_c2_carries_the_trace_not_a_counter():
+def test_ftduino_c2_carries_the_trace_not_a_counter() -> None:
     robot = _robot(counters=(Counter("C1", "M1"), Counter("C2", "M2")))
     wiring = wire(robot, load_board("ftduino"))
     assert wiring.counters == {"C1": "C1", "C2": "C3"}  # C2 is TXD1: the counter takes the next free one
@@ -164,19 +174,19 @@ def test_ftduino_c2_carries_the_trace_not_a_counter():
              load_board("ftduino"))
 
 
-def test_unknown_board_terminal_is_reported():
+def test_unknown_board_terminal_is_reported() -> None:
     with pytest.raises(TableBotError, match="input I3 cannot use 'D13'"):
         wire(_robot(sections={"board": {"uno": {"I3": "D13"}}}), load_board("uno"))
 
 
-def test_pins_csv_drives_active_low_inputs_and_pulses():
+def test_pins_csv_drives_active_low_inputs_and_pulses() -> None:
     _, machine = load(EXAMPLE)
     wiring = wire(BUMBERBOT, load_board("uno"))
     text = pins_csv(machine, wiring, [TickInput(0), TickInput(machine.input_bits["I3"])])
     assert text.splitlines() == ["PD2,PD4,PD5,PD6,PD7", "1,1,1,1,1", "0,1,1,1,1"]
 
 
-def test_tick_timer_and_uart_settings():
+def test_tick_timer_and_uart_settings() -> None:
     assert timer_setting(16_000_000, 10) == (19999, "(1 << CS11)")  # /8: 2 MHz, 20000 counts
     assert timer_setting(16_000_000, 1000)[0] == 62499  # /256
     with pytest.raises(TableBotError):

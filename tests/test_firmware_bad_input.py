@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import random
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -21,13 +22,20 @@ from tablebot.robopro.rpp_edit import rewrite
 from tablebot.robot import load_robot
 from tablebot.testing.random_tables import random_inputs, random_table
 
+if TYPE_CHECKING:
+    from typing import Any
+
+    from click.testing import Result
+
+    from tablebot.machine import Machine
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 ROBOT_TEXT = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
 runner = CliRunner()
 
 
-def invoke(*args: str):
+def invoke(*args: str) -> Result:
     result = runner.invoke(app, list(args))
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
     return result
@@ -73,7 +81,7 @@ def test_too_many_inputs_name_the_inputs_line_and_what_to_do(tmp_path: Path) -> 
 # --- monitor --------------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def bumberbot():
+def bumberbot() -> tuple[Machine, list[dict[str, Any]]]:
     _, machine = load(EXAMPLE)
     return machine, list(replay(machine, load_inputs(EXAMPLE / "inputs.csv", machine)))[:50]
 
@@ -109,7 +117,8 @@ def test_a_stream_of_another_table_without_hello_is_refused_with_few_warnings(tm
     assert result.output.count("warning:") == 21 and "not this table's firmware?" in result.output
 
 
-def test_a_truncated_stream_keeps_its_whole_frames(tmp_path: Path, bumberbot) -> None:
+def test_a_truncated_stream_keeps_its_whole_frames(tmp_path: Path,
+                                                   bumberbot: tuple[Machine, list[dict[str, Any]]]) -> None:
     machine, trace = bumberbot
     capture = tmp_path / "cut.bin"
     capture.write_bytes(encode(machine, trace)[:-5])
@@ -118,7 +127,9 @@ def test_a_truncated_stream_keeps_its_whole_frames(tmp_path: Path, bumberbot) ->
     assert "bytes at the end are not a whole frame" in result.output
 
 
-def test_checksum_problems_give_stream_positions_not_chunk_positions(bumberbot) -> None:
+def test_checksum_problems_give_stream_positions_not_chunk_positions(
+    bumberbot: tuple[Machine, list[dict[str, Any]]],
+) -> None:
     machine, trace = bumberbot
     stream = bytearray(encode(machine, trace))
     stream[15 + 7 * 12 + 5] ^= 0x55  # inside tick frame 7 (after the 15-byte hello; 12 bytes a frame)
@@ -205,7 +216,8 @@ def test_build_out_naming_a_file_is_refused_before_building(tmp_path: Path) -> N
     assert result.exit_code == 2 and "--out names a file, not a folder" in result.output
 
 
-def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path, bumberbot) -> None:
+def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path,
+                                                bumberbot: tuple[Machine, list[dict[str, Any]]]) -> None:
     machine, trace = bumberbot
     capture = tmp_path / "uart.bin"
     capture.write_bytes(encode(machine, trace))

@@ -174,7 +174,7 @@ def no_internal_error(*args: object) -> None:
 
 @FUZZ
 @given(st.data(), csv_text(TABLE_HEADER), deep(document(ROBOT_KEYS, ROBOT_SECTIONS)), st.booleans())
-def test_table_and_robot(data, table, robot, with_robot):
+def test_table_and_robot(data: st.DataObject, table: str, robot: str, with_robot: bool) -> None:
     files = {"table.csv": mangle(table, data)}
     if with_robot:
         files["robot.toml"] = mangle(robot, data)
@@ -188,19 +188,19 @@ def test_table_and_robot(data, table, robot, with_robot):
 
 @FUZZ
 @given(st.data(), deep(document(ROBOT_KEYS, ROBOT_SECTIONS)))
-def test_robot_file(data, robot):
+def test_robot_file(data: st.DataObject, robot: str) -> None:
     in_folder({"robot.toml": mangle(robot, data)}, lambda f: expect_located(lambda: load_robot(f / "robot.toml")))
 
 
 @FUZZ
 @given(st.data(), deep(document(["name", "reach"], WORLD_SECTIONS)))
-def test_world_file(data, world):
+def test_world_file(data: st.DataObject, world: str) -> None:
     in_folder({"arena.toml": mangle(world, data)}, lambda f: expect_located(lambda: load_world(f / "arena.toml")))
 
 
 @FUZZ
 @given(st.data(), csv_text(["I3", "I4", "I5", "I7", "I8", "tick", "T"]))
-def test_inputs(data, inputs):
+def test_inputs(data: st.DataObject, inputs: str) -> None:
     def run(folder: Path) -> None:
         expect_located(lambda: load_inputs(folder / "in.csv", MACHINE))
         no_internal_error("trace", EXAMPLE, "--inputs", folder / "in.csv")
@@ -214,7 +214,7 @@ def test_inputs(data, inputs):
                                       ["text", "level", "note", "never", "always", "reachable", "always_reachable",
                                        "when", "then", "within", "other"]), PROPERTY_VALUES, max_size=5), VALUE),
                                   max_size=3))
-def test_properties(data, props):
+def test_properties(data: st.DataObject, props: dict[str, Any]) -> None:
     text = "\n".join(f"{toml_key(k)} = {toml_value(v)}" for k, v in props.items()) + "\n"
     in_folder({"p.toml": mangle(text, data)},
               lambda f: expect_located(lambda: load_properties(MACHINE, [f / "p.toml"])))
@@ -226,7 +226,7 @@ LIST_LINE = st.one_of(st.integers(-5, 70000).map(str), TEXT, st.just(""))
 @FUZZ
 @given(st.data(), st.lists(st.lists(LIST_LINE, max_size=5), min_size=3, max_size=3),
        st.one_of(st.none(), csv_text(["number", "name"])))
-def test_robopro_lists_and_states(data, lists, states):
+def test_robopro_lists_and_states(data: st.DataObject, lists: list[list[str]], states: str | None) -> None:
     files = {name: mangle("\n".join(lines) + "\n", data)
              for name, lines in zip(("event.csv", "action.csv", "timer.csv"), lists, strict=True)}
     if states is not None:
@@ -247,7 +247,7 @@ XMLISH = st.sampled_from(['<o classname="ftProDataArray1D" name="Event" N="x²">
 
 @FUZZ
 @given(st.data(), st.lists(st.tuples(st.integers(0, len(RPP_TEXT)), st.integers(0, 40), XMLISH), max_size=4))
-def test_rpp(data, edits):
+def test_rpp(data: st.DataObject, edits: list[tuple[int, int, str]]) -> None:
     text = RPP_TEXT
     for at, cut, insert in edits:
         text = text[:at] + insert + text[at + cut:]
@@ -266,6 +266,6 @@ TRACE_LINE = st.one_of(st.dictionaries(TRACE_KEYS, SCALAR).map(json.dumps), VALU
 
 @FUZZ
 @given(st.data(), st.lists(TRACE_LINE, max_size=5))
-def test_trace_files(data, lines):
+def test_trace_files(data: st.DataObject, lines: list[str]) -> None:
     in_folder({"t.jsonl": mangle("\n".join(lines) + "\n", data)},
               lambda f: expect_located(lambda: read_trace(f / "t.jsonl")))

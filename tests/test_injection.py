@@ -10,12 +10,16 @@ import shutil
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
 
 from hostile import EVIL_SYMBOL, HOSTILE, INJECTED, STATES, robot_toml, write_project
 from tablebot.cli import app
+
+if TYPE_CHECKING:
+    from click.testing import Result
 
 RPP = Path(__file__).resolve().parent / "fixtures" / "rpp" / "engine.rpp"
 SVG = "{http://www.w3.org/2000/svg}"
@@ -30,7 +34,7 @@ def project(tmp_path: Path) -> Path:
     return write_project(tmp_path / "a*" / "p")
 
 
-def run(*args: object, code: int = 0):
+def run(*args: object, code: int = 0) -> Result:
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
     assert result.exit_code == code, result.output
@@ -50,7 +54,7 @@ def assert_clean(text: str) -> None:
 
 
 @needs["gcc"]
-def test_c_export_compiles_and_holds_no_injection(project, tmp_path):
+def test_c_export_compiles_and_holds_no_injection(project: Path, tmp_path: Path) -> None:
     from tablebot.cli.common import load
     from tablebot.codegen.host import build_host
 
@@ -65,7 +69,7 @@ def test_c_export_compiles_and_holds_no_injection(project, tmp_path):
 
 @needs["avr-gcc"]
 @pytest.mark.parametrize("name", [HOSTILE[0], HOSTILE[1], HOSTILE[3], HOSTILE[4]])
-def test_firmware_board_header_keeps_the_robot_name_inert(project, tmp_path, name):
+def test_firmware_board_header_keeps_the_robot_name_inert(project: Path, tmp_path: Path, name: str) -> None:
     """The reproduced injection: a robot name ending the comment of tb_board.h with a constructor
     after it built and ran at boot; one with #include printed another file during the build."""
     (project.parent / "robot.toml").write_text(robot_toml(name), encoding="utf-8")
@@ -77,7 +81,7 @@ def test_firmware_board_header_keeps_the_robot_name_inert(project, tmp_path, nam
     assert EVIL_SYMBOL not in symbols.stdout
 
 
-def test_robopro_lists_and_import_round_trip(project, tmp_path):
+def test_robopro_lists_and_import_round_trip(project: Path, tmp_path: Path) -> None:
     out = tmp_path / "lists"
     run("export", project, out, "--to", "robopro")
     names = (out / "states.csv").read_text(encoding="utf-8")
@@ -87,7 +91,7 @@ def test_robopro_lists_and_import_round_trip(project, tmp_path):
     assert set(STATES) <= set(re.findall(r"^,([^,]+),", back.read_text(encoding="utf-8"), re.M))
 
 
-def test_rpp_parses_as_xml(project, tmp_path):
+def test_rpp_parses_as_xml(project: Path, tmp_path: Path) -> None:
     out = tmp_path / "rpp"
     run("export", project, out, "--to", "robopro-rpp", "--into", RPP)
     root = ET.parse(out / RPP.name).getroot()
@@ -97,7 +101,7 @@ def test_rpp_parses_as_xml(project, tmp_path):
 
 
 @needs["dot"]
-def test_diagram_dot_and_svg(project, tmp_path):
+def test_diagram_dot_and_svg(project: Path, tmp_path: Path) -> None:
     dot_file = tmp_path / "d.dot"
     run("diagram", project, "--out", dot_file)
     svg = subprocess.run(["dot", "-Tsvg", str(dot_file)], capture_output=True, check=True).stdout
@@ -113,7 +117,7 @@ def test_diagram_dot_and_svg(project, tmp_path):
 MERMAID_LINE = re.compile(r'^    (state "[^"\n]*" as \w+|\[\*\] --> \w+|\w+ --> \w+: [^:;\n]+|direction LR)$')
 
 
-def test_mermaid_has_only_its_own_statements(project):
+def test_mermaid_has_only_its_own_statements(project: Path) -> None:
     text = run("diagram", project, "--format", "mermaid").stdout
     lines = text.splitlines()
     assert lines[0] == "stateDiagram-v2" and lines[1] == "    direction LR"
@@ -124,7 +128,7 @@ def test_mermaid_has_only_its_own_statements(project):
     assert not re.search(r"#\w+;|%%|<|>", text.replace("-->", ""))
 
 
-def test_check_prints_user_text_literally(project, tmp_path):
+def test_check_prints_user_text_literally(project: Path, tmp_path: Path) -> None:
     result = run("check", project, "--verbose", "--counterexamples", tmp_path / "cex")
     out = result.stdout
     assert "[bold]markup[/bold] :x: [/]" in out and "\u274c" not in out  # no markup, no emoji
@@ -135,14 +139,14 @@ def test_check_prints_user_text_literally(project, tmp_path):
     assert {p["text"] for p in report["properties"]} == set(HOSTILE)
 
 
-def test_bad_input_diagnostics_print_literally(tmp_path):
+def test_bad_input_diagnostics_print_literally(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(robot_toml(), encoding="utf-8")
     (tmp_path / "t.csv").write_text("state,[bold]x[/bold] :x:,next\n1,,1\n", encoding="utf-8")
     result = run("check", tmp_path / "t.csv", code=2)
     assert "unknown column '[bold]x[/bold] :x:'" in result.stderr
 
 
-def test_golden_tests_and_trace_are_data(project, tmp_path):
+def test_golden_tests_and_trace_are_data(project: Path, tmp_path: Path) -> None:
     run("tests", project, "--out", tmp_path / "golden")
     json.loads((tmp_path / "golden" / "coverage.json").read_text(encoding="utf-8"))
     inputs = next((tmp_path / "golden").glob("*.csv"))
@@ -151,7 +155,7 @@ def test_golden_tests_and_trace_are_data(project, tmp_path):
     assert states <= set(STATES)
 
 
-def test_flash_dry_run_prints_a_command_a_shell_reads_back(tmp_path):
+def test_flash_dry_run_prints_a_command_a_shell_reads_back(tmp_path: Path) -> None:
     port = "$(touch pwned) `id`; rm -rf ~ \x1b[31m"
     hexfile = tmp_path / "a b;$(x).hex"
     hexfile.write_text(":00000001FF\n")

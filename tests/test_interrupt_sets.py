@@ -121,14 +121,15 @@ def named(tmp_path: Path) -> Path:
     return folder
 
 
-def test_export_robopro_leaves_the_old_lists_or_the_new(named, tmp_path):
+def test_export_robopro_leaves_the_old_lists_or_the_new(named: Path, tmp_path: Path) -> None:
     table = named
     outcomes = interrupt_everywhere(["export", table, tmp_path / "lists", "--to", "robopro"], tmp_path / "lists",
                                     tmp_path / "ref")
     assert outcomes == ["old"] * 4 + ["new"] * 4 + ["done"]  # four files written, then four renamed
 
 
-def test_export_robopro_drops_a_states_csv_the_new_lists_have_no_names_for(bot, named, tmp_path):
+def test_export_robopro_drops_a_states_csv_the_new_lists_have_no_names_for(bot: Path, named: Path,
+                                                                           tmp_path: Path) -> None:
     """An earlier export's states.csv beside lists of integer states would name them wrongly on import."""
     assert invoke(["export", named, tmp_path / "lists", "--to", "robopro"]) == 0
     assert (tmp_path / "lists" / "states.csv").exists()
@@ -137,13 +138,13 @@ def test_export_robopro_drops_a_states_csv_the_new_lists_have_no_names_for(bot, 
 
 
 @pytest.mark.parametrize("target", ["c", "txt4"])
-def test_export_c_and_txt4_leave_the_old_files_or_the_new(bot, tmp_path, target):
+def test_export_c_and_txt4_leave_the_old_files_or_the_new(bot: Path, tmp_path: Path, target: str) -> None:
     outcomes = interrupt_everywhere(["export", bot, tmp_path / "out", "--to", target], tmp_path / "out",
                                     tmp_path / "ref")
     assert "old" in outcomes and "new" in outcomes and outcomes[-1] == "done"
 
 
-def test_tests_and_counterexamples_leave_the_old_files_or_the_new(bot, tmp_path):
+def test_tests_and_counterexamples_leave_the_old_files_or_the_new(bot: Path, tmp_path: Path) -> None:
     outcomes = interrupt_everywhere(["tests", bot, "--out", tmp_path / "golden"], tmp_path / "golden",
                                     tmp_path / "ref")
     assert "old" in outcomes and "new" in outcomes
@@ -154,13 +155,13 @@ def test_tests_and_counterexamples_leave_the_old_files_or_the_new(bot, tmp_path)
     assert outcomes == ["old", "old", "new", "new", "done"]
 
 
-def test_sim_leaves_the_old_run_or_the_new(bot, tmp_path):
+def test_sim_leaves_the_old_run_or_the_new(bot: Path, tmp_path: Path) -> None:
     outcomes = interrupt_everywhere(["sim", bot, "--seconds", "3", "--out", tmp_path / "s", "-q"], tmp_path / "s",
                                     tmp_path / "ref")
     assert outcomes == ["old"] * 3 + ["new"] * 3 + ["done"]  # trace, trajectory, timeline
 
 
-def test_new_makes_the_whole_folder_or_none(tmp_path):
+def test_new_makes_the_whole_folder_or_none(tmp_path: Path) -> None:
     outcomes = []
     for n in range(1, 10):
         code = invoke(["new", tmp_path / "robot"], f"{n}:{'INT' if n % 2 else 'TERM'}")
@@ -174,13 +175,13 @@ def test_new_makes_the_whole_folder_or_none(tmp_path):
     assert outcomes == ["none"] * 4 + ["new", "done"]  # four files written, then the folder renamed
 
 
-def test_run_writes_its_trace_and_summary_together(bot, tmp_path):
+def test_run_writes_its_trace_and_summary_together(bot: Path, tmp_path: Path) -> None:
     outcomes = interrupt_everywhere(["run", bot, "--on", "sim", "--seconds", "0.2", "-q", "--out", tmp_path / "r"],
                                     tmp_path / "r", tmp_path / "ref", loose=["summary.json", "trace.jsonl"])
     assert outcomes == ["old"] * 2 + ["new"] * 2 + ["done"]
 
 
-def test_build_leaves_the_old_firmware_or_the_new(bot, tmp_path):
+def test_build_leaves_the_old_firmware_or_the_new(bot: Path, tmp_path: Path) -> None:
     if not shutil.which("avr-gcc"):
         pytest.fail("avr-gcc is missing: scripts/bootstrap.sh installs it")
     outcomes = interrupt_everywhere(["build", bot, "--board", "uno", "--out", tmp_path / "fw"], tmp_path / "fw",
@@ -188,7 +189,7 @@ def test_build_leaves_the_old_firmware_or_the_new(bot, tmp_path):
     assert outcomes == ["old", "old", "old", "new", "new", "new", "done"]
 
 
-def test_sweep_and_tune_leave_the_old_results_or_the_new(bot, tmp_path):
+def test_sweep_and_tune_leave_the_old_results_or_the_new(bot: Path, tmp_path: Path) -> None:
     outcomes = interrupt_everywhere(["sweep", bot, "--seeds", "0..3", "--seconds", "2", "--workers", "1", "--trace",
                                      "1,2", "--no-plots", "-q", "--out", tmp_path / "sw"], tmp_path / "sw",
                                     tmp_path / "ref", ignore=["spec.json", "parts"])  # what a resume needs
@@ -204,7 +205,7 @@ def test_sweep_and_tune_leave_the_old_results_or_the_new(bot, tmp_path):
 # --- SIGKILL and the journal ------------------------------------------------------------------------
 
 
-def test_a_swap_cut_by_sigkill_is_finished_by_the_next_set(tmp_path):
+def test_a_swap_cut_by_sigkill_is_finished_by_the_next_set(tmp_path: Path) -> None:
     """The process dies between two renames: the journal lets the next set in the folder finish them."""
     folder = tmp_path / "out"
     folder.mkdir()
@@ -225,7 +226,7 @@ def test_a_swap_cut_by_sigkill_is_finished_by_the_next_set(tmp_path):
     assert not leftovers(folder)
 
 
-def test_a_stage_cut_before_its_journal_is_removed_and_a_live_one_kept(tmp_path):
+def test_a_stage_cut_before_its_journal_is_removed_and_a_live_one_kept(tmp_path: Path) -> None:
     folder = tmp_path / "out"
     folder.mkdir()
     (folder / "a.txt").write_text("old\n")
@@ -248,7 +249,7 @@ def test_a_stage_cut_before_its_journal_is_removed_and_a_live_one_kept(tmp_path)
 # --- real signals at varied moments ---------------------------------------------------------------------
 
 
-def test_real_signals_during_sim_leave_the_old_run_or_the_new(bot, tmp_path):
+def test_real_signals_during_sim_leave_the_old_run_or_the_new(bot: Path, tmp_path: Path) -> None:
     """The issue's case: SIGINT or SIGTERM while a run draws its pictures (from the moment its finished
     trace waits in the staging folder). Ctrl-C during the run itself: tests/test_sim_live.py."""
     out = tmp_path / "s"
@@ -279,7 +280,7 @@ def test_real_signals_during_sim_leave_the_old_run_or_the_new(bot, tmp_path):
 
 @pytest.mark.parametrize(("cause", "code", "word"), [("KeyboardInterrupt", 130, "interrupted"),
                                                     ("Terminated", 143, "terminated")])
-def test_an_interrupt_inside_an_import_ends_as_the_interrupt(cause, code, word):
+def test_an_interrupt_inside_an_import_ends_as_the_interrupt(cause: str, code: int, word: str) -> None:
     """Seen with SIGTERM while matplotlib imported its compiled font module: pybind11 turned the interrupt
     into ImportError('initialization failed'), reported as an internal error, then the interpreter aborted
     on its way out."""
@@ -291,7 +292,7 @@ def test_an_interrupt_inside_an_import_ends_as_the_interrupt(cause, code, word):
     assert (done.returncode, done.stderr.strip()) == (code, word)
 
 
-def test_evolve_leaves_the_old_tables_or_the_new_and_resumes(tmp_path):
+def test_evolve_leaves_the_old_tables_or_the_new_and_resumes(tmp_path: Path) -> None:
     """Over an earlier, smaller run (--budget 3) the same search continued (--budget 6) is cut at its first
     and last file written and its first and last rename: the folder holds the earlier run's tables, check
     reports, heat map and report, or the continued run's, whole; the records a resume needs (ignored here)

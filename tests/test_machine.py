@@ -10,6 +10,7 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -21,6 +22,9 @@ from tablebot.formats.table_write import format_table
 from tablebot.machine import NO_ROW, PREFILL_BITS, compile_table, first_match
 from tablebot.robot import MATCHES, Counter, Robot
 from tablebot.table import Row, Table
+
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
 
 SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 INPUTS = ("A", "B", "C")
@@ -59,7 +63,7 @@ class Spec:
 class Naive:
     """Linear scan over the generated rows, names and sets only."""
 
-    def __init__(self, spec: Spec):
+    def __init__(self, spec: Spec) -> None:
         self.spec = spec
         self.state = spec.initial_state
         self.timer = spec.initial_timer
@@ -180,7 +184,7 @@ def to_csv(spec: Spec) -> str:
     return "\n".join(",".join(cells[i] for i in spec.order) for cells in lines) + "\n"
 
 
-def build(spec: Spec):
+def build(spec: Spec) -> Machine:
     return compile_table(parse_table(to_csv(spec), "<random>", robot_of(spec)))
 
 
@@ -197,7 +201,7 @@ def mask_of(present: set[str], columns: tuple[str, ...]) -> int:
 
 @SETTINGS
 @given(spec=specs(), inputs=ticks)
-def test_compiled_engine_equals_linear_scan(spec, inputs):
+def test_compiled_engine_equals_linear_scan(spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]]) -> None:
     machine = build(spec)
     engine, naive = Engine(machine), Naive(spec)
     for present, pulses in inputs:
@@ -214,7 +218,8 @@ def test_compiled_engine_equals_linear_scan(spec, inputs):
 
 @SETTINGS
 @given(spec=specs(), inputs=ticks, split=st.integers(0, 40), jit=st.booleans())
-def test_batch_path_equals_step_path(spec, inputs, split, jit):
+def test_batch_path_equals_step_path(spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]], split: int,
+                                     jit: bool) -> None:
     """``run(masks)`` (no pulses on that path), compiled or in Python, gives what ``step`` gives,
     also when a run resumes from where the last one stopped."""
     machine = build(spec)
@@ -234,7 +239,7 @@ def test_batch_path_equals_step_path(spec, inputs, split, jit):
 
 @SETTINGS
 @given(spec=specs())
-def test_lookup_is_first_match_for_every_event_set(spec):
+def test_lookup_is_first_match_for_every_event_set(spec: Spec) -> None:
     machine = build(spec)
     width = len(machine.table.events)
     for state in range(len(machine.states)):
@@ -246,7 +251,7 @@ def test_lookup_is_first_match_for_every_event_set(spec):
 
 @settings(max_examples=60, deadline=None)
 @given(data=st.data())
-def test_lookup_beyond_prefill_width(data):
+def test_lookup_beyond_prefill_width(data: st.DataObject) -> None:
     """A state whose rows use more than PREFILL_BITS events fills its map lazily; same answers."""
     names = tuple(f"I{i}" for i in range(PREFILL_BITS + 3))
     match = data.draw(st.sampled_from(MATCHES))
@@ -267,7 +272,7 @@ def test_lookup_beyond_prefill_width(data):
 
 # --- compilation details ----------------------------------------------------------------------------
 
-def test_bumberbot_compiles_to_ten_states_with_document_bits():
+def test_bumberbot_compiles_to_ten_states_with_document_bits() -> None:
     machine = example_machine()
     assert machine.states == (1, 2, 20, 21, 22, 24, 26, 29, 11, 12)
     assert machine.timer_bit == 32
@@ -277,7 +282,7 @@ def test_bumberbot_compiles_to_ten_states_with_document_bits():
     assert machine.output_names == ("M1", "M2")
 
 
-def test_first_match_is_table_order_not_specificity():
+def test_first_match_is_table_order_not_specificity() -> None:
     machine = example_machine()
     state1 = machine.state_index(1)
     # state 1: collision rows come before the light rows, so a bump wins over light
@@ -288,7 +293,7 @@ def test_first_match_is_table_order_not_specificity():
     assert machine.lookup(state1, 0) == NO_ROW
 
 
-def test_signature_ignores_descriptions_and_lines_but_not_behaviour(tmp_path):
+def test_signature_ignores_descriptions_and_lines_but_not_behaviour(tmp_path: Path) -> None:
     base = (Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv").read_text()
     robot = example_machine().table.robot
     renamed = base.replace("Collision detection", "Bump")
@@ -302,7 +307,7 @@ def test_signature_ignores_descriptions_and_lines_but_not_behaviour(tmp_path):
 
 @SETTINGS
 @given(spec=specs())
-def test_random_tables_round_trip_through_the_writer(spec):
+def test_random_tables_round_trip_through_the_writer(spec: Spec) -> None:
     """format_table writes the document's form where it can; reading it back gives the same machine."""
     machine = build(spec)
     again = compile_table(parse_table(format_table(machine.table), "<written>", machine.table.robot))
@@ -312,7 +317,9 @@ def test_random_tables_round_trip_through_the_writer(spec):
 
 @SETTINGS
 @given(spec=specs(), inputs=ticks, split=st.integers(0, 40))
-def test_the_compiled_tick_rule_equals_step_with_pulses(spec, inputs, split):
+def test_the_compiled_tick_rule_equals_step_with_pulses(spec: Spec,
+                                                        inputs: list[tuple[frozenset[str], tuple[int, int]]],
+                                                        split: int) -> None:
     """tablebot.tick.tick, compiled (the simulator's and the fleet's rule), takes step's decisions
     tick for tick, counters counting down by their pulses included."""
     machine = build(spec)

@@ -54,7 +54,7 @@ class FakeTime:
 class TimedRobot:
     """A robot whose exchange (``write``) takes ``io_s(tick)`` of the fake time; records what it was sent."""
 
-    def __init__(self, time: FakeTime, io_s: Callable[[int], float]):
+    def __init__(self, time: FakeTime, io_s: Callable[[int], float]) -> None:
         self.time, self.io_s = time, io_s
         self.writes: list[tuple[int, ...]] = []
         self.stopped_after: int | None = None

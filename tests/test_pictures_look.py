@@ -8,6 +8,7 @@ import os
 import shutil
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from matplotlib.collections import LineCollection, PatchCollection, PolyCollection
@@ -24,6 +25,14 @@ from tablebot.sim.draw import literal_text
 from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any
+
+    from matplotlib.figure import Figure
+
+    from tablebot.sim.timeline import TimelinePicture
 
 TUTORIAL_ROBOT = """\
 name = "my-robot"
@@ -43,7 +52,7 @@ AFTER = ("description,state,T,I1,M1,M2,timer,next\nI1 while driving,2,,1,-5,5,1s
          "start driving,1,1,,6,6,8s,2\ntime to turn,2,1,,-5,5,700ms,1\n")
 
 
-def drawn(figure_of, *args):
+def drawn(figure_of: Callable[..., Figure], *args: Any) -> Figure:
     """A figure made and drawn as the pictures are (maths parsing off for user text)."""
     with literal_text():
         fig = figure_of(*args)
@@ -159,8 +168,8 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
     robot.write_text(text.replace('1 = "Seek: drive straight"', '1 = "drive\\r\\u0000"'))
     figures = []
 
-    def keeping(encode):
-        def keep(fig):
+    def keeping(encode: Callable[[Figure], bytes]) -> Callable[[Figure], bytes]:
+        def keep(fig: Figure) -> bytes:
             figures.append(fig)
             return encode(fig)
         return keep
@@ -171,7 +180,7 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
         patch.setattr(plots, "encoded", keeping(plots.encoded))  # the trajectory's PNG
         finish = timeline.TimelinePicture.finish  # the timeline's PNG is put together from bands: seen as drawn
 
-        def finishing(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        def finishing(self: TimelinePicture, *args: Any, **kwargs: Any) -> TimelinePicture:
             figures.append(self.fig)
             return finish(self, *args, **kwargs)
         patch.setattr(timeline.TimelinePicture, "finish", finishing)

@@ -18,11 +18,11 @@ BB = compile_table(load_table(EXAMPLE))
 I3, I4, T = BB.input_bits["I3"], BB.input_bits["I4"], BB.timer_bit
 
 
-def holds(text: str, events: int = 0, row: int = -1, state: int = 1, outputs=(0, 0)) -> bool:
+def holds(text: str, events: int = 0, row: int = -1, state: int = 1, outputs: tuple[int, ...] = (0, 0)) -> bool:
     return parse_condition(text, BB)((events, row, BB.state_index(state), outputs))
 
 
-def test_events_states_outputs_and_rows():
+def test_events_states_outputs_and_rows() -> None:
     assert holds("I3", I3) and not holds("I3", I4) and holds("not I3", I4)
     assert holds("I3 or I4", I4) and not holds("I3 and I4", I4) and holds("I3 and I4", I3 | I4)
     assert holds("T", T) and not holds("T")
@@ -34,14 +34,14 @@ def test_events_states_outputs_and_rows():
     assert holds("true") and not holds("false")
 
 
-def test_precedence_and_parentheses():
+def test_precedence_and_parentheses() -> None:
     # not > and > or: "I3 or I4 and T" is I3 or (I4 and T)
     assert holds("I3 or I4 and T", I3) and not holds("I3 or I4 and T", I4)
     assert not holds("(I3 or I4) and T", I3) and holds("(I3 or I4) and T", I3 | T)
     assert holds("not (I3 and I4)", I3)
 
 
-def test_input_bits_are_recorded_for_the_model():
+def test_input_bits_are_recorded_for_the_model() -> None:
     assert parse_condition("I3 or (state == 1 and not I4)", BB).input_bits == I3 | I4
     assert parse_condition("T and M1 > 0", BB).input_bits == 0
     both = Property("p", "p", "when", when=parse_condition("I3", BB), then=parse_condition("not I3", BB))
@@ -61,7 +61,7 @@ def test_input_bits_are_recorded_for_the_model():
     ("", "empty"),
     ("__import__('os').system('true')", "cannot read"),  # no eval, ever
 ])
-def test_bad_conditions(text, message):
+def test_bad_conditions(text: str, message: str) -> None:
     with pytest.raises(ConditionError, match=message.replace("(", r"\(").replace("[", r"\[")):
         parse_condition(text, BB)
 
@@ -72,7 +72,7 @@ def write(tmp_path: Path, text: str) -> Path:
     return path
 
 
-def test_kinds_and_durations(tmp_path):
+def test_kinds_and_durations(tmp_path: Path) -> None:
     path = write(tmp_path, """
 [a]
 never = "state == 20 and M1 > 0"
@@ -102,7 +102,7 @@ note = "why"
     assert props["b"].line == 4 and props["b"].source == str(path)
 
 
-def test_errors_are_all_reported_with_lines(tmp_path):
+def test_errors_are_all_reported_with_lines(tmp_path: Path) -> None:
     path = write(tmp_path, """[ok]
 never = "I3"
 
@@ -127,14 +127,14 @@ nevr = "I3"
     assert any(line == 13 and "unknown key 'nevr'" in m for line, m in found)
 
 
-def test_toml_syntax_error_is_located(tmp_path):
+def test_toml_syntax_error_is_located(tmp_path: Path) -> None:
     with pytest.raises(TableBotError) as info:
         load_properties(BB, [write(tmp_path, '[a]\nnever = "I3\n')])
     (d,) = info.value.diagnostics
     assert d.line == 2 and "TOML syntax" in d.message
 
 
-def test_properties_in_the_robot_file(tmp_path):
+def test_properties_in_the_robot_file(tmp_path: Path) -> None:
     robot = (FIX / "robot.toml").read_text() + '\n[properties.stops]\nnever = "state == 2 and M1 != 0"\n'
     (tmp_path / "robot.toml").write_text(robot)
     (tmp_path / "t.csv").write_text((FIX / "bump.csv").read_text())
@@ -144,12 +144,12 @@ def test_properties_in_the_robot_file(tmp_path):
     assert prop.line == robot.splitlines().index("[properties.stops]") + 1
 
 
-def test_a_copied_properties_section_reads_in_a_side_file(tmp_path):
+def test_a_copied_properties_section_reads_in_a_side_file(tmp_path: Path) -> None:
     path = write(tmp_path, '[properties.x]\nnever = "I3"\n')
     assert [p.name for p in load_properties(BB, [path])] == ["x"]
 
 
-def test_property_files_beside_the_table(tmp_path):
+def test_property_files_beside_the_table(tmp_path: Path) -> None:
     assert find_property_files(FIX / "bump.csv") == [FIX / "bump.properties.toml"]
     assert find_property_files(EXAMPLE) == [EXAMPLE.parent / "properties.toml"]
     assert find_property_files(tmp_path / "t.csv") == []

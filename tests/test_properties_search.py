@@ -6,6 +6,7 @@ from __future__ import annotations
 import random
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -21,23 +22,27 @@ from tablebot.replay import replay
 from tablebot.robot import MATCHES, Robot
 from tablebot.table import Row, Table
 
+if TYPE_CHECKING:
+    from tablebot.analysis.prove import Result
+    from tablebot.machine import Machine
+
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
 
 
-def props_of(table: Path, props: Path | None = None):
+def props_of(table: Path, props: Path | None = None) -> tuple[Machine, dict[str, Property]]:
     machine = compile_table(load_table(table))
     return machine, {p.name: p for p in load_properties(machine, [props or table.with_suffix(".properties.toml")])}
 
 
-def replayed_violation(machine, result, tmp_path: Path) -> int | None:
+def replayed_violation(machine: Machine, result: Result, tmp_path: Path) -> int | None:
     """Write the counterexample as `tablebot trace` reads it, read it back, replay, run the monitor."""
     path = tmp_path / "cex.csv"
     write_inputs(machine, result.inputs, path)
     return first_violation(result.prop, machine, replay(machine, load_inputs(path, machine)))
 
 
-def test_bump_counterexample_is_shortest_and_replays(tmp_path):
+def test_bump_counterexample_is_shortest_and_replays(tmp_path: Path) -> None:
     machine, props = props_of(FIX / "bump.csv")
     result = check_property(props["bump_stops"], machine)
     # A at tick 0 (stop, 20 ticks), back off 30 ticks, A exactly when the turn starts, released.
@@ -47,20 +52,20 @@ def test_bump_counterexample_is_shortest_and_replays(tmp_path):
     assert result.inputs[50].mask == machine.input_bits["A"] and result.inputs[51].mask == 0
 
 
-def test_the_fix_makes_it_hold():
+def test_the_fix_makes_it_hold() -> None:
     machine, props = props_of(FIX / "bump_fixed.csv")
     results = {name: check_property(p, machine).status for name, p in props.items()}
     assert results == {"bump_stops": "holds", "backs_off": "holds", "no_spin_in_1": "violated", "returns": "holds"}
 
 
-def test_too_large_for_the_exact_search_falls_back_to_a_padded_abstract_run(tmp_path):
+def test_too_large_for_the_exact_search_falls_back_to_a_padded_abstract_run(tmp_path: Path) -> None:
     machine, props = props_of(FIX / "bump.csv")
     result = check_property(props["bump_stops"], machine, budget=5)
     assert result.status == "violated" and not result.exact  # not promised shortest, but real:
     assert replayed_violation(machine, result, tmp_path) == result.at_tick == len(result.inputs) - 1
 
 
-def test_without_a_t_column_the_timer_is_not_tracked():
+def test_without_a_t_column_the_timer_is_not_tracked() -> None:
     robot = Robot(name="R", inputs=("A",), motors=("M1",), initial_state=1)
     rows = (Row(0, 2, "", 1, frozenset({"A"}), (3,), 500, 2), Row(1, 3, "", 2, frozenset({"A"}), (0,), 900, 1))
     machine = compile_table(Table(robot, ("A",), rows))
@@ -68,14 +73,14 @@ def test_without_a_t_column_the_timer_is_not_tracked():
     assert len(exact.nodes) == 3 and exact.model.is_exact  # start, state 2, back in state 1
 
 
-def test_never_counterexample(tmp_path):
+def test_never_counterexample(tmp_path: Path) -> None:
     machine, props = props_of(FIX / "bump.csv")
     result = check_property(props["no_spin_in_1"], machine)
     assert result.status == "violated" and len(result.inputs) == 51
     assert replayed_violation(machine, result, tmp_path) == 50
 
 
-def test_reachable_gives_a_witness_and_impossible_is_a_failure():
+def test_reachable_gives_a_witness_and_impossible_is_a_failure() -> None:
     machine, props = props_of(FIX / "bump.csv")
     result = check_property(props["backs_off"], machine)
     assert result.status == "holds" and len(result.inputs) == 21  # A, then 20 ticks of stopping
@@ -85,7 +90,7 @@ def test_reachable_gives_a_witness_and_impossible_is_a_failure():
     assert check_property(never, machine).status == "violated"
 
 
-def test_always_reachable_finds_the_trap():
+def test_always_reachable_finds_the_trap() -> None:
     machine = compile_table(load_table(FIX / "trap.csv"))
     prop = Property("back", "back", "always_reachable", cond=parse_condition("state == 1", machine))
     result = check_property(prop, machine)
@@ -94,7 +99,7 @@ def test_always_reachable_finds_the_trap():
     assert lines[-1]["state"] == 2 and len(lines) == 2  # T wins tick 0; B at tick 1 parks it
 
 
-def test_counter_witness_uses_pulses():
+def test_counter_witness_uses_pulses() -> None:
     machine = compile_table(load_table(FIX / "counters.csv"))
     prop = Property("w", "w", "reachable", cond=parse_condition("line == 3", machine))
     result = check_property(prop, machine)
@@ -102,7 +107,7 @@ def test_counter_witness_uses_pulses():
     assert list(replay(machine, result.inputs))[-1]["row"] == 1
 
 
-def test_bumberbot_found_bug_replays(tmp_path):
+def test_bumberbot_found_bug_replays(tmp_path: Path) -> None:
     machine, props = props_of(EXAMPLES / "table.csv", EXAMPLES / "properties.toml")
     result = check_property(props["front_bumper_stops"], machine)
     assert result.status == "violated" and len(result.inputs) == 54
@@ -112,15 +117,15 @@ def test_bumberbot_found_bug_replays(tmp_path):
     assert last[-1]["M2"] > 0
 
 
-def test_fixed_bumberbot_satisfies_every_shipped_property():
+def test_fixed_bumberbot_satisfies_every_shipped_property() -> None:
     machine, props = props_of(FIX / "bumberbot_fixed.csv", EXAMPLES / "properties.toml")
     assert {name: check_property(p, machine).status for name, p in props.items()} == dict.fromkeys(props, "holds")
 
 
-def test_timed_property_is_exact_to_the_tick():
+def test_timed_property_is_exact_to_the_tick() -> None:
     machine = compile_table(load_table(EXAMPLES / "table.csv"))
 
-    def pause(ticks: int):
+    def pause(ticks: int) -> Property:
         return Property("p", "p", "when", when=parse_condition("state == 20", machine),
                         then=parse_condition("state != 20", machine), within=ticks)
 
@@ -129,7 +134,7 @@ def test_timed_property_is_exact_to_the_tick():
     assert result.status == "violated" and len(result.inputs) == 50 and result.at_tick == 49
 
 
-def test_within_zero_means_the_same_tick(tmp_path):
+def test_within_zero_means_the_same_tick(tmp_path: Path) -> None:
     machine = compile_table(load_table(FIX / "bump.csv"))
     prop = Property("z", "z", "when", when=parse_condition("A", machine),
                     then=parse_condition("M1 == 0", machine), within=0)
@@ -144,7 +149,7 @@ EVENTS = ("T", "A", "B")
 
 
 @st.composite
-def tables(draw) -> Table:
+def tables(draw: st.DrawFn) -> Table:
     n = draw(st.integers(2, 3))
     rows = []
     for state in range(1, n + 1):
@@ -159,7 +164,7 @@ def tables(draw) -> Table:
 
 @settings(max_examples=80, deadline=None)
 @given(tables())
-def test_the_model_offers_every_row_any_inputs_can_fire(table):
+def test_the_model_offers_every_row_any_inputs_can_fire(table: Table) -> None:
     """Per state and timer context, the model's input classes reach every outcome some input set gives
     (under the document's rule, an input the state's rows never use still matters on its own)."""
     machine = compile_table(table)
@@ -177,7 +182,8 @@ CONDITIONS = ["A", "state == 1", "state == 2", "M1 > 0", "M2 < 0", "T", "fired",
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(tables(), st.sampled_from(CONDITIONS), st.sampled_from(CONDITIONS), st.integers(0, 4), st.randoms())
-def test_abstract_proofs_are_sound_and_counterexamples_real(table, when, then, within, rnd):
+def test_abstract_proofs_are_sound_and_counterexamples_real(table: Table, when: str, then: str, within: int,
+                                                            rnd: random.Random) -> None:
     machine = compile_table(table)
     coarse, fine = Model(machine).explore(), Model.exact(machine).explore()
     assert {(n[0], n[3]) for n in coarse.nodes} == {(n[0], n[3]) for n in fine.nodes}  # same situations
@@ -199,7 +205,7 @@ def test_abstract_proofs_are_sound_and_counterexamples_real(table, when, then, w
             _no_random_run_breaks(machine, prop, rnd)
 
 
-def _no_random_run_breaks(machine, prop, rnd: random.Random) -> None:
+def _no_random_run_breaks(machine: Machine, prop: Property, rnd: random.Random) -> None:
     for _ in range(5):
         ticks = [TickInput(rnd.getrandbits(2) & machine.input_mask) for _ in range(40)]
         assert first_violation(prop, machine, replay(machine, ticks)) is None

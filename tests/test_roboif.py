@@ -6,6 +6,7 @@ header or checksum (silence, a short or overlong reply, bytes nobody asked for, 
 from __future__ import annotations
 
 import random
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -19,8 +20,11 @@ from tablebot.hw.serial_port import PortInfo
 from tablebot.loop import LinkLost
 from tablebot.testing.roboif_emulator import RoboifEmulator
 
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
 
-def robot_on(emulator: RoboifEmulator, machine=None, timeout_s: float = 0.15) -> RoboifRobot:
+
+def robot_on(emulator: RoboifEmulator, machine: Machine | None = None, timeout_s: float = 0.15) -> RoboifRobot:
     return RoboifRobot(roboif_wiring(machine or bumberbot("roboif")), emulator.device, link_timeout_s=timeout_s)
 
 

@@ -31,7 +31,7 @@ needs_corpus = pytest.mark.skipif(CORPUS is None, reason="the ROBO Pro corpus is
 
 
 @pytest.fixture(scope="module")
-def fresh():
+def fresh() -> dict[str, object]:
     """The whole corpus, read once (about 36 MB of XML; the time is printed with -s)."""
     assert CORPUS is not None
     started = time.perf_counter()
@@ -49,20 +49,20 @@ def programs() -> list[str]:
 
 
 @needs_corpus
-def test_the_committed_vocabulary_is_what_the_corpus_yields(fresh):
+def test_the_committed_vocabulary_is_what_the_corpus_yields(fresh: dict[str, object]) -> None:
     assert fresh["files"] == 79
     assert dump(fresh) == VOCABULARY.read_text(encoding="utf-8"), \
         "regenerate it: python -m tablebot.testing.rpp_corpus"
 
 
 @needs_corpus
-def test_generated_programs_against_the_corpus(fresh):
+def test_generated_programs_against_the_corpus(fresh: dict[str, object]) -> None:
     for text in programs():
         assert problems(text, json.loads(dump(fresh))) == []
 
 
 @needs_corpus
-def test_the_series_the_generator_extends_are_the_corpus_own():
+def test_the_series_the_generator_extends_are_the_corpus_own() -> None:
     """Inputs 160.. are read as switches (inputMode 1, among other modes) and 176.. as counts (inputMode 6)
     wherever the corpus uses them: the rule the generator follows for I5–I8 and C2, C4."""
     assert CORPUS is not None
@@ -77,7 +77,7 @@ def test_the_series_the_generator_extends_are_the_corpus_own():
     assert {code: modes[code] for code in modes if code in counts} == {176: {"6"}, 178: {"6"}}
 
 
-def test_every_real_header_is_the_generated_one():
+def test_every_real_header_is_the_generated_one() -> None:
     text = programs()[0]
     root = ET.fromstring(text.encode())
     assert vocabulary()["headers"] == [[c.get("classname", c.tag) if c.tag == "o" else c.tag for c in root]]
@@ -89,14 +89,14 @@ def test_every_real_header_is_the_generated_one():
     ((' id="100003"', ' id="100002"'), "used twice"),
     (('<roboprover>04060600', '<roboprover>09000000'), "not a value real programs use"),
 ])
-def test_the_check_catches_what_real_programs_never_have(change, complaint):
+def test_the_check_catches_what_real_programs_never_have(change: tuple[str, str], complaint: str) -> None:
     text = programs()[0]
     old, new = change
     assert old in text
     assert complaint in "\n".join(problems(text.replace(old, new, 1)))
 
 
-def test_the_check_catches_a_resolveid_that_does_not_point_back():
+def test_the_check_catches_a_resolveid_that_does_not_point_back() -> None:
     text = programs()[0]
     first = re.search(r' resolveid="\d+"', text)
     assert first is not None

@@ -9,6 +9,7 @@ import itertools
 import random
 import xml.etree.ElementTree as ET
 from dataclasses import astuple, replace
+from typing import TYPE_CHECKING
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -27,6 +28,10 @@ from tablebot.robopro.program import generate
 from tablebot.robopro.vocabulary import problems as vocabulary_problems
 from tablebot.table import Row, Table
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table, with_match
+
+if TYPE_CHECKING:
+    from pathlib import Path
+    from typing import Any
 
 COUNTERS = ROOT / "examples" / "bumberbot-counters"
 
@@ -91,7 +96,7 @@ def fitting(table: Table, sections: dict) -> Table:
 
 # --- the examples ---------------------------------------------------------------------------------------
 
-def test_bumberbot_lists_hold_the_documents_encoding():
+def test_bumberbot_lists_hold_the_documents_encoding() -> None:
     table = load_table(EXAMPLE / "table.csv")
     lists = lists_of(generate(table, "document"))
     assert sorted(lists) == ["Action", "Event", "Timer"]
@@ -99,7 +104,7 @@ def test_bumberbot_lists_hold_the_documents_encoding():
     assert len(lists["Event"]) == len(table.rows) == 37
 
 
-def test_bumberbot_program_keeps_to_real_programs():
+def test_bumberbot_program_keeps_to_real_programs() -> None:
     text = generate(load_table(EXAMPLE / "table.csv"), "document")
     assert vocabulary_problems(text) == []
     assert text.startswith('<?xml version="1.0" encoding="UTF-8" standalone="yes"?>\n')
@@ -110,7 +115,7 @@ def test_bumberbot_program_keeps_to_real_programs():
 
 
 @pytest.mark.parametrize("rule", ["document", "always"])
-def test_bumberbot_recorded_run(rule):
+def test_bumberbot_recorded_run(rule: str) -> None:
     """500 ticks of the recorded inputs, from just before its first bump, engine against program."""
     table = load_table(EXAMPLE / "table.csv")
     machine = compile_table(table)
@@ -120,7 +125,7 @@ def test_bumberbot_recorded_run(rule):
     assert len({row for _, row, *_ in expected}) > 3  # rows did fire
 
 
-def test_counters_reach_the_program():
+def test_counters_reach_the_program() -> None:
     table = load_table(COUNTERS / "table.csv")
     text = generate(table)
     lists = lists_of(text)
@@ -143,7 +148,8 @@ WIRINGS = st.fixed_dictionaries({"controller": st.sampled_from(["tx", "txt"])}, 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**32), counters=st.integers(0, 2), inputs=st.integers(0, 3),
        rule=st.sampled_from(["document", "always"]), sections=WIRINGS)
-def test_random_tables_tick_for_tick(seed, counters, inputs, rule, sections):
+def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, rule: str,
+                                     sections: dict[str, Any]) -> None:
     rng = random.Random(seed)
     shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, max_timer=4, max_load=5)
     table = with_match(fitting(random_table(rng, shape), sections), rule)
@@ -155,7 +161,7 @@ def test_random_tables_tick_for_tick(seed, counters, inputs, rule, sections):
 
 
 @pytest.mark.parametrize("rule", ["document", "always"])
-def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule):
+def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule: str) -> None:
     """Generated for the table's own rule (the robot file's match, no rule given), on tables and inputs where
     the two rules take different decisions: the program takes the engine's."""
     table, ticks = random_case(random.Random(f"robopro-{rule}"),
@@ -164,7 +170,7 @@ def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule):
     assert [astuple(d) for d in run(table, ticks)] == engine_ticks(compile_table(table), ticks)
 
 
-def test_the_rules_differ_where_the_document_says():
+def test_the_rules_differ_where_the_document_says() -> None:
     """A row that requires no event fires on an empty tick under "always", never under "document"."""
     base = random_table(random.Random(7), Shape(states=1, rows=1, inputs=1, counters=0))
     row = replace(base.rows[0], events=frozenset(), timer=3, motors=(2, -2))
@@ -178,7 +184,7 @@ def test_the_rules_differ_where_the_document_says():
 
 # --- what does not fit -------------------------------------------------------------------------------------
 
-def test_check_says_why_a_table_does_not_fit(tmp_path):
+def test_check_says_why_a_table_does_not_fit(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(
         'name = "Big"\ninitial_state = 1\n[inputs]\nI1 = "a"\n[motors]\nM1 = "m"\nM2 = "n"\nM3 = "o"\n'
         '[lamps]\nL1 = "lamp"\n[counters]\nC1 = "M1"\n')
@@ -192,12 +198,12 @@ def test_check_says_why_a_table_does_not_fit(tmp_path):
         generate(load_table(tmp_path / "t.csv"))
 
 
-def test_a_line_sensor_is_refused_with_the_reason():
+def test_a_line_sensor_is_refused_with_the_reason() -> None:
     found = problems(load_table(ROOT / "examples" / "line-follower" / "table.csv"))
     assert found and "digital 10 V" in found[0].message and found[0].line is not None
 
 
-def test_the_interpreter_refuses_an_ambiguous_branch():
+def test_the_interpreter_refuses_an_ambiguous_branch() -> None:
     """TM starting at -1 would make the timer branch read a negative value: "> 0" or "≠ 0"?"""
     text = generate(load_table(EXAMPLE / "table.csv"))
     run = Run(Program(text.replace('"=" datatype="3" value="0"', '"=" datatype="3" value="-1"', 1)))
@@ -206,7 +212,7 @@ def test_the_interpreter_refuses_an_ambiguous_branch():
             run.tick({}, {})
 
 
-def test_rows_and_state_numbers():
+def test_rows_and_state_numbers() -> None:
     table = load_table(EXAMPLE / "table.csv")
     p = plan(table)
     assert p.events == ("T", "I3", "I4", "I5", "I7", "I8") and p.shift == 6
@@ -242,7 +248,7 @@ def crossing(one: tuple, other: tuple) -> bool:
     return min(max(a1[span], b1[span]), max(a2[span], b2[span])) > low
 
 
-def test_crossing_sees_crossings():
+def test_crossing_sees_crossings() -> None:
     assert crossing(("a", (0, 4), (8, 4)), ("b", (4, 0), (4, 8)))
     assert crossing(("a", (0, 4), (8, 4)), ("b", (4, 4), (12, 4)))  # along each other
     assert not crossing(("a", (0, 4), (8, 4)), ("b", (8, 0), (8, 8)))  # meeting at an end
@@ -250,7 +256,7 @@ def test_crossing_sees_crossings():
 
 
 @pytest.mark.parametrize("which", ["bumberbot-document", "counters", "random"])
-def test_wires_do_not_cross_and_everything_sits_on_the_grid(which):
+def test_wires_do_not_cross_and_everything_sits_on_the_grid(which: str) -> None:
     if which == "bumberbot-document":
         text = generate(load_table(EXAMPLE / "table.csv"), "document")
     elif which == "counters":
@@ -265,7 +271,7 @@ def test_wires_do_not_cross_and_everything_sits_on_the_grid(which):
         assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
 
 
-def test_hostile_texts_stay_text(tmp_path):
+def test_hostile_texts_stay_text(tmp_path: Path) -> None:
     """Descriptions, state names, labels and the robot name that end tags and attributes stay text: the
     file parses, keeps to the vocabulary, and shows each text as written."""
     from hostile import HOSTILE, INJECTED, write_project
@@ -282,7 +288,7 @@ def test_hostile_texts_stay_text(tmp_path):
     assert run(table, [TickInput(0, ())] * 3)  # and it runs
 
 
-def test_the_commands(tmp_path):
+def test_the_commands(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
     from tablebot.cli import app
@@ -300,7 +306,7 @@ def test_the_commands(tmp_path):
     assert result.exit_code == 2 and "robopro-program: input I1 is a line sensor" in " ".join(result.output.split())
 
 
-def test_a_wrong_robopro_section_is_a_located_error(tmp_path):
+def test_a_wrong_robopro_section_is_a_located_error(tmp_path: Path) -> None:
     from tablebot.robot import load_robot
 
     (tmp_path / "robot.toml").write_text(

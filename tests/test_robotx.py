@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import statistics
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -19,8 +20,11 @@ from tablebot.hw.serial_port import PortInfo
 from tablebot.loop import LinkLost
 from tablebot.testing.robotx_emulator import RobotxEmulator
 
+if TYPE_CHECKING:
+    from tablebot.machine import Machine
 
-def robot_on(emulator: RobotxEmulator, machine=None, timeout_s: float = 0.15) -> RobotxRobot:
+
+def robot_on(emulator: RobotxEmulator, machine: Machine | None = None, timeout_s: float = 0.15) -> RobotxRobot:
     return RobotxRobot(robotx_wiring(machine or bumberbot("robotx")), emulator.device, link_timeout_s=timeout_s)
 
 

@@ -6,6 +6,7 @@ import re
 import shutil
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -16,6 +17,9 @@ from tablebot.formats.table_read import load_table
 from tablebot.robopro import lists as robopro
 from tablebot.robopro.rpp_edit import find_lists, rewrite, write_lists
 
+if TYPE_CHECKING:
+    from tablebot.robopro.lists import Lists
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 FIXTURES = Path(__file__).resolve().parent / "fixtures" / "rpp"
@@ -25,7 +29,7 @@ N_ATTR = re.compile(rb'\bN="\d+"')
 
 
 @pytest.fixture
-def lists():
+def lists() -> Lists:
     return robopro.encode(load_table(EXAMPLE / "table.csv"))
 
 
@@ -46,7 +50,7 @@ def _outside_lists(data: bytes) -> bytes:
     return N_ATTR.sub(b'N=""', INITS.sub(b"", data))
 
 
-def test_cli_writes_the_three_lists_in_place(tmp_path, lists):
+def test_cli_writes_the_three_lists_in_place(tmp_path: Path, lists: Lists) -> None:
     program = _copy(tmp_path, "engine.rpp")
     before = program.read_bytes()
     result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program)])
@@ -62,7 +66,7 @@ def test_cli_writes_the_three_lists_in_place(tmp_path, lists):
            b'                <init value="7"></init>' in after  # a variable named Timer is not the list
 
 
-def test_inits_keep_the_programs_layout(tmp_path, lists):
+def test_inits_keep_the_programs_layout(tmp_path: Path, lists: Lists) -> None:
     program = _copy(tmp_path, "engine.rpp")
     write_lists(program, {"Event": lists.event, "Action": lists.action, "Timer": lists.timer})
     text = program.read_text()
@@ -77,7 +81,7 @@ def test_inits_keep_the_programs_layout(tmp_path, lists):
     assert program.read_bytes() == again  # writing the same lists again changes nothing
 
 
-def test_latin1_crlf_program_with_other_names(tmp_path):
+def test_latin1_crlf_program_with_other_names(tmp_path: Path) -> None:
     program = _copy(tmp_path, "german_latin1_crlf.rpp")
     before = program.read_bytes()
     result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program),
@@ -93,7 +97,7 @@ def test_latin1_crlf_program_with_other_names(tmp_path):
     assert _list_values(after)["Aktion"][0] == "37"
 
 
-def test_outdir_leaves_the_program_untouched(tmp_path):
+def test_outdir_leaves_the_program_untouched(tmp_path: Path) -> None:
     program = _copy(tmp_path, "engine.rpp")
     before = program.read_bytes()
     result = runner.invoke(app, ["export", str(EXAMPLE), str(tmp_path / "out"), "--to", "robopro-rpp",
@@ -103,7 +107,7 @@ def test_outdir_leaves_the_program_untouched(tmp_path):
     assert _list_values((tmp_path / "out" / "engine.rpp").read_bytes())["Timer"][0] == "37"
 
 
-def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path):
+def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path: Path) -> None:
     program = _copy(tmp_path, "missing_timer.rpp")
     before = program.read_bytes()
     result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program)])
@@ -112,21 +116,21 @@ def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path):
     assert program.read_bytes() == before
 
 
-def test_a_global_list_is_written_in_every_subprogram_that_has_it():
+def test_a_global_list_is_written_in_every_subprogram_that_has_it() -> None:
     text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
             '<o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o></cvg>')
     assert [[int(i.get("value")) for i in o.findall("init")] for o in ET.fromstring(rewrite(text, {"Event": [4, 5]}))
             .iter("o")] == [[4, 5], [4, 5]]
 
 
-def test_two_different_lists_of_one_name_are_refused():
+def test_two_different_lists_of_one_name_are_refused() -> None:
     text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
             '<o classname="ftProDataArray1D" name="Event" globalname="Other" N="1"></o></cvg>')
     with pytest.raises(TableBotError, match="2 different lists are named 'Event'"):
         rewrite(text, {"Event": [1]})
 
 
-def test_not_a_program_and_missing_file(tmp_path):
+def test_not_a_program_and_missing_file(tmp_path: Path) -> None:
     other = tmp_path / "notes.rpp"
     other.write_text("hello")
     result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(other)])
@@ -135,7 +139,7 @@ def test_not_a_program_and_missing_file(tmp_path):
     assert result.exit_code == 2 and "cannot read" in result.output
 
 
-def test_find_lists_sees_nested_children_only_as_the_lists_own():
+def test_find_lists_sees_nested_children_only_as_the_lists_own() -> None:
     text = (FIXTURES / "engine.rpp").read_text()
     found = {e.name: e for e in find_lists(text)}
     assert sorted(found) == ["Action", "Event", "Other", "Timer"]

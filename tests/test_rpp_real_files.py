@@ -10,6 +10,7 @@ import re
 import shutil
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -23,6 +24,11 @@ from tablebot.testing.rpp_corpus import corpus_dir
 from test_rpp import EXAMPLE, FIXTURES
 from test_rpp import _outside_lists as _without_inits
 
+if TYPE_CHECKING:
+    from click.testing import Result
+
+    from tablebot.robopro.lists import Lists
+
 CORPUS = corpus_dir()
 needs_corpus = pytest.mark.skipif(CORPUS is None, reason="the ROBO Pro corpus is not here: set "
                                   "TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository")
@@ -33,7 +39,7 @@ TEACHIN = "sli__FtTxtExamples__SLI_TeachIn__RoboPro__TeachIn_cvl_4D.rpp"
 
 
 @pytest.fixture(scope="module")
-def lists():
+def lists() -> Lists:
     return robopro.encode(load_table(EXAMPLE / "table.csv"))
 
 
@@ -56,13 +62,13 @@ def corpus_copy(tmp_path: Path, name: str) -> Path:
     return target
 
 
-def export(program: Path, *names: str):
+def export(program: Path, *names: str) -> Result:
     return runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program),
                                "--event-list", names[0], "--action-list", names[1], "--timer-list", names[2]])
 
 
 @needs_corpus
-def test_pixy_global_lists_are_written_in_every_subprogram(tmp_path, lists):
+def test_pixy_global_lists_are_written_in_every_subprogram(tmp_path: Path, lists: Lists) -> None:
     program = corpus_copy(tmp_path, PIXY)
     before = program.read_bytes()
     result = export(program, "Signature", "X", "Y")
@@ -75,7 +81,7 @@ def test_pixy_global_lists_are_written_in_every_subprogram(tmp_path, lists):
 
 
 @needs_corpus
-def test_srf08_names_are_compared_as_robopro_shows_them(tmp_path, lists):
+def test_srf08_names_are_compared_as_robopro_shows_them(tmp_path: Path, lists: Lists) -> None:
     text = (CORPUS / SRF08).read_text(encoding="utf-8")
     assert 'name="Abst&#228;nde"' in text
     new = rewrite(text, {"Abstände": list(lists.event)})
@@ -86,14 +92,14 @@ def test_srf08_names_are_compared_as_robopro_shows_them(tmp_path, lists):
 
 
 @needs_corpus
-def test_srf08_float_list_is_refused(tmp_path):
+def test_srf08_float_list_is_refused(tmp_path: Path) -> None:
     text = (CORPUS / SRF08).read_text(encoding="utf-8")
     with pytest.raises(TableBotError, match="'Messwerte' holds floats"):
         rewrite(text, {"Messwerte": [1, 2]})
 
 
 @needs_corpus
-def test_teachin_lists_loaded_from_csv_are_warned_with_their_column(tmp_path, lists):
+def test_teachin_lists_loaded_from_csv_are_warned_with_their_column(tmp_path: Path, lists: Lists) -> None:
     program = corpus_copy(tmp_path, TEACHIN)
     text = program.read_text(encoding="utf-8")
     assert re.search(r'name="Data X"[^>]*initcsvbuffer="true"', text)
@@ -106,7 +112,7 @@ def test_teachin_lists_loaded_from_csv_are_warned_with_their_column(tmp_path, li
 
 
 @needs_corpus
-def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path, lists):
+def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path: Path, lists: Lists) -> None:
     """The empty copies of Data X get their inits where SRF08's lists have theirs: after the blank line that
     follows the last pin, ``<init value="…">`` and ``</init>`` each on a line at the pins' indent."""
     program = corpus_copy(tmp_path, TEACHIN)
@@ -126,7 +132,7 @@ def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path, list
 
 # --- the same cases on a small hand-made program (always) ------------------------------------------------------
 
-def test_fixture_cases(tmp_path):
+def test_fixture_cases(tmp_path: Path) -> None:
     text = (FIXTURES / "real_cases.rpp").read_text(encoding="utf-8")
     found = {e.name: e for e in find_lists(text)}
     assert sorted(found) == ["Abstände", "Data X", "Messwerte"]

@@ -134,7 +134,7 @@ class LinkRobot:
     """A robot whose link takes ``delays[n]`` seconds to answer read ``n``, which reads ``masks[n]``; it notes
     when each write arrives and what it says. ``read`` answers in the TXT 4.0 program's form (mask, pulses)."""
 
-    def __init__(self, time: SimulatedTime, masks: list[int], delays: list[float]):
+    def __init__(self, time: SimulatedTime, masks: list[int], delays: list[float]) -> None:
         self.time, self.masks, self.delays = time, masks, delays
         self.n, self.writes, self.stops = 0, [], 0
 

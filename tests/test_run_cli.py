@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from rich.console import Console
@@ -28,12 +29,17 @@ from tablebot.machine import compile_table
 from tablebot.sinks.live_view import LiveView
 from txt_fake import FakeTxt
 
+if TYPE_CHECKING:
+    from click.testing import Result
+
+    from txt_fake import Script
+
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
 CORE = ("tick", "event", "row", "state", "timer", "M1", "M2")
 
 
-def bumps(seed: int = 3):
+def bumps(seed: int = 3) -> Script:
     """Bumpers and light that change every few ticks, so the BumberBot takes many different rows."""
     rng = random.Random(seed)
     held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
@@ -46,7 +52,7 @@ def read_trace(path: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
 
 
-def invoke(*args: object):
+def invoke(*args: object) -> Result:
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
     return result

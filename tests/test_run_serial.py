@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -21,12 +22,16 @@ from tablebot.hw.link_speed import PROBES
 from tablebot.testing.roboif_emulator import RoboifEmulator
 from tablebot.testing.robotx_emulator import RobotxEmulator
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any
+
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ("tick", "event", "row", "state", "timer", "M1", "M2")
 runner = CliRunner()
 
 
-def bumps(kind: str, seed: int = 3):
+def bumps(kind: str, seed: int = 3) -> Callable[[int], tuple[list[int], list[int] | dict[str, int]]]:
     """Bumpers and light that change every few ticks, so the BumberBot takes many different rows."""
     rng = random.Random(seed)
     held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
@@ -35,11 +40,11 @@ def bumps(kind: str, seed: int = 3):
     return lambda n: (held[(max(0, n - PROBES) // 7) % len(held)], other)  # the same inputs whatever timing came first
 
 
-def emulator(kind: str, **options):
+def emulator(kind: str, **options: Any) -> RobotxEmulator | RoboifEmulator:
     return (RobotxEmulator if kind == "robotx" else RoboifEmulator)(bumps(kind), **options)
 
 
-def off(kind: str, request) -> bool:
+def off(kind: str, request: pytest.FixtureRequest) -> bool:
     """Whether an exchange the emulator logged switched every output off."""
     if kind == "robotx":
         return request.fields["duty"] == [0] * 8

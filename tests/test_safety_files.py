@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import shutil
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -17,11 +18,14 @@ from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from tablebot.files import PendingFile, atomic_write, replacing, write_text
 
+if TYPE_CHECKING:
+    from click.testing import Result
+
 RPP = Path(__file__).resolve().parent / "fixtures" / "rpp" / "engine.rpp"
 runner = CliRunner()
 
 
-def cli(*args: object, code: int = 0):
+def cli(*args: object, code: int = 0) -> Result:
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exc_info
     assert result.exit_code == code, result.output
@@ -35,7 +39,7 @@ def bot(tmp_path: Path) -> Path:
     return folder
 
 
-def test_trace_refuses_to_write_over_its_inputs_file(bot):
+def test_trace_refuses_to_write_over_its_inputs_file(bot: Path) -> None:
     """Reproduced: `trace --inputs in.csv --out in.csv` replaced the recording with JSON Lines."""
     before = (bot / "inputs.csv").read_bytes()
     result = cli("trace", bot, "--inputs", bot / "inputs.csv", "--out", bot / "inputs.csv", code=2)
@@ -44,7 +48,7 @@ def test_trace_refuses_to_write_over_its_inputs_file(bot):
 
 
 @pytest.mark.parametrize("target", ["table.csv", "robot.toml", "inputs.csv"])
-def test_no_command_writes_over_a_file_it_read(bot, target):
+def test_no_command_writes_over_a_file_it_read(bot: Path, target: str) -> None:
     """Even with --force, and even through another spelling (a hard link) of the same file."""
     os.link(bot / target, bot / "alias")
     before = (bot / target).read_bytes()
@@ -55,7 +59,7 @@ def test_no_command_writes_over_a_file_it_read(bot, target):
     assert (bot / target).read_bytes() == before
 
 
-def test_import_refuses_to_replace_a_table_without_force(bot, tmp_path):
+def test_import_refuses_to_replace_a_table_without_force(bot: Path, tmp_path: Path) -> None:
     """Reproduced: `import lists --from robopro --out table.csv` replaced a hand-written table."""
     lists = tmp_path / "lists"
     cli("export", bot, lists, "--to", "robopro")
@@ -69,7 +73,7 @@ def test_import_refuses_to_replace_a_table_without_force(bot, tmp_path):
     assert table.read_bytes() != before and b"Collision" not in table.read_bytes()
 
 
-def test_any_output_is_refused_over_a_robot_or_table_file(bot, tmp_path):
+def test_any_output_is_refused_over_a_robot_or_table_file(bot: Path, tmp_path: Path) -> None:
     other = tmp_path / "other.toml"
     other.write_text("name = 'x'\n")
     cli("diagram", bot, "--format", "dot", "--out", other, code=2)
@@ -79,7 +83,7 @@ def test_any_output_is_refused_over_a_robot_or_table_file(bot, tmp_path):
     cli("trace", bot, "--inputs", bot / "inputs.csv", "--out", plain)
 
 
-def test_rpp_in_place_keeps_a_backup(tmp_path, bot):
+def test_rpp_in_place_keeps_a_backup(tmp_path: Path, bot: Path) -> None:
     program = tmp_path / "engine.rpp"
     shutil.copy(RPP, program)
     cli("export", bot, "--to", "robopro-rpp", "--into", program)
@@ -87,7 +91,7 @@ def test_rpp_in_place_keeps_a_backup(tmp_path, bot):
     assert program.read_bytes() != RPP.read_bytes()
 
 
-def test_check_writes_nothing_unless_asked(bot, tmp_path, monkeypatch):
+def test_check_writes_nothing_unless_asked(bot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Reproduced: check wrote ./out/check by default (and failed in a read-only folder)."""
     work = tmp_path / "work"
     work.mkdir()
@@ -102,7 +106,7 @@ def test_check_writes_nothing_unless_asked(bot, tmp_path, monkeypatch):
 
 # --- tablebot.files --------------------------------------------------------------------------------
 
-def test_an_interrupted_write_keeps_the_old_file(tmp_path):
+def test_an_interrupted_write_keeps_the_old_file(tmp_path: Path) -> None:
     path = tmp_path / "d.png"
     path.write_bytes(b"old")
     with pytest.raises(KeyboardInterrupt), atomic_write(path, "wb") as f:
@@ -111,7 +115,7 @@ def test_an_interrupted_write_keeps_the_old_file(tmp_path):
     assert path.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["d.png"]
 
 
-def test_a_tool_output_is_renamed_only_when_complete(tmp_path):
+def test_a_tool_output_is_renamed_only_when_complete(tmp_path: Path) -> None:
     elf = tmp_path / "x.elf"
     with pytest.raises(RuntimeError), replacing(elf) as temp:
         temp.write_bytes(b"partial")
@@ -123,7 +127,7 @@ def test_a_tool_output_is_renamed_only_when_complete(tmp_path):
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
-def test_a_device_is_written_not_replaced(tmp_path):
+def test_a_device_is_written_not_replaced(tmp_path: Path) -> None:
     """Renaming onto /dev/full would put a regular file where the device was."""
     with pytest.raises(OSError) as info:
         write_text("/dev/full", "x" * 100000)
@@ -144,7 +148,7 @@ def test_a_device_is_written_not_replaced(tmp_path):
     b'"state"\t"T"\t"next"\n',  # quoted cells, tabs
     "state,T,I3,timer,next\n".encode("utf-16"),  # Excel's "Unicode Text"
 ])
-def test_every_spelling_of_a_table_header_is_protected(tmp_path, header):
+def test_every_spelling_of_a_table_header_is_protected(tmp_path: Path, header: bytes) -> None:
     """Reproduced: a table saved with a BOM before its state column was replaced without --force."""
     table = tmp_path / "mine.csv"
     table.write_bytes(header)
@@ -155,13 +159,13 @@ def test_every_spelling_of_a_table_header_is_protected(tmp_path, header):
 
 
 @pytest.mark.parametrize("text", ["a,b\n1,2\n", "state,M1\n1,2\n", "", '"state,next\n'])
-def test_other_csv_files_are_not_tables(tmp_path, text):
+def test_other_csv_files_are_not_tables(tmp_path: Path, text: str) -> None:
     other = tmp_path / "data.csv"
     other.write_text(text)
     assert not files.is_user_file(other)
 
 
-def test_a_symlink_is_written_through(tmp_path):
+def test_a_symlink_is_written_through(tmp_path: Path) -> None:
     real = tmp_path / "real.jsonl"
     real.write_text("old")
     link = tmp_path / "link.jsonl"
@@ -170,7 +174,7 @@ def test_a_symlink_is_written_through(tmp_path):
     assert link.is_symlink() and real.read_text() == "new"
 
 
-def test_the_guard_outside_a_command_refuses_nothing(tmp_path):
+def test_the_guard_outside_a_command_refuses_nothing(tmp_path: Path) -> None:
     table = tmp_path / "t.csv"
     table.write_text("state,next\n1,1\n")
     write_text(table, "state,next\n2,2\n")  # library use: the caller decides

@@ -4,6 +4,7 @@ not fit the controller is refused before anything moves, every problem at once, 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -14,10 +15,13 @@ from tablebot.hw.roboif.wiring import roboif_wiring
 from tablebot.hw.robotx.wiring import robotx_wiring
 from tablebot.machine import compile_table
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
 ROBOT = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
 
 
-def wire(tmp_path: Path, section: str, body: str, extra: str = ""):
+def wire(tmp_path: Path, section: str, body: str, extra: str = "") -> Path:
     """The BumberBot whose robot file has only ``[section]`` with ``body`` (the other wirings cut off)."""
     core = ROBOT[: ROBOT.index("[txt]")]
     (tmp_path / "table.csv").write_text((EXAMPLE / "table.csv").read_text(encoding="utf-8"), encoding="utf-8")
@@ -25,7 +29,7 @@ def wire(tmp_path: Path, section: str, body: str, extra: str = ""):
     return tmp_path / "robot.toml"
 
 
-def errors_of(action) -> list[str]:
+def errors_of(action: Callable[[], object]) -> list[str]:
     with pytest.raises(TableBotError) as info:
         action()
     return [d.render() for d in info.value.diagnostics]

@@ -4,6 +4,7 @@ option is a located error with a hint and exit code 2, never a traceback."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from typer.testing import CliRunner
@@ -11,6 +12,9 @@ from typer.testing import CliRunner
 from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
+
+if TYPE_CHECKING:
+    from click.testing import Result
 
 runner = CliRunner()
 
@@ -22,7 +26,7 @@ def setup_errors(tmp_path: Path, world: str, robot: str = ROBOT) -> list[str]:
     return [d.render() for d in info.value.diagnostics]
 
 
-def sim(*args: str):
+def sim(*args: str) -> Result:
     result = runner.invoke(app, ["sim", *args])
     assert result.exception is None or isinstance(result.exception, SystemExit), result.exception
     return result

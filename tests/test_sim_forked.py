@@ -42,7 +42,7 @@ def copies() -> list[int]:
     return found
 
 
-def test_the_answer_comes_from_another_process():
+def test_the_answer_comes_from_another_process() -> None:
     me = os.getpid()
     with Forked(lambda _: str(os.getpid()).encode()) as copy:
         assert copy.pid is not None
@@ -50,7 +50,7 @@ def test_the_answer_comes_from_another_process():
     assert copies() == []
 
 
-def test_an_error_in_the_copy_is_raised_here():
+def test_an_error_in_the_copy_is_raised_here() -> None:
     def work(_: forked.Inbox) -> bytes:
         raise ValueError("no picture today")
     with Forked(work) as copy, pytest.raises(ValueError, match="no picture today"):
@@ -58,7 +58,7 @@ def test_an_error_in_the_copy_is_raised_here():
     assert copies() == []
 
 
-def test_leaving_without_the_answer_kills_the_copy_at_once():
+def test_leaving_without_the_answer_kills_the_copy_at_once() -> None:
     started = time.monotonic()
     with pytest.raises(KeyboardInterrupt), Forked(lambda _: time.sleep(60) or b"late") as copy:
         while copies() != [copy.pid]:  # the copy names itself just after the fork
@@ -68,7 +68,7 @@ def test_leaving_without_the_answer_kills_the_copy_at_once():
     assert copies() == [] and time.monotonic() - started < 30
 
 
-def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here():
+def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here() -> None:
     me = os.getpid()
     with Forked(lambda _: b"here" if os.getpid() == me else time.sleep(60) or b"there") as copy:
         os.kill(copy.pid, signal.SIGKILL)
@@ -76,7 +76,7 @@ def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here():
     assert copies() == []
 
 
-def test_messages_reach_the_copy_in_order_with_their_arrays():
+def test_messages_reach_the_copy_in_order_with_their_arrays() -> None:
     rows = np.arange(300_000, dtype=np.float32).reshape(-1, 3)  # larger than the pipe: written as it is read
 
     def work(inbox: forked.Inbox) -> bytes:
@@ -91,7 +91,7 @@ def test_messages_reach_the_copy_in_order_with_their_arrays():
     assert copies() == []
 
 
-def test_a_copy_that_died_gets_its_messages_here():
+def test_a_copy_that_died_gets_its_messages_here() -> None:
     me = os.getpid()
 
     def work(inbox: forked.Inbox) -> bytes:
@@ -109,7 +109,7 @@ def test_a_copy_that_died_gets_its_messages_here():
         assert copy.result() == b"big " * 400_000 + b"end"
 
 
-def test_a_copy_waiting_for_a_message_never_sent_leaves_quietly():
+def test_a_copy_waiting_for_a_message_never_sent_leaves_quietly() -> None:
     with Forked(lambda inbox: inbox.get()) as copy:
         pid = copy.pid
         with pytest.raises(RuntimeError, match="never sent"):
@@ -117,14 +117,14 @@ def test_a_copy_waiting_for_a_message_never_sent_leaves_quietly():
     assert copies() == [] and pid is not None
 
 
-def test_without_a_copy_the_work_runs_here(monkeypatch):
+def test_without_a_copy_the_work_runs_here(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(os, "cpu_count", lambda: 1)
     with Forked(lambda _: str(os.getpid()).encode()) as copy:
         assert copy.pid is None and int(copy.result()) == os.getpid()
 
 
 @pytest.mark.parametrize("fault", ["2:INT", "3:TERM"])
-def test_sim_interrupted_while_drawing_leaves_no_process(tmp_path, fault):
+def test_sim_interrupted_while_drawing_leaves_no_process(tmp_path: Path, fault: str) -> None:
     """Step 2 is trajectory.png written (the copy may still draw the timeline), step 3 timeline.png."""
     shutil.copytree(EXAMPLE, tmp_path / "bot")
     result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "20", "-q", "--out",

@@ -12,7 +12,7 @@ from tablebot.sim.shadows import shadowed_near
 
 
 @njit
-def plain(ax, ay, bx, by, cx, cy, dx, dy, r):  # type: ignore[no-untyped-def]
+def plain(ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float, r: float) -> bool:
     """segments_within as it was: the crossing test, then the four endpoint-to-segment distances."""
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
@@ -21,7 +21,7 @@ def plain(ax, ay, bx, by, cx, cy, dx, dy, r):  # type: ignore[no-untyped-def]
 
 
 @njit
-def disagreements(cases):  # type: ignore[no-untyped-def]
+def disagreements(cases: np.ndarray) -> tuple[int, int]:
     bad, near = 0, 0
     for k in range(cases.shape[0]):
         ax, ay, bx, by, cx, cy, dx, dy, r = cases[k]
@@ -54,7 +54,8 @@ def test_segments_within_agrees_with_the_plain_test_on_the_threshold_and_on_the_
 
 
 @njit
-def shadow_disagreements(points, lamps, edges, circles, shade):  # type: ignore[no-untyped-def]
+def shadow_disagreements(points: np.ndarray, lamps: np.ndarray, edges: np.ndarray, circles: np.ndarray,
+                         shade: np.ndarray) -> tuple[int, int]:
     bad, dark = 0, 0
     for k in range(lamps.shape[0]):
         for j in range(points.shape[0]):

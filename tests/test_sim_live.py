@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -22,6 +23,9 @@ from tablebot.sim.simrobot import SimRobot
 from tablebot.sinks.trace_file import TraceFile, block_lines
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 
+if TYPE_CHECKING:
+    from tablebot.loop import RunEnd, RunInfo
+
 EXAMPLES = [(BUMBERBOT / "table.csv", None), (ROOT / "examples" / "bumberbot-counters" / "table.csv",
                                               BUMBERBOT / "arena.toml")]
 
@@ -32,14 +36,14 @@ class Lines:
     def __init__(self) -> None:
         self.lines: list[str] = []
 
-    def start(self, info) -> None:  # type: ignore[no-untyped-def]
+    def start(self, info: RunInfo) -> None:
         self.machine = info.engine.machine
 
     def block(self, block: TickBlock) -> None:
         block.extra = {k: v for k, v in block.extra.items() if k != "late_ms"}
         self.lines.extend(block_lines(block, self.machine))
 
-    def end(self, end) -> None:  # type: ignore[no-untyped-def]
+    def end(self, end: RunEnd) -> None:
         pass
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from hypothesis import given, settings
@@ -14,6 +15,9 @@ from tablebot.sim.params import Params, speed_per_volt, terminal_volts
 from tablebot.sim.runner import simulate
 from tablebot.sim.world import inside
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
+
+if TYPE_CHECKING:
+    import pytest
 
 
 def wheel_speed(params: Params, level: int, charge: float, levels: tuple[int, ...]) -> float:
@@ -91,7 +95,8 @@ def test_driving_into_a_wall_stops_at_the_wall(tmp_path: Path) -> None:
 
 @settings(max_examples=12, deadline=None)
 @given(heading=st.floats(-180, 180), right=st.integers(-8, 8), left=st.integers(-8, 8))
-def test_the_robot_never_leaves_the_room(tmp_path_factory, heading: float, right: int, left: int) -> None:
+def test_the_robot_never_leaves_the_room(tmp_path_factory: pytest.TempPathFactory, heading: float, right: int,
+                                         left: int) -> None:
     tmp = tmp_path_factory.mktemp("room")
     rows = [f"go,1,1,,,,,,{right},{left},3000,1"]
     extra = "[[box]]\nat = [0.9, 0.9]\nsize = [0.3, 0.3]\nangle = 20\n[[circle]]\nat = [0.3, 0.3]\nradius = 0.08"

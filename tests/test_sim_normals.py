@@ -4,12 +4,17 @@ pointers): the simulator's noise may come from either without changing a trace b
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pytest
 
 from tablebot.fleet.generators import generators
 from tablebot.sim import normals
 from tablebot.sim.normals import INLINE, bitgen_address, fill
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 
 class OwnPCG64(np.random.PCG64):
@@ -57,7 +62,7 @@ def test_generators_made_at_once_draw_inline_as_default_rng() -> None:
 
 
 @pytest.mark.parametrize("make", [lambda s: OwnPCG64(s), lambda s: np.random.Philox(s), lambda s: np.random.MT19937(s)])
-def test_other_bit_generators_draw_through_numpys_pointers(make) -> None:  # type: ignore[no-untyped-def]
+def test_other_bit_generators_draw_through_numpys_pointers(make: Callable[[int], np.random.BitGenerator]) -> None:
     _same_draws(np.random.Generator(make(11)), np.random.Generator(make(11)), 200_000)
 
 

@@ -13,6 +13,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
@@ -29,6 +30,9 @@ from tablebot.sim.timeline import TimelinePicture
 from tablebot.sim.view import RunView
 from test_sim_declared import SENSORS, TABLE
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 FORKS = sys.platform.startswith("linux") and (os.cpu_count() or 1) > 1
 LAMP_ROOM = (BUMBERBOT / "arena.toml").read_text()
@@ -133,7 +137,7 @@ def painters_of(root: int) -> dict[int, str]:
 class Watch:
     """Notes every painter process (and fork of one) of a command while it runs."""
 
-    def __init__(self, proc: subprocess.Popen):
+    def __init__(self, proc: subprocess.Popen) -> None:
         self.proc, self.seen, self.done = proc, {}, False
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
@@ -163,7 +167,7 @@ def sim(out: Path, *args: str) -> subprocess.Popen:
                             text=True)
 
 
-def wait_for(check, proc: subprocess.Popen) -> None:  # type: ignore[no-untyped-def]
+def wait_for(check: Callable[[], object], proc: subprocess.Popen) -> None:
     deadline = time.monotonic() + 120
     while not check():
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()

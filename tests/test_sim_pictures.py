@@ -22,7 +22,8 @@ from test_sim_helpers import BUMBERBOT, ROOT, room, scene_of
     ((3.0 - 0.12 - 0.0005, 1.2, 0.0), (3.0, 1.2)),  # nose flat against the right wall
     ((1.0, 0.07 + 0.0005, 90.0), (1.0, 0.0)),  # backed against the bottom wall: the tail touches
 ])
-def test_a_collision_is_marked_where_the_body_touches(tmp_path: Path, pose, where) -> None:
+def test_a_collision_is_marked_where_the_body_touches(tmp_path: Path, pose: tuple[float, float, float],
+                                                      where: tuple[float, float]) -> None:
     scene = sensor_scene(tmp_path, room())
     x, y, heading = pose
     cx, cy = contact_point(scene.geometry, scene.params, x, y, math.radians(heading))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from PIL import Image
@@ -17,15 +18,18 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, room, scene_of, trace_text
 
+if TYPE_CHECKING:
+    from tablebot.sim.runner import SimRun
+
 CORE_KEYS = ["tick", "event", "row", "state", "timer", "M1", "M2"]
 
 
 @pytest.fixture(scope="module")
-def arena_run():
+def arena_run() -> SimRun:
     return simulate(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
 
 
-def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run) -> None:
+def test_bumberbot_finds_the_lamp_in_its_arena_within_the_default_run(arena_run: SimRun) -> None:
     summary = summarise(arena_run)
     assert summary.first_light_s is not None and summary.reached_s is not None
     assert summary.first_light_s < summary.reached_s < 120.0
@@ -40,7 +44,7 @@ def test_the_lamp_is_found_with_other_seeds_too() -> None:
         assert summarise(simulate(scene, 120.0, seed=seed)).reached_s is not None
 
 
-def test_same_seed_same_trace_bytes(arena_run) -> None:
+def test_same_seed_same_trace_bytes(arena_run: SimRun) -> None:
     again = simulate(scene_of(BUMBERBOT / "table.csv"), 120.0, seed=1)
     assert trace_text(again) == trace_text(arena_run)
 
@@ -50,7 +54,7 @@ def test_another_seed_another_trace() -> None:
     assert trace_text(simulate(scene, 20.0, seed=1)) != trace_text(simulate(scene, 20.0, seed=2))
 
 
-def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run) -> None:
+def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run: SimRun) -> None:
     lines = [json.loads(line) for line in trace_text(arena_run).splitlines()]
     assert len(lines) == arena_run.ticks
     assert list(lines[0])[:7] == CORE_KEYS

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -10,11 +11,14 @@ from tablebot.sim import columns as L
 from tablebot.sim.runner import simulate
 from test_sim_helpers import BUMBERBOT, STRAIGHT, bot, room, scene_of, write_bot
 
+if TYPE_CHECKING:
+    from tablebot.sim.scene import Scene
+
 STILL = ["wait,1,1,,,,,,0,0,100,1"]
 LAMP = "[[lamp]]\nat = [{x}, {y}]\nintensity = 2.0\n"
 
 
-def bumberbot_in(tmp_path: Path, world: str):
+def bumberbot_in(tmp_path: Path, world: str) -> Scene:
     (tmp_path / "world.toml").write_text(world, encoding="utf-8")
     return scene_of(BUMBERBOT / "table.csv", tmp_path / "world.toml")
 

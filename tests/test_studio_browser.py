@@ -15,6 +15,7 @@ import shutil
 from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -29,6 +30,9 @@ if not CHROMIUM.exists():
     pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)", allow_module_level=True)
 
 from tablebot.web.app import Background  # noqa: E402
+
+if TYPE_CHECKING:
+    from playwright.sync_api import Locator
 
 FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
@@ -83,7 +87,7 @@ def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
 class Tab:
     """A page on the studio that records console errors."""
 
-    def __init__(self, browser: object, url: str, shots: Path, name: str):
+    def __init__(self, browser: object, url: str, shots: Path, name: str) -> None:
         self.context = browser.new_context(viewport={"width": 1366, "height": 768})  # type: ignore[attr-defined]
         self.page = self.context.new_page()
         self.errors: list[str] = []
@@ -97,7 +101,7 @@ class Tab:
         # the page's counters live in a module (the page has no globals): the test takes a handle on them
         self.page.evaluate("import('/static/js/studio/stats.js').then((m) => { window.stats = m.stats; })")
 
-    def cell(self, row: int, col: int):  # type: ignore[no-untyped-def]
+    def cell(self, row: int, col: int) -> Locator:
         return self.page.locator(f'td[data-row="{row}"][data-col="{col}"]')
 
     def status(self) -> str:

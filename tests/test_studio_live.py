@@ -4,6 +4,7 @@ It makes the same run as ``tablebot sim``; pausing, single steps and hand-held i
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -14,6 +15,11 @@ from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 from tablebot.web.live import LiveRun, PageClock
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from tablebot.sim.scene import Scene
 
 
 class Rows:
@@ -35,7 +41,7 @@ class Rows:
         self.ended = end
 
 
-def wait_until(condition, timeout: float = 10.0) -> None:  # type: ignore[no-untyped-def]
+def wait_until(condition: Callable[[], bool], timeout: float = 10.0) -> None:
     deadline = time.monotonic() + timeout
     while not condition():
         assert time.monotonic() < deadline, "timed out"
@@ -43,12 +49,12 @@ def wait_until(condition, timeout: float = 10.0) -> None:  # type: ignore[no-unt
 
 
 @pytest.fixture(scope="module")
-def scene():  # type: ignore[no-untyped-def]
+def scene() -> Scene:
     table, machine = load(EXAMPLE)
     return scene_for(table, machine)
 
 
-def test_the_live_run_is_the_sim_commands_run(scene) -> None:  # type: ignore[no-untyped-def]
+def test_the_live_run_is_the_sim_commands_run(scene: Scene) -> None:
     ticks = 3000
     expected = simulate(scene, ticks * scene.tick_s, seed=3)
     sink = Rows()
@@ -60,7 +66,7 @@ def test_the_live_run_is_the_sim_commands_run(scene) -> None:  # type: ignore[no
     assert sink.xs[:ticks] == pytest.approx(expected.hist[:ticks, 0].tolist(), abs=1e-5)
 
 
-def test_pause_step_and_a_held_input(scene) -> None:  # type: ignore[no-untyped-def]
+def test_pause_step_and_a_held_input(scene: Scene) -> None:
     sink = Rows()
     live = LiveRun(scene, SimRobot(scene, record_history=False), speed="max", paused=True, sinks=[sink])
     time.sleep(0.2)

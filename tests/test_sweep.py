@@ -10,7 +10,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 from typer.testing import CliRunner
@@ -21,6 +21,9 @@ from tablebot.fleet.plan import read_results
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.sim.scene import robot_layer, scene_for
 from test_sim_helpers import BUMBERBOT
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
@@ -133,7 +136,7 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
 
 
 @pytest.fixture
-def dask_cluster(tmp_path: Path):  # type: ignore[no-untyped-def]
+def dask_cluster(tmp_path: Path) -> Iterator[str]:
     """A real Dask scheduler and two single-threaded workers on this machine (separate processes), one of
     them started with tablebot's preload (tablebot.fleet.worker), one plain."""
     pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")

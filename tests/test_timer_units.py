@@ -3,6 +3,8 @@ is a located error naming the nearest valid values; exports and firmware still g
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pytest
 
 from core_helpers import MINI_ROBOT, column_of, find, problems, write_table
@@ -11,6 +13,9 @@ from tablebot.durations import DurationError, to_ticks
 from tablebot.formats.table_read import parse_table
 from tablebot.robopro.lists import encode
 from tablebot.robot import BUMBERBOT, Robot
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 ROBOT7 = "name = \"Seven\"\ntick_ms = 7\ninitial_state = 1\n[inputs]\nA = \"a\"\n[motors]\nM1 = \"m\"\n"
 HEADER = "state,T,A,M1,timer,next"
@@ -35,7 +40,8 @@ def test_times_and_ticks_read_as_ticks() -> None:
     ("700s", "timer: 700s is 70000 ticks, more than the timer holds (65535)", "655.35 s at 10 ms a tick"),
     ("5 min", "timer: '5 min' is not a duration", "500ms, 0.5s"),
 ])
-def test_bad_times_are_located_with_the_nearest_valid_values(tmp_path, cell: str, message: str, hint: str) -> None:
+def test_bad_times_are_located_with_the_nearest_valid_values(tmp_path: Path, cell: str, message: str,
+                                                             hint: str) -> None:
     line = f"1,1,,3,{cell},1"
     d = find(problems(write_table(tmp_path, f"{HEADER}\n{line}\n", MINI_ROBOT)), "^timer")
     assert (d.line, d.column) == (2, column_of(line, 4))
@@ -43,7 +49,7 @@ def test_bad_times_are_located_with_the_nearest_valid_values(tmp_path, cell: str
     assert hint in d.hint
 
 
-def test_nearest_values_use_the_robots_tick(tmp_path) -> None:
+def test_nearest_values_use_the_robots_tick(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(ROBOT7, encoding="utf-8")
     table = tmp_path / "table.csv"
     table.write_text(f"{HEADER}\n1,1,,3,100ms,1\n1,,,3,98ms,1\n", encoding="utf-8")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import re
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -16,38 +17,44 @@ from tablebot.formats.trace_lines import dumps, read_trace, write_trace
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 
+if TYPE_CHECKING:
+    from pathlib import Path
 
-def trace_of(tmp_path, inputs_text: str, machine=None) -> list[dict]:
+    from tablebot.diagnostics import Diagnostic
+    from tablebot.machine import Machine
+
+
+def trace_of(tmp_path: Path, inputs_text: str, machine: Machine | None = None) -> list[dict]:
     machine = machine or example_machine()
     path = tmp_path / "inputs.csv"
     path.write_text(inputs_text)
     return list(replay(machine, load_inputs(path, machine)))
 
 
-def test_keys_in_order_and_the_readme_example(tmp_path):
+def test_keys_in_order_and_the_readme_example(tmp_path: Path) -> None:
     lines = trace_of(tmp_path, "I3,I4,I5,I7,I8\n,,,,\n")
     assert list(lines[0]) == ["tick", "event", "row", "state", "timer", "M1", "M2"]
     assert dumps(lines[0]) == '{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}'
 
 
-def test_event_bits_first_column_highest(tmp_path):
+def test_event_bits_first_column_highest(tmp_path: Path) -> None:
     """T=32, I3=16, I4=8, I5=4, I7=2, I8=1 (after tick 0 the timer holds 500, then 50: no T)."""
     lines = trace_of(tmp_path, "I8,I7,I5,I4,I3\n0,0,0,0,0\n,,,,1\n,,,1,\n,,1,,\n,1,,,\n1,,,,\n1,1,1,1,1\n")
     assert [line["event"] for line in lines] == [32, 16, 8, 4, 2, 1, 31]
 
 
-def test_row_is_null_when_nothing_fires_and_state_timer_are_after_the_tick(tmp_path):
+def test_row_is_null_when_nothing_fires_and_state_timer_are_after_the_tick(tmp_path: Path) -> None:
     lines = trace_of(tmp_path, "I3\n\n\n1\n")
     assert [(x["row"], x["state"], x["timer"]) for x in lines] == [(7, 1, 500), (None, 1, 499), (1, 20, 50)]
     assert '"row":null' in dumps(lines[1])
 
 
-def test_motors_are_signed(tmp_path):
+def test_motors_are_signed(tmp_path: Path) -> None:
     lines = trace_of(tmp_path, "I3,I4\n\n1,1\n" + "\n" * 50 + "1,1\n")
     assert (lines[-1]["row"], lines[-1]["M1"], lines[-1]["M2"]) == (9, -3, -3)  # Collision Frontal: backward
 
 
-def test_replay_is_deterministic_byte_for_byte():
+def test_replay_is_deterministic_byte_for_byte() -> None:
     machine = example_machine()
     ticks = load_inputs(EXAMPLE / "inputs.csv", machine)
     first, second = io.StringIO(), io.StringIO()
@@ -57,7 +64,7 @@ def test_replay_is_deterministic_byte_for_byte():
     assert first.getvalue().endswith("\n") and "\r" not in first.getvalue()
 
 
-def test_write_and_read_trace(tmp_path):
+def test_write_and_read_trace(tmp_path: Path) -> None:
     machine = example_machine()
     lines = list(replay(machine, [TickInput(0), TickInput(16)]))
     path = tmp_path / "t.jsonl"
@@ -67,7 +74,7 @@ def test_write_and_read_trace(tmp_path):
     assert path.read_text().splitlines()[1] == json.dumps(lines[1], separators=(",", ":"))
 
 
-def test_counters_and_lamps_follow_the_motors(tmp_path):
+def test_counters_and_lamps_follow_the_motors(tmp_path: Path) -> None:
     table = "state,T,A,C1,M1,M2,L1,L2,C1_load,C2_load,timer,next\n1,1,,,3,-2,5,=,4,,9,1\n"
     machine = compile_table(load_table(write_table(tmp_path, table, COUNTER_ROBOT)))
     lines = trace_of(tmp_path, "A,C1,C2\n,,\n,1,2\n", machine)
@@ -80,14 +87,14 @@ def test_counters_and_lamps_follow_the_motors(tmp_path):
 
 # --- the inputs CSV -----------------------------------------------------------------------------------
 
-def test_inputs_blank_is_zero_and_tick_column_is_ignored(tmp_path):
+def test_inputs_blank_is_zero_and_tick_column_is_ignored(tmp_path: Path) -> None:
     machine = example_machine()
     path = tmp_path / "in.csv"
     path.write_text("tick,I7,I3\n0,,\n1,1,\n2,1,1\n")
     assert [t.mask for t in load_inputs(path, machine)] == [0, 2, 18]
 
 
-def inputs_error(tmp_path, text, machine=None):
+def inputs_error(tmp_path: Path, text: str, machine: Machine | None = None) -> tuple[Diagnostic, ...]:
     path = tmp_path / "in.csv"
     path.write_text(text)
     with pytest.raises(TableBotError) as info:
@@ -102,7 +109,7 @@ def inputs_error(tmp_path, text, machine=None):
     ("I3,I4\n1,x\n", (2, 3), r"I4: 'x' is not 0 or 1"),
     ("I3\n²\n", (2, 1), r"I3: '²' is not 0 or 1"),
 ])
-def test_inputs_errors_are_located(tmp_path, text, where, pattern):
+def test_inputs_errors_are_located(tmp_path: Path, text: str, where: tuple[int, int], pattern: str) -> None:
     diagnostics = inputs_error(tmp_path, text)
     assert len(diagnostics) == 1
     d = diagnostics[0]
@@ -110,17 +117,17 @@ def test_inputs_errors_are_located(tmp_path, text, where, pattern):
     assert re.search(pattern, d.message) and d.hint
 
 
-def test_inputs_all_problems_at_once(tmp_path):
+def test_inputs_all_problems_at_once(tmp_path: Path) -> None:
     assert len(inputs_error(tmp_path, "I3,T,I9\n5,,\n1,,\nx,,\n")) == 4
 
 
-def test_inputs_empty_file(tmp_path):
+def test_inputs_empty_file(tmp_path: Path) -> None:
     (d,) = inputs_error(tmp_path, "")
     assert "empty" in d.message and (d.line, d.column) == (1, 1)
 
 
 @pytest.mark.parametrize("value", ["-1", "²", "1.5"])
-def test_inputs_pulses_must_be_counts(tmp_path, value):
+def test_inputs_pulses_must_be_counts(tmp_path: Path, value: str) -> None:
     table = "state,T,C1,M1,C1_load,timer,next\n1,1,,3,4,9,1\n"
     machine = compile_table(load_table(write_table(tmp_path, table, COUNTER_ROBOT)))
     (d,) = inputs_error(tmp_path, f"C1\n{value}\n", machine)

@@ -127,7 +127,7 @@ class Listener:
     """Something else on the TXT's port at ``host``: an HTTP server (Python's own, which waits for a
     request line), or a server that answers whatever comes with an HTTP error at once, as many do."""
 
-    def __init__(self, host: str, port: int, kind: str):
+    def __init__(self, host: str, port: int, kind: str) -> None:
         if kind == "http":
             self.server: socketserver.BaseServer = http.server.ThreadingHTTPServer((host, port),
                                                                                   http.server.BaseHTTPRequestHandler)

@@ -136,7 +136,7 @@ def pwm_of(line: dict) -> list[int]:
 class StopAt:
     """A sink that ends the run its own way at a given tick."""
 
-    def __init__(self, tick: int, how: str):
+    def __init__(self, tick: int, how: str) -> None:
         self.tick, self.how = tick, how
 
     def start(self, info: object) -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 
 class FakeTxt4:
-    def __init__(self, root: Path, key: str = "SECRET"):
+    def __init__(self, root: Path, key: str = "SECRET") -> None:
         self.root, self.key = root, key
         self.calls: list[tuple[str, str]] = []
         self.keys: list[str | None] = []

@@ -56,7 +56,7 @@ class FakeTxt:
     def __init__(self, script: Script = still, period_s: float = 0.01, device: str = "TXT-fake",
                  version: int = 0x04060600, fault: tuple[str, int] | None = None, late_s: float = 0.2,
                  i2c: bool = False, drift_s: float = 0.0, host: str = "127.0.0.1", port: int = 0,
-                 single_recv: bool = False, latency_s: float = 0.0):
+                 single_recv: bool = False, latency_s: float = 0.0) -> None:
         self.script, self.period_s, self.device, self.version = script, period_s, device, version
         self.latency_s = latency_s  # before every reply: a controller far away (a bad Wi-Fi)
         self.single_recv = single_recv

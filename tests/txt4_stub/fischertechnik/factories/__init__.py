@@ -111,7 +111,7 @@ class _Controller:
 
 
 class _Input:
-    def __init__(self, controller: _Controller, terminal: int):
+    def __init__(self, controller: _Controller, terminal: int) -> None:
         self.terminal = terminal
         if _state["first"] is None:
             _state["first"] = self
@@ -167,7 +167,7 @@ class _InputFactory:
 
 
 class _Motor:
-    def __init__(self, controller: _Controller, terminal: int, encoder: bool):
+    def __init__(self, controller: _Controller, terminal: int, encoder: bool) -> None:
         self.terminal, self.name = terminal, f"M{terminal}"
         controller._motor[terminal - 1] = self
         _log(self.name, "create_encodermotor" if encoder else "create_motor")
@@ -197,7 +197,7 @@ class _MotorFactory:
 
 
 class _Led:
-    def __init__(self, controller: _Controller, terminal: int):
+    def __init__(self, controller: _Controller, terminal: int) -> None:
         self.name = f"O{terminal}"
         controller._output[terminal - 1] = self
 
@@ -219,7 +219,7 @@ class _OutputFactory:
 
 
 class _Counter:
-    def __init__(self, controller: _Controller, terminal: int):
+    def __init__(self, controller: _Controller, terminal: int) -> None:
         self.terminal, self.name = terminal, f"C{terminal}"
         controller._counter[terminal - 1] = self
 
