@@ -13,9 +13,14 @@ demo: setup
 	.venv/bin/tablebot sim examples/bumberbot --out out/demo
 
 # pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
-# once first), then the wall-clock ones (marked realtime there) alone.
+# once first), then the wall-clock ones (marked realtime there) alone. mypy checks the type hints beside the
+# first pass (its 40 s from an empty cache would otherwise come on top), its report printed after it.
 test: setup
-	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15
+	@log=$$(mktemp); .venv/bin/mypy >"$$log" 2>&1 & mypy=$$!; \
+	echo '.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15  (and .venv/bin/mypy)'; \
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15; tests=$$?; \
+	wait $$mypy; types=$$?; echo ".venv/bin/mypy"; cat "$$log"; rm -f "$$log"; \
+	[ $$tests -eq 0 ] && [ $$types -eq 0 ]
 	.venv/bin/python -m pytest -n 0 -m realtime --durations=5
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .

@@ -85,6 +85,16 @@ def test_the_vector_env_lets_the_table_drive_every_robot() -> None:
             break
 
 
+def test_the_vector_env_takes_a_seed_per_robot() -> None:
+    """reset(seed=[...]) as documented: robot k gets seed[k] (gymnasium seeds its own generator from an int
+    only; the list once failed there)."""
+    vector = TableBotVectorEnv(num_envs=3, seconds=2.0)
+    obs, info = vector.reset(seed=[7, 3, 11])
+    assert info["seed"].tolist() == [7, 3, 11]
+    np.testing.assert_array_equal(obs, np.array([TableBotEnv(seconds=2.0).reset(seed=s)[0] for s in (7, 3, 11)]))
+    np.testing.assert_array_equal(vector.reset(seed=[20, 21, 22])[0], vector.reset(seed=20)[0])
+
+
 @pytest.mark.parametrize(("example", "declared"), [("obstacle-avoider", ("I1_cm", "I2_cm")),
                                                     ("line-follower", ("I1_line", "I2_line"))])
 def test_the_observation_carries_each_declared_sensor_as_its_trace_writes_it(example: str,

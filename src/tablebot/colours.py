@@ -20,11 +20,11 @@ def _wish(state: StateId) -> int:
     its text that is the same on every machine and every run (not Python's ``hash``)."""
     if isinstance(state, int):
         return (state - 1) % len(PALETTE)
-    return zlib.crc32(state.encode("utf-8")) % len(PALETTE)
+    return zlib.crc32(str(state).encode("utf-8")) % len(PALETTE)  # str(): a joint table's (k, state) too
 
 
 def _order(state: StateId) -> tuple[int, int, str]:
-    return (0, state, "") if isinstance(state, int) else (1, 0, state)
+    return (0, state, "") if isinstance(state, int) else (1, 0, str(state))
 
 
 def state_colours(states: Sequence[StateId]) -> list[str]:

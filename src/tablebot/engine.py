@@ -81,6 +81,14 @@ class Engine:
     else starting with ``_`` is the machine, precomputed for speed.
     """
 
+    # set by reset() and the property setters, all called from __init__
+    _tick: int
+    _deadline: int
+    _counters: list[int]
+    _zero_counters: int
+    _running: list[Any]  # per state, the lookup of _Lookups for a running timer
+    _at_zero: list[Any]  # and for a timer at 0
+
     def __init__(self, machine: Machine) -> None:
         self.machine = machine
         self._width = len(machine.table.events)
@@ -283,7 +291,8 @@ class Engine:
         self.outputs = tuple(outputs.tolist())
         self.counters = counters.tolist()
 
-    def _run_python(self, masks: Sequence[int], pulses: Sequence[Sequence[int]] | np.ndarray | None) -> Batch:
+    def _run_python(self, masks: Sequence[int] | np.ndarray,
+                    pulses: Sequence[Sequence[int]] | np.ndarray | None) -> Batch:
         """The batch loop without numba: ``step`` per tick, collecting the columns."""
         columns: tuple[list[int], ...] = ([], [], [], [])
         step = self.step

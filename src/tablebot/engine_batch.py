@@ -6,16 +6,21 @@ imports numba, so the engine imports it only when a batch runs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
+from tablebot.tick import EVENT, ROW, STATE, TIMER, tick
+
+njit: Callable[..., Any] | None
 try:
     from tablebot.jit import njit
 except ImportError:  # pragma: no cover - numba is a dependency, but the engine works without it
     njit = None
 
-from tablebot.tick import EVENT, ROW, STATE, TIMER, tick
-
-tick_compiled = njit(inline="always")(tick) if njit else None
+# a numba dispatcher; None without numba, and then nothing calls it (`batch` is not defined either)
+tick_compiled: Any = njit(inline="always")(tick) if njit else None
 
 
 def available() -> bool:

@@ -78,7 +78,7 @@ def _import_numba() -> ModuleType:
         import numba
 
         return numba
-    sys.modules["scipy"] = None  # type: ignore[assignment]  (`import scipy` raises ImportError meanwhile)
+    sys.modules["scipy"] = None  # type: ignore[assignment]  # `import scipy` raises ImportError meanwhile
     try:
         import numba
     finally:

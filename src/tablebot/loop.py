@@ -19,10 +19,13 @@ from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from tablebot.engine import Engine
 from tablebot.interrupts import Terminated
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 @dataclass(frozen=True)
@@ -69,15 +72,15 @@ class TickBlock:
     """
 
     start: int  # the tick number of the first row
-    masks: Sequence[int]
-    pulses: Sequence[Sequence[int]]
-    events: Sequence[int]
-    rows: Sequence[int]  # -1: no row fired
-    states: Sequence[int]  # state indices (Machine.states)
-    timers: Sequence[int]
-    outputs: Sequence[Sequence[int]]
-    counters: Sequence[Sequence[int]]
-    extra: dict[str, Sequence[Any]] = field(default_factory=dict)
+    masks: Sequence[int] | np.ndarray
+    pulses: Sequence[Sequence[int]] | np.ndarray
+    events: Sequence[int] | np.ndarray
+    rows: Sequence[int] | np.ndarray  # -1: no row fired
+    states: Sequence[int] | np.ndarray  # state indices (Machine.states)
+    timers: Sequence[int] | np.ndarray
+    outputs: Sequence[Sequence[int]] | np.ndarray
+    counters: Sequence[Sequence[int]] | np.ndarray
+    extra: Mapping[str, Sequence[Any]] = field(default_factory=dict)  # a dict, or the simulator's LazyColumns
     raw: Any = None  # the robot's own per-tick record, if it keeps one (the simulator: its state rows)
 
     def __len__(self) -> int:

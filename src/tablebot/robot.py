@@ -16,7 +16,9 @@ from tablebot import durations
 from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
-StateId = int | str
+#: A state: a number or a name; evolve's joint tables (tablebot.evolve.evaluate.joint) tag each candidate's
+#: states with its index, ``(k, state)``.
+StateId = int | str | tuple[int, "StateId"]
 TOP_KEYS = ("name", "tick_ms", "initial_state", "initial_timer", "match")
 CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
 

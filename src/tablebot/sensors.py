@@ -16,7 +16,7 @@ import math
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from tablebot.tomlfile import Source, is_number
 
@@ -41,6 +41,12 @@ class Panel:
     position: int
 
 
+class Sections(Protocol):
+    """The simulator's parameters as a sensor kind reads them: ``params[section][key]`` (sim.params.Params)."""
+
+    def __getitem__(self, section: str) -> Mapping[str, Any]: ...
+
+
 @dataclass(frozen=True)
 class SensorKind:
     """One kind of sensor the simulator models, and everything that follows from it: the words that declare
@@ -63,7 +69,7 @@ class SensorKind:
     spread: tuple[str, str] | None = None  # the [sim] parameter of its drawn half angle (degrees)
     panel: Panel | None = None  # its reading panel in the timeline (None: the event panel shows it)
     modes: Mapping[str, float] = field(default_factory=dict)  # controller input mode -> scale from its units
-    high: Callable[[Mapping[str, Any], float], float] = lambda params, light: 1.0  # its observation's upper bound
+    high: Callable[[Sections, float], float] = lambda params, light: 1.0  # its observation's upper bound
     # (params: the simulator's parameters, light: the most light a sensor can get in the world)
 
 

@@ -9,10 +9,14 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import fail
 from tablebot.examples import example_path
 from tablebot.robot import NAME_RE, RESERVED_LOWER, RESERVED_NAMES
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 EXAMPLES = ("bumberbot", "line-follower", "obstacle-avoider")
 TEMPLATES = (*EXAMPLES, "empty")
@@ -142,11 +146,16 @@ def _rename_header(table: str, mapping: dict[str, str]) -> str:
     return _rename_words(head, mapping) + "\n" + rest
 
 
+def _labelled(label: str) -> Callable[[re.Match[str]], str]:
+    """The replacement of a ``NAME = "..."`` line's label by ``label`` (taken as it is: no escapes)."""
+    return lambda m: f'{m[1]}"{label}"'
+
+
 def _relabel(robot_toml: str, labels: dict[str, str]) -> str:
     """``NAME = "label"`` lines of [inputs] and [motors] get the labels given."""
     for name, label in labels.items():
-        robot_toml = re.sub(rf'(?m)^(\s*{re.escape(name)}\s*=\s*)"[^"\n]*"', lambda m, lab=label: f'{m[1]}"{lab}"',
-                            robot_toml, count=1)
+        robot_toml = re.sub(rf'(?m)^(\s*{re.escape(name)}\s*=\s*)"[^"\n]*"', _labelled(label), robot_toml,
+                            count=1)
     return robot_toml
 
 

@@ -89,13 +89,14 @@ def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:
     if any(m is None for m in motors):
         return " ".join(f"{n} {'=' if m is None else f'{m:+d}'}" for n, m in zip(table.robot.motors, motors,
                                                                                   strict=True)), "turn"
-    if all(m == 0 for m in motors):
+    speeds = tuple(m for m in motors if m is not None)  # all of them: none is None past the test above
+    if all(m == 0 for m in speeds):
         return "stop", "stop"
     sides = _sides(table)
-    if len(motors) != 2 or sides is None:
-        text = " ".join(f"{n} {m:+d}" for n, m in zip(table.robot.motors, motors, strict=True))
-        return text, "forward" if all(m > 0 for m in motors) else "reverse" if all(m < 0 for m in motors) else "turn"
-    left, right = motors[sides[0]], motors[sides[1]]  # type: ignore[index]
+    if len(speeds) != 2 or sides is None:
+        text = " ".join(f"{n} {m:+d}" for n, m in zip(table.robot.motors, speeds, strict=True))
+        return text, "forward" if all(m > 0 for m in speeds) else "reverse" if all(m < 0 for m in speeds) else "turn"
+    left, right = speeds[sides[0]], speeds[sides[1]]
     if left == right:
         return (f"forward {left}", "forward") if left > 0 else (f"reverse {-left}", "reverse")
     # The heading turns toward the slower side going forward (signed: right > left turns left).

@@ -203,6 +203,7 @@ def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET)
             return Result(prop, "violated" if reachable else "holds", explored)
         return _confirmed(prop, machine, exact, path, explored, reachable, exact=True)
     except ModelTooLarge:
+        assert path is not None  # search raised before replacing the path found above, or found one (None returned)
         return _confirmed(prop, machine, model, path, explored, reachable, exact=False)
 
 

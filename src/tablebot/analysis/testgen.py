@@ -102,7 +102,7 @@ def _nearest(model: Model, start: Node, wanted: set[int]) -> list[tuple[Node, Ti
 
 
 def _reasons(machine: Machine, graph: Graph, golden: GoldenSet) -> dict[int, str]:
-    by_line = {}
+    by_line: dict[int, str] = {}
     for finding in find_all(machine, graph):
         if finding.code in REASON_CODES:
             for line in finding.lines[:1] if finding.code == "shadowed-row" else finding.lines:

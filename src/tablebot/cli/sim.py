@@ -7,7 +7,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -16,6 +16,7 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
+    from tablebot.loop import Sink
     from tablebot.sim.painter import Painter
     from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
@@ -111,6 +112,7 @@ def _sim(run: _Run, painter: Painter | None) -> None:
             summary = summarise(result)
             written = [p for p in (trace.written,) if p] + _pictures(result, summary, out, painter, run.gif)
             if run.html:
+                assert trace.written is not None  # the trace of a complete run is committed by its end
                 written.append(_replay_page(result, trace.written, out / "run.html"))
     if not result.end.complete:
         _stopped(result, trace.written)
@@ -131,7 +133,8 @@ class _Imports:
     def __init__(self, modules: list[Callable[[], None]]) -> None:
         import threading
 
-        self.modules, self.failed = modules, None
+        self.modules = modules
+        self.failed: BaseException | None = None
         self.thread = threading.Thread(target=self._run, name="picture imports", daemon=True)
         self.thread.start()
 
@@ -211,8 +214,8 @@ def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace:
 
     from tablebot.sim.runner import simulate
 
-    sinks = [trace] if painter is None else [trace, painter.sink]
-    kept = {"history": np.float32, "rows": rows} | ({} if painter is None else {"zeros": painter.zeros})
+    sinks: list[Sink] = [trace] if painter is None else [trace, painter.sink]
+    kept: dict[str, Any] = {"history": np.float32, "rows": rows} | ({} if painter is None else {"zeros": painter.zeros})
     if ticks is None or not sys.stderr.isatty():
         return simulate(scene, seconds, seed, sinks=sinks, **kept)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn

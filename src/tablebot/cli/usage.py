@@ -86,6 +86,7 @@ def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
         return Diagnostic(name, None, None, f"{shown} is not a number",
                           "give a whole number" if number is int else "give a number, such as 2 or 0.5")
     if number:
+        assert param is not None  # a number kind comes only from a parameter's type
         low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
         limits = f"from {low} to {high}" if low is not None and high is not None else \
             f"of at least {low}" if low is not None else f"of at most {high}"

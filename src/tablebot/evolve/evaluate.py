@@ -24,7 +24,7 @@ import numpy as np
 
 from tablebot.evolve.measures import MEASURES, STATE_SHARE
 from tablebot.fleet.work import Job
-from tablebot.table import Table
+from tablebot.table import Row, Table
 
 if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
@@ -60,7 +60,7 @@ def joint(tables: Sequence[Table]) -> Table:
     """The candidates' rows side by side as one table, candidate k's states renamed ``(k, state)`` (so no
     row of one can ever lead into another's); it starts in candidate 0's start state (:func:`starts`)."""
     robot = tables[0].robot
-    rows = []
+    rows: list[Row] = []
     for k, table in enumerate(tables):
         rows += [replace(row, index=len(rows) + i, state=(k, row.state), next=(k, row.next))
                  for i, row in enumerate(table.rows)]
@@ -70,7 +70,9 @@ def joint(tables: Sequence[Table]) -> Table:
 
 def starts(machine: Machine, parts: int) -> np.ndarray:
     """Per candidate of a joint machine, the index of its own start state."""
-    start = machine.table.robot.initial_state[1]  # type: ignore[index]
+    joint_start = machine.table.robot.initial_state
+    assert isinstance(joint_start, tuple)  # a joint table starts in (0, candidate 0's start state)
+    start = joint_start[1]
     return np.array([machine.state_index((k, start)) for k in range(parts)], dtype=np.int64)
 
 
@@ -245,7 +247,7 @@ class Evaluator:
                     mine = values.pop(part.key)
                     done(part.key, {name: float(np.sum(v) / total) for name, v in mine.items()}, mine)
 
-        self.runner.run(jobs, finished, run_eval)  # type: ignore[call-arg]
+        self.runner.run(jobs, finished, run_eval)
 
 
 def known(name: str) -> bool:

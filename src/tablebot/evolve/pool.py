@@ -16,7 +16,7 @@ import os
 import signal
 import sys
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -134,7 +134,7 @@ _END = object()
 
 
 def proved_ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None],
-                 window: Callable[[], int]) -> Iterator[Ahead]:
+                 window: Callable[[], int]) -> Generator[Ahead, None, None]:
     """The children in order, each with its machine, its canonical key and, unless the prover knows that
     key already, the answer of its proof, started in a worker up to ``window()`` children ahead of the one
     handed out (None children: a variation that gave nothing, handed out as they come)."""

@@ -182,12 +182,13 @@ class Evolution:
         seeds = [start_key]
         if not verdict.ok:
             began = time.perf_counter()
-            repairs = self.store.repairs()
-            if repairs is None:
+            stored = self.store.repairs()
+            if stored is None:
                 answers = [self.workers.submit(repaired, first, self.space, prefer) for prefer in PREFERENCES]
                 qd_module()  # pyribs' seconds of imports while the workers repair
-                repairs = [answer.get() for answer in answers]
-                self.store.keep_repairs(repairs)
+                stored = [answer.get() for answer in answers]
+                self.store.keep_repairs(stored)
+            repairs = stored
             self.counts.repair_s = time.perf_counter() - began
             self.on_repair(repairs)
             mended = [r for r in repairs if r.ok]

@@ -11,7 +11,7 @@ import threading
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tablebot.diagnostics import fail
 from tablebot.fleet.work import (
@@ -26,10 +26,8 @@ from tablebot.fleet.work import (
     warm_worker,
 )
 
-if TYPE_CHECKING:
-    from tablebot.fleet.run import FleetSummary
-
-Done = Callable[[Job, "FleetSummary"], None]
+#: Called with each job and what the run's ``fn`` gave for it (by default run_job's FleetSummary).
+Done = Callable[[Job, Any], None]
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 INSTALL_HINT = "install the cluster extra: pip install 'tablebot[cluster]' (Dask's distributed scheduler)"
 
@@ -216,7 +214,8 @@ class Runner:
         try:
             for future in as_completed(list(sent), loop=client.loop):
                 job, result = future.result()
-                done(sent[future].fill(job) if sent[future] is not None else job, result)
+                common = sent[future]
+                done(common.fill(job) if common is not None else job, result)
         except BaseException:
             client.cancel(list(sent))
             raise

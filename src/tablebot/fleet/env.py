@@ -71,7 +71,8 @@ class TableBotEnv(gym.Env):
     """One simulated robot (a :class:`~tablebot.sim.simrobot.SimRobot`): ``reset(seed=s)`` then ``step(None)``
     ticks give exactly the run of ``tablebot sim --seed s``."""
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    # gymnasium declares metadata as an instance variable, but it is (and is documented as) a class attribute
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}  # type: ignore[misc]
 
     def __init__(self, table: str | Path | None = None, world: str | Path | None = None, seconds: float = 60.0,
                  battery: float | None = None, robot: str | Path | None = None, render_mode: str | None = None) -> None:
@@ -118,7 +119,9 @@ class TableBotVectorEnv(VectorEnv):
     sub-environment that terminated or truncated is reset by the following ``step``, which returns its
     first observation with reward 0)."""
 
-    metadata: ClassVar[dict[str, Any]] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    # gymnasium declares metadata as an instance variable, but it is (and is documented as) a class attribute
+    metadata: ClassVar[dict[str, Any]] = {  # type: ignore[misc]
+        "autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(self, num_envs: int = 8, table: str | Path | None = None, world: str | Path | None = None,
                  seconds: float = 60.0, battery: float | None = None, robot: str | Path | None = None,
@@ -143,7 +146,7 @@ class TableBotVectorEnv(VectorEnv):
         generator its later autoresets draw robot seeds from, as TableBotEnv.reset(seed=...) does."""
         from gymnasium.utils import seeding
 
-        super().reset(seed=seed)
+        super().reset(seed=seed if isinstance(seed, int) else None)  # gymnasium seeds np_random from an int only
         if seed is None:
             seeds = [int(v) for v in self.np_random.integers(2**31, size=self.num_envs)]
         elif isinstance(seed, int):

@@ -13,10 +13,14 @@ tests/test_fleet_generators.py on many seeds); should it ever differ, every Gene
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.random import PCG64, Generator, SeedSequence
 from numpy.random.bit_generator import ISeedSequence
+
+if TYPE_CHECKING:
+    from numpy.typing import DTypeLike
 
 POOL = 4  # SeedSequence's default pool_size (words of entropy kept)
 INIT_A, MULT_A = 0x43B0D7E5, 0x931E8875  # mixing the seed into the pool
@@ -35,7 +39,7 @@ class _Words(ISeedSequence):
     def __init__(self, words: np.ndarray) -> None:
         self.words = words
 
-    def generate_state(self, n_words: int, dtype: type = np.uint32) -> np.ndarray:
+    def generate_state(self, n_words: int, dtype: DTypeLike = np.uint32) -> np.ndarray:
         assert n_words == PCG64_WORDS and np.dtype(dtype) == np.uint64, "made for PCG64's seeding only"
         return self.words
 
@@ -107,4 +111,5 @@ def generators(seeds: Sequence[int]) -> list[Generator]:
     if not len(seeds) or not matches_numpy() or min(seeds) < 0 or max(seeds) >= 2**128:
         return [np.random.default_rng(seed) for seed in seeds]
     words = state_words(pool_words(np.asarray(seeds, dtype=object)))
-    return [Generator(PCG64(_Words(row))) for row in words]
+    # numpy's stub lists SeedSequence only, but PCG64 takes any ISeedSequence
+    return [Generator(PCG64(_Words(row))) for row in words]  # type: ignore[arg-type]

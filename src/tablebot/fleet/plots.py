@@ -39,7 +39,7 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     for k, (key, values) in enumerate(panels):
         left, right = fig.add_subplot(len(panels), 2, 2 * k + 1), fig.add_subplot(len(panels), 2, 2 * k + 2)
         labels = [picture(label) for label, _ in values]
-        rates = [np.mean([int(r["reached"]) for r in chosen]) if chosen else 0.0 for _, chosen in values]
+        rates = [float(np.mean([int(r["reached"]) for r in chosen])) if chosen else 0.0 for _, chosen in values]
         bars = left.bar(labels, [100 * r for r in rates], color=REACHED)
         left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_, c) in zip(rates, values, strict=True)],
                        fontsize=8)
@@ -49,9 +49,9 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
         times = [[t for r in chosen if (t := number(r["first_light_s"])) is not None] for _, chosen in values]
         never = [sum(number(r["first_light_s"]) is None for r in chosen) for _, chosen in values]
         right.boxplot([t or [math.nan] for t in times], tick_labels=labels, showfliers=True)
-        for i, t in enumerate(times):
-            jitter = np.random.default_rng(i).uniform(-0.15, 0.15, len(t))  # fixed: the picture is reproducible
-            right.scatter(np.full(len(t), i + 1.0) + jitter, t, s=6, alpha=0.35, color="#f0a500", zorder=3)
+        for i, ts in enumerate(times):
+            jitter = np.random.default_rng(i).uniform(-0.15, 0.15, len(ts))  # fixed: the picture is reproducible
+            right.scatter(np.full(len(ts), i + 1.0) + jitter, ts, s=6, alpha=0.35, color="#f0a500", zorder=3)
             right.text(i + 1, seconds * 1.02, f"never: {never[i]}", ha="center", fontsize=8, color="#636e72")
         right.set_ylim(0, seconds * 1.1)
         right.set_ylabel("time to first light (s)")

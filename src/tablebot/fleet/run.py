@@ -350,7 +350,8 @@ def with_start(scene: Scene, start: Pose | None) -> Scene:
     is, and free of walls and obstacles)."""
     if start is None:
         return scene
-    world = replace(scene.world, start=tuple(float(v) for v in start))
+    sx, sy, sh = start
+    world = replace(scene.world, start=(float(sx), float(sy), float(sh)))
     x, y, heading = world.start
     if world.walls and not inside(world.walls, (x, y)):
         raise fail(world.path, f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the "

@@ -227,7 +227,7 @@ def chunk_size(total: int) -> int:
     return max(8, min(512, -(-total // 32)))
 
 
-def random_start(seed: int, walls: Sequence[tuple[float, float]], free: Any) -> Pose:
+def random_start(seed: int, walls: tuple[tuple[float, float], ...], free: Any) -> Pose:
     """A start pose drawn for ``seed`` (the same for every grid value: common random numbers): uniform
     inside the walls with any heading, redrawn until ``free(pose)`` says the body touches nothing."""
     rng = np.random.default_rng([seed, START_STREAM])

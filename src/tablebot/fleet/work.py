@@ -162,7 +162,8 @@ def use_threads(job: Job) -> None:
     if threads is not None:
         import numba
 
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+        # numba.config sets its settings at import time, unseen by mypy
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))  # type: ignore[attr-defined]
 
 
 def warm(job: Job, both: bool = False) -> float:
@@ -208,14 +209,16 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
 
         folder = os.path.join(jit.cache_dir(), f"worker-{slot}")
         os.environ[jit.ENV] = folder
-        numba.config.CACHE_DIR = folder  # read when each compiled function is defined (on import, below)
+        # read when each compiled function is defined (on import, below); set at run time, unseen by mypy
+        numba.config.CACHE_DIR = folder  # type: ignore[attr-defined]
     import numba
 
     import tablebot.fleet.run  # noqa: F401  (the fleet and every compiled module it calls: their cache folder is set)
 
     installed = jit.install_cache_files(files) if files else 0  # read by each function at its first load
     loaded = preload(*chunk_functions(_worker_threads)) if load else 0
-    return {"host": socket.gethostname(), "pid": os.getpid(), "cache": numba.config.CACHE_DIR,
+    return {"host": socket.gethostname(), "pid": os.getpid(),
+            "cache": numba.config.CACHE_DIR,  # type: ignore[attr-defined]  # a run-time numba setting
             "threads": _worker_threads, "installed": installed, "loaded": loaded,
             "ready_s": time.perf_counter() - started}
 

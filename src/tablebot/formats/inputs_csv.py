@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 from tablebot.csvtext import Cell, cells_beyond, headerless, read_text, split_records
 from tablebot.diagnostics import Collector, fail
@@ -25,9 +25,12 @@ class Events(Protocol):
     """What reading inputs needs of a compiled machine (:class:`tablebot.machine.Machine` is one): the bit
     of each input in the event mask, and the table with its robot."""
 
-    input_bits: dict[str, int]
-    input_mask: int
-    table: Table
+    @property
+    def input_bits(self) -> Mapping[str, int]: ...
+    @property
+    def input_mask(self) -> int: ...
+    @property
+    def table(self) -> Table: ...
 
 
 @dataclass(frozen=True)
@@ -136,7 +139,7 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
     keys = ("event", *(pulses_key(c) for c in machine.table.robot.counter_names))
     ticks: list[TickInput] = []
     for number, data in trace_records(text, out):
-        values = [data.get(key) for key in keys]
+        values: list[Any] = [data.get(key) for key in keys]  # JSON values, checked just below
         bad = [key for key, v in zip(keys, values, strict=True)
                if isinstance(v, bool) or not isinstance(v, int) or v < 0]
         if bad:

@@ -14,7 +14,7 @@ from tablebot.table import DOC_KEEP_SPEED, Row, Table, to_direction_speed
 
 def signed_motors(table: Table) -> frozenset[str]:
     """Motors that need the signed form: some row sets them to speed 7 (or -7)."""
-    speeds = [{abs(row.motors[i]) for row in table.rows if row.motors[i] is not None}
+    speeds = [{abs(speed) for row in table.rows if (speed := row.motors[i]) is not None}
               for i in range(len(table.robot.motors))]
     return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
 

@@ -361,7 +361,7 @@ class _Reader:
 
     def _analog(self, name: str, mode: str, value: dict[str, Any]) -> tuple[bool, int | None, int | None, int] | None:
         analog, key = self.spec.analog[mode], self.spec.section
-        limits = {k: value[k] for k in ("below", "above") if k in value}
+        limits: dict[str, Any] = {k: value[k] for k in ("below", "above") if k in value}
         declared = next((s for s in self.robot.sensors if s.name == name), None)
         if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)

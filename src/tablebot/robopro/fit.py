@@ -80,7 +80,7 @@ class Plan:
     @cached_property
     def loads(self) -> dict[str, tuple[int, ...]]:
         names = self.table.robot.counter_names
-        return {name: tuple(-1 if row.counters[i] is None else row.counters[i] for row in self.table.rows)
+        return {name: tuple(-1 if (load := row.counters[i]) is None else load for row in self.table.rows)
                 for i, name in enumerate(names)}
 
     @property

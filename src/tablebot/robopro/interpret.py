@@ -33,7 +33,7 @@ only as a table of contents, "RoboPro-En", sections 5.4 Timers, 5.6 Lists, 5.7 O
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
 
 MIN, MAX = -32768, 32767
@@ -118,9 +118,9 @@ def _pins(function: ET.Element) -> Pins:
             parent[find(pid)] = find(wire.get("id") or str(id(wire)))
     for wpid, wpin in wire_pins.items():  # dynamic pins tie the joining wire's net to the host's
         if wpin.get("name") == "dynamic" and wire_of[wpid].get("classname") == "ftProDataWire":
-            other = wire_of.get(wpin.get("resolveid", ""))
-            if other is not None:
-                parent[find(wire_of[wpid].get("id") or "")] = find(other.get("id") or "")
+            host = wire_of.get(wpin.get("resolveid", ""))
+            if host is not None:
+                parent[find(wire_of[wpid].get("id") or "")] = find(host.get("id") or "")
     for pid, pin in found.pin.items():
         if pin.get("pinclass", "").startswith("data"):
             root = find(pid)
@@ -184,7 +184,7 @@ class Run:
         yield from self._run(name, start)
         raise InterpreterError("the main program ended")
 
-    def _run(self, sub: str, element: ET.Element) -> Iterator[None]:
+    def _run(self, sub: str, element: ET.Element) -> Generator[None, None, str | None]:
         """Run ``sub`` from ``element`` until a FlowOut (whose uniqueID is the generator's value)."""
         pins = self.program.pins[sub]
         while True:
@@ -217,7 +217,7 @@ class Run:
                 found["#" + p.get("pinid", "")] = p.get("id", "")
         return found
 
-    def _do(self, sub: str, element: ET.Element) -> Iterator[None]:
+    def _do(self, sub: str, element: ET.Element) -> Generator[None, None, str]:
         kind = element.get("classname")
         outs = self._outputs(element)
         if kind in ("ftProProcessStart", "ftProSubroutineFlowIn"):
@@ -244,7 +244,7 @@ class Run:
             return (yield from self._call(sub, element, outs))
         raise InterpreterError(f"{sub}: element {kind} is not one this interpreter runs")
 
-    def _call(self, sub: str, ref: ET.Element, outs: dict[str, str]) -> Iterator[None]:
+    def _call(self, sub: str, ref: ET.Element, outs: dict[str, str]) -> Generator[None, None, str]:
         name = ref.get("name", "")
         entered = self._entered
         target = self.program.functions.get(name)
@@ -333,7 +333,7 @@ class Run:
         return compute
 
     def _list(self, element: ET.Element) -> list[int]:
-        name = element.get("globalname") or element.get("name", "")
+        name = element.get("globalname") or element.get("name") or ""
         if name not in self.lists:
             self.lists[name] = [int(i.get("value", "0")) for i in element.findall("init")]
         return self.lists[name]

@@ -51,7 +51,7 @@ class Lists:
 
 def number_states(table: Table) -> dict[StateId, int]:
     """Integer states keep their number; each named state gets the lowest free number from 1."""
-    numbers = {s: s for s in table.states if isinstance(s, int)}
+    numbers: dict[StateId, int] = {s: s for s in table.states if isinstance(s, int)}
     free = (n for n in range(1, 1 << 16) if n not in numbers.values())
     for state in table.states:
         if not isinstance(state, int):
@@ -139,7 +139,8 @@ def encode(table: Table) -> Lists:
         raise TableBotError(problems)
     numbers = number_states(table)
     values = [encode_row(table, row, numbers) for row in table.rows]
-    return Lists(*(tuple(column) for column in zip(*values, strict=True)), numbers=numbers)  # type: ignore[arg-type]
+    event, action, timer = (tuple(column) for column in zip(*values, strict=True))
+    return Lists(event, action, timer, numbers=numbers)
 
 
 def write_lists(lists: Lists, outdir: Path) -> list[Path]:
@@ -260,8 +261,9 @@ def read_table(directory: Path, robot: Robot) -> Table:
             problems.append(Diagnostic(str(directory / LIST_FILES[1]), row.line, 1, message, hint))
         else:
             line = robot.line(*where)
-            where = (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None)
-            problems.append(Diagnostic(*where, message, "the lists may be for another robot: pass its --robot"))
+            at: tuple[str, int | None, int | None] = (
+                (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None))
+            problems.append(Diagnostic(*at, message, "the lists may be for another robot: pass its --robot"))
     if problems:
         raise TableBotError(problems)
     return table

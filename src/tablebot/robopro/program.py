@@ -14,6 +14,7 @@ table's own rule, the robot file's ``match``.
 from __future__ import annotations
 
 import re
+from functools import partial
 from typing import Literal
 
 from tablebot.robopro import elements as el
@@ -93,6 +94,7 @@ def detect_event(b: Builder) -> Sub:
     b.assign(s, "EV", "=", 0)
     for name in p.events:
         bit = p.bits[name]
+        test: Tree
         if name == "T":
             test, add_when_yes = Var("TM"), False
         elif name in p.wiring.counters:
@@ -100,7 +102,7 @@ def detect_event(b: Builder) -> Sub:
         else:
             terminal, active = p.wiring.inputs[name]
             test, add_when_yes = Input(terminal), bool(active)
-        branch = s.step(lambda x, y, yes=add_when_yes: el.branch(x, y, yes_down=not yes), data=test)
+        branch = s.step(partial(el.branch, yes_down=not add_when_yes), data=test)
         b.side_send(s, branch.pins[3], "EV", "+", bit)
         b.note(s, branch, p.event_note(name))
     s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))

@@ -190,7 +190,7 @@ class Sheet:
         self.joins = []
 
     def side(self, exit_pin: Pin, makers: list[Callable[[int, int], Element]],
-             data: list[Tree | None] | None = None, extra: Callable[[Element], None] | None = None,
+             data: list[Tree | None] | None = None, extra: Callable[[Element], object] | None = None,
              rejoin: bool = True, hold: bool = False) -> tuple[list[Element], Wire | None]:
         """A side column right of the column, entered from ``exit_pin``: the elements ``makers`` make, in a
         chain; its last exit rejoins the column below (or, with no elements, the exit itself does)."""

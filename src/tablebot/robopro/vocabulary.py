@@ -78,7 +78,7 @@ def _element_problems(element: ET.Element, parent: ET.Element | None, where: str
         if rule is None or not _fits(rule, value, SERIES.get((kind, name), ())):
             problems.append(f"{where}: {kind} {name}={value!r} is not a value real programs use")
     holder = elements.get(key(parent)) if parent is not None else None
-    if holder is not None and kind not in holder["children"]:
+    if parent is not None and holder is not None and kind not in holder["children"]:
         problems.append(f"{where}: {kind} inside {key(parent)}: no real program nests them so")
     pins = [pin_signature(kind, c) for c in element if c.get("classname") == "ftProObjectPin"]
     allowed = known.get("pins")

@@ -119,8 +119,10 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
     ``problems`` (mistakes in the section itself go through ``reader``)."""
     inputs, motors, counters, problems = {}, {}, {}, []
     reader = reader or _Reader(None, robot)
+    extras: dict[str, dict[str, tuple[Any, ...]]] = {
+        "input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}}
     for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names)):
-        extra = {"input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}}[kind]
+        extra = extras[kind]
         for name in names:
             if name in section:
                 got = reader.entry(name, section[name], kind, extra)

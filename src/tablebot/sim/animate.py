@@ -6,7 +6,9 @@ a sensor reads 1) and lamps (lit when the table switches them on), its trail col
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 from matplotlib.animation import FuncAnimation
@@ -42,6 +44,7 @@ class Player:
         fig.text(0.08, 0.93, subtitle_of(summary), fontsize=8, color="#444")
         # the trail at frame resolution: one segment per frame keeps redrawing it cheap
         ticks = np.minimum(np.arange(0, result.ticks + ticks_per_frame, ticks_per_frame), result.ticks)
+        assert result.hist is not None  # an animated run keeps every robot row (sim's rows=True)
         points = result.hist[ticks][:, [L.X, L.Y]]
         self.segments = np.stack((points[:-1], points[1:]), axis=1)
         colours = to_rgba_array(state_colours(scene.machine.states))
@@ -57,8 +60,10 @@ class Player:
     def draw(self, frame: int) -> list:
         r, scene = self.result, self.result.scene
         t = min(frame * self.step, r.ticks)
-        self.trail.set_segments(self.segments[:frame])
+        # matplotlib's stubs want a sequence of (n, 2) arrays; an (n, 2, 2) array is one
+        self.trail.set_segments(cast("Sequence[np.ndarray]", self.segments[:frame]))
         self.trail.set_color(self.colours[:frame])
+        assert r.hist is not None  # checked when made
         h = r.hist[t]
         last = r.outputs[t - 1] if t > 0 else np.zeros(len(scene.machine.output_names), dtype=np.int64)
         self.robot.update(h[L.X], h[L.Y], h[L.TH],

@@ -332,7 +332,7 @@ def near_plate(s: np.ndarray, c: float, sn: float, gap: float, x0: float, y0: fl
 
 @njit(cache=True, refcounts=False, inline="always")
 def broad_phase(s: np.ndarray, reach: float, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                circles: np.ndarray, near: np.ndarray) -> tuple[int, int]:
+                circles: np.ndarray, near: np.ndarray) -> tuple[np.int64, np.int64]:
     """Bits of the pieces and of the circles of candidate list ``near`` that may lie within ``reach`` of the
     robot's centre (exact: what it rules out is farther); pieces and circles from the 63rd on share bit 62
     and are kept. The same bits as a scan of every piece, since the list leaves out only far ones."""

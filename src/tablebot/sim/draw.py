@@ -263,15 +263,15 @@ class RobotArtist:
             cone.set_theta2(aim + self.fov)
             cone.set_alpha((0.45 if seen else 0.15) * self.alpha)
         levels = tuple(lamps) + (0,) * (self.n_lamps - len(lamps))
-        for patch, glow, pt, level in zip(self.lamps, self.glows, self.lamp_pts, levels, strict=True):
-            patch.center = glow.center = tuple(_transform(pt[None, :], x, y, theta)[0])
-            patch.set_facecolor(LAMP_ON if level else LAMP_OFF)
+        for lamp, glow, pt, level in zip(self.lamps, self.glows, self.lamp_pts, levels, strict=True):
+            lamp.center = glow.center = tuple(_transform(pt[None, :], x, y, theta)[0])
+            lamp.set_facecolor(LAMP_ON if level else LAMP_OFF)
             glow.set_alpha(0.25 + 0.4 * min(level, 8) / 8 if level else 0.0)  # brighter for higher levels
         nose = _transform(np.array([(0.0, 0.0), (self.body_pts[0, 0] * 0.8, 0.0)]), x, y, theta)
         self.heading.set_data(nose[:, 0], nose[:, 1])
         values = tuple(readings) + (0.0,) * (len(self.sensors) - len(readings))
-        for patch, sensor, value in zip(self.declared, self.sensors, values, strict=True):
-            self._update_sensor(patch, sensor, value, x, y, theta)
+        for spot, sensor, value in zip(self.declared, self.sensors, values, strict=True):
+            self._update_sensor(spot, sensor, value, x, y, theta)
 
     def _update_sensor(self, patch: Polygon | Wedge, sensor: Sensor, value: float, x: float, y: float,
                        theta: float) -> None:

@@ -167,7 +167,7 @@ def _pipe(opened: list[int]) -> tuple[int, int]:
 
 
 def _child(work: Callable[[Inbox], bytes], answers: int, questions: int, parent: int,
-           blocked: set[signal.Signals]) -> None:
+           blocked: set[int | signal.Signals]) -> None:
     """The copy: do the work, write the answer, end without any of the parent's clean-up."""
     code = 1
     try:
@@ -207,7 +207,8 @@ def _write_message(pipe: int, message: object) -> None:
     text = pickle.dumps(message, protocol=5, buffer_callback=buffers.append)
     raws = [buffer.raw() for buffer in buffers]  # large arrays: written from where they are, not copied first
     _write_all(pipe, _LENGTHS.pack(len(text), len(raws)) + struct.pack(f"<{len(raws)}Q", *map(len, raws)))
-    for piece in (text, *raws):
+    pieces: tuple[bytes | memoryview, ...] = (text, *raws)
+    for piece in pieces:
         _write_all(pipe, piece)
 
 

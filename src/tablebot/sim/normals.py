@@ -192,17 +192,21 @@ def _pcg64_next64(typingctx: TypingContext, address: types.Type) -> tuple[Signat
 @njit(nogil=True, refcounts=False, inline="always")
 def _next64(handle: np.uint64) -> np.uint64:
     """The bit generator's next_uint64 (see :func:`bitgen_address` for ``handle``)."""
+    # the ignores here and below: numba's stubs type an @intrinsic's call as its typing function's (typingctx first)
     if handle & np.uint64(INLINE):
-        return _pcg64_next64(handle - np.uint64(INLINE))
-    return _next_uint64(_word(handle + np.uint64(_NEXT_UINT64 * WORD)), _word(handle))
+        return _pcg64_next64(handle - np.uint64(INLINE))  # type: ignore[call-arg,arg-type]
+    return _next_uint64(_word(handle + np.uint64(_NEXT_UINT64 * WORD)),  # type: ignore[call-arg,arg-type]
+                        _word(handle))  # type: ignore[call-arg,arg-type]
 
 
 @njit(nogil=True, refcounts=False, inline="always")
 def _next_uniform(handle: np.uint64) -> float:
     """The bit generator's next_double: for PCG64 numpy's ``uint64_to_double`` of next_uint64 (_common.pxd)."""
     if handle & np.uint64(INLINE):
-        return float(_pcg64_next64(handle - np.uint64(INLINE)) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-    return _next_double(_word(handle + np.uint64(_NEXT_DOUBLE * WORD)), _word(handle))
+        return float(_pcg64_next64(handle - np.uint64(INLINE))  # type: ignore[call-arg,arg-type]  # as above
+                     >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+    return _next_double(_word(handle + np.uint64(_NEXT_DOUBLE * WORD)),  # type: ignore[call-arg,arg-type]
+                        _word(handle))  # type: ignore[call-arg,arg-type]
 
 
 @njit(nogil=True, refcounts=False, inline="always")

@@ -8,7 +8,7 @@ import io
 import struct
 import zlib
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any, cast
 
 import matplotlib
 import matplotlib.image
@@ -20,6 +20,8 @@ from tablebot.files import atomic_write
 from tablebot.sensors import SENSOR_KINDS, SensorKind
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
     from tablebot.sim.runner import SimRun
     from tablebot.sim.scene import Scene
     from tablebot.sim.summary import Summary
@@ -78,7 +80,8 @@ def png_bytes(fig: Figure) -> bytes:
 def encoded(fig: Figure) -> bytes:
     """The figure's canvas, as drawn so far, as PNG: the pixels :func:`png_bytes` gives when the canvas holds
     what a whole draw would, in half the time (see :func:`png_of`)."""
-    return png_of(np.asarray(fig.canvas.buffer_rgba()), fig.dpi)
+    canvas = cast("FigureCanvasAgg", fig.canvas)  # the pictures' figures are made on an Agg canvas
+    return png_of(np.asarray(canvas.buffer_rgba()), fig.dpi)
 
 
 def drawn_png(fig: Figure) -> bytes:
@@ -113,8 +116,10 @@ def deflated(rows: np.ndarray, above: np.ndarray | None, last: bool) -> tuple[by
         np.subtract(flat[0], above.reshape(-1), out=filtered[0, 1:])
     np.subtract(flat[1:], flat[:-1], out=filtered[1:, 1:])  # modulo 256, as PNG's filters are
     packer = zlib.compressobj(PNG_LEVEL, zlib.DEFLATED, -15)  # raw deflate: the zlib frame is made once
-    data = packer.compress(filtered) + packer.flush(zlib.Z_FINISH if last else zlib.Z_FULL_FLUSH)
-    return data, zlib.adler32(filtered), filtered.size
+    # the ignores: numpy's stubs give ndarray a __buffer__ only for Python 3.12 on (mypy checks as 3.11)
+    data = packer.compress(filtered) + packer.flush(  # type: ignore[arg-type]
+        zlib.Z_FINISH if last else zlib.Z_FULL_FLUSH)
+    return data, zlib.adler32(filtered), filtered.size  # type: ignore[arg-type]
 
 
 def png_of_parts(parts: list[tuple[bytes, int, int]], width: int, height: int, dpi: float) -> bytes:

@@ -7,7 +7,7 @@ Figures are drawn with the Agg canvas directly, never through pyplot, so they ne
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -114,7 +114,7 @@ class TrajectoryPicture:
         assert self.drawn is not None, "the path is drawn as it grows only over the arena (render_arena)"
         pieces = self._add_path(*self.path.grow(x, y, states, done))
         if pieces is not None:
-            pieces.draw(self.fig.canvas.get_renderer())
+            pieces.draw(cast(FigureCanvasAgg, self.fig.canvas).get_renderer())  # made on an Agg canvas
             self.drawn.append(pieces)
 
     def _add_path(self, pieces: list[np.ndarray], piece_states: list[int]) -> LineCollection | None:
@@ -122,7 +122,8 @@ class TrajectoryPicture:
             return None
         lines = LineCollection(pieces, colors=[self.colours[s] for s in piece_states], linewidths=2.2,
                                capstyle="round", joinstyle="round", zorder=PATH_Z)
-        return self.ax.add_collection(lines, autolim=False)  # the arena set the limits
+        self.ax.add_collection(lines, autolim=False)  # the arena set the limits
+        return lines
 
     def finish(self, result: RunView, summary: Summary) -> TrajectoryPicture:
         """Add the rest of the run: the path's last pieces, spins, collisions, first light, lamp reached,
@@ -143,7 +144,7 @@ class TrajectoryPicture:
     def png(self) -> bytes:
         """The picture as PNG: the bytes :func:`png_bytes` gives for the whole figure."""
         assert self.drawn is not None, "the rest is drawn over the arena (render_arena)"
-        renderer = self.fig.canvas.get_renderer()
+        renderer = cast(FigureCanvasAgg, self.fig.canvas).get_renderer()  # made on an Agg canvas
         # what Axes.draw and Figure.draw would draw after what is drawn, in their order (by z-order, stably)
         rest = sorted((a for a in self.ax.get_children() if a not in self.drawn), key=lambda a: a.get_zorder())
         assert not rest or min(a.get_zorder() for a in rest) >= max(a.get_zorder() for a in self.drawn)
@@ -269,7 +270,7 @@ def _legend(fig: Figure, result: RunView, summary: Summary, spins: bool) -> None
                for state, secs in summary.state_seconds.items() if secs > 0]
     states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
                                bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
-    states_legend._legend_box.align = "left"
+    states_legend._legend_box.align = "left"  # type: ignore[attr-defined]  # private: not in matplotlib's stubs
     fig.legend(handles=legend_marks(result, summary, spins), loc="lower left", bbox_to_anchor=(0.70, 0.08),
                frameon=False, fontsize=9)
 
@@ -278,7 +279,7 @@ def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
     """What the trajectory's marks mean: only those it shows (a collision, first light, a spin that
     happened; the world's lamps, tape and obstacles; the robot's floor sensors and beams)."""
     world, drawn = result.scene.world, [k.draw for k in declared_kinds(result)]
-    marks = []
+    marks: list[Line2D | Patch] = []
     if summary.collision_ticks:
         marks.append(Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
                             label="collision (where it touched)"))

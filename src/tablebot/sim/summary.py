@@ -57,7 +57,7 @@ class Summary:
 
 def light_bits(result: SimRun | Scene) -> int:
     """The input bits of the light sensors (of a run or of its scene)."""
-    bits = getattr(result, "scene", result).bits  # a SimRun has a scene; a Scene is one
+    bits = (result.scene if hasattr(result, "scene") else result).bits  # a SimRun has a scene; a Scene is one
     return int(bits[L.B_LIGHT_R] | bits[L.B_LIGHT_L])
 
 

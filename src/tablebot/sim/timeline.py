@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pickle
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -135,7 +135,7 @@ class TimelinePicture:
         finally:  # (without a fork, the other band is drawn next, in this process)
             for artist in theirs:
                 artist.set_visible(True)
-        pixels = np.asarray(self.fig.canvas.buffer_rgba())
+        pixels = np.asarray(cast(FigureCanvasAgg, self.fig.canvas).buffer_rgba())  # made on an Agg canvas
         others = pixels[:edge] if lower else pixels[edge - 1:]  # the gap row above the edge must be blank
         if not (others == 255).all():
             return None
@@ -203,7 +203,8 @@ def _bars(ax: Axes, starts: np.ndarray, widths: np.ndarray, bottom: float, heigh
     corners = np.empty((len(x0), 4, 2))
     corners[:, :, 0] = np.column_stack((x0, x0, x1, x1))
     corners[:, :, 1] = (y0, y1, y1, y0)
-    ax.add_collection(PolyCollection(corners, facecolors=colour), autolim=False)
+    # matplotlib's stubs want a sequence of (n, 2) arrays; an (n, 4, 2) array is one
+    ax.add_collection(PolyCollection(cast("Sequence[np.ndarray]", corners), facecolors=colour), autolim=False)
 
 
 def _state_panel(ax: Axes, result: RunView) -> None:

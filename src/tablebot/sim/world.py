@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -316,7 +317,7 @@ def _first_outside(walls: list[Point], points: tuple[Point, ...]) -> Point:
     return next((p for p in points if not inside(walls, p)), points[0])
 
 
-def _inside(src: Source, walls: list[Point], places: list[tuple[str, int | None, str, Point]]) -> None:
+def _inside(src: Source, walls: list[Point], places: Sequence[tuple[str, int | None, str, Point]]) -> None:
     for section, index, key, at in places:
         if not inside(walls, at):
             src.error((section, index, key), f"{section} at {list(at)} is outside the arena walls",

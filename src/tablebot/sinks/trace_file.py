@@ -8,7 +8,7 @@ import queue
 import threading
 from concurrent.futures import Executor, ThreadPoolExecutor
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO, TypeGuard
 
 import numpy as np
 
@@ -59,16 +59,17 @@ def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.nda
 
     n_out, n_count = len(machine.output_names), len(machine.table.robot.counter_names)
     arrays = (block.events, block.rows, block.states, block.timers, block.outputs, block.counters)
-    if not all(isinstance(a, np.ndarray) for a in arrays):
+    if not _all_arrays(arrays):
         return None
+    events, rows, states, timers, outputs, counters = arrays
     extra = block.extra.number_columns()  # type: ignore[attr-defined]
     keys = ["tick", "event", "row", "state", "timer", *machine.output_names, *machine.table.robot.counter_names]
     pieces = [("{" if k == 0 else ",") + json.dumps(key, ensure_ascii=False) + ":" for k, key in enumerate(keys)]
     pieces += ["," + json.dumps(key, ensure_ascii=False) + ":" for key, _, _ in extra]
     kinds = [INT, INT, ROW, STATE, INT] + [INT] * (n_out + n_count)
     n = len(block)
-    columns = [np.arange(block.start, block.start + n), block.events, block.rows, block.states, block.timers]
-    columns += [block.outputs[:, k] for k in range(n_out)] + [block.counters[:, k] for k in range(n_count)]
+    columns = [np.arange(block.start, block.start + n), events, rows, states, timers]
+    columns += [outputs[:, k] for k in range(n_out)] + [counters[:, k] for k in range(n_count)]
     decimals = [0] * len(kinds)
     for _, values, places in extra:
         kinds.append(INT if places == 0 else DECIMAL)
@@ -76,6 +77,10 @@ def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.nda
         decimals.append(places)
     return block_views([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states),
                        scratch, helper)
+
+
+def _all_arrays(columns: tuple[object, ...]) -> TypeGuard[tuple[np.ndarray, ...]]:
+    return all(isinstance(a, np.ndarray) for a in columns)
 
 
 def _python_lines(block: TickBlock, machine: Machine) -> list[str]:
@@ -115,7 +120,7 @@ def _json_column(column: Any) -> list[str]:
     return [json.dumps(v, ensure_ascii=False) for v in values]
 
 
-def _utf8_as_written(stream: Any) -> bool:
+def _utf8_as_written(stream: Any) -> TypeGuard[TextIO]:
     """Whether bytes may go to the stream's binary buffer: a UTF-8 text file (PendingFile writes newlines
     as they are)."""
     return hasattr(stream, "buffer") and str(getattr(stream, "encoding", "")).lower().replace("-", "") == "utf8"

@@ -84,10 +84,13 @@ def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
     later = None
     if half < n:
         second = _reused(own, "second", (n - half) * line, np.uint8)
-        later = helper.submit(_lines, second, *fixed, ints[half:], floats[half:], *names_at)  # type: ignore[union-attr]
-    views = [memoryview(out)[:_lines(out, *fixed, ints[:half], floats[:half], *names_at)]]
+        assert helper is not None  # half < n only with a helper
+        args = (second, *fixed, ints[half:], floats[half:], *names_at)  # one tuple: mypy misreads several *args
+        later = helper.submit(_lines, *args)
+    # numpy's stubs give ndarray a __buffer__ only for Python 3.12 on (mypy checks as 3.11)
+    views = [memoryview(out)[:_lines(out, *fixed, ints[:half], floats[:half], *names_at)]]  # type: ignore[arg-type]
     if later is not None:
-        views.append(memoryview(second)[:later.result()])
+        views.append(memoryview(second)[:later.result()])  # type: ignore[arg-type]  # as above
     return views
 
 
