@@ -39,13 +39,14 @@ import contextlib
 import hashlib
 import os
 import resource
-import socket
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from tablebot.testing.dask_cluster import local_cluster
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
@@ -114,12 +115,6 @@ def kernel_rate(robots: int, ticks: int) -> float:
 # --- Dask: a cluster of fresh worker processes --------------------------------------------------------------
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 class FreshCluster:
     """A Dask scheduler and 2 single-threaded workers on loopback, the workers with an empty cache folder
     (as on machines that never ran tablebot); with ``preload``, started with tablebot's preload
@@ -129,23 +124,13 @@ class FreshCluster:
         self.preload = preload
 
     def __enter__(self) -> str:
-        self.home = tempfile.TemporaryDirectory()
-        port = free_port()
-        self.address = f"tcp://127.0.0.1:{port}"
-        quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-        worker_env = child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=self.home.name)
-        self.procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                                        "--port", str(port), "--no-dashboard"], env=child_env(),
-                                       **quiet)]  # type: ignore[call-overload]
-        worker = [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads", "1",
-                  "--no-dashboard", *(["--preload", "tablebot.fleet.worker"] if self.preload else [])]
-        self.procs += [subprocess.Popen(worker, env=worker_env, **quiet)  # type: ignore[call-overload]
-                       for _ in range(2)]
-        from distributed import Client
-
-        with Client(self.address, timeout="60s") as client:
-            client.wait_for_workers(2, timeout=120)
-        return self.address
+        self.stack = contextlib.ExitStack()
+        home = self.stack.enter_context(tempfile.TemporaryDirectory())
+        options = ["--preload", "tablebot.fleet.worker"] if self.preload else []
+        cluster = self.stack.enter_context(local_cluster(
+            [options, options], child_env(), child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=home)))
+        self.procs = cluster.procs
+        return cluster.address
 
     def cpu(self) -> float:
         """CPU seconds (user + system) so far of the scheduler and the workers (their nannies' children too)."""
@@ -159,13 +144,7 @@ class FreshCluster:
         return total
 
     def __exit__(self, *exc: object) -> None:
-        # the workers, then the scheduler: a worker that loses its scheduler first closes 8 s later
-        for procs in (self.procs[1:], self.procs[:1]):
-            for proc in procs:
-                proc.terminate()
-            for proc in procs:
-                proc.wait()
-        self.home.cleanup()
+        self.stack.close()
 
 
 def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False) -> tuple[

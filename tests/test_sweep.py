@@ -20,6 +20,7 @@ from tablebot.cli.common import load
 from tablebot.fleet.plan import read_results
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.sim.scene import robot_layer, scene_for
+from tablebot.testing.dask_cluster import local_cluster
 from test_sim_helpers import BUMBERBOT
 
 if TYPE_CHECKING:
@@ -136,34 +137,12 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
 
 
 @pytest.fixture
-def dask_cluster(tmp_path: Path) -> Iterator[str]:
+def dask_cluster() -> Iterator[str]:
     """A real Dask scheduler and two single-threaded workers on this machine (separate processes), one of
     them started with tablebot's preload (tablebot.fleet.worker), one plain."""
     pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")
-    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
-    file = tmp_path / "scheduler.json"
-    procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                               "--scheduler-file", str(file)], env=env(), stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)]
-    try:
-        deadline = time.monotonic() + 60
-        while not file.exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
-        for preload in ([], ["--preload", "tablebot.fleet.worker"]):
-            procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                           "--nthreads", "1", "--no-dashboard", *preload], env=env(),
-                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        from distributed import Client
-        with Client(address, timeout="30s") as client:
-            client.wait_for_workers(2, timeout=60)
-        yield address
-    finally:  # the workers, then the scheduler: a worker that loses its scheduler first closes 8 s later
-        for group in (procs[1:], procs[:1]):
-            for proc in group:
-                proc.terminate()
-            for proc in group:
-                proc.wait(timeout=30)
+    with local_cluster([[], ["--preload", "tablebot.fleet.worker"]], env()) as cluster:
+        yield cluster.address
 
 
 def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask_cluster: str) -> None:
