@@ -27,9 +27,10 @@ is the kernel can be told apart:
 * **evolve**: ``tablebot evolve examples/bumberbot`` (a small budget) as a whole process: candidates/s and
   robot-ticks/s of the search (from benchmarks/evolve.py).
 
-Every child process runs without PYTHONDONTWRITEBYTECODE (see ``child_env``): bytecode as an installed
-tablebot has it. Medians of the repeats, ratios against baselines of the same run. The machine this was written on has
-2 cores shared with other engineers' runs: figures move by tens of percent; the load average is printed.
+Every child process runs without PYTHONDONTWRITEBYTECODE (``tablebot.testing.processes.child_env``): bytecode
+as an installed tablebot has it. Medians of the repeats, ratios against baselines of the same run. The machine
+this was written on has 2 cores shared with other engineers' runs: figures move by tens of percent; the load
+average is printed.
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ import time
 from pathlib import Path
 
 from tablebot.testing.dask_cluster import local_cluster
+from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
@@ -57,20 +59,6 @@ TARGET_HOUR_S = 2.0  # sim --seconds 3600 with pictures
 
 
 CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() process: steadier than wall on a busy machine
-
-
-def child_env(**changes: str | None) -> dict[str, str]:
-    """This process's environment for a child, without PYTHONDONTWRITEBYTECODE (as benchmarks/startup.py):
-    bytecode files are written and read as a user's would be -- with it set, an editable install compiles
-    every tablebot module from source again in every process (~0.2 s of a sweep's start-up that no user
-    of an installed tablebot has). ``changes``: variables to set (None: to remove)."""
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    for key, value in changes.items():
-        if value is None:
-            env.pop(key, None)
-        else:
-            env[key] = value
-    return env
 
 
 def tablebot(*args: str) -> float:

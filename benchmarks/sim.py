@@ -39,6 +39,7 @@ from tablebot.loop import run as run_loop
 from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
+from tablebot.testing.processes import child_env
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -87,10 +88,7 @@ def command(args: list[str]) -> tuple[float, float, float, float]:
     it and every process it started."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    # bytecode written and read as an installed tablebot's is (as benchmarks/fleet.py and startup.py): with
-    # PYTHONDONTWRITEBYTECODE set, an editable install compiles every edited module again in every run
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
+    proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT, env=child_env())
     private = [0.0]
     sampler = threading.Thread(target=_sample_private, args=(proc.pid, private), daemon=True)
     sampler.start()

@@ -32,15 +32,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from tablebot.testing.processes import child_env
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 HEAVY = ("numba", "scipy", "matplotlib", "pydantic", "dask")
-
-
-def child_env() -> dict[str, str]:
-    env = dict(os.environ)
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    return env
 
 
 def timed(argv: list[str]) -> tuple[float, float, str]:
