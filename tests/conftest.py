@@ -31,7 +31,7 @@ WARMED = "TABLEBOT_TEST_NUMBA_WARMED"  # a file the main process writes when the
 
 #: Modules whose tests hold a controller, a link or a page to the wall clock (10 ms ticks, replies due within
 #: 50 ms, a tick that must come late or not): marked ``realtime``. `make test` runs them in a pass of their
-#: own after the parallel one, alone on the machine as they were written for.
+#: own after the parallel one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them.
 REALTIME = {"test_txt_robot", "test_pace", "test_roboif", "test_robotx", "test_run_serial", "test_serial_wiring",
             "test_txt_link", "test_txt_wiring", "test_loop", "test_studio_live", "test_txt4_program",
             "test_txt4_softxt", "test_txt4_upload", "test_rules"}
