@@ -45,7 +45,7 @@ def random_table(seed: int, states: int = 50, rows_per_state: int = 10) -> Table
     """Rows need one or two events (T often among them), set random speeds (sometimes keep),
     load timers up to 3 s and go anywhere; every state has rows, so every next state exists."""
     rng = random.Random(seed)
-    rows = []
+    rows: list[Row] = []
     for state in range(1, states + 1):
         for _ in range(rows_per_state):
             events = frozenset(rng.sample(EVENTS, rng.choice((1, 1, 2))))

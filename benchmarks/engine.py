@@ -53,6 +53,8 @@ from tablebot.machine import Machine, compile_table, first_match
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv"
 Result = tuple[Any, int, tuple[int | None, ...]]  # final state (name), timer, outputs
+Inputs = Sequence[int] | np.ndarray  # a contestant's input masks: a list, or (batch (array)) a numpy array
+Contestants = dict[str, tuple[Callable[..., Result], Inputs]]
 
 #: (label, contestant, baseline, the least speed ratio contestant/baseline that meets the target);
 #: closed-loop contestants against closed-loop baselines, open-loop against open-loop.
@@ -236,7 +238,7 @@ def transitions_run(machine: Machine, masks: Sequence[int]) -> Result:
 
 # --- measuring ------------------------------------------------------------------------------------------
 
-def measure(contestants: dict[str, tuple[Callable[..., Result], Sequence[int]]], machine: Machine,
+def measure(contestants: Contestants, machine: Machine,
             repeats: int) -> tuple[dict[str, list[float]], dict[str, Result]]:
     """CPU seconds of each repeat per contestant, and each one's result.
 
@@ -262,9 +264,10 @@ def main(argv: list[str] | None = None) -> int:
     machine = compile_table(load_table(EXAMPLE))
     masks = random_masks(machine, args.ticks)
     few = masks[: args.transitions_ticks]
-    contestants = {"step": (engine_step, masks), "bare step": (bare_step, masks), "linear scan": (linear_scan, masks),
-                   "transitions": (transitions_run, few), "batch": (engine_batch, masks),
-                   "batch (array)": (engine_batch_array, np.array(masks, np.uint8)), "bare loop": (bare_loop, masks)}
+    contestants: Contestants = {
+        "step": (engine_step, masks), "bare step": (bare_step, masks), "linear scan": (linear_scan, masks),
+        "transitions": (transitions_run, few), "batch": (engine_batch, masks),
+        "batch (array)": (engine_batch_array, np.array(masks, np.uint8)), "bare loop": (bare_loop, masks)}
     print(f"BumberBot, {args.ticks:,} random input ticks ({len(few):,} for transitions), "
           f"median of {args.repeats}, Python {sys.version.split()[0]}, load average {_load()}")
     start = time.perf_counter()

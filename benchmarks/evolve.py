@@ -33,10 +33,16 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TypedDict
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 NAMES = ["time_to_lamp", "area_covered", "collision_share"]
+
+
+#: What the inner loop measures: its rates (medians) and the candidates/s of each repeat.
+InnerRates = TypedDict("InnerRates", {"candidates/s": float, "robot-ticks/s": float,
+                                      "baseline robot-ticks/s": float, "spread": list[float]})
 
 
 def environment(src: str | None) -> dict[str, str]:
@@ -128,7 +134,7 @@ def children(count: int) -> tuple[object, list[tuple[str, object]], object]:
     return table, list(out.items()), sp
 
 
-def inner(repeat: int, count: int, seconds: float) -> dict[str, float]:
+def inner(repeat: int, count: int, seconds: float) -> InnerRates:
     """The inner loop in this process: candidates/s and robot-ticks/s, and the plain-fleet baseline's."""
     from tablebot.evolve.evaluate import Evaluator
     from tablebot.fleet.backends import Runner
@@ -158,7 +164,7 @@ def inner(repeat: int, count: int, seconds: float) -> dict[str, float]:
             "spread": [count / t for t in evolve_s]}
 
 
-def inner_process(repeat: int, count: int, seconds: float, src: str | None) -> dict[str, float]:
+def inner_process(repeat: int, count: int, seconds: float, src: str | None) -> InnerRates:
     """:func:`inner` in a fresh process of ``src``'s code (this tree's when None)."""
     done = subprocess.run([sys.executable, __file__, "--inner-only", str(repeat), str(count), str(seconds)],
                           env=environment(src), capture_output=True, text=True)
@@ -207,7 +213,7 @@ def say_whole(label: str, runs: list[dict[str, float]], budget: int, seconds: fl
     return med
 
 
-def say_inner(label: str, loop: dict[str, float], count: int, seconds: float, repeat: int) -> None:
+def say_inner(label: str, loop: InnerRates, count: int, seconds: float, repeat: int) -> None:
     print(f"inner loop (evaluation only), {label}: {count} tables × 16 scenarios × {seconds:g} s on the warm local "
           f"backend, median of {repeat}: {loop['candidates/s']:.1f} candidates/s "
           f"({spread(loop['spread'])}), {loop['robot-ticks/s'] / 1e6:.2f} M robot-ticks/s; baseline, the same "

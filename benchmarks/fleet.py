@@ -140,7 +140,9 @@ def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False)
     """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat, its
     workers started with tablebot's preload or not); and the CPU seconds of each (for Dask: the client's and
     the cluster's processes' together)."""
-    local, fresh, warm = [], [], []
+    local: list[float] = []
+    fresh: list[float] = []
+    warm: list[float] = []
     cpu: dict[str, list[float]] = {"local": [], "fresh": [], "warm": []}
     for _ in range(repeat):
         local.append(sweep_process(robots, seconds))
@@ -271,21 +273,21 @@ def main() -> int:
           f"{rate / inner:.2f}x the kernel's speed (the rest: start-up, planning, results)")
 
     if not args.no_dask:
-        local, fresh, warm, cpu = dask_ratios(robots, seconds, args.repeat)
+        local, fresh, warm, cpus = dask_ratios(robots, seconds, args.repeat)
         f_ratio = med(a / b for a, b in zip(local, fresh, strict=True))
         w_ratio = med(a / b for a, b in zip(local, warm, strict=True))
         ok = f_ratio >= TARGET_FRESH
         missed += not ok
         print(f"Dask, 2 single-threaded workers: local {med(local):.2f} s, fresh cluster {med(fresh):.2f} s, "
-              f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpu['local']):.2f}, fresh "
-              f"{med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}, the cluster's processes included)")
+              f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpus['local']):.2f}, fresh "
+              f"{med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}, the cluster's processes included)")
         print(f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
               f"{w_ratio:.2f}x")
-        local, fresh, warm, cpu = dask_ratios(robots, seconds, args.repeat, preload=True)
+        local, fresh, warm, cpus = dask_ratios(robots, seconds, args.repeat, preload=True)
         print(f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
               f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
               f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
-              f"{med(cpu['local']):.2f}, fresh {med(cpu['fresh']):.2f}, warm {med(cpu['warm']):.2f}")
+              f"{med(cpus['local']):.2f}, fresh {med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}")
 
     with_pics = [sim_hour(hour, True) for _ in range(args.repeat)]
     without = [sim_hour(hour, False) for _ in range(args.repeat)]

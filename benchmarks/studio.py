@@ -89,9 +89,14 @@ async def round_trips(server: Background) -> float:
             value = "9" if seq % 2 else "4"  # alternately break and fix a motor speed
             started = time.perf_counter()
             await ws.send(json.dumps({"op": "edit", "row": 4, "col": 9, "value": value, "seq": seq}))
-            await _until(ws, lambda m, s=seq: m["type"] == "analysis" and m.get("seq") == s)
+            await _until(ws, _analysis_of(seq))
             times.append(time.perf_counter() - started)
         return 1000 * statistics.median(times)
+
+
+def _analysis_of(seq: int) -> Callable[[dict], bool]:
+    """Whether a message is the analysis answering edit ``seq``."""
+    return lambda message: message["type"] == "analysis" and message.get("seq") == seq
 
 
 async def _until(ws: ClientConnection, wanted: Callable[[dict], bool]) -> dict:
