@@ -68,13 +68,14 @@ def measure(example: str, repeats: int) -> dict[str, float]:
 def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     import numpy as np
 
+    from tablebot.sim import contacts as co
     from tablebot.sim import kernel as K
     from tablebot.sim import physics as ph
 
     loops = _loops()
     g, p = scene.geometry, scene.P[0]
     shade = getattr(g, "shade", None)
-    s, near_centre = rows[0].copy(), ph.new_near(g.pstart, g.circles)
+    s, near_centre = rows[0].copy(), co.new_near(g.pstart, g.circles)
 
     def ns(name: str, *args: Any) -> float:
         loops[name](*args)
@@ -112,6 +113,7 @@ def _loops() -> dict[str, Any]:
     from tablebot.engine_batch import tick_compiled
     from tablebot.jit import njit
     from tablebot.sim import columns as L
+    from tablebot.sim import contacts as co
     from tablebot.sim import kernel as K
     from tablebot.sim import physics as ph
     from tablebot.sim.normals import standard_normal
@@ -164,10 +166,10 @@ def _loops() -> dict[str, Any]:
     @fast
     def bumpers(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
                 circles: np.ndarray, s: np.ndarray, near: np.ndarray, centre: np.ndarray) -> float:
-        reach, wide = ph.reaches(p)
+        reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.sense_bumpers(s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach,
+            co.sense_bumpers(s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach,
                              wide, near, centre)
         return s[0]
 
@@ -175,10 +177,10 @@ def _loops() -> dict[str, Any]:
     def contacts(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
                  circles: np.ndarray, s: np.ndarray, corners: np.ndarray, near: np.ndarray,
                  centre: np.ndarray) -> float:
-        reach, wide = ph.reaches(p)
+        reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast

@@ -20,7 +20,7 @@ from tablebot.machine import compile_table
 from tablebot.replay import replay
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
 FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"

@@ -19,7 +19,7 @@ FIX = Path(__file__).resolve().parent / "fixtures" / "analysis"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot" / "table.csv"
 
 
-def findings(name: str, targets: tuple[str, ...] = ()) -> list[Finding]:
+def findings(name: str | Path, targets: tuple[str, ...] = ()) -> list[Finding]:
     machine = compile_table(load_table(FIX / name if isinstance(name, str) else name))
     return find_all(machine, targets=targets)
 

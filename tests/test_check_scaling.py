@@ -47,7 +47,7 @@ def reference_overlaps(table: Table) -> list[tuple[int, int, str]]:
 
 def random_table(seed: int, states: int, per_state: int) -> Table:
     rng = random.Random(seed)
-    rows = []
+    rows: list[Row] = []
     for state in range(1, states + 1):
         for _ in range(per_state):
             events = frozenset(rng.sample(EVENTS, rng.choice((0, 1, 1, 2, 3))))

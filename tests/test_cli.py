@@ -19,7 +19,7 @@ from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
 runner = CliRunner()
 LOCATED = re.compile(r"^(?P<path>\S.*?):(?P<line>\d+):(?P<column>\d+): error: .+$")

@@ -4,6 +4,7 @@ made on a state's first tick, and tick/timer/counters read and assigned as plain
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -96,7 +97,8 @@ def test_refused_pulses_change_nothing_not_even_the_tick(tmp_path: Path) -> None
 
 def test_no_pulses_as_none_empty_tuple_or_empty_list() -> None:
     trace = []
-    for pulses in (None, (), [], np.zeros(0, dtype=np.int64)):
+    nothing: tuple[Sequence[int] | np.ndarray | None, ...] = (None, (), [], np.zeros(0, dtype=np.int64))
+    for pulses in nothing:
         engine = Engine(example_machine())
         trace.append([(engine.step(mask, pulses), engine.event, engine.row, engine.timer)
                       for mask in [0, I7, 0, I5, I3 | I4] * 3])

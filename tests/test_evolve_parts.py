@@ -22,13 +22,14 @@ from tablebot.evolve.report import as_table
 from tablebot.formats.table_read import load_table, parse_table
 from tablebot.formats.table_write import format_table
 from tablebot.machine import compile_table
+from tablebot.table import Table
 
 ROOT = Path(__file__).resolve().parents[1]
 BUMBERBOT = ROOT / "examples" / "bumberbot" / "table.csv"
 PROPERTIES = find_property_files(BUMBERBOT)
 
 
-def bumberbot_space(**limits: object) -> tuple[object, Space]:
+def bumberbot_space(**limits: object) -> tuple[Table, Space]:
     table = load_table(BUMBERBOT)
     made = space.Limits(max_rows=space.default_max_rows(table), timer_max=space.default_timer_max(table))
     return table, Space(table.states, table.robot.motors, replace(made, **limits))

@@ -25,7 +25,7 @@ from tablebot.testing.random_tables import random_inputs, random_table
 if TYPE_CHECKING:
     from typing import Any
 
-    from click.testing import Result
+    from typer.testing import Result
 
     from tablebot.machine import Machine
 

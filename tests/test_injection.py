@@ -19,7 +19,7 @@ from hostile import EVIL_SYMBOL, HOSTILE, INJECTED, STATES, robot_toml, write_pr
 from tablebot.cli import app
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
 RPP = Path(__file__).resolve().parent / "fixtures" / "rpp" / "engine.rpp"
 SVG = "{http://www.w3.org/2000/svg}"
@@ -96,7 +96,7 @@ def test_rpp_parses_as_xml(project: Path, tmp_path: Path) -> None:
     run("export", project, out, "--to", "robopro-rpp", "--into", RPP)
     root = ET.parse(out / RPP.name).getroot()
     assert not [e for e in root.iter() if e.tag == "evil"]
-    values = [init.get("value") for o in root.iter("o") if o.get("name") == "Event" for init in o.iter("init")]
+    values = [init.attrib["value"] for o in root.iter("o") if o.get("name") == "Event" for init in o.iter("init")]
     assert len(values) == len(HOSTILE) and all(v.isdigit() for v in values)
 
 

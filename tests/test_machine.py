@@ -100,7 +100,7 @@ class Naive:
 
 # --- generating tables --------------------------------------------------------------------------------
 
-STATE_POOL = (1, 2, 3, 20, "seek", "back off")
+STATE_POOL: tuple[int | str, ...] = (1, 2, 3, 20, "seek", "back off")
 
 
 @st.composite

@@ -15,7 +15,7 @@ from tablebot.formats.table_read import load_table
 runner = CliRunner()
 
 
-def invoke(*args: str) -> str:
+def invoke(*args: str | Path) -> str:
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exit_code == 0, result.output
     return result.output

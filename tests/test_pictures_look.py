@@ -8,11 +8,14 @@ import os
 import shutil
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
+import numpy as np
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PatchCollection, PolyCollection
 from matplotlib.colors import to_hex
+from matplotlib.patches import Patch
 from matplotlib.text import Text
 from PIL import Image
 from typer.testing import CliRunner
@@ -68,7 +71,7 @@ def test_the_light_panel_labels_render_and_its_y_label_is_in_view() -> None:
     ticks = [t.get_text() for t in light.get_yticklabels() if t.get_text()]
     assert ticks and not [t for t in ticks if "$" in t or "\\" in t], ticks
     assert {"0", "1", "10"} <= set(ticks)
-    label = light.yaxis.label.get_window_extent(fig.canvas.get_renderer())
+    label = light.yaxis.label.get_window_extent(cast(FigureCanvasAgg, fig.canvas).get_renderer())
     assert light.get_ylabel().startswith("light") and label.x0 >= 0 and label.x1 <= fig.bbox.x1
 
 
@@ -86,13 +89,14 @@ def test_a_state_keeps_its_colour_in_every_picture_of_a_table(tmp_path: Path) ->
         summary = summarise(result)
         trajectory = drawn(plots.trajectory_figure, result, summary)
         for handle in trajectory.legends[0].legend_handles:
-            seen[handle.get_label().split("  (")[0]].add(to_hex(handle.get_facecolor()))
+            assert isinstance(handle, Patch)  # a state's entry is a coloured patch
+            seen[str(handle.get_label()).split("  (")[0]].add(to_hex(handle.get_facecolor()))
         timeline = drawn(plots.timeline_figure, result, summary)
         bars = [c for c in timeline.axes[0].collections if isinstance(c, PolyCollection)]
         labels = [t.get_text() for t in timeline.axes[0].get_yticklabels()]
         for bar in bars:
-            row = round(bar.get_paths()[0].vertices[:, 1].mean())
-            seen[labels[row]].add(to_hex(bar.get_facecolor()[0]))
+            row = round(np.asarray(bar.get_paths()[0].vertices)[:, 1].mean())
+            seen[labels[row]].add(to_hex(tuple(np.asarray(bar.get_facecolor())[0])))
         with literal_text():
             player = Player(trajectory, result, summary, 50, 1.0)  # the gif's and the window's trail
         for tick, colour in zip(range(0, result.ticks, 50), player.colours, strict=False):
@@ -139,11 +143,12 @@ def test_a_followed_line_shows_its_path_above_the_tape() -> None:
     (tape,) = [c for c in ax.collections if isinstance(c, PatchCollection)]
     path = next(c for c in ax.collections if isinstance(c, LineCollection))
     assert path.get_zorder() > tape.get_zorder()
-    pixels = Image.frombuffer("RGBA", fig.canvas.get_width_height(), fig.canvas.buffer_rgba())
+    canvas = cast(FigureCanvasAgg, fig.canvas)  # the pictures are drawn on an Agg canvas
+    pixels = np.asarray(canvas.buffer_rgba())
     x, y = ax.transData.transform(result.hist[len(result.hist) // 3, :2])
-    near = {pixels.getpixel((round(x) + dx, pixels.height - round(y) + dy))[:3] for dx in (-1, 0, 1)
+    near = {tuple(pixels[len(pixels) - round(y) + dy, round(x) + dx, :3].tolist()) for dx in (-1, 0, 1)
             for dy in (-1, 0, 1)}
-    path_colours = {tuple(round(255 * v) for v in c[:3]) for c in path.get_colors()}
+    path_colours = {tuple(round(255 * v) for v in c[:3]) for c in np.asarray(path.get_colors()).tolist()}
     assert near & path_colours, (near, path_colours)  # the path's own colour, drawn over the tape
 
 

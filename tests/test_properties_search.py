@@ -151,7 +151,7 @@ EVENTS = ("T", "A", "B")
 @st.composite
 def tables(draw: st.DrawFn) -> Table:
     n = draw(st.integers(2, 3))
-    rows = []
+    rows: list[Row] = []
     for state in range(1, n + 1):
         for _ in range(draw(st.integers(1, 3))):
             events = frozenset(e for e in EVENTS if draw(st.booleans()))

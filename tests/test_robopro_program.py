@@ -38,7 +38,7 @@ COUNTERS = ROOT / "examples" / "bumberbot-counters"
 
 def lists_of(text: str) -> dict[str, list[int]]:
     root = ET.fromstring(text.encode("utf-8"))
-    return {o.get("name"): [int(i.get("value")) for i in o.findall("init")]
+    return {o.attrib["name"]: [int(i.attrib["value"]) for i in o.findall("init")]
             for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
 
 
@@ -229,9 +229,9 @@ def wire_segments(text: str) -> dict[str, list[tuple[str, tuple[int, int], tuple
             segments = []
             for wire in function.findall("o"):
                 if wire.get("classname") in ("ftProFlowWire", "ftProDataWire"):
-                    points = [(int(p.get("x")), int(p.get("y"))) for p in wire.findall("xy")]
-                    segments += [(wire.get("id"), a, b) for a, b in itertools.pairwise(points)]
-            found[function.get("name")] = segments
+                    points = [(int(p.attrib["x"]), int(p.attrib["y"])) for p in wire.findall("xy")]
+                    segments += [(wire.attrib["id"], a, b) for a, b in itertools.pairwise(points)]
+            found[function.attrib["name"]] = segments
     return found
 
 

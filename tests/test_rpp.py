@@ -41,7 +41,7 @@ def _copy(tmp_path: Path, name: str) -> Path:
 
 def _list_values(data: bytes) -> dict[str, tuple[str, list[int]]]:
     root = ET.fromstring(data)
-    return {o.get("name"): (o.get("N"), [int(i.get("value")) for i in o.findall("init")])
+    return {o.attrib["name"]: (o.attrib["N"], [int(i.attrib["value"]) for i in o.findall("init")])
             for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
 
 
@@ -119,7 +119,7 @@ def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path: Path) -> Non
 def test_a_global_list_is_written_in_every_subprogram_that_has_it() -> None:
     text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
             '<o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o></cvg>')
-    assert [[int(i.get("value")) for i in o.findall("init")] for o in ET.fromstring(rewrite(text, {"Event": [4, 5]}))
+    assert [[int(i.attrib["value"]) for i in o.findall("init")] for o in ET.fromstring(rewrite(text, {"Event": [4, 5]}))
             .iter("o")] == [[4, 5], [4, 5]]
 
 

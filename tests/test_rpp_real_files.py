@@ -25,7 +25,7 @@ from test_rpp import EXAMPLE, FIXTURES
 from test_rpp import _outside_lists as _without_inits
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
     from tablebot.robopro.lists import Lists
 
@@ -50,7 +50,7 @@ def _outside_lists(data: bytes) -> bytes:
 
 
 def copies(data: bytes, name: str) -> list[list[int]]:
-    return [[int(i.get("value")) for i in o.findall("init")] for o in ET.fromstring(data).iter("o")
+    return [[int(i.attrib["value"]) for i in o.findall("init")] for o in ET.fromstring(data).iter("o")
             if o.get("classname") == "ftProDataArray1D" and o.get("name") == name]
 
 

@@ -120,7 +120,8 @@ class SimulatedTime:
     """A clock both loops read: ``now`` is the simulated time, ``sleep`` advances it (and is noted)."""
 
     def __init__(self) -> None:
-        self.t, self.sleeps = 0.0, []
+        self.t = 0.0
+        self.sleeps: list[float] = []
 
     def now(self) -> float:
         return self.t
@@ -136,7 +137,8 @@ class LinkRobot:
 
     def __init__(self, time: SimulatedTime, masks: list[int], delays: list[float]) -> None:
         self.time, self.masks, self.delays = time, masks, delays
-        self.n, self.writes, self.stops = 0, [], 0
+        self.n, self.stops = 0, 0
+        self.writes: list[tuple[float, tuple[int, ...]]] = []
 
     def read(self) -> tuple[int, list[int]]:
         self.time.t += self.delays[self.n]
@@ -183,7 +185,7 @@ def test_the_txt4_programs_loop_paces_stops_and_falls_behind_as_the_run_loop(cas
     rng = random.Random(3)
     masks = [sum(b for b in machine.input_bits.values() if rng.random() < 0.15) for _ in range(60)]
     delays = [STALLS[case].get(n, 0.002) for n in range(60)]
-    program_time, loop_time, said = SimulatedTime(), SimulatedTime(), []
+    program_time, loop_time, said = SimulatedTime(), SimulatedTime(), list[str]()
     program_robot, loop_robot = LinkRobot(program_time, masks, delays), LoopRobot(loop_time, masks, delays)
     reason = txt4_runtime.run(table, program_robot, 60, now=program_time.now, sleep=program_time.sleep, log=said.append)
     clock = RealTimeClock(machine.table.robot.tick_s, now=loop_time.now, sleep=loop_time.sleep)

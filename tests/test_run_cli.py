@@ -30,7 +30,7 @@ from tablebot.sinks.live_view import LiveView
 from txt_fake import FakeTxt
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
     from txt_fake import Script
 

@@ -26,6 +26,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
+    from tablebot.testing.pty_device import Request
+
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ("tick", "event", "row", "state", "timer", "M1", "M2")
 runner = CliRunner()
@@ -36,7 +38,7 @@ def bumps(kind: str, seed: int = 3) -> Callable[[int], tuple[list[int], list[int
     rng = random.Random(seed)
     held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
             for _ in range(200)]
-    other = [0, 0, 0, 0] if kind == "robotx" else {}
+    other: list[int] | dict[str, int] = [0, 0, 0, 0] if kind == "robotx" else {}
     return lambda n: (held[(max(0, n - PROBES) // 7) % len(held)], other)  # the same inputs whatever timing came first
 
 
@@ -44,7 +46,7 @@ def emulator(kind: str, **options: Any) -> RobotxEmulator | RoboifEmulator:
     return (RobotxEmulator if kind == "robotx" else RoboifEmulator)(bumps(kind), **options)
 
 
-def off(kind: str, request: pytest.FixtureRequest) -> bool:
+def off(kind: str, request: Request) -> bool:
     """Whether an exchange the emulator logged switched every output off."""
     if kind == "robotx":
         return request.fields["duty"] == [0] * 8

@@ -19,7 +19,7 @@ from tablebot.diagnostics import TableBotError
 from tablebot.files import PendingFile, atomic_write, replacing, write_text
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
 RPP = Path(__file__).resolve().parent / "fixtures" / "rpp" / "engine.rpp"
 runner = CliRunner()

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Never
 
-    from click.testing import Result
+    from typer.testing import Result
 
     from tablebot.diagnostics import Diagnostic
 
@@ -117,7 +117,7 @@ def test_toml_that_is_not_toml_does_not_echo_its_contents(tmp_path: Path) -> Non
 def test_cp1252_table_is_read_with_a_note(tmp_path: Path) -> None:
     text = f"{HEADER}\nZurück – à gauche €,1,1,,,3,3,10,1\n"
     path = write_table(tmp_path, text, MINI_ROBOT, encoding="cp1252")
-    notes = []
+    notes: list[Diagnostic] = []
     with notes_to(notes.append):
         table = load_table(path)
     assert table.rows[0].description == "Zurück – à gauche €"
@@ -130,7 +130,7 @@ def test_cp1252_table_is_read_with_a_note(tmp_path: Path) -> None:
 def test_latin1_byte_that_cp1252_lacks(tmp_path: Path) -> None:
     path = write_table(tmp_path, f"{HEADER}\n", MINI_ROBOT)
     path.write_bytes(f"{HEADER}\n".encode() + b"x\x81y,1,1,,,3,3,10,1\n")
-    notes = []
+    notes: list[Diagnostic] = []
     with notes_to(notes.append):
         assert load_table(path).rows[0].description == "x\x81y"
     assert "Latin-1" in notes[0].message

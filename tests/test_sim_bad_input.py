@@ -14,7 +14,7 @@ from tablebot.diagnostics import TableBotError
 from test_sim_helpers import BUMBERBOT, ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
 
 if TYPE_CHECKING:
-    from click.testing import Result
+    from typer.testing import Result
 
 runner = CliRunner()
 

@@ -42,6 +42,12 @@ def copies() -> list[int]:
     return found
 
 
+def after(seconds: float, value: bytes) -> bytes:
+    """``value``, a long while later (work a test cuts short)."""
+    time.sleep(seconds)
+    return value
+
+
 def test_the_answer_comes_from_another_process() -> None:
     me = os.getpid()
     with Forked(lambda _: str(os.getpid()).encode()) as copy:
@@ -60,7 +66,7 @@ def test_an_error_in_the_copy_is_raised_here() -> None:
 
 def test_leaving_without_the_answer_kills_the_copy_at_once() -> None:
     started = time.monotonic()
-    with pytest.raises(KeyboardInterrupt), Forked(lambda _: time.sleep(60) or b"late") as copy:
+    with pytest.raises(KeyboardInterrupt), Forked(lambda _: after(60, b"late")) as copy:
         while copies() != [copy.pid]:  # the copy names itself just after the fork
             assert time.monotonic() - started < 10
             time.sleep(0.01)
@@ -70,7 +76,7 @@ def test_leaving_without_the_answer_kills_the_copy_at_once() -> None:
 
 def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here() -> None:
     me = os.getpid()
-    with Forked(lambda _: b"here" if os.getpid() == me else time.sleep(60) or b"there") as copy:
+    with Forked(lambda _: b"here" if os.getpid() == me else after(60, b"there")) as copy:
         os.kill(copy.pid, signal.SIGKILL)
         assert copy.result() == b"here"
     assert copies() == []

@@ -138,7 +138,8 @@ class Watch:
     """Notes every painter process (and fork of one) of a command while it runs."""
 
     def __init__(self, proc: subprocess.Popen) -> None:
-        self.proc, self.seen, self.done = proc, {}, False
+        self.proc, self.done = proc, False
+        self.seen: dict[int, str | None] = {}  # painter pid: when it started (see started)
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 

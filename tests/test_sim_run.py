@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 from PIL import Image
+from PIL.GifImagePlugin import GifImageFile
 from typer.testing import CliRunner
 
 from tablebot.cli.app import app
@@ -85,7 +86,7 @@ def test_cli_gif_and_quiet(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     assert result.output == ""
     with Image.open(out / "run.gif") as gif:
-        assert gif.n_frames == 31
+        assert isinstance(gif, GifImageFile) and gif.n_frames == 31
 
 
 def test_cli_bad_world_is_a_located_error(tmp_path: Path) -> None:

@@ -202,7 +202,9 @@ def test_paused_hold_i3_and_step_fires_a_collision_row(tab: Tab) -> None:
     page.wait_for_function("() => document.querySelector('#status').textContent.includes('state 20')")
     fired = page.locator("#why li.why-fired").inner_text()
     # the robot may be seeking (state 1 or 2) or following the light (11): each has its own I3 row
-    line = {"2": 3, "6": 7, "28": 29}[re.match(r"row (\d+) \(line (\d+)\) fired: it needs I3, all present", fired)[1]]
+    match = re.match(r"row (\d+) \(line (\d+)\) fired: it needs I3, all present", fired)
+    assert match, fired
+    line = {"2": 3, "6": 7, "28": 29}[match[1]]
     assert re.search(r"row \d+ \(line \d+\) did not fire: it needs I4", page.locator("#why").inner_text())
     assert page.locator("tr.fired td.num").inner_text() == str(line)
     tab.shot("step")

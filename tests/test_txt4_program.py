@@ -235,7 +235,7 @@ def bumberbot_table() -> dict:
 def test_the_on_board_loop_stops_when_it_falls_behind_is_interrupted_asked_or_fails() -> None:
     table = bumberbot_table()
     clock = iter([0.0, 0.0, 0.01, 0.02, 0.7, 0.7, 0.7])  # a 0.7 s stall before tick 3
-    robot, said = CountingRobot(), []
+    robot, said = CountingRobot(), list[str]()
     reason = txt4_runtime.run(table, robot, 10, now=lambda: next(clock), sleep=lambda s: None, log=said.append)
     assert reason == "behind"
     assert len(robot.writes) == 3 and robot.stops == 1 and "stopping rather than stretching" in said[0]

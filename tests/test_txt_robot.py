@@ -31,7 +31,7 @@ from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_table
 from txt_fake import FakeTxt
 
-FLAVOURS = {"txt": {"period_s": 0.01},
+FLAVOURS: dict[str, dict[str, object]] = {"txt": {"period_s": 0.01},
             "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000, "single_recv": True}}
 
 
@@ -59,7 +59,7 @@ def fake_settles(fake: FakeTxt) -> None:
 
 
 @pytest.fixture(params=list(FLAVOURS))
-def flavour(request: pytest.FixtureRequest) -> dict:
+def flavour(request: pytest.FixtureRequest) -> dict[str, object]:
     return FLAVOURS[request.param]
 
 

@@ -7,6 +7,7 @@ real controller does (the status a real one answers a wrong key with is unconfir
 
 from __future__ import annotations
 
+import email.message
 import email.parser
 import json
 import threading
@@ -77,15 +78,21 @@ class FakeTxt4:
         """Multipart form data, one part per file, its path in the part's filename (as SofTXT reads it)."""
         head = f"Content-Type: {request.headers['Content-Type']}\r\n\r\n".encode()
         message = email.parser.BytesParser().parsebytes(head + body)
-        for part in message.get_payload():
+        parts = message.get_payload()
+        assert isinstance(parts, list), "a multipart body"
+        for part in parts:
+            assert isinstance(part, email.message.Message)
             relative = part.get_param("filename", header="content-disposition")
+            assert isinstance(relative, str), f"every part names its file: {relative!r}"
             self.filenames.append(relative)
             relative = relative[1:] if relative.startswith("/") else relative
             target = (folder / relative).resolve()
             if folder.resolve() not in target.parents:  # SofTXT would write there; a test never should
                 return self.reply(request, 400)
             target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_bytes(part.get_payload(decode=True))
+            payload = part.get_payload(decode=True)
+            assert isinstance(payload, bytes)
+            target.write_bytes(payload)
         return self.reply(request, 200)
 
     @staticmethod

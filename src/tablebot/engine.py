@@ -109,9 +109,10 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def step(self, inputs: int | Mapping[str, int] = 0, pulses: Sequence[int] | None = None) -> tuple[int, ...]:
-        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (None or
-        () when there are none).
+    def step(self, inputs: int | Mapping[str, int] = 0,
+             pulses: Sequence[int] | np.ndarray | None = None) -> tuple[int, ...]:
+        """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (a sequence or
+        numpy array; None or () when there are none).
 
         The rule of :func:`tablebot.tick.tick`, step by step, in the form that costs Python least a tick:
 
@@ -179,7 +180,7 @@ class Engine:
             self.events_of(inputs)  # raises for a mask beyond the table's events
             raise  # a state out of range: not the input's fault
 
-    def _count_down(self, pulses: Sequence[int], tick: int, inputs: int) -> None:
+    def _count_down(self, pulses: Sequence[int] | np.ndarray, tick: int, inputs: int) -> None:
         """Each counter down by its pulses, from the second tick on; the mask and the pulses are checked
         first, so a refused tick changes nothing."""
         if tick == 1:
