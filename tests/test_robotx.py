@@ -147,7 +147,8 @@ def test_a_shell_prompt_before_the_first_frame_is_skipped_and_a_device_that_spea
         assert robot_on(emu).connect().device == "ROBO TX-000"
     with RobotxEmulator(fault=("silent", 0)) as emu:
         emu.device_name = "x"
-        emu._echo = lambda *args: emu.send(b"\r\nbad command\r\n")  # a shell that answers no frame
+        # a shell that answers no frame (the ignore: this one emulator's echo handler is replaced, on purpose)
+        emu._echo = lambda *args: emu.send(b"\r\nbad command\r\n")  # type: ignore[method-assign]
         robot = robot_on(emu)
         robot.link.setup_timeout_s = 0.2
         with pytest.raises(LinkLost, match="no answer"):
@@ -159,7 +160,7 @@ def test_auto_finds_the_controller_by_its_usb_id_then_checks_it_answers_fish_x1(
              PortInfo("/dev/ttyACM3", 0x221D, 0x1000, "ROBO TX Controller"), PortInfo("/dev/ttyS0")]
     assert [p.device for p in robotx_link.candidates(ports)] == ["/dev/ttyACM3", "/dev/rfcomm0"]
     with RobotxEmulator() as emu, RobotxEmulator(fault=("silent", 0)) as other:
-        other._echo = lambda *args: None  # a port that never answers
+        other._echo = lambda *args: None  # type: ignore[method-assign]  # a port that never answers, on purpose
         found = robotx_link.find([PortInfo(other.device, 0x221D, 0x1000), PortInfo(emu.device, 0x221D, 0x1000)],
                                  timeout_s=0.2)
     assert found is not None and found[0] == emu.device and found[1].device == "ROBO TX-000"

@@ -14,7 +14,7 @@ import threading
 import time
 import tty
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Self
 
 
 @dataclass
@@ -75,7 +75,7 @@ class PtyDevice:
             self.hang_up()
         self._thread.join(timeout=2)
 
-    def __enter__(self) -> PtyDevice:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:
