@@ -178,7 +178,8 @@ def bare_step(machine: Machine, masks: Sequence[int]) -> Result:
 
 def bare_loop(machine: Machine, masks: Sequence[int]) -> Result:
     tables, t_bit = bare_tables(machine), machine.timer_bit
-    state, timer, out, first = machine.initial_state, machine.initial_timer, (0,) * len(machine.output_names), True
+    state, timer, first = machine.initial_state, machine.initial_timer, True
+    out: tuple[int | None, ...] = (0,) * len(machine.output_names)
     for mask in masks:
         if first:
             first = False

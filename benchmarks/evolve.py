@@ -33,12 +33,16 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import TypedDict
+from typing import TYPE_CHECKING, TypedDict
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
 NAMES = ["time_to_lamp", "area_covered", "collision_share"]
 
+
+if TYPE_CHECKING:
+    from tablebot.evolve.operators import Space
+    from tablebot.table import Table
 
 #: What the inner loop measures: its rates (medians) and the candidates/s of each repeat.
 InnerRates = TypedDict("InnerRates", {"candidates/s": float, "robot-ticks/s": float,
@@ -108,7 +112,7 @@ def ticks_of(seconds: float) -> int:
     return make_plan(EXAMPLE, None, [], ["start=random"], "0..0", None, seconds).spec.ticks
 
 
-def children(count: int) -> tuple[object, list[tuple[str, object]], object]:
+def children(count: int) -> tuple[Table, list[tuple[str, Table]], Space]:
     """``count`` proved children of the repaired BumberBot (distinct behaviours), as tables."""
     import numpy as np
 
@@ -125,7 +129,7 @@ def children(count: int) -> tuple[object, list[tuple[str, object]], object]:
     prover = Prover(find_property_files(EXAMPLE / "table.csv"))
     seed = repair(space.start(table), table, prover, sp).candidate
     rng = np.random.default_rng(0)
-    out: dict[str, object] = {}
+    out: dict[str, Table] = {}
     while len(out) < count:
         child = vary(seed, sp, rng)
         key, verdict = prover.verdict(space.to_table(child, table))  # type: ignore[arg-type]
@@ -187,7 +191,7 @@ def proving(count: int) -> None:
 
     table, tables, sp = children(1)
     prover = Prover(find_property_files(EXAMPLE / "table.csv"))
-    seed = space.start(tables[0][1])  # type: ignore[arg-type]
+    seed = space.start(tables[0][1])
     rng = np.random.default_rng(1)
     kids = [space.to_table(vary(seed, sp, rng), table) for _ in range(count)]  # type: ignore[arg-type]
     started = time.perf_counter()

@@ -231,7 +231,7 @@ def peak_memory(robots: int, seconds: float) -> tuple[float, float]:
 
 def evolve_rates(budget: int, seconds: float) -> dict[str, float]:
     sys.path.insert(0, str(ROOT / "benchmarks"))
-    from evolve import whole  # type: ignore[import-not-found]  # benchmarks/evolve.py
+    from evolve import whole  # benchmarks/evolve.py
 
     return whole(budget, seconds)
 

@@ -43,7 +43,7 @@ def file_chunks(path: Path) -> Iterator[bytes]:
 def serial_chunks(port: str, baud: int, seconds: float | None) -> Iterator[bytes]:
     """Bytes from a serial port until ``seconds`` pass (forever if None); needs pyserial."""
     try:
-        import serial  # type: ignore[import-untyped]  # pyserial, only needed for a live port
+        import serial  # pyserial, only needed for a live port
     except ImportError:
         raise fail(port, "reading a serial port needs pyserial", "pip install pyserial") from None
     try:

@@ -63,7 +63,7 @@ class Plan:
 
     @cached_property
     def _lists(self) -> tuple[tuple[int, ...], ...]:
-        return tuple(zip(*(self.encode(row) for row in self.table.rows), strict=True))  # type: ignore[arg-type]
+        return tuple(zip(*(self.encode(row) for row in self.table.rows), strict=True))
 
     @property
     def event(self) -> tuple[int, ...]:

@@ -88,7 +88,7 @@ def pcg64_inline() -> int | None:
     the inline path."""
     global _inline_offset
     if _inline_offset is not False:
-        return _inline_offset  # type: ignore[return-value]
+        return _inline_offset
     _inline_offset = None
     try:
         if sys.byteorder == "little" and ctypes.sizeof(ctypes.c_void_p) == WORD and _layout_holds():
