@@ -21,6 +21,7 @@ from tablebot.codegen.source import ENGINE_FILES, generate, template
 from tablebot.formats.inputs_csv import load_inputs
 from tablebot.machine import compile_table
 from tablebot.replay import replay
+from tablebot.robot import Match
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 
 if TYPE_CHECKING:
@@ -60,7 +61,7 @@ def test_random_tables_host_c_equals_python(tmp_path_factory: pytest.TempPathFac
 
 @pytest.mark.parametrize("match", ["document", "always"])
 @pytest.mark.parametrize("lookup", ["dense", "scan"])
-def test_both_matching_rules_in_c_on_tables_where_they_part(tmp_path: Path, match: str, lookup: str) -> None:
+def test_both_matching_rules_in_c_on_tables_where_they_part(tmp_path: Path, match: Match, lookup: str) -> None:
     """Tables and inputs on which the two rules take different decisions: C follows the table's own."""
     table, ticks = random_case(random.Random(f"c-{match}"), Shape(states=3, rows=9, counters=1, match=match))
     machine = compile_table(table)

@@ -19,6 +19,7 @@ if TYPE_CHECKING:
 
     from tablebot.formats.inputs_csv import TickInput
     from tablebot.machine import Machine
+    from tablebot.robot import StateId
 
 I3, I4, I5, I7, I8, T = 16, 8, 4, 2, 1, 32
 
@@ -27,7 +28,7 @@ def bumberbot() -> Engine:
     return Engine(example_machine())
 
 
-def run(engine: Engine, masks: list[int]) -> list[tuple[int, int, object, int, tuple[int, ...]]]:
+def run(engine: Engine, masks: list[int]) -> list[tuple[int, int, StateId, int, tuple[int, ...]]]:
     """(event, row, state, timer, outputs) after each tick."""
     out = []
     for mask in masks:
@@ -302,7 +303,7 @@ def test_masks_beyond_the_tables_events_are_refused(bad: int, jit: bool | None) 
 ])
 def test_wrong_inputs_name_the_offending_key_and_the_valid_ones(inputs: object, message: str) -> None:
     with pytest.raises(ValueError, match=message):
-        bumberbot().step(inputs)
+        bumberbot().step(inputs)  # type: ignore[arg-type]  # what the hint refuses, refused at run time too
 
 
 def test_pulses_must_fit_the_counters(tmp_path: Path) -> None:

@@ -40,7 +40,7 @@ def test_with_the_table_in_charge_the_env_runs_as_tablebot_sim() -> None:
             break
     table, machine = load(BUMBERBOT)
     alone = simulate(scene_for(table, machine, None, {"battery": {"charge": 0.7}}), len(rewards) / 100, 11)
-    np.testing.assert_array_equal(np.array(seen), Observation.of(alone.scene)(alone.hist))
+    np.testing.assert_array_equal(np.array(seen), Observation.of(alone.scene)(alone.kept_rows()))
     assert sum(rewards) == pytest.approx(-len(rewards) * 0.01)
 
 

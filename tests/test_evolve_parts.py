@@ -6,6 +6,7 @@ from __future__ import annotations
 import shutil
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -29,7 +30,7 @@ BUMBERBOT = ROOT / "examples" / "bumberbot" / "table.csv"
 PROPERTIES = find_property_files(BUMBERBOT)
 
 
-def bumberbot_space(**limits: object) -> tuple[Table, Space]:
+def bumberbot_space(**limits: Any) -> tuple[Table, Space]:
     table = load_table(BUMBERBOT)
     made = space.Limits(max_rows=space.default_max_rows(table), timer_max=space.default_timer_max(table))
     return table, Space(table.states, table.robot.motors, replace(made, **limits))
@@ -48,7 +49,7 @@ def test_variation_keeps_the_states_the_row_limit_and_every_frozen_cell() -> Non
         assert len(child) <= 40 and {g.state for g in child} == set(table.states)
         assert [g for g in child if g.state in (20, 21)] == [g for g in start if g.state in (20, 21)]
         by_origin = {g.origin: g for g in child if g.origin is not None}
-        assert all(by_origin[g.origin] == g for g in frozen)  # never removed, never changed
+        assert all(g.origin is not None and by_origin[g.origin] == g for g in frozen)  # never removed, never changed
         assert by_origin[5].timer == 895 and by_origin[15].motors[0] == 3
         assert all(set(g.events) <= set(table.events) and g.next in table.states for g in child)
         changed += child != start

@@ -44,7 +44,7 @@ def test_the_floor_sensors_read_the_tape_under_them(follower: SimRun) -> None:
     """Every tick, each sensor's reading is 1 exactly when its spot lies within the tape's half width."""
     from tablebot.sim.geometry import point_segment_distance
 
-    h, scene = follower.hist, follower.scene
+    h, scene = follower.kept_rows(), follower.scene
     lines = scene.geometry.lines
     for k, sensor in enumerate(scene.table.robot.sensors):
         fx, fy = sensor.at

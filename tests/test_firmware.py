@@ -20,7 +20,7 @@ from tablebot.firmware.emulate import build_harness, emulate, pins_csv
 from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.machine import compile_table
 from tablebot.replay import replay
-from tablebot.robot import BUMBERBOT, Counter, Robot
+from tablebot.robot import BUMBERBOT, Counter, Match, Robot
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 from tablebot.tomlfile import Source
 
@@ -118,7 +118,7 @@ def test_random_tables_in_firmware_equal_python(tmp_path_factory: pytest.TempPat
 
 
 @pytest.mark.parametrize("match", ["document", "always"])
-def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness: Path, tmp_path: Path, match: str) -> None:
+def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness: Path, tmp_path: Path, match: Match) -> None:
     """Under emulation the firmware follows the table's rule where the two part (the scan lookup carries
     the rule as code, the dense one as data)."""
     table, ticks = random_case(random.Random(f"fw-{match}"), Shape(states=3, rows=9, inputs=3, counters=1,

@@ -19,7 +19,7 @@ from tablebot.cli.common import load
 from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
 from tablebot.replay import replay
-from tablebot.robot import MATCHES
+from tablebot.robot import MATCHES, Match
 from tablebot.sim.runner import simulate
 from tablebot.sim.scene import prepare, robot_layer, scene_for
 from tablebot.sim.summary import summarise
@@ -115,7 +115,7 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
 
 
 @pytest.mark.parametrize("match", MATCHES)
-def test_the_compiled_simulator_and_the_fleet_follow_the_tables_matching_rule(match: str) -> None:
+def test_the_compiled_simulator_and_the_fleet_follow_the_tables_matching_rule(match: Match) -> None:
     """A random table in a random world on which the two rules drive different runs: the compiled loop,
     alone and as robot 0 of a fleet, takes ``Engine.step``'s decisions over the inputs it sensed."""
     rng = random.Random(5)  # a table and world where the two rules part on 268 of 400 ticks

@@ -20,7 +20,7 @@ from tablebot.engine import Engine
 from tablebot.formats.table_read import parse_table
 from tablebot.formats.table_write import format_table
 from tablebot.machine import NO_ROW, PREFILL_BITS, compile_table, first_match
-from tablebot.robot import MATCHES, Counter, Robot
+from tablebot.robot import MATCHES, Counter, Match, Robot
 from tablebot.table import Row, Table
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ class Spec:
     initial_state: int | str
     initial_timer: int
     order: tuple[int, ...]  # permutation of the CSV's columns
-    match: str = "always"  # the robot file's rule for a tick with no event
+    match: Match = "always"  # the robot file's rule for a tick with no event
 
 
 # --- the reference: the document's algorithm, literally ---------------------------------------------

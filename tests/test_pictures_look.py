@@ -145,7 +145,8 @@ def test_a_followed_line_shows_its_path_above_the_tape() -> None:
     assert path.get_zorder() > tape.get_zorder()
     canvas = cast(FigureCanvasAgg, fig.canvas)  # the pictures are drawn on an Agg canvas
     pixels = np.asarray(canvas.buffer_rgba())
-    x, y = ax.transData.transform(result.hist[len(result.hist) // 3, :2])
+    rows = result.kept_rows()
+    x, y = ax.transData.transform(rows[len(rows) // 3, :2])
     near = {tuple(pixels[len(pixels) - round(y) + dy, round(x) + dx, :3].tolist()) for dx in (-1, 0, 1)
             for dy in (-1, 0, 1)}
     path_colours = {tuple(round(255 * v) for v in c[:3]) for c in np.asarray(path.get_colors()).tolist()}

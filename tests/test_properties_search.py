@@ -199,6 +199,7 @@ def test_abstract_proofs_are_sound_and_counterexamples_real(table: Table, when: 
         result = check_property(prop, machine)
         if result.status == "violated":
             assert first_violation(prop, machine, replay(machine, result.inputs)) == result.at_tick
+            assert exact is not None
             assert result.at_tick == len(exact) - 1  # shortest: as long as the exact search's path
         else:
             assert exact is None

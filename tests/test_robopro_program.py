@@ -24,7 +24,7 @@ from tablebot.machine import NO_ROW, Machine, compile_table, first_match
 from tablebot.robopro.executor import run
 from tablebot.robopro.fit import plan, problems
 from tablebot.robopro.interpret import InterpreterError, Program, Run
-from tablebot.robopro.program import generate
+from tablebot.robopro.program import Rule, generate
 from tablebot.robopro.vocabulary import problems as vocabulary_problems
 from tablebot.table import Row, Table
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table, with_match
@@ -44,7 +44,7 @@ def lists_of(text: str) -> dict[str, list[int]]:
 
 # --- the reference ------------------------------------------------------------------------------------
 
-def reference(machine: Machine, inputs: list[TickInput], rule: str) -> list[tuple]:
+def reference(machine: Machine, inputs: list[TickInput], rule: Rule) -> list[tuple]:
     """The tick rule with either matching rule: (event, row, state, timer, outputs, counters) per tick.
     With rule "always" it must equal the engine (checked below), so it is the engine's rule plus the one
     condition the document adds: no lookup on a tick whose event set is empty."""
@@ -78,7 +78,7 @@ def engine_ticks(machine: Machine, inputs: list[TickInput]) -> list[tuple]:
     return out
 
 
-def program_ticks(table: Table, text: str, inputs: list[TickInput], rule: str) -> list[tuple]:
+def program_ticks(table: Table, text: str, inputs: list[TickInput], rule: Rule) -> list[tuple]:
     """The generated program's decisions (the executor runs ``generate(table, rule)``, which is ``text``)."""
     assert generate(table, rule) == text  # the same table and rule give the same bytes
     return [astuple(d) for d in run(table, inputs, rule)]
@@ -115,7 +115,7 @@ def test_bumberbot_program_keeps_to_real_programs() -> None:
 
 
 @pytest.mark.parametrize("rule", ["document", "always"])
-def test_bumberbot_recorded_run(rule: str) -> None:
+def test_bumberbot_recorded_run(rule: Rule) -> None:
     """500 ticks of the recorded inputs, from just before its first bump, engine against program."""
     table = load_table(EXAMPLE / "table.csv")
     machine = compile_table(table)
@@ -148,7 +148,7 @@ WIRINGS = st.fixed_dictionaries({"controller": st.sampled_from(["tx", "txt"])}, 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**32), counters=st.integers(0, 2), inputs=st.integers(0, 3),
        rule=st.sampled_from(["document", "always"]), sections=WIRINGS)
-def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, rule: str,
+def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, rule: Rule,
                                      sections: dict[str, Any]) -> None:
     rng = random.Random(seed)
     shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, max_timer=4, max_load=5)
@@ -161,7 +161,7 @@ def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, rule
 
 
 @pytest.mark.parametrize("rule", ["document", "always"])
-def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule: str) -> None:
+def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule: Rule) -> None:
     """Generated for the table's own rule (the robot file's match, no rule given), on tables and inputs where
     the two rules take different decisions: the program takes the engine's."""
     table, ticks = random_case(random.Random(f"robopro-{rule}"),
@@ -176,7 +176,8 @@ def test_the_rules_differ_where_the_document_says() -> None:
     row = replace(base.rows[0], events=frozenset(), timer=3, motors=(2, -2))
     table = fitting(Table(robot=replace(base.robot, initial_timer=5), events=base.events, rows=(row,)), {})
     ticks = [TickInput(0, ())] * 3
-    for rule, fired in (("always", [0, 0, 0]), ("document", [NO_ROW, NO_ROW, NO_ROW])):
+    cases: tuple[tuple[Rule, list[int]], ...] = (("always", [0, 0, 0]), ("document", [NO_ROW, NO_ROW, NO_ROW]))
+    for rule, fired in cases:
         got = program_ticks(table, generate(table, rule), ticks, rule)
         assert [t[1] for t in got] == fired
         assert got == reference(compile_table(table), ticks, rule)

@@ -30,6 +30,14 @@ if TYPE_CHECKING:
     from tablebot.robopro.lists import Lists
 
 CORPUS = corpus_dir()
+
+
+def corpus() -> Path:
+    """The corpus folder, in a test marked needs_corpus."""
+    assert CORPUS is not None
+    return CORPUS
+
+
 needs_corpus = pytest.mark.skipif(CORPUS is None, reason="the ROBO Pro corpus is not here: set "
                                   "TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository")
 runner = CliRunner()
@@ -82,7 +90,7 @@ def test_pixy_global_lists_are_written_in_every_subprogram(tmp_path: Path, lists
 
 @needs_corpus
 def test_srf08_names_are_compared_as_robopro_shows_them(tmp_path: Path, lists: Lists) -> None:
-    text = (CORPUS / SRF08).read_text(encoding="utf-8")
+    text = (corpus() / SRF08).read_text(encoding="utf-8")
     assert 'name="Abst&#228;nde"' in text
     new = rewrite(text, {"Abstände": list(lists.event)})
     assert copies(new.encode(), "Abstände") == [list(lists.event)] * 2
@@ -93,7 +101,7 @@ def test_srf08_names_are_compared_as_robopro_shows_them(tmp_path: Path, lists: L
 
 @needs_corpus
 def test_srf08_float_list_is_refused(tmp_path: Path) -> None:
-    text = (CORPUS / SRF08).read_text(encoding="utf-8")
+    text = (corpus() / SRF08).read_text(encoding="utf-8")
     with pytest.raises(TableBotError, match="'Messwerte' holds floats"):
         rewrite(text, {"Messwerte": [1, 2]})
 
@@ -120,7 +128,7 @@ def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path: Path
     assert all(c == [] for c in copies(before, "Data X"))
     assert export(program, "Data X", "Data Y", "Data Z").exit_code == 0
     after = program.read_text(encoding="utf-8")
-    real = (CORPUS / SRF08).read_text(encoding="utf-8")
+    real = (corpus() / SRF08).read_text(encoding="utf-8")
     real_layout = re.search(r'pinid="3">\r?\n( *)</o>\r?\n +\r?\n( *)<init value0="2" value1="0" value2="0">'
                             r'\r?\n( *)</init>', real)
     assert real_layout and real_layout[1] == real_layout[2] == real_layout[3]  # one indent for pin, init, </init>

@@ -8,6 +8,7 @@ from __future__ import annotations
 import ast
 import json
 import random
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -145,7 +146,7 @@ class LinkRobot:
         self.n += 1
         return self.masks[self.n - 1], []
 
-    def write(self, outputs: list[int]) -> None:
+    def write(self, outputs: Sequence[int]) -> None:
         self.writes.append((round(self.time.t, 9), tuple(outputs)))
 
     def stop(self) -> None:

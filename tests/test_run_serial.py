@@ -33,7 +33,7 @@ CORE = ("tick", "event", "row", "state", "timer", "M1", "M2")
 runner = CliRunner()
 
 
-def bumps(kind: str, seed: int = 3) -> Callable[[int], tuple[list[int], list[int] | dict[str, int]]]:
+def bumps(kind: str, seed: int = 3) -> Callable[[int], tuple[list[int], Any]]:  # Any: a list or a dict, by kind
     """Bumpers and light that change every few ticks, so the BumberBot takes many different rows."""
     rng = random.Random(seed)
     held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]

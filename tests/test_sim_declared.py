@@ -145,7 +145,7 @@ def test_thresholds_switch_with_the_declared_hysteresis(tmp_path: Path) -> None:
 def test_the_robot_turns_back_at_the_declared_thresholds(tmp_path: Path) -> None:
     scene = sensor_scene(tmp_path, room(start=(2.5, 1.5, 0)))  # the sensor 38 cm from the wall
     result = simulate(scene, 12.0)
-    h, events, bit = result.hist, result.events, scene.machine.input_bits["I3"]
+    h, events, bit = result.kept_rows(), result.events, scene.machine.input_bits["I3"]
     readings = np.round(h[:-1, L.READING + 2] * 100).astype(int)
     on = (events & bit) != 0
     switched_on = np.flatnonzero(on[1:] & ~on[:-1]) + 1

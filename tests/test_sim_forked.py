@@ -77,6 +77,7 @@ def test_leaving_without_the_answer_kills_the_copy_at_once() -> None:
 def test_a_copy_killed_from_outside_is_replaced_by_the_work_done_here() -> None:
     me = os.getpid()
     with Forked(lambda _: b"here" if os.getpid() == me else after(60, b"there")) as copy:
+        assert copy.pid is not None  # a copy was forked (two cores or more)
         os.kill(copy.pid, signal.SIGKILL)
         assert copy.result() == b"here"
     assert copies() == []

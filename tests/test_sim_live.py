@@ -60,7 +60,7 @@ def test_the_live_trace_is_the_replayed_trace(tmp_path: Path, table: Path, world
     live = (tmp_path / "trace.jsonl").read_text(encoding="utf-8").splitlines()
     robot = SimRobot(scene, 4)
     replayed = []
-    for line, row in zip(replay(scene.machine, result.inputs()), result.hist[:-1], strict=True):
+    for line, row in zip(replay(scene.machine, result.inputs()), result.kept_rows()[:-1], strict=True):
         line.update(robot.trace_fields(row))
         replayed.append(dumps(line))
     assert live == replayed and len(live) == 6000
@@ -156,4 +156,4 @@ def test_a_run_that_keeps_no_robot_rows_sums_up_the_same(example: str) -> None:
     scene = scene_of(ROOT / "examples" / example / "table.csv")
     full, lean = simulate(scene, 90.0, seed=2), simulate(scene, 90.0, seed=2, rows=False)
     assert lean.hist is None and summarise(lean) == summarise(full)
-    assert (lean.path == full.hist[::5, :2]).all()
+    assert (lean.path == full.kept_rows()[::5, :2]).all()

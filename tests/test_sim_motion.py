@@ -46,7 +46,7 @@ def test_straight_run_covers_speed_times_time(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(0.4, 1.5, 0)))
     result = simulate(scene, 6.0)
     expected = wheel_speed(scene.params, 4, 1.0, (4, 4)) * 5.0
-    h = result.hist
+    h = result.kept_rows()
     assert abs(math.hypot(h[-1, L.X] - h[0, L.X], h[-1, L.Y] - h[0, L.Y]) - h[-1, L.DIST]) < 1e-9
     assert abs(h[-1, L.DIST] - expected) < 0.01 * expected
     assert abs(h[-1, L.Y] - 1.5) < 1e-9 and abs(h[-1, L.TH]) < 1e-12  # exact motors drive dead straight
@@ -68,7 +68,7 @@ def test_the_same_spin_turns_less_on_a_drained_battery(tmp_path: Path) -> None:
 def test_encoders_count_63_and_a_third_pulses_per_wheel_turn(tmp_path: Path) -> None:
     scene = bot(tmp_path, SPIN, room())
     result = simulate(scene, 10.0)
-    h = result.hist
+    h = result.kept_rows()
     assert h[-1, L.DIST] < 1e-9  # a spin in place drives the centre nowhere
     expected = pulses_for_turn(scene.params, -result.heading_deg()[-1])
     for column in (L.ENC_R, L.ENC_L):
@@ -78,7 +78,7 @@ def test_encoders_count_63_and_a_third_pulses_per_wheel_turn(tmp_path: Path) -> 
 
 def test_battery_drains_and_sags_under_load(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room())
-    h = simulate(scene, 6.0).hist
+    h = simulate(scene, 6.0).kept_rows()
     assert h[-1, L.SOC] < h[0, L.SOC] == 1.0
     driving, stopped = h[100, L.VBAT], h[-1, L.VBAT]
     assert stopped > driving  # motors draw current through the internal resistance
@@ -86,7 +86,7 @@ def test_battery_drains_and_sags_under_load(tmp_path: Path) -> None:
 
 def test_driving_into_a_wall_stops_at_the_wall(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(2.7, 1.5, 0)))
-    h = simulate(scene, 6.0).hist
+    h = simulate(scene, 6.0).kept_rows()
     front = scene.params["body"]["front"]
     assert abs(h[-1, L.X] + front - 3.0) < 1e-6  # pushed out exactly to the wall
     assert h[-1, L.DIST] < 0.2
@@ -101,7 +101,7 @@ def test_the_robot_never_leaves_the_room(tmp_path_factory: pytest.TempPathFactor
     rows = [f"go,1,1,,,,,,{right},{left},3000,1"]
     extra = "[[box]]\nat = [0.9, 0.9]\nsize = [0.3, 0.3]\nangle = 20\n[[circle]]\nat = [0.3, 0.3]\nradius = 0.08"
     scene = bot(tmp, rows, room(start=(0.6, 0.6, heading), size=1.2, extra=extra, noise=True))
-    h = simulate(scene, 20.0, seed=3).hist
+    h = simulate(scene, 20.0, seed=3).kept_rows()
     walls = scene.world.walls
     assert all(inside(walls, (x, y)) for x, y in h[::50, [L.X, L.Y]])
     box_centre = np.array([0.9, 0.9])

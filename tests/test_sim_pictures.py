@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 from matplotlib.collections import PatchCollection
 from matplotlib.figure import Figure
+from matplotlib.patches import Wedge
 
 from tablebot.sim.draw import RobotArtist, contact_point, draw_world
 from tablebot.sim.plots import legend_marks, reading_panels
@@ -58,6 +59,7 @@ def test_the_robot_shows_its_own_sensors_and_not_the_bumberbots(tmp_path: Path) 
     robot.update(1.0, 1.0, 0.0, readings=(0.2, 0.6))
     assert not any(p.get_visible() for p in robot.bumpers + robot.cones)  # no bumpers, no phototransistors
     near, far = robot.declared
+    assert isinstance(near, Wedge) and isinstance(far, Wedge)  # distance sensors' beams
     assert (near.r, far.r) == (pytest.approx(0.2), pytest.approx(0.6))  # each beam reaches its echo
     result = simulate(scene, 1.0)
     labels = [h.get_label() for h in legend_marks(result, summarise(result), spins=False)]

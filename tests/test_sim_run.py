@@ -137,7 +137,7 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
     ax = Figure().add_subplot()
     robot = RobotArtist(ax, scene.params, n_lamps=1)
     robot.update(1.0, 1.0, 0.0, lamps=(8,))
-    assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_ON) and robot.glows[0].get_alpha() > 0
+    assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_ON) and (robot.glows[0].get_alpha() or 0) > 0
     robot.update(1.0, 1.0, 0.0, lamps=(0,))
     assert robot.lamps[0].get_facecolor() == to_rgba(LAMP_OFF) and robot.glows[0].get_alpha() == 0
 

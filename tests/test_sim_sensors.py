@@ -31,7 +31,7 @@ def first_tick(column_values: np.ndarray) -> int:
 
 def test_head_on_contact_closes_both_front_switches(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(2.6, 1.5, 0), noise=True))
-    h = simulate(scene, 6.0, seed=5).hist
+    h = simulate(scene, 6.0, seed=5).kept_rows()
     right, left = first_tick(h[:, L.BUMP_FR]), first_tick(h[:, L.BUMP_FL])
     assert abs(right - left) <= 5  # within the document's 50 ms wait
     assert h[-1, L.BUMP_REAR] == 0
@@ -39,14 +39,14 @@ def test_head_on_contact_closes_both_front_switches(tmp_path: Path) -> None:
 
 def test_a_side_hit_closes_only_that_side(tmp_path: Path) -> None:
     scene = bot(tmp_path, STRAIGHT, room(start=(2.7, 1.5, 30)))
-    h = simulate(scene, 3.0).hist  # the right front corner meets the wall first
+    h = simulate(scene, 3.0).kept_rows()  # the right front corner meets the wall first
     closed = np.flatnonzero(h[:, L.BUMP_FR] + h[:, L.BUMP_FL] > 0)
     assert h[closed[0], L.BUMP_FR] == 1 and h[closed[0], L.BUMP_FL] == 0
 
 
 def test_the_rear_switch_closes_when_backing_into_a_wall(tmp_path: Path) -> None:
     scene = bot(tmp_path, ["back,1,1,,,,,,-4,-4,500,1"], room(start=(0.3, 1.5, 0)))
-    h = simulate(scene, 4.0).hist
+    h = simulate(scene, 4.0).kept_rows()
     assert h[-1, L.BUMP_REAR] == 1 and h[-1, L.BUMP_FR] == h[-1, L.BUMP_FL] == 0
     assert abs(h[-1, L.X] - scene.params["body"]["rear"]) < 1e-6
 
@@ -64,7 +64,7 @@ def test_bumberbot_hitting_a_wall_goes_to_state_20_then_21(tmp_path: Path) -> No
 
 def test_a_lamp_in_front_is_seen(tmp_path: Path) -> None:
     scene = bot(tmp_path, STILL, room(start=(1.0, 1.5, 0), extra=LAMP.format(x=1.9, y=1.5)))
-    h = simulate(scene, 0.1).hist
+    h = simulate(scene, 0.1).kept_rows()
     assert h[0, L.LIGHT_R] > 1 and h[0, L.LIGHT_L] > 1
     bits = scene.bits[L.B_LIGHT_R] | scene.bits[L.B_LIGHT_L]
     assert int(h[0, L.MASK]) & bits == bits
@@ -72,24 +72,24 @@ def test_a_lamp_in_front_is_seen(tmp_path: Path) -> None:
 
 def test_a_lamp_to_one_side_is_seen_by_that_side_only(tmp_path: Path) -> None:
     scene = bot(tmp_path, STILL, room(start=(1.0, 1.5, 0), extra=LAMP.format(x=1.8, y=1.1)))
-    h = simulate(scene, 0.1).hist  # 27° to the right
+    h = simulate(scene, 0.1).kept_rows()  # 27° to the right
     assert h[0, L.LIGHT_R] >= 1 > h[0, L.LIGHT_L]
 
 
 def test_a_lamp_behind_the_robot_is_not_seen(tmp_path: Path) -> None:
     scene = bot(tmp_path, STILL, room(start=(1.0, 1.5, 180), extra=LAMP.format(x=1.9, y=1.5)))
-    h = simulate(scene, 0.1).hist
+    h = simulate(scene, 0.1).kept_rows()
     assert h[0, L.LIGHT_R] == h[0, L.LIGHT_L] == 0
 
 
 def test_a_lamp_behind_a_wall_is_not_seen(tmp_path: Path) -> None:
     wall = "[[segment]]\nfrom = [1.5, 1.0]\nto = [1.5, 2.0]\n"
     scene = bot(tmp_path, STILL, room(start=(1.0, 1.5, 0), extra=LAMP.format(x=1.9, y=1.5) + wall))
-    h = simulate(scene, 0.1).hist
+    h = simulate(scene, 0.1).kept_rows()
     assert h[0, L.LIGHT_R] == h[0, L.LIGHT_L] == 0
     boxed = "[[box]]\nat = [1.5, 1.5]\nsize = [0.1, 0.6]\n"
     scene = bot(tmp_path, STILL, room(start=(1.0, 1.5, 0), extra=LAMP.format(x=1.9, y=1.5) + boxed))
-    assert simulate(scene, 0.1).hist[0, L.LIGHT_L] == 0
+    assert simulate(scene, 0.1).kept_rows()[0, L.LIGHT_L] == 0
 
 
 def test_light_falls_with_distance_squared(tmp_path: Path) -> None:
@@ -98,7 +98,7 @@ def test_light_falls_with_distance_squared(tmp_path: Path) -> None:
     for d in (0.5, 1.0):
         x, y = sensor + d * np.array([np.cos(aim), np.sin(aim)])
         table, world = write_bot(tmp_path, STILL, room(start=(1.0, 1.5, 0), extra=LAMP.format(x=x, y=y)))
-        readings.append(simulate(scene_of(table, world), 0.1).hist[0, L.LIGHT_R])
+        readings.append(simulate(scene_of(table, world), 0.1).kept_rows()[0, L.LIGHT_R])
     assert abs(readings[0] - 2.0 / 0.5**2) < 1e-9  # intensity 2 straight on at 0.5 m
     assert abs(readings[0] / readings[1] - 4.0) < 1e-9
 

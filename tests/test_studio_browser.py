@@ -34,6 +34,8 @@ from tablebot.web.app import Background  # noqa: E402
 if TYPE_CHECKING:
     from playwright.sync_api import Locator
 
+    from tablebot.robot import StateId
+
 FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
 TIMER_COL, M1_SPEED_COL = 12, 9
@@ -142,7 +144,7 @@ def _hex(rgb: list[int]) -> str:
     return "#" + "".join(f"{v:02x}" for v in rgb)
 
 
-def pictures_colours(states: tuple[object, ...]) -> dict[str, set[str]]:
+def pictures_colours(states: tuple[StateId, ...]) -> dict[str, set[str]]:
     """Each state's colour in the PNGs of a run (tablebot.colours)."""
     return {str(s): {c} for s, c in zip(states, state_colours(states), strict=True)}
 

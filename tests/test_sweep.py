@@ -56,10 +56,10 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
     fleet = Fleet(table, machine, scene_for(table, machine).world,
                   [RobotSpec(seed=5, params=(("battery", "charge", 0.6),))], robot_layer(table.robot)[0])
     fleet.run(800)
-    alone = fleet.summary().summary(0)
-    assert float(rows[5]["distance_m"]) == round(alone.distance_m, 6)
-    assert int(rows[5]["collisions"]) == alone.collisions
-    assert float(rows[5]["battery_end_v"]) == round(alone.battery_end_v, 6)
+    sixth = fleet.summary().summary(0)
+    assert float(rows[5]["distance_m"]) == round(sixth.distance_m, 6)
+    assert int(rows[5]["collisions"]) == sixth.collisions
+    assert float(rows[5]["battery_end_v"]) == round(sixth.battery_end_v, 6)
     before = {p.name: p.stat().st_mtime_ns for p in (out / "parts").iterdir()}
     code, output = sweep("--grid", "battery=1.0,0.6", "--seeds", "3..5", "--seconds", "8", "--workers", "1",
                          "--out", str(out), "--no-plots")

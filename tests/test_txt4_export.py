@@ -24,6 +24,7 @@ from tablebot.engine import Engine
 from tablebot.escape import python_string
 from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import Machine, compile_table
+from tablebot.robot import Match
 from tablebot.table import Table
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table
 
@@ -66,7 +67,7 @@ def test_the_exported_engine_takes_the_python_engines_decisions_tick_for_tick(tm
 
 
 @pytest.mark.parametrize("match", ["document", "always"])
-def test_the_exported_engine_follows_the_tables_matching_rule(tmp_path: Path, match: str) -> None:
+def test_the_exported_engine_follows_the_tables_matching_rule(tmp_path: Path, match: Match) -> None:
     """On a table and inputs where the two rules part, the program takes the engine's decisions."""
     table, ticks = random_case(random.Random(f"txt4-{match}"), Shape(states=3, rows=9, counters=1, match=match))
     machine = with_txt_section(table)

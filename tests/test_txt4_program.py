@@ -20,10 +20,10 @@ from typing import Any
 
 import pytest
 
+import tablebot.hw.txt4.runtime as txt4_runtime
 from core_helpers import EXAMPLE
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
-from tablebot.hw.txt4 import runtime as txt4_runtime
 from tablebot.hw.txt4.export import export_txt4
 from tablebot.machine import compile_table
 from tablebot.replay import replay

@@ -133,12 +133,12 @@ class Listener:
                                                                                   http.server.BaseHTTPRequestHandler)
         else:
             self.server = socketserver.ThreadingTCPServer((host, port), BadRequest)
-        self.server.daemon_threads = True  # type: ignore[attr-defined]
+        self.server.daemon_threads = True
         threading.Thread(target=self.server.serve_forever, daemon=True).start()
 
     def close(self) -> None:
         self.server.shutdown()
-        self.server.server_close()  # type: ignore[attr-defined]
+        self.server.server_close()
 
 
 class BadRequest(socketserver.BaseRequestHandler):

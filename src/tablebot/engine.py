@@ -109,7 +109,7 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def step(self, inputs: int | Mapping[str, int] = 0,
+    def step(self, inputs: int | np.integer | Mapping[str, int] = 0,
              pulses: Sequence[int] | np.ndarray | None = None) -> tuple[int, ...]:
         """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (a sequence or
         numpy array; None or () when there are none).
@@ -152,7 +152,7 @@ class Engine:
             self._choose_lookups()
         return outputs
 
-    def events_of(self, inputs: int | Mapping[str, int]) -> int:
+    def events_of(self, inputs: int | np.integer | Mapping[str, int]) -> int:
         """Input bits in the machine's event layout, from a mask or from ``{name: 0/1}``.
 
         Raises ValueError for an unknown name, a value other than 0/1, a negative mask or a mask with

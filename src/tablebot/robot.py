@@ -10,7 +10,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
 from tablebot import durations
 from tablebot.sensors import Sensor, parse_sensors
@@ -57,8 +57,11 @@ MAX_TICK_MS = 60_000
 #: ``match``: what a row that requires no event does on a tick with no event at all (no input reads 1, T
 #: absent, no counter at 0). "document": nothing fires, as in the document's engine, which looks a row up
 #: only "if an event is detected"; "always": such a row matches every event set, the empty one too.
-MATCH_DOCUMENT, MATCH_ALWAYS = "document", "always"
-MATCHES = (MATCH_DOCUMENT, MATCH_ALWAYS)
+#: The two matching rules (see below).
+Match = Literal["document", "always"]
+MATCH_DOCUMENT: Match = "document"
+MATCH_ALWAYS: Match = "always"
+MATCHES: tuple[Match, ...] = (MATCH_DOCUMENT, MATCH_ALWAYS)
 #: A robot file that does not say: tablebot's rule from before the key existed, so that no existing table
 #: silently changes (``tablebot check`` says when the choice matters). The built-in BumberBot follows the document.
 DEFAULT_MATCH = MATCH_ALWAYS
@@ -90,7 +93,7 @@ class Robot:
     initial_timer: int = 0
     tick_ms: int = 10
     #: The matching rule for rows that require no event (MATCHES; see MATCH_DOCUMENT).
-    match: str = DEFAULT_MATCH
+    match: Match = DEFAULT_MATCH
     #: What drives each input that is not a plain switch (``[sensors]``; see :mod:`tablebot.sensors`).
     sensors: tuple[Sensor, ...] = ()
     labels: dict[str, str] = field(default_factory=dict, compare=False)
@@ -280,14 +283,14 @@ def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], want: s
     return value
 
 
-def _match(src: Source) -> str:
+def _match(src: Source) -> Match:
     """``match = "document"`` or ``"always"`` (DEFAULT_MATCH when the file does not say)."""
     value = src.data.get("match", DEFAULT_MATCH)
     if value not in MATCHES:
         src.key_error(("", None, "match"), f'match must be "{MATCH_DOCUMENT}" or "{MATCH_ALWAYS}", not {value!r}',
                       MATCH_HINT)
         return DEFAULT_MATCH
-    return str(value)
+    return cast(Match, value)  # one of MATCHES, checked above
 
 
 def _state_id(value: Any) -> StateId | None:

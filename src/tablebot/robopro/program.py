@@ -15,16 +15,16 @@ from __future__ import annotations
 
 import re
 from functools import partial
-from typing import Literal
 
 from tablebot.robopro import elements as el
 from tablebot.robopro.document import Sub, document
 from tablebot.robopro.fit import Plan, plan
 from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption
 from tablebot.robopro.sheet import Const, Count, Input, Join, ListAt, Op, Sheet, Tree, Var
+from tablebot.robot import Match
 from tablebot.table import Table
 
-Rule = Literal["document", "always"]
+Rule = Match  # the robot file's matching rules (tablebot.robot.Match)
 RULES: tuple[Rule, ...] = ("document", "always")
 MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN = ("Main program", "DetectEvent", "DetermineAction", "ExecuteAction",
                                                "CountDown")
@@ -233,7 +233,7 @@ def main_program(b: Builder) -> Sub:
 def generate(table: Table, rule: Rule | None = None) -> str:
     """The whole .rpp text for ``table`` under ``rule`` (default: the table's own, the robot file's ``match``);
     raises :class:`TableBotError` when the table does not fit."""
-    rule = rule or table.robot.match  # type: ignore[assignment]
+    rule = rule or table.robot.match
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, not {rule!r}")
     p = plan(table, rule)

@@ -61,6 +61,12 @@ class SimRun:
     wall_s: float  # how long the loop took; shown to people, never written into result files
     hist_columns: tuple[int, ...] | None = None  # the sim.columns hist holds (None: all of them)
 
+    def kept_rows(self) -> np.ndarray:
+        """``hist``, for a run that kept the robot's rows (``simulate``'s default); a run that kept none says so."""
+        if self.hist is None:
+            raise ValueError("this run kept no robot rows: simulate it with rows=True (the default)")
+        return self.hist
+
     @property
     def ticks(self) -> int:
         return len(self.states)

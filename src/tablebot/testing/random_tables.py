@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import compile_table
 from tablebot.replay import replay
-from tablebot.robot import MATCHES, Counter, Robot, StateId
+from tablebot.robot import MATCHES, Counter, Match, Robot, StateId
 from tablebot.table import MAX_LAMP, MAX_SPEED, TIMER_EVENT, Row, Table
 
 
@@ -29,7 +29,7 @@ class Shape:
     event_density: float = 0.3  # chance that a row requires a given event
     keep_chance: float = 0.2  # chance that an output cell is "keep"
     no_event_chance: float = 0.1  # chance that a row requires no event at all (where the two rules differ)
-    match: str | None = None  # the matching rule (robot.MATCHES); None: drawn
+    match: Match | None = None  # the matching rule (robot.MATCHES); None: drawn
     max_speed: int = MAX_SPEED  # the fastest motor speed a row sets (the document's program holds 0..6)
 
 
@@ -88,7 +88,7 @@ def random_inputs(rng: random.Random, table: Table, ticks: int, density: float =
             for _ in range(ticks)]
 
 
-def with_match(table: Table, match: str) -> Table:
+def with_match(table: Table, match: Match) -> Table:
     """The same table under the other (or a given) matching rule."""
     return replace(table, robot=replace(table.robot, match=match))
 
