@@ -16,7 +16,8 @@ demo: setup
 # once first), then the wall-clock ones (marked realtime there) two at a time with nothing CPU-bound beside
 # them but mypy at the lowest priority (nice 19). The wall-clock tests mostly wait on the clock (14 CPU-s in
 # 56 s one by one; 31-34 s two at a time, passing even beside two busy loops at normal priority), so mypy's
-# 45 s of CPU from an empty cache (the sources, tests and benchmarks) mostly fit in what they leave idle; its report is printed after the pass.
+# 45 s of CPU from an empty cache (the sources, tests and benchmarks) mostly fit in what they leave idle; its
+# report is printed after the pass.
 test: setup
 	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15
 	@log=$$(mktemp); nice -n 19 .venv/bin/mypy >"$$log" 2>&1 & mypy=$$!; \
