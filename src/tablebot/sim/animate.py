@@ -44,8 +44,7 @@ class Player:
         fig.text(0.08, 0.93, subtitle_of(summary), fontsize=8, color="#444")
         # the trail at frame resolution: one segment per frame keeps redrawing it cheap
         ticks = np.minimum(np.arange(0, result.ticks + ticks_per_frame, ticks_per_frame), result.ticks)
-        assert result.hist is not None  # an animated run keeps every robot row (sim's rows=True)
-        points = result.hist[ticks][:, [L.X, L.Y]]
+        points = result.kept_rows()[ticks][:, [L.X, L.Y]]  # an animated run keeps every robot row
         self.segments = np.stack((points[:-1], points[1:]), axis=1)
         colours = to_rgba_array(state_colours(scene.machine.states))
         self.colours = colours[result.states[np.minimum(ticks[:-1], max(0, result.ticks - 1))]]

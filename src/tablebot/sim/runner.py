@@ -78,8 +78,7 @@ class SimRun:
 
     def column(self, column: int) -> np.ndarray:
         """One column (sim.columns) of every robot row."""
-        assert self.hist is not None, "the run kept no robot rows (simulate with rows=True)"
-        return self.hist[:, self.held.index(column)]
+        return self.kept_rows()[:, self.held.index(column)]
 
     @property
     def tick_s(self) -> float:

@@ -53,6 +53,5 @@ def turns(table_path: Path, charges: list[float], seeds: list[int], seconds: flo
         for seed in seeds:
             result = simulate(scene, seconds, seed)
             heading = result.heading_deg()
-            assert result.hist is not None  # simulate keeps every robot row by default
-            found.append(Turn(charge, seed, float(heading[-1] - heading[0]), float(result.hist[1, L.VBAT])))
+            found.append(Turn(charge, seed, float(heading[-1] - heading[0]), float(result.kept_rows()[1, L.VBAT])))
     return found
