@@ -112,6 +112,12 @@ def test_a_deeply_nested_property_is_a_located_error_and_a_long_flat_one_works(b
     (["sim", str(EXAMPLE), "--seconds", "abc"], "--seconds: error: 'abc' is not a number"),
     (["sim", str(EXAMPLE), "--seconds", "9999"], "--seconds: error: --seconds 9999 is out of range\n"
                                                  "    hint: give --seconds a value from 0.01 to 3600"),
+    (["sim", str(EXAMPLE), "--battery", "nan"], "--battery: error: --battery nan is not a finite number\n"
+                                                "    hint: give --battery a value from 0.0 to 1.0"),
+    (["sweep", str(EXAMPLE), "--seconds", "inf"], "--seconds: error: --seconds inf is not a finite number"),
+    (["run", str(EXAMPLE), "--on", "sim", "--seconds", "0.3", "-q", "--behind-limit", "nan"],
+     "--behind-limit: error: --behind-limit nan is not a finite number\n"
+     "    hint: give --behind-limit a value of at least 0.0"),
     (["sim", str(EXAMPLE), "--sed", "3"], "--sed: error: --sed is not an option of this command\n"
                                           "    hint: did you mean --seconds or --seed?"),
     (["chek", str(EXAMPLE)], "chek: error: 'chek' is not a tablebot command\n    hint: did you mean check?"),
@@ -122,6 +128,27 @@ def test_a_wrong_command_line_is_answered_in_tablebots_words(args: list[str], wo
     code, output = invoke(*args)
     assert code == 2 and words in output, output
     assert "Value error" not in output and "Input should be" not in output and "Usage:" not in output
+
+
+def test_no_number_option_of_any_command_takes_nan_or_inf() -> None:
+    """click's range test let nan through (every comparison with it is false): `sim --battery nan` simulated
+    a robot without charge, `sweep --seconds nan` ended in an internal error."""
+    import typer.main
+    from typer._click.exceptions import BadParameter
+    from typer._click.types import FloatParamType
+
+    from tablebot.cli.app import app
+
+    group = typer.main.get_command(app)
+    options = [(name, param) for name, command in group.commands.items()  # type: ignore[attr-defined]
+               for param in command.params if isinstance(param.type, FloatParamType)]
+    assert len(options) == 9  # sim, sweep, tune, evolve, run, monitor: their --seconds, and four more
+    for name, param in options:
+        for text in ("nan", "-inf", "inf", "NaN"):
+            with pytest.raises(BadParameter, match="is not a finite number"):
+                param.type.convert(text, param, None)
+        low = getattr(param.type, "min", None)
+        assert param.type.convert(repr(low or 1.0), param, None) == (low or 1.0), name  # its range, as before
 
 
 def test_export_offers_no_force_and_never_suggests_it(tmp_path: Path) -> None:

@@ -5,6 +5,7 @@ float range", "Invalid value for '--seconds'")."""
 from __future__ import annotations
 
 import difflib
+import math
 from collections.abc import Sequence
 from enum import Enum
 from typing import IO, Any
@@ -17,7 +18,7 @@ from typer._click.exceptions import (
     NoSuchOption,
     UsageError,
 )
-from typer._click.types import FloatParamType, IntParamType
+from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
 from typer.core import TyperGroup
 
@@ -25,7 +26,15 @@ from tablebot.diagnostics import Diagnostic
 
 
 class Group(TyperGroup):
-    """tablebot's command group: the commands' usage errors come out in tablebot's words."""
+    """tablebot's command group: the commands' usage errors come out in tablebot's words, and their number
+    options take finite numbers only."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for command in self.commands.values():
+            for param in command.params:
+                if isinstance(param.type, FloatParamType):
+                    param.type = FiniteFloat.like(param.type)
 
     def invoke(self, ctx: Any) -> Any:
         given = [*ctx._protected_args, *ctx.args]  # the command line, for the value a user gave
@@ -44,6 +53,25 @@ class Group(TyperGroup):
             raise OptionError(Diagnostic(name, None, None, f"{name!r} is not a tablebot command",
                                          f"{hint}tablebot -h lists the commands"))
         return super().resolve_command(ctx, args)
+
+
+class FiniteFloat(FloatRange):
+    """A float option's type that refuses nan and inf: click's range test lets nan through (every comparison
+    with it is false), and no tablebot option means anything by it (``sim --battery nan`` wrote NaN, which is
+    not JSON, into its trace; ``sweep --seconds nan`` ended in an internal error)."""
+
+    @classmethod
+    def like(cls, kind: FloatParamType) -> FiniteFloat:
+        """The same range as ``kind`` (none when it is a plain float), finite."""
+        if not isinstance(kind, FloatRange):
+            return cls()
+        return cls(kind.min, kind.max, kind.min_open, kind.max_open, kind.clamp)
+
+    def convert(self, value: Any, param: Any, ctx: Any) -> Any:
+        number = FloatParamType.convert(self, value, param, ctx)  # a number at all, before its range
+        if not math.isfinite(number):
+            self.fail(f"{number} is not a finite number", param, ctx)
+        return super().convert(number, param, ctx)
 
 
 class OptionError(ClickException):
@@ -89,8 +117,10 @@ def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
         assert param is not None  # a number kind comes only from a parameter's type
         low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
         limits = f"from {low} to {high}" if low is not None and high is not None else \
-            f"of at least {low}" if low is not None else f"of at most {high}"
-        return Diagnostic(name, None, None, f"{name} {value} is out of range", f"give {name} a value {limits}")
+            f"of at least {low}" if low is not None else f"of at most {high}" if high is not None else "such as 0.5"
+        finite = number is int or value is None or math.isfinite(float(value))
+        wrong = "is out of range" if finite else "is not a finite number"
+        return Diagnostic(name, None, None, f"{name} {value} {wrong}", f"give {name} a value {limits}")
     message = exc.message
     return Diagnostic(name, None, None, f"{shown}: {message}", f"{command} says what {name} takes")
 
