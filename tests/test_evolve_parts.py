@@ -138,3 +138,16 @@ def test_out_may_not_be_the_folder_the_table_is_read_from(tmp_path: Path) -> Non
     code, output = evolve(str(bot / "table.csv"), "--out", str(bot), "--seeds", "0..1")
     assert code == 2 and "--out" in output and "is the folder of table.csv" in output, output
     assert sorted(p.name for p in bot.iterdir()) == before
+
+
+def test_the_before_after_change_is_weighed_against_its_spread() -> None:
+    """One scenario printed "± nan" and called it no clear difference; two or more weigh the change."""
+    from tablebot.evolve.measures import MEASURES
+    from tablebot.evolve.report import paired
+
+    lamp = MEASURES["time_to_lamp"]  # low is better
+    assert paired(lamp, np.array([30.0]), np.array([20.0])) == \
+        "-10.000 (one scenario, so no standard error): no clear difference"
+    assert paired(lamp, np.array([30.0, 31.0, 29.0]), np.array([20.0, 22.0, 19.0])).endswith(": better")
+    assert paired(lamp, np.array([30.0, 10.0, 29.0]), np.array([20.0, 40.0, 19.0])).endswith("no clear difference")
+    assert "nan" not in paired(lamp, np.array([5.0, 5.0]), np.array([5.0, 5.0]))

@@ -262,9 +262,10 @@ def paired(objective: Measure, before: np.ndarray, after: np.ndarray) -> str:
     """The change in the objective, scenario by scenario (common random numbers), with two standard errors."""
     diff = np.asarray(after, dtype=float) - np.asarray(before, dtype=float)
     n = len(diff)
-    se = float(np.std(diff, ddof=1) / math.sqrt(n)) if n > 1 else float("nan")
     mean = float(np.mean(diff))
+    if n < 2:  # one scenario has no spread to weigh the change against
+        return f"{mean:+.3f} (one scenario, so no standard error): no clear difference"
+    se = float(np.std(diff, ddof=1) / math.sqrt(n))
     better = mean < 0 if objective.better == "low" else mean > 0
-    clear = abs(mean) > 2 * se if n > 1 else False
-    verdict = ("better" if better else "worse") if clear else "no clear difference"
+    verdict = ("better" if better else "worse") if abs(mean) > 2 * se else "no clear difference"
     return f"{mean:+.3f} ± {2 * se:.3f} (two standard errors over {n} paired scenarios): {verdict}"
