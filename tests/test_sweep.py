@@ -173,6 +173,11 @@ def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask
     (["--robots", "2", "--backend", "dask"], "--backend", "needs a scheduler"),
     (["--robots", "2", "--backend", "cloud"], "--backend", "unknown backend"),
     (["--robots", "2", "--trace", "2"], "--trace", "--trace 2: the sweep has runs 0..1"),
+    # addresses Dask cannot parse: an internal error (and a traceback from the half-made client) until now
+    (["--robots", "2", "--scheduler", "nonsense"], "--scheduler",
+     "--scheduler 'nonsense' is not a Dask scheduler's address: missing port number"),
+    (["--robots", "2", "--scheduler", "foo://h:1"], "--scheduler", "unknown address scheme 'foo'"),
+    (["--robots", "2", "--scheduler", "tcp://127.0.0.1:99999"], "--scheduler", "port 99999 is not from 1 to 65535"),
 ])
 def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list[str], option: str,
                                                       words: str) -> None:
@@ -181,6 +186,22 @@ def test_bad_specs_are_clear_errors_naming_the_option(tmp_path: Path, args: list
     assert output.startswith(f"{option}: error:") and words in output, output
     assert "Traceback" not in output
     assert not (tmp_path / "s").exists()  # nothing written: the mended command is no "different sweep"
+
+
+def test_a_tls_address_without_dasks_tls_settings_is_a_clear_error(tmp_path: Path) -> None:
+    """Found on connecting (as an unreachable scheduler is), so the sweep's folder is made first."""
+    code, output = sweep("--robots", "2", "--scheduler", "tls://127.0.0.1:9", "--out", str(tmp_path / "s"))
+    assert code == 2 and output.startswith("--scheduler: error: cannot connect to the Dask scheduler at tls://"), output
+    assert "distributed.comm.tls.ca-file" in output and "Traceback" not in output
+
+
+def test_a_scheduler_address_from_the_environment_is_named_as_such(tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "junk")
+    code, output = sweep("--robots", "2", "--out", str(tmp_path / "s"))
+    assert code == 2, output
+    assert output.startswith("DASK_SCHEDULER_ADDRESS: error: DASK_SCHEDULER_ADDRESS 'junk' is not"), output
+    assert "tcp://127.0.0.1:8786" in output and not (tmp_path / "s").exists()
 
 
 def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 import threading
 from collections import defaultdict
 from collections.abc import Callable, Sequence
@@ -102,6 +103,8 @@ class Runner:
         # Dask's own import (~0.5 s of Python) first, alone: the workers get their start-up that much sooner
         # than if it shared the GIL with the caller's imports; the connection itself then waits on the network.
         self._dask_imported.wait()
+        if sys.modules.get("distributed") is not None:  # (without Dask, connecting says what to install)
+            check_address(self.address or "")  # a mistyped address stops the command before it writes
 
     def imported(self) -> None:
         """The caller has imported the fleet (see :meth:`start`); locally, this process's compiled code starts
@@ -230,11 +233,35 @@ def connect(address: str) -> Any:
         from distributed import Client
     except ImportError:
         raise fail("--backend", "--backend dask: Dask is not installed", INSTALL_HINT) from None
+    check_address(address)
     try:
         return Client(address, timeout="15s", set_as_default=False)
     except (OSError, TimeoutError) as exc:
         raise fail("--scheduler", f"cannot reach the Dask scheduler at {address}: {exc}",
                    "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
+    except TypeError as exc:  # Dask's words for a tls:// address without its TLS settings
+        raise fail("--scheduler", f"cannot connect to the Dask scheduler at {address}: {exc}",
+                   "give Dask's TLS settings (distributed.comm.tls.ca-file, .client.cert and .client.key in its "
+                   "configuration), or use a tcp:// address") from None
+
+
+def check_address(address: str) -> None:
+    """Refuse an address Dask cannot parse before a client is made of it: Client raised a ValueError (an
+    internal error here), and the half-made client then printed a traceback of its own as the process ended."""
+    from distributed.comm.addressing import get_address_host_port, parse_address
+    from distributed.comm.registry import get_backend
+
+    where = SCHEDULER_ENV if address == os.environ.get(SCHEDULER_ENV) else "--scheduler"
+    try:
+        scheme, _ = parse_address(address)
+        get_backend(scheme)  # a scheme Dask knows
+        if scheme in ("tcp", "tls", "ws", "wss"):  # the network schemes: a host and a port
+            _, port = get_address_host_port(address)
+            if not 0 < port < 65536:
+                raise ValueError(f"port {port} is not from 1 to 65535")
+    except ValueError as exc:
+        raise fail(where, f"{where} {address!r} is not a Dask scheduler's address: {exc}",
+                   "write tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786 (what `dask scheduler` prints)") from None
 
 
 def submit_all(client: Any, jobs: Sequence[Job], fn: Callable[[Any], tuple[Job, Any]]) -> dict[Any, Common | None]:
