@@ -180,3 +180,23 @@ def test_the_guard_outside_a_command_refuses_nothing(tmp_path: Path) -> None:
     write_text(table, "state,next\n2,2\n")  # library use: the caller decides
     with guard.command(), pytest.raises(TableBotError):
         write_text(table, "x")
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc, where no file can be made")
+@pytest.mark.parametrize("args", [["diagram", "{table}", "--out", "/proc/tablebot-x.svg"], ["new", "/proc/tablebot-x"]])
+def test_a_file_that_cannot_be_made_is_named_as_the_user_named_it(args: list[str]) -> None:
+    """A temporary file (or staging folder) that could not be made was the one the error named:
+    "/proc/.tablebot-x.svg.ygu7q6hw.tmp: error: ...", a name the user never gave."""
+    result = CliRunner().invoke(app, [a.format(table=EXAMPLE) for a in args])
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"{args[-1]}: error: cannot write or read"), result.output
+    assert ".tmp" not in result.output and ".tablebot-" not in result.output
+
+
+def test_an_output_file_inside_a_file_is_a_clear_error(tmp_path: Path) -> None:
+    """diagram --out FILE/x.svg said "--out names a file, not a folder" with a hint to give a folder."""
+    (tmp_path / "notes").write_text("mine\n", encoding="utf-8")
+    result = CliRunner().invoke(app, ["diagram", str(EXAMPLE), "--out", str(tmp_path / "notes" / "x.svg")])
+    assert result.exit_code == 2, result.output
+    assert f"{tmp_path / 'notes'}: error: the folder of --out {tmp_path / 'notes' / 'x.svg'} is a file" in result.output
+    assert (tmp_path / "notes").read_text(encoding="utf-8") == "mine\n"

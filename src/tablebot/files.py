@@ -54,6 +54,8 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
     if path.is_dir():
         raise fail(path, f"{option} names a folder, not a file", f"give {option} a file name")
     if make_folder:
+        if path.parent.exists() and not path.parent.is_dir():
+            raise fail(path.parent, f"the folder of {option} {path} is a file", f"give {option} a file in a folder")
         out_folder(path.parent, option)
     elif not path.parent.is_dir():
         what = "is not a folder" if path.parent.exists() else "does not exist"
@@ -90,7 +92,10 @@ def _temporary(path: Path, where: Path, mode: str, encoding: str | None,
     or its place in a set's staging folder) and its name; the command's guard first refuses a path it must
     not write over (see :mod:`tablebot.overwrite`)."""
     writing(path)
-    fd, name = tempfile.mkstemp(prefix=f".{where.name}.", suffix=".tmp", dir=where.parent)
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{where.name}.", suffix=".tmp", dir=where.parent)
+    except OSError as exc:  # named as the file the user asked for, not the temporary name it never saw
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
     except BaseException:

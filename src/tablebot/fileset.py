@@ -118,7 +118,7 @@ def file_set(folder: str | Path, remove: Iterable[str] = ()) -> Iterator[FileSet
             return
     folder.mkdir(parents=True, exist_ok=True)
     recover(Path(real))
-    stage, lock = _make_stage(Path(real))
+    stage, lock = _make_stage(Path(real), folder)
     fs = FileSet(Path(real), stage, lock, set(remove))
     token = _active.set((*_active.get(), fs))
     try:
@@ -140,7 +140,7 @@ def new_folder(folder: Path) -> Iterator[Path]:
     parent = Path(os.path.realpath(folder.parent if str(folder.parent) else "."))
     parent.mkdir(parents=True, exist_ok=True)
     recover(parent)
-    stage, lock = _make_stage(parent)
+    stage, lock = _make_stage(parent, folder)
     try:
         yield stage
         umask = os.umask(0)
@@ -160,8 +160,13 @@ def new_folder(folder: Path) -> Iterator[Path]:
         raise
 
 
-def _make_stage(folder: Path) -> tuple[Path, int]:
-    stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=folder))
+def _make_stage(folder: Path, named: Path) -> tuple[Path, int]:
+    """A staging folder inside ``folder``, locked; a failure names ``named`` (what the user asked for), not
+    the staging folder's made-up name."""
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=folder))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(named)) from None
     lock = os.open(stage / LOCK, os.O_RDWR | os.O_CREAT, 0o600)
     fcntl.flock(lock, fcntl.LOCK_EX)
     return stage, lock
