@@ -103,8 +103,11 @@ def test_output_file_in_a_missing_folder_says_so(tmp_path: Path) -> None:
 
 
 def test_output_file_below_a_file(tmp_path: Path) -> None:
-    (tmp_path / "afile").write_text("")
-    assert "names a file, not a folder" in fails("diagram", EXAMPLE, "--out", tmp_path / "afile" / "x.dot")
+    """It said "--out names a file, not a folder" with a hint to give a folder, of an option that takes a file."""
+    (tmp_path / "afile").write_text("mine\n")
+    said = fails("diagram", EXAMPLE, "--out", tmp_path / "afile" / "x.dot")
+    assert said.startswith(f"{tmp_path / 'afile'}: error: the folder of --out {tmp_path / 'afile' / 'x.dot'} is a file")
+    assert "hint: give --out a file in a folder" in said and (tmp_path / "afile").read_text() == "mine\n"
 
 
 def test_existing_output_file_is_replaced(tmp_path: Path) -> None:

@@ -192,11 +192,3 @@ def test_a_file_that_cannot_be_made_is_named_as_the_user_named_it(args: list[str
     assert result.output.startswith(f"{args[-1]}: error: cannot write or read"), result.output
     assert ".tmp" not in result.output and ".tablebot-" not in result.output
 
-
-def test_an_output_file_inside_a_file_is_a_clear_error(tmp_path: Path) -> None:
-    """diagram --out FILE/x.svg said "--out names a file, not a folder" with a hint to give a folder."""
-    (tmp_path / "notes").write_text("mine\n", encoding="utf-8")
-    result = CliRunner().invoke(app, ["diagram", str(EXAMPLE), "--out", str(tmp_path / "notes" / "x.svg")])
-    assert result.exit_code == 2, result.output
-    assert f"{tmp_path / 'notes'}: error: the folder of --out {tmp_path / 'notes' / 'x.svg'} is a file" in result.output
-    assert (tmp_path / "notes").read_text(encoding="utf-8") == "mine\n"
