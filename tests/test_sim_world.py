@@ -36,6 +36,8 @@ R = room().count("\n")  # lines of the room text; the bad parts follow it
     (room() + "[[circle]]\nat = [1, 1]\nradius = \"big\"\n", R + 3, "radius must be a number"),
     (room() + "[[lamp]]\nat = [1, 1]\ncolour = \"red\"\n", R + 3, "unknown key 'colour'"),
     (room() + "[[lamp]]\nat = [1]\n", R + 2, "must be a point [x, y]"),
+    # it said "must be a point [x, y]" of a point, with "at = [...]" as the example for walls too
+    (room() + "[[lamp]]\nat = [1e9, 1]\n", R + 2, "[[lamp]] #1 at: the point [1000000000.0, 1] is out of range"),
     (room() + "[battery]\ncharge = 2\n", R + 2, "charge = 2 is out of range 0..1"),
     (room() + "[motor]\nlevels = 8.5\n", R + 2, "must be an integer"),
     (room() + "[[segment]]\nfrom = [1, 1]\nto = [1, 1]\n", R + 3, "has no length"),

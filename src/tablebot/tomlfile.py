@@ -159,12 +159,20 @@ def number(src: Source, where: Where, value: Any, low: float, high: float, integ
     return value
 
 
+#: The largest distance from the origin, in metres, a world's points may have on either axis.
+MAX_COORDINATE = 1e4
+
+
 def point(src: Source, where: Where, value: Any) -> tuple[float, float] | None:
     """An ``[x, y]`` pair of numbers in metres."""
-    if (isinstance(value, list) and len(value) == 2 and all(is_number(v) for v in value)
-            and all(abs(v) <= 1e4 for v in value)):
+    pair = isinstance(value, list) and len(value) == 2 and all(is_number(v) for v in value)
+    if pair and all(abs(v) <= MAX_COORDINATE for v in value):
         return float(value[0]), float(value[1])
-    src.error(where, f"{label(where)} must be a point [x, y] in metres, not {value!r}", "for example: at = [1.2, 0.5]")
+    if pair:  # a point, but no room is that large (and the physics' floats would lose their millimetres)
+        src.error(where, f"{label(where)}: the point {value!r} is out of range", f"write x and y from "
+                  f"{-MAX_COORDINATE:g} to {MAX_COORDINATE:g} metres")
+    else:
+        src.error(where, f"{label(where)} must be a point [x, y] in metres, not {value!r}", "for example: [1.2, 0.5]")
     return None
 
 
