@@ -69,6 +69,28 @@ def test_a_sweep_writes_one_row_per_run_equal_to_the_fleet_and_resumes(tmp_path:
     assert code == 2 and "--out holds the results of a different sweep" in output
 
 
+@pytest.mark.parametrize("damage", ["cut", "empty", "edited"])
+def test_a_damaged_part_is_made_again_not_merged(tmp_path: Path, damage: str) -> None:
+    """A part cut short (a full disk, a copy stopped half way) was merged as it was: results.csv lost rows and
+    joined two of them, and the sweep said nothing."""
+    out, args = tmp_path / "s", ("--robots", "40", "--seconds", "2", "--no-plots", "--quiet")
+    code, output = sweep(*args, "--out", str(out))
+    assert code == 0, output
+    whole = (out / "results.csv").read_bytes()
+    parts = sorted((out / "parts").iterdir())
+    assert len(parts) == 5, parts  # 8 robots each
+    kept = {p.name: p.stat().st_mtime_ns for p in parts}
+    text = parts[2].read_text(encoding="utf-8")
+    parts[2].write_text({"cut": text[: len(text) // 2], "empty": "",
+                         "edited": text.replace("\n17,", "\n71,")}[damage], encoding="utf-8")
+    code, output = sweep(*args, "--out", str(out))
+    assert code == 0, output
+    assert f"{parts[2]}: note: this part of the sweep is damaged" in output and "runs 16..23" in output
+    assert (out / "results.csv").read_bytes() == whole
+    assert {p.name: p.stat().st_mtime_ns for p in parts if p != parts[2]} == \
+        {name: ns for name, ns in kept.items() if name != parts[2].name}  # only the damaged part ran again
+
+
 def test_each_row_carries_the_start_its_robot_ran_from(tmp_path: Path) -> None:
     """Random starts as the plan draws them (the traced run begins there), given poses as given."""
     from tablebot.fleet.plan import make_plan

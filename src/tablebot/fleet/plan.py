@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.diagnostics import TableBotError, fail
+from tablebot.diagnostics import Diagnostic, TableBotError, fail, notify
 from tablebot.files import atomic_write, remove, write_text
 from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
 from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs, value_index
@@ -280,7 +280,23 @@ class Store:
             write_text(spec_file, text)
         wanted = set(chunks(self.plan.spec))
         found = {(int(m[1]), int(m[2])) for p in self.parts.iterdir() if (m := PART_RE.match(p.name))}
-        return found & wanted
+        return {chunk for chunk in found & wanted if self._whole(*chunk)}
+
+    def _whole(self, a: int, b: int) -> bool:
+        """Whether the part of runs a..b-1 holds what this sweep writes there: its header, then one whole row
+        per run, in order. A part is written whole or not at all, so only a damaged or edited one fails:
+        it is said, and its runs are made again (the same rows: a part is deterministic) over it."""
+        part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
+        columns = list(self.plan.columns())
+        with open(part, encoding="utf-8", errors="replace", newline="") as f:
+            text = f.read()
+        rows = list(csv.reader(io.StringIO(text)))  # cells may hold quoted commas (a world's path)
+        if text.endswith("\n") and rows[:1] == [columns] and [row[0] for row in rows[1:] if row] == \
+                [str(run) for run in range(a, b)] and all(len(row) == len(columns) for row in rows[1:]):
+            return True
+        notify(Diagnostic(str(part), None, None, "this part of the sweep is damaged (not the rows this sweep "
+                          f"writes for runs {a}..{b - 1}): its runs are made again", severity="note"))
+        return False
 
     def write_part(self, job: Job, text: str) -> Path:
         """A finished chunk's rows (:meth:`Plan.part_text`) as its part file."""
