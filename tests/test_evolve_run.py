@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -73,6 +74,12 @@ def test_the_bumberbot_is_repaired_first_and_every_table_written_is_usable(tmp_p
     assert code == 0, output
     assert "0 run on the fleet now, 8 taken from an earlier run" in output
     assert all(p.read_bytes() == data for p, data in again.items())
+    repairs = (out / "repairs.json").read_bytes()
+    (out / "repairs.json").write_bytes(repairs[: len(repairs) // 2])  # cut: it ended in a JSONDecodeError
+    code, output = evolve(*args)
+    assert code == 0 and "repairs.json: note: not the repairs evolve writes: the repair is made again" in output
+    assert (out / "repairs.json").read_bytes() == repairs  # made again, the same
+    assert all(p.read_bytes() == data for p, data in again.items())
 
 
 def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_run: Path,
@@ -112,6 +119,22 @@ def test_sigterm_and_ctrl_c_keep_what_ran_and_the_same_command_resumes(tmp_path:
     assert done.returncode == 0, done.stderr
     assert records.read_text().splitlines()[: len(second)] == second  # what ran before is kept, not run again
     same_results(line_run, out)
+
+
+@pytest.mark.parametrize("cut", ["evaluations.jsonl", "proofs.jsonl"])
+def test_a_record_cut_mid_line_is_done_again(tmp_path: Path, line_run: Path, cut: str) -> None:
+    """A kill (or a full disk) in the middle of a record's line left proofs.jsonl unreadable: the resumed run
+    ended in an internal error (JSONDecodeError). And a record appended after a cut line joined it, so it was
+    lost too."""
+    out = tmp_path / "resumed"
+    shutil.copytree(line_run, out)
+    data = (out / cut).read_bytes()
+    (out / cut).write_bytes(data[: len(data) - 25])  # the last record cut
+    code, output = evolve(str(LINE), "--out", str(out), *LINE_RUN, "--backend", "local", "--workers", "1")
+    assert code == 0, output
+    same_results(line_run, out)
+    lines = (out / cut).read_text(encoding="utf-8").splitlines()  # the cut record made again, on its own line
+    assert len(lines) == data.count(b"\n") + 1 and json.loads(lines[-1])
 
 
 def test_the_report_gives_a_working_command_for_every_world(tmp_path: Path) -> None:

@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import codecs
 import errno
+import json
 import os
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 from tablebot import fileset, overwrite
 from tablebot.csvtext import split_records
@@ -177,6 +178,28 @@ def remove(path: str | Path) -> None:
         owner.remove(Path(path))
     else:
         Path(path).unlink(missing_ok=True)
+
+
+def json_records(path: Path, keys: Sequence[str]) -> list[dict[str, Any]]:
+    """The records of a JSON Lines file this program appends to as its work goes (one record per line, for
+    a cut run to keep what it did), each a JSON object with ``keys``. A line cut by a kill, or one that is
+    not such a record, is skipped (its work is done again); a cut last line is ended, so that the next
+    record appended starts a line of its own rather than joining it."""
+    if not path.exists():
+        return []
+    data = path.read_bytes()
+    if data and not data.endswith(b"\n"):
+        with open(path, "ab") as f:
+            f.write(b"\n")
+    found = []
+    for line in data.decode("utf-8", errors="replace").splitlines():
+        try:
+            item = json.loads(line)
+        except ValueError:  # cut, or not JSON at all
+            continue
+        if isinstance(item, dict) and all(key in item for key in keys):
+            found.append(item)
+    return found
 
 
 def _keep_mode(path: Path, temp: Path) -> None:

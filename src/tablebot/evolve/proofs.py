@@ -22,6 +22,7 @@ from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
 from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
+from tablebot.files import json_records
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
 
@@ -71,11 +72,9 @@ class Prover:
     names: list[str] = field(default_factory=list)  # the property list's names, as last read
 
     def __post_init__(self) -> None:
-        if self.cache_path is not None and self.cache_path.exists():
-            for line in self.cache_path.read_text(encoding="utf-8").splitlines():
-                if line.strip():
-                    item = json.loads(line)
-                    self.verdicts[item["key"]] = Verdict(item["ok"], tuple(item["failed"]))
+        if self.cache_path is not None:
+            for item in json_records(self.cache_path, ("key", "ok", "failed")):
+                self.verdicts[item["key"]] = Verdict(bool(item["ok"]), tuple(item["failed"]))
 
     def properties(self, machine: Machine) -> list[Property]:
         """The properties read against this machine (its states and outputs)."""

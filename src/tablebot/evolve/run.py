@@ -21,7 +21,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import Diagnostic, fail, notify
 from tablebot.evolve.evaluate import Evaluator, Means
 from tablebot.evolve.measures import Descriptor, Measure, default_range, fitness
 from tablebot.evolve.operators import Space, vary
@@ -29,7 +29,7 @@ from tablebot.evolve.pool import Workers, proved_ahead, repaired
 from tablebot.evolve.proofs import Prover, Verdict
 from tablebot.evolve.repair import PREFERENCES, Repaired, Step
 from tablebot.evolve.space import Candidate, Gene, start, to_table
-from tablebot.files import write_text
+from tablebot.files import json_records, write_text
 from tablebot.table import Table
 
 TRIES_PER_CHILD = 30  # variations tried per child asked for before a generation gives up on it
@@ -92,22 +92,20 @@ class Store:
                        "give --out a new folder, or delete this one to start over")
         if not spec_file.exists():
             write_text(spec_file, self.spec)
-        found: dict[str, Means] = {}
-        if self.path.exists():
-            for line in self.path.read_text(encoding="utf-8").splitlines():
-                try:
-                    item = json.loads(line)
-                except json.JSONDecodeError:
-                    continue  # a line cut by a kill: that candidate runs again
-                found[item["key"]] = item["means"]
-        return found
+        # a line cut by a kill is skipped: that candidate runs again
+        return {item["key"]: item["means"] for item in json_records(self.path, ("key", "means"))}
 
     def repairs(self) -> list[Repaired] | None:
         """The repairs an earlier run of this folder found (``repairs.json``), or None."""
         path = self.folder / "repairs.json"
         if not path.exists():
             return None
-        return [repaired_from_json(item) for item in json.loads(path.read_text(encoding="utf-8"))]
+        try:
+            return [repaired_from_json(item) for item in json.loads(path.read_text(encoding="utf-8", errors="replace"))]
+        except (ValueError, KeyError, TypeError, IndexError):  # written whole, so damaged or edited since
+            notify(Diagnostic(str(path), None, None, "not the repairs evolve writes: the repair is made again",
+                              severity="note"))
+            return None
 
     def keep_repairs(self, repairs: Sequence[Repaired]) -> None:
         write_text(self.folder / "repairs.json", json.dumps([repaired_to_json(r) for r in repairs], indent=1) + "\n")
