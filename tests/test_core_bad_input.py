@@ -117,6 +117,15 @@ def test_existing_output_file_is_replaced(tmp_path: Path) -> None:
     assert result.exit_code == 0 and out.read_text().startswith('{"tick":0')
 
 
+def test_a_diagram_format_against_the_out_suffix_is_refused(tmp_path: Path) -> None:
+    """--format png --out x.svg wrote PNG bytes into x.svg, which no viewer opens as either."""
+    said = fails("diagram", EXAMPLE, "--out", tmp_path / "x.svg", "--format", "png")
+    assert said.startswith(f"--format: error: --format png, but --out {tmp_path / 'x.svg'} is named as svg")
+    assert not (tmp_path / "x.svg").exists()
+    ok = runner.invoke(app, ["diagram", str(EXAMPLE), "--out", str(tmp_path / "x.txt"), "--format", "dot"])
+    assert ok.exit_code == 0 and (tmp_path / "x.txt").read_text().startswith("digraph")  # a suffix of no format
+
+
 def test_unknown_diagram_suffix_names_the_option() -> None:
     assert fails("diagram", EXAMPLE, "--out", Path("x.pdf")).startswith("--out: error: unknown diagram format 'pdf'")
 

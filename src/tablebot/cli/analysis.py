@@ -227,10 +227,13 @@ def diagram_cmd(
 ) -> None:
     """Draw the state diagram (the document's Figure 1) from the table."""
     option = "--format"
+    suffix = out.suffix.lstrip(".").lower() if out else ""
+    named = {"mmd": "mermaid", "gv": "dot"}.get(suffix, suffix)  # the format --out's suffix names, if any
     if fmt is None:
-        suffix = out.suffix.lstrip(".").lower() if out else ""
-        fmt = {"mmd": "mermaid", "gv": "dot"}.get(suffix, suffix) if suffix else "svg"
-        option = "--out"
+        fmt, option = named or "svg", "--out"
+    elif named in FORMATS and named != fmt:  # a .svg file of PNG bytes opens nowhere
+        raise fail("--format", f"--format {fmt}, but --out {out} is named as {named}",
+                   f"drop --format, or give --out the suffix of {fmt}")
     if fmt not in FORMATS:
         raise fail(option, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)} "
                    "(--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, .mmd)")
