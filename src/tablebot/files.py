@@ -93,10 +93,8 @@ def _temporary(path: Path, where: Path, mode: str, encoding: str | None,
     or its place in a set's staging folder) and its name; the command's guard first refuses a path it must
     not write over (see :mod:`tablebot.overwrite`)."""
     writing(path)
-    try:
+    with fileset.named_as(path):
         fd, name = tempfile.mkstemp(prefix=f".{where.name}.", suffix=".tmp", dir=where.parent)
-    except OSError as exc:  # named as the file the user asked for, not the temporary name it never saw
-        raise OSError(exc.errno, exc.strerror, str(path)) from None
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
     except BaseException:

@@ -160,13 +160,20 @@ def new_folder(folder: Path) -> Iterator[Path]:
         raise
 
 
-def _make_stage(folder: Path, named: Path) -> tuple[Path, int]:
-    """A staging folder inside ``folder``, locked; a failure names ``named`` (what the user asked for), not
-    the staging folder's made-up name."""
+@contextmanager
+def named_as(path: str | Path) -> Iterator[None]:
+    """An OSError of the block names ``path``, what the user asked for, instead of the temporary file or
+    staging folder made for it, a name the user never saw."""
     try:
-        stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=folder))
+        yield
     except OSError as exc:
-        raise OSError(exc.errno, exc.strerror, str(named)) from None
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
+
+
+def _make_stage(folder: Path, named: Path) -> tuple[Path, int]:
+    """A staging folder inside ``folder``, locked; a failure to make it names ``named``."""
+    with named_as(named):
+        stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=folder))
     lock = os.open(stage / LOCK, os.O_RDWR | os.O_CREAT, 0o600)
     fcntl.flock(lock, fcntl.LOCK_EX)
     return stage, lock
