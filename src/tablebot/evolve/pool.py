@@ -5,7 +5,8 @@ threads would wait for one another).
 Workers only compute; every decision stays with the caller, which asks for the answers in the order the
 search needs them, so a run with workers makes the same choices, counts and files as a run without.
 Workers come from a fork server (a clean process: no fork of this one's threads), ignore Ctrl-C (this
-process stops them) and are ended with the run. With one worker or none (``--workers 1``), every task
+process stops them) and are ended with the run; killed outright (SIGKILL), this process cannot end them, so
+each ends itself when it sees this process gone. With one worker or none (``--workers 1``), every task
 runs here, when its answer is asked for, so a task nobody asks for costs nothing.
 """
 
@@ -15,6 +16,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 from collections import deque
 from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
@@ -188,6 +190,25 @@ def _start(files: list[Path], base: Table) -> None:
     global _context
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the run stops us
     _context = Context(Prover(files), base)
+    _end_with_parent()
+
+
+def _end_with_parent() -> None:
+    """End this worker as soon as the process that started it is gone, however it went (SIGKILL leaves it no
+    chance to end its workers): otherwise the worker waits forever for its next task, holding the run's stdout
+    and stderr open (``evolve | tee`` never ends). The parent's sentinel (the end of a pipe only the parent
+    writes to, or its process handle on Windows) becomes ready when the parent ends, on every platform."""
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_when_ready, args=(parent.sentinel,), name="tablebot-parent-watch",
+                         daemon=True).start()
+
+
+def _exit_when_ready(sentinel: int) -> None:
+    from multiprocessing.connection import wait
+
+    wait([sentinel])
+    os._exit(1)  # at once: the worker holds nothing to save, and its answers have nobody to go to
 
 
 def _run(fn: Callable[..., Any], args: tuple[Any, ...]) -> Any:
