@@ -165,15 +165,6 @@ def test_other_csv_files_are_not_tables(tmp_path: Path, text: str) -> None:
     assert not files.is_user_file(other)
 
 
-def test_a_symlink_is_written_through(tmp_path: Path) -> None:
-    real = tmp_path / "real.jsonl"
-    real.write_text("old")
-    link = tmp_path / "link.jsonl"
-    link.symlink_to(real)
-    write_text(link, "new")
-    assert link.is_symlink() and real.read_text() == "new"
-
-
 def test_the_guard_outside_a_command_refuses_nothing(tmp_path: Path) -> None:
     table = tmp_path / "t.csv"
     table.write_text("state,next\n1,1\n")

@@ -66,10 +66,10 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
 
 
 def _target(path: str | Path) -> Path:
-    """Where ``path`` really is: a symbolic link is written through (renaming onto it would replace the
-    link itself with a file)."""
+    """``path``, refused if it is a symbolic link to a file (see :func:`tablebot.overwrite.not_a_link`)."""
     path = Path(path)
-    return Path(os.path.realpath(path)) if path.is_symlink() else path
+    overwrite.not_a_link(path)
+    return path
 
 
 def is_special(path: Path) -> bool:
@@ -187,7 +187,7 @@ def json_records(path: Path, keys: Sequence[str]) -> list[dict[str, Any]]:
         return []
     data = path.read_bytes()
     if data and not data.endswith(b"\n"):
-        with open(path, "ab") as f:
+        with append(path, "b") as f:
             f.write(b"\n")
     found = []
     for line in data.decode("utf-8", errors="replace").splitlines():
@@ -198,6 +198,26 @@ def json_records(path: Path, keys: Sequence[str]) -> list[dict[str, Any]]:
         if isinstance(item, dict) and all(key in item for key in keys):
             found.append(item)
     return found
+
+
+#: Opening for appending: never through a link (O_NOFOLLOW where the system has it; elsewhere, see append).
+APPEND_FLAGS = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+@contextmanager
+def append(path: str | Path, mode: str = "") -> Iterator[IO]:
+    """``path`` opened for appending (a record log a cut run keeps), text unless ``mode`` is ``"b"``; a link
+    at ``path`` is refused, as for every file tablebot writes."""
+    path = _target(path)
+    flags = APPEND_FLAGS & ~getattr(os, "O_NOFOLLOW", 0) if path.is_symlink() else APPEND_FLAGS  # to a device
+    try:
+        fd = os.open(path, flags, 0o666)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:  # the link appeared after the check
+            overwrite.not_a_link(path)
+        raise
+    with os.fdopen(fd, "a" + mode, encoding=None if mode == "b" else "utf-8") as stream:
+        yield stream
 
 
 def _keep_mode(path: Path, temp: Path) -> None:

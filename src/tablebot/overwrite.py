@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import shutil
+import stat
+import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -110,8 +112,44 @@ def rewrite(path: str | Path) -> None:
 
 def _back_up(scope: Scope, path: Path) -> None:
     """Keep ``path`` as ``NAME.bak`` once per command: a second write of it replaces the first's output."""
-    shutil.copy2(path, path.with_name(path.name + ".bak"))
+    back_up(path)
     scope.replaced.add(os.path.realpath(path))
+
+
+def back_up(path: Path) -> Path:
+    """Copy ``path`` to ``NAME.bak`` through a temporary file in the same folder, renamed into place: a link
+    already sitting at ``NAME.bak`` (a cloned project can carry ``prog.rpp.bak -> ~/.bashrc``) is replaced,
+    never written through, and a full disk leaves the previous backup whole instead of truncating it."""
+    not_a_link(path)
+    backup = path.with_name(path.name + ".bak")
+    fd, name = tempfile.mkstemp(prefix=f".{backup.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as copy, open(path, "rb") as original:
+            shutil.copyfileobj(original, copy)
+        shutil.copystat(path, name)
+        os.replace(name, backup)
+    except BaseException as exc:
+        Path(name).unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.filename in (None, name):
+            exc.filename = str(backup)  # the user never named the temporary file
+        raise
+    return backup
+
+
+def not_a_link(path: Path) -> None:
+    """Refuse to write through a symbolic link at ``path``: in a project cloned from someone else (git keeps
+    links) ``out/trace.jsonl -> ~/.bashrc`` would otherwise overwrite whatever it points at. A link to a
+    device or pipe (``/dev/stdout``) is no such file and is written as the device it names."""
+    if not path.is_symlink():
+        return
+    try:
+        special = not stat.S_ISREG(os.stat(path).st_mode) and not stat.S_ISDIR(os.stat(path).st_mode)
+    except OSError:
+        special = False  # a dangling link: writing would create whatever it names
+    if not special:
+        raise fail(path, f"{path.name} is a symbolic link (to {os.readlink(path)}): tablebot never writes "
+                   "through a link",
+                   "remove the link, or give the path of the file it points to if that is the one to replace")
 
 
 def kind(path: Path) -> str:

@@ -22,7 +22,7 @@ from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
 from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
-from tablebot.files import json_records
+from tablebot.files import append, json_records
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
 
@@ -111,7 +111,7 @@ class Prover:
         self.proved += 1
         self.verdicts[key] = verdict
         if self.cache_path is not None:
-            with open(self.cache_path, "a", encoding="utf-8") as f:  # one line per proof: a cut run keeps them
+            with append(self.cache_path) as f:  # one line per proof: a cut run keeps them
                 f.write(json.dumps({"key": key, "ok": verdict.ok, "failed": list(verdict.failed)}) + "\n")
         return key, self.counted(verdict)
 

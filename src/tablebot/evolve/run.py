@@ -29,7 +29,7 @@ from tablebot.evolve.pool import Workers, proved_ahead, repaired
 from tablebot.evolve.proofs import Prover, Verdict
 from tablebot.evolve.repair import PREFERENCES, Repaired, Step
 from tablebot.evolve.space import Candidate, Gene, start, to_table
-from tablebot.files import json_records, write_text
+from tablebot.files import append, json_records, write_text
 from tablebot.table import Table
 
 TRIES_PER_CHILD = 30  # variations tried per child asked for before a generation gives up on it
@@ -111,7 +111,7 @@ class Store:
         write_text(self.folder / "repairs.json", json.dumps([repaired_to_json(r) for r in repairs], indent=1) + "\n")
 
     def record(self, key: str, means: Means) -> None:
-        with open(self.path, "a", encoding="utf-8") as f:
+        with append(self.path) as f:
             f.write(json.dumps({"key": key, "means": means}, sort_keys=True) + "\n")
 
 
