@@ -4,9 +4,9 @@
 The copy starts at once and may get ready (imports, a warm-up) while this process goes on; what it needs
 later (a run's arrays) is handed to it as messages, in order. It writes no file (the parent writes every
 file, under the rules of :mod:`tablebot.fileset`), ends with ``os._exit`` (no clean-up of the parent's runs
-twice), and dies with the parent, even when the parent is killed (Linux); Ctrl-C and SIGTERM end it as
-they end any process. The parent kills and reaps it on every way out, so no error path leaves a process
-behind.
+twice), and dies with the parent, even when the parent is killed with SIGKILL (at once on Linux; elsewhere
+within :data:`WATCH_S`); Ctrl-C and SIGTERM end it as they end any process. The parent kills and reaps it
+on every way out, so no error path leaves a process behind.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ import pickle
 import signal
 import struct
 import sys
+import threading
+import time
 import traceback
 import warnings
 from collections.abc import Callable, Sequence
@@ -29,6 +31,8 @@ _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 _DONE, _FAILED = b"+", b"!"
 _PIPE_BYTES = 1 << 20  # a message of a few MB passes in a few system calls (Linux's most for a user)
 _LENGTHS = struct.Struct("<QQ")  # a message's frame: the pickle's length, how many raw buffers follow
+#: Where the kernel cannot kill the copy with its parent (not Linux), how often the copy looks for it.
+WATCH_S = 0.2
 
 
 class Inbox:
@@ -189,8 +193,11 @@ def _child(work: Callable[[Inbox], bytes], answers: int, questions: int, parent:
 
 
 def _die_with(parent: int) -> None:
-    """On Linux, the copy is killed when the parent dies (even by SIGKILL) and is named NAME."""
+    """The copy ends when the parent dies, even by SIGKILL (else it would go on holding the parent's stdout:
+    ``sim | tee`` would not end): on Linux the kernel kills it (and it is named NAME), elsewhere a thread
+    of its own watches for the parent (:func:`watch_parent`)."""
     if not sys.platform.startswith("linux"):
+        watch_parent(parent)
         return
     import ctypes
 
@@ -200,6 +207,19 @@ def _die_with(parent: int) -> None:
     libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
     if os.getppid() != parent:  # the parent died before the line above
         os._exit(1)
+
+
+def watch_parent(parent: int, every_s: float = WATCH_S) -> None:
+    """End this process (``os._exit``) once ``parent`` is no longer its parent: the parent died and another
+    process (init, or a subreaper) took this one over. Every POSIX system has getppid; Linux has better
+    (:func:`_die_with`)."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(every_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="tablebot-parent-watch", daemon=True).start()
 
 
 def _write_message(pipe: int, message: object) -> None:
