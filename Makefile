@@ -1,6 +1,6 @@
 # The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff, ESLint);
 # both set themselves up first.
-.PHONY: setup demo test bench
+.PHONY: setup demo test bench lock audit
 
 # Python keeps its compiled bytecode (in __pycache__, which git ignores): without it every one of the
 # hundred tablebot processes the tests start compiles numpy, numba and tablebot again, seconds each.
@@ -31,3 +31,21 @@ test: setup
 
 bench: setup
 	status=0; for b in engine sim check mcu turn_drift studio fleet evolve controllers; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
+
+# The Python lock, requirements/dev.lock (what `make setup` installs): pyproject.toml's packages with the dev
+# extra, resolved once for every platform and Python 3.11+, with their hashes. Pins already in the lock are
+# kept unless pyproject.toml now refuses them; `make lock UPGRADE=1` moves every package to its newest allowed
+# version. Written beside the lock and renamed over it: a failed resolution leaves the old lock as it was.
+lock:
+	@[ -x .venv/bin/uv ] || ./scripts/bootstrap.sh
+	cp requirements/dev.lock requirements/.dev.lock.tmp
+	.venv/bin/uv pip compile pyproject.toml --extra dev --universal --python-version 3.11 --generate-hashes \
+	  --custom-compile-command "make lock" $(if $(UPGRADE),--upgrade) -q -o requirements/.dev.lock.tmp \
+	  || { rm -f requirements/.dev.lock.tmp; exit 1; }
+	mv requirements/.dev.lock.tmp requirements/dev.lock
+
+# Every pin of the lock (other platforms' and Pythons' too) against the vulnerability database, by pip-audit
+# (from the lock): exit 0 no known vulnerabilities, 1 some (listed), 2 not checked (the database could not be
+# reached or had no answer): scripts/audit.py. `make audit AUDIT_ARGS="-s osv"` asks OSV instead of PyPI.
+audit: setup
+	.venv/bin/python scripts/audit.py requirements/dev.lock $(AUDIT_ARGS)

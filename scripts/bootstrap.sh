@@ -37,15 +37,22 @@ if [ ! -x .venv/bin/python ]; then
   echo "creating .venv (a Python virtual environment for tablebot) with $PYTHON"
   "$PYTHON" -m venv .venv
 fi
-if [ ! -f .venv/.installed ] || [ pyproject.toml -nt .venv/.installed ]; then
-  echo "installing tablebot and its Python packages into .venv (numpy, numba, matplotlib, typer, rich, dask,"
-  echo "  playwright, ...; see pyproject.toml): a few minutes the first time"
+# The Python packages exactly as requirements/dev.lock pins them (versions and hashes; `make lock` writes it
+# from pyproject.toml), then tablebot itself, editable, with no packages of its own. .venv/.installed keeps a
+# checksum of the two files: when either changes (a pull, `make lock`), the next set-up installs again.
+LOCK=requirements/dev.lock
+stamp="$(cat pyproject.toml "$LOCK" | cksum)"
+if [ "$(cat .venv/.installed 2>/dev/null)" != "$stamp" ]; then
+  echo "installing tablebot's Python packages into .venv as $LOCK pins them (numpy, numba, matplotlib, typer,"
+  echo "  rich, dask, playwright, ...): a few minutes the first time"
   # uv (from PyPI, like everything else) fetches and installs in parallel: seconds where pip takes minutes.
-  # --compile-bytecode: the tests start tablebot in a hundred processes, each would compile numpy, numba and
-  # matplotlib again; --system-certs: the machine's own certificate store, as pip uses it.
+  # `uv pip sync` makes .venv hold exactly the lock's packages (a package dropped from it is removed; pip and
+  # uv stay). --compile-bytecode: the tests start tablebot in a hundred processes, each would compile numpy,
+  # numba and matplotlib again; --system-certs: the machine's own certificate store, as pip uses it.
   .venv/bin/python -m pip install -q uv
-  .venv/bin/uv pip install -q --python .venv/bin/python --compile-bytecode --system-certs -e '.[dev]'
-  touch .venv/.installed
+  .venv/bin/uv pip sync -q --python .venv/bin/python --compile-bytecode --system-certs --require-hashes "$LOCK"
+  .venv/bin/uv pip install -q --python .venv/bin/python --compile-bytecode --system-certs --no-deps -e .
+  echo "$stamp" >.venv/.installed
   echo "installed; .venv/bin/tablebot --help lists the commands"
 fi
 
