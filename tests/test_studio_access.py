@@ -264,14 +264,16 @@ def test_a_link_swapped_in_after_opening_is_never_written_through(studio: Backgr
     assert not [p for p in folder.iterdir() if p.name.endswith(".tmp")]
 
 
-def test_a_file_replaced_after_opening_is_not_overwritten(studio: Background, folder: Path) -> None:
+def test_a_file_replaced_after_opening_is_not_overwritten_without_asking(studio: Background, folder: Path) -> None:
+    """Replaced by a rename (an editor's save): the page is asked, as for an edit in place (what each answer
+    does: test_studio_saves.py)."""
     def swap() -> None:
         (folder / "other.csv").write_bytes(b"state,next\n1,1\n")
         os.replace(folder / "other.csv", folder / "victim.csv")
 
-    reply, _ = _swap_then_save(studio, swap)
-    assert reply["type"] == "error" and "no longer the file you opened" in reply["message"]
-    assert (folder / "victim.csv").read_bytes() == b"state,next\n1,1\n"
+    reply, _ = _swap_then_save(studio, swap, force=False)
+    assert reply["type"] == "conflict" and "victim.csv was replaced on disk" in reply["message"]
+    assert (folder / "victim.csv").read_bytes() == b"state,next\n1,1\n" and not (folder / "victim.csv.bak").exists()
 
 
 def test_a_link_to_another_table_in_the_folder_is_not_written(studio: Background, folder: Path) -> None:

@@ -8,6 +8,7 @@ diagnostic from the real parser lands on the cell the user sees.
 from __future__ import annotations
 
 import codecs
+import difflib
 from dataclasses import dataclass, field
 
 from tablebot.csvtext import SEP_RE, detect_delimiter, split_records
@@ -129,6 +130,7 @@ class CsvDocument:
         """Set one cell of a grid row (``row`` -1: the header); other cells keep their bytes."""
         if len(value) > MAX_CELL_CHARS:
             raise Refused(f"a cell holds at most {MAX_CELL_CHARS} characters")
+        value = _one_line_end(value)
         record = self._record(row)
         if column < 0 or column > max(len(self.header_values()), len(record.cells)):
             raise Refused(f"there is no column {column + 1}")
@@ -144,7 +146,8 @@ class CsvDocument:
         if after < -1 or after >= len(self.row_ids):
             raise Refused(f"there is no row {after + 1}")
         width = len(self.header_values())
-        values = (values or []) + [""] * max(0, width - len(values or []))
+        values = [_one_line_end(v) for v in values or []]
+        values += [""] * max(0, width - len(values))
         cells = [RawCell(self._encode(v, False), v) for v in values]
         at = (self.row_ids[after] if after >= 0 else self._header_index()) + 1
         if at == len(self.records) and self.records and not self.records[-1].end:
@@ -162,6 +165,35 @@ class CsvDocument:
         if not removed.end and index > 0:  # it was the last line: the new last line keeps the old style
             self.records[index - 1].end = ""
         self.row_ids = [i for i, r in enumerate(self.records) if r.kind == "row"]
+
+    def replace_grid(self, header: list[str], rows: list[list[str]]) -> None:
+        """Make the grid ``header`` and ``rows`` (a draft the page kept), changing only what differs: rows
+        alike keep their bytes, rows edited are edited cell by cell, others inserted or deleted."""
+        width = len(self.header_values())
+        if len(header) != width or any(len(row) > width for row in rows):
+            raise Refused(f"the table now has {width} columns, the edits {max(map(len, [header, *rows]))}: "
+                          "they cannot be put back (copy them from the page by hand)")
+        for column, value in enumerate(header):
+            if value != self.header_values()[column]:
+                self.set_cell(-1, column, value)
+        old = [tuple(row) for row in self.grid()]
+        new = [tuple(_one_line_end(v) for v in row) + ("",) * (width - len(row)) for row in rows]
+        matcher = difflib.SequenceMatcher(None, old, new, autojunk=False)
+        for tag, first, last, start, end in reversed(matcher.get_opcodes()):  # from the end: indices stay valid
+            if tag == "equal":
+                continue
+            paired = min(last - first, end - start)
+            for offset in range(paired):
+                self._set_row(first + offset, old[first + offset], new[start + offset])
+            for _ in range(last - first - paired):  # old rows beyond the new ones
+                self.delete_row(first + paired)
+            for offset in range(paired, end - start):  # new rows beyond the old ones
+                self.insert_row(first + offset - 1, list(new[start + offset]))
+
+    def _set_row(self, row: int, old: tuple[str, ...], new: tuple[str, ...]) -> None:
+        for column, (was, value) in enumerate(zip(old, new, strict=True)):
+            if was != value:
+                self.set_cell(row, column, value)
 
     def _check_row(self, row: int) -> int:
         if not 0 <= row < len(self.row_ids):
@@ -224,6 +256,12 @@ class CsvDocument:
 
 def record_text(record: RawRecord, delimiter: str) -> str:
     return delimiter.join(c.raw for c in record.cells)
+
+
+def _one_line_end(value: str) -> str:
+    """A cell's line breaks as the grid has them (\\n): a client's \\r\\n or \\r would be written as two line
+    ends, or a \\r alone, and the cell would gain a line."""
+    return value.replace("\r\n", "\n").replace("\r", "\n")
 
 
 def _blank(record: RawRecord) -> bool:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Awaitable, Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -16,12 +16,14 @@ from tablebot.diagnostics import TableBotError
 from tablebot.robot import Robot
 from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot_for
 from tablebot.web.document import MAX_TABLE_BYTES, CsvDocument
-from tablebot.web.errors import Refused
+from tablebot.web.errors import Refused, log
 from tablebot.web.simulate import Arena, ArenaSettings
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
-from tablebot.web.workspace import ChangedOnDisk, Kind, Opened, Workspace
+from tablebot.web.workspace import BACKUP_SUFFIX, ChangedOnDisk, Kind, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
+MAX_ROWS = 20_000  # a restored draft: far more than a table a person edits in a grid
+MAX_COLUMNS = 200
 
 
 class Hub:
@@ -33,7 +35,10 @@ class Hub:
     async def saved(self, by: Session, file: Opened) -> None:
         for other in list(self.sessions):
             if other is not by and other.opened is not None and other.opened.name == file.name:
-                await other.saved_elsewhere(file)
+                try:
+                    await other.saved_elsewhere(file)
+                except Exception as exc:  # that tab closed meanwhile (its send failed): this save stands
+                    log.info("a tab was not told of the save of %s: %r", file.name, exc, exc_info=True)
 
 
 @dataclass(eq=False)  # sessions are compared (and hashed) by identity
@@ -42,8 +47,10 @@ class Session:
     hub: Hub
     send: Send
     opened: Opened | None = None  # the table file as read (or last saved): a save writes only this file
+    base: str | None = None  # the version a restored draft started from, when not opened's
     doc: CsvDocument | None = None
     dirty: bool = False
+    edits: int = 0  # changes made to the draft, ever: a reload does not replace a draft edited meanwhile
     analysis: Analysis | None = None
     robot: Robot | None = None  # the table's robot file, read when the table is opened
     robot_error: TableBotError | None = None
@@ -75,7 +82,7 @@ class Session:
     @property
     def version(self) -> str | None:
         """Digest of the file on disk this draft started from."""
-        return None if self.opened is None else self.opened.version
+        return self.base or (None if self.opened is None else self.opened.version)
 
     async def error(self, text: str, op: str = "") -> None:
         await self.send({"type": "error", "message": text, "op": op})
@@ -87,13 +94,20 @@ class Session:
 
     async def open_table(self, message: dict[str, Any]) -> None:
         opened = await asyncio.to_thread(self.workspace.read, _text(message, "path"), Kind.TABLE, MAX_TABLE_BYTES)
-        doc = CsvDocument.from_bytes(opened.data, opened.name)
+        await self.show(opened, CsvDocument.from_bytes(opened.data, opened.name))
+
+    async def show(self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None) -> bool:
+        """Make ``doc`` (read from ``opened``) this tab's draft, with no edits, and send it to the page; not if
+        the draft was edited after edit count ``unless_edited_since`` meanwhile (the edit would be lost)."""
         path = self.workspace.root / opened.name
         try:
-            self.robot, self.robot_error = await asyncio.to_thread(robot_for, path), None
+            robot, robot_error = await asyncio.to_thread(robot_for, path), None
         except TableBotError as exc:  # the grid still opens; the robot file's errors are listed
-            self.robot, self.robot_error = None, exc
-        self.opened, self.doc, self.dirty = opened, doc, False
+            robot, robot_error = None, exc
+        if unless_edited_since is not None and self.edits != unless_edited_since:
+            return False
+        self.robot, self.robot_error = robot, robot_error
+        self.opened, self.base, self.doc, self.dirty = opened, None, doc, False
         self.arena.close()
         self.arena = Arena()
         await self.send({"type": "table", "path": opened.name, "header": doc.header_values(),
@@ -103,6 +117,7 @@ class Session:
         await self.reanalyse(None)
         if self.analysis and self.analysis.table is not None:
             await self.reset_arena({})
+        return True
 
     async def reanalyse(self, seq: Any) -> None:
         assert self.doc is not None and self.path is not None and self.opened is not None
@@ -118,6 +133,11 @@ class Session:
             svg = await asyncio.to_thread(self.arena.diagram, self.analysis.table)
             await self.send({"type": "diagram", "svg": svg})
 
+    def touched(self) -> None:
+        """The draft was edited (right after the change, before any await: see :meth:`show`)."""
+        self.dirty = True
+        self.edits += 1
+
     def _need_doc(self) -> CsvDocument:
         if self.doc is None:
             raise Refused("open a table first")
@@ -126,49 +146,67 @@ class Session:
     async def edit(self, message: dict[str, Any]) -> None:
         doc = self._need_doc()
         doc.set_cell(_int(message, "row"), _int(message, "col"), _text(message, "value", allow_empty=True))
-        self.dirty = True
+        self.touched()
         await self.reanalyse(message.get("seq"))
 
     async def insert_row(self, message: dict[str, Any]) -> None:
         doc = self._need_doc()
         row = doc.insert_row(_int(message, "after"))
-        self.dirty = True
+        self.touched()
         await self.send({"type": "grid", "grid": doc.grid(), "focus": row})
         await self.reanalyse(message.get("seq"))
 
     async def delete_row(self, message: dict[str, Any]) -> None:
         doc = self._need_doc()
         doc.delete_row(_int(message, "row"))
-        self.dirty = True
+        self.touched()
         await self.send({"type": "grid", "grid": doc.grid()})
         await self.reanalyse(message.get("seq"))
 
     async def save(self, message: dict[str, Any]) -> None:
-        """Save the draft over the file this session opened, and only that file (see Workspace.save)."""
+        """Save the draft under the name this session opened (see Workspace.save). A save that lost to a
+        change on disk (another tab's save among them) is told so; the draft stays, to save anyway or drop."""
         doc = self._need_doc()
         assert self.opened is not None
+        force = message.get("force", False)
+        if not isinstance(force, (bool, str)):
+            raise Refused('"force" must be the version the conflict named ("theirs")')
         try:
-            saved = await asyncio.to_thread(self.workspace.save, self.opened, doc.to_bytes(),
-                                            message.get("force") is True)
+            saved = await asyncio.to_thread(self.workspace.save, self.opened, doc.to_bytes(), force, self.base)
         except ChangedOnDisk as exc:
-            await self.send({"type": "conflict", "message": f"{exc}: saving now would overwrite those changes",
-                             "hint": "reload to see them (your edits are lost), or save anyway (theirs are lost)"})
+            await self.send(_conflict(str(exc), exc.how, exc.theirs, self.opened.name, "save"))
             return
-        self.opened, self.dirty = saved, False
-        await self.send({"type": "saved", "version": saved.version, "path": saved.name,
-                         "backup": saved.name + ".bak"})
-        await self.hub.saved(self, saved)
+        self.opened, self.base, self.dirty = saved.file, None, False
+        await self.send({"type": "saved", "op": "save", "version": saved.file.version, "path": saved.file.name,
+                         "backup": None if saved.backup is None else saved.file.name + BACKUP_SUFFIX,
+                         "backup_version": saved.backup})
+        await self.hub.saved(self, saved.file)
 
     async def saved_elsewhere(self, file: Opened) -> None:
         """Another tab saved this file: reload it when this tab has no edits of its own, else say so."""
+        if not self.dirty:
+            shown = await self.show(file, CsvDocument.from_bytes(file.data, file.name), self.edits)
+            if shown:
+                await self.send({"type": "notice", "message": "reloaded: the table was saved in another tab"})
+                return
+        await self.send(_conflict("another tab saved this table; yours has unsaved edits", "saved in another tab",
+                                  file.version, file.name, ""))
+
+    async def restore(self, message: dict[str, Any]) -> None:
+        """A draft the page kept (the WebSocket dropped, the page was reloaded) made this tab's draft again,
+        over the file as it is now; if it started from another version, a save asks first."""
+        self._need_doc()
         assert self.opened is not None
-        if self.dirty:  # the file on disk is now the one the other tab wrote: a forced save may replace it
-            self.opened = replace(self.opened, identity=file.identity, mode=file.mode)
-            await self.send({"type": "conflict", "message": "another tab saved this table; yours has unsaved edits",
-                             "hint": "reload to take theirs, or save anyway to keep yours"})
-            return
-        await self.open_table({"path": file.name, "reason": "saved in another tab"})
-        await self.send({"type": "notice", "message": "reloaded: the table was saved in another tab"})
+        header, grid = _rows(message, "header", single=True)[0], _rows(message, "grid")
+        base = _text(message, "base")
+        doc = CsvDocument.from_bytes(self.opened.data, self.opened.name)
+        doc.replace_grid(header, grid)
+        if len(doc.to_bytes()) > MAX_TABLE_BYTES:
+            raise Refused(f"the restored table would have more than {MAX_TABLE_BYTES:,} bytes")
+        self.doc, self.base = doc, base if base != self.opened.version else None
+        self.touched()
+        await self.send({"type": "grid", "grid": doc.grid(), "lines": _grid_lines(doc)})
+        await self.reanalyse(message.get("seq"))
 
     # --- the arena -------------------------------------------------------------------------------------
 
@@ -223,6 +261,15 @@ class Session:
                          "at_tick": result.at_tick})
 
 
+def _conflict(message: str, how: str, theirs: str, path: str, op: str) -> dict[str, Any]:
+    """The page's choice when the file on disk is not the draft's: save yours over theirs (version
+    ``theirs``, kept as NAME.bak) or load theirs."""
+    return {"type": "conflict", "op": op, "message": message, "how": how, "theirs": theirs, "path": path,
+            "backup": path + BACKUP_SUFFIX,
+            "hint": f"your edits are kept: save yours (theirs are kept as {path}{BACKUP_SUFFIX}), "
+                    "or load theirs (yours are dropped)"}
+
+
 def _grid_lines(doc: CsvDocument) -> list[int]:
     starts = doc.record_lines()
     return [starts[i] for i in doc.row_ids]
@@ -233,6 +280,17 @@ def _text(message: dict[str, Any], key: str, allow_empty: bool = False) -> str:
     if not isinstance(value, str) or (not value and not allow_empty):
         raise Refused(f'"{key}" must be text')
     return value
+
+
+def _rows(message: dict[str, Any], key: str, single: bool = False) -> list[list[str]]:
+    """A list of rows of text (``single``: one row) from the page."""
+    value = message.get(key)
+    rows = [value] if single else value
+    if not isinstance(rows, list) or len(rows) > MAX_ROWS or not all(
+            isinstance(row, list) and len(row) <= MAX_COLUMNS and all(isinstance(c, str) for c in row) for row in rows):
+        raise Refused(f'"{key}" must be {"a row" if single else "rows"} of text (at most {MAX_ROWS:,} rows of '
+                      f"{MAX_COLUMNS} cells)")
+    return rows
 
 
 def _int(message: dict[str, Any], key: str) -> int:
@@ -248,6 +306,6 @@ async def _list(session: Session, message: dict[str, Any]) -> None:
 
 HANDLERS: dict[str, Callable[[Session, dict[str, Any]], Awaitable[None]]] = {
     "open": Session.open_table, "edit": Session.edit, "insert_row": Session.insert_row,
-    "delete_row": Session.delete_row, "save": Session.save, "sim": Session.control,
+    "delete_row": Session.delete_row, "save": Session.save, "restore": Session.restore, "sim": Session.control,
     "trace": Session.open_trace, "counterexample": Session.counterexample, "files": _list,
 }

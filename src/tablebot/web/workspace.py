@@ -4,8 +4,10 @@ device, and saving a table safely.
 
 Every file is reached from the folder through directory descriptors opened without following links
 (``O_NOFOLLOW``), so a link swapped in while the studio works never leads it outside the folder. A save
-writes only the file the session opened (same device and inode), keeps the previous version as
-``NAME.bak``, and refuses a file that changed on disk unless the page says to overwrite it.
+writes only under the name the session opened, keeps the previous version as ``NAME.bak``, and refuses
+a file that changed on disk (edited in place, replaced by a rename, deleted) unless the page says to
+overwrite that version. Saves of one file are one at a time, so two tabs saving at once never both
+think they won: each save's backup is the save before it.
 """
 
 from __future__ import annotations
@@ -14,15 +16,17 @@ import codecs
 import contextlib
 import enum
 import errno
+import fcntl
 import hashlib
 import os
-import secrets
 import stat
+import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from tablebot.web.errors import Refused
+from tablebot.web.temporaries import sweep, temp_name
 
 TABLE_SUFFIXES = (".csv", ".tsv")
 TRACE_SUFFIXES = (".jsonl",)
@@ -33,6 +37,7 @@ HEAD_BYTES = 4096  # read to tell a table from another CSV
 MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table the studio opened is 1 MB at most)
 READ_FLAGS = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_NOCTTY | os.O_CLOEXEC
 DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
+GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
 
 
 class Kind(enum.Enum):
@@ -60,12 +65,24 @@ class Opened:
         return digest(self.data)
 
 
-class ChangedOnDisk(Exception):
-    """The file was changed by someone else since the page loaded it (a save may overwrite it if asked)."""
+@dataclass(frozen=True)
+class Saved:
+    """A save's outcome: the file as now written, and the version it moved to ``NAME.bak`` (None: none)."""
 
-    def __init__(self, name: str, how: str = "changed") -> None:
+    file: Opened
+    backup: str | None
+
+
+class ChangedOnDisk(Exception):
+    """The file on disk is not the version the draft started from (a save may overwrite it if asked).
+
+    ``how``: changed (in place), replaced (another file renamed over it: an editor's or tablebot's own
+    atomic save, ``sed -i``, ``git checkout``, another tab), or deleted; ``theirs``: the version on disk
+    now (:data:`GONE` if none), which a forced save must name."""
+
+    def __init__(self, name: str, how: str, theirs: str) -> None:
         super().__init__(f"{name} was {how} on disk since you opened it")
-        self.name = name
+        self.name, self.how, self.theirs = name, how, theirs
 
 
 @dataclass
@@ -76,6 +93,7 @@ class Workspace:
 
     def __post_init__(self) -> None:
         self.root = self.root.resolve()
+        sweep(self.root)  # the unfinished saves of a studio that was killed mid-save
 
     # --- names -----------------------------------------------------------------------------------------
 
@@ -148,43 +166,45 @@ class Workspace:
 
     # --- saving ----------------------------------------------------------------------------------------
 
-    def save(self, opened: Opened, data: bytes, force: bool) -> Opened:
-        """Write ``data`` over the file ``opened`` came from, keeping what is there as ``NAME.bak``.
+    def save(self, opened: Opened, data: bytes, force: bool | str = False, base: str | None = None) -> Saved:
+        """Write ``data`` under the name ``opened`` came from, keeping what is there as ``NAME.bak``.
 
-        Refused if the name now leads to another file or outside the folder; :class:`ChangedOnDisk` if
-        its content changed since (unless ``force``). Returns the file as now written."""
+        The draft started from version ``base`` (by default ``opened``'s). Refused if the name now leads
+        to another file or outside the folder; :class:`ChangedOnDisk` if the file there is not that
+        version, unless ``force`` is True or names the version there now. One save of a file at a time:
+        the check and the rename are never interleaved with another save's."""
         if self.locate(opened.name, Kind.TABLE) != opened.name:
             raise Refused(f"{opened.name} now leads to another file: reload it before saving")
         parent, leaf = _split(opened.name)
-        with self._folder(parent, opened.name) as folder:
-            current, mode = self._current(folder, leaf, opened)
-            if current is None and not force:
-                raise ChangedOnDisk(opened.name, "deleted")
-            if current is not None and digest(current) != opened.version and not force:
-                raise ChangedOnDisk(opened.name)
+        with self._folder(parent, opened.name) as folder, _one_save_at_a_time(folder, leaf):
+            current, mode, identity = self._current(folder, leaf, opened)
+            theirs = GONE if current is None else digest(current)
+            if theirs != (base or opened.version) and force is not True and force != theirs:
+                how = "deleted" if current is None else "changed" if identity == opened.identity else "replaced"
+                raise ChangedOnDisk(opened.name, how, theirs)
             try:
                 if current is not None:
                     _write_at(folder, leaf + BACKUP_SUFFIX, current, mode)
-                identity = _write_at(folder, leaf, data, mode)
+                written = _write_at(folder, leaf, data, mode)
             except OSError as exc:
                 raise Refused(f"{opened.name} was not saved: {exc.strerror or 'the system refused'} "
                               "(check the folder's permissions and free space)") from None
-        return Opened(opened.name, identity, data, mode)
+        return Saved(Opened(opened.name, written, data, mode), None if current is None else theirs)
 
-    def _current(self, folder: int, leaf: str, opened: Opened) -> tuple[bytes | None, int]:
-        """What is on disk now under the opened name (None: nothing), if it is still the opened file."""
+    def _current(self, folder: int, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
+        """What is on disk now under the opened name (None: nothing), its permissions and identity."""
         try:
             fd = os.open(leaf, READ_FLAGS, dir_fd=folder)
         except FileNotFoundError:
-            return None, opened.mode
+            return None, opened.mode, opened.identity
         except OSError as exc:
             raise _refusal(exc, opened.name) from None
         try:
             info = os.fstat(fd)
-            if not stat.S_ISREG(info.st_mode) or (info.st_dev, info.st_ino) != opened.identity:
-                raise Refused(f"{opened.name} is no longer the file you opened (it was replaced or moved on "
-                              "disk): reload it, then edit and save again")
-            return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode)
+            if not stat.S_ISREG(info.st_mode):
+                raise Refused(f"{opened.name} is no longer a regular file (a folder, pipe or device took its "
+                              "place): nothing was written")
+            return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
         finally:
             os.close(fd)
 
@@ -282,10 +302,33 @@ def _looks_like_table(head: bytes) -> bool:
     return "state" in text and "next" in text
 
 
+_LOCKS: dict[tuple[int, int, str], threading.Lock] = {}
+_LOCKS_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def _one_save_at_a_time(folder: int, leaf: str) -> Iterator[None]:
+    """Hold the save of ``leaf`` in the open ``folder``: one thread of this studio at a time, and (where the
+    file system has flock) one studio process at a time."""
+    info = os.fstat(folder)
+    with _LOCKS_LOCK:
+        lock = _LOCKS.setdefault((info.st_dev, info.st_ino, leaf), threading.Lock())
+    with lock:
+        locked = False
+        with contextlib.suppress(OSError):  # no flock on this file system: this studio's own lock still holds
+            fcntl.flock(folder, fcntl.LOCK_EX)
+            locked = True
+        try:
+            yield
+        finally:
+            if locked:
+                fcntl.flock(folder, fcntl.LOCK_UN)
+
+
 def _write_at(folder: int, leaf: str, data: bytes, mode: int) -> tuple[int, int]:
     """Write ``leaf`` in the open ``folder`` through a temporary file renamed onto it (a link there is
     replaced, never written through); returns the new file's (device, inode)."""
-    temp = f".{leaf}.{secrets.token_hex(4)}.tmp"
+    temp = temp_name(leaf)
     fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600, dir_fd=folder)
     try:
         try:
