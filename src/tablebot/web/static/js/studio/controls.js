@@ -3,11 +3,13 @@ import { all, byId } from "../lib/dom.js";
 
 const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 
-function wireTable(store, send) {
+function wireTable(store, send, drafts) {
   on("save", "click", () => send({ op: "save" }));
   on("table-pick", "change", (e) => {
     const { dirty, path } = store.get();
     if (dirty && !confirm("The table has unsaved edits. Open another and lose them?")) { e.target.value = path; return; }
+    if (dirty) drafts.drop(path, true);  // the user chose to lose them
+    store.set({ offerDraft: e.target.value });
     send({ op: "open", path: e.target.value });
   });
   on("add-row", "click", () => {
@@ -52,8 +54,8 @@ function wireTraces(send, receive) {
   });
 }
 
-export function wireControls(store, send, receive) {
-  wireTable(store, send);
+export function wireControls(store, send, receive, drafts) {
+  wireTable(store, send, drafts);
   wireLive(store, send);
   wireTraces(send, receive);
 }

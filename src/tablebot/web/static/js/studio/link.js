@@ -1,25 +1,39 @@
-// The page's one WebSocket to the studio server. Messages sent before it is open wait in a queue; the
-// token travels in the page's HttpOnly cookie, never in the address or a message.
+// The page's one WebSocket to the studio server, reconnected when it drops. Messages sent before it first
+// opens wait in a queue; messages sent while it is down are dropped (the edits among them are in the page's
+// draft, offered back once it is up again). The token travels in the page's HttpOnly cookie, never in the
+// address or a message.
 import { stats } from "./stats.js";
+
+const RETRY_MS = [1000, 2000, 4000, 8000];  // then every 10 s
 
 export function createLink() {
   const pending = [];
-  let socket = null;
+  const link = { socket: null, opened: false /* it was open once: a new connection is a reconnect */ };
 
   function send(message) {
-    if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(message));
-    else pending.push(message);
+    if (link.socket && link.socket.readyState === WebSocket.OPEN) link.socket.send(JSON.stringify(message));
+    else if (!link.opened) pending.push(message);
   }
 
-  /** Connect; `first` (if any) goes before the queued messages, each reply to `receive`. */
-  function open(first, receive, onClose) {
-    socket = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
-    socket.addEventListener("open", () => {
-      if (first) socket.send(JSON.stringify(first));
-      while (pending.length) socket.send(JSON.stringify(pending.shift()));
-    });
-    socket.addEventListener("message", (e) => { stats.messages += 1; receive(JSON.parse(e.data)); });
-    socket.addEventListener("close", onClose);
+  /** Connect, and again whenever it drops: `hello(again)` gives the first message of each connection (if
+   * any), each reply goes to `receive`; `down(tries)` and `up()` tell the page it dropped and came back. */
+  function open(hello, receive, { down, up }) {
+    let tries = 0;
+    const connect = () => {
+      const socket = link.socket = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+      socket.addEventListener("open", () => {
+        const again = link.opened;
+        const first = hello(again);
+        if (first) socket.send(JSON.stringify(first));
+        while (pending.length) socket.send(JSON.stringify(pending.shift()));
+        link.opened = true;
+        tries = 0;
+        if (again) up();
+      });
+      socket.addEventListener("message", (e) => { stats.messages += 1; receive(JSON.parse(e.data)); });
+      socket.addEventListener("close", () => { down(tries); setTimeout(connect, RETRY_MS[tries++] || 10000); });
+    };
+    connect();
   }
 
   return { send, open };

@@ -3,6 +3,7 @@ import { createStore } from "../lib/store.js";
 import { wirePlayerControls, wireZoom } from "../views/player.js";
 import { banner } from "./banner.js";
 import { wireControls } from "./controls.js";
+import { createDrafts } from "./drafts.js";
 import { createLink } from "./link.js";
 import { messageHandlers } from "./messages.js";
 import { showPanels } from "./panels.js";
@@ -13,14 +14,17 @@ const store = createStore({
   path: null, files: { tables: [], traces: [] }, machine: null, analysis: null, seq: 0, editSent: 0,
   mode: "live", frame: null, clickMode: "start", speed: "1", paused: true, held: {}, runError: null,
   world: null, tickMs: 10, dirty: null /* no table yet: neither saved nor not */, selectedRow: null, mask: undefined, why: [], arenaOk: false,
+  folder: "", version: null /* of the file the draft started from */, offerDraft: null /* the table whose kept draft to offer */,
 });
 const link = createLink();
-const views = createViews(store, link.send);
-const handlers = messageHandlers(store, views, link.send);
+let drafts = null;
+const views = createViews(store, link.send, () => drafts.keep());
+drafts = createDrafts(store, views.grid);
+const handlers = messageHandlers(store, views, link.send, drafts);
 const receive = (m) => { if (handlers[m.type]) handlers[m.type](m); };
 
 showPanels(store, views, link.send);
-wireControls(store, link.send, receive);
+wireControls(store, link.send, receive, drafts);
 wirePlayerControls(views.player);
 wireZoom(views.arena);
 
@@ -45,10 +49,22 @@ async function start() {
   const reply = await fetch("/api/config");
   if (!reply.ok) { banner(await reply.text(), "bad"); return; }
   const config = await reply.json();
-  store.set({ files: config });
+  store.set({ files: config, folder: config.folder });
   const wanted = params.get("table") || config.table || config.tables[0];
-  link.open(wanted ? { op: "open", path: wanted } : null, receive,
-    () => banner("the studio server stopped: restart tablebot studio and reload", "bad"));
+  // each connection opens the table, and offers back the edits this browser kept of it
+  const hello = () => {
+    const path = store.get().path || wanted;
+    store.set({ offerDraft: path || null });
+    return path ? { op: "open", path } : null;
+  };
+  link.open(hello, receive, { down: connectionDown, up: () => banner("connected to the studio again", "good") });
+}
+
+function connectionDown(tries) {
+  const kept = store.get().dirty ? " Your unsaved edits are kept in this browser and offered back." : "";
+  if (tries < 3) banner("lost the connection to the studio: connecting again…" + kept, "bad");
+  else banner("the studio server does not answer: if it stopped, start tablebot studio again and open the address "
+    + "it prints." + kept, "bad");
 }
 
 requestAnimationFrame(paint);

@@ -1,6 +1,7 @@
 // What the page does with each message from the server: mostly a change of state (the panels subscribed
 // to it redraw), sometimes a view's own content (the grid's rows, the diagram's SVG, a trace to play).
 import { addOption, byId } from "../lib/dom.js";
+import { ask } from "./ask.js";
 import { banner } from "./banner.js";
 import { stats } from "./stats.js";
 
@@ -49,19 +50,65 @@ function trace(store, views, m) {
     + "the table, the diagram and the timeline follow it; the arena cannot");
 }
 
-function conflict(store, send, m) {
-  banner(m.message + " — " + m.hint, "bad", [["Reload", () => send({ op: "open", path: store.get().path })],
-    ["Save anyway", () => send({ op: "save", force: true })]]);
+const WHY = { changed: "Someone changed the file since you opened it.",
+  replaced: "Another program saved over it since you opened it (an editor, git checkout, sed -i, another studio).",
+  deleted: "It was deleted since you opened it." };
+
+// The file on disk is not the one the draft started from: save mine over theirs (kept as NAME.bak), or
+// load theirs (mine dropped). Asked at once when a save lost; a notice when another tab saved meanwhile.
+function conflict(store, send, drafts, m) {
+  const saveMine = () => send({ op: "save", force: m.theirs });
+  const loadTheirs = () => { drafts.drop(m.path, true); store.set({ offerDraft: null }); send({ op: "open", path: m.path }); };
+  const answers = m.how === "deleted" ? [["Save mine (write the table again)", saveMine, "primary"]] :
+    [[`Save mine (keep theirs as ${m.backup})`, saveMine, "primary"], ["Load theirs (drop my edits)", loadTheirs]];
+  if (m.op !== "save") {  // another tab saved while this one was editing: said, not asked
+    banner(m.message + " — " + m.hint, "bad", answers.map(([label, action]) => [label, action]));
+    return;
+  }
+  const later = () => banner("not saved: your edits are kept; Save asks again", "bad");
+  ask(`${m.path} was ${m.how === "deleted" ? "deleted" : m.how + " on disk"}`,
+    [(WHY[m.how] || "") + " Nothing was saved, and your edits are kept.",
+      m.how === "deleted" ? "Save mine writes your table again." :
+        `Save mine writes your table and keeps theirs as ${m.backup}; load theirs shows their table and drops your edits.`],
+    [...answers, ["Decide later", later]], later);
+}
+
+const clock = (ms) => new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit" });
+
+// Edits this browser kept for the table just opened, which its server session does not have (the page was
+// reloaded, or its connection dropped): put them back, or drop them.
+function offerDraft(store, send, drafts, m) {
+  const draft = drafts.waiting(m.path, m.header, m.grid);
+  if (!draft) return;
+  const restore = () => {
+    const seq = store.get().seq + 1;
+    store.set({ seq });
+    send({ op: "restore", base: draft.base, header: draft.header, grid: draft.grid, seq });
+  };
+  ask(`Restore your unsaved edits to ${m.path}?`, [`You edited ${m.path} at ${clock(draft.at)} and did not save. `
+    + "The page was reloaded or lost its connection to the studio; this browser kept your edits.",
+  draft.base !== m.version ? `${m.path} has changed on disk since: restoring puts your edits back, and Save will ask `
+    + "whether to keep that version as a backup." : ""],
+  [["Restore my edits", restore, "primary"], ["Drop them", () => drafts.drop(m.path, true)]]);
+}
+
+// A table from the server (opened, reloaded, connected again): the draft kept of it is offered when the page
+// asked for it (not when another tab's save reloaded it).
+function table(store, views, send, drafts, m) {
+  views.grid.setTable(m.header, m.grid, m.lines);
+  const offer = store.get().offerDraft === m.path;
+  store.set({ path: m.path, dirty: false, version: m.version, offerDraft: null });
+  if (offer) offerDraft(store, send, drafts, m);
 }
 
 /** The handlers, by message type. */
-export function messageHandlers(store, views, send) {
+export function messageHandlers(store, views, send, drafts) {
   return {
-    table(m) {
-      views.grid.setTable(m.header, m.grid, m.lines);
-      store.set({ path: m.path, dirty: false });
+    table: (m) => table(store, views, send, drafts, m),
+    grid(m) {
+      views.grid.setTable(views.grid.header, m.grid, m.lines || views.grid.lines);
+      drafts.keep();
     },
-    grid(m) { views.grid.setTable(views.grid.header, m.grid, views.grid.lines); },
     analysis: (m) => analysis(store, m),
     diagram(m) {
       views.diagram.setSvg(m.svg);
@@ -74,10 +121,11 @@ export function messageHandlers(store, views, send) {
     trace: (m) => trace(store, views, m),
     files: (m) => store.set({ files: m }),
     saved(m) {
-      store.set({ dirty: false });
-      banner(`saved ${m.path} (the previous version is ${m.backup})`, "good");
+      store.set({ dirty: false, version: m.version });
+      drafts.drop(m.path);
+      banner(`saved ${m.path}` + (m.backup ? ` (the previous version is ${m.backup})` : ""), "good");
     },
-    conflict: (m) => conflict(store, send, m),
+    conflict: (m) => conflict(store, send, drafts, m),
     notice: (m) => banner(m.message, "good"),
     error: (m) => banner(m.message, "bad"),
   };

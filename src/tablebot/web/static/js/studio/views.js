@@ -15,12 +15,13 @@ export function stateColumn(store) {
   return analysis ? analysis.columns.findIndex((c) => c.kind === "state") : -1;
 }
 
-function makeGrid(store, send) {
+function makeGrid(store, send, edited) {
   const grid = new Grid(byId("grid"), {
     onEdit: (row, col, value) => {
       const seq = store.get().seq + 1;
       store.set({ seq, editSent: performance.now() });
       send({ op: "edit", row, col, value, seq });
+      edited();
     },
   });
   byId("grid").addEventListener("focusin", (e) => {
@@ -62,8 +63,9 @@ function repaintStates({ arena, timeline }) {
   if (arena.replayPath) { arena.clearPath(); arena.addPath(arena.replayPath); }
 }
 
-export function createViews(store, send) {
-  const grid = makeGrid(store, send);
+/** The views; `edited` is called after each edit in the grid. */
+export function createViews(store, send, edited) {
+  const grid = makeGrid(store, send, edited);
   const arena = makeArena(store, send);
   const diagram = new Diagram(byId("diagram"));
   const views = { grid, arena, diagram };
