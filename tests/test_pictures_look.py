@@ -155,8 +155,6 @@ def test_a_followed_line_shows_its_path_above_the_tape() -> None:
 
 def test_diagram_pngs_are_sharp_enough_to_read(tmp_path: Path) -> None:
     """The tutorial's two-state diagram was 366×598 px: 9-point labels a few pixels high."""
-    if not shutil.which("dot"):
-        pytest.fail("Graphviz is missing: scripts/bootstrap.sh installs it")
     (tmp_path / "robot.toml").write_text(TUTORIAL_ROBOT)
     (tmp_path / "table.csv").write_text(BEFORE)
     out = tmp_path / "d.png"

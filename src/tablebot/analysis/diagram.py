@@ -1,5 +1,6 @@
 """The document's Figure 1 drawn from the table: states as nodes, rows as labelled edges (rows
-between the same two states merged), coloured by the motion they start; Graphviz or Mermaid."""
+between the same two states merged), coloured by the motion they start; Graphviz (drawn by the program
+graphviz_run finds: no system package needed) or Mermaid."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from dataclasses import dataclass
 
 import graphviz
 
+from tablebot.analysis.graphviz_run import INSTALL, GraphvizFailed, NoGraphviz, draw
 from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
@@ -203,13 +205,11 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
     if fmt == "png":
         graph.attr(dpi=str(PNG_DPI))
     try:
-        return graph.pipe(format=fmt)
-    except graphviz.ExecutableNotFound:
-        raise fail("dot", "the Graphviz program 'dot' is not installed",
-                   "install it (apt-get install graphviz, or run scripts/bootstrap.sh), "
-                   "or use --format dot or --format mermaid") from None
-    except graphviz.CalledProcessError as exc:
-        raise fail("dot", f"Graphviz failed: {exc.stderr!r}", "report this with the table attached") from None
+        return draw(graph.source, fmt)
+    except NoGraphviz as exc:
+        raise fail("graphviz", str(exc), f"{INSTALL}; or use --format dot or --format mermaid") from None
+    except GraphvizFailed as exc:
+        raise fail("graphviz", str(exc), "report this with the table attached") from None
 
 
 # --- Mermaid ----------------------------------------------------------------------------------------

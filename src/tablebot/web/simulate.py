@@ -8,9 +8,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
-import graphviz
-
 from tablebot.analysis.diagram import to_graphviz
+from tablebot.analysis.graphviz_run import INSTALL, GraphvizFailed, NoGraphviz, draw
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
@@ -188,14 +187,17 @@ class Arena:
 
 
 def studio_diagram(table: Table) -> str:
-    """The CLI's diagram without its title and legend (the page shows both); "" without Graphviz."""
+    """The CLI's diagram without its title and legend (the page shows both), as SVG text; without it, the
+    sentence saying why, which the page shows in the diagram's place (not starting with "<")."""
     graph = to_graphviz(table)
     graph.graph_attr.update(label="", ranksep="0.5", nodesep="0.25")
     graph.body[:] = [line for line in graph.body if "__legend" not in line]  # the grid's header says it all
     try:
-        return graph.pipe(format="svg").decode("utf-8")
-    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError):
-        return ""
+        return draw(graph.source, "svg").decode("utf-8")
+    except NoGraphviz as exc:
+        return f"No diagram: {exc}. To draw it: {INSTALL}; then reopen the table."
+    except GraphvizFailed as exc:
+        return f"No diagram: {exc}"
 
 
 def _robot(scene: Scene, seed: int) -> SimRobot:

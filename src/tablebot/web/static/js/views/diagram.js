@@ -9,12 +9,20 @@ export class Diagram {
   }
 
   // svgText comes from Graphviz, which the server gave only escaped labels; it is parsed as SVG
-  // (never as HTML) and scripts or event attributes in it would not run under the page's CSP.
+  // (never as HTML) and scripts or event attributes in it would not run under the page's CSP. Text not
+  // starting with "<" is the server's sentence saying why there is no diagram (no Graphviz): shown as text.
   setSvg(svgText) {
     this.holder.textContent = "";
     this.nodes.clear();
     this.current = null;
     if (!svgText) return;
+    if (!svgText.startsWith("<")) {
+      const note = document.createElement("p");
+      note.className = "diagram-note";
+      note.textContent = svgText;
+      this.holder.appendChild(note);
+      return;
+    }
     const svg = new DOMParser().parseFromString(svgText, "image/svg+xml").documentElement;
     if (svg.nodeName !== "svg") return;
     svg.removeAttribute("width"); svg.removeAttribute("height");
