@@ -370,3 +370,50 @@ def test_a_draft_from_an_older_version_asks_before_it_is_saved(studio: Backgroun
     asyncio.run(run())
     assert path.read_bytes() == marked(original, 2, "mine")
     assert (folder / "table.csv.bak").read_bytes() == marked(original, 5, "theirs")
+
+
+def test_a_reload_for_another_tabs_save_never_replaces_an_edit_made_meanwhile(folder: Path) -> None:
+    """Tab b, with no edits, reloads the table tab a saved; an edit b sends while the reload reads the
+    robot file stays b's (b is told of a's save instead), rather than being replaced by the reloaded table.
+    The studio's threads are one worker here, held while the edit comes, to make that moment certain."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    from tablebot.web.session import Hub, Session
+    from tablebot.web.workspace import Workspace
+
+    async def run() -> list[dict[str, Any]]:
+        loop = asyncio.get_running_loop()
+        loop.set_default_executor(ThreadPoolExecutor(max_workers=1))
+        hub, workspace, held = Hub(), Workspace(folder), threading.Event()
+        told: list[dict[str, Any]] = []
+
+        async def to_a(message: dict[str, Any]) -> None:
+            if message["type"] == "saved":  # b reloads next: the worker is busy, b waits for it
+                loop.run_in_executor(None, held.wait)
+                edits.append(asyncio.create_task(b.handle({"op": "edit", "row": 1, "col": 0, "value": "b's"})))
+
+        async def to_b(message: dict[str, Any]) -> None:
+            told.append(message)
+
+        edits: list[asyncio.Task[None]] = []
+        a, b = Session(workspace, hub, to_a), Session(workspace, hub, to_b)
+        hub.sessions |= {a, b}
+        for tab in (a, b):
+            await tab.handle({"op": "open", "path": "table.csv"})
+        await a.handle({"op": "edit", "row": 0, "col": 0, "value": "a's"})
+        saving = asyncio.create_task(a.handle({"op": "save"}))
+        while not edits or b.edits == 0:
+            await asyncio.sleep(0.01)
+        held.set()  # the edit is made; the reload goes on
+        await saving
+        await edits[0]
+        assert b.doc is not None and b.doc.grid()[1][0] == "b's" and b.dirty
+        for tab in (a, b):
+            tab.close()
+        return told
+
+    told = asyncio.run(run())
+    after = [m["type"] for m in told][[m["type"] for m in told].index("arena") + 1:]  # b's messages since it opened
+    assert after == ["conflict", "analysis", "diagram"]
+    assert next(m for m in told if m["type"] == "conflict")["message"].startswith("another tab saved this table")

@@ -12,6 +12,3 @@ export function ask(title, lines, answers, onEscape = null) {
   box.showModal();
   buttons[0].focus();
 }
-
-/** The dialog's question, if one is open. */
-export const asking = () => (byId("ask").open ? byId("ask").querySelector("h2").textContent : "");
