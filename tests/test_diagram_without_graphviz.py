@@ -178,5 +178,5 @@ def test_with_no_graphviz_at_all_the_studio_says_so_in_the_diagram_panel(browser
     html, text = studio_diagram(browser, no_packaged, bare, tmp_path / "bot")
     assert "<svg" not in html
     said = " ".join(text.split())
-    assert said.startswith("No diagram: no Graphviz to draw the diagram: neither graphviz-pure nor dot was found")
+    assert said.startswith("No diagram: neither graphviz-pure nor dot was found. To draw it: pip install")
     assert "pip install graphviz-pure" in said and "reopen the table" in said

@@ -20,11 +20,14 @@ INSTALL = (f"pip install {PACKAGED} (into the Python that runs tablebot), "
            "or install Graphviz (its dot program, on PATH)")
 
 
+NOT_FOUND = f"neither {PACKAGED} nor {SYSTEM} was found"
+
+
 class NoGraphviz(Exception):
     """Neither graphviz-pure nor dot is installed."""
 
     def __init__(self) -> None:
-        super().__init__(f"no Graphviz to draw the diagram: neither {PACKAGED} nor {SYSTEM} was found")
+        super().__init__(f"no Graphviz to draw the diagram: {NOT_FOUND}")
 
 
 class GraphvizFailed(Exception):

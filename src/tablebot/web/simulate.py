@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from tablebot.analysis.diagram import to_graphviz
-from tablebot.analysis.graphviz_run import INSTALL, GraphvizFailed, NoGraphviz, draw
+from tablebot.analysis.graphviz_run import INSTALL, NOT_FOUND, GraphvizFailed, NoGraphviz, draw
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.machine import Machine
 from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
@@ -194,8 +194,8 @@ def studio_diagram(table: Table) -> str:
     graph.body[:] = [line for line in graph.body if "__legend" not in line]  # the grid's header says it all
     try:
         return draw(graph.source, "svg").decode("utf-8")
-    except NoGraphviz as exc:
-        return f"No diagram: {exc}. To draw it: {INSTALL}; then reopen the table."
+    except NoGraphviz:
+        return f"No diagram: {NOT_FOUND}. To draw it: {INSTALL}; then reopen the table."
     except GraphvizFailed as exc:
         return f"No diagram: {exc}"
 
