@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Set up everything tablebot needs on a fresh Debian-like machine: system packages (graphviz for
-# diagrams, avr-gcc/avr-libc/simavr for firmware and its emulation, chromium for the studio's browser
-# tests, node and npm for the studio's JavaScript linter), a virtual environment, and ESLint from npm.
+# Set up everything tablebot needs on a fresh Debian-like machine: system packages (graphviz, which
+# diagrams fall back to where graphviz-pure from PyPI is missing: the tests check that it still draws;
+# avr-gcc/avr-libc/simavr for firmware and its emulation, chromium for the studio's browser tests, node
+# and npm for the studio's JavaScript linter), a virtual environment, and ESLint from npm.
 # The system packages install while the Python packages do (two downloads at once: on a fresh machine
 # each takes about 40 s, one after the other 80).
 set -euo pipefail
@@ -27,7 +28,7 @@ if [ ${#missing[@]} -gt 0 ]; then
     # a Python step that fails (set -e) must not leave apt running unseen, holding dpkg's lock for the next try
     trap 'if [ -n "$apt_pid" ]; then wait "$apt_pid" || cat "$apt_log" >&2; rm -f "$apt_log"; fi' EXIT
   else
-    echo "warning: cannot install ${missing[*]} (no apt-get); diagram and firmware tests will fail" >&2
+    echo "warning: cannot install ${missing[*]} (no apt-get); firmware tests will fail" >&2
   fi
 fi
 
