@@ -18,7 +18,7 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.web.app import Background
 from test_studio_browser import CHROMIUM, FLAGS
-from test_studio_saves import marked, replace_by_rename
+from test_studio_saves import marked, replace_by_rename, version
 
 playwright = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
 
@@ -198,10 +198,20 @@ def test_a_draft_of_a_table_changed_since_says_so_and_save_asks(tab: Page, folde
     assert "table.csv has changed on disk since" in text
     tab.answer("Restore my edits")
     tab.page.wait_for_selector("#save.primary")
+    tab.page.locator(f'td[data-row="4"][data-col="{TIMER_COL}"] input').fill("55")  # kept with the draft's own start
+    tab.page.wait_for_function(f"() => JSON.parse(localStorage.getItem(({DRAFTS})()[0])).grid[4][{TIMER_COL}] === '55'")
+    kept = tab.page.evaluate(f"() => JSON.parse(localStorage.getItem(({DRAFTS})()[0])).base")
+    assert kept == version(original)
+    tab.page.reload()
+    tab.loaded()
+    tab.asked("Restore your unsaved edits to table.csv?")
+    tab.answer("Restore my edits")
+    tab.page.wait_for_selector("#save.primary")
     tab.page.click("#save")
     tab.asked("table.csv was changed on disk")
     tab.answer("Save mine (keep theirs as table.csv.bak)")
     tab.saved()
-    assert path.read_bytes() == original.replace(b",895,", b",900,")
+    row_4 = b"Collision detection,2,,1,1,,,,,0,,0,%d,20"
+    assert path.read_bytes() == original.replace(b",895,", b",900,").replace(row_4 % 50, row_4 % 55)
     assert (folder / "table.csv.bak").read_bytes() == theirs
 

@@ -82,7 +82,7 @@ function offerDraft(store, send, drafts, m) {
   if (!draft) return;
   const restore = () => {
     const seq = store.get().seq + 1;
-    store.set({ seq });
+    store.set({ seq, version: draft.base });  // the draft's own start, kept with it at every edit
     send({ op: "restore", base: draft.base, header: draft.header, grid: draft.grid, seq });
   };
   ask(`Restore your unsaved edits to ${m.path}?`, [`You edited ${m.path} at ${clock(draft.at)} and did not save. `
