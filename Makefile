@@ -1,6 +1,6 @@
-# The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff, ESLint);
+# The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff, the docs site, ESLint);
 # both set themselves up first.
-.PHONY: setup demo test bench lock audit
+.PHONY: setup demo test bench lock audit docs
 
 # Python keeps its compiled bytecode (in __pycache__, which git ignores): without it every one of the
 # hundred tablebot processes the tests start compiles numpy, numba and tablebot again, seconds each.
@@ -27,7 +27,14 @@ test: setup
 	[ $$tests -eq 0 ] && [ $$types -eq 0 ]
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .
+	$(MKDOCS)
 	node_modules/.bin/eslint src/tablebot/web/static eslint.config.js
+
+# The documentation site, from docs/ (mkdocs.yml) into site/: strict, so a warning fails it, a link, anchor or
+# file that is not there and a page made from the code (scripts/docs_reference.py) that is out of date included.
+MKDOCS = NO_MKDOCS_2_WARNING=1 .venv/bin/mkdocs build --strict --quiet
+docs: setup
+	$(MKDOCS)
 
 bench: setup
 	status=0; for b in engine sim check mcu turn_drift studio fleet evolve controllers; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status

@@ -29,11 +29,3 @@ def test_shell_completion_is_offered() -> None:
     result = CliRunner().invoke(app, ["-h"])
     assert result.exit_code == 0
     assert "--install-completion" in result.output and "--show-completion" in result.output
-
-
-def test_the_package_version_is_the_projects() -> None:
-    import re
-    from pathlib import Path
-
-    pyproject = (Path(__file__).resolve().parents[1] / "pyproject.toml").read_text(encoding="utf-8")
-    assert re.search(r'^version = "([^"]+)"', pyproject, re.M)[1] == __version__  # type: ignore[index]

@@ -18,7 +18,7 @@ app = typer.Typer(
 
 
 def version() -> str:
-    """The running code's version (``tablebot.__version__``, kept equal to pyproject's): an installed
+    """The running code's version (``tablebot.__version__``, which the wheel's version is read from): an installed
     distribution's metadata can be older than a source tree on the path."""
     from tablebot import __version__
 
