@@ -34,7 +34,7 @@ WARMED = "TABLEBOT_TEST_NUMBA_WARMED"  # a file the main process writes when the
 #: own after the parallel one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them.
 REALTIME = {"test_txt_robot", "test_pace", "test_roboif", "test_robotx", "test_run_serial", "test_serial_wiring",
             "test_txt_link", "test_txt_wiring", "test_loop", "test_studio_live", "test_txt4_program",
-            "test_txt4_softxt", "test_txt4_upload", "test_rules"}
+            "test_txt4_softxt", "test_txt4_upload", "test_rules", "test_docs_controllers"}
 #: Modules that drive Chromium: one browser at a time (one xdist worker), beside the other worker's tests.
 BROWSER = {"test_studio_browser", "test_studio_attacks", "test_studio_drafts", "test_diagram_without_graphviz"}
 #: Modules that run no simulator kernel (measured: run alone on an empty numba cache, they compile nothing, or only

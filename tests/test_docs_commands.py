@@ -1,0 +1,117 @@
+"""Every command the README, the getting-started page and the tutorial show runs as typed: each page's ``sh``
+blocks are read (tests/doc_commands.py), and their ``tablebot`` lines run in order, through the CLI, in a
+folder holding a copy of the repository's examples, with the edits the page asks the reader to make done
+between them. A renamed option or a changed example breaks this test, not the reader. Commands that are not
+tablebot's own (installing, make) are exempt, each with its reason (doc_commands.EXEMPT)."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import httpx
+import pytest
+
+from doc_commands import ROOT, Command, Edit, block_after, commands, examples_copy, run, unaccounted, uncomment
+
+TUTORIAL = "docs/tutorial.md"
+
+
+def _tutorial_sensor(folder: Path) -> None:
+    """Section 5: remove the # in front of the robot file's [sensors] lines and of the table's example row."""
+    uncomment(folder / "my-robot" / "robot.toml", block_after(TUTORIAL, "## 5. Give it a sensor", "toml"))
+    uncomment(folder / "my-robot" / "table.csv", block_after(TUTORIAL, "remove the `#` in front of the example", ""))
+
+
+#: Edits a page asks for between two of its commands: before the n-th run of a command (page, text, n).
+EDITS: dict[tuple[str, str, int], Edit] = {(TUTORIAL, "tablebot check my-robot", 2): _tutorial_sensor}
+PAGES = ["README.md", "docs/getting-started.md", TUTORIAL]
+
+
+def run_page(doc: str, folder: Path) -> list[str]:
+    """Run the page's tablebot commands in order in ``folder``; what went wrong, one line per command."""
+    seen: Counter[str] = Counter()
+    failed = []
+    for command in commands(doc):
+        if not command.argv:
+            continue
+        seen[command.text] += 1
+        edit = EDITS.get((doc, command.text, seen[command.text]))
+        if edit is not None:
+            edit(folder)
+        if command.argv[0] == "studio":
+            problem = studio_serves(command, folder)
+        else:
+            result = run(command.argv, env=command.env or None)
+            problem = "" if result.exit_code == 0 else f"exit {result.exit_code}: {result.output[-600:]}"
+        if problem:
+            failed.append(f"{command}: {problem}")
+    return failed
+
+
+def studio_serves(command: Command, folder: Path) -> str:
+    """`tablebot studio` serves until Ctrl-C and opens a browser: here it runs as a process with
+    --no-browser on a free port; the page it prints must load, then Ctrl-C must end it."""
+    argv = [sys.executable, "-m", "tablebot", *command.argv, "--no-browser", "--port", "0"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    with subprocess.Popen(argv, cwd=folder, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True) as studio:
+        assert studio.stdout is not None
+        said, deadline = "", time.monotonic() + 60
+        while "http://" not in said and time.monotonic() < deadline and studio.poll() is None:
+            said += studio.stdout.readline()
+        address = re.search(r"http://\S+", said)
+        page = httpx.get(address[0], timeout=10) if address else None
+        studio.send_signal(signal.SIGINT)
+        rest, _ = studio.communicate(timeout=30)
+    if page is None or page.status_code != 200:
+        return f"no page served: {said + rest}"
+    return "" if studio.returncode in (0, 130) else f"exit {studio.returncode}: {rest[-600:]}"
+
+
+@pytest.mark.parametrize("doc", PAGES)
+def test_every_command_a_page_shows_runs_as_typed(doc: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert not unaccounted(commands(doc)), "run these commands in the test, or exempt them with the reason"
+    assert any(c.argv for c in commands(doc))
+    monkeypatch.chdir(examples_copy(tmp_path))
+    assert run_page(doc, tmp_path) == []
+
+
+def test_the_tutorials_edits_lead_to_what_it_shows(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """After section 5's edits the robot turns away from the walls: check proves its properties, and the
+    trace has the distance sensor's field, as the tutorial says."""
+    monkeypatch.chdir(examples_copy(tmp_path))
+    assert run(["new", "my-robot"]).exit_code == 0
+    _tutorial_sensor(tmp_path)
+    checked = run(["check", "my-robot"])
+    assert checked.exit_code == 0 and "0 errors" in checked.output, checked.output
+    simulated = run(["sim", "my-robot", "--seconds", "20", "--no-plots"])
+    assert simulated.exit_code == 0, simulated.output
+    first = (tmp_path / "out" / "sim" / "trace.jsonl").read_text().splitlines()[0]
+    assert '"I1_cm"' in first
+
+
+def test_the_makefiles_demo_command_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`make demo` is make setup, then this command (the README's first): it must run as the Makefile has it."""
+    recipe = re.search(r"^demo:.*\n\t(.+)$", (ROOT / "Makefile").read_text(encoding="utf-8"), re.M)
+    assert recipe is not None
+    words = recipe[1].split()
+    assert words[0] == ".venv/bin/tablebot"
+    monkeypatch.chdir(examples_copy(tmp_path))
+    result = run(words[1:])
+    assert result.exit_code == 0, result.output
+    assert {"trace.jsonl", "trajectory.png", "timeline.png"} <= {p.name for p in (tmp_path / "out" / "demo").iterdir()}
+
+
+def test_a_page_with_an_unknown_command_is_caught(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("```sh\ntablebot sim x\nrm -rf out   # not tablebot's\n```\n")
+    found = commands(str(page))  # a path outside the repository is taken as it is
+    assert [c.text for c in found] == ["tablebot sim x", "rm -rf out"]
+    assert unaccounted(found) == [f"{page}:3: rm -rf out"]
