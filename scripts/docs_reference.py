@@ -14,7 +14,6 @@ from __future__ import annotations
 import re
 import sys
 from pathlib import Path
-
 from typing import Any
 
 import typer.main
@@ -65,7 +64,7 @@ def commands_page() -> str:
     """docs/commands.md: the top level's options, then each command in `tablebot -h`'s order."""
     from tablebot.cli import app
 
-    group = typer.main.get_command(app)
+    group: Any = typer.main.get_command(app)  # a group: typer builds it on a click of its own
     top = _context(group, "tablebot", None)
     lines = [GENERATED, "# Commands and options", "",
              "Every command of `tablebot` with every argument and option, as `tablebot COMMAND -h` prints them. "
