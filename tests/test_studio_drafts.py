@@ -215,3 +215,28 @@ def test_a_draft_of_a_table_changed_since_says_so_and_save_asks(tab: Page, folde
     assert path.read_bytes() == original.replace(b",895,", b",900,").replace(row_4 % 50, row_4 % 55)
     assert (folder / "table.csv.bak").read_bytes() == theirs
 
+
+
+def test_a_save_in_another_tab_is_said_and_save_mine_keeps_theirs(tab: Page, browser: Any, server: Background,
+                                                                   shots: Path, folder: Path) -> None:
+    path = folder / "table.csv"
+    original = path.read_bytes()
+    other = Page(browser, server, shots)
+    try:
+        tab.edit_timer("900")
+        other.page.locator(f'td[data-row="4"][data-col="{TIMER_COL}"] input').fill("60")
+        other.page.wait_for_selector("#save.primary")
+        other.save()
+        theirs = path.read_bytes()
+        tab.page.wait_for_function("() => document.querySelector('#banner').textContent.startsWith('another tab')")
+        assert tab.page.locator("#banner").inner_text().startswith(
+            "another tab saved table.csv while this one has unsaved edits: your edits are kept")
+        tab.shot("other-tab-saved")
+        tab.page.click("#save")
+        assert "Another tab of the studio saved it" in tab.asked("table.csv was saved in another tab")
+        tab.answer("Save mine (keep theirs as table.csv.bak)")
+        tab.saved()
+        assert path.read_bytes() == original.replace(b",895,", b",900,")
+        assert (folder / "table.csv.bak").read_bytes() == theirs and b",60," in theirs
+    finally:
+        other.close()

@@ -128,6 +128,7 @@ def test_eight_tabs_saving_at_once_lose_no_edit(studio: Background, folder: Path
     assert [r["type"] for r in first].count("saved") == 1
     for reply in first:
         if reply["type"] == "conflict":
+            assert reply["message"] == "table.csv was saved in another tab since you opened it"
             assert "your edits are kept" in reply["hint"] and reply["theirs"] == first_saved(first)
     assert sorted(i for i, _ in chain) == list(range(TABS))
     for i, reply in chain:  # each tab saved exactly its own draft
@@ -416,4 +417,5 @@ def test_a_reload_for_another_tabs_save_never_replaces_an_edit_made_meanwhile(fo
     told = asyncio.run(run())
     after = [m["type"] for m in told][[m["type"] for m in told].index("arena") + 1:]  # b's messages since it opened
     assert after == ["conflict", "analysis", "diagram"]
-    assert next(m for m in told if m["type"] == "conflict")["message"].startswith("another tab saved this table")
+    assert next(m for m in told if m["type"] == "conflict")["message"] == ("another tab saved table.csv "
+                                                                                    "while this one has unsaved edits")

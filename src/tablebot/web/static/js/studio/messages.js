@@ -50,9 +50,13 @@ function trace(store, views, m) {
     + "the table, the diagram and the timeline follow it; the arena cannot");
 }
 
-const WHY = { changed: "Someone changed the file since you opened it.",
-  replaced: "Another program saved over it since you opened it (an editor, git checkout, sed -i, another studio).",
-  deleted: "It was deleted since you opened it." };
+const WHAT = {  // how the file changed: the dialog's title, and what it means
+  changed: ["was changed on disk", "Someone changed the file since you opened it."],
+  replaced: ["was replaced on disk", "Another program saved over it since you opened it (an editor, git checkout, "
+    + "sed -i, another studio)."],
+  deleted: ["was deleted", "It was deleted since you opened it."],
+  "saved in another tab": ["was saved in another tab", "Another tab of the studio saved it since you opened it here."],
+};
 
 // The file on disk is not the one the draft started from: save mine over theirs (kept as NAME.bak), or
 // load theirs (mine dropped). Asked at once when a save lost; a notice when another tab saved meanwhile.
@@ -62,12 +66,12 @@ function conflict(store, send, drafts, m) {
   const answers = m.how === "deleted" ? [["Save mine (write the table again)", saveMine, "primary"]] :
     [[`Save mine (keep theirs as ${m.backup})`, saveMine, "primary"], ["Load theirs (drop my edits)", loadTheirs]];
   if (m.op !== "save") {  // another tab saved while this one was editing: said, not asked
-    banner(m.message + " — " + m.hint, "bad", answers.map(([label, action]) => [label, action]));
+    banner(m.message + ": your edits are kept", "bad", answers.map(([label, action]) => [label, action]));
     return;
   }
   const later = () => banner("not saved: your edits are kept; Save asks again", "bad");
-  ask(`${m.path} was ${m.how === "deleted" ? "deleted" : m.how + " on disk"}`,
-    [(WHY[m.how] || "") + " Nothing was saved, and your edits are kept.",
+  const [title, why] = WHAT[m.how] || ["changed", ""];
+  ask(`${m.path} ${title}`, [why + " Nothing was saved, and your edits are kept.",
       m.how === "deleted" ? "Save mine writes your table again." :
         `Save mine writes your table and keeps theirs as ${m.backup}; load theirs shows their table and drops your edits.`],
     [...answers, ["Decide later", later]], later);
