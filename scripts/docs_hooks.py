@@ -5,13 +5,15 @@
 * the example robots (examples/) are part of the site, so a page can link to ``examples/bumberbot/robot.toml``
   and the reader gets the file;
 * a page made from the code (scripts/docs_reference.py) that is out of date is a warning, so the strict build
-  fails until the script has been run again.
+  fails until the script has been run again;
+* the docstrings' Sphinx roles (``:meth:`step```) show as the code they name, without the role's name.
 """
 
 from __future__ import annotations
 
 import importlib.util
 import logging
+import re
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -21,6 +23,7 @@ from mkdocs.structure.files import File, Files
 
 ROOT = Path(__file__).resolve().parents[1]
 log = logging.getLogger("mkdocs.hooks.tablebot")
+ROLE_RE = re.compile(r":(?:py:)?(?:meth|func|class|mod|attr|data|exc|obj|const):(?=<code>)")
 
 
 def _reference() -> ModuleType:
@@ -50,3 +53,7 @@ def on_files(files: Files, config: MkDocsConfig, **_: Any) -> Files:
         uri = path.relative_to(ROOT).as_posix()
         files.append(File.generated(config, uri, abs_src_path=str(path)))
     return files
+
+
+def on_page_content(html: str, **_: Any) -> str:
+    return ROLE_RE.sub("", html)

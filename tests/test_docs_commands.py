@@ -18,7 +18,18 @@ from pathlib import Path
 import httpx
 import pytest
 
-from doc_commands import ROOT, Command, Edit, block_after, commands, examples_copy, run, unaccounted, uncomment
+from doc_commands import (
+    FENCE_RE,
+    ROOT,
+    Command,
+    Edit,
+    block_after,
+    commands,
+    examples_copy,
+    run,
+    unaccounted,
+    uncomment,
+)
 
 TUTORIAL = "docs/tutorial.md"
 
@@ -97,15 +108,26 @@ def test_the_tutorials_edits_lead_to_what_it_shows(tmp_path: Path, monkeypatch: 
     assert '"I1_cm"' in first
 
 
-def test_the_makefiles_demo_command_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """`make demo` is make setup, then this command (the README's first): it must run as the Makefile has it."""
-    recipe = re.search(r"^demo:.*\n\t(.+)$", (ROOT / "Makefile").read_text(encoding="utf-8"), re.M)
+def demo_commands() -> list[list[str]]:
+    """The tablebot commands `make demo` runs: its recipe's, and those of a script of scripts/ it calls."""
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    recipe = re.search(r"^demo:.*\n((?:\t.*\n)+)", makefile, re.M)
     assert recipe is not None
-    words = recipe[1].split()
-    assert words[0] == ".venv/bin/tablebot"
+    lines = recipe[1].splitlines()
+    for script in re.findall(r"\./(scripts/[\w.-]+\.sh)", recipe[1]):
+        lines += (ROOT / script).read_text(encoding="utf-8").splitlines()
+    return [line.split()[1:] for line in (raw.strip().lstrip("@") for raw in lines)
+            if line.startswith(".venv/bin/tablebot ")]
+
+
+def test_the_makefiles_demo_command_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`make demo` sets up, then runs tablebot: its commands must run as it has them."""
+    found = demo_commands()
+    assert found
     monkeypatch.chdir(examples_copy(tmp_path))
-    result = run(words[1:])
-    assert result.exit_code == 0, result.output
+    for argv in found:
+        result = run(argv)
+        assert result.exit_code == 0, result.output
     assert {"trace.jsonl", "trajectory.png", "timeline.png"} <= {p.name for p in (tmp_path / "out" / "demo").iterdir()}
 
 
@@ -115,3 +137,14 @@ def test_a_page_with_an_unknown_command_is_caught(tmp_path: Path) -> None:
     found = commands(str(page))  # a path outside the repository is taken as it is
     assert [c.text for c in found] == ["tablebot sim x", "rm -rf out"]
     assert unaccounted(found) == [f"{page}:3: rm -rf out"]
+
+
+@pytest.mark.parametrize("doc", ["docs/engine.md", "docs/api.md"])
+def test_the_python_examples_run(doc: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Python a page shows runs as it stands, from the repository's folder (its paths are examples/...)."""
+    text = (ROOT / doc).read_text(encoding="utf-8")
+    blocks = [b[2] for b in FENCE_RE.finditer(text) if b[1] == "python"]
+    assert blocks
+    monkeypatch.chdir(ROOT)
+    for block in blocks:
+        exec(compile(block, doc, "exec"), {"__name__": "__docs__"})
