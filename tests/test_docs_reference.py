@@ -132,3 +132,52 @@ def test_the_version_is_the_packages_everywhere() -> None:
     config.load_dict({"site_name": "tablebot"})
     assert hooks.on_config(config).copyright == f"tablebot {tablebot.__version__}"
     assert CliRunner().invoke(app, ["--version"]).output.strip() == f"tablebot {tablebot.__version__}"
+
+
+TABLEBOT_LINE = re.compile(r"^\s*(?:\$ )?(?:\w+=\S+ )*tablebot (.*)$")
+
+
+def mentioned_commands(text: str) -> list[str]:
+    """Every `tablebot COMMAND ...` a page shows: a line of a code block (a synopsis's indented continuation
+    lines joined to it) or an inline code span; the words after `tablebot`, comments dropped."""
+    found = []
+    for block in re.finditer(r"^```\w*\n(.*?)^```", text, re.M | re.S):
+        body = re.sub(r"\n\s+(?=\[|--|\()", " ", block[1].replace("\\\n", " "))
+        found += [m[1] for m in map(TABLEBOT_LINE.match, body.splitlines()) if m]
+    found += re.findall(r"`tablebot ([^`]+)`", text.replace("\n", " "))
+    return [line.split(" #")[0] for line in found]
+
+
+def unknown_options(text: str) -> list[str]:
+    """Options a page gives a command that the command does not have (a rename the page missed)."""
+    import typer.main
+
+    group = typer.main.get_command(app)
+    commands = group.commands  # type: ignore[attr-defined]
+    bad = []
+    for line in mentioned_commands(text):
+        words = line.split()
+        if not words or words[0] not in commands:
+            continue
+        known = {"-h", "--help"}
+        for param in commands[words[0]].params:
+            known |= {*getattr(param, "opts", ()), *getattr(param, "secondary_opts", ())}
+        bad += [f"tablebot {words[0]} {option}" for word in words[1:]
+                for option in re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", word) if option not in known]
+    return bad
+
+
+def test_every_option_a_page_gives_a_command_exists() -> None:
+    """Pages not run by the tests (synopses such as `tablebot sweep TABLE [--grid ...]`) still name only
+    options their command has."""
+    pages = [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]
+    checked = sum(len(mentioned_commands(p.read_text(encoding="utf-8"))) for p in pages)
+    assert checked > 150
+    bad = [f"{p.name}: {o}" for p in pages for o in unknown_options(p.read_text(encoding="utf-8"))]
+    assert bad == []
+
+
+def test_a_renamed_option_is_caught() -> None:
+    page = ("```sh\ntablebot sweep TABLE [--world W ...] (--robots N | --seeds 0..9)\n"
+            "               [--grid start=random] [--bogus 3]\n```\nthen `tablebot sim x --no-plots --colour`.\n")
+    assert unknown_options(page) == ["tablebot sweep --bogus", "tablebot sim --colour"]
