@@ -19,21 +19,18 @@ from tablebot.web.document import MAX_TABLE_BYTES, CsvDocument
 from tablebot.web.errors import Refused, log
 from tablebot.web.simulate import Arena, ArenaSettings
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
-from tablebot.web.workspace import BACKUP_SUFFIX, ChangedOnDisk, Kind, Opened, Workspace
+from tablebot.web.workspace import BACKUP_SUFFIX, OTHER_TAB, ChangedOnDisk, Kind, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
-OTHER_TAB = "saved in another tab"  # how a file changed on disk, when a tab of this studio saved it
 MAX_ROWS = 20_000  # a restored draft: far more than a table a person edits in a grid
 MAX_COLUMNS = 200
 
 
 class Hub:
-    """Which sessions have which file open, so that a save reaches the other tabs; ``versions``: the version
-    each table was last saved at by a tab (a save that lost to one is told so)."""
+    """Which sessions have which file open, so that a save reaches the other tabs."""
 
     def __init__(self) -> None:
         self.sessions: set[Session] = set()
-        self.versions: dict[str, str] = {}
 
     async def saved(self, by: Session, file: Opened) -> None:
         for other in list(self.sessions):
@@ -177,13 +174,8 @@ class Session:
         try:
             saved = await asyncio.to_thread(self.workspace.save, self.opened, doc.to_bytes(), force, self.base)
         except ChangedOnDisk as exc:
-            if self.hub.versions.get(exc.name) == exc.theirs:  # by this studio's hand
-                await self.send(_conflict(f"{exc.name} was {OTHER_TAB} since you opened it", OTHER_TAB, exc.theirs,
-                                          exc.name, "save"))
-                return
             await self.send(_conflict(str(exc), exc.how, exc.theirs, exc.name, "save"))
             return
-        self.hub.versions[saved.file.name] = saved.file.version  # before any await: a save that lost says by whom
         self.opened, self.base, self.dirty = saved.file, None, False
         await self.send({"type": "saved", "op": "save", "version": saved.file.version, "path": saved.file.name,
                          "backup": None if saved.backup is None else saved.file.name + BACKUP_SUFFIX,

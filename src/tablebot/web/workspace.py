@@ -22,7 +22,7 @@ import os
 import stat
 import threading
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from tablebot.web.errors import Refused
@@ -38,6 +38,7 @@ MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table t
 READ_FLAGS = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_NOCTTY | os.O_CLOEXEC
 DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
+OTHER_TAB = "saved in another tab"  # how a file changed, when the version there is one this studio wrote
 
 
 class Kind(enum.Enum):
@@ -77,11 +78,11 @@ class ChangedOnDisk(Exception):
     """The file on disk is not the version the draft started from (a save may overwrite it if asked).
 
     ``how``: changed (in place), replaced (another file renamed over it: an editor's or tablebot's own
-    atomic save, ``sed -i``, ``git checkout``, another tab), or deleted; ``theirs``: the version on disk
-    now (:data:`GONE` if none), which a forced save must name."""
+    atomic save, ``sed -i``, ``git checkout``), :data:`OTHER_TAB`, or deleted; ``theirs``: the version on
+    disk now (:data:`GONE` if none), which a forced save must name."""
 
     def __init__(self, name: str, how: str, theirs: str) -> None:
-        super().__init__(f"{name} was {how} on disk since you opened it")
+        super().__init__(f"{name} was {how if how == OTHER_TAB else how + ' on disk'} since you opened it")
         self.name, self.how, self.theirs = name, how, theirs
 
 
@@ -90,6 +91,7 @@ class Workspace:
     """The served folder; every name the page sends is checked (and refused) here."""
 
     root: Path
+    written: dict[str, str] = field(default_factory=dict)  # the version each table was last saved at here
 
     def __post_init__(self) -> None:
         self.root = self.root.resolve()
@@ -181,11 +183,12 @@ class Workspace:
             theirs = GONE if current is None else digest(current)
             if theirs != (base or opened.version) and force is not True and force != theirs:
                 how = "deleted" if current is None else "changed" if identity == opened.identity else "replaced"
-                raise ChangedOnDisk(opened.name, how, theirs)
+                raise ChangedOnDisk(opened.name, OTHER_TAB if self.written.get(opened.name) == theirs else how, theirs)
             try:
                 if current is not None:
                     _write_at(folder, leaf + BACKUP_SUFFIX, current, mode)
                 written = _write_at(folder, leaf, data, mode)
+                self.written[opened.name] = digest(data)  # still one save at a time: the next one sees it
             except OSError as exc:
                 raise Refused(f"{opened.name} was not saved: {exc.strerror or 'the system refused'} "
                               "(check the folder's permissions and free space)") from None
