@@ -9,8 +9,10 @@ unexport PYTHONDONTWRITEBYTECODE
 setup:
 	@./scripts/bootstrap.sh
 
-demo: setup
-	.venv/bin/tablebot sim examples/bumberbot --out out/demo
+# The demo sets up only what a user's commands need (scripts/bootstrap.sh user: Python packages from PyPI, no
+# sudo, no system packages, no developer tools) and shows the simulated BumberBot: scripts/demo.sh.
+demo:
+	@./scripts/demo.sh
 
 # pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
 # once first), then the wall-clock ones (marked realtime there) two at a time with nothing CPU-bound beside
@@ -43,6 +45,8 @@ bench: setup
 # extra, resolved once for every platform and Python 3.11+, with their hashes. Pins already in the lock are
 # kept unless pyproject.toml now refuses them; `make lock UPGRADE=1` moves every package to its newest allowed
 # version. Written beside the lock and renamed over it: a failed resolution leaves the old lock as it was.
+# requirements/user.lock (what `make demo` installs) is the same for the packages without the extras, held
+# to dev.lock's versions: a user and the tests run the same numpy, numba, ...
 lock:
 	@[ -x .venv/bin/uv ] || ./scripts/bootstrap.sh
 	cp requirements/dev.lock requirements/.dev.lock.tmp
@@ -50,6 +54,10 @@ lock:
 	  --custom-compile-command "make lock" $(if $(UPGRADE),--upgrade) -q -o requirements/.dev.lock.tmp \
 	  || { rm -f requirements/.dev.lock.tmp; exit 1; }
 	mv requirements/.dev.lock.tmp requirements/dev.lock
+	.venv/bin/uv pip compile pyproject.toml --constraint requirements/dev.lock --universal --python-version 3.11 \
+	  --generate-hashes --custom-compile-command "make lock" -q -o requirements/.user.lock.tmp \
+	  || { rm -f requirements/.user.lock.tmp; exit 1; }
+	mv requirements/.user.lock.tmp requirements/user.lock
 
 # Every pin of the lock (other platforms' and Pythons' too) against the vulnerability database, by pip-audit
 # (from the lock): exit 0 no known vulnerabilities, 1 some (listed), 2 not checked (the database could not be

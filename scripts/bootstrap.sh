@@ -1,61 +1,151 @@
 #!/usr/bin/env bash
-# Set up everything tablebot needs on a fresh Debian-like machine: system packages (graphviz, which
-# diagrams fall back to where graphviz-pure from PyPI is missing: the tests check that it still draws;
-# avr-gcc/avr-libc/simavr for firmware and its emulation, chromium for the studio's browser tests, node
-# and npm for the studio's JavaScript linter), a virtual environment, and ESLint from npm.
+# Set up tablebot in .venv/, at one of two levels:
+#
+#   scripts/bootstrap.sh user   what a user's commands need (`make demo`): a virtual environment with
+#                               tablebot and its Python packages from PyPI, as requirements/user.lock pins
+#                               them. No system package, no sudo, no compiler, no Node: any OS with Python 3.11+.
+#   scripts/bootstrap.sh        everything the tests need (`make setup`, `make test`): the same, plus the
+#                               dev packages (requirements/dev.lock), and on a Debian-like machine the system
+#                               packages (graphviz, which diagrams fall back to where graphviz-pure from PyPI
+#                               is missing: the tests check that it still draws; avr-gcc/avr-libc/simavr for
+#                               firmware and its emulation, chromium for the studio's browser tests, node and
+#                               npm for the studio's JavaScript linter) and ESLint from npm.
+#
 # The system packages install while the Python packages do (two downloads at once: on a fresh machine
 # each takes about 40 s, one after the other 80).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config chromium)
-missing=()
-for pkg in "${SYSTEM_PACKAGES[@]}"; do
-  dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")
-done
-command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)  # any node with npm will do (Debian's, or another)
+LEVEL=${1:-dev}
+case "$LEVEL" in
+  user|dev) ;;
+  *) echo "usage: scripts/bootstrap.sh [user|dev]  (user: what tablebot's commands need; dev, the default: the tests too)" >&2
+     exit 2 ;;
+esac
+
 apt_pid=""
 apt_log=""
-if [ ${#missing[@]} -gt 0 ]; then
-  if command -v apt-get >/dev/null 2>&1; then
-    SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-    [ -z "$SUDO" ] || sudo -v  # ask for the password now, not in the middle of the Python packages' output
-    echo "installing system packages (in the background): ${missing[*]}"
-    apt_log=$(mktemp)
-    ( $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" ) \
-      >"$apt_log" 2>&1 &
-    apt_pid=$!
-    # a Python step that fails (set -e) must not leave apt running unseen, holding dpkg's lock for the next try
-    trap 'if [ -n "$apt_pid" ]; then wait "$apt_pid" || cat "$apt_log" >&2; rm -f "$apt_log"; fi' EXIT
-  else
-    echo "warning: cannot install ${missing[*]} (no apt-get); firmware tests will fail" >&2
+if [ "$LEVEL" = dev ]; then
+  SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config chromium)
+  missing=()
+  for pkg in "${SYSTEM_PACKAGES[@]}"; do
+    dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")  # no dpkg (not Debian-like): all missing, said below
+  done
+  command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)  # any node with npm will do (Debian's, or another)
+  if [ ${#missing[@]} -gt 0 ]; then
+    if command -v apt-get >/dev/null 2>&1; then
+      SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+      [ -z "$SUDO" ] || sudo -v  # ask for the password now, not in the middle of the Python packages' output
+      echo "installing system packages (in the background): ${missing[*]}"
+      apt_log=$(mktemp)
+      ( $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" ) \
+        >"$apt_log" 2>&1 &
+      apt_pid=$!
+      # a Python step that fails (set -e) must not leave apt running unseen, holding dpkg's lock for the next try
+      trap 'if [ -n "$apt_pid" ]; then wait "$apt_pid" || cat "$apt_log" >&2; rm -f "$apt_log"; fi' EXIT
+    else
+      echo "warning: cannot install ${missing[*]} (no apt-get); firmware, browser and ESLint checks will fail" >&2
+    fi
   fi
 fi
 
-# Each step says what it does before it starts: the first set-up takes minutes, and must not look hung.
-PYTHON=${PYTHON:-python3}
-if [ ! -x .venv/bin/python ]; then
-  echo "creating .venv (a Python virtual environment for tablebot) with $PYTHON"
-  "$PYTHON" -m venv .venv
+# Each step says what it does before it starts: the first set-up takes a while, and must not look hung.
+# A Python of 3.11 or newer: $PYTHON, else the first of these on PATH.
+if [ -z "${PYTHON:-}" ]; then
+  for candidate in python3 python3.13 python3.12 python3.11 python; do
+    if command -v "$candidate" >/dev/null 2>&1 \
+       && "$candidate" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+      PYTHON=$candidate
+      break
+    fi
+  done
 fi
-# The Python packages exactly as requirements/dev.lock pins them (versions and hashes; `make lock` writes it
-# from pyproject.toml), then tablebot itself, editable, with no packages of its own. .venv/.installed keeps a
-# checksum of the two files: when either changes (a pull, `make lock`), the next set-up installs again.
-LOCK=requirements/dev.lock
-stamp="$(cat pyproject.toml "$LOCK" | cksum)"
-if [ "$(cat .venv/.installed 2>/dev/null)" != "$stamp" ]; then
-  echo "installing tablebot's Python packages into .venv as $LOCK pins them (numpy, numba, matplotlib, typer,"
-  echo "  rich, dask, playwright, ...): a few minutes the first time"
+if [ ! -x .venv/bin/python ]; then
+  if [ -z "${PYTHON:-}" ] || ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+    echo "error: tablebot needs Python 3.11 or newer, and none was found on PATH (python3, python3.13, python3.12," >&2
+    echo "  python3.11); install one (docs/install.md says how on each system) or name it: make demo PYTHON=/path/to/python3.12" >&2
+    exit 1
+  fi
+  echo "creating .venv (a Python virtual environment for tablebot) with $PYTHON ($("$PYTHON" -c 'import platform; print(platform.python_version())'))"
+  # without pip: a venv's own pip costs seconds to set up, and Debian's Python has none without the
+  # python3-venv package (a system package); uv installs everything, pip included where the tests want it
+  "$PYTHON" -m venv --without-pip .venv
+fi
+
+# The Python packages exactly as the lock pins them (versions and hashes; `make lock` writes both locks from
+# pyproject.toml, user.lock with dev.lock's versions), then tablebot itself, editable, with no packages of its
+# own. A stamp in .venv keeps a checksum of pyproject.toml and the lock: when either changes (a pull, `make
+# lock`), the next set-up installs again. The dev packages include every user package, so a venv set up for
+# the tests serves the demo as it is.
+stamp_of() { cat pyproject.toml "$1" | cksum; }
+DEV_LOCK=requirements/dev.lock
+USER_LOCK=requirements/user.lock
+dev_stamp="$(stamp_of "$DEV_LOCK")"
+user_stamp="$(stamp_of "$USER_LOCK")"
+installed() { [ "$(cat ".venv/$1" 2>/dev/null)" = "$2" ]; }
+
+# "$@" with a line every 10 s while it runs: a step of tens of seconds (uv's quiet downloads) must not look hung.
+talking() {
+  local what=$1; shift
+  "$@" &
+  local pid=$! started=$SECONDS said=$SECONDS
+  while kill -0 "$pid" 2>/dev/null; do
+    sleep 0.5
+    if [ $((SECONDS - said)) -ge 10 ] && kill -0 "$pid" 2>/dev/null; then
+      said=$SECONDS
+      echo "  still $what: $((SECONDS - started)) s"
+    fi
+  done
+  wait "$pid"
+}
+
+uv_ready() {
   # uv (from PyPI, like everything else) fetches and installs in parallel: seconds where pip takes minutes.
+  # Into .venv with whichever installer there is: a uv on PATH, the Python's own pip (22.3+: --python), or a
+  # pip that ensurepip puts into .venv.
+  [ -x .venv/bin/uv ] && return
+  if command -v uv >/dev/null 2>&1 && uv pip install -q --python .venv/bin/python uv; then return; fi
+  if "${PYTHON:-python3}" -m pip --version >/dev/null 2>&1 \
+     && "${PYTHON:-python3}" -m pip --python .venv/bin/python install -q --disable-pip-version-check uv 2>/dev/null; then
+    return
+  fi
+  if .venv/bin/python -m ensurepip -q >/dev/null 2>&1; then
+    .venv/bin/python -m pip install -q --disable-pip-version-check uv
+    return
+  fi
+  echo "error: no way to install uv into .venv: ${PYTHON:-python3} has no pip and no ensurepip. Install uv (python3 -m pip" >&2
+  echo "  install --user uv, pipx install uv, or uv's own installer), or pip for this Python (Debian, Ubuntu:" >&2
+  echo "  the python3-pip package), then run this again" >&2
+  exit 1
+}
+
+if [ "$LEVEL" = user ]; then
+  if ! installed .installed "$dev_stamp" && ! installed .installed-user "$user_stamp"; then
+    echo "installing tablebot and the Python packages its commands need into .venv, as $USER_LOCK pins them"
+    echo "  (numpy, numba, matplotlib, graphviz-pure, ...; no system packages): 10-30 s the first time"
+    uv_ready
+    # install, not sync: a venv that also holds the dev packages (make test) keeps them
+    talking "installing" .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --require-hashes \
+      -r "$USER_LOCK"
+    .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --no-deps -e .
+    echo "$user_stamp" >.venv/.installed-user
+    echo "installed; .venv/bin/tablebot --help lists the commands"
+  fi
+elif ! installed .installed "$dev_stamp"; then
+  echo "installing tablebot's Python packages and the developer tools into .venv as $DEV_LOCK pins them"
+  echo "  (numpy, numba, matplotlib, typer, rich, dask, playwright, pytest, mypy, ...): a few minutes the first time"
+  uv_ready
   # `uv pip sync` makes .venv hold exactly the lock's packages (a package dropped from it is removed; pip and
   # uv stay). --compile-bytecode: the tests start tablebot in a hundred processes, each would compile numpy,
   # numba and matplotlib again; --system-certs: the machine's own certificate store, as pip uses it.
-  .venv/bin/python -m pip install -q uv
-  .venv/bin/uv pip sync -q --python .venv/bin/python --compile-bytecode --system-certs --require-hashes "$LOCK"
+  talking "installing" .venv/bin/uv pip sync -q --python .venv/bin/python --compile-bytecode --system-certs \
+    --require-hashes "$DEV_LOCK"
   .venv/bin/uv pip install -q --python .venv/bin/python --compile-bytecode --system-certs --no-deps -e .
-  echo "$stamp" >.venv/.installed
+  echo "$dev_stamp" >.venv/.installed
   echo "installed; .venv/bin/tablebot --help lists the commands"
 fi
+
+[ "$LEVEL" = dev ] || exit 0
 
 if [ -n "$apt_pid" ]; then
   pid=$apt_pid; apt_pid=""  # waited for here: the exit trap has nothing left to do

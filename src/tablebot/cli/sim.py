@@ -16,6 +16,7 @@ from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guar
 from tablebot.escape import plain
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
+    from tablebot.jit import Compiling
     from tablebot.loop import Sink
     from tablebot.sim.painter import Painter
     from tablebot.sim.runner import SimRun
@@ -96,17 +97,20 @@ def _sim(run: _Run, painter: Painter | None) -> None:
     scene = sim_scene.scene_for(parsed, machine, run.world, overrides)
     ticks = ticks_for(scene, run.seconds)  # refuses too long a run before anything is written
     out_folder(out, "--out")  # before the run, so that a bad path fails at once
-    from tablebot.jit import say_compiling
+    from tablebot.jit import Compiling
     from tablebot.sim.kernel import run_robot
 
-    say_compiling("the simulator", run_robot)
+    compiling = Compiling("the simulator", run_robot)  # talks until the first ticks have run (first run only)
     # the robot rows are kept only for what draws the run: the painter needs some columns, an animation all
     every_row = run.gif or run.view
     rows = painter.start(scene, ticks, seed, every_row=every_row) if painter is not None else every_row
     drawing = _import_drawing(run.gif, run.html)
     with file_set(out):  # the trace and the pictures replace the previous run's all at once, or not at all
         trace = TraceFile(out / "trace.jsonl", background=True)
-        result = _simulate(scene, run.seconds, seed, None if run.quiet else ticks, trace, rows, painter)
+        try:
+            result = _simulate(scene, run.seconds, seed, None if run.quiet else ticks, trace, rows, painter, compiling)
+        finally:
+            compiling.done(finished=False)  # an error or Ctrl-C during the compile: the notice stops, says no more
         drawing.join()
         if result.end.complete:
             summary = summarise(result)
@@ -206,10 +210,11 @@ def _report(result: SimRun, summary: Summary, written: list[Path]) -> None:
 
 
 def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace: TraceFile,
-              rows: bool | tuple[int, ...], painter: Painter | None) -> SimRun:
+              rows: bool | tuple[int, ...], painter: Painter | None, compiling: Compiling) -> SimRun:
     """The run, with a progress bar of ``ticks`` on a terminal (None: quiet); history in float32 (half
     the memory, plenty for pictures: the trace is written from the exact values), the pictured part of
-    it in memory the painter shares, which learns how far the run is as it goes."""
+    it in memory the painter shares, which learns how far the run is as it goes. A first run compiles the
+    simulator before its first tick: ``compiling`` talks meanwhile, and the bar appears once ticks run."""
     import numpy as np
 
     from tablebot.sim.runner import simulate
@@ -217,11 +222,23 @@ def _simulate(scene: Scene, seconds: float, seed: int, ticks: int | None, trace:
     sinks: list[Sink] = [trace] if painter is None else [trace, painter.sink]
     kept: dict[str, Any] = {"history": np.float32, "rows": rows} | ({} if painter is None else {"zeros": painter.zeros})
     if ticks is None or not sys.stderr.isatty():
-        return simulate(scene, seconds, seed, sinks=sinks, **kept)
+        compiled = (lambda done: compiling.done()) if compiling.active else None
+        return simulate(scene, seconds, seed, progress=compiled, sinks=sinks, **kept)
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn())
-    with Progress(*columns, console=err_console, transient=True) as bar:
-        task = bar.add_task("sim", total=ticks)
-        return simulate(scene, seconds, seed, progress=lambda done: bar.update(task, completed=done), sinks=sinks,
-                        **kept)
+    bar = Progress(*columns, console=err_console, transient=True)
+    task = bar.add_task("sim", total=ticks)
+
+    def report(done: int) -> None:
+        if not bar.live.is_started:  # the first ticks ran: the compile (if any) is over
+            compiling.done()
+            bar.start()
+        bar.update(task, completed=done)
+
+    try:
+        if not compiling.active:
+            bar.start()
+        return simulate(scene, seconds, seed, progress=report, sinks=sinks, **kept)
+    finally:
+        bar.stop()

@@ -1,0 +1,74 @@
+"""A first run compiles tablebot's kernels for tens of seconds: tablebot.jit.Compiling talks all that while
+(what, how long it usually takes, the seconds so far) instead of a progress bar standing at 0 %, and says
+nothing at all once the code is in numba's cache."""
+
+from __future__ import annotations
+
+import importlib.util
+import io
+import sys
+import time
+from pathlib import Path
+from types import ModuleType
+
+from tablebot.jit import USUALLY, Compiling
+
+KERNEL = '''
+from tablebot.jit import njit
+
+
+@njit
+def twice(x):
+    return 2 * x
+'''
+
+
+def fresh_kernel(folder: Path, name: str) -> ModuleType:
+    """A module with one compiled function that no cache has seen (a file of its own: numba caches by file)."""
+    path = folder / f"{name}.py"
+    path.write_text(KERNEL, encoding="utf-8")
+    spec = importlib.util.spec_from_file_location(name, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_compile_is_announced_then_talked_through_then_timed_in_a_log(tmp_path: Path) -> None:
+    kernel = fresh_kernel(tmp_path, f"notice_kernel_{time.monotonic_ns()}")
+    log = io.StringIO()
+    notice = Compiling("the doubler", kernel.twice, every_s=0.05, stream=log)
+    assert notice.active
+    time.sleep(0.3)
+    assert kernel.twice(21) == 42  # compiled (and cached) here
+    notice.done()
+    notice.done()  # only the first says anything
+    lines = log.getvalue().splitlines()
+    assert lines[0] == f"compiling the doubler for this machine: first run only, {USUALLY}; later runs start at once"
+    assert len(lines) >= 4 and all(line.startswith("  still compiling the doubler: ") for line in lines[1:-1])
+    assert lines[-1].startswith("compiled the doubler in ") and "later runs start at once" in lines[-1]
+    # the function is in the cache now: a later run is told nothing
+    quiet = io.StringIO()
+    later = Compiling("the doubler", kernel.twice, every_s=0.01, stream=quiet)
+    time.sleep(0.05)
+    later.done()
+    assert not later.active and quiet.getvalue() == ""
+
+
+class Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_on_a_terminal_one_line_is_redrawn_with_a_spinner_and_the_seconds(tmp_path: Path) -> None:
+    kernel = fresh_kernel(tmp_path, f"notice_kernel_{time.monotonic_ns()}")
+    screen = Terminal()
+    notice = Compiling("the doubler", kernel.twice, stream=screen)
+    time.sleep(0.35)
+    notice.done(finished=False)  # cut short (an error, Ctrl-C): the line is cleared, nothing claimed
+    shown = screen.getvalue()
+    frames = [frame for frame in shown.split("\r") if frame]
+    assert "\n" not in shown and len(frames) >= 3
+    assert frames[0].startswith(f"{Compiling.SPINNER[0]} compiling the doubler for this machine: 0 s (first run only")
+    assert frames[-1] == "\x1b[K"
