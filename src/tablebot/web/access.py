@@ -7,13 +7,23 @@ The rules follow Jupyter's server (``jupyter_server/base/handlers.py``: ``check_
 token login): a page on another origin cannot read or change the folder, and DNS rebinding (a foreign name
 that resolves to 127.0.0.1) meets the ``Host`` check. The token reaches the page once, in the address the
 studio prints (``/?token=...``); the page keeps it as an HttpOnly, SameSite=Strict cookie named after the
-port, and logs show it as ``[token]``.
+port, and logs show it as ``[token]``, however it is percent-encoded.
+
+What the cookie's name and scope achieve, on a machine other users' pages and servers share: browsers keep
+cookies per host name, not per port, so every server on 127.0.0.1 receives the cookie (a server on another
+port can read it from its requests; nothing a cookie can say prevents that). A *page's script* from another
+port cannot read it (HttpOnly) nor replace it (a script may not overwrite an HttpOnly cookie); what it can do
+is plant a cookie of the same name with a longer path (``path=/ws``), which the browser sends first: the
+studio therefore accepts the request if *any* cookie of its name holds the token, so a planted one neither
+locks the user out nor gets anyone in. Its requests to the studio are refused by ``Sec-Fetch-Site`` and
+``Origin`` (below), and the name carries the port, so two studios never take each other's cookie.
 """
 
 from __future__ import annotations
 
 import ipaddress
 import logging
+import re
 import secrets
 import socket
 from collections.abc import Awaitable, Callable, MutableMapping
@@ -99,9 +109,10 @@ class Access:
         return name in self.names or (self.any_ip and _is_ip(name))
 
     def has_token(self, cookie: str | None, query_token: str | None = None) -> bool:
-        """The token, from the page's cookie or (first visit) from the address."""
-        given = query_token if query_token is not None else _cookie_value(cookie or "", self.cookie)
-        return given is not None and secrets.compare_digest(given.encode(), self.token.encode())
+        """The token, from the page's cookie or (first visit) from the address. Any cookie of the studio's
+        name may hold it: one planted by another port's page (``path=/ws``) comes first in the header."""
+        given = [query_token] if query_token is not None else _cookie_values(cookie or "", self.cookie)
+        return any(secrets.compare_digest(value.encode(), self.token.encode()) for value in given)
 
     def refusal(self, scope: Scope) -> str | None:
         """Why the request is refused (the studio's words), or None to let it through."""
@@ -125,12 +136,14 @@ class Access:
         return None
 
 
-def _cookie_value(header: str, name: str) -> str | None:
+def _cookie_values(header: str, name: str) -> list[str]:
+    """The values of every cookie called ``name`` in a Cookie header (a browser sends one per path)."""
+    values = []
     for part in header.split(";"):
         key, _, value = part.strip().partition("=")
         if key == name:
-            return value
-    return None
+            values.append(value)
+    return values
 
 
 def _first_token(scope: Scope) -> str | None:
@@ -182,17 +195,30 @@ async def _deny(scope: Scope, send: Send, reason: str) -> None:
         await send({"type": "websocket.close", "code": 1008})
 
 
+def spellings(token: str) -> re.Pattern[str]:
+    """Every way ``token`` can be written in an address: each character as it is or percent-encoded, once or
+    more (``%41``, ``%2541``; either case of hex digit), since the server decodes the query before comparing."""
+    parts = []
+    for char in token:
+        hex_digits = "".join(f"[{d.lower()}{d.upper()}]" for d in f"{ord(char):02x}")
+        parts.append(f"(?:{re.escape(char)}|%(?:25)*{hex_digits})")
+    return re.compile("".join(parts))
+
+
 class HideToken(logging.Filter):
     """Writes every studio token of this process as ``[token]`` in log records (uvicorn's request lines
-    show query strings)."""
+    show query strings as they came, percent-encoding and all)."""
 
     def __init__(self) -> None:
         super().__init__()
-        self.tokens: set[str] = set()
+        self.tokens: dict[str, re.Pattern[str]] = {}
+
+    def add(self, token: str) -> None:
+        self.tokens.setdefault(token, spellings(token))
 
     def _hide(self, text: str) -> str:
-        for token in self.tokens:
-            text = text.replace(token, "[token]")
+        for pattern in self.tokens.values():
+            text = pattern.sub("[token]", text)
         return text
 
     def filter(self, record: logging.LogRecord) -> bool:
@@ -208,7 +234,7 @@ _HIDE = HideToken()
 
 def hide_token_in_logs(token: str) -> None:
     """Hide ``token`` in uvicorn's logs (call after uvicorn has configured its loggers)."""
-    _HIDE.tokens.add(token)
+    _HIDE.add(token)
     for name in ("uvicorn.access", "uvicorn.error", "uvicorn"):
         logger = logging.getLogger(name)
         if _HIDE not in logger.filters:
