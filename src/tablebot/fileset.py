@@ -10,13 +10,13 @@ interrupted, the staging folder goes and nothing in ``folder`` has changed. The 
 
 A process killed outright (SIGKILL, a crash) can leave a staging folder behind. The next set written into
 that folder finishes its swap if its journal was complete, and removes it otherwise. A staging folder is
-locked (``flock``) by the process that writes it, so a live one is never taken for a dead one.
+locked by the process that writes it (``flock``; on Windows a byte lock, ``msvcrt.locking``), so a live one
+is never taken for a dead one; where neither exists, the process named in its name is asked whether it lives.
 """
 
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import json
 import os
 import re
@@ -30,6 +30,15 @@ from pathlib import Path
 
 from tablebot.diagnostics import fail
 from tablebot.interrupts import fault_point, held
+
+try:  # POSIX
+    import fcntl
+except ImportError:  # Windows
+    fcntl = None  # type: ignore[assignment]
+try:  # Windows
+    import msvcrt
+except ImportError:  # POSIX
+    msvcrt = None  # type: ignore[assignment]
 
 STAGE_PREFIX = ".tablebot-"
 STAGE_RE = re.compile(r"^\.tablebot-(\d+)-[A-Za-z0-9_]{8}$")  # what tempfile.mkdtemp makes of the prefix
@@ -151,13 +160,22 @@ def new_folder(folder: Path) -> Iterator[Path]:
             lock = -1
             (stage / LOCK).unlink()
             fault_point()
-            os.rename(stage, folder)  # POSIX: onto an empty folder too, in one step
+            _rename_folder(stage, folder)
     except BaseException:
         with held():
             if lock >= 0:
                 os.close(lock)
             shutil.rmtree(stage, ignore_errors=True)
         raise
+
+
+def _rename_folder(stage: Path, folder: Path) -> None:
+    """POSIX renames a folder onto an empty folder in one step; Windows refuses to, so there the empty
+    folder goes first (a folder that is not empty stays, and the rename's error says so)."""
+    if os.name == "nt" and folder.is_dir() and not folder.is_symlink():
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+    os.rename(stage, folder)
 
 
 @contextmanager
@@ -175,8 +193,57 @@ def _make_stage(folder: Path, named: Path) -> tuple[Path, int]:
     with named_as(named):
         stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{os.getpid()}-", dir=folder))
     lock = os.open(stage / LOCK, os.O_RDWR | os.O_CREAT, 0o600)
-    fcntl.flock(lock, fcntl.LOCK_EX)
+    try_lock(lock)  # a fresh file: nobody else holds it
     return stage, lock
+
+
+def try_lock(fd: int) -> bool:
+    """Lock the open file ``fd`` for this process, without waiting: False when another process holds it.
+    Where the system has no file locks (neither flock nor msvcrt), True: callers then ask whether the
+    process is alive (:func:`process_alive`)."""
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        elif msvcrt is not None:
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)  # the first byte; released when the file is closed
+    except OSError:
+        return False
+    return True
+
+
+def can_lock() -> bool:
+    """Whether :func:`try_lock` really locks (else a stage's process is judged by its pid alone)."""
+    return fcntl is not None or msvcrt is not None
+
+
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` is running (or may be: one we may not look at counts as alive)."""
+    if os.name == "nt":  # os.kill(pid, 0) on Windows would end the process (TerminateProcess with code 0)
+        return _windows_process_alive(pid)
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _windows_process_alive(pid: int) -> bool:
+    import ctypes
+
+    kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)  # type: ignore[attr-defined]
+    query_limited_information, still_active, invalid_parameter = 0x1000, 259, 87
+    handle = kernel32.OpenProcess(query_limited_information, False, pid)
+    if not handle:  # no such process (or one we may not open: alive)
+        return ctypes.get_last_error() != invalid_parameter  # type: ignore[attr-defined]
+    try:
+        code = ctypes.c_ulong()
+        if not kernel32.GetExitCodeProcess(handle, ctypes.byref(code)):
+            return True
+        return code.value == still_active
+    finally:
+        kernel32.CloseHandle(handle)
 
 
 def _files(stage: Path) -> list[str]:
@@ -239,6 +306,14 @@ def _discard(fs: FileSet) -> None:
         with contextlib.suppress(OSError):
             os.close(fs.lock)
         fs.lock = -1
+        _remove_rest(fs.stage)
+
+
+def _remove_rest(stage: Path) -> None:
+    """Windows removes no open file: the lock file (and so the stage) outlives a removal made while it was
+    open, and goes now that it is closed. Elsewhere the stage is gone already."""
+    if os.path.lexists(stage):
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 # --- what a killed process left ---------------------------------------------------------------------
@@ -267,28 +342,21 @@ def recover(folder: Path) -> list[Path]:
         finally:
             if lock >= 0:
                 os.close(lock)
+        _remove_rest(stage)
     return done
 
 
 def _take(stage: Path) -> int | None:
     """The stage's lock if its process is gone (-1: a stage with no lock file, whose process is gone);
     None while its process lives."""
+    pid = int(STAGE_RE.match(stage.name)[1])  # type: ignore[index]
     try:
         lock = os.open(stage / LOCK, os.O_RDWR)
     except FileNotFoundError:  # made but not yet locked, or being renamed into place: ask about its process
-        pid = int(STAGE_RE.match(stage.name)[1])  # type: ignore[index]
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            return -1
-        except PermissionError:
-            return None
-        return None
+        return None if process_alive(pid) else -1
     except OSError:
         return None
-    try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
+    if not try_lock(lock) or (not can_lock() and process_alive(pid)):
         os.close(lock)
         return None
     return lock

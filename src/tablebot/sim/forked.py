@@ -163,7 +163,8 @@ class Forked:
 def _pipe(opened: list[int]) -> tuple[int, int]:
     read, write = os.pipe()
     opened += [read, write]
-    with contextlib.suppress(OSError, AttributeError):  # a smaller pipe only costs more system calls
+    # a smaller pipe only costs more system calls (no F_SETPIPE_SZ: not Linux; no fcntl: not POSIX)
+    with contextlib.suppress(OSError, AttributeError, ImportError):
         import fcntl
 
         fcntl.fcntl(write, fcntl.F_SETPIPE_SZ, _PIPE_BYTES)

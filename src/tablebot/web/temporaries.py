@@ -14,8 +14,10 @@ import re
 import secrets
 import stat
 import time
+from collections.abc import Iterator
 from pathlib import PurePosixPath
 
+from tablebot.fileset import process_alive
 from tablebot.web.errors import log
 
 #: Only names a save gives: ``.`` + a table's name (or its .bak) + ``.studio-PID-8HEX.tmp``.
@@ -34,13 +36,13 @@ def sweep(root: str | os.PathLike[str]) -> list[str]:
     """Remove the stale temporaries of studio saves under ``root``; their names relative to it."""
     removed: list[str] = []
     now = time.time()
-    for count, (folder, dirs, files, fd) in enumerate(os.fwalk(root)):  # never follows a link
+    for count, (folder, dirs, files, fd) in enumerate(_walk(root)):  # never follows a link
         keep = count < MAX_SWEPT_FOLDERS
         dirs[:] = [d for d in dirs if keep and d not in SKIP_DIRS and not d.startswith(".")]
         for name in files:
-            if _stale(name, fd, now):
+            if _stale(name, folder, fd, now):
                 try:
-                    os.unlink(name, dir_fd=fd)
+                    os.unlink(name, dir_fd=fd) if fd is not None else os.unlink(os.path.join(folder, name))
                 except OSError:
                     continue  # gone meanwhile, or not ours to remove: left alone
                 removed.append(PurePosixPath(os.path.relpath(os.path.join(folder, name), root)).as_posix())
@@ -51,12 +53,23 @@ def sweep(root: str | os.PathLike[str]) -> list[str]:
     return removed
 
 
-def _stale(name: str, folder: int, now: float) -> bool:
+def _walk(root: str | os.PathLike[str]) -> Iterator[tuple[str, list[str], list[str], int | None]]:
+    """os.fwalk (each folder open, so a link swapped in meanwhile leads nowhere); where the system has none
+    (Windows), os.walk, which follows no link either, and no folder descriptor (None)."""
+    if hasattr(os, "fwalk"):
+        yield from os.fwalk(root)
+    else:
+        for folder, dirs, files in os.walk(root):
+            yield folder, dirs, files, None
+
+
+def _stale(name: str, folder: str, fd: int | None, now: float) -> bool:
     found = TEMP_RE.fullmatch(name)
     if found is None:
         return False
     try:
-        info = os.stat(name, dir_fd=folder, follow_symlinks=False)
+        info = os.stat(name, dir_fd=fd, follow_symlinks=False) if fd is not None else \
+            os.stat(os.path.join(folder, name), follow_symlinks=False)
     except OSError:
         return False
     if not stat.S_ISREG(info.st_mode):
@@ -69,9 +82,6 @@ def _running(pid: int) -> bool:
     if pid == os.getpid():
         return True
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
+        return process_alive(pid)  # not os.kill(pid, 0): on Windows that would end the process
     except (OSError, OverflowError):  # another user's process (EPERM), or no such number: left alone
         return True
-    return True

@@ -16,7 +16,6 @@ import codecs
 import contextlib
 import enum
 import errno
-import fcntl
 import hashlib
 import os
 import stat
@@ -28,6 +27,11 @@ from pathlib import Path, PurePosixPath
 from tablebot.web.errors import Refused
 from tablebot.web.temporaries import sweep, temp_name
 
+try:  # POSIX; without it (Windows) this studio's own lock still holds saves one at a time
+    import fcntl
+except ImportError:
+    fcntl = None  # type: ignore[assignment]
+
 TABLE_SUFFIXES = (".csv", ".tsv")
 TRACE_SUFFIXES = (".jsonl",)
 SKIP_DIRS = {"node_modules", "__pycache__"}  # besides every folder whose name starts with a dot
@@ -35,8 +39,10 @@ MAX_LISTED = 500  # files listed for the open menus; a home folder is not a proj
 BACKUP_SUFFIX = ".bak"
 HEAD_BYTES = 4096  # read to tell a table from another CSV
 MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table the studio opened is 1 MB at most)
-READ_FLAGS = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_NOCTTY | os.O_CLOEXEC
-DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
+# the POSIX-only flags are 0 where the system has none of them (Windows)
+NOFOLLOW, CLOEXEC = getattr(os, "O_NOFOLLOW", 0), getattr(os, "O_CLOEXEC", 0)
+READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | getattr(os, "O_NOCTTY", 0) | CLOEXEC
+DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | NOFOLLOW | CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
 OTHER_TAB = "saved in another tab"  # how a file changed, when the version there is one this studio wrote
 
@@ -153,7 +159,7 @@ class Workspace:
     @contextlib.contextmanager
     def _folder(self, parts: tuple[str, ...], real: str) -> Iterator[int]:
         """A descriptor of a folder inside the served one, reached without following any link."""
-        fd = os.open(self.root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+        fd = os.open(self.root, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | CLOEXEC)
         try:
             for part in parts:
                 try:
@@ -319,12 +325,13 @@ def _one_save_at_a_time(folder: int, leaf: str) -> Iterator[None]:
     with lock:
         locked = False
         with contextlib.suppress(OSError):  # no flock on this file system: this studio's own lock still holds
-            fcntl.flock(folder, fcntl.LOCK_EX)
-            locked = True
+            if fcntl is not None:
+                fcntl.flock(folder, fcntl.LOCK_EX)
+                locked = True
         try:
             yield
         finally:
-            if locked:
+            if locked and fcntl is not None:
                 fcntl.flock(folder, fcntl.LOCK_UN)
 
 
@@ -332,13 +339,14 @@ def _write_at(folder: int, leaf: str, data: bytes, mode: int) -> tuple[int, int]
     """Write ``leaf`` in the open ``folder`` through a temporary file renamed onto it (a link there is
     replaced, never written through); returns the new file's (device, inode)."""
     temp = temp_name(leaf)
-    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600, dir_fd=folder)
+    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | NOFOLLOW | CLOEXEC, 0o600, dir_fd=folder)
     try:
         try:
             view = memoryview(data)
             while view:
                 view = view[os.write(fd, view):]
-            os.fchmod(fd, mode)
+            if hasattr(os, "fchmod"):  # Windows before Python 3.13 has none (and modes are only read-only there)
+                os.fchmod(fd, mode)
             os.fsync(fd)
             info = os.fstat(fd)
         finally:
