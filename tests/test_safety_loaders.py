@@ -78,12 +78,13 @@ def test_states_csv_with_a_superscript_digit(tmp_path: Path) -> None:
 def test_dev_zero_stops_at_the_size_limit() -> None:
     """Reproduced: `tablebot check /dev/zero` read until MemoryError."""
     result = cli("check", "/dev/zero")
-    assert result.exit_code == 2 and "larger than 64 MB" in result.stderr
+    assert result.exit_code == 2 and "larger than 16 MB" in result.stderr  # a table's limit
 
 
 @pytest.mark.parametrize("loader", ["table", "robot", "inputs", "trace"])
 def test_every_kind_of_input_has_a_size_limit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, loader: str) -> None:
     monkeypatch.setattr(csvtext, "MAX_TEXT_BYTES", 1000)
+    monkeypatch.setattr("tablebot.formats.table_read.MAX_TABLE_BYTES", 1000)
     monkeypatch.setattr("tablebot.tomlfile.MAX_TOML_BYTES", 1000)
     monkeypatch.setattr("tablebot.formats.trace_lines.MAX_TRACE_BYTES", 1000)
     path = tmp_path / "big"

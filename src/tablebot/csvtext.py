@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import codecs
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
@@ -45,6 +45,11 @@ CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with cha
 #: The largest file a loader reads, by default: a 100,000-row table is about 5 MB, an hour of recorded
 #: inputs at 10 ms ticks about 6 MB. Anything larger is almost surely the wrong file (or /dev/zero).
 MAX_TEXT_BYTES = 64 * 1024 * 1024
+#: The widest record and the longest cell a loader reads (:func:`read_records`), far beyond any real file: the
+#: examples' tables have up to 14 columns and cells of at most 40 characters. Both are refused before the
+#: record is built, so neither a line of a million commas nor a cell of megabytes costs memory.
+MAX_COLUMNS = 1000
+MAX_CELL_CHARS = 4000
 #: Bytes that no text file holds (NUL and the other C0 controls but tab and line ends): binary data.
 BINARY_RE = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
 #: A well-formed UTF-8 sequence of two or more bytes: a file that has one is UTF-8 with a few bad bytes,
@@ -140,12 +145,43 @@ def detect_delimiter(first_line: str) -> str:
 
 
 def _first_filled_line(text: str) -> str:
-    """The first line with any text (the header), so blank lines above it do not hide its delimiter."""
-    return next((line for line in text.split("\n") if line.strip()), "")
+    """The first line with any text (the header), so blank lines above it do not hide its delimiter (found
+    line by line: splitting a whole file of millions of lines would build a list of all of them)."""
+    start = 0
+    while start <= len(text):
+        end = text.find("\n", start)
+        end = len(text) if end < 0 else end
+        if text[start:end].strip():
+            return text[start:end]
+        start = end + 1
+    return ""
 
 
 def split_records(text: str, path: str, delimiter: str | None = None) -> list[Record]:
-    """Split CSV text into records; a quoted cell may hold delimiters, quotes ("") and newlines."""
+    """Split CSV text into records; a quoted cell may hold delimiters, quotes ("") and newlines. Any width
+    and cell length: for a glance at a file (is it a table?) and the studio; loaders use :func:`read_records`."""
+    return list(_records(text, path, delimiter, bounded=False))
+
+
+def read_records(text: str, path: str, delimiter: str | None = None) -> Iterator[Record]:
+    """:func:`split_records` one record at a time (a loader keeps only what it makes of each), refusing a record
+    of more than MAX_COLUMNS cells and a cell of more than MAX_CELL_CHARS characters where it is, before
+    building it."""
+    return _records(text, path, delimiter, bounded=True)
+
+
+def _records(text: str, path: str, delimiter: str | None, bounded: bool) -> Iterator[Record]:
+    """Every record, but the empty one after the final newline (held back one record to see which is last)."""
+    held = None
+    for record in _all_records(text, path, delimiter, bounded):
+        if held is not None:
+            yield held
+        held = record
+    if held is not None and (len(held.cells) > 1 or held.cells[0].text):
+        yield held
+
+
+def _all_records(text: str, path: str, delimiter: str | None, bounded: bool) -> Iterator[Record]:
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     first = _first_filled_line(text)
     excel = SEP_RE.match(first)
@@ -154,7 +190,6 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
     if delimiter is None:
         delimiter = excel[1] if excel else detect_delimiter(first)
     stop = re.compile(f"[{re.escape(delimiter)}\n]")
-    records: list[Record] = []
     cells: list[Cell] = []
     line, column, i = 1, 1, 0
     record_line = 1
@@ -164,17 +199,18 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
             end = text.find("\n", i)
             end = n if end < 0 else end
             if '"' not in text[i:end]:
-                records.append(Record(line, _split_line(text[i:end], delimiter, line)))
+                if bounded:
+                    _check_line(text[i:end], delimiter, path, line)
+                yield Record(line, _split_line(text[i:end], delimiter, line))
                 i, line = end + 1, line + 1
                 record_line = line
                 continue
         start_line, start_col = line, column
         if i < n and text[i] == '"':
-            value, i, line, column = _quoted(text, i, line, column, path)
-            while i < n and text[i] not in (delimiter, "\n"):  # stray text after a closing quote
-                value += text[i]
-                i += 1
-                column += 1
+            value, i, line, column = _quoted(text, i, line, column, path, bounded)
+            found = stop.search(text, i)  # stray text after the closing quote belongs to the cell
+            j = found.start() if found else n
+            value, column, i = value + text[i:j], column + j - i, j
         else:
             found = stop.search(text, i)  # the cell's end, found in C: a long table has millions of characters
             j = found.start() if found else n
@@ -182,20 +218,19 @@ def split_records(text: str, path: str, delimiter: str | None = None) -> list[Re
             column += j - i
             i = j
         cells.append(Cell(value, start_line, start_col))
+        if bounded:
+            _check_cell(cells, path)
         if i < n and text[i] == delimiter:
             i += 1
             column += 1
             continue
         # end of record (newline or end of text)
-        records.append(Record(record_line, tuple(cells)))
+        yield Record(record_line, tuple(cells))
         cells = []
         i += 1
         line += 1
         column = 1
         record_line = line
-    if records and len(records[-1].cells) == 1 and not records[-1].cells[0].text:
-        records.pop()  # the empty "record" after the final newline
-    return records
 
 
 def _split_line(text: str, delimiter: str, line: int) -> tuple[Cell, ...]:
@@ -208,30 +243,62 @@ def _split_line(text: str, delimiter: str, line: int) -> tuple[Cell, ...]:
     return tuple(cells)
 
 
-def _quoted(text: str, i: int, line: int, column: int, path: str) -> tuple[str, int, int, int]:
-    start_line, start_col = line, column
-    out: list[str] = []
-    i += 1
-    column += 1
-    n = len(text)
-    while i < n:
-        ch = text[i]
-        if ch == '"':
-            if i + 1 < n and text[i + 1] == '"':
-                out.append('"')
-                i += 2
-                column += 2
-                continue
-            return "".join(out), i + 1, line, column + 1
-        out.append(ch)
-        if ch == "\n":
-            line += 1
-            column = 1
-        else:
-            column += 1
-        i += 1
+def _check_line(text: str, delimiter: str, path: str, line: int) -> None:
+    """Refuse a line (without quotes) of too many cells, or with a cell too long, before it is split."""
+    if text.count(delimiter) >= MAX_COLUMNS:
+        rest = text.split(delimiter, MAX_COLUMNS)[-1]
+        raise _too_wide(path, line, len(text) - len(rest) + 1)
+    if len(text) > MAX_CELL_CHARS:
+        column = 1
+        for value in text.split(delimiter):
+            if len(value) > MAX_CELL_CHARS:
+                raise _too_long(path, line, column)
+            column += len(value) + 1
+
+
+def _check_cell(cells: list[Cell], path: str) -> None:
+    """Refuse the cell just read (of a record with quotes) if it is one too many or too long."""
+    cell = cells[-1]
+    if len(cells) > MAX_COLUMNS:
+        raise _too_wide(path, cell.line, cell.column)
+    if len(cell.text) > MAX_CELL_CHARS:
+        raise _too_long(path, cell.line, cell.column)
+
+
+def _too_wide(path: str, line: int, column: int) -> TableBotError:
+    return fail(path, f"this line has more than {MAX_COLUMNS:,} cells, the most tablebot reads",
+                "a table has a column per input and output, a few dozen at most: is this the right file?",
+                line, column)
+
+
+def _too_long(path: str, line: int, column: int) -> TableBotError:
+    return fail(path, f"this cell is longer than {MAX_CELL_CHARS:,} characters, the most tablebot reads",
+                "shorten it (a description is a sentence or two); is this the right file?", line, column)
+
+
+def _quoted(text: str, i: int, line: int, column: int, path: str, bounded: bool) -> tuple[str, int, int, int]:
+    """The value of the quoted cell at ``i`` (its opening quote), and where its closing quote ends (index, line,
+    column). Each quote is found in C; a ``bounded`` read stops at a cell longer than MAX_CELL_CHARS."""
+    start = i
+    parts: list[str] = []
+    j = i + 1
+    while True:
+        k = text.find('"', j)
+        if k < 0 or (bounded and k - start > 2 * MAX_CELL_CHARS + 2):  # "" is 2 characters of the file for 1
+            break
+        parts.append(text[j:k])
+        if text.startswith('"', k + 1):  # a doubled quote: one quote in the value
+            parts.append('"')
+            j = k + 2
+            continue
+        raw = text[start:k + 1]
+        newlines = raw.count("\n")
+        column = len(raw) - raw.rfind("\n") if newlines else column + len(raw)
+        return "".join(parts), k + 1, line + newlines, column
+    if k >= 0:
+        raise _too_long(path, line, column)
     raise fail(path, "a quoted cell is never closed", 'add the closing " (write "" for a quote inside)',
-               start_line, start_col)
+               line, column)
 
 
 def cells_beyond(cells: Sequence[Cell], width: int, out: Collector) -> None:

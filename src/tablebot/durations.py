@@ -13,6 +13,10 @@ from fractions import Fraction
 
 DURATION_RE = re.compile(r"^\s*(\d+(?:\.\d*)?|\.\d+)\s*(ticks?|ms|s)?\s*$", re.IGNORECASE)
 MS_PER = {"ms": 1, "s": 1000}
+#: The longest number, in characters, read from what people write (table cells, durations, state numbers, the
+#: numbers of a TOML file): no count, state or time comes near it, and ``int()`` of a longer one may fail
+#: (Python refuses to convert more than 4,300 digits, a guard against conversions that take seconds).
+MAX_NUMBER_CHARS = 100
 
 
 def seconds(ticks: float, tick_ms: int) -> float:
@@ -35,6 +39,10 @@ def to_ticks(text: str, tick_ms: int) -> int:
     if match is None:
         raise DurationError(f"{text.strip()!r} is not a duration",
                             f"write ticks (50) or a time: 500ms, 0.5s (one tick is {tick_ms} ms)")
+    if len(match[1]) > MAX_NUMBER_CHARS:
+        raise DurationError(f"a number of {len(match[1]):,} characters is no duration",
+                            f"write ticks (50) or a time: 500ms, 0.5s; a number has at most {MAX_NUMBER_CHARS} "
+                            "characters")
     amount, unit = Fraction(match[1]), (match[2] or "ticks").lower()
     ticks = amount if unit.startswith("tick") else amount * MS_PER[unit] / tick_ms
     if ticks.denominator == 1:

@@ -301,7 +301,7 @@ def _state_id(value: Any) -> StateId | None:
         return value if value >= 0 else None
     text = value.strip()
     if text.isascii() and text.isdigit():
-        return int(text)
+        return int(text) if len(text) <= durations.MAX_NUMBER_CHARS else None  # int() of more may fail
     return text if STATE_RE.match(text) else None
 
 

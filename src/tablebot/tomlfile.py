@@ -14,6 +14,7 @@ from typing import Any
 
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
+from tablebot.durations import MAX_NUMBER_CHARS
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 Where = tuple[str, int | None, str | None]  # (section path, index in an array of tables, key)
@@ -33,10 +34,9 @@ def read_toml(path: Path, hint: str) -> tuple[dict[str, Any], str]:
 
 def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
     """Parse TOML text; a syntax error names its line and column and gives ``hint``."""
-    deep = too_deep(text)
-    if deep:
-        raise fail(path, f"arrays or inline tables nested more than {MAX_DEPTH} levels deep",
-                   "no tablebot file nests that deep: is this the right file?", *deep)
+    unreadable = _unreadable(text)
+    if unreadable:
+        raise fail(path, *unreadable)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -48,14 +48,21 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
             line, col = len(lines), len(lines[-1]) + 1
         message = re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc))
         raise fail(path, f"TOML syntax: {message}", hint, line, col) from None
-    except RecursionError:  # nesting that too_deep() did not count (it is a safety net, not the parser)
+    except RecursionError:  # nesting that _unreadable() did not count (it is a safety net, not the parser)
         raise fail(path, "nested too deeply to read", "no tablebot file nests that deep: is this the right file?",
                    1, 1) from None
 
 
-def too_deep(text: str) -> tuple[int, int] | None:
-    """(line, column) where ``[``/``{`` brackets outside strings and comments first nest deeper than
-    MAX_DEPTH, else None. A header line's ``[[x]]`` counts too, which never reaches the limit."""
+#: What may follow a digit in one TOML value or bare key: a number, a date or time, or a key such as ``20``.
+TOKEN_RE = re.compile(r"[0-9A-Za-z_.:+-]+")
+
+
+def _unreadable(text: str) -> tuple[str, str, int, int] | None:
+    """(message, hint, line, column) of the first thing the parser should not be given, outside strings and
+    comments: ``[``/``{`` brackets nested deeper than MAX_DEPTH (the parser recurses; a header line's ``[[x]]``
+    counts too, which never reaches the limit), or a number (or bare key) that starts with a digit and runs
+    longer than MAX_NUMBER_CHARS (tomllib's ``int()`` fails past 4,300 digits, and a huge hexadecimal one
+    would reach every reader as an int too large for a float or for numpy)."""
     depth, quote = 0, ""
     line, column = 1, 0
     i, n = 0, len(text)
@@ -79,9 +86,17 @@ def too_deep(text: str) -> tuple[int, int] | None:
         elif ch in "[{":
             depth += 1
             if depth > MAX_DEPTH:
-                return line, column
+                return (f"arrays or inline tables nested more than {MAX_DEPTH} levels deep",
+                        "no tablebot file nests that deep: is this the right file?", line, column)
         elif ch in "]}":
             depth = max(0, depth - 1)
+        elif token := TOKEN_RE.match(text, i):  # a value or a bare key: skipped whole
+            length = token.end() - i
+            if length > MAX_NUMBER_CHARS and ch in "0123456789+-":
+                return (f"a number of {length:,} characters, more than the {MAX_NUMBER_CHARS} tablebot reads",
+                        "no tablebot setting needs such a number: is this the right file?", line, column)
+            i += length - 1
+            column += length - 1
         i += 1
     return None
 

@@ -13,6 +13,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.machine import Machine
 from tablebot.table import TIMER_EVENT
 
@@ -61,6 +62,9 @@ def _tokens(text: str) -> list[str]:
         match = TOKEN_RE.match(text, pos)
         if not match or match.end() == pos:
             raise ConditionError(f"cannot read {text[pos:]!r} in condition {text!r}")
+        if match["num"] and len(match["num"]) > MAX_NUMBER_CHARS:  # int() of it may fail; none is that large
+            raise ConditionError(f"a number of {len(match['num']):,} characters in condition: no state, line or "
+                                 f"output value has more than {MAX_NUMBER_CHARS}")
         tokens.append(match.group().strip())
         pos = match.end()
     if not tokens:

@@ -14,8 +14,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from tablebot.csvtext import Cell, cells_beyond, headerless, read_text, split_records
+from tablebot.csvtext import Cell, cells_beyond, headerless, read_records, read_text
 from tablebot.diagnostics import Collector, fail
+from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.files import write_text
 from tablebot.formats.trace_lines import trace_records
 from tablebot.table import TIMER_EVENT, Table
@@ -33,12 +34,17 @@ class Events(Protocol):
     def table(self) -> Table: ...
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)  # slots: a long recording holds a million of them
 class TickInput:
     """What the robot read in one tick: input bits in event layout, and pulses per counter."""
 
     mask: int
     pulses: tuple[int, ...] = ()
+
+
+#: The most ticks an inputs file (or a replayed trace) may give: nearly three hours at 10 ms ticks, and a
+#: simulated run is at most an hour. Counted as they are read, before more is kept.
+MAX_INPUT_TICKS = 1_000_000
 
 
 def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
@@ -48,16 +54,25 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     text = read_text(path)
     if path.suffix.lower() == ".jsonl" or text.lstrip().startswith("{"):
         return trace_inputs(path, text, machine)
-    records = split_records(text, str(path))
-    while records and records[0].is_blank():  # blank lines above the header (below it, a blank row is a tick)
-        records.pop(0)
-    if not records:
+    records = read_records(text, str(path))  # one at a time: only the ticks are kept
+    header = next((record for record in records if not record.is_blank()), None)  # blank lines above it
+    if header is None:  # (below it, a blank row is a tick)
         raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
     out = Collector(path)
-    columns = _columns(records[0].cells, machine, out)
-    ticks = [_tick(record.cells, columns, machine, out) for record in records[1:]]
+    columns = _columns(header.cells, machine, out)
+    ticks: list[TickInput] = []
+    for record in records:
+        _count(ticks, path, record.line)
+        ticks.append(_tick(record.cells, columns, machine, out))
     out.raise_if_any()
     return ticks
+
+
+def _count(ticks: list[TickInput], path: Path, line: int) -> None:
+    """Refuse the tick about to be added to ``ticks`` (read from ``line``) if it is one too many."""
+    if len(ticks) == MAX_INPUT_TICKS:
+        raise fail(path, f"more than {MAX_INPUT_TICKS:,} ticks, the most tablebot replays",
+                   "replay a shorter recording (split the file)", line, 1)
 
 
 def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tuple[str, str]]:
@@ -102,6 +117,9 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events
             out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
         elif kind == "input":
             mask |= machine.input_bits.get(name, 0) if text == "1" else 0
+        elif len(text) > MAX_NUMBER_CHARS:  # int() of it may fail, and no encoder counts that many in a tick
+            out.error(cell.line, cell.column, f"{name}: a number of {len(text):,} characters is too many pulses",
+                      "write the pulses of one tick (a few at most); blank means 0")
         else:
             pulses[robot.counter_names.index(name)] = int(text)
     cells_beyond(cells, len(columns), out)
@@ -146,6 +164,7 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
             out.error(number, 1, f"this trace line has no whole-number {bad[0]}",
                       "replay a trace that a run of this table recorded (tablebot run --out)")
             continue
+        _count(ticks, path, number)
         ticks.append(TickInput(values[0] & machine.input_mask, tuple(values[1:])))
     out.raise_if_any()
     return ticks

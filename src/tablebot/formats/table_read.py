@@ -11,9 +11,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_text, split_records
+from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_records, read_text
 from tablebot.diagnostics import Collector, Diagnostic, fail
-from tablebot.durations import DurationError, seconds, to_ticks
+from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,
@@ -50,36 +50,74 @@ class Column:
     cell: Cell
 
 
+#: The largest table read, far beyond any real one (the examples have up to 40 rows, 10 states and 14 columns; a
+#: table of a few thousand rows is big; ROBO Pro's lists hold 128 states) and small enough that ``check`` and
+#: ``sim`` of the largest one accepted stay within seconds and a few hundred MB (benchmarks/limits.py): the
+#: file's size, its lines below the header (counted as they are read, blank and comment lines too), its states
+#: (compiling precomputes up to 4,096 lookups per state) and its event columns (each is a bit of the
+#: simulator's 64-bit event word). Columns and cells: :data:`tablebot.csvtext.MAX_COLUMNS`.
+MAX_TABLE_BYTES = 16 * 1024 * 1024
+MAX_TABLE_ROWS = 100_000
+MAX_STATES = 1_000
+MAX_EVENT_COLUMNS = 63
+
+
 def load_table(path: str | Path, robot: Robot | None = None) -> Table:
     """Parse a table file; the robot comes from ``robot``, a side file, or the built-in BumberBot."""
     path = Path(path)
     if robot is None:
         side = find_robot_file(path)
         robot = load_robot(side) if side else BUMBERBOT
-    return parse_table(read_text(path), str(path), robot)
+    return parse_table(read_text(path, limit=MAX_TABLE_BYTES), str(path), robot)
 
 
 def parse_table(text: str, path: str, robot: Robot) -> Table:
     out = Collector(path)
-    records = [record for record in split_records(text, path) if not record.is_blank()]
-    if not records:
+    records = read_records(text, path)  # one at a time: only the rows made of them are kept
+    header = next((record for record in records if not record.is_blank()), None)
+    if header is None:
         raise fail(path, "the table is empty", "the first line must be a header such as "
                    "description,state,T,I3,M1_dir,M1_speed,timer,next", 1, 1)
-    header, body = records[0], [record for record in records[1:] if not is_comment(record)]
     columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
+    next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
+    state_at = next((i for i, c in enumerate(columns) if c.kind == "state"), None)
+    states: set[StateId] = set()
     memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
     rows: list[Row] = []
-    for record in body:
+    next_cells: dict[int, Cell] = {}  # line -> its next-state cell, where missing states are reported
+    for count, record in enumerate(records, start=1):
+        if count > MAX_TABLE_ROWS:
+            raise fail(path, f"the table has more than {MAX_TABLE_ROWS:,} lines below its header, the most "
+                       "tablebot reads", "split it into smaller tables; is this the right file?", record.line, 1)
+        if record.is_blank() or is_comment(record):
+            continue
         row = _row(record, columns, robot, out, memo, len(rows), rows[-1].description if rows else "")
         if row is not None:
             rows.append(row)
+            _count_states(states, row, record, (state_at, next_at), path)
+        if next_at is not None and len(record.cells) > next_at:
+            next_cells[record.line] = record.cells[next_at]
     if not rows and not out.items:
         out.error(header.line + 1, 1, "the table has a header but no rows",
                   "add one row per transition below the header")
-    _check_states(rows, robot, out, columns, body)
+    _check_states(rows, robot, out, next_cells, columns)
     out.raise_if_any()
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
+
+
+def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int | None, int | None],
+                  path: str) -> None:
+    """Add the states ``row`` names (from ``record``; ``at``: its state and next-state columns) to ``states``,
+    refusing the one past MAX_STATES at its cell."""
+    for value, column in ((row.state, at[0]), (row.next, at[1])):
+        if value not in states:
+            states.add(value)
+            if len(states) > MAX_STATES:
+                where = record.cells[column].column if column is not None and column < len(record.cells) else 1
+                raise fail(path, f"the table has more than {MAX_STATES:,} states, the most tablebot reads",
+                           "split the robot's behaviour into smaller tables; is this the right file?",
+                           record.line, where)
 
 
 def is_comment(record: Record) -> bool:
@@ -130,6 +168,12 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
                       f"(first at column {first.column})", "delete or rename one of them")
         seen[kind_name] = cell
         columns.append(Column(kind_name[0], kind_name[1], cell))
+    events = [c.cell for c in columns if c.kind == "event"]
+    if len(events) > MAX_EVENT_COLUMNS:
+        cell = events[MAX_EVENT_COLUMNS]
+        out.error(cell.line, cell.column, f"the table has {len(events)} event columns (T, inputs and counters), "
+                  f"more than the {MAX_EVENT_COLUMNS} the engines' 64-bit event word holds",
+                  f"keep at most {MAX_EVENT_COLUMNS} event columns (this is the first one too many)")
     for required in ("state", "next"):
         if (required, required) not in seen:
             out.error(record.line, None, f"the header has no {required!r} column",
@@ -165,6 +209,10 @@ def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int 
     if not INT_RE.match(text):
         out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer", hint)
         return blank
+    if len(text) > MAX_NUMBER_CHARS:  # never in range, and int() of it may fail
+        out.error(cell.line, cell.column, f"{what}: a number of {len(text):,} characters is out of range "
+                  f"{low}..{high}", hint)
+        return blank
     value = _whole(text)
     if not low <= value <= high:
         out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}", hint)
@@ -184,6 +232,10 @@ def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
     text = cell.text.strip()
     if not text:
         out.error(cell.line, cell.column, f"{what} is missing", "write a state number or name")
+        return None
+    if INT_RE.match(text) and len(text) > MAX_NUMBER_CHARS:  # int() of it may fail
+        out.error(cell.line, cell.column, f"{what}: a number of {len(text):,} characters is too long",
+                  f"a state number has at most {MAX_NUMBER_CHARS} characters; or use a name")
         return None
     if INT_RE.match(text):
         value = _whole(text)
@@ -285,13 +337,11 @@ def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:
     return from_direction_speed(values.get(("dir", motor)) or 0, values.get(("speed", motor)) or 0)
 
 
-def _check_states(rows: list[Row], robot: Robot, out: Collector, columns: list[Column],
-                  body: list[Record]) -> None:
+def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell],
+                  columns: list[Column]) -> None:
     """Report :func:`missing_states` at the next-state cell, or where the robot names the state."""
     if not rows:
         return
-    next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
-    next_cells = {r.line: r.cells[next_at] for r in body if next_at is not None and len(r.cells) > next_at}
     for row, where, message, hint in missing_states(rows, robot):
         if row is None:
             _robot_error(out, robot, where, columns, message, hint)

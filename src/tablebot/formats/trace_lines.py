@@ -9,6 +9,7 @@ each lamp's level and each counter's value. Extra fields (a simulator's pose) ma
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
@@ -63,6 +64,8 @@ def read_trace(path: str | Path) -> list[dict[str, Any]]:
     return parse_trace(text, path)
 
 
+#: A run of more digits than Python turns into an int (json.loads raises a plain ValueError on it).
+LONG_NUMBER_RE = re.compile(r"\d{4301,}")
 #: Located errors reported before a bad trace is given up on.
 MAX_TRACE_ERRORS = 10
 
@@ -88,9 +91,15 @@ def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> 
             continue
         try:
             line = json.loads(raw)
-        except (ValueError, RecursionError) as exc:  # RecursionError: nesting deeper than the parser's stack
-            out.error(number, getattr(exc, "colno", 1),
-                      f"line {number} is not JSON: {getattr(exc, 'msg', 'nested too deeply')}", hint)
+        except json.JSONDecodeError as exc:
+            out.error(number, exc.colno, f"line {number} is not JSON: {exc.msg}", hint)
+            continue
+        except RecursionError:  # nesting deeper than the parser's stack
+            out.error(number, 1, f"line {number} is not JSON: nested too deeply", hint)
+            continue
+        except ValueError:  # int() of a number past Python's 4,300 digits
+            long = LONG_NUMBER_RE.search(raw)
+            out.error(number, long.start() + 1 if long else 1, f"line {number} has a number too long to read", hint)
             continue
         if not isinstance(line, dict):
             out.error(number, 1, f"line {number} is JSON but not an object {{...}}", hint)

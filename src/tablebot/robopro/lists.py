@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass
+from itertools import islice
 from pathlib import Path
 
-from tablebot.csvtext import read_text, split_records
+from tablebot.csvtext import read_records, read_text
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
+from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.files import atomic_write, write_text
 from tablebot.fileset import file_set
 from tablebot.robot import MATCH_DOCUMENT, STATE_RE, Robot, StateId
@@ -185,8 +187,8 @@ def _read_list(path: Path) -> list[int]:
 
 
 def _digits(text: str) -> bool:
-    """ASCII digits only: str.isdigit() also takes '²', which int() refuses."""
-    return text.isascii() and text.isdigit()
+    """ASCII digits only (str.isdigit() also takes '²', which int() refuses), and not so many that int() fails."""
+    return text.isascii() and text.isdigit() and len(text) <= MAX_NUMBER_CHARS
 
 
 def _read_names(directory: Path) -> dict[int, StateId]:
@@ -195,7 +197,7 @@ def _read_names(directory: Path) -> dict[int, StateId]:
     if not path.is_file():
         return {}
     names: dict[int, StateId] = {}
-    for record in split_records(read_text(path), str(path))[1:]:
+    for record in islice(read_records(read_text(path), str(path)), 1, None):
         cells = [cell.text.strip() for cell in record.cells]
         if record.is_blank():
             continue
