@@ -231,3 +231,16 @@ def test_a_robopro_states_csv_with_a_5000_digit_number(tmp_path: Path) -> None:
         (tmp_path / name).write_text(text)
     (tmp_path / "states.csv").write_text(f"number,name\n{'9' * 200},seek\n")
     assert "states.csv:2:1: error: expected number,name" in refused("import", tmp_path, "--from", "robopro")
+
+
+# --- numbers in options ------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("seeds", [f"0..{HUGE}", HUGE, "0..99999999999"])
+def test_sweep_seeds_past_the_limits_are_refused_before_any_is_made(tmp_path: Path, seeds: str) -> None:
+    """Reproduced: int() of 5,000 digits (exit 70); and 0..99999999999 was made into a list before the 10 million
+    seeds limit was checked (MemoryError)."""
+    assert "--seeds: error: --seeds" in refused("sweep", EXAMPLE, "--seeds", seeds, "--out", tmp_path / "s")
+
+
+def test_evolve_freeze_cell_of_5000_digits_is_refused(tmp_path: Path) -> None:
+    assert "--freeze-cell: error:" in refused("evolve", EXAMPLE, "--freeze-cell", f"line {HUGE}", "--out", tmp_path)

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from tablebot.diagnostics import fail
+from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.robot import MAX_TIMER, StateId
 from tablebot.table import MAX_SPEED, Row, Table
 
@@ -136,7 +137,7 @@ def parse_freeze_cells(values: Sequence[str], table: Table) -> frozenset[tuple[i
     for value in values:
         for part in (p.strip() for p in value.split(",") if p.strip()):
             found = FREEZE_RE.match(part)
-            if not found:
+            if not found or len(found[1]) > MAX_NUMBER_CHARS:  # int() of a longer number may fail
                 raise fail("--freeze-cell", f"--freeze-cell: {part!r} does not name a cell",
                            'write "line 5 timer", "line 5 M1", "line 5 next" or "line 5" (the whole row)')
             line = int(found[1])

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import fail
+from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.fleet.robots import Pose
 from tablebot.sim.params import DEFAULTS
 from tablebot.sim.world import inside
@@ -97,12 +98,14 @@ def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -
     seeds: list[int] = []
     for part in (p for p in text.split(",") if p.strip()):
         found = RANGE_RE.match(part)
-        if found:
+        if found and len(part) <= 2 * MAX_NUMBER_CHARS + 2:  # int() of longer numbers may fail
             low, high = int(found[1]), int(found[2])
             if high < low:
                 raise fail(option, f"{option} {part.strip()} is an empty range", f"write {high}..{low} (low..high)")
+            if high - low >= MAX_RUNS - len(seeds):  # before the range is made: 0..99999999999 is 800 GB of it
+                raise fail(option, f"{option} gives more than {MAX_RUNS:,} seeds", "sweep fewer seeds")
             seeds.extend(range(low, high + 1))
-        elif part.strip().isdigit():
+        elif part.strip().isdigit() and len(part.strip()) <= MAX_NUMBER_CHARS:
             seeds.append(int(part))
         else:
             raise fail(option, f"{option}: {part.strip()!r} is not a seed or a range",
