@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from core_helpers import EXAMPLE, MINI_ROBOT, write_table
+from core_helpers import EXAMPLE, FIXTURES, MINI_ROBOT, write_table
 from tablebot.cli import app
 from tablebot.csvtext import MAX_CELL_CHARS, MAX_COLUMNS
 from tablebot.diagnostics import Diagnostic, TableBotError
@@ -21,6 +21,8 @@ from tablebot.formats import inputs_csv, table_read
 from tablebot.formats.inputs_csv import load_inputs
 from tablebot.formats.table_read import MAX_EVENT_COLUMNS, MAX_TABLE_BYTES, load_table
 from tablebot.machine import compile_table
+from tablebot.robopro import lists as robopro
+from tablebot.robopro.rpp_edit import rewrite
 
 runner = CliRunner()
 #: More digits than Python's int() converts (4,300): what ended in an internal error (exit 70) before.
@@ -224,6 +226,15 @@ def test_property_numbers_of_5000_digits_are_located_errors(tmp_path: Path, clai
     properties.write_text(f"[huge]\n{claim}\n")
     err = refused("check", EXAMPLE, "--properties", properties)
     assert "p.toml:" in err and "characters" in err
+
+
+def test_a_robopro_program_whose_list_size_has_5000_digits_gets_its_lists_written() -> None:
+    """Reproduced: export --into a .rpp whose list says N="<5,000 digits>" ended in int()'s ValueError. No real
+    list is that long: the size is read as unknown and written as the lists' own."""
+    program = (FIXTURES / "rpp" / "engine.rpp").read_text(encoding="utf-8").replace('N="10"', f'N="{HUGE}"', 1)
+    lists = robopro.encode(load_table(EXAMPLE / "table.csv"))
+    written = rewrite(program, {"Event": lists.event, "Action": lists.action, "Timer": lists.timer})
+    assert f'N="{len(lists.event)}"' in written and HUGE not in written
 
 
 def test_a_robopro_states_csv_with_a_5000_digit_number(tmp_path: Path) -> None:

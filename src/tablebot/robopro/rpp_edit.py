@@ -56,7 +56,7 @@ class ListElement:
         """The CSV column ROBO Pro loads the list from when the program starts, or None."""
         column = (self.csv_column or "").strip()
         if column not in ("", "-1"):
-            return int(column) if re.fullmatch(r"-?\d+", column) else 0
+            return int(column) if re.fullmatch(r"-?\d{1,100}", column) else 0  # more digits than int() takes: 0
         return 0 if self.csv_buffer and self.csv_column is None else None
 
 
@@ -96,7 +96,7 @@ def find_lists(text: str) -> list[ListElement]:
             if "N" in attrs:
                 value, a, b = attrs["N"]
                 element.n_span = (m.start(3) + a, m.start(3) + b)
-                element.n_value = int(value) if re.fullmatch(r"\s*-?[0-9]+\s*", value) else 0
+                element.n_value = int(value) if re.fullmatch(r"\s*-?[0-9]{1,100}\s*", value) else 0  # int() limit
             element.csv_column = attrs["initcsvcolumn"][0] if "initcsvcolumn" in attrs else None
             element.csv_buffer = attrs.get("initcsvbuffer", ("",))[0].strip() == "true"
             element.globalname = html.unescape(attrs.get("globalname", ("",))[0])
