@@ -113,10 +113,13 @@ uv_ready() {
     .venv/bin/python -m pip install -q --disable-pip-version-check uv
     return
   fi
-  echo "error: no way to install uv into .venv: ${PYTHON:-python3} has no pip and no ensurepip. Install uv (python3 -m pip" >&2
-  echo "  install --user uv, pipx install uv, or uv's own installer), or pip for this Python (Debian, Ubuntu:" >&2
-  echo "  the python3-pip package), then run this again" >&2
-  exit 1
+  # no pip at all (Debian's python3 without python3-pip and python3-venv): pip's own wheel from PyPI runs as it is
+  echo "  (this Python has no pip: fetching pip's wheel from PyPI to install uv with)"
+  local wheels wheel
+  wheels=$(mktemp -d)
+  wheel=$(.venv/bin/python scripts/fetch_pip.py "$wheels")
+  .venv/bin/python "$wheel/pip" install -q --disable-pip-version-check uv
+  rm -rf "$wheels"
 }
 
 if [ "$LEVEL" = user ]; then
