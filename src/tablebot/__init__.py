@@ -1,7 +1,16 @@
 """tablebot: robot behaviour written as a transition table, and the engine that runs it.
 
-Data flows one way: table file (formats.table_read) -> parsed table (table) -> compiled machine
-(machine) -> engine tick (engine) <-> robot I/O (loop) -> trace (trace). See docs/architecture.md.
+The front door is :func:`open` (:mod:`tablebot.api`): open a robot's folder, table or robot file, then
+simulate, check, sweep, tune, evolve, export or run it, the results as objects::
+
+    import tablebot
+    robot = tablebot.open("examples/bumberbot")
+    run = robot.simulate(seconds=60, seed=1)
+
+Beside it, the table and its engine: :func:`load_table`, :func:`compile_table`, :class:`Engine`. These names
+are the public API (``__all__``; docs/api.md); the other modules are tablebot's internals. Data flows one way:
+table file (formats.table_read) -> parsed table (table) -> compiled machine (machine) -> engine tick (engine)
+<-> robot I/O (loop) -> trace. See docs/architecture.md.
 """
 
 from __future__ import annotations
@@ -9,18 +18,22 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from tablebot.api import Project, open
     from tablebot.engine import Engine
     from tablebot.formats.table_read import load_table
     from tablebot.machine import Machine, compile_table
     from tablebot.table import Row, Table
 
-__all__ = ["Engine", "Machine", "Row", "Table", "compile_table", "load_table"]
+__all__ = ["Engine", "Machine", "Project", "Row", "Table", "compile_table", "load_table", "open"]
 __version__ = "0.2.0"
-
 
 
 def __getattr__(name: str) -> Any:
     """The public names, imported on first use, so `import tablebot` (and `tablebot --help`) does not load numpy."""
+    if name in ("open", "Project"):
+        from tablebot import api
+
+        return getattr(api, name)
     if name == "Engine":
         from tablebot.engine import Engine
 

@@ -48,6 +48,11 @@ def command(force: bool = False, offered: bool = True) -> Iterator[Scope]:
         _scope.reset(token)
 
 
+def active() -> bool:
+    """Whether a command's scope is open (library calls open their own only outside one)."""
+    return _scope.get() is not None
+
+
 def read(path: str | Path) -> None:
     """Remember that the current command read ``path``."""
     scope = _scope.get()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -22,17 +21,17 @@ from tablebot.cli.common import (
     err_console,
     guarded,
     load,
+    open_project,
     out_file,
     out_folder,
-    resolve_table_path,
 )
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.escape import plain, shell_word, terminal
 
 if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --help` stays quick
-    from tablebot.analysis.check import CheckReport
     from tablebot.analysis.finding import Finding
     from tablebot.analysis.prove import Result
+    from tablebot.api.checking import Check
 
 #: The diagram formats (tablebot.analysis.diagram.FORMATS, which a test keeps equal).
 FORMATS = ("svg", "png", "dot", "mermaid")
@@ -67,25 +66,15 @@ def check_cmd(
 
     Exit code 0 when clean, 1 for warnings with --strict, 2 for errors.
     """
-    from tablebot.analysis.check import report_json, run_check
-    from tablebot.analysis.properties import find_property_files, load_properties
+    from tablebot.cli.progress import StepBar
 
-    known = registry.check_targets()
-    for name in target:
-        if name not in known:
-            raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(known)}")
     with Stages(total=3) as stages:
         stages.step(f"reading {table}")
-        _, machine = load(table, robot)
-        files = properties or find_property_files(resolve_table_path(table))
-        props = load_properties(machine, files)
-        stages.expect(3 + len(props))  # reading, exploring, findings, then one step per property
-        report = run_check(machine, props, tuple(target), stages.step)
-    report.property_files = files
-    found = any(r.inputs for r in report.results)
-    unsaved = _save_counterexamples(report, cex_dir) if cex_dir is not None and found else None
+        project = open_project(table, robot, properties=properties or None)
+        report = project.check(targets=target, progress=StepBar(stages))
+    unsaved = _save_counterexamples(report, cex_dir) if cex_dir is not None else None
     if fmt == Format.json:
-        sys.stdout.write(json.dumps(report_json(report, strict), indent=2) + "\n")
+        sys.stdout.write(report.json_text(strict))
     else:
         _print_report(report, table, verbose, cex_dir is not None)
     if unsaved is not None:  # reported after the report, which a folder problem must not cost the user
@@ -93,12 +82,10 @@ def check_cmd(
     raise typer.Exit(report.exit_code(strict))
 
 
-def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | None:
+def _save_counterexamples(report: Check, folder: Path) -> TableBotError | None:
     """Write the counterexample CSVs; returns (not raises) the error of a folder that cannot take them."""
-    from tablebot.analysis.check import write_counterexamples
-
     try:
-        write_counterexamples(report, out_folder(folder, "--counterexamples"))
+        report.write_counterexamples(folder)
     except TableBotError as exc:
         return exc
     except OSError as exc:
@@ -107,9 +94,10 @@ def _save_counterexamples(report: CheckReport, folder: Path) -> TableBotError | 
     return None
 
 
-def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: bool) -> None:
+def _print_report(check: Check, table_arg: Path, verbose: bool, saving: bool) -> None:
     from tablebot.analysis.names import plural
 
+    report = check.report
     machine = report.machine
     table = machine.table
     console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
@@ -126,7 +114,7 @@ def _print_report(report: CheckReport, table_arg: Path, verbose: bool, saving: b
         sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
         console.print(f"\n[bold]properties[/bold] ({terminal(sources)}):")
         for result in report.results:
-            _print_result(report, result, table_arg, verbose, saving)
+            _print_result(check, result, table_arg, verbose, saving)
     counts = report.counts()
     tail = ""
     if hidden:
@@ -158,9 +146,7 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
     sys.stdout.flush()
 
 
-def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:
-    from tablebot.analysis.check import story
-
+def _print_result(check: Check, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:
     prop = result.prop
     marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
              "unknown": "[yellow]unknown [/yellow]"}
@@ -174,7 +160,7 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
         console.print(f"           note: {terminal(prop.note)}")
     if not result.inputs:
         return
-    path = report.counterexamples.get(prop.name)
+    path = check.report.counterexamples.get(prop.name)
     kind = "example" if prop.kind == "reachable" else "counterexample"
     shortest = "shortest " if result.exact else ""
     written = (f", written to {terminal(str(path))}" if path else " (not written)" if saving
@@ -184,7 +170,7 @@ def _print_result(report: CheckReport, result: Result, table_arg: Path, verbose:
         command = " ".join(shell_word(str(word)) for word in ("tablebot", "trace", table_arg, "--inputs", path))
         console.print(f"           replay: {terminal(command)}")
     if result.failed or verbose:
-        for line in story(report.machine, result):
+        for line in check.story(result):
             console.print(f"             {terminal(line)}")
 
 

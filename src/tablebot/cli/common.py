@@ -18,10 +18,10 @@ from tablebot import overwrite
 from tablebot.diagnostics import Diagnostic, TableBotError, notes_to
 from tablebot.escape import terminal
 from tablebot.files import OS_HINTS, out_file, out_folder  # noqa: F401  (re-exported for the commands)
-from tablebot.formats.table_read import resolve_table_path
 from tablebot.interrupts import Terminated, sigterm_raises
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
+    from tablebot.api.project import Project
     from tablebot.machine import Machine
     from tablebot.table import Table
 
@@ -38,15 +38,19 @@ FORCE_OPT = typer.Option(False, "--force", help="Replace an existing table or ro
 
 
 
+def open_project(path: Path, robot_path: Path | None = None, worlds: list[Path] | None = None,
+                 properties: list[Path] | None = None) -> Project:
+    """The command's TABLE (a table, or a folder holding table.csv) with ``--robot``, ``--world`` and
+    ``--properties`` as given (None: found as tablebot.api.open finds them)."""
+    from tablebot.api import open as open_robot
+
+    return open_robot(path, robot=robot_path, worlds=worlds or (), properties=properties)
+
 
 def load(path: Path, robot_path: Path | None = None) -> tuple[Table, Machine]:
-    from tablebot.formats.table_read import load_table
-    from tablebot.machine import compile_table
-    from tablebot.robot import load_robot
-
-    robot = load_robot(robot_path) if robot_path else None
-    table = load_table(resolve_table_path(path), robot)
-    return table, compile_table(table)
+    """The table and its compiled machine (for the commands that only read a table)."""
+    project = open_project(path, robot_path)
+    return project.table, project.machine
 
 
 class Stages:

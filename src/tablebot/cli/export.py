@@ -1,4 +1,5 @@
-"""The ``export`` command: a table for another system (ROBO Pro lists, a ROBO Pro program, C, a TXT 4.0 program)."""
+"""The ``export`` command: a table for another system (ROBO Pro lists, a ROBO Pro program, C, a TXT 4.0 program),
+through :func:`tablebot.api.exporting.export`."""
 
 from __future__ import annotations
 
@@ -9,8 +10,7 @@ import typer
 
 from tablebot import registry
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load
-from tablebot.diagnostics import fail
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.escape import terminal
 from tablebot.robopro import rpp_edit as rpp
 
@@ -45,13 +45,9 @@ def export_cmd(
     Its files replace an earlier export's in OUTDIR, all at once; a table or robot file of yours that has
     one of their names is never replaced (choose another OUTDIR).
     """
-    backend = registry.get(to.value)
-    _, machine = load(table, robot)
-    if outdir is None and backend.needs_out:
-        raise fail("OUTDIR", f"--to {to.value} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
-    assert backend.export is not None
-    done = backend.export(machine, outdir, {"into": into, "lists": (event_list, action_list, timer_list),
-                                            "lookup": lookup.value})
+    project = open_project(table, robot)
+    done = project.export(to.value, outdir, into=into, lists=(event_list, action_list, timer_list),
+                          lookup=lookup.value)
     for line in done.lines:
         console.print(terminal(line))
     for line in done.warnings:

@@ -11,31 +11,14 @@ import typer
 
 from tablebot import registry
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, load, out_folder
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project, out_folder
 from tablebot.diagnostics import fail
 from tablebot.escape import terminal
 
 if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when the command runs
-    from tablebot.loop import RobotIO, RunEnd, Sink
+    from tablebot.api.running import Connection, LiveRun
+    from tablebot.loop import Sink
     from tablebot.machine import Machine
-    from tablebot.sinks.run_trace import RunTrace
-
-def _address_hint() -> str:
-    """Every address form of every live back-end: ``write --on txt://HOST:PORT, ..., sim or sim:WORLD.toml``."""
-    forms = [form for backend in registry.backends("live") for form in backend.addresses]
-    return "write --on " + (", ".join(forms[:-1]) + " or " + forms[-1] if len(forms) > 1 else "".join(forms))
-
-
-TARGET_HINT = _address_hint()
-
-
-def live_backend(text: str) -> registry.Backend:
-    """The live back-end ``--on`` names; anything else is a located error."""
-    backend = registry.live_for(text)
-    if backend is None:
-        raise fail("--on", f"unknown target {text!r}", TARGET_HINT)
-    return backend
-
 
 def _on_help() -> str:
     helps = [b.help for b in registry.backends("live")]
@@ -63,66 +46,53 @@ def run_cmd(
 ) -> None:
     """Run TABLE on a real robot (or the simulator, in real time): outputs off on Ctrl-C, SIGTERM, any error
     and at the end; a lost link ends the run with exit code 3."""
-    backend = live_backend(on)
-    parsed, machine = load(table, robot)
-    tick_s = parsed.robot.tick_s
-    ticks = None if seconds is None else max(1, round(seconds / tick_s))
+    from tablebot.api.running import live_backend
+
+    live_backend(on)  # a wrong --on is said before the table is read
+    project = open_project(table, robot)
     if out is not None:
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
-    assert backend.open is not None
-    opened = backend.open(machine, on, {"link_timeout_s": link_timeout, "seed": seed, "hint": TARGET_HINT,
-                                        "behind_limit_s": behind_limit})
-    for warning in opened.warnings:
+    connection = project.connect(on, link_timeout=link_timeout, behind_limit=behind_limit, seed=seed)
+    for warning in connection.opened.warnings:
         err_console.print(terminal(f"warning: {warning}"))
-    end = _drive(machine, opened.robot, opened.where, opened.device, ticks, out, behind_limit or None, quiet)
-    if end.exit_code:
-        raise typer.Exit(end.exit_code)
+    done = _drive(connection, seconds, out, quiet)
+    if done.end.exit_code:
+        raise typer.Exit(done.end.exit_code)
 
 
-def _drive(machine: Machine, bot: RobotIO, target: str, device: str, ticks: int | None, out: Path | None,
-           behind_limit_s: float | None, quiet: bool) -> RunEnd:
-    """The loop with its sinks: the live view first (so it always ends first and restores the terminal).
-    A TXT paces exchanges at 10 ms but ftrobopy_server on a TXT 4.0 answers at once and the simulator
-    never waits, so the clock paces ticks too (it only sleeps when a tick is early; see loop.RealTimeClock)."""
-    from tablebot.engine import Engine
-    from tablebot.loop import RealTimeClock, run
+def _drive(connection: Connection, seconds: float | None, out: Path | None, quiet: bool) -> LiveRun:
+    """The run with the live view (on a terminal, unless quiet), then what it did."""
     from tablebot.sinks.live_view import LiveView
-    from tablebot.sinks.run_trace import RunTrace
 
+    opened, machine = connection.opened, connection.project.machine
     sinks: list[Sink] = []
     if not quiet and err_console.is_terminal:
-        sinks.append(LiveView(err_console, device))
-    trace = RunTrace(out) if out is not None else None
-    if trace is not None:
-        sinks.append(trace)
+        sinks.append(LiveView(err_console, opened.device))
     if not quiet:
-        err_console.print(terminal(f"running {machine.table.path} on {target} ({device}); Ctrl-C stops it"))
-    switch = sys.getswitchinterval()
-    sys.setswitchinterval(0.001)  # the live view's thread hands the interpreter back within 1 ms, not 5
-    try:
-        end = run(Engine(machine), bot, clock=RealTimeClock(machine.table.robot.tick_s), sinks=sinks,
-                  ticks=ticks, target=target, behind_limit_s=behind_limit_s)
-    finally:
-        sys.setswitchinterval(switch)
+        err_console.print(terminal(f"running {machine.table.path} on {opened.where} ({opened.device}); Ctrl-C "
+                                   "stops it"))
+    done = connection.run(seconds, out, sinks)
     if not quiet:
-        _report(end, machine, trace)
-    elif end.exit_code:  # quiet hides the live view and the summary, never why a run failed
+        _report(done, machine)
+    elif done.end.exit_code:  # quiet hides the live view and the summary, never why a run failed
+        end = done.end
         why = f" — {end.message}" if end.message else ""
         err_console.print(terminal(f"ran {end.ticks} ticks: {end.reason}{why}"))
-        for path in trace.files if trace is not None else []:
+        for path in done.files:
             err_console.print(terminal(f"kept {path}"))
-    return end
+    return done
 
 
-def _report(end: RunEnd, machine: Machine, trace: RunTrace | None) -> None:
+def _report(done: LiveRun, machine: Machine) -> None:
     """How the run ended on stdout; the files written on stderr."""
+    end = done.end
     seconds = end.ticks * machine.table.robot.tick_s
     why = f" — {end.message}" if end.message else ""
     console.print(terminal(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"))
     if end.late_ticks:
         ticks = "tick" if end.late_ticks == 1 else "ticks"
         console.print(f"{end.late_ticks} {ticks} started late (worst {1000 * end.worst_late_s:.1f} ms)")
-    for path in trace.files if trace is not None else []:
+    for path in done.files:
         err_console.print(terminal(f"wrote {path}"))
     sys.stdout.flush()
 

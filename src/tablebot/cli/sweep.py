@@ -3,18 +3,19 @@ machine's cores or a Dask cluster, one result row per run, pictures, resumable."
 
 from __future__ import annotations
 
-import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
 from tablebot.cli.app import app
-from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, out_folder
+from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.escape import plain
 
 if TYPE_CHECKING:
-    from tablebot.fleet.plan import Plan
+    from tablebot.api.sweeping import Sweep
 
 WORLD_OPT = typer.Option(None, "--world", help="World TOML; repeat for several worlds (default: the table's arena).")
 BACKEND_OPT = typer.Option("auto", "--backend", help="local (this machine's cores) or dask (a cluster); auto: "
@@ -48,131 +49,38 @@ def sweep_cmd(
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
     OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
     resumes."""
-    from tablebot.fleet.backends import Runner, choose
+    from tablebot.cli.progress import CountBar
 
-    chosen, address = choose(backend, scheduler)
-    with Runner(chosen, address, workers) as runner:
-        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
-        from tablebot.fileset import current, file_set
-        from tablebot.fleet.plan import REPORT_COLUMNS, Store, make_plan, read_results
-        from tablebot.interrupts import INTERRUPTS
-
-        if plots:  # before the run (an interrupt never lands in matplotlib's import); not at all without pictures
-            from tablebot.fleet.plots import write_all
-        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
-        plan = make_plan(table, robot, world or [], grid or [], seeds, robots, seconds)
-        traced = trace_runs(trace, plan.spec.total)
-        out_folder(out, "--out")
-        store = Store(out, plan)
-        finished = store.open()
-        jobs = plan.jobs(skip=finished)
-        total, already = plan.spec.total, sum(b - a for a, b in finished)
-        if chosen == "local" and jobs:
-            from tablebot.fleet.kernel import run_fleet, run_fleet_serial
-            from tablebot.jit import say_compiling
-
-            say_compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one: threaded
-        started = time.perf_counter()
-        with Bar("robots", total, quiet, already, plan.spec.ticks) as progress:
-            def done(job: Any, summary: Any) -> None:
-                store.write_part(job, plan.part_text(job, summary))
-                progress.advance(len(summary))
-            try:
-                runner.run(jobs, done)
-            except INTERRUPTS as exc:
-                runner.close(failed=True)
-                stopped(store, total, exc)
-    wall_s = time.perf_counter() - started
-    with file_set(out, remove=["results.partial.csv"]):  # results, traces and pictures: all at once
-        path, _ = store.merge(complete=True)
-        rows = [] if quiet and not plots else \
-            read_results(current(path), None if plots else REPORT_COLUMNS)  # pictures read every column
-        written = [path, *plan.write_traces(traced, out), *(write_all(plan, rows, out) if plots else [])]
+    project = open_project(table, robot, worlds=world)
+    with stops():
+        result = project.sweep(robots=robots, seeds=seeds, grid=grid or [], seconds=seconds, backend=backend,
+                               scheduler=scheduler, workers=workers, out=out, plots=plots, trace=trace,
+                               progress=CountBar(quiet))
     if not quiet:
-        report(plan, rows, written, wall_s, total - already)
+        report(result)
 
 
-def stopped(store: Any, total: int, why: BaseException) -> None:
-    """Ctrl-C or SIGTERM: the finished chunks merged into results.partial.csv, then exit 130 (143)."""
-    from tablebot.interrupts import Terminated
+@contextmanager
+def stops() -> Iterator[None]:
+    """Ctrl-C or SIGTERM during a sweep, tune or evolve: what was kept, where, then exit 130 (143)."""
+    from tablebot.api.progress import Stopped
 
-    path, count = store.merge(complete=False)
-    word = "terminated" if isinstance(why, Terminated) else "interrupted"
-    err_console.print(f"{word}: {count:,} of {total:,} runs finished, kept in {plain(str(path))}; run the same "
-                      "command again to resume", markup=False)
-    raise typer.Exit(143 if isinstance(why, Terminated) else 130) from None
-
-
-def trace_runs(text: str | None, total: int) -> list[int]:
-    """The run numbers of ``--trace`` (as --seeds reads numbers), each one of the sweep's runs."""
-    from tablebot.diagnostics import TableBotError, fail
-    from tablebot.fleet.spec import parse_seeds
-
-    if text is None:
-        return []
     try:
-        chosen = parse_seeds(text, None, "--trace")
-    except TableBotError as exc:  # the words of --seeds, with a hint about run numbers
-        raise fail("--trace", exc.diagnostics[0].message, "give run numbers: 0,17 or 0..9") from None
-    beyond = [k for k in chosen if k >= total]
-    if beyond:
-        raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")
-    return list(chosen)
+        yield
+    except Stopped as stopped:
+        err_console.print(f"{stopped.word}: {plain(stopped.kept)}; run the same command again to resume",
+                          markup=False)
+        raise typer.Exit(stopped.exit_code) from None
 
 
-def report(plan: Plan, rows: list[dict[str, str]], written: list[Path], wall_s: float, ran: int) -> None:
+def report(result: Sweep) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
-    from tablebot.fleet.plan import groups
-
-    lamps = any(world.lamps for world in plan.worlds)
-    for key, values in groups(plan, rows):
-        for label, chosen in values:
-            name = key if key == "all runs" else f"{key} {label}"
-            if lamps:
-                line = f"{sum(int(r['reached']) for r in chosen)}/{len(chosen)} reached the lamp"
-            else:
-                collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
-                metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
-                line = f"{len(chosen)} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run"
-            console.print(plain(f"{name}: {line}"), markup=False)
-    if ran:
-        rate = ran * plan.spec.ticks / max(wall_s, 1e-9)
-        console.print(f"[dim]({ran:,} runs in {wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
-    for p in written:
+    for line in result.lines():
+        console.print(plain(line), markup=False)
+    if result.ran:
+        rate = result.ran * result.plan.spec.ticks / max(result.wall_s, 1e-9)
+        console.print(f"[dim]({result.ran:,} runs in {result.wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
+    for p in result.files:
         err_console.print(f"wrote {plain(str(p))}", markup=False)
 
 
-class Bar:
-    """A rich progress bar of ``label`` done out of ``total`` and the time left (on a terminal only); given
-    the robot-ticks of one item (``ticks``), also the robot-ticks per second."""
-
-    def __init__(self, label: str, total: int, quiet: bool, done: int = 0, ticks: int | None = None) -> None:
-        self.label, self.total, self.done, self.ticks = label, total, done, ticks
-        self.quiet = quiet or not err_console.is_terminal
-        self.started = time.perf_counter()
-        self.new = 0
-
-    def __enter__(self) -> Bar:
-        if not self.quiet:
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-            rate = [TextColumn("{task.fields[rate]}")] if self.ticks else []
-            self.bar = Progress(TextColumn(self.label), BarColumn(), MofNCompleteColumn(), *rate,
-                                TimeRemainingColumn(), console=err_console, transient=True)
-            self.bar.__enter__()
-            self.task = self.bar.add_task(self.label, total=self.total, completed=self.done, rate="")
-        return self
-
-    def advance(self, count: int) -> None:
-        self.new += count
-        if self.quiet:
-            return
-        rate = ""
-        if self.ticks:
-            per_s = self.new * self.ticks / max(time.perf_counter() - self.started, 1e-9)
-            rate = f"{per_s / 1e6:.2f} M robot-ticks/s"
-        self.bar.update(self.task, advance=count, rate=rate)
-
-    def __exit__(self, *exc: object) -> None:
-        if not self.quiet:
-            self.bar.__exit__(None, None, None)

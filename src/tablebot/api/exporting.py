@@ -1,0 +1,48 @@
+"""``export`` from Python: the table for another system (ROBO Pro lists, a ROBO Pro program, C, a TXT 4.0
+program, ...), each target a back-end of :mod:`tablebot.registry`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from tablebot.diagnostics import fail
+
+if TYPE_CHECKING:
+    from tablebot.api.loaded import Loaded, PathLike
+    from tablebot.registry import Exported
+
+
+def targets() -> list[str]:
+    """The names ``to`` takes: every registered export back-end."""
+    from tablebot import registry
+
+    return [b.name for b in registry.backends("export")]
+
+
+def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathLike | None = None,
+           lists: Sequence[str] | None = None, lookup: str = "auto") -> Exported:
+    """Export the table (``tablebot export TABLE OUT --to TO``): its files replace an earlier export's in
+    ``out`` all at once (a table or robot file of yours is never replaced). ``into``: the ROBO Pro program to
+    update (``robopro-rpp``); ``lists``: its event, action and timer lists' names; ``lookup``: the C engine's
+    first-match lookup, ``dense``, ``scan`` or ``auto``. Returns what was written and what to say about it.
+
+    >>> import tablebot
+    >>> done = tablebot.open("examples/bumberbot").export(to="c", out="out/c")
+    >>> sorted(p.name for p in done.files)
+    ['tb_config.h', 'tb_engine.c', 'tb_engine.h', 'tb_table.c']
+    """
+    from tablebot import registry
+    from tablebot.robopro.rpp_edit import DEFAULT_NAMES
+
+    if to not in targets():
+        raise fail("--to", f"unknown export target {to!r}", f"use one of {', '.join(targets())}")
+    backend = registry.get(to)
+    if out is None and backend.needs_out:
+        raise fail("OUTDIR", f"--to {to} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
+    assert backend.export is not None
+    names = tuple(lists) if lists is not None else DEFAULT_NAMES
+    with project.writing():
+        return backend.export(project.machine, Path(out) if out is not None else None,
+                              {"into": Path(into) if into is not None else None, "lists": names, "lookup": lookup})

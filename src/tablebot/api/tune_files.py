@@ -1,0 +1,154 @@
+"""The files ``tune`` writes: the tuned table (the input's bytes but for the tuned cells), every evaluation,
+the convergence picture and the report (:mod:`tablebot.api.tuning` runs the search)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tablebot.fleet.plan import Plan
+    from tablebot.fleet.tune import Cell, Evaluator
+
+
+def tuned_path(table: Path, out: Path) -> Path:
+    """``OUT/NAME.tuned.csv``: never the input itself."""
+    path = out / f"{table.stem}.tuned{table.suffix or '.csv'}"
+    if path.resolve() == table.resolve():
+        from tablebot.diagnostics import fail
+        raise fail("--out", f"the tuned table would replace its input {table}", "give --out another folder")
+    return path
+
+
+def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Path) -> Path:
+    """The input table byte for byte, but for the tuned cells (its delimiter, quoting and line ends kept)."""
+    from tablebot.files import write_bytes
+    from tablebot.web.document import CsvDocument
+
+    source = Path(plan.table.path)
+    doc = CsvDocument.from_bytes(source.read_bytes(), str(source))
+    header = [h.strip().lower() for h in doc.header_values()]
+    lines = doc.record_lines()
+    grid = doc.grid()
+    for cell, value in zip(cells, values, strict=True):
+        grid_row = next(g for g, index in enumerate(doc.row_ids) if lines[index] == cell.line)
+        column = header.index(cell.column.lower())
+        text = str(value) if cell.counter is not None else \
+            as_written(grid[grid_row][column], value, plan.table.robot.tick_ms)
+        doc.set_cell(grid_row, column, text)
+    return write_bytes(path, doc.to_bytes())
+
+
+def as_written(old: str, ticks: int, tick_ms: int) -> str:
+    """A tuned timer in the unit its cell was written in: ``300ms`` tuned to 45 ticks of 10 ms is
+    ``450ms`` (not ``45``, which reads as a shorter time), ``0.5 s`` stays seconds, a bare number counts ticks."""
+    from decimal import Decimal
+
+    from tablebot.durations import DURATION_RE, MS_PER
+
+    match = DURATION_RE.match(old)
+    if match is None:
+        return str(ticks)
+    unit = (match[2] or "").lower()
+    number = format(Decimal(ticks * tick_ms) / MS_PER[unit], "f") if unit in MS_PER else str(ticks)
+    return old[:match.start(1)] + number + old[match.end(1):]
+
+
+def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
+    from tablebot.files import write_text
+    from tablebot.fleet.plan import csv_text
+
+    columns = ["evaluation", *(c.label for c in evaluate.cells), evaluate.objective]
+    rows = [{"evaluation": k, **dict(zip(columns[1:-1], values, strict=True)), evaluate.objective: value}
+            for k, (values, value) in enumerate(evaluate.history)]
+    return write_text(path, csv_text(columns, rows))
+
+
+def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
+    """The convergence picture, its text drawn as written (see tablebot.sim.draw.literal_text)."""
+    from tablebot.sim.draw import literal_text
+
+    with literal_text():
+        return _convergence(evaluate, method, path)
+
+
+def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
+    """Every evaluation's objective and the best so far; for one cell also the objective against its value."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from tablebot.escape import picture
+    from tablebot.sim.plots import save
+
+    values = np.array([v for _, v in evaluate.history])
+    one, two = len(evaluate.cells) == 1, len(evaluate.cells) == 2
+    fig = Figure(figsize=(11 if one or two else 7, 4.2), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 2 if one or two else 1, 1)
+    ax.scatter(np.arange(len(values)), values, s=8, alpha=0.4, color="#636e72", label="candidate")
+    ax.plot(np.minimum.accumulate(values), color="#20bf6b", linewidth=2, label="best so far")
+    ax.axhline(values[0], color="#e8413a", linestyle="--", linewidth=1, label="the table as it was")
+    ax.set_xlabel("evaluation")
+    ax.set_ylabel(evaluate.objective)
+    ax.set_title(f"{method}: {len(values)} candidates", fontsize=11)
+    ax.legend(fontsize=8)
+    if one:
+        side = fig.add_subplot(1, 2, 2)
+        xs = np.array([c[0] for c, _ in evaluate.history])
+        order = np.argsort(xs)
+        side.plot(xs[order], values[order], color="#1f77b4", linewidth=1)
+        side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
+        side.set_xlabel(picture(f"{evaluate.cells[0].label} (ticks)"))
+        side.set_ylabel(evaluate.objective)
+    if two:
+        side = fig.add_subplot(1, 2, 2)
+        points = np.array([c for c, _ in evaluate.history])
+        dots = side.scatter(points[:, 0], points[:, 1], c=values, cmap="viridis_r", s=30, marker="s")
+        fig.colorbar(dots, ax=side, label=evaluate.objective)
+        a, b = evaluate.cells
+        best = points[int(np.argmin(values))]
+        side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label="as it was")
+        side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
+        side.set_xlabel(picture(a.label))
+        side.set_ylabel(picture(b.label))
+        side.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
+                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path) -> Path:
+    from tablebot.files import write_text
+
+    spec, cells = plan.spec, evaluate.cells
+    seconds = spec.ticks * plan.scenes[0].tick_s
+    axes = "".join(" × random starts" if a.values == ("random",) else f" × {len(a.values)} {a.key}"
+                   for a in spec.axes)
+    scenario = (f"{spec.total} scenarios ({len(spec.seeds)} seeds{axes} × {len(spec.worlds)} world(s), "
+                f"{seconds:g} s each)")
+    lines = [f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}", "",
+             f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
+             "| cell | before | after |", "|---|---|---|"]
+    lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
+    if any(c.counter is None for c in cells):
+        lines += ["", f"Timers count ticks of {plan.table.robot.tick_ms} ms (the tuned table writes each in its "
+                  "cell's own unit)."]
+    lines += ["", f"Checked on {check.spec.total} fresh scenarios (seeds {check.spec.seeds[0]}.."
+              f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
+    for metric, (a, b) in before_after.items():
+        lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
+    lines += ["", f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
+    return write_text(path, "\n".join(lines) + "\n")
+
+
+def sim_command(plan: Plan, tuned: Path) -> str:
+    """``tablebot sim`` of the tuned table with the robot file and world it was tuned with: beside it in
+    OUT there are neither, and on its own it would get the built-in BumberBot in an empty room."""
+    from tablebot.escape import shell_word
+
+    words = ["tablebot", "sim", str(tuned)]
+    for option, given in (("--robot", plan.table.robot.source), ("--world", plan.spec.worlds[0])):
+        if Path(given).is_file():
+            words += [option, given]
+    return " ".join(shell_word(word) for word in words)
