@@ -180,3 +180,13 @@ def test_the_user_lock_pins_what_pyproject_asks_for_at_the_dev_locks_versions() 
     names = {name for name, _ in user}
     assert {canonicalize_name(Requirement(r).name) for r in project["dependencies"]} <= names
     assert not {"dask", "gymnasium", "pytest", "mypy", "playwright"} & names  # extras and dev tools stay out
+
+
+def test_only_firmware_needs_a_toolchain_and_it_says_how_to_get_it_on_each_system(installed: Installed) -> None:
+    done = installed.tablebot("build", "bumberbot", "--board", "uno", "--out", "firmware", ok=(2,))
+    said = " ".join(done.stderr.split())
+    assert "avr-gcc not found (only firmware needs it)" in said
+    for system in ("Debian or Ubuntu sudo apt-get install gcc-avr avr-libc", "macOS brew tap osx-cross/avr",
+                   "Windows unpack Microchip's AVR 8-bit Toolchain"):
+        assert system in said, said
+    assert not list(installed.work.glob("firmware/**/*.hex"))

@@ -41,8 +41,10 @@ class Firmware:
 def tool(name: str) -> str:
     found = shutil.which(name)
     if not found:
-        raise fail(name, f"{name} not found", "install the AVR toolchain: apt-get install gcc-avr avr-libc "
-                   "(scripts/bootstrap.sh does it)")
+        raise fail(name, f"{name} not found (only firmware needs it)", "install the AVR toolchain: on Debian or "
+                   "Ubuntu sudo apt-get install gcc-avr avr-libc; on macOS brew tap osx-cross/avr, then brew install "
+                   "avr-gcc; on Windows unpack Microchip's AVR 8-bit Toolchain (Windows) and add its bin folder to "
+                   "PATH (docs/install.md)")
     return found
 
 

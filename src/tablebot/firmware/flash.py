@@ -40,6 +40,7 @@ def check_hex(path: Path) -> None:
 def flash(command: list[str]) -> int:
     """Run avrdude; its own output goes to the terminal. Returns its exit status."""
     if not shutil.which(command[0]):
-        raise fail(command[0], "avrdude not found", "install it (Debian: apt-get install avrdude) or use "
-                   "--dry-run and run the printed command where avrdude is")
+        raise fail(command[0], "avrdude not found", "install it (Debian, Ubuntu: sudo apt-get install avrdude; "
+                   "macOS: brew install avrdude; Windows: avrdude's release zip, its folder on PATH: docs/install.md) "
+                   "or use --dry-run and run the printed command where avrdude is")
     return subprocess.run(command, check=False).returncode
