@@ -4,7 +4,9 @@ written byte-exact against deadlines, so that silence, a short reply or a pulled
 
 Bytes go through the port's own file descriptor (pyserial leaves it non-blocking): a request that Ctrl-C
 cuts short keeps its unsent rest here (:attr:`SerialPort.unsent`), so the link can finish it before
-anything else and the device never sees half a request followed by another.
+anything else and the device never sees half a request followed by another. Windows has no descriptor to
+wait on (a COM port is a handle, and select takes sockets only): there pyserial's own reads and writes do the
+waiting, each with the time left as its timeout (:data:`FD_IO` False).
 """
 
 from __future__ import annotations
@@ -22,6 +24,9 @@ from tablebot.loop import LinkLost
 
 #: How long a read waits at most when a caller passes no deadline (seconds).
 DEFAULT_WAIT_S = 1.0
+#: Bytes through the port's file descriptor, waited for with select (POSIX); else through pyserial's read and
+#: write with timeouts (Windows, where a COM port has no descriptor).
+FD_IO = os.name != "nt"
 
 
 @dataclass(frozen=True)
@@ -76,6 +81,9 @@ class SerialPort:
     def write(self, data: bytes, deadline: float) -> None:
         """Send ``data`` whole (after the rest of an earlier cut-short write), or raise LinkLost."""
         self.unsent += data
+        if not FD_IO:
+            self._write_portable(deadline)
+            return
         fd = self._fd()
         while self.unsent:
             self._wait(fd, deadline, writing=True, what="the device to take our request")
@@ -101,6 +109,8 @@ class SerialPort:
 
     def read_some(self, most: int, deadline: float, what: str) -> bytes:
         """1..``most`` bytes as soon as any arrive, by ``deadline``."""
+        if not FD_IO:
+            return self._read_portable(most, deadline, what)
         fd = self._fd()
         while True:
             self._wait(fd, deadline, writing=False, what=what)
@@ -116,6 +126,13 @@ class SerialPort:
 
     def pending(self) -> bytes:
         """Whatever has already arrived, without waiting (b"" if nothing; LinkLost if the device is gone)."""
+        if not FD_IO:
+            port = self._port()
+            try:
+                waiting = port.in_waiting
+                return port.read(waiting) if waiting else b""
+            except (serial.SerialException, OSError) as exc:
+                raise self._lost(exc) from None
         fd = self._fd()
         if not select.select([fd], [], [], 0)[0]:
             return b""
@@ -139,12 +156,48 @@ class SerialPort:
                 break
         return dropped
 
+    # --- without a file descriptor (Windows) -----------------------------------------------------------
+
+    def _write_portable(self, deadline: float) -> None:
+        port = self._port()
+        while self.unsent:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise LinkLost(f"no answer from {self.device}: expected the device to take our request")
+            try:
+                port.write_timeout = left
+                sent = port.write(self.unsent)
+            except serial.SerialTimeoutException:
+                raise LinkLost(f"no answer from {self.device}: expected the device to take our request") from None
+            except (serial.SerialException, OSError) as exc:
+                raise self._lost(exc) from None
+            self.unsent = self.unsent[sent if sent is not None else len(self.unsent):]
+
+    def _read_portable(self, most: int, deadline: float, what: str) -> bytes:
+        port = self._port()
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
+        try:
+            port.timeout = left
+            chunk = port.read(1)  # the first byte, waited for up to the deadline
+            if chunk and most > 1 and (waiting := port.in_waiting):
+                chunk += port.read(min(waiting, most - 1))  # and whatever came with it, without waiting
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from None
+        if not chunk:
+            raise LinkLost(f"no answer from {self.device}: expected {what}")
+        return chunk
+
     # --- helpers ----------------------------------------------------------------------------------
 
-    def _fd(self) -> int:
+    def _port(self) -> serial.Serial:
         if self.port is None:
             raise LinkLost(f"{self.device} is not open")
-        return self.port.fd
+        return self.port
+
+    def _fd(self) -> int:
+        return self._port().fd
 
     def _wait(self, fd: int, deadline: float, *, writing: bool, what: str) -> None:
         left = deadline - time.monotonic()
@@ -157,8 +210,10 @@ class SerialPort:
         if not any(ready):
             raise LinkLost(f"no answer from {self.device}: expected {what}")
 
-    def _lost(self, exc: OSError) -> LinkLost:
-        return LinkLost(f"lost {self.device}: {exc.strerror or exc} (was it unplugged?)")
+    def _lost(self, exc: OSError | serial.SerialException) -> LinkLost:
+        if "returned no data" in str(exc):  # pyserial: readable, yet nothing: the other end hung up
+            return LinkLost(f"{self.device} was disconnected")
+        return LinkLost(f"lost {self.device}: {getattr(exc, 'strerror', None) or exc} (was it unplugged?)")
 
 
 def _reason(exc: BaseException) -> str:
