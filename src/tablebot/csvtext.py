@@ -11,6 +11,8 @@ import codecs
 import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from itertools import accumulate, repeat
+from operator import add
 from pathlib import Path
 from typing import NamedTuple
 
@@ -234,13 +236,11 @@ def _all_records(text: str, path: str, delimiter: str | None, bounded: bool) -> 
 
 
 def _split_line(text: str, delimiter: str, line: int) -> tuple[Cell, ...]:
-    cells = []
-    column = 1
-    make = Cell._make  # tuple.__new__ itself: no Python-level constructor per cell
-    for value in text.split(delimiter):
-        cells.append(make((value, line, column)))
-        column += len(value) + 1
-    return tuple(cells)
+    """The cells of a line without quotes, made in C (no Python-level step per cell: a wide table has millions):
+    each starts one past the end of the one before."""
+    values = text.split(delimiter)
+    columns = accumulate(map(add, map(len, values), repeat(1)), initial=1)
+    return tuple(map(tuple.__new__, repeat(Cell), zip(values, repeat(line), columns)))
 
 
 def _check_line(text: str, delimiter: str, path: str, line: int) -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from operator import attrgetter
 from pathlib import Path
 from typing import Any
 
@@ -83,6 +84,7 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
     state_at = next((i for i, c in enumerate(columns) if c.kind == "state"), None)
     states: set[StateId] = set()
+    layout = _Layout.of(columns)
     memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
     rows: list[Row] = []
     next_cells: dict[int, Cell] = {}  # line -> its next-state cell, where missing states are reported
@@ -92,7 +94,7 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
                        "tablebot reads", "split it into smaller tables; is this the right file?", record.line, 1)
         if record.is_blank() or is_comment(record):
             continue
-        row = _row(record, columns, robot, out, memo, len(rows), rows[-1].description if rows else "")
+        row = _row(record, layout, robot, out, memo, len(rows), rows[-1].description if rows else "")
         if row is not None:
             rows.append(row)
             _count_states(states, row, record, (state_at, next_at), path)
@@ -256,7 +258,28 @@ NUMBERS: dict[str, tuple[int, int, int | None, bool]] = {
 }
 
 
-def _row(record: Record, columns: list[Column], robot: Robot, out: Collector,
+@dataclass(frozen=True)
+class _Layout:
+    """The header's columns, found once for all rows: those read (``named``, with their index) and those under a
+    blank header (``blank``), where only a filled cell matters (a wide table may have hundreds)."""
+
+    columns: list[Column]
+    named: list[tuple[int, Column]]
+    blank: list[int]
+
+    @staticmethod
+    def of(columns: list[Column]) -> _Layout:
+        return _Layout(columns, [(i, c) for i, c in enumerate(columns) if c.kind != "ignore"],
+                       [i for i, c in enumerate(columns) if c.kind == "ignore" and not c.name])
+
+    def headerless(self, cells: list[Cell], out: Collector) -> None:
+        """Report the filled cells under a blank header (their texts joined in C first: they are mostly empty)."""
+        if "".join(map(attrgetter("text"), map(cells.__getitem__, self.blank))).strip():
+            for i in self.blank:
+                headerless(cells[i], out)
+
+
+def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
          memo: dict[tuple[int, str], Any], index: int, above: str) -> Row | None:
     """The row of one record (the ``index``-th, 0-based; a blank description continues ``above``, the
     one of the row before), or None when its state or next state is unreadable.
@@ -264,12 +287,13 @@ def _row(record: Record, columns: list[Column], robot: Robot, out: Collector,
     A row with other bad cells is still returned (with the bad cells at their blank value) so that
     its state counts as having rows; the collected errors stop the table from being used.
     """
-    cells = list(record.cells[: len(columns)])
+    width = len(layout.columns)
+    cells = list(record.cells[:width])
     end = (cells[-1].column + len(cells[-1].text) + 1) if cells else 1
-    cells += [Cell("", record.line, end)] * (len(columns) - len(cells))
-    values = {(c.kind, c.name): _cached(i, c, cell, out, memo, robot.tick_ms)
-              for i, (c, cell) in enumerate(zip(columns, cells, strict=True))}
-    cells_beyond(record.cells, len(columns), out)
+    cells += [Cell("", record.line, end)] * (width - len(cells))
+    values = {(c.kind, c.name): _cached(i, c, cells[i], out, memo, robot.tick_ms) for i, c in layout.named}
+    layout.headerless(cells, out)
+    cells_beyond(record.cells, width, out)
     state, nxt = values.get(("state", "state")), values.get(("next", "next"))
     if state is None or nxt is None:
         return None
@@ -310,9 +334,7 @@ def _value(column: Column, cell: Cell, out: Collector, tick_ms: int) -> Any:
         label = column.cell.text.strip()
         what = "timer" if kind == "timer" else f"event {label}" if kind == "event" else label
         return _int(cell, what, low, high, out, blank, keep)
-    if not column.name:  # an ignored column with a name was reported in the header
-        headerless(cell, out)
-    return None
+    return None  # an ignored column: one with a name was reported in the header, a blank one by _Layout
 
 
 def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
