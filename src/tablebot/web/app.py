@@ -7,20 +7,23 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import uvicorn
 from starlette.applications import Starlette
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
+from tablebot.escape import terminal
 from tablebot.web.access import Access, Gate, hide_token_in_logs
 from tablebot.web.errors import INTERNAL, log
+from tablebot.web.live import give_back_memory
 from tablebot.web.session import Hub, Session
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
 from tablebot.web.workspace import Workspace
@@ -28,6 +31,9 @@ from tablebot.web.workspace import Workspace
 STATIC = Path(__file__).parent / "static"
 FRAME_S = 0.04  # 25 frames a second: smooth to the eye, whatever the simulation's speed
 MAX_MESSAGE_BYTES = 2 * 1024 * 1024  # an edit is a cell; a whole table is at most 1 MB
+#: Tabs one studio serves at once, each with its own live robot (a thread): 60 made a new request wait 20 s.
+#: More than a pupil opens; one more is told why (benchmarks/studio_tabs.py measures a full studio).
+MAX_TABS = 8
 #: Scripts and styles only from this server; nothing from the internet.
 CSP = ("default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
        "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
@@ -37,10 +43,12 @@ class Gone(Exception):
     """The tab closed its WebSocket: stop talking to it."""
 
 
-def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
-    """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first."""
+def create_app(root: Path, access: Access, table: str | None = None, max_tabs: int = MAX_TABS) -> Gate:
+    """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first;
+    at most ``max_tabs`` tabs at once."""
     workspace = Workspace(root)
     hub = Hub()
+    doors = Doors(max_tabs)
 
     async def index(request: Request) -> Response:
         response = FileResponse(STATIC / "index.html", headers={"Content-Security-Policy": CSP,
@@ -58,11 +66,17 @@ def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
         """A trace file from the user's computer (the body), size-limited while it arrives."""
         name = request.query_params.get("name", "uploaded trace")[:200]
         body = bytearray()
-        async for chunk in request.stream():
-            body += chunk
-            if len(body) > MAX_PLAYER_TRACE_BYTES:
-                return JSONResponse({"type": "error", "message": f"the trace is larger than {MAX_PLAYER_TRACE_BYTES:,} "
-                                     "bytes", "hint": "cut the run shorter"}, status_code=413)
+        try:
+            async for chunk in request.stream():
+                body += chunk
+                if len(body) > MAX_PLAYER_TRACE_BYTES:
+                    return JSONResponse({"type": "error", "message": f"the trace is larger than "
+                                         f"{MAX_PLAYER_TRACE_BYTES:,} bytes", "hint": "cut the run shorter"},
+                                        status_code=413)
+        except ClientDisconnect:  # the tab closed or reloaded mid-upload: nobody is left to answer
+            log.warning("an uploaded trace (%s) was cut off after %s: the page closed the connection, nothing "
+                        "was read", terminal(name), _of_bytes(len(body), request.headers.get("content-length")))
+            return Response(status_code=400)
         try:
             lines = await asyncio.to_thread(read_trace_bytes, bytes(body), name)
         except TableBotError as exc:
@@ -74,6 +88,9 @@ def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
 
     async def socket(websocket: WebSocket) -> None:
         await websocket.accept()
+        if len(hub.sessions) >= doors.most:
+            await doors.turn_away(websocket)
+            return
         lock = asyncio.Lock()
 
         async def send(message: dict[str, Any]) -> None:
@@ -102,11 +119,44 @@ def create_app(root: Path, access: Access, table: str | None = None) -> Gate:
         finally:
             ticker.cancel()
             hub.sessions.discard(session)
+            doors.told = False  # a place came free: the next tab turned away is said again
             await asyncio.to_thread(session.close)
+            await asyncio.to_thread(give_back_memory)
 
     routes = [Route("/", index), Route("/api/config", config), Route("/api/trace", upload_trace, methods=["POST"]),
               WebSocketRoute("/ws", socket), Mount("/static", StaticFiles(directory=STATIC), name="static")]
     return Gate(Starlette(routes=routes), access)
+
+
+def _of_bytes(got: int, announced: str | None) -> str:
+    """"1,050 of 100,000 bytes" (or "1,050 bytes" when the upload did not say its length)."""
+    return f"{got:,} of {int(announced):,} bytes" if announced and announced.isdigit() else f"{got:,} bytes"
+
+
+@dataclass
+class Doors:
+    """How many tabs a studio serves at once (each has a live robot: a thread), and whether the terminal has
+    been told of a tab turned away since a place last came free (one line, not one per tab)."""
+
+    most: int
+    told: bool = False
+
+    async def turn_away(self, websocket: WebSocket) -> None:
+        """The page shows why in its banner: an error, answered to every message (the socket stays open,
+        since the page reads a closed one as the studio stopping)."""
+        tabs = f"{self.most} tab{'s' if self.most != 1 else ''}"
+        if not self.told:
+            log.warning("refused a tab: %s %s open already, the most one studio serves at once (close one of "
+                        "them in the browser)", tabs, "are" if self.most != 1 else "is")
+            self.told = True
+        refusal = json.dumps({"type": "error", "op": "", "message": f"this studio already has {tabs} open, the "
+                              "most it serves at once: close one of them, then reload this tab"})
+        try:
+            await websocket.send_text(refusal)
+            while (await websocket.receive())["type"] != "websocket.disconnect":
+                await websocket.send_text(refusal)
+        except (WebSocketDisconnect, RuntimeError, OSError):  # the tab went while being told
+            pass
 
 
 async def _answer(session: Session, text: str) -> None:
@@ -159,7 +209,7 @@ class Background:
     ``origin`` and ``headers`` (what its own page would send) for other clients, :meth:`stop` to end."""
 
     def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
-                 log_level: str = "warning") -> None:
+                 log_level: str = "warning", max_tabs: int = MAX_TABS) -> None:
         import socket
         import threading
 
@@ -171,7 +221,7 @@ class Background:
         self.origin = f"http://{host}:{self.access.port}"
         self.url = self.access.url(host)
         self.headers = {"Origin": self.origin, "Cookie": f"{self.access.cookie}={self.access.token}"}
-        self.server = server(create_app(root, self.access, table), self.access, log_level)
+        self.server = server(create_app(root, self.access, table, max_tabs), self.access, log_level)
         self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]}, daemon=True)
         self.thread.start()
         while not self.server.started:
