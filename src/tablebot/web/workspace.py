@@ -41,6 +41,10 @@ HEAD_BYTES = 4096  # read to tell a table from another CSV
 MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table the studio opened is 1 MB at most)
 # the POSIX-only flags are 0 where the system has none of them (Windows)
 NOFOLLOW, CLOEXEC = getattr(os, "O_NOFOLLOW", 0), getattr(os, "O_CLOEXEC", 0)
+#: Files opened relative to an open folder (openat: POSIX); where the system cannot (Windows), a folder is
+#: its path, each part checked to be no link on the way (Windows makes links only for administrators).
+AT_FOLDER = {os.open, os.replace, os.unlink} <= os.supports_dir_fd
+Folder = int | str  # an open folder's descriptor, or (without AT_FOLDER) its path
 READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | getattr(os, "O_NOCTTY", 0) | CLOEXEC
 DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | NOFOLLOW | CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
@@ -145,7 +149,7 @@ class Workspace:
         parent, leaf = _split(real)
         with self._folder(parent, real) as folder:
             try:
-                fd = os.open(leaf, READ_FLAGS, dir_fd=folder)
+                fd = _open_at(folder, leaf, READ_FLAGS)
             except OSError as exc:
                 raise _refusal(exc, real) from None
             try:
@@ -157,8 +161,17 @@ class Workspace:
                 os.close(fd)
 
     @contextlib.contextmanager
-    def _folder(self, parts: tuple[str, ...], real: str) -> Iterator[int]:
-        """A descriptor of a folder inside the served one, reached without following any link."""
+    def _folder(self, parts: tuple[str, ...], real: str) -> Iterator[Folder]:
+        """A descriptor of a folder inside the served one, reached without following any link (without
+        AT_FOLDER: its path, no part of it a link)."""
+        if not AT_FOLDER:
+            path = str(self.root)
+            for part in parts:
+                path = os.path.join(path, part)
+                if os.path.islink(path) or not os.path.isdir(path):
+                    raise _refusal(OSError(errno.ENOTDIR, "not a folder"), real)
+            yield path
+            return
         fd = os.open(self.root, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | CLOEXEC)
         try:
             for part in parts:
@@ -200,10 +213,10 @@ class Workspace:
                               "(check the folder's permissions and free space)") from None
         return Saved(Opened(opened.name, written, data, mode), None if current is None else theirs)
 
-    def _current(self, folder: int, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
+    def _current(self, folder: Folder, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
         """What is on disk now under the opened name (None: nothing), its permissions and identity."""
         try:
-            fd = os.open(leaf, READ_FLAGS, dir_fd=folder)
+            fd = _open_at(folder, leaf, READ_FLAGS)
         except FileNotFoundError:
             return None, opened.mode, opened.identity
         except OSError as exc:
@@ -268,6 +281,21 @@ def _check_name(path: PurePosixPath, kind: Kind, shown: str) -> None:
         raise Refused(f"{shown} is not {what}: the studio opens {' and '.join(kind.value)} files here")
 
 
+def _open_at(folder: Folder, leaf: str, flags: int, mode: int = 0o777) -> int:
+    """``os.open`` of ``leaf`` in ``folder``; without AT_FOLDER, a link there is refused as O_NOFOLLOW would."""
+    if isinstance(folder, int):
+        return os.open(leaf, flags, mode, dir_fd=folder)
+    path = os.path.join(folder, leaf)
+    if os.path.islink(path):
+        raise OSError(errno.ELOOP, "a link", path)
+    return os.open(path, flags | getattr(os, "O_BINARY", 0), mode)
+
+
+def _at(folder: Folder, leaf: str) -> tuple[str, dict[str, int]]:
+    """``leaf`` in ``folder`` as a name and the keywords that say where (dir_fd), or as a path."""
+    return (leaf, {"dir_fd": folder}) if isinstance(folder, int) else (os.path.join(folder, leaf), {})
+
+
 def _split(real: str) -> tuple[tuple[str, ...], str]:
     parts = PurePosixPath(real).parts
     return parts[:-1], parts[-1]
@@ -316,30 +344,30 @@ _LOCKS_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
-def _one_save_at_a_time(folder: int, leaf: str) -> Iterator[None]:
+def _one_save_at_a_time(folder: Folder, leaf: str) -> Iterator[None]:
     """Hold the save of ``leaf`` in the open ``folder``: one thread of this studio at a time, and (where the
     file system has flock) one studio process at a time."""
-    info = os.fstat(folder)
+    info = os.fstat(folder) if isinstance(folder, int) else os.stat(folder)
     with _LOCKS_LOCK:
         lock = _LOCKS.setdefault((info.st_dev, info.st_ino, leaf), threading.Lock())
     with lock:
         locked = False
         with contextlib.suppress(OSError):  # no flock on this file system: this studio's own lock still holds
-            if fcntl is not None:
+            if fcntl is not None and isinstance(folder, int):
                 fcntl.flock(folder, fcntl.LOCK_EX)
                 locked = True
         try:
             yield
         finally:
-            if locked and fcntl is not None:
+            if locked and fcntl is not None and isinstance(folder, int):
                 fcntl.flock(folder, fcntl.LOCK_UN)
 
 
-def _write_at(folder: int, leaf: str, data: bytes, mode: int) -> tuple[int, int]:
+def _write_at(folder: Folder, leaf: str, data: bytes, mode: int) -> tuple[int, int]:
     """Write ``leaf`` in the open ``folder`` through a temporary file renamed onto it (a link there is
     replaced, never written through); returns the new file's (device, inode)."""
     temp = temp_name(leaf)
-    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | NOFOLLOW | CLOEXEC, 0o600, dir_fd=folder)
+    fd = _open_at(folder, temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | NOFOLLOW | CLOEXEC, 0o600)
     try:
         try:
             view = memoryview(data)
@@ -351,9 +379,13 @@ def _write_at(folder: int, leaf: str, data: bytes, mode: int) -> tuple[int, int]
             info = os.fstat(fd)
         finally:
             os.close(fd)
-        os.replace(temp, leaf, src_dir_fd=folder, dst_dir_fd=folder)
+        if isinstance(folder, int):
+            os.replace(temp, leaf, src_dir_fd=folder, dst_dir_fd=folder)
+        else:
+            os.replace(os.path.join(folder, temp), os.path.join(folder, leaf))
     except BaseException:
         with contextlib.suppress(OSError):
-            os.unlink(temp, dir_fd=folder)
+            name, where = _at(folder, temp)
+            os.unlink(name, **where)
         raise
     return info.st_dev, info.st_ino
