@@ -14,8 +14,8 @@ if TYPE_CHECKING:
     from tablebot.analysis.check import CheckReport
     from tablebot.analysis.finding import Finding
     from tablebot.analysis.prove import Result
-    from tablebot.api.loaded import Loaded, PathLike
     from tablebot.api.progress import Progress
+    from tablebot.loading import Loaded, PathLike
 
 
 @dataclass(frozen=True)
@@ -119,8 +119,6 @@ def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | 
     ``[properties]`` and :attr:`~tablebot.api.project.Project.property_files`); ``targets`` are export
     targets whose limits to check too (``check --target``)."""
     from tablebot import registry
-    from tablebot.analysis.check import run_check
-    from tablebot.analysis.properties import load_properties
     from tablebot.api.progress import Progress
 
     shown = progress or Progress()
@@ -128,11 +126,9 @@ def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | 
     for name in targets:
         if name not in known:
             raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(known)}")
-    props = load_properties(project.machine, list(project.property_files))
+    props = project.properties()
     shown.start("steps", 3 + len(props), done=1)  # reading is done; exploring, findings, then each property
     try:
-        report = run_check(project.machine, props, tuple(targets), shown.step)
+        return Check(project.check_report(targets, shown.step, props))
     finally:
         shown.stop()
-    report.property_files = list(project.property_files)
-    return Check(report)

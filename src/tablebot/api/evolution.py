@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING, Any
 from tablebot.api.progress import Progress, stopped
 
 if TYPE_CHECKING:
-    from tablebot.api.loaded import Loaded, PathLike
     from tablebot.evolve.run import Outcome
     from tablebot.fleet.plan import Plan
+    from tablebot.loading import Loaded, PathLike
 
 
 @dataclass(frozen=True)

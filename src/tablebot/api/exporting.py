@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from tablebot.diagnostics import fail
 
 if TYPE_CHECKING:
-    from tablebot.api.loaded import Loaded, PathLike
+    from tablebot.loading import Loaded, PathLike
     from tablebot.registry import Exported
 
 

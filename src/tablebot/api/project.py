@@ -7,11 +7,9 @@ a call imports what it needs."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tablebot.api.loaded import Loaded, PathLike
-from tablebot.diagnostics import fail
+from tablebot.loading import Loaded, PathLike
 
 if TYPE_CHECKING:
     from tablebot.api.checking import Check
@@ -25,7 +23,6 @@ if TYPE_CHECKING:
     from tablebot.registry import Exported
 
 __all__ = ["PathLike", "Project", "open"]
-TABLE_NAMES = ("table.csv", "table.tsv")
 
 
 def open(path: PathLike, *, robot: PathLike | None = None, worlds: Sequence[PathLike] = (),
@@ -45,40 +42,12 @@ def open(path: PathLike, *, robot: PathLike | None = None, worlds: Sequence[Path
     >>> robot.table.robot.name, len(robot.table.rows)
     ('BumberBot', 36)
     """
-    from tablebot.analysis.properties import find_property_files
-    from tablebot.formats.table_read import load_table, resolve_table_path
-    from tablebot.machine import compile_table
-    from tablebot.robot import load_robot
-
-    given = Path(path)
-    robot_file = Path(robot) if robot is not None else _robot_file_named(given)
-    table_path = _table_beside(given) if given.suffix.lower() == ".toml" else resolve_table_path(given)
-    table = load_table(table_path, load_robot(robot_file) if robot_file is not None else None)
-    found = find_property_files(table_path) if properties is None else [Path(p) for p in properties]
-    return Project(table, compile_table(table), tuple(Path(w) for w in worlds), tuple(found), robot_file)
-
-
-def _robot_file_named(path: Path) -> Path | None:
-    """The robot file ``open`` was given as its path (None: it was given a table or a folder)."""
-    return path if path.suffix.lower() == ".toml" else None
-
-
-def _table_beside(robot_file: Path) -> Path:
-    """The table a robot file belongs to: ``NAME.csv`` (or ``.tsv``) beside it, else ``table.csv`` there."""
-    if not robot_file.is_file():
-        raise fail(robot_file, "no such robot file", "give a folder, a table file or a robot file that exists")
-    candidates = [robot_file.with_suffix(".csv"), robot_file.with_suffix(".tsv"),
-                  *(robot_file.parent / name for name in TABLE_NAMES)]
-    for candidate in candidates:
-        if candidate.is_file():
-            return candidate
-    raise fail(robot_file, f"no table beside this robot file ({', '.join(c.name for c in candidates[:3])})",
-               "give the table file itself, with robot= naming this file")
+    return Project.open(path, robot=robot, worlds=worlds, properties=properties)
 
 
 class Project(Loaded):
     """A robot opened by :func:`open`: its table (read and compiled) with the files it runs with (see
-    :class:`~tablebot.api.loaded.Loaded`: ``table``, ``machine``, ``robot``, ``world_files``,
+    :class:`~tablebot.loading.Loaded`: ``table``, ``machine``, ``robot``, ``world_files``,
     ``property_files``, ``worlds``, ``scene()``). Every call below is what the command of its name does, with
     the command's options as keyword arguments; each returns its results as an object (a dataclass) that can
     also write them as the command does.

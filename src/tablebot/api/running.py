@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 from tablebot.diagnostics import fail
 
 if TYPE_CHECKING:
-    from tablebot.api.loaded import Loaded, PathLike
     from tablebot.api.progress import Progress
+    from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
     from tablebot.registry import Backend, Opened
 

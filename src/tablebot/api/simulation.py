@@ -15,7 +15,7 @@ from tablebot.files import out_folder
 if TYPE_CHECKING:
     import numpy as np
 
-    from tablebot.api.loaded import Loaded, PathLike
+    from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
     from tablebot.sim.painter import Painter
     from tablebot.sim.runner import SimRun

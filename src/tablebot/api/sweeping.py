@@ -17,11 +17,11 @@ from tablebot.api.progress import Progress, stopped
 if TYPE_CHECKING:
     import numpy as np
 
-    from tablebot.api.loaded import Loaded, PathLike
     from tablebot.fleet.backends import Runner
     from tablebot.fleet.plan import Plan, Store
     from tablebot.fleet.run import FleetSummary
     from tablebot.fleet.work import Job
+    from tablebot.loading import Loaded, PathLike
 
 #: What ``--trace`` takes: run numbers as text (``0,17`` or ``0..9``) or as numbers.
 Traced = str | Sequence[int] | None

@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING
 from tablebot.api.progress import Progress, stopped
 
 if TYPE_CHECKING:
-    from tablebot.api.loaded import Loaded, PathLike
     from tablebot.fleet.backends import Runner
     from tablebot.fleet.plan import Plan
     from tablebot.fleet.tune import Cell, Evaluator
+    from tablebot.loading import Loaded, PathLike
 
 METRICS = ("time_to_lamp", "time_to_light", "collisions", "lamp_distance", "missed_lamp")
 JOURNAL = "evaluations.partial.json"

@@ -12,24 +12,19 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from tablebot.analysis.check import CheckReport, run_check
-from tablebot.analysis.properties import find_property_files, load_properties
+from tablebot.analysis.check import CheckReport
 from tablebot.colours import state_colours
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
+from tablebot.loading import Loaded
+from tablebot.loading import robot_for as robot_for  # the robot a table file runs on, as the CLI finds it
 from tablebot.machine import NO_ROW, Machine, compile_table
-from tablebot.robot import BUMBERBOT, Robot, find_robot_file, load_robot
+from tablebot.robot import Robot
 from tablebot.table import Table, normalise_header
 from tablebot.web.document import CsvDocument
 
 #: Column kinds the grid draws differently (see table_read.Column.kind).
 FLAG_KINDS = ("event", "dir")
-
-
-def robot_for(table_path: Path) -> Robot:
-    """The robot a table file runs on, as the CLI finds it (a side file, else the built-in BumberBot)."""
-    side = find_robot_file(table_path)
-    return load_robot(side) if side else BUMBERBOT
 
 
 @dataclass
@@ -68,8 +63,7 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysi
         # simulator looks for the arena beside it
         table = replace(table_read.parse_table(text, display, robot), path=str(path))
         machine = compile_table(table)
-        props = load_properties(machine, find_property_files(path))
-        report = run_check(machine, props)
+        report = Loaded.of(table, machine).check_report()  # its properties found and proved as check does
     except TableBotError as exc:
         diagnostics = [_locate(d, display, places, lines, header_line) for d in exc.diagnostics]
     data: dict[str, Any] = {

@@ -11,8 +11,9 @@ from typing import Any
 from tablebot.analysis.diagram import to_graphviz
 from tablebot.analysis.graphviz_run import INSTALL, NOT_FOUND, GraphvizFailed, NoGraphviz, draw
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.loading import Loaded
 from tablebot.machine import Machine
-from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
+from tablebot.sim.scene import Scene
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.world import World
 from tablebot.table import Table
@@ -87,14 +88,15 @@ class Arena:
         self.close()
         self.settings, self.table, self.machine = settings, table, machine
         try:
-            layer, robot_world = robot_layer(table.robot)
+            loaded = Loaded(table, machine)  # the table as edited, with the world the CLI would find for it
+            robot_world = loaded.robot_world()
             if robot_world is not None and robot_world.exists() and not robot_world.is_file():
                 raise fail(robot_world, "the robot's world is not a regular file (a folder, pipe or device)",
                            "name a world .toml file in the robot file's [sim] section")
-            base: World = find_world(table, None, robot_world)
+            base: World = loaded.default_world()
             world = moved(base, settings.start, settings.lamp)
             overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}
-            scene = prepare(table, machine, world, layer, overrides)
+            scene = loaded.scene(world, overrides)
         except TableBotError as exc:
             self.problem = str(exc)
             return {"ok": False, "problem": self.problem}
