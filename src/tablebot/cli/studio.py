@@ -34,12 +34,14 @@ def studio_cmd(
     """Edit a table in the browser, see its checks as you type, and watch the robot run it live.
 
     The address printed (and opened) carries a secret token made at each start: only a page opened from
-    it can use the studio."""
-    import webbrowser
+    it can use the studio. The browser is given a file only you can read that leads to it, so that no
+    command line (which every user of the computer can see) holds the token."""
+    from contextlib import ExitStack
     from urllib.parse import quote
 
     from tablebot.web.access import WILDCARDS, Access
     from tablebot.web.app import create_app, server
+    from tablebot.web.launch import open_in_browser, redirect_file
 
     root, table = _root_and_table(where)
     address = host or LOCAL
@@ -58,9 +60,10 @@ def studio_cmd(
         err_console.print(f"  {other}  (from other machines)", soft_wrap=True, markup=False)
     err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
     uvicorn_server = server(create_app(root, access, table), access, "info" if verbose else "warning")
-    if not no_browser:
-        webbrowser.open(url)
-    uvicorn_server.run(sockets=[sock])
+    with ExitStack() as stack:  # the file goes when the studio stops (Ctrl-C, SIGTERM)
+        if not no_browser:
+            open_in_browser(stack.enter_context(redirect_file(url)))
+        uvicorn_server.run(sockets=[sock])
 
 
 def _loopback(address: str) -> bool:
