@@ -1,6 +1,7 @@
 """A first run compiles tablebot's kernels for tens of seconds: tablebot.jit.Compiling talks all that while
 (what, how long it usually takes, the seconds so far) instead of a progress bar standing at 0 %, and says
-nothing at all once the code is in numba's cache."""
+nothing at all once the code is in numba's cache. tablebot.talk.Talking, which it uses, also covers a first
+start's imports, and says nothing for a step that ends within its delay."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from pathlib import Path
 from types import ModuleType
 
 from tablebot.jit import USUALLY, Compiling
+from tablebot.talk import SPINNER, Talking
 
 KERNEL = '''
 from tablebot.jit import njit
@@ -45,8 +47,9 @@ def test_a_compile_is_announced_then_talked_through_then_timed_in_a_log(tmp_path
     notice.done()
     notice.done()  # only the first says anything
     lines = log.getvalue().splitlines()
-    assert lines[0] == f"compiling the doubler for this machine: first run only, {USUALLY}; later runs start at once"
-    assert len(lines) >= 4 and all(line.startswith("  still compiling the doubler: ") for line in lines[1:-1])
+    assert lines[0] == f"compiling the doubler for this machine (first run only, {USUALLY}; later runs start at once)"
+    still = "  still compiling the doubler for this machine: "
+    assert len(lines) >= 4 and all(line.startswith(still) for line in lines[1:-1])
     assert lines[-1].startswith("compiled the doubler in ") and "later runs start at once" in lines[-1]
     # the function is in the cache now: a later run is told nothing
     quiet = io.StringIO()
@@ -70,5 +73,17 @@ def test_on_a_terminal_one_line_is_redrawn_with_a_spinner_and_the_seconds(tmp_pa
     shown = screen.getvalue()
     frames = [frame for frame in shown.split("\r") if frame]
     assert "\n" not in shown and len(frames) >= 3
-    assert frames[0].startswith(f"{Compiling.SPINNER[0]} compiling the doubler for this machine: 0 s (first run only")
+    assert frames[0].startswith(f"{SPINNER[0]} compiling the doubler for this machine: 0 s (first run only")
     assert frames[-1] == "\x1b[K"
+
+
+def test_a_step_that_ends_within_the_delay_says_nothing_and_a_longer_one_is_talked_through() -> None:
+    quick = io.StringIO()
+    Talking("loading", "why", "loaded in {s} s", every_s=0.05, delay_s=0.5, stream=quick).done()
+    assert quick.getvalue() == ""
+    slow = io.StringIO()
+    talking = Talking("loading", "why", "loaded in {s} s", every_s=0.05, delay_s=0.1, stream=slow)
+    time.sleep(0.4)
+    talking.done()
+    lines = slow.getvalue().splitlines()
+    assert lines[0] == "loading (why)" and lines[1].startswith("  still loading: ") and lines[-1] == "loaded in 0 s"

@@ -159,62 +159,22 @@ class Compiling:
     """Tells the user, on stderr, all the while ``functions`` compile (a first run's tens of seconds must not
     look like a hang, nor like a progress bar stuck at 0 %): what, how long it usually takes, and the seconds
     so far -- on a terminal one line with a spinner, redrawn; elsewhere (a pipe, a log) a line at the start
-    and one every ``every_s``. :meth:`done` ends it with the time taken. Nothing at all when the functions
-    are in the cache already (``active`` is False)."""
-
-    SPINNER = "⠋⠙⠹⠸⠼⠴⠦⠧⠇⠏"
+    and one every ``every_s`` (:class:`tablebot.talk.Talking`). :meth:`done` ends it with the time taken.
+    Nothing at all when the functions are in the cache already (``active`` is False)."""
 
     def __init__(self, what: str, *functions: Any, every_s: float = 10.0, stream: Any = None) -> None:
-        import threading
-        import time
+        from tablebot.talk import Talking
 
-        self.what, self.every_s = what, every_s
-        self.stream = stream if stream is not None else sys.stderr
         self.active = not compiled(*functions)
-        self.started = time.monotonic()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-        if self.active:
-            self.live = bool(getattr(self.stream, "isatty", lambda: False)())
-            if not self.live:
-                self._say(f"compiling {what} for this machine: first run only, {USUALLY}; later runs start at once")
-            self._thread = threading.Thread(target=self._talk, name="compile notice", daemon=True)
-            self._thread.start()
-
-    def _say(self, text: str, end: str = "\n") -> None:
-        try:
-            self.stream.write(text + end)
-            self.stream.flush()
-        except (OSError, ValueError):  # a closed or broken stderr: nobody to tell
-            pass
-
-    def elapsed(self) -> float:
-        import time
-
-        return time.monotonic() - self.started
-
-    def _talk(self) -> None:
-        turn = 0
-        while not self._stop.wait(0.1 if self.live else self.every_s):
-            if self.live:  # one line, redrawn in place (\r, then erase to its end)
-                spinner = self.SPINNER[turn % len(self.SPINNER)]
-                self._say(f"\r{spinner} compiling {self.what} for this machine: {self.elapsed():.0f} s (first run "
-                          f"only, {USUALLY}; later runs start at once)\x1b[K", end="")
-                turn += 1
-            else:
-                self._say(f"  still compiling {self.what}: {self.elapsed():.0f} s")
+        self.talking = Talking(f"compiling {what} for this machine", f"first run only, {USUALLY}; later runs start "
+                               "at once", f"compiled {what} in {{s}} s (kept in the cache: later runs start at once)",
+                               every_s=every_s, stream=stream) if self.active else None
 
     def done(self, finished: bool = True) -> None:
         """The compile is over: stop talking and, when it ``finished`` (not cut short by an error or Ctrl-C),
         say how long it took. Only the first call does anything."""
-        if self._thread is None:
-            return
-        self._stop.set()
-        self._thread.join()
-        self._thread = None
-        clear = "\r\x1b[K" if self.live else ""
-        said = f"compiled {self.what} in {self.elapsed():.0f} s (kept in the cache: later runs start at once)"
-        self._say(clear + said if finished else clear, end="\n" if finished else "")
+        if self.talking is not None:
+            self.talking.done(finished)
 
 
 def njit(*args: Any, refcounts: bool = True, **kwargs: Any) -> Callable[..., Any]:

@@ -22,14 +22,21 @@ class TickBar(Progress):
     ``quiet``); once ticks run, a bar of them with the time left, on a terminal and unless ``quiet``."""
 
     def __init__(self, quiet: bool) -> None:
+        from tablebot.talk import Talking
+
         self.quiet = quiet
         self.compile: Compiling | None = None
         self.bar: RichProgress | None = None
         self.task: TaskID | None = None
+        # until the compile (or the run) starts: a first start compiles numba's and numpy's bytecode, seconds
+        # with nothing to show (said only past 3 s)
+        self.loading = Talking("loading the simulator", "a first start compiles numba's and numpy's bytecode",
+                               delay_s=3.0)
 
     def compiling(self, what: str, *functions: Any) -> None:
         from tablebot.jit import Compiling
 
+        self.loading.done(finished=False)
         self.compile = Compiling(what, *functions)  # talks until the first ticks have run (first run only)
 
     def start(self, what: str, total: int, done: int = 0, ticks: int | None = None) -> None:
@@ -53,6 +60,7 @@ class TickBar(Progress):
             self.bar.update(self.task, advance=count)
 
     def stop(self) -> None:
+        self.loading.done(finished=False)
         if self.compile is not None:
             self.compile.done(finished=False)  # an error or Ctrl-C during the compile: the notice stops
         if self.bar is not None:
