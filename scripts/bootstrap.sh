@@ -99,6 +99,12 @@ talking() {
   wait "$pid"
 }
 
+install_user() {
+  # install, not sync: a venv that also holds the dev packages (make test) keeps them
+  .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --require-hashes -r "$USER_LOCK"
+  .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --no-deps -e .
+}
+
 uv_ready() {
   # uv (from PyPI, like everything else) fetches and installs in parallel: seconds where pip takes minutes.
   # Into .venv with whichever installer there is: a uv on PATH, the Python's own pip (22.3+: --python), or a
@@ -127,10 +133,7 @@ if [ "$LEVEL" = user ]; then
     echo "installing tablebot and the Python packages its commands need into .venv, as $USER_LOCK pins them"
     echo "  (numpy, numba, matplotlib, graphviz-pure, ...; no system packages): 10-30 s the first time"
     uv_ready
-    # install, not sync: a venv that also holds the dev packages (make test) keeps them
-    talking "installing" .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --require-hashes \
-      -r "$USER_LOCK"
-    .venv/bin/uv pip install -q --python .venv/bin/python --system-certs --no-deps -e .
+    talking "installing" install_user
     echo "$user_stamp" >.venv/.installed-user
     echo "installed; .venv/bin/tablebot --help lists the commands"
   fi
