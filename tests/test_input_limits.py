@@ -129,6 +129,18 @@ def test_event_columns_beyond_63_are_refused_at_the_first_one_too_many(tmp_path:
     assert f"table.csv:1:{column}: error: the table has 64 event columns" in err
 
 
+def test_sim_of_more_event_columns_than_its_lookup_holds_is_refused_at_the_header(tmp_path: Path) -> None:
+    """Reproduced: sim of a table of 11 to 63 event columns ended in an internal error (simrobot's ValueError:
+    the compiled simulator's lookup holds 10); check still reads such a table."""
+    robot = MINI_ROBOT.replace('A = "left switch"\nB = "right switch"\n', "".join(f'I{i} = "in"\n' for i in range(10)))
+    names = ",".join(f"I{i}" for i in range(10))
+    write_table(tmp_path, f"state,T,{names},M1,M2,next\n1,1,{'1,' * 10}3,3,1\n", robot)
+    assert runner.invoke(app, ["check", str(tmp_path)]).exit_code in (0, 1)
+    err = refused("sim", tmp_path, "--seconds", "0.1", "--out", tmp_path / "out")
+    assert "table.csv:1: error: the table has 11 event columns (T, inputs and counters); the simulator takes at " \
+           "most 10" in err
+
+
 def test_lines_below_the_header_are_counted_as_they_are_read(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(table_read, "MAX_TABLE_ROWS", 4)  # 100,000 in use: the same code, reached sooner
     rows = ["go,1,1,,,3,3,0,1", "", "# a comment counts too", "back,1,,1,,3,3,0,1"]

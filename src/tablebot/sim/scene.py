@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
-from tablebot.machine import Machine
+from tablebot.machine import FLAT_BITS, Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
 from tablebot.sim.contacts import body_corners, deepest_contact
@@ -100,6 +100,7 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     _check_tick(params, table.robot)
     tick_s = table.robot.tick_s
     _check_sensor_count(table.robot)
+    _check_events(table)
     P = param_row(params, tick_s, table.robot.sensors)[None, :]
     geo = geometry(world)
     _check_start(world, geo, P)
@@ -171,6 +172,13 @@ def _check_sensor_count(robot: Robot) -> None:
     if len(robot.sensors) > L.MAX_SENSORS:
         raise fail(robot.source, f"the simulator models at most {L.MAX_SENSORS} sensors in [sensors], and robot "
                    f"{robot.name} declares {len(robot.sensors)}", "declare fewer sensors", robot.line("sensors"))
+
+
+def _check_events(table: Table) -> None:
+    """The compiled simulator looks each tick's row up in a flat table of every event set: 2**events per state."""
+    if len(table.events) > FLAT_BITS:
+        raise fail(table.path, f"the table has {len(table.events)} event columns (T, inputs and counters); the "
+                   f"simulator takes at most {FLAT_BITS}", "simulate a table that looks at fewer inputs", 1)
 
 
 def _check_tick(params: Params, robot: Robot) -> None:
