@@ -173,6 +173,33 @@ def test_the_file_is_removed_when_the_studio_stops(folder: Path, tmp_path: Path,
     assert "Traceback" not in running.text()
 
 
+OPEN_AND_WAIT = """import sys, threading
+from tablebot.web.launch import open_in_browser, redirect_file
+visited = threading.Event()
+if sys.argv[1] == "visited":
+    visited.set()
+with redirect_file("http://127.0.0.1:1/?token=secret") as path:
+    open_in_browser(path, visited, patience_s=0.2)
+    next(t for t in threading.enumerate() if t.name == "tablebot-browser").join(20)
+"""
+
+
+@pytest.mark.parametrize("visit", ["visited", "not"])
+def test_a_browser_that_does_not_come_gets_the_user_a_hint(tmp_path: Path, visit: str) -> None:
+    """A browser installed as a snap cannot read the file: the terminal says to open the printed address."""
+    fake = tmp_path / "fake-browser"
+    fake.write_text(f"#!{sys.executable}\nimport sys\nopen({str(tmp_path / 'argv')!r}, 'w').write(sys.argv[1])\n")
+    fake.chmod(0o700)
+    done = subprocess.run([sys.executable, "-c", OPEN_AND_WAIT, visit], env={**os.environ, "BROWSER": str(fake)},
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "argv").read_text().startswith("file://")
+    hint = ("the browser has not come to the studio after 0.2 s: if it cannot find "
+            f"{(tmp_path / 'argv').read_text().removeprefix('file://')} (a browser installed as a snap cannot read "
+            "that folder), open the address above")
+    assert done.stderr.strip() == ("" if visit == "visited" else hint)
+
+
 # --- the verbose log -------------------------------------------------------------------------------------
 
 def _get(url: str, headers: dict[str, str] | None = None) -> int:

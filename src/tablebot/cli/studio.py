@@ -36,6 +36,7 @@ def studio_cmd(
     The address printed (and opened) carries a secret token made at each start: only a page opened from
     it can use the studio. The browser is given a file only you can read that leads to it, so that no
     command line (which every user of the computer can see) holds the token."""
+    import threading
     from contextlib import ExitStack
     from urllib.parse import quote
 
@@ -59,10 +60,12 @@ def studio_cmd(
         other = access.url(socket.gethostname(), f"table={quote(table)}" if table else "")
         err_console.print(f"  {other}  (from other machines)", soft_wrap=True, markup=False)
     err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
-    uvicorn_server = server(create_app(root, access, table), access, "info" if verbose else "warning")
+    visited = threading.Event()
+    uvicorn_server = server(create_app(root, access, table, visited=visited), access,
+                            "info" if verbose else "warning")
     with ExitStack() as stack:  # the file goes when the studio stops (Ctrl-C, SIGTERM)
         if not no_browser:
-            open_in_browser(stack.enter_context(redirect_file(url)))
+            open_in_browser(stack.enter_context(redirect_file(url)), visited)
         uvicorn_server.run(sockets=[sock])
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -43,9 +44,10 @@ class Gone(Exception):
     """The tab closed its WebSocket: stop talking to it."""
 
 
-def create_app(root: Path, access: Access, table: str | None = None, max_tabs: int = MAX_TABS) -> Gate:
+def create_app(root: Path, access: Access, table: str | None = None, max_tabs: int = MAX_TABS,
+               visited: threading.Event | None = None) -> Gate:
     """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first;
-    at most ``max_tabs`` tabs at once."""
+    at most ``max_tabs`` tabs at once; ``visited`` is set when a page comes with the token in its address."""
     workspace = Workspace(root)
     hub = Hub()
     doors = Doors(max_tabs)
@@ -55,6 +57,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
                                                                 "Cache-Control": "no-store"})
         if access.has_token(None, request.query_params.get("token")):  # the first visit: the page keeps it
             response.headers.append("Set-Cookie", access.set_cookie())
+            if visited is not None:
+                visited.set()
         return response
 
     async def config(request: Request) -> Response:
@@ -211,7 +215,6 @@ class Background:
     def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
                  log_level: str = "warning", max_tabs: int = MAX_TABS) -> None:
         import socket
-        import threading
 
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from tablebot.web.errors import log
 
+PATIENCE_S = 20.0  # a cold browser on a slow school computer takes a while
 PAGE = """<!doctype html>
 <html><head><meta charset="utf-8"><meta name="referrer" content="no-referrer">
 <meta http-equiv="refresh" content="0;url={url}"><title>tablebot studio</title></head>
@@ -67,12 +68,17 @@ def _write_private(path: Path, text: str) -> None:
         raise
 
 
-def open_in_browser(path: Path) -> None:
-    """Open the local file ``path`` in the user's browser, from a thread of its own: a browser named by
-    ``$BROWSER`` is waited for until it exits, and the studio must serve meanwhile."""
+def open_in_browser(path: Path, visited: threading.Event, patience_s: float = PATIENCE_S) -> None:
+    """Open the local file ``path`` in the user's browser, from a thread of its own (a browser named by
+    ``$BROWSER`` is waited for until it exits, and the studio must serve meanwhile); if the page has not
+    ``visited`` the studio within ``patience_s``, say what to do. A browser installed as a snap (Ubuntu's
+    Firefox and Chromium) cannot read the runtime or temporary folder and shows "file not found"."""
 
     def run() -> None:
         if not webbrowser.open(path.as_uri()):
             log.warning("no browser could be opened: open the address above in one")
+        elif not visited.wait(patience_s):
+            log.warning("the browser has not come to the studio after %g s: if it cannot find %s (a browser "
+                        "installed as a snap cannot read that folder), open the address above", patience_s, path)
 
     threading.Thread(target=run, name="tablebot-browser", daemon=True).start()
