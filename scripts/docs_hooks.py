@@ -6,7 +6,8 @@
   and the reader gets the file;
 * a page made from the code (scripts/docs_reference.py) that is out of date is a warning, so the strict build
   fails until the script has been run again;
-* the docstrings' Sphinx roles (``:meth:`step```) show as the code they name, without the role's name.
+* the docstrings' Sphinx roles (``:meth:`step```) show as the code they name, without the role's name (and
+  ``~a.b.Name`` as ``Name``, as Sphinx shows it).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from mkdocs.structure.files import File, Files
 ROOT = Path(__file__).resolve().parents[1]
 log = logging.getLogger("mkdocs.hooks.tablebot")
 ROLE_RE = re.compile(r":(?:py:)?(?:meth|func|class|mod|attr|data|exc|obj|const):(?=<code>)")
+#: A role's ``~a.b.Name``: Sphinx shows the last name only.
+SHORT_RE = re.compile(r"<code>~(?:\w+\.)+(\w+)</code>")
 
 
 def _reference() -> ModuleType:
@@ -56,4 +59,4 @@ def on_files(files: Files, config: MkDocsConfig, **_: Any) -> Files:
 
 
 def on_page_content(html: str, **_: Any) -> str:
-    return ROLE_RE.sub("", html)
+    return SHORT_RE.sub(r"<code>\1</code>", ROLE_RE.sub("", html))

@@ -45,7 +45,7 @@ BROWSER = {"test_studio_browser", "test_studio_attacks", "test_studio_drafts", "
 KERNEL_FREE = {
     "test_bench_engine", "test_check_cli", "test_check_findings", "test_check_scaling", "test_cli_basics",
     "test_codegen", "test_core_bad_input", "test_counters", "test_diagram", "test_docs_paths", "test_docs_reference",
-    "test_escape", "test_version",
+    "test_escape", "test_version", "test_front_door_api",
     "test_evolve_pyribs", "test_firmware", "test_firmware_bad_input", "test_firmware_monitor",
     "test_fleet_generators", "test_fuzz_loaders", "test_injection", "test_properties_language",
     "test_properties_search", "test_robopro", "test_robopro_corpus", "test_robopro_program", "test_robot_sections",

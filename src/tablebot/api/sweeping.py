@@ -36,7 +36,7 @@ class Sweep:
 
     >>> import tablebot
     >>> sweep = tablebot.open("examples/bumberbot").sweep(robots=4, seconds=1)
-    >>> len(sweep.results), list(sweep.results["run"])
+    >>> len(sweep.results), sweep.results["run"].tolist()
     (4, [0, 1, 2, 3])
     """
 

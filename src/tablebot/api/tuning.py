@@ -32,8 +32,10 @@ class Tuning:
     >>> robot = tablebot.open("examples/bumberbot")
     >>> tuned = robot.tune("line 5 timer=100..900", objective="collisions", budget=3, seeds="0..1",
     ...                    check_seeds="9..10", seconds=1)
-    >>> len(tuned.history), len(tuned.winner)
-    (3, 1)
+    >>> tuned.objective, len(tuned.winner), [p.name for p in tuned.files]
+    ('collisions', 1, [])
+    >>> [p.name for p in tuned.save("out/tune")]
+    ['table.tuned.csv', 'evaluations.csv', 'convergence.png', 'report.md']
     """
 
     evaluator: Evaluator
