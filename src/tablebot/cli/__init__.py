@@ -1,4 +1,8 @@
-"""Command-line interface: one module per group of commands, all registered on one Typer app."""
+"""Command-line interface: one module per group of commands, all registered on one Typer app.
+
+Internal to tablebot: its public API is ``tablebot`` and ``tablebot.api`` (docs/api.md, which also names the
+modules stable enough to use beside them); anything here may change in any release.
+"""
 
 from __future__ import annotations
 

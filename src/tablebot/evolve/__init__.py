@@ -8,4 +8,7 @@ Modules, in the order data flows: ``space`` (what may change), ``operators`` (ho
 ``measures`` (objectives and behaviour descriptors), ``evaluate`` (candidates on the fleet),
 ``archive`` (the MAP-Elites archive and emitter), ``run`` (the loop, its store and resume),
 ``report`` (tables, check reports, heat map, before/after).
+
+Internal to tablebot: its public API is ``tablebot`` and ``tablebot.api`` (docs/api.md, which also names the
+modules stable enough to use beside them); anything here may change in any release.
 """
