@@ -11,6 +11,7 @@ import csv
 import io
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from operator import attrgetter
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -45,6 +46,8 @@ class TickInput:
 #: The most ticks an inputs file (or a replayed trace) may give: nearly three hours at 10 ms ticks, and a
 #: simulated run is at most an hour. Counted as they are read, before more is kept.
 MAX_INPUT_TICKS = 1_000_000
+#: The most distinct rows remembered while reading (a column of tick numbers makes every row distinct).
+MAX_SEEN_ROWS = 4096
 
 
 def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
@@ -61,9 +64,17 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     out = Collector(path)
     columns = _columns(header.cells, machine, out)
     ticks: list[TickInput] = []
+    seen: dict[tuple[str, ...], TickInput] = {}  # a row's texts -> its tick: a recording repeats a few rows
     for record in records:
         _count(ticks, path, record.line)
-        ticks.append(_tick(record.cells, columns, machine, out))
+        key = tuple(map(attrgetter("text"), record.cells))
+        tick = seen.get(key)
+        if tick is None:
+            errors = len(out.items)
+            tick = _tick(record.cells, columns, machine, out)
+            if len(out.items) == errors and len(seen) < MAX_SEEN_ROWS:  # a bad cell is reported at each place
+                seen[key] = tick
+        ticks.append(tick)
     out.raise_if_any()
     return ticks
 
@@ -103,9 +114,9 @@ def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tu
 
 
 def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events, out: Collector) -> TickInput:
-    robot = machine.table.robot
+    counters = machine.table.robot.counter_names
     mask = 0
-    pulses = [0] * len(robot.counter_names)
+    pulses = [0] * len(counters)
     for (kind, name), cell in zip(columns, cells, strict=False):
         text = cell.text.strip()
         if kind in ("bad", "tick") or not text:
@@ -121,7 +132,7 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events
             out.error(cell.line, cell.column, f"{name}: a number of {len(text):,} characters is too many pulses",
                       "write the pulses of one tick (a few at most); blank means 0")
         else:
-            pulses[robot.counter_names.index(name)] = int(text)
+            pulses[counters.index(name)] = int(text)
     cells_beyond(cells, len(columns), out)
     return TickInput(mask, tuple(pulses))
 
