@@ -20,6 +20,7 @@ from typer.testing import CliRunner
 import tablebot
 from doc_commands import examples_copy
 from tablebot.cli import app
+from tablebot.diagnostics import TableBotError
 
 #: report.md says how long tune and evolve took: wall-clock seconds, different in every run.
 WALL_RE = re.compile(r"\b\d+(\.\d+)? s\b")
@@ -156,3 +157,19 @@ def test_the_examples_in_the_docstrings_hold(module: str, here: Path) -> None:
     """Each result type's docstring shows it in use (docs/api.md shows them): what they show is what it does."""
     result = doctest.testmod(importlib.import_module(f"tablebot.{module}"))
     assert result.attempted and not result.failed
+
+
+def test_the_library_keeps_the_commands_rule_on_replacing_a_users_table(here: Path) -> None:
+    """A tuned table is a table a user may have edited since: a second tuning into the same folder replaces it
+    only with force=True (the command's --force), the old one kept as NAME.bak, from Python as from the command."""
+    robot = tablebot.open("examples/bumberbot")
+    options = {"objective": "collisions", "budget": 2, "seeds": "0..1", "check_seeds": "9..10", "seconds": 1}
+    robot.tune("line 5 timer", out="out", **options)  # type: ignore[arg-type]  # (a dict of mixed values)
+    tuned = here / "out" / "table.tuned.csv"
+    tuned.write_text(tuned.read_text() + "# my note\n")
+    with pytest.raises(TableBotError, match="not replaced without --force"):
+        robot.tune("line 5 timer", out="out", **options)  # type: ignore[arg-type]
+    assert tuned.read_text().endswith("# my note\n")
+    robot.tune("line 5 timer", out="out", force=True, **options)  # type: ignore[arg-type]
+    assert (here / "out" / "table.tuned.csv.bak").read_text().endswith("# my note\n")
+    assert not tuned.read_text().endswith("# my note\n")

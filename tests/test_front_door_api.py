@@ -69,7 +69,7 @@ def test_open_takes_a_folder_a_table_or_a_robot_file(tmp_path: Path, monkeypatch
     assert opened[2].robot_file == folder / "robot.toml"
     given = tablebot.open(folder, worlds=[folder / "arena.toml"], properties=[])
     assert given.property_files == () and [w.name for w in given.worlds] == ["BumberBot arena"]
-    with pytest.raises(TableBotError, match="no such robot file"):
+    with pytest.raises(TableBotError, match="No such file"):
         tablebot.open(folder / "nothing.toml")
     (tmp_path / "alone").mkdir()
     (tmp_path / "alone" / "robot.toml").write_text((folder / "robot.toml").read_text())

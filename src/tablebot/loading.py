@@ -87,8 +87,9 @@ class Loaded:
 
         given = Path(path)
         robot_file = Path(robot) if robot is not None else given if given.suffix.lower() == ".toml" else None
+        robot_read = load_robot(robot_file) if robot_file is not None else None  # first, as every command reads it
         found = table_path(given)
-        table = load_table(found, load_robot(robot_file) if robot_file is not None else None)
+        table = load_table(found, robot_read)
         props = property_files(found) if properties is None else [Path(p) for p in properties]
         return cls(table, compile_table(table), tuple(Path(w) for w in worlds), tuple(props), robot_file)
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -55,7 +56,7 @@ class Simulation:
         """The table, robot, world and simulator parameters it ran with."""
         return self.run.scene
 
-    @property
+    @cached_property
     def trace(self) -> np.ndarray:
         """The trace, a numpy structured array: ``trace["x"]`` is a column, ``trace[0]`` the first tick.
         Made from the run when it kept its robot rows (a run in memory), else read from the trace it wrote."""
@@ -99,7 +100,7 @@ def simulate(project: Loaded, seconds: float = 120.0, seed: int = 1, *, world: P
 
     # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
     # while this process imports numba and runs the robot, and draws the pictures when the run is over
-    with _painter() if plots else contextlib.nullcontext() as painter:
+    with _painter() if plots else contextlib.nullcontext() as painter, project.writing():
         scene = project.scene(world, overrides)
         return _into(scene, seconds, seed, Path(out), painter, gif, html, every_row or gif, shown)
 

@@ -125,8 +125,10 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
         traced = trace_runs(trace, plan.spec.total)
         if out is None:
             return _in_memory(plan, runner, chosen, shown)
-        store, ran, wall_s = _into(plan, runner, chosen, Path(out), shown)
-    return _finish(plan, store, traced, plots, wall_s, ran)
+        with project.writing():
+            store, ran, wall_s = _into(plan, runner, chosen, Path(out), shown)
+    with project.writing():
+        return _finish(plan, store, traced, plots, wall_s, ran)
 
 
 def trace_runs(runs: Traced, total: int) -> list[int]:
