@@ -23,7 +23,13 @@ class PropertyResult:
     """One property and what proving it gave, with the names and values of ``check --format json``:
     ``status`` is ``holds``, ``violated`` or ``unknown``; a counterexample (or a ``reachable`` property's
     example) has ``ticks``, the tick it shows at and whether it is the ``shortest``, and ``inputs_csv`` once
-    :meth:`Check.write_counterexamples` has written it."""
+    :meth:`Check.write_counterexamples` has written it.
+
+    >>> import tablebot
+    >>> first = tablebot.open("examples/bumberbot").check().properties[0]
+    >>> first.name, first.status, first.level
+    ('collision_stops', 'holds', 'error')
+    """
 
     name: str
     text: str

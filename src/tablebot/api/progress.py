@@ -41,7 +41,12 @@ class Progress:
 class Stopped(KeyboardInterrupt):
     """Ctrl-C (or SIGTERM, inside a command) cut a long call short, after it kept what it had done: ``kept``
     says what and where, in one line of plain text; calling it again the same way resumes from there.
-    ``terminated`` says SIGTERM did it, and ``exit_code`` is the command's (130 or 143)."""
+    ``terminated`` says SIGTERM did it, and ``exit_code`` is the command's (130 or 143).
+
+    >>> stopped = Stopped("12 of 40 runs finished, kept in out/sweep/results.partial.csv")
+    >>> isinstance(stopped, KeyboardInterrupt), stopped.word, stopped.exit_code
+    (True, 'interrupted', 130)
+    """
 
     def __init__(self, kept: str, terminated: bool = False) -> None:
         super().__init__(kept)

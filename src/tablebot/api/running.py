@@ -55,7 +55,13 @@ class LiveRun:
 @dataclass(frozen=True)
 class Connection:
     """A live robot opened for the project's table (:func:`connect`): :attr:`opened` says where it is and
-    what it is (``where``, ``device``) and what to know before it moves (``warnings``); :meth:`run` drives it."""
+    what it is (``where``, ``device``) and what to know before it moves (``warnings``); :meth:`run` drives it.
+
+    >>> import tablebot
+    >>> connection = tablebot.open("examples/bumberbot").connect("sim", seed=2)
+    >>> connection.opened.device, connection.run(seconds=0.03).end.ticks
+    ('simulated, seed 2', 3)
+    """
 
     project: Loaded
     opened: Opened
