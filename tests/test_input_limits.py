@@ -141,9 +141,10 @@ def test_sim_of_more_event_columns_than_its_lookup_holds_is_refused_at_the_heade
            "most 10" in err
 
 
-def test_lines_below_the_header_are_counted_as_they_are_read(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize("first", ["go", '"go, first"'])  # without a quote, lines are counted before any is read
+def test_lines_below_the_header_are_counted(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, first: str) -> None:
     monkeypatch.setattr(table_read, "MAX_TABLE_ROWS", 4)  # 100,000 in use: the same code, reached sooner
-    rows = ["go,1,1,,,3,3,0,1", "", "# a comment counts too", "back,1,,1,,3,3,0,1"]
+    rows = [f"{first},1,1,,,3,3,0,1", "", "# a comment counts too", "back,1,,1,,3,3,0,1"]
     assert len(load_table(write_table(tmp_path, "\n".join([HEADER, *rows]) + "\n", MINI_ROBOT)).rows) == 2
     write_table(tmp_path, "\n".join([HEADER, *rows, "x,1,,,1,3,3,0,1"]) + "\n")
     assert "table.csv:6:1: error: the table has more than 4 lines below its header" in refused("check", tmp_path)
@@ -177,8 +178,9 @@ def test_inputs_past_the_tick_limit_are_refused_as_they_are_read(tmp_path: Path,
     ok.write_text("I3,I4\n1,\n\n,1\n")  # a blank row is a tick
     assert len(load_inputs(ok, machine)) == 3
     over = tmp_path / "over.csv"
-    over.write_text("I3,I4\n1,\n\n,1\n1,1\n")
-    assert "over.csv:5:1: error: more than 3 ticks" in refused("trace", EXAMPLE, "--inputs", over)
+    for quote in ("", '"'):  # without a quote, the rows are counted before any is read
+        over.write_text(f"I3,I4\n1,\n\n,1\n{quote}1{quote},1\n")
+        assert "over.csv:5:1: error: more than 3 ticks" in refused("trace", EXAMPLE, "--inputs", over)
     trace = tmp_path / "run.jsonl"
     trace.write_text("".join(f'{{"tick":{t},"event":0}}\n' for t in range(4)))
     assert "run.jsonl:4:1: error: more than 3 ticks" in refused("trace", EXAMPLE, "--inputs", trace)

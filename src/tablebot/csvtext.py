@@ -48,7 +48,7 @@ CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with cha
 #: inputs at 10 ms ticks about 6 MB. Anything larger is almost surely the wrong file (or /dev/zero).
 MAX_TEXT_BYTES = 64 * 1024 * 1024
 #: The widest record and the longest cell a loader reads (:func:`read_records`), far beyond any real file: the
-#: examples' tables have up to 14 columns and cells of at most 40 characters. Both are refused before the
+#: examples' tables have up to 16 columns and cells of at most 49 characters. Both are refused before the
 #: record is built, so neither a line of a million commas nor a cell of megabytes costs memory.
 MAX_COLUMNS = 1000
 MAX_CELL_CHARS = 4000
@@ -157,6 +157,16 @@ def _first_filled_line(text: str) -> str:
             return text[start:end]
         start = end + 1
     return ""
+
+
+def records_after(text: str, line: int) -> int | None:
+    """How many records follow line ``line`` (1-based) of ``text``, counted in C, when the text has no quote: each
+    record is then one line, so a loader refuses too many before reading any. None when it has one (a quoted cell
+    may span lines): the loader counts the records as it reads them."""
+    if '"' in text:
+        return None
+    breaks = text.count("\n") + text.count("\r") - text.count("\r\n")
+    return breaks + (0 if not text or text.endswith(("\n", "\r")) else 1) - line
 
 
 def split_records(text: str, path: str, delimiter: str | None = None) -> list[Record]:

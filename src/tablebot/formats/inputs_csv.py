@@ -15,8 +15,8 @@ from operator import attrgetter
 from pathlib import Path
 from typing import Any, Protocol
 
-from tablebot.csvtext import Cell, cells_beyond, headerless, read_records, read_text
-from tablebot.diagnostics import Collector, fail
+from tablebot.csvtext import Cell, cells_beyond, headerless, read_records, read_text, records_after
+from tablebot.diagnostics import Collector, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.files import write_text
 from tablebot.formats.trace_lines import trace_records
@@ -61,6 +61,9 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     header = next((record for record in records if not record.is_blank()), None)  # blank lines above it
     if header is None:  # (below it, a blank row is a tick)
         raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
+    after = records_after(text, header.line)
+    if after is not None and after > MAX_INPUT_TICKS:  # known at once: no row is read
+        raise _too_many_ticks(path, header.line + MAX_INPUT_TICKS + 1)
     out = Collector(path)
     columns = _columns(header.cells, machine, out)
     ticks: list[TickInput] = []
@@ -82,8 +85,12 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
 def _count(ticks: list[TickInput], path: Path, line: int) -> None:
     """Refuse the tick about to be added to ``ticks`` (read from ``line``) if it is one too many."""
     if len(ticks) == MAX_INPUT_TICKS:
-        raise fail(path, f"more than {MAX_INPUT_TICKS:,} ticks, the most tablebot replays",
-                   "replay a shorter recording (split the file)", line, 1)
+        raise _too_many_ticks(path, line)
+
+
+def _too_many_ticks(path: Path, line: int) -> TableBotError:
+    return fail(path, f"more than {MAX_INPUT_TICKS:,} ticks, the most tablebot replays",
+                "replay a shorter recording (split the file)", line, 1)
 
 
 def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tuple[str, str]]:

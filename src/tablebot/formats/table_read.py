@@ -12,8 +12,8 @@ from operator import attrgetter
 from pathlib import Path
 from typing import Any
 
-from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_records, read_text
-from tablebot.diagnostics import Collector, Diagnostic, fail
+from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_records, read_text, records_after
+from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
 from tablebot.robot import (
     BUMBERBOT,
@@ -51,7 +51,7 @@ class Column:
     cell: Cell
 
 
-#: The largest table read, far beyond any real one (the examples have up to 40 rows, 10 states and 14 columns; a
+#: The largest table read, far beyond any real one (the examples have up to 41 rows, 10 states and 16 columns; a
 #: table of a few thousand rows is big; ROBO Pro's lists hold 128 states) and small enough that ``check`` and
 #: ``sim`` of the largest one accepted stay within seconds and a few hundred MB (benchmarks/limits.py): the
 #: file's size, its lines below the header (counted as they are read, blank and comment lines too), its states
@@ -88,10 +88,12 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
     rows: list[Row] = []
     next_cells: dict[int, Cell] = {}  # line -> its next-state cell, where missing states are reported
+    after = records_after(text, header.line)
+    if after is not None and after > MAX_TABLE_ROWS:  # known at once: no line is read
+        raise _too_many_rows(path, header.line + MAX_TABLE_ROWS + 1)
     for count, record in enumerate(records, start=1):
         if count > MAX_TABLE_ROWS:
-            raise fail(path, f"the table has more than {MAX_TABLE_ROWS:,} lines below its header, the most "
-                       "tablebot reads", "split it into smaller tables; is this the right file?", record.line, 1)
+            raise _too_many_rows(path, record.line)
         if record.is_blank() or is_comment(record):
             continue
         row = _row(record, layout, robot, out, memo, len(rows), rows[-1].description if rows else "")
@@ -106,6 +108,11 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     _check_states(rows, robot, out, next_cells, columns)
     out.raise_if_any()
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
+
+
+def _too_many_rows(path: str, line: int) -> TableBotError:
+    return fail(path, f"the table has more than {MAX_TABLE_ROWS:,} lines below its header, the most tablebot reads",
+                "split it into smaller tables; is this the right file?", line, 1)
 
 
 def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int | None, int | None],
