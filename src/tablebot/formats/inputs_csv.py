@@ -174,6 +174,7 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
     out = Collector(path)
     keys = ("event", *(pulses_key(c) for c in machine.table.robot.counter_names))
     ticks: list[TickInput] = []
+    seen: dict[tuple[Any, ...], TickInput] = {}  # one tick object per distinct tick: a run repeats a few
     for number, data in trace_records(text, out):
         values: list[Any] = [data.get(key) for key in keys]  # JSON values, checked just below
         bad = [key for key, v in zip(keys, values, strict=True)
@@ -183,6 +184,10 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
                       "replay a trace that a run of this table recorded (tablebot run --out)")
             continue
         _count(ticks, path, number)
-        ticks.append(TickInput(values[0] & machine.input_mask, tuple(values[1:])))
+        key = (values[0] & machine.input_mask, *values[1:])
+        tick = seen.get(key) or TickInput(key[0], key[1:])
+        if len(seen) < MAX_SEEN_ROWS:
+            seen[key] = tick
+        ticks.append(tick)
     out.raise_if_any()
     return ticks

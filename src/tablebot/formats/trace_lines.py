@@ -79,12 +79,25 @@ def parse_trace(text: str, path: str | Path, required: tuple[str, ...] = ()) -> 
     return lines
 
 
+#: One line and its end (``\n``, ``\r\n`` or ``\r``; at the end of the text, none).
+LINE_RE = re.compile(r"([^\r\n]*)(?:\r\n|\r|\n|$)")
+
+
+def lines_of(text: str) -> Iterator[str]:
+    """The lines of ``text``, one at a time (a 64 MB trace split at once is a list of half a million strings), each
+    without its end. Only line ends end a line: a JSON string may hold U+2028, which str.splitlines also splits at."""
+    for line in LINE_RE.finditer(text):
+        if not line[0]:  # the empty match at the very end
+            return
+        yield line[1]
+
+
 def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> Iterator[tuple[int, dict[str, Any]]]:
     """(line number, tick line) of a trace's text up to an ``end`` record; a bad line goes to ``out``.
     The one reader of trace lines: ``tablebot trace --inputs RUN.jsonl``, the studio's player and
     :func:`read_trace` all go through it."""
     hint = "a trace has one JSON object per line, as tablebot sim, trace, run or monitor write it"
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(lines_of(text), start=1):
         if len(out.items) >= MAX_TRACE_ERRORS:
             return
         if not raw.strip():
