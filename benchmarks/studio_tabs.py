@@ -9,7 +9,10 @@ starts in the arena) and plays them all as fast as they go, then measures how lo
 closes every tab. The studio serves at most ``tablebot.web.app.MAX_TABS`` tabs at once: the others are
 turned away (counted). Memory is given as the size with the tabs open and after they closed, against the
 size after the first tab (the baseline): "given back" is the share of what the tabs took that the studio
-returned once they were gone.
+returned once they were gone, and the size after each round says whether it keeps growing.
+
+The studio is the ``tablebot`` the interpreter imports: ``PYTHONPATH=<another tree>/src`` measures that
+tree's (an older studio serves every tab: run it the same way to compare).
 """
 
 from __future__ import annotations

@@ -35,6 +35,7 @@ MAX_MESSAGE_BYTES = 2 * 1024 * 1024  # an edit is a cell; a whole table is at mo
 #: Tabs one studio serves at once, each with its own live robot (a thread): 60 made a new request wait 20 s.
 #: More than a pupil opens; one more is told why (benchmarks/studio_tabs.py measures a full studio).
 MAX_TABS = 8
+TIDY_AFTER_S = 0.25  # tabs closing together (a window of them) go within this; their memory goes back at once
 #: Scripts and styles only from this server; nothing from the internet.
 CSP = ("default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
        "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
@@ -50,7 +51,7 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
     at most ``max_tabs`` tabs at once; ``visited`` is set when a page comes with the token in its address."""
     workspace = Workspace(root)
     hub = Hub()
-    doors = Doors(max_tabs)
+    tabs = Tabs(max_tabs)
 
     async def index(request: Request) -> Response:
         response = FileResponse(STATIC / "index.html", headers={"Content-Security-Policy": CSP,
@@ -92,8 +93,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
 
     async def socket(websocket: WebSocket) -> None:
         await websocket.accept()
-        if len(hub.sessions) >= doors.most:
-            await doors.turn_away(websocket)
+        if len(hub.sessions) >= tabs.most:
+            await tabs.turn_away(websocket)
             return
         lock = asyncio.Lock()
 
@@ -123,9 +124,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
         finally:
             ticker.cancel()
             hub.sessions.discard(session)
-            doors.told = False  # a place came free: the next tab turned away is said again
             await asyncio.to_thread(session.close)
-            await asyncio.to_thread(give_back_memory)
+            await tabs.gone()
 
     routes = [Route("/", index), Route("/api/config", config), Route("/api/trace", upload_trace, methods=["POST"]),
               WebSocketRoute("/ws", socket), Mount("/static", StaticFiles(directory=STATIC), name="static")]
@@ -138,12 +138,31 @@ def _of_bytes(got: int, announced: str | None) -> str:
 
 
 @dataclass
-class Doors:
-    """How many tabs a studio serves at once (each has a live robot: a thread), and whether the terminal has
-    been told of a tab turned away since a place last came free (one line, not one per tab)."""
+class Tabs:
+    """How many tabs a studio serves at once (each has a live robot: a thread), whether the terminal has
+    been told of a tab turned away since a place last came free (one line, not one per tab), and whether
+    the memory of tabs that went is about to be given back."""
 
     most: int
     told: bool = False
+    tidying: bool = False
+
+    async def gone(self) -> None:
+        """A tab went: a place is free, and the memory it used goes back to the system."""
+        self.told = False
+        await self.tidy()
+
+    async def tidy(self) -> None:
+        """Give back the memory of connections that closed: once for those that close together (a browser
+        window of tabs), since it holds every thread for a moment."""
+        if self.tidying:
+            return
+        self.tidying = True
+        try:
+            await asyncio.sleep(TIDY_AFTER_S)
+        finally:
+            self.tidying = False
+        await asyncio.to_thread(give_back_memory)
 
     async def turn_away(self, websocket: WebSocket) -> None:
         """The page shows why in its banner: an error, answered to every message (the socket stays open,
@@ -161,6 +180,7 @@ class Doors:
                 await websocket.send_text(refusal)
         except (WebSocketDisconnect, RuntimeError, OSError):  # the tab went while being told
             pass
+        await self.tidy()
 
 
 async def _answer(session: Session, text: str) -> None:

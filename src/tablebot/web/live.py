@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import gc
 import math
 import threading
 import time
@@ -261,9 +262,12 @@ class LiveRun:
 
 
 def give_back_memory() -> None:
-    """Hand the memory a closed tab's live robot freed back to the system. glibc keeps what its threads freed
-    in per-thread pools, so a studio's size stayed at its peak after the tabs went (benchmarks/studio_tabs.py
-    measures it); ``malloc_trim`` returns the free pages. Without glibc (macOS, Windows, musl): nothing to do."""
+    """Hand the memory closed tabs used back to the system. Their connections leave reference cycles that
+    only a full collection frees, and Python runs one rarely in a process with as many objects as the
+    studio (it grew by some 60 KB a connection, never given back: benchmarks/studio_tabs.py); then glibc
+    keeps what was freed in its pools, and ``malloc_trim`` returns the free pages (without glibc: nothing
+    to do). A full collection holds every thread for tens of milliseconds: once for tabs that close together."""
+    gc.collect()
     trim = _malloc_trim()
     if trim is not None:
         trim(0)
