@@ -190,3 +190,17 @@ def test_only_firmware_needs_a_toolchain_and_it_says_how_to_get_it_on_each_syste
                    "Windows unpack Microchip's AVR 8-bit Toolchain"):
         assert system in said, said
     assert not list(installed.work.glob("firmware/**/*.hex"))
+
+
+def test_uv_tool_install_from_the_checkout_puts_a_working_tablebot_on_path(tmp_path: Path) -> None:
+    tools, bin_dir = tmp_path / "tools", tmp_path / "bin"
+    env = {key: value for key, value in os.environ.items() if key not in ("VIRTUAL_ENV", "PYTHONPATH")}
+    env |= {"UV_TOOL_DIR": str(tools), "UV_TOOL_BIN_DIR": str(bin_dir)}
+    run(UV, "tool", "install", "--quiet", "--python", sys.executable, "--constraints",
+        ROOT / "requirements" / "user.lock", ROOT, env=env)
+    user = {**env, "PATH": str(bin_dir), "HOME": str(tmp_path), "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    work = tmp_path / "work"
+    shutil.copytree(EXAMPLE, work / "bumberbot")
+    checked = subprocess.run(["tablebot", "check", "bumberbot"], cwd=work, env=user, capture_output=True, text=True,
+                             timeout=120)
+    assert checked.returncode in (0, 1) and "0 errors" in checked.stdout, checked.stderr
