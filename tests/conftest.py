@@ -37,7 +37,7 @@ REALTIME = {"test_txt_robot", "test_pace", "test_roboif", "test_robotx", "test_r
             "test_txt4_softxt", "test_txt4_upload", "test_rules", "test_docs_controllers"}
 #: Modules that drive Chromium: one browser at a time (one xdist worker), beside the other worker's tests.
 BROWSER = {"test_studio_browser", "test_studio_attacks", "test_studio_drafts", "test_diagram_without_graphviz",
-           "test_studio_shared_pc"}
+           "test_studio_shared_pc", "test_studio_tabs"}
 #: Modules that run no simulator kernel (measured: run alone on an empty numba cache, they compile nothing, or only
 #: a small function of their own in seconds: the batch engine, the trace writer, a noise filler). They run first,
 #: while the kernels compile; a module wrongly listed here is not wrong, only slow (it compiles the kernels itself),

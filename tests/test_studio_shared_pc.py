@@ -1,4 +1,4 @@
-"""The studio on a shared school computer (issue 33, section 3; two items of section 4), tested with the real
+"""The studio on a shared school computer (issue 33, section 3; the cut upload of section 4), tested with the real
 command as a user runs it, a real second web server on another loopback port and a real Chromium.
 
 * No process's command line holds the token: the studio opens the browser on a private file (0600, in a
@@ -10,7 +10,6 @@ command as a user runs it, a real second web server on another loopback port and
   the page in.
 * ``--verbose`` logs show a token as ``[token]`` however it is percent-encoded.
 * An upload cut off mid-body is one line in the terminal, not a traceback.
-* A studio serves a bounded number of tabs: one more is told why, in the page and in the terminal.
 """
 
 from __future__ import annotations
@@ -28,22 +27,17 @@ import threading
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Callable, Iterator
-from contextlib import ExitStack
+from collections.abc import Iterator
 from dataclasses import dataclass
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 
 import pytest
-from websockets.sync.client import ClientConnection, connect
 
 from core_helpers import EXAMPLE
+from studio_helpers import chromium, studio_works, wait_for
 from tablebot.web.app import Background
-
-CHROMIUM = Path("/usr/bin/chromium")
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
 
 
 @pytest.fixture(scope="module")
@@ -51,14 +45,6 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("shared-pc") / "bot"
     shutil.copytree(EXAMPLE, root)
     return root
-
-
-def wait_for(condition: Callable[[], Any], what: str, timeout: float = 60) -> Any:
-    deadline = time.monotonic() + timeout
-    while not (found := condition()):
-        assert time.monotonic() < deadline, f"timed out waiting for {what}"
-        time.sleep(0.02)
-    return found
 
 
 # --- the command as a process, with a stand-in browser ---------------------------------------------------
@@ -309,21 +295,7 @@ def planter(studio: Background) -> Iterator[str]:
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    if not CHROMIUM.exists():
-        if os.environ.get("CI"):  # CI runs scripts/bootstrap.sh, which installs it: missing there is a failure
-            raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-        pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
-    sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
-    with sync_api.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
-        yield chromium
-        chromium.close()
-
-
-def _studio_works(page: Any) -> None:
-    """The studio's page fetched its config and talks over its WebSocket: the table and the robot are up."""
-    page.wait_for_selector("#play:not([disabled])", timeout=20_000)
-    assert page.locator("#banner").is_hidden() or "stopped" not in page.locator("#banner").inner_text()
+    yield from chromium()
 
 
 def test_a_cookie_planted_from_another_port_does_not_lock_the_user_out(browser: Any, studio: Background,
@@ -331,7 +303,7 @@ def test_a_cookie_planted_from_another_port_does_not_lock_the_user_out(browser: 
     context = browser.new_context()
     page = context.new_page()
     page.goto(studio.url)
-    _studio_works(page)
+    studio_works(page)
     page.goto(planter)
     page.wait_for_function("() => window.planted")
     mine = [c for c in context.cookies() if c["name"] == studio.access.cookie]
@@ -339,7 +311,7 @@ def test_a_cookie_planted_from_another_port_does_not_lock_the_user_out(browser: 
     assert [c["value"] for c in mine if c["path"] == "/"] == [studio.access.token]  # HttpOnly: not replaced
     assert studio.access.token not in page.inner_text("body")  # nor read by the page's script
     page.goto(studio.origin + "/")  # the user comes back to the studio (no token in the address)
-    _studio_works(page)
+    studio_works(page)
     context.close()
 
 
@@ -350,81 +322,7 @@ def test_the_private_file_opened_in_chromium_leads_to_the_studio(browser: Any, c
     assert opened.startswith("file://")
     page.goto(opened)
     page.wait_for_url(f"http://127.0.0.1:{command.port}/**")
-    _studio_works(page)
+    studio_works(page)
     assert "token" not in page.url
     assert f"tablebot-studio-{command.port}" in {c["name"] for c in context.cookies()}
     context.close()
-
-
-# --- a bounded number of tabs ----------------------------------------------------------------------------
-
-def _tab(tabs: ExitStack, server: Background, wait: bool = False) -> ClientConnection | None:
-    """A tab that opened the table (the page's WebSocket, closed with ``tabs``), once its robot is up;
-    ``wait``: None if it was turned away."""
-    ws = tabs.enter_context(connect(server.origin.replace("http", "ws") + "/ws", additional_headers=server.headers,
-                                    max_size=2**24))
-    ws.send(json.dumps({"op": "open", "path": "table.csv"}))
-    while (reply := json.loads(ws.recv(20)))["type"] not in ("arena", "error"):
-        pass
-    if wait and reply["type"] == "error":
-        ws.close()
-        return None
-    assert reply["type"] == "arena", reply
-    return ws
-
-
-def _refused(server: Background) -> dict[str, Any]:
-    """The studio's first answer to a tab that asks for the table (and the same to its next message)."""
-    with connect(server.origin.replace("http", "ws") + "/ws", additional_headers=server.headers) as ws:
-        ws.send(json.dumps({"op": "open", "path": "table.csv"}))
-        reply: dict[str, Any] = json.loads(ws.recv(20))
-        if reply["type"] == "error":
-            ws.send(json.dumps({"op": "files"}))  # the connection stays: every message gets the same answer
-            assert json.loads(ws.recv(20)) == reply
-        return reply
-
-
-def test_one_tab_more_than_the_studio_serves_is_told_why(folder: Path, caplog: pytest.LogCaptureFixture) -> None:
-    server = Background(folder, "table.csv", max_tabs=3)
-    try:
-        with caplog.at_level("WARNING", logger="tablebot.studio"), ExitStack() as tabs:
-            first, *_ = [_tab(tabs, server) for _ in range(3)]
-            assert first is not None
-            reply = _refused(server)
-            assert _refused(server) == reply  # the terminal is told once, not once per tab
-            first.close()  # a place comes free once the studio has seen the tab go (the next moment)
-            wait_for(lambda: _tab(tabs, server, wait=True), "a place to come free", timeout=10)
-    finally:
-        server.stop()
-    assert reply == {"type": "error", "op": "", "message": "this studio already has 3 tabs open, the most it "
-                     "serves at once: close one of them, then reload this tab"}
-    said = [r.getMessage() for r in caplog.records if r.name == "tablebot.studio"]
-    assert said == ["refused a tab: 3 tabs are open already, the most one studio serves at once (close one of "
-                    "them in the browser)"], said
-
-
-def test_the_refused_tab_shows_why_in_the_page(browser: Any, folder: Path) -> None:
-    server = Background(folder, "table.csv", max_tabs=1)
-    context = browser.new_context()
-    try:
-        first = context.new_page()
-        first.goto(server.url)
-        _studio_works(first)
-        second = context.new_page()
-        second.goto(server.origin + "/")
-        second.wait_for_selector("#banner:not([hidden])")
-        assert second.inner_text("#banner").startswith("this studio already has 1 tab open, the most it serves at "
-                                                       "once: close one of them, then reload this tab")
-        first.close()  # the place comes free once the studio has seen the tab go (the next moment)
-        wait_for(lambda: _reloaded(second), "the reloaded tab to be served", timeout=20)
-        _studio_works(second)
-    finally:
-        context.close()
-        server.stop()
-
-
-def _reloaded(page: Any) -> bool:
-    """Reload the page: whether the studio served it this time."""
-    page.reload()
-    page.wait_for_selector("#play:not([disabled]), #banner:not([hidden])")
-    return page.locator("#banner").is_hidden() or "already has" not in page.inner_text("#banner")
