@@ -87,3 +87,18 @@ def test_a_step_that_ends_within_the_delay_says_nothing_and_a_longer_one_is_talk
     talking.done()
     lines = slow.getvalue().splitlines()
     assert lines[0] == "loading (why)" and lines[1].startswith("  still loading: ") and lines[-1] == "loaded in 0 s"
+
+
+def test_a_sim_refused_before_its_run_leaves_no_notice_talking(tmp_path: Path) -> None:
+    import threading
+
+    from typer.testing import CliRunner
+
+    from tablebot.cli import app
+
+    blocker = tmp_path / "a file"
+    blocker.write_text("not a folder", encoding="utf-8")
+    example = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
+    result = CliRunner().invoke(app, ["sim", str(example), "--out", str(blocker), "--seconds", "1"])
+    assert result.exit_code == 2, result.output
+    assert not [t for t in threading.enumerate() if t.name == "talking"]

@@ -46,8 +46,12 @@ def sim_cmd(
         from tablebot.sim.animate import check_display
         check_display()
     project = open_project(table, robot)
-    run = project.simulate(seconds, seed, world=world, battery=charge, out=out, plots=plots, gif=gif, html=html,
-                           every_row=view, progress=TickBar(quiet))
+    bar = TickBar(quiet)
+    try:
+        run = project.simulate(seconds, seed, world=world, battery=charge, out=out, plots=plots, gif=gif, html=html,
+                               every_row=view, progress=bar)
+    finally:
+        bar.loading.done(finished=False)  # a refusal before the run (a bad --out) ends the loading notice too
     if not run.complete:
         _stopped(run)
     if not quiet:
