@@ -22,7 +22,8 @@ def without_descriptor(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     yield
 
 
-def robot_on(emulator: RobotxEmulator, timeout_s: float = 0.3) -> RobotxRobot:
+def robot_on(emulator: RobotxEmulator, timeout_s: float = 1.0) -> RobotxRobot:
+    """Replies are due within ``timeout_s``: generous, as these tests run beside others on a busy machine."""
     return RobotxRobot(robotx_wiring(bumberbot("robotx")), emulator.device, link_timeout_s=timeout_s)
 
 
@@ -41,6 +42,6 @@ def test_a_run_greets_configures_and_exchanges_every_tick() -> None:
 @pytest.mark.parametrize(("fault", "says"), [("silent", "no answer"), ("hang_up", "disconnected")])
 def test_a_silent_or_vanished_device_ends_the_run_as_link_lost(fault: str, says: str) -> None:
     with RobotxEmulator(lambda n: ([0] * 8, [0] * 4), fault=(fault, 12)) as emu:
-        end = drive(bumberbot("robotx"), robot_on(emu, timeout_s=0.1), ticks=60)
+        end = drive(bumberbot("robotx"), robot_on(emu, timeout_s=0.5), ticks=60)
     assert end.reason == "link_lost" and end.ticks == 12, end
     assert says in end.message, end.message
