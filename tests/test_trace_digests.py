@@ -128,7 +128,8 @@ def sweep_case() -> str:
     d = Digest()
     for job in plan.jobs():
         done, summary = run_job(job)
-        d.text("part", [plan.part_text(done, summary)])
+        # the world column names the world file by its path: the checkout's place is no part of the bytes made
+        d.text("part", [plan.part_text(done, summary).replace(str(EXAMPLES), "EXAMPLES")])
     return d.hex()
 
 
