@@ -79,6 +79,13 @@ def _no_dir_fd(function):
 
 for name in ("open", "stat", "unlink", "remove", "rename", "replace", "mkdir", "rmdir"):
     setattr(os, name, _no_dir_fd(getattr(os, name)))
+
+import multiprocessing
+import multiprocessing.context as _contexts
+
+# processes start by spawn, as on Windows, which has no fork server (nor fork: see os.fork above)
+_contexts._concrete_contexts.pop("forkserver", None)
+multiprocessing.set_start_method("spawn", force=True)
 '''
 
 #: Modules no user command imports: test helpers (a pseudo-terminal standing in for a serial device).
@@ -168,6 +175,18 @@ def test_the_main_commands_run_without_them_in_awkward_folders(windowsish: dict[
     assert "ran 50 ticks" in ran.stdout + ran.stderr
     tablebot(windowsish, home, "sim", str(EXAMPLE), "--seconds", "5", "--out", "Läufe\\erster")  # replaces the set
     assert (run / "trace.jsonl").read_text(encoding="utf-8").count("\n") > 400
+
+
+def test_sweep_and_evolve_with_worker_processes_started_as_on_windows(windowsish: dict[str, str],
+                                                                      tmp_path: Path) -> None:
+    """evolve's provers are processes: from a fork server on POSIX, spawned on Windows (which has none)."""
+    home = tmp_path / "Schüler Arbeit"
+    home.mkdir()
+    tablebot(windowsish, home, "sweep", str(EXAMPLE), "--robots", "8", "--seconds", "3", "--out", "Flotte")
+    assert (home / "Flotte" / "results.csv").exists()
+    tablebot(windowsish, home, "evolve", str(EXAMPLE), "--out", "Evolution", "--budget", "3", "--batch", "2",
+             "--seeds", "0..1", "--check-seeds", "10..11", "--seconds", "2", "--workers", "2", "-q")
+    assert (home / "Evolution").is_dir()
 
 
 #: The studio's file access where no function takes dir_fd: read, list, save with a backup, a save that lost

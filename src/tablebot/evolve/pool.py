@@ -84,8 +84,8 @@ class Workers:
     """``count`` worker processes (default: one per core) knowing the property files and the starting
     table; with a count of 1 none, and tasks run here. Use as a context manager: the workers end with it.
 
-    They come from a fork server, so, as for any ``multiprocessing`` program, the main module must be
-    importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
+    They come from a fork server (spawned afresh on Windows), so, as for any ``multiprocessing`` program, the
+    main module must be importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
 
     def __init__(self, files: Sequence[Path], base: Table, count: int | None = None) -> None:
         self.count = max(1, count if count is not None else os.cpu_count() or 1)
@@ -94,9 +94,8 @@ class Workers:
         if self.count > 1:
             from concurrent.futures import ProcessPoolExecutor
 
-            spawner = multiprocessing.get_context("forkserver")
-            spawner.set_forkserver_preload(preload())  # imported once, in the fork server, not in each worker
-            self.pool = ProcessPoolExecutor(self.count, spawner, initializer=_start, initargs=(list(files), base))
+            self.pool = ProcessPoolExecutor(self.count, _spawner(), initializer=_start,
+                                            initargs=(list(files), base))
 
     def __enter__(self) -> Workers:
         return self
@@ -170,6 +169,17 @@ def _ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None
         if not queue:
             return
         yield queue.popleft()
+
+
+def _spawner() -> Any:
+    """A fork server where the system has one (POSIX): the modules the workers need are imported once, in
+    it, not in each worker. Windows has none: each worker starts as a fresh Python (spawn) and imports them."""
+    try:
+        spawner = multiprocessing.get_context("forkserver")
+    except ValueError:  # "cannot find context for 'forkserver'"
+        return multiprocessing.get_context("spawn")
+    spawner.set_forkserver_preload(preload())
+    return spawner
 
 
 def preload() -> list[str]:
