@@ -19,7 +19,7 @@ from txt_fake import FakeTxt
 
 #: The example's robot file up to its [txt] wiring (the other controllers' sections after it are not the TXT's).
 FULL = (EXAMPLE / "robot.toml").read_text(encoding="utf-8")
-ROBOT = FULL[: FULL.index("\n# The same wiring on the seed's own controllers") + 1]
+ROBOT = FULL[: FULL.index("\n# The same wiring on the document's own controllers") + 1]
 TXT_START = ROBOT.index("[txt]")
 
 
