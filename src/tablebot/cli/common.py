@@ -85,7 +85,8 @@ class Stages:
 
     def __exit__(self, *exc: object) -> None:
         self.timer.cancel()
-        self.progress.stop()
+        if self.progress.live.is_started:  # rich's stop prints an empty line off a terminal, shown or not
+            self.progress.stop()
 
 
 def print_diagnostic(d: Diagnostic) -> None:
