@@ -58,12 +58,31 @@ def run_page(doc: str, folder: Path) -> list[str]:
             edit(folder)
         if command.argv[0] == "studio":
             problem = studio_serves(command, folder)
+        elif command.argv == ["--install-completion"]:
+            problem = completion_installs(folder)
         else:
             result = run(command.argv, env=command.env or None)
             problem = "" if result.exit_code == 0 else f"exit {result.exit_code}: {result.output[-600:]}"
         if problem:
             failed.append(f"{command}: {problem}")
     return failed
+
+
+def completion_installs(folder: Path) -> str:
+    """`tablebot --install-completion` writes into the user's shell start-up files: here into a home folder of
+    the test's own, from a bash (the shell is found among the process's parents: under make it is sh, which
+    typer does not complete for; a second command keeps bash from replacing itself with the one)."""
+    home = folder / "home"
+    home.mkdir(exist_ok=True)
+    env = {**os.environ, "HOME": str(home), "PYTHONPATH": str(ROOT / "src")}
+    tablebot = Path(sys.executable).parent / "tablebot"  # the command as installed: its name is what completes
+    done = subprocess.run(["bash", "-c", f"'{tablebot}' --install-completion; exit $?"], cwd=folder, env=env,
+                          capture_output=True, text=True, timeout=60)
+    if done.returncode != 0:
+        return f"exit {done.returncode}: {(done.stdout + done.stderr)[-600:]}"
+    script = home / ".bash_completions" / "tablebot.sh"
+    sourced = (home / ".bashrc").read_text(encoding="utf-8") if (home / ".bashrc").exists() else ""
+    return "" if script.exists() and str(script) in sourced else f"no completion installed: {done.stdout}"
 
 
 def studio_serves(command: Command, folder: Path) -> str:
