@@ -12,6 +12,7 @@ waiting, each with the time left as its timeout (:data:`FD_IO` False).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import select
 import time
@@ -211,9 +212,21 @@ class SerialPort:
             raise LinkLost(f"no answer from {self.device}: expected {what}")
 
     def _lost(self, exc: OSError | serial.SerialException) -> LinkLost:
-        if "returned no data" in str(exc):  # pyserial: readable, yet nothing: the other end hung up
+        if "returned no data" in str(exc) or _hung_up(exc):  # pyserial: readable, yet nothing: the other end hung up
             return LinkLost(f"{self.device} was disconnected")
         return LinkLost(f"lost {self.device}: {getattr(exc, 'strerror', None) or exc} (was it unplugged?)")
+
+
+def _hung_up(exc: BaseException) -> bool:
+    """EIO on the port or on configuring it (pyserial wraps termios' error, which is no OSError): a USB adapter
+    pulled out, or a pty whose other end closed."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        termios_eio = seen.args[:1] == (errno.EIO,) and not isinstance(seen, OSError)
+        if getattr(seen, "errno", None) == errno.EIO or termios_eio:
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 def _reason(exc: BaseException) -> str:
