@@ -13,6 +13,7 @@ from pathlib import Path
 from types import ModuleType
 
 from tablebot.jit import USUALLY, Compiling
+from tablebot.loop import TickBlock
 from tablebot.talk import SPINNER, Talking
 
 KERNEL = '''
@@ -102,3 +103,62 @@ def test_a_sim_refused_before_its_run_leaves_no_notice_talking(tmp_path: Path) -
     result = CliRunner().invoke(app, ["sim", str(example), "--out", str(blocker), "--seconds", "1"])
     assert result.exit_code == 2, result.output
     assert not [t for t in threading.enumerate() if t.name == "talking"]
+
+
+FIRST_SHORT_RUN = """
+import pickle, sys
+from pathlib import Path
+from tablebot import jit
+jit.install_cache_files(pickle.loads(Path(sys.argv[1]).read_bytes()))
+sys.argv = ["tablebot", "sim", sys.argv[2], "--seconds", "120", "--no-plots", "-q", "--out", sys.argv[3]]
+from tablebot.cli import main
+main()
+"""
+
+
+def test_a_first_short_run_writes_its_trace_in_python_rather_than_compile_the_trace_writer(tmp_path: Path) -> None:
+    """make demo's run (120 s, 12,000 ticks) on a cache holding the simulator but not the trace writer's
+    compiled lines: the trace is written by Python (0.04 s) instead of compiling them (4-7 s), byte for byte
+    what the compiled lines write."""
+    import os
+    import pickle
+    import subprocess
+
+    import tablebot
+    from tablebot import jit
+    from tablebot.sim.runner import simulate
+    from tablebot.sinks.trace_file import block_views_of
+    from tablebot.testing.processes import child_env
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "bumberbot"
+    files = {source: found for source, found in jit.cache_files().items() if source != "sinks/trace_text.py"}
+    (tmp_path / "compiled.pickle").write_bytes(pickle.dumps(files))
+    cache = tmp_path / "numba"
+    env = child_env(NUMBA_CACHE_DIR=str(cache))
+    done = subprocess.run([sys.executable, "-c", FIRST_SHORT_RUN, str(tmp_path / "compiled.pickle"), str(example),
+                           str(tmp_path / "out")], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert not list(cache.rglob("trace_text._lines-*.nbi")), "the trace writer's lines were compiled"
+    written = (tmp_path / "out" / "trace.jsonl").read_bytes()
+
+    blocks: list[TickBlock] = []
+
+    class Keep:
+        def start(self, info: object) -> None:
+            pass
+
+        def block(self, block: TickBlock) -> None:
+            blocks.append(block)
+
+        def end(self, end: object) -> None:
+            pass
+
+    scene = tablebot.open(example).scene(None, {})
+    simulate(scene, 120, 1, sinks=[Keep()])
+    compiled = b""
+    for block in blocks:
+        views = block_views_of(block, scene.machine, {}, compiled=True)
+        assert isinstance(views, list)  # the compiled lines made these
+        compiled += b"".join(views)
+    assert written == compiled
+    assert os.path.getsize(tmp_path / "out" / "trace.jsonl") > 1_000_000

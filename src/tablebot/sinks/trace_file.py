@@ -19,6 +19,11 @@ from tablebot.machine import Machine
 
 #: Ticks from which a simulator's block is written by compiled code (sinks.trace_text), not by Python.
 COMPILED_FROM = 256
+#: A run of this many ticks (or one with no planned end) has its trace written by compiled code even when that
+#: code is not compiled yet: Python takes 1.4 s for an hour at 10 ms, the compiled code 0.4 s, and compiling it
+#: 4-7 s once (then it is in numba's cache). A shorter first run (make demo's two minutes: 0.04 s in Python)
+#: is written by Python rather than wait for the compile; the bytes are the same either way.
+COMPILE_FOR_TICKS = 100_000
 
 
 def block_text(block: TickBlock, machine: Machine) -> str:
@@ -36,14 +41,19 @@ def block_bytes_of(block: TickBlock, machine: Machine) -> bytes | str:
 
 
 def block_views_of(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray],
-                   helper: Executor | None = None) -> list[memoryview] | str:
+                   helper: Executor | None = None, compiled: bool = True) -> list[memoryview] | str:
     """:func:`block_bytes_of` as the views of ``scratch``'s memory the compiled code made (see
-    trace_text.block_views), or as text when Python made it."""
-    if len(block) >= COMPILED_FROM and hasattr(block.extra, "number_columns"):
+    trace_text.block_views), or as text when Python made it (always, when not ``compiled``)."""
+    if compiled and compiled_block(block):
         views = _compiled_text(block, machine, scratch, helper)
         if views is not None:
             return views
     return "".join(_python_lines(block, machine))
+
+
+def compiled_block(block: TickBlock) -> bool:
+    """Whether compiled code can write ``block``: a long block of the simulator's."""
+    return len(block) >= COMPILED_FROM and hasattr(block.extra, "number_columns")
 
 
 def block_lines(block: TickBlock, machine: Machine) -> list[str]:
@@ -144,9 +154,12 @@ class TraceFile:
         self._failed: BaseException | None = None
         self._scratch: dict[str, np.ndarray] = {}  # the formatting's arrays, reused block after block
         self._helper: ThreadPoolExecutor | None = None
+        self._ticks: int | None = None
+        self._compiled: bool | None = None  # compiled code writes this run's long blocks (decided at the first)
 
     def start(self, info: RunInfo) -> None:
         self.machine = info.engine.machine
+        self._ticks = info.ticks
         self.file = PendingFile(self.path)
         if self.background:
             self._queue = queue.Queue(maxsize=4)  # bounded: memory stays a few blocks whatever the disk does
@@ -162,8 +175,21 @@ class TraceFile:
             raise self._failed
         self._queue.put(block)
 
+    def _use_compiled(self) -> bool:
+        """Whether compiled code writes this run's long blocks: when numba has it in its cache, or when the
+        run is long enough to be worth compiling it for (:data:`COMPILE_FOR_TICKS`)."""
+        if self._compiled is None:
+            from tablebot import jit
+            from tablebot.sinks.trace_text import _lines
+
+            long = self._ticks is None or self._ticks >= COMPILE_FOR_TICKS
+            self._compiled = long or jit.compiled(_lines)
+        return self._compiled
+
     def _write(self, block: TickBlock) -> None:
-        text, stream = block_views_of(block, self.machine, self._scratch, self._helper), self.file.stream
+        compiled = compiled_block(block) and self._use_compiled()  # a controller's blocks never import numba
+        text = block_views_of(block, self.machine, self._scratch, self._helper, compiled)
+        stream = self.file.stream
         if isinstance(text, str):
             stream.write(text)
         elif _utf8_as_written(stream):  # past the text layer (flushed) as it is
