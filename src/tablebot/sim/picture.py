@@ -8,7 +8,7 @@ import io
 import struct
 import zlib
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, cast
+from typing import IO, TYPE_CHECKING, Any, TypeAlias, cast
 
 import matplotlib
 import matplotlib.image
@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a
     from tablebot.sim.summary import Summary
     from tablebot.sim.view import RunView, SceneView
 
-    Run = SimRun | RunView
+    Run: TypeAlias = SimRun | RunView  # declared: mypy may take a union of classes not yet seen for a value
 
 DPI = 150
 #: zlib's fastest level: the same pixels as Pillow's default (6) in two thirds of the time, files ~25 % larger
