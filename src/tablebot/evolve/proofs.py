@@ -150,13 +150,6 @@ class Prover:
         return Verdict(False, ("zero-time-loop",)) if stuck else Verdict(True)
 
 
-def verdict_of(report: CheckReport) -> Verdict:
-    """Kept only when every property holds (whatever its level) and no finding is an error."""
-    failed = [r.prop.name for r in report.results if r.status != "holds"]
-    failed += [f.code for f in report.findings if f.severity == "error"]
-    return Verdict(not failed, tuple(dict.fromkeys(failed)))
-
-
 LINE_WORD = re.compile(r"(?<![\w.-])line(?![\w.-])")  # the condition language's ``line`` (conditions.TOKEN_RE)
 
 

@@ -147,16 +147,6 @@ class SerialPort:
             raise LinkLost(f"{self.device} was disconnected")
         return chunk
 
-    def drain(self, quiet_s: float, deadline: float) -> int:
-        """Read and drop bytes until none came for ``quiet_s`` (or ``deadline``); how many were dropped."""
-        dropped = 0
-        while time.monotonic() < deadline:
-            try:
-                dropped += len(self.read_some(4096, min(deadline, time.monotonic() + quiet_s), "quiet"))
-            except LinkLost:
-                break
-        return dropped
-
     # --- without a file descriptor (Windows) -----------------------------------------------------------
 
     def _write_portable(self, deadline: float) -> None:

@@ -12,16 +12,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError
 from tablebot.robopro.lists import NEXT_WEIGHT, number_states
 from tablebot.robopro.wiring import Wiring, wiring
 from tablebot.robot import StateId
 from tablebot.table import DOC_KEEP_SPEED, TIMER_EVENT, Row, Table, to_direction_speed
-
-if TYPE_CHECKING:
-    from tablebot.machine import Machine
 
 MAX_VALUE = 32767  # ROBO Pro integers are 16-bit signed
 MAX_MOTORS = 2  # the document's action word
@@ -201,11 +197,6 @@ def _row_problems(table: Table, out: Collector) -> None:
     if numbers[table.robot.initial_state] > max_state:
         out.error(1, 1, f"initial state {table.robot.initial_state!r} is number {numbers[table.robot.initial_state]},"
                   f" over {max_state}", "number the states lower")
-
-
-def machine_problems(machine: Machine) -> list[Diagnostic]:
-    """``check --target robopro-program``: :func:`problems` of the machine's table."""
-    return problems(machine.table)
 
 
 def plan(table: Table, rule: str | None = None) -> Plan:

@@ -13,7 +13,7 @@ import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from tablebot.escape import xml_attr, xml_text
+from tablebot.escape import xml_attr
 
 FLAGS = " selectable visible draggable shadow filled snap"
 WIRE_FLAGS = " selectable visible shadow filled snap"
@@ -268,6 +268,3 @@ def new_guid(seed: str) -> str:
     """A stable GUID per subprogram name: the same table gives the same file."""
     return str(uuid.uuid5(uuid.NAMESPACE_URL, "tablebot-robopro:" + seed))
 
-
-def text_node(tag: str, text: str) -> str:
-    return f"<{tag}>{xml_text(text)}</{tag}>"
