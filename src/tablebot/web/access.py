@@ -1,22 +1,24 @@
 """Who may talk to the studio: only the page it served. Every HTTP request and WebSocket upgrade passes
 :class:`Gate`, which answers 403 before any route runs unless the ``Host`` is a name the studio serves,
 the ``Origin`` (when the browser sends one) is the studio's own, the request was not started by another
-site, and it carries the secret token made at this start.
+site, and (except for the page's own files) it carries the secret token made at this start.
 
 The rules follow Jupyter's server (``jupyter_server/base/handlers.py``: ``check_host``, ``check_origin``,
 token login): a page on another origin cannot read or change the folder, and DNS rebinding (a foreign name
-that resolves to 127.0.0.1) meets the ``Host`` check. The token reaches the page once, in the address the
-studio prints (``/?token=...``); the page keeps it as an HttpOnly, SameSite=Strict cookie named after the
-port, and logs show it as ``[token]``, however it is percent-encoded.
+that resolves to 127.0.0.1) meets the ``Host`` check. Logs show the token as ``[token]``, however it is
+percent-encoded.
 
-What the cookie's name and scope achieve, on a machine other users' pages and servers share: browsers keep
-cookies per host name, not per port, so every server on 127.0.0.1 receives the cookie (a server on another
-port can read it from its requests; nothing a cookie can say prevents that). A *page's script* from another
-port cannot read it (HttpOnly) nor replace it (a script may not overwrite an HttpOnly cookie); what it can do
-is plant a cookie of the same name with a longer path (``path=/ws``), which the browser sends first: the
-studio therefore accepts the request if *any* cookie of its name holds the token, so a planted one neither
-locks the user out nor gets anyone in. Its requests to the studio are refused by ``Sec-Fetch-Site`` and
-``Origin`` (below), and the name carries the port, so two studios never take each other's cookie.
+Where the token lives, on a machine other users' pages and servers share: not in a cookie. Browsers keep
+cookies per host name, not per port, so a cookie of 127.0.0.1 goes to every server on 127.0.0.1 (another
+user's program on another port would read the token from its requests), and a page on another port can
+plant cookies of the same name. The token reaches the page once, in the address the studio prints
+(``/?token=...``, opened through :mod:`.launch`'s private file); the page keeps it in ``sessionStorage``
+(one per origin, that is per port, and per tab) and takes it out of the address bar and history at once.
+It sends it with every API request in the ``X-Tablebot-Token`` header and with the WebSocket as a
+subprotocol (``tablebot-token.<token>``, beside ``tablebot-studio``, the one the server accepts), so the
+gate checks it on the upgrade, before any route runs. The page itself and its scripts and styles
+(``/``, ``/static/...``) hold no secret and are served without the token; a page without one shows the
+studio's refusal, which says how to get in.
 """
 
 from __future__ import annotations
@@ -29,7 +31,6 @@ import socket
 from collections.abc import Awaitable, Callable, MutableMapping
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import parse_qs
 
 Scope = MutableMapping[str, Any]
 Message = MutableMapping[str, Any]
@@ -42,6 +43,13 @@ WILDCARDS = ("0.0.0.0", "::", "[::]")
 #: Sec-Fetch-Site values of requests the studio's own page makes (or the user typed): anything else was
 #: started by another page, even one on this machine's other ports ("same-site").
 OWN_FETCHES = ("same-origin", "none")
+#: The header that carries the token on the page's requests, and the WebSocket subprotocols: the one the
+#: server accepts (never the one holding the token, which stays out of the answer) and the token's prefix.
+TOKEN_HEADER = "x-tablebot-token"
+SUBPROTOCOL = "tablebot-studio"
+TOKEN_PROTOCOL = "tablebot-token."
+#: What the page is made of: files that hold no secret, served without the token (to GET and HEAD only).
+PUBLIC_PATHS = ("/", "/static/")
 #: Sent with every answer: no sniffing JSON as script, no framing, no address (with its token) in a Referer.
 HEADERS = [(b"x-content-type-options", b"nosniff"), (b"x-frame-options", b"DENY"),
            (b"referrer-policy", b"no-referrer")]
@@ -85,14 +93,6 @@ class Access:
         extra = {"token": token} if token else {}
         return cls(port, frozenset(names), wildcard, **extra)
 
-    @property
-    def cookie(self) -> str:
-        """The cookie's name: one per port, since browsers share cookies between a host's ports."""
-        return f"tablebot-studio-{self.port}"
-
-    def set_cookie(self) -> str:
-        return f"{self.cookie}={self.token}; HttpOnly; SameSite=Strict; Path=/"
-
     def url(self, shown: str, query: str = "") -> str:
         """The address to print and open: the studio's page with the token."""
         return f"http://{host_name(shown)}:{self.port}/?token={self.token}" + (f"&{query}" if query else "")
@@ -108,10 +108,8 @@ class Access:
             return False
         return name in self.names or (self.any_ip and _is_ip(name))
 
-    def has_token(self, cookie: str | None, query_token: str | None = None) -> bool:
-        """The token, from the page's cookie or (first visit) from the address. Any cookie of the studio's
-        name may hold it: one planted by another port's page (``path=/ws``) comes first in the header."""
-        given = [query_token] if query_token is not None else _cookie_values(cookie or "", self.cookie)
+    def has_token(self, given: list[str]) -> bool:
+        """Whether any of the tokens ``given`` (from headers, subprotocols or the address) is this start's."""
         return any(secrets.compare_digest(value.encode(), self.token.encode()) for value in given)
 
     def refusal(self, scope: Scope) -> str | None:
@@ -124,32 +122,40 @@ class Access:
         origin = headers.get("origin")
         if origin is not None and origin.lower() != f"http://{host.lower()}":
             return f"refused: a page from {origin[:100]!r} may not use this studio"
-        query_token = _first_token(scope)
-        first_visit = scope["type"] == "http" and scope.get("method") == "GET" and scope.get("path") == "/" \
-            and query_token is not None
+        public = _public(scope)
+        landing = public and scope.get("path") == "/"  # a link from anywhere may lead to the page: it holds nothing
         fetch_site = headers.get("sec-fetch-site")
-        if fetch_site is not None and fetch_site not in OWN_FETCHES and not first_visit:
+        if fetch_site is not None and fetch_site not in OWN_FETCHES and not landing:
             return f"refused: the request was started by another page ({fetch_site[:20]})"
-        if not self.has_token(headers.get("cookie"), query_token if first_visit else None):
-            return ("refused: the studio's key is missing or out of date: open the address that tablebot "
-                    "studio printed (…/?token=…); each start makes a new one")
-        return None
+        if public or self.has_token(given_tokens(scope)):
+            return None
+        return ("refused: the studio's key is missing or out of date: open the address that tablebot "
+                "studio printed (…/?token=…); each start makes a new one")
 
 
-def _cookie_values(header: str, name: str) -> list[str]:
-    """The values of every cookie called ``name`` in a Cookie header (a browser sends one per path)."""
-    values = []
-    for part in header.split(";"):
-        key, _, value = part.strip().partition("=")
-        if key == name:
-            values.append(value)
-    return values
+def _public(scope: Scope) -> bool:
+    """The page or one of its files (no secret in them), fetched, not posted."""
+    path = str(scope.get("path", ""))
+    return scope["type"] == "http" and scope.get("method") in ("GET", "HEAD") \
+        and (path == PUBLIC_PATHS[0] or path.startswith(PUBLIC_PATHS[1]))
 
 
-def _first_token(scope: Scope) -> str | None:
-    query = scope.get("query_string", b"").decode("latin-1")
-    values = parse_qs(query).get("token")
-    return values[0] if values else None
+def given_tokens(scope: Scope) -> list[str]:
+    """The tokens a request carries: every ``X-Tablebot-Token`` header, and for a WebSocket upgrade every
+    offered subprotocol ``tablebot-token.<token>`` (a browser's WebSocket can set no header)."""
+    given = []
+    for key, value in scope.get("headers", []):
+        if key.lower() == TOKEN_HEADER.encode():
+            given.append(value.decode("latin-1").strip())
+    if scope["type"] == "websocket":
+        given += [p[len(TOKEN_PROTOCOL):] for p in scope.get("subprotocols", []) if p.startswith(TOKEN_PROTOCOL)]
+    return given
+
+
+def subprotocol(scope: Scope) -> str | None:
+    """The subprotocol to accept a WebSocket with: the studio's, when the page offered it (a browser fails a
+    connection whose offered subprotocols the server ignores), else none."""
+    return SUBPROTOCOL if SUBPROTOCOL in scope.get("subprotocols", []) else None
 
 
 class Gate:

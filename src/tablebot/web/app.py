@@ -22,7 +22,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
 from tablebot.escape import terminal
-from tablebot.web.access import Access, Gate, hide_token_in_logs
+from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.live import give_back_memory
 from tablebot.web.session import Hub, Session
@@ -56,10 +56,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
     async def index(request: Request) -> Response:
         response = FileResponse(STATIC / "index.html", headers={"Content-Security-Policy": CSP,
                                                                 "Cache-Control": "no-store"})
-        if access.has_token(None, request.query_params.get("token")):  # the first visit: the page keeps it
-            response.headers.append("Set-Cookie", access.set_cookie())
-            if visited is not None:
-                visited.set()
+        if visited is not None and access.has_token(request.query_params.getlist("token")):
+            visited.set()  # the browser came with the token (the page keeps it; the server sets no cookie)
         return response
 
     async def config(request: Request) -> Response:
@@ -92,7 +90,7 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
         return JSONResponse({"type": "trace", "name": name, "columns": trace_columns(lines)})
 
     async def socket(websocket: WebSocket) -> None:
-        await websocket.accept()
+        await websocket.accept(subprotocol(websocket.scope))  # the page's key was checked by the gate
         if len(hub.sessions) >= tabs.most:
             await tabs.turn_away(websocket)
             return
@@ -230,7 +228,8 @@ def server(app: Gate, access: Access, log_level: str = "warning") -> uvicorn.Ser
 
 class Background:
     """The studio served from a thread (tests, benchmarks): ``url`` (with its token) while running,
-    ``origin`` and ``headers`` (what its own page would send) for other clients, :meth:`stop` to end."""
+    ``origin`` and ``headers`` (what its own page sends: its Origin and token header) for other clients,
+    :meth:`stop` to end."""
 
     def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
                  log_level: str = "warning", max_tabs: int = MAX_TABS) -> None:
@@ -243,7 +242,7 @@ class Background:
         self.access = Access.serving(host, self.sock.getsockname()[1])
         self.origin = f"http://{host}:{self.access.port}"
         self.url = self.access.url(host)
-        self.headers = {"Origin": self.origin, "Cookie": f"{self.access.cookie}={self.access.token}"}
+        self.headers = {"Origin": self.origin, TOKEN_HEADER: self.access.token}
         self.server = server(create_app(root, self.access, table, max_tabs), self.access, log_level)
         self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]}, daemon=True)
         self.thread.start()

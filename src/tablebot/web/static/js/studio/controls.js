@@ -1,5 +1,6 @@
 // What the page's own buttons, menus and keys do: each sends a message or changes the store.
 import { all, byId } from "../lib/dom.js";
+import { api } from "../lib/key.js";
 
 const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 
@@ -48,7 +49,7 @@ function wireTraces(send, receive) {
   on("trace-file", "change", async (e) => {
     const file = e.target.files[0];
     if (!file) return;
-    const reply = await fetch("/api/trace?name=" + encodeURIComponent(file.name), { method: "POST", body: file });
+    const reply = await api("/api/trace?name=" + encodeURIComponent(file.name), { method: "POST", body: file });
     const json = (reply.headers.get("content-type") || "").startsWith("application/json");
     receive(json ? await reply.json() : { type: "error", message: await reply.text() });
   });

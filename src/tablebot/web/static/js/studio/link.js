@@ -1,7 +1,7 @@
 // The page's one WebSocket to the studio server, reconnected when it drops. Messages sent before it first
 // opens wait in a queue; messages sent while it is down are dropped (the edits among them are in the page's
-// draft, offered back once it is up again). The token travels in the page's HttpOnly cookie, never in the
-// address or a message.
+// draft, offered back once it is up again). The studio's key goes with each connection (../lib/key.js).
+import { socketTo } from "../lib/key.js";
 import { stats } from "./stats.js";
 
 const RETRY_MS = [1000, 2000, 4000, 8000];  // then every 10 s
@@ -20,7 +20,7 @@ export function createLink() {
   function open(hello, receive, { down, up }) {
     let tries = 0;
     const connect = () => {
-      const socket = link.socket = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+      const socket = link.socket = socketTo("/ws");
       socket.addEventListener("open", () => {
         const again = link.opened;
         const first = hello(again);

@@ -1,4 +1,5 @@
 // The studio page: one store, one WebSocket, the views and panels wired to them.
+import { api } from "../lib/key.js";
 import { createStore } from "../lib/store.js";
 import { wirePlayerControls, wireZoom } from "../views/player.js";
 import { banner } from "./banner.js";
@@ -35,18 +36,9 @@ function paint() {
   requestAnimationFrame(paint);
 }
 
-// The token came in the address (the server keeps it in an HttpOnly cookie): out of sight and history.
-function forgetToken() {
-  const params = new URLSearchParams(location.search);
-  if (!params.has("token")) return params;
-  params.delete("token");
-  history.replaceState(null, "", location.pathname + (params.toString() ? "?" + params : ""));
-  return params;
-}
-
 async function start() {
-  const params = forgetToken();
-  const reply = await fetch("/api/config");
+  const params = new URLSearchParams(location.search);  // without the token (../lib/key.js took it)
+  const reply = await api("/api/config");
   if (!reply.ok) { banner(await reply.text(), "bad"); return; }
   const config = await reply.json();
   store.set({ files: config, folder: config.folder });
