@@ -40,7 +40,7 @@ SETTLE_S = 2.0  # after the tabs open or close, before measuring: the live threa
 
 
 class Studio:
-    """A ``tablebot studio`` process and what its page sends (Origin, token cookie)."""
+    """A ``tablebot studio`` process and what its page sends (Origin, token header)."""
 
     def __init__(self, folder: Path) -> None:
         self.process = subprocess.Popen([sys.executable, "-m", "tablebot.cli", "studio", str(folder), "--port", "0",
@@ -51,7 +51,7 @@ class Studio:
                 raise SystemExit("the studio did not start")
         self.port, token = int(found[1]), found[2]
         self.origin = f"http://127.0.0.1:{self.port}"
-        self.headers = {"Origin": self.origin, "Cookie": f"tablebot-studio-{self.port}={token}"}
+        self.headers = {"Origin": self.origin, "X-Tablebot-Token": token}
 
     def rss_mb(self) -> float:
         status = Path(f"/proc/{self.process.pid}/status").read_text()
