@@ -29,11 +29,11 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from tablebot.analysis.check import run_check  # noqa: E402
 from tablebot.analysis.properties import find_property_files, load_properties  # noqa: E402
+from tablebot.formats.csv_document import CsvDocument  # noqa: E402
 from tablebot.formats.table_read import load_table  # noqa: E402
 from tablebot.machine import compile_table  # noqa: E402
 from tablebot.web.analyse import analyse, robot_for  # noqa: E402
 from tablebot.web.app import Background  # noqa: E402
-from tablebot.web.document import CsvDocument  # noqa: E402
 
 if TYPE_CHECKING:
     from collections.abc import Callable

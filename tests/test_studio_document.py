@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from core_helpers import EXAMPLE
 from tablebot.csvtext import split_records
 from tablebot.diagnostics import TableBotError
-from tablebot.web.document import CsvDocument
+from tablebot.formats.csv_document import CsvDocument
 
 cell_text = st.text(alphabet=st.sampled_from(list('ab1 ,;\t"\r\n=é')), max_size=6)
 

@@ -219,7 +219,7 @@ def test_a_forced_save_overwrites_only_the_version_it_was_shown(studio: Backgrou
 @pytest.mark.parametrize("typed", ["two\r\nlines", "two\rlines", "two\nlines"])
 def test_a_line_break_in_a_cell_is_one_line_break_whoever_sent_it(newline: str, typed: str) -> None:
     """A client other than the browser may send \\r\\n or \\r: the file gets one line end of its own kind."""
-    from tablebot.web.document import CsvDocument
+    from tablebot.formats.csv_document import CsvDocument
 
     doc = CsvDocument.from_text(newline.join(["description,state,next", "x,1,1", "y,1,1", ""]))
     doc.set_cell(0, 0, typed)

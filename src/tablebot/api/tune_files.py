@@ -23,7 +23,7 @@ def tuned_path(table: Path, out: Path) -> Path:
 def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Path) -> Path:
     """The input table byte for byte, but for the tuned cells (its delimiter, quoting and line ends kept)."""
     from tablebot.files import write_bytes
-    from tablebot.web.document import CsvDocument
+    from tablebot.formats.csv_document import CsvDocument
 
     source = Path(plan.table.path)
     doc = CsvDocument.from_bytes(source.read_bytes(), str(source))

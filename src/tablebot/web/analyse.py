@@ -16,12 +16,12 @@ from tablebot.analysis.check import CheckReport
 from tablebot.colours import state_colours
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
+from tablebot.formats.csv_document import CsvDocument
 from tablebot.loading import Loaded
 from tablebot.loading import robot_for as robot_for  # the robot a table file runs on, as the CLI finds it
 from tablebot.machine import NO_ROW, Machine, compile_table
 from tablebot.robot import Robot
 from tablebot.table import Table, normalise_header
-from tablebot.web.document import CsvDocument
 
 #: Column kinds the grid draws differently (see table_read.Column.kind).
 FLAG_KINDS = ("event", "dir")

@@ -6,14 +6,14 @@ from __future__ import annotations
 
 import logging
 
+# The document the studio edits refuses edits in the studio's words; its refusal is the studio's.
+from tablebot.formats.csv_document import Refused
+
+__all__ = ["INTERNAL", "Refused", "log"]
+
 #: Where the studio's own bugs are reported (the terminal that runs ``tablebot studio``).
 log = logging.getLogger("tablebot.studio")
 
 #: What the page is told about a bug; the traceback goes to the terminal, never to the page.
 INTERNAL = "internal error in the studio (the terminal running tablebot studio shows the details)"
 
-
-class Refused(ValueError):
-    """A request the studio will not carry out; ``str()`` is the sentence the page shows.
-
-    A ValueError, so that code that reads a table outside the studio treats it as bad input."""

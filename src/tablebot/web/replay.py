@@ -16,6 +16,7 @@ from typing import Any
 
 from tablebot.diagnostics import TableBotError
 from tablebot.files import write_text
+from tablebot.formats.csv_document import CsvDocument
 from tablebot.formats.table_write import format_table
 from tablebot.machine import compile_table
 from tablebot.sim.params import Params
@@ -23,7 +24,6 @@ from tablebot.sim.world import World
 from tablebot.table import Table
 from tablebot.web.analyse import columns_of, machine_json
 from tablebot.web.bundle import bundle
-from tablebot.web.document import CsvDocument
 from tablebot.web.simulate import studio_diagram
 from tablebot.web.tracefile import trace_columns
 from tablebot.web.worldview import world_json

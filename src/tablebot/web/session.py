@@ -13,9 +13,9 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import TableBotError
+from tablebot.formats.csv_document import MAX_TABLE_BYTES, CsvDocument
 from tablebot.robot import Robot
 from tablebot.web.analyse import Analysis, analyse, explain, robot_failed, robot_for
-from tablebot.web.document import MAX_TABLE_BYTES, CsvDocument
 from tablebot.web.errors import Refused, log
 from tablebot.web.simulate import Arena, ArenaSettings
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns

@@ -1,5 +1,6 @@
-"""A table file as the studio edits it: every cell keeps its exact source text, so saving writes the
-file back byte for byte except the cells that were edited (delimiter, quoting, BOM, line ends kept).
+"""A table file as the studio edits it (and ``tune``, writing its tuned table): every cell keeps its exact
+source text, so saving writes the file back byte for byte except the cells that were edited (delimiter,
+quoting, BOM, line ends kept).
 
 Cell values and (line, column) positions follow :func:`tablebot.csvtext.split_records`, so a
 diagnostic from the real parser lands on the cell the user sees.
@@ -13,7 +14,14 @@ from dataclasses import dataclass, field
 
 from tablebot.csvtext import SEP_RE, detect_delimiter, split_records
 from tablebot.diagnostics import fail
-from tablebot.web.errors import Refused
+
+
+class Refused(ValueError):
+    """An edit the document will not make; ``str()`` is the sentence a person is shown. The studio answers it
+    as its own refusal (:class:`tablebot.web.errors.Refused` is this class).
+
+    A ValueError, so that code that reads a table outside the studio treats it as bad input."""
+
 
 #: A table larger than this is not a table a person edits in a grid.
 MAX_TABLE_BYTES = 1_000_000
