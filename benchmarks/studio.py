@@ -79,7 +79,7 @@ def edit_latency(folder: Path) -> None:
 
 
 async def round_trips(server: Background) -> float:
-    """Median edit round trip, as the studio's page talks (its Origin and token cookie)."""
+    """Median edit round trip, as the studio's page talks (its Origin and token header)."""
     async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
                                   additional_headers=server.headers) as ws:
         await ws.send(json.dumps({"op": "open", "path": "table.csv"}))
