@@ -1,0 +1,298 @@
+"""Links that carry a table (``tablebot share``): the table, its robot file and its world (when it has one of
+its own), compressed into the fragment of a studio address, the part after ``#`` that a browser never sends
+to any server.
+
+A link reads ``http://127.0.0.1:8765/#share=1.PAYLOAD``: the studio's default address, ``share=``, the link
+format's version, a dot, and the payload: the files as compact JSON (a robot or world file that is a copy
+of a shipped example's is named, with its digest, instead of carried), compressed with zlib (deflate with its
+checksum, so a cut link is told from a whole one) and written in base64url without padding. The studio opens
+such a link wherever it is served (only the part from ``#share=`` on is read), and so do
+:func:`decode` and ``tablebot grade``.
+
+>>> shared = collect("examples/bumberbot")
+>>> decode(encode(shared)) == shared
+True
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import contextlib
+import functools
+import hashlib
+import json
+import re
+import tempfile
+import zlib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from tablebot.diagnostics import TableBotError, fail
+
+__all__ = ["FORMAT", "STUDIO", "Shared", "collect", "decode", "encode"]
+
+#: The link format this tablebot writes and reads: a link of another version is refused with a clear message.
+FORMAT = 1
+#: The studio's default address (``tablebot studio`` serves it): the part of a link before the fragment.
+STUDIO = "http://127.0.0.1:8765/"
+KEY = "share="
+#: A shared robot is a few KB; more than this, unpacked, is no link tablebot made (a zip bomb is refused early).
+MAX_UNPACKED = 2 * 1024 * 1024
+WORLD_NAME = "arena.toml"
+_PAYLOAD_RE = re.compile(r"[A-Za-z0-9_-]*")
+_FILE_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_. -]{0,99}$")  # a plain file name: no folder, no leading dot
+_NAME_RE = re.compile(r"[^A-Za-z0-9_. -]+")
+
+
+@dataclass(frozen=True)
+class Shared:
+    """What a link carries: a ``name`` (the folder's, or the table's when it is not ``table.csv``), the table
+    as (file name, text), the robot file as (file name, text) or None (the built-in BumberBot), and the world's
+    text or None (an empty room). The world is always written as ``arena.toml`` beside the table, where every
+    command finds it; a robot file's ``sim.world`` is made to name it."""
+
+    name: str
+    table: tuple[str, str]
+    robot: tuple[str, str] | None = None
+    world: str | None = None
+
+    def files(self) -> dict[str, str]:
+        """The files to write into a folder, by name."""
+        files = {self.table[0]: self.table[1]}
+        if self.robot is not None:
+            files[self.robot[0]] = self.robot[1]
+        if self.world is not None:
+            files[WORLD_NAME] = self.world
+        return files
+
+    def write(self, folder: Path) -> Path:
+        """Write the files into ``folder`` (it must not exist, or be empty): the folder appears whole or not at
+        all. Returns the table's path."""
+        from tablebot.files import write_text
+        from tablebot.fileset import new_folder
+
+        if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+            raise fail(folder, "this folder is not empty" if folder.is_dir() else "this is a file, not a folder",
+                       "give the name of a new folder (a shared table never writes over files)")
+        with new_folder(folder) as stage:
+            for name, text in self.files().items():
+                write_text(stage / name, text)
+        return folder / self.table[0]
+
+    def check(self, where: str = "link") -> None:
+        """Read the files as every command would (the table against its robot file, the world): a broken one
+        raises the errors, each named ``WHERE: FILE`` and with its line and column."""
+        from tablebot.api.project import open as open_robot
+
+        with tempfile.TemporaryDirectory(prefix="tablebot-share-") as tmp:
+            folder = Path(tmp) / "shared"
+            table = self.write(folder)
+            try:
+                project = open_robot(table)
+                project.default_world()
+            except TableBotError as exc:
+                raise TableBotError(replace(d, path=_renamed(d.path, folder, where)) for d in exc.diagnostics) \
+                    from None
+
+
+def _renamed(path: str, folder: Path, where: str) -> str:
+    """A diagnostic's path in the temporary folder, as the link's file name."""
+    with contextlib.suppress(ValueError):
+        return f"{where}: {Path(path).resolve().relative_to(folder.resolve()).as_posix()}"
+    return path
+
+
+def collect(path: str | Path) -> Shared:
+    """What a link for ``path`` (a folder, a table file or a robot file) carries: the files every command
+    reads for it, checked as they would be (a broken table is refused here, with its errors)."""
+    from tablebot.api.project import open as open_robot
+    from tablebot.csvtext import read_text
+
+    project = open_robot(path)
+    table = project.path
+    robot_path = Path(project.robot.source) if project.robot.source and Path(project.robot.source).is_file() \
+        else None
+    robot = None
+    if robot_path is not None:
+        robot = (_file_name(robot_path), _robot_text(robot_path, read_text(robot_path, spreadsheet=False)))
+    world_path = project.robot_world() or (table.parent / WORLD_NAME if (table.parent / WORLD_NAME).is_file()
+                                           else None)
+    world = read_text(world_path, spreadsheet=False) if world_path is not None else None
+    project.default_world()  # a broken world is refused before it is shared
+    name = table.parent.resolve().name if table.stem == "table" else table.stem
+    return Shared(_NAME_RE.sub("-", name).strip(" .-") or "shared", (_file_name(table), read_text(table)), robot,
+                  world)
+
+
+def _file_name(path: Path) -> str:
+    if not _FILE_RE.match(path.name):
+        raise fail(path, "a link carries files with plain names (letters, digits, '_', '-', '.', spaces)",
+                   "rename the file")
+    return path.name
+
+
+def _robot_text(path: Path, text: str) -> str:
+    """The robot file's text with its ``sim.world`` (if any) naming the world the link carries, arena.toml:
+    the folder a link is opened into holds the world there, whatever folder it came from."""
+    from tablebot.tomlfile import Source
+
+    src = Source.parse(path, text)
+    sim = src.data.get("sim")
+    if not isinstance(sim, dict) or "world" not in sim:
+        return text
+    number = src.line("sim", None, "world")
+    lines = text.splitlines(keepends=True)
+    if number is not None:
+        new, count = re.subn(r"""(world\s*=\s*)("[^"\n]*"|'[^'\n]*')""", rf'\g<1>"{WORLD_NAME}"', lines[number - 1],
+                             count=1)
+        if count:
+            lines[number - 1] = new
+            return "".join(lines)
+    raise fail(path, "cannot find the line of sim.world to point it at the world the link carries",
+               'write it in a [sim] section as world = "FILE.toml"', number)
+
+
+def encode(shared: Shared, base: str = STUDIO) -> str:
+    """The link carrying ``shared``: ``BASE#share=1.PAYLOAD`` (see the module). The same files always give
+    the same link."""
+    body = {"name": shared.name, "table": list(shared.table),
+            "robot": [shared.robot[0], _reference(shared.robot[1])] if shared.robot else None,
+            "world": None if shared.world is None else _reference(shared.world)}
+    packed = zlib.compress(json.dumps(body, ensure_ascii=False, separators=(",", ":")).encode("utf-8"), 9)
+    payload = base64.urlsafe_b64encode(packed).decode("ascii").rstrip("=")
+    return f"{base}#{KEY}{FORMAT}.{payload}"
+
+
+def decode(link: str, where: str = "link") -> Shared:
+    """The files a link carries (as :func:`encode` made it; anything before ``#share=`` is ignored, so a
+    link to any studio address works, and so does the bare ``share=...`` part). A link that is not one, from
+    another version of tablebot, cut short or damaged raises a :class:`~tablebot.diagnostics.TableBotError`
+    naming ``where`` (the option, or a file and line) and what to do. The files are not read as a table
+    here: :meth:`Shared.check` does that."""
+    text = link.strip()
+    at = text.find(KEY)
+    if at < 0:
+        raise fail(where, "this is not a tablebot share link: it has no '#share='",
+                   "copy the whole link that `tablebot share` printed or the studio's Share button gave")
+    version, dot, payload = text[at + len(KEY):].partition(".")
+    if not version.isdigit() or not dot:
+        raise fail(where, "this share link is damaged: its version is missing", "copy the whole link again")
+    _check_version(int(version), where)
+    bad = _PAYLOAD_RE.match(payload)
+    if bad is None or bad.end() != len(payload):
+        end = 0 if bad is None else bad.end()
+        raise fail(where, f"this share link holds a character no share link has ({payload[end]!r} at character "
+                   f"{at + len(KEY) + len(version) + 1 + end + 1})",
+                   "copy the link again whole: a chat program or e-mail may have changed or wrapped it")
+    return _unpack(_inflate(payload, where), where)
+
+
+def _check_version(version: int, where: str) -> None:
+    if version > FORMAT:
+        raise fail(where, f"this link was made by a newer tablebot (link format {version}; this one reads "
+                   f"format {FORMAT})", "update tablebot (pip install --upgrade tablebot), or ask for the files")
+    if version < FORMAT:
+        raise fail(where, f"this link was made by an older tablebot (link format {version}), which this one no "
+                   f"longer reads (it reads format {FORMAT})", "ask for a new link, or for the files")
+
+
+def _inflate(payload: str, where: str) -> bytes:
+    cut = f"this share link is cut short or damaged (its {len(payload):,} characters of contents do not unpack)"
+    hint = "copy the whole link again: it is one long line, and the end is often lost"
+    try:
+        packed = base64.urlsafe_b64decode(payload + "=" * (-len(payload) % 4))
+    except (binascii.Error, ValueError):
+        raise fail(where, cut, hint) from None
+    unpacker = zlib.decompressobj()
+    try:
+        data = unpacker.decompress(packed, MAX_UNPACKED + 1)
+    except zlib.error:
+        raise fail(where, cut, hint) from None
+    if len(data) > MAX_UNPACKED or unpacker.unconsumed_tail:
+        raise fail(where, f"this share link unpacks to more than {MAX_UNPACKED // 2**20} MB: no table is that large",
+                   "share the files instead")
+    if not unpacker.eof:
+        raise fail(where, cut, hint)
+    return data
+
+
+def _unpack(data: bytes, where: str) -> Shared:
+    broken = fail(where, "this share link unpacks, but not to a table and its files",
+                  "make it again with `tablebot share` or the studio's Share button")
+    try:
+        body = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError):
+        raise broken from None
+    if not isinstance(body, dict) or not isinstance(body.get("name"), str):
+        raise broken
+    table, robot = _pair(body.get("table"), where), _pair(body.get("robot"), where, optional=True)
+    world = body.get("world")
+    world = _shipped(world, where) if isinstance(world, dict) else world
+    if table is None or (world is not None and not isinstance(world, str)):
+        raise broken
+    if not table[0].lower().endswith((".csv", ".tsv")) or (robot and not robot[0].lower().endswith(".toml")):
+        raise fail(where, "this share link's files are not a table and a robot file",
+                   "make it again with `tablebot share`")
+    name = _NAME_RE.sub("-", body["name"]).strip(" .-")[:100] or "shared"
+    return Shared(name, table, robot, world)
+
+
+def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] | None:
+    """A (file name, text) pair of the payload; a name that is not a plain file name is refused, so that a
+    link never writes outside the folder it is opened into."""
+    if value is None and optional:
+        return None
+    if not (isinstance(value, list) and len(value) == 2 and isinstance(value[0], str)
+            and isinstance(value[1], str | dict)):
+        raise fail(where, "this share link unpacks, but not to a table and its files",
+                   "make it again with `tablebot share` or the studio's Share button")
+    name, text = value[0], _shipped(value[1], where) if isinstance(value[1], dict) else value[1]
+    if not _FILE_RE.match(name) or name == WORLD_NAME or not name.lower().endswith((".csv", ".tsv", ".toml")):
+        raise fail(where, f"this share link names a file {name!r} that no shared table has",
+                   "make it again with `tablebot share`")
+    return name, text
+
+
+# --- files tablebot ships: named, not carried --------------------------------------------------------------
+
+#: The shipped examples whose robot and world files a link names instead of carrying them (a pupil's folder
+#: made by ``tablebot new --from bumberbot`` keeps them as they are: its link carries the table alone).
+SHIPPED = ("bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider")
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+@functools.cache
+def _shipped_files() -> dict[str, str]:
+    """Each shipped robot and world file's text, by ``EXAMPLE/FILE``."""
+    from tablebot.examples import example_path
+
+    found = {}
+    for example in SHIPPED:
+        for name in ("robot.toml", WORLD_NAME):
+            path = example_path(example) / name
+            if path.is_file():
+                found[f"{example}/{name}"] = path.read_text(encoding="utf-8")
+    return found
+
+
+def _reference(text: str) -> str | dict[str, str]:
+    """A file's text, or the name and digest of the shipped file it is a copy of."""
+    for key, shipped in _shipped_files().items():
+        if shipped == text:
+            return {"example": key, "sha256": _digest(text)}
+    return text
+
+
+def _shipped(reference: dict[str, object], where: str) -> str:
+    """The text of the shipped file a link names, as the link's tablebot shipped it."""
+    key, digest = reference.get("example"), reference.get("sha256")
+    text = _shipped_files().get(key) if isinstance(key, str) else None
+    if text is None or _digest(text) != digest:
+        raise fail(where, f"this share link names tablebot's example file {key!r} as another version of tablebot "
+                   "ships it, not as this one does", "use the same version of tablebot as the link's maker, or "
+                   "ask for the files")
+    return text
