@@ -29,6 +29,7 @@ import pytest
 import websockets
 
 from core_helpers import EXAMPLE
+from tablebot.web.access import TOKEN_HEADER
 from tablebot.web.app import Background
 from tablebot.web.errors import Refused
 from tablebot.web.workspace import Kind, Workspace
@@ -108,43 +109,74 @@ def talk(server: Background, messages: list[Any], until: str, limit: int = 40) -
 
 
 def upgrade_status(server: Background, headers: dict[str, str]) -> int:
-    """The status a WebSocket upgrade with ``headers`` gets (101 when accepted), its bytes written by hand so
-    that the Host header is exactly the one given."""
+    """The status a WebSocket upgrade with ``headers`` gets (101 when accepted)."""
+    return upgrade(server, headers)[0]
+
+
+def upgrade(server: Background, headers: dict[str, str]) -> tuple[int, str | None]:
+    """The status a WebSocket upgrade with ``headers`` gets and the subprotocol accepted, its bytes written by
+    hand so that the Host header is exactly the one given."""
     lines = ["GET /ws HTTP/1.1", "Upgrade: websocket", "Connection: Upgrade", "Sec-WebSocket-Version: 13",
              "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ=="]
     headers = {"Host": f"127.0.0.1:{server.access.port}", **headers}
     lines += [f"{key}: {value}" for key, value in headers.items()]
     with socket.create_connection(("127.0.0.1", server.access.port), timeout=10) as conn:
         conn.sendall(("\r\n".join(lines) + "\r\n\r\n").encode("latin-1"))
-        status_line = conn.makefile("rb").readline().decode("latin-1")
-    return int(status_line.split()[1])
+        answer = conn.makefile("rb")
+        status = int(answer.readline().split()[1])
+        protocol = None
+        while (line := answer.readline().decode("latin-1").strip()):
+            name, _, value = line.partition(":")
+            if name.lower() == "sec-websocket-protocol":
+                protocol = value.strip()
+    return status, protocol
 
 
 # --- Host, Origin, token ------------------------------------------------------------------------------------
 
-def test_the_page_and_every_api_need_the_token(studio: Background) -> None:
+def test_every_api_needs_the_token_the_pages_files_do_not(studio: Background) -> None:
+    """The page, its scripts and styles hold no secret: served without the token, so an address without it
+    shows the studio's refusal in the page. What reads or changes the folder needs it, in its header."""
     origin_only = {"Origin": studio.origin}
-    for path in ("", "api/config", "static/js/studio/main.js", "static/studio.css"):
-        status, body = http(studio, path, origin_only)
-        assert status == 403 and b"the studio's key is missing" in body, path
-        assert http(studio, path)[0] == 200, path  # with the page's cookie
-    wrong = {**studio.headers, "Cookie": f"{studio.access.cookie}={'x' * len(studio.access.token)}"}
+    for path in ("", "static/js/studio/main.js", "static/js/lib/key.js", "static/studio.css"):
+        assert http(studio, path, origin_only)[0] == 200, path
+    status, body = http(studio, "api/config", origin_only)
+    assert status == 403 and b"the studio's key is missing" in body
+    assert http(studio, "api/config")[0] == 200  # with the page's header
+    wrong = {**studio.headers, TOKEN_HEADER: "x" * len(studio.access.token)}
     assert http(studio, "api/config", wrong)[0] == 403
-    other_port = {**studio.headers, "Cookie": f"tablebot-studio-1={studio.access.token}"}
-    assert http(studio, "api/config", other_port)[0] == 403  # the cookie is named after this studio's port
+    cookie = {"Origin": studio.origin, "Cookie": f"tablebot-studio-{studio.access.port}={studio.access.token}"}
+    assert http(studio, "api/config", cookie)[0] == 403  # the old cookie opens nothing any more
     assert http(studio, "api/trace?name=t.jsonl", origin_only, b'{"tick":0,"state":1}\n')[0] == 403
-    assert http(studio, f"api/config?token={studio.access.token}", origin_only)[0] == 403  # only / takes it
+    assert http(studio, f"api/config?token={studio.access.token}", origin_only)[0] == 403  # never from the address
+    assert http(studio, "static/js/studio/main.js", origin_only, b"x")[0] in (403, 405)  # files are only fetched
     assert upgrade_status(studio, origin_only) == 403
     assert upgrade_status(studio, studio.headers) == 101
 
 
-def test_the_first_visit_sets_an_http_only_strict_cookie(studio: Background) -> None:
+def test_a_websocket_carries_the_token_as_a_subprotocol(studio: Background) -> None:
+    """A browser's WebSocket can set no header: the page offers the token as a subprotocol beside the
+    studio's, and the server accepts the studio's (the token stays out of its answer)."""
+    token = studio.access.token
+    offer = {"Origin": studio.origin, "Sec-WebSocket-Protocol": f"tablebot-studio, tablebot-token.{token}"}
+    assert upgrade(studio, offer) == (101, "tablebot-studio")
+    other = token[:-1] + ("A" if token[-1] != "A" else "B")
+    for wrong in ("tablebot-studio, tablebot-token.", f"tablebot-studio, tablebot-token.{other}",
+                  f"tablebot-studio, {token}", "tablebot-studio"):
+        assert upgrade(studio, {**offer, "Sec-WebSocket-Protocol": wrong})[0] == 403, wrong
+    assert upgrade(studio, {**offer, "Origin": "http://127.0.0.1:1"})[0] == 403  # the Origin is checked as well
+
+
+def test_no_answer_sets_a_cookie(studio: Background) -> None:
+    """A 127.0.0.1 cookie would go to every port of 127.0.0.1: the studio sets none (the page keeps the token)."""
     request = urllib.request.Request(studio.url, headers={"Sec-Fetch-Site": "cross-site"})  # a link elsewhere
     with urllib.request.urlopen(request) as reply:
-        cookie = reply.headers["Set-Cookie"]
         assert reply.headers["Referrer-Policy"] == "no-referrer" and reply.headers["X-Frame-Options"] == "DENY"
-    assert cookie == f"{studio.access.cookie}={studio.access.token}; HttpOnly; SameSite=Strict; Path=/"
-    assert http(studio, "?token=wrong", {})[0] == 403
+        assert "frame-ancestors 'none'" in reply.headers["Content-Security-Policy"]
+        assert reply.headers.get_all("Set-Cookie") is None
+    for path in ("api/config", "static/js/lib/key.js"):
+        with urllib.request.urlopen(urllib.request.Request(f"{studio.origin}/{path}", headers=studio.headers)) as reply:
+            assert reply.headers.get_all("Set-Cookie") is None, path
 
 
 @pytest.mark.parametrize("host", ["attacker.example:{port}", "attacker.example", "127.0.0.1:1", "localhost.evil:{port}",
@@ -177,11 +209,13 @@ def test_a_foreign_origin_is_refused(studio: Background, origin: str) -> None:
 
 @pytest.mark.parametrize("site", ["same-site", "cross-site"])
 def test_a_request_another_page_started_is_refused(studio: Background, site: str) -> None:
-    """Browsers share cookies between a host's ports: a page on 127.0.0.1:OTHER sends the studio's cookie
-    with an <img> or <iframe> (no Origin header); Sec-Fetch-Site tells."""
-    status, body = http(studio, "api/config", {"Cookie": studio.headers["Cookie"], "Sec-Fetch-Site": site})
+    """A page on 127.0.0.1:OTHER that had the token still could not use it from an <img> or <iframe> (no
+    Origin header); Sec-Fetch-Site tells. Only the page itself may be reached by a link from elsewhere."""
+    token = {TOKEN_HEADER: studio.access.token, "Sec-Fetch-Site": site}
+    status, body = http(studio, "api/config", token)
     assert status == 403 and b"started by another page" in body
-    assert http(studio, "", {"Cookie": studio.headers["Cookie"], "Sec-Fetch-Site": site})[0] == 403
+    assert http(studio, "static/js/studio/main.js", token)[0] == 403
+    assert http(studio, "", {"Sec-Fetch-Site": site})[0] == 200  # the page, which holds nothing
 
 
 # --- what the page may name ----------------------------------------------------------------------------------
@@ -422,8 +456,8 @@ def test_the_command_hides_its_token_in_logs_and_ctrl_c_stops_it_with_a_pipe_in_
     port = int(url.split(":")[2].split("/")[0])
     try:
         with urllib.request.urlopen(url, timeout=10) as reply:  # the first visit, as the browser makes it
-            cookie = reply.headers["Set-Cookie"].split(";")[0]
-        request = urllib.request.Request(f"http://127.0.0.1:{port}/api/config", headers={"Cookie": cookie})
+            assert reply.headers.get_all("Set-Cookie") is None
+        request = urllib.request.Request(f"http://127.0.0.1:{port}/api/config", headers={TOKEN_HEADER: token})
         with urllib.request.urlopen(request, timeout=10) as reply:
             assert "notes.csv" not in json.loads(reply.read())["tables"]
         with pytest.raises(urllib.error.HTTPError):
