@@ -1,7 +1,7 @@
 """The vocabulary of real ROBO Pro programs, and the generated program held against it.
 
 With the corpus present (``../shared/rpp-corpus`` beside the repository, or ``$TABLEBOT_RPP_CORPUS``), the
-whole corpus is read once: the committed ``robopro/vocabulary.json`` must be exactly what it yields, and
+whole corpus is read once: the committed ``testing/rpp_vocabulary.json`` must be exactly what it yields, and
 the generated programs are checked against that fresh reading. Without it (CI), the generated programs are
 checked against the committed vocabulary (test_robopro_program.py) and the checker is shown to catch
 what it must.
@@ -20,9 +20,9 @@ import pytest
 from core_helpers import EXAMPLE, ROOT
 from tablebot.formats.table_read import load_table
 from tablebot.robopro.program import generate
-from tablebot.robopro.vocabulary import SERIES, VOCABULARY, problems, vocabulary
 from tablebot.testing.random_tables import Shape, random_table
 from tablebot.testing.rpp_corpus import corpus_dir, dump, read_corpus
+from tablebot.testing.rpp_vocabulary import SERIES, VOCABULARY, problems, vocabulary
 from test_robopro_program import fitting
 
 CORPUS = corpus_dir()

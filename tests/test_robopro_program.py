@@ -25,9 +25,9 @@ from tablebot.robopro.executor import run
 from tablebot.robopro.fit import plan, problems
 from tablebot.robopro.interpret import InterpreterError, Program, Run
 from tablebot.robopro.program import Rule, generate
-from tablebot.robopro.vocabulary import problems as vocabulary_problems
 from tablebot.table import Row, Table
 from tablebot.testing.random_tables import Shape, random_case, random_inputs, random_table, with_match
+from tablebot.testing.rpp_vocabulary import problems as vocabulary_problems
 
 if TYPE_CHECKING:
     from pathlib import Path

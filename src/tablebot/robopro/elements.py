@@ -1,6 +1,6 @@
 """The ROBO Pro elements the generated program uses, each built exactly as real programs write it: the
 attribute order, the attribute values and the pins (name, class, id, place, size) are ones the corpus
-shows (``vocabulary.json``; the tests check every one).
+shows (``testing/rpp_vocabulary.json``; the tests check every one).
 
 Inputs and outputs: ``ftProDataIn input`` is 160 + n − 1 for In (In = I1…I8: the corpus shows 160–163 for
 I1–I4) and 176 + n − 1 for the value of counter Cn (the corpus's TeachIn robots read their encoder motors'

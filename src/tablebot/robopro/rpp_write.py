@@ -2,7 +2,7 @@
 document around them, as text laid out the way ROBO Pro saves it.
 
 Every classname, attribute order and pin place used here is one real programs show (the tests check the
-output against ``vocabulary.json``). Wires run between pin positions on a grid of 4; a wire that joins
+output against ``testing/rpp_vocabulary.json``). Wires run between pin positions on a grid of 4; a wire that joins
 another wire ends at a ``dynamic`` pin placed on that wire, as ROBO Pro stores converging flows.
 """
 

@@ -3,7 +3,7 @@ attributes each writes (in ROBO Pro's order), the values of every enumerated att
 element carries and the order of a document's header. The generator may write only what this holds.
 
 It is derived, never copied: ``python -m tablebot.testing.rpp_corpus CORPUS_DIR`` writes the facts to
-``src/tablebot/robopro/vocabulary.json`` (the committed copy, which tests compare with a fresh reading
+``src/tablebot/testing/rpp_vocabulary.json`` (the committed copy, which tests compare with a fresh reading
 of the corpus when it is present). The corpus itself (79 programs from public repositories that state no
 licence) stays outside the project: ``$TABLEBOT_RPP_CORPUS`` or ``../shared/rpp-corpus`` beside the
 repository.
@@ -19,7 +19,7 @@ from collections import defaultdict
 from collections.abc import Iterable
 from pathlib import Path
 
-from tablebot.robopro.vocabulary import (
+from tablebot.testing.rpp_vocabulary import (
     DECIMAL_RE,
     INT_RE,
     INTERFACE_PINS,

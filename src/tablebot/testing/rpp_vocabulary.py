@@ -1,6 +1,7 @@
-"""What a ROBO Pro program may contain, as real programs show it (``vocabulary.json``, derived from the
+"""What a ROBO Pro program may contain, as real programs show it (``rpp_vocabulary.json``, derived from the
 corpus by :mod:`tablebot.testing.rpp_corpus`), and the check of a document against it and against the
-invariants every real program keeps: unique ids, and every ``resolveid`` pointing back."""
+invariants every real program keeps: unique ids, and every ``resolveid`` pointing back. The tests hold the
+generated program to it; the generator itself never reads it."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-VOCABULARY = Path(__file__).with_name("vocabulary.json")
+VOCABULARY = Path(__file__).with_name("rpp_vocabulary.json")
 TEXT = "#text"
 INT_RE = re.compile(r"-?\d+")
 DECIMAL_RE = re.compile(r"-?\d+(\.\d+)?")
