@@ -77,7 +77,7 @@ class Shared:
                        "give the name of a new folder (a shared table never writes over files)")
         with new_folder(folder) as stage:
             for name, text in self.files().items():
-                write_text(stage / name, text)
+                write_text(stage / name, text, newline="")  # byte for byte as shared
         return folder / self.table[0]
 
     def check(self, where: str = "link") -> None:
@@ -183,7 +183,7 @@ def decode(link: str, where: str = "link") -> Shared:
     if bad is None or bad.end() != len(payload):
         end = 0 if bad is None else bad.end()
         raise fail(where, f"this share link holds a character no share link has ({payload[end]!r} at character "
-                   f"{at + len(KEY) + len(version) + 1 + end + 1})",
+                   f"{at + len(KEY) + len(version) + 1 + end + 1} of the link)",
                    "copy the link again whole: a chat program or e-mail may have changed or wrapped it")
     return _unpack(_inflate(payload, where), where)
 

@@ -1,0 +1,58 @@
+"""The ``share`` command: a link that carries a table, its robot file and its world (:mod:`tablebot.share`),
+printed for a chat or an e-mail, and its QR code for a phone or a projector."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from tablebot.cli.app import app
+from tablebot.cli.common import err_console, guarded, out_file
+from tablebot.escape import plain
+
+QR_SCALE = 8  # pixels per module: a QR code of a thousand characters is about 600 px wide, easy for a phone
+QR_OPT = typer.Option(None, "--qr", metavar="FILE.png", help="Also write the link's QR code as a PNG picture.")
+
+
+@app.command("share")
+@guarded
+def share_cmd(
+    where: Path = typer.Argument(..., metavar="FOLDER|TABLE", help="A folder holding table.csv, or a table file."),
+    qr: Path | None = QR_OPT,
+    base: str = typer.Option("", "--base", metavar="URL", help="The studio address the link starts with "
+                             "(default: http://127.0.0.1:8765/, where `tablebot studio` serves)."),
+) -> None:
+    """Print a link that carries FOLDER's table, its robot file and its world, compressed into the part after
+    '#' (a browser never sends that to any server). `tablebot studio --open LINK`, the studio's Open box and
+    `tablebot grade` read it back; files that are copies of tablebot's shipped examples are named, not carried."""
+    from tablebot import share
+
+    shared = share.collect(where)
+    link = share.encode(shared, base or share.STUDIO)
+    print(link)
+    err_console.print(f"{len(link):,} characters: the table {plain(shared.table[0])}"
+                      + (f", {plain(shared.robot[0])}" if shared.robot else ", the built-in BumberBot")
+                      + (", its world" if shared.world is not None else ", an empty room"), markup=False)
+    if qr is not None:
+        write_qr(out_file(qr, "--qr"), link)
+        err_console.print(f"wrote {plain(str(qr))}", markup=False)
+
+
+def write_qr(path: Path, link: str) -> None:
+    """The link's QR code as a PNG (the strongest error correction the link leaves room for)."""
+    import io
+
+    import segno
+
+    from tablebot.diagnostics import fail
+    from tablebot.files import write_bytes
+
+    try:
+        code = segno.make(link, error="l", boost_error=True, micro=False)
+    except segno.DataOverflowError:
+        raise fail("--qr", f"the link is too long for a QR code ({len(link):,} characters; one holds about 2,900)",
+                   "share the link as text, or shorten the robot and world files' comments") from None
+    picture = io.BytesIO()
+    code.save(picture, kind="png", scale=QR_SCALE, border=4)
+    write_bytes(path, picture.getvalue())
