@@ -2,6 +2,10 @@
 
 Every loader collects all of a file's problems before failing, so a user fixes them in one go; a note
 (not a problem, such as an assumed text encoding) goes out through :func:`notify`.
+
+A message or hint may be a :class:`tablebot.i18n.Message` (an id and its arguments, written ``N_(...)``): its
+value is the English text, and :meth:`Diagnostic.render` says it in the reader's language, so the command line
+and the studio show the same words.
 """
 
 from __future__ import annotations
@@ -11,6 +15,17 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+
+from tablebot.i18n import N_, localise
+
+#: The words of a diagnostic's kind and its hint's label, marked for the catalog (shown by :func:`severity_word`).
+SEVERITIES = {"error": N_("error"), "warning": N_("warning"), "note": N_("note")}
+HINT_LABEL = N_("hint")
+
+
+def severity_word(severity: str, language: str | None = None) -> str:
+    """``error``, ``warning`` or ``note`` in the reader's language (``Fehler``, ``Warnung``, ``Hinweis``)."""
+    return localise(SEVERITIES.get(severity, severity), language)
 
 
 @dataclass(frozen=True)
@@ -33,10 +48,11 @@ class Diagnostic:
                 parts.append(str(self.column))
         return ":".join(parts)
 
-    def render(self) -> str:
-        text = f"{self.location()}: {self.severity}: {self.message}"
+    def render(self, language: str | None = None) -> str:
+        """The diagnostic as lines of text, in ``language`` (default: the language in use)."""
+        text = f"{self.location()}: {severity_word(self.severity, language)}: {localise(self.message, language)}"
         if self.hint:
-            text += f"\n    hint: {self.hint}"
+            text += f"\n    {localise(HINT_LABEL, language)}: {localise(self.hint, language)}"
         for line in self.detail.splitlines():
             text += f"\n    | {line}"
         return text

@@ -20,6 +20,8 @@ os.environ.setdefault("TYPER_USE_RICH", "0")
 # Importing a module registers its commands; `tablebot --help` lists them in this order.
 from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune, evolve, share  # noqa: F401, I001
 from tablebot.cli.app import app
+from tablebot.diagnostics import Diagnostic
+from tablebot.i18n import LANGUAGES, N_, LanguageError, set_from
 from tablebot.interrupts import Terminated
 
 #: Exit code of an internal error (a tablebot bug): sysexits' EX_SOFTWARE, apart from 1 (warnings), 2 (bad
@@ -40,6 +42,7 @@ def main() -> None:
     # written and closed by then, and the other exit handlers and weakref finalizers still run.
     atexit.unregister(gc.freeze)  # once, however many times one process calls main (tests)
     atexit.register(gc.freeze)
+    _choose_language()
     try:
         app()
     except (SystemExit, KeyboardInterrupt):
@@ -56,3 +59,17 @@ def main() -> None:
                   f"tablebot: please report it with the command and the files it read "
                   f"(run again with {DEBUG_ENV}=1 to see the traceback)", file=sys.stderr)
         sys.exit(INTERNAL_ERROR)
+
+
+def _choose_language() -> None:
+    """Speak the language asked for (--lang, TABLEBOT_LANG, the system's) before typer builds any help; --lang
+    is taken off the command line here, so that every command accepts it."""
+    try:
+        sys.argv[1:] = set_from(sys.argv[1:])
+    except LanguageError as exc:
+        from tablebot.cli.common import print_diagnostic
+
+        print_diagnostic(Diagnostic(exc.where, None, None, N_("{value!r} is not a language tablebot speaks",
+                                                              value=exc.value),
+                                    N_("use one of: {choices}", choices=", ".join(LANGUAGES))))
+        sys.exit(2)

@@ -35,5 +35,8 @@ def _print_version(value: bool) -> None:
 def main(
     show_version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
                                       help="Print tablebot's version and exit."),
+    lang: str = typer.Option("", "--lang", metavar="de|en", show_default=False,
+                             help="The language of tablebot's messages: de (Deutsch) or en (English); default: "
+                             "TABLEBOT_LANG, else the system's language. It may stand anywhere on the line."),
 ) -> None:
     """Robot behaviour written as a table: check it, trace it, simulate it, export it."""

@@ -15,9 +15,10 @@ import typer
 from rich.console import Console
 
 from tablebot import overwrite
-from tablebot.diagnostics import Diagnostic, TableBotError, notes_to
+from tablebot.diagnostics import HINT_LABEL, Diagnostic, TableBotError, notes_to, severity_word
 from tablebot.escape import terminal
 from tablebot.files import OS_HINTS, out_file, out_folder  # noqa: F401  (re-exported for the commands)
+from tablebot.i18n import localise
 from tablebot.interrupts import Terminated, sigterm_raises
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
@@ -94,10 +95,10 @@ def print_diagnostic(d: Diagnostic) -> None:
     each (a line break in a name is shown as \\n: it cannot forge a line of its own); a tool's output
     follows, each of its lines marked as part of this diagnostic."""
     colour = {"error": "red", "warning": "yellow"}.get(d.severity, "cyan")
-    err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{d.severity}[/{colour}]: "
-                      f"{terminal(d.message)}")
+    err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{severity_word(d.severity)}[/{colour}]: "
+                      f"{terminal(localise(d.message))}")
     if d.hint:
-        err_console.print(f"    [dim]hint:[/dim] {terminal(d.hint)}")
+        err_console.print(f"    [dim]{localise(HINT_LABEL)}:[/dim] {terminal(localise(d.hint))}")
     for line in d.detail.splitlines():
         err_console.print(f"    [dim]|[/dim] {terminal(line)}")
 

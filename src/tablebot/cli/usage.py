@@ -22,6 +22,7 @@ from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
 from typer.core import TyperGroup
 
+from tablebot.cli.words import localise
 from tablebot.diagnostics import Diagnostic
 
 
@@ -35,6 +36,7 @@ class Group(TyperGroup):
             for param in command.params:
                 if isinstance(param.type, FloatParamType):
                     param.type = FiniteFloat.like(param.type)
+        localise(self)  # every help text in the reader's language, before any is shown
 
     def invoke(self, ctx: Any) -> Any:
         given = [*ctx._protected_args, *ctx.args]  # the command line, for the value a user gave

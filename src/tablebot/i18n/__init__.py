@@ -1,0 +1,239 @@
+"""The reader's language: German or English, for every word tablebot says (issue 38).
+
+One gettext catalog per language under ``tablebot/locale/<lang>/LC_MESSAGES/tablebot.mo`` (domain ``tablebot``),
+made from the ``.po`` files beside them, whose template ``tablebot/locale/tablebot.pot`` is extracted from the code
+(``scripts/catalog.py``). Three ways to mark a text:
+
+* ``_("...")``: translated now, into the language in use (help and progress lines, printed at once);
+* ``ngettext(singular, plural, n)``: the same, with the plural form of ``n``;
+* ``N_("... {name} ...", name=...)``: a :class:`Message`, translated when it is shown. A diagnostic carries one
+  (its id and arguments), so the command line and the studio each render it in their reader's language.
+
+The language is chosen once per command (:func:`choose`: ``--lang``, else ``TABLEBOT_LANG``, else the system's
+locale) and set with :func:`use`. A table file's meaning never depends on it: tables are data.
+"""
+
+from __future__ import annotations
+
+import gettext as _gettext
+import os
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "DOMAIN",
+    "ENV",
+    "LANGUAGES",
+    "LOCALE_DIR",
+    "NP_",
+    "N_",
+    "PSEUDO",
+    "LanguageError",
+    "Message",
+    "_",
+    "choose",
+    "current",
+    "gettext",
+    "localise",
+    "ngettext",
+    "set_from",
+    "system_language",
+    "translation",
+    "use",
+]
+
+DOMAIN = "tablebot"
+LOCALE_DIR = Path(__file__).resolve().parent.parent / "locale"
+#: The languages a reader may choose; the first is the one the code is written in.
+LANGUAGES = ("en", "de")
+ENV = "TABLEBOT_LANG"
+#: Not a language: every translated text wrapped in markers, so a test sees any text that was never
+#: translated (it stands outside them). Chosen by TABLEBOT_LANG only, never offered in --lang's help.
+PSEUDO = "pseudo"
+PSEUDO_OPEN, PSEUDO_CLOSE = "⟦", "⟧"
+
+
+class LanguageError(ValueError):
+    """A language asked for that tablebot does not speak; ``where`` is the option or variable that asked."""
+
+    def __init__(self, where: str, value: str) -> None:
+        super().__init__(f"{where}: {value!r} is not a language tablebot speaks")
+        self.where, self.value = where, value
+
+
+class _Pseudo(_gettext.NullTranslations):
+    """The pseudo-locale: the English text between markers."""
+
+    def gettext(self, message: str) -> str:
+        return f"{PSEUDO_OPEN}{message}{PSEUDO_CLOSE}"
+
+    def ngettext(self, msgid1: str, msgid2: str, n: int) -> str:
+        return self.gettext(msgid1 if n == 1 else msgid2)
+
+
+_loaded: dict[str, _gettext.NullTranslations] = {}
+_language = LANGUAGES[0]
+
+
+def translation(language: str | None = None) -> _gettext.NullTranslations:
+    """The catalog of ``language`` (default: the one in use), loaded once. English is the code's own text."""
+    language = language or _language
+    if language not in _loaded:
+        if language == PSEUDO:
+            _loaded[language] = _Pseudo()
+        elif language == LANGUAGES[0]:
+            _loaded[language] = _gettext.NullTranslations()
+        else:  # a missing .mo would be a broken install: fail loudly rather than speak English silently
+            with open(LOCALE_DIR / language / "LC_MESSAGES" / f"{DOMAIN}.mo", "rb") as mo:
+                _loaded[language] = _gettext.GNUTranslations(mo)
+    return _loaded[language]
+
+
+def use(language: str) -> None:
+    """Speak ``language`` (one of :data:`LANGUAGES`, or :data:`PSEUDO`) from now on, in this process."""
+    global _language
+    if language not in (*LANGUAGES, PSEUDO):
+        raise LanguageError("language", language)
+    translation(language)
+    _language = language
+
+
+def current() -> str:
+    """The language in use."""
+    return _language
+
+
+def gettext(message: str) -> str:
+    """``message`` in the language in use."""
+    return translation().gettext(message)
+
+
+_ = gettext
+
+
+def ngettext(singular: str, plural: str, n: int) -> str:
+    """The singular or plural of a text, as the language in use counts ``n``."""
+    return translation().ngettext(singular, plural, n)
+
+
+class Message(str):
+    """A text to translate when it is shown: its value as a ``str`` is the English text (so logs, JSON and
+    comparisons do not depend on the reader), its id and arguments let :meth:`render` say it in any language.
+
+    An argument that is itself a Message is rendered in the same language (a hint made of parts)."""
+
+    msgid: str
+    plural: str | None
+    args: Mapping[str, Any]
+
+    def __new__(cls, msgid: str, args: Mapping[str, Any] | None = None, plural: str | None = None) -> Message:
+        args = dict(args or {})
+        english = plural if plural is not None and args.get("n") != 1 else msgid
+        self = super().__new__(cls, english.format(**args) if args else english)
+        self.msgid, self.plural, self.args = msgid, plural, args
+        return self
+
+    def render(self, language: str | None = None) -> str:
+        """The text in ``language`` (default: the language in use)."""
+        catalog = translation(language)
+        text = catalog.gettext(self.msgid) if self.plural is None else \
+            catalog.ngettext(self.msgid, self.plural, int(self.args["n"]))
+        if not self.args:
+            return text
+        return text.format(**{k: localise(v, language) for k, v in self.args.items()})
+
+    def __reduce__(self) -> tuple[Any, ...]:  # pickled between processes (evolve's and sweep's workers)
+        return Message, (self.msgid, self.args, self.plural)
+
+
+def N_(msgid: str, /, **args: Any) -> Message:
+    """A text translated when shown, with its ``{name}`` fields filled from ``args``."""
+    return Message(msgid, args)
+
+
+def NP_(singular: str, plural: str, n: int, /, **args: Any) -> Message:
+    """:func:`N_` with a plural: ``n`` chooses the form (and fills ``{n}``)."""
+    return Message(singular, {**args, "n": n}, plural)
+
+
+def localise(text: Any, language: str | None = None) -> Any:
+    """A :class:`Message` in ``language`` (default: the one in use); any other value as it is."""
+    return text.render(language) if isinstance(text, Message) else text
+
+
+# --- choosing the language ------------------------------------------------------------------------
+
+def choose(argv: Sequence[str], environ: Mapping[str, str], system: Callable[[], str | None] | None = None) \
+        -> tuple[str, list[str]]:
+    """The language a command speaks and its arguments without ``--lang``: ``--lang de|en`` (anywhere before
+    ``--``, so ``tablebot sim --lang de`` works as ``tablebot --lang de sim``), else ``TABLEBOT_LANG``, else the
+    system's locale (:func:`system_language`), else English. An unknown language asked for by name raises
+    :class:`LanguageError`; a system locale tablebot does not speak (``fr_FR``) is English."""
+    rest: list[str] = []
+    asked: tuple[str, str] | None = None
+    words = iter(argv)
+    for word in words:
+        if word == "--":
+            rest += [word, *words]
+            break
+        if word == "--lang":
+            asked = ("--lang", next(words, ""))
+        elif word.startswith("--lang="):
+            asked = ("--lang", word.partition("=")[2])
+        else:
+            rest.append(word)
+    if asked is None and environ.get(ENV, "").strip():
+        asked = (ENV, environ[ENV].strip())
+    if asked is not None:
+        value = asked[1].strip().lower()
+        if value not in LANGUAGES and not (asked[0] == ENV and value == PSEUDO):
+            raise LanguageError(*asked)
+        return value, rest
+    found = (system or (lambda: system_language(environ)))()
+    return (found if found in LANGUAGES else LANGUAGES[0]), rest
+
+
+def system_language(environ: Mapping[str, str], platform: str = sys.platform,
+                    windows_ui: Callable[[], int] | None = None) -> str | None:
+    """The language of the system's locale: POSIX's LC_ALL, LC_MESSAGES, LANG (the first set; ``de_DE.UTF-8``
+    is ``de``; ``C`` and ``POSIX`` are none), and on Windows, where those are rarely set, the user's interface
+    language (GetUserDefaultUILanguage, a Windows language id named through Python's table of them)."""
+    for name in ("LC_ALL", "LC_MESSAGES", "LANG"):
+        value = environ.get(name, "").strip()
+        if value:
+            return _language_of(value)
+    if platform == "win32":
+        import locale
+
+        ui = windows_ui or _windows_ui_language
+        try:
+            name = locale.windows_locale.get(ui(), "")
+        except OSError:  # no such call on this Windows: its user locale instead
+            name = locale.getlocale()[0] or ""
+        return _language_of(name) if name else None
+    return None
+
+
+def _language_of(locale_name: str) -> str | None:
+    """``de_DE.UTF-8`` -> ``de``; ``C``/``POSIX`` -> None; Windows' ``German_Germany`` -> ``de``."""
+    base = locale_name.split(".")[0].split("@")[0]
+    if base in ("C", "POSIX", ""):
+        return None
+    code = base.replace("-", "_").split("_")[0].lower()
+    return {"german": "de", "english": "en"}.get(code, code)
+
+
+def _windows_ui_language() -> int:
+    import ctypes
+
+    windll = getattr(ctypes, "windll")  # noqa: B009  (Windows only: mypy on other systems knows no windll)
+    return int(windll.kernel32.GetUserDefaultUILanguage())
+
+
+def set_from(argv: Sequence[str], environ: Mapping[str, str] | None = None) -> list[str]:
+    """Choose and use the language for a command line; the arguments without ``--lang``."""
+    language, rest = choose(argv, os.environ if environ is None else environ)
+    use(language)
+    return rest
