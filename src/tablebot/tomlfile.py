@@ -15,6 +15,7 @@ from typing import Any
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
 from tablebot.durations import MAX_NUMBER_CHARS
+from tablebot.tomlwords import worded
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 Where = tuple[str, int | None, str | None]  # (section path, index in an array of tables, key)
@@ -46,8 +47,9 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
         else:  # "(at end of document)": the last line, after its last character
             lines = text.splitlines() or [""]
             line, col = len(lines), len(lines[-1]) + 1
-        message = re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc))
-        raise fail(path, f"TOML syntax: {message}", hint, line, col) from None
+        message, better, line, col = worded(text, re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc)), line,
+                                            col)
+        raise fail(path, message, better or hint, line, col) from None
     except RecursionError:  # nesting that _unreadable() did not count (it is a safety net, not the parser)
         raise fail(path, "nested too deeply to read", "no tablebot file nests that deep: is this the right file?",
                    1, 1) from None
