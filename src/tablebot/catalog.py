@@ -21,5 +21,6 @@ def load_all() -> None:
     from tablebot.hw.txt4 import backend as _txt4  # txt4
     from tablebot.sim import backend as _sim  # sim; [sim]
     from tablebot.analysis import section as _properties  # [properties]
+    from tablebot import robot_tables as _tables  # [tables], [groups]
 
-    del _robopro, _c, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties
+    del _robopro, _c, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties, _tables

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from tablebot.sim.scene import Scene
     from tablebot.sim.world import World
     from tablebot.table import Table
+    from tablebot.tables import RobotTables
 
 #: A file or folder name, as the front door takes them.
 PathLike = str | os.PathLike[str]
@@ -76,6 +77,8 @@ class Loaded:
     world_files: tuple[Path, ...] = ()
     property_files: tuple[Path, ...] = ()
     robot_file: Path | None = None
+    #: A robot of several tables (``[tables]``): all of them, ``table`` the main one (:mod:`tablebot.tables`).
+    tables: RobotTables | None = None
 
     @classmethod
     def open(cls: type[L], path: PathLike, *, robot: PathLike | None = None, worlds: Sequence[PathLike] = (),
@@ -84,14 +87,18 @@ class Loaded:
         from tablebot.formats.table_read import load_table
         from tablebot.machine import compile_table
         from tablebot.robot import load_robot
+        from tablebot.tables import several
 
         given = Path(path)
         robot_file = Path(robot) if robot is not None else given if given.suffix.lower() == ".toml" else None
         robot_read = load_robot(robot_file) if robot_file is not None else None  # first, as every command reads it
         found = table_path(given)
         table = load_table(found, robot_read)
+        tables = several(table)  # every table of the robot, checked together; the main one is the robot's table
+        if tables is not None:
+            table = tables.table
         props = property_files(found) if properties is None else [Path(p) for p in properties]
-        return cls(table, compile_table(table), tuple(Path(w) for w in worlds), tuple(props), robot_file)
+        return cls(table, compile_table(table), tuple(Path(w) for w in worlds), tuple(props), robot_file, tables)
 
     @classmethod
     def of(cls: type[L], table: Table, machine: Machine) -> L:

@@ -208,7 +208,7 @@ def compile_table(table: Table) -> Machine:
         dispatch=tuple(Dispatch(r) for r in per_state),
         timer_bit=bit(TIMER_EVENT) if TIMER_EVENT in table.events else 0,
         counter_bits=tuple(bit(c) if c in table.events else 0 for c in robot.counter_names),
-        input_bits={name: bit(name) for name in table.input_events},
+        input_bits={name: bit(name) for name in table.engine_inputs},  # inputs and cross-table events
         initial_state=index[robot.initial_state], initial_timer=robot.initial_timer,
         needs_event=robot.match == MATCH_DOCUMENT,
     )

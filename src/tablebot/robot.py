@@ -307,6 +307,10 @@ def _state_id(value: Any) -> StateId | None:
 
 def _initial_state(src: Source) -> StateId:
     if "initial_state" not in src.data:
+        tables = src.data.get("tables")
+        if isinstance(tables, dict) and tables:  # each table says its own ([tables], tablebot.robot_tables)
+            first = next(iter(tables.values()))
+            return _state_id(first.get("initial_state") if isinstance(first, dict) else None) or 0
         src.out.error(None, None, "initial_state is missing", "add a line like: initial_state = 2")
         return 0
     state = _state_id(src.data["initial_state"])

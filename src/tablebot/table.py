@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
+from tablebot.i18n.headers import GERMAN_FIXED
 from tablebot.robot import Robot, StateId
+from tablebot.robot_tables import CrossEvent
 
 #: The document's direction + speed encoding uses speed 7 for "keep".
 DOC_KEEP_SPEED = 7
@@ -21,7 +23,8 @@ MAX_LAMP = 8
 TIMER_EVENT = "T"
 #: The fixed columns of a table, and the other spellings the reader takes for them.
 FIXED = ("description", "state", "timer", "next")
-ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state"}
+ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state",
+           **GERMAN_FIXED}  # Beschreibung, Zustand, Folgezustand: a German table reads the same in any language
 
 
 def from_direction_speed(direction: int, speed: int) -> int | None:
@@ -57,6 +60,15 @@ class Row:
     next: StateId
     counters: tuple[int | None, ...] = ()
     lamps: tuple[int | None, ...] = ()
+    #: A row written for a state group (``[groups]``) is one row per state of the group, in its place:
+    #: ``group`` names the group, ``written`` is its 0-based index among the rows as written (None: ``index``).
+    group: str = ""
+    written: int | None = None
+
+    @property
+    def as_written(self) -> int:
+        """The row's 0-based index as the file writes it (what traces and reports name)."""
+        return self.index if self.written is None else self.written
 
 
 @dataclass(frozen=True)
@@ -67,6 +79,12 @@ class Table:
     events: tuple[str, ...]
     rows: tuple[Row, ...]
     path: str = "<table>"
+    #: In a robot of several tables (``[tables]``, :mod:`tablebot.tables`): this table's name there, its
+    #: cross-table event columns (event name -> what it reads), and the outputs it has columns for, each with
+    #: its header cell (line, column): the one writer of each output. Empty for a robot of one table.
+    name: str = field(default="", compare=False)
+    cross: dict[str, CrossEvent] = field(default_factory=dict, compare=False)
+    writes: dict[str, tuple[int, int]] = field(default_factory=dict, compare=False)
 
     @cached_property
     def states(self) -> tuple[StateId, ...]:
@@ -127,6 +145,12 @@ class Table:
         """Event columns that are robot inputs (not the timer, not counters)."""
         return tuple(e for e in self.events if e in self.robot.inputs)
 
+    @property
+    def engine_inputs(self) -> tuple[str, ...]:
+        """Event columns the engine is given from outside the table: the robot's inputs and the cross-table
+        events (which the robot's other tables make); the same as :attr:`input_events` in a one-table robot."""
+        return tuple(e for e in self.events if e in self.robot.inputs or e in self.cross)
+
 
 @dataclass(frozen=True)
 class NoEventRow:
@@ -180,7 +204,8 @@ def missing_states(rows: Sequence[Row], robot: Robot) -> list[MissingState]:
     with_rows = {row.state for row in rows}
     found: list[MissingState] = [
         (row, ("", "next"), f"next state {row.next!r} is unknown: no row has state {row.next!r}",
-         f"add rows for state {row.next!r} or fix the next state") for row in rows if row.next not in with_rows]
+         f"add rows for state {row.next!r} or fix the next state")
+        for row in {r.line: r for r in rows if r.next not in with_rows}.values()]  # a group row once
     if robot.initial_state not in with_rows:
         found.append((None, ("", "initial_state"),
                       f"initial state {robot.initial_state!r} (from {robot.source} robot {robot.name}) has no rows",
@@ -203,3 +228,28 @@ def is_table_header(cells: Iterable[str]) -> bool:
     """Whether header cells name a state and a next column (spelled any way :func:`parse_table` takes)."""
     names = {normalise_header(text) for text in cells}
     return "state" in names and "next" in names
+
+
+#: A row written for a group that cannot be: (the row, "state" or "next": the cell to blame, message, hint).
+GroupProblem = tuple[Row, str, str, str]
+
+
+def expand_groups(rows: Sequence[Row],
+                  groups: dict[str, tuple[StateId, ...]]) -> tuple[list[Row], list[GroupProblem]]:
+    """The rows as the engine runs them: a row whose state is a group (``[groups]``) becomes one row per state of
+    the group, in its place, so that a state's candidate rows are its own and its groups', in table order.
+    Indices are renumbered; each row keeps its line and its index as written (:attr:`Row.as_written`). A group
+    is no next state: a robot is in one state at a time."""
+    used = {row.state for row in rows if row.state in groups}
+    if not used:
+        return list(rows), []
+    problems: list[GroupProblem] = [
+        (row, "next", f"next state {row.next!r} is a group ([groups]): a robot is in one state at a time",
+         "go to one of its states") for row in rows if row.next in groups]
+    expanded: list[Row] = []
+    for row in rows:
+        states = groups.get(row.state, (row.state,)) if row.state in used else (row.state,)
+        for state in states:
+            group = str(row.state) if row.state in used else ""
+            expanded.append(replace(row, index=len(expanded), state=state, group=group, written=row.index))
+    return expanded, problems

@@ -15,6 +15,7 @@ from typing import Any
 from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_records, read_text, records_after
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
+from tablebot.formats.table_parts import cross_column, grouped, robot_for_table, writes
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,
@@ -25,6 +26,7 @@ from tablebot.robot import (
     find_robot_file,
     load_robot,
 )
+from tablebot.robot_tables import tables_of
 from tablebot.table import (
     FIXED,
     MAX_LAMP,
@@ -69,10 +71,11 @@ def load_table(path: str | Path, robot: Robot | None = None) -> Table:
     if robot is None:
         side = find_robot_file(path)
         robot = load_robot(side) if side else BUMBERBOT
-    return parse_table(read_text(path, limit=MAX_TABLE_BYTES), str(path), robot)
+    robot, name = robot_for_table(path, robot)  # one of several tables: its own start and rule
+    return parse_table(read_text(path, limit=MAX_TABLE_BYTES), str(path), robot, name)
 
 
-def parse_table(text: str, path: str, robot: Robot) -> Table:
+def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
     out = Collector(path)
     records = read_records(text, path)  # one at a time: only the rows made of them are kept
     header = next((record for record in records if not record.is_blank()), None)
@@ -88,6 +91,7 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
     memo: dict[tuple[int, str], Any] = {}  # (column, cell text) -> value, for cells read without an error
     rows: list[Row] = []
     next_cells: dict[int, Cell] = {}  # line -> its next-state cell, where missing states are reported
+    state_cells: dict[int, Cell] = {}  # and its state cell, where a misused group is
     after = records_after(text, header.line)
     if after is not None and after > MAX_TABLE_ROWS:  # known at once: no line is read
         raise _too_many_rows(path, header.line + MAX_TABLE_ROWS + 1)
@@ -102,12 +106,17 @@ def parse_table(text: str, path: str, robot: Robot) -> Table:
             _count_states(states, row, record, (state_at, next_at), path)
         if next_at is not None and len(record.cells) > next_at:
             next_cells[record.line] = record.cells[next_at]
+        if state_at is not None and len(record.cells) > state_at:
+            state_cells[record.line] = record.cells[state_at]
     if not rows and not out.items:
         out.error(header.line + 1, 1, "the table has a header but no rows",
                   "add one row per transition below the header")
+    rows = grouped(rows, robot, out, state_cells, next_cells)
     _check_states(rows, robot, out, next_cells, columns)
     out.raise_if_any()
-    return Table(robot=robot, events=events, rows=tuple(rows), path=path)
+    cross = {c.name: x for c in columns if c.kind == "event" and (x := cross_column(c.cell, robot, out)) is not None}
+    return Table(robot=robot, events=events, rows=tuple(rows), path=path, name=name, cross=cross,
+                 writes=writes((c.kind, c.name, c.cell) for c in columns))
 
 
 def _too_many_rows(path: str, line: int) -> TableBotError:
@@ -164,6 +173,10 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
         name = normalise_header(cell.text)
         if not name:
             columns.append(Column("ignore", "", cell))
+            continue
+        if "=" in name and tables_of(robot):  # a cross-table event (several tables: tablebot.robot_tables)
+            cross = cross_column(cell, robot, out)
+            columns.append(Column("event", cross.column, cell) if cross else Column("ignore", name, cell))
             continue
         kind_name = _classify(name, robot)
         if kind_name is None:
@@ -306,7 +319,7 @@ def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
         return None
     return Row(index=index, line=record.line, description=values.get(("description", "description")) or above,
                state=state, events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
-               motors=tuple(_motor(motor, values) for motor in robot.motors),
+               motors=tuple(_motor(motor, values, bool(tables_of(robot))) for motor in robot.motors),
                timer=values.get(("timer", "timer")) or 0, next=nxt,
                counters=tuple(values.get(("load", c.name)) for c in robot.counters),
                lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
@@ -359,10 +372,13 @@ def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
     return ticks
 
 
-def _motor(motor: str, values: dict[tuple[str, str], Any]) -> int | None:
-    """The signed speed (None = keep) from either the document's dir+speed form or a signed cell."""
+def _motor(motor: str, values: dict[tuple[str, str], Any], several: bool = False) -> int | None:
+    """The signed speed (None = keep) from either the document's dir+speed form or a signed cell; in a robot
+    of ``several`` tables, a motor the table has no column for is another table's: kept."""
     if ("signed", motor) in values:
         return values[("signed", motor)]
+    if several and ("dir", motor) not in values and ("speed", motor) not in values:
+        return None
     return from_direction_speed(values.get(("dir", motor)) or 0, values.get(("speed", motor)) or 0)
 
 
