@@ -16,6 +16,8 @@ from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_record
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
 from tablebot.formats.table_parts import cross_column, grouped, robot_for_table, writes
+from tablebot.i18n import N_
+from tablebot.i18n.headers import suffix
 from tablebot.robot import (
     BUMBERBOT,
     MAX_TIMER,
@@ -155,10 +157,11 @@ def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
         return "signed", name
     if name in robot.lamps:
         return "lamp", name
-    base, _, suffix = name.rpartition("_")
-    if base in robot.motors and suffix.lower() in ("dir", "speed"):
-        return suffix.lower(), base
-    if base in robot.counter_names and suffix.lower() == "load":
+    base, _, end = name.rpartition("_")
+    part = suffix(end)  # M1_Richtung, M1_Tempo, C1_Laden: German names (tablebot.i18n.headers)
+    if base in robot.motors and part in ("dir", "speed"):
+        return part, base
+    if base in robot.counter_names and part == "load":
         return "load", base
     return None
 
@@ -363,7 +366,7 @@ def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
     try:
         ticks = to_ticks(text, tick_ms)
     except DurationError as exc:
-        out.error(cell.line, cell.column, f"timer: {exc.message}", exc.hint)
+        out.error(cell.line, cell.column, N_("timer: {problem}", problem=exc.message), exc.hint)
         return 0
     if ticks > MAX_TIMER:
         out.error(cell.line, cell.column, f"timer: {text} is {ticks} ticks, more than the timer holds ({MAX_TIMER})",

@@ -1,0 +1,100 @@
+"""Tables in German (issue 38 §2): German header names and decimal-comma times, read whatever the reader's
+language; a German table and its English twin give the same trace, byte for byte."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tablebot.diagnostics import TableBotError
+from tablebot.durations import DurationError, to_ticks
+from tablebot.formats.table_read import load_table
+from tablebot.i18n import use
+from tablebot.testing.processes import child_env
+
+ROOT = Path(__file__).resolve().parents[1]
+BUMBERBOT = ROOT / "examples" / "bumberbot"
+GERMAN = {"description": "Beschreibung", "state": "ZUSTAND", "timer": "Timer", "next": "folgezustand",
+          "M1_dir": "M1_Richtung", "M1_speed": "M1_tempo", "M2_dir": "M2_richtung", "M2_speed": "M2_Tempo"}
+
+
+def twins(folder: Path) -> tuple[Path, Path]:
+    """The BumberBot's table in English (timers as times with a decimal point, comma-separated) and in German
+    (German header, decimal commas, semicolon-separated as German Excel saves it), each beside the robot file."""
+    lines = (BUMBERBOT / "table.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    at = header.index("timer")
+    rows = [line.split(",") for line in lines[1:]]
+    english, german = folder / "en", folder / "de"
+    for side in (english, german):
+        side.mkdir()
+        shutil.copy(BUMBERBOT / "robot.toml", side / "robot.toml")
+    timed = [[*row[:at], f"{int(row[at]) / 100:g} s", *row[at + 1:]] for row in rows]  # 50 -> "0.5 s"
+    (english / "table.csv").write_text("\n".join(",".join(r) for r in [header, *timed]) + "\n")
+    german_rows = [[*r[:at], r[at].replace(".", ",").replace(" s", "s"), *r[at + 1:]] for r in timed]
+    german_header = [GERMAN.get(name, name) for name in header]
+    (german / "table.csv").write_text("\n".join(";".join(r) for r in [german_header, *german_rows]) + "\n")
+    return english / "table.csv", german / "table.csv"
+
+
+SMALL_ROBOT = 'name = "Small"\ntick_ms = 10\ninitial_state = 1\n[inputs]\nI3 = "bumper"\n[motors]\nM1 = "drive"\n'
+
+
+def trace(table: Path, *lang: str) -> bytes:
+    done = subprocess.run([sys.executable, "-m", "tablebot", *lang, "trace", str(table), "--inputs",
+                           str(BUMBERBOT / "inputs.csv")], capture_output=True, env=child_env(), cwd=ROOT)
+    assert done.returncode == 0, done.stderr.decode()
+    return done.stdout
+
+
+def test_a_german_table_traces_as_its_english_twin(tmp_path: Path) -> None:
+    english, german = twins(tmp_path)
+    assert ",5s;" in german.read_text() and "Folgezustand".lower() in german.read_text().lower()
+    same = trace(english)
+    assert same and trace(german) == same  # the German table, in an English reader's process
+    assert trace(german, "--lang", "de") == same  # and in a German one: a table's meaning is no reader's
+
+
+def test_german_headers_read_as_english_ones(tmp_path: Path) -> None:
+    english, german = twins(tmp_path)
+    use("de")
+    try:
+        ours, theirs = load_table(german), load_table(english)
+    finally:
+        use("en")
+    assert ours.rows == theirs.rows and ours.events == theirs.events
+    assert [r.timer for r in ours.rows][:2] == [50, 50]
+
+
+def test_a_decimal_comma_in_a_comma_separated_table_is_read_when_quoted(tmp_path: Path) -> None:
+    (tmp_path / "robot.toml").write_text(SMALL_ROBOT)
+    table = tmp_path / "table.csv"
+    table.write_text('Zustand,I3,M1_Richtung,M1_Tempo,Timer,Folgezustand\n1,1,,2,"1,25 s",2\n2,,,0,"0,5s",1\n')
+    rows = load_table(table).rows
+    assert [r.timer for r in rows] == [125, 50]
+
+
+@pytest.mark.parametrize(("text", "ticks"), [("0,5s", 50), ("1,25 s", 125), (",5 s", 50), ("2,ms", 0)])
+def test_decimal_comma_durations(text: str, ticks: int) -> None:
+    if ticks:
+        assert to_ticks(text, 10) == ticks
+    else:
+        with pytest.raises(DurationError):
+            to_ticks(text, 10)
+
+
+def test_a_bad_time_names_the_forms_accepted_in_both_languages(tmp_path: Path) -> None:
+    (tmp_path / "robot.toml").write_text(SMALL_ROBOT)
+    table = tmp_path / "table.csv"
+    table.write_text("Zustand;I3;Timer;Folgezustand\n1;1;0.5 Sekunden;2\n2;;0;1\n")
+    with pytest.raises(TableBotError) as caught:
+        load_table(table)
+    (found,) = caught.value.diagnostics
+    assert (found.line, found.column) == (2, 5)
+    assert "500ms, 0.5s or 0,5s" in found.render()
+    german = found.render("de")
+    assert "keine Zeitangabe" in german and "0,5s" in german and "Tipp:" in german and "Fehler" in german
