@@ -168,10 +168,21 @@ def empty(name: str, inputs: list[Named], motors: list[Named]) -> Template:
     sides = ("right motor", "left motor")  # the simulator drives the first two as right and left wheel
     motors_toml = "".join(f'{n} = "{label or (sides[k] if k < 2 else n)}"\n' for k, (n, label) in enumerate(motors))
     files = {"robot.toml": ROBOT.format(name=name.replace('"', "'"), inputs=inputs_toml, motors=motors_toml,
-                                        first=inputs[0][0] if inputs else "I1"),
+                                        sensors=_sensor_examples([n for n, _ in inputs] or ["I1"])),
              "table.csv": _empty_table(inputs, motors), "arena.toml": ARENA,
              "properties.toml": _empty_properties([n for n, _ in motors])}
     return Template(files, notes)
+
+
+def _sensor_examples(inputs: list[str]) -> str:
+    """The commented [sensors] lines: a kind of sensor per input, never two for one input, so that uncommenting
+    every line gives a file that loads (a second kind for the same input is offered in words, not as a line)."""
+    distance = '{ sensor = "distance", below = "20 cm", at = [0.12, 0] }   # ultrasonic: 1 nearer than 20 cm'
+    line = '{ sensor = "line", at = [0.1, 0.01] }                       # track sensor: 1 over tape'
+    if len(inputs) >= 2:
+        return f"# {inputs[0]} = {distance}\n# {inputs[1]} = {line}\n"
+    return (f"# {inputs[0]} = {distance}\n"
+            f'#   (or a track sensor, 1 over tape: {{ sensor = "line", at = [0.1, 0.01] }})\n')
 
 
 def _empty_table(inputs: list[Named], motors: list[Named]) -> str:
@@ -214,9 +225,7 @@ match = "document"    # a row that requires no event fires only on a tick with s
 
 # What drives an input in the simulator (uncomment and adapt; docs/tutorial.md explains):
 # [sensors]
-# {first} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}   # ultrasonic: 1 nearer than 20 cm
-# {first} = {{ sensor = "line", at = [0.1, 0.01] }}                       # track sensor: 1 over tape
-"""
+{sensors}"""
 
 ARENA = """\
 # The world `tablebot sim` drives the robot in (format: examples/bumberbot/arena.toml).
