@@ -118,7 +118,11 @@ def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
 
 
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
-                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path) -> Path:
+                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path,
+                 no_better: str = "") -> Path:
+    """``report.md``; ``no_better`` says why the winner is not better than the table as it was on the fresh
+    scenarios (empty: it is better): then it is called the best candidate, not the tuned table, and no command
+    to simulate it is offered."""
     from tablebot.files import write_text
 
     spec, cells = plan.spec, evaluate.cells
@@ -127,9 +131,9 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
                    for a in spec.axes)
     scenario = (f"{spec.total} scenarios ({len(spec.seeds)} seeds{axes} × {len(spec.worlds)} world(s), "
                 f"{seconds:g} s each)")
-    lines = [f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}", "",
-             f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
-             "| cell | before | after |", "|---|---|---|"]
+    title = f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}" + (": no better" if no_better else "")
+    lines = [title, "", f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
+             "| cell | before | " + ("best candidate |" if no_better else "after |"), "|---|---|---|"]
     lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
     if any(c.counter is None for c in cells):
         lines += ["", f"Timers count ticks of {plan.table.robot.tick_ms} ms (the tuned table writes each in its "
@@ -138,7 +142,12 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
               f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
     for metric, (a, b) in before_after.items():
         lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
-    lines += ["", f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
+    if no_better:
+        lines += ["", no_better, "", f"{tuned.name} holds the best candidate of the tuning scenarios, for reference; "
+                  "it is not an improvement."]
+    else:
+        lines += ["", "Better than the table as it was on fresh seeds: yes.", "",
+                  f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
     return write_text(path, "\n".join(lines) + "\n")
 
 

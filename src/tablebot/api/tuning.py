@@ -63,6 +63,32 @@ class Tuning:
     def history(self) -> list[tuple[tuple[int, ...], float]]:
         return self.evaluator.history
 
+    @property
+    def baseline(self) -> tuple[int, ...]:
+        """The tuned cells' values in the table as it was."""
+        return tuple(c.value for c in self.cells)
+
+    @property
+    def helped(self) -> bool:
+        """Whether the tuned values are better than the table's own on the fresh scenarios (the objective's
+        mean there is smaller): only then is the tuned table worth having. A tuning that kept the table's own
+        values, or whose winner did better on the tuning scenarios alone, did not help."""
+        before, after = self.before_after[self.objective]
+        return self.winner != self.baseline and after < before
+
+    def verdict(self) -> str:
+        """One line: whether tuning helped, with the objective before and after on the fresh scenarios."""
+        before, after = self.before_after[self.objective]
+        numbers = f"{self.objective} {before:.3f} before, {after:.3f} after, on {self.check.spec.total} fresh " \
+                  "scenarios"
+        if self.helped:
+            return f"Better than the table as it was on fresh seeds: yes ({numbers})."
+        if self.winner == self.baseline:
+            return f"Better than the table as it was on fresh seeds: no: no candidate beat the table's own values " \
+                   f"({numbers}); keep the table as it is."
+        return f"Better than the table as it was on fresh seeds: no ({numbers}): the values that did best on the " \
+               "tuning scenarios do not carry over; keep the table as it is, or tune on more seeds (--seeds)."
+
     def report_text(self) -> str:
         """``report.md`` of the tuning written (the first of its files named so)."""
         return next(p for p in self.files if p.name == "report.md").read_text(encoding="utf-8")
@@ -183,7 +209,7 @@ def _outputs(tuning: Tuning, folder: Path, target: Path) -> list[Path]:
             write_evaluations(evaluate, folder / "evaluations.csv"),
             convergence(evaluate, tuning.method, folder / "convergence.png"),
             write_report(tuning.plan, tuning.check, evaluate, tuning.method, tuning.winner, tuning.before_after,
-                         folder / "report.md", tuning.wall_s, target)]
+                         folder / "report.md", tuning.wall_s, target, tuning.verdict() if not tuning.helped else "")]
 
 
 class Journal:

@@ -11,7 +11,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, stops
-from tablebot.escape import plain
+from tablebot.escape import plain, terminal
 
 
 @app.command("tune")
@@ -57,3 +57,5 @@ def tune_cmd(
             console.print(plain(line), markup=False)
         for path in tuned.files:
             err_console.print(f"wrote {plain(str(path))}", markup=False)
+        if not tuned.helped:  # the report says so too; the last word on the terminal must not read as a success
+            err_console.print(f"[yellow]note:[/yellow] {terminal(tuned.verdict())}")
