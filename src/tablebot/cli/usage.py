@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 from collections.abc import Sequence
 from enum import Enum
 from typing import IO, Any
@@ -22,8 +23,9 @@ from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
 from typer.core import TyperGroup
 
-from tablebot.cli.words import localise
+from tablebot.cli.words import localise, localise_params
 from tablebot.diagnostics import Diagnostic
+from tablebot.i18n import N_, Message
 
 
 class Group(TyperGroup):
@@ -38,6 +40,12 @@ class Group(TyperGroup):
                     param.type = FiniteFloat.like(param.type)
         localise(self)  # every help text in the reader's language, before any is shown
 
+    def get_params(self, ctx: Any) -> list[Any]:
+        # typer adds the completion options after the group is made: translated when first asked for
+        params: list[Any] = super().get_params(ctx)
+        localise_params(self, ctx)
+        return params
+
     def invoke(self, ctx: Any) -> Any:
         given = [*ctx._protected_args, *ctx.args]  # the command line, for the value a user gave
         try:
@@ -47,13 +55,23 @@ class Group(TyperGroup):
         except UsageError as exc:
             raise OptionError(explain(exc, given)) from None
 
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        given = list(args)
+        try:
+            return list(super().parse_args(ctx, args))
+        except NoArgsIsHelpError:
+            raise
+        except UsageError as exc:  # tablebot's own options (--bogus before any command)
+            raise OptionError(explain(exc, given)) from None
+
     def resolve_command(self, ctx: Any, args: list[str]) -> Any:
         name = args[0] if args else ""
         if name and not name.startswith("-") and self.get_command(ctx, name) is None:
             near = difflib.get_close_matches(name, self.list_commands(ctx), n=2)
-            hint = f"did you mean {' or '.join(near)}? " if near else ""
-            raise OptionError(Diagnostic(name, None, None, f"{name!r} is not a tablebot command",
-                                         f"{hint}tablebot -h lists the commands"))
+            hint = N_("did you mean {names}? tablebot -h lists the commands", names=_or(near)) if near else \
+                N_("tablebot -h lists the commands")
+            raise OptionError(Diagnostic(name, None, None, N_("{name!r} is not a tablebot command", name=name),
+                                         hint))
         return super().resolve_command(ctx, args)
 
 
@@ -72,7 +90,7 @@ class FiniteFloat(FloatRange):
     def convert(self, value: Any, param: Any, ctx: Any) -> Any:
         number = FloatParamType.convert(self, value, param, ctx)  # a number at all, before its range
         if not math.isfinite(number):
-            self.fail(f"{number} is not a finite number", param, ctx)
+            self.fail(N_("{number} is not a finite number", number=number), param, ctx)
         return super().convert(number, param, ctx)
 
 
@@ -93,38 +111,79 @@ class OptionError(ClickException):
 
 def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
     """What was wrong with the command line, and what to write instead."""
-    command = f"tablebot {exc.ctx.info_name} -h" if exc.ctx is not None and exc.ctx.info_name else "tablebot -h"
+    sub = exc.ctx is not None and exc.ctx.parent is not None and exc.ctx.info_name
+    command = f"tablebot {exc.ctx.info_name} -h" if sub and exc.ctx is not None else "tablebot -h"
     if not isinstance(exc, BadParameter | NoSuchOption):  # an extra argument, say
-        return Diagnostic("tablebot", None, None, exc.message.rstrip("."), f"{command} says how to call it")
+        return Diagnostic("tablebot", None, None, _click_message(exc.message),
+                          N_("{command} says how to call it", command=command))
     if isinstance(exc, NoSuchOption):
-        near = f"did you mean {' or '.join(sorted(exc.possibilities))}? " if exc.possibilities else ""
-        return Diagnostic(exc.option_name, None, None, f"{exc.option_name} is not an option of this command",
-                          f"{near}{command} lists the options")
+        lists = N_("{command} lists the options", command=command)
+        hint = N_("did you mean {names}? {then}", names=_or(sorted(exc.possibilities)), then=lists) \
+            if exc.possibilities else lists
+        return Diagnostic(exc.option_name, None, None,
+                          N_("{option} is not an option of this command", option=exc.option_name), hint)
     param = exc.param
     name = _name(param)
     choices = _choices(param)
     if isinstance(exc, MissingParameter):
-        hint = f"give {name} one of: {', '.join(choices)}" if choices else f"{command} says what {name} takes"
-        return Diagnostic(name, None, None, f"{name} is missing", hint)
+        hint = N_("give {name} one of: {choices}", name=name, choices=", ".join(choices)) if choices else \
+            N_("{command} says what {name} takes", command=command, name=name)
+        return Diagnostic(name, None, None, N_("{name} is missing", name=name), hint)
     value = _value(given, param)
-    shown = repr(value) if value is not None else "the value given"
+    shown = repr(value) if value is not None else N_("the value given")
     if choices:
-        return Diagnostic(name, None, None, f"{shown} is not one of the choices of {name}",
-                          f"use one of: {', '.join(choices)}")
+        return Diagnostic(name, None, None, N_("{shown} is not one of the choices of {name}", shown=shown, name=name),
+                          N_("use one of: {choices}", choices=", ".join(choices)))
     number = _number_kind(param)
     if number and value is not None and not _parses(value, number):
-        return Diagnostic(name, None, None, f"{shown} is not a number",
-                          "give a whole number" if number is int else "give a number, such as 2 or 0.5")
+        return Diagnostic(name, None, None, N_("{shown} is not a number", shown=shown),
+                          N_("give a whole number") if number is int else N_("give a number, such as 2 or 0.5"))
     if number:
         assert param is not None  # a number kind comes only from a parameter's type
         low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
-        limits = f"from {low} to {high}" if low is not None and high is not None else \
-            f"of at least {low}" if low is not None else f"of at most {high}" if high is not None else "such as 0.5"
+        hint = N_("give {name} a value from {low} to {high}", name=name, low=low, high=high) \
+            if low is not None and high is not None else \
+            N_("give {name} a value of at least {low}", name=name, low=low) if low is not None else \
+            N_("give {name} a value of at most {high}", name=name, high=high) if high is not None else \
+            N_("give {name} a value such as 0.5", name=name)
         finite = number is int or value is None or math.isfinite(float(value))
-        wrong = "is out of range" if finite else "is not a finite number"
-        return Diagnostic(name, None, None, f"{name} {value} {wrong}", f"give {name} a value {limits}")
-    message = exc.message
-    return Diagnostic(name, None, None, f"{shown}: {message}", f"{command} says what {name} takes")
+        wrong = N_("{name} {value} is out of range", name=name, value=value) if finite else \
+            N_("{name} {value} is not a finite number", name=name, value=value)
+        return Diagnostic(name, None, None, wrong, hint)
+    return Diagnostic(name, None, None, N_("{shown}: {problem}", shown=shown, problem=_click_message(exc.message)),
+                      N_("{command} says what {name} takes", command=command, name=name))
+
+
+def _or(names: Sequence[str]) -> str:
+    """``a or b`` (``a, b or c``), in the reader's language."""
+    if len(names) == 1:
+        return names[0]
+    return N_("{first} or {last}", first=", ".join(names[:-1]), last=names[-1])
+
+
+#: click's own messages that reach a user (its copy in typer writes them in English), as tablebot's: a pattern
+#: of click's text, and the message with the pattern's groups as its arguments.
+CLICK_MESSAGES = (
+    (re.compile(r"Got unexpected extra argument(?:s|\(s\))? \((?P<args>.*)\)$", re.S),
+     lambda args: N_("unexpected extra argument(s): {args}", args=args)),
+    (re.compile(r"Option '(?P<option>[^']*)' requires (?:an argument|(?P<n>\d+) arguments)\.?$"),
+     lambda option, n: N_("{option} needs a value", option=option)),
+    (re.compile(r"Option '(?P<option>[^']*)' does not take a value\.?$"),
+     lambda option: N_("{option} takes no value", option=option)),
+    (re.compile(r"(?P<value>'.*') is not a valid (?P<kind>[a-z ]+)\.?$", re.S),
+     lambda value, kind: N_("{value} is not a valid value", value=value)),
+)
+
+
+def _click_message(text: Any) -> Any:
+    """A message of click's own in tablebot's words (one of ours, FiniteFloat's, as it is); one not known here in
+    click's English."""
+    if isinstance(text, Message):
+        return text
+    for pattern, message in CLICK_MESSAGES:
+        if found := pattern.match(str(text)):
+            return message(**found.groupdict())
+    return text
 
 
 def _name(param: Any) -> str:

@@ -66,10 +66,17 @@ def localise(command: Any) -> None:
             cmd.options_metavar = gettext(cmd.options_metavar)
         if getattr(cmd, "subcommand_metavar", None):
             cmd.subcommand_metavar = gettext(cmd.subcommand_metavar)
-        ctx = LocalContext(cmd, info_name=cmd.name, help_option_names=HELP_NAMES)
-        helper = cmd.get_help_option(ctx)
-        for param in [*cmd.params, *([helper] if helper is not None else [])]:
+        localise_params(cmd, LocalContext(cmd, info_name=cmd.name, help_option_names=HELP_NAMES))
+
+
+def localise_params(cmd: Any, ctx: Context) -> None:
+    """Translate a command's options and arguments (and its help option), each once: typer adds some to a group
+    after it is made (the completion options), so this runs again when they are asked for."""
+    helper = cmd.get_help_option(ctx)
+    for param in [*cmd.params, *([helper] if helper is not None else [])]:
+        if not getattr(param, "_tablebot_localised", False):
             _param(param, ctx)
+            param._tablebot_localised = True
 
 
 def _param(param: Any, ctx: Context) -> None:
