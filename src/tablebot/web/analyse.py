@@ -97,6 +97,8 @@ def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
         "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
         "motors": list(robot.motors), "tick_ms": robot.tick_ms, "initial_state": str(robot.initial_state),
         "robot": robot.name, "labels": dict(robot.labels),
+        # row i (a trace's 0-based ``row``) is this line of the file: the number the grid and every message show
+        "row_lines": [row.line for row in table.rows],
     }
 
 
@@ -165,21 +167,21 @@ def explain(table: Table, machine: Machine, state: int, events: int) -> list[dic
             continue
         row = table.rows[compiled.index]
         missing = [e for e in names if compiled.mask & table.bit(e) and not events & table.bit(e)]
+        line = f"line {row.line}" + (f" ({row.description})" if row.description else "")
         if compiled.index == fired:
-            why = f"row {compiled.index + 1} (line {row.line}) fired: " + (
+            why = f"{line} fired: " + (
                 f"it needs {' + '.join(e for e in names if e in row.events)}, all present" if row.events
                 else "it needs nothing")
             status = "fired"
         elif missing:
-            why = f"row {compiled.index + 1} (line {row.line}) did not fire: it needs {' + '.join(missing)}"
+            why = f"{line} did not fire: it needs {' + '.join(missing)}"
             status = "missing"
         elif fired == NO_ROW:  # it needs nothing, yet nothing fired: the document's rule on a tick with no event
-            why = (f"row {compiled.index + 1} (line {row.line}) did not fire: no event this tick, and with "
+            why = (f"{line} did not fire: no event this tick, and with "
                    'match = "document" no row is looked up then')
             status = "missing"
         else:
-            why = (f"row {compiled.index + 1} (line {row.line}) did not fire: row {fired + 1} comes first "
-                   "and matches too")
+            why = f"{line} did not fire: line {table.rows[fired].line} comes first and matches too"
             status = "shadowed"
         out.append({"row": compiled.index, "status": status, "why": why, "line": row.line})
     if fired == NO_ROW:

@@ -5,6 +5,7 @@ import { wirePlayerControls, wireZoom } from "../views/player.js";
 import { banner } from "./banner.js";
 import { wireControls } from "./controls.js";
 import { createDrafts } from "./drafts.js";
+import { keepFitted } from "./layout.js";
 import { createLink } from "./link.js";
 import { messageHandlers } from "./messages.js";
 import { showPanels } from "./panels.js";
@@ -28,6 +29,7 @@ showPanels(store, views, link.send);
 wireControls(store, link.send, receive, drafts);
 wirePlayerControls(views.player);
 wireZoom(views.arena);
+keepFitted();
 
 function paint() {
   const t0 = performance.now();

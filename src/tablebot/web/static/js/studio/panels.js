@@ -16,6 +16,7 @@ function countsText(m) {
 function showAnalysis(store, views) {
   store.on(["analysis"], ({ analysis: m, machine, tickMs }) => {
     views.grid.lines = m.lines;
+    if (m.machine) views.grid.rowLines = m.machine.row_lines;  // else the last table that read: the one running
     views.grid.setColumns(m.columns, m.machine ? m.machine.tick_ms : (machine ? machine.tick_ms : tickMs));
     views.grid.setDiagnostics(m.diagnostics);
     views.grid.setFindings(m.findings || []);
@@ -33,7 +34,7 @@ function showFrames(store, views) {
     if (!m || mode !== "live") return;
     views.arena.addPath(m.path);
     views.arena.setRobot(m.pose, m.bumpers, m.light);
-    const row = m.fired.length ? m.fired[m.fired.length - 1][1] : (m.paused ? m.row : views.grid.firedRow);
+    const row = m.fired.length ? m.fired[m.fired.length - 1][1] : (m.paused ? m.row : views.grid.liveRow);
     views.grid.setLive(row, m.state_id, stateColumn(store));
     views.diagram.highlight(m.state_id);
     const outputs = {};
@@ -51,7 +52,7 @@ function showWhy(store, views) {
   store.on(["why"], ({ why }) => {
     byId("why").replaceChildren(...why.map((item) => {
       const li = make("li", { className: "why-" + item.status }, item.why);
-      if (item.row !== null) li.addEventListener("click", () => views.grid.select([item.row]));
+      if (item.row !== null) li.addEventListener("click", () => views.grid.select([views.grid.gridRow(item.row)]));
       return li;
     }));
   });

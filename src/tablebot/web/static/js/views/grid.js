@@ -29,6 +29,7 @@ export class Grid {
     this.focused = null;
     this.lastEdited = null;
     this.firedRow = undefined;
+    this.rowLines = null;  // the machine's rows as file lines (row i of a trace fired line rowLines[i])
   }
 
   setTable(header, rows, lines) {
@@ -50,7 +51,7 @@ export class Grid {
   render() {
     const table = make("table", { className: "grid" });
     const head = table.createTHead().insertRow();
-    head.append(make("th", { className: "num", title: "the line in the file" }, "line"));
+    head.append(make("th", { className: "num", title: "the line in the file, as a spreadsheet numbers it" }, "line"));
     this.header.forEach((name, col) => head.append(this._headCell(name, col)));
     const body = table.createTBody();
     this.values.forEach((row, r) => body.append(this._row(row, r)));
@@ -64,8 +65,8 @@ export class Grid {
   _headCell(name, col) {
     const th = make("th", { className: "k-" + this.kind(col) });
     th.dataset.col = col;
-    name.split("_").forEach((part, i) => {  // M1_speed may break after the underscore: narrow columns
-      if (i) th.append("_", make("wbr"));
+    name.split("_").forEach((part, i) => {  // M1_speed on two lines, after its underscore: narrow columns
+      if (i) th.append("_", make("br"));
       th.append(part);
     });
     const label = (this.columns[col] || {}).label || "";
@@ -79,8 +80,7 @@ export class Grid {
   _row(values, r) {
     const tr = make("tr");
     tr.dataset.row = r;
-    tr.append(make("td", { className: "num", title: `row ${r + 1}, line ${this.lines[r]} of the file` },
-      String(this.lines[r])));
+    tr.append(make("td", { className: "num", title: `line ${this.lines[r]} of the file` }, String(this.lines[r])));
     values.forEach((value, c) => tr.append(this._cell(value, r, c)));
     return tr;
   }
@@ -89,7 +89,7 @@ export class Grid {
     const kind = this.kind(c);
     const td = make("td", { className: "k-" + kind });
     td.dataset.row = r; td.dataset.col = c;
-    td.append(TOGGLES.includes(kind) ? this._toggleButton(value, r, c, kind) : this._input(value, r, c, kind));
+    td.append(TOGGLES.includes(kind) ? this._toggleButton(value, r, c, kind) : this._fitted(this._input(value, r, c, kind)));
     if (kind === "timer") td.append(make("span", { className: "ms" }, timeText(value, this.tickMs)));
     return td;
   }
@@ -102,9 +102,21 @@ export class Grid {
     return b;
   }
 
+  // A cell's text is never cut: the input sits in a box that a hidden copy of its text sizes (a description
+  // wraps onto more lines instead, in a textarea as tall as its text).
+  _fitted(input) {
+    const box = make("span", { className: input.tagName === "TEXTAREA" ? "fit wrap" : "fit" });
+    box.dataset.value = input.value;
+    box.append(input);
+    return box;
+  }
+
   _input(value, r, c, kind) {
-    const input = make("input", { value, spellcheck: false, readOnly: this.readOnly });
-    input.setAttribute("aria-label", (this.header[c] || "") + " of row " + (r + 1));
+    const wraps = kind === "description";
+    const input = make(wraps ? "textarea" : "input", { value, spellcheck: false, readOnly: this.readOnly });
+    if (wraps) input.rows = 1;  // (and the smallest box of its own: the hidden copy beside it sizes it)
+    if (wraps) input.cols = 1; else input.size = 1;
+    input.setAttribute("aria-label", `${this.header[c] || ""} on line ${this.lines[r]}`);
     if (kind !== "description" && kind !== "unknown") input.inputMode = kind === "state" || kind === "next" ? "text" : "numeric";
     input.addEventListener("input", () => this._typed(r, c, input.value));
     input.addEventListener("focus", () => this._focus(r, c));
@@ -133,6 +145,7 @@ export class Grid {
 
   _typed(r, c, value) {
     this.values[r][c] = value;
+    this.td(r, c).querySelector(".fit").dataset.value = value;
     this.lastEdited = [r, c];
     if (this.kind(c) === "timer") this.td(r, c).querySelector(".ms").textContent = timeText(value, this.tickMs);
     clearTimeout(this.timers.get(r + ":" + c));
@@ -141,7 +154,9 @@ export class Grid {
 
   _keys(e, r, c) {
     const move = MOVES[e.key];
-    if (move === undefined || !this.td(r + move, c)) return;
+    if (move === undefined) return;
+    if (e.key === "Enter") e.preventDefault();  // a cell holds one line, even a description's textarea
+    if (!this.td(r + move, c)) return;
     e.preventDefault();
     this.focusCell(r + move, c);
   }
@@ -232,9 +247,18 @@ export class Grid {
     });
   }
 
-  // The row that fired this tick (-1: none) and the state the machine is in (its id as text).
-  setLive(row, stateId, stateCol) {
+  /** The grid row showing the machine's row ``row`` (an index into the table's rows, as a trace's ``row``):
+   * the one on the same line of the file (a row blanked in the grid is no row of the machine). */
+  gridRow(row) {
+    if (row === null || row === undefined || row < 0) return -1;
+    return this.rowLines ? this.lines.indexOf(this.rowLines[row]) : row;
+  }
+
+  // The machine's row that fired this tick (-1: none) and the state the machine is in (its id as text).
+  setLive(machineRow, stateId, stateCol) {
     if (!this.table) return;
+    const row = this.gridRow(machineRow);
+    this.liveRow = machineRow;
     if (this.firedRow !== row) {
       const old = this._tr(this.firedRow);
       if (old) old.classList.remove("fired");

@@ -10,7 +10,8 @@ export function describeTick(machine, t) {
   const st = machine.states.find((s) => s.id === String(t.state));
   parts.push(`state ${t.state}` + (st && st.label ? ` (${st.label})` : ""));
   if (t.timer !== undefined && t.timer !== null) parts.push(`timer ${t.timer} (${seconds(t.timer, machine)})`);
-  parts.push(t.row === null || t.row === undefined || t.row < 0 ? "no row fired" : `row ${t.row + 1} fired`);
+  // a person reads the file's line numbers (the grid's); a trace's 0-based row is an index into the rows
+  parts.push(t.row === null || t.row === undefined || t.row < 0 ? "no row fired" : `line ${machine.row_lines[t.row]} fired`);
   if (t.event !== undefined && t.event !== null) {
     const names = machine.events.filter((e, i) => t.event & (1 << (machine.events.length - 1 - i)));
     parts.push("events: " + (names.join(" + ") || "none"));
