@@ -55,7 +55,7 @@ def read_at(scene: Scene, x: float, y: float, heading: float) -> np.ndarray:
     """The robot's state row after sensing at a pose (no motion)."""
     s = np.zeros(L.N_STATE)
     s[L.X], s[L.Y], s[L.TH] = x, y, math.radians(heading)
-    sense(s, scene.P[0], *world_arrays(scene), np.zeros(L.N_NOISE), scene.bits)  # the simulator's own first reading
+    sense(s, scene.P[0], world_arrays(scene), np.zeros(L.N_NOISE), scene.bits)  # the simulator's own first reading
     return s
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -144,6 +145,29 @@ class Machine:
                 self.initial_state, self.initial_timer, self.output_names, *rule)
 
 
+class Program(NamedTuple):
+    """A compiled table as the compiled tick (:func:`tablebot.tick.tick`) reads it: one table's rule as integer
+    arrays, by name. numba passes it as the arrays it holds (no cost beside separate arguments); a robot that
+    runs several tables takes one Program per table (a tuple of them), each made by :attr:`MachineArrays.program`.
+
+    ``lookup[state, events]`` is the fired row or -1; per row, ``next_state`` and ``timers`` (the timer it
+    loads), ``outputs``/``keep`` each output's new value or "keep", ``loads``/``load_set`` each counter's load
+    or "leave alone"; ``counter_bits[c]`` is counter c's event bit (0: no column), ``input_mask`` the events
+    that come from inputs, ``timer_bit`` the T column's bit (0: none).
+    """
+
+    input_mask: int
+    timer_bit: int
+    lookup: np.ndarray
+    next_state: np.ndarray
+    timers: np.ndarray
+    outputs: np.ndarray
+    keep: np.ndarray
+    loads: np.ndarray
+    load_set: np.ndarray
+    counter_bits: np.ndarray
+
+
 @dataclass(frozen=True)
 class MachineArrays:
     """A machine as int64/bool arrays: what a compiled tick loop (numba, C) indexes directly.
@@ -163,11 +187,12 @@ class MachineArrays:
     input_mask: int = 0
     timer_bit: int = 0
 
-    @property
-    def program(self) -> tuple:
-        """The arrays in the order :func:`tablebot.tick.tick` unpacks them."""
-        return (self.input_mask, self.timer_bit, self.lookup, self.next, self.timer, self.outputs, self.keep,
-                self.loads, self.load_set, self.counter_bits)
+    @cached_property
+    def program(self) -> Program:
+        """The arrays as compiled loops take them (:class:`Program`)."""
+        return Program(input_mask=self.input_mask, timer_bit=self.timer_bit, lookup=self.lookup,
+                       next_state=self.next, timers=self.timer, outputs=self.outputs, keep=self.keep,
+                       loads=self.loads, load_set=self.load_set, counter_bits=self.counter_bits)
 
     @staticmethod
     def of(machine: Machine) -> MachineArrays:

@@ -7,7 +7,12 @@ one tick at a time in Python; tests prove the two agree tick for tick on random 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from tablebot.machine import Program
 
 # The engine's registers, one int64 array per robot: what a tick reads and changes besides the
 # outputs and counters arrays.
@@ -16,7 +21,7 @@ N_REGS = 5
 
 
 def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: int, pulses: np.ndarray,
-         program: tuple) -> int:
+         program: Program) -> int:
     """One tick of the document's engine; returns the fired row (-1: none).
 
     1. after the first tick the timer counts down (never below 0) and each counter by its pulses;
@@ -26,7 +31,6 @@ def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: in
        tick with no event at all, the robot file's ``match``, is in ``lookup[state, 0]``: no flag here);
     4. it sets each output it does not keep, loads the timer and the counters it names, and moves on.
     """
-    input_mask, timer_bit, lookup, nxt, timers, new_outputs, keep, loads, load_set, counter_bits = program
     n_counters = counters.shape[0]
     if regs[TICK] > 0:
         if regs[TIMER] > 0:
@@ -34,24 +38,24 @@ def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: in
         for c in range(n_counters):
             counters[c] = max(0, counters[c] - pulses[c])
     regs[TICK] += 1
-    events = inputs & input_mask
+    events = inputs & program.input_mask
     if regs[TIMER] == 0:
-        events |= timer_bit
+        events |= program.timer_bit
     for c in range(n_counters):
         if counters[c] == 0:
-            events |= counter_bits[c]
-    row = lookup[regs[STATE], events]
+            events |= program.counter_bits[c]
+    row = program.lookup[regs[STATE], events]
     regs[EVENT] = events
     regs[ROW] = row
     if row >= 0:
         for k in range(outputs.shape[0]):
-            if not keep[row, k]:
-                outputs[k] = new_outputs[row, k]
+            if not program.keep[row, k]:
+                outputs[k] = program.outputs[row, k]
         for c in range(n_counters):
-            if load_set[row, c]:
-                counters[c] = loads[row, c]
-        regs[TIMER] = timers[row]
-        regs[STATE] = nxt[row]
+            if program.load_set[row, c]:
+                counters[c] = program.loads[row, c]
+        regs[TIMER] = program.timers[row]
+        regs[STATE] = program.next_state[row]
     return row
 
 

@@ -12,75 +12,66 @@ from __future__ import annotations
 import numpy as np
 
 from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
+from tablebot.machine import Program
 from tablebot.sim.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
 from tablebot.sim.kernel import move, run_robot
+from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants, Record, RobotState, Wiring, WorldArrays
 
 
 @njit(nogil=True)
-def run_one(i: int, S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple, timers: np.ndarray,
-            loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray,
-            bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgens: np.ndarray,
-            acc: np.ndarray, collisions: np.ndarray, light_bits: int, t0: int, counts: np.ndarray,
-            first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray, hist: np.ndarray,
-            ints: np.ndarray) -> None:
+def run_one(i: int, fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
+            ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
     """Robot i of :func:`run_fleet`."""
-    input_mask, timer_bit, lookup, nxt, _, new_outputs, keep, _, load_set, counter_bits = program
-    v = variant[i]
-    own = (input_mask, timer_bit, lookup, nxt, timers[v], new_outputs, keep, loads[v], load_set, counter_bits)
-    slot = traced[i]
+    v = variants.variant[i]
+    own = Program(program.input_mask, program.timer_bit, program.lookup, program.next_state, variants.timers[v],
+                  program.outputs, program.keep, variants.loads[v], program.load_set, program.counter_bits)
+    slot = record.traced[i]
     if slot >= 0:
-        rows, record = hist[slot], ints[slot]
+        rows, ints = record.hist[slot], record.ints[slot]
     else:  # neither rows nor tick records: the tally is all a robot leaves
-        rows, record = np.empty((0, S.shape[1])), np.empty((0, ints.shape[2]), dtype=np.int64)
-    run_robot(S[i], P[i], *world, own, regs[i], outputs[i], counters[i], bits, drive, pcols, ticks, noise[i],
-              bitgens[i], rows, record, acc[i], collisions[i], counts[i], first_visit[i], first_light[i:i + 1],
-              light_bits, t0)
+        rows = np.empty((0, fleet.S.shape[1]))
+        ints = np.empty((0, record.ints.shape[2]), dtype=np.int64)
+    robot = RobotState(fleet.S[i], fleet.P[i], fleet.regs[i], fleet.outputs[i], fleet.counters[i], fleet.acc[i],
+                       fleet.collisions[i])
+    kept = Record(rows, ints, record.counts[i], record.first_visit[i], record.first_light[i:i + 1], record.light_bits,
+                  record.t0)
+    run_robot(robot, world, own, wiring, ticks, noise[i], bitgens[i], kept)
 
 
 @njit(nogil=True, parallel=True)
-def run_fleet(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple,
-              timers: np.ndarray, loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray,
-              counters: np.ndarray, bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int,
-              noise: np.ndarray, bitgens: np.ndarray, acc: np.ndarray, collisions: np.ndarray, light_bits: int,
-              t0: int, counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray,
-              hist: np.ndarray, ints: np.ndarray) -> None:
-    """Advance every robot ``ticks`` ticks: robot i runs ``run_robot`` on row i of each per-robot array, with
-    its program variant's timers and counter loads (``variant[i]``), its noise rows ``noise[i]`` or, when
-    they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.normals).
+def run_fleet(fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
+              ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
+    """Advance every robot ``ticks`` ticks: robot i runs ``run_robot`` on row i of each of the fleet's arrays,
+    with its program variant's timers and counter loads (``variants.variant[i]``), its noise rows ``noise[i]``
+    or, when they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.normals).
 
-    ``traced[i]`` >= 0 names the slot of ``hist``/``ints`` where robot i's robot rows and tick records
-    are kept (for its trace); other robots record into scratch space that is folded and dropped.
+    ``record.traced[i]`` >= 0 names the slot of ``record.hist``/``record.ints`` where robot i's robot rows and
+    tick records are kept (for its trace); other robots record into scratch space that is folded and dropped.
     """
-    for i in prange(S.shape[0]):
-        run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols, ticks,
-                noise, bitgens, acc, collisions, light_bits, t0, counts, first_visit, first_light, traced, hist, ints)
+    for i in prange(fleet.S.shape[0]):
+        run_one(i, fleet, world, program, variants, wiring, ticks, noise, bitgens, record)
 
 
 @njit(nogil=True)
-def run_fleet_serial(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], program: tuple,
-                     timers: np.ndarray, loads: np.ndarray, variant: np.ndarray, regs: np.ndarray, outputs: np.ndarray,
-                     counters: np.ndarray, bits: np.ndarray, drive: np.ndarray, pcols: np.ndarray, ticks: int,
-                     noise: np.ndarray, bitgens: np.ndarray, acc: np.ndarray, collisions: np.ndarray, light_bits: int,
-                     t0: int, counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, traced: np.ndarray,
-                     hist: np.ndarray, ints: np.ndarray) -> None:
+def run_fleet_serial(fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
+                     ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
     """:func:`run_fleet` on this thread alone (small fleets, single-threaded workers: no thread pool to wake)."""
-    for i in range(S.shape[0]):
-        run_one(i, S, P, world, program, timers, loads, variant, regs, outputs, counters, bits, drive, pcols, ticks,
-                noise, bitgens, acc, collisions, light_bits, t0, counts, first_visit, first_light, traced, hist, ints)
+    for i in range(fleet.S.shape[0]):
+        run_one(i, fleet, world, program, variants, wiring, ticks, noise, bitgens, record)
 
 
 @njit(nogil=True, parallel=True)
-def move_parallel(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+def move_parallel(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
                   bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     for i in prange(S.shape[0]):
-        move(S[i], commands[i, 0], commands[i, 1], P[i], *world, noise[i], bits, acc[i], collisions[i])
+        move(S[i], commands[i, 0], commands[i, 1], P[i], world, noise[i], bits, acc[i], collisions[i])
 
 
 @njit(nogil=True)
-def move_serial(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+def move_serial(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
                 bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     for i in range(S.shape[0]):
-        move(S[i], commands[i, 0], commands[i, 1], P[i], *world, noise[i], bits, acc[i], collisions[i])
+        move(S[i], commands[i, 0], commands[i, 1], P[i], world, noise[i], bits, acc[i], collisions[i])
 
 
 #: Robot-ticks of work below which a call runs on the calling thread: waking the thread pool costs tens of
@@ -94,7 +85,7 @@ def parallel(robots: int, ticks: int) -> bool:
     return robots > 1 and robots * ticks >= PARALLEL_WORK and numba.get_num_threads() > 1
 
 
-def move_fleet(S: np.ndarray, P: np.ndarray, world: tuple[np.ndarray, ...], commands: np.ndarray, noise: np.ndarray,
+def move_fleet(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
                bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """One tick of physics for every robot with the motor levels ``commands[i]`` (right, left) given
     from outside (a learned controller): ``sim.kernel.move`` on each robot's rows."""

@@ -28,7 +28,8 @@ from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.scene import Scene, _check_start, prepare
-from tablebot.sim.simrobot import SimRobot, Starter, world_arrays
+from tablebot.sim.simrobot import SimRobot, Starter, wiring_of, world_arrays
+from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants
 from tablebot.sim.summary import Summary, light_bits
 from tablebot.sim.world import World, inside
 from tablebot.sinks.run_trace import seconds_per_state
@@ -150,7 +151,7 @@ class Fleet:
         self.traced = np.full(n, -1, dtype=np.int64)
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
         self.world = world_arrays(first)
-        self.drive, self.pcols = np.array(first.drive, dtype=np.int64), np.array(first.pulse_columns, dtype=np.int64)
+        self.wiring = wiring_of(first)
         self.regs[:], self.outputs[:], self.counters[:] = self.initial
         rngs = generators([spec.seed for spec in self.specs])  # default_rng(seed) each, made at once
         by_params: dict[tuple, list[int]] = defaultdict(list)  # untraced robots, by parameter set
@@ -241,10 +242,11 @@ class Fleet:
         v = self.variants
         pool = parallel(len(self.specs), ticks) if threads is None else threads
         kernel = run_fleet if pool else run_fleet_serial
-        kernel(self.S, self.P, self.world, self.machine.arrays.program, v.timers, v.loads, self.variant,  # type: ignore[union-attr]
-               self.regs, self.outputs, self.counters, self.bits, self.drive, self.pcols, ticks, noise, self.bitgens,
-               self.acc, self.collisions, self.light_bits, self.t0, self.counts, self.first_visit, self.first_light,
-               self.traced, hist, ints)
+        fleet = FleetState(self.S, self.P, self.regs, self.outputs, self.counters, self.acc, self.collisions)
+        record = FleetRecord(self.counts, self.first_visit, self.first_light, self.traced, hist, ints, self.light_bits,
+                             self.t0)
+        kernel(fleet, self.world, self.machine.arrays.program, ProgramVariants(v.timers, v.loads, self.variant),  # type: ignore[union-attr]
+               self.wiring, ticks, noise, self.bitgens, record)
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]

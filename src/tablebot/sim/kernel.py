@@ -16,11 +16,13 @@ import numpy as np
 
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
+from tablebot.machine import Program
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.contacts import new_near, reaches
 from tablebot.sim.geometry import within
 from tablebot.sim.normals import standard_normal
 from tablebot.sim.physics import advance, advance_called, aim_turns
+from tablebot.sim.structures import Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tick import EVENT, ROW, STATE, TIMER
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -38,8 +40,6 @@ A_DEBOUNCE = 6  # rows: touches within this many rows belong to the last collisi
 N_ACC = 7
 NEVER = -1e18
 NO_TICK = -1  # "never" in a tally's first visits and first light
-#: run_robot's tally arguments when nothing is tallied (a single robot: its tick records say it all).
-NO_TALLY = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0, 0)
 
 
 def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
@@ -54,21 +54,21 @@ def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
 def observe(s: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """Fold one robot row into the running summary: reaching a lamp and the start of each collision
     (a rise of any bumper or contact with no touch in the debounce rows before it)."""
-    row = acc[A_ROWS]
-    acc[A_ROWS] = row + 1.0
+    robot_row = acc[A_ROWS]  # the row's number (not tick.py's ROW register, nor a noise row)
+    acc[A_ROWS] = robot_row + 1.0
     if acc[A_REACHED] < 0.0:
         for k in range(lamps.shape[0]):
             if within(s[X] - lamps[k, 0], s[Y] - lamps[k, 1], acc[A_REACH]):
-                acc[A_REACHED] = row
+                acc[A_REACHED] = robot_row
                 break
     touching = s[BUMP_FR] + s[BUMP_FL] + s[BUMP_REAR] + s[CONTACT] > 0.0
     if touching:
-        if acc[A_TOUCHING] == 0.0 and acc[A_LAST_TOUCH] < row - acc[A_DEBOUNCE]:
+        if acc[A_TOUCHING] == 0.0 and acc[A_LAST_TOUCH] < robot_row - acc[A_DEBOUNCE]:
             n = int(acc[A_COLLISIONS])
             if n < collisions.shape[0]:
-                collisions[n] = int(row)
+                collisions[n] = int(robot_row)
             acc[A_COLLISIONS] = n + 1
-        acc[A_LAST_TOUCH] = row
+        acc[A_LAST_TOUCH] = robot_row
     acc[A_TOUCHING] = 1.0 if touching else 0.0
 
 
@@ -85,62 +85,53 @@ def tally(counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, 
 
 
 @njit(nogil=True)
-def run_robot(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-              edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
-              program: tuple, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, bits: np.ndarray,
-              drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgen: np.uint64,
-              hist: np.ndarray, ints: np.ndarray, acc: np.ndarray, collisions: np.ndarray, counts: np.ndarray,
-              first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, t0: int) -> None:
+def run_robot(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
+              noise: np.ndarray, bitgen: np.uint64, record: Record) -> None:
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
     rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.normals.bitgen_address).
 
-    Writes the robot at the start of each tick into ``hist`` (when it has rows) and each tick's
-    integer record into ``ints`` (when it has rows), folds every new robot row into
-    ``acc``/``collisions`` (see :func:`observe`), and, when ``counts`` has room, tallies each tick (numbered
-    from ``t0``) into ``counts``/``first_visit``/``first_light`` (see :func:`tally`; ``NO_TALLY``: none).
+    Writes the robot at the start of each tick into ``record.hist`` (when it has rows) and each tick's
+    integer record into ``record.ints`` (when it has rows), folds every new robot row into the robot's
+    ``acc``/``collisions`` (see :func:`observe`), and, when ``record.counts`` has room, tallies each tick
+    (numbered from ``record.t0``) into the record's counts, first visits and first light (see :func:`tally`).
     """
-    near, centre = new_near(pstart, circles)
-    reach, wide = reaches(p)
+    near, centre = new_near(world.pstart, world.circles)
+    reach, wide = reaches(robot.p)
     turns = np.empty(4)
-    aim_turns(p, turns)
-    run_ticks(s, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, program, regs, outputs, counters, bits,
-              drive, pcols, ticks, noise, bitgen, hist, ints, acc, collisions, counts, first_visit, first_light,
-              light_bits, t0, np.zeros(counters.shape[0], dtype=np.int64), np.empty((4, 2)), reach, wide, near,
-              centre, turns, np.empty(N_NOISE))
+    aim_turns(robot.p, turns)
+    scratch = Scratch(np.zeros(robot.counters.shape[0], dtype=np.int64), np.empty((4, 2)), near, centre, turns,
+                      np.empty(N_NOISE), reach, wide)
+    run_ticks(robot, world, program, wiring, ticks, noise, bitgen, record, scratch)
 
 
 @njit(nogil=True, refcounts=False)
-def run_ticks(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-              edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
-              program: tuple, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, bits: np.ndarray,
-              drive: np.ndarray, pcols: np.ndarray, ticks: int, noise: np.ndarray, bitgen: np.uint64,
-              hist: np.ndarray, ints: np.ndarray, acc: np.ndarray, collisions: np.ndarray, counts: np.ndarray,
-              first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, t0: int, pulses: np.ndarray,
-              corners: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
-              turns: np.ndarray, z: np.ndarray) -> None:
+def run_ticks(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
+              noise: np.ndarray, bitgen: np.uint64, record: Record, scratch: Scratch) -> None:
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
-    n_counters = counters.shape[0]
+    s, regs, outputs, counters = robot.s, robot.regs, robot.outputs, robot.counters
+    hist, ints, counts, z, pulses = record.hist, record.ints, record.counts, scratch.z, scratch.pulses
+    pcols, drive = wiring.pulse_columns, wiring.drive
     for t in range(ticks):
         if hist.shape[0]:
             for j in range(s.shape[0]):
                 hist[t, j] = s[j]
         mask = int(s[MASK])
-        for c in range(n_counters):
+        for c in range(counters.shape[0]):
             pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
         tick_compiled(regs, outputs, counters, mask, pulses, program)
         if ints.shape[0]:
             _record(ints, t, mask, regs, outputs, counters, pulses)
         if counts.shape[0]:
-            tally(counts, first_visit, first_light, light_bits, regs[STATE], mask, t0 + t)
+            tally(counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask,
+                  record.t0 + t)
         if noise.shape[0]:
             for k in range(N_NOISE):
                 z[k] = noise[t, k]
         else:
             for k in range(N_NOISE):
                 z[k] = standard_normal(bitgen)
-        advance(s, outputs[drive[0]], outputs[drive[1]], p, verts, pstart, pbound, edges, circles, lamps, lines, shade,
-                z, bits, True, corners, reach, wide, near, centre, turns)
-        observe(s, lamps, acc, collisions)
+        advance(s, outputs[drive[0]], outputs[drive[1]], robot.p, world, wiring.bits, True, scratch)
+        observe(s, world.lamps, robot.acc, robot.collisions)
 
 
 @njit(nogil=True, refcounts=False, inline="always")
@@ -164,30 +155,27 @@ def _record(ints: np.ndarray, t: int, mask: int, regs: np.ndarray, outputs: np.n
 
 
 @njit(nogil=True)
-def sense(s: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray, edges: np.ndarray,
-          circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray, z: np.ndarray,
-          bits: np.ndarray) -> None:
+def sense(s: np.ndarray, p: np.ndarray, world: WorldArrays, z: np.ndarray, bits: np.ndarray) -> None:
     """Read the sensors without moving (the start of a run)."""
-    near, centre = new_near(pstart, circles)
-    reach, wide = reaches(p)
-    turns = np.empty(4)
-    aim_turns(p, turns)
     # not the constants 0 and False: numba would compile advance_called again for their literal types
     # (half a minute), since move passes variables
     still, moving = np.int64(0), np.bool_(False)
-    advance_called(s, still, still, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, moving,
-                   np.empty((4, 2)), reach, wide, near, centre, turns)
+    advance_called(s, still, still, p, world, bits, moving, _scratch(p, world, z))
 
 
 @njit(nogil=True)
-def move(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-         pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
-         shade: np.ndarray, z: np.ndarray, bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def move(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, z: np.ndarray, bits: np.ndarray,
+         acc: np.ndarray, collisions: np.ndarray) -> None:
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
-    near, centre = new_near(pstart, circles)
+    advance_called(s, right, left, p, world, bits, np.bool_(True), _scratch(p, world, z))  # not True: see sense
+    observe(s, world.lamps, acc, collisions)
+
+
+@njit(nogil=True, inline="always")
+def _scratch(p: np.ndarray, world: WorldArrays, z: np.ndarray) -> Scratch:
+    """A robot's working space for one tick of physics alone (no table: no pulses)."""
+    near, centre = new_near(world.pstart, world.circles)
     reach, wide = reaches(p)
     turns = np.empty(4)
     aim_turns(p, turns)
-    advance_called(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits,
-                   np.bool_(True), np.empty((4, 2)), reach, wide, near, centre, turns)  # not True: see sense
-    observe(s, lamps, acc, collisions)
+    return Scratch(np.zeros(0, dtype=np.int64), np.empty((4, 2)), near, centre, turns, z, reach, wide)

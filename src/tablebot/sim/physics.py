@@ -73,6 +73,7 @@ from tablebot.sim.columns import (
 from tablebot.sim.contacts import resolve, sense_bumpers
 from tablebot.sim.sensing import light_turned, sense_declared, sensor_events
 from tablebot.sim.shadows import NO_SHADE
+from tablebot.sim.structures import Scratch, WorldArrays
 
 NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 
@@ -192,33 +193,28 @@ def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, p
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-            pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
-            shade: np.ndarray, z: np.ndarray, bits: np.ndarray, move: bool, corners: np.ndarray, reach: float,
-            wide: float, near: np.ndarray, centre: np.ndarray, turns: np.ndarray) -> None:
+def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray, move: bool,
+            scratch: Scratch) -> None:
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
-    sense; fills the robot's MASK column. ``corners`` is scratch space of shape (4, 2); ``reach``, ``wide``:
-    :func:`~tablebot.sim.contacts.reaches`; ``near`` and ``centre`` the robot's candidate list
-    (:func:`~tablebot.sim.contacts.new_near`), kept from tick to tick;
-    ``turns``: :func:`aim_turns`."""
+    sense, moved by the noise row ``scratch.z``; fills the robot's MASK column. ``scratch`` also keeps the
+    robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.contacts.new_near`)."""
+    w, near, centre = world, scratch.near, scratch.centre
     if move:
         x0, y0 = s[X], s[Y]
         cmd = (right, left)
-        drive(s, cmd, p, z)
-        resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+        drive(s, cmd, p, scratch.z)
+        resolve(s, p, scratch.corners, w.verts, w.pstart, w.pbound, w.circles, scratch.reach, scratch.wide, near,
+                centre)
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-    sense_near(s, p, z, verts, pstart, pbound, edges, circles, lamps, lines, shade, bits, reach, wide, near, centre,
-               turns)
+    sense_near(s, p, scratch.z, w.verts, w.pstart, w.pbound, w.edges, w.circles, w.lamps, w.lines, w.shade, bits,
+               scratch.reach, scratch.wide, near, centre, scratch.turns)
 
 
 @njit(cache=True, refcounts=False)
-def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-                   pbound: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray,
-                   shade: np.ndarray, z: np.ndarray, bits: np.ndarray, move: bool, corners: np.ndarray,
-                   reach: float, wide: float, near: np.ndarray, centre: np.ndarray, turns: np.ndarray) -> None:
+def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray,
+                   move: bool, scratch: Scratch) -> None:
     """:func:`advance` compiled once as a function of its own, for sim.kernel.move and sense: the tick-by-tick
     robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
     where a call per robot-tick costs little beside the rest of a controller's step, and each inlined copy
     took numba ~20 s to compile. The loops that run the table too (run_robot) inline :func:`advance` itself."""
-    advance(s, right, left, p, verts, pstart, pbound, edges, circles, lamps, lines, shade, z, bits, move, corners,
-            reach, wide, near, centre, turns)
+    advance(s, right, left, p, world, bits, move, scratch)

@@ -19,6 +19,7 @@ from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
 from tablebot.sim.scene import Scene, sensor_columns
+from tablebot.sim.structures import RobotState, Wiring, WorldArrays, untallied
 from tablebot.tick import registers
 
 DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
@@ -37,8 +38,7 @@ class SimRobot:
         self.scene = scene
         self.record_history = record_history  # keep each tick's robot row in blocks (``TickBlock.extra``)
         self._world = world_arrays(scene)
-        self._drive = np.array(scene.drive, dtype=np.int64)
-        self._pcols = np.array(scene.pulse_columns, dtype=np.int64)
+        self._wiring = wiring_of(scene)
         self.light_keys = light_keys(scene)
         self._layout = trace_layout(scene)  # the trace fields, worked out once instead of every tick
         self.collision_rows = np.zeros(MAX_COLLISIONS, dtype=np.int64)
@@ -70,12 +70,12 @@ class SimRobot:
 
     def read(self) -> Reading:
         s = self.s
-        pulses = tuple(0 if c < 0 else int(s[c]) for c in self._pcols.tolist())
+        pulses = tuple(0 if c < 0 else int(s[c]) for c in self.scene.pulse_columns)
         return Reading(int(s[L.MASK]), pulses, RowFields(self, s.copy()))
 
     def write(self, outputs: Sequence[int]) -> None:
         right, left = (0, 0) if self.stopped else (outputs[self.scene.drive[0]], outputs[self.scene.drive[1]])
-        K.move(self.s, right, left, self.scene.P[0], *self._world, self._noise(1)[0], self.scene.bits, self.acc,
+        K.move(self.s, right, left, self.scene.P[0], self._world, self._noise(1)[0], self.scene.bits, self.acc,
                self.collision_rows)
 
     def stop(self) -> None:
@@ -101,9 +101,9 @@ class SimRobot:
         ints = np.zeros((ticks, K.I_OUTPUTS + n_out + 2 * n_c), dtype=np.int64)
         hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
         start = engine.tick
-        K.run_robot(self.s, self.scene.P[0], *self._world, arrays.program, regs, outputs, counters,
-                    self.scene.bits, self._drive, self._pcols, ticks, NO_NOISE, bitgen_address(self.rng), hist, ints,
-                    self.acc, self.collision_rows, *K.NO_TALLY)
+        robot = RobotState(self.s, self.scene.P[0], regs, outputs, counters, self.acc, self.collision_rows)
+        K.run_robot(robot, self._world, arrays.program, self._wiring, ticks, NO_NOISE, bitgen_address(self.rng),
+                    untallied(hist, ints))
         engine._sync(regs, outputs, counters)
         return self._block(start, ints, hist, n_out, n_c)
 
@@ -152,10 +152,15 @@ class SimRobot:
         return self._observation(self.s[None, :])[0]
 
 
-def world_arrays(scene: Scene) -> tuple[np.ndarray, ...]:
+def world_arrays(scene: Scene) -> WorldArrays:
     """The scene's walls, obstacles, lamps and lines as the compiled code takes them."""
     g = scene.geometry
-    return g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines, g.shade
+    return WorldArrays(g.verts, g.pstart, g.pbound, g.edges, g.circles, g.lamps, g.lines, g.shade)
+
+
+def wiring_of(scene: Scene) -> Wiring:
+    """The scene's wiring as the compiled code takes it."""
+    return Wiring(scene.bits, np.array(scene.drive, dtype=np.int64), np.array(scene.pulse_columns, dtype=np.int64))
 
 
 class Starter:
@@ -185,8 +190,8 @@ class Starter:
         acc[rows] = self.acc
         collisions[rows] = 0
         for k, i in enumerate(rows):
-            K.sense(S[i], self.p, *self.world, draws[k, 2:], self.bits)
-            K.observe(S[i], self.world[5], acc[i], collisions[i])
+            K.sense(S[i], self.p, self.world, draws[k, 2:], self.bits)
+            K.observe(S[i], self.world.lamps, acc[i], collisions[i])
 
 
 def light_keys(scene: Scene) -> tuple[str, str]:
