@@ -1,14 +1,22 @@
-"""Helpers of the studio's tests: waiting for a condition, a real Chromium, and whether its page is up."""
+"""Helpers of the studio's tests: a copy of the BumberBot, a studio served from a thread, waiting for a
+condition, a real Chromium, whether its page is up, a folder for screenshots, and a second web server on
+another loopback port (the page of someone else's program) that records what the browser sends it."""
 
 from __future__ import annotations
 
 import os
+import shutil
+import threading
 import time
 from collections.abc import Callable, Iterator
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 
 import pytest
+
+from core_helpers import EXAMPLE
+from tablebot.web.app import Background
 
 CHROMIUM = Path("/usr/bin/chromium")
 FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
@@ -42,3 +50,60 @@ def studio_works(page: Any) -> None:
     """The studio's page fetched its config and talks over its WebSocket: the table and the robot are up."""
     page.wait_for_selector("#play:not([disabled])", timeout=20_000)
     assert page.locator("#banner").is_hidden() or "stopped" not in page.locator("#banner").inner_text()
+
+
+def bumberbot(parent: Path, name: str = "bot") -> Path:
+    """A copy of the BumberBot example in ``parent/name``."""
+    root = parent / name
+    shutil.copytree(EXAMPLE, root)
+    return root
+
+
+def served(folder: Path, table: str | None = "table.csv", **options: Any) -> Iterator[Background]:
+    """The studio for ``folder`` from a thread (a fixture yields from it), stopped afterwards."""
+    studio = Background(folder, table, **options)
+    yield studio
+    studio.stop()
+
+
+def screenshots(tmp_path_factory: pytest.TempPathFactory, name: str) -> Path:
+    """Where a module's screenshots go: ``$TABLEBOT_SCREENSHOTS``, or ``name`` in pytest's temporary folder."""
+    folder = Path(os.environ.get("TABLEBOT_SCREENSHOTS") or tmp_path_factory.mktemp(name))
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+class OtherPort:
+    """A second web server on another loopback port, as another program of this machine: ``page`` (HTML)
+    at every path; ``cookies`` holds every Cookie header a request brought (none: nothing kept)."""
+
+    def __init__(self, page: str) -> None:
+        self.cookies: list[str] = []
+        body, cookies = page.encode(), self.cookies
+
+        class Handler(BaseHTTPRequestHandler):
+            def do_GET(self) -> None:
+                cookies.extend(self.headers.get_all("Cookie") or [])
+                self.send_response(200)
+                self.send_header("Content-Type", "text/html; charset=utf-8")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body)
+
+            def log_message(self, *args: Any) -> None:
+                pass
+
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.origin = f"http://127.0.0.1:{self.server.server_address[1]}"
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+
+    def close(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()
+
+
+def other_port(page: str) -> Iterator[OtherPort]:
+    """An :class:`OtherPort` serving ``page`` (a fixture yields from it), closed afterwards."""
+    server = OtherPort(page)
+    yield server
+    server.close()

@@ -5,9 +5,10 @@ command as a user runs it, a real second web server on another loopback port and
   0700 folder of the user's runtime or temporary folder) that leads to the tokened address, and removes it
   when it stops. The browser here is a stand-in named by ``BROWSER`` that records its own argv; the file it
   was given, opened in Chromium, leads to the studio.
-* A cookie of the studio's name planted by a page on another port (``path=/ws``, which the browser sends
-  before the studio's own) no longer locks the user out: any cookie of that name holding the token lets
-  the page in.
+* The token is in no cookie, so no other port's server receives it (browsers send a 127.0.0.1 cookie to
+  every port): the page keeps it in sessionStorage (per port), out of the address bar and history, and
+  sends it in a header and a WebSocket subprotocol. A real second server on another port records every
+  Cookie header the browser sends it; its page cannot get in, and the cookies it plants lock nobody out.
 * ``--verbose`` logs show a token as ``[token]`` however it is percent-encoded.
 * An upload cut off mid-body is one line in the terminal, not a traceback.
 """
@@ -23,20 +24,19 @@ import socket
 import stat
 import subprocess
 import sys
-import threading
 import time
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
 from dataclasses import dataclass
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from core_helpers import EXAMPLE
-from studio_helpers import chromium, studio_works, wait_for
+from studio_helpers import OtherPort, chromium, other_port, served, studio_works, wait_for
+from tablebot.web.access import TOKEN_HEADER
 from tablebot.web.app import Background
 
 
@@ -204,14 +204,14 @@ def test_verbose_logs_hide_a_percent_encoded_token(command: Command) -> None:
     base = f"http://127.0.0.1:{command.port}"
     assert _get(f"{base}/?token={every}&table=table.csv") == 200  # the server decodes it: it is the token
     assert _get(f"{base}/api/config?token={some}") == 403
-    assert _get(f"{base}/?table={twice}") == 403
-    wait_for(lambda: '"GET /?table=' in command.text(), "the log line of the last request")
+    assert _get(f"{base}/api/config?table={twice}") == 403
+    wait_for(lambda: '"GET /api/config?table=' in command.text(), "the log line of the last request")
     log = command.text()
     for form in (every, some, twice, token):
         assert form not in log.replace(command.url, ""), form  # only the printed address shows it
     assert re.search(r'"GET /\?token=\[token\]&table=table.csv HTTP/1.1" 200', log), log
     assert re.search(r'"GET /api/config\?token=\[token\] HTTP/1.1" 403', log), log
-    assert re.search(r'"GET /\?table=\[token\] HTTP/1.1" 403', log), log
+    assert re.search(r'"GET /api/config\?table=\[token\] HTTP/1.1" 403', log), log
 
 
 # --- an upload cut off -----------------------------------------------------------------------------------
@@ -219,7 +219,7 @@ def test_verbose_logs_hide_a_percent_encoded_token(command: Command) -> None:
 def test_an_upload_cut_off_mid_body_is_one_line_not_a_traceback(command: Command) -> None:
     port = command.port
     head = (f"POST /api/trace?name=cut.jsonl HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-            f"Origin: http://127.0.0.1:{port}\r\nCookie: tablebot-studio-{port}={command.token}\r\n"
+            f"Origin: http://127.0.0.1:{port}\r\n{TOKEN_HEADER}: {command.token}\r\n"
             "Content-Type: application/octet-stream\r\nContent-Length: 100000\r\n\r\n")
     body = b'{"tick":0,"state":1}\n' * 50  # 1,050 of the 100,000 bytes announced
     with socket.create_connection(("127.0.0.1", port), timeout=10) as conn:
@@ -229,68 +229,41 @@ def test_an_upload_cut_off_mid_body_is_one_line_not_a_traceback(command: Command
     assert "cut off after 1,050 of 100,000 bytes" in line[0], line[0]
     log = command.text()
     assert "Traceback" not in log and "ClientDisconnect" not in log and "Exception in ASGI" not in log, log
-    cookie = {"Cookie": f"tablebot-studio-{port}={command.token}"}
-    assert _get(f"http://127.0.0.1:{port}/api/config", cookie) == 200  # and the studio goes on
+    assert _get(f"http://127.0.0.1:{port}/api/config", {TOKEN_HEADER: command.token}) == 200  # and the studio goes on
 
 
-# --- a cookie planted by a page on another port ----------------------------------------------------------
+# --- the token kept by the page, in no cookie ----------------------------------------------------------
 
 @pytest.fixture(scope="module")
 def studio(folder: Path) -> Iterator[Background]:
-    server = Background(folder, "table.csv")
-    yield server
-    server.stop()
+    yield from served(folder)
 
 
-def _upgrade(studio: Background, cookie: str) -> int:
-    """The status of the page's WebSocket upgrade with this Cookie header (101: accepted)."""
-    port = studio.access.port
-    request = (f"GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: {studio.origin}\r\nCookie: {cookie}\r\n"
-               "Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n"
-               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n")
-    with socket.create_connection(("127.0.0.1", port), timeout=10) as conn:
-        conn.sendall(request.encode())
-        return int(conn.makefile("rb").readline().split()[1])
-
-
-def test_any_cookie_of_the_studios_name_with_the_token_lets_the_page_in(studio: Background) -> None:
-    """As a browser sends them: the planted path=/ws cookie first (longer path), the studio's after it."""
-    name, token = studio.access.cookie, studio.access.token
-    planted = f"{name}=planted; {name}={token}"
-    assert _get(f"{studio.origin}/api/config", {"Origin": studio.origin, "Cookie": planted}) == 200
-    assert _upgrade(studio, planted) == 101
-    assert _upgrade(studio, f"{name}=planted; other={token}; {name}=x") == 403  # the name matters
-    assert _upgrade(studio, f"{name}=planted; {name}=") == 403
-
-
-#: The hostile page on another port: it plants cookies of the studio's name (and tries to replace its own).
-PLANT_PAGE = """<!doctype html><html><body><script>
-for (const path of ["/ws", "/api/config", "/static", "/"]) document.cookie = NAME + "=planted; path=" + path;
-document.body.textContent = "planted: " + document.cookie;
-window.planted = true;
+#: The page of another program on another port: it reads what it can, plants cookies of the names the
+#: studio used, and tries to get in (the studio's API, its WebSocket bare and with a guessed key).
+OTHER_PAGE = """<!doctype html><html><body><script>
+const studio = STUDIO;
+for (const path of ["/ws", "/api/config", "/"]) document.cookie = NAME + "=planted; path=" + path;
+function socket(protocols) {
+  return new Promise((resolve) => {
+    const s = new WebSocket(studio.replace("http", "ws") + "/ws", protocols);
+    s.onopen = () => resolve("opened"); s.onerror = () => resolve("refused");
+  });
+}
+(async () => {
+  const got = { storage: JSON.stringify([{ ...sessionStorage }, { ...localStorage }]), cookie: document.cookie };
+  try { got.config = (await fetch(studio + "/api/config")).status; } catch (e) { got.config = "blocked"; }
+  got.bare = await socket();
+  got.guessed = await socket(["tablebot-studio", "tablebot-token.planted"]);
+  window.got = got;
+})();
 </script></body></html>"""
 
 
 @pytest.fixture(scope="module")
-def planter(studio: Background) -> Iterator[str]:
-    """A second web server on another loopback port, serving the page that plants the cookies."""
-    page = PLANT_PAGE.replace("NAME", json.dumps(studio.access.cookie)).encode()
-
-    class Handler(BaseHTTPRequestHandler):
-        def do_GET(self) -> None:
-            self.send_response(200)
-            self.send_header("Content-Type", "text/html; charset=utf-8")
-            self.end_headers()
-            self.wfile.write(page)
-
-        def log_message(self, *args: Any) -> None:
-            pass
-
-    server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    yield f"http://127.0.0.1:{server.server_address[1]}/plant.html"
-    server.shutdown()
-    server.server_close()
+def other(studio: Background) -> Iterator[OtherPort]:
+    page = OTHER_PAGE.replace("STUDIO", json.dumps(studio.origin))
+    yield from other_port(page.replace("NAME", json.dumps(f"tablebot-studio-{studio.access.port}")))
 
 
 @pytest.fixture(scope="module")
@@ -298,20 +271,52 @@ def browser() -> Iterator[Any]:
     yield from chromium()
 
 
-def test_a_cookie_planted_from_another_port_does_not_lock_the_user_out(browser: Any, studio: Background,
-                                                                       planter: str) -> None:
+def test_no_other_port_receives_the_token_and_its_page_cannot_get_in(browser: Any, studio: Background,
+                                                                      other: OtherPort) -> None:
+    token = studio.access.token
     context = browser.new_context()
     page = context.new_page()
     page.goto(studio.url)
     studio_works(page)
-    page.goto(planter)
-    page.wait_for_function("() => window.planted")
-    mine = [c for c in context.cookies() if c["name"] == studio.access.cookie]
-    assert sorted(c["path"] for c in mine) == ["/", "/api/config", "/static", "/ws"]  # the attack took hold
-    assert [c["value"] for c in mine if c["path"] == "/"] == [studio.access.token]  # HttpOnly: not replaced
-    assert studio.access.token not in page.inner_text("body")  # nor read by the page's script
-    page.goto(studio.origin + "/")  # the user comes back to the studio (no token in the address)
+    assert page.url == studio.origin + "/"  # the token left the address bar at once
+    assert context.cookies() == [] and page.evaluate("sessionStorage.getItem('tablebot-studio-token')") == token
+    page.goto(other.origin + "/page.html")  # the user visits another program's page in the same tab
+    got = page.wait_for_function("() => window.got").json_value()
+    assert token not in json.dumps(got) and got["bare"] == got["guessed"] == "refused", got
+    assert got["config"] in (403, "blocked"), got
+    page.go_back()  # the studio's entry in the history holds no token, and the page there gets in again
+    assert "token" not in page.url
     studio_works(page)
+    page.reload()
+    studio_works(page)
+    second = context.new_page()  # a second tab, opened with the printed address
+    second.goto(studio.url)
+    studio_works(second)
+    second.goto(other.origin + "/again.html")
+    second.wait_for_function("() => window.got")
+    assert other.cookies and all(token not in cookie for cookie in other.cookies), other.cookies  # its own only
+    context.close()
+
+
+def test_a_websocket_without_the_token_is_refused_on_the_studios_own_page(browser: Any, studio: Background) -> None:
+    context = browser.new_context()
+    page = context.new_page()
+    page.goto(studio.url)
+    studio_works(page)
+    opened = page.evaluate("""() => Promise.all([[], ["tablebot-studio"], ["tablebot-studio", "tablebot-token.x"]]
+      .map((protocols) => new Promise((resolve) => {
+        const s = new WebSocket("ws://" + location.host + "/ws", protocols);
+        s.onopen = () => resolve("opened"); s.onerror = () => resolve("refused"); })))""")
+    assert opened == ["refused", "refused", "refused"]
+    context.close()
+
+
+def test_an_address_without_the_token_says_how_to_get_in(browser: Any, studio: Background) -> None:
+    context = browser.new_context()
+    page = context.new_page()
+    page.goto(studio.origin + "/?table=table.csv")  # an old address, or a new tab opened by hand
+    page.wait_for_selector("#banner:not([hidden])")
+    assert "open the address that tablebot studio printed" in page.inner_text("#banner")
     context.close()
 
 
@@ -323,6 +328,5 @@ def test_the_private_file_opened_in_chromium_leads_to_the_studio(browser: Any, c
     page.goto(opened)
     page.wait_for_url(f"http://127.0.0.1:{command.port}/**")
     studio_works(page)
-    assert "token" not in page.url
-    assert f"tablebot-studio-{command.port}" in {c["name"] for c in context.cookies()}
+    assert "token" not in page.url and context.cookies() == []
     context.close()
