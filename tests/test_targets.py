@@ -79,9 +79,12 @@ def test_the_commands_choices_are_the_registered_back_ends() -> None:
 def test_a_back_end_registers_once_and_says_what_it_is() -> None:
     c = registry.get("c")
     assert registry.register(c) is c  # registering the same one again is harmless
+    assert isinstance(c, registry.ExportBackend) and c.kind == "export"
     with pytest.raises(ValueError, match="two back-ends"):
-        registry.register(registry.Backend("c", "export", "another", export=c.export))
-    with pytest.raises(ValueError, match=r"export .* or open"):
-        registry.register(registry.Backend("neither", "export", "nothing"))
-    with pytest.raises(ValueError, match="only a live back-end opens"):
-        registry.register(registry.Backend("wrong", "export", "x", open=registry.get("sim").open))
+        registry.register(registry.ExportBackend(name="c", makes="another", export=c.export))
+    with pytest.raises(TypeError, match="an ExportBackend or a LiveBackend"):
+        registry.register(object())  # type: ignore[type-var]
+    sim = registry.get("sim")
+    assert isinstance(sim, registry.LiveBackend) and sim.kind == "live" and registry.exporter("sim") is None
+    assert [b.name for b in registry.lives()] == registry.names("live")
+    assert [b.name for b in registry.exporters("board")] == registry.names("board") == ["uno", "ftduino"]

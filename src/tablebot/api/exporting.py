@@ -11,14 +11,17 @@ from tablebot.diagnostics import fail
 
 if TYPE_CHECKING:
     from tablebot.loading import Loaded, PathLike
-    from tablebot.registry import Exported
+    from tablebot.registry import Exported, Lookup
+
+#: ``lookup``'s choices (``--lookup``).
+LOOKUPS = ("auto", "dense", "scan")
 
 
 def targets() -> list[str]:
     """The names ``to`` takes: every registered export back-end."""
     from tablebot import registry
 
-    return [b.name for b in registry.backends("export")]
+    return [b.name for b in registry.exporters("export")]
 
 
 def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathLike | None = None,
@@ -34,15 +37,29 @@ def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathL
     ['tb_config.h', 'tb_engine.c', 'tb_engine.h', 'tb_table.c']
     """
     from tablebot import registry
-    from tablebot.robopro.rpp_edit import DEFAULT_NAMES
 
-    if to not in targets():
+    backend = registry.exporter(to)
+    if backend is None or backend.kind != "export":
         raise fail("--to", f"unknown export target {to!r}", f"use one of {', '.join(targets())}")
-    backend = registry.get(to)
     if out is None and backend.needs_out:
         raise fail("OUTDIR", f"--to {to} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
-    assert backend.export is not None
-    names = tuple(lists) if lists is not None else DEFAULT_NAMES
+    options = registry.ExportOptions(into=Path(into) if into is not None else None, lists=_three(lists),
+                                     lookup=_lookup(lookup))
     with project.writing():
-        return backend.export(project.machine, Path(out) if out is not None else None,
-                              {"into": Path(into) if into is not None else None, "lists": names, "lookup": lookup})
+        return backend.export(project.machine, Path(out) if out is not None else None, options)
+
+
+def _three(lists: Sequence[str] | None) -> tuple[str, str, str] | None:
+    """The event, action and timer lists' names, or None for the document's own."""
+    if lists is None:
+        return None
+    if len(lists) != 3:
+        raise fail("--event-list", f"give three list names (event, action, timer), not {len(lists)}",
+                   "--event-list, --action-list and --timer-list")
+    return lists[0], lists[1], lists[2]
+
+
+def _lookup(lookup: str) -> Lookup:
+    if lookup not in LOOKUPS:
+        raise fail("--lookup", f"unknown lookup {lookup!r}", f"use one of {', '.join(LOOKUPS)}")
+    return lookup  # type: ignore[return-value]  # one of LOOKUPS

@@ -15,18 +15,18 @@ if TYPE_CHECKING:
     from tablebot.api.progress import Progress
     from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
-    from tablebot.registry import Backend, Opened
+    from tablebot.registry import LiveBackend, Opened
 
 
 def address_hint() -> str:
     """Every address form of every live back-end: ``write --on txt://HOST:PORT, ..., sim or sim:WORLD.toml``."""
     from tablebot import registry
 
-    forms = [form for backend in registry.backends("live") for form in backend.addresses]
+    forms = [form for backend in registry.lives() for form in backend.addresses]
     return "write --on " + (", ".join(forms[:-1]) + " or " + forms[-1] if len(forms) > 1 else "".join(forms))
 
 
-def live_backend(text: str) -> Backend:
+def live_backend(text: str) -> LiveBackend:
     """The live back-end an address (``--on``) names; anything else is a located error."""
     from tablebot import registry
 
@@ -98,8 +98,8 @@ def connect(project: Loaded, on: str, *, link_timeout: float | None = None, behi
     ``sim`` or ``sim:WORLD.toml``, ...) for the table: ``link_timeout`` seconds without a valid reply end a
     run as ``link_lost`` (default: 5 ticks); a run ends as ``behind`` when the table's time falls
     ``behind_limit`` seconds behind the wall clock within any 5 s (0: never); ``seed``: the simulator's."""
-    backend = live_backend(on)
-    assert backend.open is not None
-    opened = backend.open(project.machine, on, {"link_timeout_s": link_timeout, "seed": seed,
-                                                "hint": address_hint(), "behind_limit_s": behind_limit})
+    from tablebot.registry import LinkOptions
+
+    link = LinkOptions(on, link_timeout_s=link_timeout, behind_limit_s=behind_limit, seed=seed, hint=address_hint())
+    opened = live_backend(on).open(project.machine, link)
     return Connection(project, opened, behind_limit)

@@ -38,9 +38,9 @@ OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: bu
 
 def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
     _, machine = load(table, robot)
-    backend = registry.get(board.value)
-    assert backend.export is not None
-    done = backend.export(machine, out, {})
+    backend = registry.exporter(board.value)
+    assert backend is not None  # --board's choices are the registered boards
+    done = backend.export(machine, out, registry.ExportOptions())
     for line in done.lines:
         console.print(terminal(line))
     return done.value

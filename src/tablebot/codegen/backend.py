@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic
 from tablebot.files import out_folder
-from tablebot.registry import Backend, Exported, Options, refused, register
+from tablebot.registry import ExportBackend, Exported, ExportOptions, refused, register
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
@@ -20,11 +20,11 @@ def fit(machine: Machine) -> list[Diagnostic]:
     return refused(lambda: check_fits(machine)) or refused(lambda: plan(machine))
 
 
-def export(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.codegen.source import generate
 
     assert out is not None
-    source = generate(machine, options.get("lookup", "auto"))  # before the folder is made: a refused table leaves none
+    source = generate(machine, options.lookup)  # before the folder is made: a refused table leaves none
     files = tuple(source.write(out_folder(out, "OUTDIR")))
     kind = "dense" if source.layout.dense else "scan"
     return Exported(files, (*(f"wrote {path}" for path in files),
@@ -32,5 +32,5 @@ def export(machine: Machine, out: Path | None, options: Options) -> Exported:
                             f"table hash 0x{source.layout.table_hash:08x}"))
 
 
-C = register(Backend("c", "export", "a portable C99 engine and the table as const data",
-                     help="portable C99 engine + table", fit=fit, export=export))
+C = register(ExportBackend(name="c", makes="a portable C99 engine and the table as const data",
+                           help="portable C99 engine + table", fit=fit, export=export))

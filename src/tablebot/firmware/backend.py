@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 from tablebot.codegen import backend as c
 from tablebot.diagnostics import Diagnostic
 from tablebot.files import out_folder
-from tablebot.registry import Backend, Exported, Options, refused, register
+from tablebot.registry import ExportBackend, Exported, Exporter, ExportOptions, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
@@ -32,8 +32,8 @@ def fit_for(board: str) -> Any:
     return fit
 
 
-def export_for(board: str) -> Any:
-    def export(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export_for(board: str) -> Exporter:
+    def export(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
         from tablebot.firmware.build import build
 
         firmware = build(machine, board, out_folder(out or Path("build") / "firmware" / board, "--out"))
@@ -49,9 +49,9 @@ def export_for(board: str) -> Any:
     return export
 
 
-UNO = register(Backend("uno", "board", "AVR firmware for an Arduino Uno with the Motor Shield Rev3",
-                       help="Arduino Uno + Motor Shield Rev3", fit=fit_for("uno"), section="board",
-                       read_section=read_section, export=export_for("uno")))
-FTDUINO = register(Backend("ftduino", "board", "AVR firmware for the ftDuino",
-                           fit=fit_for("ftduino"), section="board", read_section=read_section,
-                           export=export_for("ftduino")))
+UNO = register(ExportBackend(name="uno", board=True, makes="AVR firmware for an Arduino Uno with the Motor Shield Rev3",
+                             help="Arduino Uno + Motor Shield Rev3", fit=fit_for("uno"), section="board",
+                             read_section=read_section, export=export_for("uno")))
+FTDUINO = register(ExportBackend(name="ftduino", board=True, makes="AVR firmware for the ftDuino",
+                                 fit=fit_for("ftduino"), section="board", read_section=read_section,
+                                 export=export_for("ftduino")))

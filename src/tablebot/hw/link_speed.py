@@ -15,13 +15,14 @@ import statistics
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.loop import LinkLost
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
+    from tablebot.registry import LinkOptions
     from tablebot.robot import Robot
 
 PROBES = 7  # round trips timed; their median is the link's time (one slow wake-up of a busy host does not count)
@@ -50,18 +51,18 @@ class Connected(Protocol):
     def close(self) -> None: ...
 
 
-def check_link(bot: Connected, machine: Machine, options: Any, probe: Callable[[], object], what: str, *,
+def check_link(bot: Connected, machine: Machine, options: LinkOptions, probe: Callable[[], object], what: str, *,
                line: str = "", faster: str = "", connect_hint: str = "") -> tuple[str, ...]:
     """Time ``probe`` (one round trip on the link of a connected ``bot``, moving nothing) and :func:`judge` it
-    (``options["behind_limit_s"]`` of 0 accepts slow timers). Refused, or lost while being timed, ``bot`` is
-    closed first."""
+    (``--behind-limit 0``, :attr:`~tablebot.registry.LinkOptions.accept_slow`, accepts slow timers). Refused,
+    or lost while being timed, ``bot`` is closed first."""
     try:
         link = LinkTime(bot.target, what, median_round_trip(probe), line, faster)
     except LinkLost as exc:
         bot.close()
         raise fail("--on", str(exc), connect_hint) from None
     try:
-        return judge(machine, link, accept_slow=options.get("behind_limit_s") == 0)
+        return judge(machine, link, accept_slow=options.accept_slow)
     except TableBotError:
         bot.close()
         raise

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.files import out_folder
-from tablebot.registry import Backend, Exported, Options, register
+from tablebot.registry import ExportBackend, Exported, ExportOptions, register
 from tablebot.robopro.rpp_edit import DEFAULT_NAMES
 from tablebot.robopro.wiring import read_robot_robopro
 
@@ -23,7 +23,7 @@ def fit(machine: Machine) -> list[Diagnostic]:
     return fit_problems(machine.table)
 
 
-def export_lists(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export_lists(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.robopro import lists
 
     assert out is not None
@@ -32,13 +32,13 @@ def export_lists(machine: Machine, out: Path | None, options: Options) -> Export
     return Exported(files, tuple(f"wrote {path}" for path in files))
 
 
-def export_rpp(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     """The three lists written into a ROBO Pro program: ``--into`` itself, or its copy in ``out``."""
     from tablebot.robopro import lists
     from tablebot.robopro import rpp_edit as rpp
 
-    into: Path | None = options.get("into")
-    names = tuple(options.get("lists", DEFAULT_NAMES))
+    into = options.into
+    names = options.lists or DEFAULT_NAMES
     if into is None:
         raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
     encoded = lists.encode(machine.table)
@@ -60,7 +60,7 @@ def program_fit(machine: Machine) -> list[Diagnostic]:
     return problems(machine.table)
 
 
-def export_program(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export_program(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     """The whole engine as one .rpp, named after the robot; a table that does not fit is refused before the
     folder is made."""
     from tablebot.files import write_text
@@ -72,12 +72,12 @@ def export_program(machine: Machine, out: Path | None, options: Options) -> Expo
     return Exported((path,), (f"wrote {path}: open it in ROBO Pro 4.x",))
 
 
-ROBOPRO = register(Backend("robopro", "export", "the document's three ROBO Pro lists (event, action, timer)",
-                           help="the three lists as CSV", fit=fit, export=export_lists))
-ROBOPRO_RPP = register(Backend("robopro-rpp", "export", "the three lists written into a ROBO Pro program",
-                               help="the lists written into a ROBO Pro program (--into)", fit=fit, export=export_rpp,
-                               needs_out=False))
-ROBOPRO_PROGRAM = register(Backend(
-    "robopro-program", "export", "a whole ROBO Pro program running the table (the document's engine)",
+ROBOPRO = register(ExportBackend(name="robopro", makes="the document's three ROBO Pro lists (event, action, timer)",
+                                 help="the three lists as CSV", fit=fit, export=export_lists))
+ROBOPRO_RPP = register(ExportBackend(name="robopro-rpp", makes="the three lists written into a ROBO Pro program",
+                                     help="the lists written into a ROBO Pro program (--into)", fit=fit,
+                                     export=export_rpp, needs_out=False))
+ROBOPRO_PROGRAM = register(ExportBackend(
+    name="robopro-program", makes="a whole ROBO Pro program running the table (the document's engine)",
     help="a whole ROBO Pro program that runs the table", fit=program_fit, export=export_program,
     section="robopro", read_section=read_robot_robopro))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tablebot.registry import Backend, Opened, Options, register
+from tablebot.registry import LinkOptions, LiveBackend, Opened, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
@@ -20,15 +20,15 @@ def read_section(src: Source, data: Any, robot: Robot) -> Any:
     return read_robot_sim(src, data, robot)
 
 
-def open_sim(machine: Machine, address: str, options: Options) -> Opened:
+def open_sim(machine: Machine, link: LinkOptions) -> Opened:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
     from tablebot.jit import say_compiling
     from tablebot.sim import kernel
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
-    world = address.partition(":")[2]
-    seed = int(options.get("seed", 1))
+    world = link.address.partition(":")[2]
+    seed = link.seed
     say_compiling("the simulator", kernel.move)
     bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None), seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
@@ -36,6 +36,6 @@ def open_sim(machine: Machine, address: str, options: Options) -> Opened:
     return Opened(bot, "sim", f"simulated, seed {seed}")
 
 
-SIM = register(Backend("sim", "live", "the simulator, driven in real time by `tablebot run`",
-                       help="sim[:WORLD] (the simulator, in real time)", section="sim", read_section=read_section,
-                       open=open_sim, addresses=("sim", "sim:WORLD.toml")))
+SIM = register(LiveBackend(name="sim", makes="the simulator, driven in real time by `tablebot run`",
+                           help="sim[:WORLD] (the simulator, in real time)", section="sim",
+                           read_section=read_section, open=open_sim, addresses=("sim", "sim:WORLD.toml")))

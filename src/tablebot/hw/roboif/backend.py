@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.hw.serial_address import parse_serial_address
-from tablebot.registry import Backend, Opened, Options, refused, register
+from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
@@ -35,7 +35,7 @@ def fit(machine: Machine) -> list[Diagnostic]:
     return refused(lambda: roboif_wiring(machine))
 
 
-def open_roboif(machine: Machine, address: str, options: Options) -> Opened:
+def open_roboif(machine: Machine, link: LinkOptions) -> Opened:
     """The wiring checked (nothing is opened if the table does not fit), the port found, the interface greeted
     (it must answer as a ROBO Interface), and its exchange timed against the table's tick."""
     from tablebot.hw.link_speed import check_link
@@ -45,24 +45,25 @@ def open_roboif(machine: Machine, address: str, options: Options) -> Opened:
     from tablebot.hw.roboif.wiring import roboif_wiring
     from tablebot.loop import LinkLost
 
-    device = parse_serial_address(address, "roboif", options.get("hint", ADDRESS_HINT))
+    device = parse_serial_address(link.address, "roboif", link.hint_or(ADDRESS_HINT))
     wiring = roboif_wiring(machine)
     if device is None:
         device = find()
         if device is None:
             raise fail("--on", "roboif://auto found no serial port that answers as a ROBO Interface", CONNECT_HINT)
-    bot = RoboifRobot(wiring, device, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
+    bot = RoboifRobot(wiring, device, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         bot.connect()
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
     line = (f"its {wire.REQUEST_BYTES + wire.REPLY_BYTES} bytes alone take {1000 * wire.EXCHANGE_LINE_S:.1f} ms "
             f"on the {wire.BAUD}-baud line")
-    warnings = check_link(bot, machine, options, lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
+    warnings = check_link(bot, machine, link, lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
                           "one exchange with the ROBO Interface", line=line, faster=FASTER, connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)", warnings)
 
 
-ROBOIF = register(Backend("roboif", "live", "a ROBO Interface driven live over its serial port by `tablebot run`",
-                          help="roboif://DEVICE (a ROBO Interface on its serial port), roboif://auto", fit=fit,
-                          section="roboif", read_section=read_section, open=open_roboif, addresses=ADDRESSES))
+ROBOIF = register(LiveBackend(
+    name="roboif", makes="a ROBO Interface driven live over its serial port by `tablebot run`",
+    help="roboif://DEVICE (a ROBO Interface on its serial port), roboif://auto", fit=fit,
+    section="roboif", read_section=read_section, open=open_roboif, addresses=ADDRESSES))

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.hw.serial_address import parse_serial_address
-from tablebot.registry import Backend, Opened, Options, refused, register
+from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
@@ -34,7 +34,7 @@ def fit(machine: Machine) -> list[Diagnostic]:
     return refused(lambda: robotx_wiring(machine))
 
 
-def open_robotx(machine: Machine, address: str, options: Options) -> Opened:
+def open_robotx(machine: Machine, link: LinkOptions) -> Opened:
     """The wiring checked (nothing is opened if the table does not fit), the port found, and the controller
     asked who it is (it must answer fish.X1), and its exchange timed against the table's tick."""
     from tablebot.hw.link_speed import check_link
@@ -43,24 +43,24 @@ def open_robotx(machine: Machine, address: str, options: Options) -> Opened:
     from tablebot.hw.robotx.wiring import robotx_wiring
     from tablebot.loop import LinkLost
 
-    device = parse_serial_address(address, "robotx", options.get("hint", ADDRESS_HINT))
+    device = parse_serial_address(link.address, "robotx", link.hint_or(ADDRESS_HINT))
     wiring = robotx_wiring(machine)
     if device is None:
         found = find()
         if found is None:
             raise fail("--on", "robotx://auto found no serial port that answers as a ROBO TX Controller", CONNECT_HINT)
         device = found[0]
-    bot = RobotxRobot(wiring, device, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
+    bot = RobotxRobot(wiring, device, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         info = bot.connect()
     except LinkLost as exc:
         raise fail("--on", str(exc), CONNECT_HINT) from None
-    warnings = check_link(bot, machine, options, lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
+    warnings = check_link(bot, machine, link, lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
                           "one exchange with the ROBO TX", faster=FASTER, connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, f"{info.device} {info.version_text}", warnings)
 
 
-ROBOTX = register(Backend("robotx", "live", "a ROBO TX Controller driven live over fish.X1 by `tablebot run`",
-                          help="robotx://DEVICE (a ROBO TX on its USB or Bluetooth serial port), robotx://auto",
-                          fit=fit, section="robotx", read_section=read_section, open=open_robotx,
-                          addresses=ADDRESSES))
+ROBOTX = register(LiveBackend(
+    name="robotx", makes="a ROBO TX Controller driven live over fish.X1 by `tablebot run`",
+    help="robotx://DEVICE (a ROBO TX on its USB or Bluetooth serial port), robotx://auto", fit=fit,
+    section="robotx", read_section=read_section, open=open_robotx, addresses=ADDRESSES))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
-from tablebot.registry import Backend, Opened, Options, refused, register
+from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
@@ -47,23 +47,23 @@ def parse_address(text: str, hint: str) -> tuple[str | None, int]:
     return None if host == "auto" else host, int(port) if port else PORT
 
 
-def open_txt(machine: Machine, address: str, options: Options) -> Opened:
+def open_txt(machine: Machine, link: LinkOptions) -> Opened:
     """The robot, where it is and what it is: the wiring checked (nothing moves if the table does not
     fit), then the controller found (an address counts when it answers as a TXT), asked who it is, and its
     round trip timed against the table's tick."""
     from tablebot.hw.link_speed import check_link
-    from tablebot.hw.txt import link
+    from tablebot.hw.txt import link as txt_link
     from tablebot.hw.txt.controller import FirmwareTooOld, TxtRobot
     from tablebot.hw.txt.wiring import txt_wiring
     from tablebot.loop import LinkLost
 
-    host, port = parse_address(address, options.get("hint", ADDRESS_HINT))
+    host, port = parse_address(link.address, link.hint_or(ADDRESS_HINT))
     wiring = txt_wiring(machine)
     if host is None:
-        host, tried = link.find_controller(link.AUTO_HOSTS, port)
+        host, tried = txt_link.find_controller(txt_link.AUTO_HOSTS, port)
         if host is None:
             raise fail("--on", "txt://auto found no TXT: " + "; ".join(tried), CONNECT_HINT)
-    bot = TxtRobot(wiring, host, port, link_timeout_s=options.get("link_timeout_s") or 5 * machine.table.robot.tick_s)
+    bot = TxtRobot(wiring, host, port, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         status = bot.connect()
     except FirmwareTooOld as exc:
@@ -72,12 +72,12 @@ def open_txt(machine: Machine, address: str, options: Options) -> Opened:
         raise fail("--on", str(exc), CONNECT_HINT) from None
     # Before going online only QueryStatus can be asked; it costs the network's round trip, as each exchange
     # does (a TXT then paces exchanges at 10 ms on its own side).
-    warnings = check_link(bot, machine, options, bot.link.query_status, "a round trip to the controller",
+    warnings = check_link(bot, machine, link, bot.link.query_status, "a round trip to the controller",
                           faster=FASTER, connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, f"{status.device} {status.version_text}", warnings)
 
 
-TXT = register(Backend("txt", "live", "a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",
-                       help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), txt://auto (USB, "
-                       "Wi-Fi, Bluetooth addresses)", fit=fit, section="txt", read_section=read_section,
-                       open=open_txt, addresses=ADDRESSES))
+TXT = register(LiveBackend(
+    name="txt", makes="a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",
+    help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), txt://auto (USB, Wi-Fi, Bluetooth "
+    "addresses)", fit=fit, section="txt", read_section=read_section, open=open_txt, addresses=ADDRESSES))

@@ -9,13 +9,13 @@ from typing import TYPE_CHECKING
 from tablebot.escape import shell_word
 from tablebot.files import out_folder
 from tablebot.hw.txt import backend as txt
-from tablebot.registry import Backend, Exported, Options, register
+from tablebot.registry import ExportBackend, Exported, ExportOptions, register
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
 
 
-def export(machine: Machine, out: Path | None, options: Options) -> Exported:
+def export(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.hw.txt4.export import export_txt4
 
     assert out is not None
@@ -26,6 +26,6 @@ def export(machine: Machine, out: Path | None, options: Options) -> Exported:
                             "--to txt4://192.168.7.2 (it asks for the API key the TXT 4.0 shows)"))
 
 
-TXT4 = register(Backend("txt4", "export", "a program that runs the table on a TXT 4.0 by itself",
-                        help="a program that runs the table on a TXT 4.0 itself (then: tablebot upload)",
-                        fit=txt.fit, export=export))
+TXT4 = register(ExportBackend(name="txt4", makes="a program that runs the table on a TXT 4.0 by itself",
+                              help="a program that runs the table on a TXT 4.0 itself (then: tablebot upload)",
+                              fit=txt.fit, export=export))
