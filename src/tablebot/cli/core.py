@@ -17,6 +17,7 @@ from tablebot.cli.common import (
     err_console,
     guarded,
     load,
+    open_project,
     out_file,
     out_folder,
 )
@@ -82,15 +83,17 @@ def trace_cmd(
     from tablebot.files import atomic_write
     from tablebot.formats.inputs_csv import load_inputs
     from tablebot.formats.trace_lines import write_trace
-    from tablebot.replay import replay
+    from tablebot.replay import replay, replay_several
 
-    _, machine = load(table, robot)
-    ticks = load_inputs(inputs, machine)
+    project = open_project(table, robot)
+    several = project.tables  # a robot of several tables runs them all (tablebot.tables)
+    ticks = load_inputs(inputs, several or project.machine)
+    lines = replay_several(several, ticks) if several else replay(project.machine, ticks)
     if out is None:
-        write_trace(replay(machine, ticks), sys.stdout)
+        write_trace(lines, sys.stdout)
         return
     with atomic_write(out_file(out, "--out")) as stream:
-        count = write_trace(replay(machine, ticks), stream)
+        count = write_trace(lines, stream)
     err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")
 
 

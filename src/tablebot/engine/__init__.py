@@ -4,6 +4,10 @@ Per tick: after the first tick the timer counts down (never below 0) and each co
 by its pulses; the event set is the inputs that read 1 plus T (and each Cn) at 0; the first
 matching row of the current state fires (:meth:`tablebot.machine.Machine.lookup`, which also decides a
 tick with no event by the table's rule). The engine knows nothing of files, hardware or time.
+
+The package: :class:`Engine` (one table, here), :class:`~tablebot.engine.batch.Batch` (what a batch of ticks
+gives back), the per-state lookups the step indexes (:mod:`tablebot.engine.lookups`) and a robot of several
+tables (:class:`tablebot.engine.several.Several`).
 """
 
 from __future__ import annotations
@@ -13,61 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.machine import NO_ROW, CompiledRow, Machine, MachineArrays
+from tablebot.engine.batch import Batch, mask_array
+from tablebot.engine.lookups import Entry, Lookups, bits_text, mask_of_names, snapshot_count
+from tablebot.machine import NO_ROW, Machine, MachineArrays
 
-
-class Batch:
-    """Per-tick results of :meth:`Engine.run`: event mask, fired row (-1: none), state index, timer.
-
-    The compiled path fills integer arrays (:attr:`arrays`); the list attributes are made from them
-    on first use, so a caller that only wants the arrays (or nothing) pays nothing for lists.
-    """
-
-    FIELDS = ("events", "rows", "states", "timers")
-
-    def __init__(self, events: Sequence[int], rows: Sequence[int], states: Sequence[int],
-                 timers: Sequence[int]) -> None:
-        self._columns: dict[str, Sequence[int]] = dict(zip(self.FIELDS, (events, rows, states, timers), strict=True))
-
-    def _list(self, name: str) -> list[int]:
-        column = self._columns[name]
-        if not isinstance(column, list):
-            column = self._columns[name] = np.asarray(column).tolist()
-        return column
-
-    @property
-    def events(self) -> list[int]:
-        return self._list("events")
-
-    @property
-    def rows(self) -> list[int]:
-        return self._list("rows")
-
-    @property
-    def states(self) -> list[int]:
-        return self._list("states")
-
-    @property
-    def timers(self) -> list[int]:
-        return self._list("timers")
-
-    @property
-    def arrays(self) -> tuple[np.ndarray, ...]:
-        """events, rows, states, timers as integer numpy arrays (no copy on the compiled path)."""
-        return tuple(np.asarray(self._columns[name]) for name in self.FIELDS)
-
-    def __len__(self) -> int:
-        return len(self._columns["events"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Batch):
-            return NotImplemented
-        return all(self._list(name) == other._list(name) for name in self.FIELDS)
-
-    __hash__ = None  # type: ignore[assignment]  # mutable caches; equality is by value
-
-    def __repr__(self) -> str:
-        return f"Batch({', '.join(f'{name}={self._list(name)!r}' for name in self.FIELDS)})"
+__all__ = ["Batch", "Engine"]
 
 
 class Engine:
@@ -86,7 +40,7 @@ class Engine:
     _deadline: int
     _counters: list[int]
     _zero_counters: int
-    _running: list[Any]  # per state, the lookup of _Lookups for a running timer
+    _running: list[Any]  # per state, the lookup of Lookups for a running timer
     _at_zero: list[Any]  # and for a timer at 0
 
     def __init__(self, machine: Machine) -> None:
@@ -94,7 +48,7 @@ class Engine:
         self._width = len(machine.table.events)
         self._counter_bits = machine.counter_bits if any(machine.counter_bits) else ()
         self._n_counters = len(machine.counter_bits)
-        self._lookups = _Lookups(machine)
+        self._lookups = Lookups(machine)
         self.reset()
 
     def reset(self) -> None:
@@ -121,7 +75,7 @@ class Engine:
            read. The counters count down by their pulses in :meth:`_count_down`;
         2. and 3. per state, a list indexed by the input mask gives the tick's event set (the mask's T
            and Cn bits dropped, the engine's own added), the row that fires and its effect, all made
-           from :meth:`tablebot.machine.Machine.lookup` (:class:`_Lookups`): a list for a running timer
+           from :meth:`tablebot.machine.Machine.lookup` (:class:`Lookups`): a list for a running timer
            and one for a timer at 0, for the counters now at 0 (chosen when the counters change);
         4. the effect sets the state, timer, outputs (merging kept ones) and counter loads.
 
@@ -160,14 +114,14 @@ class Engine:
         """
         m = self.machine
         if isinstance(inputs, Mapping):
-            return _mask_of_names(m, inputs)
+            return mask_of_names(m, inputs)
         if isinstance(inputs, bool) or not isinstance(inputs, int | np.integer):
             raise ValueError(f"inputs must be an int mask or a mapping of input names, not {type(inputs).__name__}")
         value = int(inputs)
         width = self._width
         if value < 0 or value >> width:
             raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
-                             f"(0..{(1 << width) - 1}); its inputs are {_bits_text(m)}")
+                             f"(0..{(1 << width) - 1}); its inputs are {bits_text(m)}")
         return value & m.input_mask
 
     def _entry(self, tick: int, inputs: int) -> Entry:
@@ -258,7 +212,7 @@ class Engine:
             from tablebot import engine_batch as kernels
 
             if kernels.available():
-                return self._run_compiled(arrays, _mask_array(masks, self._width),
+                return self._run_compiled(arrays, mask_array(masks, self._width),
                                           self._pulse_array(pulses, len(masks)))
         if jit:
             raise RuntimeError("the compiled batch path needs numba and at most FLAT_BITS event columns")
@@ -323,7 +277,7 @@ class Engine:
         Everything is checked before anything changes, so a refused snapshot leaves the engine as it was.
         """
         m = self.machine
-        tick, timer = _count(snapshot, "tick"), _count(snapshot, "timer")
+        tick, timer = snapshot_count(snapshot, "tick"), snapshot_count(snapshot, "timer")
         if "state" not in snapshot:
             raise ValueError("state: missing from the snapshot")
         if snapshot["state"] not in m.states:
@@ -345,124 +299,3 @@ class Engine:
 # pulses that count nothing: a caller's () is this very object in CPython (one empty tuple), so step skips it
 # with an identity test; any other empty sequence reaches _count_down, which counts nothing either
 _NONE: tuple[int, ...] = ()
-
-#: What a fired row does: (next state, timer, outputs (None = keep), keeps any, counter loads or ()).
-Effect = tuple[int, int, tuple[int | None, ...], bool, tuple[int | None, ...]]
-#: A tick's outcome for one input mask: (event set, fired row or -1, the row's effect or None).
-Entry = tuple[int, int, Effect | None]
-
-
-def _effect(row: CompiledRow) -> Effect:
-    return row.next, row.timer, row.outputs, row.keeps, row.loads if any(v is not None for v in row.loads) else ()
-
-
-class _Lookups(dict[int, list[Any]]):
-    """The engine's own events present (bits of T and of the counters at 0) -> per state, the lookup
-    input mask -> :data:`Entry`.
-
-    A state's lookup is a list over every mask of the table's event columns (tables up to FLAT_BITS
-    events), empty until :meth:`made` on the first tick that needs it, or a dict that fills itself from
-    :meth:`Machine.lookup` (wider tables); either raises IndexError for a mask beyond the event
-    columns. A mask's T and Cn bits are ignored, as :meth:`Engine.events_of` ignores them: the engine
-    makes those events.
-    """
-
-    def __init__(self, machine: Machine) -> None:
-        super().__init__()
-        self.machine = machine
-        self.effects = [_effect(row) for row in machine.rows]
-        self.idle: dict[int, Entry] = {}  # the entry of an event set that fires no row, shared by all states
-
-    def __missing__(self, present: int) -> list[Any]:
-        m = self.machine
-        self[present] = lookups = [[] if m.flat is not None else _WideEntries(self, state, present)
-                                   for state in range(len(m.states))]
-        return lookups
-
-    def made(self, present: int, state: int) -> list[Entry] | _WideEntries:
-        """The lookup of ``state`` when ``present`` are in the event set, its list made if still empty."""
-        lookup = self[present][state]
-        if isinstance(lookup, list) and not lookup:
-            m = self.machine
-            width = len(m.table.events)
-            keep, flat, base = m.input_mask, m.flat, state << width
-            entries: dict[int, Entry] = {}  # masks that differ only in T or Cn bits share an entry
-            for mask in range(1 << width):
-                events = mask & keep | present
-                if (entry := entries.get(events)) is None:
-                    entry = entries[events] = self.entry(events, flat[base + events])  # type: ignore[index]
-                lookup.append(entry)
-        return lookup
-
-    def entry(self, events: int, row: int) -> Entry:
-        if row == NO_ROW:
-            return self.idle.setdefault(events, (events, NO_ROW, None))
-        return events, row, self.effects[row]
-
-
-class _WideEntries(dict[int, Entry]):
-    """One state's lookup in a table wider than FLAT_BITS events: input mask -> entry, made on first use."""
-
-    def __init__(self, lookups: _Lookups, state: int, present: int) -> None:
-        super().__init__()
-        self.lookups, self.state, self.present = lookups, state, present
-
-    def __missing__(self, mask: int) -> Entry:
-        m = self.lookups.machine
-        if mask >> len(m.table.events):
-            raise IndexError(mask)  # as the list of a narrower table would
-        events = mask & m.input_mask | self.present
-        self[mask] = entry = self.lookups.entry(events, m.lookup(self.state, events))
-        return entry
-
-
-def _mask_of_names(machine: Machine, inputs: Mapping[str, int]) -> int:
-    bits = machine.input_bits
-    mask = 0
-    for name, value in inputs.items():
-        if name not in bits:
-            raise ValueError(f"unknown input {name!r}; the inputs are {_bits_text(machine)}")
-        if value not in (0, 1) or not isinstance(value, int | np.integer):
-            raise ValueError(f"input {name!r}: {value!r} is not 0 or 1")
-        if value:
-            mask |= bits[name]
-    return mask
-
-
-def _bits_text(machine: Machine) -> str:
-    return ", ".join(f"{name}={bit}" for name, bit in machine.input_bits.items()) or "none"
-
-
-def _count(snapshot: Mapping[str, Any], key: str) -> int:
-    """A snapshot's tick or timer: present, an integer, not negative."""
-    if key not in snapshot:
-        raise ValueError(f"{key}: missing from the snapshot")
-    value = snapshot[key]
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"{key}: {value!r} is not an integer")
-    if value < 0:
-        raise ValueError(f"{key}: {value} must not be negative")
-    return value
-
-
-# --- masks for the compiled loop ------------------------------------------------------------------
-
-def _mask_array(masks: Sequence[int] | np.ndarray, width: int) -> np.ndarray:
-    """Masks as a contiguous uint8 or int64 array (the two types the kernel is compiled for), each
-    checked to be a mask of ``width`` event columns.
-
-    A list of masks below 256 (any table with at most eight event columns) goes through
-    ``bytearray``, about 2 ns per tick, where ``np.array(list)`` costs about 17.
-    """
-    if isinstance(masks, np.ndarray):
-        array = np.ascontiguousarray(masks, dtype=np.uint8 if masks.dtype == np.uint8 else np.int64)
-    else:
-        try:
-            array = np.frombuffer(bytearray(masks), dtype=np.uint8)
-        except (TypeError, ValueError):  # a mask of 256 or more (or a negative one): the general path
-            array = np.asarray(masks, dtype=np.int64)
-    if len(array) and (array.min() < 0 or int(array.max()) >> width):
-        bad = next(int(v) for v in array.tolist() if v < 0 or v >> width)
-        raise ValueError(f"input mask {bad} is not a mask of this table's {width} event columns "
-                         f"(0..{(1 << width) - 1})")
-    return array
