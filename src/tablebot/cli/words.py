@@ -82,9 +82,10 @@ def localise_params(cmd: Any, ctx: Context) -> None:
 def _param(param: Any, ctx: Context) -> None:
     if getattr(param, "help", None):
         param.help = gettext(param.help)
+    if param.metavar:  # an argument's name (TABLE), or an option's value as the code names it (URL, FILE.png)
+        param.metavar = gettext(param.metavar)
+        return
     if param.param_type_name == "argument":
-        if param.metavar:
-            param.metavar = gettext(param.metavar)
         return
     if param.metavar is None and not getattr(param, "is_flag", False) and not getattr(param, "count", False) \
             and param.type.get_metavar(param=param, ctx=ctx) is None:
@@ -106,5 +107,5 @@ def help_texts(command: Any) -> Iterator[str]:
         for param in cmd.params:
             if getattr(param, "help", None):
                 yield param.help
-            if param.param_type_name == "argument" and param.metavar:
+            if param.metavar:
                 yield param.metavar
