@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import json
 import shutil
+import time
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
@@ -127,19 +128,32 @@ def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None
     assert d["message"] == "M1_speed: 9 is out of range 0..8" and d["hint"] == "write a whole number from 0 to 8"
 
 
-def test_a_counterexample_is_scripted_into_the_arena(studio: tuple[Background, Path]) -> None:
+def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_it_breaks(
+        studio: tuple[Background, Path]) -> None:
     server, _ = studio
-    replies = talk(server, [{"op": "open", "path": "table.csv"},
-                                {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"},
-                                {"op": "sim", "action": "step"}], until="frame", limit=20)
-    control = next(r for r in replies if r["type"] == "control")
-    assert control["paused"] and control["scripted"] == 54
-    frame = replies[-1]
-    # the first tick is explained in the initial state 2: its rows are on lines 6 to 9 and 25 to 27
-    fired = [w["line"] for w in frame["why"] if w["status"] == "fired"]
-    assert frame["tick"] == 0 and len(fired) == 1 and fired[0] in (6, 7, 8, 9, 25, 26, 27)
-    assert [point[2] for point in frame["path"]] == [frame["state_id"]]  # by id: an edit may reorder the states
-    assert {w["line"] for w in frame["why"]} == {6, 7, 8, 9, 25, 26, 27}
+
+    async def run() -> tuple[dict[str, Any], list[tuple[float, dict[str, Any]]]]:
+        control, frames = None, []
+        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
+                                      additional_headers=server.headers) as ws:
+            for message in ({"op": "open", "path": "table.csv"},
+                            {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"}):
+                await ws.send(json.dumps(message))
+            while True:
+                reply = json.loads(await asyncio.wait_for(ws.recv(), 10))
+                control = control or (reply if reply["type"] == "control" else None)
+                if reply["type"] == "frame":
+                    frames.append((time.monotonic(), reply))
+                    if reply["paused"] and reply["scripted"] == 0 and reply["tick"] == 53:
+                        return control, frames
+
+    control, frames = asyncio.run(run())
+    assert not control["paused"] and 0 < control["scripted"] <= 54  # it plays at once, no Play needed
+    # its last 12 ticks (42-53) are played 10 times slower than real time; it stops on tick 53, where it breaks
+    slow_from = next(at for at, frame in frames if frame["tick"] >= 42)
+    assert frames[-1][0] - slow_from >= 0.9
+    last = frames[-1][1]
+    assert last["state_id"] == "29" and last["row"] == -1 and last["why"][-1]["status"] == "none"
     replies = talk(server, [{"op": "counterexample", "name": "no_such"}], until="error", limit=1)
     assert replies[0]["message"] == "fix the table's errors first"
 

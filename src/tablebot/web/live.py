@@ -27,6 +27,11 @@ from tablebot.web.errors import INTERNAL, log
 PATH_STEP_M = 0.005  # a path point every 5 mm (or at a state change): what the eye can see
 MAX_FIRED = 200  # fired rows kept between two frames
 SPEEDS = {"1": 1.0, "10": 10.0, "max": 0.0}  # 0: as fast as possible
+# A counterexample played in the arena: its last ticks, up to the one where the property breaks, 10 times slower
+# than real time (a person sees each of them), the ticks before at real time or faster (at most LEAD_S seconds)
+SLOW_TICKS = 12
+SLOW_SPEED = 0.1
+LEAD_S = 3.0
 
 
 class StopRequested(KeyboardInterrupt):
@@ -103,6 +108,7 @@ class HandInputs:
         self.light_keys = light_keys(robot.scene)
         self.forced: dict[int, bool] = {}  # input bit -> held on (True) or off (False)
         self.script: list[int] = []  # whole masks to read next (a counterexample), one per tick
+        self.on_script: Callable[[int], None] | None = None  # told how many scripted masks are left, at each
 
     def open(self) -> None:
         self.robot.open()
@@ -112,6 +118,8 @@ class HandInputs:
         mask = reading.mask
         if self.script:
             mask = self.script.pop(0)
+            if self.on_script is not None:
+                self.on_script(len(self.script))
         for bit, on in self.forced.items():
             mask = mask | bit if on else mask & ~bit
         s = self.robot.s
@@ -206,6 +214,7 @@ class LiveRun:
         self.scene = scene
         self.engine = Engine(scene.machine)
         self.robot = HandInputs(robot)
+        self.robot.on_script = self._scripted
         self.sink = FrameSink()
         self.sinks = [self.sink, *sinks]
         self.clock = PageClock(SPEEDS[speed], scene.tick_s, paused)
@@ -250,7 +259,19 @@ class LiveRun:
             self.robot.forced[bit] = on
 
     def play_script(self, masks: list[int]) -> None:
+        """Play these input masks (a counterexample) at once: its lead-in at real time or faster, its last
+        ticks slowly, and pause on its last tick (where the property shows broken)."""
         self.robot.script = list(masks)
+        lead = len(masks) - SLOW_TICKS
+        speed = SLOW_SPEED if lead <= 0 else max(1.0, lead * self.scene.tick_s / LEAD_S)
+        self.clock.control(paused=False, speed=speed, tick=self.engine.tick)
+
+    def _scripted(self, left: int) -> None:
+        """Called in the run's thread as each scripted mask is read (``left``: how many remain)."""
+        if left == SLOW_TICKS:
+            self.clock.control(speed=SLOW_SPEED, tick=self.engine.tick)
+        elif left == 0:  # this tick is the last: the run stops after it, and goes on at the page's speed
+            self.clock.control(paused=True, speed=SPEEDS[self.speed], tick=self.engine.tick)
 
     def close(self, timeout: float = 5.0) -> None:
         self.clock.control(stop=True)

@@ -128,8 +128,7 @@ class Arena:
             masks = message.get("masks")
             if not isinstance(masks, list) or not all(type(m) is int and 0 <= m < 2**31 for m in masks):
                 raise Refused('"masks" must be a list of whole numbers')
-            run.pause()
-            run.play_script(masks)
+            run.play_script(masks)  # at once, slowing down before the end, and paused on its last tick
         else:
             raise Refused(f"unknown action {action!r}")
 
