@@ -216,6 +216,8 @@ def test_a_request_another_page_started_is_refused(studio: Background, site: str
     assert status == 403 and b"started by another page" in body
     assert http(studio, "static/js/studio/main.js", token)[0] == 403
     assert http(studio, "", {"Sec-Fetch-Site": site})[0] == 200  # the page, which holds nothing
+    assert http(studio, "", {"Sec-Fetch-Site": site, "Sec-Fetch-Dest": "document"})[0] == 200  # a link
+    assert http(studio, "", {"Sec-Fetch-Site": site, "Sec-Fetch-Dest": "iframe"})[0] == 403  # a frame: never
 
 
 # --- what the page may name ----------------------------------------------------------------------------------

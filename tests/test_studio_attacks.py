@@ -1,9 +1,9 @@
 """Pages that are not the studio's attack it in a real Chromium (issue 18, section 1), and fail.
 
-The user has the studio open (its token cookie is in the browser) and visits a hostile page: one served
-by a second local HTTP server on another port (cookies are shared between a host's ports, so the browser
-does send the studio's cookie along), and one whose name is rebound to 127.0.0.1 (DNS rebinding: the
-page's own origin then reaches the studio's port; Chromium's --host-resolver-rules plays the DNS server).
+The user has the studio open (its token kept by its page, in no cookie) and visits a hostile page: one
+served by a second local HTTP server on another port, and one whose name is rebound to 127.0.0.1 (DNS
+rebinding: the page's own origin then reaches the studio's port; Chromium's --host-resolver-rules plays
+the DNS server).
 Each page tries to read secret.env, .git/config and hook.py over the WebSocket, rewrite and save a file,
 send a message nested 100,000 deep, read /api/config, upload a trace, frame the studio and load its API
 as an image. The studio's own log shows every one of those requests answered 403, nothing on disk
@@ -185,13 +185,12 @@ def browser() -> Iterator[Any]:
 
 @pytest.fixture
 def context(browser: Any, studio: Background) -> Iterator[Any]:
-    """A browser profile in which the user opened the studio (its cookie is set) and keeps it open."""
+    """A browser profile in which the user opened the studio (its page holds the token) and keeps it open."""
     context = browser.new_context(viewport={"width": 1366, "height": 768})
     own = context.new_page()
     own.goto(studio.url)
     own.wait_for_selector("#play:not([disabled])")
-    assert f"{studio.access.cookie}" in {c["name"] for c in context.cookies()}
-    assert all(c["httpOnly"] and c["sameSite"] == "Strict" for c in context.cookies())
+    assert context.cookies() == []  # the token is in no cookie: the page keeps it in sessionStorage
     assert "token" not in own.url  # the page took it out of the address bar and history
     yield context
     context.close()

@@ -123,7 +123,8 @@ class Access:
         if origin is not None and origin.lower() != f"http://{host.lower()}":
             return f"refused: a page from {origin[:100]!r} may not use this studio"
         public = _public(scope)
-        landing = public and scope.get("path") == "/"  # a link from anywhere may lead to the page: it holds nothing
+        # a link from anywhere may lead to the page (it holds nothing); a frame of it, never
+        landing = public and scope.get("path") == "/" and headers.get("sec-fetch-dest", "document") == "document"
         fetch_site = headers.get("sec-fetch-site")
         if fetch_site is not None and fetch_site not in OWN_FETCHES and not landing:
             return f"refused: the request was started by another page ({fetch_site[:20]})"
