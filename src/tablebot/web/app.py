@@ -22,6 +22,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
 from tablebot.escape import terminal
+from tablebot.templates import TEMPLATES
 from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.live import give_back_memory
@@ -62,7 +63,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
 
     async def config(request: Request) -> Response:
         listing = await asyncio.to_thread(workspace.listing)
-        return JSONResponse({"table": table, "folder": workspace.root.name, **listing},
+        # templates: what `tablebot new` offers, for a folder without a table
+        return JSONResponse({"table": table, "folder": workspace.root.name, "templates": list(TEMPLATES), **listing},
                             headers={"Cache-Control": "no-store"})
 
     async def upload_trace(request: Request) -> Response:
