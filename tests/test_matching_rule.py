@@ -128,6 +128,16 @@ def test_check_says_both_rules_agree_where_t_is_always_there() -> None:
     assert findings(ROOT / "examples" / "bumberbot" / "table.csv") == []
 
 
+def test_check_names_every_row_that_requires_no_event_a_later_one_of_its_state_too(tmp_path: Path) -> None:
+    """Issue 36 §2: the second of two rows that need no event in state 2 was left out."""
+    table = tmp_path / "table.csv"
+    table.write_text("state,T,I3,M1,M2,timer,next\n2,,,0,0,5,2\n2,,,1,1,0,2\n")
+    found = findings(table)
+    assert [f["lines"] for f in found] == [[2], [3]]
+    assert "the row on line 2 above it requires no event either, so this one never fires" in found[1]["message"]
+    assert "line 2" not in found[0]["message"].split(";")[-1]
+
+
 # --- the lists: run by the document's engine ----------------------------------------------------------------
 
 @pytest.mark.parametrize("match", ["always", None])

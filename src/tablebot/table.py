@@ -154,9 +154,9 @@ class Table:
 
 @dataclass(frozen=True)
 class NoEventRow:
-    """The first row of a state that requires no event (a later one never fires), and what can bring a tick
-    with no event at all in that state: the one place the two matching rules (the robot file's ``match``)
-    part. There ``always`` fires the row and ``document`` fires nothing."""
+    """A row that requires no event, and what can bring a tick with no event at all in its state: the one place
+    the two matching rules (the robot file's ``match``) part. There ``always`` fires the first such row of the
+    state and ``document`` fires nothing."""
 
     row: Row
     #: Why a tick with no event can come in the row's state; "" when it cannot (T is there on every tick).
@@ -164,7 +164,8 @@ class NoEventRow:
 
 
 def no_event_rows(table: Table) -> list[NoEventRow]:
-    """Per state with a row that requires no event, that row and whether the matching rule can matter there.
+    """Every row that requires no event (per state, in table order) and whether the matching rule can matter in
+    its state.
 
     A tick in a state has T whenever the timer is 0 on it: when T is an event column, the robot never starts
     in the state with a timer above 0, and every row that leads into it loads the timer with 0 or 1 (1 has
@@ -174,9 +175,11 @@ def no_event_rows(table: Table) -> list[NoEventRow]:
     """
     found = []
     for state, rows in table.rows_by_state.items():
-        row = next((r for r in rows if not r.events), None)
-        if row is not None:
-            found.append(NoEventRow(row, _quiet_tick(table, state)))
+        quiet: str | None = None
+        for row in rows:
+            if not row.events:  # every such row, a later one too: the README promises each of them a finding
+                quiet = _quiet_tick(table, state) if quiet is None else quiet
+                found.append(NoEventRow(row, quiet))
     return found
 
 

@@ -4,17 +4,30 @@ there, and the key that chooses."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from tablebot.analysis.finding import Finding
 from tablebot.analysis.names import state_text
-from tablebot.robot import MATCH_ALWAYS, MATCH_DOCUMENT, Robot
-from tablebot.table import NoEventRow, Table, no_event_rows
+from tablebot.robot import MATCH_ALWAYS, MATCH_DOCUMENT, Robot, StateId
+from tablebot.table import NoEventRow, Row, Table, no_event_rows
 
 CODE = "no-event-row"
 
 
 def no_event_findings(table: Table) -> list[Finding]:
-    """A finding per state's first row that requires no event (later ones are shadowed and said so)."""
-    return [_finding(table, found) for found in no_event_rows(table)]
+    """A finding per row that requires no event; a later one of its state is shadowed by the first, and says so."""
+    first: dict[StateId, Row] = {}
+    findings = []
+    for found in no_event_rows(table):
+        above = first.setdefault(found.row.state, found.row)
+        finding = _finding(table, found)
+        if above is not found.row:
+            finding = replace(finding, message=f"{finding.message}; but the row on line {above.line} above it "
+                              f"requires no event either, so this one never fires in {state_text(table, above.state)}",
+                              hint=f"give it an event so that it can fire, or delete it (line {above.line} "
+                              "does what it would)")
+        findings.append(finding)
+    return findings
 
 
 def _finding(table: Table, found: NoEventRow) -> Finding:
