@@ -1,6 +1,6 @@
 """Benchmark: where a fresh tablebot process spends its time before (and around) the work the user asked for.
 
-Run: ``.venv/bin/python benchmarks/startup.py [--repeat 5] [--quick]``.
+Run: ``.venv/bin/python benchmarks/startup.py [--repeat 5] [--quick] [--help-only]``.
 
 Two parts, both fresh processes (``python -m tablebot``, as a user runs it):
 
@@ -10,6 +10,9 @@ Two parts, both fresh processes (``python -m tablebot``, as a user runs it):
   examples/bumberbot --robots 10000 --seconds 10 --no-plots``; for sim and sweep beside the time of the run
   inside (what the command itself reports: the simulated speed, "runs in N s"), so start-up and the rest
   around the run read as the difference. Which of numba, scipy, matplotlib, pydantic each command imports.
+* **help**: ``tablebot --help`` and ``tablebot --lang de --help`` (the German catalog loaded, every help text
+  translated), each against its target, 0.15 s, and as a ratio to the interpreter alone (``--help-only``: these
+  rows alone).
 * **phases**: one fresh process doing a sweep's start-up step by step, each step timed: the imports (tablebot,
   its command line, numpy, numba), planning 10,000 runs (it loads the compiled code the scene
   checks use, and starts numba's runtime), and a one-robot fleet's first tick (loads the fleet kernel).
@@ -81,6 +84,8 @@ def imported(args: list[str]) -> list[str]:
 
 
 SIM_SECONDS = 3600.0
+#: `tablebot --help` as a whole process, in either language (issue 38 §3).
+HELP_TARGET = 0.15
 
 
 def commands(quick: bool) -> list[tuple[str, list[str]]]:
@@ -89,6 +94,8 @@ def commands(quick: bool) -> list[tuple[str, list[str]]]:
     return [
         ("python -c pass", []),
         ("--version", ["--version"]),
+        ("--help", ["--help"]),
+        ("--help (de)", ["--lang", "de", "--help"]),  # the German catalog loaded and every help text translated
         ("check", ["check", str(EXAMPLE)]),
         ("sim --no-plots", ["sim", str(EXAMPLE), "--seconds", hour, "--no-plots", "--out", "OUT"]),
         ("sim (pictures)", ["sim", str(EXAMPLE), "--seconds", hour, "--out", "OUT"]),
@@ -127,22 +134,32 @@ def phases() -> list[tuple[str, float]]:
     return [(name, float(sec)) for name, sec in (line.split("\t") for line in done.stdout.splitlines() if "\t" in line)]
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--quick", action="store_true", help="shorter sim and sweep (a smoke test of this script)")
-    args = parser.parse_args()
-    med = statistics.median
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); medians of "
-          f"{args.repeat} fresh processes")
-    with tempfile.TemporaryDirectory() as warm:  # the compiled code into this machine's cache (not counted)
+def warm_up() -> None:
+    """The compiled code into this machine's cache (not counted)."""
+    with tempfile.TemporaryDirectory() as warm:
         timed([sys.executable, "-m", "tablebot", "sweep", str(EXAMPLE), "--robots", "64", "--seconds", "1",
                "--no-plots", "--out", warm + "/s"])
         timed([sys.executable, "-m", "tablebot", "sim", str(EXAMPLE), "--seconds", "1", "--out", warm + "/t"])
 
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="shorter sim and sweep (a smoke test of this script)")
+    parser.add_argument("--help-only", action="store_true", help="only the interpreter and --help in both languages")
+    args = parser.parse_args()
+    med = statistics.median
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); medians of "
+          f"{args.repeat} fresh processes")
+    if not args.help_only:
+        warm_up()
+
     print(f"{'command':<18} {'wall s':>7} {'cpu s':>7} {'run s':>7} {'around':>7}  imports")
     floor = None
+    help_walls: dict[str, list[float]] = {}
     for name, cmd in commands(args.quick):
+        if args.help_only and cmd and not name.startswith("--help"):
+            continue
         runs = []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as out:
@@ -150,6 +167,8 @@ def main() -> int:
                     [sys.executable, "-m", "tablebot", *[a.replace("OUT", out) for a in cmd]]
                 runs.append(timed(argv))
         wall, cpu = med(r[0] for r in runs), med(r[1] for r in runs)
+        if name.startswith("--help"):
+            help_walls[name] = [r[0] for r in runs]
         inner = [s for r in runs if (s := inner_seconds(name, r[2])) is not None]
         run = med(inner) if inner else None
         floor = floor if floor is not None else wall
@@ -159,7 +178,14 @@ def main() -> int:
         print(f"{name:<18} {wall:7.2f} {cpu:7.2f} {shown} {around}  {heavy or '-'}")
     print(f"(run s: the run as the command reports it; around = wall - run: start-up, planning, files. The "
           f"interpreter alone is {floor:.3f} s.)")
+    assert floor is not None  # python -c pass is the first row
+    helps = {name: med(w) for name, w in help_walls.items()}
+    for name, wall in helps.items():
+        print(f"{name}: {wall:.3f} s, {wall / floor:.1f}x the interpreter alone; target under {HELP_TARGET} s "
+              f"({'met' if wall < HELP_TARGET else 'NOT met'})")
 
+    if args.help_only:
+        return 0
     print("\nphases of a fresh process (a sweep's start-up, step by step; medians, ms):")
     laps = [phases() for _ in range(args.repeat)]
     names = [name for name, _ in laps[0]]
