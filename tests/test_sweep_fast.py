@@ -3,7 +3,8 @@ of a process sharing their scenes, and cluster chunks their table and world."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+import json
+from dataclasses import asdict, replace
 
 import numpy as np
 
@@ -51,3 +52,16 @@ def test_chunks_of_one_plan_share_their_scenes_and_run_as_they_would_alone() -> 
         for name in ("distance_m", "battery_end_v", "counts", "first_visit", "collision_rows", "final_pose"):
             assert np.array_equal(getattr(summary, name), getattr(expected, name)), name
     assert len(shared(first)[1].scenes) == 2  # one per battery
+
+
+def test_spec_json_is_the_spec_as_a_resumed_sweep_compares_it() -> None:
+    """spec.json, written without asdict's deep copy of every seed, holds what asdict gives (a sweep made by an
+    earlier tablebot resumes): every field, each axis with its key and values, a start pose as a list."""
+    plan = make_plan(BUMBERBOT / "table.csv", None, [], ["battery=1.0,0.6", "start=random,0.5:0.4:90"], "0..2,7",
+                     None, 0.5)
+    spec = plan.spec
+    assert spec.to_json() == json.dumps(asdict(spec), indent=1, sort_keys=True) + "\n"
+    data = json.loads(spec.to_json())
+    assert data["seeds"] == [0, 1, 2, 7] and data["ticks"] == 50 and data["code"] == spec.code
+    assert data["axes"] == [{"key": "battery", "values": [1.0, 0.6]},
+                            {"key": "start", "values": ["random", [0.5, 0.4, 90.0]]}]

@@ -13,7 +13,7 @@ import json
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
@@ -56,7 +56,11 @@ class SweepSpec:
     code: str = ""  # the simulator's sources (tablebot.jit.sources_digest): other code, other runs
 
     def to_json(self) -> str:
-        return json.dumps(asdict(self), indent=1, sort_keys=True) + "\n"
+        """``spec.json``'s text: :func:`dataclasses.asdict`'s, without its deep copy of every seed (a tenth of
+        a 10,000-robot sweep's planning)."""
+        data = {f.name: getattr(self, f.name) for f in fields(self)}
+        data["axes"] = [asdict(axis) for axis in self.axes]
+        return json.dumps(data, indent=1, sort_keys=True) + "\n"
 
     @property
     def runs_per_world(self) -> int:
