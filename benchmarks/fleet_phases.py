@@ -1,0 +1,68 @@
+"""Where a ``tablebot sweep`` process spends its time: run by benchmarks/fleet.py as a fresh process.
+
+    .venv/bin/python benchmarks/fleet_phases.py SWEEP-ARGS...
+
+Runs ``tablebot SWEEP-ARGS`` in this process as ``python -m tablebot`` would, with the sweep's steps wrapped
+to note when each starts and ends, and prints one JSON object: the seconds from the script's start to
+planning (the imports), planning, the chunks (the compiled fleet, each chunk's set-up and, in the main thread
+meanwhile, each chunk's result rows written: "results in the chunks"), merging results.csv, the rest, and
+the whole; the interpreter's own start is what the caller's wall time adds.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+STARTED = time.perf_counter()
+
+
+def main() -> None:
+    import tablebot.api.sweeping as sweeping
+    import tablebot.fleet.backends as backends
+    import tablebot.fleet.plan as plan
+    from tablebot.cli import main as cli
+
+    marks: dict[str, float] = {}
+    spent = {"part_text": 0.0, "write_part": 0.0}
+
+    def timed(owner: Any, name: str, mark: str | None = None, into: str | None = None) -> None:
+        original: Callable[..., Any] = getattr(owner, name)
+
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            started = time.perf_counter()
+            if mark:
+                marks.setdefault(f"{mark} start", started - STARTED)
+            try:
+                return original(*args, **kwargs)
+            finally:
+                if mark:
+                    marks[f"{mark} end"] = time.perf_counter() - STARTED
+                if into:
+                    spent[into] += time.perf_counter() - started
+        setattr(owner, name, wrapper)
+
+    timed(plan, "make_plan", "plan")
+    timed(backends.Runner, "run", "run")
+    timed(sweeping, "_finish", "finish")
+    timed(plan.Plan, "part_text", into="part_text")
+    timed(plan.Store, "write_part", into="write_part")
+    sys.argv = ["tablebot", *sys.argv[1:]]
+    try:
+        cli()
+    except SystemExit as exc:
+        if exc.code:
+            raise
+    end = time.perf_counter() - STARTED
+    plan_s, run_s = marks["plan end"] - marks["plan start"], marks["run end"] - marks["run start"]
+    merge_s = marks["finish end"] - marks["finish start"]
+    print(json.dumps({"before planning": marks["plan start"], "planning": plan_s, "chunks": run_s,
+                      "results in the chunks": spent["part_text"] + spent["write_part"], "merging": merge_s,
+                      "after planning, besides": end - marks["plan start"] - plan_s - run_s - merge_s,
+                      "in this interpreter": end}))
+
+if __name__ == "__main__":
+    main()
