@@ -18,7 +18,7 @@ import traceback
 os.environ.setdefault("TYPER_USE_RICH", "0")
 
 # Importing a module registers its commands; `tablebot --help` lists them in this order.
-from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune, evolve, share  # noqa: F401, I001
+from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune, evolve, share, grade  # noqa: F401, I001
 from tablebot.cli.app import app
 from tablebot.diagnostics import Diagnostic
 from tablebot.i18n import LANGUAGES, N_, LanguageError, set_from
