@@ -86,7 +86,7 @@ def test_the_refused_tab_shows_why_in_the_page(browser: Any, folder: Path) -> No
         first.goto(server.url)
         studio_works(first)
         second = context.new_page()
-        second.goto(server.origin + "/")
+        second.goto(server.url)  # the printed address (the key is kept per tab, not in a cookie)
         second.wait_for_selector("#banner:not([hidden])")
         assert second.inner_text("#banner").startswith("this studio already has 1 tab open, the most it serves at "
                                                        "once: close one of them, then reload this tab")
