@@ -14,6 +14,7 @@ def load_all() -> None:
     # The order is the order of --to, --board, --on and check --target: keep it (noqa: not sorted).
     from tablebot.robopro import backend as _robopro  # noqa: I001  robopro, robopro-rpp, robopro-program; [robopro]
     from tablebot.codegen import backend as _c  # c
+    from tablebot.codegen import statecharts as _statecharts  # scxml, xstate
     from tablebot.firmware import backend as _boards  # uno, ftduino; [board]
     from tablebot.hw.txt import backend as _txt  # txt; [txt]
     from tablebot.hw.robotx import backend as _robotx  # robotx; [robotx]
@@ -23,4 +24,4 @@ def load_all() -> None:
     from tablebot.analysis import section as _properties  # [properties]
     from tablebot import robot_tables as _tables  # [tables], [groups]
 
-    del _robopro, _c, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties, _tables
+    del _robopro, _c, _statecharts, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties, _tables
