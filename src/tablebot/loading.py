@@ -152,7 +152,7 @@ class Loaded:
         """The robot file's ``[properties]`` and those of :attr:`property_files`, read and checked."""
         from tablebot.analysis.properties import load_properties
 
-        return load_properties(self.machine, list(self.property_files))
+        return load_properties(self.machine, list(self.property_files), self.tables)
 
     def check_report(self, targets: Sequence[str] = (), step: Callable[[str], None] = lambda what: None,
                      properties: list[Property] | None = None) -> CheckReport:
@@ -161,7 +161,7 @@ class Loaded:
         from tablebot.analysis.check import run_check
 
         props = self.properties() if properties is None else properties
-        report = run_check(self.machine, props, tuple(targets), step)
+        report = run_check(self.machine, props, tuple(targets), step, self.tables)
         report.property_files = list(self.property_files)
         return report
 

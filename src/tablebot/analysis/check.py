@@ -17,6 +17,7 @@ from tablebot.diagnostics import fail
 from tablebot.formats.inputs_csv import write_inputs
 from tablebot.machine import Machine
 from tablebot.replay import replay
+from tablebot.tables import RobotTables
 
 
 @dataclass
@@ -29,6 +30,8 @@ class CheckReport:
     situations: int
     property_files: list[Path] = field(default_factory=list)
     counterexamples: dict[str, Path] = field(default_factory=dict)
+    #: A robot of several tables: all of them (findings are each table's, proofs over them together).
+    tables: RobotTables | None = None
 
     def severity_of(self, result: Result) -> str | None:
         """A property's failure counts as its level; an undecided one as a warning."""
@@ -55,8 +58,13 @@ class CheckReport:
 
 
 def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = (),
-              step: Callable[[str], None] = lambda what: None) -> CheckReport:
-    """Explore, find, prove; ``step`` is told what starts next (a progress display)."""
+              step: Callable[[str], None] = lambda what: None, tables: RobotTables | None = None) -> CheckReport:
+    """Explore, find, prove; ``step`` is told what starts next (a progress display). A robot of several
+    ``tables`` (``machine`` the main one's): see :func:`tablebot.analysis.check_tables.run_check_tables`."""
+    if tables is not None:
+        from tablebot.analysis.check_tables import run_check_tables
+
+        return run_check_tables(tables, props, targets, step)
     try:
         step("exploring the situations")
         graph = Model(machine).explore()
@@ -81,13 +89,17 @@ def write_counterexamples(report: CheckReport, outdir: Path) -> None:
         for result in report.results:
             if result.inputs:
                 path = outdir / f"{result.prop.name}.csv"
-                write_inputs(report.machine, result.inputs, path)
+                write_inputs(report.tables or report.machine, result.inputs, path)
                 written[result.prop.name] = path
     report.counterexamples.update(written)
 
 
-def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:
+def story(machine: Machine, result: Result, limit: int = 12, tables: RobotTables | None = None) -> list[str]:
     """What happens in a counterexample, tick by tick, with quiet stretches folded into one line."""
+    if tables is not None:
+        from tablebot.analysis.check_tables import story_of_tables
+
+        return story_of_tables(tables, result, limit)
     lines = list(replay(machine, result.inputs))
     items: list[str] = []
     quiet_from = None

@@ -4,6 +4,10 @@ A condition looks at one tick as the trace records it: the events of the tick (`
 the row that fired (``line == 14``, ``fired``), and the state and outputs after it
 (``state == 20``, ``state in [22, 24]``, ``M1 < 0``); combine with ``and``, ``or``, ``not`` and
 parentheses. ``true`` and ``false`` are conditions too.
+
+In a robot of several tables (:mod:`tablebot.tables`) a condition may name any table's state by the table's name
+(``drive == 20 and lights == 3``, ``lights in [1, 2]``); ``state``, ``line`` and ``fired`` are the main table's,
+``T`` the main table's timer event, and a tick is seen as :mod:`tablebot.analysis.product` describes it.
 """
 
 from __future__ import annotations
@@ -12,14 +16,17 @@ import operator
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.machine import Machine
 from tablebot.table import TIMER_EVENT
+from tablebot.tables import RobotTables
 
-#: One tick as conditions see it: (event mask, fired row index or -1, state index after, outputs after).
-Obs = tuple[int, int, int, tuple[int, ...]]
-Predicate = Callable[[int, int, int, tuple[int, ...]], bool]
+#: One tick as conditions see it: (event mask, fired row index or -1, state index after, outputs after); in a
+#: robot of several tables the state is the tuple of every table's state index.
+Obs = tuple[int, int, Any, tuple[int, ...]]
+Predicate = Callable[[int, int, Any, tuple[int, ...]], bool]
 
 TOKEN_RE = re.compile(r"\s*(?:(?P<num>-?\d+)|(?P<op>==|!=|<=|>=|<|>|\(|\)|\[|\]|,)|(?P<word>[A-Za-z_][\w.-]*))")
 COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
@@ -46,9 +53,10 @@ class Condition:
         return self.test(*obs)
 
 
-def parse_condition(text: str, machine: Machine) -> Condition:
-    """Parse ``text`` against the names of ``machine``; raises :class:`ConditionError` with a hint."""
-    parser = _Parser(_tokens(text), machine)
+def parse_condition(text: str, machine: Machine, tables: RobotTables | None = None) -> Condition:
+    """Parse ``text`` against the names of ``machine`` (``tables``: of every table of the robot, ``machine`` the
+    main one's); raises :class:`ConditionError` with a hint."""
+    parser = _Parser(_tokens(text), machine, tables)
     test = parser.expression()
     if parser.peek() is not None:
         raise ConditionError(f"unexpected {parser.peek()!r} in {text!r}")
@@ -76,8 +84,8 @@ class _Parser:
     """Recursive descent: or > and > not > atom; builds closures as it goes (a chain of ``and`` or ``or``
     as one closure over all its terms, so a thousand terms do not nest a thousand calls)."""
 
-    def __init__(self, tokens: list[str], machine: Machine) -> None:
-        self.tokens, self.pos, self.machine = tokens, 0, machine
+    def __init__(self, tokens: list[str], machine: Machine, tables: RobotTables | None = None) -> None:
+        self.tokens, self.pos, self.machine, self.tables = tokens, 0, machine, tables
         self.input_bits = 0
         self.depth = 0
 
@@ -141,6 +149,8 @@ class _Parser:
             return lambda e, r, s, o: r >= 0
         if token == "state":
             return self.state_test()
+        if self.tables is not None and token in self.tables.names:
+            return self.state_test(self.tables.index(token))
         if token == "line":
             return self.line_test()
         return self.name_test(token)
@@ -160,23 +170,30 @@ class _Parser:
             return items
         return [self.take("a value")]
 
-    def state_test(self) -> Predicate:
+    def state_test(self, table: int = 0) -> Predicate:
+        """``state`` (the main table's) or ``NAME`` (table ``table`` of several) ``==``, ``!=`` or ``in``."""
+        word = "state" if self.tables is None or self.tokens[self.pos - 1] == "state" else self.tokens[self.pos - 1]
         op = self.take("== or != or in")
         if op not in ("==", "!=", "in"):
-            raise ConditionError(f"state can be compared with ==, != or in, not {op!r}")
+            raise ConditionError(f"{word} can be compared with ==, != or in, not {op!r}")
         if op == "in":
             self.pos -= 1
-        indices = frozenset(self.state_index(v) for v in self.values())
+        indices = frozenset(self.state_index(v, table) for v in self.values())
+        if self.tables is not None:
+            negate = op == "!="
+            return lambda e, r, s, o: (s[table] in indices) != negate
         if op == "!=":
             return lambda e, r, s, o: s not in indices
         return lambda e, r, s, o: s in indices
 
-    def state_index(self, text: str) -> int:
-        states = self.machine.states
+    def state_index(self, text: str, table: int = 0) -> int:
+        machine = self.machine if self.tables is None else self.tables.machines[table]
+        states = machine.states
         for index, state in enumerate(states):
             if str(state) == text:
                 return index
-        raise ConditionError(f"there is no state {text} in the table (states: {', '.join(map(str, states))})")
+        which = "the table" if self.tables is None else f"table {self.tables.names[table]}"
+        raise ConditionError(f"there is no state {text} in {which} (states: {', '.join(map(str, states))})")
 
     def line_test(self) -> Predicate:
         op = self.take("== or in")
@@ -195,7 +212,7 @@ class _Parser:
 
     def name_test(self, name: str) -> Predicate:
         machine = self.machine
-        if name == TIMER_EVENT or name in machine.input_bits or name in machine.table.robot.counter_names:
+        if name == TIMER_EVENT or name in self.input_names() or name in machine.table.robot.counter_names:
             bit = self.event_bit(name)
             if self.peek() in COMPARE:
                 raise ConditionError(f"{name} is an event: write just {name} (or not {name})")
@@ -210,11 +227,17 @@ class _Parser:
                 raise ConditionError(f"{name} {op} needs a number, not {value!r}")
             compare, number = COMPARE[op], int(value)
             return lambda e, r, s, o: compare(o[index], number)
-        known = [TIMER_EVENT, *machine.input_bits, *machine.table.robot.counter_names, *machine.output_names]
+        known = [TIMER_EVENT, *self.input_names(), *machine.table.robot.counter_names, *machine.output_names,
+                 *(self.tables.names if self.tables else ())]
         raise ConditionError(f"unknown name {name!r}; use state, line, fired or one of {', '.join(known)}")
+
+    def input_names(self) -> list[str]:
+        return list((self.tables or self.machine).input_bits)
 
     def event_bit(self, name: str) -> int:
         machine = self.machine
+        if self.tables is not None:  # the event word of tablebot.analysis.product
+            return self.product_bit(name)
         if name == TIMER_EVENT:
             return machine.timer_bit
         if name in machine.input_bits:
@@ -224,6 +247,20 @@ class _Parser:
         if not bit:
             raise ConditionError(f"counter {name} has no event column in the table, so it is never an event")
         return bit
+
+
+    def product_bit(self, name: str) -> int:
+        """An event's bit in the event word of several tables: the robot's inputs, the main T, each counter."""
+        assert self.tables is not None
+        bits = self.tables.input_bits
+        if name in bits:
+            self.input_bits |= bits[name]
+            return bits[name]
+        if name == TIMER_EVENT:
+            if not self.machine.timer_bit:
+                raise ConditionError(f"the main table ({self.tables.names[0]}) has no T column")
+            return 1 << len(bits)
+        return 1 << (len(bits) + 1 + self.machine.table.robot.counter_names.index(name))
 
 
 def _all(terms: list[Predicate]) -> Predicate:

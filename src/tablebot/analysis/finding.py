@@ -21,7 +21,11 @@ class Finding:
     hint: str = ""
     state: StateId | None = None
     detail: dict[str, Any] = field(default_factory=dict, compare=False)
+    #: In a robot of several tables, a finding of another table than the main one: its name and file.
+    table: str = ""
+    path: str = ""
 
     def as_json(self) -> dict[str, Any]:
+        where = {"table": self.table, "file": self.path} if self.table else {}
         return {"code": self.code, "severity": self.severity, "lines": list(self.lines),
-                "state": self.state, "message": self.message, "hint": self.hint, **self.detail}
+                "state": self.state, "message": self.message, "hint": self.hint, **where, **self.detail}

@@ -26,6 +26,7 @@ from tablebot.analysis.conditions import Condition, ConditionError, parse_condit
 from tablebot.diagnostics import Collector, TableBotError
 from tablebot.durations import DurationError, to_ticks
 from tablebot.machine import Machine
+from tablebot.tables import RobotTables
 from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
@@ -83,8 +84,9 @@ def find_property_files(table_path: Path) -> list[Path]:
     return []
 
 
-def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
-    """The robot file's ``[properties]`` plus every file given; all problems are reported at once."""
+def load_properties(machine: Machine, files: list[Path], tables: RobotTables | None = None) -> list[Property]:
+    """The robot file's ``[properties]`` plus every file given; all problems are reported at once. In a robot of
+    several ``tables`` (``machine`` the main one's) a condition may name each table's state."""
     robot = machine.table.robot
     sources: list[tuple[Source, Any, str]] = []  # (file, its property tables, the section holding them)
     if "properties" in robot.sections:
@@ -103,7 +105,7 @@ def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
         else:
             for name, entry in entries.items():
                 line = src.line(f"{section}.{name}" if section else name) or src.line(section, None, name)
-                prop = _property(name, entry, machine, src.out, src.path, line)
+                prop = _property(name, entry, machine, src.out, src.path, line, tables)
                 if prop is not None:
                     found.append(prop)
         errors.extend(src.out.items)
@@ -113,7 +115,7 @@ def load_properties(machine: Machine, files: list[Path]) -> list[Property]:
 
 
 def _property(name: str, entry: Any, machine: Machine, out: Collector, source: str,
-              line: int | None) -> Property | None:
+              line: int | None, tables: RobotTables | None = None) -> Property | None:
     """One property table, or None after reporting everything wrong with it."""
     if not isinstance(entry, dict):
         out.error(line, None, f"property {name!r} must be a table of keys",
@@ -126,7 +128,7 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
     kind = _kind(name, entry, line, out)
     if kind is None:
         return None
-    fields = _claims(name, entry, kind, machine, line, out)
+    fields = _claims(name, entry, kind, machine, line, out, tables)
     if len(out.items) > before:
         return None
     return Property(name=name, text=str(entry.get("text", name)), kind=kind, level=entry.get("level", "error"),
@@ -155,7 +157,7 @@ def _kind(name: str, entry: dict[str, Any], line: int | None, out: Collector) ->
 
 
 def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line: int | None,
-            out: Collector) -> dict[str, Any]:
+            out: Collector, tables: RobotTables | None = None) -> dict[str, Any]:
     """The parsed conditions (and ``within``) of a property of ``kind``, as Property fields."""
 
     def condition(key: str) -> Condition | None:
@@ -165,7 +167,7 @@ def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line:
                       f'for example: {key} = "state == 20"')
             return None
         try:
-            return parse_condition(value, machine)
+            return parse_condition(value, machine, tables)
         except ConditionError as exc:
             out.error(line, None, f"property {name}: {key}: {exc}", "see the condition language in docs/checking.md")
             return None

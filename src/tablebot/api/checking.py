@@ -117,7 +117,7 @@ class Check:
         """What happens in a property's counterexample, tick by tick (quiet stretches folded)."""
         from tablebot.analysis.check import story
 
-        return story(self.report.machine, result)
+        return story(self.report.machine, result, tables=self.report.tables)
 
 
 def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | None = None) -> Check:

@@ -129,7 +129,7 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
     terminal_out = console.is_terminal
     batch: list[Text] = []
     for finding in findings:
-        where = f"{path}:{finding.lines[0]}" if finding.lines else path
+        where = f"{finding.path or path}:{finding.lines[0]}" if finding.lines else finding.path or path
         line = [(plain(where) + ":", "bold"), (" ", ""), (finding.severity, COLOURS[finding.severity]),
                 (": " + plain(finding.message), "")]
         if finding.hint:

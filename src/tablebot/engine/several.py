@@ -29,8 +29,8 @@ class Several:
         self.engines = tuple(Engine(machine) for machine in tables.machines)
         #: The order the tables are stepped in (any order gives the same ticks: a test permutes it).
         self.order = tuple(range(len(self.engines)) if order is None else order)
-        self._inputs = [_input_map(tables, i) for i in range(len(self.engines))]
-        self._cross = [_cross_map(tables, i) for i in range(len(self.engines))]
+        self.input_maps = [_input_map(tables, i) for i in range(len(self.engines))]
+        self.cross_maps = [_cross_map(tables, i) for i in range(len(self.engines))]
         robot = tables.robot
         self._writers = [tables.writer(name) for name in tables.output_names]
         self._counter_writers = [(c, w) for c, name in enumerate(robot.counter_names)
@@ -52,8 +52,8 @@ class Several:
         states = [engine.state for engine in self.engines]  # the start of the tick, before any table fires
         engines = self.engines
         for i in self.order:
-            table_mask = self._inputs[i](mask)
-            for source, bits in self._cross[i]:
+            table_mask = self.input_maps[i](mask)
+            for source, bits in self.cross_maps[i]:
                 table_mask |= bits[states[source]]
             engines[i].step(table_mask, pulses)
         self.outputs = tuple(0 if w is None else engines[w].outputs[k] for k, w in enumerate(self._writers))
