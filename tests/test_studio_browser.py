@@ -316,7 +316,7 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     page.goto(page_file.as_uri())
     page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')")
     assert page.locator("table.grid tbody tr").count() == 37
-    assert page.locator('td[data-row="7"][data-col="0"] input').input_value() == hostile
+    assert page.locator('td[data-row="7"][data-col="0"] textarea').input_value() == hostile
     page.locator("#scrub").fill("2000")
     page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 2000')")
     assert page.locator("#diagram g.node.current").count() == 1

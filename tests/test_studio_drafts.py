@@ -142,7 +142,7 @@ def test_load_theirs_shows_their_table_and_drops_mine(tab: Page, folder: Path) -
     tab.asked("table.csv was replaced on disk")
     tab.answer("Load theirs (drop my edits)")
     tab.page.wait_for_function(f"() => document.querySelector('{TIMER}').value === '895'")
-    description = tab.page.locator('td[data-row="5"][data-col="0"] input').input_value()
+    description = tab.page.locator('td[data-row="5"][data-col="0"] textarea').input_value()
     assert description == "their edit" and tab.page.locator("#save-state").inner_text() == "saved"
     assert path.read_bytes() == theirs and not (folder / "table.csv.bak").exists()
     assert tab.page.evaluate(DRAFTS) == []

@@ -60,6 +60,8 @@ def studio_cmd(
         other = access.url(socket.gethostname(), f"table={quote(table)}" if table else "")
         err_console.print(f"  {other}  (from other machines)", soft_wrap=True, markup=False)
     err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
+    if table is None:
+        _say_no_table(root)
     visited = threading.Event()
     uvicorn_server = server(create_app(root, access, table, visited=visited), access,
                             "info" if verbose else "warning")
@@ -85,6 +87,22 @@ def _warn_network(root: Path, address: str, port: int) -> None:
         "to this machine: anyone who can reach it and has the address below (with its token) can read the "
         "folder's tables, robot and world files and traces, and change its tables. The connection is plain "
         "HTTP: anyone who can watch the network can see the token.", soft_wrap=True)
+
+
+def _say_no_table(root: Path) -> None:
+    """A folder without a table (a pupil in the wrong folder: the default is the current one): say so, and how
+    to start one, as the page does."""
+    from tablebot.templates import TEMPLATES
+    from tablebot.web.workspace import Workspace
+
+    if Workspace(root).listing()["tables"]:
+        return  # another table there: the page opens it
+    err_console.print(f"[yellow]note:[/yellow] there is no table in {terminal(str(root))} (a .csv or .tsv whose "
+                      "first line names the state and next columns). Start one from a template, then open it:",
+                      soft_wrap=True)
+    for name in TEMPLATES:
+        err_console.print(f"  tablebot new my-robot --from {name}", soft_wrap=True, markup=False)
+    err_console.print("  tablebot studio my-robot", soft_wrap=True, markup=False)
 
 
 def _root_and_table(where: Path) -> tuple[Path, str | None]:

@@ -22,7 +22,10 @@ function wireTable(store, send, drafts) {
     if (selectedRow !== null) send({ op: "delete_row", row: selectedRow });
   });
   document.addEventListener("keydown", (e) => {
-    if ((e.ctrlKey || e.metaKey) && e.key === "s") { e.preventDefault(); send({ op: "save" }); }
+    if ((e.ctrlKey || e.metaKey) && e.key === "s") {
+      e.preventDefault();
+      if (store.get().path && store.get().dirty) send({ op: "save" });  // nothing to save: nothing done
+    }
   });
   window.addEventListener("beforeunload", (e) => {
     if (store.get().dirty) { e.preventDefault(); e.returnValue = ""; }

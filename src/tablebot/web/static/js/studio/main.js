@@ -8,7 +8,8 @@ import { createDrafts } from "./drafts.js";
 import { keepFitted } from "./layout.js";
 import { createLink } from "./link.js";
 import { messageHandlers } from "./messages.js";
-import { showPanels } from "./panels.js";
+import { checkedLink } from "./protocol.js";
+import { showNoTable, showPanels } from "./panels.js";
 import { stats } from "./stats.js";
 import { createViews } from "./views.js";
 
@@ -16,9 +17,9 @@ const store = createStore({
   path: null, files: { tables: [], traces: [] }, machine: null, analysis: null, seq: 0, editSent: 0,
   mode: "live", frame: null, clickMode: "start", speed: "1", paused: true, held: {}, runError: null,
   world: null, tickMs: 10, dirty: null /* no table yet: neither saved nor not */, selectedRow: null, mask: undefined, why: [], arenaOk: false,
-  folder: "", version: null /* of the file the draft started from */, offerDraft: null /* the table whose kept draft to offer */,
+  cex: null /* a counterexample playing in the arena */, folder: "", version: null /* of the file the draft started from */, offerDraft: null /* the table whose kept draft to offer */,
 });
-const link = createLink();
+const link = checkedLink(createLink());  // what the page sends is an operation of the protocol
 let drafts = null;
 const views = createViews(store, link.send, () => drafts.keep());
 drafts = createDrafts(store, views.grid);
@@ -45,6 +46,7 @@ async function start() {
   const config = await reply.json();
   store.set({ files: config, folder: config.folder });
   const wanted = params.get("table") || config.table || config.tables[0];
+  if (!wanted) showNoTable(config);
   // each connection opens the table, and offers back the edits this browser kept of it
   const hello = () => {
     const path = store.get().path || wanted;

@@ -3,6 +3,7 @@
 import { addOption, byId } from "../lib/dom.js";
 import { ask } from "./ask.js";
 import { banner } from "./banner.js";
+import { byKind } from "./protocol.js";
 import { stats } from "./stats.js";
 
 /** The note over the arena (a world problem, a trace without poses); "" hides it. */
@@ -25,6 +26,8 @@ function arena(store, views, m) {
   store.set({ arenaOk: m.ok });
   if (!m.ok) { arenaNote(m.problem); return; }
   arenaNote("");
+  views.arena.setMarker(null);
+  if ((store.get().cex || {}).shown) store.set({ cex: null });  // started over after a counterexample
   views.arena.replayPath = null;
   views.arena.setWorld(m.world);
   byId("seed").value = m.settings.seed;
@@ -105,9 +108,9 @@ function table(store, views, send, drafts, m) {
   if (offer) offerDraft(store, send, drafts, m);
 }
 
-/** The handlers, by message type. */
+/** The handlers, by message type: one for each kind of message the protocol has (protocol.js). */
 export function messageHandlers(store, views, send, drafts) {
-  return {
+  return byKind({
     table: (m) => table(store, views, send, drafts, m),
     grid(m) {
       views.grid.setTable(views.grid.header, m.grid, m.lines || views.grid.lines);
@@ -132,5 +135,5 @@ export function messageHandlers(store, views, send, drafts) {
     conflict: (m) => conflict(store, send, drafts, m),
     notice: (m) => banner(m.message, "good"),
     error: (m) => banner(m.message, "bad"),
-  };
+  });
 }

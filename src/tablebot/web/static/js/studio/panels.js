@@ -26,6 +26,13 @@ function showAnalysis(store, views) {
     byId("counts").className = "counts " + kind;
     byId("analysis-time").textContent = `checked in ${m.ms} ms`;
   });
+  // the robot keeps running the table it was started with: while the edited one does not read, say so
+  store.on(["analysis", "arenaOk", "mode"], ({ analysis, arenaOk, mode }) => {
+    const stale = Boolean(analysis && !analysis.ok && arenaOk && mode === "live");
+    byId("arena-stale").hidden = !stale;
+    byId("arena-stale").textContent = stale ? "The table has errors: the robot runs the last table that read. "
+      + "Fix them, then Reset runs yours." : "";
+  });
 }
 
 // The live robot: arena, lit row and state, status line, why the rows fired.
@@ -43,9 +50,28 @@ function showFrames(store, views) {
       byId("status").textContent = describeTick(machine, { tick: m.tick, state: m.state_id, timer: m.timer,
         event: m.event, row: m.row, outputs });
     }
+    showCounterexample(store, views, m);
     const why = m.why || [];  // repeated in every frame while paused: redrawn only when it says something new
     store.set({ mask: m.mask, ...(JSON.stringify(why) === JSON.stringify(store.get().why) ? {} : { why }) });
   });
+}
+
+// A counterexample playing in the arena: once its scripted inputs are spent and the run paused on its last
+// tick, the place is marked and the property's words said; Play (or Reset) goes on without them.
+function showCounterexample(store, views, m) {
+  const { cex } = store.get();
+  if (!cex) return;
+  if (m.paused && m.scripted === 0 && m.pose[0] !== null) {
+    const what = cex.example ? "reached" : "broken";
+    views.arena.setMarker({ x: m.pose[0], y: m.pose[1], label: `${cex.name} ${what} here` });
+    arenaNote(`${cex.example ? "✔" : "✘"} ${cex.name} is ${what} here, at tick ${m.tick}: ${cex.text}. `
+      + "Play goes on with the sensors; Reset starts over.");
+    cex.shown = true;
+  } else if (cex.shown && !m.paused) {
+    views.arena.setMarker(null);
+    arenaNote("");
+    store.set({ cex: null });
+  }
 }
 
 function showWhy(store, views) {
@@ -105,10 +131,27 @@ function showControls(store) {
   });
 }
 
+/** A folder without a table: the page says so, and how to start one from `tablebot new`'s templates. */
+export function showNoTable(config) {
+  const what = make("p", {}, `There is no table in ${config.folder || "this folder"}: the studio opens a .csv or .tsv `
+    + "file whose first line names the state and next columns. Start a robot from one of tablebot's templates: "
+    + "in a terminal, in this folder, type one of");
+  const commands = make("ul", { className: "commands" }, ...(config.templates || []).map((name) =>
+    make("li", {}, make("code", {}, `tablebot new my-robot --from ${name}`))));
+  byId("grid").replaceChildren(make("div", { className: "no-table", role: "status" },
+    make("h2", {}, "No table here"), what, commands,
+    make("p", {}, "then open it: ", make("code", {}, "tablebot studio my-robot"),
+      " (or start the studio in the folder that holds your table).")));
+  byId("save-state").textContent = "no table";
+}
+
 function showFile(store) {
-  store.on(["dirty"], ({ dirty }) => {
-    byId("save-state").textContent = dirty ? "unsaved edits" : "saved";
-    byId("save").classList.toggle("primary", dirty);
+  // nothing to save (no table, or no edit since it was read or saved): Save is off
+  store.on(["dirty", "path"], ({ dirty, path }) => {
+    if (path) byId("save-state").textContent = dirty ? "unsaved edits" : "saved";
+    byId("save").classList.toggle("primary", Boolean(dirty));
+    byId("save").disabled = !path || !dirty;
+    byId("add-row").disabled = byId("del-row").disabled = !path;
   });
   store.on(["path"], ({ path }) => {
     byId("table-pick").value = path;

@@ -43,7 +43,7 @@ function makeArena(store, send) {
 
 function makeChecks(store, send, grid) {
   const els = { problems: byId("problems"), findings: byId("findings"), properties: byId("properties"),
-    showInfo: byId("show-info") };
+    showInfo: byId("show-info"), verdicts: byId("verdicts") };
   return new Checks(els, {
     select: (rows, col) => {
       grid.select(rows);
@@ -51,6 +51,10 @@ function makeChecks(store, send, grid) {
     },
     counterexample: (name, where) => {
       if (where === "table") store.set({ mode: "trace" });
+      else {  // played in the arena at once; marked where it breaks (panels.js)
+        const p = ((store.get().analysis || {}).properties || []).find((q) => q.name === name);
+        store.set({ mode: "live", cex: p ? { ...p, shown: false } : null });
+      }
       send({ op: "counterexample", name, where });
     },
   });
@@ -67,7 +71,9 @@ function repaintStates({ arena, timeline }) {
 export function createViews(store, send, edited) {
   const grid = makeGrid(store, send, edited);
   const arena = makeArena(store, send);
-  const diagram = new Diagram(byId("diagram"));
+  // enlarged over the table (and the checks beside the robot), never over the arena
+  const diagram = new Diagram(byId("diagram"), { bigPlace: () => (document.body.dataset.layout === "stack"
+    ? byId("grid") : document.querySelector("main .left")).getBoundingClientRect() });
   const views = { grid, arena, diagram };
   views.timeline = new Timeline(byId("timeline"), stateColours(store), (i) => views.player.seek(i));
   views.player = new Player({ arena, grid, diagram, timeline: views.timeline, status: byId("status"),

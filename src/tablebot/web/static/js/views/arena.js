@@ -15,6 +15,7 @@ export class Arena {
     this.light = [0, 0];
     this.lastPoint = null;
     this.replayPath = null;
+    this.marker = null;  // {x, y, label}: where a counterexample breaks its property
     this.onClick = onClick;
     this.dirty = true;
     if (onClick) this._listen();
@@ -85,6 +86,12 @@ export class Arena {
     this.dirty = true;
   }
 
+  /** Mark a place (a red ring and a label; null: none), e.g. where a counterexample breaks its property. */
+  setMarker(marker) {
+    this.marker = marker;
+    this.dirty = true;
+  }
+
   draw() {
     if (!this.dirty) return;
     this.dirty = false;
@@ -95,6 +102,19 @@ export class Arena {
     this._drawWorld(g);
     g.drawImage(this.pathLayer, 0, 0);
     if (this.pose && this.pose[0] !== null && this.world.body) this._drawRobot(g);
+    if (this.marker) this._drawMarker(g, this.marker);
+  }
+
+  _drawMarker(g, { x, y, label }) {
+    const r = this.ratio, [cx, cy] = this.toScreen(x, y), rad = Math.max(16 * r, 0.14 * this.scale);
+    g.lineWidth = 4 * r; g.strokeStyle = "#c0262d"; g.setLineDash([]);
+    g.beginPath(); g.arc(cx, cy, rad, 0, 2 * Math.PI); g.stroke();
+    g.font = `bold ${Math.round(14 * r)}px system-ui, sans-serif`;
+    const w = g.measureText(label).width + 10 * r, h = 20 * r;
+    const lx = Math.min(Math.max(4 * r, cx - w / 2), this.canvas.width - w - 4 * r);
+    const ly = cy + rad + h + 4 * r < this.canvas.height ? cy + rad + 4 * r : cy - rad - h - 4 * r;
+    g.fillStyle = "#c0262d"; g.fillRect(lx, ly, w, h);
+    g.fillStyle = "#fff"; g.textBaseline = "middle"; g.fillText(label, lx + 5 * r, ly + h / 2);
   }
 
   // --- the world -----------------------------------------------------------------------------------------

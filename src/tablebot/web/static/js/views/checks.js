@@ -6,7 +6,7 @@ const hasRow = (d) => d.row !== null && d.row !== undefined;
 
 export class Checks {
   constructor(els, actions) {
-    this.els = els;          // {problems, findings, properties, showInfo}
+    this.els = els;          // {problems, findings, properties, showInfo, verdicts}
     this.actions = actions;  // {select(rows, col), counterexample(name, where)}
     this.data = null;
     els.showInfo.addEventListener("change", () => this.render(this.data));
@@ -27,11 +27,13 @@ export class Checks {
   render(data) {
     this.data = data;
     const { problems, findings, properties } = this.els;
-    for (const list of [problems, findings, properties]) list.textContent = "";
+    for (const list of [problems, findings, properties, this.els.verdicts]) list.textContent = "";
     if (!data) return;
     this._problems(data.diagnostics || []);
     this._findings(data.findings || []);
-    for (const p of data.properties || []) this._property(properties, p);
+    // the broken ones first; every verdict also in the strip at the top, which never scrolls away
+    const props = [...(data.properties || [])].sort((a, b) => (a.status === "holds") - (b.status === "holds"));
+    for (const p of props) this._verdict(this._property(properties, p), p);
     const quiet = !(data.findings || []).some((f) => f.severity !== "info") && !(data.properties || []).some((p) => p.severity);
     if (data.ok && quiet) findings.prepend(make("li", { className: "sev-ok" }, "no errors, no warnings"));
   }
@@ -63,6 +65,16 @@ export class Checks {
     li.title = p.claim;
     if (p.detail) li.append(make("div", { className: "hint" }, p.detail));
     if (p.ticks) li.append(this._replayBar(p));
+    return li;
+  }
+
+  _verdict(li, p) {
+    const mark = { holds: "✔", violated: "✘" }[p.status] || "?";
+    const chip = button(`${mark} ${p.name}`, () => { li.scrollIntoView({ block: "nearest" }); li.focus(); },
+      { className: "verdict v-" + p.status, title: `${p.name} ${p.status}: ${p.text}` });
+    chip.dataset.property = p.name;
+    li.tabIndex = -1;
+    this.els.verdicts.append(make("li", {}, chip));
   }
 
   _replayBar(p) {

@@ -29,6 +29,7 @@ export class Grid {
     this.focused = null;
     this.lastEdited = null;
     this.firedRow = undefined;
+    holder.addEventListener("scroll", () => { if (!this.note.hidden) this._showNote(); });
     this.rowLines = null;  // the machine's rows as file lines (row i of a trace fired line rowLines[i])
   }
 
@@ -217,8 +218,17 @@ export class Grid {
     this.note.replaceChildren(make("b", {}, `line ${d.line}${d.column ? ", column " + d.column : ""}: `), d.message);
     if (d.hint) this.note.append(make("div", { className: "hint" }, "hint: " + d.hint));
     this.note.hidden = false;
-    this.note.style.left = Math.max(0, td.offsetLeft - 4) + "px";
-    this.note.style.top = (td.offsetTop + td.offsetHeight + 2) + "px";
+    this._placeNote(td);
+  }
+
+  // Under its cell (above it near the window's bottom), kept inside the window: the note is fixed to the
+  // window, so the grid's edge never cuts it, however far right the column is.
+  _placeNote(td) {
+    const cell = td.getBoundingClientRect(), note = this.note.getBoundingClientRect();
+    const left = Math.max(8, Math.min(cell.left - 4, window.innerWidth - note.width - 8));
+    const below = cell.bottom + 2 + note.height <= window.innerHeight - 8;
+    this.note.style.left = left + "px";
+    this.note.style.top = Math.max(8, below ? cell.bottom + 2 : cell.top - 2 - note.height) + "px";
   }
 
   setFindings(findings) {
