@@ -3,6 +3,7 @@ language; a German table and its English twin give the same trace, byte for byte
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -13,7 +14,7 @@ import pytest
 from tablebot.diagnostics import TableBotError
 from tablebot.durations import DurationError, to_ticks
 from tablebot.formats.table_read import load_table
-from tablebot.i18n import use
+from tablebot.i18n import PSEUDO_CLOSE, PSEUDO_OPEN, use
 from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -98,3 +99,39 @@ def test_a_bad_time_names_the_forms_accepted_in_both_languages(tmp_path: Path) -
     assert "500ms, 0.5s or 0,5s" in found.render()
     german = found.render("de")
     assert "keine Zeitangabe" in german and "0,5s" in german and "Tipp:" in german and "Fehler" in german
+
+
+def outside(text: str) -> str:
+    """What ``text`` says outside the pseudo-locale's markers (they nest)."""
+    depth, kept = 0, []
+    for ch in text:
+        depth += (ch == PSEUDO_OPEN) - (ch == PSEUDO_CLOSE)
+        if depth == 0 and ch not in (PSEUDO_OPEN, PSEUDO_CLOSE):
+            kept.append(ch)
+    return "".join(kept)
+
+
+HEAD = "description,state,I3,M1_dir,M1_speed,timer,next\n"
+#: Bad tables (the hardening cases of the table reader), each with a word that must stay as the file wrote it.
+BAD_TABLES = [
+    "", HEAD, "state,I9,next\n1,,1\n", "state,state,next\n1,1,1\n", "description,state,I3\n1,1,1\n",
+    HEAD + "a,1,x,,2,0,1\n", HEAD + "a,1,7,,2,0,1\n", HEAD + "a,1,,,2,70000,1\n", HEAD + "a,1,,,2,0.505s,1\n",
+    HEAD + "a,1,,,2,11 minutes,1\n", HEAD + "a,1,,,2,0,\n", HEAD + "a,-3,,,2,0,1\n", HEAD + "a,1,,,2,0,9\n",
+    HEAD + "a,1,,,2,0,'bad'\n", HEAD + "a,1,,,2,1000s,1\n", "state,M1,M1_dir,M1_speed,next\n1,1,,2,1\n",
+    "state,M1_dir,next\n1,1,1\n", "state,next\n" + "1" * 200 + ",1\n",
+]
+
+
+@pytest.mark.parametrize("text", BAD_TABLES, ids=range(len(BAD_TABLES)))
+def test_bad_tables_are_explained_in_the_readers_language(tmp_path: Path, text: str) -> None:
+    (tmp_path / "robot.toml").write_text(SMALL_ROBOT)
+    table = tmp_path / "table.csv"
+    table.write_text(text)
+    with pytest.raises(TableBotError) as caught:
+        load_table(table)
+    for found in caught.value.diagnostics:
+        shown = found.render("pseudo").split(": ", 1)[1]  # after the file's place
+        rest = re.sub(r"'[^']*'|\b\w*\d\w*\b|robot\.toml|BumberBot|Small", "", outside(shown))  # data and names
+        assert not re.search(r"[A-Za-z]{3,}", rest.replace("table.csv", "")), shown
+        german = found.render("de")
+        assert ": Fehler: " in german and str(found.message) not in german, german

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any, Literal, cast
 
 from tablebot import durations
+from tablebot.i18n import N_
 from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
@@ -50,7 +51,7 @@ MISPLACED = {"wiring": "the simulator's wiring goes in [sim.wiring] in a robot f
 NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: A state name as tables and robot files write it (a state is otherwise a whole number 0 or more).
 STATE_RE = re.compile(r"^[A-Za-z_][\w .-]*$")
-STATE_HINT = "use a number, or a name that starts with A-Z or _ (then letters, digits, spaces, _ . -)"
+STATE_HINT = N_("use a number, or a name that starts with A-Z or _ (then letters, digits, spaces, _ . -)")
 #: Timer loads and the initial timer are 16-bit tick counts; one tick lasts at most a minute.
 MAX_TIMER = 65535
 MAX_TICK_MS = 60_000

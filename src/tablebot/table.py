@@ -12,9 +12,10 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
+from tablebot.i18n import N_
 from tablebot.i18n.headers import GERMAN_FIXED
 from tablebot.robot import Robot, StateId
-from tablebot.robot_tables import CrossEvent
+from tablebot.robot_tables import CrossEvent, tables_of
 
 #: The document's direction + speed encoding uses speed 7 for "keep".
 DOC_KEEP_SPEED = 7
@@ -206,15 +207,20 @@ def missing_states(rows: Sequence[Row], robot: Robot) -> list[MissingState]:
     """Every next state, the initial state and every named state must have rows of its own."""
     with_rows = {row.state for row in rows}
     found: list[MissingState] = [
-        (row, ("", "next"), f"next state {row.next!r} is unknown: no row has state {row.next!r}",
-         f"add rows for state {row.next!r} or fix the next state")
+        (row, ("", "next"), N_("next state {state!r} is unknown: no row has state {state!r}", state=row.next),
+         N_("add rows for state {state!r} or fix the next state", state=row.next))
         for row in {r.line: r for r in rows if r.next not in with_rows}.values()]  # a group row once
     if robot.initial_state not in with_rows:
         found.append((None, ("", "initial_state"),
-                      f"initial state {robot.initial_state!r} (from {robot.source} robot {robot.name}) has no rows",
-                      "add rows for it or change initial_state in the robot file"))
-    found += [(None, ("states", str(state)), f"state {state!r} is named in {robot.source} but has no rows",
-               "add rows for it or remove it from [states]") for state in robot.state_names if state not in with_rows]
+                      N_("initial state {state!r} (from {source} robot {robot}) has no rows",
+                         state=robot.initial_state, source=robot.source, robot=robot.name),
+                      N_("add rows for it or change initial_state in the robot file")))
+    if tables_of(robot):  # [states] names the states of all the robot's tables (tablebot.tables checks them)
+        return found
+    found += [(None, ("states", str(state)),
+               N_("state {state!r} is named in {source} but has no rows", state=state, source=robot.source),
+               N_("add rows for it or remove it from [states]"))
+              for state in robot.state_names if state not in with_rows]
     return found
 
 

@@ -16,7 +16,7 @@ from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_record
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
 from tablebot.formats.table_parts import cross_column, grouped, robot_for_table, writes
-from tablebot.i18n import N_
+from tablebot.i18n import N_, Message
 from tablebot.i18n.headers import suffix
 from tablebot.robot import (
     BUMBERBOT,
@@ -82,8 +82,9 @@ def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
     records = read_records(text, path)  # one at a time: only the rows made of them are kept
     header = next((record for record in records if not record.is_blank()), None)
     if header is None:
-        raise fail(path, "the table is empty", "the first line must be a header such as "
-                   "description,state,T,I3,M1_dir,M1_speed,timer,next", 1, 1)
+        raise fail(path, N_("the table is empty"), N_("the first line must be a header such as {example}",
+                                                      example="description,state,T,I3,M1_dir,M1_speed,timer,next"),
+                   1, 1)
     columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
     next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
@@ -111,8 +112,8 @@ def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
         if state_at is not None and len(record.cells) > state_at:
             state_cells[record.line] = record.cells[state_at]
     if not rows and not out.items:
-        out.error(header.line + 1, 1, "the table has a header but no rows",
-                  "add one row per transition below the header")
+        out.error(header.line + 1, 1, N_("the table has a header but no rows"),
+                  N_("add one row per transition below the header"))
     rows = grouped(rows, robot, out, state_cells, next_cells)
     _check_states(rows, robot, out, next_cells, columns)
     out.raise_if_any()
@@ -122,8 +123,9 @@ def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
 
 
 def _too_many_rows(path: str, line: int) -> TableBotError:
-    return fail(path, f"the table has more than {MAX_TABLE_ROWS:,} lines below its header, the most tablebot reads",
-                "split it into smaller tables; is this the right file?", line, 1)
+    return fail(path, N_("the table has more than {most:,} lines below its header, the most tablebot reads",
+                         most=MAX_TABLE_ROWS),
+                N_("split it into smaller tables; is this the right file?"), line, 1)
 
 
 def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int | None, int | None],
@@ -135,8 +137,9 @@ def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int 
             states.add(value)
             if len(states) > MAX_STATES:
                 where = record.cells[column].column if column is not None and column < len(record.cells) else 1
-                raise fail(path, f"the table has more than {MAX_STATES:,} states, the most tablebot reads",
-                           "split the robot's behaviour into smaller tables; is this the right file?",
+                raise fail(path, N_("the table has more than {most:,} states, the most tablebot reads",
+                                    most=MAX_STATES),
+                           N_("split the robot's behaviour into smaller tables; is this the right file?"),
                            record.line, where)
 
 
@@ -169,9 +172,9 @@ def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
 def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
     columns: list[Column] = []
     seen: dict[tuple[str, str], Cell] = {}
-    known = ", ".join([*FIXED, TIMER_EVENT, *robot.inputs, *robot.counter_names,
-                       *(f"{m}_dir/{m}_speed or {m}" for m in robot.motors), *robot.lamps,
-                       *(f"{c}_load" for c in robot.counter_names)])
+    known = (*FIXED, TIMER_EVENT, *robot.inputs, *robot.counter_names,
+             *(N_("{m}_dir/{m}_speed or {m}", m=m) for m in robot.motors), *robot.lamps,
+             *(f"{c}_load" for c in robot.counter_names))
     for cell in record.cells:
         name = normalise_header(cell.text)
         if not name:
@@ -183,36 +186,39 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
             continue
         kind_name = _classify(name, robot)
         if kind_name is None:
-            out.error(cell.line, cell.column, f"unknown column {cell.text.strip()!r} for robot {robot.name}",
-                      f"known columns: {known}; declare new inputs or outputs in the robot file")
+            out.error(cell.line, cell.column, N_("unknown column {name!r} for robot {robot}", name=cell.text.strip(),
+                                                 robot=robot.name),
+                      N_("known columns: {known}; declare new inputs or outputs in the robot file", known=known))
             columns.append(Column("ignore", name, cell))
             continue
         if kind_name in seen:
             first = seen[kind_name]
-            out.error(cell.line, cell.column, f"column {cell.text.strip()!r} appears twice "
-                      f"(first at column {first.column})", "delete or rename one of them")
+            out.error(cell.line, cell.column, N_("column {name!r} appears twice (first at column {first})",
+                                                 name=cell.text.strip(), first=first.column),
+                      N_("delete or rename one of them"))
         seen[kind_name] = cell
         columns.append(Column(kind_name[0], kind_name[1], cell))
     events = [c.cell for c in columns if c.kind == "event"]
     if len(events) > MAX_EVENT_COLUMNS:
         cell = events[MAX_EVENT_COLUMNS]
-        out.error(cell.line, cell.column, f"the table has {len(events)} event columns (T, inputs and counters), "
-                  f"more than the {MAX_EVENT_COLUMNS} the engines' 64-bit event word holds",
-                  f"keep at most {MAX_EVENT_COLUMNS} event columns (this is the first one too many)")
+        out.error(cell.line, cell.column, N_("the table has {count} event columns (T, inputs and counters), more "
+                                             "than the {most} the engines' 64-bit event word holds",
+                                             count=len(events), most=MAX_EVENT_COLUMNS),
+                  N_("keep at most {most} event columns (this is the first one too many)", most=MAX_EVENT_COLUMNS))
     for required in ("state", "next"):
         if (required, required) not in seen:
-            out.error(record.line, None, f"the header has no {required!r} column",
-                      "every table needs state and next columns")
+            out.error(record.line, None, N_("the header has no {name!r} column", name=required),
+                      N_("every table needs state and next columns"))
     for motor in robot.motors:
         forms = {k for (k, n) in seen if n == motor}
         if "signed" in forms and forms & {"dir", "speed"}:
             cell = seen[("signed", motor)]
-            out.error(cell.line, cell.column, f"motor {motor} is given both as {motor} and as "
-                      f"{motor}_dir/{motor}_speed", "use one form per motor")
+            out.error(cell.line, cell.column, N_("motor {m} is given both as {m} and as {m}_dir/{m}_speed", m=motor),
+                      N_("use one form per motor"))
         elif "dir" in forms and "speed" not in forms:
             cell = seen[("dir", motor)]
-            out.error(cell.line, cell.column, f"{motor}_dir has no {motor}_speed column",
-                      f"add a {motor}_speed column (or use one signed column {motor})")
+            out.error(cell.line, cell.column, N_("{m}_dir has no {m}_speed column", m=motor),
+                      N_("add a {m}_speed column (or use one signed column {m})", m=motor))
     return columns
 
 
@@ -232,43 +238,50 @@ def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int 
         return None
     hint = _range_hint(low, high, keep)
     if not INT_RE.match(text):
-        out.error(cell.line, cell.column, f"{what}: {text!r} is not an integer", hint)
+        out.error(cell.line, cell.column, N_("{what}: {text!r} is not an integer", what=what, text=text), hint)
         return blank
     if len(text) > MAX_NUMBER_CHARS:  # never in range, and int() of it may fail
-        out.error(cell.line, cell.column, f"{what}: a number of {len(text):,} characters is out of range "
-                  f"{low}..{high}", hint)
+        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is out of range {low}..{high}",
+                                             what=what, count=len(text), low=low, high=high), hint)
         return blank
     value = _whole(text)
     if not low <= value <= high:
-        out.error(cell.line, cell.column, f"{what}: {value} is out of range {low}..{high}", hint)
+        out.error(cell.line, cell.column, N_("{what}: {value} is out of range {low}..{high}", what=what, value=value,
+                                             low=low, high=high), hint)
         return blank
     return value
 
 
-def _range_hint(low: int, high: int, keep: bool) -> str:
+def _range_hint(low: int, high: int, keep: bool) -> Message:
     if (low, high) == (0, 1):  # event and direction cells: a flag, not a quantity
-        return "write 1 or 0 (a blank cell is 0)"
+        return N_("write 1 or 0 (a blank cell is 0)")
     if (low, high, keep) == (0, MAX_TIMER, False):  # the timer: ticks or a time
-        return f"write a whole number of ticks from 0 to {high}, or a time such as 500ms or 0.5s"
-    return f"write a whole number from {low} to {high}" + (", or = to keep it as it is" if keep else "")
+        return N_("write a whole number of ticks from 0 to {high}, or a time such as 500ms, 0.5s or 0,5s",
+                  high=high)
+    if keep:
+        return N_("write a whole number from {low} to {high}, or = to keep it as it is", low=low, high=high)
+    return N_("write a whole number from {low} to {high}", low=low, high=high)
 
 
 def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
     text = cell.text.strip()
     if not text:
-        out.error(cell.line, cell.column, f"{what} is missing", "write a state number or name")
+        out.error(cell.line, cell.column, N_("{what} is missing", what=what), N_("write a state number or name"))
         return None
     if INT_RE.match(text) and len(text) > MAX_NUMBER_CHARS:  # int() of it may fail
-        out.error(cell.line, cell.column, f"{what}: a number of {len(text):,} characters is too long",
-                  f"a state number has at most {MAX_NUMBER_CHARS} characters; or use a name")
+        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is too long", what=what,
+                                             count=len(text)),
+                  N_("a state number has at most {most} characters; or use a name", most=MAX_NUMBER_CHARS))
         return None
     if INT_RE.match(text):
         value = _whole(text)
         if value < 0:
-            out.error(cell.line, cell.column, f"{what} {value} is negative", "states are 0 or more")
+            out.error(cell.line, cell.column, N_("{what} {value} is negative", what=what, value=value),
+                      N_("states are 0 or more"))
         return value
     if not STATE_RE.match(text):
-        out.error(cell.line, cell.column, f"{what} {text!r} is not a valid state name", STATE_HINT)
+        out.error(cell.line, cell.column, N_("{what} {text!r} is not a valid state name", what=what, text=text),
+                  STATE_HINT)
         return None
     return text
 
@@ -351,11 +364,11 @@ def _value(column: Column, cell: Cell, out: Collector, tick_ms: int) -> Any:
     if kind == "timer" and TIME_RE.search(text):
         return _timer(cell, tick_ms, out)
     if kind in ("state", "next"):
-        return _state(cell, "next state" if kind == "next" else "state", out)
+        return _state(cell, N_("next state") if kind == "next" else N_("state"), out)
     if kind in NUMBERS:
         low, high, blank, keep = NUMBERS[kind]
         label = column.cell.text.strip()
-        what = "timer" if kind == "timer" else f"event {label}" if kind == "event" else label
+        what = N_("timer") if kind == "timer" else N_("event {label}", label=label) if kind == "event" else label
         return _int(cell, what, low, high, out, blank, keep)
     return None  # an ignored column: one with a name was reported in the header, a blank one by _Layout
 
@@ -369,8 +382,10 @@ def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
         out.error(cell.line, cell.column, N_("timer: {problem}", problem=exc.message), exc.hint)
         return 0
     if ticks > MAX_TIMER:
-        out.error(cell.line, cell.column, f"timer: {text} is {ticks} ticks, more than the timer holds ({MAX_TIMER})",
-                  f"the longest timer is {MAX_TIMER} ticks ({seconds(MAX_TIMER, tick_ms):g} s at {tick_ms} ms a tick)")
+        out.error(cell.line, cell.column, N_("timer: {text} is {ticks} ticks, more than the timer holds ({most})",
+                                             text=text, ticks=ticks, most=MAX_TIMER),
+                  N_("the longest timer is {most} ticks ({seconds:g} s at {tick} ms a tick)", most=MAX_TIMER,
+                     seconds=seconds(MAX_TIMER, tick_ms), tick=tick_ms))
         return 0
     return ticks
 
@@ -416,6 +431,6 @@ def resolve_table_path(path: Path) -> Path:
         for name in ("table.csv", "table.tsv"):
             if (path / name).is_file():
                 return path / name
-        raise fail(path, "this folder holds no table.csv or table.tsv",
-                   "give the table file itself, or a folder that holds table.csv")
+        raise fail(path, N_("this folder holds no table.csv or table.tsv"),
+                   N_("give the table file itself, or a folder that holds table.csv"))
     return path

@@ -131,7 +131,7 @@ class Message(str):
     def __new__(cls, msgid: str, args: Mapping[str, Any] | None = None, plural: str | None = None) -> Message:
         args = dict(args or {})
         english = plural if plural is not None and args.get("n") != 1 else msgid
-        self = super().__new__(cls, english.format(**args) if args else english)
+        self = super().__new__(cls, _fill(english, args, LANGUAGES[0]))
         self.msgid, self.plural, self.args = msgid, plural, args
         return self
 
@@ -140,12 +140,18 @@ class Message(str):
         catalog = translation(language)
         text = catalog.gettext(self.msgid) if self.plural is None else \
             catalog.ngettext(self.msgid, self.plural, int(self.args["n"]))
-        if not self.args:
-            return text
-        return text.format(**{k: localise(v, language) for k, v in self.args.items()})
+        return _fill(text, self.args, language)
 
     def __reduce__(self) -> tuple[Any, ...]:  # pickled between processes (evolve's and sweep's workers)
         return Message, (self.msgid, self.args, self.plural)
+
+
+def _fill(text: str, args: Mapping[str, Any], language: str | None) -> str:
+    """``text`` with its fields filled: a Message argument in ``language``, a tuple of them as a list (``a, b``)."""
+    if not args:
+        return text
+    return text.format(**{k: ", ".join(str(localise(item, language)) for item in v) if isinstance(v, tuple)
+                          else localise(v, language) for k, v in args.items()})
 
 
 def N_(msgid: str, /, **args: Any) -> Message:
