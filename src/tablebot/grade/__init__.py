@@ -5,7 +5,7 @@ links) is read against that robot, its rules proved, run on the fleet over the s
 
 >>> import tablebot.grade as grade
 >>> result = grade.grade("examples/challenges/find-the-lamp", ["examples/bumberbot"], "out/grade")
->>> [(e.name, e.why[:26]) for e in result.entries]
+>>> [(e.name, e.why[:25]) for e in result.entries]
 [('bumberbot', 'breaks front_bumper_stops')]
 """
 
