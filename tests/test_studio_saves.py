@@ -332,12 +332,12 @@ def test_a_reload_for_another_tabs_save_never_replaces_an_edit_made_meanwhile(fo
             await tab.handle({"op": "open", "path": "table.csv"})
         await a.handle({"op": "edit", "row": 0, "col": 0, "value": "a's"})
         saving = asyncio.create_task(a.handle({"op": "save"}))
-        while not edits or b.edits == 0:
+        while not edits or b.draft.edits == 0:
             await asyncio.sleep(0.01)
         held.set()  # the edit is made; the reload goes on
         await saving
         await edits[0]
-        assert b.doc is not None and b.doc.grid()[1][0] == "b's" and b.dirty
+        assert b.draft.doc is not None and b.draft.doc.grid()[1][0] == "b's" and b.draft.dirty
         for tab in (a, b):
             tab.close()
         return told

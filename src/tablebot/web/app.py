@@ -26,6 +26,7 @@ from tablebot.templates import TEMPLATES
 from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.live import give_back_memory
+from tablebot.web.protocol import ErrorMsg, TraceMsg
 from tablebot.web.session import Hub, Session
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
 from tablebot.web.workspace import Workspace
@@ -75,9 +76,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
             async for chunk in request.stream():
                 body += chunk
                 if len(body) > MAX_PLAYER_TRACE_BYTES:
-                    return JSONResponse({"type": "error", "message": f"the trace is larger than "
-                                         f"{MAX_PLAYER_TRACE_BYTES:,} bytes", "hint": "cut the run shorter"},
-                                        status_code=413)
+                    return JSONResponse(ErrorMsg(f"the trace is larger than {MAX_PLAYER_TRACE_BYTES:,} bytes",
+                                                 hint="cut the run shorter").data(), status_code=413)
         except ClientDisconnect:  # the tab closed or reloaded mid-upload: nobody is left to answer
             log.warning("an uploaded trace (%s) was cut off after %s: the page closed the connection, nothing "
                         "was read", terminal(name), _of_bytes(len(body), request.headers.get("content-length")))
@@ -85,11 +85,11 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
         try:
             lines = await asyncio.to_thread(read_trace_bytes, bytes(body), name)
         except TableBotError as exc:
-            return JSONResponse({"type": "error", "message": str(exc)}, status_code=400)
+            return JSONResponse(ErrorMsg(str(exc)).data(), status_code=400)
         except Exception:  # a bug: the page gets the studio's words, the terminal the traceback
             log.exception("an uploaded trace failed")
-            return JSONResponse({"type": "error", "message": INTERNAL}, status_code=500)
-        return JSONResponse({"type": "trace", "name": name, "columns": trace_columns(lines)})
+            return JSONResponse(ErrorMsg(INTERNAL).data(), status_code=500)
+        return JSONResponse(TraceMsg(name, trace_columns(lines)).data())
 
     async def socket(websocket: WebSocket) -> None:
         await websocket.accept(subprotocol(websocket.scope))  # the page's key was checked by the gate
@@ -172,8 +172,8 @@ class Tabs:
             log.warning("refused a tab: %s %s open already, the most one studio serves at once (close one of "
                         "them in the browser)", tabs, "are" if self.most != 1 else "is")
             self.told = True
-        refusal = json.dumps({"type": "error", "op": "", "message": f"this studio already has {tabs} open, the "
-                              "most it serves at once: close one of them, then reload this tab"})
+        refusal = json.dumps(ErrorMsg(f"this studio already has {tabs} open, the most it serves at once: close one "
+                                      "of them, then reload this tab").data())
         try:
             await websocket.send_text(refusal)
             while (await websocket.receive())["type"] != "websocket.disconnect":
