@@ -135,3 +135,31 @@ def test_bad_tables_are_explained_in_the_readers_language(tmp_path: Path, text: 
         assert not re.search(r"[A-Za-z]{3,}", rest.replace("table.csv", "")), shown
         german = found.render("de")
         assert ": Fehler: " in german and str(found.message) not in german, german
+
+
+def test_a_table_written_in_german_reads_back_the_same() -> None:
+    from tablebot.formats.table_read import parse_table
+    from tablebot.formats.table_write import format_table
+
+    table = load_table(BUMBERBOT / "table.csv")
+    german = format_table(table, "de")
+    assert german.startswith("Beschreibung,Zustand,T,I3,I4,I5,I7,I8,M1_Richtung,M1_Tempo,M2_Richtung,M2_Tempo,Timer,"
+                             "Folgezustand\n")
+    assert parse_table(german, "de.csv", table.robot).rows == table.rows
+    assert format_table(table) == format_table(table, "en") and format_table(table).startswith("description,state,")
+
+
+def test_new_writes_a_german_table_when_asked(tmp_path: Path) -> None:
+    def new(folder: str, *args: str, **env: str) -> str:
+        done = subprocess.run([sys.executable, "-m", "tablebot", "new", str(tmp_path / folder), *args],
+                              capture_output=True, text=True, env=child_env(**env), cwd=ROOT)
+        assert done.returncode == 0, done.stderr
+        return done.stdout
+
+    said = new("de", "--lang", "de", "--inputs", "I1", "--motors", "M1,M2")
+    assert said.startswith(f"{tmp_path / 'de'} angelegt aus einem leeren Roboter:")
+    text = (tmp_path / "de" / "table.csv").read_text()
+    assert text.startswith("Beschreibung,Zustand,T,I1,M1,M2,Timer,Folgezustand\n") and "losfahren" in text
+    assert [r.timer for r in load_table(tmp_path / "de" / "table.csv").rows] == [800, 70]
+    new("system", "--inputs", "I1", LANG="de_DE.UTF-8")  # German words, but the file in English: not asked for
+    assert (tmp_path / "system" / "table.csv").read_text().startswith("description,state,T,I1,")

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import fail
 from tablebot.examples import example_path
+from tablebot.i18n import N_, Message, asked, localise
 from tablebot.robot import NAME_RE, RESERVED_LOWER, RESERVED_NAMES
 
 if TYPE_CHECKING:
@@ -22,10 +23,10 @@ EXAMPLES = ("bumberbot", "line-follower", "obstacle-avoider")
 TEMPLATES = (*EXAMPLES, "empty")
 FILES = ("table.csv", "robot.toml", "arena.toml", "properties.toml")
 #: What each file is for, shown after ``tablebot new``.
-PURPOSE = {"table.csv": "the behaviour: one row per transition (open it in a spreadsheet)",
-           "robot.toml": "its inputs, motors, sensors and state names",
-           "arena.toml": "the world `tablebot sim` drives it in",
-           "properties.toml": "claims about every run that `tablebot check` proves or refutes"}
+PURPOSE = {"table.csv": N_("the behaviour: one row per transition (open it in a spreadsheet)"),
+           "robot.toml": N_("its inputs, motors, sensors and state names"),
+           "arena.toml": N_("the world `tablebot sim` drives it in"),
+           "properties.toml": N_("claims about every run that `tablebot check` proves or refutes")}
 #: The simulator's default parts (tablebot.sim.params.WIRING): a renamed BumberBot keeps them wired.
 BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                    "rear": "I5", "light_right": "I7", "light_left": "I8"}
@@ -195,15 +196,22 @@ def _empty_table(inputs: list[Named], motors: list[Named]) -> str:
         cells += [str(speeds[k]) if k < len(speeds) else "0" for k in range(len(drives))]
         return ",".join([*cells, timer, str(nxt)])
 
-    example = row(f"# {names[0]} reads 1 while driving: turn away for 1 s", 2, "", {names[0]: "1"}, [5, -5],
-                  "1s", 1) if names else "# description,state,T,inputs...,motors...,timer,next"
-    return "\n".join([header,
-                      "# A row fires in its state when its marked events are present: it sets the motors and loads "
-                      "the timer and the robot goes to the next state (the first such row of a state wins)",
-                      "# Remove the # of the next line to use it (it must come before the other state 2 row):",
-                      example,
-                      row("start driving", 1, "1", {}, [6, 6], "8s", 2),
-                      row("time to turn", 2, "1", {}, [5, -5], "0.7s", 1)]) + "\n"
+    said = asked()  # the table's words in the language asked for (--lang); its header: cli/new.py
+
+    def words(text: Message) -> str:
+        return str(localise(text, said))
+
+    example = row(words(N_("# {name} reads 1 while driving: turn away for 1 s", name=names[0])), 2, "",
+                  {names[0]: "1"}, [5, -5], "1s", 1) if names else \
+        words(N_("# description,state,T,inputs...,motors...,timer,next"))
+    return "\n".join([
+        header,
+        words(N_("# A row fires in its state when its marked events are present: it sets the motors and loads "
+                 "the timer and the robot goes to the next state (the first such row of a state wins)")),
+        words(N_("# Remove the # of the next line to use it (it must come before the other state 2 row):")),
+        example,
+        row(words(N_("start driving")), 1, "1", {}, [6, 6], "8s", 2),
+        row(words(N_("time to turn")), 2, "1", {}, [5, -5], "0.7s", 1)]) + "\n"
 
 
 ROBOT = """\

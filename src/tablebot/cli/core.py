@@ -21,7 +21,9 @@ from tablebot.cli.common import (
     out_file,
     out_folder,
 )
+from tablebot.diagnostics import severity_word
 from tablebot.escape import terminal
+from tablebot.i18n import N_, Message, _, asked, localise, ngettext
 from tablebot.table import Table
 
 
@@ -46,16 +48,18 @@ def import_cmd(
 
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
     for line in _rule_warnings(table):
-        err_console.print(f"warning: {terminal(line)}")
-    text = format_table(table)
+        err_console.print(f"{severity_word('warning')}: {terminal(localise(line))}")
+    text = format_table(table, asked())  # its header in the language asked for (--lang): the reader takes either
     if out is None:
         sys.stdout.write(text)
     else:
         write_text(out_file(out, "--out"), text)
-        err_console.print(f"wrote {terminal(str(out))} ({len(table.rows)} rows; descriptions are not in the lists)")
+        err_console.print(ngettext("wrote {path} ({n} row; descriptions are not in the lists)",
+                                   "wrote {path} ({n} rows; descriptions are not in the lists)",
+                                   len(table.rows)).format(path=terminal(str(out)), n=len(table.rows)))
 
 
-def _rule_warnings(table: Table) -> list[str]:
+def _rule_warnings(table: Table) -> list[Message]:
     """The lists ran in the document's engine; a robot whose rule is "always" would run a row that requires no
     event differently wherever a tick with no event can come."""
     from tablebot.robot import MATCH_DOCUMENT
@@ -63,10 +67,11 @@ def _rule_warnings(table: Table) -> list[str]:
 
     if table.robot.match == MATCH_DOCUMENT:
         return []
-    return [f"line {f.row.line} of the lists requires no event: the document's engine, which ran these lists, "
-            f"fires nothing on a tick with no event, but {table.robot.source} follows match = \"always\" (it fires "
-            f"the row there), and such a tick can come in state {f.row.state!r} ({f.quiet}); write "
-            f"match = \"document\" in {table.robot.source} to run the table as the lists ran"
+    return [N_("line {line} of the lists requires no event: the document's engine, which ran these lists, fires "
+               "nothing on a tick with no event, but {source} follows match = \"always\" (it fires the row there), "
+               "and such a tick can come in state {state!r} ({why}); write match = \"document\" in {source} to run "
+               "the table as the lists ran", line=f.row.line, source=table.robot.source, state=f.row.state,
+               why=f.quiet)
             for f in no_event_rows(table) if f.quiet]
 
 
@@ -94,7 +99,8 @@ def trace_cmd(
         return
     with atomic_write(out_file(out, "--out")) as stream:
         count = write_trace(lines, stream)
-    err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")
+    err_console.print(ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count)
+                      .format(path=terminal(str(out)), n=count))
 
 
 @app.command("demo")
@@ -109,7 +115,7 @@ def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder 
     from tablebot.replay import replay
 
     folder = example_path("bumberbot")
-    _, machine = load(folder / "table.csv")
+    machine = load(folder / "table.csv")[1]
     ticks = load_inputs(folder / "inputs.csv", machine)
     out_folder(out, "--out")
     lines = list(replay(machine, ticks))
@@ -119,8 +125,9 @@ def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder 
     for line in lines:
         visits[line["state"]] = visits.get(line["state"], 0) + 1
     fired = sum(1 for line in lines if line["row"] is not None)
-    console.print(f"BumberBot: {len(lines)} ticks ({machine.table.robot.seconds(len(lines)):.1f} s), "
-                  f"{fired} rows fired")
+    console.print(_("BumberBot: {ticks} ticks ({seconds:.1f} s), {fired} rows fired").format(
+        ticks=len(lines), seconds=machine.table.robot.seconds(len(lines)), fired=fired))
     for state, count in visits.items():
-        console.print(f"  state {terminal(str(state)):>4}: {machine.table.robot.seconds(count):6.2f} s")
-    console.print(f"wrote {terminal(str(out / 'trace.jsonl'))}")
+        console.print("  " + _("state {state:>4}: {seconds:6.2f} s").format(
+            state=terminal(str(state)), seconds=machine.table.robot.seconds(count)))
+    console.print(_("wrote {path}").format(path=terminal(str(out / "trace.jsonl"))))

@@ -9,7 +9,10 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import console, guarded
+from tablebot.diagnostics import severity_word
 from tablebot.escape import shell_word, terminal
+from tablebot.i18n import N_, _, asked, localise
+from tablebot.i18n.headers import header_line
 
 
 class From(StrEnum):
@@ -35,13 +38,14 @@ def new_cmd(
 
     made = templates.make(template.value, folder.name or "robot", templates.parse_names(inputs, "--inputs"),
                           templates.parse_names(motors, "--motors"))
+    made.files["table.csv"] = header_line(made.files["table.csv"], asked())  # Zustand, Folgezustand with --lang de
     written = templates.write_folder(folder, made)
-    source = "an empty robot" if template is From.empty else f"the {template.value} example"
-    console.print(f"created {terminal(str(folder))} from {source}:")
+    source = N_("an empty robot") if template is From.empty else N_("the {name} example", name=template.value)
+    console.print(_("created {folder} from {source}:").format(folder=terminal(str(folder)), source=localise(source)))
     for path in written:
-        console.print(f"  {terminal(str(path)):<36} {terminal(templates.PURPOSE[path.name])}")
+        console.print(f"  {terminal(str(path)):<36} {terminal(localise(templates.PURPOSE[path.name]))}")
     for note in made.notes:
-        console.print(f"[yellow]note:[/yellow] {terminal(note)}")
-    console.print("next:")
+        console.print(f"[yellow]{severity_word('note')}:[/yellow] {terminal(localise(note))}")
+    console.print(_("next:"))
     for command in ("check", "sim", "diagram"):  # lines to paste: the folder quoted for a shell
         console.print(f"  tablebot {command} {terminal(shell_word(str(folder)))}")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import io
 
+from tablebot.i18n.headers import header_name
 from tablebot.table import DOC_KEEP_SPEED, Row, Table, to_direction_speed
 
 
@@ -19,11 +20,12 @@ def signed_motors(table: Table) -> frozenset[str]:
     return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
 
 
-def header(table: Table, signed: frozenset[str]) -> list[str]:
+def header(table: Table, signed: frozenset[str], language: str = "en") -> list[str]:
+    """The header's cells, in ``language`` (German: Zustand, Folgezustand, M1_Richtung: tablebot.i18n.headers)."""
     robot = table.robot
     motors = [name for m in robot.motors for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
-    return ["description", "state", *table.events, *motors,
-            *robot.lamps, *(f"{c}_load" for c in robot.counter_names), "timer", "next"]
+    return [header_name(name, language) for name in ["description", "state", *table.events, *motors, *robot.lamps,
+                                                      *(f"{c}_load" for c in robot.counter_names), "timer", "next"]]
 
 
 def _motor_cells(speed: int | None, signed: bool) -> list[str]:
@@ -46,12 +48,13 @@ def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[st
             str(row.timer), str(row.next)]
 
 
-def format_table(table: Table) -> str:
-    """CSV text that :func:`tablebot.formats.table_read.parse_table` reads back into the same machine."""
+def format_table(table: Table, language: str = "en") -> str:
+    """CSV text that :func:`tablebot.formats.table_read.parse_table` reads back into the same machine (its header in
+    ``language``: the reader takes either)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     signed = signed_motors(table)
-    writer.writerow(header(table, signed))
+    writer.writerow(header(table, signed, language))
     previous = None
     for row in table.rows:
         writer.writerow(row_cells(table, row, previous, signed))

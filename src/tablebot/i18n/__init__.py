@@ -33,6 +33,7 @@ __all__ = [
     "LanguageError",
     "Message",
     "_",
+    "asked",
     "choose",
     "current",
     "gettext",
@@ -172,11 +173,12 @@ def localise(text: Any, language: str | None = None) -> Any:
 # --- choosing the language ------------------------------------------------------------------------
 
 def choose(argv: Sequence[str], environ: Mapping[str, str], system: Callable[[], str | None] | None = None) \
-        -> tuple[str, list[str]]:
+        -> tuple[str, list[str], bool]:
     """The language a command speaks and its arguments without ``--lang``: ``--lang de|en`` (anywhere before
     ``--``, so ``tablebot sim --lang de`` works as ``tablebot --lang de sim``), else ``TABLEBOT_LANG``, else the
-    system's locale (:func:`system_language`), else English. An unknown language asked for by name raises
-    :class:`LanguageError`; a system locale tablebot does not speak (``fr_FR``) is English."""
+    system's locale (:func:`system_language`), else English; and whether it was asked for by name (--lang or
+    TABLEBOT_LANG). An unknown language asked for by name raises :class:`LanguageError`; a system locale tablebot
+    does not speak (``fr_FR``) is English."""
     rest: list[str] = []
     asked: tuple[str, str] | None = None
     words = iter(argv)
@@ -196,9 +198,9 @@ def choose(argv: Sequence[str], environ: Mapping[str, str], system: Callable[[],
         value = asked[1].strip().lower()
         if value not in LANGUAGES and not (asked[0] == ENV and value == PSEUDO):
             raise LanguageError(*asked)
-        return value, rest
+        return value, rest, True
     found = (system or (lambda: system_language(environ)))()
-    return (found if found in LANGUAGES else LANGUAGES[0]), rest
+    return (found if found in LANGUAGES else LANGUAGES[0]), rest, False
 
 
 def system_language(environ: Mapping[str, str], platform: str = sys.platform,
@@ -238,8 +240,20 @@ def _windows_ui_language() -> int:
     return int(windll.kernel32.GetUserDefaultUILanguage())
 
 
+_asked: str | None = None
+
+
 def set_from(argv: Sequence[str], environ: Mapping[str, str] | None = None) -> list[str]:
     """Choose and use the language for a command line; the arguments without ``--lang``."""
-    language, rest = choose(argv, os.environ if environ is None else environ)
+    global _asked
+    language, rest, named = choose(argv, os.environ if environ is None else environ)
     use(language)
+    _asked = language if named else None
     return rest
+
+
+def asked() -> str:
+    """The language a user asked for by name (--lang, TABLEBOT_LANG), else English: the language of the files a
+    command writes for people to edit (the header of a table from ``new`` or ``import``), which a system's
+    locale alone does not change (a table written on one computer is read on another)."""
+    return _asked if _asked in LANGUAGES else LANGUAGES[0]

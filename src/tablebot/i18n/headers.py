@@ -8,7 +8,7 @@ ROBO Pro's German interface names its inputs and motors.
 
 from __future__ import annotations
 
-__all__ = ["FIXED", "GERMAN_FIXED", "GERMAN_SUFFIXES", "header_name", "suffix"]
+__all__ = ["FIXED", "GERMAN_FIXED", "GERMAN_SUFFIXES", "header_line", "header_name", "suffix"]
 
 #: The fixed columns, English -> German (ROBO Pro's and the kits' words: Zustand, Folgezustand).
 FIXED = {"description": "Beschreibung", "state": "Zustand", "timer": "Timer", "next": "Folgezustand"}
@@ -35,3 +35,13 @@ def header_name(name: str, language: str) -> str:
     if sep and end in SUFFIXES:
         return f"{base}_{SUFFIXES[end]}"
     return name
+
+
+def header_line(text: str, language: str) -> str:
+    """A table's text with its header (its first line) written in ``language``; the rows as they are. The header's
+    cells are names (never quoted, never holding the delimiter), split on the delimiter the line uses."""
+    if language == "en":
+        return text
+    first, newline, rest = text.partition("\n")
+    delimiter = "\t" if "\t" in first else ";" if ";" in first and "," not in first else ","
+    return delimiter.join(header_name(cell, language) for cell in first.split(delimiter)) + newline + rest
