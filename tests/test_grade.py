@@ -122,13 +122,21 @@ def test_line_laps_ranks_more_laps_first(tmp_path: Path) -> None:
     assert [r["name"] for r in table] == ["line-follower", "slow"] and float(table[0]["score"]) > 1
 
 
-def test_dask_grades_byte_for_byte_as_this_machine(graded: Path, pupils: Path, tmp_path: Path,
-                                                   dask_cluster: str) -> None:  # noqa: F811
+def test_dask_grades_both_shipped_challenges_byte_for_byte_as_this_machine(graded: Path, pupils: Path,
+                                                                           tmp_path: Path,
+                                                                           dask_cluster: str) -> None:  # noqa: F811
     code, output = grade(LAMP, *(pupils / n for n in ("anna", "ben", "carl.csv", "dora", "emil", "links.txt")),
                          "--out", tmp_path / "dask", "--scheduler", dask_cluster)
     assert code == 0, output
     assert (tmp_path / "dask" / "scores.csv").read_bytes() == (graded / "scores.csv").read_bytes()
     assert (tmp_path / "dask" / "leaderboard.html").read_bytes() == (graded / "leaderboard.html").read_bytes()
+    laps = [ROOT / "examples" / "line-follower", pupils / "emil"]
+    code, output = grade(LAPS, *laps, "--out", tmp_path / "laps-local", "--workers", "2")
+    assert code == 0, output
+    code, output = grade(LAPS, *laps, "--out", tmp_path / "laps-dask", "--scheduler", dask_cluster)
+    assert code == 0, output
+    local = (tmp_path / "laps-local" / "scores.csv").read_bytes()
+    assert local == (tmp_path / "laps-dask" / "scores.csv").read_bytes() and local.count(b",,") == 0  # both ranked
 
 
 @pytest.fixture(scope="module")
