@@ -16,7 +16,8 @@ A table's names: states are ``s12`` (state 12) or ``n_`` and the name with every
 ``_HEX_`` (``Seek turn``: ``n_Seek_20_turn``), so that ids are XML names and JavaScript identifiers and read back
 exactly; in a robot of several tables each table's states, timer, flags and ``pending`` carry its name and ``_``
 (``drive_s12``, ``drive_timer``), and its region is the table's name. Inputs, outputs and counters are the robot's
-and keep their names.
+and keep their names; the chart's own data items (``is_started``, ``is_pending``, ``fired_row``, ``has_I3``) and the
+event data's pulse keys (``C1_pulses``) have an underscore, which no name in a robot file has, so none can clash.
 """
 
 from __future__ import annotations
@@ -28,12 +29,20 @@ from dataclasses import dataclass
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
-__all__ = ["TICK", "WRAPPER", "Chart", "Part", "chart_of", "state_id", "state_of"]
+__all__ = ["STARTED", "TICK", "WRAPPER", "Chart", "Part", "chart_of", "pulses", "state_id", "state_of"]
 
 #: The one event a program sends per tick.
 TICK = "tick"
 #: The id of the state (SCXML) that wraps one table, or of the parallel state that holds several.
 WRAPPER = "robot_"
+#: The data item that says the first tick has come (nothing counts down on it).
+STARTED = "is_started"
+
+
+def pulses(counter: str) -> str:
+    """The key of a counter's pulses in a tick's event data (``C1_pulses``: python-statemachine gives the event
+    data's keys as names to expressions, before the data model's, so ``C1`` there would hide the counter)."""
+    return f"{counter}_pulses"
 _PLAIN = re.compile(r"[A-Za-z0-9]")
 _CODE = re.compile(r"_([0-9a-f]{1,6})_")
 
@@ -88,11 +97,11 @@ class Part:
 
     @property
     def pending(self) -> str:
-        return f"{self.prefix}pending"
+        return f"{self.prefix}is_pending"
 
     @property
     def row(self) -> str:
-        return f"{self.prefix}row"
+        return f"{self.prefix}fired_row"
 
     def flag(self, event: str) -> str | None:
         """The data item that says whether ``event`` is present this tick; None for a cross-table event."""

@@ -13,14 +13,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from tablebot.formats.statecharts.chart import TICK, WRAPPER, Chart, Part, chart_of
+from tablebot.formats.statecharts.chart import STARTED, TICK, WRAPPER, Chart, Part, chart_of, pulses
 from tablebot.formats.statecharts.xmltree import Element, serialise
 from tablebot.table import Row, Table
 
 __all__ = ["export_scxml", "scxml_tree"]
 
 COMMENT = ("written by tablebot (export, to scxml): send one event, tick, per tick with each input (0 or 1) and "
-           "the pulses of each counter as its data; the timers live in the data model")
+           "the pulses of each counter (C1_pulses) as its data; the timers live in the data model")
 
 
 def export_scxml(tables: Sequence[Table]) -> str:
@@ -54,7 +54,7 @@ def scxml_tree(chart: Chart) -> Element:
 
 def _datamodel(model: Element, chart: Chart) -> None:
     robot = chart.main.robot
-    model.add("data", id="started", expr="0")
+    model.add("data", id=STARTED, expr="0")
     for name in chart.inputs:
         model.add("data", id=f"has_{name}", expr="0", tb_input=name)
     for name in robot.motors:
@@ -77,13 +77,13 @@ def _assign(parent: Element, location: str, expr: str) -> None:
 
 def _tick(transition: Element, chart: Chart) -> None:
     """The first half of a tick: count down (not on the first tick), then the event flags, then ``pending``."""
-    counting = transition.add("if", cond="started")
+    counting = transition.add("if", cond=STARTED)
     for part in chart.parts:
         _assign(counting.add("if", cond=f"{part.timer} > 0"), part.timer, f"{part.timer} - 1")
     for counter in chart.main.robot.counter_names:
-        _assign(counting, counter, f"{counter} - _event.data.{counter}")
+        _assign(counting, counter, f"{counter} - _event.data.{pulses(counter)}")
         _assign(counting.add("if", cond=f"{counter} < 0"), counter, "0")
-    _assign(transition, "started", "1")
+    _assign(transition, STARTED, "1")
     for name in chart.inputs:
         _assign(transition, f"has_{name}", f"_event.data.{name} == 1")
     for counter in chart.main.robot.counter_names:

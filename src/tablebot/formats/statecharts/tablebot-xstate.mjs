@@ -4,7 +4,7 @@
 //   import { createActor } from "xstate";
 //   import { tablebotMachine, tick } from "./tablebot-xstate.mjs";
 //   const actor = createActor(tablebotMachine(config)).start();
-//   tick(actor, { I3: 1, I4: 0 }, { C1: 2 });          // each input 0 or 1, each counter's pulses
+//   tick(actor, { I3: 1, I4: 0 }, { C1: 2 });   // each input 0 or 1, each counter's pulses (sent as C1_pulses)
 //   actor.getSnapshot().value, actor.getSnapshot().context.M1
 //
 // The tick model: the root's `tick` transition counts the timers and counters down (not on the first tick), sets
@@ -29,13 +29,13 @@ const guards = {
 };
 
 function countDown(context, event, params) {
-  const next = { started: 1 };
-  if (context.started === 1) {
+  const next = { [params.started]: 1 };
+  if (context[params.started] === 1) {
     for (const table of params.tables) {
       next[table.timer] = Math.max(0, context[table.timer] - 1);
     }
     for (const counter of params.counters) {
-      next[counter] = Math.max(0, context[counter] - event[counter]);
+      next[counter.name] = Math.max(0, context[counter.name] - event[counter.pulses]);
     }
   }
   const value = (name) => (name in next ? next[name] : context[name]);
@@ -43,7 +43,7 @@ function countDown(context, event, params) {
     next[`has_${input}`] = event[input] === 1;
   }
   for (const counter of params.counters) {
-    next[`has_${counter}`] = value(counter) === 0;
+    next[`has_${counter.name}`] = value(counter.name) === 0;
   }
   for (const table of params.tables) {
     next[table.flag] = value(table.timer) === 0;
@@ -96,5 +96,6 @@ export function tablebotMachine(config) {
 }
 
 export function tick(actor, inputs, pulses = {}) {
-  actor.send({ type: "tick", ...inputs, ...pulses });
+  const counts = Object.fromEntries(Object.entries(pulses).map(([name, count]) => [`${name}_pulses`, count]));
+  actor.send({ type: "tick", ...inputs, ...counts });
 }

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from importlib import resources
 from typing import Any
 
-from tablebot.formats.statecharts.chart import TICK, Chart, Part, chart_of
+from tablebot.formats.statecharts.chart import STARTED, TICK, Chart, Part, chart_of, pulses
 from tablebot.table import Row, Table
 
 __all__ = ["FORMAT", "RUNTIME", "export_xstate", "runtime_module", "xstate_config"]
@@ -39,7 +39,7 @@ def runtime_module() -> str:
 
 def xstate_config(chart: Chart) -> dict[str, Any]:
     robot = chart.main.robot
-    context: dict[str, Any] = {"started": 0, **{f"has_{name}": False for name in chart.inputs}}
+    context: dict[str, Any] = {STARTED: 0, **{f"has_{name}": False for name in chart.inputs}}
     context.update({name: 0 for name in (*robot.motors, *robot.lamps)})
     for counter in robot.counter_names:
         context.update({counter: 0, f"has_{counter}": False})
@@ -47,7 +47,8 @@ def xstate_config(chart: Chart) -> dict[str, Any]:
         context.update({part.timer: part.table.robot.initial_timer, f"{part.prefix}has_T": False,
                         part.pending: 0, part.row: -1})
     tick = {"type": "tick", "params": {
-        "inputs": list(chart.inputs), "counters": list(robot.counter_names),
+        "inputs": list(chart.inputs), "started": STARTED,
+        "counters": [{"name": c, "pulses": pulses(c)} for c in robot.counter_names],
         "tables": [{"timer": p.timer, "flag": f"{p.prefix}has_T", "pending": p.pending} for p in chart.parts]}}
     meta = {"tablebot": {
         "format": FORMAT, "tickMs": robot.tick_ms, "inputs": list(chart.inputs), "motors": list(robot.motors),
