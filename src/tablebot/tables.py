@@ -102,7 +102,7 @@ def load_tables(table: Table) -> RobotTables:
     specs = tables_of(table.robot)
     base = Path(table.robot.source).parent
     tables = tuple(table if spec.name == table.name else _load(base, spec, table.robot) for spec in specs)
-    problems = [*_cross_problems(tables), *_writer_problems(tables)]
+    problems = [*_cross_problems(tables), *_writer_problems(tables), *_named_problems(tables)]
     if problems:
         raise TableBotError(problems)
     return RobotTables(tables, tuple(compile_table(t) for t in tables))
@@ -143,3 +143,13 @@ def _writer_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
                     f"{output} is written by two tables, {owner.name} ({owner.path}:{at[0]}:{at[1]}) and {table.name}",
                     f"each motor, lamp and counter load has one writer: remove the {output} column from one table"))
     return found
+
+
+def _named_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
+    """A state ``[states]`` names that no table has rows for (the names are the robot's, for all its tables)."""
+    robot = tables[0].robot
+    with_rows = {row.state for t in tables for row in t.rows}
+    return [Diagnostic(robot.source, robot.line("states", str(state)), 1,
+                       f"state {state!r} is named in {robot.source} but no table has rows for it",
+                       "add rows for it or remove it from [states]")
+            for state in robot.state_names if state not in with_rows]
