@@ -12,12 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple
 
 import numpy as np
 
 from tablebot.robot import MATCH_DOCUMENT, StateId
 from tablebot.table import TIMER_EVENT, Table
+from tablebot.tick import Program
 
 #: Per state, lookups are precomputed for every combination of the bits its rows use when there
 #: are at most this many such bits; beyond that they are computed on first use and cached.
@@ -143,29 +143,6 @@ class Machine:
         return (self.states, self.table.events, self.timer_bit, self.counter_bits,
                 tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
                 self.initial_state, self.initial_timer, self.output_names, *rule)
-
-
-class Program(NamedTuple):
-    """A compiled table as the compiled tick (:func:`tablebot.tick.tick`) reads it: one table's rule as integer
-    arrays, by name. numba passes it as the arrays it holds (no cost beside separate arguments); a robot that
-    runs several tables takes one Program per table (a tuple of them), each made by :attr:`MachineArrays.program`.
-
-    ``lookup[state, events]`` is the fired row or -1; per row, ``next_state`` and ``timers`` (the timer it
-    loads), ``outputs``/``keep`` each output's new value or "keep", ``loads``/``load_set`` each counter's load
-    or "leave alone"; ``counter_bits[c]`` is counter c's event bit (0: no column), ``input_mask`` the events
-    that come from inputs, ``timer_bit`` the T column's bit (0: none).
-    """
-
-    input_mask: int
-    timer_bit: int
-    lookup: np.ndarray
-    next_state: np.ndarray
-    timers: np.ndarray
-    outputs: np.ndarray
-    keep: np.ndarray
-    loads: np.ndarray
-    load_set: np.ndarray
-    counter_bits: np.ndarray
 
 
 @dataclass(frozen=True)

@@ -7,17 +7,37 @@ one tick at a time in Python; tests prove the two agree tick for tick on random 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import NamedTuple
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from tablebot.machine import Program
 
 # The engine's registers, one int64 array per robot: what a tick reads and changes besides the
 # outputs and counters arrays.
 TICK, STATE, TIMER, EVENT, ROW = 0, 1, 2, 3, 4
 N_REGS = 5
+
+
+class Program(NamedTuple):
+    """A compiled table as :func:`tick` reads it: one table's rule as integer arrays, by name (made by
+    :attr:`tablebot.machine.MachineArrays.program`). numba passes it as the arrays it holds, at no cost beside
+    separate arguments; a robot that runs several tables would take one Program per table (a tuple of them).
+
+    ``lookup[state, events]`` is the fired row or -1; per row, ``next_state`` and ``timers`` (the timer it
+    loads), ``outputs``/``keep`` each output's new value or "keep", ``loads``/``load_set`` each counter's load
+    or "leave alone"; ``counter_bits[c]`` is counter c's event bit (0: no column), ``input_mask`` the events
+    that come from inputs, ``timer_bit`` the T column's bit (0: none).
+    """
+
+    input_mask: int
+    timer_bit: int
+    lookup: np.ndarray
+    next_state: np.ndarray
+    timers: np.ndarray
+    outputs: np.ndarray
+    keep: np.ndarray
+    loads: np.ndarray
+    load_set: np.ndarray
+    counter_bits: np.ndarray
 
 
 def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: int, pulses: np.ndarray,

@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
-from tablebot.machine import Program
 from tablebot.sim.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
 from tablebot.sim.kernel import move, run_robot
 from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants, Record, RobotState, Wiring, WorldArrays
+from tablebot.tick import Program
 
 
 @njit(nogil=True)

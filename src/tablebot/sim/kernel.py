@@ -16,14 +16,13 @@ import numpy as np
 
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.machine import Program
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
 from tablebot.sim.contacts import new_near, reaches
 from tablebot.sim.geometry import within
 from tablebot.sim.normals import standard_normal
 from tablebot.sim.physics import advance, advance_called, aim_turns
 from tablebot.sim.structures import Record, RobotState, Scratch, Wiring, WorldArrays
-from tablebot.tick import EVENT, ROW, STATE, TIMER
+from tablebot.tick import EVENT, ROW, STATE, TIMER, Program
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
 I_MASK, I_EVENT, I_ROW, I_STATE, I_TIMER = 0, 1, 2, 3, 4
