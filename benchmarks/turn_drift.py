@@ -24,7 +24,7 @@ from tablebot.cli.common import load
 from tablebot.sim.runner import simulate
 from tablebot.sim.scene import scene_for
 from tablebot.sim.summary import summarise
-from tablebot.sim.turn_drift import Turn, turns
+from tablebot.testing.turn_drift import Turn, turns
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

@@ -12,7 +12,7 @@ import pytest
 
 from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
-from tablebot.sim.turn_drift import turns
+from tablebot.testing.turn_drift import turns
 from test_sim_helpers import ROOT, scene_of, trace_text
 
 if TYPE_CHECKING:
