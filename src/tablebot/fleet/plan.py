@@ -22,13 +22,32 @@ import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notify
 from tablebot.files import atomic_write, remove, write_text
-from tablebot.fleet.run import Fleet, FleetSummary, RobotSpec, with_start
-from tablebot.fleet.spec import START_COLUMNS, Run, SweepSpec, chunks, param_of, random_start, runs, value_index
+from tablebot.fleet.results import FleetSummary
+from tablebot.fleet.robots import RobotSpec
+from tablebot.fleet.run import Fleet
+from tablebot.fleet.spec import (
+    START_COLUMNS,
+    Run,
+    SweepSpec,
+    chunks,
+    digest,
+    param_of,
+    parse_grid,
+    parse_seeds,
+    random_start,
+    runs,
+    value_index,
+)
+from tablebot.fleet.starts import with_start
 from tablebot.fleet.work import Job
+from tablebot.formats.table_read import load_table, resolve_table_path
 from tablebot.formats.trace_lines import exact_round
-from tablebot.machine import Machine
-from tablebot.sim.scene import Scene, prepare
-from tablebot.sim.world import World
+from tablebot.jit import sources_digest
+from tablebot.machine import FLAT_BITS, Machine, compile_table
+from tablebot.robot import load_robot
+from tablebot.sim.runner import ticks_for
+from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
+from tablebot.sim.world import World, load_world
 from tablebot.table import Table
 
 PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
@@ -222,15 +241,6 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
               robots: int | None, seconds: float) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
     as a plan of runs; every mistake is a located error before anything is written."""
-    from tablebot.fleet.spec import SweepSpec, digest, parse_grid, parse_seeds
-    from tablebot.formats.table_read import load_table, resolve_table_path
-    from tablebot.jit import sources_digest
-    from tablebot.machine import FLAT_BITS, compile_table
-    from tablebot.robot import load_robot
-    from tablebot.sim.runner import ticks_for
-    from tablebot.sim.scene import find_world, robot_layer
-    from tablebot.sim.world import load_world
-
     axes = parse_grid(list(grid))
     seed_list = parse_seeds(seeds, robots)
     robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them

@@ -1,4 +1,5 @@
-"""Many simulated robots of one table in one world, advanced together in compiled code (sim.fleet_kernel).
+"""Many simulated robots of one table in one world, advanced together in compiled code (fleet.kernel); how they
+start is :mod:`tablebot.fleet.starts`, what their run amounts to :mod:`tablebot.fleet.results`.
 
 Each robot is set up by :class:`~tablebot.sim.simrobot.SimRobot` itself (start row, gains, first reading,
 its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does (inside the
@@ -10,93 +11,34 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
-from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.fleet.generators import generators
 from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
+from tablebot.fleet.results import FLEET_COLLISIONS, FleetSummary, Trace
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
-from tablebot.loop import RunEnd, TickBlock
+from tablebot.fleet.starts import Prepared, Starts, with_start
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
 from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
-from tablebot.sim.runner import PATH_STRIDE, SimRun
-from tablebot.sim.scene import Scene, _check_start, prepare
-from tablebot.sim.simrobot import SimRobot, Starter, wiring_of, world_arrays
+from tablebot.sim.runner import SimRun
+from tablebot.sim.scene import Scene
+from tablebot.sim.simrobot import SimRobot, wiring_of, world_arrays
 from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants
-from tablebot.sim.summary import Summary, light_bits
-from tablebot.sim.world import World, inside
-from tablebot.sinks.run_trace import seconds_per_state
-from tablebot.sinks.trace_file import block_lines
+from tablebot.sim.summary import light_bits
+from tablebot.sim.world import World
 from tablebot.table import Table
 from tablebot.tick import STATE, registers
 
+__all__ = ["BLOCK_TICKS", "FLEET_COLLISIONS", "Fleet", "FleetSummary", "NoiseRows", "Prepared", "RobotSpec", "Trace",
+           "Variants", "with_start"]
+
 BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced robots' blocks kept, per block)
-FLEET_COLLISIONS = 16  # collision starts remembered per robot (the count goes on beyond)
-
-
-@dataclass
-class FleetSummary:
-    """Per robot, what a sweep needs: arrays indexed by robot (``NO_TICK``/-1: never)."""
-
-    ticks: int
-    tick_s: float
-    states: tuple[Any, ...]  # the machine's states (indices in final_state and counts)
-    first_light: np.ndarray  # tick whose reading first held a light bit
-    reached: np.ndarray  # robot row that first came within reach of a lamp
-    collisions: np.ndarray
-    distance_m: np.ndarray
-    battery_start_v: np.ndarray
-    battery_end_v: np.ndarray
-    final_state: np.ndarray  # state index after the last tick
-    counts: np.ndarray  # (N, states): ticks spent in each state (the state after each tick)
-    first_visit: np.ndarray  # (N, states): first tick after which the robot was in that state
-    collision_rows: np.ndarray  # (N, FLEET_COLLISIONS): the first collision starts
-    final_pose: np.ndarray  # (N, 3): x, y (m) and heading (radians, unwrapped) after the last tick
-    lamps: bool = True  # whether the world has lamps (as in sim.summary.Summary)
-
-    def __len__(self) -> int:
-        return len(self.first_light)
-
-    def summary(self, i: int) -> Summary:
-        """Robot i's numbers as :func:`tablebot.sim.summary.summarise` gives them for a single run, but for
-        laps round a track (they need the whole path, which a fleet does not keep: None)."""
-        def seconds(tick: int) -> float | None:
-            return None if tick < 0 else tick * self.tick_s
-        count = int(self.collisions[i])
-        return Summary(seconds=self.ticks * self.tick_s, first_light_s=seconds(int(self.first_light[i])),
-                       reached_s=seconds(int(self.reached[i])), collisions=count,
-                       collision_ticks=tuple(self.collision_rows[i, : min(count, FLEET_COLLISIONS)].tolist()),
-                       distance_m=float(self.distance_m[i]),
-                       state_seconds=seconds_per_state(self.counts[i], self.first_visit[i], self.states, self.tick_s),
-                       battery_start_v=float(self.battery_start_v[i]), battery_end_v=float(self.battery_end_v[i]),
-                       lamps=self.lamps)
-
-
-@dataclass
-class Prepared:
-    """What fleets of one table in one world with one robot layer share, by parameter set: the scene
-    (:func:`~tablebot.sim.scene.prepare`: the world's pieces and shadow grid, milliseconds each) and how its
-    robots start. A sweep's chunks in one process share one instead of preparing them again per chunk
-    (:func:`tablebot.fleet.work.shared`); scenes and starters are only read once made."""
-
-    scenes: dict[tuple, Scene] = field(default_factory=dict)
-    starters: dict[tuple, Starter] = field(default_factory=dict)
-
-
-@dataclass
-class Trace:
-    """A traced robot's run, kept block by block (its SimRobot makes the blocks, as in ``tablebot sim``)."""
-
-    robot: SimRobot
-    blocks: list[TickBlock] = field(default_factory=list)
-    rows: list[np.ndarray] = field(default_factory=list)  # robot rows at the start of each tick
 
 
 class Fleet:
@@ -110,25 +52,12 @@ class Fleet:
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
         self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
-        self._prepared = prepared or Prepared()
-        self.scenes = [self.scene_of(spec) for spec in self.specs]
+        self.starts = Starts(table, machine, world, robot_params, prepared)
+        self.scenes = [self.starts.scene(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
         self._tick_noise: NoiseRows | None = None
         self._observation: Observation | None = None
         self._setup(traced)
-
-    def scene_of(self, spec: RobotSpec) -> Scene:
-        """The robot's scene: the table in the world with its parameters (made once per parameter set)
-        and its start; every robot of a fleet must be wired alike."""
-        scenes = self._prepared.scenes
-        if spec.params not in scenes:
-            scene = prepare(self.table, self.machine, self.world_model, self.robot_params, spec.overrides())
-            first = next(iter(scenes.values()), scene)
-            if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
-                                                                           first.pulse_columns):
-                raise ValueError("robots of one fleet must share their wiring")
-            scenes[spec.params] = scene
-        return with_start(scenes[spec.params], spec.start)
 
     def _setup(self, traced: Sequence[int]) -> None:
         """Every robot's rows (see :meth:`place`), and what the fleet shares."""
@@ -172,7 +101,7 @@ class Fleet:
         """Put robot i at its start as SimRobot sets a robot up (its gains and first reading drawn from its
         own Generator, which then gives its noise: :class:`Starter`), with a fresh engine. With ``record``
         (a traced robot) it is a SimRobot, returned."""
-        scene = scene or self.scene_of(spec)
+        scene = scene or self.starts.scene(spec)
         self.specs[i] = spec
         self.regs[i], self.outputs[i], self.counters[i] = self.initial
         self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
@@ -190,19 +119,12 @@ class Fleet:
         """Robots ``rows`` (of one parameter set, that of ``scene``) at their ``starts``, each with its
         Generator (``default_rng(seed)``), written straight into the fleet's rows: a SimRobot each was
         most of a sweep's set-up."""
-        self.starter(self.specs[rows[0]], scene).start(starts, rngs, rows, self.S, self.acc, self.collisions)
+        self.starts.starter(self.specs[rows[0]], scene).start(starts, rngs, rows, self.S, self.acc, self.collisions)
         self.P[rows] = scene.P[0]
         self.variant[rows] = [self.specs[i].variant for i in rows]
         self.battery_start_v[rows] = self.S[rows, L.VBAT]
         for i, rng in zip(rows, rngs, strict=True):
             self.rngs[i], self.bitgens[i] = rng, bitgen_address(rng)
-
-    def starter(self, spec: RobotSpec, scene: Scene) -> Starter:
-        """How robots with ``spec``'s parameters start (one per parameter set, as their scenes)."""
-        starters = self._prepared.starters
-        if spec.params not in starters:
-            starters[spec.params] = Starter(scene)
-        return starters[spec.params]
 
     def __len__(self) -> int:
         return len(self.specs)
@@ -220,7 +142,7 @@ class Fleet:
                 progress(done)
 
     def draw_noise(self, ticks: int) -> np.ndarray:
-        """The next ``ticks`` rows of every robot's noise stream (SimRobot._noise, robot by robot)."""
+        """The next ``ticks`` rows of every robot's noise stream (as SimRobot draws its own, robot by robot)."""
         noise = np.empty((len(self.specs), ticks, L.N_NOISE))
         for i, rng in enumerate(self.rngs):
             rng.standard_normal(out=noise[i])
@@ -250,7 +172,7 @@ class Fleet:
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]
-            trace.blocks.append(trace.robot._block(self.t0, ints[slot], hist[slot], n_out, n_c))
+            trace.blocks.append(trace.robot.block(self.t0, ints[slot], hist[slot], n_out, n_c))
             trace.rows.append(hist[slot])
         self.t0 += ticks
 
@@ -288,7 +210,7 @@ class Fleet:
             self._observation = Observation.of(self.scenes[0])
         return self._observation(self.S)
 
-    # --- what the run amounts to --------------------------------------------------------------------
+    # --- what the run amounts to (fleet.results) ------------------------------------------------------
 
     def summary(self) -> FleetSummary:
         return FleetSummary(
@@ -301,24 +223,11 @@ class Fleet:
 
     def trace_lines(self, i: int) -> list[str]:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""
-        return [line for block in self.traces[i].blocks for line in block_lines(block, self.machine)]
+        return self.traces[i].lines(self.machine)
 
     def result(self, i: int) -> SimRun:
         """Robot i's whole run as the single-robot runner's :class:`SimRun` (for its pictures)."""
-        trace = self.traces[i]
-        blocks, robot = trace.blocks, trace.robot
-        def column(name: str) -> np.ndarray:
-            return np.concatenate([np.asarray(getattr(b, name)) for b in blocks])
-        hist = np.concatenate([*trace.rows, self.S[i][None, :]])
-        count = int(self.acc[i, K.A_COLLISIONS])
-        reached = int(self.acc[i, K.A_REACHED])
-        return SimRun(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
-                      path=hist[::PATH_STRIDE, [L.X, L.Y]], masks=column("masks"), events=column("events"),
-                      rows=column("rows"), states=column("states"), timers=column("timers"),
-                      outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),
-                      collision_rows=self.collisions[i, : min(count, FLEET_COLLISIONS)].tolist(),
-                      collision_count=count, reached_row=None if reached < 0 else reached,
-                      end=RunEnd("done", self.t0), wall_s=0.0)
+        return self.traces[i].result(self.S[i], self.acc[i], self.collisions[i], self.t0)
 
 
 class NoiseRows:
@@ -345,18 +254,3 @@ class NoiseRows:
         out = self.rows[np.arange(len(self.at)), self.at]
         self.at += 1
         return out
-
-
-def with_start(scene: Scene, start: Pose | None) -> Scene:
-    """The scene with the robot starting at ``start`` (checked inside the walls, as a world file's [start]
-    is, and free of walls and obstacles)."""
-    if start is None:
-        return scene
-    sx, sy, sh = start
-    world = replace(scene.world, start=(float(sx), float(sy), float(sh)))
-    x, y, heading = world.start
-    if world.walls and not inside(world.walls, (x, y)):
-        raise fail(world.path, f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the "
-                   "arena walls", "choose a start inside the [arena] walls")
-    _check_start(world, scene.geometry, scene.P)
-    return replace(scene, world=world)

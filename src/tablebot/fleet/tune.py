@@ -27,7 +27,7 @@ from tablebot.table import Table
 
 if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
-    from tablebot.fleet.run import FleetSummary
+    from tablebot.fleet.results import FleetSummary
 
 CELL_RE = re.compile(r"^line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$", re.IGNORECASE)
 ROBOTS_PER_JOB = 512

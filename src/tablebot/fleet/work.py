@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING, Any
 from tablebot.fleet.robots import RobotSpec, Variants
 
 if TYPE_CHECKING:
-    from tablebot.fleet.run import FleetSummary, Prepared
+    from tablebot.fleet.results import FleetSummary
+    from tablebot.fleet.starts import Prepared
     from tablebot.machine import Machine
     from tablebot.sim.world import World
     from tablebot.table import Table
@@ -105,7 +106,7 @@ def shared(job: Job) -> tuple[Machine, Prepared]:
     layer (the same objects: a local sweep's chunks all hold its plan's, and a cluster worker's chunks get
     them as one shared piece of data, see :mod:`tablebot.fleet.backends`). Keyed by identity: an entry holds
     its objects, so no other object can take their ids while it is kept."""
-    from tablebot.fleet.run import Prepared
+    from tablebot.fleet.starts import Prepared
     from tablebot.machine import compile_table
 
     key = (id(job.table), id(job.world), id(job.robot_params))

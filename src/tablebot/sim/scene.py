@@ -103,7 +103,7 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     _check_events(table)
     P = param_row(params, tick_s, table.robot.sensors)[None, :]
     geo = geometry(world)
-    _check_start(world, geo, P)
+    check_start(world, geo, P)
     outputs = machine.output_names
     robot = table.robot
     # the BumberBot roles' bits, then one per declared sensor (sensor slot k at B_SENSOR + k)
@@ -192,7 +192,8 @@ def _check_tick(params: Params, robot: Robot) -> None:
                    "firmware take any tick)", robot.line("", "tick_ms"))
 
 
-def _check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
+def check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
+    """A clear error when the robot of parameters ``P`` overlaps a wall or obstacle at the world's start pose."""
     x, y, heading = world.start
     s = np.zeros(L.N_STATE)
     s[L.X], s[L.Y], s[L.TH] = x, y, np.radians(heading)

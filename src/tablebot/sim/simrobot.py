@@ -105,9 +105,11 @@ class SimRobot:
         K.run_robot(robot, self._world, arrays.program, self._wiring, ticks, NO_NOISE, bitgen_address(self.rng),
                     untallied(hist, ints))
         engine._sync(regs, outputs, counters)
-        return self._block(start, ints, hist, n_out, n_c)
+        return self.block(start, ints, hist, n_out, n_c)
 
-    def _block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
+    def block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
+        """The ticks from ``start`` that a compiled loop recorded (``ints``: sim.kernel's I_* records of ``n_out``
+        outputs and ``n_c`` counters; ``hist``: the robot's rows, or none) as the run loop's TickBlock."""
         o, c = K.I_OUTPUTS, K.I_OUTPUTS + n_out  # outputs, then counters, then pulses
         block = TickBlock(start, ints[:, K.I_MASK], ints[:, c + n_c:], ints[:, K.I_EVENT], ints[:, K.I_ROW],
                           ints[:, K.I_STATE], ints[:, K.I_TIMER], ints[:, o:c], ints[:, c:c + n_c])
