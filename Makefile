@@ -1,6 +1,6 @@
 # The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff, the docs site, ESLint);
 # both set themselves up first.
-.PHONY: setup demo test bench lock audit docs
+.PHONY: setup demo test bench lock audit docs golden
 
 # Python keeps its compiled bytecode (in __pycache__, which git ignores): without it every one of the
 # hundred tablebot processes the tests start compiles numpy, numba and tablebot again, seconds each.
@@ -37,6 +37,11 @@ test: setup
 MKDOCS = NO_MKDOCS_2_WARNING=1 .venv/bin/mkdocs build --strict --quiet
 docs: setup
 	$(MKDOCS)
+
+# The golden files of tests/golden/ (what tablebot writes for the BumberBot, compared byte for byte by
+# tests/test_golden.py) made again from the code as it is: review them with git diff, then commit them.
+golden: setup
+	.venv/bin/python scripts/golden.py
 
 bench: setup
 	status=0; for b in engine sim check limits mcu turn_drift studio studio_tabs fleet evolve controllers demo; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
