@@ -24,7 +24,7 @@ def share_cmd(
                              "(default: http://127.0.0.1:8765/, where `tablebot studio` serves)."),
 ) -> None:
     """Print a link that carries FOLDER's table, its robot file and its world, compressed into the part after
-    '#' (a browser never sends that to any server). `tablebot studio --open LINK`, the studio's Open box and
+    '#' (a browser never sends that to any server). The studio (its Open box, or studio --open LINK) and
     `tablebot grade` read it back; files that are copies of tablebot's shipped examples are named, not carried."""
     from tablebot import share
 
