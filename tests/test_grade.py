@@ -174,3 +174,21 @@ def test_the_examples_in_the_docstrings_hold(module: str, tmp_path: Path, monkey
     monkeypatch.chdir(tmp_path)
     result = doctest.testmod(importlib.import_module(module))
     assert result.attempted and not result.failed
+
+
+def test_a_broken_challenge_is_refused_with_every_mistake_located(tmp_path: Path) -> None:
+    for name in ("robot.toml", "rules.toml", "track.toml"):
+        shutil.copy(LAPS / name, tmp_path / name)
+    (tmp_path / "challenge.toml").write_text('title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml", "nowhere"]\n'
+                                             'seconds = 99999\nseeds = "5..1"\nscore = "laps"\ncolour = 3\n')
+    code, output = grade(tmp_path, ROOT / "examples" / "line-follower", "--out", tmp_path / "out")
+    assert code == 2 and "Traceback" not in output
+    for words in ("challenge.toml:7: error: unknown key 'colour'", "challenge.toml:3:1: error: worlds[1]: nowhere "
+                  "is neither a file", "challenge.toml:4: error: seconds = 99999 is out of range",
+                  "challenge.toml:5:1: error: seeds 5..1 is an empty range"):
+        assert words in output
+    (tmp_path / "challenge.toml").write_text('title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml"]\n'
+                                             'seconds = 9\nseeds = "0..1"\nscore = "time_to_lamp"\n')
+    code, output = grade(tmp_path, ROOT / "examples" / "line-follower", "--out", tmp_path / "out")
+    assert code == 2 and "challenge.toml:6:1: error: score = 'time_to_lamp': the worlds cannot measure it" in output
+    assert not (tmp_path / "out").exists()
