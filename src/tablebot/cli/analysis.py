@@ -25,8 +25,9 @@ from tablebot.cli.common import (
     out_file,
     out_folder,
 )
-from tablebot.diagnostics import TableBotError, fail
+from tablebot.diagnostics import HINT_LABEL, TableBotError, fail, severity_word
 from tablebot.escape import plain, shell_word, terminal
+from tablebot.i18n import N_, _, localise, ngettext
 
 if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --help` stays quick
     from tablebot.analysis.finding import Finding
@@ -37,6 +38,8 @@ if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --he
 FORMATS = ("svg", "png", "dot", "mermaid")
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
+#: A finding's severity as shown ("info" reads "note", as the summary counts it).
+FINDING_WORDS = {"error": N_("error"), "warning": N_("warning"), "info": N_("note")}
 #: Findings are printed this many lines at a time (a 100,000-row table can have as many findings).
 PRINT_BATCH = 2000
 
@@ -69,7 +72,7 @@ def check_cmd(
     from tablebot.cli.progress import StepBar
 
     with Stages(total=3) as stages:
-        stages.step(f"reading {table}")
+        stages.step(_("reading {path}").format(path=table))
         project = open_project(table, robot, properties=properties or None)
         report = project.check(targets=target, progress=StepBar(stages))
     unsaved = _save_counterexamples(report, cex_dir) if cex_dir is not None else None
@@ -89,19 +92,19 @@ def _save_counterexamples(report: Check, folder: Path) -> TableBotError | None:
     except TableBotError as exc:
         return exc
     except OSError as exc:
-        return fail(exc.filename or folder, f"counterexamples not written: {exc.strerror or exc}",
-                    "give --counterexamples a folder you can write to")
+        return fail(exc.filename or folder, N_("counterexamples not written: {reason}", reason=exc.strerror or exc),
+                    N_("give --counterexamples a folder you can write to"))
     return None
 
 
 def _print_report(check: Check, table_arg: Path, verbose: bool, saving: bool) -> None:
-    from tablebot.analysis.names import plural
-
     report = check.report
     machine = report.machine
     table = machine.table
-    console.print(f"[bold]{terminal(table.path)}:[/bold] {len(table.rows)} rows, {len(machine.states)} states, "
-                  f"robot {terminal(table.robot.name)}; {report.situations} situations explored")
+    console.print(f"[bold]{terminal(table.path)}:[/bold] " + _(
+        "{rows} rows, {states} states, robot {robot}; {situations} situations explored").format(
+        rows=len(table.rows), states=len(machine.states), robot=terminal(table.robot.name),
+        situations=report.situations))
     hidden: dict[str, int] = {}
     shown = []
     for finding in report.findings:
@@ -112,15 +115,19 @@ def _print_report(check: Check, table_arg: Path, verbose: bool, saving: bool) ->
     _print_findings(table.path, shown)
     if report.results:
         sources = ", ".join(str(p) for p in report.property_files) or table.robot.source
-        console.print(f"\n[bold]properties[/bold] ({terminal(sources)}):")
+        heading = _("properties")
+        console.print(f"\n[bold]{heading}[/bold] ({terminal(sources)}):")
         for result in report.results:
             _print_result(check, result, table_arg, verbose, saving)
     counts = report.counts()
     tail = ""
     if hidden:
-        tail = " (" + ", ".join(f"{n} {code}" for code, n in hidden.items()) + "; --verbose lists them)"
-    console.print(f"\n{plural(counts['error'], 'error')}, {plural(counts['warning'], 'warning')}, "
-                  f"{plural(counts['info'], 'note')}{tail}")
+        tail = " (" + _("{counts}; --verbose lists them").format(
+            counts=", ".join(f"{n} {code}" for code, n in hidden.items())) + ")"
+    console.print("\n" + ", ".join([
+        ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
+        ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
+        ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"])]) + tail)
 
 
 def _print_findings(path: str, findings: list[Finding]) -> None:
@@ -128,12 +135,14 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
     table can have 100,000 findings, and rich's cost is per line and per call."""
     terminal_out = console.is_terminal
     batch: list[Text] = []
+    hint_word = str(localise(HINT_LABEL))
     for finding in findings:
         where = f"{finding.path or path}:{finding.lines[0]}" if finding.lines else finding.path or path
-        line = [(plain(where) + ":", "bold"), (" ", ""), (finding.severity, COLOURS[finding.severity]),
-                (": " + plain(finding.message), "")]
+        severity = str(localise(FINDING_WORDS[finding.severity]))
+        line = [(plain(where) + ":", "bold"), (" ", ""), (severity, COLOURS[finding.severity]),
+                (": " + plain(str(localise(finding.message))), "")]
         if finding.hint:
-            line += [("\n    ", ""), ("hint:", "dim"), (" " + plain(finding.hint), "")]
+            line += [("\n    ", ""), (hint_word + ":", "dim"), (" " + plain(str(localise(finding.hint))), "")]
         if not terminal_out:
             sys.stdout.write("".join(text for text, _ in line) + "\n")
             continue
@@ -148,30 +157,35 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
 
 def _print_result(check: Check, result: Result, table_arg: Path, verbose: bool, saving: bool) -> None:
     prop = result.prop
-    marks = {"holds": "[green]holds   [/green]", "violated": "[red]VIOLATED[/red]",
-             "unknown": "[yellow]unknown [/yellow]"}
-    level = f" [dim]({prop.level})[/dim]" if result.status == "violated" and prop.level != "error" else ""
-    console.print(f"  {marks[result.status]} [bold]{terminal(prop.name)}[/bold]{level}: {terminal(prop.text)}")
+    words = {"holds": _("holds"), "violated": _("VIOLATED"), "unknown": _("unknown")}
+    width = max(len(w) for w in words.values())
+    colour = {"holds": "green", "violated": "red", "unknown": "yellow"}[result.status]
+    mark = f"[{colour}]{words[result.status]:<{width}}[/{colour}]"
+    level = f" [dim]({severity_word(prop.level)})[/dim]" if result.status == "violated" and prop.level != "error" \
+        else ""
+    console.print(f"  {mark} [bold]{terminal(prop.name)}[/bold]{level}: {terminal(prop.text)}")
     if verbose or result.failed:
-        console.print(f"           [dim]{terminal(prop.claim())}; {result.explored} situations[/dim]")
+        console.print(f"           [dim]{terminal(str(localise(prop.claim())))}; " +
+                      _("{n} situations").format(n=result.explored) + "[/dim]")
     if result.detail:
-        console.print(f"           {terminal(result.detail)}")
+        console.print(f"           {terminal(str(localise(result.detail)))}")
     if prop.note and result.failed:
-        console.print(f"           note: {terminal(prop.note)}")
+        console.print(f"           {severity_word('note')}: {terminal(prop.note)}")
     if not result.inputs:
         return
     path = check.report.counterexamples.get(prop.name)
-    kind = "example" if prop.kind == "reachable" else "counterexample"
-    shortest = "shortest " if result.exact else ""
-    written = (f", written to {terminal(str(path))}" if path else " (not written)" if saving
-               else " (--counterexamples DIR saves it)")
-    console.print(f"           {shortest}{kind}: {len(result.inputs)} ticks{written}")
+    kind = (_("shortest example") if result.exact else _("example")) if prop.kind == "reachable" else \
+        (_("shortest counterexample") if result.exact else _("counterexample"))
+    written = _(", written to {path}").format(path=terminal(str(path))) if path else \
+        _(" (not written)") if saving else _(" (--counterexamples DIR saves it)")
+    console.print(f"           {kind}: " + ngettext("{n} tick", "{n} ticks", len(result.inputs)).format(
+        n=len(result.inputs)) + written)
     if path:
         command = " ".join(shell_word(str(word)) for word in ("tablebot", "trace", table_arg, "--inputs", path))
-        console.print(f"           replay: {terminal(command)}")
+        console.print("           " + _("replay: {command}").format(command=terminal(command)))
     if result.failed or verbose:
         for line in check.story(result):
-            console.print(f"             {terminal(line)}")
+            console.print(f"             {terminal(str(localise(line)))}")
 
 
 @app.command("tests")
@@ -186,18 +200,20 @@ def tests_cmd(
     expected trace (JSON Lines), plus coverage.json."""
     from tablebot.analysis.testgen import generate, write_golden
 
-    _, machine = load(table, robot)
+    machine = load(table, robot)[1]
     golden = generate(machine)
     write_golden(golden, out_folder(out, "--out"))
     for seq in golden.sequences:
-        console.print(f"wrote {terminal(str(out / seq.inputs_name))} and {terminal(seq.trace_name)} "
-                      f"({len(seq.inputs)} ticks, {len(seq.rows)} rows)")
+        console.print(_("wrote {inputs} and {trace} ({ticks} ticks, {rows} rows)").format(
+            inputs=terminal(str(out / seq.inputs_name)), trace=terminal(seq.trace_name), ticks=len(seq.inputs),
+            rows=len(seq.rows)))
     table_rows = machine.table.rows
-    console.print(f"row coverage: {len(golden.covered)} of {len(table_rows)} rows fired "
-                  f"({len(golden.fireable)} can fire at all)")
+    console.print(_("row coverage: {covered} of {rows} rows fired ({fireable} can fire at all)").format(
+        covered=len(golden.covered), rows=len(table_rows), fireable=len(golden.fireable)))
     for index, reason in sorted(golden.reasons.items()):
-        console.print(f"  line {table_rows[index].line}: not covered: {terminal(reason)}")
-    console.print(f"wrote {terminal(str(out / 'coverage.json'))}")
+        console.print("  " + _("line {line}: not covered: {reason}").format(
+            line=table_rows[index].line, reason=terminal(str(localise(reason)))))
+    console.print(_("wrote {path}").format(path=terminal(str(out / "coverage.json"))))
 
 
 @app.command("diagram")
@@ -218,19 +234,22 @@ def diagram_cmd(
     if fmt is None:
         fmt, option = named or "svg", "--out"
     elif named in FORMATS and named != fmt:  # a .svg file of PNG bytes opens nowhere
-        raise fail("--format", f"--format {fmt}, but --out {out} is named as {named}",
-                   f"drop --format, or give --out the suffix of {fmt}")
+        raise fail("--format", N_("--format {fmt}, but --out {out} is named as {named}", fmt=fmt, out=out,
+                                  named=named),
+                   N_("drop --format, or give --out the suffix of {fmt}", fmt=fmt))
     if fmt not in FORMATS:
-        raise fail(option, f"unknown diagram format {fmt!r}", f"use one of {', '.join(FORMATS)} "
-                   "(--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, .mmd)")
+        raise fail(option, N_("unknown diagram format {fmt!r}", fmt=fmt),
+                   N_("use one of {formats} (--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, "
+                      ".mmd)", formats=", ".join(FORMATS)))
     from tablebot.analysis.diagram import render
     from tablebot.files import write_bytes
 
-    parsed, _ = load(table, robot)
+    parsed = load(table, robot)[0]
     data = render(parsed, fmt, colour)
     if out is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
         return
     write_bytes(out_file(out, "--out", make_folder=True), data)
-    err_console.print(f"wrote {terminal(str(out))} ({fmt}, {len(data)} bytes)")
+    err_console.print(_("wrote {path} ({fmt}, {size} bytes)").format(path=terminal(str(out)), fmt=fmt,
+                                                                      size=len(data)))
