@@ -29,22 +29,38 @@ from tablebot.table import Table
 
 class Source(StrEnum):
     robopro = "robopro"
+    scxml = "scxml"
+    xstate = "xstate"
 
 
 @app.command("import")
 @guarded
 def import_cmd(
-    directory: Path = typer.Argument(..., metavar="FOLDER", help="Folder with event.csv, action.csv, timer.csv."),
-    source: Source = typer.Option(..., "--from", help="What the folder holds."),
-    out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output)."),
+    directory: Path = typer.Argument(..., metavar="FOLDER|FILE", help="Folder with event.csv, action.csv, "
+                                     "timer.csv (robopro), or the exported statechart (scxml, xstate)."),
+    source: Source = typer.Option(..., "--from", help="What it holds: robopro lists, or what export --to scxml "
+                                  "or --to xstate wrote."),
+    out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output); a folder "
+                                    "for a statechart of several tables."),
     robot: Path | None = ROBOT_OPT,
     force: bool = FORCE_OPT,
 ) -> None:
-    """Rebuild a table from ROBO Pro lists. Descriptions are lost: the lists never held them."""
+    """Rebuild a table from ROBO Pro lists (descriptions are lost: the lists never held them), or from an SCXML or
+    XState statechart that tablebot exported."""
     from tablebot.files import write_text
     from tablebot.formats.table_write import format_table
     from tablebot.robopro import lists as robopro
     from tablebot.robot import BUMBERBOT, load_robot
+
+    if source is not Source.robopro:
+        from tablebot.formats.statecharts.importing import import_statechart
+
+        target = out if out is None or out.is_dir() else out_file(out, "--out")  # a folder: several tables
+        text, said = import_statechart(directory, source.value, target, load_robot(robot) if robot else None)
+        sys.stdout.write(text or "")
+        for line in said:
+            err_console.print(terminal(line))
+        return
 
     table = robopro.read_table(directory, load_robot(robot) if robot else BUMBERBOT)
     for line in _rule_warnings(table):

@@ -42,6 +42,8 @@ def scxml_tree(chart: Chart) -> Element:
         holder = wrapper if not chart.several else wrapper.add(
             "state", id=part.region, initial=part.state(part.table.robot.initial_state))
         holder.attrs.update({"tb:events": " ".join(part.table.events), "tb:match": part.table.robot.match})
+        if chart.several:
+            holder.attrs["tb:writes"] = " ".join(part.table.writes)
         for state, rows in part.states_rows():
             node = holder.add("state", id=part.state(state))
             for row in rows:
@@ -115,9 +117,10 @@ def guard(part: Part, row: Row, chart: Chart) -> str:
 def _row(state: Element, part: Part, row: Row, chart: Chart) -> None:
     robot = part.table.robot
     transition = state.add("transition", cond=guard(part, row, chart), target=part.state(row.next),
-                           tb_row=str(row.as_written), tb_description=row.description)
-    if row.group:
-        transition.attrs["tb:group"] = row.group
+                           tb_row=str(row.as_written), tb_description=row.description,
+                           tb_events=" ".join(e for e in part.table.events if e in row.events))
+    if row.group:  # one row as written for each state of a group: its group, and where in the table it runs
+        transition.attrs.update({"tb:group": row.group, "tb:index": str(row.index)})
     outputs = [*zip(robot.motors, row.motors, strict=True), *zip(robot.lamps, row.lamps, strict=True),
                *zip(robot.counter_names, row.counters, strict=True)]
     for name, value in outputs:

@@ -53,8 +53,8 @@ def xstate_config(chart: Chart) -> dict[str, Any]:
     meta = {"tablebot": {
         "format": FORMAT, "tickMs": robot.tick_ms, "inputs": list(chart.inputs), "motors": list(robot.motors),
         "lamps": list(robot.lamps), "counters": [{"name": c.name, "motor": c.motor} for c in robot.counters],
-        "tables": [{"name": p.table.name, "events": list(p.table.events), "match": p.table.robot.match}
-                   for p in chart.parts]}}
+        "tables": [{"name": p.table.name, "events": list(p.table.events), "match": p.table.robot.match,
+                    "writes": list(p.table.writes) if chart.several else []} for p in chart.parts]}}
     config: dict[str, Any] = {"id": robot.name, "context": context, "meta": meta, "on": {TICK: {"actions": [tick]}}}
     if chart.several:
         config["type"] = "parallel"
@@ -94,6 +94,6 @@ def _row(part: Part, row: Row, chart: Chart) -> dict[str, Any]:
     transition: dict[str, Any] = {"guard": {"type": "row", "params": params}, "target": part.state(row.next),
                                   "actions": [{"type": "fire", "params": fire}], "description": row.description,
                                   "meta": {"row": row.as_written}}
-    if row.group:
-        transition["meta"]["group"] = row.group
+    if row.group:  # one row as written for each state of a group: its group, and where in the table it runs
+        transition["meta"].update({"group": row.group, "index": row.index})
     return transition
