@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -22,12 +23,33 @@ def load_benchmark() -> ModuleType:
     return module
 
 
-def test_contestants_agree_on_a_short_run(capsys: pytest.CaptureFixture[str]) -> None:
+ROW = re.compile(r"^  (?P<name>[a-z ()]+?)\s+(?P<cpu>[\d.]+) s CPU\s+(?P<rate>[\d,]+) ticks/s"
+                 r"\s+(?P<ns>[\d.]+) ns/tick$", re.MULTILINE)
+TARGET = re.compile(r"^  (?P<a>[a-z ]+?) vs (?P<b>[a-z ]+?)(?: \([^)]*\))?\s+(?P<ratio>[\d.]+)x "
+                    r"\((?P<low>[\d.]+)\.\.(?P<high>[\d.]+)\)\s+target >= (?P<want>[\d.]+)x\s+(?P<verdict>ok|MISSED)$",
+                    re.MULTILINE)
+
+
+def test_a_short_run_reports_figures_that_agree_with_each_other(capsys: pytest.CaptureFixture[str]) -> None:
+    """What a reader of the report checks (no timing asserted; main itself asserts that the contestants
+    agree): the run it says it timed, every contestant's rate and time per tick agreeing, each target's ratio
+    being the ratio of the two rates it names, and its verdict following from its figure."""
     bench = load_benchmark()
-    bench.main(["--ticks", "3000", "--repeats", "1", "--transitions-ticks", "500"])  # asserts agreement
+    bench.main(["--ticks", "3000", "--repeats", "1", "--transitions-ticks", "500"])
     out = capsys.readouterr().out
-    for name in ("batch", "step", "bare step", "linear scan", "bare loop", "transitions", "targets", "closed loop"):
-        assert name in out
+    assert out.startswith("BumberBot, 3,000 random input ticks (500 for transitions), median of 1,")
+    rates = {m["name"]: float(m["rate"].replace(",", "")) for m in ROW.finditer(out)}
+    assert set(rates) == {"step", "bare step", "linear scan", "transitions", "batch", "batch (array)", "bare loop"}
+    for m in ROW.finditer(out):
+        assert float(m["rate"].replace(",", "")) * float(m["ns"]) == pytest.approx(1e9, rel=0.002)
+    targets = list(TARGET.finditer(out))
+    assert [(t["a"], t["b"]) for t in targets] == [("step", "bare step"), ("step", "linear scan"),
+                                                   ("step", "transitions"), ("batch", "bare loop")]
+    for t in targets:
+        ratio = float(t["ratio"])
+        assert ratio == pytest.approx(rates[t["a"]] / rates[t["b"]], abs=0.006)  # one round: its own median
+        assert float(t["low"]) == float(t["high"]) == ratio
+        assert t["verdict"] == ("ok" if ratio >= float(t["want"]) else "MISSED")
 
 
 def test_contestants_match_the_engine_tick_for_tick_state() -> None:

@@ -8,9 +8,10 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
+import typer.main
 from typer.testing import CliRunner
 
 from core_helpers import EXAMPLE, MINI_ROBOT, SEED_TSV, column_of, example_machine, write_table
@@ -53,21 +54,42 @@ def assert_located_errors(stderr: str, count: int) -> list[re.Match]:
 
 # --- help ---------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("command", [[], ["check"], ["export"], ["import"], ["trace"], ["demo"]])
-def test_help(command: list[str]) -> None:
-    result = invoke(*command, "--help")
+def commands() -> dict[str, Any]:
+    """The commands as the command line has them (click's, as typer builds them)."""
+    return dict(typer.main.get_command(app).commands)  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("command", ["check", "export", "import", "trace", "demo"])
+def test_a_commands_help_says_what_it_does_and_lists_every_option(command: str) -> None:
+    """What a user reads in ``tablebot COMMAND -h``: how to call it, what it does (its docstring's first
+    sentence) and each of its arguments and options by name, as the command really takes them."""
+    result = invoke(command, "--help")
     assert result.exit_code == 0, result.output
-    assert "Usage" in result.output and "--help" in result.output
+    said = " ".join(result.output.split())  # rich wraps the help to the terminal's width
+    the = commands()[command]
+    assert said.startswith(f"Usage: tablebot {command} [OPTIONS]")
+    assert " ".join((the.help or "").split(".")[0].split()) in said
+    for param in the.params:
+        names = param.opts if param.param_type_name == "option" else [param.human_readable_name]
+        assert any(name in said for name in names), (command, param.name, said)
 
 
-def test_no_arguments_shows_help() -> None:
+def test_no_arguments_lists_every_command_with_what_it_does() -> None:
     result = invoke()
-    assert "check" in result.output and "trace" in result.output
+    lines = result.output.splitlines()
+    listed = {line.split()[0]: line.split(maxsplit=1)[1] for line in lines[lines.index("Commands:") + 1:]
+              if line.startswith("  ") and len(line.split()) > 1}
+    assert set(listed) == set(commands()) and len(listed) >= 15
+    for name, command in commands().items():
+        first = (command.help or "").split()[:3]
+        assert listed[name].split()[:3] == first, (name, listed[name])
 
 
-def test_usage_error_exits_2() -> None:
+def test_a_missing_argument_is_named_with_where_to_read_about_it() -> None:
     result = invoke("check")
     assert result.exit_code == 2
+    assert result.output.splitlines() == ["TABLE: error: TABLE is missing",
+                                          "    hint: tablebot check -h says what TABLE takes"]
     assert "Traceback" not in result.output
 
 

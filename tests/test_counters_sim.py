@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import re
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -90,7 +91,21 @@ def test_turn_drift_script_writes_plot_and_tables(tmp_path: Path, capsys: pytest
     assert len(rows) == 12 and rows[0].startswith("charge,volts,timed_mean")
 
 
-def test_sim_benchmark_runs(capsys: pytest.CaptureFixture[str]) -> None:
+def test_sim_benchmark_reports_figures_that_agree_with_each_other(capsys: pytest.CaptureFixture[str]) -> None:
+    """What a reader of benchmarks/sim.py checks (no timing asserted): the run it says it timed, each way's
+    time per tick and speed against real time agreeing (a 10 ms tick), the ratio between the two ways of
+    running the loop, and a target's verdict that follows from its figure."""
     load_script("sim").main(["--repeat", "1", "--seconds", "5", "--no-commands"])
     out = capsys.readouterr().out
-    assert "compiled block path" in out and "tick by tick" in out and "× real time" in out
+    assert "one BumberBot in BumberBot arena, 5 s simulated (500 ticks), median of 1" in out
+    rows = {m["name"].strip(): (float(m["us"]), float(m["times"].replace(",", ""))) for m in re.finditer(
+        r"^  (?P<name>.+?)\s+(?P<wall>[\d.]+)\s+(?P<us>[\d.]+)\s+(?P<times>[\d,]+)$", out, re.MULTILINE)}
+    assert set(rows) == {"run loop, compiled block path", "run loop, tick by tick from Python (baseline)",
+                         "engine alone, Engine.step on recorded inputs"}
+    for us, times in rows.values():  # × real time is the 10,000 µs tick over µs a tick (both rounded)
+        assert us > 0 and times == pytest.approx(10_000 / us, rel=0.06, abs=1)
+    compiled, python = rows["run loop, compiled block path"], rows["run loop, tick by tick from Python (baseline)"]
+    ratio = float(re.search(r"compiled loop vs tick-by-tick: ([\d.]+)×", out)[1])  # type: ignore[index]
+    assert ratio == pytest.approx(python[0] / compiled[0], rel=0.06)
+    verdict = re.search(r"run loop ≥ 10,000× real time\s+(ok|MISSED)", out)[1]  # type: ignore[index]
+    assert verdict == ("ok" if compiled[1] >= 10_000 else "MISSED")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -50,9 +51,19 @@ def test_same_seed_same_trace_bytes(arena_run: SimRun) -> None:
     assert trace_text(again) == trace_text(arena_run)
 
 
-def test_another_seed_another_trace() -> None:
+def test_another_seed_is_the_same_robot_with_other_noise() -> None:
+    """Another seed changes the simulated noise, nothing else: the run starts from the same pose with the same
+    first tick, the path drifts apart from the first ticks on by millimetres, then centimetres, and in its
+    first second (nothing seen yet) the table decides exactly the same."""
     scene = scene_of(BUMBERBOT / "table.csv")
-    assert trace_text(simulate(scene, 20.0, seed=1)) != trace_text(simulate(scene, 20.0, seed=2))
+    one, two = ([json.loads(line) for line in trace_text(simulate(scene, 20.0, seed=seed)).splitlines()]
+                for seed in (1, 2))
+    assert len(one) == len(two) == 2000 and one[0] == two[0]
+    assert one[0]["x"] == one[0]["y"] == 0.35 and one[0]["heading"] == 20.0  # the arena's start
+    apart = [math.dist((a["x"], a["y"]), (b["x"], b["y"])) for a, b in zip(one, two, strict=True)]
+    assert 0 < next(i for i, d in enumerate(apart) if d > 0) <= 10  # the noise acts from the start
+    assert 0 < apart[100] < 0.01 and 0.001 < apart[500] < 0.05  # at 1 s and 5 s: drift, not another start
+    assert [[r[k] for k in CORE_KEYS] for r in one[:100]] == [[r[k] for k in CORE_KEYS] for r in two[:100]]
 
 
 def test_trace_is_the_core_trace_plus_pose_and_sensors(arena_run: SimRun) -> None:
