@@ -78,6 +78,3 @@ def _copy_linked(tmp: Path, folder: Path) -> list[Path]:
         if path.is_file():
             written.append(write_bytes(folder / path.relative_to(tmp), path.read_bytes()))
     return written
-
-
-

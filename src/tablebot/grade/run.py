@@ -95,9 +95,10 @@ def _grade(challenge: Challenge, entry: Entry, runner: Runner) -> None:
     from tablebot.api import open as open_robot
 
     sub = entry.sub
+    assert sub.table is not None  # a submission without a table has its error already
     confine(sub)
     _same_robot(challenge, sub)
-    project = open_robot(sub.table, robot=challenge.robot, worlds=challenge.worlds,  # type: ignore[arg-type]
+    project = open_robot(sub.table, robot=challenge.robot, worlds=challenge.worlds,
                          properties=[challenge.properties] if challenge.properties else [])
     entry.project, entry.rows = project, len(project.table.rows)
     if challenge.max_rows is not None and entry.rows > challenge.max_rows:
