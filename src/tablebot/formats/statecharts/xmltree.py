@@ -88,7 +88,11 @@ def parse(text: str, path: str) -> Element:
             refuse("text inside an element", "tablebot's SCXML holds everything in attributes")
 
     def doctype(*_: object) -> None:
-        refuse("a DOCTYPE (a DTD can declare entities, and a table is data)", "remove the <!DOCTYPE ...> line")
+        line, column = where()  # expat is past the DOCTYPE's name: point at its start
+        before = text.splitlines()[line - 1][:column] if line <= len(text.splitlines()) else ""
+        start = before.rfind("<!DOCTYPE")
+        raise fail(path, "a DOCTYPE (a DTD can declare entities, and a table is data)", "remove the <!DOCTYPE ...>",
+                   line, start + 1 if start >= 0 else column)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = lambda name: stack.pop()
