@@ -21,31 +21,34 @@ from typing import IO, Any
 from tablebot import fileset, overwrite
 from tablebot.csvtext import split_records
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.i18n import N_
 from tablebot.interrupts import fault_point
 from tablebot.table import is_table_header
 
 #: Per errno of a failed read or write: what the user can do about it.
 OS_HINTS = {
-    errno.EEXIST: "a file stands where a folder is needed: choose another path",
-    errno.ENOTDIR: "a file stands where a folder is needed: choose another path",
-    errno.EISDIR: "a folder stands where a file is needed: give a file name",
-    errno.ENOENT: "the folder does not exist: create it or choose another path",
-    errno.EACCES: "you may not write there: choose another path or change its permissions",
-    errno.EPERM: "you may not write there: choose another path or change its permissions",
-    errno.EROFS: "the disk is read-only: choose another path",
-    errno.ENOSPC: "the disk is full: free some space or choose another disk",
+    errno.EEXIST: N_("a file stands where a folder is needed: choose another path"),
+    errno.ENOTDIR: N_("a file stands where a folder is needed: choose another path"),
+    errno.EISDIR: N_("a folder stands where a file is needed: give a file name"),
+    errno.ENOENT: N_("the folder does not exist: create it or choose another path"),
+    errno.EACCES: N_("you may not write there: choose another path or change its permissions"),
+    errno.EPERM: N_("you may not write there: choose another path or change its permissions"),
+    errno.EROFS: N_("the disk is read-only: choose another path"),
+    errno.ENOSPC: N_("the disk is full: free some space or choose another disk"),
 }
 
 
 def out_folder(path: Path, option: str) -> Path:
     """The folder an option names for writing into, created (with its parents) if missing."""
     if path.exists() and not path.is_dir():
-        raise fail(path, f"{option} names a file, not a folder", f"give {option} a folder (it is created if missing)")
+        raise fail(path, N_("{option} names a file, not a folder", option=option),
+                   N_("give {option} a folder (it is created if missing)", option=option))
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise fail(exc.filename or path, f"cannot create the folder for {option}: {exc.strerror}",
-                   OS_HINTS.get(exc.errno or 0, f"give {option} another folder")) from None
+        raise fail(exc.filename or path, N_("cannot create the folder for {option}: {reason}", option=option,
+                                            reason=exc.strerror),
+                   OS_HINTS.get(exc.errno or 0, N_("give {option} another folder", option=option))) from None
     return path
 
 
@@ -53,15 +56,18 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
     """The file an option names for writing (an existing file is replaced); its folder must exist,
     unless ``make_folder`` says to create it."""
     if path.is_dir():
-        raise fail(path, f"{option} names a folder, not a file", f"give {option} a file name")
+        raise fail(path, N_("{option} names a folder, not a file", option=option),
+                   N_("give {option} a file name", option=option))
     if make_folder:
         if path.parent.exists() and not path.parent.is_dir():
-            raise fail(path.parent, f"the folder of {option} {path} is a file", f"give {option} a file in a folder")
+            raise fail(path.parent, N_("the folder of {option} {path} is a file", option=option, path=path),
+                       N_("give {option} a file in a folder", option=option))
         out_folder(path.parent, option)
     elif not path.parent.is_dir():
-        what = "is not a folder" if path.parent.exists() else "does not exist"
-        raise fail(path.parent, f"the folder of {option} {path} {what}", "create the folder first, or "
-                   f"give {option} a file in an existing folder")
+        problem = N_("the folder of {option} {path} is not a folder", option=option, path=path) \
+            if path.parent.exists() else N_("the folder of {option} {path} does not exist", option=option, path=path)
+        raise fail(path.parent, problem,
+                   N_("create the folder first, or give {option} a file in an existing folder", option=option))
     return path
 
 

@@ -18,7 +18,7 @@ from tablebot import overwrite
 from tablebot.diagnostics import HINT_LABEL, Diagnostic, TableBotError, notes_to, severity_word
 from tablebot.escape import terminal
 from tablebot.files import OS_HINTS, out_file, out_folder  # noqa: F401  (re-exported for the commands)
-from tablebot.i18n import localise
+from tablebot.i18n import N_, _, localise
 from tablebot.interrupts import Terminated, sigterm_raises
 
 if TYPE_CHECKING:  # the table machinery is imported when a command loads a table: `--help` stays quick
@@ -63,7 +63,7 @@ class Stages:
 
         self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                                  TimeElapsedColumn(), console=err_console, transient=True)
-        self.task = self.progress.add_task("reading", total=total)
+        self.task = self.progress.add_task(_("reading"), total=total)
         self.timer = threading.Timer(delay, self.progress.start)
         self.timer.daemon = True
         self.started = False
@@ -113,7 +113,7 @@ def _interrupted_import(exc: ImportError) -> None:
         cause = cause.__cause__ or cause.__context__
     if cause is None:
         return
-    print("interrupted" if isinstance(cause, KeyboardInterrupt) else "terminated", file=sys.stderr)
+    print(_("interrupted") if isinstance(cause, KeyboardInterrupt) else _("terminated"), file=sys.stderr)
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(130 if isinstance(cause, KeyboardInterrupt) else 143)
@@ -139,14 +139,15 @@ def guarded(func: F) -> F:
             raise typer.Exit(0) from None
         except OSError as exc:  # a file the command had to write (or read) is not there to be had
             where = exc.filename if exc.filename is not None else "tablebot"
-            print_diagnostic(Diagnostic(str(where), None, None, f"cannot write or read: {exc.strerror or exc}",
-                                        OS_HINTS.get(exc.errno or 0, "check the path")))
+            print_diagnostic(Diagnostic(str(where), None, None,
+                                        N_("cannot write or read: {reason}", reason=exc.strerror or exc),
+                                        OS_HINTS.get(exc.errno or 0, N_("check the path"))))
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
-            print("interrupted", file=sys.stderr)
+            print(_("interrupted"), file=sys.stderr)
             raise typer.Exit(130) from None
         except Terminated:
-            print("terminated", file=sys.stderr)
+            print(_("terminated"), file=sys.stderr)
             raise typer.Exit(143) from None
         except ImportError as exc:
             _interrupted_import(exc)

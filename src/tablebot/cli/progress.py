@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 from tablebot.api.progress import Progress
 from tablebot.cli.common import Stages, err_console
 from tablebot.escape import plain
+from tablebot.i18n import _, localise
 
 if TYPE_CHECKING:
     from rich.progress import Progress as RichProgress
@@ -30,7 +31,7 @@ class TickBar(Progress):
         self.task: TaskID | None = None
         # until the compile (or the run) starts: a first start compiles numba's and numpy's bytecode, seconds
         # with nothing to show (said only past 3 s)
-        self.loading = Talking("loading the simulator", "a first start compiles numba's and numpy's bytecode",
+        self.loading = Talking(_("loading the simulator"), _("a first start compiles numba's and numpy's bytecode"),
                                delay_s=3.0)
 
     def compiling(self, what: str, *functions: Any) -> None:
@@ -44,7 +45,7 @@ class TickBar(Progress):
             return
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-        columns = (TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+        columns = (TextColumn(_("simulating")), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
                    TimeRemainingColumn())
         self.bar = Progress(*columns, console=err_console, transient=True)
         self.task = self.bar.add_task("sim", total=total, completed=done)
@@ -92,8 +93,8 @@ class CountBar(Progress):
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
         rate = [TextColumn("{task.fields[rate]}")] if ticks else []
-        self.bar = Progress(TextColumn(what), BarColumn(), MofNCompleteColumn(), *rate, TimeRemainingColumn(),
-                            console=err_console, transient=True)
+        self.bar = Progress(TextColumn(str(localise(what))), BarColumn(), MofNCompleteColumn(), *rate,
+                            TimeRemainingColumn(), console=err_console, transient=True)
         self.bar.start()
         self.task = self.bar.add_task(what, total=total, completed=done, rate="")
 
@@ -104,12 +105,12 @@ class CountBar(Progress):
         rate = ""
         if self.ticks:
             per_s = self.new * self.ticks / max(time.perf_counter() - self.started, 1e-9)
-            rate = f"{per_s / 1e6:.2f} M robot-ticks/s"
+            rate = _("{rate:.2f} M robot-ticks/s").format(rate=per_s / 1e6)
         self.bar.update(self.task, advance=count, rate=rate)
 
     def note(self, text: str) -> None:
         if not self.quiet:
-            err_console.print(plain(text), markup=False)
+            err_console.print(plain(str(localise(text))), markup=False)
 
     def stop(self) -> None:
         if self.bar is not None:

@@ -11,6 +11,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.escape import plain
+from tablebot.i18n import _, localise
 
 if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the command runs
     from tablebot.api.simulation import Simulation
@@ -66,8 +67,8 @@ def _stopped(run: Simulation) -> None:
     """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
     end = run.end
     kept = run.files[0] if run.files else None
-    err_console.print(f"{end.message or end.reason} after {run.run.ticks:,} ticks; kept {plain(str(kept))} (the "
-                      "previous run's files are untouched)", markup=False)
+    err_console.print(_("{why} after {ticks:,} ticks; kept {kept} (the previous run's files are untouched)").format(
+        why=localise(end.message or end.reason), ticks=run.run.ticks, kept=plain(str(kept))), markup=False)
     raise typer.Exit(end.exit_code)
 
 
@@ -75,9 +76,9 @@ def _report(run: Simulation) -> None:
     """The summary on standard output, the files written on standard error."""
     assert run.summary is not None
     for line in run.summary.lines(run.scene.table.robot.state_names):
-        console.print(plain(line), markup=False)
+        console.print(plain(str(localise(line))), markup=False)
     result = run.run
     speed = result.ticks * result.tick_s / max(result.wall_s, 1e-9)
-    console.print(f"[dim](simulated {speed:,.0f}× faster than real time)[/dim]")
+    console.print("[dim]" + _("(simulated {speed:,.0f}× faster than real time)").format(speed=speed) + "[/dim]")
     for path in run.files:
-        err_console.print(f"wrote {plain(str(path))}", markup=False)
+        err_console.print(_("wrote {path}").format(path=plain(str(path))), markup=False)
