@@ -34,7 +34,8 @@ class Tuning:
     ...                    check_seeds="9..10", seconds=1)
     >>> tuned.objective, len(tuned.winner), [p.name for p in tuned.files]
     ('collisions', 1, [])
-    >>> [p.name for p in tuned.save("out/tune")]
+    >>> written = [p.name for p in tuned.save("out/tune")]
+    >>> written
     ['table.tuned.csv', 'evaluations.csv', 'convergence.png', 'report.md']
     """
 
