@@ -8,7 +8,7 @@ const MIN_RIGHT_EM = 25;  // the arena and its controls beside the table: narrow
 
 function needs(table, holder) {
   // the grid's own width, its border and its vertical scroll bar
-  return table.offsetWidth + (holder.offsetWidth - holder.clientWidth);
+  return table.getBoundingClientRect().width + (holder.offsetWidth - holder.clientWidth);
 }
 
 function fits(layout, need, main, fontPx) {

@@ -124,7 +124,7 @@ export class Diagram {
   _size() {
     if (!this.svg) return;
     const pagePx = parseFloat(getComputedStyle(document.body).fontSize) / 14;
-    const scale = MIN_TEXT_PX / this.minFont * Math.max(1, pagePx) * ZOOMS[this.zoom];
+    const scale = MIN_TEXT_PX * 1.001 / this.minFont * Math.max(1, pagePx) * ZOOMS[this.zoom];  // (not 10.9999)
     this.svg.style.width = this.width * scale + "px";
     this.svg.style.height = this.height * scale + "px";
   }
