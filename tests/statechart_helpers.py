@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import random
 import shutil
 import subprocess
 from collections.abc import Sequence
@@ -26,6 +27,7 @@ from tablebot.formats.statecharts.xstate import RUNTIME, export_xstate, runtime_
 from tablebot.machine import Machine, compile_table
 from tablebot.replay import replay
 from tablebot.table import TIMER_EVENT, Table
+from tablebot.tables import RobotTables
 
 REPO = Path(__file__).resolve().parents[1]
 NODE_MODULES = REPO / "node_modules"
@@ -76,6 +78,29 @@ def one_table(table: Table) -> tuple[Robot, Machine]:
 
 def expected(machine: Machine, inputs: Sequence[TickInput]) -> list[dict[str, Any]]:
     return list(replay(machine, inputs))
+
+
+def several(tables: RobotTables) -> Robot:
+    """A robot of several tables (:mod:`tablebot.tables`) as the statecharts run it."""
+    return Robot(tables.tables, dict(tables.input_bits))
+
+
+def random_several(rng: random.Random, folder: Path, count: int) -> RobotTables:
+    """A random robot of ``count`` tables (cross-table events, a group, a counter loaded by one table and read by
+    others, either rule per table), written as a user's files and read back."""
+    from tablebot.loading import Loaded
+    from tablebot.testing.random_robots import RobotShape, random_robot
+
+    tables = Loaded.open(random_robot(rng, folder, RobotShape(tables=count)) / "t0.csv").tables
+    assert tables is not None
+    return tables
+
+
+def random_ticks(rng: random.Random, tables: RobotTables, count: int) -> list[TickInput]:
+    """Inputs for a robot of several tables: many ticks with no input at all (where the rules part), pulses."""
+    width, counters = len(tables.input_bits), len(tables.robot.counters)
+    return [TickInput(rng.randrange(1 << width) if rng.random() < 0.4 else 0,
+                      tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters))) for _ in range(count)]
 
 
 def _mask(part: Part, chart: Chart, data: dict[str, Any], before: dict[str, str]) -> int:
