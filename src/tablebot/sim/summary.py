@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tablebot.i18n import _
 from tablebot.robot import StateId
 from tablebot.sim import columns as L
 from tablebot.sim.track import laps
@@ -36,19 +37,23 @@ class Summary:
     lamps: bool = True  # whether the world has lamps (else the light lines say nothing)
 
     def lines(self, names: dict[StateId, str] | None = None) -> list[str]:
-        """Human-readable summary lines (``names``: the robot's [states], see Table.state_name)."""
+        """Human-readable summary lines (``names``: the robot's [states], see Table.state_name), in the reader's
+        language (tablebot.i18n), each label padded to the longest."""
         names = names or {}
+
         def when(value: float | None) -> str:
-            return "never" if value is None else f"{value:.2f} s"
-        out = [f"simulated {self.seconds:.1f} s"]
+            return _("never") if value is None else f"{value:.2f} s"
+        pairs: list[tuple[str, str]] = []
         if self.lamps:
-            out += [f"first light seen: {when(self.first_light_s)}", f"lamp reached:     {when(self.reached_s)}"]
+            pairs += [(_("first light seen:"), when(self.first_light_s)), (_("lamp reached:"), when(self.reached_s))]
         if self.laps is not None:
-            out.append(f"laps of the line: {self.laps:.2f}")
-        out += [f"collisions:       {self.collisions}",
-               f"distance driven:  {self.distance_m:.2f} m",
-               f"battery:          {self.battery_start_v:.2f} V -> {self.battery_end_v:.2f} V",
-               "time per state:"]
+            pairs.append((_("laps of the line:"), f"{self.laps:.2f}"))
+        pairs += [(_("collisions:"), str(self.collisions)), (_("distance driven:"), f"{self.distance_m:.2f} m"),
+                  (_("battery:"), f"{self.battery_start_v:.2f} V -> {self.battery_end_v:.2f} V")]
+        longest = (_("first light seen:"), _("laps of the line:"), *(label for label, _value in pairs))
+        width = max(map(len, longest))  # every label, shown or not: the values line up as in any other run
+        out = [_("simulated {seconds:.1f} s").format(seconds=self.seconds),
+               *(f"{label:<{width}} {value}".rstrip() for label, value in pairs), _("time per state:")]
         for state, secs in self.state_seconds.items():
             label = f"{state} {names[state]}" if state in names else str(state)
             out.append(f"  {label:<24} {secs:7.2f} s  {100 * secs / self.seconds:5.1f} %")
