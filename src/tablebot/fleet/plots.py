@@ -19,7 +19,8 @@ from matplotlib.figure import Figure
 from tablebot.escape import picture
 from tablebot.fleet.plan import Plan, groups
 from tablebot.sim.draw import REACHED, draw_world, literal_text
-from tablebot.sim.plots import save
+from tablebot.sim.plots import save, trajectory
+from tablebot.sim.summary import summarise
 
 NEVER = "#b2bec3"
 Row = dict[str, Any]
@@ -115,9 +116,6 @@ def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
 @literal_text()
 def trajectories(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
     """``best.png`` and ``worst.png``: the two runs again, traced, drawn as ``tablebot sim`` draws a run."""
-    from tablebot.sim.plots import trajectory
-    from tablebot.sim.summary import summarise
-
     written = []
     for name, row in zip(("best", "worst"), best_and_worst(rows), strict=True):
         if row is None:

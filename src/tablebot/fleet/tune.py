@@ -11,7 +11,7 @@ import itertools
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -194,8 +194,6 @@ def jobs_for(plan: Plan, variants: Variants, count: int, slots: int = 1) -> list
     as many jobs as that needs rounded up to a multiple of ``slots`` (the workers that run them at once),
     and sizes that differ by one robot at most, so that no worker waits on another's last job (528 robots
     on two workers: 264 + 264, not 512 + 16)."""
-    from dataclasses import replace
-
     jobs: list[Job] = []
     scenarios = runs(plan.spec)
     robots = [plan.robot(run) for run in scenarios]
