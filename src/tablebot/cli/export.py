@@ -15,7 +15,7 @@ from tablebot.escape import terminal
 from tablebot.robopro import rpp_edit as rpp
 
 #: ``--to``'s choices: every registered export back-end.
-Target = StrEnum("Target", {b.name: b.name for b in registry.backends("export")})  # type: ignore[misc]
+Target = StrEnum("Target", {b.name: b.name for b in registry.exporters()})  # type: ignore[misc]
 
 
 class Lookup(StrEnum):
@@ -30,7 +30,7 @@ def export_cmd(
     table: Path = TABLE_ARG,
     outdir: Path | None = typer.Argument(None, metavar="OUTDIR", help="Folder to write into (created if missing); "
                                          "for robopro-rpp, where to put the program instead of rewriting it."),
-    to: Target = typer.Option(..., "--to", help="; ".join(f"{b.name}: {b.help}" for b in registry.backends("export"))
+    to: Target = typer.Option(..., "--to", help="; ".join(f"{b.name}: {b.help}" for b in registry.exporters())
                               + "."),
     into: Path | None = typer.Option(None, "--into", help="robopro-rpp: the ROBO Pro program (.rpp) to update."),
     event_list: str = typer.Option(rpp.DEFAULT_NAMES[0], "--event-list", help="robopro-rpp: the event list's name."),

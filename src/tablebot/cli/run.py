@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when 
     from tablebot.machine import Machine
 
 def _on_help() -> str:
-    helps = [b.help for b in registry.backends("live")]
+    helps = [b.help for b in registry.lives()]
     return (", ".join(helps[:-1]) + ", or " + helps[-1] if len(helps) > 1 else "".join(helps)) + "."
 
 
