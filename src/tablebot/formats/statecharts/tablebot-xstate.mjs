@@ -14,7 +14,7 @@
 // cross-table events become XState's own `stateIn` guards here, with `and`/`or`, when the machine is made.
 import { and, assign, or, setup, stateIn } from "xstate";
 
-const guards = {
+export const guards = {
   // pending, and every flag the row requires; cross-table events and the document's "some event" are
   // added by tablebotMachine as stateIn guards beside this one
   row: ({ context }, params) => {
@@ -52,7 +52,7 @@ function countDown(context, event, params) {
   return next;
 }
 
-const actions = {
+export const actions = {
   tick: assign(({ context, event }, params) => countDown(context, event, params)),
   fire: assign((_, params) => ({
     ...params.set,
