@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from statechart_helpers import NODE_MODULES, node_missing
 
+from statechart_helpers import NODE_MODULES, node_missing
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
