@@ -60,7 +60,7 @@ def test_unknown_target_names_the_known_ones() -> None:
 def test_the_commands_choices_are_the_registered_back_ends() -> None:
     """--to, --board, --on and check --target list exactly what is registered, in its order."""
     runner = CliRunner()
-    assert registry.names("export") == ["robopro", "robopro-rpp", "robopro-program", "c", "txt4"]
+    assert registry.names("export") == ["robopro", "robopro-rpp", "robopro-program", "c", "scxml", "xstate", "txt4"]
     assert registry.names("board") == ["uno", "ftduino"]
     assert registry.names("live") == ["txt", "robotx", "roboif", "sim"]
     assert registry.check_targets() == ["robopro", "robopro-rpp", "robopro-program", "c", "uno", "ftduino", "txt",
