@@ -5,6 +5,8 @@ and every user of a shared computer can read that. As Jupyter does, the browser 
 file instead, which leads on to the address: written 0600 in a folder of its own (0700) in the user's
 runtime folder (``$XDG_RUNTIME_DIR``) or else the temporary folder, and removed when the studio stops.
 Only the user can read it; the address the terminal prints still carries the token, for the user's eyes.
+The page that address opens takes the token out of the address bar and keeps it in its tab, never in a
+cookie (see :mod:`.access`).
 """
 
 from __future__ import annotations
