@@ -40,10 +40,6 @@ class PortInfo:
     product: str = ""
     description: str = ""
 
-    @property
-    def usb_id(self) -> str:
-        return "" if self.vid is None or self.pid is None else f"{self.vid:04x}:{self.pid:04x}"
-
 
 def serial_ports() -> list[PortInfo]:
     """Every serial port the system lists (pyserial's ``list_ports``), sorted by device name."""
