@@ -114,8 +114,8 @@ def test_line_laps_ranks_more_laps_first(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "examples" / "line-follower", slow)
     text = (slow / "table.csv").read_text()
     (slow / "table.csv").write_text(text.replace(",6,6,", ",4,4,", 1))
-    code, output = grade(LAPS, ROOT / "examples" / "line-follower", slow, "--out", tmp_path / "out",
-                         "--workers", "2")
+    code, output = grade("line-laps", ROOT / "examples" / "line-follower", slow, "--out", tmp_path / "out",
+                         "--workers", "2")  # a shipped challenge by its name
     assert code == 0, output
     table = rows(tmp_path / "out")
     assert [r["rank"] for r in table] == ["1", "2"], table

@@ -34,12 +34,21 @@ class Challenge:
     grid: tuple[str, ...]
 
 
+#: The challenges tablebot ships (examples/challenges/NAME): a name alone finds them, in a wheel as in a checkout.
+SHIPPED = ("find-the-lamp", "line-laps")
+
+
 def load_challenge(path: str | Path) -> Challenge:
-    """The challenge in ``path`` (its folder, or its ``challenge.toml``)."""
+    """The challenge in ``path`` (its folder, or its ``challenge.toml``), or a shipped one by its name."""
     path = Path(path)
+    if not path.exists() and str(path) in SHIPPED:
+        from tablebot.examples import example_path
+
+        path = example_path(f"challenges/{path}")
     file = path / FILE_NAME if path.is_dir() else path
     if not file.is_file():
-        raise fail(path, f"no {FILE_NAME} here", f"give a challenge folder holding {FILE_NAME} ({HINT})")
+        raise fail(path, f"no {FILE_NAME} here", f"give a challenge folder holding {FILE_NAME}, or the name of "
+                   f"a shipped challenge: {', '.join(SHIPPED)}")
     src = Source.read(file, HINT)
     data = src.data
     known_keys(src, ("", None), data, KEYS)
