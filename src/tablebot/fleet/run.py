@@ -15,7 +15,6 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.engine import Engine
 from tablebot.fleet.generators import generators
 from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
 from tablebot.fleet.results import FLEET_COLLISIONS, FleetSummary, Trace
@@ -61,10 +60,12 @@ class Fleet:
 
     def _setup(self, traced: Sequence[int]) -> None:
         """Every robot's rows (see :meth:`place`), and what the fleet shares."""
-        n, engine = len(self.specs), Engine(self.machine)
-        n_out, n_c, n_states = len(engine.outputs), len(engine.counters), len(self.machine.states)
-        self.initial = (registers(engine.tick, engine.state, engine.timer, engine.event, engine.row),
-                        np.array(engine.outputs, dtype=np.int64), np.array(engine.counters, dtype=np.int64))
+        machine, n = self.machine, len(self.specs)
+        n_out, n_c, n_states = len(machine.output_names), len(machine.counter_bits), len(machine.states)
+        # a fresh Engine's registers, outputs and counters, without making one: its step's lookups, which no
+        # compiled loop reads, were a fifth of a sweep chunk's set-up
+        self.initial = (registers(0, machine.initial_state, machine.initial_timer),
+                        np.zeros(n_out, dtype=np.int64), np.zeros(n_c, dtype=np.int64))
         self.S, self.P = np.zeros((n, L.N_STATE)), np.zeros((n, self.scenes[0].P.shape[1]))
         self.acc, self.collisions = np.zeros((n, K.N_ACC)), np.zeros((n, FLEET_COLLISIONS), dtype=np.int64)
         self.regs = np.zeros((n, len(self.initial[0])), dtype=np.int64)
