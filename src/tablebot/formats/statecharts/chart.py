@@ -9,8 +9,10 @@ The second half is eventless: in each table's current state the first transition
 fires: a row's guard is ``pending`` and its events; the last transition of every state fires when no row did.
 Each clears ``pending``, so the statechart is stable again before the next tick. Cross-table events are ``In()``
 (SCXML) and ``stateIn`` (XState): all tables' eventless transitions are selected in one microstep, before any of
-them fires, so they see the states at the start of the tick, as the engine's rule says. The timer lives in the
-data model: never ``<send delay>``, which is wall-clock time in every engine.
+them fires, so they see the states at the start of the tick, as the engine's rule says (the W3C SCXML
+recommendation, Appendix D, selectEventlessTransitions; statelyai/xstate, packages/core/src/stateUtils.ts,
+selectEventlessTransitions and macrostep). The timer lives in the data model: never ``<send delay>``, which is
+wall-clock time in every engine.
 
 A table's names: states are ``s12`` (state 12) or ``n_`` and the name with every character but A-Z, a-z, 0-9 as
 ``_HEX_`` (``Seek turn``: ``n_Seek_20_turn``), so that ids are XML names and JavaScript identifiers and read back
