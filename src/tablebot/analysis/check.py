@@ -15,6 +15,7 @@ from tablebot.analysis.properties import Property
 from tablebot.analysis.prove import Result, check_property
 from tablebot.diagnostics import fail
 from tablebot.formats.inputs_csv import write_inputs
+from tablebot.i18n import N_, Message
 from tablebot.machine import Machine
 from tablebot.replay import replay
 from tablebot.tables import RobotTables
@@ -66,17 +67,17 @@ def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, .
 
         return run_check_tables(tables, props, targets, step)
     try:
-        step("exploring the situations")
+        step(N_("exploring the situations"))
         graph = Model(machine).explore()
-        step("looking for findings")
+        step(N_("looking for findings"))
         findings = find_all(machine, graph, targets)
         results = []
         for prop in props:
-            step(f"property {prop.name}")
+            step(N_("property {name}", name=prop.name))
             results.append(check_property(prop, machine))
     except ModelTooLarge as exc:
-        raise fail(machine.table.path, f"too large to explore: {exc}",
-                   "split the table, or give states fewer inputs to look at") from None
+        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc),
+                   N_("split the table, or give states fewer inputs to look at")) from None
     return CheckReport(machine, findings, results, len(graph.nodes))
 
 
@@ -112,28 +113,34 @@ def story(machine: Machine, result: Result, limit: int = 12, tables: RobotTables
         if quiet_from is not None:
             items.append(_quiet(quiet_from, i - 1, lines[i - 1]))
             quiet_from = None
-        items.append(_tick_text(machine, line, pressed) + ("   <- it shows here" if last else ""))
+        text = _tick_text(machine, line, pressed)
+        items.append(N_("{step}   <- it shows here", step=text) if last else text)
     if len(items) > limit:
-        items = [items[0], f"... ({len(items) - limit + 1} more steps) ...", *items[-(limit - 2):]]
+        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2):]]
     return items
 
 
-def _quiet(first: int, last: int, line: dict[str, Any]) -> str:
-    span = f"tick {first}" if first == last else f"ticks {first}-{last}"
-    return f"{span}: nothing pressed, nothing fires (state {line['state']}, timer counts down)"
+def _quiet(first: int, last: int, line: dict[str, Any]) -> Message:
+    if first == last:
+        return N_("tick {first}: nothing pressed, nothing fires (state {state}, timer counts down)", first=first,
+                  state=line["state"])
+    return N_("ticks {first}-{last}: nothing pressed, nothing fires (state {state}, timer counts down)", first=first,
+              last=last, state=line["state"])
 
 
-def _tick_text(machine: Machine, line: dict[str, Any], pressed: list[str]) -> str:
+def _tick_text(machine: Machine, line: dict[str, Any], pressed: list[str]) -> Message:
     table = machine.table
-    what = " + ".join(pressed) if pressed else "nothing pressed"
+    what: str = " + ".join(pressed) if pressed else N_("nothing pressed")
     if line["event"] & machine.timer_bit:
-        what += ", timer ran out"
+        what = N_("{what}, timer ran out", what=what)
     outputs = " ".join(f"{n} {line[n]}" for n in machine.output_names)
     if line["row"] is None:
-        return f"tick {line['tick']}: {what}; no row fires (state {line['state']}, {outputs})"
+        return N_("tick {tick}: {what}; no row fires (state {state}, {outputs})", tick=line["tick"], what=what,
+                  state=line["state"], outputs=outputs)
     row = table.rows[line["row"]]
     label = f" ({row.description})" if row.description else ""
-    return f"tick {line['tick']}: {what} -> line {row.line}{label} fires: state {line['state']}, {outputs}"
+    return N_("tick {tick}: {what} -> line {line}{label} fires: state {state}, {outputs}", tick=line["tick"],
+              what=what, line=row.line, label=label, state=line["state"], outputs=outputs)
 
 
 def report_json(report: CheckReport, strict: bool) -> dict[str, Any]:

@@ -16,6 +16,7 @@ from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.matching import no_event_findings
 from tablebot.analysis.model import Graph, Model
 from tablebot.analysis.names import event_name, events_text, lines_text, mask_events, rows_phrase, state_text
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
@@ -73,14 +74,15 @@ def shadowed_rows(table: Table) -> list[Finding]:
             if winner == i:
                 continue
             earlier = rows[winner]
-            needs = (f"needs only {events_text(table, earlier.events)}, so it always wins first"
-                     if earlier.events else "needs no event at all, so it fires first every time")
+            needs = (N_("needs only {events}, so it always wins first", events=events_text(table, earlier.events))
+                     if earlier.events else N_("needs no event at all, so it fires first every time"))
             found.append(Finding(
                 "shadowed-row", "warning",
-                f"row on line {row.line} can never fire: in {state_text(table, state)} the earlier row "
-                f"on line {earlier.line} {needs}",
-                (row.line, earlier.line), "move this row above line "
-                f"{earlier.line} if it is the more specific case, or delete it", state,
+                N_("row on line {line} can never fire: in {state} the earlier row on line {earlier} {needs}",
+                   line=row.line, state=state_text(table, state), earlier=earlier.line, needs=needs),
+                (row.line, earlier.line),
+                N_("move this row above line {earlier} if it is the more specific case, or delete it",
+                   earlier=earlier.line), state,
                 {"shadowed_by": earlier.line}))
     return found
 
@@ -107,12 +109,13 @@ def overlaps(table: Table) -> list[Finding]:
                 if _same_effect(first, later):
                     continue  # same effect means order cannot matter
                 both = first.events | later.events
-                kind = "specific before general" if later.events <= first.events else "neither contains the other"
+                kind = N_("specific before general") if later.events <= first.events else \
+                    N_("neither contains the other")
                 found.append(Finding(
                     "overlap", "info",
-                    f"in {state_text(table, state)}, when {events_text(table, both)} happen together, "
-                    f"the rows on lines {first.line} and {later.line} both match; line {first.line} "
-                    f"wins because it comes first ({kind})",
+                    N_("in {state}, when {events} happen together, the rows on lines {first} and {later} both "
+                       "match; line {first} wins because it comes first ({kind})", state=state_text(table, state),
+                       events=events_text(table, both), first=first.line, later=later.line, kind=kind),
                     (first.line, later.line), "", state,
                     {"events": sorted(both, key=table.events.index), "winner": first.line}))
     return found
@@ -126,9 +129,10 @@ def ignored_inputs(machine: Machine) -> list[Finding]:
         ignored = [name for name, bit in machine.input_bits.items() if _never_matters(machine, index, bit)]
         if not ignored or not rows_of(table, state):
             continue
-        names = ", ".join(event_name(table, n) for n in ignored)
+        names = tuple(event_name(table, n) for n in ignored)
         found.append(Finding(
-            "ignored-inputs", "info", f"in {state_text(table, state)} the robot does not react to {names}",
+            "ignored-inputs", "info", N_("in {state} the robot does not react to {names}",
+                                         state=state_text(table, state), names=names),
             (rows_of(table, state)[0].line,), "", state, {"inputs": ignored}))
     return found
 
@@ -193,23 +197,24 @@ def _unreachable(machine: Machine, state: StateId, rows: list[Row], seen: Seen) 
     table = machine.table
     into = [r for r in table.rows if r.next == state and r.state != state]
     start = state_text(table, machine.states[machine.initial_state])
-    why = ("no row leads to it" if not into else
-           f"the rows that lead to it ({lines_text(into)}) can never fire")
+    why = (N_("no row leads to it") if not into else
+           N_("the rows that lead to it ({lines}) can never fire", lines=lines_text(into)))
     return Finding("unreachable-state", "warning",
-                   f"{state_text(table, state)} can never be reached from the initial {start}: {why}; "
-                   f"its rows ({lines_text(rows)}) are dead",
-                   tuple(r.line for r in rows), "add a row that leads here, or delete these rows", state)
+                   N_("{state} can never be reached from the initial {start}: {why}; its rows ({lines}) are dead",
+                      state=state_text(table, state), start=start, why=why, lines=lines_text(rows)),
+                   tuple(r.line for r in rows), N_("add a row that leads here, or delete these rows"), state)
 
 
 def _dead_end(table: Table, state: StateId, rows: list[Row], seen: Seen) -> list[Finding]:
     leaving = [r for r in rows if r.next != state]
     if any(r.index in seen.fired for r in leaving):
         return []
-    why = ("no row of it leads to another state" if not leaving else
-           f"the rows that lead out ({lines_text(leaving)}) can never fire")
+    why = (N_("no row of it leads to another state") if not leaving else
+           N_("the rows that lead out ({lines}) can never fire", lines=lines_text(leaving)))
     return [Finding("dead-end", "warning",
-                    f"once the robot is in {state_text(table, state)} it can never leave: {why}",
-                    (rows[0].line,), "add a row that leads to another state (a timeout on T, say)", state)]
+                    N_("once the robot is in {state} it can never leave: {why}", state=state_text(table, state),
+                       why=why),
+                    (rows[0].line,), N_("add a row that leads to another state (a timeout on T, say)"), state)]
 
 
 def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> list[Finding]:
@@ -220,18 +225,19 @@ def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> 
     found = []
     if waiting_for_t:
         busy = sorted(seen.idle_rows.get(index, set()))
-        reload = lines_text([table.rows[i] for i in busy]) if busy else "other rows"
+        reload = lines_text([table.rows[i] for i in busy]) if busy else N_("other rows")
         found.append(Finding(
             "timer-never-expires", "warning",
-            f"in {state_text(table, state)} the timer never runs out: on every tick a row fires first "
-            f"and reloads it ({reload}), so {rows_phrase(waiting_for_t)} waiting for T can never fire",
-            tuple(r.line for r in waiting_for_t), "a row that needs no input fires whenever nothing "
-            "above it matches; give it an input to wait for", state))
+            N_("in {state} the timer never runs out: on every tick a row fires first and reloads it ({reload}), "
+               "so {rows} waiting for T can never fire", state=state_text(table, state), reload=reload,
+               rows=rows_phrase(waiting_for_t)),
+            tuple(r.line for r in waiting_for_t), N_("a row that needs no input fires whenever nothing above it "
+                                                     "matches; give it an input to wait for"), state))
     for row in silent:
         if row in waiting_for_t:
             continue
         found.append(Finding("row-never-fires", "warning", _why_silent(machine, index, row, contexts),
-                             (row.line,), "check the order and the events of this state's rows", state))
+                             (row.line,), N_("check the order and the events of this state's rows"), state))
     return found
 
 
@@ -244,18 +250,21 @@ def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> s
     fits = [c for c in contexts if c & needs == needs]
     if not fits:
         missing = [e for e in mask_events(table, needs) if not any(c & table.bit(e) for c in contexts)]
-        return (f"row on line {row.line} can never fire: it needs {events_text(table, missing)}, "
-                f"which never happens while the robot is in {where}")
+        return N_("row on line {line} can never fire: it needs {events}, which never happens while the robot is "
+                  "in {where}", line=row.line, events=events_text(table, missing), where=where)
     winners = {machine.lookup(index, c | (mask & machine.input_mask)) for c in fits}
     lines = sorted(table.rows[w].line for w in winners if w != NO_ROW)
     if not lines:  # it needs no event, and no event ever comes here: the document's rule looks up no row
-        return (f"row on line {row.line} can never fire: it requires no event, and in {where} no event ever "
-                'comes, so under match = "document" no row is looked up there')
+        return N_("row on line {line} can never fire: it requires no event, and in {where} no event ever comes, "
+                  'so under match = "document" no row is looked up there', line=row.line, where=where)
     always = functools.reduce(operator.and_, fits) & ~needs
     also = events_text(table, mask_events(table, always))
-    because = f" (in {where} there is always {also} as well)" if always else ""
-    return (f"row on line {row.line} can never fire: whenever its events happen, the row on "
-            f"line {', '.join(map(str, lines))} fires first{because}")
+    if always:
+        return N_("row on line {line} can never fire: whenever its events happen, the row on line {first} fires "
+                  "first (in {where} there is always {also} as well)", line=row.line,
+                  first=", ".join(map(str, lines)), where=where, also=also)
+    return N_("row on line {line} can never fire: whenever its events happen, the row on line {first} fires first",
+              line=row.line, first=", ".join(map(str, lines)))
 
 
 # --- export limits ----------------------------------------------------------------------------------
@@ -265,6 +274,7 @@ def encoding(machine: Machine, target: str) -> list[Finding]:
     check of its back-end (:mod:`tablebot.registry`)."""
     table_path = machine.table.path
     return [Finding(f"encoding-{target}", "error",
-                    f"{target}: {d.message}" + ("" if d.path == table_path else f" ({d.location()})"),
+                    N_("{target}: {problem}", target=target, problem=d.message) if d.path == table_path else
+                    N_("{target}: {problem} ({where})", target=target, problem=d.message, where=d.location()),
                     (d.line,) if d.line is not None and d.path == table_path else (), d.hint)
             for d in registry.get(target).problems(machine)]

@@ -38,8 +38,8 @@ if TYPE_CHECKING:  # the checker is imported when a command runs: `tablebot --he
 FORMATS = ("svg", "png", "dot", "mermaid")
 
 COLOURS = {"error": "red", "warning": "yellow", "info": "cyan"}
-#: A finding's severity as shown ("info" reads "note", as the summary counts it).
-FINDING_WORDS = {"error": N_("error"), "warning": N_("warning"), "info": N_("note")}
+#: A finding's severity as shown.
+FINDING_WORDS = {"error": N_("error"), "warning": N_("warning"), "info": N_("info")}
 #: Findings are printed this many lines at a time (a 100,000-row table can have as many findings).
 PRINT_BATCH = 2000
 

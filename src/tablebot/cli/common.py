@@ -78,7 +78,7 @@ class Stages:
         if self.started:
             self.progress.advance(self.task)
         self.started = True
-        self.progress.update(self.task, description=terminal(what))
+        self.progress.update(self.task, description=terminal(str(localise(what))))
 
     def expect(self, total: int) -> None:
         """How many steps there are, once that is known (a check learns it after reading the properties)."""
