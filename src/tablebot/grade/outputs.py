@@ -74,7 +74,8 @@ def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: dict[s
     rows = "".join(_row(rank, entry, replays.get(entry.name, [])) for rank, entry in ranked(entries, challenge.better))
     from tablebot.fleet.spec import parse_seeds
 
-    scenarios = len(parse_seeds(challenge.seeds, None)) * len(challenge.worlds)
+    planned = [e.plan.spec.total for e in entries if e.plan is not None]  # seeds x grid values x worlds
+    scenarios = planned[0] if planned else len(parse_seeds(challenge.seeds, None)) * len(challenge.worlds)
     about = (f"{len(entries)} submissions, each run on the same {scenarios} scenarios of {challenge.seconds:g} s; "
              f"score: {challenge.score} ({challenge.better} is better), the mean over the scenarios ± its standard "
              "deviation. A table that breaks a rule scores nothing.")
