@@ -28,6 +28,8 @@ def share_cmd(
     `tablebot grade` read it back; files that are copies of tablebot's shipped examples are named, not carried."""
     from tablebot import share
 
+    if qr is not None:
+        out_file(qr, "--qr")  # a picture that cannot be written is said before the link is printed
     shared = share.collect(where)
     link = share.encode(shared, base or share.STUDIO)
     print(link)
@@ -35,7 +37,7 @@ def share_cmd(
                       + (f", {plain(shared.robot[0])}" if shared.robot else ", the built-in BumberBot")
                       + (", its world" if shared.world is not None else ", an empty room"), markup=False)
     if qr is not None:
-        write_qr(out_file(qr, "--qr"), link)
+        write_qr(qr, link)
         err_console.print(f"wrote {plain(str(qr))}", markup=False)
 
 
