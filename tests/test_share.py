@@ -134,3 +134,8 @@ def test_sharing_a_broken_table_is_refused(tmp_path: Path) -> None:
     (folder / "table.csv").write_text("description,state,T,I1,I2,M1,M2,timer,next\ngo,1,1,,,9,6,1s,1\n")
     result = runner.invoke(app, ["share", str(folder)])
     assert result.exit_code == 2 and "table.csv:2:" in result.output and "Traceback" not in result.output
+
+
+def test_a_qr_code_that_cannot_be_written_is_refused_before_the_link(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["share", str(EXAMPLES / "bumberbot"), "--qr", str(tmp_path / "no" / "qr.png")])
+    assert result.exit_code == 2 and result.stdout == "" and "the folder of --qr" in result.stderr
