@@ -5,6 +5,7 @@ carry a broken table are refused in words."""
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import shutil
 import zlib
@@ -139,3 +140,28 @@ def test_sharing_a_broken_table_is_refused(tmp_path: Path) -> None:
 def test_a_qr_code_that_cannot_be_written_is_refused_before_the_link(tmp_path: Path) -> None:
     result = runner.invoke(app, ["share", str(EXAMPLES / "bumberbot"), "--qr", str(tmp_path / "no" / "qr.png")])
     assert result.exit_code == 2 and result.stdout == "" and "the folder of --qr" in result.stderr
+
+
+def test_any_text_is_a_link_or_refused_in_words() -> None:
+    """Whatever is pasted (a damaged link, random bytes after '#share=1.', a forged payload), decode gives the
+    files or a TableBotError, never another exception."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    link = share.encode(share.collect(EXAMPLES / "line-follower"))
+    payload = link.split("share=1.", 1)[1]
+
+    @settings(max_examples=300, deadline=None, derandomize=True)
+    @given(st.one_of(st.text(max_size=200).map(lambda t: "#share=1." + t),
+                     st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(b).decode()),
+                     st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(
+                         zlib.compress(b)).decode()),
+                     st.integers(0, len(payload)).map(lambda n: link[:len(link) - n]),
+                     st.tuples(st.integers(0, len(payload) - 1), st.characters()).map(
+                         lambda c: link[:len(link) - len(payload) + c[0]] + c[1] + link[len(link) - len(payload)
+                                                                                      + c[0] + 1:])))
+    def pasted(text: str) -> None:
+        with contextlib.suppress(TableBotError):  # refused in words is fine; anything else fails the test
+            share.decode(text)
+
+    pasted()
