@@ -96,10 +96,12 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
     reply is a kind the page handles."""
     for name in ("table.csv", "robot.toml", "arena.toml", "properties.toml"):
         shutil.copy(EXAMPLE / name, tmp_path / name)
-    messages = {"open": {"path": "table.csv"}, "edit": {"row": 0, "col": 0, "value": "x", "seq": 1},
-                "insert_row": {"after": 0, "seq": 2}, "delete_row": {"row": 1, "seq": 3}, "save": {},
-                "restore": {"header": None, "grid": None, "base": "v"}, "sim": {"action": "step"},
-                "trace": {"path": "nothing.jsonl"}, "counterexample": {"name": "no_such_property"}, "files": {}}
+    messages: dict[str, dict[str, Any]] = {
+        "open": {"path": "table.csv"}, "edit": {"row": 0, "col": 0, "value": "x", "seq": 1},
+        "insert_row": {"after": 0, "seq": 2}, "delete_row": {"row": 1, "seq": 3}, "save": {},
+        "restore": {"header": None, "grid": None, "base": "v"}, "sim": {"action": "step"},
+        "trace": {"path": "nothing.jsonl"}, "counterexample": {"name": "no_such_property"}, "files": {},
+    }
     assert sorted(messages) == sorted(protocol.OPERATIONS)
 
     async def run() -> dict[str, list[dict[str, Any]]]:
