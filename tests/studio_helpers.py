@@ -32,16 +32,16 @@ def wait_for(condition: Callable[[], Any], what: str, timeout: float = 60) -> An
     return found
 
 
-def chromium() -> Iterator[Any]:
-    """Debian's Chromium through Playwright (a module fixture yields from it); skipped where it is missing,
-    except in CI, whose set-up installs it."""
+def chromium(*flags: str) -> Iterator[Any]:
+    """Debian's Chromium through Playwright, started with :data:`FLAGS` and ``flags`` (a module fixture
+    yields from it); skipped where it is missing, except in CI, whose set-up installs it."""
     if not CHROMIUM.exists():
         if os.environ.get("CI"):
             raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
         pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
     sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
     with sync_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
+        browser = p.chromium.launch(executable_path=str(CHROMIUM), args=[*FLAGS, *flags])
         yield browser
         browser.close()
 

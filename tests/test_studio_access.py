@@ -29,6 +29,7 @@ import pytest
 import websockets
 
 from core_helpers import EXAMPLE
+from studio_helpers import bumberbot, served
 from tablebot.web.access import TOKEN_HEADER
 from tablebot.web.app import Background
 from tablebot.web.errors import Refused
@@ -43,8 +44,7 @@ PYTHON_WORDS = ("Errno", "Traceback", "subpath", "Error:", "errno", "object has 
 def folder(tmp_path: Path) -> Path:
     """A BumberBot folder with things a page must never reach: a secret, code, a git folder, a file
     outside, hidden tables, and links leading out of the folder or into a hidden one."""
-    root = tmp_path / "bot"
-    shutil.copytree(EXAMPLE, root)
+    root = bumberbot(tmp_path)
     (root / "secret.env").write_text(SECRET)
     (root / "hook.py").write_text(HOOK)
     (root / "notes.txt").write_text("state,next\n")
@@ -64,9 +64,7 @@ def folder(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def studio(folder: Path) -> Iterator[Background]:
-    server = Background(folder, "table.csv")
-    yield server
-    server.stop()
+    yield from served(folder)
 
 
 def http(server: Background, path: str, headers: dict[str, str] | None = None, data: bytes | None = None,

@@ -14,31 +14,17 @@ from __future__ import annotations
 
 import json
 import logging
-import os
-import shutil
-import threading
 from collections.abc import Iterator
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from core_helpers import EXAMPLE
-
-playwright = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
-CHROMIUM = Path("/usr/bin/chromium")
-if not CHROMIUM.exists():
-    if os.environ.get("CI"):  # CI runs scripts/bootstrap.sh, which installs it: missing there is a failure
-        raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-    pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)", allow_module_level=True)
-
-from tablebot.web.app import Background  # noqa: E402
+from studio_helpers import OtherPort, bumberbot, chromium, other_port, screenshots, served
+from tablebot.web.app import Background
 
 REBOUND = "rebind.test"
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions",
-         f"--host-resolver-rules=MAP {REBOUND} 127.0.0.1",
+FLAGS = [f"--host-resolver-rules=MAP {REBOUND} 127.0.0.1",
          # Chromium's Private Network Access would stop the rebound page before it reaches the studio;
          # other browsers have no such check, and the studio must hold without it
          "--disable-features=BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessRespectPreflightResults,"
@@ -124,8 +110,7 @@ class Log(logging.Handler):
 
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("studio-attacks") / "bot"
-    shutil.copytree(EXAMPLE, root)
+    root = bumberbot(tmp_path_factory.mktemp("studio-attacks"))
     (root / "secret.env").write_text(SECRET + "\n")
     (root / "hook.py").write_text("print('hello')\n")
     (root / ".git").mkdir()
@@ -147,40 +132,20 @@ def log(studio: Background) -> Iterator[Log]:
 
 @pytest.fixture(scope="module")
 def studio(folder: Path) -> Iterator[Background]:
-    server = Background(folder, "table.csv", log_level="info")
-    yield server
-    server.stop()
+    yield from served(folder, log_level="info")
 
 
 @pytest.fixture(scope="module")
 def attacker(studio: Background) -> Iterator[str]:
     """A second local web server, on another port, serving the hostile page aimed at the studio."""
-    page = ATTACK_PAGE.replace("TARGET", json.dumps(studio.origin)).encode()
-
-    class Handler(BaseHTTPRequestHandler):
-        def do_GET(self) -> None:
-            self.send_response(200)
-            self.send_header("Content-Type", "text/html; charset=utf-8")
-            self.end_headers()
-            self.wfile.write(page)
-
-        def log_message(self, *args: Any) -> None:
-            pass
-
-    server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{server.server_address[1]}/cats.html"
-    server.shutdown()
-    server.server_close()
+    server: OtherPort
+    for server in other_port(ATTACK_PAGE.replace("TARGET", json.dumps(studio.origin))):
+        yield server.origin + "/cats.html"
 
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    with playwright.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
-        yield chromium
-        chromium.close()
+    yield from chromium(*FLAGS)
 
 
 @pytest.fixture
@@ -213,9 +178,7 @@ def _files(folder: Path) -> dict[str, bytes]:
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = Path(os.environ.get("TABLEBOT_SCREENSHOTS") or tmp_path_factory.mktemp("attack-screens"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+    return screenshots(tmp_path_factory, "attack-screens")
 
 
 def test_a_page_on_another_port_gets_nothing_and_changes_nothing(context: Any, attacker: str, folder: Path,

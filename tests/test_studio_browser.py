@@ -9,9 +9,7 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import re
-import shutil
 from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
@@ -19,25 +17,15 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from core_helpers import EXAMPLE
+from studio_helpers import bumberbot, chromium, screenshots, served
 from tablebot.colours import state_colours
-
-playwright = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
-CHROMIUM = Path("/usr/bin/chromium")
-if not CHROMIUM.exists():
-    if os.environ.get("CI"):  # CI runs scripts/bootstrap.sh, which installs it: missing there is a failure
-        raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-    pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)", allow_module_level=True)
-
-from tablebot.web.app import Background  # noqa: E402
+from tablebot.web.app import Background
 
 if TYPE_CHECKING:
     from playwright.sync_api import Locator
 
     from tablebot.robot import StateId
 
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
 TIMER_COL, M1_SPEED_COL = 12, 9
 # what the browser drew: the timeline's top row of pixels (RGBA), and each state's border in the diagram
 TIMELINE = """() => { const c = document.querySelector('#timeline');
@@ -48,8 +36,7 @@ BORDERS = """() => [...document.querySelectorAll('#diagram g.node')].map((g) => 
 
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("studio-browser") / "bumberbot"
-    shutil.copytree(EXAMPLE, root)
+    root = bumberbot(tmp_path_factory.mktemp("studio-browser"), "bumberbot")
     _write_sim_trace(root)
     return root
 
@@ -66,24 +53,17 @@ def _write_sim_trace(root: Path) -> None:
 
 @pytest.fixture(scope="module")
 def server(folder: Path) -> Iterator[Background]:
-    studio = Background(folder, "table.csv")
-    yield studio
-    studio.stop()
+    yield from served(folder)
 
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[object]:
-    with playwright.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
-        yield chromium
-        chromium.close()
+    yield from chromium()
 
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = Path(os.environ.get("TABLEBOT_SCREENSHOTS") or tmp_path_factory.mktemp("studio-screens"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+    return screenshots(tmp_path_factory, "studio-screens")
 
 
 class Tab:
@@ -294,8 +274,7 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
 
-    folder = tmp_path / "bot"
-    shutil.copytree(EXAMPLE, folder)
+    folder = bumberbot(tmp_path)
     table_csv = folder / "table.csv"
     hostile = '</script><script>window.pwned=1</script><img src=x onerror="window.pwned=2">'
     table_csv.write_text(table_csv.read_text().replace("Seek - Turn", hostile.replace('"', '""').join('""')))

@@ -7,20 +7,15 @@ page error fails the test. The server's side of the same is in test_studio_saves
 
 from __future__ import annotations
 
-import os
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from core_helpers import EXAMPLE
+from studio_helpers import bumberbot, chromium, screenshots, served
 from tablebot.web.app import Background
-from test_studio_browser import CHROMIUM, FLAGS
 from test_studio_saves import marked, replace_by_rename, version
-
-playwright = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
 
 TIMER_COL = 12
 TIMER = f'td[data-row="3"][data-col="{TIMER_COL}"] input'
@@ -29,31 +24,22 @@ DRAFTS = "() => Object.keys(localStorage).filter((k) => k.startsWith('tablebot-d
 
 @pytest.fixture
 def folder(tmp_path: Path) -> Path:
-    root = tmp_path / "bumberbot"
-    shutil.copytree(EXAMPLE, root)
-    return root
+    return bumberbot(tmp_path, "bumberbot")
 
 
 @pytest.fixture
 def server(folder: Path) -> Iterator[Background]:
-    studio = Background(folder, "table.csv")
-    yield studio
-    studio.stop()
+    yield from served(folder)
 
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    with playwright.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
-        yield chromium
-        chromium.close()
+    yield from chromium()
 
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = Path(os.environ.get("TABLEBOT_SCREENSHOTS") or tmp_path_factory.mktemp("studio-drafts"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+    return screenshots(tmp_path_factory, "studio-drafts")
 
 
 class Page:

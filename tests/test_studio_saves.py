@@ -10,7 +10,6 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import json
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -18,7 +17,7 @@ from typing import Any
 import pytest
 import websockets
 
-from core_helpers import EXAMPLE
+from studio_helpers import bumberbot, served
 from tablebot.web.app import Background
 
 TABS = 8
@@ -27,16 +26,12 @@ DESCRIPTION = 0
 
 @pytest.fixture
 def folder(tmp_path: Path) -> Path:
-    root = tmp_path / "bot"
-    shutil.copytree(EXAMPLE, root)
-    return root
+    return bumberbot(tmp_path)
 
 
 @pytest.fixture
 def studio(folder: Path) -> Iterator[Background]:
-    server = Background(folder, "table.csv")
-    yield server
-    server.stop()
+    yield from served(folder)
 
 
 def version(data: bytes) -> str:
