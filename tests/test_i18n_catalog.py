@@ -136,3 +136,22 @@ def test_the_windows_user_interface_language() -> None:
     assert i18n.system_language({}, "win32", lambda: 0x0C07) == "de"  # German (Austria)
     assert i18n.system_language({}, "win32", lambda: 0x0409) == "en"
     assert i18n.system_language({"LANG": "C.UTF-8"}, "linux") is None
+
+
+def example_words(folder: Path) -> set[str]:
+    """Every word of an example's own files and their names (its states' names, inputs' labels, properties'
+    texts, table.csv): the user's."""
+    return {w for path in folder.iterdir() if path.is_file()
+            for w in re.findall(r"[A-Za-z]+", f"{path.name} {path.read_text()}")}
+
+
+@pytest.mark.parametrize("args", [["check", str(EXAMPLE), "-v"], ["sim", str(EXAMPLE), "--seconds", "2",
+                                                                  "--no-plots", "--out", "OUT"]], ids=lambda a: a[0])
+def test_check_and_sim_say_nothing_outside_the_markers(args: list[str], tmp_path: Path) -> None:
+    args = [a.replace("OUT", str(tmp_path / "out")) for a in args]
+    done = subprocess.run([sys.executable, "-m", "tablebot", *args], capture_output=True, text=True, cwd=ROOT,
+                          env={"PATH": "/usr/bin:/bin", "TABLEBOT_LANG": i18n.PSEUDO, "HOME": str(Path.home())})
+    assert done.returncode in (0, 1), done.stderr
+    allowed = names(typer.main.get_command(app)) | set(args) | example_words(EXAMPLE) | {"jsonl"}
+    shown = done.stdout + done.stderr
+    assert PSEUDO_OPEN in shown and words(outside(shown), allowed) == [], shown[-3000:]

@@ -25,11 +25,15 @@ from typing import Any
 from tablebot.analysis.conditions import Condition, ConditionError, parse_condition
 from tablebot.diagnostics import Collector, TableBotError
 from tablebot.durations import DurationError, to_ticks
+from tablebot.i18n import N_, NP_, Message
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
 from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
+#: How :meth:`Property.claim` says each kind but ``when`` (the condition is the user's, as written).
+CLAIMS = {"never": N_("never: {cond}"), "always": N_("always: {cond}"), "reachable": N_("reachable: {cond}"),
+          "always_reachable": N_("always reachable: {cond}")}
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
 LEVELS = ("error", "warning")
 PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
@@ -70,9 +74,9 @@ class Property:
     def claim(self) -> str:
         """The claim in tablebot's words, e.g. ``never: state == 20 and M1 > 0``."""
         if self.kind == "when":
-            ticks = f"{self.within} tick{'' if self.within == 1 else 's'}"
-            return f"when {self.when.text}, then {self.then.text} within {ticks}"  # type: ignore[union-attr]
-        return f"{self.kind.replace('_', ' ')}: {self.cond.text}"  # type: ignore[union-attr]
+            return NP_("when {when}, then {then} within {n} tick", "when {when}, then {then} within {n} ticks",
+                       self.within, when=self.when.text, then=self.then.text)  # type: ignore[union-attr]
+        return Message(CLAIMS[self.kind].msgid, {"cond": self.cond.text})  # type: ignore[union-attr]
 
 
 def find_property_files(table_path: Path) -> list[Path]:
