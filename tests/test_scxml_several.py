@@ -9,6 +9,8 @@ nothing, which is what these tests show: the trace is the engine's, whose tables
 from __future__ import annotations
 
 import random
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -46,3 +48,23 @@ def test_several_tables_read_back_as_the_same_table_bytes(tmp_path: Path, seed: 
     back = read_scxml(export_scxml(tables.tables), "machine.scxml")
     assert [format_table(t) for t in back] == [format_table(t) for t in tables.tables]
     assert [t.name for t in back] == list(tables.names) and export_scxml(back) == export_scxml(tables.tables)
+
+
+def test_the_import_command_writes_tables_a_robot_file_reads_again(tmp_path: Path) -> None:
+    """export the BumberBot with its lights, import it into a folder: the lights table comes back byte for byte,
+    the drive table (table.csv) with its group rows once; beside the original robot file, the robot runs as the
+    original does."""
+    original = Path("examples/bumberbot-lights")
+    run = [sys.executable, "-m", "tablebot"]
+    subprocess.run([*run, "export", str(original), str(tmp_path / "out"), "--to", "scxml"], check=True,
+                   capture_output=True)
+    done = subprocess.run([*run, "import", str(tmp_path / "out" / "machine.scxml"), "--from", "scxml", "--out",
+                           str(tmp_path / "back")], check=True, capture_output=True, text=True)
+    assert (tmp_path / "back" / "lights.csv").read_bytes() == (original / "lights.csv").read_bytes()
+    assert 'drive = { file = "table.csv", initial_state = 2' in done.stderr
+    assert 'seeking = [1, 2, 11]' in done.stderr
+    (tmp_path / "back" / "robot.toml").write_bytes((original / "robot.toml").read_bytes())
+    tables, again = Loaded.open(original).tables, Loaded.open(tmp_path / "back").tables
+    assert tables is not None and again is not None
+    inputs = random_ticks(random.Random(3), tables, 200)
+    assert list(replay_several(again, inputs)) == list(replay_several(tables, inputs))

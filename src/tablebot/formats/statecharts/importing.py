@@ -1,20 +1,23 @@
 """``tablebot import FILE --from scxml|xstate``: a statechart tablebot exported, read back into its tables and written
-as table CSV (:func:`tablebot.formats.table_write.format_table`: the same bytes as the exported table's).
+as table CSV (:func:`tablebot.formats.table_write.format_table`: the same bytes as the exported table's, in their
+written form: a group's rows once, with the group as their state, :func:`table_text`).
 
-One table: its CSV goes to ``--out`` (or standard output). Several: ``--out`` is a folder, and each table is written
-there as ``NAME.csv``, the robot file's ``[tables]`` lines said on the terminal. A robot file given with ``--robot``
-must name every input, motor, lamp and counter the statechart has (the table is then read with it).
+One table: its CSV goes to ``--out`` (or standard output). Several: ``--out`` is a folder, the main table is
+written there as ``table.csv`` and each other as ``NAME.csv``, the robot file's ``[tables]`` lines said on the
+terminal (and ``[groups]``, when rows were written for groups). A robot file given with ``--robot`` must name
+every input, motor, lamp and counter the statechart has.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import fail
 from tablebot.files import out_folder, write_text
 from tablebot.formats.table_write import format_table
-from tablebot.robot import Robot
+from tablebot.robot import Robot, StateId
 from tablebot.table import Table
 
 __all__ = ["KINDS", "import_statechart", "read_statechart"]
@@ -22,6 +25,41 @@ __all__ = ["KINDS", "import_statechart", "read_statechart"]
 KINDS = ("scxml", "xstate")
 #: The largest statechart read: a table of 100,000 rows exports to some 60 MB of SCXML.
 MAX_BYTES = 128 * 1024 * 1024
+
+
+def table_text(table: Table) -> str:
+    """A table as its file writes it (:func:`format_table`): a group's rows once, with the group as their state,
+    and in a robot of several tables only the outputs the table writes (another table's column would make it a
+    second writer)."""
+    rows, seen = [], set()
+    for row in table.rows:
+        if row.group:
+            if row.as_written in seen:
+                continue
+            seen.add(row.as_written)
+            row = replace(row, state=row.group)
+        rows.append(row)
+    robot = table.robot
+    if table.name:
+        motors = [i for i, m in enumerate(robot.motors) if m in table.writes]
+        lamps = [i for i, lamp in enumerate(robot.lamps) if lamp in table.writes]
+        counters = [i for i, c in enumerate(robot.counter_names) if c in table.writes]
+        rows = [replace(r, motors=tuple(r.motors[i] for i in motors), lamps=tuple(r.lamps[i] for i in lamps),
+                        counters=tuple(r.counters[i] for i in counters)) for r in rows]
+        robot = replace(robot, motors=tuple(robot.motors[i] for i in motors),
+                        lamps=tuple(robot.lamps[i] for i in lamps),
+                        counters=tuple(robot.counters[i] for i in counters))
+    return format_table(replace(table, robot=robot, rows=tuple(rows)))
+
+
+def groups(tables: tuple[Table, ...]) -> dict[str, list[StateId]]:
+    """The state groups the tables' rows were written for, each with its states in the order it lists them."""
+    found: dict[str, list[StateId]] = {}
+    for table in tables:
+        for row in table.rows:
+            if row.group and row.state not in found.setdefault(row.group, []):
+                found[row.group].append(row.state)
+    return found
 
 
 def read_statechart(path: Path, kind: str) -> tuple[Table, ...]:
@@ -54,18 +92,23 @@ def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | No
     tables = read_statechart(path, kind)
     if robot is not None:
         _against(tables, robot)
+    said = ["the robot file's [groups]: " + "; ".join(f"{name} = {list(states)!r}".replace("'", '"')
+                                                        for name, states in groups(tables).items())]
+    said = said if groups(tables) else []
     if len(tables) == 1:
-        text = format_table(tables[0])
+        text = table_text(tables[0])
         if out is None:
-            return text, []
+            return text, said
         write_text(out, text)
-        return None, [f"wrote {out} ({len(tables[0].rows)} rows)"]
+        return None, [f"wrote {out} ({len(tables[0].rows)} rows)", *said]
     if out is None:
         raise fail("--out", f"{path} holds {len(tables)} tables",
-                   "give --out FOLDER: each is written there as NAME.csv")
+                   "give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv")
     folder = out_folder(out, "--out")
-    lines = [f"wrote {write_text(folder / f'{t.name}.csv', format_table(t))}" for t in tables]
+    files = ["table.csv", *(f"{t.name}.csv" for t in tables[1:])]  # the main one where a folder's table is
+    lines = [f"wrote {write_text(folder / name, table_text(t))}" for name, t in zip(files, tables, strict=True)]
     lines.append("the robot file's [tables]: " + "; ".join(
-        f'{t.name} = {{ file = "{t.name}.csv", initial_state = {t.robot.initial_state!r}, '
-        f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}' for t in tables).replace("'", '"'))
-    return None, lines
+        f'{t.name} = {{ file = "{name}", initial_state = {t.robot.initial_state!r}, '
+        f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}'
+        for name, t in zip(files, tables, strict=True)).replace("'", '"'))
+    return None, [*lines, *said]
