@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 from tablebot import overwrite
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail, notify
+from tablebot.i18n import N_
 
 #: The line Excel may put above the header to name the delimiter: ``sep=;``.
 SEP_RE = re.compile(r"^\s*sep=([,;\t])\s*$")
@@ -43,7 +44,7 @@ class Record:
 
 
 #: What to do about a file that is not UTF-8 text, for files a spreadsheet saves.
-CSV_ENCODING_HINT = "save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)"
+CSV_ENCODING_HINT = N_("save the file as 'CSV UTF-8' (Excel) or 'Text CSV' with character set UTF-8 (LibreOffice)")
 #: The largest file a loader reads, by default: a 100,000-row table is about 5 MB, an hour of recorded
 #: inputs at 10 ms ticks about 6 MB. Anything larger is almost surely the wrong file (or /dev/zero).
 MAX_TEXT_BYTES = 64 * 1024 * 1024
@@ -72,16 +73,17 @@ def read_bytes(path: Path, limit: int | None = None) -> bytes:
     further than that: a device such as /dev/zero never ends); the default limit is MAX_TEXT_BYTES."""
     limit = MAX_TEXT_BYTES if limit is None else limit
     if path.is_dir():
-        raise fail(path, "this is a folder, not a file", "give the path of a file")
+        raise fail(path, N_("this is a folder, not a file"), N_("give the path of a file"))
     try:
         with path.open("rb") as stream:
             data = stream.read(limit + 1)
     except OSError as exc:
-        raise fail(path, f"cannot read: {exc.strerror or exc}", "check the file name") from None
+        raise fail(path, N_("cannot read: {reason}", reason=exc.strerror or exc), N_("check the file name")) from None
     overwrite.read(path)
     if len(data) > limit:
-        raise fail(path, f"the file is larger than {size_text(limit)}, the most tablebot reads of such a file",
-                   "is this the right file? split it, or give a smaller one")
+        raise fail(path, N_("the file is larger than {size}, the most tablebot reads of such a file",
+                            size=size_text(limit)),
+                   N_("is this the right file? split it, or give a smaller one"))
     return data
 
 
@@ -115,9 +117,10 @@ def _legacy(path: Path, data: bytes, first_bad: int) -> str:
     except UnicodeDecodeError:  # cp1252 leaves five bytes undefined; Latin-1 has them all
         text, name = data.decode("latin-1"), "Latin-1 (ISO-8859-1)"
     bad = _bad_bytes(path, data, "")[0]
-    notify(Diagnostic(str(path), bad.line, bad.column, f"not UTF-8 (byte 0x{data[first_bad]:02x}); read as "
-                      f"{name}, as a Western European Excel saves 'CSV'",
-                      f"if characters look wrong, {CSV_ENCODING_HINT}", "note"))
+    notify(Diagnostic(str(path), bad.line, bad.column,
+                      N_("not UTF-8 (byte 0x{byte:02x}); read as {name}, as a Western European Excel saves 'CSV'",
+                         byte=data[first_bad], name=name),
+                      N_("if characters look wrong, {hint}", hint=CSV_ENCODING_HINT), "note"))
     return text
 
 
@@ -130,8 +133,8 @@ def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:
             raw.decode("utf-8")
         except UnicodeDecodeError as exc:
             column = len(raw[: exc.start].decode("utf-8")) + 1
-            found.append(Diagnostic(str(path), number, column, f"byte 0x{raw[exc.start]:02x} is not UTF-8 text",
-                                    hint))
+            found.append(Diagnostic(str(path), number, column,
+                                    N_("byte 0x{byte:02x} is not UTF-8 text", byte=raw[exc.start]), hint))
             if len(found) == MAX_BAD_LINES:
                 break
     return found
@@ -276,14 +279,15 @@ def _check_cell(cells: list[Cell], path: str) -> None:
 
 
 def _too_wide(path: str, line: int, column: int) -> TableBotError:
-    return fail(path, f"this line has more than {MAX_COLUMNS:,} cells, the most tablebot reads",
-                "a table has a column per input and output, a few dozen at most: is this the right file?",
+    return fail(path, N_("this line has more than {most:,} cells, the most tablebot reads", most=MAX_COLUMNS),
+                N_("a table has a column per input and output, a few dozen at most: is this the right file?"),
                 line, column)
 
 
 def _too_long(path: str, line: int, column: int) -> TableBotError:
-    return fail(path, f"this cell is longer than {MAX_CELL_CHARS:,} characters, the most tablebot reads",
-                "shorten it (a description is a sentence or two); is this the right file?", line, column)
+    return fail(path, N_("this cell is longer than {most:,} characters, the most tablebot reads",
+                         most=MAX_CELL_CHARS),
+                N_("shorten it (a description is a sentence or two); is this the right file?"), line, column)
 
 
 def _quoted(text: str, i: int, line: int, column: int, path: str, bounded: bool) -> tuple[str, int, int, int]:
@@ -307,7 +311,7 @@ def _quoted(text: str, i: int, line: int, column: int, path: str, bounded: bool)
         return "".join(parts), k + 1, line + newlines, column
     if k >= 0:
         raise _too_long(path, line, column)
-    raise fail(path, "a quoted cell is never closed", 'add the closing " (write "" for a quote inside)',
+    raise fail(path, N_("a quoted cell is never closed"), N_('add the closing " (write "" for a quote inside)'),
                line, column)
 
 
@@ -315,12 +319,13 @@ def cells_beyond(cells: Sequence[Cell], width: int, out: Collector) -> None:
     """Report the filled cells right of a ``width``-column header (a spreadsheet shows them; nothing reads them)."""
     for cell in cells[width:]:
         if cell.text.strip():
-            out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is beyond the last column",
-                      "remove it or add a header for it")
+            out.error(cell.line, cell.column, N_("cell {text!r} is beyond the last column", text=cell.text.strip()),
+                      N_("remove it or add a header for it; a cell holding a comma (0,5s in a comma-separated "
+                         "file) is written in quotes: \"0,5s\""))
 
 
 def headerless(cell: Cell, out: Collector) -> None:
     """Report a filled cell in a column whose header is blank."""
     if cell.text.strip():
-        out.error(cell.line, cell.column, f"cell {cell.text.strip()!r} is in a column with no header",
-                  "name the column in the header, or clear the cell")
+        out.error(cell.line, cell.column, N_("cell {text!r} is in a column with no header", text=cell.text.strip()),
+                  N_("name the column in the header, or clear the cell"))

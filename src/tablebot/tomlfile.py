@@ -15,6 +15,7 @@ from typing import Any
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
 from tablebot.durations import MAX_NUMBER_CHARS
+from tablebot.i18n import N_
 from tablebot.tomlwords import worded
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
@@ -29,7 +30,7 @@ MAX_DEPTH = 32
 
 def read_toml(path: Path, hint: str) -> tuple[dict[str, Any], str]:
     """The data and text of a TOML file; unreadable bytes and syntax errors raise located errors."""
-    text = read_text(path, "save the file as UTF-8 text", MAX_TOML_BYTES, spreadsheet=False)
+    text = read_text(path, N_("save the file as UTF-8 text"), MAX_TOML_BYTES, spreadsheet=False)
     return loads(path, text, hint), text
 
 
@@ -51,8 +52,8 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
                                             col)
         raise fail(path, message, better or hint, line, col) from None
     except RecursionError:  # nesting that _unreadable() did not count (it is a safety net, not the parser)
-        raise fail(path, "nested too deeply to read", "no tablebot file nests that deep: is this the right file?",
-                   1, 1) from None
+        raise fail(path, N_("nested too deeply to read"),
+                   N_("no tablebot file nests that deep: is this the right file?"), 1, 1) from None
 
 
 #: What may follow a digit in one TOML value or bare key: a number, a date or time, or a key such as ``20``.
@@ -88,15 +89,16 @@ def _unreadable(text: str) -> tuple[str, str, int, int] | None:
         elif ch in "[{":
             depth += 1
             if depth > MAX_DEPTH:
-                return (f"arrays or inline tables nested more than {MAX_DEPTH} levels deep",
-                        "no tablebot file nests that deep: is this the right file?", line, column)
+                return (N_("arrays or inline tables nested more than {most} levels deep", most=MAX_DEPTH),
+                        N_("no tablebot file nests that deep: is this the right file?"), line, column)
         elif ch in "]}":
             depth = max(0, depth - 1)
         elif token := TOKEN_RE.match(text, i):  # a value or a bare key: skipped whole
             length = token.end() - i
             if length > MAX_NUMBER_CHARS and ch in "0123456789+-":
-                return (f"a number of {length:,} characters, more than the {MAX_NUMBER_CHARS} tablebot reads",
-                        "no tablebot setting needs such a number: is this the right file?", line, column)
+                return (N_("a number of {count:,} characters, more than the {most} tablebot reads", count=length,
+                           most=MAX_NUMBER_CHARS),
+                        N_("no tablebot setting needs such a number: is this the right file?"), line, column)
             i += length - 1
             column += length - 1
         i += 1
@@ -165,13 +167,15 @@ def is_number(value: Any) -> bool:
 
 def number(src: Source, where: Where, value: Any, low: float, high: float, integer: bool = False) -> float | None:
     """A number in [low, high] (an integer when asked), or None after reporting why not."""
-    kind = "an integer" if integer else "a number"
+    write = N_("write an integer from {low:g} to {high:g}", low=low, high=high) if integer else \
+        N_("write a number from {low:g} to {high:g}", low=low, high=high)
     if not is_number(value) or (integer and not isinstance(value, int)):
-        src.error(where, f"{label(where)} must be {kind}, not {value!r}", f"write {kind} from {low:g} to {high:g}")
+        src.error(where, N_("{name} must be an integer, not {value!r}", name=label(where), value=value) if integer
+                  else N_("{name} must be a number, not {value!r}", name=label(where), value=value), write)
         return None
     if not low <= value <= high:
-        src.error(where, f"{label(where)} = {value:g} is out of range {low:g}..{high:g}",
-                  f"write {kind} from {low:g} to {high:g}")
+        src.error(where, N_("{name} = {value:g} is out of range {low:g}..{high:g}", name=label(where), value=value,
+                            low=low, high=high), write)
         return None
     return value
 
@@ -186,17 +190,19 @@ def point(src: Source, where: Where, value: Any) -> tuple[float, float] | None:
     if pair and all(abs(v) <= MAX_COORDINATE for v in value):
         return float(value[0]), float(value[1])
     if pair:  # a point, but no room is that large (and the physics' floats would lose their millimetres)
-        src.error(where, f"{label(where)}: the point {value!r} is out of range", f"write x and y from "
-                  f"{-MAX_COORDINATE:g} to {MAX_COORDINATE:g} metres")
+        src.error(where, N_("{name}: the point {value!r} is out of range", name=label(where), value=value),
+                  N_("write x and y from {low:g} to {high:g} metres", low=-MAX_COORDINATE, high=MAX_COORDINATE))
     else:
-        src.error(where, f"{label(where)} must be a point [x, y] in metres, not {value!r}", "for example: [1.2, 0.5]")
+        src.error(where, N_("{name} must be a point [x, y] in metres, not {value!r}", name=label(where), value=value),
+                  N_("for example: [1.2, 0.5]"))
     return None
 
 
 def table_of(src: Source, where: Where, value: Any) -> dict[str, Any]:
     if isinstance(value, dict):
         return value
-    src.error(where, f"{label(where)} must be a table", f"write it as a [{where[0]}] section")
+    src.error(where, N_("{name} must be a table", name=label(where)),
+              N_("write it as a [{section}] section", section=where[0]))
     return {}
 
 
@@ -205,5 +211,7 @@ def known_keys(src: Source, where_section: tuple[str, int | None], table: dict[s
     for key in table:
         if key not in known:
             section, index = where_section
-            src.error((section, index, key), f"unknown key {key!r} in {label((section, index, None)) or 'the file'}",
-                      f"known keys: {', '.join(known)}")
+            place = label((section, index, None))
+            src.error((section, index, key), N_("unknown key {key!r} in {place}", key=key, place=place) if place
+                      else N_("unknown key {key!r} in the file", key=key),
+                      N_("known keys: {known}", known=", ".join(known)))
