@@ -97,3 +97,24 @@ def test_every_run_of_the_engine_is_a_run_of_the_product(tmp_path_factory: Any, 
         engine.step(rng.randrange(1 << len(tables.input_bits)) if rng.random() < 0.4 else 0, (rng.choice((0, 5)),))
         seen = (tuple(e.state for e in engine.engines), tuple(e.timer for e in engine.engines), engine.outputs)
         assert seen in nodes
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 2**32))
+def test_leaving_out_tables_that_cannot_influence_changes_nothing_a_property_sees(tmp_path_factory: Any,
+                                                                                  seed: int) -> None:
+    rng = random.Random(seed)
+    folder = random_robot(rng, tmp_path_factory.mktemp("robot"), RobotShape(tables=3, states=3))
+    tables = Loaded.open(folder / "t0.csv").tables
+    assert tables is not None
+    for read in ({0}, {1}, {2}, {0, 2}):
+        relevant = tables.influence(frozenset(read))
+        whole = ProductModel(tables, 2).explore().nodes
+        part = ProductModel(tables, 2, relevant=relevant).explore().nodes
+        outputs = [i for i, name in enumerate(tables.output_names) if tables.writer(name) in relevant]
+
+        def seen(nodes: list[Any], relevant: frozenset[int] = relevant, outputs: list[int] = outputs) -> set[Any]:
+            return {(tuple(n[0][k] for k in sorted(relevant)), tuple(n[1][k] for k in sorted(relevant)),
+                     tuple(n[3][i] for i in outputs)) for n in nodes}
+
+        assert seen(part) == seen(whole)

@@ -79,6 +79,20 @@ class RobotTables:
         """The index of the table that writes ``output`` (a motor, lamp or counter), None if none does."""
         return next((i for i, t in enumerate(self.tables) if output in t.writes), None)
 
+    def influence(self, read: frozenset[int]) -> frozenset[int]:
+        """The tables whose runs decide what the tables ``read`` do: they, the tables their cross-table events
+        name, the writers of the counters they read, and so on. The others cannot change them (each output has
+        one writer), so a proof about ``read`` may leave them out."""
+        found, todo = set(read), list(read)
+        while todo:
+            table = self.tables[todo.pop()]
+            sources = {self.index(e.table) for e in table.cross.values()}
+            sources |= {w for c in self.robot.counter_names if c in table.events and (w := self.writer(c)) is not None}
+            for source in sources - found:
+                found.add(source)
+                todo.append(source)
+        return frozenset(found)
+
     def index(self, name: str) -> int:
         return self.names.index(name)
 

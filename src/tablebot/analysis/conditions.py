@@ -48,6 +48,8 @@ class Condition:
     text: str
     test: Predicate
     input_bits: int
+    #: In a robot of several tables: the tables whose state or outputs it reads (indices; 0 the main table).
+    tables: frozenset[int] = frozenset()
 
     def __call__(self, obs: Obs) -> bool:
         return self.test(*obs)
@@ -60,7 +62,7 @@ def parse_condition(text: str, machine: Machine, tables: RobotTables | None = No
     test = parser.expression()
     if parser.peek() is not None:
         raise ConditionError(f"unexpected {parser.peek()!r} in {text!r}")
-    return Condition(text, test, parser.input_bits)
+    return Condition(text, test, parser.input_bits, frozenset(parser.reads))
 
 
 def _tokens(text: str) -> list[str]:
@@ -87,6 +89,7 @@ class _Parser:
     def __init__(self, tokens: list[str], machine: Machine, tables: RobotTables | None = None) -> None:
         self.tokens, self.pos, self.machine, self.tables = tokens, 0, machine, tables
         self.input_bits = 0
+        self.reads: set[int] = set()  # the tables whose state or outputs it reads (several tables)
         self.depth = 0
 
     def deeper(self) -> None:
@@ -145,11 +148,14 @@ class _Parser:
         if token in ("true", "false"):
             value = token == "true"
             return lambda e, r, s, o: value
+        if token in ("fired", "state", "line"):
+            self.reads.add(0)  # the main table's
         if token == "fired":
             return lambda e, r, s, o: r >= 0
         if token == "state":
             return self.state_test()
         if self.tables is not None and token in self.tables.names:
+            self.reads.add(self.tables.index(token))
             return self.state_test(self.tables.index(token))
         if token == "line":
             return self.line_test()
@@ -219,6 +225,8 @@ class _Parser:
             return lambda e, r, s, o: e & bit != 0
         if name in machine.output_names:
             index = machine.output_names.index(name)
+            if self.tables is not None and (writer := self.tables.writer(name)) is not None:
+                self.reads.add(writer)
             op = self.take("a comparison such as < 0")
             if op not in COMPARE:
                 raise ConditionError(f"compare {name} with a number, like {name} < 0 or {name} == 0")
@@ -257,9 +265,12 @@ class _Parser:
             self.input_bits |= bits[name]
             return bits[name]
         if name == TIMER_EVENT:
+            self.reads.add(0)
             if not self.machine.timer_bit:
                 raise ConditionError(f"the main table ({self.tables.names[0]}) has no T column")
             return 1 << len(bits)
+        if (writer := self.tables.writer(name)) is not None:
+            self.reads.add(writer)
         return 1 << (len(bits) + 1 + self.machine.table.robot.counter_names.index(name))
 
 

@@ -35,11 +35,14 @@ PTick = tuple[int, int, int, PNode]
 @dataclass
 class ProductModel:
     """The robot's tables together under the timer horizon ``horizon``; ``watch`` = event-word bits (robot
-    inputs) that properties read."""
+    inputs) that properties read. ``relevant``: the tables to run (None: all); the others stay in their initial
+    state and fire nothing, which is exact for a property that reads only tables they cannot influence
+    (:meth:`RobotTables.influence`): each output has one writer, so they change nothing the property sees."""
 
     tables: RobotTables
     horizon: int = 1
     watch: int = 0
+    relevant: frozenset[int] | None = None
     _succ: dict[PNode, list[PTick]] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -55,26 +58,26 @@ class ProductModel:
         self.tracked = sum(1 << c for c, name in enumerate(robot.counter_names)
                            if any(m.counter_bits[c] for m in tables.machines))
         self.engine = Several(tables)  # its input and cross-table maps, made once
+        self.active = tuple(k for k in range(len(tables.machines)) if self.relevant is None or k in self.relevant)
         self.writers = [tables.writer(name) for name in tables.output_names]
 
     @classmethod
-    def exact(cls, tables: RobotTables, watch: int = 0) -> ProductModel:
-        """The model in which no timer value of any table is abstracted."""
-        loads = [r.timer for m in tables.machines for r in m.rows]
-        return cls(tables, max([1, *loads, *(m.initial_timer for m in tables.machines)]), watch)
+    def exact(cls, tables: RobotTables, watch: int = 0, relevant: frozenset[int] | None = None) -> ProductModel:
+        """The model in which no timer value of any (relevant) table is abstracted."""
+        return cls(tables, _longest(tables, relevant), watch, relevant)
 
     @property
     def is_exact(self) -> bool:
-        return self.horizon >= max([1, *(r.timer for m in self.tables.machines for r in m.rows),
-                                    *(m.initial_timer for m in self.tables.machines)])
+        return self.horizon >= _longest(self.tables, self.relevant)
 
     def timer_class(self, value: int) -> int:
         return value if value <= self.horizon else self.omega
 
     def initial(self) -> PNode:
         machines = self.tables.machines
-        return (tuple(m.initial_state for m in machines), tuple(self.timer_class(m.initial_timer) for m in machines),
-                self.tracked, (0,) * len(self.tables.output_names), True)
+        timers = tuple(self.timer_class(m.initial_timer) if k in self.active else 0 for k, m in enumerate(machines))
+        return (tuple(m.initial_state for m in machines), timers, self.tracked, (0,) * len(self.tables.output_names),
+                True)
 
     def successors(self, node: PNode) -> list[PTick]:
         cached = self._succ.get(node)
@@ -85,6 +88,7 @@ class ProductModel:
     def _expand(self, node: PNode) -> Iterator[PTick]:
         states, timers, zero, outputs, first = node
         afters = [timers] if first else [tuple(t if t == self.omega else max(0, t - 1) for t in timers)]
+        # (a table left out keeps timer 0 and fires nothing: see _rows)
         zeroings = [0] if first else list(_subsets(self.tracked & ~zero))
         seen: set[tuple[int, ...]] = set()
         for after, zeroed in itertools.product(afters, zeroings):
@@ -105,6 +109,9 @@ class ProductModel:
         engine, machines = self.engine, self.tables.machines
         rows = []
         for k, machine in enumerate(machines):
+            if k not in self.active:
+                rows.append(NO_ROW)
+                continue
             events = engine.input_maps[k](mask)
             for source, bits in engine.cross_maps[k]:
                 events |= bits[states[source]]
@@ -131,7 +138,7 @@ class ProductModel:
             for c, load in enumerate(row.loads):
                 if load is not None and self.tracked >> c & 1:
                     zero = zero | (1 << c) if load == 0 else zero & ~(1 << c)
-        waiting = [k for k, index in enumerate(rows) if index == NO_ROW and timers[k] == self.omega and not first]
+        waiting = [k for k in self.active if rows[k] == NO_ROW and timers[k] == self.omega and not first]
         for dropped in _subsets(sum(1 << k for k in waiting)):
             after = tuple(self.horizon if dropped >> k & 1 else t for k, t in enumerate(new_timers))
             yield tuple(new_states), after, zero, tuple(new_out), False
@@ -170,6 +177,12 @@ class ProductModel:
             ticks.append(TickInput(mask, pulses))
             faithful &= engine.engines[0].row == row
         return ticks, faithful
+
+
+def _longest(tables: RobotTables, relevant: frozenset[int] | None) -> int:
+    """The longest timer value the (relevant) tables load or start with: the horizon of the exact model."""
+    machines = [m for k, m in enumerate(tables.machines) if relevant is None or k in relevant]
+    return max([1, *(r.timer for m in machines for r in m.rows), *(m.initial_timer for m in machines)])
 
 
 def _subsets(bits: int) -> Iterator[int]:

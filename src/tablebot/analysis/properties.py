@@ -67,6 +67,11 @@ class Property:
         return bits
 
     @property
+    def tables(self) -> frozenset[int]:
+        """In a robot of several tables: the tables whose state or outputs the property reads."""
+        return frozenset().union(*(c.tables for c in (self.cond, self.when, self.then) if c is not None))
+
+    @property
     def horizon(self) -> int:
         """Timer values the model must keep exact for this property (see the model's docstring)."""
         return self.within + 1 if self.kind == "when" else 1

@@ -22,8 +22,9 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
     if prop.kind == "always_reachable":
         return _always_reachable(prop, tables, budget)
     reachable = prop.kind == "reachable"
+    relevant = tables.influence(prop.tables)  # the tables that can change what the property sees
     try:
-        model = ProductModel(tables, prop.horizon, prop.watch)
+        model = ProductModel(tables, prop.horizon, prop.watch, relevant)
         path, explored = search(model, monitor_of(prop))  # type: ignore[arg-type]  # same interface as Model
     except ModelTooLarge as exc:
         return Result(prop, "unknown", detail=f"too large to search ({exc}); a condition that reads fewer inputs "
@@ -32,7 +33,7 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
         return Result(prop, "violated" if reachable else "holds", explored,
                       detail="it can never happen" if reachable else "")
     try:
-        exact = model if model.is_exact else ProductModel.exact(tables, prop.watch)
+        exact = model if model.is_exact else ProductModel.exact(tables, prop.watch, relevant)
         if exact is not model:
             path, _ = search(exact, monitor_of(prop), budget)  # type: ignore[arg-type]
         if path is None:  # the abstraction was too coarse about when a long timer runs out
@@ -50,13 +51,14 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
 
 
 def _always_reachable(prop: Property, tables: RobotTables, budget: int) -> Result:
-    model = ProductModel(tables, 1, prop.watch)
+    relevant = tables.influence(prop.tables)
+    model = ProductModel(tables, 1, prop.watch, relevant)
     graph = model.explore()
     path, _ = trapped(graph, prop.cond)
     if path is None:
         return Result(prop, "holds", len(graph.nodes))
     try:
-        exact = ProductModel.exact(tables, prop.watch)
+        exact = ProductModel.exact(tables, prop.watch, relevant)
         path, _ = trapped(exact.explore(budget), prop.cond)
         model = exact
     except ModelTooLarge:
