@@ -15,6 +15,7 @@ from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
+from tablebot.tables import RobotTables
 
 FORMATS = ("svg", "png", "dot", "mermaid")
 PNG_DPI = 150  # Graphviz's default 72 dpi draws 9-point labels a few pixels high
@@ -64,15 +65,27 @@ def condition(table: Table, event_sets: Sequence[frozenset[str]], otherwise: boo
     minimal = [s for s in event_sets if not any(o < s for o in event_sets)]
     unique = list(dict.fromkeys(minimal))
     empty = "otherwise" if otherwise else "always"
-    parts = ["+".join(e if e != TIMER_EVENT else "T" for e in table.events if e in s) or empty for s in unique]
+    parts = ["+".join(event_label(table, e) for e in table.events if e in s) or empty for s in unique]
     return " or ".join(parts)
+
+
+def event_label(table: Table, event: str) -> str:
+    """An event as diagrams write it: a cross-table event (``drive=11,12``) as ``drive in {11,12}`` (``drive in
+    20..29`` for a range): the other table's states it needs at the start of the tick."""
+    cross = table.cross.get(event)
+    if cross is None:
+        return event
+    states = ",".join([*map(str, cross.states), *(f"{low}..{high}" for low, high in cross.ranges)])
+    return f"{cross.table} in {{{states}}}" if cross.states or len(cross.ranges) > 1 else f"{cross.table} in {states}"
 
 
 def action(table: Table, row: Row) -> Action:
     text, motion = motion_of(table, row.motors)
     extras = [f"{n}={v}" for n, v in zip(table.robot.lamps, row.lamps, strict=True) if v is not None]
     extras += [f"{n}:={v}" for n, v in zip(table.robot.counter_names, row.counters, strict=True) if v is not None]
-    if extras:
+    if extras and table.name and not set(table.robot.motors) & set(table.writes):
+        text = " ".join(extras)  # one table of several that drives no motor: its lamps and counters are its action
+    elif extras:
         text = f"{text} {' '.join(extras)}"
     return Action(text, motion, duration(table, row.timer))
 
@@ -124,16 +137,31 @@ def _sides(table: Table) -> tuple[int, int] | None:
 # --- Graphviz ---------------------------------------------------------------------------------------
 
 def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
-    robot = table.robot
-    ids = state_ids(table.states)
     # Every user text goes into HTML-like labels (<…>): the only Graphviz strings without escapes of their own.
+    graph = digraph(f"{table.robot.name}: {table.path}")
+    draw_table(graph, table, colour)
+    graph.node("__legend", _legend(table, colour), shape="plain", fontsize="9")
+    return graph
+
+
+def digraph(title: str) -> graphviz.Digraph:
+    """An empty diagram titled ``title``, with the house style for its nodes and edges."""
     graph = graphviz.Digraph("tablebot", graph_attr={
         "rankdir": "TB", "fontname": "Helvetica", "fontsize": "11", "nodesep": "0.35", "ranksep": "0.9",
-        "labelloc": "t", "label": f"<{dot_label(f'{robot.name}: {table.path}')}>", "pad": "0.2"})
+        "labelloc": "t", "label": f"<{dot_label(title)}>", "pad": "0.2"})
     graph.attr("node", shape="box", style="rounded,filled", fillcolor="#f4f4f4", fontname="Helvetica",
                fontsize="12", color="#555555")
     graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
-    graph.node("__start", "", shape="circle", style="filled", fillcolor="black", width="0.18")
+    return graph
+
+
+def draw_table(graph: graphviz.Digraph, table: Table, colour: bool, prefix: str = "") -> None:
+    """The table's states, start and edges into ``graph`` (a whole diagram, or one table's cluster of a robot of
+    several tables, whose ids then start with ``prefix``)."""
+    robot = table.robot
+    ids = {state: prefix + mid for state, mid in state_ids(table.states).items()}
+    start = f"{prefix}__start"
+    graph.node(start, "", shape="circle", style="filled", fillcolor="black", width="0.18")
     colours = state_colours(table.states)  # each state's colour in the pictures of a run
     for state, state_colour in zip(table.states, colours, strict=True):
         label = table.state_name(state)
@@ -141,15 +169,13 @@ def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
         initial = state == robot.initial_state
         graph.node(ids[state], title, penwidth="3" if initial else "2", color=state_colour,
                    fillcolor="#fff7d6" if initial else "#f4f4f4")
-    graph.edge("__start", ids[robot.initial_state], label=f"< start, timer {robot.initial_timer}>")
+    graph.edge(start, ids[robot.initial_state], label=f"< start, timer {robot.initial_timer}>")
     for edge in edges(table):
         first = edge.lines[0][1].motion
         same = all(a.motion == first for _, a in edge.lines)
         graph.edge(ids[edge.source], ids[edge.target], label=_html_label(edge, colour),
                    color=COLOURS[first] if colour and same else "#666666",
                    penwidth="1.6" if colour and same else "1.0")
-    graph.node("__legend", _legend(table, colour), shape="plain", fontsize="9")
-    return graph
 
 
 def state_ids(states: Sequence[StateId]) -> dict[StateId, str]:
@@ -195,11 +221,19 @@ def _legend(table: Table, colour: bool) -> str:
     return f'<<table border="1" cellborder="0" cellspacing="1" color="#999999">{body}</table>>'
 
 
-def render(table: Table, fmt: str, colour: bool = True) -> bytes:
-    """The diagram as file contents in ``fmt`` (one of FORMATS)."""
-    if fmt == "mermaid":
+def render(table: Table, fmt: str, colour: bool = True, tables: RobotTables | None = None) -> bytes:
+    """The diagram as file contents in ``fmt`` (one of FORMATS); a robot of several ``tables`` gets one diagram
+    per table, side by side (:mod:`tablebot.analysis.diagram_tables`)."""
+    if tables is not None:
+        from tablebot.analysis.diagram_tables import tables_graphviz, tables_mermaid
+
+        if fmt == "mermaid":
+            return tables_mermaid(tables).encode()
+        graph = tables_graphviz(tables, colour)
+    elif fmt == "mermaid":
         return to_mermaid(table).encode()
-    graph = to_graphviz(table, colour)
+    else:
+        graph = to_graphviz(table, colour)
     if fmt == "dot":
         return graph.source.encode()
     if fmt == "png":
@@ -216,16 +250,21 @@ def render(table: Table, fmt: str, colour: bool = True) -> bytes:
 
 def to_mermaid(table: Table) -> str:
     """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""
-    ids = state_ids(table.states)
-    out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {ids[table.robot.initial_state]}"]
+    return "\n".join(["stateDiagram-v2", "    direction LR", *mermaid_lines(table)]) + "\n"
+
+
+def mermaid_lines(table: Table, prefix: str = "", indent: str = "    ") -> list[str]:
+    """The table's states and edges as Mermaid lines (ids starting with ``prefix``, for one table of several)."""
+    ids = {state: prefix + mid for state, mid in state_ids(table.states).items()}
+    out = [f"{indent}[*] --> {ids[table.robot.initial_state]}"]
     for state in table.states:
         label = table.state_name(state)
         name = f"{state} - {label}" if label else str(state)
-        out.append(f'    state "{mermaid_label(name)}" as {ids[state]}')
+        out.append(f'{indent}state "{mermaid_label(name)}" as {ids[state]}')
     for edge in edges(table):
         parts = []
         for cond, act in edge.lines:
             timer = f" {act.timer}" if act.timer else ""
             parts.append(f"{cond} / {act.text}{timer}")
-        out.append(f"    {ids[edge.source]} --> {ids[edge.target]}: {mermaid_label(', '.join(parts))}")
-    return "\n".join(out) + "\n"
+        out.append(f"{indent}{ids[edge.source]} --> {ids[edge.target]}: {mermaid_label(', '.join(parts))}")
+    return out

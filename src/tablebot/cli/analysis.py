@@ -244,8 +244,8 @@ def diagram_cmd(
     from tablebot.analysis.diagram import render
     from tablebot.files import write_bytes
 
-    parsed = load(table, robot)[0]
-    data = render(parsed, fmt, colour)
+    project = open_project(table, robot)
+    data = render(project.table, fmt, colour, project.tables)  # a robot of several tables: one diagram each
     if out is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
