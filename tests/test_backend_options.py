@@ -59,6 +59,20 @@ def test_link_timeout_is_the_real_links_timeout(kind: str) -> None:
     assert "link_lost" in said[None] and "within 50 ms" in said[None]  # 5 ticks of 10 ms
 
 
+def test_behind_limit_zero_reaches_the_links_judge() -> None:
+    """A ROBO Interface at 38400 baud is too slow for a 10 ms tick: refused, unless --behind-limit 0 accepts
+    slow timers (then it runs, and says so)."""
+    said = {}
+    for extra in ([], ["--behind-limit", "0"]):
+        with RoboifEmulator(baud=38400) as emu:
+            said[bool(extra)] = invoke("run", EXAMPLE, "--on", f"roboif://{emu.device}", "--seconds", "0.1",
+                                       "--link-timeout", "0.5", *extra)
+    refused, accepted = said[False], said[True]
+    assert refused.exit_code == 2 and "accept timers" in refused.output and "--behind-limit 0" in refused.output
+    assert accepted.exit_code == 0, accepted.output
+    assert "running anyway (--behind-limit 0)" in " ".join(accepted.output.split())
+
+
 def test_link_options_say_what_a_live_back_end_is_given() -> None:
     link = registry.LinkOptions("robotx://auto", link_timeout_s=0.37, behind_limit_s=0.0, seed=4)
     assert link.timeout_s(0.01) == 0.37 and registry.LinkOptions("sim").timeout_s(0.02) == pytest.approx(0.1)
