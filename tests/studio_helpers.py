@@ -8,6 +8,8 @@ import os
 import shutil
 import threading
 import time
+import urllib.error
+import urllib.request
 from collections.abc import Callable, Iterator
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -107,3 +109,15 @@ def other_port(page: str) -> Iterator[OtherPort]:
     server = OtherPort(page)
     yield server
     server.close()
+
+
+def http(server: Background, path: str, headers: dict[str, str] | None = None, data: bytes | None = None,
+         timeout: float = 10) -> tuple[int, bytes]:
+    """Status and body of a request to the studio; ``headers`` replace the page's own."""
+    request = urllib.request.Request(f"{server.origin}/{path}", data=data,
+                                     headers=server.headers if headers is None else headers)
+    try:
+        with urllib.request.urlopen(request, timeout=timeout) as reply:
+            return reply.status, reply.read()
+    except urllib.error.HTTPError as err:
+        return err.code, err.read()
