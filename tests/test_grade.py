@@ -145,6 +145,8 @@ def browser() -> Iterator[Any]:
 
 
 def test_the_leaderboard_opens_offline_with_no_console_error(graded: Path, browser: Any) -> None:
+    """One file: the board, and each replay unpacked from it into a frame over the board (Esc closes it)."""
+    assert sorted(p.name for p in graded.iterdir()) == ["leaderboard.html", "scores.csv", "submissions"]
     context = browser.new_context(offline=True, viewport={"width": 1280, "height": 720})
     page = context.new_page()
     errors: list[str] = []
@@ -156,11 +158,15 @@ def test_the_leaderboard_opens_offline_with_no_console_error(graded: Path, brows
     assert page.locator("tbody tr").count() == 7
     assert "breaks front_bumper_stops" in page.locator("tbody").inner_text()
     page.screenshot(path=str(graded.parent / "leaderboard.png"), full_page=True)
-    replay = page.locator("a", has_text="best").first
-    replay.click()
-    page.wait_for_load_state("load")
-    assert page.url.endswith("replays/001-best.html")
+    page.locator("button.replay", has_text="worst").first.click()
+    replay = page.frame_locator("#viewer iframe")
+    replay.locator("#title").wait_for(timeout=20_000)
+    assert replay.locator("#title").inner_text().startswith("anna: worst: seed ")
+    replay.locator("#tplay").click()
     page.wait_for_timeout(500)
+    page.screenshot(path=str(graded.parent / "replay.png"))
+    page.keyboard.press("Escape")
+    assert page.locator("#viewer").is_hidden()
     assert errors == [] and all(url.startswith("file://") for url in requests), (errors, requests)
     context.close()
 

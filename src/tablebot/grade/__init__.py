@@ -36,13 +36,13 @@ def grade(challenge: str | Path, submissions: Sequence[str | Path], out: str | P
           told: Callable[[str], None] = lambda text: None) -> Grading:
     """Grade ``submissions`` (table files, folders holding table.csv, text files of share links) on the
     ``challenge`` (its folder or challenge.toml) on this machine's cores or a Dask cluster (``backend``,
-    ``scheduler``, ``workers`` as for sweep), and write ``scores.csv``, ``leaderboard.html``, the replays and
-    the linked submissions' files into ``out``, replacing an earlier grading's all at once. ``told`` hears
+    ``scheduler``, ``workers`` as for sweep), and write ``scores.csv``, ``leaderboard.html`` (its replays in
+    it) and the linked submissions' files into ``out``, replacing an earlier grading's all at once. ``told`` hears
     what is being done."""
     from tablebot.files import out_folder, write_text
     from tablebot.fileset import file_set
     from tablebot.fleet.backends import Runner, choose
-    from tablebot.grade.outputs import leaderboard_html, scores_csv, write_replays
+    from tablebot.grade.outputs import leaderboard_html, replay_pages, scores_csv
     from tablebot.grade.run import grade_all
     from tablebot.grade.submissions import collect
 
@@ -56,17 +56,17 @@ def grade(challenge: str | Path, submissions: Sequence[str | Path], out: str | P
         told("writing the leaderboard")
         with file_set(folder, remove=_previous(folder)):
             files = [write_text(folder / "scores.csv", scores_csv(entries, found))]
-            replays = write_replays(entries, found, folder)
-            files += [folder / name for pages in replays.values() for _, name in pages]
-            files.append(write_text(folder / "leaderboard.html", leaderboard_html(entries, found, replays)))
+            replays, packed = replay_pages(entries, found)
+            files.append(write_text(folder / "leaderboard.html", leaderboard_html(entries, found, replays, packed)))
             files += _copy_linked(Path(tmp), folder)
     return Grading(found, tuple(entries), tuple(files))
 
 
 def _previous(folder: Path) -> list[str]:
-    """An earlier grading's replays and linked submissions, which the new set replaces."""
-    return [p.relative_to(folder).as_posix() for sub in ("replays", "submissions") if (folder / sub).is_dir()
-            for p in sorted((folder / sub).rglob("*")) if p.is_file()]
+    """An earlier grading's linked submissions, which the new set replaces."""
+    linked = folder / "submissions"
+    return [p.relative_to(folder).as_posix() for p in sorted(linked.rglob("*")) if p.is_file()] \
+        if linked.is_dir() else []
 
 
 def _copy_linked(tmp: Path, folder: Path) -> list[Path]:

@@ -1,7 +1,9 @@
 """What ``grade`` writes: ``scores.csv`` (rank, name, score, why: the same bytes on every machine) and
-``leaderboard.html``, a page with nothing to fetch (its style inline): rank, name, score with its spread, every
-rule's verdict with its counterexample's words, and links to each qualified submission's best and worst run,
-each a replay page of its own (``replays/``, made by the replay page builder of ``tablebot sim --html``)."""
+``leaderboard.html``, one page with nothing to fetch: rank, name, score with its spread, every rule's verdict
+with its counterexample's words, and each qualified submission's best and worst run, replayed in the page
+itself. Each replay is the page ``tablebot sim --html`` writes (:mod:`tablebot.web.replay`), compressed
+(zlib) into the leaderboard and unpacked by the browser (DecompressionStream) when it is asked for: about
+80 KB a run instead of 430."""
 
 from __future__ import annotations
 
@@ -27,32 +29,34 @@ def scores_csv(entries: list[Entry], challenge: Challenge) -> str:
     return buffer.getvalue()
 
 
-def replay_name(rank_index: int, which: str) -> str:
-    """A replay page's file name: by place on the board, never by a pupil's text."""
-    return f"replays/{rank_index + 1:03d}-{which}.html"
+Replays = dict[str, list[tuple[str, str]]]  # per submission name: (label, key of its packed page)
 
 
-def write_replays(entries: list[Entry], challenge: Challenge, folder: Path) -> dict[str, list[tuple[str, str]]]:
-    """Each qualified submission's best and worst run as a replay page; per name, (label, file) pairs."""
+def replay_pages(entries: list[Entry], challenge: Challenge) -> tuple[Replays, dict[str, str]]:
+    """Each qualified submission's best and worst run as a replay page, packed: the labels per name, and
+    each page's zlib-compressed bytes in base64 by key (``NNN-best``: by place on the board, never by a
+    pupil's text)."""
+    import base64
+    import zlib
+
     from tablebot.fleet.spec import runs
-    from tablebot.web.replay import write_html
+    from tablebot.web.replay import render_html, replay_data
 
-    links: dict[str, list[tuple[str, str]]] = {}
+    links: Replays = {}
+    packed: dict[str, str] = {}
     for k, (_, entry) in enumerate(ranked(entries, challenge.better)):
         if entry.why or entry.plan is None or entry.values is None:
             continue
         plan = entry.plan
-        pages = []
         for which, index in zip(("best", "worst"), best_and_worst(entry, challenge.better), strict=True):
             run = runs(plan.spec, index, index + 1)[0]
-            lines = plan.traced(index).trace_lines(0)
             label = f"{which}: seed {run.seed}, {challenge.score} {shown(float(entry.values[index]))}"
-            name = replay_name(k, which)
-            write_html(folder / name, lines, plan.worlds[run.world], plan.table, params=plan.scenes[run.world].params,
-                       title=f"{entry.name}: {label}")
-            pages.append((label, name))
-        links[entry.name] = pages
-    return links
+            data = replay_data(plan.traced(index).trace_lines(0), plan.worlds[run.world], plan.table,
+                               plan.scenes[run.world].params, f"{entry.name}: {label}")
+            key = f"{k + 1:03d}-{which}"
+            packed[key] = base64.b64encode(zlib.compress(render_html(data).encode("utf-8"), 9)).decode("ascii")
+            links.setdefault(entry.name, []).append((label, key))
+    return links, packed
 
 
 STYLE = """
@@ -66,12 +70,44 @@ td.rank { font-size: 1.3rem; font-weight: 700; width: 3rem; } td.score { white-s
 details { margin: .15rem 0; } summary { cursor: pointer; } pre { white-space: pre-wrap; font-size: .85rem;
   background: #f7f7f9; padding: .4rem; margin: .3rem 0; } a { color: #1e6fd9; }
 tr.unranked td { background: #fcfcfd; }
+button.replay { font: inherit; font-size: .9rem; margin: .1rem 0; padding: .3rem .6rem; min-height: 2.5rem;
+  border: 1px solid #1e6fd9; border-radius: 4px; background: #fff; color: #1e6fd9; cursor: pointer; display: block; }
+#viewer { position: fixed; inset: 0; background: rgba(30, 39, 46, .6); display: flex; flex-direction: column;
+  padding: 1rem; } #viewer[hidden] { display: none; }
+#viewer .head { display: flex; justify-content: flex-end; } #viewer iframe { flex: 1; border: 0; background: #fff; }
+#viewer .head button { font: inherit; min-height: 2.5rem; padding: .3rem 1rem; }
+"""
+
+#: Opens a replay: its page unpacked from the script element that holds it, shown in a frame over the board.
+SCRIPT = """
+const viewer = document.getElementById('viewer');
+const frame = viewer.querySelector('iframe');
+async function unpack(key) {
+  const text = document.getElementById('replay-' + key).textContent;
+  const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
+  const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+  return new Response(stream).text();
+}
+function close() { viewer.hidden = true; frame.removeAttribute('srcdoc'); }
+document.addEventListener('click', async (event) => {
+  const button = event.target.closest('button.replay');
+  if (button) { frame.srcdoc = await unpack(button.dataset.replay); viewer.hidden = false; frame.focus(); }
+});
+viewer.querySelector('.head button').addEventListener('click', close);
+function onEscape(event) { if (event.key === 'Escape') close(); }
+document.addEventListener('keydown', onEscape);
+frame.addEventListener('load', () => {  // Esc pressed in the replay, too (its page has the board's origin)
+  if (frame.contentDocument) frame.contentDocument.addEventListener('keydown', onEscape);
+});
 """
 
 
-def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: dict[str, list[tuple[str, str]]]) -> str:
-    """The page: a row per submission in leaderboard order."""
+def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: Replays, packed: dict[str, str]) -> str:
+    """The page: a row per submission in leaderboard order, the packed replays, the viewer."""
     rows = "".join(_row(rank, entry, replays.get(entry.name, [])) for rank, entry in ranked(entries, challenge.better))
+    pages = "".join(f'<script type="text/plain" id="replay-{key}">{text}</script>' for key, text in packed.items())
+    viewer = ('<div id="viewer" hidden role="dialog" aria-label="replay"><div class="head"><button type="button">'
+              "close (Esc)</button></div><iframe title=\"replay\"></iframe></div>")
     from tablebot.fleet.spec import parse_seeds
 
     planned = [e.plan.spec.total for e in entries if e.plan is not None]  # seeds x grid values x worlds
@@ -84,7 +120,7 @@ def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: dict[s
             f"<title>{h(challenge.title)}: leaderboard</title><style>{STYLE}</style></head><body>"
             f"<h1>{h(challenge.title)}</h1><p class=\"about\">{h(about)}</p>"
             "<table><thead><tr><th>rank</th><th>name</th><th>score</th><th>rules</th><th>replays</th></tr></thead>"
-            f"<tbody>{rows}</tbody></table></body></html>\n")
+            f"<tbody>{rows}</tbody></table>{viewer}{pages}<script>{SCRIPT}</script></body></html>\n")
 
 
 def _row(rank: int | None, entry: Entry, replays: list[tuple[str, str]]) -> str:
@@ -94,7 +130,8 @@ def _row(rank: int | None, entry: Entry, replays: list[tuple[str, str]]) -> str:
         low, high = float(entry.values.min()), float(entry.values.max())
         score = (f"{shown(entry.score)}<span class=\"spread\">± {shown(entry.spread)} "
                  f"({shown(low)} to {shown(high)})</span>")
-    links = " ".join(f'<a href="{h(name)}">{h(label)}</a><br>' for label, name in replays)
+    links = "".join(f'<button type="button" class="replay" data-replay="{h(key)}">▶ {h(label)}</button>'
+                    for label, key in replays)
     klass = "" if rank is not None else ' class="unranked"'
     given = Path(entry.sub.given).name if Path(entry.sub.given).exists() else entry.sub.given  # no machine's paths
     source = f"<br><small class=\"out\">{h(given)}</small>" if given != entry.name else ""
