@@ -163,3 +163,28 @@ def test_new_writes_a_german_table_when_asked(tmp_path: Path) -> None:
     assert [r.timer for r in load_table(tmp_path / "de" / "table.csv").rows] == [800, 70]
     new("system", "--inputs", "I1", LANG="de_DE.UTF-8")  # German words, but the file in English: not asked for
     assert (tmp_path / "system" / "table.csv").read_text().startswith("description,state,T,I1,")
+
+
+BAD_ROBOTS = [
+    "name = 1\n[motors]\nM1 = 2\n", "tick_ms = 0\ninitial_state = 1\n[motors]\nM1 = 'm'\n", "initial_state = 1\n",
+    "initial_state = 1\nmatch = 'sometimes'\n[inputs]\nI1 = 'a'\n[motors]\nI1 = 'b'\n",
+    "initial_state = 1\n[motors]\nM1 = 'm'\n[counters]\nC1 = 'M9'\n",
+    "initial_state = 1\n[motors]\nM1 = 'm'\n[wiring]\n",
+    "initial_state = 1\n[motors]\nZustand = 'm'\n", "initial_state = 1\n[motors\n", "initial_state = 1\nx = = 2\n",
+    "initial_state = 1\n[motors]\nM1 = 'm'\nname = 'late'\n", "initial_state = [1]\n[states]\nx-y = 3\n",
+]
+
+
+@pytest.mark.parametrize("text", BAD_ROBOTS, ids=range(len(BAD_ROBOTS)))
+def test_bad_robot_files_are_explained_in_the_readers_language(tmp_path: Path, text: str) -> None:
+    from tablebot.robot import load_robot
+
+    robot = tmp_path / "robot.toml"
+    robot.write_text(text)
+    with pytest.raises(TableBotError) as caught:
+        load_robot(robot)
+    for found in caught.value.diagnostics:
+        shown = found.render("pseudo").split(": ", 1)[1]
+        rest = re.sub(r"'[^']*'|\b\w*\d\w*\b|robot\.toml|\bx\b|\by\b", "", outside(shown))
+        assert not re.search(r"[A-Za-z]{3,}", rest), shown
+        assert ": Fehler: " in found.render("de"), found.render("de")

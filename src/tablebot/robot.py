@@ -14,6 +14,7 @@ from typing import Any, Literal, cast
 
 from tablebot import durations
 from tablebot.i18n import N_
+from tablebot.i18n.headers import GERMAN_FIXED
 from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
@@ -45,8 +46,8 @@ def register_section(name: str, reader: SectionReader) -> None:
 
 
 #: Sections people write in the wrong file: the hint says where they belong.
-MISPLACED = {"wiring": "the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)",
-             **{s: f"simulator parameters go in [sim.{s}] in a robot file" for s in
+MISPLACED = {"wiring": N_("the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)"),
+             **{s: N_("simulator parameters go in [sim.{section}] in a robot file", section=s) for s in
                 ("body", "motor", "battery", "encoder", "light", "distance", "noise")}}
 NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: A state name as tables and robot files write it (a state is otherwise a whole number 0 or more).
@@ -66,11 +67,11 @@ MATCHES: tuple[Match, ...] = (MATCH_DOCUMENT, MATCH_ALWAYS)
 #: A robot file that does not say: tablebot's rule from before the key existed, so that no existing table
 #: silently changes (``tablebot check`` says when the choice matters). The built-in BumberBot follows the document.
 DEFAULT_MATCH = MATCH_ALWAYS
-MATCH_HINT = ('match = "document": a row that requires no event fires only on a tick with some event, as in the '
-              'document\'s engine; match = "always": it fires on every tick, even one with no event at all')
+MATCH_HINT = N_('match = "document": a row that requires no event fires only on a tick with some event, as in the '
+                'document\'s engine; match = "always": it fires on every tick, even one with no event at all')
 RESERVED_NAMES = {"T", "description", "state", "timer", "next"}
 #: Header names the table parser reads case-insensitively as fixed columns (aliases included).
-RESERVED_LOWER = {"description", "desc", "state", "st", "timer", "next"}
+RESERVED_LOWER = {"description", "desc", "state", "st", "timer", "next", *GERMAN_FIXED}  # Zustand, Folgezustand too
 
 
 @dataclass(frozen=True)
@@ -158,31 +159,37 @@ def find_robot_file(table_path: Path) -> Path | None:
 def load_robot(path: str | Path) -> Robot:
     """Read a robot TOML file, reporting every problem with its line."""
     path = Path(path)
-    src = Source.read(path, "see the robot file format in the README")
+    src = Source.read(path, N_("see the robot file format in the README"))
     data = src.data
     for key in data:
         if key not in TOP_KEYS and key not in CORE_SECTIONS and key not in SECTION_READERS:
-            what = "section" if isinstance(data[key], dict) else "key"
-            src.key_error(("", None, key), f"unknown {what} {key!r}",
-                      MISPLACED.get(key, f"known keys: {', '.join(TOP_KEYS)}; sections: "
-                                         f"{', '.join((*CORE_SECTIONS, *SECTION_READERS))}"))
+            unknown = N_("unknown section {key!r}", key=key) if isinstance(data[key], dict) else \
+                N_("unknown key {key!r}", key=key)
+            src.key_error(("", None, key), unknown,
+                          MISPLACED.get(key, N_("known keys: {keys}; sections: {sections}", keys=", ".join(TOP_KEYS),
+                                                sections=", ".join((*CORE_SECTIONS, *SECTION_READERS)))))
     inputs, motors, lamps = (_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = _counters(src, motors)
     sensors = parse_sensors(src, inputs)
     _distinct(src, {"inputs": inputs, "motors": motors, "lamps": lamps, "counters": {c.name: "" for c in counters}})
     if not motors and not lamps:
-        src.out.error(None, None, "the robot has no [motors] and no [lamps]",
-                      'add a section like [motors] with M1 = "right motor"')
-    tick_ms = _whole(src, "tick_ms", 10, (1, MAX_TICK_MS), f"a positive whole number up to {MAX_TICK_MS}",
-                     "the document's engine ticks every 10 ms: tick_ms = 10")
-    initial_timer = _whole(src, "initial_timer", 0, (0, MAX_TIMER), f"a whole number 0..{MAX_TIMER}",
-                           "the timer counts ticks; 0 means it has expired")
+        src.out.error(None, None, N_("the robot has no [motors] and no [lamps]"),
+                      N_('add a section like [motors] with M1 = "right motor"'))
+    tick_ms = _whole(src, "tick_ms", 10, (1, MAX_TICK_MS),
+                     N_("{key} must be a positive whole number up to {most}, not {value!r}", key="tick_ms",
+                        most=MAX_TICK_MS, value=data.get("tick_ms")),
+                     N_("the document's engine ticks every 10 ms: tick_ms = 10"))
+    initial_timer = _whole(src, "initial_timer", 0, (0, MAX_TIMER),
+                           N_("{key} must be a whole number 0..{most}, not {value!r}", key="initial_timer",
+                              most=MAX_TIMER, value=data.get("initial_timer")),
+                           N_("the timer counts ticks; 0 means it has expired"))
     initial_state = _initial_state(src)
     match = _match(src)
     states = _state_names(src)
     name = data.get("name", path.stem)
     if not isinstance(name, str):
-        src.key_error(("", None, "name"), f"name must be text, not {name!r}", 'write it in quotes: name = "BumberBot"')
+        src.key_error(("", None, "name"), N_("name must be text, not {value!r}", value=name),
+                      N_('write it in quotes: name = "BumberBot"'))
     # The other stages' sections are read even when the core has mistakes, so that every mistake of the
     # file shows in one go; their readers see the names that did read.
     robot = Robot(
@@ -212,13 +219,14 @@ def _names(src: Source, key: str) -> dict[str, str]:
     if isinstance(section, list):
         section = {str(name): "" for name in section}
     if not isinstance(section, dict):
-        src.key_error(("", None, key), f"[{key}] must be a table of NAME = \"label\"",
-                  'for example: I3 = "front-right bumper"')
+        src.key_error(("", None, key), N_('[{key}] must be a table of NAME = "label"', key=key),
+                      N_('for example: I3 = "front-right bumper"'))
         return {}
     for name, label in section.items():
         if _good_name(src, key, name) and not isinstance(label, str):
-            src.key_error((key, None, name), f"[{key}] {name}: the label must be text, not {label!r}",
-                      f'write it in quotes: {name} = "what it is"')
+            src.key_error((key, None, name), N_("[{key}] {name}: the label must be text, not {label!r}", key=key,
+                                                name=name, label=label),
+                          N_('write it in quotes: {name} = "what it is"', name=name))
     return {name: str(label) for name, label in section.items()}
 
 
@@ -227,8 +235,8 @@ def _good_name(src: Source, key: str, name: str) -> bool:
     if _misplaced(src, key, name):
         return False
     if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-        src.key_error((key, None, name), f"bad {key} name {name!r}",
-                  "use a letter then letters/digits (like I3 or M1), not T, state, timer or next")
+        src.key_error((key, None, name), N_("bad {key} name {name!r}", key=key, name=name),
+                      N_("use a letter then letters/digits (like I3 or M1), not T, state, timer or next"))
         return False
     return True
 
@@ -238,8 +246,9 @@ def _misplaced(src: Source, section: str, key: str) -> bool:
     in that section); reported if so."""
     if key not in TOP_KEYS:
         return False
-    src.key_error((section, None, key), f"{key} is inside [{section}]",
-              f"move {key} = … above the first [section]: every key below [{section}] belongs to it")
+    src.key_error((section, None, key), N_("{key} is inside [{section}]", key=key, section=section),
+                  N_("move {key} = … above the first [section]: every key below [{section}] belongs to it", key=key,
+                     section=section))
     return True
 
 
@@ -247,19 +256,22 @@ def _counters(src: Source, motors: dict[str, str]) -> list[Counter]:
     """``[counters]``: C1 = "M1" (or C1 = {motor = "M1"}), each counting one motor's encoder."""
     section = src.data.get("counters") or {}
     if not isinstance(section, dict):
-        src.key_error(("", None, "counters"), "[counters] must be a table of C1 = \"M1\"",
-                  "each counter names the motor whose encoder it counts")
+        src.key_error(("", None, "counters"), N_('[counters] must be a table of C1 = "M1"'),
+                      N_("each counter names the motor whose encoder it counts"))
         return []
     counters = []
     for name, value in section.items():
         _good_name(src, "counters", name)
         motor = value.get("motor") if isinstance(value, dict) else value
         if isinstance(value, dict) and set(value) != {"motor"}:
-            src.key_error(("counters", None, name), f"counter {name} may only say motor = \"M1\", not "
-                      f"{', '.join(sorted(set(value) - {'motor'})) or 'nothing'}", f'write {name} = "M1"')
+            src.key_error(("counters", None, name), N_('counter {name} may only say motor = "M1", not {keys}',
+                                                        name=name, keys=", ".join(sorted(set(value) - {"motor"}))
+                                                        or N_("nothing")),
+                          N_('write {name} = "M1"', name=name))
         elif not isinstance(motor, str) or motor not in motors:  # a list or table is no motor name (nor hashable)
-            src.key_error(("counters", None, name), f"counter {name} counts motor {motor!r}, which is not in [motors]",
-                      f'write {name} = "M1" with a motor name from [motors]')
+            src.key_error(("counters", None, name), N_("counter {name} counts motor {motor!r}, which is not in "
+                                                        "[motors]", name=name, motor=motor),
+                          N_('write {name} = "M1" with a motor name from [motors]', name=name))
         counters.append(Counter(name, str(motor)))
     return counters
 
@@ -270,16 +282,17 @@ def _distinct(src: Source, sections: dict[str, dict[str, str]]) -> None:
     for key, names in sections.items():
         for name in names:
             if name in first and first[name] != key:
-                src.key_error((first[name], None, name), f"name {name} is used twice ([{first[name]}] and [{key}])",
-                          "inputs, motors, counters and lamps need distinct names")
+                src.key_error((first[name], None, name), N_("name {name} is used twice ([{first}] and [{second}])",
+                                                            name=name, first=first[name], second=key),
+                              N_("inputs, motors, counters and lamps need distinct names"))
             first.setdefault(name, key)
 
 
-def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], want: str, hint: str) -> int:
-    """A top-level whole number within ``bounds`` (``default`` when absent or after reporting why not)."""
+def _whole(src: Source, key: str, default: int, bounds: tuple[int, int], wrong: str, hint: str) -> int:
+    """A top-level whole number within ``bounds`` (``default`` when absent or after reporting ``wrong``)."""
     value = src.data.get(key, default)
     if not isinstance(value, int) or isinstance(value, bool) or not bounds[0] <= value <= bounds[1]:
-        src.key_error(("", None, key), f"{key} must be {want}, not {value!r}", hint)
+        src.key_error(("", None, key), wrong, hint)
         return default
     return value
 
@@ -288,8 +301,8 @@ def _match(src: Source) -> Match:
     """``match = "document"`` or ``"always"`` (DEFAULT_MATCH when the file does not say)."""
     value = src.data.get("match", DEFAULT_MATCH)
     if value not in MATCHES:
-        src.key_error(("", None, "match"), f'match must be "{MATCH_DOCUMENT}" or "{MATCH_ALWAYS}", not {value!r}',
-                      MATCH_HINT)
+        src.key_error(("", None, "match"), N_('match must be "{document}" or "{always}", not {value!r}',
+                                              document=MATCH_DOCUMENT, always=MATCH_ALWAYS, value=value), MATCH_HINT)
         return DEFAULT_MATCH
     return cast(Match, value)  # one of MATCHES, checked above
 
@@ -312,12 +325,12 @@ def _initial_state(src: Source) -> StateId:
         if isinstance(tables, dict) and tables:  # each table says its own ([tables], tablebot.robot_tables)
             first = next(iter(tables.values()))
             return _state_id(first.get("initial_state") if isinstance(first, dict) else None) or 0
-        src.out.error(None, None, "initial_state is missing", "add a line like: initial_state = 2")
+        src.out.error(None, None, N_("initial_state is missing"), N_("add a line like: initial_state = 2"))
         return 0
     state = _state_id(src.data["initial_state"])
     if state is None:
-        src.key_error(("", None, "initial_state"), f"initial_state {src.data['initial_state']!r} is not a state",
-                  STATE_HINT)
+        src.key_error(("", None, "initial_state"), N_("initial_state {value!r} is not a state",
+                                                      value=src.data["initial_state"]), STATE_HINT)
         return 0
     return state
 
@@ -326,8 +339,8 @@ def _state_names(src: Source) -> dict[StateId, str]:
     """``[states]``: NUMBER = "name", the names people read for the table's states."""
     section = src.data.get("states") or {}
     if not isinstance(section, dict):
-        src.key_error(("", None, "states"), "[states] must be a table of NUMBER = \"name\"",
-                  'for example: 20 = "collision"')
+        src.key_error(("", None, "states"), N_('[states] must be a table of NUMBER = "name"'),
+                      N_('for example: 20 = "collision"'))
         return {}
     names: dict[StateId, str] = {}
     for key, label in section.items():
@@ -335,10 +348,11 @@ def _state_names(src: Source) -> dict[StateId, str]:
         if _misplaced(src, "states", key):
             continue
         if state is None:
-            src.key_error(("states", None, key), f"[states] {key!r} is not a state", STATE_HINT)
+            src.key_error(("states", None, key), N_("[states] {key!r} is not a state", key=key), STATE_HINT)
         elif not isinstance(label, str):
-            src.key_error(("states", None, key), f"[states] {key}: the name must be text, not {label!r}",
-                      f'write it in quotes: {key} = "seek"')
+            src.key_error(("states", None, key), N_("[states] {key}: the name must be text, not {label!r}", key=key,
+                                                    label=label),
+                          N_('write it in quotes: {key} = "seek"', key=key))
         else:
             names[state] = label
     return names
