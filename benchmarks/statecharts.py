@@ -18,6 +18,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import TickInput, load_inputs
@@ -54,7 +55,7 @@ def engine(machine: Machine, ticks: list[TickInput]) -> tuple[float, list[str]]:
     return time.perf_counter() - start, states
 
 
-def statemachine(text: str, payloads: list[dict[str, int]]) -> tuple[float, list[str]]:
+def statemachine(text: str, payloads: list[dict[str, Any]]) -> tuple[float, list[str]]:
     from statemachine.io import load
 
     robot = load(text, format="scxml")()
@@ -85,7 +86,8 @@ def main() -> int:
     table = load_table(ROOT / "examples" / "bumberbot" / "table.csv")
     machine = compile_table(table)
     ticks = load_inputs(ROOT / "examples" / "bumberbot" / "inputs.csv", machine)
-    payloads = [{name: int(bool(t.mask & bit)) for name, bit in machine.input_bits.items()} for t in ticks]
+    payloads: list[dict[str, Any]] = [{name: int(bool(t.mask & bit)) for name, bit in machine.input_bits.items()}
+                                      for t in ticks]
     scxml, config = export_scxml([table]), export_xstate([table])
     with tempfile.TemporaryDirectory() as folder:
         runs = {"Engine.step (baseline)": [engine(machine, ticks) for _ in range(repeats)],
