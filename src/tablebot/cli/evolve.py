@@ -12,6 +12,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORLD_OPT, stops
+from tablebot.i18n import _, localise
 
 EVOLVE_WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local worker threads for the fleet, and prover "
                                   "processes (default: one per core; 1 proves in this process).")
@@ -70,21 +71,21 @@ def evolve_cmd(
                                  seed=seed, backend=backend, scheduler=scheduler, workers=workers,
                                  progress=CountBar(quiet))
     if not quiet:
-        console.print(evolved.report_text(), markup=False)
+        console.print(localise(evolved.report_text()), markup=False)
         console.print(_pace(evolved.outcome, evolved.plan, evolved.wall_s), markup=False)
         for path in evolved.files:
-            err_console.print(f"wrote {path}", markup=False)
+            err_console.print(_("wrote {path}").format(path=path), markup=False)
 
 
 def _pace(outcome: Any, plan: Any, wall: float) -> str:
     """The run's pace: tables and robot-ticks of the search per second of the fleet's time (the fresh-seed
     check after it not counted); a resumed run says how many tables it took from the folder."""
     counts = outcome.counts
-    said = f"({len(outcome.order)} tables in {wall:.0f} s"
+    said = _("({tables} tables in {seconds:.0f} s").format(tables=len(outcome.order), seconds=wall)
     if counts.resumed:
-        said += f", {counts.resumed} of them from the earlier run in this folder"
+        said += _(", {n} of them from the earlier run in this folder").format(n=counts.resumed)
     if counts.evaluated and counts.fleet_s > 0:
         ticks = counts.evaluated * plan.spec.total * plan.spec.ticks
-        said += (f"; the search ran {counts.evaluated / counts.fleet_s:.1f} tables/s, "
-                 f"{ticks / counts.fleet_s / 1e6:.2f} M robot-ticks/s on the fleet")
+        said += _("; the search ran {tables:.1f} tables/s, {rate:.2f} M robot-ticks/s on the fleet").format(
+            tables=counts.evaluated / counts.fleet_s, rate=ticks / counts.fleet_s / 1e6)
     return said + ")"

@@ -21,8 +21,9 @@ from tablebot.cli.common import (
     load,
     out_file,
 )
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import fail, severity_word
 from tablebot.escape import plain, shell_word, terminal
+from tablebot.i18n import N_, _, localise, ngettext
 
 if TYPE_CHECKING:  # the firmware tools are imported when a command runs: `--help` stays quick
     from tablebot.firmware.build import Firmware
@@ -37,12 +38,12 @@ OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: bu
 
 
 def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) -> Firmware:
-    _, machine = load(table, robot)
+    machine = load(table, robot)[1]
     backend = registry.exporter(board.value)
     assert backend is not None  # --board's choices are the registered boards
     done = backend.export(machine, out, registry.ExportOptions())
     for line in done.lines:
-        console.print(terminal(line))
+        console.print(terminal(str(localise(line))))
     return done.value
 
 
@@ -72,7 +73,7 @@ def flash_cmd(
     from tablebot.firmware.flash import NOTES, avrdude_command, check_hex, flash
 
     if not port.strip():
-        raise fail("--port", "the port is empty", "give the board's serial port, such as /dev/ttyACM0 or COM3")
+        raise fail("--port", N_("the port is empty"), N_("give the board's serial port, such as /dev/ttyACM0 or COM3"))
     if table.suffix.lower() == ".hex":
         check_hex(table)
         hexfile = table
@@ -83,11 +84,12 @@ def flash_cmd(
     if dry_run:
         return
     if board.value in NOTES:
-        err_console.print(f"note: {NOTES[board.value]}")
+        err_console.print(f"{severity_word('note')}: {localise(NOTES[board.value])}")
     status = flash(command)
     if status:
-        raise fail("avrdude", f"avrdude failed with exit status {status}", "check --port, the cable and the "
-                   "board; the Uno needs no button, the ftDuino a reset just before")
+        raise fail("avrdude", N_("avrdude failed with exit status {status}", status=status),
+                   N_("check --port, the cable and the board; the Uno needs no button, the ftDuino a reset just "
+                      "before"))
 
 
 @app.command("monitor")
@@ -108,11 +110,11 @@ def monitor_cmd(
     from tablebot.files import PendingFile
     from tablebot.firmware.monitor import chunks_from, monitor
 
-    _, machine = load(table, robot)
+    machine = load(table, robot)[1]
     chunks = chunks_from(source, baud, seconds)
 
     def warn(text: str) -> None:
-        err_console.print(plain(text), markup=False, soft_wrap=True)  # the source is the user's words
+        err_console.print(plain(str(localise(text))), markup=False, soft_wrap=True)  # the source is the user's words
 
     if out is None:
         count = monitor(machine, chunks, sys.stdout, source, ticks, warn)
@@ -121,7 +123,8 @@ def monitor_cmd(
         try:
             count = monitor(machine, chunks, pending.stream, source, ticks, warn)
         except BaseException:  # Ctrl-C on a serial port: keep what came, under a name that says so
-            err_console.print(f"kept the ticks so far in {terminal(str(pending.keep_partial()))}")
+            err_console.print(_("kept the ticks so far in {path}").format(path=terminal(str(pending.keep_partial()))))
             raise
         pending.commit()
-        err_console.print(f"wrote {terminal(str(out))} ({count} ticks)")
+        err_console.print(ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count).format(
+            path=terminal(str(out)), n=count))

@@ -9,8 +9,9 @@ import typer
 
 from tablebot.cli.app import app
 from tablebot.cli.common import err_console, guarded
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import fail, severity_word
 from tablebot.escape import terminal
+from tablebot.i18n import N_, _
 
 if TYPE_CHECKING:
     import socket
@@ -52,14 +53,15 @@ def studio_cmd(
         _warn_network(root, address, access.port)
     shown = LOCAL if address in WILDCARDS else address
     url = access.url(shown, f"table={quote(table)}" if table else "")
-    err_console.print(f"tablebot studio: serving {terminal(str(root))} at", soft_wrap=True)
+    err_console.print(_("tablebot studio: serving {folder} at").format(folder=terminal(str(root))), soft_wrap=True)
     err_console.print(f"  {url}", soft_wrap=True, markup=False)  # whole, never wrapped: it is the key
     if address in WILDCARDS:
         import socket
 
         other = access.url(socket.gethostname(), f"table={quote(table)}" if table else "")
-        err_console.print(f"  {other}  (from other machines)", soft_wrap=True, markup=False)
-    err_console.print("(Ctrl-C stops; each start makes a new token)", soft_wrap=True)
+        err_console.print("  " + _("{address}  (from other machines)").format(address=other), soft_wrap=True,
+                          markup=False)
+    err_console.print(_("(Ctrl-C stops; each start makes a new token)"), soft_wrap=True)
     if table is None:
         _say_no_table(root)
     visited = threading.Event()
@@ -82,11 +84,11 @@ def _loopback(address: str) -> bool:
 
 
 def _warn_network(root: Path, address: str, port: int) -> None:
-    err_console.print(
-        f"[bold red]warning:[/bold red] serving {terminal(str(root))} on {terminal(address)}:{port}, not only "
-        "to this machine: anyone who can reach it and has the address below (with its token) can read the "
-        "folder's tables, robot and world files and traces, and change its tables. The connection is plain "
-        "HTTP: anyone who can watch the network can see the token.", soft_wrap=True)
+    err_console.print(f"[bold red]{severity_word('warning')}:[/bold red] " + _(
+        "serving {folder} on {address}:{port}, not only to this machine: anyone who can reach it and has the "
+        "address below (with its token) can read the folder's tables, robot and world files and traces, and change "
+        "its tables. The connection is plain HTTP: anyone who can watch the network can see the token.").format(
+        folder=terminal(str(root)), address=terminal(address), port=port), soft_wrap=True)
 
 
 def _say_no_table(root: Path) -> None:
@@ -97,9 +99,9 @@ def _say_no_table(root: Path) -> None:
 
     if Workspace(root).listing()["tables"]:
         return  # another table there: the page opens it
-    err_console.print(f"[yellow]note:[/yellow] there is no table in {terminal(str(root))} (a .csv or .tsv whose "
-                      "first line names the state and next columns). Start one from a template, then open it:",
-                      soft_wrap=True)
+    err_console.print(f"[yellow]{severity_word('note')}:[/yellow] " + _(
+        "there is no table in {folder} (a .csv or .tsv whose first line names the state and next columns). Start "
+        "one from a template, then open it:").format(folder=terminal(str(root))), soft_wrap=True)
     for name in TEMPLATES:
         err_console.print(f"  tablebot new my-robot --from {name}", soft_wrap=True, markup=False)
     err_console.print("  tablebot studio my-robot", soft_wrap=True, markup=False)
@@ -108,7 +110,7 @@ def _say_no_table(root: Path) -> None:
 def _root_and_table(where: Path) -> tuple[Path, str | None]:
     """The served folder and the table to open first (relative to it)."""
     if not where.exists():
-        raise fail(where, "no such file or folder", "give a folder that holds a table, or a table file")
+        raise fail(where, N_("no such file or folder"), N_("give a folder that holds a table, or a table file"))
     if where.is_dir():
         first = next((name for name in ("table.csv", "table.tsv") if (where / name).is_file()), None)
         return where.resolve(), first
@@ -127,9 +129,10 @@ def _bind(address: str, port: int) -> socket.socket:
         sock.bind((address, port))
     except OSError as exc:
         sock.close()
-        hint = "choose another --port (0 picks a free one)" if exc.errno == errno.EADDRINUSE else \
-            "give --host an address of this machine"
+        hint = N_("choose another --port (0 picks a free one)") if exc.errno == errno.EADDRINUSE else \
+            N_("give --host an address of this machine")
         raise fail("--port" if exc.errno == errno.EADDRINUSE else "--host",
-                   f"cannot serve on {address}:{port}: {exc.strerror}", hint) from None
+                   N_("cannot serve on {address}:{port}: {reason}", address=address, port=port, reason=exc.strerror),
+                   hint) from None
     sock.listen(64)
     return sock

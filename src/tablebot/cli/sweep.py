@@ -13,6 +13,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.escape import plain
+from tablebot.i18n import _, localise
 
 if TYPE_CHECKING:
     from tablebot.api.sweeping import Sweep
@@ -68,19 +69,20 @@ def stops() -> Iterator[None]:
     try:
         yield
     except Stopped as stopped:
-        err_console.print(f"{stopped.word}: {plain(stopped.kept)}; run the same command again to resume",
-                          markup=False)
+        err_console.print(_("{word}: {kept}; run the same command again to resume").format(
+            word=localise(stopped.word), kept=plain(str(localise(stopped.kept)))), markup=False)
         raise typer.Exit(stopped.exit_code) from None
 
 
 def report(result: Sweep) -> None:
     """Success rate per grid value on standard output; the files written on standard error."""
     for line in result.lines():
-        console.print(plain(line), markup=False)
+        console.print(plain(str(localise(line))), markup=False)
     if result.ran:
         rate = result.ran * result.plan.spec.ticks / max(result.wall_s, 1e-9)
-        console.print(f"[dim]({result.ran:,} runs in {result.wall_s:.1f} s: {rate / 1e6:.2f} M robot-ticks/s)[/dim]")
+        console.print("[dim]" + _("({runs:,} runs in {seconds:.1f} s: {rate:.2f} M robot-ticks/s)").format(
+            runs=result.ran, seconds=result.wall_s, rate=rate / 1e6) + "[/dim]")
     for p in result.files:
-        err_console.print(f"wrote {plain(str(p))}", markup=False)
+        err_console.print(_("wrote {path}").format(path=plain(str(p))), markup=False)
 
 
