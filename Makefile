@@ -30,7 +30,7 @@ test: setup
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .
 	$(MKDOCS)
-	node_modules/.bin/eslint src/tablebot/web/static eslint.config.js
+	node_modules/.bin/eslint src/tablebot/web/static src/tablebot/formats/statecharts eslint.config.js
 
 # The documentation site, from docs/ (mkdocs.yml) into site/: strict, so a warning fails it, a link, anchor or
 # file that is not there and a page made from the code (scripts/docs_reference.py) that is out of date included.
