@@ -172,7 +172,7 @@ def _crash(*args: object, **kwargs: object) -> Never:
 
 
 def test_internal_error_is_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    monkeypatch.setattr("tablebot.cli.core.load", _crash)
+    monkeypatch.setattr("tablebot.cli.core.open_project", _crash)  # what trace calls first
     monkeypatch.setattr(sys, "argv", ["tablebot", "trace", str(EXAMPLE), "--inputs", str(EXAMPLE / "inputs.csv")])
     monkeypatch.delenv("TABLEBOT_DEBUG", raising=False)
     with pytest.raises(SystemExit) as info:
