@@ -8,7 +8,8 @@ from collections.abc import Iterable
 
 from tablebot.analysis.finding import Finding
 from tablebot.analysis.model import Graph, Node
-from tablebot.analysis.names import rows_phrase, state_text, verb
+from tablebot.analysis.names import rows_phrase, state_text
+from tablebot.i18n import N_, Message
 from tablebot.machine import NO_ROW
 
 
@@ -31,17 +32,27 @@ def zero_time_loops(graph: Graph) -> list[Finding]:
         row_objs = [table.rows[i] for i in sorted(rows)]
         states = list(dict.fromkeys(table.rows[i].state for i in sorted(rows)))
         trapped = not _can_escape(graph, component)
-        path = " → ".join(state_text(table, s) for s in states)
-        goes = f"cycles {path}" if len(states) > 1 else f"stays in {path}"
-        message = (f"zero-time loop: {rows_phrase(row_objs)} {verb(row_objs, 'fires', 'fire')} on every "
-                   f"tick with no input pressed, so the robot {goes} without ever waiting")
-        message += (" and no input can ever get it out: it is stuck for good" if trapped
-                    else "; it only leaves when an input arrives")
+        path = state_text(table, states[0]) if len(states) < 2 else _arrows([state_text(table, s) for s in states])
+        goes = N_("cycles {path}", path=path) if len(states) > 1 else N_("stays in {path}", path=path)
+        several = len({r.line for r in row_objs}) > 1
+        message = N_("zero-time loop: {rows} fire on every tick with no input pressed, so the robot {goes} without "
+                     "ever waiting", rows=rows_phrase(row_objs), goes=goes) if several else \
+            N_("zero-time loop: {rows} fires on every tick with no input pressed, so the robot {goes} without ever "
+               "waiting", rows=rows_phrase(row_objs), goes=goes)
+        message = N_("{loop} and no input can ever get it out: it is stuck for good", loop=message) if trapped \
+            else N_("{loop}; it only leaves when an input arrives", loop=message)
         found.append(Finding("zero-time-loop", "error" if trapped else "warning", message,
                              tuple(r.line for r in row_objs),
-                             "load a timer above 0 and wait for T, or wait for an input", states[0],
+                             N_("load a timer above 0 and wait for T, or wait for an input"), states[0],
                              {"states": states}))
     return found
+
+
+def _arrows(states: list[Message]) -> Message:
+    """``a → b → c``, each state in the reader's language."""
+    if len(states) == 2:
+        return N_("{first} → {second}", first=states[0], second=states[1])
+    return N_("{first} → {second}", first=states[0], second=_arrows(states[1:]))
 
 
 def _can_escape(graph: Graph, component: set[Node]) -> bool:
