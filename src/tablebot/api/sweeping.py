@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from tablebot.api.progress import Progress, stopped
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     import numpy as np
@@ -73,17 +74,19 @@ class Sweep:
         from tablebot.fleet.plan import REPORT_COLUMNS, groups
 
         lamps = any(world.lamps for world in self.plan.worlds)
-        out = []
+        out: list[str] = []
         for key, values in groups(self.plan, self.rows(REPORT_COLUMNS)):
             for label, chosen in values:
-                name = key if key == "all runs" else f"{key} {label}"
+                name = N_("all runs") if key == "all runs" else f"{key} {label}"
                 if lamps:
-                    line = f"{sum(int(r['reached']) for r in chosen)}/{len(chosen)} reached the lamp"
+                    line = N_("{reached}/{runs} reached the lamp", reached=sum(int(r["reached"]) for r in chosen),
+                              runs=len(chosen))
                 else:
                     collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
                     metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
-                    line = f"{len(chosen)} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run"
-                out.append(f"{name}: {line}")
+                    line = N_("{runs} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run",
+                              runs=len(chosen), collisions=collisions, metres=metres)
+                out.append(N_("{name}: {result}", name=name, result=line))
         return out
 
     def save(self, folder: PathLike, *, plots: bool = True, trace: Traced = None) -> list[Path]:
