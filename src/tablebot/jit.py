@@ -6,6 +6,7 @@ chosen before numba is first imported; read-only installs and cluster workers th
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import sys
@@ -41,9 +42,11 @@ COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py")
 ROOT = Path(__file__).resolve().parent  # the tablebot package
 
 
+@functools.lru_cache(maxsize=1)
 def sources_digest() -> str:
     """A short digest of the tablebot sources that end up in compiled code (every file that compiles a
-    function, and the constants they read)."""
+    function, and the constants they read). Worked out once a process (reading every source file: tens of ms;
+    a sweep asked twice): the process's cache folder is named after it when it is first imported."""
     digest = hashlib.sha1()
     for path in sorted(ROOT.rglob("*.py")):
         text = path.read_bytes()

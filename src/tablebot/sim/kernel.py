@@ -170,6 +170,21 @@ def move(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays
     observe(s, world.lamps, acc, collisions)
 
 
+@njit(nogil=True)
+def first_readings(S: np.ndarray, p: np.ndarray, world: WorldArrays, rows: np.ndarray, draws: np.ndarray,
+                   bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+    """Robots ``rows`` of ``S`` read their sensors where they start (:func:`sense`, robot ``rows[k]`` moved by
+    noise row ``draws[k, 2:]``) and fold that first row into their summaries (:func:`observe`): a fleet's
+    robots start in one call, not two calls from Python each."""
+    z = np.empty(N_NOISE)
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        for j in range(N_NOISE):
+            z[j] = draws[k, 2 + j]
+        sense(S[i], p, world, z, bits)
+        observe(S[i], world.lamps, acc[i], collisions[i])
+
+
 @njit(nogil=True, inline="always")
 def _scratch(p: np.ndarray, world: WorldArrays, z: np.ndarray) -> Scratch:
     """A robot's working space for one tick of physics alone (no table: no pulses)."""

@@ -191,9 +191,7 @@ class Starter:
         S[rows, L.GAIN_L] = 1.0 + self.spread * draws[:, 1]
         acc[rows] = self.acc
         collisions[rows] = 0
-        for k, i in enumerate(rows):
-            K.sense(S[i], self.p, self.world, draws[k, 2:], self.bits)
-            K.observe(S[i], self.world.lamps, acc[i], collisions[i])
+        K.first_readings(S, self.p, self.world, np.asarray(rows, dtype=np.int64), draws, self.bits, acc, collisions)
 
 
 def light_keys(scene: Scene) -> tuple[str, str]:
