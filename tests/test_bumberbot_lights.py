@@ -8,8 +8,11 @@ import json
 import random
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
+
+import pytest
 
 from tablebot.formats.inputs_csv import TickInput, load_inputs
 from tablebot.formats.trace_lines import dumps
@@ -80,3 +83,12 @@ def test_the_example_checks_its_properties_across_both_tables() -> None:
     assert set(status.values()) == {"holds"}, status
     assert {"lamps_burn_on_the_light", "no_flashing_in_a_collision", "blinks_while_backing_off"} <= set(status)
     assert report["counts"]["error"] == 0 and done.returncode == 0
+
+
+def test_the_simulator_says_it_runs_the_main_table_only() -> None:
+    """Until the simulator runs every table, it says so rather than leave the lamps dark without a word."""
+    with pytest.warns(UserWarning, match=r"robot.toml:31:1: note: the simulator runs the main table \(drive\) only"):
+        Loaded.open(EXAMPLE).scene()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Loaded.open(ORIGINAL).scene()

@@ -143,10 +143,25 @@ class Loaded:
         from tablebot.sim.scene import prepare, robot_layer, scene_for
         from tablebot.sim.world import World
 
+        if self.tables is not None:  # said, not hidden: the lamps of the other tables would stay dark
+            self._main_table_only("the simulator")
         if isinstance(world, World):
             return prepare(self.table, self.machine, world, robot_layer(self.robot)[0], overrides)
         chosen = Path(world) if world is not None else (self.world_files[0] if self.world_files else None)
         return scene_for(self.table, self.machine, chosen, overrides)
+
+    def _main_table_only(self, what: str) -> None:
+        """A note that ``what`` runs only the main table of a robot of several (the others not yet)."""
+        from tablebot.diagnostics import Diagnostic, notify
+
+        assert self.tables is not None
+        others = ", ".join(self.tables.names[1:])
+        robot = self.robot
+        notify(Diagnostic(robot.source, robot.line("tables"), 1,
+                          f"{what} runs the main table ({self.tables.names[0]}) only so far, not {others}: the "
+                          "outputs only they write stay at 0",
+                          "tablebot trace, check and diagram run every table (docs/engine.md, Several tables)",
+                          "note"))
 
     def properties(self) -> list[Property]:
         """The robot file's ``[properties]`` and those of :attr:`property_files`, read and checked."""
