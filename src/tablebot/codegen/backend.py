@@ -15,16 +15,28 @@ if TYPE_CHECKING:
 
 def fit(machine: Machine) -> list[Diagnostic]:
     """What the C engine's data layout cannot hold (also the base of every board's fit)."""
+    from tablebot.tables import several
+
+    tables = several(machine.table)  # a robot of several tables: each must fit
+    machines = (machine,) if tables is None else tables.machines
+    return [found for m in machines for found in _fit_one(m)]
+
+
+def _fit_one(machine: Machine) -> list[Diagnostic]:
     from tablebot.codegen.packing import check_fits, plan
 
     return refused(lambda: check_fits(machine)) or refused(lambda: plan(machine))
 
 
 def export(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
+    from tablebot.codegen.several import generate_several
     from tablebot.codegen.source import generate
+    from tablebot.tables import several
 
     assert out is not None
-    source = generate(machine, options.lookup)  # before the folder is made: a refused table leaves none
+    tables = several(machine.table)  # a robot of several tables: all of them, stepped by tb_robot.c
+    # before the folder is made: a refused table leaves none
+    source = generate(machine, options.lookup) if tables is None else generate_several(tables, options.lookup)
     files = tuple(source.write(out_folder(out, "OUTDIR")))
     kind = "dense" if source.layout.dense else "scan"
     return Exported(files, (*(f"wrote {path}" for path in files),
