@@ -11,8 +11,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from statechart_helpers import random_several, random_ticks
 
+from statechart_helpers import random_several, random_ticks
 from tablebot.codegen.host import build_host_several, find_compiler, run_host_several
 from tablebot.codegen.source import template
 from tablebot.loading import Loaded
