@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
-from tablebot.i18n import N_
+from tablebot.i18n import N_, NP_
 from tablebot.i18n.headers import GERMAN_FIXED
 from tablebot.robot import Robot, StateId
 from tablebot.robot_tables import CrossEvent, tables_of
@@ -187,15 +187,22 @@ def no_event_rows(table: Table) -> list[NoEventRow]:
 def _quiet_tick(table: Table, state: StateId) -> str:
     robot = table.robot
     if TIMER_EVENT not in table.events:
-        counters = " and no counter is at 0" if set(robot.counter_names) & set(table.events) else ""
-        return f"the table has no T column, so a tick on which no input reads 1{counters} has no event"
+        if set(robot.counter_names) & set(table.events):
+            return N_("the table has no T column, so a tick on which no input reads 1 and no counter is at 0 has no "
+                      "event")
+        return N_("the table has no T column, so a tick on which no input reads 1 has no event")
     if state == robot.initial_state and robot.initial_timer > 0:
-        return f"the robot starts in it with timer {robot.initial_timer}, and T is absent until that runs out"
+        return N_("the robot starts in it with timer {timer}, and T is absent until that runs out",
+                  timer=robot.initial_timer)
     slow = [r for r in table.rows if r.next == state and r.timer > 1]
     if not slow:
         return ""
-    more = f" (and {len(slow) - 1} more rows)" if len(slow) > 1 else ""
-    return f"line {slow[0].line} leads into it with timer {slow[0].timer}{more}, and T is absent until that runs out"
+    if len(slow) > 1:
+        return NP_("line {line} leads into it with timer {timer} (and {n} more row), and T is absent until that runs "
+                   "out", "line {line} leads into it with timer {timer} (and {n} more rows), and T is absent until "
+                   "that runs out", len(slow) - 1, line=slow[0].line, timer=slow[0].timer)
+    return N_("line {line} leads into it with timer {timer}, and T is absent until that runs out", line=slow[0].line,
+              timer=slow[0].timer)
 
 
 #: A state that is used but has no rows: (the row whose next state it is, or None when the robot
