@@ -19,10 +19,11 @@ from typing import Any
 from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine, compile_table
-from tablebot.replay import record
+from tablebot.replay import record, replay_several
 from tablebot.table import Table
 from tablebot.testing.harness import CORE, Case, Executor, Run, busy_world, fits_controller, register, wired_for
 from tablebot.testing.serial_executors import SERIAL_EXECUTORS
+from tablebot.testing.several_cases import SeveralCase
 
 
 def _engine_step(case: Case, workdir: Path) -> Run:
@@ -32,6 +33,20 @@ def _engine_step(case: Case, workdir: Path) -> Run:
         engine.step(tick.mask, tick.pulses)
         lines.append(record(engine))
     return Run(list(case.inputs), lines)
+
+
+def _several_step(case: SeveralCase, workdir: Path) -> Run:
+    """:class:`tablebot.engine.several.Several`, its tables stepped last to first (any order gives the same
+    ticks; the reference steps them first to last)."""
+    order = tuple(reversed(range(len(case.tables.machines))))
+    return Run(list(case.inputs), list(replay_several(case.tables, case.inputs, order)))
+
+
+def _host_c_several(case: SeveralCase, workdir: Path) -> Run:
+    from tablebot.codegen.host import build_host_several, run_host_several
+
+    exe = build_host_several(case.tables, workdir / "host")
+    return Run(list(case.inputs), run_host_several(exe, case.tables, case.inputs))
 
 
 def _engine_run(case: Case, workdir: Path) -> Run:
@@ -273,13 +288,14 @@ def _fits_robopro(machine: Machine) -> bool:
 def register_all() -> None:
     """The executors of this tablebot, each once."""
     for executor in (
-        Executor("python step", _engine_step, what="Engine.step: one tick in Python (the path of real robots)"),
+        Executor("python step", _engine_step, several=_several_step,
+                 what="Engine.step: one tick in Python (the path of real robots)"),
         Executor("engine batch", _engine_run, fits=lambda m: m.arrays is not None,
                  what="Engine.run: tick.tick compiled by numba over recorded masks"),
         Executor("simulator", _simulator, fits=_sim_fits,
                  what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.kernel, compiled)"),
         Executor("fleet", _fleet, fits=_sim_fits, what="a robot of a fleet (fleet.kernel.run_fleet, compiled)"),
-        Executor("host C", _host_c, missing=_no_compiler,
+        Executor("host C", _host_c, missing=_no_compiler, several=_host_c_several,
                  what="the generated C engine compiled for this computer (codegen.host)"),
         Executor("AVR firmware", _avr_firmware, missing=_no_avr, fits=_fits_uno,
                  what="the Uno firmware under simavr, its UART trace decoded"),

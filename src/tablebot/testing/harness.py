@@ -22,12 +22,15 @@ import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine, compile_table
 from tablebot.replay import replay
 from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.testing.several_cases import SeveralCase
 
 #: The core fields every executor reports for every tick.
 CORE = ("tick", "event", "row", "state", "timer")
@@ -64,6 +67,8 @@ class Executor:
     fits: Callable[[Machine], bool] = lambda machine: True
     rules: tuple[str, ...] = ("always",)
     what: str = ""  # which path of tablebot this is, in a few words
+    #: How it runs a robot of several tables (:mod:`tablebot.testing.several_cases`), None if it runs one table.
+    several: Callable[[SeveralCase, Path], Run] | None = None
 
 
 EXECUTORS: dict[str, Executor] = {}

@@ -1,0 +1,86 @@
+"""The differential harness for robots of several tables (issue 36 §2): every executor that runs several tables
+(:attr:`tablebot.testing.harness.Executor.several`) takes a :class:`SeveralCase` (a robot's tables and recorded
+inputs in the robot-wide layout of :attr:`RobotTables.input_bits`) and returns a :class:`~tablebot.testing.harness.Run`
+whose lines are keyed as :func:`tablebot.replay.record_several` keys a trace (the main table's ``tick, event, row,
+state, timer``, the robot's outputs and counters, ``NAME.event, NAME.row, NAME.state, NAME.timer`` of each other
+table). :func:`several_differences` holds it to :class:`tablebot.engine.several.Several` tick by tick;
+:func:`check_several` runs every registered executor and says which cannot run several tables yet."""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from tablebot.formats.inputs_csv import TickInput
+from tablebot.replay import replay_several
+from tablebot.tables import RobotTables
+from tablebot.testing.harness import EXECUTORS, Report, Run
+
+__all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks"]
+
+
+@dataclass(frozen=True)
+class SeveralCase:
+    """A robot of several tables and recorded inputs to run it on (``seed``: where they came from)."""
+
+    tables: RobotTables
+    inputs: tuple[TickInput, ...]
+    seed: int = 0
+
+
+def several_ticks(rng: random.Random, tables: RobotTables, count: int, density: float = 0.4) -> list[TickInput]:
+    """Inputs for a robot of several tables: many ticks with no input at all (where the two matching rules
+    part), encoder pulses for every counter."""
+    width, counters = len(tables.input_bits), len(tables.robot.counters)
+    return [TickInput(rng.randrange(1 << width) if rng.random() < density else 0,
+                      tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters))) for _ in range(count)]
+
+
+def random_several_case(seed: int, folder: Path, ticks: int = 240) -> SeveralCase:
+    """A random robot of 2-3 tables (:mod:`tablebot.testing.random_robots`, written as a user's files into
+    ``folder`` and read back) and random inputs for it."""
+    from tablebot.loading import Loaded
+    from tablebot.testing.random_robots import RobotShape, random_robot
+
+    rng = random.Random(seed)
+    tables = Loaded.open(random_robot(rng, folder, RobotShape(tables=2 + seed % 2)) / "t0.csv").tables
+    assert tables is not None
+    return SeveralCase(tables, tuple(several_ticks(rng, tables, ticks)), seed)
+
+
+def several_differences(tables: RobotTables, run: Run, order: Sequence[int] | None = None) -> str | None:
+    """The first tick where ``run`` disagrees with :class:`~tablebot.engine.several.Several` (stepping its
+    tables in ``order``) on the inputs it read, or None. Every key of the engine's line must be reported."""
+    expected = list(replay_several(tables, run.inputs, order))
+    if len(run.lines) != len(expected):
+        return f"{len(run.lines)} ticks reported for {len(expected)} inputs"
+    for line, want in zip(run.lines, expected, strict=True):
+        missing = [key for key in want if key not in line]
+        if missing:
+            return f"tick {want['tick']}: no {', '.join(missing)} reported"
+        for key, value in line.items():
+            if want.get(key, value) != value:
+                return f"tick {want['tick']}: {key} is {value!r}, the engine says {want[key]!r} ({want})"
+    return None
+
+
+def check_several(case: SeveralCase, workdir: Path, names: Sequence[str] | None = None) -> Report:
+    """Run every registered executor (or ``names``) that runs several tables on ``case`` and compare each with
+    the engine; the others are skipped, saying so."""
+    report = Report()
+    for name in names or list(EXECUTORS):
+        executor = EXECUTORS[name]
+        why = executor.missing() or (None if executor.several else "runs one table only")
+        if why or executor.several is None:
+            report.skipped[name] = why or ""
+            continue
+        folder = workdir / name.replace(" ", "-")
+        folder.mkdir(parents=True, exist_ok=True)
+        difference = several_differences(case.tables, executor.several(case, folder))
+        if difference is None:
+            report.agreed.append(name)
+        else:
+            report.differ[name] = difference
+    return report
