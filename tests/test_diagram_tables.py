@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from tablebot.analysis.diagram import render
+from tablebot.analysis.diagram_tables import render_tables
 from tablebot.loading import Loaded
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot-lights"
@@ -15,7 +15,8 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bumberbot-lights"
 
 def test_one_diagram_per_table_with_cross_table_events_labelled() -> None:
     loaded = Loaded.open(EXAMPLE)
-    source = render(loaded.table, "dot", tables=loaded.tables).decode()
+    assert loaded.tables is not None
+    source = render_tables(loaded.tables, "dot").decode()
     assert "subgraph cluster_0 {" in source and "subgraph cluster_1 {" in source
     assert "<b>main table drive</b>" in source and "<b>table lights</b>" in source
     assert "drive___start -> drive_s_2 [" in source and "lights___start -> lights_s_flash_left [" in source

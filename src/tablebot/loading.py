@@ -174,9 +174,11 @@ class Loaded:
         """``check``'s exploration, findings and proofs of :meth:`properties` (or ``properties``, read
         already); ``targets``: export targets whose limits to check too; ``step`` is told what starts next."""
         from tablebot.analysis.check import run_check
+        from tablebot.analysis.check_tables import run_check_tables
 
         props = self.properties() if properties is None else properties
-        report = run_check(self.machine, props, tuple(targets), step, self.tables)
+        report = (run_check_tables(self.tables, props, tuple(targets), step) if self.tables is not None
+                  else run_check(self.machine, props, tuple(targets), step))
         report.property_files = list(self.property_files)
         return report
 

@@ -59,13 +59,9 @@ class CheckReport:
 
 
 def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = (),
-              step: Callable[[str], None] = lambda what: None, tables: RobotTables | None = None) -> CheckReport:
+              step: Callable[[str], None] = lambda what: None) -> CheckReport:
     """Explore, find, prove; ``step`` is told what starts next (a progress display). A robot of several
-    ``tables`` (``machine`` the main one's): see :func:`tablebot.analysis.check_tables.run_check_tables`."""
-    if tables is not None:
-        from tablebot.analysis.check_tables import run_check_tables
-
-        return run_check_tables(tables, props, targets, step)
+    tables: :func:`tablebot.analysis.check_tables.run_check_tables`."""
     try:
         step(N_("exploring the situations"))
         graph = Model(machine).explore()
@@ -95,12 +91,9 @@ def write_counterexamples(report: CheckReport, outdir: Path) -> None:
     report.counterexamples.update(written)
 
 
-def story(machine: Machine, result: Result, limit: int = 12, tables: RobotTables | None = None) -> list[str]:
-    """What happens in a counterexample, tick by tick, with quiet stretches folded into one line."""
-    if tables is not None:
-        from tablebot.analysis.check_tables import story_of_tables
-
-        return story_of_tables(tables, result, limit)
+def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:
+    """What happens in a counterexample, tick by tick, with quiet stretches folded into one line (several
+    tables: :func:`tablebot.analysis.check_tables.story_of_tables`)."""
     lines = list(replay(machine, result.inputs))
     items: list[str] = []
     quiet_from = None

@@ -15,7 +15,6 @@ from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
-from tablebot.tables import RobotTables
 
 FORMATS = ("svg", "png", "dot", "mermaid")
 PNG_DPI = 150  # Graphviz's default 72 dpi draws 9-point labels a few pixels high
@@ -221,19 +220,16 @@ def _legend(table: Table, colour: bool) -> str:
     return f'<<table border="1" cellborder="0" cellspacing="1" color="#999999">{body}</table>>'
 
 
-def render(table: Table, fmt: str, colour: bool = True, tables: RobotTables | None = None) -> bytes:
-    """The diagram as file contents in ``fmt`` (one of FORMATS); a robot of several ``tables`` gets one diagram
-    per table, side by side (:mod:`tablebot.analysis.diagram_tables`)."""
-    if tables is not None:
-        from tablebot.analysis.diagram_tables import tables_graphviz, tables_mermaid
-
-        if fmt == "mermaid":
-            return tables_mermaid(tables).encode()
-        graph = tables_graphviz(tables, colour)
-    elif fmt == "mermaid":
+def render(table: Table, fmt: str, colour: bool = True) -> bytes:
+    """The diagram as file contents in ``fmt`` (one of FORMATS); a robot of several tables:
+    :func:`tablebot.analysis.diagram_tables.render_tables`."""
+    if fmt == "mermaid":
         return to_mermaid(table).encode()
-    else:
-        graph = to_graphviz(table, colour)
+    return drawn(to_graphviz(table, colour), fmt)
+
+
+def drawn(graph: graphviz.Digraph, fmt: str) -> bytes:
+    """A Graphviz diagram as file contents in ``fmt`` (dot, svg or png)."""
     if fmt == "dot":
         return graph.source.encode()
     if fmt == "png":

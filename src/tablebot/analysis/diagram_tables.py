@@ -6,9 +6,16 @@ from __future__ import annotations
 
 import graphviz
 
-from tablebot.analysis.diagram import COLOURS, digraph, draw_table, event_label, mermaid_lines
+from tablebot.analysis.diagram import COLOURS, digraph, draw_table, drawn, event_label, mermaid_lines
 from tablebot.escape import dot_id, dot_label, mermaid_label
 from tablebot.tables import RobotTables
+
+
+def render_tables(tables: RobotTables, fmt: str, colour: bool = True) -> bytes:
+    """The diagram of every table of the robot as file contents in ``fmt`` (one of diagram.FORMATS)."""
+    if fmt == "mermaid":
+        return tables_mermaid(tables).encode()
+    return drawn(tables_graphviz(tables, colour), fmt)
 
 
 def tables_graphviz(tables: RobotTables, colour: bool = True) -> graphviz.Digraph:

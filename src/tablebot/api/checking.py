@@ -116,8 +116,11 @@ class Check:
     def story(self, result: Result) -> list[str]:
         """What happens in a property's counterexample, tick by tick (quiet stretches folded)."""
         from tablebot.analysis.check import story
+        from tablebot.analysis.check_tables import story_of_tables
 
-        return story(self.report.machine, result, tables=self.report.tables)
+        if self.report.tables is not None:  # a robot of several tables: each table's line, each tick
+            return story_of_tables(self.report.tables, result)
+        return story(self.report.machine, result)
 
 
 def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | None = None) -> Check:

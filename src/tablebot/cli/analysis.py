@@ -242,10 +242,11 @@ def diagram_cmd(
                    N_("use one of {formats} (--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, "
                       ".mmd)", formats=", ".join(FORMATS)))
     from tablebot.analysis.diagram import render
+    from tablebot.analysis.diagram_tables import render_tables
     from tablebot.files import write_bytes
 
-    project = open_project(table, robot)
-    data = render(project.table, fmt, colour, project.tables)  # a robot of several tables: one diagram each
+    project = open_project(table, robot)  # a robot of several tables: one diagram each
+    data = render_tables(project.tables, fmt, colour) if project.tables else render(project.table, fmt, colour)
     if out is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()
