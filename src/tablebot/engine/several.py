@@ -72,7 +72,7 @@ class Several:
             for name, value in inputs.items():
                 if name not in bits:
                     raise ValueError(f"unknown input {name!r}; the robot's tables read {', '.join(bits) or 'none'}")
-                if value not in (0, 1) or isinstance(value, bool):
+                if value not in (0, 1) or not isinstance(value, int | np.integer):  # as Engine.events_of
                     raise ValueError(f"input {name!r}: {value!r} is not 0 or 1")
                 mask |= bits[name] if value else 0
             return mask
