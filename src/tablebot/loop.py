@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from tablebot.engine import Engine
+from tablebot.engine.as_one import RobotEngine
 from tablebot.interrupts import Terminated
 
 if TYPE_CHECKING:
@@ -87,9 +88,12 @@ class TickBlock:
         return len(self.events)
 
     @staticmethod
-    def of_tick(engine: Engine, reading: Reading, extra: Mapping[str, Any] | None = None) -> TickBlock:
-        """The tick the engine just made, after ``reading``."""
+    def of_tick(engine: Engine | RobotEngine, reading: Reading, extra: Mapping[str, Any] | None = None) -> TickBlock:
+        """The tick the engine just made, after ``reading`` (a robot of several tables: the main table's
+        decisions, the other tables' as extra fields)."""
         fields = {**(reading.extra or {}), **(extra or {})}
+        if isinstance(engine, RobotEngine):
+            fields.update(engine.fields())
         return TickBlock(engine.tick - 1, [reading.mask], [reading.pulses], [engine.event], [engine.row],
                          [engine.state], [engine.timer], [engine.outputs], [tuple(engine.counters)],
                          {k: [v] for k, v in fields.items()})
@@ -99,7 +103,7 @@ class TickBlock:
 class RunInfo:
     """What sinks learn when the run starts."""
 
-    engine: Engine
+    engine: Engine | RobotEngine
     tick_s: float
     target: str  # "sim", "txt://192.168.7.2", ...
     ticks: int | None  # planned length, None = until stopped
@@ -366,7 +370,7 @@ class _Behind(Exception):
 BLOCK_TICKS = 4096  # ticks per block on the compiled path: few Python round trips, bounded memory
 
 
-def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Sequence[Sink] = (),
+def run(engine: Engine | RobotEngine, robot: RobotIO, *, clock: Clock | None = None, sinks: Sequence[Sink] = (),
         ticks: int | None = None, watchdog: Watchdog | None = None, target: str = "",
         behind_limit_s: float | None = None, block_ticks: int = BLOCK_TICKS) -> RunEnd:
     """Drive ``robot`` with ``engine`` for ``ticks`` ticks (None: until stopped) and return why it ended.
@@ -390,7 +394,7 @@ def run(engine: Engine, robot: RobotIO, *, clock: Clock | None = None, sinks: Se
                 sink.start(info)
                 started.append(sink)
             clock.start()
-            if clock.free_running and isinstance(robot, BlockIO):
+            if clock.free_running and isinstance(robot, BlockIO) and isinstance(engine, Engine):
                 _run_blocks(engine, robot, started, ticks, block_ticks, stop)
             else:
                 _run_ticks(engine, robot, clock, started, ticks, watchdog, late, pace, stop)
@@ -430,7 +434,7 @@ def _end_sinks(sinks: Sequence[Sink], end: RunEnd) -> Exception | None:
     return first
 
 
-def exchange(engine: Engine, robot: RobotIO) -> Reading:
+def exchange(engine: Engine | RobotEngine, robot: RobotIO) -> Reading:
     """One tick's work with a robot: read it, step the engine on what it read, write the outputs; returns the
     reading. The loop does this every tick (inside the watchdog); so does the Gymnasium env when the table
     drives, so that a tick means the same everywhere."""
@@ -439,7 +443,7 @@ def exchange(engine: Engine, robot: RobotIO) -> Reading:
     return reading
 
 
-def _run_ticks(engine: Engine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
+def _run_ticks(engine: Engine | RobotEngine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
                watchdog: Watchdog, late: Lateness, pace: Pace | None, stop: StopRequest) -> None:
     """One tick at a time: the path of real robots and of the real-time rehearsal."""
     while ticks is None or engine.tick < ticks:

@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
     from tablebot.registry import LiveBackend, Opened
+    from tablebot.tables import RobotTables
 
 
 def address_hint() -> str:
@@ -66,6 +67,9 @@ class Connection:
     project: Loaded
     opened: Opened
     behind_limit: float
+    #: A robot of several tables on a controller: all of them, stepped together (the simulator, whose compiled
+    #: robot runs the main table and says so, gets None).
+    tables: RobotTables | None = None
 
     def run(self, seconds: float | None = None, out: PathLike | None = None, sinks: Sequence[Sink] = (),
             progress: Progress | None = None) -> LiveRun:
@@ -73,6 +77,7 @@ class Connection:
         tick (the command's live view); with ``out`` the trace and summary are written there as it goes. The
         robot's outputs are off on every way out."""
         from tablebot.engine import Engine
+        from tablebot.engine.as_one import RobotEngine
         from tablebot.files import out_folder
         from tablebot.loop import RealTimeClock, run
         from tablebot.sinks.run_trace import RunTrace
@@ -84,7 +89,8 @@ class Connection:
         switch = sys.getswitchinterval()
         sys.setswitchinterval(0.001)  # a live view's thread hands the interpreter back within 1 ms, not 5
         try:
-            end = run(Engine(machine), self.opened.robot, clock=RealTimeClock(tick_s),
+            engine = RobotEngine(self.tables) if self.tables is not None else Engine(machine)
+            end = run(engine, self.opened.robot, clock=RealTimeClock(tick_s),
                       sinks=[*sinks, *([trace] if trace is not None else [])], ticks=ticks, target=self.opened.where,
                       behind_limit_s=self.behind_limit or None)
         finally:
@@ -98,8 +104,12 @@ def connect(project: Loaded, on: str, *, link_timeout: float | None = None, behi
     ``sim`` or ``sim:WORLD.toml``, ...) for the table: ``link_timeout`` seconds without a valid reply end a
     run as ``link_lost`` (default: 5 ticks); a run ends as ``behind`` when the table's time falls
     ``behind_limit`` seconds behind the wall clock within any 5 s (0: never); ``seed``: the simulator's."""
+    from tablebot.engine.as_one import robot_machine
     from tablebot.registry import LinkOptions
 
     link = LinkOptions(on, link_timeout_s=link_timeout, behind_limit_s=behind_limit, seed=seed, hint=address_hint())
-    opened = live_backend(on).open(project.machine, link)
-    return Connection(project, opened, behind_limit)
+    backend = live_backend(on)
+    tables = project.tables if backend.name != "sim" else None
+    # a controller of a robot of several tables is wired for every input any table reads (the robot's layout)
+    opened = backend.open(project.machine if tables is None else robot_machine(tables), link)
+    return Connection(project, opened, behind_limit, tables)

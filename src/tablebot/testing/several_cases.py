@@ -8,17 +8,21 @@ table). :func:`several_differences` holds it to :class:`tablebot.engine.several.
 
 from __future__ import annotations
 
+import dataclasses
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from tablebot.engine.as_one import robot_machine
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.machine import Machine
 from tablebot.replay import replay_several
 from tablebot.tables import RobotTables
-from tablebot.testing.harness import EXECUTORS, Report, Run
+from tablebot.testing.harness import EXECUTORS, Report, Run, wired_for
 
-__all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks"]
+__all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks",
+           "wired_robot"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,14 @@ def random_several_case(seed: int, folder: Path, ticks: int = 240) -> SeveralCas
     return SeveralCase(tables, tuple(several_ticks(rng, tables, ticks)), seed)
 
 
+def wired_robot(tables: RobotTables, section: str) -> Machine:
+    """What a controller of a robot of several tables is wired for (:func:`tablebot.engine.as_one.robot_machine`:
+    the robot-wide input layout), its robot file given the section ``section`` as
+    :func:`tablebot.testing.harness.wired_for` writes it."""
+    wired = wired_for(tables.table, section)
+    return dataclasses.replace(robot_machine(tables), table=wired.table)
+
+
 def several_differences(tables: RobotTables, run: Run, order: Sequence[int] | None = None) -> str | None:
     """The first tick where ``run`` disagrees with :class:`~tablebot.engine.several.Several` (stepping its
     tables in ``order``) on the inputs it read, or None. Every key of the engine's line must be reported."""
@@ -72,7 +84,8 @@ def check_several(case: SeveralCase, workdir: Path, names: Sequence[str] | None 
     report = Report()
     for name in names or list(EXECUTORS):
         executor = EXECUTORS[name]
-        why = executor.missing() or (None if executor.several else "runs one table only")
+        why = executor.missing() or (None if executor.several else "runs one table only") or (
+            None if executor.fits(robot_machine(case.tables)) else "does not take this robot")
         if why or executor.several is None:
             report.skipped[name] = why or ""
             continue
