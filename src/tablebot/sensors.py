@@ -18,6 +18,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from tablebot.i18n import N_, NP_
 from tablebot.tomlfile import Source, is_number
 
 KEYS = ("sensor", "at", "angle", "below", "above", "hysteresis")
@@ -172,8 +173,8 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
     if section is None:
         return ()
     if not isinstance(section, dict):
-        src.key_error(("", None, "sensors"), "[sensors] must be a table of INPUT = { sensor = ... }",
-                  'for example: I1 = { sensor = "line", at = [0.1, 0.01] }')
+        src.key_error(("", None, "sensors"), N_("[sensors] must be a table of INPUT = { sensor = ... }"),
+                      N_('for example: I1 = { sensor = "line", at = [0.1, 0.01] }'))
         return ()
     found = [_sensor(src, name, value, inputs) for name, value in section.items()]
     return tuple(s for s in found if s is not None)
@@ -182,22 +183,25 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
 def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Sensor | None:
     where = ("sensors", None, name)
     if name not in inputs:
-        src.key_error(where, f"[sensors] {name} is not an input of the robot",
-                  f"add {name} to [inputs] first (its column in the table is the sensor's event)")
+        src.key_error(where, N_("[sensors] {name} is not an input of the robot", name=name),
+                      N_("add {name} to [inputs] first (its column in the table is the sensor's event)", name=name))
         return None
     if not isinstance(value, dict):
-        src.key_error(where, f"[sensors] {name} must be a table like {{ sensor = \"distance\", ... }}, not {value!r}",
-                  f'for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}')
+        src.key_error(where, N_('[sensors] {name} must be a table like {{ sensor = "distance", ... }}, not {value!r}',
+                                name=name, value=value),
+                      N_('for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}', name=name))
         return None
     unknown = sorted(set(value) - set(KEYS))
     if unknown:
-        src.key_error(where, f"[sensors] {name}: unknown key{'s' * (len(unknown) > 1)} {', '.join(unknown)}",
-                  f"known keys: {', '.join(KEYS)}")
+        src.key_error(where, NP_("[sensors] {name}: unknown key {keys}", "[sensors] {name}: unknown keys {keys}",
+                                 len(unknown), name=name, keys=", ".join(unknown)),
+                      N_("known keys: {known}", known=", ".join(KEYS)))
     model = value.get("sensor")
     words = word_kinds()
     if model not in words:
-        src.key_error(where, f"[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows",
-                  f"write sensor = one of {', '.join(repr(k) for k in words)}")
+        src.key_error(where, N_("[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows", name=name,
+                                model=model),
+                      N_("write sensor = one of {kinds}", kinds=", ".join(repr(k) for k in words)))
         return None
     kind = SENSOR_KINDS[words[model]]
     at = _at(src, name, value.get("at"))
@@ -219,16 +223,18 @@ def _unthresholded(src: Source, name: str, model: str, kind: SensorKind, value: 
     """A kind without a threshold (a floor sensor reads the floor straight below it): no direction, no angle."""
     extra = [k for k in ("below", "above", "hysteresis", "angle") if k in value]
     if extra:
-        src.key_error(("sensors", None, name), f"[sensors] {name}: a {kind.name} sensor has no {', '.join(extra)}",
-                  f"it reads {kind.reads} and 0 elsewhere; give only sensor and at")
+        src.key_error(("sensors", None, name), N_("[sensors] {name}: a {kind} sensor has no {keys}", name=name,
+                                                  kind=kind.name, keys=", ".join(extra)),
+                      N_("it reads {reads} and 0 elsewhere; give only sensor and at", reads=kind.reads))
     return None if at is None or angle is None or extra else Sensor(name, model, at)
 
 
 def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
     ok = isinstance(value, list) and len(value) == 2 and all(is_number(v) and abs(v) <= MAX_OFFSET for v in value)
     if not ok:
-        src.key_error(("sensors", None, name), f"[sensors] {name}: at must be [forward, left] in metres from the axle "
-                  f"centre, not {value!r}", f"for example: at = [0.12, 0] (each within ±{MAX_OFFSET:g} m)")
+        src.key_error(("sensors", None, name), N_("[sensors] {name}: at must be [forward, left] in metres from the "
+                                                  "axle centre, not {value!r}", name=name, value=value),
+                      N_("for example: at = [0.12, 0] (each within ±{most:g} m)", most=MAX_OFFSET))
         return None
     return float(value[0]), float(value[1])
 
@@ -236,8 +242,9 @@ def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
 def _angle(src: Source, name: str, value: dict[str, Any]) -> float | None:
     angle = value.get("angle", 0.0)
     if not is_number(angle) or not -180 <= angle <= 180:
-        src.key_error(("sensors", None, name), f"[sensors] {name}: angle must be degrees from -180 to 180, "
-                  f"not {angle!r}", "0 points straight ahead, positive to the left")
+        src.key_error(("sensors", None, name), N_("[sensors] {name}: angle must be degrees from -180 to 180, not "
+                                                  "{angle!r}", name=name, angle=angle),
+                      N_("0 points straight ahead, positive to the left"))
         return None
     return float(angle)
 
@@ -248,9 +255,12 @@ def _threshold(src: Source, name: str, model: str, kind: SensorKind,
     given = [k for k in ("below", "above") if k in value]
     if len(given) != 1:
         example = kind.example
-        src.key_error(("sensors", None, name), f"[sensors] {name}: a {model} sensor needs "
-                  f"{'one of below or above, not both' if given else 'a threshold'}",
-                  f"write below = {example} (the event is 1 while the reading is below it) or above = {example}")
+        src.key_error(("sensors", None, name),
+                      N_("[sensors] {name}: a {model} sensor needs one of below or above, not both", name=name,
+                         model=model) if given else
+                      N_("[sensors] {name}: a {model} sensor needs a threshold", name=name, model=model),
+                      N_("write below = {example} (the event is 1 while the reading is below it) or above = {example}",
+                         example=example))
         return None
     direction = given[0]
     amount = _amount(src, name, direction, value[direction], kind)
@@ -267,17 +277,20 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: SensorKind) -> tup
             return 0.0, "cm"
         match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
         if match is None:
-            src.key_error(where, f"[sensors] {name}: {key} must be a length with its unit, not {raw!r}",
-                      f'write it in quotes with mm, cm or m: {key} = "20 cm"')
+            src.key_error(where, N_("[sensors] {name}: {key} must be a length with its unit, not {raw!r}", name=name,
+                                    key=key, raw=raw),
+                          N_('write it in quotes with mm, cm or m: {key} = "20 cm"', key=key))
             return None
         metres, unit = float(match[1]) * LENGTH_UNITS[match[2]], match[2]
     else:
         if not is_number(raw):
-            src.key_error(where, f"[sensors] {name}: {key} must be a {kind.name} level (a number), not {raw!r}",
-                      f"{kind.reads}: {key} = {kind.example}")
+            src.key_error(where, N_("[sensors] {name}: {key} must be a {kind} level (a number), not {raw!r}",
+                                    name=name, key=key, kind=kind.name, raw=raw),
+                          f"{kind.reads}: {key} = {kind.example}")
             return None
         metres = float(raw)
     if metres < 0 or not math.isfinite(metres):
-        src.key_error(where, f"[sensors] {name}: {key} must not be negative", f"write {key} as 0 or more")
+        src.key_error(where, N_("[sensors] {name}: {key} must not be negative", name=name, key=key),
+                      N_("write {key} as 0 or more", key=key))
         return None
     return metres, unit
