@@ -3,6 +3,7 @@ column-wise, in the format of :mod:`tablebot.formats.trace_lines`."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import queue
 import threading
@@ -44,11 +45,24 @@ def block_views_of(block: TickBlock, machine: Machine, scratch: dict[str, np.nda
                    helper: Executor | None = None, compiled: bool = True) -> list[memoryview] | str:
     """:func:`block_bytes_of` as the views of ``scratch``'s memory the compiled code made (see
     trace_text.block_views), or as text when Python made it (always, when not ``compiled``)."""
+    block = _rows_as_written(block, machine)
     if compiled and compiled_block(block):
         views = _compiled_text(block, machine, scratch, helper)
         if views is not None:
             return views
     return "".join(_python_lines(block, machine))
+
+
+def _rows_as_written(block: TickBlock, machine: Machine) -> TickBlock:
+    """A trace names a row as its file writes it (:attr:`tablebot.table.Row.as_written`, as
+    :func:`tablebot.replay.record` does): a row written for a state group (``[groups]``) is run as one row per
+    state, numbered apart. A table without groups is left as it is."""
+    written = [row.as_written for row in machine.table.rows]
+    if written == list(range(len(written))):
+        return block
+    rows = [-1 if r < 0 else written[r] for r in _ints(block.rows)]
+    return dataclasses.replace(block, rows=np.array(rows, dtype=np.int64) if isinstance(block.rows, np.ndarray)
+                               else rows)
 
 
 def compiled_block(block: TickBlock) -> bool:
