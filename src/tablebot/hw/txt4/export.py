@@ -15,11 +15,13 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from tablebot.engine.as_one import robot_machine
 from tablebot.escape import python_string
 from tablebot.files import write_text
 from tablebot.fileset import file_set
 from tablebot.hw.txt.wiring import TxtWiring, txt_wiring
 from tablebot.machine import Machine
+from tablebot.tables import RobotTables, several
 
 PROGRAM = "lib/tablebot_program.py"
 LAUNCHER = '''\
@@ -50,11 +52,17 @@ def workspace_name(machine: Machine) -> str:
 
 
 def export_txt4(machine: Machine) -> Workspace:
-    """The workspace for ``machine``; a table that does not fit the TXT's terminals is refused (its
-    robot-file line named) before anything is written."""
+    """The workspace for ``machine`` (a robot of several tables: all of them, run as :class:`runtime.Tables`);
+    a table that does not fit the TXT's terminals is refused (its robot-file line named) before anything is
+    written."""
+    tables = several(machine.table)
+    if tables is not None:
+        machine = robot_machine(tables)  # the robot's inputs, in the layout the runtime's Tables reads
     wiring = txt_wiring(machine)
     name = workspace_name(machine)
     data = table_data(machine, wiring)
+    if tables is not None:
+        data.update(tables_data(tables))
     runtime = resources.files("tablebot.hw.txt4").joinpath("runtime.py").read_text(encoding="utf-8")
     program = f"{runtime}\n\n# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
     digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
@@ -99,6 +107,40 @@ def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
         "counters": [{"name": c.name, "terminal": _number(t), "motor": terminal_of.get(c.motor)}
                      for c, t in zip(robot.counters, wired.counters, strict=True)],
     }
+
+
+def engine_data(machine: Machine) -> dict[str, Any]:
+    """What :class:`runtime.Engine` needs of one table."""
+    per_state: list[list[list[Any]]] = [[] for _ in machine.states]
+    for row in machine.rows:
+        per_state[row.state].append([row.index, row.mask, row.next, row.timer, list(row.outputs), list(row.loads)])
+    return {"states": list(machine.states), "initial_state": machine.initial_state,
+            "initial_timer": machine.initial_timer, "input_mask": machine.input_mask, "timer_bit": machine.timer_bit,
+            "counter_bits": list(machine.counter_bits), "match": machine.table.robot.match,
+            "n_outputs": len(machine.output_names), "rows": per_state}
+
+
+def tables_data(tables: RobotTables) -> dict[str, Any]:
+    """What :class:`runtime.Tables` adds for a robot of several tables: each table's engine, where its inputs
+    are in the robot's input layout, its cross-table events per state of each table it reads, and the writer
+    of each output and counter (tablebot.tables)."""
+    robot_bits = tables.input_bits
+    cross = []
+    for table in tables.tables:
+        by_source: dict[int, list[int]] = {}
+        for name, event in table.cross.items():
+            source, states = tables.covers(event)
+            bits = by_source.setdefault(source, [0] * len(tables.machines[source].states))
+            for state in states:
+                bits[state] |= table.bit(name)
+        cross.append([[source, bits] for source, bits in sorted(by_source.items())])
+    writers = [tables.writer(name) for name in tables.output_names]
+    counter_writers = [[c, w] for c, name in enumerate(tables.robot.counter_names)
+                       if (w := tables.writer(name)) is not None]
+    return {"table_names": list(tables.names), "tables": [engine_data(m) for m in tables.machines],
+            "table_inputs": [[[bit, m.input_bits[name]] for name, bit in robot_bits.items() if name in m.input_bits]
+                             for m in tables.machines],
+            "cross": cross, "writers": [-1 if w is None else w for w in writers], "counter_writers": counter_writers}
 
 
 def _number(terminal: str) -> int:

@@ -79,6 +79,40 @@ class Engine:
         return self.outputs
 
 
+class Tables:
+    """A robot of several tables (``table["tables"]``, each an :class:`Engine`'s data, the main one first) as one
+    engine: the inputs read once, each table's cross-table events from the states at the start of the tick,
+    each output and counter load from its one writer (tablebot.tables); ``event``, ``row``, ``state`` and
+    ``timer`` are the main table's."""
+
+    def __init__(self, table: dict) -> None:
+        self.engines = [Engine(part) for part in table["tables"]]
+        self.inputs, self.cross = table["table_inputs"], table["cross"]  # per table: (robot bit, table bit)s
+        self.writers, self.counter_writers = table["writers"], table["counter_writers"]
+        self.outputs = [0] * table["n_outputs"]
+
+    def __getattr__(self, name: str) -> Any:  # tick, event, row, state, timer, counters: the main table's
+        return getattr(self.engines[0], name)
+
+    def step(self, mask: int, pulses: list | tuple = ()) -> list:
+        states = [engine.state for engine in self.engines]  # the start of the tick, before any table fires
+        for i, engine in enumerate(self.engines):  # zip(strict=) is newer than the controller's Python
+            events = sum(bit for robot_bit, bit in self.inputs[i] if mask & robot_bit)
+            for source, bits in self.cross[i]:
+                events |= bits[states[source]]
+            engine.step(events, pulses)
+        self.outputs = [0 if w < 0 else self.engines[w].outputs[k] for k, w in enumerate(self.writers)]
+        for c, w in self.counter_writers:  # a load is its writer's: every table then counts from it
+            for engine in self.engines:
+                engine.counters[c] = self.engines[w].counters[c]
+        return self.outputs
+
+
+def engine_for(table: dict) -> Any:
+    """The engine of a table, or of a robot's several tables."""
+    return Tables(table) if "tables" in table else Engine(table)
+
+
 class Txt4Robot:
     """The table's inputs, motors, lamps and counters on this controller's terminals. ``stop`` may be
     called from another thread than ``read``/``write`` (a SIGTERM handled in the main thread)."""
@@ -239,7 +273,7 @@ def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], flo
     or every tick a little too slow) ends the run. Returns why it ended."""
     stop = stop or Stop()
     pause = sleep or stop.requested.wait
-    engine, tick_s = Engine(table), table["tick_ms"] / 1000
+    engine, tick_s = engine_for(table), table["tick_ms"] / 1000
     anchor, anchor_tick, late_ticks, reason = now(), 0, 0, "done"
     recent = collections.deque([(0, anchor)])  # (tick, when it started) over the last BEHIND_WINDOW_S
     try:
