@@ -13,10 +13,12 @@ import subprocess
 import sys
 import time
 from collections import Counter
+from itertools import pairwise
 from pathlib import Path
 
 import httpx
 import pytest
+from typer.testing import Result
 
 from doc_commands import (
     FENCE_RE,
@@ -30,8 +32,10 @@ from doc_commands import (
     unaccounted,
     uncomment,
 )
+from tablebot import i18n
 
 TUTORIAL = "docs/tutorial.md"
+TUTORIAL_DE = "docs/tutorial.de.md"
 
 
 def _tutorial_sensor(folder: Path) -> None:
@@ -40,9 +44,36 @@ def _tutorial_sensor(folder: Path) -> None:
     uncomment(folder / "my-robot" / "table.csv", block_after(TUTORIAL, "remove the `#` in front of the example", ""))
 
 
+def _tutorial_de_table(folder: Path) -> None:
+    """The German tutorial's section 2: its table (the file the page shows, docs/tutorial-de/table.csv) in place
+    of the one `new` wrote, and the states' German names in the robot file."""
+    page = (ROOT / TUTORIAL_DE).read_text(encoding="utf-8")
+    assert '--8<-- "docs/tutorial-de/table.csv"' in page  # what the page shows is the file
+    robot = folder / "mein-roboter"
+    (robot / "table.csv").write_bytes((ROOT / "docs" / "tutorial-de" / "table.csv").read_bytes())
+    text = (robot / "robot.toml").read_text(encoding="utf-8")
+    for line in block_after(TUTORIAL_DE, "deutsche Namen", "toml").strip().splitlines():
+        text, found = re.subn(rf'^{re.escape(line.split("=")[0])}= "[^"]*"', line, text, count=1, flags=re.M)
+        assert found, line
+    (robot / "robot.toml").write_text(text, encoding="utf-8")
+
+
+def _tutorial_de_sensor(folder: Path) -> None:
+    """The German tutorial's section 5, as the English one's."""
+    uncomment(folder / "mein-roboter" / "robot.toml", block_after(TUTORIAL_DE, "## 5. Ein Sensor", "toml"))
+    uncomment(folder / "mein-roboter" / "table.csv", block_after(TUTORIAL_DE, "vor der\nBeispielzeile", ""))
+
+
 #: Edits a page asks for between two of its commands: before the n-th run of a command (page, text, n).
-EDITS: dict[tuple[str, str, int], Edit] = {(TUTORIAL, "tablebot check my-robot", 2): _tutorial_sensor}
-PAGES = ["README.md", "docs/getting-started.md", TUTORIAL]
+EDITS: dict[tuple[str, str, int], Edit] = {
+    (TUTORIAL, "tablebot check my-robot", 2): _tutorial_sensor,
+    (TUTORIAL_DE, "tablebot check mein-roboter --lang de", 1): _tutorial_de_table,
+    (TUTORIAL_DE, "tablebot check mein-roboter --lang de", 2): _tutorial_de_sensor,
+}
+#: The German pages' output blocks (a plain block right below a block of commands) are what its last command
+#: printed, "..." for lines left out: the German words there are the catalog's, not the page's own.
+GERMAN = ["docs/getting-started.de.md", TUTORIAL_DE]
+PAGES = ["README.md", "docs/getting-started.md", TUTORIAL, *GERMAN]
 
 
 def run_page(doc: str, folder: Path) -> list[str]:
@@ -61,11 +92,42 @@ def run_page(doc: str, folder: Path) -> list[str]:
         elif command.argv == ["--install-completion"]:
             problem = completion_installs(folder)
         else:
-            result = run(command.argv, env=command.env or None)
+            result = run_in_language(command)
             problem = "" if result.exit_code == 0 else f"exit {result.exit_code}: {result.output[-600:]}"
+            if not problem and doc in GERMAN:
+                problem = unshown(shown_output(doc).get(command.line, []), result.output)
         if problem:
             failed.append(f"{command}: {problem}")
     return failed
+
+
+def run_in_language(command: Command) -> Result:
+    """The command in the language it asks for (--lang, TABLEBOT_LANG), as `tablebot` chooses it before its
+    app runs (the CLI's main, which the runner does not call); the process's own language again after."""
+    argv = i18n.set_from(command.argv, {**os.environ, **command.env})
+    try:
+        return run(argv, env=command.env or None)
+    finally:
+        i18n.set_from([], os.environ)
+
+
+def shown_output(doc: str) -> dict[int, list[str]]:
+    """The output a page shows below a block of commands, by the line of the block's last command."""
+    text = (ROOT / doc).read_text(encoding="utf-8")
+    blocks = list(FENCE_RE.finditer(text))
+    shown = {}
+    for above, below in pairwise(blocks):
+        if above[1] == "sh" and below[1] == "" and not text[above.end():below.start()].strip():
+            last = text.count("\n", 0, above.start(2)) + len(above[2].rstrip("\n").splitlines())
+            shown[last] = [line for line in below[2].splitlines() if line.strip() not in ("", "...")]
+    return shown
+
+
+def unshown(lines: list[str], output: str) -> str:
+    """The shown lines the command did not print (spacing aside: the runner's console may wrap)."""
+    said = " ".join(output.split())
+    missing = [line for line in lines if " ".join(line.split()) not in said]
+    return f"printed no {missing}, but: {output[-600:]}" if missing else ""
 
 
 def completion_installs(folder: Path) -> str:
