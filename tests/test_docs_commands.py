@@ -230,3 +230,20 @@ def test_the_python_examples_run(doc: str, tmp_path: Path, monkeypatch: pytest.M
     monkeypatch.chdir(examples_copy(tmp_path))
     for block in blocks:
         exec(compile(block, doc, "exec"), {"__name__": "__docs__"})
+
+
+def test_the_german_tutorials_table_drives_as_the_english_one(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The German tutorial's table (Richtung and Tempo, semicolons, 0,7s) is the English template's in other
+    words: with their sensor rows in use, the same trace byte for byte."""
+    monkeypatch.chdir(tmp_path)
+    for name in ("english", "german"):
+        assert run(["new", name]).exit_code == 0
+        if name == "german":
+            (tmp_path / name / "table.csv").write_bytes((ROOT / "docs" / "tutorial-de" / "table.csv").read_bytes())
+        table, robot = tmp_path / name / "table.csv", tmp_path / name / "robot.toml"
+        table.write_text(re.sub(r"^# (I1 \w+ 1)", r"\1", table.read_text(encoding="utf-8"), flags=re.M),
+                         encoding="utf-8")
+        uncomment(robot, block_after(TUTORIAL, "## 5. Give it a sensor", "toml"))
+        assert run(["sim", name, "--seconds", "20", "--no-plots", "--out", f"out-{name}"]).exit_code == 0
+    english, german = ((tmp_path / f"out-{name}" / "trace.jsonl").read_bytes() for name in ("english", "german"))
+    assert b'"I1_cm"' in german and german == english
