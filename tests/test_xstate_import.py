@@ -74,6 +74,16 @@ def test_extra_keys_missing_keys_wrong_types_and_unknown_events_are_refused(conf
     assert "$.states.s1.always[0].guard.params: names 'I9', which is no event column" in _refused(unknown)
 
 
+def test_a_null_guard_and_no_tables_are_refused_not_crashed_on(config: dict) -> None:
+    """Found by tests/test_scxml_fuzz.py: a null guard was an AttributeError, an empty list of tables an IndexError."""
+    null = json.loads(json.dumps(config))
+    null["states"]["s21"]["always"][0]["guard"] = None
+    assert _refused(null).startswith("in.json: error: $.states.s21.always[0].guard: is null")
+    empty = json.loads(json.dumps(config))
+    empty["meta"]["tablebot"]["tables"] = []
+    assert "$.meta.tablebot.tables: names no table" in _refused(empty)
+
+
 def test_text_that_is_not_json_is_located_by_line_and_column() -> None:
     assert _refused('{\n  "id": }').startswith("in.json:2:9: error: not JSON")
     assert "nested too deep" in _refused("[" * 100_000)

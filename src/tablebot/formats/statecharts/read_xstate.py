@@ -86,6 +86,8 @@ def _found(root: _At) -> Found:
     found = Found(root["id"].of(str, "a name"), meta["tickMs"].of(int, "a whole number"), meta["inputs"].names(),
                   meta["motors"].names(), meta["lamps"].names(), counters)
     tables = meta["tables"].list()
+    if not tables:
+        raise meta["tables"].error("names no table")
     several = len(tables) > 1
     for entry in tables:
         name = entry["name"].of(str, "a name")
@@ -96,10 +98,18 @@ def _found(root: _At) -> Found:
                            entry["writes"].names())
         for ident, state in holder["states"].items():
             source = _state(_At(ident, f"{state.path}", state.file), prefix)
-            table.rows.extend(_row(t, source, table, prefix) for t in state["always"].list()
-                              if t.get("guard", {}).get("type") == "row")
+            table.rows.extend(_row(t, source, table, prefix) for t in state["always"].list() if _is_row(t))
         found.tables.append(table)
     return found
+
+
+def _is_row(transition: _At) -> bool:
+    """A row's transition, or the idle one (last in every state); any other is refused here."""
+    guard = transition["guard"]
+    kind = guard.get("type", None)
+    if kind not in ("row", "idle"):
+        raise guard.error(f"is {json.dumps(guard.value)[:60]}, not a row's guard (type row) or the idle one")
+    return bool(kind == "row")
 
 
 def _state(at: _At, prefix: str) -> StateId:

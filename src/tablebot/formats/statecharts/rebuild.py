@@ -56,7 +56,9 @@ class Found:
 
 
 def build(found: Found, path: str, where: tuple[int | None, int | None] = (None, None)) -> tuple[Table, ...]:
-    """The tables (the main one first); a rule that is neither of tablebot's is a located error."""
+    """The tables (the main one first); no table, or a rule that is neither of tablebot's, is a located error."""
+    if not found.tables:
+        raise fail(path, "the statechart holds no table", "write what tablebot export wrote", *where)
     for table in found.tables:
         if table.match not in MATCHES:
             raise fail(path, f"matching rule {table.match!r} is not one of {', '.join(MATCHES)}",
