@@ -27,7 +27,7 @@ STUB = Path(__file__).resolve().parent / "txt4_stub"
 LIGHTS = Path(__file__).resolve().parents[1] / "examples" / "bumberbot-lights"
 #: The executors that run several tables; the others say they run one table only. The ROBO Interface counts
 #: nothing: it takes the BumberBot with its lights, not the random robots (their tables load a counter).
-SEVERAL = {"python step", "host C", "TXT 4.0 program", "ROBO TX", "ROBO Interface"}
+SEVERAL = {"python step", "host C", "AVR firmware", "TXT 4.0 program", "ROBO TX", "ROBO Interface"}
 NO_COUNTERS = {"ROBO Interface"}
 
 

@@ -180,10 +180,11 @@ def _init_statements(machine: Machine, wiring: Wiring) -> list[str]:
     return lines
 
 
-def board_header(machine: Machine, wiring: Wiring, layout: Layout) -> str:
-    """The whole ``tb_board.h`` for one table on one board."""
+def board_header(machine: Machine, wiring: Wiring, layout: Layout, payload: int | None = None) -> str:
+    """The whole ``tb_board.h`` for one table on one board (``payload``: a tick frame's bytes, when it is not
+    one table's frame: a robot of several tables, tablebot.firmware.several)."""
     board, robot = wiring.board, machine.table.robot
-    payload = tick_payload(machine, layout)
+    payload = tick_payload(machine, layout) if payload is None else payload
     if payload + 3 > 128:
         raise fail(machine.table.path, f"a trace frame of {payload + 3} bytes is too long for the UART ring",
                    "use fewer outputs and counters")

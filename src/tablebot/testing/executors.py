@@ -170,6 +170,13 @@ def _avr_firmware(case: Case, workdir: Path) -> Run:
     return Run(list(case.inputs), run.trace)
 
 
+def _avr_several(case: SeveralCase, workdir: Path) -> Run:
+    from tablebot.firmware.several import build_several, emulate_several
+
+    firmware = build_several(case.tables, BOARD, workdir / "fw")
+    return Run(list(case.inputs), emulate_several(firmware, case.tables, case.inputs, workdir / "run"))
+
+
 def _no_avr() -> str | None:
     from tablebot.diagnostics import TableBotError
     from tablebot.firmware.emulate import build_harness
@@ -343,7 +350,7 @@ def register_all() -> None:
         Executor("fleet", _fleet, fits=_sim_fits, what="a robot of a fleet (fleet.kernel.run_fleet, compiled)"),
         Executor("host C", _host_c, missing=_no_compiler, several=_host_c_several,
                  what="the generated C engine compiled for this computer (codegen.host)"),
-        Executor("AVR firmware", _avr_firmware, missing=_no_avr, fits=_fits_uno,
+        Executor("AVR firmware", _avr_firmware, missing=_no_avr, fits=_fits_uno, several=_avr_several,
                  what="the Uno firmware under simavr, its UART trace decoded"),
         Executor("TXT 4.0 program", _txt4_program, missing=_no_txt4_stub, fits=_fits_txt, several=_txt4_several,
                  what="export --to txt4's standalone program against the fischertechnik stub"),
