@@ -17,6 +17,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from tablebot.i18n import N_, _, localise
+
 ENV = "NUMBA_CACHE_DIR"
 
 
@@ -154,8 +156,8 @@ def say_compiling(what: str, *functions: Any) -> None:
     """One line on stderr when ``functions`` are about to be compiled, not loaded from the cache: the first
     run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
     if not compiled(*functions):
-        print(f"compiling {what} for this machine (first run only, {USUALLY}; later runs start at "
-              "once)…", file=sys.stderr, flush=True)
+        print(_("compiling {what} for this machine (first run only, usually 30-60 s; later runs start at once)…")
+              .format(what=localise(what)), file=sys.stderr, flush=True)
 
 
 class Compiling:
@@ -169,8 +171,10 @@ class Compiling:
         from tablebot.talk import Talking
 
         self.active = not compiled(*functions)
-        self.talking = Talking(f"compiling {what} for this machine", f"first run only, {USUALLY}; later runs start "
-                               "at once", f"compiled {what} in {{s}} s (kept in the cache: later runs start at once)",
+        self.talking = Talking(N_("compiling {what} for this machine", what=what),
+                               N_("first run only, usually 30-60 s; later runs start at once"),
+                               N_("compiled {what} in {{s}} s (kept in the cache: later runs start at once)",
+                                  what=what),
                                every_s=every_s, stream=stream) if self.active else None
 
     def done(self, finished: bool = True) -> None:

@@ -9,6 +9,8 @@ import threading
 import time
 from typing import Any
 
+from tablebot.i18n import _, localise
+
 SPINNER = "⠋⠙⠹⠸⠼⠴⠦⠧⠇⠏"
 
 
@@ -43,16 +45,17 @@ class Talking:
         if self._stop.wait(delay_s):
             return
         self.spoke = True
-        why = f" ({self.why})" if self.why else ""
+        what = localise(self.what)
+        why = f" ({localise(self.why)})" if self.why else ""
         if not self.live:
-            self.say(f"{self.what}{why}")
+            self.say(f"{what}{why}")
         turn = 0
         while not self._stop.wait(0.1 if self.live else self.every_s):
             if self.live:  # one line, redrawn in place (\r, then erase to its end)
-                self.say(f"\r{SPINNER[turn % len(SPINNER)]} {self.what}: {self.elapsed():.0f} s{why}\x1b[K", end="")
+                self.say(f"\r{SPINNER[turn % len(SPINNER)]} {what}: {self.elapsed():.0f} s{why}\x1b[K", end="")
                 turn += 1
             else:
-                self.say(f"  still {self.what}: {self.elapsed():.0f} s")
+                self.say("  " + _("still {what}: {seconds:.0f} s").format(what=what, seconds=self.elapsed()))
 
     def done(self, finished: bool = True) -> None:
         """Stop talking (only the first call does anything)."""
@@ -65,6 +68,6 @@ class Talking:
             return
         clear = "\r\x1b[K" if self.live else ""
         if finished and self.done_text:
-            self.say(clear + self.done_text.format(s=f"{self.elapsed():.0f}"))
+            self.say(clear + str(localise(self.done_text)).format(s=f"{self.elapsed():.0f}"))
         elif clear:
             self.say(clear, end="")
