@@ -35,8 +35,12 @@ def fit_for(board: str) -> Any:
 def export_for(board: str) -> Exporter:
     def export(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
         from tablebot.firmware.build import build
+        from tablebot.firmware.several import build_several
+        from tablebot.tables import several
 
-        firmware = build(machine, board, out_folder(out or Path("build") / "firmware" / board, "--out"))
+        folder = out_folder(out or Path("build") / "firmware" / board, "--out")
+        tables = several(machine.table)  # a robot of several tables: all of them in the tick interrupt
+        firmware = build(machine, board, folder) if tables is None else build_several(tables, board, folder)
         wiring = firmware.wiring
         assert wiring is not None
         pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
