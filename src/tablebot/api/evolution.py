@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from tablebot.api.progress import Progress, stopped
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.evolve.run import Outcome
@@ -180,7 +181,7 @@ def _run(plan: Plan, check: Plan, setup: Setup, out: Path, backend: str, address
                                 setup.replay, provers)
     except INTERRUPTS as exc:  # SIGTERM raises Terminated while a command runs (cli.common.guarded)
         kept = len(search.store.open()) if search else 0
-        raise stopped(f"{kept} tables evaluated so far are kept in {out}", exc) from None
+        raise stopped(N_("{kept} tables evaluated so far are kept in {out}", kept=kept, out=out), exc) from None
     finally:
         progress.stop()
     return Evolution(outcome, plan, tuple(written), time.perf_counter() - started)

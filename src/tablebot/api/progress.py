@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from tablebot.i18n import N_
+
 
 class Progress:
     """Told what a long call is doing; every method does nothing here. Subclass it and pass it as
@@ -59,7 +61,7 @@ class Stopped(KeyboardInterrupt):
     @property
     def word(self) -> str:
         """``interrupted`` or ``terminated``."""
-        return "terminated" if self.terminated else "interrupted"
+        return N_("terminated") if self.terminated else N_("interrupted")
 
 
 def stopped(kept: str, why: BaseException) -> Stopped:

@@ -201,7 +201,8 @@ def _into(plan: Plan, runner: Runner, backend: str, out: Path, progress: Progres
     except INTERRUPTS as exc:
         runner.close(failed=True)
         path, count = store.merge(complete=False)
-        raise stopped(f"{count:,} of {total:,} runs finished, kept in {path}", exc) from None
+        raise stopped(N_("{count:,} of {total:,} runs finished, kept in {path}", count=count, total=total, path=path),
+                      exc) from None
     finally:
         progress.stop()
     return store, total - already, time.perf_counter() - started

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from tablebot.api.progress import Progress, stopped
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
@@ -188,8 +189,8 @@ def _search(plan: Plan, check: Plan, cells: list[Cell], objective: str, method: 
         before_after = evaluate.measure([baseline, winner], check, metrics)
     except INTERRUPTS as exc:
         count = journal.count if journal is not None else 0
-        kept = f"{count} evaluations kept in {journal.path}" if journal is not None and count else \
-            "no evaluation had finished"
+        kept = N_("{count} evaluations kept in {path}", count=count, path=journal.path) \
+            if journal is not None and count else N_("no evaluation had finished")
         raise stopped(kept, exc) from None
     finally:
         progress.stop()
