@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tablebot.diagnostics import Diagnostic, fail
+from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.files import out_folder
 from tablebot.registry import ExportBackend, Exported, ExportOptions, register
 from tablebot.robopro.rpp_edit import DEFAULT_NAMES
@@ -20,16 +20,48 @@ if TYPE_CHECKING:
 def fit(machine: Machine) -> list[Diagnostic]:
     from tablebot.robopro.lists import fit_problems
 
-    return fit_problems(machine.table)
+    return cross_problems(machine) or fit_problems(machine.table)
+
+
+def cross_problems(machine: Machine) -> list[Diagnostic]:
+    """A cross-table column of the main table: the ROBO Pro exports run the main table alone, so the state it
+    reads is nowhere (refused at the column, rather than read as never present)."""
+    table = machine.table
+    return [Diagnostic(table.path, event.line, event.at,
+                       f"{event.column}: the ROBO Pro exports run table {table.name} alone, without table "
+                       f"{event.table} whose state this column reads",
+                       "export a robot of one table to ROBO Pro (docs: Several tables in one robot)")
+            for event in table.cross.values()]
+
+
+def _refuse_cross(machine: Machine) -> None:
+    """Before anything is written: a main table reading another table's state cannot be exported alone."""
+    problems = cross_problems(machine)
+    if problems:
+        raise TableBotError(problems)
+
+
+def main_only(machine: Machine) -> tuple[str, ...]:
+    """The warning for a robot of several tables, whose ROBO Pro export holds its main table alone (one process
+    per table would need a barrier every tick to read the others' states at the start of the tick)."""
+    from tablebot.robot_tables import tables_of
+
+    specs = tables_of(machine.table.robot)
+    if not specs:
+        return ()
+    others = ", ".join(spec.name for spec in specs[1:])
+    return (f"the robot has {len(specs)} tables: this ROBO Pro export runs its main table "
+            f"({specs[0].name}) only, not {others} (docs: Several tables in one robot)",)
 
 
 def export_lists(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.robopro import lists
 
     assert out is not None
+    _refuse_cross(machine)
     encoded = lists.encode(machine.table)
     files = tuple(lists.write_lists(encoded, out_folder(out, "OUTDIR")))
-    return Exported(files, tuple(f"wrote {path}" for path in files))
+    return Exported(files, tuple(f"wrote {path}" for path in files), main_only(machine))
 
 
 def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -41,6 +73,7 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
     names = options.lists or DEFAULT_NAMES
     if into is None:
         raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
+    _refuse_cross(machine)
     encoded = lists.encode(machine.table)
     named = dict(zip(names, (encoded.event, encoded.action, encoded.timer), strict=True))
     if len(named) < 3:
@@ -48,7 +81,8 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
     target = out_folder(out, "OUTDIR") / into.name if out else None
     written, from_csv = rpp.write_lists(into, named, target)
     return Exported((written,), (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),
-                    tuple(f"list {name} loads its values from column {column} of a CSV file when the program starts "
+                    main_only(machine) + tuple(
+                    f"list {name} loads its values from column {column} of a CSV file when the program starts "
                           "(its load-from-CSV setting), which replaces the values written here; turn that off in "
                           "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
                           "CSV files instead" for name, column in from_csv.items()))
@@ -57,7 +91,7 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
 def program_fit(machine: Machine) -> list[Diagnostic]:
     from tablebot.robopro.fit import problems
 
-    return problems(machine.table)
+    return cross_problems(machine) or problems(machine.table)
 
 
 def export_program(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -67,9 +101,10 @@ def export_program(machine: Machine, out: Path | None, options: ExportOptions) -
     from tablebot.robopro.program import file_name, generate
 
     assert out is not None
+    _refuse_cross(machine)
     text = generate(machine.table)
     path = write_text(out_folder(out, "OUTDIR") / file_name(machine.table), text)
-    return Exported((path,), (f"wrote {path}: open it in ROBO Pro 4.x",))
+    return Exported((path,), (f"wrote {path}: open it in ROBO Pro 4.x",), main_only(machine))
 
 
 ROBOPRO = register(ExportBackend(name="robopro", makes="the document's three ROBO Pro lists (event, action, timer)",
