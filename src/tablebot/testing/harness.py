@@ -22,15 +22,13 @@ import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine, compile_table
 from tablebot.replay import replay
 from tablebot.table import Table
-
-if TYPE_CHECKING:
-    from tablebot.testing.several_cases import SeveralCase
+from tablebot.tables import RobotTables
 
 #: The core fields every executor reports for every tick.
 CORE = ("tick", "event", "row", "state", "timer")
@@ -45,6 +43,16 @@ class Case:
     seed: int = 0
     rule: str = "always"  # the matching rule: a row with no required events always matches
     own_world: bool = False  # simulated executors: the robot's own world and [sim], else a busy random room
+
+
+@dataclass(frozen=True)
+class SeveralCase:
+    """A robot of several tables and recorded inputs (the robot-wide layout of :attr:`RobotTables.input_bits`)
+    to run it on (``seed``: where they came from); :mod:`tablebot.testing.several_cases` runs it."""
+
+    tables: RobotTables
+    inputs: tuple[TickInput, ...]
+    seed: int = 0
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import random
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from tablebot.engine.as_one import robot_machine
@@ -19,19 +18,10 @@ from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine
 from tablebot.replay import replay_several
 from tablebot.tables import RobotTables
-from tablebot.testing.harness import EXECUTORS, Report, Run, wired_for
+from tablebot.testing.harness import EXECUTORS, Report, Run, SeveralCase, wired_for
 
 __all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks",
            "wired_robot"]
-
-
-@dataclass(frozen=True)
-class SeveralCase:
-    """A robot of several tables and recorded inputs to run it on (``seed``: where they came from)."""
-
-    tables: RobotTables
-    inputs: tuple[TickInput, ...]
-    seed: int = 0
 
 
 def several_ticks(rng: random.Random, tables: RobotTables, count: int, density: float = 0.4) -> list[TickInput]:
@@ -45,12 +35,12 @@ def several_ticks(rng: random.Random, tables: RobotTables, count: int, density: 
 def random_several_case(seed: int, folder: Path, ticks: int = 240) -> SeveralCase:
     """A random robot of 2-3 tables (:mod:`tablebot.testing.random_robots`, written as a user's files into
     ``folder`` and read back) and random inputs for it."""
-    from tablebot.loading import Loaded
+    from tablebot.formats.table_read import load_table
+    from tablebot.tables import load_tables
     from tablebot.testing.random_robots import RobotShape, random_robot
 
     rng = random.Random(seed)
-    tables = Loaded.open(random_robot(rng, folder, RobotShape(tables=2 + seed % 2)) / "t0.csv").tables
-    assert tables is not None
+    tables = load_tables(load_table(random_robot(rng, folder, RobotShape(tables=2 + seed % 2)) / "t0.csv"))
     return SeveralCase(tables, tuple(several_ticks(rng, tables, ticks)), seed)
 
 
