@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -17,10 +18,16 @@ from tablebot.formats.statecharts.read_xstate import read_xstate
 from tablebot.formats.statecharts.scxml import export_scxml
 from tablebot.formats.statecharts.xstate import export_xstate
 from tablebot.formats.table_read import load_table
+from tablebot.loading import Loaded
 
-TABLE = load_table(Path(__file__).resolve().parents[1] / "examples" / "bumberbot-counters" / "table.csv")
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+TABLE = load_table(EXAMPLES / "bumberbot-counters" / "table.csv")
 SCXML = export_scxml([TABLE])
 CONFIG = json.loads(export_xstate([TABLE]))
+LIGHTS = Loaded.open(EXAMPLES / "bumberbot-lights").tables
+assert LIGHTS is not None
+#: Two tables with group rows (their group and index are written for them alone) and cross-table events.
+SEVERAL = json.loads(export_xstate(LIGHTS.tables))
 EDITS = st.lists(st.tuples(st.integers(0, len(SCXML) - 1), st.sampled_from(["drop", "double", "put"]),
                            st.sampled_from(list('<>/="& \n-_x1')) | st.characters()), min_size=1, max_size=4)
 JSON = st.recursive(st.none() | st.booleans() | st.integers(-3, 70000) | st.text(max_size=8),
@@ -39,7 +46,7 @@ def _paths(value: Any, path: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
     return found
 
 
-PATHS = _paths(CONFIG)
+PLACES = [(config, path) for config in (CONFIG, SEVERAL) for path in _paths(config)[1:]]
 
 
 @settings(max_examples=300, deadline=None)
@@ -55,10 +62,12 @@ def test_an_edited_scxml_is_read_or_refused_with_a_location(edits: list[tuple[in
         assert all(d.path == "in.scxml" and d.line for d in exc.diagnostics), exc
 
 
-@settings(max_examples=300, deadline=None)
-@given(st.sampled_from(PATHS[1:]), JSON)
-def test_an_edited_xstate_config_is_read_or_refused_with_its_json_path(path: tuple[Any, ...], value: Any) -> None:
-    config = json.loads(json.dumps(CONFIG))
+@settings(max_examples=400, deadline=None)
+@given(st.sampled_from(PLACES), JSON)
+def test_an_edited_xstate_config_is_read_or_refused_with_its_json_path(place: tuple[dict[str, Any], tuple[Any, ...]],
+                                                                       value: Any) -> None:
+    original, path = place
+    config = json.loads(json.dumps(original))
     holder = config
     for key in path[:-1]:
         holder = holder[key]
@@ -67,3 +76,13 @@ def test_an_edited_xstate_config_is_read_or_refused_with_its_json_path(path: tup
         read_xstate(json.dumps(config), "in.json")
     except TableBotError as exc:
         assert all(d.message.startswith("$") for d in exc.diagnostics), exc
+
+
+def test_a_group_rows_index_that_is_no_number_is_refused() -> None:
+    """Found by fuzzing: a group row's meta.index of null was a TypeError where the rows were sorted."""
+    config = json.loads(json.dumps(SEVERAL))
+    transition = config["states"]["drive"]["states"]["drive_s1"]["always"][0]
+    assert transition["meta"]["group"] == "seeking"
+    transition["meta"]["index"] = None
+    with pytest.raises(TableBotError, match=r"\$\.states\.drive\.states\.drive_s1\.always\[0\]\.meta\.index: is null"):
+        read_xstate(json.dumps(config), "in.json")

@@ -135,8 +135,13 @@ def _row(transition: _At, state: StateId, table: FoundTable, prefix: str) -> Fou
     return FoundRow(state=state, events=frozenset(events),
                     outputs={name: value.of(int, "a number") for name, value in fire["set"].items()},
                     timer=fire["load"].of(int, "a number"), next=_state(transition["target"], prefix),
-                    description=transition.get("description", ""), written=meta["row"].of(int, "a number"),
-                    group=meta.get("group", ""), index=meta.get("index", 0))
+                    description=_optional(transition, "description", str, ""), written=meta["row"].of(int, "a number"),
+                    group=_optional(meta, "group", str, ""), index=_optional(meta, "index", int, 0))
+
+
+def _optional(at: _At, key: str, kind: type, default: Any) -> Any:
+    """A key the export writes only sometimes (a group row's group and index), of its type when there."""
+    return at[key].of(kind, "a number" if kind is int else "text") if key in at.of(dict, "an object") else default
 
 
 def _same(read: Any, made: Any, where: str, path: str, depth: int) -> None:
