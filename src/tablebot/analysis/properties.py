@@ -109,8 +109,8 @@ def load_properties(machine: Machine, files: list[Path], tables: RobotTables | N
     errors = []
     for src, entries, section in sources:
         if not isinstance(entries, dict):
-            src.out.error(src.line("", None, "properties"), None, "properties must be named tables",
-                          'write [properties.my_name] (robot file) or [my_name] (properties file)')
+            src.out.error(src.line("", None, "properties"), None, N_("properties must be named tables"),
+                          N_("write [properties.my_name] (robot file) or [my_name] (properties file)"))
         else:
             for name, entry in entries.items():
                 line = src.line(f"{section}.{name}" if section else name) or src.line(section, None, name)
@@ -127,13 +127,13 @@ def _property(name: str, entry: Any, machine: Machine, out: Collector, source: s
               line: int | None, tables: RobotTables | None = None) -> Property | None:
     """One property table, or None after reporting everything wrong with it."""
     if not isinstance(entry, dict):
-        out.error(line, None, f"property {name!r} must be a table of keys",
-                  f'write [{name}] followed by lines like never = "state == 3"')
+        out.error(line, None, N_("property {name!r} must be a table of keys", name=name),
+                  N_('write [{name}] followed by lines like never = "state == 3"', name=name))
         return None
     before = len(out.items)
     if not NAME_RE.match(name):
-        out.error(line, None, f"property name {name!r} cannot name a file",
-                  "use letters, digits, spaces, _ . and - (its counterexample is written to NAME.csv)")
+        out.error(line, None, N_("property name {name!r} cannot name a file", name=name),
+                  N_("use letters, digits, spaces, _ . and - (its counterexample is written to NAME.csv)"))
     kind = _kind(name, entry, line, out)
     if kind is None:
         return None
@@ -148,19 +148,23 @@ def _kind(name: str, entry: dict[str, Any], line: int | None, out: Collector) ->
     """The property's kind (exactly one of KINDS must be given); the other keys are checked on the way."""
     for key in entry:
         if key not in KEYS:
-            out.error(line, None, f"property {name}: unknown key {key!r}", f"known keys: {', '.join(sorted(KEYS))}")
+            out.error(line, None, N_("property {name}: unknown key {key!r}", name=name, key=key),
+                      N_("known keys: {known}", known=", ".join(sorted(KEYS))))
     level = entry.get("level", "error")
     if level not in LEVELS:
-        out.error(line, None, f"property {name}: level must be error or warning, not {level!r}",
-                  'write level = "warning" to make a violation a warning, or leave level out')
+        out.error(line, None, N_("property {name}: level must be error or warning, not {level!r}", name=name,
+                                 level=level),
+                  N_('write level = "warning" to make a violation a warning, or leave level out'))
     for key in ("text", "note"):
         if not isinstance(entry.get(key, ""), str):
-            out.error(line, None, f"property {name}: {key} must be text, not {entry[key]!r}",
-                      f'write it in quotes: {key} = "…"')
+            out.error(line, None, N_("property {name}: {key} must be text, not {value!r}", name=name, key=key,
+                                     value=entry[key]),
+                      N_('write it in quotes: {key} = "…"', key=key))
     kinds = [k for k in KINDS if k in entry]
     if len(kinds) != 1:
-        out.error(line, None, f"property {name} needs exactly one of {', '.join(KINDS)} (found {len(kinds)})",
-                  'for example: never = "state == 20 and M1 > 0"')
+        out.error(line, None, N_("property {name} needs exactly one of {kinds} (found {found})", name=name,
+                                 kinds=", ".join(KINDS), found=len(kinds)),
+                  N_('for example: never = "state == 20 and M1 > 0"'))
         return None
     return kinds[0]
 
@@ -172,13 +176,14 @@ def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line:
     def condition(key: str) -> Condition | None:
         value = entry.get(key)
         if not isinstance(value, str):
-            out.error(line, None, f"property {name}: {key} must be a condition in quotes",
-                      f'for example: {key} = "state == 20"')
+            out.error(line, None, N_("property {name}: {key} must be a condition in quotes", name=name, key=key),
+                      N_('for example: {key} = "state == 20"', key=key))
             return None
         try:
             return parse_condition(value, machine, tables)
         except ConditionError as exc:
-            out.error(line, None, f"property {name}: {key}: {exc}", "see the condition language in docs/checking.md")
+            out.error(line, None, N_("property {name}: {key}: {problem}", name=name, key=key, problem=str(exc)),
+                      N_("see the condition language in docs/checking.md"))
             return None
 
     if kind != "when":
@@ -189,17 +194,19 @@ def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line:
 
 def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collector) -> int:
     """``within`` in ticks, from a number of ticks or a text like "10 ms", "1 tick", "0.5 s"."""
-    hint = f'write within = "100 ms" or "3 ticks" (one tick is {tick_ms} ms)'
+    hint = N_('write within = "100 ms" or "3 ticks" (one tick is {tick} ms)', tick=tick_ms)
     if value is None:
-        out.error(line, None, f"property {name}: within is missing (when/then needs a time limit)", hint)
+        out.error(line, None, N_("property {name}: within is missing (when/then needs a time limit)", name=name),
+                  hint)
         return 0
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
         return value
     if not isinstance(value, str):
-        out.error(line, None, f"property {name}: within = {value!r} is not a duration", hint)
+        out.error(line, None, N_("property {name}: within = {value!r} is not a duration", name=name, value=value),
+                  hint)
         return 0
     try:
         return to_ticks(value, tick_ms)
     except DurationError as exc:
-        out.error(line, None, f"property {name}: within = {exc.message}", exc.hint)
+        out.error(line, None, N_("property {name}: within = {problem}", name=name, problem=exc.message), exc.hint)
         return 0

@@ -21,11 +21,11 @@ from typer._click.exceptions import (
 )
 from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
-from typer.core import TyperGroup
+from typer.core import TyperGroup, TyperOption
 
 from tablebot.cli.words import localise, localise_params
 from tablebot.diagnostics import Diagnostic
-from tablebot.i18n import N_, Message
+from tablebot.i18n import LANGUAGES, N_, Message, use
 
 
 class Group(TyperGroup):
@@ -38,6 +38,8 @@ class Group(TyperGroup):
             for param in command.params:
                 if isinstance(param.type, FloatParamType):
                     param.type = FiniteFloat.like(param.type)
+            if not any("--lang" in param.opts for param in command.params):
+                command.params.append(lang_option())
         localise(self)  # every help text in the reader's language, before any is shown
 
     def get_params(self, ctx: Any) -> list[Any]:
@@ -73,6 +75,14 @@ class Group(TyperGroup):
             raise OptionError(Diagnostic(name, None, None, N_("{name!r} is not a tablebot command", name=name),
                                          hint))
         return super().resolve_command(ctx, args)
+
+
+def lang_option() -> TyperOption:
+    """``--lang`` on every command, hidden (the main help lists it): tablebot.cli.main takes it off the command
+    line before typer sees it, so this one is met only when the app is called in-process (a test's CliRunner),
+    where it sets the language of what follows."""
+    return TyperOption(param_decls=["--lang"], type=TyperChoice(LANGUAGES), expose_value=False, hidden=True,
+                       default=None, callback=lambda ctx, param, value: use(value) if value else None)
 
 
 class FiniteFloat(FloatRange):
