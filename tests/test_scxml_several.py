@@ -2,9 +2,9 @@
 tick by tick and equal to tablebot's engine (tablebot.engine.several): the shipped BumberBot with its lights (two
 tables, state groups) and random robots of 2-3 tables, and each reads back as the same table bytes.
 
-python-statemachine orders parallel regions by insertion, not document order (statemachine/io/builder.py builds
-the states in the order the reader met them); under one writer per output the order of the regions changes
-nothing, which is what these tests show: the trace is the engine's, whose tables' order changes nothing either."""
+An engine may run the regions' transitions in an order of its own (python-statemachine is said to order parallel
+regions by insertion rather than by document order); under one writer per output the order changes nothing, which
+is what these tests show: the trace is the engine's, whose tables' order changes nothing either."""
 
 from __future__ import annotations
 
