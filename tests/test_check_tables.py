@@ -49,6 +49,8 @@ def test_properties_across_tables_are_proved_or_broken_with_a_counterexample_tha
     report = check(folder, "--counterexamples", str(tmp_path / "cex"))
     status = {p["name"]: p["status"] for p in report["properties"]}
     assert status == {"stopped_dark": "violated", "lamp_follows": "holds", "comes_back": "holds"}
+    assert [(t["name"], Path(t["table"]).name, t["rows"], t["states"]) for t in report["tables"]] == [
+        ("drive", "table.csv", 5, 3), ("lights", "lights.csv", 4, 2)]
     broken = next(p for p in report["properties"] if p["name"] == "stopped_dark")
     assert broken["shortest"] and broken["ticks"] == 2  # I1 at once: drive in 3 on tick 0, lights sees it on 1
     loaded = Loaded.open(folder)

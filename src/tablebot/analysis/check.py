@@ -144,6 +144,9 @@ def report_json(report: CheckReport, strict: bool) -> dict[str, Any]:
         "findings": [f.as_json() for f in report.findings],
         "properties": [_result_json(report, r) for r in report.results],
         "counts": report.counts(), "exit_code": report.exit_code(strict),
+        **({"tables": [{"name": t.name, "table": t.path, "rows": len(t.rows), "states": len(m.states)}
+                       for t, m in zip(report.tables.tables, report.tables.machines, strict=True)]}
+           if report.tables is not None else {}),
     }
 
 
