@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from tablebot.i18n import N_
 from tablebot.sim.params import SECTIONS, check_layer
 from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
 
@@ -132,7 +133,7 @@ def parse_world(src: Source) -> World:
     known_keys(src, ("", None), data, TOP_KEYS)
     name = data.get("name", Path(src.path).stem)
     if not isinstance(name, str):
-        src.error(("", None, "name"), "name must be a string", 'for example: name = "living room"')
+        src.error(("", None, "name"), N_("name must be a string"), N_('for example: name = "living room"'))
     reach = number(src, ("", None, "reach"), data.get("reach", 0.25), 0.01, 100.0)
     walls = _walls(src, table_of(src, ("arena", None, None), data.get("arena", {})))
     start = _start(src, table_of(src, ("start", None, None), data.get("start", {})))
@@ -160,8 +161,9 @@ def _many(src: Source, data: dict[str, Any], section: str, read: Any) -> list[An
     if isinstance(items, dict):
         items = [items]
     if not isinstance(items, list) or not all(isinstance(item, dict) for item in items):
-        src.error(("", None, section), f"{section} must be written as [[{section}]] tables, not {items!r}",
-                  "see examples/bumberbot/arena.toml")
+        src.error(("", None, section), N_("{section} must be written as [[{section}]] tables, not {items!r}",
+                                          section=section, items=items),
+                  N_("see examples/bumberbot/arena.toml"))
         return []
     found = [read(src, i, item) for i, item in enumerate(items)]
     return [item for item in found if item is not None]
@@ -171,7 +173,7 @@ def _point(src: Source, where: Where, table: dict[str, Any]) -> Point | None:
     """The point ``where`` names in ``table``; a missing one is reported as missing."""
     key = where[2]
     if key not in table:
-        src.error(where, f"{label(where)} is missing", f"add {key} = [x, y] (metres)")
+        src.error(where, N_("{name} is missing", name=label(where)), N_("add {key} = [x, y] (metres)", key=key))
         return None
     return point(src, where, table[key])
 
@@ -181,12 +183,13 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     raw = arena.get("walls")
     where = ("arena", None, "walls")
     if raw is None:
-        src.error(where, "[arena] walls is missing: the room's corners", "add an [arena] section with "
-                  "walls = [[0, 0], [3, 0], [3, 2], [0, 2]] (metres, in order around the room)")
+        src.error(where, N_("[arena] walls is missing: the room's corners"),
+                  N_("add an [arena] section with walls = [[0, 0], [3, 0], [3, 2], [0, 2]] (metres, in order around "
+                     "the room)"))
         return []
     if not isinstance(raw, list) or len(raw) < 3:
-        src.error(where, "[arena] walls must list at least three corners [x, y]",
-                  "for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]")
+        src.error(where, N_("[arena] walls must list at least three corners [x, y]"),
+                  N_("for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]"))
         return []
     corners = [point(src, where, p) for p in raw]
     if any(c is None for c in corners):
@@ -194,18 +197,19 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     walls: list[Point] = corners  # type: ignore[assignment]
     crossing = _self_crossing(walls)
     if crossing:
-        src.error(where, f"[arena] walls cross themselves (wall {crossing[0] + 1} and wall {crossing[1] + 1})",
-                  "list the corners in order around the room, clockwise or counter-clockwise")
+        src.error(where, N_("[arena] walls cross themselves (wall {first} and wall {second})", first=crossing[0] + 1,
+                            second=crossing[1] + 1),
+                  N_("list the corners in order around the room, clockwise or counter-clockwise"))
     elif abs(_area(walls)) < 1e-6:
-        src.error(where, "[arena] walls enclose no area", "list the corners of the room in order")
+        src.error(where, N_("[arena] walls enclose no area"), N_("list the corners of the room in order"))
     return walls
 
 
 def _start(src: Source, start: dict[str, Any]) -> tuple[float, float, float] | None:
     known_keys(src, ("start", None), start, ("at", "heading"))
     if "at" not in start:
-        src.error(("start", None, None), "[start] needs at = [x, y], the robot's axle centre",
-                  "add a [start] section with at = [0.5, 0.5] and heading = 0")
+        src.error(("start", None, None), N_("[start] needs at = [x, y], the robot's axle centre"),
+                  N_("add a [start] section with at = [0.5, 0.5] and heading = 0"))
         return None
     at = point(src, ("start", None, "at"), start["at"])
     heading = number(src, ("start", None, "heading"), start.get("heading", 0.0), -3600, 3600)
@@ -230,8 +234,8 @@ def _box(src: Source, i: int, t: dict[str, Any]) -> Box | None:
     size = _point(src, ("box", i, "size"), t)
     angle = number(src, ("box", i, "angle"), t.get("angle", 0.0), -3600, 3600)
     if size is not None and min(size) <= 0:
-        src.error(("box", i, "size"), f"[[box]] #{i + 1} size must be positive, not {list(size)}",
-                  "size = [width, depth] in metres")
+        src.error(("box", i, "size"), N_("[[box]] #{n} size must be positive, not {size}", n=i + 1, size=list(size)),
+                  N_("size = [width, depth] in metres"))
         return None
     if at is None or size is None or angle is None:
         return None
@@ -242,7 +246,8 @@ def _circle(src: Source, i: int, t: dict[str, Any]) -> Circle | None:
     known_keys(src, ("circle", i), t, ("at", "radius"))
     at = _point(src, ("circle", i, "at"), t)
     if "radius" not in t:
-        src.error(("circle", i, "radius"), f"[[circle]] #{i + 1} radius is missing", "add radius = 0.1 (metres)")
+        src.error(("circle", i, "radius"), N_("[[circle]] #{n} radius is missing", n=i + 1),
+                  N_("add radius = 0.1 (metres)"))
         return None
     radius = number(src, ("circle", i, "radius"), t["radius"], 0.001, 100.0)
     return None if at is None or radius is None else Circle(at, float(radius))
@@ -253,7 +258,7 @@ def _segment(src: Source, i: int, t: dict[str, Any]) -> Segment | None:
     a = _point(src, ("segment", i, "from"), t)
     b = _point(src, ("segment", i, "to"), t)
     if a is not None and a == b:
-        src.error(("segment", i, "to"), f"[[segment]] #{i + 1} has no length", "give two different points")
+        src.error(("segment", i, "to"), N_("[[segment]] #{n} has no length", n=i + 1), N_("give two different points"))
         return None
     return None if a is None or b is None else Segment(a, b)
 
@@ -263,20 +268,22 @@ def _line(src: Source, i: int, t: dict[str, Any]) -> Line | None:
     where = ("line", i, "points")
     raw = t.get("points")
     if not isinstance(raw, list) or len(raw) < 2:
-        src.error(where, f"[[line]] #{i + 1} needs points = [[x, y], [x, y], ...] (at least two)",
-                  "list the corners of the tape in order, in metres")
+        src.error(where, N_("[[line]] #{n} needs points = [[x, y], [x, y], ...] (at least two)", n=i + 1),
+                  N_("list the corners of the tape in order, in metres"))
         return None
     points = [point(src, where, p) for p in raw]
     width = number(src, ("line", i, "width"), t.get("width", TAPE_WIDTH), 0.001, 1.0)
     closed = t.get("closed", False)
     if not isinstance(closed, bool):
-        src.error(("line", i, "closed"), f"[[line]] #{i + 1} closed must be true or false, not {closed!r}",
-                  "closed = true joins the last point back to the first")
+        src.error(("line", i, "closed"), N_("[[line]] #{n} closed must be true or false, not {closed!r}", n=i + 1,
+                                            closed=closed),
+                  N_("closed = true joins the last point back to the first"))
         return None
     if any(p is None for p in points) or width is None:
         return None
     if any(a == b for a, b in itertools.pairwise(points)):
-        src.error(where, f"[[line]] #{i + 1} repeats a point: a piece of no length", "remove the repeated point")
+        src.error(where, N_("[[line]] #{n} repeats a point: a piece of no length", n=i + 1),
+                  N_("remove the repeated point"))
         return None
     return Line(tuple(points), float(width), closed)  # type: ignore[arg-type]
 
@@ -320,8 +327,9 @@ def _first_outside(walls: list[Point], points: tuple[Point, ...]) -> Point:
 def _inside(src: Source, walls: list[Point], places: Sequence[tuple[str, int | None, str, Point]]) -> None:
     for section, index, key, at in places:
         if not inside(walls, at):
-            src.error((section, index, key), f"{section} at {list(at)} is outside the arena walls",
-                      "move it inside the [arena] walls polygon")
+            src.error((section, index, key), N_("{section} at {at} is outside the arena walls", section=section,
+                                                at=list(at)),
+                      N_("move it inside the [arena] walls polygon"))
 
 
 def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes: list[Box],
@@ -331,8 +339,9 @@ def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes
     for i, lamp in enumerate(lamps):
         place = _blocked(lamp.at, lines, boxes, circles) if inside(walls, lamp.at) else None  # else: outside
         if place:
-            src.error(("lamp", i, "at"), f"[[lamp]] #{i + 1} at {list(lamp.at)} is {place}: its light cannot "
-                      "reach the robot", "move the lamp into the open")
+            src.error(("lamp", i, "at"), N_("[[lamp]] #{n} at {at} is {place}: its light cannot reach the robot",
+                                            n=i + 1, at=list(lamp.at), place=place),
+                      N_("move the lamp into the open"))
 
 
 def _distance_to_segment(p: Point, a: Point, b: Point) -> float:
@@ -347,12 +356,12 @@ def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circ
     """Where ``at`` is shut in: inside a box or a circle, or on a wall line; None when in the open."""
     for k, box in enumerate(boxes):
         if inside(box.corners(), at):
-            return f"inside [[box]] #{k + 1}"
+            return N_("inside [[box]] #{n}", n=k + 1)
     for k, circle in enumerate(circles):
         if math.dist(circle.at, at) < circle.radius:
-            return f"inside [[circle]] #{k + 1}"
+            return N_("inside [[circle]] #{n}", n=k + 1)
     if any(_distance_to_segment(at, a, b) < ON_A_WALL for a, b in lines):
-        return "on a wall"
+        return N_("on a wall")
     return None
 
 
