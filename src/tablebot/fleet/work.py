@@ -225,14 +225,14 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
 
 
 def chunk_functions(threads: int | None) -> tuple[Any, ...]:
-    """The compiled functions a chunk calls: the start check of a scene, a robot's first reading, and the fleet
+    """The compiled functions a chunk calls: the start check of a scene, its robots' first readings, and the fleet
     loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
     calling thread)."""
     from tablebot.fleet.kernel import run_fleet, run_fleet_serial
     from tablebot.sim import contacts, kernel
 
     loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
-    return (contacts.body_corners, contacts.deepest_contact, kernel.sense, kernel.observe, *loops)
+    return (contacts.body_corners, contacts.deepest_contact, kernel.first_readings, *loops)
 
 
 def warm_worker(job: Job, slot: str, share: int = 1,
