@@ -13,8 +13,10 @@ from typing import IO, Any
 from tablebot.codegen.packing import plan
 from tablebot.diagnostics import fail
 from tablebot.firmware.framing import Decoder
+from tablebot.firmware.several import SeveralDecoder
 from tablebot.formats.trace_lines import dumps
 from tablebot.machine import Machine
+from tablebot.tables import RobotTables, several
 
 CHUNK = 4096
 MAX_WARNINGS = 20  # a stream of garbage would otherwise print a warning per sync byte
@@ -75,6 +77,9 @@ def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str
 
     A stream in which no frame decodes at all is refused: it is not this firmware's trace.
     """
+    tables = several(machine.table)
+    if tables is not None:  # a robot of several tables: its firmware's frames carry all of them
+        return _monitor_several(tables, chunks, out, source, ticks, warn)
     decoder = Decoder(machine, plan(machine))
     written = warned = 0
     for chunk in chunks:
@@ -99,7 +104,30 @@ def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str
     return written
 
 
-def _warn(decoder: Decoder, source: str, warn: Callable[[str], Any], warned: int) -> int:
+def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str], source: str, ticks: int | None,
+                     warn: Callable[[str], Any]) -> int:
+    """:func:`monitor` of the firmware of a robot of several tables (tablebot.firmware.several)."""
+    decoder = SeveralDecoder(tables)
+    written = warned = 0
+    for chunk in chunks:
+        lines = decoder.feed(chunk)
+        warned = _warn(decoder, source, warn, warned)
+        for line in lines[:len(lines) if ticks is None else ticks - written]:
+            out.write(dumps(line) + "\n")
+            written += 1
+        if ticks is not None and written >= ticks:
+            return written
+        out.flush()
+    if not decoder.hellos and not decoder.ticks:
+        raise fail(source, f"no trace frame in {decoder.consumed + len(decoder.buffer)} bytes",
+                   "give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this robot by "
+                   "`tablebot build`")
+    if decoder.buffer:
+        warn(f"{source}: warning: {len(decoder.buffer)} bytes at the end are not a whole frame")
+    return written
+
+
+def _warn(decoder: Decoder | SeveralDecoder, source: str, warn: Callable[[str], Any], warned: int) -> int:
     """Pass the decoder's new problems on, up to MAX_WARNINGS in all; returns how many were passed."""
     for problem in decoder.problems:
         if warned < MAX_WARNINGS:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +27,7 @@ from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
 
-__all__ = ["MAIN", "build_several", "decode", "emulate_several", "tick_payload"]
+__all__ = ["MAIN", "SeveralDecoder", "build_several", "decode", "emulate_several", "tick_payload"]
 
 MAIN = "tb_firmware_several.c"
 HELLO, TICK, VERSION = ord("H"), ord("S"), 2
@@ -87,45 +88,85 @@ def emulate_several(firmware: Firmware, tables: RobotTables, ticks: Sequence[Tic
 
 
 def decode(tables: RobotTables, data: bytes) -> list[dict[str, Any]]:
-    """The trace lines of a firmware's UART stream: a hello frame, then one tick frame per tick; anything
-    else (a bad checksum, a gap in the tick numbers) is refused, saying where."""
-    lengths = {HELLO: 4, TICK: tick_payload(tables)}
-    lines: list[dict[str, Any]] = []
-    at = 0
-    while at < len(data):
-        kind = data[at + 1] if at + 1 < len(data) else None
-        if data[at] != SYNC or kind not in lengths:
-            raise fail("uart", f"byte {at}: no frame starts here", "report this as a tablebot bug")
-        end = at + 2 + lengths[kind]
-        body = data[at + 1:end + 1]
-        if len(body) < lengths[kind] + 2:  # the run ended inside a frame
-            break
-        if checksum(body[:-1]) != body[-1]:
-            raise fail("uart", f"byte {at}: bad checksum", "report this as a tablebot bug")
-        if kind == TICK:
-            lines.append(_line(tables, body[1:-1], len(lines)))
-        elif body[1] != VERSION or body[2] != len(tables.machines):
-            raise fail("uart", f"the firmware says version {body[1]}, {body[2]} tables", "build it again")
-        at = end + 1
+    """The trace lines of a whole UART stream; anything wrong in it (a bad checksum, a lost tick, a hello of
+    another firmware) is refused, saying where."""
+    decoder = SeveralDecoder(tables)
+    lines = decoder.feed(data)
+    if decoder.problems:
+        raise fail("uart", decoder.problems[0], "report this as a tablebot bug")
     return lines
 
 
-def _line(tables: RobotTables, payload: bytes, expected: int) -> dict[str, Any]:
-    tick = struct.unpack_from("<H", payload)[0]
-    if tick != expected & 0xFFFF:
-        raise fail("uart", f"tick frame {expected} says tick {tick}: a frame was dropped", "use a slower tick")
-    line: dict[str, Any] = {"tick": expected}
-    at, size = 2, struct.calcsize(TABLE_FORMAT)
-    for i, (name, machine) in enumerate(zip(tables.names, tables.machines, strict=True)):
-        event, row, state, timer = struct.unpack_from(TABLE_FORMAT, payload, at)
-        at += size
-        key = "" if i == 0 else f"{name}."
-        line.update({f"{key}event": event, f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
-                     f"{key}state": machine.states[state], f"{key}timer": timer})
-    n_out = len(tables.output_names)
-    outputs = struct.unpack_from(f"<{n_out}b", payload, at)
-    counters = struct.unpack_from(f"<{len(tables.robot.counters)}H", payload, at + n_out)
-    main = {**dict(zip(tables.output_names, outputs, strict=True)),
-            **dict(zip(tables.robot.counter_names, counters, strict=True))}
-    keys = list(line)
-    return {**{k: line[k] for k in keys[:5]}, **main, **{k: line[k] for k in keys[5:]}}
+@dataclass
+class SeveralDecoder:
+    """Feed it UART bytes in any chunks; it returns trace lines (keyed as a trace of several tables is) and
+    notes what went wrong in ``problems``: it resynchronises on the next sync byte after a bad checksum,
+    extends tick numbers past 16 bits and names lost ticks (``tablebot monitor``)."""
+
+    tables: RobotTables
+    problems: list[str] = field(default_factory=list)
+    hellos: int = 0
+    ticks: int = 0
+    consumed: int = 0
+    buffer: bytearray = field(default_factory=bytearray)
+    last_tick: int | None = None
+
+    def feed(self, data: bytes) -> list[dict[str, Any]]:
+        lengths = {HELLO: 4, TICK: tick_payload(self.tables)}
+        self.buffer += data
+        buf, at = self.buffer, 0
+        lines: list[dict[str, Any]] = []
+        while True:
+            at = buf.find(SYNC, at)
+            if at < 0 or at + 2 > len(buf):
+                break
+            length = lengths.get(buf[at + 1])
+            if length is None:
+                at += 1
+                continue
+            end = at + 2 + length + 1
+            if end > len(buf):
+                break
+            body = bytes(buf[at + 1:end])
+            if checksum(body[:-1]) != body[-1]:
+                self.problems.append(f"bad checksum at byte {self.consumed + at}; resynchronising")
+                at += 1
+                continue
+            if body[0] == TICK:
+                lines.append(self._line(body[1:-1]))
+            else:
+                self._hello(body[1:-1])
+            at = end
+        done = at if at >= 0 else len(buf)
+        del buf[:done]
+        self.consumed += done
+        self.ticks += len(lines)
+        return lines
+
+    def _hello(self, payload: bytes) -> None:
+        self.hellos += 1
+        self.last_tick = None  # the firmware restarted: its tick count starts again at 0
+        if payload[0] != VERSION or payload[1] != len(self.tables.machines):
+            self.problems.append(f"the firmware says version {payload[0]}, {payload[1]} tables: not this robot's")
+
+    def _line(self, payload: bytes) -> dict[str, Any]:
+        tables = self.tables
+        tick16 = struct.unpack_from("<H", payload)[0]
+        tick = tick16 if self.last_tick is None else self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
+        if self.last_tick is not None and tick != self.last_tick + 1:
+            self.problems.append(f"ticks {self.last_tick + 1}..{tick - 1} missing from the stream")
+        self.last_tick = tick
+        line: dict[str, Any] = {"tick": tick}
+        at, size = 2, struct.calcsize(TABLE_FORMAT)
+        later: dict[str, Any] = {}  # the other tables' keys come after the robot's outputs and counters
+        for i, (name, machine) in enumerate(zip(tables.names, tables.machines, strict=True)):
+            event, row, state, timer = struct.unpack_from(TABLE_FORMAT, payload, at)
+            at += size
+            key, into = ("", line) if i == 0 else (f"{name}.", later)
+            into.update({f"{key}event": event, f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
+                         f"{key}state": machine.states[state], f"{key}timer": timer})
+        n_out = len(tables.output_names)
+        line.update(zip(tables.output_names, struct.unpack_from(f"<{n_out}b", payload, at), strict=True))
+        counters = struct.unpack_from(f"<{len(tables.robot.counters)}H", payload, at + n_out)
+        line.update(zip(tables.robot.counter_names, counters, strict=True))
+        return {**line, **later}
