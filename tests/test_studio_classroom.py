@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -190,6 +191,8 @@ def test_a_folder_without_a_table_says_so_in_the_page_and_the_terminal(browser: 
                                                                        shots: Path) -> None:
     empty = tmp_path / "empty"
     empty.mkdir()
+    said = _terminal_of_studio(empty)
+    assert f"there is no table in {empty}" in said and "tablebot new my-robot --from line-follower" in said
     for studio in served(empty, None):
         page = open_page(browser, studio.url, table=False)
         page.wait_for_selector(".no-table")
@@ -197,10 +200,16 @@ def test_a_folder_without_a_table_says_so_in_the_page_and_the_terminal(browser: 
         assert "There is no table in empty" in text and "tablebot new my-robot --from bumberbot" in text
         assert page.locator("#save").is_disabled() and page.locator("#add-row").is_disabled()
         page.screenshot(path=str(shots / "empty.png"))
+        page.fill("#new-name", "../outside")  # one plain name, inside the folder: refused in words
+        page.click('.no-table button:text-is("bumberbot")')
+        page.wait_for_function("() => document.querySelector('#banner').textContent.includes('a new robot')")
+        page.fill("#new-name", "robo")
+        page.click('.no-table button:text-is("bumberbot")')
+        page.wait_for_function("() => document.querySelectorAll('table.grid tbody tr').length === 37")
+        assert (empty / "robo" / "table.csv").is_file() and not (tmp_path / "outside").exists()
+        assert page.locator("#table-pick").input_value() == "robo/table.csv" and page.locator("#save").is_disabled()
         assert page.errors == []
         page.context.close()
-    said = _terminal_of_studio(empty)
-    assert f"there is no table in {empty}" in said and "tablebot new my-robot --from line-follower" in said
 
 
 def _terminal_of_studio(folder: Path) -> str:
@@ -208,10 +217,12 @@ def _terminal_of_studio(folder: Path) -> str:
     env = {**os.environ, "COLUMNS": "200"}
     process = subprocess.Popen([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0"],
                                cwd=folder, env=env, stderr=subprocess.PIPE, text=True)
+    lines: list[str] = []  # read in a thread: a line that never comes must not block the test
+    reader = threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True)  # type: ignore[arg-type]
+    reader.start()
     try:
-        lines: list[str] = []
-        wait_for(lambda: lines.append(process.stderr.readline()) or "tablebot studio my-robot" in lines[-1]
-                 or process.poll() is not None, "the studio's notes", 30)
+        wait_for(lambda: "tablebot studio my-robot" in "".join(lines) or process.poll() is not None,
+                 "the studio's notes", 30)
         return "".join(lines)
     finally:
         process.terminate()

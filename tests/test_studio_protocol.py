@@ -102,6 +102,7 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
         "insert_row": {"after": 0, "seq": 2}, "delete_row": {"row": 1, "seq": 3}, "save": {},
         "restore": {"header": None, "grid": None, "base": "v"}, "sim": {"action": "step"},
         "trace": {"path": "nothing.jsonl"}, "counterexample": {"name": "no_such_property"}, "files": {},
+        "new": {"template": "empty", "name": "table.csv"},  # a taken name: refused in words
     }
     assert sorted(messages) == sorted(protocol.OPERATIONS)
 

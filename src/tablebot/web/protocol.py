@@ -18,7 +18,7 @@ from tablebot.web.errors import Refused
 __all__ = [
     "MESSAGES", "OPERATIONS", "AnalysisMsg", "ArenaMsg", "ConflictMsg", "ControlMsg", "Counterexample",
     "DeleteRow", "DiagramMsg", "Edit", "ErrorMsg", "Files", "FilesMsg", "FrameMsg", "GridMsg", "InsertRow",
-    "Message", "NoticeMsg", "Open", "Operation", "Restore", "Save", "SavedMsg", "Sim", "TableMsg", "Trace",
+    "Message", "NewRobot", "NoticeMsg", "Open", "Operation", "Restore", "Save", "SavedMsg", "Sim", "TableMsg", "Trace",
     "TraceMsg", "op_name", "operation",
 ]
 
@@ -187,8 +187,23 @@ class Files(Operation):
     op: ClassVar[str] = "files"
 
 
+@dataclass(frozen=True)
+class NewRobot(Operation):
+    """A robot from ``template`` (one of ``tablebot new``'s) in a new folder ``name`` of the served one, opened:
+    what the page offers in a folder without a table (Workspace.new_robot checks both)."""
+
+    op: ClassVar[str] = "new"
+    template: str
+    name: str
+
+    @classmethod
+    def of(cls, message: Mapping[str, Any]) -> NewRobot:
+        return cls(_text(message, "template"), _text(message, "name"))
+
+
 OPERATIONS: dict[str, type[Operation]] = {
-    kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files)
+    kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files,
+                               NewRobot)
 }
 
 

@@ -29,6 +29,7 @@ from tablebot.web.protocol import (
     FilesMsg,
     InsertRow,
     Message,
+    NewRobot,
     NoticeMsg,
     Open,
     Operation,
@@ -116,6 +117,10 @@ class Session:
                 await self.player.counterexample(op)
             case Files():
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
+            case NewRobot():
+                path = await asyncio.to_thread(self.workspace.new_robot, op.template, op.name)
+                await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
+                await self.dispatch(Open(path))
             case _:
                 raise AssertionError(f"no handler for {op!r}")  # protocol.OPERATIONS and this match differ
 

@@ -46,7 +46,7 @@ async function start() {
   const config = await reply.json();
   store.set({ files: config, folder: config.folder });
   const wanted = params.get("table") || config.table || config.tables[0];
-  if (!wanted) showNoTable(config);
+  if (!wanted) showNoTable(config, link.send);
   // each connection opens the table, and offers back the edits this browser kept of it
   const hello = () => {
     const path = store.get().path || wanted;

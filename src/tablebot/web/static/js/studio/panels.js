@@ -1,5 +1,5 @@
 // The parts of the page drawn from the store: each function subscribes to the keys it shows.
-import { addOption, all, byId, make } from "../lib/dom.js";
+import { addOption, all, button, byId, make } from "../lib/dom.js";
 import { describeTick } from "../views/player.js";
 import { banner } from "./banner.js";
 import { arenaNote } from "./messages.js";
@@ -131,16 +131,23 @@ function showControls(store) {
   });
 }
 
-/** A folder without a table: the page says so, and how to start one from `tablebot new`'s templates. */
-export function showNoTable(config) {
+/** A folder without a table: the page says so, and offers `tablebot new`'s templates (a click makes the robot
+ * in a new folder here and opens it; the commands do the same in a terminal). */
+export function showNoTable(config, send) {
   const what = make("p", {}, `There is no table in ${config.folder || "this folder"}: the studio opens a .csv or .tsv `
-    + "file whose first line names the state and next columns. Start a robot from one of tablebot's templates: "
-    + "in a terminal, in this folder, type one of");
-  const commands = make("ul", { className: "commands" }, ...(config.templates || []).map((name) =>
-    make("li", {}, make("code", {}, `tablebot new my-robot --from ${name}`))));
+    + "file whose first line names the state and next columns. Start a robot from one of tablebot's templates, "
+    + "in a new folder here named");
+  const name = make("input", { id: "new-name", value: "my-robot", spellcheck: false, maxLength: 64 });
+  name.setAttribute("aria-label", "the new robot's folder");
+  const templates = config.templates || [];
+  const starts = make("p", { className: "starts" }, name, " from ", ...templates.map((template) => button(template,
+    () => send({ op: "new", template, name: name.value.trim() }), { className: "primary" })));
+  const commands = make("ul", { className: "commands" }, ...templates.map((template) =>
+    make("li", {}, make("code", {}, `tablebot new my-robot --from ${template}`))));
   byId("grid").replaceChildren(make("div", { className: "no-table", role: "status" },
-    make("h2", {}, "No table here"), what, commands,
-    make("p", {}, "then open it: ", make("code", {}, "tablebot studio my-robot"),
+    make("h2", {}, "No table here"), what, starts,
+    make("p", {}, "or in a terminal, in this folder, one of"), commands,
+    make("p", {}, "then ", make("code", {}, "tablebot studio my-robot"),
       " (or start the studio in the folder that holds your table).")));
   byId("save-state").textContent = "no table";
 }

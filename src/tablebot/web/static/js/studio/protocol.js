@@ -15,6 +15,7 @@ export const OPERATIONS = Object.freeze({
   trace: ["path"],
   counterexample: ["name", "where"],
   files: [],
+  new: ["template", "name"],  // a robot from a `tablebot new` template, in a folder without a table
 });
 
 /** The kinds of message the server sends, which the page handles (messages.js, one handler each). */
