@@ -44,7 +44,7 @@ golden: setup
 	.venv/bin/python scripts/golden.py
 
 bench: setup
-	status=0; for b in engine sim check limits mcu turn_drift studio studio_tabs fleet evolve controllers statecharts demo; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
+	status=0; for b in engine sim check limits mcu turn_drift studio studio_tabs fleet evolve controllers statecharts harness_several demo; do .venv/bin/python benchmarks/$$b.py || status=1; done; exit $$status
 
 # The Python lock, requirements/dev.lock (what `make setup` installs): pyproject.toml's packages with the dev
 # extra, resolved once for every platform and Python 3.11+, with their hashes. Pins already in the lock are
