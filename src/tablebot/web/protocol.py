@@ -190,7 +190,7 @@ class Files(Operation):
 @dataclass(frozen=True)
 class NewRobot(Operation):
     """A robot from ``template`` (one of ``tablebot new``'s) in a new folder ``name`` of the served one, opened:
-    what the page offers in a folder without a table (Workspace.new_robot checks both)."""
+    what the page offers in a folder without a table (web.new_robot checks both)."""
 
     op: ClassVar[str] = "new"
     template: str

@@ -20,6 +20,7 @@ from tablebot.formats.csv_document import CsvDocument
 from tablebot.web.arena_robot import ArenaRobot
 from tablebot.web.draft import Draft, conflict
 from tablebot.web.errors import Refused, log
+from tablebot.web.new_robot import new_robot
 from tablebot.web.protocol import (
     Counterexample,
     DeleteRow,
@@ -118,7 +119,7 @@ class Session:
             case Files():
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
             case NewRobot():
-                path = await asyncio.to_thread(self.workspace.new_robot, op.template, op.name)
+                path = await asyncio.to_thread(new_robot, self.workspace.root, op.template, op.name)
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
                 await self.dispatch(Open(path))
             case _:

@@ -18,14 +18,12 @@ import enum
 import errno
 import hashlib
 import os
-import re
 import stat
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from tablebot.diagnostics import TableBotError
 from tablebot.web.errors import Refused
 from tablebot.web.temporaries import sweep, temp_name
 
@@ -50,7 +48,6 @@ Folder = int | str  # an open folder's descriptor, or (without AT_FOLDER) its pa
 READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | getattr(os, "O_NOCTTY", 0) | CLOEXEC
 DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | NOFOLLOW | CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
-NEW_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")  # a new robot's folder: one plain name
 OTHER_TAB = "saved in another tab"  # how a file changed, when the version there is one this studio wrote
 
 
@@ -232,26 +229,6 @@ class Workspace:
             return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
         finally:
             os.close(fd)
-
-    # --- a new robot -----------------------------------------------------------------------------------
-
-    def new_robot(self, template: object, name: object) -> str:
-        """Make the folder ``name`` in the served one from one of ``tablebot new``'s templates (as the command
-        does: all its files at once, or none); the relative name of its table."""
-        from tablebot.templates import TEMPLATES, make, write_folder
-
-        if template not in TEMPLATES:
-            raise Refused(f"no template {_shown(str(template))}: tablebot new has {', '.join(TEMPLATES)}")
-        if not isinstance(name, str) or not NEW_NAME.fullmatch(name):
-            raise Refused("a new robot's name is letters, digits, - and _ (at most 64, not starting with - or _)")
-        folder = self.root / name
-        if folder.is_symlink() or folder.exists():
-            raise Refused(f"{name} is there already: choose another name")
-        try:
-            write_folder(folder, make(template, name, [], []))
-        except TableBotError as exc:
-            raise Refused(str(exc)) from None
-        return f"{name}/table.csv"
 
     # --- listing ---------------------------------------------------------------------------------------
 
