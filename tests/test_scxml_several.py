@@ -82,3 +82,20 @@ def test_python_statemachine_runs_an_scxml_documents_regions_in_document_order(f
                    format="scxml")()
     machine.send("go")
     assert machine.model.x == 12  # the first region's action, then the second's
+
+
+def test_an_import_that_would_replace_a_table_of_yours_writes_none(tmp_path: Path) -> None:
+    """Without --force a table of yours is never replaced, and then no other table is written either (before, the
+    main table was written and the second refused, a half-imported robot)."""
+    tables = Loaded.open(Path("examples/bumberbot-lights")).tables
+    assert tables is not None
+    source = tmp_path / "machine.scxml"
+    source.write_text(export_scxml(tables.tables), encoding="utf-8")
+    folder = tmp_path / "robot"
+    folder.mkdir()
+    (folder / "lights.csv").write_text("state,next\n1,1\n", encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "tablebot", "import", str(source), "--from", "scxml", "--out",
+                           str(folder)], capture_output=True, text=True, check=False)
+    assert done.returncode == 2 and "lights.csv exists and is a table file" in done.stderr
+    assert sorted(p.name for p in folder.iterdir()) == ["lights.csv"]
+    assert (folder / "lights.csv").read_text(encoding="utf-8") == "state,next\n1,1\n"

@@ -16,6 +16,7 @@ from pathlib import Path
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import fail
 from tablebot.files import out_folder, write_text
+from tablebot.fileset import file_set
 from tablebot.formats.table_write import format_table
 from tablebot.robot import Robot, StateId
 from tablebot.table import Table
@@ -106,7 +107,8 @@ def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | No
                    "give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv")
     folder = out_folder(out, "--out")
     files = ["table.csv", *(f"{t.name}.csv" for t in tables[1:])]  # the main one where a folder's table is
-    lines = [f"wrote {write_text(folder / name, table_text(t))}" for name, t in zip(files, tables, strict=True)]
+    with file_set(folder):  # all the tables or none: a refused one (a table of yours, no --force) leaves none
+        lines = [f"wrote {write_text(folder / name, table_text(t))}" for name, t in zip(files, tables, strict=True)]
     lines.append("the robot file's [tables]: " + "; ".join(
         f'{t.name} = {{ file = "{name}", initial_state = {t.robot.initial_state!r}, '
         f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}'
