@@ -83,3 +83,18 @@ def test_the_notebook_pattern_catches_what_the_readme_used_to_say() -> None:
     for said in ("issue 22's targets", "in the session, against", "other engineers' test runs",
                  "`../shared/rpp-corpus`", "4.4 s on this 2-core machine"):
         assert NOTEBOOK_RE.search(said), said
+
+
+def test_every_german_page_is_the_twin_of_an_english_one_in_the_navigation() -> None:
+    """The site's language switch leads from PAGE.de.md to PAGE.md and back: each German page has its English
+    page, which the navigation lists (mkdocs.yml), and the German home page names each German page."""
+    german = sorted((ROOT / "docs").glob("*.de.md"))
+    assert {p.name for p in german} >= {"index.de.md", "getting-started.de.md", "install.de.md", "tutorial.de.md",
+                                        "teachers.de.md", "classroom.de.md"}
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    home = (ROOT / "docs" / "index.de.md").read_text(encoding="utf-8")
+    for page in german:
+        english = page.name.removesuffix(".de.md") + ".md"
+        assert (page.parent / english).exists(), english
+        assert re.search(rf":\s+{re.escape(english)}$", nav, re.M), f"{english} is not in mkdocs.yml's nav"
+        assert english == "index.md" or f"]({english})" in home, f"index.de.md does not name {english}"
