@@ -65,3 +65,20 @@ def test_export_writes_a_unit_per_table_beside_the_engine_as_it_is(tmp_path: Pat
     assert built.returncode == 0, built.stderr
     ran = subprocess.run([str(out / "robot")], input="0\n16\n", capture_output=True, text=True, check=True)
     assert len(ran.stdout.splitlines()) == 2
+
+
+def test_a_robot_reading_more_inputs_than_the_c_mask_holds_is_refused(tmp_path: Path) -> None:
+    """Each table fits the C engine (at most 32 events), but the robot's input mask is one uint32_t: 34 inputs
+    read by two tables are refused at the robot file, before any file is written."""
+    names = [f"B{i}" for i in range(34)]
+    (tmp_path / "robot.toml").write_text(
+        'name = "Wide"\n[inputs]\n' + "".join(f'{n} = "button {n}"\n' for n in names)
+        + '[motors]\nM1 = "right"\nM2 = "left"\n[tables]\n'
+        + 'a = { file = "a.csv", initial_state = 1 }\nb = { file = "b.csv", initial_state = 1 }\n')
+    for file, motor, part in (("a.csv", "M1", names[:17]), ("b.csv", "M2", names[17:])):
+        (tmp_path / file).write_text(f"state,{','.join(part)},{motor},timer,next\n1,{',' * (len(part) - 1)},1,0,1\n")
+    done = subprocess.run([".venv/bin/tablebot", "export", str(tmp_path / "a.csv"), "--to", "c", str(tmp_path / "c")],
+                          capture_output=True, text=True, check=False, cwd=LIGHTS.parents[1])
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "the robot's tables read 34 inputs, more than the 32 the C engine of several tables takes" in done.stderr
+    assert not (tmp_path / "c").exists()

@@ -15,8 +15,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from tablebot.codegen.packing import plan
+from tablebot.codegen.packing import MAX_EVENTS, plan
 from tablebot.codegen.source import ENGINE_FILES, CSource, c_list, config_header, table_source, template
+from tablebot.diagnostics import fail
 from tablebot.escape import c_comment
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
@@ -46,6 +47,9 @@ def unit_name(name: str) -> str:
 
 def generate_several(tables: RobotTables, lookup: str = "auto", order: Sequence[int] | None = None) -> CSource:
     """The C files of a robot of several tables (the layout returned is the main table's)."""
+    if len(tables.input_bits) > MAX_EVENTS:  # the robot's input mask is one uint32_t
+        raise fail(tables.robot.source, f"the robot's tables read {len(tables.input_bits)} inputs, more than the "
+                   f"{MAX_EVENTS} the C engine of several tables takes", "read fewer inputs in the tables")
     files = {name: template(name) for name in ENGINE_FILES}
     files["tb_config.h"] = CONFIG_GUARD
     layouts = [plan(machine, lookup) for machine in tables.machines]
