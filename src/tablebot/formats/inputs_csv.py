@@ -20,6 +20,7 @@ from tablebot.diagnostics import Collector, TableBotError, fail
 from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.files import write_text
 from tablebot.formats.trace_lines import trace_records
+from tablebot.i18n import N_
 from tablebot.table import TIMER_EVENT, Table
 
 
@@ -60,7 +61,8 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     records = read_records(text, str(path))  # one at a time: only the ticks are kept
     header = next((record for record in records if not record.is_blank()), None)  # blank lines above it
     if header is None:  # (below it, a blank row is a tick)
-        raise fail(path, "the inputs file is empty", "write a header of input names, then one row per tick", 1, 1)
+        raise fail(path, N_("the inputs file is empty"), N_("write a header of input names, then one row per tick"),
+                   1, 1)
     after = records_after(text, header.line)
     if after is not None and after > MAX_INPUT_TICKS:  # known at once: no row is read
         raise _too_many_ticks(path, header.line + MAX_INPUT_TICKS + 1)
@@ -89,8 +91,8 @@ def _count(ticks: list[TickInput], path: Path, line: int) -> None:
 
 
 def _too_many_ticks(path: Path, line: int) -> TableBotError:
-    return fail(path, f"more than {MAX_INPUT_TICKS:,} ticks, the most tablebot replays",
-                "replay a shorter recording (split the file)", line, 1)
+    return fail(path, N_("more than {most:,} ticks, the most tablebot replays", most=MAX_INPUT_TICKS),
+                N_("replay a shorter recording (split the file)"), line, 1)
 
 
 def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tuple[str, str]]:
@@ -104,15 +106,17 @@ def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tu
         kind = ("input" if name in robot.inputs else "pulses" if name in robot.counter_names
                 else "tick" if name == "tick" else "blank" if not name else "bad")
         if name == TIMER_EVENT:
-            out.error(cell.line, cell.column, "T is never an input: the engine makes it from the timer",
-                      "remove the T column")
+            out.error(cell.line, cell.column, N_("T is never an input: the engine makes it from the timer"),
+                      N_("remove the T column"))
         elif kind == "bad":
-            out.error(cell.line, cell.column, f"unknown input {name!r} for robot {robot.name}",
-                      f"inputs are {', '.join(robot.inputs)}; counters (pulses per tick) are "
-                      f"{', '.join(robot.counter_names) or 'none'}")
+            out.error(cell.line, cell.column, N_("unknown input {name!r} for robot {robot}", name=name,
+                                                 robot=robot.name),
+                      N_("inputs are {inputs}; counters (pulses per tick) are {counters}",
+                         inputs=", ".join(robot.inputs), counters=", ".join(robot.counter_names) or N_("none")))
         elif name in seen:
-            out.error(cell.line, cell.column, f"column {name!r} appears twice (first at column {seen[name].column})",
-                      "delete or rename one of them")
+            out.error(cell.line, cell.column, N_("column {name!r} appears twice (first at column {first})", name=name,
+                                                 first=seen[name].column),
+                      N_("delete or rename one of them"))
             kind = "bad"
         if name:
             seen.setdefault(name, cell)
@@ -131,13 +135,19 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events
         if kind == "blank":
             headerless(cell, out)
         elif not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
-            want = "0 or 1" if kind == "input" else "a pulse count (0 or more)"
-            out.error(cell.line, cell.column, f"{name}: {text!r} is not {want}", f"write {want}; blank means 0")
+            if kind == "input":
+                out.error(cell.line, cell.column, N_("{name}: {text!r} is not 0 or 1", name=name, text=text),
+                          N_("write 0 or 1; blank means 0"))
+            else:
+                out.error(cell.line, cell.column, N_("{name}: {text!r} is not a pulse count (0 or more)", name=name,
+                                                     text=text),
+                          N_("write a pulse count (0 or more); blank means 0"))
         elif kind == "input":
             mask |= machine.input_bits.get(name, 0) if text == "1" else 0
         elif len(text) > MAX_NUMBER_CHARS:  # int() of it may fail, and no encoder counts that many in a tick
-            out.error(cell.line, cell.column, f"{name}: a number of {len(text):,} characters is too many pulses",
-                      "write the pulses of one tick (a few at most); blank means 0")
+            out.error(cell.line, cell.column, N_("{name}: a number of {count:,} characters is too many pulses",
+                                                 name=name, count=len(text)),
+                      N_("write the pulses of one tick (a few at most); blank means 0"))
         else:
             pulses[counters.index(name)] = int(text)
     cells_beyond(cells, len(columns), out)
@@ -180,8 +190,8 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
         bad = [key for key, v in zip(keys, values, strict=True)
                if isinstance(v, bool) or not isinstance(v, int) or v < 0]
         if bad:
-            out.error(number, 1, f"this trace line has no whole-number {bad[0]}",
-                      "replay a trace that a run of this table recorded (tablebot run --out)")
+            out.error(number, 1, N_("this trace line has no whole-number {key}", key=bad[0]),
+                      N_("replay a trace that a run of this table recorded (tablebot run --out)"))
             continue
         _count(ticks, path, number)
         key = (values[0] & machine.input_mask, *values[1:])
