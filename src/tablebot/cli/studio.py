@@ -31,6 +31,9 @@ def studio_cmd(
     no_browser: bool = typer.Option(False, "--no-browser", help="Do not open a browser."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every request (the token shown as "
                                  "[token])."),
+    open_link: str | None = typer.Option(None, "--open", metavar="LINK", help="Open the table a share link "
+                                         "carries (tablebot share): its files go into a new folder in FOLDER, "
+                                         "named as the link names it, and its table opens."),
 ) -> None:
     """Edit a table in the browser, see its checks as you type, and watch the robot run it live.
 
@@ -46,6 +49,8 @@ def studio_cmd(
     from tablebot.web.launch import open_in_browser, redirect_file
 
     root, table = _root_and_table(where)
+    if open_link is not None:
+        table = _unpack_link(root, open_link)
     address = host or LOCAL
     sock = _bind(address, port)
     access = Access.serving(address, sock.getsockname()[1])
@@ -89,6 +94,22 @@ def _warn_network(root: Path, address: str, port: int) -> None:
         "address below (with its token) can read the folder's tables, robot and world files and traces, and change "
         "its tables. The connection is plain HTTP: anyone who can watch the network can see the token.").format(
         folder=terminal(str(root)), address=terminal(address), port=port), soft_wrap=True)
+
+
+def _unpack_link(root: Path, link: str) -> str:
+    """Write the files a share link carries into a new folder of ``root`` (never over anything: NAME, NAME-2,
+    ...), exactly as shared; the table's name relative to ``root``. A link that is no link, cut, damaged, from
+    another version or carrying a broken table is refused in words, naming --open."""
+    from tablebot import share
+
+    shared = share.decode(link, "--open")
+    shared.check("--open")
+    folder = next(root / name for name in (shared.name, *(f"{shared.name}-{n}" for n in range(2, 1000)))
+                  if not (root / name).exists() and not (root / name).is_symlink())
+    table = shared.write(folder)
+    err_console.print(f"tablebot studio: the link's table {terminal(shared.name)} is in {terminal(str(folder))} "
+                      "(with its robot file and world), as it was shared", soft_wrap=True)
+    return table.relative_to(root).as_posix()
 
 
 def _say_no_table(root: Path) -> None:

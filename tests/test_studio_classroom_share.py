@@ -1,0 +1,88 @@
+"""`tablebot studio --open LINK` (issue 37 §2): a real studio process opens the table a share link carries,
+exactly as shared, cell for cell in a real Chromium; a second open never writes over the first; a cut link is
+refused in words, naming --open."""
+
+from __future__ import annotations
+
+import csv
+import os
+import re
+import subprocess
+import sys
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from core_helpers import EXAMPLE
+from studio_helpers import chromium, wait_for
+from tablebot import share
+
+CELLS = """() => [...document.querySelectorAll('table.grid tbody tr')]
+  .map((tr) => [...tr.querySelectorAll('td[data-col]')].map((td) => {
+    const b = td.querySelector('button.flag'), i = td.querySelector('input, textarea');
+    return b ? (b.getAttribute('aria-pressed') === 'true' ? '1' : '') : i.value; }))"""
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    yield from chromium()
+
+
+class Studio:
+    """``tablebot studio --open LINK`` in ``folder``, a real process; ``said`` what it wrote to the terminal."""
+
+    def __init__(self, folder: Path, link: str) -> None:
+        self.process = subprocess.Popen([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0",
+                                         "--open", link], cwd=folder, env={**os.environ, "COLUMNS": "300"},
+                                        stderr=subprocess.PIPE, text=True)
+        self.lines: list[str] = []  # read in a thread: a line that never comes must not block the test
+        reader = threading.Thread(target=lambda: self.lines.extend(self.process.stderr), daemon=True)  # type: ignore[arg-type]
+        reader.start()
+
+    @property
+    def said(self) -> str:
+        return "".join(self.lines)
+
+    def url(self) -> str:
+        return wait_for(lambda: re.search(r"http://127\.0\.0\.1:\d+/\?token=\S+", self.said), "the address", 60)[0]
+
+    def stop(self) -> None:
+        self.process.terminate()
+        self.process.wait(10)
+
+
+def test_a_link_opens_its_table_exactly_as_shared_and_never_over_a_folder(browser: Any, tmp_path: Path) -> None:
+    link = share.encode(share.collect(EXAMPLE))
+    studio = Studio(tmp_path, link)
+    try:
+        page = browser.new_page(viewport={"width": 1280, "height": 720})
+        page.goto(studio.url())
+        page.wait_for_function("() => document.querySelectorAll('table.grid tbody tr').length === 37")
+        with (EXAMPLE / "table.csv").open(newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))[1:]
+        assert page.evaluate(CELLS) == rows  # cell for cell
+        assert page.locator("#table-pick").input_value() == "bumberbot/table.csv"
+        assert "the link's table bumberbot is in" in studio.said
+        page.close()
+    finally:
+        studio.stop()
+    for name in ("table.csv", "robot.toml", "arena.toml"):
+        assert (tmp_path / "bumberbot" / name).read_bytes() == (EXAMPLE / name).read_bytes()
+    again = Studio(tmp_path, link)
+    try:
+        assert again.url().endswith("table=bumberbot-2/table.csv")  # the first is kept as it is
+    finally:
+        again.stop()
+    assert (tmp_path / "bumberbot-2" / "table.csv").read_bytes() == (EXAMPLE / "table.csv").read_bytes()
+
+
+def test_a_cut_link_is_refused_in_words(tmp_path: Path) -> None:
+    link = share.encode(share.collect(EXAMPLE))
+    done = subprocess.run([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0",
+                           "--open", link[:300]], cwd=tmp_path, env={**os.environ, "COLUMNS": "300"},
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "--open: error: this share link is cut short or damaged" in done.stderr
+    assert list(tmp_path.iterdir()) == []  # nothing written
