@@ -96,3 +96,16 @@ def test_the_import_command_writes_the_table_and_refuses_with_a_location(tmp_pat
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "matching rule 'sometimes' is not one of document, always" in done.stderr
+
+
+def test_the_documents_name_is_an_identifier_and_the_robots_name_reads_back() -> None:
+    """SCION 4 (@scion-scxml/scxml) makes a JavaScript function's name of <scxml name>: "BumberBot with counters" was
+    a syntax error there, and a crafted robot name would have been code. The name is now letters, digits and _,
+    and the robot's own name is in tb:name."""
+    table = load_table(Path("examples/bumberbot-counters/table.csv"))
+    text = export_scxml([table])
+    assert 'name="BumberBot_with_counters"' in text and 'tb:name="BumberBot with counters"' in text
+    (back,) = read_scxml(text, "machine.scxml")
+    assert back.robot.name == "BumberBot with counters"
+    crafted = replace(table, robot=replace(table.robot, name="x(){}; process.exit(3); function y"))
+    assert 'name="x______process_exit_3___function_y"' in export_scxml([crafted])

@@ -63,7 +63,7 @@ def _found(root: Element, path: str) -> Found:
              for kind in ("motor", "lamp")}
     counters = tuple(Counter(_attr(d, "id", path), _attr(d, "tb:motor", path))
                      for d in data if d.attrs.get("tb:kind") == "counter")
-    found = Found(_attr(root, "name", path), _int(root, "tb:tick-ms", path),
+    found = Found(_attr(root, "tb:name", path), _int(root, "tb:tick-ms", path),
                   tuple(d.attrs["tb:input"] for d in data if "tb:input" in d.attrs), kinds["motor"], kinds["lamp"],
                   counters)
     values = {d.attrs.get("id", ""): d for d in data}

@@ -11,6 +11,7 @@ tablebot's namespace, which SCXML processors ignore.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 from tablebot.formats.statecharts.chart import STARTED, TICK, WRAPPER, Chart, Part, chart_of, pulses
@@ -31,8 +32,8 @@ def export_scxml(tables: Sequence[Table]) -> str:
 def scxml_tree(chart: Chart) -> Element:
     main = chart.main
     robot = main.robot
-    root = Element("scxml", {"version": "1.0", "datamodel": "ecmascript", "name": robot.name, "initial": WRAPPER,
-                             "tb:tick-ms": str(robot.tick_ms)})
+    root = Element("scxml", {"version": "1.0", "datamodel": "ecmascript", "name": identifier(robot.name),
+                             "initial": WRAPPER, "tb:name": robot.name, "tb:tick-ms": str(robot.tick_ms)})
     _datamodel(root.add("datamodel"), chart)
     wrapper = root.add("parallel" if chart.several else "state", id=WRAPPER)
     if not chart.several:
@@ -52,6 +53,14 @@ def scxml_tree(chart: Chart) -> Element:
             _assign(idle, part.row, "-1")
             _assign(idle, part.pending, "0")
     return root
+
+
+def identifier(name: str) -> str:
+    """The robot's name as the document's ``name``: letters, digits and ``_`` only (its exact text is in
+    ``tb:name``). Some processors make code of it (SCION 4, @scion-scxml/scxml, names a JavaScript function after
+    it, so "BumberBot with counters" was a syntax error there, and a crafted name would have been code)."""
+    word = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return word if word[:1].isalpha() or word[:1] == "_" else f"_{word}"
 
 
 def _datamodel(model: Element, chart: Chart) -> None:
