@@ -43,7 +43,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import hashlib
-import json
 import os
 import resource
 import statistics
@@ -53,6 +52,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from fleet_phases import measure as phases  # benchmarks/fleet_phases.py
 from tablebot.testing.dask_cluster import local_cluster
 from tablebot.testing.processes import child_env
 
@@ -120,22 +120,6 @@ def api_rate(robots: int, seconds: float) -> float:
     return robots * round(seconds / 0.010) / elapsed
 
 
-def phases(robots: int, seconds: float) -> dict[str, float]:
-    """A sweep process's time by phase (benchmarks/fleet_phases.py), the interpreter's own start included."""
-    with tempfile.TemporaryDirectory() as out:
-        started = time.perf_counter()
-        done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fleet_phases.py"),
-                               *sweep_args(robots, seconds, out + "/sweep")], cwd=ROOT, env=child_env(),
-                              capture_output=True, text=True)
-        wall = time.perf_counter() - started
-    if done.returncode:
-        raise SystemExit(f"benchmarks/fleet_phases.py failed:\n{done.stderr}")
-    found: dict[str, float] = json.loads(done.stdout.strip().splitlines()[-1])
-    found["interpreter start and exit"] = wall - found.pop("in this interpreter")
-    found["wall"] = wall
-    return found
-
-
 def sweep_ratios(robots: int, seconds: float, repeat: int) -> int:
     """The sweep as a whole process and from Python, each beside the kernel measured alternately with it,
     and the process's time by phase; returns the targets missed."""
@@ -150,7 +134,8 @@ def sweep_ratios(robots: int, seconds: float, repeat: int) -> int:
         kernels.append(kernel_rate(robots, ticks))
         apis.append(api_rate(robots, seconds))
         api_kernels.append(kernel_rate(robots, ticks))
-        parts.append(phases(robots, seconds))
+        with tempfile.TemporaryDirectory() as out:
+            parts.append(phases(sweep_args(robots, seconds, out + "/sweep")))
     rate, inner = work / med(walls), med(kernels)
     missed = 0
     ok = rate >= TARGET_SWEEP

@@ -12,12 +12,32 @@ the whole; the interpreter's own start is what the caller's wall time adds.
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 STARTED = time.perf_counter()
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def measure(args: list[str]) -> dict[str, float]:
+    """``tablebot ARGS`` (a sweep) by phase, run as this script in a fresh process, the interpreter's own start
+    and exit included (the caller's wall time less the script's)."""
+    from tablebot.testing.processes import child_env  # not at the top: the script's own run imports tablebot timed
+
+    started = time.perf_counter()
+    done = subprocess.run([sys.executable, __file__, *args], cwd=ROOT, env=child_env(), capture_output=True,
+                          text=True)
+    wall = time.perf_counter() - started
+    if done.returncode:
+        raise SystemExit(f"benchmarks/fleet_phases.py failed:\n{done.stderr}")
+    found: dict[str, float] = json.loads(done.stdout.strip().splitlines()[-1])
+    found["interpreter start and exit"] = wall - found.pop("in this interpreter")
+    found["wall"] = wall
+    return found
 
 
 def main() -> None:
