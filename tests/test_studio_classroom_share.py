@@ -86,3 +86,32 @@ def test_a_cut_link_is_refused_in_words(tmp_path: Path) -> None:
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "--open: error: this share link is cut short or damaged" in done.stderr
     assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_the_share_button_gives_the_link_of_the_table_as_edited_and_its_qr_code(browser: Any, tmp_path: Path) -> None:
+    from studio_helpers import bumberbot, served
+    from tablebot.cli.studio import link_maker
+    from tablebot.web import sharing
+
+    sharing.maker = link_maker  # as tablebot studio hands it in
+    errors: list[str] = []
+    for studio in served(bumberbot(tmp_path)):
+        page = browser.new_page(viewport={"width": 1280, "height": 720})
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        page.goto(studio.url)
+        page.wait_for_selector("#share:not([disabled])")
+        page.locator('td[data-row="0"][data-col="12"] input').fill("55")  # not saved: the link carries it
+        page.wait_for_selector("#save:not([disabled])")
+        page.click("#share")
+        page.wait_for_selector("dialog#ask[open] .share-qr")
+        link = page.locator("dialog#ask .share-link").input_value()
+        assert page.evaluate("document.querySelector('dialog#ask .share-qr').naturalWidth") > 100
+        page.screenshot(path=str(tmp_path / "share.png"))
+        page.close()
+    sharing.maker = None
+    assert errors == []
+    shared = share.decode(link)
+    text = (EXAMPLE / "table.csv").read_text(encoding="utf-8")
+    assert shared.table == ("table.csv", text.replace("Collision detection,1,,1,1,,,,,0,,0,50,20",
+                                                      "Collision detection,1,,1,1,,,,,0,,0,55,20", 1))
+    assert link.startswith(share.STUDIO + "#share=1.")

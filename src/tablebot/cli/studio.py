@@ -44,6 +44,7 @@ def studio_cmd(
     from contextlib import ExitStack
     from urllib.parse import quote
 
+    from tablebot.web import sharing
     from tablebot.web.access import WILDCARDS, Access
     from tablebot.web.app import create_app, server
     from tablebot.web.launch import open_in_browser, redirect_file
@@ -69,6 +70,7 @@ def studio_cmd(
     err_console.print(_("(Ctrl-C stops; each start makes a new token)"), soft_wrap=True)
     if table is None:
         _say_no_table(root)
+    sharing.maker = link_maker  # the Share button's links
     visited = threading.Event()
     uvicorn_server = server(create_app(root, access, table, visited=visited), access,
                             "info" if verbose else "warning")
@@ -94,6 +96,26 @@ def _warn_network(root: Path, address: str, port: int) -> None:
         "address below (with its token) can read the folder's tables, robot and world files and traces, and change "
         "its tables. The connection is plain HTTP: anyone who can watch the network can see the token.").format(
         folder=terminal(str(root)), address=terminal(address), port=port), soft_wrap=True)
+
+
+def link_maker(table: Path, text: str) -> tuple[str, str]:
+    """The studio's Share button: ``tablebot share``'s link for the table at ``table`` with ``text`` (the draft on
+    the page) as its contents, checked as every command reads it, and its QR code as an SVG data: address."""
+    from dataclasses import replace
+
+    import segno
+
+    from tablebot import share
+
+    shared = share.collect(table)
+    shared = replace(shared, table=(shared.table[0], text))
+    shared.check("the table")
+    link = share.encode(shared)
+    try:
+        qr = segno.make(link, error="l", boost_error=True, micro=False).svg_data_uri(scale=3, border=4)
+    except segno.DataOverflowError:
+        qr = ""  # the page shows the link alone
+    return link, qr
 
 
 def _unpack_link(root: Path, link: str) -> str:

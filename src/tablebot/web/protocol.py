@@ -18,8 +18,8 @@ from tablebot.web.errors import Refused
 __all__ = [
     "MESSAGES", "OPERATIONS", "AnalysisMsg", "ArenaMsg", "ConflictMsg", "ControlMsg", "Counterexample",
     "DeleteRow", "DiagramMsg", "Edit", "ErrorMsg", "Files", "FilesMsg", "FrameMsg", "GridMsg", "InsertRow",
-    "Message", "NewRobot", "NoticeMsg", "Open", "Operation", "Restore", "Save", "SavedMsg", "Sim", "TableMsg", "Trace",
-    "TraceMsg", "op_name", "operation",
+    "Message", "NewRobot", "NoticeMsg", "Open", "Operation", "Restore", "Save", "SavedMsg", "Share", "SharedMsg",
+    "Sim", "TableMsg", "Trace", "TraceMsg", "op_name", "operation",
 ]
 
 MAX_ROWS = 20_000  # a restored draft: far more than a table a person edits in a grid
@@ -201,9 +201,16 @@ class NewRobot(Operation):
         return cls(_text(message, "template"), _text(message, "name"))
 
 
+@dataclass(frozen=True)
+class Share(Operation):
+    """A link carrying the table as edited (the Share button): answered by a ``shared`` message."""
+
+    op: ClassVar[str] = "share"
+
+
 OPERATIONS: dict[str, type[Operation]] = {
     kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files,
-                               NewRobot)
+                               NewRobot, Share)
 }
 
 
@@ -354,6 +361,16 @@ class FilesMsg(Message):
 
 
 @dataclass(frozen=True)
+class SharedMsg(Message):
+    """The Share button's link (``tablebot share``'s, of the table as edited) and its QR code (an SVG data:
+    address; empty when the link is too long for one)."""
+
+    kind: ClassVar[str] = "shared"
+    link: str
+    qr: str
+
+
+@dataclass(frozen=True)
 class SavedMsg(Message):
     kind: ClassVar[str] = "saved"
     op: str
@@ -399,5 +416,5 @@ class ErrorMsg(Message):
 
 MESSAGES: dict[str, type[Message]] = {
     kind.kind: kind for kind in (TableMsg, GridMsg, AnalysisMsg, DiagramMsg, ArenaMsg, ControlMsg, FrameMsg,
-                                 TraceMsg, FilesMsg, SavedMsg, ConflictMsg, NoticeMsg, ErrorMsg)
+                                 TraceMsg, FilesMsg, SavedMsg, ConflictMsg, NoticeMsg, ErrorMsg, SharedMsg)
 }

@@ -36,11 +36,14 @@ from tablebot.web.protocol import (
     Operation,
     Restore,
     Save,
+    Share,
+    SharedMsg,
     Sim,
     Trace,
     op_name,
     operation,
 )
+from tablebot.web.sharing import share
 from tablebot.web.trace_player import TracePlayer
 from tablebot.web.workspace import OTHER_TAB, Opened, Workspace
 
@@ -118,6 +121,11 @@ class Session:
                 await self.player.counterexample(op)
             case Files():
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
+            case Share():
+                doc, table = self.draft.need_doc(), self.draft.path
+                assert table is not None
+                link, qr = await asyncio.to_thread(share, table, doc.text())
+                await self.say(SharedMsg(link, qr))
             case NewRobot():
                 path = await asyncio.to_thread(new_robot, self.workspace.root, op.template, op.name)
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))

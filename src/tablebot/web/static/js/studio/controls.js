@@ -6,6 +6,7 @@ const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 
 function wireTable(store, send, drafts) {
   on("save", "click", () => send({ op: "save" }));
+  on("share", "click", () => send({ op: "share" }));
   on("table-pick", "change", (e) => {
     const { dirty, path } = store.get();
     if (dirty && !confirm("The table has unsaved edits. Open another and lose them?")) { e.target.value = path; return; }

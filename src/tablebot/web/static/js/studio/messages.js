@@ -4,6 +4,7 @@ import { addOption, byId } from "../lib/dom.js";
 import { ask } from "./ask.js";
 import { banner } from "./banner.js";
 import { byKind } from "./protocol.js";
+import { showShared } from "./sharebox.js";
 import { stats } from "./stats.js";
 
 /** The note over the arena (a world problem, a trace without poses); "" hides it. */
@@ -135,5 +136,6 @@ export function messageHandlers(store, views, send, drafts) {
     conflict: (m) => conflict(store, send, drafts, m),
     notice: (m) => banner(m.message, "good"),
     error: (m) => banner(m.message, "bad"),
+    shared: (m) => showShared(m),
   });
 }

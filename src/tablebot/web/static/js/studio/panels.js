@@ -158,7 +158,7 @@ function showFile(store) {
     if (path) byId("save-state").textContent = dirty ? "unsaved edits" : "saved";
     byId("save").classList.toggle("primary", Boolean(dirty));
     byId("save").disabled = !path || !dirty;
-    byId("add-row").disabled = byId("del-row").disabled = !path;
+    byId("add-row").disabled = byId("del-row").disabled = byId("share").disabled = !path;
   });
   store.on(["path"], ({ path }) => {
     byId("table-pick").value = path;

@@ -16,11 +16,12 @@ export const OPERATIONS = Object.freeze({
   counterexample: ["name", "where"],
   files: [],
   new: ["template", "name"],  // a robot from a `tablebot new` template, in a folder without a table
+  share: [],  // a link carrying the table as edited, and its QR code
 });
 
 /** The kinds of message the server sends, which the page handles (messages.js, one handler each). */
 export const MESSAGES = Object.freeze(["table", "grid", "analysis", "diagram", "arena", "control", "frame", "trace",
-  "files", "saved", "conflict", "notice", "error"]);
+  "files", "saved", "conflict", "notice", "error", "shared"]);
 
 /** `message` if it is an operation of the protocol with only its fields; anything else throws, so a mistake
  * in the page shows in the console where it was made instead of as the server's "unknown op". */
