@@ -26,11 +26,12 @@ from tablebot.fleet.work import (
     warm,
     warm_worker,
 )
+from tablebot.i18n import N_
 
 #: Called with each job and what the run's ``fn`` gave for it (by default run_job's FleetSummary).
 Done = Callable[[Job, Any], None]
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
-INSTALL_HINT = "install the cluster extra: pip install 'tablebot[cluster]' (Dask's distributed scheduler)"
+INSTALL_HINT = N_("install the cluster extra: pip install 'tablebot[cluster]' (Dask's distributed scheduler)")
 
 
 def choose(backend: str, scheduler: str | None) -> tuple[str, str | None]:
@@ -38,15 +39,16 @@ def choose(backend: str, scheduler: str | None) -> tuple[str, str | None]:
     --scheduler or DASK_SCHEDULER_ADDRESS) and --backend was left at its default."""
     address = scheduler or os.environ.get(SCHEDULER_ENV) or None
     if backend not in ("auto", "local", "dask"):
-        raise fail("--backend", f"--backend {backend}: unknown backend", "use --backend local or --backend dask")
+        raise fail("--backend", N_("--backend {backend}: unknown backend", backend=backend),
+                   N_("use --backend local or --backend dask"))
     if backend == "local" and scheduler:
-        raise fail("--scheduler", "--scheduler names a Dask scheduler, but --backend is local",
-                   "drop --backend local (or use --backend dask)")
+        raise fail("--scheduler", N_("--scheduler names a Dask scheduler, but --backend is local"),
+                   N_("drop --backend local (or use --backend dask)"))
     if backend == "auto":
         backend = "dask" if address else "local"
     if backend == "dask" and not address:
-        raise fail("--backend", "--backend dask needs a scheduler to send the chunks to",
-                   f"give --scheduler tcp://HOST:8786 or set {SCHEDULER_ENV}")
+        raise fail("--backend", N_("--backend dask needs a scheduler to send the chunks to"),
+                   N_("give --scheduler tcp://HOST:8786 or set {env}", env=SCHEDULER_ENV))
     return backend, address if backend == "dask" else None
 
 
@@ -232,17 +234,19 @@ def connect(address: str) -> Any:
     try:
         from distributed import Client
     except ImportError:
-        raise fail("--backend", "--backend dask: Dask is not installed", INSTALL_HINT) from None
+        raise fail("--backend", N_("--backend dask: Dask is not installed"), INSTALL_HINT) from None
     check_address(address)
     try:
         return Client(address, timeout="15s", set_as_default=False)
     except (OSError, TimeoutError) as exc:
-        raise fail("--scheduler", f"cannot reach the Dask scheduler at {address}: {exc}",
-                   "start one with `dask scheduler` and `dask worker ADDRESS`, or check the address") from None
+        raise fail("--scheduler", N_("cannot reach the Dask scheduler at {address}: {reason}", address=address,
+                                     reason=str(exc)),
+                   N_("start one with `dask scheduler` and `dask worker ADDRESS`, or check the address")) from None
     except TypeError as exc:  # Dask's words for a tls:// address without its TLS settings
-        raise fail("--scheduler", f"cannot connect to the Dask scheduler at {address}: {exc}",
-                   "give Dask's TLS settings (distributed.comm.tls.ca-file, .client.cert and .client.key in its "
-                   "configuration), or use a tcp:// address") from None
+        raise fail("--scheduler", N_("cannot connect to the Dask scheduler at {address}: {reason}", address=address,
+                                     reason=str(exc)),
+                   N_("give Dask's TLS settings (distributed.comm.tls.ca-file, .client.cert and .client.key in its "
+                      "configuration), or use a tcp:// address")) from None
 
 
 def check_address(address: str) -> None:
@@ -260,8 +264,9 @@ def check_address(address: str) -> None:
             if not 0 < port < 65536:
                 raise ValueError(f"port {port} is not from 1 to 65535")
     except ValueError as exc:
-        raise fail(where, f"{where} {address!r} is not a Dask scheduler's address: {exc}",
-                   "write tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786 (what `dask scheduler` prints)") from None
+        raise fail(where, N_("{where} {address!r} is not a Dask scheduler's address: {reason}", where=where,
+                             address=address, reason=str(exc)),
+                   N_("write tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786 (what `dask scheduler` prints)")) from None
 
 
 def submit_all(client: Any, jobs: Sequence[Job], fn: Callable[[Any], tuple[Job, Any]]) -> dict[Any, Common | None]:
@@ -342,7 +347,7 @@ def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) ->
     opened = opened or {}
     places = slots(client)
     if not places:
-        raise fail("--scheduler", "the Dask scheduler has no workers", "start some with `dask worker ADDRESS`")
+        raise fail("--scheduler", N_("the Dask scheduler has no workers"), N_("start some with `dask worker ADDRESS`"))
     files = opened.get("files")
     if files is not None:
         futures = send_ready(client, [p for p in places if p[0] not in opened.get("places", ())], files)
@@ -358,6 +363,7 @@ def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) ->
         ready = client.gather(opened.get("ready", []))
         warmed = client.gather(futures)
     except Exception as exc:  # a scheduler or worker without tablebot (or another version of it)
-        raise fail("--scheduler", f"the Dask cluster could not run tablebot's fleet: {type(exc).__name__}: {exc}",
-                   "install the same tablebot (and Python) on the scheduler and every worker") from None
+        raise fail("--scheduler", N_("the Dask cluster could not run tablebot's fleet: {kind}: {reason}",
+                                     kind=type(exc).__name__, reason=str(exc)),
+                   N_("install the same tablebot (and Python) on the scheduler and every worker")) from None
     return {"workers": len(places), "ready": ready, "warm": warmed}

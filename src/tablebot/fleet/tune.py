@@ -22,6 +22,7 @@ from tablebot.fleet.plan import Plan
 from tablebot.fleet.robots import Variants
 from tablebot.fleet.spec import runs
 from tablebot.fleet.work import Job
+from tablebot.i18n import N_
 from tablebot.robot import MAX_TIMER
 from tablebot.table import Table
 
@@ -65,34 +66,37 @@ def parse_cells(text: str, table: Table) -> list[Cell]:
     for part in (p.strip() for p in text.split(",") if p.strip()):
         found = CELL_RE.match(part)
         if not found:
-            raise fail("--cells", f"--cells: {part!r} does not name a cell",
-                       'write "line 5 timer, line 9 timer" (file lines, the header is line 1), optionally '
-                       'with a range: "line 5 timer=100..2000"')
+            raise fail("--cells", N_("--cells: {part!r} does not name a cell", part=part),
+                       N_('write "line 5 timer, line 9 timer" (file lines, the header is line 1), optionally with a '
+                          'range: "line 5 timer=100..2000"'))
         line, column = int(found[1]), found[2]
         if line not in by_line:
-            raise fail("--cells", f"--cells: line {line} of {Path(table.path).name} is not a row of the table",
-                       f"rows are on lines {min(by_line)}..{max(by_line)}")
+            raise fail("--cells", N_("--cells: line {line} of {file} is not a row of the table", line=line,
+                                     file=Path(table.path).name),
+                       N_("rows are on lines {first}..{last}", first=min(by_line), last=max(by_line)))
         row = by_line[line]
         counter = _counter_of(column, counters)
         if column.lower() != "timer" and counter is None:
-            raise fail("--cells", f"--cells: {part!r} is not a timer or a counter load",
-                       "only timer cells (timer) and counter loads (" + (", ".join(f"{c}_load" for c in counters)
-                                                                       or "none in this robot") + ") can be tuned")
+            raise fail("--cells", N_("--cells: {part!r} is not a timer or a counter load", part=part),
+                       N_("only timer cells (timer) and counter loads ({loads}) can be tuned",
+                          loads=", ".join(f"{c}_load" for c in counters) or N_("none in this robot")))
         value = row.timer if counter is None else row.counters[counter]
         if value is None:
-            raise fail("--cells", f"--cells: line {line} leaves {counters[counter]} alone (its load is blank)",  # type: ignore[index]
-                       "tune a load the row sets, or write a load into the cell first")
+            raise fail("--cells", N_("--cells: line {line} leaves {counter} alone (its load is blank)", line=line,
+                                     counter=counters[counter]),  # type: ignore[index]
+                       N_("tune a load the row sets, or write a load into the cell first"))
         low, high = (int(found[3]), int(found[4])) if found[3] else (0, min(MAX_TIMER, max(2 * value, 100)))
         if not 0 <= low <= high <= MAX_TIMER:
-            raise fail("--cells", f"--cells: {part!r}: the range must be LOW..HIGH within 0..{MAX_TIMER}",
-                       "write for example line 5 timer=100..2000")
+            raise fail("--cells", N_("--cells: {part!r}: the range must be LOW..HIGH within 0..{most}", part=part,
+                                     most=MAX_TIMER),
+                       N_("write for example line 5 timer=100..2000"))
         cell = Cell(line, row.index, "timer" if counter is None else f"{counters[counter]}_load", counter, value,
                     low, high)
         if any(c.line == cell.line and c.column == cell.column for c in cells):
-            raise fail("--cells", f"--cells names {cell.label} twice", "name each cell once")
+            raise fail("--cells", N_("--cells names {cell} twice", cell=cell.label), N_("name each cell once"))
         cells.append(cell)
     if not cells:
-        raise fail("--cells", "--cells names no cell", 'write --cells "line 5 timer, line 9 timer"')
+        raise fail("--cells", N_("--cells names no cell"), N_('write --cells "line 5 timer, line 9 timer"'))
     return cells
 
 
