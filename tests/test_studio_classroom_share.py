@@ -65,7 +65,7 @@ def test_a_link_opens_its_table_exactly_as_shared_and_never_over_a_folder(browse
             rows = list(csv.reader(f))[1:]
         assert page.evaluate(CELLS) == rows  # cell for cell
         assert page.locator("#table-pick").input_value() == "bumberbot/table.csv"
-        assert "the link's table bumberbot is in" in studio.said
+        assert "the link's table is bumberbot/table.csv in" in studio.said
         page.close()
     finally:
         studio.stop()
@@ -115,3 +115,28 @@ def test_the_share_button_gives_the_link_of_the_table_as_edited_and_its_qr_code(
     assert shared.table == ("table.csv", text.replace("Collision detection,1,,1,1,,,,,0,,0,50,20",
                                                       "Collision detection,1,,1,1,,,,,0,,0,55,20", 1))
     assert link.startswith(share.STUDIO + "#share=1.")
+
+
+def test_a_link_in_the_pages_address_or_pasted_in_opens_its_table(browser: Any, tmp_path: Path) -> None:
+    from studio_helpers import bumberbot, served
+    from tablebot.cli.studio import link_opener
+    from tablebot.web import sharing
+
+    link = share.encode(share.collect(EXAMPLE / "../line-follower"))
+    sharing.opener = link_opener  # as tablebot studio hands it in
+    errors: list[str] = []
+    for studio in served(bumberbot(tmp_path)):
+        page = browser.new_page(viewport={"width": 1280, "height": 720})
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        page.goto(studio.url + link[link.index("#"):])  # pasted into the address bar of a running studio
+        page.wait_for_function("() => document.querySelector('#table-pick').value === 'line-follower/table.csv'")
+        assert "#" not in page.url  # the address is put back without the link
+        page.click("#open-link")
+        page.fill("dialog#ask textarea", link[:200])  # cut short in a chat
+        page.click('dialog#ask button:text-is("Open")')
+        page.wait_for_function("() => document.querySelector('#banner').textContent.includes('cut short')")
+        page.close()
+    sharing.opener = None
+    assert errors == []
+    line_follower = (EXAMPLE / "../line-follower/table.csv").resolve()
+    assert (tmp_path / "bot" / "line-follower" / "table.csv").read_bytes() == line_follower.read_bytes()

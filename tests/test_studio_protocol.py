@@ -103,6 +103,7 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
         "restore": {"header": None, "grid": None, "base": "v"}, "sim": {"action": "step"},
         "trace": {"path": "nothing.jsonl"}, "counterexample": {"name": "no_such_property"}, "files": {},
         "new": {"template": "empty", "name": "table.csv"},  # a taken name: refused in words
+        "open_link": {"link": "nonsense"},  # no link opener handed in either: refused in words
         "share": {},  # no link maker handed in (tablebot studio hands one): refused in words
     }
     assert sorted(messages) == sorted(protocol.OPERATIONS)

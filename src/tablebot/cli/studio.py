@@ -70,7 +70,7 @@ def studio_cmd(
     err_console.print(_("(Ctrl-C stops; each start makes a new token)"), soft_wrap=True)
     if table is None:
         _say_no_table(root)
-    sharing.maker = link_maker  # the Share button's links
+    sharing.maker, sharing.opener = link_maker, link_opener  # the Share button's links, and links pasted in
     visited = threading.Event()
     uvicorn_server = server(create_app(root, access, table, visited=visited), access,
                             "info" if verbose else "warning")
@@ -119,19 +119,24 @@ def link_maker(table: Path, text: str) -> tuple[str, str]:
 
 
 def _unpack_link(root: Path, link: str) -> str:
+    """``--open LINK``: :func:`link_opener`, and the terminal says where the files went."""
+    table = link_opener(root, link, "--open")
+    err_console.print(f"tablebot studio: the link's table is {terminal(table)} in {terminal(str(root))} (with "
+                      "its robot file and world), as it was shared", soft_wrap=True)
+    return table
+
+
+def link_opener(root: Path, link: str, where: str = "the link") -> str:
     """Write the files a share link carries into a new folder of ``root`` (never over anything: NAME, NAME-2,
     ...), exactly as shared; the table's name relative to ``root``. A link that is no link, cut, damaged, from
-    another version or carrying a broken table is refused in words, naming --open."""
+    another version or carrying a broken table is refused in words, naming ``where``."""
     from tablebot import share
 
-    shared = share.decode(link, "--open")
-    shared.check("--open")
+    shared = share.decode(link, where)
+    shared.check(where)
     folder = next(root / name for name in (shared.name, *(f"{shared.name}-{n}" for n in range(2, 1000)))
                   if not (root / name).exists() and not (root / name).is_symlink())
-    table = shared.write(folder)
-    err_console.print(f"tablebot studio: the link's table {terminal(shared.name)} is in {terminal(str(folder))} "
-                      "(with its robot file and world), as it was shared", soft_wrap=True)
-    return table.relative_to(root).as_posix()
+    return shared.write(folder).relative_to(root).as_posix()
 
 
 def _say_no_table(root: Path) -> None:

@@ -18,8 +18,8 @@ from tablebot.web.errors import Refused
 __all__ = [
     "MESSAGES", "OPERATIONS", "AnalysisMsg", "ArenaMsg", "ConflictMsg", "ControlMsg", "Counterexample",
     "DeleteRow", "DiagramMsg", "Edit", "ErrorMsg", "Files", "FilesMsg", "FrameMsg", "GridMsg", "InsertRow",
-    "Message", "NewRobot", "NoticeMsg", "Open", "Operation", "Restore", "Save", "SavedMsg", "Share", "SharedMsg",
-    "Sim", "TableMsg", "Trace", "TraceMsg", "op_name", "operation",
+    "Message", "NewRobot", "NoticeMsg", "Open", "OpenLink", "Operation", "Restore", "Save", "SavedMsg", "Share",
+    "SharedMsg", "Sim", "TableMsg", "Trace", "TraceMsg", "op_name", "operation",
 ]
 
 MAX_ROWS = 20_000  # a restored draft: far more than a table a person edits in a grid
@@ -208,9 +208,21 @@ class Share(Operation):
     op: ClassVar[str] = "share"
 
 
+@dataclass(frozen=True)
+class OpenLink(Operation):
+    """Open the table a share link carries (pasted in the page, or in its address): written into a new folder."""
+
+    op: ClassVar[str] = "open_link"
+    link: str
+
+    @classmethod
+    def of(cls, message: Mapping[str, Any]) -> OpenLink:
+        return cls(_text(message, "link"))
+
+
 OPERATIONS: dict[str, type[Operation]] = {
     kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files,
-                               NewRobot, Share)
+                               NewRobot, Share, OpenLink)
 }
 
 

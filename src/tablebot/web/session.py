@@ -33,6 +33,7 @@ from tablebot.web.protocol import (
     NewRobot,
     NoticeMsg,
     Open,
+    OpenLink,
     Operation,
     Restore,
     Save,
@@ -43,7 +44,7 @@ from tablebot.web.protocol import (
     op_name,
     operation,
 )
-from tablebot.web.sharing import share
+from tablebot.web.sharing import open_link, share
 from tablebot.web.trace_player import TracePlayer
 from tablebot.web.workspace import OTHER_TAB, Opened, Workspace
 
@@ -126,6 +127,11 @@ class Session:
                 assert table is not None
                 link, qr = await asyncio.to_thread(share, table, doc.text())
                 await self.say(SharedMsg(link, qr))
+            case OpenLink():
+                path = await asyncio.to_thread(open_link, self.workspace.root, op.link)
+                await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
+                await self.dispatch(Open(path))
+                await self.say(NoticeMsg(f"the link's table is in {path}, as it was shared"))
             case NewRobot():
                 path = await asyncio.to_thread(new_robot, self.workspace.root, op.template, op.name)
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))

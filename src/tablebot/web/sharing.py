@@ -9,11 +9,14 @@ from pathlib import Path
 
 from tablebot.web.errors import Refused
 
-__all__ = ["Maker", "maker", "share"]
+__all__ = ["Maker", "Opener", "maker", "open_link", "opener", "share"]
 
 #: (the table's path, the draft's text) -> (the link, its QR code as an SVG data: address, "" if too long)
 Maker = Callable[[Path, str], tuple[str, str]]
 maker: Maker | None = None
+#: (the served folder, a link) -> the table it carries, written into a new folder there (relative name)
+Opener = Callable[[Path, str], str]
+opener: Opener | None = None
 
 
 def share(table: Path, text: str) -> tuple[str, str]:
@@ -21,3 +24,10 @@ def share(table: Path, text: str) -> tuple[str, str]:
     if maker is None:
         raise Refused("this studio makes no links: start it with tablebot studio")
     return maker(table, text)
+
+
+def open_link(root: Path, link: str) -> str:
+    """Write the files ``link`` carries into a new folder of ``root``; the relative name of its table."""
+    if opener is None:
+        raise Refused("this studio opens no links: start it with tablebot studio")
+    return opener(root, link)

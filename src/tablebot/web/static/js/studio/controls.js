@@ -1,5 +1,6 @@
 // What the page's own buttons, menus and keys do: each sends a message or changes the store.
 import { all, byId } from "../lib/dom.js";
+import { askForLink } from "./sharebox.js";
 import { api } from "../lib/key.js";
 
 const on = (id, type, handler) => byId(id).addEventListener(type, handler);
@@ -7,6 +8,7 @@ const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 function wireTable(store, send, drafts) {
   on("save", "click", () => send({ op: "save" }));
   on("share", "click", () => send({ op: "share" }));
+  on("open-link", "click", () => askForLink(send));
   on("table-pick", "change", (e) => {
     const { dirty, path } = store.get();
     if (dirty && !confirm("The table has unsaved edits. Open another and lose them?")) { e.target.value = path; return; }

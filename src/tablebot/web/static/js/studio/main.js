@@ -10,6 +10,7 @@ import { createLink } from "./link.js";
 import { messageHandlers } from "./messages.js";
 import { checkedLink } from "./protocol.js";
 import { showNoTable, showPanels } from "./panels.js";
+import { openLinkInAddress } from "./sharebox.js";
 import { stats } from "./stats.js";
 import { createViews } from "./views.js";
 
@@ -53,6 +54,7 @@ async function start() {
     store.set({ offerDraft: path || null });
     return path ? { op: "open", path } : null;
   };
+  openLinkInAddress(link.send);  // sent once the connection is up (after the table it opens first)
   link.open(hello, receive, { down: connectionDown, up: () => banner("connected to the studio again", "good") });
 }
 

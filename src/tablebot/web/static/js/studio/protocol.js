@@ -16,7 +16,8 @@ export const OPERATIONS = Object.freeze({
   counterexample: ["name", "where"],
   files: [],
   new: ["template", "name"],  // a robot from a `tablebot new` template, in a folder without a table
-  share: [],  // a link carrying the table as edited, and its QR code
+  share: [],
+  open_link: ["link"],  // a share link pasted in the page or in its address: its table, in a new folder  // a link carrying the table as edited, and its QR code
 });
 
 /** The kinds of message the server sends, which the page handles (messages.js, one handler each). */

@@ -1,5 +1,6 @@
-// The Share button's answer: the link that carries the table as edited (to paste into a chat, or to open with
-// `tablebot studio --open LINK`) and its QR code, in the page's dialog.
+// Links that carry a table: the Share button's answer (the link of the table as edited, to paste into a chat or
+// open with `tablebot studio --open LINK`, and its QR code), and opening a link pasted in (the "Open a link"
+// box, or the page's own address with #share=...), in the page's dialog.
 import { byId, button, make } from "../lib/dom.js";
 
 export function showShared(m) {
@@ -21,4 +22,30 @@ export function showShared(m) {
   box.oncancel = null;
   box.showModal();
   text.select();
+}
+
+/** The "Open a link" box: a link pasted in opens its table (written into a new folder of the served one). */
+export function askForLink(send) {
+  const box = byId("ask");
+  if (box.open) box.close();
+  const text = make("textarea", { className: "share-link", rows: 4, spellcheck: false,
+    placeholder: "http://127.0.0.1:8765/#share=1.…" });
+  text.setAttribute("aria-label", "the link to open");
+  const open = button("Open", () => { box.close(); if (text.value.trim()) send({ op: "open_link", link: text.value.trim() }); },
+    { className: "primary" });
+  box.replaceChildren(make("h2", {}, "Open a shared table"),
+    make("p", {}, "Paste a link that tablebot share or a Share button made: its table, robot file and world go into "
+      + "a new folder here (nothing is written over), and the table opens, exactly as it was shared."),
+    text, make("div", { className: "answers" }, open, button("Cancel", () => box.close())));
+  box.oncancel = null;
+  box.showModal();
+  text.focus();
+}
+
+/** A link in the page's own address (#share=...: pasted into the browser's address bar): opened, then the
+ * address is put back without it. */
+export function openLinkInAddress(send) {
+  if (!location.hash.includes("share=")) return;
+  send({ op: "open_link", link: location.hash });
+  history.replaceState(null, "", location.pathname + location.search);
 }
