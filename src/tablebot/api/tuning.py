@@ -81,15 +81,16 @@ class Tuning:
     def verdict(self) -> str:
         """One line: whether tuning helped, with the objective before and after on the fresh scenarios."""
         before, after = self.before_after[self.objective]
-        numbers = f"{self.objective} {before:.3f} before, {after:.3f} after, on {self.check.spec.total} fresh " \
-                  "scenarios"
+        numbers = N_("{objective} {before:.3f} before, {after:.3f} after, on {n} fresh scenarios",
+                     objective=self.objective, before=before, after=after, n=self.check.spec.total)
         if self.helped:
-            return f"Better than the table as it was on fresh seeds: yes ({numbers})."
+            return N_("Better than the table as it was on fresh seeds: yes ({numbers}).", numbers=numbers)
         if self.winner == self.baseline:
-            return f"Better than the table as it was on fresh seeds: no: no candidate beat the table's own values " \
-                   f"({numbers}); keep the table as it is."
-        return f"Better than the table as it was on fresh seeds: no ({numbers}): the values that did best on the " \
-               "tuning scenarios do not carry over; keep the table as it is, or tune on more seeds (--seeds)."
+            return N_("Better than the table as it was on fresh seeds: no: no candidate beat the table's own values "
+                      "({numbers}); keep the table as it is.", numbers=numbers)
+        return N_("Better than the table as it was on fresh seeds: no ({numbers}): the values that did best on the "
+                  "tuning scenarios do not carry over; keep the table as it is, or tune on more seeds (--seeds).",
+                  numbers=numbers)
 
     def report_text(self) -> str:
         """``report.md`` of the tuning written (the first of its files named so)."""
@@ -128,7 +129,8 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
     from tablebot.fleet.tune import parse_cells
 
     if objective not in METRICS:
-        raise fail("--objective", f"--objective {objective}: unknown objective", f"use one of {', '.join(METRICS)}")
+        raise fail("--objective", N_("--objective {objective}: unknown objective", objective=objective),
+                   N_("use one of {choices}", choices=", ".join(METRICS)))
     if method not in ("auto", "grid", "cma"):
         raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
     chosen, address = choose(backend, scheduler)
