@@ -18,9 +18,21 @@ function fits(layout, need, main, fontPx) {
   return inner - need - parseFloat(style.columnGap) >= MIN_RIGHT_EM * fontPx;
 }
 
+// The toolbar on one line if leaving out the name and the word "table" does it (a tablet, A+).
+function fitBar(body) {
+  const bar = document.querySelector(".bar");
+  const wrapped = () => {
+    const shown = [...bar.children].filter((el) => el.offsetParent !== null);
+    return shown.some((el) => el.offsetTop > shown[0].offsetTop + el.offsetHeight / 2);
+  };
+  body.classList.remove("tight-bar");
+  if (bar && wrapped()) body.classList.add("tight-bar");
+}
+
 /** Choose the layout for the window as it is now (called when the window, the text size or the table change). */
 export function fitLayout() {
   const body = document.body, main = document.querySelector("main");
+  fitBar(body);
   const table = document.querySelector("#grid table.grid"), holder = document.querySelector("#grid");
   if (!table || !main) return;
   const fontPx = parseFloat(getComputedStyle(body).fontSize);
