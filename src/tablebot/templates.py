@@ -51,15 +51,17 @@ def parse_names(values: list[str], option: str) -> list[Named]:
                 continue
             name, _, label = (s.strip() for s in part.partition("="))
             if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-                raise fail(option, f"{name!r} cannot name a column", "use a letter then letters or digits, like I1 "
-                           "or M2 (not T, state, timer or next); add a label with NAME=label")
+                raise fail(option, N_("{name!r} cannot name a column", name=name),
+                           N_("use a letter then letters or digits, like I1 or M2 (not T, state, timer or next); add "
+                              "a label with NAME=label"))
             if '"' in label or "\\" in label:
-                raise fail(option, f"the label of {name} may not hold quotes or backslashes", "write it without them")
+                raise fail(option, N_("the label of {name} may not hold quotes or backslashes", name=name),
+                           N_("write it without them"))
             names.append((name, label))
     seen = [n for n, _ in names]
     twice = sorted({n for n in seen if seen.count(n) > 1})
     if twice:
-        raise fail(option, f"{', '.join(twice)} given twice", "give each name once")
+        raise fail(option, N_("{names} given twice", names=", ".join(twice)), N_("give each name once"))
     return names
 
 
@@ -85,8 +87,10 @@ def renamed(template: str, files: dict[str, str], inputs: list[Named], motors: l
         if not given:
             continue
         if len(given) != len(old):
-            raise fail(option, f"the {template} template has {len(old)} {section} ({', '.join(old)}); "
-                       f"{option} gives {len(given)}", f"give {len(old)} names, in that order, or leave {option} out")
+            raise fail(option, N_("the {template} template has {n} {section} ({names}); {option} gives {given}",
+                                  template=template, n=len(old), section=section, names=", ".join(old), option=option,
+                                  given=len(given)),
+                       N_("give {n} names, in that order, or leave {option} out", n=len(old), option=option))
         mapping.update({o: n for o, (n, _) in zip(old, given, strict=True)})
         labels.update({n: label for n, label in given if label})
     if not mapping and not labels:
@@ -272,8 +276,8 @@ def write_folder(folder: Path, template: Template) -> list[Path]:
     from tablebot.fileset import new_folder
 
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-        what = "this is a file, not a folder" if not folder.is_dir() else "this folder is not empty"
-        raise fail(folder, what, "give the name of a new folder (tablebot new never writes over files)")
+        what = N_("this is a file, not a folder") if not folder.is_dir() else N_("this folder is not empty")
+        raise fail(folder, what, N_("give the name of a new folder (tablebot new never writes over files)"))
     with new_folder(folder) as stage:
         for name in FILES:
             write_text(stage / name, template.files[name])

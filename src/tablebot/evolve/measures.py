@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 from tablebot.sim.track import loop_of
 from tablebot.sim.world import World
 
@@ -63,15 +64,17 @@ def allowed(worlds: Sequence[World], states: Sequence[object] = ()) -> list[str]
 def check_objective(name: str, worlds: Sequence[World]) -> Measure:
     usable = [n for n in allowed(worlds) if MEASURES[n].objective]
     if name not in usable:
-        why = "unknown objective" if name not in MEASURES else f"the worlds cannot measure it ({_need(name)})"
-        raise fail("--objective", f"--objective {name}: {why}", f"use one of {', '.join(usable)}")
+        why = N_("unknown objective") if name not in MEASURES else \
+            N_("the worlds cannot measure it ({need})", need=_need(name))
+        raise fail("--objective", N_("--objective {name}: {why}", name=name, why=why),
+                   N_("use one of {choices}", choices=", ".join(usable)))
     return MEASURES[name]
 
 
 def _need(name: str) -> str:
     needs = MEASURES[name].needs
-    return {"lamp": "it needs a [[lamp]] in every world", "loop": "it needs a closed [[line]] in every world",
-            "walls": "it needs [arena] walls in every world"}.get(needs, "")
+    return {"lamp": N_("it needs a [[lamp]] in every world"), "loop": N_("it needs a closed [[line]] in every world"),
+            "walls": N_("it needs [arena] walls in every world")}.get(needs, "")
 
 
 def parse_descriptors(text: str, worlds: Sequence[World], states: Sequence[object], seconds: float,
@@ -84,20 +87,23 @@ def parse_descriptors(text: str, worlds: Sequence[World], states: Sequence[objec
         found = RANGE_RE.match(part)
         name = found[1] if found else part.strip()
         if not found or name not in usable:
-            why = "unknown descriptor" if found and name not in MEASURES and not name.startswith(STATE_SHARE) \
-                else "the worlds cannot measure it" if found and name in MEASURES else "not a descriptor"
-            raise fail("--descriptors", f"--descriptors {part.strip()}: {why}",
-                       f"use one or two of {', '.join(usable)} (optionally with a range: area_covered=0..0.5)")
+            why = N_("unknown descriptor") if found and name not in MEASURES and not name.startswith(STATE_SHARE) \
+                else N_("the worlds cannot measure it") if found and name in MEASURES else N_("not a descriptor")
+            raise fail("--descriptors", N_("--descriptors {part}: {why}", part=part.strip(), why=why),
+                       N_("use one or two of {choices} (optionally with a range: area_covered=0..0.5)",
+                          choices=", ".join(usable)))
         low, high = (float(found[2]), float(found[3])) if found[2] is not None else default_range(name, seconds)
         if not high > low:
-            raise fail("--descriptors", f"--descriptors {part.strip()}: the range must be LOW..HIGH with LOW < HIGH",
-                       f"write for example {name}=0..1")
+            raise fail("--descriptors", N_("--descriptors {part}: the range must be LOW..HIGH with LOW < HIGH",
+                                           part=part.strip()),
+                       N_("write for example {name}=0..1", name=name))
         if any(d.name == name for d in out):
-            raise fail("--descriptors", f"--descriptors names {name} twice", "name each descriptor once")
+            raise fail("--descriptors", N_("--descriptors names {name} twice", name=name),
+                       N_("name each descriptor once"))
         out.append(Descriptor(name, low, high, cells))
     if not 1 <= len(out) <= 2:
-        raise fail("--descriptors", f"--descriptors needs one or two descriptors, not {len(out)}",
-                   f"for example --descriptors {','.join(usable[:2])}")
+        raise fail("--descriptors", N_("--descriptors needs one or two descriptors, not {n}", n=len(out)),
+                   N_("for example --descriptors {example}", example=",".join(usable[:2])))
     return out
 
 
