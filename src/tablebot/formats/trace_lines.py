@@ -18,6 +18,7 @@ import numpy as np
 
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector
+from tablebot.i18n import N_
 
 
 def dumps(line: dict[str, Any]) -> str:
@@ -96,7 +97,7 @@ def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> 
     """(line number, tick line) of a trace's text up to an ``end`` record; a bad line goes to ``out``.
     The one reader of trace lines: ``tablebot trace --inputs RUN.jsonl``, the studio's player and
     :func:`read_trace` all go through it."""
-    hint = "a trace has one JSON object per line, as tablebot sim, trace, run or monitor write it"
+    hint = N_("a trace has one JSON object per line, as tablebot sim, trace, run or monitor write it")
     for number, raw in enumerate(lines_of(text), start=1):
         if len(out.items) >= MAX_TRACE_ERRORS:
             return
@@ -105,20 +106,21 @@ def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> 
         try:
             line = json.loads(raw)
         except json.JSONDecodeError as exc:
-            out.error(number, exc.colno, f"line {number} is not JSON: {exc.msg}", hint)
+            out.error(number, exc.colno, N_("line {n} is not JSON: {reason}", n=number, reason=exc.msg), hint)
             continue
         except RecursionError:  # nesting deeper than the parser's stack
-            out.error(number, 1, f"line {number} is not JSON: nested too deeply", hint)
+            out.error(number, 1, N_("line {n} is not JSON: nested too deeply", n=number), hint)
             continue
         except ValueError:  # int() of a number past Python's 4,300 digits
             long = LONG_NUMBER_RE.search(raw)
-            out.error(number, long.start() + 1 if long else 1, f"line {number} has a number too long to read", hint)
+            out.error(number, long.start() + 1 if long else 1, N_("line {n} has a number too long to read", n=number),
+                      hint)
             continue
         if not isinstance(line, dict):
-            out.error(number, 1, f"line {number} is JSON but not an object {{...}}", hint)
+            out.error(number, 1, N_("line {n} is JSON but not an object {{...}}", n=number), hint)
         elif "end" in line:
             return
         elif missing := [key for key in required if key not in line]:
-            out.error(number, 1, f"a trace line needs {' and '.join(missing)}", hint)
+            out.error(number, 1, N_("a trace line needs {keys}", keys=" and ".join(missing)), hint)
         else:
             yield number, line
