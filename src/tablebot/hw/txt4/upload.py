@@ -29,12 +29,13 @@ from pathlib import Path
 import httpx
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 DEFAULT_PORT = 80
 KEY_ENV = "TABLEBOT_TXT4_KEY"
-URL_HINT = "write --to txt4://192.168.7.2 (USB), txt4://192.168.8.2 (Wi-Fi) or txt4://HOST:PORT"
-KEY_HINT = (f"give the key the TXT 4.0 shows (the one ROBO Pro Coding asks for) in ${KEY_ENV}, with "
-            "--key-file FILE, at the prompt (run it in a terminal), or with --key KEY")
+URL_HINT = N_("write --to txt4://192.168.7.2 (USB), txt4://192.168.8.2 (Wi-Fi) or txt4://HOST:PORT")
+KEY_HINT = N_("give the key the TXT 4.0 shows (the one ROBO Pro Coding asks for) in ${env}, with --key-file FILE, "
+              "at the prompt (run it in a terminal), or with --key KEY", env=KEY_ENV)
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
@@ -42,7 +43,7 @@ def base_url(target: str) -> str:
     """``txt4://HOST[:PORT]`` as ``http://HOST:PORT``; anything else is an error naming ``--to``."""
     match = re.fullmatch(r"txt4://([A-Za-z0-9.-]+)(?::(\d{1,5}))?/?", target)
     if not match or (match[2] and not 0 < int(match[2]) < 65536):
-        raise fail("--to", f"{target!r} is not txt4://HOST or txt4://HOST:PORT", URL_HINT)
+        raise fail("--to", N_("{target!r} is not txt4://HOST or txt4://HOST:PORT", target=target), URL_HINT)
     return f"http://{match[1]}:{match[2] or DEFAULT_PORT}"
 
 
@@ -50,22 +51,22 @@ def api_key(key: str | None, key_file: Path | None, prompt: Callable[[], str] | 
     """The key from ``--key``, ``--key-file``, ``$TABLEBOT_TXT4_KEY`` or ``prompt`` (None: not a terminal),
     first found first; ``--key`` puts it in the process list and the shell's history, the others do not."""
     if key is not None and key_file is not None:
-        raise fail("--key", "give the key once: --key or --key-file, not both", KEY_HINT)
+        raise fail("--key", N_("give the key once: --key or --key-file, not both"), KEY_HINT)
     if key_file is not None:
         try:
             key = key_file.read_text(encoding="utf-8").strip()
         except (OSError, UnicodeDecodeError) as exc:
-            raise fail(key_file, f"cannot read the key file: {getattr(exc, 'strerror', None) or exc}",
-                       "the file holds the key the TXT 4.0 shows, on one line") from None
+            raise fail(key_file, N_("cannot read the key file: {reason}", reason=getattr(exc, "strerror", None) or exc),
+                       N_("the file holds the key the TXT 4.0 shows, on one line")) from None
         if not key:
-            raise fail(key_file, "the key file is empty", "write the key the TXT 4.0 shows into it")
+            raise fail(key_file, N_("the key file is empty"), N_("write the key the TXT 4.0 shows into it"))
     key = key if key is not None else os.environ.get(KEY_ENV) or None
     if key is None and prompt is not None:
         key = prompt().strip()
     if not key:
-        raise fail("--key", "no API key", KEY_HINT)
+        raise fail("--key", N_("no API key"), KEY_HINT)
     if not key.isprintable() or len(key) > 256:
-        raise fail("--key", "the API key holds control characters or is too long", KEY_HINT)
+        raise fail("--key", N_("the API key holds control characters or is too long"), KEY_HINT)
     return key
 
 
@@ -77,8 +78,8 @@ def workspace_files(folder: Path) -> tuple[str, dict[str, bytes]]:
     except (OSError, ValueError, AttributeError):
         name = None
     if not isinstance(name, str) or not NAME_RE.match(name):
-        raise fail(folder, "this folder is not a program written by `tablebot export --to txt4`",
-                   "export one first: tablebot export TABLE OUTDIR --to txt4")
+        raise fail(folder, N_("this folder is not a program written by `tablebot export --to txt4`"),
+                   N_("export one first: tablebot export TABLE OUTDIR --to txt4"))
     files = {"/" + p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*"))
              if p.is_file() and "__pycache__" not in p.parts}
     return name, files
@@ -94,10 +95,11 @@ def upload(folder: Path, target: str, key: str, start: bool = True, timeout_s: f
         _call(client, "DELETE", "/api/v1/stop", target)
         form = [("files", (path, data, "text/plain")) for path, data in files.items()]
         _call(client, "POST", f"/api/v1/workspaces/{name}/files", target, files=form)
-        say(f"uploaded {len(files)} files to workspace {name} on {target}")
+        say(N_("uploaded {n} files to workspace {name} on {target}", n=len(files), name=name, target=target))
         if start:
             _call(client, "POST", f"/api/v1/application/{name}/start", target)
-            say(f"started {name}; stop it on the controller, or: curl -X DELETE {url}/api/v1/stop")
+            say(N_("started {name}; stop it on the controller, or: curl -X DELETE {url}/api/v1/stop", name=name,
+                   url=url))
     return name
 
 
@@ -105,17 +107,20 @@ def _call(client: httpx.Client, method: str, path: str, target: str, **kwargs: o
     try:
         response = client.request(method, path, **kwargs)  # type: ignore[arg-type]
     except httpx.TimeoutException:
-        raise fail("--to", f"{target} did not answer {method} {path} in time",
-                   "is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?") from None
+        raise fail("--to", N_("{target} did not answer {method} {path} in time", target=target, method=method,
+                              path=path),
+                   N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?")) from None
     except httpx.HTTPError as exc:
-        raise fail("--to", f"cannot reach {target}: {exc}",
-                   "is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?") from None
+        raise fail("--to", N_("cannot reach {target}: {reason}", target=target, reason=str(exc)),
+                   N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?")) from None
     if response.status_code in (401, 403):
-        raise fail("--key", f"{target} refused the API key ({response.status_code} on {method} {path})",
-                   "the TXT 4.0 shows a new key now and then: read it again from its display")
+        raise fail("--key", N_("{target} refused the API key ({status} on {method} {path})", target=target,
+                               status=response.status_code, method=method, path=path),
+                   N_("the TXT 4.0 shows a new key now and then: read it again from its display"))
     if response.status_code >= 400:
-        raise fail("--to", f"{target} answered {response.status_code} to {method} {path}",
-                   "check that it is a TXT 4.0 with the ROBO Pro Coding interface switched on")
+        raise fail("--to", N_("{target} answered {status} to {method} {path}", target=target,
+                              status=response.status_code, method=method, path=path),
+                   N_("check that it is a TXT 4.0 with the ROBO Pro Coding interface switched on"))
     return response
 
 
