@@ -29,7 +29,7 @@ export function askForLink(send) {
   const box = byId("ask");
   if (box.open) box.close();
   const text = make("textarea", { className: "share-link", rows: 4, spellcheck: false,
-    placeholder: "http://127.0.0.1:8765/#share=1.…" });
+    placeholder: "the link: …/#share=1.…" });
   text.setAttribute("aria-label", "the link to open");
   const open = button("Open", () => { box.close(); if (text.value.trim()) send({ op: "open_link", link: text.value.trim() }); },
     { className: "primary" });
