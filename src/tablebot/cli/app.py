@@ -4,6 +4,7 @@ options every invocation shares: ``--version``, ``-h``/``--help`` and shell comp
 import typer
 
 from tablebot.cli.usage import Group
+from tablebot.cli.words import LANG_HELP
 
 app = typer.Typer(
     name="tablebot",
@@ -35,8 +36,6 @@ def _print_version(value: bool) -> None:
 def main(
     show_version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
                                       help="Print tablebot's version and exit."),
-    lang: str = typer.Option("", "--lang", metavar="de|en", show_default=False,
-                             help="The language of tablebot's messages: de (Deutsch) or en (English); default: "
-                             "TABLEBOT_LANG, else the system's language. It may stand anywhere on the line."),
+    lang: str = typer.Option("", "--lang", metavar="de|en", show_default=False, help=LANG_HELP),
 ) -> None:
     """Robot behaviour written as a table: check it, trace it, simulate it, export it."""

@@ -23,7 +23,7 @@ from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
 from typer.core import TyperGroup, TyperOption
 
-from tablebot.cli.words import localise, localise_params
+from tablebot.cli.words import LANG_HELP, localise, localise_params
 from tablebot.diagnostics import Diagnostic
 from tablebot.i18n import LANGUAGES, N_, Message, use
 
@@ -78,11 +78,12 @@ class Group(TyperGroup):
 
 
 def lang_option() -> TyperOption:
-    """``--lang`` on every command, hidden (the main help lists it): tablebot.cli.main takes it off the command
+    """``--lang`` on every command, in its help as in the main one: tablebot.cli.main takes it off the command
     line before typer sees it, so this one is met only when the app is called in-process (a test's CliRunner),
     where it sets the language of what follows."""
-    return TyperOption(param_decls=["--lang"], type=TyperChoice(LANGUAGES), expose_value=False, hidden=True,
-                       default=None, callback=lambda ctx, param, value: use(value) if value else None)
+    return TyperOption(param_decls=["--lang"], type=TyperChoice(LANGUAGES), expose_value=False, metavar="de|en",
+                       default=None, callback=lambda ctx, param, value: use(value) if value else None,
+                       help=LANG_HELP)
 
 
 class FiniteFloat(FloatRange):

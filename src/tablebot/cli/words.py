@@ -33,6 +33,9 @@ CLICK_WORDS = (
     N_("env var: {var}"), N_("Aborted!"), N_("Missing command."),
 )
 HELP_NAMES = ["-h", "--help"]
+#: ``--lang``'s help, the main one's and every command's (the option is taken anywhere on the line).
+LANG_HELP = ("The language of tablebot's messages: de (Deutsch) or en (English); default: TABLEBOT_LANG, else the "
+             "system's language. It may stand anywhere on the line.")
 
 
 def _translate(text: str) -> str:
