@@ -148,11 +148,12 @@ def studio_diagram(browser: object, python: str, env: dict[str, str], folder: Pa
         page.on("pageerror", lambda e: errors.append(str(e)))
         page.goto(url)
         try:  # minutes only where numba compiles the simulator first (a cold cache)
-            page.wait_for_selector("#diagram > *", timeout=120_000)
+            page.wait_for_selector("#diagram .diagram-view > *", timeout=120_000)
         except Exception as exc:
             process.kill()
             raise AssertionError(f"no diagram shown; the studio said: {process.communicate()[1][-3000:]}") from exc
-        shown = page.inner_html("#diagram"), page.inner_text("#diagram")
+        # the drawing (or the studio's words) is in the panel's view, beside its zoom buttons
+        shown = page.inner_html("#diagram .diagram-view"), page.inner_text("#diagram .diagram-view")
         context.close()
         assert errors == []
         return shown
