@@ -38,6 +38,7 @@ __all__ = [
     "current",
     "gettext",
     "localise",
+    "named",
     "ngettext",
     "set_from",
     "system_language",
@@ -250,6 +251,12 @@ def set_from(argv: Sequence[str], environ: Mapping[str, str] | None = None) -> l
     use(language)
     _asked = language if named else None
     return rest
+
+
+def named() -> str | None:
+    """The language asked for by name (--lang, TABLEBOT_LANG), or None when the system's locale chose it: the
+    studio's page then speaks its browser's language (issue 38)."""
+    return _asked if _asked in LANGUAGES else None
 
 
 def asked() -> str:
