@@ -136,19 +136,23 @@ class Loaded:
 
         return find_world(self.table, None, self.robot_world())
 
-    def scene(self, world: PathLike | World | None = None, overrides: dict[str, Any] | None = None) -> Scene:
+    def scene(self, world: PathLike | World | None = None, overrides: dict[str, Any] | None = None,
+              every_table: bool = False) -> Scene:
         """Table, robot and world checked and packed for the simulator: ``world`` (a file, or a world already
         read) if given, else the first of :attr:`world_files`, else the default one; ``overrides`` are
-        simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's."""
+        simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's.
+        ``every_table``: a robot of several tables is simulated whole (``sim``, tick by tick); without it its
+        main table alone, with a note (the compiled sweep, tune and the studio's arena, for now)."""
         from tablebot.sim.scene import prepare, robot_layer, scene_for
         from tablebot.sim.world import World
 
-        if self.tables is not None:  # said, not hidden: the lamps of the other tables would stay dark
+        tables = self.tables if every_table else None
+        if self.tables is not None and tables is None:  # said, not hidden: the other tables' lamps stay dark
             self._main_table_only("the simulator")
         if isinstance(world, World):
-            return prepare(self.table, self.machine, world, robot_layer(self.robot)[0], overrides)
+            return prepare(self.table, self.machine, world, robot_layer(self.robot)[0], overrides, tables)
         chosen = Path(world) if world is not None else (self.world_files[0] if self.world_files else None)
-        return scene_for(self.table, self.machine, chosen, overrides)
+        return scene_for(self.table, self.machine, chosen, overrides, tables)
 
     def _main_table_only(self, what: str) -> None:
         """A note that ``what`` runs only the main table of a robot of several (the others not yet)."""

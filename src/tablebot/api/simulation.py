@@ -95,13 +95,13 @@ def simulate(project: Loaded, seconds: float = 120.0, seed: int = 1, *, world: P
     overrides = {"battery": {"charge": battery}} if battery is not None else {}
     shown = progress or Progress()
     if out is None:
-        return _in_memory(project.scene(world, overrides), seconds, seed, shown)
+        return _in_memory(project.scene(world, overrides, every_table=True), seconds, seed, shown)
     import numpy  # noqa: F401 (before the fork: both processes need it, one import serves them)
 
     # the painter is forked first, before the simulator is imported: it imports matplotlib on the other core
     # while this process imports numba and runs the robot, and draws the pictures when the run is over
     with _painter() if plots else contextlib.nullcontext() as painter, project.writing():
-        scene = project.scene(world, overrides)
+        scene = project.scene(world, overrides, every_table=True)
         return _into(scene, seconds, seed, Path(out), painter, gif, html, every_row or gif, shown)
 
 

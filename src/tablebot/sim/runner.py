@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import IO, Any
 
 import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.engine import Engine
+from tablebot.engine.as_one import RobotEngine
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
 from tablebot.loop import run as run_loop
@@ -60,6 +61,9 @@ class SimRun:
     end: RunEnd
     wall_s: float  # how long the loop took; shown to people, never written into result files
     hist_columns: tuple[int, ...] | None = None  # the sim.columns hist holds (None: all of them)
+    #: A robot of several tables: the other tables' decisions per tick, keyed as a trace keys them
+    #: (``NAME.event``, ``NAME.row``, ``NAME.state``, ``NAME.timer``); empty for one table.
+    others: dict[str, list] = field(default_factory=dict)
 
     def kept_rows(self) -> np.ndarray:
         """``hist``, for a run that kept the robot's rows (``simulate``'s default); a run that kept none says so."""
@@ -95,7 +99,7 @@ class SimRun:
 
         assert self.hist is not None and self.hist_columns is None, "the trace needs every robot row"
         return TickBlock(0, self.masks, self.pulses, self.events, self.rows, self.states, self.timers,
-                         self.outputs, self.counters, field_columns(self.scene, self.hist[:-1]))
+                         self.outputs, self.counters, {**field_columns(self.scene, self.hist[:-1]), **self.others})
 
     def write_trace(self, stream: IO[str]) -> int:
         """Write the run's trace as JSON Lines (what ``tablebot sim`` writes live); returns the number of ticks."""
@@ -125,6 +129,7 @@ class History:
         self._kept = np.array(self.kept or (), dtype=np.intp)
         self.ended: RunEnd | None = None
         self.done = 0
+        self.others: dict[str, list] = {}  # the other tables' keys of a robot of several tables, per tick
 
     def start(self, info: RunInfo) -> None:
         machine = info.engine.machine
@@ -145,6 +150,9 @@ class History:
         a, b = block.start, block.start + len(block)
         for name in self.COLUMNS:
             self.columns[name][a:b] = getattr(block, name)
+        if self.robot.scene.tables is not None and block.extra is not None:
+            for key in other_keys(self.robot.scene):
+                self.others.setdefault(key, []).extend(block.extra[key])
         if block.raw is not None:  # the robot at the start of each tick; the one after the last comes below
             if self.rows:
                 self.hist[a:b] = block.raw if self.kept is None else block.raw[:, self._kept]
@@ -170,7 +178,13 @@ class History:
                       ends=np.stack((self.first, robot.s)), path=self.path[: n // PATH_STRIDE + 1], **cut,
                       collision_rows=robot.collisions, collision_count=robot.collision_count,
                       reached_row=robot.reached_row, end=self.ended, wall_s=wall_s,  # type: ignore[arg-type]
-                      hist_columns=self.kept)
+                      hist_columns=self.kept, others={k: v[:n] for k, v in self.others.items()})
+
+
+def other_keys(scene: Scene) -> list[str]:
+    """The trace keys of a robot's tables other than the main one (none for one table)."""
+    names = scene.tables.names[1:] if scene.tables is not None else ()
+    return [f"{name}.{key}" for name in names for key in ("event", "row", "state", "timer")]
 
 
 class Progress:
@@ -187,6 +201,12 @@ class Progress:
 
     def end(self, end: RunEnd) -> None:
         pass
+
+
+def engine_for(scene: Scene) -> Engine | RobotEngine:
+    """The engine a run of ``scene`` steps: its table's, or every table of a robot of several. The run loop
+    runs an Engine in compiled blocks, a RobotEngine tick by tick from Python (every table, slower)."""
+    return RobotEngine(scene.tables) if scene.tables is not None else Engine(scene.machine)
 
 
 def ticks_for(scene: Scene, seconds: float) -> int:
@@ -213,5 +233,5 @@ def simulate(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[in
     keep = History(robot, history, rows, zeros)
     extra = [Progress(progress)] if progress else []
     started = time.perf_counter()
-    run_loop(Engine(scene.machine), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")
+    run_loop(engine_for(scene), robot, sinks=[keep, *sinks, *extra], ticks=ticks, target="sim")
     return keep.result(scene, seed, time.perf_counter() - started)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
+from tablebot.engine.as_one import robot_machine
 from tablebot.machine import FLAT_BITS, Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
@@ -28,6 +29,7 @@ from tablebot.sim.params import (
 )
 from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
+from tablebot.tables import RobotTables
 
 MAX_STEP_M = 0.04  # the most the robot may move in one tick: well under half its length, so contacts stay found
 SIDE_COLUMNS = {"right_motor": L.PUL_R, "left_motor": L.PUL_L}
@@ -47,6 +49,10 @@ class Scene:
     drive: tuple[int, int]  # output indices of the right and left motor
     pulse_columns: tuple[int, ...]  # per robot counter: state column of its motor's pulses, -1 = none
     lamp_outputs: tuple[int, ...]  # output indices of the robot's lamps
+    #: A robot of several tables run whole (every table, issue 36): ``machine`` is then
+    #: :func:`tablebot.engine.as_one.robot_machine`'s (the robot-wide input layout ``bits`` is in) and the run
+    #: steps a RobotEngine tick by tick. None: the one table of ``machine`` (or a robot's main table alone).
+    tables: RobotTables | None = None
 
     @property
     def tick_s(self) -> float:
@@ -80,15 +86,19 @@ def find_world(table: Table, world_path: Path | None, robot_world: Path | None) 
 
 
 def scene_for(table: Table, machine: Machine, world_path: Path | None = None,
-              overrides: dict[str, Any] | None = None) -> Scene:
-    """The whole chain for one table: its robot's [sim], its world (see :func:`find_world`), checked and packed."""
+              overrides: dict[str, Any] | None = None, tables: RobotTables | None = None) -> Scene:
+    """The whole chain for one table (or, with ``tables``, every table of the robot): its robot's [sim], its
+    world (see :func:`find_world`), checked and packed."""
     layer, robot_world = robot_layer(table.robot)
-    return prepare(table, machine, find_world(table, world_path, robot_world), layer, overrides)
+    return prepare(table, machine, find_world(table, world_path, robot_world), layer, overrides, tables)
 
 
 def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None = None,
-            overrides: dict[str, Any] | None = None) -> Scene:
-    """Check that robot, table and world fit together and pack them for the physics core."""
+            overrides: dict[str, Any] | None = None, tables: RobotTables | None = None) -> Scene:
+    """Check that robot, table and world fit together and pack them for the physics core; with ``tables``,
+    for every table of the robot (its inputs wired in the robot-wide layout)."""
+    if tables is not None:
+        machine = robot_machine(tables)
     robot_params = robot_params or {}
     params = _unwire_absent_sensors(merged(robot_params, world.params, overrides or {}), table.robot)
     found = [(section, key, message, "fix the value in the world or robot file")
@@ -113,7 +123,8 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     columns = tuple(SIDE_COLUMNS[motor_roles[c.motor]] if c.motor in motor_roles else -1 for c in robot.counters)
     return Scene(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
                  drive=(outputs.index(params.wiring["right_motor"]), outputs.index(params.wiring["left_motor"])),
-                 pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps))
+                 pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps),
+                 tables=tables)
 
 
 def _locate(section: str, key: str, world: World, robot: Robot,

@@ -1,0 +1,47 @@
+"""sim of a robot of several tables (issue 36 §2) runs every table: the simulated robot's trace holds the other
+tables' NAME.event/row/state/timer keys, its decisions are tablebot.engine.several's on the inputs the robot read
+(as the differential harness holds every executor), and the lamps only the lights table writes are lit."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import tablebot
+from tablebot.testing.harness import Run
+from tablebot.testing.several_cases import several_differences
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "bumberbot-lights"
+OTHERS = ("lights.event", "lights.row", "lights.state", "lights.timer")
+
+
+def test_sim_runs_every_table_as_several_does() -> None:
+    project = tablebot.open(EXAMPLE)
+    assert project.tables is not None
+    sim = project.simulate(seconds=6, seed=3)
+    text = io.StringIO()
+    sim.run.write_trace(text)
+    lines = [json.loads(line) for line in text.getvalue().splitlines()]
+    assert all(key in lines[0] for key in OTHERS)
+    assert several_differences(project.tables, Run(sim.run.inputs(), lines)) is None
+    states = {line["lights.state"] for line in lines}
+    assert len(states) > 1, states  # the lights table moved on, and with it the lamps
+    assert {line["L1"] for line in lines} != {0} and {line["L2"] for line in lines} != {0}
+
+
+def test_sim_command_writes_the_other_tables_keys(tmp_path: Path) -> None:
+    """The trace `tablebot sim --out` writes while the robot runs is the one the run makes again afterwards."""
+    done = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(EXAMPLE), "--seconds", "3", "--seed", "3",
+                           "--out", str(tmp_path)], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    assert "main table" not in done.stderr  # no note that the lights table is left out
+    written = (tmp_path / "trace.jsonl").read_text()
+    again = io.StringIO()
+    tablebot.open(EXAMPLE).simulate(seconds=3, seed=3).run.write_trace(again)
+    assert written == again.getvalue()
+    first = json.loads(written.splitlines()[0])
+    assert list(first)[-4:] == list(OTHERS)
