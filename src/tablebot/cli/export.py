@@ -11,7 +11,9 @@ import typer
 from tablebot import registry
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
+from tablebot.diagnostics import severity_word
 from tablebot.escape import terminal
+from tablebot.i18n import localise
 from tablebot.robopro import rpp_edit as rpp
 
 #: ``--to``'s choices: every registered export back-end.
@@ -49,6 +51,6 @@ def export_cmd(
     done = project.export(to.value, outdir, into=into, lists=(event_list, action_list, timer_list),
                           lookup=lookup.value)
     for line in done.lines:
-        console.print(terminal(line))
+        console.print(terminal(str(localise(line))))
     for line in done.warnings:
-        err_console.print(f"warning: {terminal(line)}")
+        err_console.print(f"{severity_word('warning')}: {terminal(str(localise(line)))}")

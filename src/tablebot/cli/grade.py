@@ -12,6 +12,7 @@ from tablebot.cli.app import app
 from tablebot.cli.common import console, err_console, guarded
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT
 from tablebot.escape import plain
+from tablebot.i18n import _, localise
 
 
 @app.command("grade")
@@ -36,11 +37,12 @@ def grade_cmd(
 
     def told(text: str) -> None:
         if not quiet:
-            err_console.print(plain(text), markup=False)
+            err_console.print(plain(str(localise(text))), markup=False)
 
     graded = grade(challenge, submissions, out, backend=backend, scheduler=scheduler, workers=workers, told=told)
     if not quiet:
         for line in scores_csv(list(graded.entries), graded.challenge).splitlines():  # pupils' names: user text
             console.print(plain(line), markup=False)
-        err_console.print(f"wrote {plain(str(Path(out) / 'scores.csv'))} and "
-                          f"{plain(str(Path(out) / 'leaderboard.html'))}", markup=False)
+        err_console.print(_("wrote {scores} and {board}").format(scores=plain(str(Path(out) / "scores.csv")),
+                                                                  board=plain(str(Path(out) / "leaderboard.html"))),
+                          markup=False)

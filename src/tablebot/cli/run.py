@@ -12,8 +12,9 @@ import typer
 from tablebot import registry
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project, out_folder
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import fail, severity_word
 from tablebot.escape import terminal
+from tablebot.i18n import N_, _, localise, ngettext
 
 if TYPE_CHECKING:  # the engine, the loop and the robots are imported only when the command runs
     from tablebot.api.running import Connection, LiveRun
@@ -54,7 +55,7 @@ def run_cmd(
         out_folder(out, "--out")  # before anything moves, so that a bad path fails at once
     connection = project.connect(on, link_timeout=link_timeout, behind_limit=behind_limit, seed=seed)
     for warning in connection.opened.warnings:
-        err_console.print(terminal(f"warning: {warning}"))
+        err_console.print(terminal(f"{severity_word('warning')}: {localise(warning)}"))
     done = _drive(connection, seconds, out, quiet)
     if done.end.exit_code:
         raise typer.Exit(done.end.exit_code)
@@ -69,17 +70,17 @@ def _drive(connection: Connection, seconds: float | None, out: Path | None, quie
     if not quiet and err_console.is_terminal:
         sinks.append(LiveView(err_console, opened.device))
     if not quiet:
-        err_console.print(terminal(f"running {machine.table.path} on {opened.where} ({opened.device}); Ctrl-C "
-                                   "stops it"))
+        err_console.print(terminal(_("running {table} on {where} ({device}); Ctrl-C stops it").format(
+            table=machine.table.path, where=opened.where, device=opened.device)))
     done = connection.run(seconds, out, sinks)
     if not quiet:
         _report(done, machine)
     elif done.end.exit_code:  # quiet hides the live view and the summary, never why a run failed
         end = done.end
-        why = f" — {end.message}" if end.message else ""
-        err_console.print(terminal(f"ran {end.ticks} ticks: {end.reason}{why}"))
+        why = f" — {localise(end.message)}" if end.message else ""
+        err_console.print(terminal(_("ran {ticks} ticks: {reason}").format(ticks=end.ticks, reason=end.reason) + why))
         for path in done.files:
-            err_console.print(terminal(f"kept {path}"))
+            err_console.print(terminal(_("kept {path}").format(path=path)))
     return done
 
 
@@ -87,13 +88,15 @@ def _report(done: LiveRun, machine: Machine) -> None:
     """How the run ended on stdout; the files written on stderr."""
     end = done.end
     seconds = end.ticks * machine.table.robot.tick_s
-    why = f" — {end.message}" if end.message else ""
-    console.print(terminal(f"ran {end.ticks} ticks ({seconds:.2f} s): {end.reason}{why}"))
+    why = f" — {localise(end.message)}" if end.message else ""
+    console.print(terminal(_("ran {ticks} ticks ({seconds:.2f} s): {reason}").format(
+        ticks=end.ticks, seconds=seconds, reason=end.reason) + why))
     if end.late_ticks:
-        ticks = "tick" if end.late_ticks == 1 else "ticks"
-        console.print(f"{end.late_ticks} {ticks} started late (worst {1000 * end.worst_late_s:.1f} ms)")
+        console.print(ngettext("{n} tick started late (worst {ms:.1f} ms)",
+                               "{n} ticks started late (worst {ms:.1f} ms)", end.late_ticks).format(
+            n=end.late_ticks, ms=1000 * end.worst_late_s))
     for path in done.files:
-        err_console.print(terminal(f"wrote {path}"))
+        err_console.print(terminal(_("wrote {path}").format(path=path)))
     sys.stdout.flush()
 
 
@@ -113,7 +116,8 @@ def upload_cmd(
     from tablebot.hw.txt4.upload import api_key, base_url, terminal_prompt, upload, workspace_files
 
     if not folder.is_dir():
-        raise fail(folder, "is a file, not a folder" if folder.exists() else "no such folder",
-                   "give the folder `tablebot export --to txt4` wrote")
+        raise fail(folder, N_("is a file, not a folder") if folder.exists() else N_("no such folder"),
+                   N_("give the folder `tablebot export --to txt4` wrote"))
     base_url(to), workspace_files(folder)  # a wrong --to or folder is said before the key is asked for
-    upload(folder, to, api_key(key, key_file, terminal_prompt()), start, say=lambda text: console.print(terminal(text)))
+    upload(folder, to, api_key(key, key_file, terminal_prompt()), start,
+           say=lambda text: console.print(terminal(str(localise(text)))))

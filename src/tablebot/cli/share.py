@@ -10,6 +10,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import err_console, guarded, out_file
 from tablebot.escape import plain
+from tablebot.i18n import N_, _
 
 QR_SCALE = 8  # pixels per module: a QR code of a thousand characters is about 600 px wide, easy for a phone
 QR_OPT = typer.Option(None, "--qr", metavar="FILE.png", help="Also write the link's QR code as a PNG picture.")
@@ -33,12 +34,13 @@ def share_cmd(
     shared = share.collect(where)
     link = share.encode(shared, base or share.STUDIO)
     print(link)
-    err_console.print(f"{len(link):,} characters: the table {plain(shared.table[0])}"
-                      + (f", {plain(shared.robot[0])}" if shared.robot else ", the built-in BumberBot")
-                      + (", its world" if shared.world is not None else ", an empty room"), markup=False)
+    robot = plain(shared.robot[0]) if shared.robot else _("the built-in BumberBot")
+    world = _("its world") if shared.world is not None else _("an empty room")
+    err_console.print(_("{n:,} characters: the table {table}, {robot}, {world}").format(
+        n=len(link), table=plain(shared.table[0]), robot=robot, world=world), markup=False)
     if qr is not None:
         write_qr(qr, link)
-        err_console.print(f"wrote {plain(str(qr))}", markup=False)
+        err_console.print(_("wrote {path}").format(path=plain(str(qr))), markup=False)
 
 
 def write_qr(path: Path, link: str) -> None:
@@ -53,8 +55,9 @@ def write_qr(path: Path, link: str) -> None:
     try:
         code = segno.make(link, error="l", boost_error=True, micro=False)
     except segno.DataOverflowError:
-        raise fail("--qr", f"the link is too long for a QR code ({len(link):,} characters; one holds about 2,900)",
-                   "share the link as text, or shorten the robot and world files' comments") from None
+        raise fail("--qr", N_("the link is too long for a QR code ({n:,} characters; one holds about 2,900)",
+                              n=len(link)),
+                   N_("share the link as text, or shorten the robot and world files' comments")) from None
     picture = io.BytesIO()
     code.save(picture, kind="png", scale=QR_SCALE, border=4)
     write_bytes(path, picture.getvalue())

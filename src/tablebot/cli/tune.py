@@ -11,7 +11,9 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import FORCE_OPT, ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORKERS_OPT, WORLD_OPT, stops
+from tablebot.diagnostics import severity_word
 from tablebot.escape import plain, terminal
+from tablebot.i18n import _, localise
 
 
 @app.command("tune")
@@ -56,6 +58,6 @@ def tune_cmd(
         for line in tuned.report_text().splitlines():  # the report names the table and its cells: user text
             console.print(plain(line), markup=False)
         for path in tuned.files:
-            err_console.print(f"wrote {plain(str(path))}", markup=False)
+            err_console.print(_("wrote {path}").format(path=plain(str(path))), markup=False)
         if not tuned.helped:  # the report says so too; the last word on the terminal must not read as a success
-            err_console.print(f"[yellow]note:[/yellow] {terminal(tuned.verdict())}")
+            err_console.print(f"[yellow]{severity_word('note')}:[/yellow] {terminal(str(localise(tuned.verdict())))}")
