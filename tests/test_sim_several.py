@@ -45,3 +45,13 @@ def test_sim_command_writes_the_other_tables_keys(tmp_path: Path) -> None:
     assert written == again.getvalue()
     first = json.loads(written.splitlines()[0])
     assert list(first)[-4:] == list(OTHERS)
+
+
+def test_a_saved_run_writes_the_other_tables_keys(tmp_path: Path) -> None:
+    """Simulation.save writes the trace `sim --out` writes (the lights table's keys too)."""
+    sim = tablebot.open(EXAMPLE).simulate(seconds=2, seed=5)
+    sim.save(tmp_path, plots=False)
+    again = io.StringIO()
+    sim.run.write_trace(again)
+    assert (tmp_path / "trace.jsonl").read_text() == again.getvalue()
+    assert all(key in json.loads(again.getvalue().splitlines()[-1]) for key in OTHERS)

@@ -214,7 +214,8 @@ def _write_trace(sim: Simulation, folder: Path) -> Path:
         return write_bytes(folder / written.name, written.read_bytes())
     trace = TraceFile(folder / "trace.jsonl")
     trace.start(RunInfo(Engine(run.scene.machine), run.tick_s, "sim", run.ticks))
-    for block in traces.blocks(run, BLOCK_TICKS):
+    # a robot of several tables: its other tables' keys are the run's, not its robot rows' (one block, the same lines)
+    for block in [run.block()] if run.others else traces.blocks(run, BLOCK_TICKS):
         trace.block(block)
     trace.end(run.end)
     assert trace.written is not None
