@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from tablebot import i18n
 from tablebot.cli.app import app
 from tablebot.cli.common import err_console, guarded
 from tablebot.diagnostics import fail, severity_word
@@ -72,7 +73,7 @@ def studio_cmd(
         _say_no_table(root)
     sharing.maker, sharing.opener = link_maker, link_opener  # the Share button's links, and links pasted in
     visited = threading.Event()
-    uvicorn_server = server(create_app(root, access, table, visited=visited), access,
+    uvicorn_server = server(create_app(root, access, table, visited=visited, lang=i18n.named()), access,
                             "info" if verbose else "warning")
     with ExitStack() as stack:  # the file goes when the studio stops (Ctrl-C, SIGTERM)
         if not no_browser:

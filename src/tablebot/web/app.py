@@ -29,6 +29,7 @@ from tablebot.web.live import give_back_memory
 from tablebot.web.protocol import ErrorMsg, TraceMsg
 from tablebot.web.session import Hub, Session
 from tablebot.web.tracefile import MAX_PLAYER_TRACE_BYTES, read_trace_bytes, trace_columns
+from tablebot.web.words import language_of
 from tablebot.web.workspace import Workspace
 
 STATIC = Path(__file__).parent / "static"
@@ -48,9 +49,11 @@ class Gone(Exception):
 
 
 def create_app(root: Path, access: Access, table: str | None = None, max_tabs: int = MAX_TABS,
-               visited: threading.Event | None = None) -> Gate:
+               visited: threading.Event | None = None, lang: str | None = None) -> Gate:
     """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first;
-    at most ``max_tabs`` tabs at once; ``visited`` is set when a page comes with the token in its address."""
+    at most ``max_tabs`` tabs at once; ``visited`` is set when a page comes with the token in its address;
+    ``lang`` is the language asked for (``tablebot studio --lang``), which the page speaks unless its switch says
+    otherwise (None: the browser's language)."""
     workspace = Workspace(root)
     hub = Hub()
     tabs = Tabs(max_tabs)
@@ -65,7 +68,8 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
     async def config(request: Request) -> Response:
         listing = await asyncio.to_thread(workspace.listing)
         # templates: what `tablebot new` offers, for a folder without a table
-        return JSONResponse({"table": table, "folder": workspace.root.name, "templates": list(TEMPLATES), **listing},
+        return JSONResponse({"table": table, "folder": workspace.root.name, "templates": list(TEMPLATES), "lang": lang,
+                             **listing},
                             headers={"Cache-Control": "no-store"})
 
     async def upload_trace(request: Request) -> Response:
@@ -107,7 +111,7 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
                 except (WebSocketDisconnect, RuntimeError, OSError) as exc:  # the tab went away mid-send
                     raise Gone from exc
 
-        session = Session(workspace, hub, send)
+        session = Session(workspace, hub, send, language_of(websocket.query_params.get("lang")))
         hub.sessions.add(session)
         ticker = asyncio.create_task(_frames(session))
         try:
@@ -234,7 +238,7 @@ class Background:
     :meth:`stop` to end."""
 
     def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
-                 log_level: str = "warning", max_tabs: int = MAX_TABS) -> None:
+                 log_level: str = "warning", max_tabs: int = MAX_TABS, lang: str | None = None) -> None:
         import socket
 
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -245,7 +249,7 @@ class Background:
         self.origin = f"http://{host}:{self.access.port}"
         self.url = self.access.url(host)
         self.headers = {"Origin": self.origin, TOKEN_HEADER: self.access.token}
-        self.server = server(create_app(root, self.access, table, max_tabs), self.access, log_level)
+        self.server = server(create_app(root, self.access, table, max_tabs, lang=lang), self.access, log_level)
         self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]}, daemon=True)
         self.thread.start()
         while not self.server.started:

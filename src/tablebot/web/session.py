@@ -46,6 +46,7 @@ from tablebot.web.protocol import (
 )
 from tablebot.web.sharing import open_link, share
 from tablebot.web.trace_player import TracePlayer
+from tablebot.web.words import diagnostics_text, localised
 from tablebot.web.workspace import OTHER_TAB, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
@@ -71,6 +72,7 @@ class Session:
     workspace: Workspace
     hub: Hub
     send: Send
+    language: str = "en"  # the page's (tablebot.i18n's name): what the server says to this tab is in it
     robot: ArenaRobot = field(init=False)
     draft: Draft = field(init=False)
     player: TracePlayer = field(init=False)
@@ -81,7 +83,7 @@ class Session:
         self.player = TracePlayer(self.workspace, self.say, lambda: self.draft.analysis, self.robot)
 
     async def say(self, message: Message) -> None:
-        await self.send(message.data())
+        await self.send(localised(message.data(), self.language))
 
     async def handle(self, message: Any) -> None:
         try:
@@ -92,7 +94,8 @@ class Session:
         try:
             await self.dispatch(operation(message))
         except TableBotError as exc:
-            await self.say(ErrorMsg(exc.diagnostics[0].message if exc.diagnostics else str(exc), name, str(exc)))
+            await self.say(ErrorMsg(exc.diagnostics[0].message if exc.diagnostics else str(exc), name,
+                                    diagnostics_text(exc.diagnostics, self.language)))
         except Refused as exc:
             await self.error(str(exc), name)
 

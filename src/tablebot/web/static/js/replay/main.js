@@ -7,6 +7,7 @@ import { Diagram } from "../views/diagram.js";
 import { Grid } from "../views/grid.js";
 import { Player, wirePlayerControls, wireZoom } from "../views/player.js";
 import { Timeline } from "../views/timeline.js";
+import { chooseLanguage, setLanguage, t, translatePage, wireSwitch } from "../lib/words.js";
 
 function showInputs(machine, mask) {
   byId("inputs").replaceChildren(...machine.inputs.map((name) => make("span", {
@@ -27,8 +28,8 @@ function replay(data) {
   const stateCol = data.table.columns.findIndex((c) => c.kind === "state");
   const timeline = new Timeline(byId("timeline"), colourOf, (i) => player.seek(i));
   const player = new Player({ arena, grid, diagram, timeline, status: byId("status"), slider: byId("scrub"),
-    stateCol: () => stateCol, onEnd: () => { byId("tplay").textContent = "▶ Play"; },
-    onSeek: (t) => showInputs(data.machine, t.event) });
+    stateCol: () => stateCol, onEnd: () => { byId("tplay").textContent = t("live.play"); },
+    onSeek: (tick) => showInputs(data.machine, tick.event) });
   player.load(data.trace, data.machine, 0);
   wirePlayerControls(player);
   wireZoom(arena);
@@ -37,4 +38,7 @@ function replay(data) {
 }
 
 const holder = byId("tb-data");
+setLanguage(chooseLanguage(null));  // the reader's: the switch's choice, else the browser's
+translatePage();
+wireSwitch(byId("language"));
 if (holder) replay(JSON.parse(holder.textContent));

@@ -2,6 +2,7 @@
 import { all, byId } from "../lib/dom.js";
 import { askForLink } from "./sharebox.js";
 import { api } from "../lib/key.js";
+import { t } from "../lib/words.js";
 
 const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 
@@ -11,7 +12,7 @@ function wireTable(store, send, drafts) {
   on("open-link", "click", () => askForLink(send));
   on("table-pick", "change", (e) => {
     const { dirty, path } = store.get();
-    if (dirty && !confirm("The table has unsaved edits. Open another and lose them?")) { e.target.value = path; return; }
+    if (dirty && !confirm(t("open.unsaved"))) { e.target.value = path; return; }
     if (dirty) drafts.drop(path, true);  // the user chose to lose them
     store.set({ offerDraft: e.target.value });
     send({ op: "open", path: e.target.value });

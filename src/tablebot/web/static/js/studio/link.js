@@ -15,12 +15,13 @@ export function createLink() {
     else if (!link.opened) pending.push(message);
   }
 
-  /** Connect, and again whenever it drops: `hello(again)` gives the first message of each connection (if
+  /** Connect, and again whenever it drops, telling the server the page's language (`lang`: it says its errors
+   * and findings in it): `hello(again)` gives the first message of each connection (if
    * any), each reply goes to `receive`; `down(tries)` and `up()` tell the page it dropped and came back. */
-  function open(hello, receive, { down, up }) {
+  function open(hello, lang, receive, { down, up }) {
     let tries = 0;
     const connect = () => {
-      const socket = link.socket = socketTo("/ws");
+      const socket = link.socket = socketTo("/ws?lang=" + encodeURIComponent(lang));
       socket.addEventListener("open", () => {
         const again = link.opened;
         const first = hello(again);

@@ -1,6 +1,8 @@
 // The studio page: one store, one WebSocket, the views and panels wired to them.
+import { byId } from "../lib/dom.js";
 import { api } from "../lib/key.js";
 import { createStore } from "../lib/store.js";
+import { chooseLanguage, currentLanguage, setLanguage, t, translatePage, wireSwitch } from "../lib/words.js";
 import { wirePlayerControls, wireZoom } from "../views/player.js";
 import { banner } from "./banner.js";
 import { wireControls } from "./controls.js";
@@ -45,6 +47,9 @@ async function start() {
   const reply = await api("/api/config");
   if (!reply.ok) { banner(await reply.text(), "bad"); return; }
   const config = await reply.json();
+  setLanguage(chooseLanguage(config.lang));  // before any word is shown, and before the server is told it
+  translatePage();
+  wireSwitch(byId("language"));
   store.set({ files: config, folder: config.folder });
   const wanted = params.get("table") || config.table || config.tables[0];
   if (!wanted) showNoTable(config, link.send);
@@ -55,14 +60,12 @@ async function start() {
     return path ? { op: "open", path } : null;
   };
   openLinkInAddress(link.send);  // sent once the connection is up (after the table it opens first)
-  link.open(hello, receive, { down: connectionDown, up: () => banner("connected to the studio again", "good") });
+  link.open(hello, currentLanguage(), receive, { down: connectionDown, up: () => banner(t("link.again"), "good") });
 }
 
 function connectionDown(tries) {
-  const kept = store.get().dirty ? " Your unsaved edits are kept in this browser and offered back." : "";
-  if (tries < 3) banner("lost the connection to the studio: connecting again…" + kept, "bad");
-  else banner("the studio server does not answer: if it stopped, start tablebot studio again and open the address "
-    + "it prints." + kept, "bad");
+  const kept = store.get().dirty ? " " + t("link.kept") : "";
+  banner(t(tries < 3 ? "link.lost" : "link.gone") + kept, "bad");
 }
 
 requestAnimationFrame(paint);

@@ -1,6 +1,7 @@
 // What the page does with each message from the server: mostly a change of state (the panels subscribed
 // to it redraw), sometimes a view's own content (the grid's rows, the diagram's SVG, a trace to play).
 import { addOption, byId } from "../lib/dom.js";
+import { t } from "../lib/words.js";
 import { ask } from "./ask.js";
 import { banner } from "./banner.js";
 import { byKind } from "./protocol.js";
@@ -47,19 +48,17 @@ function trace(store, views, m) {
   addOption(byId("trace-pick"), m.name);
   byId("trace-pick").value = m.name;
   const machine = store.get().machine;
-  if (!machine) { banner("open a table that reads before playing a trace", "bad"); return; }
+  if (!machine) { banner(t("trace.no_table"), "bad"); return; }
   views.player.load(m.columns, machine, m.at_tick);
   store.set({ why: [] });
-  arenaNote("x" in m.columns ? "" : "this trace has no robot pose (a replay, a counterexample or a real robot): "
-    + "the table, the diagram and the timeline follow it; the arena cannot");
+  arenaNote("x" in m.columns ? "" : t("trace.no_pose"));
 }
 
-const WHAT = {  // how the file changed: the dialog's title, and what it means
-  changed: ["was changed on disk", "Someone changed the file since you opened it."],
-  replaced: ["was replaced on disk", "Another program saved over it since you opened it (an editor, git checkout, "
-    + "sed -i, another studio)."],
-  deleted: ["was deleted", "It was deleted since you opened it."],
-  "saved in another tab": ["was saved in another tab", "Another tab of the studio saved it since you opened it here."],
+const WHAT = {  // how the file changed: the dialog's title, and what it means (keys of the page's catalog)
+  changed: ["conflict.changed", "conflict.changed_why"],
+  replaced: ["conflict.replaced", "conflict.replaced_why"],
+  deleted: ["conflict.deleted", "conflict.deleted_why"],
+  "saved in another tab": ["conflict.other_tab", "conflict.other_tab_why"],
 };
 
 // The file on disk is not the one the draft started from: save mine over theirs (kept as NAME.bak), or
@@ -67,18 +66,17 @@ const WHAT = {  // how the file changed: the dialog's title, and what it means
 function conflict(store, send, drafts, m) {
   const saveMine = () => send({ op: "save", force: m.theirs });
   const loadTheirs = () => { drafts.drop(m.path, true); store.set({ offerDraft: null }); send({ op: "open", path: m.path }); };
-  const answers = m.how === "deleted" ? [["Save mine (write the table again)", saveMine, "primary"]] :
-    [[`Save mine (keep theirs as ${m.backup})`, saveMine, "primary"], ["Load theirs (drop my edits)", loadTheirs]];
+  const answers = m.how === "deleted" ? [[t("conflict.save_again"), saveMine, "primary"]] :
+    [[t("conflict.save_mine", { backup: m.backup }), saveMine, "primary"], [t("conflict.load_theirs"), loadTheirs]];
   if (m.op !== "save") {  // another tab saved while this one was editing: said, not asked
-    banner(m.message + ": your edits are kept", "bad", answers.map(([label, action]) => [label, action]));
+    banner(t("conflict.kept", { message: m.message }), "bad", answers.map(([label, action]) => [label, action]));
     return;
   }
-  const later = () => banner("not saved: your edits are kept; Save asks again", "bad");
-  const [title, why] = WHAT[m.how] || ["changed", ""];
-  ask(`${m.path} ${title}`, [why + " Nothing was saved, and your edits are kept.",
-      m.how === "deleted" ? "Save mine writes your table again." :
-        `Save mine writes your table and keeps theirs as ${m.backup}; load theirs shows their table and drops your edits.`],
-    [...answers, ["Decide later", later]], later);
+  const later = () => banner(t("conflict.later_said"), "bad");
+  const [title, why] = WHAT[m.how] || WHAT.changed;
+  ask(t(title, { path: m.path }), [t(why) + " " + t("conflict.nothing_saved"),
+      m.how === "deleted" ? t("conflict.deleted_answer") : t("conflict.answer", { backup: m.backup })],
+    [...answers, [t("conflict.later"), later]], later);
 }
 
 const clock = (ms) => new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit" });
@@ -93,11 +91,9 @@ function offerDraft(store, send, drafts, m) {
     store.set({ seq, version: draft.base });  // the draft's own start, kept with it at every edit
     send({ op: "restore", base: draft.base, header: draft.header, grid: draft.grid, seq });
   };
-  ask(`Restore your unsaved edits to ${m.path}?`, [`You edited ${m.path} at ${clock(draft.at)} and did not save. `
-    + "The page was reloaded or lost its connection to the studio; this browser kept your edits.",
-  draft.base !== m.version ? `${m.path} has changed on disk since: restoring puts your edits back, and Save will ask `
-    + "whether to keep that version as a backup." : ""],
-  [["Restore my edits", restore, "primary"], ["Drop them", () => drafts.drop(m.path, true)]]);
+  ask(t("draft.title", { path: m.path }), [t("draft.why", { path: m.path, at: clock(draft.at) }),
+    draft.base !== m.version ? t("draft.changed", { path: m.path }) : ""],
+  [[t("draft.restore"), restore, "primary"], [t("draft.drop"), () => drafts.drop(m.path, true)]]);
 }
 
 // A table from the server (opened, reloaded, connected again): the draft kept of it is offered when the page
@@ -131,7 +127,7 @@ export function messageHandlers(store, views, send, drafts) {
     saved(m) {
       store.set({ dirty: false, version: m.version });
       drafts.drop(m.path);
-      banner(`saved ${m.path}` + (m.backup ? ` (the previous version is ${m.backup})` : ""), "good");
+      banner(m.backup ? t("saved.backup", { path: m.path, backup: m.backup }) : t("saved.saved", { path: m.path }), "good");
     },
     conflict: (m) => conflict(store, send, drafts, m),
     notice: (m) => banner(m.message, "good"),

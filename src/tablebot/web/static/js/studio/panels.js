@@ -1,14 +1,19 @@
 // The parts of the page drawn from the store: each function subscribes to the keys it shows.
 import { addOption, all, button, byId, make } from "../lib/dom.js";
+import { t } from "../lib/words.js";
 import { describeTick } from "../views/player.js";
 import { banner } from "./banner.js";
 import { arenaNote } from "./messages.js";
 import { stateColumn } from "./views.js";
 
+const counted = (word, n) => t(n === 1 ? `counts.${word}` : `counts.${word}s`, { n });
+
 function countsText(m) {
   const c = m.counts || {};
-  if (!m.ok) return [`${m.diagnostics.length} problem${m.diagnostics.length === 1 ? "" : "s"}: the table does not read`, "bad"];
-  const text = `${m.machine.rows} rows · ${m.machine.states.length} states · ${c.error || 0} errors · ${c.warning || 0} warnings`;
+  const n = m.diagnostics.length;
+  if (!m.ok) return [t(n === 1 ? "counts.problem" : "counts.problems", { n }), "bad"];
+  const text = t("counts.ok", { rows: counted("row", m.machine.rows), states: counted("state", m.machine.states.length),
+    errors: counted("error", c.error || 0), warnings: counted("warning", c.warning || 0) });
   return [text, c.error ? "bad" : c.warning ? "warn" : "good"];
 }
 
@@ -24,14 +29,13 @@ function showAnalysis(store, views) {
     const [text, kind] = countsText(m);
     byId("counts").textContent = text;
     byId("counts").className = "counts " + kind;
-    byId("analysis-time").textContent = `checked in ${m.ms} ms`;
+    byId("analysis-time").textContent = t("counts.checked", { ms: m.ms });
   });
   // the robot keeps running the table it was started with: while the edited one does not read, say so
   store.on(["analysis", "arenaOk", "mode"], ({ analysis, arenaOk, mode }) => {
     const stale = Boolean(analysis && !analysis.ok && arenaOk && mode === "live");
     byId("arena-stale").hidden = !stale;
-    byId("arena-stale").textContent = stale ? "The table has errors: the robot runs the last table that read. "
-      + "Fix them, then Reset runs yours." : "";
+    byId("arena-stale").textContent = stale ? t("arena.stale") : "";
   });
 }
 
@@ -63,9 +67,8 @@ function showCounterexample(store, views, m) {
   if (!cex) return;
   if (m.paused && m.scripted === 0 && m.pose[0] !== null) {
     const what = cex.example ? "reached" : "broken";
-    views.arena.setMarker({ x: m.pose[0], y: m.pose[1], label: `${cex.name} ${what} here` });
-    arenaNote(`${cex.example ? "✔" : "✘"} ${cex.name} is ${what} here, at tick ${m.tick}: ${cex.text}. `
-      + "Play goes on with the sensors; Reset starts over.");
+    views.arena.setMarker({ x: m.pose[0], y: m.pose[1], label: t(`cex.${what}_marker`, { name: cex.name }) });
+    arenaNote(`${cex.example ? "✔" : "✘"} ` + t(`cex.${what}_note`, { name: cex.name, tick: m.tick, text: cex.text }));
     cex.shown = true;
   } else if (cex.shown && !m.paused) {
     views.arena.setMarker(null);
@@ -84,7 +87,7 @@ function showWhy(store, views) {
   });
 }
 
-const HELD_WORDS = { true: ": held on", false: ": held off" };
+const HELD_WORDS = { true: "inputs.held_on", false: "inputs.held_off" };
 const HELD_CLASSES = { true: " held-on", false: " held-off" };
 
 function inputButton(store, send, name) {
@@ -101,9 +104,9 @@ function paintInputs(buttons, { machine, held, mode, mask }) {
   for (const [name, b] of buttons) {
     const live = mask !== undefined && (mask & machine.input_bits[name]);
     b.className = "input" + (live ? " live" : "") + (HELD_CLASSES[held[name]] || "");
-    b.textContent = name + (HELD_WORDS[held[name]] || "");
+    b.textContent = name + (HELD_WORDS[held[name]] ? t(HELD_WORDS[held[name]]) : "");
     b.disabled = mode !== "live";
-    b.title = (machine.labels[name] || name) + ": click to hold it on, again to hold it off, again to let the sensor decide";
+    b.title = t("inputs.title", { name: machine.labels[name] || name });
   }
 }
 
@@ -120,12 +123,12 @@ function showInputs(store, send) {
 
 function showControls(store) {
   store.on(["paused", "speed"], ({ paused, speed }) => {
-    byId("play").textContent = paused ? "▶ Play" : "❚❚ Pause";
+    byId("play").textContent = paused ? t("live.play") : t("live.pause");
     byId("step").disabled = !paused;
     for (const b of all("[data-speed]")) b.classList.toggle("on", b.dataset.speed === speed);
   });
   store.on(["arenaOk"], ({ arenaOk }) => { byId("play").disabled = !arenaOk; });
-  store.on(["runError"], ({ runError }) => { if (runError) banner("the live robot stopped: " + runError, "bad"); });
+  store.on(["runError"], ({ runError }) => { if (runError) banner(t("live.stopped", { error: runError }), "bad"); });
   store.on(["clickMode"], ({ clickMode }) => {
     for (const b of all("[data-click]")) b.classList.toggle("on", b.dataset.click === clickMode);
   });
@@ -134,28 +137,25 @@ function showControls(store) {
 /** A folder without a table: the page says so, and offers `tablebot new`'s templates (a click makes the robot
  * in a new folder here and opens it; the commands do the same in a terminal). */
 export function showNoTable(config, send) {
-  const what = make("p", {}, `There is no table in ${config.folder || "this folder"}: the studio opens a .csv or .tsv `
-    + "file whose first line names the state and next columns. Start a robot from one of tablebot's templates, "
-    + "in a new folder here named");
+  const what = make("p", {}, config.folder ? t("none.what", { folder: config.folder }) : t("none.what_here"));
   const name = make("input", { id: "new-name", value: "my-robot", spellcheck: false, maxLength: 64 });
-  name.setAttribute("aria-label", "the new robot's folder");
+  name.setAttribute("aria-label", t("none.name_aria"));
   const templates = config.templates || [];
-  const starts = make("p", { className: "starts" }, name, " from ", ...templates.map((template) => button(template,
+  const starts = make("p", { className: "starts" }, name, ` ${t("none.from")} `, ...templates.map((template) => button(template,
     () => send({ op: "new", template, name: name.value.trim() }), { className: "primary" })));
   const commands = make("ul", { className: "commands" }, ...templates.map((template) =>
     make("li", {}, make("code", {}, `tablebot new my-robot --from ${template}`))));
   byId("grid").replaceChildren(make("div", { className: "no-table", role: "status" },
-    make("h2", {}, "No table here"), what, starts,
-    make("p", {}, "or in a terminal, in this folder, one of"), commands,
-    make("p", {}, "then ", make("code", {}, "tablebot studio my-robot"),
-      " (or start the studio in the folder that holds your table).")));
-  byId("save-state").textContent = "no table";
+    make("h2", {}, t("none.title")), what, starts,
+    make("p", {}, t("none.terminal")), commands,
+    make("p", {}, t("none.then") + " ", make("code", {}, "tablebot studio my-robot"), " " + t("none.or_start"))));
+  byId("save-state").textContent = t("none.state");
 }
 
 function showFile(store) {
   // nothing to save (no table, or no edit since it was read or saved): Save is off
   store.on(["dirty", "path"], ({ dirty, path }) => {
-    if (path) byId("save-state").textContent = dirty ? "unsaved edits" : "saved";
+    if (path) byId("save-state").textContent = dirty ? t("file.unsaved") : t("file.saved");
     byId("save").classList.toggle("primary", Boolean(dirty));
     byId("save").disabled = !path || !dirty;
     byId("add-row").disabled = byId("del-row").disabled = byId("share").disabled = !path;
@@ -167,9 +167,9 @@ function showFile(store) {
   store.on(["files"], ({ files, path }) => {
     const tables = byId("table-pick"), traces = byId("trace-pick");
     tables.replaceChildren();
-    traces.replaceChildren(make("option", { value: "" }, "choose a trace…"));
-    files.tables.forEach((t) => addOption(tables, t));
-    files.traces.forEach((t) => addOption(traces, t));
+    traces.replaceChildren(make("option", { value: "" }, t("trace.choose")));
+    files.tables.forEach((name) => addOption(tables, name));
+    files.traces.forEach((name) => addOption(traces, name));
     if (path) tables.value = path;
   });
 }

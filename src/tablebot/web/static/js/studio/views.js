@@ -2,6 +2,7 @@
 // store and the server: what the user does in a view becomes a message or a change of state.
 import { stateColours } from "../lib/colours.js";
 import { byId } from "../lib/dom.js";
+import { t } from "../lib/words.js";
 import { Arena } from "../views/arena.js";
 import { Checks } from "../views/checks.js";
 import { Diagram } from "../views/diagram.js";
@@ -78,7 +79,7 @@ export function createViews(store, send, edited) {
   views.timeline = new Timeline(byId("timeline"), stateColours(store), (i) => views.player.seek(i));
   views.player = new Player({ arena, grid, diagram, timeline: views.timeline, status: byId("status"),
     slider: byId("scrub"), stateCol: () => stateColumn(store),
-    onEnd: () => { byId("tplay").textContent = "▶ Play"; }, onSeek: (t) => store.set({ mask: t.event }) });
+    onEnd: () => { byId("tplay").textContent = t("live.play"); }, onSeek: (tick) => store.set({ mask: tick.event }) });
   views.checks = makeChecks(store, send, grid);
   store.on(["machine"], () => repaintStates(views));
   return views;

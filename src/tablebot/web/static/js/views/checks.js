@@ -1,6 +1,7 @@
 // The checks panel: the parser's errors, check's findings and the property results, each clickable to
 // select its rows; a broken property's counterexample can be played on the table or in the arena.
 import { button, make } from "../lib/dom.js";
+import { t } from "../lib/words.js";
 
 const hasRow = (d) => d.row !== null && d.row !== undefined;
 
@@ -13,8 +14,8 @@ export class Checks {
   }
 
   _item(list, severity, text, hint, onClick) {
-    const li = make("li", { className: "sev-" + severity }, make("span", { className: "tag" }, severity), " ", text);
-    if (hint) li.append(make("div", { className: "hint" }, "hint: " + hint));
+    const li = make("li", { className: "sev-" + severity }, make("span", { className: "tag" }, t("severity." + severity)), " ", text);
+    if (hint) li.append(make("div", { className: "hint" }, t("checks.hint", { hint })));
     if (onClick) {
       li.tabIndex = 0;
       li.addEventListener("click", onClick);
@@ -35,7 +36,7 @@ export class Checks {
     const props = [...(data.properties || [])].sort((a, b) => (a.status === "holds") - (b.status === "holds"));
     for (const p of props) this._verdict(this._property(properties, p), p);
     const quiet = !(data.findings || []).some((f) => f.severity !== "info") && !(data.properties || []).some((p) => p.severity);
-    if (data.ok && quiet) findings.prepend(make("li", { className: "sev-ok" }, "no errors, no warnings"));
+    if (data.ok && quiet) findings.prepend(make("li", { className: "sev-ok" }, t("checks.clean")));
   }
 
   _problems(diagnostics) {
@@ -49,17 +50,17 @@ export class Checks {
   _findings(all) {
     const shown = all.filter((f) => this.els.showInfo.checked || f.severity !== "info");
     for (const f of shown) {
-      const where = f.lines.length ? `line ${f.lines.join(", ")}: ` : "";
+      const where = f.lines.length ? t("checks.line", { lines: f.lines.join(", ") }) : "";
       this._item(this.els.findings, f.severity, where + f.message, f.hint,
         f.rows.length ? () => this.actions.select(f.rows) : null);
     }
     const hidden = all.length - shown.length;
-    if (hidden) this.els.findings.append(make("li", { className: "muted" }, `${hidden} notes (overlaps, ignored inputs) hidden`));
+    if (hidden) this.els.findings.append(make("li", { className: "muted" }, t("checks.hidden", { n: hidden })));
   }
 
   _property(list, p) {
     const holds = p.status === "holds";
-    const word = p.status === "violated" ? "VIOLATED" : "unknown";
+    const word = p.status === "violated" ? t("checks.violated") : t("checks.unknown");
     const li = this._item(list, holds ? "holds" : p.severity || "info", `${holds ? "" : word + ": "}${p.name}: ${p.text}`,
       holds ? "" : p.note, null);
     li.title = p.claim;
@@ -71,15 +72,15 @@ export class Checks {
   _verdict(li, p) {
     const mark = { holds: "✔", violated: "✘" }[p.status] || "?";
     const chip = button(`${mark} ${p.name}`, () => { li.scrollIntoView({ block: "nearest" }); li.focus(); },
-      { className: "verdict v-" + p.status, title: `${p.name} ${p.status}: ${p.text}` });
+      { className: "verdict v-" + p.status, title: `${p.name} ${t("status." + p.status)}: ${p.text}` });
     chip.dataset.property = p.name;
     li.tabIndex = -1;
     this.els.verdicts.append(make("li", {}, chip));
   }
 
   _replayBar(p) {
-    const bar = make("div", { className: "cex" }, `${p.example ? "example" : "counterexample"}: ${p.ticks} ticks `);
-    for (const [where, label] of [["table", "▶ on the table"], ["arena", "▶ in the arena"]]) {
+    const bar = make("div", { className: "cex" }, t(p.example ? "cex.example" : "cex.counterexample", { n: p.ticks }) + " ");
+    for (const [where, label] of [["table", t("cex.on_table")], ["arena", t("cex.in_arena")]]) {
       const b = button(label, (e) => { e.stopPropagation(); this.actions.counterexample(p.name, where); });
       b.dataset.where = where;
       bar.append(b);

@@ -2,6 +2,7 @@
 // Drawn so that its smallest text is at least 11 px (more with A+), in a view that pans (drag, or scroll) and
 // zooms (the − and + buttons, or Ctrl + wheel, as a pinch sends it), following the current state. Enlarged (a
 // click, or ⤢) over the part of the page `bigPlace()` gives, never over the arena; Esc or ✕ puts it back.
+import { t } from "../lib/words.js";
 
 const MIN_TEXT_PX = 11;
 const ZOOMS = [0.35, 0.5, 0.7, 0.85, 1, 1.25, 1.6, 2, 2.5];  // × the readable size
@@ -27,8 +28,8 @@ export class Diagram {
     this.view.className = "diagram-view";
     this.tools = document.createElement("div");
     this.tools.className = "diagram-tools";
-    this.bigButton = tool("⤢", "enlarge (Esc puts it back)", () => this.setBig(!this.big));
-    this.tools.append(tool("−", "smaller", () => this.zoomBy(-1)), tool("+", "larger", () => this.zoomBy(1)), this.bigButton);
+    this.bigButton = tool("⤢", t("diagram.enlarge"), () => this.setBig(!this.big));
+    this.tools.append(tool("−", t("diagram.smaller"), () => this.zoomBy(-1)), tool("+", t("diagram.larger"), () => this.zoomBy(1)), this.bigButton);
     holder.replaceChildren(this.view, this.tools);
     this._listen();
     new ResizeObserver(() => this._size()).observe(this.tools);  // the tools grow with A+: so does the text
@@ -39,7 +40,7 @@ export class Diagram {
   setBig(on) {
     this.holder.classList.toggle("big", on);
     this.bigButton.textContent = on ? "✕" : "⤢";
-    this.bigButton.title = on ? "put it back (Esc)" : "enlarge (Esc puts it back)";
+    this.bigButton.title = on ? t("diagram.back") : t("diagram.enlarge");
     const box = on && this.bigPlace ? this.bigPlace() : null;
     for (const [side, value] of Object.entries(box ? { left: box.left, top: box.top, width: box.width, height: box.height }
       : { left: null, top: null, width: null, height: null })) this.holder.style[side] = value === null ? "" : value + "px";
@@ -115,7 +116,7 @@ export class Diagram {
     const box = svg.viewBox.baseVal;
     this.width = box && box.width ? box.width : parseFloat(svg.getAttribute("width")) || 400;
     this.height = box && box.height ? box.height : parseFloat(svg.getAttribute("height")) || 300;
-    const sizes = [...svg.querySelectorAll("text")].map((t) => parseFloat(t.getAttribute("font-size")) || 14);
+    const sizes = [...svg.querySelectorAll("text")].map((text) => parseFloat(text.getAttribute("font-size")) || 14);
     this.minFont = sizes.length ? Math.min(...sizes) : 14;
     svg.removeAttribute("width"); svg.removeAttribute("height");
   }

@@ -2,6 +2,7 @@
 // its time beside it; errors on their cells, findings on their rows, the fired row and current state lit.
 // User text only ever reaches the page through textContent and input values, never as HTML.
 import { make } from "../lib/dom.js";
+import { t } from "../lib/words.js";
 
 const RANK = { error: 3, warning: 2, info: 1 };
 const TOGGLES = ["event", "dir"];
@@ -52,7 +53,7 @@ export class Grid {
   render() {
     const table = make("table", { className: "grid" });
     const head = table.createTHead().insertRow();
-    head.append(make("th", { className: "num", title: "the line in the file, as a spreadsheet numbers it" }, "line"));
+    head.append(make("th", { className: "num", title: t("grid.line_title") }, t("grid.line")));
     this.header.forEach((name, col) => head.append(this._headCell(name, col)));
     const body = table.createTBody();
     this.values.forEach((row, r) => body.append(this._row(row, r)));
@@ -81,7 +82,7 @@ export class Grid {
   _row(values, r) {
     const tr = make("tr");
     tr.dataset.row = r;
-    tr.append(make("td", { className: "num", title: `line ${this.lines[r]} of the file` }, String(this.lines[r])));
+    tr.append(make("td", { className: "num", title: t("grid.line_of_file", { line: this.lines[r] }) }, String(this.lines[r])));
     values.forEach((value, c) => tr.append(this._cell(value, r, c)));
     return tr;
   }
@@ -117,7 +118,7 @@ export class Grid {
     const input = make(wraps ? "textarea" : "input", { value, spellcheck: false, readOnly: this.readOnly });
     if (wraps) input.rows = 1;  // (and the smallest box of its own: the hidden copy beside it sizes it)
     if (wraps) input.cols = 1; else input.size = 1;
-    input.setAttribute("aria-label", `${this.header[c] || ""} on line ${this.lines[r]}`);
+    input.setAttribute("aria-label", t("grid.cell", { column: this.header[c] || "", line: this.lines[r] }));
     if (kind !== "description" && kind !== "unknown") input.inputMode = kind === "state" || kind === "next" ? "text" : "numeric";
     input.addEventListener("input", () => this._typed(r, c, input.value));
     input.addEventListener("focus", () => this._focus(r, c));
@@ -129,7 +130,7 @@ export class Grid {
     const v = value.trim(), on = v === "1";
     button.setAttribute("aria-pressed", on ? "true" : "false");
     button.textContent = kind === "dir" ? (on ? "back" : "") : (on ? "1" : "");
-    if (kind === "dir") button.title = on ? "1 = backward" : "blank = forward";
+    if (kind === "dir") button.title = on ? t("grid.backward") : t("grid.forward");
     if (kind === "event" && v && !on && v !== "0") button.textContent = v;
   }
 
@@ -215,8 +216,8 @@ export class Grid {
     const td = pick && this.table && this.td(pick[0], pick[1]);
     if (!td) { this.note.hidden = true; return; }
     const d = this._errorAt(pick);
-    this.note.replaceChildren(make("b", {}, `line ${d.line}${d.column ? ", column " + d.column : ""}: `), d.message);
-    if (d.hint) this.note.append(make("div", { className: "hint" }, "hint: " + d.hint));
+    this.note.replaceChildren(make("b", {}, d.column ? t("grid.where_column", { line: d.line, column: d.column }) : t("grid.where", { line: d.line })), d.message);
+    if (d.hint) this.note.append(make("div", { className: "hint" }, t("checks.hint", { hint: d.hint })));
     this.note.hidden = false;
     this._placeNote(td);
   }

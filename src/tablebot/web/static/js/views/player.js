@@ -1,20 +1,21 @@
 // The trace player: a trace's columns (tick, event, row, state, timer, outputs, pose...) scrubbed and
 // played through the same views as the live robot: arena, grid, diagram, timeline and the status line.
 import { all, byId } from "../lib/dom.js";
+import { t as word } from "../lib/words.js";
 
 const seconds = (ticks, machine) => (ticks * machine.tick_ms / 1000).toFixed(2) + " s";
 
 /** One tick as a line a person reads; t: {tick, state, timer, event, row, outputs: {name: value}}. */
 export function describeTick(machine, t) {
-  const parts = [`tick ${t.tick}`, seconds(t.tick, machine)];
+  const parts = [word("tick.tick", { tick: t.tick }), seconds(t.tick, machine)];
   const st = machine.states.find((s) => s.id === String(t.state));
-  parts.push(`state ${t.state}` + (st && st.label ? ` (${st.label})` : ""));
-  if (t.timer !== undefined && t.timer !== null) parts.push(`timer ${t.timer} (${seconds(t.timer, machine)})`);
+  parts.push(word("tick.state", { state: t.state }) + (st && st.label ? ` (${st.label})` : ""));
+  if (t.timer !== undefined && t.timer !== null) parts.push(word("tick.timer", { timer: t.timer, seconds: seconds(t.timer, machine) }));
   // a person reads the file's line numbers (the grid's); a trace's 0-based row is an index into the rows
-  parts.push(t.row === null || t.row === undefined || t.row < 0 ? "no row fired" : `line ${machine.row_lines[t.row]} fired`);
+  parts.push(t.row === null || t.row === undefined || t.row < 0 ? word("tick.none") : word("tick.fired", { line: machine.row_lines[t.row] }));
   if (t.event !== undefined && t.event !== null) {
     const names = machine.events.filter((e, i) => t.event & (1 << (machine.events.length - 1 - i)));
-    parts.push("events: " + (names.join(" + ") || "none"));
+    parts.push(word("tick.events", { names: names.join(" + ") || word("tick.no_events") }));
   }
   if (t.outputs) parts.push(Object.entries(t.outputs).map(([k, v]) => `${k} ${v}`).join(" "));
   return parts.join(" · ");

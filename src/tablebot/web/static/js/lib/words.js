@@ -1,0 +1,72 @@
+// The page's own words, in English and German (issue 38): every text the studio and the replay page show
+// is `t(key, args)` of this catalog, so both languages have the same keys (tests/test_studio_i18n.py holds
+// them equal) and no English is left in a German page. The words follow ROBO Pro's German interface and
+// the command line's German catalog (locale/de/LC_MESSAGES/tablebot.po): Zustand, Folgezustand, Zeile,
+// Eingang, Taster, Lampe, Startwert, Akku, Aufzeichnung; a row "schaltet".
+// What the server says (errors, findings, reports) it renders itself, in the language the page tells it.
+import { DE } from "./words_de.js";
+import { EN } from "./words_en.js";
+
+export const LANGUAGES = Object.freeze(["en", "de"]);
+const KEPT = "tablebot-studio-lang";  // the switch's choice, in localStorage (kept across visits)
+/** Not a language: English between markers, so a test finds any text that does not come from the catalog. */
+export const PSEUDO = "qps";
+export const CATALOGS = Object.freeze({ en: EN, de: DE });
+let language = "en";
+
+/** The page's language: the switch's choice (kept), else the studio's --lang (`server`), else the browser's. */
+export function chooseLanguage(server) {
+  let kept = null;
+  try { kept = localStorage.getItem(KEPT); } catch { /* storage off: not kept */ }
+  if (kept === PSEUDO || LANGUAGES.includes(kept)) return kept;
+  if (LANGUAGES.includes(server)) return server;
+  for (const wanted of navigator.languages || [navigator.language || ""]) {
+    const base = String(wanted).toLowerCase().split("-")[0];
+    if (LANGUAGES.includes(base)) return base;
+  }
+  return "en";
+}
+
+/** Speak `lang` from now on (one of LANGUAGES, or PSEUDO); `keep` remembers it (the switch). */
+export function setLanguage(lang, keep = false) {
+  language = lang === PSEUDO || LANGUAGES.includes(lang) ? lang : "en";
+  document.documentElement.lang = language === PSEUDO ? "en" : language;
+  if (keep) try { localStorage.setItem(KEPT, language); } catch { /* storage off: for this page only */ }
+}
+
+/** The language in use. */
+export function currentLanguage() { return language; }
+
+/** The text of `key` in the language in use, its `{name}` fields filled from `args`. */
+export function t(key, args = {}) {
+  const catalog = language === "de" ? DE : EN;
+  if (!Object.hasOwn(catalog, key)) throw new Error(`no word ${key} in the page's catalog`);
+  const text = catalog[key].replace(/\{(\w+)\}/g, (whole, name) => (Object.hasOwn(args, name) ? String(args[name]) : whole));
+  return language === PSEUDO ? `⟦${text}⟧` : text;
+}
+
+// the page's HTML names its words by key: data-t (the text), data-t-title, data-t-aria, data-t-placeholder
+const ATTRIBUTES = [["tTitle", "title"], ["tAria", "aria-label"], ["tPlaceholder", "placeholder"]];
+
+/** Every element under `root` that names a word, given it in the language in use. */
+export function translatePage(root = document) {
+  for (const el of root.querySelectorAll("[data-t]")) el.textContent = t(el.dataset.t);
+  for (const [data, attribute] of ATTRIBUTES) {
+    const selector = "[data-" + data.replace(/[A-Z]/g, (c) => "-" + c.toLowerCase()) + "]";
+    for (const el of root.querySelectorAll(selector)) el.setAttribute(attribute, t(el.dataset[data]));
+  }
+}
+
+/** The switch: a select of the languages (each named in itself); a change is kept and reloads the page, so
+ * every word (and the server's, which it renders for this tab's language) is said again in the new one. */
+export function wireSwitch(select) {
+  select.replaceChildren(...LANGUAGES.map((lang) => {
+    const option = document.createElement("option");
+    option.value = lang;
+    const name = CATALOGS[lang]["language.name"];  // each language named in itself
+    option.textContent = language === PSEUDO ? `⟦${name}⟧` : name;
+    return option;
+  }));
+  select.value = language === PSEUDO ? "en" : language;
+  select.addEventListener("change", () => { setLanguage(select.value, true); location.reload(); });
+}
