@@ -21,6 +21,7 @@ from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, renumbered, to_table
 from tablebot.files import write_text
 from tablebot.formats.table_write import format_table
+from tablebot.i18n import _
 from tablebot.machine import compile_table
 from tablebot.table import Row, Table
 
@@ -174,11 +175,12 @@ def sweep_command(path: Path, label: str, replay: Replay) -> str:
 
 
 def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-             start: tuple[float, ...] | None, path: Path, start_label: str = "the starting table") -> Path:
+             start: tuple[float, ...] | None, path: Path, start_label: str | None = None) -> Path:
     from tablebot.sim.draw import literal_text
 
     with literal_text():
-        return _heat_map(archive, descriptors, objective, history, start, path, start_label)
+        return _heat_map(archive, descriptors, objective, history, start, path,
+                         _("the starting table") if start_label is None else start_label)
 
 
 def _heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
@@ -205,7 +207,7 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
             grid[j, i] = v
         image = ax.imshow(grid, origin="lower", cmap=cmap, aspect="auto",
                           extent=(first.low, first.high, second.low, second.high))
-        fig.colorbar(image, ax=ax, label=f"{objective.name} ({objective.better} is better)")
+        fig.colorbar(image, ax=ax, label=_better(objective))
         ax.set_ylabel(f"{second.name}")
         if start is not None:
             ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
@@ -217,30 +219,38 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         lefts = [first.low + c[0] * width for c in cells]
         ax.bar(lefts, values, width=width * 0.9, align="edge", color="#20bf6b")
         ax.set_xlim(first.low, first.high)  # the whole range, empty cells too
-        ax.set_ylabel(f"{objective.name} ({objective.better} is better)")
+        ax.set_ylabel(_better(objective))
         if start is not None:
             ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--",
                        label=start_label)
             ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)
     ax.set_xlabel(first.name)
-    ax.set_title(f"archive: {len(values)} elites in {int(np.prod([d.cells for d in descriptors]))} cells",
+    ax.set_title(_("archive: {elites} elites in {cells} cells").format(
+        elites=len(values), cells=int(np.prod([d.cells for d in descriptors]))),
                  fontsize=11)
     side = fig.add_subplot(1, 2, 2)
     xs = [h["evaluated"] for h in history]
     side.plot(xs, [h["best"] for h in history], color="#20bf6b", linewidth=2, drawstyle="steps-post",
-              label=f"best {objective.name}")
-    side.set_xlabel("tables evaluated on the fleet")
-    side.set_ylabel(f"best {objective.name}")
+              label=_("best {measure}").format(measure=objective.name))
+    side.set_xlabel(_("tables evaluated on the fleet"))
+    side.set_ylabel(_("best {measure}").format(measure=objective.name))
     twin = side.twinx()
     twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
-              label="cells filled")
-    twin.set_ylabel("cells filled (%)")
+              label=_("cells filled"))
+    twin.set_ylabel(_("cells filled (%)"))
     (lines, labels), (more_lines, more_labels) = side.get_legend_handles_labels(), twin.get_legend_handles_labels()
     side.legend(lines + more_lines, labels + more_labels, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                 fontsize=8, frameon=False)  # under the axes: inside, each legend covered one of the two lines
-    side.set_title("search", fontsize=11)
+    side.set_title(_("search"), fontsize=11)
     fig.tight_layout()
     return save(fig, path)
+
+
+def _better(objective: Measure) -> str:
+    """The objective's axis: its name and which way is better, in the reader's language."""
+    if objective.better == "low":
+        return _("{measure} (low is better)").format(measure=objective.name)
+    return _("{measure} (high is better)").format(measure=objective.name)
 
 
 # --- report.md --------------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from tablebot.escape import picture
 from tablebot.fleet.plan import Plan, groups
+from tablebot.i18n import _
 from tablebot.sim.draw import REACHED, draw_world, literal_text
 from tablebot.sim.plots import save, trajectory
 from tablebot.sim.summary import summarise
@@ -39,25 +40,27 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
     for k, (key, values) in enumerate(panels):
         left, right = fig.add_subplot(len(panels), 2, 2 * k + 1), fig.add_subplot(len(panels), 2, 2 * k + 2)
-        labels = [picture(label) for label, _ in values]
-        rates = [float(np.mean([int(r["reached"]) for r in chosen])) if chosen else 0.0 for _, chosen in values]
+        labels = [picture(label) for label, _chosen in values]
+        rates = [float(np.mean([int(r["reached"]) for r in chosen])) if chosen else 0.0 for _label, chosen in values]
         bars = left.bar(labels, [100 * r for r in rates], color=REACHED)
-        left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_, c) in zip(rates, values, strict=True)],
+        left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_label, c) in zip(rates, values, strict=True)],
                        fontsize=8)
         left.set_ylim(0, 118)
-        left.set_ylabel("reached the lamp (%)")
+        left.set_ylabel(_("reached the lamp (%)"))
         left.set_xlabel(key)
-        times = [[t for r in chosen if (t := number(r["first_light_s"])) is not None] for _, chosen in values]
-        never = [sum(number(r["first_light_s"]) is None for r in chosen) for _, chosen in values]
+        times = [[t for r in chosen if (t := number(r["first_light_s"])) is not None] for _label, chosen in values]
+        never = [sum(number(r["first_light_s"]) is None for r in chosen) for _label, chosen in values]
         right.boxplot([t or [math.nan] for t in times], tick_labels=labels, showfliers=True)
         for i, ts in enumerate(times):
             jitter = np.random.default_rng(i).uniform(-0.15, 0.15, len(ts))  # fixed: the picture is reproducible
             right.scatter(np.full(len(ts), i + 1.0) + jitter, ts, s=6, alpha=0.35, color="#f0a500", zorder=3)
-            right.text(i + 1, seconds * 1.02, f"never: {never[i]}", ha="center", fontsize=8, color="#636e72")
+            right.text(i + 1, seconds * 1.02, _("never: {n}").format(n=never[i]), ha="center", fontsize=8,
+                       color="#636e72")
         right.set_ylim(0, seconds * 1.1)
-        right.set_ylabel("time to first light (s)")
+        right.set_ylabel(_("time to first light (s)"))
         right.set_xlabel(key)
-    fig.suptitle(f"{picture(plan.table.robot.name)}: {len(rows):,} runs of {seconds:g} s", fontsize=13,
+    fig.suptitle(_("{robot}: {runs:,} runs of {seconds:g} s").format(robot=picture(plan.table.robot.name),
+                                                                      runs=len(rows), seconds=seconds), fontsize=13,
                  fontweight="bold")
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     return save(fig, path)
@@ -79,7 +82,7 @@ def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     if len(world_rows) > 600:
         cells = ax.hexbin(xs, ys, C=reached * 100.0, reduce_C_function=np.mean, gridsize=24, cmap="RdYlGn",
                           vmin=0, vmax=100, alpha=0.85, zorder=3, mincnt=1)
-        fig.colorbar(cells, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label="reached the lamp (% of starts here)")
+        fig.colorbar(cells, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label=_("reached the lamp (% of starts here)"))
     else:
         times = np.array([number(r["reached_s"]) or math.nan for r in world_rows])
         headings = np.radians([float(r["start_heading"]) for r in world_rows])
@@ -87,15 +90,15 @@ def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
         ax.quiver(xs, ys, np.cos(headings), np.sin(headings), color="#2d3436", alpha=0.5, scale=40, width=0.003,
                   zorder=3)
         if (~ok).any():  # the legend says only what the picture shows
-            ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label="never reached the lamp")
+            ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label=_("never reached the lamp"))
         dots = ax.scatter(xs[ok], ys[ok], c=times[ok], s=30, cmap="viridis_r", edgecolors="white", linewidths=0.5,
                           zorder=5)
         if ok.any():
-            fig.colorbar(dots, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label="time to reach the lamp (s)")
+            fig.colorbar(dots, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label=_("time to reach the lamp (s)"))
         if (~ok).any():
             ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"Start positions in {picture(world.name)}: {int(reached.sum())} of {len(world_rows)} reached "
-                 "the lamp", fontsize=12, fontweight="bold")
+    ax.set_title(_("Start positions in {world}: {reached} of {runs} reached the lamp").format(
+        world=picture(world.name), reached=int(reached.sum()), runs=len(world_rows)), fontsize=12, fontweight="bold")
     return save(fig, path)
 
 

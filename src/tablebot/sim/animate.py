@@ -22,6 +22,7 @@ from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import picture
 from tablebot.files import atomic_write
+from tablebot.i18n import _
 from tablebot.sim import columns as L
 from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings
 from tablebot.sim.plots import subtitle_of, title_of
@@ -73,9 +74,10 @@ class Player:
         state = scene.machine.states[r.states[max(0, t - 1)]] if r.ticks else scene.table.robot.initial_state
         names = scene.machine.output_names
         n_motors = scene.machine.n_motors
-        outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {'on ' + str(int(v)) if v else 'off'}"
+        on, off = _("on {level}"), _("off")  # a lamp's words
+        outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {on.format(level=int(v)) if v else off}"
                             for k, (n, v) in enumerate(zip(names, last, strict=True)))
-        speed = f"   ({self.speed:g}× speed)" if self.speed != 1 else ""
+        speed = "   " + _("({speed:g}× speed)").format(speed=self.speed) if self.speed != 1 else ""
         now = picture(f"{scene.table.state_title(state)}   {outputs}")
         self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{now}")
         return [self.trail, self.hud, *self.robot.artists()]

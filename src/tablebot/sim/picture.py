@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 
 from tablebot.escape import picture
 from tablebot.files import atomic_write
+from tablebot.i18n import _, ngettext
 from tablebot.sensors import SENSOR_KINDS, SensorKind
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
@@ -41,18 +42,23 @@ def title_of(result: Run) -> str:
 def title(scene: SceneView | Scene, ticks: int, seed: int) -> str:
     """The pictures' title: the robot, the world, the run's length and seed (all known before the run)."""
     robot, world = picture(scene.table.robot.name), picture(scene.world.name)
-    return f"{robot} in {world} — {ticks * scene.tick_s:g} s, seed {seed}"
+    return _("{robot} in {world} — {seconds:g} s, seed {seed}").format(robot=robot, world=world,
+                                                                        seconds=ticks * scene.tick_s, seed=seed)
 
 
 def subtitle_of(summary: Summary) -> str:
+    """The summary line under the title, in the reader's language (numbers with
+    a decimal point, the same as the axes' ticks and every file tablebot writes)."""
     def when(v: float | None) -> str:
-        return "never" if v is None else f"{v:.1f} s"
+        return _("never") if v is None else f"{v:.1f} s"
     parts = []
     if summary.lamps:
-        parts += [f"light first seen: {when(summary.first_light_s)}", f"lamp reached: {when(summary.reached_s)}"]
+        parts += [_("light first seen: {when}").format(when=when(summary.first_light_s)),
+                  _("lamp reached: {when}").format(when=when(summary.reached_s))]
     if summary.laps is not None:
-        parts.append(f"{summary.laps:.2f} laps of the line")
-    parts += [f"{summary.collisions} collision{'s' * (summary.collisions != 1)}", f"{summary.distance_m:.2f} m driven"]
+        parts.append(_("{laps:.2f} laps of the line").format(laps=summary.laps))
+    parts += [ngettext("{n} collision", "{n} collisions", summary.collisions).format(n=summary.collisions),
+              _("{metres:.2f} m driven").format(metres=summary.distance_m)]
     return "   ·   ".join(parts)
 
 
@@ -125,9 +131,9 @@ def deflated(rows: np.ndarray, above: np.ndarray | None, last: bool) -> tuple[by
 def png_of_parts(parts: list[tuple[bytes, int, int]], width: int, height: int, dpi: float) -> bytes:
     """The PNG of an RGBA image whose rows, in order, are in ``parts`` (see :func:`deflated`)."""
     check = 1
-    for _, adler, length in parts:
+    for _data, adler, length in parts:
         check = _adler32_combine(check, adler, length)
-    stream = b"".join((b"\x78\x01", *(data for data, _, _ in parts), struct.pack(">I", check)))
+    stream = b"".join((b"\x78\x01", *(data for data, _adler, _length in parts), struct.pack(">I", check)))
     per_metre = int(dpi / 0.0254 + 0.5)
     return b"".join((b"\x89PNG\r\n\x1a\n",
                      _chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)),

@@ -18,6 +18,7 @@ from matplotlib.patches import Patch
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
+from tablebot.i18n import _
 from tablebot.sim import columns as L
 from tablebot.sim.draw import (
     BEAM,
@@ -268,7 +269,7 @@ def _legend(fig: Figure, result: RunView, summary: Summary, spins: bool) -> None
     handles = [Patch(color=colours[machine.states.index(state)],
                      label=picture(f"{result.scene.table.state_title(state)}  ({secs:.1f} s)"))
                for state, secs in summary.state_seconds.items() if secs > 0]
-    states_legend = fig.legend(handles=handles, title="path colour = state (time in it)", loc="upper left",
+    states_legend = fig.legend(handles=handles, title=_("path colour = state (time in it)"), loc="upper left",
                                bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
     states_legend._legend_box.align = "left"  # type: ignore[attr-defined]  # private: not in matplotlib's stubs
     fig.legend(handles=legend_marks(result, summary, spins), loc="lower left", bbox_to_anchor=(0.70, 0.08),
@@ -282,27 +283,27 @@ def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
     marks: list[Line2D | Patch] = []
     if summary.collision_ticks:
         marks.append(Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
-                            label="collision (where it touched)"))
+                            label=_("collision (where it touched)")))
     if world.lamps and summary.first_light_s is not None:
         marks.append(Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
-                            label="light first seen"))
+                            label=_("light first seen")))
     if world.lamps and summary.reached_s is not None:
         marks.append(Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
-                            label=f"lamp reached (≤ {world.reach:g} m)"))
+                            label=_("lamp reached (≤ {reach:g} m)").format(reach=world.reach)))
     if spins:
         marks.append(Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
-                            label="a state begins with a turn on the spot"))
+                            label=_("a state begins with a turn on the spot")))
     if world.lamps:
         marks += [Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=11,
-                         label="lamp, on its base (an obstacle)"),
-                  Line2D([], [], ls="--", color="#b8860b", label="lamp visible inside (sensor facing it)")]
+                         label=_("lamp, on its base (an obstacle)")),
+                  Line2D([], [], ls="--", color="#b8860b", label=_("lamp visible inside (sensor facing it)"))]
     if world.lines:
-        marks.append(Patch(facecolor=TAPE_FILL, label="tape on the floor"))
+        marks.append(Patch(facecolor=TAPE_FILL, label=_("tape on the floor")))
     if "spot" in drawn:
         marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
-                            label="floor sensor (dark over tape)"))
+                            label=_("floor sensor (dark over tape)")))
     if "beam" in drawn:
-        marks.append(Patch(facecolor=BEAM, alpha=0.45, label="distance beam, out to the echo"))
+        marks.append(Patch(facecolor=BEAM, alpha=0.45, label=_("distance beam, out to the echo")))
     if world.boxes or world.circles:
-        marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label="obstacle"))
+        marks.append(Patch(facecolor="#a4b0be", edgecolor="#57606f", hatch="//", label=_("obstacle")))
     return marks

@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
+from tablebot.i18n import N_, _
 from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
@@ -31,6 +32,9 @@ if TYPE_CHECKING:
     from tablebot.sim.summary import Summary
 
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
+#: The sensor kinds' panel labels (tablebot.sensors, which speaks no language: it is data), marked here for the
+#: catalog; the panel translates its label when it draws it.
+_KIND_LABELS = (N_("distance (cm)\n-- on, ·· off"), N_("light\n(× threshold)"))
 
 
 @literal_text()
@@ -59,14 +63,14 @@ class TimelinePicture:
         FigureCanvasAgg(fig)
         ratios = [2.2, 1.6, 1.6] + [1.3] * len(self.readings)
         self.axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios, "hspace": 0.12})
-        self.axes[0].set_ylabel("state")
+        self.axes[0].set_ylabel(_("state"))
         _output_setup(self.axes[1], scene)
         _event_setup(self.axes[2], scene)
         for ax, panel in zip(self.axes[3:], self.readings, strict=True):
             panel.setup(ax, scene)
         for ax in self.axes:
             ax.grid(axis="x", alpha=0.3)
-        self.axes[-1].set_xlabel("time (s)")
+        self.axes[-1].set_xlabel(_("time (s)"))
         self.axes[-1].set_xlim(0, max((ticks - 1) * scene.tick_s, scene.tick_s))
         fig.suptitle(title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.07, ha="left", y=0.975)
         fig.subplots_adjust(left=0.16, right=0.97, top=0.91, bottom=0.06)
@@ -93,7 +97,8 @@ class TimelinePicture:
             if summary.first_light_s is not None:
                 ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
             if k == 0:
-                key = "   (red lines: collisions" + (", dashed: first light)" if summary.lamps else ")")
+                key = "   " + (_("(red lines: collisions, dashed: first light)") if summary.lamps
+                               else _("(red lines: collisions)"))
                 self.fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
             self.finished.add(k)
         return self
@@ -229,7 +234,7 @@ def _state_panel(ax: Axes, result: RunView) -> None:
 def _output_setup(ax: Axes, scene: SceneView) -> None:
     ax.set_ylim(-8.9, 8.9)
     ax.set_yticks([-8, -4, 0, 4, 8])
-    ax.set_ylabel("motor speed\n(+ forward)")
+    ax.set_ylabel(_("motor speed\n(+ forward)"))
 
 
 def _output_panel(ax: Axes, result: RunView, t: np.ndarray) -> None:
@@ -251,11 +256,11 @@ def _output_panel(ax: Axes, result: RunView, t: np.ndarray) -> None:
 def _event_setup(ax: Axes, scene: SceneView) -> None:
     table, labels = scene.table, scene.table.robot.labels
     ax.set_yticks(range(len(table.events)))
-    ax.set_yticklabels([picture(f"{n} {labels.get(n, 'timer = 0' if n == 'T' else 'counter = 0')}")
+    ax.set_yticklabels([picture(f"{n} {labels.get(n, _('timer = 0') if n == 'T' else _('counter = 0'))}")
                         for n in table.events], fontsize=8)
     ax.set_ylim(-0.7, len(table.events) - 0.3)
     ax.invert_yaxis()
-    ax.set_ylabel("events")
+    ax.set_ylabel(_("events"))
 
 
 def _event_panel(ax: Axes, result: RunView) -> None:
@@ -293,7 +298,7 @@ def _panel_of(kind: SensorKind) -> Panel:
         else:  # the range where the table's thresholds act, not the far wall
             ax.set_ylim(0, max(level * panel.scale for _, sensor in _sensors(scene, kind.name)
                                for level in sensor.switch_points()) * 3)
-        ax.set_ylabel(panel.label)
+        ax.set_ylabel(_(panel.label))  # marked in _KIND_LABELS
 
     def draw(ax: Axes, result: RunView, t: np.ndarray) -> None:
         for k, sensor in _sensors(result.scene, kind.name):
@@ -316,16 +321,18 @@ def _sensors(scene: SceneView, kind: str) -> list[Any]:
 
 def _light_setup(ax: Axes, scene: SceneView) -> None:
     _log_scale(ax)
-    ax.set_ylabel("light\n(× threshold)")
+    ax.set_ylabel(_("light\n(× threshold)"))
 
 
 def _light_panel(ax: Axes, result: RunView, t: np.ndarray) -> None:
     """The BumberBot's wired phototransistors against their threshold."""
     wiring = result.scene.params.wiring
     right, left = result.column(L.LIGHT_R)[:-1], result.column(L.LIGHT_L)[:-1]
-    ax.plot(*envelope(t, right, LIGHT_BINS), lw=1.1, color="#e67e22", label=picture(f"{wiring['light_right']} right"))
-    ax.plot(*envelope(t, left, LIGHT_BINS), lw=1.1, color="#8e44ad", label=picture(f"{wiring['light_left']} left"))
-    ax.axhline(1.0, color=WALL, lw=1, ls="--", label="threshold")
+    right_name = picture(_("{sensor} right").format(sensor=wiring["light_right"]))
+    left_name = picture(_("{sensor} left").format(sensor=wiring["light_left"]))
+    ax.plot(*envelope(t, right, LIGHT_BINS), lw=1.1, color="#e67e22", label=right_name)
+    ax.plot(*envelope(t, left, LIGHT_BINS), lw=1.1, color="#8e44ad", label=left_name)
+    ax.axhline(1.0, color=WALL, lw=1, ls="--", label=_("threshold"))
     ax.set_ylim(0, max(10.0, float(max(right.max(), left.max())) * 1.5))
     ax.legend(loc="upper right", fontsize=8, ncol=3, frameon=False)
 

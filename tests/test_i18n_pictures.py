@@ -1,0 +1,92 @@
+"""The pictures in the reader's language (issue 38): titles, axes, legends and notes of the trajectory and the
+timeline, read back from the drawn figures' text artists, and a whole `tablebot sim --lang de` run's pictures."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from matplotlib.figure import Figure
+from matplotlib.text import Text
+
+from tablebot import i18n
+from tablebot.sim.plots import timeline_figure, trajectory_figure
+from tablebot.sim.runner import SimRun, simulate
+from tablebot.sim.summary import summarise
+from test_sim_helpers import BUMBERBOT, ROOT, scene_of
+
+#: Texts each picture shows, English and German (the catalog's words: Zustand, Startwert, Schwelle ...).
+TRAJECTORY = {"en": ["seed 1", "path colour = state (time in it)", "m driven", "lamp reached: never", "obstacle"],
+              "de": ["Startwert 1", "Farbe der Bahn = Zustand (Zeit darin)", "m gefahren", "Lampe erreicht: nie",
+                     "Hindernis"]}
+TIMELINE = {"en": ["time (s)", "state", "events", "threshold", "motor speed\n(+ forward)", "(red lines: collisions"],
+            "de": ["Zeit (s)", "Zustand", "Ereignisse", "Schwelle", "Motortempo\n(+ vorwärts)", "(rote Linien:"]}
+
+
+@pytest.fixture(scope="module")
+def run() -> SimRun:
+    return simulate(scene_of(ROOT / "examples" / "bumberbot" / "table.csv"), 3.0)
+
+
+def drawn(language: str, run: SimRun, picture: str) -> list[str]:
+    """Every text the picture draws (title, notes, axis labels, ticks, legends), in ``language``."""
+    i18n.use(language)
+    try:
+        draw = trajectory_figure if picture == "trajectory" else timeline_figure
+        fig = draw(run, summarise(run))
+    finally:
+        i18n.use("en")
+    return [t.get_text() for t in texts(fig)]
+
+
+def texts(fig: Figure) -> Iterator[Text]:
+    return (t for t in fig.findobj(Text) if isinstance(t, Text) and t.get_text())
+
+
+@pytest.mark.parametrize("language", ["en", "de"])
+@pytest.mark.parametrize(("picture", "expected"), [("trajectory", TRAJECTORY), ("timeline", TIMELINE)])
+def test_a_picture_speaks_the_readers_language(run: SimRun, language: str, picture: str,
+                                               expected: dict[str, list[str]]) -> None:
+    words = "\n".join(drawn(language, run, picture))
+    other = "de" if language == "en" else "en"
+    assert all(w in words for w in expected[language]), words
+    assert not any(w in words for w in expected[other] if w not in expected[language]), words
+
+
+#: The table's and robot's own words in the BumberBot's pictures (names, state titles, sensor labels), and units.
+THEIRS = ("BumberBot", "arena", "M1", "M2", "T", "I3", "I4", "I5", "I7", "I8", "Seek:", "drive", "straight", "turn",
+          "right", "left", "front-right", "front-left", "rear", "bumper", "phototransistor", "motor)", "(right",
+          "(left", "timer", "s", "s)", "m", "x", "y", "(m)")
+
+
+def unmarked(text: str) -> list[str]:
+    """The words of ``text`` outside the pseudo-locale's markers (a marked text's arguments are inside them)."""
+    while i18n.PSEUDO_OPEN in text:
+        start = text.index(i18n.PSEUDO_OPEN)
+        text = text[:start] + text[text.index(i18n.PSEUDO_CLOSE, start) + 1:]
+    return [w for w in text.split() if any(c.isalpha() for c in w)]
+
+
+@pytest.mark.parametrize("picture", ["trajectory", "timeline"])
+def test_every_word_of_a_picture_is_translated(run: SimRun, picture: str) -> None:
+    """In the pseudo-locale every text tablebot wrote is between markers; what stands outside is the table's
+    and robot's own words, numbers and units."""
+    outside = [t for t in drawn(i18n.PSEUDO, run, picture) if set(unmarked(t)) - set(THEIRS)]
+    assert not outside, outside
+
+
+def test_sim_with_lang_de_draws_german_pictures(tmp_path: Path) -> None:
+    """The whole command: the painter (a fork made as the command starts) draws in the language --lang chose.
+    The same run in English and German differs in the pictures' words only: same trace, other PNG bytes."""
+    pictures = {}
+    for language in ("en", "de"):
+        out = tmp_path / language
+        subprocess.run([sys.executable, "-m", "tablebot", "--lang", language, "sim", str(BUMBERBOT), "--seconds", "2",
+                        "--out", str(out), "-q"], check=True, capture_output=True, timeout=120)
+        pictures[language] = {n: (out / n).read_bytes() for n in ("trace.jsonl", "trajectory.png", "timeline.png")}
+    assert pictures["en"]["trace.jsonl"] == pictures["de"]["trace.jsonl"]
+    assert pictures["en"]["trajectory.png"] != pictures["de"]["trajectory.png"]
+    assert pictures["en"]["timeline.png"] != pictures["de"]["timeline.png"]
