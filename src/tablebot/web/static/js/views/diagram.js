@@ -7,11 +7,12 @@ import { t } from "../lib/words.js";
 const MIN_TEXT_PX = 11;
 const ZOOMS = [0.35, 0.5, 0.7, 0.85, 1, 1.25, 1.6, 2, 2.5];  // × the readable size
 
-function tool(label, title, action) {
+function tool(label, key, action) {  // key: its title's word; made before the page's language is known
   const b = document.createElement("button");
   b.type = "button";
   b.textContent = label;
-  b.title = title;
+  b.dataset.tTitle = key;  // said again by translatePage once it is (lib/words.js)
+  b.title = t(key);
   b.addEventListener("click", (e) => { e.stopPropagation(); action(); });
   return b;
 }
@@ -28,8 +29,8 @@ export class Diagram {
     this.view.className = "diagram-view";
     this.tools = document.createElement("div");
     this.tools.className = "diagram-tools";
-    this.bigButton = tool("⤢", t("diagram.enlarge"), () => this.setBig(!this.big));
-    this.tools.append(tool("−", t("diagram.smaller"), () => this.zoomBy(-1)), tool("+", t("diagram.larger"), () => this.zoomBy(1)), this.bigButton);
+    this.bigButton = tool("⤢", "diagram.enlarge", () => this.setBig(!this.big));
+    this.tools.append(tool("−", "diagram.smaller", () => this.zoomBy(-1)), tool("+", "diagram.larger", () => this.zoomBy(1)), this.bigButton);
     holder.replaceChildren(this.view, this.tools);
     this._listen();
     new ResizeObserver(() => this._size()).observe(this.tools);  // the tools grow with A+: so does the text
@@ -40,7 +41,8 @@ export class Diagram {
   setBig(on) {
     this.holder.classList.toggle("big", on);
     this.bigButton.textContent = on ? "✕" : "⤢";
-    this.bigButton.title = on ? t("diagram.back") : t("diagram.enlarge");
+    this.bigButton.dataset.tTitle = on ? "diagram.back" : "diagram.enlarge";
+    this.bigButton.title = t(this.bigButton.dataset.tTitle);
     const box = on && this.bigPlace ? this.bigPlace() : null;
     for (const [side, value] of Object.entries(box ? { left: box.left, top: box.top, width: box.width, height: box.height }
       : { left: null, top: null, width: null, height: null })) this.holder.style[side] = value === null ? "" : value + "px";

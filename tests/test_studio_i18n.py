@@ -1,0 +1,201 @@
+"""The studio in German and English (issue 38 §1), in a real Chromium against the real server: a browser whose
+language is German sees the studio in German, the switch on the page changes it and is kept, ``studio --lang en``
+wins over a German browser, a table's error comes in the page's language, and in the pseudo-language ``qps``
+(every word of the page's catalog between markers) no word the page shows stands outside the markers, except
+the user's own table. The catalogs themselves (js/lib/words_en.js, words_de.js) are read under Node.
+
+One studio per module; each test a fresh browser context. Screenshots go to ``studio-i18n`` under pytest's
+temporary folder (or ``$TABLEBOT_SCREENSHOTS``): look at them.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from studio_helpers import bumberbot, chromium, screenshots, served, studio_works
+from tablebot.web.app import STATIC, Background
+
+NEXT_COL = 13
+CATALOGS = """
+const [en, de] = await Promise.all([import(process.argv[1] + "/words_en.js"), import(process.argv[1] + "/words_de.js")]);
+console.log(JSON.stringify({ en: en.EN, de: de.DE }));
+"""
+
+
+@pytest.fixture(scope="module")
+def catalogs() -> dict[str, dict[str, str]]:
+    node = shutil.which("node")
+    assert node is not None, "Node runs the page's modules here"
+    done = subprocess.run([node, "--input-type=module", "-e", CATALOGS, (STATIC / "js" / "lib").as_uri()],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    found: dict[str, dict[str, str]] = json.loads(done.stdout)
+    return found
+
+
+def test_both_catalogs_have_the_same_keys_and_the_same_fields(catalogs: dict[str, dict[str, str]]) -> None:
+    en, de = catalogs["en"], catalogs["de"]
+    assert sorted(en) == sorted(de)
+    fields = re.compile(r"\{(\w+)\}")
+    assert {k: sorted(fields.findall(v)) for k, v in en.items()} == {k: sorted(fields.findall(v)) for k, v in de.items()}
+    assert all(value.strip() for value in [*en.values(), *de.values()])
+
+
+def test_every_word_the_page_names_is_in_the_catalog(catalogs: dict[str, dict[str, str]]) -> None:
+    named = set()
+    for path in [*STATIC.glob("*.html"), *STATIC.glob("js/**/*.js")]:
+        text = path.read_text(encoding="utf-8")
+        named |= set(re.findall(r'data-t(?:-\w+)?="([\w.]+)"', text))
+        named |= set(re.findall(r'\bt\("([\w.]+)"[,)]', text)) | set(re.findall(r'\bword\("([\w.]+)"[,)]', text))
+    assert len(named) > 100
+    assert named - set(catalogs["en"]) == set()
+
+
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
+    yield from served(bumberbot(tmp_path_factory.mktemp("i18n")))
+
+
+@pytest.fixture(scope="module")
+def studio_en(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
+    yield from served(bumberbot(tmp_path_factory.mktemp("i18n-en")), lang="en")
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    yield from chromium()
+
+
+@pytest.fixture(scope="module")
+def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return screenshots(tmp_path_factory, "studio-i18n")
+
+
+def open_page(browser: Any, url: str, locale: str, kept: str | None = None, width: int = 1280,
+              height: int = 720, touch: bool = False) -> Any:
+    """A page of the studio in a new browser context whose language is ``locale`` (``kept``: the switch's
+    choice already in its storage); console errors and page errors are collected."""
+    context = browser.new_context(locale=locale, viewport={"width": width, "height": height}, has_touch=touch)
+    if kept is not None:
+        context.add_init_script(f"localStorage.setItem('tablebot-studio-lang', {json.dumps(kept)})")
+    page = context.new_page()
+    page.errors = []
+    page.on("console", lambda m: page.errors.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.goto(url)
+    page.wait_for_selector("#play:not([disabled])", timeout=120_000)
+    studio_works(page)
+    page.wait_for_function("() => document.querySelectorAll('#verdicts button').length === 6")
+    page.wait_for_timeout(150)
+    return page
+
+
+def test_a_german_browser_sees_the_studio_in_german(browser: Any, studio: Background, shots: Path) -> None:
+    page = open_page(browser, studio.url, "de-DE")
+    page.screenshot(path=str(shots / "german.png"))
+    assert page.evaluate("document.documentElement.lang") == "de"
+    assert page.locator("#save").inner_text() == "Speichern"
+    assert page.locator("#mode-trace").inner_text() == "Aufzeichnung"
+    assert page.locator("#play").inner_text() == "▶ Start"
+    assert page.locator("#reset").get_attribute("title").startswith("von vorn beginnen")
+    assert "Zustände" in page.locator("#counts").inner_text()
+    assert page.locator("#language").input_value() == "de"
+    assert page.errors == []
+    page.context.close()
+
+
+def test_the_switch_changes_the_language_and_is_kept(browser: Any, studio: Background) -> None:
+    page = open_page(browser, studio.url, "en-US")
+    assert page.locator("#save").inner_text() == "Save"
+    page.select_option("#language", "de")
+    page.wait_for_selector("#save:text-is('Speichern')")
+    again = page.context.new_page()  # another visit, same browser: still German
+    again.goto(studio.url)
+    again.wait_for_selector("#save:text-is('Speichern')")
+    again.select_option("#language", "en")
+    again.wait_for_selector("#save:text-is('Save')")
+    page.context.close()
+
+
+def test_studio_lang_en_wins_over_a_german_browser(browser: Any, studio_en: Background) -> None:
+    page = open_page(browser, studio_en.url, "de-DE")
+    assert page.locator("#save").inner_text() == "Save"
+    assert page.locator("#language").input_value() == "en"
+    page.context.close()
+
+
+def test_a_table_error_comes_in_the_pages_language(browser: Any, studio: Background, shots: Path) -> None:
+    page = open_page(browser, studio.url, "de-DE")
+    page.locator(f'td[data-row="0"][data-col="{NEXT_COL}"] input').fill("nirgendwo")
+    page.wait_for_selector(f'td[data-row="0"][data-col="{NEXT_COL}"].err')
+    note = page.locator(".cell-note")
+    note.wait_for(state="visible")
+    problems = page.locator("#problems").inner_text()
+    page.screenshot(path=str(shots / "german-error.png"))
+    assert "nirgendwo" in problems and "Fehler" in problems, problems
+    assert "Zeile" in note.inner_text() and "Folgezustand" in problems, (note.inner_text(), problems)
+    assert "does not" not in problems and "hint:" not in problems, problems
+    assert "Die Tabelle hat Fehler" in page.locator("#arena-stale").inner_text()
+    page.context.close()
+
+
+# Every text node, title, aria-label, placeholder and alt the page shows that has a letter in it and does not
+# stand between the pseudo-language's markers; the user's own table (the grid's cells and headers, the diagram,
+# the robot file's names) is theirs, and a property's name and text come from their robot file.
+OUTSIDE_MARKERS = r"""() => {
+  const own = (el) => el.closest('table.grid tbody, table.grid thead th:not(.num), #diagram svg, #inputs, #why, '
+    + '#table-pick, #trace-pick, .brand, #verdicts, #properties');
+  const bare = (text) => {  // markers nest (a message made of messages): take the innermost out until none is left
+    for (let left = text.replace(/⟦[^⟦⟧]*⟧/g, ''); ; left = left.replace(/⟦[^⟦⟧]*⟧/g, '')) {
+      if (!/⟦[^⟦⟧]*⟧/.test(left)) return left;
+    }
+  };
+  const out = [];
+  const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+    const el = node.parentElement;
+    if (!el || own(el) || el.closest('[hidden], script') || !el.getClientRects().length) continue;
+    if (/\p{L}{2}/u.test(bare(node.textContent))) out.push(node.textContent.trim());
+  }
+  for (const el of document.querySelectorAll('[title], [aria-label], [placeholder], [alt]')) {
+    if (own(el)) continue;
+    for (const name of ['title', 'aria-label', 'placeholder', 'alt']) {
+      const text = el.getAttribute(name);
+      if (text && /\p{L}{2}/u.test(bare(text))) out.push(name + ': ' + text);
+    }
+  }
+  return out;
+}"""
+
+
+def test_no_word_of_the_page_is_outside_the_catalog(browser: Any, studio: Background, shots: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    from tablebot.cli.studio import link_maker
+    from tablebot.web import sharing
+
+    monkeypatch.setattr(sharing, "maker", link_maker)  # as tablebot studio hands it in
+    page = open_page(browser, studio.url, "en-US", kept="qps")
+    assert page.locator("#save").inner_text() == "⟦Save⟧"
+    page.check("#show-info")  # the notes too
+    page.click("#mode-trace")
+    seen = page.evaluate(OUTSIDE_MARKERS)
+    page.click("#mode-live")
+    page.click("#share")  # the share box (a dialog over the page)
+    page.wait_for_selector("#ask[open] img, #ask[open] p.muted")
+    seen += page.evaluate(OUTSIDE_MARKERS)
+    page.keyboard.press("Escape")
+    page.click("#open-link")
+    page.wait_for_selector("#ask[open] textarea")
+    seen += page.evaluate(OUTSIDE_MARKERS)
+    page.keyboard.press("Escape")
+    page.screenshot(path=str(shots / "pseudo.png"))
+    assert seen == [], seen
+    page.context.close()
