@@ -22,10 +22,11 @@ import pytest
 
 from studio_helpers import bumberbot, chromium, screenshots, served, studio_works
 from tablebot.web.app import STATIC, Background
+from test_studio_classroom import CLIPPED, SIZES, SMALL_TARGETS, VIEW, inside
 
 NEXT_COL = 13
 CATALOGS = """
-const [en, de] = await Promise.all([import(process.argv[1] + "/words_en.js"), import(process.argv[1] + "/words_de.js")]);
+const [en, de] = await Promise.all(["en", "de"].map((lang) => import(`${process.argv[1]}/words_${lang}.js`)));
 console.log(JSON.stringify({ en: en.EN, de: de.DE }));
 """
 
@@ -45,7 +46,10 @@ def test_both_catalogs_have_the_same_keys_and_the_same_fields(catalogs: dict[str
     en, de = catalogs["en"], catalogs["de"]
     assert sorted(en) == sorted(de)
     fields = re.compile(r"\{(\w+)\}")
-    assert {k: sorted(fields.findall(v)) for k, v in en.items()} == {k: sorted(fields.findall(v)) for k, v in de.items()}
+    def named(catalog: dict[str, str]) -> dict[str, list[str]]:
+        return {key: sorted(fields.findall(text)) for key, text in catalog.items()}
+
+    assert named(en) == named(de)
     assert all(value.strip() for value in [*en.values(), *de.values()])
 
 
@@ -199,3 +203,39 @@ def test_no_word_of_the_page_is_outside_the_catalog(browser: Any, studio: Backgr
     page.screenshot(path=str(shots / "pseudo.png"))
     assert seen == [], seen
     page.context.close()
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_in_german_every_column_the_verdicts_and_the_arena_are_on_the_screen(browser: Any, studio: Background,
+                                                                             shots: Path, size: str) -> None:
+    """The classroom's sizes (test_studio_classroom.py) with German's longer words: nothing clipped or pushed off."""
+    width, height, touch, bigger = SIZES[size]
+    page = open_page(browser, studio.url, "de-DE", width=width, height=height, touch=touch)
+    for _ in range(bigger):
+        page.click("#bigger")
+    page.wait_for_timeout(200)
+    page.screenshot(path=str(shots / f"german-{size}.png"))
+    seen = page.evaluate(VIEW)
+    screen = [0, 0, seen["width"], seen["height"]]
+    assert seen["pageWide"] <= seen["width"] and seen["gridWide"] <= seen["gridShown"], seen
+    shown = [seen["grid"][0], seen["grid"][1], seen["grid"][0] + seen["gridShown"], seen["grid"][3]]
+    assert seen["heads"][0][0] == "Zeile" and len(seen["heads"]) == 15
+    for name, box in [*seen["heads"]]:
+        assert inside(box, screen) and inside(box, shown), (name, box, seen["layout"], seen["compact"])
+    for name, box in seen["verdicts"]:
+        assert inside(box, screen), (name, box)
+    arena = seen["arena"]
+    assert inside(arena, screen) and arena[2] - arena[0] >= 250 and arena[3] - arena[1] >= 150, arena
+    if touch:
+        assert page.evaluate(SMALL_TARGETS) == []
+    assert page.evaluate(CLIPPED) == []
+    assert page.evaluate(CUT_BUTTONS) == []
+    assert page.errors == []
+    page.context.close()
+
+
+# the toolbar's and the controls' buttons, whole: no label cut or spilling out of its button
+CUT_BUTTONS = """() => [...document.querySelectorAll('header button, .controls button, .controls label, .row-tools *')]
+  .filter((el) => el.offsetParent !== null)
+  .filter((el) => el.scrollWidth > el.clientWidth + 1 || el.scrollHeight > el.clientHeight + 1)
+  .map((el) => el.textContent)"""
