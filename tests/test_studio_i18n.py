@@ -235,7 +235,8 @@ def test_in_german_every_column_the_verdicts_and_the_arena_are_on_the_screen(bro
 
 
 # the toolbar's and the controls' buttons, whole: no label cut or spilling out of its button
-CUT_BUTTONS = """() => [...document.querySelectorAll('header button, .controls button, .controls label, .row-tools *')]
+CUT_BUTTONS = """() => [...document.querySelectorAll(
+    'header button, .controls button, .controls label, .row-tools *, table.grid button')]
   .filter((el) => el.offsetParent !== null)
   .filter((el) => el.scrollWidth > el.clientWidth + 1 || el.scrollHeight > el.clientHeight + 1)
   .map((el) => el.textContent)"""

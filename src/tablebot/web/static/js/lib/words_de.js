@@ -162,6 +162,7 @@ export const DE = Object.freeze({
   "grid.line_title": "die Zeile in der Datei, wie eine Tabellenkalkulation sie zählt",
   "grid.line_of_file": "Zeile {line} der Datei",
   "grid.cell": "{column} in Zeile {line}",
+  "grid.back": "zurück",
   "grid.backward": "1 = rückwärts",
   "grid.forward": "leer = vorwärts",
   "grid.where_column": "Zeile {line}, Spalte {column}: ",

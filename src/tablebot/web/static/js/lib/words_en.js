@@ -161,6 +161,7 @@ export const EN = Object.freeze({
   "grid.line_title": "the line in the file, as a spreadsheet numbers it",
   "grid.line_of_file": "line {line} of the file",
   "grid.cell": "{column} on line {line}",
+  "grid.back": "back",
   "grid.backward": "1 = backward",
   "grid.forward": "blank = forward",
   "grid.where_column": "line {line}, column {column}: ",

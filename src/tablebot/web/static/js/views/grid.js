@@ -129,7 +129,7 @@ export class Grid {
   _flag(button, value, kind) {
     const v = value.trim(), on = v === "1";
     button.setAttribute("aria-pressed", on ? "true" : "false");
-    button.textContent = kind === "dir" ? (on ? "back" : "") : (on ? "1" : "");
+    button.textContent = kind === "dir" ? (on ? t("grid.back") : "") : (on ? "1" : "");
     if (kind === "dir") button.title = on ? t("grid.backward") : t("grid.forward");
     if (kind === "event" && v && !on && v !== "0") button.textContent = v;
   }
