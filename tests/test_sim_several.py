@@ -8,6 +8,7 @@ import io
 import json
 import subprocess
 import sys
+from collections.abc import Sized
 from pathlib import Path
 
 import tablebot
@@ -55,3 +56,42 @@ def test_a_saved_run_writes_the_other_tables_keys(tmp_path: Path) -> None:
     sim.run.write_trace(again)
     assert (tmp_path / "trace.jsonl").read_text() == again.getvalue()
     assert all(key in json.loads(again.getvalue().splitlines()[-1]) for key in OTHERS)
+
+
+def test_the_compiled_loop_is_the_tick_by_tick_run(tmp_path: Path) -> None:
+    """sim runs the tables in compiled blocks (tablebot.sim.several); the same robot stepped one tick at a time
+    through the run loop's exchange (RobotEngine, as a live controller runs) writes the same trace bytes."""
+    from tablebot.engine.as_one import RobotEngine
+    from tablebot.loop import TickBlock, exchange
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.simrobot import SimRobot
+    from tablebot.sinks.trace_file import block_lines
+
+    scene = tablebot.open(EXAMPLE).scene(every_table=True)
+    assert scene.tables is not None
+    compiled, sizes = io.StringIO(), Sizes()
+    run = simulate(scene, 4.0, seed=7, sinks=[sizes])
+    assert max(sizes.seen) > 1  # whole blocks of ticks: the compiled loop ran them
+    run.write_trace(compiled)
+    robot, engine = SimRobot(scene, 7), RobotEngine(scene.tables)
+    lines: list[str] = []
+    for _ in range(run.ticks):
+        reading = exchange(engine, robot)
+        lines += block_lines(TickBlock.of_tick(engine, reading), scene.machine)
+    assert "".join(lines) == compiled.getvalue()
+
+
+class Sizes:
+    """A sink that notes how many ticks each block it is given holds."""
+
+    def __init__(self) -> None:
+        self.seen: list[int] = []
+
+    def start(self, info: object) -> None:
+        pass
+
+    def block(self, block: Sized) -> None:
+        self.seen.append(len(block))
+
+    def end(self, end: object) -> None:
+        pass

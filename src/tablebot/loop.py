@@ -62,7 +62,7 @@ class RobotIO(Protocol):
 class BlockIO(Protocol):
     """A robot that can advance itself and the engine many ticks at once (in compiled code)."""
 
-    def advance(self, engine: Engine, ticks: int) -> TickBlock: ...
+    def advance(self, engine: Engine | RobotEngine, ticks: int) -> TickBlock: ...
 
 
 @dataclass
@@ -394,7 +394,7 @@ def run(engine: Engine | RobotEngine, robot: RobotIO, *, clock: Clock | None = N
                 sink.start(info)
                 started.append(sink)
             clock.start()
-            if clock.free_running and isinstance(robot, BlockIO) and isinstance(engine, Engine):
+            if clock.free_running and isinstance(robot, BlockIO):
                 _run_blocks(engine, robot, started, ticks, block_ticks, stop)
             else:
                 _run_ticks(engine, robot, clock, started, ticks, watchdog, late, pace, stop)
@@ -461,8 +461,8 @@ def _run_ticks(engine: Engine | RobotEngine, robot: RobotIO, clock: Clock, sinks
             sink.block(block)
 
 
-def _run_blocks(engine: Engine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None, block_ticks: int,
-                stop: StopRequest) -> None:
+def _run_blocks(engine: Engine | RobotEngine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None,
+                block_ticks: int, stop: StopRequest) -> None:
     """Many ticks per call: the compiled simulator."""
     while ticks is None or engine.tick < ticks:
         stop.check()

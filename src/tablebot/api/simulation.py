@@ -156,8 +156,9 @@ def _run(scene: Scene, seconds: float, seed: int, progress: Progress, sinks: lis
     before its first tick: ``progress.compiling`` is told first)."""
     from tablebot.sim.kernel import run_robot
     from tablebot.sim.runner import simulate, ticks_for
+    from tablebot.sim.several import run_several
 
-    progress.compiling("the simulator", run_robot)
+    progress.compiling("the simulator", run_robot if scene.tables is None else run_several)
     progress.start("ticks", ticks_for(scene, seconds))
     done = 0
 

@@ -11,10 +11,12 @@ from typing import Any
 import numpy as np
 
 from tablebot.engine import Engine
+from tablebot.engine.as_one import RobotEngine
 from tablebot.formats.trace_lines import exact_round_array
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
 from tablebot.sim import kernel as K
+from tablebot.sim import several as S
 from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.params import terminal_volts
@@ -87,9 +89,11 @@ class SimRobot:
 
     # --- many ticks at once -----------------------------------------------------------------------
 
-    def advance(self, engine: Engine, ticks: int) -> TickBlock:
+    def advance(self, engine: Engine | RobotEngine, ticks: int) -> TickBlock:
         """Run ``engine`` on this robot for ``ticks`` ticks in compiled code; the engine ends where
         ``ticks`` calls of ``read``/``step``/``write`` would have left it."""
+        if isinstance(engine, RobotEngine):
+            return self._advance_several(engine, ticks)
         machine = engine.machine
         arrays = machine.arrays
         if arrays is None:
@@ -106,6 +110,24 @@ class SimRobot:
                     untallied(hist, ints))
         engine._sync(regs, outputs, counters)
         return self.block(start, ints, hist, n_out, n_c)
+
+    def _advance_several(self, engine: RobotEngine, ticks: int) -> TickBlock:
+        """:meth:`advance` for a robot of several tables (:mod:`tablebot.sim.several`); the block's extra
+        fields hold the other tables' keys after the robot's."""
+        program, state = S.several_program(engine.tables), S.several_state(engine)
+        outputs = np.array(engine.outputs, dtype=np.int64)
+        n_out, n_c, start = len(outputs), state.counters.shape[1], engine.tick
+        ints = np.zeros((ticks, K.I_OUTPUTS + n_out + 2 * n_c), dtype=np.int64)
+        hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
+        kept = np.zeros((ticks, state.regs.shape[0], S.N_K), dtype=np.int64)
+        robot = RobotState(self.s, self.scene.P[0], state.regs[0], outputs, state.counters[0], self.acc,
+                           self.collision_rows)
+        S.run_several(robot, self._world, program, state, self._wiring, ticks, NO_NOISE, bitgen_address(self.rng),
+                      untallied(hist, ints), kept)
+        S.sync(engine, state, outputs)
+        block = self.block(start, ints, hist, n_out, n_c)
+        block.extra = Joined(block.extra or {}, S.table_columns(engine.tables, kept))
+        return block
 
     def block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
         """The ticks from ``start`` that a compiled loop recorded (``ints``: sim.kernel's I_* records of ``n_out``
@@ -281,3 +303,21 @@ class LazyColumns(Mapping[str, Sequence[float]]):
         writer (tablebot.sinks.trace_text) takes."""
         columns = number_columns(self.scene, self.hist)
         return [(key, *columns[key]) for key in self.keys_]
+
+
+class Joined(Mapping[str, Sequence[Any]]):
+    """A block's robot fields (made when asked for) followed by the other tables' columns: what a trace writer
+    reads of a block of a robot of several tables."""
+
+    def __init__(self, first: Mapping[str, Sequence[Any]], then: Mapping[str, Sequence[Any]]) -> None:
+        self.first, self.then = first, then
+
+    def __getitem__(self, key: str) -> Sequence[Any]:
+        return self.then[key] if key in self.then else self.first[key]
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self.first
+        yield from self.then
+
+    def __len__(self) -> int:
+        return len(self.first) + len(self.then)
