@@ -240,3 +240,30 @@ CUT_BUTTONS = """() => [...document.querySelectorAll(
   .filter((el) => el.offsetParent !== null)
   .filter((el) => el.scrollWidth > el.clientWidth + 1 || el.scrollHeight > el.clientHeight + 1)
   .map((el) => el.textContent)"""
+
+
+def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, tmp_path: Path, shots: Path) -> None:
+    from tablebot.cli.common import load
+    from tablebot.sim.runner import simulate
+    from tablebot.sim.scene import scene_for
+    from tablebot.sinks.trace_file import block_lines
+    from tablebot.web.replay import write_html
+
+    table, machine = load(bumberbot(tmp_path))
+    scene = scene_for(table, machine)
+    page_file = write_html(tmp_path / "run.html", block_lines(simulate(scene, 5.0, 1).block(), machine), scene.world,
+                           table, params=scene.params)
+    context = browser.new_context(locale="de-DE", viewport={"width": 1280, "height": 720})
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.goto(page_file.as_uri())
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('Takt 0')")
+    assert page.locator("#tplay").inner_text() == "▶ Start"
+    assert page.locator("table.grid thead th").first.inner_text() == "Zeile"
+    page.screenshot(path=str(shots / "replay-german.png"))
+    page.select_option("#language", "en")
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')")
+    assert page.locator("#tplay").inner_text() == "▶ Play"
+    context.close()
+    assert errors == []
