@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import io
 import json
+import random
 import subprocess
 import sys
 from collections.abc import Sized
 from pathlib import Path
+
+import pytest
 
 import tablebot
 from tablebot.testing.harness import Run
@@ -95,3 +98,23 @@ class Sizes:
 
     def end(self, end: object) -> None:
         pass
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 6])
+def test_random_robots_simulate_as_several_steps_them(seed: int, tmp_path: Path) -> None:
+    """Random robots of 2-3 tables (cross-table columns, a state group, a counter on the right motor loaded by one
+    table and read by others, either matching rule): the simulated decisions are Several's on the inputs and
+    pulses the simulated robot read."""
+    from tablebot.sim.runner import simulate
+    from tablebot.testing.random_robots import RobotShape, random_robot
+
+    folder = random_robot(random.Random(seed), tmp_path, RobotShape(tables=2 + seed % 2))
+    project = tablebot.open(folder / "t0.csv", robot=folder / "robot.toml")
+    assert project.tables is not None
+    run = simulate(project.scene(every_table=True), 3.0, seed=seed)
+    text = io.StringIO()
+    run.write_trace(text)
+    lines = [json.loads(line) for line in text.getvalue().splitlines()]
+    assert several_differences(project.tables, Run(run.inputs(), lines)) is None
+    if seed == 1:  # its right motor runs: the counter counts its pulses (seed 6's is loaded, seed 3's held at 5)
+        assert run.pulses.any()
