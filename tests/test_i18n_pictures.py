@@ -90,3 +90,31 @@ def test_sim_with_lang_de_draws_german_pictures(tmp_path: Path) -> None:
     assert pictures["en"]["trace.jsonl"] == pictures["de"]["trace.jsonl"]
     assert pictures["en"]["trajectory.png"] != pictures["de"]["trajectory.png"]
     assert pictures["en"]["timeline.png"] != pictures["de"]["timeline.png"]
+
+
+def test_the_leaderboard_speaks_the_readers_language(tmp_path: Path) -> None:
+    """grade's leaderboard.html: its headings, the line under the title, a score's spread, the replays' buttons
+    and the viewer in German (the page says lang="de"); scores.csv, a data file, stays as it is."""
+    from typer.testing import CliRunner
+
+    from tablebot.cli import app
+
+    pupil = tmp_path / "anna"
+    pupil.mkdir()
+    (pupil / "table.csv").write_bytes((ROOT / "tests" / "fixtures" / "analysis" / "bumberbot_fixed.csv").read_bytes())
+    i18n.use("de")
+    try:
+        result = CliRunner().invoke(app, ["grade", str(ROOT / "examples" / "challenges" / "find-the-lamp"),
+                                          str(pupil), "--out", str(tmp_path / "out")])
+    finally:
+        i18n.use("en")
+    assert result.exit_code == 0, result.output
+    page = (tmp_path / "out" / "leaderboard.html").read_text(encoding="utf-8")
+    head = page[:page.index("<script")]  # the board, not the packed replays
+    for german in ('<html lang="de">', "Rangliste</title>", "<th>Platz</th>", "<th>Punkte</th>", "<th>Regeln</th>",
+                   "1 Einreichung, gefahren auf", "(niedrig ist besser)", " bis ", "▶ beste: Startwert",
+                   "schließen (Esc)"):
+        assert german in page, german
+    for english in ("leaderboard", "<th>rank", "submission", "is better", " to ", "seed ", "close"):
+        assert english not in head, english
+    assert (tmp_path / "out" / "scores.csv").read_text(encoding="utf-8").startswith("rank,name,score,why\n")

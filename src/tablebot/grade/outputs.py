@@ -14,6 +14,7 @@ from pathlib import Path
 from tablebot.escape import html_text as h
 from tablebot.grade.challenge import Challenge
 from tablebot.grade.run import Entry, best_and_worst, ranked, shown
+from tablebot.i18n import _, current, ngettext
 
 COLUMNS = ("rank", "name", "score", "why")
 
@@ -44,13 +45,15 @@ def replay_pages(entries: list[Entry], challenge: Challenge) -> tuple[Replays, d
 
     links: Replays = {}
     packed: dict[str, str] = {}
-    for k, (_, entry) in enumerate(ranked(entries, challenge.better)):
+    for k, (_rank, entry) in enumerate(ranked(entries, challenge.better)):
         if entry.why or entry.plan is None or entry.values is None:
             continue
         plan = entry.plan
         for which, index in zip(("best", "worst"), best_and_worst(entry, challenge.better), strict=True):
             run = runs(plan.spec, index, index + 1)[0]
-            label = f"{which}: seed {run.seed}, {challenge.score} {shown(float(entry.values[index]))}"
+            label = (_("best: seed {seed}, {measure} {value}") if which == "best" else
+                     _("worst: seed {seed}, {measure} {value}")).format(
+                seed=run.seed, measure=challenge.score, value=shown(float(entry.values[index])))
             data = replay_data(plan.traced(index).trace_lines(0), plan.worlds[run.world], plan.table,
                                plan.scenes[run.world].params, f"{entry.name}: {label}")
             key = f"{k + 1:03d}-{which}"
@@ -106,30 +109,42 @@ def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: Replay
     """The page: a row per submission in leaderboard order, the packed replays, the viewer."""
     rows = "".join(_row(rank, entry, replays.get(entry.name, [])) for rank, entry in ranked(entries, challenge.better))
     pages = "".join(f'<script type="text/plain" id="replay-{key}">{text}</script>' for key, text in packed.items())
-    viewer = ('<div id="viewer" hidden role="dialog" aria-label="replay"><div class="head"><button type="button">'
-              "close (Esc)</button></div><iframe title=\"replay\"></iframe></div>")
+    replay, close = h(_("replay")), h(_("close (Esc)"))
+    viewer = (f'<div id="viewer" hidden role="dialog" aria-label="{replay}"><div class="head"><button type="button">'
+              f'{close}</button></div><iframe title="{replay}"></iframe></div>')
+    page_title = h(_("{title}: leaderboard").format(title=challenge.title))
+    heads = "".join(f"<th>{h(head)}</th>" for head in (_("rank"), _("name"), _("score"), _("rules"), _("replays")))
+    return (f'<!DOCTYPE html>\n<html lang="{current() if current() != "pseudo" else "en"}"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{page_title}</title><style>{STYLE}</style>"
+            f"</head><body><h1>{h(challenge.title)}</h1><p class=\"about\">{h(_about(entries, challenge))}</p>"
+            f"<table><thead><tr>{heads}</tr></thead>"
+            f"<tbody>{rows}</tbody></table>{viewer}{pages}<script>{SCRIPT}</script></body></html>\n")
+
+
+def _about(entries: list[Entry], challenge: Challenge) -> str:
+    """The line under the title: what was run, how it is scored, in the reader's language."""
     from tablebot.fleet.spec import parse_seeds
 
     planned = [e.plan.spec.total for e in entries if e.plan is not None]  # seeds x grid values x worlds
     scenarios = planned[0] if planned else len(parse_seeds(challenge.seeds, None)) * len(challenge.worlds)
-    about = (f"{len(entries)} submissions, each run on the same {scenarios} scenarios of {challenge.seconds:g} s; "
-             f"score: {challenge.score} ({challenge.better} is better), the mean over the scenarios ± its standard "
-             "deviation. A table that breaks a rule scores nothing.")
-    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>{h(challenge.title)}: leaderboard</title><style>{STYLE}</style></head><body>"
-            f"<h1>{h(challenge.title)}</h1><p class=\"about\">{h(about)}</p>"
-            "<table><thead><tr><th>rank</th><th>name</th><th>score</th><th>rules</th><th>replays</th></tr></thead>"
-            f"<tbody>{rows}</tbody></table>{viewer}{pages}<script>{SCRIPT}</script></body></html>\n")
+    ran = ngettext("{n} submission, run on {scenarios} scenarios of {seconds:g} s; ",
+                   "{n} submissions, each run on the same {scenarios} scenarios of {seconds:g} s; ", len(entries))
+    scored = (_("score: {measure} (low is better), the mean over the scenarios ± its standard deviation. A table "
+                "that breaks a rule scores nothing.") if challenge.better == "low" else
+              _("score: {measure} (high is better), the mean over the scenarios ± its standard deviation. A table "
+                "that breaks a rule scores nothing."))
+    return (ran.format(n=len(entries), scenarios=scenarios, seconds=challenge.seconds)
+            + scored.format(measure=challenge.score))
 
 
 def _row(rank: int | None, entry: Entry, replays: list[tuple[str, str]]) -> str:
     if entry.why or entry.values is None or entry.score is None:
-        score = '<span class="out">no score</span>'
+        score = '<span class="out">' + h(_("no score")) + "</span>"
     else:
         low, high = float(entry.values.min()), float(entry.values.max())
         score = (f"{shown(entry.score)}<span class=\"spread\">± {shown(entry.spread)} "
-                 f"({shown(low)} to {shown(high)})</span>")
+                 + h(_("({low} to {high})").format(low=shown(low), high=shown(high))) + "</span>")
     links = "".join(f'<button type="button" class="replay" data-replay="{h(key)}">▶ {h(label)}</button>'
                     for label, key in replays)
     klass = "" if rank is not None else ' class="unranked"'
@@ -146,7 +161,7 @@ def _rules(entry: Entry) -> str:
         if rule.status == "holds":
             parts.append(f'<div class="holds">✓ {h(rule.name)}</div>')
             continue
-        verdict = "breaks" if rule.status == "violated" else "not proved:"
+        verdict = h(_("breaks") if rule.status == "violated" else _("not proved:"))
         story = "\n".join(rule.story)
         parts.append(f'<details open><summary class="broken">✗ {verdict} {h(rule.name)}</summary>'
                      f"{h(rule.text)}" + (f"<pre>{h(story)}</pre>" if story else "") + "</details>")

@@ -256,7 +256,8 @@ def _output_panel(ax: Axes, result: RunView, t: np.ndarray) -> None:
 def _event_setup(ax: Axes, scene: SceneView) -> None:
     table, labels = scene.table, scene.table.robot.labels
     ax.set_yticks(range(len(table.events)))
-    ax.set_yticklabels([picture(f"{n} {labels.get(n, _('timer = 0') if n == 'T' else _('counter = 0'))}")
+    timer, counter = _("timer = 0"), _("counter = 0")  # what an event the robot does not label means
+    ax.set_yticklabels([picture(f"{n} {labels.get(n, timer if n == 'T' else counter)}")
                         for n in table.events], fontsize=8)
     ax.set_ylim(-0.7, len(table.events) - 0.3)
     ax.invert_yaxis()
