@@ -7,6 +7,7 @@ page error fails the test. The server's side of the same is in test_studio_saves
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -54,7 +55,8 @@ class Page:
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.on("dialog", lambda d: d.accept())  # "leave the page with unsaved edits?": yes, on reload
         self.sockets: list[tuple[Any, Any]] = []
-        self.page.route_web_socket("**/ws", lambda ws: self.sockets.append((ws, ws.connect_to_server())))
+        socket = re.compile(r"/ws(\?.*)?$")  # /ws?lang=en: the page says its language as it connects
+        self.page.route_web_socket(socket, lambda ws: self.sockets.append((ws, ws.connect_to_server())))
         self.shots = shots
         self.page.goto(server.url)
         self.loaded()
