@@ -148,6 +148,16 @@ def test_a_table_error_comes_in_the_pages_language(browser: Any, studio: Backgro
     assert "Zeile" in note.inner_text() and "Folgezustand" in problems, (note.inner_text(), problems)
     assert "does not" not in problems and "hint:" not in problems, problems
     assert "Die Tabelle hat Fehler" in page.locator("#arena-stale").inner_text()
+    title = page.locator(f'td[data-row="0"][data-col="{NEXT_COL}"]').get_attribute("title")
+    assert title.startswith("table.csv:") and ": Fehler: " in title and "Tipp: " in title, title
+    # an English tab on the same studio at the same time: the server says its words in English
+    english = open_page(browser, studio.url, "en-GB")
+    english.locator(f'td[data-row="0"][data-col="{NEXT_COL}"] input').fill("nowhere")
+    english.wait_for_selector(f'td[data-row="0"][data-col="{NEXT_COL}"].err')
+    title = english.locator(f'td[data-row="0"][data-col="{NEXT_COL}"]').get_attribute("title")
+    assert ": error: " in title and "hint: " in title, title
+    assert "Fehler" not in english.locator("#problems").inner_text()
+    english.context.close()
     page.context.close()
 
 
