@@ -279,3 +279,25 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
     assert page.locator("#tplay").inner_text() == "▶ Play"
     context.close()
     assert errors == []
+
+
+def test_a_folder_without_a_table_says_so_in_german_and_nothing_outside_the_catalog(browser: Any,
+                                                                                    tmp_path: Path) -> None:
+    empty = tmp_path / "leer"
+    empty.mkdir()
+    for studio in served(empty, None):
+        for locale, kept in (("de-DE", None), ("en-US", "qps")):
+            context = browser.new_context(locale=locale, viewport={"width": 1280, "height": 720})
+            if kept:
+                context.add_init_script(f"localStorage.setItem('tablebot-studio-lang', {json.dumps(kept)})")
+            page = context.new_page()
+            page.goto(studio.url)
+            page.wait_for_selector(".no-table")
+            if kept:  # the commands to type and the templates' names are tablebot's own words, in every language
+                page.evaluate("document.querySelectorAll('.no-table code, .starts button').forEach((e) => e.remove())")
+                assert page.evaluate(OUTSIDE_MARKERS) == []
+            else:
+                text = page.locator(".no-table").inner_text()
+                assert "Hier gibt es keine Tabelle" in text and "In leer gibt es keine Tabelle" in text, text
+                assert page.locator("#save-state").inner_text() == "keine Tabelle"
+            context.close()
