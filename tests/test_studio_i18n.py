@@ -11,16 +11,20 @@ temporary folder (or ``$TABLEBOT_SCREENSHOTS``): look at them.
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import subprocess
+import sys
+import threading
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from studio_helpers import bumberbot, chromium, screenshots, served, studio_works
+from studio_helpers import bumberbot, chromium, screenshots, served, studio_works, wait_for
 from tablebot.web.app import STATIC, Background
 from test_studio_classroom import CLIPPED, SIZES, SMALL_TARGETS, VIEW, inside
 
@@ -301,3 +305,30 @@ def test_a_folder_without_a_table_says_so_in_german_and_nothing_outside_the_cata
                 assert "Hier gibt es keine Tabelle" in text and "In leer gibt es keine Tabelle" in text, text
                 assert page.locator("#save-state").inner_text() == "keine Tabelle"
             context.close()
+
+
+def _page_language_of_studio(folder: Path, *args: str, **env: str) -> Any:
+    """The language ``tablebot studio`` (a real process, with ``args`` and ``env``) hands its page: its
+    /api/config's ``lang``, fetched with the token it printed."""
+    process = subprocess.Popen([sys.executable, "-m", "tablebot", *args, "studio", str(folder), "--no-browser",
+                                "--port", "0"], env={**os.environ, "COLUMNS": "200", **env}, stderr=subprocess.PIPE,
+                               text=True)
+    lines: list[str] = []
+    threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True).start()  # type: ignore[arg-type]
+    try:
+        found = wait_for(lambda: re.search(r"(http://127\.0\.0\.1:\d+)/\?token=([\w-]+)", "".join(lines)),
+                         "the studio's address", 30)
+        request = urllib.request.Request(found[1] + "/api/config", headers={"X-Tablebot-Token": found[2]})
+        with urllib.request.urlopen(request, timeout=10) as reply:
+            return json.load(reply)["lang"]
+    finally:
+        process.terminate()
+        process.wait(10)
+
+
+def test_studio_hands_lang_to_its_page_and_the_system_locale_leaves_it_to_the_browser(tmp_path: Path) -> None:
+    folder = bumberbot(tmp_path)
+    plain = {"TABLEBOT_LANG": "", "LC_ALL": "", "LC_MESSAGES": ""}
+    assert _page_language_of_studio(folder, "--lang", "de", **plain, LANG="C.UTF-8") == "de"
+    assert _page_language_of_studio(folder, **{**plain, "TABLEBOT_LANG": "en"}, LANG="de_DE.UTF-8") == "en"
+    assert _page_language_of_studio(folder, **plain, LANG="de_DE.UTF-8") is None  # the browser's, then
