@@ -16,7 +16,15 @@ from typing import Any
 import numpy as np
 
 from tablebot.fleet.generators import generators
-from tablebot.fleet.kernel import NO_TICK, move_fleet, parallel, run_fleet, run_fleet_serial
+from tablebot.fleet.kernel import (
+    NO_TICK,
+    move_fleet,
+    parallel,
+    run_fleet,
+    run_fleet_serial,
+    run_fleet_several,
+    run_fleet_several_serial,
+)
 from tablebot.fleet.results import FLEET_COLLISIONS, FleetSummary, Trace
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.fleet.starts import Prepared, Starts, with_start
@@ -27,11 +35,13 @@ from tablebot.sim.normals import bitgen_address
 from tablebot.sim.observation import Observation
 from tablebot.sim.runner import SimRun
 from tablebot.sim.scene import Scene
-from tablebot.sim.simrobot import SimRobot, wiring_of, world_arrays
+from tablebot.sim.several import N_K, SeveralState, several_program, table_columns
+from tablebot.sim.simrobot import Joined, SimRobot, wiring_of, world_arrays
 from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants
 from tablebot.sim.summary import light_bits
 from tablebot.sim.world import World
 from tablebot.table import Table
+from tablebot.tables import RobotTables
 from tablebot.tick import STATE, registers
 
 __all__ = ["BLOCK_TICKS", "FLEET_COLLISIONS", "Fleet", "FleetSummary", "NoiseRows", "Prepared", "RobotSpec", "Trace",
@@ -41,17 +51,22 @@ BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced r
 
 
 class Fleet:
-    """N robots of one table in one world (each with its own seed, start, parameters and program variant)."""
+    """N robots of one table in one world (each with its own seed, start, parameters and program variant); with
+    ``tables``, of every table of a robot of several (``table`` and ``machine`` its main one's; no variants)."""
 
     def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
                  robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
-                 variants: Variants | None = None, prepared: Prepared | None = None) -> None:
+                 variants: Variants | None = None, prepared: Prepared | None = None,
+                 tables: RobotTables | None = None) -> None:
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
+        if tables is not None and variants is not None:
+            raise ValueError("a fleet of a robot of several tables runs its tables as they are (no variants)")
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
+        self.tables = tables
         self.specs = list(specs)
         self.variants = variants or Variants.of(machine)
-        self.starts = Starts(table, machine, world, robot_params, prepared)
+        self.starts = Starts(table, machine, world, robot_params, prepared, tables)
         self.scenes = [self.starts.scene(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
         self._tick_noise: NoiseRows | None = None
@@ -83,6 +98,7 @@ class Fleet:
         self.world = world_arrays(first)
         self.wiring = wiring_of(first)
         self.regs[:], self.outputs[:], self.counters[:] = self.initial
+        self._setup_tables(n, n_out, n_c)
         rngs = generators([spec.seed for spec in self.specs])  # default_rng(seed) each, made at once
         by_params: dict[tuple, list[int]] = defaultdict(list)  # untraced robots, by parameter set
         recorded = set(traced)
@@ -98,6 +114,22 @@ class Fleet:
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
+    def _setup_tables(self, n: int, n_out: int, n_c: int) -> None:
+        """A robot of several tables: every table's rows per robot (sim.several), each as a fresh Engine's."""
+        if self.tables is None:
+            return
+        machines = self.tables.machines
+        self.program = several_program(self.tables)
+        self.table_initial = np.stack([registers(0, m.initial_state, m.initial_timer) for m in machines])
+        count = len(machines)
+        self.table_rows = SeveralState(np.repeat(self.table_initial[None], n, axis=0),
+                                       np.zeros((n, count, n_out), dtype=np.int64),
+                                       np.zeros((n, count, n_c), dtype=np.int64), np.zeros((n, count), dtype=np.int64))
+
+    def _reset_tables(self, i: int) -> None:
+        if self.tables is not None:
+            self.table_rows.regs[i], self.table_rows.outputs[i], self.table_rows.counters[i] = self.table_initial, 0, 0
+
     def place(self, i: int, spec: RobotSpec, scene: Scene | None = None, record: bool = False) -> SimRobot | None:
         """Put robot i at its start as SimRobot sets a robot up (its gains and first reading drawn from its
         own Generator, which then gives its noise: :class:`Starter`), with a fresh engine. With ``record``
@@ -105,6 +137,7 @@ class Fleet:
         scene = scene or self.starts.scene(spec)
         self.specs[i] = spec
         self.regs[i], self.outputs[i], self.counters[i] = self.initial
+        self._reset_tables(i)
         self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
         if not record:
             self._start([i], [np.random.default_rng(spec.seed)], scene, [scene.world.start])
@@ -164,16 +197,27 @@ class Fleet:
         ints = np.zeros((n_traced, ticks, self.width), dtype=np.int64)
         v = self.variants
         pool = parallel(len(self.specs), ticks) if threads is None else threads
-        kernel = run_fleet if pool else run_fleet_serial
         fleet = FleetState(self.S, self.P, self.regs, self.outputs, self.counters, self.acc, self.collisions)
         record = FleetRecord(self.counts, self.first_visit, self.first_light, self.traced, hist, ints, self.light_bits,
                              self.t0)
-        kernel(fleet, self.world, self.machine.arrays.program, ProgramVariants(v.timers, v.loads, self.variant),  # type: ignore[union-attr]
-               self.wiring, ticks, noise, self.bitgens, record)
+        kept = None
+        if self.tables is None:
+            kernel = run_fleet if pool else run_fleet_serial
+            kernel(fleet, self.world, self.machine.arrays.program, ProgramVariants(v.timers, v.loads, self.variant),  # type: ignore[union-attr]
+                   self.wiring, ticks, noise, self.bitgens, record)
+        else:
+            kept = np.zeros((n_traced, ticks, len(self.tables.machines), N_K), dtype=np.int64)
+            several = run_fleet_several if pool else run_fleet_several_serial
+            several(fleet, self.world, self.program, self.table_rows, self.wiring, ticks, noise, self.bitgens, record,
+                    kept)
+            self.regs[:], self.counters[:] = self.table_rows.regs[:, 0], self.table_rows.counters[:, 0]
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
             slot = self.traced[i]
-            trace.blocks.append(trace.robot.block(self.t0, ints[slot], hist[slot], n_out, n_c))
+            block = trace.robot.block(self.t0, ints[slot], hist[slot], n_out, n_c)
+            if kept is not None and self.tables is not None:  # the other tables' keys after the robot's fields
+                block.extra = Joined(block.extra or {}, table_columns(self.tables, kept[slot]))
+            trace.blocks.append(block)
             trace.rows.append(hist[slot])
         self.t0 += ticks
 

@@ -14,6 +14,7 @@ from tablebot.sim.scene import Scene, check_start, prepare
 from tablebot.sim.simrobot import Starter
 from tablebot.sim.world import World, inside
 from tablebot.table import Table
+from tablebot.tables import RobotTables
 
 
 @dataclass
@@ -31,16 +32,17 @@ class Starts:
     """The scenes and starters of one fleet's robots: a table in a world with one robot layer."""
 
     def __init__(self, table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None,
-                 prepared: Prepared | None = None) -> None:
+                 prepared: Prepared | None = None, tables: RobotTables | None = None) -> None:
         self.table, self.machine, self.world, self.robot_params = table, machine, world, robot_params
         self.prepared = prepared or Prepared()
+        self.tables = tables  # a robot of several tables: its scenes are wired for all of them
 
     def scene(self, spec: RobotSpec) -> Scene:
         """The robot's scene: the table in the world with its parameters (made once per parameter set)
         and its start; every robot of a fleet must be wired alike."""
         scenes = self.prepared.scenes
         if spec.params not in scenes:
-            scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides())
+            scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides(), self.tables)
             first = next(iter(scenes.values()), scene)
             if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
                                                                            first.pulse_columns):

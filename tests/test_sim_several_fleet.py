@@ -1,0 +1,37 @@
+"""A fleet of robots of several tables (issue 36 §2): robot k runs every table as ``tablebot sim`` runs it, the
+same trace bytes (the lights table's keys too) and the same summary; untraced robots tally as traced ones."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+import tablebot
+from tablebot.fleet.run import Fleet, RobotSpec
+from tablebot.sim.runner import simulate
+from tablebot.sim.scene import robot_layer
+from tablebot.sim.summary import summarise
+
+EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "bumberbot-lights"
+
+
+def test_robot_k_of_a_fleet_of_several_tables_runs_as_sim() -> None:
+    project = tablebot.open(EXAMPLE)
+    assert project.tables is not None
+    scene = project.scene(every_table=True)
+    specs = [RobotSpec(seed=s, params=(("battery", "charge", c),)) for s, c in ((4, 1.0), (5, 0.6), (4, 1.0))]
+    fleet = Fleet(project.table, project.machine, scene.world, specs, robot_layer(project.robot)[0], traced=[0, 1],
+                  tables=project.tables)
+    fleet.run(700, block_ticks=256)
+    for k, spec in enumerate(specs[:2]):
+        alone = simulate(project.scene(every_table=True, overrides=spec.overrides()), 7.0, spec.seed)
+        text = io.StringIO()
+        alone.write_trace(text)
+        assert "".join(fleet.trace_lines(k)) == text.getvalue()
+        assert "lights.state" in fleet.trace_lines(k)[-1]
+        assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
+    summary = fleet.summary()  # robot 2 is robot 0 untraced: the same tally
+    assert np.array_equal(summary.counts[2], summary.counts[0]) and summary.final_state[2] == summary.final_state[0]
