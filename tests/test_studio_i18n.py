@@ -274,12 +274,12 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.goto(page_file.as_uri())
-    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('Takt 0')")
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('Takt 0')", timeout=60_000)
     assert page.locator("#tplay").inner_text() == "▶ Start"
     assert page.locator("table.grid thead th").first.inner_text() == "Zeile"
     page.screenshot(path=str(shots / "replay-german.png"))
     page.select_option("#language", "en")
-    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')")
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')", timeout=60_000)
     assert page.locator("#tplay").inner_text() == "▶ Play"
     context.close()
     assert errors == []
