@@ -118,3 +118,32 @@ def test_the_leaderboard_speaks_the_readers_language(tmp_path: Path) -> None:
     for english in ("leaderboard", "<th>rank", "submission", "is better", " to ", "seed ", "close"):
         assert english not in head, english
     assert (tmp_path / "out" / "scores.csv").read_text(encoding="utf-8").startswith("rank,name,score,why\n")
+
+
+def test_sweeps_pictures_speak_the_readers_language(tmp_path: Path) -> None:
+    """sweep's outcomes and starts: titles, axes, notes and legend in German, and no English left in them."""
+    from typer.testing import CliRunner
+
+    from tablebot.cli import app
+    from tablebot.fleet.plan import make_plan, read_results
+    from tablebot.fleet.plots import outcomes_figure, starts_figure
+
+    out = tmp_path / "s"
+    result = CliRunner().invoke(app, ["sweep", str(BUMBERBOT), "--seeds", "0..3", "--seconds", "1", "--workers", "1",
+                                      "--out", str(out), "--no-plots"])
+    assert result.exit_code == 0, result.output
+    plan, rows = make_plan(BUMBERBOT, None, [], [], "0..3", None, 1.0), read_results(out / "results.csv")
+    words = {}
+    for language in ("en", "de"):
+        i18n.use(language)
+        try:
+            figures = (outcomes_figure(plan, rows), starts_figure(plan, rows))
+        finally:
+            i18n.use("en")
+        words[language] = "\n".join(t.get_text() for fig in figures for t in texts(fig))
+    english = ["4 runs of 1 s", "reached the lamp (%)", "never: 4", "time to first light (s)", "Start positions in",
+               "0 of 4 reached the lamp", "never reached the lamp"]
+    german = ["4 Fahrten zu je 1 s", "erreichten die Lampe (%)", "nie: 4", "Zeit bis zum ersten Licht (s)",
+              "Startpositionen in", "0 von 4 erreichten die Lampe", "erreichte die Lampe nie"]
+    assert all(w in words["en"] for w in english), words["en"]
+    assert all(w in words["de"] for w in german) and not any(w in words["de"] for w in english), words["de"]

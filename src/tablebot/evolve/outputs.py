@@ -31,6 +31,7 @@ from tablebot.evolve.report import (
 from tablebot.evolve.run import Outcome, Settings
 from tablebot.files import remove, write_text
 from tablebot.fileset import current, file_set
+from tablebot.i18n import gettext
 from tablebot.table import Table
 
 BEST = 3  # best tables written (elites of the best cells)
@@ -106,7 +107,8 @@ def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover
     written = [write_table(table, label, key, answer.get())
                for (label, key), table, answer in zip(tables, ready, checks, strict=True)]
     start_at = tuple(outcome.means[start][d.name] for d in settings.descriptors)
-    label = "the starting table" if outcome.start_verdict.ok else "the starting table (breaks a property: not kept)"
+    label = (gettext("the starting table") if outcome.start_verdict.ok  # the archive picture's legend
+             else gettext("the starting table (breaks a property: not kept)"))
     paths = [heat_map(outcome.archive, settings.descriptors, settings.objective, outcome.history, start_at,
                       out / "archive.png", label),
              write_evaluations(outcome, settings, out / "evaluations.csv")]

@@ -34,6 +34,11 @@ def number(value: Any) -> float | None:
 @literal_text()
 def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     """Per grid axis: the share of runs that reached the lamp, and the time to first light (box plot)."""
+    return save(outcomes_figure(plan, rows), path)
+
+
+@literal_text()
+def outcomes_figure(plan: Plan, rows: Sequence[Row]) -> Figure:
     panels = groups(plan, rows)
     fig = Figure(figsize=(11, 3.6 * len(panels) + 0.8), dpi=120)
     FigureCanvasAgg(fig)
@@ -63,13 +68,18 @@ def outcomes(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
                                                                       runs=len(rows), seconds=seconds), fontsize=13,
                  fontweight="bold")
     fig.tight_layout(rect=(0, 0, 1, 0.96))
-    return save(fig, path)
+    return fig
 
 
 @literal_text()
 def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
     """Start positions in the (first) world: each start coloured by the time it took to reach the lamp,
     grey when it never did; with many runs, a hexagon heat map of the success rate instead."""
+    return save(starts_figure(plan, rows), path)
+
+
+@literal_text()
+def starts_figure(plan: Plan, rows: Sequence[Row]) -> Figure:
     world_rows = [r for r in rows if r["world"] == plan.spec.worlds[0]]
     world = plan.worlds[0]
     fig = Figure(figsize=(9, 7), dpi=120)
@@ -99,7 +109,7 @@ def starts(plan: Plan, rows: Sequence[Row], path: Path) -> Path:
             ax.legend(loc="lower right", fontsize=8)
     ax.set_title(_("Start positions in {world}: {reached} of {runs} reached the lamp").format(
         world=picture(world.name), reached=int(reached.sum()), runs=len(world_rows)), fontsize=12, fontweight="bold")
-    return save(fig, path)
+    return fig
 
 
 def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
