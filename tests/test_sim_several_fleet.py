@@ -4,6 +4,9 @@ same trace bytes (the lights table's keys too) and the same summary; untraced ro
 from __future__ import annotations
 
 import io
+import json
+import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -11,6 +14,7 @@ import numpy as np
 
 import tablebot
 from tablebot.fleet.run import Fleet, RobotSpec
+from tablebot.fleet.spec import digest
 from tablebot.sim.runner import simulate
 from tablebot.sim.scene import robot_layer
 from tablebot.sim.summary import summarise
@@ -35,3 +39,21 @@ def test_robot_k_of_a_fleet_of_several_tables_runs_as_sim() -> None:
         assert fleet.summary().summary(k) == replace(summarise(alone), laps=None)
     summary = fleet.summary()  # robot 2 is robot 0 untraced: the same tally
     assert np.array_equal(summary.counts[2], summary.counts[0]) and summary.final_state[2] == summary.final_state[0]
+
+
+def test_a_sweep_of_several_tables_is_n_sims(tmp_path: Path) -> None:
+    """tablebot sweep of the BumberBot with its lights: each run's trace is what tablebot sim writes for its seed
+    (every table, the lights table's keys too); the spec's table digest covers the lights table."""
+    sweep = tmp_path / "sweep"
+    done = subprocess.run([sys.executable, "-m", "tablebot", "sweep", str(EXAMPLE), "--seeds", "2,3", "--seconds",
+                           "3", "--trace", "0,1", "--no-plots", "--out", str(sweep)], capture_output=True, text=True,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    assert "main table" not in done.stderr
+    for run, seed in ((0, 2), (1, 3)):
+        alone = simulate(tablebot.open(EXAMPLE).scene(every_table=True), 3.0, seed)
+        text = io.StringIO()
+        alone.write_trace(text)
+        assert (sweep / f"trace-{run}.jsonl").read_text() == text.getvalue()
+    spec = json.loads((sweep / "spec.json").read_text())
+    assert spec["table_digest"] != digest(EXAMPLE / "table.csv")

@@ -124,7 +124,8 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
         if plots and out is not None:  # before the run (an interrupt never lands in matplotlib's import)
             import tablebot.fleet.plots  # noqa: F401
         runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
-        plan = make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds)
+        plan = make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
+                         every_table=True)
         traced = trace_runs(trace, plan.spec.total)
         if out is None:
             return _in_memory(plan, runner, chosen, shown)

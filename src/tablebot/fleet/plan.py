@@ -36,6 +36,7 @@ from tablebot.fleet.spec import (
     parse_seeds,
     random_start,
     runs,
+    tables_digest,
     value_index,
 )
 from tablebot.fleet.starts import with_start
@@ -49,6 +50,7 @@ from tablebot.sim.runner import ticks_for
 from tablebot.sim.scene import Scene, find_world, prepare, robot_layer
 from tablebot.sim.world import World, load_world
 from tablebot.table import Table
+from tablebot.tables import RobotTables, several
 
 PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
 RESULT_COLUMNS = ("seconds", "first_light_s", "reached", "reached_s", "collisions", "distance_m",
@@ -64,9 +66,11 @@ class Plan:
     machine: Machine
     worlds: list[World]
     robot_params: dict[str, Any]
+    tables: RobotTables | None = None  # a robot of several tables run whole (``table`` is its main one)
 
     def __post_init__(self) -> None:
-        self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params) for w in self.worlds]
+        self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params, tables=self.tables)
+                                    for w in self.worlds]
         self.bodies: list[list[Scene]] = self._check_params()
         self._check_starts()
 
@@ -109,7 +113,8 @@ class Plan:
                 continue
             robots = self._robots(a, b, combos)
             out.append(Job(self.table, self.worlds[a // self.spec.runs_per_world], self.robot_params, robots,
-                           self.spec.ticks, first=a, info={"stop": b, "starts": [robot.start for robot in robots]}))
+                           self.spec.ticks, first=a, info={"stop": b, "starts": [robot.start for robot in robots]},
+                           tables=self.tables))
         return out
 
     def _robots(self, a: int, b: int, combos: Sequence[tuple[Any, ...]]) -> list[RobotSpec]:
@@ -143,7 +148,7 @@ class Plan:
                                                                                           strict=True))).overrides()
             for world, found in zip(self.worlds, bodies, strict=True):
                 try:
-                    scene = prepare(self.table, self.machine, world, self.robot_params, overrides)
+                    scene = prepare(self.table, self.machine, world, self.robot_params, overrides, self.tables)
                 except TableBotError as exc:
                     setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
                     raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
@@ -168,7 +173,7 @@ class Plan:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
         run = runs(self.spec, index, index + 1)[0]
         fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
-                      traced=[0])
+                      traced=[0], tables=self.tables)
         fleet.run(self.spec.ticks)
         return fleet
 
@@ -238,28 +243,31 @@ def cell(value: Any) -> str:
 
 
 def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Sequence[str], seeds: str | None,
-              robots: int | None, seconds: float) -> Plan:
+              robots: int | None, seconds: float, every_table: bool = False) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
-    as a plan of runs; every mistake is a located error before anything is written."""
+    as a plan of runs; every mistake is a located error before anything is written. ``every_table``: a robot of
+    several tables runs all of them (``sweep``), else its main table alone (``tune``, ``evolve``, ``grade``)."""
     axes = parse_grid(list(grid))
     seed_list = parse_seeds(seeds, robots)
     robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them
     parsed = load_table(resolve_table_path(table), robot_file_given)
-    machine = compile_table(parsed)
+    tables = several(parsed) if every_table else None
+    parsed = tables.table if tables is not None else parsed
+    machine = tables.machines[0] if tables is not None else compile_table(parsed)
     if machine.arrays is None:
         raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
                    f"{FLAT_BITS}", "simulate it one robot at a time with tablebot sim, or use fewer inputs")
     layer, robot_world = robot_layer(parsed.robot)
     loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
     paths = [str(w) for w in worlds] or [loaded[0].path]
-    ticks = ticks_for(prepare(parsed, machine, loaded[0], layer), seconds)
+    ticks = ticks_for(prepare(parsed, machine, loaded[0], layer, tables=tables), seconds)
     files = [Path(p) if Path(p).is_file() else None for p in paths]
     robot_file = Path(parsed.robot.source)
-    spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=digest(Path(parsed.path)),
+    spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=tables_digest(parsed, tables),
                      worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
                      seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
                      code=sources_digest())
-    return Plan(spec, parsed, machine, loaded, layer)
+    return Plan(spec, parsed, machine, loaded, layer, tables)
 
 
 def _body(scene: Scene) -> tuple:

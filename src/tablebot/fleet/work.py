@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from tablebot.machine import Machine
     from tablebot.sim.world import World
     from tablebot.table import Table
+    from tablebot.tables import RobotTables
 
 COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
@@ -48,6 +49,7 @@ class Job:
     variants: Variants | None = None
     threads: int | None = None  # numba threads for this job (None: numba's default)
     info: dict[str, Any] = field(default_factory=dict)  # what the caller needs back with the result
+    tables: RobotTables | None = None  # a robot of several tables: all of them (the main one is ``table``)
 
 
 @dataclass(frozen=True)
@@ -58,17 +60,18 @@ class Common:
     table: Table
     world: World
     robot_params: dict[str, Any]
+    tables: RobotTables | None = None
 
     @staticmethod
     def of(job: Job) -> Common:
-        return Common(job.table, job.world, job.robot_params)
+        return Common(job.table, job.world, job.robot_params, job.tables)
 
     def strip(self, job: Job) -> Job:
         """The job without what it shares (None in its place: put back by :meth:`fill`)."""
-        return replace(job, table=None, world=None, robot_params=None)  # type: ignore[arg-type]
+        return replace(job, table=None, world=None, robot_params=None, tables=None)  # type: ignore[arg-type]
 
     def fill(self, job: Job) -> Job:
-        return replace(job, table=self.table, world=self.world, robot_params=self.robot_params)
+        return replace(job, table=self.table, world=self.world, robot_params=self.robot_params, tables=self.tables)
 
 
 def run_common(fn: Callable[[Job], tuple[Job, Any]], common: Common, job: Job) -> tuple[Job, Any]:
@@ -96,7 +99,7 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
         use_threads(job)
     machine, prepared = shared(job)
     fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params, variants=job.variants,
-                  prepared=prepared)
+                  prepared=prepared, tables=job.tables)
     fleet.run(job.ticks, progress=check, threads=False if threads == 1 else None, block_ticks=block_ticks(job))
     return replace(job, specs=[], variants=None), fleet.summary()
 
@@ -177,7 +180,7 @@ def warm(job: Job, both: bool = False) -> float:
     started = time.perf_counter()
     machine, prepared = shared(job)
     fleet = Fleet(job.table, machine, job.world, job.specs[:1], job.robot_params, variants=job.variants,
-                  prepared=prepared)
+                  prepared=prepared, tables=job.tables)
     for threads in (False, True) if both else (False,):
         fleet.run(1, threads=threads)
     return time.perf_counter() - started
