@@ -147,3 +147,29 @@ def test_sweeps_pictures_speak_the_readers_language(tmp_path: Path) -> None:
               "Startpositionen in", "0 von 4 erreichten die Lampe", "erreichte die Lampe nie"]
     assert all(w in words["en"] for w in english), words["en"]
     assert all(w in words["de"] for w in german) and not any(w in words["de"] for w in english), words["de"]
+
+
+def test_tunes_convergence_picture_speaks_the_readers_language(tmp_path: Path) -> None:
+    """tune's convergence.png: a real evaluator runs three candidates of one timer cell on the fleet; the
+    picture drawn from its history has German title, axes and legend."""
+    from tablebot.api.tune_files import convergence_figure
+    from tablebot.fleet.backends import Runner
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.tune import Evaluator, parse_cells
+
+    plan = make_plan(BUMBERBOT, None, [], [], "0", None, 1.0)
+    cells = parse_cells("line 2 timer=100..300", plan.table)
+    with Runner("local", None, 1) as runner:
+        evaluate = Evaluator(plan, cells, "distance_m", runner)
+        evaluate([(100,), (200,), (300,)])
+    words = {}
+    for language in ("en", "de"):
+        i18n.use(language)
+        try:
+            words[language] = "\n".join(t.get_text() for t in texts(convergence_figure(evaluate, "grid")))
+        finally:
+            i18n.use("en")
+    english = ["grid: 3 candidates", "evaluation", "best so far", "the table as it was", "(ticks)"]
+    german = ["grid: 3 Kandidaten", "Bewertung", "bisher bester", "die ursprüngliche Tabelle", "(Takte)"]
+    assert all(w in words["en"] for w in english), words["en"]
+    assert all(w in words["de"] for w in german) and not any(w in words["de"] for w in english), words["de"]

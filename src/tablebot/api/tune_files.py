@@ -7,6 +7,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from tablebot.fleet.plan import Plan
     from tablebot.fleet.tune import Cell, Evaluator
 
@@ -67,54 +69,55 @@ def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
 def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
     """The convergence picture, its text drawn as written (see tablebot.sim.draw.literal_text)."""
     from tablebot.sim.draw import literal_text
+    from tablebot.sim.plots import save
 
     with literal_text():
-        return _convergence(evaluate, method, path)
+        return save(convergence_figure(evaluate, method), path)
 
 
-def _convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
+def convergence_figure(evaluate: Evaluator, method: str) -> Figure:
     """Every evaluation's objective and the best so far; for one cell also the objective against its value."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from tablebot.escape import picture
-    from tablebot.sim.plots import save
+    from tablebot.i18n import _
 
-    values = np.array([v for _, v in evaluate.history])
+    values = np.array([v for _cells, v in evaluate.history])
     one, two = len(evaluate.cells) == 1, len(evaluate.cells) == 2
     fig = Figure(figsize=(11 if one or two else 7, 4.2), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 2 if one or two else 1, 1)
-    ax.scatter(np.arange(len(values)), values, s=8, alpha=0.4, color="#636e72", label="candidate")
-    ax.plot(np.minimum.accumulate(values), color="#20bf6b", linewidth=2, label="best so far")
-    ax.axhline(values[0], color="#e8413a", linestyle="--", linewidth=1, label="the table as it was")
-    ax.set_xlabel("evaluation")
+    ax.scatter(np.arange(len(values)), values, s=8, alpha=0.4, color="#636e72", label=_("candidate"))
+    ax.plot(np.minimum.accumulate(values), color="#20bf6b", linewidth=2, label=_("best so far"))
+    ax.axhline(values[0], color="#e8413a", linestyle="--", linewidth=1, label=_("the table as it was"))
+    ax.set_xlabel(_("evaluation"))
     ax.set_ylabel(evaluate.objective)
-    ax.set_title(f"{method}: {len(values)} candidates", fontsize=11)
+    ax.set_title(_("{method}: {n} candidates").format(method=method, n=len(values)), fontsize=11)
     ax.legend(fontsize=8)
     if one:
         side = fig.add_subplot(1, 2, 2)
-        xs = np.array([c[0] for c, _ in evaluate.history])
+        xs = np.array([c[0] for c, _value in evaluate.history])
         order = np.argsort(xs)
         side.plot(xs[order], values[order], color="#1f77b4", linewidth=1)
         side.axvline(evaluate.cells[0].value, color="#e8413a", linestyle="--", linewidth=1)
-        side.set_xlabel(picture(f"{evaluate.cells[0].label} (ticks)"))
+        side.set_xlabel(picture(_("{cell} (ticks)").format(cell=evaluate.cells[0].label)))
         side.set_ylabel(evaluate.objective)
     if two:
         side = fig.add_subplot(1, 2, 2)
-        points = np.array([c for c, _ in evaluate.history])
+        points = np.array([c for c, _value in evaluate.history])
         dots = side.scatter(points[:, 0], points[:, 1], c=values, cmap="viridis_r", s=30, marker="s")
         fig.colorbar(dots, ax=side, label=evaluate.objective)
         a, b = evaluate.cells
         best = points[int(np.argmin(values))]
-        side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label="as it was")
-        side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label="tuned")
+        side.plot(a.value, b.value, "x", color="#e8413a", markersize=12, mew=2.5, label=_("as it was"))
+        side.plot(*best, "*", color="#ffd32a", markersize=16, markeredgecolor="black", label=_("tuned"))
         side.set_xlabel(picture(a.label))
         side.set_ylabel(picture(b.label))
         side.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
     fig.tight_layout()
-    return save(fig, path)
+    return fig
 
 
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
