@@ -7,12 +7,15 @@ import io
 import json
 import subprocess
 import sys
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import tablebot
+from tablebot.fleet.plan import make_plan
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.fleet.spec import digest
 from tablebot.sim.runner import simulate
@@ -57,3 +60,15 @@ def test_a_sweep_of_several_tables_is_n_sims(tmp_path: Path) -> None:
         assert (sweep / f"trace-{run}.jsonl").read_text() == text.getvalue()
     spec = json.loads((sweep / "spec.json").read_text())
     assert spec["table_digest"] != digest(EXAMPLE / "table.csv")
+
+
+def test_a_plan_of_the_main_table_alone_says_so() -> None:
+    """tune, evolve and grade plan a robot of several tables' main table alone: a note at its [tables] says so;
+    sweep's plan runs them all and says nothing."""
+    with pytest.warns(UserWarning, match=r"robot.toml:31:1: note: this runs the main table \(drive\) only"):
+        alone = make_plan(EXAMPLE, None, [], [], "1", None, 1.0)
+    assert alone.tables is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        whole = make_plan(EXAMPLE, None, [], [], "1", None, 1.0, every_table=True)
+    assert whole.tables is not None and whole.spec.table_digest != alone.spec.table_digest

@@ -36,10 +36,10 @@ from tablebot.fleet.spec import (
     parse_seeds,
     random_start,
     runs,
-    tables_digest,
     value_index,
 )
 from tablebot.fleet.starts import with_start
+from tablebot.fleet.tables import main_table_only, tables_digest
 from tablebot.fleet.work import Job
 from tablebot.formats.table_read import load_table, resolve_table_path
 from tablebot.formats.trace_lines import exact_round
@@ -252,6 +252,8 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
     robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them
     parsed = load_table(resolve_table_path(table), robot_file_given)
     tables = several(parsed) if every_table else None
+    if tables is None:
+        main_table_only(parsed.robot)
     parsed = tables.table if tables is not None else parsed
     machine = tables.machines[0] if tables is not None else compile_table(parsed)
     if machine.arrays is None:

@@ -15,7 +15,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -25,10 +25,6 @@ from tablebot.fleet.robots import Pose
 from tablebot.i18n import N_
 from tablebot.sim.params import DEFAULTS
 from tablebot.sim.world import inside
-
-if TYPE_CHECKING:
-    from tablebot.table import Table
-    from tablebot.tables import RobotTables
 
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000
@@ -88,14 +84,6 @@ class Run:
 
 def digest(path: Path | None) -> str:
     return "" if path is None else hashlib.sha256(path.read_bytes()).hexdigest()[:16]
-
-
-def tables_digest(table: Table, tables: RobotTables | None) -> str:
-    """The table file's digest; for a robot of several tables, of every table file (a resumed sweep of a robot
-    whose lights table changed starts again, as one whose main table changed does)."""
-    if tables is None:
-        return digest(Path(table.path))
-    return hashlib.sha256("".join(digest(Path(t.path)) for t in tables.tables).encode()).hexdigest()[:16]
 
 
 # --- options ----------------------------------------------------------------------------------------
