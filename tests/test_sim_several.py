@@ -118,3 +118,19 @@ def test_random_robots_simulate_as_several_steps_them(seed: int, tmp_path: Path)
     assert several_differences(project.tables, Run(run.inputs(), lines)) is None
     if seed == 1:  # its right motor runs: the counter counts its pulses (seed 6's is loaded, seed 3's held at 5)
         assert run.pulses.any()
+
+
+def test_run_on_sim_steps_every_table(tmp_path: Path) -> None:
+    """tablebot run --on sim (the simulator paced in real time, the code path of a controller) of the BumberBot with
+    its lights runs both tables: its trace is sim's for the seed, the lights table's keys too (and the clock's)."""
+    project = tablebot.open(EXAMPLE)
+    connection = project.connect("sim", seed=4)
+    assert connection.tables is not None
+    live = connection.run(seconds=0.3, out=tmp_path)
+    assert live.end.reason == "done"
+    written = next(p for p in live.files if p.name.startswith("trace"))
+    lines = [json.loads(line) for line in written.read_text().splitlines()]
+    text = io.StringIO()
+    project.simulate(seconds=0.3, seed=4).run.write_trace(text)
+    expected = [json.loads(line) for line in text.getvalue().splitlines()]
+    assert [{k: v for k, v in line.items() if k not in ("late_ms", "wall")} for line in lines] == expected

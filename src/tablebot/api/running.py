@@ -67,8 +67,7 @@ class Connection:
     project: Loaded
     opened: Opened
     behind_limit: float
-    #: A robot of several tables on a controller: all of them, stepped together (the simulator, whose compiled
-    #: robot runs the main table and says so, gets None).
+    #: A robot of several tables on a controller or the simulator: all of them, stepped together.
     tables: RobotTables | None = None
 
     def run(self, seconds: float | None = None, out: PathLike | None = None, sinks: Sequence[Sink] = (),
@@ -109,7 +108,7 @@ def connect(project: Loaded, on: str, *, link_timeout: float | None = None, behi
 
     link = LinkOptions(on, link_timeout_s=link_timeout, behind_limit_s=behind_limit, seed=seed, hint=address_hint())
     backend = live_backend(on)
-    tables = project.tables if backend.name != "sim" else None
+    tables = project.tables
     # a controller of a robot of several tables is wired for every input any table reads (the robot's layout)
     opened = backend.open(project.machine if tables is None else robot_machine(tables), link)
     return Connection(project, opened, behind_limit, tables)

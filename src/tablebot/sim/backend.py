@@ -21,16 +21,19 @@ def read_section(src: Source, data: Any, robot: Robot) -> Any:
 
 
 def open_sim(machine: Machine, link: LinkOptions) -> Opened:
-    """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run."""
+    """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run. A robot
+    of several tables is wired for all of them (``machine`` is then the robot's, its rows the main table's)."""
     from tablebot.jit import say_compiling
     from tablebot.sim import kernel
     from tablebot.sim.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
+    from tablebot.tables import several
 
     world = link.address.partition(":")[2]
     seed = link.seed
     say_compiling("the simulator", kernel.move)
-    bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None), seed)
+    tables = several(machine.table)
+    bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None, tables=tables), seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
     bot.reset(seed=seed)
     return Opened(bot, "sim", f"simulated, seed {seed}")
