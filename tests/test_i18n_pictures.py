@@ -173,3 +173,15 @@ def test_tunes_convergence_picture_speaks_the_readers_language(tmp_path: Path) -
     german = ["grid: 3 Kandidaten", "Bewertung", "bisher bester", "die ursprüngliche Tabelle", "(Takte)"]
     assert all(w in words["en"] for w in english), words["en"]
     assert all(w in words["de"] for w in german) and not any(w in words["de"] for w in english), words["de"]
+
+
+def test_view_without_a_window_says_so_in_german(tmp_path: Path) -> None:
+    """sim --view where no window can open: the error and its hint in the reader's language."""
+    import os
+
+    done = subprocess.run([sys.executable, "-m", "tablebot", "--lang", "de", "sim", str(BUMBERBOT), "--seconds", "1",
+                           "--view", "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "MPLBACKEND": "agg"})
+    assert done.returncode != 0
+    assert "--view: Fehler: hier lässt sich kein Fenster öffnen" in done.stderr + done.stdout
+    assert "Tipp: ohne --view starten und die Bilder öffnen" in done.stderr + done.stdout

@@ -22,7 +22,7 @@ from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import picture
 from tablebot.files import atomic_write
-from tablebot.i18n import _
+from tablebot.i18n import N_, _
 from tablebot.sim import columns as L
 from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings
 from tablebot.sim.plots import subtitle_of, title_of
@@ -121,8 +121,9 @@ def check_display() -> None:
     import matplotlib.pyplot as plt
 
     if not _interactive(plt.get_backend()):
-        raise fail("--view", "no window can be opened here (no display, or matplotlib's backend is "
-                   f"{plt.get_backend()!r})", "run without --view and open the pictures, or use --gif")
+        raise fail("--view", N_("no window can be opened here (no display, or matplotlib's backend is {backend!r})",
+                                backend=plt.get_backend()),
+                   N_("run without --view and open the pictures, or use --gif"))
 
 
 @literal_text()
