@@ -47,7 +47,8 @@ def test_a_short_run_reports_figures_that_agree_with_each_other(capsys: pytest.C
                                                    ("step", "transitions"), ("batch", "bare loop")]
     for t in targets:
         ratio = float(t["ratio"])
-        assert ratio == pytest.approx(rates[t["a"]] / rates[t["b"]], abs=0.006)  # one round: its own median
+        # one round: its own median; the rates are printed rounded, so a large ratio differs in its last digits
+        assert ratio == pytest.approx(rates[t["a"]] / rates[t["b"]], rel=0.002, abs=0.006)
         assert float(t["low"]) == float(t["high"]) == ratio
         assert t["verdict"] == ("ok" if ratio >= float(t["want"]) else "MISSED")
 
