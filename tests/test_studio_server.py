@@ -133,7 +133,8 @@ def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_
     server, _ = studio
 
     async def run() -> tuple[dict[str, Any], list[tuple[float, dict[str, Any]]]]:
-        control, frames = None, []
+        control: dict[str, Any] | None = None
+        frames: list[tuple[float, dict[str, Any]]] = []
         async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
                                       additional_headers=server.headers) as ws:
             for message in ({"op": "open", "path": "table.csv"},
@@ -145,6 +146,7 @@ def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_
                 if reply["type"] == "frame":
                     frames.append((time.monotonic(), reply))
                     if reply["paused"] and reply["scripted"] == 0 and reply["tick"] == 53:
+                        assert control is not None, "no control message came before the violating tick"
                         return control, frames
 
     control, frames = asyncio.run(run())
