@@ -50,7 +50,7 @@ def test_a_tuning_that_did_not_help_says_so(tmp_path: Path, timer: int, seeds: s
 
 
 def test_a_tuning_that_helped_says_so_and_offers_the_tuned_table(tmp_path: Path) -> None:
-    stdout, stderr, report = tune(tmp_path, 646, "0..0")  # 647: 0.10454 -> 0.10452 m on the fresh seeds
+    _stdout, stderr, report = tune(tmp_path, 646, "0..0")  # 647: 0.10454 -> 0.10452 m on the fresh seeds
     assert report.startswith("# Tuning table.csv: lamp_distance\n")
     assert "Better than the table as it was on fresh seeds: yes." in report
     assert "| cell | before | after |" in report and "Simulate the tuned table" in report
