@@ -1,5 +1,6 @@
 """A simulated run's trace as one numpy record per tick: the fields of ``trace.jsonl`` (tick, event, row,
-state, timer, each output and counter, then the simulator's own: pose, battery, sensors), as columns."""
+state, timer, each output and counter, then the simulator's own: pose, battery, sensors, then for a robot of
+several tables each other table's ``NAME.event``, ``NAME.row``, ``NAME.state``, ``NAME.timer``), as columns."""
 
 from __future__ import annotations
 
@@ -63,8 +64,9 @@ def from_run(run: SimRun) -> np.ndarray:
     out = np.zeros(run.ticks, dtype=_dtype(machine, fields))
     _, state_values = _state_column(machine)
     out["tick"] = np.arange(run.ticks)
-    for name in ("event", "row", "timer"):
+    for name in ("event", "timer"):
         out[name] = getattr(run, f"{name}s")
+    out["row"] = _as_written(machine)[run.rows]  # a group's row as the file writes it, as trace.jsonl names it
     out["state"] = state_values[run.states]
     for k, name in enumerate(machine.output_names):
         out[name] = run.outputs[:, k]
@@ -72,7 +74,35 @@ def from_run(run: SimRun) -> np.ndarray:
         out[name] = run.counters[:, k]
     for key, (values, _) in columns.items():
         out[key] = values
+    return _with_others(out, run)
+
+
+def _as_written(machine: Machine) -> np.ndarray:
+    """Per row index (and -1: none fired, the last place), the row as its file writes it."""
+    return np.array([row.as_written for row in machine.table.rows] + [-1], dtype=np.int32)
+
+
+def _with_others(trace: np.ndarray, run: SimRun) -> np.ndarray:
+    """The trace with the other tables' columns of a robot of several tables after its own (as ``trace.jsonl``
+    has them): ``NAME.row`` -1 where the table fired no row, ``NAME.state`` typed as its table's states are."""
+    tables = run.scene.tables
+    if tables is None or not run.others:
+        return trace
+    fields: list[tuple[str, Any]] = []
+    for name, machine in zip(tables.names[1:], tables.machines[1:], strict=True):
+        fields += [(f"{name}.event", np.int64), (f"{name}.row", np.int32),
+                   (f"{name}.state", _state_column(machine)[0]), (f"{name}.timer", np.int64)]
+    out = np.zeros(len(trace), dtype=np.dtype([*_fields(trace.dtype), *fields]))
+    for name in trace.dtype.names or ():
+        out[name] = trace[name]
+    for key, _ in fields:
+        values = run.others[key][:len(trace)]
+        out[key] = [-1 if v is None else v for v in values] if key.endswith(".row") else values
     return out
+
+
+def _fields(dtype: np.dtype) -> list[tuple[str, Any]]:
+    return [(name, dtype.fields[name][0]) for name in dtype.names or ()]  # type: ignore[index]
 
 
 def from_file(path: Path, machine: Machine) -> np.ndarray:
@@ -83,9 +113,17 @@ def from_file(path: Path, machine: Machine) -> np.ndarray:
     ticks = [r for r in records if "tick" in r and "end" not in r]
     known = {"tick", "event", "row", "state", "timer", *machine.output_names, *machine.table.robot.counter_names}
     extra = [key for key in (ticks[0] if ticks else {}) if key not in known]
-    fields = [(key, np.int64 if all(isinstance(r[key], int) for r in ticks) else np.float64) for key in extra]
+    fields = [(key, np.int32 if key.endswith(".row") else _kind([r[key] for r in ticks])) for key in extra]
     out = np.zeros(len(ticks), dtype=_dtype(machine, fields))
     for name in out.dtype.names or ():
         values = [r[name] for r in ticks]
-        out[name] = [-1 if v is None else v for v in values] if name == "row" else values
+        out[name] = [-1 if v is None else v for v in values] if name == "row" or name.endswith(".row") else values
     return out
+
+
+def _kind(values: list[Any]) -> Any:
+    """The dtype of an extra key's column: whole numbers (an other table's row, None where it fired none, is
+    -1), else text where any value is text (an other table's state names), else floats."""
+    if any(isinstance(v, str) for v in values):
+        return np.array([str(v) for v in values]).dtype
+    return np.int64 if all(v is None or isinstance(v, int) for v in values) else np.float64
