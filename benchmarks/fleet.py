@@ -98,7 +98,7 @@ def kernel_rate(robots: int, ticks: int) -> float:
     """Robot-ticks/s of ``robots`` BumberBots as one warm in-process fleet (numba's threads over all cores)."""
     from tablebot.cli.common import load
     from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.sim.scene import robot_layer, scene_for
+    from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = load(EXAMPLE)
     world = scene_for(table, machine).world
@@ -239,7 +239,7 @@ def small_fleet_us(robots: int, ticks: int, by_tick: bool) -> float:
     its noise rows handed over from Python: the Gymnasium vector env's path)."""
     from tablebot.cli.common import load
     from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.sim.scene import robot_layer, scene_for
+    from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = load(EXAMPLE)
     world, params = scene_for(table, machine).world, robot_layer(table.robot)[0]
@@ -258,7 +258,7 @@ def simrobot_us(ticks: int) -> float:
     """Microseconds per tick of one SimRobot through read/step/write (the loop's tick-by-tick path)."""
     from tablebot.cli.common import load
     from tablebot.engine import Engine
-    from tablebot.sim.scene import scene_for
+    from tablebot.sim.model.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
     table, machine = load(EXAMPLE)

@@ -44,7 +44,7 @@ def measure(example: str, repeats: int) -> dict[str, float]:
 
     from tablebot.cli.common import load
     from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.sim.scene import robot_layer, scene_for
+    from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = load(ROOT / "examples" / example)
     scene = scene_for(table, machine)
@@ -68,9 +68,9 @@ def measure(example: str, repeats: int) -> dict[str, float]:
 def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     import numpy as np
 
-    from tablebot.sim import contacts as co
-    from tablebot.sim import kernel as K
-    from tablebot.sim import physics as ph
+    from tablebot.sim.physics import contacts as co
+    from tablebot.sim.physics import kernel as K
+    from tablebot.sim.physics import step as ph
 
     loops = _loops()
     g, p = scene.geometry, scene.P[0]
@@ -113,11 +113,11 @@ def _loops() -> dict[str, Any]:
     from tablebot.engine_batch import tick_compiled
     from tablebot.jit import njit
     from tablebot.sim import columns as L
-    from tablebot.sim import contacts as co
-    from tablebot.sim import kernel as K
-    from tablebot.sim import physics as ph
-    from tablebot.sim.normals import standard_normal
-    from tablebot.sim.sensing import sense_declared
+    from tablebot.sim.physics import contacts as co
+    from tablebot.sim.physics import kernel as K
+    from tablebot.sim.physics import step as ph
+    from tablebot.sim.physics.normals import standard_normal
+    from tablebot.sim.physics.sensing import sense_declared
 
     fast = njit(refcounts=False, cache=False)
 

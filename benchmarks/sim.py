@@ -37,14 +37,14 @@ from tablebot.cli.common import load
 from tablebot.engine import Engine
 from tablebot.loop import run as run_loop
 from tablebot.sim.runner import simulate
-from tablebot.sim.scene import scene_for
+from tablebot.sim.model.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 from tablebot.testing.processes import child_env
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

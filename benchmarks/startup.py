@@ -118,7 +118,7 @@ from pathlib import Path
 plan = make_plan(Path(sys.argv[1]), None, [], [], None, 10000, 10.0)
 lap("plan 10,000 runs (scene checks: first compiled code, numba's runtime)")
 from tablebot.fleet.run import Fleet, RobotSpec
-from tablebot.sim.scene import robot_layer
+from tablebot.sim.model.scene import robot_layer
 layer = robot_layer(plan.table.robot)[0]
 fleet = Fleet(plan.table, plan.machine, plan.scenes[0].world, [RobotSpec(seed=0)], layer)
 lap("place one robot (loads sense, observe)")

@@ -2,12 +2,12 @@
 
 Run: ``.venv/bin/python benchmarks/structures.py [--repeat 5] [--robots 10000] [--ticks 1000]``.
 
-The work is the motors' and the pose's update of every tick (sim.physics.drive's arithmetic: battery volts
+The work is the motors' and the pose's update of every tick (sim.physics.step.drive's arithmetic: battery volts
 and charge, two motors with their lag, the midpoint heading) for many robots, on one thread, in four forms:
 
 * **positional**: the robots' rows (float64, columns named by integer constants as in sim.columns) and their
   parameters passed as separate arrays -- the kernels' form before issue 35;
-* **NamedTuple**: the same arrays in a NamedTuple (sim.structures' form);
+* **NamedTuple**: the same arrays in a NamedTuple (sim.physics.structures' form);
 * **record, by field**: each robot a numpy record (a structured dtype), its fields read and written by name
   (``s.x``, ``p.kv``);
 * **record, rows as views**: the same records, but the loop takes each robot's record once and works on it.

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 
 from tablebot.cli.common import load
 from tablebot.sim.runner import simulate
-from tablebot.sim.scene import scene_for
+from tablebot.sim.model.scene import scene_for
 from tablebot.sim.summary import summarise
 from tablebot.testing.turn_drift import Turn, turns
 

@@ -86,7 +86,7 @@ def commands_page() -> str:
 
 def sim_parameters_page() -> str:
     """docs/sim-parameters.md: every ``[sim.SECTION]`` key of a robot file (and world file section)."""
-    from tablebot.sim.params import DEFAULTS, WIRING
+    from tablebot.sim.model.params import DEFAULTS, WIRING
 
     lines = [GENERATED, "# Simulator parameters", "",
              "The simulated robot's physical parameters. Each has a default, fitted to the BumberBot; a robot file "

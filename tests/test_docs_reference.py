@@ -20,7 +20,7 @@ from tablebot.cli import app
 from tablebot.robot import CORE_SECTIONS, SECTION_READERS
 from tablebot.robot import TOP_KEYS as ROBOT_KEYS
 from tablebot.sensors import KEYS as SENSOR_KEYS
-from tablebot.sim.world import TOP_KEYS as WORLD_KEYS
+from tablebot.sim.model.world import TOP_KEYS as WORLD_KEYS
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -104,7 +104,7 @@ def test_each_findings_example_is_what_check_prints(monkeypatch: pytest.MonkeyPa
 
 
 def world_section_keys() -> dict[str, set[str]]:
-    source = (ROOT / "src" / "tablebot" / "sim" / "world.py").read_text(encoding="utf-8")
+    source = (ROOT / "src" / "tablebot" / "sim" / "model" / "world.py").read_text(encoding="utf-8")
     found = re.findall(r'known_keys\(src, \("(\w+)", \w+\), \w+, \(([^)]*)\)\)', source)
     return {section: set(re.findall(r'"(\w+)"', keys)) for section, keys in found}
 

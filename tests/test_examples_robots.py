@@ -42,7 +42,7 @@ def test_the_hairpin_needs_the_recovery_rows(follower: SimRun) -> None:
 
 def test_the_floor_sensors_read_the_tape_under_them(follower: SimRun) -> None:
     """Every tick, each sensor's reading is 1 exactly when its spot lies within the tape's half width."""
-    from tablebot.sim.geometry import point_segment_distance
+    from tablebot.sim.physics.geometry import point_segment_distance
 
     h, scene = follower.kept_rows(), follower.scene
     lines = scene.geometry.lines

@@ -31,7 +31,7 @@ from tablebot.machine import compile_table
 from tablebot.robopro.lists import read_table
 from tablebot.robopro.rpp_edit import write_lists
 from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.sim.world import load_world
+from tablebot.sim.model.world import load_world
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"

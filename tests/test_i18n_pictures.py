@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.text import Text
 
 from tablebot import i18n
-from tablebot.sim.plots import timeline_figure, trajectory_figure
+from tablebot.sim.pictures.plots import timeline_figure, trajectory_figure
 from tablebot.sim.runner import SimRun, simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of

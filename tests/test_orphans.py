@@ -131,7 +131,7 @@ def test_sim_killed_with_sigkill_takes_its_drawing_copy_with_it(tmp_path: Path) 
 #: A process whose forked copy (holding its stdout, as a drawing copy does) watches for it portably.
 WATCHED = """
 import os, time
-from tablebot.sim.forked import watch_parent
+from tablebot.sim.pictures.forked import watch_parent
 parent = os.getpid()
 if os.fork() == 0:
     watch_parent(parent)

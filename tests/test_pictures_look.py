@@ -22,9 +22,9 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.colours import PALETTE, state_colours
-from tablebot.sim import plots, timeline
-from tablebot.sim.animate import Player
-from tablebot.sim.draw import literal_text
+from tablebot.sim.pictures import plots, timeline
+from tablebot.sim.pictures.animate import Player
+from tablebot.sim.pictures.draw import literal_text
 from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
     from matplotlib.figure import Figure
 
-    from tablebot.sim.timeline import TimelinePicture
+    from tablebot.sim.pictures.timeline import TimelinePicture
 
 TUTORIAL_ROBOT = """\
 name = "my-robot"

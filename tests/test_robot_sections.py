@@ -10,7 +10,7 @@ import pytest
 
 from tablebot.diagnostics import TableBotError
 from tablebot.robot import load_robot
-from tablebot.sim.params import SimSection
+from tablebot.sim.model.params import SimSection
 
 BASE = 'name = "Bot"\ninitial_state = 1\n[inputs]\nI3 = "bumper"\n[motors]\nM1 = "right"\nM2 = "left"\n'
 
@@ -55,9 +55,9 @@ def test_sections_are_typed(tmp_path: Path) -> None:
 
 
 def test_reading_robot_and_world_files_does_not_load_the_simulator() -> None:
-    code = ("import sys; from tablebot.robot import load_robot; from tablebot.sim.world import load_world; "
+    code = ("import sys; from tablebot.robot import load_robot; from tablebot.sim.model.world import load_world; "
             "load_robot('examples/bumberbot/robot.toml'); load_world('examples/bumberbot/arena.toml'); "
-            "print(sorted(m for m in ('numba', 'matplotlib', 'tablebot.sim.physics') if m in sys.modules))")
+            "print(sorted(m for m in ('numba', 'matplotlib', 'tablebot.sim.physics.step') if m in sys.modules))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                           cwd=Path(__file__).resolve().parents[1])
     assert done.stdout.strip() == "[]"

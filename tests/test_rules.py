@@ -24,8 +24,8 @@ from tablebot.loop import Reading, RealTimeClock, run
 from tablebot.machine import compile_table
 from tablebot.sensors import Sensor, threshold_event
 from tablebot.sim import columns as L
-from tablebot.sim.params import sensor_fields
-from tablebot.sim.sensing import sensor_events
+from tablebot.sim.model.params import sensor_fields
+from tablebot.sim.physics.sensing import sensor_events
 from test_txt4_program import stub_robot
 
 

@@ -1,4 +1,4 @@
-"""The forked copy that draws one of a run's pictures on the other core (tablebot.sim.forked): its answer, its
+"""The forked copy that draws one of a run's pictures on the other core (tablebot.sim.pictures.forked): its answer, its
 errors, and no process left behind on any way out, the sim command's interrupts included."""
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 from core_helpers import EXAMPLE
 from tablebot.cli import app
 from tablebot.interrupts import FAULT_ENV
-from tablebot.sim import forked
-from tablebot.sim.forked import Forked
+from tablebot.sim.pictures import forked
+from tablebot.sim.pictures.forked import Forked
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
                                 reason="the copy is forked on Linux with two cores or more (elsewhere the work "

@@ -1,5 +1,5 @@
-"""The simulator's shortcuts in its geometry give the plain tests' answers exactly: sim.geometry.segments_within
-refuses segments clear of each other's line before its four distances, and sim.shadows tests only the pieces
+"""The simulator's shortcuts in its geometry give the plain tests' answers exactly: sim.physics.geometry.segments_within
+refuses segments clear of each other's line before its four distances, and sim.physics.shadows tests only the pieces
 its grid lists: both must agree with the plain tests always."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_within, segments_cross, segments_within, shadowed
-from tablebot.sim.shadows import shadowed_near
+from tablebot.sim.physics.geometry import point_segment_within, segments_cross, segments_within, shadowed
+from tablebot.sim.physics.shadows import shadowed_near
 
 
 @njit
@@ -67,11 +67,11 @@ def shadow_disagreements(points: np.ndarray, lamps: np.ndarray, edges: np.ndarra
 
 
 def test_the_shadow_grid_gives_every_shadow_test_the_full_scans_answer() -> None:
-    """sim.shadows lists per cell only the pieces that may shadow each lamp: its answer must be the scan of every
+    """sim.physics.shadows lists per cell only the pieces that may shadow each lamp: its answer must be the scan of every
     piece, also on the lines through a lamp and a corner, on an edge's own line, just off both, and beyond
     the grid -- in a world with two lamps (one in line with a box's side, one with no base), a hanging
     circle and a partition."""
-    from tablebot.sim.world import geometry, parse_world
+    from tablebot.sim.model.world import geometry, parse_world
     from tablebot.tomlfile import Source
 
     world = parse_world(Source.parse("<w>", """

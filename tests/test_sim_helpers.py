@@ -13,8 +13,8 @@ import pytest
 from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
 from tablebot.sim.runner import SimRun, simulate
-from tablebot.sim.scene import Scene, scene_for
-from tablebot.sim.world import load_world
+from tablebot.sim.model.scene import Scene, scene_for
+from tablebot.sim.model.world import load_world
 
 ROOT = Path(__file__).resolve().parents[1]
 BUMBERBOT = ROOT / "examples" / "bumberbot"

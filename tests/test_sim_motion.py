@@ -11,9 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tablebot.sim import columns as L
-from tablebot.sim.params import Params, speed_per_volt, terminal_volts
+from tablebot.sim.model.params import Params, speed_per_volt, terminal_volts
 from tablebot.sim.runner import simulate
-from tablebot.sim.world import inside
+from tablebot.sim.model.world import inside
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
 
 if TYPE_CHECKING:

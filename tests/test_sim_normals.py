@@ -1,4 +1,4 @@
-"""numpy's standard normal drawn inside compiled code (sim.normals) is numpy's own, number for number and
+"""numpy's standard normal drawn inside compiled code (sim.physics.normals) is numpy's own, number for number and
 state for state, on both of its paths (PCG64 stepped inline, any bit generator through numpy's function
 pointers): the simulator's noise may come from either without changing a trace byte."""
 
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tablebot.fleet.generators import generators
-from tablebot.sim import normals
-from tablebot.sim.normals import INLINE, bitgen_address, fill
+from tablebot.sim.physics import normals
+from tablebot.sim.physics.normals import INLINE, bitgen_address, fill
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -1,4 +1,4 @@
-"""The pictures a painter draws while the robot runs (tablebot.sim.painter): the same pixels as the figures drawn
+"""The pictures a painter draws while the robot runs (tablebot.sim.pictures.painter): the same pixels as the figures drawn
 whole in one process, however they were drawn (the arena first, the path as it grows, the timeline in two
 bands, PNGs put together from parts), and no process of the painter's left behind on any way out."""
 
@@ -21,13 +21,13 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from tablebot.cli import app
-from tablebot.sim import forked, plots
-from tablebot.sim.draw import literal_text
-from tablebot.sim.picture import deflated, png_of, png_of_parts
+from tablebot.sim.pictures import forked, plots
+from tablebot.sim.pictures.draw import literal_text
+from tablebot.sim.pictures.picture import deflated, png_of, png_of_parts
 from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
-from tablebot.sim.timeline import TimelinePicture
-from tablebot.sim.view import RunView
+from tablebot.sim.pictures.timeline import TimelinePicture
+from tablebot.sim.pictures.view import RunView
 from test_sim_declared import SENSORS, TABLE
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 
@@ -239,7 +239,7 @@ def test_the_pictures_are_the_same_whatever_the_painter_is_handed(tmp_path: Path
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     """Without memory to share, the arrays go to the painter when the run is over; with --gif the run keeps
     every column of every robot row, and the painter draws from those."""
-    from tablebot.sim import painter
+    from tablebot.sim.pictures import painter
 
     def refuse(self: painter.Shared) -> None:
         raise OSError("no memory to map")

@@ -9,8 +9,8 @@ import struct
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tablebot.sim import params as P
-from tablebot.sim.physics import duty, pack_volts
+from tablebot.sim.model import params as P
+from tablebot.sim.physics.step import duty, pack_volts
 
 VOLTS = st.floats(0.0, 60.0, allow_nan=False)
 

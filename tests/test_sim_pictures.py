@@ -11,8 +11,8 @@ from matplotlib.collections import PatchCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Wedge
 
-from tablebot.sim.draw import RobotArtist, contact_point, draw_world
-from tablebot.sim.plots import legend_marks, reading_panels
+from tablebot.sim.pictures.draw import RobotArtist, contact_point, draw_world
+from tablebot.sim.pictures.plots import legend_marks, reading_panels
 from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from test_sim_declared import sensor_scene
@@ -69,7 +69,7 @@ def test_the_robot_shows_its_own_sensors_and_not_the_bumberbots(tmp_path: Path) 
 
 def test_names_with_dollar_signs_are_drawn_as_written(tmp_path: Path) -> None:
     """matplotlib reads text between two $ as maths: a robot called 'cost $\\frac{ room $' crashed the
-    pictures. Every picture is drawn with literal text (sim.draw.literal_text)."""
+    pictures. Every picture is drawn with literal text (sim.pictures.draw.literal_text)."""
     from typer.testing import CliRunner
 
     from tablebot.cli.app import app

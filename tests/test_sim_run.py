@@ -137,7 +137,7 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
     from matplotlib.colors import to_rgba
     from matplotlib.figure import Figure
 
-    from tablebot.sim.draw import LAMP_OFF, LAMP_ON, RobotArtist
+    from tablebot.sim.pictures.draw import LAMP_OFF, LAMP_ON, RobotArtist
 
     (tmp_path / "robot.toml").write_text(LAMP_ROBOT, encoding="utf-8")
     (tmp_path / "table.csv").write_text(LAMP_TABLE, encoding="utf-8")

@@ -62,7 +62,7 @@ def test_a_saved_run_writes_the_other_tables_keys(tmp_path: Path) -> None:
 
 
 def test_the_compiled_loop_is_the_tick_by_tick_run(tmp_path: Path) -> None:
-    """sim runs the tables in compiled blocks (tablebot.sim.several); the same robot stepped one tick at a time
+    """sim runs the tables in compiled blocks (tablebot.sim.physics.several); the same robot stepped one tick at a time
     through the run loop's exchange (RobotEngine, as a live controller runs) writes the same trace bytes."""
     from tablebot.engine.as_one import RobotEngine
     from tablebot.loop import TickBlock, exchange

@@ -19,7 +19,7 @@ from tablebot.fleet.plan import make_plan
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.fleet.spec import digest
 from tablebot.sim.runner import simulate
-from tablebot.sim.scene import robot_layer
+from tablebot.sim.model.scene import robot_layer
 from tablebot.sim.summary import summarise
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "bumberbot-lights"

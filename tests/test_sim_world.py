@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from tablebot.diagnostics import TableBotError
-from tablebot.sim.world import geometry, load_world
+from tablebot.sim.model.world import geometry, load_world
 from test_sim_helpers import ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
 
 GOOD = room(extra="[[lamp]]\nat = [2, 2]\n[[box]]\nat = [0.5, 2.5]\nsize = [0.2, 0.3]\nangle = 45\n"

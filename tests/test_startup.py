@@ -38,12 +38,12 @@ def packages_of(*args: str) -> set[str]:
 
 def test_a_cached_function_loads_without_numba_s_compiler_and_scipy(tmp_path: Path) -> None:
     cache = {"NUMBA_CACHE_DIR": str(tmp_path)}
-    compile_it = "from tablebot.sim.physics import duty; print(duty(3, 8))"
+    compile_it = "from tablebot.sim.physics.step import duty; print(duty(3, 8))"
     first = python(compile_it, env=cache)
     assert first.returncode == 0, first.stderr
     load_it = """
 import sys
-from tablebot.sim.physics import duty
+from tablebot.sim.physics.step import duty
 print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_misses.values()))
 print(sorted(m for m in ('numba.np.arraymath', 'numba.np.linalg', 'scipy', 'scipy.linalg') if m in sys.modules))
 """
@@ -89,12 +89,12 @@ def test_preload_loads_what_the_cache_holds_before_the_first_call_and_compiles_n
     """fleet.work.preload (a sweep loads its compiled code on a thread while it plans): a function the cache
     holds is loaded without a call, from the cache; one it does not hold is left alone, not compiled."""
     cache = {"NUMBA_CACHE_DIR": str(tmp_path)}
-    first = python("from tablebot.sim.physics import duty; print(duty(3, 8))", env=cache)
+    first = python("from tablebot.sim.physics.step import duty; print(duty(3, 8))", env=cache)
     assert first.returncode == 0, first.stderr
     load_it = """
 from tablebot.fleet.work import preload
-from tablebot.sim.contacts import body_corners
-from tablebot.sim.physics import duty
+from tablebot.sim.physics.contacts import body_corners
+from tablebot.sim.physics.step import duty
 print(preload(duty), len(duty.overloads), preload(body_corners), len(body_corners.overloads))
 print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_misses.values()))
 """

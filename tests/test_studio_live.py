@@ -12,14 +12,14 @@ from core_helpers import EXAMPLE
 from tablebot.cli.common import load
 from tablebot.loop import RunEnd, RunInfo, TickBlock
 from tablebot.sim.runner import simulate
-from tablebot.sim.scene import scene_for
+from tablebot.sim.model.scene import scene_for
 from tablebot.sim.simrobot import SimRobot
 from tablebot.web.live import LiveRun, PageClock
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
 
 
 class Rows:

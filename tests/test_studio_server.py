@@ -163,7 +163,7 @@ def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_
 def test_the_arena_gets_the_tape_and_light_cones_only_for_a_robot_that_has_them() -> None:
     """A line follower's world carries its tape; its robot has no phototransistors, so no light cones."""
     from tablebot.cli.common import load
-    from tablebot.sim.scene import scene_for
+    from tablebot.sim.model.scene import scene_for
     from tablebot.web.worldview import world_json
 
     for name, tape, light in (("line-follower", True, False), ("bumberbot", False, True)):

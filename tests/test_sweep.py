@@ -19,7 +19,7 @@ from tablebot.cli import app
 from tablebot.cli.common import load
 from tablebot.fleet.plan import read_results
 from tablebot.fleet.run import Fleet, RobotSpec
-from tablebot.sim.scene import robot_layer, scene_for
+from tablebot.sim.model.scene import robot_layer, scene_for
 from tablebot.testing.dask_cluster import local_cluster
 from test_sim_helpers import BUMBERBOT
 

@@ -58,7 +58,7 @@ def sim_case(example: str, seconds: float, seed: int, busy: int | None = None) -
     """``tablebot sim``'s loop: the trace lines and every robot row of one run."""
     from tablebot.loop import RunEnd, RunInfo, TickBlock
     from tablebot.sim.runner import simulate
-    from tablebot.sim.scene import prepare, scene_for
+    from tablebot.sim.model.scene import prepare, scene_for
     from tablebot.sinks.trace_file import block_lines
 
     table, machine = _load(example)
@@ -99,7 +99,7 @@ def fleet_case(threads: bool, variants: bool = False) -> str:
     traced: its trace lines and rows, and every robot's summary."""
     from tablebot.fleet.robots import RobotSpec, Variants
     from tablebot.fleet.run import Fleet
-    from tablebot.sim.scene import robot_layer, scene_for
+    from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = _load("bumberbot")
     world = scene_for(table, machine).world
@@ -137,7 +137,7 @@ def tick_case(commands: bool) -> str:
     """The fleet a tick at a time (the Gymnasium env's path): the table drives it, or motor commands do."""
     from tablebot.fleet.robots import RobotSpec
     from tablebot.fleet.run import Fleet
-    from tablebot.sim.scene import robot_layer, scene_for
+    from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = _load("bumberbot")
     fleet = Fleet(table, machine, scene_for(table, machine).world, [RobotSpec(seed=s) for s in range(3)],

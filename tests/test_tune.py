@@ -11,7 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tablebot.cli import app
-from tablebot.sim.params import merged, top_speed
+from tablebot.sim.model.params import merged, top_speed
 
 ROBOT = """\
 name = "TestBot"
@@ -170,7 +170,7 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table
     from tablebot.sim.runner import simulate
-    from tablebot.sim.scene import scene_for
+    from tablebot.sim.model.scene import scene_for
     from test_sim_helpers import BUMBERBOT, trace_text
 
     example = BUMBERBOT.parent / "bumberbot-counters"

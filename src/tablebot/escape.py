@@ -143,7 +143,7 @@ def plain(text: str) -> str:
 def picture(text: str) -> str:
     """User text for a picture (matplotlib): on one line, every character printable (a control character
     would draw a missing glyph: shown as ``\\xNN``, line breaks as ``\\n``). The pictures are drawn with
-    maths parsing off (``tablebot.sim.draw.literal_text``), so a ``$`` stays a ``$``."""
+    maths parsing off (``tablebot.sim.pictures.draw.literal_text``), so a ``$`` stays a ``$``."""
     return plain(text)
 
 

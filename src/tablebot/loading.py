@@ -21,8 +21,8 @@ if TYPE_CHECKING:
     from tablebot.analysis.properties import Property
     from tablebot.machine import Machine
     from tablebot.robot import Robot
-    from tablebot.sim.scene import Scene
-    from tablebot.sim.world import World
+    from tablebot.sim.model.scene import Scene
+    from tablebot.sim.model.world import World
     from tablebot.table import Table
     from tablebot.tables import RobotTables
 
@@ -118,7 +118,7 @@ class Loaded:
     @cached_property
     def worlds(self) -> tuple[World, ...]:
         """The worlds it runs in: those given, else its default one (read on first use)."""
-        from tablebot.sim.world import load_world
+        from tablebot.sim.model.world import load_world
 
         if self.world_files:
             return tuple(load_world(path) for path in self.world_files)
@@ -126,13 +126,13 @@ class Loaded:
 
     def robot_world(self) -> Path | None:
         """The world the robot file names (``[sim] world``), if it names one."""
-        from tablebot.sim.scene import robot_layer
+        from tablebot.sim.model.scene import robot_layer
 
         return robot_layer(self.robot)[1]
 
     def default_world(self) -> World:
         """The robot's ``sim.world``, else ``arena.toml`` beside the table, else an empty room."""
-        from tablebot.sim.scene import find_world
+        from tablebot.sim.model.scene import find_world
 
         return find_world(self.table, None, self.robot_world())
 
@@ -143,8 +143,8 @@ class Loaded:
         simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's.
         ``every_table``: a robot of several tables is simulated whole (``sim``, tick by tick); without it its
         main table alone, with a note (the compiled sweep, tune and the studio's arena, for now)."""
-        from tablebot.sim.scene import prepare, robot_layer, scene_for
-        from tablebot.sim.world import World
+        from tablebot.sim.model.scene import prepare, robot_layer, scene_for
+        from tablebot.sim.model.world import World
 
         tables = self.tables if every_table else None
         if self.tables is not None and tables is None:  # said, not hidden: the other tables' lamps stay dark

@@ -43,7 +43,7 @@ class Panel:
 
 
 class Sections(Protocol):
-    """The simulator's parameters as a sensor kind reads them: ``params[section][key]`` (sim.params.Params)."""
+    """The simulator's parameters as a sensor kind reads them: ``params[section][key]`` (sim.model.params.Params)."""
 
     def __getitem__(self, section: str) -> Mapping[str, Any]: ...
 
@@ -51,12 +51,12 @@ class Sections(Protocol):
 @dataclass(frozen=True)
 class SensorKind:
     """One kind of sensor the simulator models, and everything that follows from it: the words that declare
-    it, how its thresholds are written, its code in the simulator (whose physics, ``sim/sensing.py``, has a
+    it, how its thresholds are written, its code in the simulator (whose physics, ``sim/physics/sensing.py``, has a
     branch per code), its trace field, how pictures draw it, its reading panel, the controller input modes
     that read it with its declared threshold, and its place in a learning agent's observation.
 
-    Adding a kind: register one here, its physics in ``sim/sensing.py`` (and its parameters, if it has any, in
-    ``sim/params.py``); every other stage reads this object.
+    Adding a kind: register one here, its physics in ``sim/physics/sensing.py`` (and its parameters, if it has any, in
+    ``sim/model/params.py``); every other stage reads this object.
     """
 
     name: str  # what the simulator models
@@ -160,7 +160,7 @@ def threshold_event(reading: float, above: bool, on_at: float, off_at: float, wa
     hysteresis; ``was_on``: the event last tick).
 
     The one rule for every analog input: the simulator compiles this function into its sensing
-    (``sim.sensing``), every controller's wiring calls it (``hw.wiring``), and the TXT 4.0 program, a standalone
+    (``sim.physics.sensing``), every controller's wiring calls it (``hw.wiring``), and the TXT 4.0 program, a standalone
     file, carries a copy that ``tests/test_rules.py`` proves equal to it.
     """
     level = off_at if was_on else on_at

@@ -27,7 +27,7 @@ PURPOSE = {"table.csv": N_("the behaviour: one row per transition (open it in a 
            "robot.toml": N_("its inputs, motors, sensors and state names"),
            "arena.toml": N_("the world `tablebot sim` drives it in"),
            "properties.toml": N_("claims about every run that `tablebot check` proves or refutes")}
-#: The simulator's default parts (tablebot.sim.params.WIRING): a renamed BumberBot keeps them wired.
+#: The simulator's default parts (tablebot.sim.model.params.WIRING): a renamed BumberBot keeps them wired.
 BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
                    "rear": "I5", "light_right": "I7", "light_left": "I8"}
 Named = tuple[str, str]  # (name, label; "" keeps the template's label)

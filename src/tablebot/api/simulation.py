@@ -18,9 +18,9 @@ if TYPE_CHECKING:
 
     from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
-    from tablebot.sim.painter import Painter
+    from tablebot.sim.pictures.painter import Painter
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
     from tablebot.sim.summary import Summary
     from tablebot.sinks.trace_file import TraceFile
 
@@ -106,7 +106,7 @@ def simulate(project: Loaded, seconds: float = 120.0, seed: int = 1, *, world: P
 
 
 def _painter() -> Painter:
-    from tablebot.sim.painter import Painter
+    from tablebot.sim.pictures.painter import Painter
 
     return Painter()
 
@@ -154,9 +154,9 @@ def _run(scene: Scene, seconds: float, seed: int, progress: Progress, sinks: lis
          **kept: Any) -> SimRun:
     """The run, telling ``progress`` the ticks done after each block (a first run compiles the simulator
     before its first tick: ``progress.compiling`` is told first)."""
-    from tablebot.sim.kernel import run_robot
+    from tablebot.sim.physics.kernel import run_robot
     from tablebot.sim.runner import simulate, ticks_for
-    from tablebot.sim.several import run_several
+    from tablebot.sim.physics.several import run_several
 
     progress.compiling("the simulator", run_robot if scene.tables is None else run_several)
     progress.start("ticks", ticks_for(scene, seconds))
@@ -273,7 +273,7 @@ def _import_drawing(gif: bool, html: bool) -> _Imports:
 
 # Plain import statements (not module names as strings), so that import-linter sees these imports too.
 def _load_animate() -> None:
-    import tablebot.sim.animate  # noqa: F401
+    import tablebot.sim.pictures.animate  # noqa: F401
 
 
 def _load_replay() -> None:
@@ -285,7 +285,7 @@ def _pictures(result: SimRun, summary: Summary, out: Path, painter: Painter | No
     animation."""
     written = painter.draw(result, summary, out) if painter is not None else []
     if gif:
-        from tablebot.sim.animate import write_gif
+        from tablebot.sim.pictures.animate import write_gif
         written.append(write_gif(result, summary, out / "run.gif"))
     return written
 

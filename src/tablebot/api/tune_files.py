@@ -67,9 +67,9 @@ def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
 
 
 def convergence(evaluate: Evaluator, method: str, path: Path) -> Path:
-    """The convergence picture, its text drawn as written (see tablebot.sim.draw.literal_text)."""
-    from tablebot.sim.draw import literal_text
-    from tablebot.sim.plots import save
+    """The convergence picture, its text drawn as written (see tablebot.sim.pictures.draw.literal_text)."""
+    from tablebot.sim.pictures.draw import literal_text
+    from tablebot.sim.pictures.plots import save
 
     with literal_text():
         return save(convergence_figure(evaluate, method), path)

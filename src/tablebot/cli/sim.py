@@ -44,7 +44,7 @@ def sim_cmd(
     from tablebot.cli.progress import TickBar
 
     if view:
-        from tablebot.sim.animate import check_display
+        from tablebot.sim.pictures.animate import check_display
         check_display()
     project = open_project(table, robot)
     bar = TickBar(quiet)
@@ -58,7 +58,7 @@ def sim_cmd(
     if not quiet:
         _report(run)
     if view:
-        from tablebot.sim.animate import show
+        from tablebot.sim.pictures.animate import show
         assert run.summary is not None
         show(run.run, run.summary)
 

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from tablebot.fleet.robots import RobotSpec
     from tablebot.fleet.run import Fleet
     from tablebot.machine import Machine
-    from tablebot.sim.world import World
+    from tablebot.sim.model.world import World
 
 STRIDE = 20  # ticks between pose samples (0.2 s at 10 ms: a robot moves at most 6 cm)
 CELL_M = 0.10  # floor squares for area_covered
@@ -98,7 +98,7 @@ class Poses:
     """What the robots' sampled poses add up to: laps round the loop, floor squares visited, contact."""
 
     def __init__(self, fleet: Fleet, world: World) -> None:
-        from tablebot.sim.track import loop_of
+        from tablebot.sim.model.track import loop_of
 
         self.fleet, self.n = fleet, len(fleet)
         self.loop = loop_of(world)
@@ -126,7 +126,7 @@ class Poses:
         iy = np.minimum(np.maximum(((y - self.origin[1]) / CELL_M).astype(np.int64), 0), self.ny - 1)
         self.visited[np.arange(self.n), ix * self.ny + iy] = True
         if self.loop is not None:
-            from tablebot.sim.track import arc_positions
+            from tablebot.sim.model.track import arc_positions
 
             arc = arc_positions(self.loop, x, y)
             if self.arc is not None:  # crossing the loop's start is a small step, not a lap

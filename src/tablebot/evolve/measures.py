@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 from tablebot.diagnostics import fail
 from tablebot.i18n import N_
-from tablebot.sim.track import loop_of
-from tablebot.sim.world import World
+from tablebot.sim.model.track import loop_of
+from tablebot.sim.model.world import World
 
 RANGE_RE = re.compile(r"^\s*([\w:.-]+?)\s*(?:=\s*(-?[\d.]+)\s*\.\.\s*(-?[\d.]+))?\s*$")
 STATE_SHARE = "state_share:"

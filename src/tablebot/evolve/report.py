@@ -176,7 +176,7 @@ def sweep_command(path: Path, label: str, replay: Replay) -> str:
 
 def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
              start: tuple[float, ...] | None, path: Path, start_label: str | None = None) -> Path:
-    from tablebot.sim.draw import literal_text
+    from tablebot.sim.pictures.draw import literal_text
 
     with literal_text():
         return _heat_map(archive, descriptors, objective, history, start, path,
@@ -190,7 +190,7 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from tablebot.sim.plots import save
+    from tablebot.sim.pictures.plots import save
 
     data = archive.data(["objective", "index"])  # type: ignore[attr-defined]
     cells = archive.int_to_grid_index(data["index"]) if len(data["index"]) else np.zeros((0, len(descriptors)))  # type: ignore[attr-defined]

@@ -25,11 +25,11 @@ except ImportError as exc:  # pragma: no cover - gymnasium is an extra
     raise ImportError("tablebot.fleet.env needs Gymnasium: pip install 'tablebot[research]'") from exc
 
 from tablebot.loop import exchange
-from tablebot.sim.observation import BUILT_IN
+from tablebot.sim.model.observation import BUILT_IN
 
 ENV_ID = "tablebot/TableBot-v0"
 #: The observation vector's first part, in order; every declared sensor's reading follows (the names of a
-#: robot's whole vector: ``env.observation_names``; see :class:`tablebot.sim.observation.Observation`).
+#: robot's whole vector: ``env.observation_names``; see :class:`tablebot.sim.model.observation.Observation`).
 OBSERVATION = tuple(name for name, _ in BUILT_IN)
 
 
@@ -42,9 +42,9 @@ class Setup:
         from tablebot.formats.table_read import load_table, resolve_table_path
         from tablebot.machine import compile_table
         from tablebot.robot import load_robot
-        from tablebot.sim.observation import Observation
+        from tablebot.sim.model.observation import Observation
         from tablebot.sim.runner import ticks_for
-        from tablebot.sim.scene import find_world, prepare, robot_layer
+        from tablebot.sim.model.scene import find_world, prepare, robot_layer
 
         path = resolve_table_path(Path(table) if table else example_path("bumberbot"))
         self.table = load_table(path, load_robot(robot) if robot else None)

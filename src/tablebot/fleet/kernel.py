@@ -1,10 +1,10 @@
-"""The fleet's compiled loop: ``prange`` over robots, each advanced by :func:`tablebot.sim.kernel.run_robot`
+"""The fleet's compiled loop: ``prange`` over robots, each advanced by :func:`tablebot.sim.physics.kernel.run_robot`
 (the very loop ``tablebot sim`` runs) on its own rows, then folded into per-robot summary counters.
 """
 
 # Nothing here simulates anything itself: the tick rule, the physics, the collision/lamp accumulators and
-# the tally of each tick (time per state, first visit of each state, first light: sim.kernel.tally, so no
-# tick needs to be kept) are those of sim.kernel. What the fleet adds is the loop over robots and the
+# the tally of each tick (time per state, first visit of each state, first light: sim.physics.kernel.tally, so no
+# tick needs to be kept) are those of sim.physics.kernel. What the fleet adds is the loop over robots and the
 # per-robot program (a tuned table's timers and counter loads).
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
-from tablebot.sim.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
-from tablebot.sim.kernel import move, run_robot
-from tablebot.sim.several import SeveralProgram, SeveralState, run_several
-from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants, Record, RobotState, Wiring, WorldArrays
+from tablebot.sim.physics.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
+from tablebot.sim.physics.kernel import move, run_robot
+from tablebot.sim.physics.several import SeveralProgram, SeveralState, run_several
+from tablebot.sim.physics.structures import FleetRecord, FleetState, ProgramVariants, Record, RobotState, Wiring, WorldArrays
 from tablebot.tick import Program
 
 
@@ -44,7 +44,7 @@ def run_fleet(fleet: FleetState, world: WorldArrays, program: Program, variants:
               ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
     """Advance every robot ``ticks`` ticks: robot i runs ``run_robot`` on row i of each of the fleet's arrays,
     with its program variant's timers and counter loads (``variants.variant[i]``), its noise rows ``noise[i]``
-    or, when they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.normals).
+    or, when they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.physics.normals).
 
     ``record.traced[i]`` >= 0 names the slot of ``record.hist``/``record.ints`` where robot i's robot rows and
     tick records are kept (for its trace); other robots record into scratch space that is folded and dropped.
@@ -65,7 +65,7 @@ def run_fleet_serial(fleet: FleetState, world: WorldArrays, program: Program, va
 def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: SeveralProgram, tables: SeveralState,
                     wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
                     kept_tables: np.ndarray) -> None:
-    """Robot i of :func:`run_fleet_several`: sim.several.run_several on its rows (``tables``: every table's
+    """Robot i of :func:`run_fleet_several`: sim.physics.several.run_several on its rows (``tables``: every table's
     registers, outputs and counters, a row per robot; ``kept_tables``: each traced robot's tables per tick)."""
     slot = record.traced[i]
     if slot >= 0:
@@ -128,6 +128,6 @@ def parallel(robots: int, ticks: int) -> bool:
 def move_fleet(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
                bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """One tick of physics for every robot with the motor levels ``commands[i]`` (right, left) given
-    from outside (a learned controller): ``sim.kernel.move`` on each robot's rows."""
+    from outside (a learned controller): ``sim.physics.kernel.move`` on each robot's rows."""
     kernel = move_parallel if parallel(S.shape[0], 1) else move_serial
     kernel(S, P, world, commands, noise, bits, acc, collisions)

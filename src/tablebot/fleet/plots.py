@@ -19,8 +19,8 @@ from matplotlib.figure import Figure
 from tablebot.escape import picture
 from tablebot.fleet.plan import Plan, groups
 from tablebot.i18n import _
-from tablebot.sim.draw import REACHED, draw_world, literal_text
-from tablebot.sim.plots import save, trajectory
+from tablebot.sim.pictures.draw import REACHED, draw_world, literal_text
+from tablebot.sim.pictures.plots import save, trajectory
 from tablebot.sim.summary import summarise
 
 NEVER = "#b2bec3"

@@ -11,7 +11,7 @@ import numpy as np
 from tablebot.loop import RunEnd, TickBlock
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
-from tablebot.sim import kernel as K
+from tablebot.sim.physics import kernel as K
 from tablebot.sim.runner import PATH_STRIDE, SimRun
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.summary import Summary

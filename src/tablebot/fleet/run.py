@@ -3,7 +3,7 @@ start is :mod:`tablebot.fleet.starts`, what their run amounts to :mod:`tablebot.
 
 Each robot is set up by :class:`~tablebot.sim.simrobot.SimRobot` itself (start row, gains, first reading,
 its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does (inside the
-compiled loop, sim.normals), so robot k of a fleet gives the trace ``tablebot sim`` gives for the same
+compiled loop, sim.physics.normals), so robot k of a fleet gives the trace ``tablebot sim`` gives for the same
 table, world, start, battery and seed.
 """
 
@@ -30,16 +30,16 @@ from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.fleet.starts import Prepared, Starts, with_start
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
-from tablebot.sim import kernel as K
-from tablebot.sim.normals import bitgen_address
-from tablebot.sim.observation import Observation
+from tablebot.sim.physics import kernel as K
+from tablebot.sim.physics.normals import bitgen_address
+from tablebot.sim.model.observation import Observation
 from tablebot.sim.runner import SimRun
-from tablebot.sim.scene import Scene
-from tablebot.sim.several import N_K, SeveralState, several_program, table_columns
+from tablebot.sim.model.scene import Scene
+from tablebot.sim.physics.several import N_K, SeveralState, several_program, table_columns
 from tablebot.sim.simrobot import Joined, SimRobot, wiring_of, world_arrays
-from tablebot.sim.structures import FleetRecord, FleetState, ProgramVariants
+from tablebot.sim.physics.structures import FleetRecord, FleetState, ProgramVariants
 from tablebot.sim.summary import light_bits
-from tablebot.sim.world import World
+from tablebot.sim.model.world import World
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 from tablebot.tick import STATE, registers
@@ -91,7 +91,7 @@ class Fleet:
         self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
-        self.bitgens = np.zeros(n, dtype=np.uint64)  # each robot's Generator's handle (sim.normals.bitgen_address)
+        self.bitgens = np.zeros(n, dtype=np.uint64)  # each robot's Generator's handle (sim.physics.normals.bitgen_address)
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
@@ -115,7 +115,7 @@ class Fleet:
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
 
     def _setup_tables(self, n: int, n_out: int, n_c: int) -> None:
-        """A robot of several tables: every table's rows per robot (sim.several), each as a fresh Engine's."""
+        """A robot of several tables: every table's rows per robot (sim.physics.several), each as a fresh Engine's."""
         if self.tables is None:
             return
         machines = self.tables.machines
@@ -249,7 +249,7 @@ class Fleet:
         return self.acc[:, K.A_REACHED] >= 0
 
     def observations(self) -> np.ndarray:
-        """What a learning agent sees of every robot now, a row each (:class:`~tablebot.sim.observation.Observation`
+        """What a learning agent sees of every robot now, a row each (:class:`~tablebot.sim.model.observation.Observation`
         of the fleet's scene)."""
         if self._observation is None:
             self._observation = Observation.of(self.scenes[0])

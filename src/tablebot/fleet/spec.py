@@ -23,8 +23,8 @@ from tablebot.diagnostics import fail
 from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.fleet.robots import Pose
 from tablebot.i18n import N_
-from tablebot.sim.params import DEFAULTS
-from tablebot.sim.world import inside
+from tablebot.sim.model.params import DEFAULTS
+from tablebot.sim.model.world import inside
 
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000

@@ -10,9 +10,9 @@ from typing import Any
 from tablebot.diagnostics import fail
 from tablebot.fleet.robots import Pose, RobotSpec
 from tablebot.machine import Machine
-from tablebot.sim.scene import Scene, check_start, prepare
+from tablebot.sim.model.scene import Scene, check_start, prepare
 from tablebot.sim.simrobot import Starter
-from tablebot.sim.world import World, inside
+from tablebot.sim.model.world import World, inside
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 
@@ -20,7 +20,7 @@ from tablebot.tables import RobotTables
 @dataclass
 class Prepared:
     """What fleets of one table in one world with one robot layer share, by parameter set: the scene
-    (:func:`~tablebot.sim.scene.prepare`: the world's pieces and shadow grid, milliseconds each) and how its
+    (:func:`~tablebot.sim.model.scene.prepare`: the world's pieces and shadow grid, milliseconds each) and how its
     robots start. A sweep's chunks in one process share one instead of preparing them again per chunk
     (:func:`tablebot.fleet.work.shared`); scenes and starters are only read once made."""
 

@@ -22,11 +22,11 @@ if TYPE_CHECKING:
     from tablebot.fleet.results import FleetSummary
     from tablebot.fleet.starts import Prepared
     from tablebot.machine import Machine
-    from tablebot.sim.world import World
+    from tablebot.sim.model.world import World
     from tablebot.table import Table
     from tablebot.tables import RobotTables
 
-COMPILED = ("tablebot.sim.physics", "tablebot.sim.kernel", "tablebot.engine_batch")
+COMPILED = ("tablebot.sim.physics.step", "tablebot.sim.physics.kernel", "tablebot.engine_batch")
 CALL_ROBOT_TICKS = 256_000  # robot-ticks per compiled call of a chunk (~0.1 s of one core)
 MAX_BLOCK_TICKS = 4096  # each robot records this many ticks in scratch space per call (32 B a tick and column)
 _worker_threads: int | None = None  # set by ready_worker: this worker's share of its machine's cores
@@ -232,7 +232,7 @@ def chunk_functions(threads: int | None) -> tuple[Any, ...]:
     loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
     calling thread)."""
     from tablebot.fleet.kernel import run_fleet, run_fleet_serial
-    from tablebot.sim import contacts, kernel
+    from tablebot.sim.physics import contacts, kernel
 
     loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
     return (contacts.body_corners, contacts.deepest_contact, kernel.first_readings, *loops)

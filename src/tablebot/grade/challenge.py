@@ -130,7 +130,7 @@ def _seeds(src: Source, value: Any) -> str:
 def _score(src: Source, name: Any, worlds: tuple[Path, ...]) -> tuple[str, str]:
     """The measure that scores a run (evolve's list), measurable in every world of the challenge."""
     from tablebot.evolve.measures import MEASURES, allowed
-    from tablebot.sim.world import load_world
+    from tablebot.sim.model.world import load_world
 
     usable = [n for n in allowed([load_world(w) for w in worlds]) if MEASURES[n].objective]
     if name not in usable:

@@ -18,7 +18,7 @@ from tablebot.formats.inputs_csv import TickInput
 from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
 from tablebot.loop import run as run_loop
 from tablebot.sim import columns as L
-from tablebot.sim.scene import Scene
+from tablebot.sim.model.scene import Scene
 from tablebot.sim.simrobot import SimRobot
 from tablebot.sinks.trace_file import block_lines
 

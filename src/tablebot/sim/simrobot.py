@@ -15,13 +15,13 @@ from tablebot.engine.as_one import RobotEngine
 from tablebot.formats.trace_lines import exact_round_array
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
-from tablebot.sim import kernel as K
-from tablebot.sim import several as S
-from tablebot.sim.normals import bitgen_address
-from tablebot.sim.observation import Observation
-from tablebot.sim.params import terminal_volts
-from tablebot.sim.scene import Scene, sensor_columns
-from tablebot.sim.structures import RobotState, Wiring, WorldArrays, untallied
+from tablebot.sim.physics import kernel as K
+from tablebot.sim.physics import several as S
+from tablebot.sim.physics.normals import bitgen_address
+from tablebot.sim.model.observation import Observation
+from tablebot.sim.model.params import terminal_volts
+from tablebot.sim.model.scene import Scene, sensor_columns
+from tablebot.sim.physics.structures import RobotState, Wiring, WorldArrays, untallied
 from tablebot.tick import registers
 
 DEBOUNCE_S = 0.2  # touches closer together than this are one collision (a head-on hit closes two switches)
@@ -112,7 +112,7 @@ class SimRobot:
         return self.block(start, ints, hist, n_out, n_c)
 
     def _advance_several(self, engine: RobotEngine, ticks: int) -> TickBlock:
-        """:meth:`advance` for a robot of several tables (:mod:`tablebot.sim.several`); the block's extra
+        """:meth:`advance` for a robot of several tables (:mod:`tablebot.sim.physics.several`); the block's extra
         fields hold the other tables' keys after the robot's."""
         program, state = S.several_program(engine.tables), S.several_state(engine)
         outputs = np.array(engine.outputs, dtype=np.int64)
@@ -130,7 +130,7 @@ class SimRobot:
         return block
 
     def block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
-        """The ticks from ``start`` that a compiled loop recorded (``ints``: sim.kernel's I_* records of ``n_out``
+        """The ticks from ``start`` that a compiled loop recorded (``ints``: sim.physics.kernel's I_* records of ``n_out``
         outputs and ``n_c`` counters; ``hist``: the robot's rows, or none) as the run loop's TickBlock."""
         o, c = K.I_OUTPUTS, K.I_OUTPUTS + n_out  # outputs, then counters, then pulses
         block = TickBlock(start, ints[:, K.I_MASK], ints[:, c + n_c:], ints[:, K.I_EVENT], ints[:, K.I_ROW],
@@ -170,7 +170,7 @@ class SimRobot:
         return None if row < 0 else row
 
     def observation(self) -> np.ndarray:
-        """What a learning agent sees of the robot now (:class:`tablebot.sim.observation.Observation`)."""
+        """What a learning agent sees of the robot now (:class:`tablebot.sim.model.observation.Observation`)."""
         if self._observation is None:
             self._observation = Observation.of(self.scene)
         return self._observation(self.s[None, :])[0]

@@ -1,7 +1,7 @@
 """What a run amounts to: first light seen, lamp reached, laps of a track, collisions, distance, time per state.
 
 Computed from a :class:`~tablebot.sim.runner.SimRun`, so the CLI, the plots and the tests agree on one
-set of numbers; collisions and the lamp are counted by the simulated robot as it runs (sim.kernel.observe).
+set of numbers; collisions and the lamp are counted by the simulated robot as it runs (sim.physics.kernel.observe).
 """
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ import numpy as np
 from tablebot.i18n import _
 from tablebot.robot import StateId
 from tablebot.sim import columns as L
-from tablebot.sim.track import laps
+from tablebot.sim.model.track import laps
 from tablebot.sinks.run_trace import seconds_per_state
 
 if TYPE_CHECKING:  # only types: time per state is wanted beside a real robot's run, without the simulator
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
 
 
 @dataclass(frozen=True)

@@ -78,7 +78,7 @@ def _sim_lines(machine: Machine, run: Any) -> Run:
 def _busy_world(seed: int) -> Any:
     """The first of the seed's busy rooms the simulator accepts."""
     from tablebot.diagnostics import TableBotError
-    from tablebot.sim.world import parse_world
+    from tablebot.sim.model.world import parse_world
     from tablebot.tomlfile import Source
 
     rng = random.Random(seed)
@@ -91,7 +91,7 @@ def _busy_world(seed: int) -> Any:
 
 def _world_and_layer(case: Case) -> tuple[Any, dict[str, Any] | None]:
     """Where a simulated executor runs the case: its robot's own world and [sim], or a busy random room."""
-    from tablebot.sim.scene import find_world, robot_layer
+    from tablebot.sim.model.scene import find_world, robot_layer
 
     table = case.machine.table
     if case.own_world:
@@ -107,7 +107,7 @@ SIM_TICKS = 1500
 def _simulator(case: Case, workdir: Path) -> Run:
     """``tablebot sim``'s path: the run loop handing blocks to ``SimRobot.advance`` (the compiled kernel)."""
     from tablebot.sim.runner import simulate
-    from tablebot.sim.scene import prepare
+    from tablebot.sim.model.scene import prepare
 
     world, layer = _world_and_layer(case)
     scene = prepare(case.machine.table, case.machine, world, layer)
@@ -133,7 +133,7 @@ def example_case(name: str, seconds: float = 20.0, seed: int = 1) -> Case:
     from tablebot.examples import example_path
     from tablebot.formats.table_read import load_table, resolve_table_path
     from tablebot.sim.runner import simulate
-    from tablebot.sim.scene import scene_for
+    from tablebot.sim.model.scene import scene_for
 
     table = load_table(resolve_table_path(example_path(name)))
     machine = compile_table(table)
@@ -346,7 +346,7 @@ def register_all() -> None:
         Executor("engine batch", _engine_run, fits=lambda m: m.arrays is not None,
                  what="Engine.run: tick.tick compiled by numba over recorded masks"),
         Executor("simulator", _simulator, fits=_sim_fits,
-                 what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.kernel, compiled)"),
+                 what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.physics.kernel, compiled)"),
         Executor("fleet", _fleet, fits=_sim_fits, what="a robot of a fleet (fleet.kernel.run_fleet, compiled)"),
         Executor("host C", _host_c, missing=_no_compiler, several=_host_c_several,
                  what="the generated C engine compiled for this computer (codegen.host)"),

@@ -13,8 +13,8 @@ from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 from tablebot.sim import columns as L
 from tablebot.sim.runner import simulate
-from tablebot.sim.scene import prepare, robot_layer
-from tablebot.sim.world import World, parse_world
+from tablebot.sim.model.scene import prepare, robot_layer
+from tablebot.sim.model.world import World, parse_world
 from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.

@@ -20,7 +20,7 @@ from typing import Any
 from tablebot.engine import Engine
 from tablebot.loop import Reading, RunEnd, RunInfo, Sink, TickBlock, run
 from tablebot.sim import columns as L
-from tablebot.sim.scene import Scene
+from tablebot.sim.model.scene import Scene
 from tablebot.sim.simrobot import SimRobot, light_keys
 from tablebot.web.errors import INTERNAL, log
 

@@ -19,8 +19,8 @@ from tablebot.files import write_text
 from tablebot.formats.csv_document import CsvDocument
 from tablebot.formats.table_write import format_table
 from tablebot.machine import compile_table
-from tablebot.sim.params import Params
-from tablebot.sim.world import World
+from tablebot.sim.model.params import Params
+from tablebot.sim.model.world import World
 from tablebot.table import Table
 from tablebot.web.analyse import columns_of, machine_json
 from tablebot.web.bundle import bundle
@@ -88,7 +88,7 @@ def write_html(path: str | Path, lines: Iterable[Mapping[str, Any] | str], world
     JSON text lines of a trace.jsonl), ``world`` and ``table`` what it ran in and on, ``params`` the
     simulator's parameters (for the robot's outline; the default body when None)."""
     if params is None:
-        from tablebot.sim.params import merged
+        from tablebot.sim.model.params import merged
 
         params = merged(world.params)
     return write_text(path, render_html(replay_data(lines, world, table, params, title)))

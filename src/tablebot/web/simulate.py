@@ -13,9 +13,9 @@ from tablebot.analysis.graphviz_run import INSTALL, NOT_FOUND, GraphvizFailed, N
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.loading import Loaded
 from tablebot.machine import Machine
-from tablebot.sim.scene import Scene
+from tablebot.sim.model.scene import Scene
 from tablebot.sim.simrobot import SimRobot
-from tablebot.sim.world import World
+from tablebot.sim.model.world import World
 from tablebot.table import Table
 from tablebot.web.errors import Refused
 from tablebot.web.live import SPEEDS, LiveRun

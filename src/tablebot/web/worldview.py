@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from tablebot.sim.params import Params
-from tablebot.sim.world import World
+from tablebot.sim.model.params import Params
+from tablebot.sim.model.world import World
 
 
 def world_json(world: World, params: Params | None = None) -> dict[str, Any]:

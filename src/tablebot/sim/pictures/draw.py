@@ -22,8 +22,8 @@ from matplotlib.patches import Polygon, Rectangle, Wedge
 
 from tablebot.sensors import Sensor
 from tablebot.sim import columns as L
-from tablebot.sim.params import Params
-from tablebot.sim.world import Geometry, World
+from tablebot.sim.model.params import Params
+from tablebot.sim.model.world import Geometry, World
 
 
 #: Every picture is drawn inside this: user text (a robot's name, a state's, a label) is drawn as written.

@@ -206,7 +206,7 @@ def _formulas() -> tuple[Callable[..., float], Callable[..., float]]:
     (tens of ms in a fresh process). Compiled without fast-math, the same arithmetic gives the same bits
     in Python (tests/test_sim_params_formulas.py).
     """
-    from tablebot.sim.physics import duty, pack_volts  # numba is imported, never run, for these
+    from tablebot.sim.physics.step import duty, pack_volts  # numba is imported, never run, for these
 
     return duty.py_func, pack_volts.py_func
 

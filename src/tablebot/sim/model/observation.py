@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tablebot.sim import columns as L
-from tablebot.sim.scene import Scene
+from tablebot.sim.model.scene import Scene
 
 #: The robot's own part of every observation, in order, and the state column each is read from.
 BUILT_IN = (("x", L.X), ("y", L.Y), ("cos_heading", L.TH), ("sin_heading", L.TH), ("light_right", L.LIGHT_R),

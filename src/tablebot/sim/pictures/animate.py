@@ -24,8 +24,8 @@ from tablebot.escape import picture
 from tablebot.files import atomic_write
 from tablebot.i18n import N_, _
 from tablebot.sim import columns as L
-from tablebot.sim.draw import RobotArtist, draw_world, literal_text, sensor_readings
-from tablebot.sim.plots import subtitle_of, title_of
+from tablebot.sim.pictures.draw import RobotArtist, draw_world, literal_text, sensor_readings
+from tablebot.sim.pictures.plots import subtitle_of, title_of
 from tablebot.sim.runner import SimRun
 from tablebot.sim.summary import Summary
 

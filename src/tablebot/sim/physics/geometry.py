@@ -2,7 +2,7 @@
 segments, segment crossings, and whether anything blocks a straight line of sight.
 """
 
-# World arrays as in tablebot.sim.physics: ``edges`` (E, 4) = x0, y0, x1, y1 of every wall and obstacle
+# World arrays as in tablebot.sim.physics.step: ``edges`` (E, 4) = x0, y0, x1, y1 of every wall and obstacle
 # edge, ``circles`` (C, 4) = x, y, r, lamp index or -1.
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """A run as its pictures see it: the scene's plain parts and the run's arrays they draw, with no tie to the
-simulator (numba) or to matplotlib, so that a painter process can have it (:mod:`tablebot.sim.painter`)."""
+simulator (numba) or to matplotlib, so that a painter process can have it (:mod:`tablebot.sim.pictures.painter`)."""
 
 from __future__ import annotations
 
@@ -12,16 +12,16 @@ if TYPE_CHECKING:  # only types: see the module
     import numpy as np
 
     from tablebot.machine import Machine
-    from tablebot.sim.params import Params
+    from tablebot.sim.model.params import Params
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.scene import Scene
-    from tablebot.sim.world import Geometry, World
+    from tablebot.sim.model.scene import Scene
+    from tablebot.sim.model.world import Geometry, World
     from tablebot.table import Table
 
 
 @dataclass(frozen=True)
 class SceneView:
-    """The parts of a :class:`~tablebot.sim.scene.Scene` the pictures draw."""
+    """The parts of a :class:`~tablebot.sim.model.scene.Scene` the pictures draw."""
 
     table: Table
     machine: Machine

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tablebot.sim.world import Line, World
+from tablebot.sim.model.world import Line, World
 
 
 def loop_of(world: World) -> Line | None:

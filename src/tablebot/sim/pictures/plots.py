@@ -1,5 +1,5 @@
 """The run's pictures: ``trajectory.png`` (the path in the arena, coloured by state, drawn here) and
-``timeline.png`` (:mod:`tablebot.sim.timeline`), and the two drawn at once by a painter (:class:`Painting`).
+``timeline.png`` (:mod:`tablebot.sim.pictures.timeline`), and the two drawn at once by a painter (:class:`Painting`).
 
 Figures are drawn with the Agg canvas directly, never through pyplot, so they need no display.
 """
@@ -20,7 +20,7 @@ from tablebot.colours import state_colours
 from tablebot.escape import picture
 from tablebot.i18n import _
 from tablebot.sim import columns as L
-from tablebot.sim.draw import (
+from tablebot.sim.pictures.draw import (
     BEAM,
     COLLISION,
     LAMP_ON,
@@ -35,8 +35,8 @@ from tablebot.sim.draw import (
     literal_text,
     sensor_readings,
 )
-from tablebot.sim.forked import Forked
-from tablebot.sim.picture import (  # noqa: F401 (title_of: other modules import it from here)
+from tablebot.sim.pictures.forked import Forked
+from tablebot.sim.pictures.picture import (  # noqa: F401 (title_of: other modules import it from here)
     DPI,
     declared_kinds,
     encoded,
@@ -47,18 +47,18 @@ from tablebot.sim.picture import (  # noqa: F401 (title_of: other modules import
     title_of,
 )
 from tablebot.sim.summary import Summary
-from tablebot.sim.timeline import (  # noqa: F401 (the timeline's public functions, imported from here too)
+from tablebot.sim.pictures.timeline import (  # noqa: F401 (the timeline's public functions, imported from here too)
     TimelinePicture,
     reading_panels,
     timeline_figure,
 )
-from tablebot.sim.view import RunView, SceneView
+from tablebot.sim.pictures.view import RunView, SceneView
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
     from matplotlib.axes import Axes
 
-    from tablebot.sim.picture import Run
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.pictures.picture import Run
+    from tablebot.sim.model.scene import Scene
 
 PATH_Z = 4  # the path's z-order: everything the arena draws is below it
 PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels
@@ -158,10 +158,10 @@ class TrajectoryPicture:
 
 
 class Painting:
-    """Both pictures as the painter (:mod:`tablebot.sim.painter`) draws them: what the scene fixes at once
+    """Both pictures as the painter (:mod:`tablebot.sim.pictures.painter`) draws them: what the scene fixes at once
     (the arena drawn, the timeline's panels made), the path as the run goes (:meth:`grow`), the rest when
     it is over (:meth:`finish`: the timeline by a fork of this process on the other core,
-    :mod:`tablebot.sim.forked`)."""
+    :mod:`tablebot.sim.pictures.forked`)."""
 
     def __init__(self, scene: SceneView, ticks: int, seed: int) -> None:
         with literal_text():  # the timeline first: when the run ends early, its fork can start at once

@@ -8,7 +8,7 @@ for many robots, so robot k of a fleet and a single simulated robot cannot diffe
 # sensors read); the engine ticks on that mask and those pulses; the motors then run for one tick
 # (physics.advance) and the sensors read again for tick t + 1. Every random number comes from the robot's
 # own numpy Generator: given as ``noise`` rows, or drawn here from that Generator's C bit generator
-# (sim.normals, the same numbers numpy's standard_normal gives), one row of N_NOISE a tick either way.
+# (sim.physics.normals, the same numbers numpy's standard_normal gives), one row of N_NOISE a tick either way.
 
 from __future__ import annotations
 
@@ -17,11 +17,11 @@ import numpy as np
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
 from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
-from tablebot.sim.contacts import new_near, reaches
-from tablebot.sim.geometry import within
-from tablebot.sim.normals import standard_normal
-from tablebot.sim.physics import advance, advance_called, aim_turns
-from tablebot.sim.structures import Record, RobotState, Scratch, Wiring, WorldArrays
+from tablebot.sim.physics.contacts import new_near, reaches
+from tablebot.sim.physics.geometry import within
+from tablebot.sim.physics.normals import standard_normal
+from tablebot.sim.physics.step import advance, advance_called, aim_turns
+from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tick import EVENT, ROW, STATE, TIMER, Program
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -87,7 +87,7 @@ def tally(counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, 
 def run_robot(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
               noise: np.ndarray, bitgen: np.uint64, record: Record) -> None:
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
-    rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.normals.bitgen_address).
+    rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.physics.normals.bitgen_address).
 
     Writes the robot at the start of each tick into ``record.hist`` (when it has rows) and each tick's
     integer record into ``record.ints`` (when it has rows), folds every new robot row into the robot's

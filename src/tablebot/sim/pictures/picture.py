@@ -24,9 +24,9 @@ if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
     from tablebot.sim.summary import Summary
-    from tablebot.sim.view import RunView, SceneView
+    from tablebot.sim.pictures.view import RunView, SceneView
 
     Run: TypeAlias = SimRun | RunView  # declared: mypy may take a union of classes not yet seen for a value
 

@@ -18,8 +18,8 @@ from tablebot.engine.as_one import robot_machine
 from tablebot.machine import FLAT_BITS, Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
-from tablebot.sim.contacts import body_corners, deepest_contact
-from tablebot.sim.params import (
+from tablebot.sim.physics.contacts import body_corners, deepest_contact
+from tablebot.sim.model.params import (
     INPUT_ROLES,
     Params,
     merged,
@@ -27,7 +27,7 @@ from tablebot.sim.params import (
     problems,
     top_speed,
 )
-from tablebot.sim.world import Geometry, World, default_world, geometry, load_world
+from tablebot.sim.model.world import Geometry, World, default_world, geometry, load_world
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 

@@ -16,7 +16,7 @@ import numpy as np
 
 
 class WorldArrays(NamedTuple):
-    """A world's geometry as the physics reads it (made by :func:`tablebot.sim.world.geometry`)."""
+    """A world's geometry as the physics reads it (made by :func:`tablebot.sim.model.world.geometry`)."""
 
     verts: np.ndarray  # (V, 2) the vertices of every convex piece (a wall: 2, a box: 4)
     pstart: np.ndarray  # (P+1,) where each piece's vertices start in verts
@@ -25,7 +25,7 @@ class WorldArrays(NamedTuple):
     circles: np.ndarray  # (C, 4) x, y, r, lamp index or -1
     lamps: np.ndarray  # (L, 3) x, y, intensity
     lines: np.ndarray  # (K, 5) tape on the floor: x0, y0, x1, y1, half width
-    shade: np.ndarray  # the shadow grid (sim.shadows)
+    shade: np.ndarray  # the shadow grid (sim.physics.shadows)
 
 
 class Wiring(NamedTuple):
@@ -39,23 +39,23 @@ class Wiring(NamedTuple):
 
 class RobotState(NamedTuple):
     """One robot as a run changes it: its row (pose, battery, sensors: sim.columns), its parameters, its
-    engine (registers, outputs, counters) and the running summary of its rows (see sim.kernel.observe)."""
+    engine (registers, outputs, counters) and the running summary of its rows (see sim.physics.kernel.observe)."""
 
     s: np.ndarray  # float64 (N_STATE,)
     p: np.ndarray  # float64 (N_PARAM,)
     regs: np.ndarray  # int64 (N_REGS,): tablebot.tick's registers
     outputs: np.ndarray  # int64 (outputs,)
     counters: np.ndarray  # int64 (counters,)
-    acc: np.ndarray  # float64 (N_ACC,): sim.kernel's A_* fields
+    acc: np.ndarray  # float64 (N_ACC,): sim.physics.kernel's A_* fields
     collisions: np.ndarray  # int64: the robot rows where collisions began (as many as fit)
 
 
 class Record(NamedTuple):
     """What a run keeps of its ticks: each robot row and integer record (arrays with no rows: none) and the
-    tally of a fleet's robot (``counts`` with no room: none; see sim.kernel.tally)."""
+    tally of a fleet's robot (``counts`` with no room: none; see sim.physics.kernel.tally)."""
 
     hist: np.ndarray  # float64 (ticks or 0, N_STATE): the robot at the start of each tick
-    ints: np.ndarray  # int64 (ticks or 0, width): each tick's integer record (sim.kernel I_*)
+    ints: np.ndarray  # int64 (ticks or 0, width): each tick's integer record (sim.physics.kernel I_*)
     counts: np.ndarray  # int64 (states,): ticks that ended in each state
     first_visit: np.ndarray  # int64 (states,): the first tick that ended in each state
     first_light: np.ndarray  # int64 (1,): the first tick whose input mask held a light bit
@@ -64,8 +64,8 @@ class Record(NamedTuple):
 
 
 class Scratch(NamedTuple):
-    """A robot's working space for a run: worked out once (``reach``, ``wide``, ``turns``: sim.contacts.reaches,
-    sim.physics.aim_turns), kept from tick to tick (``near``, ``centre``: the candidate obstacles), or
+    """A robot's working space for a run: worked out once (``reach``, ``wide``, ``turns``: sim.physics.contacts.reaches,
+    sim.physics.step.aim_turns), kept from tick to tick (``near``, ``centre``: the candidate obstacles), or
     overwritten every tick (``pulses``, ``corners``, ``z``)."""
 
     pulses: np.ndarray  # int64 (counters,)

@@ -19,11 +19,11 @@ from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
 from tablebot.sim.columns import MASK, N_NOISE
-from tablebot.sim.contacts import new_near, reaches
-from tablebot.sim.kernel import _record, observe, tally
-from tablebot.sim.normals import standard_normal
-from tablebot.sim.physics import advance, aim_turns
-from tablebot.sim.structures import Record, RobotState, Scratch, Wiring, WorldArrays
+from tablebot.sim.physics.contacts import new_near, reaches
+from tablebot.sim.physics.kernel import _record, observe, tally
+from tablebot.sim.physics.normals import standard_normal
+from tablebot.sim.physics.step import advance, aim_turns
+from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tables import RobotTables
 from tablebot.tick import EVENT, ROW, STATE, TIMER, registers
 
@@ -121,7 +121,7 @@ def tick_several(sp: SeveralProgram, st: SeveralState, outputs: np.ndarray, mask
 @njit(nogil=True)
 def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: SeveralState, wiring: Wiring,
                 ticks: int, noise: np.ndarray, bitgen: np.uint64, record: Record, tables: np.ndarray) -> None:
-    """:func:`tablebot.sim.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
+    """:func:`tablebot.sim.physics.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
     near, centre = new_near(world.pstart, world.circles)

@@ -1,9 +1,9 @@
 """The robot's body against the world: the broad phase (which pieces may be near), contacts and how the body is
-pushed out of them, and the bumpers' switches. Part of the simulator's physics (:mod:`tablebot.sim.physics`
+pushed out of them, and the bumpers' switches. Part of the simulator's physics (:mod:`tablebot.sim.physics.step`
 calls these each tick), on the same compiled arrays of N robots.
 """
 
-# World geometry: the arrays of tablebot.sim.physics (built by tablebot.sim.world).
+# World geometry: the arrays of tablebot.sim.physics.step (built by tablebot.sim.model.world).
 #
 # No shapely or pymunk: both work object by object from Python, which would not batch over thousands
 # of robots; the few primitives needed (separating axes for convex pieces, segment distances) are short
@@ -33,7 +33,7 @@ from tablebot.sim.columns import (
     X,
     Y,
 )
-from tablebot.sim.geometry import point_segment_within, segments_within, within
+from tablebot.sim.physics.geometry import point_segment_within, segments_within, within
 
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
 TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.geometry import point_segment_within, segments_cross, shadowed
+from tablebot.sim.physics.geometry import point_segment_within, segments_cross, shadowed
 
 CELLS = 48  # cells along the world's longer side (a 2.4 m arena: 5 cm cells)
 HEADER = 5  # shade[0:5] = x0, y0, cells per metre, columns, rows; then per lamp and cell where its list starts
@@ -97,7 +97,7 @@ def _circle_may_block(corners: np.ndarray, lamp: np.ndarray, circle: np.ndarray,
 @njit(cache=True, refcounts=False)
 def shadowed_near(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray, circles: np.ndarray,
                   shade: np.ndarray) -> bool:
-    """:func:`tablebot.sim.geometry.shadowed`'s answer, testing only the pieces the grid ``shade`` lists for
+    """:func:`tablebot.sim.physics.geometry.shadowed`'s answer, testing only the pieces the grid ``shade`` lists for
     the sensor's cell (every piece when there is no grid or the sensor is outside it)."""
     if shade.shape[0] == 0:
         return shadowed(sx, sy, lx, ly, lamp, edges, circles)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from tablebot.i18n import N_
-from tablebot.sim.params import SECTIONS, check_layer
+from tablebot.sim.model.params import SECTIONS, check_layer
 from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
@@ -95,7 +95,7 @@ class World:
 
 @dataclass(frozen=True)
 class Geometry:
-    """A world as the physics core's arrays (see :mod:`tablebot.sim.physics`)."""
+    """A world as the physics core's arrays (see :mod:`tablebot.sim.physics.step`)."""
 
     verts: np.ndarray
     pstart: np.ndarray
@@ -104,7 +104,7 @@ class Geometry:
     circles: np.ndarray
     lamps: np.ndarray
     lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))  # (K, 5): x0, y0, x1, y1, half width
-    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # which pieces may shadow a lamp (sim.shadows)
+    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # which pieces may shadow a lamp (sim.physics.shadows)
 
 
 DEFAULT_WORLD = """\
@@ -387,7 +387,7 @@ def geometry(world: World) -> Geometry:
                 for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
     lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
     lines = [(a[0], a[1], b[0], b[1], line.width / 2) for line in world.lines for a, b in line.segments()]
-    from tablebot.sim.shadows import shade_grid  # compiled code: loaded only when a world is packed for it
+    from tablebot.sim.physics.shadows import shade_grid  # compiled code: loaded only when a world is packed for it
 
     edge_array = np.array(edges, dtype=np.float64).reshape(-1, 4)
     circle_array = np.array(circles, dtype=np.float64).reshape(-1, 4)

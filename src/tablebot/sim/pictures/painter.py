@@ -6,7 +6,7 @@ it knows the scene, the path as the robot drives it, and the rest of both pictur
 The run's columns the pictures draw are kept in memory this process maps before the fork and shares with
 the painter (:class:`Shared`): nothing is copied to it; it is told, block by block, how far the run is.
 This module imports neither matplotlib nor the simulator, nor even numpy, so that the painter is forked
-as early as can be; the drawing itself is :class:`tablebot.sim.plots.Painting`.
+as early as can be; the drawing itself is :class:`tablebot.sim.pictures.plots.Painting`.
 """
 
 from __future__ import annotations
@@ -22,15 +22,15 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.files import atomic_write
 from tablebot.sim import columns as L
-from tablebot.sim.forked import Forked, Inbox
-from tablebot.sim.view import RunView, SceneView, ends_of, picture_columns
+from tablebot.sim.pictures.forked import Forked, Inbox
+from tablebot.sim.pictures.view import RunView, SceneView, ends_of, picture_columns
 
 if TYPE_CHECKING:  # only types: see the module
     import numpy as np
 
     from tablebot.loop import RunEnd, RunInfo, TickBlock
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.scene import Scene
+    from tablebot.sim.model.scene import Scene
     from tablebot.sim.summary import Summary
 
 #: The pictures' file names, in the order they are written.
@@ -152,7 +152,7 @@ class _Progress:
 def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
     """The painter's work: the messages of :class:`Painter`, in order, turned into the pictures' PNG bytes
     (pickled, trajectory first)."""
-    from tablebot.sim.plots import Painting  # matplotlib: imported at once, while this process waits
+    from tablebot.sim.pictures.plots import Painting  # matplotlib: imported at once, while this process waits
 
     _, scene, ticks, seed, kept = inbox.get()
     painting = Painting(scene, ticks, seed)

@@ -22,13 +22,13 @@ from tablebot.escape import picture
 from tablebot.i18n import N_, _
 from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
-from tablebot.sim.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
-from tablebot.sim.forked import Forked
-from tablebot.sim.picture import DPI, declared_kinds, deflated, drawn_png, png_of_parts, subtitle_of, title
-from tablebot.sim.view import RunView, SceneView
+from tablebot.sim.pictures.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
+from tablebot.sim.pictures.forked import Forked
+from tablebot.sim.pictures.picture import DPI, declared_kinds, deflated, drawn_png, png_of_parts, subtitle_of, title
+from tablebot.sim.pictures.view import RunView, SceneView
 
 if TYPE_CHECKING:
-    from tablebot.sim.picture import Run
+    from tablebot.sim.pictures.picture import Run
     from tablebot.sim.summary import Summary
 
 LIGHT_BINS = 1500  # time bins of the light panel, each drawn as its low and high value
@@ -105,7 +105,7 @@ class TimelinePicture:
 
     def png(self, result: RunView, summary: Summary) -> bytes:
         """The run drawn into the panels, as PNG, drawn and compressed in two bands at once: the lower panels
-        by a fork of this process on the other core (:mod:`tablebot.sim.forked`), the upper ones here. The
+        by a fork of this process on the other core (:mod:`tablebot.sim.pictures.forked`), the upper ones here. The
         band's edge runs through the blank gap between two panels, so each band's pixels are those of the
         whole figure drawn at once; when either finds a pixel of the other's rows not blank (or the gap
         not blank), the whole figure is drawn here instead."""
@@ -128,7 +128,7 @@ class TimelinePicture:
     def _band(self, result: RunView, summary: Summary, edge: int, lower: bool) -> tuple[bytes, int, int] | None:
         """Draw the run into one band's panels (the lower ones and the time axis, or the upper ones and the
         titles), draw them, and compress the band's rows as a part of the PNG
-        (:func:`~tablebot.sim.picture.deflated`); None when the other band's rows, or the gap row above the
+        (:func:`~tablebot.sim.pictures.picture.deflated`); None when the other band's rows, or the gap row above the
         edge, are not blank."""
         split = len(self.axes) // 2
         self.finish(result, summary, range(split, len(self.axes)) if lower else range(split))

@@ -36,8 +36,8 @@ from tablebot.sim.columns import (
     X,
     Y,
 )
-from tablebot.sim.geometry import point_segment_distance, point_segment_within
-from tablebot.sim.shadows import NO_SHADE, shadowed_near
+from tablebot.sim.physics.geometry import point_segment_distance, point_segment_within
+from tablebot.sim.physics.shadows import NO_SHADE, shadowed_near
 
 if TYPE_CHECKING:
     import numpy as np
@@ -52,7 +52,7 @@ def light_from(s: np.ndarray, c: float, sn: float, p: np.ndarray, lx: float, ly:
                edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray = NO_SHADE) -> float:
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
     sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine;
-    ``shade``: the world's shadow grid, sim.shadows).
+    ``shade``: the world's shadow grid, sim.physics.shadows).
 
     The response fades to zero over the last quarter of the field of view (a lens tube's edge).
     """
@@ -227,7 +227,7 @@ def echo(sx: float, sy: float, aim: float, p: np.ndarray, edges: np.ndarray, cir
 def sense_declared(s: np.ndarray, c: float, sn: float, p: np.ndarray, edges: np.ndarray, circles: np.ndarray,
                    lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray = NO_SHADE) -> None:
     """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
-    (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.shadows)."""
+    (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.physics.shadows)."""
     for k in range(MAX_SENSORS):
         base = P_SENSOR + k * SENSOR_FIELDS
         kind = p[base + F_KIND]

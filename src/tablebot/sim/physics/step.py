@@ -1,10 +1,10 @@
 """The simulator's physics, one tick of one robot: motors and battery, kinematics, the body's contacts and
-bumpers (:mod:`tablebot.sim.contacts`), light and the declared sensors (:mod:`tablebot.sim.sensing`). It
+bumpers (:mod:`tablebot.sim.physics.contacts`), light and the declared sensors (:mod:`tablebot.sim.physics.sensing`). It
 works on numpy arrays of N robots (layout in :mod:`tablebot.sim.columns`), compiled with numba, so one
 robot and a batch of thousands (which do not see each other) share this code.
 """
 
-# World geometry (built by tablebot.sim.world): ``verts`` (V, 2) and ``pstart`` (P+1,) are convex
+# World geometry (built by tablebot.sim.model.world): ``verts`` (V, 2) and ``pstart`` (P+1,) are convex
 # pieces (a wall or segment is a 2-vertex piece, a box a 4-vertex one); ``pbound`` (P, 3) their
 # bounding circles; ``edges`` (E, 4) every piece's edges for ray casts; ``circles`` (C, 4) = x, y, r,
 # lamp index or -1; ``lamps`` (L, 3) = x, y, intensity; ``lines`` (K, 5) = x0, y0, x1, y1, half width of
@@ -70,10 +70,10 @@ from tablebot.sim.columns import (
     X,
     Y,
 )
-from tablebot.sim.contacts import resolve, sense_bumpers
-from tablebot.sim.sensing import light_turned, sense_declared, sensor_events
-from tablebot.sim.shadows import NO_SHADE
-from tablebot.sim.structures import Scratch, WorldArrays
+from tablebot.sim.physics.contacts import resolve, sense_bumpers
+from tablebot.sim.physics.sensing import light_turned, sense_declared, sensor_events
+from tablebot.sim.physics.shadows import NO_SHADE
+from tablebot.sim.physics.structures import Scratch, WorldArrays
 
 NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 
@@ -85,7 +85,7 @@ def light_side(s: np.ndarray, c: float, sn: float, p: np.ndarray, side: float, c
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
     ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
     the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
-    :func:`sim.sensing.light_turned` rules such lamps out cheaply, with light_from's answer."""
+    :func:`sim.physics.sensing.light_turned` rules such lamps out cheaply, with light_from's answer."""
     return light_turned(s, c, sn, p, p[P_LX], side * p[P_LY], side * p[P_TOE], ct, st, edges, circles, lamps, shade)
 
 
@@ -178,7 +178,7 @@ def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, p
                bits: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
                turns: np.ndarray) -> None:
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
-    declares (sim.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
+    declares (sim.physics.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
     c, sn = math.cos(s[TH]), math.sin(s[TH])
     sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
@@ -197,7 +197,7 @@ def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArr
             scratch: Scratch) -> None:
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense, moved by the noise row ``scratch.z``; fills the robot's MASK column. ``scratch`` also keeps the
-    robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.contacts.new_near`)."""
+    robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.physics.contacts.new_near`)."""
     w, near, centre = world, scratch.near, scratch.centre
     if move:
         x0, y0 = s[X], s[Y]
@@ -213,7 +213,7 @@ def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArr
 @njit(cache=True, refcounts=False)
 def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray,
                    move: bool, scratch: Scratch) -> None:
-    """:func:`advance` compiled once as a function of its own, for sim.kernel.move and sense: the tick-by-tick
+    """:func:`advance` compiled once as a function of its own, for sim.physics.kernel.move and sense: the tick-by-tick
     robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
     where a call per robot-tick costs little beside the rest of a controller's step, and each inlined copy
     took numba ~20 s to compile. The loops that run the table too (run_robot) inline :func:`advance` itself."""
