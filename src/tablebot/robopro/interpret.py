@@ -6,7 +6,9 @@ It reads any .rpp made of these elements, not only ours: the flow follows the wi
 where that comes from (no ROBO Pro installation was available to watch; fischertechnik's manual was found
 only as a table of contents, "RoboPro-En", sections 5.4 Timers, 5.6 Lists, 5.7 Operators):
 
-* ``ftProProcessStart``, ``ftProFlowDelay`` (waits ``value`` × 10^``scale`` ms; here: the tick ends),
+* ``ftProProcessStart`` (each Start of the main program is a process of its own, as olagino/roproparser's
+  ``roSubroutine.run`` runs one thread per Start and its test/multi.rpp, a real program, flashes two lamps in
+  two), ``ftProFlowDelay`` (waits ``value`` × 10^``scale`` ms),
   ``ftProSubroutineRef`` / ``FlowIn`` / ``FlowOut`` (a call enters at the FlowIn whose ``uniqueID`` is the
   pin id of the call's input and leaves by the output whose pin id is the FlowOut's ``uniqueID``): how the
   corpus wires them, and olagino/roproparser (GitHub, ``code/roObject.py``, a ROBO Pro interpreter in
@@ -19,6 +21,8 @@ only as a table of contents, "RoboPro-En", sections 5.4 Timers, 5.6 Lists, 5.7 O
 * ``ftProDataMssg``: sends ``command value`` (the value at its data input when one is wired) to every
   input on its output's wire: ``=``, ``+``, ``-`` to a variable; ``cw``, ``ccw`` (speed) and ``Stop`` to a
   motor (olagino/roproparser); ``=`` to a list's I input sets its index.
+* ``ftProDataOutSngl`` (a lamp on output O(``output`` + 1)): ``On`` with a brightness 0–8, ``Off``; as
+  olagino/roproparser's test/regal_test.rpp (a real ROBO Pro 4.2.4 program) sends them to its lamps.
 * ``ftProDataVariable`` (value at its output), ``ftProDataConst``, ``ftProDataIn`` (``input`` 160 + n − 1
   reads In, 176 + n − 1 the count of Cn), ``ftProDataOutDual``: as the corpus wires them. A variable of
   ``scope`` 1 is global, one value for every copy of its name (olagino/roproparser; in the corpus, names
@@ -28,23 +32,27 @@ only as a table of contents, "RoboPro-En", sections 5.4 Timers, 5.6 Lists, 5.7 O
 * ``ftProDataOprt`` ``+ - AND OR XOR SHL SHR`` on 16-bit integers; a result beyond −32768…32767 is an
   overflow error (``nooverflowcheck="false"``); SHR of a negative number is an error (logical or
   arithmetic shift cannot be told apart from the corpus, which also has ASR).
+
+Time: elements take none; a Wait takes its milliseconds. Processes run one after the other at the same moment
+(each until it waits, or, given a ``seed``, switching at random after any element, as ROBO Pro's scheduler
+may), and time moves on to the next wake-up when every process waits. A tick lasts from the moment the first
+process (the main program's first Start) wakes until it wakes again after the first Wait it enters.
 """
 
 from __future__ import annotations
 
+import random
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
+
+from tablebot.robopro.nets import InterpreterError, pins_of
 
 MIN, MAX = -32768, 32767
 STEP_LIMIT = 200_000  # elements per tick before the program is taken to be stuck
 COMPARE: dict[str, Callable[[int, int], bool]] = {
     "0": lambda a, b: a > b, "1": lambda a, b: a >= b, "2": lambda a, b: a == b,
     "3": lambda a, b: a <= b, "4": lambda a, b: a < b, "5": lambda a, b: a != b}
-
-
-class InterpreterError(Exception):
-    """The program did something this interpreter does not know, or something ambiguous."""
 
 
 def _int(value: int, what: str) -> int:
@@ -59,76 +67,6 @@ OPERATIONS: dict[str, Callable[[int, int], int]] = {
 }
 
 
-@dataclass
-class Pins:
-    """Every pin of one subprogram and how the wires connect them."""
-
-    owner: dict[str, ET.Element] = field(default_factory=dict)  # object pin id -> its element
-    pin: dict[str, ET.Element] = field(default_factory=dict)  # object pin id -> the pin
-    next_flow: dict[str, str] = field(default_factory=dict)  # flow output pin id -> the input it leads to
-    net: dict[str, int] = field(default_factory=dict)  # data pin id -> its net
-    members: dict[int, list[str]] = field(default_factory=dict)  # net -> data pin ids
-
-
-def _pins(function: ET.Element) -> Pins:
-    found = Pins()
-    wire_pins: dict[str, ET.Element] = {}
-    wire_of: dict[str, ET.Element] = {}
-    for element in function.findall("o"):
-        for child in element.findall("o"):
-            if child.get("classname") == "ftProObjectPin":
-                found.owner[child.get("id", "")] = element
-                found.pin[child.get("id", "")] = child
-            elif child.get("classname") == "wxCanvasPin":
-                wire_pins[child.get("id", "")] = child
-                wire_of[child.get("id", "")] = element
-
-    def end_of(wire: ET.Element) -> ET.Element:
-        return next(p for p in wire.findall("o") if p.get("name") == "end")
-
-    def arrive(wire_pin: ET.Element) -> str:
-        """The object input a wire ending at ``wire_pin`` reaches (through the wires it joins)."""
-        for _ in range(1000):
-            target = wire_pin.get("resolveid", "")
-            if target in found.pin:
-                return target
-            joined = wire_pins.get(target)
-            if joined is None or joined.get("name") != "dynamic":
-                raise InterpreterError(f"flow wire pin {wire_pin.get('id')} leads nowhere")
-            wire_pin = end_of(wire_of[target])
-        raise InterpreterError("flow wires join in a circle")
-
-    parent: dict[str, str] = {}
-
-    def find(x: str) -> str:
-        while parent.get(x, x) != x:
-            x = parent[x]
-        return x
-
-    for pid, pin in found.pin.items():
-        begin = wire_pins.get(pin.get("resolveid", ""))
-        if begin is None:
-            continue
-        wire = wire_of[begin.get("id", "")]
-        if pin.get("pinclass") == "flowobjectoutput":  # the flow goes to the wire's other end
-            other = end_of(wire) if begin.get("name") == "begin" else next(
-                p for p in wire.findall("o") if p.get("name") == "begin")
-            found.next_flow[pid] = arrive(other)
-        elif pin.get("pinclass", "").startswith("data"):
-            parent[find(pid)] = find(wire.get("id") or str(id(wire)))
-    for wpid, wpin in wire_pins.items():  # dynamic pins tie the joining wire's net to the host's
-        if wpin.get("name") == "dynamic" and wire_of[wpid].get("classname") == "ftProDataWire":
-            host = wire_of.get(wpin.get("resolveid", ""))
-            if host is not None:
-                parent[find(wire_of[wpid].get("id") or "")] = find(host.get("id") or "")
-    for pid, pin in found.pin.items():
-        if pin.get("pinclass", "").startswith("data"):
-            root = find(pid)
-            number = found.net.setdefault(pid, hash(root))
-            found.members.setdefault(number, []).append(pid)
-    return found
-
-
 class Program:
     """A parsed .rpp: its subprograms (function element and pins), ready to run."""
 
@@ -136,58 +74,95 @@ class Program:
         root = ET.fromstring(text.encode("utf-8"))
         self.functions = {f.get("name", ""): f for f in root.iter("o")
                           if f.get("classname") == "ftProSubroutineFunction"}
-        self.pins = {name: _pins(f) for name, f in self.functions.items()}
+        self.pins = {name: pins_of(f) for name, f in self.functions.items()}
         self.main = next(name for name, f in self.functions.items()
                          if any(e.get("classname") == "ftProProcessStart" for e in f.findall("o")))
+        self.starts = [e for e in self.functions[self.main].findall("o") if e.get("classname") == "ftProProcessStart"]
 
 
 @dataclass
 class Tick:
-    """What the program did in one tick: its variables and motors when the tick ended, and which
+    """What the program did in one tick: its variables, motors and lamps when the tick ended, and which
     subprogram exits were taken."""
 
     variables: dict[str, int]
     motors: dict[int, tuple[str, int]]
     exits: list[tuple[str, str]]
+    lamps: dict[int, int] = field(default_factory=dict)
+
+
+@dataclass
+class _Process:
+    """A process: its flow (yields None after each element, the milliseconds of each Wait it enters) and the
+    time it may run again."""
+
+    flow: Iterator[int | None]
+    wake: int = 0
 
 
 class Run:
     """The program running against scripted inputs: ``digital[n]`` is terminal In's level, ``counts[n]``
-    counter Cn's count."""
+    counter Cn's count. ``seed``: switch processes at random after any element (None: each runs until it
+    waits, in the order of the Starts)."""
 
-    def __init__(self, program: Program) -> None:
+    def __init__(self, program: Program, seed: int | None = None) -> None:
         self.program = program
         self.variables: dict[str, int] = {}
         self.lists: dict[str, list[int]] = {}
         self.index: dict[str, int] = {}
         self.motors: dict[int, tuple[str, int]] = {}
+        self.lamps: dict[int, int] = {}
         self.digital: dict[int, int] = {}
         self.counts: dict[int, int] = {}
         self.exits: list[tuple[str, str]] = []
         self.steps = 0
+        self.time = 0  # ms
         self._memo: dict[tuple, object] = {}  # per element and pin: what the wiring says, worked out once
-        self._flow = self._main()
+        self._rng = None if seed is None else random.Random(seed)
+        self._processes = [_Process(self._process(start)) for start in program.starts]
 
     def tick(self, digital: dict[int, int], counts: dict[int, int]) -> Tick:
-        """Set the inputs, run to the end of the tick (the next Wait), and report."""
+        """Set the inputs, run every process to the end of the tick, and report."""
         self.digital, self.counts = dict(digital), dict(counts)
         self.exits, self.steps = [], 0
-        next(self._flow)
-        return Tick(dict(self.variables), dict(self.motors), list(self.exits))
+        first, end = self._processes[0], None
+        while True:
+            runnable = [p for p in self._processes if p.wake <= self.time]
+            if not runnable:
+                wake = min(p.wake for p in self._processes)
+                if end is not None and wake >= end:
+                    self.time = end
+                    break
+                self.time = wake
+                continue
+            process = runnable[0] if self._rng is None else self._rng.choice(runnable)
+            waited = self._advance(process)
+            if waited is not None and process is first and end is None:
+                end = process.wake
+        return Tick(dict(self.variables), dict(self.motors), list(self.exits), dict(self.lamps))
+
+    def _advance(self, process: _Process) -> int | None:
+        """Run ``process`` until it waits (the milliseconds), or, switching at random, one element (None)."""
+        while True:
+            waited = next(process.flow)
+            if waited is not None:
+                process.wake = self.time + waited
+                return waited
+            if self._rng is not None:
+                return None
 
     # --- flow -------------------------------------------------------------------------------------
 
-    def _main(self) -> Iterator[None]:
-        name = self.program.main
-        start = next(e for e in self.program.functions[name].findall("o")
-                     if e.get("classname") == "ftProProcessStart")
-        yield from self._run(name, start)
-        raise InterpreterError("the main program ended")
+    def _process(self, start: ET.Element) -> Iterator[int | None]:
+        yield from self._run(self.program.main, start)
+        raise InterpreterError("a process of the main program ended")
 
-    def _run(self, sub: str, element: ET.Element) -> Generator[None, None, str | None]:
+    def _run(self, sub: str, element: ET.Element) -> Generator[int | None, None, str | None]:
         """Run ``sub`` from ``element`` until a FlowOut (whose uniqueID is the generator's value)."""
         pins = self.program.pins[sub]
+        entered: ET.Element | None = None  # the flow input the flow came in by (a call's names the entry)
         while True:
+            yield None
             self.steps += 1
             if self.steps > STEP_LIMIT:
                 raise InterpreterError(f"no Wait within {STEP_LIMIT} elements: the program is stuck in {sub}")
@@ -197,12 +172,11 @@ class Run:
                 return element.get("uniqueID")
             if kind == "ftProProcessStop":
                 raise InterpreterError("the program stopped")
-            out = yield from self._do(sub, element)
+            out = yield from self._do(sub, element, entered)
             nxt = pins.next_flow.get(out)
             if nxt is None:
                 raise InterpreterError(f"{sub}: the flow leaves {kind} by an unwired output")
-            element = pins.owner[nxt]
-            self._entered = pins.pin[nxt]
+            element, entered = pins.owner[nxt], pins.pin[nxt]
 
     def _outputs(self, element: ET.Element) -> dict[str, str]:
         """Flow output pin id by pin name (and by pin id as text)."""
@@ -217,13 +191,13 @@ class Run:
                 found["#" + p.get("pinid", "")] = p.get("id", "")
         return found
 
-    def _do(self, sub: str, element: ET.Element) -> Generator[None, None, str]:
+    def _do(self, sub: str, element: ET.Element, entered: ET.Element | None) -> Generator[int | None, None, str]:
         kind = element.get("classname")
         outs = self._outputs(element)
         if kind in ("ftProProcessStart", "ftProSubroutineFlowIn"):
             return outs["#0"]
         if kind == "ftProFlowDelay":
-            yield
+            yield int(element.get("value", "0")) * 10 ** int(element.get("scale", "0"))
             return outs["#0"]
         if kind == "ftProFlowIf":
             a = self._input(sub, element, "A")
@@ -241,12 +215,13 @@ class Run:
             self._send(sub, element)
             return outs["#0"]
         if kind == "ftProSubroutineRef":
-            return (yield from self._call(sub, element, outs))
+            assert entered is not None
+            return (yield from self._call(sub, element, entered, outs))
         raise InterpreterError(f"{sub}: element {kind} is not one this interpreter runs")
 
-    def _call(self, sub: str, ref: ET.Element, outs: dict[str, str]) -> Generator[None, None, str]:
+    def _call(self, sub: str, ref: ET.Element, entered: ET.Element,
+              outs: dict[str, str]) -> Generator[int | None, None, str]:
         name = ref.get("name", "")
-        entered = self._entered
         target = self.program.functions.get(name)
         if target is None:
             raise InterpreterError(f"{sub} calls {name!r}, which the program does not have")
@@ -385,6 +360,10 @@ class Run:
             if not 0 <= speed <= 8:
                 raise InterpreterError(f"motor speed {speed} outside 0..8")
             self.motors[int(element.get("output", "0")) + 1] = (command, speed)
+        elif kind == "ftProDataOutSngl":
+            if command not in ("On", "Off") or (command == "On" and not 0 <= value <= 8):
+                raise InterpreterError(f"command {command} {value} sent to a lamp")
+            self.lamps[int(element.get("output", "0")) + 1] = value if command == "On" else 0
         elif kind == "ftProDataArray1D" and pin.get("pinid") == "1" and command == "=":
             self.index[element.get("name", "")] = value
         else:
