@@ -36,8 +36,8 @@ from typing import TYPE_CHECKING
 from tablebot.cli.common import load
 from tablebot.engine import Engine
 from tablebot.loop import run as run_loop
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import scene_for
+from tablebot.sim.runner import simulate
 from tablebot.sim.simrobot import SimRobot
 from tablebot.testing.processes import child_env
 

@@ -21,8 +21,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from tablebot.cli.common import load
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import scene_for
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 from tablebot.testing.turn_drift import Turn, turns
 

@@ -15,8 +15,8 @@ from gymnasium.wrappers.vector import NormalizeObservation  # noqa: E402
 from tablebot.cli.common import load  # noqa: E402
 from tablebot.fleet.env import ENV_ID, TableBotEnv, TableBotVectorEnv  # noqa: E402
 from tablebot.sim.model.observation import Observation  # noqa: E402
-from tablebot.sim.runner import simulate  # noqa: E402
 from tablebot.sim.model.scene import scene_for  # noqa: E402
+from tablebot.sim.runner import simulate  # noqa: E402
 from test_sim_helpers import BUMBERBOT  # noqa: E402
 
 

@@ -20,10 +20,10 @@ from tablebot.fleet.run import Fleet, RobotSpec, Variants
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 from tablebot.robot import MATCHES, Match
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import prepare, robot_layer, scene_for
-from tablebot.sim.summary import summarise
 from tablebot.sim.model.world import parse_world
+from tablebot.sim.runner import simulate
+from tablebot.sim.summary import summarise
 from tablebot.testing.harness import random_world
 from tablebot.testing.random_tables import Shape, random_table, with_match
 from tablebot.tomlfile import Source

@@ -18,8 +18,8 @@ from tablebot.diagnostics import TableBotError
 from tablebot.formats.table_read import load_table
 from tablebot.machine import NO_ROW, compile_table
 from tablebot.robot import BUMBERBOT, load_robot
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import scene_for
+from tablebot.sim.runner import simulate
 from tablebot.table import no_event_rows
 from tablebot.testing.random_tables import with_match
 from tablebot.web.analyse import explain

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from tablebot.sim import columns as L
+from tablebot.sim.model.scene import Scene
 from tablebot.sim.physics.kernel import sense
+from tablebot.sim.physics.sensing import sensor_events
 from tablebot.sim.physics.step import light_at
 from tablebot.sim.runner import simulate
-from tablebot.sim.model.scene import Scene
-from tablebot.sim.physics.sensing import sensor_events
 from tablebot.sim.simrobot import world_arrays
 from test_sim_helpers import room, scene_of
 

@@ -67,7 +67,7 @@ def shadow_disagreements(points: np.ndarray, lamps: np.ndarray, edges: np.ndarra
 
 
 def test_the_shadow_grid_gives_every_shadow_test_the_full_scans_answer() -> None:
-    """sim.physics.shadows lists per cell only the pieces that may shadow each lamp: its answer must be the scan of every
+    """physics.shadows lists per cell only the pieces that may shadow each lamp: its answer must be the scan of every
     piece, also on the lines through a lamp and a corner, on an edge's own line, just off both, and beyond
     the grid -- in a world with two lamps (one in line with a box's side, one with no base), a hanging
     circle and a partition."""

@@ -12,9 +12,9 @@ import pytest
 
 from tablebot.cli.common import load
 from tablebot.diagnostics import TableBotError
-from tablebot.sim.runner import SimRun, simulate
 from tablebot.sim.model.scene import Scene, scene_for
 from tablebot.sim.model.world import load_world
+from tablebot.sim.runner import SimRun, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 BUMBERBOT = ROOT / "examples" / "bumberbot"

@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 
 from tablebot.sim import columns as L
 from tablebot.sim.model.params import Params, speed_per_volt, terminal_volts
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.world import inside
+from tablebot.sim.runner import simulate
 from test_sim_helpers import SPIN, STRAIGHT, bot, room
 
 if TYPE_CHECKING:

@@ -1,4 +1,4 @@
-"""The pictures a painter draws while the robot runs (tablebot.sim.pictures.painter): the same pixels as the figures drawn
+"""The pictures a painter draws while the robot runs (sim.pictures.painter): the same pixels as the figures drawn
 whole in one process, however they were drawn (the arena first, the path as it grows, the timeline in two
 bands, PNGs put together from parts), and no process of the painter's left behind on any way out."""
 
@@ -24,10 +24,10 @@ from tablebot.cli import app
 from tablebot.sim.pictures import forked, plots
 from tablebot.sim.pictures.draw import literal_text
 from tablebot.sim.pictures.picture import deflated, png_of, png_of_parts
-from tablebot.sim.runner import simulate
-from tablebot.sim.summary import summarise
 from tablebot.sim.pictures.timeline import TimelinePicture
 from tablebot.sim.pictures.view import RunView
+from tablebot.sim.runner import simulate
+from tablebot.sim.summary import summarise
 from test_sim_declared import SENSORS, TABLE
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 

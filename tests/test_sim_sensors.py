@@ -109,8 +109,8 @@ def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path:
     inside or outside the field of view's edge and for headings after thousands of turns."""
     import math
 
-    from tablebot.sim.physics.step import light_at
     from tablebot.sim.physics.sensing import light_from
+    from tablebot.sim.physics.step import light_at
 
     scene = bumberbot_in(tmp_path, room(extra="[[lamp]]\nat = [2.0, 1.5]\nintensity = 3.0\n"))
     p, g = scene.P[0], scene.geometry

@@ -18,8 +18,8 @@ import tablebot
 from tablebot.fleet.plan import make_plan
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.fleet.spec import digest
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import robot_layer
+from tablebot.sim.runner import simulate
 from tablebot.sim.summary import summarise
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "bumberbot-lights"

@@ -43,8 +43,8 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def _write_sim_trace(root: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.runner import simulate
 
     table, machine = load(root)
     with (root / "trace.jsonl").open("w", encoding="utf-8") as f:
@@ -269,8 +269,8 @@ def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
 def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path,
                                                                   shots: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.runner import simulate
     from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
 

@@ -260,8 +260,8 @@ CUT_BUTTONS = """() => [...document.querySelectorAll(
 
 def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, tmp_path: Path, shots: Path) -> None:
     from tablebot.cli.common import load
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.runner import simulate
     from tablebot.sinks.trace_file import block_lines
     from tablebot.web.replay import write_html
 

@@ -11,8 +11,8 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.cli.common import load
 from tablebot.loop import RunEnd, RunInfo, TickBlock
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import scene_for
+from tablebot.sim.runner import simulate
 from tablebot.sim.simrobot import SimRobot
 from tablebot.web.live import LiveRun, PageClock
 

@@ -57,8 +57,8 @@ def _load(example: str) -> tuple:
 def sim_case(example: str, seconds: float, seed: int, busy: int | None = None) -> str:
     """``tablebot sim``'s loop: the trace lines and every robot row of one run."""
     from tablebot.loop import RunEnd, RunInfo, TickBlock
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import prepare, scene_for
+    from tablebot.sim.runner import simulate
     from tablebot.sinks.trace_file import block_lines
 
     table, machine = _load(example)

@@ -169,8 +169,8 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from tablebot.fleet.run import Fleet, RobotSpec
     from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.runner import simulate
     from test_sim_helpers import BUMBERBOT, trace_text
 
     example = BUMBERBOT.parent / "bumberbot-counters"

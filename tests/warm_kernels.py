@@ -27,9 +27,9 @@ def warm_loop() -> None:
     from tablebot.engine import Engine
     from tablebot.loop import SimulatedClock
     from tablebot.loop import run as run_loop
+    from tablebot.sim.model.scene import scene_for
     from tablebot.sim.physics import kernel
     from tablebot.sim.runner import simulate
-    from tablebot.sim.model.scene import scene_for
     from tablebot.sim.simrobot import SimRobot
 
     table, machine = load(EXAMPLES / "bumberbot" / "table.csv")

@@ -18,9 +18,9 @@ if TYPE_CHECKING:
 
     from tablebot.loading import Loaded, PathLike
     from tablebot.loop import RunEnd, Sink
+    from tablebot.sim.model.scene import Scene
     from tablebot.sim.pictures.painter import Painter
     from tablebot.sim.runner import SimRun
-    from tablebot.sim.model.scene import Scene
     from tablebot.sim.summary import Summary
     from tablebot.sinks.trace_file import TraceFile
 
@@ -155,8 +155,8 @@ def _run(scene: Scene, seconds: float, seed: int, progress: Progress, sinks: lis
     """The run, telling ``progress`` the ticks done after each block (a first run compiles the simulator
     before its first tick: ``progress.compiling`` is told first)."""
     from tablebot.sim.physics.kernel import run_robot
-    from tablebot.sim.runner import simulate, ticks_for
     from tablebot.sim.physics.several import run_several
+    from tablebot.sim.runner import simulate, ticks_for
 
     progress.compiling("the simulator", run_robot if scene.tables is None else run_several)
     progress.start("ticks", ticks_for(scene, seconds))

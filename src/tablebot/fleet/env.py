@@ -43,8 +43,8 @@ class Setup:
         from tablebot.machine import compile_table
         from tablebot.robot import load_robot
         from tablebot.sim.model.observation import Observation
-        from tablebot.sim.runner import ticks_for
         from tablebot.sim.model.scene import find_world, prepare, robot_layer
+        from tablebot.sim.runner import ticks_for
 
         path = resolve_table_path(Path(table) if table else example_path("bumberbot"))
         self.table = load_table(path, load_robot(robot) if robot else None)

@@ -15,7 +15,15 @@ from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it
 from tablebot.sim.physics.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
 from tablebot.sim.physics.kernel import move, run_robot
 from tablebot.sim.physics.several import SeveralProgram, SeveralState, run_several
-from tablebot.sim.physics.structures import FleetRecord, FleetState, ProgramVariants, Record, RobotState, Wiring, WorldArrays
+from tablebot.sim.physics.structures import (
+    FleetRecord,
+    FleetState,
+    ProgramVariants,
+    Record,
+    RobotState,
+    Wiring,
+    WorldArrays,
+)
 from tablebot.tick import Program
 
 

@@ -46,9 +46,9 @@ from tablebot.formats.trace_lines import exact_round
 from tablebot.jit import sources_digest
 from tablebot.machine import FLAT_BITS, Machine, compile_table
 from tablebot.robot import load_robot
-from tablebot.sim.runner import ticks_for
 from tablebot.sim.model.scene import Scene, find_world, prepare, robot_layer
 from tablebot.sim.model.world import World, load_world
+from tablebot.sim.runner import ticks_for
 from tablebot.table import Table
 from tablebot.tables import RobotTables, several
 

@@ -30,16 +30,16 @@ from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.fleet.starts import Prepared, Starts, with_start
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
+from tablebot.sim.model.observation import Observation
+from tablebot.sim.model.scene import Scene
+from tablebot.sim.model.world import World
 from tablebot.sim.physics import kernel as K
 from tablebot.sim.physics.normals import bitgen_address
-from tablebot.sim.model.observation import Observation
-from tablebot.sim.runner import SimRun
-from tablebot.sim.model.scene import Scene
 from tablebot.sim.physics.several import N_K, SeveralState, several_program, table_columns
-from tablebot.sim.simrobot import Joined, SimRobot, wiring_of, world_arrays
 from tablebot.sim.physics.structures import FleetRecord, FleetState, ProgramVariants
+from tablebot.sim.runner import SimRun
+from tablebot.sim.simrobot import Joined, SimRobot, wiring_of, world_arrays
 from tablebot.sim.summary import light_bits
-from tablebot.sim.model.world import World
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 from tablebot.tick import STATE, registers
@@ -91,7 +91,8 @@ class Fleet:
         self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
-        self.bitgens = np.zeros(n, dtype=np.uint64)  # each robot's Generator's handle (sim.physics.normals.bitgen_address)
+        # each robot's Generator's handle (sim.physics.normals.bitgen_address)
+        self.bitgens = np.zeros(n, dtype=np.uint64)
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
@@ -249,7 +250,7 @@ class Fleet:
         return self.acc[:, K.A_REACHED] >= 0
 
     def observations(self) -> np.ndarray:
-        """What a learning agent sees of every robot now, a row each (:class:`~tablebot.sim.model.observation.Observation`
+        """What a learning agent sees of every robot now, a row each (:class:`~.observation.Observation`
         of the fleet's scene)."""
         if self._observation is None:
             self._observation = Observation.of(self.scenes[0])

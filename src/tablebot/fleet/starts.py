@@ -11,8 +11,8 @@ from tablebot.diagnostics import fail
 from tablebot.fleet.robots import Pose, RobotSpec
 from tablebot.machine import Machine
 from tablebot.sim.model.scene import Scene, check_start, prepare
-from tablebot.sim.simrobot import Starter
 from tablebot.sim.model.world import World, inside
+from tablebot.sim.simrobot import Starter
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 

@@ -24,8 +24,8 @@ def open_sim(machine: Machine, link: LinkOptions) -> Opened:
     """The simulator as a robot, paced in real time: a rehearsal on exactly the code path of a real run. A robot
     of several tables is wired for all of them (``machine`` is then the robot's, its rows the main table's)."""
     from tablebot.jit import say_compiling
-    from tablebot.sim.physics import kernel
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.physics import kernel
     from tablebot.sim.simrobot import SimRobot
     from tablebot.tables import several
 

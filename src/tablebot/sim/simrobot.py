@@ -15,12 +15,12 @@ from tablebot.engine.as_one import RobotEngine
 from tablebot.formats.trace_lines import exact_round_array
 from tablebot.loop import Reading, TickBlock
 from tablebot.sim import columns as L
-from tablebot.sim.physics import kernel as K
-from tablebot.sim.physics import several as S
-from tablebot.sim.physics.normals import bitgen_address
 from tablebot.sim.model.observation import Observation
 from tablebot.sim.model.params import terminal_volts
 from tablebot.sim.model.scene import Scene, sensor_columns
+from tablebot.sim.physics import kernel as K
+from tablebot.sim.physics import several as S
+from tablebot.sim.physics.normals import bitgen_address
 from tablebot.sim.physics.structures import RobotState, Wiring, WorldArrays, untallied
 from tablebot.tick import registers
 
@@ -130,7 +130,7 @@ class SimRobot:
         return block
 
     def block(self, start: int, ints: np.ndarray, hist: np.ndarray, n_out: int, n_c: int) -> TickBlock:
-        """The ticks from ``start`` that a compiled loop recorded (``ints``: sim.physics.kernel's I_* records of ``n_out``
+        """The ticks from ``start`` that a compiled loop recorded (``ints``: .kernel's I_* records of ``n_out``
         outputs and ``n_c`` counters; ``hist``: the robot's rows, or none) as the run loop's TickBlock."""
         o, c = K.I_OUTPUTS, K.I_OUTPUTS + n_out  # outputs, then counters, then pulses
         block = TickBlock(start, ints[:, K.I_MASK], ints[:, c + n_c:], ints[:, K.I_EVENT], ints[:, K.I_ROW],

@@ -18,8 +18,8 @@ from tablebot.sim.model.track import laps
 from tablebot.sinks.run_trace import seconds_per_state
 
 if TYPE_CHECKING:  # only types: time per state is wanted beside a real robot's run, without the simulator
-    from tablebot.sim.runner import SimRun
     from tablebot.sim.model.scene import Scene
+    from tablebot.sim.runner import SimRun
 
 
 @dataclass(frozen=True)

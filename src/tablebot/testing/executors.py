@@ -106,8 +106,8 @@ SIM_TICKS = 1500
 
 def _simulator(case: Case, workdir: Path) -> Run:
     """``tablebot sim``'s path: the run loop handing blocks to ``SimRobot.advance`` (the compiled kernel)."""
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import prepare
+    from tablebot.sim.runner import simulate
 
     world, layer = _world_and_layer(case)
     scene = prepare(case.machine.table, case.machine, world, layer)
@@ -132,8 +132,8 @@ def example_case(name: str, seconds: float = 20.0, seed: int = 1) -> Case:
     them; the simulated ones run it in its own world)."""
     from tablebot.examples import example_path
     from tablebot.formats.table_read import load_table, resolve_table_path
-    from tablebot.sim.runner import simulate
     from tablebot.sim.model.scene import scene_for
+    from tablebot.sim.runner import simulate
 
     table = load_table(resolve_table_path(example_path(name)))
     machine = compile_table(table)

@@ -12,9 +12,9 @@ from pathlib import Path
 from tablebot.formats.table_read import load_table
 from tablebot.machine import compile_table
 from tablebot.sim import columns as L
-from tablebot.sim.runner import simulate
 from tablebot.sim.model.scene import prepare, robot_layer
 from tablebot.sim.model.world import World, parse_world
+from tablebot.sim.runner import simulate
 from tablebot.tomlfile import Source
 
 #: An empty room with the robot in the middle: nothing to bump into while it turns.

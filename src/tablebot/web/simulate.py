@@ -14,8 +14,8 @@ from tablebot.diagnostics import TableBotError, fail
 from tablebot.loading import Loaded
 from tablebot.machine import Machine
 from tablebot.sim.model.scene import Scene
-from tablebot.sim.simrobot import SimRobot
 from tablebot.sim.model.world import World
+from tablebot.sim.simrobot import SimRobot
 from tablebot.table import Table
 from tablebot.web.errors import Refused
 from tablebot.web.live import SPEEDS, LiveRun

@@ -18,7 +18,6 @@ from tablebot.engine.as_one import robot_machine
 from tablebot.machine import FLAT_BITS, Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
-from tablebot.sim.physics.contacts import body_corners, deepest_contact
 from tablebot.sim.model.params import (
     INPUT_ROLES,
     Params,
@@ -28,6 +27,7 @@ from tablebot.sim.model.params import (
     top_speed,
 )
 from tablebot.sim.model.world import Geometry, World, default_world, geometry, load_world
+from tablebot.sim.physics.contacts import body_corners, deepest_contact
 from tablebot.table import Table
 from tablebot.tables import RobotTables
 

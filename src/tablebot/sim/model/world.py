@@ -104,7 +104,7 @@ class Geometry:
     circles: np.ndarray
     lamps: np.ndarray
     lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))  # (K, 5): x0, y0, x1, y1, half width
-    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # which pieces may shadow a lamp (sim.physics.shadows)
+    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the pieces that may shadow a lamp (.shadows)
 
 
 DEFAULT_WORLD = """\

@@ -121,7 +121,7 @@ def tick_several(sp: SeveralProgram, st: SeveralState, outputs: np.ndarray, mask
 @njit(nogil=True)
 def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: SeveralState, wiring: Wiring,
                 ticks: int, noise: np.ndarray, bitgen: np.uint64, record: Record, tables: np.ndarray) -> None:
-    """:func:`tablebot.sim.physics.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
+    """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
     near, centre = new_near(world.pstart, world.circles)

@@ -29,8 +29,8 @@ if TYPE_CHECKING:  # only types: see the module
     import numpy as np
 
     from tablebot.loop import RunEnd, RunInfo, TickBlock
-    from tablebot.sim.runner import SimRun
     from tablebot.sim.model.scene import Scene
+    from tablebot.sim.runner import SimRun
     from tablebot.sim.summary import Summary
 
 #: The pictures' file names, in the order they are written.

@@ -23,10 +23,10 @@ from tablebot.sensors import SENSOR_KINDS, SensorKind
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from tablebot.sim.runner import SimRun
     from tablebot.sim.model.scene import Scene
-    from tablebot.sim.summary import Summary
     from tablebot.sim.pictures.view import RunView, SceneView
+    from tablebot.sim.runner import SimRun
+    from tablebot.sim.summary import Summary
 
     Run: TypeAlias = SimRun | RunView  # declared: mypy may take a union of classes not yet seen for a value
 

@@ -46,19 +46,19 @@ from tablebot.sim.pictures.picture import (  # noqa: F401 (title_of: other modul
     title,
     title_of,
 )
-from tablebot.sim.summary import Summary
 from tablebot.sim.pictures.timeline import (  # noqa: F401 (the timeline's public functions, imported from here too)
     TimelinePicture,
     reading_panels,
     timeline_figure,
 )
 from tablebot.sim.pictures.view import RunView, SceneView
+from tablebot.sim.summary import Summary
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
     from matplotlib.axes import Axes
 
-    from tablebot.sim.pictures.picture import Run
     from tablebot.sim.model.scene import Scene
+    from tablebot.sim.pictures.picture import Run
 
 PATH_Z = 4  # the path's z-order: everything the arena draws is below it
 PATH_STEP_M = 0.002  # the path is drawn through points 2 mm apart: finer than the picture's pixels

@@ -13,9 +13,9 @@ if TYPE_CHECKING:  # only types: see the module
 
     from tablebot.machine import Machine
     from tablebot.sim.model.params import Params
-    from tablebot.sim.runner import SimRun
     from tablebot.sim.model.scene import Scene
     from tablebot.sim.model.world import Geometry, World
+    from tablebot.sim.runner import SimRun
     from tablebot.table import Table
 
 
