@@ -1,5 +1,6 @@
 """The simulator's model: a robot's parameters (:mod:`.params`), the world it drives in (:mod:`.world`), both
-put together with the table (:mod:`.scene`), the tape a line follower laps (:mod:`.track`) and what a learning agent
-observes (:mod:`.observation`). Plain Python and numpy; the compiled code it packs for is in :mod:`tablebot.sim.physics`."""
+put together with the table (:mod:`.scene`), the tape a line follower laps (:mod:`.track`) and what a learning
+agent observes (:mod:`.observation`). Plain Python and numpy; it packs the arrays :mod:`tablebot.sim.physics`
+computes on, and calls a few of its functions to do so (a body's corners, a battery's volts, a shadow grid)."""
 
 __all__ = ["observation", "params", "scene", "track", "world"]
