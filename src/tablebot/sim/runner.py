@@ -19,7 +19,7 @@ from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
 from tablebot.loop import run as run_loop
 from tablebot.sim import columns as L
 from tablebot.sim.model.scene import Scene
-from tablebot.sim.simrobot import SimRobot
+from tablebot.sim.simrobot import SimRobot, field_columns
 from tablebot.sinks.trace_file import block_lines
 
 MAX_TICKS = 360_000  # an hour at the BumberBot's 10 ms: the whole history is kept in memory
@@ -95,8 +95,6 @@ class SimRun:
 
     def block(self) -> TickBlock:
         """The whole run as one block of ticks, with the simulator's trace fields."""
-        from tablebot.sim.simrobot import field_columns
-
         assert self.hist is not None and self.hist_columns is None, "the trace needs every robot row"
         return TickBlock(0, self.masks, self.pulses, self.events, self.rows, self.states, self.timers,
                          self.outputs, self.counters, {**field_columns(self.scene, self.hist[:-1]), **self.others})

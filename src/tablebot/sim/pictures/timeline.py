@@ -16,6 +16,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
@@ -342,7 +343,5 @@ def _log_scale(ax: Axes) -> None:
     """A reading (light) on a symmetric log scale (0, then 0.1 to 100s), its ticks written as plain numbers: the
     pictures draw text with maths parsing off (for user text), so matplotlib's 10^n labels would print
     as raw TeX."""
-    from matplotlib.ticker import FuncFormatter
-
     ax.set_yscale("symlog", linthresh=0.1)
     ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
