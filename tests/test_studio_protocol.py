@@ -134,3 +134,30 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
     assert replies["restore"] == [{"type": "error", "op": "restore",
                                    "message": '"header" must be a row of text (at most 20,000 rows of 200 cells)'}]
     assert replies["counterexample"][0]["message"] == "property 'no_such_property' has no counterexample"
+
+
+def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> None:
+    """The protocol's refusals are messages of the catalog: a German tab reads them in German, an English one
+    in English (the same operations, one studio)."""
+
+    async def replies(language: str) -> list[dict[str, Any]]:
+        sent: list[dict[str, Any]] = []
+
+        async def send(message: dict[str, Any]) -> None:
+            sent.append(message)
+
+        session = Session(Workspace(tmp_path), Hub(), send, language)
+        try:
+            for message in ({"op": "open", "path": ""}, {"op": "edit", "row": "1", "col": 0, "value": ""},
+                            {"op": "explode"}, [1]):
+                await session.handle(message)
+        finally:
+            session.close()
+        return sent
+
+    german = [m["message"] for m in asyncio.run(replies("de"))]
+    assert german == ['"path" muss Text sein', '"row" muss eine ganze Zahl sein', "unbekannte Operation 'explode'",
+                      'eine Nachricht muss ein JSON-Objekt mit einem "op" sein']
+    english = [m["message"] for m in asyncio.run(replies("en"))]
+    assert english == ['"path" must be text', '"row" must be a whole number', "unknown op 'explode'",
+                       'a message must be a JSON object with an "op"']

@@ -13,7 +13,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
+from tablebot.i18n import N_
 from tablebot.web.errors import Refused
+from tablebot.web.wire import READERS, any_text, text, wire
 
 __all__ = [
     "MESSAGES", "OPERATIONS", "AnalysisMsg", "ArenaMsg", "ConflictMsg", "ControlMsg", "Counterexample",
@@ -22,24 +24,21 @@ __all__ = [
     "SharedMsg", "Sim", "TableMsg", "Trace", "TraceMsg", "op_name", "operation",
 ]
 
-MAX_ROWS = 20_000  # a restored draft: far more than a table a person edits in a grid
-MAX_COLUMNS = 200
 #: What the page is told when a message is not an operation at all.
-NOT_AN_OPERATION = 'a message must be a JSON object with an "op"'
+NOT_AN_OPERATION = N_('a message must be a JSON object with an "op"')
 
 
 # --- operations: the page to the server -----------------------------------------------------------------
 
-
 @dataclass(frozen=True)
 class Operation:
-    """One message from the page; ``op`` is its name on the wire."""
+    """One message from the page; ``op`` is its name on the wire, each field read by :data:`READERS`."""
 
     op: ClassVar[str]
 
     @classmethod
     def of(cls, message: Mapping[str, Any]) -> Operation:
-        return cls()
+        return cls(**{f.name: f.metadata.get("read", READERS[str(f.type)])(message, f.name) for f in fields(cls)})
 
     @classmethod
     def wire_fields(cls) -> tuple[str, ...]:
@@ -54,10 +53,6 @@ class Open(Operation):
     op: ClassVar[str] = "open"
     path: str
 
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Open:
-        return cls(_text(message, "path"))
-
 
 @dataclass(frozen=True)
 class Edit(Operation):
@@ -66,13 +61,8 @@ class Edit(Operation):
     op: ClassVar[str] = "edit"
     row: int
     col: int
-    value: str
+    value: str = wire(any_text)
     seq: Any = None
-
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Edit:
-        return cls(_int(message, "row"), _int(message, "col"), _text(message, "value", allow_empty=True),
-                   message.get("seq"))
 
 
 @dataclass(frozen=True)
@@ -83,20 +73,12 @@ class InsertRow(Operation):
     after: int
     seq: Any = None
 
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> InsertRow:
-        return cls(_int(message, "after"), message.get("seq"))
-
 
 @dataclass(frozen=True)
 class DeleteRow(Operation):
     op: ClassVar[str] = "delete_row"
     row: int
     seq: Any = None
-
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> DeleteRow:
-        return cls(_int(message, "row"), message.get("seq"))
 
 
 @dataclass(frozen=True)
@@ -105,13 +87,6 @@ class Save(Operation):
 
     op: ClassVar[str] = "save"
     force: bool | str = False
-
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Save:
-        force = message.get("force", False)
-        if not isinstance(force, bool | str):
-            raise Refused('"force" must be the version the conflict named ("theirs")')
-        return cls(force)
 
 
 @dataclass(frozen=True)
@@ -123,11 +98,6 @@ class Restore(Operation):
     grid: list[list[str]]
     base: str
     seq: Any = None
-
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Restore:
-        return cls(_rows(message, "header", single=True)[0], _rows(message, "grid"), _text(message, "base"),
-                   message.get("seq"))
 
 
 @dataclass(frozen=True)
@@ -146,8 +116,7 @@ class Sim(Operation):
 
     @classmethod
     def of(cls, message: Mapping[str, Any]) -> Sim:
-        action = _text(message, "action")
-        return cls(action, {k: v for k, v in message.items() if k not in ("op", "action")})
+        return cls(text(message, "action"), {k: v for k, v in message.items() if k not in ("op", "action")})
 
     @classmethod
     def wire_fields(cls) -> tuple[str, ...]:
@@ -161,10 +130,6 @@ class Trace(Operation):
     op: ClassVar[str] = "trace"
     path: str
 
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Trace:
-        return cls(_text(message, "path"))
-
 
 @dataclass(frozen=True)
 class Counterexample(Operation):
@@ -173,11 +138,6 @@ class Counterexample(Operation):
     op: ClassVar[str] = "counterexample"
     name: str
     where: str | None = None
-
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> Counterexample:
-        where = message.get("where")
-        return cls(_text(message, "name"), where if isinstance(where, str) else None)
 
 
 @dataclass(frozen=True)
@@ -196,10 +156,6 @@ class NewRobot(Operation):
     template: str
     name: str
 
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> NewRobot:
-        return cls(_text(message, "template"), _text(message, "name"))
-
 
 @dataclass(frozen=True)
 class Share(Operation):
@@ -215,10 +171,6 @@ class OpenLink(Operation):
     op: ClassVar[str] = "open_link"
     link: str
 
-    @classmethod
-    def of(cls, message: Mapping[str, Any]) -> OpenLink:
-        return cls(_text(message, "link"))
-
 
 OPERATIONS: dict[str, type[Operation]] = {
     kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files,
@@ -231,38 +183,13 @@ def op_name(message: Any) -> str:
     if not isinstance(message, dict) or not isinstance(message.get("op"), str):
         raise Refused(NOT_AN_OPERATION)
     if message["op"] not in OPERATIONS:
-        raise Refused(f"unknown op {message['op']!r}")
+        raise Refused(N_("unknown op {op}", op=repr(message["op"])))
     return message["op"]
 
 
 def operation(message: Any) -> Operation:
     """The operation a message from the page asks for, its fields checked (:func:`op_name` first)."""
     return OPERATIONS[op_name(message)].of(message)
-
-
-def _text(message: Mapping[str, Any], key: str, allow_empty: bool = False) -> str:
-    value = message.get(key)
-    if not isinstance(value, str) or (not value and not allow_empty):
-        raise Refused(f'"{key}" must be text')
-    return value
-
-
-def _rows(message: Mapping[str, Any], key: str, single: bool = False) -> list[list[str]]:
-    """A list of rows of text (``single``: one row) from the page."""
-    value = message.get(key)
-    rows = [value] if single else value
-    if not isinstance(rows, list) or len(rows) > MAX_ROWS or not all(
-            isinstance(row, list) and len(row) <= MAX_COLUMNS and all(isinstance(c, str) for c in row) for row in rows):
-        raise Refused(f'"{key}" must be {"a row" if single else "rows"} of text (at most {MAX_ROWS:,} rows of '
-                      f"{MAX_COLUMNS} cells)")
-    return rows
-
-
-def _int(message: Mapping[str, Any], key: str) -> int:
-    value = message.get(key)
-    if not isinstance(value, int) or isinstance(value, bool):
-        raise Refused(f'"{key}" must be a whole number')
-    return value
 
 
 # --- messages: the server to the page ---------------------------------------------------------------------
@@ -330,27 +257,28 @@ class DiagramMsg(Message):
 
 
 @dataclass(frozen=True)
-class ArenaMsg(Message):
+class Spread(Message):
+    """A message that is another part's own data (``more``), spread into it."""
+
+    more: Mapping[str, Any]
+
+
+class ArenaMsg(Spread):
     """The arena after a reset: its world, settings and state (``more``, :meth:`Arena.reset`'s)."""
 
     kind: ClassVar[str] = "arena"
-    more: Mapping[str, Any]
 
 
-@dataclass(frozen=True)
-class ControlMsg(Message):
+class ControlMsg(Spread):
     """The arena's robot's state (``more``: paused, speed, held inputs, error)."""
 
     kind: ClassVar[str] = "control"
-    more: Mapping[str, Any]
 
 
-@dataclass(frozen=True)
-class FrameMsg(Message):
+class FrameMsg(Spread):
     """What the arena's robot did since the last frame (``more``: :meth:`Arena.frame`'s)."""
 
     kind: ClassVar[str] = "frame"
-    more: Mapping[str, Any]
 
 
 @dataclass(frozen=True)
@@ -364,12 +292,10 @@ class TraceMsg(Message):
     at_tick: int | None = None
 
 
-@dataclass(frozen=True)
-class FilesMsg(Message):
+class FilesMsg(Spread):
     """The folder's tables and traces (``more``: :meth:`Workspace.listing`'s)."""
 
     kind: ClassVar[str] = "files"
-    more: Mapping[str, Any]
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from tablebot.diagnostics import TableBotError
 from tablebot.formats.csv_document import CsvDocument
 from tablebot.web.arena_robot import ArenaRobot
 from tablebot.web.draft import Draft, conflict
-from tablebot.web.errors import Refused, log
+from tablebot.web.errors import Refused, log, said
 from tablebot.web.new_robot import new_robot
 from tablebot.web.protocol import (
     Counterexample,
@@ -89,15 +89,15 @@ class Session:
         try:
             name = op_name(message)
         except Refused as exc:
-            await self.error(str(exc))
+            await self.error(said(exc))
             return
         try:
             await self.dispatch(operation(message))
         except TableBotError as exc:
-            await self.say(ErrorMsg(exc.diagnostics[0].message if exc.diagnostics else str(exc), name,
+            await self.say(ErrorMsg(exc.diagnostics[0].message if exc.diagnostics else said(exc), name,
                                     diagnostics_text(exc.diagnostics, self.language)))
         except Refused as exc:
-            await self.error(str(exc), name)
+            await self.error(said(exc), name)
 
     async def dispatch(self, op: Operation) -> None:
         """Carry out one operation, by the part that owns what it changes."""
