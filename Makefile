@@ -21,10 +21,10 @@ demo:
 # 45 s of CPU from an empty cache (the sources, tests and benchmarks) mostly fit in what they leave idle; its
 # report is printed after the pass.
 test: setup
-	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15 -rs
 	@log=$$(mktemp); nice -n 19 .venv/bin/mypy >"$$log" 2>&1 & mypy=$$!; \
-	echo '.venv/bin/python -m pytest -n 2 -m realtime --durations=5  (and .venv/bin/mypy)'; \
-	.venv/bin/python -m pytest -n 2 -m realtime --durations=5; tests=$$?; \
+	echo '.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs  (and .venv/bin/mypy)'; \
+	.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs; tests=$$?; \
 	wait $$mypy; types=$$?; echo ".venv/bin/mypy"; cat "$$log"; rm -f "$$log"; \
 	[ $$tests -eq 0 ] && [ $$types -eq 0 ]
 	.venv/bin/lint-imports
