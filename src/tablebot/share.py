@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.i18n import N_
 
 __all__ = ["FORMAT", "STUDIO", "Shared", "collect", "decode", "encode"]
 
@@ -73,8 +74,9 @@ class Shared:
         from tablebot.fileset import new_folder
 
         if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-            raise fail(folder, "this folder is not empty" if folder.is_dir() else "this is a file, not a folder",
-                       "give the name of a new folder (a shared table never writes over files)")
+            raise fail(folder, N_("this folder is not empty") if folder.is_dir() else
+                       N_("this is a file, not a folder"),
+                       N_("give the name of a new folder (a shared table never writes over files)"))
         with new_folder(folder) as stage:
             for name, text in self.files().items():
                 write_text(stage / name, text, newline="")  # byte for byte as shared
@@ -127,8 +129,8 @@ def collect(path: str | Path) -> Shared:
 
 def _file_name(path: Path) -> str:
     if not _FILE_RE.match(path.name):
-        raise fail(path, "a link carries files with plain names (letters, digits, '_', '-', '.', spaces)",
-                   "rename the file")
+        raise fail(path, N_("a link carries files with plain names (letters, digits, '_', '-', '.', spaces)"),
+                   N_("rename the file"))
     return path.name
 
 
@@ -149,8 +151,8 @@ def _robot_text(path: Path, text: str) -> str:
         if count:
             lines[number - 1] = new
             return "".join(lines)
-    raise fail(path, "cannot find the line of sim.world to point it at the world the link carries",
-               'write it in a [sim] section as world = "FILE.toml"', number)
+    raise fail(path, N_("cannot find the line of sim.world to point it at the world the link carries"),
+               N_('write it in a [sim] section as world = "FILE.toml"'), number)
 
 
 def encode(shared: Shared, base: str = STUDIO) -> str:
@@ -173,33 +175,36 @@ def decode(link: str, where: str = "link") -> Shared:
     text = link.strip()
     at = text.find(KEY)
     if at < 0:
-        raise fail(where, "this is not a tablebot share link: it has no '#share='",
-                   "copy the whole link that `tablebot share` printed or the studio's Share button gave")
+        raise fail(where, N_("this is not a tablebot share link: it has no '#share='"),
+                   N_("copy the whole link that `tablebot share` printed or the studio's Share button gave"))
     version, dot, payload = text[at + len(KEY):].partition(".")
     if not version.isdigit() or not dot:
-        raise fail(where, "this share link is damaged: its version is missing", "copy the whole link again")
+        raise fail(where, N_("this share link is damaged: its version is missing"), N_("copy the whole link again"))
     _check_version(int(version), where)
     bad = _PAYLOAD_RE.match(payload)
     if bad is None or bad.end() != len(payload):
         end = 0 if bad is None else bad.end()
-        raise fail(where, f"this share link holds a character no share link has ({payload[end]!r} at character "
-                   f"{at + len(KEY) + len(version) + 1 + end + 1} of the link)",
-                   "copy the link again whole: a chat program or e-mail may have changed or wrapped it")
+        raise fail(where, N_("this share link holds a character no share link has ({char!r} at character "
+                             "{at} of the link)", char=payload[end], at=at + len(KEY) + len(version) + 1 + end + 1),
+                   N_("copy the link again whole: a chat program or e-mail may have changed or wrapped it"))
     return _unpack(_inflate(payload, where), where)
 
 
 def _check_version(version: int, where: str) -> None:
     if version > FORMAT:
-        raise fail(where, f"this link was made by a newer tablebot (link format {version}; this one reads "
-                   f"format {FORMAT})", "update tablebot (pip install --upgrade tablebot), or ask for the files")
+        raise fail(where, N_("this link was made by a newer tablebot (link format {version}; this one reads "
+                             "format {format})", version=version, format=FORMAT),
+                   N_("update tablebot (pip install --upgrade tablebot), or ask for the files"))
     if version < FORMAT:
-        raise fail(where, f"this link was made by an older tablebot (link format {version}), which this one no "
-                   f"longer reads (it reads format {FORMAT})", "ask for a new link, or for the files")
+        raise fail(where, N_("this link was made by an older tablebot (link format {version}), which this one no "
+                             "longer reads (it reads format {format})", version=version, format=FORMAT),
+                   N_("ask for a new link, or for the files"))
 
 
 def _inflate(payload: str, where: str) -> bytes:
-    cut = f"this share link is cut short or damaged (its {len(payload):,} characters of contents do not unpack)"
-    hint = "copy the whole link again: it is one long line, and the end is often lost"
+    cut = N_("this share link is cut short or damaged (its {count:,} characters of contents do not unpack)",
+             count=len(payload))
+    hint = N_("copy the whole link again: it is one long line, and the end is often lost")
     try:
         packed = base64.urlsafe_b64decode(payload + "=" * (-len(payload) % 4))
     except (binascii.Error, ValueError):
@@ -210,16 +215,16 @@ def _inflate(payload: str, where: str) -> bytes:
     except zlib.error:
         raise fail(where, cut, hint) from None
     if len(data) > MAX_UNPACKED or unpacker.unconsumed_tail:
-        raise fail(where, f"this share link unpacks to more than {MAX_UNPACKED // 2**20} MB: no table is that large",
-                   "share the files instead")
+        raise fail(where, N_("this share link unpacks to more than {mb} MB: no table is that large",
+                             mb=MAX_UNPACKED // 2**20), N_("share the files instead"))
     if not unpacker.eof:
         raise fail(where, cut, hint)
     return data
 
 
 def _unpack(data: bytes, where: str) -> Shared:
-    broken = fail(where, "this share link unpacks, but not to a table and its files",
-                  "make it again with `tablebot share` or the studio's Share button")
+    broken = fail(where, N_("this share link unpacks, but not to a table and its files"),
+                  N_("make it again with `tablebot share` or the studio's Share button"))
     try:
         body = json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError):
@@ -232,8 +237,8 @@ def _unpack(data: bytes, where: str) -> Shared:
     if table is None or (world is not None and not isinstance(world, str)):
         raise broken
     if not table[0].lower().endswith((".csv", ".tsv")) or (robot and not robot[0].lower().endswith(".toml")):
-        raise fail(where, "this share link's files are not a table and a robot file",
-                   "make it again with `tablebot share`")
+        raise fail(where, N_("this share link's files are not a table and a robot file"),
+                   N_("make it again with `tablebot share`"))
     name = _NAME_RE.sub("-", body["name"]).strip(" .-")[:100] or "shared"
     return Shared(name, table, robot, world)
 
@@ -245,12 +250,12 @@ def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] 
         return None
     if not (isinstance(value, list) and len(value) == 2 and isinstance(value[0], str)
             and isinstance(value[1], str | dict)):
-        raise fail(where, "this share link unpacks, but not to a table and its files",
-                   "make it again with `tablebot share` or the studio's Share button")
+        raise fail(where, N_("this share link unpacks, but not to a table and its files"),
+                   N_("make it again with `tablebot share` or the studio's Share button"))
     name, text = value[0], _shipped(value[1], where) if isinstance(value[1], dict) else value[1]
     if not _FILE_RE.match(name) or name == WORLD_NAME or not name.lower().endswith((".csv", ".tsv", ".toml")):
-        raise fail(where, f"this share link names a file {name!r} that no shared table has",
-                   "make it again with `tablebot share`")
+        raise fail(where, N_("this share link names a file {name!r} that no shared table has", name=name),
+                   N_("make it again with `tablebot share`"))
     return name, text
 
 
@@ -292,7 +297,7 @@ def _shipped(reference: dict[str, object], where: str) -> str:
     key, digest = reference.get("example"), reference.get("sha256")
     text = _shipped_files().get(key) if isinstance(key, str) else None
     if text is None or _digest(text) != digest:
-        raise fail(where, f"this share link names tablebot's example file {key!r} as another version of tablebot "
-                   "ships it, not as this one does", "use the same version of tablebot as the link's maker, or "
-                   "ask for the files")
+        raise fail(where, N_("this share link names tablebot's example file {key!r} as another version of "
+                             "tablebot ships it, not as this one does", key=key),
+                   N_("use the same version of tablebot as the link's maker, or ask for the files"))
     return text

@@ -9,6 +9,7 @@ from tablebot.diagnostics import fail
 from tablebot.escape import c_comment
 from tablebot.firmware.boards import Wiring
 from tablebot.firmware.framing import tick_payload
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 
 PRESCALERS = ((1, "(1 << CS10)"), (8, "(1 << CS11)"), (64, "((1 << CS11) | (1 << CS10))"),
@@ -36,8 +37,9 @@ def timer_setting(f_cpu: int, tick_ms: int, where: str = "robot") -> tuple[int, 
         counts, rest = divmod(f_cpu * tick_ms, prescaler * 1000)
         if rest == 0 and 0 < counts <= 65536:
             return counts - 1, bits
-    raise fail(where, f"tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz",
-               "use a tick of at most 4000 ms (above 1048 ms, a multiple of 8 ms)")
+    raise fail(where, N_("tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz",
+                         tick_ms=tick_ms, f_cpu=f_cpu),
+               N_("use a tick of at most 4000 ms (above 1048 ms, a multiple of 8 ms)"))
 
 
 def ubrr(f_cpu: int, baud: int) -> int:
@@ -186,8 +188,9 @@ def board_header(machine: Machine, wiring: Wiring, layout: Layout, payload: int 
     board, robot = wiring.board, machine.table.robot
     payload = tick_payload(machine, layout) if payload is None else payload
     if payload + 3 > 128:
-        raise fail(machine.table.path, f"a trace frame of {payload + 3} bytes is too long for the UART ring",
-                   "use fewer outputs and counters")
+        raise fail(machine.table.path, N_("a trace frame of {size} bytes is too long for the UART ring",
+                                          size=payload + 3),
+                   N_("use fewer outputs and counters"))
     top, ticks = timer_setting(board.f_cpu, robot.tick_ms, robot.source)
     isrs, counter_init = _counter_code(machine, wiring)
     channels = [int(t[1:]) - 1 for n, t in wiring.inputs.items() if n in machine.input_bits]

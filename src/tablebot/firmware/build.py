@@ -16,6 +16,7 @@ from tablebot.files import replacing, write_text
 from tablebot.fileset import current, file_set
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import Board, Wiring, load_board, wire
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 
 # -O2 with link-time optimisation: tb_tick() is inlined into the tick interrupt, so the engine
@@ -38,13 +39,17 @@ class Firmware:
     ram: int  # bytes of static RAM: .data + .bss (the stack comes on top)
 
 
+#: The hint of a failure that is tablebot's own, not the user's.
+BUG = N_("report this as a tablebot bug")
+
+
 def tool(name: str) -> str:
     found = shutil.which(name)
     if not found:
-        raise fail(name, f"{name} not found (only firmware needs it)", "install the AVR toolchain: on Debian or "
-                   "Ubuntu sudo apt-get install gcc-avr avr-libc; on macOS brew tap osx-cross/avr, then brew install "
-                   "avr-gcc; on Windows unpack Microchip's AVR 8-bit Toolchain (Windows) and add its bin folder to "
-                   "PATH (docs/install.md)")
+        raise fail(name, N_("{name} not found (only firmware needs it)", name=name),
+                   N_("install the AVR toolchain: on Debian or Ubuntu sudo apt-get install gcc-avr avr-libc; on macOS "
+                      "brew tap osx-cross/avr, then brew install avr-gcc; on Windows unpack Microchip's AVR 8-bit "
+                      "Toolchain (Windows) and add its bin folder to PATH (docs/install.md)"))
     return found
 
 
@@ -69,7 +74,7 @@ def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "a
 def _run(command: list[str], what: str) -> str:
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(command[0], f"{what} failed", "report this as a tablebot bug", detail=done.stderr.strip())
+        raise fail(command[0], N_("{tool} failed", tool=what), BUG, detail=done.stderr.strip())
     return done.stdout
 
 

@@ -19,6 +19,7 @@ from tablebot.firmware.boards import Wiring
 from tablebot.firmware.build import Firmware
 from tablebot.firmware.framing import Decoder, Hello
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 
 ADC_OPEN_MV = 5000  # an open ftDuino input: pulled up to 5 V
@@ -47,13 +48,13 @@ def build_harness(where: Path | None = None) -> Path:
     cc = shutil.which("cc") or shutil.which("gcc")
     flags = subprocess.run(["pkg-config", "--cflags", "simavr"], capture_output=True, text=True, check=False)
     if not cc or flags.returncode:
-        raise fail("harness", "cannot build the simavr harness: need a C compiler and libsimavr-dev",
-                   "apt-get install gcc simavr libsimavr-dev libelf-dev pkg-config (scripts/bootstrap.sh)")
+        raise fail("harness", N_("cannot build the simavr harness: need a C compiler and libsimavr-dev"),
+                   N_("apt-get install gcc simavr libsimavr-dev libelf-dev pkg-config (scripts/bootstrap.sh)"))
     command = [cc, "-O2", "-Wall", "-Wextra", *flags.stdout.split(), str(folder / "harness.c"),
                "-lsimavr", "-lelf", "-o", str(exe) + ".tmp"]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail("harness", "compiling the harness failed", "check libsimavr-dev", detail=done.stderr)
+        raise fail("harness", N_("compiling the harness failed"), N_("check libsimavr-dev"), detail=done.stderr)
     os.replace(str(exe) + ".tmp", exe)  # atomic: parallel test workers may race here
     return exe
 
@@ -106,8 +107,9 @@ class Emulation:
 def run_harness(harness: Path, args: list[str], timeout: float = 120) -> None:
     done = subprocess.run([str(harness), *args], capture_output=True, text=True, timeout=timeout, check=False)
     if done.returncode:
-        raise fail("harness", f"emulation failed ({done.returncode}): {done.stderr.strip()}",
-                   "run the harness by hand with the same arguments to see more")
+        raise fail("harness", N_("emulation failed ({code}): {error}", code=done.returncode,
+                                 error=done.stderr.strip()),
+                   N_("run the harness by hand with the same arguments to see more"))
 
 
 def read_cycles(path: Path) -> tuple[int, list[TickCycles]]:
@@ -126,7 +128,8 @@ def emulate(firmware: Firmware, machine: Machine, ticks: Sequence[TickInput], wo
             harness: Path | None = None) -> Emulation:
     """Run the firmware over recorded inputs and decode what it sent."""
     if firmware.wiring is None:
-        raise fail(firmware.elf, "this firmware has no wiring (a benchmark build?)", "build with main firmware")
+        raise fail(firmware.elf, N_("this firmware has no wiring (a benchmark build?)"),
+                   N_("build with main firmware"))
     harness = harness or build_harness()
     workdir.mkdir(parents=True, exist_ok=True)
     pins, ticks_out, uart = workdir / "pins.csv", workdir / "ticks.csv", workdir / "uart.bin"

@@ -10,6 +10,7 @@ from typing import Any
 
 from tablebot.codegen.host import trace_line
 from tablebot.codegen.packing import Layout, plan
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 
 # A frame is 0x7E TYPE PAYLOAD CHECK; CHECK makes the 8-bit sum of TYPE, PAYLOAD and CHECK zero.
@@ -91,7 +92,7 @@ class Decoder:
                 break
             body = bytes(buf[at + 1:end])
             if sum(body) & 0xFF:
-                self.problems.append(f"bad checksum at byte {self.consumed + at}; resynchronising")
+                self.problems.append(N_("bad checksum at byte {at}; resynchronising", at=self.consumed + at))
                 at += 1
                 continue
             line = self._frame(body[0], body[1:-1])
@@ -124,7 +125,7 @@ class Decoder:
         row = NO_ROW if row == lay.no_row else row
         wrong = self._impossible(event, row, state, timer)
         if wrong:
-            self.problems.append(f"tick frame {tick16} {wrong}: not this table's firmware?")
+            self.problems.append(N_("tick frame {tick} {wrong}: not this table's firmware?", tick=tick16, wrong=wrong))
             self.rejected += 1
             return None
         outputs = [b - 256 if b > 127 else b for b in payload[at:at + self.n_outputs]]
@@ -139,20 +140,22 @@ class Decoder:
         no row fired, none matches and T is present exactly when the timer is 0."""
         machine = self.machine
         if state >= len(machine.states):
-            return f"names state index {state}"
+            return N_("names state index {state}", state=state)
         if event >> len(machine.table.events):
-            return f"has event bits {event:#x} beyond the table's {len(machine.table.events)} events"
+            return N_("has event bits {bits:#x} beyond the table's {count} events", bits=event,
+                      count=len(machine.table.events))
         if row == NO_ROW:
             if machine.lookup(state, event) != NO_ROW:
-                return f"says no row fired, but row {machine.lookup(state, event)} matches its events"
+                return N_("says no row fired, but row {row} matches its events", row=machine.lookup(state, event))
             if machine.timer_bit and (timer == 0) != bool(event & machine.timer_bit):
-                return f"has timer {timer} but {'no ' * (timer == 0)}T event"
+                return N_("has timer {timer} but no T event", timer=timer) if timer == 0 else \
+                    N_("has timer {timer} but T event", timer=timer)
             return ""
         if row >= len(machine.rows):
-            return f"names row {row}"
+            return N_("names row {row}", row=row)
         fired = machine.rows[row]
         if (fired.next, fired.timer) != (state, timer) or fired.mask & event != fired.mask:
-            return f"says row {row} fired, but its events, state or timer are not that row's"
+            return N_("says row {row} fired, but its events, state or timer are not that row's", row=row)
         return ""
 
     def _unwrap(self, tick16: int) -> int:
@@ -162,7 +165,8 @@ class Decoder:
         else:
             tick = self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
             if tick != self.last_tick + 1:
-                self.problems.append(f"ticks {self.last_tick + 1}..{tick - 1} missing from the stream")
+                self.problems.append(N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1,
+                                        last=tick - 1))
         self.last_tick = tick
         return tick
 

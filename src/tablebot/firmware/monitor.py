@@ -11,10 +11,11 @@ from pathlib import Path
 from typing import IO, Any
 
 from tablebot.codegen.packing import plan
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import fail, severity_word
 from tablebot.firmware.framing import Decoder
 from tablebot.firmware.several import SeveralDecoder
 from tablebot.formats.trace_lines import dumps
+from tablebot.i18n import N_, localise
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables, several
 
@@ -27,12 +28,13 @@ def chunks_from(source: str, baud: int, seconds: float | None) -> Iterator[bytes
     """The bytes of a capture file, or of a serial port when ``source`` names one."""
     path = Path(source)
     if path.is_dir():
-        raise fail(source, "is a folder, not a capture file or serial port", "give the file of captured bytes")
+        raise fail(source, N_("is a folder, not a capture file or serial port"),
+                   N_("give the file of captured bytes"))
     if path.is_file():
         return file_chunks(path)
     if not PORT_RE.match(source):
-        raise fail(source, "no such file, and not a serial port name",
-                   "give a file of captured UART bytes, or a port such as /dev/ttyACM0 or COM3")
+        raise fail(source, N_("no such file, and not a serial port name"),
+                   N_("give a file of captured UART bytes, or a port such as /dev/ttyACM0 or COM3"))
     return serial_chunks(source, baud, seconds)
 
 
@@ -47,12 +49,13 @@ def serial_chunks(port: str, baud: int, seconds: float | None) -> Iterator[bytes
     try:
         import serial  # pyserial, only needed for a live port
     except ImportError:
-        raise fail(port, "reading a serial port needs pyserial", "pip install pyserial") from None
+        raise fail(port, N_("reading a serial port needs pyserial"), "pip install pyserial") from None
     try:
         link = serial.Serial(port, baud, timeout=0.1)
     except (serial.SerialException, OSError) as exc:
-        raise fail(port, f"cannot open serial port: {exc}", "check the port name (ls /dev/tty*) and "
-                   "that no other program (an IDE's serial monitor) holds it") from None
+        raise fail(port, N_("cannot open serial port: {error}", error=str(exc)),
+                   N_("check the port name (ls /dev/tty*) and that no other program (an IDE's serial monitor) "
+                      "holds it")) from None
     end = None if seconds is None else time.monotonic() + seconds
     with link:
         while end is None or time.monotonic() < end:
@@ -67,8 +70,8 @@ def check_hello(decoder: Decoder, source: str) -> None:
     assert layout is not None
     for hello in decoder.hellos:
         if hello.table_hash != layout.table_hash:
-            raise fail(source, f"the firmware runs another table (hash 0x{hello.table_hash:08x}, "
-                       f"this table 0x{layout.table_hash:08x})", "give the table the firmware was built from")
+            raise fail(source, N_("the firmware runs another table (hash 0x{theirs:08x}, this table 0x{ours:08x})",
+                                  theirs=hello.table_hash, ours=layout.table_hash), BUILT_FROM)
 
 
 def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str,
@@ -93,15 +96,24 @@ def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str
             return written
         out.flush()
     if not decoder.hellos and not decoder.ticks:
-        raise fail(source, f"no trace frame in {decoder.consumed + len(decoder.buffer)} bytes",
-                   "give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this table by "
-                   "`tablebot build`")
+        raise fail(source, N_("no trace frame in {count} bytes", count=decoder.consumed + len(decoder.buffer)),
+                   N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this table by "
+                      "`tablebot build`"))
     if decoder.rejected * 10 > decoder.rejected + decoder.ticks:  # more than noise: another table's stream
-        raise fail(source, f"{decoder.rejected} of {decoder.rejected + decoder.ticks} tick frames are impossible for "
-                   "this table", "give the table the firmware was built from")
+        raise fail(source, N_("{rejected} of {count} tick frames are impossible for this table",
+                              rejected=decoder.rejected, count=decoder.rejected + decoder.ticks), BUILT_FROM)
     if decoder.buffer:
-        warn(f"{source}: warning: {len(decoder.buffer)} bytes at the end are not a whole frame")
+        warn(_warning(source, N_("{count} bytes at the end are not a whole frame", count=len(decoder.buffer))))
     return written
+
+
+#: The hint of a stream from another table's firmware.
+BUILT_FROM = N_("give the table the firmware was built from")
+
+
+def _warning(source: str, text: str) -> str:
+    """A warning line in the reader's language: ``SOURCE: warning: TEXT``."""
+    return f"{source}: {severity_word('warning')}: {localise(text)}"
 
 
 def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str], source: str, ticks: int | None,
@@ -119,11 +131,11 @@ def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str],
             return written
         out.flush()
     if not decoder.hellos and not decoder.ticks:
-        raise fail(source, f"no trace frame in {decoder.consumed + len(decoder.buffer)} bytes",
-                   "give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this robot by "
-                   "`tablebot build`")
+        raise fail(source, N_("no trace frame in {count} bytes", count=decoder.consumed + len(decoder.buffer)),
+                   N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this robot by "
+                      "`tablebot build`"))
     if decoder.buffer:
-        warn(f"{source}: warning: {len(decoder.buffer)} bytes at the end are not a whole frame")
+        warn(_warning(source, N_("{count} bytes at the end are not a whole frame", count=len(decoder.buffer))))
     return written
 
 
@@ -131,9 +143,9 @@ def _warn(decoder: Decoder | SeveralDecoder, source: str, warn: Callable[[str], 
     """Pass the decoder's new problems on, up to MAX_WARNINGS in all; returns how many were passed."""
     for problem in decoder.problems:
         if warned < MAX_WARNINGS:
-            warn(f"{source}: warning: {problem}")
+            warn(_warning(source, problem))
         elif warned == MAX_WARNINGS:
-            warn(f"{source}: warning: more problems follow; not shown")
+            warn(_warning(source, N_("more problems follow; not shown")))
         warned += 1
     decoder.problems.clear()
     return warned

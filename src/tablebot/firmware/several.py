@@ -20,10 +20,11 @@ from tablebot.files import replacing, write_text
 from tablebot.fileset import current, file_set
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import load_board, wire
-from tablebot.firmware.build import CFLAGS, Firmware, _run, c_source, sizes, tool
+from tablebot.firmware.build import BUG, CFLAGS, Firmware, _run, c_source, sizes, tool
 from tablebot.firmware.emulate import build_harness, pins_csv, run_harness
 from tablebot.firmware.framing import SYNC, checksum
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
 
@@ -83,7 +84,8 @@ def emulate_several(firmware: Firmware, tables: RobotTables, ticks: Sequence[Tic
                                   "--uart-out", str(uart), "--flush-ms", str(FLUSH_MS)])
     lines = decode(tables, uart.read_bytes())
     if len(lines) < len(ticks):
-        raise fail("uart", f"{len(lines)} tick frames for {len(ticks)} ticks", "report this as a tablebot bug")
+        raise fail("uart", N_("{frames} tick frames for {ticks} ticks", frames=len(lines), ticks=len(ticks)),
+                   BUG)
     return lines[:len(ticks)]
 
 
@@ -93,7 +95,7 @@ def decode(tables: RobotTables, data: bytes) -> list[dict[str, Any]]:
     decoder = SeveralDecoder(tables)
     lines = decoder.feed(data)
     if decoder.problems:
-        raise fail("uart", decoder.problems[0], "report this as a tablebot bug")
+        raise fail("uart", decoder.problems[0], BUG)
     return lines
 
 
@@ -129,7 +131,7 @@ class SeveralDecoder:
                 break
             body = bytes(buf[at + 1:end])
             if checksum(body[:-1]) != body[-1]:
-                self.problems.append(f"bad checksum at byte {self.consumed + at}; resynchronising")
+                self.problems.append(N_("bad checksum at byte {at}; resynchronising", at=self.consumed + at))
                 at += 1
                 continue
             if body[0] == TICK:
@@ -147,14 +149,16 @@ class SeveralDecoder:
         self.hellos += 1
         self.last_tick = None  # the firmware restarted: its tick count starts again at 0
         if payload[0] != VERSION or payload[1] != len(self.tables.machines):
-            self.problems.append(f"the firmware says version {payload[0]}, {payload[1]} tables: not this robot's")
+            self.problems.append(N_("the firmware says version {version}, {count} tables: not this robot's",
+                                    version=payload[0], count=payload[1]))
 
     def _line(self, payload: bytes) -> dict[str, Any]:
         tables = self.tables
         tick16 = struct.unpack_from("<H", payload)[0]
         tick = tick16 if self.last_tick is None else self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
         if self.last_tick is not None and tick != self.last_tick + 1:
-            self.problems.append(f"ticks {self.last_tick + 1}..{tick - 1} missing from the stream")
+            self.problems.append(N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1,
+                                    last=tick - 1))
         self.last_tick = tick
         line: dict[str, Any] = {"tick": tick}
         at, size = 2, struct.calcsize(TABLE_FORMAT)
