@@ -110,12 +110,14 @@ def several(table: Table) -> RobotTables | None:
     return load_tables(table) if tables_of(table.robot) else None
 
 
-def load_tables(table: Table) -> RobotTables:
-    """Every table of ``table``'s robot (``table`` itself is one of them, read already), checked together:
-    cross-table events name states their table has, and every output has one writer."""
+def load_tables(table: Table, given: Mapping[str, Table] | None = None) -> RobotTables:
+    """Every table of ``table``'s robot (``table`` itself is one of them, read already; ``given``: others read
+    already, by name, such as the studio's drafts), checked together: cross-table events name states their
+    table has, and every output has one writer."""
     specs = tables_of(table.robot)
     base = Path(table.robot.source).parent
-    tables = tuple(table if spec.name == table.name else _load(base, spec, table.robot) for spec in specs)
+    read = {**(given or {}), table.name: table}
+    tables = tuple(read[spec.name] if spec.name in read else _load(base, spec, table.robot) for spec in specs)
     problems = [*_cross_problems(tables), *_writer_problems(tables), *_named_problems(tables)]
     if problems:
         raise TableBotError(problems)
