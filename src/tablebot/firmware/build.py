@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -24,6 +25,9 @@ from tablebot.machine import Machine
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-flto", "-ffunction-sections", "-fdata-sections")
 FIRMWARE_MAIN = "tb_firmware.c"
 BENCH_MAIN = "tb_bench.c"
+#: The C every main includes beside the generated files: the cycle markers, and main(), the tick interrupt and
+#: the frame ring that tb_firmware.c and tb_firmware_several.c share.
+SHARED_HEADERS = ("tb_mark.h", "tb_tick_frames.h")
 
 
 @dataclass(frozen=True)
@@ -67,8 +71,14 @@ def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "a
         wiring = wire(machine.table.robot, board)
         write_text(srcdir / "tb_board.h", board_header(machine, wiring, source.layout))
         write_text(srcdir / f"board_{board.name}.h", c_source(f"board_{board.name}.h"))
-    write_text(srcdir / main, c_source(main))
+    write_main(srcdir, main)
     return wiring, source.layout
+
+
+def write_main(srcdir: Path, main: str) -> None:
+    """A firmware's main C file and the headers it shares with the other mains into ``srcdir``."""
+    for name in (*SHARED_HEADERS, main):
+        write_text(srcdir / name, c_source(name))
 
 
 def _run(command: list[str], what: str) -> str:
@@ -93,12 +103,18 @@ def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto",
     elf, hexfile = outdir / f"{stem}.elf", outdir / f"{stem}.hex"
     with file_set(outdir):  # sources, .elf and .hex replace the previous build's at once
         wiring, layout = write_sources(machine, board, srcdir, lookup, main)
-        # until the set is swapped in, the tools read the files where they are being written
-        sources = [str(current(srcdir / name)) for name in (main, "tb_engine.c", "tb_table.c")]
-        with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
-            _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS,
-                  f"-I{current(srcdir)}", "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
-        with replacing(hexfile) as temp:
-            _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(current(elf)), str(temp)], "avr-objcopy")
-        flash, ram = sizes(current(elf))
+        flash, ram = compile_and_link(board, srcdir, (main, "tb_engine.c", "tb_table.c"), elf, hexfile)
     return Firmware(elf, hexfile, board, wiring, layout, flash, ram)
+
+
+def compile_and_link(board: Board, srcdir: Path, units: Sequence[str], elf: Path, hexfile: Path) -> tuple[int, int]:
+    """avr-gcc the C ``units`` of ``srcdir`` into ``elf`` and ``hexfile``, inside a :func:`file_set` of their
+    folder; (flash, static RAM) in bytes."""
+    # until the set is swapped in, the tools read the files where they are being written
+    sources = [str(current(srcdir / name)) for name in units]
+    with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
+        _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS,
+              f"-I{current(srcdir)}", "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
+    with replacing(hexfile) as temp:
+        _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(current(elf)), str(temp)], "avr-objcopy")
+    return sizes(current(elf))

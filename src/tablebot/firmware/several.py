@@ -16,11 +16,11 @@ from typing import Any
 from tablebot.codegen.several import generate_several
 from tablebot.diagnostics import fail
 from tablebot.engine.as_one import robot_machine
-from tablebot.files import replacing, write_text
-from tablebot.fileset import current, file_set
+from tablebot.files import write_text
+from tablebot.fileset import file_set
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import load_board, wire
-from tablebot.firmware.build import BUG, CFLAGS, Firmware, _run, c_source, sizes, tool
+from tablebot.firmware.build import BUG, Firmware, c_source, compile_and_link, write_main
 from tablebot.firmware.emulate import build_harness, pins_csv, run_harness
 from tablebot.firmware.framing import SYNC, checksum
 from tablebot.formats.inputs_csv import TickInput
@@ -58,15 +58,9 @@ def build_several(tables: RobotTables, board_name: str, outdir: Path, machine: M
         wiring = wire(machine.table.robot, board)
         write_text(srcdir / "tb_board.h", board_header(machine, wiring, source.layout, payload))
         write_text(srcdir / f"board_{board.name}.h", c_source(f"board_{board.name}.h"))
-        write_text(srcdir / MAIN, c_source(MAIN))
+        write_main(srcdir, MAIN)
         units = [name for name in source.files if name.endswith(".c") and name != "tb_engine.c"]
-        sources = [str(current(srcdir / name)) for name in (MAIN, *units)]
-        with replacing(elf) as temp:
-            _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS,
-                  f"-I{current(srcdir)}", "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
-        with replacing(hexfile) as temp:
-            _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(current(elf)), str(temp)], "avr-objcopy")
-        flash, ram = sizes(current(elf))
+        flash, ram = compile_and_link(board, srcdir, (MAIN, *units), elf, hexfile)
     return Firmware(elf, hexfile, board, wiring, source.layout, flash, ram)
 
 

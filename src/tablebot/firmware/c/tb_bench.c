@@ -10,13 +10,7 @@
 #include <avr/sleep.h>
 
 #include "tb_engine.h"
-
-#define TB_MARK(v)                                   \
-    do {                                             \
-        __asm__ __volatile__("" ::: "memory");       \
-        GPIOR0 = (v);                                \
-        __asm__ __volatile__("" ::: "memory");       \
-    } while (0)
+#include "tb_mark.h"
 
 #ifndef TB_BENCH_MAX_EVENTS
 #define TB_BENCH_MAX_EVENTS 4096UL /* event sets per state: all of them up to 12 event columns */

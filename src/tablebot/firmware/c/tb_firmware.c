@@ -1,92 +1,39 @@
 /* tablebot firmware: the generated table runs in a timer interrupt every tick (10 ms by default)
- * and each tick's trace goes out over the UART as one frame.
- *
- * Tick interrupt: sample the inputs (and encoder pulses), tb_tick(), drive the outputs, queue
- * the trace frame. The UART sends from a ring buffer in its own interrupt; main() sleeps.
- * Frames (decoded by tablebot.firmware.framing, documented in docs/firmware.md):
- *   0x7E TYPE PAYLOAD CHECK   with CHECK making TYPE + PAYLOAD + CHECK sum to 0 mod 256.
+ * and each tick's trace goes out over the UART as one frame (tb_tick_frames.h: main, the tick
+ * interrupt, the frame ring). Frames (decoded by tablebot.firmware.framing, docs/firmware.md):
  *   'H' hello, once at start: version, table hash, states, rows, event bytes, outputs, counters,
  *       tick in ms.
  *   'T' tick: tick number (16 bit), event, row, state, timer, outputs (int8), counters (16 bit),
  *       all little-endian, widths as in tb_config.h.
- * GPIOR0 markers let an emulator count cycles: 1 tick start, 2 step start, 3 step end, 4 tick end.
  */
-#include <avr/interrupt.h>
+#include <avr/interrupt.h> /* before tb_board.h: its encoder interrupts */
 #include <avr/io.h>
 #include <avr/sleep.h>
 
 #include "tb_engine.h"
 #include "tb_board.h"
 
-#define TB_SYNC 0x7E
-#define TB_FRAME_HELLO 'H'
 #define TB_FRAME_TICK 'T'
 #define TB_FRAME_VERSION 1
-#define TB_TX_MASK (TB_TX_SIZE - 1)
+#define TB_FW_COUNTERS TB_N_COUNTERS
 
-/* The barriers keep the compiler from moving work across a marker. */
-#define TB_MARK(v)                                   \
-    do {                                             \
-        __asm__ __volatile__("" ::: "memory");       \
-        GPIOR0 = (v);                                \
-        __asm__ __volatile__("" ::: "memory");       \
-    } while (0)
+#include "tb_tick_frames.h"
 
 static tb_engine_t engine;
-static uint16_t tick_no;
-static uint8_t tx_buf[TB_TX_SIZE];
-static volatile uint8_t tx_head, tx_tail;
 
-/* A frame being written into the ring: a local, so that it lives in registers. */
-typedef struct {
-    uint8_t at, sum;
-} frame_t;
-
-static inline void put(frame_t *f, uint8_t b)
+static inline void tb_fw_init(void)
 {
-    tx_buf[f->at] = b;
-    f->at = (uint8_t)((f->at + 1) & TB_TX_MASK);
-    f->sum = (uint8_t)(f->sum + b);
+    tb_init(&engine);
 }
 
-static inline void put_le(frame_t *f, uint32_t v, uint8_t n)
+static inline void tb_fw_step(tb_event_t inputs, const uint16_t *pulses)
 {
-    while (n--) {
-        put(f, (uint8_t)v);
-        v >>= 8;
-    }
+    tb_tick(&engine, inputs, pulses);
 }
 
-/* Start a frame of `len` payload bytes, or refuse (0) when the ring cannot take it whole:
- * the frame is dropped and the decoder sees a gap in the tick numbers. */
-static inline uint8_t frame_begin(frame_t *f, uint8_t type, uint8_t len)
+static inline void tb_fw_outputs(void)
 {
-    uint8_t room = (uint8_t)((tx_tail - tx_head - 1) & TB_TX_MASK);
-    if (room < (uint8_t)(len + 3))
-        return 0;
-    f->at = tx_head;
-    put(f, TB_SYNC);
-    f->sum = 0;
-    put(f, type);
-    return 1;
-}
-
-static inline void frame_end(frame_t *f)
-{
-    put(f, (uint8_t)(0 - f->sum));
-    tx_head = f->at;
-    TB_UCSRB |= 1 << TB_UDRIE;
-}
-
-ISR(TB_UDRE_vect)
-{
-    uint8_t t = tx_tail;
-    if (t == tx_head) {
-        TB_UCSRB &= (uint8_t)~(1 << TB_UDRIE);
-        return;
-    }
-    TB_UDR = tx_buf[t];
-    tx_tail = (uint8_t)((t + 1) & TB_TX_MASK);
+    tb_wiring_outputs(engine.out);
 }
 
 static void send_hello(void)
@@ -126,39 +73,4 @@ static void send_tick(void)
         put_le(&f, engine.counter[i], 2);
 #endif
     frame_end(&f);
-}
-
-ISR(TIMER1_COMPA_vect)
-{
-    tb_event_t inputs;
-    uint16_t pulses[TB_N_COUNTERS > 0 ? TB_N_COUNTERS : 1];
-    TB_MARK(1);
-    inputs = tb_wiring_inputs();
-    tb_wiring_pulses(pulses);
-    TB_MARK(2);
-    tb_tick(&engine, inputs, pulses);
-    TB_MARK(3);
-    tb_wiring_outputs(engine.out);
-    send_tick();
-    tick_no++;
-    TB_MARK(4);
-}
-
-int main(void)
-{
-    tb_init(&engine);
-    tb_board_init();
-    tb_wiring_init();
-    tb_uart_init(TB_UBRR);
-    TB_MARK(0xE0); /* two markers back to back: the emulator's measure of marker overhead */
-    TB_MARK(0xE1);
-    send_hello();
-    OCR1A = TB_TICK_TOP;
-    TCCR1A = 0;
-    TCCR1B = (1 << WGM12) | TB_TICK_CS; /* CTC: an interrupt every tick */
-    TIMSK1 = 1 << OCIE1A;
-    set_sleep_mode(SLEEP_MODE_IDLE);
-    sei();
-    for (;;)
-        sleep_mode();
 }

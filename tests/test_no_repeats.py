@@ -1,0 +1,27 @@
+"""Code written once (issue 35): the places a review found repeating each other share no run of six lines.
+A run is six lines alike once indentation and blank lines are set aside; the firmware's C mains share theirs
+through tb_tick_frames.h, the Python helpers through the one module each was moved to."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "tablebot"
+RUN = 6
+
+
+def runs(path: Path) -> set[tuple[str, ...]]:
+    """Every run of RUN consecutive non-blank lines of a file, stripped."""
+    lines = [line.strip() for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+    return {tuple(lines[i:i + RUN]) for i in range(len(lines) - RUN + 1)}
+
+
+@pytest.mark.parametrize(("one", "other"), [
+    ("firmware/c/tb_firmware.c", "firmware/c/tb_firmware_several.c"),
+    ("firmware/c/tb_bench.c", "firmware/c/tb_firmware_several.c"),
+])
+def test_no_run_of_six_lines_stands_in_both(one: str, other: str) -> None:
+    shared = runs(SRC / one) & runs(SRC / other)
+    assert not shared, "\n".join(sorted("\n".join(run) for run in shared)[:1])
