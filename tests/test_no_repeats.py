@@ -21,6 +21,10 @@ def runs(path: Path) -> set[tuple[str, ...]]:
 @pytest.mark.parametrize(("one", "other"), [
     ("firmware/c/tb_firmware.c", "firmware/c/tb_firmware_several.c"),
     ("firmware/c/tb_bench.c", "firmware/c/tb_firmware_several.c"),
+    # cross-table events per state: tablebot.engine.several.cross_bits
+    ("codegen/several.py", "engine/several.py"),
+    ("codegen/several.py", "hw/txt4/export.py"),
+    ("engine/several.py", "hw/txt4/export.py"),
 ])
 def test_no_run_of_six_lines_stands_in_both(one: str, other: str) -> None:
     shared = runs(SRC / one) & runs(SRC / other)

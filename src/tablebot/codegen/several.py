@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from tablebot.codegen.packing import MAX_EVENTS, plan
 from tablebot.codegen.source import ENGINE_FILES, CSource, c_list, config_header, table_source, template
 from tablebot.diagnostics import fail
+from tablebot.engine.several import cross_bits, input_bits
 from tablebot.escape import c_comment
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
@@ -160,21 +161,12 @@ const int8_t *tb_robot_tick(tb_robot_t *r, uint32_t inputs, const uint16_t *puls
 
 def _events(tables: RobotTables, index: int) -> list[str]:
     """The C that builds table ``index``'s events from the robot's inputs and the states at the tick's start."""
-    machine, table = tables.machines[index], tables.tables[index]
     prefix = unit_name(tables.names[index])
     lines = [f"static uint32_t {prefix}_events(uint32_t inputs, const uint16_t *states)", "{",
              "    uint32_t e = 0;", "    (void)inputs;", "    (void)states;"]
-    for name, bit in tables.input_bits.items():
-        if name in machine.input_bits:
-            own = machine.input_bits[name]
-            lines += [f"    if (inputs & {bit}uL)  /* {c_comment(name)} */", f"        e |= {own}uL;"]
-    by_source: dict[int, list[int]] = {}
-    for name, event in table.cross.items():
-        source, states = tables.covers(event)
-        bits = by_source.setdefault(source, [0] * len(tables.machines[source].states))
-        for state in states:
-            bits[state] |= table.bit(name)
-    for source, bits in sorted(by_source.items()):
+    for name, bit, own in input_bits(tables, index):
+        lines += [f"    if (inputs & {bit}uL)  /* {c_comment(name)} */", f"        e |= {own}uL;"]
+    for source, bits in cross_bits(tables, index):
         array = f"{prefix}_from_{tables.names[source]}"
         lines[:0] = [f"/* {c_comment(tables.names[index])}'s events per state of table "
                      f"{c_comment(tables.names[source])} at the start of the tick. */",

@@ -11,6 +11,8 @@ import numpy as np
 from tablebot.engine import Engine
 from tablebot.tables import RobotTables
 
+__all__ = ["LIST_BITS", "Several", "cross_bits", "input_bits"]
+
 #: Robot input masks of at most this many bits get a precomputed list per table (robot mask -> table bits).
 LIST_BITS = 12
 
@@ -30,7 +32,7 @@ class Several:
         #: The order the tables are stepped in (any order gives the same ticks: a test permutes it).
         self.order = tuple(range(len(self.engines)) if order is None else order)
         self.input_maps = [_input_map(tables, i) for i in range(len(self.engines))]
-        self.cross_maps = [_cross_map(tables, i) for i in range(len(self.engines))]
+        self.cross_maps = [cross_bits(tables, i) for i in range(len(self.engines))]
         robot = tables.robot
         self._writers = [tables.writer(name) for name in tables.output_names]
         self._counter_writers = [(c, w) for c, name in enumerate(robot.counter_names)
@@ -82,18 +84,16 @@ class Several:
         return int(inputs)
 
 
-def _input_map(tables: RobotTables, index: int) -> Callable[[int], int]:
-    """Robot mask -> the table's input bits: a list when the robot has few inputs, else a loop."""
-    machine = tables.machines[index]
-    pairs = [(bit, machine.input_bits[name]) for name, bit in tables.input_bits.items() if name in machine.input_bits]
-    width = len(tables.input_bits)
-    if width <= LIST_BITS:
-        return [sum(table_bit for bit, table_bit in pairs if mask & bit) for mask in range(1 << width)].__getitem__
-    return lambda mask: sum(table_bit for bit, table_bit in pairs if mask & bit)
+def input_bits(tables: RobotTables, index: int) -> list[tuple[str, int, int]]:
+    """(name, robot bit, table bit) of every robot input table ``index`` reads, in the robot's order: where its
+    inputs are, as this engine, the generated C and the TXT 4.0's program read them."""
+    own = tables.machines[index].input_bits
+    return [(name, bit, own[name]) for name, bit in tables.input_bits.items() if name in own]
 
 
-def _cross_map(tables: RobotTables, index: int) -> list[tuple[int, list[int]]]:
-    """Per table another table's state may be read from: (its index, its state index -> this table's bits)."""
+def cross_bits(tables: RobotTables, index: int) -> list[tuple[int, list[int]]]:
+    """Per table that table ``index`` reads the state of, in index order: (its index, its state index -> this
+    table's cross-table event bits); the one reading of cross-table events every executor shares."""
     table = tables.tables[index]
     by_source: dict[int, list[int]] = {}
     for name, event in table.cross.items():
@@ -102,4 +102,13 @@ def _cross_map(tables: RobotTables, index: int) -> list[tuple[int, list[int]]]:
         for state in states:
             bits[state] |= table.bit(name)
     return sorted(by_source.items())
+
+
+def _input_map(tables: RobotTables, index: int) -> Callable[[int], int]:
+    """Robot mask -> the table's input bits: a list when the robot has few inputs, else a loop."""
+    pairs = [(bit, own) for _, bit, own in input_bits(tables, index)]
+    width = len(tables.input_bits)
+    if width <= LIST_BITS:
+        return [sum(table_bit for bit, table_bit in pairs if mask & bit) for mask in range(1 << width)].__getitem__
+    return lambda mask: sum(table_bit for bit, table_bit in pairs if mask & bit)
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.engine.as_one import robot_machine
+from tablebot.engine.several import cross_bits, input_bits
 from tablebot.escape import python_string
 from tablebot.files import write_text
 from tablebot.fileset import file_set
@@ -124,22 +125,13 @@ def tables_data(tables: RobotTables) -> dict[str, Any]:
     """What :class:`runtime.Tables` adds for a robot of several tables: each table's engine, where its inputs
     are in the robot's input layout, its cross-table events per state of each table it reads, and the writer
     of each output and counter (tablebot.tables)."""
-    robot_bits = tables.input_bits
-    cross = []
-    for table in tables.tables:
-        by_source: dict[int, list[int]] = {}
-        for name, event in table.cross.items():
-            source, states = tables.covers(event)
-            bits = by_source.setdefault(source, [0] * len(tables.machines[source].states))
-            for state in states:
-                bits[state] |= table.bit(name)
-        cross.append([[source, bits] for source, bits in sorted(by_source.items())])
+    indices = range(len(tables.machines))
+    cross = [[[source, bits] for source, bits in cross_bits(tables, i)] for i in indices]
     writers = [tables.writer(name) for name in tables.output_names]
     counter_writers = [[c, w] for c, name in enumerate(tables.robot.counter_names)
                        if (w := tables.writer(name)) is not None]
     return {"table_names": list(tables.names), "tables": [engine_data(m) for m in tables.machines],
-            "table_inputs": [[[bit, m.input_bits[name]] for name, bit in robot_bits.items() if name in m.input_bits]
-                             for m in tables.machines],
+            "table_inputs": [[[bit, own] for _, bit, own in input_bits(tables, i)] for i in indices],
             "cross": cross, "writers": [-1 if w is None else w for w in writers], "counter_writers": counter_writers}
 
 
