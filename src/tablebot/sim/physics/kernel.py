@@ -94,43 +94,66 @@ def run_robot(robot: RobotState, world: WorldArrays, program: Program, wiring: W
     ``acc``/``collisions`` (see :func:`observe`), and, when ``record.counts`` has room, tallies each tick
     (numbered from ``record.t0``) into the record's counts, first visits and first light (see :func:`tally`).
     """
+    run_ticks(robot, world, program, wiring, ticks, noise, bitgen, record, robot_scratch(robot, world))
+
+
+@njit(nogil=True, inline="always")
+def robot_scratch(robot: RobotState, world: WorldArrays) -> Scratch:
+    """A robot's working space for a run of its table(s): its counters' pulses and one tick of physics."""
     near, centre = new_near(world.pstart, world.circles)
     reach, wide = reaches(robot.p)
     turns = np.empty(4)
     aim_turns(robot.p, turns)
-    scratch = Scratch(np.zeros(robot.counters.shape[0], dtype=np.int64), np.empty((4, 2)), near, centre, turns,
-                      np.empty(N_NOISE), reach, wide)
-    run_ticks(robot, world, program, wiring, ticks, noise, bitgen, record, scratch)
+    return Scratch(np.zeros(robot.counters.shape[0], dtype=np.int64), np.empty((4, 2)), near, centre, turns,
+                   np.empty(N_NOISE), reach, wide)
 
 
 @njit(nogil=True, refcounts=False)
 def run_ticks(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
               noise: np.ndarray, bitgen: np.uint64, record: Record, scratch: Scratch) -> None:
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
-    s, regs, outputs, counters = robot.s, robot.regs, robot.outputs, robot.counters
-    hist, ints, counts, z, pulses = record.hist, record.ints, record.counts, scratch.z, scratch.pulses
-    pcols, drive = wiring.pulse_columns, wiring.drive
     for t in range(ticks):
-        if hist.shape[0]:
-            for j in range(s.shape[0]):
-                hist[t, j] = s[j]
-        mask = int(s[MASK])
-        for c in range(counters.shape[0]):
-            pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
-        tick_compiled(regs, outputs, counters, mask, pulses, program)
-        if ints.shape[0]:
-            _record(ints, t, mask, regs, outputs, counters, pulses)
-        if counts.shape[0]:
-            tally(counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask,
-                  record.t0 + t)
-        if noise.shape[0]:
-            for k in range(N_NOISE):
-                z[k] = noise[t, k]
-        else:
-            for k in range(N_NOISE):
-                z[k] = standard_normal(bitgen)
-        advance(s, outputs[drive[0]], outputs[drive[1]], robot.p, world, wiring.bits, True, scratch)
-        observe(s, world.lamps, robot.acc, robot.collisions)
+        mask = start_tick(t, robot, wiring, record, scratch)
+        tick_compiled(robot.regs, robot.outputs, robot.counters, mask, scratch.pulses, program)
+        end_tick(t, mask, robot, world, wiring, noise, bitgen, record, scratch)
+
+
+# The two halves of a tick round the tables' tick, shared by every loop (one table here, several in
+# sim.physics.several), so that the rows a robot's run records are written by one piece of code.
+@njit(nogil=True, refcounts=False, inline="always")
+def start_tick(t: int, robot: RobotState, wiring: Wiring, record: Record, scratch: Scratch) -> int:
+    """Tick t starts: the robot row (the robot as its sensors read it) into ``record.hist`` when it keeps rows,
+    the counters' pulses into ``scratch.pulses``; returns the input mask the tables tick on."""
+    s, hist, pulses, pcols = robot.s, record.hist, scratch.pulses, wiring.pulse_columns
+    if hist.shape[0]:
+        for j in range(s.shape[0]):
+            hist[t, j] = s[j]
+    for c in range(pulses.shape[0]):
+        pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
+    return int(s[MASK])
+
+
+@njit(nogil=True, refcounts=False, inline="always")
+def end_tick(t: int, mask: int, robot: RobotState, world: WorldArrays, wiring: Wiring, noise: np.ndarray,
+             bitgen: np.uint64, record: Record, scratch: Scratch) -> None:
+    """Tick t ends, the tables ticked: its integer record into ``record.ints`` and its tally into the record's
+    counts (each when it has rows), then the robot moves one tick on noise row t (or a row drawn from
+    ``bitgen``: see :func:`run_robot`) and its new row is folded into its summary."""
+    regs, outputs, z = robot.regs, robot.outputs, scratch.z
+    if record.ints.shape[0]:
+        _record(record.ints, t, mask, regs, outputs, robot.counters, scratch.pulses)
+    if record.counts.shape[0]:
+        tally(record.counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask,
+              record.t0 + t)
+    if noise.shape[0]:
+        for k in range(N_NOISE):
+            z[k] = noise[t, k]
+    else:
+        for k in range(N_NOISE):
+            z[k] = standard_normal(bitgen)
+    drive = wiring.drive
+    advance(robot.s, outputs[drive[0]], outputs[drive[1]], robot.p, world, wiring.bits, True, scratch)
+    observe(robot.s, world.lamps, robot.acc, robot.collisions)
 
 
 @njit(nogil=True, refcounts=False, inline="always")

@@ -18,12 +18,8 @@ import numpy as np
 from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.sim.columns import MASK, N_NOISE
-from tablebot.sim.physics.contacts import new_near, reaches
-from tablebot.sim.physics.kernel import _record, observe, tally
-from tablebot.sim.physics.normals import standard_normal
-from tablebot.sim.physics.step import advance, aim_turns
-from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
+from tablebot.sim.physics.kernel import end_tick, robot_scratch, start_tick
+from tablebot.sim.physics.structures import Record, RobotState, Wiring, WorldArrays
 from tablebot.tables import RobotTables
 from tablebot.tick import EVENT, ROW, STATE, TIMER, registers
 
@@ -124,42 +120,17 @@ def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: S
     """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
-    near, centre = new_near(world.pstart, world.circles)
-    reach, wide = reaches(robot.p)
-    turns = np.empty(4)
-    aim_turns(robot.p, turns)
-    scratch = Scratch(np.zeros(robot.counters.shape[0], dtype=np.int64), np.empty((4, 2)), near, centre, turns,
-                      np.empty(N_NOISE), reach, wide)
-    s, regs, outputs, counters = robot.s, robot.regs, robot.outputs, robot.counters
-    hist, ints, counts, z, pulses = record.hist, record.ints, record.counts, scratch.z, scratch.pulses
-    pcols, drive = wiring.pulse_columns, wiring.drive
+    scratch = robot_scratch(robot, world)
     for t in range(ticks):
-        if hist.shape[0]:
-            for j in range(s.shape[0]):
-                hist[t, j] = s[j]
-        mask = int(s[MASK])
-        for c in range(counters.shape[0]):
-            pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
-        tick_several(sp, st, outputs, mask, pulses)
-        if ints.shape[0]:
-            _record(ints, t, mask, regs, outputs, counters, pulses)
+        mask = start_tick(t, robot, wiring, record, scratch)
+        tick_several(sp, st, robot.outputs, mask, scratch.pulses)
         if tables.shape[0]:
             for k in range(st.regs.shape[0]):
                 tables[t, k, K_EVENT] = st.regs[k, EVENT]
                 tables[t, k, K_ROW] = st.regs[k, ROW]
                 tables[t, k, K_STATE] = st.regs[k, STATE]
                 tables[t, k, K_TIMER] = st.regs[k, TIMER]
-        if counts.shape[0]:
-            tally(counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask,
-                  record.t0 + t)
-        if noise.shape[0]:
-            for k in range(N_NOISE):
-                z[k] = noise[t, k]
-        else:
-            for k in range(N_NOISE):
-                z[k] = standard_normal(bitgen)
-        advance(s, outputs[drive[0]], outputs[drive[1]], robot.p, world, wiring.bits, True, scratch)
-        observe(s, world.lamps, robot.acc, robot.collisions)
+        end_tick(t, mask, robot, world, wiring, noise, bitgen, record, scratch)
 
 
 def table_columns(tables: RobotTables, kept: np.ndarray) -> dict[str, list]:
