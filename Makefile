@@ -21,7 +21,11 @@ demo:
 # 45 s of CPU from an empty cache (the sources, tests and benchmarks) mostly fit in what they leave idle; its
 # report is printed after the pass.
 test: setup
-	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15 -rs
+	@mkdir -p build/coverage
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15 -rs \
+	  --cov --cov-report=
+	@echo "coverage of the pass above, least covered first (all: .venv/bin/coverage html, then build/coverage/html):"
+	@.venv/bin/coverage report | sed -n 1,27p; .venv/bin/coverage report --format=total | sed 's/^/total: /;s/$$/ %/'
 	@log=$$(mktemp); nice -n 19 .venv/bin/mypy >"$$log" 2>&1 & mypy=$$!; \
 	echo '.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs  (and .venv/bin/mypy)'; \
 	.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs; tests=$$?; \
