@@ -19,6 +19,7 @@ machine. Without it, each part is also shown as a share of the whole tick.
 from __future__ import annotations
 
 import argparse
+import importlib
 import inspect
 import json
 import math
@@ -38,13 +39,25 @@ ROOT = Path(__file__).resolve().parent.parent
 WHOLE = "whole kernel"
 
 
+def _sim(name: str) -> Any:
+    """The simulator's module ``name`` (``physics.kernel``) in the tree this process imports; a baseline from before
+    sim/ was split by what it owns (issue 35) has it one level up (``sim.kernel``; ``physics.step`` was
+    ``sim.physics``)."""
+    try:
+        return importlib.import_module(f"tablebot.sim.{name}")
+    except ModuleNotFoundError:
+        old = "physics" if name == "physics.step" else name.split(".")[1]
+        return importlib.import_module(f"tablebot.sim.{old}")
+
+
 def measure(example: str, repeats: int) -> dict[str, float]:
     """ns per robot-tick of the whole kernel and of each part, in this process's tablebot."""
     import numpy as np
 
     from tablebot.cli.common import load
     from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.sim.model.scene import robot_layer, scene_for
+
+    robot_layer, scene_for = _sim("model.scene").robot_layer, _sim("model.scene").scene_for
 
     table, machine = load(ROOT / "examples" / example)
     scene = scene_for(table, machine)
@@ -68,10 +81,7 @@ def measure(example: str, repeats: int) -> dict[str, float]:
 def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     import numpy as np
 
-    from tablebot.sim.physics import contacts as co
-    from tablebot.sim.physics import kernel as K
-    from tablebot.sim.physics import step as ph
-
+    co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
     loops = _loops()
     g, p = scene.geometry, scene.P[0]
     shade = getattr(g, "shade", None)
@@ -113,12 +123,9 @@ def _loops() -> dict[str, Any]:
     from tablebot.engine_batch import tick_compiled
     from tablebot.jit import njit
     from tablebot.sim import columns as L
-    from tablebot.sim.physics import contacts as co
-    from tablebot.sim.physics import kernel as K
-    from tablebot.sim.physics import step as ph
-    from tablebot.sim.physics.normals import standard_normal
-    from tablebot.sim.physics.sensing import sense_declared
 
+    co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
+    standard_normal, sense_declared = _sim("physics.normals").standard_normal, _sim("physics.sensing").sense_declared
     fast = njit(refcounts=False, cache=False)
 
     @fast
