@@ -146,12 +146,12 @@ WIRINGS = st.fixed_dictionaries({"controller": st.sampled_from(["tx", "txt"])}, 
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**32), counters=st.integers(0, 2), inputs=st.integers(0, 3),
+@given(seed=st.integers(0, 2**32), counters=st.integers(0, 2), inputs=st.integers(0, 3), lamps=st.integers(0, 2),
        rule=st.sampled_from(["document", "always"]), sections=WIRINGS)
-def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, rule: Rule,
+def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, lamps: int, rule: Rule,
                                      sections: dict[str, Any]) -> None:
     rng = random.Random(seed)
-    shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, max_timer=4, max_load=5)
+    shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, lamps=lamps, max_timer=4, max_load=5)
     table = with_match(fitting(random_table(rng, shape), sections), rule)
     ticks = random_inputs(rng, table, 50, density=0.25, max_pulses=2)
     machine = compile_table(table)
@@ -192,11 +192,28 @@ def test_check_says_why_a_table_does_not_fit(tmp_path: Path) -> None:
     (tmp_path / "t.csv").write_text("state,I1,M1,M2,M3,timer,next\n1,1,7,0,0,40000,300\n300,,0,0,0,0,1\n")
     found = [d.message for d in problems(load_table(tmp_path / "t.csv"))]
     text = "\n".join(found)
-    for expected in ("lamps", "3 motors", "ROBO Interface has no counter inputs", "speed 7", "timer 40000",
-                     "number 300"):
+    for expected in ("3 motors", "ROBO Interface has no counter inputs", "speed 7", "timer 40000", "number 300"):
         assert expected in text, (expected, found)
     with pytest.raises(TableBotError):
         generate(load_table(tmp_path / "t.csv"))
+
+
+def test_lamps_are_lamp_outputs_and_one_on_a_motors_output_is_refused(tmp_path: Path) -> None:
+    """A lamp is ROBO Pro's lamp output (``ftProDataOutSngl``) on the single output the motors leave free, or the
+    one ``[robopro]`` names; one wired to a motor's output is refused, naming both."""
+    (tmp_path / "robot.toml").write_text('name = "Lit"\ninitial_state = 1\n[inputs]\nI1 = "a"\n[motors]\n'
+                                         'M1 = "m"\n[lamps]\nL1 = "front"\nL2 = "back"\n[robopro]\nL2 = "O8"\n')
+    (tmp_path / "t.csv").write_text("state,I1,M1,L1,L2,timer,next\n1,1,3,8,,0,2\n2,,,0,5,0,1\n")
+    table = load_table(tmp_path / "t.csv")
+    root = ET.fromstring(generate(table).encode("utf-8"))
+    assert sorted(o.get("output") for o in root.iter("o") if o.get("classname") == "ftProDataOutSngl") \
+        == ["2", "2", "2", "7", "7", "7"]  # O3 and O8: each turned off at the start, then Off and On by the lists
+    ticks = [TickInput(1, ()), TickInput(0, ()), TickInput(1, ())]
+    assert [d.outputs for d in run(table, ticks)] == [(3, 8, 0), (0, 0, 5), (3, 8, 5)]  # a blank L2 keeps it
+    assert [astuple(d) for d in run(table, ticks)] == engine_ticks(compile_table(table), ticks)
+    (tmp_path / "robot.toml").write_text((tmp_path / "robot.toml").read_text().replace('"O8"', '"O2"'))
+    found = [d.message for d in problems(load_table(tmp_path / "t.csv"))]
+    assert found == ["lamp L2 is wired to O2, an output of motor M1"]
 
 
 def test_a_line_sensor_is_refused_with_the_reason() -> None:

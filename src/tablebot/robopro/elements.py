@@ -115,6 +115,14 @@ def motor(x: int, y: int, output: int) -> Element:
                                               ("resolution", "0")], _pins(("", "dataobjectinput", 0, -8, 0)))
 
 
+def lamp(x: int, y: int, output: int) -> Element:
+    """Lamp output Ok (``output`` k): a single output, levels 0–8 (resolution 0). No program of the corpus has
+    one; real ROBO Pro programs outside it write it so (olagino/roproparser's test/regal_test.rpp, ROBO Pro
+    4.2.4: ``ftProDataOutSngl``, ``output`` k − 1, ``image`` 1, one data input as the motor's)."""
+    return Element("ftProDataOutSngl", x, y, [("output", str(output - 1)), ("module", "IF1"), ("image", "1"),
+                                              ("resolution", "0")], _pins(("", "dataobjectinput", 0, -8, 0)))
+
+
 def array(x: int, y: int, name: str, values: list[int], indent: str) -> Element:
     """A global list pre-filled with ``values``: S (command) and I (index) in, R (value at I) and I out."""
     inits = [f'{indent}    <init value="{v}">\n{indent}    </init>\n' for v in values]

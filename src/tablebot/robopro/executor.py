@@ -18,7 +18,7 @@ from tablebot.table import Table
 @dataclass(frozen=True)
 class Decision:
     """One tick as the engine reports it: the event mask (table event columns), the fired row (``NO_ROW``:
-    none), the state index, the timer, the motor speeds (signed) and the counters."""
+    none), the state index, the timer, the outputs (motor speeds, signed, then lamp levels) and the counters."""
 
     event: int
     row: int
@@ -50,6 +50,7 @@ def run(table: Table, inputs: Sequence[TickInput], rule: Rule | None = None) -> 
             output, forward = p.wiring.motors[motor]
             command, speed = tick.motors[output]
             motors.append(speed if command == forward else -speed)
+        motors += [tick.lamps[p.wiring.lamps[lamp]] for lamp in table.robot.lamps]
         found.append(Decision(
             event=sum(table.bit(name) for name in table.events if v["EV"] & p.bits[name]),
             row=v["ROW"] if (EXECUTE, EXIT) in tick.exits else NO_ROW,

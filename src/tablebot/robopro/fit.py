@@ -5,12 +5,17 @@ robopro-program`` reports and the export refuses on).
 Encoding, the document's generalised to counters: event = state · 2^B + the event bits, B = number of
 events (T, the robot's inputs, then its counters; T highest), so the BumberBot's first row is the
 document's 88 (B = 6); action = next · 256 + M1dir · 128 + M1speed · 16 + M2dir · 8 + M2speed (speed 7 =
-keep) — the document's word; timer = ticks; one list per counter of loads, −1 = leave it alone.
+keep) — the document's word; timer = ticks; one list per counter of loads, −1 = leave it alone; one list per
+lamp of levels 0–8, 9 = leave it alone.
+
+A table of a robot of several tables (``[tables]``) has the events it has columns for: T, the inputs and
+counters it reads, then its cross-table columns (each a bit, set from the other table's state at the start of
+the tick: :mod:`tablebot.robopro.processes`); it drives the outputs it has columns for.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError
@@ -24,6 +29,7 @@ MAX_MOTORS = 2  # the document's action word
 MAX_NEXT = MAX_VALUE // NEXT_WEIGHT
 MAX_WAIT_MS = 32767  # a Wait in ms; longer ticks need whole tens of ms (the 10 ms scale)
 DOC_BITS = 6
+LAMP_KEEP = 9  # a lamp list's "leave it alone" (levels are 0..8)
 
 
 @dataclass(frozen=True)
@@ -32,11 +38,35 @@ class Plan:
     wiring: Wiring
     rule: str
     numbers: dict[StateId, int]
+    #: In a robot of several tables: every table's state numbers, by table name (for its cross-table events).
+    others: dict[str, dict[StateId, int]] = field(default_factory=dict)
 
     @cached_property
     def events(self) -> tuple[str, ...]:
-        """The event bits, highest first: T, the robot's inputs, its counters."""
-        return (TIMER_EVENT, *self.table.robot.inputs, *self.table.robot.counter_names)
+        """The event bits, highest first: T, the robot's inputs, its counters (a table of several: those it
+        reads, then its cross-table columns)."""
+        return events_of(self.table)
+
+    @property
+    def several(self) -> bool:
+        return bool(self.table.name)
+
+    def drives(self, output: str) -> bool:
+        """Whether this program's table writes ``output`` (one table: every output of the robot)."""
+        return not self.several or output in self.table.writes
+
+    @cached_property
+    def cross_lists(self) -> dict[str, tuple[int, ...]]:
+        """Per table whose state a cross-table column reads: by that table's state number, the sum of the bits
+        of this table's cross-table columns present in it."""
+        found: dict[str, list[int]] = {}
+        for name, event in self.table.cross.items():
+            numbers = self.others[event.table]
+            values = found.setdefault(event.table, [0] * (max(numbers.values()) + 1))
+            for state, number in numbers.items():
+                if event.covers(state):
+                    values[number] += self.bits[name]
+        return {source: tuple(values) for source, values in found.items()}
 
     @property
     def shift(self) -> int:
@@ -77,7 +107,13 @@ class Plan:
     def loads(self) -> dict[str, tuple[int, ...]]:
         names = self.table.robot.counter_names
         return {name: tuple(-1 if (load := row.counters[i]) is None else load for row in self.table.rows)
-                for i, name in enumerate(names)}
+                for i, name in enumerate(names) if self.drives(name)}
+
+    @cached_property
+    def levels(self) -> dict[str, tuple[int, ...]]:
+        """Per lamp the table drives, its level in each row (LAMP_KEEP: leave it alone)."""
+        return {name: tuple(LAMP_KEEP if (level := row.lamps[i]) is None else level for row in self.table.rows)
+                for i, name in enumerate(self.table.robot.lamps) if self.drives(name)}
 
     @property
     def initial_state(self) -> int:
@@ -111,6 +147,7 @@ class Plan:
         for row, (event, action, timer) in zip(table.rows, zip(self.event, self.action, self.timer, strict=True),
                                                 strict=True):
             loads = "".join(f", {n} load {self.loads[n][row.index]}" for n in self.loads)
+            loads += "".join(f", {n} {self.levels[n][row.index]}" for n in self.levels)
             lines.append(f"row {row.index} (list index {row.index}): {event} / {action} / {timer}{loads}"
                          f"  {row.description}")
         return lines
@@ -135,9 +172,6 @@ def problems(table: Table, rule: str | None = None) -> list[Diagnostic]:
         line = robot.line(section, key) if robot.toml else None
         out.items.append(Diagnostic(where, line, None if line is None else 1, message, hint))
 
-    if robot.lamps:
-        robot_error(f"the robot has lamps ({', '.join(robot.lamps)}); no real ROBO Pro program of the corpus "
-                    "has a lamp output element to copy", "export a table for a robot without lamps", "lamps")
     if len(robot.motors) > MAX_MOTORS:
         robot_error(f"{len(robot.motors)} motors; the document's action word holds M1 and M2 only",
                     "use a robot with at most two motors", "motors")
@@ -153,13 +187,19 @@ def problems(table: Table, rule: str | None = None) -> list[Diagnostic]:
     for name, message, hint in wired.problems:
         robot_error(message, hint, "robopro", name)
     for kind, used in (("input", {n: t for n, (t, _) in wired.inputs.items()}),
-                       ("motor", {n: t for n, (t, _) in wired.motors.items()}), ("counter", wired.counters)):
+                       ("motor", {n: t for n, (t, _) in wired.motors.items()}), ("counter", wired.counters),
+                       ("lamp", wired.lamps)):
         seen: dict[int, str] = {}
         for name, terminal in used.items():
             if terminal in seen:
                 robot_error(f"{kind}s {seen[terminal]} and {name} are wired to the same terminal",
                             "give each its own terminal in [robopro]", "robopro", name)
             seen.setdefault(terminal, name)
+    for name, output in wired.lamps.items():
+        motor = next((m for m, (o, _) in wired.motors.items() if output in (2 * o - 1, 2 * o)), None)
+        if motor is not None:
+            robot_error(f"lamp {name} is wired to O{output}, an output of motor {motor}",
+                        "wire the lamp to an output no motor uses in [robopro]", "robopro", name)
     _row_problems(table, out)
     if robot.tick_ms > MAX_WAIT_MS and robot.tick_ms % 10:
         robot_error(f"tick_ms = {robot.tick_ms}: a ROBO Pro Wait holds up to {MAX_WAIT_MS} ms, or whole tens of ms",
@@ -170,8 +210,18 @@ def problems(table: Table, rule: str | None = None) -> list[Diagnostic]:
     return out.items
 
 
+def events_of(table: Table) -> tuple[str, ...]:
+    """The event bits of ``table``'s program, highest first (see :attr:`Plan.events`)."""
+    robot = table.robot
+    if not table.name:
+        return (TIMER_EVENT, *robot.inputs, *robot.counter_names)
+    read = set(table.events)
+    return (TIMER_EVENT, *(n for n in robot.inputs if n in read), *(n for n in robot.counter_names if n in read),
+            *table.cross)
+
+
 def _row_problems(table: Table, out: Collector) -> None:
-    shift = 1 + len(table.robot.inputs) + len(table.robot.counters)
+    shift = len(events_of(table))
     max_state = (MAX_VALUE >> shift) if shift < 15 else 0
     numbers = number_states(table)
     if shift >= 15:

@@ -14,11 +14,13 @@ table's own rule, the robot file's ``match``.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
+from dataclasses import dataclass
 from functools import partial
 
 from tablebot.robopro import elements as el
 from tablebot.robopro.document import Sub, document
-from tablebot.robopro.fit import Plan, plan
+from tablebot.robopro.fit import LAMP_KEEP, Plan, plan
 from tablebot.robopro.rpp_write import Canvas, Element, Ids, Pin, caption
 from tablebot.robopro.sheet import Const, Count, Input, Join, ListAt, Op, Sheet, Tree, Var
 from tablebot.robot import Match
@@ -33,35 +35,61 @@ COLUMN = 136  # x of every subprogram's flow column
 INDENT = "            "  # elements inside a subprogram
 
 
-class Builder:
-    """Builds the subprograms of one plan, sharing one id counter."""
+@dataclass(frozen=True)
+class Lamp:
+    """A lamp's single output (O1…O8), as a command's target."""
 
-    def __init__(self, p: Plan) -> None:
-        self.p = p
-        self.ids = Ids()
-        self.inits = {"ST": p.initial_state, "TM": p.initial_timer}
-        self.subs: dict[str, Sub] = {}
+    output: int
+
+
+class Builder:
+    """Builds the subprograms of one plan, sharing one id counter (and, for a robot of several tables, the
+    document's ids, subprograms and variables' initial values with the other tables' builders). ``prefix``
+    names this table's variables, lists and subprograms (``drive ST``); "" for a robot of one table."""
+
+    def __init__(self, p: Plan, prefix: str = "", ids: Ids | None = None, subs: dict[str, Sub] | None = None,
+                 inits: dict[str, int] | None = None) -> None:
+        self.p, self.prefix = p, prefix
+        self.ids = ids or Ids()
+        self.inits = inits if inits is not None else {}
+        self.inits.update({self.v("ST"): p.initial_state, self.v("TM"): p.initial_timer})
+        self.subs: dict[str, Sub] = subs if subs is not None else {}
+
+    def v(self, name: str) -> str:
+        """The name of this table's variable, list or subprogram ``name``."""
+        return self.prefix + name
+
+    def reads(self, name: str) -> tuple[Tree, bool]:
+        """What DetectEvent tests for the event ``name`` (an input or a counter), and whether a value above 0
+        means the event is there. A table of several reads the input image of the tick (``in I3``, the counts
+        ``C1 tick``), which the clock process takes before any table looks."""
+        wiring = self.p.wiring
+        if name in wiring.counters:
+            return (Var(f"{name} tick") if self.p.several else Var(name)), False
+        terminal, active = wiring.inputs[name]
+        return (Var(f"in {name}") if self.p.several else Input(terminal)), bool(active)
 
     def sheet(self) -> Sheet:
         return Sheet(Canvas(self.ids), COLUMN, self.inits, INDENT)
 
-    def send(self, sheet: Sheet, element: Element, target: str | int) -> Element:
-        """Wire a command element's output to a variable (by name) or a motor (by output number) on its right."""
+    def send(self, sheet: Sheet, element: Element, target: str | int | Lamp) -> Element:
+        """Wire a command element's output to a variable (by name), a motor (by output number) or a lamp on its
+        right."""
         out = element.pin(0)
         x, y = out.at
         made = el.variable(x + 12, y, target, self.inits.get(target, 0)) if isinstance(target, str) \
-            else el.motor(x + 12, y, target)
+            else el.lamp(x + 12, y, target.output) if isinstance(target, Lamp) else el.motor(x + 12, y, target)
         sheet.canvas.add(made)
         sheet.canvas.connect(out, made.pins_of("dataobjectinput")[0])
         return made
 
-    def assign(self, sheet: Sheet, target: str | int, command: str, value: int | None = None,
+    def assign(self, sheet: Sheet, target: str | int | Lamp, command: str, value: int | None = None,
                data: Tree | None = None) -> Element:
         element = sheet.step(lambda x, y: el.message(x, y, command, value), data=data)
         self.send(sheet, element, target)
         return element
 
-    def side_send(self, sheet: Sheet, exit_pin: Pin, target: str | int, command: str, value: int | None = None,
+    def side_send(self, sheet: Sheet, exit_pin: Pin, target: str | int | Lamp, command: str, value: int | None = None,
                   data: Tree | None = None, hold: bool = False) -> None:
         sheet.side(exit_pin, [lambda x, y: el.message(x, y, command, value)], data=[data],
                    extra=lambda e: self.send(sheet, e, target), hold=hold)
@@ -89,44 +117,47 @@ class Builder:
 # --- the subprograms ---------------------------------------------------------------------------------
 
 def detect_event(b: Builder) -> Sub:
-    p, s = b.p, b.sheet()
+    p, s, v = b.p, b.sheet(), b.v
     s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
-    b.assign(s, "EV", "=", 0)
+    b.assign(s, v("EV"), "=", 0)
     for name in p.events:
+        if name in p.table.cross:
+            continue
         bit = p.bits[name]
         test: Tree
         if name == "T":
-            test, add_when_yes = Var("TM"), False
-        elif name in p.wiring.counters:
-            test, add_when_yes = Var(name), False
+            test, add_when_yes = Var(v("TM")), False
         else:
-            terminal, active = p.wiring.inputs[name]
-            test, add_when_yes = Input(terminal), bool(active)
+            test, add_when_yes = b.reads(name)
         branch = s.step(partial(el.branch, yes_down=not add_when_yes), data=test)
-        b.side_send(s, branch.pins[3], "EV", "+", bit)
+        b.side_send(s, branch.pins[3], v("EV"), "+", bit)
         b.note(s, branch, p.event_note(name))
+    for source, values in p.cross_lists.items():
+        cross = b.assign(s, v("EV"), "+", data=ListAt(v(f"from {source}"), values, Var(f"{source} S0")))
+        b.note(s, cross, f"the columns reading table {source}'s state at the start of the tick: "
+                         + ", ".join(f"{n} (+{p.bits[n]})" for n, e in p.table.cross.items() if e.table == source))
     s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
-    return b.finish(DETECT, s, [(EXIT, 2)], "EV := the events of this tick, one bit each: " + p.bit_text())
+    return b.finish(v(DETECT), s, [(EXIT, 2)], "EV := the events of this tick, one bit each: " + p.bit_text())
 
 
 def determine_action(b: Builder) -> Sub:
-    p, s = b.p, b.sheet()
+    p, s, v = b.p, b.sheet(), b.v
     s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
-    b.assign(s, "ROW", "=", 0)
-    more = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var("ROW"), Const(len(p.event))))
+    b.assign(s, v("ROW"), "=", 0)
+    more = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var(v("ROW")), Const(len(p.event))))
     loop_wire, loop_in = s.last_wire, more.pins[1].at
     s.side(more.pins[3], [lambda x, y: el.flow_out(x, y, NONE, 3)], rejoin=False)
     b.note(s, more, f"rows left? (ROW < {len(p.event)})")
-    b.assign(s, "E", "=", data=ListAt("Event", p.event, Var("ROW")))
+    b.assign(s, v("E"), "=", data=ListAt(v("Event"), p.event, Var(v("ROW"))))
     state = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                   data=Op("XOR", Op("SHR", Var("E"), Const(p.shift)), Var("ST")))
+                   data=Op("XOR", Op("SHR", Var(v("E")), Const(p.shift)), Var(v("ST"))))
     b.note(s, state, f"row's state (E SHR {p.shift}) is not ST?")
-    need = Op("AND", Var("E"), Const(p.mask))
+    need = Op("AND", Var(v("E")), Const(p.mask))
     missing = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                     data=Op("XOR", Op("AND", need, Var("EV")), need))
+                     data=Op("XOR", Op("AND", need, Var(v("EV"))), need))
     b.note(s, missing, f"an event of the row (E AND {p.mask}) missing from EV?")
     (step_on,), wire = s.side(missing.pins[3], [lambda x, y: el.message(x, y, "+", 1)],
-                              extra=lambda e: b.send(s, e, "ROW"), rejoin=False)
+                              extra=lambda e: b.send(s, e, v("ROW")), rejoin=False)
     assert wire is not None
     _ex, ey = state.pins[3].at
     sx, sy = wire.points[1]
@@ -134,53 +165,86 @@ def determine_action(b: Builder) -> Sub:
     s.step(lambda x, y: el.flow_out(x, y, FOUND, 2))
     assert loop_wire is not None
     s.loop_back(step_on.pin(2), loop_wire, (loop_in[0], loop_in[1] - 4))
-    return b.finish(DETERMINE, s, [(FOUND, 2), (NONE, 3)],
+    return b.finish(v(DETERMINE), s, [(FOUND, 2), (NONE, 3)],
                     "ROW := the first row of the Event list whose state is ST and whose events are all in EV")
 
 
 def execute_action(b: Builder) -> Sub:
-    p, s = b.p, b.sheet()
+    p, s, v = b.p, b.sheet(), b.v
     s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
-    b.assign(s, "ACT", "=", data=ListAt("Action", p.action, Var("ROW")))
-    b.assign(s, "TM", "=", data=ListAt("Timer", p.timer, Var("ROW")))
-    first = b.assign(s, "ST", "=", data=Op("SHR", Var("ACT"), Const(8)))
+    b.assign(s, v("ACT"), "=", data=ListAt(v("Action"), p.action, Var(v("ROW"))))
+    b.assign(s, v("TM"), "=", data=ListAt(v("Timer"), p.timer, Var(v("ROW"))))
+    first = b.assign(s, v("ST"), "=", data=Op("SHR", Var(v("ACT")), Const(8)))
     b.note(s, first, "next state: ACT SHR 8")
     for motor, (speed_shift, dir_shift) in zip(p.table.robot.motors, ((4, 7), (0, 3)), strict=False):
-        output, forward = p.wiring.motors[motor]
-        backward = "ccw" if forward == "cw" else "cw"
-        field = Op("SHR", Var("ACT"), Const(speed_shift)) if speed_shift else Var("ACT")
-        speed = b.assign(s, "SPEED", "=", data=Op("AND", field, Const(7)))
-        b.note(s, speed, f"{motor}: SPEED = (ACT SHR {speed_shift}) AND 7")
-        keep = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var("SPEED"), Const(7)))
-        b.note(s, keep, f"{motor}: speed 7 keeps the motor as it is")
-        s.side(keep.pins[3], [], hold=True)
-        moving = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var("SPEED"))
-        b.note(s, moving, f"{motor}: speed 0 stops it")
-        b.side_send(s, moving.pins[3], output, "Stop", -32768, hold=True)
-        direction = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                           data=Op("AND", Op("SHR", Var("ACT"), Const(dir_shift)), Const(1)))
-        b.note(s, direction, f"{motor}: direction (ACT SHR {dir_shift}) AND 1: 1 = backward ({backward}), "
-                             f"0 = forward ({forward})")
-        b.side_send(s, direction.pins[3], output, backward, data=Var("SPEED"), hold=True)
-        b.assign(s, output, forward, data=Var("SPEED"))
-        s.release()
-    for name in p.wiring.counters:
-        b.assign(s, "CL", "=", data=ListAt(f"{name} load", p.loads[name], Var("ROW")))
-        load = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Op("+", Var("CL"), Const(1)))
+        if p.drives(motor):
+            _motor(b, s, motor, speed_shift, dir_shift)
+    for name in p.levels:
+        _lamp(b, s, name)
+    for name in p.loads:
+        b.assign(s, v("CL"), "=", data=ListAt(v(f"{name} load"), p.loads[name], Var(v("ROW"))))
+        load = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Op("+", Var(v("CL")), Const(1)))
         b.note(s, load, f"{name}: a load of -1 leaves the counter alone")
-        b.side_send(s, load.pins[3], name, "=", data=Var("CL"))
+        b.side_send(s, load.pins[3], name, "=", data=Var(v("CL")))
     s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
-    return b.finish(EXECUTE, s, [(EXIT, 2)],
+    return b.finish(v(EXECUTE), s, [(EXIT, 2)],
                     "The action of row ROW: motors (speed 7 keeps), TM from the Timer list, ST := next state")
 
 
+def _motor(b: Builder, s: Sheet, motor: str, speed_shift: int, dir_shift: int) -> None:
+    """Motor ``motor`` as the action word ACT says: speed 7 keeps it, 0 stops it, else its direction bit."""
+    v = b.v
+    output, forward = b.p.wiring.motors[motor]
+    backward = "ccw" if forward == "cw" else "cw"
+    field = Op("SHR", Var(v("ACT")), Const(speed_shift)) if speed_shift else Var(v("ACT"))
+    speed = b.assign(s, v("SPEED"), "=", data=Op("AND", field, Const(7)))
+    b.note(s, speed, f"{motor}: SPEED = (ACT SHR {speed_shift}) AND 7")
+    keep = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var(v("SPEED")), Const(7)))
+    b.note(s, keep, f"{motor}: speed 7 keeps the motor as it is")
+    s.side(keep.pins[3], [], hold=True)
+    moving = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var(v("SPEED")))
+    b.note(s, moving, f"{motor}: speed 0 stops it")
+    b.side_send(s, moving.pins[3], output, "Stop", -32768, hold=True)
+    direction = s.step(lambda x, y: el.branch(x, y, yes_down=False),
+                       data=Op("AND", Op("SHR", Var(v("ACT")), Const(dir_shift)), Const(1)))
+    b.note(s, direction, f"{motor}: direction (ACT SHR {dir_shift}) AND 1: 1 = backward ({backward}), "
+                         f"0 = forward ({forward})")
+    b.side_send(s, direction.pins[3], output, backward, data=Var(v("SPEED")), hold=True)
+    b.assign(s, output, forward, data=Var(v("SPEED")))
+    s.release()
+
+
+def _lamp(b: Builder, s: Sheet, lamp: str) -> None:
+    """Lamp ``lamp`` from its list: 9 leaves it alone, 0 turns it off, else on at that level."""
+    v, target = b.v, Lamp(b.p.wiring.lamps[lamp])
+    level = b.assign(s, v("LEVEL"), "=", data=ListAt(v(lamp), b.p.levels[lamp], Var(v("ROW"))))
+    b.note(s, level, f"{lamp}: its level in row ROW")
+    keep = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Op("XOR", Var(v("LEVEL")), Const(LAMP_KEEP)))
+    b.note(s, keep, f"{lamp}: level {LAMP_KEEP} keeps the lamp as it is")
+    s.side(keep.pins[3], [], hold=True)
+    lit = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var(v("LEVEL")))
+    b.note(s, lit, f"{lamp}: level 0 turns it off")
+    b.side_send(s, lit.pins[3], target, "Off", -32768, hold=True)
+    b.assign(s, target, "On", data=Var(v("LEVEL")))
+    s.release()
+
+
 def count_down(b: Builder) -> Sub:
-    p, s = b.p, b.sheet()
+    """TM by one (and, in a robot of one table, the counters: in one of several the clock process counts them)."""
+    p, s, v = b.p, b.sheet(), b.v
     s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
-    timer = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Var("TM"))
+    timer = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Var(v("TM")))
     b.note(s, timer, "TM counts down to 0, one per tick")
-    b.side_send(s, timer.pins[3], "TM", "-", 1)
-    for name, counter in p.wiring.counters.items():
+    b.side_send(s, timer.pins[3], v("TM"), "-", 1)
+    if not p.several:
+        count_counters(b, s)
+    s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
+    return b.finish(v(COUNTDOWN), s, [(EXIT, 2)], "One tick later: TM and the counters count down")
+
+
+def count_counters(b: Builder, s: Sheet) -> None:
+    """Each counter down by the pulses its input counted since the last tick, never below 0."""
+    for name, counter in b.p.wiring.counters.items():
         now, last = f"{name} now", f"{name} last"
         b.assign(s, now, "=", data=Count(counter))
         cmp = s.step(el.compare)
@@ -192,42 +256,64 @@ def count_down(b: Builder) -> Sub:
         b.assign(s, name, "=", 0)
         b.side_send(s, cmp.pin(">"), name, "=", data=Op("-", Var(name), pulses))
         b.assign(s, last, "=", data=Var(now))
-    s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
-    return b.finish(COUNTDOWN, s, [(EXIT, 2)], "One tick later: TM and the counters count down")
 
 
 def _left_join(pin: Pin) -> Join:
     return Join(pin, pin.at[1])
 
 
-def main_program(b: Builder) -> Sub:
-    p, s = b.p, b.sheet()
-    s.begin(el.start(COLUMN, 8))
-    b.assign(s, "ST", "=", p.initial_state)
-    b.assign(s, "TM", "=", p.initial_timer)
+def begin_outputs(b: Builder, s: Sheet) -> None:
+    """The start: ST and TM, the motors the table drives stopped, its lamps off (one table: the counters)."""
+    p = b.p
+    b.assign(s, b.v("ST"), "=", p.initial_state)
+    b.assign(s, b.v("TM"), "=", p.initial_timer)
     for motor in p.table.robot.motors:
-        b.assign(s, p.wiring.motors[motor][0], "Stop", -32768)
-    for name, counter in p.wiring.counters.items():
-        b.assign(s, name, "=", 0)
-        b.assign(s, f"{name} last", "=", data=Count(counter))
-    detect = b.call(s, DETECT)
+        if p.drives(motor):
+            b.assign(s, p.wiring.motors[motor][0], "Stop", -32768)
+    for lamp in p.levels:
+        b.assign(s, Lamp(p.wiring.lamps[lamp]), "Off", -32768)
+    if not p.several:
+        for name, counter in p.wiring.counters.items():
+            b.assign(s, name, "=", 0)
+            b.assign(s, f"{name} last", "=", data=Count(counter))
+
+
+def engine_loop(b: Builder, s: Sheet, end_tick: Callable[[Sheet], None]) -> None:
+    """DetectEvent, (if an event is detected,) DetermineAction, ExecuteAction, the end of the tick
+    (``end_tick``: the flows that skipped a row are held to join its first element), CountDown, and back."""
+    p, v = b.p, b.v
+    detect = b.call(s, v(DETECT))
     loop_wire, loop_in = s.last_wire, detect.pins[0].at
     if p.rule == "document":
-        any_event = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var("EV"))
+        any_event = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var(v("EV")))
         b.note(s, any_event, "if an event is detected (EV > 0)")
         s.side(any_event.pins[3], [], hold=True)
-    determine = b.call(s, DETERMINE, dx=4)
+    determine = b.call(s, v(DETERMINE), dx=4)
     s.held.append(_left_join(determine.pin(NONE)))
-    b.call(s, EXECUTE)
-    tick = s.step(lambda x, y: el.wait(x, y, p.table.robot.tick_ms), release=True)
-    b.note(s, tick, f"one tick: {p.table.robot.tick_ms} ms")
-    countdown = b.call(s, COUNTDOWN)
+    b.call(s, v(EXECUTE))
+    end_tick(s)
+    countdown = b.call(s, v(COUNTDOWN))
     assert loop_wire is not None
     s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
     for n, line in enumerate(p.table_notes()):
         s.canvas.comments.append(caption(INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2,
                                          align="336", linespace="0"))
+
+
+def main_program(b: Builder) -> Sub:
+    p, s = b.p, b.sheet()
+    s.begin(el.start(COLUMN, 8))
+    begin_outputs(b, s)
+
+    def wait(s: Sheet) -> None:
+        tick = s.step(lambda x, y: el.wait(x, y, p.table.robot.tick_ms), release=True)
+        b.note(s, tick, f"one tick: {p.table.robot.tick_ms} ms")
+    engine_loop(b, s, wait)
     return b.finish(MAIN, s, [], p.summary(), inputs=[])
+
+
+#: The engine's subprograms, in the order they are built (each calls only those built before it).
+ENGINE: tuple[Callable[[Builder], Sub], ...] = (detect_event, determine_action, execute_action, count_down)
 
 
 def generate(table: Table, rule: Rule | None = None) -> str:
@@ -238,7 +324,7 @@ def generate(table: Table, rule: Rule | None = None) -> str:
         raise ValueError(f"rule must be one of {RULES}, not {rule!r}")
     p = plan(table, rule)
     b = Builder(p)
-    for build in (detect_event, determine_action, execute_action, count_down):
+    for build in ENGINE:
         build(b)
     main_program(b)
     return document(b.ids, p, [b.subs[n] for n in (MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN)])

@@ -7,11 +7,13 @@ controller = "robo-interface"          # the document's; or "tx", "txt"
 I3 = "I3"                               # an input's terminal, or { terminal = "I3", active = 0 }
 M1 = { output = "M1", forward = "cw" }  # a motor's output, and the command that drives it forward
 C1 = "C1"                               # a counter's terminal (ROBO TX and TXT only)
+L1 = "O5"                               # a lamp's single output
 ```
 
-Everything has a default, so the section may be left out: an input named I1…I8, a motor named M1…M4 and a
-counter named C1…C4 use the terminal of that name; a counter otherwise uses the counter of its motor's
-number; ``active = 1`` (the event is present while the input reads 1) and ``forward = "cw"``.
+Everything has a default, so the section may be left out: an input named I1…I8, a motor named M1…M4, a
+counter named C1…C4 and a lamp named O1…O8 use the terminal of that name; a counter otherwise uses the counter
+of its motor's number, and a lamp the single outputs the motors leave free, in order (a motor Mk takes O2k−1 and
+O2k); ``active = 1`` (the event is present while the input reads 1) and ``forward = "cw"``.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
 CONTROLLERS = ("robo-interface", "tx", "txt")
-TERMINALS = {"input": ("I", 8), "motor": ("M", 4), "counter": ("C", 4)}
+TERMINALS = {"input": ("I", 8), "motor": ("M", 4), "counter": ("C", 4), "lamp": ("O", 8)}
 COMMANDS = ("cw", "ccw")
 DEFAULT = object()
 
@@ -38,6 +40,7 @@ class Wiring:
     inputs: dict[str, tuple[int, int]] = field(default_factory=dict)  # name -> (terminal, active level)
     motors: dict[str, tuple[int, str]] = field(default_factory=dict)  # name -> (output, forward command)
     counters: dict[str, int] = field(default_factory=dict)  # name -> counter
+    lamps: dict[str, int] = field(default_factory=dict)  # name -> single output O1..O8
     problems: tuple[tuple[str, str, str], ...] = ()  # (robot name, message, hint) of names left unwired
 
 
@@ -71,7 +74,7 @@ class _Reader:
     def entry(self, name: str, value: Any, kind: str, extra: dict[str, tuple[Any, ...]]) -> tuple[int, dict] | None:
         """A terminal (``"I3"``) or a table ``{terminal = "I3", key = value}`` with ``extra``'s keys."""
         letter, count = TERMINALS[kind]
-        word = "output" if kind == "motor" else "terminal"
+        word = "output" if kind in ("motor", "lamp") else "terminal"
         options: dict[str, Any] = {}
         if isinstance(value, dict):
             unknown = sorted(set(value) - {word, *extra})
@@ -107,9 +110,9 @@ def read_robot_robopro(src: Source, section: Any, robot: Robot) -> Wiring:
         reader.error("controller", f"controller = {controller!r} is not one ROBO Pro drives here",
                      f"write controller = one of {', '.join(map(repr, CONTROLLERS))}")
     for name in section:
-        if name != "controller" and name not in (*robot.inputs, *robot.motors, *robot.counter_names):
+        if name != "controller" and name not in (*robot.inputs, *robot.motors, *robot.counter_names, *robot.lamps):
             reader.error(name, f"wires {name!r}, which robot {robot.name} does not have",
-                         "wire the robot's inputs, motors and counters (names from the robot file)")
+                         "wire the robot's inputs, motors, counters and lamps (names from the robot file)")
     return wiring_of(robot, section, reader, str(controller))
 
 
@@ -117,17 +120,22 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
               controller: str = "robo-interface") -> Wiring:
     """The wiring ``section`` says, defaults filled in; names that cannot be wired are listed in
     ``problems`` (mistakes in the section itself go through ``reader``)."""
-    inputs, motors, counters, problems = {}, {}, {}, []
+    inputs: dict[str, tuple[int, int]] = {}
+    motors: dict[str, tuple[int, str]] = {}
+    counters: dict[str, int] = {}
+    lamps: dict[str, int] = {}
+    problems: list[tuple[str, str, str]] = []
     reader = reader or _Reader(None, robot)
     extras: dict[str, dict[str, tuple[Any, ...]]] = {
-        "input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}}
-    for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names)):
+        "input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}, "lamp": {}}
+    for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names),
+                        ("lamp", robot.lamps)):
         extra = extras[kind]
         for name in names:
             if name in section:
                 got = reader.entry(name, section[name], kind, extra)
             else:  # unwired names are the export's problem, not the robot file's
-                terminal = _default(name, kind, robot)
+                terminal = _default(name, kind, robot) if kind != "lamp" else _free_output(name, robot, motors, lamps)
                 got = (terminal, {}) if terminal is not None and name not in section else None
             if got is None:
                 letter, count = TERMINALS[kind]
@@ -139,10 +147,22 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
                 inputs[name] = (terminal, int(options.get("active", 1)))
             elif kind == "motor":
                 motors[name] = (terminal, str(options.get("forward", "cw")))
+            elif kind == "lamp":
+                lamps[name] = terminal
             else:
                 counters[name] = terminal
-    return Wiring(controller if controller in CONTROLLERS else "robo-interface", inputs, motors, counters,
+    return Wiring(controller if controller in CONTROLLERS else "robo-interface", inputs, motors, counters, lamps,
                   tuple(problems) + tuple(reader.errors))
+
+
+def _free_output(name: str, robot: Robot, motors: dict[str, tuple[int, str]], lamps: dict[str, int]) -> int | None:
+    """A lamp's default output: O1…O8 by its name, else the first single output no motor and no lamp takes."""
+    named = _terminal(name, "lamp")
+    if named is not None:
+        return named
+    taken = {o for output, _ in motors.values() for o in (2 * output - 1, 2 * output)} | set(lamps.values())
+    taken |= {t for lamp in robot.lamps if (t := _terminal(lamp, "lamp")) is not None}
+    return next((o for o in range(1, 9) if o not in taken), None)
 
 
 def wiring(robot: Robot) -> Wiring:
