@@ -23,9 +23,9 @@ not: that choice is made explicitly, which makes this part exact, not just sound
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import TickInput
@@ -37,6 +37,7 @@ Tick = tuple[int, int, int, Node]
 #: Pulses written for a counter that must reach 0 this tick: more than any load can hold.
 ZERO_PULSES = 65535
 K = TypeVar("K")
+V = TypeVar("V")
 #: Input bits a state is enumerated over; beyond this the model would be too large to explore.
 MAX_ENUMERATED_BITS = 16
 
@@ -114,7 +115,7 @@ class Model:
         if bits.bit_count() > MAX_ENUMERATED_BITS:
             raise ModelTooLarge(f"state {m.states[state]} depends on {bits.bit_count()} inputs")
         seen: dict[tuple[int, int], int] = {}
-        for inputs in sorted(_subsets(bits), key=lambda x: (x.bit_count(), x)):
+        for inputs in sorted(subsets(bits), key=lambda x: (x.bit_count(), x)):
             events = inputs | context
             row = m.lookup(state, events)
             seen.setdefault((row, inputs & self.watch), events)
@@ -123,10 +124,7 @@ class Model:
         return result
 
     def successors(self, node: Node) -> list[Tick]:
-        cached = self._succ.get(node)
-        if cached is None:
-            cached = self._succ[node] = list(self._expand(node))
-        return cached
+        return memoised(self._succ, node, self._expand)
 
     def _expand(self, node: Node) -> Iterator[Tick]:
         state, timer, zero, outputs, first = node
@@ -135,7 +133,7 @@ class Model:
             choices = [(timer, 0)]
         else:
             after = timer if timer == self.omega else max(0, timer - 1)
-            choices = [(after, z) for z in _subsets(self.tracked & ~zero)]
+            choices = [(after, z) for z in subsets(self.tracked & ~zero)]
         for after, zeroed in choices:
             now_zero = zero | zeroed
             context = (m.timer_bit if after == 0 else 0) | self.counter_events(now_zero)
@@ -162,21 +160,7 @@ class Model:
 
     def explore(self, budget: int = 2_000_000) -> Graph:
         """Every node reachable from the initial node, with its ticks."""
-        start = self.initial()
-        order = [start]
-        seen = {start}
-        queue = deque(order)
-        while queue:
-            node = queue.popleft()
-            for tick in self.successors(node):
-                nxt = tick[3]
-                if nxt not in seen:
-                    seen.add(nxt)
-                    order.append(nxt)
-                    queue.append(nxt)
-                    if len(order) > budget:
-                        raise ModelTooLarge(f"more than {budget} reachable situations")
-        return Graph(self, order)
+        return Graph(self, reachable(self.initial(), self.successors, budget))
 
     def drops(self, before: Node, tick: Tick) -> bool:
         """Whether this tick is OMEGA coming down to the horizon (a wait that must be padded)."""
@@ -236,7 +220,31 @@ def walk_back(parent: dict[K, tuple[K, Tick] | None], key: K) -> list[tuple[K, T
     return steps
 
 
-def _subsets(bits: int) -> Iterator[int]:
+def memoised(cache: dict[K, list[V]], key: K, make: Callable[[K], Iterable[V]]) -> list[V]:
+    """``make(key)`` as a list, made once per key: a model's successors, asked again by every search."""
+    cached = cache.get(key)
+    if cached is None:
+        cached = cache[key] = list(make(key))
+    return cached
+
+
+def reachable(start: K, successors: Callable[[K], Iterable[tuple[Any, ...]]], budget: int) -> list[K]:
+    """Every node reachable from ``start`` in breadth-first order, a tick's node after being its last item
+    (the one-table model's and the product's); ModelTooLarge past ``budget`` nodes."""
+    order, seen, queue = [start], {start}, deque([start])
+    while queue:
+        for tick in successors(queue.popleft()):
+            nxt = tick[-1]
+            if nxt not in seen:
+                seen.add(nxt)
+                order.append(nxt)
+                queue.append(nxt)
+                if len(order) > budget:
+                    raise ModelTooLarge(f"more than {budget} reachable situations")
+    return order
+
+
+def subsets(bits: int) -> Iterator[int]:
     """Every subset of ``bits``, the empty one first."""
     sub = 0
     while True:

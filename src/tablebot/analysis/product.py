@@ -16,11 +16,10 @@ row; the tuple of every table's state (index into its machine's ``states``); the
 from __future__ import annotations
 
 import itertools
-from collections import deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
-from tablebot.analysis.model import MAX_ENUMERATED_BITS, ZERO_PULSES, Graph, ModelTooLarge
+from tablebot.analysis.model import MAX_ENUMERATED_BITS, ZERO_PULSES, Graph, ModelTooLarge, memoised, reachable, subsets
 from tablebot.engine.several import Several
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import NO_ROW
@@ -80,16 +79,13 @@ class ProductModel:
                 True)
 
     def successors(self, node: PNode) -> list[PTick]:
-        cached = self._succ.get(node)
-        if cached is None:
-            cached = self._succ[node] = list(self._expand(node))
-        return cached
+        return memoised(self._succ, node, self._expand)
 
     def _expand(self, node: PNode) -> Iterator[PTick]:
         states, timers, zero, outputs, first = node
         afters = [timers] if first else [tuple(t if t == self.omega else max(0, t - 1) for t in timers)]
         # (a table left out keeps timer 0 and fires nothing: see _rows)
-        zeroings = [0] if first else list(_subsets(self.tracked & ~zero))
+        zeroings = [0] if first else list(subsets(self.tracked & ~zero))
         seen: set[tuple[int, ...]] = set()
         for after, zeroed in itertools.product(afters, zeroings):
             now_zero = zero | zeroed
@@ -139,23 +135,13 @@ class ProductModel:
                 if load is not None and self.tracked >> c & 1:
                     zero = zero | (1 << c) if load == 0 else zero & ~(1 << c)
         waiting = [k for k in self.active if rows[k] == NO_ROW and timers[k] == self.omega and not first]
-        for dropped in _subsets(sum(1 << k for k in waiting)):
+        for dropped in subsets(sum(1 << k for k in waiting)):
             after = tuple(self.horizon if dropped >> k & 1 else t for k, t in enumerate(new_timers))
             yield tuple(new_states), after, zero, tuple(new_out), False
 
     def explore(self, budget: int = 2_000_000) -> Graph:
         """Every node reachable from the initial node (a :class:`Graph`, as the one-table model's)."""
-        start = self.initial()
-        order, seen, queue = [start], {start}, deque([start])
-        while queue:
-            for tick in self.successors(queue.popleft()):
-                nxt = tick[3]
-                if nxt not in seen:
-                    seen.add(nxt)
-                    order.append(nxt)
-                    queue.append(nxt)
-                    if len(order) > budget:
-                        raise ModelTooLarge(f"more than {budget} reachable situations")
+        order = reachable(self.initial(), self.successors, budget)
         return Graph(self, order)  # type: ignore[arg-type]  # the same interface: initial, successors
 
     def drops(self, before: PNode, tick: PTick) -> bool:
@@ -184,11 +170,3 @@ def _longest(tables: RobotTables, relevant: frozenset[int] | None) -> int:
     machines = [m for k, m in enumerate(tables.machines) if relevant is None or k in relevant]
     return max([1, *(r.timer for m in machines for r in m.rows), *(m.initial_timer for m in machines)])
 
-
-def _subsets(bits: int) -> Iterator[int]:
-    sub = 0
-    while True:
-        yield sub
-        sub = (sub - bits) & bits
-        if sub == 0:
-            return

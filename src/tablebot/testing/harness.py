@@ -90,11 +90,17 @@ def register(executor: Executor) -> Executor:
 def differences(machine: Machine, run: Run) -> str | None:
     """The first tick where ``run`` disagrees with ``Engine.step`` on the inputs it read, or None. Fields an
     executor's line leaves out are not compared (``Engine.run``'s per-tick columns have no outputs)."""
-    expected = list(replay(machine, run.inputs))
-    if len(run.lines) != len(expected):
-        return f"{len(run.lines)} ticks reported for {len(expected)} inputs"
-    for line, want in zip(run.lines, expected, strict=True):
-        missing = [key for key in CORE if key not in line]
+    return first_difference(run.lines, list(replay(machine, run.inputs)), CORE)
+
+
+def first_difference(lines: Sequence[dict[str, Any]], expected: Sequence[dict[str, Any]],
+                     required: Sequence[str] | None = None) -> str | None:
+    """The first tick and field where an executor's ``lines`` disagree with the engine's ``expected`` lines, or
+    None; ``required``: the keys each line must report (None: every key of the engine's line)."""
+    if len(lines) != len(expected):
+        return f"{len(lines)} ticks reported for {len(expected)} inputs"
+    for line, want in zip(lines, expected, strict=True):
+        missing = [key for key in (want if required is None else required) if key not in line]
         if missing:
             return f"tick {want['tick']}: no {', '.join(missing)} reported"
         for key, value in line.items():
@@ -169,6 +175,20 @@ class Report:
     skipped: dict[str, str] = field(default_factory=dict)
     differ: dict[str, str] = field(default_factory=dict)
 
+    def note(self, name: str, difference: str | None) -> None:
+        """What executor ``name`` gave: it agreed (None) or its first difference."""
+        if difference is None:
+            self.agreed.append(name)
+        else:
+            self.differ[name] = difference
+
+
+def executor_folder(workdir: Path, name: str) -> Path:
+    """The folder executor ``name`` runs a case in, made."""
+    folder = workdir / name.replace(" ", "-")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
 
 def check(case: Case, workdir: Path, names: Sequence[str] | None = None) -> Report:
     """Run every registered executor (or ``names``) on ``case`` and compare each with ``Engine.step``."""
@@ -180,11 +200,5 @@ def check(case: Case, workdir: Path, names: Sequence[str] | None = None) -> Repo
         if why:
             report.skipped[name] = why
             continue
-        folder = workdir / name.replace(" ", "-")
-        folder.mkdir(parents=True, exist_ok=True)
-        difference = differences(case.machine, executor.run(case, folder))
-        if difference is None:
-            report.agreed.append(name)
-        else:
-            report.differ[name] = difference
+        report.note(name, differences(case.machine, executor.run(case, executor_folder(workdir, name))))
     return report

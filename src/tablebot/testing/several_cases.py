@@ -18,7 +18,7 @@ from tablebot.formats.inputs_csv import TickInput
 from tablebot.machine import Machine
 from tablebot.replay import replay_several
 from tablebot.tables import RobotTables
-from tablebot.testing.harness import EXECUTORS, Report, Run, SeveralCase, wired_for
+from tablebot.testing.harness import EXECUTORS, Report, Run, SeveralCase, executor_folder, first_difference, wired_for
 
 __all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks",
            "wired_robot"]
@@ -55,17 +55,7 @@ def wired_robot(tables: RobotTables, section: str) -> Machine:
 def several_differences(tables: RobotTables, run: Run, order: Sequence[int] | None = None) -> str | None:
     """The first tick where ``run`` disagrees with :class:`~tablebot.engine.several.Several` (stepping its
     tables in ``order``) on the inputs it read, or None. Every key of the engine's line must be reported."""
-    expected = list(replay_several(tables, run.inputs, order))
-    if len(run.lines) != len(expected):
-        return f"{len(run.lines)} ticks reported for {len(expected)} inputs"
-    for line, want in zip(run.lines, expected, strict=True):
-        missing = [key for key in want if key not in line]
-        if missing:
-            return f"tick {want['tick']}: no {', '.join(missing)} reported"
-        for key, value in line.items():
-            if want.get(key, value) != value:
-                return f"tick {want['tick']}: {key} is {value!r}, the engine says {want[key]!r} ({want})"
-    return None
+    return first_difference(run.lines, list(replay_several(tables, run.inputs, order)))
 
 
 def check_several(case: SeveralCase, workdir: Path, names: Sequence[str] | None = None) -> Report:
@@ -79,11 +69,5 @@ def check_several(case: SeveralCase, workdir: Path, names: Sequence[str] | None 
         if why or executor.several is None:
             report.skipped[name] = why or ""
             continue
-        folder = workdir / name.replace(" ", "-")
-        folder.mkdir(parents=True, exist_ok=True)
-        difference = several_differences(case.tables, executor.several(case, folder))
-        if difference is None:
-            report.agreed.append(name)
-        else:
-            report.differ[name] = difference
+        report.note(name, several_differences(case.tables, executor.several(case, executor_folder(workdir, name))))
     return report
