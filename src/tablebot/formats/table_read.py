@@ -6,7 +6,6 @@ as ``file:line:column: message`` with a hint. Loading never executes anything fr
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from operator import attrgetter
 from pathlib import Path
@@ -14,15 +13,12 @@ from typing import Any
 
 from tablebot.csvtext import Cell, Record, cells_beyond, headerless, read_records, read_text, records_after
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError, fail
-from tablebot.durations import MAX_NUMBER_CHARS, DurationError, seconds, to_ticks
+from tablebot.formats.table_cells import Column, motor_speed, read_value
 from tablebot.formats.table_parts import cross_column, grouped, robot_for_table, writes
-from tablebot.i18n import N_, Message
+from tablebot.i18n import N_
 from tablebot.i18n.headers import suffix
 from tablebot.robot import (
     BUMBERBOT,
-    MAX_TIMER,
-    STATE_HINT,
-    STATE_RE,
     Robot,
     StateId,
     find_robot_file,
@@ -31,29 +27,12 @@ from tablebot.robot import (
 from tablebot.robot_tables import tables_of
 from tablebot.table import (
     FIXED,
-    MAX_LAMP,
-    MAX_SPEED,
     TIMER_EVENT,
     Row,
     Table,
-    from_direction_speed,
     missing_states,
     normalise_header,
 )
-
-KEEP_WORDS = {"=", "keep", "k"}
-INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
-TIME_RE = re.compile(r"[A-Za-z]\s*$")  # a timer cell that ends in a unit (500ms, 0.5 s, 3 ticks) is a duration
-
-
-@dataclass(frozen=True)
-class Column:
-    """What one header cell means: a fixed column, an event, or one field of an output."""
-
-    kind: str  # description|state|timer|next|event|dir|speed|signed|lamp|load, or ignore (no such column)
-    name: str  # event/motor/lamp/counter name, or the fixed column's name
-    cell: Cell
-
 
 #: The largest table read, far beyond any real one (the examples have up to 41 rows, 10 states and 16 columns; a
 #: table of a few thousand rows is big; ROBO Pro's lists hold 128 states) and small enough that ``check`` and
@@ -224,76 +203,6 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
 
 # --- rows ---------------------------------------------------------------------------------------
 
-def _whole(text: str) -> int:
-    """The integer of a cell that matches INT_RE ("3", "+3", "3.0"), exactly: no detour through float."""
-    return int(text.partition(".")[0])
-
-
-def _int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int | None = 0,
-         keep: bool = False) -> int | None:
-    text = cell.text.strip()
-    if not text:
-        return blank
-    if keep and text.lower() in KEEP_WORDS:
-        return None
-    hint = _range_hint(low, high, keep)
-    if not INT_RE.match(text):
-        out.error(cell.line, cell.column, N_("{what}: {text!r} is not an integer", what=what, text=text), hint)
-        return blank
-    if len(text) > MAX_NUMBER_CHARS:  # never in range, and int() of it may fail
-        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is out of range {low}..{high}",
-                                             what=what, count=len(text), low=low, high=high), hint)
-        return blank
-    value = _whole(text)
-    if not low <= value <= high:
-        out.error(cell.line, cell.column, N_("{what}: {value} is out of range {low}..{high}", what=what, value=value,
-                                             low=low, high=high), hint)
-        return blank
-    return value
-
-
-def _range_hint(low: int, high: int, keep: bool) -> Message:
-    if (low, high) == (0, 1):  # event and direction cells: a flag, not a quantity
-        return N_("write 1 or 0 (a blank cell is 0)")
-    if (low, high, keep) == (0, MAX_TIMER, False):  # the timer: ticks or a time
-        return N_("write a whole number of ticks from 0 to {high}, or a time such as 500ms, 0.5s or 0,5s",
-                  high=high)
-    if keep:
-        return N_("write a whole number from {low} to {high}, or = to keep it as it is", low=low, high=high)
-    return N_("write a whole number from {low} to {high}", low=low, high=high)
-
-
-def _state(cell: Cell, what: str, out: Collector) -> StateId | None:
-    text = cell.text.strip()
-    if not text:
-        out.error(cell.line, cell.column, N_("{what} is missing", what=what), N_("write a state number or name"))
-        return None
-    if INT_RE.match(text) and len(text) > MAX_NUMBER_CHARS:  # int() of it may fail
-        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is too long", what=what,
-                                             count=len(text)),
-                  N_("a state number has at most {most} characters; or use a name", most=MAX_NUMBER_CHARS))
-        return None
-    if INT_RE.match(text):
-        value = _whole(text)
-        if value < 0:
-            out.error(cell.line, cell.column, N_("{what} {value} is negative", what=what, value=value),
-                      N_("states are 0 or more"))
-        return value
-    if not STATE_RE.match(text):
-        out.error(cell.line, cell.column, N_("{what} {text!r} is not a valid state name", what=what, text=text),
-                  STATE_HINT)
-        return None
-    return text
-
-
-#: How _int reads each numeric column kind: (low, high, value of a blank cell, whether "=" keeps).
-NUMBERS: dict[str, tuple[int, int, int | None, bool]] = {
-    "timer": (0, MAX_TIMER, 0, False), "event": (0, 1, 0, False), "dir": (0, 1, 0, False),
-    "speed": (0, MAX_SPEED, 0, False), "signed": (-MAX_SPEED, MAX_SPEED, 0, True),
-    "lamp": (0, MAX_LAMP, None, True), "load": (0, MAX_TIMER, None, True),
-}
-
-
 @dataclass(frozen=True)
 class _Layout:
     """The header's columns, found once for all rows: those read (``named``, with their index) and those under a
@@ -335,7 +244,7 @@ def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
         return None
     return Row(index=index, line=record.line, description=values.get(("description", "description")) or above,
                state=state, events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
-               motors=tuple(_motor(motor, values, bool(tables_of(robot))) for motor in robot.motors),
+               motors=tuple(motor_speed(motor, values, bool(tables_of(robot))) for motor in robot.motors),
                timer=values.get(("timer", "timer")) or 0, next=nxt,
                counters=tuple(values.get(("load", c.name)) for c in robot.counters),
                lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
@@ -343,61 +252,19 @@ def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
 
 def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any],
             tick_ms: int) -> Any:
-    """:func:`_value`, remembered per column and text: a long table repeats the same few cell texts.
-    A cell with an error is never remembered, so every bad cell is reported at its own place."""
+    """:func:`~tablebot.formats.table_cells.read_value`, remembered per column and text: a long table repeats
+    the same few cell texts. A cell with an error is never remembered, so every bad cell is reported at its own
+    place."""
     if column.kind == "description":
         return cell.text.strip()
     key = (index, cell.text)
     if key in memo:
         return memo[key]
     errors = len(out.items)
-    value = _value(column, cell, out, tick_ms)
+    value = read_value(column, cell, out, tick_ms)
     if len(out.items) == errors:
         memo[key] = value
     return value
-
-
-def _value(column: Column, cell: Cell, out: Collector, tick_ms: int) -> Any:
-    """What one cell says (never a description: :func:`_cached` takes those as they are): a state, a
-    number or None (keep); errors go to ``out``."""
-    kind, text = column.kind, cell.text.strip()
-    if kind == "timer" and TIME_RE.search(text):
-        return _timer(cell, tick_ms, out)
-    if kind in ("state", "next"):
-        return _state(cell, N_("next state") if kind == "next" else N_("state"), out)
-    if kind in NUMBERS:
-        low, high, blank, keep = NUMBERS[kind]
-        label = column.cell.text.strip()
-        what = N_("timer") if kind == "timer" else N_("event {label}", label=label) if kind == "event" else label
-        return _int(cell, what, low, high, out, blank, keep)
-    return None  # an ignored column: one with a name was reported in the header, a blank one by _Layout
-
-
-def _timer(cell: Cell, tick_ms: int, out: Collector) -> int:
-    """A timer cell written as a time (``500ms``, ``0.5s``, ``3 ticks``): whole ticks, or 0 after an error."""
-    text = cell.text.strip()
-    try:
-        ticks = to_ticks(text, tick_ms)
-    except DurationError as exc:
-        out.error(cell.line, cell.column, N_("timer: {problem}", problem=exc.message), exc.hint)
-        return 0
-    if ticks > MAX_TIMER:
-        out.error(cell.line, cell.column, N_("timer: {text} is {ticks} ticks, more than the timer holds ({most})",
-                                             text=text, ticks=ticks, most=MAX_TIMER),
-                  N_("the longest timer is {most} ticks ({seconds:g} s at {tick} ms a tick)", most=MAX_TIMER,
-                     seconds=seconds(MAX_TIMER, tick_ms), tick=tick_ms))
-        return 0
-    return ticks
-
-
-def _motor(motor: str, values: dict[tuple[str, str], Any], several: bool = False) -> int | None:
-    """The signed speed (None = keep) from either the document's dir+speed form or a signed cell; in a robot
-    of ``several`` tables, a motor the table has no column for is another table's: kept."""
-    if ("signed", motor) in values:
-        return values[("signed", motor)]
-    if several and ("dir", motor) not in values and ("speed", motor) not in values:
-        return None
-    return from_direction_speed(values.get(("dir", motor)) or 0, values.get(("speed", motor)) or 0)
 
 
 def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell],
