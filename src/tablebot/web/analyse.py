@@ -8,6 +8,7 @@ and hints are the CLI's.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -17,11 +18,14 @@ from tablebot.colours import state_colours
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
 from tablebot.formats.csv_document import CsvDocument
-from tablebot.loading import Loaded
+from tablebot.formats.table_parts import robot_for_table
+from tablebot.loading import Loaded, property_files
 from tablebot.loading import robot_for as robot_for  # the robot a table file runs on, as the CLI finds it
 from tablebot.machine import NO_ROW, Machine, compile_table
 from tablebot.robot import Robot
+from tablebot.robot_tables import CrossEvent, parse_cross, tables_of
 from tablebot.table import Table, normalise_header
+from tablebot.tables import RobotTables, load_tables
 
 #: Column kinds the grid draws differently (see table_read.Column.kind).
 FLAG_KINDS = ("event", "dir")
@@ -29,18 +33,23 @@ FLAG_KINDS = ("event", "dir")
 
 @dataclass
 class Analysis:
-    """One edit's verdict: the parsed table (None while it has errors) and what to show where."""
+    """One edit's verdict: the parsed table (None while it has errors) and what to show where; ``tables``: a
+    robot of several tables, all of them (this one as edited), which the arena runs and check proves together."""
 
     table: Table | None
     machine: Machine | None
     report: CheckReport | None
     data: dict[str, Any] = field(default_factory=dict)
+    tables: RobotTables | None = None
 
 
 def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
     """Per header cell: its kind for the grid (event, dir, speed, signed, timer, state, ...) and a label."""
     out = []
     for text in header:
+        if isinstance(parse_cross(text, robot), CrossEvent):  # another table's state: an event like an input's
+            out.append({"kind": "event", "name": text.strip(), "label": ""})
+            continue
         name = normalise_header(text)  # the parser's own reading of a header cell
         kind_name = table_read._classify(name, robot) if name else None
         kind, base = kind_name if kind_name else ("unknown", name)
@@ -49,21 +58,27 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
     return out
 
 
-def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysis:
-    """Parse the document's text as the CLI would, then check it; located results for the grid."""
+def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
+            others: Mapping[str, Table] | None = None) -> Analysis:
+    """Parse the document's text as the CLI would, then check it; located results for the grid. A table of a
+    robot of several tables is read as one of them (its name, start and rule) and checked with the others:
+    ``others`` as the studio has them (edited), the rest from their files."""
     started = time.perf_counter()
-    text = doc.text()
     places = _cell_places(doc)
     lines = {line: grid for grid, line in enumerate(_row_lines(doc))}
     header_line = _header_line(doc)
-    table = machine = report = None
+    table = machine = report = tables = None
     diagnostics: list[dict[str, Any]] = []
     try:
+        robot, name = robot_for_table(path, robot)  # one of several tables: its own start and rule
         # the parser names the file as the page shows it; the table keeps its real path, where the
         # simulator looks for the arena beside it
-        table = replace(table_read.parse_table(text, display, robot), path=str(path))
+        table = replace(table_read.parse_table(doc.text(), display, robot, name), path=str(path))
         machine = compile_table(table)
-        report = Loaded.of(table, machine).check_report()  # its properties found and proved as check does
+        tables = load_tables(table, others) if tables_of(robot) else None
+        loaded = Loaded(table, machine, property_files=tuple(property_files(path))) if tables is None else \
+            Loaded(tables.table, tables.machines[0], property_files=tuple(property_files(path)), tables=tables)
+        report = loaded.check_report()  # its properties found and proved as check does
     except TableBotError as exc:
         diagnostics = [_locate(d, display, places, lines, header_line) for d in exc.diagnostics]
     data: dict[str, Any] = {
@@ -73,10 +88,10 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str) -> Analysi
     }
     if table is not None and machine is not None:
         data["machine"] = machine_json(table, machine)
-    if report is not None:
-        data.update(_report_json(report, lines))
+    if report is not None and table is not None:
+        data.update(_report_json(report, lines, "" if tables is None or table is tables.table else table.name))
     data["ms"] = round(1000 * (time.perf_counter() - started), 2)
-    return Analysis(table, machine, report, data)
+    return Analysis(table if report is not None else None, machine, report, data, tables)
 
 
 def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
@@ -102,9 +117,11 @@ def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
     }
 
 
-def _report_json(report: CheckReport, lines: dict[int, int]) -> dict[str, Any]:
-    findings = [{"code": f.code, "severity": f.severity, "message": f.message, "hint": f.hint,
-                 "lines": list(f.lines), "rows": [lines[n] for n in f.lines if n in lines]} for f in report.findings]
+def _report_json(report: CheckReport, lines: dict[int, int], table: str) -> dict[str, Any]:
+    """``table``: the name of the table the grid shows ("" the main one): only its findings mark its rows."""
+    findings = [{"code": f.code, "severity": f.severity, "message": f.message, "hint": f.hint, "lines": list(f.lines),
+                 "rows": [lines[n] for n in f.lines if n in lines] if f.table == table else []}
+                for f in report.findings]
     props = []
     for result in report.results:
         prop = result.prop

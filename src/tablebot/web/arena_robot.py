@@ -30,6 +30,16 @@ class ArenaRobot:
         self.arena.close()
         self.arena = Arena()
 
+    def runs(self, analysis: Analysis) -> bool:
+        """Whether the robot runs the robot of ``analysis`` already (one of its several tables): a tab of another
+        of its tables is shown without starting it over."""
+        running, tables = self.arena.tables, analysis.tables
+        return running is not None and tables is not None and running.robot.source == tables.robot.source
+
+    def view(self, name: str) -> None:
+        """The page shows table ``name`` of the robot: the frames say its state and row."""
+        self.arena.view = name
+
     def diagram(self, table: Table) -> str:
         return self.arena.diagram(table)
 
@@ -39,7 +49,9 @@ class ArenaRobot:
         if analysis is None or analysis.table is None or analysis.machine is None:
             raise Refused("fix the table's errors first: the robot runs only a table that reads")
         settings = ArenaSettings.of(fields, self.arena.settings)
-        info = await asyncio.to_thread(self.arena.reset, analysis.table, analysis.machine, settings)
+        tables = analysis.tables
+        main = (analysis.table, analysis.machine) if tables is None else (tables.table, tables.machines[0])
+        info = await asyncio.to_thread(self.arena.reset, *main, settings, tables)
         await self.say(ArenaMsg(info))
 
     async def control(self, op: Sim) -> None:

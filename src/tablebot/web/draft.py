@@ -5,13 +5,14 @@ on disk leaves the draft as it is, to save anyway or drop."""
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Awaitable, Callable
+from collections.abc import Awaitable, Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.csv_document import MAX_TABLE_BYTES, CsvDocument
 from tablebot.robot import Robot
+from tablebot.robot_tables import tables_of
 from tablebot.table import Table
 from tablebot.web.analyse import Analysis, analyse, robot_failed, robot_for
 from tablebot.web.errors import Refused
@@ -49,6 +50,26 @@ class Draft:
     analysis: Analysis | None = None
     robot: Robot | None = None  # the table's robot file, read when the table is opened
     robot_error: TableBotError | None = None
+    #: The robot's other tables as this tab has them (edited), by name: checked and run with this one.
+    others: Callable[[], Mapping[str, Table]] = dict
+
+    @property
+    def name(self) -> str:
+        """The table's name in its robot's ``[tables]`` ("" for a robot of one table, or before it reads)."""
+        table = None if self.analysis is None else self.analysis.table
+        return "" if table is None else table.name
+
+    def tabs(self) -> list[dict[str, str]]:
+        """The robot's tables, a tab each on the page: name and file (relative to the folder, as opened)."""
+        if self.robot is None or self.path is None:
+            return []
+        base = Path(self.robot.source).parent
+        found = []
+        for spec in tables_of(self.robot):
+            path = (base / spec.file).resolve()
+            if path.is_relative_to(self.workspace.root):
+                found.append({"name": spec.name, "file": path.relative_to(self.workspace.root).as_posix()})
+        return found
 
     @property
     def path(self) -> Path | None:
@@ -84,10 +105,16 @@ class Draft:
         self.robot, self.robot_error = robot, robot_error
         self.opened, self.base, self.doc, self.dirty = opened, None, doc, False
         replaced()
+        await self.resend()
+        return True
+
+    async def resend(self) -> None:
+        """The draft to the page as it is now (opened, or its tab shown again with its edits)."""
+        doc, opened = self.need_doc(), self.opened
+        assert opened is not None
         await self.say(TableMsg(opened.name, doc.header_values(), doc.grid(), grid_lines(doc), self.version,
                                 {"delimiter": doc.dialect.delimiter, "encoding": doc.dialect.encoding,
-                                 "newline": repr(doc.dialect.newline)[1:-1]}))
-        return True
+                                 "newline": repr(doc.dialect.newline)[1:-1]}, self.dirty))
 
     async def reanalyse(self, seq: object) -> None:
         """Check the draft and send the analysis (and the state diagram of a table that reads)."""
@@ -96,8 +123,10 @@ class Draft:
             assert self.robot_error is not None
             await self.say(AnalysisMsg(seq, self.dirty, grid_lines(self.doc), robot_failed(self.robot_error, self.doc)))
             return
-        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot, self.opened.name)
-        await self.say(AnalysisMsg(seq, self.dirty, grid_lines(self.doc), self.analysis.data))
+        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot, self.opened.name,
+                                                self.others())
+        data = {**self.analysis.data, "tables": self.tabs()}
+        await self.say(AnalysisMsg(seq, self.dirty, grid_lines(self.doc), data))
         if self.analysis.table is not None:
             await self.say(DiagramMsg(await asyncio.to_thread(self.diagram, self.analysis.table)))
 

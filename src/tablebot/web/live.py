@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tablebot.engine import Engine
+from tablebot.engine.as_one import RobotEngine
 from tablebot.loop import Reading, RunEnd, RunInfo, Sink, TickBlock, run
 from tablebot.sim import columns as L
 from tablebot.sim.model.scene import Scene
@@ -212,7 +213,8 @@ class LiveRun:
     def __init__(self, scene: Scene, robot: SimRobot, speed: str = "1", paused: bool = True,
                  on_end: Callable[[RunEnd], None] | None = None, sinks: Sequence[Sink] = ()) -> None:
         self.scene = scene
-        self.engine = Engine(scene.machine)
+        # a robot of several tables runs whole: every table stepped together, the lights table's lamps too
+        self.engine: Engine | RobotEngine = Engine(scene.machine) if scene.tables is None else RobotEngine(scene.tables)
         self.robot = HandInputs(robot)
         self.robot.on_script = self._scripted
         self.sink = FrameSink()

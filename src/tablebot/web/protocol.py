@@ -226,6 +226,7 @@ class TableMsg(Message):
     lines: list[int]
     version: str | None
     dialect: Mapping[str, str]
+    dirty: bool = False  # a tab of a robot's other table shown again, with its edits not yet saved
 
 
 @dataclass(frozen=True)

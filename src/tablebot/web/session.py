@@ -47,9 +47,13 @@ from tablebot.web.protocol import (
 from tablebot.web.sharing import open_link, share
 from tablebot.web.trace_player import TracePlayer
 from tablebot.web.words import diagnostics_text, localised
-from tablebot.web.workspace import OTHER_TAB, Opened, Workspace
+from tablebot.web.workspace import OTHER_TAB, Kind, Opened, Workspace
 
 Send = Callable[[dict[str, Any]], Awaitable[None]]
+
+
+def _nothing() -> None:
+    """What replacing a draft does to a robot that goes on running (another table of its robot shown)."""
 
 
 class Hub:
@@ -60,7 +64,7 @@ class Hub:
 
     async def saved(self, by: Session, file: Opened) -> None:
         for other in list(self.sessions):
-            if other is not by and other.draft.opened is not None and other.draft.opened.name == file.name:
+            if other is not by and file.name in other.drafts:
                 try:
                     await other.saved_elsewhere(file)
                 except Exception as exc:  # that tab closed meanwhile (its send failed): this save stands
@@ -74,13 +78,22 @@ class Session:
     send: Send
     language: str = "en"  # the page's (tablebot.i18n's name): what the server says to this tab is in it
     robot: ArenaRobot = field(init=False)
-    draft: Draft = field(init=False)
+    draft: Draft = field(init=False)  # the table the page shows
+    #: Every table this tab has open, by file: a robot of several tables has a tab for each on the page, each
+    #: with its own draft (edits kept while another is shown) and saved to its own file.
+    drafts: dict[str, Draft] = field(init=False, default_factory=dict)
     player: TracePlayer = field(init=False)
 
     def __post_init__(self) -> None:
         self.robot = ArenaRobot(self.say, lambda: self.draft.analysis)
-        self.draft = Draft(self.workspace, self.say, self.robot.diagram)
+        self.draft = self.new_draft()
         self.player = TracePlayer(self.workspace, self.say, lambda: self.draft.analysis, self.robot)
+
+    def new_draft(self) -> Draft:
+        draft = Draft(self.workspace, self.say, self.robot.diagram)
+        draft.others = lambda: {d.name: d.analysis.table for d in self.drafts.values()
+                                if d is not draft and d.name and d.analysis is not None and d.analysis.table}
+        return draft
 
     async def say(self, message: Message) -> None:
         await self.send(localised(message.data(), self.language))
@@ -103,8 +116,7 @@ class Session:
         """Carry out one operation, by the part that owns what it changes."""
         match op:
             case Open():
-                opened, doc = await self.draft.read(op.path)
-                await self.show(opened, doc)
+                await self.open(op.path)
             case Edit():
                 await self.draft.edit(op)
             case InsertRow():
@@ -142,17 +154,53 @@ class Session:
             case _:
                 raise AssertionError(f"no handler for {op!r}")  # protocol.OPERATIONS and this match differ
 
-    async def show(self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None) -> bool:
-        """Make ``doc`` this tab's draft (:meth:`Draft.show`), check it, and start its arena robot over."""
-        if not await self.draft.show(opened, doc, unless_edited_since, self.robot.restart):
+    async def open(self, path: str) -> None:
+        """Show table ``path``: the draft this tab has of it (another table's tab of the same robot, shown
+        again with its edits), else the file read afresh."""
+        kept = self.drafts.get(await asyncio.to_thread(self.workspace.locate, path, Kind.TABLE))
+        if kept is not None and kept.doc is not None and kept is not self.draft:
+            self.draft = kept
+            await kept.resend()
+            await self.reanalyse_shown()
+            return
+        draft = self.new_draft()
+        opened, doc = await draft.read(path)
+        same = self.same_robot(opened.name)
+        if not same:
+            self.drafts.clear()  # another robot: its tables' drafts are not this one's
+        self.draft = self.drafts[opened.name] = draft
+        await self.show(opened, doc, restart=not same)
+
+    def same_robot(self, name: str) -> bool:
+        """Whether table ``name`` is one of the tables of the robot this tab shows (a tab of it)."""
+        return any(tab["file"] == name for tab in self.draft.tabs())
+
+    async def show(self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None,
+                   restart: bool = True) -> bool:
+        """Make ``doc`` this tab's draft (:meth:`Draft.show`), check it, and start its arena robot over (not
+        with ``restart`` False, when it runs this table's robot already: the first look at another table)."""
+        if not await self.draft.show(opened, doc, unless_edited_since, self.robot.restart if restart else _nothing):
             return False
-        await self.draft.reanalyse(None)
-        if self.draft.runnable() is not None:
-            await self.robot.reset({})
+        await self.reanalyse_shown()
         return True
 
+    async def reanalyse_shown(self) -> None:
+        """Check the draft shown, and run its robot in the arena (the frames speak of the table shown)."""
+        await self.draft.reanalyse(None)
+        analysis = self.draft.runnable()
+        if analysis is not None and not self.robot.runs(analysis):
+            self.robot.restart()
+            self.robot.view(self.draft.name)
+            await self.robot.reset({})
+        self.robot.view(self.draft.name)
+
     async def saved_elsewhere(self, file: Opened) -> None:
-        """Another tab saved this file: reload it when this tab has no edits of its own, else say so."""
+        """Another tab saved this file: reload it when this tab has no edits of its own, else say so (a table
+        not shown now, without edits, is read afresh when its tab is shown again)."""
+        if self.draft is not self.drafts.get(file.name):
+            if not self.drafts[file.name].dirty:
+                del self.drafts[file.name]
+            return
         if not self.draft.dirty:
             shown = await self.show(file, CsvDocument.from_bytes(file.data, file.name), self.draft.edits)
             if shown:

@@ -17,6 +17,7 @@ from tablebot.sim.model.scene import Scene
 from tablebot.sim.model.world import World
 from tablebot.sim.simrobot import SimRobot
 from tablebot.table import Table
+from tablebot.tables import RobotTables
 from tablebot.web.errors import Refused
 from tablebot.web.live import SPEEDS, LiveRun
 from tablebot.web.worldview import moved, world_json
@@ -82,13 +83,19 @@ class Arena:
         self.machine: Machine | None = None
         self._diagram: tuple[Any, str] | None = None
         self.problem: str | None = None
+        self.tables: RobotTables | None = None
+        self.view = ""  # the table the page shows, by name ("": the main one): the frames speak of it
 
-    def reset(self, table: Table, machine: Machine, settings: ArenaSettings) -> dict[str, Any]:
-        """Start the table over in the world with ``settings``; a world problem is reported, not raised."""
+    def reset(self, table: Table, machine: Machine, settings: ArenaSettings,
+              tables: RobotTables | None = None) -> dict[str, Any]:
+        """Start the table over in the world with ``settings`` (``tables``: the robot's, all of them run, the
+        main one ``table``); a world problem is reported, not raised."""
         self.close()
-        self.settings, self.table, self.machine = settings, table, machine
+        self.settings, self.table, self.machine, self.tables = settings, table, machine, tables
         try:
-            loaded = Loaded(table, machine)  # the table as edited, with the world the CLI would find for it
+            # the table as edited, with the world the CLI would find for it
+            loaded = Loaded(table, machine) if tables is None else Loaded(tables.table, tables.machines[0],
+                                                                          tables=tables)
             robot_world = loaded.robot_world()
             if robot_world is not None and robot_world.exists() and not robot_world.is_file():
                 raise fail(robot_world, "the robot's world is not a regular file (a folder, pipe or device)",
@@ -96,7 +103,8 @@ class Arena:
             base: World = loaded.default_world()
             world = moved(base, settings.start, settings.lamp)
             overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}
-            scene = loaded.scene(world, overrides)
+            scene = loaded.scene(world, overrides, every_table=True)
+            self.machine = scene.machine  # a robot of several tables: wired for every input any of them reads
         except TableBotError as exc:
             self.problem = str(exc)
             return {"ok": False, "problem": self.problem}
@@ -169,6 +177,11 @@ class Arena:
                  "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
                  "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
                  "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}
+        # each lamp's output this tick (0: off, up to 8: full), drawn on the robot
+        frame["lamps"] = {name: latest.outputs[i] for i, name in enumerate(self.machine.output_names)
+                          if name in self.table.robot.lamps}
+        if self.tables is not None and self.view and self.view != self.tables.names[0]:
+            return {**frame, **viewed(self.tables, self.view, extra, latest.tick), "why": []}
         if run.paused:
             frame["why"] = explain(self.table, self.machine, latest.prev_state, latest.event)
         return frame
@@ -199,6 +212,20 @@ def studio_diagram(table: Table) -> str:
         return f"No diagram: {NOT_FOUND}. To draw it: {INSTALL}; then reopen the table."
     except GraphvizFailed as exc:
         return f"No diagram: {exc}"
+
+
+def viewed(tables: RobotTables, name: str, extra: dict[str, Any], tick: int) -> dict[str, Any]:
+    """A frame's state, row, timer and event as table ``name`` (not the main one) had them on its latest tick:
+    what the page shows while that table's tab is open. Its row is the first of the rows as run (a group's row
+    is one per state) written as the trace's, so the grid lights the line the file has."""
+    table = tables.tables[tables.index(name)]
+    written = extra.get(f"{name}.row")
+    row = next((r.index for r in table.rows if r.as_written == written), -1) if written is not None else -1
+    state = extra.get(f"{name}.state")
+    states = tables.machines[tables.index(name)].states
+    return {"state": states.index(state) if state in states else 0, "state_id": str(state), "row": row,
+            "timer": extra.get(f"{name}.timer", 0), "event": extra.get(f"{name}.event", 0),
+            "fired": [[tick, row]] if row >= 0 else []}
 
 
 def _robot(scene: Scene, seed: int) -> SimRobot:

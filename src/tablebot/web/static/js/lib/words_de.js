@@ -5,6 +5,8 @@
 export const DE = Object.freeze({
   "language.name": "Deutsch",
   "language.switch": "Sprache der Seite",
+  "tabs.aria": "die Tabellen des Roboters",
+  "tabs.title": "Tabelle {name} ({file})",
   "bar.table": "Tabelle",
   "bar.table_pick": "Tabelle öffnen",
   "bar.save": "Speichern",

@@ -4,6 +4,8 @@
 export const EN = Object.freeze({
   "language.name": "English",
   "language.switch": "language of the page",
+  "tabs.aria": "the robot's tables",
+  "tabs.title": "table {name} ({file})",
   "bar.table": "table",
   "bar.table_pick": "table to open",
   "bar.save": "Save",

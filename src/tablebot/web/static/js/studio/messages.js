@@ -101,7 +101,7 @@ function offerDraft(store, send, drafts, m) {
 function table(store, views, send, drafts, m) {
   views.grid.setTable(m.header, m.grid, m.lines);
   const offer = store.get().offerDraft === m.path;
-  store.set({ path: m.path, dirty: false, version: m.version, offerDraft: null });
+  store.set({ path: m.path, dirty: Boolean(m.dirty), version: m.version, offerDraft: null });
   if (offer) offerDraft(store, send, drafts, m);
 }
 

@@ -44,7 +44,8 @@ function showFrames(store, views) {
   store.on(["frame"], ({ frame: m, mode, machine }) => {
     if (!m || mode !== "live") return;
     views.arena.addPath(m.path);
-    views.arena.setRobot(m.pose, m.bumpers, m.light);
+    views.arena.setRobot(m.pose, m.bumpers, m.light, m.lamps);
+    byId("arena").dataset.tick = m.tick;  // the tick the arena shows (its lamps: data-lamps)
     const row = m.fired.length ? m.fired[m.fired.length - 1][1] : (m.paused ? m.row : views.grid.liveRow);
     views.grid.setLive(row, m.state_id, stateColumn(store));
     views.diagram.highlight(m.state_id);
@@ -191,7 +192,27 @@ function showMode(store, views, send) {
   });
 }
 
+// A robot of several tables: a tab for each (named as in the robot file's [tables]); a click shows that table,
+// its edits kept by the server while another is shown. The arena runs all of them whichever is shown.
+function showTableTabs(store, send) {
+  store.on(["analysis", "path", "dirty"], ({ analysis, path, dirty }) => {
+    const tabs = (analysis && analysis.tables) || [];
+    const holder = byId("table-tabs");
+    holder.hidden = tabs.length < 2;
+    holder.replaceChildren(...tabs.map(({ name, file }) => {
+      const on = file === path;
+      const tab = button(name + (on && dirty ? " •" : ""), () => { if (!on) send({ op: "open", path: file }); },
+        { className: on ? "on" : "", title: t("tabs.title", { name, file }) });
+      tab.setAttribute("role", "tab");
+      tab.setAttribute("aria-selected", String(on));
+      tab.dataset.table = name;
+      return tab;
+    }));
+  });
+}
+
 export function showPanels(store, views, send) {
+  showTableTabs(store, send);
   showAnalysis(store, views);
   showFrames(store, views);
   showWhy(store, views);

@@ -1,7 +1,8 @@
-// The arena: the world, the robot (body, bumpers, light cones) and its path coloured by state, on a canvas.
+// The arena: the world, the robot (body, bumpers, light cones, lamps) and its path coloured by state, on a canvas.
 // Shared by the studio and the stand-alone replay file.
 
 const WALL = "#2f3640", FLOOR = "#f6f3ec", BLOCK = "#a4b0be", BLOCK_EDGE = "#57606f";
+const LAMP_ON = "#ffd32a", LAMP_OFF = "#57606f";
 
 export class Arena {
   constructor(canvas, colourOf, onClick) {
@@ -12,6 +13,7 @@ export class Arena {
     this.world = null;
     this.pose = null;
     this.bumpers = 0;
+    this.lamps = {};
     this.light = [0, 0];
     this.lastPoint = null;
     this.replayPath = null;
@@ -81,8 +83,11 @@ export class Arena {
     this.dirty = true;
   }
 
-  setRobot(pose, bumpers, light) {
-    this.pose = pose; this.bumpers = bumpers || 0; this.light = light || [0, 0];
+  /** The robot's pose, bumpers, light sensors and lamps ({L1: 0..8, ...}: off, or on that bright). */
+  setRobot(pose, bumpers, light, lamps) {
+    this.pose = pose; this.bumpers = bumpers || 0; this.light = light || [0, 0]; this.lamps = lamps || {};
+    // what the lamps show, for a person's tools and the tests: "L1=0 L2=8"
+    this.canvas.dataset.lamps = Object.entries(this.lamps).map(([name, v]) => `${name}=${v}`).join(" ");
     this.dirty = true;
   }
 
@@ -212,6 +217,18 @@ export class Arena {
     });
     const [ax, ay] = at(0, 0), [nx, ny] = at(f * 0.8, 0);
     g.beginPath(); g.moveTo(ax, ay); g.lineTo(nx, ny); g.strokeStyle = WALL; g.lineWidth = 2 * this.ratio; g.stroke();
+    this._drawLamps(g, at, rr, w);
+  }
+
+  // the lamps on the robot's back, the first on the left (as [lamps] lists them): lit yellow while on
+  _drawLamps(g, at, rr, w) {
+    const names = Object.keys(this.lamps || {}), rad = Math.max(5 * this.ratio, 0.02 * this.scale);
+    names.forEach((name, i) => {
+      const [cx, cy] = at(rr * 0.55, w * (1 - 2 * (i + 1) / (names.length + 1))), on = this.lamps[name] > 0;
+      if (on) { g.fillStyle = "rgba(255, 211, 42, 0.45)"; g.beginPath(); g.arc(cx, cy, rad * 2, 0, 2 * Math.PI); g.fill(); }
+      g.fillStyle = on ? LAMP_ON : LAMP_OFF; g.strokeStyle = WALL; g.lineWidth = this.ratio;
+      g.beginPath(); g.arc(cx, cy, rad, 0, 2 * Math.PI); g.fill(); g.stroke();
+    });
   }
 
   // light cones (a robot with phototransistors): brighter when the sensor sees the lamp

@@ -1,0 +1,146 @@
+"""A robot of several tables in the studio (issue 36 §2), in a real Chromium against the real server: a tab per
+table (named as in the robot file's [tables]), each edited in the same grid and saved to its own file, its edits
+kept while another tab is shown; the arena runs the whole robot and draws its lamps, tick for tick as the engine's
+trace has them; the page fits a projector and a tablet without sideways scrolling, in German too.
+
+Screenshots go to ``studio-several`` under pytest's temporary folder (or ``$TABLEBOT_SCREENSHOTS``): look at them.
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import tablebot
+from core_helpers import ROOT
+from studio_helpers import chromium, screenshots, served, studio_works, wait_for
+from tablebot.web.app import Background
+
+LIGHTS = ROOT / "examples" / "bumberbot-lights"
+#: A room with no lamp: the BumberBot seeks, so its lights table flashes the lamps in turn (beside a lamp they burn).
+DARK_ROOM = """name = "A dark room"
+[arena]
+walls = [[0, 0], [2.4, 0], [2.4, 1.8], [0, 1.8]]
+[start]
+at = [1.2, 0.9]
+heading = 0
+"""
+TIMER_COL = 8  # lights.csv: description, state, T, drive=1,2, drive=11,12, drive=20..29, L1, L2, timer, next
+SEEN = """() => { window.seen = []; const arena = document.querySelector('#arena');
+  new MutationObserver(() => window.seen.push([+arena.dataset.tick, arena.dataset.lamps]))
+    .observe(arena, { attributes: true, attributeFilter: ['data-lamps'] }); }"""
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("several") / "bot"
+    shutil.copytree(LIGHTS, root)
+    (root / "arena.toml").write_text(DARK_ROOM, encoding="utf-8")
+    return root
+
+
+@pytest.fixture(scope="module")
+def studio(folder: Path) -> Iterator[Background]:
+    yield from served(folder)
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    yield from chromium()
+
+
+@pytest.fixture(scope="module")
+def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return screenshots(tmp_path_factory, "studio-several")
+
+
+def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, locale: str = "en-GB") -> Any:
+    context = browser.new_context(viewport={"width": width, "height": height}, locale=locale)
+    page = context.new_page()
+    page.errors = []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.goto(url)
+    page.wait_for_selector("#play:not([disabled])", timeout=120_000)
+    studio_works(page)
+    page.wait_for_selector("#table-tabs button[data-table=lights]")
+    return page
+
+
+def tabs(page: Any) -> list[tuple[str, str]]:
+    return page.eval_on_selector_all("#table-tabs button", "bs => bs.map(b => [b.textContent, b.getAttribute('aria-selected')])")
+
+
+def show(page: Any, name: str, header: str) -> None:
+    """Click table ``name``'s tab and wait for its grid (a header cell ``header`` of it)."""
+    page.click(f"#table-tabs button[data-table={name}]")
+    wait_for(lambda: header in page.eval_on_selector_all("table.grid thead th", "hs => hs.map(h => h.textContent)"),
+             f"the grid of {name}", 30)
+
+
+def cell(page: Any, row: int, col: int) -> Any:
+    return page.locator(f'td[data-row="{row}"][data-col="{col}"] input')
+
+
+def test_a_tab_per_table_each_edited_and_saved_to_its_own_file(browser: Any, studio: Background, folder: Path,
+                                                                shots: Path) -> None:
+    drive_before = (folder / "table.csv").read_bytes()
+    page = open_page(browser, studio.url)
+    assert tabs(page) == [["drive", "true"], ["lights", "false"]]
+    show(page, "lights", "drive=1,2")
+    assert tabs(page) == [["drive", "false"], ["lights", "true"]]
+    cell(page, 2, TIMER_COL).fill("40")  # the left lamp's flash: 40 ticks, not 50
+    page.wait_for_selector("#save:not([disabled])")
+    assert tabs(page)[1] == ["lights •", "true"]  # not saved yet
+    show(page, "drive", "M1_dir")  # another tab shown: the lights table's edit is kept meanwhile
+    assert page.locator("#save").is_disabled()
+    show(page, "lights", "drive=1,2")
+    assert cell(page, 2, TIMER_COL).input_value() == "40" and tabs(page)[1] == ["lights •", "true"]
+    page.screenshot(path=str(shots / "lights-tab.png"))
+    page.keyboard.press("Control+s")
+    wait_for(lambda: b",0,8,40,flash_right" in (folder / "lights.csv").read_bytes(), "lights.csv saved")
+    assert (folder / "lights.csv.bak").read_bytes() == (LIGHTS / "lights.csv").read_bytes()
+    assert (folder / "table.csv").read_bytes() == drive_before  # each tab saves its own file only
+    assert page.errors == []
+    page.context.close()
+
+
+def test_the_arena_runs_every_table_and_shows_the_lamps_as_the_engine_has_them(browser: Any, studio: Background,
+                                                                               folder: Path, shots: Path) -> None:
+    page = open_page(browser, studio.url)
+    show(page, "lights", "drive=1,2")
+    page.click("#reset")  # the robot as the files are now (the lights table saved by the test before)
+    page.wait_for_timeout(300)
+    page.evaluate(SEEN)
+    page.click("#play")
+    wait_for(lambda: page.evaluate("() => new Set(window.seen.map((s) => s[1])).size") >= 2, "the lamps changing", 60)
+    page.click("#play")  # pause
+    page.screenshot(path=str(shots / "lamps.png"))
+    seen = page.evaluate("() => window.seen")
+    trace = tablebot.open(folder).simulate(seconds=seen[-1][0] * 0.01 + 0.1, seed=1).trace
+    for tick, lamps in seen:  # every frame's lamps the page drew, at its tick
+        assert lamps == f"L1={trace['L1'][tick]} L2={trace['L2'][tick]}", (tick, lamps)
+    assert {lamps for _, lamps in seen} >= {"L1=0 L2=8", "L1=8 L2=0"}  # they flash in turn
+    state = page.eval_on_selector("#status", "s => s.textContent")
+    assert "flash_" in state  # the status line speaks of the table shown: the lights table's state
+    assert page.errors == []
+    page.context.close()
+
+
+@pytest.mark.parametrize(("width", "height", "locale"), [(1280, 720, "en-GB"), (1024, 768, "de-DE")])
+def test_the_tabs_fit_a_classroom_screen(browser: Any, studio: Background, shots: Path, width: int, height: int,
+                                         locale: str) -> None:
+    page = open_page(browser, studio.url, width, height, locale)
+    show(page, "lights", "drive=1,2")
+    page.wait_for_timeout(200)
+    page.screenshot(path=str(shots / f"tabs-{width}-{locale}.png"))
+    wide = page.evaluate("() => [document.documentElement.scrollWidth, innerWidth, "
+                         "document.querySelector('#grid').scrollWidth, document.querySelector('#grid').clientWidth]")
+    assert wide[0] <= wide[1] and wide[2] <= wide[3], wide
+    title = page.get_attribute("#table-tabs button[data-table=lights]", "title")
+    assert title == ("Tabelle lights (lights.csv)" if locale == "de-DE" else "table lights (lights.csv)")
+    assert page.errors == []
+    page.context.close()
