@@ -70,8 +70,10 @@ def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, loca
     return page
 
 
-def tabs(page: Any) -> list[tuple[str, str]]:
-    return page.eval_on_selector_all("#table-tabs button", "bs => bs.map(b => [b.textContent, b.getAttribute('aria-selected')])")
+def tabs(page: Any) -> list[list[str]]:
+    """The tabs' words, and whether each is the one shown."""
+    return page.eval_on_selector_all("#table-tabs button",
+                                     "bs => bs.map(b => [b.textContent, b.getAttribute('aria-selected')])")
 
 
 def show(page: Any, name: str, header: str) -> None:
