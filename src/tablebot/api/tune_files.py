@@ -3,6 +3,7 @@ the convergence picture and the report (:mod:`tablebot.api.tuning` runs the sear
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -22,12 +23,23 @@ def tuned_path(table: Path, out: Path) -> Path:
     return path
 
 
-def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Path) -> Path:
-    """The input table byte for byte, but for the tuned cells (its delimiter, quoting and line ends kept)."""
+def tuned_paths(plan: Plan, cells: Sequence[Cell], out: Path) -> dict[int, Path]:
+    """Per table with a tuned cell (its index in the robot's tables, 0: the main one), ``OUT/NAME.tuned.csv``;
+    a robot of one table has its tuned table even when no cell is given (it is always written)."""
+    tables = plan.tables.tables if plan.tables is not None else (plan.table,)
+    tuned = sorted({cell.table for cell in cells} or {0})
+    return {k: tuned_path(Path(tables[k].path), out) for k in tuned}
+
+
+def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Path, table: int = 0) -> Path:
+    """Table ``table`` of the robot (0: the main one) byte for byte, but for its tuned cells (its delimiter,
+    quoting and line ends kept)."""
     from tablebot.files import write_bytes
     from tablebot.formats.csv_document import CsvDocument
 
-    source = Path(plan.table.path)
+    mine = [(cell, value) for cell, value in zip(cells, values, strict=True) if cell.table == table]
+    cells, values = [cell for cell, _ in mine], tuple(value for _, value in mine)
+    source = Path((plan.tables.tables[table] if plan.tables is not None else plan.table).path)
     doc = CsvDocument.from_bytes(source.read_bytes(), str(source))
     header = [h.strip().lower() for h in doc.header_values()]
     lines = doc.record_lines()
@@ -121,12 +133,13 @@ def convergence_figure(evaluate: Evaluator, method: str) -> Figure:
 
 
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
-                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Path,
+                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Sequence[Path],
                  no_better: str = "") -> Path:
     """``report.md``; ``no_better`` says why the winner is not better than the table as it was on the fresh
     scenarios (empty: it is better): then it is called the best candidate, not the tuned table, and no command
     to simulate it is offered."""
     from tablebot.files import write_text
+    from tablebot.i18n import _
 
     spec, cells = plan.spec, evaluate.cells
     seconds = spec.ticks * plan.scenes[0].tick_s
@@ -146,12 +159,28 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
     for metric, (a, b) in before_after.items():
         lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
     if no_better:
-        lines += ["", no_better, "", f"{tuned.name} holds the best candidate of the tuning scenarios, for reference; "
-                  "it is not an improvement."]
+        names = ", ".join(p.name for p in tuned)
+        lines += ["", no_better, "", f"{names} holds the best candidate of the tuning scenarios, for reference; "
+                  "it is not an improvement." if len(tuned) == 1 else
+                  _("{names} hold the best candidate of the tuning scenarios, for reference; it is not an "
+                    "improvement.").format(names=names)]
     else:
-        lines += ["", "Better than the table as it was on fresh seeds: yes.", "",
-                  f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned)}`"]
+        lines += ["", "Better than the table as it was on fresh seeds: yes.", "", *_use(plan, cells, tuned)]
     return write_text(path, "\n".join(lines) + "\n")
+
+
+def _use(plan: Plan, cells: Sequence[Cell], tuned: Sequence[Path]) -> list[str]:
+    """How to run the tuned robot: ``tablebot sim`` of the tuned table, or for a robot of several tables (whose
+    robot file names its table files) the tuned tables to put in place of their files."""
+    from tablebot.i18n import _
+
+    if plan.tables is None:
+        return [f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned[0])}`"]
+    sources = plan.tables.tables
+    pairs = ", ".join(f"{target.name} → {Path(sources[k].path).name}"
+                      for k, target in tuned_paths(plan, cells, tuned[0].parent).items())
+    return [_("The robot file's [tables] names its table files: put each tuned table in place of its file to run "
+              "the robot as tuned ({pairs}); the other tables ran as they are.").format(pairs=pairs)]
 
 
 def sim_command(plan: Plan, tuned: Path) -> str:

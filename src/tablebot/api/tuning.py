@@ -103,10 +103,11 @@ class Tuning:
         from tablebot.fileset import file_set
 
         folder = files.out_folder(Path(folder), "--out")
-        target = _tuned_path(self.plan, folder)
-        files.writing(target)
+        targets = _tuned_paths(self.plan, self.cells, folder)
+        for target in targets.values():
+            files.writing(target)
         with file_set(folder, remove=[JOURNAL]):
-            return _outputs(self, folder, target)
+            return _outputs(self, folder, targets)
 
 
 def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget: int = 300, method: str = "auto",
@@ -135,14 +136,14 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
         raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
     chosen, address = choose(backend, scheduler)
     plan = make_plan(project.path, project.robot_file, project.world_files, grid or ["start=random"], seeds, None,
-                     seconds)
+                     seconds, every_table=True)
     metrics = measurable(plan, objective)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
-    tuned_cells = parse_cells(cells, plan.table)
+    tuned_cells = parse_cells(cells, plan.table, plan.tables)
     method = method if method != "auto" else ("grid" if len(tuned_cells) <= 2 else "cma")
     shown = progress or Progress()
     with project.writing(force):
-        folder = _folder(plan, Path(out)) if out is not None else None
+        folder = _folder(plan, tuned_cells, Path(out)) if out is not None else None
         journal = Journal(folder / JOURNAL, plan, tuned_cells, objective) if folder is not None else None
         known = journal.load() if journal is not None else {}
         if chosen == "local":
@@ -159,13 +160,14 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
         return replace(tuning, files=tuple(tuning.save(folder))) if folder is not None else tuning
 
 
-def _folder(plan: Plan, out: Path) -> Path:
-    """``out``, made, once the tuned table it will hold is known to be writable there (a tuned table of an
+def _folder(plan: Plan, cells: list[Cell], out: Path) -> Path:
+    """``out``, made, once the tuned tables it will hold are known to be writable there (a tuned table of an
     earlier run needs --force: said now, not after the search)."""
     from tablebot import files
 
     files.out_folder(out, "--out")
-    files.writing(_tuned_path(plan, out))
+    for target in _tuned_paths(plan, cells, out).values():
+        files.writing(target)
     return out
 
 
@@ -199,21 +201,21 @@ def _search(plan: Plan, check: Plan, cells: list[Cell], objective: str, method: 
     return Tuning(evaluate, check, method, winner, before_after, 0.0)
 
 
-def _tuned_path(plan: Plan, folder: Path) -> Path:
-    from tablebot.api.tune_files import tuned_path
+def _tuned_paths(plan: Plan, cells: Sequence[Cell], folder: Path) -> dict[int, Path]:
+    from tablebot.api.tune_files import tuned_paths
 
-    return tuned_path(Path(plan.table.path), folder)
+    return tuned_paths(plan, cells, folder)
 
 
-def _outputs(tuning: Tuning, folder: Path, target: Path) -> list[Path]:
+def _outputs(tuning: Tuning, folder: Path, targets: dict[int, Path]) -> list[Path]:
     from tablebot.api.tune_files import convergence, write_evaluations, write_report, write_tuned
 
     evaluate = tuning.evaluator
-    return [write_tuned(tuning.plan, list(tuning.cells), tuning.winner, target),
-            write_evaluations(evaluate, folder / "evaluations.csv"),
+    tuned = [write_tuned(tuning.plan, list(tuning.cells), tuning.winner, target, k) for k, target in targets.items()]
+    return [*tuned, write_evaluations(evaluate, folder / "evaluations.csv"),
             convergence(evaluate, tuning.method, folder / "convergence.png"),
             write_report(tuning.plan, tuning.check, evaluate, tuning.method, tuning.winner, tuning.before_after,
-                         folder / "report.md", tuning.wall_s, target, tuning.verdict() if not tuning.helped else "")]
+                         folder / "report.md", tuning.wall_s, tuned, tuning.verdict() if not tuning.helped else "")]
 
 
 class Journal:

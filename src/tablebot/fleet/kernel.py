@@ -14,7 +14,7 @@ import numpy as np
 from tablebot.jit import njit, numba, prange  # numba as tablebot.jit imports it (its cache folder, no scipy)
 from tablebot.sim.physics.kernel import NO_TICK as NO_TICK  # fleet.run's "never"
 from tablebot.sim.physics.kernel import move, run_robot
-from tablebot.sim.physics.several import SeveralProgram, SeveralState, run_several
+from tablebot.sim.physics.several import SeveralProgram, SeveralState, own, run_several
 from tablebot.sim.physics.structures import (
     FleetRecord,
     FleetState,
@@ -70,11 +70,14 @@ def run_fleet_serial(fleet: FleetState, world: WorldArrays, program: Program, va
 
 
 @njit(nogil=True)
-def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: SeveralProgram, tables: SeveralState,
-                    wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
-                    kept_tables: np.ndarray) -> None:
+def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: SeveralProgram, variants: ProgramVariants,
+                    tables: SeveralState, wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray,
+                    record: FleetRecord, kept_tables: np.ndarray) -> None:
     """Robot i of :func:`run_fleet_several`: sim.physics.several.run_several on its rows (``tables``: every table's
-    registers, outputs and counters, a row per robot; ``kept_tables``: each traced robot's tables per tick)."""
+    registers, outputs and counters, a row per robot; ``kept_tables``: each traced robot's tables per tick),
+    every table with its variant's timers and loads (``variants.timers[v]``: tables × rows)."""
+    v = variants.variant[i]
+    mine = own(program, variants.timers[v], variants.loads[v])
     slot = record.traced[i]
     if slot >= 0:
         rows, ints, kept = record.hist[slot], record.ints[slot], kept_tables[slot]
@@ -82,30 +85,25 @@ def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: Seve
         rows = np.empty((0, fleet.S.shape[1]))
         ints = np.empty((0, record.ints.shape[2]), dtype=np.int64)
         kept = np.empty((0, kept_tables.shape[2], kept_tables.shape[3]), dtype=np.int64)
-    own = SeveralState(tables.regs[i], tables.outputs[i], tables.counters[i], tables.starts[i])
-    robot = RobotState(fleet.S[i], fleet.P[i], own.regs[0], fleet.outputs[i], own.counters[0], fleet.acc[i],
+    state = SeveralState(tables.regs[i], tables.outputs[i], tables.counters[i], tables.starts[i])
+    robot = RobotState(fleet.S[i], fleet.P[i], state.regs[0], fleet.outputs[i], state.counters[0], fleet.acc[i],
                        fleet.collisions[i])
     record_i = Record(rows, ints, record.counts[i], record.first_visit[i], record.first_light[i:i + 1],
                       record.light_bits, record.t0)
-    run_several(robot, world, program, own, wiring, ticks, noise[i], bitgens[i], record_i, kept)
-
-
-@njit(nogil=True, parallel=True)
-def run_fleet_several(fleet: FleetState, world: WorldArrays, program: SeveralProgram, tables: SeveralState,
-                      wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
-                      kept_tables: np.ndarray) -> None:
-    """:func:`run_fleet` for robots of several tables (every table each tick, as ``tablebot sim`` runs them)."""
-    for i in prange(fleet.S.shape[0]):
-        run_one_several(i, fleet, world, program, tables, wiring, ticks, noise, bitgens, record, kept_tables)
+    run_several(robot, world, mine, state, wiring, ticks, noise[i], bitgens[i], record_i, kept)
 
 
 @njit(nogil=True)
-def run_fleet_several_serial(fleet: FleetState, world: WorldArrays, program: SeveralProgram, tables: SeveralState,
-                             wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
+def run_fleet_several_serial(fleet: FleetState, world: WorldArrays, program: SeveralProgram,
+                             variants: ProgramVariants, tables: SeveralState, wiring: Wiring, ticks: int,
+                             noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
                              kept_tables: np.ndarray) -> None:
-    """:func:`run_fleet_several` on this thread alone."""
+    """Advance every robot of several tables ``ticks`` ticks (every table each tick, as ``tablebot sim`` runs them),
+    on this thread: numba's parallel loop cannot take a tuple of programs (each table's), so a fleet runs this on
+    slices of its robots in threads of its own (:func:`tablebot.fleet.run.in_threads`; it holds no GIL)."""
     for i in range(fleet.S.shape[0]):
-        run_one_several(i, fleet, world, program, tables, wiring, ticks, noise, bitgens, record, kept_tables)
+        run_one_several(i, fleet, world, program, variants, tables, wiring, ticks, noise, bitgens, record,
+                        kept_tables)
 
 
 @njit(nogil=True, parallel=True)

@@ -10,6 +10,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from tablebot.machine import Machine
+    from tablebot.tables import RobotTables
 
 Pose = tuple[float, float, float]  # x, y (m), heading (degrees)
 @dataclass(frozen=True)
@@ -32,10 +33,17 @@ class RobotSpec:
 
 @dataclass
 class Variants:
-    """Program variants: per variant every row's timer and counter loads (the rest of the table is shared)."""
+    """Program variants: per variant every row's timer and counter loads (the rest of the table is shared); for a
+    robot of several tables, every table's (:meth:`of_tables`: a table's rows, then 0 up to the longest's)."""
 
-    timers: np.ndarray  # (V, rows) int64
-    loads: np.ndarray  # (V, rows, counters) int64
+    timers: np.ndarray  # (V, rows) int64; several tables: (V, tables, most rows)
+    loads: np.ndarray  # (V, rows, counters) int64; several tables: (V, tables, most rows, counters)
+
+    @staticmethod
+    def of_tables(tables: RobotTables) -> Variants:
+        from tablebot.sim.physics.several import table_values
+
+        return Variants(*table_values(tables))
 
     @staticmethod
     def of(machine: Machine) -> Variants:

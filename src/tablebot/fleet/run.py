@@ -9,6 +9,7 @@ table, world, start, battery and seed.
 
 from __future__ import annotations
 
+import itertools
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -22,12 +23,12 @@ from tablebot.fleet.kernel import (
     parallel,
     run_fleet,
     run_fleet_serial,
-    run_fleet_several,
     run_fleet_several_serial,
 )
 from tablebot.fleet.results import FLEET_COLLISIONS, FleetSummary, Trace
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.fleet.starts import Prepared, Starts, with_start
+from tablebot.jit import numba
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
 from tablebot.sim.model.observation import Observation
@@ -52,7 +53,8 @@ BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced r
 
 class Fleet:
     """N robots of one table in one world (each with its own seed, start, parameters and program variant); with
-    ``tables``, of every table of a robot of several (``table`` and ``machine`` its main one's; no variants)."""
+    ``tables``, of every table of a robot of several (``table`` and ``machine`` its main one's; ``variants`` then
+    of every table's timers and loads, :meth:`Variants.of_tables`)."""
 
     def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
                  robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
@@ -60,12 +62,10 @@ class Fleet:
                  tables: RobotTables | None = None) -> None:
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
-        if tables is not None and variants is not None:
-            raise ValueError("a fleet of a robot of several tables runs its tables as they are (no variants)")
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
         self.tables = tables
         self.specs = list(specs)
-        self.variants = variants or Variants.of(machine)
+        self.variants = variants or (Variants.of(machine) if tables is None else Variants.of_tables(tables))
         self.starts = Starts(table, machine, world, robot_params, prepared, tables)
         self.scenes = [self.starts.scene(spec) for spec in self.specs]
         self.tick_s, self.t0 = self.scenes[0].tick_s, 0
@@ -208,9 +208,15 @@ class Fleet:
                    self.wiring, ticks, noise, self.bitgens, record)
         else:
             kept = np.zeros((n_traced, ticks, len(self.tables.machines), N_K), dtype=np.int64)
-            several = run_fleet_several if pool else run_fleet_several_serial
-            several(fleet, self.world, self.program, self.table_rows, self.wiring, ticks, noise, self.bitgens, record,
-                    kept)
+            variants = ProgramVariants(v.timers, v.loads, self.variant)
+
+            def robots(a: int, b: int) -> None:  # robots a..b-1: every per-robot array cut to them
+                run_fleet_several_serial(
+                    _rows(fleet, a, b), self.world, self.program, variants._replace(variant=self.variant[a:b]),
+                    _rows(self.table_rows, a, b), self.wiring, ticks, noise[a:b], self.bitgens[a:b],
+                    record._replace(counts=self.counts[a:b], first_visit=self.first_visit[a:b],
+                                    first_light=self.first_light[a:b], traced=self.traced[a:b]), kept)
+            in_threads(numba.get_num_threads() if pool else 1, len(self.specs), robots)
             self.regs[:], self.counters[:] = self.table_rows.regs[:, 0], self.table_rows.counters[:, 0]
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
         for i, trace in self.traces.items():
@@ -274,6 +280,25 @@ class Fleet:
     def result(self, i: int) -> SimRun:
         """Robot i's whole run as the single-robot runner's :class:`SimRun` (for its pictures)."""
         return self.traces[i].result(self.S[i], self.acc[i], self.collisions[i], self.t0)
+
+
+def _rows(arrays: Any, a: int, b: int) -> Any:
+    """A named tuple of per-robot arrays cut to robots a..b-1 (views: what the kernel writes lands in the whole)."""
+    return type(arrays)(*(array[a:b] for array in arrays))
+
+
+def in_threads(threads: int, robots: int, run: Callable[[int, int], None]) -> None:
+    """``run(a, b)`` on robots a..b-1 of ``robots``, cut into ``threads`` slices each on a thread of its own (the
+    compiled loop holds no GIL); one slice runs on this thread."""
+    cuts = [k * robots // threads for k in range(threads + 1)] if threads > 1 and robots > 1 else [0, robots]
+    if len(cuts) == 2:
+        run(0, robots)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(len(cuts) - 1) as pool:
+        for done in [pool.submit(run, a, b) for a, b in itertools.pairwise(cuts) if b > a]:
+            done.result()
 
 
 class NoiseRows:

@@ -9,28 +9,25 @@ from __future__ import annotations
 
 import itertools
 import math
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tablebot.diagnostics import fail
+from tablebot.fleet.cells import Cell, parse_cells
 from tablebot.fleet.plan import Plan
 from tablebot.fleet.robots import Variants
 from tablebot.fleet.spec import runs
 from tablebot.fleet.work import Job
-from tablebot.i18n import N_
-from tablebot.robot import MAX_TIMER
-from tablebot.table import Table
 
 if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
     from tablebot.fleet.results import FleetSummary
 
-CELL_RE = re.compile(r"^line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$", re.IGNORECASE)
+__all__ = ["OBJECTIVES", "Cell", "Evaluator", "best", "grid_points", "jobs_for", "losses", "parse_cells", "search_cma",
+           "search_grid", "split", "variants_of"]
+
 ROBOTS_PER_JOB = 512
 OBJECTIVES = {
     "time_to_lamp": "mean seconds until the lamp is reached (a run that never reaches it counts its whole length)",
@@ -41,83 +38,21 @@ OBJECTIVES = {
 }
 
 
-@dataclass(frozen=True)
-class Cell:
-    """One tunable cell: the timer or a counter's load of the row on file line ``line``."""
-
-    line: int
-    row: int  # index of the row in the table
-    column: str  # "timer" or "C1_load"
-    counter: int | None  # the counter a load cell loads (None: the timer)
-    value: int  # as the table has it
-    low: int
-    high: int
-
-    @property
-    def label(self) -> str:
-        return f"line {self.line} {self.column}"
-
-
-def parse_cells(text: str, table: Table) -> list[Cell]:
-    """``"line 5 timer, line 9 timer=100..2000, line 12 C1_load"``: file lines as an editor numbers them."""
-    by_line = {row.line: row for row in table.rows}
-    counters = table.robot.counter_names
-    cells: list[Cell] = []
-    for part in (p.strip() for p in text.split(",") if p.strip()):
-        found = CELL_RE.match(part)
-        if not found:
-            raise fail("--cells", N_("--cells: {part!r} does not name a cell", part=part),
-                       N_('write "line 5 timer, line 9 timer" (file lines, the header is line 1), optionally with a '
-                          'range: "line 5 timer=100..2000"'))
-        line, column = int(found[1]), found[2]
-        if line not in by_line:
-            raise fail("--cells", N_("--cells: line {line} of {file} is not a row of the table", line=line,
-                                     file=Path(table.path).name),
-                       N_("rows are on lines {first}..{last}", first=min(by_line), last=max(by_line)))
-        row = by_line[line]
-        counter = _counter_of(column, counters)
-        if column.lower() != "timer" and counter is None:
-            raise fail("--cells", N_("--cells: {part!r} is not a timer or a counter load", part=part),
-                       N_("only timer cells (timer) and counter loads ({loads}) can be tuned",
-                          loads=", ".join(f"{c}_load" for c in counters) or N_("none in this robot")))
-        value = row.timer if counter is None else row.counters[counter]
-        if value is None:
-            raise fail("--cells", N_("--cells: line {line} leaves {counter} alone (its load is blank)", line=line,
-                                     counter=counters[counter]),  # type: ignore[index]
-                       N_("tune a load the row sets, or write a load into the cell first"))
-        low, high = (int(found[3]), int(found[4])) if found[3] else (0, min(MAX_TIMER, max(2 * value, 100)))
-        if not 0 <= low <= high <= MAX_TIMER:
-            raise fail("--cells", N_("--cells: {part!r}: the range must be LOW..HIGH within 0..{most}", part=part,
-                                     most=MAX_TIMER),
-                       N_("write for example line 5 timer=100..2000"))
-        cell = Cell(line, row.index, "timer" if counter is None else f"{counters[counter]}_load", counter, value,
-                    low, high)
-        if any(c.line == cell.line and c.column == cell.column for c in cells):
-            raise fail("--cells", N_("--cells names {cell} twice", cell=cell.label), N_("name each cell once"))
-        cells.append(cell)
-    if not cells:
-        raise fail("--cells", N_("--cells names no cell"), N_('write --cells "line 5 timer, line 9 timer"'))
-    return cells
-
-
-def _counter_of(column: str, counters: tuple[str, ...]) -> int | None:
-    for k, name in enumerate(counters):
-        if column.lower() == f"{name.lower()}_load":
-            return k
-    return None
-
-
 def variants_of(plan: Plan, cells: Sequence[Cell], candidates: Sequence[Sequence[int]]) -> Variants:
-    """The table's timers and loads with each candidate's values written into its cells."""
-    base = Variants.of(plan.machine)
+    """The table's timers and loads with each candidate's values written into its cells (a robot of several
+    tables: every table's, each cell in its own table)."""
+    several = plan.tables is not None
+    base = Variants.of_tables(plan.tables) if plan.tables is not None else Variants.of(plan.machine)
     timers = np.repeat(base.timers, len(candidates), axis=0)
     loads = np.repeat(base.loads, len(candidates), axis=0)
     for v, values in enumerate(candidates):
         for cell, value in zip(cells, values, strict=True):
-            if cell.counter is None:
-                timers[v, cell.row] = value
-            else:
-                loads[v, cell.row, cell.counter] = value
+            for row in cell.rows:
+                at = (v, cell.table, row) if several else (v, row)
+                if cell.counter is None:
+                    timers[at] = value
+                else:
+                    loads[(*at, cell.counter)] = value
     return Variants(timers, loads)
 
 
@@ -207,7 +142,8 @@ def jobs_for(plan: Plan, variants: Variants, count: int, slots: int = 1) -> list
         for a, b in split(len(specs), slots):
             chunk = specs[a:b]
             jobs.append(Job(plan.table, plan.worlds[world], plan.robot_params, chunk, plan.spec.ticks, first=a,
-                            variants=variants, info={"world": world, "variants": [s.variant for s in chunk]}))
+                            variants=variants, info={"world": world, "variants": [s.variant for s in chunk]},
+                            tables=plan.tables))
     return jobs
 
 

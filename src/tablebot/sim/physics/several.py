@@ -21,7 +21,7 @@ from tablebot.jit import njit
 from tablebot.sim.physics.kernel import end_tick, robot_scratch, start_tick
 from tablebot.sim.physics.structures import Record, RobotState, Wiring, WorldArrays
 from tablebot.tables import RobotTables
-from tablebot.tick import EVENT, ROW, STATE, TIMER, registers
+from tablebot.tick import EVENT, ROW, STATE, TIMER, Program, registers
 
 # --- what the loop keeps of every table each tick: tables[t, k, :] ---------------------------------------
 K_EVENT, K_ROW, K_STATE, K_TIMER = 0, 1, 2, 3
@@ -36,6 +36,8 @@ class SeveralProgram(NamedTuple):
     cross: np.ndarray  # int64 (tables, tables, most states): table k's bits while table s is in state i
     writers: np.ndarray  # int64 (outputs,): the table that writes each output, -1: none (it stays 0)
     counter_writers: np.ndarray  # int64 (counters,): the table that loads each counter, -1: none
+    timers: np.ndarray  # int64 (tables, most rows): each row's timer (a tuned variant's in a fleet: ``own``)
+    loads: np.ndarray  # int64 (tables, most rows, counters): each row's counter loads, likewise
 
 
 class SeveralState(NamedTuple):
@@ -70,7 +72,29 @@ def several_program(tables: RobotTables) -> SeveralProgram:
                        dtype=np.int64)
     counter_writers = np.array([-1 if (w := tables.writer(name)) is None else w
                                 for name in tables.robot.counter_names], dtype=np.int64)
-    return SeveralProgram(tuple(programs), inputs, cross, writers, counter_writers)
+    timers, loads = table_values(tables)
+    return SeveralProgram(tuple(programs), inputs, cross, writers, counter_writers, timers[0], loads[0])
+
+
+def table_values(tables: RobotTables) -> tuple[np.ndarray, np.ndarray]:
+    """Every table's timers (1, tables, most rows) and counter loads (1, tables, most rows, counters), each
+    table's rows first (the rest 0, never read): the values a tuned variant changes (:func:`own`)."""
+    arrays = [machine.arrays for machine in tables.machines]
+    most = max(len(a.timer) for a in arrays if a is not None)
+    counters = len(tables.robot.counter_names)
+    timers = np.zeros((1, len(arrays), most), dtype=np.int64)
+    loads = np.zeros((1, len(arrays), most, counters), dtype=np.int64)
+    for k, a in enumerate(arrays):
+        assert a is not None, "several_program refuses a table too wide for the flat lookup"
+        timers[0, k, :len(a.timer)] = a.timer
+        loads[0, k, :len(a.timer)] = a.loads.reshape(len(a.timer), counters)
+    return timers, loads
+
+
+@njit(nogil=True, inline="always")
+def own(sp: SeveralProgram, timers: np.ndarray, loads: np.ndarray) -> SeveralProgram:
+    """``sp`` with the timers and counter loads of one program variant (a robot of a tuning's fleet)."""
+    return SeveralProgram(sp.programs, sp.inputs, sp.cross, sp.writers, sp.counter_writers, timers, loads)
 
 
 def several_state(engine: RobotEngine) -> SeveralState:
@@ -102,7 +126,10 @@ def tick_several(sp: SeveralProgram, st: SeveralState, outputs: np.ndarray, mask
                 events |= sp.inputs[k, j]
         for source in range(count):
             events |= sp.cross[k, source, st.starts[source]]
-        tick_compiled(st.regs[k], st.outputs[k], st.counters[k], events, pulses, sp.programs[k])
+        p = sp.programs[k]  # with the timers and loads of this robot's variant
+        program = Program(p.input_mask, p.timer_bit, p.lookup, p.next_state, sp.timers[k], p.outputs, p.keep,
+                          sp.loads[k], p.load_set, p.counter_bits)
+        tick_compiled(st.regs[k], st.outputs[k], st.counters[k], events, pulses, program)
     for o in range(outputs.shape[0]):
         writer = sp.writers[o]
         outputs[o] = 0 if writer < 0 else st.outputs[writer, o]
