@@ -17,8 +17,8 @@ import traceback
 # variable once, when it is first imported, which is just below.
 os.environ.setdefault("TYPER_USE_RICH", "0")
 
-# Importing a module registers its commands; `tablebot --help` lists them in this order.
-from tablebot.cli import new, sim, analysis, studio, run, core, export, firmware, sweep, tune, evolve, share, grade  # noqa: F401, I001
+# The commands' modules are imported when a command runs or its help is asked for (tablebot.cli.index lists
+# them, with the summaries `tablebot --help` shows), not here.
 from tablebot.cli.app import app
 from tablebot.diagnostics import Diagnostic
 from tablebot.i18n import LANGUAGES, N_, LanguageError, set_from

@@ -6,9 +6,17 @@ import typer
 from tablebot.cli.usage import Group
 from tablebot.cli.words import LANG_HELP
 
+
+class AppGroup(Group):
+    """tablebot's group, whose commands are those registered on :data:`app`."""
+
+    def typer_app(self) -> typer.Typer:
+        return app
+
+
 app = typer.Typer(
     name="tablebot",
-    cls=Group,  # a wrong option is answered in tablebot's words, with the choices
+    cls=AppGroup,  # a wrong option is answered in tablebot's words, with the choices; commands built when used
     rich_markup_mode=None,  # errors through OptionError.show, and plain help, wherever typer finds rich
     help="Robot behaviour written as a table: check it, trace it, simulate it, export it.",
     no_args_is_help=True,

@@ -22,10 +22,13 @@ from typer._click.exceptions import (
 from typer._click.types import FloatParamType, FloatRange, IntParamType
 from typer._types import TyperChoice
 from typer.core import TyperGroup, TyperOption
+from typer.main import Typer, get_command_from_info
 
+from tablebot.cli.index import BY_NAME, COMMANDS, Commands, load_module
 from tablebot.cli.words import LANG_HELP, localise, localise_params
 from tablebot.diagnostics import Diagnostic
-from tablebot.i18n import LANGUAGES, N_, Message, use
+from tablebot.i18n import LANGUAGES, N_, Message, gettext, use
+from tablebot.i18n import localise as l10n
 
 
 class Group(TyperGroup):
@@ -34,13 +37,33 @@ class Group(TyperGroup):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        for command in self.commands.values():
-            for param in command.params:
-                if isinstance(param.type, FloatParamType):
-                    param.type = FiniteFloat.like(param.type)
-            if not any("--lang" in param.opts for param in command.params):
-                command.params.append(lang_option())
-        localise(self)  # every help text in the reader's language, before any is shown
+        # Each command is built when it is first looked up (tablebot.cli.index): `tablebot --help` and a
+        # command's run import the command modules they need, not all of them.
+        self.commands = Commands({name: _prepared(cmd) for name, cmd in self.commands.items()}, self._build)
+        localise(self, commands=False)  # the group's help in the reader's language, before any is shown
+
+    def typer_app(self) -> Typer:
+        """The app whose commands this group builds (tablebot.cli.app's group says which)."""
+        raise NotImplementedError
+
+    def _build(self, name: str) -> Any:
+        """Command ``name``'s click command: its module imported (which registers it on the app), then built as
+        typer builds it, with tablebot's touches (:func:`_prepared`)."""
+        app = self.typer_app()
+        load_module(name)
+        info = next(i for i in app.registered_commands if i.name == name)
+        command = get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
+                                        rich_markup_mode=app.rich_markup_mode)
+        return _prepared(command)
+
+    def list_commands(self, ctx: Any) -> list[str]:
+        return list(self.commands)  # the names alone: typer's would build every command
+
+    def format_commands(self, ctx: Any, formatter: Any) -> None:
+        """The commands and their summaries from the index, in the reader's language: none is imported."""
+        rows = [(entry.name, str(l10n(entry.summary))) for entry in COMMANDS]
+        with formatter.section(gettext("Commands")):
+            formatter.write_dl(rows)
 
     def get_params(self, ctx: Any) -> list[Any]:
         # typer adds the completion options after the group is made: translated when first asked for
@@ -75,6 +98,20 @@ class Group(TyperGroup):
             raise OptionError(Diagnostic(name, None, None, N_("{name!r} is not a tablebot command", name=name),
                                          hint))
         return super().resolve_command(ctx, args)
+
+
+def _prepared(command: Any) -> Any:
+    """A command as tablebot shows and parses it: finite numbers only, ``--lang`` among its options, every help
+    text in the reader's language, and the index's summary as its short help (shell completion shows it)."""
+    for param in command.params:
+        if isinstance(param.type, FloatParamType):
+            param.type = FiniteFloat.like(param.type)
+    if not any("--lang" in param.opts for param in command.params):
+        command.params.append(lang_option())
+    localise(command)
+    if command.name in BY_NAME:
+        command.short_help = str(l10n(BY_NAME[command.name].summary))
+    return command
 
 
 def lang_option() -> TyperOption:

@@ -54,12 +54,13 @@ class LocalContext(Context):
     formatter_class = LocalFormatter
 
 
-def localise(command: Any) -> None:
-    """Translate a built click command (a group: with its commands) into the language in use."""
+def localise(command: Any, commands: bool = True) -> None:
+    """Translate a built click command into the language in use: a group with its commands, or without them
+    (``commands=False``: tablebot's group translates each command as it builds it)."""
     # typer.core took the stdlib's gettext at import (`from gettext import gettext as _`): its few words are
     # sent to tablebot's catalog instead, whose language tablebot chooses (the stdlib's follows LANGUAGE).
     setattr(typer.core, "_", _translate)  # noqa: B010  (typer's module-level name, not an attribute of ours)
-    for cmd in _commands(command):
+    for cmd in _commands(command) if commands else [command]:
         cmd.context_class = LocalContext
         if cmd.help:
             cmd.help = gettext(cmd.help)
