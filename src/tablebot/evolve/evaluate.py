@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from tablebot.fleet.run import Fleet
     from tablebot.machine import Machine
     from tablebot.sim.model.world import World
+    from tablebot.tables import RobotTables
 
 STRIDE = 20  # ticks between pose samples (0.2 s at 10 ms: a robot moves at most 6 cm)
 CELL_M = 0.10  # floor squares for area_covered
@@ -85,10 +86,13 @@ def run_eval(job: EvalJob) -> tuple[EvalJob, dict[str, np.ndarray]]:
     from tablebot.tick import STATE
 
     use_threads(job)
-    machine = compile_table(job.table)
-    fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params)
     owner = np.repeat(np.arange(len(job.parts)), [len(part.scenarios) for part in job.parts])
-    fleet.regs[:, STATE] = starts(machine, len(job.parts))[owner]  # the engine's registers before its first tick
+    if job.tables is not None:  # one candidate, every table of the robot (no joint table: see Evaluator.jobs)
+        fleet = Fleet(job.table, job.tables.machines[0], job.world, job.specs, job.robot_params, tables=job.tables)
+    else:
+        machine = compile_table(job.table)
+        fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params)
+        fleet.regs[:, STATE] = starts(machine, len(job.parts))[owner]  # the registers before the first tick
     poses = Poses(fleet, job.world)
     fleet.run(job.ticks, progress=lambda done: poses.sample(), block_ticks=job.stride)
     return replace(job, specs=[]), measure_all(fleet, job.world, poses, owner)
@@ -155,7 +159,8 @@ def measure_all(fleet: Fleet, world: World, poses: Poses, owner: np.ndarray) -> 
         out["laps"] = poses.laps.copy()
     total = np.maximum(1, s.counts.sum(axis=1))
     column: dict[str, np.ndarray] = {}  # per state: its column in the joint table for each candidate
-    for j, (k, state) in enumerate(s.states):
+    for j, named in enumerate(s.states):  # a joint table's (candidate, state), or one candidate's own states
+        k, state = named if isinstance(named, tuple) else (0, named)
         column.setdefault(f"{STATE_SHARE}{state}", np.zeros(int(owner.max()) + 1, dtype=np.int64))[k] = j
     robots = np.arange(len(owner))
     for name, columns in column.items():
@@ -181,6 +186,7 @@ class Evaluator:
     runner: Runner
     names: Sequence[str]
     robot_ticks: int = 0  # robot-ticks simulated so far (throughput)
+    evolved: int = 0  # a robot of several tables: the index of the table the candidates are (0: the main one)
 
     def __post_init__(self) -> None:
         self._scenarios: dict[int, tuple[Plan, list[Scenario]]] = {}
@@ -200,6 +206,8 @@ class Evaluator:
         as the backend has slots (or a multiple, at most ROBOTS_PER_JOB robots a job), each cut again
         where its robots change world."""
         plan = plan or self.plan
+        if plan.tables is not None:
+            return self.several_jobs(candidates, plan)
         robots = [(k, *scenario) for k in range(len(candidates)) for scenario in self.scenarios(plan)]
         slots = self.runner.slots()
         count = slots * math.ceil(len(robots) / (slots * ROBOTS_PER_JOB))
@@ -208,6 +216,25 @@ class Evaluator:
             chunk = robots[a:b]
             for world in dict.fromkeys(r[1] for r in chunk):
                 jobs.append(self.job(candidates, [r for r in chunk if r[1] == world], plan, world))
+        return jobs
+
+    def several_jobs(self, candidates: Sequence[tuple[str, Table]], plan: Plan) -> list[EvalJob]:
+        """A robot of several tables: each candidate (table ``evolved`` of the robot) beside the robot's other
+        tables as they are, its robots in jobs of its own (a joint table would rename the states the other
+        tables read), cut as :meth:`jobs` cuts them."""
+        scenarios = self.scenarios(plan)
+        share = max(1, self.runner.slots() // max(1, len(candidates)))
+        count = max(share, math.ceil(len(scenarios) / ROBOTS_PER_JOB))
+        jobs = []
+        for key, table in candidates:
+            tables = with_table(plan, self.evolved, table)
+            for a, b in cuts(len(scenarios), count):
+                chunk = scenarios[a:b]
+                for world in dict.fromkeys(r[0] for r in chunk):
+                    mine = [r for r in chunk if r[0] == world]
+                    jobs.append(EvalJob(tables.table, plan.worlds[world], plan.robot_params, [r[2] for r in mine],
+                                        plan.spec.ticks, first=mine[0][1], tables=tables,
+                                        parts=(Part(key, tuple(r[1] for r in mine)),)))
         return jobs
 
     @staticmethod
@@ -248,6 +275,19 @@ class Evaluator:
                     done(part.key, {name: float(np.sum(v) / total) for name, v in mine.items()}, mine)
 
         self.runner.run(jobs, finished, run_eval)
+
+
+def with_table(plan: Plan, k: int, table: Table) -> RobotTables:
+    """The plan's tables with table ``k`` replaced by ``table`` (the plan's own when it is that table), checked
+    together as the robot file's tables are (a cross-table column must still name a state its table has)."""
+    from tablebot.tables import load_tables
+
+    tables = plan.tables
+    assert tables is not None, "a plan of several tables"
+    if tables.tables[k] is table:
+        return tables
+    given = {t.name: t for t in tables.tables} | {tables.names[k]: table}
+    return load_tables(given[tables.names[0]], given)
 
 
 def known(name: str) -> bool:

@@ -14,7 +14,9 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.grade.challenge import Challenge
+from tablebot.grade.several import robot_of
 from tablebot.grade.submissions import Submission, confine
+from tablebot.i18n import N_, _
 
 if TYPE_CHECKING:
     import numpy as np
@@ -74,7 +76,7 @@ def grade_all(challenge: Challenge, subs: list[Submission], runner: Runner,
     """Every submission graded, in the order given (one that breaks anything never stops the others)."""
     entries = []
     for sub in subs:
-        told(f"grading {sub.name}")
+        told(_("grading {name}").format(name=sub.name))
         entry = Entry(sub)
         try:
             if sub.error:
@@ -98,8 +100,14 @@ def _grade(challenge: Challenge, entry: Entry, runner: Runner) -> None:
     assert sub.table is not None  # a submission without a table has its error already
     confine(sub)
     _same_robot(challenge, sub)
-    project = open_robot(sub.table, robot=challenge.robot, worlds=challenge.worlds,
-                         properties=[challenge.properties] if challenge.properties else [])
+    with robot_of(challenge, sub) as (table, robot):  # a robot of several tables: the submission's beside them
+        _grade_as(challenge, entry, runner, open_robot(table, robot=robot, worlds=challenge.worlds,
+                                                       properties=[challenge.properties] if challenge.properties
+                                                       else []), robot)
+
+
+def _grade_as(challenge: Challenge, entry: Entry, runner: Runner, project: Project, robot: Path) -> None:
+    """Prove the submission's rules and, if it keeps them, run it (``robot``: the robot file it runs on)."""
     entry.project, entry.rows = project, len(project.table.rows)
     if challenge.max_rows is not None and entry.rows > challenge.max_rows:
         entry.why = f"{entry.rows} rows, more than the challenge's {challenge.max_rows}"
@@ -112,7 +120,7 @@ def _grade(challenge: Challenge, entry: Entry, runner: Runner) -> None:
     if broken:
         entry.why = "; ".join(_broken(rule) for rule in broken)
         return
-    entry.plan, entry.values = _run(challenge, project, runner)
+    entry.plan, entry.values = _run(challenge, project, runner, robot)
 
 
 def _broken(rule: Rule) -> str:
@@ -133,18 +141,22 @@ def _same_robot(challenge: Challenge, sub: Submission) -> None:
     mine, theirs = load_robot(sub.robot_file), load_robot(challenge.robot)
     for what in ("inputs", "motors", "counters", "sensors", "tick_ms", "initial_state", "initial_timer", "match"):
         if getattr(mine, what) != getattr(theirs, what):
-            words = what.replace("_", " ")
-            raise fail(sub.robot_file.name, f"its robot file is not the challenge's robot: its {words} differ",
-                       "write the table for the challenge's robot.toml")
+            raise fail(sub.robot_file.name, N_("its robot file is not the challenge's robot: its {what} differ",
+                                               what=ROBOT_PARTS.get(what, what.replace("_", " "))),
+                       N_("write the table for the challenge's robot.toml"))
 
 
-def _run(challenge: Challenge, project: Project, runner: Runner) -> tuple[Plan, np.ndarray]:
+#: The parts of a robot file a submission must keep as the challenge has them, as a message names them.
+ROBOT_PARTS = {"inputs": N_("inputs"), "motors": N_("motors"), "counters": N_("counters"), "sensors": N_("sensors")}
+
+
+def _run(challenge: Challenge, project: Project, runner: Runner, robot: Path) -> tuple[Plan, np.ndarray]:
     """The table on the fleet over the challenge's scenarios: the score's measure in each one."""
     from tablebot.evolve.evaluate import Evaluator
     from tablebot.fleet.plan import make_plan
 
-    plan = make_plan(project.path, challenge.robot, list(challenge.worlds), list(challenge.grid), challenge.seeds,
-                     None, challenge.seconds)
+    plan = make_plan(project.path, robot, list(challenge.worlds), list(challenge.grid), challenge.seeds,
+                     None, challenge.seconds, every_table=True)  # a robot of several tables runs whole
     got = {}
 
     def done(key: str, means: dict[str, float], values: dict[str, np.ndarray]) -> None:
