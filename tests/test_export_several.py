@@ -1,7 +1,7 @@
-"""The ROBO Pro exports of a robot of several tables (issue 36 §2) hold its main table alone, and say so: a
-ROBO Pro process per table would need a barrier every tick to read the other tables' states at the start of
-the tick (docs/engine.md). A main table with a cross-table column is refused at that column (the lists'
-encoder failed there with a ValueError); a robot of one table gets no such warning."""
+"""The ROBO Pro exports of a robot of several tables (issue 36 §2): the whole program runs every table, one
+process each (tests/test_robopro_several.py); the three lists hold its main table alone, and say so, and a main
+table with a cross-table column is refused there at that column (the lists' encoder failed there with a
+ValueError); a robot of one table gets no such warning."""
 
 from __future__ import annotations
 
@@ -27,27 +27,31 @@ CROSS = "state,T,I1,other=2,M1,timer,next\n1,1,,,3,5,2\n2,,,1,0,0,1\n2,1,,,-3,5,
 OTHER = "state,T,I1,M2,timer,next\n1,,1,4,0,2\n2,1,,0,10,1\n"
 
 
-@pytest.mark.parametrize("target", ["robopro", "robopro-program"])
-def test_a_cross_table_column_is_refused_where_it_is(tmp_path: Path, target: str) -> None:
+def test_a_cross_table_column_is_refused_by_the_lists_where_it_is(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(ROBOT)
     (tmp_path / "drive.csv").write_text(CROSS)
     (tmp_path / "other.csv").write_text(OTHER)
-    result = invoke("export", tmp_path / "drive.csv", "--to", target, tmp_path / "out")
+    result = invoke("export", tmp_path / "drive.csv", "--to", "robopro", tmp_path / "out")
     assert result.exit_code == 2, result.output
-    assert f"{tmp_path / 'drive.csv'}:1:12: error: other=2: the ROBO Pro exports run table drive alone" in \
+    assert f"{tmp_path / 'drive.csv'}:1:12: error: other=2: the ROBO Pro lists hold table drive alone" in \
         " ".join(result.output.split())
     assert not (tmp_path / "out").exists()
+    program = invoke("export", tmp_path / "drive.csv", "--to", "robopro-program", tmp_path / "program")
+    assert program.exit_code == 0 and "process per table (drive, other)" in program.output, program.output
 
 
 @pytest.mark.parametrize("target", ["robopro", "robopro-program"])
-def test_the_robopro_export_of_several_tables_says_it_runs_the_main_one(tmp_path: Path, target: str) -> None:
+def test_only_the_robopro_lists_of_several_tables_hold_the_main_one(tmp_path: Path, target: str) -> None:
     (tmp_path / "robot.toml").write_text(ROBOT)
     (tmp_path / "drive.csv").write_text(DRIVE)
     (tmp_path / "other.csv").write_text(OTHER)
     result = invoke("export", tmp_path / "drive.csv", "--to", target, tmp_path / "out")
     assert result.exit_code == 0, result.output
-    assert "the robot has 2 tables: this ROBO Pro export runs its main table (drive) only, not other" in \
-        " ".join(result.output.split())
+    said = " ".join(result.output.split())
+    if target == "robopro":
+        assert "the robot has 2 tables: the ROBO Pro lists hold its main table (drive) only, not other" in said
+    else:
+        assert "main table" not in said and "a process per table (drive, other)" in said
     (tmp_path / "robot.toml").write_text(ROBOT.split("[tables]")[0])
     alone = invoke("export", tmp_path / "drive.csv", "--to", target, tmp_path / "out2")
     assert alone.exit_code != 0 or "tables:" not in alone.output

@@ -14,15 +14,18 @@ import random
 import re
 import time
 import xml.etree.ElementTree as ET
+from typing import Any
 
 import pytest
 
 from core_helpers import EXAMPLE, ROOT
 from tablebot.formats.table_read import load_table
+from tablebot.robopro.processes import generate_several
 from tablebot.robopro.program import generate
+from tablebot.tables import load_tables
 from tablebot.testing.random_tables import Shape, random_table
 from tablebot.testing.rpp_corpus import corpus_dir, dump, read_corpus
-from tablebot.testing.rpp_vocabulary import SERIES, VOCABULARY, problems, vocabulary
+from tablebot.testing.rpp_vocabulary import BEYOND_CORPUS, SERIES, VOCABULARY, problems, vocabulary
 from test_robopro_program import fitting
 
 CORPUS = corpus_dir()
@@ -45,7 +48,8 @@ def programs() -> list[str]:
                     {"controller": "tx", "I3": {"terminal": "I8", "active": 0}})
     return [generate(load_table(EXAMPLE / "table.csv"), "document"),
             generate(load_table(ROOT / "examples" / "bumberbot-counters" / "table.csv")),
-            generate(table, "always")]
+            generate(table, "always"),
+            generate_several(load_tables(load_table(ROOT / "examples" / "bumberbot-lights" / "table.csv")))]
 
 
 @needs_corpus
@@ -59,6 +63,18 @@ def test_the_committed_vocabulary_is_what_the_corpus_yields(fresh: dict[str, obj
 def test_generated_programs_against_the_corpus(fresh: dict[str, object]) -> None:
     for text in programs():
         assert problems(text, json.loads(dump(fresh))) == []
+
+
+@needs_corpus
+def test_processes_are_the_corpus_own_and_the_lamp_output_is_not(fresh: dict[str, Any]) -> None:
+    """A robot of several tables runs a process per table: real main programs hold several Starts (the TeachIn
+    robot's, 11). No program of the corpus drives a lamp output: that element comes from BEYOND_CORPUS (real
+    programs outside the corpus), and this says so the day the corpus has one."""
+    assert CORPUS is not None
+    starts = [len(re.findall(r'classname="ftProProcessStart"', f.read_text(encoding="utf-8")))
+              for f in CORPUS.glob("*.rpp")]
+    assert max(starts) >= 2
+    assert not set(BEYOND_CORPUS) & set(fresh["elements"])
 
 
 @needs_corpus

@@ -206,7 +206,7 @@ def test_lamps_are_lamp_outputs_and_one_on_a_motors_output_is_refused(tmp_path: 
     (tmp_path / "t.csv").write_text("state,I1,M1,L1,L2,timer,next\n1,1,3,8,,0,2\n2,,,0,5,0,1\n")
     table = load_table(tmp_path / "t.csv")
     root = ET.fromstring(generate(table).encode("utf-8"))
-    assert sorted(o.get("output") for o in root.iter("o") if o.get("classname") == "ftProDataOutSngl") \
+    assert sorted(o.get("output", "") for o in root.iter("o") if o.get("classname") == "ftProDataOutSngl") \
         == ["2", "2", "2", "7", "7", "7"]  # O3 and O8: each turned off at the start, then Off and On by the lists
     ticks = [TickInput(1, ()), TickInput(0, ()), TickInput(1, ())]
     assert [d.outputs for d in run(table, ticks)] == [(3, 8, 0), (0, 0, 5), (3, 8, 5)]  # a blank L2 keeps it

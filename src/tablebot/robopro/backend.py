@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.files import out_folder
+from tablebot.i18n import N_
 from tablebot.registry import ExportBackend, Exported, ExportOptions, register
 from tablebot.robopro.rpp_edit import DEFAULT_NAMES
 from tablebot.robopro.wiring import read_robot_robopro
@@ -24,13 +25,13 @@ def fit(machine: Machine) -> list[Diagnostic]:
 
 
 def cross_problems(machine: Machine) -> list[Diagnostic]:
-    """A cross-table column of the main table: the ROBO Pro exports run the main table alone, so the state it
+    """A cross-table column of the main table: the three lists hold the main table alone, so the state it
     reads is nowhere (refused at the column, rather than read as never present)."""
     table = machine.table
     return [Diagnostic(table.path, event.line, event.at,
-                       f"{event.column}: the ROBO Pro exports run table {table.name} alone, without table "
-                       f"{event.table} whose state this column reads",
-                       "export a robot of one table to ROBO Pro (docs: Several tables in one robot)")
+                       N_("{column}: the ROBO Pro lists hold table {table} alone, without table {other} whose "
+                          "state this column reads", column=event.column, table=table.name, other=event.table),
+                       N_("export --to robopro-program runs every table, one process each (docs: ROBO Pro)"))
             for event in table.cross.values()]
 
 
@@ -42,16 +43,16 @@ def _refuse_cross(machine: Machine) -> None:
 
 
 def main_only(machine: Machine) -> tuple[str, ...]:
-    """The warning for a robot of several tables, whose ROBO Pro export holds its main table alone (one process
-    per table would need a barrier every tick to read the others' states at the start of the tick)."""
+    """The warning for a robot of several tables, whose three lists hold its main table alone (the document's
+    lists are one table's; the whole program runs every table, one process each)."""
     from tablebot.robot_tables import tables_of
 
     specs = tables_of(machine.table.robot)
     if not specs:
         return ()
-    others = ", ".join(spec.name for spec in specs[1:])
-    return (f"the robot has {len(specs)} tables: this ROBO Pro export runs its main table "
-            f"({specs[0].name}) only, not {others} (docs: Several tables in one robot)",)
+    return (N_("the robot has {n} tables: the ROBO Pro lists hold its main table ({main}) only, not {others}; "
+               "export --to robopro-program runs every table, one process each", n=len(specs), main=specs[0].name,
+               others=", ".join(spec.name for spec in specs[1:])),)
 
 
 def export_lists(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -89,22 +90,35 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
 
 
 def program_fit(machine: Machine) -> list[Diagnostic]:
+    """Every reason the program does not take the table (a robot of several tables: any of its tables)."""
     from tablebot.robopro.fit import problems
+    from tablebot.robopro.processes import several_problems
+    from tablebot.tables import several
 
-    return cross_problems(machine) or problems(machine.table)
+    tables = several(machine.table)
+    if tables is None:
+        return problems(machine.table)
+    # the main table's answer covers every table (each problem once, located in its own file)
+    return several_problems(tables) if machine.table.name == tables.names[0] else []
 
 
 def export_program(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     """The whole engine as one .rpp, named after the robot; a table that does not fit is refused before the
     folder is made."""
     from tablebot.files import write_text
+    from tablebot.robopro.processes import generate_several
     from tablebot.robopro.program import file_name, generate
+    from tablebot.tables import several
 
     assert out is not None
-    _refuse_cross(machine)
-    text = generate(machine.table)
+    tables = several(machine.table)
+    text = generate(machine.table) if tables is None else generate_several(tables)
     path = write_text(out_folder(out, "OUTDIR") / file_name(machine.table), text)
-    return Exported((path,), (f"wrote {path}: open it in ROBO Pro 4.x",), main_only(machine))
+    lines: tuple[str, ...] = (f"wrote {path}: open it in ROBO Pro 4.x",)
+    if tables is not None:
+        lines += (N_("its main program runs a process per table ({tables}) and a clock process that starts "
+                     "each tick for all of them", tables=", ".join(tables.names)),)
+    return Exported((path,), lines)
 
 
 ROBOPRO = register(ExportBackend(name="robopro", makes="the document's three ROBO Pro lists (event, action, timer)",

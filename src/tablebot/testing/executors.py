@@ -22,6 +22,7 @@ from tablebot.machine import Machine, compile_table
 from tablebot.replay import record, replay_several
 from tablebot.table import Table
 from tablebot.testing.harness import CORE, Case, Executor, Run, busy_world, fits_controller, register, wired_for
+from tablebot.testing.robopro_several import fits_robopro_several, robopro_several
 from tablebot.testing.serial_executors import SERIAL_EXECUTORS
 from tablebot.testing.several_cases import SeveralCase, wired_robot
 
@@ -334,7 +335,10 @@ def _robopro_program(case: Case, workdir: Path) -> Run:
 
 def _fits_robopro(machine: Machine) -> bool:
     from tablebot.robopro.fit import problems
+    from tablebot.robot_tables import tables_of
 
+    if tables_of(machine.table.robot):  # a robot of several tables: one process per table
+        return fits_robopro_several(machine)
     return not problems(wired_for_robopro(machine.table), "always")
 
 
@@ -355,7 +359,7 @@ def register_all() -> None:
         Executor("TXT 4.0 program", _txt4_program, missing=_no_txt4_stub, fits=_fits_txt, several=_txt4_several,
                  what="export --to txt4's standalone program against the fischertechnik stub"),
         # It knows the document's rule too; the reference (Engine.step) does not yet, so only "always" is checked.
-        Executor("ROBO Pro program", _robopro_program, fits=_fits_robopro,
+        Executor("ROBO Pro program", _robopro_program, fits=_fits_robopro, several=robopro_several,
                  what="export --to robopro-program in the ROBO Pro element interpreter"),
         *SERIAL_EXECUTORS,
     ):

@@ -5,6 +5,7 @@ generated program to it; the generator itself never reads it."""
 
 from __future__ import annotations
 
+import copy
 import json
 import re
 import xml.etree.ElementTree as ET
@@ -29,9 +30,43 @@ INTERFACE_PINS = frozenset({"ftProSubroutineRef", "ftProSubroutineSymbol", "ftPr
 SERIES: dict[tuple[str, str], tuple[range, ...]] = {("ftProDataIn", "input"): (range(160, 168), range(176, 180))}
 
 
+_FLAGS = " selectable visible draggable shadow filled snap"
+#: What the generator writes that no program of the corpus shows, as real programs outside it write it: ROBO
+#: Pro's lamp output (a single output O1–O8, ``output`` 0–7, with one data input as the motor output's) and the
+#: ``On``/``Off`` commands sent to it. olagino/roproparser (GitHub) keeps such programs as test data:
+#: test/regal_test.rpp (ROBO Pro 4.2.4, lamps on O5–O8 driven by ``On`` 8 and ``Off``) and test/multi.rpp
+#: (4.4.4, two processes flashing two lamps).
+BEYOND_CORPUS: dict[str, Any] = {
+    "ftProDataOutSngl": {
+        "attribute_orders": [["classname", "id", "flags", "hitflags", "transform", "output", "module", "image",
+                              "resolution"]],
+        "attributes": {"classname": {"values": ["ftProDataOutSngl"]}, "id": {"kind": "int"},
+                       "flags": {"values": [_FLAGS]}, "hitflags": {"values": [" fill visible"]},
+                       "transform": {"kind": "matrix"}, "output": {"values": [str(n) for n in range(8)]},
+                       "module": {"values": ["IF1"]}, "image": {"values": ["1"]}, "resolution": {"values": ["0"]}},
+        "children": ["ftProObjectPin"],
+        "pins": [[["", "dataobjectinput", "0", "matrix( 1 0 0 1 -8 0 )", "4", "4", ""]]],
+    },
+}
+BEYOND_COMMANDS = ("On", "Off")
+
+
 @cache
 def vocabulary() -> dict[str, Any]:
     return json.loads(VOCABULARY.read_text(encoding="utf-8"))
+
+
+def with_beyond(known: dict[str, Any]) -> dict[str, Any]:
+    """``known`` (a corpus's vocabulary) with :data:`BEYOND_CORPUS`: the lamp output where subprograms hold
+    elements, and its commands."""
+    merged = copy.deepcopy(known)
+    elements = merged["elements"]
+    elements.update(copy.deepcopy(BEYOND_CORPUS))
+    elements["ftProSubroutineFunction"]["children"] = sorted({*elements["ftProSubroutineFunction"]["children"],
+                                                               *BEYOND_CORPUS})
+    command = elements["ftProDataMssg"]["attributes"]["command"]
+    command["values"] = sorted({*command["values"], *BEYOND_COMMANDS})
+    return merged
 
 
 def key(element: ET.Element) -> str:
@@ -94,8 +129,8 @@ def _element_problems(element: ET.Element, parent: ET.Element | None, where: str
 
 def problems(text: str, known: dict[str, Any] | None = None) -> list[str]:
     """Everything in an .rpp document that real programs do not show (``known``: a vocabulary, by default
-    the committed one), and every broken invariant."""
-    known = known or vocabulary()
+    the committed one; with :data:`BEYOND_CORPUS`), and every broken invariant."""
+    known = with_beyond(known or vocabulary())
     found: list[str] = []
     first_line = text.split("\n", 1)[0].strip()
     if first_line not in known["declarations"]:
