@@ -21,7 +21,8 @@ from tablebot.i18n import _, localise
 def tune_cmd(
     table: Path = TABLE_ARG,
     cells: str = typer.Option(..., "--cells", help='Cells to tune: "line 5 timer, line 9 timer" (file lines; '
-                              'a range: "line 5 timer=100..2000"; counter loads: "line 12 C1_load").'),
+                              'a range: "line 5 timer=100..2000"; counter loads: "line 12 C1_load"; another table '
+                              'of a robot of several: "lights: line 4 timer").'),
     objective: str = typer.Option("time_to_lamp", "--objective", help="What to make smallest: time_to_lamp, "
                                   "time_to_light, collisions, lamp_distance or missed_lamp (means over the "
                                   "scenarios)."),
