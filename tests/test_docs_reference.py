@@ -14,7 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tablebot
-from tablebot import registry
+from tablebot import plugins, registry
 from tablebot.analysis.properties import KEYS as PROPERTY_KEYS
 from tablebot.cli import app
 from tablebot.robot import CORE_SECTIONS, SECTION_READERS
@@ -114,6 +114,7 @@ def test_the_file_formats_page_names_every_key() -> None:
     named = set(re.findall(r"`\[*([\w.]+)\]*`", page))
     sections = world_section_keys()
     assert {"box", "line", "arena"} <= set(sections)
+    plugins.load()  # every back-end's robot-file section registered
     keys = {*ROBOT_KEYS, *CORE_SECTIONS, *SECTION_READERS, *SENSOR_KEYS, *PROPERTY_KEYS, *WORLD_KEYS,
             *(k for ks in sections.values() for k in ks)}
     assert sorted(keys - named) == []

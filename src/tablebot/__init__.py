@@ -53,7 +53,9 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'tablebot' has no attribute {name!r}")
 
 
-# Every back-end registers itself and its robot-file section (light modules: nothing heavy loads here).
+# Every back-end registers itself and its robot-file section when the registry or a robot file's reader first
+# needs them (tablebot.plugins): their modules bring the table machinery, which `tablebot --help` does without.
+from tablebot import plugins  # noqa: E402
 from tablebot.catalog import load_all  # noqa: E402
 
-load_all()
+plugins.defer(load_all)

@@ -1,9 +1,10 @@
 """Every back-end tablebot has, imported once so that each registers itself (:mod:`tablebot.registry`) and its
 robot-file section can be read (:data:`tablebot.robot.SECTION_READERS`).
 
-Importing ``tablebot`` calls :func:`load_all`, so a robot file's ``[sim]``, ``[board]``, ``[txt]`` and
-``[properties]`` are known to every command and every library use. Each module it imports is light (what
-it needs to run is imported when it runs). A new back-end adds its one line here.
+Importing ``tablebot`` defers :func:`load_all` to the first use of the registry or of a robot file's reader
+(:mod:`tablebot.plugins`), so a robot file's ``[sim]``, ``[board]``, ``[txt]`` and ``[properties]`` are known to
+every command and every library use that reads one, and ``tablebot --help`` imports none of them. Each module
+it imports is light (what it needs to run is imported when it runs). A new back-end adds its one line here.
 """
 
 from __future__ import annotations

@@ -3,7 +3,8 @@ needs of a robot file and what in a table it cannot hold.
 
 A back-end is one module that builds an :class:`ExportBackend` (an export target or a board) or a
 :class:`LiveBackend` (a robot driven tick by tick) and calls :func:`register` when imported;
-:func:`tablebot.catalog.load_all` imports every such module. ``tablebot export --to``, ``build --board``,
+:func:`tablebot.catalog.load_all` imports every such module, before the registry is first asked
+(:func:`tablebot.plugins.load`). ``tablebot export --to``, ``build --board``,
 ``run --on`` and ``check --target`` take their choices from here, and a back-end's robot-file section is
 read through the reader it registers (:func:`tablebot.robot.register_section`). What a command's options
 say reaches a back-end by name, in :class:`ExportOptions` or :class:`LinkOptions`. See
@@ -17,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
+from tablebot import plugins
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.robot import SectionReader, register_section
 
@@ -193,6 +195,7 @@ def register(backend: B) -> B:
 
 def backends(kind: Kind | None = None) -> list[Backend]:
     """The registered back-ends (of one kind), in the order they were registered."""
+    plugins.load()
     return [b for b in _BACKENDS.values() if kind is None or b.kind == kind]
 
 
@@ -201,20 +204,24 @@ def names(kind: Kind | None = None) -> list[str]:
 
 
 def get(name: str) -> Backend:
+    plugins.load()
     return _BACKENDS[name]
 
 
 def exporter(name: str) -> ExportBackend | None:
     """The export target or board of that name, or None."""
+    plugins.load()
     backend = _BACKENDS.get(name)
     return backend if isinstance(backend, ExportBackend) else None
 
 
 def exporters(kind: Literal["export", "board"] = "export") -> list[ExportBackend]:
+    plugins.load()
     return [b for b in _BACKENDS.values() if isinstance(b, ExportBackend) and b.kind == kind]
 
 
 def lives() -> list[LiveBackend]:
+    plugins.load()
     return [b for b in _BACKENDS.values() if isinstance(b, LiveBackend)]
 
 
@@ -235,5 +242,6 @@ def refused(action: Callable[[], object]) -> list[Diagnostic]:
 def live_for(address: str) -> LiveBackend | None:
     """The live back-end an ``--on`` address names by its scheme (``txt://HOST``: txt; ``sim`` or
     ``sim:WORLD``: sim), or None; the back-end's ``open`` reads the rest of the address."""
+    plugins.load()
     backend = _BACKENDS.get(address.partition(":")[0])
     return backend if isinstance(backend, LiveBackend) else None

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, cast
 
-from tablebot import durations
+from tablebot import durations, plugins
 from tablebot.i18n import N_
 from tablebot.i18n.headers import GERMAN_FIXED
 from tablebot.sensors import Sensor, parse_sensors
@@ -29,8 +29,9 @@ CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
 SectionReader = Callable[[Source, Any, "Robot"], Any]
 #: Sections of a robot file that belong to other stages (``[sim]``, ``[board]``, ``[properties]``, ``[txt]``,
 #: ...), each with its reader. The stages register them (:func:`register_section`, called by
-#: :func:`tablebot.registry.register` for back-ends), so this module imports none of them; importing
-#: ``tablebot`` registers every one (:func:`tablebot.catalog.load_all`). Every section is read when the
+#: :func:`tablebot.registry.register` for back-ends), so this module imports none of them; reading a robot
+#: file registers every one first (:func:`tablebot.catalog.load_all`, through :func:`tablebot.plugins.load`),
+#: and so does asking the registry. Every section is read when the
 #: file is, so all its mistakes show at once, whichever command runs.
 SECTION_READERS: dict[str, SectionReader] = {}
 
@@ -158,6 +159,7 @@ def find_robot_file(table_path: Path) -> Path | None:
 
 def load_robot(path: str | Path) -> Robot:
     """Read a robot TOML file, reporting every problem with its line."""
+    plugins.load()  # every back-end's section registered
     path = Path(path)
     src = Source.read(path, N_("see the robot file format in the README"))
     data = src.data

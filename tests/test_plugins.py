@@ -1,0 +1,62 @@
+"""The back-ends register when first needed (tablebot.plugins): `import tablebot` imports none of them, and the
+registry and a robot file's reader see every one, from any thread, whichever is asked first."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from tablebot.testing.processes import child_env
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "bumberbot"
+EVERY_BACKEND = ["robopro", "robopro-rpp", "robopro-program", "c", "scxml", "xstate", "uno", "ftduino", "txt",
+                 "robotx", "roboif", "txt4", "sim"]
+
+
+def fresh(code: str) -> list[str]:
+    """The lines a fresh interpreter running ``code`` prints."""
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=child_env(), capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+def test_import_tablebot_imports_no_back_end_and_the_registry_then_knows_them_all() -> None:
+    lines = fresh("""
+import sys
+import tablebot
+print(sorted(m for m in sys.modules if m.endswith('.backend') or m in ('tablebot.robot', 'tablebot.table')))
+from tablebot import registry
+print(registry.names())
+print('tablebot.robopro.backend' in sys.modules)
+""")
+    assert lines == ["[]", str(EVERY_BACKEND), "True"]
+
+
+def test_a_robot_file_read_first_is_read_with_every_back_end_s_section() -> None:
+    lines = fresh(f"""
+from tablebot.robot import load_robot
+robot = load_robot({str(EXAMPLE / 'robot.toml')!r})
+print(sorted(robot.sections))
+""")
+    assert lines == [str(sorted(["txt", "robotx", "roboif"]))]  # none refused as an unknown section
+
+
+def test_threads_asking_at_once_each_see_every_back_end() -> None:
+    lines = fresh("""
+import threading
+import tablebot
+from tablebot import registry
+start = threading.Barrier(8)
+seen = []
+def ask():
+    start.wait()
+    seen.append(registry.names())
+threads = [threading.Thread(target=ask) for _ in range(8)]
+for t in threads: t.start()
+for t in threads: t.join()
+print(len(seen), all(names == seen[0] for names in seen), seen[0])
+""")
+    assert lines == [f"8 True {EVERY_BACKEND}"]
