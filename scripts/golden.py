@@ -7,7 +7,8 @@ tests/test_golden.py makes the same files and compares them byte for byte with t
 command a user types, as a process in the checkout (so paths in them read ``examples/bumberbot/...``):
 
 * ``c/``: ``tablebot export examples/bumberbot OUT --to c`` (the generated C engine and table)
-* ``robopro/``: ``tablebot export examples/bumberbot OUT --to robopro-program`` (the ROBO Pro program)
+* ``robopro/``: ``tablebot export examples/bumberbot OUT --to robopro-program`` (the ROBO Pro program), and the
+  same of examples/bumberbot-lights (the drive and the lights tables, a ROBO Pro process each)
 * ``diagram.svg``: ``tablebot diagram examples/bumberbot --out diagram.svg`` (drawn by graphviz-pure, the same
   on every platform)
 * ``check.txt``: what ``tablebot check examples/bumberbot`` prints
@@ -29,6 +30,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden"
 EXAMPLE = "examples/bumberbot"
+LIGHTS = "examples/bumberbot-lights"  # the document's robot whole: its ROBO Pro program, the lights a process
 #: Where the files below were made; the simulated ones are compared only there.
 PLATFORM = f"{sys.platform}-{platform.machine()}"
 SIMULATED = ("sim-trace.jsonl",)
@@ -47,6 +49,7 @@ def make(out: Path) -> dict[str, bytes]:
     """Every golden file, made afresh into ``out``: {path under tests/golden: bytes}."""
     tablebot("export", EXAMPLE, str(out / "c"), "--to", "c")
     tablebot("export", EXAMPLE, str(out / "robopro"), "--to", "robopro-program")
+    tablebot("export", LIGHTS, str(out / "robopro"), "--to", "robopro-program")  # a process per table
     tablebot("diagram", EXAMPLE, "--out", str(out / "diagram.svg"))
     (out / "check.txt").write_text(tablebot("check", EXAMPLE), encoding="utf-8")
     sim = out / "sim-run"
