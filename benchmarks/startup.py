@@ -12,7 +12,8 @@ Two parts, both fresh processes (``python -m tablebot``, as a user runs it):
   around the run read as the difference. Which of numba, scipy, matplotlib, pydantic each command imports.
 * **help**: ``tablebot --help`` and ``tablebot --lang de --help`` (the German catalog loaded, every help text
   translated), each against its target, 0.15 s, and as a ratio to the interpreter alone (``--help-only``: these
-  rows alone).
+  rows alone, run in turn with ``python -c pass`` and ``python -c "import typer"`` -- what any typer program's
+  help costs -- and the ratios taken round by round).
 * **phases**: one fresh process doing a sweep's start-up step by step, each step timed: the imports (tablebot,
   its command line, numpy, numba), planning 10,000 runs (it loads the compiled code the scene
   checks use, and starts numba's runtime), and a one-robot fleet's first tick (loads the fleet kernel).
@@ -142,6 +143,39 @@ def warm_up() -> None:
         timed([sys.executable, "-m", "tablebot", "sim", str(EXAMPLE), "--seconds", "1", "--out", warm + "/t"])
 
 
+#: ``--help-only``'s rows, run in turn (one of each per round, so that a ratio compares runs made side by side):
+#: the interpreter alone, the interpreter with typer (what any typer help costs), and tablebot's help.
+HELP_ROWS = (
+    ("python -c pass", ["-c", "pass"]),
+    ("import typer", ["-c", "import typer"]),
+    ("--help", ["-m", "tablebot", "--help"]),
+    ("--help (de)", ["-m", "tablebot", "--lang", "de", "--help"]),
+)
+
+
+def help_only(repeat: int) -> int:
+    """--help in both languages beside the interpreter and typer, round by round; ratios pair by pair."""
+    runs: dict[str, list[tuple[float, float]]] = {name: [] for name, _ in HELP_ROWS}
+    for _ in range(repeat + 1):  # the first round warms the file cache and is not counted
+        for name, argv in HELP_ROWS:
+            wall, cpu, _out = timed([sys.executable, *argv])
+            runs[name].append((wall, cpu))
+    runs = {name: rows[1:] for name, rows in runs.items()}
+    med = statistics.median
+    print(f"{'command':<16} {'wall s':>7} {'cpu s':>7} {'wall/interpreter':>17} {'cpu/import typer':>17}")
+    for name, rows in runs.items():
+        walls = [w / p[0] for (w, _c), p in zip(rows, runs["python -c pass"], strict=True)]
+        cpus = [c / t[1] for (_w, c), t in zip(rows, runs["import typer"], strict=True)]
+        print(f"{name:<16} {med(w for w, _ in rows):7.3f} {med(c for _, c in rows):7.3f} {med(walls):16.1f}x "
+              f"{med(cpus):16.2f}x")
+    for name in ("--help", "--help (de)"):
+        wall = med(w for w, _ in runs[name])
+        print(f"{name}: {wall:.3f} s wall, target under {HELP_TARGET} s ({'met' if wall < HELP_TARGET else 'NOT met'})")
+    print(f"load average {os.getloadavg()[0]:.2f} at the end: above {os.cpu_count()}, a process's wall time includes "
+          f"waiting for a core; its cpu seconds, and the ratios, move less")
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
@@ -151,15 +185,14 @@ def main() -> int:
     med = statistics.median
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); medians of "
           f"{args.repeat} fresh processes")
-    if not args.help_only:
-        warm_up()
+    if args.help_only:
+        return help_only(args.repeat)
+    warm_up()
 
     print(f"{'command':<18} {'wall s':>7} {'cpu s':>7} {'run s':>7} {'around':>7}  imports")
     floor = None
     help_walls: dict[str, list[float]] = {}
     for name, cmd in commands(args.quick):
-        if args.help_only and cmd and not name.startswith("--help"):
-            continue
         runs = []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as out:
@@ -184,8 +217,6 @@ def main() -> int:
         print(f"{name}: {wall:.3f} s, {wall / floor:.1f}x the interpreter alone; target under {HELP_TARGET} s "
               f"({'met' if wall < HELP_TARGET else 'NOT met'})")
 
-    if args.help_only:
-        return 0
     print("\nphases of a fresh process (a sweep's start-up, step by step; medians, ms):")
     laps = [phases() for _ in range(args.repeat)]
     names = [name for name, _ in laps[0]]
