@@ -146,3 +146,35 @@ def test_the_tabs_fit_a_classroom_screen(browser: Any, studio: Background, shots
     assert title == ("Tabelle lights (lights.csv)" if locale == "de-DE" else "table lights (lights.csv)")
     assert page.errors == []
     page.context.close()
+
+
+def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio: Background, folder: Path,
+                                                            shots: Path) -> None:
+    """A trace of the whole robot played on the lights tab: the lights table's state, row and timer speak (its
+    timeline, lit row and diagram), and the drive table's state and line are said beside them, as the trace has
+    them; on the drive tab the other way round."""
+    run = tablebot.open(folder).simulate(seconds=1.2, seed=1)
+    run.save(folder / "run", plots=False)
+    trace = run.trace
+    page = open_page(browser, studio.url)
+    show(page, "lights", "drive=1,2")
+    page.click("#mode-trace")
+    page.evaluate("() => { const s = document.querySelector('#trace-pick');"
+                  " s.append(new Option('run/trace.jsonl', 'run/trace.jsonl')); }")
+    page.select_option("#trace-pick", "run/trace.jsonl")
+    wait_for(lambda: "drive:" in page.inner_text("#status"), "the player's status line", 30)
+    tick = next(k for k in range(len(trace)) if trace["row"][k] >= 0)  # a drive row fired: a group row, as written
+    page.evaluate(f"() => {{ const s = document.querySelector('#scrub'); s.value = {tick};"
+                  " s.dispatchEvent(new Event('input')); }")
+    status = page.inner_text("#status")
+    page.screenshot(path=str(shots / "player-lights.png"))
+    lights_state, drive_state = trace["lights.state"][tick], trace["state"][tick]
+    assert f"state {lights_state}" in status.split(" · drive:")[0], status
+    drive_row = trace["row"][tick]  # as written: a group's row once
+    table = tablebot.open(folder).table
+    line = next((r.line for r in table.rows if r.as_written == drive_row), None)
+    said = f"drive: state {drive_state}, line {line} fired"
+    assert said in status, (said, status)
+    assert page.get_attribute("#arena", "data-lamps") == f"L1={trace['L1'][tick]} L2={trace['L2'][tick]}"
+    assert page.errors == []
+    page.context.close()

@@ -87,7 +87,7 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
         "columns": columns_of(doc.header_values(), robot),
     }
     if table is not None and machine is not None:
-        data["machine"] = machine_json(table, machine)
+        data["machine"] = machine_json(table, machine, tables)
     if report is not None and table is not None:
         data.update(_report_json(report, lines, "" if tables is None or table is tables.table else table.name))
     data["ms"] = round(1000 * (time.perf_counter() - started), 2)
@@ -100,9 +100,14 @@ def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
             "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics], "ms": 0}
 
 
-def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
+def machine_json(table: Table, machine: Machine, tables: RobotTables | None = None) -> dict[str, Any]:
     """The machine as the page needs it; each state carries its colour from ``tablebot.colours``, the one
-    the PNGs of a run give it (the page only looks colours up, so the two can never disagree)."""
+    the PNGs of a run give it (the page only looks colours up, so the two can never disagree). A robot of
+    several tables: its name and the main one's, and each table's rows as a trace names them (as written) ->
+    their lines, for the trace player's other tables."""
+    several = {} if tables is None else {
+        "name": table.name, "main_name": tables.names[0],
+        "table_lines": {t.name: {r.as_written: r.line for r in t.rows} for t in tables.tables}}
     robot = table.robot
     colours = state_colours(machine.states)
     return {
@@ -110,10 +115,12 @@ def machine_json(table: Table, machine: Machine) -> dict[str, Any]:
                    for s, c in zip(machine.states, colours, strict=True)],
         "rows": len(table.rows), "events": list(table.events), "inputs": list(table.input_events),
         "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
-        "motors": list(robot.motors), "tick_ms": robot.tick_ms, "initial_state": str(robot.initial_state),
-        "robot": robot.name, "labels": dict(robot.labels),
+        "motors": list(robot.motors), "lamps": list(robot.lamps), "tick_ms": robot.tick_ms,
+        "initial_state": str(robot.initial_state), "robot": robot.name, "labels": dict(robot.labels),
         # row i (a trace's 0-based ``row``) is this line of the file: the number the grid and every message show
         "row_lines": [row.line for row in table.rows],
+        # a trace names a row as written (a group's row once): that row's line, by the trace's number
+        "written_lines": {row.as_written: row.line for row in table.rows}, **several,
     }
 
 

@@ -22,6 +22,7 @@ from tablebot.machine import compile_table
 from tablebot.sim.model.params import Params
 from tablebot.sim.model.world import World
 from tablebot.table import Table
+from tablebot.tables import several
 from tablebot.web.analyse import columns_of, machine_json
 from tablebot.web.bundle import bundle
 from tablebot.web.simulate import studio_diagram
@@ -53,10 +54,14 @@ def replay_data(lines: Iterable[Mapping[str, Any] | str], world: World, table: T
         columns[name] = [None if v is None else round(v, 3) for v in columns[name]]
     header, grid, lines_of = _table_cells(table)
     machine = compile_table(table)
+    try:  # a robot of several tables: the player says the other tables' states and lines beside the main one's
+        tables = several(table)
+    except TableBotError:  # its other files changed since the run: their states are still said, not their lines
+        tables = None
     return {"title": title or f"{table.robot.name}: {Path(table.path).name} in {world.name}",
             "table": {"path": Path(table.path).name, "header": header, "grid": grid, "lines": lines_of,
                       "columns": columns_of(header, table.robot)},
-            "machine": machine_json(table, machine), "world": world_json(world, params),
+            "machine": machine_json(table, machine, tables), "world": world_json(world, params),
             "diagram": studio_diagram(table), "trace": columns}
 
 

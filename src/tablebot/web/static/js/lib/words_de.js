@@ -144,6 +144,8 @@ export const DE = Object.freeze({
   "tick.tick": "Takt {tick}",
   "tick.state": "Zustand {state}",
   "tick.timer": "Timer {timer} ({seconds})",
+  "tick.other": "{table}: Zustand {state}, Zeile {line} hat geschaltet",
+  "tick.other_none": "{table}: Zustand {state}, keine Zeile hat geschaltet",
   "tick.none": "keine Zeile hat geschaltet",
   "tick.fired": "Zeile {line} hat geschaltet",
   "tick.events": "Ereignisse: {names}",

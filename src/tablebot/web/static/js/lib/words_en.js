@@ -143,6 +143,8 @@ export const EN = Object.freeze({
   "tick.tick": "tick {tick}",
   "tick.state": "state {state}",
   "tick.timer": "timer {timer} ({seconds})",
+  "tick.other": "{table}: state {state}, line {line} fired",
+  "tick.other_none": "{table}: state {state}, no row fired",
   "tick.none": "no row fired",
   "tick.fired": "line {line} fired",
   "tick.events": "events: {names}",

@@ -11,15 +11,29 @@ export function describeTick(machine, t) {
   const st = machine.states.find((s) => s.id === String(t.state));
   parts.push(word("tick.state", { state: t.state }) + (st && st.label ? ` (${st.label})` : ""));
   if (t.timer !== undefined && t.timer !== null) parts.push(word("tick.timer", { timer: t.timer, seconds: seconds(t.timer, machine) }));
-  // a person reads the file's line numbers (the grid's); a trace's 0-based row is an index into the rows
-  parts.push(t.row === null || t.row === undefined || t.row < 0 ? word("tick.none") : word("tick.fired", { line: machine.row_lines[t.row] }));
+  parts.push(fired(machine, t.row));
   if (t.event !== undefined && t.event !== null) {
     const names = machine.events.filter((e, i) => t.event & (1 << (machine.events.length - 1 - i)));
     parts.push(word("tick.events", { names: names.join(" + ") || word("tick.no_events") }));
   }
   if (t.outputs) parts.push(Object.entries(t.outputs).map(([k, v]) => `${k} ${v}`).join(" "));
+  for (const o of t.others || []) parts.push(otherTable(machine, o));
   return parts.join(" · ");
 }
+
+// a person reads the file's line numbers (the grid's); a trace's 0-based row is an index into the rows
+const fired = (machine, row) => (row === null || row === undefined || row < 0 ? word("tick.none") :
+  word("tick.fired", { line: machine.row_lines[row] }));
+
+/** Another table of the robot on this tick (a trace's NAME.state and NAME.row): its state and the line that fired. */
+function otherTable(machine, { name, state, row }) {
+  const line = row === null || row === undefined || row < 0 ? null : ((machine.table_lines || {})[name] || {})[row];
+  if (line === null) return word("tick.other_none", { table: name, state });
+  return word("tick.other", { table: name, state, line: line === undefined ? "?" : line });
+}
+
+/** The robot's tables a trace has besides its main one (its NAME.state columns), in its order. */
+const otherTables = (columns) => Object.keys(columns).filter((k) => k.endsWith(".state")).map((k) => k.slice(0, -6));
 
 /** The path a trace drew: a point every 5 mm or at a state change, [x, y, stateId]. */
 function tracePath(columns, stateIds) {
@@ -48,7 +62,12 @@ export class Player {
     this.columns = columns;
     this.machine = machine;
     this.n = columns.tick.length;
-    this.stateIds = columns.state.map(String);
+    // a robot of several tables: the table whose tab is shown speaks (its state, row and timer), the others
+    // are said beside it (the main table's own columns are state, row, timer and event)
+    this.others = otherTables(columns);
+    this.view = this.others.includes(machine.name) ? machine.name : null;
+    if (this.view) this.others = [machine.main_name, ...this.others.filter((n) => n !== this.view)];
+    this.stateIds = this.column("state").map(String);
     this.outputNames = machine.outputs.filter((name) => name in columns);
     this.lightKeys = Object.keys(columns).filter((k) => k.endsWith("_light"));  // right, then left
     this.views.timeline.setStates(this.stateIds);
@@ -62,11 +81,26 @@ export class Player {
     this.seek(atTick ? Math.min(atTick, this.n - 1) : 0);
   }
 
+  /** The column ``key`` (state, row, timer, event) of the table shown: ``lights.state`` for the lights tab. */
+  column(key, table = this.view) {
+    return this.columns[table && table !== this.machine.main_name ? `${table}.${key}` : key];
+  }
+
   tickAt(i) {
     const c = this.columns, outputs = {};
     for (const name of this.outputNames) outputs[name] = c[name][i];
-    const at = (name) => (c[name] ? c[name][i] : null);
-    return { tick: c.tick[i], state: c.state[i], timer: at("timer"), event: at("event"), row: at("row"), outputs };
+    const at = (key, table) => { const col = this.column(key, table); return col ? col[i] : null; };
+    const others = this.others.map((name) => ({ name, state: at("state", name), row: at("row", name) }));
+    return { tick: c.tick[i], state: at("state"), timer: at("timer"), event: at("event"), row: this._row(at("row")),
+      outputs, others };
+  }
+
+  // A row as the grid counts them (the rows as run): a trace names its row as written (a group's row once),
+  // which is the first of the rows as run on its line
+  _row(row) {
+    if (row === null || row === undefined || row < 0) return row;
+    const written = this.view ? (this.machine.table_lines || {})[this.view] : this.machine.written_lines;
+    return written ? this.machine.row_lines.indexOf(written[row]) : row;
   }
 
   seek(i) {
@@ -85,7 +119,8 @@ export class Player {
   _pose() {
     const c = this.columns, i = this.index, arena = this.views.arena;
     if (!arena || !("x" in c) || c.x[i] === null) return;
-    arena.setRobot([c.x[i], c.y[i], c.heading[i]], c.bumpers ? c.bumpers[i] : 0, this.lightKeys.map((k) => c[k][i]));
+    const lamps = Object.fromEntries((this.machine.lamps || []).filter((n) => n in c).map((n) => [n, c[n][i]]));
+    arena.setRobot([c.x[i], c.y[i], c.heading[i]], c.bumpers ? c.bumpers[i] : 0, this.lightKeys.map((k) => c[k][i]), lamps);
   }
 
   play(speed) {
