@@ -23,6 +23,7 @@ from tablebot.testing.harness import Run
 from tablebot.testing.robopro_several import robopro_several_case
 from tablebot.testing.rpp_vocabulary import problems as vocabulary_problems
 from tablebot.testing.several_cases import check_several, several_differences
+from test_robopro_program import crossing, wire_segments
 from test_run_cli import invoke
 
 LIGHTS = ROOT / "examples" / "bumberbot-lights"
@@ -111,3 +112,15 @@ def test_export_writes_every_table_and_check_says_what_does_not_fit(tmp_path: Pa
     said = " ".join(checked.output.split())
     assert "error: robopro-program: tick_ms = 5: the processes of the tables look for the next tick" in said
     assert f"robot.toml:{line}:1)" in said and "1 error," in said, said
+
+
+def test_wires_do_not_cross_and_everything_sits_on_the_grid(lights: RobotTables, tmp_path: Path) -> None:
+    from tablebot.testing.robopro_several import wired_txt
+
+    three = load_tables(wired_txt(robopro_several_case(1, tmp_path / "robot").tables.table))
+    for text in (generate_several(lights), generate_several(three)):
+        for name, segments in wire_segments(text).items():
+            crossed = [(a[0], b[0]) for n, a in enumerate(segments) for b in segments[n + 1:]
+                       if a[0] != b[0] and crossing(a, b)]
+            assert crossed == [], f"{name}: wires cross"
+            assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
