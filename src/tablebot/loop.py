@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from tablebot.engine import Engine
 from tablebot.engine.as_one import RobotEngine
+from tablebot.i18n import N_, Message
 from tablebot.interrupts import Terminated
 from tablebot.pacing import (
     BEHIND_WINDOW_S,
@@ -192,20 +193,20 @@ def run(engine: Engine | RobotEngine, robot: RobotIO, *, clock: Clock | None = N
                 _run_ticks(engine, robot, clock, started, ticks, watchdog, late, pace, stop)
             end = RunEnd("done" if ticks is not None else "stopped", engine.tick)
     except KeyboardInterrupt:
-        end = RunEnd("stopped" if ticks is None else "interrupted", engine.tick, "stopped by Ctrl-C")
+        end = RunEnd("stopped" if ticks is None else "interrupted", engine.tick, N_("stopped by Ctrl-C"))
     except Terminated as exc:
-        end = RunEnd("terminated", engine.tick, str(exc))
+        end = RunEnd("terminated", engine.tick, _why(exc))
     except WatchdogTimeout as exc:
-        end = RunEnd("watchdog", engine.tick, str(exc))
+        end = RunEnd("watchdog", engine.tick, _why(exc))
     except LinkLost as exc:
-        end = RunEnd("link_lost", engine.tick, str(exc))
+        end = RunEnd("link_lost", engine.tick, _why(exc))
     except Behind as exc:
-        end = RunEnd("behind", engine.tick, str(exc))
+        end = RunEnd("behind", engine.tick, _why(exc))
     except BaseException as exc:
         end, bug = RunEnd("error", engine.tick, f"{type(exc).__name__}: {exc}"), exc
     finally:
         _shut_down(robot)
-        final = end or RunEnd("error", engine.tick, "the run ended without a reason")
+        final = end or RunEnd("error", engine.tick, N_("the run ended without a reason"))
         final = RunEnd(final.reason, final.ticks, final.message, late.count, late.worst_s)
         failed = _end_sinks(started, final)
     if bug is not None:
@@ -213,6 +214,13 @@ def run(engine: Engine | RobotEngine, robot: RobotIO, *, clock: Clock | None = N
     if failed is not None:  # a sink could not finish (a full disk under the trace): after every sink has ended
         raise failed
     return final
+
+
+def _why(exc: BaseException) -> str:
+    """Why ``exc`` ended the run: its message as raised (a :class:`Message` stays one, to be said in the reader's
+    language where it is shown; its text is the English one)."""
+    said = exc.args[0] if len(exc.args) == 1 else None
+    return said if isinstance(said, Message) else str(exc)
 
 
 def _end_sinks(sinks: Sequence[Sink], end: RunEnd) -> Exception | None:

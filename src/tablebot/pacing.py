@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from tablebot.i18n import N_, Message
 from tablebot.interrupts import Terminated
 
 __all__ = ["BEHIND_WINDOW_S", "Behind", "Clock", "Lateness", "Pace", "RealTimeClock", "SimulatedClock", "StopRequest",
@@ -136,8 +137,8 @@ class Watchdog:
         if self.fired:
             raise WatchdogTimeout(self._message())
 
-    def _message(self) -> str:
-        return f"a tick's robot I/O took longer than the watchdog's {1000 * (self.deadline_s or 0):g} ms"
+    def _message(self) -> Message:
+        return N_("a tick's robot I/O took longer than the watchdog's {ms:g} ms", ms=1000 * (self.deadline_s or 0))
 
     def _alarm(self, signum: int, frame: Any) -> None:
         self.fired = True
@@ -163,7 +164,7 @@ class StopRequest:
 
     def check(self) -> None:
         if self.signal == signal.SIGTERM:
-            raise Terminated("terminated by SIGTERM")
+            raise Terminated(N_("terminated by SIGTERM"))
         if self.signal is not None:
             raise KeyboardInterrupt
 
@@ -225,20 +226,19 @@ class Pace:
         if fell > self.limit_s:
             raise Behind(self._message(fell, tick - first_tick, wall - first_wall))
 
-    def _message(self, fell: float, ticks: int, wall: float) -> str:
+    def _message(self, fell: float, ticks: int, wall: float) -> Message:
         longest = max(b[1] - a[1] for a, b in itertools.pairwise(self._ticks))
-        limit = f"limit {self.limit_s:g} s within any {self.window_s:g} s"
+        limit = N_("limit {limit:g} s within any {window:g} s", limit=self.limit_s, window=self.window_s)
         if longest - self.tick_s >= fell / 2:  # mostly one gap: a stall, not a slow robot
-            return (f"the run fell {fell:.2f} s behind the wall clock ({limit}): one tick started "
-                    f"{1000 * longest:.0f} ms after the one before it (the robot's link or this machine stalled), "
-                    "and the table's timers would stretch by as much")
+            return N_("the run fell {fell:.2f} s behind the wall clock ({limit}): one tick started {gap:.0f} ms after "
+                      "the one before it (the robot's link or this machine stalled), and the table's timers would "
+                      "stretch by as much", fell=fell, limit=limit, gap=1000 * longest)
         ms, mean = 1000 * self.tick_s, 1000 * wall / ticks
-        slow = 100 * (mean / ms - 1)
-        return (f"the robot cannot keep the table's {ms:g} ms tick: over the last {wall:.1f} s its ticks took "
-                f"{mean:.1f} ms on average, so the table's timers would run {slow:.0f} % slow ({fell:.2f} s behind "
-                f"the wall clock; {limit}). Give the robot file a longer tick_ms (write the table's timers as "
-                "times, such as 500ms, so they keep their length) or use a faster link; --behind-limit 0 runs on "
-                "with slow timers")
+        return N_("the robot cannot keep the table's {ms:g} ms tick: over the last {wall:.1f} s its ticks took "
+                  "{mean:.1f} ms on average, so the table's timers would run {slow} slow ({fell:.2f} s behind "
+                  "the wall clock; {limit}). Give the robot file a longer tick_ms (write the table's timers as times, "
+                  "such as 500ms, so they keep their length) or use a faster link; --behind-limit 0 runs on with slow "
+                  "timers", ms=ms, wall=wall, mean=mean, slow=f"{100 * (mean / ms - 1):.0f} %", fell=fell, limit=limit)
 
 
 class Behind(Exception):

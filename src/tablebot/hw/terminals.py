@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from tablebot.i18n import N_
 from tablebot.sensors import threshold_event
 from tablebot.table import MAX_SPEED
 
@@ -28,8 +29,8 @@ class Digital:
 
 
 #: The digital modes every controller offers (a controller may add its own: :attr:`Terminals.digital_modes`)
-DIGITAL = {"switch": Digital("pressed", "a push-button", "while the push-button is pressed"),
-           "phototransistor": Digital("lit", "a phototransistor", "while the phototransistor sees light",
+DIGITAL = {"switch": Digital("pressed", N_("a push-button"), N_("while the push-button is pressed")),
+           "phototransistor": Digital("lit", N_("a phototransistor"), N_("while the phototransistor sees light"),
                                       words=("photo", "light"))}
 
 

@@ -32,7 +32,11 @@ from tablebot.hw.terminals import (
     input_event,
     level_duty,
 )
+from tablebot.i18n import N_, Message
 from tablebot.tomlfile import Source
+
+#: How a message names each kind of signal (the kinds are the code's words).
+KINDS = {"input": N_("input"), "motor": N_("motor"), "lamp": N_("lamp"), "counter": N_("counter")}
 
 if TYPE_CHECKING:  # read when a robot file is: only what the section needs is imported
     from tablebot.machine import Machine
@@ -50,8 +54,9 @@ def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Se
     lines; an entry with a mistake is left out."""
     found = Section({}, {}, {})
     if not isinstance(section, dict):
-        _error(src, src.line("", None, spec.section), f"[{spec.section}] must be a table of NAME = terminal",
-               'for example: M1 = "M1"')
+        _error(src, src.line("", None, spec.section),
+               N_("[{section}] must be a table of NAME = terminal", section=spec.section),
+               N_("for example: {example}", example='M1 = "M1"'))
         return found
     reader = _Reader(spec, robot, src, section)
     for name in section:
@@ -64,8 +69,9 @@ def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Se
         elif name in robot.counter_names:
             wired, into = reader.terminal(name, "counter", section[name]), found.counters
         else:
-            reader.error(name, f"[{spec.section}] wires {name!r}, which robot {robot.name} does not have",
-                         "wire the robot's inputs, motors, lamps and counters (names from the robot file)")
+            reader.error(name, N_("[{section}] wires {name!r}, which robot {robot} does not have",
+                                  section=spec.section, name=name, robot=robot.name),
+                         N_("wire the robot's inputs, motors, lamps and counters (names from the robot file)"))
             continue
         if wired is not None:
             into[name] = wired
@@ -79,9 +85,9 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
     src = robot.file_source()
     section = robot.sections.get(spec.section)
     if section is None:
-        _error(src, None, f"robot {robot.name} has no [{spec.section}] section: tablebot does not know how it is "
-               f"wired to the {spec.controller}", "add one to the robot file, for example:\n" +
-               suggest(spec, robot, machine))
+        _error(src, None, N_("robot {robot} has no [{section}] section: tablebot does not know how it is wired to "
+                             "the {controller}", robot=robot.name, section=spec.section, controller=spec.controller),
+               N_("add one to the robot file, for example:\n{section}", section=suggest(spec, robot, machine)))
         for name in robot.counter_names if not spec.counters else ():
             _unwired(spec, src, robot, "counter", name)
         src.raise_if_any()
@@ -95,8 +101,10 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
             if name not in wired:
                 _unwired(spec, src, robot, kind, name)
     if robot.tick_ms < spec.min_tick_ms:
-        _error(src, robot.line("", "tick_ms"), f"tick_ms = {robot.tick_ms} is shorter than the {spec.controller} "
-               f"can keep ({spec.tick_reason})", f"use tick_ms = {spec.min_tick_ms} or more to run on it")
+        _error(src, robot.line("", "tick_ms"),
+               N_("tick_ms = {tick} is shorter than the {controller} can keep ({reason})", tick=robot.tick_ms,
+                  controller=spec.controller, reason=spec.tick_reason),
+               N_("use tick_ms = {least} or more to run on it", least=spec.min_tick_ms))
     src.raise_if_any()
     inputs = tuple(section.inputs[name] for name in machine.input_bits)
     return Wiring(inputs, tuple(machine.input_bits[w.name] for w in inputs),
@@ -106,14 +114,17 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
 
 def _unwired(spec: Terminals, src: Source, robot: Robot, kind: str, name: str) -> None:
     if kind == "counter" and not spec.counters:
-        _error(src, robot.line("counters", name) or src.line(spec.section), f"counter {name}: the {spec.controller} "
-               "has no counter inputs", "run this table on a controller with counters (ROBO TX, TXT)")
+        _error(src, robot.line("counters", name) or src.line(spec.section),
+               N_("counter {name}: the {controller} has no counter inputs", name=name, controller=spec.controller),
+               N_("run this table on a controller with counters (ROBO TX, TXT)"))
         return
     first = spec.names(kind)[0]
     example = (f'{name} = {{ terminal = "{first}", mode = "switch", pressed = 1 }}' if kind == "input"
                else f'{name} = "{first}"')
-    _error(src, robot.line(f"{kind}s", name) or src.line(spec.section), f"{kind} {name} is used by the table but "
-           f"not wired to the {spec.controller}", f"add it to [{spec.section}], for example: {example}")
+    _error(src, robot.line(f"{kind}s", name) or src.line(spec.section),
+           N_("{kind} {name} is used by the table but not wired to the {controller}", kind=KINDS[kind], name=name,
+              controller=spec.controller),
+           N_("add it to [{section}], for example: {example}", section=spec.section, example=example))
 
 
 def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
@@ -139,7 +150,15 @@ def _suggested_mode(spec: Terminals, robot: Robot, name: str) -> str:
     return f'mode = "{mode}", {spec.digital_modes[mode].key} = 1'
 
 
-def _error(src: Source, line: int | None, message: str, hint: str) -> None:
+def _joined(parts: list[Message]) -> Message:
+    """``parts`` as one text, each part in the reader's language, joined by "; "."""
+    joined = parts[-1]
+    for part in reversed(parts[:-1]):
+        joined = N_("{first}; {rest}", first=part, rest=joined)
+    return joined
+
+
+def _error(src: Source, line: int | None, message: Message, hint: Message) -> None:
     src.out.error(line, None if line is None else 1, message, hint)
 
 
@@ -154,29 +173,33 @@ class _Reader:
         key = self.spec.section
         return self.src.line(key, None, name) or self.src.line(f"{key}.{name}") or self.src.line(key)
 
-    def error(self, name: str, message: str, hint: str) -> None:
+    def error(self, name: str, message: Message, hint: Message) -> None:
         _error(self.src, self.line(name), message, hint)
 
     def terminal(self, name: str, kind: str, value: Any, allowed: Sequence[str] | None = None) -> str | None:
         """``value`` checked as a terminal of ``kind`` (one of ``allowed`` if given), or None after an error."""
         key, names = self.spec.section, list(allowed if allowed is not None else self.spec.names(kind))
         if not names:
-            self.error(name, f"{kind} {name}: the {self.spec.controller} has no {kind} terminals",
-                       f"remove {name} from [{key}]")
+            self.error(name, N_("{kind} {name}: the {controller} has no {kind} terminals", kind=KINDS[kind],
+                                name=name, controller=self.spec.controller),
+                       N_("remove {name} from [{section}]", name=name, section=key))
             return None
         if value is None:
-            self.error(name, f"[{key}] {name}: which terminal is it wired to?",
-                       f'say it with terminal = "{names[0]}" (one of {", ".join(names)})')
+            self.error(name, N_("[{section}] {name}: which terminal is it wired to?", section=key, name=name),
+                       N_('say it with terminal = "{first}" (one of {names})', first=names[0], names=", ".join(names)))
             return None
         if not isinstance(value, str):
-            self.error(name, f"[{key}] {name}: the terminal must be text like {names[0]!r}, not {value!r}",
-                       f'write it in quotes: {name} = "{names[0]}"')
+            self.error(name, N_("[{section}] {name}: the terminal must be text like {first!r}, not {value!r}",
+                                section=key, name=name, first=names[0], value=value),
+                       N_('write it in quotes: {name} = "{first}"', name=name, first=names[0]))
             return None
         if value not in names:
             same = [n for n in names if n.lower() == value.strip().lower()]
-            hint = (f"terminal names are case-sensitive: write {same[0]!r}" if same
-                    else f"the {self.spec.controller}'s terminals for this are {', '.join(names)}")
-            self.error(name, f"{kind} {name}: the {self.spec.controller} has no {kind} terminal {value!r}", hint)
+            hint = (N_("terminal names are case-sensitive: write {same!r}", same=same[0]) if same
+                    else N_("the {controller}'s terminals for this are {names}", controller=self.spec.controller,
+                            names=", ".join(names)))
+            self.error(name, N_("{kind} {name}: the {controller} has no {kind} terminal {value!r}", kind=KINDS[kind],
+                                name=name, controller=self.spec.controller, value=value), hint)
             return None
         return value if self._take(name, kind, value) else None
 
@@ -189,9 +212,11 @@ class _Reader:
             needs = [("output" if kind == "lamp" else kind, value)]
         for used in needs:
             if used in self.taken:
-                self.error(name, f"{kind} {name}: terminal {value} is already used by {self.taken[used]}"
-                           + (" (a motor drives both outputs of its pair)" if used[0] == "output" else ""),
-                           f"give {name} a terminal of its own in [{self.spec.section}]")
+                taken = dict(kind=KINDS[kind], name=name, terminal=value, user=self.taken[used])
+                self.error(name, N_("{kind} {name}: terminal {terminal} is already used by {user} (a motor drives both "
+                                    "outputs of its pair)", **taken) if used[0] == "output" else
+                           N_("{kind} {name}: terminal {terminal} is already used by {user}", **taken),
+                           N_("give {name} a terminal of its own in [{section}]", name=name, section=self.spec.section))
                 return False
         self.taken.update(dict.fromkeys(needs, name))
         return True
@@ -199,20 +224,23 @@ class _Reader:
     def input(self, name: str) -> InputWire | None:
         key, value = self.spec.section, self.section[name]
         if not isinstance(value, dict):
-            self.error(name, f"[{key}] {name} must say its terminal, mode and polarity",
-                       f'for example: {name} = {{ terminal = "{self.spec.digital_inputs[0]}", mode = "switch", '
-                       "pressed = 1 }")
+            self.error(name, N_("[{section}] {name} must say its terminal, mode and polarity", section=key, name=name),
+                       N_("for example: {example}", example=f'{name} = {{ terminal = "{self.spec.digital_inputs[0]}", '
+                          'mode = "switch", pressed = 1 }'))
             return None
         mode = value.get("mode")
         if mode not in self.spec.modes:
-            self.error(name, f"[{key}] {name}: mode must be one of {', '.join(self.spec.modes)}, not {mode!r}",
-                       "; ".join(f'{d.device} is mode = "{m}"' for m, d in self.spec.digital_modes.items()))
+            self.error(name, N_("[{section}] {name}: mode must be one of {modes}, not {mode!r}", section=key, name=name,
+                                modes=", ".join(self.spec.modes), mode=mode),
+                       _joined([N_('{device} is mode = "{mode}"', device=d.device, mode=m)
+                                for m, d in self.spec.digital_modes.items()]))
             return None
         digital = self.spec.digital_modes.get(mode)
         known = ("terminal", "mode", digital.key) if digital else ("terminal", "mode", "below", "above")
         for k in value:
             if k not in known:
-                self.error(name, f"[{key}] {name}: unknown key {k!r} for mode {mode!r}", f"keys: {', '.join(known)}")
+                self.error(name, N_("[{section}] {name}: unknown key {key!r} for mode {mode!r}", section=key, name=name,
+                                    key=k, mode=mode), N_("keys: {keys}", keys=", ".join(known)))
         allowed = self.spec.digital_inputs if digital else self.spec.analog[mode].terminals
         default = name if name in allowed else None
         terminal = self.terminal(name, "input", value.get("terminal", default), allowed)
@@ -224,9 +252,12 @@ class _Reader:
     def _digital(self, name: str, mode: Digital, value: dict[str, Any]) -> tuple[bool] | None:
         reads = value.get(mode.key)
         if reads not in (0, 1) or isinstance(reads, bool):
-            self.error(name, f"[{self.spec.section}] {name}: say what the table reads {mode.meaning}: {mode.key} = 1 "
-                       f"or {mode.key} = 0" + ("" if reads is None else f", not {reads!r}"),
-                       f"{mode.key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')")
+            said = dict(section=self.spec.section, name=name, meaning=mode.meaning, key=mode.key, reads=reads)
+            self.error(name, N_("[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0",
+                                **said) if reads is None else
+                       N_("[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0, "
+                          "not {reads!r}", **said),
+                       N_("{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')", key=mode.key))
             return None
         return (reads != mode.reports,)
 
@@ -237,14 +268,16 @@ class _Reader:
         if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
-            self.error(name, f"[{key}] {name}: a {mode} input needs exactly one of below = N or above = N "
-                       f"({analog.unit})", "the table reads 1 while the value is below (or above) N, for example: "
-                       f"below = {analog.most // 50}")
+            self.error(name, N_("[{section}] {name}: a {mode} input needs exactly one of below = N or above = N "
+                                "({unit})", section=key, name=name, mode=mode, unit=analog.unit),
+                       N_("the table reads 1 while the value is below (or above) N, for example: below = {example}",
+                          example=analog.most // 50))
             return None
         (which, limit), = limits.items()
         if isinstance(limit, bool) or not isinstance(limit, int) or not 0 <= limit <= analog.most:
-            self.error(name, f"[{key}] {name}: {which} must be a whole number 0..{analog.most} ({analog.unit}), "
-                       f"not {limit!r}", f"for example: {which} = {analog.most // 50}")
+            self.error(name, N_("[{section}] {name}: {which} must be a whole number 0..{most} ({unit}), not {limit!r}",
+                                section=key, name=name, which=which, most=analog.most, unit=analog.unit, limit=limit),
+                       N_("for example: {example}", example=f"{which} = {analog.most // 50}"))
             return None
         return (False, limit if which == "below" else None, limit if which == "above" else None, 0)
 
@@ -254,21 +287,28 @@ class _Reader:
         the table reads the same on the robot: only a distance sensor in the controller's distance mode (cm)."""
         key = self.spec.section
         if limits:
-            self.error(name, f"[{key}] {name}: its threshold is declared in [sensors] ({sensor.describe()})",
-                       f"remove {', '.join(limits)} here: the simulator and the controller read the one declaration")
+            self.error(name, N_("[{section}] {name}: its threshold is declared in [sensors] ({sensor})", section=key,
+                                name=name, sensor=sensor.describe()),
+                       N_("remove {keys} here: the simulator and the controller read the one declaration",
+                          keys=", ".join(limits)))
             return None
         scale = sensor.sensor_kind.modes.get(mode)  # from the declaration's units into the mode's
         if scale is None or mode not in self.spec.analog:
-            where = (f'wire a distance sensor as mode = "{self.spec.distance_mode}"; ' if self.spec.distance_mode
-                     else f"the {self.spec.controller} measures no distance in cm; ")
-            self.error(name, f"[{key}] {name}: a {sensor.model} sensor ({sensor.describe()}) cannot be read in "
-                       f"{mode} mode with its declared threshold", where + "or give a calibrated threshold here in "
-                       "the controller's units and drop the input from [sensors]")
+            where = (N_('wire a distance sensor as mode = "{mode}"; or give a calibrated threshold here in the '
+                        "controller's units and drop the input from [sensors]", mode=self.spec.distance_mode)
+                     if self.spec.distance_mode else
+                     N_("the {controller} measures no distance in cm; or give a calibrated threshold here in the "
+                        "controller's units and drop the input from [sensors]", controller=self.spec.controller))
+            self.error(name, N_("[{section}] {name}: a {model} sensor ({sensor}) cannot be read in {mode} mode with "
+                                "its declared threshold", section=key, name=name, model=sensor.model,
+                                sensor=sensor.describe(), mode=mode), where)
             return None
         limit, slack = round(sensor.threshold * scale, 6), round(sensor.hysteresis * scale, 6)
         if limit != int(limit) or slack != int(slack):
-            self.error(name, f"[{key}] {name}: the {self.spec.controller} measures whole centimetres; [sensors] says "
-                       f"{sensor.describe()}", "declare the threshold and hysteresis in whole cm")
+            self.error(name, N_("[{section}] {name}: the {controller} measures whole centimetres; [sensors] says "
+                                "{sensor}", section=key, name=name, controller=self.spec.controller,
+                                sensor=sensor.describe()),
+                       N_("declare the threshold and hysteresis in whole cm"))
             return None
         below = sensor.direction == "below"
         return (False, int(limit) if below else None, None if below else int(limit), int(slack))
@@ -279,11 +319,13 @@ class _Reader:
         if isinstance(value, dict) and kind == "motor":
             for k in value:
                 if k not in ("terminal", "reverse"):
-                    self.error(name, f"[{self.spec.section}] {name}: unknown key {k!r}", "keys: terminal, reverse")
+                    self.error(name, N_("[{section}] {name}: unknown key {key!r}", section=self.spec.section, name=name,
+                                        key=k), N_("keys: {keys}", keys="terminal, reverse"))
             reverse = value.get("reverse", False)
             if not isinstance(reverse, bool):
-                self.error(name, f"[{self.spec.section}] {name}: reverse must be true or false, not {reverse!r}",
-                           "reverse = true swaps the motor's forward and backward")
+                self.error(name, N_("[{section}] {name}: reverse must be true or false, not {value!r}",
+                                    section=self.spec.section, name=name, value=reverse),
+                           N_("reverse = true swaps the motor's forward and backward"))
                 reverse = False
             value = value.get("terminal", name if name in self.spec.motors else None)
         terminal = self.terminal(name, kind, value)

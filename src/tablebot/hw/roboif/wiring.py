@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.hw import wiring
 from tablebot.hw.roboif import protocol as wire
+from tablebot.i18n import N_
 from tablebot.table import MAX_LAMP, MAX_SPEED
 from tablebot.tomlfile import Source
 
@@ -27,8 +28,8 @@ TERMINALS = wiring.Terminals(
             "voltage": wiring.Analog("raw 0..1023", 1023, ("A1", "A2")),
             "distance": wiring.Analog("raw 0..1023", 1023, ("D1", "D2"))},
     motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
-    counters=(), min_tick_ms=10, tick_reason="libroboint exchanges every 10 ms, and at 38400 baud one exchange "
-    "already takes 9.9 ms on the wire")
+    counters=(), min_tick_ms=10, tick_reason=N_("libroboint exchanges every 10 ms, and at 38400 baud one exchange "
+                                                 "already takes 9.9 ms on the wire"))
 
 
 def read_robot_roboif(src: Source, section: Any, robot: Robot) -> wiring.Section:

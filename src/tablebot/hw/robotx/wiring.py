@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.hw import wiring
 from tablebot.hw.robotx import protocol as wire
+from tablebot.i18n import N_
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:
@@ -23,7 +24,7 @@ TERMINALS = wiring.Terminals(
             "ultrasonic": wiring.Analog("cm", 1023, INPUTS)},
     motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
     counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)), min_tick_ms=10,
-    tick_reason="ftMscLib exchanges the transfer area every 10 ms", distance_mode="ultrasonic")
+    tick_reason=N_("ftMscLib exchanges the transfer area every 10 ms"), distance_mode="ultrasonic")
 MODES = {"switch": (wire.InputMode.RESISTANCE, True), "phototransistor": (wire.InputMode.RESISTANCE, True),
          "resistance": (wire.InputMode.RESISTANCE, False), "voltage": (wire.InputMode.VOLTAGE, False),
          "ultrasonic": (wire.InputMode.ULTRASONIC, False)}

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.hw import wiring
 from tablebot.hw.txt import protocol as wire
+from tablebot.i18n import N_
 from tablebot.tomlfile import Source
 
 if TYPE_CHECKING:
@@ -25,8 +26,8 @@ INPUTS = tuple(f"I{i + 1}" for i in range(wire.N_INPUTS))
 #: ``trailfollower`` reads it (ftrobopy.py) and ftrobopy_server maps mode (0, digital) to ``ft::TrailFollower``;
 #: ROBO Pro Coding's ``create_trail_follower(...).get_state()`` reads 0 on the line (fischertechnik's FTS
 #: program, ORBIS-Modellfabrik ``integrations/TXT-FTS/.../lib/line_follower.py``).
-TRAIL = wiring.Digital("dark", "a track sensor", "while the track sensor's spot is over the dark line", reports=0,
-                       words=("track", "trail"))
+TRAIL = wiring.Digital("dark", N_("a track sensor"), N_("while the track sensor's spot is over the dark line"),
+                       reports=0, words=("track", "trail"))
 TRAIL_LIGHT_MV = 600  # ftrobopy: a trail sensor reporting millivolts reads light above 600 mV
 TERMINALS = wiring.Terminals(
     section="txt", controller="TXT", digital_inputs=INPUTS,
@@ -34,7 +35,7 @@ TERMINALS = wiring.Terminals(
             "ultrasonic": wiring.Analog("cm", 1024, INPUTS)},
     motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
     counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)), min_tick_ms=10,
-    tick_reason="it answers one exchange every 10 ms", distance_mode="ultrasonic",
+    tick_reason=N_("it answers one exchange every 10 ms"), distance_mode="ultrasonic",
     digital_modes={**wiring.DIGITAL, "trail": TRAIL})
 #: mode -> the input's UpdateConfig (measuring mode, reported as 0/1)
 MODES = {"switch": wire.InputConfig(wire.InputMode.RESISTANCE, True),
