@@ -29,10 +29,21 @@ def runs(path: Path) -> set[tuple[str, ...]]:
     # the models' exploration and successor cache (analysis.model), the harness's comparison and report
     ("analysis/product.py", "analysis/model.py"),
     ("testing/several_cases.py", "testing/harness.py"),
+    # a UART stream's frames: tablebot.firmware.framing.take_frames
+    ("firmware/several.py", "firmware/framing.py"),
 ])
 def test_no_run_of_six_lines_stands_in_both(one: str, other: str) -> None:
     shared = runs(SRC / one) & runs(SRC / other)
     assert not shared, "\n".join(sorted("\n".join(run) for run in shared)[:1])
+
+
+@pytest.mark.parametrize("name", ["firmware/monitor.py"])
+def test_no_run_of_six_lines_stands_twice_in_one_module(name: str) -> None:
+    lines = [line.strip() for line in (SRC / name).read_text(encoding="utf-8").splitlines() if line.strip()]
+    seen: dict[tuple[str, ...], int] = {}
+    for i in range(len(lines) - RUN + 1):
+        run = tuple(lines[i:i + RUN])
+        assert seen.setdefault(run, i) == i or seen[run] + RUN > i, "\n".join(run)
 
 
 @pytest.mark.parametrize("name", ["formats/table_read.py", "formats/table_cells.py", "hw/wiring.py", "hw/terminals.py",

@@ -4,9 +4,9 @@ The frame layout is documented in docs/firmware.md and at the constants below.""
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from tablebot.codegen.host import trace_line
 from tablebot.codegen.packing import Layout, plan
@@ -48,6 +48,46 @@ def checksum(body: bytes) -> int:
     return -sum(body) & 0xFF
 
 
+class FrameStream(Protocol):
+    """What :func:`take_frames` keeps of a stream: the bytes not yet a whole frame, how many came before them, and
+    the problems found."""
+
+    buffer: bytearray
+    consumed: int
+    problems: list[str]
+
+
+def take_frames(stream: FrameStream, data: bytes, lengths: Mapping[int, int],
+                take: Callable[[int, bytes], None]) -> None:
+    """Every whole frame in ``stream``'s buffer with ``data`` added, as ``take(type, payload)``, in order: a frame's
+    payload length is ``lengths[type]``; a byte that starts no known frame is skipped, and after a bad checksum
+    the stream resynchronises on the next sync byte (a problem noted at its byte in the stream). What is left is
+    the start of a frame still to come."""
+    stream.buffer += data
+    buf, at = stream.buffer, 0
+    while True:
+        at = buf.find(SYNC, at)
+        if at < 0 or at + 2 > len(buf):
+            break
+        length = lengths.get(buf[at + 1])
+        if length is None:
+            at += 1  # not a frame start: resynchronise on the next sync byte
+            continue
+        end = at + 2 + length + 1
+        if end > len(buf):
+            break
+        body = bytes(buf[at + 1:end])
+        if sum(body) & 0xFF:
+            stream.problems.append(N_("bad checksum at byte {at}; resynchronising", at=stream.consumed + at))
+            at += 1
+            continue
+        take(body[0], body[1:-1])
+        at = end
+    done = at if at >= 0 else len(buf)
+    del buf[:done]
+    stream.consumed += done
+
+
 def _frame(kind: int, payload: bytes) -> bytes:
     body = bytes([kind]) + payload
     return bytes([SYNC]) + body + bytes([checksum(body)])
@@ -75,33 +115,14 @@ class Decoder:
         self.lengths = {HELLO: HELLO_PAYLOAD, TICK: tick_payload(self.machine, self.layout)}  # payload per type
 
     def feed(self, data: bytes) -> list[dict[str, Any]]:
-        self.buffer += data
         lines: list[dict[str, Any]] = []
-        at = 0
-        buf = self.buffer
-        while True:
-            at = buf.find(SYNC, at)
-            if at < 0 or at + 2 > len(buf):
-                break
-            length = self.lengths.get(buf[at + 1])
-            if length is None:
-                at += 1  # not a frame start: resynchronise on the next sync byte
-                continue
-            end = at + 2 + length + 1
-            if end > len(buf):
-                break
-            body = bytes(buf[at + 1:end])
-            if sum(body) & 0xFF:
-                self.problems.append(N_("bad checksum at byte {at}; resynchronising", at=self.consumed + at))
-                at += 1
-                continue
-            line = self._frame(body[0], body[1:-1])
+
+        def take(kind: int, payload: bytes) -> None:
+            line = self._frame(kind, payload)
             if line is not None:
                 lines.append(line)
-            at = end
-        done = at if at >= 0 else len(buf)
-        del buf[:done]
-        self.consumed += done
+
+        take_frames(self, data, self.lengths, take)
         self.ticks += len(lines)
         return lines
 

@@ -84,26 +84,15 @@ def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str
     if tables is not None:  # a robot of several tables: its firmware's frames carry all of them
         return _monitor_several(tables, chunks, out, source, ticks, warn)
     decoder = Decoder(machine, plan(machine))
-    written = warned = 0
-    for chunk in chunks:
-        lines = decoder.feed(chunk)
-        check_hello(decoder, source)
-        warned = _warn(decoder, source, warn, warned)
-        for line in lines[:len(lines) if ticks is None else ticks - written]:
-            out.write(dumps(line) + "\n")
-            written += 1
-        if ticks is not None and written >= ticks:
-            return written
-        out.flush()
-    if not decoder.hellos and not decoder.ticks:
-        raise fail(source, N_("no trace frame in {count} bytes", count=decoder.consumed + len(decoder.buffer)),
-                   N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this table by "
-                      "`tablebot build`"))
+    written = _copy(decoder, chunks, out, source, ticks, warn, lambda: check_hello(decoder, source))
+    if ticks is not None and written >= ticks:
+        return written
+    _none_decoded(decoder, source, N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this "
+                                      "table by `tablebot build`"))
     if decoder.rejected * 10 > decoder.rejected + decoder.ticks:  # more than noise: another table's stream
         raise fail(source, N_("{rejected} of {count} tick frames are impossible for this table",
                               rejected=decoder.rejected, count=decoder.rejected + decoder.ticks), BUILT_FROM)
-    if decoder.buffer:
-        warn(_warning(source, N_("{count} bytes at the end are not a whole frame", count=len(decoder.buffer))))
+    _leftover(decoder, source, warn)
     return written
 
 
@@ -120,9 +109,23 @@ def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str],
                      warn: Callable[[str], Any]) -> int:
     """:func:`monitor` of the firmware of a robot of several tables (tablebot.firmware.several)."""
     decoder = SeveralDecoder(tables)
+    written = _copy(decoder, chunks, out, source, ticks, warn)
+    if ticks is not None and written >= ticks:
+        return written
+    _none_decoded(decoder, source, N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this "
+                                      "robot by `tablebot build`"))
+    _leftover(decoder, source, warn)
+    return written
+
+
+def _copy(decoder: Decoder | SeveralDecoder, chunks: Iterator[bytes], out: IO[str], source: str, ticks: int | None,
+          warn: Callable[[str], Any], check: Callable[[], None] = lambda: None) -> int:
+    """The decoded lines of ``chunks`` onto ``out`` (``ticks`` of them at the most, None: all), the decoder's
+    problems passed to ``warn`` as they come; ``check`` after every chunk may refuse the stream. Lines written."""
     written = warned = 0
     for chunk in chunks:
         lines = decoder.feed(chunk)
+        check()
         warned = _warn(decoder, source, warn, warned)
         for line in lines[:len(lines) if ticks is None else ticks - written]:
             out.write(dumps(line) + "\n")
@@ -130,13 +133,19 @@ def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str],
         if ticks is not None and written >= ticks:
             return written
         out.flush()
+    return written
+
+
+def _none_decoded(decoder: Decoder | SeveralDecoder, source: str, hint: str) -> None:
+    """Refuse a stream in which no frame decoded at all: it is not this firmware's trace."""
     if not decoder.hellos and not decoder.ticks:
-        raise fail(source, N_("no trace frame in {count} bytes", count=decoder.consumed + len(decoder.buffer)),
-                   N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this robot by "
-                      "`tablebot build`"))
+        raise fail(source, N_("no trace frame in {count} bytes", count=decoder.consumed + len(decoder.buffer)), hint)
+
+
+def _leftover(decoder: Decoder | SeveralDecoder, source: str, warn: Callable[[str], Any]) -> None:
+    """Warn of bytes at the end that are not a whole frame (the capture was cut)."""
     if decoder.buffer:
         warn(_warning(source, N_("{count} bytes at the end are not a whole frame", count=len(decoder.buffer))))
-    return written
 
 
 def _warn(decoder: Decoder | SeveralDecoder, source: str, warn: Callable[[str], Any], warned: int) -> int:

@@ -22,7 +22,7 @@ from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.build import BUG, Firmware, c_source, compile_and_link, write_main
 from tablebot.firmware.emulate import build_harness, pins_csv, run_harness
-from tablebot.firmware.framing import SYNC, checksum
+from tablebot.firmware.framing import take_frames
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.i18n import N_
 from tablebot.machine import Machine
@@ -108,34 +108,15 @@ class SeveralDecoder:
     last_tick: int | None = None
 
     def feed(self, data: bytes) -> list[dict[str, Any]]:
-        lengths = {HELLO: 4, TICK: tick_payload(self.tables)}
-        self.buffer += data
-        buf, at = self.buffer, 0
         lines: list[dict[str, Any]] = []
-        while True:
-            at = buf.find(SYNC, at)
-            if at < 0 or at + 2 > len(buf):
-                break
-            length = lengths.get(buf[at + 1])
-            if length is None:
-                at += 1
-                continue
-            end = at + 2 + length + 1
-            if end > len(buf):
-                break
-            body = bytes(buf[at + 1:end])
-            if checksum(body[:-1]) != body[-1]:
-                self.problems.append(N_("bad checksum at byte {at}; resynchronising", at=self.consumed + at))
-                at += 1
-                continue
-            if body[0] == TICK:
-                lines.append(self._line(body[1:-1]))
+
+        def take(kind: int, payload: bytes) -> None:
+            if kind == TICK:
+                lines.append(self._line(payload))
             else:
-                self._hello(body[1:-1])
-            at = end
-        done = at if at >= 0 else len(buf)
-        del buf[:done]
-        self.consumed += done
+                self._hello(payload)
+
+        take_frames(self, data, {HELLO: 4, TICK: tick_payload(self.tables)}, take)
         self.ticks += len(lines)
         return lines
 
