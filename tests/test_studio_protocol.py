@@ -137,8 +137,8 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
 
 
 def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> None:
-    """The protocol's refusals are messages of the catalog: a German tab reads them in German, an English one
-    in English (the same operations, one studio)."""
+    """The studio's refusals (the protocol's, the folder's, the arena's, the table's) are messages of the catalog: a
+    German tab reads them in German, an English one in English (the same operations, one studio)."""
 
     async def replies(language: str) -> list[dict[str, Any]]:
         sent: list[dict[str, Any]] = []
@@ -149,7 +149,8 @@ def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> Non
         session = Session(Workspace(tmp_path), Hub(), send, language)
         try:
             for message in ({"op": "open", "path": ""}, {"op": "edit", "row": "1", "col": 0, "value": ""},
-                            {"op": "explode"}, [1]):
+                            {"op": "explode"}, [1], {"op": "open", "path": "../secret.csv"},
+                            {"op": "sim", "action": "play"}, {"op": "save"}):
                 await session.handle(message)
         finally:
             session.close()
@@ -157,7 +158,41 @@ def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> Non
 
     german = [m["message"] for m in asyncio.run(replies("de"))]
     assert german == ['"path" muss Text sein', '"row" muss eine ganze Zahl sein', "unbekannte Operation 'explode'",
-                      'eine Nachricht muss ein JSON-Objekt mit einem "op" sein']
+                      'eine Nachricht muss ein JSON-Objekt mit einem "op" sein',
+                      "'../secret.csv' liegt außerhalb des freigegebenen Ordners",
+                      "der Roboter fährt nicht: zuerst die Tabelle berichtigen", "zuerst eine Tabelle öffnen"]
     english = [m["message"] for m in asyncio.run(replies("en"))]
     assert english == ['"path" must be text', '"row" must be a whole number', "unknown op 'explode'",
-                       'a message must be a JSON object with an "op"']
+                       'a message must be a JSON object with an "op"', "'../secret.csv' is outside the served folder",
+                       "the robot is not running: fix the table first", "open a table first"]
+
+
+def test_why_a_row_fired_is_said_in_the_tabs_language(tmp_path: Path) -> None:
+    """The paused arena's why list (each row of the state: fired, or why not) in a German tab is German."""
+    for name in ("table.csv", "robot.toml", "arena.toml", "properties.toml"):
+        shutil.copy(EXAMPLE / name, tmp_path / name)
+
+    async def why(language: str) -> list[str]:
+        sent: list[dict[str, Any]] = []
+
+        async def send(message: dict[str, Any]) -> None:
+            sent.append(message)
+
+        session = Session(Workspace(tmp_path), Hub(), send, language)
+        try:
+            await session.handle({"op": "open", "path": "table.csv"})
+            await session.handle({"op": "sim", "action": "step"})
+            for _ in range(200):
+                await asyncio.sleep(0.02)
+                await session.frame()
+                frames = [m for m in sent if m["type"] == "frame" and m["tick"] >= 0 and m.get("why")]
+                if frames:
+                    return [item["why"] for item in frames[-1]["why"]]
+        finally:
+            session.close()
+        raise AssertionError("no frame")
+
+    german, english = asyncio.run(why("de")), asyncio.run(why("en"))
+    assert english[0].startswith("line ") and " fired" in " ".join(english), english
+    assert german[0].startswith("Zeile ") and "hat geschaltet" in " ".join(german), german
+    assert len(german) == len(english)

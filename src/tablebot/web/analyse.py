@@ -19,6 +19,7 @@ from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats import table_read
 from tablebot.formats.csv_document import CsvDocument
 from tablebot.formats.table_parts import robot_for_table
+from tablebot.i18n import N_
 from tablebot.loading import Loaded, property_files
 from tablebot.loading import robot_for as robot_for  # the robot a table file runs on, as the CLI finds it
 from tablebot.machine import NO_ROW, Machine, compile_table
@@ -191,23 +192,25 @@ def explain(table: Table, machine: Machine, state: int, events: int) -> list[dic
             continue
         row = table.rows[compiled.index]
         missing = [e for e in names if compiled.mask & table.bit(e) and not events & table.bit(e)]
-        line = f"line {row.line}" + (f" ({row.description})" if row.description else "")
+        line = N_("line {line} ({description})", line=row.line, description=row.description) if row.description \
+            else N_("line {line}", line=row.line)
         if compiled.index == fired:
-            why = f"{line} fired: " + (
-                f"it needs {' + '.join(e for e in names if e in row.events)}, all present" if row.events
-                else "it needs nothing")
+            why = N_("{line} fired: it needs {events}, all present", line=line,
+                     events=" + ".join(e for e in names if e in row.events)) if row.events \
+                else N_("{line} fired: it needs nothing", line=line)
             status = "fired"
         elif missing:
-            why = f"{line} did not fire: it needs {' + '.join(missing)}"
+            why = N_("{line} did not fire: it needs {events}", line=line, events=" + ".join(missing))
             status = "missing"
         elif fired == NO_ROW:  # it needs nothing, yet nothing fired: the document's rule on a tick with no event
-            why = (f"{line} did not fire: no event this tick, and with "
-                   'match = "document" no row is looked up then')
+            why = N_('{line} did not fire: no event this tick, and with match = "document" no row is looked up then',
+                     line=line)
             status = "missing"
         else:
-            why = f"{line} did not fire: line {table.rows[fired].line} comes first and matches too"
+            why = N_("{line} did not fire: line {first} comes first and matches too", line=line,
+                     first=table.rows[fired].line)
             status = "shadowed"
         out.append({"row": compiled.index, "status": status, "why": why, "line": row.line})
     if fired == NO_ROW:
-        out.append({"row": None, "status": "none", "why": "no row fired: nothing changes this tick"})
+        out.append({"row": None, "status": "none", "why": N_("no row fired: nothing changes this tick")})
     return out

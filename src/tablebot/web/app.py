@@ -22,6 +22,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
 from tablebot.escape import terminal
+from tablebot.i18n import N_
 from tablebot.templates import TEMPLATES
 from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
 from tablebot.web.errors import INTERNAL, log
@@ -120,7 +121,7 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
                 if message["type"] == "websocket.disconnect":
                     break
                 if message.get("text") is None:
-                    await session.error("a message must be JSON text, not binary data")
+                    await session.error(N_("a message must be JSON text, not binary data"))
                     continue
                 await _answer(session, message["text"])
         except (WebSocketDisconnect, Gone):
@@ -190,15 +191,15 @@ class Tabs:
 async def _answer(session: Session, text: str) -> None:
     """One message from the page; nothing it sends can end the connection or the server."""
     if len(text) > MAX_MESSAGE_BYTES:
-        await session.error(f"message too large ({len(text):,} characters)")
+        await session.error(N_("message too large ({n:,} characters)", n=len(text)))
         return
     try:
         message = json.loads(text)
     except json.JSONDecodeError as exc:
-        await session.error(f"not JSON: {exc.msg}")
+        await session.error(N_("not JSON: {why}", why=exc.msg))
         return
     except RecursionError:
-        await session.error("the message is nested too deeply: the page never sends such a message")
+        await session.error(N_("the message is nested too deeply: the page never sends such a message"))
         return
     try:
         await session.handle(message)

@@ -8,6 +8,7 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from tablebot.i18n import N_
 from tablebot.table import Table
 from tablebot.web.analyse import Analysis, explain
 from tablebot.web.errors import Refused
@@ -47,7 +48,7 @@ class ArenaRobot:
         """Put the robot at its start (with the settings ``fields`` changes) and send the arena."""
         analysis = self.analysis()
         if analysis is None or analysis.table is None or analysis.machine is None:
-            raise Refused("fix the table's errors first: the robot runs only a table that reads")
+            raise Refused(N_("fix the table's errors first: the robot runs only a table that reads"))
         settings = ArenaSettings.of(fields, self.arena.settings)
         tables = analysis.tables
         main = (analysis.table, analysis.machine) if tables is None else (tables.table, tables.machines[0])

@@ -11,11 +11,12 @@ from pathlib import Path
 
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.csv_document import MAX_TABLE_BYTES, CsvDocument
+from tablebot.i18n import N_
 from tablebot.robot import Robot
 from tablebot.robot_tables import tables_of
 from tablebot.table import Table
 from tablebot.web.analyse import Analysis, analyse, robot_failed, robot_for
-from tablebot.web.errors import Refused
+from tablebot.web.errors import Refused, said
 from tablebot.web.protocol import (
     AnalysisMsg,
     ConflictMsg,
@@ -137,7 +138,7 @@ class Draft:
 
     def need_doc(self) -> CsvDocument:
         if self.doc is None:
-            raise Refused("open a table first")
+            raise Refused(N_("open a table first"))
         return self.doc
 
     async def edit(self, op: Edit) -> None:
@@ -167,7 +168,7 @@ class Draft:
         try:
             saved = await asyncio.to_thread(self.workspace.save, self.opened, doc.to_bytes(), op.force, self.base)
         except ChangedOnDisk as exc:
-            await self.say(conflict(str(exc), exc.how, exc.theirs, exc.name, "save"))
+            await self.say(conflict(said(exc), exc.how, exc.theirs, exc.name, "save"))
             return None
         self.opened, self.base, self.dirty = saved.file, None, False
         await self.say(SavedMsg("save", saved.file.version, saved.file.name,
@@ -182,7 +183,7 @@ class Draft:
         doc = CsvDocument.from_bytes(self.opened.data, self.opened.name)
         doc.replace_grid(op.header, op.grid)
         if len(doc.to_bytes()) > MAX_TABLE_BYTES:
-            raise Refused(f"the restored table would have more than {MAX_TABLE_BYTES:,} bytes")
+            raise Refused(N_("the restored table would have more than {most:,} bytes", most=MAX_TABLE_BYTES))
         self.doc, self.base = doc, op.base if op.base != self.opened.version else None
         self.touched()
         await self.say(GridMsg(doc.grid(), grid_lines(doc)))
@@ -193,8 +194,8 @@ def conflict(message: str, how: str, theirs: str, path: str, op: str) -> Conflic
     """The page's choice when the file on disk is not the draft's: save yours over theirs (version
     ``theirs``, kept as NAME.bak) or load theirs."""
     return ConflictMsg(op, message, how, theirs, path, path + BACKUP_SUFFIX,
-                       f"your edits are kept: save yours (theirs are kept as {path}{BACKUP_SUFFIX}), "
-                       "or load theirs (yours are dropped)")
+                       N_("your edits are kept: save yours (theirs are kept as {backup}), or load theirs (yours are "
+                          "dropped)", backup=path + BACKUP_SUFFIX))
 
 
 def grid_lines(doc: CsvDocument) -> list[int]:

@@ -8,7 +8,7 @@ import logging
 
 # The document the studio edits refuses edits in the studio's words; its refusal is the studio's.
 from tablebot.formats.csv_document import Refused
-from tablebot.i18n import Message
+from tablebot.i18n import N_, Message
 
 __all__ = ["INTERNAL", "Refused", "log", "said"]
 
@@ -16,7 +16,7 @@ __all__ = ["INTERNAL", "Refused", "log", "said"]
 log = logging.getLogger("tablebot.studio")
 
 #: What the page is told about a bug; the traceback goes to the terminal, never to the page.
-INTERNAL = "internal error in the studio (the terminal running tablebot studio shows the details)"
+INTERNAL = N_("internal error in the studio (the terminal running tablebot studio shows the details)")
 
 
 

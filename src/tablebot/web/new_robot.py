@@ -6,7 +6,8 @@ import re
 from pathlib import Path
 
 from tablebot.diagnostics import TableBotError
-from tablebot.web.errors import Refused
+from tablebot.i18n import N_
+from tablebot.web.errors import Refused, said
 
 __all__ = ["NEW_NAME", "new_robot"]
 
@@ -19,14 +20,15 @@ def new_robot(root: Path, template: object, name: object) -> str:
     from tablebot.templates import TEMPLATES, make, write_folder
 
     if template not in TEMPLATES:
-        raise Refused(f"no template {str(template)[:40]!r}: tablebot new has {', '.join(TEMPLATES)}")
+        raise Refused(N_("no template {template}: tablebot new has {templates}", template=repr(str(template)[:40]),
+                         templates=", ".join(TEMPLATES)))
     if not isinstance(name, str) or not NEW_NAME.fullmatch(name):
-        raise Refused("a new robot's name is letters, digits, - and _ (at most 64, not starting with - or _)")
+        raise Refused(N_("a new robot's name is letters, digits, - and _ (at most 64, not starting with - or _)"))
     folder = root / name
     if folder.is_symlink() or folder.exists():
-        raise Refused(f"{name} is there already: choose another name")
+        raise Refused(N_("{name} is there already: choose another name", name=name))
     try:
         write_folder(folder, make(template, name, [], []))
     except TableBotError as exc:
-        raise Refused(str(exc)) from None
+        raise Refused(said(exc)) from None
     return f"{name}/table.csv"

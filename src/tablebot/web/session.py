@@ -17,6 +17,7 @@ from typing import Any
 
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.csv_document import CsvDocument
+from tablebot.i18n import N_
 from tablebot.web.arena_robot import ArenaRobot
 from tablebot.web.draft import Draft, conflict
 from tablebot.web.errors import Refused, log, said
@@ -146,7 +147,7 @@ class Session:
                 path = await asyncio.to_thread(open_link, self.workspace.root, op.link)
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
                 await self.dispatch(Open(path))
-                await self.say(NoticeMsg(f"the link's table is in {path}, as it was shared"))
+                await self.say(NoticeMsg(N_("the link's table is in {path}, as it was shared", path=path)))
             case NewRobot():
                 path = await asyncio.to_thread(new_robot, self.workspace.root, op.template, op.name)
                 await self.say(FilesMsg(await asyncio.to_thread(self.workspace.listing)))
@@ -204,9 +205,10 @@ class Session:
         if not self.draft.dirty:
             shown = await self.show(file, CsvDocument.from_bytes(file.data, file.name), self.draft.edits)
             if shown:
-                await self.say(NoticeMsg("reloaded: the table was saved in another tab"))
+                await self.say(NoticeMsg(N_("reloaded: the table was saved in another tab")))
                 return
-        await self.say(conflict(f"another tab saved {file.name} while this one has unsaved edits", OTHER_TAB,
+        await self.say(conflict(N_("another tab saved {name} while this one has unsaved edits", name=file.name),
+                                OTHER_TAB,
                                 file.version, file.name, ""))
 
     async def error(self, text: str, op: str = "") -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from tablebot.i18n import N_
 from tablebot.web.errors import Refused
 
 __all__ = ["Maker", "Opener", "maker", "open_link", "opener", "share"]
@@ -22,12 +23,12 @@ opener: Opener | None = None
 def share(table: Path, text: str) -> tuple[str, str]:
     """The link and QR code of the table at ``table`` with ``text`` as its contents (the draft on the page)."""
     if maker is None:
-        raise Refused("this studio makes no links: start it with tablebot studio")
+        raise Refused(N_("this studio makes no links: start it with tablebot studio"))
     return maker(table, text)
 
 
 def open_link(root: Path, link: str) -> str:
     """Write the files ``link`` carries into a new folder of ``root``; the relative name of its table."""
     if opener is None:
-        raise Refused("this studio opens no links: start it with tablebot studio")
+        raise Refused(N_("this studio opens no links: start it with tablebot studio"))
     return opener(root, link)

@@ -11,6 +11,7 @@ from typing import Any
 from tablebot.analysis.diagram import to_graphviz
 from tablebot.analysis.graphviz_run import INSTALL, NOT_FOUND, GraphvizFailed, NoGraphviz, draw
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.i18n import N_, Message
 from tablebot.loading import Loaded
 from tablebot.machine import Machine
 from tablebot.sim.model.scene import Scene
@@ -30,9 +31,9 @@ def _number(message: dict[str, Any], key: str, low: float, high: float) -> float
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise Refused(f'"{key}" must be a number')
+        raise Refused(N_('"{key}" must be a number', key=key))
     if not low <= value <= high:
-        raise Refused(f'"{key}" must be from {low:g} to {high:g}')
+        raise Refused(N_('"{key}" must be from {low:g} to {high:g}', key=key, low=low, high=high))
     return float(value)
 
 
@@ -57,19 +58,23 @@ class ArenaSettings:
         if "lamp" in message:
             pair = message["lamp"]
             if not isinstance(pair, list) or len(pair) != 2:
-                raise Refused('"lamp" must be [x, y]')
+                raise Refused(N_('"lamp" must be [x, y]'))
             lamp = (_number({"v": pair[0]}, "v", -1e3, 1e3), _number({"v": pair[1]}, "v", -1e3, 1e3))  # type: ignore
         speed = message.get("speed", old.speed)
         if speed not in SPEEDS:
-            raise Refused(f"speed must be one of {', '.join(SPEEDS)}")
+            raise Refused(_speeds())
         paused = message.get("paused", old.paused)
         return cls(int(seed) if seed is not None else old.seed, charge if charge is not None else old.charge,
                    start, lamp, speed, bool(paused))
 
 
+def _speeds() -> Message:
+    return N_("speed must be one of {speeds}", speeds=", ".join(SPEEDS))
+
+
 def _triple(value: Any) -> list[Any]:
     if not isinstance(value, list) or len(value) != 3:
-        raise Refused('"start" must be [x, y, heading]')
+        raise Refused(N_('"start" must be [x, y, heading]'))
     return value
 
 
@@ -117,7 +122,7 @@ class Arena:
     def control(self, action: str, message: dict[str, Any]) -> None:
         run = self.run
         if run is None:
-            raise Refused(self.problem or "the robot is not running: fix the table first")
+            raise Refused(self.problem or N_("the robot is not running: fix the table first"))
         if action == "play":
             run.play()
         elif action == "pause":
@@ -127,7 +132,7 @@ class Arena:
         elif action == "speed":
             speed = message.get("speed")
             if speed not in SPEEDS:
-                raise Refused(f"speed must be one of {', '.join(SPEEDS)}")
+                raise Refused(_speeds())
             run.set_speed(speed)
             self.settings = replace(self.settings, speed=speed)
         elif action == "hold":
@@ -135,19 +140,20 @@ class Arena:
         elif action == "script":
             masks = message.get("masks")
             if not isinstance(masks, list) or not all(type(m) is int and 0 <= m < 2**31 for m in masks):
-                raise Refused('"masks" must be a list of whole numbers')
+                raise Refused(N_('"masks" must be a list of whole numbers'))
             run.play_script(masks)  # at once, slowing down before the end, and paused on its last tick
         else:
-            raise Refused(f"unknown action {action!r}")
+            raise Refused(N_("unknown action {action}", action=repr(action)))
 
     def _hold(self, run: LiveRun, message: dict[str, Any]) -> None:
         assert self.machine is not None
         name, on = message.get("input"), message.get("on")
         bits = self.machine.input_bits
         if name not in bits:
-            raise Refused(f"unknown input {name!r}: the robot's inputs are {', '.join(bits)}")
+            raise Refused(N_("unknown input {name}: the robot's inputs are {inputs}", name=repr(name),
+                             inputs=", ".join(bits)))
         if on not in (True, False, None):
-            raise Refused('"on" must be true, false or null')
+            raise Refused(N_('"on" must be true, false or null'))
         run.hold(bits[name], on)
 
     def status(self) -> dict[str, Any]:
@@ -209,9 +215,9 @@ def studio_diagram(table: Table) -> str:
     try:
         return draw(graph.source, "svg").decode("utf-8")
     except NoGraphviz:
-        return f"No diagram: {NOT_FOUND}. To draw it: {INSTALL}; then reopen the table."
+        return N_("No diagram: {why}. To draw it: {how}; then reopen the table.", why=NOT_FOUND, how=INSTALL)
     except GraphvizFailed as exc:
-        return f"No diagram: {exc}"
+        return N_("No diagram: {why}", why=str(exc))
 
 
 def viewed(tables: RobotTables, name: str, extra: dict[str, Any], tick: int) -> dict[str, Any]:

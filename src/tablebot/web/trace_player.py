@@ -7,6 +7,7 @@ import asyncio
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 
+from tablebot.i18n import N_
 from tablebot.web.analyse import Analysis
 from tablebot.web.arena_robot import ArenaRobot
 from tablebot.web.errors import Refused
@@ -33,10 +34,10 @@ class TracePlayer:
         """A property's counterexample: replayed on the table (trace player) or scripted into the arena."""
         analysis = self.analysis()
         if analysis is None or analysis.report is None:
-            raise Refused("fix the table's errors first")
+            raise Refused(N_("fix the table's errors first"))
         result = next((r for r in analysis.report.results if r.prop.name == op.name), None)
         if result is None or not result.inputs:
-            raise Refused(f"property {op.name!r} has no counterexample")
+            raise Refused(N_("property {name} has no counterexample", name=repr(op.name)))
         if op.where == "arena":
             await self.robot.script([t.mask for t in result.inputs])
             return

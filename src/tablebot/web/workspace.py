@@ -24,7 +24,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
+from tablebot.i18n import N_
 from tablebot.web.errors import Refused
+from tablebot.web.refusals import OTHER_TAB, not_regular
+from tablebot.web.refusals import changed as _changed
+from tablebot.web.refusals import refusal as _refusal
 from tablebot.web.temporaries import sweep, temp_name
 
 try:  # POSIX; without it (Windows) this studio's own lock still holds saves one at a time
@@ -48,7 +52,6 @@ Folder = int | str  # an open folder's descriptor, or (without AT_FOLDER) its pa
 READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | getattr(os, "O_NOCTTY", 0) | CLOEXEC
 DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | NOFOLLOW | CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
-OTHER_TAB = "saved in another tab"  # how a file changed, when the version there is one this studio wrote
 
 
 class Kind(enum.Enum):
@@ -92,7 +95,7 @@ class ChangedOnDisk(Exception):
     disk now (:data:`GONE` if none), which a forced save must name."""
 
     def __init__(self, name: str, how: str, theirs: str) -> None:
-        super().__init__(f"{name} was {how if how == OTHER_TAB else how + ' on disk'} since you opened it")
+        super().__init__(_changed(name, how))
         self.name, self.how, self.theirs = name, how, theirs
 
 
@@ -113,18 +116,18 @@ class Workspace:
         """The file ``name`` (relative to the folder) really is, as a relative name, if the page may open
         it: inside the folder, of ``kind``, no part starting with a dot (before and after links)."""
         if not isinstance(name, str) or not name or "\x00" in name or len(name) > 1000:
-            raise Refused("no file name given")
+            raise Refused(N_("no file name given"))
         given = PurePosixPath(name)
         shown = _shown(name)
         if given.is_absolute() or ".." in given.parts:
-            raise Refused(f"{shown} is outside the served folder")
+            raise Refused(N_("{shown} is outside the served folder", shown=shown))
         _check_name(given, kind, shown)
         try:
             real = (self.root / given).resolve()
         except (OSError, RuntimeError):  # a loop of links
-            raise Refused(f"{shown} cannot be opened: its links go round in a circle") from None
+            raise Refused(N_("{shown} cannot be opened: its links go round in a circle", shown=shown)) from None
         if not real.is_relative_to(self.root):
-            raise Refused(f"{shown} is outside the served folder (a link leads out of it)")
+            raise Refused(N_("{shown} is outside the served folder (a link leads out of it)", shown=shown))
         inside = PurePosixPath(real.relative_to(self.root).as_posix())
         _check_name(inside, kind, shown)
         return inside.as_posix()
@@ -137,10 +140,11 @@ class Workspace:
         real = self.locate(name, kind)
         with self._file(real) as (fd, info):
             if info.st_size > limit:
-                raise Refused(f"{real} has {info.st_size:,} bytes; the studio opens such files up to {limit:,}")
+                raise Refused(N_("{real} has {size:,} bytes; the studio opens such files up to {limit:,}", real=real,
+                                 size=info.st_size, limit=limit))
             data = _read_all(fd, limit)
         if kind is Kind.TABLE and not _looks_like_table(data[:HEAD_BYTES]):
-            raise Refused(f"{real} is not a table: its first line names no state and next column")
+            raise Refused(N_("{real} is not a table: its first line names no state and next column", real=real))
         return Opened(real, (info.st_dev, info.st_ino), data, stat.S_IMODE(info.st_mode))
 
     @contextlib.contextmanager
@@ -155,7 +159,7 @@ class Workspace:
             try:
                 info = os.fstat(fd)
                 if not stat.S_ISREG(info.st_mode):
-                    raise Refused(f"{real} is not a regular file (a folder, pipe or device): the studio skips it")
+                    raise Refused(not_regular(real))
                 yield fd, info
             finally:
                 os.close(fd)
@@ -195,7 +199,7 @@ class Workspace:
         version, unless ``force`` is True or names the version there now. One save of a file at a time:
         the check and the rename are never interleaved with another save's."""
         if self.locate(opened.name, Kind.TABLE) != opened.name:
-            raise Refused(f"{opened.name} now leads to another file: reload it before saving")
+            raise Refused(N_("{name} now leads to another file: reload it before saving", name=opened.name))
         parent, leaf = _split(opened.name)
         with self._folder(parent, opened.name) as folder, _one_save_at_a_time(folder, leaf):
             current, mode, identity = self._current(folder, leaf, opened)
@@ -209,8 +213,8 @@ class Workspace:
                 written = _write_at(folder, leaf, data, mode)
                 self.written[opened.name] = digest(data)  # still one save at a time: the next one sees it
             except OSError as exc:
-                raise Refused(f"{opened.name} was not saved: {exc.strerror or 'the system refused'} "
-                              "(check the folder's permissions and free space)") from None
+                raise Refused(N_("{name} was not saved: {why} (check the folder's permissions and free space)",
+                                 name=opened.name, why=exc.strerror or N_("the system refused"))) from None
         return Saved(Opened(opened.name, written, data, mode), None if current is None else theirs)
 
     def _current(self, folder: Folder, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
@@ -224,8 +228,8 @@ class Workspace:
         try:
             info = os.fstat(fd)
             if not stat.S_ISREG(info.st_mode):
-                raise Refused(f"{opened.name} is no longer a regular file (a folder, pipe or device took its "
-                              "place): nothing was written")
+                raise Refused(N_("{name} is no longer a regular file (a folder, pipe or device took its place): "
+                                 "nothing was written", name=opened.name))
             return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
         finally:
             os.close(fd)
@@ -275,10 +279,12 @@ def _shown(name: str) -> str:
 
 def _check_name(path: PurePosixPath, kind: Kind, shown: str) -> None:
     if any(part.startswith(".") for part in path.parts):
-        raise Refused(f"{shown}: the studio does not open hidden files or folders (names starting with a dot)")
+        raise Refused(N_("{shown}: the studio does not open hidden files or folders (names starting with a dot)",
+                         shown=shown))
     if path.suffix.lower() not in kind.value:
-        what = "a table" if kind is Kind.TABLE else "a trace"
-        raise Refused(f"{shown} is not {what}: the studio opens {' and '.join(kind.value)} files here")
+        raise Refused(N_("{shown} is not a table: the studio opens .csv and .tsv files here", shown=shown)
+                      if kind is Kind.TABLE else N_("{shown} is not a trace: the studio opens .jsonl files here",
+                                                    shown=shown))
 
 
 def _open_at(folder: Folder, leaf: str, flags: int, mode: int = 0o777) -> int:
@@ -301,20 +307,6 @@ def _split(real: str) -> tuple[tuple[str, ...], str]:
     return parts[:-1], parts[-1]
 
 
-def _refusal(exc: OSError, name: str) -> Refused:
-    """An OS error on the way to ``name``, in the studio's words."""
-    if exc.errno in (errno.ELOOP, errno.ENOTDIR, errno.EMLINK):
-        return Refused(f"{name} changed while the studio was opening it (a link appeared on its way): "
-                       "nothing was read or written; try again")
-    if exc.errno == errno.ENXIO:  # a socket
-        return Refused(f"{name} is not a regular file (a folder, pipe or device): the studio skips it")
-    if exc.errno == errno.ENOENT:
-        return Refused(f"there is no file {name} in the folder (moved or deleted?)")
-    if exc.errno in (errno.EACCES, errno.EPERM):
-        return Refused(f"{name} may not be read: check its permissions")
-    return Refused(f"{name} cannot be opened: {exc.strerror or 'the system refused'}")
-
-
 def _read_all(fd: int, limit: int) -> bytes:
     chunks: list[bytes] = []
     size = 0
@@ -325,7 +317,7 @@ def _read_all(fd: int, limit: int) -> bytes:
         chunks.append(chunk)
         size += len(chunk)
     if size > limit:
-        raise Refused(f"the file grew past {limit:,} bytes while the studio read it")
+        raise Refused(N_("the file grew past {limit:,} bytes while the studio read it", limit=limit))
     return b"".join(chunks)
 
 
