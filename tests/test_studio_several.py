@@ -178,3 +178,22 @@ def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio:
     assert page.get_attribute("#arena", "data-lamps") == f"L1={trace['L1'][tick]} L2={trace['L2'][tick]}"
     assert page.errors == []
     page.context.close()
+
+
+def test_a_german_walk_through_the_tabs(browser: Any, studio: Background, shots: Path) -> None:
+    """A German browser: the tabs' tips, why each row of the drive table fired or not (said by the server in the
+    tab's language), and the lights tab's status line speak German."""
+    page = open_page(browser, studio.url, 1280, 720, "de-DE")
+    assert page.inner_text("#save") == "Speichern"
+    page.click("#step")
+    wait_for(lambda: page.eval_on_selector_all("#why li", "ls => ls.map(l => l.textContent)"), "the why list", 30)
+    why = page.eval_on_selector_all("#why li", "ls => ls.map(l => l.textContent)")
+    assert why and all(line.startswith(("Zeile ", "keine Zeile")) for line in why), why
+    assert any("hat geschaltet" in line for line in why), why
+    show(page, "lights", "drive=1,2")
+    page.click("#step")
+    wait_for(lambda: "Zustand flash_" in page.inner_text("#status"), "the lights table's state, in German", 30)
+    assert page.get_attribute("#table-tabs button[data-table=drive]", "title") == "Tabelle drive (table.csv)"
+    page.screenshot(path=str(shots / "german-walk.png"))
+    assert page.errors == []
+    page.context.close()
