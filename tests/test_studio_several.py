@@ -18,6 +18,8 @@ import pytest
 import tablebot
 from core_helpers import ROOT
 from studio_helpers import chromium, screenshots, served, studio_works, wait_for
+from tablebot.formats.csv_document import CsvDocument
+from tablebot.web.analyse import analyse, robot_for
 from tablebot.web.app import Background
 
 LIGHTS = ROOT / "examples" / "bumberbot-lights"
@@ -197,3 +199,18 @@ def test_a_german_walk_through_the_tabs(browser: Any, studio: Background, shots:
     page.screenshot(path=str(shots / "german-walk.png"))
     assert page.errors == []
     page.context.close()
+
+
+@pytest.mark.parametrize(("old", "new", "column", "words"), [
+    ("drive=20..29", "drive=99", 5, "drive=99: table drive has no state 99"),
+    (",L1,", ",M1_speed,", 6, "M1 is written by two tables, drive ("),
+])
+def test_an_error_across_the_tables_is_marked_on_its_cell_in_its_tab(folder: Path, old: str, new: str, column: int,
+                                                                      words: str) -> None:
+    """An error only the tables together show (a cross-table column naming a state its table lacks, a second writer
+    of an output) is on its header cell in the tab of the table it is in, named by its file as the page names it."""
+    path = folder / "lights.csv"
+    doc = CsvDocument.from_text(path.read_text(encoding="utf-8").replace(old, new, 1))
+    found = analyse(doc, path, robot_for(path), "lights.csv").data["diagnostics"]
+    assert [(d["file"], d["row"], d["col"]) for d in found] == [("lights.csv", -1, column)], found
+    assert found[0]["message"].startswith(words)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 from tablebot.analysis.check import CheckReport
@@ -81,7 +81,8 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
             Loaded(tables.table, tables.machines[0], property_files=tuple(property_files(path)), tables=tables)
         report = loaded.check_report()  # its properties found and proved as check does
     except TableBotError as exc:
-        diagnostics = [_locate(d, display, places, lines, header_line) for d in exc.diagnostics]
+        diagnostics = [_locate(_as_shown(d, path, display), display, places, lines, header_line)
+                       for d in exc.diagnostics]
     data: dict[str, Any] = {
         "ok": table is not None and not diagnostics,
         "diagnostics": diagnostics,
@@ -163,6 +164,18 @@ def _row_lines(doc: CsvDocument) -> list[int]:
 def _header_line(doc: CsvDocument) -> int | None:
     starts = doc.record_lines()
     return next((starts[i] for i, r in enumerate(doc.records) if r.kind == "header"), None)
+
+
+def _as_shown(d: Diagnostic, path: Path, display: str) -> Diagnostic:
+    """A diagnostic about a file of the robot named as the page names files (relative to the folder): the robot's
+    tables checked together name theirs by their real paths (this table's too), the parser by ``display``."""
+    if d.path == str(path):
+        return replace(d, path=display)
+    try:
+        inside = Path(d.path).relative_to(path.parent)
+    except ValueError:  # not beside this table: named as it is
+        return d
+    return replace(d, path=(PurePosixPath(display).parent / inside.as_posix()).as_posix())
 
 
 def _locate(d: Diagnostic, display: str, places: dict[tuple[int, int], tuple[int, int]],
