@@ -1,6 +1,6 @@
 """Code written once, in modules of one concern (issue 35): the places a review found repeating each other share no
 run of six lines, and the modules it found too long stay under 400 lines.
-A run is six lines alike once indentation and blank lines are set aside; the firmware's C mains share theirs
+A run is six lines alike once indentation, blank lines and imports are set aside; the firmware's C mains share theirs
 through tb_tick_frames.h, the Python helpers through the one module each was moved to."""
 
 from __future__ import annotations
@@ -14,8 +14,9 @@ RUN = 6
 
 
 def runs(path: Path) -> set[tuple[str, ...]]:
-    """Every run of RUN consecutive non-blank lines of a file, stripped."""
-    lines = [line.strip() for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+    """Every run of RUN consecutive lines of a file, stripped, blank lines and imports set aside."""
+    lines = [line.strip() for line in path.read_text(encoding="utf-8").splitlines()
+             if line.strip() and not line.startswith(("from ", "import ", "#include"))]
     return {tuple(lines[i:i + RUN]) for i in range(len(lines) - RUN + 1)}
 
 

@@ -5,13 +5,15 @@ and a table's signals on a controller (:class:`Wiring`)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 from tablebot.i18n import N_
 from tablebot.sensors import threshold_event
 from tablebot.table import MAX_SPEED
+
+T = TypeVar("T")
 
 __all__ = ["DIGITAL", "Analog", "Digital", "InputWire", "OutputWire", "Section", "Terminals", "Wiring", "input_event",
            "level_duty"]
@@ -159,3 +161,27 @@ class Wiring:
         """Each output's signed level by terminal: a motor's speed -8..8 (``reverse`` applied), a lamp's 0..8."""
         return {out.terminal: -value if out.reverse else value
                 for out, value in zip(self.outputs, outputs, strict=True)}
+
+    def motor_pairs(self, pairs: int) -> tuple[bool, ...]:
+        """Per output pair (O1 and O2, O3 and O4, ...) whether it drives a motor: every pair without a lamp."""
+        lamp_pairs = {(int(o.terminal[1:]) - 1) // 2 for o in self.outputs if o.kind == "lamp"}
+        return tuple(i not in lamp_pairs for i in range(pairs))
+
+    def input_modes(self, terminals: Sequence[str], modes: Mapping[str, T], unused: T) -> list[T]:
+        """Each input terminal's setting, in ``terminals``' order: its wired input's mode's, else ``unused``."""
+        found = [unused] * len(terminals)
+        for inp in self.inputs:
+            found[terminals.index(inp.terminal)] = modes[inp.mode]
+        return found
+
+    def output_values(self, outputs: Sequence[int], count: int, value: Callable[[int], int]) -> list[int]:
+        """O1..O``count`` for the engine's outputs: a lamp's ``value(level)`` on its output, motor Mn's
+        ``value(speed)`` on O(2n-1) forward or O(2n) backward (the other output 0)."""
+        found = [0] * count
+        for terminal, level in self.levels(outputs).items():
+            index = int(terminal[1:]) - 1
+            if terminal[0] == "O":
+                found[index] = value(level)
+            elif level:
+                found[2 * index + (level < 0)] = value(abs(level))
+        return found

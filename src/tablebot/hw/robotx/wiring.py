@@ -50,22 +50,12 @@ class RobotxWiring:
     def config(self) -> wire.Config:
         """TA_CONFIG: pairs with a lamp are single outputs, every other pair a motor; unused inputs stay
         digital 5 kOhm (as fttxpy configures them); counters in mode 1."""
-        lamp_pairs = {(int(o.terminal[1:]) - 1) // 2 for o in self.wired.outputs if o.kind == "lamp"}
-        inputs = [(wire.InputMode.RESISTANCE, True)] * wire.N_INPUTS
-        for inp in self.wired.inputs:
-            inputs[INPUTS.index(inp.terminal)] = MODES[inp.mode]
-        return wire.Config(motors=tuple(i not in lamp_pairs for i in range(wire.N_MOTORS)), inputs=tuple(inputs))
+        inputs = self.wired.input_modes(INPUTS, MODES, (wire.InputMode.RESISTANCE, True))
+        return wire.Config(motors=self.wired.motor_pairs(wire.N_MOTORS), inputs=tuple(inputs))
 
     def duty(self, outputs: Sequence[int]) -> list[int]:
         """O1..O8 duty for the engine's outputs: motor Mn forward on O(2n-1), backward on O(2n)."""
-        duty = [0] * wire.N_OUTPUTS
-        for terminal, level in self.wired.levels(outputs).items():
-            index = int(terminal[1:]) - 1
-            if terminal[0] == "O":
-                duty[index] = wiring.level_duty(level, wire.MAX_DUTY)
-            elif level:
-                duty[2 * index + (level < 0)] = wiring.level_duty(abs(level), wire.MAX_DUTY)
-        return duty
+        return self.wired.output_values(outputs, wire.N_OUTPUTS, lambda level: wiring.level_duty(level, wire.MAX_DUTY))
 
     def values(self, inputs: wire.Inputs) -> dict[str, int]:
         return dict(zip(INPUTS, inputs.universal, strict=True))

@@ -80,22 +80,12 @@ class TxtWiring:
     def config(self) -> wire.Config:
         """UpdateConfig: pairs with a lamp are single outputs, every other pair a motor; unused inputs keep
         the controller's default (digital 5 kOhm)."""
-        lamp_pairs = {(int(o.terminal[1:]) - 1) // 2 for o in self.wired.outputs if o.kind == "lamp"}
-        inputs = [wire.InputConfig()] * wire.N_INPUTS
-        for inp in self.wired.inputs:
-            inputs[INPUTS.index(inp.terminal)] = MODES[inp.mode]
-        return wire.Config(motors=tuple(i not in lamp_pairs for i in range(wire.N_MOTORS)), inputs=tuple(inputs))
+        inputs = self.wired.input_modes(INPUTS, MODES, wire.InputConfig())
+        return wire.Config(motors=self.wired.motor_pairs(wire.N_MOTORS), inputs=tuple(inputs))
 
     def pwm(self, outputs: Sequence[int]) -> list[int]:
         """O1..O8 PWM for the engine's outputs: motor Mn forward on O(2n-1), backward on O(2n)."""
-        pwm = [0] * wire.N_OUTPUTS
-        for terminal, level in self.wired.levels(outputs).items():
-            index = int(terminal[1:]) - 1
-            if terminal[0] == "O":
-                pwm[index] = level_pwm(level)
-            elif level:
-                pwm[2 * index + (level < 0)] = level_pwm(abs(level))
-        return pwm
+        return self.wired.output_values(outputs, wire.N_OUTPUTS, level_pwm)
 
     def values(self, universal: Sequence[int]) -> dict[str, int]:
         """One reply's I1..I8 by terminal, a track sensor's as its 0/1 (:func:`trail_light`)."""
