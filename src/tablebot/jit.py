@@ -72,23 +72,30 @@ os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 
 def _import_numba() -> ModuleType:
-    """numba, imported without importing scipy.
+    """numba, imported without importing scipy, coverage or yaml, which it imports for what tablebot never uses.
 
     numba's ``__init__`` imports scipy only to check that it is not older than 1.0 (skipped when scipy is
-    absent), and that import is a tenth of numba's own; nothing tablebot compiles uses scipy. scipy stays
-    importable as ever: whoever needs it (evolve's archive) imports it as usual, and a compile that uses
-    BLAS has numba import it then.
+    absent), and that import is a tenth of numba's own; nothing tablebot compiles uses scipy. It imports coverage
+    (where installed: ~0.1 s, with sqlite3 and multiprocessing) to tell a coverage run which lines it compiled,
+    and no run is measuring this process when coverage is not imported yet (a run imports it before the code it
+    measures); and yaml, to read a ``.numba_config.yaml`` in the working folder, held off only when there is
+    none. Each stays importable as ever: whoever needs it imports it as usual (evolve's archive, scipy), and a
+    compile that uses BLAS has numba import scipy then.
     """
-    if "numba" in sys.modules or "scipy" in sys.modules:
+    if "numba" in sys.modules:
         import numba
 
         return numba
-    sys.modules["scipy"] = None  # type: ignore[assignment]  # `import scipy` raises ImportError meanwhile
+    held = [name for name in ("scipy", "coverage", "yaml") if name not in sys.modules
+            and not (name == "yaml" and os.path.isfile(".numba_config.yaml"))]
+    for name in held:
+        sys.modules[name] = None  # type: ignore[assignment]  # `import NAME` raises ImportError meanwhile
     try:
         import numba
     finally:
-        if "scipy" in sys.modules and sys.modules["scipy"] is None:
-            del sys.modules["scipy"]
+        for name in held:
+            if name in sys.modules and sys.modules[name] is None:
+                del sys.modules[name]
     return numba
 
 

@@ -1,0 +1,49 @@
+"""numba comes without the packages it imports for what tablebot never uses (tablebot.jit): coverage where no
+coverage run measures the process, yaml where no .numba_config.yaml is there to read, scipy; each still imports,
+a coverage run still gets numba's coverage, and a .numba_config.yaml is still read."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from tablebot.testing.processes import child_env
+
+ROOT = Path(__file__).resolve().parents[1]
+HELD = ("scipy", "coverage", "yaml")
+
+
+def fresh(code: str, cwd: Path = ROOT) -> list[str]:
+    done = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=child_env(), capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+def test_numba_imports_none_of_them_and_each_still_imports() -> None:
+    lines = fresh(f"""
+import sys
+import tablebot.jit
+print(sorted(m for m in {HELD!r} if m in sys.modules))
+import scipy, coverage, yaml
+print(scipy.__name__, coverage.__name__, yaml.__name__)
+""")
+    assert lines == ["[]", "scipy coverage yaml"]
+
+
+def test_a_coverage_run_imported_first_still_gets_numba_s_coverage_support() -> None:
+    lines = fresh("""
+import coverage
+import tablebot.jit
+from numba.misc import coverage_support
+print(coverage_support.coverage_available)
+""")
+    assert lines == ["True"]
+
+
+def test_a_numba_config_file_in_the_working_folder_is_still_read(tmp_path: Path) -> None:
+    (tmp_path / ".numba_config.yaml").write_text("boundscheck: 1\n", encoding="utf-8")
+    lines = fresh("import sys, tablebot.jit, numba; print('yaml' in sys.modules, numba.config.BOUNDSCHECK)",
+                  cwd=tmp_path)
+    assert lines == ["True 1"]
