@@ -124,3 +124,17 @@ def test_wires_do_not_cross_and_everything_sits_on_the_grid(lights: RobotTables,
                        if a[0] != b[0] and crossing(a, b)]
             assert crossed == [], f"{name}: wires cross"
             assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
+
+
+def test_a_row_of_another_table_that_does_not_fit_is_named_once_where_it_is_written(tmp_path: Path) -> None:
+    """The lights table's third row as written (the table's fifth once its groups are rows) with a timer over
+    ROBO Pro's 16 bits: check names its line and its row as written, once, whichever table check is given."""
+    for name in ("robot.toml", "table.csv", "lights.csv", "properties.toml"):
+        (tmp_path / name).write_text((LIGHTS / name).read_text(encoding="utf-8"), encoding="utf-8")
+    lights = (tmp_path / "lights.csv").read_text(encoding="utf-8")
+    (tmp_path / "lights.csv").write_text(lights.replace("flash_left,1,,,,0,8,50,", "flash_left,1,,,,0,8,40000,"),
+                                         encoding="utf-8")
+    for given in (tmp_path, tmp_path / "lights.csv"):
+        said = " ".join(invoke("check", given, "--target", "robopro-program").output.split())
+        assert said.count("error:") == 1, said
+        assert f"{tmp_path / 'lights.csv'}:4: error: table lights: robopro-program: row 2: timer 40000 is over" in said

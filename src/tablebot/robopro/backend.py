@@ -98,8 +98,11 @@ def program_fit(machine: Machine) -> list[Diagnostic]:
     tables = several(machine.table)
     if tables is None:
         return problems(machine.table)
-    # the main table's answer covers every table (each problem once, located in its own file)
-    return several_problems(tables) if machine.table.name == tables.names[0] else []
+    # each table's own rows; the robot file's problems once, with the main table
+    found = several_problems(tables)
+    files = {table.path for table in tables.tables}
+    main = machine.table.name == tables.names[0]
+    return [d for d in found if d.path == machine.table.path or (main and d.path not in files)]
 
 
 def export_program(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:

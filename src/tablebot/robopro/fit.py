@@ -148,7 +148,7 @@ class Plan:
                                                 strict=True):
             loads = "".join(f", {n} load {self.loads[n][row.index]}" for n in self.loads)
             loads += "".join(f", {n} {self.levels[n][row.index]}" for n in self.levels)
-            lines.append(f"row {row.index} (list index {row.index}): {event} / {action} / {timer}{loads}"
+            lines.append(f"row {row.as_written} (list index {row.index}): {event} / {action} / {timer}{loads}"
                          f"  {row.description}")
         return lines
 
@@ -231,18 +231,19 @@ def _row_problems(table: Table, out: Collector) -> None:
     for row in table.rows:
         for what, state, limit in (("state", row.state, max_state), ("next state", row.next, min(MAX_NEXT, max_state))):
             if numbers[state] > limit:
-                out.error(row.line, None, f"row {row.index}: {what} {state!r} is number {numbers[state]}, over "
+                out.error(row.line, None, f"row {row.as_written}: {what} {state!r} is number {numbers[state]}, over "
                           f"{limit}", f"with {shift} event bits the 16-bit lists hold states 0..{limit}")
         if row.timer > MAX_VALUE:
-            out.error(row.line, None, f"row {row.index}: timer {row.timer} is over {MAX_VALUE}",
+            out.error(row.line, None, f"row {row.as_written}: timer {row.timer} is over {MAX_VALUE}",
                       "ROBO Pro integers are 16-bit signed")
         for motor, speed in zip(table.robot.motors, row.motors, strict=True):
             if speed is not None and abs(speed) >= DOC_KEEP_SPEED:
-                out.error(row.line, None, f"row {row.index}: {motor} speed {abs(speed)} does not fit the action word",
+                out.error(row.line, None,
+                          f"row {row.as_written}: {motor} speed {abs(speed)} does not fit the action word",
                           "the document's speeds are 0..6 (7 means keep): use 6 or less")
         for name, load in zip(table.robot.counter_names, row.counters, strict=True):
             if load is not None and load > MAX_VALUE:
-                out.error(row.line, None, f"row {row.index}: {name} load {load} is over {MAX_VALUE}",
+                out.error(row.line, None, f"row {row.as_written}: {name} load {load} is over {MAX_VALUE}",
                           "ROBO Pro integers are 16-bit signed")
     if numbers[table.robot.initial_state] > max_state:
         out.error(1, 1, f"initial state {table.robot.initial_state!r} is number {numbers[table.robot.initial_state]},"
