@@ -30,7 +30,7 @@ SHAPES = [Shape(states=4, rows=14, inputs=7, motors=2, lamps=0, counters=2, max_
           Shape(states=4, rows=12, inputs=8, motors=2, lamps=2, counters=0, max_timer=30, max_speed=6)]
 ALL = {"python step", "engine batch", "simulator", "fleet", "host C", "AVR firmware", "TXT 4.0 program",
        "ROBO Pro program", "ROBO TX", "ROBO Interface"}
-#: What takes only some tables: the ROBO Pro program holds no lamp and speeds 0..6, the ROBO Interface counts
+#: What takes only some tables: the ROBO Pro program holds speeds 0..6 only (lamps too), the ROBO Interface counts
 #: nothing, the AVR firmware has the Uno's pins.
 SOME = {"ROBO Pro program", "ROBO Interface", "AVR firmware"}
 
