@@ -31,6 +31,7 @@ from pathlib import Path
 
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.formats.table_read import load_table
+from tablebot.i18n import N_
 from tablebot.machine import Machine, compile_table
 from tablebot.robot import Robot, StateId
 from tablebot.robot_tables import CrossEvent, TableSpec, tables_of
@@ -140,8 +141,9 @@ def _cross_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
                      if not any(isinstance(s, int) and low <= s <= high for s in known)]
             for what in (*(repr(s) for s in missing), *empty):
                 found.append(Diagnostic(table.path, event.line, event.at,
-                                        f"{event.column}: table {event.table} has no state {what}",
-                                        f"its states: {', '.join(map(str, known))}"))
+                                        N_("{column}: table {table} has no state {state}", column=event.column,
+                                           table=event.table, state=what),
+                                        N_("its states: {states}", states=tuple(map(str, known)))))
     return found
 
 
@@ -156,8 +158,10 @@ def _writer_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
                 at = owner.writes[output]
                 found.append(Diagnostic(
                     table.path, line, column,
-                    f"{output} is written by two tables, {owner.name} ({owner.path}:{at[0]}:{at[1]}) and {table.name}",
-                    f"each motor, lamp and counter load has one writer: remove the {output} column from one table"))
+                    N_("{output} is written by two tables, {first} ({place}) and {second}", output=output,
+                       first=owner.name, place=f"{owner.path}:{at[0]}:{at[1]}", second=table.name),
+                    N_("each motor, lamp and counter load has one writer: remove the {output} column from one table",
+                       output=output)))
     return found
 
 
@@ -166,6 +170,7 @@ def _named_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
     robot = tables[0].robot
     with_rows = {row.state for t in tables for row in t.rows}
     return [Diagnostic(robot.source, robot.line("states", str(state)), 1,
-                       f"state {state!r} is named in {robot.source} but no table has rows for it",
-                       "add rows for it or remove it from [states]")
+                       N_("state {state!r} is named in {file} but no table has rows for it", state=state,
+                          file=robot.source),
+                       N_("add rows for it or remove it from [states]"))
             for state in robot.state_names if state not in with_rows]

@@ -72,7 +72,7 @@ def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, .
             step(N_("property {name}", name=prop.name))
             results.append(check_property(prop, machine))
     except ModelTooLarge as exc:
-        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc),
+        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
                    N_("split the table, or give states fewer inputs to look at")) from None
     return CheckReport(machine, findings, results, len(graph.nodes))
 

@@ -17,6 +17,7 @@ from tablebot.analysis.prove import Result
 from tablebot.analysis.prove_product import check_product_property
 from tablebot.diagnostics import fail
 from tablebot.engine.several import Several
+from tablebot.i18n import N_, Message
 from tablebot.machine import NO_ROW
 from tablebot.tables import RobotTables
 
@@ -31,24 +32,25 @@ def run_check_tables(tables: RobotTables, props: Sequence[Property], targets: tu
 
     main = tables.machines[0]
     try:
-        step("exploring the situations")
+        step(N_("exploring the situations"))
         situations = len(ProductModel(tables).explore().nodes)
-        step("looking for findings")
+        step(N_("looking for findings"))
         findings = []
         for k, machine in enumerate(tables.machines):
             found = find_all(machine, Model(machine).explore(), targets)
             if k:  # the main table's findings read as a one-table robot's; the others' name their table
                 table = machine.table
-                found = [replace(f, message=f"table {table.name}: {f.message}", table=table.name, path=table.path)
+                found = [replace(f, message=N_("table {name}: {message}", name=table.name, message=f.message),
+                                 table=table.name, path=table.path)
                          for f in found]
             findings += found
         results = []
         for prop in props:
-            step(f"property {prop.name}")
+            step(N_("property {name}", name=prop.name))
             results.append(check_product_property(prop, tables))
     except ModelTooLarge as exc:
-        raise fail(main.table.path, f"too large to explore: {exc}",
-                   "split the tables, or give their states fewer inputs to look at") from None
+        raise fail(main.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
+                   N_("split the tables, or give their states fewer inputs to look at")) from None
     return CheckReport(main, findings, results, situations, tables=tables)
 
 
@@ -67,15 +69,23 @@ def story_of_tables(tables: RobotTables, result: Result, limit: int = 12) -> lis
             quiet_from = n if quiet_from is None else quiet_from
             continue
         if quiet_from is not None:
-            span = f"tick {quiet_from}" if quiet_from == n - 1 else f"ticks {quiet_from}-{n - 1}"
-            items.append(f"{span}: nothing pressed, nothing fires (timers count down)")
+            items.append(_quiet(quiet_from, n - 1))
             quiet_from = None
-        what = " + ".join(pressed) or "nothing pressed"
-        lines = ", ".join(f"{name} line {e.machine.table.rows[e.row].line}" for name, e in fired) or "no row fires"
+        what = " + ".join(pressed) or N_("nothing pressed")
+        lines = tuple(N_("{table} line {line}", table=name, line=e.machine.table.rows[e.row].line)
+                      for name, e in fired) or N_("no row fires")
         states = " ".join(f"{name} {e.machine.states[e.state]}" for name, e in zip(tables.names, robot.engines,
                                                                                   strict=True))
         outputs = " ".join(f"{name} {value}" for name, value in zip(tables.output_names, robot.outputs, strict=True))
-        items.append(f"tick {n}: {what} -> {lines}: {states}, {outputs}" + ("   <- it shows here" if last else ""))
+        step = N_("tick {tick}: {what} -> {lines}: {states}, {outputs}", tick=n, what=what, lines=lines,
+                  states=states, outputs=outputs)
+        items.append(N_("{step}   <- it shows here", step=step) if last else step)
     if len(items) > limit:
-        items = [items[0], f"... ({len(items) - limit + 1} more steps) ...", *items[-(limit - 2):]]
+        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2):]]
     return items
+
+
+def _quiet(first: int, last: int) -> Message:
+    if first == last:
+        return N_("tick {first}: nothing pressed, nothing fires (timers count down)", first=first)
+    return N_("ticks {first}-{last}: nothing pressed, nothing fires (timers count down)", first=first, last=last)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tablebot.durations import MAX_NUMBER_CHARS
+from tablebot.i18n import N_, Message
 from tablebot.machine import Machine
 from tablebot.table import TIMER_EVENT
 from tablebot.tables import RobotTables
@@ -38,7 +39,12 @@ MAX_DEPTH = 50
 
 
 class ConditionError(ValueError):
-    """A condition that does not parse or names something the table does not have."""
+    """A condition that does not parse or names something the table does not have; its argument is a
+    :class:`~tablebot.i18n.Message`, said in the reader's language where it is shown (:attr:`problem`)."""
+
+    def __init__(self, problem: Message) -> None:
+        super().__init__(problem)
+        self.problem = problem
 
 
 @dataclass(frozen=True)
@@ -61,7 +67,7 @@ def parse_condition(text: str, machine: Machine, tables: RobotTables | None = No
     parser = _Parser(_tokens(text), machine, tables)
     test = parser.expression()
     if parser.peek() is not None:
-        raise ConditionError(f"unexpected {parser.peek()!r} in {text!r}")
+        raise ConditionError(N_("unexpected {token!r} in {text!r}", token=parser.peek(), text=text))
     return Condition(text, test, parser.input_bits, frozenset(parser.reads))
 
 
@@ -71,14 +77,14 @@ def _tokens(text: str) -> list[str]:
     while pos < len(text):
         match = TOKEN_RE.match(text, pos)
         if not match or match.end() == pos:
-            raise ConditionError(f"cannot read {text[pos:]!r} in condition {text!r}")
+            raise ConditionError(N_("cannot read {rest!r} in condition {text!r}", rest=text[pos:], text=text))
         if match["num"] and len(match["num"]) > MAX_NUMBER_CHARS:  # int() of it may fail; none is that large
-            raise ConditionError(f"a number of {len(match['num']):,} characters in condition: no state, line or "
-                                 f"output value has more than {MAX_NUMBER_CHARS}")
+            raise ConditionError(N_("a number of {count:,} characters in condition: no state, line or output value "
+                                    "has more than {most}", count=len(match["num"]), most=MAX_NUMBER_CHARS))
         tokens.append(match.group().strip())
         pos = match.end()
     if not tokens:
-        raise ConditionError("the condition is empty")
+        raise ConditionError(N_("the condition is empty"))
     return tokens
 
 
@@ -96,23 +102,23 @@ class _Parser:
         """One more level of parentheses or ``not``: refused past MAX_DEPTH."""
         self.depth += 1
         if self.depth > MAX_DEPTH:
-            raise ConditionError(f"the condition nests parentheses or 'not' more than {MAX_DEPTH} deep")
+            raise ConditionError(N_("the condition nests parentheses or 'not' more than {most} deep", most=MAX_DEPTH))
 
     def peek(self) -> str | None:
         return self.tokens[self.pos] if self.pos < len(self.tokens) else None
 
-    def take(self, what: str = "more") -> str:
+    def take(self, what: str = N_("more")) -> str:
         """The next token, whatever it is; ``what`` says what was wanted if there is none."""
         token = self.peek()
         if token is None:
-            raise ConditionError(f"the condition ends too early (expected {what})")
+            raise ConditionError(N_("the condition ends too early (expected {what})", what=what))
         self.pos += 1
         return token
 
     def expect(self, token: str) -> None:
         found = self.take(repr(token))
         if found != token:
-            raise ConditionError(f"expected {token!r} but found {found!r}")
+            raise ConditionError(N_("expected {token!r} but found {found!r}", token=token, found=found))
 
     def expression(self) -> Predicate:
         terms = [self.conjunction()]
@@ -138,7 +144,7 @@ class _Parser:
         return self.atom()
 
     def atom(self) -> Predicate:
-        token = self.take("a condition")
+        token = self.take(N_("a condition"))
         if token == "(":
             self.deeper()
             inner = self.expression()
@@ -168,20 +174,20 @@ class _Parser:
         if self.peek() == "in":
             self.take()
             self.expect("[")
-            items = [self.take("a value")]
+            items = [self.take(N_("a value"))]
             while self.peek() == ",":
                 self.take()
-                items.append(self.take("a value"))
+                items.append(self.take(N_("a value")))
             self.expect("]")
             return items
-        return [self.take("a value")]
+        return [self.take(N_("a value"))]
 
     def state_test(self, table: int = 0) -> Predicate:
         """``state`` (the main table's) or ``NAME`` (table ``table`` of several) ``==``, ``!=`` or ``in``."""
         word = "state" if self.tables is None or self.tokens[self.pos - 1] == "state" else self.tokens[self.pos - 1]
-        op = self.take("== or != or in")
+        op = self.take(N_("== or != or in"))
         if op not in ("==", "!=", "in"):
-            raise ConditionError(f"{word} can be compared with ==, != or in, not {op!r}")
+            raise ConditionError(N_("{word} can be compared with ==, != or in, not {op!r}", word=word, op=op))
         if op == "in":
             self.pos -= 1
         indices = frozenset(self.state_index(v, table) for v in self.values())
@@ -198,20 +204,23 @@ class _Parser:
         for index, state in enumerate(states):
             if str(state) == text:
                 return index
-        which = "the table" if self.tables is None else f"table {self.tables.names[table]}"
-        raise ConditionError(f"there is no state {text} in {which} (states: {', '.join(map(str, states))})")
+        if self.tables is None:
+            raise ConditionError(N_("there is no state {state} in the table (states: {states})", state=text,
+                                    states=tuple(map(str, states))))
+        raise ConditionError(N_("there is no state {state} in table {table} (states: {states})", state=text,
+                                table=self.tables.names[table], states=tuple(map(str, states))))
 
     def line_test(self) -> Predicate:
-        op = self.take("== or in")
+        op = self.take(N_("== or in"))
         if op not in ("==", "in"):
-            raise ConditionError(f"line can be compared with == or in, not {op!r}")
+            raise ConditionError(N_("line can be compared with == or in, not {op!r}", op=op))
         if op == "in":
             self.pos -= 1
         by_line = {row.line: row.index for row in self.machine.table.rows}
         rows = set()
         for value in self.values():
             if not value.isdigit() or int(value) not in by_line:
-                raise ConditionError(f"no row of the table is on line {value}")
+                raise ConditionError(N_("no row of the table is on line {line}", line=value))
             rows.add(by_line[int(value)])
         frozen = frozenset(rows)
         return lambda e, r, s, o: r in frozen
@@ -221,23 +230,24 @@ class _Parser:
         if name == TIMER_EVENT or name in self.input_names() or name in machine.table.robot.counter_names:
             bit = self.event_bit(name)
             if self.peek() in COMPARE:
-                raise ConditionError(f"{name} is an event: write just {name} (or not {name})")
+                raise ConditionError(N_("{name} is an event: write just {name} (or not {name})", name=name))
             return lambda e, r, s, o: e & bit != 0
         if name in machine.output_names:
             index = machine.output_names.index(name)
             if self.tables is not None and (writer := self.tables.writer(name)) is not None:
                 self.reads.add(writer)
-            op = self.take("a comparison such as < 0")
+            op = self.take(N_("a comparison such as < 0"))
             if op not in COMPARE:
-                raise ConditionError(f"compare {name} with a number, like {name} < 0 or {name} == 0")
-            value = self.take("a number")
+                raise ConditionError(N_("compare {name} with a number, like {name} < 0 or {name} == 0", name=name))
+            value = self.take(N_("a number"))
             if not re.fullmatch(r"-?\d+", value):
-                raise ConditionError(f"{name} {op} needs a number, not {value!r}")
+                raise ConditionError(N_("{name} {op} needs a number, not {value!r}", name=name, op=op, value=value))
             compare, number = COMPARE[op], int(value)
             return lambda e, r, s, o: compare(o[index], number)
         known = [TIMER_EVENT, *self.input_names(), *machine.table.robot.counter_names, *machine.output_names,
                  *(self.tables.names if self.tables else ())]
-        raise ConditionError(f"unknown name {name!r}; use state, line, fired or one of {', '.join(known)}")
+        raise ConditionError(N_("unknown name {name!r}; use state, line, fired or one of {known}", name=name,
+                                known=tuple(map(str, known))))
 
     def input_names(self) -> list[str]:
         return list((self.tables or self.machine).input_bits)
@@ -253,7 +263,8 @@ class _Parser:
             return machine.input_bits[name]
         bit = machine.counter_bits[machine.table.robot.counter_names.index(name)]
         if not bit:
-            raise ConditionError(f"counter {name} has no event column in the table, so it is never an event")
+            raise ConditionError(N_("counter {name} has no event column in the table, so it is never an event",
+                                    name=name))
         return bit
 
 
@@ -267,7 +278,7 @@ class _Parser:
         if name == TIMER_EVENT:
             self.reads.add(0)
             if not self.machine.timer_bit:
-                raise ConditionError(f"the main table ({self.tables.names[0]}) has no T column")
+                raise ConditionError(N_("the main table ({name}) has no T column", name=self.tables.names[0]))
             return 1 << len(bits)
         if (writer := self.tables.writer(name)) is not None:
             self.reads.add(writer)

@@ -13,12 +13,21 @@ from tablebot.analysis.graphviz_run import INSTALL, GraphvizFailed, NoGraphviz, 
 from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
+from tablebot.i18n import N_, _, localise
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
 FORMATS = ("svg", "png", "dot", "mermaid")
 PNG_DPI = 150  # Graphviz's default 72 dpi draws 9-point labels a few pixels high
 COLOURS = {"forward": "#2e7d32", "reverse": "#c62828", "turn": "#1565c0", "stop": "#222222", "keep": "#888888"}
+#: The legend's word for each colour (the keys above are class names, never shown).
+MOTIONS = {"forward": N_("forward"), "reverse": N_("reverse"), "turn": N_("turn"), "stop": N_("stop"),
+           "keep": N_("keep")}
+
+
+def motion_legend() -> list[str]:
+    """The legend's cells for the edge colours, in the reader's language."""
+    return [f'<font color="{c}">■ {dot_label(localise(MOTIONS[m]))}</font>' for m, c in COLOURS.items()]
 
 
 @dataclass(frozen=True)
@@ -63,9 +72,9 @@ def condition(table: Table, event_sets: Sequence[frozenset[str]], otherwise: boo
     earlier rows of its state are tried first."""
     minimal = [s for s in event_sets if not any(o < s for o in event_sets)]
     unique = list(dict.fromkeys(minimal))
-    empty = "otherwise" if otherwise else "always"
+    empty = _("otherwise") if otherwise else _("always")
     parts = ["+".join(event_label(table, e) for e in table.events if e in s) or empty for s in unique]
-    return " or ".join(parts)
+    return _(" or ").join(parts)
 
 
 def event_label(table: Table, event: str) -> str:
@@ -75,7 +84,8 @@ def event_label(table: Table, event: str) -> str:
     if cross is None:
         return event
     states = ",".join([*map(str, cross.states), *(f"{low}..{high}" for low, high in cross.ranges)])
-    return f"{cross.table} in {{{states}}}" if cross.states or len(cross.ranges) > 1 else f"{cross.table} in {states}"
+    return _("{table} in {{{states}}}").format(table=cross.table, states=states) if cross.states or \
+        len(cross.ranges) > 1 else _("{table} in {states}").format(table=cross.table, states=states)
 
 
 def action(table: Table, row: Row) -> Action:
@@ -99,28 +109,34 @@ def duration(table: Table, ticks: int) -> str:
 def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:
     """A word for what the motors do, and its colour class (forward, reverse, turn, stop, keep)."""
     if not motors or all(m is None for m in motors):
-        return "keep", "keep"
+        return _("keep"), "keep"
     if any(m is None for m in motors):
         return " ".join(f"{n} {'=' if m is None else f'{m:+d}'}" for n, m in zip(table.robot.motors, motors,
                                                                                   strict=True)), "turn"
     speeds = tuple(m for m in motors if m is not None)  # all of them: none is None past the test above
     if all(m == 0 for m in speeds):
-        return "stop", "stop"
+        return _("stop"), "stop"
     sides = _sides(table)
     if len(speeds) != 2 or sides is None:
         text = " ".join(f"{n} {m:+d}" for n, m in zip(table.robot.motors, speeds, strict=True))
         return text, "forward" if all(m > 0 for m in speeds) else "reverse" if all(m < 0 for m in speeds) else "turn"
     left, right = speeds[sides[0]], speeds[sides[1]]
     if left == right:
-        return (f"forward {left}", "forward") if left > 0 else (f"reverse {-left}", "reverse")
+        return (_("forward {speed}").format(speed=left), "forward") if left > 0 else \
+            (_("reverse {speed}").format(speed=-left), "reverse")
     # The heading turns toward the slower side going forward (signed: right > left turns left).
-    toward = "left" if right > left else "right"
     wheels = f"L{left} R{right}"
     if left * right < 0:
-        return f"spin {toward} {wheels}", "turn"
+        words = _("spin left {wheels}") if right > left else _("spin right {wheels}")
+        return words.format(wheels=wheels), "turn"
     if left < 0 or right < 0:
-        return f"back, turn {toward} {wheels}", "reverse"
-    return f"{'pivot' if left * right == 0 else 'curve'} {toward} {wheels}", "turn"
+        words = _("back, turn left {wheels}") if right > left else _("back, turn right {wheels}")
+        return words.format(wheels=wheels), "reverse"
+    if left * right == 0:
+        words = _("pivot left {wheels}") if right > left else _("pivot right {wheels}")
+    else:
+        words = _("curve left {wheels}") if right > left else _("curve right {wheels}")
+    return words.format(wheels=wheels), "turn"
 
 
 def _sides(table: Table) -> tuple[int, int] | None:
@@ -168,7 +184,8 @@ def draw_table(graph: graphviz.Digraph, table: Table, colour: bool, prefix: str 
         initial = state == robot.initial_state
         graph.node(ids[state], title, penwidth="3" if initial else "2", color=state_colour,
                    fillcolor="#fff7d6" if initial else "#f4f4f4")
-    graph.edge(start, ids[robot.initial_state], label=f"< start, timer {robot.initial_timer}>")
+    graph.edge(start, ids[robot.initial_state],
+               label="< " + dot_label(_("start, timer {timer}").format(timer=robot.initial_timer)) + ">")
     for edge in edges(table):
         first = edge.lines[0][1].motion
         same = all(a.motion == first for _, a in edge.lines)
@@ -203,7 +220,7 @@ def _html_label(edge: Edge, colour: bool) -> str:
             text = f'<font color="{COLOURS[act.motion]}">{text}</font>'
         rows.append(text)
     if shared and next(iter(timers)):
-        rows.append(f"timer {dot_label(next(iter(timers)))}")
+        rows.append(dot_label(_("timer {time}").format(time=next(iter(timers)))))
     return "<" + "<br/>".join(rows) + ">"
 
 
@@ -211,11 +228,11 @@ def _legend(table: Table, colour: bool) -> str:
     robot = table.robot
     cells = [f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}"
              for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
-    cells.insert(0, "<b>T</b> timer ran out")
-    cells.append("times: timer loaded by the row")
-    cells.append("state border: its colour in the run's pictures")
+    cells.insert(0, f"<b>T</b> {dot_label(_('timer ran out'))}")
+    cells.append(dot_label(_("times: timer loaded by the row")))
+    cells.append(dot_label(_("state border: its colour in the run's pictures")))
     if colour:
-        cells += [f'<font color="{c}">■ {m}</font>' for m, c in COLOURS.items()]
+        cells += motion_legend()
     body = "".join(f'<tr><td align="left">{c}</td></tr>' for c in cells)
     return f'<<table border="1" cellborder="0" cellspacing="1" color="#999999">{body}</table>>'
 
@@ -237,9 +254,10 @@ def drawn(graph: graphviz.Digraph, fmt: str) -> bytes:
     try:
         return draw(graph.source, fmt)
     except NoGraphviz as exc:
-        raise fail("graphviz", str(exc), f"{INSTALL}; or use --format dot or --format mermaid") from None
+        raise fail("graphviz", exc.args[0], N_("{install}; or use --format dot or --format mermaid",
+                                               install=INSTALL)) from None
     except GraphvizFailed as exc:
-        raise fail("graphviz", str(exc), "report this with the table attached") from None
+        raise fail("graphviz", exc.args[0], N_("report this with the table attached")) from None
 
 
 # --- Mermaid ----------------------------------------------------------------------------------------

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import graphviz
 
-from tablebot.analysis.diagram import COLOURS, digraph, draw_table, drawn, event_label, mermaid_lines
+from tablebot.analysis.diagram import digraph, draw_table, drawn, event_label, mermaid_lines, motion_legend
 from tablebot.escape import dot_id, dot_label, mermaid_label
+from tablebot.i18n import _
+from tablebot.robot_tables import CrossEvent
 from tablebot.tables import RobotTables
 
 
@@ -20,11 +22,12 @@ def render_tables(tables: RobotTables, fmt: str, colour: bool = True) -> bytes:
 
 def tables_graphviz(tables: RobotTables, colour: bool = True) -> graphviz.Digraph:
     robot = tables.robot
-    graph = digraph(f"{robot.name}: {len(tables.tables)} tables, run together on every tick")
+    graph = digraph(_("{robot}: {count} tables, run together on every tick").format(robot=robot.name,
+                                                                                    count=len(tables.tables)))
     for k, table in enumerate(tables.tables):
         with graph.subgraph(name=f"cluster_{k}") as cluster:
-            role = "main table" if k == 0 else "table"
-            cluster.attr(label=f"<<b>{dot_label(f'{role} {table.name}')}</b> {dot_label(table.path)}>",
+            role = _("main table {name}") if k == 0 else _("table {name}")
+            cluster.attr(label=f"<<b>{dot_label(role.format(name=table.name))}</b> {dot_label(table.path)}>",
                          style="rounded", color="#999999", fontsize="12")
             draw_table(cluster, table, colour, prefix=f"{dot_id(table.name)}_")
     graph.node("__legend", _legend(tables, colour), shape="plain", fontsize="9")
@@ -33,21 +36,27 @@ def tables_graphviz(tables: RobotTables, colour: bool = True) -> graphviz.Digrap
 
 def _legend(tables: RobotTables, colour: bool) -> str:
     robot = tables.robot
-    cells = ["<b>T</b> the table's own timer ran out"]
+    own_timer = _("the table's own timer ran out")
+    cells = [f"<b>T</b> {dot_label(own_timer)}"]
     names = [*tables.input_bits, *robot.motors, *robot.lamps]
     cells += [f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}" for name in names]
     for table in tables.tables:
         for event in table.cross.values():
-            states = " or ".join(map(str, event.states))
-            spans = " or ".join(f"{low} to {high}" for low, high in event.ranges)
-            cells.append(f"<b>{dot_label(event_label(table, event.column))}</b> "
-                         f"{dot_label(f'table {event.table} was in state {states or spans}')}"
-                         f"{dot_label(f' or {spans}' if states and spans else '')} at the start of the tick")
-    cells.append("times: timer loaded by the row")
+            cells.append(f"<b>{dot_label(event_label(table, event.column))}</b> {dot_label(_cross_words(event))}")
+    cells.append(dot_label(_("times: timer loaded by the row")))
     if colour:
-        cells += [f'<font color="{c}">■ {m}</font>' for m, c in COLOURS.items()]
+        cells += motion_legend()
     body = "".join(f'<tr><td align="left">{c}</td></tr>' for c in cells)
     return f'<<table border="1" cellborder="0" cellspacing="1" color="#999999">{body}</table>>'
+
+
+def _cross_words(event: CrossEvent) -> str:
+    """What a cross-table event needs: ``table drive was in state 11 or 12 at the start of the tick``."""
+    either = _(" or ")
+    states = either.join(map(str, event.states))
+    spans = either.join(_("{low} to {high}").format(low=low, high=high) for low, high in event.ranges)
+    return _("table {table} was in state {states} at the start of the tick").format(
+        table=event.table, states=either.join(part for part in (states, spans) if part))
 
 
 def tables_mermaid(tables: RobotTables) -> str:

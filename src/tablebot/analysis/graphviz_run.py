@@ -14,20 +14,20 @@ import shutil
 import subprocess
 import sysconfig
 
+from tablebot.i18n import N_
+
 PACKAGED = "graphviz-pure"
 SYSTEM = "dot"
-INSTALL = (f"pip install {PACKAGED} (into the Python that runs tablebot), "
-           "or install Graphviz (its dot program, on PATH)")
-
-
-NOT_FOUND = f"neither {PACKAGED} nor {SYSTEM} was found"
+INSTALL = N_("pip install {packaged} (into the Python that runs tablebot), or install Graphviz (its dot program, "
+             "on PATH)", packaged=PACKAGED)
+NOT_FOUND = N_("neither {packaged} nor {system} was found", packaged=PACKAGED, system=SYSTEM)
 
 
 class NoGraphviz(Exception):
     """Neither graphviz-pure nor dot is installed."""
 
     def __init__(self) -> None:
-        super().__init__(f"no Graphviz to draw the diagram: {NOT_FOUND}")
+        super().__init__(N_("no Graphviz to draw the diagram: {why}", why=NOT_FOUND))
 
 
 class GraphvizFailed(Exception):
@@ -58,8 +58,9 @@ def draw(source: str, fmt: str) -> bytes:
     try:
         done = subprocess.run([program, f"-T{fmt}"], input=source.encode(), capture_output=True, check=False)
     except OSError as exc:  # found but not runnable (a wheel for another machine, no execute bit)
-        raise GraphvizFailed(f"{program} could not be started: {exc.strerror or exc}") from None
+        raise GraphvizFailed(N_("{program} could not be started: {error}", program=program,
+                                error=str(exc.strerror or exc))) from None
     if done.returncode != 0 or not done.stdout:
-        said = done.stderr.decode(errors="replace").strip() or f"exit status {done.returncode}"
-        raise GraphvizFailed(f"{program} failed: {said}")
+        said = done.stderr.decode(errors="replace").strip() or N_("exit status {code}", code=done.returncode)
+        raise GraphvizFailed(N_("{program} failed: {said}", program=program, said=said))
     return done.stdout

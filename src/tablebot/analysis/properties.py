@@ -182,7 +182,7 @@ def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line:
         try:
             return parse_condition(value, machine, tables)
         except ConditionError as exc:
-            out.error(line, None, N_("property {name}: {key}: {problem}", name=name, key=key, problem=str(exc)),
+            out.error(line, None, N_("property {name}: {key}: {problem}", name=name, key=key, problem=exc.problem),
                       N_("see the condition language in docs/checking.md"))
             return None
 

@@ -19,6 +19,7 @@ from tablebot.analysis.conditions import Obs
 from tablebot.analysis.model import Graph, Model, ModelTooLarge, Node, Tick, walk_back
 from tablebot.analysis.properties import Property
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 from tablebot.replay import replay
 
@@ -132,7 +133,7 @@ def search(model: Model, monitor: Monitor, budget: int = 10_000_000) -> tuple[Pa
                 parent[pair] = (key, tick)
                 queue.append(pair)
                 if len(parent) > budget:
-                    raise ModelTooLarge(f"more than {budget} situations")
+                    raise ModelTooLarge(N_("more than {budget} situations", budget=budget))
     return None, len(parent)
 
 
@@ -189,12 +190,15 @@ def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET)
     try:
         path, explored = search(model, monitor_of(prop))
     except ModelTooLarge as exc:
-        hint = "a shorter within" if prop.kind == "when" else "a condition that reads fewer inputs"
-        return Result(prop, "unknown", detail=f"too large to search ({exc}); {hint} makes it smaller")
+        detail = N_("too large to search ({reason}); a shorter within makes it smaller", reason=exc.args[0]) \
+            if prop.kind == "when" else \
+            N_("too large to search ({reason}); a condition that reads fewer inputs makes it smaller",
+               reason=exc.args[0])
+        return Result(prop, "unknown", detail=detail)
     reachable = prop.kind == "reachable"
     if path is None:
         status = "violated" if reachable else "holds"
-        return Result(prop, status, explored, detail="it can never happen" if reachable else "")
+        return Result(prop, status, explored, detail=NEVER if reachable else "")
     exact = model if model.is_exact else Model.exact(machine, prop.watch)
     try:
         if exact is not model:
@@ -213,8 +217,7 @@ def _confirmed(prop: Property, machine: Machine, model: Model, path: Path, explo
     inputs, _ = model.concretize(path)
     shown = first_violation(prop, machine, replay(machine, inputs))
     if shown is None:
-        return Result(prop, "unknown", explored, detail="the abstract counterexample did not replay; "
-                      "the exact search was too large")
+        return Result(prop, "unknown", explored, detail=NO_REPLAY)
     status = "holds" if reachable else "violated"
     return Result(prop, status, explored, inputs[: shown + 1], shown, exact=exact)
 
@@ -236,4 +239,9 @@ def _check_always_reachable(prop: Property, machine: Machine, budget: int) -> Re
     state = machine.states[path[-1][1][3][0]] if path else machine.states[machine.initial_state]
     return Result(prop, "violated", explored, inputs, len(inputs) - 1 if inputs else None,
                   state=state, exact=model.is_exact,
-                  detail=f"from state {state} on, no inputs can ever make it happen again")
+                  detail=N_("from state {state} on, no inputs can ever make it happen again", state=state))
+
+
+#: A result's words shared with tablebot.analysis.prove_product.
+NEVER = N_("it can never happen")
+NO_REPLAY = N_("the abstract counterexample did not replay; the exact search was too large")

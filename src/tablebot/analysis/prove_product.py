@@ -11,9 +11,10 @@ from tablebot.analysis.conditions import Obs
 from tablebot.analysis.model import ModelTooLarge
 from tablebot.analysis.product import ProductModel
 from tablebot.analysis.properties import Property
-from tablebot.analysis.prove import EXACT_BUDGET, VIOLATION, Result, monitor_of, search, trapped
+from tablebot.analysis.prove import EXACT_BUDGET, NEVER, NO_REPLAY, VIOLATION, Result, monitor_of, search, trapped
 from tablebot.engine.several import Several
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.tables import RobotTables
 
 
@@ -27,11 +28,11 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
         model = ProductModel(tables, prop.horizon, prop.watch, relevant)
         path, explored = search(model, monitor_of(prop))  # type: ignore[arg-type]  # same interface as Model
     except ModelTooLarge as exc:
-        return Result(prop, "unknown", detail=f"too large to search ({exc}); a condition that reads fewer inputs "
-                      "or a shorter within makes it smaller")
+        return Result(prop, "unknown", detail=N_("too large to search ({reason}); a condition that reads fewer "
+                                                 "inputs or a shorter within makes it smaller", reason=exc.args[0]))
     if path is None:
         return Result(prop, "violated" if reachable else "holds", explored,
-                      detail="it can never happen" if reachable else "")
+                      detail=NEVER if reachable else "")
     try:
         exact = model if model.is_exact else ProductModel.exact(tables, prop.watch, relevant)
         if exact is not model:
@@ -44,8 +45,7 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
     inputs, _ = model.concretize(path)  # type: ignore[arg-type]
     shown = first_violation(prop, tables, inputs)
     if shown is None:
-        return Result(prop, "unknown", explored, detail="the abstract counterexample did not replay; "
-                      "the exact search was too large")
+        return Result(prop, "unknown", explored, detail=NO_REPLAY)
     return Result(prop, "holds" if reachable else "violated", explored, inputs[: shown + 1], shown,
                   exact=model.is_exact)
 
@@ -68,7 +68,8 @@ def _always_reachable(prop: Property, tables: RobotTables, budget: int) -> Resul
     state = ", ".join(f"{name} {m.states[s]}" for name, m, s in zip(tables.names, tables.machines, states,
                                                                     strict=True))
     return Result(prop, "violated", len(graph.nodes), inputs, len(inputs) - 1 if inputs else None, state=state,
-                  exact=model.is_exact, detail=f"from {state} on, no inputs can ever make it happen again")
+                  exact=model.is_exact, detail=N_("from {state} on, no inputs can ever make it happen again",
+                                                  state=state))
 
 
 def first_violation(prop: Property, tables: RobotTables, inputs: Sequence[TickInput]) -> int | None:

@@ -20,6 +20,7 @@ from tablebot.files import atomic_write, write_text
 from tablebot.fileset import file_set
 from tablebot.formats.inputs_csv import TickInput, write_inputs
 from tablebot.formats.trace_lines import write_trace
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 from tablebot.replay import replay
 
@@ -56,7 +57,8 @@ def generate(machine: Machine) -> GoldenSet:
     try:
         graph = model.explore()
     except ModelTooLarge as exc:
-        raise fail(machine.table.path, f"too large to explore: {exc}", "split the table") from None
+        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
+                   N_("split the table")) from None
     golden = GoldenSet(machine, fireable=graph.fired_rows())
     while golden.fireable - golden.covered:
         path = _sequence(model, golden.fireable - golden.covered)

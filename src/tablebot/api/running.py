@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.api.progress import Progress
@@ -24,7 +25,9 @@ def address_hint() -> str:
     from tablebot import registry
 
     forms = [form for backend in registry.lives() for form in backend.addresses]
-    return "write --on " + (", ".join(forms[:-1]) + " or " + forms[-1] if len(forms) > 1 else "".join(forms))
+    if len(forms) > 1:
+        return N_("write --on {forms} or {last}", forms=tuple(forms[:-1]), last=forms[-1])
+    return N_("write --on {form}", form="".join(forms))
 
 
 def live_backend(text: str) -> LiveBackend:
@@ -33,7 +36,7 @@ def live_backend(text: str) -> LiveBackend:
 
     backend = registry.live_for(text)
     if backend is None:
-        raise fail("--on", f"unknown target {text!r}", address_hint())
+        raise fail("--on", N_("unknown target {text!r}", text=text), address_hint())
     return backend
 
 

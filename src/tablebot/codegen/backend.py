@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import Diagnostic
 from tablebot.files import out_folder
+from tablebot.i18n import N_
 from tablebot.registry import ExportBackend, Exported, ExportOptions, refused, register
 
 if TYPE_CHECKING:
@@ -39,9 +40,9 @@ def export(machine: Machine, out: Path | None, options: ExportOptions) -> Export
     source = generate(machine, options.lookup) if tables is None else generate_several(tables, options.lookup)
     files = tuple(source.write(out_folder(out, "OUTDIR")))
     kind = "dense" if source.layout.dense else "scan"
-    return Exported(files, (*(f"wrote {path}" for path in files),
-                            f"lookup: {kind}, {source.layout.lookup_bytes} bytes; "
-                            f"table hash 0x{source.layout.table_hash:08x}"))
+    return Exported(files, (*(N_("wrote {file}", file=str(path)) for path in files),
+                            N_("lookup: {kind}, {size} bytes; table hash 0x{hash:08x}", kind=kind,
+                               size=source.layout.lookup_bytes, hash=source.layout.table_hash)))
 
 
 C = register(ExportBackend(name="c", makes="a portable C99 engine and the table as const data",

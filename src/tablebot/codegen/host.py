@@ -12,16 +12,22 @@ from typing import Any
 from tablebot.codegen.source import HOST_RUNNER, generate, template_path
 from tablebot.diagnostics import fail
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 from tablebot.tables import RobotTables
 
 WARNINGS = ("-Wall", "-Wextra", "-std=c99", "-pedantic", "-Werror")
 
 
+NO_COMPILE = N_("the generated C does not compile")
+#: The hint of a failure that is tablebot's own, not the user's (the same words as tablebot.firmware.build's).
+BUG = N_("report this as a tablebot bug")
+
+
 def find_compiler(name: str = "cc") -> str:
     found = shutil.which(name) or shutil.which("gcc")
     if not found:
-        raise fail(name, "no C compiler found", "install gcc (Debian: apt-get install gcc)")
+        raise fail(name, N_("no C compiler found"), N_("install gcc (Debian: apt-get install gcc)"))
     return found
 
 
@@ -33,7 +39,7 @@ def build_host(machine: Machine, outdir: Path, lookup: str = "auto") -> Path:
     command = [find_compiler(), *WARNINGS, "-O1", f"-I{outdir}", "-o", str(exe), *sources]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(outdir, "the generated C does not compile", "report this as a tablebot bug", detail=done.stderr)
+        raise fail(outdir, NO_COMPILE, BUG, detail=done.stderr)
     return exe
 
 
@@ -79,7 +85,7 @@ def build_host_several(tables: RobotTables, outdir: Path, lookup: str = "auto",
                *units]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
-        raise fail(outdir, "the generated C does not compile", "report this as a tablebot bug", detail=done.stderr)
+        raise fail(outdir, NO_COMPILE, BUG, detail=done.stderr)
     return exe
 
 

@@ -7,6 +7,7 @@ import zlib
 from dataclasses import dataclass
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 
 #: ``auto`` uses the dense lookup while it needs at most this many bytes.
@@ -68,14 +69,17 @@ def check_fits(machine: Machine) -> None:
     table = machine.table
     n_events = len(table.events)
     if n_events > MAX_EVENTS:
-        raise fail(table.path, f"{n_events} event columns; the C engine holds at most {MAX_EVENTS}",
-                   "drop event columns the table does not need", 1)
+        raise fail(table.path, N_("{count} event columns; the C engine holds at most {most}", count=n_events,
+                                  most=MAX_EVENTS),
+                   N_("drop event columns the table does not need"), 1)
     counters = len(table.robot.counters)
     if counters > MAX_COUNTERS:
-        raise fail(table.robot.source, f"{counters} counters; the C engine holds at most {MAX_COUNTERS}",
-                   "use fewer counters")
+        raise fail(table.robot.source, N_("{count} counters; the C engine holds at most {most}", count=counters,
+                                          most=MAX_COUNTERS),
+                   N_("use fewer counters"))
     if len(machine.rows) >= 0xFFFF:
-        raise fail(table.path, f"{len(machine.rows)} rows; the C engine holds at most 65534", "split the table")
+        raise fail(table.path, N_("{count} rows; the C engine holds at most 65534", count=len(machine.rows)),
+                   N_("split the table"))
 
 
 def reachable(rows: list[tuple[int, int]]) -> list[tuple[int, int]]:
@@ -116,8 +120,8 @@ def plan(machine: Machine, lookup: str = "auto") -> Layout:
     dense = lookup == "dense" or (lookup == "auto" and dense_bytes is not None
                                   and dense_bytes <= DENSE_LIMIT_BYTES)
     if dense and dense_bytes is None:
-        raise fail(machine.table.path, f"a dense lookup of {n_events} event bits is too large",
-                   "use the scan lookup")
+        raise fail(machine.table.path, N_("a dense lookup of {count} event bits is too large", count=n_events),
+                   N_("use the scan lookup"))
     starts, entries = ((), ()) if dense else _scan(machine)
     return Layout(
         event=unsigned_for((1 << n_events) - 1 if n_events else 0),

@@ -20,6 +20,7 @@ from tablebot.codegen.source import ENGINE_FILES, CSource, c_list, config_header
 from tablebot.diagnostics import fail
 from tablebot.engine.several import cross_bits, input_bits
 from tablebot.escape import c_comment
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 from tablebot.tables import RobotTables
 
@@ -49,8 +50,9 @@ def unit_name(name: str) -> str:
 def generate_several(tables: RobotTables, lookup: str = "auto", order: Sequence[int] | None = None) -> CSource:
     """The C files of a robot of several tables (the layout returned is the main table's)."""
     if len(tables.input_bits) > MAX_EVENTS:  # the robot's input mask is one uint32_t
-        raise fail(tables.robot.source, f"the robot's tables read {len(tables.input_bits)} inputs, more than the "
-                   f"{MAX_EVENTS} the C engine of several tables takes", "read fewer inputs in the tables")
+        raise fail(tables.robot.source, N_("the robot's tables read {count} inputs, more than the {most} the C engine "
+                                           "of several tables takes", count=len(tables.input_bits), most=MAX_EVENTS),
+                   N_("read fewer inputs in the tables"))
     files = {name: template(name) for name in ENGINE_FILES}
     files["tb_config.h"] = CONFIG_GUARD
     layouts = [plan(machine, lookup) for machine in tables.machines]

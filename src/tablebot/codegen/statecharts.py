@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from tablebot.files import out_folder, write_text
 from tablebot.fileset import file_set
+from tablebot.i18n import N_
 from tablebot.registry import ExportBackend, Exported, ExportOptions, register
 
 if TYPE_CHECKING:
@@ -33,15 +34,15 @@ def _write(out: Path | None, files: dict[str, str], how: str) -> Exported:
     folder = out_folder(out, "OUTDIR")
     with file_set(folder):
         written = tuple(write_text(folder / name, text) for name, text in files.items())
-    return Exported(written, (*(f"wrote {path}" for path in written), how))
+    return Exported(written, (*(N_("wrote {file}", file=str(path)) for path in written), how))
 
 
 def export_scxml(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.formats.statecharts.scxml import export_scxml as scxml
 
     text = scxml(_tables(machine))
-    return _write(out, {SCXML_FILE: text}, "send it one event 'tick' per tick, the inputs and pulses as its data "
-                                           "(docs: Statecharts)")
+    return _write(out, {SCXML_FILE: text}, N_("send it one event 'tick' per tick, the inputs and pulses as its data "
+                                              "(docs: Statecharts)"))
 
 
 def export_xstate(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -49,8 +50,8 @@ def export_xstate(machine: Machine, out: Path | None, options: ExportOptions) ->
 
     text = export_xstate(_tables(machine))
     return _write(out, {XSTATE_FILE: text, RUNTIME: runtime_module()},
-                  f"createActor(tablebotMachine(config)) from {RUNTIME}, then one 'tick' event per tick "
-                  "(docs: Statecharts)")
+                  N_("createActor(tablebotMachine(config)) from {runtime}, then one 'tick' event per tick "
+                     "(docs: Statecharts)", runtime=RUNTIME))
 
 
 SCXML = register(ExportBackend(name="scxml", makes="a W3C SCXML statechart, one 'tick' event per tick",

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 from tablebot.codegen import backend as c
 from tablebot.diagnostics import Diagnostic
 from tablebot.files import out_folder
+from tablebot.i18n import N_
 from tablebot.registry import ExportBackend, Exported, Exporter, ExportOptions, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
@@ -46,9 +47,11 @@ def export_for(board: str) -> Exporter:
         pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
                          for n, t in kind.items())
         return Exported((firmware.hex, firmware.elf), (
-            f"wrote {firmware.hex} and {firmware.elf} for {firmware.board.title}",
-            f"flash {firmware.flash} bytes, static RAM {firmware.ram} bytes; wiring: {pins}",
-            f"trace: {firmware.board.uart}, {firmware.board.baud} baud 8N1"), value=firmware)
+            N_("wrote {hex} and {elf} for {board}", hex=str(firmware.hex), elf=str(firmware.elf),
+               board=firmware.board.title),
+            N_("flash {flash} bytes, static RAM {ram} bytes; wiring: {pins}", flash=firmware.flash, ram=firmware.ram,
+               pins=pins),
+            N_("trace: {uart}, {baud} baud 8N1", uart=firmware.board.uart, baud=firmware.board.baud)), value=firmware)
 
     return export
 

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from tablebot.grade.challenge import Challenge, load_challenge
 from tablebot.grade.run import Entry
+from tablebot.i18n import _
 
 __all__ = ["Challenge", "Entry", "Grading", "grade", "load_challenge"]
 
@@ -53,7 +54,7 @@ def grade(challenge: str | Path, submissions: Sequence[str | Path], out: str | P
         subs = collect([Path(s) for s in submissions], Path(tmp))
         with Runner(chosen, address, workers) as runner:
             entries = grade_all(found, subs, runner, told)
-        told("writing the leaderboard")
+        told(_("writing the leaderboard"))
         with file_set(folder, remove=_previous(folder)):
             files = [write_text(folder / "scores.csv", scores_csv(entries, found))]
             replays, packed = replay_pages(entries, found)

@@ -9,11 +9,12 @@ from pathlib import Path
 from typing import Any
 
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.i18n import N_
 from tablebot.tomlfile import Source, known_keys, label, number
 
 KEYS = ("title", "robot", "worlds", "seconds", "seeds", "score", "properties", "max_rows", "grid")
 FILE_NAME = "challenge.toml"
-HINT = "see examples/challenges/find-the-lamp/challenge.toml"
+HINT = N_("see examples/challenges/find-the-lamp/challenge.toml")
 
 
 @dataclass(frozen=True)
@@ -47,14 +48,16 @@ def load_challenge(path: str | Path) -> Challenge:
         path = example_path(f"challenges/{path}")
     file = path / FILE_NAME if path.is_dir() else path
     if not file.is_file():
-        raise fail(path, f"no {FILE_NAME} here", f"give a challenge folder holding {FILE_NAME}, or the name of "
-                   f"a shipped challenge: {', '.join(SHIPPED)}")
+        raise fail(path, N_("no {file} here", file=FILE_NAME),
+                   N_("give a challenge folder holding {file}, or the name of a shipped challenge: {names}",
+                      file=FILE_NAME, names=tuple(SHIPPED)))
     src = Source.read(file, HINT)
     data = src.data
     known_keys(src, ("", None), data, KEYS)
     for key in ("title", "robot", "worlds", "seconds", "seeds", "score"):
         if key not in data:
-            src.error(("", None, None), f"{FILE_NAME} has no {key}", f"add {key} = ... ({HINT})")
+            src.error(("", None, None), N_("{file} has no {key}", file=FILE_NAME, key=key),
+                      N_("add {key} = ... ({hint})", key=key, hint=HINT))
     folder = file.parent
     title = _text(src, "title", data.get("title", ""))
     robot = _file(src, folder, "robot", data.get("robot"))
@@ -73,7 +76,8 @@ def load_challenge(path: str | Path) -> Challenge:
 
 def _text(src: Source, key: str, value: Any) -> str:
     if not isinstance(value, str):
-        src.key_error(("", None, key), f"{key} must be text in quotes, not {value!r}", f'for example: {key} = "..."')
+        src.key_error(("", None, key), N_("{key} must be text in quotes, not {value!r}", key=key, value=value),
+                      N_("for example: {example}", example=f'{key} = "..."'))
         return ""
     return value
 
@@ -81,7 +85,8 @@ def _text(src: Source, key: str, value: Any) -> str:
 def _list(src: Source, key: str, data: dict[str, Any]) -> list[Any]:
     value = data.get(key, [])
     if not isinstance(value, list):
-        src.key_error(("", None, key), f"{key} must be a list", f'for example: {key} = ["arena.toml"]')
+        src.key_error(("", None, key), N_("{key} must be a list", key=key),
+                      N_("for example: {example}", example=f'{key} = ["arena.toml"]'))
         return []
     return value
 
@@ -91,8 +96,9 @@ def _file(src: Source, folder: Path, key: str, value: Any) -> Path:
     name = _text(src, key, value)
     path = folder / name
     if name and not path.is_file():
-        src.key_error(("", None, key), f"{label(('', None, key))}: {name} is not a file beside challenge.toml",
-                      "name a file in the challenge's folder")
+        src.key_error(("", None, key), N_("{key}: {name} is not a file beside challenge.toml",
+                                          key=label(("", None, key)), name=name),
+                      N_("name a file in the challenge's folder"))
     return path
 
 
@@ -111,8 +117,9 @@ def _world(src: Source, folder: Path, index: int, value: Any) -> Path | None:
         shipped = None
     if shipped is not None and shipped.is_file():
         return shipped
-    src.key_error(("", None, "worlds"), f"worlds[{index}]: {name} is neither a file beside challenge.toml nor a "
-                  "shipped example's world", "name a world file, or one of bumberbot, line-follower, obstacle-avoider")
+    src.key_error(("", None, "worlds"), N_("worlds[{index}]: {name} is neither a file beside challenge.toml nor a "
+                                           "shipped example's world", index=index, name=name),
+                  N_("name a world file, or one of bumberbot, line-follower, obstacle-avoider"))
     return None
 
 
@@ -123,7 +130,8 @@ def _seeds(src: Source, value: Any) -> str:
     try:
         parse_seeds(text, None, "seeds")
     except TableBotError as exc:
-        src.key_error(("", None, "seeds"), exc.diagnostics[0].message, 'for example: seeds = "0..31"')
+        src.key_error(("", None, "seeds"), exc.diagnostics[0].message,
+                      N_("for example: {example}", example='seeds = "0..31"'))
     return text
 
 
@@ -134,7 +142,8 @@ def _score(src: Source, name: Any, worlds: tuple[Path, ...]) -> tuple[str, str]:
 
     usable = [n for n in allowed([load_world(w) for w in worlds]) if MEASURES[n].objective]
     if name not in usable:
-        why = "not a measure tablebot has" if name not in MEASURES else "the worlds cannot measure it"
-        src.key_error(("", None, "score"), f"score = {name!r}: {why}", f"use one of {', '.join(usable)}")
+        why = N_("not a measure tablebot has") if name not in MEASURES else N_("the worlds cannot measure it")
+        src.key_error(("", None, "score"), N_("score = {name!r}: {why}", name=name, why=why),
+                      N_("use one of {names}", names=tuple(usable)))
         src.raise_if_any()
     return name, MEASURES[name].better

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.i18n import N_, Message
 from tablebot.loop import LinkLost
 
 if TYPE_CHECKING:
@@ -60,7 +61,7 @@ def check_link(bot: Connected, machine: Machine, options: LinkOptions, probe: Ca
         link = LinkTime(bot.target, what, median_round_trip(probe), line, faster)
     except LinkLost as exc:
         bot.close()
-        raise fail("--on", str(exc), connect_hint) from None
+        raise fail("--on", exc.args[0], connect_hint) from None
     try:
         return judge(machine, link, accept_slow=options.accept_slow)
     except TableBotError:
@@ -89,15 +90,18 @@ def judge(machine: Machine, link: LinkTime, accept_slow: bool) -> tuple[str, ...
         return ()
     suggested = suggest_tick_ms(machine, need)
     if need <= REFUSE_ABOVE * tick_s:
-        return (f"{link.target}: {took}, {need / tick_s:.0%} of the table's {robot.tick_ms} ms tick: ticks will "
-                f"start late when this machine or the link is busy (tick_ms = {suggested} would leave room)",)
-    slow = f"at least {100 * (need / tick_s - 1):.0f} % slow" if need > tick_s else "slow"
+        return (N_("{target}: {took}, {share:.0%} of the table's {tick_ms} ms tick: ticks will start late when this "
+                   "machine or the link is busy (tick_ms = {suggested} would leave room)", target=link.target,
+                   took=took, share=need / tick_s, tick_ms=robot.tick_ms, suggested=suggested),)
+    slow = N_("at least {percent} slow", percent=f"{100 * (need / tick_s - 1):.0f} %") if need > tick_s else N_("slow")
     if accept_slow:
-        return (f"{link.target}: {took}, more than the table's {robot.tick_ms} ms tick can hold: running anyway "
-                f"(--behind-limit 0), so the table's timers will run {slow}",)
+        return (N_("{target}: {took}, more than the table's {tick_ms} ms tick can hold: running anyway "
+                   "(--behind-limit 0), so the table's timers will run {slow}", target=link.target, took=took,
+                   tick_ms=robot.tick_ms, slow=slow),)
     where, line = _tick_ms_place(robot)
-    raise fail(where, f"{link.target}: {took}, more than the table's {robot.tick_ms} ms tick can hold "
-               f"(tick_ms = {robot.tick_ms}): every tick would start late and the table's timers would run {slow}",
+    raise fail(where, N_("{target}: {took}, more than the table's {tick_ms} ms tick can hold (tick_ms = {tick_ms}): "
+                         "every tick would start late and the table's timers would run {slow}", target=link.target,
+                         took=took, tick_ms=robot.tick_ms, slow=slow),
                _advice(machine, suggested, link, slow), line=line, column=None if line is None else 1)
 
 
@@ -117,20 +121,26 @@ def _timers_gcd_ms(machine: Machine) -> int:
     return math.gcd(*(ticks * robot.tick_ms for ticks in loads if ticks))
 
 
-def _took(link: LinkTime) -> str:
-    return f"{link.what} takes {1000 * link.measured_s:.1f} ms (measured{'; ' + link.line if link.line else ''})"
+def _took(link: LinkTime) -> Message:
+    if link.line:
+        return N_("{what} takes {ms:.1f} ms (measured; {line})", what=link.what, ms=1000 * link.measured_s,
+                  line=link.line)
+    return N_("{what} takes {ms:.1f} ms (measured)", what=link.what, ms=1000 * link.measured_s)
 
 
-def _advice(machine: Machine, suggested: int, link: LinkTime, slow: str) -> str:
+def _advice(machine: Machine, suggested: int, link: LinkTime, slow: str) -> Message:
     robot = machine.table.robot
     timers = [row.timer for row in machine.table.rows if row.timer]
-    example = (f", e.g. {timers[0] * robot.tick_ms}ms for a timer of {timers[0]}" if timers else "")
-    fits = (" (every timer of this table is a whole number of such ticks)"
-            if _timers_gcd_ms(machine) % suggested == 0 and timers else "")
-    faster = f"; or use a faster link ({link.faster})" if link.faster else "; or use a faster link"
-    return (f"give tick_ms = {suggested}{fits} and write the table's timers as times{example}, so that they keep "
-            f"their length (a timer in ticks would last {suggested / robot.tick_ms:g} times as long){faster}; or "
-            f"accept timers {slow} with --behind-limit 0")
+    example = N_(", e.g. {ms}ms for a timer of {timer}", ms=timers[0] * robot.tick_ms, timer=timers[0]) \
+        if timers else ""
+    fits = N_(" (every timer of this table is a whole number of such ticks)") \
+        if _timers_gcd_ms(machine) % suggested == 0 and timers else ""
+    faster = N_("; or use a faster link ({faster})", faster=link.faster) if link.faster else \
+        N_("; or use a faster link")
+    return N_("give tick_ms = {suggested}{fits} and write the table's timers as times{example}, so that they keep "
+              "their length (a timer in ticks would last {times:g} times as long){faster}; or accept timers {slow} "
+              "with --behind-limit 0", suggested=suggested, fits=fits, example=example,
+              times=suggested / robot.tick_ms, faster=faster, slow=slow)
 
 
 def _tick_ms_place(robot: Robot) -> tuple[str, int | None]:

@@ -18,6 +18,7 @@ from tablebot.diagnostics import fail
 from tablebot.files import out_folder, write_text
 from tablebot.fileset import file_set
 from tablebot.formats.table_write import format_table
+from tablebot.i18n import N_, _
 from tablebot.robot import Robot, StateId
 from tablebot.table import Table
 
@@ -80,20 +81,22 @@ def _against(tables: tuple[Table, ...], robot: Robot) -> None:
                                   ("counters", used.counter_names, robot.counter_names)):
         missing = [name for name in names if name not in known]
         if missing:
-            raise fail(robot.source, f"[{section}] has no {', '.join(missing)}, which the statechart uses",
-                       f'add {missing[0]} = "what it is" to [{section}], or import without --robot',
-                       robot.line(section))
+            raise fail(robot.source, N_("[{section}] has no {names}, which the statechart uses", section=section,
+                                        names=tuple(missing)),
+                       N_('add {name} = "what it is" to [{section}], or import without --robot', name=missing[0],
+                          section=section), robot.line(section))
 
 
 def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | None) -> tuple[str | None, list[str]]:
     """Read the statechart and write its tables: (the CSV text for standard output, or None when written to
     ``out``; the lines to say)."""
     if out is not None and out.resolve() == path.resolve():
-        raise fail("--out", f"--out is {out}, the statechart being read", "write the table to another file")
+        raise fail("--out", N_("--out is {out}, the statechart being read", out=str(out)),
+                   N_("write the table to another file"))
     tables = read_statechart(path, kind)
     if robot is not None:
         _against(tables, robot)
-    said = ["the robot file's [groups]: " + "; ".join(f"{name} = {list(states)!r}".replace("'", '"')
+    said = [_("the robot file's [groups]: ") + "; ".join(f"{name} = {list(states)!r}".replace("'", '"')
                                                         for name, states in groups(tables).items())]
     said = said if groups(tables) else []
     if len(tables) == 1:
@@ -101,15 +104,16 @@ def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | No
         if out is None:
             return text, said
         write_text(out, text)
-        return None, [f"wrote {out} ({len(tables[0].rows)} rows)", *said]
+        return None, [_("wrote {file} ({count} rows)").format(file=out, count=len(tables[0].rows)), *said]
     if out is None:
-        raise fail("--out", f"{path} holds {len(tables)} tables",
-                   "give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv")
+        raise fail("--out", N_("{file} holds {count} tables", file=str(path), count=len(tables)),
+                   N_("give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv"))
     folder = out_folder(out, "--out")
     files = ["table.csv", *(f"{t.name}.csv" for t in tables[1:])]  # the main one where a folder's table is
     with file_set(folder):  # all the tables or none: a refused one (a table of yours, no --force) leaves none
-        lines = [f"wrote {write_text(folder / name, table_text(t))}" for name, t in zip(files, tables, strict=True)]
-    lines.append("the robot file's [tables]: " + "; ".join(
+        lines = [_("wrote {file}").format(file=write_text(folder / name, table_text(t)))
+                 for name, t in zip(files, tables, strict=True)]
+    lines.append(_("the robot file's [tables]: ") + "; ".join(
         f'{t.name} = {{ file = "{name}", initial_state = {t.robot.initial_state!r}, '
         f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}'
         for name, t in zip(files, tables, strict=True)).replace("'", '"'))

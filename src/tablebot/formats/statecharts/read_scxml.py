@@ -14,12 +14,13 @@ from tablebot.formats.statecharts.chart import WRAPPER, chart_of, state_of
 from tablebot.formats.statecharts.rebuild import Found, FoundRow, FoundTable, build
 from tablebot.formats.statecharts.scxml import scxml_tree
 from tablebot.formats.statecharts.xmltree import Element, parse
+from tablebot.i18n import N_
 from tablebot.robot import Counter, StateId
 from tablebot.table import Table
 
 __all__ = ["read_scxml"]
 
-HINT = "import reads what tablebot export --to scxml wrote, unchanged"
+HINT = N_("import reads what tablebot export --to scxml wrote, unchanged")
 
 
 def read_scxml(text: str, path: str) -> tuple[Table, ...]:
@@ -36,14 +37,15 @@ def _error(element: Element, path: str, message: str) -> Exception:
 
 def _attr(element: Element, name: str, path: str) -> str:
     if name not in element.attrs:
-        raise _error(element, path, f"<{element.tag}> has no {name} attribute")
+        raise _error(element, path, N_("<{tag}> has no {name} attribute", tag=element.tag, name=name))
     return element.attrs[name]
 
 
 def _int(element: Element, name: str, path: str) -> int:
     text = _attr(element, name, path)
     if not text.lstrip("-").isdigit() or len(text) > 9:
-        raise _error(element, path, f"{name}={text!r} on <{element.tag}> is not a whole number")
+        raise _error(element, path, N_("{name}={text!r} on <{tag}> is not a whole number", name=name, text=text,
+                                       tag=element.tag))
     return int(text)
 
 
@@ -52,12 +54,12 @@ def _child(element: Element, tag: str, path: str, ident: str | None = None) -> E
         if child.tag == tag and (ident is None or child.attrs.get("id") == ident):
             return child
     what = f"<{tag}>" if ident is None else f'<{tag} id="{ident}">'
-    raise _error(element, path, f"<{element.tag}> holds no {what}")
+    raise _error(element, path, N_("<{tag}> holds no {what}", tag=element.tag, what=what))
 
 
 def _found(root: Element, path: str) -> Found:
     if root.tag != "scxml":
-        raise _error(root, path, f"the document is <{root.tag}>, not <scxml>")
+        raise _error(root, path, N_("the document is <{tag}>, not <scxml>", tag=root.tag))
     data = _child(root, "datamodel", path).children
     kinds = {kind: tuple(_attr(d, "id", path) for d in data if d.attrs.get("tb:kind") == kind)
              for kind in ("motor", "lamp")}
@@ -69,7 +71,7 @@ def _found(root: Element, path: str) -> Found:
     values = {d.attrs.get("id", ""): d for d in data}
     wrapper = next((c for c in root.children if c.attrs.get("id") == WRAPPER), None)
     if wrapper is None:
-        raise _error(root, path, f'<scxml> holds no state with id="{WRAPPER}"')
+        raise _error(root, path, N_('<scxml> holds no state with id="{id}"', id=WRAPPER))
     several = wrapper.tag == "parallel"
     holders = [c for c in wrapper.children if c.tag == "state"] if several else [wrapper]
     for holder in holders:
@@ -77,7 +79,7 @@ def _found(root: Element, path: str) -> Found:
         prefix = f"{name}_" if several else ""
         timer = values.get(f"{prefix}timer")
         if timer is None:
-            raise _error(root, path, f"the data model has no {prefix}timer")
+            raise _error(root, path, N_("the data model has no {prefix}timer", prefix=prefix))
         table = FoundTable(name, tuple(_attr(holder, "tb:events", path).split()), _attr(holder, "tb:match", path),
                            _state(holder, _attr(holder, "initial", path), prefix, path), _int(timer, "expr", path),
                            tuple(holder.attrs.get("tb:writes", "").split()))
@@ -91,7 +93,7 @@ def _found(root: Element, path: str) -> Found:
 def _state(element: Element, ident: str, prefix: str, path: str) -> StateId:
     state = state_of(ident, prefix)
     if state is None:
-        raise _error(element, path, f"{ident!r} is no state id tablebot writes (s12, n_ and a name)")
+        raise _error(element, path, N_("{ident!r} is no state id tablebot writes (s12, n_ and a name)", ident=ident))
     return state
 
 
@@ -105,11 +107,12 @@ def _rows(element: Element, table: FoundTable, prefix: str, found: Found, path: 
         events = transition.attrs.get("tb:events", "").split()
         unknown = [e for e in events if e not in table.events]
         if unknown:
-            raise _error(transition, path, f"tb:events names {unknown[0]!r}, which is no event column of the table")
+            raise _error(transition, path, N_("tb:events names {name!r}, which is no event column of the table",
+                                                  name=unknown[0]))
         values = {a.attrs.get("location", ""): a for a in transition.children if a.tag == "assign"}
         timer = values.get(f"{prefix}timer")
         if timer is None:
-            raise _error(transition, path, f"this row does not load {prefix}timer")
+            raise _error(transition, path, N_("this row does not load {prefix}timer", prefix=prefix))
         rows.append(FoundRow(
             state=state, events=frozenset(events), timer=_int(timer, "expr", path),
             outputs={name: _int(a, "expr", path) for name, a in values.items() if name in outputs},
@@ -123,16 +126,17 @@ def _rows(element: Element, table: FoundTable, prefix: str, found: Found, path: 
 def _same(read: Element, made: Element, path: str) -> None:
     """The file's tree is the export's, or the first place it is not is a located error."""
     if read.tag != made.tag:
-        raise _error(read, path, f"<{read.tag}> where tablebot writes <{made.tag}>")
+        raise _error(read, path, N_("<{tag}> where tablebot writes <{made}>", tag=read.tag, made=made.tag))
     for name in {**made.attrs, **read.attrs}:
         if read.attrs.get(name) != made.attrs.get(name):
             want = made.attrs.get(name)
-            said = f"{name}={read.attrs[name]!r}" if name in read.attrs else f"no {name}"
-            raise _error(read, path, f"<{read.tag}> has {said}, where tablebot writes "
-                         + (f"{name}={want!r}" if want is not None else f"no {name}"))
+            said = f"{name}={read.attrs[name]!r}" if name in read.attrs else N_("no {name}", name=name)
+            wrote = f"{name}={want!r}" if want is not None else N_("no {name}", name=name)
+            raise _error(read, path, N_("<{tag}> has {said}, where tablebot writes {wrote}", tag=read.tag, said=said,
+                                        wrote=wrote))
     for child, model in zip(read.children, made.children, strict=False):
         _same(child, model, path)
     if len(read.children) != len(made.children):
         extra = read.children[len(made.children)] if len(read.children) > len(made.children) else read
-        raise _error(extra, path, f"<{read.tag}> holds {len(read.children)} elements, where tablebot writes "
-                     f"{len(made.children)}")
+        raise _error(extra, path, N_("<{tag}> holds {count} elements, where tablebot writes {made}", tag=read.tag,
+                                     count=len(read.children), made=len(made.children)))

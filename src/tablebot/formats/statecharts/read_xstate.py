@@ -16,12 +16,13 @@ from tablebot.diagnostics import fail
 from tablebot.formats.statecharts.chart import chart_of, state_of
 from tablebot.formats.statecharts.rebuild import Found, FoundRow, FoundTable, build
 from tablebot.formats.statecharts.xstate import FORMAT, xstate_config
+from tablebot.i18n import N_
 from tablebot.robot import Counter, StateId
 from tablebot.table import Table
 
 __all__ = ["read_xstate"]
 
-HINT = "import reads what tablebot export --to xstate wrote (machine.json), unchanged"
+HINT = N_("import reads what tablebot export --to xstate wrote (machine.json), unchanged")
 #: The deepest JSON read (the export nests eight deep).
 MAX_DEPTH = 64
 
@@ -33,16 +34,16 @@ class _At:
         self.value, self.path, self.file = value, path, file
 
     def error(self, message: str) -> Exception:
-        return fail(self.file, f"{self.path}: {message}", HINT)
+        return fail(self.file, N_("{path}: {message}", path=self.path, message=message), HINT)
 
     def __getitem__(self, key: str | int) -> _At:
         value = self.value
         if isinstance(key, int):
             if not isinstance(value, list) or not -len(value) <= key < len(value):
-                raise self.error(f"is no list with an item {key}")
+                raise self.error(N_("is no list with an item {key}", key=key))
             return _At(value[key], f"{self.path}[{key}]", self.file)
         if not isinstance(value, dict) or key not in value:
-            raise self.error(f"has no key {key!r}")
+            raise self.error(N_("has no key {key!r}", key=key))
         return _At(value[key], f"{self.path}.{key}", self.file)
 
     def get(self, key: str, default: Any) -> Any:
@@ -50,17 +51,17 @@ class _At:
 
     def of(self, kind: type, what: str) -> Any:
         if not isinstance(self.value, kind) or (isinstance(self.value, bool) and kind is not bool):
-            raise self.error(f"is {json.dumps(self.value)[:60]}, not {what}")
+            raise self.error(N_("is {value}, not {what}", value=json.dumps(self.value)[:60], what=what))
         return self.value
 
     def items(self) -> list[tuple[str, _At]]:
-        return [(k, self[k]) for k in self.of(dict, "an object")]
+        return [(k, self[k]) for k in self.of(dict, N_("an object"))]
 
     def list(self) -> list[_At]:
-        return [self[i] for i in range(len(self.of(list, "a list")))]
+        return [self[i] for i in range(len(self.of(list, N_("a list"))))]
 
     def names(self) -> tuple[str, ...]:
-        return tuple(item.of(str, "a name") for item in self.list())
+        return tuple(item.of(str, N_("a name")) for item in self.list())
 
 
 def read_xstate(text: str, path: str) -> tuple[Table, ...]:
@@ -68,9 +69,9 @@ def read_xstate(text: str, path: str) -> tuple[Table, ...]:
     try:
         config = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise fail(path, f"not JSON: {exc.msg}", HINT, exc.lineno, exc.colno) from None
+        raise fail(path, N_("not JSON: {error}", error=exc.msg), HINT, exc.lineno, exc.colno) from None
     except RecursionError:
-        raise fail(path, "nested too deep", HINT) from None
+        raise fail(path, N_("nested too deep"), HINT) from None
     root = _At(config, "$", path)
     tables = build(_found(root), path)
     _same(config, xstate_config(chart_of(tables)), "$", path, 0)
@@ -80,21 +81,22 @@ def read_xstate(text: str, path: str) -> tuple[Table, ...]:
 def _found(root: _At) -> Found:
     meta = root["meta"]["tablebot"]
     if meta["format"].value != FORMAT:
-        raise meta["format"].error(f"is {meta['format'].value!r}: this tablebot reads format {FORMAT}")
-    counters = tuple(Counter(c["name"].of(str, "a name"), c["motor"].of(str, "a name"))
+        raise meta["format"].error(N_("is {value!r}: this tablebot reads format {format}",
+                                            value=meta["format"].value, format=FORMAT))
+    counters = tuple(Counter(c["name"].of(str, N_("a name")), c["motor"].of(str, N_("a name")))
                      for c in meta["counters"].list())
-    found = Found(root["id"].of(str, "a name"), meta["tickMs"].of(int, "a whole number"), meta["inputs"].names(),
-                  meta["motors"].names(), meta["lamps"].names(), counters)
+    found = Found(root["id"].of(str, N_("a name")), meta["tickMs"].of(int, N_("a whole number")),
+                  meta["inputs"].names(), meta["motors"].names(), meta["lamps"].names(), counters)
     tables = meta["tables"].list()
     if not tables:
-        raise meta["tables"].error("names no table")
+        raise meta["tables"].error(N_("names no table"))
     several = len(tables) > 1
     for entry in tables:
-        name = entry["name"].of(str, "a name")
+        name = entry["name"].of(str, N_("a name"))
         prefix = f"{name}_" if several else ""
         holder = root["states"][name] if several else root
-        table = FoundTable(name, entry["events"].names(), entry["match"].of(str, "a rule"),
-                           _state(holder["initial"], prefix), root["context"][f"{prefix}timer"].of(int, "a number"),
+        table = FoundTable(name, entry["events"].names(), entry["match"].of(str, N_("a rule")),
+                           _state(holder["initial"], prefix), root["context"][f"{prefix}timer"].of(int, N_("a number")),
                            entry["writes"].names())
         for ident, state in holder["states"].items():
             source = _state(_At(ident, f"{state.path}", state.file), prefix)
@@ -108,14 +110,15 @@ def _is_row(transition: _At) -> bool:
     guard = transition["guard"]
     kind = guard.get("type", None)
     if kind not in ("row", "idle"):
-        raise guard.error(f"is {json.dumps(guard.value)[:60]}, not a row's guard (type row) or the idle one")
+        raise guard.error(N_("is {value}, not a row's guard (type row) or the idle one",
+                              value=json.dumps(guard.value)[:60]))
     return bool(kind == "row")
 
 
 def _state(at: _At, prefix: str) -> StateId:
-    state = state_of(at.of(str, "a state id"), prefix)
+    state = state_of(at.of(str, N_("a state id")), prefix)
     if state is None:
-        raise at.error(f"{at.value!r} is no state id tablebot writes (s12, n_ and a name)")
+        raise at.error(N_("{ident!r} is no state id tablebot writes (s12, n_ and a name)", ident=at.value))
     return state
 
 
@@ -126,36 +129,40 @@ def _event(flag: str, prefix: str) -> str:
 def _row(transition: _At, state: StateId, table: FoundTable, prefix: str) -> FoundRow:
     params = transition["guard"]["params"]
     events = {_event(flag, prefix) for flag in params["flags"].names()}
-    events |= {cross["column"].of(str, "a column") for cross in params["cross"].list()}
+    events |= {cross["column"].of(str, N_("a column")) for cross in params["cross"].list()}
     unknown = sorted(events - set(table.events))
     if unknown:
-        raise params.error(f"names {unknown[0]!r}, which is no event column of the table")
+        raise params.error(N_("names {name!r}, which is no event column of the table", name=unknown[0]))
     fire = transition["actions"][0]["params"]
     meta = transition["meta"]
     return FoundRow(state=state, events=frozenset(events),
-                    outputs={name: value.of(int, "a number") for name, value in fire["set"].items()},
-                    timer=fire["load"].of(int, "a number"), next=_state(transition["target"], prefix),
-                    description=_optional(transition, "description", str, ""), written=meta["row"].of(int, "a number"),
+                    outputs={name: value.of(int, N_("a number")) for name, value in fire["set"].items()},
+                    timer=fire["load"].of(int, N_("a number")), next=_state(transition["target"], prefix),
+                    description=_optional(transition, "description", str, ""),
+                    written=meta["row"].of(int, N_("a number")),
                     group=_optional(meta, "group", str, ""), index=_optional(meta, "index", int, 0))
 
 
 def _optional(at: _At, key: str, kind: type, default: Any) -> Any:
     """A key the export writes only sometimes (a group row's group and index), of its type when there."""
-    return at[key].of(kind, "a number" if kind is int else "text") if key in at.of(dict, "an object") else default
+    if key not in at.of(dict, N_("an object")):
+        return default
+    return at[key].of(kind, N_("a number") if kind is int else N_("text"))
 
 
 def _same(read: Any, made: Any, where: str, path: str, depth: int) -> None:
     """The file's config is the export's, or the first JSON path where it is not is the error."""
     if depth > MAX_DEPTH:
-        raise fail(path, f"{where}: nested deeper than {MAX_DEPTH}", HINT)
+        raise fail(path, N_("{where}: nested deeper than {most}", where=where, most=MAX_DEPTH), HINT)
     if isinstance(made, dict) and isinstance(read, dict):
         for key in {**made, **read}:
             if key not in read or key not in made:
-                raise fail(path, f"{where}: " + (f"has no key {key!r}" if key not in read else
-                                                  f"has a key {key!r} tablebot does not write"), HINT)
+                raise fail(path, N_("{where}: has no key {key!r}", where=where, key=key) if key not in read else
+                           N_("{where}: has a key {key!r} tablebot does not write", where=where, key=key), HINT)
             _same(read[key], made[key], f"{where}.{key}", path, depth + 1)
     elif isinstance(made, list) and isinstance(read, list) and len(made) == len(read):
         for i, (got, want) in enumerate(zip(read, made, strict=True)):
             _same(got, want, f"{where}[{i}]", path, depth + 1)
     elif read != made or type(read) is not type(made):
-        raise fail(path, f"{where}: is {json.dumps(read)[:80]}, where tablebot writes {json.dumps(made)[:80]}", HINT)
+        raise fail(path, N_("{where}: is {value}, where tablebot writes {made}", where=where,
+                            value=json.dumps(read)[:80], made=json.dumps(made)[:80]), HINT)

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 from tablebot.robot import MATCHES, Counter, Match, Robot, StateId
 from tablebot.robot_tables import TableSpec, parse_cross, spec_robot
 from tablebot.table import Row, Table
@@ -55,14 +56,17 @@ class Found:
     tables: list[FoundTable] = field(default_factory=list)
 
 
+AS_EXPORTED = N_("write what tablebot export wrote")
+
+
 def build(found: Found, path: str, where: tuple[int | None, int | None] = (None, None)) -> tuple[Table, ...]:
     """The tables (the main one first); no table, or a rule that is neither of tablebot's, is a located error."""
     if not found.tables:
-        raise fail(path, "the statechart holds no table", "write what tablebot export wrote", *where)
+        raise fail(path, N_("the statechart holds no table"), AS_EXPORTED, *where)
     for table in found.tables:
         if table.match not in MATCHES:
-            raise fail(path, f"matching rule {table.match!r} is not one of {', '.join(MATCHES)}",
-                       "write what tablebot export wrote", *where)
+            raise fail(path, N_("matching rule {match!r} is not one of {matches}", match=table.match,
+                                matches=tuple(MATCHES)), AS_EXPORTED, *where)
     robot = Robot(name=found.name, inputs=found.inputs, motors=found.motors, lamps=found.lamps,
                   counters=found.counters, tick_ms=found.tick_ms, source=path)
     if len(found.tables) == 1:
@@ -93,7 +97,7 @@ def _table(robot: Robot, found: FoundTable, path: str, name: str) -> Table:
     for event in found.events:
         parsed = parse_cross(event, robot) if name else None
         if isinstance(parsed, str):
-            raise fail(path, f"event column {event!r}: {parsed}", "write what tablebot export wrote")
+            raise fail(path, N_("event column {event!r}: {problem}", event=event, problem=parsed), AS_EXPORTED)
         if parsed is not None:
             cross[event] = parsed
     writes = {output: (0, 0) for output in found.writes}

@@ -10,6 +10,7 @@ from xml.parsers import expat
 
 from tablebot.diagnostics import fail
 from tablebot.escape import xml_attr
+from tablebot.i18n import N_
 
 __all__ = ["Element", "parse", "serialise"]
 
@@ -76,7 +77,7 @@ def parse(text: str, path: str) -> Element:
 
     def start(name: str, attrs: dict[str, str]) -> None:
         if len(stack) >= MAX_DEPTH:
-            refuse(f"elements nested more than {MAX_DEPTH} deep", "tablebot's export nests five deep")
+            refuse(N_("elements nested more than {most} deep", most=MAX_DEPTH), N_("tablebot's export nests five deep"))
         line, column = where()
         element = Element(_name(name, path, line, column), {_name(k, path, line, column): v for k, v in attrs.items()},
                           line=line, column=column)
@@ -85,14 +86,14 @@ def parse(text: str, path: str) -> Element:
 
     def chars(data: str) -> None:
         if data.strip():
-            refuse("text inside an element", "tablebot's SCXML holds everything in attributes")
+            refuse(N_("text inside an element"), N_("tablebot's SCXML holds everything in attributes"))
 
     def doctype(*_: object) -> None:
         line, column = where()  # expat is past the DOCTYPE's name: point at its start
         before = text.splitlines()[line - 1][:column] if line <= len(text.splitlines()) else ""
         start = before.rfind("<!DOCTYPE")
-        raise fail(path, "a DOCTYPE (a DTD can declare entities, and a table is data)", "remove the <!DOCTYPE ...>",
-                   line, start + 1 if start >= 0 else column)
+        raise fail(path, N_("a DOCTYPE (a DTD can declare entities, and a table is data)"),
+                   N_("remove the <!DOCTYPE ...>"), line, start + 1 if start >= 0 else column)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = lambda name: stack.pop()
@@ -102,8 +103,8 @@ def parse(text: str, path: str) -> Element:
     try:
         parser.Parse(text, True)
     except expat.ExpatError as exc:
-        raise fail(path, f"not well-formed XML: {expat.ErrorString(exc.code)}",
-                   "an SCXML file as tablebot export --to scxml writes it", exc.lineno, exc.offset + 1) from None
+        raise fail(path, N_("not well-formed XML: {error}", error=expat.ErrorString(exc.code)),
+                   N_("an SCXML file as tablebot export --to scxml writes it"), exc.lineno, exc.offset + 1) from None
     return done[0]
 
 
@@ -114,6 +115,6 @@ def _name(name: str, path: str, line: int, column: int) -> str:
     if not space:
         return local
     if space not in PREFIXES:
-        raise fail(path, f"{local!r} is in the namespace {space!r}", "tablebot reads SCXML and its own attributes",
-                   line, column)
+        raise fail(path, N_("{name!r} is in the namespace {space!r}", name=local, space=space),
+                   N_("tablebot reads SCXML and its own attributes"), line, column)
     return PREFIXES[space] + local

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.hw.serial_address import parse_serial_address
+from tablebot.i18n import N_
 from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
@@ -15,11 +16,11 @@ if TYPE_CHECKING:
     from tablebot.machine import Machine
 
 ADDRESSES = ("roboif://auto", "roboif:///dev/ttyUSB0 (its serial port)", "roboif://COM1")
-ADDRESS_HINT = "write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)"
-CONNECT_HINT = ("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
-                "serial port only, not on its USB port (docs/controllers.md)")
-FASTER = ("a ROBO TX or a TXT on its USB cable: the interface's serial port runs at 38400 baud only, and tablebot "
-          "does not drive its USB port")
+ADDRESS_HINT = N_("write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)")
+CONNECT_HINT = N_("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
+                  "serial port only, not on its USB port (docs/controllers.md)")
+FASTER = N_("a ROBO TX or a TXT on its USB cable: the interface's serial port runs at 38400 baud only, and tablebot "
+            "does not drive its USB port")
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -50,16 +51,17 @@ def open_roboif(machine: Machine, link: LinkOptions) -> Opened:
     if device is None:
         device = find()
         if device is None:
-            raise fail("--on", "roboif://auto found no serial port that answers as a ROBO Interface", CONNECT_HINT)
+            raise fail("--on", N_("roboif://auto found no serial port that answers as a ROBO Interface"), CONNECT_HINT)
     bot = RoboifRobot(wiring, device, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         bot.connect()
     except LinkLost as exc:
-        raise fail("--on", str(exc), CONNECT_HINT) from None
-    line = (f"its {wire.REQUEST_BYTES + wire.REPLY_BYTES} bytes alone take {1000 * wire.EXCHANGE_LINE_S:.1f} ms "
-            f"on the {wire.BAUD}-baud line")
+        raise fail("--on", exc.args[0], CONNECT_HINT) from None
+    line = N_("its {count} bytes alone take {ms:.1f} ms on the {baud}-baud line",
+              count=wire.REQUEST_BYTES + wire.REPLY_BYTES, ms=1000 * wire.EXCHANGE_LINE_S, baud=wire.BAUD)
     warnings = check_link(bot, machine, link, lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
-                          "one exchange with the ROBO Interface", line=line, faster=FASTER, connect_hint=CONNECT_HINT)
+                          N_("one exchange with the ROBO Interface"), line=line, faster=FASTER,
+                          connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)", warnings)
 
 

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
 from tablebot.hw.serial_address import parse_serial_address
+from tablebot.i18n import N_
 from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
@@ -15,10 +16,11 @@ if TYPE_CHECKING:
     from tablebot.machine import Machine
 
 ADDRESSES = ("robotx://auto", "robotx:///dev/ttyACM0 (USB)", "robotx:///dev/rfcomm0 (Bluetooth)", "robotx://COM3")
-ADDRESS_HINT = "write --on robotx://auto, robotx:///dev/ttyACM0 (USB), robotx:///dev/rfcomm0 (Bluetooth) or robotx://COM3"
-CONNECT_HINT = ("is the ROBO TX on and connected? Over USB it is a serial port /dev/ttyACM* (USB id 221d:1000); over "
-                "Bluetooth pair it and bind an rfcomm device first (docs/controllers.md)")
-FASTER = "the ROBO TX on its USB cable, robotx:///dev/ttyACM0, rather than Bluetooth"
+ADDRESS_HINT = N_("write --on robotx://auto, robotx:///dev/ttyACM0 (USB), robotx:///dev/rfcomm0 (Bluetooth) or "
+                  "robotx://COM3")
+CONNECT_HINT = N_("is the ROBO TX on and connected? Over USB it is a serial port /dev/ttyACM* (USB id 221d:1000); "
+                  "over Bluetooth pair it and bind an rfcomm device first (docs/controllers.md)")
+FASTER = N_("the ROBO TX on its USB cable, robotx:///dev/ttyACM0, rather than Bluetooth")
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -48,15 +50,16 @@ def open_robotx(machine: Machine, link: LinkOptions) -> Opened:
     if device is None:
         found = find()
         if found is None:
-            raise fail("--on", "robotx://auto found no serial port that answers as a ROBO TX Controller", CONNECT_HINT)
+            raise fail("--on", N_("robotx://auto found no serial port that answers as a ROBO TX Controller"),
+                       CONNECT_HINT)
         device = found[0]
     bot = RobotxRobot(wiring, device, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         info = bot.connect()
     except LinkLost as exc:
-        raise fail("--on", str(exc), CONNECT_HINT) from None
+        raise fail("--on", exc.args[0], CONNECT_HINT) from None
     warnings = check_link(bot, machine, link, lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
-                          "one exchange with the ROBO TX", faster=FASTER, connect_hint=CONNECT_HINT)
+                          N_("one exchange with the ROBO TX"), faster=FASTER, connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, f"{info.device} {info.version_text}", warnings)
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import Diagnostic, fail
+from tablebot.i18n import N_
 from tablebot.registry import LinkOptions, LiveBackend, Opened, refused, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
@@ -15,11 +16,11 @@ if TYPE_CHECKING:
 
 PORT = 65000
 ADDRESSES = ("txt://192.168.7.2 (USB)", "txt://HOST:PORT", "txt://auto")
-FIRMWARE_HINT = "update the TXT's firmware to 4.6.6 or later"
-ADDRESS_HINT = "write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto"
-CONNECT_HINT = ("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
-                "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
-FASTER = "the TXT on its USB cable, txt://192.168.7.2, rather than Wi-Fi or Bluetooth"
+FIRMWARE_HINT = N_("update the TXT's firmware to 4.6.6 or later")
+ADDRESS_HINT = N_("write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto")
+CONNECT_HINT = N_("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
+                  "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
+FASTER = N_("the TXT on its USB cable, txt://192.168.7.2, rather than Wi-Fi or Bluetooth")
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -39,11 +40,11 @@ def parse_address(text: str, hint: str) -> tuple[str | None, int]:
     """``txt://HOST[:PORT]`` -> (HOST, PORT); ``txt://auto[:PORT]`` -> (None, PORT or 65000); anything else
     a located error."""
     if not text.startswith("txt://"):
-        raise fail("--on", f"unknown target {text!r}", hint)
+        raise fail("--on", N_("unknown target {text!r}", text=text), hint)
     rest = text[len("txt://"):].rstrip("/")
     host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
     if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
-        raise fail("--on", f"{text!r} is not txt://HOST or txt://HOST:PORT", hint)
+        raise fail("--on", N_("{text!r} is not txt://HOST or txt://HOST:PORT", text=text), hint)
     return None if host == "auto" else host, int(port) if port else PORT
 
 
@@ -62,17 +63,17 @@ def open_txt(machine: Machine, link: LinkOptions) -> Opened:
     if host is None:
         host, tried = txt_link.find_controller(txt_link.AUTO_HOSTS, port)
         if host is None:
-            raise fail("--on", "txt://auto found no TXT: " + "; ".join(tried), CONNECT_HINT)
+            raise fail("--on", N_("txt://auto found no TXT: {tried}", tried="; ".join(tried)), CONNECT_HINT)
     bot = TxtRobot(wiring, host, port, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         status = bot.connect()
     except FirmwareTooOld as exc:
-        raise fail("--on", str(exc), FIRMWARE_HINT) from None
+        raise fail("--on", exc.args[0], FIRMWARE_HINT) from None
     except LinkLost as exc:
-        raise fail("--on", str(exc), CONNECT_HINT) from None
+        raise fail("--on", exc.args[0], CONNECT_HINT) from None
     # Before going online only QueryStatus can be asked; it costs the network's round trip, as each exchange
     # does (a TXT then paces exchanges at 10 ms on its own side).
-    warnings = check_link(bot, machine, link, bot.link.query_status, "a round trip to the controller",
+    warnings = check_link(bot, machine, link, bot.link.query_status, N_("a round trip to the controller"),
                           faster=FASTER, connect_hint=CONNECT_HINT)
     return Opened(bot, bot.target, f"{status.device} {status.version_text}", warnings)
 
