@@ -29,6 +29,7 @@ from typing import Any, TypeVar
 
 from tablebot.engine import Engine
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW, Machine
 
 Node = tuple[int, int, int, tuple[int, ...], bool]
@@ -113,7 +114,8 @@ class Model:
             spare = m.input_mask & ~bits
             bits |= spare & -spare
         if bits.bit_count() > MAX_ENUMERATED_BITS:
-            raise ModelTooLarge(f"state {m.states[state]} depends on {bits.bit_count()} inputs")
+            raise ModelTooLarge(N_("state {state} depends on {count} inputs", state=m.states[state],
+                                   count=bits.bit_count()))
         seen: dict[tuple[int, int], int] = {}
         for inputs in sorted(subsets(bits), key=lambda x: (x.bit_count(), x)):
             events = inputs | context
@@ -240,7 +242,7 @@ def reachable(start: K, successors: Callable[[K], Iterable[tuple[Any, ...]]], bu
                 order.append(nxt)
                 queue.append(nxt)
                 if len(order) > budget:
-                    raise ModelTooLarge(f"more than {budget} reachable situations")
+                    raise ModelTooLarge(N_("more than {budget} reachable situations", budget=budget))
     return order
 
 

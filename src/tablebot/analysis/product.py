@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from tablebot.analysis.model import MAX_ENUMERATED_BITS, ZERO_PULSES, Graph, ModelTooLarge, memoised, reachable, subsets
 from tablebot.engine.several import Several
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.machine import NO_ROW
 from tablebot.tables import RobotTables
 
@@ -50,7 +51,7 @@ class ProductModel:
         self.omega = self.horizon + 1
         self.width = len(tables.input_bits)
         if self.width > MAX_ENUMERATED_BITS:
-            raise ModelTooLarge(f"the robot's tables read {self.width} inputs")
+            raise ModelTooLarge(N_("the robot's tables read {count} inputs", count=self.width))
         self.timer_word = 1 << self.width  # the main table's T in the event word
         robot = tables.robot
         self.counter_word = tuple(1 << (self.width + 1 + c) for c in range(len(robot.counters)))
