@@ -183,8 +183,8 @@ def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio:
 
 
 def test_a_german_walk_through_the_tabs(browser: Any, studio: Background, shots: Path) -> None:
-    """A German browser: the tabs' tips, why each row of the drive table fired or not (said by the server in the
-    tab's language), and the lights tab's status line speak German."""
+    """A German browser: the tabs' tips, why each row of the drive table and of the lights table fired or not (said
+    by the server in the tab's language), and the lights tab's status line speak German."""
     page = open_page(browser, studio.url, 1280, 720, "de-DE")
     assert page.inner_text("#save") == "Speichern"
     page.click("#step")
@@ -195,6 +195,10 @@ def test_a_german_walk_through_the_tabs(browser: Any, studio: Background, shots:
     show(page, "lights", "drive=1,2")
     page.click("#step")
     wait_for(lambda: "Zustand flash_" in page.inner_text("#status"), "the lights table's state, in German", 30)
+    # why the lights table's rows of its state fired or not: its own rows (a group's row among them), by line
+    wait_for(lambda: any(line.startswith("Zeile 5 (Seeking: flash right) hat nicht geschaltet: sie braucht T")
+                         for line in page.eval_on_selector_all("#why li", "ls => ls.map(l => l.textContent)")),
+             "why the lights table's rows did not fire", 30)
     assert page.get_attribute("#table-tabs button[data-table=drive]", "title") == "Tabelle drive (table.csv)"
     page.screenshot(path=str(shots / "german-walk.png"))
     assert page.errors == []

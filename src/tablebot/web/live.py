@@ -150,6 +150,7 @@ class Latest:
     row: int = -1
     outputs: tuple[int, ...] = ()
     extra: dict[str, Any] | None = None
+    prev_extra: dict[str, Any] | None = None  # the tick before's (a robot's other tables: their states before it)
 
 
 class FrameSink:
@@ -183,6 +184,7 @@ class FrameSink:
             latest.tick, latest.timer, latest.event = block.start + k, int(block.timers[k]), int(block.events[k])
             latest.mask, latest.row = int(block.masks[k]), int(block.rows[k])
             latest.outputs = tuple(int(v) for v in block.outputs[k])
+            latest.prev_extra = {name: values[k - 1] for name, values in extra.items()} if k else latest.extra
             latest.extra = {name: values[k] for name, values in extra.items()}
             self.ticks_seen += len(block)
 

@@ -187,7 +187,10 @@ class Arena:
         frame["lamps"] = {name: latest.outputs[i] for i, name in enumerate(self.machine.output_names)
                           if name in self.table.robot.lamps}
         if self.tables is not None and self.view and self.view != self.tables.names[0]:
-            return {**frame, **viewed(self.tables, self.view, extra, latest.tick), "why": []}
+            shown = viewed(self.tables, self.view, extra, latest.tick)
+            if run.paused:
+                shown["why"] = why_viewed(self.tables, self.view, latest.prev_extra, extra, explain)
+            return {**frame, **shown}
         if run.paused:
             frame["why"] = explain(self.table, self.machine, latest.prev_state, latest.event)
         return frame
@@ -232,6 +235,17 @@ def viewed(tables: RobotTables, name: str, extra: dict[str, Any], tick: int) -> 
     return {"state": states.index(state) if state in states else 0, "state_id": str(state), "row": row,
             "timer": extra.get(f"{name}.timer", 0), "event": extra.get(f"{name}.event", 0),
             "fired": [[tick, row]] if row >= 0 else []}
+
+
+def why_viewed(tables: RobotTables, name: str, before: dict[str, Any] | None, extra: dict[str, Any],
+               explain: Callable[..., list[dict[str, Any]]]) -> list[dict[str, Any]]:
+    """Why each row of table ``name``'s state fired or not on the latest tick: its state before the tick (the
+    tick before's ``NAME.state``; on the first, its start) and its events then."""
+    k = tables.index(name)
+    table, machine = tables.tables[k], tables.machines[k]
+    state = (before or {}).get(f"{name}.state", table.robot.initial_state)
+    index = machine.states.index(state) if state in machine.states else 0
+    return explain(table, machine, index, int(extra.get(f"{name}.event", 0)))
 
 
 def _robot(scene: Scene, seed: int) -> SimRobot:
