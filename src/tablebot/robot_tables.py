@@ -207,7 +207,7 @@ def _read_groups(src: Source, data: Any, robot: Robot) -> dict[str, tuple[StateI
                   for m in members] if isinstance(members, list) else [None]
         if not states or None in states:
             src.key_error(where, N_("group {name} must list its states, not {members!r}", name=name, members=members),
-                          N_("for example: {example}", example=f"{name} = [1, 2, 11]"))
+                          N_("for example: {example}", example=name + " = [1, 2, 11]"))
             continue
         if len(set(states)) != len(states):
             src.key_error(where, N_("group {name} lists a state twice", name=name), N_("list each state once"))

@@ -159,7 +159,7 @@ def _writer_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
                 found.append(Diagnostic(
                     table.path, line, column,
                     N_("{output} is written by two tables, {first} ({place}) and {second}", output=output,
-                       first=owner.name, place=f"{owner.path}:{at[0]}:{at[1]}", second=table.name),
+                       first=owner.name, place=":".join(map(str, (owner.path, *at))), second=table.name),
                     N_("each motor, lamp and counter load has one writer: remove the {output} column from one table",
                        output=output)))
     return found

@@ -77,7 +77,7 @@ def load_challenge(path: str | Path) -> Challenge:
 def _text(src: Source, key: str, value: Any) -> str:
     if not isinstance(value, str):
         src.key_error(("", None, key), N_("{key} must be text in quotes, not {value!r}", key=key, value=value),
-                      N_("for example: {example}", example=f'{key} = "..."'))
+                      N_("for example: {example}", example=key + ' = "..."'))
         return ""
     return value
 
@@ -86,7 +86,7 @@ def _list(src: Source, key: str, data: dict[str, Any]) -> list[Any]:
     value = data.get(key, [])
     if not isinstance(value, list):
         src.key_error(("", None, key), N_("{key} must be a list", key=key),
-                      N_("for example: {example}", example=f'{key} = ["arena.toml"]'))
+                      N_("for example: {example}", example=key + ' = ["arena.toml"]'))
         return []
     return value
 

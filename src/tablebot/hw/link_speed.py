@@ -93,7 +93,8 @@ def judge(machine: Machine, link: LinkTime, accept_slow: bool) -> tuple[str, ...
         return (N_("{target}: {took}, {share:.0%} of the table's {tick_ms} ms tick: ticks will start late when this "
                    "machine or the link is busy (tick_ms = {suggested} would leave room)", target=link.target,
                    took=took, share=need / tick_s, tick_ms=robot.tick_ms, suggested=suggested),)
-    slow = N_("at least {percent} slow", percent=f"{100 * (need / tick_s - 1):.0f} %") if need > tick_s else N_("slow")
+    late = format(100 * (need / tick_s - 1), ".0f") + " %"  # outside the msgid: "% s" would read as printf's
+    slow = N_("at least {percent} slow", percent=late) if need > tick_s else N_("slow")
     if accept_slow:
         return (N_("{target}: {took}, more than the table's {tick_ms} ms tick can hold: running anyway "
                    "(--behind-limit 0), so the table's timers will run {slow}", target=link.target, took=took,
