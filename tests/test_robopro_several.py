@@ -77,9 +77,15 @@ def test_one_process_per_table_and_names_that_do_not_collide(lights: RobotTables
     text = generate_several(lights)
     subs = functions(text)
     starts = [e for e in subs["Main program"].findall("o") if e.get("classname") == "ftProProcessStart"]
+    assert len(starts) == 3  # the clock, then a process per table, each a Start of the main program
+    assert set(subs) == {"Main program", *(f"{table} {sub}" for table in ("drive", "lights") for sub in (
+        "DetectEvent", "DetermineAction", "ExecuteAction", "CountDown", "WaitTick"))}
     calls = [e.get("name") for e in subs["Main program"].findall("o") if e.get("classname") == "ftProSubroutineRef"]
-    assert len(starts) == 3 and calls == ["Tick clock", "drive process", "lights process"]
-    assert {"drive DetectEvent", "lights DetectEvent", "drive WaitTick", "lights ExecuteAction"} <= set(subs)
+    assert calls == [f"{table} {sub}" for table in ("drive", "lights") for sub in (
+        "WaitTick", "DetectEvent", "DetermineAction", "ExecuteAction", "WaitTick", "CountDown")]
+    for name, sub in subs.items():  # as every real subprogram: an entry and an exit (the processes never return)
+        kinds = {e.get("classname") for e in sub.findall("o")}
+        assert name == "Main program" or {"ftProSubroutineFlowIn", "ftProSubroutineFlowOut"} <= kinds, name
     root = ET.fromstring(text.encode("utf-8"))
     lists = {o.get("name", "") for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
     assert lists == {"drive Event", "drive Action", "drive Timer", "lights Event", "lights Action", "lights Timer",
@@ -87,9 +93,9 @@ def test_one_process_per_table_and_names_that_do_not_collide(lights: RobotTables
     lamps = {(o.get("output"), f) for f, sub in subs.items() for o in sub.iter("o")
              if o.get("classname") == "ftProDataOutSngl"}
     assert {output for output, _ in lamps} == {"4", "5"}  # O5 and O6, as the robot file wires them on the TXT
-    assert {f for _, f in lamps} == {"lights process", "lights ExecuteAction"}  # only the lights table drives them
+    assert {f for _, f in lamps} == {"Main program", "lights ExecuteAction"}  # off at the start, then by its rows
     motors = {f for f, sub in subs.items() for o in sub.iter("o") if o.get("classname") == "ftProDataOutDual"}
-    assert motors == {"drive process", "drive ExecuteAction"}
+    assert motors == {"Main program", "drive ExecuteAction"}
     assert vocabulary_problems(text) == []
 
 

@@ -1,23 +1,27 @@
 """The ROBO Pro program of a robot of several tables (``[tables]``): one process per table, as the document's
 main program runs its FlashLights routine beside the engine, and a clock process that keeps them in step.
 
-ROBO Pro runs every Start of the main program as a process of its own, switching between them as it likes, so
-the tables' rule (:mod:`tablebot.tables`: inputs read once per tick, cross-table events from the states at the
-start of the tick) needs a barrier. The clock process ("Tick clock") takes the tick's image before any table
-looks: each input a table reads into ``in I3``, each counter into ``C1 tick``, each table's state ``drive ST``
-into ``drive S0``; then it flips ``TICK`` (0, 1, 0, …: a 16-bit count would overflow after 32767 ticks), waits
-one tick, waits until ``DONE`` says every table has finished, sets it to 0 and counts the counters down. Each
-table's process ("drive process") is the document's engine loop on the table's own variables, lists and
-subprograms (``drive ST``, ``drive Event``, ``drive DetectEvent``): it waits until ``TICK`` is not what it last
-saw (``drive WaitTick``, looking every millisecond), runs DetectEvent (reading the image: cross-table columns
-through a list by the other table's state number, ``drive from lights``), DetermineAction and ExecuteAction,
-adds 1 to ``DONE``, waits for the next tick and counts its timer down. A table writes only the outputs it has
-columns for, so no two processes drive one output, and none reads what another writes during the tick: the
-order ROBO Pro runs them in changes nothing (the interpreter switches between them at random after any element
-to show it: tests/test_robopro_several.py).
+ROBO Pro runs every Start of the main program as a process of its own (real main programs hold several: the
+corpus's TeachIn robot eleven), switching between them as it likes, so the tables' rule (:mod:`tablebot.tables`:
+inputs read once per tick, cross-table events from the states at the start of the tick) needs a barrier. The
+clock process (the main program's first Start) takes the tick's image before any table looks: each input a table
+reads into ``in I3``, each counter into ``C1 tick``, each table's state ``drive ST`` into ``drive S0``; then it
+flips ``TICK`` (0, 1, 0, …: a 16-bit count would overflow after 32767 ticks), waits one tick, waits until
+``DONE`` says every table has finished, sets it to 0 and counts the counters down. Each table's process (a Start
+of its own beside it) is the document's engine loop on the table's own variables, lists and subprograms
+(``drive ST``, ``drive Event``, ``drive DetectEvent``): it waits until ``TICK`` is not what it last saw
+(``drive WaitTick``, looking every millisecond), runs DetectEvent (reading the image: cross-table columns through
+a list by the other table's state number, ``drive from lights``), DetermineAction and ExecuteAction, adds 1 to
+``DONE``, waits for the next tick and counts its timer down. A table writes only the outputs it has columns for,
+so no two processes drive one output, and none reads what another writes during the tick: the order ROBO Pro
+runs them in changes nothing (the interpreter switches between them at random after any element to show it:
+tests/test_robopro_several.py).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from functools import partial
 
 from tablebot.diagnostics import Diagnostic, TableBotError
 from tablebot.i18n import N_
@@ -42,10 +46,10 @@ from tablebot.robopro.sheet import Const, Count, Input, Op, Sheet, Tree, Var
 from tablebot.robopro.wiring import wiring
 from tablebot.tables import RobotTables
 
-__all__ = ["CLOCK", "generate_several", "plans", "several_problems"]
+__all__ = ["generate_several", "plans", "several_problems"]
 
-CLOCK = "Tick clock"
 WAIT_TICK = "WaitTick"
+NOTES_WIDTH = 160  # room for a column's comments before the next process's column
 POLL_MS = 1  # how often a table's process looks for the next tick
 MIN_TICK_MS = 10  # a tick must leave the processes time to look for it and run
 
@@ -85,16 +89,12 @@ def generate_several(tables: RobotTables) -> str:
     ids, subs, inits = Ids(), dict[str, Sub](), dict[str, int]()
     builders = [Builder(p, f"{p.table.name} ", ids, subs, inits) for p in ps]
     inits.update({f"{p.table.name} S0": p.initial_state for p in ps})
-    order = [MAIN, CLOCK]
     for b in builders:
         for build in ENGINE:
             build(b)
         wait_tick(b)
-        table_process(b)
-        order += [b.v("process"), *(n for n in subs if n.startswith(b.prefix) and n != b.v("process"))]
-    clock(Builder(ps[0], "", ids, subs, inits), tables)
-    main_program(Builder(ps[0], "", ids, subs, inits), [f"{p.table.name} process" for p in ps])
-    return document(ids, ps[0], [subs[name] for name in order])
+    main = main_program(Builder(ps[0], "", ids, subs, inits), tables, builders)
+    return document(ids, ps[0], [main, *(sub for name, sub in subs.items() if name != MAIN)])
 
 
 def wait_tick(b: Builder) -> Sub:
@@ -112,10 +112,9 @@ def wait_tick(b: Builder) -> Sub:
     return b.finish(b.v(WAIT_TICK), s, [(EXIT, 2)], "Wait until the clock process starts the next tick")
 
 
-def table_process(b: Builder) -> Sub:
-    """The table's engine: its start, then each tick once the clock has started it, DONE + 1 when it is done."""
-    s = b.sheet()
-    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+def table_process(b: Builder, s: Sheet) -> None:
+    """The table's engine after its Start: its start, then each tick once the clock has started it, DONE + 1
+    when it is done."""
     begin_outputs(b, s)
     b.call(s, b.v(WAIT_TICK))
 
@@ -124,14 +123,13 @@ def table_process(b: Builder) -> Sub:
         done = b.assign(s, "DONE", "+", 1)
         b.note(s, done, "this table's tick is done")
         b.call(s, b.v(WAIT_TICK))
-    engine_loop(b, s, end_tick)
-    return b.finish(b.v("process"), s, [], f"Table {b.p.table.name}: " + b.p.summary(), inputs=[(ENTRY, 1)])
+    engine_loop(b, s, end_tick, notes=False)
 
 
-def clock(b: Builder, tables: RobotTables) -> Sub:
-    """The tick's image (inputs, counters, states), TICK flipped, one tick, the barrier, the counters down."""
-    s, wired, robot = b.sheet(), b.p.wiring, tables.robot
-    s.begin(el.flow_in(COLUMN, 8, ENTRY, 1))
+def clock(b: Builder, s: Sheet, tables: RobotTables) -> None:
+    """After its Start: the tick's image (inputs, counters, states), TICK flipped, one tick, the barrier, the
+    counters down, and again."""
+    wired, robot = b.p.wiring, tables.robot
     for name, counter in wired.counters.items():
         b.assign(s, name, "=", 0)
         b.assign(s, f"{name} last", "=", data=Count(counter))
@@ -158,24 +156,32 @@ def clock(b: Builder, tables: RobotTables) -> Sub:
     assert loop_wire is not None and done_wire is not None
     s.loop_back(pause.pins_of("flowobjectoutput")[0], done_wire, (done_in[0], done_in[1] - 4))
     s.loop_back(last.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
-    return b.finish(CLOCK, s, [], "Keeps the tables' processes in step: one tick each, all from the same image",
-                    inputs=[(ENTRY, 1)])
 
 
-def main_program(b: Builder, processes: list[str]) -> Sub:
-    """A Start per process, side by side: the clock, then each table's engine."""
-    canvas = Canvas(b.ids)
-    x = COLUMN
-    for n, name in enumerate([CLOCK, *processes]):
+def main_program(b: Builder, tables: RobotTables, builders: list[Builder]) -> Sub:
+    """A Start per process, as real main programs run several: the clock's column first (the process whose Wait
+    is the tick), then each table's engine; each column's comments right of it; the tables' lists below all."""
+    canvas, x, low = Canvas(b.ids), COLUMN, 0
+    columns: list[tuple[Callable[[Sheet], None], str]] = [
+        (lambda s: clock(b, s, tables), "the clock: keeps the tables' processes in step")]
+    columns += [(partial(table_process, t), f"table {t.p.table.name}") for t in builders]
+    for body, title in columns:
         sheet = Sheet(canvas, x, b.inits, INDENT)
-        sheet.begin(el.start(x, 8))
-        b.call(sheet, name)
-        text = "keeps the tables in step" if n == 0 else f"table {name.removesuffix(' process')}"
-        canvas.comments.append(caption(INDENT, b.ids(), text, (x, 40), size=2, align="336", linespace="0"))
-        x += 64
-    summary = (f"Generated by tablebot for {b.p.table.robot.name} ({b.p.wiring.controller}): one process per "
-               f"table ({', '.join(p.removesuffix(' process') for p in processes)}) and a clock that starts each "
-               "tick for all of them from the same inputs and states.")
+        start = sheet.begin(el.start(x, 8))
+        sheet.note(start.y, title)
+        body(sheet)
+        notes_x = max(sheet.right, sheet.lanes) + 24
+        for y, text in sheet.notes:
+            canvas.comments.append(caption(INDENT, b.ids(), text, (notes_x, y), size=3, align="336", linespace="0"))
+        x = notes_x + NOTES_WIDTH + COLUMN
+        low = max(low, sheet.y)
+    lines = [line for t in builders for line in t.p.table_notes()]
+    for n, line in enumerate(lines):
+        canvas.comments.append(caption(INDENT, b.ids(), line, (COLUMN - 96, low + 24 + 4 * n), size=2, align="336",
+                                       linespace="0"))
+    summary = (f"Generated by tablebot for {tables.robot.name} ({b.p.wiring.controller}): a process per table "
+               f"({', '.join(tables.names)}) and a clock process that starts each tick for all of them from the "
+               "same inputs and states.")
     sub = Sub(MAIN, canvas, [], [], summary)
     b.subs[MAIN] = sub
     return sub

@@ -278,9 +278,10 @@ def begin_outputs(b: Builder, s: Sheet) -> None:
             b.assign(s, f"{name} last", "=", data=Count(counter))
 
 
-def engine_loop(b: Builder, s: Sheet, end_tick: Callable[[Sheet], None]) -> None:
+def engine_loop(b: Builder, s: Sheet, end_tick: Callable[[Sheet], None], notes: bool = True) -> None:
     """DetectEvent, (if an event is detected,) DetermineAction, ExecuteAction, the end of the tick
-    (``end_tick``: the flows that skipped a row are held to join its first element), CountDown, and back."""
+    (``end_tick``: the flows that skipped a row are held to join its first element), CountDown, and back; with
+    ``notes``, the table's lists as comments right of it."""
     p, v = b.p, b.v
     detect = b.call(s, v(DETECT))
     loop_wire, loop_in = s.last_wire, detect.pins[0].at
@@ -295,7 +296,7 @@ def engine_loop(b: Builder, s: Sheet, end_tick: Callable[[Sheet], None]) -> None
     countdown = b.call(s, v(COUNTDOWN))
     assert loop_wire is not None
     s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
-    for n, line in enumerate(p.table_notes()):
+    for n, line in enumerate(p.table_notes() if notes else ()):
         s.canvas.comments.append(caption(INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2,
                                          align="336", linespace="0"))
 
