@@ -8,8 +8,10 @@ Screenshots go to ``studio-several`` under pytest's temporary folder (or ``$TABL
 
 from __future__ import annotations
 
+import asyncio
 import shutil
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +23,8 @@ from studio_helpers import chromium, screenshots, served, studio_works, wait_for
 from tablebot.formats.csv_document import CsvDocument
 from tablebot.web.analyse import analyse, robot_for
 from tablebot.web.app import Background
+from tablebot.web.session import Hub, Session
+from tablebot.web.workspace import Workspace
 
 LIGHTS = ROOT / "examples" / "bumberbot-lights"
 #: A room with no lamp: the BumberBot seeks, so its lights table flashes the lamps in turn (beside a lamp they burn).
@@ -218,3 +222,39 @@ def test_an_error_across_the_tables_is_marked_on_its_cell_in_its_tab(folder: Pat
     found = analyse(doc, path, robot_for(path), "lights.csv").data["diagnostics"]
     assert [(d["file"], d["row"], d["col"]) for d in found] == [("lights.csv", -1, column)], found
     assert found[0]["message"].startswith(words)
+
+
+def test_the_live_path_is_coloured_by_the_states_of_the_table_shown(folder: Path) -> None:
+    """The arena's path carries the state of the table whose tab is shown (the page colours it with that table's
+    colours; the main table's states there would be grey), and the main table's again on its tab."""
+
+    async def path_states(first: str, then: str) -> tuple[set[str], set[str]]:
+        sent: list[dict[str, Any]] = []
+
+        async def send(message: dict[str, Any]) -> None:
+            sent.append(message)
+
+        async def run_for(ticks: int) -> set[str]:
+            sent.clear()
+            await session.handle({"op": "sim", "action": "speed", "speed": "max"})
+            await session.handle({"op": "sim", "action": "play"})
+            while not any(m["type"] == "frame" and m["tick"] >= ticks for m in sent):
+                await asyncio.sleep(0.04)
+                await session.frame()
+            await session.handle({"op": "sim", "action": "pause"})
+            return {p[2] for m in sent if m["type"] == "frame" for p in m["path"]}
+
+        session = Session(Workspace(folder), Hub(), send)
+        try:
+            await session.handle({"op": "open", "path": first})
+            seen_first = await run_for(300)
+            await session.handle({"op": "open", "path": then})
+            seen_then = await run_for(600)
+        finally:
+            session.close()
+        return seen_first, seen_then
+
+    with ThreadPoolExecutor(1) as thread:  # the browser tests' Playwright holds this thread's event loop
+        lights, drive = thread.submit(asyncio.run, path_states("lights.csv", "table.csv")).result()
+    assert lights and lights <= {"flash_left", "flash_right", "burn", "blink_on", "blink_off"}, lights
+    assert drive and drive <= {"1", "2", "11", "12", "20", "21", "22", "24", "26", "29"}, drive

@@ -160,14 +160,19 @@ class FrameSink:
         self._lock = threading.Lock()
         self.latest = Latest()
         self._fired: list[list[int]] = []
-        self._path: list[list[float]] = []
-        self._last_point: tuple[float, float, int] | None = None
+        self._path: list[list[float | str]] = []
+        self._last_point: tuple[float, float, str] | None = None
         self.ended: RunEnd | None = None
         self.ticks_seen = 0
+        self._states: Sequence[Any] = ()
+        #: A robot of several tables, another table's tab shown: the path is coloured by that table's states,
+        #: read from this field of each tick (``lights.state``); None: by the main table's
+        self.colour_by: str | None = None
 
     def start(self, info: RunInfo) -> None:
         with self._lock:
             self.latest.state = info.engine.state  # the state before the first tick (why it fired)
+            self._states = info.engine.machine.states
 
     def block(self, block: TickBlock) -> None:
         extra = block.extra
@@ -178,7 +183,9 @@ class FrameSink:
                 if row >= 0 and len(self._fired) < MAX_FIRED:
                     self._fired.append([block.start + k, row])
                 if "x" in extra:
-                    self._add_point(float(extra["x"][k]), float(extra["y"][k]), state)
+                    by = extra.get(self.colour_by) if self.colour_by else None
+                    self._add_point(float(extra["x"][k]), float(extra["y"][k]),
+                                    str(by[k] if by is not None else self._states[state]))
                 latest.prev_state, latest.state = latest.state, state
             k = len(block) - 1
             latest.tick, latest.timer, latest.event = block.start + k, int(block.timers[k]), int(block.events[k])
@@ -188,7 +195,7 @@ class FrameSink:
             latest.extra = {name: values[k] for name, values in extra.items()}
             self.ticks_seen += len(block)
 
-    def _add_point(self, x: float, y: float, state: int) -> None:
+    def _add_point(self, x: float, y: float, state: str) -> None:
         last = self._last_point
         if last is None or last[2] != state or math.hypot(x - last[0], y - last[1]) >= PATH_STEP_M:
             self._path.append([round(x, 4), round(y, 4), state])

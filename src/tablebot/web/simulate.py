@@ -89,7 +89,18 @@ class Arena:
         self._diagram: tuple[Any, str] | None = None
         self.problem: str | None = None
         self.tables: RobotTables | None = None
-        self.view = ""  # the table the page shows, by name ("": the main one): the frames speak of it
+        self._view = ""  # the table the page shows, by name ("": the main one): the frames speak of it
+
+    @property
+    def view(self) -> str:
+        return self._view
+
+    @view.setter
+    def view(self, name: str) -> None:
+        self._view = name
+        if self.run is not None:
+            shown = self.tables is not None and name and name != self.tables.names[0]
+            self.run.sink.colour_by = f"{name}.state" if shown else None
 
     def reset(self, table: Table, machine: Machine, settings: ArenaSettings,
               tables: RobotTables | None = None) -> dict[str, Any]:
@@ -115,6 +126,7 @@ class Arena:
             return {"ok": False, "problem": self.problem}
         self.problem = None
         self.run = LiveRun(scene, _robot(scene, settings.seed), settings.speed, settings.paused)
+        self.view = self._view  # the path coloured by the table shown
         return {"ok": True, "world": world_json(world, scene.params), "tick_ms": table.robot.tick_ms,
                 "settings": {"seed": settings.seed, "charge": scene.params["battery"]["charge"],
                              "speed": settings.speed, "start": list(world.start)}, **self.status()}
@@ -179,7 +191,7 @@ class Arena:
                  "prev_state": latest.prev_state, "timer": latest.timer, "event": latest.event, "mask": latest.mask,
                  "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"],
                  # by state id: the page colours a point by its state, and an edit may reorder the states
-                 "path": [[x, y, str(states[int(s)])] for x, y, s in data["path"]],
+                 "path": data["path"],  # [x, y, state id]: coloured by the table shown
                  "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
                  "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
                  "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}
