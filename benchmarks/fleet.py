@@ -66,6 +66,7 @@ TARGET_PROCESS_RATIO = 0.6  # the whole sweep process's speed as a share of its 
 TARGET_API_RATIO = 0.85  # tablebot.open(...).sweep(...) from Python, as a share of the kernel's speed
 
 
+KERNEL_CPU_S: list[float] = []  # CPU seconds (every thread) of each kernel_rate run
 CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() process: steadier than wall on a busy machine
 
 
@@ -103,8 +104,9 @@ def kernel_rate(robots: int, ticks: int) -> float:
     table, machine = load(EXAMPLE)
     world = scene_for(table, machine).world
     fleet = Fleet(table, machine, world, [RobotSpec(seed=s) for s in range(robots)], robot_layer(table.robot)[0])
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     fleet.run(ticks)
+    KERNEL_CPU_S.append(time.process_time() - cpu)
     return robots * ticks / (time.perf_counter() - started)
 
 
@@ -127,6 +129,7 @@ def sweep_ratios(robots: int, seconds: float, repeat: int) -> int:
     ticks = round(seconds / 0.010)
     work = robots * ticks
     CPU_S.clear()
+    KERNEL_CPU_S.clear()
     walls, kernels, apis, api_kernels, parts = [], [], [], [], []
     api_rate(64, 1.0)  # the compiled code loaded in this process (not counted)
     for _ in range(repeat):
@@ -150,7 +153,12 @@ def sweep_ratios(robots: int, seconds: float, repeat: int) -> int:
           f"{ratio:.2f}x the kernel's speed (median of the repeats' ratios)  target >= {TARGET_PROCESS_RATIO}x  "
           f"{verdict(ok)}")
     print("  where a sweep process's time goes (medians, s): " + ", ".join(
-        f"{name} {med(p[name] for p in parts):.3f}" for name in parts[0]))
+        f"{name} {med(p[name] for p in parts):.3f}" for name in parts[0] if not name.startswith("cpu: ")))
+    kernel_cpu = med(KERNEL_CPU_S)
+    print("  its CPU seconds, every thread (medians): " + ", ".join(
+        f"{name[5:]} {med(p[name] for p in parts):.3f}" for name in parts[0] if name.startswith("cpu: "))
+        + f"; the kernel alone for the same robots {kernel_cpu:.3f} s CPU: the process spends "
+          f"{med(p['cpu: in this interpreter'] for p in parts) - kernel_cpu:.3f} s CPU outside it")
     api = med(a / k for a, k in zip(apis, api_kernels, strict=True))
     ok = api >= TARGET_API_RATIO
     missed += not ok

@@ -6,7 +6,8 @@ Runs ``tablebot SWEEP-ARGS`` in this process as ``python -m tablebot`` would, wi
 to note when each starts and ends, and prints one JSON object: the seconds from the script's start to
 planning (the imports), planning, the chunks (the compiled fleet, each chunk's set-up and, in the main thread
 meanwhile, each chunk's result rows written: "results in the chunks"), merging results.csv, the rest, and
-the whole; the interpreter's own start is what the caller's wall time adds.
+the whole; the interpreter's own start is what the caller's wall time adds. Beside each, as ``cpu: ...``, the
+CPU seconds of every thread of the process in that phase (what a busy machine's waiting leaves out).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 STARTED = time.perf_counter()
+CPU_STARTED = time.process_time()  # every thread's CPU seconds: on a busy machine wall time is mostly waiting
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -47,6 +49,7 @@ def main() -> None:
     from tablebot.cli import main as cli
 
     marks: dict[str, float] = {}
+    cpu: dict[str, float] = {}  # the process's CPU seconds (every thread) at the same marks
     spent = {"part_text": 0.0, "write_part": 0.0}
 
     def timed(owner: Any, name: str, mark: str | None = None, into: str | None = None) -> None:
@@ -56,11 +59,13 @@ def main() -> None:
             started = time.perf_counter()
             if mark:
                 marks.setdefault(f"{mark} start", started - STARTED)
+                cpu.setdefault(f"{mark} start", time.process_time() - CPU_STARTED)
             try:
                 return original(*args, **kwargs)
             finally:
                 if mark:
                     marks[f"{mark} end"] = time.perf_counter() - STARTED
+                    cpu[f"{mark} end"] = time.process_time() - CPU_STARTED
                 if into:
                     spent[into] += time.perf_counter() - started
         setattr(owner, name, wrapper)
@@ -76,13 +81,20 @@ def main() -> None:
     except SystemExit as exc:
         if exc.code:
             raise
-    end = time.perf_counter() - STARTED
+    end, cpu_end = time.perf_counter() - STARTED, time.process_time() - CPU_STARTED
     plan_s, run_s = marks["plan end"] - marks["plan start"], marks["run end"] - marks["run start"]
     merge_s = marks["finish end"] - marks["finish start"]
+
+    def cpu_of(mark: str) -> float:
+        return cpu[f"{mark} end"] - cpu[f"{mark} start"]
     print(json.dumps({"before planning": marks["plan start"], "planning": plan_s, "chunks": run_s,
                       "results in the chunks": spent["part_text"] + spent["write_part"], "merging": merge_s,
                       "after planning, besides": end - marks["plan start"] - plan_s - run_s - merge_s,
-                      "in this interpreter": end}))
+                      "in this interpreter": end,
+                      "cpu: before planning": cpu["plan start"], "cpu: planning": cpu_of("plan"),
+                      "cpu: chunks": cpu_of("run"), "cpu: merging": cpu_of("finish"),
+                      "cpu: after planning, besides": cpu_end - cpu["plan start"] - cpu_of("plan") - cpu_of("run")
+                      - cpu_of("finish"), "cpu: in this interpreter": cpu_end}))
 
 if __name__ == "__main__":
     main()
