@@ -258,3 +258,28 @@ def test_the_live_path_is_coloured_by_the_states_of_the_table_shown(folder: Path
         lights, drive = thread.submit(asyncio.run, path_states("lights.csv", "table.csv")).result()
     assert lights and lights <= {"flash_left", "flash_right", "burn", "blink_on", "blink_off"}, lights
     assert drive and drive <= {"1", "2", "11", "12", "20", "21", "22", "24", "26", "29"}, drive
+
+
+def test_the_robot_starts_over_when_its_table_is_read_again_not_when_another_tab_is_shown(folder: Path) -> None:
+    """The first look at another table's tab leaves the robot running; the table shown read again (its file
+    loaded after a conflict, the page reconnecting) starts it over with the file as it is, as it always did."""
+
+    async def arenas() -> list[int]:
+        sent: list[dict[str, Any]] = []
+
+        async def send(message: dict[str, Any]) -> None:
+            sent.append(message)
+
+        session = Session(Workspace(folder), Hub(), send)
+        counts = []
+        try:
+            for path in ("table.csv", "lights.csv", "table.csv", "table.csv"):
+                sent.clear()
+                await session.handle({"op": "open", "path": path})
+                counts.append(sum(m["type"] == "arena" for m in sent))
+        finally:
+            session.close()
+        return counts
+
+    with ThreadPoolExecutor(1) as thread:
+        assert thread.submit(asyncio.run, arenas()).result() == [1, 0, 0, 1]

@@ -167,10 +167,11 @@ class Session:
         draft = self.new_draft()
         opened, doc = await draft.read(path)
         same = self.same_robot(opened.name)
+        first_look = same and opened.name not in self.drafts  # another table's tab: the robot runs on
         if not same:
             self.drafts.clear()  # another robot: its tables' drafts are not this one's
         self.draft = self.drafts[opened.name] = draft
-        await self.show(opened, doc, restart=not same)
+        await self.show(opened, doc, restart=not first_look)
 
     def same_robot(self, name: str) -> bool:
         """Whether table ``name`` is one of the tables of the robot this tab shows (a tab of it)."""
