@@ -242,6 +242,9 @@ def test_the_live_path_is_coloured_by_the_states_of_the_table_shown(folder: Path
                 await asyncio.sleep(0.04)
                 await session.frame()
             await session.handle({"op": "sim", "action": "pause"})
+            for _ in range(5):  # what it drew up to the pause (the next tab's frames are that tab's)
+                await asyncio.sleep(0.04)
+                await session.frame()
             return {p[2] for m in sent if m["type"] == "frame" for p in m["path"]}
 
         session = Session(Workspace(folder), Hub(), send)
