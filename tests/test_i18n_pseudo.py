@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 import typer.main
 
-from test_i18n_catalog import names, outside, run_in, words
 from tablebot import i18n
 from tablebot.cli.app import app
 from tablebot.i18n import PSEUDO_OPEN
+from test_i18n_catalog import names, outside, run_in, words
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
@@ -92,8 +92,13 @@ def bad_address(tmp: Path) -> list[str]:
     return ["run", str(EXAMPLE), "--on", "robotx://"]
 
 
+def no_device(tmp: Path) -> list[str]:
+    """A serial device that is not there: the link's own words (tablebot.hw.serial_port), then the hint."""
+    return ["run", str(EXAMPLE), "--on", f"robotx://{tmp / 'ttyACM9'}"]
+
+
 BAD: list[Callable[[Path], list[str]]] = [garbage, not_hex, bad_link, no_challenge, doctype, wrong_root, not_json,
-                                          bad_tables, bad_board, bad_conditions, bad_address]
+                                          bad_tables, bad_board, bad_conditions, bad_address, no_device]
 
 
 def user_words(tmp: Path) -> set[str]:

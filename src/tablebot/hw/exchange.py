@@ -11,6 +11,7 @@ import threading
 from collections.abc import Sequence
 from typing import Any
 
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost, Reading
 
 COUNTER_WRAP = 1 << 16  # the TXT's and the ROBO TX's counters count up in 16 bits
@@ -34,7 +35,7 @@ class ExchangeRobot:
 
     def read(self) -> Reading:
         if self._reading is None:
-            raise LinkLost(f"{self.target} is not online (open() was not called or failed)")
+            raise LinkLost(N_("{target} is not online (open() was not called or failed)", target=self.target))
         return self._reading
 
     def write(self, outputs: Sequence[int]) -> None:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import serial
 from serial.tools import list_ports
 
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost
 
 #: How long a read waits at most when a caller passes no deadline (seconds).
@@ -63,7 +64,7 @@ class SerialPort:
         try:
             self.port = serial.Serial(self.device, self.baudrate, timeout=0, write_timeout=0, exclusive=True)
         except (serial.SerialException, OSError, ValueError) as exc:
-            raise LinkLost(f"cannot open {self.device}: {_reason(exc)}") from None
+            raise LinkLost(N_("cannot open {device}: {value}", device=self.device, value=_reason(exc))) from None
         self.port.reset_input_buffer()
 
     def close(self) -> None:
@@ -100,7 +101,8 @@ class SerialPort:
                 data += self.read_some(size - len(data), deadline, what)
             except LinkLost as exc:
                 if data and "no answer" in str(exc):
-                    raise LinkLost(f"{exc} (only {len(data)} of {size} bytes came)") from None
+                    raise LinkLost(N_("{exc} (only {value} of {size} bytes came)",
+                                      exc=exc.args[0], value=len(data), size=size)) from None
                 raise
         return bytes(data)
 
@@ -118,7 +120,7 @@ class SerialPort:
             except OSError as exc:
                 raise self._lost(exc) from None
             if not chunk:  # readable but nothing: the other end hung up
-                raise LinkLost(f"{self.device} was disconnected (waiting for {what})")
+                raise LinkLost(N_("{device} was disconnected (waiting for {what})", device=self.device, what=what))
             return chunk
 
     def pending(self) -> bytes:
@@ -140,7 +142,7 @@ class SerialPort:
         except OSError as exc:
             raise self._lost(exc) from None
         if not chunk:
-            raise LinkLost(f"{self.device} was disconnected")
+            raise LinkLost(N_("{device} was disconnected", device=self.device))
         return chunk
 
     # --- without a file descriptor (Windows) -----------------------------------------------------------
@@ -150,12 +152,14 @@ class SerialPort:
         while self.unsent:
             left = deadline - time.monotonic()
             if left <= 0:
-                raise LinkLost(f"no answer from {self.device}: expected the device to take our request")
+                raise LinkLost(N_("no answer from {device}: expected the device to take our request",
+                                  device=self.device))
             try:
                 port.write_timeout = left
                 sent = port.write(self.unsent)
             except serial.SerialTimeoutException:
-                raise LinkLost(f"no answer from {self.device}: expected the device to take our request") from None
+                raise LinkLost(N_("no answer from {device}: expected the device to take our request",
+                                  device=self.device)) from None
             except (serial.SerialException, OSError) as exc:
                 raise self._lost(exc) from None
             self.unsent = self.unsent[sent if sent is not None else len(self.unsent):]
@@ -164,7 +168,7 @@ class SerialPort:
         port = self._port()
         left = deadline - time.monotonic()
         if left <= 0:
-            raise LinkLost(f"no answer from {self.device}: expected {what}")
+            raise LinkLost(N_("no answer from {device}: expected {what}", device=self.device, what=what))
         try:
             port.timeout = left
             chunk = port.read(1)  # the first byte, waited for up to the deadline
@@ -173,14 +177,14 @@ class SerialPort:
         except (serial.SerialException, OSError) as exc:
             raise self._lost(exc) from None
         if not chunk:
-            raise LinkLost(f"no answer from {self.device}: expected {what}")
+            raise LinkLost(N_("no answer from {device}: expected {what}", device=self.device, what=what))
         return chunk
 
     # --- helpers ----------------------------------------------------------------------------------
 
     def _port(self) -> serial.Serial:
         if self.port is None:
-            raise LinkLost(f"{self.device} is not open")
+            raise LinkLost(N_("{device} is not open", device=self.device))
         return self.port
 
     def _fd(self) -> int:
@@ -189,18 +193,19 @@ class SerialPort:
     def _wait(self, fd: int, deadline: float, *, writing: bool, what: str) -> None:
         left = deadline - time.monotonic()
         if left <= 0:
-            raise LinkLost(f"no answer from {self.device}: expected {what}")
+            raise LinkLost(N_("no answer from {device}: expected {what}", device=self.device, what=what))
         try:
             ready = select.select([], [fd], [], left) if writing else select.select([fd], [], [], left)
         except (OSError, ValueError) as exc:  # the descriptor was closed under us
-            raise LinkLost(f"{self.device} was closed ({exc})") from None
+            raise LinkLost(N_("{device} was closed ({exc})", device=self.device, exc=exc)) from None
         if not any(ready):
-            raise LinkLost(f"no answer from {self.device}: expected {what}")
+            raise LinkLost(N_("no answer from {device}: expected {what}", device=self.device, what=what))
 
     def _lost(self, exc: OSError | serial.SerialException) -> LinkLost:
         if "returned no data" in str(exc) or _hung_up(exc):  # pyserial: readable, yet nothing: the other end hung up
-            return LinkLost(f"{self.device} was disconnected")
-        return LinkLost(f"lost {self.device}: {getattr(exc, 'strerror', None) or exc} (was it unplugged?)")
+            return LinkLost(N_("{device} was disconnected", device=self.device))
+        return LinkLost(N_("lost {device}: {value} (was it unplugged?)",
+                           device=self.device, value=getattr(exc, 'strerror', None) or exc))
 
 
 def _hung_up(exc: BaseException) -> bool:

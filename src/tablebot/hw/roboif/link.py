@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 from tablebot.hw.roboif import protocol as wire
 from tablebot.hw.serial_port import PortInfo, SerialPort, serial_ports
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost
 
 SETUP_TIMEOUT_S = 1.0
@@ -64,8 +65,9 @@ class RoboifLink:
         reply = self.port.read(wire.HELLO_REPLY_BYTES, deadline, "the answer to the greeting")
         if reply[0] != wire.HELLO_OK:
             self._trusted = False
-            raise LinkLost(f"wrong answer from {self.device}: {reply.hex(' ')} to the greeting (a ROBO Interface "
-                           f"answers 0x{wire.HELLO_OK:02x} first): is this a ROBO Interface?")
+            raise LinkLost(N_("wrong answer from {device}: {reply} to the greeting (a ROBO Interface answers "
+                              "0x{ok:02x} first): is this a ROBO Interface?", device=self.device,
+                              reply=reply.hex(" "), ok=wire.HELLO_OK))
         self.online = True
         self._expect_quiet("after the greeting's answer", settle_s=0.005)
         return reply
@@ -73,7 +75,7 @@ class RoboifLink:
     def exchange(self, directions: int, pwm: Sequence[int], timeout_s: float | None = None) -> wire.Inputs:
         """Send the outputs, get the inputs back (within ``timeout_s``; default: the reply timeout of a run)."""
         if not self._trusted:
-            raise LinkLost(f"{self.device} was out of step earlier: its replies cannot be trusted")
+            raise LinkLost(N_("{device} was out of step earlier: its replies cannot be trusted", device=self.device))
         timeout_s = timeout_s or self.reply_timeout_s
         deadline = time.monotonic() + timeout_s
         self.port.write(b"", deadline)  # the rest of a request a signal cut short: its reply is owed
@@ -109,8 +111,9 @@ class RoboifLink:
         extra = self.port.pending()
         if extra:
             self._trusted = False
-            raise LinkLost(f"garbage from {self.device}: {len(extra)} unexpected bytes {when} "
-                           f"({extra[:8].hex(' ')}{' ...' if len(extra) > 8 else ''})")
+            raise LinkLost(N_("garbage from {device}: {count} unexpected bytes {when} ({first}{more})",
+                              device=self.device, count=len(extra), when=when, first=extra[:8].hex(" "),
+                              more=" ..." if len(extra) > 8 else ""))
 
     def _discard_owed(self, deadline: float) -> None:
         while self._owed > 0:

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from tablebot.i18n import N_
+
 BAUD = 38400
 HELLO = b"\xa1ft-Robo-ON-V1"  # 14 bytes
 HELLO_REPLY_BYTES, HELLO_OK = 5, 0x5E
@@ -55,7 +57,8 @@ def exchange(directions: int, pwm: list[int] | tuple[int, ...]) -> bytes:
 
 def decode(data: bytes) -> Inputs:
     if len(data) != REPLY_BYTES:
-        raise WireError(f"a reply of {len(data)} bytes (expected {REPLY_BYTES})")
+        raise WireError(N_("a reply of {value} bytes (expected {REPLY_BYTES})",
+                           value=len(data), REPLY_BYTES=REPLY_BYTES))
 
     def ten(low: int, high_byte: int, shift: int) -> int:
         return data[low] | ((data[high_byte] >> shift) & 0x3) << 8

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from tablebot.hw.robotx import protocol as wire
 from tablebot.hw.robotx.protocol import Command, Frame
 from tablebot.hw.serial_port import PortInfo, SerialPort, serial_ports
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost
 
 #: The USB id of a ROBO TX Controller (a USB CDC serial port "ROBO TX Controller" by "fischertechnik"), as
@@ -104,7 +105,8 @@ class RobotxLink:
     def _request(self, command: Command, areas: tuple[tuple[int, bytes], ...], timeout_s: float,
                  first: bool = False) -> Frame:
         if not self._trusted:
-            raise LinkLost(f"{self.device} sent a malformed or wrong reply earlier: its replies cannot be trusted")
+            raise LinkLost(N_("{device} sent a malformed or wrong reply earlier: its replies cannot be trusted",
+                              device=self.device))
         deadline = time.monotonic() + timeout_s
         self.port.write(b"", deadline)  # the rest of a request a signal cut short (its reply is owed)
         self._discard_owed(deadline)
@@ -116,7 +118,7 @@ class RobotxLink:
             reply = self._read_frame(deadline, what, skip_junk=first)
         except wire.WireError as exc:
             self._trusted = False
-            raise LinkLost(f"garbage from {self.device}: {exc}") from None
+            raise LinkLost(N_("garbage from {device}: {exc}", device=self.device, exc=exc.args[0])) from None
         self._owed -= 1
         self._check(reply, command)
         return reply
@@ -132,7 +134,7 @@ class RobotxLink:
                        "(it ended the online link)")
         if problem:
             self._trusted = False
-            raise LinkLost(f"wrong answer from {self.device}: {problem}")
+            raise LinkLost(N_("wrong answer from {device}: {problem}", device=self.device, problem=problem))
         if self.sid is None:
             self.sid = reply.sid  # the controller names the session in its reply to the first request
 
@@ -141,8 +143,8 @@ class RobotxLink:
         if data is None or len(data) != size:
             self._trusted = False
             got = "no data for the controller" if data is None else f"{len(data)} bytes"
-            raise LinkLost(f"wrong answer from {self.device}: {got} in the reply to {command.name} "
-                           f"(expected {size} bytes)")
+            raise LinkLost(N_("wrong answer from {device}: {got} in the reply to {name} (expected {size} bytes)",
+                              device=self.device, got=got, name=command.name, size=size))
         return data
 
     def _read_frame(self, deadline: float, what: str, skip_junk: bool = False) -> Frame:
@@ -158,7 +160,8 @@ class RobotxLink:
             if previous == wire.STX and byte == wire.MARK:
                 return bytes((wire.STX, wire.MARK)) + self.port.read(2, deadline, what)
             previous = byte
-        raise wire.WireError(f"{MAX_JUNK} bytes without a fish.X1 frame: is this a ROBO TX Controller?")
+        raise wire.WireError(N_("{MAX_JUNK} bytes without a fish.X1 frame: is this a ROBO TX Controller?",
+                                MAX_JUNK=MAX_JUNK))
 
     def _discard_owed(self, deadline: float) -> None:
         """Read and drop the replies still owed (each frame found by its start, whatever came before)."""

@@ -21,6 +21,8 @@ import struct
 from dataclasses import dataclass
 from enum import IntEnum
 
+from tablebot.i18n import N_
+
 STX, MARK, ETX = 0x02, 0x55, 0x03
 HEADER_BYTES = 20  # FROM, TO, TID, SID, command, n: what the length field counts besides the payload
 #: The largest frame we accept: a header and nine transfer areas (master + 8 extensions) of 64 bytes.
@@ -137,10 +139,11 @@ def encode(frame: Frame) -> bytes:
 def frame_length(start: bytes) -> int:
     """The whole frame's size from its first four bytes (STX, 0x55, length); WireError if they are not that."""
     if len(start) < 4 or start[0] != STX or start[1] != MARK:
-        raise WireError(f"not the start of a fish.X1 frame: {start[:4].hex(' ')}")
+        raise WireError(N_("not the start of a fish.X1 frame: {value}", value=start[:4].hex(' ')))
     length = int.from_bytes(start[2:4], "big")
     if not HEADER_BYTES <= length <= MAX_LENGTH:
-        raise WireError(f"a frame length of {length} bytes (a fish.X1 frame has {HEADER_BYTES}..{MAX_LENGTH})")
+        raise WireError(N_("a frame length of {length} bytes (a fish.X1 frame has {HEADER_BYTES}..{MAX_LENGTH})",
+                           length=length, HEADER_BYTES=HEADER_BYTES, MAX_LENGTH=MAX_LENGTH))
     return 2 + 2 + length + 3
 
 
@@ -148,13 +151,13 @@ def decode(data: bytes) -> Frame:
     """A whole frame's fields; WireError for a wrong start, length, checksum, end mark or area layout."""
     size = frame_length(data)
     if len(data) != size:
-        raise WireError(f"a frame of {len(data)} bytes where its length field says {size}")
+        raise WireError(N_("a frame of {value} bytes where its length field says {size}", value=len(data), size=size))
     if data[-1] != ETX:
-        raise WireError(f"the frame does not end with ETX (0x03) but 0x{data[-1]:02x}")
+        raise WireError(N_("the frame does not end with ETX (0x03) but 0x{value:02x}", value=data[-1]))
     checked = data[2:-3]
     expected, got = checksum(checked), int.from_bytes(data[-3:-1], "big")
     if got != expected:
-        raise WireError(f"checksum 0x{got:04x} where the bytes give 0x{expected:04x}")
+        raise WireError(N_("checksum 0x{got:04x} where the bytes give 0x{expected:04x}", got=got, expected=expected))
     src, dst, tid, sid, command, count = _HEAD.unpack_from(data, 4)
     payload = data[4 + _HEAD.size:-3]
     return Frame(command, tid, sid, _areas(payload, count), src, dst)
@@ -163,10 +166,10 @@ def decode(data: bytes) -> Frame:
 def _areas(payload: bytes, count: int) -> tuple[tuple[int, bytes], ...]:
     if count == 0:
         if payload:
-            raise WireError(f"{len(payload)} bytes of data in a frame that declares no transfer area")
+            raise WireError(N_("{value} bytes of data in a frame that declares no transfer area", value=len(payload)))
         return ()
     if count > 9 or len(payload) % count or len(payload) // count < _TA_ID.size:
-        raise WireError(f"{len(payload)} bytes of data cannot be {count} transfer areas")
+        raise WireError(N_("{value} bytes of data cannot be {count} transfer areas", value=len(payload), count=count))
     each = len(payload) // count
     return tuple((_TA_ID.unpack_from(payload, i * each)[0], payload[i * each + 4:(i + 1) * each])
                  for i in range(count))
@@ -190,14 +193,15 @@ def config(cfg: Config) -> bytes:
 
 def decode_inputs(data: bytes) -> Inputs:
     if len(data) != INPUT_BYTES:
-        raise WireError(f"TA_INPUT of {len(data)} bytes (expected {INPUT_BYTES})")
+        raise WireError(N_("TA_INPUT of {value} bytes (expected {INPUT_BYTES})",
+                           value=len(data), INPUT_BYTES=INPUT_BYTES))
     values = _INPUT.unpack(data)
     return Inputs(universal=values[0:8], counter_levels=values[8:12], counter_values=values[12:16])
 
 
 def decode_info(data: bytes) -> Info:
     if len(data) != INFO_BYTES:
-        raise WireError(f"TA_INFO of {len(data)} bytes (expected {INFO_BYTES})")
+        raise WireError(N_("TA_INFO of {value} bytes (expected {INFO_BYTES})", value=len(data), INFO_BYTES=INFO_BYTES))
     name, bt, _, _, _, hardware, firmware, _ = _INFO.unpack(data)
     return Info(_text(name), _text(bt), hardware, firmware)
 

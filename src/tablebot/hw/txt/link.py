@@ -23,6 +23,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 from tablebot.hw.txt import protocol as wire
 from tablebot.hw.txt.protocol import Command
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost
 
 #: Where a TXT answers: USB, Wi-Fi access point, Bluetooth (the order ``txt://auto`` tries them in).
@@ -94,11 +95,14 @@ class TxtLink:
         try:
             self.sock = socket.create_connection((self.host, self.port), timeout=timeout_s)
         except socket.gaierror as exc:
-            raise LinkLost(f"cannot find the controller {self.host}: {exc.strerror}") from None
+            raise LinkLost(N_("cannot find the controller {host}: {strerror}",
+                              host=self.host, strerror=exc.strerror)) from None
         except TimeoutError:
-            raise LinkLost(f"no controller answered at {self.where} within {timeout_s:g} s") from None
+            raise LinkLost(N_("no controller answered at {where} within {timeout_s:g} s",
+                              where=self.where, timeout_s=timeout_s)) from None
         except OSError as exc:
-            raise LinkLost(f"cannot connect to {self.where}: {exc.strerror or exc}") from None
+            raise LinkLost(N_("cannot connect to {where}: {value}",
+                              where=self.where, value=exc.strerror or exc)) from None
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # one small packet per request, at once
         self.last_reply = time.monotonic()
 
@@ -157,9 +161,10 @@ class TxtLink:
 
     def _request(self, command: Command, payload: bytes, timeout_s: float) -> bytes:
         if self.sock is None:
-            raise LinkLost(f"not connected to {self.where}")
+            raise LinkLost(N_("not connected to {where}", where=self.where))
         if not self._trusted:
-            raise LinkLost(f"{self.where} sent a malformed reply earlier: its replies cannot be trusted")
+            raise LinkLost(N_("{where} sent a malformed reply earlier: its replies cannot be trusted",
+                              where=self.where))
         deadline = time.monotonic() + timeout_s
         self._discard_owed(deadline, command)  # the rest of a reply a signal cut short, or one given up on
         self._owed = wire.REPLY_SIZE[command]  # owed from the moment the request may be out
@@ -172,7 +177,8 @@ class TxtLink:
         """The whole request in one ``sendall``, signals held; a request that may have gone out in part
         leaves the connection unusable (what follows would be misread)."""
         if not self._sendable:
-            raise LinkLost(f"{self.where}: a request went out in part earlier; nothing more can be sent")
+            raise LinkLost(N_("{where}: a request went out in part earlier; nothing more can be sent",
+                              where=self.where))
         sock = self._socket()
         sock.settimeout(self._remaining(deadline, command, "sending"))
         with signals_held():
@@ -180,7 +186,8 @@ class TxtLink:
                 sock.sendall(payload)
             except TimeoutError:
                 self._sendable = False
-                raise LinkLost(f"{self.where} did not take {command.name} in time (its buffer is full)") from None
+                raise LinkLost(N_("{where} did not take {name} in time (its buffer is full)",
+                                  where=self.where, name=command.name)) from None
             except OSError as exc:
                 self._sendable = False
                 raise self._lost(exc, command) from None
@@ -200,7 +207,7 @@ class TxtLink:
             wire.check_reply(command, bytes(data))
         except wire.WireError as exc:
             self._trusted = False
-            raise LinkLost(f"malformed reply from {self.where}: {exc}") from None
+            raise LinkLost(N_("malformed reply from {where}: {exc}", where=self.where, exc=exc.args[0])) from None
         return bytes(data)
 
     @staticmethod
@@ -214,24 +221,25 @@ class TxtLink:
         try:
             chunk = sock.recv(most)
         except TimeoutError:
-            raise LinkLost(f"no answer from {self.where}: expected {what}") from None
+            raise LinkLost(N_("no answer from {where}: expected {what}", where=self.where, what=what)) from None
         except OSError as exc:
             raise self._lost(exc, command) from None
         if not chunk:
-            raise LinkLost(f"{self.where} closed the connection (during {command.name})")
+            raise LinkLost(N_("{where} closed the connection (during {name})", where=self.where, name=command.name))
         self._owed -= len(chunk)
         return chunk
 
     def _remaining(self, deadline: float, command: Command, what: str) -> float:
         left = deadline - time.monotonic()
         if left <= 0:
-            raise LinkLost(f"no answer from {self.where}: expected {what}")
+            raise LinkLost(N_("no answer from {where}: expected {what}", where=self.where, what=what))
         return left
 
     def _socket(self) -> socket.socket:
         if self.sock is None:
-            raise LinkLost(f"not connected to {self.where}")
+            raise LinkLost(N_("not connected to {where}", where=self.where))
         return self.sock
 
     def _lost(self, exc: OSError, command: Command) -> LinkLost:
-        return LinkLost(f"lost the connection to {self.where} during {command.name}: {exc.strerror or exc}")
+        return LinkLost(N_("lost the connection to {where} during {name}: {value}",
+                           where=self.where, name=command.name, value=exc.strerror or exc))

@@ -14,6 +14,8 @@ import struct
 from dataclasses import dataclass
 from enum import IntEnum
 
+from tablebot.i18n import N_
+
 PORT = 65000  # camera 65001, I2C 65002 (not used)
 N_OUTPUTS = 8  # O1..O8, PWM 0..512 each
 N_MOTORS = 4  # M1..M4: motor n drives O(2n-1) forward and O(2n) backward
@@ -119,17 +121,19 @@ class Inputs:
 
 def _id(data: bytes, expected: int, what: str) -> None:
     if len(data) < 4:
-        raise WireError(f"{what}: {len(data)} bytes is too short for a reply")
+        raise WireError(N_("{what}: {value} bytes is too short for a reply", what=what, value=len(data)))
     (got,) = _ID.unpack_from(data)
     if got != expected:
-        raise WireError(f"{what}: wrong response id 0x{got:08X} (expected 0x{expected:08X})")
+        raise WireError(N_("{what}: wrong response id 0x{got:08X} (expected 0x{expected:08X})",
+                           what=what, got=got, expected=expected))
 
 
 def check_reply(command: Command, data: bytes) -> None:
     """Raise :class:`WireError` unless ``data`` is a whole reply to ``command`` with its response id."""
     _id(data, REPLY_ID[command], command.name)
     if len(data) != REPLY_SIZE[command]:
-        raise WireError(f"{command.name}: reply of {len(data)} bytes (expected {REPLY_SIZE[command]})")
+        raise WireError(N_("{name}: reply of {value} bytes (expected {value2})",
+                           name=command.name, value=len(data), value2=REPLY_SIZE[command]))
 
 
 # --- requests ---------------------------------------------------------------------------------------
