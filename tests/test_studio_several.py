@@ -286,3 +286,38 @@ def test_the_robot_starts_over_when_its_table_is_read_again_not_when_another_tab
 
     with ThreadPoolExecutor(1) as thread:
         assert thread.submit(asyncio.run, arenas()).result() == [1, 0, 0, 1]
+
+
+def test_a_counterexample_on_the_table_replays_every_table(folder: Path) -> None:
+    """A broken property's counterexample played on the table (the trace player) is the whole robot's run: the
+    lights table's columns and the lamps as tablebot's engine of several tables has them on those inputs."""
+    from tablebot.replay import replay_several
+    from tablebot.tables import several
+
+    async def columns() -> dict[str, Any]:
+        sent: list[dict[str, Any]] = []
+
+        async def send(message: dict[str, Any]) -> None:
+            sent.append(message)
+
+        session = Session(Workspace(folder), Hub(), send)
+        try:
+            await session.handle({"op": "open", "path": "lights.csv"})
+            sent.clear()
+            await session.handle({"op": "counterexample", "name": "front_bumper_stops"})
+            analysis = session.draft.analysis
+            assert analysis is not None and analysis.report is not None
+            result = next(r for r in analysis.report.results if r.prop.name == "front_bumper_stops")
+        finally:
+            session.close()
+        (trace,) = [m for m in sent if m["type"] == "trace"]
+        tables = several(tablebot.open(folder).table)
+        assert tables is not None
+        expected = list(replay_several(tables, result.inputs))
+        assert trace["columns"]["lights.state"] == [line["lights.state"] for line in expected]
+        return trace["columns"]
+
+    with ThreadPoolExecutor(1) as thread:
+        found = thread.submit(asyncio.run, columns()).result()
+    assert {"lights.state", "lights.row", "L1", "L2"} <= set(found)
+    assert any(found["L1"]) and any(found["L2"])  # the lamps the lights table lit on the way

@@ -41,7 +41,9 @@ class TracePlayer:
         if op.where == "arena":
             await self.robot.script([t.mask for t in result.inputs])
             return
-        from tablebot.replay import replay
+        from tablebot.replay import replay, replay_several
 
-        lines = list(replay(analysis.report.machine, result.inputs))
+        # a robot of several tables: all of them replayed, the player shows the tab's table and says the others
+        lines = list(replay(analysis.report.machine, result.inputs) if analysis.tables is None
+                     else replay_several(analysis.tables, result.inputs))
         await self.say(TraceMsg(f"counterexample: {op.name}", trace_columns(lines), result.at_tick))
