@@ -15,7 +15,7 @@ from tablebot.tomlfile import Source
 if TYPE_CHECKING:
     from tablebot.machine import Machine
 
-ADDRESSES = ("roboif://auto", "roboif:///dev/ttyUSB0 (its serial port)", "roboif://COM1")
+ADDRESSES = ("roboif://auto", N_("roboif:///dev/ttyUSB0 (its serial port)"), "roboif://COM1")
 ADDRESS_HINT = N_("write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)")
 CONNECT_HINT = N_("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
                   "serial port only, not on its USB port (docs/controllers.md)")

@@ -60,16 +60,16 @@ class RoboifLink:
     def hello(self) -> bytes:
         """The greeting; the interface answers 5 bytes starting with 0x5E (anything else: not a ROBO Interface)."""
         deadline = time.monotonic() + self.setup_timeout_s
-        self._expect_quiet("before the greeting")
+        self._expect_quiet(N_("before the greeting"))
         self.port.write(wire.HELLO, deadline)
-        reply = self.port.read(wire.HELLO_REPLY_BYTES, deadline, "the answer to the greeting")
+        reply = self.port.read(wire.HELLO_REPLY_BYTES, deadline, N_("the answer to the greeting"))
         if reply[0] != wire.HELLO_OK:
             self._trusted = False
             raise LinkLost(N_("wrong answer from {device}: {reply} to the greeting (a ROBO Interface answers "
                               "0x{ok:02x} first): is this a ROBO Interface?", device=self.device,
                               reply=reply.hex(" "), ok=wire.HELLO_OK))
         self.online = True
-        self._expect_quiet("after the greeting's answer", settle_s=0.005)
+        self._expect_quiet(N_("after the greeting's answer"), settle_s=0.005)
         return reply
 
     def exchange(self, directions: int, pwm: Sequence[int], timeout_s: float | None = None) -> wire.Inputs:
@@ -80,13 +80,13 @@ class RoboifLink:
         deadline = time.monotonic() + timeout_s
         self.port.write(b"", deadline)  # the rest of a request a signal cut short: its reply is owed
         self._discard_owed(deadline)
-        self._expect_quiet("before a request was sent")
+        self._expect_quiet(N_("before a request was sent"))
         self._owed += wire.REPLY_BYTES
         self.port.write(wire.exchange(directions, list(pwm)), deadline)
-        data = self.port.read(wire.REPLY_BYTES, deadline, f"the {wire.REPLY_BYTES}-byte reply within "
-                              f"{1000 * timeout_s:.0f} ms")
+        data = self.port.read(wire.REPLY_BYTES, deadline, N_("the {size}-byte reply within {ms:.0f} ms",
+                                                              size=wire.REPLY_BYTES, ms=1000 * timeout_s))
         self._owed -= wire.REPLY_BYTES
-        self._expect_quiet(f"beyond the {wire.REPLY_BYTES}-byte reply")
+        self._expect_quiet(N_("beyond the {size}-byte reply", size=wire.REPLY_BYTES))
         return wire.decode(data)
 
     def send_best_effort(self, directions: int, pwm: Sequence[int], timeout_s: float) -> bool:

@@ -113,7 +113,7 @@ class RobotxLink:
         frame = self._frame(command, areas)
         self._owed += 1
         self.port.write(frame, deadline)
-        what = f"the reply to {command.name} within {1000 * timeout_s:.0f} ms"
+        what = N_("the reply to {name} within {ms:.0f} ms", name=command.name, ms=1000 * timeout_s)
         try:
             reply = self._read_frame(deadline, what, skip_junk=first)
         except wire.WireError as exc:
@@ -126,12 +126,13 @@ class RobotxLink:
     def _check(self, reply: Frame, command: Command) -> None:
         problem = ""
         if reply.command != command.reply:
-            problem = f"reply code {reply.command} to {command.name} (expected {command.reply})"
+            problem = N_("reply code {code} to {name} (expected {expected})", code=reply.command, name=command.name,
+                         expected=command.reply)
         elif reply.tid != self.tid:
-            problem = f"the reply to transaction {reply.tid} where {self.tid} was sent"
+            problem = N_("the reply to transaction {got} where {sent} was sent", got=reply.tid, sent=self.tid)
         elif self.sid is not None and reply.sid != self.sid:
-            problem = (f"session {reply.sid} where it was {self.sid}: the controller started a new session "
-                       "(it ended the online link)")
+            problem = N_("session {got} where it was {was}: the controller started a new session (it ended the "
+                         "online link)", got=reply.sid, was=self.sid)
         if problem:
             self._trusted = False
             raise LinkLost(N_("wrong answer from {device}: {problem}", device=self.device, problem=problem))
@@ -142,7 +143,7 @@ class RobotxLink:
         data = reply.area(wire.TA_LOCAL)
         if data is None or len(data) != size:
             self._trusted = False
-            got = "no data for the controller" if data is None else f"{len(data)} bytes"
+            got = N_("no data for the controller") if data is None else N_("{count} bytes", count=len(data))
             raise LinkLost(N_("wrong answer from {device}: {got} in the reply to {name} (expected {size} bytes)",
                               device=self.device, got=got, name=command.name, size=size))
         return data
@@ -167,7 +168,7 @@ class RobotxLink:
         """Read and drop the replies still owed (each frame found by its start, whatever came before)."""
         while self._owed > 0:
             with contextlib.suppress(wire.WireError):
-                self._read_frame(deadline, "a reply still owed", skip_junk=True)
+                self._read_frame(deadline, N_("a reply still owed"), skip_junk=True)
             self._owed -= 1
 
 

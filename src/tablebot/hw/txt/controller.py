@@ -16,6 +16,7 @@ from tablebot.hw.txt import protocol as wire
 from tablebot.hw.txt.link import TxtLink
 from tablebot.hw.txt.protocol import Command
 from tablebot.hw.txt.wiring import TxtWiring
+from tablebot.i18n import N_
 from tablebot.loop import LinkLost, Reading
 
 ZERO = [0] * wire.N_OUTPUTS
@@ -47,9 +48,10 @@ class TxtRobot(ExchangeRobot):
         self.status = self.link.query_status()
         if self.status.version < wire.MIN_VERSION:
             self.link.close()
-            raise FirmwareTooOld(f"{self.status.device} at {self.link.where} runs firmware "
-                                 f"{self.status.version_text} (0x{self.status.version:08X}); the online protocol "
-                                 "needs 4.6.6 or later, as fischertechnik's own online client checks")
+            raise FirmwareTooOld(N_("{device} at {where} runs firmware {version} (0x{number:08X}); the online "
+                                    "protocol needs 4.6.6 or later, as fischertechnik's own online client checks",
+                                    device=self.status.device, where=self.link.where,
+                                    version=self.status.version_text, number=self.status.version))
         return self.status
 
     # --- RobotIO ----------------------------------------------------------------------------------

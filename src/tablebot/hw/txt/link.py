@@ -194,12 +194,12 @@ class TxtLink:
 
     def _discard_owed(self, deadline: float, command: Command) -> None:
         while self._owed > 0:
-            self._chunk(min(self._owed, 4096), deadline, command, "a late reply")
+            self._chunk(min(self._owed, 4096), deadline, command, N_("a late reply"))
 
     def _receive(self, size: int, deadline: float, command: Command, timeout_s: float) -> bytes:
         data = bytearray()
         while len(data) < size:
-            what = f"a reply to {command.name} within {1000 * timeout_s:.0f} ms"
+            what = N_("a reply to {name} within {ms:.0f} ms", name=command.name, ms=1000 * timeout_s)
             data += self._chunk(size - len(data), deadline, command, what)
             if len(data) >= 4 and not self._id_ok(command, data):
                 break
