@@ -125,7 +125,7 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
             import tablebot.fleet.plots  # noqa: F401
         runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
         plan = make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
-                         every_table=True)
+                         every_table=True, grid_cells=True)
         traced = trace_runs(trace, plan.spec.total)
         if out is None:
             return _in_memory(plan, runner, chosen, shown)

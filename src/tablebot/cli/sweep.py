@@ -33,8 +33,10 @@ def sweep_cmd(
     world: list[Path] | None = WORLD_OPT,
     robots: int | None = typer.Option(None, "--robots", help="Run N robots: seeds 0..N-1 (or use --seeds)."),
     grid: list[str] | None = typer.Option(None, "--grid", help='KEY=V1,V2,...: battery=1.0,0.6, start=random '
-                                          '(or X:Y:HEADING poses), or a simulator parameter such as '
-                                          'motor.friction_volts=0.2,0.4. Repeat: every combination runs.'),
+                                          '(or X:Y:HEADING poses), a simulator parameter such as '
+                                          'motor.friction_volts=0.2,0.4, or a table cell: "line 5 timer=300,600" '
+                                          '("lights: line 4 timer=20,50": another table). Repeat: every '
+                                          'combination runs.'),
     seeds: str | None = typer.Option(None, "--seeds", help="Seeds of each combination: 0..999, 1,5,9 or a mix."),
     seconds: float = typer.Option(60.0, "--seconds", min=0.01, max=3600, help="Simulated time of each run."),
     backend: str = BACKEND_OPT,

@@ -5,17 +5,25 @@ every one of them, as editing the one cell of the file would."""
 
 from __future__ import annotations
 
+import itertools
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from tablebot.diagnostics import fail
+from tablebot.diagnostics import TableBotError, fail
 from tablebot.i18n import N_
 from tablebot.robot import MAX_TIMER
 from tablebot.table import Row, Table
 from tablebot.tables import RobotTables
 
-__all__ = ["CELL_RE", "Cell", "parse_cells"]
+if TYPE_CHECKING:
+    from tablebot.fleet.plan import Plan
+    from tablebot.fleet.robots import Variants
+    from tablebot.fleet.spec import Axis
+
+__all__ = ["CELL_RE", "Cell", "grid_variants", "parse_cells", "refuse_cells"]
 
 CELL_RE = re.compile(r"^(?:([^\s:,]+)\s*:\s*)?line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$",
                      re.IGNORECASE)
@@ -42,8 +50,19 @@ class Cell:
         return f"{self.table_name}: {where}" if self.table_name else where
 
 
-def parse_cells(text: str, table: Table, tables: RobotTables | None = None) -> list[Cell]:
-    """The cells ``text`` names in ``table`` (or, for a robot of several tables, in the one each names)."""
+def parse_cells(text: str, table: Table, tables: RobotTables | None = None, option: str = "--cells") -> list[Cell]:
+    """The cells ``text`` names in ``table`` (or, for a robot of several tables, in the one each names); a
+    mistake names ``option`` (``--grid`` for a sweep's cells)."""
+    try:
+        return _parse_cells(text, table, tables)
+    except TableBotError as exc:
+        if option == "--cells":
+            raise
+        first = exc.diagnostics[0]
+        raise fail(option, first.message.replace("--cells", option, 1), first.hint) from None
+
+
+def _parse_cells(text: str, table: Table, tables: RobotTables | None) -> list[Cell]:
     cells: list[Cell] = []
     for part in (p.strip() for p in text.split(",") if p.strip()):
         found = CELL_RE.match(part)
@@ -112,3 +131,26 @@ def _counter_of(column: str, counters: tuple[str, ...]) -> int | None:
         if column.lower() == f"{name.lower()}_load":
             return k
     return None
+
+
+def grid_variants(plan: Plan) -> tuple[Variants | None, dict[tuple[Any, ...], int]]:
+    """A sweep's table cells on its grid (``--grid "lights: line 4 timer=20,50"``): a program variant per
+    combination of their values, and each combination's variant (none without such a key)."""
+    from tablebot.fleet.tune import variants_of
+
+    if not plan.cell_axes:
+        return None, {}
+    axes = [plan.spec.axes[k] for k in plan.cell_axes]
+    cells = parse_cells(", ".join(axis.key for axis in axes), plan.table, plan.tables, "--grid")
+    combos = list(itertools.product(*(axis.values for axis in axes)))
+    return variants_of(plan, cells, combos), {combo: v for v, combo in reversed(list(enumerate(combos)))}
+
+
+def refuse_cells(axes: Sequence[Axis]) -> None:
+    """``--grid`` of a command other than sweep may not set a table cell (tune searches them with --cells)."""
+    from tablebot.fleet.spec import is_cell
+
+    for axis in axes:
+        if is_cell(axis.key):
+            raise fail("--grid", N_("--grid {key}: only sweep runs a table cell's values side by side", key=axis.key),
+                       N_("tune a cell with --cells; give --grid battery, start or a simulator parameter"))

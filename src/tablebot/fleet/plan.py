@@ -22,8 +22,9 @@ import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notify
 from tablebot.files import atomic_write, remove, write_text
+from tablebot.fleet.cells import grid_variants, refuse_cells
 from tablebot.fleet.results import FleetSummary
-from tablebot.fleet.robots import RobotSpec
+from tablebot.fleet.robots import RobotSpec, Variants
 from tablebot.fleet.run import Fleet
 from tablebot.fleet.spec import (
     START_COLUMNS,
@@ -31,6 +32,7 @@ from tablebot.fleet.spec import (
     SweepSpec,
     chunks,
     digest,
+    is_cell,
     param_of,
     parse_grid,
     parse_seeds,
@@ -69,6 +71,9 @@ class Plan:
     tables: RobotTables | None = None  # a robot of several tables run whole (``table`` is its main one)
 
     def __post_init__(self) -> None:
+        self.cell_axes = [k for k, axis in enumerate(self.spec.axes) if is_cell(axis.key)]
+        self.variants: Variants | None  # the grid's table cells' program variants (fleet.cells.grid_variants)
+        self.variants, self.variant_of = grid_variants(self)
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params, tables=self.tables)
                                     for w in self.worlds]
         self.bodies: list[list[Scene]] = self._check_params()
@@ -81,15 +86,17 @@ class Plan:
         return ["run", "world", "seed", *axes, *start, *RESULT_COLUMNS, *states]
 
     def robot(self, run: Run) -> RobotSpec:
-        """The fleet robot of one run (a random start drawn for its seed, checked free)."""
+        """The fleet robot of one run (a random start drawn for its seed, checked free; the program variant of
+        its values of the grid's table cells)."""
         params, start = [], None
-        for axis, value in zip(self.spec.axes, run.values, strict=True):
+        for k, (axis, value) in enumerate(zip(self.spec.axes, run.values, strict=True)):
             if axis.key == "start":
                 start = random_start(run.seed, self.worlds[run.world].walls, self._free(run.world)) \
                     if value == "random" else tuple(value)
-            else:
+            elif k not in self.cell_axes:
                 params.append((*param_of(axis.key), value))
-        return RobotSpec(seed=run.seed, start=start, params=tuple(params))
+        variant = self.variant_of.get(tuple(run.values[k] for k in self.cell_axes), 0)
+        return RobotSpec(seed=run.seed, start=start, params=tuple(params), variant=variant)
 
     def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
         """Whether a pose is a free start in the world for every robot body of the grid (a random start
@@ -114,7 +121,7 @@ class Plan:
             robots = self._robots(a, b, combos)
             out.append(Job(self.table, self.worlds[a // self.spec.runs_per_world], self.robot_params, robots,
                            self.spec.ticks, first=a, info={"stop": b, "starts": [robot.start for robot in robots]},
-                           tables=self.tables))
+                           tables=self.tables, variants=self.variants))
         return out
 
     def _robots(self, a: int, b: int, combos: Sequence[tuple[Any, ...]]) -> list[RobotSpec]:
@@ -132,7 +139,7 @@ class Plan:
                 out += [self.robot(Run(index + j, world, values, seed)) for j, seed in enumerate(seeds)]
             else:
                 first = self.robot(Run(index, world, values, seeds[0]))
-                out += [RobotSpec(seed, first.start, first.params) for seed in seeds]
+                out += [RobotSpec(seed, first.start, first.params, first.variant) for seed in seeds]
             index = stop
         return out
 
@@ -141,7 +148,7 @@ class Plan:
         the tick, the robot's body at the world's start), checked here before anything is written or run:
         a worker would blame the robot file for a value the grid set. Returns per world a scene for each
         robot body the grid gives (the starts must fit them all)."""
-        axes = [axis for axis in self.spec.axes if axis.key != "start"]
+        axes = [axis for k, axis in enumerate(self.spec.axes) if axis.key != "start" and k not in self.cell_axes]
         bodies = [{_body(scene): scene} for scene in self.scenes]
         for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
             overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
@@ -173,7 +180,7 @@ class Plan:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
         run = runs(self.spec, index, index + 1)[0]
         fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
-                      traced=[0], tables=self.tables)
+                      traced=[0], tables=self.tables, variants=self.variants)
         fleet.run(self.spec.ticks)
         return fleet
 
@@ -243,11 +250,14 @@ def cell(value: Any) -> str:
 
 
 def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Sequence[str], seeds: str | None,
-              robots: int | None, seconds: float, every_table: bool = False) -> Plan:
+              robots: int | None, seconds: float, every_table: bool = False, grid_cells: bool = False) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
     as a plan of runs; every mistake is a located error before anything is written. ``every_table``: a robot of
-    several tables runs all of them (``sweep``), else its main table alone (``tune``, ``evolve``, ``grade``)."""
+    several tables runs all of them (``sweep``, ``tune``, ``grade``), else its main table alone (``evolve``).
+    ``grid_cells``: ``--grid`` may set table cells (``sweep``: ``--grid "lights: line 4 timer=20,50"``)."""
     axes = parse_grid(list(grid))
+    if not grid_cells:  # sweep's alone: tune has --cells
+        refuse_cells(axes)
     seed_list = parse_seeds(seeds, robots)
     robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them
     parsed = load_table(resolve_table_path(table), robot_file_given)

@@ -136,8 +136,8 @@ def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
     parameter as section.key (``motor.friction_volts=0.2,0.4``)."""
     axes: list[Axis] = []
     for item in items:
-        key, sep, values = item.partition("=")
-        key = key.strip().lower()
+        raw, sep, values = item.partition("=")
+        key = raw.strip().lower()
         cells = [v.strip() for v in values.split(",") if v.strip()]
         if not sep or not key:
             raise fail("--grid", N_("--grid {item!r} is not KEY=VALUES", item=item),
@@ -146,8 +146,36 @@ def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
             raise fail("--grid", N_("--grid {key}= has no values", key=key), N_('write --grid "{key}=V1,V2"', key=key))
         if key in (a.key for a in axes):
             raise fail("--grid", N_("--grid names {key} twice", key=key), N_("give each key once, with all its values"))
+        if is_cell(raw):  # a timer or counter load of a table row: its values are program variants
+            key = " ".join(raw.split())
+            if key in (a.key for a in axes):
+                raise fail("--grid", N_("--grid names {key} twice", key=key),
+                           N_("give each key once, with all its values"))
+            axes.append(Axis(key, _counts(key, cells)))
+            continue
         axes.append(Axis(key, _start_values(cells) if key == "start" else _numbers(key, cells)))
     return tuple(axes)
+
+
+def is_cell(key: str) -> bool:
+    """Whether a grid key names a table cell (``line 5 timer``, ``lights: line 4 timer``, ``line 12 C1_load``)."""
+    from tablebot.fleet.cells import CELL_RE
+
+    return CELL_RE.match(key.strip()) is not None and "=" not in key
+
+
+def _counts(key: str, cells: list[str]) -> tuple[int, ...]:
+    """A cell axis's values: whole numbers of ticks (or counts) from 0 to MAX_TIMER."""
+    from tablebot.robot import MAX_TIMER
+
+    out = []
+    for cell in cells:
+        if not cell.isdigit() or int(cell) > MAX_TIMER:
+            raise fail("--grid", N_("--grid {key}: {cell!r} is not a whole number from 0 to {most}", key=key, cell=cell,
+                                    most=MAX_TIMER),
+                       N_('write ticks (or counts), e.g. --grid "{key}=20,50,100"', key=key))
+        out.append(int(cell))
+    return tuple(out)
 
 
 def known_keys() -> list[str]:
