@@ -1,5 +1,5 @@
 """What a fleet's plan needs of a robot of several tables (issue 36 §2): a digest of all its table files, and the
-note that a plan running its main table alone gives (``tune``, ``evolve``, ``grade``; ``sweep`` runs them all)."""
+note that a plan running its main table alone gives (``evolve``; ``sweep``, ``tune`` and ``grade`` run them all)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tablebot.diagnostics import Diagnostic, notify
 from tablebot.fleet.spec import digest
+from tablebot.i18n import N_
 from tablebot.robot import Robot
 from tablebot.robot_tables import tables_of
 from tablebot.table import Table
@@ -25,10 +26,11 @@ def tables_digest(table: Table, tables: RobotTables | None) -> str:
 
 
 def main_table_only(robot: Robot) -> None:
-    """A note that a plan of a robot of several tables runs its main table alone (``tune``, ``evolve``, ``grade``)."""
+    """A note that a plan of a robot of several tables runs its main table alone (``evolve``)."""
     specs = tables_of(robot)
     if specs:
         others = ", ".join(spec.name for spec in specs[1:])
         notify(Diagnostic(robot.source, robot.line("tables"), 1,
-                          f"this runs the main table ({specs[0].name}) only so far, not {others}: the outputs only "
-                          "they write stay at 0", "tablebot sim and sweep run every table (docs/engine.md)", "note"))
+                          N_("this runs the main table ({main}) only so far, not {others}: the outputs only they write "
+                             "stay at 0", main=specs[0].name, others=others),
+                          N_("tablebot sim, sweep, tune and grade run every table (docs/engine.md)"), "note"))
