@@ -138,7 +138,8 @@ def test_the_arena_runs_every_table_and_shows_the_lamps_as_the_engine_has_them(b
     page.context.close()
 
 
-@pytest.mark.parametrize(("width", "height", "locale"), [(1280, 720, "en-GB"), (1024, 768, "de-DE")])
+@pytest.mark.parametrize(("width", "height", "locale"), [(1280, 720, "en-GB"), (1280, 720, "de-DE"),
+                                                      (1024, 768, "de-DE"), (1024, 768, "en-GB")])
 def test_the_tabs_fit_a_classroom_screen(browser: Any, studio: Background, shots: Path, width: int, height: int,
                                          locale: str) -> None:
     page = open_page(browser, studio.url, width, height, locale)
