@@ -170,3 +170,18 @@ def test_import_says_what_it_wrote(tmp_path: Path) -> None:
     shown = says_nothing_outside(["import", str(chart), "--from", "scxml", "--out", str(tmp_path / "t.csv")],
                                  tmp_path)
     assert "⟦wrote" in shown, shown
+
+
+def test_no_text_is_marked_where_the_extraction_cannot_see_it() -> None:
+    """A ``_("...")`` inside an f-string's braces is translated in the pseudo-locale (every text is) but never
+    reaches the catalog (Babel does not look inside f-strings), so German readers would read it in English."""
+    import ast
+
+    marks = {"_", "N_", "NP_", "gettext", "ngettext"}
+    hidden = []
+    for path in sorted((ROOT / "src" / "tablebot").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.JoinedStr):
+                hidden += [f"{path.relative_to(ROOT)}:{call.lineno}" for call in ast.walk(node)
+                           if isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id in marks]
+    assert hidden == [], "mark the text outside the f-string: " + ", ".join(hidden)

@@ -228,7 +228,8 @@ def _legend(table: Table, colour: bool) -> str:
     robot = table.robot
     cells = [f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}"
              for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
-    cells.insert(0, f"<b>T</b> {dot_label(_('timer ran out'))}")
+    ran_out = _("timer ran out")  # outside the f-string: Babel does not look inside one
+    cells.insert(0, f"<b>T</b> {dot_label(ran_out)}")
     cells.append(dot_label(_("times: timer loaded by the row")))
     cells.append(dot_label(_("state border: its colour in the run's pictures")))
     if colour:
