@@ -10,20 +10,21 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
 
 from tablebot.diagnostics import TableBotError, fail
+from tablebot.fleet.robots import Variants
 from tablebot.i18n import N_
 from tablebot.robot import MAX_TIMER
 from tablebot.table import Row, Table
 from tablebot.tables import RobotTables
 
 if TYPE_CHECKING:
-    from tablebot.fleet.plan import Plan
-    from tablebot.fleet.robots import Variants
-    from tablebot.fleet.spec import Axis
+    from tablebot.machine import Machine
 
-__all__ = ["CELL_RE", "Cell", "grid_variants", "parse_cells", "refuse_cells"]
+__all__ = ["CELL_RE", "Cell", "cell_variants", "grid_variants", "parse_cells"]
 
 CELL_RE = re.compile(r"^(?:([^\s:,]+)\s*:\s*)?line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$",
                      re.IGNORECASE)
@@ -133,24 +134,41 @@ def _counter_of(column: str, counters: tuple[str, ...]) -> int | None:
     return None
 
 
-def grid_variants(plan: Plan) -> tuple[Variants | None, dict[tuple[Any, ...], int]]:
-    """A sweep's table cells on its grid (``--grid "lights: line 4 timer=20,50"``): a program variant per
-    combination of their values, and each combination's variant (none without such a key)."""
-    from tablebot.fleet.tune import variants_of
+def cell_variants(tables: RobotTables | None, machine: Machine, cells: Sequence[Cell],
+                  candidates: Sequence[Sequence[int]]) -> Variants:
+    """The table's timers and loads with each candidate's values written into its cells (a robot of several
+    tables: every table's, each cell in its own table)."""
+    several = tables is not None
+    base = Variants.of_tables(tables) if tables is not None else Variants.of(machine)
+    timers = np.repeat(base.timers, len(candidates), axis=0)
+    loads = np.repeat(base.loads, len(candidates), axis=0)
+    for v, values in enumerate(candidates):
+        for cell, value in zip(cells, values, strict=True):
+            for row in cell.rows:
+                at = (v, cell.table, row) if several else (v, row)
+                if cell.counter is None:
+                    timers[at] = value
+                else:
+                    loads[(*at, cell.counter)] = value
+    return Variants(timers, loads)
 
-    if not plan.cell_axes:
+
+class _Axis(Protocol):
+    """A sweep's grid axis (:class:`tablebot.fleet.spec.Axis`, which imports this module)."""
+
+    @property
+    def key(self) -> str: ...
+
+    @property
+    def values(self) -> tuple[Any, ...]: ...
+
+
+def grid_variants(axes: Sequence[_Axis], table: Table, tables: RobotTables | None,
+                  machine: Machine) -> tuple[Variants | None, dict[tuple[Any, ...], int]]:
+    """A sweep's table cells on its grid (``--grid "lights: line 4 timer=20,50"``, ``axes``): a program variant
+    per combination of their values, and each combination's variant (none without such a key)."""
+    if not axes:
         return None, {}
-    axes = [plan.spec.axes[k] for k in plan.cell_axes]
-    cells = parse_cells(", ".join(axis.key for axis in axes), plan.table, plan.tables, "--grid")
+    cells = parse_cells(", ".join(axis.key for axis in axes), table, tables, "--grid")
     combos = list(itertools.product(*(axis.values for axis in axes)))
-    return variants_of(plan, cells, combos), {combo: v for v, combo in reversed(list(enumerate(combos)))}
-
-
-def refuse_cells(axes: Sequence[Axis]) -> None:
-    """``--grid`` of a command other than sweep may not set a table cell (tune searches them with --cells)."""
-    from tablebot.fleet.spec import is_cell
-
-    for axis in axes:
-        if is_cell(axis.key):
-            raise fail("--grid", N_("--grid {key}: only sweep runs a table cell's values side by side", key=axis.key),
-                       N_("tune a cell with --cells; give --grid battery, start or a simulator parameter"))
+    return cell_variants(tables, machine, cells, combos), {combo: v for v, combo in reversed(list(enumerate(combos)))}

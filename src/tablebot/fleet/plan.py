@@ -22,7 +22,7 @@ import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail, notify
 from tablebot.files import atomic_write, remove, write_text
-from tablebot.fleet.cells import grid_variants, refuse_cells
+from tablebot.fleet.cells import grid_variants
 from tablebot.fleet.results import FleetSummary
 from tablebot.fleet.robots import RobotSpec, Variants
 from tablebot.fleet.run import Fleet
@@ -37,6 +37,7 @@ from tablebot.fleet.spec import (
     parse_grid,
     parse_seeds,
     random_start,
+    refuse_cells,
     runs,
     value_index,
 )
@@ -73,7 +74,8 @@ class Plan:
     def __post_init__(self) -> None:
         self.cell_axes = [k for k, axis in enumerate(self.spec.axes) if is_cell(axis.key)]
         self.variants: Variants | None  # the grid's table cells' program variants (fleet.cells.grid_variants)
-        self.variants, self.variant_of = grid_variants(self)
+        self.variants, self.variant_of = grid_variants([self.spec.axes[k] for k in self.cell_axes], self.table,
+                                                       self.tables, self.machine)
         self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params, tables=self.tables)
                                     for w in self.worlds]
         self.bodies: list[list[Scene]] = self._check_params()

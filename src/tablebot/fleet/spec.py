@@ -21,6 +21,7 @@ import numpy as np
 
 from tablebot.diagnostics import fail
 from tablebot.durations import MAX_NUMBER_CHARS
+from tablebot.fleet.cells import CELL_RE
 from tablebot.fleet.robots import Pose
 from tablebot.i18n import N_
 from tablebot.sim.model.params import DEFAULTS
@@ -159,8 +160,6 @@ def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
 
 def is_cell(key: str) -> bool:
     """Whether a grid key names a table cell (``line 5 timer``, ``lights: line 4 timer``, ``line 12 C1_load``)."""
-    from tablebot.fleet.cells import CELL_RE
-
     return CELL_RE.match(key.strip()) is not None and "=" not in key
 
 
@@ -284,3 +283,10 @@ def random_start(seed: int, walls: tuple[tuple[float, float], ...], free: Any) -
     raise fail("--grid", N_("start=random: found no free start pose in the world"),
                N_("give the world more free floor"))
 
+
+def refuse_cells(axes: Sequence[Axis]) -> None:
+    """``--grid`` of a command other than sweep may not set a table cell (tune searches them with --cells)."""
+    for axis in axes:
+        if is_cell(axis.key):
+            raise fail("--grid", N_("--grid {key}: only sweep runs a table cell's values side by side", key=axis.key),
+                       N_("tune a cell with --cells; give --grid battery, start or a simulator parameter"))

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tablebot.fleet.cells import Cell, parse_cells
+from tablebot.fleet.cells import Cell, cell_variants, parse_cells
 from tablebot.fleet.plan import Plan
 from tablebot.fleet.robots import Variants
 from tablebot.fleet.spec import runs
@@ -39,21 +39,9 @@ OBJECTIVES = {
 
 
 def variants_of(plan: Plan, cells: Sequence[Cell], candidates: Sequence[Sequence[int]]) -> Variants:
-    """The table's timers and loads with each candidate's values written into its cells (a robot of several
-    tables: every table's, each cell in its own table)."""
-    several = plan.tables is not None
-    base = Variants.of_tables(plan.tables) if plan.tables is not None else Variants.of(plan.machine)
-    timers = np.repeat(base.timers, len(candidates), axis=0)
-    loads = np.repeat(base.loads, len(candidates), axis=0)
-    for v, values in enumerate(candidates):
-        for cell, value in zip(cells, values, strict=True):
-            for row in cell.rows:
-                at = (v, cell.table, row) if several else (v, row)
-                if cell.counter is None:
-                    timers[at] = value
-                else:
-                    loads[(*at, cell.counter)] = value
-    return Variants(timers, loads)
+    """The plan's timers and loads with each candidate's values written into its cells
+    (:func:`~tablebot.fleet.cells.cell_variants`)."""
+    return cell_variants(plan.tables, plan.machine, cells, candidates)
 
 
 def losses(objective: str, s: FleetSummary, plan: Plan, world: int) -> np.ndarray:
