@@ -165,3 +165,50 @@ def test_any_text_is_a_link_or_refused_in_words() -> None:
             share.decode(text)
 
     pasted()
+
+
+def test_a_robot_of_several_tables_is_shared_whole_and_opens_to_the_same_robot(tmp_path: Path) -> None:
+    """examples/bumberbot-lights: the link carries the drive table and the lights table (its robot file named as
+    shipped), and the folder it opens into runs the same two tables."""
+    source = EXAMPLES / "bumberbot-lights"
+    shared = share.collect(source / "lights.csv")  # from either table: the robot's tables, the main one first
+    assert shared.table[0] == "table.csv" and [name for name, _ in shared.tables] == ["lights.csv"]
+    link = share.encode(shared)
+    assert len(link) < 1000  # docs/share.md
+    table = share.decode(link).write(tmp_path / "opened")
+    for name in ("table.csv", "lights.csv", "robot.toml"):
+        assert (tmp_path / "opened" / name).read_bytes() == (source / name).read_bytes()
+    opened, first = open_robot(table), open_robot(source)
+    assert opened.tables is not None and first.tables is not None
+    assert [t.rows for t in opened.tables.tables] == [t.rows for t in first.tables.tables]
+
+
+def test_the_studio_shares_the_tab_it_shows_as_edited_beside_the_others_as_saved(tmp_path: Path) -> None:
+    from tablebot.cli.studio import link_maker
+
+    source = EXAMPLES / "bumberbot-lights"
+    edited = (source / "lights.csv").read_text().rstrip("\n").rsplit("\n", 1)[0] + "\n"  # the tab's last row deleted
+    link, qr = link_maker(source / "lights.csv", edited)
+    assert qr.startswith("data:image/svg+xml")
+    files = share.decode(link).files()
+    assert files["lights.csv"] == edited and files["table.csv"] == (source / "table.csv").read_text()
+
+
+def test_a_links_other_tables_are_table_files_of_their_own_names() -> None:
+    body = {"name": "x", "table": ["table.csv", "a"], "robot": None, "world": None}
+    assert "not a table and a robot file" in refusal(forged(dict(body, tables=[["table.csv", "b"]])))
+    assert "not a table and a robot file" in refusal(forged(dict(body, tables=[["robot.toml", "b"]])))
+    assert "names a file '../x.csv'" in refusal(forged(dict(body, tables=[["../x.csv", "b"]])))
+    assert "not to a table" in refusal(forged(dict(body, tables="lights.csv")))
+
+
+def test_a_table_in_another_folder_cannot_be_carried(tmp_path: Path) -> None:
+    folder = tmp_path / "robot"
+    shutil.copytree(EXAMPLES / "bumberbot-lights", folder)
+    (folder / "parts").mkdir()
+    (folder / "lights.csv").rename(folder / "parts" / "lights.csv")
+    robot = folder / "robot.toml"
+    robot.write_text(robot.read_text().replace('file = "lights.csv"', 'file = "parts/lights.csv"'))
+    with pytest.raises(TableBotError) as caught:
+        share.collect(folder)
+    assert "in another folder (parts/lights.csv)" in str(caught.value) and "Traceback" not in str(caught.value)

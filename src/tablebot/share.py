@@ -30,6 +30,7 @@ from pathlib import Path
 
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.i18n import N_
+from tablebot.robot_tables import tables_of
 
 __all__ = ["FORMAT", "STUDIO", "Shared", "collect", "decode", "encode"]
 
@@ -51,16 +52,18 @@ class Shared:
     """What a link carries: a ``name`` (the folder's, or the table's when it is not ``table.csv``), the table
     as (file name, text), the robot file as (file name, text) or None (the built-in BumberBot), and the world's
     text or None (an empty room). The world is always written as ``arena.toml`` beside the table, where every
-    command finds it; a robot file's ``sim.world`` is made to name it."""
+    command finds it; a robot file's ``sim.world`` is made to name it. A robot of several tables: ``table`` is
+    its main table and ``tables`` the others, each (file name, text), as its ``[tables]`` names them."""
 
     name: str
     table: tuple[str, str]
     robot: tuple[str, str] | None = None
     world: str | None = None
+    tables: tuple[tuple[str, str], ...] = ()
 
     def files(self) -> dict[str, str]:
         """The files to write into a folder, by name."""
-        files = {self.table[0]: self.table[1]}
+        files = {self.table[0]: self.table[1], **dict(self.tables)}
         if self.robot is not None:
             files[self.robot[0]] = self.robot[1]
         if self.world is not None:
@@ -81,6 +84,16 @@ class Shared:
             for name, text in self.files().items():
                 write_text(stage / name, text, newline="")  # byte for byte as shared
         return folder / self.table[0]
+
+    def with_text(self, file: str, text: str) -> Shared:
+        """The same files with the table named ``file`` (the main table or another) holding ``text`` instead:
+        the studio shares a tab's table as edited, beside the robot's other tables as saved."""
+        if file == self.table[0]:
+            return replace(self, table=(file, text))
+        if file not in dict(self.tables):
+            raise fail(file, N_("this table is not one of the robot's tables"),
+                       N_("share the robot's folder: its robot file's [tables] names the tables a link carries"))
+        return replace(self, tables=tuple((name, text if name == file else old) for name, old in self.tables))
 
     def check(self, where: str = "link") -> None:
         """Read the files as every command would (the table against its robot file, the world): a broken one
@@ -112,7 +125,8 @@ def collect(path: str | Path) -> Shared:
     from tablebot.csvtext import read_text
 
     project = open_robot(path)
-    table = project.path
+    specs = tables_of(project.robot)
+    table = _table_path(project.robot.source, specs[0].file) if specs else project.path
     robot_path = Path(project.robot.source) if project.robot.source and Path(project.robot.source).is_file() \
         else None
     robot = None
@@ -123,8 +137,21 @@ def collect(path: str | Path) -> Shared:
     world = read_text(world_path, spreadsheet=False) if world_path is not None else None
     project.default_world()  # a broken world is refused before it is shared
     name = table.parent.resolve().name if table.stem == "table" else table.stem
+    others = tuple((_file_name(other), read_text(other))
+                   for other in (_table_path(project.robot.source, spec.file) for spec in specs[1:]))
     return Shared(_NAME_RE.sub("-", name).strip(" .-") or "shared", (_file_name(table), read_text(table)), robot,
-                  world)
+                  world, others)
+
+
+def _table_path(robot_file: str | None, file: str) -> Path:
+    """A ``[tables]`` entry's file: beside the robot file, as every command reads it. A link writes its files
+    into one folder, so a table in another folder cannot be carried (:func:`_file_name` says so)."""
+    path = Path(robot_file or ".").parent / file
+    if Path(file).name != file:
+        raise fail(path, N_("a link carries the robot's tables beside its robot file, and this one is in another "
+                            "folder ({file})", file=file),
+                   N_("move the table beside the robot file and name it in [tables] by its file name alone"))
+    return path
 
 
 def _file_name(path: Path) -> str:
@@ -158,9 +185,11 @@ def _robot_text(path: Path, text: str) -> str:
 def encode(shared: Shared, base: str = STUDIO) -> str:
     """The link carrying ``shared``: ``BASE#share=1.PAYLOAD`` (see the module). The same files always give
     the same link."""
-    body = {"name": shared.name, "table": list(shared.table),
-            "robot": [shared.robot[0], _reference(shared.robot[1])] if shared.robot else None,
-            "world": None if shared.world is None else _reference(shared.world)}
+    body: dict[str, object] = {"name": shared.name, "table": list(shared.table),
+                               "robot": [shared.robot[0], _reference(shared.robot[1])] if shared.robot else None,
+                               "world": None if shared.world is None else _reference(shared.world)}
+    if shared.tables:  # only then: a link of one table stays what it was, byte for byte
+        body["tables"] = [list(pair) for pair in shared.tables]
     packed = zlib.compress(json.dumps(body, ensure_ascii=False, separators=(",", ":")).encode("utf-8"), 9)
     payload = base64.urlsafe_b64encode(packed).decode("ascii").rstrip("=")
     return f"{base}#{KEY}{FORMAT}.{payload}"
@@ -240,7 +269,20 @@ def _unpack(data: bytes, where: str) -> Shared:
         raise fail(where, N_("this share link's files are not a table and a robot file"),
                    N_("make it again with `tablebot share`"))
     name = _NAME_RE.sub("-", body["name"]).strip(" .-")[:100] or "shared"
-    return Shared(name, table, robot, world)
+    return Shared(name, table, robot, world, _other_tables(body.get("tables", []), table[0], where))
+
+
+def _other_tables(value: object, main: str, where: str) -> tuple[tuple[str, str], ...]:
+    """A link's other tables (a robot of several): each a table file of its own name, none the main table's."""
+    if not isinstance(value, list):
+        raise fail(where, N_("this share link unpacks, but not to a table and its files"),
+                   N_("make it again with `tablebot share` or the studio's Share button"))
+    pairs = tuple(pair for pair in (_pair(item, where) for item in value) if pair is not None)
+    names = [main, *(name for name, _ in pairs)]
+    if len(set(names)) != len(names) or not all(name.lower().endswith((".csv", ".tsv")) for name in names):
+        raise fail(where, N_("this share link's files are not a table and a robot file"),
+                   N_("make it again with `tablebot share`"))
+    return pairs
 
 
 def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] | None:
@@ -263,7 +305,7 @@ def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] 
 
 #: The shipped examples whose robot and world files a link names instead of carrying them (a pupil's folder
 #: made by ``tablebot new --from bumberbot`` keeps them as they are: its link carries the table alone).
-SHIPPED = ("bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider")
+SHIPPED = ("bumberbot", "bumberbot-counters", "bumberbot-lights", "line-follower", "obstacle-avoider")
 
 
 def _digest(text: str) -> str:

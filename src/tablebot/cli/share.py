@@ -36,8 +36,14 @@ def share_cmd(
     print(link)
     robot = plain(shared.robot[0]) if shared.robot else _("the built-in BumberBot")
     world = _("its world") if shared.world is not None else _("an empty room")
-    err_console.print(_("{n:,} characters: the table {table}, {robot}, {world}").format(
-        n=len(link), table=plain(shared.table[0]), robot=robot, world=world), markup=False)
+    if shared.tables:  # a robot of several tables: every one of them
+        names = plain(", ".join([shared.table[0], *(name for name, _ in shared.tables)]))
+        said = _("{n:,} characters: the tables {tables}, {robot}, {world}").format(
+            n=len(link), tables=names, robot=robot, world=world)
+    else:
+        said = _("{n:,} characters: the table {table}, {robot}, {world}").format(
+            n=len(link), table=plain(shared.table[0]), robot=robot, world=world)
+    err_console.print(said, markup=False)
     if qr is not None:
         write_qr(qr, link)
         err_console.print(_("wrote {path}").format(path=plain(str(qr))), markup=False)

@@ -102,14 +102,11 @@ def _warn_network(root: Path, address: str, port: int) -> None:
 def link_maker(table: Path, text: str) -> tuple[str, str]:
     """The studio's Share button: ``tablebot share``'s link for the table at ``table`` with ``text`` (the draft on
     the page) as its contents, checked as every command reads it, and its QR code as an SVG data: address."""
-    from dataclasses import replace
-
     import segno
 
     from tablebot import share
 
-    shared = share.collect(table)
-    shared = replace(shared, table=(shared.table[0], text))
+    shared = share.collect(table).with_text(table.name, text)  # a robot of several: all its tables, this as edited
     shared.check("the table")
     link = share.encode(shared)
     try:
