@@ -171,8 +171,10 @@ def help_only(repeat: int) -> int:
     for name in ("--help", "--help (de)"):
         wall = med(w for w, _ in runs[name])
         print(f"{name}: {wall:.3f} s wall, target under {HELP_TARGET} s ({'met' if wall < HELP_TARGET else 'NOT met'})")
-    print(f"load average {os.getloadavg()[0]:.2f} at the end: above {os.cpu_count()}, a process's wall time includes "
-          f"waiting for a core; its cpu seconds, and the ratios, move less")
+    load, cores = os.getloadavg()[0], os.cpu_count() or 1
+    print(f"load average {load:.2f} at the end" + (f": above {cores}, a process's wall time includes waiting for a "
+                                                   "core; its cpu seconds, and the ratios, move less" if load > cores
+                                                   else ""))
     return 0
 
 
