@@ -60,7 +60,7 @@ class Check:
 
     >>> import tablebot
     >>> report = tablebot.open("examples/bumberbot").check()
-    >>> report.ok, [p.status for p in report.properties][:2]
+    >>> report.ok, [p.status for p in report.properties[:2]]
     (True, ['holds', 'holds'])
     """
 
