@@ -20,12 +20,21 @@ def signed_motors(table: Table) -> frozenset[str]:
     return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
 
 
+def owns(table: Table, output: str) -> bool:
+    """Whether the table has a column for ``output``: one table of a robot of several (``[tables]``) only for the
+    outputs it writes (another column would make it a second writer); a robot's one table for every output."""
+    return not table.name or output in table.writes
+
+
 def header(table: Table, signed: frozenset[str], language: str = "en") -> list[str]:
     """The header's cells, in ``language`` (German: Zustand, Folgezustand, M1_Richtung: tablebot.i18n.headers)."""
     robot = table.robot
-    motors = [name for m in robot.motors for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
-    return [header_name(name, language) for name in ["description", "state", *table.events, *motors, *robot.lamps,
-                                                      *(f"{c}_load" for c in robot.counter_names), "timer", "next"]]
+    motors = [name for m in robot.motors if owns(table, m)
+              for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
+    lamps = [lamp for lamp in robot.lamps if owns(table, lamp)]
+    loads = [f"{c}_load" for c in robot.counter_names if owns(table, c)]
+    return [header_name(name, language) for name in ["description", "state", *table.events, *motors, *lamps,
+                                                      *loads, "timer", "next"]]
 
 
 def _motor_cells(speed: int | None, signed: bool) -> list[str]:
@@ -41,10 +50,13 @@ def _keep(value: int | None) -> str:
 
 def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[str]) -> list[str]:
     description = "" if previous and previous.description == row.description else row.description
-    motors = zip(table.robot.motors, row.motors, strict=True)
+    robot = table.robot
+    motors = [(m, speed) for m, speed in zip(robot.motors, row.motors, strict=True) if owns(table, m)]
+    lamps = [v for lamp, v in zip(robot.lamps, row.lamps, strict=True) if owns(table, lamp)]
+    loads = [v for c, v in zip(robot.counter_names, row.counters, strict=True) if owns(table, c)]
     return [description, str(row.state), *("1" if e in row.events else "" for e in table.events),
             *(cell for motor, speed in motors for cell in _motor_cells(speed, motor in signed)),
-            *(_keep(v) for v in row.lamps), *("" if v is None else str(v) for v in row.counters),
+            *(_keep(v) for v in lamps), *("" if v is None else str(v) for v in loads),
             str(row.timer), str(row.next)]
 
 
