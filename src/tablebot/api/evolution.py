@@ -28,6 +28,12 @@ class Setup:
     files: list[Path]
     names: list[str]
     replay: Any = None  # tablebot.evolve.report.Replay: what the report's commands need
+    whole: Any = None  # tablebot.evolve.whole.Whole: a robot of several tables, the table evolved (None: one table)
+
+    @property
+    def base(self) -> Any:
+        """The table evolved (of several, the one ``--table`` names)."""
+        return self.whole.table if self.whole is not None else None
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,13 +65,16 @@ def evolve(project: Loaded, *, out: PathLike = "out/evolve", objective: str | No
            seeds: str = "0..15", check_seeds: str = "1000..1063", grid: Sequence[str] | None = None,
            seconds: float = 60.0, max_rows: int | None = None, freeze_state: Sequence[str] = (),
            freeze_cell: Sequence[str] = (), seed: int = 0, backend: str = "auto", scheduler: str | None = None,
-           workers: int | None = None, progress: Progress | None = None) -> Evolution:
+           workers: int | None = None, progress: Progress | None = None, table: str | None = None) -> Evolution:
     """Evolve the table (``tablebot evolve``, each keyword its option): change its motor cells, timers and next
     states, add, remove and reorder rows, keep only tables that satisfy every property of the robot (the
     project's property files; proved by ``check``), run them on the fleet over the project's worlds x ``grid``
     x ``seeds``, and keep an archive of the best tables that behave differently, in ``out`` (a folder of its
-    own: the same call again resumes there; Ctrl-C raises :class:`~tablebot.api.progress.Stopped`)."""
+    own: the same call again resumes there; Ctrl-C raises :class:`~tablebot.api.progress.Stopped`). A robot of
+    several tables evolves the one ``table`` names (default: the main one) beside the others as they are: each
+    candidate is proved and run with them, and only that table's files are written (``NAME.best-1.csv``)."""
     from tablebot.diagnostics import fail
+    from tablebot.evolve.whole import choose as chosen_table
     from tablebot.files import out_folder
     from tablebot.fleet.backends import choose
     from tablebot.fleet.plan import make_plan
@@ -74,13 +83,15 @@ def evolve(project: Loaded, *, out: PathLike = "out/evolve", objective: str | No
     folder = Path(out)
     chosen, address = choose(backend, scheduler)
     scenarios = list(grid or ["start=random"])
-    plan = make_plan(project.path, project.robot_file, project.world_files, scenarios, seeds, None, seconds)
+    plan = make_plan(project.path, project.robot_file, project.world_files, scenarios, seeds, None, seconds,
+                     every_table=True)  # a robot of several tables runs whole; one of them evolves
+    whole = chosen_table(plan.tables, table)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     if batch is not None and batch > budget:
         raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
     batch = batch or 16  # a budget below it takes what it has room for (the batch stays one, for resuming)
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, list(freeze_state),
-                   list(freeze_cell), list(project.property_files))
+                   list(freeze_cell), list(project.property_files), whole)
     setup = replace(setup, replay=_replay(plan, seeds, scenarios, folder))
     _own_folder(folder, plan, setup.files)
     out_folder(folder, "--out")
@@ -89,31 +100,38 @@ def evolve(project: Loaded, *, out: PathLike = "out/evolve", objective: str | No
 
 
 def _setup(plan: Plan, objective: str | None, descriptors: str | None, cells: int, budget: int, batch: int, seed: int,
-           max_rows: int | None, freeze_state: list[str], freeze_cell: list[str], files: list[Path]) -> Setup:
-    """Every option checked against the table and its worlds, before anything is written."""
+           max_rows: int | None, freeze_state: list[str], freeze_cell: list[str], files: list[Path],
+           whole: Any = None) -> Setup:
+    """Every option checked against the table and its worlds, before anything is written (of several tables,
+    the table evolved: ``whole``)."""
     from tablebot.diagnostics import fail
     from tablebot.evolve import measures, space
     from tablebot.evolve.operators import Space
     from tablebot.evolve.proofs import Prover, refuse_line_conditions
     from tablebot.evolve.run import Settings
+    from tablebot.evolve.whole import refuse_fixed
 
-    base = plan.table
+    base = whole.table if whole is not None else plan.table
     seconds = plan.spec.ticks * plan.scenes[0].tick_s
     measure = measures.check_objective(objective or measures.default_objective(plan.worlds), plan.worlds)
     text = measures.default_descriptors(plan.worlds) if descriptors is None else descriptors
-    chosen = measures.parse_descriptors(text, plan.worlds, base.states, seconds, cells)
+    chosen = measures.parse_descriptors(text, plan.worlds, plan.table.states, seconds, cells)  # the fleet counts
+    # the main table's states
     rows = max_rows or space.default_max_rows(base)
     if rows < len(base.rows):
         raise fail("--max-rows", f"--max-rows {rows} is fewer than the {len(base.rows)} rows the table starts with",
                    f"give --max-rows {len(base.rows)} or more")
     limits = space.Limits(rows, space.parse_freeze_states(freeze_state, base), space.parse_freeze_cells(freeze_cell,
                           base), space.default_timer_max(base))
-    prover = Prover(files)
-    refuse_line_conditions(prover, plan.machine)
+    prover = Prover(files, whole=whole)
+    refuse_line_conditions(prover, plan.machine if whole is None else whole.tables.machines[whole.index])
+    if whole is not None:
+        refuse_fixed(whole, prover)
     names = [n for n in measures.allowed(plan.worlds) if n != "lamp_distance" or n == measure.name]
     names += [d.name for d in chosen if d.name not in names]
     settings = Settings(measure, tuple(chosen), budget, batch, seed)
-    return Setup(settings, Space(base.states, base.robot.motors, limits), files, names)
+    writes = frozenset(base.writes) if whole is not None else None  # one table of several: its own columns
+    return Setup(settings, Space(base.states, base.robot.motors, limits, writes), files, names, whole=whole)
 
 
 def _own_folder(out: Path, plan: Plan, properties: list[Path]) -> None:
@@ -121,7 +139,8 @@ def _own_folder(out: Path, plan: Plan, properties: list[Path]) -> None:
     robot's own files (and a table named best-1.csv there would be a user's)."""
     from tablebot.diagnostics import fail
 
-    inputs = [Path(plan.table.path), *(Path(w) for w in plan.spec.worlds if w), *properties]
+    tables = plan.tables.tables if plan.tables is not None else (plan.table,)
+    inputs = [*(Path(t.path) for t in tables), *(Path(w) for w in plan.spec.worlds if w), *properties]
     if plan.table.robot.source:
         inputs.append(Path(plan.table.robot.source))
     here = out.resolve()
@@ -149,7 +168,7 @@ def _spec(plan: Plan, setup: Setup) -> dict[str, Any]:
             "batch": s.batch, "seed": s.seed, "max_rows": limits.max_rows,
             "frozen_states": sorted(map(str, limits.frozen_states)),
             "frozen_cells": sorted(f"{line} {col}" for line, col in limits.frozen_cells),
-            "timer_max": limits.timer_max}
+            "timer_max": limits.timer_max, **({"table": setup.whole.name} if setup.whole is not None else {})}
 
 
 def _run(plan: Plan, check: Plan, setup: Setup, out: Path, backend: str, address: str | None, workers: int | None,
@@ -164,20 +183,22 @@ def _run(plan: Plan, check: Plan, setup: Setup, out: Path, backend: str, address
 
     settings = setup.settings
     store = Store(out, _spec(plan, setup))
-    prover = Prover(setup.files, store.proofs)
+    prover = Prover(setup.files, store.proofs, whole=setup.whole)
+    base = setup.base or plan.table
     started = time.perf_counter()
     search = None
     progress.start("tables", settings.budget)
     try:
-        with Workers(setup.files, plan.table, workers) as provers, Runner(backend, address, workers) as runner:
-            evaluator = Evaluator(plan, runner, setup.names)
-            search = Search(plan.table, setup.space, settings, prover, evaluator, store, provers,
+        with Workers(setup.files, base, workers, setup.whole) as provers, \
+                Runner(backend, address, workers) as runner:
+            evaluator = Evaluator(plan, runner, setup.names, evolved=setup.whole.index if setup.whole else 0)
+            search = Search(base, setup.space, settings, prover, evaluator, store, provers,
                             on_eval=progress.advance, on_repair=lambda repairs: _said_repairs(repairs, progress))
             outcome = search.run()
             progress.stop()
             from tablebot.evolve.outputs import write_all  # after the run: it imports pyribs, which the run does
 
-            written = write_all(outcome, settings, plan.table, prover, evaluator, check, out, setup.names,
+            written = write_all(outcome, settings, base, prover, evaluator, check, out, setup.names,
                                 setup.replay, provers)
     except INTERRUPTS as exc:  # SIGTERM raises Terminated while a command runs (cli.common.guarded)
         kept = len(search.store.open()) if search else 0

@@ -100,14 +100,15 @@ class Project(Loaded):
                check_seeds: str = "1000..1063", grid: Sequence[str] | None = None, seconds: float = 60.0,
                max_rows: int | None = None, freeze_state: Sequence[str] = (), freeze_cell: Sequence[str] = (),
                seed: int = 0, backend: str = "auto", scheduler: str | None = None, workers: int | None = None,
-               progress: Progress | None = None) -> Evolution:
-        """Evolve the table under its properties (``tablebot evolve``): :func:`tablebot.api.evolution.evolve`."""
+               progress: Progress | None = None, table: str | None = None) -> Evolution:
+        """Evolve the table under its properties (``tablebot evolve``; ``table``: which of a robot's several
+        tables, default the main one): :func:`tablebot.api.evolution.evolve`."""
         from tablebot.api.evolution import evolve
 
         return evolve(self, out=out, objective=objective, descriptors=descriptors, cells=cells, budget=budget,
                       batch=batch, seeds=seeds, check_seeds=check_seeds, grid=grid, seconds=seconds,
                       max_rows=max_rows, freeze_state=freeze_state, freeze_cell=freeze_cell, seed=seed,
-                      backend=backend, scheduler=scheduler, workers=workers, progress=progress)
+                      backend=backend, scheduler=scheduler, workers=workers, progress=progress, table=table)
 
     def export(self, to: str, out: PathLike | None = None, *, into: PathLike | None = None,
                lists: Sequence[str] | None = None, lookup: str = "auto") -> Exported:

@@ -52,6 +52,9 @@ def evolve_cmd(
                                                  "satisfy (instead of those beside the table; the robot file's "
                                                  "[properties] always count)."),
     seed: int = typer.Option(0, "--seed", min=0, help="Seed of the search itself."),
+    which_table: str | None = typer.Option(None, "--table", help="A robot of several tables ([tables] in its robot "
+                                       "file): the one to evolve, the others staying as they are (default: the "
+                                       "main table)."),
     backend: str = BACKEND_OPT,
     scheduler: str | None = SCHEDULER_OPT,
     workers: int | None = EVOLVE_WORKERS_OPT,
@@ -69,7 +72,7 @@ def evolve_cmd(
                                  batch=batch, seeds=seeds, check_seeds=check_seeds, grid=grid, seconds=seconds,
                                  max_rows=max_rows, freeze_state=freeze_state or [], freeze_cell=freeze_cell or [],
                                  seed=seed, backend=backend, scheduler=scheduler, workers=workers,
-                                 progress=CountBar(quiet))
+                                 progress=CountBar(quiet), table=which_table)
     if not quiet:
         console.print(localise(evolved.report_text()), markup=False)
         console.print(_pace(evolved.outcome, evolved.plan, evolved.wall_s), markup=False)

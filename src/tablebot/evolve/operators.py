@@ -17,11 +17,17 @@ from tablebot.robot import StateId
 
 @dataclass(frozen=True)
 class Space:
-    """What the operators need to know: the states (fixed), the motors and the user's limits."""
+    """What the operators need to know: the states (fixed), the motors (a row's motor cells, in the robot's
+    order), the user's limits, and the motors the table has columns for (None: all of them; one table of a
+    robot of several writes only its own outputs, so a motor it has no column for is never set)."""
 
     states: tuple[StateId, ...]
     motors: tuple[str, ...]
     limits: Limits
+    writes: frozenset[str] | None = None
+
+    def may_set(self, motor: str) -> bool:
+        return self.writes is None or motor in self.writes
 
 
 Operator = Callable[[Candidate, Space, np.random.Generator], Candidate | None]
@@ -34,7 +40,7 @@ def _pick(rng: np.random.Generator, items: Sequence[int]) -> int | None:
 def motor(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """One motor cell of one row: a step of 1 or 2, reversed, stopped, kept or any speed."""
     cells = [(i, m) for i, gene in enumerate(c) for m, name in enumerate(space.motors)
-             if not space.limits.cell_frozen(gene, name)]
+             if space.may_set(name) and not space.limits.cell_frozen(gene, name)]
     if not cells:
         return None
     i, m = cells[int(rng.integers(len(cells)))]

@@ -8,7 +8,7 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from tablebot.files import remove, write_text
 from tablebot.fileset import current, file_set
 from tablebot.i18n import gettext
 from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.evolve.whole import Whole
 
 BEST = 3  # best tables written (elites of the best cells)
 
@@ -96,10 +99,11 @@ def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover
     forget_own(out)
     best = best_keys(outcome)
     start, seeds = outcome.start_key, outcome.seeds
-    tables = [("repaired" if k == 0 else f"repaired-{k + 1}", key)
+    own = f"{prover.whole.name}." if prover.whole is not None else ""  # one of several tables: lights.best-1.csv
+    tables = [(own + ("repaired" if k == 0 else f"repaired-{k + 1}"), key)
               for k, key in enumerate(seeds if outcome.repairs else [])]
-    tables += [(f"best-{k + 1}", key) for k, key in enumerate(best)]
-    tables += [("elites/cell-" + "-".join(f"{c:02d}" for c in cell), key)
+    tables += [(f"{own}best-{k + 1}", key) for k, key in enumerate(best)]
+    tables += [(f"elites/{own}cell-" + "-".join(f"{c:02d}" for c in cell), key)
                for key, _, _, cell in qd.elites(outcome.archive)]
     ready = [as_table(outcome.candidates[key], base, out / f"{label}.csv") for label, key in tables]
     checks = [workers.submit(check_report, table) for table in ready]  # in the workers while the fleet runs
@@ -141,17 +145,33 @@ def report_text(outcome: Outcome, settings: Settings, base: Table, prover: Prove
              f"{generations} generation{'' if generations == 1 else 's'} of up to {settings.batch}, "
              f"seed {settings.seed}; "
              f"{outcome.seconds:.0f} s.", ""]
+    lines += several_section(prover.whole)
     lines += start_section(outcome, base)
     lines += search_section(outcome, prover)
     lines += archive_section(outcome, settings)
     lines += fresh_section(outcome, objective, check, fresh, best, names)
-    lines += tables_section(outcome, objective, written, replay)
+    lines += tables_section(outcome, objective, written, replay, prover.whole)
     return "\n".join(lines) + "\n"
 
 
-def tables_section(outcome: Outcome, objective: Measure, written: list[Written], replay: Replay) -> list[str]:
+def several_section(whole: Whole | None) -> list[str]:
+    """Of a robot of several tables: which table evolved, and that the others stayed as they are."""
+    if whole is None:
+        return []
+    others = ", ".join(whole.others)
+    return ["## The robot's tables", "",
+            f"The robot has {len(whole.tables.names)} tables ({', '.join(whole.tables.names)}); evolve changed "
+            f"table **{whole.name}** only (`--table {whole.name}`). The other tables ({others}) stayed exactly as "
+            "they are: every candidate was proved over the product of all the tables and run on the fleet with "
+            f"all of them, the tables written here are {whole.name} tables ({whole.name}.best-1.csv, ...), and no "
+            f"file of {others} was written.", ""]
+
+
+def tables_section(outcome: Outcome, objective: Measure, written: list[Written], replay: Replay,
+                   whole: Whole | None = None) -> list[str]:
     """Every table written, with the ``tablebot sim`` that runs it in each world (a folder of its own
-    under OUT/sim for each), and the ``tablebot sweep`` that runs one on all the search's scenarios."""
+    under OUT/sim for each), and the ``tablebot sweep`` that runs one on all the search's scenarios; of a
+    robot of several tables, put in a copy of the robot's folder first (its robot file names its tables)."""
     several = len(replay.worlds) > 1
     lines = ["", "## The tables", "",
              "Each is written in the document's layout with its `check` report beside it (`NAME.check.txt`); "
@@ -161,16 +181,17 @@ def tables_section(outcome: Outcome, objective: Measure, written: list[Written],
         status = "every property holds" if w.holds else "A PROPERTY FAILS"
         head = (f"- `{w.label}.csv` ({status}; {objective.name} {outcome.means[w.key][objective.name]:.3f} on the "
                 "search scenarios)")
-        commands = sim_commands(w.path, w.label, replay)
+        commands = sim_commands(w.path, w.label, replay, whole)
         if several:
             lines += [f"{head}:", *(f"  - in {world}: `{command}`"
                                     for world, (_, command) in zip(replay.worlds, commands, strict=True))]
         else:
             lines.append(f"{head}: `{commands[0][1]}`")
     if written:
-        first = next((w for w in written if w.label == "best-1"), written[0])
+        first = next((w for w in written if w.label.rsplit(".", 1)[-1] == "best-1"), written[0])
         lines += ["", f"Run a table on every scenario and world it was evolved on at once (`{first.label}` here; "
-                  "any table above in its place):", "", f"`{sweep_command(first.path, first.label, replay)}`"]
+                  "any table above in its place):", "",
+                  f"`{sweep_command(first.path, first.label, replay, whole)}`"]
     return lines
 
 

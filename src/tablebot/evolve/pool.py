@@ -21,15 +21,15 @@ from collections import deque
 from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
-from tablebot.analysis.loops import zero_time_loops
-from tablebot.analysis.model import Model
-from tablebot.analysis.prove import check_property
 from tablebot.evolve.proofs import Prover, canonical
 from tablebot.evolve.space import Candidate, to_table
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.evolve.whole import Whole
 
 #: Per property tried (by its place in the property list), whether it holds; then, when all of them
 #: hold, whether a zero-time loop traps the robot (None: not looked at).
@@ -74,7 +74,8 @@ class Answered:
 @dataclass(frozen=True)
 class Context:
     """What every task needs: a prover of the run's property files (no cache: the run keeps that) and the
-    starting table (candidates become tables of its robot and columns)."""
+    starting table (candidates become tables of its robot and columns); of several tables, the prover knows the
+    robot (:class:`tablebot.evolve.whole.Whole`)."""
 
     prover: Prover
     base: Table
@@ -87,15 +88,16 @@ class Workers:
     They come from a fork server (spawned afresh on Windows), so, as for any ``multiprocessing`` program, the
     main module must be importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
 
-    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None) -> None:
+    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None,
+                 whole: Whole | None = None) -> None:
         self.count = max(1, count if count is not None else os.cpu_count() or 1)
-        self.context = Context(Prover(list(files)), base)
+        self.context = Context(Prover(list(files), whole=whole), base)
         self.pool: Any = None
         if self.count > 1:
             from concurrent.futures import ProcessPoolExecutor
 
             self.pool = ProcessPoolExecutor(self.count, _spawner(), initializer=_start,
-                                            initargs=(list(files), base))
+                                            initargs=(list(files), base, whole))
 
     def __enter__(self) -> Workers:
         return self
@@ -196,10 +198,10 @@ def preload() -> list[str]:
 _context: Context | None = None
 
 
-def _start(files: list[Path], base: Table) -> None:
+def _start(files: list[Path], base: Table, whole: Whole | None) -> None:
     global _context
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the run stops us
-    _context = Context(Prover(files), base)
+    _context = Context(Prover(files, whole=whole), base)
     _end_with_parent()
 
 
@@ -236,10 +238,10 @@ def statuses(context: Context, candidate: Candidate, order: Sequence[int]) -> St
     props = context.prover.properties(machine)
     known: dict[int, bool] = {}
     for index in order:
-        known[index] = check_property(props[index], machine).status == "holds"
+        known[index] = context.prover.check(props[index], machine).status == "holds"
         if not known[index]:
             return known, None
-    return known, any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
+    return known, context.prover.stuck(machine)
 
 
 def repaired(context: Context, candidate: Candidate, space: Any, prefer: str) -> Any:

@@ -14,17 +14,20 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tablebot.analysis.check import CheckReport, run_check
 from tablebot.analysis.loops import zero_time_loops
 from tablebot.analysis.model import Model
 from tablebot.analysis.properties import Property, load_properties
-from tablebot.analysis.prove import Result, check_property
+from tablebot.analysis.prove import Result, check_property, first_violation
 from tablebot.diagnostics import fail
 from tablebot.files import append, json_records
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.evolve.whole import Whole
 
 
 def canonical(machine: Machine) -> str:
@@ -70,6 +73,9 @@ class Prover:
     seconds: float = 0.0
     failures: dict[str, int] = field(default_factory=dict)  # proofs each property failed (ordering only)
     names: list[str] = field(default_factory=list)  # the property list's names, as last read
+    #: a robot of several tables: the table evolved and the others as they are (None: a robot of one table)
+    whole: Whole | None = None
+    fixed: dict[str, Result] = field(default_factory=dict)  # results of properties no candidate can change
 
     def __post_init__(self) -> None:
         if self.cache_path is not None:
@@ -77,19 +83,54 @@ class Prover:
                 self.verdicts[item["key"]] = Verdict(bool(item["ok"]), tuple(item["failed"]))
 
     def properties(self, machine: Machine) -> list[Property]:
-        """The properties read against this machine (its states and outputs)."""
-        return load_properties(machine, list(self.files))
+        """The properties read against this machine (its states and outputs; of several tables, the robot's
+        with the candidate in its place: a property may name any table's states)."""
+        if self.whole is None:
+            return load_properties(machine, list(self.files))
+        robot = self.whole.robot(machine)
+        return load_properties(robot.machines[0], list(self.files), robot)
+
+    def check(self, prop: Property, machine: Machine) -> Result:
+        """``check``'s proof of one property for the candidate ``machine`` (of several tables: over the product
+        of the robot's tables, the candidate in its place; a property it cannot change, proved once)."""
+        if self.whole is None:
+            return check_property(prop, machine)
+        from tablebot.analysis.prove_product import check_product_property
+
+        if self.whole.depends(prop):
+            return check_product_property(prop, self.whole.robot(machine))
+        if prop.name not in self.fixed:
+            self.fixed[prop.name] = check_product_property(prop, self.whole.tables)
+        return self.fixed[prop.name]
+
+    def violation(self, prop: Property, machine: Machine, inputs: Any) -> int | None:
+        """The tick at which ``inputs`` (a counterexample) break ``prop`` in the candidate, or None."""
+        if self.whole is None:
+            from tablebot.replay import replay
+
+            return first_violation(prop, machine, replay(machine, inputs))
+        from tablebot.analysis import prove_product
+
+        return prove_product.first_violation(prop, self.whole.robot(machine), inputs)
 
     def report(self, machine: Machine) -> CheckReport:
-        """The whole ``check`` of one machine (findings and every property, counterexamples included)."""
-        return run_check(machine, self.properties(machine))
+        """The whole ``check`` of one machine (findings and every property, counterexamples included; of
+        several tables, of the robot with the candidate in its place)."""
+        if self.whole is None:
+            return run_check(machine, self.properties(machine))
+        from tablebot.analysis.check_tables import run_check_tables
+
+        return run_check_tables(self.whole.robot(machine), self.properties(machine))
+
+    def stuck(self, machine: Machine) -> bool:
+        """Whether a zero-time loop no input can leave traps the candidate (its own table: the others stay as
+        they are, and a cross-table column is free there, as an input is)."""
+        return any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
 
     def results(self, machine: Machine) -> tuple[list[Result], bool]:
         """Every property's result (counterexamples included) and whether a zero-time loop traps the
         robot: what a repair weighs, without check's other findings."""
-        results = [check_property(prop, machine) for prop in self.properties(machine)]
-        stuck = any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
-        return results, stuck
+        return [self.check(prop, machine) for prop in self.properties(machine)], self.stuck(machine)
 
     def verdict(self, table: Table) -> tuple[str, Verdict]:
         """The candidate's canonical key and verdict (proved now, or from the cache)."""
@@ -142,11 +183,11 @@ class Prover:
         for index in self.order():
             holds = (known or {}).get(index)
             if holds is None:
-                holds = check_property(props[index], machine).status == "holds"
+                holds = self.check(props[index], machine).status == "holds"
             if not holds:
                 return Verdict(False, (props[index].name,))
         if stuck is None:
-            stuck = any(f.severity == "error" for f in zero_time_loops(Model(machine).explore()))
+            stuck = self.stuck(machine)
         return Verdict(False, ("zero-time-loop",)) if stuck else Verdict(True)
 
 

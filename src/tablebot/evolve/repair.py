@@ -15,9 +15,10 @@ breaks no other property is kept, until every property holds.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from tablebot.analysis.diagram import action, condition
-from tablebot.analysis.prove import Result, check_property, first_violation
+from tablebot.analysis.prove import Result
 from tablebot.evolve.operators import Space
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, to_table
@@ -25,6 +26,9 @@ from tablebot.machine import Machine, compile_table
 from tablebot.replay import replay
 from tablebot.robot import StateId
 from tablebot.table import Table
+
+if TYPE_CHECKING:
+    from tablebot.evolve.whole import Tick, Whole
 
 STAY_TIMERS = (1, 10)  # ticks a "keep going while pressed" guard waits before looking again
 
@@ -71,7 +75,7 @@ def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, pref
         target = next((r for r in report.results if r.status != "holds" and r.inputs), None)
         if target is None:
             return done  # nothing to read a repair from (an unknown result, or a zero-time loop)
-        proposals = guard_proposals(current, report.machine, target, space, prefer)
+        proposals = guard_proposals(current, report.machine, target, space, prefer, prover.whole)
         done.proposals += len(proposals)
         found = None
         for mended, step in proposals:
@@ -102,9 +106,9 @@ def weigh(mended: Candidate, base: Table, prover: Prover, target: Result, before
     """The mended table's results when it is a step forward: it mends the counterexample it was made for,
     the property's next counterexample is no shorter (or it holds), and no other property breaks."""
     machine = compile_table(to_table(mended, base))
-    if first_violation(target.prop, machine, replay(machine, target.inputs)) is not None:
+    if prover.violation(target.prop, machine, target.inputs) is not None:
         return None
-    again = check_property(target.prop, machine)
+    again = prover.check(target.prop, machine)
     if again.status != "holds" and len(again.inputs) < len(target.inputs):
         return None
     results, stuck = prover.results(machine)
@@ -122,29 +126,41 @@ def score(report: Weighed, name: str) -> tuple[int, int]:
 
 
 def guard_proposals(candidate: Candidate, machine: Machine, result: Result, space: Space,
-                    prefer: str = "keep") -> list[tuple[Candidate, Step]]:
-    """Candidates with one guard row added where the counterexample goes wrong (see the module doc)."""
+                    prefer: str = "keep", whole: Whole | None = None) -> list[tuple[Candidate, Step]]:
+    """Candidates with one guard row added where the counterexample goes wrong (see the module doc); of a
+    robot of several tables (``whole``), the counterexample replays every table, and the guard rows are the
+    evolved table's."""
     table = machine.table
-    lines = list(replay(machine, result.inputs))
+    ticks = _ticks(machine, result) if whole is None else whole.ticks(machine, result.inputs)
     window = result.prop.within + 1 if result.prop.kind == "when" else 1
-    watched = {name for name, bit in machine.input_bits.items() if bit & result.prop.watch}
+    watched = _watched(machine, result) if whole is None else whole.watched(result.prop)
     out: list[tuple[Candidate, Step]] = []
     seen: set[tuple] = set()
-    for k in range(max(0, len(lines) - window), len(lines)):
-        state = machine.states[machine.initial_state] if k == 0 else lines[k - 1]["state"]
+    for state, pressed, fired in ticks[max(0, len(ticks) - window):]:
         if space.limits.state_frozen(state) or len(candidate) >= space.limits.max_rows:
             continue
-        pressed = {name for name, bit in machine.input_bits.items() if lines[k]["event"] & bit}
         guard = (pressed & watched) or pressed
         for events in _event_sets(guard, table):
             for gene in _actions(table, state, events, result.prop.name, prefer):
-                for at in _places(candidate, state, lines[k]["row"], table):
+                for at in _places(candidate, state, fired, table):
                     mended = (*candidate[:at], gene, *candidate[at:])
                     if (mended_key := tuple(g.effect() for g in mended)) in seen:
                         continue
                     seen.add(mended_key)
                     out.append((mended, Step(result.prop.name, state, gene, len(result.inputs))))
     return out
+
+
+def _ticks(machine: Machine, result: Result) -> list[Tick]:
+    """The counterexample replayed on the table: per tick the state before it, what was pressed, the row."""
+    lines = list(replay(machine, result.inputs))
+    pressed = [{name for name, bit in machine.input_bits.items() if line["event"] & bit} for line in lines]
+    before = [machine.states[machine.initial_state], *(line["state"] for line in lines[:-1])]
+    return [(state, p, line["row"]) for state, p, line in zip(before, pressed, lines, strict=True)]
+
+
+def _watched(machine: Machine, result: Result) -> set[str]:
+    return {name for name, bit in machine.input_bits.items() if bit & result.prop.watch}
 
 
 def _event_sets(guard: set[str], table: Table) -> list[frozenset[str]]:

@@ -96,7 +96,7 @@ def to_table(candidate: Candidate, base: Table, path: str = "<evolved>") -> Tabl
         rows.append(Row(index=index, line=line, description=gene.description, state=gene.state, events=gene.events,
                         motors=gene.motors, timer=gene.timer, next=gene.next, counters=gene.counters,
                         lamps=gene.lamps))
-    return Table(base.robot, base.events, tuple(rows), path)
+    return replace(base, rows=tuple(rows), path=path)  # its name and cross-table columns too (several tables)
 
 
 def renumbered(table: Table) -> Table:
