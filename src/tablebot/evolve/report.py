@@ -48,7 +48,8 @@ def describe(gene: Gene, base: Table) -> str:
     """A row's description: the starting row's own words, with what evolution changed said after them;
     an added row says what it needs and does."""
     table = base
-    original = next((row for row in base.rows if row.line == gene.origin), None)
+    original = next((row for row in base.rows if row.line == gene.origin and row.state == gene.state),  # a group
+                    next((row for row in base.rows if row.line == gene.origin), None))  # row is one per state
     if original is None:
         if gene.description and gene.note.startswith("guard"):
             return gene.description
@@ -110,14 +111,19 @@ def check_text(report: CheckReport, prover: Prover) -> str:
     """``tablebot check``'s report in plain text: every property and every finding, by file line."""
     table, machine = report.machine.table, report.machine
     sources = ", ".join(str(f) for f in prover.files) or "none"
-    lines = [f"{Path(table.path).name}: {len(table.rows)} rows, {len(machine.states)} states, "
-             f"{report.situations} situations explored", "", f"properties (the robot file's and {sources}):"]
+    head = f"{Path(table.path).name}: {len(table.rows)} rows, {len(machine.states)} states, "
+    whole = prover.whole
+    if whole is not None and report.tables is not None:  # one table of several: proved with the others
+        mine = report.tables.machines[whole.index]
+        head = (f"{Path(mine.table.path).name} (table {whole.name}; unchanged beside it: {', '.join(whole.others)}): "
+                f"{len(mine.table.rows)} rows, {len(mine.states)} states; the tables together: ")
+    lines = [f"{head}{report.situations} situations explored", "", f"properties (the robot file's and {sources}):"]
     marks = {"holds": "holds   ", "violated": "VIOLATED", "unknown": "UNKNOWN "}
     for result in report.results:
         lines.append(f"  {marks[result.status]} {result.prop.name}: {result.prop.text}")
         lines.append(f"           {result.prop.claim()}")
     lines += ["", "findings:"]
-    lines += [f"  {Path(table.path).name}:{','.join(map(str, f.lines)) or '-'}: {f.severity}: {f.message}"
+    lines += [f"  {Path(f.path or table.path).name}:{','.join(map(str, f.lines)) or '-'}: {f.severity}: {f.message}"
               for f in report.findings] or ["  none"]
     counts = report.counts()
     lines += ["", f"{counts['error']} errors, {counts['warning']} warnings, {counts['info']} notes"]
