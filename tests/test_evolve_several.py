@@ -73,6 +73,8 @@ def test_only_the_lights_table_is_written_and_the_robot_files_are_untouched(
     assert "every property holds" in report and "A PROPERTY FAILS" not in report
     check = (out / "lights.best-1.check.txt").read_text(encoding="utf-8")
     assert "VIOLATED" not in check and "lamps_burn_on_the_light" in check  # proved over both tables
+    assert check.startswith("lights.best-1.csv (table lights; unchanged beside it: drive): ")
+    assert "moved from state" not in (out / "lights.best-1.csv").read_text(encoding="utf-8")  # a group's rows
 
 
 def test_the_printed_command_runs_the_evolved_lights_beside_the_drive_table(

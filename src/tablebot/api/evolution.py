@@ -107,9 +107,8 @@ def _setup(plan: Plan, objective: str | None, descriptors: str | None, cells: in
     from tablebot.diagnostics import fail
     from tablebot.evolve import measures, space
     from tablebot.evolve.operators import Space
-    from tablebot.evolve.proofs import Prover, refuse_line_conditions
+    from tablebot.evolve.proofs import Prover, refuse_fixed, refuse_line_conditions
     from tablebot.evolve.run import Settings
-    from tablebot.evolve.whole import refuse_fixed
 
     base = whole.table if whole is not None else plan.table
     seconds = plan.spec.ticks * plan.scenes[0].tick_s

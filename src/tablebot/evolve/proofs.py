@@ -23,6 +23,7 @@ from tablebot.analysis.properties import Property, load_properties
 from tablebot.analysis.prove import Result, check_property, first_violation
 from tablebot.diagnostics import fail
 from tablebot.files import append, json_records
+from tablebot.i18n import N_
 from tablebot.machine import Machine, compile_table
 from tablebot.table import Table
 
@@ -204,3 +205,19 @@ def refuse_line_conditions(prover: Prover, machine: Machine) -> None:
             raise fail(where, f"property {prop.name} names a file line; evolve adds, removes and moves rows, so "
                        "a line number would name another row", "write the property with states, events and "
                        "outputs instead of line (or give evolve other properties with --properties)")
+
+
+def refuse_fixed(whole: Whole, prover: Prover) -> None:
+    """Before the search: a property the evolved table cannot change that fails in the robot as it is would
+    discard every candidate. Said, naming the property, the table that decides it and ``--table``."""
+    robot = whole.tables
+    for prop in prover.properties(robot.machines[whole.index]):
+        if whole.depends(prop) or prover.check(prop, robot.machines[whole.index]).status == "holds":
+            continue
+        deciders = ", ".join(robot.names[k] for k in sorted(robot.influence(prop.tables)))
+        raise fail("--table", N_("--table {name}: property {prop} fails in the robot as it is, and only table "
+                                 "{deciders} decides it, which evolve --table {name} leaves as it is, so no "
+                                 "{name} table could keep it", name=whole.name, prop=prop.name, deciders=deciders),
+                   N_("mend table {deciders} first (tablebot check shows the counterexample; evolve --table "
+                      "repairs the table it evolves), or give --properties files without {prop}", deciders=deciders,
+                      prop=prop.name))

@@ -7,7 +7,7 @@ and the fleet runs every table (:meth:`tablebot.evolve.evaluate.Evaluator.severa
 A property only other tables decide (the evolved one is not among the tables its tables read from,
 :meth:`~tablebot.tables.RobotTables.influence`) holds or fails alike for every candidate: it is proved once,
 and when it fails in the robot as it is, no table evolve could find keeps it, which is said before the search
-starts (:func:`refuse_fixed`).
+starts (:func:`tablebot.evolve.proofs.refuse_fixed`).
 """
 
 from __future__ import annotations
@@ -25,10 +25,9 @@ from tablebot.tables import RobotTables
 
 if TYPE_CHECKING:
     from tablebot.analysis.properties import Property
-    from tablebot.evolve.proofs import Prover
     from tablebot.formats.inputs_csv import TickInput
 
-__all__ = ["Tick", "Whole", "choose", "refuse_fixed"]
+__all__ = ["Tick", "Whole", "choose"]
 
 #: One tick of a replayed counterexample as a repair reads it: the evolved table's state before the tick, the
 #: inputs that read 1, and the index of the evolved table's row that fired (None: none).
@@ -103,19 +102,3 @@ def choose(tables: RobotTables | None, name: str | None) -> Whole | None:
         raise fail("--table", N_("--table {name}: the robot has no table of that name", name=name),
                    N_("name one of its tables: {names}", names=", ".join(tables.names)))
     return Whole(tables, tables.names.index(name))
-
-
-def refuse_fixed(whole: Whole, prover: Prover) -> None:
-    """Before the search: a property the evolved table cannot change that fails in the robot as it is would
-    discard every candidate. Said, naming the property, the table that decides it and ``--table``."""
-    robot = whole.tables
-    for prop in prover.properties(robot.machines[whole.index]):
-        if whole.depends(prop) or prover.check(prop, robot.machines[whole.index]).status == "holds":
-            continue
-        deciders = ", ".join(robot.names[k] for k in sorted(robot.influence(prop.tables)))
-        raise fail("--table", N_("--table {name}: property {prop} fails in the robot as it is, and only table "
-                                 "{deciders} decides it, which evolve --table {name} leaves as it is, so no "
-                                 "{name} table could keep it", name=whole.name, prop=prop.name, deciders=deciders),
-                   N_("mend table {deciders} first (tablebot check shows the counterexample; evolve --table "
-                      "repairs the table it evolves), or give --properties files without {prop}", deciders=deciders,
-                      prop=prop.name))
