@@ -187,3 +187,23 @@ def test_a_lights_table_written_back_loads_beside_the_drive_table(tmp_path: Path
         return [(r.state, r.events, r.motors, r.lamps, r.timer, r.next) for r in table.rows]
 
     assert cells(both.tables[1]) == cells(lights) and "M1" not in both.tables[1].writes
+
+
+def test_the_main_table_is_repaired_on_counterexamples_of_the_whole_robot(tmp_path: Path) -> None:
+    """Without --table the drive table evolves: it breaks front_bumper_stops, and the repair, replaying check's
+    counterexamples on both tables, mends it so that every property of the robot holds beside the lights."""
+    out = tmp_path / "drive"
+    code, output = evolve(str(EXAMPLE), "--out", str(out), "--seeds", "0", "--check-seeds", "9", "--seconds", "1",
+                          "--budget", "3", "--batch", "1", "--workers", "2")
+    assert code == 0, output
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "It breaks front_bumper_stops" in report and "**drive.repaired.csv** (" in report
+    assert "evolve changed table **drive** only" in report
+    copy = tmp_path / "robot"
+    copy.mkdir()
+    for name in ("robot.toml", "lights.csv", "properties.toml"):
+        (copy / name).write_bytes((EXAMPLE / name).read_bytes())
+    (copy / "table.csv").write_bytes((out / "drive.repaired.csv").read_bytes())
+    checked = tablebot.open(copy).check_report()
+    assert {r.prop.name: r.status for r in checked.results}["front_bumper_stops"] == "holds"
+    assert all(r.status == "holds" for r in checked.results), [(r.prop.name, r.status) for r in checked.results]

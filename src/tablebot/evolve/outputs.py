@@ -146,7 +146,7 @@ def report_text(outcome: Outcome, settings: Settings, base: Table, prover: Prove
              f"seed {settings.seed}; "
              f"{outcome.seconds:.0f} s.", ""]
     lines += several_section(prover.whole)
-    lines += start_section(outcome, base)
+    lines += start_section(outcome, base, f"{prover.whole.name}." if prover.whole is not None else "")
     lines += search_section(outcome, prover)
     lines += archive_section(outcome, settings)
     lines += fresh_section(outcome, objective, check, fresh, best, names)
@@ -195,14 +195,14 @@ def tables_section(outcome: Outcome, objective: Measure, written: list[Written],
     return lines
 
 
-def start_section(outcome: Outcome, base: Table) -> list[str]:
+def start_section(outcome: Outcome, base: Table, own: str = "") -> list[str]:
     lines = ["## The starting table", ""]
     if outcome.start_verdict.ok:
         return [*lines, "Every property holds in it: the archive starts from it as it is.", ""]
     lines.append(f"It breaks {', '.join(outcome.start_verdict.failed)}, so no table evolved from it could be kept "
                  "until it was repaired. The repair (guided by `check`'s shortest counterexamples) added:")
     for k, repaired in enumerate(outcome.repairs):
-        label = "repaired.csv" if k == 0 else f"repaired-{k + 1}.csv"
+        label = own + ("repaired.csv" if k == 0 else f"repaired-{k + 1}.csv")
         done = "every property holds" if repaired.ok else f"still failing: {', '.join(repaired.failing)}"
         lines += ["", f"**{label}** ({len(repaired.steps)} guard rows, {repaired.proposals} proposals checked; "
                   f"{done}):", ""]
