@@ -159,6 +159,11 @@ def test_unknown_table_and_table_on_a_one_table_robot_are_located_errors(tmp_pat
     assert not (tmp_path / "a").exists() and not (tmp_path / "c").exists()  # refused before anything is written
 
 
+def test_freeze_cell_names_the_evolved_tables_own_cells(tmp_path: Path) -> None:
+    code, output = evolve(str(EXAMPLE), "--table", "lights", "--freeze-cell", "line 3 M1", "--out", str(tmp_path), *RUN)
+    assert code == 2 and "--freeze-cell: 'M1' is not a cell evolution changes" in output, output
+
+
 def test_a_property_only_other_tables_decide_stops_it_first(tmp_path: Path) -> None:
     """The shipped properties: front_bumper_stops fails in the drive table, which lights cannot change."""
     code, output = evolve(str(EXAMPLE), "--table", "lights", "--out", str(tmp_path / "a"), *RUN)

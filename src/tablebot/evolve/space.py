@@ -132,7 +132,8 @@ def parse_freeze_cells(values: Sequence[str], table: Table) -> frozenset[tuple[i
     """``--freeze-cell "line 5 timer"``, ``"line 5 M1"``, ``"line 5 next"`` or ``"line 5"`` (the whole
     row), comma-separated or repeated; file lines as an editor numbers them (the header is line 1)."""
     lines = {row.line for row in table.rows}
-    columns = {c.lower(): c for c in (*table.robot.motors, *ROW_COLUMNS)}
+    own = [m for m in table.robot.motors if not table.name or m in table.writes]  # one of several: its own motors
+    columns = {c.lower(): c for c in (*own, *ROW_COLUMNS)}
     out: set[tuple[int, str]] = set()
     for value in values:
         for part in (p.strip() for p in value.split(",") if p.strip()):
