@@ -135,14 +135,27 @@ def test_every_candidate_changes_lights_only_and_keeps_the_properties_over_both_
     assert changed >= 1  # the search did change the lights
 
 
-def test_a_mutation_never_sets_a_motor_the_table_has_no_column_for() -> None:
+def test_a_mutation_never_sets_a_motor_the_table_has_no_column_for_and_changes_its_lamps() -> None:
     lights = load_table(EXAMPLE / "lights.csv")
-    space = Space(lights.states, lights.robot.motors, Limits(len(lights.rows) + 8), frozenset(lights.writes))
+    space = Space(lights.states, lights.robot.motors, Limits(len(lights.rows) + 8), frozenset(lights.writes),
+                  lights.robot.lamps)
     rng = np.random.default_rng(0)
-    child = start(lights)
+    child, levels = start(lights), set()
     for _ in range(300):
         child = vary(child, space, rng) or child
         assert all(all(m is None for m in gene.motors) for gene in child)
+        levels |= {lamp for gene in child for lamp in gene.lamps}
+    assert levels - {0, 8}  # lamp cells are the lights table's own: they change (0 and 8 are the start's)
+
+
+def test_a_robot_of_one_table_keeps_its_lamp_levels() -> None:
+    table = load_table(EXAMPLE / "lights.csv")
+    space = Space(table.states, table.robot.motors, Limits(len(table.rows) + 8), None, table.robot.lamps)
+    rng = np.random.default_rng(0)
+    child = start(table)
+    for _ in range(200):
+        child = vary(child, space, rng) or child
+    assert {lamp for gene in child for lamp in gene.lamps} <= {0, 8}
 
 
 def test_unknown_table_and_table_on_a_one_table_robot_are_located_errors(tmp_path: Path) -> None:

@@ -130,7 +130,8 @@ def _setup(plan: Plan, objective: str | None, descriptors: str | None, cells: in
     names += [d.name for d in chosen if d.name not in names]
     settings = Settings(measure, tuple(chosen), budget, batch, seed)
     writes = frozenset(base.writes) if whole is not None else None  # one table of several: its own columns
-    return Setup(settings, Space(base.states, base.robot.motors, limits, writes), files, names, whole=whole)
+    searched = Space(base.states, base.robot.motors, limits, writes, base.robot.lamps)
+    return Setup(settings, searched, files, names, whole=whole)
 
 
 def _own_folder(out: Path, plan: Plan, properties: list[Path]) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 
 from tablebot.evolve.space import Candidate, Limits, valid
 from tablebot.robot import StateId
+from tablebot.table import MAX_LAMP
 
 
 @dataclass(frozen=True)
@@ -25,9 +26,15 @@ class Space:
     motors: tuple[str, ...]
     limits: Limits
     writes: frozenset[str] | None = None
+    lamps: tuple[str, ...] = ()  # one table of several: the robot's lamps, in a row's order (lamp cells may change)
 
     def may_set(self, motor: str) -> bool:
         return self.writes is None or motor in self.writes
+
+    def own_lamps(self) -> list[int]:
+        """The lamp cells evolution may change: those of one table of several that has columns for them (a robot
+        of one table keeps its lamp levels, as it always has)."""
+        return [] if self.writes is None else [k for k, name in enumerate(self.lamps) if name in self.writes]
 
 
 Operator = Callable[[Candidate, Space, np.random.Generator], Candidate | None]
@@ -61,6 +68,25 @@ def motor(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | N
         return None
     motors = tuple(new if k == m else v for k, v in enumerate(c[i].motors))
     return (*c[:i], replace(c[i], motors=motors), *c[i + 1:])
+
+
+def lamp(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
+    """One lamp cell of one row (a table of several that writes lamps): off, full, a step of 1 or 2, any level,
+    or kept."""
+    cells = [(i, k) for i, gene in enumerate(c) for k in space.own_lamps()
+             if not space.limits.cell_frozen(gene, space.lamps[k])]
+    if not cells:
+        return None
+    i, k = cells[int(rng.integers(len(cells)))]
+    old = c[i].lamps[k]
+    choice = int(rng.integers(5))
+    new: int | None = (0 if choice == 0 else MAX_LAMP if choice == 1 else None if choice == 2 else
+                       int(rng.integers(0, MAX_LAMP + 1)) if choice == 3 or old is None else
+                       int(np.clip(old + int(rng.choice([-2, -1, 1, 2])), 0, MAX_LAMP)))
+    if new == old:
+        return None
+    lamps = tuple(new if n == k else v for n, v in enumerate(c[i].lamps))
+    return (*c[:i], replace(c[i], lamps=lamps), *c[i + 1:])
 
 
 def timer(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
@@ -152,6 +178,7 @@ def take_state(c: Candidate, other: Candidate, space: Space, rng: np.random.Gene
 OPERATORS: dict[str, tuple[Operator, float]] = {
     "motor": (motor, 3.0), "timer": (timer, 3.0), "next": (next_state, 1.0), "add": (add_row, 1.0),
     "remove": (remove_row, 1.0), "move": (move_row, 1.0),
+    "lamp": (lamp, 3.0),  # last, and weighed 0 where no lamp may change: a robot of one table draws as it did
 }
 CROSSOVER_RATE = 0.2
 
@@ -161,7 +188,8 @@ def vary(parent: Candidate, space: Space, rng: np.random.Generator, other: Candi
     """A child of ``parent``: a crossover with ``other`` now and then, then one or more mutations (one
     most often, a few at times); None when nothing could change."""
     names = list(OPERATORS)
-    weights = np.array([OPERATORS[n][1] for n in names])
+    lamps = bool(space.own_lamps())
+    weights = np.array([OPERATORS[n][1] if n != "lamp" or lamps else 0.0 for n in names])
     weights /= weights.sum()
     for _ in range(tries):
         child: Candidate | None = parent

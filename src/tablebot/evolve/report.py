@@ -61,6 +61,9 @@ def describe(gene: Gene, base: Table) -> str:
     for name, old, new in zip(table.robot.motors, original.motors, gene.motors, strict=True):
         if old != new:
             changes.append(f"{name} {_speed(old)}->{_speed(new)}")
+    for name, old_level, new_level in zip(table.robot.lamps, original.lamps, gene.lamps, strict=True):
+        if old_level != new_level:
+            changes.append(f"{name} {_level(old_level)}->{_level(new_level)}")
     if original.timer != gene.timer:
         changes.append(f"timer {original.timer}->{gene.timer}")
     if original.next != gene.next:
@@ -73,6 +76,10 @@ def describe(gene: Gene, base: Table) -> str:
 
 def _speed(value: int | None) -> str:
     return "keep" if value is None else f"{value:+d}"
+
+
+def _level(value: int | None) -> str:
+    return "keep" if value is None else str(value)
 
 
 def _row(gene: Gene) -> Row:

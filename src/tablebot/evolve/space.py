@@ -133,6 +133,7 @@ def parse_freeze_cells(values: Sequence[str], table: Table) -> frozenset[tuple[i
     row), comma-separated or repeated; file lines as an editor numbers them (the header is line 1)."""
     lines = {row.line for row in table.rows}
     own = [m for m in table.robot.motors if not table.name or m in table.writes]  # one of several: its own motors
+    own += [lamp for lamp in table.robot.lamps if table.name and lamp in table.writes]  # and lamps
     columns = {c.lower(): c for c in (*own, *ROW_COLUMNS)}
     out: set[tuple[int, str]] = set()
     for value in values:
