@@ -43,7 +43,7 @@ docs: setup
 	$(MKDOCS)
 
 # The golden files of tests/golden/ (what tablebot writes for the BumberBot, compared byte for byte by
-# tests/test_golden.py) made again from the code as it is: review them with git diff, then commit them.
+# tests/project/test_golden.py) made again from the code as it is: review them with git diff, then commit them.
 golden: setup
 	.venv/bin/python scripts/golden.py
 

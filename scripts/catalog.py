@@ -12,7 +12,7 @@ help text of the command line (read from the built commands: docstrings and ``he
 locations name files without line numbers, so that a line moved by an unrelated edit leaves it up to date; its
 dates are fixed, so that extracting again gives the same bytes. The ``.mo`` files are committed: a wheel built
 anywhere (pip, uv, hatchling alone) carries them without a build step of ours, and ``check`` (in make test,
-tests/test_i18n_catalog.py) keeps them equal to what their ``.po`` compiles to.
+tests/i18n/test_i18n_catalog.py) keeps them equal to what their ``.po`` compiles to.
 """
 
 from __future__ import annotations

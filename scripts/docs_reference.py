@@ -5,7 +5,7 @@ and docs/sim-parameters.md (every simulator parameter with its default, range an
     .venv/bin/python scripts/docs_reference.py           # write both pages
     .venv/bin/python scripts/docs_reference.py --check   # exit 1 naming the pages that are out of date
 
-`make docs` (mkdocs, through scripts/docs_hooks.py) and tests/test_docs_reference.py fail while a page is
+`make docs` (mkdocs, through scripts/docs_hooks.py) and tests/project/test_docs_reference.py fail while a page is
 out of date.
 """
 

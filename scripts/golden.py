@@ -3,7 +3,7 @@ reviewed like code, so that a change to any output shows up as a diff in the cha
 
     make golden                     # (or .venv/bin/python scripts/golden.py) write them again, then git diff
 
-tests/test_golden.py makes the same files and compares them byte for byte with these. Each is made by the
+tests/project/test_golden.py makes the same files and compares them byte for byte with these. Each is made by the
 command a user types, as a process in the checkout (so paths in them read ``examples/bumberbot/...``):
 
 * ``c/``: ``tablebot export examples/bumberbot OUT --to c`` (the generated C engine and table)
@@ -14,7 +14,7 @@ command a user types, as a process in the checkout (so paths in them read ``exam
 * ``check.txt``: what ``tablebot check examples/bumberbot`` prints
 * ``sim-trace.jsonl``: the trace of ``tablebot sim examples/bumberbot --seconds 24 --seed 1`` (seeking, turning,
   then following the lamp); floating point may round otherwise on another platform (as the trace digests,
-  tests/test_trace_digests.py), so it is compared only on the platform in ``PLATFORM``.
+  tests/testing/test_trace_digests.py), so it is compared only on the platform in ``PLATFORM``.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ Two processes compiling into one numba cache folder at once race (numba issues #
 half-written cache file can crash the reader), and two workers compiling the same kernels would
 also spend the same minute twice. So the main pytest process starts ``tests/warm_kernels.py`` into the
 shared folder and, while it compiles (about a minute and a half on two cores, one of them), the workers run
-the modules that need no kernel (KERNEL_FREE, run first); a worker's first other test waits for the warm-up
+the modules that need no kernel (marked ``kernel_free``, run first); a worker's first other test waits for the warm-up
 and copies the shared folder into the worker's own, where whatever a test compiles that the warm-up did not
 reach stays that worker's. Without ``-n`` nothing changes: the one process compiles on demand, as before.
 """
@@ -14,6 +14,7 @@ reach stays that worker's. Without ``-n`` nothing changes: the one process compi
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -29,36 +30,28 @@ ROOT = Path(__file__).resolve().parents[1]
 SHARED = "TABLEBOT_TEST_NUMBA_SHARED"  # the warmed folder, handed from the main process to its workers
 WARMED = "TABLEBOT_TEST_NUMBA_WARMED"  # a file the main process writes when the warm-up has ended: "ok" or its errors
 
-#: Modules whose tests hold a controller, a link or a page to the wall clock (10 ms ticks, replies due within
-#: 50 ms, a tick that must come late or not): marked ``realtime``. `make test` runs them in a pass of their
-#: own after the parallel one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them.
-REALTIME = {"test_txt_robot", "test_pace", "test_roboif", "test_robotx", "test_run_serial", "test_serial_wiring",
-            "test_txt_link", "test_txt_wiring", "test_loop", "test_studio_live", "test_txt4_program",
-            "test_txt4_softxt", "test_txt4_upload", "test_rules", "test_docs_controllers"}
-#: Modules that drive Chromium: one browser at a time (one xdist worker), beside the other worker's tests.
-BROWSER = {"test_studio_browser", "test_studio_attacks", "test_studio_drafts", "test_diagram_without_graphviz",
-           "test_studio_shared_pc", "test_studio_tabs"}
-#: Modules that run no simulator kernel (measured: run alone on an empty numba cache, they compile nothing, or only
-#: a small function of their own in seconds: the batch engine, the trace writer, a noise filler). They run first,
-#: while the kernels compile; a module wrongly listed here is not wrong, only slow (it compiles the kernels itself),
-#: and the session's summary names it.
-KERNEL_FREE = {
-    "test_bench_engine", "test_check_cli", "test_check_findings", "test_check_scaling", "test_cli_basics",
-    "test_codegen", "test_core_bad_input", "test_counters", "test_diagram", "test_docs_paths", "test_docs_reference",
-    "test_escape", "test_version", "test_front_door_api",
-    "test_evolve_pyribs", "test_firmware", "test_firmware_bad_input", "test_firmware_monitor",
-    "test_fleet_generators", "test_fuzz_loaders", "test_injection", "test_properties_language",
-    "test_properties_search", "test_robopro", "test_robopro_corpus", "test_robopro_program", "test_robot_sections",
-    "test_rpp", "test_rpp_real_files", "test_run_cli", "test_safety_files", "test_safety_loaders",
-    "test_sensors_bad_input", "test_sim_normals", "test_sim_params_formulas", "test_studio_bundle",
-    "test_studio_document", "test_tablefile", "test_targets", "test_testgen", "test_timer_units", "test_trace",
-    "test_txt4_export",
+#: The folders of tests/, which mirror the packages of src/tablebot (tests/sim/ tests tablebot/sim/, and so on;
+#: tests of top-level modules and the shared helpers stay in tests/). A test module may import a helper or a
+#: fixture from another folder's module by its name (``from test_sim_helpers import scene_of``), as when they
+#: all stood in one folder: pytest puts only a module's own folder on sys.path, so every folder goes there now.
+FOLDERS = sorted({p.parent for p in (ROOT / "tests").glob("*/test_*.py")})
+for _folder in FOLDERS:
+    if str(_folder) not in sys.path:
+        sys.path.insert(1, str(_folder))
+
+#: The markers, declared in the modules they apply to (``pytestmark = [pytest.mark.realtime]``):
+MARKERS = {
+    "realtime": "holds a controller, a link or a page to the wall clock (10 ms ticks, replies due within 50 ms, a "
+                "tick that must come late or not); `make test` runs these in a pass of their own after the parallel "
+                "one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them",
+    "browser": "drives Chromium: one browser at a time (one xdist worker), beside the other worker's tests",
+    "kernel_free": "runs no simulator kernel (measured: run alone on an empty numba cache, it compiles nothing, or "
+                   "only a small function of its own in seconds); these run first, while the kernels compile. A "
+                   "module wrongly marked is not wrong, only slow (it compiles the kernels itself), and the "
+                   "session's summary names it",
 }
-#: Kernels big enough that compiling them in a kernel-free module means the module is not one (see KERNEL_FREE).
+#: Kernels big enough that compiling them in a kernel-free module means the module is not one (see MARKERS).
 BIG_KERNELS = ("kernel.run_ticks", "kernel.move", "kernel.sense", "kernel.run_fleet")
-_gone = sorted(m for m in REALTIME | BROWSER | KERNEL_FREE if not (ROOT / "tests" / f"{m}.py").exists())
-if _gone:  # a renamed module would silently join the parallel pass
-    raise pytest.UsageError(f"tests/conftest.py names test modules that do not exist: {', '.join(_gone)}")
 
 
 def _parallel(config: pytest.Config) -> bool:
@@ -120,7 +113,7 @@ def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> Non
         terminalreporter.write_line(config.stash[_WARMUP].said())
     slow = config.stash.get(_NOT_FREE, None)
     if slow:
-        terminalreporter.write_line("KERNEL_FREE in tests/conftest.py names modules that compiled a simulator kernel "
+        terminalreporter.write_line("modules marked kernel_free compiled a simulator kernel "
                                     f"before the warm-up ended (take them out): {', '.join(sorted(slow))}")
 
 
@@ -136,23 +129,27 @@ def pytest_testnodedown(node: Any, error: Any) -> None:
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
     """`-m realtime` (the serial pass) does not import the other ninety modules only to deselect them."""
     if config.option.markexpr == "realtime" and collection_path.suffix == ".py":
-        return collection_path.stem.startswith("test_") and collection_path.stem not in REALTIME
+        # the module's text, not the module: importing it is what this saves
+        return collection_path.stem.startswith("test_") and not _marked(collection_path, "realtime")
     return None
 
 
+def _marked(path: Path, marker: str) -> bool:
+    """Whether a test module declares ``marker`` for the whole module (its ``pytestmark``, on one line or more)."""
+    found = re.search(r"^pytestmark\s*=.*?(?=^\S|\Z)", path.read_text(encoding="utf-8"), re.M | re.S)
+    return bool(found) and f"pytest.mark.{marker}" in found.group(0)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    items.sort(key=lambda item: item.path.stem not in KERNEL_FREE)  # stable: each part keeps its order
+    items.sort(key=lambda item: item.get_closest_marker("kernel_free") is None)  # stable: each part keeps its order
     for item in items:
-        module = item.path.stem
-        if module in REALTIME:
-            item.add_marker(pytest.mark.realtime)
-        if module in BROWSER:
+        if item.get_closest_marker("browser"):
             item.add_marker(pytest.mark.xdist_group("browser"))
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    config.addinivalue_line("markers", "realtime: holds something to the wall clock; `make test` runs it in a "
-                                       "serial pass of its own (tests/conftest.py, REALTIME)")
+    for name, meaning in MARKERS.items():
+        config.addinivalue_line("markers", f"{name}: {meaning}")
     _own_numba_cache(config)
 
 
@@ -171,7 +168,7 @@ def _own_numba_cache(config: pytest.Config) -> None:
 
 
 class _Worker:
-    """A worker's side of the warm-up: before its first test outside KERNEL_FREE, wait for the warm-up to end
+    """A worker's side of the warm-up: before its first test not marked kernel_free, wait for the warm-up to end
     and copy the warmed cache into the worker's own folder; until then, note a kernel-free module that compiled
     a simulator kernel itself (it is not kernel-free: the main process's summary names it)."""
 
@@ -184,7 +181,7 @@ class _Worker:
 
     @pytest.hookimpl(tryfirst=True)
     def pytest_runtest_setup(self, item: pytest.Item) -> None:
-        if self.ready or item.path.stem in KERNEL_FREE:
+        if self.ready or item.get_closest_marker("kernel_free"):
             return
         deadline = time.monotonic() + self.WAIT_S
         while not self.marker.exists() and time.monotonic() < deadline:

@@ -1,6 +1,6 @@
 """The commands a page tells its reader to type: every line of its fenced ``sh`` blocks, each either a
 ``tablebot`` command (which the tests run) or one this module exempts, with the reason. A plain module shared
-by tests/test_docs_commands.py and tests/test_docs_controllers.py."""
+by tests/project/test_docs_commands.py and tests/project/test_docs_controllers.py."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Running tablebot's SCXML and XState exports in engines tablebot did not write, tick by tick, and reading their
-traces in tablebot's trace keys (tests/test_scxml*.py, tests/test_xstate*.py).
+traces in tablebot's trace keys (tests/formats/test_scxml*.py, tests/formats/test_xstate*.py).
 
 python-statemachine loads the SCXML with its secure-by-default reader (fgmacedo/python-statemachine,
 statemachine/io/loader.py: ``load(text, format="scxml")``) and takes ``send("tick", **data)``; XState 5 runs the

@@ -17,6 +17,8 @@ from tablebot.cli import app
 from tablebot.formats.table_read import parse_table
 from tablebot.robot import BUMBERBOT
 
+pytestmark = [pytest.mark.kernel_free]
+
 runner = CliRunner()
 
 

@@ -29,6 +29,8 @@ from tablebot.escape import (
     xml_text,
 )
 
+pytestmark = [pytest.mark.kernel_free]
+
 if TYPE_CHECKING:
     from pathlib import Path
 

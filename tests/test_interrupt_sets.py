@@ -184,8 +184,9 @@ def test_run_writes_its_trace_and_summary_together(bot: Path, tmp_path: Path) ->
 def test_build_leaves_the_old_firmware_or_the_new(bot: Path, tmp_path: Path) -> None:
     if not shutil.which("avr-gcc"):
         pytest.fail("avr-gcc is missing: scripts/bootstrap.sh installs it")
+    # the steps either side of where the set turns new: step 12 of 22 (the build folder's sources, then the firmware)
     outcomes = interrupt_everywhere(["build", bot, "--board", "uno", "--out", tmp_path / "fw"], tmp_path / "fw",
-                                    tmp_path / "ref", points=[1, 8, 9, 10, 17, 18, 99])
+                                    tmp_path / "ref", points=[1, 10, 11, 12, 21, 22, 99])
     assert outcomes == ["old", "old", "old", "new", "new", "new", "done"]
 
 
@@ -251,7 +252,7 @@ def test_a_stage_cut_before_its_journal_is_removed_and_a_live_one_kept(tmp_path:
 
 def test_real_signals_during_sim_leave_the_old_run_or_the_new(bot: Path, tmp_path: Path) -> None:
     """The issue's case: SIGINT or SIGTERM while a run draws its pictures (from the moment its finished
-    trace waits in the staging folder). Ctrl-C during the run itself: tests/test_sim_live.py."""
+    trace waits in the staging folder). Ctrl-C during the run itself: tests/sim/test_sim_live.py."""
     out = tmp_path / "s"
     command = ["sim", str(bot), "--seconds", "300", "-q", "--out", str(out)]
     assert invoke(command) == 0

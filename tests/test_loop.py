@@ -15,6 +15,8 @@ from tablebot.loop import LinkLost, Reading, RealTimeClock, RunEnd, RunInfo, Tic
 from tablebot.machine import compile_table
 from tablebot.replay import replay
 
+pytestmark = [pytest.mark.realtime]
+
 
 def bumberbot() -> Engine:
     return Engine(compile_table(load_table(EXAMPLE / "table.csv")))

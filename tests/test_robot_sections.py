@@ -12,6 +12,8 @@ from tablebot.diagnostics import TableBotError
 from tablebot.robot import load_robot
 from tablebot.sim.model.params import SimSection
 
+pytestmark = [pytest.mark.kernel_free]
+
 BASE = 'name = "Bot"\ninitial_state = 1\n[inputs]\nI3 = "bumper"\n[motors]\nM1 = "right"\nM2 = "left"\n'
 
 

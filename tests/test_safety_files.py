@@ -18,6 +18,8 @@ from tablebot.cli import app
 from tablebot.diagnostics import TableBotError
 from tablebot.files import PendingFile, atomic_write, replacing, write_text
 
+pytestmark = [pytest.mark.kernel_free]
+
 if TYPE_CHECKING:
     from typer.testing import Result
 

@@ -21,6 +21,8 @@ from tablebot.formats.trace_lines import read_trace
 from tablebot.robopro.lists import read_lists
 from tablebot.robot import load_robot
 
+pytestmark = [pytest.mark.kernel_free]
+
 if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Never

@@ -11,6 +11,8 @@ from tablebot.robot import load_robot
 from test_sim_declared import SENSORS, TABLE, sensor_scene
 from test_sim_helpers import room, world_errors
 
+pytestmark = [pytest.mark.kernel_free]
+
 HEAD = """\
 name = "Bad"
 initial_state = 1

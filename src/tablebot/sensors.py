@@ -161,7 +161,7 @@ def threshold_event(reading: float, above: bool, on_at: float, off_at: float, wa
 
     The one rule for every analog input: the simulator compiles this function into its sensing
     (``sim.physics.sensing``), every controller's wiring calls it (``hw.wiring``), and the TXT 4.0 program, a standalone
-    file, carries a copy that ``tests/test_rules.py`` proves equal to it.
+    file, carries a copy that ``tests/hw/test_rules.py`` proves equal to it.
     """
     level = off_at if was_on else on_at
     return reading > level if above else reading < level

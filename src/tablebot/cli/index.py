@@ -3,7 +3,7 @@
 ``tablebot --help`` lists the commands from here, without importing the modules that define them (rich, the
 table machinery and each command's own imports cost more than the rest of ``--help`` together); a command's
 module is imported when the command runs or its own help is asked for (:class:`Commands`). A new command adds
-its line here, in the place ``--help`` lists it (tests/test_cli_index.py checks that every registered command
+its line here, in the place ``--help`` lists it (tests/cli/test_cli_index.py checks that every registered command
 is in the index and every entry registers its command).
 """
 

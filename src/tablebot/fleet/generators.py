@@ -7,7 +7,7 @@ the GIL the other thread's compiled loop needed. Here the hashing is done for al
 numpy array arithmetic -- numpy's ``SeedSequence`` algorithm (numpy/random/bit_generator.pyx, after
 M. O'Neill's seed_seq), whose output numpy guarantees stable for a seed -- and each ``PCG64`` is seeded
 with its four words. :func:`matches_numpy` checks it against numpy on first use (and
-tests/test_fleet_generators.py on many seeds); should it ever differ, every Generator is made by numpy.
+tests/fleet/test_fleet_generators.py on many seeds); should it ever differ, every Generator is made by numpy.
 """
 
 from __future__ import annotations

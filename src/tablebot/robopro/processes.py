@@ -15,7 +15,7 @@ a list by the other table's state number, ``drive from lights``), DetermineActio
 ``DONE``, waits for the next tick and counts its timer down. A table writes only the outputs it has columns for,
 so no two processes drive one output, and none reads what another writes during the tick: the order ROBO Pro
 runs them in changes nothing (the interpreter switches between them at random after any element to show it:
-tests/test_robopro_several.py).
+tests/robopro/test_robopro_several.py).
 """
 
 from __future__ import annotations

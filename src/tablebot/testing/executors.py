@@ -247,7 +247,7 @@ def _txt4_stub() -> Path:
 def _txt4_program(case: Case, workdir: Path) -> Run:
     """``export --to txt4``'s program, as the controller runs it (``python -S``: no numpy, no tablebot) against
     the stub: its robot reads the inputs off the stub's terminals and counters, its engine steps, its robot
-    writes; its own pacing loop is proven equal to ``loop.run`` in tests/test_rules.py."""
+    writes; its own pacing loop is proven equal to ``loop.run`` in tests/hw/test_rules.py."""
     from tablebot.codegen.host import trace_line
 
     m = wired_for(case.machine.table, "txt")

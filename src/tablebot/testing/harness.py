@@ -10,7 +10,7 @@ read. :func:`differences` replays the inputs an executor read through ``Engine.s
 tick and field where it disagrees.
 
 A new executor is one :func:`register` call (the executors of this tablebot: :mod:`tablebot.testing.executors`);
-``tests/test_executors.py`` runs every registered one on the same random tables (counters and pulses included)
+``tests/testing/test_executors.py`` runs every registered one on the same random tables (counters and pulses included)
 and the shipped examples. A case carries the matching rule, so an executor that knows only one rule says so in
 ``rules`` and is left out of cases with the other.
 """

@@ -4,7 +4,7 @@ every message the server sends back (``type``), each a typed object with its fie
 :func:`operation` reads a message from the page into its :class:`Operation` (a mistake in it is a
 :class:`~tablebot.web.errors.Refused` in the studio's words, which the page shows); a :class:`Message`'s
 :meth:`~Message.data` is what goes to the page as JSON. The page's side is ``static/js/studio/protocol.js``,
-which names the same operations and kinds (tests/test_studio_protocol.py holds them equal).
+which names the same operations and kinds (tests/web/test_studio_protocol.py holds them equal).
 """
 
 from __future__ import annotations

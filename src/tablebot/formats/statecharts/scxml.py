@@ -2,7 +2,7 @@
 
 Expressions are the part of ECMAScript that is Python too (``==``, ``-``, ``&&``, ``||``, numbers, ``In('id')``,
 ``_event.data.I3``), so that an ECMAScript data model runs it and so does python-statemachine's restricted Python
-one (tests/test_scxml.py; its reader and evaluator: fgmacedo/python-statemachine,
+one (tests/formats/test_scxml.py; its reader and evaluator: fgmacedo/python-statemachine,
 statemachine/io/scxml/reader.py and statemachine/io/evaluators.py, which maps ``&&`` and ``||`` in conditions
 but not in values, so every boolean is computed in a condition or as a comparison). What only tablebot reads
 back (each row's description, its index as written, its group; what each data item is) is in attributes of

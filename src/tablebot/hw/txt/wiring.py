@@ -49,7 +49,7 @@ MODES = {"switch": wire.InputConfig(wire.InputMode.RESISTANCE, True),
 def level_pwm(level: int) -> int:
     """A motor's speed (its size) or a lamp's level, 0..8, as the TXT family's PWM 0..512 (a level beyond 8 is 8,
     one below 0 is off; :func:`tablebot.hw.wiring.level_duty`): THE scaling of the TXT and the TXT 4.0, whose
-    standalone program carries a copy that ``tests/test_rules.py`` proves equal to this one."""
+    standalone program carries a copy that ``tests/hw/test_rules.py`` proves equal to this one."""
     return wiring.level_duty(level, wire.MAX_PWM)
 
 

@@ -204,7 +204,7 @@ def _formulas() -> tuple[Callable[..., float], Callable[..., float]]:
 
     Planning calls each a few times per scene; called compiled, each would first load its machine code
     (tens of ms in a fresh process). Compiled without fast-math, the same arithmetic gives the same bits
-    in Python (tests/test_sim_params_formulas.py).
+    in Python (tests/sim/test_sim_params_formulas.py).
     """
     from tablebot.sim.physics.step import duty, pack_volts  # numba is imported, never run, for these
 

@@ -4,7 +4,7 @@ A compiled loop over thousands of robots cannot call each robot's ``Generator.st
 Python call per robot and block, on one core, into an array as large as the fleet); instead it draws the
 Generator's bits itself and turns them into normals with numpy's ziggurat (``random_standard_normal`` in
 numpy's ``distributions.c``, as numba ports it). The Generator's state advances exactly as numpy's own
-draws advance it, so a run may mix the two; ``tests/test_sim_normals.py`` proves the numbers identical.
+draws advance it, so a run may mix the two; ``tests/sim/test_sim_normals.py`` proves the numbers identical.
 """
 
 # The bits come one of two ways, chosen per Generator when its handle is made (:func:`bitgen_address`):

@@ -1,5 +1,5 @@
 // The page's own words, in English and German (issue 38): every text the studio and the replay page show
-// is `t(key, args)` of this catalog, so both languages have the same keys (tests/test_studio_i18n.py holds
+// is `t(key, args)` of this catalog, so both languages have the same keys (tests/web/test_studio_i18n.py holds
 // them equal) and no English is left in a German page. The words follow ROBO Pro's German interface and
 // the command line's German catalog (locale/de/LC_MESSAGES/tablebot.po): Zustand, Folgezustand, Zeile,
 // Eingang, Taster, Lampe, Startwert, Akku, Aufzeichnung; a row "schaltet".

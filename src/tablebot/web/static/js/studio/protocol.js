@@ -1,6 +1,6 @@
 // The studio's WebSocket protocol as the page sees it: every operation the page sends (`op`) with its fields,
 // and every kind of message (`type`) the server sends back. The server's side is tablebot/web/protocol.py;
-// tests/test_studio_protocol.py imports this module under Node and holds the two equal.
+// tests/web/test_studio_protocol.py imports this module under Node and holds the two equal.
 
 /** The operations the page may send, each with the fields it may carry. */
 export const OPERATIONS = Object.freeze({
