@@ -85,7 +85,7 @@ class _WarmUp:
         env = {**os.environ, "NUMBA_CACHE_DIR": shared}
         self.parts = [subprocess.Popen([sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names], env=env,
                                        cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-                      for names in (["loop", "fleet"], ["tick", "archive"])]
+                      for names in (["loop", "fleet"], ["tick", "archive", "several"])]
         self.thread = threading.Thread(target=self._wait, name="numba warm-up", daemon=True)
         self.thread.start()
 
@@ -137,7 +137,7 @@ def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool 
 def _marked(path: Path, marker: str) -> bool:
     """Whether a test module declares ``marker`` for the whole module (its ``pytestmark``, on one line or more)."""
     found = re.search(r"^pytestmark\s*=.*?(?=^\S|\Z)", path.read_text(encoding="utf-8"), re.M | re.S)
-    return bool(found) and f"pytest.mark.{marker}" in found.group(0)
+    return found is not None and f"pytest.mark.{marker}" in found.group(0)
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

@@ -3,8 +3,9 @@
 Run by ``tests/conftest.py`` in the main pytest process. Each part calls the public paths the tests
 take, on the smallest input that reaches each kernel with the argument types the tests give it:
 ``loop`` (one robot's loop), ``fleet`` (the fleet loop, which calls it), ``tick`` (the tick-by-tick robot,
-the env's physics-only loop, the engine's batch loop on both mask types) and ``archive`` (pyribs' grid
-archive, which compiles numpy_groupies' kernels: half a minute, in every evolve process of a cold cache).
+the env's physics-only loop, the engine's batch loop on both mask types), ``several`` (the loop of a robot of
+several tables) and ``archive`` (pyribs' grid archive, which compiles numpy_groupies' kernels: half a minute,
+in every evolve process of a cold cache).
 Numba caches one machine code per argument types, so a kernel reached here with other types than a test's is
 compiled again by that test; conftest gives each worker a cache folder of its own, so that costs time, not safety.
 """
@@ -83,7 +84,31 @@ def warm_archive() -> None:
         add(make_archive(descriptors), ["x", "y"], [1.0, 2.0], [[0.2] * len(descriptors), [0.7] * len(descriptors)])
 
 
-PARTS = {"loop": warm_loop, "fleet": warm_fleet, "tick": warm_tick, "archive": warm_archive}
+def warm_several() -> None:
+    """The loop of a robot of several tables (sim.physics.several.run_several), for 2 and 3 tables, and its fleet's
+    (the BumberBot with its lights, as sweep, tune and evolve run it): numba types a
+    tuple of tables by its length, so each is compiled once (a minute each on one core, in every test process
+    that simulates such a robot on a cold cache)."""
+    import random
+    import tempfile
+
+    import tablebot
+    from tablebot.sim.runner import simulate
+    from tablebot.testing.random_robots import RobotShape, random_robot
+
+    for tables in (2, 3):
+        with tempfile.TemporaryDirectory(prefix="tablebot-warm-") as tmp:
+            folder = random_robot(random.Random(tables), Path(tmp), RobotShape(tables=tables))
+            project = tablebot.open(folder / "t0.csv", robot=folder / "robot.toml")
+            simulate(project.scene(every_table=True), 0.05, seed=1)
+    from tablebot.fleet.plan import make_plan
+    from tablebot.fleet.work import warm
+
+    warm(make_plan(EXAMPLES / "bumberbot-lights", None, [], [], "0", None, 1.0, every_table=True).jobs()[0])
+
+
+PARTS = {"loop": warm_loop, "fleet": warm_fleet, "tick": warm_tick, "archive": warm_archive,
+         "several": warm_several}
 
 if __name__ == "__main__":
     for name in sys.argv[1:] or list(PARTS):

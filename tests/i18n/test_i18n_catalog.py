@@ -4,6 +4,7 @@ help of every command and the command line's errors show no text outside them.""
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -150,7 +151,9 @@ def example_words(folder: Path) -> set[str]:
 def test_check_and_sim_say_nothing_outside_the_markers(args: list[str], tmp_path: Path) -> None:
     args = [a.replace("OUT", str(tmp_path / "out")) for a in args]
     done = subprocess.run([sys.executable, "-m", "tablebot", *args], capture_output=True, text=True, cwd=ROOT,
-                          env={"PATH": "/usr/bin:/bin", "TABLEBOT_LANG": i18n.PSEUDO, "HOME": str(Path.home())})
+                          env={"PATH": "/usr/bin:/bin", "TABLEBOT_LANG": i18n.PSEUDO, "HOME": str(Path.home()),
+                               # the test session's compiled kernels (else sim compiles them all: a minute)
+                               **{k: v for k, v in os.environ.items() if k == "NUMBA_CACHE_DIR"}})
     assert done.returncode in (0, 1), done.stderr
     allowed = names(typer.main.get_command(app)) | set(args) | example_words(EXAMPLE) | {"jsonl"}
     shown = done.stdout + done.stderr

@@ -255,7 +255,7 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
               robots: int | None, seconds: float, every_table: bool = False, grid_cells: bool = False) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
     as a plan of runs; every mistake is a located error before anything is written. ``every_table``: a robot of
-    several tables runs all of them (``sweep``, ``tune``, ``grade``), else its main table alone (``evolve``).
+    several tables runs all of them (``sweep``, ``tune``, ``grade``, ``evolve``), else its main table alone.
     ``grid_cells``: ``--grid`` may set table cells (``sweep``: ``--grid "lights: line 4 timer=20,50"``)."""
     axes = parse_grid(list(grid))
     if not grid_cells:  # sweep's alone: tune has --cells
