@@ -141,8 +141,8 @@ class Loaded:
         """Table, robot and world checked and packed for the simulator: ``world`` (a file, or a world already
         read) if given, else the first of :attr:`world_files`, else the default one; ``overrides`` are
         simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's.
-        ``every_table``: a robot of several tables is simulated whole (``sim``, tick by tick); without it its
-        main table alone, with a note (the compiled sweep, tune and the studio's arena, for now)."""
+        ``every_table``: a robot of several tables is simulated whole (every command asks for this); without it
+        its main table alone, with a note saying so (the other tables' lamps stay dark)."""
         from tablebot.sim.model.scene import prepare, robot_layer, scene_for
         from tablebot.sim.model.world import World
 

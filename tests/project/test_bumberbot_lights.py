@@ -86,7 +86,8 @@ def test_the_example_checks_its_properties_across_both_tables() -> None:
 
 
 def test_the_simulator_says_it_runs_the_main_table_only() -> None:
-    """Until the simulator runs every table, it says so rather than leave the lamps dark without a word."""
+    """A scene of the main table alone (``scene()`` without ``every_table``) says so rather than leave the lamps
+    dark without a word; a robot of one table is told nothing."""
     with pytest.warns(UserWarning, match=r"robot.toml:31:1: note: the simulator runs the main table \(drive\) only"):
         Loaded.open(EXAMPLE).scene()
     with warnings.catch_warnings():

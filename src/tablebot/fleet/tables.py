@@ -1,5 +1,6 @@
 """What a fleet's plan needs of a robot of several tables (issue 36 §2): a digest of all its table files, and the
-note that a plan running its main table alone gives (``evolve``; ``sweep``, ``tune`` and ``grade`` run them all)."""
+note that a plan running its main table alone gives (``make_plan`` without ``every_table``; ``sweep``, ``tune``,
+``grade`` and ``evolve`` run them all)."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ def tables_digest(table: Table, tables: RobotTables | None) -> str:
 
 
 def main_table_only(robot: Robot) -> None:
-    """A note that a plan of a robot of several tables runs its main table alone (``evolve``)."""
+    """A note that a plan of a robot of several tables runs its main table alone (no command asks for one now)."""
     specs = tables_of(robot)
     if specs:
         others = ", ".join(spec.name for spec in specs[1:])
