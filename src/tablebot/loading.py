@@ -137,12 +137,12 @@ class Loaded:
         return find_world(self.table, None, self.robot_world())
 
     def scene(self, world: PathLike | World | None = None, overrides: dict[str, Any] | None = None,
-              every_table: bool = False) -> Scene:
+              every_table: bool = True) -> Scene:
         """Table, robot and world checked and packed for the simulator: ``world`` (a file, or a world already
         read) if given, else the first of :attr:`world_files`, else the default one; ``overrides`` are
         simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's.
-        ``every_table``: a robot of several tables is simulated whole (every command asks for this); without it
-        its main table alone, with a note saying so (the other tables' lamps stay dark)."""
+        A robot of several tables is simulated whole, as every command runs it; ``every_table=False`` runs its
+        main table alone, with a note saying so (the other tables' lamps stay dark)."""
         from tablebot.sim.model.scene import prepare, robot_layer, scene_for
         from tablebot.sim.model.world import World
 

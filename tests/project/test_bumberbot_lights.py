@@ -85,11 +85,16 @@ def test_the_example_checks_its_properties_across_both_tables() -> None:
     assert report["counts"]["error"] == 0 and done.returncode == 0
 
 
-def test_the_simulator_says_it_runs_the_main_table_only() -> None:
-    """A scene of the main table alone (``scene()`` without ``every_table``) says so rather than leave the lamps
-    dark without a word; a robot of one table is told nothing."""
-    with pytest.warns(UserWarning, match=r"robot.toml:31:1: note: the simulator runs the main table \(drive\) only"):
-        Loaded.open(EXAMPLE).scene()
+def test_a_scene_runs_every_table_unless_asked_for_the_main_table_alone() -> None:
+    """``scene()`` of a robot of several tables packs every table, as every command runs it,
+    without a word; ``scene(every_table=False)`` packs the main table alone and says so rather than leave the
+    lamps dark without a word; a robot of one table is told nothing either way."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        Loaded.open(ORIGINAL).scene()
+        whole = Loaded.open(EXAMPLE).scene()
+        assert whole.tables is not None and whole.tables.names == ("drive", "lights")
+        assert Loaded.open(ORIGINAL).scene().tables is None
+        assert Loaded.open(ORIGINAL).scene(every_table=False).tables is None
+    with pytest.warns(UserWarning, match=r"robot.toml:31:1: note: the simulator runs the main table \(drive\) only"):
+        alone = Loaded.open(EXAMPLE).scene(every_table=False)
+    assert alone.tables is None
