@@ -27,10 +27,31 @@ from tablebot.sensors import Sensor, parse_sensors
 from tablebot.tomlfile import Source
 
 __all__ = [
-    "BUMBERBOT", "CORE_SECTIONS", "DEFAULT_MATCH", "MATCHES", "MATCH_ALWAYS", "MATCH_DOCUMENT", "MATCH_HINT",
-    "MAX_TICK_MS", "MAX_TIMER", "MISPLACED", "NAME_RE", "RESERVED_LOWER", "RESERVED_NAMES", "SECTION_READERS",
-    "STATE_HINT", "STATE_RE", "TOP_KEYS", "Counter", "Match", "Robot", "SectionReader", "StateId", "find_robot_file",
-    "load_robot", "register_section",
+    "BUMBERBOT",
+    "CORE_SECTIONS",
+    "DEFAULT_MATCH",
+    "MATCHES",
+    "MATCH_ALWAYS",
+    "MATCH_DOCUMENT",
+    "MATCH_HINT",
+    "MAX_TICK_MS",
+    "MAX_TIMER",
+    "MISPLACED",
+    "NAME_RE",
+    "RESERVED_LOWER",
+    "RESERVED_NAMES",
+    "SECTION_READERS",
+    "STATE_HINT",
+    "STATE_RE",
+    "TOP_KEYS",
+    "Counter",
+    "Match",
+    "Robot",
+    "SectionReader",
+    "StateId",
+    "find_robot_file",
+    "load_robot",
+    "register_section",
 ]
 
 CORE_SECTIONS = ("inputs", "motors", "counters", "lamps", "states", "sensors")
@@ -58,9 +79,13 @@ def register_section(name: str, reader: SectionReader) -> None:
 
 
 #: Sections people write in the wrong file: the hint says where they belong.
-MISPLACED = {"wiring": N_("the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)"),
-             **{s: N_("simulator parameters go in [sim.{section}] in a robot file", section=s) for s in
-                ("body", "motor", "battery", "encoder", "light", "distance", "noise")}}
+MISPLACED = {
+    "wiring": N_("the simulator's wiring goes in [sim.wiring] in a robot file ([wiring] is for world files)"),
+    **{
+        s: N_("simulator parameters go in [sim.{section}] in a robot file", section=s)
+        for s in ("body", "motor", "battery", "encoder", "light", "distance", "noise")
+    },
+}
 #: Timer loads and the initial timer are 16-bit tick counts; one tick lasts at most a minute.
 MAX_TIMER = 65535
 MAX_TICK_MS = 60_000
@@ -75,8 +100,10 @@ MATCHES: tuple[Match, ...] = (MATCH_DOCUMENT, MATCH_ALWAYS)
 #: A robot file that does not say: tablebot's rule from before the key existed, so that no existing table
 #: silently changes (``tablebot check`` says when the choice matters). The built-in BumberBot follows the document.
 DEFAULT_MATCH = MATCH_ALWAYS
-MATCH_HINT = N_('match = "document": a row that requires no event fires only on a tick with some event, as in the '
-                'document\'s engine; match = "always": it fires on every tick, even one with no event at all')
+MATCH_HINT = N_(
+    'match = "document": a row that requires no event fires only on a tick with some event, as in the '
+    'document\'s engine; match = "always": it fires on every tick, even one with no event at all'
+)
 
 
 @dataclass(frozen=True)
@@ -139,9 +166,15 @@ BUMBERBOT = Robot(
     initial_timer=0,
     tick_ms=10,
     match=MATCH_DOCUMENT,
-    labels={"I3": "front-right bumper", "I4": "front-left bumper", "I5": "rear bumper",
-            "I7": "right phototransistor", "I8": "left phototransistor",
-            "M1": "right motor", "M2": "left motor"},
+    labels={
+        "I3": "front-right bumper",
+        "I4": "front-left bumper",
+        "I5": "rear bumper",
+        "I7": "right phototransistor",
+        "I8": "left phototransistor",
+        "M1": "right motor",
+        "M2": "left motor",
+    },
 )
 
 
@@ -161,40 +194,89 @@ def load_robot(path: str | Path) -> Robot:
     data = src.data
     for key in data:
         if key not in TOP_KEYS and key not in CORE_SECTIONS and key not in SECTION_READERS:
-            unknown = N_("unknown section {key!r}", key=key) if isinstance(data[key], dict) else \
-                N_("unknown key {key!r}", key=key)
-            src.key_error(("", None, key), unknown,
-                          MISPLACED.get(key, N_("known keys: {keys}; sections: {sections}", keys=", ".join(TOP_KEYS),
-                                                sections=", ".join((*CORE_SECTIONS, *SECTION_READERS)))))
+            unknown = (
+                N_("unknown section {key!r}", key=key)
+                if isinstance(data[key], dict)
+                else N_("unknown key {key!r}", key=key)
+            )
+            src.key_error(
+                ("", None, key),
+                unknown,
+                MISPLACED.get(
+                    key,
+                    N_(
+                        "known keys: {keys}; sections: {sections}",
+                        keys=", ".join(TOP_KEYS),
+                        sections=", ".join((*CORE_SECTIONS, *SECTION_READERS)),
+                    ),
+                ),
+            )
     inputs, motors, lamps = (robot_names.section_names(src, key) for key in ("inputs", "motors", "lamps"))
     counters = robot_names.counters(src, motors)
     sensors = parse_sensors(src, inputs)
-    robot_names.distinct(src, {"inputs": inputs, "motors": motors, "lamps": lamps,
-                               "counters": {c.name: "" for c in counters}})
+    robot_names.distinct(
+        src, {"inputs": inputs, "motors": motors, "lamps": lamps, "counters": {c.name: "" for c in counters}}
+    )
     if not motors and not lamps:
-        src.out.error(None, None, N_("the robot has no [motors] and no [lamps]"),
-                      N_('add a section like [motors] with M1 = "right motor"'))
-    tick_ms = _whole(src, "tick_ms", 10, (1, MAX_TICK_MS),
-                     N_("{key} must be a positive whole number up to {most}, not {value!r}", key="tick_ms",
-                        most=MAX_TICK_MS, value=data.get("tick_ms")),
-                     N_("the document's engine ticks every 10 ms: tick_ms = 10"))
-    initial_timer = _whole(src, "initial_timer", 0, (0, MAX_TIMER),
-                           N_("{key} must be a whole number 0..{most}, not {value!r}", key="initial_timer",
-                              most=MAX_TIMER, value=data.get("initial_timer")),
-                           N_("the timer counts ticks; 0 means it has expired"))
+        src.out.error(
+            None,
+            None,
+            N_("the robot has no [motors] and no [lamps]"),
+            N_('add a section like [motors] with M1 = "right motor"'),
+        )
+    tick_ms = _whole(
+        src,
+        "tick_ms",
+        10,
+        (1, MAX_TICK_MS),
+        N_(
+            "{key} must be a positive whole number up to {most}, not {value!r}",
+            key="tick_ms",
+            most=MAX_TICK_MS,
+            value=data.get("tick_ms"),
+        ),
+        N_("the document's engine ticks every 10 ms: tick_ms = 10"),
+    )
+    initial_timer = _whole(
+        src,
+        "initial_timer",
+        0,
+        (0, MAX_TIMER),
+        N_(
+            "{key} must be a whole number 0..{most}, not {value!r}",
+            key="initial_timer",
+            most=MAX_TIMER,
+            value=data.get("initial_timer"),
+        ),
+        N_("the timer counts ticks; 0 means it has expired"),
+    )
     initial_state = robot_names.initial_state(src)
     match = _match(src)
     states = robot_names.state_names(src)
     name = data.get("name", path.stem)
     if not isinstance(name, str):
-        src.key_error(("", None, "name"), N_("name must be text, not {value!r}", value=name),
-                      N_('write it in quotes: name = "BumberBot"'))
+        src.key_error(
+            ("", None, "name"),
+            N_("name must be text, not {value!r}", value=name),
+            N_('write it in quotes: name = "BumberBot"'),
+        )
     # The other stages' sections are read even when the core has mistakes, so that every mistake of the
     # file shows in one go; their readers see the names that did read.
     robot = Robot(
-        name=str(name), inputs=tuple(inputs), motors=tuple(motors), lamps=tuple(lamps), counters=tuple(counters),
-        initial_state=initial_state, initial_timer=initial_timer, tick_ms=tick_ms, match=match, sensors=sensors,
-        labels={**inputs, **motors, **lamps}, state_names=states, source=str(path), toml=src,
+        name=str(name),
+        inputs=tuple(inputs),
+        motors=tuple(motors),
+        lamps=tuple(lamps),
+        counters=tuple(counters),
+        initial_state=initial_state,
+        initial_timer=initial_timer,
+        tick_ms=tick_ms,
+        match=match,
+        sensors=sensors,
+        labels={**inputs, **motors, **lamps},
+        state_names=states,
+        source=str(path),
+        toml=src,
     )
     robot.sections.update(_foreign_sections(src, robot))
     return robot
@@ -223,9 +305,15 @@ def _match(src: Source) -> Match:
     """``match = "document"`` or ``"always"`` (DEFAULT_MATCH when the file does not say)."""
     value = src.data.get("match", DEFAULT_MATCH)
     if value not in MATCHES:
-        src.key_error(("", None, "match"), N_('match must be "{document}" or "{always}", not {value!r}',
-                                              document=MATCH_DOCUMENT, always=MATCH_ALWAYS, value=value), MATCH_HINT)
+        src.key_error(
+            ("", None, "match"),
+            N_(
+                'match must be "{document}" or "{always}", not {value!r}',
+                document=MATCH_DOCUMENT,
+                always=MATCH_ALWAYS,
+                value=value,
+            ),
+            MATCH_HINT,
+        )
         return DEFAULT_MATCH
     return cast(Match, value)  # one of MATCHES, checked above
-
-

@@ -46,14 +46,19 @@ def section_names(src: Source, key: str) -> dict[str, str]:
     if isinstance(section, list):
         section = {str(name): "" for name in section}
     if not isinstance(section, dict):
-        src.key_error(("", None, key), N_('[{key}] must be a table of NAME = "label"', key=key),
-                      N_('for example: I3 = "front-right bumper"'))
+        src.key_error(
+            ("", None, key),
+            N_('[{key}] must be a table of NAME = "label"', key=key),
+            N_('for example: I3 = "front-right bumper"'),
+        )
         return {}
     for name, label in section.items():
         if good_name(src, key, name) and not isinstance(label, str):
-            src.key_error((key, None, name), N_("[{key}] {name}: the label must be text, not {label!r}", key=key,
-                                                name=name, label=label),
-                          N_('write it in quotes: {name} = "what it is"', name=name))
+            src.key_error(
+                (key, None, name),
+                N_("[{key}] {name}: the label must be text, not {label!r}", key=key, name=name, label=label),
+                N_('write it in quotes: {name} = "what it is"', name=name),
+            )
     return {name: str(label) for name, label in section.items()}
 
 
@@ -62,8 +67,11 @@ def good_name(src: Source, key: str, name: str) -> bool:
     if misplaced(src, key, name):
         return False
     if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-        src.key_error((key, None, name), N_("bad {key} name {name!r}", key=key, name=name),
-                      N_("use a letter then letters/digits (like I3 or M1), not T, state, timer or next"))
+        src.key_error(
+            (key, None, name),
+            N_("bad {key} name {name!r}", key=key, name=name),
+            N_("use a letter then letters/digits (like I3 or M1), not T, state, timer or next"),
+        )
         return False
     return True
 
@@ -73,9 +81,15 @@ def misplaced(src: Source, section: str, key: str) -> bool:
     in that section); reported if so."""
     if key not in TOP_KEYS:
         return False
-    src.key_error((section, None, key), N_("{key} is inside [{section}]", key=key, section=section),
-                  N_("move {key} = … above the first [section]: every key below [{section}] belongs to it", key=key,
-                     section=section))
+    src.key_error(
+        (section, None, key),
+        N_("{key} is inside [{section}]", key=key, section=section),
+        N_(
+            "move {key} = … above the first [section]: every key below [{section}] belongs to it",
+            key=key,
+            section=section,
+        ),
+    )
     return True
 
 
@@ -83,22 +97,32 @@ def counters(src: Source, motors: dict[str, str]) -> list[Counter]:
     """``[counters]``: C1 = "M1" (or C1 = {motor = "M1"}), each counting one motor's encoder."""
     section = src.data.get("counters") or {}
     if not isinstance(section, dict):
-        src.key_error(("", None, "counters"), N_('[counters] must be a table of C1 = "M1"'),
-                      N_("each counter names the motor whose encoder it counts"))
+        src.key_error(
+            ("", None, "counters"),
+            N_('[counters] must be a table of C1 = "M1"'),
+            N_("each counter names the motor whose encoder it counts"),
+        )
         return []
     counters = []
     for name, value in section.items():
         good_name(src, "counters", name)
         motor = value.get("motor") if isinstance(value, dict) else value
         if isinstance(value, dict) and set(value) != {"motor"}:
-            src.key_error(("counters", None, name), N_('counter {name} may only say motor = "M1", not {keys}',
-                                                        name=name, keys=", ".join(sorted(set(value) - {"motor"}))
-                                                        or N_("nothing")),
-                          N_('write {name} = "M1"', name=name))
+            src.key_error(
+                ("counters", None, name),
+                N_(
+                    'counter {name} may only say motor = "M1", not {keys}',
+                    name=name,
+                    keys=", ".join(sorted(set(value) - {"motor"})) or N_("nothing"),
+                ),
+                N_('write {name} = "M1"', name=name),
+            )
         elif not isinstance(motor, str) or motor not in motors:  # a list or table is no motor name (nor hashable)
-            src.key_error(("counters", None, name), N_("counter {name} counts motor {motor!r}, which is not in "
-                                                        "[motors]", name=name, motor=motor),
-                          N_('write {name} = "M1" with a motor name from [motors]', name=name))
+            src.key_error(
+                ("counters", None, name),
+                N_("counter {name} counts motor {motor!r}, which is not in [motors]", name=name, motor=motor),
+                N_('write {name} = "M1" with a motor name from [motors]', name=name),
+            )
         counters.append(Counter(name, str(motor)))
     return counters
 
@@ -109,9 +133,13 @@ def distinct(src: Source, sections: dict[str, dict[str, str]]) -> None:
     for key, names in sections.items():
         for name in names:
             if name in first and first[name] != key:
-                src.key_error((first[name], None, name), N_("name {name} is used twice ([{first}] and [{second}])",
-                                                            name=name, first=first[name], second=key),
-                              N_("inputs, motors, counters and lamps need distinct names"))
+                src.key_error(
+                    (first[name], None, name),
+                    N_(
+                        "name {name} is used twice ([{first}] and [{second}])", name=name, first=first[name], second=key
+                    ),
+                    N_("inputs, motors, counters and lamps need distinct names"),
+                )
             first.setdefault(name, key)
 
 
@@ -137,8 +165,11 @@ def initial_state(src: Source) -> StateId:
         return 0
     state = state_id(src.data["initial_state"])
     if state is None:
-        src.key_error(("", None, "initial_state"), N_("initial_state {value!r} is not a state",
-                                                      value=src.data["initial_state"]), STATE_HINT)
+        src.key_error(
+            ("", None, "initial_state"),
+            N_("initial_state {value!r} is not a state", value=src.data["initial_state"]),
+            STATE_HINT,
+        )
         return 0
     return state
 
@@ -147,8 +178,9 @@ def state_names(src: Source) -> dict[StateId, str]:
     """``[states]``: NUMBER = "name", the names people read for the table's states."""
     section = src.data.get("states") or {}
     if not isinstance(section, dict):
-        src.key_error(("", None, "states"), N_('[states] must be a table of NUMBER = "name"'),
-                      N_('for example: 20 = "collision"'))
+        src.key_error(
+            ("", None, "states"), N_('[states] must be a table of NUMBER = "name"'), N_('for example: 20 = "collision"')
+        )
         return {}
     names: dict[StateId, str] = {}
     for key, label in section.items():
@@ -158,9 +190,11 @@ def state_names(src: Source) -> dict[StateId, str]:
         if state is None:
             src.key_error(("states", None, key), N_("[states] {key!r} is not a state", key=key), STATE_HINT)
         elif not isinstance(label, str):
-            src.key_error(("states", None, key), N_("[states] {key}: the name must be text, not {label!r}", key=key,
-                                                    label=label),
-                          N_('write it in quotes: {key} = "seek"', key=key))
+            src.key_error(
+                ("states", None, key),
+                N_("[states] {key}: the name must be text, not {label!r}", key=key, label=label),
+                N_('write it in quotes: {key} = "seek"', key=key),
+            )
         else:
             names[state] = label
     return names
