@@ -165,9 +165,9 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     from dataclasses import replace
 
     from tablebot.cli.common import load
+    from tablebot.fleet.cells import cell_variants, parse_cells
     from tablebot.fleet.plan import make_plan
     from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.fleet.tune import parse_cells, variants_of
     from tablebot.machine import compile_table
     from tablebot.sim.model.scene import scene_for
     from tablebot.sim.runner import simulate
@@ -178,7 +178,7 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     cells = parse_cells("line 5 C1_load=10..200", plan.table)
     assert (cells[0].column, cells[0].value, cells[0].low, cells[0].high) == ("C1_load", 107, 10, 200)
     fleet = Fleet(plan.table, plan.machine, plan.worlds[0], [RobotSpec(seed=2, variant=1)], plan.robot_params,
-                  traced=[0], variants=variants_of(plan, cells, [(107,), (40,)]))
+                  traced=[0], variants=cell_variants(plan.tables, plan.machine, cells, [(107,), (40,)]))
     fleet.run(500)
     table, _ = load(example)
     rows = tuple(replace(r, counters=(40, *r.counters[1:])) if r.line == 5 else r for r in table.rows)

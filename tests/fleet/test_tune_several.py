@@ -13,9 +13,9 @@ from typer.testing import CliRunner
 
 import tablebot
 from tablebot.cli import app
+from tablebot.fleet.cells import cell_variants, parse_cells
 from tablebot.fleet.plan import make_plan
 from tablebot.fleet.run import Fleet, RobotSpec
-from tablebot.fleet.tune import parse_cells, variants_of
 from tablebot.sim.model.scene import robot_layer
 from tablebot.sim.runner import simulate
 from test_tune import HALL, hand_optimum
@@ -87,7 +87,7 @@ def test_a_variant_of_the_lights_table_runs_as_sim_of_the_edited_table(tmp_path:
             lines[k] = ",".join([*cells_of[:-2], value, cells_of[-1]])
         (edited / name).write_text("".join(lines), encoding="utf-8")
     project = tablebot.open(LIGHTS)
-    variants = variants_of(plan, cells, [tuple(c.value for c in cells), (17, 23, 33)])
+    variants = cell_variants(plan.tables, plan.machine, cells, [tuple(c.value for c in cells), (17, 23, 33)])
     specs = [RobotSpec(seed=3, variant=1), RobotSpec(seed=3, variant=0)]
     fleet = Fleet(project.table, project.machine, project.scene(every_table=True).world, specs,
                   robot_layer(project.robot)[0], traced=[0, 1], variants=variants, tables=plan.tables)

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from tablebot.fleet.results import FleetSummary
 
 __all__ = ["OBJECTIVES", "Cell", "Evaluator", "best", "grid_points", "jobs_for", "losses", "parse_cells", "search_cma",
-           "search_grid", "split", "variants_of"]
+           "search_grid", "split"]
 
 ROBOTS_PER_JOB = 512
 OBJECTIVES = {
@@ -36,12 +36,6 @@ OBJECTIVES = {
     "lamp_distance": "mean distance (m) from the robot to the nearest lamp when the run ends",
     "missed_lamp": "the share of runs that never reach the lamp",
 }
-
-
-def variants_of(plan: Plan, cells: Sequence[Cell], candidates: Sequence[Sequence[int]]) -> Variants:
-    """The plan's timers and loads with each candidate's values written into its cells
-    (:func:`~tablebot.fleet.cells.cell_variants`)."""
-    return cell_variants(plan.tables, plan.machine, cells, candidates)
 
 
 def losses(objective: str, s: FleetSummary, plan: Plan, world: int) -> np.ndarray:
@@ -103,7 +97,8 @@ class Evaluator:
         metrics = tuple(metrics) or (self.objective,)
         if not candidates:
             return {metric: [] for metric in metrics}
-        jobs = jobs_for(plan, variants_of(plan, self.cells, candidates), len(candidates), self.runner.slots())
+        variants = cell_variants(plan.tables, plan.machine, self.cells, candidates)
+        jobs = jobs_for(plan, variants, len(candidates), self.runner.slots())
         finished: dict[tuple[int, int], dict[str, np.ndarray]] = {}
         def done(job: Job, summary: FleetSummary) -> None:
             finished[job.info["world"], job.first] = {m: losses(m, summary, plan, job.info["world"]) for m in metrics}
