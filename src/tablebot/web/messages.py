@@ -169,6 +169,21 @@ class ErrorMsg(Message):
 
 
 MESSAGES: dict[str, type[Message]] = {
-    kind.kind: kind for kind in (TableMsg, GridMsg, AnalysisMsg, DiagramMsg, ArenaMsg, ControlMsg, FrameMsg,
-                                 TraceMsg, FilesMsg, SavedMsg, ConflictMsg, NoticeMsg, ErrorMsg, SharedMsg)
+    kind.kind: kind
+    for kind in (
+        TableMsg,
+        GridMsg,
+        AnalysisMsg,
+        DiagramMsg,
+        ArenaMsg,
+        ControlMsg,
+        FrameMsg,
+        TraceMsg,
+        FilesMsg,
+        SavedMsg,
+        ConflictMsg,
+        NoticeMsg,
+        ErrorMsg,
+        SharedMsg,
+    )
 }

@@ -98,8 +98,17 @@ class Sim(Operation):
 
     op: ClassVar[str] = "sim"
     #: The actions' fields, all optional.
-    ARENA_FIELDS: ClassVar[tuple[str, ...]] = ("speed", "input", "on", "masks", "seed", "charge", "start", "lamp",
-                                               "paused")
+    ARENA_FIELDS: ClassVar[tuple[str, ...]] = (
+        "speed",
+        "input",
+        "on",
+        "masks",
+        "seed",
+        "charge",
+        "start",
+        "lamp",
+        "paused",
+    )
     action: str
     fields: Mapping[str, Any] = field(default_factory=dict)
 
@@ -162,8 +171,22 @@ class OpenLink(Operation):
 
 
 OPERATIONS: dict[str, type[Operation]] = {
-    kind.op: kind for kind in (Open, Edit, InsertRow, DeleteRow, Save, Restore, Sim, Trace, Counterexample, Files,
-                               NewRobot, Share, OpenLink)
+    kind.op: kind
+    for kind in (
+        Open,
+        Edit,
+        InsertRow,
+        DeleteRow,
+        Save,
+        Restore,
+        Sim,
+        Trace,
+        Counterexample,
+        Files,
+        NewRobot,
+        Share,
+        OpenLink,
+    )
 }
 
 
