@@ -19,22 +19,27 @@ import errno
 import hashlib
 import os
 import stat
-import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from tablebot.i18n import N_
 from tablebot.web.errors import Refused
+from tablebot.web.folder_fd import (
+    AT_FOLDER,
+    CLOEXEC,
+    DIR_FLAGS,
+    READ_FLAGS,
+    Folder,
+    one_save_at_a_time,
+    open_at,
+    read_all,
+    write_at,
+)
 from tablebot.web.refusals import OTHER_TAB, not_regular
 from tablebot.web.refusals import changed as _changed
 from tablebot.web.refusals import refusal as _refusal
-from tablebot.web.temporaries import sweep, temp_name
-
-try:  # POSIX; without it (Windows) this studio's own lock still holds saves one at a time
-    import fcntl
-except ImportError:
-    fcntl = None  # type: ignore[assignment]
+from tablebot.web.temporaries import sweep
 
 TABLE_SUFFIXES = (".csv", ".tsv")
 TRACE_SUFFIXES = (".jsonl",)
@@ -43,14 +48,6 @@ MAX_LISTED = 500  # files listed for the open menus; a home folder is not a proj
 BACKUP_SUFFIX = ".bak"
 HEAD_BYTES = 4096  # read to tell a table from another CSV
 MAX_BACKUP_BYTES = 16 * 1024 * 1024  # what a save copies to NAME.bak (a table the studio opened is 1 MB at most)
-# the POSIX-only flags are 0 where the system has none of them (Windows)
-NOFOLLOW, CLOEXEC = getattr(os, "O_NOFOLLOW", 0), getattr(os, "O_CLOEXEC", 0)
-#: Files opened relative to an open folder (openat: POSIX); where the system cannot (Windows), a folder is
-#: its path, each part checked to be no link on the way (Windows makes links only for administrators).
-AT_FOLDER = {os.open, os.replace, os.unlink} <= os.supports_dir_fd
-Folder = int | str  # an open folder's descriptor, or (without AT_FOLDER) its path
-READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | NOFOLLOW | getattr(os, "O_NOCTTY", 0) | CLOEXEC
-DIR_FLAGS = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | NOFOLLOW | CLOEXEC
 GONE = "deleted"  # the version of a file that is not there (what a forced save over nothing names)
 
 
@@ -142,7 +139,7 @@ class Workspace:
             if info.st_size > limit:
                 raise Refused(N_("{real} has {size:,} bytes; the studio opens such files up to {limit:,}", real=real,
                                  size=info.st_size, limit=limit))
-            data = _read_all(fd, limit)
+            data = read_all(fd, limit)
         if kind is Kind.TABLE and not _looks_like_table(data[:HEAD_BYTES]):
             raise Refused(N_("{real} is not a table: its first line names no state and next column", real=real))
         return Opened(real, (info.st_dev, info.st_ino), data, stat.S_IMODE(info.st_mode))
@@ -153,7 +150,7 @@ class Workspace:
         parent, leaf = _split(real)
         with self._folder(parent, real) as folder:
             try:
-                fd = _open_at(folder, leaf, READ_FLAGS)
+                fd = open_at(folder, leaf, READ_FLAGS)
             except OSError as exc:
                 raise _refusal(exc, real) from None
             try:
@@ -201,7 +198,7 @@ class Workspace:
         if self.locate(opened.name, Kind.TABLE) != opened.name:
             raise Refused(N_("{name} now leads to another file: reload it before saving", name=opened.name))
         parent, leaf = _split(opened.name)
-        with self._folder(parent, opened.name) as folder, _one_save_at_a_time(folder, leaf):
+        with self._folder(parent, opened.name) as folder, one_save_at_a_time(folder, leaf):
             current, mode, identity = self._current(folder, leaf, opened)
             theirs = GONE if current is None else digest(current)
             if theirs != (base or opened.version) and force is not True and force != theirs:
@@ -209,8 +206,8 @@ class Workspace:
                 raise ChangedOnDisk(opened.name, OTHER_TAB if self.written.get(opened.name) == theirs else how, theirs)
             try:
                 if current is not None:
-                    _write_at(folder, leaf + BACKUP_SUFFIX, current, mode)
-                written = _write_at(folder, leaf, data, mode)
+                    write_at(folder, leaf + BACKUP_SUFFIX, current, mode)
+                written = write_at(folder, leaf, data, mode)
                 self.written[opened.name] = digest(data)  # still one save at a time: the next one sees it
             except OSError as exc:
                 raise Refused(N_("{name} was not saved: {why} (check the folder's permissions and free space)",
@@ -220,7 +217,7 @@ class Workspace:
     def _current(self, folder: Folder, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
         """What is on disk now under the opened name (None: nothing), its permissions and identity."""
         try:
-            fd = _open_at(folder, leaf, READ_FLAGS)
+            fd = open_at(folder, leaf, READ_FLAGS)
         except FileNotFoundError:
             return None, opened.mode, opened.identity
         except OSError as exc:
@@ -230,7 +227,7 @@ class Workspace:
             if not stat.S_ISREG(info.st_mode):
                 raise Refused(N_("{name} is no longer a regular file (a folder, pipe or device took its place): "
                                  "nothing was written", name=opened.name))
-            return _read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
+            return read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
         finally:
             os.close(fd)
 
@@ -287,38 +284,9 @@ def _check_name(path: PurePosixPath, kind: Kind, shown: str) -> None:
                                                     shown=shown))
 
 
-def _open_at(folder: Folder, leaf: str, flags: int, mode: int = 0o777) -> int:
-    """``os.open`` of ``leaf`` in ``folder``; without AT_FOLDER, a link there is refused as O_NOFOLLOW would."""
-    if isinstance(folder, int):
-        return os.open(leaf, flags, mode, dir_fd=folder)
-    path = os.path.join(folder, leaf)
-    if os.path.islink(path):
-        raise OSError(errno.ELOOP, "a link", path)
-    return os.open(path, flags | getattr(os, "O_BINARY", 0), mode)
-
-
-def _at(folder: Folder, leaf: str) -> tuple[str, dict[str, int]]:
-    """``leaf`` in ``folder`` as a name and the keywords that say where (dir_fd), or as a path."""
-    return (leaf, {"dir_fd": folder}) if isinstance(folder, int) else (os.path.join(folder, leaf), {})
-
-
 def _split(real: str) -> tuple[tuple[str, ...], str]:
     parts = PurePosixPath(real).parts
     return parts[:-1], parts[-1]
-
-
-def _read_all(fd: int, limit: int) -> bytes:
-    chunks: list[bytes] = []
-    size = 0
-    while size <= limit:
-        chunk = os.read(fd, 1 << 20)
-        if not chunk:
-            break
-        chunks.append(chunk)
-        size += len(chunk)
-    if size > limit:
-        raise Refused(N_("the file grew past {limit:,} bytes while the studio read it", limit=limit))
-    return b"".join(chunks)
 
 
 def _looks_like_table(head: bytes) -> bool:
@@ -331,53 +299,3 @@ def _looks_like_table(head: bytes) -> bool:
     return "state" in text and "next" in text
 
 
-_LOCKS: dict[tuple[int, int, str], threading.Lock] = {}
-_LOCKS_LOCK = threading.Lock()
-
-
-@contextlib.contextmanager
-def _one_save_at_a_time(folder: Folder, leaf: str) -> Iterator[None]:
-    """Hold the save of ``leaf`` in the open ``folder``: one thread of this studio at a time, and (where the
-    file system has flock) one studio process at a time."""
-    info = os.fstat(folder) if isinstance(folder, int) else os.stat(folder)
-    with _LOCKS_LOCK:
-        lock = _LOCKS.setdefault((info.st_dev, info.st_ino, leaf), threading.Lock())
-    with lock:
-        locked = False
-        with contextlib.suppress(OSError):  # no flock on this file system: this studio's own lock still holds
-            if fcntl is not None and isinstance(folder, int):
-                fcntl.flock(folder, fcntl.LOCK_EX)
-                locked = True
-        try:
-            yield
-        finally:
-            if locked and fcntl is not None and isinstance(folder, int):
-                fcntl.flock(folder, fcntl.LOCK_UN)
-
-
-def _write_at(folder: Folder, leaf: str, data: bytes, mode: int) -> tuple[int, int]:
-    """Write ``leaf`` in the open ``folder`` through a temporary file renamed onto it (a link there is
-    replaced, never written through); returns the new file's (device, inode)."""
-    temp = temp_name(leaf)
-    fd = _open_at(folder, temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | NOFOLLOW | CLOEXEC, 0o600)
-    try:
-        try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view):]
-            if hasattr(os, "fchmod"):  # Windows before Python 3.13 has none (and modes are only read-only there)
-                os.fchmod(fd, mode)
-            os.fsync(fd)
-            info = os.fstat(fd)
-        finally:
-            os.close(fd)
-        if isinstance(folder, int):
-            os.replace(temp, leaf, src_dir_fd=folder, dst_dir_fd=folder)
-        else:
-            os.replace(os.path.join(folder, temp), os.path.join(folder, leaf))
-    except BaseException:
-        with contextlib.suppress(OSError):
-            name, where = _at(folder, temp)
-            os.unlink(name, **where)
-        raise
-    return info.st_dev, info.st_ino
