@@ -94,7 +94,7 @@ def write_at(folder: Folder, leaf: str, data: bytes, mode: int) -> tuple[int, in
         try:
             view = memoryview(data)
             while view:
-                view = view[os.write(fd, view):]
+                view = view[os.write(fd, view) :]
             if hasattr(os, "fchmod"):  # Windows before Python 3.13 has none (and modes are only read-only there)
                 os.fchmod(fd, mode)
             os.fsync(fd)

@@ -137,8 +137,14 @@ class Workspace:
         real = self.locate(name, kind)
         with self._file(real) as (fd, info):
             if info.st_size > limit:
-                raise Refused(N_("{real} has {size:,} bytes; the studio opens such files up to {limit:,}", real=real,
-                                 size=info.st_size, limit=limit))
+                raise Refused(
+                    N_(
+                        "{real} has {size:,} bytes; the studio opens such files up to {limit:,}",
+                        real=real,
+                        size=info.st_size,
+                        limit=limit,
+                    )
+                )
             data = read_all(fd, limit)
         if kind is Kind.TABLE and not _looks_like_table(data[:HEAD_BYTES]):
             raise Refused(N_("{real} is not a table: its first line names no state and next column", real=real))
@@ -210,8 +216,13 @@ class Workspace:
                 written = write_at(folder, leaf, data, mode)
                 self.written[opened.name] = digest(data)  # still one save at a time: the next one sees it
             except OSError as exc:
-                raise Refused(N_("{name} was not saved: {why} (check the folder's permissions and free space)",
-                                 name=opened.name, why=exc.strerror or N_("the system refused"))) from None
+                raise Refused(
+                    N_(
+                        "{name} was not saved: {why} (check the folder's permissions and free space)",
+                        name=opened.name,
+                        why=exc.strerror or N_("the system refused"),
+                    )
+                ) from None
         return Saved(Opened(opened.name, written, data, mode), None if current is None else theirs)
 
     def _current(self, folder: Folder, leaf: str, opened: Opened) -> tuple[bytes | None, int, tuple[int, int]]:
@@ -225,8 +236,13 @@ class Workspace:
         try:
             info = os.fstat(fd)
             if not stat.S_ISREG(info.st_mode):
-                raise Refused(N_("{name} is no longer a regular file (a folder, pipe or device took its place): "
-                                 "nothing was written", name=opened.name))
+                raise Refused(
+                    N_(
+                        "{name} is no longer a regular file (a folder, pipe or device took its place): "
+                        "nothing was written",
+                        name=opened.name,
+                    )
+                )
             return read_all(fd, MAX_BACKUP_BYTES), stat.S_IMODE(info.st_mode), (info.st_dev, info.st_ino)
         finally:
             os.close(fd)
@@ -269,6 +285,7 @@ class Workspace:
 
 # --- helpers ---------------------------------------------------------------------------------------------
 
+
 def _shown(name: str) -> str:
     """A name from the page as a message shows it (quoted, control characters escaped, cut short)."""
     return repr(name[:200])
@@ -276,12 +293,15 @@ def _shown(name: str) -> str:
 
 def _check_name(path: PurePosixPath, kind: Kind, shown: str) -> None:
     if any(part.startswith(".") for part in path.parts):
-        raise Refused(N_("{shown}: the studio does not open hidden files or folders (names starting with a dot)",
-                         shown=shown))
+        raise Refused(
+            N_("{shown}: the studio does not open hidden files or folders (names starting with a dot)", shown=shown)
+        )
     if path.suffix.lower() not in kind.value:
-        raise Refused(N_("{shown} is not a table: the studio opens .csv and .tsv files here", shown=shown)
-                      if kind is Kind.TABLE else N_("{shown} is not a trace: the studio opens .jsonl files here",
-                                                    shown=shown))
+        raise Refused(
+            N_("{shown} is not a table: the studio opens .csv and .tsv files here", shown=shown)
+            if kind is Kind.TABLE
+            else N_("{shown} is not a trace: the studio opens .jsonl files here", shown=shown)
+        )
 
 
 def _split(real: str) -> tuple[tuple[str, ...], str]:
@@ -297,5 +317,3 @@ def _looks_like_table(head: bytes) -> bool:
         text = head.decode("utf-8", "replace")
     text = text.lower()
     return "state" in text and "next" in text
-
-
