@@ -234,7 +234,7 @@ def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
     if not ok:
         src.key_error(("sensors", None, name), N_("[sensors] {name}: at must be [forward, left] in metres from the "
                                                   "axle centre, not {value!r}", name=name, value=value),
-                      N_("for example: at = [0.12, 0] (each within ±{most:g} m)", most=MAX_OFFSET))
+                      N_("for example: at = [0.12, 0] (each within ±{most} m)", most=str(MAX_OFFSET)))
         return None
     return float(value[0]), float(value[1])
 

@@ -167,21 +167,25 @@ def is_number(value: Any) -> bool:
 
 def number(src: Source, where: Where, value: Any, low: float, high: float, integer: bool = False) -> float | None:
     """A number in [low, high] (an integer when asked), or None after reporting why not."""
-    write = N_("write an integer from {low:g} to {high:g}", low=low, high=high) if integer else \
-        N_("write a number from {low:g} to {high:g}", low=low, high=high)
+    # the file's own numbers, written as the file writes them: a point in every language (issue 38)
+    low_s, high_s = f"{low:g}", f"{high:g}"
+    write = N_("write an integer from {low} to {high}", low=low_s, high=high_s) if integer else \
+        N_("write a number from {low} to {high}", low=low_s, high=high_s)
     if not is_number(value) or (integer and not isinstance(value, int)):
         src.error(where, N_("{name} must be an integer, not {value!r}", name=label(where), value=value) if integer
                   else N_("{name} must be a number, not {value!r}", name=label(where), value=value), write)
         return None
     if not low <= value <= high:
-        src.error(where, N_("{name} = {value:g} is out of range {low:g}..{high:g}", name=label(where), value=value,
-                            low=low, high=high), write)
+        value_s = f"{value:g}"
+        src.error(where, N_("{name} = {value} is out of range {low}..{high}", name=label(where), value=value_s,
+                            low=low_s, high=high_s), write)
         return None
     return value
 
 
 #: The largest distance from the origin, in metres, a world's points may have on either axis.
 MAX_COORDINATE = 1e4
+_MOST_S = (f"{-MAX_COORDINATE:g}", f"{MAX_COORDINATE:g}")  # as a file writes them, in every language
 
 
 def point(src: Source, where: Where, value: Any) -> tuple[float, float] | None:
@@ -191,7 +195,7 @@ def point(src: Source, where: Where, value: Any) -> tuple[float, float] | None:
         return float(value[0]), float(value[1])
     if pair:  # a point, but no room is that large (and the physics' floats would lose their millimetres)
         src.error(where, N_("{name}: the point {value!r} is out of range", name=label(where), value=value),
-                  N_("write x and y from {low:g} to {high:g} metres", low=-MAX_COORDINATE, high=MAX_COORDINATE))
+                  N_("write x and y from {low} to {high} metres", low=_MOST_S[0], high=_MOST_S[1]))
     else:
         src.error(where, N_("{name} must be a point [x, y] in metres, not {value!r}", name=label(where), value=value),
                   N_("for example: [1.2, 0.5]"))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import gettext as _gettext
 import os
+import string
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -40,6 +41,7 @@ __all__ = [
     "localise",
     "named",
     "ngettext",
+    "number",
     "set_from",
     "system_language",
     "translation",
@@ -149,11 +151,39 @@ class Message(str):
 
 
 def _fill(text: str, args: Mapping[str, Any], language: str | None) -> str:
-    """``text`` with its fields filled: a Message argument in ``language``, a tuple of them as a list (``a, b``)."""
+    """``text`` with its fields filled: a Message argument in ``language``, a tuple of them as a list (``a, b``),
+    a number as ``language`` writes it (:func:`number`: ``{seconds:.1f}`` is ``0,5`` in German)."""
     if not args:
         return text
-    return text.format(**{k: ", ".join(str(localise(item, language)) for item in v) if isinstance(v, tuple)
-                          else localise(v, language) for k, v in args.items()})
+    return _NumberFormatter(language).format(
+        text, **{k: ", ".join(str(localise(item, language)) for item in v) if isinstance(v, tuple)
+                 else localise(v, language) for k, v in args.items()})
+
+
+#: German writes the decimal comma and groups thousands with a point: the two swapped (issue 38).
+_DECIMALS = {"de": str.maketrans(".,", ",.")}
+
+
+def number(value: float, spec: str = "g", language: str | None = None) -> str:
+    """``value`` formatted by ``spec`` (Python's format mini-language: ``.2f``, ``+.3f``, ``,``, ``.0%``) as
+    ``language`` (default: the one in use) writes numbers for people: ``0,5`` and ``12.000`` in German. Only
+    for text a person reads; machine-readable output (CSV, JSON, trace files, ``--format json``) keeps
+    Python's point in every language."""
+    text = format(value, spec)
+    table = _DECIMALS.get(language or _language)
+    return text.translate(table) if table else text
+
+
+class _NumberFormatter(string.Formatter):
+    """str.format, with every int or float field written by :func:`number` in one language."""
+
+    def __init__(self, language: str | None) -> None:
+        self.language = language
+
+    def format_field(self, value: Any, format_spec: str) -> Any:
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return number(value, format_spec, self.language)
+        return super().format_field(value, format_spec)
 
 
 def N_(msgid: str, /, **args: Any) -> Message:
