@@ -20,11 +20,14 @@ def _int(value: int, what: str) -> int:
 
 
 OPERATIONS: dict[str, Callable[[int, int], int]] = {
-    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "AND": lambda a, b: a & b, "OR": lambda a, b: a | b,
-    "XOR": lambda a, b: a ^ b, "SHL": lambda a, b: a << b, "SHR": lambda a, b: a >> b,
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "AND": lambda a, b: a & b,
+    "OR": lambda a, b: a | b,
+    "XOR": lambda a, b: a ^ b,
+    "SHL": lambda a, b: a << b,
+    "SHR": lambda a, b: a >> b,
 }
-
-
 
 
 class Dataflow:
@@ -46,8 +49,14 @@ class Dataflow:
     def _data_pin(self, element: ET.Element, name: str | None, pinclass: str) -> ET.Element | None:
         key = ("pin", id(element), name, pinclass)
         if key not in self._memo:
-            self._memo[key] = next((p for p in element.findall("o") if p.get("pinclass") == pinclass
-                                    and (name is None or p.get("name") == name)), None)
+            self._memo[key] = next(
+                (
+                    p
+                    for p in element.findall("o")
+                    if p.get("pinclass") == pinclass and (name is None or p.get("name") == name)
+                ),
+                None,
+            )
         return self._memo[key]  # type: ignore[return-value]
 
     def _input(self, sub: str, element: ET.Element, name: str | None) -> int:
@@ -64,8 +73,11 @@ class Dataflow:
         key = ("reader", sub, pin_id)
         if key not in self._memo:
             pins = self.pins[sub]
-            sources = [p for p in pins.members.get(pins.net.get(pin_id, -1), ())
-                       if pins.pin[p].get("pinclass") == "dataobjectoutput"]
+            sources = [
+                p
+                for p in pins.members.get(pins.net.get(pin_id, -1), ())
+                if pins.pin[p].get("pinclass") == "dataobjectoutput"
+            ]
             if len(sources) != 1:
                 raise InterpreterError(f"{sub}: a data input has {len(sources)} sources")
             self._memo[key] = self._source(sub, sources[0])
@@ -92,11 +104,13 @@ class Dataflow:
         if kind == "ftProDataOprt":
             return self._operator(sub, element)
         if kind == "ftProDataArray1D" and pin.get("pinid") == "2":
+
             def read() -> int:
                 values, index = self._list(element), self._index(sub, element)
                 if not 0 <= index < len(values):
                     raise InterpreterError(f"list {element.get('name')}: index {index} outside 0..{len(values) - 1}")
                 return values[index]
+
             return read
         raise InterpreterError(f"{kind} gives no value this interpreter knows")
 
@@ -114,6 +128,7 @@ class Dataflow:
             if operation in ("SHR", "SHL") and (a < 0 or b < 0):
                 raise InterpreterError(f"{operation} of {a} by {b}: a negative shift is ambiguous here")
             return _int(apply(a, b), f"{a} {operation} {b}")
+
         return compute
 
     def _list(self, element: ET.Element) -> list[int]:
@@ -125,12 +140,16 @@ class Dataflow:
     def _index(self, sub: str, element: ET.Element) -> int:
         key = ("index", id(element))
         if key not in self._memo:
-            pin = next(p for p in element.findall("o") if p.get("pinclass") == "dataobjectinput"
-                       and p.get("pinid") == "1")
+            pin = next(
+                p for p in element.findall("o") if p.get("pinclass") == "dataobjectinput" and p.get("pinid") == "1"
+            )
             pins = self.pins[sub]
-            wired = [p for p in pins.members.get(pins.net.get(pin.get("id", ""), -1), ())
-                     if pins.pin[p].get("pinclass") == "dataobjectoutput"
-                     and pins.owner[p].get("classname") != "ftProDataMssg"]
+            wired = [
+                p
+                for p in pins.members.get(pins.net.get(pin.get("id", ""), -1), ())
+                if pins.pin[p].get("pinclass") == "dataobjectoutput"
+                and pins.owner[p].get("classname") != "ftProDataMssg"
+            ]
             self._memo[key] = pin.get("id", "") if wired else None
         wired_pin = self._memo[key]
         if wired_pin is not None:
@@ -140,16 +159,20 @@ class Dataflow:
     def _send(self, sub: str, message: ET.Element) -> None:
         command = message.get("command", "")
         data_in = self._data_pin(message, None, "dataobjectinput")
-        value = self._net_value(sub, data_in.get("id", "")) if data_in is not None and data_in.get("resolveid") \
+        value = (
+            self._net_value(sub, data_in.get("id", ""))
+            if data_in is not None and data_in.get("resolveid")
             else int(message.get("value", "0"))
+        )
         key = ("targets", id(message))
         pins = self.pins[sub]
         if key not in self._memo:
             out = self._data_pin(message, None, "dataobjectoutput")
             assert out is not None
             net = pins.members.get(pins.net.get(out.get("id", ""), -1), ())
-            self._memo[key] = [(pins.owner[t], pins.pin[t]) for t in net
-                               if pins.pin[t].get("pinclass") == "dataobjectinput"]
+            self._memo[key] = [
+                (pins.owner[t], pins.pin[t]) for t in net if pins.pin[t].get("pinclass") == "dataobjectinput"
+            ]
         for element, pin in self._memo[key]:  # type: ignore[attr-defined]
             self._receive(element, pin, command, value)
 

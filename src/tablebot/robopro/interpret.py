@@ -51,8 +51,13 @@ from tablebot.robopro.nets import InterpreterError, pins_of
 
 STEP_LIMIT = 200_000  # elements per tick before the program is taken to be stuck
 COMPARE: dict[str, Callable[[int, int], bool]] = {
-    "0": lambda a, b: a > b, "1": lambda a, b: a >= b, "2": lambda a, b: a == b,
-    "3": lambda a, b: a <= b, "4": lambda a, b: a < b, "5": lambda a, b: a != b}
+    "0": lambda a, b: a > b,
+    "1": lambda a, b: a >= b,
+    "2": lambda a, b: a == b,
+    "3": lambda a, b: a <= b,
+    "4": lambda a, b: a < b,
+    "5": lambda a, b: a != b,
+}
 
 
 class Program:
@@ -60,11 +65,15 @@ class Program:
 
     def __init__(self, text: str) -> None:
         root = ET.fromstring(text.encode("utf-8"))
-        self.functions = {f.get("name", ""): f for f in root.iter("o")
-                          if f.get("classname") == "ftProSubroutineFunction"}
+        self.functions = {
+            f.get("name", ""): f for f in root.iter("o") if f.get("classname") == "ftProSubroutineFunction"
+        }
         self.pins = {name: pins_of(f) for name, f in self.functions.items()}
-        self.main = next(name for name, f in self.functions.items()
-                         if any(e.get("classname") == "ftProProcessStart" for e in f.findall("o")))
+        self.main = next(
+            name
+            for name, f in self.functions.items()
+            if any(e.get("classname") == "ftProProcessStart" for e in f.findall("o"))
+        )
         self.starts = [e for e in self.functions[self.main].findall("o") if e.get("classname") == "ftProProcessStart"]
 
 
@@ -202,14 +211,21 @@ class Run(Dataflow):
             return (yield from self._call(sub, element, entered, outs))
         raise InterpreterError(f"{sub}: element {kind} is not one this interpreter runs")
 
-    def _call(self, sub: str, ref: ET.Element, entered: ET.Element,
-              outs: dict[str, str]) -> Generator[int | None, None, str]:
+    def _call(
+        self, sub: str, ref: ET.Element, entered: ET.Element, outs: dict[str, str]
+    ) -> Generator[int | None, None, str]:
         name = ref.get("name", "")
         target = self.program.functions.get(name)
         if target is None:
             raise InterpreterError(f"{sub} calls {name!r}, which the program does not have")
-        entry = next((e for e in target.findall("o") if e.get("classname") == "ftProSubroutineFlowIn"
-                      and e.get("uniqueID") == entered.get("pinid")), None)
+        entry = next(
+            (
+                e
+                for e in target.findall("o")
+                if e.get("classname") == "ftProSubroutineFlowIn" and e.get("uniqueID") == entered.get("pinid")
+            ),
+            None,
+        )
         if entry is None:
             raise InterpreterError(f"{name} has no entry with uniqueID {entered.get('pinid')}")
         unique = yield from self._run(name, entry)
