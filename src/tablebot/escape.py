@@ -113,6 +113,29 @@ def dot_label(text: str) -> str:
     return html_text(_ANY_CONTROL_RE.sub(" ", text))
 
 
+# --- Markdown (report.md) -------------------------------------------------------------------------
+
+#: What CommonMark reads as markup wherever it stands (a table's pipe too); ``_`` is escaped where it could
+#: open or close emphasis (not inside a word, so ``front_bumper_stops`` reads as written either way).
+_MARKDOWN_RE = re.compile(r"[\\`*\[\]<>|!#~&]|(?<![A-Za-z0-9])_|_(?![A-Za-z0-9])")
+
+
+def markdown_text(text: str) -> str:
+    """User text in a Markdown paragraph, heading or table cell: on one line, markup characters
+    backslash-escaped (a ``|`` cannot end a cell, a ``*`` cannot start emphasis, ``<`` cannot start HTML)."""
+    return _MARKDOWN_RE.sub(lambda m: "\\" + m.group(), _ANY_CONTROL_RE.sub(" ", text))
+
+
+def markdown_code(text: str) -> str:
+    """A complete Markdown code span (with its backticks) holding ``text`` on one line: fenced by one more
+    backtick than the longest run inside it, padded when it starts or ends with one (not for a table's cell:
+    a ``|`` would end it there)."""
+    text = _ANY_CONTROL_RE.sub(" ", text)
+    fence = "`" * (max((len(run) for run in re.findall("`+", text)), default=0) + 1)
+    pad = " " if text.startswith("`") or text.endswith("`") else ""
+    return f"{fence}{pad}{text}{pad}{fence}"
+
+
 # --- command lines, Python, terminal ---------------------------------------------------------------
 
 def shell_word(text: str) -> str:
