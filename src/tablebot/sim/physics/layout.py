@@ -122,13 +122,14 @@ for _protocol, _dtype in ((State, STATE), (Params, PARAMS)):  # one list of name
 
 
 def as_state(s: np.ndarray | State) -> State:
-    """Row ``s`` (float64, N_STATE) as a :data:`STATE` record, the same memory (a record is returned as it is)."""
-    return cast(State, s.view(STATE)[0] if isinstance(s, np.ndarray) else s)
+    """Row ``s`` (float64, N_STATE) as a :data:`STATE` record, the same memory (a record is returned as it is;
+    from Python a ``numpy.record``, whose fields read as attributes too)."""
+    return cast(State, s.view(STATE).view(np.recarray)[0] if isinstance(s, np.ndarray) else s)
 
 
 def as_params(p: np.ndarray | Params) -> Params:
     """Row ``p`` (float64, N_PARAM) as a :data:`PARAMS` record, the same memory (a record is returned as it is)."""
-    return cast(Params, p.view(PARAMS)[0] if isinstance(p, np.ndarray) else p)
+    return cast(Params, p.view(PARAMS).view(np.recarray)[0] if isinstance(p, np.ndarray) else p)
 
 
 def state_rows(rows: np.ndarray) -> np.ndarray:
