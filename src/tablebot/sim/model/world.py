@@ -1,4 +1,5 @@
 """World files: the arena a simulated robot drives in (walls, obstacles, lamps, start pose), read and checked;
+what it is made of is :mod:`tablebot.sim.model.shapes` (re-exported here);
 ``examples/bumberbot/arena.toml`` is the commented reference of the TOML format.
 Lengths are metres, angles degrees (0 = +x, counter-clockwise); a world may also hold the parameter
 sections of a robot file's ``[sim]`` ([body], [motor], [battery], ...), which win over the robot's.
@@ -9,102 +10,33 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from tablebot.i18n import N_
 from tablebot.sim.model.params import SECTIONS, check_layer
+from tablebot.sim.model.plane import Point, area, distance_to_segment, first_outside, inside, self_crossing
+from tablebot.sim.model.shapes import (
+    TAPE_WIDTH,
+    Box,
+    Circle,
+    Geometry,
+    Lamp,
+    Line,
+    Segment,
+    World,
+    geometry,
+)
 from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
+
+__all__ = [
+    "DEFAULT_WORLD", "ON_A_WALL", "TAPE_WIDTH", "TOP_KEYS", "Box", "Circle", "Geometry", "Lamp", "Line", "Point",
+    "Segment", "World", "default_world", "geometry", "inside", "load_world", "parse_world",
+]
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", "line", *SECTIONS)
-TAPE_WIDTH = 0.019  # metres: a line's default width, that of common PVC insulating tape (15 or 19 mm)
-Point = tuple[float, float]
 
-
-@dataclass(frozen=True)
-class Lamp:
-    at: Point
-    intensity: float = 3.0  # threshold units at 1 m, straight ahead: seen on-axis up to √3 ≈ 1.7 m
-    radius: float = 0.04  # its base is an obstacle; 0 = a lamp hanging in the air
-
-
-@dataclass(frozen=True)
-class Box:
-    at: Point
-    size: Point
-    angle: float = 0.0
-
-    def corners(self) -> list[Point]:
-        c, s = math.cos(math.radians(self.angle)), math.sin(math.radians(self.angle))
-        w, h = self.size[0] / 2, self.size[1] / 2
-        corners = ((-w, -h), (w, -h), (w, h), (-w, h))
-        return [(self.at[0] + c * x - s * y, self.at[1] + s * x + c * y) for x, y in corners]
-
-
-@dataclass(frozen=True)
-class Circle:
-    at: Point
-    radius: float
-
-
-@dataclass(frozen=True)
-class Segment:
-    start: Point
-    end: Point
-
-
-@dataclass(frozen=True)
-class Line:
-    """A line on the floor (tape) that floor sensors see: a polyline of ``width``, closed into a loop or not.
-    It does not block the robot, its light or its distance sensors."""
-
-    points: tuple[Point, ...]
-    width: float = TAPE_WIDTH
-    closed: bool = False
-
-    def segments(self) -> list[tuple[Point, Point]]:
-        pts = list(self.points)
-        ends = pts[1:] + (pts[:1] if self.closed else [])
-        return list(zip(pts, ends, strict=False))
-
-
-@dataclass(frozen=True)
-class World:
-    """A checked world; ``params`` holds its parameter sections, ``line`` finds a key's line for errors."""
-
-    name: str
-    walls: tuple[Point, ...]
-    start: tuple[float, float, float]  # x, y, heading in degrees
-    lamps: tuple[Lamp, ...] = ()
-    boxes: tuple[Box, ...] = ()
-    circles: tuple[Circle, ...] = ()
-    segments: tuple[Segment, ...] = ()
-    lines: tuple[Line, ...] = ()
-    reach: float = 0.25  # the lamp counts as found when the axle centre is this close
-    params: dict[str, dict[str, Any]] = field(default_factory=dict)
-    path: str = "<world>"
-    source: Source | None = field(default=None, compare=False, repr=False)
-
-    def line(self, section: str, key: str | None = None) -> int | None:
-        return self.source.line(section, None, key) if self.source else None
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """A world as the physics core's arrays (see :mod:`tablebot.sim.physics.step`)."""
-
-    verts: np.ndarray
-    pstart: np.ndarray
-    pbound: np.ndarray
-    edges: np.ndarray
-    circles: np.ndarray
-    lamps: np.ndarray
-    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))  # (K, 5): x0, y0, x1, y1, half width
-    shade: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the pieces that may shadow a lamp (.shadows)
 
 
 DEFAULT_WORLD = """\
@@ -146,7 +78,7 @@ def parse_world(src: Source) -> World:
     if walls and start:
         _inside(src, walls, [("start", None, "at", start[:2])]
                 + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)]
-                + [("line", i, "points", _first_outside(walls, line.points)) for i, line in enumerate(lines)])
+                + [("line", i, "points", first_outside(walls, line.points)) for i, line in enumerate(lines)])
     if walls:
         _lamps_in_the_open(src, walls, lamps, boxes, circles, segments)
     src.raise_if_any()
@@ -195,12 +127,12 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     if any(c is None for c in corners):
         return []
     walls: list[Point] = corners  # type: ignore[assignment]
-    crossing = _self_crossing(walls)
+    crossing = self_crossing(walls)
     if crossing:
         src.error(where, N_("[arena] walls cross themselves (wall {first} and wall {second})", first=crossing[0] + 1,
                             second=crossing[1] + 1),
                   N_("list the corners in order around the room, clockwise or counter-clockwise"))
-    elif abs(_area(walls)) < 1e-6:
+    elif abs(area(walls)) < 1e-6:
         src.error(where, N_("[arena] walls enclose no area"), N_("list the corners of the room in order"))
     return walls
 
@@ -288,42 +220,6 @@ def _line(src: Source, i: int, t: dict[str, Any]) -> Line | None:
     return Line(tuple(points), float(width), closed)  # type: ignore[arg-type]
 
 
-def _area(poly: list[Point]) -> float:
-    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1], strict=True))
-
-
-def _cross(a: Point, b: Point, c: Point, d: Point) -> bool:
-    def orient(p: Point, q: Point, r: Point) -> float:
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-    return orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0
-
-
-def _self_crossing(poly: list[Point]) -> tuple[int, int] | None:
-    n = len(poly)
-    for i in range(n):
-        for j in range(i + 2, n):
-            if i == 0 and j == n - 1:
-                continue  # neighbours through the closing corner
-            if _cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n]):
-                return i, j
-    return None
-
-
-def inside(poly: tuple[Point, ...] | list[Point], p: Point) -> bool:
-    """Even-odd rule point-in-polygon."""
-    x, y = p
-    result = False
-    for (x0, y0), (x1, y1) in zip(poly, [*poly[1:], poly[0]], strict=True):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            result = not result
-    return result
-
-
-def _first_outside(walls: list[Point], points: tuple[Point, ...]) -> Point:
-    """The first point of a line outside the walls (or its first point, inside: nothing to report)."""
-    return next((p for p in points if not inside(walls, p)), points[0])
-
-
 def _inside(src: Source, walls: list[Point], places: Sequence[tuple[str, int | None, str, Point]]) -> None:
     for section, index, key, at in places:
         if not inside(walls, at):
@@ -344,14 +240,6 @@ def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes
                       N_("move the lamp into the open"))
 
 
-def _distance_to_segment(p: Point, a: Point, b: Point) -> float:
-    """Distance from p to segment ab (for checking a world file; the simulator has its own compiled one)."""
-    ex, ey = b[0] - a[0], b[1] - a[1]
-    length2 = ex * ex + ey * ey
-    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, ((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / length2))
-    return math.hypot(p[0] - a[0] - t * ex, p[1] - a[1] - t * ey)
-
-
 def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circles: list[Circle]) -> str | None:
     """Where ``at`` is shut in: inside a box or a circle, or on a wall line; None when in the open."""
     for k, box in enumerate(boxes):
@@ -360,38 +248,6 @@ def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circ
     for k, circle in enumerate(circles):
         if math.dist(circle.at, at) < circle.radius:
             return N_("inside [[circle]] #{n}", n=k + 1)
-    if any(_distance_to_segment(at, a, b) < ON_A_WALL for a, b in lines):
+    if any(distance_to_segment(at, a, b) < ON_A_WALL for a, b in lines):
         return N_("on a wall")
     return None
-
-
-def geometry(world: World) -> Geometry:
-    """The world as convex pieces (each wall and segment a 2-vertex piece, each box a 4-vertex one)."""
-    pieces: list[list[Point]] = []
-    walls = list(world.walls)
-    pieces += [[a, b] for a, b in zip(walls, walls[1:] + walls[:1], strict=True)]
-    pieces += [[s.start, s.end] for s in world.segments]
-    pieces += [b.corners() for b in world.boxes]
-    verts = np.array([v for piece in pieces for v in piece], dtype=np.float64).reshape(-1, 2)
-    pstart = np.cumsum([0] + [len(piece) for piece in pieces]).astype(np.int64)
-    pbound = np.zeros((len(pieces), 3))
-    edges: list[tuple[float, float, float, float]] = []
-    for k, piece in enumerate(pieces):
-        arr = np.array(piece)
-        centre = arr.mean(axis=0)
-        pbound[k] = (*centre, np.hypot(*(arr - centre).T).max())
-        pairs = [(piece[0], piece[1])] if len(piece) == 2 else list(zip(piece, piece[1:] + piece[:1], strict=True))
-        edges += [(a[0], a[1], b[0], b[1]) for a, b in pairs]
-    circles = [(c.at[0], c.at[1], c.radius, -1.0) for c in world.circles]
-    circles += [(lamp.at[0], lamp.at[1], lamp.radius, float(k))
-                for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
-    lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
-    lines = [(a[0], a[1], b[0], b[1], line.width / 2) for line in world.lines for a, b in line.segments()]
-    from tablebot.sim.physics.shadows import shade_grid  # compiled code: loaded only when a world is packed for it
-
-    edge_array = np.array(edges, dtype=np.float64).reshape(-1, 4)
-    circle_array = np.array(circles, dtype=np.float64).reshape(-1, 4)
-    lamp_array = np.array(lamps, dtype=np.float64).reshape(-1, 3)
-    return Geometry(verts=verts, pstart=pstart, pbound=pbound, edges=edge_array, circles=circle_array,
-                    lamps=lamp_array, lines=np.array(lines, dtype=np.float64).reshape(-1, 5),
-                    shade=shade_grid(edge_array, circle_array, lamp_array))
