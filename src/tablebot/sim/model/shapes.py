@@ -116,8 +116,9 @@ def geometry(world: World) -> Geometry:
         pairs = [(piece[0], piece[1])] if len(piece) == 2 else list(zip(piece, piece[1:] + piece[:1], strict=True))
         edges += [(a[0], a[1], b[0], b[1]) for a, b in pairs]
     circles = [(c.at[0], c.at[1], c.radius, -1.0) for c in world.circles]
-    circles += [(lamp.at[0], lamp.at[1], lamp.radius, float(k))
-                for k, lamp in enumerate(world.lamps) if lamp.radius > 0]
+    circles += [
+        (lamp.at[0], lamp.at[1], lamp.radius, float(k)) for k, lamp in enumerate(world.lamps) if lamp.radius > 0
+    ]
     lamps = [(lamp.at[0], lamp.at[1], lamp.intensity) for lamp in world.lamps]
     lines = [(a[0], a[1], b[0], b[1], line.width / 2) for line in world.lines for a, b in line.segments()]
     from tablebot.sim.physics.shadows import shade_grid  # compiled code: loaded only when a world is packed for it
@@ -125,6 +126,13 @@ def geometry(world: World) -> Geometry:
     edge_array = np.array(edges, dtype=np.float64).reshape(-1, 4)
     circle_array = np.array(circles, dtype=np.float64).reshape(-1, 4)
     lamp_array = np.array(lamps, dtype=np.float64).reshape(-1, 3)
-    return Geometry(verts=verts, pstart=pstart, pbound=pbound, edges=edge_array, circles=circle_array,
-                    lamps=lamp_array, lines=np.array(lines, dtype=np.float64).reshape(-1, 5),
-                    shade=shade_grid(edge_array, circle_array, lamp_array))
+    return Geometry(
+        verts=verts,
+        pstart=pstart,
+        pbound=pbound,
+        edges=edge_array,
+        circles=circle_array,
+        lamps=lamp_array,
+        lines=np.array(lines, dtype=np.float64).reshape(-1, 5),
+        shade=shade_grid(edge_array, circle_array, lamp_array),
+    )

@@ -30,13 +30,27 @@ from tablebot.sim.model.shapes import (
 from tablebot.tomlfile import Source, Where, known_keys, label, number, point, table_of
 
 __all__ = [
-    "DEFAULT_WORLD", "ON_A_WALL", "TAPE_WIDTH", "TOP_KEYS", "Box", "Circle", "Geometry", "Lamp", "Line", "Point",
-    "Segment", "World", "default_world", "geometry", "inside", "load_world", "parse_world",
+    "DEFAULT_WORLD",
+    "ON_A_WALL",
+    "TAPE_WIDTH",
+    "TOP_KEYS",
+    "Box",
+    "Circle",
+    "Geometry",
+    "Lamp",
+    "Line",
+    "Point",
+    "Segment",
+    "World",
+    "default_world",
+    "geometry",
+    "inside",
+    "load_world",
+    "parse_world",
 ]
 
 ON_A_WALL = 1e-6  # metres: a lamp this close to a wall's line is in it (every ray to it crosses the wall)
 TOP_KEYS = ("name", "reach", "arena", "start", "lamp", "box", "circle", "segment", "line", *SECTIONS)
-
 
 
 DEFAULT_WORLD = """\
@@ -76,15 +90,30 @@ def parse_world(src: Source) -> World:
     lines = _many(src, data, "line", _line)
     params = check_layer(src, data)
     if walls and start:
-        _inside(src, walls, [("start", None, "at", start[:2])]
-                + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)]
-                + [("line", i, "points", first_outside(walls, line.points)) for i, line in enumerate(lines)])
+        _inside(
+            src,
+            walls,
+            [("start", None, "at", start[:2])]
+            + [("lamp", i, "at", lamp.at) for i, lamp in enumerate(lamps)]
+            + [("line", i, "points", first_outside(walls, line.points)) for i, line in enumerate(lines)],
+        )
     if walls:
         _lamps_in_the_open(src, walls, lamps, boxes, circles, segments)
     src.raise_if_any()
-    return World(name=str(name), walls=tuple(walls), start=start, lamps=tuple(lamps),  # type: ignore[arg-type]
-                 boxes=tuple(boxes), circles=tuple(circles), segments=tuple(segments), lines=tuple(lines),
-                 reach=float(reach or 0.25), params=params, path=src.path, source=src)
+    return World(
+        name=str(name),
+        walls=tuple(walls),
+        start=start,
+        lamps=tuple(lamps),  # type: ignore[arg-type]
+        boxes=tuple(boxes),
+        circles=tuple(circles),
+        segments=tuple(segments),
+        lines=tuple(lines),
+        reach=float(reach or 0.25),
+        params=params,
+        path=src.path,
+        source=src,
+    )
 
 
 def _many(src: Source, data: dict[str, Any], section: str, read: Any) -> list[Any]:
@@ -93,9 +122,11 @@ def _many(src: Source, data: dict[str, Any], section: str, read: Any) -> list[An
     if isinstance(items, dict):
         items = [items]
     if not isinstance(items, list) or not all(isinstance(item, dict) for item in items):
-        src.error(("", None, section), N_("{section} must be written as [[{section}]] tables, not {items!r}",
-                                          section=section, items=items),
-                  N_("see examples/bumberbot/arena.toml"))
+        src.error(
+            ("", None, section),
+            N_("{section} must be written as [[{section}]] tables, not {items!r}", section=section, items=items),
+            N_("see examples/bumberbot/arena.toml"),
+        )
         return []
     found = [read(src, i, item) for i, item in enumerate(items)]
     return [item for item in found if item is not None]
@@ -115,13 +146,21 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     raw = arena.get("walls")
     where = ("arena", None, "walls")
     if raw is None:
-        src.error(where, N_("[arena] walls is missing: the room's corners"),
-                  N_("add an [arena] section with walls = [[0, 0], [3, 0], [3, 2], [0, 2]] (metres, in order around "
-                     "the room)"))
+        src.error(
+            where,
+            N_("[arena] walls is missing: the room's corners"),
+            N_(
+                "add an [arena] section with walls = [[0, 0], [3, 0], [3, 2], [0, 2]] (metres, in order around "
+                "the room)"
+            ),
+        )
         return []
     if not isinstance(raw, list) or len(raw) < 3:
-        src.error(where, N_("[arena] walls must list at least three corners [x, y]"),
-                  N_("for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]"))
+        src.error(
+            where,
+            N_("[arena] walls must list at least three corners [x, y]"),
+            N_("for example: walls = [[0, 0], [3, 0], [3, 2], [0, 2]]"),
+        )
         return []
     corners = [point(src, where, p) for p in raw]
     if any(c is None for c in corners):
@@ -129,9 +168,15 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
     walls: list[Point] = corners  # type: ignore[assignment]
     crossing = self_crossing(walls)
     if crossing:
-        src.error(where, N_("[arena] walls cross themselves (wall {first} and wall {second})", first=crossing[0] + 1,
-                            second=crossing[1] + 1),
-                  N_("list the corners in order around the room, clockwise or counter-clockwise"))
+        src.error(
+            where,
+            N_(
+                "[arena] walls cross themselves (wall {first} and wall {second})",
+                first=crossing[0] + 1,
+                second=crossing[1] + 1,
+            ),
+            N_("list the corners in order around the room, clockwise or counter-clockwise"),
+        )
     elif abs(area(walls)) < 1e-6:
         src.error(where, N_("[arena] walls enclose no area"), N_("list the corners of the room in order"))
     return walls
@@ -140,8 +185,11 @@ def _walls(src: Source, arena: dict[str, Any]) -> list[Point]:
 def _start(src: Source, start: dict[str, Any]) -> tuple[float, float, float] | None:
     known_keys(src, ("start", None), start, ("at", "heading"))
     if "at" not in start:
-        src.error(("start", None, None), N_("[start] needs at = [x, y], the robot's axle centre"),
-                  N_("add a [start] section with at = [0.5, 0.5] and heading = 0"))
+        src.error(
+            ("start", None, None),
+            N_("[start] needs at = [x, y], the robot's axle centre"),
+            N_("add a [start] section with at = [0.5, 0.5] and heading = 0"),
+        )
         return None
     at = point(src, ("start", None, "at"), start["at"])
     heading = number(src, ("start", None, "heading"), start.get("heading", 0.0), -3600, 3600)
@@ -166,8 +214,11 @@ def _box(src: Source, i: int, t: dict[str, Any]) -> Box | None:
     size = _point(src, ("box", i, "size"), t)
     angle = number(src, ("box", i, "angle"), t.get("angle", 0.0), -3600, 3600)
     if size is not None and min(size) <= 0:
-        src.error(("box", i, "size"), N_("[[box]] #{n} size must be positive, not {size}", n=i + 1, size=list(size)),
-                  N_("size = [width, depth] in metres"))
+        src.error(
+            ("box", i, "size"),
+            N_("[[box]] #{n} size must be positive, not {size}", n=i + 1, size=list(size)),
+            N_("size = [width, depth] in metres"),
+        )
         return None
     if at is None or size is None or angle is None:
         return None
@@ -178,8 +229,9 @@ def _circle(src: Source, i: int, t: dict[str, Any]) -> Circle | None:
     known_keys(src, ("circle", i), t, ("at", "radius"))
     at = _point(src, ("circle", i, "at"), t)
     if "radius" not in t:
-        src.error(("circle", i, "radius"), N_("[[circle]] #{n} radius is missing", n=i + 1),
-                  N_("add radius = 0.1 (metres)"))
+        src.error(
+            ("circle", i, "radius"), N_("[[circle]] #{n} radius is missing", n=i + 1), N_("add radius = 0.1 (metres)")
+        )
         return None
     radius = number(src, ("circle", i, "radius"), t["radius"], 0.001, 100.0)
     return None if at is None or radius is None else Circle(at, float(radius))
@@ -200,22 +252,28 @@ def _line(src: Source, i: int, t: dict[str, Any]) -> Line | None:
     where = ("line", i, "points")
     raw = t.get("points")
     if not isinstance(raw, list) or len(raw) < 2:
-        src.error(where, N_("[[line]] #{n} needs points = [[x, y], [x, y], ...] (at least two)", n=i + 1),
-                  N_("list the corners of the tape in order, in metres"))
+        src.error(
+            where,
+            N_("[[line]] #{n} needs points = [[x, y], [x, y], ...] (at least two)", n=i + 1),
+            N_("list the corners of the tape in order, in metres"),
+        )
         return None
     points = [point(src, where, p) for p in raw]
     width = number(src, ("line", i, "width"), t.get("width", TAPE_WIDTH), 0.001, 1.0)
     closed = t.get("closed", False)
     if not isinstance(closed, bool):
-        src.error(("line", i, "closed"), N_("[[line]] #{n} closed must be true or false, not {closed!r}", n=i + 1,
-                                            closed=closed),
-                  N_("closed = true joins the last point back to the first"))
+        src.error(
+            ("line", i, "closed"),
+            N_("[[line]] #{n} closed must be true or false, not {closed!r}", n=i + 1, closed=closed),
+            N_("closed = true joins the last point back to the first"),
+        )
         return None
     if any(p is None for p in points) or width is None:
         return None
     if any(a == b for a, b in itertools.pairwise(points)):
-        src.error(where, N_("[[line]] #{n} repeats a point: a piece of no length", n=i + 1),
-                  N_("remove the repeated point"))
+        src.error(
+            where, N_("[[line]] #{n} repeats a point: a piece of no length", n=i + 1), N_("remove the repeated point")
+        )
         return None
     return Line(tuple(points), float(width), closed)  # type: ignore[arg-type]
 
@@ -223,21 +281,31 @@ def _line(src: Source, i: int, t: dict[str, Any]) -> Line | None:
 def _inside(src: Source, walls: list[Point], places: Sequence[tuple[str, int | None, str, Point]]) -> None:
     for section, index, key, at in places:
         if not inside(walls, at):
-            src.error((section, index, key), N_("{section} at {at} is outside the arena walls", section=section,
-                                                at=list(at)),
-                      N_("move it inside the [arena] walls polygon"))
+            src.error(
+                (section, index, key),
+                N_("{section} at {at} is outside the arena walls", section=section, at=list(at)),
+                N_("move it inside the [arena] walls polygon"),
+            )
 
 
-def _lamps_in_the_open(src: Source, walls: list[Point], lamps: list[Lamp], boxes: list[Box],
-                       circles: list[Circle], segments: list[Segment]) -> None:
+def _lamps_in_the_open(
+    src: Source, walls: list[Point], lamps: list[Lamp], boxes: list[Box], circles: list[Circle], segments: list[Segment]
+) -> None:
     """A lamp inside an obstacle or on a wall is dark: every ray from it to the robot is blocked."""
     lines = [*zip(walls, walls[1:] + walls[:1], strict=True), *((s.start, s.end) for s in segments)]
     for i, lamp in enumerate(lamps):
         place = _blocked(lamp.at, lines, boxes, circles) if inside(walls, lamp.at) else None  # else: outside
         if place:
-            src.error(("lamp", i, "at"), N_("[[lamp]] #{n} at {at} is {place}: its light cannot reach the robot",
-                                            n=i + 1, at=list(lamp.at), place=place),
-                      N_("move the lamp into the open"))
+            src.error(
+                ("lamp", i, "at"),
+                N_(
+                    "[[lamp]] #{n} at {at} is {place}: its light cannot reach the robot",
+                    n=i + 1,
+                    at=list(lamp.at),
+                    place=place,
+                ),
+                N_("move the lamp into the open"),
+            )
 
 
 def _blocked(at: Point, lines: list[tuple[Point, Point]], boxes: list[Box], circles: list[Circle]) -> str | None:
