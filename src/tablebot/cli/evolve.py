@@ -12,7 +12,7 @@ import typer
 from tablebot.cli.app import app
 from tablebot.cli.common import ROBOT_OPT, TABLE_ARG, console, err_console, guarded, open_project
 from tablebot.cli.sweep import BACKEND_OPT, SCHEDULER_OPT, WORLD_OPT, stops
-from tablebot.i18n import _, localise
+from tablebot.i18n import _, localise, number
 
 EVOLVE_WORKERS_OPT = typer.Option(None, "--workers", min=1, help="Local worker threads for the fleet, and prover "
                                   "processes (default: one per core; 1 proves in this process).")
@@ -84,11 +84,11 @@ def _pace(outcome: Any, plan: Any, wall: float) -> str:
     """The run's pace: tables and robot-ticks of the search per second of the fleet's time (the fresh-seed
     check after it not counted); a resumed run says how many tables it took from the folder."""
     counts = outcome.counts
-    said = _("({tables} tables in {seconds:.0f} s").format(tables=len(outcome.order), seconds=wall)
+    said = _("({tables} tables in {seconds} s").format(tables=len(outcome.order), seconds=number(wall, ".0f"))
     if counts.resumed:
         said += _(", {n} of them from the earlier run in this folder").format(n=counts.resumed)
     if counts.evaluated and counts.fleet_s > 0:
         ticks = counts.evaluated * plan.spec.total * plan.spec.ticks
-        said += _("; the search ran {tables:.1f} tables/s, {rate:.2f} M robot-ticks/s on the fleet").format(
-            tables=counts.evaluated / counts.fleet_s, rate=ticks / counts.fleet_s / 1e6)
+        said += _("; the search ran {tables} tables/s, {rate} M robot-ticks/s on the fleet").format(
+            tables=number(counts.evaluated / counts.fleet_s, ".1f"), rate=number(ticks / counts.fleet_s / 1e6, ".2f"))
     return said + ")"

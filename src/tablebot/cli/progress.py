@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 from tablebot.api.progress import Progress
 from tablebot.cli.common import Stages, err_console
 from tablebot.escape import plain
-from tablebot.i18n import _, localise
+from tablebot.i18n import _, localise, number
 
 if TYPE_CHECKING:
     from rich.progress import Progress as RichProgress
@@ -105,7 +105,7 @@ class CountBar(Progress):
         rate = ""
         if self.ticks:
             per_s = self.new * self.ticks / max(time.perf_counter() - self.started, 1e-9)
-            rate = _("{rate:.2f} M robot-ticks/s").format(rate=per_s / 1e6)
+            rate = _("{rate} M robot-ticks/s").format(rate=number(per_s / 1e6, ".2f"))
         self.bar.update(self.task, advance=count, rate=rate)
 
     def note(self, text: str) -> None:

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from tablebot.diagnostics import fail
-from tablebot.i18n import N_
+from tablebot.i18n import N_, Message, localise
 from tablebot.sim.model.track import loop_of
 from tablebot.sim.model.world import World
 
@@ -23,24 +23,32 @@ class Measure:
     """One number per run, averaged over the scenarios; ``better``: "low" or "high" (as an objective)."""
 
     name: str
-    text: str
+    text: Message  # what it is, said in the reader's language (measure_text)
     better: str
     needs: str = ""  # "lamp", "loop", "walls" or "" (measurable in any world)
     objective: bool = True  # may be the objective (a state's share of time has no better side)
 
 
 MEASURES = {m.name: m for m in (
-    Measure("time_to_lamp", "seconds until the lamp is reached (never: the whole run)", "low", "lamp"),
-    Measure("time_to_light", "seconds until a light sensor first sees a lamp (never: the whole run)", "low", "lamp"),
-    Measure("missed_lamp", "share of runs that never reach the lamp", "low", "lamp"),
-    Measure("lamp_distance", "metres from the robot to the nearest lamp when the run ends", "low", "lamp"),
-    Measure("collisions", "collisions per run", "low"),
-    Measure("collision_share", "share of the time the body touches something", "low"),
-    Measure("distance", "metres driven", "high"),
-    Measure("area_covered", "square metres of floor the robot's centre passed over (in 10 cm squares)", "high",
+    Measure("time_to_lamp", N_("seconds until the lamp is reached (never: the whole run)"), "low", "lamp"),
+    Measure("time_to_light", N_("seconds until a light sensor first sees a lamp (never: the whole run)"), "low",
+            "lamp"),
+    Measure("missed_lamp", N_("share of runs that never reach the lamp"), "low", "lamp"),
+    Measure("lamp_distance", N_("metres from the robot to the nearest lamp when the run ends"), "low", "lamp"),
+    Measure("collisions", N_("collisions per run"), "low"),
+    Measure("collision_share", N_("share of the time the body touches something"), "low"),
+    Measure("distance", N_("metres driven"), "high"),
+    Measure("area_covered", N_("square metres of floor the robot's centre passed over (in 10 cm squares)"), "high",
             "walls"),
-    Measure("laps", "net laps round the world's closed line of tape", "high", "loop"),
+    Measure("laps", N_("net laps round the world's closed line of tape"), "high", "loop"),
 )}
+
+
+def measure_text(name: str) -> str:
+    """What a measure (or a descriptor ``state_share:STATE``) is, in the reader's language."""
+    if name in MEASURES:
+        return str(localise(MEASURES[name].text))
+    return str(localise(N_("share of the time in state {state}", state=name[len(STATE_SHARE):])))
 
 
 @dataclass(frozen=True)

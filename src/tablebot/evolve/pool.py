@@ -251,9 +251,12 @@ def repaired(context: Context, candidate: Candidate, space: Any, prefer: str) ->
     return repair(candidate, context.base, context.prover, space, prefer)
 
 
-def check_report(context: Context, table: Table) -> tuple[str, bool]:
-    """The table's ``check`` report as text, and whether every property holds in it."""
+def check_report(context: Context, table: Table, language: str = "en") -> tuple[str, bool]:
+    """The table's ``check`` report as text in ``language`` (a worker process speaks the reader's language only
+    when told), and whether every property holds in it."""
     from tablebot.evolve.report import check_text
+    from tablebot.i18n import use
 
+    use(language)
     report = context.prover.report(compile_table(table))
     return check_text(report, context.prover), all(r.status == "holds" for r in report.results)

@@ -17,12 +17,12 @@ import numpy as np
 from tablebot.analysis.check import CheckReport
 from tablebot.analysis.diagram import action, condition
 from tablebot.escape import shell_word
-from tablebot.evolve.measures import MEASURES, STATE_SHARE, Measure, fitness
+from tablebot.evolve.measures import Measure, fitness
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, renumbered, to_table
 from tablebot.files import write_text
 from tablebot.formats.table_write import format_table
-from tablebot.i18n import _
+from tablebot.i18n import _, localise, ngettext, number
 from tablebot.machine import compile_table
 from tablebot.table import Row, Table
 
@@ -114,26 +114,37 @@ def write_table(table: Table, label: str, key: str, checked: tuple[str, bool]) -
     return Written(label, key, path, check, checked[1])
 
 
+_FINDING_WORDS = {"error": lambda: _("error"), "warning": lambda: _("warning"), "info": lambda: _("info")}
+
+
 def check_text(report: CheckReport, prover: Prover) -> str:
-    """``tablebot check``'s report in plain text: every property and every finding, by file line."""
+    """``tablebot check``'s report in plain text, in the language in use: every property and every finding, by
+    file line."""
     table, machine = report.machine.table, report.machine
-    sources = ", ".join(str(f) for f in prover.files) or "none"
-    head = f"{Path(table.path).name}: {len(table.rows)} rows, {len(machine.states)} states, "
+    sources = ", ".join(str(f) for f in prover.files) or _("none")
+    head = _("{file}: {rows} rows, {states} states, ").format(file=Path(table.path).name, rows=len(table.rows),
+                                                             states=len(machine.states))
     whole = prover.whole
     if whole is not None and report.tables is not None:  # one table of several: proved with the others
         mine = report.tables.machines[whole.index]
-        head = (f"{Path(mine.table.path).name} (table {whole.name}; unchanged beside it: {', '.join(whole.others)}): "
-                f"{len(mine.table.rows)} rows, {len(mine.states)} states; the tables together: ")
-    lines = [f"{head}{report.situations} situations explored", "", f"properties (the robot file's and {sources}):"]
-    marks = {"holds": "holds   ", "violated": "VIOLATED", "unknown": "UNKNOWN "}
+        head = _("{file} (table {name}; unchanged beside it: {others}): {rows} rows, {states} states; the tables "
+                 "together: ").format(file=Path(mine.table.path).name, name=whole.name, others=", ".join(whole.others),
+                                      rows=len(mine.table.rows), states=len(mine.states))
+    lines = [head + _("{situations} situations explored").format(situations=report.situations), "",
+             _("properties (the robot file's and {sources}):").format(sources=sources)]
+    marks = {"holds": _("holds"), "violated": _("VIOLATED"), "unknown": _("unknown")}
+    width = max(len(mark) for mark in marks.values())
     for result in report.results:
-        lines.append(f"  {marks[result.status]} {result.prop.name}: {result.prop.text}")
-        lines.append(f"           {result.prop.claim()}")
-    lines += ["", "findings:"]
-    lines += [f"  {Path(f.path or table.path).name}:{','.join(map(str, f.lines)) or '-'}: {f.severity}: {f.message}"
-              for f in report.findings] or ["  none"]
+        lines.append(f"  {marks[result.status]:<{width}} {result.prop.name}: {result.prop.text}")
+        lines.append(" " * (width + 3) + str(localise(result.prop.claim())))
+    lines += ["", _("findings:")]
+    lines += [f"  {Path(f.path or table.path).name}:{','.join(map(str, f.lines)) or '-'}: "
+              f"{_FINDING_WORDS[f.severity]()}: {localise(f.message)}" for f in report.findings] or \
+        ["  " + _("none")]
     counts = report.counts()
-    lines += ["", f"{counts['error']} errors, {counts['warning']} warnings, {counts['info']} notes"]
+    lines += ["", ", ".join([ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
+                             ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
+                             ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"])])]
     return "\n".join(lines) + "\n"
 
 
@@ -294,26 +305,22 @@ def _better(objective: Measure) -> str:
 # --- report.md --------------------------------------------------------------------------------------------
 
 
-def measure_rows(names: Sequence[str], columns: Sequence[tuple[str, dict[str, float]]],
-                 objective: Measure) -> list[str]:
-    """A markdown table: one row per measure, one column per table compared."""
-    lines = ["| mean over the fresh scenarios | " + " | ".join(label for label, _ in columns) + " |",
-             "|---" * (len(columns) + 1) + "|"]
-    for name in names:
-        text = MEASURES[name].text if name in MEASURES else f"share of the time in state {name[len(STATE_SHARE):]}"
-        mark = f" (objective, {objective.better} is better)" if name == objective.name else ""
-        lines.append(f"| {name}{mark}: {text} | " + " | ".join(f"{means[name]:.3f}" for _, means in columns) + " |")
-    return lines
-
-
 def paired(objective: Measure, before: np.ndarray, after: np.ndarray) -> str:
     """The change in the objective, scenario by scenario (common random numbers), with two standard errors."""
+    return paired_change(objective, before, after)[0]
+
+
+def paired_change(objective: Measure, before: np.ndarray, after: np.ndarray) -> tuple[str, str]:
+    """:func:`paired`'s text in the reader's language, and its verdict: "better", "worse" or "unclear"."""
     diff = np.asarray(after, dtype=float) - np.asarray(before, dtype=float)
     n = len(diff)
     mean = float(np.mean(diff))
     if n < 2:  # one scenario has no spread to weigh the change against
-        return f"{mean:+.3f} (one scenario, so no standard error): no clear difference"
+        return _("{mean} (one scenario, so no standard error): no clear difference").format(
+            mean=number(mean, "+.3f")), "unclear"
     se = float(np.std(diff, ddof=1) / math.sqrt(n))
     better = mean < 0 if objective.better == "low" else mean > 0
-    verdict = ("better" if better else "worse") if abs(mean) > 2 * se else "no clear difference"
-    return f"{mean:+.3f} ± {2 * se:.3f} (two standard errors over {n} paired scenarios): {verdict}"
+    verdict = ("better" if better else "worse") if abs(mean) > 2 * se else "unclear"
+    said = {"better": _("better"), "worse": _("worse"), "unclear": _("no clear difference")}[verdict]
+    return _("{mean} ± {spread} (two standard errors over {n} paired scenarios): {verdict}").format(
+        mean=number(mean, "+.3f"), spread=number(2 * se, ".3f"), n=n, verdict=said), verdict
