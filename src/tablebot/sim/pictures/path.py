@@ -33,17 +33,18 @@ class PathPieces:
         self.travelled = 0.0  # the distance along the path to row ``known``
         self.kept: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]  # the rows a piece keeps inside it, in order
 
-    def grow(self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int,
-             last: bool = False) -> tuple[list[np.ndarray], list[int]]:
+    def grow(
+        self, x: np.ndarray, y: np.ndarray, states: np.ndarray, done: int, last: bool = False
+    ) -> tuple[list[np.ndarray], list[int]]:
         """The pieces complete once robot rows 0..done (``x``, ``y``) and ``states[:done]`` are known (with
         ``last``, the run is over: ``done`` is its length, and the last piece ends there)."""
         if done > self.known:
-            xy = np.column_stack((x[self.known:done + 1], y[self.known:done + 1])).astype(np.float64)
+            xy = np.column_stack((x[self.known : done + 1], y[self.known : done + 1])).astype(np.float64)
             travelled = np.cumsum(np.concatenate(([self.travelled], np.hypot(*np.diff(xy, axis=0).T))))
             bucket = np.floor(travelled / self.step)  # a row is kept where the path enters the next step
             self.kept.append(np.flatnonzero(bucket[1:] != bucket[:-1]) + self.known + 1)
             self.known, self.travelled = done, float(travelled[-1])
-        change = np.flatnonzero(np.diff(states[self.start:done])) + self.start + 1
+        change = np.flatnonzero(np.diff(states[self.start : done])) + self.start + 1
         ends = np.concatenate((change, [done])) if last else change
         if not len(ends):
             return [], []
@@ -52,9 +53,10 @@ class PathPieces:
         kept = np.concatenate(self.kept)
         self.kept = [kept]
         inner_from, inner_to = np.searchsorted(kept, starts, "right"), np.searchsorted(kept, ends, "left")
-        rows = [np.concatenate(([a], kept[i:j], [b]))
-                for a, b, i, j in zip(starts.tolist(), ends.tolist(), inner_from.tolist(), inner_to.tolist(),
-                                      strict=True)]
+        rows = [
+            np.concatenate(([a], kept[i:j], [b]))
+            for a, b, i, j in zip(starts.tolist(), ends.tolist(), inner_from.tolist(), inner_to.tolist(), strict=True)
+        ]
         every = np.concatenate(rows)
         xy = np.column_stack((x[every], y[every])).astype(np.float64)
         pieces = np.split(xy, np.cumsum([len(r) for r in rows[:-1]]))

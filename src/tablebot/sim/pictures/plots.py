@@ -91,8 +91,9 @@ class TrajectoryPicture:
         FigureCanvasAgg(self.fig)
         self.ax = self.fig.add_axes((0.06, 0.08, 0.62, 0.8))
         draw_world(self.ax, world)
-        self.title = self.fig.suptitle(title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.06, ha="left",
-                                       y=0.975)
+        self.title = self.fig.suptitle(
+            title(scene, ticks, seed), fontsize=15, fontweight="bold", x=0.06, ha="left", y=0.975
+        )
         self.colours = state_colours(scene.machine.states)
         self.path = PathPieces()
         self.drawn: list[Any] | None = None  # what is in the canvas already, once render_arena ran
@@ -120,8 +121,14 @@ class TrajectoryPicture:
     def _add_path(self, pieces: list[np.ndarray], piece_states: list[int]) -> LineCollection | None:
         if not pieces:
             return None
-        lines = LineCollection(pieces, colors=[self.colours[s] for s in piece_states], linewidths=2.2,
-                               capstyle="round", joinstyle="round", zorder=PATH_Z)
+        lines = LineCollection(
+            pieces,
+            colors=[self.colours[s] for s in piece_states],
+            linewidths=2.2,
+            capstyle="round",
+            joinstyle="round",
+            zorder=PATH_Z,
+        )
         self.ax.add_collection(lines, autolim=False)  # the arena set the limits
         return lines
 
@@ -133,8 +140,15 @@ class TrajectoryPicture:
         self._add_path(*self.path.grow(x, y, result.states, result.ticks, last=True))
         # spins in place draw no line: a dot where such a state begins shows them
         spins = spin_starts(x, y, result.column(L.TH), result.states)
-        ax.scatter(x[spins], y[spins], s=18, c=[colours[s] for s in result.states[spins].tolist()],
-                   edgecolors="white", linewidths=0.6, zorder=5)
+        ax.scatter(
+            x[spins],
+            y[spins],
+            s=18,
+            c=[colours[s] for s in result.states[spins].tolist()],
+            edgecolors="white",
+            linewidths=0.6,
+            zorder=5,
+        )
         _markers(ax, result, summary)
         _robot_poses(ax, result)
         fig.text(0.06, 0.915, subtitle_of(summary), fontsize=10.5, color="#444")
@@ -185,8 +199,17 @@ def _markers(ax: Axes, result: RunView, summary: Summary) -> None:
     if rows:  # where the body touched the wall or obstacle; one artist for all of them: an hour has hundreds
         poses = np.column_stack((x[rows], y[rows], heading[rows])).astype(np.float64)
         touched = contact_points(scene.geometry, scene.params, poses)
-        ax.plot(touched[:, 0], touched[:, 1], ls="", marker="X", markersize=11, color=COLLISION,
-                markeredgecolor="white", markeredgewidth=1.2, zorder=9)
+        ax.plot(
+            touched[:, 0],
+            touched[:, 1],
+            ls="",
+            marker="X",
+            markersize=11,
+            color=COLLISION,
+            markeredgecolor="white",
+            markeredgewidth=1.2,
+            zorder=9,
+        )
     tick = result.tick_s
     if summary.first_light_s is not None:
         row = round(summary.first_light_s / tick)
@@ -204,24 +227,46 @@ def _robot_poses(ax: Axes, result: RunView) -> None:
     start.update(first[L.X], first[L.Y], first[L.TH], readings=sensor_readings(first, sensors))
     end = RobotArtist(ax, scene.params, n_lamps, sensors=sensors)
     last = result.outputs[-1] if result.ticks else ()
-    end.update(last_row[L.X], last_row[L.Y], last_row[L.TH],
-               bumpers=(last_row[L.BUMP_FR] > 0, last_row[L.BUMP_FL] > 0, last_row[L.BUMP_REAR] > 0),
-               lights=(last_row[L.LIGHT_R] >= 1, last_row[L.LIGHT_L] >= 1),
-               lamps=tuple(int(last[i]) for i in scene.lamp_outputs), readings=sensor_readings(last_row, sensors))
+    end.update(
+        last_row[L.X],
+        last_row[L.Y],
+        last_row[L.TH],
+        bumpers=(last_row[L.BUMP_FR] > 0, last_row[L.BUMP_FL] > 0, last_row[L.BUMP_REAR] > 0),
+        lights=(last_row[L.LIGHT_R] >= 1, last_row[L.LIGHT_L] >= 1),
+        lamps=tuple(int(last[i]) for i in scene.lamp_outputs),
+        readings=sensor_readings(last_row, sensors),
+    )
 
 
 def _legend(fig: Figure, result: RunView, summary: Summary, spins: bool) -> None:
     """The states the run was in (their colours and time), and the marks this picture shows."""
     machine = result.scene.machine
     colours = state_colours(machine.states)
-    handles = [Patch(color=colours[machine.states.index(state)],
-                     label=picture(f"{result.scene.table.state_title(state)}  ({secs:.1f} s)"))
-               for state, secs in summary.state_seconds.items() if secs > 0]
-    states_legend = fig.legend(handles=handles, title=_("path colour = state (time in it)"), loc="upper left",
-                               bbox_to_anchor=(0.70, 0.88), frameon=False, fontsize=9, title_fontsize=10)
+    handles = [
+        Patch(
+            color=colours[machine.states.index(state)],
+            label=picture(f"{result.scene.table.state_title(state)}  ({secs:.1f} s)"),
+        )
+        for state, secs in summary.state_seconds.items()
+        if secs > 0
+    ]
+    states_legend = fig.legend(
+        handles=handles,
+        title=_("path colour = state (time in it)"),
+        loc="upper left",
+        bbox_to_anchor=(0.70, 0.88),
+        frameon=False,
+        fontsize=9,
+        title_fontsize=10,
+    )
     states_legend._legend_box.align = "left"  # type: ignore[attr-defined]  # private: not in matplotlib's stubs
-    fig.legend(handles=legend_marks(result, summary, spins), loc="lower left", bbox_to_anchor=(0.70, 0.08),
-               frameon=False, fontsize=9)
+    fig.legend(
+        handles=legend_marks(result, summary, spins),
+        loc="lower left",
+        bbox_to_anchor=(0.70, 0.08),
+        frameon=False,
+        fontsize=9,
+    )
 
 
 def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
@@ -230,26 +275,86 @@ def legend_marks(result: Run, summary: Summary, spins: bool) -> list:
     world, drawn = result.scene.world, [k.draw for k in declared_kinds(result)]
     marks: list[Line2D | Patch] = []
     if summary.collision_ticks:
-        marks.append(Line2D([], [], marker="X", ls="", color=COLLISION, markeredgecolor="white", markersize=10,
-                            label=_("collision (where it touched)")))
+        marks.append(
+            Line2D(
+                [],
+                [],
+                marker="X",
+                ls="",
+                color=COLLISION,
+                markeredgecolor="white",
+                markersize=10,
+                label=_("collision (where it touched)"),
+            )
+        )
     if world.lamps and summary.first_light_s is not None:
-        marks.append(Line2D([], [], marker="o", ls="", color=LIGHT_SEEN, markeredgecolor=WALL, markersize=10,
-                            label=_("light first seen")))
+        marks.append(
+            Line2D(
+                [],
+                [],
+                marker="o",
+                ls="",
+                color=LIGHT_SEEN,
+                markeredgecolor=WALL,
+                markersize=10,
+                label=_("light first seen"),
+            )
+        )
     if world.lamps and summary.reached_s is not None:
-        marks.append(Line2D([], [], marker="D", ls="", color=REACHED, markeredgecolor=WALL, markersize=9,
-                            label=_("lamp reached (≤ {reach:g} m)").format(reach=world.reach)))
+        marks.append(
+            Line2D(
+                [],
+                [],
+                marker="D",
+                ls="",
+                color=REACHED,
+                markeredgecolor=WALL,
+                markersize=9,
+                label=_("lamp reached (≤ {reach:g} m)").format(reach=world.reach),
+            )
+        )
     if spins:
-        marks.append(Line2D([], [], marker="o", ls="", color="#888", markeredgecolor="white", markersize=6,
-                            label=_("a state begins with a turn on the spot")))
+        marks.append(
+            Line2D(
+                [],
+                [],
+                marker="o",
+                ls="",
+                color="#888",
+                markeredgecolor="white",
+                markersize=6,
+                label=_("a state begins with a turn on the spot"),
+            )
+        )
     if world.lamps:
-        marks += [Line2D([], [], marker="*", ls="", color=LAMP_ON, markeredgecolor="#b8860b", markersize=11,
-                         label=_("lamp, on its base (an obstacle)")),
-                  Line2D([], [], ls="--", color="#b8860b", label=_("lamp visible inside (sensor facing it)"))]
+        marks += [
+            Line2D(
+                [],
+                [],
+                marker="*",
+                ls="",
+                color=LAMP_ON,
+                markeredgecolor="#b8860b",
+                markersize=11,
+                label=_("lamp, on its base (an obstacle)"),
+            ),
+            Line2D([], [], ls="--", color="#b8860b", label=_("lamp visible inside (sensor facing it)")),
+        ]
     if world.lines:
         marks.append(Patch(facecolor=TAPE_FILL, label=_("tape on the floor")))
     if "spot" in drawn:
-        marks.append(Line2D([], [], marker="s", ls="", color=TAPE, markerfacecolor="white", markersize=7,
-                            label=_("floor sensor (dark over tape)")))
+        marks.append(
+            Line2D(
+                [],
+                [],
+                marker="s",
+                ls="",
+                color=TAPE,
+                markerfacecolor="white",
+                markersize=7,
+                label=_("floor sensor (dark over tape)"),
+            )
+        )
     if "beam" in drawn:
         marks.append(Patch(facecolor=BEAM, alpha=0.45, label=_("distance beam, out to the echo")))
     if world.boxes or world.circles:
