@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 
 from tablebot.cli import app
 from tablebot.cli.common import load
-from tablebot.fleet.plan import read_results
 from tablebot.fleet.run import Fleet, RobotSpec
+from tablebot.fleet.store import read_results
 from tablebot.sim.model.scene import robot_layer, scene_for
 from tablebot.testing.dask_cluster import local_cluster
 from test_sim_helpers import BUMBERBOT

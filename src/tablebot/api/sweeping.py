@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import csv
+import gc
 import io
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -19,8 +21,9 @@ if TYPE_CHECKING:
     import numpy as np
 
     from tablebot.fleet.backends import Runner
-    from tablebot.fleet.plan import Plan, Store
+    from tablebot.fleet.plan import Plan
     from tablebot.fleet.run import FleetSummary
+    from tablebot.fleet.store import Store
     from tablebot.fleet.work import Job
     from tablebot.loading import Loaded, PathLike
 
@@ -58,7 +61,7 @@ class Sweep:
     def rows(self, columns: Sequence[str] | None = None) -> list[dict[str, str]]:
         """The result rows as ``results.csv`` has them: text cells by column name (only ``columns``, if given)."""
         if self.read is None and self.text_in_memory is None:
-            from tablebot.fleet.plan import read_results
+            from tablebot.fleet.store import read_results
 
             return read_results(self.files[0], columns)  # only the columns asked for: a third of the time
         rows = self.read if self.read is not None else list(csv.DictReader(io.StringIO(self.csv_text())))
@@ -71,7 +74,7 @@ class Sweep:
     def lines(self) -> list[str]:
         """What the sweep amounts to, a line per grid value (or one for all runs): the lamp reached, or
         collisions and distance driven where no world has a lamp."""
-        from tablebot.fleet.plan import REPORT_COLUMNS, groups
+        from tablebot.fleet.groups import REPORT_COLUMNS, groups
 
         lamps = any(world.lamps for world in self.plan.worlds)
         out: list[str] = []
@@ -118,14 +121,7 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
     shown = progress or Progress()
     chosen, address = choose(backend, scheduler)
     with Runner(chosen, address, workers) as runner:
-        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
-        from tablebot.fleet.plan import make_plan
-
-        if plots and out is not None:  # before the run (an interrupt never lands in matplotlib's import)
-            import tablebot.fleet.plots  # noqa: F401
-        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
-        plan = make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
-                         every_table=True, grid_cells=True)
+        plan = _start(project, runner, grid, seeds, robots, seconds, plots and out is not None)
         traced = trace_runs(trace, plan.spec.total)
         if out is None:
             return _in_memory(plan, runner, chosen, shown)
@@ -133,6 +129,36 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
             store, ran, wall_s = _into(plan, runner, chosen, Path(out), shown)
     with project.writing():
         return _finish(plan, store, traced, plots, wall_s, ran)
+
+
+def _start(project: Loaded, runner: Runner, grid: Sequence[str], seeds: str | None, robots: int | None,
+           seconds: float, pictures: bool) -> Plan:
+    """The fleet's modules imported and the sweep planned, while a cluster's workers start up or this process's
+    compiled code loads on a thread (:meth:`Runner.imported`); the robot's tables as ``project`` read them."""
+    with collection_paused():
+        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
+        from tablebot.fleet.plan import make_plan
+
+        if pictures:  # before the run (an interrupt never lands in matplotlib's import)
+            import tablebot.fleet.plots  # noqa: F401
+        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
+        return make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
+                         every_table=True, grid_cells=True, read=(project.table, project.tables))
+
+
+@contextmanager
+def collection_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector held off meanwhile, then as it was: a sweep's start-up makes hundreds of
+    thousands of objects that live on (numba's, numpy's and tablebot's modules, the plan), and the collector
+    walked them all again and again as they were made -- a tenth of the imports' CPU time -- finding no garbage
+    among them."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 def trace_runs(runs: Traced, total: int) -> list[int]:
@@ -161,7 +187,7 @@ def _compiling(progress: Progress, backend: str, jobs: Sequence[Job]) -> None:
 
 
 def _in_memory(plan: Plan, runner: Runner, backend: str, progress: Progress) -> Sweep:
-    from tablebot.fleet.plan import csv_text
+    from tablebot.fleet.store import csv_text
 
     jobs = plan.jobs()
     parts: dict[int, str] = {}
@@ -183,11 +209,11 @@ def _into(plan: Plan, runner: Runner, backend: str, out: Path, progress: Progres
     """The runs not in ``out`` yet, each finished chunk written there at once: the store, the runs made and
     how long they took. Ctrl-C merges the finished chunks into results.partial.csv and raises Stopped."""
     from tablebot.files import out_folder
-    from tablebot.fleet.plan import Store
+    from tablebot.fleet.store import Store
     from tablebot.interrupts import INTERRUPTS
 
     out_folder(out, "--out")
-    store = Store(out, plan)
+    store = Store(out, plan.spec, plan.columns())
     finished = store.open()
     jobs = plan.jobs(skip=finished)
     total, already = plan.spec.total, sum(b - a for a, b in finished)
@@ -212,7 +238,7 @@ def _into(plan: Plan, runner: Runner, backend: str, out: Path, progress: Progres
 def _finish(plan: Plan, store: Store, traced: list[int], plots: bool, wall_s: float, ran: int) -> Sweep:
     """results.csv merged from the parts, the traced runs and the pictures: all at once."""
     from tablebot.fileset import current, file_set
-    from tablebot.fleet.plan import read_results
+    from tablebot.fleet.store import read_results
 
     out = store.folder
     with file_set(out, remove=["results.partial.csv"]):

@@ -1,27 +1,18 @@
-"""Running a sweep: its runs cut into jobs for a backend, each finished chunk written at once as a part
-file, the parts merged into ``results.csv`` (one row per run, in run order).
-
-An interrupted sweep keeps its parts (and writes ``results.partial.csv``); the same command run again
-finds ``spec.json`` unchanged and runs only the chunks that have no part yet.
+"""Planning a sweep: its options checked into a plan of runs, cut into jobs for a backend, and each finished
+chunk's result rows (one per run). Where they are kept -- the part files, ``results.csv`` -- is
+:mod:`tablebot.fleet.store`; how they are grouped for the report, :mod:`tablebot.fleet.groups`.
 """
 
 from __future__ import annotations
 
-import csv
-import functools
-import io
 import itertools
-import operator
-import re
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from tablebot.diagnostics import Diagnostic, TableBotError, fail, notify
-from tablebot.files import atomic_write, remove, write_text
+from tablebot.diagnostics import TableBotError, fail
+from tablebot.files import write_text
 from tablebot.fleet.cells import grid_variants
 from tablebot.fleet.results import FleetSummary
 from tablebot.fleet.robots import RobotSpec, Variants
@@ -39,13 +30,12 @@ from tablebot.fleet.spec import (
     random_start,
     refuse_cells,
     runs,
-    value_index,
 )
 from tablebot.fleet.starts import with_start
+from tablebot.fleet.store import Store, cell, csv_text, decimals, read_results, times
 from tablebot.fleet.tables import main_table_only, tables_digest
 from tablebot.fleet.work import Job
 from tablebot.formats.table_read import load_table, resolve_table_path
-from tablebot.formats.trace_lines import exact_round
 from tablebot.jit import sources_digest
 from tablebot.machine import FLAT_BITS, Machine, compile_table
 from tablebot.robot import load_robot
@@ -55,7 +45,11 @@ from tablebot.sim.runner import ticks_for
 from tablebot.table import Table
 from tablebot.tables import RobotTables, several
 
-PART_RE = re.compile(r"^runs-(\d{7})-(\d{7})\.csv$")
+__all__ = ["RESULT_COLUMNS", "Plan", "Read", "Store", "csv_text", "make_plan", "read_results"]  # Store, csv_text,
+# read_results: where tune and evolve have always found them
+
+#: A robot's table and, for a robot of several, all its tables (tablebot.tables.several), as a caller read them.
+Read = tuple[Table, RobotTables | None]
 RESULT_COLUMNS = ("seconds", "first_light_s", "reached", "reached_s", "collisions", "distance_m",
                   "battery_start_v", "battery_end_v", "final_state")
 
@@ -70,14 +64,17 @@ class Plan:
     worlds: list[World]
     robot_params: dict[str, Any]
     tables: RobotTables | None = None  # a robot of several tables run whole (``table`` is its main one)
+    first: InitVar[Scene | None] = None  # the first world's scene, prepared already (make_plan's)
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, first: Scene | None) -> None:
         self.cell_axes = [k for k, axis in enumerate(self.spec.axes) if is_cell(axis.key)]
         self.variants: Variants | None  # the grid's table cells' program variants (fleet.cells.grid_variants)
         self.variants, self.variant_of = grid_variants([self.spec.axes[k] for k in self.cell_axes], self.table,
                                                        self.tables, self.machine)
-        self.scenes: list[Scene] = [prepare(self.table, self.machine, w, self.robot_params, tables=self.tables)
-                                    for w in self.worlds]
+        self.scenes: list[Scene] = [
+            first if k == 0 and first is not None else prepare(self.table, self.machine, w, self.robot_params,
+                                                               tables=self.tables)
+            for k, w in enumerate(self.worlds)]
         self.bodies: list[list[Scene]] = self._check_params()
         self._check_starts()
 
@@ -213,60 +210,32 @@ class Plan:
                for j, axis in enumerate(spec.axes) if axis.key != "start"}}
         state_cells = [cell(state) for state in states]
         cells.update(seconds=[cell(round(summary.ticks * tick_s, 6))] * (b - a),
-                     first_light_s=_times(summary.first_light, tick_s),
+                     first_light_s=times(summary.first_light, tick_s),
                      reached=["0" if tick < 0 else "1" for tick in summary.reached.tolist()],
-                     reached_s=_times(summary.reached, tick_s), collisions=list(map(str, summary.collisions.tolist())),
-                     distance_m=_decimals(summary.distance_m), battery_start_v=_decimals(summary.battery_start_v),
-                     battery_end_v=_decimals(summary.battery_end_v),
+                     reached_s=times(summary.reached, tick_s), collisions=list(map(str, summary.collisions.tolist())),
+                     distance_m=decimals(summary.distance_m), battery_start_v=decimals(summary.battery_start_v),
+                     battery_end_v=decimals(summary.battery_end_v),
                      final_state=[state_cells[k] for k in summary.final_state.tolist()])
-        cells.update((f"time_{state}_s", _decimals(summary.counts[:, k] * tick_s)) for k, state in enumerate(states))
+        cells.update((f"time_{state}_s", decimals(summary.counts[:, k] * tick_s)) for k, state in enumerate(states))
         columns = self.columns()
         lines = map(",".join, zip(*(cells[column] for column in columns), strict=True))
         return csv_text(columns, []) + "".join(line + "\n" for line in lines)
 
 
-def _times(ticks: np.ndarray, tick_s: float) -> list[str]:
-    """Ticks as seconds, 6 decimals; blank for never (-1)."""
-    rounded = exact_round(ticks * tick_s, 6)
-    return ["" if tick < 0 else repr(value) for tick, value in zip(ticks.tolist(), rounded, strict=True)]
-
-
-def _decimals(values: np.ndarray) -> list[str]:
-    """Numbers rounded to 6 decimals as Python's ``round`` does, written as Python writes floats."""
-    return list(map(repr, exact_round(values, 6)))
-
-
-@functools.lru_cache(maxsize=4096)
-def _text_cell(text: str) -> str:
-    buffer = io.StringIO()
-    csv.writer(buffer, lineterminator="\n").writerow([text, ""])
-    return buffer.getvalue()[: -len(",\n")]
-
-
-def cell(value: Any) -> str:
-    """One value as ``csv.writer`` writes it in a row of several: blank for None, text quoted where it
-    must be, anything else as ``str``."""
-    if value is None:
-        return ""
-    return _text_cell(value) if isinstance(value, str) else str(value)
-
-
 def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Sequence[str], seeds: str | None,
-              robots: int | None, seconds: float, every_table: bool = False, grid_cells: bool = False) -> Plan:
+              robots: int | None, seconds: float, every_table: bool = False, grid_cells: bool = False,
+              read: Read | None = None) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
     as a plan of runs; every mistake is a located error before anything is written. ``every_table``: a robot of
     several tables runs all of them (``sweep``, ``tune``, ``grade``, ``evolve``), else its main table alone.
-    ``grid_cells``: ``--grid`` may set table cells (``sweep``: ``--grid "lights: line 4 timer=20,50"``)."""
+    ``grid_cells``: ``--grid`` may set table cells (``sweep``: ``--grid "lights: line 4 timer=20,50"``).
+    ``read``: the robot's tables as the caller read them from ``table`` and ``robot`` (with ``every_table``),
+    not read again."""
     axes = parse_grid(list(grid))
     if not grid_cells:  # sweep's alone: tune has --cells
         refuse_cells(axes)
     seed_list = parse_seeds(seeds, robots)
-    robot_file_given = load_robot(robot) if robot else None  # read first, as every command reads them
-    parsed = load_table(resolve_table_path(table), robot_file_given)
-    tables = several(parsed) if every_table else None
-    if tables is None:
-        main_table_only(parsed.robot)
-    parsed = tables.table if tables is not None else parsed
+    parsed, tables = read if read is not None and every_table else _read(table, robot, every_table)
     machine = tables.machines[0] if tables is not None else compile_table(parsed)
     if machine.arrays is None:
         raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
@@ -274,14 +243,25 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
     layer, robot_world = robot_layer(parsed.robot)
     loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
     paths = [str(w) for w in worlds] or [loaded[0].path]
-    ticks = ticks_for(prepare(parsed, machine, loaded[0], layer, tables=tables), seconds)
+    first = prepare(parsed, machine, loaded[0], layer, tables=tables)
+    ticks = ticks_for(first, seconds)
     files = [Path(p) if Path(p).is_file() else None for p in paths]
     robot_file = Path(parsed.robot.source)
     spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=tables_digest(parsed, tables),
                      worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
                      seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
                      code=sources_digest())
-    return Plan(spec, parsed, machine, loaded, layer, tables)
+    return Plan(spec, parsed, machine, loaded, layer, tables, first)
+
+
+def _read(table: Path, robot: Path | None, every_table: bool) -> Read:
+    """The table (the robot file first, as every command reads them) and, with ``every_table``, all the robot's
+    tables; without, a robot of several tables is told that its main table runs alone."""
+    parsed = load_table(resolve_table_path(table), load_robot(robot) if robot else None)
+    tables = several(parsed) if every_table else None
+    if tables is None:
+        main_table_only(parsed.robot)
+    return (tables.table if tables is not None else parsed), tables
 
 
 def _body(scene: Scene) -> tuple:
@@ -289,120 +269,3 @@ def _body(scene: Scene) -> tuple:
     return tuple(sorted(scene.params["body"].items()))
 
 
-# --- the output folder ------------------------------------------------------------------------------
-
-
-class Store:
-    """``DIR/spec.json``, ``DIR/parts/runs-A-B.csv`` per finished chunk, ``DIR/results.csv`` at the end."""
-
-    def __init__(self, folder: Path, plan: Plan) -> None:
-        self.folder, self.plan = folder, plan
-        self.parts = folder / "parts"
-
-    def open(self) -> set[tuple[int, int]]:
-        """Check the folder holds this spec's sweep (or none) and return the chunks already finished."""
-        spec_file = self.folder / "spec.json"
-        text = self.plan.spec.to_json()
-        if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
-            raise fail(self.folder, "--out holds the results of a different sweep (another table, robot file, "
-                       "world, grid, seeds, length or simulator version)",
-                       "give --out a new folder, or delete this one to start over")
-        self.parts.mkdir(parents=True, exist_ok=True)
-        if not spec_file.exists():
-            write_text(spec_file, text)
-        wanted = set(chunks(self.plan.spec))
-        found = {(int(m[1]), int(m[2])) for p in self.parts.iterdir() if (m := PART_RE.match(p.name))}
-        return {chunk for chunk in found & wanted if self._whole(*chunk)}
-
-    def _whole(self, a: int, b: int) -> bool:
-        """Whether the part of runs a..b-1 holds what this sweep writes there: its header, then one whole row
-        per run, in order. A part is written whole or not at all, so only a damaged or edited one fails:
-        it is said, and its runs are made again (the same rows: a part is deterministic) over it."""
-        part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
-        columns = list(self.plan.columns())
-        with open(part, encoding="utf-8", errors="replace", newline="") as f:
-            text = f.read()
-        rows = list(csv.reader(io.StringIO(text)))  # cells may hold quoted commas (a world's path)
-        if text.endswith("\n") and rows[:1] == [columns] and [row[0] for row in rows[1:] if row] == \
-                [str(run) for run in range(a, b)] and all(len(row) == len(columns) for row in rows[1:]):
-            return True
-        notify(Diagnostic(str(part), None, None, "this part of the sweep is damaged (not the rows this sweep "
-                          f"writes for runs {a}..{b - 1}): its runs are made again", severity="note"))
-        return False
-
-    def write_part(self, job: Job, text: str) -> Path:
-        """A finished chunk's rows (:meth:`Plan.part_text`) as its part file."""
-        return write_text(self.parts / f"runs-{job.first:07d}-{job.info['stop']:07d}.csv", text)
-
-    def merge(self, complete: bool) -> tuple[Path, int]:
-        """All finished parts in run order as ``results.csv`` (or ``results.partial.csv`` when not complete),
-        streamed part by part (a sweep of millions of runs is never held in memory whole)."""
-        count = 0
-        path = self.folder / ("results.csv" if complete else "results.partial.csv")
-        with atomic_write(path) as out:
-            out.write(csv_text(self.plan.columns(), []))
-            for a, b in chunks(self.plan.spec):
-                part = self.parts / f"runs-{a:07d}-{b:07d}.csv"
-                if part.exists():
-                    with open(part, encoding="utf-8") as f:
-                        next(f)  # its header
-                        for line in f:
-                            out.write(line)
-                            count += 1
-        if complete:
-            remove(self.folder / "results.partial.csv")  # with the new results, when they are in a set
-        return path, count
-
-
-def csv_text(columns: Sequence[str], rows: Sequence[dict[str, Any]]) -> str:
-    """Rows as CSV text: floats as Python writes them (exact), blank for "never" (None) and for a column a
-    row lacks; what csv.DictWriter writes, without its check of every row's keys."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(columns)
-    writer.writerows([row.get(column) for column in columns] for row in rows)
-    return buffer.getvalue()
-
-
-REPORT_COLUMNS = ("run", "reached", "collisions", "distance_m")  # what the summary of a sweep reads
-
-
-def read_results(path: Path, columns: Sequence[str] | None = None) -> list[dict[str, str]]:
-    """The rows of a results file, each with every column, or only ``columns`` (a third of the time)."""
-    with open(path, encoding="utf-8", newline="") as f:
-        if columns is None:
-            return list(csv.DictReader(f))
-        reader = csv.reader(f)
-        header = next(reader)
-        places = [header.index(column) for column in columns]
-        cells = operator.itemgetter(*places, *places[:1])  # two at least: a tuple, the last one dropped by zip
-        return [dict(zip(columns, cells(row), strict=False)) for row in reader]
-
-
-# How a sweep's results are grouped, for its report and its pictures (here, not in the picture module, so that
-# a sweep without pictures never loads matplotlib).
-def groups(plan: Plan, rows: Sequence[dict[str, Any]]) -> list[tuple[str, list[tuple[str, list[dict[str, Any]]]]]]:
-    """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
-    out = []
-    if len(plan.spec.worlds) > 1:
-        by_world: list[list[dict[str, Any]]] = [[] for _ in plan.worlds]
-        for r in rows:
-            by_world[int(r["run"]) // plan.spec.runs_per_world].append(r)
-        out.append(("world", list(zip(world_labels(plan), by_world, strict=True))))
-    for k, axis in enumerate(plan.spec.axes):
-        if len(axis.values) < 2:
-            continue
-        # by the run's value (a random start has no other mark)
-        chosen: list[list[dict[str, Any]]] = [[] for _ in axis.values]
-        for r in rows:
-            chosen[value_index(plan.spec, int(r["run"]), k)].append(r)
-        labels = [":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
-                  for value in axis.values]
-        out.append((axis.key, list(zip(labels, chosen, strict=True))))
-    return out or [("all runs", [("all", list(rows))])]
-
-
-def world_labels(plan: Plan) -> list[str]:
-    """Each world's name, numbered where two share one (two files both called arena.toml, say)."""
-    names = [world.name for world in plan.worlds]
-    return [f"{name} ({k + 1})" if names.count(name) > 1 else name for k, name in enumerate(names)]

@@ -17,7 +17,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from tablebot.escape import picture
-from tablebot.fleet.plan import Plan, groups
+from tablebot.fleet.groups import groups
+from tablebot.fleet.plan import Plan
 from tablebot.i18n import _
 from tablebot.sim.pictures.draw import REACHED, draw_world, literal_text
 from tablebot.sim.pictures.plots import save, trajectory

@@ -30,6 +30,7 @@ from tablebot.sim.model.world import inside
 START_STREAM = 0x5747  # random starts come from Generator([seed, START_STREAM]): apart from the robot's noise
 MAX_RUNS = 10_000_000
 START_COLUMNS = ("start_x", "start_y", "start_heading")  # a run's start pose in its result row
+SEEDS_MARK = "\0seeds\0"  # spec.json's seeds while the rest is written (no key or path holds a NUL)
 RANGE_RE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
 
 
@@ -59,10 +60,13 @@ class SweepSpec:
 
     def to_json(self) -> str:
         """``spec.json``'s text: :func:`dataclasses.asdict`'s, without its deep copy of every seed (a tenth of
-        a 10,000-robot sweep's planning)."""
-        data = {f.name: getattr(self, f.name) for f in fields(self)}
+        a 10,000-robot sweep's planning), and its seeds written as ``json.dumps(indent=1)`` writes a list of
+        whole numbers, one a line, in one join: json's indenting encoder is pure Python, a call per seed."""
+        data: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)}
         data["axes"] = [asdict(axis) for axis in self.axes]
-        return json.dumps(data, indent=1, sort_keys=True) + "\n"
+        data["seeds"] = SEEDS_MARK
+        seeds = "[\n  " + ",\n  ".join(map(str, self.seeds)) + "\n ]" if self.seeds else "[]"
+        return json.dumps(data, indent=1, sort_keys=True).replace(json.dumps(SEEDS_MARK), seeds, 1) + "\n"
 
     @property
     def runs_per_world(self) -> int:

@@ -8,7 +8,6 @@ choose its numba cache folder (:func:`ready_worker`) before the first compiled m
 from __future__ import annotations
 
 import os
-import socket
 import sys
 import threading
 from collections import OrderedDict
@@ -200,6 +199,7 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
     numba's compiler is not readied: cached code loads without it (tablebot.jit), and readying it cost a
     fresh worker ~0.5 s of CPU (its typing and lowering rules, and scipy.linalg), taken from the chunks on a
     machine whose cores the workers share."""
+    import socket
     import time
 
     global _worker_threads
