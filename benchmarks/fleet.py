@@ -44,7 +44,6 @@ import argparse
 import contextlib
 import hashlib
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -52,176 +51,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from fleet_phases import measure as phases  # benchmarks/fleet_phases.py
-from tablebot.testing.dask_cluster import local_cluster
-from tablebot.testing.processes import child_env
+from fleet_dask import dask_figures
+from fleet_sweep import EXAMPLE, sweep_args, sweep_ratios, tablebot, verdict
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLE = ROOT / "examples" / "bumberbot"
 SWEEP_ROBOTS, SWEEP_SECONDS = 10_000, 10.0
-TARGET_SWEEP = 3.5e6  # robot-ticks/s, whole process, 2 cores
 TARGET_FRESH = 0.8  # a fresh Dask cluster's speed as a share of the local run's
 TARGET_HOUR_S = 2.0  # sim --seconds 3600 with pictures
-TARGET_PROCESS_RATIO = 0.6  # the whole sweep process's speed as a share of its kernel's (issue 35)
-TARGET_API_RATIO = 0.85  # tablebot.open(...).sweep(...) from Python, as a share of the kernel's speed
-
-
-KERNEL_CPU_S: list[float] = []  # CPU seconds (every thread) of each kernel_rate run
-CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() process: steadier than wall on a busy machine
-
-
-def tablebot(*args: str) -> float:
-    """Wall seconds of ``python -m tablebot ARGS`` as a fresh process (it must succeed); its CPU seconds go
-    to ``CPU_S``."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=child_env(),
-                          capture_output=True, text=True)
-    elapsed = time.perf_counter() - started
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    CPU_S.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
-    if done.returncode:
-        raise SystemExit(f"tablebot {' '.join(args)} failed:\n{done.stderr}")
-    return elapsed
-
-
-def sweep_args(robots: int, seconds: float, out: str) -> list[str]:
-    return ["sweep", str(EXAMPLE), "--robots", str(robots), "--seconds", f"{seconds:g}", "--no-plots", "--quiet",
-            "--out", out]
-
-
-def sweep_process(robots: int, seconds: float, *extra: str) -> float:
-    with tempfile.TemporaryDirectory() as out:
-        return tablebot(*sweep_args(robots, seconds, out + "/sweep"), *extra)
-
-
-def kernel_rate(robots: int, ticks: int) -> float:
-    """Robot-ticks/s of ``robots`` BumberBots as one warm in-process fleet (numba's threads over all cores)."""
-    from tablebot.cli.common import load
-    from tablebot.fleet.run import Fleet, RobotSpec
-    from tablebot.sim.model.scene import robot_layer, scene_for
-
-    table, machine = load(EXAMPLE)
-    world = scene_for(table, machine).world
-    fleet = Fleet(table, machine, world, [RobotSpec(seed=s) for s in range(robots)], robot_layer(table.robot)[0])
-    started, cpu = time.perf_counter(), time.process_time()
-    fleet.run(ticks)
-    KERNEL_CPU_S.append(time.process_time() - cpu)
-    return robots * ticks / (time.perf_counter() - started)
-
-
-def api_rate(robots: int, seconds: float) -> float:
-    """Robot-ticks/s of ``tablebot.open(EXAMPLE).sweep(...)`` in this process, results in memory, no pictures."""
-    import tablebot
-
-    robot = tablebot.open(EXAMPLE)
-    started = time.perf_counter()
-    sweep = robot.sweep(robots=robots, seconds=seconds, plots=False)
-    elapsed = time.perf_counter() - started
-    assert len(sweep.results) == robots
-    return robots * round(seconds / 0.010) / elapsed
-
-
-def sweep_ratios(robots: int, seconds: float, repeat: int) -> int:
-    """The sweep as a whole process and from Python, each beside the kernel measured alternately with it,
-    and the process's time by phase; returns the targets missed."""
-    med = statistics.median
-    ticks = round(seconds / 0.010)
-    work = robots * ticks
-    CPU_S.clear()
-    KERNEL_CPU_S.clear()
-    walls, kernels, apis, api_kernels, parts = [], [], [], [], []
-    api_rate(64, 1.0)  # the compiled code loaded in this process (not counted)
-    for _ in range(repeat):
-        walls.append(sweep_process(robots, seconds))
-        kernels.append(kernel_rate(robots, ticks))
-        apis.append(api_rate(robots, seconds))
-        api_kernels.append(kernel_rate(robots, ticks))
-        with tempfile.TemporaryDirectory() as out:
-            parts.append(phases(sweep_args(robots, seconds, out + "/sweep")))
-    rate, inner = work / med(walls), med(kernels)
-    missed = 0
-    ok = rate >= TARGET_SWEEP
-    missed += not ok
-    print(f"sweep --robots {robots:,} --seconds {seconds:g}, whole process: {med(walls):.2f} s = {rate / 1e6:.2f} M "
-          f"robot-ticks/s ({' '.join(f'{w:.2f}' for w in walls)} s; {med(CPU_S):.2f} s CPU)  "
-          f"target >= {TARGET_SWEEP / 1e6:g} M  {verdict(ok)}")
-    ratio = med(work / w / k for w, k in zip(walls, kernels, strict=True))
-    ok = ratio >= TARGET_PROCESS_RATIO
-    missed += not ok
-    print(f"  the kernel alone (in-process fleet, warm): {inner / 1e6:.2f} M robot-ticks/s; the process runs at "
-          f"{ratio:.2f}x the kernel's speed (median of the repeats' ratios)  target >= {TARGET_PROCESS_RATIO}x  "
-          f"{verdict(ok)}")
-    print("  where a sweep process's time goes (medians, s): " + ", ".join(
-        f"{name} {med(p[name] for p in parts):.3f}" for name in parts[0] if not name.startswith("cpu: ")))
-    kernel_cpu = med(KERNEL_CPU_S)
-    print("  its CPU seconds, every thread (medians): " + ", ".join(
-        f"{name[5:]} {med(p[name] for p in parts):.3f}" for name in parts[0] if name.startswith("cpu: "))
-        + f"; the kernel alone for the same robots {kernel_cpu:.3f} s CPU: the process spends "
-          f"{med(p['cpu: in this interpreter'] for p in parts) - kernel_cpu:.3f} s CPU outside it")
-    api = med(a / k for a, k in zip(apis, api_kernels, strict=True))
-    ok = api >= TARGET_API_RATIO
-    missed += not ok
-    print(f"from Python, tablebot.open(...).sweep(robots={robots:,}, seconds={seconds:g}, plots=False): "
-          f"{med(apis) / 1e6:.2f} M robot-ticks/s against the kernel's {med(api_kernels) / 1e6:.2f} M: {api:.2f}x  "
-          f"target >= {TARGET_API_RATIO}x  {verdict(ok)}")
-    return missed
-
-
-# --- Dask: a cluster of fresh worker processes --------------------------------------------------------------
-
-
-class FreshCluster:
-    """A Dask scheduler and 2 single-threaded workers on loopback, the workers with an empty cache folder
-    (as on machines that never ran tablebot); with ``preload``, started with tablebot's preload
-    (``--preload tablebot.fleet.worker``: numba imported as the worker starts, no compiled code)."""
-
-    def __init__(self, preload: bool = False) -> None:
-        self.preload = preload
-
-    def __enter__(self) -> str:
-        self.stack = contextlib.ExitStack()
-        home = self.stack.enter_context(tempfile.TemporaryDirectory())
-        options = ["--preload", "tablebot.fleet.worker"] if self.preload else []
-        cluster = self.stack.enter_context(local_cluster(
-            [options, options], child_env(), child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=home)))
-        self.procs = cluster.procs
-        return cluster.address
-
-    def cpu(self) -> float:
-        """CPU seconds (user + system) so far of the scheduler and the workers (their nannies' children too)."""
-        import psutil
-
-        total = 0.0
-        for proc in self.procs:
-            with contextlib.suppress(psutil.Error):
-                parent = psutil.Process(proc.pid)
-                total += sum(sum(p.cpu_times()[:2]) for p in [parent, *parent.children(recursive=True)])
-        return total
-
-    def __exit__(self, *exc: object) -> None:
-        self.stack.close()
-
-
-def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False) -> tuple[
-        list[float], list[float], list[float], dict[str, list[float]]]:
-    """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat, its
-    workers started with tablebot's preload or not); and the CPU seconds of each (for Dask: the client's and
-    the cluster's processes' together)."""
-    local: list[float] = []
-    fresh: list[float] = []
-    warm: list[float] = []
-    cpu: dict[str, list[float]] = {"local": [], "fresh": [], "warm": []}
-    for _ in range(repeat):
-        local.append(sweep_process(robots, seconds))
-        cpu["local"].append(CPU_S[-1])
-        cluster = FreshCluster(preload)
-        with cluster as address:
-            for walls, name in ((fresh, "fresh"), (warm, "warm")):
-                before = cluster.cpu()
-                walls.append(sweep_process(robots, seconds, "--scheduler", address))
-                cpu[name].append(CPU_S[-1] + cluster.cpu() - before)
-    return local, fresh, warm, cpu
 
 
 # --- one robot ---------------------------------------------------------------------------------------------
@@ -304,10 +140,6 @@ def evolve_rates(budget: int, seconds: float) -> dict[str, float]:
     return whole(budget, seconds)
 
 
-def verdict(ok: bool) -> str:
-    return "ok" if ok else "MISSED"
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -316,6 +148,10 @@ def main() -> int:
     parser.add_argument("--no-evolve", action="store_true")
     parser.add_argument("--no-memory", action="store_true")
     parser.add_argument("--sweep-only", action="store_true", help="only the sweep's figures (process, Python, kernel)")
+    parser.add_argument("--baseline", metavar="REV", help="the sweep's figures for git revision REV too, the rounds "
+                        "alternating (its src/ exported into the temporary folder)")
+    parser.add_argument("--code", metavar="REV", help="the sweep's figures for git revision REV instead of the "
+                        "working tree (one others are editing meanwhile)")
     args = parser.parse_args()
     robots, seconds = (1_000, 2.0) if args.quick else (SWEEP_ROBOTS, SWEEP_SECONDS)
     hour = 60.0 if args.quick else 3600.0
@@ -323,30 +159,13 @@ def main() -> int:
     missed = 0
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); "
           f"medians of {args.repeat}")
-    sweep_process(64, 1.0)  # the compiled code into this machine's cache (not counted)
-    kernel_rate(4, 10)
-
-    missed += sweep_ratios(robots, seconds, args.repeat)
+    missed += sweep_ratios(robots, seconds, args.repeat, args.code, args.baseline)
     if args.sweep_only:
         print(f"load average {os.getloadavg()[0]:.2f} at the end")
         return 1 if missed else 0
 
     if not args.no_dask:
-        local, fresh, warm, cpus = dask_ratios(robots, seconds, args.repeat)
-        f_ratio = med(a / b for a, b in zip(local, fresh, strict=True))
-        w_ratio = med(a / b for a, b in zip(local, warm, strict=True))
-        ok = f_ratio >= TARGET_FRESH
-        missed += not ok
-        print(f"Dask, 2 single-threaded workers: local {med(local):.2f} s, fresh cluster {med(fresh):.2f} s, "
-              f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpus['local']):.2f}, fresh "
-              f"{med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}, the cluster's processes included)")
-        print(f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
-              f"{w_ratio:.2f}x")
-        local, fresh, warm, cpus = dask_ratios(robots, seconds, args.repeat, preload=True)
-        print(f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
-              f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
-              f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
-              f"{med(cpus['local']):.2f}, fresh {med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}")
+        missed += dask_figures(robots, seconds, args.repeat)
 
     with_pics = [sim_hour(hour, True) for _ in range(args.repeat)]
     without = [sim_hour(hour, False) for _ in range(args.repeat)]

@@ -25,13 +25,14 @@ CPU_STARTED = time.process_time()  # every thread's CPU seconds: on a busy machi
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def measure(args: list[str]) -> dict[str, float]:
-    """``tablebot ARGS`` (a sweep) by phase, run as this script in a fresh process, the interpreter's own start
-    and exit included (the caller's wall time less the script's)."""
+def measure(args: list[str], env: dict[str, str] | None = None) -> dict[str, float]:
+    """``tablebot ARGS`` (a sweep) by phase, run as this script in a fresh process (with ``env``: that
+    environment, e.g. another tree's PYTHONPATH), the interpreter's own start and exit included (the caller's
+    wall time less the script's)."""
     from tablebot.testing.processes import child_env  # not at the top: the script's own run imports tablebot timed
 
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, __file__, *args], cwd=ROOT, env=child_env(), capture_output=True,
+    done = subprocess.run([sys.executable, __file__, *args], cwd=ROOT, env=env or child_env(), capture_output=True,
                           text=True)
     wall = time.perf_counter() - started
     if done.returncode:
@@ -74,7 +75,7 @@ def main() -> None:
     timed(backends.Runner, "run", "run")
     timed(sweeping, "_finish", "finish")
     timed(plan.Plan, "part_text", into="part_text")
-    timed(plan.Store, "write_part", into="write_part")
+    timed(store_module().Store, "write_part", into="write_part")
     sys.argv = ["tablebot", *sys.argv[1:]]
     try:
         cli()
@@ -95,6 +96,16 @@ def main() -> None:
                       "cpu: chunks": cpu_of("run"), "cpu: merging": cpu_of("finish"),
                       "cpu: after planning, besides": cpu_end - cpu["plan start"] - cpu_of("plan") - cpu_of("run")
                       - cpu_of("finish"), "cpu: in this interpreter": cpu_end}))
+
+def store_module() -> Any:
+    """Where the sweep's output folder is kept: tablebot.fleet.store, or in trees before it, fleet.plan."""
+    import importlib
+
+    try:
+        return importlib.import_module("tablebot.fleet.store")
+    except ImportError:
+        return importlib.import_module("tablebot.fleet.plan")
+
 
 if __name__ == "__main__":
     main()
