@@ -41,8 +41,21 @@ if TYPE_CHECKING:  # read when a robot file is: only what the section needs is i
 
 #: The reader's own names, and the types of :mod:`tablebot.hw.terminals` that every controller's wiring reaches
 #: through this module.
-__all__ = ["DIGITAL", "Analog", "Digital", "InputWire", "OutputWire", "Section", "Terminals", "Wiring", "input_event",
-           "level_duty", "read_section", "suggest", "wiring_for"]
+__all__ = [
+    "DIGITAL",
+    "Analog",
+    "Digital",
+    "InputWire",
+    "OutputWire",
+    "Section",
+    "Terminals",
+    "Wiring",
+    "input_event",
+    "level_duty",
+    "read_section",
+    "suggest",
+    "wiring_for",
+]
 
 
 def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Section:
@@ -50,9 +63,12 @@ def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Se
     lines; an entry with a mistake is left out."""
     found = Section({}, {}, {})
     if not isinstance(section, dict):
-        error(src, src.line("", None, spec.section),
-               N_("[{section}] must be a table of NAME = terminal", section=spec.section),
-               N_("for example: {example}", example='M1 = "M1"'))
+        error(
+            src,
+            src.line("", None, spec.section),
+            N_("[{section}] must be a table of NAME = terminal", section=spec.section),
+            N_("for example: {example}", example='M1 = "M1"'),
+        )
         return found
     reader = EntryReader(spec, robot, src, section)
     for name in section:
@@ -65,9 +81,16 @@ def read_section(spec: Terminals, src: Source, section: Any, robot: Robot) -> Se
         elif name in robot.counter_names:
             wired, into = reader.terminal(name, "counter", section[name]), found.counters
         else:
-            reader.error(name, N_("[{section}] wires {name!r}, which robot {robot} does not have",
-                                  section=spec.section, name=name, robot=robot.name),
-                         N_("wire the robot's inputs, motors, lamps and counters (names from the robot file)"))
+            reader.error(
+                name,
+                N_(
+                    "[{section}] wires {name!r}, which robot {robot} does not have",
+                    section=spec.section,
+                    name=name,
+                    robot=robot.name,
+                ),
+                N_("wire the robot's inputs, motors, lamps and counters (names from the robot file)"),
+            )
             continue
         if wired is not None:
             into[name] = wired
@@ -81,9 +104,17 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
     src = robot.file_source()
     section = robot.sections.get(spec.section)
     if section is None:
-        error(src, None, N_("robot {robot} has no [{section}] section: tablebot does not know how it is wired to "
-                             "the {controller}", robot=robot.name, section=spec.section, controller=spec.controller),
-               N_("add one to the robot file, for example:\n{section}", section=suggest(spec, robot, machine)))
+        error(
+            src,
+            None,
+            N_(
+                "robot {robot} has no [{section}] section: tablebot does not know how it is wired to the {controller}",
+                robot=robot.name,
+                section=spec.section,
+                controller=spec.controller,
+            ),
+            N_("add one to the robot file, for example:\n{section}", section=suggest(spec, robot, machine)),
+        )
         for name in robot.counter_names if not spec.counters else ():
             _unwired(spec, src, robot, "counter", name)
         src.raise_if_any()
@@ -91,36 +122,63 @@ def wiring_for(spec: Terminals, machine: Machine) -> Wiring:
         section = read_section(spec, src, section, robot)
         src.raise_if_any()
     wired = {**section.inputs, **section.outputs, **section.counters}
-    for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
-                        ("counter", robot.counter_names)):
+    for kind, names in (
+        ("input", machine.input_bits),
+        ("motor", robot.motors),
+        ("lamp", robot.lamps),
+        ("counter", robot.counter_names),
+    ):
         for name in names:
             if name not in wired:
                 _unwired(spec, src, robot, kind, name)
     if robot.tick_ms < spec.min_tick_ms:
-        error(src, robot.line("", "tick_ms"),
-               N_("tick_ms = {tick} is shorter than the {controller} can keep ({reason})", tick=robot.tick_ms,
-                  controller=spec.controller, reason=spec.tick_reason),
-               N_("use tick_ms = {least} or more to run on it", least=spec.min_tick_ms))
+        error(
+            src,
+            robot.line("", "tick_ms"),
+            N_(
+                "tick_ms = {tick} is shorter than the {controller} can keep ({reason})",
+                tick=robot.tick_ms,
+                controller=spec.controller,
+                reason=spec.tick_reason,
+            ),
+            N_("use tick_ms = {least} or more to run on it", least=spec.min_tick_ms),
+        )
     src.raise_if_any()
     inputs = tuple(section.inputs[name] for name in machine.input_bits)
-    return Wiring(inputs, tuple(machine.input_bits[w.name] for w in inputs),
-                  tuple(section.outputs[name] for name in machine.output_names),
-                  tuple(section.counters[name] for name in robot.counter_names))
+    return Wiring(
+        inputs,
+        tuple(machine.input_bits[w.name] for w in inputs),
+        tuple(section.outputs[name] for name in machine.output_names),
+        tuple(section.counters[name] for name in robot.counter_names),
+    )
 
 
 def _unwired(spec: Terminals, src: Source, robot: Robot, kind: str, name: str) -> None:
     if kind == "counter" and not spec.counters:
-        error(src, robot.line("counters", name) or src.line(spec.section),
-               N_("counter {name}: the {controller} has no counter inputs", name=name, controller=spec.controller),
-               N_("run this table on a controller with counters (ROBO TX, TXT)"))
+        error(
+            src,
+            robot.line("counters", name) or src.line(spec.section),
+            N_("counter {name}: the {controller} has no counter inputs", name=name, controller=spec.controller),
+            N_("run this table on a controller with counters (ROBO TX, TXT)"),
+        )
         return
     first = spec.names(kind)[0]
-    example = (f'{name} = {{ terminal = "{first}", mode = "switch", pressed = 1 }}' if kind == "input"
-               else f'{name} = "{first}"')
-    error(src, robot.line(f"{kind}s", name) or src.line(spec.section),
-           N_("{kind} {name} is used by the table but not wired to the {controller}", kind=KINDS[kind], name=name,
-              controller=spec.controller),
-           N_("add it to [{section}], for example: {example}", section=spec.section, example=example))
+    example = (
+        f'{name} = {{ terminal = "{first}", mode = "switch", pressed = 1 }}'
+        if kind == "input"
+        else f'{name} = "{first}"'
+    )
+    error(
+        src,
+        robot.line(f"{kind}s", name) or src.line(spec.section),
+        N_(
+            "{kind} {name} is used by the table but not wired to the {controller}",
+            kind=KINDS[kind],
+            name=name,
+            controller=spec.controller,
+        ),
+        N_("add it to [{section}], for example: {example}", section=spec.section, example=example),
+    )
 
 
 def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
@@ -128,14 +186,21 @@ def suggest(spec: Terminals, robot: Robot, machine: Machine) -> str:
     lines = [f"[{spec.section}]"]
     free = {kind: list(spec.names(kind)) for kind in ("input", "motor", "lamp", "counter")}
     free["input"] = list(spec.digital_inputs)
-    for kind, names in (("input", machine.input_bits), ("motor", robot.motors), ("lamp", robot.lamps),
-                        ("counter", robot.counter_names if spec.counters else ())):
+    for kind, names in (
+        ("input", machine.input_bits),
+        ("motor", robot.motors),
+        ("lamp", robot.lamps),
+        ("counter", robot.counter_names if spec.counters else ()),
+    ):
         for name in names:
             terminal = name if name in free[kind] else (free[kind][0] if free[kind] else "?")
             if terminal in free[kind]:
                 free[kind].remove(terminal)
-            lines.append(f'{name} = {{ terminal = "{terminal}", {_suggested_mode(spec, robot, name)} }}'
-                         if kind == "input" else f'{name} = "{terminal}"')
+            lines.append(
+                f'{name} = {{ terminal = "{terminal}", {_suggested_mode(spec, robot, name)} }}'
+                if kind == "input"
+                else f'{name} = "{terminal}"'
+            )
     return "\n".join(f"        {line}" for line in lines)
 
 

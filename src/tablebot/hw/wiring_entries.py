@@ -51,26 +51,59 @@ class EntryReader:
         """``value`` checked as a terminal of ``kind`` (one of ``allowed`` if given), or None after an error."""
         key, names = self.spec.section, list(allowed if allowed is not None else self.spec.names(kind))
         if not names:
-            self.error(name, N_("{kind} {name}: the {controller} has no {kind} terminals", kind=KINDS[kind],
-                                name=name, controller=self.spec.controller),
-                       N_("remove {name} from [{section}]", name=name, section=key))
+            self.error(
+                name,
+                N_(
+                    "{kind} {name}: the {controller} has no {kind} terminals",
+                    kind=KINDS[kind],
+                    name=name,
+                    controller=self.spec.controller,
+                ),
+                N_("remove {name} from [{section}]", name=name, section=key),
+            )
             return None
         if value is None:
-            self.error(name, N_("[{section}] {name}: which terminal is it wired to?", section=key, name=name),
-                       N_('say it with terminal = "{first}" (one of {names})', first=names[0], names=", ".join(names)))
+            self.error(
+                name,
+                N_("[{section}] {name}: which terminal is it wired to?", section=key, name=name),
+                N_('say it with terminal = "{first}" (one of {names})', first=names[0], names=", ".join(names)),
+            )
             return None
         if not isinstance(value, str):
-            self.error(name, N_("[{section}] {name}: the terminal must be text like {first!r}, not {value!r}",
-                                section=key, name=name, first=names[0], value=value),
-                       N_('write it in quotes: {name} = "{first}"', name=name, first=names[0]))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: the terminal must be text like {first!r}, not {value!r}",
+                    section=key,
+                    name=name,
+                    first=names[0],
+                    value=value,
+                ),
+                N_('write it in quotes: {name} = "{first}"', name=name, first=names[0]),
+            )
             return None
         if value not in names:
             same = [n for n in names if n.lower() == value.strip().lower()]
-            hint = (N_("terminal names are case-sensitive: write {same!r}", same=same[0]) if same
-                    else N_("the {controller}'s terminals for this are {names}", controller=self.spec.controller,
-                            names=", ".join(names)))
-            self.error(name, N_("{kind} {name}: the {controller} has no {kind} terminal {value!r}", kind=KINDS[kind],
-                                name=name, controller=self.spec.controller, value=value), hint)
+            hint = (
+                N_("terminal names are case-sensitive: write {same!r}", same=same[0])
+                if same
+                else N_(
+                    "the {controller}'s terminals for this are {names}",
+                    controller=self.spec.controller,
+                    names=", ".join(names),
+                )
+            )
+            self.error(
+                name,
+                N_(
+                    "{kind} {name}: the {controller} has no {kind} terminal {value!r}",
+                    kind=KINDS[kind],
+                    name=name,
+                    controller=self.spec.controller,
+                    value=value,
+                ),
+                hint,
+            )
             return None
         return value if self._take(name, kind, value) else None
 
@@ -84,10 +117,17 @@ class EntryReader:
         for used in needs:
             if used in self.taken:
                 taken = dict(kind=KINDS[kind], name=name, terminal=value, user=self.taken[used])
-                self.error(name, N_("{kind} {name}: terminal {terminal} is already used by {user} (a motor drives both "
-                                    "outputs of its pair)", **taken) if used[0] == "output" else
-                           N_("{kind} {name}: terminal {terminal} is already used by {user}", **taken),
-                           N_("give {name} a terminal of its own in [{section}]", name=name, section=self.spec.section))
+                self.error(
+                    name,
+                    N_(
+                        "{kind} {name}: terminal {terminal} is already used by {user} (a motor drives both "
+                        "outputs of its pair)",
+                        **taken,
+                    )
+                    if used[0] == "output"
+                    else N_("{kind} {name}: terminal {terminal} is already used by {user}", **taken),
+                    N_("give {name} a terminal of its own in [{section}]", name=name, section=self.spec.section),
+                )
                 return False
         self.taken.update(dict.fromkeys(needs, name))
         return True
@@ -95,23 +135,49 @@ class EntryReader:
     def input(self, name: str) -> InputWire | None:
         key, value = self.spec.section, self.section[name]
         if not isinstance(value, dict):
-            self.error(name, N_("[{section}] {name} must say its terminal, mode and polarity", section=key, name=name),
-                       N_("for example: {example}", example=f'{name} = {{ terminal = "{self.spec.digital_inputs[0]}", '
-                          'mode = "switch", pressed = 1 }'))
+            self.error(
+                name,
+                N_("[{section}] {name} must say its terminal, mode and polarity", section=key, name=name),
+                N_(
+                    "for example: {example}",
+                    example=f'{name} = {{ terminal = "{self.spec.digital_inputs[0]}", mode = "switch", pressed = 1 }}',
+                ),
+            )
             return None
         mode = value.get("mode")
         if mode not in self.spec.modes:
-            self.error(name, N_("[{section}] {name}: mode must be one of {modes}, not {mode!r}", section=key, name=name,
-                                modes=", ".join(self.spec.modes), mode=mode),
-                       _joined([N_('{device} is mode = "{mode}"', device=d.device, mode=m)
-                                for m, d in self.spec.digital_modes.items()]))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: mode must be one of {modes}, not {mode!r}",
+                    section=key,
+                    name=name,
+                    modes=", ".join(self.spec.modes),
+                    mode=mode,
+                ),
+                _joined(
+                    [
+                        N_('{device} is mode = "{mode}"', device=d.device, mode=m)
+                        for m, d in self.spec.digital_modes.items()
+                    ]
+                ),
+            )
             return None
         digital = self.spec.digital_modes.get(mode)
         known = ("terminal", "mode", digital.key) if digital else ("terminal", "mode", "below", "above")
         for k in value:
             if k not in known:
-                self.error(name, N_("[{section}] {name}: unknown key {key!r} for mode {mode!r}", section=key, name=name,
-                                    key=k, mode=mode), N_("keys: {keys}", keys=", ".join(known)))
+                self.error(
+                    name,
+                    N_(
+                        "[{section}] {name}: unknown key {key!r} for mode {mode!r}",
+                        section=key,
+                        name=name,
+                        key=k,
+                        mode=mode,
+                    ),
+                    N_("keys: {keys}", keys=", ".join(known)),
+                )
         allowed = self.spec.digital_inputs if digital else self.spec.analog[mode].terminals
         default = name if name in allowed else None
         terminal = self.terminal(name, "input", value.get("terminal", default), allowed)
@@ -124,11 +190,16 @@ class EntryReader:
         reads = value.get(mode.key)
         if reads not in (0, 1) or isinstance(reads, bool):
             said = dict(section=self.spec.section, name=name, meaning=mode.meaning, key=mode.key, reads=reads)
-            self.error(name, N_("[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0",
-                                **said) if reads is None else
-                       N_("[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0, "
-                          "not {reads!r}", **said),
-                       N_("{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')", key=mode.key))
+            self.error(
+                name,
+                N_("[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0", **said)
+                if reads is None
+                else N_(
+                    "[{section}] {name}: say what the table reads {meaning}: {key} = 1 or {key} = 0, not {reads!r}",
+                    **said,
+                ),
+                N_("{key} = 1 is the usual wiring (see docs/controllers.md, 'Input polarity')", key=mode.key),
+            )
             return None
         return (reads != mode.reports,)
 
@@ -139,47 +210,102 @@ class EntryReader:
         if declared is not None and declared.sensor_kind.units:  # a kind with a threshold
             return self._declared(name, mode, declared, limits)
         if len(limits) != 1:
-            self.error(name, N_("[{section}] {name}: a {mode} input needs exactly one of below = N or above = N "
-                                "({unit})", section=key, name=name, mode=mode, unit=analog.unit),
-                       N_("the table reads 1 while the value is below (or above) N, for example: below = {example}",
-                          example=analog.most // 50))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: a {mode} input needs exactly one of below = N or above = N ({unit})",
+                    section=key,
+                    name=name,
+                    mode=mode,
+                    unit=analog.unit,
+                ),
+                N_(
+                    "the table reads 1 while the value is below (or above) N, for example: below = {example}",
+                    example=analog.most // 50,
+                ),
+            )
             return None
-        (which, limit), = limits.items()
+        ((which, limit),) = limits.items()
         if isinstance(limit, bool) or not isinstance(limit, int) or not 0 <= limit <= analog.most:
-            self.error(name, N_("[{section}] {name}: {which} must be a whole number 0..{most} ({unit}), not {limit!r}",
-                                section=key, name=name, which=which, most=analog.most, unit=analog.unit, limit=limit),
-                       N_("for example: {example}", example=f"{which} = {analog.most // 50}"))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: {which} must be a whole number 0..{most} ({unit}), not {limit!r}",
+                    section=key,
+                    name=name,
+                    which=which,
+                    most=analog.most,
+                    unit=analog.unit,
+                    limit=limit,
+                ),
+                N_("for example: {example}", example=f"{which} = {analog.most // 50}"),
+            )
             return None
         return (False, limit if which == "below" else None, limit if which == "above" else None, 0)
 
-    def _declared(self, name: str, mode: str, sensor: Sensor, limits: dict[str, Any]
-                  ) -> tuple[bool, int | None, int | None, int] | None:
+    def _declared(
+        self, name: str, mode: str, sensor: Sensor, limits: dict[str, Any]
+    ) -> tuple[bool, int | None, int | None, int] | None:
         """Threshold and hysteresis from the input's ``[sensors]`` declaration (the one the simulator uses), so
         the table reads the same on the robot: only a distance sensor in the controller's distance mode (cm)."""
         key = self.spec.section
         if limits:
-            self.error(name, N_("[{section}] {name}: its threshold is declared in [sensors] ({sensor})", section=key,
-                                name=name, sensor=sensor.describe()),
-                       N_("remove {keys} here: the simulator and the controller read the one declaration",
-                          keys=", ".join(limits)))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: its threshold is declared in [sensors] ({sensor})",
+                    section=key,
+                    name=name,
+                    sensor=sensor.describe(),
+                ),
+                N_(
+                    "remove {keys} here: the simulator and the controller read the one declaration",
+                    keys=", ".join(limits),
+                ),
+            )
             return None
         scale = sensor.sensor_kind.modes.get(mode)  # from the declaration's units into the mode's
         if scale is None or mode not in self.spec.analog:
-            where = (N_('wire a distance sensor as mode = "{mode}"; or give a calibrated threshold here in the '
-                        "controller's units and drop the input from [sensors]", mode=self.spec.distance_mode)
-                     if self.spec.distance_mode else
-                     N_("the {controller} measures no distance in cm; or give a calibrated threshold here in the "
-                        "controller's units and drop the input from [sensors]", controller=self.spec.controller))
-            self.error(name, N_("[{section}] {name}: a {model} sensor ({sensor}) cannot be read in {mode} mode with "
-                                "its declared threshold", section=key, name=name, model=sensor.model,
-                                sensor=sensor.describe(), mode=mode), where)
+            where = (
+                N_(
+                    'wire a distance sensor as mode = "{mode}"; or give a calibrated threshold here in the '
+                    "controller's units and drop the input from [sensors]",
+                    mode=self.spec.distance_mode,
+                )
+                if self.spec.distance_mode
+                else N_(
+                    "the {controller} measures no distance in cm; or give a calibrated threshold here in the "
+                    "controller's units and drop the input from [sensors]",
+                    controller=self.spec.controller,
+                )
+            )
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: a {model} sensor ({sensor}) cannot be read in {mode} mode with "
+                    "its declared threshold",
+                    section=key,
+                    name=name,
+                    model=sensor.model,
+                    sensor=sensor.describe(),
+                    mode=mode,
+                ),
+                where,
+            )
             return None
         limit, slack = round(sensor.threshold * scale, 6), round(sensor.hysteresis * scale, 6)
         if limit != int(limit) or slack != int(slack):
-            self.error(name, N_("[{section}] {name}: the {controller} measures whole centimetres; [sensors] says "
-                                "{sensor}", section=key, name=name, controller=self.spec.controller,
-                                sensor=sensor.describe()),
-                       N_("declare the threshold and hysteresis in whole cm"))
+            self.error(
+                name,
+                N_(
+                    "[{section}] {name}: the {controller} measures whole centimetres; [sensors] says {sensor}",
+                    section=key,
+                    name=name,
+                    controller=self.spec.controller,
+                    sensor=sensor.describe(),
+                ),
+                N_("declare the threshold and hysteresis in whole cm"),
+            )
             return None
         below = sensor.direction == "below"
         return (False, int(limit) if below else None, None if below else int(limit), int(slack))
@@ -190,13 +316,23 @@ class EntryReader:
         if isinstance(value, dict) and kind == "motor":
             for k in value:
                 if k not in ("terminal", "reverse"):
-                    self.error(name, N_("[{section}] {name}: unknown key {key!r}", section=self.spec.section, name=name,
-                                        key=k), N_("keys: {keys}", keys="terminal, reverse"))
+                    self.error(
+                        name,
+                        N_("[{section}] {name}: unknown key {key!r}", section=self.spec.section, name=name, key=k),
+                        N_("keys: {keys}", keys="terminal, reverse"),
+                    )
             reverse = value.get("reverse", False)
             if not isinstance(reverse, bool):
-                self.error(name, N_("[{section}] {name}: reverse must be true or false, not {value!r}",
-                                    section=self.spec.section, name=name, value=reverse),
-                           N_("reverse = true swaps the motor's forward and backward"))
+                self.error(
+                    name,
+                    N_(
+                        "[{section}] {name}: reverse must be true or false, not {value!r}",
+                        section=self.spec.section,
+                        name=name,
+                        value=reverse,
+                    ),
+                    N_("reverse = true swaps the motor's forward and backward"),
+                )
                 reverse = False
             value = value.get("terminal", name if name in self.spec.motors else None)
         terminal = self.terminal(name, kind, value)
