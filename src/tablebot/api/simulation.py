@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from tablebot.api.progress import Progress
 from tablebot.files import out_folder
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     import numpy as np
@@ -158,7 +159,7 @@ def _run(scene: Scene, seconds: float, seed: int, progress: Progress, sinks: lis
     from tablebot.sim.physics.several import run_several
     from tablebot.sim.runner import simulate, ticks_for
 
-    progress.compiling("the simulator", run_robot if scene.tables is None else run_several)
+    progress.compiling(N_("the simulator"), run_robot if scene.tables is None else run_several)
     progress.start("ticks", ticks_for(scene, seconds))
     done = 0
 

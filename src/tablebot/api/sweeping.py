@@ -183,7 +183,8 @@ def _compiling(progress: Progress, backend: str, jobs: Sequence[Job]) -> None:
     if backend == "local" and jobs:
         from tablebot.fleet.kernel import run_fleet, run_fleet_serial
 
-        progress.compiling("the fleet simulator", run_fleet if len(jobs) == 1 else run_fleet_serial)  # one: threaded
+        progress.compiling(N_("the fleet simulator"),  # one job: the threaded kernel
+                           run_fleet if len(jobs) == 1 else run_fleet_serial)
 
 
 def _in_memory(plan: Plan, runner: Runner, backend: str, progress: Progress) -> Sweep:

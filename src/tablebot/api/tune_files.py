@@ -19,7 +19,10 @@ def tuned_path(table: Path, out: Path) -> Path:
     path = out / f"{table.stem}.tuned{table.suffix or '.csv'}"
     if path.resolve() == table.resolve():
         from tablebot.diagnostics import fail
-        raise fail("--out", f"the tuned table would replace its input {table}", "give --out another folder")
+        from tablebot.i18n import N_
+
+        raise fail("--out", N_("the tuned table would replace its input {table}", table=str(table)),
+                   N_("give --out another folder"))
     return path
 
 
@@ -135,49 +138,67 @@ def convergence_figure(evaluate: Evaluator, method: str) -> Figure:
 def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
                  before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Sequence[Path],
                  no_better: str = "") -> Path:
-    """``report.md``; ``no_better`` says why the winner is not better than the table as it was on the fresh
-    scenarios (empty: it is better): then it is called the best candidate, not the tuned table, and no command
-    to simulate it is offered."""
+    """``report.md`` in the reader's language (numbers too: tablebot.i18n.number); ``no_better`` says why the
+    winner is not better than the table as it was on the fresh scenarios (empty: it is better): then it is called
+    the best candidate, not the tuned table, and no command to simulate it is offered."""
+    from tablebot.escape import markdown_text
     from tablebot.files import write_text
-    from tablebot.i18n import _
+    from tablebot.i18n import _, localise, number
 
-    spec, cells = plan.spec, evaluate.cells
-    seconds = spec.ticks * plan.scenes[0].tick_s
-    axes = "".join(" × random starts" if a.values == ("random",) else f" × {len(a.values)} {a.key}"
-                   for a in spec.axes)
-    scenario = (f"{spec.total} scenarios ({len(spec.seeds)} seeds{axes} × {len(spec.worlds)} world(s), "
-                f"{seconds:g} s each)")
-    title = f"# Tuning {Path(plan.table.path).name}: {evaluate.objective}" + (": no better" if no_better else "")
-    lines = [title, "", f"{method}, {len(evaluate.history)} candidates on {scenario}, {wall_s:.0f} s.", "",
-             "| cell | before | " + ("best candidate |" if no_better else "after |"), "|---|---|---|"]
-    lines += [f"| {c.label} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
+    cells = evaluate.cells
+    title = _("# Tuning {table}: {objective}").format(table=markdown_text(Path(plan.table.path).name),
+                                                      objective=evaluate.objective)
+    lines = [title + (_(": no better") if no_better else ""), "",
+             _("{method}, {n} candidates on {scenarios}, {seconds} s.").format(
+                 method=method, n=len(evaluate.history), scenarios=_scenarios(plan), seconds=number(wall_s, ".0f")),
+             "", "| " + " | ".join([_("cell"), _("before"), _("best candidate") if no_better else _("after")]) + " |",
+             "|---|---|---|"]
+    lines += [f"| {markdown_text(c.label)} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
     if any(c.counter is None for c in cells):
-        lines += ["", f"Timers count ticks of {plan.table.robot.tick_ms} ms (the tuned table writes each in its "
-                  "cell's own unit)."]
-    lines += ["", f"Checked on {check.spec.total} fresh scenarios (seeds {check.spec.seeds[0]}.."
-              f"{check.spec.seeds[-1]}):", "", "| mean over the fresh scenarios | before | after |", "|---|---|---|"]
+        lines += ["", _("Timers count ticks of {tick} ms (the tuned table writes each in its cell's own "
+                        "unit).").format(tick=number(plan.table.robot.tick_ms))]
+    lines += ["", _("Checked on {n} fresh scenarios (seeds {first}..{last}):").format(
+        n=check.spec.total, first=check.spec.seeds[0], last=check.spec.seeds[-1]), "",
+        "| " + " | ".join([_("mean over the fresh scenarios"), _("before"), _("after")]) + " |", "|---|---|---|"]
     for metric, (a, b) in before_after.items():
-        lines.append(f"| {metric}{' (objective)' if metric == evaluate.objective else ''} | {a:.3f} | {b:.3f} |")
+        mark = " " + _("(objective)") if metric == evaluate.objective else ""
+        lines.append(f"| {metric}{mark} | {number(a, '.3f')} | {number(b, '.3f')} |")
     if no_better:
-        names = ", ".join(p.name for p in tuned)
-        lines += ["", no_better, "", f"{names} holds the best candidate of the tuning scenarios, for reference; "
-                  "it is not an improvement." if len(tuned) == 1 else
+        names = ", ".join(markdown_text(p.name) for p in tuned)
+        lines += ["", markdown_text(str(localise(no_better))), "",
+                  _("{names} holds the best candidate of the tuning scenarios, for reference; it is not an "
+                    "improvement.").format(names=names) if len(tuned) == 1 else
                   _("{names} hold the best candidate of the tuning scenarios, for reference; it is not an "
                     "improvement.").format(names=names)]
     else:
-        lines += ["", "Better than the table as it was on fresh seeds: yes.", "", *_use(plan, cells, tuned)]
+        lines += ["", _("Better than the table as it was on fresh seeds: yes."), "", *_use(plan, cells, tuned)]
     return write_text(path, "\n".join(lines) + "\n")
+
+
+def _scenarios(plan: Plan) -> str:
+    """``64 scenarios (16 seeds × random starts × 1 world, 60 s each)``, in the reader's language."""
+    from tablebot.i18n import _, ngettext, number
+
+    spec = plan.spec
+    axes = "".join(_(" × random starts") if a.values == ("random",) else f" × {len(a.values)} {a.key}"
+                   for a in spec.axes)
+    worlds = ngettext("{n} world", "{n} worlds", len(spec.worlds)).format(n=len(spec.worlds))
+    return _("{total} scenarios ({seeds} seeds{axes} × {worlds}, {seconds} s each)").format(
+        total=spec.total, seeds=len(spec.seeds), axes=axes, worlds=worlds,
+        seconds=number(spec.ticks * plan.scenes[0].tick_s))
 
 
 def _use(plan: Plan, cells: Sequence[Cell], tuned: Sequence[Path]) -> list[str]:
     """How to run the tuned robot: ``tablebot sim`` of the tuned table, or for a robot of several tables (whose
     robot file names its table files) the tuned tables to put in place of their files."""
+    from tablebot.escape import markdown_code, markdown_text
     from tablebot.i18n import _
 
     if plan.tables is None:
-        return [f"Simulate the tuned table as it was tuned: `{sim_command(plan, tuned[0])}`"]
+        return [_("Simulate the tuned table as it was tuned: {command}").format(
+            command=markdown_code(sim_command(plan, tuned[0])))]
     sources = plan.tables.tables
-    pairs = ", ".join(f"{target.name} → {Path(sources[k].path).name}"
+    pairs = ", ".join(f"{markdown_text(target.name)} → {markdown_text(Path(sources[k].path).name)}"
                       for k, target in tuned_paths(plan, cells, tuned[0].parent).items())
     return [_("The robot file's [tables] names its table files: put each tuned table in place of its file to run "
               "the robot as tuned ({pairs}); the other tables ran as they are.").format(pairs=pairs)]

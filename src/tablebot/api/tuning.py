@@ -133,7 +133,7 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
         raise fail("--objective", N_("--objective {objective}: unknown objective", objective=objective),
                    N_("use one of {choices}", choices=", ".join(METRICS)))
     if method not in ("auto", "grid", "cma"):
-        raise fail("--method", f"--method {method}: unknown method", "use grid, cma or auto")
+        raise fail("--method", N_("--method {method}: unknown method", method=method), N_("use grid, cma or auto"))
     chosen, address = choose(backend, scheduler)
     plan = make_plan(project.path, project.robot_file, project.world_files, grid or ["start=random"], seeds, None,
                      seconds, every_table=True)
@@ -149,9 +149,10 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
         if chosen == "local":
             from tablebot.fleet.kernel import run_fleet
 
-            shown.compiling("the fleet simulator", run_fleet)
+            shown.compiling(N_("the fleet simulator"), run_fleet)
         if known and journal is not None:
-            shown.note(f"resuming: {len(known)} evaluations from {journal.path} are not run again")
+            shown.note(N_("resuming: {n} evaluations from {path} are not run again", n=len(known),
+                          path=str(journal.path)))
         started = time.perf_counter()
         with Runner(chosen, address, workers) as runner:
             tuning = _search(plan, check, tuned_cells, objective, method, budget, seed, metrics, runner, known,
@@ -243,9 +244,9 @@ class Journal:
         except (ValueError, KeyError, TypeError):
             same, known = False, {}
         if not same:
-            raise fail(self.path, "--out holds the evaluations of an interrupted tuning of another table, robot "
-                       "file, world, scenario set, cells or objective", f"give --out a new folder, or delete "
-                       f"{self.path.name} to start over")
+            raise fail(self.path, N_("--out holds the evaluations of an interrupted tuning of another table, robot "
+                                     "file, world, scenario set, cells or objective"),
+                       N_("give --out a new folder, or delete {name} to start over", name=self.path.name))
         self.count = len(known)
         return known
 
@@ -268,6 +269,8 @@ def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
     if objective not in usable:
         from tablebot.diagnostics import fail
 
-        raise fail("--objective", f"--objective {objective} needs a lamp, and {', '.join(dark)} has none",
-                   f"tune for {' or '.join(f'--objective {m}' for m in usable)}, or give every --world a [[lamp]]")
+        options = ", ".join(f"--objective {m}" for m in usable)
+        raise fail("--objective", N_("--objective {objective} needs a lamp, and {worlds} has none",
+                                     objective=objective, worlds=", ".join(dark)),
+                   N_("tune for {options}, or give every --world a [[lamp]]", options=options))
     return usable

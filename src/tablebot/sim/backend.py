@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from tablebot.i18n import N_
 from tablebot.registry import LinkOptions, LiveBackend, Opened, register
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
@@ -31,7 +32,7 @@ def open_sim(machine: Machine, link: LinkOptions) -> Opened:
 
     world = link.address.partition(":")[2]
     seed = link.seed
-    say_compiling("the simulator", kernel.move)
+    say_compiling(N_("the simulator"), kernel.move)
     tables = several(machine.table)
     bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None, tables=tables), seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
