@@ -56,7 +56,8 @@ def _engine_run(case: Case, workdir: Path) -> Run:
     batch = engine.run([t.mask for t in case.inputs], pulses, jit=True)
     lines: list[dict[str, Any]] = [
         {"tick": i, "event": e, "row": None if r < 0 else r, "state": m.states[s], "timer": t}
-        for i, (e, r, s, t) in enumerate(zip(batch.events, batch.rows, batch.states, batch.timers, strict=True))]
+        for i, (e, r, s, t) in enumerate(zip(batch.events, batch.rows, batch.states, batch.timers, strict=True))
+    ]
     if lines:
         last = record(engine)
         lines[-1].update({k: v for k, v in last.items() if k not in CORE})
@@ -68,8 +69,19 @@ def _sim_lines(machine: Machine, run: Any) -> Run:
     from tablebot.codegen.host import trace_line
 
     inputs = run.inputs()
-    lines = [trace_line(machine, i, int(run.events[i]), int(run.rows[i]), int(run.states[i]), int(run.timers[i]),
-                        run.outputs[i].tolist(), run.counters[i].tolist()) for i in range(run.ticks)]
+    lines = [
+        trace_line(
+            machine,
+            i,
+            int(run.events[i]),
+            int(run.rows[i]),
+            int(run.states[i]),
+            int(run.timers[i]),
+            run.outputs[i].tolist(),
+            run.counters[i].tolist(),
+        )
+        for i in range(run.ticks)
+    ]
     return Run(inputs, lines)
 
 
@@ -190,14 +202,20 @@ def _no_avr() -> str | None:
 
 def _fits_uno(machine: Machine) -> bool:
     robot = machine.table.robot
-    return (len(robot.inputs) + len(robot.lamps) <= 8 and len(robot.motors) <= 2 and len(robot.counters) <= 2
-            and len(machine.states) <= 255)
+    return (
+        len(robot.inputs) + len(robot.lamps) <= 8
+        and len(robot.motors) <= 2
+        and len(robot.counters) <= 2
+        and len(machine.states) <= 255
+    )
 
 
 def wired_for_robopro(table: Table) -> Table:
     """A table's robot with a ``[robopro]`` section for a TXT (the controller whose program has counters)."""
-    return dataclasses.replace(table, robot=dataclasses.replace(
-        table.robot, sections={**table.robot.sections, "robopro": {"controller": "txt"}}))
+    return dataclasses.replace(
+        table,
+        robot=dataclasses.replace(table.robot, sections={**table.robot.sections, "robopro": {"controller": "txt"}}),
+    )
 
 
 #: Ticks the ROBO Pro interpreter runs of a case at most: it interprets every element (about 1 ms a tick here).
@@ -213,8 +231,10 @@ def _robopro_program(case: Case, workdir: Path) -> Run:
     m = case.machine
     inputs = list(case.inputs[:ROBOPRO_TICKS])
     decisions = run(wired_for_robopro(m.table), inputs, case.rule)  # type: ignore[arg-type]
-    return Run(inputs, [trace_line(m, i, d.event, d.row, d.state, d.timer, d.outputs, d.counters)
-                                   for i, d in enumerate(decisions)])
+    return Run(
+        inputs,
+        [trace_line(m, i, d.event, d.row, d.state, d.timer, d.outputs, d.counters) for i, d in enumerate(decisions)],
+    )
 
 
 def _fits_robopro(machine: Machine) -> bool:
@@ -229,21 +249,49 @@ def _fits_robopro(machine: Machine) -> bool:
 def register_all() -> None:
     """The executors of this tablebot, each once."""
     for executor in (
-        Executor("python step", _engine_step, several=_several_step,
-                 what="Engine.step: one tick in Python (the path of real robots)"),
-        Executor("engine batch", _engine_run, fits=lambda m: m.arrays is not None,
-                 what="Engine.run: tick.tick compiled by numba over recorded masks"),
-        Executor("simulator", _simulator, fits=_sim_fits,
-                 what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.physics.kernel, compiled)"),
+        Executor(
+            "python step",
+            _engine_step,
+            several=_several_step,
+            what="Engine.step: one tick in Python (the path of real robots)",
+        ),
+        Executor(
+            "engine batch",
+            _engine_run,
+            fits=lambda m: m.arrays is not None,
+            what="Engine.run: tick.tick compiled by numba over recorded masks",
+        ),
+        Executor(
+            "simulator",
+            _simulator,
+            fits=_sim_fits,
+            what="tablebot sim: the run loop's blocks through SimRobot.advance (sim.physics.kernel, compiled)",
+        ),
         Executor("fleet", _fleet, fits=_sim_fits, what="a robot of a fleet (fleet.kernel.run_fleet, compiled)"),
-        Executor("host C", _host_c, missing=_no_compiler, several=_host_c_several,
-                 what="the generated C engine compiled for this computer (codegen.host)"),
-        Executor("AVR firmware", _avr_firmware, missing=_no_avr, fits=_fits_uno, several=_avr_several,
-                 what="the Uno firmware under simavr, its UART trace decoded"),
+        Executor(
+            "host C",
+            _host_c,
+            missing=_no_compiler,
+            several=_host_c_several,
+            what="the generated C engine compiled for this computer (codegen.host)",
+        ),
+        Executor(
+            "AVR firmware",
+            _avr_firmware,
+            missing=_no_avr,
+            fits=_fits_uno,
+            several=_avr_several,
+            what="the Uno firmware under simavr, its UART trace decoded",
+        ),
         TXT4_EXECUTOR,
         # It knows the document's rule too; the reference (Engine.step) does not yet, so only "always" is checked.
-        Executor("ROBO Pro program", _robopro_program, fits=_fits_robopro, several=robopro_several,
-                 what="export --to robopro-program in the ROBO Pro element interpreter"),
+        Executor(
+            "ROBO Pro program",
+            _robopro_program,
+            fits=_fits_robopro,
+            several=robopro_several,
+            what="export --to robopro-program in the ROBO Pro element interpreter",
+        ),
         *SERIAL_EXECUTORS,
     ):
         register(executor)

@@ -73,8 +73,10 @@ def _txt4_program(case: Case, workdir: Path) -> Run:
 
     m = wired_for(case.machine.table, "txt")
     seen = _run_txt4(m, case.inputs, workdir, TXT4_DRIVER)
-    return Run([TickInput(mask, tuple(pulses)) for mask, pulses, *_ in seen],
-               [trace_line(m, i, *values[2:]) for i, values in enumerate(seen)])
+    return Run(
+        [TickInput(mask, tuple(pulses)) for mask, pulses, *_ in seen],
+        [trace_line(m, i, *values[2:]) for i, values in enumerate(seen)],
+    )
 
 
 def _txt4_several(case: SeveralCase, workdir: Path) -> Run:
@@ -88,8 +90,14 @@ def _txt4_several(case: SeveralCase, workdir: Path) -> Run:
         for i, (name, machine) in enumerate(zip(tables.names, tables.machines, strict=True)):
             event, row, state, timer = decisions[i]
             key = "" if i == 0 else f"{name}."
-            line.update({f"{key}event": event, f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
-                         f"{key}state": machine.states[state], f"{key}timer": timer})
+            line.update(
+                {
+                    f"{key}event": event,
+                    f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
+                    f"{key}state": machine.states[state],
+                    f"{key}timer": timer,
+                }
+            )
             if i == 0:
                 line.update(zip(tables.output_names, outputs, strict=True))
                 line.update(zip(tables.robot.counter_names, counters, strict=True))
@@ -106,17 +114,30 @@ def _run_txt4(m: Machine, inputs: tuple[TickInput, ...], workdir: Path, driver: 
     export_txt4(m).write(folder)
     (folder / "driver.py").write_text(driver, encoding="utf-8")
     terminals = [int(name[1:]) - 1 for name in m.input_bits]
-    script = {"inputs": [[0] * 8 for _ in range(len(inputs) + 1)],
-              "pulses": [[0, 0, 0, 0] for _ in range(len(inputs) + 1)]}
+    script = {
+        "inputs": [[0] * 8 for _ in range(len(inputs) + 1)],
+        "pulses": [[0, 0, 0, 0] for _ in range(len(inputs) + 1)],
+    }
     for row, pulses, tick in zip(script["inputs"], script["pulses"], inputs, strict=False):
         for terminal, bit in zip(terminals, m.input_bits.values(), strict=True):
             row[terminal] = int(bool(tick.mask & bit))
         pulses[: len(tick.pulses)] = list(tick.pulses)
     (folder / "script.json").write_text(json.dumps(script), encoding="utf-8")
-    env = {"PATH": os.environ.get("PATH", ""), "PYTHONPATH": str(_txt4_stub()),
-           "TABLEBOT_STUB_SCRIPT": str(folder / "script.json"), "TABLEBOT_STUB_LOG": str(folder / "calls.jsonl")}
-    done = subprocess.run([sys.executable, "-S", "driver.py", str(len(inputs))], cwd=folder, env=env,
-                          capture_output=True, text=True, timeout=120, check=False)
+    env = {
+        "PATH": os.environ.get("PATH", ""),
+        "PYTHONPATH": str(_txt4_stub()),
+        "TABLEBOT_STUB_SCRIPT": str(folder / "script.json"),
+        "TABLEBOT_STUB_LOG": str(folder / "calls.jsonl"),
+    }
+    done = subprocess.run(
+        [sys.executable, "-S", "driver.py", str(len(inputs))],
+        cwd=folder,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
     if done.returncode:
         raise AssertionError(f"the TXT 4.0 program failed: {done.stderr}")
     return list(json.loads(done.stdout.splitlines()[-1]))
@@ -131,6 +152,11 @@ def _fits_txt(machine: Machine) -> bool:
     return fits_controller(machine)
 
 
-TXT4_EXECUTOR = Executor("TXT 4.0 program", _txt4_program, missing=_no_txt4_stub, fits=_fits_txt,
-                         several=_txt4_several,
-                         what="export --to txt4's standalone program against the fischertechnik stub")
+TXT4_EXECUTOR = Executor(
+    "TXT 4.0 program",
+    _txt4_program,
+    missing=_no_txt4_stub,
+    fits=_fits_txt,
+    several=_txt4_several,
+    what="export --to txt4's standalone program against the fischertechnik stub",
+)
