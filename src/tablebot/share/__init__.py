@@ -19,8 +19,6 @@ from __future__ import annotations
 import base64
 import binascii
 import contextlib
-import functools
-import hashlib
 import json
 import re
 import tempfile
@@ -31,6 +29,7 @@ from pathlib import Path
 from tablebot.diagnostics import TableBotError, fail
 from tablebot.i18n import N_
 from tablebot.robot_tables import tables_of
+from tablebot.share.shipped import WORLD_NAME, reference, shipped
 
 __all__ = ["FORMAT", "STUDIO", "Shared", "collect", "decode", "encode"]
 
@@ -41,7 +40,6 @@ STUDIO = "http://127.0.0.1:8765/"
 KEY = "share="
 #: A shared robot is a few KB; more than this, unpacked, is no link tablebot made (a zip bomb is refused early).
 MAX_UNPACKED = 2 * 1024 * 1024
-WORLD_NAME = "arena.toml"
 _PAYLOAD_RE = re.compile(r"[A-Za-z0-9_-]*")
 _FILE_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_. -]{0,99}$")  # a plain file name: no folder, no leading dot
 _NAME_RE = re.compile(r"[^A-Za-z0-9_. -]+")
@@ -186,8 +184,8 @@ def encode(shared: Shared, base: str = STUDIO) -> str:
     """The link carrying ``shared``: ``BASE#share=1.PAYLOAD`` (see the module). The same files always give
     the same link."""
     body: dict[str, object] = {"name": shared.name, "table": list(shared.table),
-                               "robot": [shared.robot[0], _reference(shared.robot[1])] if shared.robot else None,
-                               "world": None if shared.world is None else _reference(shared.world)}
+                               "robot": [shared.robot[0], reference(shared.robot[1])] if shared.robot else None,
+                               "world": None if shared.world is None else reference(shared.world)}
     if shared.tables:  # only then: a link of one table stays what it was, byte for byte
         body["tables"] = [list(pair) for pair in shared.tables]
     packed = zlib.compress(json.dumps(body, ensure_ascii=False, separators=(",", ":")).encode("utf-8"), 9)
@@ -262,7 +260,7 @@ def _unpack(data: bytes, where: str) -> Shared:
         raise broken
     table, robot = _pair(body.get("table"), where), _pair(body.get("robot"), where, optional=True)
     world = body.get("world")
-    world = _shipped(world, where) if isinstance(world, dict) else world
+    world = shipped(world, where) if isinstance(world, dict) else world
     if table is None or (world is not None and not isinstance(world, str)):
         raise broken
     if not table[0].lower().endswith((".csv", ".tsv")) or (robot and not robot[0].lower().endswith(".toml")):
@@ -294,52 +292,8 @@ def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] 
             and isinstance(value[1], str | dict)):
         raise fail(where, N_("this share link unpacks, but not to a table and its files"),
                    N_("make it again with `tablebot share` or the studio's Share button"))
-    name, text = value[0], _shipped(value[1], where) if isinstance(value[1], dict) else value[1]
+    name, text = value[0], shipped(value[1], where) if isinstance(value[1], dict) else value[1]
     if not _FILE_RE.match(name) or name == WORLD_NAME or not name.lower().endswith((".csv", ".tsv", ".toml")):
         raise fail(where, N_("this share link names a file {name!r} that no shared table has", name=name),
                    N_("make it again with `tablebot share`"))
     return name, text
-
-
-# --- files tablebot ships: named, not carried --------------------------------------------------------------
-
-#: The shipped examples whose robot and world files a link names instead of carrying them (a pupil's folder
-#: made by ``tablebot new --from bumberbot`` keeps them as they are: its link carries the table alone).
-SHIPPED = ("bumberbot", "bumberbot-counters", "bumberbot-lights", "line-follower", "obstacle-avoider")
-
-
-def _digest(text: str) -> str:
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
-
-
-@functools.cache
-def _shipped_files() -> dict[str, str]:
-    """Each shipped robot and world file's text, by ``EXAMPLE/FILE``."""
-    from tablebot.examples import example_path
-
-    found = {}
-    for example in SHIPPED:
-        for name in ("robot.toml", WORLD_NAME):
-            path = example_path(example) / name
-            if path.is_file():
-                found[f"{example}/{name}"] = path.read_text(encoding="utf-8")
-    return found
-
-
-def _reference(text: str) -> str | dict[str, str]:
-    """A file's text, or the name and digest of the shipped file it is a copy of."""
-    for key, shipped in _shipped_files().items():
-        if shipped == text:
-            return {"example": key, "sha256": _digest(text)}
-    return text
-
-
-def _shipped(reference: dict[str, object], where: str) -> str:
-    """The text of the shipped file a link names, as the link's tablebot shipped it."""
-    key, digest = reference.get("example"), reference.get("sha256")
-    text = _shipped_files().get(key) if isinstance(key, str) else None
-    if text is None or _digest(text) != digest:
-        raise fail(where, N_("this share link names tablebot's example file {key!r} as another version of "
-                             "tablebot ships it, not as this one does", key=key),
-                   N_("use the same version of tablebot as the link's maker, or ask for the files"))
-    return text
