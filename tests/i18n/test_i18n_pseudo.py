@@ -185,3 +185,75 @@ def test_no_text_is_marked_where_the_extraction_cannot_see_it() -> None:
                 hidden += [f"{path.relative_to(ROOT)}:{call.lineno}" for call in ast.walk(node)
                            if isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id in marks]
     assert hidden == [], "mark the text outside the f-string: " + ", ".join(hidden)
+
+
+# --- the files a command writes for people to read: evolve's report.md and check reports, tune's report.md --------
+
+LINE = ROOT / "examples" / "line-follower"
+#: The measures' names: option values a user types (--objective laps), never translated.
+MEASURE_NAMES = {"time_to_lamp", "time_to_light", "missed_lamp", "lamp_distance", "collisions", "collision_share",
+                 "distance", "area_covered", "laps"}
+
+
+def evolve_args(folder: Path, out: Path) -> list[str]:
+    """The tiniest evolve that writes every file: 2 tables, 2 seeds of 1 s, 2 fresh ones, proved in this process."""
+    return ["evolve", str(folder), "--budget", "2", "--batch", "2", "--seeds", "0..1", "--check-seeds",
+            "1000..1001", "--seconds", "1", "--workers", "1", "--out", str(out), "-q"]
+
+
+def tune_args(out: Path) -> list[str]:
+    return ["tune", str(EXAMPLE), "--cells", "line 5 timer", "--budget", "3", "--seeds", "0..1", "--check-seeds",
+            "1000..1003", "--seconds", "2", "--out", str(out), "-q"]
+
+
+def written_words(out: Path) -> set[str]:
+    """The names of the files a run wrote (best-1.csv, elites/cell-07-00.csv, archive.png): the command's own."""
+    return {w for path in out.rglob("*") for w in re.findall(r"[A-Za-z]+", str(path.relative_to(out)))}
+
+
+def file_says_nothing_outside(path: Path, args: list[str], tmp: Path) -> None:
+    shown = path.read_text(encoding="utf-8")
+    allowed = (names(typer.main.get_command(app)) | user_words(tmp) | written_words(path.parent) | MEASURE_NAMES
+               | {w for a in args for w in re.findall(r"[A-Za-z]+", a)})
+    assert PSEUDO_OPEN in shown and words(outside(shown), allowed) == [], f"{path.name}:\n{shown}"
+
+
+def test_evolves_report_and_check_reports_are_marked(tmp_path: Path) -> None:
+    folder = tmp_path / "robot"
+    shutil.copytree(LINE, folder)  # its words (state names, properties) are the user's
+    args = evolve_args(folder, tmp_path / "out")
+    run_in(i18n.PSEUDO, args)
+    for path in [tmp_path / "out" / "report.md", *sorted((tmp_path / "out").rglob("*.check.txt"))]:
+        file_says_nothing_outside(path, args, tmp_path)
+
+
+def test_tunes_report_is_marked(tmp_path: Path) -> None:
+    args = tune_args(tmp_path / "out")
+    run_in(i18n.PSEUDO, args)
+    file_says_nothing_outside(tmp_path / "out" / "report.md", args, tmp_path)
+
+
+def csv_numbers_keep_the_point(path: Path) -> None:
+    """Every number of a CSV file reads as Python's float: a German run's data has no decimal comma."""
+    import csv
+
+    rows = list(csv.DictReader(path.open(encoding="utf-8")))
+    numbers = [value for row in rows for key, value in row.items() if key != "key"]
+    assert numbers and all(re.fullmatch(r"-?\d+(\.\d+)?(e-?\d+)?", v) for v in numbers), path.read_text("utf-8")
+
+
+def test_german_reports_write_decimal_commas_and_their_data_the_point(tmp_path: Path) -> None:
+    """A German reader reads 0,125 in report.md; evaluations.csv and the JSON records stay Python's (0.125)."""
+    import json
+
+    run_in("de", evolve_args(LINE, tmp_path / "ev"))
+    report = (tmp_path / "ev" / "report.md").read_text(encoding="utf-8")
+    assert "## Vorher und nachher" in report and re.search(r"\| -?\d+,\d{3} \|", report), report
+    assert not re.search(r"\| -?\d+\.\d{3} \|", report), report
+    csv_numbers_keep_the_point(tmp_path / "ev" / "evaluations.csv")
+    for line in (tmp_path / "ev" / "evaluations.jsonl").read_text(encoding="utf-8").splitlines():
+        assert all(isinstance(v, float | int) for v in json.loads(line)["means"].values())
+    run_in("de", tune_args(tmp_path / "tune"))
+    report = (tmp_path / "tune" / "report.md").read_text(encoding="utf-8")
+    assert "| time_to_lamp (Ziel) | " in report and re.search(r"\| \d+,\d{3} \| \d+,\d{3} \|", report), report
+    csv_numbers_keep_the_point(tmp_path / "tune" / "evaluations.csv")
