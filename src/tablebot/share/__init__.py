@@ -75,9 +75,11 @@ class Shared:
         from tablebot.fileset import new_folder
 
         if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-            raise fail(folder, N_("this folder is not empty") if folder.is_dir() else
-                       N_("this is a file, not a folder"),
-                       N_("give the name of a new folder (a shared table never writes over files)"))
+            raise fail(
+                folder,
+                N_("this folder is not empty") if folder.is_dir() else N_("this is a file, not a folder"),
+                N_("give the name of a new folder (a shared table never writes over files)"),
+            )
         with new_folder(folder) as stage:
             for name, text in self.files().items():
                 write_text(stage / name, text, newline="")  # byte for byte as shared
@@ -89,8 +91,11 @@ class Shared:
         if file == self.table[0]:
             return replace(self, table=(file, text))
         if file not in dict(self.tables):
-            raise fail(file, N_("this table is not one of the robot's tables"),
-                       N_("share the robot's folder: its robot file's [tables] names the tables a link carries"))
+            raise fail(
+                file,
+                N_("this table is not one of the robot's tables"),
+                N_("share the robot's folder: its robot file's [tables] names the tables a link carries"),
+            )
         return replace(self, tables=tuple((name, text if name == file else old) for name, old in self.tables))
 
     def check(self, where: str = "link") -> None:
@@ -105,8 +110,7 @@ class Shared:
                 project = open_robot(table)
                 project.default_world()
             except TableBotError as exc:
-                raise TableBotError(replace(d, path=_renamed(d.path, folder, where)) for d in exc.diagnostics) \
-                    from None
+                raise TableBotError(replace(d, path=_renamed(d.path, folder, where)) for d in exc.diagnostics) from None
 
 
 def _renamed(path: str, folder: Path, where: str) -> str:
@@ -125,20 +129,21 @@ def collect(path: str | Path) -> Shared:
     project = open_robot(path)
     specs = tables_of(project.robot)
     table = _table_path(project.robot.source, specs[0].file) if specs else project.path
-    robot_path = Path(project.robot.source) if project.robot.source and Path(project.robot.source).is_file() \
-        else None
+    robot_path = Path(project.robot.source) if project.robot.source and Path(project.robot.source).is_file() else None
     robot = None
     if robot_path is not None:
         robot = (_file_name(robot_path), _robot_text(robot_path, read_text(robot_path, spreadsheet=False)))
-    world_path = project.robot_world() or (table.parent / WORLD_NAME if (table.parent / WORLD_NAME).is_file()
-                                           else None)
+    world_path = project.robot_world() or (table.parent / WORLD_NAME if (table.parent / WORLD_NAME).is_file() else None)
     world = read_text(world_path, spreadsheet=False) if world_path is not None else None
     project.default_world()  # a broken world is refused before it is shared
     name = table.parent.resolve().name if table.stem == "table" else table.stem
-    others = tuple((_file_name(other), read_text(other))
-                   for other in (_table_path(project.robot.source, spec.file) for spec in specs[1:]))
-    return Shared(_NAME_RE.sub("-", name).strip(" .-") or "shared", (_file_name(table), read_text(table)), robot,
-                  world, others)
+    others = tuple(
+        (_file_name(other), read_text(other))
+        for other in (_table_path(project.robot.source, spec.file) for spec in specs[1:])
+    )
+    return Shared(
+        _NAME_RE.sub("-", name).strip(" .-") or "shared", (_file_name(table), read_text(table)), robot, world, others
+    )
 
 
 def _table_path(robot_file: str | None, file: str) -> Path:
@@ -146,16 +151,24 @@ def _table_path(robot_file: str | None, file: str) -> Path:
     into one folder, so a table in another folder cannot be carried (:func:`_file_name` says so)."""
     path = Path(robot_file or ".").parent / file
     if Path(file).name != file:
-        raise fail(path, N_("a link carries the robot's tables beside its robot file, and this one is in another "
-                            "folder ({file})", file=file),
-                   N_("move the table beside the robot file and name it in [tables] by its file name alone"))
+        raise fail(
+            path,
+            N_(
+                "a link carries the robot's tables beside its robot file, and this one is in another folder ({file})",
+                file=file,
+            ),
+            N_("move the table beside the robot file and name it in [tables] by its file name alone"),
+        )
     return path
 
 
 def _file_name(path: Path) -> str:
     if not _FILE_RE.match(path.name):
-        raise fail(path, N_("a link carries files with plain names (letters, digits, '_', '-', '.', spaces)"),
-                   N_("rename the file"))
+        raise fail(
+            path,
+            N_("a link carries files with plain names (letters, digits, '_', '-', '.', spaces)"),
+            N_("rename the file"),
+        )
     return path.name
 
 
@@ -171,21 +184,29 @@ def _robot_text(path: Path, text: str) -> str:
     number = src.line("sim", None, "world")
     lines = text.splitlines(keepends=True)
     if number is not None:
-        new, count = re.subn(r"""(world\s*=\s*)("[^"\n]*"|'[^'\n]*')""", rf'\g<1>"{WORLD_NAME}"', lines[number - 1],
-                             count=1)
+        new, count = re.subn(
+            r"""(world\s*=\s*)("[^"\n]*"|'[^'\n]*')""", rf'\g<1>"{WORLD_NAME}"', lines[number - 1], count=1
+        )
         if count:
             lines[number - 1] = new
             return "".join(lines)
-    raise fail(path, N_("cannot find the line of sim.world to point it at the world the link carries"),
-               N_('write it in a [sim] section as world = "FILE.toml"'), number)
+    raise fail(
+        path,
+        N_("cannot find the line of sim.world to point it at the world the link carries"),
+        N_('write it in a [sim] section as world = "FILE.toml"'),
+        number,
+    )
 
 
 def encode(shared: Shared, base: str = STUDIO) -> str:
     """The link carrying ``shared``: ``BASE#share=1.PAYLOAD`` (see the module). The same files always give
     the same link."""
-    body: dict[str, object] = {"name": shared.name, "table": list(shared.table),
-                               "robot": [shared.robot[0], reference(shared.robot[1])] if shared.robot else None,
-                               "world": None if shared.world is None else reference(shared.world)}
+    body: dict[str, object] = {
+        "name": shared.name,
+        "table": list(shared.table),
+        "robot": [shared.robot[0], reference(shared.robot[1])] if shared.robot else None,
+        "world": None if shared.world is None else reference(shared.world),
+    }
     if shared.tables:  # only then: a link of one table stays what it was, byte for byte
         body["tables"] = [list(pair) for pair in shared.tables]
     packed = zlib.compress(json.dumps(body, ensure_ascii=False, separators=(",", ":")).encode("utf-8"), 9)
@@ -202,35 +223,59 @@ def decode(link: str, where: str = "link") -> Shared:
     text = link.strip()
     at = text.find(KEY)
     if at < 0:
-        raise fail(where, N_("this is not a tablebot share link: it has no '#share='"),
-                   N_("copy the whole link that `tablebot share` printed or the studio's Share button gave"))
-    version, dot, payload = text[at + len(KEY):].partition(".")
+        raise fail(
+            where,
+            N_("this is not a tablebot share link: it has no '#share='"),
+            N_("copy the whole link that `tablebot share` printed or the studio's Share button gave"),
+        )
+    version, dot, payload = text[at + len(KEY) :].partition(".")
     if not version.isdigit() or not dot:
         raise fail(where, N_("this share link is damaged: its version is missing"), N_("copy the whole link again"))
     _check_version(int(version), where)
     bad = _PAYLOAD_RE.match(payload)
     if bad is None or bad.end() != len(payload):
         end = 0 if bad is None else bad.end()
-        raise fail(where, N_("this share link holds a character no share link has ({char!r} at character "
-                             "{at} of the link)", char=payload[end], at=at + len(KEY) + len(version) + 1 + end + 1),
-                   N_("copy the link again whole: a chat program or e-mail may have changed or wrapped it"))
+        raise fail(
+            where,
+            N_(
+                "this share link holds a character no share link has ({char!r} at character {at} of the link)",
+                char=payload[end],
+                at=at + len(KEY) + len(version) + 1 + end + 1,
+            ),
+            N_("copy the link again whole: a chat program or e-mail may have changed or wrapped it"),
+        )
     return _unpack(_inflate(payload, where), where)
 
 
 def _check_version(version: int, where: str) -> None:
     if version > FORMAT:
-        raise fail(where, N_("this link was made by a newer tablebot (link format {version}; this one reads "
-                             "format {format})", version=version, format=FORMAT),
-                   N_("update tablebot (pip install --upgrade tablebot), or ask for the files"))
+        raise fail(
+            where,
+            N_(
+                "this link was made by a newer tablebot (link format {version}; this one reads format {format})",
+                version=version,
+                format=FORMAT,
+            ),
+            N_("update tablebot (pip install --upgrade tablebot), or ask for the files"),
+        )
     if version < FORMAT:
-        raise fail(where, N_("this link was made by an older tablebot (link format {version}), which this one no "
-                             "longer reads (it reads format {format})", version=version, format=FORMAT),
-                   N_("ask for a new link, or for the files"))
+        raise fail(
+            where,
+            N_(
+                "this link was made by an older tablebot (link format {version}), which this one no "
+                "longer reads (it reads format {format})",
+                version=version,
+                format=FORMAT,
+            ),
+            N_("ask for a new link, or for the files"),
+        )
 
 
 def _inflate(payload: str, where: str) -> bytes:
-    cut = N_("this share link is cut short or damaged (its {count:,} characters of contents do not unpack)",
-             count=len(payload))
+    cut = N_(
+        "this share link is cut short or damaged (its {count:,} characters of contents do not unpack)",
+        count=len(payload),
+    )
     hint = N_("copy the whole link again: it is one long line, and the end is often lost")
     try:
         packed = base64.urlsafe_b64decode(payload + "=" * (-len(payload) % 4))
@@ -242,16 +287,22 @@ def _inflate(payload: str, where: str) -> bytes:
     except zlib.error:
         raise fail(where, cut, hint) from None
     if len(data) > MAX_UNPACKED or unpacker.unconsumed_tail:
-        raise fail(where, N_("this share link unpacks to more than {mb} MB: no table is that large",
-                             mb=MAX_UNPACKED // 2**20), N_("share the files instead"))
+        raise fail(
+            where,
+            N_("this share link unpacks to more than {mb} MB: no table is that large", mb=MAX_UNPACKED // 2**20),
+            N_("share the files instead"),
+        )
     if not unpacker.eof:
         raise fail(where, cut, hint)
     return data
 
 
 def _unpack(data: bytes, where: str) -> Shared:
-    broken = fail(where, N_("this share link unpacks, but not to a table and its files"),
-                  N_("make it again with `tablebot share` or the studio's Share button"))
+    broken = fail(
+        where,
+        N_("this share link unpacks, but not to a table and its files"),
+        N_("make it again with `tablebot share` or the studio's Share button"),
+    )
     try:
         body = json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError):
@@ -264,8 +315,11 @@ def _unpack(data: bytes, where: str) -> Shared:
     if table is None or (world is not None and not isinstance(world, str)):
         raise broken
     if not table[0].lower().endswith((".csv", ".tsv")) or (robot and not robot[0].lower().endswith(".toml")):
-        raise fail(where, N_("this share link's files are not a table and a robot file"),
-                   N_("make it again with `tablebot share`"))
+        raise fail(
+            where,
+            N_("this share link's files are not a table and a robot file"),
+            N_("make it again with `tablebot share`"),
+        )
     name = _NAME_RE.sub("-", body["name"]).strip(" .-")[:100] or "shared"
     return Shared(name, table, robot, world, _other_tables(body.get("tables", []), table[0], where))
 
@@ -273,13 +327,19 @@ def _unpack(data: bytes, where: str) -> Shared:
 def _other_tables(value: object, main: str, where: str) -> tuple[tuple[str, str], ...]:
     """A link's other tables (a robot of several): each a table file of its own name, none the main table's."""
     if not isinstance(value, list):
-        raise fail(where, N_("this share link unpacks, but not to a table and its files"),
-                   N_("make it again with `tablebot share` or the studio's Share button"))
+        raise fail(
+            where,
+            N_("this share link unpacks, but not to a table and its files"),
+            N_("make it again with `tablebot share` or the studio's Share button"),
+        )
     pairs = tuple(pair for pair in (_pair(item, where) for item in value) if pair is not None)
     names = [main, *(name for name, _ in pairs)]
     if len(set(names)) != len(names) or not all(name.lower().endswith((".csv", ".tsv")) for name in names):
-        raise fail(where, N_("this share link's files are not a table and a robot file"),
-                   N_("make it again with `tablebot share`"))
+        raise fail(
+            where,
+            N_("this share link's files are not a table and a robot file"),
+            N_("make it again with `tablebot share`"),
+        )
     return pairs
 
 
@@ -288,12 +348,19 @@ def _pair(value: object, where: str, optional: bool = False) -> tuple[str, str] 
     link never writes outside the folder it is opened into."""
     if value is None and optional:
         return None
-    if not (isinstance(value, list) and len(value) == 2 and isinstance(value[0], str)
-            and isinstance(value[1], str | dict)):
-        raise fail(where, N_("this share link unpacks, but not to a table and its files"),
-                   N_("make it again with `tablebot share` or the studio's Share button"))
+    if not (
+        isinstance(value, list) and len(value) == 2 and isinstance(value[0], str) and isinstance(value[1], str | dict)
+    ):
+        raise fail(
+            where,
+            N_("this share link unpacks, but not to a table and its files"),
+            N_("make it again with `tablebot share` or the studio's Share button"),
+        )
     name, text = value[0], shipped(value[1], where) if isinstance(value[1], dict) else value[1]
     if not _FILE_RE.match(name) or name == WORLD_NAME or not name.lower().endswith((".csv", ".tsv", ".toml")):
-        raise fail(where, N_("this share link names a file {name!r} that no shared table has", name=name),
-                   N_("make it again with `tablebot share`"))
+        raise fail(
+            where,
+            N_("this share link names a file {name!r} that no shared table has", name=name),
+            N_("make it again with `tablebot share`"),
+        )
     return name, text

@@ -49,7 +49,13 @@ def shipped(reference: dict[str, object], where: str) -> str:
     key, named = reference.get("example"), reference.get("sha256")
     text = shipped_files().get(key) if isinstance(key, str) else None
     if text is None or digest(text) != named:
-        raise fail(where, N_("this share link names tablebot's example file {key!r} as another version of "
-                             "tablebot ships it, not as this one does", key=key),
-                   N_("use the same version of tablebot as the link's maker, or ask for the files"))
+        raise fail(
+            where,
+            N_(
+                "this share link names tablebot's example file {key!r} as another version of "
+                "tablebot ships it, not as this one does",
+                key=key,
+            ),
+            N_("use the same version of tablebot as the link's maker, or ask for the files"),
+        )
     return text
