@@ -20,7 +20,7 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import OtherPort, bumberbot, chromium, other_port, screenshots, served
+from studio_helpers import OtherPort, bumberbot, chromium, other_port, served
 from tablebot.web.app import Background
 
 pytestmark = [pytest.mark.browser]
@@ -176,11 +176,6 @@ def _attack(context: Any, url: str, log: Log, shots: Path, name: str) -> tuple[d
 
 def _files(folder: Path) -> dict[str, bytes]:
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "attack-screens")
 
 
 def test_a_page_on_another_port_gets_nothing_and_changes_nothing(context: Any, attacker: str, folder: Path,

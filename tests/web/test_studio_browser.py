@@ -1,7 +1,7 @@
 """The studio in a real browser: Debian's Chromium driven by Playwright against the real server.
 
 One server and one browser for the module; each test gets a fresh page (a tab) on a copy of the
-BumberBot. Screenshots of every view go to ``studio-screens`` under pytest's temporary folder (or to
+BumberBot. Screenshots of every view go to ``studio-browser`` under pytest's temporary folder (or to
 ``$TABLEBOT_SCREENSHOTS``) for a person to look at. Any console error or page error fails the test.
 """
 
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from studio_helpers import bumberbot, chromium, screenshots, served
+from studio_helpers import bumberbot
 from tablebot.colours import state_colours
 from tablebot.web.app import Background
 
@@ -53,21 +53,6 @@ def _write_sim_trace(root: Path) -> None:
         simulate(scene_for(table, machine), 20.0, 1).write_trace(f)
 
 
-@pytest.fixture(scope="module")
-def server(folder: Path) -> Iterator[Background]:
-    yield from served(folder)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[object]:
-    yield from chromium()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "studio-screens")
-
-
 class Tab:
     """A page on the studio that records console errors."""
 
@@ -100,8 +85,8 @@ class Tab:
 
 
 @pytest.fixture
-def tab(browser: object, server: Background, shots: Path, request: pytest.FixtureRequest) -> Iterator[Tab]:
-    page = Tab(browser, server.url, shots, request.node.name.removeprefix("test_"))
+def tab(browser: object, studio: Background, shots: Path, request: pytest.FixtureRequest) -> Iterator[Tab]:
+    page = Tab(browser, studio.url, shots, request.node.name.removeprefix("test_"))
     yield page
     page.close()
 
@@ -196,11 +181,11 @@ def test_paused_hold_i3_and_step_fires_a_collision_row(tab: Tab) -> None:
 
 
 def test_save_changes_only_the_edited_cell_and_keeps_a_backup(tab: Tab, folder: Path, browser: object,
-                                                             server: Background, shots: Path) -> None:
+                                                             studio: Background, shots: Path) -> None:
     page = tab.page
     path = folder / "table.csv"
     original = path.read_bytes()
-    other = Tab(browser, server.url, shots, "other-tab")
+    other = Tab(browser, studio.url, shots, "other-tab")
     try:
         tab.cell(3, TIMER_COL).locator("input").fill("900")
         page.wait_for_selector("#save.primary")

@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import bumberbot, chromium, screenshots, served, studio_works, wait_for
+from studio_helpers import bumberbot, served, studio_works, wait_for
 from tablebot.web.app import Background
 
 NEXT_COL = 13
@@ -49,16 +49,6 @@ DIAGRAM_TEXT_PX = """() => { const svg = document.querySelector('#diagram svg'),
 @pytest.fixture(scope="module")
 def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
     yield from served(bumberbot(tmp_path_factory.mktemp("classroom")))
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "studio-classroom")
 
 
 def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, touch: bool = False,

@@ -10,25 +10,21 @@ import re
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from core_helpers import EXAMPLE
-from studio_helpers import chromium, wait_for
+from studio_helpers import wait_for
 from tablebot import share
+
+pytestmark = [pytest.mark.browser]  # a real Chromium: on the one worker that drives browsers
 
 CELLS = """() => [...document.querySelectorAll('table.grid tbody tr')]
   .map((tr) => [...tr.querySelectorAll('td[data-col]')].map((td) => {
     const b = td.querySelector('button.flag'), i = td.querySelector('input, textarea');
     return b ? (b.getAttribute('aria-pressed') === 'true' ? '1' : '') : i.value; }))"""
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
 
 
 class Studio:

@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import bumberbot, chromium, screenshots, served
+from studio_helpers import bumberbot, served
 from tablebot.web.app import Background
 from test_studio_saves import marked, replace_by_rename, version
 
@@ -33,16 +33,6 @@ def folder(tmp_path: Path) -> Path:
 @pytest.fixture
 def server(folder: Path) -> Iterator[Background]:
     yield from served(folder)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "studio-drafts")
 
 
 class Page:

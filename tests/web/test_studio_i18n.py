@@ -24,7 +24,7 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import bumberbot, chromium, screenshots, served, studio_works, wait_for
+from studio_helpers import bumberbot, served, studio_works, wait_for
 from tablebot.web.app import STATIC, Background
 from test_studio_classroom import CLIPPED, SIZES, SMALL_TARGETS, VIEW, inside
 
@@ -75,16 +75,6 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
 @pytest.fixture(scope="module")
 def studio_en(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
     yield from served(bumberbot(tmp_path_factory.mktemp("i18n-en")), lang="en")
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "studio-i18n")
 
 
 def open_page(browser: Any, url: str, locale: str, kept: str | None = None, width: int = 1280,

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -19,7 +18,7 @@ import pytest
 
 import tablebot
 from core_helpers import ROOT
-from studio_helpers import chromium, screenshots, served, studio_works, wait_for
+from studio_helpers import studio_works, wait_for
 from tablebot.formats.csv_document import CsvDocument
 from tablebot.web.analyse import analyse, robot_for
 from tablebot.web.app import Background
@@ -47,21 +46,6 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     shutil.copytree(LIGHTS, root)
     (root / "arena.toml").write_text(DARK_ROOM, encoding="utf-8")
     return root
-
-
-@pytest.fixture(scope="module")
-def studio(folder: Path) -> Iterator[Background]:
-    yield from served(folder)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return screenshots(tmp_path_factory, "studio-several")
 
 
 def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, locale: str = "en-GB") -> Any:

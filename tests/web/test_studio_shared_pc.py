@@ -35,7 +35,7 @@ from typing import Any
 import pytest
 
 from core_helpers import EXAMPLE
-from studio_helpers import OtherPort, chromium, other_port, served, studio_works, wait_for
+from studio_helpers import OtherPort, other_port, studio_works, wait_for
 from tablebot.web.access import TOKEN_HEADER
 from tablebot.web.app import Background
 
@@ -236,11 +236,6 @@ def test_an_upload_cut_off_mid_body_is_one_line_not_a_traceback(command: Command
 
 # --- the token kept by the page, in no cookie ----------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def studio(folder: Path) -> Iterator[Background]:
-    yield from served(folder)
-
-
 #: The page of another program on another port: it reads what it can, plants cookies of the names the
 #: studio used, and tries to get in (the studio's API, its WebSocket bare and with a guessed key).
 OTHER_PAGE = """<!doctype html><html><body><script>
@@ -266,11 +261,6 @@ function socket(protocols) {
 def other(studio: Background) -> Iterator[OtherPort]:
     page = OTHER_PAGE.replace("STUDIO", json.dumps(studio.origin))
     yield from other_port(page.replace("NAME", json.dumps(f"tablebot-studio-{studio.access.port}")))
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
 
 
 def test_no_other_port_receives_the_token_and_its_page_cannot_get_in(browser: Any, studio: Background,

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import shutil
-from collections.abc import Iterator
 from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
@@ -17,7 +16,7 @@ import pytest
 from websockets.sync.client import ClientConnection, connect
 
 from core_helpers import EXAMPLE
-from studio_helpers import chromium, studio_works, wait_for
+from studio_helpers import studio_works, wait_for
 from tablebot.web.app import Background
 
 pytestmark = [pytest.mark.browser]
@@ -28,11 +27,6 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("studio-tabs") / "bot"
     shutil.copytree(EXAMPLE, root)
     return root
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
 
 
 def _tab(tabs: ExitStack, server: Background, wait: bool = False) -> ClientConnection | None:
