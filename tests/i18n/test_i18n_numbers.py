@@ -46,3 +46,34 @@ def test_a_robot_files_range_keeps_its_point_in_german(tmp_path: Path) -> None:
         src.raise_if_any()
     said = " ".join(f"{localise(d.message, 'de')} {localise(d.hint, 'de')}" for d in caught.value.diagnostics)
     assert "9.5" in said and "0.01..0.5" in said and "0,01" not in said, said
+
+
+def test_a_translated_texts_format_writes_the_readers_numbers() -> None:
+    """``_("...{rate:.2f}...").format(rate=...)``, the way most of the command line fills its texts."""
+    import numpy as np
+
+    from tablebot.i18n import _, ngettext
+
+    try:
+        use("de")
+        assert _("message too large ({n:,} characters)").format(n=12000) == "Nachricht zu groß (12.000 Zeichen)"
+        assert _("simulated {seconds:.1f} s").format(seconds=np.float64(5)) == "5,0 s simuliert"
+        assert ngettext("{n} tick", "{n} ticks", 2).format(n=12000) == "12000 Takte"
+    finally:
+        use("en")
+    assert _("simulated {seconds:.1f} s").format(seconds=5) == "simulated 5.0 s"
+
+
+def test_sims_summary_in_german(tmp_path: Path) -> None:
+    from tablebot.sim.summary import Summary
+
+    summary = Summary(seconds=120.0, first_light_s=None, reached_s=1.5, collisions=1, collision_ticks=(3,),
+                      distance_m=2.79, state_seconds={1: 120.0}, battery_start_v=9.05, battery_end_v=8.9)
+    try:
+        use("de")
+        german = "\n".join(summary.lines())
+    finally:
+        use("en")
+    assert "120,0 s simuliert" in german and "2,79 m" in german and "9,05 V -> 8,90 V" in german, german
+    assert "1,50 s" in german and "100,0 %" in german and "120.0" not in german, german
+    assert "distance driven:  2.79 m" in "\n".join(summary.lines())

@@ -16,12 +16,13 @@ locale) and set with :func:`use`. A table file's meaning never depends on it: ta
 from __future__ import annotations
 
 import gettext as _gettext
+import numbers
 import os
 import string
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 __all__ = [
     "DOMAIN",
@@ -110,16 +111,26 @@ def current() -> str:
 
 
 def gettext(message: str) -> str:
-    """``message`` in the language in use."""
-    return translation().gettext(message)
+    """``message`` in the language in use; its ``.format`` writes numbers as that language does (:func:`number`)."""
+    return _Text(translation().gettext(message))
 
 
 _ = gettext
 
 
 def ngettext(singular: str, plural: str, n: int) -> str:
-    """The singular or plural of a text, as the language in use counts ``n``."""
-    return translation().ngettext(singular, plural, n)
+    """The singular or plural of a text, as the language in use counts ``n`` (its numbers as :func:`gettext`'s)."""
+    return _Text(translation().ngettext(singular, plural, n))
+
+
+class _Text(str):
+    """A translated text: ``.format`` fills it as :class:`Message` does, every number written by :func:`number` in
+    the language in use (``{rate:.2f}`` is ``29,20`` in German), so no caller formats a number by hand."""
+
+    __slots__ = ()
+
+    def format(self, *args: Any, **kwargs: Any) -> str:
+        return _NumberFormatter(None).format(str(self), *args, **kwargs)
 
 
 class Message(str):
@@ -181,8 +192,8 @@ class _NumberFormatter(string.Formatter):
         self.language = language
 
     def format_field(self, value: Any, format_spec: str) -> Any:
-        if isinstance(value, int | float) and not isinstance(value, bool):
-            return number(value, format_spec, self.language)
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):  # numpy's numbers too
+            return number(cast(float, value), format_spec, self.language)
         return super().format_field(value, format_spec)
 
 

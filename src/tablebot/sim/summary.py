@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tablebot.i18n import _
+from tablebot.i18n import _, number
 from tablebot.robot import StateId
 from tablebot.sim import columns as L
 from tablebot.sim.model.track import laps
@@ -42,21 +42,22 @@ class Summary:
         names = names or {}
 
         def when(value: float | None) -> str:
-            return _("never") if value is None else f"{value:.2f} s"
+            return _("never") if value is None else f"{number(value, '.2f')} s"
         pairs: list[tuple[str, str]] = []
         if self.lamps:
             pairs += [(_("first light seen:"), when(self.first_light_s)), (_("lamp reached:"), when(self.reached_s))]
         if self.laps is not None:
-            pairs.append((_("laps of the line:"), f"{self.laps:.2f}"))
-        pairs += [(_("collisions:"), str(self.collisions)), (_("distance driven:"), f"{self.distance_m:.2f} m"),
-                  (_("battery:"), f"{self.battery_start_v:.2f} V -> {self.battery_end_v:.2f} V")]
+            pairs.append((_("laps of the line:"), number(self.laps, ".2f")))
+        volts = f"{number(self.battery_start_v, '.2f')} V -> {number(self.battery_end_v, '.2f')} V"
+        pairs += [(_("collisions:"), str(self.collisions)),
+                  (_("distance driven:"), f"{number(self.distance_m, '.2f')} m"), (_("battery:"), volts)]
         longest = (_("first light seen:"), _("laps of the line:"), *(label for label, _value in pairs))
         width = max(map(len, longest))  # every label, shown or not: the values line up as in any other run
         out = [_("simulated {seconds:.1f} s").format(seconds=self.seconds),
                *(f"{label:<{width}} {value}".rstrip() for label, value in pairs), _("time per state:")]
         for state, secs in self.state_seconds.items():
             label = f"{state} {names[state]}" if state in names else str(state)
-            out.append(f"  {label:<24} {secs:7.2f} s  {100 * secs / self.seconds:5.1f} %")
+            out.append(f"  {label:<24} {number(secs, '7.2f')} s  {number(100 * secs / self.seconds, '5.1f')} %")
         return out
 
 
