@@ -60,10 +60,14 @@ def studio(folder: Path) -> Iterator[Background]:
     yield from served(folder)
 
 
-async def _session(server: Background, messages: list[Any], replies_wanted: int,
-                   headers: dict[str, str] | None = None) -> list[dict[str, Any]]:
-    async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
-                                  additional_headers=server.headers if headers is None else headers) as ws:
+async def _session(
+    server: Background, messages: list[Any], replies_wanted: int, headers: dict[str, str] | None = None
+) -> list[dict[str, Any]]:
+    async with websockets.connect(
+        server.origin.replace("http", "ws") + "/ws",
+        max_size=2**24,
+        additional_headers=server.headers if headers is None else headers,
+    ) as ws:
         for message in messages:
             await ws.send(message if isinstance(message, str) else json.dumps(message))
         return [json.loads(await asyncio.wait_for(ws.recv(), 20)) for _ in range(replies_wanted)]
@@ -74,8 +78,9 @@ def talk(server: Background, messages: list[Any], until: str, limit: int = 40) -
 
     async def run() -> list[dict[str, Any]]:
         replies: list[dict[str, Any]] = []
-        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
-                                      additional_headers=server.headers) as ws:
+        async with websockets.connect(
+            server.origin.replace("http", "ws") + "/ws", max_size=2**24, additional_headers=server.headers
+        ) as ws:
             for message in messages:
                 await ws.send(message if isinstance(message, str) else json.dumps(message))
             while len(replies) < limit:
@@ -90,19 +95,34 @@ def talk(server: Background, messages: list[Any], until: str, limit: int = 40) -
 # --- what the page may name ----------------------------------------------------------------------------------
 
 REFUSED = {
-    "secret.env": "is not a table", "hook.py": "is not a table", "notes.txt": "is not a table",
-    "data.csv": "is not a table", ".git/config": "hidden files", ".git/table.csv": "hidden files",
-    ".hidden.csv": "hidden files", "sub/.private/t.csv": "hidden files", "./.hidden.csv": "hidden files",
-    "into-git.csv": "hidden files", "out.csv": "outside the served folder", "../outside.csv": "outside the served",
-    "/etc/passwd": "outside the served folder", "sub/../../outside.csv": "outside the served folder",
+    "secret.env": "is not a table",
+    "hook.py": "is not a table",
+    "notes.txt": "is not a table",
+    "data.csv": "is not a table",
+    ".git/config": "hidden files",
+    ".git/table.csv": "hidden files",
+    ".hidden.csv": "hidden files",
+    "sub/.private/t.csv": "hidden files",
+    "./.hidden.csv": "hidden files",
+    "into-git.csv": "hidden files",
+    "out.csv": "outside the served folder",
+    "../outside.csv": "outside the served",
+    "/etc/passwd": "outside the served folder",
+    "sub/../../outside.csv": "outside the served folder",
 }
 
 
 def test_only_tables_and_traces_of_the_folder_open(studio: Background, folder: Path) -> None:
     names = list(REFUSED)
-    replies = talk(studio, [*({"op": "open", "path": n} for n in names),
-                            *({"op": "trace", "path": n} for n in ("secret.env", "table.csv", ".t.jsonl")),
-                            {"op": "files"}], until="files")
+    replies = talk(
+        studio,
+        [
+            *({"op": "open", "path": n} for n in names),
+            *({"op": "trace", "path": n} for n in ("secret.env", "table.csv", ".t.jsonl")),
+            {"op": "files"},
+        ],
+        until="files",
+    )
     errors = [r for r in replies if r["type"] == "error"]
     assert [r["type"] for r in replies] == ["error"] * (len(names) + 3) + ["files"]
     for name, reply in zip(names, errors, strict=False):
@@ -119,18 +139,23 @@ def test_only_tables_and_traces_of_the_folder_open(studio: Background, folder: P
 
 def test_a_table_opens_and_saves_through_a_link_inside_the_folder(studio: Background, folder: Path) -> None:
     (folder / "latest.csv").symlink_to("victim.csv")
-    replies = talk(studio, [{"op": "open", "path": "latest.csv"}, {"op": "edit", "row": 3, "col": 12, "value": "901"},
-                            {"op": "save"}], until="saved")
+    replies = talk(
+        studio,
+        [{"op": "open", "path": "latest.csv"}, {"op": "edit", "row": 3, "col": 12, "value": "901"}, {"op": "save"}],
+        until="saved",
+    )
     assert replies[0]["path"] == "victim.csv" and replies[-1]["type"] == "saved"
     assert b",901," in (folder / "victim.csv").read_bytes() and (folder / "latest.csv").is_symlink()
 
 
 # --- saving: only the file this session opened ------------------------------------------------------------
 
+
 def _swap_then_save(studio: Background, swap: Any, force: bool = True) -> list[dict[str, Any]]:
     async def run() -> list[dict[str, Any]]:
-        async with websockets.connect(studio.origin.replace("http", "ws") + "/ws",
-                                      additional_headers=studio.headers, max_size=2**24) as ws:
+        async with websockets.connect(
+            studio.origin.replace("http", "ws") + "/ws", additional_headers=studio.headers, max_size=2**24
+        ) as ws:
             await ws.send(json.dumps({"op": "open", "path": "victim.csv"}))
             await _until(ws, "analysis")
             await ws.send(json.dumps({"op": "edit", "row": 3, "col": 12, "value": "777", "seq": 1}))
@@ -170,6 +195,7 @@ def test_a_link_swapped_in_after_opening_is_never_written_through(studio: Backgr
 def test_a_file_replaced_after_opening_is_not_overwritten_without_asking(studio: Background, folder: Path) -> None:
     """Replaced by a rename (an editor's save): the page is asked, as for an edit in place (what each answer
     does: test_studio_saves.py)."""
+
     def swap() -> None:
         (folder / "other.csv").write_bytes(b"state,next\n1,1\n")
         os.replace(folder / "other.csv", folder / "victim.csv")
@@ -210,8 +236,10 @@ def test_a_race_between_check_and_write_meets_no_follow(folder: Path, monkeypatc
     outside = folder.parent / "outside.csv"
     before = outside.read_bytes()
     (folder / "sub" / "t.csv").write_bytes((EXAMPLE / "table.csv").read_bytes())
-    for name, swap in (("victim.csv", lambda: _relink(folder / "victim.csv", outside)),
-                       ("sub/t.csv", lambda: _relink(folder / "sub", folder.parent))):
+    for name, swap in (
+        ("victim.csv", lambda: _relink(folder / "victim.csv", outside)),
+        ("sub/t.csv", lambda: _relink(folder / "sub", folder.parent)),
+    ):
         opened = workspace.read(name, Kind.TABLE, 10**6)
         swap()
         monkeypatch.setattr(Workspace, "locate", lambda self, n, kind: n)
@@ -233,10 +261,14 @@ def _relink(path: Path, target: Path) -> None:
 
 # --- messages that must not end the connection ---------------------------------------------------------------
 
+
 def test_a_message_nested_100000_deep_is_an_error_and_the_connection_lives(studio: Background) -> None:
     deep = "[" * 100_000 + "]" * 100_000
-    replies = talk(studio, [deep, '{"op": "open", "path": ' + "[" * 100_000, b"\x00binary".decode(),
-                            {"op": "files"}], until="files")
+    replies = talk(
+        studio,
+        [deep, '{"op": "open", "path": ' + "[" * 100_000, b"\x00binary".decode(), {"op": "files"}],
+        until="files",
+    )
     assert [r["type"] for r in replies] == ["error", "error", "error", "files"]
     assert "nested too deeply" in replies[0]["message"]
     status, body = http(studio, "api/trace?name=deep.jsonl", data=b'{"tick":0,"state":1}\n' + deep.encode() + b"\n")
@@ -245,8 +277,9 @@ def test_a_message_nested_100000_deep_is_an_error_and_the_connection_lives(studi
 
 def test_a_binary_frame_is_an_error_and_the_connection_lives(studio: Background) -> None:
     async def run() -> list[dict[str, Any]]:
-        async with websockets.connect(studio.origin.replace("http", "ws") + "/ws",
-                                      additional_headers=studio.headers) as ws:
+        async with websockets.connect(
+            studio.origin.replace("http", "ws") + "/ws", additional_headers=studio.headers
+        ) as ws:
             await ws.send(b"\x01\x02")
             await ws.send(json.dumps({"op": "files"}))
             return [json.loads(await ws.recv()), json.loads(await ws.recv())]
@@ -263,6 +296,7 @@ def test_a_table_that_is_not_utf8_is_refused_in_the_studios_words(studio: Backgr
 
 
 # --- pipes, sockets, devices -------------------------------------------------------------------------------
+
 
 def _can_mknod(tmp: Path) -> bool:
     try:

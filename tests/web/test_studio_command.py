@@ -29,8 +29,12 @@ def folder(tmp_path: Path) -> Path:
 
 def _start(*args: str) -> tuple[subprocess.Popen[str], str]:
     """``tablebot studio ARGS`` as a user runs it; the address it printed."""
-    process = subprocess.Popen([sys.executable, "-m", "tablebot.cli", "studio", *args, "--port", "0", "--no-browser"],
-                               stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "tablebot.cli", "studio", *args, "--port", "0", "--no-browser"],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     assert process.stderr is not None
     lines = []
     deadline = time.monotonic() + 60
@@ -81,5 +85,7 @@ def test_serving_the_network_warns_that_the_token_opens_the_folder(folder: Path)
         process.communicate(timeout=20)
     text = " ".join(printed.split())
     assert "warning: serving" in text and "0.0.0.0" in text
-    assert "anyone who can reach it and has the address below (with its token) can read the folder's tables, robot " \
-           "and world files and traces, and change its tables" in text
+    assert (
+        "anyone who can reach it and has the address below (with its token) can read the folder's tables, robot "
+        "and world files and traces, and change its tables" in text
+    )
