@@ -32,6 +32,7 @@ GOOD = HEADER + "\nGo,1,1,,,,3,,3,10,2\nBack,2,1,,,1,2,,0,5,1\n"
 
 # --- the document's own table ---------------------------------------------------------------------
 
+
 def test_seed_tsv_without_side_file_is_the_bumberbot(tmp_path: Path) -> None:
     path = tmp_path / "bumberbot-table.tsv"
     shutil.copy(SEED_TSV, path)
@@ -72,6 +73,7 @@ def test_example_uses_its_robot_file() -> None:
 
 # --- what spreadsheets save -------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("delimiter", [",", "\t", ";"])
 def test_delimiter_is_detected(tmp_path: Path, delimiter: str) -> None:
     text = (EXAMPLE / "table.csv").read_text().replace(",", delimiter)
@@ -100,8 +102,11 @@ def test_old_mac_line_ends(tmp_path: Path) -> None:
 
 
 def test_quoted_cells(tmp_path: Path) -> None:
+    # a table's rows one to a line, as the file has them: left as written
+    # fmt: off
     text = (HEADER + '\n"Go, fast ""now""\nand then",1,"1",,,,"3",,3,10,"2"\n'
             "Back,2,1,,,1,2,,0,5,1\n")
+    # fmt: on
     table = load_table(write_table(tmp_path, text, MINI_ROBOT))
     assert table.rows[0].description == 'Go, fast "now"\nand then'
     assert table.rows[0].events == {"T"}
@@ -146,10 +151,13 @@ def test_columns_in_any_order_and_missing_optional_ones(tmp_path: Path) -> None:
 
 
 def test_motor_forms_and_keep(tmp_path: Path) -> None:
+    # each row's comment on its row: left as written
+    # fmt: off
     text = (HEADER + "\n"
             "a,1,,,,1,3,0,3,0,1\n"   # backward 3, forward 3
             "b,1,,,,1,7,1,7,0,1\n"   # speed 7: keep, whatever the direction
             "c,1,,,,1,0,,8,0,1\n")   # backward 0 is stop; speed 8 is a real speed here
+    # fmt: on
     rows = load_table(write_table(tmp_path, text, MINI_ROBOT)).rows
     assert [r.motors for r in rows] == [(-3, 3), (None, None), (0, 8)]
 
@@ -162,8 +170,10 @@ def test_integer_like_cells(tmp_path: Path) -> None:
 
 def test_named_states(tmp_path: Path) -> None:
     robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "seek"')
-    text = ("state,T,A,M1,M2,timer,next\n"
-            "seek,1,,2,2,10,back off\nback off,1,,-2,-2,5,seek\nseek,,1,0,0,0,2\n2,1,,0,0,0,seek\n")
+    text = (
+        "state,T,A,M1,M2,timer,next\n"
+        "seek,1,,2,2,10,back off\nback off,1,,-2,-2,5,seek\nseek,,1,0,0,0,2\n2,1,,0,0,0,seek\n"
+    )
     machine = machine_of(tmp_path, text, robot)
     assert machine.states == ("seek", "back off", 2)
     assert machine.initial_state == 0

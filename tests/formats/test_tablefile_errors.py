@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
 # --- errors: one per kind, located -------------------------------------------------------------------
 
+
 def test_unknown_column(tmp_path: Path) -> None:
     text = HEADER.replace(",B,", ",Q9,") + "\nGo,1,1,,,,3,,3,10,1\n"
     d = find(problems(write_table(tmp_path, text, MINI_ROBOT)), "unknown column 'Q9'")
@@ -40,16 +41,19 @@ def test_non_integer(tmp_path: Path) -> None:
     assert "'fast'" in d.message and d.hint
 
 
-@pytest.mark.parametrize(("cells", "index", "pattern"), [
-    ("Go,1,1,,,,9,,3,10,1", 6, r"M1_speed: 9 is out of range 0\.\.8"),
-    ("Go,1,1,,,,-1,,3,10,1", 6, r"M1_speed: -1 is out of range"),
-    ("Go,1,1,,,2,3,,3,10,1", 5, r"M1_dir: 2 is out of range 0\.\.1"),
-    ("Go,1,1,,,,3,,3,65536,1", 9, r"timer: 65536 is out of range 0\.\.65535"),
-    ("Go,1,1,,,,3,,3,-1,1", 9, r"timer: -1 is out of range"),
-    ("Go,1,2,,,,3,,3,10,1", 2, r"event T: 2 is out of range 0\.\.1"),
-    ("Go,1,1,x,,,3,,3,10,1", 3, r"event A: 'x' is not an integer"),
-    ("Go,1,1,,,,3,,3,1.5,1", 9, r"timer: '1\.5' is not an integer"),
-])
+@pytest.mark.parametrize(
+    ("cells", "index", "pattern"),
+    [
+        ("Go,1,1,,,,9,,3,10,1", 6, r"M1_speed: 9 is out of range 0\.\.8"),
+        ("Go,1,1,,,,-1,,3,10,1", 6, r"M1_speed: -1 is out of range"),
+        ("Go,1,1,,,2,3,,3,10,1", 5, r"M1_dir: 2 is out of range 0\.\.1"),
+        ("Go,1,1,,,,3,,3,65536,1", 9, r"timer: 65536 is out of range 0\.\.65535"),
+        ("Go,1,1,,,,3,,3,-1,1", 9, r"timer: -1 is out of range"),
+        ("Go,1,2,,,,3,,3,10,1", 2, r"event T: 2 is out of range 0\.\.1"),
+        ("Go,1,1,x,,,3,,3,10,1", 3, r"event A: 'x' is not an integer"),
+        ("Go,1,1,,,,3,,3,1.5,1", 9, r"timer: '1\.5' is not an integer"),
+    ],
+)
 def test_cell_values_out_of_range(tmp_path: Path, cells: str, index: int, pattern: str) -> None:
     d = find(problems(write_table(tmp_path, HEADER + "\n" + cells + "\n", MINI_ROBOT)), pattern)
     assert (d.line, d.column) == (2, column_of(cells, index))
@@ -159,11 +163,13 @@ def test_cell_under_a_blank_header(tmp_path: Path) -> None:
 
 
 def test_all_problems_of_a_file_in_one_run(tmp_path: Path) -> None:
-    text = (HEADER.replace("description", "descr") + "\n"
-            "Go,1,1,,,,9,,3,10,1\n"
-            "Go,1,1,,,,3,,3,99999,1\n"
-            "Go,1,1,,,,3,,3,10,42\n"
-            "Go,x y!,1,,,,3,,3,10,1\n")
+    text = (
+        HEADER.replace("description", "descr") + "\n"
+        "Go,1,1,,,,9,,3,10,1\n"
+        "Go,1,1,,,,3,,3,99999,1\n"
+        "Go,1,1,,,,3,,3,10,42\n"
+        "Go,x y!,1,,,,3,,3,10,1\n"
+    )
     diagnostics = problems(write_table(tmp_path, text, MINI_ROBOT))
     assert [d.line for d in diagnostics] == [1, 2, 3, 5, 4]
     assert all(d.hint for d in diagnostics)
@@ -212,15 +218,19 @@ def test_parse_table_directly() -> None:
 
 # --- robot files -----------------------------------------------------------------------------------
 
-@pytest.mark.parametrize(("robot", "pattern", "line"), [
-    ("colour = 3\n" + MINI_ROBOT, "unknown key 'colour'", 1),
-    (MINI_ROBOT.replace("initial_state = 1\n", ""), "initial_state is missing", None),
-    ("tick_ms = 0\n" + MINI_ROBOT, "tick_ms must be a positive", 1),
-    (MINI_ROBOT.replace('A = "left switch"', 'T = "oops"'), "bad inputs name 'T'", 5),
-    (MINI_ROBOT.replace('B = "right switch"', 'M1 = "twice"'), "M1 is used twice", 6),
-    (MINI_ROBOT + "[counters]\nC1 = \"M9\"\n", "counter C1 counts motor 'M9'", 11),
-    (MINI_ROBOT + "[counters]\nT = \"M1\"\n", "bad counters name 'T'", 11),
-])
+
+@pytest.mark.parametrize(
+    ("robot", "pattern", "line"),
+    [
+        ("colour = 3\n" + MINI_ROBOT, "unknown key 'colour'", 1),
+        (MINI_ROBOT.replace("initial_state = 1\n", ""), "initial_state is missing", None),
+        ("tick_ms = 0\n" + MINI_ROBOT, "tick_ms must be a positive", 1),
+        (MINI_ROBOT.replace('A = "left switch"', 'T = "oops"'), "bad inputs name 'T'", 5),
+        (MINI_ROBOT.replace('B = "right switch"', 'M1 = "twice"'), "M1 is used twice", 6),
+        (MINI_ROBOT + '[counters]\nC1 = "M9"\n', "counter C1 counts motor 'M9'", 11),
+        (MINI_ROBOT + '[counters]\nT = "M1"\n', "bad counters name 'T'", 11),
+    ],
+)
 def test_robot_file_problems(tmp_path: Path, robot: str, pattern: str, line: int | None) -> None:
     d = find(problems(write_table(tmp_path, GOOD, robot)), pattern)
     assert d.path.endswith("robot.toml")
