@@ -59,7 +59,7 @@ def sweep_cmd(
 
     left_to_the_system()
     with collection_paused():  # start-up (see there); the sweep holds the collector off while it plans too
-        project = open_project(table, robot, worlds=world)
+        project = open_project(table, robot, worlds=world, properties=[])  # a sweep proves nothing: none looked for
     with stops():
         result = project.sweep(robots=robots, seeds=seeds, grid=grid or [], seconds=seconds, backend=backend,
                                scheduler=scheduler, workers=workers, out=out, plots=plots, trace=trace,
