@@ -13,7 +13,7 @@ from tablebot.analysis.graphviz_run import INSTALL, GraphvizFailed, NoGraphviz, 
 from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import dot_id, dot_label, mermaid_label
-from tablebot.i18n import N_, _, localise
+from tablebot.i18n import N_, _, localise, number
 from tablebot.robot import StateId
 from tablebot.table import TIMER_EVENT, Row, Table
 
@@ -103,7 +103,7 @@ def duration(table: Table, ticks: int) -> str:
     if ticks == 0:
         return ""
     ms = ticks * table.robot.tick_ms
-    return f"{ms / 1000:g} s" if ms >= 1000 else f"{ms} ms"
+    return f"{number(ms / 1000)} s" if ms >= 1000 else f"{ms} ms"  # 1,5 s in German
 
 
 def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:

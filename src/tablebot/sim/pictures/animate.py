@@ -22,7 +22,7 @@ from tablebot.colours import state_colours
 from tablebot.diagnostics import fail
 from tablebot.escape import picture
 from tablebot.files import atomic_write
-from tablebot.i18n import N_, _
+from tablebot.i18n import N_, _, number
 from tablebot.sim import columns as L
 from tablebot.sim.pictures.draw import RobotArtist, draw_world, literal_text, sensor_readings
 from tablebot.sim.pictures.plots import subtitle_of, title_of
@@ -79,7 +79,7 @@ class Player:
                             for k, (n, v) in enumerate(zip(names, last, strict=True)))
         speed = "   " + _("({speed:g}× speed)").format(speed=self.speed) if self.speed != 1 else ""
         now = picture(f"{scene.table.state_title(state)}   {outputs}")
-        self.hud.set_text(f"t = {t * r.tick_s:6.2f} s{speed}\n{now}")
+        self.hud.set_text(f"t = {number(t * r.tick_s, '6.2f')} s{speed}\n{now}")
         return [self.trail, self.hud, *self.robot.artists()]
 
 

@@ -18,7 +18,7 @@ from matplotlib.patches import Patch
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
-from tablebot.i18n import _
+from tablebot.i18n import _, number
 from tablebot.sim import columns as L
 from tablebot.sim.pictures.draw import (
     BEAM,
@@ -245,7 +245,7 @@ def _legend(fig: Figure, result: RunView, summary: Summary, spins: bool) -> None
     handles = [
         Patch(
             color=colours[machine.states.index(state)],
-            label=picture(f"{result.scene.table.state_title(state)}  ({secs:.1f} s)"),
+            label=picture(f"{result.scene.table.state_title(state)}  ({number(secs, '.1f')} s)"),
         )
         for state, secs in summary.state_seconds.items()
         if secs > 0
