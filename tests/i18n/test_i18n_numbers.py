@@ -77,3 +77,11 @@ def test_sims_summary_in_german(tmp_path: Path) -> None:
     assert "120,0 s simuliert" in german and "2,79 m" in german and "9,05 V -> 8,90 V" in german, german
     assert "1,50 s" in german and "100,0 %" in german and "120.0" not in german, german
     assert "distance driven:  2.79 m" in "\n".join(summary.lines())
+
+
+def test_a_diagrams_timer_in_german() -> None:
+    from test_i18n_catalog import run_in
+
+    bumberbot = str(Path(__file__).resolve().parents[2] / "examples" / "bumberbot")
+    assert "1,5 s" in run_in("de", ["diagram", bumberbot, "--format", "mermaid"])
+    assert "1.5 s" in run_in("en", ["diagram", bumberbot, "--format", "mermaid"])
