@@ -23,14 +23,46 @@ from tablebot.diagnostics import TableBotError
 _MODE = os.environ.get("TABLEBOT_FUZZ", "ci")
 _LONG = _MODE != "ci"
 _EXAMPLES = int(_MODE) if _MODE.isdigit() else 1500 if _LONG else 60
-FUZZ = settings(max_examples=_EXAMPLES, derandomize=not _LONG, deadline=None, database=None,
-                suppress_health_check=list(HealthCheck))
+FUZZ = settings(
+    max_examples=_EXAMPLES, derandomize=not _LONG, deadline=None, database=None, suppress_health_check=list(HealthCheck)
+)
 runner = CliRunner()
 
 HUGE = st.sampled_from([2**63, -(2**63) - 1, 10**400, 65536, -1, 0, 1, 7, 8, 9, 32767, 1e308, 1e-308])
-WEIRD_TEXT = st.sampled_from(["", " ", "\x00", "²", "٣", "1e9", "-0", "+1", "1.5", "=", "keep", "NaN", "inf",
-                              '"', '""', "a,b", "a;b", "\n", "\r", "\t", "T", "state", "next", "I3", "M1",
-                              "*/", "[bold]", "\ud800", "x" * 1000, "1" * 400])
+WEIRD_TEXT = st.sampled_from(
+    [
+        "",
+        " ",
+        "\x00",
+        "²",
+        "٣",
+        "1e9",
+        "-0",
+        "+1",
+        "1.5",
+        "=",
+        "keep",
+        "NaN",
+        "inf",
+        '"',
+        '""',
+        "a,b",
+        "a;b",
+        "\n",
+        "\r",
+        "\t",
+        "T",
+        "state",
+        "next",
+        "I3",
+        "M1",
+        "*/",
+        "[bold]",
+        "\ud800",
+        "x" * 1000,
+        "1" * 400,
+    ]
+)
 TEXT = st.one_of(WEIRD_TEXT, st.text(max_size=12), HUGE.map(str))
 
 
@@ -54,21 +86,32 @@ def toml_value(value: Any) -> str:
 
 
 SCALAR = st.one_of(st.booleans(), HUGE, st.integers(), st.floats(), TEXT.filter(lambda s: "\ud800" not in s))
-VALUE = st.recursive(SCALAR, lambda inner: st.one_of(st.lists(inner, max_size=3),
-                                                     st.dictionaries(st.text(max_size=4), inner, max_size=3)),
-                     max_leaves=8)
+VALUE = st.recursive(
+    SCALAR,
+    lambda inner: st.one_of(st.lists(inner, max_size=3), st.dictionaries(st.text(max_size=4), inner, max_size=3)),
+    max_leaves=8,
+)
 
 
 def document(keys: list[str], sections: dict[str, list[str]]) -> st.SearchStrategy[str]:
     """TOML text whose keys are (mostly) the loader's own, each with a value of any type."""
+
     def key(known: list[str]) -> st.SearchStrategy[str]:
         return st.one_of(st.sampled_from(known), st.text(min_size=1, max_size=5))
 
     top = st.dictionaries(key(keys), VALUE, max_size=6)
-    parts = st.dictionaries(st.sampled_from(list(sections)),
-                            st.one_of(st.dictionaries(st.text(max_size=1).flatmap(lambda _: key(
-                                [k for ks in sections.values() for k in ks])), VALUE, max_size=5), VALUE),
-                            max_size=4)
+    parts = st.dictionaries(
+        st.sampled_from(list(sections)),
+        st.one_of(
+            st.dictionaries(
+                st.text(max_size=1).flatmap(lambda _: key([k for ks in sections.values() for k in ks])),
+                VALUE,
+                max_size=5,
+            ),
+            VALUE,
+        ),
+        max_size=4,
+    )
 
     def render(values: tuple[dict, dict]) -> str:
         head, body = values
@@ -95,21 +138,31 @@ def mangle(text: str, data: st.DataObject) -> bytes:
     raw = text.encode("utf-8", "surrogatepass")
     how = data.draw(st.sampled_from(["keep", "keep", "nul", "latin1", "cut", "bom16"]))
     at = data.draw(st.integers(0, len(raw)))
-    return {"keep": raw, "nul": raw[:at] + b"\x00" + raw[at:], "latin1": raw[:at] + b"\xe9\xff" + raw[at:],
-            "cut": raw[:at], "bom16": b"\xff\xfe" + raw}[how]
+    return {
+        "keep": raw,
+        "nul": raw[:at] + b"\x00" + raw[at:],
+        "latin1": raw[:at] + b"\xe9\xff" + raw[at:],
+        "cut": raw[:at],
+        "bom16": b"\xff\xfe" + raw,
+    }[how]
 
 
 def csv_text(header: list[str]) -> st.SearchStrategy[str]:
     cells = st.one_of(st.sampled_from(["", "1", "0", "3", "-3", "=", "7"]), TEXT)
     row = st.lists(cells, min_size=0, max_size=len(header) + 2)
-    head = st.one_of(st.just(header), st.permutations(header), st.lists(st.one_of(st.sampled_from(header), TEXT),
-                                                                       max_size=len(header) + 2))
+    head = st.one_of(
+        st.just(header),
+        st.permutations(header),
+        st.lists(st.one_of(st.sampled_from(header), TEXT), max_size=len(header) + 2),
+    )
     sep = st.sampled_from([",", ";", "\t"])
 
     def render(values: tuple[list[str], list[list[str]], str, bool]) -> str:
         first, rows, delimiter, quote = values
+
         def line(cells: list[str]) -> str:
             return delimiter.join(f'"{c}"' if quote and '"' not in c else c for c in cells)
+
         return "\n".join([line(first), *(line(r) for r in rows)]) + "\n"
 
     return st.tuples(head, st.lists(row, max_size=6), sep, st.booleans()).map(render)

@@ -50,19 +50,79 @@ EXAMPLE = ROOT / "examples" / "bumberbot"
 RPP = Path(__file__).resolve().parents[1] / "fixtures" / "rpp" / "engine.rpp"
 MACHINE = compile_table(load_table(EXAMPLE / "table.csv"))
 
-TABLE_HEADER = ["description", "state", "T", "I3", "I4", "I5", "I7", "I8", "M1_dir", "M1_speed", "M2_dir",
-                "M2_speed", "timer", "next"]
+TABLE_HEADER = [
+    "description",
+    "state",
+    "T",
+    "I3",
+    "I4",
+    "I5",
+    "I7",
+    "I8",
+    "M1_dir",
+    "M1_speed",
+    "M2_dir",
+    "M2_speed",
+    "timer",
+    "next",
+]
 ROBOT_KEYS = ["name", "tick_ms", "initial_state", "initial_timer"]
-ROBOT_SECTIONS = {"inputs": ["I3", "A", "T"], "motors": ["M1", "M2"], "counters": ["C1"], "lamps": ["L1"],
-                  "states": ["1", "2", "seek"], "sim": ["world"], "wiring": ["I3"], "properties": ["p"]}
-WORLD_SECTIONS = {"arena": ["walls"], "start": ["at", "heading"], "lamp": ["at", "intensity", "radius"],
-                  "box": ["at", "size", "angle"], "circle": ["at", "radius"], "segment": ["from", "to"]}
-PROPERTY_VALUES = st.one_of(VALUE, st.lists(st.sampled_from(
-    ["state", "==", "20", "and", "or", "not", "(", ")", "M1", ">", "-1", "I3", "T", "in", "[", "]", ",", "line",
-     "fired", "99999999999999999999", "²", "ticks", "ms", "s"]), max_size=8).map(" ".join))
+ROBOT_SECTIONS = {
+    "inputs": ["I3", "A", "T"],
+    "motors": ["M1", "M2"],
+    "counters": ["C1"],
+    "lamps": ["L1"],
+    "states": ["1", "2", "seek"],
+    "sim": ["world"],
+    "wiring": ["I3"],
+    "properties": ["p"],
+}
+WORLD_SECTIONS = {
+    "arena": ["walls"],
+    "start": ["at", "heading"],
+    "lamp": ["at", "intensity", "radius"],
+    "box": ["at", "size", "angle"],
+    "circle": ["at", "radius"],
+    "segment": ["from", "to"],
+}
+PROPERTY_VALUES = st.one_of(
+    VALUE,
+    st.lists(
+        st.sampled_from(
+            [
+                "state",
+                "==",
+                "20",
+                "and",
+                "or",
+                "not",
+                "(",
+                ")",
+                "M1",
+                ">",
+                "-1",
+                "I3",
+                "T",
+                "in",
+                "[",
+                "]",
+                ",",
+                "line",
+                "fired",
+                "99999999999999999999",
+                "²",
+                "ticks",
+                "ms",
+                "s",
+            ]
+        ),
+        max_size=8,
+    ).map(" ".join),
+)
 
 
 # --- the loaders ------------------------------------------------------------------------------------------
+
 
 @FUZZ
 @given(st.data(), csv_text(TABLE_HEADER), deep(document(ROBOT_KEYS, ROBOT_SECTIONS)), st.booleans())
@@ -101,26 +161,56 @@ def test_inputs(data: st.DataObject, inputs: str) -> None:
 
 
 @FUZZ
-@given(st.data(), st.dictionaries(st.one_of(st.sampled_from(["p", "bad name", "../x", "a\x00"]), st.text(max_size=4)),
-                                  st.one_of(st.dictionaries(st.sampled_from(
-                                      ["text", "level", "note", "never", "always", "reachable", "always_reachable",
-                                       "when", "then", "within", "other"]), PROPERTY_VALUES, max_size=5), VALUE),
-                                  max_size=3))
+@given(
+    st.data(),
+    st.dictionaries(
+        st.one_of(st.sampled_from(["p", "bad name", "../x", "a\x00"]), st.text(max_size=4)),
+        st.one_of(
+            st.dictionaries(
+                st.sampled_from(
+                    [
+                        "text",
+                        "level",
+                        "note",
+                        "never",
+                        "always",
+                        "reachable",
+                        "always_reachable",
+                        "when",
+                        "then",
+                        "within",
+                        "other",
+                    ]
+                ),
+                PROPERTY_VALUES,
+                max_size=5,
+            ),
+            VALUE,
+        ),
+        max_size=3,
+    ),
+)
 def test_properties(data: st.DataObject, props: dict[str, Any]) -> None:
     text = "\n".join(f"{toml_key(k)} = {toml_value(v)}" for k, v in props.items()) + "\n"
-    in_folder({"p.toml": mangle(text, data)},
-              lambda f: expect_located(lambda: load_properties(MACHINE, [f / "p.toml"])))
+    in_folder(
+        {"p.toml": mangle(text, data)}, lambda f: expect_located(lambda: load_properties(MACHINE, [f / "p.toml"]))
+    )
 
 
 LIST_LINE = st.one_of(st.integers(-5, 70000).map(str), TEXT, st.just(""))
 
 
 @FUZZ
-@given(st.data(), st.lists(st.lists(LIST_LINE, max_size=5), min_size=3, max_size=3),
-       st.one_of(st.none(), csv_text(["number", "name"])))
+@given(
+    st.data(),
+    st.lists(st.lists(LIST_LINE, max_size=5), min_size=3, max_size=3),
+    st.one_of(st.none(), csv_text(["number", "name"])),
+)
 def test_robopro_lists_and_states(data: st.DataObject, lists: list[list[str]], states: str | None) -> None:
-    files = {name: mangle("\n".join(lines) + "\n", data)
-             for name, lines in zip(("event.csv", "action.csv", "timer.csv"), lists, strict=True)}
+    files = {
+        name: mangle("\n".join(lines) + "\n", data)
+        for name, lines in zip(("event.csv", "action.csv", "timer.csv"), lists, strict=True)
+    }
     if states is not None:
         files["states.csv"] = mangle(states, data)
 
@@ -132,9 +222,26 @@ def test_robopro_lists_and_states(data: st.DataObject, lists: list[list[str]], s
 
 
 RPP_TEXT = RPP.read_text(encoding="utf-8")
-XMLISH = st.sampled_from(['<o classname="ftProDataArray1D" name="Event" N="x²">', "</o>", "<init/>", "<init value='1'>",
-                          "<!--", "-->", "<![CDATA[", "]]>", '<?xml version="1.0" encoding="rot13"?>', "<cvg>",
-                          '<o classname="ftProDataArray1D" name="Event"/>', "\x00", "&", "<", ">", '"'])
+XMLISH = st.sampled_from(
+    [
+        '<o classname="ftProDataArray1D" name="Event" N="x²">',
+        "</o>",
+        "<init/>",
+        "<init value='1'>",
+        "<!--",
+        "-->",
+        "<![CDATA[",
+        "]]>",
+        '<?xml version="1.0" encoding="rot13"?>',
+        "<cvg>",
+        '<o classname="ftProDataArray1D" name="Event"/>',
+        "\x00",
+        "&",
+        "<",
+        ">",
+        '"',
+    ]
+)
 
 
 @FUZZ
@@ -142,7 +249,7 @@ XMLISH = st.sampled_from(['<o classname="ftProDataArray1D" name="Event" N="x²">
 def test_rpp(data: st.DataObject, edits: list[tuple[int, int, str]]) -> None:
     text = RPP_TEXT
     for at, cut, insert in edits:
-        text = text[:at] + insert + text[at + cut:]
+        text = text[:at] + insert + text[at + cut :]
 
     def run(folder: Path) -> None:
         lists = {"Event": [1, 2], "Action": [3, 4], "Timer": [5, 6]}
@@ -152,12 +259,17 @@ def test_rpp(data: st.DataObject, edits: list[tuple[int, int, str]]) -> None:
 
 
 TRACE_KEYS = st.sampled_from(["tick", "event", "row", "state", "M1"])
-TRACE_LINE = st.one_of(st.dictionaries(TRACE_KEYS, SCALAR).map(json.dumps), VALUE.map(json.dumps), TEXT,
-                       st.integers(1, 3000).map(lambda n: "[" * n + "]" * n))
+TRACE_LINE = st.one_of(
+    st.dictionaries(TRACE_KEYS, SCALAR).map(json.dumps),
+    VALUE.map(json.dumps),
+    TEXT,
+    st.integers(1, 3000).map(lambda n: "[" * n + "]" * n),
+)
 
 
 @FUZZ
 @given(st.data(), st.lists(TRACE_LINE, max_size=5))
 def test_trace_files(data: st.DataObject, lines: list[str]) -> None:
-    in_folder({"t.jsonl": mangle("\n".join(lines) + "\n", data)},
-              lambda f: expect_located(lambda: read_trace(f / "t.jsonl")))
+    in_folder(
+        {"t.jsonl": mangle("\n".join(lines) + "\n", data)}, lambda f: expect_located(lambda: read_trace(f / "t.jsonl"))
+    )
