@@ -4,11 +4,9 @@
 from __future__ import annotations
 
 import csv
-import gc
 import io
 import time
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -135,30 +133,14 @@ def _start(project: Loaded, runner: Runner, grid: Sequence[str], seeds: str | No
            seconds: float, pictures: bool) -> Plan:
     """The fleet's modules imported and the sweep planned, while a cluster's workers start up or this process's
     compiled code loads on a thread (:meth:`Runner.imported`); the robot's tables as ``project`` read them."""
-    with collection_paused():
-        runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
-        from tablebot.fleet.plan import make_plan
+    runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
+    from tablebot.fleet.plan import make_plan
 
-        if pictures:  # before the run (an interrupt never lands in matplotlib's import)
-            import tablebot.fleet.plots  # noqa: F401
-        runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
-        return make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
-                         every_table=True, grid_cells=True, read=(project.table, project.tables))
-
-
-@contextmanager
-def collection_paused() -> Iterator[None]:
-    """Python's cyclic garbage collector held off meanwhile, then as it was: a sweep's start-up makes hundreds of
-    thousands of objects that live on (numba's, numpy's and tablebot's modules, the plan), and the collector
-    walked them all again and again as they were made -- a tenth of the imports' CPU time -- finding no garbage
-    among them."""
-    was = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was:
-            gc.enable()
+    if pictures:  # before the run (an interrupt never lands in matplotlib's import)
+        import tablebot.fleet.plots  # noqa: F401
+    runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
+    return make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
+                     every_table=True, grid_cells=True, read=(project.table, project.tables))
 
 
 def trace_runs(runs: Traced, total: int) -> list[int]:

@@ -3,8 +3,6 @@ machine's cores or a Dask cluster, one result row per run, pictures, resumable."
 
 from __future__ import annotations
 
-import atexit
-import gc
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -54,28 +52,15 @@ def sweep_cmd(
     """Run TABLE on many simulated robots: every world × grid combination × seed, one row per run in
     OUT/results.csv, with pictures. Ctrl-C (or SIGTERM) keeps every finished chunk; the same command again
     resumes."""
-    from tablebot.api.sweeping import collection_paused
     from tablebot.cli.progress import CountBar
 
-    left_to_the_system()
-    with collection_paused():  # start-up (see there); the sweep holds the collector off while it plans too
-        project = open_project(table, robot, worlds=world, properties=[])  # a sweep proves nothing: none looked for
+    project = open_project(table, robot, worlds=world, properties=[])  # a sweep proves nothing: none looked for
     with stops():
         result = project.sweep(robots=robots, seeds=seeds, grid=grid or [], seconds=seconds, backend=backend,
                                scheduler=scheduler, workers=workers, out=out, plots=plots, trace=trace,
                                progress=CountBar(quiet))
     if not quiet:
         report(result)
-
-
-def left_to_the_system() -> None:
-    """As this process exits, its objects are left for the system to free: the interpreter's last collections
-    walked every object numba, numpy and the sweep made (~0.1 s of a 10,000-robot sweep's ~2 s on 2 cores), to
-    free memory the process was giving back anyway. Files are closed and standard output flushed as ever (the
-    sweep closes what it writes; the interpreter flushes its streams itself). Run at exit, so a process that
-    goes on after the command (the tests' CliRunner) keeps its collector as it was."""
-    atexit.unregister(gc.freeze)  # once, however many sweeps a process makes
-    atexit.register(gc.freeze)
 
 
 @contextmanager
