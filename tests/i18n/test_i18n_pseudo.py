@@ -257,3 +257,10 @@ def test_german_reports_write_decimal_commas_and_their_data_the_point(tmp_path: 
     report = (tmp_path / "tune" / "report.md").read_text(encoding="utf-8")
     assert "| time_to_lamp (Ziel) | " in report and re.search(r"\| \d+,\d{3} \| \d+,\d{3} \|", report), report
     csv_numbers_keep_the_point(tmp_path / "tune" / "evaluations.csv")
+
+
+def test_the_leaderboards_counterexample_is_in_the_readers_language(tmp_path: Path) -> None:
+    """grade's leaderboard.html told a broken rule's story in English (its steps are messages, joined as text)."""
+    run_in("de", ["grade", "find-the-lamp", str(EXAMPLE), "--out", str(tmp_path / "de")])
+    page = (tmp_path / "de" / "leaderboard.html").read_text(encoding="utf-8")
+    assert "Zeile 19 (Collision Rear) schaltet" in page and "fires:" not in page, page

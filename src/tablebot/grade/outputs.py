@@ -14,7 +14,7 @@ from pathlib import Path
 from tablebot.escape import html_text as h
 from tablebot.grade.challenge import Challenge
 from tablebot.grade.run import Entry, best_and_worst, ranked, shown
-from tablebot.i18n import _, current, ngettext
+from tablebot.i18n import _, current, localise, ngettext
 
 COLUMNS = ("rank", "name", "score", "why")
 
@@ -162,7 +162,7 @@ def _rules(entry: Entry) -> str:
             parts.append(f'<div class="holds">✓ {h(rule.name)}</div>')
             continue
         verdict = h(_("breaks") if rule.status == "violated" else _("not proved:"))
-        story = "\n".join(rule.story)
+        story = "\n".join(str(localise(line)) for line in rule.story)  # Messages: in the reader's language
         parts.append(f'<details open><summary class="broken">✗ {verdict} {h(rule.name)}</summary>'
                      f"{h(rule.text)}" + (f"<pre>{h(story)}</pre>" if story else "") + "</details>")
     if entry.why and not any(rule.status != "holds" for rule in entry.rules):
