@@ -85,3 +85,23 @@ def test_a_diagrams_timer_in_german() -> None:
     bumberbot = str(Path(__file__).resolve().parents[2] / "examples" / "bumberbot")
     assert "1,5 s" in run_in("de", ["diagram", bumberbot, "--format", "mermaid"])
     assert "1.5 s" in run_in("en", ["diagram", bumberbot, "--format", "mermaid"])
+
+
+def test_an_evolved_rows_description_in_german() -> None:
+    """A table evolve writes says in each changed row's description what changed, in the reader's language."""
+    from dataclasses import replace
+
+    from tablebot.evolve import space
+    from tablebot.evolve.report import describe
+    from tablebot.formats.table_read import load_table
+
+    table = load_table(str(Path(__file__).resolve().parents[2] / "examples" / "bumberbot" / "table.csv"))
+    gene = next(g for g in space.start(table) if g.timer)
+    changed = replace(gene, timer=gene.timer + 5, motors=(None, *gene.motors[1:]))
+    try:
+        use("de")
+        german = describe(changed, table)
+    finally:
+        use("en")
+    assert "entwickelt:" in german and f"Timer {gene.timer}->{gene.timer + 5}" in german, german
+    assert "evolved:" in describe(changed, table)

@@ -56,7 +56,8 @@ def describe(gene: Gene, base: Table) -> str:
         what = action(table, _row(gene))
         timer = f", {what.timer}" if what.timer else ""
         goes = f" -> {table.state_title(gene.next)}"
-        return f"{condition(table, [gene.events])}: {what.text}{timer}{goes} (added: {gene.note or 'new row'})"
+        return _("{when}: {action} (added: {note})").format(
+            when=condition(table, [gene.events]), action=f"{what.text}{timer}{goes}", note=gene.note or _("new row"))
     changes = []
     for name, old, new in zip(table.robot.motors, original.motors, gene.motors, strict=True):
         if old != new:
@@ -65,21 +66,22 @@ def describe(gene: Gene, base: Table) -> str:
         if old_level != new_level:
             changes.append(f"{name} {_level(old_level)}->{_level(new_level)}")
     if original.timer != gene.timer:
-        changes.append(f"timer {original.timer}->{gene.timer}")
+        changes.append(_("timer {old}->{new}").format(old=original.timer, new=gene.timer))
     if original.next != gene.next:
-        changes.append(f"next {original.next}->{gene.next}")
+        changes.append(_("next {old}->{new}").format(old=original.next, new=gene.next))
     if original.state != gene.state:
-        changes.append(f"moved from state {original.state}")
-    text = original.description or f"line {original.line}"
-    return f"{text} (evolved: {', '.join(changes)})" if changes else original.description
+        changes.append(_("moved from state {state}").format(state=original.state))
+    text = original.description or _("line {line}").format(line=original.line)
+    return _("{text} (evolved: {changes})").format(text=text, changes=", ".join(changes)) if changes \
+        else original.description
 
 
 def _speed(value: int | None) -> str:
-    return "keep" if value is None else f"{value:+d}"
+    return _("keep") if value is None else f"{value:+d}"
 
 
 def _level(value: int | None) -> str:
-    return "keep" if value is None else str(value)
+    return _("keep") if value is None else str(value)
 
 
 def _row(gene: Gene) -> Row:
