@@ -4,9 +4,12 @@ of a process sharing their scenes, and cluster chunks their table and world."""
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import asdict, replace
+from typing import Any
 
 import numpy as np
+import pytest
 
 from tablebot.fleet.plan import make_plan
 from tablebot.fleet.spec import chunks, runs
@@ -65,3 +68,43 @@ def test_spec_json_is_the_spec_as_a_resumed_sweep_compares_it() -> None:
     assert data["seeds"] == [0, 1, 2, 7] and data["ticks"] == 50 and data["code"] == spec.code
     assert data["axes"] == [{"key": "battery", "values": [1.0, 0.6]},
                             {"key": "start", "values": ["random", [0.5, 0.4, 90.0]]}]
+
+
+def test_threads_starting_chunks_at_once_prepare_each_scene_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sweep's two worker threads start their first chunks together: one prepares the scene their chunks
+    share while the other waits for it, and nothing reads the scenes while they change (two threads both
+    prepared it, and one read the scenes as the other added one: "dictionary changed size during iteration")."""
+    import threading
+
+    import tablebot.fleet.starts as starts
+    from tablebot.fleet.run import Fleet
+
+    plan = make_plan(BUMBERBOT, None, [], [], "0..3", None, 0.1)
+    job = plan.jobs()[0]
+    machine, prepared = shared(job)
+    inside, calls = threading.Event(), []
+
+    def slow_prepare(*args: Any, **kwargs: Any) -> Any:
+        calls.append(threading.current_thread().name)
+        inside.set()
+        time.sleep(0.3)  # the other thread asks meanwhile
+        return prepare(*args, **kwargs)
+
+    prepare = starts.prepare
+    monkeypatch.setattr(starts, "prepare", slow_prepare)
+    failed: list[BaseException] = []
+
+    def chunk() -> None:
+        try:
+            Fleet(job.table, machine, job.world, job.specs, job.robot_params, prepared=prepared)
+        except BaseException as exc:
+            failed.append(exc)
+
+    first = threading.Thread(target=chunk, name="first")
+    first.start()
+    inside.wait(10)
+    second = threading.Thread(target=chunk, name="second")
+    second.start()
+    first.join(30)
+    second.join(30)
+    assert failed == [] and calls == ["first"] and len(prepared.scenes) == 1

@@ -4,6 +4,7 @@ once per parameter set, shared by the chunks of one process) at its own start po
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -22,10 +23,14 @@ class Prepared:
     """What fleets of one table in one world with one robot layer share, by parameter set: the scene
     (:func:`~tablebot.sim.model.scene.prepare`: the world's pieces and shadow grid, milliseconds each) and how its
     robots start. A sweep's chunks in one process share one instead of preparing them again per chunk
-    (:func:`tablebot.fleet.work.shared`); scenes and starters are only read once made."""
+    (:func:`tablebot.fleet.work.shared`); scenes and starters are only read once made. Its chunks run on several
+    threads at once: each entry is made under ``lock``, once (two threads starting their first chunks both
+    prepared the scene, and one could read the scenes while the other added one: "dictionary changed size
+    during iteration", the sweep ended by an internal error)."""
 
     scenes: dict[tuple, Scene] = field(default_factory=dict)
     starters: dict[tuple, Starter] = field(default_factory=dict)
+    lock: threading.Lock = field(default_factory=threading.Lock, repr=False, compare=False)
 
 
 class Starts:
@@ -41,21 +46,25 @@ class Starts:
         """The robot's scene: the table in the world with its parameters (made once per parameter set)
         and its start; every robot of a fleet must be wired alike."""
         scenes = self.prepared.scenes
-        if spec.params not in scenes:
-            scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides(), self.tables)
-            first = next(iter(scenes.values()), scene)
-            if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
-                                                                           first.pulse_columns):
-                raise ValueError("robots of one fleet must share their wiring")
-            scenes[spec.params] = scene
-        return with_start(scenes[spec.params], spec.start)
+        with self.prepared.lock:
+            if spec.params not in scenes:
+                scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides(),
+                                self.tables)
+                first = next(iter(scenes.values()), scene)
+                if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
+                                                                               first.pulse_columns):
+                    raise ValueError("robots of one fleet must share their wiring")
+                scenes[spec.params] = scene
+            made = scenes[spec.params]
+        return with_start(made, spec.start)
 
     def starter(self, spec: RobotSpec, scene: Scene) -> Starter:
         """How robots with ``spec``'s parameters start (one per parameter set, as their scenes)."""
         starters = self.prepared.starters
-        if spec.params not in starters:
-            starters[spec.params] = Starter(scene)
-        return starters[spec.params]
+        with self.prepared.lock:
+            if spec.params not in starters:
+                starters[spec.params] = Starter(scene)
+            return starters[spec.params]
 
 
 def with_start(scene: Scene, start: Pose | None) -> Scene:
