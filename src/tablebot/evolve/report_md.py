@@ -13,8 +13,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tablebot.escape import markdown_code, markdown_text
+from tablebot.evolve.commands import Replay, sim_commands, sweep_command
 from tablebot.evolve.measures import Measure, fitness, measure_text
-from tablebot.evolve.report import Replay, Written, paired_change, sim_commands, sweep_command
+from tablebot.evolve.report import Written, paired_change
 from tablebot.i18n import _, ngettext, number
 from tablebot.table import Table
 
