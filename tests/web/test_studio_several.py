@@ -9,6 +9,7 @@ Screenshots go to ``studio-several`` under pytest's temporary folder (or ``$TABL
 from __future__ import annotations
 
 import asyncio
+import re
 import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -167,6 +168,37 @@ def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio:
     said = f"drive: state {drive_state}, line {line} fired"
     assert said in status, (said, status)
     assert page.get_attribute("#arena", "data-lamps") == f"L1={trace['L1'][tick]} L2={trace['L2'][tick]}"
+    assert page.errors == []
+    page.context.close()
+
+
+def test_a_tab_clicked_while_a_trace_plays_speaks_for_that_table(browser: Any, studio: Background, folder: Path,
+                                                                 shots: Path) -> None:
+    """The trace playing on the drive tab, the lights tab clicked: the player goes on at the same tick with the
+    lights table speaking (its state in the status line, the drive table's said beside it, its timeline), without
+    the trace opened again; it kept the drive table's view until then (issue 36's leftover)."""
+    run = tablebot.open(folder).simulate(seconds=20.0, seed=2)
+    run.save(folder / "played", plots=False)
+    trace = run.trace
+    page = open_page(browser, studio.url)
+    page.click("#mode-trace")
+    page.evaluate("() => { const s = document.querySelector('#trace-pick');"
+                  " s.append(new Option('played/trace.jsonl', 'played/trace.jsonl')); }")
+    page.select_option("#trace-pick", "played/trace.jsonl")
+    wait_for(lambda: "lights:" in page.inner_text("#status"), "the drive tab's status line", 30)
+    page.click("#tplay")
+    wait_for(lambda: int(page.eval_on_selector("#scrub", "s => +s.value")) > 0, "the trace playing", 30)
+    show(page, "lights", "drive=1,2")
+    wait_for(lambda: "drive:" in page.inner_text("#status"), "the lights table speaking", 10)
+    page.click("#tplay")  # paused: the tick shown and the status line stay together
+    index = int(page.eval_on_selector("#scrub", "s => +s.value"))
+    status = page.inner_text("#status")
+    page.screenshot(path=str(shots / "player-tab-switched.png"))
+    assert 0 < index < len(trace["tick"]) - 1, index  # switched while it played, not after the end
+    head, drive = status.split(" · drive:")
+    assert head.startswith(f"tick {trace['tick'][index]} · "), status
+    assert re.search(rf"· state {re.escape(str(trace['lights.state'][index]))}( \(| ·|$)", head), status
+    assert drive.startswith(f" state {trace['state'][index]},"), status
     assert page.errors == []
     page.context.close()
 

@@ -81,6 +81,10 @@ export function createViews(store, send, edited) {
     slider: byId("scrub"), stateCol: () => stateColumn(store),
     onEnd: () => { byId("tplay").textContent = t("live.play"); }, onSeek: (tick) => store.set({ mask: tick.event }) });
   views.checks = makeChecks(store, send, grid);
-  store.on(["machine"], () => repaintStates(views));
+  store.on(["machine"], ({ machine, mode }) => {
+    // a trace playing when another tab is shown: that table speaks from the tick it is at (it kept the old one)
+    if (mode === "trace") views.player.show(machine);
+    repaintStates(views);
+  });
   return views;
 }

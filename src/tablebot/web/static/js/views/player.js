@@ -60,25 +60,39 @@ export class Player {
 
   load(columns, machine, atTick) {
     this.columns = columns;
-    this.machine = machine;
     this.n = columns.tick.length;
-    // a robot of several tables: the table whose tab is shown speaks (its state, row and timer), the others
-    // are said beside it (the main table's own columns are state, row, timer and event)
+    this.lightKeys = Object.keys(columns).filter((k) => k.endsWith("_light"));  // right, then left
+    this.views.slider.max = Math.max(0, this.n - 1);
+    this._speaking(machine);
+    this.seek(atTick ? Math.min(atTick, this.n - 1) : 0);
+  }
+
+  /** Another table's tab shown (or the table edited): the same trace, at the same tick and playing on, with
+   * ``machine``'s table speaking. */
+  show(machine) {
+    if (!this.columns || !machine || machine === this.machine) return;
+    this._speaking(machine);
+    this.seek(this.index);
+  }
+
+  // A robot of several tables: the table whose tab is shown speaks (its state, row and timer; its states
+  // colour the timeline and the path), the others are said beside it (the main table's own columns are
+  // state, row, timer and event)
+  _speaking(machine) {
+    const columns = this.columns;
+    this.machine = machine;
     this.others = otherTables(columns);
     this.view = this.others.includes(machine.name) ? machine.name : null;
     if (this.view) this.others = [machine.main_name, ...this.others.filter((n) => n !== this.view)];
     this.stateIds = this.column("state").map(String);
     this.outputNames = machine.outputs.filter((name) => name in columns);
-    this.lightKeys = Object.keys(columns).filter((k) => k.endsWith("_light"));  // right, then left
     this.views.timeline.setStates(this.stateIds);
-    this.views.slider.max = Math.max(0, this.n - 1);
     const arena = this.views.arena;
     if (arena && "x" in columns) {
       arena.replayPath = tracePath(columns, this.stateIds);
       arena.clearPath();
       arena.addPath(arena.replayPath);
     }
-    this.seek(atTick ? Math.min(atTick, this.n - 1) : 0);
   }
 
   /** The column ``key`` (state, row, timer, event) of the table shown: ``lights.state`` for the lights tab. */
