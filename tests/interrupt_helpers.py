@@ -23,8 +23,10 @@ def snapshot(folder: Path, ignore: Sequence[str] = ()) -> Snapshot:
     found = {}
     for path in sorted(folder.rglob("*")):
         if path.is_file() and path.suffix != ".bak" and path.relative_to(folder).parts[0] not in ignore:
-            found[path.relative_to(folder).as_posix()] = (path.stat().st_ino,
-                                                          hashlib.sha256(path.read_bytes()).hexdigest())
+            found[path.relative_to(folder).as_posix()] = (
+                path.stat().st_ino,
+                hashlib.sha256(path.read_bytes()).hexdigest(),
+            )
     return found
 
 
@@ -54,8 +56,14 @@ def check_outcome(folder: Path, before: Snapshot, after: Snapshot, new: Snapshot
     return "new"
 
 
-def interrupt_everywhere(command: Sequence[object], folder: Path, reference: Path, points: Sequence[int] = (),
-                         loose: Sequence[str] = (), ignore: Sequence[str] = ()) -> list[str]:
+def interrupt_everywhere(
+    command: Sequence[object],
+    folder: Path,
+    reference: Path,
+    points: Sequence[int] = (),
+    loose: Sequence[str] = (),
+    ignore: Sequence[str] = (),
+) -> list[str]:
     """Run ``command`` (writing into ``folder``) once, and into ``reference`` for the new set; then again
     with the fault at every step (or at ``points``), SIGINT at odd steps and SIGTERM at even ones: each
     run leaves the old set or the new one (``ignore``: files that keep an interrupted run's work, not part
