@@ -103,8 +103,8 @@ def parse_world(src: Source) -> World:
     return World(
         name=str(name),
         walls=tuple(walls),
-        start=start,
-        lamps=tuple(lamps),  # type: ignore[arg-type]
+        start=start,  # type: ignore[arg-type]  # None only with an error, raised above
+        lamps=tuple(lamps),
         boxes=tuple(boxes),
         circles=tuple(circles),
         segments=tuple(segments),
