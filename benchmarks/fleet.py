@@ -66,8 +66,16 @@ TARGET_HOUR_S = 2.0  # sim --seconds 3600 with pictures
 def sim_hour(seconds: float, pictures: bool) -> tuple[float, str]:
     """Wall seconds of ``tablebot sim --seconds S`` (with or without its pictures) and its trace's sha256."""
     with tempfile.TemporaryDirectory() as out:
-        wall = tablebot("sim", str(EXAMPLE), "--seconds", f"{seconds:g}", "--quiet", "--out", out,
-                        *([] if pictures else ["--no-plots"]))
+        wall = tablebot(
+            "sim",
+            str(EXAMPLE),
+            "--seconds",
+            f"{seconds:g}",
+            "--quiet",
+            "--out",
+            out,
+            *([] if pictures else ["--no-plots"]),
+        )
         trace = hashlib.sha256((Path(out) / "trace.jsonl").read_bytes()).hexdigest()
         if pictures:
             assert (Path(out) / "trajectory.png").stat().st_size and (Path(out) / "timeline.png").stat().st_size
@@ -121,8 +129,12 @@ def peak_memory(robots: int, seconds: float) -> tuple[float, float]:
 
     with tempfile.TemporaryDirectory() as out:
         started = time.perf_counter()
-        proc = subprocess.Popen([sys.executable, "-m", "tablebot", *sweep_args(robots, seconds, out + "/sweep")],
-                                cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "tablebot", *sweep_args(robots, seconds, out + "/sweep")],
+            cwd=ROOT,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         parent, peak = psutil.Process(proc.pid), 0
         while proc.poll() is None:
             with contextlib.suppress(psutil.Error):
@@ -148,17 +160,26 @@ def main() -> int:
     parser.add_argument("--no-evolve", action="store_true")
     parser.add_argument("--no-memory", action="store_true")
     parser.add_argument("--sweep-only", action="store_true", help="only the sweep's figures (process, Python, kernel)")
-    parser.add_argument("--baseline", metavar="REV", help="the sweep's figures for git revision REV too, the rounds "
-                        "alternating (its src/ exported into the temporary folder)")
-    parser.add_argument("--code", metavar="REV", help="the sweep's figures for git revision REV instead of the "
-                        "working tree (one others are editing meanwhile)")
+    parser.add_argument(
+        "--baseline",
+        metavar="REV",
+        help="the sweep's figures for git revision REV too, the rounds "
+        "alternating (its src/ exported into the temporary folder)",
+    )
+    parser.add_argument(
+        "--code",
+        metavar="REV",
+        help="the sweep's figures for git revision REV instead of the working tree (one others are editing meanwhile)",
+    )
     args = parser.parse_args()
     robots, seconds = (1_000, 2.0) if args.quick else (SWEEP_ROBOTS, SWEEP_SECONDS)
     hour = 60.0 if args.quick else 3600.0
     med = statistics.median
     missed = 0
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); "
-          f"medians of {args.repeat}")
+    print(
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); "
+        f"medians of {args.repeat}"
+    )
     missed += sweep_ratios(robots, seconds, args.repeat, args.code, args.baseline)
     if args.sweep_only:
         print(f"load average {os.getloadavg()[0]:.2f} at the end")
@@ -173,31 +194,39 @@ def main() -> int:
     a, b = med(w for w, _ in with_pics), med(w for w, _ in without)
     ok = a < TARGET_HOUR_S and same
     missed += not ok
-    print(f"sim --seconds {hour:g}, whole process: with pictures {a:.2f} s, --no-plots {b:.2f} s "
-          f"({a / b:.2f}x); trace bytes {'identical' if same else 'DIFFER'} either way   target < {TARGET_HOUR_S:g} s "
-          f"with pictures  {verdict(ok)}")
+    print(
+        f"sim --seconds {hour:g}, whole process: with pictures {a:.2f} s, --no-plots {b:.2f} s "
+        f"({a / b:.2f}x); trace bytes {'identical' if same else 'DIFFER'} either way   target < {TARGET_HOUR_S:g} s "
+        f"with pictures  {verdict(ok)}"
+    )
 
     one = med(simrobot_us(20_000) for _ in range(args.repeat))
     print(f"small fleets, after a large fleet woke numba's thread pool (one SimRobot tick by tick: {one:.2f} us):")
     for n in (1, 16):
         run = med(small_fleet_us(n, 20_000, False) for _ in range(args.repeat))
         by_tick = med(small_fleet_us(n, 2_000, True) for _ in range(args.repeat))
-        print(f"  fleet of {n:>2}: Fleet.run {run:7.2f} us per tick ({run / n:.2f} per robot-tick), Fleet.tick "
-              f"{by_tick:7.2f} us per tick ({by_tick / one:.1f}x the SimRobot tick)")
+        print(
+            f"  fleet of {n:>2}: Fleet.run {run:7.2f} us per tick ({run / n:.2f} per robot-tick), Fleet.tick "
+            f"{by_tick:7.2f} us per tick ({by_tick / one:.1f}x the SimRobot tick)"
+        )
     print(f"  numba threading layer {threading_layer()}, OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}")
 
     if not args.no_evolve:
         budget, evolve_s = (16, 2.0) if args.quick else (32, 10.0)  # whole() runs --batch 16
         runs = [evolve_rates(budget, evolve_s) for _ in range(args.repeat)]
-        print(f"evolve --budget {budget} --seeds 0..15 --seconds {evolve_s:g}, whole process: "
-              f"{med(r['wall'] for r in runs):.2f} s, {med(r['tables/s'] for r in runs):.2f} candidates/s, "
-              f"{med(r['robot-ticks/s'] for r in runs) / 1e3:,.0f} k robot-ticks/s (waiting for the fleet "
-              f"{med(r['fleet'] for r in runs):.2f} s, proofs {med(r['proofs'] for r in runs):.2f} s)")
+        print(
+            f"evolve --budget {budget} --seeds 0..15 --seconds {evolve_s:g}, whole process: "
+            f"{med(r['wall'] for r in runs):.2f} s, {med(r['tables/s'] for r in runs):.2f} candidates/s, "
+            f"{med(r['robot-ticks/s'] for r in runs) / 1e3:,.0f} k robot-ticks/s (waiting for the fleet "
+            f"{med(r['fleet'] for r in runs):.2f} s, proofs {med(r['proofs'] for r in runs):.2f} s)"
+        )
     if not args.no_memory:
         robots, seconds = (1_000, 10.0) if args.quick else (10_000, 60.0)
         mib, wall = peak_memory(robots, seconds)
-        print(f"sweep --robots {robots:,} --seconds {seconds:g}: peak {mib:.0f} MiB for the process tree, {wall:.1f} s "
-              f"wall (target < 1024 MiB, issue 11)")
+        print(
+            f"sweep --robots {robots:,} --seconds {seconds:g}: peak {mib:.0f} MiB for the process tree, {wall:.1f} s "
+            f"wall (target < 1024 MiB, issue 11)"
+        )
     print(f"load average {os.getloadavg()[0]:.2f} at the end")
     return 1 if missed else 0
 

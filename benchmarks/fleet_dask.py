@@ -31,8 +31,9 @@ class FreshCluster:
         self.stack = contextlib.ExitStack()
         home = self.stack.enter_context(tempfile.TemporaryDirectory())
         options = ["--preload", "tablebot.fleet.worker"] if self.preload else []
-        cluster = self.stack.enter_context(local_cluster(
-            [options, options], child_env(), child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=home)))
+        cluster = self.stack.enter_context(
+            local_cluster([options, options], child_env(), child_env(NUMBA_CACHE_DIR=None, XDG_CACHE_HOME=home))
+        )
         self.procs = cluster.procs
         return cluster.address
 
@@ -51,8 +52,9 @@ class FreshCluster:
         self.stack.close()
 
 
-def dask_ratios(robots: int, seconds: float, repeat: int, preload: bool = False) -> tuple[
-        list[float], list[float], list[float], dict[str, list[float]]]:
+def dask_ratios(
+    robots: int, seconds: float, repeat: int, preload: bool = False
+) -> tuple[list[float], list[float], list[float], dict[str, list[float]]]:
     """Per repeat: local sweep seconds, then fresh and warm Dask sweep seconds (a new cluster per repeat, its
     workers started with tablebot's preload or not); and the CPU seconds of each (for Dask: the client's and
     the cluster's processes' together)."""
@@ -81,14 +83,20 @@ def dask_figures(robots: int, seconds: float, repeat: int) -> int:
     w_ratio = med(a / b for a, b in zip(local, warm, strict=True))
     ok = f_ratio >= TARGET_FRESH
     missed += not ok
-    print(f"Dask, 2 single-threaded workers: local {med(local):.2f} s, fresh cluster {med(fresh):.2f} s, "
-          f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpus['local']):.2f}, fresh "
-          f"{med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}, the cluster's processes included)")
-    print(f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
-          f"{w_ratio:.2f}x")
+    print(
+        f"Dask, 2 single-threaded workers: local {med(local):.2f} s, fresh cluster {med(fresh):.2f} s, "
+        f"warm {med(warm):.2f} s (whole sweep processes; CPU s: local {med(cpus['local']):.2f}, fresh "
+        f"{med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}, the cluster's processes included)"
+    )
+    print(
+        f"  fresh/local speed {f_ratio:.2f}x   target >= {TARGET_FRESH}x  {verdict(ok)};  warm/local speed "
+        f"{w_ratio:.2f}x"
+    )
     local, fresh, warm, cpus = dask_ratios(robots, seconds, repeat, preload=True)
-    print(f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
-          f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
-          f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
-          f"{med(cpus['local']):.2f}, fresh {med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}")
+    print(
+        f"  workers started with --preload tablebot.fleet.worker: local {med(local):.2f} s, fresh "
+        f"{med(fresh):.2f} s ({med(a / b for a, b in zip(local, fresh, strict=True)):.2f}x), warm "
+        f"{med(warm):.2f} s ({med(a / b for a, b in zip(local, warm, strict=True)):.2f}x); CPU s: local "
+        f"{med(cpus['local']):.2f}, fresh {med(cpus['fresh']):.2f}, warm {med(cpus['warm']):.2f}"
+    )
     return missed

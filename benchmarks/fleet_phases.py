@@ -32,8 +32,9 @@ def measure(args: list[str], env: dict[str, str] | None = None) -> dict[str, flo
     from tablebot.testing.processes import child_env  # not at the top: the script's own run imports tablebot timed
 
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, __file__, *args], cwd=ROOT, env=env or child_env(), capture_output=True,
-                          text=True)
+    done = subprocess.run(
+        [sys.executable, __file__, *args], cwd=ROOT, env=env or child_env(), capture_output=True, text=True
+    )
     wall = time.perf_counter() - started
     if done.returncode:
         raise SystemExit(f"benchmarks/fleet_phases.py failed:\n{done.stderr}")
@@ -69,6 +70,7 @@ def main() -> None:
                     cpu[f"{mark} end"] = time.process_time() - CPU_STARTED
                 if into:
                     spent[into] += time.perf_counter() - started
+
         setattr(owner, name, wrapper)
 
     timed(plan, "make_plan", "plan")
@@ -88,14 +90,31 @@ def main() -> None:
 
     def cpu_of(mark: str) -> float:
         return cpu[f"{mark} end"] - cpu[f"{mark} start"]
-    print(json.dumps({"before planning": marks["plan start"], "planning": plan_s, "chunks": run_s,
-                      "results in the chunks": spent["part_text"] + spent["write_part"], "merging": merge_s,
-                      "after planning, besides": end - marks["plan start"] - plan_s - run_s - merge_s,
-                      "in this interpreter": end,
-                      "cpu: before planning": cpu["plan start"], "cpu: planning": cpu_of("plan"),
-                      "cpu: chunks": cpu_of("run"), "cpu: merging": cpu_of("finish"),
-                      "cpu: after planning, besides": cpu_end - cpu["plan start"] - cpu_of("plan") - cpu_of("run")
-                      - cpu_of("finish"), "cpu: in this interpreter": cpu_end}))
+
+    print(
+        json.dumps(
+            {
+                "before planning": marks["plan start"],
+                "planning": plan_s,
+                "chunks": run_s,
+                "results in the chunks": spent["part_text"] + spent["write_part"],
+                "merging": merge_s,
+                "after planning, besides": end - marks["plan start"] - plan_s - run_s - merge_s,
+                "in this interpreter": end,
+                "cpu: before planning": cpu["plan start"],
+                "cpu: planning": cpu_of("plan"),
+                "cpu: chunks": cpu_of("run"),
+                "cpu: merging": cpu_of("finish"),
+                "cpu: after planning, besides": cpu_end
+                - cpu["plan start"]
+                - cpu_of("plan")
+                - cpu_of("run")
+                - cpu_of("finish"),
+                "cpu: in this interpreter": cpu_end,
+            }
+        )
+    )
+
 
 def store_module() -> Any:
     """Where the sweep's output folder is kept: tablebot.fleet.store, or in trees before it, fleet.plan."""

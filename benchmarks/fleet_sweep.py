@@ -37,8 +37,12 @@ def sources(rev: str | None) -> str:
     """The ``src`` folder of revision ``rev`` (exported once into the temporary folder), or this tree's (None)."""
     if rev is None:
         return str(ROOT / "src")
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", f"{rev}^{{commit}}"], check=True,
-                            capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--verify", f"{rev}^{{commit}}"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout.strip()
     folder = Path(tempfile.gettempdir()) / f"tablebot-fleet-baseline-{commit[:12]}"
     if not (folder / "src").is_dir():
         partial = Path(tempfile.mkdtemp(prefix=folder.name + "."))
@@ -59,8 +63,13 @@ def tablebot(*args: str, src: str | None = None, again: bool = True) -> float:
     again once (``again``): trees before 5aff52d could, now and then, when a sweep's two threads started at once."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, env=env_for(src or sources(None)),
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", *args],
+        cwd=ROOT,
+        env=env_for(src or sources(None)),
+        capture_output=True,
+        text=True,
+    )
     elapsed = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode and again and "internal error" in done.stderr:
@@ -73,8 +82,18 @@ def tablebot(*args: str, src: str | None = None, again: bool = True) -> float:
 
 
 def sweep_args(robots: int, seconds: float, out: str) -> list[str]:
-    return ["sweep", str(EXAMPLE), "--robots", str(robots), "--seconds", f"{seconds:g}", "--no-plots", "--quiet",
-            "--out", out]
+    return [
+        "sweep",
+        str(EXAMPLE),
+        "--robots",
+        str(robots),
+        "--seconds",
+        f"{seconds:g}",
+        "--no-plots",
+        "--quiet",
+        "--out",
+        out,
+    ]
 
 
 def sweep_process(robots: int, seconds: float, *extra: str, src: str | None = None) -> float:
@@ -122,8 +141,13 @@ def inner(robots: int, seconds: float) -> dict[str, float]:
 
 def inner_child(robots: int, seconds: float, src: str) -> dict[str, float]:
     """:func:`inner` in a fresh process importing ``src``."""
-    done = subprocess.run([sys.executable, __file__, "--inner", str(robots), f"{seconds:g}"], cwd=ROOT,
-                          env=env_for(src), capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, __file__, "--inner", str(robots), f"{seconds:g}"],
+        cwd=ROOT,
+        env=env_for(src),
+        capture_output=True,
+        text=True,
+    )
     if done.returncode:
         raise SystemExit(f"benchmarks/fleet_sweep.py --inner failed:\n{done.stderr}")
     found: dict[str, float] = json.loads(done.stdout.strip().splitlines()[-1])
@@ -153,28 +177,37 @@ def report(name: str, found: list[dict[str, Any]], robots: int, seconds: float) 
     api = med(f["api"] / f["api_kernel"] for f in found)
     oks = (rate >= TARGET_SWEEP, ratio >= TARGET_PROCESS_RATIO, api >= TARGET_API_RATIO)
     parts = [f["parts"] for f in found]
-    print(f"[{name}] sweep --robots {robots:,} --seconds {seconds:g}, whole process: {med(walls):.2f} s = "
-          f"{rate / 1e6:.2f} M robot-ticks/s ({' '.join(f'{w:.2f}' for w in walls)} s; "
-          f"{med(f['cpu'] for f in found):.2f} s CPU)  target >= {TARGET_SWEEP / 1e6:g} M  {verdict(oks[0])}")
-    print(f"  the kernel alone (warm fleet in a process of this tree): {med(f['kernel'] for f in found) / 1e6:.2f} M "
-          f"robot-ticks/s; the process runs at {ratio:.2f}x the kernel's speed (median of the rounds' ratios)  "
-          f"target >= {TARGET_PROCESS_RATIO}x  {verdict(oks[1])}")
-    print("  where a sweep process's time goes (medians, s): " + ", ".join(
-        f"{key} {med(p[key] for p in parts):.3f}" for key in parts[0] if not key.startswith("cpu: ")))
+    print(
+        f"[{name}] sweep --robots {robots:,} --seconds {seconds:g}, whole process: {med(walls):.2f} s = "
+        f"{rate / 1e6:.2f} M robot-ticks/s ({' '.join(f'{w:.2f}' for w in walls)} s; "
+        f"{med(f['cpu'] for f in found):.2f} s CPU)  target >= {TARGET_SWEEP / 1e6:g} M  {verdict(oks[0])}"
+    )
+    print(
+        f"  the kernel alone (warm fleet in a process of this tree): {med(f['kernel'] for f in found) / 1e6:.2f} M "
+        f"robot-ticks/s; the process runs at {ratio:.2f}x the kernel's speed (median of the rounds' ratios)  "
+        f"target >= {TARGET_PROCESS_RATIO}x  {verdict(oks[1])}"
+    )
+    print(
+        "  where a sweep process's time goes (medians, s): "
+        + ", ".join(f"{key} {med(p[key] for p in parts):.3f}" for key in parts[0] if not key.startswith("cpu: "))
+    )
     kernel_cpu = med(f["kernel_cpu"] for f in found)
-    print("  its CPU seconds, every thread (medians): " + ", ".join(
-        f"{key[5:]} {med(p[key] for p in parts):.3f}" for key in parts[0] if key.startswith("cpu: "))
+    print(
+        "  its CPU seconds, every thread (medians): "
+        + ", ".join(f"{key[5:]} {med(p[key] for p in parts):.3f}" for key in parts[0] if key.startswith("cpu: "))
         + f"; the kernel alone for the same robots {kernel_cpu:.3f} s CPU: the process spends "
-          f"{med(p['cpu: in this interpreter'] for p in parts) - kernel_cpu:.3f} s CPU outside it")
-    print(f"  from Python, tablebot.open(...).sweep(robots={robots:,}, seconds={seconds:g}, plots=False): "
-          f"{med(f['api'] for f in found) / 1e6:.2f} M robot-ticks/s against the kernel's "
-          f"{med(f['api_kernel'] for f in found) / 1e6:.2f} M: {api:.2f}x  target >= {TARGET_API_RATIO}x  "
-          f"{verdict(oks[2])}")
+        f"{med(p['cpu: in this interpreter'] for p in parts) - kernel_cpu:.3f} s CPU outside it"
+    )
+    print(
+        f"  from Python, tablebot.open(...).sweep(robots={robots:,}, seconds={seconds:g}, plots=False): "
+        f"{med(f['api'] for f in found) / 1e6:.2f} M robot-ticks/s against the kernel's "
+        f"{med(f['api_kernel'] for f in found) / 1e6:.2f} M: {api:.2f}x  target >= {TARGET_API_RATIO}x  "
+        f"{verdict(oks[2])}"
+    )
     return sum(not ok for ok in oks), ratio, api
 
 
-def sweep_ratios(robots: int, seconds: float, repeat: int, code: str | None = None,
-                 baseline: str | None = None) -> int:
+def sweep_ratios(robots: int, seconds: float, repeat: int, code: str | None = None, baseline: str | None = None) -> int:
     """The sweep's figures for this tree (or revision ``code``), and with ``baseline`` for that revision too, the
     rounds alternating; returns the targets this tree missed."""
     trees = {code or "this tree": sources(code)}
@@ -193,8 +226,10 @@ def sweep_ratios(robots: int, seconds: float, repeat: int, code: str | None = No
         mine, theirs = found[first], found[baseline]
         wall = med(f["wall"] for f in mine) / med(f["wall"] for f in theirs)
         cpu = med(f["cpu"] for f in mine) / med(f["cpu"] for f in theirs)
-        print(f"{first} against {baseline} (same run): process/kernel {results[first][1]:.2f}x against "
-              f"{results[baseline][1]:.2f}x; process wall x{wall:.2f}, CPU x{cpu:.2f} (after/before)")
+        print(
+            f"{first} against {baseline} (same run): process/kernel {results[first][1]:.2f}x against "
+            f"{results[baseline][1]:.2f}x; process wall x{wall:.2f}, CPU x{cpu:.2f} (after/before)"
+        )
     return next(iter(results.values()))[0]
 
 

@@ -15,10 +15,8 @@ from test_sim_helpers import BUMBERBOT
 from test_sweep import dask_cluster, env, sweep  # noqa: F401  (dask_cluster: a real scheduler and two workers)
 
 
-def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path,
-                                                            dask_cluster: str) -> None:  # noqa: F811
-    spec = ["--grid", "battery=1.0,0.7", "--grid", "start=random", "--seeds", "0..23", "--seconds", "10",
-            "--no-plots"]
+def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask_cluster: str) -> None:  # noqa: F811
+    spec = ["--grid", "battery=1.0,0.7", "--grid", "start=random", "--seeds", "0..23", "--seconds", "10", "--no-plots"]
     code, output = sweep(*spec, "--out", str(tmp_path / "local"), "--backend", "local", "--workers", "2")
     assert code == 0, output
     code, output = sweep(*spec, "--out", str(tmp_path / "dask"), "--scheduler", dask_cluster)
@@ -35,8 +33,9 @@ def test_a_tls_address_without_dasks_tls_settings_is_a_clear_error(tmp_path: Pat
     assert "distributed.comm.tls.ca-file" in output and "Traceback" not in output
 
 
-def test_a_scheduler_address_from_the_environment_is_named_as_such(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_scheduler_address_from_the_environment_is_named_as_such(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "junk")
     code, output = sweep("--robots", "2", "--out", str(tmp_path / "s"))
     assert code == 2, output
@@ -44,8 +43,7 @@ def test_a_scheduler_address_from_the_environment_is_named_as_such(tmp_path: Pat
     assert "tcp://127.0.0.1:8786" in output and not (tmp_path / "s").exists()
 
 
-def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path,
-                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+def test_without_dask_the_dask_backend_says_what_to_install(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed: importing fails
     code, output = sweep("--robots", "2", "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "s"))
     assert code == 2, output
@@ -71,10 +69,12 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     version = f"py{sys.version_info.major}{sys.version_info.minor}"
     mine = home / "tablebot" / f"numba-{version}-{jit.sources_digest()}" / "worker-testhost-0"
     (tmp_path / "job.pickle").write_bytes(pickle.dumps((job, files)))
-    code = ("import json, os, pickle, sys; from tablebot.fleet.work import job_threads, warm_worker; "
-            "job, files = pickle.load(open(sys.argv[1], 'rb')); "
-            "info = warm_worker(job, 'testhost-0', os.cpu_count(), files); "
-            "print(json.dumps({**info, 'job_threads': job_threads(job)}))")
+    code = (
+        "import json, os, pickle, sys; from tablebot.fleet.work import job_threads, warm_worker; "
+        "job, files = pickle.load(open(sys.argv[1], 'rb')); "
+        "info = warm_worker(job, 'testhost-0', os.cpu_count(), files); "
+        "print(json.dumps({**info, 'job_threads': job_threads(job)}))"
+    )
     worker_env = {k: v for k, v in env().items() if k != "NUMBA_CACHE_DIR"}
     worker_env["XDG_CACHE_HOME"] = str(home)
     info = worker_says(code, tmp_path / "job.pickle", worker_env)
@@ -88,11 +88,13 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
         folder = next(p for p in mine.iterdir() if p.name.startswith((Path(relative).parent.name or "tablebot") + "_"))
         assert all((folder / name).read_bytes() == data for name, data in named.items())
     # as a sweep readies a worker: its imports first, without code; then the code, which it loads, before any job
-    code = ("import json, pickle, sys; from tablebot.fleet.work import chunk_functions, ready_worker; "
-            "job, files = pickle.load(open(sys.argv[1], 'rb')); first = ready_worker('testhost-1', 2, None, False); "
-            "functions = chunk_functions(1); before = [len(f.overloads) for f in functions]; "
-            "second = ready_worker('testhost-1', 2, files); "
-            "print(json.dumps([first, second, before, [len(f.overloads) for f in functions]]))")
+    code = (
+        "import json, pickle, sys; from tablebot.fleet.work import chunk_functions, ready_worker; "
+        "job, files = pickle.load(open(sys.argv[1], 'rb')); first = ready_worker('testhost-1', 2, None, False); "
+        "functions = chunk_functions(1); before = [len(f.overloads) for f in functions]; "
+        "second = ready_worker('testhost-1', 2, files); "
+        "print(json.dumps([first, second, before, [len(f.overloads) for f in functions]]))"
+    )
     first, second, before, after = worker_says(code, tmp_path / "job.pickle", worker_env)
     assert first["cache"] == second["cache"] == str(mine.parent / "worker-testhost-1")
     assert (first["installed"], first["loaded"]) == (0, 0) and before == [0] * len(before)
@@ -100,10 +102,12 @@ def test_a_fresh_cluster_worker_loads_the_compiled_kernel_it_is_sent(tmp_path: P
     landed = sorted(p.name for p in (mine.parent / "worker-testhost-1").rglob("*") if p.is_file())
     assert landed == sent  # loaded, not compiled
     # a worker started with tablebot's preload has numba before the client comes, and still gets its own folder
-    code = ("import json, pickle, sys; from tablebot.fleet.worker import dask_setup; dask_setup(); "
-            "early = 'numba' in sys.modules; from tablebot.fleet.work import ready_worker; "
-            "job, files = pickle.load(open(sys.argv[1], 'rb')); ready_worker('testhost-2', 2, None, False); "
-            "print(json.dumps([early, ready_worker('testhost-2', 2, files)]))")
+    code = (
+        "import json, pickle, sys; from tablebot.fleet.worker import dask_setup; dask_setup(); "
+        "early = 'numba' in sys.modules; from tablebot.fleet.work import ready_worker; "
+        "job, files = pickle.load(open(sys.argv[1], 'rb')); ready_worker('testhost-2', 2, None, False); "
+        "print(json.dumps([early, ready_worker('testhost-2', 2, files)]))"
+    )
     early, info = worker_says(code, tmp_path / "job.pickle", worker_env)
     assert early and info["cache"] == str(mine.parent / "worker-testhost-2") and info["loaded"] == len(after)
     assert sorted(p.name for p in (mine.parent / "worker-testhost-2").rglob("*") if p.is_file()) == sent

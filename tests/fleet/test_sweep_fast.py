@@ -21,8 +21,7 @@ def test_each_chunks_robots_are_those_of_its_runs_one_by_one() -> None:
     """Grid combinations spanning chunks, a fixed and a random start, two worlds: the robots a job gets are
     :meth:`Plan.robot` of each of its runs."""
     worlds = [BUMBERBOT / "arena.toml", BUMBERBOT.parent / "obstacle-avoider" / "arena.toml"]
-    plan = make_plan(BUMBERBOT, None, worlds, ["battery=1.0,0.6", "start=random,0.4:0.4:30"], "0..6,9,12", None,
-                     1.0)
+    plan = make_plan(BUMBERBOT, None, worlds, ["battery=1.0,0.6", "start=random,0.4:0.4:30"], "0..6,9,12", None, 1.0)
     jobs = plan.jobs()
     assert [(job.first, job.info["stop"]) for job in jobs] == chunks(plan.spec) and len(jobs) > 4
     for job in jobs:
@@ -60,14 +59,17 @@ def test_chunks_of_one_plan_share_their_scenes_and_run_as_they_would_alone() -> 
 def test_spec_json_is_the_spec_as_a_resumed_sweep_compares_it() -> None:
     """spec.json, written without asdict's deep copy of every seed, holds what asdict gives (a sweep made by an
     earlier tablebot resumes): every field, each axis with its key and values, a start pose as a list."""
-    plan = make_plan(BUMBERBOT / "table.csv", None, [], ["battery=1.0,0.6", "start=random,0.5:0.4:90"], "0..2,7",
-                     None, 0.5)
+    plan = make_plan(
+        BUMBERBOT / "table.csv", None, [], ["battery=1.0,0.6", "start=random,0.5:0.4:90"], "0..2,7", None, 0.5
+    )
     spec = plan.spec
     assert spec.to_json() == json.dumps(asdict(spec), indent=1, sort_keys=True) + "\n"
     data = json.loads(spec.to_json())
     assert data["seeds"] == [0, 1, 2, 7] and data["ticks"] == 50 and data["code"] == spec.code
-    assert data["axes"] == [{"key": "battery", "values": [1.0, 0.6]},
-                            {"key": "start", "values": ["random", [0.5, 0.4, 90.0]]}]
+    assert data["axes"] == [
+        {"key": "battery", "values": [1.0, 0.6]},
+        {"key": "start", "values": ["random", [0.5, 0.4, 90.0]]},
+    ]
 
 
 def test_threads_starting_chunks_at_once_prepare_each_scene_once(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -56,15 +56,37 @@ def tune(tmp_path: Path, rows: list[str], *args: str, world: str = HALL) -> tupl
     table.write_text("\r\n".join(["description,state,T,I3,M1,M2,timer,next", *rows]) + "\r\n", encoding="utf-8")
     (tmp_path / "hall.toml").write_text(world, encoding="utf-8")
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["tune", str(table), "--world", str(tmp_path / "hall.toml"), "--grid",
-                                      "battery=1.0", "--seeds", "0..1", "--check-seeds", "7..8", "--seconds", "9",
-                                      "--objective", "lamp_distance", "--workers", "1", "--out", str(out), *args])
+    result = CliRunner().invoke(
+        app,
+        [
+            "tune",
+            str(table),
+            "--world",
+            str(tmp_path / "hall.toml"),
+            "--grid",
+            "battery=1.0",
+            "--seeds",
+            "0..1",
+            "--check-seeds",
+            "7..8",
+            "--seconds",
+            "9",
+            "--objective",
+            "lamp_distance",
+            "--workers",
+            "1",
+            "--out",
+            str(out),
+            *args,
+        ],
+    )
     return result.exit_code, result.output, out
 
 
 def test_the_grid_finds_the_stopping_time_computed_by_hand(tmp_path: Path) -> None:
-    code, output, out = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer=0..800",
-                             "--budget", "1000")
+    code, output, out = tune(
+        tmp_path, ["go,1,1,,8,8,500,2", "stop,2,1,,0,0,0,2"], "--cells", "line 2 timer=0..800", "--budget", "1000"
+    )
     assert code == 0, output
     best = round(hand_optimum())
     tuned = (out / "table.tuned.csv").read_bytes()
@@ -85,9 +107,18 @@ def test_the_grid_finds_the_stopping_time_computed_by_hand(tmp_path: Path) -> No
 
 def test_cma_es_finds_the_optimum_of_two_timers_that_add_up(tmp_path: Path) -> None:
     """Two legs of full speed ahead: any X1 + X2 equal to the hand optimum is best."""
-    code, output, out = tune(tmp_path, ['leg one,1,1,,8,8,100,2', 'leg two,2,1,,8,8,100,3', 'stop,3,1,,0,0,0,3'],
-                             "--cells", "line 2 timer=0..600, line 3 timer=0..600", "--method", "cma",
-                             "--budget", "400", "--seed", "3")
+    code, output, out = tune(
+        tmp_path,
+        ["leg one,1,1,,8,8,100,2", "leg two,2,1,,8,8,100,3", "stop,3,1,,0,0,0,3"],
+        "--cells",
+        "line 2 timer=0..600, line 3 timer=0..600",
+        "--method",
+        "cma",
+        "--budget",
+        "400",
+        "--seed",
+        "3",
+    )
     assert code == 0, output
     lines = (out / "table.tuned.csv").read_text(encoding="utf-8").splitlines()
     total = int(lines[1].split(",")[6]) + int(lines[2].split(",")[6])
@@ -95,32 +126,38 @@ def test_cma_es_finds_the_optimum_of_two_timers_that_add_up(tmp_path: Path) -> N
     assert "cma," in (out / "report.md").read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize(("cells", "words"), [
-    ("line 2 M1", "'line 2 M1' is not a timer or a counter load"),
-    ("line 9 timer", "line 9 of table.csv is not a row of the table"),
-    ("row 2 timer", "does not name a cell"),
-    ("line 2 timer=9..3", "the range must be LOW..HIGH"),
-    ("line 2 timer, line 2 timer", "names line 2 timer twice"),
-    ("", "names no cell"),
-])
+@pytest.mark.parametrize(
+    ("cells", "words"),
+    [
+        ("line 2 M1", "'line 2 M1' is not a timer or a counter load"),
+        ("line 9 timer", "line 9 of table.csv is not a row of the table"),
+        ("row 2 timer", "does not name a cell"),
+        ("line 2 timer=9..3", "the range must be LOW..HIGH"),
+        ("line 2 timer, line 2 timer", "names line 2 timer twice"),
+        ("", "names no cell"),
+    ],
+)
 def test_bad_cells_are_clear_errors_naming_the_option(tmp_path: Path, cells: str, words: str) -> None:
-    code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", cells)
+    code, output, _ = tune(tmp_path, ["go,1,1,,8,8,500,2", "stop,2,1,,0,0,0,2"], "--cells", cells)
     assert code == 2, output
     assert output.startswith("--cells: error:") and words in output, output
 
 
 def test_bad_objective_and_method_name_their_option(tmp_path: Path) -> None:
-    for args, option in ((["--objective", "speed"], "--objective"), (["--method", "bayes"], "--method"),
-                         (["--check-seeds", "9..3"], "--check-seeds"), (["--grid", "start=0.05:1.5:0"], "--grid")):
-        code, output, _ = tune(tmp_path, ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2'], "--cells", "line 2 timer",
-                               *args)
+    for args, option in (
+        (["--objective", "speed"], "--objective"),
+        (["--method", "bayes"], "--method"),
+        (["--check-seeds", "9..3"], "--check-seeds"),
+        (["--grid", "start=0.05:1.5:0"], "--grid"),
+    ):
+        code, output, _ = tune(tmp_path, ["go,1,1,,8,8,500,2", "stop,2,1,,0,0,0,2"], "--cells", "line 2 timer", *args)
         assert code == 2 and output.startswith(f"{option}: error:"), output
         assert "--seeds" not in output, output  # the option given, not the one whose words it shares
 
 
 def test_a_second_run_replaces_the_tuned_table_only_with_force(tmp_path: Path) -> None:
     """Refused before the search (nothing else rewritten), as every command refuses to replace a table."""
-    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    rows = ["go,1,1,,8,8,500,2", "stop,2,1,,0,0,0,2"]
     code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..40", "--budget", "3")
     assert code == 0, output
     before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
@@ -136,8 +173,9 @@ def test_a_timer_written_in_seconds_is_tuned_in_seconds(tmp_path: Path) -> None:
     """``5s`` tuned to N ticks is written N × 10 ms in seconds: a bare N would read as N ticks, far less."""
     from tablebot.durations import to_ticks
 
-    code, output, out = tune(tmp_path, ['go,1,1,,8,8,5s,2', 'stop,2,1,,0,0,0,2'], "--cells",
-                             "line 2 timer=100..800", "--budget", "4")
+    code, output, out = tune(
+        tmp_path, ["go,1,1,,8,8,5s,2", "stop,2,1,,0,0,0,2"], "--cells", "line 2 timer=100..800", "--budget", "4"
+    )
     assert code == 0, output
     cell = (out / "table.tuned.csv").read_text(encoding="utf-8").splitlines()[1].split(",")[6]
     after = int(next(line for line in output.splitlines() if line.startswith("| line 2 timer |")).split("|")[3])
@@ -148,12 +186,11 @@ def test_a_timer_written_in_seconds_is_tuned_in_seconds(tmp_path: Path) -> None:
 def test_a_lamp_objective_in_a_world_without_lamps_is_refused(tmp_path: Path) -> None:
     """Every candidate would tie (never reached): the objective is named, collisions still tune."""
     dark = HALL.replace("[[lamp]]\nat = [1.5, 1.5]\nradius = 0\n", "")
-    rows = ['go,1,1,,8,8,500,2', 'stop,2,1,,0,0,0,2']
+    rows = ["go,1,1,,8,8,500,2", "stop,2,1,,0,0,0,2"]
     code, output, _ = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", world=dark)
     assert code == 2, output
     assert output.startswith("--objective: error: --objective lamp_distance needs a lamp, and hall has none"), output
-    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", "--objective", "collisions",
-                             world=dark)
+    code, output, out = tune(tmp_path, rows, "--cells", "line 2 timer=0..50", "--objective", "collisions", world=dark)
     assert code == 0, output
     report = (out / "report.md").read_text(encoding="utf-8")
     assert "| collisions (objective) |" in report and "lamp_distance" not in report
@@ -177,8 +214,15 @@ def test_counter_loads_are_tuned_as_program_variants(tmp_path: Path) -> None:
     plan = make_plan(example, None, [], [], "0", None, 5.0)
     cells = parse_cells("line 5 C1_load=10..200", plan.table)
     assert (cells[0].column, cells[0].value, cells[0].low, cells[0].high) == ("C1_load", 107, 10, 200)
-    fleet = Fleet(plan.table, plan.machine, plan.worlds[0], [RobotSpec(seed=2, variant=1)], plan.robot_params,
-                  traced=[0], variants=cell_variants(plan.tables, plan.machine, cells, [(107,), (40,)]))
+    fleet = Fleet(
+        plan.table,
+        plan.machine,
+        plan.worlds[0],
+        [RobotSpec(seed=2, variant=1)],
+        plan.robot_params,
+        traced=[0],
+        variants=cell_variants(plan.tables, plan.machine, cells, [(107,), (40,)]),
+    )
     fleet.run(500)
     table, _ = load(example)
     rows = tuple(replace(r, counters=(40, *r.counters[1:])) if r.line == 5 else r for r in table.rows)

@@ -47,10 +47,32 @@ def robot(tmp_path: Path) -> Path:
 
 
 def tune(folder: Path, *args: str) -> tuple[int, str]:
-    result = CliRunner().invoke(app, ["tune", str(folder / "drive.csv"), "--robot", str(folder / "robot.toml"),
-                                      "--world", str(folder / "hall.toml"), "--grid", "battery=1.0", "--seeds", "0..1",
-                                      "--check-seeds", "7..8", "--seconds", "9", "--objective", "lamp_distance",
-                                      "--workers", "1", "--out", str(folder / "out"), *args])
+    result = CliRunner().invoke(
+        app,
+        [
+            "tune",
+            str(folder / "drive.csv"),
+            "--robot",
+            str(folder / "robot.toml"),
+            "--world",
+            str(folder / "hall.toml"),
+            "--grid",
+            "battery=1.0",
+            "--seeds",
+            "0..1",
+            "--check-seeds",
+            "7..8",
+            "--seconds",
+            "9",
+            "--objective",
+            "lamp_distance",
+            "--workers",
+            "1",
+            "--out",
+            str(folder / "out"),
+            *args,
+        ],
+    )
     return result.exit_code, result.output
 
 
@@ -89,8 +111,16 @@ def test_a_variant_of_the_lights_table_runs_as_sim_of_the_edited_table(tmp_path:
     project = tablebot.open(LIGHTS)
     variants = cell_variants(plan.tables, plan.machine, cells, [tuple(c.value for c in cells), (17, 23, 33)])
     specs = [RobotSpec(seed=3, variant=1), RobotSpec(seed=3, variant=0)]
-    fleet = Fleet(project.table, project.machine, project.scene(every_table=True).world, specs,
-                  robot_layer(project.robot)[0], traced=[0, 1], variants=variants, tables=plan.tables)
+    fleet = Fleet(
+        project.table,
+        project.machine,
+        project.scene(every_table=True).world,
+        specs,
+        robot_layer(project.robot)[0],
+        traced=[0, 1],
+        variants=variants,
+        tables=plan.tables,
+    )
     fleet.run(600)
     for k, folder in ((0, edited), (1, LIGHTS)):
         alone = simulate(tablebot.open(folder).scene(every_table=True), 6.0, 3)
@@ -100,11 +130,14 @@ def test_a_variant_of_the_lights_table_runs_as_sim_of_the_edited_table(tmp_path:
     assert fleet.trace_lines(0) != fleet.trace_lines(1)
 
 
-@pytest.mark.parametrize(("cells", "words"), [
-    ("lamps: line 2 timer", "--cells: 'lamps: line 2 timer': the robot has no table lamps"),
-    ("clock: line 9 timer", "line 9 of clock.csv is not a row of the table"),
-    ("clock: line 2 timer, clock:line 2 timer", "names clock: line 2 timer twice"),
-])
+@pytest.mark.parametrize(
+    ("cells", "words"),
+    [
+        ("lamps: line 2 timer", "--cells: 'lamps: line 2 timer': the robot has no table lamps"),
+        ("clock: line 9 timer", "line 9 of clock.csv is not a row of the table"),
+        ("clock: line 2 timer, clock:line 2 timer", "names clock: line 2 timer twice"),
+    ],
+)
 def test_bad_cells_of_several_tables_name_the_option(tmp_path: Path, cells: str, words: str) -> None:
     code, output = tune(robot(tmp_path), "--cells", cells)
     assert code == 2, output
@@ -114,8 +147,24 @@ def test_bad_cells_of_several_tables_name_the_option(tmp_path: Path, cells: str,
 
 def test_a_table_named_for_a_robot_of_one_table_is_a_clear_error(tmp_path: Path) -> None:
     (tmp_path / "table.csv").write_text("description,state,T,M1,M2,timer,next\ngo,2,1,8,8,5,2\n", encoding="utf-8")
-    result = CliRunner().invoke(app, ["tune", str(tmp_path / "table.csv"), "--cells", "lights: line 2 timer",
-                                      "--seeds", "0", "--check-seeds", "1", "--seconds", "1", "--workers", "1",
-                                      "--out", str(tmp_path / "out")])
+    result = CliRunner().invoke(
+        app,
+        [
+            "tune",
+            str(tmp_path / "table.csv"),
+            "--cells",
+            "lights: line 2 timer",
+            "--seeds",
+            "0",
+            "--check-seeds",
+            "1",
+            "--seconds",
+            "1",
+            "--workers",
+            "1",
+            "--out",
+            str(tmp_path / "out"),
+        ],
+    )
     assert result.exit_code == 2, result.output
     assert "names the table lights, but the robot has one table" in result.output

@@ -49,7 +49,6 @@ class Sweep:
     ran: int = 0  # runs made by this call (a resumed sweep took the others from its folder)
     read: list[dict[str, str]] | None = field(default=None, repr=False)  # every row, when read already
 
-
     def csv_text(self) -> str:
         """``results.csv``, byte for byte."""
         if self.text_in_memory is not None:
@@ -80,13 +79,20 @@ class Sweep:
             for label, chosen in values:
                 name = N_("all runs") if key == "all runs" else f"{key} {label}"
                 if lamps:
-                    line = N_("{reached}/{runs} reached the lamp", reached=sum(int(r["reached"]) for r in chosen),
-                              runs=len(chosen))
+                    line = N_(
+                        "{reached}/{runs} reached the lamp",
+                        reached=sum(int(r["reached"]) for r in chosen),
+                        runs=len(chosen),
+                    )
                 else:
                     collisions = sum(int(r["collisions"]) for r in chosen) / max(1, len(chosen))
                     metres = sum(float(r["distance_m"]) for r in chosen) / max(1, len(chosen))
-                    line = N_("{runs} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run",
-                              runs=len(chosen), collisions=collisions, metres=metres)
+                    line = N_(
+                        "{runs} runs, {collisions:.1f} collisions and {metres:.2f} m driven a run",
+                        runs=len(chosen),
+                        collisions=collisions,
+                        metres=metres,
+                    )
                 out.append(N_("{name}: {result}", name=name, result=line))
         return out
 
@@ -103,10 +109,21 @@ class Sweep:
             return [path, *_extras(self.plan, traced, folder, plots, self.rows() if plots else [])]
 
 
-def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = None, grid: Sequence[str] = (),
-          seconds: float = 60.0, backend: str = "auto", scheduler: str | None = None, workers: int | None = None,
-          out: PathLike | None = None, plots: bool = True, trace: Traced = None,
-          progress: Progress | None = None) -> Sweep:
+def sweep(
+    project: Loaded,
+    *,
+    robots: int | None = None,
+    seeds: str | None = None,
+    grid: Sequence[str] = (),
+    seconds: float = 60.0,
+    backend: str = "auto",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    out: PathLike | None = None,
+    plots: bool = True,
+    trace: Traced = None,
+    progress: Progress | None = None,
+) -> Sweep:
     """Run the table on many simulated robots (``tablebot sweep``): every world of the project x every
     combination of ``grid`` values (``["battery=1.0,0.6", "start=random"]``) x every seed (``robots``: seeds
     0..N-1, or ``seeds``: ``"0..999"``), ``seconds`` each, on this machine's cores (``workers`` threads) or a
@@ -129,8 +146,15 @@ def sweep(project: Loaded, *, robots: int | None = None, seeds: str | None = Non
         return _finish(plan, store, traced, plots, wall_s, ran)
 
 
-def _start(project: Loaded, runner: Runner, grid: Sequence[str], seeds: str | None, robots: int | None,
-           seconds: float, pictures: bool) -> Plan:
+def _start(
+    project: Loaded,
+    runner: Runner,
+    grid: Sequence[str],
+    seeds: str | None,
+    robots: int | None,
+    seconds: float,
+    pictures: bool,
+) -> Plan:
     """The fleet's modules imported and the sweep planned, while a cluster's workers start up or this process's
     compiled code loads on a thread (:meth:`Runner.imported`); the robot's tables as ``project`` read them."""
     runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
@@ -139,8 +163,18 @@ def _start(project: Loaded, runner: Runner, grid: Sequence[str], seeds: str | No
     if pictures:  # before the run (an interrupt never lands in matplotlib's import)
         import tablebot.fleet.plots  # noqa: F401
     runner.imported()  # this process's compiled code is sent to them, or loaded here, while it plans
-    return make_plan(project.path, project.robot_file, project.world_files, grid, seeds, robots, seconds,
-                     every_table=True, grid_cells=True, read=(project.table, project.tables))
+    return make_plan(
+        project.path,
+        project.robot_file,
+        project.world_files,
+        grid,
+        seeds,
+        robots,
+        seconds,
+        every_table=True,
+        grid_cells=True,
+        read=(project.table, project.tables),
+    )
 
 
 def trace_runs(runs: Traced, total: int) -> list[int]:
@@ -165,8 +199,10 @@ def _compiling(progress: Progress, backend: str, jobs: Sequence[Job]) -> None:
     if backend == "local" and jobs:
         from tablebot.fleet.kernel import run_fleet, run_fleet_serial
 
-        progress.compiling(N_("the fleet simulator"),  # one job: the threaded kernel
-                           run_fleet if len(jobs) == 1 else run_fleet_serial)
+        progress.compiling(
+            N_("the fleet simulator"),  # one job: the threaded kernel
+            run_fleet if len(jobs) == 1 else run_fleet_serial,
+        )
 
 
 def _in_memory(plan: Plan, runner: Runner, backend: str, progress: Progress) -> Sweep:
@@ -178,9 +214,11 @@ def _in_memory(plan: Plan, runner: Runner, backend: str, progress: Progress) -> 
     started = time.perf_counter()
     progress.start("robots", plan.spec.total, 0, plan.spec.ticks)
     try:
+
         def done(job: Job, summary: FleetSummary) -> None:
             parts[job.first] = plan.part_text(job, summary).partition("\n")[2]  # its rows, below its header
             progress.advance(len(summary))
+
         runner.run(jobs, done)
     finally:
         progress.stop()
@@ -204,15 +242,18 @@ def _into(plan: Plan, runner: Runner, backend: str, out: Path, progress: Progres
     started = time.perf_counter()
     progress.start("robots", total, already, plan.spec.ticks)
     try:
+
         def done(job: Job, summary: FleetSummary) -> None:
             store.write_part(job, plan.part_text(job, summary))
             progress.advance(len(summary))
+
         runner.run(jobs, done)
     except INTERRUPTS as exc:
         runner.close(failed=True)
         path, count = store.merge(complete=False)
-        raise stopped(N_("{count:,} of {total:,} runs finished, kept in {path}", count=count, total=total, path=path),
-                      exc) from None
+        raise stopped(
+            N_("{count:,} of {total:,} runs finished, kept in {path}", count=count, total=total, path=path), exc
+        ) from None
     finally:
         progress.stop()
     return store, total - already, time.perf_counter() - started

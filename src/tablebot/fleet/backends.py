@@ -29,16 +29,25 @@ def choose(backend: str, scheduler: str | None) -> tuple[str, str | None]:
     --scheduler or DASK_SCHEDULER_ADDRESS) and --backend was left at its default."""
     address = scheduler or os.environ.get(SCHEDULER_ENV) or None
     if backend not in ("auto", "local", "dask"):
-        raise fail("--backend", N_("--backend {backend}: unknown backend", backend=backend),
-                   N_("use --backend local or --backend dask"))
+        raise fail(
+            "--backend",
+            N_("--backend {backend}: unknown backend", backend=backend),
+            N_("use --backend local or --backend dask"),
+        )
     if backend == "local" and scheduler:
-        raise fail("--scheduler", N_("--scheduler names a Dask scheduler, but --backend is local"),
-                   N_("drop --backend local (or use --backend dask)"))
+        raise fail(
+            "--scheduler",
+            N_("--scheduler names a Dask scheduler, but --backend is local"),
+            N_("drop --backend local (or use --backend dask)"),
+        )
     if backend == "auto":
         backend = "dask" if address else "local"
     if backend == "dask" and not address:
-        raise fail("--backend", N_("--backend dask needs a scheduler to send the chunks to"),
-                   N_("give --scheduler tcp://HOST:8786 or set {env}", env=SCHEDULER_ENV))
+        raise fail(
+            "--backend",
+            N_("--backend dask needs a scheduler to send the chunks to"),
+            N_("give --scheduler tcp://HOST:8786 or set {env}", env=SCHEDULER_ENV),
+        )
     return backend, address if backend == "dask" else None
 
 
@@ -105,8 +114,7 @@ class Runner:
         self._imported.set()
         if self.backend == "local" and self._loading is None:
             threads = 1 if self._local_workers > 1 else None  # as _run_local runs them
-            self._loading = threading.Thread(target=preload_quietly, args=(threads,), name="tablebot-load",
-                                             daemon=True)
+            self._loading = threading.Thread(target=preload_quietly, args=(threads,), name="tablebot-load", daemon=True)
             self._loading.start()
 
     def _open(self) -> None:

@@ -29,14 +29,20 @@ def connect(address: str) -> Any:
     try:
         return Client(address, timeout="15s", set_as_default=False)
     except (OSError, TimeoutError) as exc:
-        raise fail("--scheduler", N_("cannot reach the Dask scheduler at {address}: {reason}", address=address,
-                                     reason=str(exc)),
-                   N_("start one with `dask scheduler` and `dask worker ADDRESS`, or check the address")) from None
+        raise fail(
+            "--scheduler",
+            N_("cannot reach the Dask scheduler at {address}: {reason}", address=address, reason=str(exc)),
+            N_("start one with `dask scheduler` and `dask worker ADDRESS`, or check the address"),
+        ) from None
     except TypeError as exc:  # Dask's words for a tls:// address without its TLS settings
-        raise fail("--scheduler", N_("cannot connect to the Dask scheduler at {address}: {reason}", address=address,
-                                     reason=str(exc)),
-                   N_("give Dask's TLS settings (distributed.comm.tls.ca-file, .client.cert and .client.key in its "
-                      "configuration), or use a tcp:// address")) from None
+        raise fail(
+            "--scheduler",
+            N_("cannot connect to the Dask scheduler at {address}: {reason}", address=address, reason=str(exc)),
+            N_(
+                "give Dask's TLS settings (distributed.comm.tls.ca-file, .client.cert and .client.key in its "
+                "configuration), or use a tcp:// address"
+            ),
+        ) from None
 
 
 def check_address(address: str) -> None:
@@ -54,9 +60,16 @@ def check_address(address: str) -> None:
             if not 0 < port < 65536:
                 raise ValueError(f"port {port} is not from 1 to 65535")
     except ValueError as exc:
-        raise fail(where, N_("{where} {address!r} is not a Dask scheduler's address: {reason}", where=where,
-                             address=address, reason=str(exc)),
-                   N_("write tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786 (what `dask scheduler` prints)")) from None
+        raise fail(
+            where,
+            N_(
+                "{where} {address!r} is not a Dask scheduler's address: {reason}",
+                where=where,
+                address=address,
+                reason=str(exc),
+            ),
+            N_("write tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786 (what `dask scheduler` prints)"),
+        ) from None
 
 
 def submit_all(client: Any, jobs: Sequence[Job], fn: Callable[[Any], tuple[Job, Any]]) -> dict[Any, Common | None]:
@@ -86,8 +99,11 @@ def slots(client: Any) -> list[tuple[str, str, int]]:
     by_host: dict[str, list[str]] = defaultdict(list)
     for address, worker in sorted(workers.items()):
         by_host[worker.get("host", address)].append(address)
-    return [(address, f"{host}-{rank}".replace(":", "_").replace("/", "_"), len(addresses))
-            for host, addresses in by_host.items() for rank, address in enumerate(addresses)]
+    return [
+        (address, f"{host}-{rank}".replace(":", "_").replace("/", "_"), len(addresses))
+        for host, addresses in by_host.items()
+        for rank, address in enumerate(addresses)
+    ]
 
 
 def compiled_files() -> dict[str, dict[str, bytes]] | None:
@@ -119,8 +135,20 @@ def send_ready(client: Any, places: Sequence[tuple[str, str, int]], files: Any) 
     """:func:`~tablebot.fleet.work.ready_worker` to each worker of ``places``, pinned to it: with the compiled
     code ``files`` (scattered) to load, or, with None, its imports alone."""
     load, step = (False, "import") if files is None else (True, "ready")
-    return [client.submit(ready_worker, slot, share, files, load, workers=[address], allow_other_workers=False,
-                          pure=False, key=f"tablebot-{step}-{slot}") for address, slot, share in places]
+    return [
+        client.submit(
+            ready_worker,
+            slot,
+            share,
+            files,
+            load,
+            workers=[address],
+            allow_other_workers=False,
+            pure=False,
+            key=f"tablebot-{step}-{slot}",
+        )
+        for address, slot, share in places
+    ]
 
 
 def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -139,14 +167,31 @@ def warm_cluster(client: Any, job: Job, opened: dict[str, Any] | None = None) ->
 
         warm(job, both=True)
         files = client.scatter(jit.cache_files(), broadcast=True, hash=False)
-        futures = [client.submit(warm_worker, job, slot, share, files, workers=[address],
-                                 allow_other_workers=False, pure=False, key=f"tablebot-warm-{slot}")
-                   for address, slot, share in places]
+        futures = [
+            client.submit(
+                warm_worker,
+                job,
+                slot,
+                share,
+                files,
+                workers=[address],
+                allow_other_workers=False,
+                pure=False,
+                key=f"tablebot-warm-{slot}",
+            )
+            for address, slot, share in places
+        ]
     try:
         ready = client.gather(opened.get("ready", []))
         warmed = client.gather(futures)
     except Exception as exc:  # a scheduler or worker without tablebot (or another version of it)
-        raise fail("--scheduler", N_("the Dask cluster could not run tablebot's fleet: {kind}: {reason}",
-                                     kind=type(exc).__name__, reason=str(exc)),
-                   N_("install the same tablebot (and Python) on the scheduler and every worker")) from None
+        raise fail(
+            "--scheduler",
+            N_(
+                "the Dask cluster could not run tablebot's fleet: {kind}: {reason}",
+                kind=type(exc).__name__,
+                reason=str(exc),
+            ),
+            N_("install the same tablebot (and Python) on the scheduler and every worker"),
+        ) from None
     return {"workers": len(places), "ready": ready, "warm": warmed}

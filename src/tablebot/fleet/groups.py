@@ -14,6 +14,7 @@ if TYPE_CHECKING:
 
 REPORT_COLUMNS = ("run", "reached", "collisions", "distance_m")  # what the summary of a sweep reads
 
+
 def groups(plan: Plan, rows: Sequence[dict[str, Any]]) -> list[tuple[str, list[tuple[str, list[dict[str, Any]]]]]]:
     """Per grid axis (or "all runs" without one): its values, each with the rows that had it."""
     out = []
@@ -29,8 +30,9 @@ def groups(plan: Plan, rows: Sequence[dict[str, Any]]) -> list[tuple[str, list[t
         chosen: list[list[dict[str, Any]]] = [[] for _ in axis.values]
         for r in rows:
             chosen[value_index(plan.spec, int(r["run"]), k)].append(r)
-        labels = [":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value)
-                  for value in axis.values]
+        labels = [
+            ":".join(f"{v:g}" for v in value) if isinstance(value, tuple) else str(value) for value in axis.values
+        ]
         out.append((axis.key, list(zip(labels, chosen, strict=True))))
     return out or [("all runs", [("all", list(rows))])]
 

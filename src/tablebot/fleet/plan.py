@@ -50,8 +50,17 @@ __all__ = ["RESULT_COLUMNS", "Plan", "Read", "Store", "csv_text", "make_plan", "
 
 #: A robot's table and, for a robot of several, all its tables (tablebot.tables.several), as a caller read them.
 Read = tuple[Table, RobotTables | None]
-RESULT_COLUMNS = ("seconds", "first_light_s", "reached", "reached_s", "collisions", "distance_m",
-                  "battery_start_v", "battery_end_v", "final_state")
+RESULT_COLUMNS = (
+    "seconds",
+    "first_light_s",
+    "reached",
+    "reached_s",
+    "collisions",
+    "distance_m",
+    "battery_start_v",
+    "battery_end_v",
+    "final_state",
+)
 
 
 @dataclass
@@ -69,12 +78,15 @@ class Plan:
     def __post_init__(self, first: Scene | None) -> None:
         self.cell_axes = [k for k, axis in enumerate(self.spec.axes) if is_cell(axis.key)]
         self.variants: Variants | None  # the grid's table cells' program variants (fleet.cells.grid_variants)
-        self.variants, self.variant_of = grid_variants([self.spec.axes[k] for k in self.cell_axes], self.table,
-                                                       self.tables, self.machine)
+        self.variants, self.variant_of = grid_variants(
+            [self.spec.axes[k] for k in self.cell_axes], self.table, self.tables, self.machine
+        )
         self.scenes: list[Scene] = [
-            first if k == 0 and first is not None else prepare(self.table, self.machine, w, self.robot_params,
-                                                               tables=self.tables)
-            for k, w in enumerate(self.worlds)]
+            first
+            if k == 0 and first is not None
+            else prepare(self.table, self.machine, w, self.robot_params, tables=self.tables)
+            for k, w in enumerate(self.worlds)
+        ]
         self.bodies: list[list[Scene]] = self._check_params()
         self._check_starts()
 
@@ -90,8 +102,11 @@ class Plan:
         params, start = [], None
         for k, (axis, value) in enumerate(zip(self.spec.axes, run.values, strict=True)):
             if axis.key == "start":
-                start = random_start(run.seed, self.worlds[run.world].walls, self._free(run.world)) \
-                    if value == "random" else tuple(value)
+                start = (
+                    random_start(run.seed, self.worlds[run.world].walls, self._free(run.world))
+                    if value == "random"
+                    else tuple(value)
+                )
             elif k not in self.cell_axes:
                 params.append((*param_of(axis.key), value))
         variant = self.variant_of.get(tuple(run.values[k] for k in self.cell_axes), 0)
@@ -100,6 +115,7 @@ class Plan:
     def _free(self, world: int) -> Callable[[tuple[float, float, float]], bool]:
         """Whether a pose is a free start in the world for every robot body of the grid (a random start
         serves every grid value of its seed)."""
+
         def free(pose: tuple[float, float, float]) -> bool:
             try:
                 for scene in self.bodies[world]:
@@ -107,6 +123,7 @@ class Plan:
             except TableBotError:
                 return False
             return True
+
         return free
 
     def jobs(self, skip: Collection[tuple[int, int]] = ()) -> list[Job]:
@@ -118,9 +135,19 @@ class Plan:
             if (a, b) in skip:
                 continue
             robots = self._robots(a, b, combos)
-            out.append(Job(self.table, self.worlds[a // self.spec.runs_per_world], self.robot_params, robots,
-                           self.spec.ticks, first=a, info={"stop": b, "starts": [robot.start for robot in robots]},
-                           tables=self.tables, variants=self.variants))
+            out.append(
+                Job(
+                    self.table,
+                    self.worlds[a // self.spec.runs_per_world],
+                    self.robot_params,
+                    robots,
+                    self.spec.ticks,
+                    first=a,
+                    info={"stop": b, "starts": [robot.start for robot in robots]},
+                    tables=self.tables,
+                    variants=self.variants,
+                )
+            )
         return out
 
     def _robots(self, a: int, b: int, combos: Sequence[tuple[Any, ...]]) -> list[RobotSpec]:
@@ -133,7 +160,7 @@ class Plan:
             world, rest = divmod(index, spec.runs_per_world)
             combo, k = divmod(rest, count)
             stop, values = min(b, index + count - k), combos[combo]
-            seeds = spec.seeds[k: k + stop - index]
+            seeds = spec.seeds[k : k + stop - index]
             if "random" in values:
                 out += [self.robot(Run(index + j, world, values, seed)) for j, seed in enumerate(seeds)]
             else:
@@ -150,15 +177,19 @@ class Plan:
         axes = [axis for k, axis in enumerate(self.spec.axes) if axis.key != "start" and k not in self.cell_axes]
         bodies = [{_body(scene): scene} for scene in self.scenes]
         for values in itertools.product(*(axis.values for axis in axes)) if axes else ():
-            overrides = RobotSpec(0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values,
-                                                                                          strict=True))).overrides()
+            overrides = RobotSpec(
+                0, params=tuple((*param_of(a.key), v) for a, v in zip(axes, values, strict=True))
+            ).overrides()
             for world, found in zip(self.worlds, bodies, strict=True):
                 try:
                     scene = prepare(self.table, self.machine, world, self.robot_params, overrides, self.tables)
                 except TableBotError as exc:
                     setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
-                    raise fail("--grid", f"--grid {setting}: {exc.diagnostics[0].message}",
-                               "choose --grid values the simulated robot can take") from None
+                    raise fail(
+                        "--grid",
+                        f"--grid {setting}: {exc.diagnostics[0].message}",
+                        "choose --grid values the simulated robot can take",
+                    ) from None
                 found.setdefault(_body(scene), scene)
         return [list(found.values()) for found in bodies]
 
@@ -172,21 +203,33 @@ class Plan:
                     try:
                         with_start(scene, pose)
                     except TableBotError as exc:  # the world's words, about the option
-                        raise fail("--grid", f"--grid start: {exc.diagnostics[0].message}",
-                                   "choose a start pose inside the walls, clear of walls and obstacles") from None
+                        raise fail(
+                            "--grid",
+                            f"--grid start: {exc.diagnostics[0].message}",
+                            "choose a start pose inside the walls, clear of walls and obstacles",
+                        ) from None
 
     def traced(self, index: int) -> Fleet:
         """Run ``index`` of the sweep again as the traced robot of a fleet of one (the same run it made)."""
         run = runs(self.spec, index, index + 1)[0]
-        fleet = Fleet(self.table, self.machine, self.worlds[run.world], [self.robot(run)], self.robot_params,
-                      traced=[0], tables=self.tables, variants=self.variants)
+        fleet = Fleet(
+            self.table,
+            self.machine,
+            self.worlds[run.world],
+            [self.robot(run)],
+            self.robot_params,
+            traced=[0],
+            tables=self.tables,
+            variants=self.variants,
+        )
         fleet.run(self.spec.ticks)
         return fleet
 
     def write_traces(self, indices: Sequence[int], folder: Path) -> list[Path]:
         """``trace-RUN.jsonl`` of each run: the trace ``tablebot sim`` writes for that robot."""
-        return [write_text(folder / f"trace-{index}.jsonl", "".join(self.traced(index).trace_lines(0)))
-                for index in indices]
+        return [
+            write_text(folder / f"trace-{index}.jsonl", "".join(self.traced(index).trace_lines(0))) for index in indices
+        ]
 
     def part_text(self, job: Job, summary: FleetSummary) -> str:
         """A finished chunk's result rows as CSV text (header first), one row per robot, its start as
@@ -203,28 +246,46 @@ class Plan:
         tick_s, states = summary.tick_s, self.machine.states
         starts = [start or self.worlds[world].start for start in job.info["starts"]]
         cells: dict[str, list[str]] = {
-            "run": list(map(str, range(a, b))), "world": [cell(spec.worlds[world])] * (b - a),
+            "run": list(map(str, range(a, b))),
+            "world": [cell(spec.worlds[world])] * (b - a),
             "seed": [str(spec.seeds[k % count]) for k in per_seed],
             **{column: [str(start[j]) for start in starts] for j, column in enumerate(START_COLUMNS)},
-            **{axis.key: [cell(combos[k // count][j]) for k in per_seed]
-               for j, axis in enumerate(spec.axes) if axis.key != "start"}}
+            **{
+                axis.key: [cell(combos[k // count][j]) for k in per_seed]
+                for j, axis in enumerate(spec.axes)
+                if axis.key != "start"
+            },
+        }
         state_cells = [cell(state) for state in states]
-        cells.update(seconds=[cell(round(summary.ticks * tick_s, 6))] * (b - a),
-                     first_light_s=times(summary.first_light, tick_s),
-                     reached=["0" if tick < 0 else "1" for tick in summary.reached.tolist()],
-                     reached_s=times(summary.reached, tick_s), collisions=list(map(str, summary.collisions.tolist())),
-                     distance_m=decimals(summary.distance_m), battery_start_v=decimals(summary.battery_start_v),
-                     battery_end_v=decimals(summary.battery_end_v),
-                     final_state=[state_cells[k] for k in summary.final_state.tolist()])
+        cells.update(
+            seconds=[cell(round(summary.ticks * tick_s, 6))] * (b - a),
+            first_light_s=times(summary.first_light, tick_s),
+            reached=["0" if tick < 0 else "1" for tick in summary.reached.tolist()],
+            reached_s=times(summary.reached, tick_s),
+            collisions=list(map(str, summary.collisions.tolist())),
+            distance_m=decimals(summary.distance_m),
+            battery_start_v=decimals(summary.battery_start_v),
+            battery_end_v=decimals(summary.battery_end_v),
+            final_state=[state_cells[k] for k in summary.final_state.tolist()],
+        )
         cells.update((f"time_{state}_s", decimals(summary.counts[:, k] * tick_s)) for k, state in enumerate(states))
         columns = self.columns()
         lines = map(",".join, zip(*(cells[column] for column in columns), strict=True))
         return csv_text(columns, []) + "".join(line + "\n" for line in lines)
 
 
-def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Sequence[str], seeds: str | None,
-              robots: int | None, seconds: float, every_table: bool = False, grid_cells: bool = False,
-              read: Read | None = None) -> Plan:
+def make_plan(
+    table: Path,
+    robot: Path | None,
+    worlds: Sequence[Path],
+    grid: Sequence[str],
+    seeds: str | None,
+    robots: int | None,
+    seconds: float,
+    every_table: bool = False,
+    grid_cells: bool = False,
+    read: Read | None = None,
+) -> Plan:
     """The table, its worlds and the checked options (``--grid``, ``--seeds`` or ``--robots``, ``--seconds``)
     as a plan of runs; every mistake is a located error before anything is written. ``every_table``: a robot of
     several tables runs all of them (``sweep``, ``tune``, ``grade``, ``evolve``), else its main table alone.
@@ -238,8 +299,11 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
     parsed, tables = read if read is not None and every_table else _read(table, robot, every_table)
     machine = tables.machines[0] if tables is not None else compile_table(parsed)
     if machine.arrays is None:
-        raise fail(parsed.path, f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most "
-                   f"{FLAT_BITS}", "simulate it one robot at a time with tablebot sim, or use fewer inputs")
+        raise fail(
+            parsed.path,
+            f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most {FLAT_BITS}",
+            "simulate it one robot at a time with tablebot sim, or use fewer inputs",
+        )
     layer, robot_world = robot_layer(parsed.robot)
     loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]
     paths = [str(w) for w in worlds] or [loaded[0].path]
@@ -247,10 +311,17 @@ def make_plan(table: Path, robot: Path | None, worlds: Sequence[Path], grid: Seq
     ticks = ticks_for(first, seconds)
     files = [Path(p) if Path(p).is_file() else None for p in paths]
     robot_file = Path(parsed.robot.source)
-    spec = SweepSpec(table=str(Path(parsed.path).name), table_digest=tables_digest(parsed, tables),
-                     worlds=tuple(paths), world_digests=tuple(digest(f) for f in files), axes=axes,
-                     seeds=seed_list, ticks=ticks, robot_digest=digest(robot_file if robot_file.is_file() else None),
-                     code=sources_digest())
+    spec = SweepSpec(
+        table=str(Path(parsed.path).name),
+        table_digest=tables_digest(parsed, tables),
+        worlds=tuple(paths),
+        world_digests=tuple(digest(f) for f in files),
+        axes=axes,
+        seeds=seed_list,
+        ticks=ticks,
+        robot_digest=digest(robot_file if robot_file.is_file() else None),
+        code=sources_digest(),
+    )
     return Plan(spec, parsed, machine, loaded, layer, tables, first)
 
 
@@ -267,5 +338,3 @@ def _read(table: Path, robot: Path | None, every_table: bool) -> Read:
 def _body(scene: Scene) -> tuple:
     """What decides whether a start pose is free for the robot: its body's measures."""
     return tuple(sorted(scene.params["body"].items()))
-
-

@@ -49,8 +49,9 @@ def outcomes_figure(plan: Plan, rows: Sequence[Row]) -> Figure:
         labels = [picture(label) for label, _chosen in values]
         rates = [float(np.mean([int(r["reached"]) for r in chosen])) if chosen else 0.0 for _label, chosen in values]
         bars = left.bar(labels, [100 * r for r in rates], color=REACHED)
-        left.bar_label(bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_label, c) in zip(rates, values, strict=True)],
-                       fontsize=8)
+        left.bar_label(
+            bars, [f"{100 * r:.0f}%\n(n={len(c)})" for r, (_label, c) in zip(rates, values, strict=True)], fontsize=8
+        )
         left.set_ylim(0, 118)
         left.set_ylabel(_("reached the lamp (%)"))
         left.set_xlabel(key)
@@ -60,14 +61,19 @@ def outcomes_figure(plan: Plan, rows: Sequence[Row]) -> Figure:
         for i, ts in enumerate(times):
             jitter = np.random.default_rng(i).uniform(-0.15, 0.15, len(ts))  # fixed: the picture is reproducible
             right.scatter(np.full(len(ts), i + 1.0) + jitter, ts, s=6, alpha=0.35, color="#f0a500", zorder=3)
-            right.text(i + 1, seconds * 1.02, _("never: {n}").format(n=never[i]), ha="center", fontsize=8,
-                       color="#636e72")
+            right.text(
+                i + 1, seconds * 1.02, _("never: {n}").format(n=never[i]), ha="center", fontsize=8, color="#636e72"
+            )
         right.set_ylim(0, seconds * 1.1)
         right.set_ylabel(_("time to first light (s)"))
         right.set_xlabel(key)
-    fig.suptitle(_("{robot}: {runs:,} runs of {seconds:g} s").format(robot=picture(plan.table.robot.name),
-                                                                      runs=len(rows), seconds=seconds), fontsize=13,
-                 fontweight="bold")
+    fig.suptitle(
+        _("{robot}: {runs:,} runs of {seconds:g} s").format(
+            robot=picture(plan.table.robot.name), runs=len(rows), seconds=seconds
+        ),
+        fontsize=13,
+        fontweight="bold",
+    )
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     return fig
 
@@ -91,25 +97,43 @@ def starts_figure(plan: Plan, rows: Sequence[Row]) -> Figure:
     ys = np.array([float(r["start_y"]) for r in world_rows])
     reached = np.array([int(r["reached"]) for r in world_rows])
     if len(world_rows) > 600:
-        cells = ax.hexbin(xs, ys, C=reached * 100.0, reduce_C_function=np.mean, gridsize=24, cmap="RdYlGn",
-                          vmin=0, vmax=100, alpha=0.85, zorder=3, mincnt=1)
+        cells = ax.hexbin(
+            xs,
+            ys,
+            C=reached * 100.0,
+            reduce_C_function=np.mean,
+            gridsize=24,
+            cmap="RdYlGn",
+            vmin=0,
+            vmax=100,
+            alpha=0.85,
+            zorder=3,
+            mincnt=1,
+        )
         fig.colorbar(cells, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label=_("reached the lamp (% of starts here)"))
     else:
         times = np.array([number(r["reached_s"]) or math.nan for r in world_rows])
         headings = np.radians([float(r["start_heading"]) for r in world_rows])
         ok = ~np.isnan(times)
-        ax.quiver(xs, ys, np.cos(headings), np.sin(headings), color="#2d3436", alpha=0.5, scale=40, width=0.003,
-                  zorder=3)
+        ax.quiver(
+            xs, ys, np.cos(headings), np.sin(headings), color="#2d3436", alpha=0.5, scale=40, width=0.003, zorder=3
+        )
         if (~ok).any():  # the legend says only what the picture shows
             ax.scatter(xs[~ok], ys[~ok], s=28, color=NEVER, marker="x", zorder=4, label=_("never reached the lamp"))
-        dots = ax.scatter(xs[ok], ys[ok], c=times[ok], s=30, cmap="viridis_r", edgecolors="white", linewidths=0.5,
-                          zorder=5)
+        dots = ax.scatter(
+            xs[ok], ys[ok], c=times[ok], s=30, cmap="viridis_r", edgecolors="white", linewidths=0.5, zorder=5
+        )
         if ok.any():
             fig.colorbar(dots, cax=fig.add_axes((0.88, 0.15, 0.025, 0.7)), label=_("time to reach the lamp (s)"))
         if (~ok).any():
             ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(_("Start positions in {world}: {reached} of {runs} reached the lamp").format(
-        world=picture(world.name), reached=int(reached.sum()), runs=len(world_rows)), fontsize=12, fontweight="bold")
+    ax.set_title(
+        _("Start positions in {world}: {reached} of {runs} reached the lamp").format(
+            world=picture(world.name), reached=int(reached.sum()), runs=len(world_rows)
+        ),
+        fontsize=12,
+        fontweight="bold",
+    )
     return fig
 
 
@@ -118,11 +142,17 @@ def best_and_worst(rows: Sequence[Row]) -> tuple[Row | None, Row | None]:
     else reached it last."""
     if not rows:
         return None, None
+
     def cost(r: Row) -> tuple[float, ...]:
         reached = number(r["reached_s"])
         light = number(r["first_light_s"])
-        return (math.inf if reached is None else reached, int(r["collisions"]), math.inf if light is None else light,
-                int(r["run"]))
+        return (
+            math.inf if reached is None else reached,
+            int(r["collisions"]),
+            math.inf if light is None else light,
+            int(r["run"]),
+        )
+
     ordered = sorted(rows, key=cost)
     return ordered[0], ordered[-1] if len(ordered) > 1 else None
 
@@ -142,5 +172,8 @@ def trajectories(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
 def write_all(plan: Plan, rows: Sequence[Row], folder: Path) -> list[Path]:
     if not rows:
         return []
-    return [outcomes(plan, rows, folder / "outcomes.png"), starts(plan, rows, folder / "starts.png"),
-            *trajectories(plan, rows, folder)]
+    return [
+        outcomes(plan, rows, folder / "outcomes.png"),
+        starts(plan, rows, folder / "starts.png"),
+        *trajectories(plan, rows, folder),
+    ]

@@ -98,14 +98,20 @@ def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -
     """``--seeds 0..999`` (both ends included), ``1,5,9`` or a mix; ``--robots N`` means seeds 0..N-1.
     Errors name ``option`` (the same numbers are read for --check-seeds and --trace)."""
     if text is not None and robots is not None:
-        raise fail("--robots", N_("give --robots or {option}, not both", option=option),
-                   N_("--robots N is short for {option} 0..N-1", option=option))
+        raise fail(
+            "--robots",
+            N_("give --robots or {option}, not both", option=option),
+            N_("--robots N is short for {option} 0..N-1", option=option),
+        )
     if text is None:
         if robots is None:
             raise fail(option, N_("say which runs to make"), N_("give {option} 0..99 or --robots 100", option=option))
         if robots < 1:
-            raise fail("--robots", N_("--robots {n}: there must be at least one robot", n=robots),
-                       N_("give --robots 1 or more"))
+            raise fail(
+                "--robots",
+                N_("--robots {n}: there must be at least one robot", n=robots),
+                N_("give --robots 1 or more"),
+            )
         return tuple(range(robots))
     seeds: list[int] = []
     for part in (p for p in text.split(",") if p.strip()):
@@ -113,20 +119,32 @@ def parse_seeds(text: str | None, robots: int | None, option: str = "--seeds") -
         if found and len(part) <= 2 * MAX_NUMBER_CHARS + 2:  # int() of longer numbers may fail
             low, high = int(found[1]), int(found[2])
             if high < low:
-                raise fail(option, N_("{option} {part} is an empty range", option=option, part=part.strip()),
-                           N_("write {low}..{high} (low..high)", low=high, high=low))
+                raise fail(
+                    option,
+                    N_("{option} {part} is an empty range", option=option, part=part.strip()),
+                    N_("write {low}..{high} (low..high)", low=high, high=low),
+                )
             if high - low >= MAX_RUNS - len(seeds):  # before the range is made: 0..99999999999 is 800 GB of it
-                raise fail(option, N_("{option} gives more than {most:,} seeds", option=option, most=MAX_RUNS),
-                           N_("sweep fewer seeds"))
+                raise fail(
+                    option,
+                    N_("{option} gives more than {most:,} seeds", option=option, most=MAX_RUNS),
+                    N_("sweep fewer seeds"),
+                )
             seeds.extend(range(low, high + 1))
         elif part.strip().isdigit() and len(part.strip()) <= MAX_NUMBER_CHARS:
             seeds.append(int(part))
         else:
-            raise fail(option, N_("{option}: {part!r} is not a seed or a range", option=option, part=part.strip()),
-                       N_("write whole numbers and ranges: 0..999 or 1,5,9 or 0..9,20"))
+            raise fail(
+                option,
+                N_("{option}: {part!r} is not a seed or a range", option=option, part=part.strip()),
+                N_("write whole numbers and ranges: 0..999 or 1,5,9 or 0..9,20"),
+            )
         if len(seeds) > MAX_RUNS:
-            raise fail(option, N_("{option} gives more than {most:,} seeds", option=option, most=MAX_RUNS),
-                       N_("sweep fewer seeds"))
+            raise fail(
+                option,
+                N_("{option} gives more than {most:,} seeds", option=option, most=MAX_RUNS),
+                N_("sweep fewer seeds"),
+            )
     if not seeds:
         raise fail(option, N_("{option} names no seed", option=option), N_("give {option} 0..99", option=option))
     if min(seeds) < 0:
@@ -145,8 +163,9 @@ def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
         key = raw.strip().lower()
         cells = [v.strip() for v in values.split(",") if v.strip()]
         if not sep or not key:
-            raise fail("--grid", N_("--grid {item!r} is not KEY=VALUES", item=item),
-                       N_('write --grid "battery=1.0,0.8,0.6"'))
+            raise fail(
+                "--grid", N_("--grid {item!r} is not KEY=VALUES", item=item), N_('write --grid "battery=1.0,0.8,0.6"')
+            )
         if not cells:
             raise fail("--grid", N_("--grid {key}= has no values", key=key), N_('write --grid "{key}=V1,V2"', key=key))
         if key in (a.key for a in axes):
@@ -154,8 +173,9 @@ def parse_grid(items: Sequence[str]) -> tuple[Axis, ...]:
         if is_cell(raw):  # a timer or counter load of a table row: its values are program variants
             key = " ".join(raw.split())
             if key in (a.key for a in axes):
-                raise fail("--grid", N_("--grid names {key} twice", key=key),
-                           N_("give each key once, with all its values"))
+                raise fail(
+                    "--grid", N_("--grid names {key} twice", key=key), N_("give each key once, with all its values")
+                )
             axes.append(Axis(key, _counts(key, cells)))
             continue
         axes.append(Axis(key, _start_values(cells) if key == "start" else _numbers(key, cells)))
@@ -174,9 +194,11 @@ def _counts(key: str, cells: list[str]) -> tuple[int, ...]:
     out = []
     for cell in cells:
         if not cell.isdigit() or int(cell) > MAX_TIMER:
-            raise fail("--grid", N_("--grid {key}: {cell!r} is not a whole number from 0 to {most}", key=key, cell=cell,
-                                    most=MAX_TIMER),
-                       N_('write ticks (or counts), e.g. --grid "{key}=20,50,100"', key=key))
+            raise fail(
+                "--grid",
+                N_("--grid {key}: {cell!r} is not a whole number from 0 to {most}", key=key, cell=cell, most=MAX_TIMER),
+                N_('write ticks (or counts), e.g. --grid "{key}=20,50,100"', key=key),
+            )
         out.append(int(cell))
     return tuple(out)
 
@@ -196,20 +218,31 @@ def param_of(key: str) -> tuple[str, str]:
 def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
     section, name = param_of(key)
     if section not in DEFAULTS or name not in DEFAULTS[section]:
-        raise fail("--grid", N_("--grid: unknown key {key!r}", key=key),
-                   N_("use battery, start, or a simulator parameter such as motor.friction_volts, noise.light "
-                      "(all: {keys})", keys=", ".join(known_keys()[2:])))
+        raise fail(
+            "--grid",
+            N_("--grid: unknown key {key!r}", key=key),
+            N_(
+                "use battery, start, or a simulator parameter such as motor.friction_volts, noise.light (all: {keys})",
+                keys=", ".join(known_keys()[2:]),
+            ),
+        )
     default, low, high, _ = DEFAULTS[section][name]
     out = []
     for cell in cells:
         try:
             value = float(cell)
         except ValueError:
-            raise fail("--grid", N_("--grid {key}: {cell!r} is not a number", key=key, cell=cell),
-                       N_("write numbers from {low} to {high}", low=low, high=high)) from None
+            raise fail(
+                "--grid",
+                N_("--grid {key}: {cell!r} is not a number", key=key, cell=cell),
+                N_("write numbers from {low} to {high}", low=low, high=high),
+            ) from None
         if not low <= value <= high or (isinstance(default, int) and value != int(value)):
-            hint = N_("write a whole number from {low} to {high}", low=low, high=high) if isinstance(default, int) \
+            hint = (
+                N_("write a whole number from {low} to {high}", low=low, high=high)
+                if isinstance(default, int)
                 else N_("write a number from {low} to {high}", low=low, high=high)
+            )
             raise fail("--grid", N_("--grid {key}: {cell} is out of range", key=key, cell=cell), hint)
         out.append(int(value) if isinstance(default, int) else value)
     return tuple(out)
@@ -227,9 +260,14 @@ def _start_values(cells: list[str]) -> tuple[Any, ...]:
         except ValueError:
             pose = ()
         if len(pose) != 3 or not all(math.isfinite(v) for v in pose):
-            raise fail("--grid", N_("--grid start: {cell!r} is not a pose", cell=cell),
-                       N_('write start=random or start=X:Y:HEADING (metres, metres, degrees), e.g. '
-                          '"start=0.35:0.35:20,1.0:0.5:90"'))
+            raise fail(
+                "--grid",
+                N_("--grid start: {cell!r} is not a pose", cell=cell),
+                N_(
+                    "write start=random or start=X:Y:HEADING (metres, metres, degrees), e.g. "
+                    '"start=0.35:0.35:20,1.0:0.5:90"'
+                ),
+            )
         out.append(pose)
     return tuple(out)
 
@@ -254,7 +292,7 @@ def value_index(spec: SweepSpec, index: int, axis: int) -> int:
     """Which of ``spec.axes[axis]``'s values run ``index`` has (in the order of :func:`runs`: the last
     axis turns fastest)."""
     combo = index % spec.runs_per_world // len(spec.seeds)
-    after = math.prod(len(a.values) for a in spec.axes[axis + 1:])
+    after = math.prod(len(a.values) for a in spec.axes[axis + 1 :])
     return combo // after % len(spec.axes[axis].values)
 
 
@@ -284,13 +322,17 @@ def random_start(seed: int, walls: tuple[tuple[float, float], ...], free: Any) -
         pose = (round(float(x), 4), round(float(y), 4), round(float(rng.uniform(-180.0, 180.0)), 2))
         if inside(walls, (x, y)) and free(pose):
             return pose
-    raise fail("--grid", N_("start=random: found no free start pose in the world"),
-               N_("give the world more free floor"))
+    raise fail(
+        "--grid", N_("start=random: found no free start pose in the world"), N_("give the world more free floor")
+    )
 
 
 def refuse_cells(axes: Sequence[Axis]) -> None:
     """``--grid`` of a command other than sweep may not set a table cell (tune searches them with --cells)."""
     for axis in axes:
         if is_cell(axis.key):
-            raise fail("--grid", N_("--grid {key}: only sweep runs a table cell's values side by side", key=axis.key),
-                       N_("tune a cell with --cells; give --grid battery, start or a simulator parameter"))
+            raise fail(
+                "--grid",
+                N_("--grid {key}: only sweep runs a table cell's values side by side", key=axis.key),
+                N_("tune a cell with --cells; give --grid battery, start or a simulator parameter"),
+            )

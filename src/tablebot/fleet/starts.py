@@ -36,8 +36,15 @@ class Prepared:
 class Starts:
     """The scenes and starters of one fleet's robots: a table in a world with one robot layer."""
 
-    def __init__(self, table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None,
-                 prepared: Prepared | None = None, tables: RobotTables | None = None) -> None:
+    def __init__(
+        self,
+        table: Table,
+        machine: Machine,
+        world: World,
+        robot_params: dict[str, Any] | None,
+        prepared: Prepared | None = None,
+        tables: RobotTables | None = None,
+    ) -> None:
         self.table, self.machine, self.world, self.robot_params = table, machine, world, robot_params
         self.prepared = prepared or Prepared()
         self.tables = tables  # a robot of several tables: its scenes are wired for all of them
@@ -48,11 +55,13 @@ class Starts:
         scenes = self.prepared.scenes
         with self.prepared.lock:
             if spec.params not in scenes:
-                scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides(),
-                                self.tables)
+                scene = prepare(self.table, self.machine, self.world, self.robot_params, spec.overrides(), self.tables)
                 first = next(iter(scenes.values()), scene)
-                if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (first.bits.tolist(), first.drive,
-                                                                               first.pulse_columns):
+                if (scene.bits.tolist(), scene.drive, scene.pulse_columns) != (
+                    first.bits.tolist(),
+                    first.drive,
+                    first.pulse_columns,
+                ):
                     raise ValueError("robots of one fleet must share their wiring")
                 scenes[spec.params] = scene
             made = scenes[spec.params]
@@ -76,7 +85,10 @@ def with_start(scene: Scene, start: Pose | None) -> Scene:
     world = replace(scene.world, start=(float(sx), float(sy), float(sh)))
     x, y, heading = world.start
     if world.walls and not inside(world.walls, (x, y)):
-        raise fail(world.path, f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the "
-                   "arena walls", "choose a start inside the [arena] walls")
+        raise fail(
+            world.path,
+            f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the arena walls",
+            "choose a start inside the [arena] walls",
+        )
     check_start(world, scene.geometry, scene.P)
     return replace(scene, world=world)

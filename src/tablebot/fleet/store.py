@@ -44,9 +44,12 @@ class Store:
         spec_file = self.folder / "spec.json"
         text = self.spec.to_json()
         if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
-            raise fail(self.folder, "--out holds the results of a different sweep (another table, robot file, "
-                       "world, grid, seeds, length or simulator version)",
-                       "give --out a new folder, or delete this one to start over")
+            raise fail(
+                self.folder,
+                "--out holds the results of a different sweep (another table, robot file, "
+                "world, grid, seeds, length or simulator version)",
+                "give --out a new folder, or delete this one to start over",
+            )
         self.parts.mkdir(parents=True, exist_ok=True)
         if not spec_file.exists():
             write_text(spec_file, text)
@@ -63,11 +66,23 @@ class Store:
         with open(part, encoding="utf-8", errors="replace", newline="") as f:
             text = f.read()
         rows = list(csv.reader(io.StringIO(text)))  # cells may hold quoted commas (a world's path)
-        if text.endswith("\n") and rows[:1] == [columns] and [row[0] for row in rows[1:] if row] == \
-                [str(run) for run in range(a, b)] and all(len(row) == len(columns) for row in rows[1:]):
+        if (
+            text.endswith("\n")
+            and rows[:1] == [columns]
+            and [row[0] for row in rows[1:] if row] == [str(run) for run in range(a, b)]
+            and all(len(row) == len(columns) for row in rows[1:])
+        ):
             return True
-        notify(Diagnostic(str(part), None, None, "this part of the sweep is damaged (not the rows this sweep "
-                          f"writes for runs {a}..{b - 1}): its runs are made again", severity="note"))
+        notify(
+            Diagnostic(
+                str(part),
+                None,
+                None,
+                "this part of the sweep is damaged (not the rows this sweep "
+                f"writes for runs {a}..{b - 1}): its runs are made again",
+                severity="note",
+            )
+        )
         return False
 
     def write_part(self, job: Job, text: str) -> Path:

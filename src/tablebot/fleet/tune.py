@@ -25,8 +25,19 @@ if TYPE_CHECKING:
     from tablebot.fleet.backends import Runner
     from tablebot.fleet.results import FleetSummary
 
-__all__ = ["OBJECTIVES", "Cell", "Evaluator", "best", "grid_points", "jobs_for", "losses", "parse_cells", "search_cma",
-           "search_grid", "split"]
+__all__ = [
+    "OBJECTIVES",
+    "Cell",
+    "Evaluator",
+    "best",
+    "grid_points",
+    "jobs_for",
+    "losses",
+    "parse_cells",
+    "search_cma",
+    "search_grid",
+    "split",
+]
 
 ROBOTS_PER_JOB = 512
 OBJECTIVES = {
@@ -91,8 +102,9 @@ class Evaluator:
             self.on_eval(len(new))
         return [self.cache[c] for c in wanted]
 
-    def measure(self, candidates: Sequence[tuple[int, ...]], plan: Plan,
-                metrics: Sequence[str] = ()) -> dict[str, list[float]]:
+    def measure(
+        self, candidates: Sequence[tuple[int, ...]], plan: Plan, metrics: Sequence[str] = ()
+    ) -> dict[str, list[float]]:
         """Mean of each metric (default: the objective) per candidate over ``plan``'s scenarios."""
         metrics = tuple(metrics) or (self.objective,)
         if not candidates:
@@ -100,8 +112,10 @@ class Evaluator:
         variants = cell_variants(plan.tables, plan.machine, self.cells, candidates)
         jobs = jobs_for(plan, variants, len(candidates), self.runner.slots())
         finished: dict[tuple[int, int], dict[str, np.ndarray]] = {}
+
         def done(job: Job, summary: FleetSummary) -> None:
             finished[job.info["world"], job.first] = {m: losses(m, summary, plan, job.info["world"]) for m in metrics}
+
         self.runner.run(jobs, done)
         sums = {metric: np.zeros(len(candidates)) for metric in metrics}
         for job in jobs:  # summed in job order, not in the order the workers finished: the same sums every time
@@ -124,9 +138,19 @@ def jobs_for(plan: Plan, variants: Variants, count: int, slots: int = 1) -> list
         specs = [replace(robot, variant=v) for v in range(count) for _, robot in mine]
         for a, b in split(len(specs), slots):
             chunk = specs[a:b]
-            jobs.append(Job(plan.table, plan.worlds[world], plan.robot_params, chunk, plan.spec.ticks, first=a,
-                            variants=variants, info={"world": world, "variants": [s.variant for s in chunk]},
-                            tables=plan.tables))
+            jobs.append(
+                Job(
+                    plan.table,
+                    plan.worlds[world],
+                    plan.robot_params,
+                    chunk,
+                    plan.spec.ticks,
+                    first=a,
+                    variants=variants,
+                    info={"world": world, "variants": [s.variant for s in chunk]},
+                    tables=plan.tables,
+                )
+            )
     return jobs
 
 
@@ -148,9 +172,11 @@ def grid_points(cells: Sequence[Cell], budget: int) -> list[tuple[int, ...]]:
     axes = []
     for cell in cells:
         size = cell.high - cell.low + 1
-        axes.append(list(range(cell.low, cell.high + 1)) if size <= per_cell or math.prod(
-            c.high - c.low + 1 for c in cells) <= budget else
-            sorted({round(v) for v in np.linspace(cell.low, cell.high, per_cell)}))
+        axes.append(
+            list(range(cell.low, cell.high + 1))
+            if size <= per_cell or math.prod(c.high - c.low + 1 for c in cells) <= budget
+            else sorted({round(v) for v in np.linspace(cell.low, cell.high, per_cell)})
+        )
     if len(axes) == 1:
         return [(v,) for v in axes[0]]
     return [(a, b) for a in axes[0] for b in axes[1]]
@@ -159,7 +185,7 @@ def grid_points(cells: Sequence[Cell], budget: int) -> list[tuple[int, ...]]:
 def search_grid(evaluate: Evaluator, budget: int, batch: int = 64) -> None:
     points = grid_points(evaluate.cells, budget)
     for a in range(0, len(points), batch):
-        evaluate(points[a:a + batch])
+        evaluate(points[a : a + batch])
 
 
 def search_cma(evaluate: Evaluator, budget: int, seed: int = 0) -> None:

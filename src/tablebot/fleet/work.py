@@ -97,8 +97,16 @@ def run_job(job: Job, stop: threading.Event | None = None) -> tuple[Job, FleetSu
     if threads != 1:  # one thread: the calling thread alone, without numba's pool (not even started)
         use_threads(job)
     machine, prepared = shared(job)
-    fleet = Fleet(job.table, machine, job.world, job.specs, job.robot_params, variants=job.variants,
-                  prepared=prepared, tables=job.tables)
+    fleet = Fleet(
+        job.table,
+        machine,
+        job.world,
+        job.specs,
+        job.robot_params,
+        variants=job.variants,
+        prepared=prepared,
+        tables=job.tables,
+    )
     fleet.run(job.ticks, progress=check, threads=False if threads == 1 else None, block_ticks=block_ticks(job))
     return replace(job, specs=[], variants=None), fleet.summary()
 
@@ -178,15 +186,24 @@ def warm(job: Job, both: bool = False) -> float:
 
     started = time.perf_counter()
     machine, prepared = shared(job)
-    fleet = Fleet(job.table, machine, job.world, job.specs[:1], job.robot_params, variants=job.variants,
-                  prepared=prepared, tables=job.tables)
+    fleet = Fleet(
+        job.table,
+        machine,
+        job.world,
+        job.specs[:1],
+        job.robot_params,
+        variants=job.variants,
+        prepared=prepared,
+        tables=job.tables,
+    )
     for threads in (False, True) if both else (False,):
         fleet.run(1, threads=threads)
     return time.perf_counter() - started
 
 
-def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None,
-                 load: bool = True) -> dict[str, Any]:
+def ready_worker(
+    slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None, load: bool = True
+) -> dict[str, Any]:
     """On a cluster worker, before it sees a job: choose a cache folder of its own (``worker-SLOT`` in the
     user's numba cache for tablebot) unless ``NUMBA_CACHE_DIR`` was set for the worker or compiled code is
     already loaded here, and import the compiled modules; put the client's compiled code in their folder
@@ -221,10 +238,15 @@ def ready_worker(slot: str, share: int = 1, files: dict[str, dict[str, bytes]] |
 
     installed = jit.install_cache_files(files) if files else 0  # read by each function at its first load
     loaded = preload(*chunk_functions(_worker_threads)) if load else 0
-    return {"host": socket.gethostname(), "pid": os.getpid(),
-            "cache": numba.config.CACHE_DIR,  # type: ignore[attr-defined]  # a run-time numba setting
-            "threads": _worker_threads, "installed": installed, "loaded": loaded,
-            "ready_s": time.perf_counter() - started}
+    return {
+        "host": socket.gethostname(),
+        "pid": os.getpid(),
+        "cache": numba.config.CACHE_DIR,  # type: ignore[attr-defined]  # a run-time numba setting
+        "threads": _worker_threads,
+        "installed": installed,
+        "loaded": loaded,
+        "ready_s": time.perf_counter() - started,
+    }
 
 
 def chunk_functions(threads: int | None) -> tuple[Any, ...]:
@@ -238,8 +260,9 @@ def chunk_functions(threads: int | None) -> tuple[Any, ...]:
     return (contacts.body_corners, contacts.deepest_contact, kernel.first_readings, *loops)
 
 
-def warm_worker(job: Job, slot: str, share: int = 1,
-                files: dict[str, dict[str, bytes]] | None = None) -> dict[str, Any]:
+def warm_worker(
+    job: Job, slot: str, share: int = 1, files: dict[str, dict[str, bytes]] | None = None
+) -> dict[str, Any]:
     """On a cluster worker: :func:`ready_worker` (if it has not run), then load (or compile) the kernel
     once, before any chunk runs (concurrent compiles into one cache folder race: numba issues #4807,
     #10128)."""
