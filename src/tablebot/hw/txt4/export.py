@@ -1,7 +1,8 @@
 """``tablebot export --to txt4``: a ROBO Pro Coding workspace that runs the table on a TXT 4.0 by itself:
-``NAME.py`` starts ``lib/tablebot_program.py``, which is :mod:`tablebot.hw.txt4.runtime` with the compiled
-table and the robot file's ``[txt]`` wiring appended as plain data (no numpy, no tablebot on the
-controller). Text from the user's files reaches the program only as escaped string literals.
+``NAME.py`` starts ``lib/tablebot_program.py``, which is :mod:`tablebot.hw.txt4.runtime` (and the code of
+:mod:`tablebot.hw.txt4.runtime_stop`, :func:`runtime_text`) with the compiled table and the robot file's
+``[txt]`` wiring appended as plain data (no numpy, no tablebot on the controller). Text from the user's files
+reaches the program only as escaped string literals.
 """
 
 from __future__ import annotations
@@ -64,11 +65,30 @@ def export_txt4(machine: Machine) -> Workspace:
     data = table_data(machine, wiring)
     if tables is not None:
         data.update(tables_data(tables))
-    runtime = resources.files("tablebot.hw.txt4").joinpath("runtime.py").read_text(encoding="utf-8")
-    program = f"{runtime}\n\n# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
+    table = f"# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
+    program = f"{runtime_text()}\n\n{table}"
     digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
     return Workspace(name, {f"{name}.py": LAUNCHER, "lib/__init__.py": "", PROGRAM: program,
                             ".project.json": project_json(name, uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))})
+
+
+#: The runtime's import of how it stops: the program carries that code itself, so the line is dropped.
+STOP_IMPORT = "from tablebot.hw.txt4.runtime_stop import Guard, Stop, Terminated\n"
+
+
+def runtime_text() -> str:
+    """The program's code without its table: :mod:`tablebot.hw.txt4.runtime`, then the code of
+    :mod:`tablebot.hw.txt4.runtime_stop` (its imports with it; its docstring and ``__future__`` import, which
+    only a file's start may hold, left out), one file needing nothing but the standard library."""
+    files = resources.files("tablebot.hw.txt4")
+    runtime = files.joinpath("runtime.py").read_text(encoding="utf-8")
+    stop = files.joinpath("runtime_stop.py").read_text(encoding="utf-8")
+    future = "from __future__ import annotations\n"
+    if STOP_IMPORT not in runtime or future not in stop:  # tablebot's own files, changed without this function
+        raise RuntimeError("tablebot/hw/txt4: runtime.py no longer imports runtime_stop as export_txt4 expects")
+    stop_code = stop.split(future, 1)[1].lstrip("\n")
+    return (runtime.replace(STOP_IMPORT, "").rstrip("\n")
+            + "\n\n\n# --- how the program stops (tablebot.hw.txt4.runtime_stop) ---\n\n" + stop_code)
 
 
 def project_json(name: str, project_uuid: uuid.UUID) -> str:

@@ -17,20 +17,19 @@ under harbaum/SofTXT.
 
 from __future__ import annotations
 
-import atexit
 import collections
 import contextlib
-import os
-import signal
 import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
+# Exported, the program carries runtime_stop's code itself (below this file's): export drops this line.
+from tablebot.hw.txt4.runtime_stop import Guard, Stop, Terminated
+
 PWM_STEP = 64  # speed or lamp level 8 = PWM 512
 BEHIND_LIMIT_S = 0.5  # the table's time may fall this far behind the wall clock within BEHIND_WINDOW_S,
 BEHIND_WINDOW_S = 5.0  # else the robot stops rather than stretch the table's timers (as tablebot.loop.Pace)
-HANDOVER_S = 1.0  # how long a SIGTERM handled in the main thread waits for the run's thread to stop
 TABLE: dict = {}  # the exported table (appended by ``tablebot export --to txt4``)
 
 
@@ -242,23 +241,6 @@ def _reads(inp: dict, value: Any, was_on: bool) -> bool:
     return bool(value) != inp["invert"]
 
 
-class Terminated(Exception):
-    """SIGTERM (ROBO Pro Coding's stop, or ``DELETE /api/v1/stop``) arrived."""
-
-
-class Stop:
-    """A request to end the run, from any thread: a signal handler, ``atexit``, a caller."""
-
-    def __init__(self) -> None:
-        self.requested = threading.Event()
-        self.done = threading.Event()  # set once the run has stopped the outputs and said so
-        self.reason = ""
-
-    def request(self, reason: str) -> None:
-        self.reason = self.reason or reason
-        self.requested.set()
-
-
 def say(*words: object) -> None:
     """Print at once: a runner reading our output through a pipe or pty sees each line as it happens."""
     print(*words, flush=True)
@@ -313,87 +295,6 @@ def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], flo
             log(f"tablebot: {reason} after {engine.tick} ticks ({late_ticks} late); outputs off")
         stop.done.set()
     return reason
-
-
-class Guard:
-    """Ends the run with its outputs off however the program is ended: SIGTERM to the process (in the
-    main thread, or in the runner's thread when the program runs in a worker thread, as harbaum/SofTXT's
-    run.py runs it), the interpreter exiting (``atexit``), and -- in :func:`run` -- Ctrl-C, the end of the
-    thread and any exception."""
-
-    def __init__(self, stop: Stop) -> None:
-        self.stop = stop
-        self.robot: Any = None  # set once it is built: a stop before then has nothing to switch off
-        self.previous: Any = signal.SIG_DFL
-
-    def install(self) -> str:
-        """Take SIGTERM over (after ``fischertechnik.factories`` installed its own on import); returns a
-        sentence saying how SIGTERM is handled."""
-        if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGTERM, self.in_run_thread)
-            return "tablebot: SIGTERM stops the outputs"
-        # Only the main thread may set a signal handler: ask it to, at its next Python step.
-        if _in_main_thread(self._install_for_worker):
-            return "tablebot: running in a worker thread; the main thread hands SIGTERM over"
-        return "tablebot: warning: running in a worker thread and SIGTERM cannot be caught here"
-
-    def attach(self, robot: Any) -> None:
-        """The robot to stop; its exit hook runs before the package's own (registered when the controller
-        was made: atexit runs the last registered first)."""
-        self.robot = robot
-        atexit.register(self.at_exit)
-
-    def in_run_thread(self, signum: int, frame: Any) -> None:
-        if not self.stop.requested.is_set():  # a second SIGTERM while stopping must not cut the stop short
-            self.stop.request("terminated")
-            raise Terminated()
-
-    def _install_for_worker(self) -> None:
-        self.previous = signal.signal(signal.SIGTERM, self.for_worker)
-
-    def for_worker(self, signum: int, frame: Any) -> None:
-        """In the main thread while the run is in another: stop it, wait for its outputs-off, then end
-        as SIGTERM would have ended the process without us."""
-        self.stop.request("terminated")
-        if not self.stop.done.wait(HANDOVER_S) and self.robot is not None:
-            self.robot.stop()
-        previous, self.previous = self.previous, signal.SIG_DFL
-        signal.signal(signum, previous)
-        if previous == signal.SIG_DFL:
-            os.kill(os.getpid(), signum)
-        elif callable(previous):
-            previous(signum, frame)
-
-    def at_exit(self) -> None:
-        if not self.stop.done.is_set():
-            self.stop.request("exit")
-            if not self.stop.done.wait(HANDOVER_S) and self.robot is not None:
-                self.robot.stop()
-
-
-_PENDING: list = []  # ctypes callbacks must outlive the call
-
-
-def _in_main_thread(func: Callable[[], None]) -> bool:
-    """Have the main thread call ``func`` at its next Python step (CPython's ``Py_AddPendingCall``,
-    which runs pending calls in the main thread only)."""
-    try:
-        import ctypes
-
-        callback_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p)
-
-        def call(_: Any) -> int:
-            with contextlib.suppress(Exception):
-                func()
-            return 0
-
-        callback = callback_type(call)
-        _PENDING.append(callback)
-        add = ctypes.pythonapi.Py_AddPendingCall
-        add.argtypes, add.restype = [callback_type, ctypes.c_void_p], ctypes.c_int
-        return add(callback, None) == 0
-    except (ImportError, AttributeError, OSError):
-        return False
 
 
 def main(table: dict | None = None) -> str:
