@@ -117,12 +117,14 @@ class Txt4Robot:
     called from another thread than ``read``/``write`` (a SIGTERM handled in the main thread)."""
 
     #: mode -> (the input factory's create call, the device's reading call), as ROBO Pro Coding emits them
-    READERS = (("switch", "create_mini_switch", "get_state"),
-               ("phototransistor", "create_photo_transistor", "is_bright"),
-               ("trail", "create_trail_follower", "get_state"),
-               ("ultrasonic", "create_ultrasonic_distance_meter", "get_distance"),
-               ("voltage", "create_color_sensor", "get_voltage"),
-               ("resistance", "create_ntc_resistor", "get_resistance"))
+    READERS = (
+        ("switch", "create_mini_switch", "get_state"),
+        ("phototransistor", "create_photo_transistor", "is_bright"),
+        ("trail", "create_trail_follower", "get_state"),
+        ("ultrasonic", "create_ultrasonic_distance_meter", "get_distance"),
+        ("voltage", "create_color_sensor", "get_voltage"),
+        ("resistance", "create_ntc_resistor", "get_resistance"),
+    )
 
     def __init__(self, table: dict, factory: Any, motor_class: Any) -> None:
         self.table, self.motor_class = table, motor_class
@@ -246,9 +248,15 @@ def say(*words: object) -> None:
     print(*words, flush=True)
 
 
-def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], float] = time.monotonic,
-        sleep: Callable[[float], Any] | None = None, log: Callable[..., None] = say,
-        stop: Stop | None = None) -> str:
+def run(
+    table: dict,
+    robot: Any,
+    ticks: int | None = None,
+    now: Callable[[], float] = time.monotonic,
+    sleep: Callable[[float], Any] | None = None,
+    log: Callable[..., None] = say,
+    stop: Stop | None = None,
+) -> str:
     """Run the table until ``ticks`` (None: until stopped); the outputs are stopped on every way out.
     Ticks are paced on a fixed grid; a tick later than half a tick restarts the grid (counted as late); the
     table's time falling more than BEHIND_LIMIT_S behind the wall clock within BEHIND_WINDOW_S (one stall,
@@ -273,8 +281,10 @@ def run(table: dict, robot: Any, ticks: int | None = None, now: Callable[[], flo
             fell = started - recent[0][1] - (engine.tick - recent[0][0]) * tick_s
             if fell > BEHIND_LIMIT_S:
                 reason = "behind"
-                log(f"tablebot: the table's time fell {fell:.2f} s behind the wall clock by tick {engine.tick}: "
-                    "stopping rather than stretching the table's timers")
+                log(
+                    f"tablebot: the table's time fell {fell:.2f} s behind the wall clock by tick {engine.tick}: "
+                    "stopping rather than stretching the table's timers"
+                )
                 break
             if stop.requested.is_set():
                 reason = stop.reason
