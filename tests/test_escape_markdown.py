@@ -16,8 +16,21 @@ from tablebot.escape import markdown_code, markdown_text
 pytestmark = [pytest.mark.kernel_free]
 
 PARSER = MarkdownIt("commonmark").enable("table")
-NASTY = ["a|b", "*bold*", "_under_", "front_bumper_stops", "<b>x</b>", "[link](http://x)", "`tick`", "a\\", "# h",
-         "&amp;", "![img](x.png)", "~~gone~~", "line\nbreak"]
+NASTY = [
+    "a|b",
+    "*bold*",
+    "_under_",
+    "front_bumper_stops",
+    "<b>x</b>",
+    "[link](http://x)",
+    "`tick`",
+    "a\\",
+    "# h",
+    "&amp;",
+    "![img](x.png)",
+    "~~gone~~",
+    "line\nbreak",
+]
 
 
 def _text_of(rendered: str, tag: str) -> str:

@@ -67,8 +67,17 @@ def test_a_translated_texts_format_writes_the_readers_numbers() -> None:
 def test_sims_summary_in_german(tmp_path: Path) -> None:
     from tablebot.sim.summary import Summary
 
-    summary = Summary(seconds=120.0, first_light_s=None, reached_s=1.5, collisions=1, collision_ticks=(3,),
-                      distance_m=2.79, state_seconds={1: 120.0}, battery_start_v=9.05, battery_end_v=8.9)
+    summary = Summary(
+        seconds=120.0,
+        first_light_s=None,
+        reached_s=1.5,
+        collisions=1,
+        collision_ticks=(3,),
+        distance_m=2.79,
+        state_seconds={1: 120.0},
+        battery_start_v=9.05,
+        battery_end_v=8.9,
+    )
     try:
         use("de")
         german = "\n".join(summary.lines())

@@ -70,8 +70,11 @@ def not_json(tmp: Path) -> list[str]:
 
 
 def bad_tables(tmp: Path) -> list[str]:
-    folder = bumberbot(tmp / "robot", '\n[tables]\n"2nd" = { file = "table.csv", initial_timer = -1 }\n'
-                                      'main = { file = "table.csv", match = "sometimes", colour = 1 }\n')
+    folder = bumberbot(
+        tmp / "robot",
+        '\n[tables]\n"2nd" = { file = "table.csv", initial_timer = -1 }\n'
+        'main = { file = "table.csv", match = "sometimes", colour = 1 }\n',
+    )
     return ["check", str(folder)]
 
 
@@ -81,8 +84,10 @@ def bad_board(tmp: Path) -> list[str]:
 
 
 def bad_conditions(tmp: Path) -> list[str]:
-    props = ('[a]\nnever = "state === 3"\n[b]\nnever = "state == 99"\n[c]\nnever = "M1 > fast"\n'
-             '[d]\nnever = "line == 9999"\n[e]\nnever = "(state == 1"\n[f]\nnever = "bogus"\n')
+    props = (
+        '[a]\nnever = "state === 3"\n[b]\nnever = "state == 99"\n[c]\nnever = "M1 > fast"\n'
+        '[d]\nnever = "line == 9999"\n[e]\nnever = "(state == 1"\n[f]\nnever = "bogus"\n'
+    )
     folder = bumberbot(tmp / "robot", properties=props)
     return ["check", str(folder)]
 
@@ -97,15 +102,31 @@ def no_device(tmp: Path) -> list[str]:
     return ["run", str(EXAMPLE), "--on", f"robotx://{tmp / 'ttyACM9'}"]
 
 
-BAD: list[Callable[[Path], list[str]]] = [garbage, not_hex, bad_link, no_challenge, doctype, wrong_root, not_json,
-                                          bad_tables, bad_board, bad_conditions, bad_address, no_device]
+BAD: list[Callable[[Path], list[str]]] = [
+    garbage,
+    not_hex,
+    bad_link,
+    no_challenge,
+    doctype,
+    wrong_root,
+    not_json,
+    bad_tables,
+    bad_board,
+    bad_conditions,
+    bad_address,
+    no_device,
+]
 
 
 def user_words(tmp: Path) -> set[str]:
     """Every word of the files a case wrote (and of the examples it copied): the user's, not tablebot's."""
-    return {w for folder in (tmp, EXAMPLE, SEVERAL) for path in folder.rglob("*") if path.is_file()
-            and path.suffix in (".toml", ".csv", ".txt", ".scxml", ".json", ".hex")
-            for w in re.findall(r"[A-Za-z]+", f"{path.name} {path.read_text(encoding='utf-8')}")}
+    return {
+        w
+        for folder in (tmp, EXAMPLE, SEVERAL)
+        for path in folder.rglob("*")
+        if path.is_file() and path.suffix in (".toml", ".csv", ".txt", ".scxml", ".json", ".hex")
+        for w in re.findall(r"[A-Za-z]+", f"{path.name} {path.read_text(encoding='utf-8')}")
+    }
 
 
 def without_csv(text: str) -> str:
@@ -120,8 +141,9 @@ def without_csv(text: str) -> str:
 
 def says_nothing_outside(args: list[str], tmp: Path) -> str:
     shown = without_csv(run_in(i18n.PSEUDO, args))
-    allowed = names(typer.main.get_command(app)) | user_words(tmp) | {w for a in args for w in re.findall(
-        r"[A-Za-z]+", a)}
+    allowed = (
+        names(typer.main.get_command(app)) | user_words(tmp) | {w for a in args for w in re.findall(r"[A-Za-z]+", a)}
+    )
     assert PSEUDO_OPEN in shown and words(outside(shown), allowed) == [], shown
     return shown
 
@@ -167,8 +189,7 @@ def test_import_says_what_it_wrote(tmp_path: Path) -> None:
     chart = tmp_path / "machine.scxml"
     says_nothing_outside(["export", str(EXAMPLE), "--to", "scxml", str(tmp_path / "chart")], tmp_path)
     shutil.copy(next((tmp_path / "chart").glob("*.scxml")), chart)
-    shown = says_nothing_outside(["import", str(chart), "--from", "scxml", "--out", str(tmp_path / "t.csv")],
-                                 tmp_path)
+    shown = says_nothing_outside(["import", str(chart), "--from", "scxml", "--out", str(tmp_path / "t.csv")], tmp_path)
     assert "⟦wrote" in shown, shown
 
 
@@ -182,8 +203,11 @@ def test_no_text_is_marked_where_the_extraction_cannot_see_it() -> None:
     for path in sorted((ROOT / "src" / "tablebot").rglob("*.py")):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.JoinedStr):
-                hidden += [f"{path.relative_to(ROOT)}:{call.lineno}" for call in ast.walk(node)
-                           if isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id in marks]
+                hidden += [
+                    f"{path.relative_to(ROOT)}:{call.lineno}"
+                    for call in ast.walk(node)
+                    if isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id in marks
+                ]
     assert hidden == [], "mark the text outside the f-string: " + ", ".join(hidden)
 
 
@@ -191,19 +215,60 @@ def test_no_text_is_marked_where_the_extraction_cannot_see_it() -> None:
 
 LINE = ROOT / "examples" / "line-follower"
 #: The measures' names: option values a user types (--objective laps), never translated.
-MEASURE_NAMES = {"time_to_lamp", "time_to_light", "missed_lamp", "lamp_distance", "collisions", "collision_share",
-                 "distance", "area_covered", "laps"}
+MEASURE_NAMES = {
+    "time_to_lamp",
+    "time_to_light",
+    "missed_lamp",
+    "lamp_distance",
+    "collisions",
+    "collision_share",
+    "distance",
+    "area_covered",
+    "laps",
+}
 
 
 def evolve_args(folder: Path, out: Path) -> list[str]:
     """The tiniest evolve that writes every file: 2 tables, 2 seeds of 1 s, 2 fresh ones, proved in this process."""
-    return ["evolve", str(folder), "--budget", "2", "--batch", "2", "--seeds", "0..1", "--check-seeds",
-            "1000..1001", "--seconds", "1", "--workers", "1", "--out", str(out), "-q"]
+    return [
+        "evolve",
+        str(folder),
+        "--budget",
+        "2",
+        "--batch",
+        "2",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "1000..1001",
+        "--seconds",
+        "1",
+        "--workers",
+        "1",
+        "--out",
+        str(out),
+        "-q",
+    ]
 
 
 def tune_args(out: Path) -> list[str]:
-    return ["tune", str(EXAMPLE), "--cells", "line 5 timer", "--budget", "3", "--seeds", "0..1", "--check-seeds",
-            "1000..1003", "--seconds", "2", "--out", str(out), "-q"]
+    return [
+        "tune",
+        str(EXAMPLE),
+        "--cells",
+        "line 5 timer",
+        "--budget",
+        "3",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "1000..1003",
+        "--seconds",
+        "2",
+        "--out",
+        str(out),
+        "-q",
+    ]
 
 
 def written_words(out: Path) -> set[str]:
@@ -213,8 +278,13 @@ def written_words(out: Path) -> set[str]:
 
 def file_says_nothing_outside(path: Path, args: list[str], tmp: Path) -> None:
     shown = path.read_text(encoding="utf-8")
-    allowed = (names(typer.main.get_command(app)) | user_words(tmp) | written_words(path.parent) | MEASURE_NAMES
-               | {w for a in args for w in re.findall(r"[A-Za-z]+", a)})
+    allowed = (
+        names(typer.main.get_command(app))
+        | user_words(tmp)
+        | written_words(path.parent)
+        | MEASURE_NAMES
+        | {w for a in args for w in re.findall(r"[A-Za-z]+", a)}
+    )
     assert PSEUDO_OPEN in shown and words(outside(shown), allowed) == [], f"{path.name}:\n{shown}"
 
 

@@ -21,8 +21,11 @@ def tuned_path(table: Path, out: Path) -> Path:
         from tablebot.diagnostics import fail
         from tablebot.i18n import N_
 
-        raise fail("--out", N_("the tuned table would replace its input {table}", table=str(table)),
-                   N_("give --out another folder"))
+        raise fail(
+            "--out",
+            N_("the tuned table would replace its input {table}", table=str(table)),
+            N_("give --out another folder"),
+        )
     return path
 
 
@@ -50,8 +53,11 @@ def write_tuned(plan: Plan, cells: list[Cell], values: tuple[int, ...], path: Pa
     for cell, value in zip(cells, values, strict=True):
         grid_row = next(g for g, index in enumerate(doc.row_ids) if lines[index] == cell.line)
         column = header.index(cell.column.lower())
-        text = str(value) if cell.counter is not None else \
-            as_written(grid[grid_row][column], value, plan.table.robot.tick_ms)
+        text = (
+            str(value)
+            if cell.counter is not None
+            else as_written(grid[grid_row][column], value, plan.table.robot.tick_ms)
+        )
         doc.set_cell(grid_row, column, text)
     return write_bytes(path, doc.to_bytes())
 
@@ -68,7 +74,7 @@ def as_written(old: str, ticks: int, tick_ms: int) -> str:
         return str(ticks)
     unit = (match[2] or "").lower()
     number = format(Decimal(ticks * tick_ms) / MS_PER[unit], "f") if unit in MS_PER else str(ticks)
-    return old[:match.start(1)] + number + old[match.end(1):]
+    return old[: match.start(1)] + number + old[match.end(1) :]
 
 
 def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
@@ -76,8 +82,10 @@ def write_evaluations(evaluate: Evaluator, path: Path) -> Path:
     from tablebot.fleet.plan import csv_text
 
     columns = ["evaluation", *(c.label for c in evaluate.cells), evaluate.objective]
-    rows = [{"evaluation": k, **dict(zip(columns[1:-1], values, strict=True)), evaluate.objective: value}
-            for k, (values, value) in enumerate(evaluate.history)]
+    rows = [
+        {"evaluation": k, **dict(zip(columns[1:-1], values, strict=True)), evaluate.objective: value}
+        for k, (values, value) in enumerate(evaluate.history)
+    ]
     return write_text(path, csv_text(columns, rows))
 
 
@@ -135,9 +143,18 @@ def convergence_figure(evaluate: Evaluator, method: str) -> Figure:
     return fig
 
 
-def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winner: tuple[int, ...],
-                 before_after: dict[str, list[float]], path: Path, wall_s: float, tuned: Sequence[Path],
-                 no_better: str = "") -> Path:
+def write_report(
+    plan: Plan,
+    check: Plan,
+    evaluate: Evaluator,
+    method: str,
+    winner: tuple[int, ...],
+    before_after: dict[str, list[float]],
+    path: Path,
+    wall_s: float,
+    tuned: Sequence[Path],
+    no_better: str = "",
+) -> Path:
     """``report.md`` in the reader's language (numbers too: tablebot.i18n.number); ``no_better`` says why the
     winner is not better than the table as it was on the fresh scenarios (empty: it is better): then it is called
     the best candidate, not the tuned table, and no command to simulate it is offered."""
@@ -146,30 +163,53 @@ def write_report(plan: Plan, check: Plan, evaluate: Evaluator, method: str, winn
     from tablebot.i18n import _, localise, number
 
     cells = evaluate.cells
-    title = _("# Tuning {table}: {objective}").format(table=markdown_text(Path(plan.table.path).name),
-                                                      objective=evaluate.objective)
-    lines = [title + (_(": no better") if no_better else ""), "",
-             _("{method}, {n} candidates on {scenarios}, {seconds} s.").format(
-                 method=method, n=len(evaluate.history), scenarios=_scenarios(plan), seconds=number(wall_s, ".0f")),
-             "", "| " + " | ".join([_("cell"), _("before"), _("best candidate") if no_better else _("after")]) + " |",
-             "|---|---|---|"]
+    title = _("# Tuning {table}: {objective}").format(
+        table=markdown_text(Path(plan.table.path).name), objective=evaluate.objective
+    )
+    lines = [
+        title + (_(": no better") if no_better else ""),
+        "",
+        _("{method}, {n} candidates on {scenarios}, {seconds} s.").format(
+            method=method, n=len(evaluate.history), scenarios=_scenarios(plan), seconds=number(wall_s, ".0f")
+        ),
+        "",
+        "| " + " | ".join([_("cell"), _("before"), _("best candidate") if no_better else _("after")]) + " |",
+        "|---|---|---|",
+    ]
     lines += [f"| {markdown_text(c.label)} | {c.value} | {v} |" for c, v in zip(cells, winner, strict=True)]
     if any(c.counter is None for c in cells):
-        lines += ["", _("Timers count ticks of {tick} ms (the tuned table writes each in its cell's own "
-                        "unit).").format(tick=number(plan.table.robot.tick_ms))]
-    lines += ["", _("Checked on {n} fresh scenarios (seeds {first}..{last}):").format(
-        n=check.spec.total, first=check.spec.seeds[0], last=check.spec.seeds[-1]), "",
-        "| " + " | ".join([_("mean over the fresh scenarios"), _("before"), _("after")]) + " |", "|---|---|---|"]
+        lines += [
+            "",
+            _("Timers count ticks of {tick} ms (the tuned table writes each in its cell's own unit).").format(
+                tick=number(plan.table.robot.tick_ms)
+            ),
+        ]
+    lines += [
+        "",
+        _("Checked on {n} fresh scenarios (seeds {first}..{last}):").format(
+            n=check.spec.total, first=check.spec.seeds[0], last=check.spec.seeds[-1]
+        ),
+        "",
+        "| " + " | ".join([_("mean over the fresh scenarios"), _("before"), _("after")]) + " |",
+        "|---|---|---|",
+    ]
     for metric, (a, b) in before_after.items():
         mark = " " + _("(objective)") if metric == evaluate.objective else ""
         lines.append(f"| {metric}{mark} | {number(a, '.3f')} | {number(b, '.3f')} |")
     if no_better:
         names = ", ".join(markdown_text(p.name) for p in tuned)
-        lines += ["", markdown_text(str(localise(no_better))), "",
-                  _("{names} holds the best candidate of the tuning scenarios, for reference; it is not an "
-                    "improvement.").format(names=names) if len(tuned) == 1 else
-                  _("{names} hold the best candidate of the tuning scenarios, for reference; it is not an "
-                    "improvement.").format(names=names)]
+        lines += [
+            "",
+            markdown_text(str(localise(no_better))),
+            "",
+            _(
+                "{names} holds the best candidate of the tuning scenarios, for reference; it is not an improvement."
+            ).format(names=names)
+            if len(tuned) == 1
+            else _(
+                "{names} hold the best candidate of the tuning scenarios, for reference; it is not an improvement."
+            ).format(names=names),
+        ]
     else:
         lines += ["", _("Better than the table as it was on fresh seeds: yes."), "", *_use(plan, cells, tuned)]
     return write_text(path, "\n".join(lines) + "\n")
@@ -180,12 +220,17 @@ def _scenarios(plan: Plan) -> str:
     from tablebot.i18n import _, ngettext, number
 
     spec = plan.spec
-    axes = "".join(_(" × random starts") if a.values == ("random",) else f" × {len(a.values)} {a.key}"
-                   for a in spec.axes)
+    axes = "".join(
+        _(" × random starts") if a.values == ("random",) else f" × {len(a.values)} {a.key}" for a in spec.axes
+    )
     worlds = ngettext("{n} world", "{n} worlds", len(spec.worlds)).format(n=len(spec.worlds))
     return _("{total} scenarios ({seeds} seeds{axes} × {worlds}, {seconds} s each)").format(
-        total=spec.total, seeds=len(spec.seeds), axes=axes, worlds=worlds,
-        seconds=number(spec.ticks * plan.scenes[0].tick_s))
+        total=spec.total,
+        seeds=len(spec.seeds),
+        axes=axes,
+        worlds=worlds,
+        seconds=number(spec.ticks * plan.scenes[0].tick_s),
+    )
 
 
 def _use(plan: Plan, cells: Sequence[Cell], tuned: Sequence[Path]) -> list[str]:
@@ -195,13 +240,22 @@ def _use(plan: Plan, cells: Sequence[Cell], tuned: Sequence[Path]) -> list[str]:
     from tablebot.i18n import _
 
     if plan.tables is None:
-        return [_("Simulate the tuned table as it was tuned: {command}").format(
-            command=markdown_code(sim_command(plan, tuned[0])))]
+        return [
+            _("Simulate the tuned table as it was tuned: {command}").format(
+                command=markdown_code(sim_command(plan, tuned[0]))
+            )
+        ]
     sources = plan.tables.tables
-    pairs = ", ".join(f"{markdown_text(target.name)} → {markdown_text(Path(sources[k].path).name)}"
-                      for k, target in tuned_paths(plan, cells, tuned[0].parent).items())
-    return [_("The robot file's [tables] names its table files: put each tuned table in place of its file to run "
-              "the robot as tuned ({pairs}); the other tables ran as they are.").format(pairs=pairs)]
+    pairs = ", ".join(
+        f"{markdown_text(target.name)} → {markdown_text(Path(sources[k].path).name)}"
+        for k, target in tuned_paths(plan, cells, tuned[0].parent).items()
+    )
+    return [
+        _(
+            "The robot file's [tables] names its table files: put each tuned table in place of its file to run "
+            "the robot as tuned ({pairs}); the other tables ran as they are."
+        ).format(pairs=pairs)
+    ]
 
 
 def sim_command(plan: Plan, tuned: Path) -> str:

@@ -81,16 +81,26 @@ class Tuning:
     def verdict(self) -> str:
         """One line: whether tuning helped, with the objective before and after on the fresh scenarios."""
         before, after = self.before_after[self.objective]
-        numbers = N_("{objective} {before:.3f} before, {after:.3f} after, on {n} fresh scenarios",
-                     objective=self.objective, before=before, after=after, n=self.check.spec.total)
+        numbers = N_(
+            "{objective} {before:.3f} before, {after:.3f} after, on {n} fresh scenarios",
+            objective=self.objective,
+            before=before,
+            after=after,
+            n=self.check.spec.total,
+        )
         if self.helped:
             return N_("Better than the table as it was on fresh seeds: yes ({numbers}).", numbers=numbers)
         if self.winner == self.baseline:
-            return N_("Better than the table as it was on fresh seeds: no: no candidate beat the table's own values "
-                      "({numbers}); keep the table as it is.", numbers=numbers)
-        return N_("Better than the table as it was on fresh seeds: no ({numbers}): the values that did best on the "
-                  "tuning scenarios do not carry over; keep the table as it is, or tune on more seeds (--seeds).",
-                  numbers=numbers)
+            return N_(
+                "Better than the table as it was on fresh seeds: no: no candidate beat the table's own values "
+                "({numbers}); keep the table as it is.",
+                numbers=numbers,
+            )
+        return N_(
+            "Better than the table as it was on fresh seeds: no ({numbers}): the values that did best on the "
+            "tuning scenarios do not carry over; keep the table as it is, or tune on more seeds (--seeds).",
+            numbers=numbers,
+        )
 
     def report_text(self) -> str:
         """``report.md`` of the tuning written (the first of its files named so)."""
@@ -110,11 +120,25 @@ class Tuning:
             return _outputs(self, folder, targets)
 
 
-def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget: int = 300, method: str = "auto",
-         grid: Sequence[str] | None = None, seeds: str = "0..15", check_seeds: str = "1000..1063",
-         seconds: float = 60.0, seed: int = 0, backend: str = "auto", scheduler: str | None = None,
-         workers: int | None = None, out: PathLike | None = None, force: bool = False,
-         progress: Progress | None = None) -> Tuning:
+def tune(
+    project: Loaded,
+    cells: str,
+    *,
+    objective: str = "time_to_lamp",
+    budget: int = 300,
+    method: str = "auto",
+    grid: Sequence[str] | None = None,
+    seeds: str = "0..15",
+    check_seeds: str = "1000..1063",
+    seconds: float = 60.0,
+    seed: int = 0,
+    backend: str = "auto",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    out: PathLike | None = None,
+    force: bool = False,
+    progress: Progress | None = None,
+) -> Tuning:
     """Tune the table's ``cells`` (``"line 5 timer, line 9 timer"``: file lines; a range ``"line 5
     timer=100..2000"``; counter loads ``"line 12 C1_load"``) for ``objective`` (``time_to_lamp``,
     ``time_to_light``, ``collisions``, ``lamp_distance`` or ``missed_lamp``: a mean, made smallest) over the
@@ -130,13 +154,24 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
     from tablebot.fleet.tune import parse_cells
 
     if objective not in METRICS:
-        raise fail("--objective", N_("--objective {objective}: unknown objective", objective=objective),
-                   N_("use one of {choices}", choices=", ".join(METRICS)))
+        raise fail(
+            "--objective",
+            N_("--objective {objective}: unknown objective", objective=objective),
+            N_("use one of {choices}", choices=", ".join(METRICS)),
+        )
     if method not in ("auto", "grid", "cma"):
         raise fail("--method", N_("--method {method}: unknown method", method=method), N_("use grid, cma or auto"))
     chosen, address = choose(backend, scheduler)
-    plan = make_plan(project.path, project.robot_file, project.world_files, grid or ["start=random"], seeds, None,
-                     seconds, every_table=True)
+    plan = make_plan(
+        project.path,
+        project.robot_file,
+        project.world_files,
+        grid or ["start=random"],
+        seeds,
+        None,
+        seconds,
+        every_table=True,
+    )
     metrics = measurable(plan, objective)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     tuned_cells = parse_cells(cells, plan.table, plan.tables)
@@ -151,12 +186,14 @@ def tune(project: Loaded, cells: str, *, objective: str = "time_to_lamp", budget
 
             shown.compiling(N_("the fleet simulator"), run_fleet)
         if known and journal is not None:
-            shown.note(N_("resuming: {n} evaluations from {path} are not run again", n=len(known),
-                          path=str(journal.path)))
+            shown.note(
+                N_("resuming: {n} evaluations from {path} are not run again", n=len(known), path=str(journal.path))
+            )
         started = time.perf_counter()
         with Runner(chosen, address, workers) as runner:
-            tuning = _search(plan, check, tuned_cells, objective, method, budget, seed, metrics, runner, known,
-                             journal, shown)
+            tuning = _search(
+                plan, check, tuned_cells, objective, method, budget, seed, metrics, runner, known, journal, shown
+            )
         tuning = replace(tuning, wall_s=time.perf_counter() - started)
         return replace(tuning, files=tuple(tuning.save(folder))) if folder is not None else tuning
 
@@ -172,9 +209,20 @@ def _folder(plan: Plan, cells: list[Cell], out: Path) -> Path:
     return out
 
 
-def _search(plan: Plan, check: Plan, cells: list[Cell], objective: str, method: str, budget: int, seed: int,
-            metrics: tuple[str, ...], runner: Runner, known: dict[tuple[int, ...], float], journal: Journal | None,
-            progress: Progress) -> Tuning:
+def _search(
+    plan: Plan,
+    check: Plan,
+    cells: list[Cell],
+    objective: str,
+    method: str,
+    budget: int,
+    seed: int,
+    metrics: tuple[str, ...],
+    runner: Runner,
+    known: dict[tuple[int, ...], float],
+    journal: Journal | None,
+    progress: Progress,
+) -> Tuning:
     """The search from the table as it is, then its best candidate and the table as it was measured on the
     fresh scenarios. Ctrl-C raises Stopped, after the journal kept every evaluation made."""
     from tablebot.fleet.tune import Evaluator, best, search_cma, search_grid
@@ -182,8 +230,15 @@ def _search(plan: Plan, check: Plan, cells: list[Cell], objective: str, method: 
 
     progress.start("candidates", budget)
     try:
-        evaluate = Evaluator(plan, cells, objective, runner, on_eval=progress.advance, known=known,
-                             on_record=journal.save if journal is not None else None)
+        evaluate = Evaluator(
+            plan,
+            cells,
+            objective,
+            runner,
+            on_eval=progress.advance,
+            known=known,
+            on_record=journal.save if journal is not None else None,
+        )
         baseline = tuple(c.value for c in cells)
         evaluate([baseline])
         if method == "grid":
@@ -194,8 +249,11 @@ def _search(plan: Plan, check: Plan, cells: list[Cell], objective: str, method: 
         before_after = evaluate.measure([baseline, winner], check, metrics)
     except INTERRUPTS as exc:
         count = journal.count if journal is not None else 0
-        kept = N_("{count} evaluations kept in {path}", count=count, path=journal.path) \
-            if journal is not None and count else N_("no evaluation had finished")
+        kept = (
+            N_("{count} evaluations kept in {path}", count=count, path=journal.path)
+            if journal is not None and count
+            else N_("no evaluation had finished")
+        )
         raise stopped(kept, exc) from None
     finally:
         progress.stop()
@@ -213,10 +271,23 @@ def _outputs(tuning: Tuning, folder: Path, targets: dict[int, Path]) -> list[Pat
 
     evaluate = tuning.evaluator
     tuned = [write_tuned(tuning.plan, list(tuning.cells), tuning.winner, target, k) for k, target in targets.items()]
-    return [*tuned, write_evaluations(evaluate, folder / "evaluations.csv"),
-            convergence(evaluate, tuning.method, folder / "convergence.png"),
-            write_report(tuning.plan, tuning.check, evaluate, tuning.method, tuning.winner, tuning.before_after,
-                         folder / "report.md", tuning.wall_s, tuned, tuning.verdict() if not tuning.helped else "")]
+    return [
+        *tuned,
+        write_evaluations(evaluate, folder / "evaluations.csv"),
+        convergence(evaluate, tuning.method, folder / "convergence.png"),
+        write_report(
+            tuning.plan,
+            tuning.check,
+            evaluate,
+            tuning.method,
+            tuning.winner,
+            tuning.before_after,
+            folder / "report.md",
+            tuning.wall_s,
+            tuned,
+            tuning.verdict() if not tuning.helped else "",
+        ),
+    ]
 
 
 class Journal:
@@ -244,9 +315,14 @@ class Journal:
         except (ValueError, KeyError, TypeError):
             same, known = False, {}
         if not same:
-            raise fail(self.path, N_("--out holds the evaluations of an interrupted tuning of another table, robot "
-                                     "file, world, scenario set, cells or objective"),
-                       N_("give --out a new folder, or delete {name} to start over", name=self.path.name))
+            raise fail(
+                self.path,
+                N_(
+                    "--out holds the evaluations of an interrupted tuning of another table, robot "
+                    "file, world, scenario set, cells or objective"
+                ),
+                N_("give --out a new folder, or delete {name} to start over", name=self.path.name),
+            )
         self.count = len(known)
         return known
 
@@ -264,13 +340,24 @@ def measurable(plan: Plan, objective: str) -> tuple[str, ...]:
     """The metrics the scenarios' worlds give a meaning. Without a lamp anywhere only collisions (every
     candidate would tie on the others); the distance to the nearest lamp needs one in every world."""
     dark = [world.name for world in plan.worlds if not world.lamps]
-    usable = METRICS if not dark else ("collisions",) if len(dark) == len(plan.worlds) else \
-        tuple(m for m in METRICS if m != "lamp_distance")
+    usable = (
+        METRICS
+        if not dark
+        else ("collisions",)
+        if len(dark) == len(plan.worlds)
+        else tuple(m for m in METRICS if m != "lamp_distance")
+    )
     if objective not in usable:
         from tablebot.diagnostics import fail
 
         options = ", ".join(f"--objective {m}" for m in usable)
-        raise fail("--objective", N_("--objective {objective} needs a lamp, and {worlds} has none",
-                                     objective=objective, worlds=", ".join(dark)),
-                   N_("tune for {options}, or give every --world a [[lamp]]", options=options))
+        raise fail(
+            "--objective",
+            N_(
+                "--objective {objective} needs a lamp, and {worlds} has none",
+                objective=objective,
+                worlds=", ".join(dark),
+            ),
+            N_("tune for {options}, or give every --world a [[lamp]]", options=options),
+        )
     return usable

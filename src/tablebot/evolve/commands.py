@@ -59,8 +59,11 @@ def placed(path: Path, label: str, replay: Replay, whole: Whole | None) -> tuple
     robot = Path(replay.robot)
     specs = tables_of(whole.tables.robot)
     folder = replay.out / "robot" / label
-    words = [["mkdir", "-p", str(folder)], ["cp", "-R", f"{robot.parent}/.", f"{folder}/"],
-             ["cp", str(path), str(folder / specs[whole.index].file)]]
+    words = [
+        ["mkdir", "-p", str(folder)],
+        ["cp", "-R", f"{robot.parent}/.", f"{folder}/"],
+        ["cp", str(path), str(folder / specs[whole.index].file)],
+    ]
     setup = " && ".join(" ".join(shell_word(w) for w in command) for command in words) + " && "
     return setup, str(folder / specs[0].file), str(folder / robot.name)
 
@@ -73,8 +76,16 @@ def sim_commands(path: Path, label: str, replay: Replay, whole: Whole | None = N
     found = []
     for world, name in zip(replay.worlds, names, strict=True):
         out = replay.out / "sim" / label if len(replay.worlds) == 1 else replay.out / "sim" / label / name
-        words = ["tablebot", "sim", table, *_files_given(replay, [world], robot), "--seconds",
-                 f"{replay.seconds:g}", "--out", str(out)]
+        words = [
+            "tablebot",
+            "sim",
+            table,
+            *_files_given(replay, [world], robot),
+            "--seconds",
+            f"{replay.seconds:g}",
+            "--out",
+            str(out),
+        ]
         found.append((name, setup + " ".join(shell_word(word) for word in words)))
     return found
 

@@ -29,26 +29,34 @@ class Measure:
     objective: bool = True  # may be the objective (a state's share of time has no better side)
 
 
-MEASURES = {m.name: m for m in (
-    Measure("time_to_lamp", N_("seconds until the lamp is reached (never: the whole run)"), "low", "lamp"),
-    Measure("time_to_light", N_("seconds until a light sensor first sees a lamp (never: the whole run)"), "low",
-            "lamp"),
-    Measure("missed_lamp", N_("share of runs that never reach the lamp"), "low", "lamp"),
-    Measure("lamp_distance", N_("metres from the robot to the nearest lamp when the run ends"), "low", "lamp"),
-    Measure("collisions", N_("collisions per run"), "low"),
-    Measure("collision_share", N_("share of the time the body touches something"), "low"),
-    Measure("distance", N_("metres driven"), "high"),
-    Measure("area_covered", N_("square metres of floor the robot's centre passed over (in 10 cm squares)"), "high",
-            "walls"),
-    Measure("laps", N_("net laps round the world's closed line of tape"), "high", "loop"),
-)}
+MEASURES = {
+    m.name: m
+    for m in (
+        Measure("time_to_lamp", N_("seconds until the lamp is reached (never: the whole run)"), "low", "lamp"),
+        Measure(
+            "time_to_light", N_("seconds until a light sensor first sees a lamp (never: the whole run)"), "low", "lamp"
+        ),
+        Measure("missed_lamp", N_("share of runs that never reach the lamp"), "low", "lamp"),
+        Measure("lamp_distance", N_("metres from the robot to the nearest lamp when the run ends"), "low", "lamp"),
+        Measure("collisions", N_("collisions per run"), "low"),
+        Measure("collision_share", N_("share of the time the body touches something"), "low"),
+        Measure("distance", N_("metres driven"), "high"),
+        Measure(
+            "area_covered",
+            N_("square metres of floor the robot's centre passed over (in 10 cm squares)"),
+            "high",
+            "walls",
+        ),
+        Measure("laps", N_("net laps round the world's closed line of tape"), "high", "loop"),
+    )
+}
 
 
 def measure_text(name: str) -> str:
     """What a measure (or a descriptor ``state_share:STATE``) is, in the reader's language."""
     if name in MEASURES:
         return str(localise(MEASURES[name].text))
-    return str(localise(N_("share of the time in state {state}", state=name[len(STATE_SHARE):])))
+    return str(localise(N_("share of the time in state {state}", state=name[len(STATE_SHARE) :])))
 
 
 @dataclass(frozen=True)
@@ -64,29 +72,43 @@ class Descriptor:
 
 def allowed(worlds: Sequence[World], states: Sequence[object] = ()) -> list[str]:
     """The measures every world can give a meaning (a lamp measure needs a lamp in every world)."""
-    has = {"lamp": all(w.lamps for w in worlds), "loop": all(loop_of(w) is not None for w in worlds),
-           "walls": all(len(w.walls) >= 3 for w in worlds), "": True}
+    has = {
+        "lamp": all(w.lamps for w in worlds),
+        "loop": all(loop_of(w) is not None for w in worlds),
+        "walls": all(len(w.walls) >= 3 for w in worlds),
+        "": True,
+    }
     return [name for name, m in MEASURES.items() if has[m.needs]] + [f"{STATE_SHARE}{s}" for s in states]
 
 
 def check_objective(name: str, worlds: Sequence[World]) -> Measure:
     usable = [n for n in allowed(worlds) if MEASURES[n].objective]
     if name not in usable:
-        why = N_("unknown objective") if name not in MEASURES else \
-            N_("the worlds cannot measure it ({need})", need=_need(name))
-        raise fail("--objective", N_("--objective {name}: {why}", name=name, why=why),
-                   N_("use one of {choices}", choices=", ".join(usable)))
+        why = (
+            N_("unknown objective")
+            if name not in MEASURES
+            else N_("the worlds cannot measure it ({need})", need=_need(name))
+        )
+        raise fail(
+            "--objective",
+            N_("--objective {name}: {why}", name=name, why=why),
+            N_("use one of {choices}", choices=", ".join(usable)),
+        )
     return MEASURES[name]
 
 
 def _need(name: str) -> str:
     needs = MEASURES[name].needs
-    return {"lamp": N_("it needs a [[lamp]] in every world"), "loop": N_("it needs a closed [[line]] in every world"),
-            "walls": N_("it needs [arena] walls in every world")}.get(needs, "")
+    return {
+        "lamp": N_("it needs a [[lamp]] in every world"),
+        "loop": N_("it needs a closed [[line]] in every world"),
+        "walls": N_("it needs [arena] walls in every world"),
+    }.get(needs, "")
 
 
-def parse_descriptors(text: str, worlds: Sequence[World], states: Sequence[object], seconds: float,
-                      cells: int) -> list[Descriptor]:
+def parse_descriptors(
+    text: str, worlds: Sequence[World], states: Sequence[object], seconds: float, cells: int
+) -> list[Descriptor]:
     """``--descriptors "collision_share,area_covered=0..0.5"``: one or two measures, each with an
     optional range (the default range fits the measure and the run's length)."""
     usable = allowed(worlds, states)
@@ -95,23 +117,39 @@ def parse_descriptors(text: str, worlds: Sequence[World], states: Sequence[objec
         found = RANGE_RE.match(part)
         name = found[1] if found else part.strip()
         if not found or name not in usable:
-            why = N_("unknown descriptor") if found and name not in MEASURES and not name.startswith(STATE_SHARE) \
-                else N_("the worlds cannot measure it") if found and name in MEASURES else N_("not a descriptor")
-            raise fail("--descriptors", N_("--descriptors {part}: {why}", part=part.strip(), why=why),
-                       N_("use one or two of {choices} (optionally with a range: area_covered=0..0.5)",
-                          choices=", ".join(usable)))
+            why = (
+                N_("unknown descriptor")
+                if found and name not in MEASURES and not name.startswith(STATE_SHARE)
+                else N_("the worlds cannot measure it")
+                if found and name in MEASURES
+                else N_("not a descriptor")
+            )
+            raise fail(
+                "--descriptors",
+                N_("--descriptors {part}: {why}", part=part.strip(), why=why),
+                N_(
+                    "use one or two of {choices} (optionally with a range: area_covered=0..0.5)",
+                    choices=", ".join(usable),
+                ),
+            )
         low, high = (float(found[2]), float(found[3])) if found[2] is not None else default_range(name, seconds)
         if not high > low:
-            raise fail("--descriptors", N_("--descriptors {part}: the range must be LOW..HIGH with LOW < HIGH",
-                                           part=part.strip()),
-                       N_("write for example {name}=0..1", name=name))
+            raise fail(
+                "--descriptors",
+                N_("--descriptors {part}: the range must be LOW..HIGH with LOW < HIGH", part=part.strip()),
+                N_("write for example {name}=0..1", name=name),
+            )
         if any(d.name == name for d in out):
-            raise fail("--descriptors", N_("--descriptors names {name} twice", name=name),
-                       N_("name each descriptor once"))
+            raise fail(
+                "--descriptors", N_("--descriptors names {name} twice", name=name), N_("name each descriptor once")
+            )
         out.append(Descriptor(name, low, high, cells))
     if not 1 <= len(out) <= 2:
-        raise fail("--descriptors", N_("--descriptors needs one or two descriptors, not {n}", n=len(out)),
-                   N_("for example --descriptors {example}", example=",".join(usable[:2])))
+        raise fail(
+            "--descriptors",
+            N_("--descriptors needs one or two descriptors, not {n}", n=len(out)),
+            N_("for example --descriptors {example}", example=",".join(usable[:2])),
+        )
     return out
 
 

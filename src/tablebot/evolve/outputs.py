@@ -60,42 +60,83 @@ def forget_own(out: Path) -> None:
 
 
 def remember_own(out: Path, paths: Sequence[Path]) -> Path:
-    digests = {str(p.relative_to(out)): hashlib.sha256(current(p).read_bytes()).hexdigest() for p in paths
-               if current(p).is_file()}  # the files as written into the set, before it is swapped in
+    digests = {
+        str(p.relative_to(out)): hashlib.sha256(current(p).read_bytes()).hexdigest()
+        for p in paths
+        if current(p).is_file()
+    }  # the files as written into the set, before it is swapped in
     return write_text(out / MANIFEST, json.dumps(digests, indent=1, sort_keys=True) + "\n")
 
 
-def write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-              out: Path, names: Sequence[str], replay: Replay, workers: Workers) -> list[Path]:
+def write_all(
+    outcome: Outcome,
+    settings: Settings,
+    base: Table,
+    prover: Prover,
+    evaluator: Evaluator,
+    check: Any,
+    out: Path,
+    names: Sequence[str],
+    replay: Replay,
+    workers: Workers,
+) -> list[Path]:
     """Every table, check report, the heat map, evaluations.csv and report.md, replacing the previous run's
     all at once (tablebot.fileset); returns the paths written."""
     with file_set(out):
         return _write_all(outcome, settings, base, prover, evaluator, check, out, names, replay, workers)
 
 
-def _write_all(outcome: Outcome, settings: Settings, base: Table, prover: Prover, evaluator: Evaluator, check: Any,
-               out: Path, names: Sequence[str], replay: Replay, workers: Workers) -> list[Path]:
+def _write_all(
+    outcome: Outcome,
+    settings: Settings,
+    base: Table,
+    prover: Prover,
+    evaluator: Evaluator,
+    check: Any,
+    out: Path,
+    names: Sequence[str],
+    replay: Replay,
+    workers: Workers,
+) -> list[Path]:
     forget_own(out)
     best = best_keys(outcome)
     start, seeds = outcome.start_key, outcome.seeds
     own = f"{prover.whole.name}." if prover.whole is not None else ""  # one of several tables: lights.best-1.csv
-    tables = [(own + ("repaired" if k == 0 else f"repaired-{k + 1}"), key)
-              for k, key in enumerate(seeds if outcome.repairs else [])]
+    tables = [
+        (own + ("repaired" if k == 0 else f"repaired-{k + 1}"), key)
+        for k, key in enumerate(seeds if outcome.repairs else [])
+    ]
     tables += [(f"{own}best-{k + 1}", key) for k, key in enumerate(best)]
-    tables += [(f"elites/{own}cell-" + "-".join(f"{c:02d}" for c in cell), key)
-               for key, _, _, cell in qd.elites(outcome.archive)]
+    tables += [
+        (f"elites/{own}cell-" + "-".join(f"{c:02d}" for c in cell), key)
+        for key, _, _, cell in qd.elites(outcome.archive)
+    ]
     ready = [as_table(outcome.candidates[key], base, out / f"{label}.csv") for label, key in tables]
     language = current_language()  # the workers' processes speak it only when told
     checks = [workers.submit(check_report, table, language) for table in ready]  # in the workers while the fleet runs
     fresh = measure_fresh(evaluator, check, outcome, [start, *seeds, *best], base)
-    written = [write_table(table, label, key, answer.get())
-               for (label, key), table, answer in zip(tables, ready, checks, strict=True)]
+    written = [
+        write_table(table, label, key, answer.get())
+        for (label, key), table, answer in zip(tables, ready, checks, strict=True)
+    ]
     start_at = tuple(outcome.means[start][d.name] for d in settings.descriptors)
-    label = (gettext("the starting table") if outcome.start_verdict.ok  # the archive picture's legend
-             else gettext("the starting table (breaks a property: not kept)"))
-    paths = [heat_map(outcome.archive, settings.descriptors, settings.objective, outcome.history, start_at,
-                      out / "archive.png", label),
-             write_evaluations(outcome, settings, out / "evaluations.csv")]
+    label = (
+        gettext("the starting table")
+        if outcome.start_verdict.ok  # the archive picture's legend
+        else gettext("the starting table (breaks a property: not kept)")
+    )
+    paths = [
+        heat_map(
+            outcome.archive,
+            settings.descriptors,
+            settings.objective,
+            outcome.history,
+            start_at,
+            out / "archive.png",
+            label,
+        ),
+        write_evaluations(outcome, settings, out / "evaluations.csv"),
+    ]
     text = report_text(outcome, settings, base, prover, evaluator, check, fresh, written, best, names, replay)
     paths.append(write_text(out / "report.md", text))
     remember_own(out, [p for w in written for p in (w.path, w.check)])
@@ -107,6 +148,13 @@ def write_evaluations(outcome: Outcome, settings: Settings, path: Path) -> Path:
 
     names = [settings.objective.name, *(d.name for d in settings.descriptors if d.name != settings.objective.name)]
     in_archive = {key for key, *_ in qd.elites(outcome.archive)}
-    rows = [{"evaluation": k, "key": key, **{n: round(outcome.means[key][n], 6) for n in names},
-             "elite": int(key in in_archive)} for k, key in enumerate(outcome.order)]
+    rows = [
+        {
+            "evaluation": k,
+            "key": key,
+            **{n: round(outcome.means[key][n], 6) for n in names},
+            "elite": int(key in in_archive),
+        }
+        for k, key in enumerate(outcome.order)
+    ]
     return write_text(path, csv_text(["evaluation", "key", *names, "elite"], rows))

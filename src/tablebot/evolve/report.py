@@ -44,8 +44,10 @@ def describe(gene: Gene, base: Table) -> str:
     """A row's description: the starting row's own words, with what evolution changed said after them;
     an added row says what it needs and does."""
     table = base
-    original = next((row for row in base.rows if row.line == gene.origin and row.state == gene.state),  # a group
-                    next((row for row in base.rows if row.line == gene.origin), None))  # row is one per state
+    original = next(
+        (row for row in base.rows if row.line == gene.origin and row.state == gene.state),  # a group
+        next((row for row in base.rows if row.line == gene.origin), None),
+    )  # row is one per state
     if original is None:
         if gene.description and gene.note.startswith("guard"):
             return gene.description
@@ -53,7 +55,8 @@ def describe(gene: Gene, base: Table) -> str:
         timer = f", {what.timer}" if what.timer else ""
         goes = f" -> {table.state_title(gene.next)}"
         return _("{when}: {action} (added: {note})").format(
-            when=condition(table, [gene.events]), action=f"{what.text}{timer}{goes}", note=gene.note or _("new row"))
+            when=condition(table, [gene.events]), action=f"{what.text}{timer}{goes}", note=gene.note or _("new row")
+        )
     changes = []
     for name, old, new in zip(table.robot.motors, original.motors, gene.motors, strict=True):
         if old != new:
@@ -68,8 +71,11 @@ def describe(gene: Gene, base: Table) -> str:
     if original.state != gene.state:
         changes.append(_("moved from state {state}").format(state=original.state))
     text = original.description or _("line {line}").format(line=original.line)
-    return _("{text} (evolved: {changes})").format(text=text, changes=", ".join(changes)) if changes \
+    return (
+        _("{text} (evolved: {changes})").format(text=text, changes=", ".join(changes))
+        if changes
         else original.description
+    )
 
 
 def _speed(value: int | None) -> str:
@@ -81,8 +87,9 @@ def _level(value: int | None) -> str:
 
 
 def _row(gene: Gene) -> Row:
-    return Row(0, 0, gene.description, gene.state, gene.events, gene.motors, gene.timer, gene.next, gene.counters,
-               gene.lamps)
+    return Row(
+        0, 0, gene.description, gene.state, gene.events, gene.motors, gene.timer, gene.next, gene.counters, gene.lamps
+    )
 
 
 def pruned(candidate: Candidate, base: Table) -> Candidate:
@@ -97,8 +104,10 @@ def as_table(candidate: Candidate, base: Table, path: Path) -> Table:
     """The candidate as the table that will be written to ``path`` (rows on their new lines; rows that
     can never fire left out)."""
     candidate = pruned(candidate, base)
-    described = tuple(Gene(g.state, g.events, g.motors, g.timer, g.next, describe(g, base), g.counters, g.lamps,
-                           g.origin, g.note) for g in candidate)
+    described = tuple(
+        Gene(g.state, g.events, g.motors, g.timer, g.next, describe(g, base), g.counters, g.lamps, g.origin, g.note)
+        for g in candidate
+    )
     return renumbered(to_table(described, base, str(path)))
 
 
@@ -120,46 +129,86 @@ def check_text(report: CheckReport, prover: Prover) -> str:
     file line."""
     table, machine = report.machine.table, report.machine
     sources = ", ".join(str(f) for f in prover.files) or _("none")
-    head = _("{file}: {rows} rows, {states} states, ").format(file=Path(table.path).name, rows=len(table.rows),
-                                                             states=len(machine.states))
+    head = _("{file}: {rows} rows, {states} states, ").format(
+        file=Path(table.path).name, rows=len(table.rows), states=len(machine.states)
+    )
     whole = prover.whole
     if whole is not None and report.tables is not None:  # one table of several: proved with the others
         mine = report.tables.machines[whole.index]
-        head = _("{file} (table {name}; unchanged beside it: {others}): {rows} rows, {states} states; the tables "
-                 "together: ").format(file=Path(mine.table.path).name, name=whole.name, others=", ".join(whole.others),
-                                      rows=len(mine.table.rows), states=len(mine.states))
-    lines = [head + _("{situations} situations explored").format(situations=report.situations), "",
-             _("properties (the robot file's and {sources}):").format(sources=sources)]
+        head = _(
+            "{file} (table {name}; unchanged beside it: {others}): {rows} rows, {states} states; the tables together: "
+        ).format(
+            file=Path(mine.table.path).name,
+            name=whole.name,
+            others=", ".join(whole.others),
+            rows=len(mine.table.rows),
+            states=len(mine.states),
+        )
+    lines = [
+        head + _("{situations} situations explored").format(situations=report.situations),
+        "",
+        _("properties (the robot file's and {sources}):").format(sources=sources),
+    ]
     marks = {"holds": _("holds"), "violated": _("VIOLATED"), "unknown": _("unknown")}
     width = max(len(mark) for mark in marks.values())
     for result in report.results:
         lines.append(f"  {marks[result.status]:<{width}} {result.prop.name}: {result.prop.text}")
         lines.append(" " * (width + 3) + str(localise(result.prop.claim())))
     lines += ["", _("findings:")]
-    lines += [f"  {Path(f.path or table.path).name}:{','.join(map(str, f.lines)) or '-'}: "
-              f"{_FINDING_WORDS[f.severity]()}: {localise(f.message)}" for f in report.findings] or \
-        ["  " + _("none")]
+    lines += [
+        f"  {Path(f.path or table.path).name}:{','.join(map(str, f.lines)) or '-'}: "
+        f"{_FINDING_WORDS[f.severity]()}: {localise(f.message)}"
+        for f in report.findings
+    ] or ["  " + _("none")]
     counts = report.counts()
-    lines += ["", ", ".join([ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
-                             ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
-                             ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"])])]
+    lines += [
+        "",
+        ", ".join(
+            [
+                ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
+                ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
+                ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"]),
+            ]
+        ),
+    ]
     return "\n".join(lines) + "\n"
 
 
 # --- the archive's picture ------------------------------------------------------------------------------
 
 
-def heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-             start: tuple[float, ...] | None, path: Path, start_label: str | None = None) -> Path:
+def heat_map(
+    archive: object,
+    descriptors: Sequence,
+    objective: Measure,
+    history: Sequence[dict[str, float]],
+    start: tuple[float, ...] | None,
+    path: Path,
+    start_label: str | None = None,
+) -> Path:
     from tablebot.sim.pictures.draw import literal_text
 
     with literal_text():
-        return _heat_map(archive, descriptors, objective, history, start, path,
-                         _("the starting table") if start_label is None else start_label)
+        return _heat_map(
+            archive,
+            descriptors,
+            objective,
+            history,
+            start,
+            path,
+            _("the starting table") if start_label is None else start_label,
+        )
 
 
-def _heat_map(archive: object, descriptors: Sequence, objective: Measure, history: Sequence[dict[str, float]],
-              start: tuple[float, ...] | None, path: Path, start_label: str) -> Path:
+def _heat_map(
+    archive: object,
+    descriptors: Sequence,
+    objective: Measure,
+    history: Sequence[dict[str, float]],
+    start: tuple[float, ...] | None,
+    path: Path,
+    start_label: str,
+) -> Path:
     """Left: each cell's elite coloured by its objective (the start marked); right: the best objective
     and the cells filled as the evaluations went on."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -180,14 +229,22 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         grid = np.full((second.cells, first.cells), np.nan)
         for (i, j), v in zip(cells, values, strict=True):
             grid[j, i] = v
-        image = ax.imshow(grid, origin="lower", cmap=cmap, aspect="auto",
-                          extent=(first.low, first.high, second.low, second.high))
+        image = ax.imshow(
+            grid, origin="lower", cmap=cmap, aspect="auto", extent=(first.low, first.high, second.low, second.high)
+        )
         fig.colorbar(image, ax=ax, label=_better(objective))
         ax.set_ylabel(f"{second.name}")
         if start is not None:
-            ax.plot(np.clip(start[0], first.low, first.high), np.clip(start[1], second.low, second.high), "x",
-                    color="#e8413a", markersize=12, mew=2.5, label=start_label,
-                    clip_on=False)  # on the grid's edge (a value beyond the range) it shows whole
+            ax.plot(
+                np.clip(start[0], first.low, first.high),
+                np.clip(start[1], second.low, second.high),
+                "x",
+                color="#e8413a",
+                markersize=12,
+                mew=2.5,
+                label=start_label,
+                clip_on=False,
+            )  # on the grid's edge (a value beyond the range) it shows whole
             ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)  # off the cells
     else:
         width = (first.high - first.low) / first.cells
@@ -196,26 +253,47 @@ def _heat_map(archive: object, descriptors: Sequence, objective: Measure, histor
         ax.set_xlim(first.low, first.high)  # the whole range, empty cells too
         ax.set_ylabel(_better(objective))
         if start is not None:
-            ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--",
-                       label=start_label)
+            ax.axvline(np.clip(start[0], first.low, first.high), color="#e8413a", linestyle="--", label=start_label)
             ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False)
     ax.set_xlabel(first.name)
-    ax.set_title(_("archive: {elites} elites in {cells} cells").format(
-        elites=len(values), cells=int(np.prod([d.cells for d in descriptors]))),
-                 fontsize=11)
+    ax.set_title(
+        _("archive: {elites} elites in {cells} cells").format(
+            elites=len(values), cells=int(np.prod([d.cells for d in descriptors]))
+        ),
+        fontsize=11,
+    )
     side = fig.add_subplot(1, 2, 2)
     xs = [h["evaluated"] for h in history]
-    side.plot(xs, [h["best"] for h in history], color="#20bf6b", linewidth=2, drawstyle="steps-post",
-              label=_("best {measure}").format(measure=objective.name))
+    side.plot(
+        xs,
+        [h["best"] for h in history],
+        color="#20bf6b",
+        linewidth=2,
+        drawstyle="steps-post",
+        label=_("best {measure}").format(measure=objective.name),
+    )
     side.set_xlabel(_("tables evaluated on the fleet"))
     side.set_ylabel(_("best {measure}").format(measure=objective.name))
     twin = side.twinx()
-    twin.plot(xs, [100 * h["coverage"] for h in history], color="#636e72", linestyle="--", drawstyle="steps-post",
-              label=_("cells filled"))
+    twin.plot(
+        xs,
+        [100 * h["coverage"] for h in history],
+        color="#636e72",
+        linestyle="--",
+        drawstyle="steps-post",
+        label=_("cells filled"),
+    )
     twin.set_ylabel(_("cells filled (%)"))
     (lines, labels), (more_lines, more_labels) = side.get_legend_handles_labels(), twin.get_legend_handles_labels()
-    side.legend(lines + more_lines, labels + more_labels, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
-                fontsize=8, frameon=False)  # under the axes: inside, each legend covered one of the two lines
+    side.legend(
+        lines + more_lines,
+        labels + more_labels,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.13),
+        ncol=2,
+        fontsize=8,
+        frameon=False,
+    )  # under the axes: inside, each legend covered one of the two lines
     side.set_title(_("search"), fontsize=11)
     fig.tight_layout()
     return save(fig, path)
@@ -243,10 +321,12 @@ def paired_change(objective: Measure, before: np.ndarray, after: np.ndarray) -> 
     mean = float(np.mean(diff))
     if n < 2:  # one scenario has no spread to weigh the change against
         return _("{mean} (one scenario, so no standard error): no clear difference").format(
-            mean=number(mean, "+.3f")), "unclear"
+            mean=number(mean, "+.3f")
+        ), "unclear"
     se = float(np.std(diff, ddof=1) / math.sqrt(n))
     better = mean < 0 if objective.better == "low" else mean > 0
     verdict = ("better" if better else "worse") if abs(mean) > 2 * se else "unclear"
     said = {"better": _("better"), "worse": _("worse"), "unclear": _("no clear difference")}[verdict]
     return _("{mean} ± {spread} (two standard errors over {n} paired scenarios): {verdict}").format(
-        mean=number(mean, "+.3f"), spread=number(2 * se, ".3f"), n=n, verdict=said), verdict
+        mean=number(mean, "+.3f"), spread=number(2 * se, ".3f"), n=n, verdict=said
+    ), verdict

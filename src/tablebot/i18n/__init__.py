@@ -153,8 +153,11 @@ class Message(str):
     def render(self, language: str | None = None) -> str:
         """The text in ``language`` (default: the language in use)."""
         catalog = translation(language)
-        text = catalog.gettext(self.msgid) if self.plural is None else \
-            catalog.ngettext(self.msgid, self.plural, int(self.args["n"]))
+        text = (
+            catalog.gettext(self.msgid)
+            if self.plural is None
+            else catalog.ngettext(self.msgid, self.plural, int(self.args["n"]))
+        )
         return _fill(text, self.args, language)
 
     def __reduce__(self) -> tuple[Any, ...]:  # pickled between processes (evolve's and sweep's workers)
@@ -167,8 +170,12 @@ def _fill(text: str, args: Mapping[str, Any], language: str | None) -> str:
     if not args:
         return text
     return _NumberFormatter(language).format(
-        text, **{k: ", ".join(str(localise(item, language)) for item in v) if isinstance(v, tuple)
-                 else localise(v, language) for k, v in args.items()})
+        text,
+        **{
+            k: ", ".join(str(localise(item, language)) for item in v) if isinstance(v, tuple) else localise(v, language)
+            for k, v in args.items()
+        },
+    )
 
 
 #: German writes the decimal comma and groups thousands with a point: the two swapped (issue 38).
@@ -214,8 +221,10 @@ def localise(text: Any, language: str | None = None) -> Any:
 
 # --- choosing the language ------------------------------------------------------------------------
 
-def choose(argv: Sequence[str], environ: Mapping[str, str], system: Callable[[], str | None] | None = None) \
-        -> tuple[str, list[str], bool]:
+
+def choose(
+    argv: Sequence[str], environ: Mapping[str, str], system: Callable[[], str | None] | None = None
+) -> tuple[str, list[str], bool]:
     """The language a command speaks and its arguments without ``--lang``: ``--lang de|en`` (anywhere before
     ``--``, so ``tablebot sim --lang de`` works as ``tablebot --lang de sim``), else ``TABLEBOT_LANG``, else the
     system's locale (:func:`system_language`), else English; and whether it was asked for by name (--lang or
@@ -245,8 +254,9 @@ def choose(argv: Sequence[str], environ: Mapping[str, str], system: Callable[[],
     return (found if found in LANGUAGES else LANGUAGES[0]), rest, False
 
 
-def system_language(environ: Mapping[str, str], platform: str = sys.platform,
-                    windows_ui: Callable[[], int] | None = None) -> str | None:
+def system_language(
+    environ: Mapping[str, str], platform: str = sys.platform, windows_ui: Callable[[], int] | None = None
+) -> str | None:
     """The language of the system's locale: POSIX's LC_ALL, LC_MESSAGES, LANG (the first set; ``de_DE.UTF-8``
     is ``de``; ``C`` and ``POSIX`` are none), and on Windows, where those are rarely set, the user's interface
     language (GetUserDefaultUILanguage, a Windows language id named through Python's table of them)."""
