@@ -114,3 +114,30 @@ def test_an_evolved_rows_description_in_german() -> None:
         use("en")
     assert "entwickelt:" in german and f"Timer {gene.timer}->{gene.timer + 5}" in german, german
     assert "evolved:" in describe(changed, table)
+
+
+def test_a_pictures_axes_write_the_readers_numbers() -> None:
+    """A picture's numbered axes read 0,5 in German (evolve's archive, tune's convergence, sim's pictures);
+    an axis labelled otherwise (state names) keeps its labels."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from tablebot.sim.pictures.picture import readers_numbers
+
+    def labels(language: str) -> tuple[list[str], list[str]]:
+        fig = Figure()
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot()
+        ax.plot([0, 0.5, 1.0], [0, 1, 2])
+        ax.set_yticks([0, 1, 2], ["a", "b", "c"])
+        try:
+            use(language)
+            readers_numbers(fig)
+        finally:
+            use("en")
+        fig.canvas.draw()
+        return [t.get_text() for t in ax.get_xticklabels()], [t.get_text() for t in ax.get_yticklabels()]
+
+    german, english = labels("de"), labels("en")
+    assert "0,4" in german[0] and "0.4" not in german[0] and german[1] == ["a", "b", "c"], german
+    assert "0.4" in english[0], english

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 
 from tablebot.escape import picture
 from tablebot.files import atomic_write
-from tablebot.i18n import _, ngettext
+from tablebot.i18n import _, current, ngettext, number
 from tablebot.sensors import SENSOR_KINDS, SensorKind
 
 if TYPE_CHECKING:  # only types: the pictures are drawn without the simulator (a painter never imports numba)
@@ -155,5 +155,22 @@ def _chunk(kind: bytes, data: bytes) -> bytes:
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
 
 
+def readers_numbers(fig: Figure) -> Figure:
+    """The axes' numbers as the reader's language writes them (0,5 in German): an axis with matplotlib's own
+    number formatter gets tablebot.i18n.number's; an axis that labels its ticks otherwise (state names, a
+    formatter of its own) is left as it is, and so is every axis in English."""
+    from matplotlib.ticker import FuncFormatter, ScalarFormatter
+
+    language = current()  # the figure's, whatever is in use when it is drawn
+    if number(0.5, language=language) == "0.5":
+        return fig
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if type(axis.get_major_formatter()) is ScalarFormatter:
+                axis.set_major_formatter(FuncFormatter(lambda value, _pos: number(value, "g", language)))
+    return fig
+
+
 def _write_png(fig: Figure, stream: IO[bytes]) -> None:
+    readers_numbers(fig)
     fig.savefig(stream, format="png", facecolor="white", pil_kwargs={"compress_level": PNG_LEVEL})

@@ -20,7 +20,7 @@ from matplotlib.ticker import FuncFormatter
 
 from tablebot.colours import state_colours
 from tablebot.escape import picture
-from tablebot.i18n import N_, _
+from tablebot.i18n import N_, _, number
 from tablebot.sensors import SensorKind
 from tablebot.sim import columns as L
 from tablebot.sim.pictures.draw import COLLISION, LIGHT_SEEN, WALL, literal_text
@@ -344,4 +344,4 @@ def _log_scale(ax: Axes) -> None:
     pictures draw text with maths parsing off (for user text), so matplotlib's 10^n labels would print
     as raw TeX."""
     ax.set_yscale("symlog", linthresh=0.1)
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: number(value)))  # 0,1 in German
