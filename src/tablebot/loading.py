@@ -61,8 +61,11 @@ def table_path(given: Path) -> Path:
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    raise fail(given, f"no table beside this robot file ({', '.join(c.name for c in candidates[:3])})",
-               "give the table file itself, with robot= naming this file")
+    raise fail(
+        given,
+        f"no table beside this robot file ({', '.join(c.name for c in candidates[:3])})",
+        "give the table file itself, with robot= naming this file",
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,8 +84,14 @@ class Loaded:
     tables: RobotTables | None = None
 
     @classmethod
-    def open(cls: type[L], path: PathLike, *, robot: PathLike | None = None, worlds: Sequence[PathLike] = (),
-             properties: Sequence[PathLike] | None = None) -> L:
+    def open(
+        cls: type[L],
+        path: PathLike,
+        *,
+        robot: PathLike | None = None,
+        worlds: Sequence[PathLike] = (),
+        properties: Sequence[PathLike] | None = None,
+    ) -> L:
         """Find and read a robot's files (see :func:`tablebot.api.project.open`)."""
         from tablebot.formats.table_read import load_table
         from tablebot.machine import compile_table
@@ -136,8 +145,9 @@ class Loaded:
 
         return find_world(self.table, None, self.robot_world())
 
-    def scene(self, world: PathLike | World | None = None, overrides: dict[str, Any] | None = None,
-              every_table: bool = True) -> Scene:
+    def scene(
+        self, world: PathLike | World | None = None, overrides: dict[str, Any] | None = None, every_table: bool = True
+    ) -> Scene:
         """Table, robot and world checked and packed for the simulator: ``world`` (a file, or a world already
         read) if given, else the first of :attr:`world_files`, else the default one; ``overrides`` are
         simulator parameters (``{"battery": {"charge": 0.5}}``) over the robot file's and the world's.
@@ -161,11 +171,17 @@ class Loaded:
         assert self.tables is not None
         others = ", ".join(self.tables.names[1:])
         robot = self.robot
-        notify(Diagnostic(robot.source, robot.line("tables"), 1,
-                          f"{what} runs the main table ({self.tables.names[0]}) only so far, not {others}: the "
-                          "outputs only they write stay at 0",
-                          "tablebot trace, check and diagram run every table (docs/engine.md, Several tables)",
-                          "note"))
+        notify(
+            Diagnostic(
+                robot.source,
+                robot.line("tables"),
+                1,
+                f"{what} runs the main table ({self.tables.names[0]}) only so far, not {others}: the "
+                "outputs only they write stay at 0",
+                "tablebot trace, check and diagram run every table (docs/engine.md, Several tables)",
+                "note",
+            )
+        )
 
     def properties(self) -> list[Property]:
         """The robot file's ``[properties]`` and those of :attr:`property_files`, read and checked."""
@@ -173,16 +189,23 @@ class Loaded:
 
         return load_properties(self.machine, list(self.property_files), self.tables)
 
-    def check_report(self, targets: Sequence[str] = (), step: Callable[[str], None] = lambda what: None,
-                     properties: list[Property] | None = None) -> CheckReport:
+    def check_report(
+        self,
+        targets: Sequence[str] = (),
+        step: Callable[[str], None] = lambda what: None,
+        properties: list[Property] | None = None,
+    ) -> CheckReport:
         """``check``'s exploration, findings and proofs of :meth:`properties` (or ``properties``, read
         already); ``targets``: export targets whose limits to check too; ``step`` is told what starts next."""
         from tablebot.analysis.check import run_check
         from tablebot.analysis.check_tables import run_check_tables
 
         props = self.properties() if properties is None else properties
-        report = (run_check_tables(self.tables, props, tuple(targets), step) if self.tables is not None
-                  else run_check(self.machine, props, tuple(targets), step))
+        report = (
+            run_check_tables(self.tables, props, tuple(targets), step)
+            if self.tables is not None
+            else run_check(self.machine, props, tuple(targets), step)
+        )
         report.property_files = list(self.property_files)
         return report
 

@@ -75,8 +75,9 @@ def test_the_lamps_follow_what_the_drive_table_does() -> None:
 
 
 def test_the_example_checks_its_properties_across_both_tables() -> None:
-    done = subprocess.run([sys.executable, "-m", "tablebot", "check", str(EXAMPLE), "--format", "json"],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "check", str(EXAMPLE), "--format", "json"], capture_output=True, text=True
+    )
     report = json.loads(done.stdout)
     status = {p["name"]: p["status"] for p in report["properties"]}
     assert status.pop("front_bumper_stops") == "violated"  # the BumberBot's known bug, a warning, as there

@@ -26,11 +26,13 @@ from tablebot.web.app import Background
 pytestmark = [pytest.mark.browser]
 
 REBOUND = "rebind.test"
-FLAGS = [f"--host-resolver-rules=MAP {REBOUND} 127.0.0.1",
-         # Chromium's Private Network Access would stop the rebound page before it reaches the studio;
-         # other browsers have no such check, and the studio must hold without it
-         "--disable-features=BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessRespectPreflightResults,"
-         "LocalNetworkAccessChecks"]
+FLAGS = [
+    f"--host-resolver-rules=MAP {REBOUND} 127.0.0.1",
+    # Chromium's Private Network Access would stop the rebound page before it reaches the studio;
+    # other browsers have no such check, and the studio must hold without it
+    "--disable-features=BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessRespectPreflightResults,"
+    "LocalNetworkAccessChecks",
+]
 SECRET = "API_KEY=do-not-leak-4711"
 TIMER_COL = 12
 
@@ -178,8 +180,9 @@ def _files(folder: Path) -> dict[str, bytes]:
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
-def test_a_page_on_another_port_gets_nothing_and_changes_nothing(context: Any, attacker: str, folder: Path,
-                                                                 log: Log, shots: Path) -> None:
+def test_a_page_on_another_port_gets_nothing_and_changes_nothing(
+    context: Any, attacker: str, folder: Path, log: Log, shots: Path
+) -> None:
     before = _files(folder)
     results, lines = _attack(context, attacker, log, shots, "other-port")
     socket = results["socket"]
@@ -197,8 +200,9 @@ def test_a_page_on_another_port_gets_nothing_and_changes_nothing(context: Any, a
     assert _files(folder) == before
 
 
-def test_a_rebound_name_meets_the_host_check(context: Any, studio: Background, folder: Path, log: Log,
-                                            shots: Path) -> None:
+def test_a_rebound_name_meets_the_host_check(
+    context: Any, studio: Background, folder: Path, log: Log, shots: Path
+) -> None:
     """The hostile page's origin is http://rebind.test:PORT, its name now resolving to 127.0.0.1: to the
     browser the studio is the page's own origin, so the page could read any answer; it reads only 403s."""
     url = f"http://{REBOUND}:{studio.access.port}/cats.html"
@@ -219,8 +223,9 @@ def test_a_rebound_name_meets_the_host_check(context: Any, studio: Background, f
     assert _files(folder) == before
 
 
-def test_the_studios_own_page_still_works_end_to_end(context: Any, attacker: str, folder: Path, log: Log,
-                                                     shots: Path) -> None:
+def test_the_studios_own_page_still_works_end_to_end(
+    context: Any, attacker: str, folder: Path, log: Log, shots: Path
+) -> None:
     """After an attack in the next tab: open, edit (a located error, then fixed), save, live robot."""
     _attack(context, attacker, log, shots, "before-own-use")
     page = context.pages[0]

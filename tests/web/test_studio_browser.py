@@ -95,7 +95,7 @@ def drawn_colours(page: object, ticks: list[str], cursor: int) -> dict[str, set[
     """The colours the page drew for each state: over its ticks in the timeline (``ticks``: the state of each
     tick of the trace shown; the cursor, at tick ``cursor``, left out) and as its border in the diagram."""
     pixels = page.evaluate(TIMELINE)  # type: ignore[attr-defined]
-    band = [_hex(pixels[i:i + 3]) for i in range(0, len(pixels), 4)]
+    band = [_hex(pixels[i : i + 3]) for i in range(0, len(pixels), 4)]
     drawn: dict[str, set[str]] = defaultdict(set)
     at = cursor / max(1, len(ticks) - 1) * (len(band) - 2) + 1
     for x, colour in enumerate(band):  # pixel column x shows tick floor(x / width * ticks), as the page draws it
@@ -180,8 +180,9 @@ def test_paused_hold_i3_and_step_fires_a_collision_row(tab: Tab) -> None:
     tab.shot("step")
 
 
-def test_save_changes_only_the_edited_cell_and_keeps_a_backup(tab: Tab, folder: Path, browser: object,
-                                                             studio: Background, shots: Path) -> None:
+def test_save_changes_only_the_edited_cell_and_keeps_a_backup(
+    tab: Tab, folder: Path, browser: object, studio: Background, shots: Path
+) -> None:
     page = tab.page
     path = folder / "table.csv"
     original = path.read_bytes()
@@ -253,8 +254,7 @@ def test_a_counterexample_plays_on_the_table(tab: Tab) -> None:
     tab.shot("counterexample")
 
 
-def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path,
-                                                                  shots: Path) -> None:
+def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: object, tmp_path: Path, shots: Path) -> None:
     from tablebot.cli.common import load
     from tablebot.sim.model.scene import scene_for
     from tablebot.sim.runner import simulate
@@ -268,8 +268,9 @@ def test_the_replay_file_plays_alone_and_keeps_hostile_text_inert(browser: objec
     table, machine = load(folder)
     scene = scene_for(table, machine)
     result = simulate(scene, 30.0, 1)
-    page_file = write_html(tmp_path / "run.html", block_lines(result.block(), machine), scene.world, table,
-                           params=scene.params)
+    page_file = write_html(
+        tmp_path / "run.html", block_lines(result.block(), machine), scene.world, table, params=scene.params
+    )
     text = page_file.read_text()
     assert text.lower().count("</script") == 2
     assert "http:" not in text.replace("http://www.w3.org/", "") and "https:" not in text  # SVG namespaces

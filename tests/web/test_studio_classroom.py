@@ -51,8 +51,9 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
     yield from served(bumberbot(tmp_path_factory.mktemp("classroom")))
 
 
-def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, touch: bool = False,
-              table: bool = True) -> Any:
+def open_page(
+    browser: Any, url: str, width: int = 1280, height: int = 720, touch: bool = False, table: bool = True
+) -> Any:
     """A page of the studio in a new browser context; console errors and page errors are collected."""
     context = browser.new_context(viewport={"width": width, "height": height}, has_touch=touch)
     page = context.new_page()
@@ -69,16 +70,21 @@ def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, touc
 
 
 def inside(box: list[float], frame: list[float], slack: float = 0.5) -> bool:
-    return (box[0] >= frame[0] - slack and box[1] >= frame[1] - slack and box[2] <= frame[2] + slack
-            and box[3] <= frame[3] + slack)
+    return (
+        box[0] >= frame[0] - slack
+        and box[1] >= frame[1] - slack
+        and box[2] <= frame[2] + slack
+        and box[3] <= frame[3] + slack
+    )
 
 
 SIZES = {"projector": (1280, 720, False, 0), "tablet": (1024, 768, True, 0), "projector-A+": (1280, 720, False, 2)}
 
 
 @pytest.mark.parametrize("size", SIZES)
-def test_every_column_the_verdicts_and_the_arena_are_on_the_screen(browser: Any, studio: Background, shots: Path,
-                                                                   size: str) -> None:
+def test_every_column_the_verdicts_and_the_arena_are_on_the_screen(
+    browser: Any, studio: Background, shots: Path, size: str
+) -> None:
     width, height, touch, bigger = SIZES[size]
     page = open_page(browser, studio.url, width, height, touch)
     for _ in range(bigger):
@@ -117,8 +123,9 @@ def test_no_cell_cuts_its_text(browser: Any, studio: Background) -> None:
     page.context.close()
 
 
-def test_a_counterexample_plays_in_the_arena_at_once_and_is_marked_where_it_breaks(browser: Any, studio: Background,
-                                                                                   shots: Path) -> None:
+def test_a_counterexample_plays_in_the_arena_at_once_and_is_marked_where_it_breaks(
+    browser: Any, studio: Background, shots: Path
+) -> None:
     page = open_page(browser, studio.url)
     page.locator("#properties li", has_text="front_bumper_stops").locator('button[data-where="arena"]').click()
     page.wait_for_function("() => !document.querySelector('#status').textContent.startsWith('tick 0 ')", timeout=5000)
@@ -134,8 +141,9 @@ def test_a_counterexample_plays_in_the_arena_at_once_and_is_marked_where_it_brea
     page.context.close()
 
 
-def test_an_error_note_is_whole_and_the_arena_says_it_runs_the_last_good_table(browser: Any, studio: Background,
-                                                                              shots: Path) -> None:
+def test_an_error_note_is_whole_and_the_arena_says_it_runs_the_last_good_table(
+    browser: Any, studio: Background, shots: Path
+) -> None:
     page = open_page(browser, studio.url)
     stale = page.locator("#arena-stale")
     assert stale.is_hidden()
@@ -148,8 +156,10 @@ def test_an_error_note_is_whole_and_the_arena_says_it_runs_the_last_good_table(b
     width = page.evaluate("innerWidth")
     assert box["x"] >= 0 and box["x"] + box["width"] <= width and box["width"] > 200, box
     # nothing covers it or cuts it: its far corner is the note's own
-    corner = page.evaluate(f"document.elementFromPoint({box['x'] + box['width'] - 4}, {box['y'] + box['height'] - 4})"
-                           ".closest('.cell-note') !== null")
+    corner = page.evaluate(
+        f"document.elementFromPoint({box['x'] + box['width'] - 4}, {box['y'] + box['height'] - 4})"
+        ".closest('.cell-note') !== null"
+    )
     assert corner and "nowhere" in note.inner_text()
     assert stale.is_visible() and "runs the last table that read" in stale.inner_text()
     page.screenshot(path=str(shots / "error.png"))
@@ -158,8 +168,9 @@ def test_an_error_note_is_whole_and_the_arena_says_it_runs_the_last_good_table(b
     page.context.close()
 
 
-def test_the_diagram_is_readable_zooms_and_enlarges_beside_the_arena(browser: Any, studio: Background,
-                                                                     shots: Path) -> None:
+def test_the_diagram_is_readable_zooms_and_enlarges_beside_the_arena(
+    browser: Any, studio: Background, shots: Path
+) -> None:
     page = open_page(browser, studio.url)
     page.wait_for_selector("#diagram svg")
     assert page.evaluate(DIAGRAM_TEXT_PX) >= 11
@@ -177,8 +188,9 @@ def test_the_diagram_is_readable_zooms_and_enlarges_beside_the_arena(browser: An
     page.context.close()
 
 
-def test_a_folder_without_a_table_says_so_in_the_page_and_the_terminal(browser: Any, tmp_path: Path,
-                                                                       shots: Path) -> None:
+def test_a_folder_without_a_table_says_so_in_the_page_and_the_terminal(
+    browser: Any, tmp_path: Path, shots: Path
+) -> None:
     empty = tmp_path / "empty"
     empty.mkdir()
     said = _terminal_of_studio(empty)
@@ -205,14 +217,20 @@ def test_a_folder_without_a_table_says_so_in_the_page_and_the_terminal(browser: 
 def _terminal_of_studio(folder: Path) -> str:
     """What ``tablebot studio`` (a real process, started in ``folder``) writes before it serves."""
     env = {**os.environ, "COLUMNS": "200"}
-    process = subprocess.Popen([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0"],
-                               cwd=folder, env=env, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0"],
+        cwd=folder,
+        env=env,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     lines: list[str] = []  # read in a thread: a line that never comes must not block the test
     reader = threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True)  # type: ignore[arg-type]
     reader.start()
     try:
-        wait_for(lambda: "tablebot studio my-robot" in "".join(lines) or process.poll() is not None,
-                 "the studio's notes", 30)
+        wait_for(
+            lambda: "tablebot studio my-robot" in "".join(lines) or process.poll() is not None, "the studio's notes", 30
+        )
         return "".join(lines)
     finally:
         process.terminate()

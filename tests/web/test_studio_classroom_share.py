@@ -31,9 +31,13 @@ class Studio:
     """``tablebot studio --open LINK`` in ``folder``, a real process; ``said`` what it wrote to the terminal."""
 
     def __init__(self, folder: Path, link: str) -> None:
-        self.process = subprocess.Popen([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0",
-                                         "--open", link], cwd=folder, env={**os.environ, "COLUMNS": "300"},
-                                        stderr=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0", "--open", link],
+            cwd=folder,
+            env={**os.environ, "COLUMNS": "300"},
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         self.lines: list[str] = []  # read in a thread: a line that never comes must not block the test
         reader = threading.Thread(target=lambda: self.lines.extend(self.process.stderr), daemon=True)  # type: ignore[arg-type]
         reader.start()
@@ -77,9 +81,14 @@ def test_a_link_opens_its_table_exactly_as_shared_and_never_over_a_folder(browse
 
 def test_a_cut_link_is_refused_in_words(tmp_path: Path) -> None:
     link = share.encode(share.collect(EXAMPLE))
-    done = subprocess.run([sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0",
-                           "--open", link[:300]], cwd=tmp_path, env={**os.environ, "COLUMNS": "300"},
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "studio", "--no-browser", "--port", "0", "--open", link[:300]],
+        cwd=tmp_path,
+        env={**os.environ, "COLUMNS": "300"},
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 2 and "--open: error: this share link is cut short or damaged" in done.stderr
     assert list(tmp_path.iterdir()) == []  # nothing written
 
@@ -108,8 +117,10 @@ def test_the_share_button_gives_the_link_of_the_table_as_edited_and_its_qr_code(
     assert errors == []
     shared = share.decode(link)
     text = (EXAMPLE / "table.csv").read_text(encoding="utf-8")
-    assert shared.table == ("table.csv", text.replace("Collision detection,1,,1,1,,,,,0,,0,50,20",
-                                                      "Collision detection,1,,1,1,,,,,0,,0,55,20", 1))
+    assert shared.table == (
+        "table.csv",
+        text.replace("Collision detection,1,,1,1,,,,,0,,0,50,20", "Collision detection,1,,1,1,,,,,0,,0,55,20", 1),
+    )
     assert link.startswith(share.STUDIO + "#share=1.")
 
 
@@ -124,7 +135,7 @@ def test_a_link_in_the_pages_address_or_pasted_in_opens_its_table(browser: Any, 
     for studio in served(bumberbot(tmp_path)):
         page = browser.new_page(viewport={"width": 1280, "height": 720})
         page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-        page.goto(studio.url + link[link.index("#"):])  # pasted into the address bar of a running studio
+        page.goto(studio.url + link[link.index("#") :])  # pasted into the address bar of a running studio
         page.wait_for_function("() => document.querySelector('#table-pick').value === 'line-follower/table.csv'")
         assert "#" not in page.url  # the address is put back without the link
         page.click("#open-link")

@@ -196,9 +196,9 @@ def test_a_draft_of_a_table_changed_since_says_so_and_save_asks(tab: Page, folde
     assert (folder / "table.csv.bak").read_bytes() == theirs
 
 
-
-def test_a_save_in_another_tab_is_said_and_save_mine_keeps_theirs(tab: Page, browser: Any, server: Background,
-                                                                   shots: Path, folder: Path) -> None:
+def test_a_save_in_another_tab_is_said_and_save_mine_keeps_theirs(
+    tab: Page, browser: Any, server: Background, shots: Path, folder: Path
+) -> None:
     path = folder / "table.csv"
     original = path.read_bytes()
     other = Page(browser, server, shots)
@@ -209,8 +209,11 @@ def test_a_save_in_another_tab_is_said_and_save_mine_keeps_theirs(tab: Page, bro
         other.save()
         theirs = path.read_bytes()
         tab.page.wait_for_function("() => document.querySelector('#banner').textContent.startsWith('another tab')")
-        assert tab.page.locator("#banner").inner_text().startswith(
-            "another tab saved table.csv while this one has unsaved edits: your edits are kept")
+        assert (
+            tab.page.locator("#banner")
+            .inner_text()
+            .startswith("another tab saved table.csv while this one has unsaved edits: your edits are kept")
+        )
         tab.shot("other-tab-saved")
         tab.page.click("#save")
         assert "Another tab of the studio saved it" in tab.asked("table.csv was saved in another tab")

@@ -39,8 +39,12 @@ console.log(JSON.stringify({ en: en.EN, de: de.DE }));
 def catalogs() -> dict[str, dict[str, str]]:
     node = shutil.which("node")
     assert node is not None, "Node runs the page's modules here"
-    done = subprocess.run([node, "--input-type=module", "-e", CATALOGS, (STATIC / "js" / "lib").as_uri()],
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [node, "--input-type=module", "-e", CATALOGS, (STATIC / "js" / "lib").as_uri()],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0, done.stderr
     found: dict[str, dict[str, str]] = json.loads(done.stdout)
     return found
@@ -50,6 +54,7 @@ def test_both_catalogs_have_the_same_keys_and_the_same_fields(catalogs: dict[str
     en, de = catalogs["en"], catalogs["de"]
     assert sorted(en) == sorted(de)
     fields = re.compile(r"\{(\w+)\}")
+
     def named(catalog: dict[str, str]) -> dict[str, list[str]]:
         return {key: sorted(fields.findall(text)) for key, text in catalog.items()}
 
@@ -77,8 +82,15 @@ def studio_en(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Background]:
     yield from served(bumberbot(tmp_path_factory.mktemp("i18n-en")), lang="en")
 
 
-def open_page(browser: Any, url: str, locale: str, kept: str | None = None, width: int = 1280,
-              height: int = 720, touch: bool = False) -> Any:
+def open_page(
+    browser: Any,
+    url: str,
+    locale: str,
+    kept: str | None = None,
+    width: int = 1280,
+    height: int = 720,
+    touch: bool = False,
+) -> Any:
     """A page of the studio in a new browser context whose language is ``locale`` (``kept``: the switch's
     choice already in its storage); console errors and page errors are collected."""
     context = browser.new_context(locale=locale, viewport={"width": width, "height": height}, has_touch=touch)
@@ -186,8 +198,9 @@ OUTSIDE_MARKERS = r"""() => {
 }"""
 
 
-def test_no_word_of_the_page_is_outside_the_catalog(browser: Any, studio: Background, shots: Path,
-                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_no_word_of_the_page_is_outside_the_catalog(
+    browser: Any, studio: Background, shots: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from tablebot.cli.studio import link_maker
     from tablebot.web import sharing
 
@@ -212,8 +225,9 @@ def test_no_word_of_the_page_is_outside_the_catalog(browser: Any, studio: Backgr
 
 
 @pytest.mark.parametrize("size", SIZES)
-def test_in_german_every_column_the_verdicts_and_the_arena_are_on_the_screen(browser: Any, studio: Background,
-                                                                             shots: Path, size: str) -> None:
+def test_in_german_every_column_the_verdicts_and_the_arena_are_on_the_screen(
+    browser: Any, studio: Background, shots: Path, size: str
+) -> None:
     """The classroom's sizes (test_studio_classroom.py) with German's longer words: nothing clipped or pushed off."""
     width, height, touch, bigger = SIZES[size]
     page = open_page(browser, studio.url, "de-DE", width=width, height=height, touch=touch)
@@ -257,8 +271,13 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
 
     table, machine = load(bumberbot(tmp_path))
     scene = scene_for(table, machine)
-    page_file = write_html(tmp_path / "run.html", block_lines(simulate(scene, 5.0, 1).block(), machine), scene.world,
-                           table, params=scene.params)
+    page_file = write_html(
+        tmp_path / "run.html",
+        block_lines(simulate(scene, 5.0, 1).block(), machine),
+        scene.world,
+        table,
+        params=scene.params,
+    )
     context = browser.new_context(locale="de-DE", viewport={"width": 1280, "height": 720})
     page = context.new_page()
     errors: list[str] = []
@@ -275,8 +294,9 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
     assert errors == []
 
 
-def test_a_folder_without_a_table_says_so_in_german_and_nothing_outside_the_catalog(browser: Any,
-                                                                                    tmp_path: Path) -> None:
+def test_a_folder_without_a_table_says_so_in_german_and_nothing_outside_the_catalog(
+    browser: Any, tmp_path: Path
+) -> None:
     empty = tmp_path / "leer"
     empty.mkdir()
     for studio in served(empty, None):
@@ -300,14 +320,18 @@ def test_a_folder_without_a_table_says_so_in_german_and_nothing_outside_the_cata
 def _page_language_of_studio(folder: Path, *args: str, **env: str) -> Any:
     """The language ``tablebot studio`` (a real process, with ``args`` and ``env``) hands its page: its
     /api/config's ``lang``, fetched with the token it printed."""
-    process = subprocess.Popen([sys.executable, "-m", "tablebot", *args, "studio", str(folder), "--no-browser",
-                                "--port", "0"], env={**os.environ, "COLUMNS": "200", **env}, stderr=subprocess.PIPE,
-                               text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "tablebot", *args, "studio", str(folder), "--no-browser", "--port", "0"],
+        env={**os.environ, "COLUMNS": "200", **env},
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     lines: list[str] = []
     threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True).start()  # type: ignore[arg-type]
     try:
-        found = wait_for(lambda: re.search(r"(http://127\.0\.0\.1:\d+)/\?token=([\w-]+)", "".join(lines)),
-                         "the studio's address", 30)
+        found = wait_for(
+            lambda: re.search(r"(http://127\.0\.0\.1:\d+)/\?token=([\w-]+)", "".join(lines)), "the studio's address", 30
+        )
         request = urllib.request.Request(found[1] + "/api/config", headers={"X-Tablebot-Token": found[2]})
         with urllib.request.urlopen(request, timeout=10) as reply:
             return json.load(reply)["lang"]

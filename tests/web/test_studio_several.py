@@ -63,23 +63,28 @@ def open_page(browser: Any, url: str, width: int = 1280, height: int = 720, loca
 
 def tabs(page: Any) -> list[list[str]]:
     """The tabs' words, and whether each is the one shown."""
-    return page.eval_on_selector_all("#table-tabs button",
-                                     "bs => bs.map(b => [b.textContent, b.getAttribute('aria-selected')])")
+    return page.eval_on_selector_all(
+        "#table-tabs button", "bs => bs.map(b => [b.textContent, b.getAttribute('aria-selected')])"
+    )
 
 
 def show(page: Any, name: str, header: str) -> None:
     """Click table ``name``'s tab and wait for its grid (a header cell ``header`` of it)."""
     page.click(f"#table-tabs button[data-table={name}]")
-    wait_for(lambda: header in page.eval_on_selector_all("table.grid thead th", "hs => hs.map(h => h.textContent)"),
-             f"the grid of {name}", 30)
+    wait_for(
+        lambda: header in page.eval_on_selector_all("table.grid thead th", "hs => hs.map(h => h.textContent)"),
+        f"the grid of {name}",
+        30,
+    )
 
 
 def cell(page: Any, row: int, col: int) -> Any:
     return page.locator(f'td[data-row="{row}"][data-col="{col}"] input')
 
 
-def test_a_tab_per_table_each_edited_and_saved_to_its_own_file(browser: Any, studio: Background, folder: Path,
-                                                                shots: Path) -> None:
+def test_a_tab_per_table_each_edited_and_saved_to_its_own_file(
+    browser: Any, studio: Background, folder: Path, shots: Path
+) -> None:
     drive_before = (folder / "table.csv").read_bytes()
     page = open_page(browser, studio.url)
     assert tabs(page) == [["drive", "true"], ["lights", "false"]]
@@ -101,8 +106,9 @@ def test_a_tab_per_table_each_edited_and_saved_to_its_own_file(browser: Any, stu
     page.context.close()
 
 
-def test_the_arena_runs_every_table_and_shows_the_lamps_as_the_engine_has_them(browser: Any, studio: Background,
-                                                                               folder: Path, shots: Path) -> None:
+def test_the_arena_runs_every_table_and_shows_the_lamps_as_the_engine_has_them(
+    browser: Any, studio: Background, folder: Path, shots: Path
+) -> None:
     page = open_page(browser, studio.url)
     show(page, "lights", "drive=1,2")
     page.click("#reset")  # the robot as the files are now (the lights table saved by the test before)
@@ -123,16 +129,21 @@ def test_the_arena_runs_every_table_and_shows_the_lamps_as_the_engine_has_them(b
     page.context.close()
 
 
-@pytest.mark.parametrize(("width", "height", "locale"), [(1280, 720, "en-GB"), (1280, 720, "de-DE"),
-                                                      (1024, 768, "de-DE"), (1024, 768, "en-GB")])
-def test_the_tabs_fit_a_classroom_screen(browser: Any, studio: Background, shots: Path, width: int, height: int,
-                                         locale: str) -> None:
+@pytest.mark.parametrize(
+    ("width", "height", "locale"),
+    [(1280, 720, "en-GB"), (1280, 720, "de-DE"), (1024, 768, "de-DE"), (1024, 768, "en-GB")],
+)
+def test_the_tabs_fit_a_classroom_screen(
+    browser: Any, studio: Background, shots: Path, width: int, height: int, locale: str
+) -> None:
     page = open_page(browser, studio.url, width, height, locale)
     show(page, "lights", "drive=1,2")
     page.wait_for_timeout(200)
     page.screenshot(path=str(shots / f"tabs-{width}-{locale}.png"))
-    wide = page.evaluate("() => [document.documentElement.scrollWidth, innerWidth, "
-                         "document.querySelector('#grid').scrollWidth, document.querySelector('#grid').clientWidth]")
+    wide = page.evaluate(
+        "() => [document.documentElement.scrollWidth, innerWidth, "
+        "document.querySelector('#grid').scrollWidth, document.querySelector('#grid').clientWidth]"
+    )
     assert wide[0] <= wide[1] and wide[2] <= wide[3], wide
     title = page.get_attribute("#table-tabs button[data-table=lights]", "title")
     assert title == ("Tabelle lights (lights.csv)" if locale == "de-DE" else "table lights (lights.csv)")
@@ -140,8 +151,9 @@ def test_the_tabs_fit_a_classroom_screen(browser: Any, studio: Background, shots
     page.context.close()
 
 
-def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio: Background, folder: Path,
-                                                            shots: Path) -> None:
+def test_the_trace_player_says_every_tables_state_and_line(
+    browser: Any, studio: Background, folder: Path, shots: Path
+) -> None:
     """A trace of the whole robot played on the lights tab: the lights table's state, row and timer speak (its
     timeline, lit row and diagram), and the drive table's state and line are said beside them, as the trace has
     them; on the drive tab the other way round."""
@@ -151,13 +163,17 @@ def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio:
     page = open_page(browser, studio.url)
     show(page, "lights", "drive=1,2")
     page.click("#mode-trace")
-    page.evaluate("() => { const s = document.querySelector('#trace-pick');"
-                  " s.append(new Option('run/trace.jsonl', 'run/trace.jsonl')); }")
+    page.evaluate(
+        "() => { const s = document.querySelector('#trace-pick');"
+        " s.append(new Option('run/trace.jsonl', 'run/trace.jsonl')); }"
+    )
     page.select_option("#trace-pick", "run/trace.jsonl")
     wait_for(lambda: "drive:" in page.inner_text("#status"), "the player's status line", 30)
     tick = next(k for k in range(len(trace)) if trace["row"][k] >= 0)  # a drive row fired: a group row, as written
-    page.evaluate(f"() => {{ const s = document.querySelector('#scrub'); s.value = {tick};"
-                  " s.dispatchEvent(new Event('input')); }")
+    page.evaluate(
+        f"() => {{ const s = document.querySelector('#scrub'); s.value = {tick};"
+        " s.dispatchEvent(new Event('input')); }"
+    )
     status = page.inner_text("#status")
     page.screenshot(path=str(shots / "player-lights.png"))
     lights_state, drive_state = trace["lights.state"][tick], trace["state"][tick]
@@ -172,8 +188,9 @@ def test_the_trace_player_says_every_tables_state_and_line(browser: Any, studio:
     page.context.close()
 
 
-def test_a_tab_clicked_while_a_trace_plays_speaks_for_that_table(browser: Any, studio: Background, folder: Path,
-                                                                 shots: Path) -> None:
+def test_a_tab_clicked_while_a_trace_plays_speaks_for_that_table(
+    browser: Any, studio: Background, folder: Path, shots: Path
+) -> None:
     """The trace playing on the drive tab, the lights tab clicked: the player goes on at the same tick with the
     lights table speaking (its state in the status line, the drive table's said beside it, its timeline), without
     the trace opened again; it kept the drive table's view until then (issue 36's leftover)."""
@@ -182,8 +199,10 @@ def test_a_tab_clicked_while_a_trace_plays_speaks_for_that_table(browser: Any, s
     trace = run.trace
     page = open_page(browser, studio.url)
     page.click("#mode-trace")
-    page.evaluate("() => { const s = document.querySelector('#trace-pick');"
-                  " s.append(new Option('played/trace.jsonl', 'played/trace.jsonl')); }")
+    page.evaluate(
+        "() => { const s = document.querySelector('#trace-pick');"
+        " s.append(new Option('played/trace.jsonl', 'played/trace.jsonl')); }"
+    )
     page.select_option("#trace-pick", "played/trace.jsonl")
     wait_for(lambda: "lights:" in page.inner_text("#status"), "the drive tab's status line", 30)
     page.click("#tplay")
@@ -217,21 +236,30 @@ def test_a_german_walk_through_the_tabs(browser: Any, studio: Background, shots:
     page.click("#step")
     wait_for(lambda: "Zustand flash_" in page.inner_text("#status"), "the lights table's state, in German", 30)
     # why the lights table's rows of its state fired or not: its own rows (a group's row among them), by line
-    wait_for(lambda: any(line.startswith("Zeile 5 (Seeking: flash right) hat nicht geschaltet: sie braucht T")
-                         for line in page.eval_on_selector_all("#why li", "ls => ls.map(l => l.textContent)")),
-             "why the lights table's rows did not fire", 30)
+    wait_for(
+        lambda: any(
+            line.startswith("Zeile 5 (Seeking: flash right) hat nicht geschaltet: sie braucht T")
+            for line in page.eval_on_selector_all("#why li", "ls => ls.map(l => l.textContent)")
+        ),
+        "why the lights table's rows did not fire",
+        30,
+    )
     assert page.get_attribute("#table-tabs button[data-table=drive]", "title") == "Tabelle drive (table.csv)"
     page.screenshot(path=str(shots / "german-walk.png"))
     assert page.errors == []
     page.context.close()
 
 
-@pytest.mark.parametrize(("old", "new", "column", "words"), [
-    ("drive=20..29", "drive=99", 5, "drive=99: table drive has no state 99"),
-    (",L1,", ",M1_speed,", 6, "M1 is written by two tables, drive ("),
-])
-def test_an_error_across_the_tables_is_marked_on_its_cell_in_its_tab(folder: Path, old: str, new: str, column: int,
-                                                                      words: str) -> None:
+@pytest.mark.parametrize(
+    ("old", "new", "column", "words"),
+    [
+        ("drive=20..29", "drive=99", 5, "drive=99: table drive has no state 99"),
+        (",L1,", ",M1_speed,", 6, "M1 is written by two tables, drive ("),
+    ],
+)
+def test_an_error_across_the_tables_is_marked_on_its_cell_in_its_tab(
+    folder: Path, old: str, new: str, column: int, words: str
+) -> None:
     """An error only the tables together show (a cross-table column naming a state its table lacks, a second writer
     of an output) is on its header cell in the tab of the table it is in, named by its file as the page names it."""
     path = folder / "lights.csv"

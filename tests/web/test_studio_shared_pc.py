@@ -51,6 +51,7 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 # --- the command as a process, with a stand-in browser ---------------------------------------------------
 
+
 @dataclass
 class Command:
     """``tablebot studio`` running with BROWSER set to a stand-in that records its argv."""
@@ -82,18 +83,25 @@ class Command:
 def start_command(folder: Path, tmp: Path, env: dict[str, str], *args: str) -> Command:
     record = tmp / "browser-argv.json"
     fake = tmp / "fake-browser"
-    fake.write_text(f"#!{sys.executable}\nimport json, os, sys\n"
-                    f"open({str(record) + '.tmp'!r}, 'w').write(json.dumps(sys.argv))\n"
-                    f"os.replace({str(record) + '.tmp'!r}, {str(record)!r})\n")
+    fake.write_text(
+        f"#!{sys.executable}\nimport json, os, sys\n"
+        f"open({str(record) + '.tmp'!r}, 'w').write(json.dumps(sys.argv))\n"
+        f"os.replace({str(record) + '.tmp'!r}, {str(record)!r})\n"
+    )
     fake.chmod(0o700)
     log = tmp / "terminal.txt"
     with log.open("wb") as terminal:
-        process = subprocess.Popen([sys.executable, "-m", "tablebot.cli", "studio", str(folder), "--port", "0",
-                                    *args], stdout=terminal, stderr=terminal,
-                                   env={**os.environ, "BROWSER": str(fake), **env})
+        process = subprocess.Popen(
+            [sys.executable, "-m", "tablebot.cli", "studio", str(folder), "--port", "0", *args],
+            stdout=terminal,
+            stderr=terminal,
+            env={**os.environ, "BROWSER": str(fake), **env},
+        )
     try:
-        url = wait_for(lambda: re.search(r"http://\S+/\?token=\S+", log.read_text()) or process.poll() is not None,
-                       "the printed address")
+        url = wait_for(
+            lambda: re.search(r"http://\S+/\?token=\S+", log.read_text()) or process.poll() is not None,
+            "the printed address",
+        )
         assert url is not True, log.read_text()
     except BaseException:
         process.kill()
@@ -111,8 +119,7 @@ def runtime(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def command(folder: Path, runtime: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Command]:
-    running = start_command(folder, tmp_path_factory.mktemp("command"), {"XDG_RUNTIME_DIR": str(runtime)},
-                            "--verbose")
+    running = start_command(folder, tmp_path_factory.mktemp("command"), {"XDG_RUNTIME_DIR": str(runtime)}, "--verbose")
     yield running
     running.stop()
 
@@ -178,17 +185,25 @@ def test_a_browser_that_does_not_come_gets_the_user_a_hint(tmp_path: Path, visit
     fake = tmp_path / "fake-browser"
     fake.write_text(f"#!{sys.executable}\nimport sys\nopen({str(tmp_path / 'argv')!r}, 'w').write(sys.argv[1])\n")
     fake.chmod(0o700)
-    done = subprocess.run([sys.executable, "-c", OPEN_AND_WAIT, visit], env={**os.environ, "BROWSER": str(fake)},
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-c", OPEN_AND_WAIT, visit],
+        env={**os.environ, "BROWSER": str(fake)},
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "argv").read_text().startswith("file://")
-    hint = ("the browser has not come to the studio after 0.2 s: if it cannot find "
-            f"{(tmp_path / 'argv').read_text().removeprefix('file://')} (a browser installed as a snap cannot read "
-            "that folder), open the address above")
+    hint = (
+        "the browser has not come to the studio after 0.2 s: if it cannot find "
+        f"{(tmp_path / 'argv').read_text().removeprefix('file://')} (a browser installed as a snap cannot read "
+        "that folder), open the address above"
+    )
     assert done.stderr.strip() == ("" if visit == "visited" else hint)
 
 
 # --- the verbose log -------------------------------------------------------------------------------------
+
 
 def _get(url: str, headers: dict[str, str] | None = None) -> int:
     try:
@@ -218,11 +233,14 @@ def test_verbose_logs_hide_a_percent_encoded_token(command: Command) -> None:
 
 # --- an upload cut off -----------------------------------------------------------------------------------
 
+
 def test_an_upload_cut_off_mid_body_is_one_line_not_a_traceback(command: Command) -> None:
     port = command.port
-    head = (f"POST /api/trace?name=cut.jsonl HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-            f"Origin: http://127.0.0.1:{port}\r\n{TOKEN_HEADER}: {command.token}\r\n"
-            "Content-Type: application/octet-stream\r\nContent-Length: 100000\r\n\r\n")
+    head = (
+        f"POST /api/trace?name=cut.jsonl HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
+        f"Origin: http://127.0.0.1:{port}\r\n{TOKEN_HEADER}: {command.token}\r\n"
+        "Content-Type: application/octet-stream\r\nContent-Length: 100000\r\n\r\n"
+    )
     body = b'{"tick":0,"state":1}\n' * 50  # 1,050 of the 100,000 bytes announced
     with socket.create_connection(("127.0.0.1", port), timeout=10) as conn:
         conn.sendall(head.encode() + body)
@@ -263,8 +281,9 @@ def other(studio: Background) -> Iterator[OtherPort]:
     yield from other_port(page.replace("NAME", json.dumps(f"tablebot-studio-{studio.access.port}")))
 
 
-def test_no_other_port_receives_the_token_and_its_page_cannot_get_in(browser: Any, studio: Background,
-                                                                      other: OtherPort) -> None:
+def test_no_other_port_receives_the_token_and_its_page_cannot_get_in(
+    browser: Any, studio: Background, other: OtherPort
+) -> None:
     token = studio.access.token
     context = browser.new_context()
     page = context.new_page()

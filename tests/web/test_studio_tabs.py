@@ -32,8 +32,9 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def _tab(tabs: ExitStack, server: Background, wait: bool = False) -> ClientConnection | None:
     """A tab that opened the table (the page's WebSocket, closed with ``tabs``), once its robot is up;
     ``wait``: None if it was turned away."""
-    ws = tabs.enter_context(connect(server.origin.replace("http", "ws") + "/ws", additional_headers=server.headers,
-                                    max_size=2**24))
+    ws = tabs.enter_context(
+        connect(server.origin.replace("http", "ws") + "/ws", additional_headers=server.headers, max_size=2**24)
+    )
     ws.send(json.dumps({"op": "open", "path": "table.csv"}))
     while (reply := json.loads(ws.recv(20)))["type"] not in ("arena", "error"):
         pass
@@ -67,11 +68,16 @@ def test_one_tab_more_than_the_studio_serves_is_told_why(folder: Path, caplog: p
             wait_for(lambda: _tab(tabs, server, wait=True), "a place to come free", timeout=10)
     finally:
         server.stop()
-    assert reply == {"type": "error", "op": "", "message": "this studio already has 3 tabs open, the most it "
-                     "serves at once: close one of them, then reload this tab"}
+    assert reply == {
+        "type": "error",
+        "op": "",
+        "message": "this studio already has 3 tabs open, the most it "
+        "serves at once: close one of them, then reload this tab",
+    }
     said = [r.getMessage() for r in caplog.records if r.name == "tablebot.studio"]
-    assert said == ["refused a tab: 3 tabs are open already, the most one studio serves at once (close one of "
-                    "them in the browser)"], said
+    assert said == [
+        "refused a tab: 3 tabs are open already, the most one studio serves at once (close one of them in the browser)"
+    ], said
 
 
 def test_the_refused_tab_shows_why_in_the_page(browser: Any, folder: Path) -> None:
@@ -84,8 +90,9 @@ def test_the_refused_tab_shows_why_in_the_page(browser: Any, folder: Path) -> No
         second = context.new_page()
         second.goto(server.url)  # the printed address (the key is kept per tab, not in a cookie)
         second.wait_for_selector("#banner:not([hidden])")
-        assert second.inner_text("#banner").startswith("this studio already has 1 tab open, the most it serves at "
-                                                       "once: close one of them, then reload this tab")
+        assert second.inner_text("#banner").startswith(
+            "this studio already has 1 tab open, the most it serves at once: close one of them, then reload this tab"
+        )
         first.close()  # the place comes free once the studio has seen the tab go (the next moment)
         wait_for(lambda: _reloaded(second), "the reloaded tab to be served", timeout=20)
         studio_works(second)
