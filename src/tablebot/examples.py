@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 _CANDIDATES = (
     Path(__file__).resolve().parent / "_examples",  # installed wheel (force-included)
@@ -14,4 +15,4 @@ def example_path(name: str) -> Path:
     for root in _CANDIDATES:
         if (root / name).is_dir():
             return root / name
-    raise fail(name, "example not found", "run from a tablebot checkout or reinstall the package")
+    raise fail(name, N_("example not found"), N_("run from a tablebot checkout or reinstall the package"))

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 from tablebot.interrupts import fault_point, held
 
 try:  # POSIX
@@ -263,7 +264,7 @@ def _commit(fs: FileSet) -> None:
     for name in names:  # everything that could refuse comes before the first rename (each file passed the
         target = fs.folder / name  # command's overwrite guard when tablebot.files wrote it into the stage)
         if target.is_dir() and not target.is_symlink():
-            raise fail(target, "a folder stands where this file is to be written", "move the folder away")
+            raise fail(target, N_("a folder stands where this file is to be written"), N_("move the folder away"))
         target.parent.mkdir(parents=True, exist_ok=True)
     removals = sorted(fs.removals - set(names))
     with held():

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_, Message
 
 if TYPE_CHECKING:
     from tablebot.analysis.check import CheckReport
@@ -56,15 +57,15 @@ def table_path(given: Path) -> Path:
     if given.suffix.lower() != ".toml":
         return resolve_table_path(given)
     if not given.is_file():
-        raise fail(given, "no such robot file", "give a folder, a table file or a robot file that exists")
+        raise fail(given, N_("no such robot file"), N_("give a folder, a table file or a robot file that exists"))
     candidates = [given.with_suffix(".csv"), given.with_suffix(".tsv"), *(given.parent / n for n in TABLE_NAMES)]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
     raise fail(
         given,
-        f"no table beside this robot file ({', '.join(c.name for c in candidates[:3])})",
-        "give the table file itself, with robot= naming this file",
+        N_("no table beside this robot file ({names})", names=tuple(c.name for c in candidates[:3])),
+        N_("give the table file itself, with robot= naming this file"),
     )
 
 
@@ -158,13 +159,13 @@ class Loaded:
 
         tables = self.tables if every_table else None
         if self.tables is not None and tables is None:  # said, not hidden: the other tables' lamps stay dark
-            self._main_table_only("the simulator")
+            self._main_table_only(N_("the simulator"))
         if isinstance(world, World):
             return prepare(self.table, self.machine, world, robot_layer(self.robot)[0], overrides, tables)
         chosen = Path(world) if world is not None else (self.world_files[0] if self.world_files else None)
         return scene_for(self.table, self.machine, chosen, overrides, tables)
 
-    def _main_table_only(self, what: str) -> None:
+    def _main_table_only(self, what: Message) -> None:
         """A note that ``what`` runs only the main table of a robot of several (the others not yet)."""
         from tablebot.diagnostics import Diagnostic, notify
 
@@ -176,9 +177,9 @@ class Loaded:
                 robot.source,
                 robot.line("tables"),
                 1,
-                f"{what} runs the main table ({self.tables.names[0]}) only so far, not {others}: the "
-                "outputs only they write stay at 0",
-                "tablebot trace, check and diagram run every table (docs/engine.md, Several tables)",
+                N_("{what} runs the main table ({main}) only so far, not {others}: the outputs only they write "
+                   "stay at 0", what=what, main=self.tables.names[0], others=others),
+                N_("tablebot trace, check and diagram run every table (docs/engine.md, Several tables)"),
                 "note",
             )
         )

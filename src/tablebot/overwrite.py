@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_, Message
 
 #: Files a user writes by hand: tablebot never writes TOML, and a CSV with state and next columns is a table.
 USER_SUFFIXES = {".toml"}
@@ -86,17 +87,20 @@ def writing(path: str | Path, is_user_file: Callable[[Path], bool]) -> None:
         return
     path = Path(path)
     if _is_input(scope, path):
-        raise fail(path, "this command reads this file, so it will not write over it",
-                   "write the output to another file")
+        raise fail(path, N_("this command reads this file, so it will not write over it"),
+                   N_("write the output to another file"))
     key = os.path.realpath(path)
     if key in scope.replaced or not path.is_file() or not is_user_file(path):
         return
     if not scope.force and not scope.offered:
-        raise fail(path, f"{path.name} exists and is a {kind(path)} file: this command never replaces it",
-                   "write into another folder, or move the file away")
+        raise fail(path, N_("{name} exists and is a {kind}: this command never replaces it",
+                              name=path.name, kind=kind(path)),
+                   N_("write into another folder, or move the file away"))
     if not scope.force:
-        raise fail(path, f"{path.name} exists and is a {kind(path)} file: it is not replaced without --force",
-                   f"write to another file, or add --force (the old file is then kept as {path.name}.bak)")
+        raise fail(path, N_("{name} exists and is a {kind}: it is not replaced without --force",
+                              name=path.name, kind=kind(path)),
+                   N_("write to another file, or add --force (the old file is then kept as {name}.bak)",
+                      name=path.name))
     _back_up(scope, path)
 
 
@@ -152,10 +156,11 @@ def not_a_link(path: Path) -> None:
     except OSError:
         special = False  # a dangling link: writing would create whatever it names
     if not special:
-        raise fail(path, f"{path.name} is a symbolic link (to {os.readlink(path)}): tablebot never writes "
-                   "through a link",
-                   "remove the link, or give the path of the file it points to if that is the one to replace")
+        raise fail(path, N_("{name} is a symbolic link (to {target}): tablebot never writes through a link",
+                              name=path.name, target=os.readlink(path)),
+                   N_("remove the link, or give the path of the file it points to if that is the one to replace"))
 
 
-def kind(path: Path) -> str:
-    return "robot or settings" if path.suffix.lower() in USER_SUFFIXES else "table"
+def kind(path: Path) -> Message:
+    """The kind of a user file, as a refusal names it (a word of the reader's language when shown)."""
+    return N_("robot or settings file") if path.suffix.lower() in USER_SUFFIXES else N_("table file")

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.analysis.check import CheckReport
@@ -134,7 +135,8 @@ def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | 
     known = registry.check_targets()
     for name in targets:
         if name not in known:
-            raise fail("--target", f"unknown export target {name!r}", f"use one of {', '.join(known)}")
+            raise fail("--target", N_("unknown export target {name!r}", name=name),
+                       N_("use one of {known}", known=tuple(known)))
     props = project.properties()
     shown.start("steps", 3 + len(props), done=1)  # reading is done; exploring, findings, then each property
     try:

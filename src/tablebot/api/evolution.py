@@ -88,7 +88,8 @@ def evolve(project: Loaded, *, out: PathLike = "out/evolve", objective: str | No
     whole = chosen_table(plan.tables, table)
     check = replace(plan, spec=replace(plan.spec, seeds=parse_seeds(check_seeds, None, "--check-seeds")))
     if batch is not None and batch > budget:
-        raise fail("--batch", f"--batch {batch} is more than --budget {budget}", "give a --batch up to the budget")
+        raise fail("--batch", N_("--batch {batch} is more than --budget {budget}", batch=batch, budget=budget),
+                   N_("give a --batch up to the budget"))
     batch = batch or 16  # a budget below it takes what it has room for (the batch stays one, for resuming)
     setup = _setup(plan, objective, descriptors, cells, budget, batch, seed, max_rows, list(freeze_state),
                    list(freeze_cell), list(project.property_files), whole)
@@ -118,8 +119,9 @@ def _setup(plan: Plan, objective: str | None, descriptors: str | None, cells: in
     # the main table's states
     rows = max_rows or space.default_max_rows(base)
     if rows < len(base.rows):
-        raise fail("--max-rows", f"--max-rows {rows} is fewer than the {len(base.rows)} rows the table starts with",
-                   f"give --max-rows {len(base.rows)} or more")
+        raise fail("--max-rows", N_("--max-rows {rows} is fewer than the {n} rows the table starts with", rows=rows,
+                                    n=len(base.rows)),
+                   N_("give --max-rows {n} or more", n=len(base.rows)))
     limits = space.Limits(rows, space.parse_freeze_states(freeze_state, base), space.parse_freeze_cells(freeze_cell,
                           base), space.default_timer_max(base))
     prover = Prover(files, whole=whole)
@@ -146,9 +148,9 @@ def _own_folder(out: Path, plan: Plan, properties: list[Path]) -> None:
     here = out.resolve()
     for path in inputs:
         if path.is_file() and path.resolve().parent == here:
-            raise fail("--out", f"--out {out} is the folder of {path.name}, which evolve reads: its tables, reports "
-                       "and records would lie among the robot's own files", "give --out a folder of its own, such as "
-                       "out/evolve")
+            raise fail("--out", N_("--out {out} is the folder of {name}, which evolve reads: its tables, reports and "
+                                  "records would lie among the robot's own files", out=str(out), name=path.name),
+                       N_("give --out a folder of its own, such as out/evolve"))
 
 
 def _replay(plan: Plan, seeds: str, grid: list[str], out: Path) -> Any:

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.loading import Loaded, PathLike
@@ -40,9 +41,11 @@ def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathL
 
     backend = registry.exporter(to)
     if backend is None or backend.kind != "export":
-        raise fail("--to", f"unknown export target {to!r}", f"use one of {', '.join(targets())}")
+        raise fail("--to", N_("unknown export target {name!r}", name=to),
+                   N_("use one of {known}", known=tuple(targets())))
     if out is None and backend.needs_out:
-        raise fail("OUTDIR", f"--to {to} needs a folder to write into", f"tablebot export TABLE OUTDIR --to {to}")
+        raise fail("OUTDIR", N_("--to {to} needs a folder to write into", to=to),
+                   N_("tablebot export TABLE OUTDIR --to {to}", to=to))
     options = registry.ExportOptions(into=Path(into) if into is not None else None, lists=_three(lists),
                                      lookup=_lookup(lookup))
     with project.writing():
@@ -54,12 +57,13 @@ def _three(lists: Sequence[str] | None) -> tuple[str, str, str] | None:
     if lists is None:
         return None
     if len(lists) != 3:
-        raise fail("--event-list", f"give three list names (event, action, timer), not {len(lists)}",
-                   "--event-list, --action-list and --timer-list")
+        raise fail("--event-list", N_("give three list names (event, action, timer), not {n}", n=len(lists)),
+                   N_("--event-list, --action-list and --timer-list"))
     return lists[0], lists[1], lists[2]
 
 
 def _lookup(lookup: str) -> Lookup:
     if lookup not in LOOKUPS:
-        raise fail("--lookup", f"unknown lookup {lookup!r}", f"use one of {', '.join(LOOKUPS)}")
+        raise fail("--lookup", N_("unknown lookup {name!r}", name=lookup),
+                   N_("use one of {known}", known=tuple(LOOKUPS)))
     return lookup  # type: ignore[return-value]  # one of LOOKUPS

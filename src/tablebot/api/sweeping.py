@@ -188,10 +188,11 @@ def trace_runs(runs: Traced, total: int) -> list[int]:
         try:
             runs = parse_seeds(runs, None, "--trace")
         except TableBotError as exc:  # the words of --seeds, with a hint about run numbers
-            raise fail("--trace", exc.diagnostics[0].message, "give run numbers: 0,17 or 0..9") from None
+            raise fail("--trace", exc.diagnostics[0].message, N_("give run numbers: 0,17 or 0..9")) from None
     beyond = [k for k in runs if not 0 <= k < total]
     if beyond:
-        raise fail("--trace", f"--trace {beyond[0]}: the sweep has runs 0..{total - 1}", "give run numbers it has")
+        raise fail("--trace", N_("--trace {run}: the sweep has runs 0..{last}", run=beyond[0], last=total - 1),
+                   N_("give run numbers it has"))
     return list(runs)
 
 

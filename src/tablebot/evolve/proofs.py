@@ -202,9 +202,10 @@ def refuse_line_conditions(prover: Prover, machine: Machine) -> None:
         texts = [c.text for c in (prop.cond, prop.when, prop.then) if c is not None]
         if any(LINE_WORD.search(text) for text in texts):
             where = f"{prop.source}:{prop.line}" if prop.line else prop.source
-            raise fail(where, f"property {prop.name} names a file line; evolve adds, removes and moves rows, so "
-                       "a line number would name another row", "write the property with states, events and "
-                       "outputs instead of line (or give evolve other properties with --properties)")
+            raise fail(where, N_("property {name} names a file line; evolve adds, removes and moves rows, so a line "
+                                  "number would name another row", name=prop.name),
+                       N_("write the property with states, events and outputs instead of line (or give evolve "
+                          "other properties with --properties)"))
 
 
 def refuse_fixed(whole: Whole, prover: Prover) -> None:

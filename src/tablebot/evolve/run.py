@@ -30,6 +30,7 @@ from tablebot.evolve.proofs import Prover, Verdict
 from tablebot.evolve.repair import PREFERENCES, Repaired, Step
 from tablebot.evolve.space import Candidate, Gene, start, to_table
 from tablebot.files import append, json_records, write_text
+from tablebot.i18n import N_
 from tablebot.table import Table
 
 TRIES_PER_CHILD = 30  # variations tried per child asked for before a generation gives up on it
@@ -87,9 +88,9 @@ class Store:
     def open(self) -> dict[str, Means]:
         spec_file = self.folder / "spec.json"
         if spec_file.exists() and spec_file.read_text(encoding="utf-8") != self.spec:
-            raise fail(self.folder, "--out holds another evolve run (another table, robot file, world, properties, "
-                       "scenarios, objective, descriptors, limits or seed)",
-                       "give --out a new folder, or delete this one to start over")
+            raise fail(self.folder, N_("--out holds another evolve run (another table, robot file, world, properties, "
+                                          "scenarios, objective, descriptors, limits or seed)"),
+                       N_("give --out a new folder, or delete this one to start over"))
         if not spec_file.exists():
             write_text(spec_file, self.spec)
         # a line cut by a kill is skipped: that candidate runs again
@@ -103,7 +104,7 @@ class Store:
         try:
             return [repaired_from_json(item) for item in json.loads(path.read_text(encoding="utf-8", errors="replace"))]
         except (ValueError, KeyError, TypeError, IndexError):  # written whole, so damaged or edited since
-            notify(Diagnostic(str(path), None, None, "not the repairs evolve writes: the repair is made again",
+            notify(Diagnostic(str(path), None, None, N_("not the repairs evolve writes: the repair is made again"),
                               severity="note"))
             return None
 
@@ -192,10 +193,11 @@ class Evolution:
             mended = [r for r in repairs if r.ok]
             if not mended:
                 failing = sorted({name for r in repairs for name in r.failing})
-                raise fail(self.base.path, f"the table breaks {', '.join(verdict.failed)}, and evolve found no guard "
-                           f"rows that mend it ({', '.join(failing)} still fail)", "mend the table by hand "
-                           "(tablebot check shows the counterexample), or give evolve the properties it must keep "
-                           "with --properties")
+                raise fail(self.base.path, N_("the table breaks {broken}, and evolve found no guard rows that mend it "
+                                               "({failing} still fail)", broken=tuple(verdict.failed),
+                                               failing=tuple(failing)),
+                           N_("mend the table by hand (tablebot check shows the counterexample), or give evolve "
+                              "the properties it must keep with --properties"))
             seeds = []
             for r in mended:
                 key, _ = self.prover.verdict(to_table(r.candidate, self.base))

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 
 from tablebot.diagnostics import fail
 from tablebot.durations import MAX_NUMBER_CHARS
+from tablebot.i18n import N_
 from tablebot.robot import MAX_TIMER, StateId
 from tablebot.table import MAX_SPEED, Row, Table
 
@@ -122,8 +123,8 @@ def parse_freeze_states(values: Sequence[str], table: Table) -> frozenset[StateI
     for value in values:
         for part in (p.strip() for p in value.split(",") if p.strip()):
             if part not in by_text:
-                raise fail("--freeze-state", f"--freeze-state {part}: the table has no state {part}",
-                           f"name states of the table: {', '.join(map(str, table.states))}")
+                raise fail("--freeze-state", N_("--freeze-state {part}: the table has no state {part}", part=part),
+                           N_("name states of the table: {states}", states=tuple(map(str, table.states))))
             out.add(by_text[part])
     return frozenset(out)
 
@@ -140,16 +141,19 @@ def parse_freeze_cells(values: Sequence[str], table: Table) -> frozenset[tuple[i
         for part in (p.strip() for p in value.split(",") if p.strip()):
             found = FREEZE_RE.match(part)
             if not found or len(found[1]) > MAX_NUMBER_CHARS:  # int() of a longer number may fail
-                raise fail("--freeze-cell", f"--freeze-cell: {part!r} does not name a cell",
-                           'write "line 5 timer", "line 5 M1", "line 5 next" or "line 5" (the whole row)')
+                raise fail("--freeze-cell", N_("--freeze-cell: {part!r} does not name a cell", part=part),
+                           N_('write "line 5 timer", "line 5 M1", "line 5 next" or "line 5" (the whole row)'))
             line = int(found[1])
             if line not in lines:
-                raise fail("--freeze-cell", f"--freeze-cell: line {line} of {table.path} is not a row of the table",
-                           f"rows are on lines {min(lines)}..{max(lines)}")
+                raise fail("--freeze-cell", N_("--freeze-cell: line {line} of {path} is not a row of the table",
+                                               line=line, path=str(table.path)),
+                           N_("rows are on lines {first}..{last}", first=min(lines), last=max(lines)))
             column = found[2]
             if column is not None and column.lower() not in columns:
-                raise fail("--freeze-cell", f"--freeze-cell: {column!r} is not a cell evolution changes",
-                           f"name one of {', '.join(columns.values())}, or give just the line to freeze the row")
+                raise fail("--freeze-cell", N_("--freeze-cell: {column!r} is not a cell evolution changes",
+                                               column=column),
+                           N_("name one of {known}, or give just the line to freeze the row",
+                              known=tuple(columns.values())))
             out.add((line, WHOLE_ROW if column is None else columns[column.lower()]))
     return frozenset(out)
 

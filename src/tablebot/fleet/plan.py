@@ -36,6 +36,7 @@ from tablebot.fleet.store import Store, cell, csv_text, decimals, read_results, 
 from tablebot.fleet.tables import main_table_only, tables_digest
 from tablebot.fleet.work import Job
 from tablebot.formats.table_read import load_table, resolve_table_path
+from tablebot.i18n import N_
 from tablebot.jit import sources_digest
 from tablebot.machine import FLAT_BITS, Machine, compile_table
 from tablebot.robot import load_robot
@@ -187,8 +188,8 @@ class Plan:
                     setting = " ".join(f"{a.key}={v}" for a, v in zip(axes, values, strict=True))
                     raise fail(
                         "--grid",
-                        f"--grid {setting}: {exc.diagnostics[0].message}",
-                        "choose --grid values the simulated robot can take",
+                        N_("--grid {setting}: {problem}", setting=setting, problem=exc.diagnostics[0].message),
+                        N_("choose --grid values the simulated robot can take"),
                     ) from None
                 found.setdefault(_body(scene), scene)
         return [list(found.values()) for found in bodies]
@@ -205,8 +206,8 @@ class Plan:
                     except TableBotError as exc:  # the world's words, about the option
                         raise fail(
                             "--grid",
-                            f"--grid start: {exc.diagnostics[0].message}",
-                            "choose a start pose inside the walls, clear of walls and obstacles",
+                            N_("--grid start: {problem}", problem=exc.diagnostics[0].message),
+                            N_("choose a start pose inside the walls, clear of walls and obstacles"),
                         ) from None
 
     def traced(self, index: int) -> Fleet:
@@ -301,8 +302,12 @@ def make_plan(
     if machine.arrays is None:
         raise fail(
             parsed.path,
-            f"the table has {len(parsed.events)} event columns; the compiled fleet takes at most {FLAT_BITS}",
-            "simulate it one robot at a time with tablebot sim, or use fewer inputs",
+            N_(
+                "the table has {n} event columns; the compiled fleet takes at most {most}",
+                n=len(parsed.events),
+                most=FLAT_BITS,
+            ),
+            N_("simulate it one robot at a time with tablebot sim, or use fewer inputs"),
         )
     layer, robot_world = robot_layer(parsed.robot)
     loaded = [load_world(w) for w in worlds] or [find_world(parsed, None, robot_world)]

@@ -10,6 +10,7 @@ from typing import Any
 
 from tablebot.diagnostics import fail
 from tablebot.fleet.robots import Pose, RobotSpec
+from tablebot.i18n import N_
 from tablebot.machine import Machine
 from tablebot.sim.model.scene import Scene, check_start, prepare
 from tablebot.sim.model.world import World, inside
@@ -87,8 +88,13 @@ def with_start(scene: Scene, start: Pose | None) -> Scene:
     if world.walls and not inside(world.walls, (x, y)):
         raise fail(
             world.path,
-            f"the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the arena walls",
-            "choose a start inside the [arena] walls",
+            N_(
+                "the robot's start pose ({x:g}, {y:g}, heading {heading:g}°) lies outside the arena walls",
+                x=x,
+                y=y,
+                heading=heading,
+            ),
+            N_("choose a start inside the [arena] walls"),
         )
     check_start(world, scene.geometry, scene.P)
     return replace(scene, world=world)

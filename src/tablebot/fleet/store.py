@@ -23,6 +23,7 @@ from tablebot.diagnostics import Diagnostic, fail, notify
 from tablebot.files import atomic_write, remove, write_text
 from tablebot.fleet.spec import chunks
 from tablebot.formats.trace_lines import exact_round
+from tablebot.i18n import N_
 
 if TYPE_CHECKING:
     from tablebot.fleet.spec import SweepSpec
@@ -46,9 +47,11 @@ class Store:
         if spec_file.exists() and spec_file.read_text(encoding="utf-8") != text:
             raise fail(
                 self.folder,
-                "--out holds the results of a different sweep (another table, robot file, "
-                "world, grid, seeds, length or simulator version)",
-                "give --out a new folder, or delete this one to start over",
+                N_(
+                    "--out holds the results of a different sweep (another table, robot file, "
+                    "world, grid, seeds, length or simulator version)"
+                ),
+                N_("give --out a new folder, or delete this one to start over"),
             )
         self.parts.mkdir(parents=True, exist_ok=True)
         if not spec_file.exists():
@@ -78,8 +81,12 @@ class Store:
                 str(part),
                 None,
                 None,
-                "this part of the sweep is damaged (not the rows this sweep "
-                f"writes for runs {a}..{b - 1}): its runs are made again",
+                N_(
+                    "this part of the sweep is damaged (not the rows this sweep writes for runs {first}..{last}): "
+                    "its runs are made again",
+                    first=a,
+                    last=b - 1,
+                ),
                 severity="note",
             )
         )

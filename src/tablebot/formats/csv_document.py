@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 from tablebot.csvtext import SEP_RE, detect_delimiter, split_records
 from tablebot.diagnostics import fail
+from tablebot.i18n import N_
 
 
 class Refused(ValueError):
@@ -65,8 +66,9 @@ class CsvDocument:
     @classmethod
     def from_bytes(cls, data: bytes, path: str) -> CsvDocument:
         if len(data) > MAX_TABLE_BYTES:
-            raise fail(path, f"the file has {len(data):,} bytes; the studio edits tables up to "
-                       f"{MAX_TABLE_BYTES:,}", "edit it in a spreadsheet or split it")
+            raise fail(path, N_("the file has {size:,} bytes; the studio edits tables up to {limit:,}",
+                                size=len(data), limit=MAX_TABLE_BYTES),
+                       N_("edit it in a spreadsheet or split it"))
         try:
             if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
                 text, encoding = data.decode("utf-16"), "utf-16"
@@ -76,9 +78,9 @@ class CsvDocument:
                 text, encoding = data.decode("utf-8"), "utf-8"
         except UnicodeDecodeError as exc:
             line = data[: exc.start].count(b"\n") + 1
-            raise fail(path, f"byte {exc.start} is not {exc.encoding.upper()} text: the studio edits tables saved "
-                       "as UTF-8 or UTF-16", "save it as UTF-8 (Excel: CSV UTF-8), or edit it in a spreadsheet",
-                       line) from None
+            raise fail(path, N_("byte {at} is not {encoding} text: the studio edits tables saved as UTF-8 or UTF-16",
+                                at=exc.start, encoding=exc.encoding.upper()),
+                       N_("save it as UTF-8 (Excel: CSV UTF-8), or edit it in a spreadsheet"), line) from None
         return cls.from_text(text, encoding, path)
 
     @classmethod

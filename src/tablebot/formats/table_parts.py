@@ -10,6 +10,7 @@ from pathlib import Path
 
 from tablebot.csvtext import Cell
 from tablebot.diagnostics import Collector, fail
+from tablebot.i18n import N_
 from tablebot.robot import Robot
 from tablebot.robot_tables import CrossEvent, TableSpec, groups_of, parse_cross, spec_robot, tables_of
 from tablebot.table import Row, expand_groups
@@ -28,9 +29,9 @@ def spec_of(path: Path, robot: Robot) -> TableSpec | None:
     for spec in specs:
         if (base / spec.file).resolve() == path.resolve():
             return spec
-    raise fail(path, f"this table is none of the tables of {robot.source} "
-               f"({', '.join(f'{s.name} = {s.file}' for s in specs)})",
-               "give the robot's folder or robot file, or add this table to its [tables]")
+    raise fail(path, N_("this table is none of the tables of {robot} ({tables})", robot=str(robot.source),
+                        tables=tuple(f"{s.name} = {s.file}" for s in specs)),
+               N_("give the robot's folder or robot file, or add this table to its [tables]"))
 
 
 def robot_for_table(path: Path, robot: Robot) -> tuple[Robot, str]:

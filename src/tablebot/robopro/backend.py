@@ -73,12 +73,12 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
     into = options.into
     names = options.lists or DEFAULT_NAMES
     if into is None:
-        raise fail("--into", "robopro-rpp needs the program to write into", "add --into ENGINE.rpp")
+        raise fail("--into", N_("robopro-rpp needs the program to write into"), N_("add --into ENGINE.rpp"))
     _refuse_cross(machine)
     encoded = lists.encode(machine.table)
     named = dict(zip(names, (encoded.event, encoded.action, encoded.timer), strict=True))
     if len(named) < 3:
-        raise fail("--event-list", "the three list names must differ", "give each list its own name")
+        raise fail("--event-list", N_("the three list names must differ"), N_("give each list its own name"))
     target = out_folder(out, "OUTDIR") / into.name if out else None
     written, from_csv = rpp.write_lists(into, named, target)
     return Exported((written,), (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),

@@ -21,6 +21,7 @@ from tablebot.csvtext import read_bytes
 from tablebot.diagnostics import Collector, fail
 from tablebot.escape import xml_attr
 from tablebot.files import write_bytes
+from tablebot.i18n import N_
 
 LIST_CLASS = "ftProDataArray1D"
 DEFAULT_NAMES = ("Event", "Action", "Timer")
@@ -219,13 +220,13 @@ def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]],
     try:
         text = data.decode(encoding)
     except UnicodeDecodeError as exc:
-        raise fail(rpp, f"not a ROBO Pro program: byte {exc.start} is not {encoding} text",
-                   "give a .rpp file saved by ROBO Pro") from None
+        raise fail(rpp, N_("not a ROBO Pro program: byte {at} is not {encoding} text", at=exc.start, encoding=encoding),
+                   N_("give a .rpp file saved by ROBO Pro")) from None
     except LookupError:
-        raise fail(rpp, f"unknown text encoding {encoding!r} in the XML declaration",
-                   "save the program again in ROBO Pro (it writes UTF-8)", 1) from None
+        raise fail(rpp, N_("unknown text encoding {encoding!r} in the XML declaration", encoding=encoding),
+                   N_("save the program again in ROBO Pro (it writes UTF-8)"), 1) from None
     if "<cvg" not in text[:4096] and LIST_CLASS not in text:
-        raise fail(rpp, "not a ROBO Pro program (no <cvg> document element)", "give a .rpp file", 1, 1)
+        raise fail(rpp, N_("not a ROBO Pro program (no <cvg> document element)"), N_("give a .rpp file"), 1, 1)
     new = rewrite(text, lists, rpp)
     target = out or rpp
     if out is None:

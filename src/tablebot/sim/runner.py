@@ -15,6 +15,7 @@ from tablebot.diagnostics import fail
 from tablebot.engine import Engine
 from tablebot.engine.as_one import RobotEngine
 from tablebot.formats.inputs_csv import TickInput
+from tablebot.i18n import N_
 from tablebot.loop import RunEnd, RunInfo, Sink, TickBlock
 from tablebot.loop import run as run_loop
 from tablebot.sim import columns as L
@@ -211,8 +212,10 @@ def ticks_for(scene: Scene, seconds: float) -> int:
     """The ticks in ``seconds`` of robot time (at least one); more than MAX_TICKS are refused."""
     ticks = max(1, round(seconds / scene.tick_s))
     if ticks > MAX_TICKS:
-        raise fail("--seconds", f"{seconds:g} s at tick_ms = {scene.table.robot.tick_ms} is {ticks:,} ticks; "
-                   f"a run holds at most {MAX_TICKS:,}", f"simulate at most {MAX_TICKS * scene.tick_s:g} s")
+        raise fail("--seconds", N_("{seconds:g} s at tick_ms = {tick_ms} is {ticks:,} ticks; a run holds at most "
+                                   "{most:,}", seconds=seconds, tick_ms=scene.table.robot.tick_ms, ticks=ticks,
+                                   most=MAX_TICKS),
+                   N_("simulate at most {most:g} s", most=MAX_TICKS * scene.tick_s))
     return ticks
 
 

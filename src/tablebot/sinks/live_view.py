@@ -14,6 +14,7 @@ from rich.panel import Panel
 from rich.table import Table
 from rich.text import Text
 
+from tablebot.i18n import _
 from tablebot.loop import Lateness, RunEnd, RunInfo, TickBlock
 from tablebot.table import MAX_SPEED
 
@@ -79,16 +80,18 @@ class LiveView:
         assert self.info is not None
         machine = self.info.engine.machine
         last = self.last
-        title = Text(f"tablebot run — {plain(self.info.target)}" + (f" ({plain(self.device)})" if self.device else ""))
+        title = Text(_("tablebot run — {target}").format(target=plain(self.info.target))
+                     + (f" ({plain(self.device)})" if self.device else ""))
         if not last:
-            return Panel(Text("connecting…", style="dim"), title=title, title_align="left")
+            return Panel(Text(_("connecting…"), style="dim"), title=title, title_align="left")
         state = machine.states[last["state"]]
-        head = Text(f"state {plain(str(state))}", style="bold")
+        head = Text(_("state {state}").format(state=plain(str(state))), style="bold")
         name = machine.table.state_name(state)
         if name:
             head.append(f"  {plain(name)}", style="cyan")
         seconds = (last["tick"] + 1) * self.info.tick_s
-        head.append(f"   timer {last['timer']}   t {seconds:8.2f} s   tick {last['tick']}")
+        head.append(_("   timer {timer}   t {seconds:8.2f} s   tick {tick}").format(
+            timer=last["timer"], seconds=seconds, tick=last["tick"]))
         return Panel(Group(head, self._inputs(last["mask"]), self._outputs(last), self._lateness(last)),
                      title=title, title_align="left")
 
@@ -114,7 +117,7 @@ class LiveView:
             shown = motor_bar(int(value)) if name in robot.motors else Text(f"{'▮' * int(value):<8} {value}")
             grid.add_row(label, shown)
         for name, value in zip(robot.counter_names, last["counters"], strict=True):
-            grid.add_row(Text(plain(name)), Text(f"{value} pulses to go"))
+            grid.add_row(Text(plain(name)), Text(_("{value} pulses to go").format(value=value)))
         return grid
 
     def _lateness(self, last: dict[str, Any]) -> Text:
@@ -122,4 +125,5 @@ class LiveView:
             return Text("")
         count = self.lateness.count if self.lateness is not None else 0
         style = "red" if count else "dim"
-        return Text(f"ticks late {count}   this tick {last['late_ms']:.1f} ms late", style=style)
+        return Text(_("ticks late {count}   this tick {ms:.1f} ms late").format(count=count, ms=last["late_ms"]),
+                    style=style)

@@ -114,8 +114,8 @@ class Arena:
                                                                           tables=tables)
             robot_world = loaded.robot_world()
             if robot_world is not None and robot_world.exists() and not robot_world.is_file():
-                raise fail(robot_world, "the robot's world is not a regular file (a folder, pipe or device)",
-                           "name a world .toml file in the robot file's [sim] section")
+                raise fail(robot_world, N_("the robot's world is not a regular file (a folder, pipe or device)"),
+                           N_("name a world .toml file in the robot file's [sim] section"))
             base: World = loaded.default_world()
             world = moved(base, settings.start, settings.lamp)
             overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}

@@ -8,6 +8,7 @@ from typing import Any
 
 from tablebot.diagnostics import fail
 from tablebot.formats.trace_lines import parse_trace
+from tablebot.i18n import N_
 
 #: The largest trace the browser's player opens (it holds every column in the page); tablebot itself reads
 #: traces up to :data:`tablebot.formats.trace_lines.MAX_TRACE_BYTES`.
@@ -31,13 +32,14 @@ def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
     """Parse JSON Lines (through the one trace reader, :func:`tablebot.formats.trace_lines.parse_trace`); every bad line
     is reported (the first ten) with its number."""
     if len(data) > MAX_PLAYER_TRACE_BYTES:
-        raise fail(name, f"the trace has {len(data):,} bytes; the player opens traces up to {MAX_PLAYER_TRACE_BYTES:,}",
-                   "cut the run shorter (--seconds) or open a part of it")
+        raise fail(name, N_("the trace has {size:,} bytes; the player opens traces up to {limit:,}", size=len(data),
+                            limit=MAX_PLAYER_TRACE_BYTES),
+                   N_("cut the run shorter (--seconds) or open a part of it"))
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise fail(name, f"byte {exc.start} is not UTF-8 text", "a trace is JSON Lines text") from None
+        raise fail(name, N_("byte {at} is not UTF-8 text", at=exc.start), N_("a trace is JSON Lines text")) from None
     lines = parse_trace(text, name, REQUIRED)
     if not lines:
-        raise fail(name, "the trace has no lines", "open a trace.jsonl written by tablebot")
+        raise fail(name, N_("the trace has no lines"), N_("open a trace.jsonl written by tablebot"))
     return lines

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from tablebot.i18n import N_
 from tablebot.sensors import Sensor
 from tablebot.sim import columns as L
 from tablebot.tomlfile import Source, known_keys, number, table_of
@@ -177,14 +178,14 @@ def merged(*layers: dict[str, Any]) -> Params:
 
 def problems(params: Params) -> list[tuple[str, str, str]]:
     """Combinations no single value shows: (section, key, message)."""
-    found = []
+    found: list[tuple[str, str, str]] = []
     bat, body = params["battery"], params["body"]
     if bat["empty_volts"] >= bat["full_volts"]:
-        found.append(("battery", "empty_volts", "empty_volts must be below full_volts"))
+        found.append(("battery", "empty_volts", N_("empty_volts must be below full_volts")))
     if params["distance"]["blind"] >= params["distance"]["range"]:
-        found.append(("distance", "blind", "blind must be below range"))
+        found.append(("distance", "blind", N_("blind must be below range")))
     if body["bumper_overlap"] > body["half_width"]:
-        found.append(("body", "bumper_overlap", "bumper_overlap must not exceed half_width"))
+        found.append(("body", "bumper_overlap", N_("bumper_overlap must not exceed half_width")))
     try:
         speed_per_volt(params)
     except ValueError as exc:

@@ -15,6 +15,7 @@ import numpy as np
 
 from tablebot.diagnostics import Diagnostic, TableBotError, fail
 from tablebot.engine.as_one import robot_machine
+from tablebot.i18n import N_, NP_, Message
 from tablebot.machine import FLAT_BITS, Machine
 from tablebot.robot import Robot
 from tablebot.sim import columns as L
@@ -101,8 +102,9 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
         machine = robot_machine(tables)
     robot_params = robot_params or {}
     params = _unwire_absent_sensors(merged(robot_params, world.params, overrides or {}), table.robot)
-    found = [(section, key, message, "fix the value in the world or robot file")
-             for section, key, message in problems(params)]
+    found: list[tuple[str, str, str, str]] = [
+        (section, key, message, N_("fix the value in the world or robot file"))
+        for section, key, message in problems(params)]
     found += _wiring_errors(params, table.robot)
     if found:
         raise TableBotError(Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
@@ -153,43 +155,58 @@ def _unwire_absent_sensors(params: Params, robot: Robot) -> Params:
 def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, str]]:
     """Drive motors must be two motors of the robot; a sensor must name an input ("" = not connected)."""
     if len(robot.motors) < 2:
-        return [("wiring", "right_motor", f"the simulated robot drives two wheels, but robot {robot.name} has "
-                 f"{len(robot.motors) or 'no'} motor{'s' * (len(robot.motors) != 1)}",
-                 "add a right and a left motor to [motors] in the robot file")]
-    errors = []
+        return [("wiring", "right_motor", NP_("the simulated robot drives two wheels, but robot {robot} has {n} motor",
+                                              "the simulated robot drives two wheels, but robot {robot} has {n} "
+                                              "motors", len(robot.motors), robot=robot.name),
+                 N_("add a right and a left motor to [motors] in the robot file"))]
+    errors: list[tuple[str, str, str, str]] = []
     for role, name in params.wiring.items():
         motor = role.endswith("motor")
         wanted = robot.motors if motor else robot.inputs
         if name in wanted or (not motor and name == ""):
             continue
-        kind = "motor" if motor else "input"
-        unwired = "" if motor else ' ("none": not connected)'
-        errors.append(("wiring", role, f"wiring: {role} = {name!r} is not {'a' if motor else 'an'} {kind} of "
-                       f"robot {robot.name}", f"its {kind}s are {', '.join(wanted) or 'none'}; set [wiring] {role} "
-                       f"in the world or [sim.wiring] in the robot file{unwired}"))
+        errors.append(("wiring", role, _not_wired(role, name, motor, robot.name), _wire_hint(role, wanted, motor)))
     declared = {s.name: s for s in robot.sensors}
     for role, name in params.wiring.items():
         if name in declared:
-            errors.append(("wiring", role, f"wiring: {role} = {name!r}, but {name} is declared in [sensors] as a "
-                           f"{declared[name].model} sensor", f"wire {role} to another input, or to \"none\""))
+            errors.append(("wiring", role, N_("wiring: {role} = {name!r}, but {name} is declared in [sensors] as a "
+                                              "{model} sensor", role=role, name=name, model=declared[name].model),
+                           N_('wire {role} to another input, or to "none"', role=role)))
     right, left = params.wiring["right_motor"], params.wiring["left_motor"]
     if right == left and right in robot.motors:
-        errors.append(("wiring", "left_motor", f"wiring: right_motor and left_motor are both {right}",
-                       "the simulated robot drives two wheels: give each its own motor"))
+        errors.append(("wiring", "left_motor", N_("wiring: right_motor and left_motor are both {right}", right=right),
+                       N_("the simulated robot drives two wheels: give each its own motor")))
     return errors
+
+
+def _not_wired(role: str, name: str, motor: bool, robot: str) -> Message:
+    if motor:
+        return N_("wiring: {role} = {name!r} is not a motor of robot {robot}", role=role, name=name, robot=robot)
+    return N_("wiring: {role} = {name!r} is not an input of robot {robot}", role=role, name=name, robot=robot)
+
+
+def _wire_hint(role: str, wanted: tuple[str, ...] | list[str], motor: bool) -> Message:
+    known = tuple(wanted) or (N_("none"),)
+    if motor:
+        return N_("its motors are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file",
+                  known=known, role=role)
+    return N_('its inputs are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file ("none": '
+              "not connected)", known=known, role=role)
 
 
 def _check_sensor_count(robot: Robot) -> None:
     if len(robot.sensors) > L.MAX_SENSORS:
-        raise fail(robot.source, f"the simulator models at most {L.MAX_SENSORS} sensors in [sensors], and robot "
-                   f"{robot.name} declares {len(robot.sensors)}", "declare fewer sensors", robot.line("sensors"))
+        raise fail(robot.source, N_("the simulator models at most {most} sensors in [sensors], and robot {robot} "
+                                     "declares {n}", most=L.MAX_SENSORS, robot=robot.name, n=len(robot.sensors)),
+                   N_("declare fewer sensors"), robot.line("sensors"))
 
 
 def _check_events(table: Table) -> None:
     """The compiled simulator looks each tick's row up in a flat table of every event set: 2**events per state."""
     if len(table.events) > FLAT_BITS:
-        raise fail(table.path, f"the table has {len(table.events)} event columns (T, inputs and counters); the "
-                   f"simulator takes at most {FLAT_BITS}", "simulate a table that looks at fewer inputs", 1)
+        raise fail(table.path, N_("the table has {n} event columns (T, inputs and counters); the simulator takes at "
+                                   "most {most}", n=len(table.events), most=FLAT_BITS),
+                   N_("simulate a table that looks at fewer inputs"), 1)
 
 
 def _check_tick(params: Params, robot: Robot) -> None:
@@ -197,10 +214,11 @@ def _check_tick(params: Params, robot: Robot) -> None:
     top = top_speed(params)
     step = robot.seconds(top)
     if step > MAX_STEP_M:
-        raise fail(robot.source, f"tick_ms = {robot.tick_ms} is too coarse for the simulator: the robot would move "
-                   f"up to {100 * step:.0f} cm per tick, through thin walls",
-                   f"simulate with tick_ms = {math.floor(MAX_STEP_M / top * 1000)} or less (the engine and the "
-                   "firmware take any tick)", robot.line("", "tick_ms"))
+        raise fail(robot.source, N_("tick_ms = {tick_ms} is too coarse for the simulator: the robot would move up "
+                                     "to {cm:.0f} cm per tick, through thin walls", tick_ms=robot.tick_ms,
+                                     cm=100 * step),
+                   N_("simulate with tick_ms = {most} or less (the engine and the firmware take any tick)",
+                      most=math.floor(MAX_STEP_M / top * 1000)), robot.line("", "tick_ms"))
 
 
 def check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
@@ -212,6 +230,7 @@ def check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
     body_corners(s, P[0], corners)
     hit = deepest_contact(s, P[0], corners, geo.verts, geo.pstart, geo.pbound, geo.circles)
     if hit[0] > 1e-9:
-        raise fail(world.path, f"the robot at its start pose ({x:g}, {y:g}, heading {heading:g}°) overlaps "
-                   f"a wall or obstacle near ({hit[3]:.2f}, {hit[4]:.2f})",
-                   "move [start] at, or turn it with heading", world.line("start", "at"))
+        raise fail(world.path, N_("the robot at its start pose ({x:g}, {y:g}, heading {heading:g}°) overlaps a wall "
+                                   "or obstacle near ({hx:.2f}, {hy:.2f})", x=x, y=y, heading=heading,
+                                   hx=hit[3], hy=hit[4]),
+                   N_("move [start] at, or turn it with heading"), world.line("start", "at"))
