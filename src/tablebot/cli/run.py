@@ -71,17 +71,28 @@ def _drive(connection: Connection, seconds: float | None, out: Path | None, quie
         sinks.append(LiveView(err_console, opened.device))
     if not quiet:
         err_console.print(terminal(_("running {table} on {where} ({device}); Ctrl-C stops it").format(
-            table=machine.table.path, where=opened.where, device=opened.device)))
+            table=machine.table.path, where=opened.where, device=localise(opened.device))))
     done = connection.run(seconds, out, sinks)
     if not quiet:
         _report(done, machine)
     elif done.end.exit_code:  # quiet hides the live view and the summary, never why a run failed
         end = done.end
         why = f" — {localise(end.message)}" if end.message else ""
-        err_console.print(terminal(_("ran {ticks} ticks: {reason}").format(ticks=end.ticks, reason=end.reason) + why))
+        ran = _("ran {ticks} ticks: {reason}").format(ticks=end.ticks, reason=said(end.reason))
+        err_console.print(terminal(ran + why))
         for path in done.files:
             err_console.print(terminal(_("kept {path}").format(path=path)))
     return done
+
+
+#: Why a run ended (tablebot.loop.EXIT_CODES' keys, which records keep as they are), in the reader's words.
+REASONS = {"done": N_("done"), "stopped": N_("stopped"), "error": N_("error"), "link_lost": N_("link lost"),
+           "watchdog": N_("watchdog"), "behind": N_("fell behind"), "interrupted": N_("interrupted"),
+           "terminated": N_("terminated")}
+
+
+def said(reason: str) -> str:
+    return str(localise(REASONS.get(reason, reason)))
 
 
 def _report(done: LiveRun, machine: Machine) -> None:
@@ -90,7 +101,7 @@ def _report(done: LiveRun, machine: Machine) -> None:
     seconds = end.ticks * machine.table.robot.tick_s
     why = f" — {localise(end.message)}" if end.message else ""
     console.print(terminal(_("ran {ticks} ticks ({seconds:.2f} s): {reason}").format(
-        ticks=end.ticks, seconds=seconds, reason=end.reason) + why))
+        ticks=end.ticks, seconds=seconds, reason=said(end.reason)) + why))
     if end.late_ticks:
         console.print(ngettext("{n} tick started late (worst {ms:.1f} ms)",
                                "{n} ticks started late (worst {ms:.1f} ms)", end.late_ticks).format(

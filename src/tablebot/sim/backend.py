@@ -37,7 +37,7 @@ def open_sim(machine: Machine, link: LinkOptions) -> Opened:
     bot = SimRobot(scene_for(machine.table, machine, Path(world) if world else None, tables=tables), seed)
     bot.write((0,) * len(machine.output_names))  # compiles the one-tick physics now, not in the first tick
     bot.reset(seed=seed)
-    return Opened(bot, "sim", f"simulated, seed {seed}")
+    return Opened(bot, "sim", N_("simulated, seed {seed}", seed=seed))
 
 
 SIM = register(LiveBackend(name="sim", makes="the simulator, driven in real time by `tablebot run`",

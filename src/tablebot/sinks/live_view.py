@@ -14,7 +14,7 @@ from rich.panel import Panel
 from rich.table import Table
 from rich.text import Text
 
-from tablebot.i18n import _
+from tablebot.i18n import _, localise
 from tablebot.loop import Lateness, RunEnd, RunInfo, TickBlock
 from tablebot.table import MAX_SPEED
 
@@ -81,7 +81,7 @@ class LiveView:
         machine = self.info.engine.machine
         last = self.last
         title = Text(_("tablebot run — {target}").format(target=plain(self.info.target))
-                     + (f" ({plain(self.device)})" if self.device else ""))
+                     + (f" ({plain(str(localise(self.device)))})" if self.device else ""))
         if not last:
             return Panel(Text(_("connecting…"), style="dim"), title=title, title_align="left")
         state = machine.states[last["state"]]
