@@ -54,7 +54,7 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
         name = normalise_header(text)  # the parser's own reading of a header cell
         kind_name = table_read._classify(name, robot) if name else None
         kind, base = kind_name if kind_name else ("unknown", name)
-        label = robot.labels.get(base, "timer ran out" if base == "T" else "")
+        label = robot.labels.get(base, N_("timer ran out") if base == "T" else "")  # said in the tab's language
         out.append({"kind": kind, "name": base, "label": label})
     return out
 

@@ -37,6 +37,29 @@ export function setLanguage(lang, keep = false) {
 /** The language in use. */
 export function currentLanguage() { return language; }
 
+// Intl's formats, made once per language and digits (a frame's status line asks for several numbers a tick)
+const formats = new Map();
+
+/** `value` as the page's language writes a number for a person (1,25 in German, 1.25 in English; no thousands
+ * grouping, as the command line's tablebot.i18n.number): every number the page draws comes through here, so
+ * none is written in English by a toFixed. At most `most` decimals, at least `least` (trailing zeros dropped
+ * down to it). Only for text: a cell's value and what is saved stay as the table file has them. */
+export function number(value, most = 2, least = 0) {
+  const lang = language === PSEUDO ? "en" : language;
+  const key = `${lang} ${most} ${least}`;
+  if (!formats.has(key)) {
+    formats.set(key, new Intl.NumberFormat(lang, { maximumFractionDigits: most, minimumFractionDigits: least,
+      useGrouping: false }));
+  }
+  return formats.get(key).format(value);
+}
+
+/** The hour and minute of `ms` (since the epoch) as the page's language writes a time of day (14:05). */
+export function clock(ms) {
+  const lang = language === PSEUDO ? "en" : language;
+  return new Date(ms).toLocaleTimeString(lang, { hour: "2-digit", minute: "2-digit" });
+}
+
 /** The text of `key` in the language in use, its `{name}` fields filled from `args`. */
 export function t(key, args = {}) {
   const catalog = language === "de" ? DE : EN;

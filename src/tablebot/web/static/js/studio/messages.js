@@ -1,7 +1,7 @@
 // What the page does with each message from the server: mostly a change of state (the panels subscribed
 // to it redraw), sometimes a view's own content (the grid's rows, the diagram's SVG, a trace to play).
 import { addOption, byId } from "../lib/dom.js";
-import { t } from "../lib/words.js";
+import { clock, t } from "../lib/words.js";
 import { ask } from "./ask.js";
 import { banner } from "./banner.js";
 import { byKind } from "./protocol.js";
@@ -78,8 +78,6 @@ function conflict(store, send, drafts, m) {
       m.how === "deleted" ? t("conflict.deleted_answer") : t("conflict.answer", { backup: m.backup })],
     [...answers, [t("conflict.later"), later]], later);
 }
-
-const clock = (ms) => new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit" });
 
 // Edits this browser kept for the table just opened, which its server session does not have (the page was
 // reloaded, or its connection dropped): put them back, or drop them.

@@ -1,6 +1,6 @@
 // The parts of the page drawn from the store: each function subscribes to the keys it shows.
 import { addOption, all, button, byId, make } from "../lib/dom.js";
-import { t } from "../lib/words.js";
+import { number, t } from "../lib/words.js";
 import { describeTick } from "../views/player.js";
 import { banner } from "./banner.js";
 import { arenaNote } from "./messages.js";
@@ -29,7 +29,7 @@ function showAnalysis(store, views) {
     const [text, kind] = countsText(m);
     byId("counts").textContent = text;
     byId("counts").className = "counts " + kind;
-    byId("analysis-time").textContent = t("counts.checked", { ms: m.ms });
+    byId("analysis-time").textContent = t("counts.checked", { ms: number(m.ms, 1) });
   });
   // the robot keeps running the table it was started with: while the edited one does not read, say so
   store.on(["analysis", "arenaOk", "mode"], ({ analysis, arenaOk, mode }) => {

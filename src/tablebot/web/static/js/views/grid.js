@@ -2,18 +2,19 @@
 // its time beside it; errors on their cells, findings on their rows, the fired row and current state lit.
 // User text only ever reaches the page through textContent and input values, never as HTML.
 import { make } from "../lib/dom.js";
-import { t } from "../lib/words.js";
+import { number, t } from "../lib/words.js";
 
 const RANK = { error: 3, warning: 2, info: 1 };
 const TOGGLES = ["event", "dir"];
 const MOVES = { ArrowUp: -1, ArrowDown: 1, Enter: 1 };
 
-/** A timer's ticks as time ("8.95 s", "500 ms"); "" for anything else. */
+/** A timer's ticks as time in the page's language ("8,95 s" in German, "500 ms"); "" for anything else. The
+ * cell itself keeps the ticks as typed: this is only the time shown beside them. */
 function timeText(value, tickMs) {
   const v = value.trim();
   if (!/^\d+$/.test(v) || +v <= 0) return "";
   const ms = +v * tickMs;
-  return ms >= 1000 ? (ms / 1000).toFixed(ms % 1000 ? 2 : 0).replace(/\.?0+$/, "") + " s" : ms + " ms";
+  return ms >= 1000 ? number(ms / 1000) + " s" : number(ms) + " ms";
 }
 
 export class Grid {

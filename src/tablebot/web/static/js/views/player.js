@@ -1,9 +1,10 @@
 // The trace player: a trace's columns (tick, event, row, state, timer, outputs, pose...) scrubbed and
 // played through the same views as the live robot: arena, grid, diagram, timeline and the status line.
 import { all, byId } from "../lib/dom.js";
-import { t as word } from "../lib/words.js";
+import { number, t as word } from "../lib/words.js";
 
-const seconds = (ticks, machine) => (ticks * machine.tick_ms / 1000).toFixed(2) + " s";
+// two decimals always, so the status line does not jump while a trace plays (1,80 s then 1,81 s)
+const seconds = (ticks, machine) => number(ticks * machine.tick_ms / 1000, 2, 2) + " s";
 
 /** One tick as a line a person reads; t: {tick, state, timer, event, row, outputs: {name: value}}. */
 export function describeTick(machine, t) {
@@ -163,7 +164,7 @@ export class Player {
 export function wirePlayerControls(player) {
   byId("tplay").addEventListener("click", () => {
     if (player.playing) player.pause(); else player.play();
-    byId("tplay").textContent = player.playing ? "❚❚ Pause" : "▶ Play";
+    byId("tplay").textContent = word(player.playing ? "live.pause" : "live.play");
   });
   byId("scrub").addEventListener("input", (e) => player.seek(+e.target.value));
   for (const b of all("[data-tspeed]")) {
