@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from fleet_phases import measure as phases  # benchmarks/fleet_phases.py
+from kernel import baseline_sources  # benchmarks/kernel.py
 from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,22 +35,9 @@ CPU_S: list[float] = []  # CPU seconds (user + system) of each tablebot() proces
 
 
 def sources(rev: str | None) -> str:
-    """The ``src`` folder of revision ``rev`` (exported once into the temporary folder), or this tree's (None)."""
-    if rev is None:
-        return str(ROOT / "src")
-    commit = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--verify", f"{rev}^{{commit}}"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout.strip()
-    folder = Path(tempfile.gettempdir()) / f"tablebot-fleet-baseline-{commit[:12]}"
-    if not (folder / "src").is_dir():
-        partial = Path(tempfile.mkdtemp(prefix=folder.name + "."))
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit, "src"], check=True, capture_output=True)
-        subprocess.run(["tar", "-x", "-C", str(partial)], input=archive.stdout, check=True)
-        partial.rename(folder)  # whole or not at all
-    return str(folder / "src")
+    """The ``src`` folder of revision ``rev`` (exported once into the temporary folder, as benchmarks/kernel.py
+    exports its baseline: the same folder serves both), or this tree's (None)."""
+    return str(ROOT / "src") if rev is None else baseline_sources(rev)
 
 
 def env_for(src: str) -> dict[str, str]:
