@@ -133,3 +133,20 @@ def test_in_the_pseudo_language_the_words_found_in_german_are_between_markers(
     open_trace(page, 10)
     assert page.inner_text("#tplay") == "⟦▶ Play⟧"
     page.context.close()
+
+
+def test_a_drafts_time_of_day_is_the_pages_language_not_the_browsers(browser: Any, tmp_path: Path) -> None:
+    """studio --lang de in an American browser: the page is German, and so is the time it says an unsaved edit
+    was made at (13:05, not 01:05 PM: the old code asked the browser's language for it)."""
+    for studio in served(bumberbot(tmp_path), lang="de"):
+        page = open_page(browser, studio.url, "en-US")
+        page.on("dialog", lambda d: d.accept())  # "leave the page with unsaved edits?": yes, on reload
+        page.locator(f'td[data-row="3"][data-col="{TIMER_COL}"] input').fill("900")
+        page.wait_for_selector("#save.primary")  # the server has the edit: unsaved
+        page.wait_for_function("() => Object.keys(localStorage).some((k) => k.startsWith('tablebot-draft:'))")
+        page.reload()
+        page.wait_for_selector("#ask[open]")
+        said = page.locator("#ask").inner_text()
+        assert re.search(r"um \d\d:\d\d geändert", said), said
+        assert not re.search(r"AM|PM", said), said
+        page.context.close()
