@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from tablebot.api.progress import Progress, stopped
-from tablebot.i18n import N_
+from tablebot.i18n import N_, _, ngettext
 
 if TYPE_CHECKING:
     from tablebot.evolve.run import Outcome
@@ -212,5 +212,7 @@ def _run(plan: Plan, check: Plan, setup: Setup, out: Path, backend: str, address
 
 def _said_repairs(repairs: list[Any], progress: Progress) -> None:
     for k, r in enumerate(repairs):
-        state = "mended it" if r.ok else f"could not mend {', '.join(r.failing)}"
-        progress.note(f"repair {k + 1}: the starting table breaks a property; {len(r.steps)} guard rows {state}")
+        state = _("mended it") if r.ok else _("could not mend {failing}").format(failing=", ".join(r.failing))
+        progress.note(ngettext("repair {k}: the starting table breaks a property; {n} guard row {state}",
+                               "repair {k}: the starting table breaks a property; {n} guard rows {state}",
+                               len(r.steps)).format(k=k + 1, n=len(r.steps), state=state))

@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from tablebot.evolve.space import Candidate, Limits, valid
+from tablebot.i18n import N_
 from tablebot.robot import StateId
 from tablebot.table import MAX_LAMP
 
@@ -129,8 +130,8 @@ def add_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate |
     where = [i for i, gene in enumerate(c) if gene.state == state]
     slots = [*where, where[-1] + 1] if where else [len(c)]
     at = slots[int(rng.integers(len(slots)))]
-    line = f"line {source.origin}" if source.origin is not None else "an added row"
-    gene = replace(source, state=state, origin=None, note=f"a copy of {line}")
+    note = N_("a copy of an added row") if source.origin is None else N_("a copy of line {line}", line=source.origin)
+    gene = replace(source, state=state, origin=None, note=note)
     return (*c[:at], gene, *c[at:])
 
 

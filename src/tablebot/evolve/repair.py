@@ -22,6 +22,7 @@ from tablebot.analysis.prove import Result
 from tablebot.evolve.operators import Space
 from tablebot.evolve.proofs import Prover
 from tablebot.evolve.space import Candidate, Gene, to_table
+from tablebot.i18n import N_
 from tablebot.machine import Machine, compile_table
 from tablebot.replay import replay
 from tablebot.robot import StateId
@@ -180,16 +181,19 @@ def _actions(table: Table, state: StateId, events: frozenset[str], prop: str, pr
     when = condition(table, [events])
     for row in donors:
         what = action(table, row)
-        text = f"{when}: {what.text}{', ' + what.timer if what.timer else ''} (guard for {prop})"
+        does = f"{what.text}{', ' + what.timer if what.timer else ''}"
+        # Messages, not text: made in a worker process, said in the reader's language by the report
+        text = N_("{when}: {action} (guard for {prop})", when=when, action=does, prop=prop)
         gene = Gene(state, events, row.motors, row.timer, row.next, text, row.counters, row.lamps,
-                    note=f"guard for {prop}, doing what line {row.line} does")
+                    note=N_("guard for {prop}, doing what line {line} does", prop=prop, line=row.line))
         copies.setdefault(gene.effect(), gene)
     keep = (None,) * len(table.robot.motors)
     lamps = (None,) * len(table.robot.lamps)
     counters = (None,) * len(table.robot.counter_names)
     for ticks in STAY_TIMERS:
-        gene = Gene(state, events, keep, ticks, state, f"{when}: keep going (guard for {prop})", counters, lamps,
-                    note=f"guard for {prop}: keep the motors while {when}")
+        gene = Gene(state, events, keep, ticks, state, N_("{when}: keep going (guard for {prop})", when=when,
+                                                           prop=prop), counters, lamps,
+                    note=N_("guard for {prop}: keep the motors while {when}", prop=prop, when=when))
         keeps.setdefault(gene.effect(), gene)
     first, second = (keeps, copies) if prefer == "keep" else (copies, keeps)
     return [*first.values(), *second.values()]

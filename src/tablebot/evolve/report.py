@@ -50,12 +50,14 @@ def describe(gene: Gene, base: Table) -> str:
     )  # row is one per state
     if original is None:
         if gene.description and gene.note.startswith("guard"):
-            return gene.description
+            return str(localise(gene.description))
         what = action(table, _row(gene))
         timer = f", {what.timer}" if what.timer else ""
         goes = f" -> {table.state_title(gene.next)}"
         return _("{when}: {action} (added: {note})").format(
-            when=condition(table, [gene.events]), action=f"{what.text}{timer}{goes}", note=gene.note or _("new row")
+            when=condition(table, [gene.events]),
+            action=f"{what.text}{timer}{goes}",
+            note=localise(gene.note) if gene.note else _("new row"),
         )
     changes = []
     for name, old, new in zip(table.robot.motors, original.motors, gene.motors, strict=True):

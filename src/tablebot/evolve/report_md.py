@@ -16,7 +16,7 @@ from tablebot.escape import markdown_code, markdown_text
 from tablebot.evolve.commands import Replay, sim_commands, sweep_command
 from tablebot.evolve.measures import Measure, fitness, measure_text
 from tablebot.evolve.report import Written, paired_change
-from tablebot.i18n import _, ngettext, number
+from tablebot.i18n import _, localise, ngettext, number
 from tablebot.table import Table
 
 if TYPE_CHECKING:
@@ -200,7 +200,7 @@ def start_section(outcome: Outcome, base: Table, own: str = "") -> list[str]:
         lines += [
             _("- {state}: {row} (its counterexample was {ticks} ticks)").format(
                 state=markdown_text(_state(base, s.state)),
-                row=markdown_code(s.gene.description),
+                row=markdown_code(str(localise(s.gene.description))),
                 ticks=s.counterexample_ticks,
             )
             for s in repaired.steps
