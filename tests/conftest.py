@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -147,7 +148,18 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.xdist_group("browser"))
 
 
+def _hear_ctrl_c() -> None:
+    """Python's own Ctrl-C handler where pytest was started with SIGINT ignored (a background job of a
+    non-interactive shell, ``make test &`` or ``nohup make test &``, as a CI runner may start it): every process
+    the tests start would inherit the ignore, and the tests that interrupt a command with SIGINT would see it
+    run on to the end (16 of them failed so). A handler set here is reset to the default by exec: the workers
+    and the commands they start get Python's handler, as from a terminal."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def pytest_configure(config: pytest.Config) -> None:
+    _hear_ctrl_c()
     for name, meaning in MARKERS.items():
         config.addinivalue_line("markers", f"{name}: {meaning}")
     _own_numba_cache(config)
