@@ -36,3 +36,15 @@ def test_a_start_in_a_box_is_refused_in_german_with_german_numbers(tmp_path: Pat
     shown = " ".join(run_in("de", ["sim", str(robot), "--seconds", "1", "--no-plots"]).split())
     assert "Fehler: der Roboter in seiner Startpose (1,25, 0,95, Richtung 20°) überlappt eine Wand oder ein" in shown
     assert "Tipp: [start] at verschieben oder mit heading drehen" in shown, shown
+
+
+def test_a_robot_files_sim_and_robopro_sections_are_refused_in_german(tmp_path: Path) -> None:
+    robot = tmp_path / "bot"
+    shutil.copytree(EXAMPLE, robot)
+    with (robot / "robot.toml").open("a", encoding="utf-8") as extra:
+        extra.write('\n[sim]\nworld = 3\n\n[robopro]\ncontroller = "c64"\nM1 = "X9"\n')
+    shown = run_in("de", ["check", str(robot)])
+    assert "Fehler: [robopro] controller = 'c64' ist keiner, den ROBO Pro hier ansteuert" in shown, shown
+    assert "Fehler: [robopro] M1: 'X9' ist kein Anschluss (Motor) des Controllers" in shown
+    assert 'Tipp: output = "M1" … "M4" schreiben' in shown
+    assert "Fehler: sim.world muss ein Dateiname sein" in shown

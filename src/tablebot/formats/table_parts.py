@@ -45,8 +45,8 @@ def cross_column(cell: Cell, robot: Robot, out: Collector) -> CrossEvent | None:
     cross = parse_cross(cell.text, robot)
     if isinstance(cross, str):
         out.error(cell.line, cell.column, cross,
-                  "a cross-table column is NAME=S, NAME=S1,S2 or NAME=20..29 with NAME from [tables]"
-                  " (quote it in a CSV when it has a comma)")
+                  N_("a cross-table column is NAME=S, NAME=S1,S2 or NAME=20..29 with NAME from [tables] (quote it "
+                     "in a CSV when it has a comma)"))
         return None
     return None if cross is None else replace(cross, line=cell.line, at=cell.column)
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 from tablebot.diagnostics import Collector, Diagnostic, TableBotError
+from tablebot.i18n import N_
 from tablebot.robopro.lists import NEXT_WEIGHT, number_states
 from tablebot.robopro.wiring import Wiring, wiring
 from tablebot.robot import StateId
@@ -225,29 +226,35 @@ def _row_problems(table: Table, out: Collector) -> None:
     max_state = (MAX_VALUE >> shift) if shift < 15 else 0
     numbers = number_states(table)
     if shift >= 15:
-        out.error(1, 1, f"{shift} events (T, inputs and counters) leave no bits for the state in a 16-bit word",
-                  "use fewer inputs or counters")
+        out.error(1, 1, N_("{n} events (T, inputs and counters) leave no bits for the state in a 16-bit word",
+                           n=shift), N_("use fewer inputs or counters"))
         return
     for row in table.rows:
-        for what, state, limit in (("state", row.state, max_state), ("next state", row.next, min(MAX_NEXT, max_state))):
+        for what, state, limit in ((N_("state"), row.state, max_state),
+                                   (N_("next state"), row.next, min(MAX_NEXT, max_state))):
             if numbers[state] > limit:
-                out.error(row.line, None, f"row {row.as_written}: {what} {state!r} is number {numbers[state]}, over "
-                          f"{limit}", f"with {shift} event bits the 16-bit lists hold states 0..{limit}")
+                out.error(row.line, None, N_("row {row}: {what} {state!r} is number {number}, over {limit}",
+                                             row=row.as_written, what=what, state=state, number=numbers[state],
+                                             limit=limit),
+                          N_("with {n} event bits the 16-bit lists hold states 0..{limit}", n=shift, limit=limit))
         if row.timer > MAX_VALUE:
-            out.error(row.line, None, f"row {row.as_written}: timer {row.timer} is over {MAX_VALUE}",
-                      "ROBO Pro integers are 16-bit signed")
+            out.error(row.line, None, N_("row {row}: timer {timer} is over {most}", row=row.as_written,
+                                         timer=row.timer, most=MAX_VALUE), N_("ROBO Pro integers are 16-bit signed"))
         for motor, speed in zip(table.robot.motors, row.motors, strict=True):
             if speed is not None and abs(speed) >= DOC_KEEP_SPEED:
                 out.error(row.line, None,
-                          f"row {row.as_written}: {motor} speed {abs(speed)} does not fit the action word",
-                          "the document's speeds are 0..6 (7 means keep): use 6 or less")
+                          N_("row {row}: {motor} speed {speed} does not fit the action word", row=row.as_written,
+                             motor=motor, speed=abs(speed)),
+                          N_("the document's speeds are 0..6 (7 means keep): use 6 or less"))
         for name, load in zip(table.robot.counter_names, row.counters, strict=True):
             if load is not None and load > MAX_VALUE:
-                out.error(row.line, None, f"row {row.as_written}: {name} load {load} is over {MAX_VALUE}",
-                          "ROBO Pro integers are 16-bit signed")
+                out.error(row.line, None, N_("row {row}: {name} load {load} is over {most}", row=row.as_written,
+                                             name=name, load=load, most=MAX_VALUE),
+                          N_("ROBO Pro integers are 16-bit signed"))
     if numbers[table.robot.initial_state] > max_state:
-        out.error(1, 1, f"initial state {table.robot.initial_state!r} is number {numbers[table.robot.initial_state]},"
-                  f" over {max_state}", "number the states lower")
+        out.error(1, 1, N_("initial state {state!r} is number {number}, over {most}", state=table.robot.initial_state,
+                           number=numbers[table.robot.initial_state], most=max_state),
+                  N_("number the states lower"))
 
 
 def plan(table: Table, rule: str | None = None) -> Plan:

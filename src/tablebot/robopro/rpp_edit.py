@@ -165,19 +165,22 @@ def rewrite(text: str, lists: Mapping[str, Sequence[int]], path: str | Path = "<
     by_name: dict[str, list[ListElement]] = {}
     for element in found:
         by_name.setdefault(element.name, []).append(element)
-    names = ", ".join(sorted(by_name)) or "none"
+    names = tuple(sorted(by_name)) or (N_("none"),)
     edits: list[tuple[int, int, str]] = []
     for name, values in lists.items():
         matches = by_name.get(name, [])
         if not matches:
-            out.error(None, None, f"no list named {name!r} ({LIST_CLASS}) in this program",
-                      f"lists in the program: {names}; choose names with --event-list/--action-list/--timer-list")
+            out.error(None, None, N_("no list named {name!r} ({kind}) in this program", name=name, kind=LIST_CLASS),
+                      N_("lists in the program: {names}; choose names with --event-list/--action-list/--timer-list",
+                         names=names))
             continue
         global_names = sorted({e.globalname for e in matches})
         if len(global_names) > 1:
-            out.error(matches[1].line, None, f"{len(matches)} different lists are named {name!r} (global names "
-                      f"{', '.join(map(repr, global_names))}, lines {', '.join(str(e.line) for e in matches)})",
-                      "rename all but one in ROBO Pro")
+            out.error(matches[1].line, None, N_("{n} different lists are named {name!r} (global names {globals}, "
+                                                "lines {lines})", n=len(matches), name=name,
+                                                globals=tuple(map(repr, global_names)),
+                                                lines=tuple(str(e.line) for e in matches)),
+                      N_("rename all but one in ROBO Pro"))
             continue
         for element in matches:  # a global list: one copy per subprogram that uses it, each written
             problem = _unwritable(element)

@@ -22,11 +22,14 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from tablebot.i18n import N_
 from tablebot.robot import Robot
 from tablebot.tomlfile import Source
 
 CONTROLLERS = ("robo-interface", "tx", "txt")
 TERMINALS = {"input": ("I", 8), "motor": ("M", 4), "counter": ("C", 4), "lamp": ("O", 8)}
+#: The kinds of terminal in the reader's words (Eingang, Motor, Zähler, Lampe).
+KIND_WORDS = {"input": N_("input"), "motor": N_("motor"), "counter": N_("counter"), "lamp": N_("lamp")}
 COMMANDS = ("cw", "ccw")
 DEFAULT = object()
 
@@ -67,9 +70,9 @@ class _Reader:
 
     def error(self, key: str, message: str, hint: str) -> None:
         if self.src is None:
-            self.errors.append((key, f"[robopro] {message}", hint))
+            self.errors.append((key, N_("[robopro] {message}", message=message), hint))
         else:
-            self.src.key_error(("robopro", None, key), f"[robopro] {message}", hint)
+            self.src.key_error(("robopro", None, key), N_("[robopro] {message}", message=message), hint)
 
     def entry(self, name: str, value: Any, kind: str, extra: dict[str, tuple[Any, ...]]) -> tuple[int, dict] | None:
         """A terminal (``"I3"``) or a table ``{terminal = "I3", key = value}`` with ``extra``'s keys."""
@@ -79,21 +82,23 @@ class _Reader:
         if isinstance(value, dict):
             unknown = sorted(set(value) - {word, *extra})
             if unknown:
-                self.error(name, f"{name}: unknown key {', '.join(unknown)}",
-                           f"a {kind} takes {word}{''.join(', ' + k for k in extra)}")
+                self.error(name, N_("{name}: unknown key {keys}", name=name, keys=tuple(unknown)),
+                           N_("a {kind} takes {keys}", kind=KIND_WORDS[kind], keys=(word, *extra)))
                 return None
             options = {k: value[k] for k in extra if k in value}
             value = value.get(word, DEFAULT)
         terminal = _default(name, kind, self.robot) if value is DEFAULT else _terminal(value, kind)
         if terminal is None:
-            shown = "no terminal" if value is DEFAULT else repr(value)
-            self.error(name, f"{name}: {shown} is not a {kind} terminal of the controller",
-                       f'write {word} = "{letter}1" … "{letter}{count}"')
+            shown = N_("no terminal") if value is DEFAULT else repr(value)
+            self.error(name, N_("{name}: {shown} is not a {kind} terminal of the controller", name=name, shown=shown,
+                                kind=KIND_WORDS[kind]),
+                       N_('write {word} = "{letter}1" … "{letter}{count}"', word=word, letter=letter, count=count))
             return None
         for key, allowed in extra.items():
             if key in options and options[key] not in allowed:
-                self.error(name, f"{name}: {key} = {options[key]!r} is not one of {', '.join(map(repr, allowed))}",
-                           f"write {key} = {allowed[0]!r}")
+                self.error(name, N_("{name}: {key} = {value!r} is not one of {allowed}", name=name, key=key,
+                                    value=options[key], allowed=tuple(map(repr, allowed))),
+                           N_("write {key} = {value!r}", key=key, value=allowed[0]))
                 return None
         return terminal, options
 
@@ -102,17 +107,19 @@ def read_robot_robopro(src: Source, section: Any, robot: Robot) -> Wiring:
     """``[robopro]`` of a robot file (a reader of :data:`tablebot.robot.SECTION_READERS`); errors go to
     ``src`` with their lines."""
     if not isinstance(section, dict):
-        src.key_error(("", None, "robopro"), "[robopro] must be a table", 'for example: controller = "txt"')
+        src.key_error(("", None, "robopro"), N_("[robopro] must be a table"),
+                      N_("for example: {example}", example='controller = "txt"'))
         return wiring_of(robot, {})
     reader = _Reader(src, robot)
     controller = section.get("controller", "robo-interface")
     if controller not in CONTROLLERS:
-        reader.error("controller", f"controller = {controller!r} is not one ROBO Pro drives here",
-                     f"write controller = one of {', '.join(map(repr, CONTROLLERS))}")
+        reader.error("controller", N_("controller = {controller!r} is not one ROBO Pro drives here",
+                                      controller=controller),
+                     N_("write controller = one of {known}", known=tuple(map(repr, CONTROLLERS))))
     for name in section:
         if name != "controller" and name not in (*robot.inputs, *robot.motors, *robot.counter_names, *robot.lamps):
-            reader.error(name, f"wires {name!r}, which robot {robot.name} does not have",
-                         "wire the robot's inputs, motors, counters and lamps (names from the robot file)")
+            reader.error(name, N_("wires {name!r}, which robot {robot} does not have", name=name, robot=robot.name),
+                         N_("wire the robot's inputs, motors, counters and lamps (names from the robot file)"))
     return wiring_of(robot, section, reader, str(controller))
 
 

@@ -133,17 +133,18 @@ class SimSection:
 def read_robot_sim(src: Source, sim: Any, robot: Any) -> SimSection:
     """``[sim]`` of a robot file, checked (errors go to ``src``): parameter sections and ``world``."""
     if not isinstance(sim, dict):
-        src.error(("", None, "sim"), "[sim] must be a table", "write [sim.battery] etc.")
+        src.error(("", None, "sim"), N_("[sim] must be a table"), N_("write [sim.battery] etc."))
         return SimSection({}, None)
     known_keys(src, ("sim", None), sim, (*SECTIONS, "world"))
     layer = check_layer(src, sim, prefix="sim.")
     world = sim.get("world")
     path = Path(src.path).parent / world if isinstance(world, str) else None
     if world is not None and not isinstance(world, str):
-        src.error(("sim", None, "world"), "sim.world must be a file name", 'for example: world = "arena.toml"')
+        src.error(("sim", None, "world"), N_("sim.world must be a file name"),
+                  N_("for example: {example}", example='world = "arena.toml"'))
     elif path is not None and not path.is_file():
-        src.error(("sim", None, "world"), f"sim.world: {path} is not a file",
-                  "name a world file, relative to the robot file's folder")
+        src.error(("sim", None, "world"), N_("sim.world: {path} is not a file", path=str(path)),
+                  N_("name a world file, relative to the robot file's folder"))
         path = None
     return SimSection(layer, path)
 
@@ -158,8 +159,8 @@ def _wiring_value(src: Source, name: str, key: str, value: Any) -> str | None:
     """The robot name a role is wired to ("" for a sensor that is "none"), else None after an error."""
     if isinstance(value, str) and (value or not key.endswith("motor")):
         return "" if value.lower() == "none" else value
-    src.error((name, None, key), f"[{name}] {key} must name a robot input or motor",
-              f'for example: {key} = "{WIRING[key]}" (a sensor may be "none")')
+    src.error((name, None, key), N_("[{name}] {key} must name a robot input or motor", name=name, key=key),
+              N_('for example: {key} = "{value}" (a sensor may be "none")', key=key, value=WIRING[key]))
     return None
 
 
