@@ -1,8 +1,8 @@
 """The studio's numbers and its last English words in German (issue 38), in a real Chromium against the real
 server, at the classroom's projector sizes: a timer's time beside its cell (8,95 s), the status line's seconds
-live and in the trace player (0,01 s, 1,37 s), how long the check took, the trace player's Play/Pause button
-after a click and the T column's "timer ran out" all in the page's language; in English as before; in the
-pseudo-language between markers. A cell keeps the ticks as typed: only the text beside it changes.
+live and in the trace player (0,01 s, 1,37 s), how long the check took, the battery (100 %), the trace player's
+Play/Pause button after a click and the T column's "timer ran out" all in the page's language; in English as
+before; in the pseudo-language between markers. A cell keeps the ticks as typed: only the text beside it changes.
 
 Screenshots go to ``studio-numbers`` under pytest's temporary folder (or ``$TABLEBOT_SCREENSHOTS``): look at them.
 """
@@ -101,6 +101,7 @@ def test_a_german_page_writes_its_numbers_with_a_decimal_comma(
     assert "Timer abgelaufen" in page.eval_on_selector("table.grid thead", "e => e.textContent")
     took = page.inner_text("#analysis-time")
     assert re.fullmatch(r"geprüft in \d+(,\d)? ms", took), took
+    assert re.fullmatch(r"100\s%", page.inner_text("#battery-text")), page.inner_text("#battery-text")  # German: 100 %
     live = step_once(page)
     assert re.match(r"Takt [1-9]\d* · 0,\d\d s · ", live), live
     page.screenshot(path=str(shots / f"german-live-{size[0]}.png"))
@@ -118,6 +119,9 @@ def test_an_english_page_keeps_its_decimal_point(browser: Any, studio: Backgroun
     page = open_page(browser, studio.url, "en-US")
     assert "8.95 s" in timer_times(page)
     assert "timer ran out" in page.eval_on_selector("table.grid thead", "e => e.textContent")
+    page.evaluate("() => { const b = document.querySelector('#battery'); b.value = 50;"
+                  " b.dispatchEvent(new Event('input')); }")
+    assert page.inner_text("#battery-text") == "50%"
     assert re.match(r"tick [1-9]\d* · 0\.\d\d s · ", step_once(page))
     assert open_trace(page, 137).startswith("tick 137 · 1.37 s · ")
     assert page.inner_text("#tplay") == "▶ Play"

@@ -37,21 +37,27 @@ export function setLanguage(lang, keep = false) {
 /** The language in use. */
 export function currentLanguage() { return language; }
 
-// Intl's formats, made once per language and digits (a frame's status line asks for several numbers a tick)
+// Intl's formats, made once per language and options (a frame's status line asks for several numbers a tick)
 const formats = new Map();
+
+function format(options) {
+  const lang = language === PSEUDO ? "en" : language;
+  const key = lang + JSON.stringify(options);
+  if (!formats.has(key)) formats.set(key, new Intl.NumberFormat(lang, { useGrouping: false, ...options }));
+  return formats.get(key);
+}
 
 /** `value` as the page's language writes a number for a person (1,25 in German, 1.25 in English; no thousands
  * grouping, as the command line's tablebot.i18n.number): every number the page draws comes through here, so
  * none is written in English by a toFixed. At most `most` decimals, at least `least` (trailing zeros dropped
  * down to it). Only for text: a cell's value and what is saved stay as the table file has them. */
 export function number(value, most = 2, least = 0) {
-  const lang = language === PSEUDO ? "en" : language;
-  const key = `${lang} ${most} ${least}`;
-  if (!formats.has(key)) {
-    formats.set(key, new Intl.NumberFormat(lang, { maximumFractionDigits: most, minimumFractionDigits: least,
-      useGrouping: false }));
-  }
-  return formats.get(key).format(value);
+  return format({ maximumFractionDigits: most, minimumFractionDigits: least }).format(value);
+}
+
+/** A fraction (0.5) as a whole percentage the page's language writes (50 % in German, 50% in English). */
+export function percent(fraction) {
+  return format({ style: "percent", maximumFractionDigits: 0 }).format(fraction);
 }
 
 /** The hour and minute of `ms` (since the epoch) as the page's language writes a time of day (14:05). */

@@ -2,7 +2,7 @@
 import { all, byId } from "../lib/dom.js";
 import { askForLink } from "./sharebox.js";
 import { api } from "../lib/key.js";
-import { t } from "../lib/words.js";
+import { percent, t } from "../lib/words.js";
 
 const on = (id, type, handler) => byId(id).addEventListener(type, handler);
 
@@ -45,7 +45,7 @@ function wireLive(store, send) {
   for (const b of all("[data-click]")) b.addEventListener("click", () => store.set({ clickMode: b.dataset.click }));
   const reset = () => send({ op: "sim", action: "reset", seed: Math.max(0, parseInt(byId("seed").value, 10) || 0),
     charge: +byId("battery").value / 100 });
-  on("battery", "input", () => { byId("battery-text").textContent = byId("battery").value + "%"; });
+  on("battery", "input", () => { byId("battery-text").textContent = percent(byId("battery").value / 100); });
   on("battery", "change", reset);
   on("reset", "click", reset);
 }

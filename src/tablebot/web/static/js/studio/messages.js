@@ -1,7 +1,7 @@
 // What the page does with each message from the server: mostly a change of state (the panels subscribed
 // to it redraw), sometimes a view's own content (the grid's rows, the diagram's SVG, a trace to play).
 import { addOption, byId } from "../lib/dom.js";
-import { clock, t } from "../lib/words.js";
+import { clock, percent, t } from "../lib/words.js";
 import { ask } from "./ask.js";
 import { banner } from "./banner.js";
 import { byKind } from "./protocol.js";
@@ -34,7 +34,7 @@ function arena(store, views, m) {
   views.arena.setWorld(m.world);
   byId("seed").value = m.settings.seed;
   byId("battery").value = Math.round(100 * m.settings.charge);
-  byId("battery-text").textContent = Math.round(100 * m.settings.charge) + "%";
+  byId("battery-text").textContent = percent(m.settings.charge);
   store.set({ world: m.world, tickMs: m.tick_ms, frame: null, ...controlState(m) });
 }
 
