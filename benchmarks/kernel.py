@@ -81,18 +81,11 @@ def measure(example: str, repeats: int) -> dict[str, float]:
 def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     import numpy as np
 
-    from tablebot.sim import columns as L
-
     co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
     loops = _loops()
     g, p = scene.geometry, scene.P[0]
     shade = getattr(g, "shade", None)
     s, near_centre = rows[0].copy(), co.new_near(g.pstart, g.circles)
-    # the physics' own view of the rows: records read by name (sim.physics.layout), or, in a tree from before,
-    # the float rows themselves (the loops index both with the column constants)
-    named = _named()
-    sv, recs, pv = (named.as_state(s), named.state_rows(rows), named.as_params(p)) if named else (s, rows, p)
-    has_sensors = bool(p[L.P_SENSOR + L.F_KIND] != 0.0)
 
     def ns(name: str, *args: Any) -> float:
         loops[name](*args)
@@ -105,38 +98,24 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
 
     copy = ns("copy", rows, s)
     regs, outputs, counters = (a.copy() for a in fleet.initial)
-    light = ("light_shade", recs, pv, g.edges, g.circles, g.lamps, np.empty(4), shade) if shade is not None else (
-        "light", recs, pv, g.edges, g.circles, g.lamps, np.empty(4))
+    light = ("light_shade", rows, p, g.edges, g.circles, g.lamps, np.empty(4), shade) if shade is not None else (
+        "light", rows, p, g.edges, g.circles, g.lamps, np.empty(4))
     parts = {
         "light (2 phototransistors)": ns(*light),
-        "bumpers": ns("bumpers", rows, pv, g.verts, g.pstart, g.pbound, g.circles, s, sv, *near_centre) - copy,
-        "contacts": ns("contacts", rows, pv, g.verts, g.pstart, g.pbound, g.circles, s, sv, np.empty((4, 2)),
+        "bumpers": ns("bumpers", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, *near_centre) - copy,
+        "contacts": ns("contacts", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, np.empty((4, 2)),
                        *near_centre) - copy,
-        "motors": ns("motors", rows, pv, s, sv, np.zeros(4)) - copy,
-        "declared sensors": ns("declared", rows, pv, g.edges, g.circles, g.lamps, g.lines, s, sv,
-                               has_sensors or not _skips_without_sensors(ph)) - copy,
-        "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s,
-                                sv) - copy,
+        "motors": ns("motors", rows, p, s, np.zeros(4)) - copy,
+        "declared sensors": ns("declared", rows, p, g.edges, g.circles, g.lamps, g.lines, s,
+                               "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func)) - copy,
+        "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s)
+        - copy,
         "noise (4 normals)": ns("noise", rows.shape[0], fleet.bitgens[0]),
         "engine tick": ns("engine", rows, regs, outputs, counters, np.zeros(counters.shape[0], np.int64),
                           fleet.machine.arrays.program),
         "heading cos+sin": ns("trig", rows),
     }
     return parts
-
-
-def _named() -> Any:
-    """sim.physics.layout (robot rows as records) in this tree, None in a tree from before it."""
-    try:
-        return importlib.import_module("tablebot.sim.physics.layout")
-    except ModuleNotFoundError:
-        return None
-
-
-def _skips_without_sensors(ph: Any) -> bool:
-    """Whether the tree's kernel skips the declared sensors' pass for a robot without any."""
-    source = inspect.getsource(ph.sense_near.py_func)
-    return "P_SENSOR + F_KIND" in source or "sensor[0, F_KIND]" in source
 
 
 def _loops() -> dict[str, Any]:
@@ -193,46 +172,45 @@ def _loops() -> dict[str, Any]:
 
     @fast
     def bumpers(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                circles: np.ndarray, s: np.ndarray, sv: Any, near: np.ndarray, centre: np.ndarray) -> float:
+                circles: np.ndarray, s: np.ndarray, near: np.ndarray, centre: np.ndarray) -> float:
         reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.sense_bumpers(sv, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach,
+            co.sense_bumpers(s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach,
                              wide, near, centre)
         return s[0]
 
     @fast
     def contacts(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                 circles: np.ndarray, s: np.ndarray, sv: Any, corners: np.ndarray, near: np.ndarray,
+                 circles: np.ndarray, s: np.ndarray, corners: np.ndarray, near: np.ndarray,
                  centre: np.ndarray) -> float:
         reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.resolve(sv, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
-    def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, sv: Any, z: np.ndarray) -> float:
+    def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, z: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.drive(sv, (2, -2), p, z)
+            ph.drive(s, (2, -2), p, z)
         return s[0]
 
     @fast
     def declared(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
-                 lines: np.ndarray, s: np.ndarray, sv: Any, run: bool) -> float:
+                 lines: np.ndarray, s: np.ndarray, skip: bool) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            if run:  # not when the tree's kernel skips robots without any and this one has none
-                sense_declared(sv, math.cos(s[L.TH]), math.sin(s[L.TH]), p, edges, circles, lamps, lines)
+            if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
+                sense_declared(s, math.cos(s[L.TH]), math.sin(s[L.TH]), p, edges, circles, lamps, lines)
         return s[0]
 
     @fast
-    def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray,
-                sv: Any) -> float:
+    def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            K.observe(sv, lamps, acc, collisions)
+            K.observe(s, lamps, acc, collisions)
         return s[0]
 
     @fast

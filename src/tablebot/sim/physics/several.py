@@ -18,7 +18,7 @@ import numpy as np
 from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.sim.physics.kernel import end_tick, named, robot_scratch, start_tick
+from tablebot.sim.physics.kernel import end_tick, robot_scratch, start_tick
 from tablebot.sim.physics.structures import Record, RobotState, Wiring, WorldArrays
 from tablebot.tables import RobotTables
 from tablebot.tick import EVENT, ROW, STATE, TIMER, Program, registers
@@ -147,7 +147,6 @@ def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: S
     """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
-    robot = named(robot)
     scratch = robot_scratch(robot, world)
     for t in range(ticks):
         mask = start_tick(t, robot, wiring, record, scratch)

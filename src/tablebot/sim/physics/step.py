@@ -18,19 +18,59 @@ import numpy as np
 
 from tablebot.jit import njit
 from tablebot.sim.columns import (
+    AMPS,
     B_FL,
     B_FR,
     B_LIGHT_L,
     B_LIGHT_R,
     B_REAR,
+    BUMP_FL,
+    BUMP_FR,
+    BUMP_REAR,
+    DIST,
+    ENC_L,
+    ENC_R,
     F_KIND,
+    GAIN_L,
+    GAIN_R,
+    LIGHT_L,
+    LIGHT_R,
+    MASK,
+    P_ALPHA,
+    P_BASE,
+    P_CAP,
+    P_DT,
+    P_IIDLE,
+    P_IMOTOR,
+    P_KV,
+    P_LEVELS,
+    P_LX,
+    P_LY,
+    P_NLIGHT,
+    P_NMOTOR,
+    P_PPR,
+    P_RINT,
+    P_SENSOR,
+    P_TOE,
+    P_VEMPTY,
+    P_VF,
+    P_VFULL,
+    P_WHEEL_R,
+    PUL_L,
+    PUL_R,
+    SOC,
+    TH,
+    V_L,
+    V_R,
+    VBAT,
     Z_LIGHT_L,
     Z_LIGHT_R,
     Z_MOTOR_L,
     Z_MOTOR_R,
+    X,
+    Y,
 )
 from tablebot.sim.physics.contacts import resolve, sense_bumpers
-from tablebot.sim.physics.layout import Params, State, as_params, as_state
 from tablebot.sim.physics.sensing import light_turned, sense_declared, sensor_events
 from tablebot.sim.physics.shadows import NO_SHADE
 from tablebot.sim.physics.structures import Scratch, WorldArrays
@@ -40,32 +80,31 @@ NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 # --- light ---------------------------------------------------------------------------------------
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_side(s: State, c: float, sn: float, p: Params, side: float, ct: float, st: float,
+def light_side(s: np.ndarray, c: float, sn: float, p: np.ndarray, side: float, ct: float, st: float,
                edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
     ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
     the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
     :func:`sim.physics.sensing.light_turned` rules such lamps out cheaply, with light_from's answer."""
-    return light_turned(s, c, sn, p, p.lx, side * p.ly, side * p.toe, ct, st, edges, circles, lamps, shade)
+    return light_turned(s, c, sn, p, p[P_LX], side * p[P_LY], side * p[P_TOE], ct, st, edges, circles, lamps, shade)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def aim_turns(p: Params, out: np.ndarray) -> None:
+def aim_turns(p: np.ndarray, out: np.ndarray) -> None:
     """``out``: cosine and sine of the right phototransistor's turn from the heading, then the left one's."""
-    out[0], out[1] = math.cos(-1.0 * p.toe), math.sin(-1.0 * p.toe)
-    out[2], out[3] = math.cos(1.0 * p.toe), math.sin(1.0 * p.toe)
+    out[0], out[1] = math.cos(-1.0 * p[P_TOE]), math.sin(-1.0 * p[P_TOE])
+    out[2], out[3] = math.cos(1.0 * p[P_TOE]), math.sin(1.0 * p[P_TOE])
 
 
 @njit(cache=True)
 def light_at(s: np.ndarray, p: np.ndarray, side: float, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
              shade: np.ndarray = NO_SHADE) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
-    row, params = as_state(s), as_params(p)  # float64 rows from Python, or records
     turns = np.empty(4)
-    aim_turns(params, turns)
+    aim_turns(p, turns)
     k = 0 if side < 0.0 else 2
-    return light_side(row, math.cos(row.th), math.sin(row.th), params, side, turns[k], turns[k + 1], edges, circles,
-                      lamps, shade)
+    return light_side(s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps,
+                      shade)
 
 
 # --- motors, battery, motion ---------------------------------------------------------------------
@@ -84,95 +123,95 @@ def pack_volts(full: float, empty: float, charge: float, amps: float, ohms: floa
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def motor(p: Params, level: int, volts: float, gain: float, speed: float, enc: float,
-          noise: float) -> tuple[float, float, float]:
-    """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag. Returns
-    its new wheel speed, encoder count and whole pulses this tick (given its ``gain``, ``speed`` and ``enc``).
+def motor(s: np.ndarray, p: np.ndarray, level: int, volts: float, gain: int, speed: int, enc: int, pul: int,
+          noise: float) -> None:
+    """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
     The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
     """
-    power = duty(level, p.levels)
-    target = np.sign(level) * gain * p.kv * max(0.0, power * volts - p.vf) * (1.0 + p.nmotor * noise)
-    speed += (target - speed) * p.alpha
-    after = enc + abs(speed) * p.dt / (2.0 * math.pi * p.wheel_r) * p.ppr
-    return speed, after, math.floor(after) - math.floor(enc)
+    power = duty(level, p[P_LEVELS])
+    target = np.sign(level) * s[gain] * p[P_KV] * max(0.0, power * volts - p[P_VF]) * (1.0 + p[P_NMOTOR] * noise)
+    s[speed] += (target - s[speed]) * p[P_ALPHA]
+    before = s[enc]
+    s[enc] += abs(s[speed]) * p[P_DT] / (2.0 * math.pi * p[P_WHEEL_R]) * p[P_PPR]
+    s[pul] = math.floor(s[enc]) - math.floor(before)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def drive(s: State, cmd: tuple[int, int], p: Params, z: np.ndarray) -> None:
+def drive(s: np.ndarray, cmd: tuple[int, int], p: np.ndarray, z: np.ndarray) -> None:
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
-    dt = p.dt
-    amps = p.iidle + p.imotor * (duty(cmd[0], p.levels) + duty(cmd[1], p.levels))
-    volts = pack_volts(p.vfull, p.vempty, s.soc, amps, p.rint)
-    s.amps, s.vbat = amps, volts
-    s.soc = max(0.0, s.soc - amps * dt / p.cap)
-    s.v_r, s.enc_r, s.pul_r = motor(p, cmd[0], volts, s.gain_r, s.v_r, s.enc_r, z[Z_MOTOR_R])
-    s.v_l, s.enc_l, s.pul_l = motor(p, cmd[1], volts, s.gain_l, s.v_l, s.enc_l, z[Z_MOTOR_L])
-    turn = (s.v_r - s.v_l) / p.base * dt
-    ahead = 0.5 * (s.v_r + s.v_l) * dt
-    mid = s.th + 0.5 * turn  # midpoint heading: exact for straight runs and spins, close on arcs
-    s.x += ahead * math.cos(mid)
-    s.y += ahead * math.sin(mid)
-    s.th += turn
+    dt = p[P_DT]
+    amps = p[P_IIDLE] + p[P_IMOTOR] * (duty(cmd[0], p[P_LEVELS]) + duty(cmd[1], p[P_LEVELS]))
+    volts = pack_volts(p[P_VFULL], p[P_VEMPTY], s[SOC], amps, p[P_RINT])
+    s[AMPS], s[VBAT] = amps, volts
+    s[SOC] = max(0.0, s[SOC] - amps * dt / p[P_CAP])
+    motor(s, p, cmd[0], volts, GAIN_R, V_R, ENC_R, PUL_R, z[Z_MOTOR_R])
+    motor(s, p, cmd[1], volts, GAIN_L, V_L, ENC_L, PUL_L, z[Z_MOTOR_L])
+    turn = (s[V_R] - s[V_L]) / p[P_BASE] * dt
+    ahead = 0.5 * (s[V_R] + s[V_L]) * dt
+    mid = s[TH] + 0.5 * turn  # midpoint heading: exact for straight runs and spins, close on arcs
+    s[X] += ahead * math.cos(mid)
+    s[Y] += ahead * math.sin(mid)
+    s[TH] += turn
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def input_mask(s: State, bits: np.ndarray) -> int:
+def input_mask(s: np.ndarray, bits: np.ndarray) -> int:
     """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
     mask = 0
-    if s.bump_fr > 0.0:
+    if s[BUMP_FR] > 0.0:
         mask |= bits[B_FR]
-    if s.bump_fl > 0.0:
+    if s[BUMP_FL] > 0.0:
         mask |= bits[B_FL]
-    if s.bump_rear > 0.0:
+    if s[BUMP_REAR] > 0.0:
         mask |= bits[B_REAR]
-    if s.light_r >= 1.0:
+    if s[LIGHT_R] >= 1.0:
         mask |= bits[B_LIGHT_R]
-    if s.light_l >= 1.0:
+    if s[LIGHT_L] >= 1.0:
         mask |= bits[B_LIGHT_L]
     return mask
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_near(s: State, p: Params, z: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
+def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
                edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
                bits: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
                turns: np.ndarray) -> None:
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.physics.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
-    c, sn = math.cos(s.th), math.sin(s.th)
+    c, sn = math.cos(s[TH]), math.sin(s[TH])
     sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
     right = light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade)
-    s.light_r = max(0.0, right * (1.0 + p.nlight * z[Z_LIGHT_R]))
+    s[LIGHT_R] = max(0.0, right * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
     left = light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade)
-    s.light_l = max(0.0, left * (1.0 + p.nlight * z[Z_LIGHT_L]))
-    if p.sensor[0, F_KIND] != 0.0:  # declared sensors fill the slots from the first: none declared, no pass
+    s[LIGHT_L] = max(0.0, left * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
+    if p[P_SENSOR + F_KIND] != 0.0:  # declared sensors fill the slots from the first: none declared, no pass
         sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade)
-    previous = int(s.mask)
-    s.mask = input_mask(s, bits) | sensor_events(s, p, bits, previous)
+    previous = int(s[MASK])
+    s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def advance(s: State, right: int, left: int, p: Params, world: WorldArrays, bits: np.ndarray, move: bool,
+def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray, move: bool,
             scratch: Scratch) -> None:
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense, moved by the noise row ``scratch.z``; fills the robot's MASK column. ``scratch`` also keeps the
     robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.physics.contacts.new_near`)."""
     w, near, centre = world, scratch.near, scratch.centre
     if move:
-        x0, y0 = s.x, s.y
+        x0, y0 = s[X], s[Y]
         cmd = (right, left)
         drive(s, cmd, p, scratch.z)
         resolve(s, p, scratch.corners, w.verts, w.pstart, w.pbound, w.circles, scratch.reach, scratch.wide, near,
                 centre)
-        s.dist += math.hypot(s.x - x0, s.y - y0)
+        s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
     sense_near(s, p, scratch.z, w.verts, w.pstart, w.pbound, w.edges, w.circles, w.lamps, w.lines, w.shade, bits,
                scratch.reach, scratch.wide, near, centre, scratch.turns)
 
 
 @njit(cache=True, refcounts=False)
-def advance_called(s: State, right: int, left: int, p: Params, world: WorldArrays, bits: np.ndarray,
+def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray,
                    move: bool, scratch: Scratch) -> None:
     """:func:`advance` compiled once as a function of its own, for sim.physics.kernel.move and sense: the tick-by-tick
     robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
