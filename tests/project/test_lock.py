@@ -134,9 +134,9 @@ def vulnerability(name: str, fixed: str) -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def lock(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """numpy twice (one pin for Python 3.11, one for 3.12 and later) and six."""
-    path = small_lock(tmp_path_factory.mktemp("lock"), {"numpy", "six"})
-    assert [name for name, *_ in pins_of(path)] == ["numpy", "numpy", "six"]
+    """scipy twice (one pin for Python 3.11, one for 3.12 and later) and six."""
+    path = small_lock(tmp_path_factory.mktemp("lock"), {"scipy", "six"})
+    assert [name for name, *_ in pins_of(path)] == ["scipy", "scipy", "six"]
     return path
 
 
@@ -153,11 +153,11 @@ def test_a_clean_answer_for_every_pin_is_a_clean_audit(lock: Path) -> None:
 
 def test_a_vulnerability_in_another_pythons_pin_is_found(lock: Path) -> None:
     """The pin for Python 3.12 and later is audited too, though this machine would never install it."""
-    other = [version for name, version in pins_of(lock) if name == "numpy" and version != metadata.version("numpy")]
-    with osv({("numpy", other[0]): [vulnerability("numpy", "99.0")]}) as url:
+    other = [version for name, version in pins_of(lock) if name == "scipy" and version != metadata.version("scipy")]
+    with osv({("scipy", other[0]): [vulnerability("scipy", "99.0")]}) as url:
         done = audit(lock, url)
     assert done.returncode == 1, done.stdout + done.stderr
-    line = next(line for line in done.stdout.splitlines() if line.startswith(f"  numpy {other[0]}: "))
+    line = next(line for line in done.stdout.splitlines() if line.startswith(f"  scipy {other[0]}: "))
     assert "GHSA-test-0001" in line and "CVE-0000-0001" in line and line.endswith("; fixed in 99.0")
     assert "1 known vulnerability in" in done.stdout
     assert "no known vulnerabilities" not in done.stdout
