@@ -119,8 +119,9 @@ def test_an_english_page_keeps_its_decimal_point(browser: Any, studio: Backgroun
     page = open_page(browser, studio.url, "en-US")
     assert "8.95 s" in timer_times(page)
     assert "timer ran out" in page.eval_on_selector("table.grid thead", "e => e.textContent")
-    page.evaluate("() => { const b = document.querySelector('#battery'); b.value = 50;"
-                  " b.dispatchEvent(new Event('input')); }")
+    page.evaluate(
+        "() => { const b = document.querySelector('#battery'); b.value = 50; b.dispatchEvent(new Event('input')); }"
+    )
     assert page.inner_text("#battery-text") == "50%"
     assert re.match(r"tick [1-9]\d* · 0\.\d\d s · ", step_once(page))
     assert open_trace(page, 137).startswith("tick 137 · 1.37 s · ")
@@ -128,9 +129,7 @@ def test_an_english_page_keeps_its_decimal_point(browser: Any, studio: Backgroun
     page.context.close()
 
 
-def test_in_the_pseudo_language_the_words_found_in_german_are_between_markers(
-    browser: Any, studio: Background
-) -> None:
+def test_in_the_pseudo_language_the_words_found_in_german_are_between_markers(browser: Any, studio: Background) -> None:
     page = open_page(browser, studio.url, "en-US", kept="qps")
     heads = page.eval_on_selector("table.grid thead", "e => e.textContent")
     assert "⟦timer ran out⟧" in heads, heads
