@@ -86,14 +86,14 @@ def register_kind(kind: SensorKind) -> SensorKind:
 
 
 register_kind(SensorKind(
-    "line", ("line",), 1, "", "", "1 over a line", ("line", 1.0, 0), "spot"))
+    "line", ("line",), 1, "", "", N_("1 over a line"), ("line", 1.0, 0), "spot"))
 register_kind(SensorKind(
     "distance", ("distance", "ultrasonic"), 2, "length", '"20 cm"', "", ("cm", 100.0, 1), "beam",
     spread=("distance", "beam"), panel=Panel("distance (cm)\n-- on, ·· off", 100.0, False, 1),
     modes={"ultrasonic": 100.0}, high=lambda params, light: params["distance"]["range"]))
 register_kind(SensorKind(
     "light", ("phototransistor", "photoresistor", "light"), 3, "level", "1.5",
-    "1 is the level at which a phototransistor switches", ("light", 1.0, 4), "cone",
+    N_("1 is the level at which a phototransistor switches"), ("light", 1.0, 4), "cone",
     spread=("light", "half_response"), panel=Panel("light\n(× threshold)", 1.0, True, 0),
     high=lambda params, light: light))
 
@@ -286,7 +286,7 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: SensorKind) -> tup
         if not is_number(raw):
             src.key_error(where, N_("[sensors] {name}: {key} must be a {kind} level (a number), not {raw!r}",
                                     name=name, key=key, kind=kind.name, raw=raw),
-                          f"{kind.reads}: {key} = {kind.example}")
+                          N_("{reads}: {key} = {example}", reads=kind.reads, key=key, example=kind.example))
             return None
         metres = float(raw)
     if metres < 0 or not math.isfinite(metres):

@@ -11,6 +11,8 @@ from pathlib import Path
 SOURCE = Path(__file__).resolve().parents[2] / "src" / "tablebot"
 #: Where each builder takes its message and hint: positions and keywords.
 SLOTS = {"fail": ((1, 2), ("message", "hint")), "Diagnostic": ((3, 4), ("message", "hint"))}
+#: A collector's methods (diagnostics.Collector, tomlfile.Source, robopro's wiring reader): the place comes first.
+COLLECTING = ("error", "key_error")
 #: The few that stay as written, with why: a command to type reads the same in every language.
 ALLOWED = {
     ("firmware/monitor.py", "pip install pyserial"),
@@ -31,20 +33,29 @@ def plain(node: ast.expr) -> str | None:
 def builder(call: ast.Call) -> str | None:
     func = call.func
     name = func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else None
-    return name if name in SLOTS else None
+    return name if name in SLOTS or name in COLLECTING else None
+
+
+def given_text(call: ast.Call, name: str) -> list[ast.expr]:
+    """The arguments of ``call`` that carry a message or a hint."""
+    if name in COLLECTING:  # everything after the place (a line, a key, a Where)
+        return [*call.args[1:], *(k.value for k in call.keywords)]
+    positions, keywords = SLOTS[name]
+    return [a for i, a in enumerate(call.args) if i in positions] + [
+        k.value for k in call.keywords if k.arg in keywords
+    ]
 
 
 def unmarked(tree: ast.AST) -> list[tuple[int, str]]:
-    """(line, text) of every message or hint given to a builder as plain text."""
+    """(line, text) of every message or hint given to a builder as plain text (given to a collector, a word
+    without a space is a key or a name, not a message)."""
     found = []
     for call in (n for n in ast.walk(tree) if isinstance(n, ast.Call)):
         name = builder(call)
-        if name is None:
-            continue
-        positions, keywords = SLOTS[name]
-        given = [a for i, a in enumerate(call.args) if i in positions]
-        given += [k.value for k in call.keywords if k.arg in keywords]
-        found += [(call.lineno, text) for text in map(plain, given) if text is not None]
+        for node in given_text(call, name) if name is not None else []:
+            text = plain(node)
+            if text is not None and (name in SLOTS or " " in text or isinstance(node, ast.JoinedStr)):
+                found.append((call.lineno, text))
     return found
 
 
@@ -63,5 +74,13 @@ def test_the_check_sees_each_kind_of_plain_text() -> None:
     code = (
         'fail("x", "plain")\nfail("x", N_("ok"), f"hint {n}")\nDiagnostic(p, 1, 2, "a" + b)\n'
         'fail("x", message, hint="kw")\nfail("x", N_("ok"), "")\nerrors.Diagnostic(p, 1, 2, N_("ok"), N_("ok"))\n'
+        'out.error(3, None, "two words", N_("ok"))\nsrc.key_error(where, N_("ok"), f"{a}")\nr.error("key", N_("ok"))\n'
     )
-    assert unmarked(ast.parse(code)) == [(1, "plain"), (2, "f'hint {n}'"), (3, "a"), (4, "kw")]
+    assert unmarked(ast.parse(code)) == [
+        (1, "plain"),
+        (2, "f'hint {n}'"),
+        (3, "a"),
+        (4, "kw"),
+        (7, "two words"),
+        (8, "f'{a}'"),
+    ]
