@@ -42,14 +42,18 @@ for _folder in FOLDERS:
 
 #: The markers, declared in the modules they apply to (``pytestmark = [pytest.mark.realtime]``):
 MARKERS = {
-    "realtime": "holds a controller, a link or a page to the wall clock (10 ms ticks, replies due within 50 ms, a "
-                "tick that must come late or not); `make test` runs these in a pass of their own after the parallel "
-                "one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them",
+    "realtime": (
+        "holds a controller, a link or a page to the wall clock (10 ms ticks, replies due within 50 ms, a "
+        "tick that must come late or not); `make test` runs these in a pass of their own after the parallel "
+        "one, two at a time: they mostly sleep, and nothing CPU-bound runs beside them"
+    ),
     "browser": "drives Chromium: one browser at a time (one xdist worker), beside the other worker's tests",
-    "kernel_free": "runs no simulator kernel (measured: run alone on an empty numba cache, it compiles nothing, or "
-                   "only a small function of its own in seconds); these run first, while the kernels compile. A "
-                   "module wrongly marked is not wrong, only slow (it compiles the kernels itself), and the "
-                   "session's summary names it",
+    "kernel_free": (
+        "runs no simulator kernel (measured: run alone on an empty numba cache, it compiles nothing, or "
+        "only a small function of its own in seconds); these run first, while the kernels compile. A "
+        "module wrongly marked is not wrong, only slow (it compiles the kernels itself), and the "
+        "session's summary names it"
+    ),
 }
 #: Kernels big enough that compiling them in a kernel-free module means the module is not one (see MARKERS).
 BIG_KERNELS = ("kernel.run_ticks", "kernel.move", "kernel.sense", "kernel.run_fleet")
@@ -84,9 +88,17 @@ class _WarmUp:
         self.shared, self.marker, self.started = shared, marker, time.monotonic()
         self.seconds: float | None = None
         env = {**os.environ, "NUMBA_CACHE_DIR": shared}
-        self.parts = [subprocess.Popen([sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names], env=env,
-                                       cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-                      for names in (["loop", "fleet"], ["tick", "archive", "several"])]
+        self.parts = [
+            subprocess.Popen(
+                [sys.executable, str(ROOT / "tests" / "warm_kernels.py"), *names],
+                env=env,
+                cwd=ROOT,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for names in (["loop", "fleet"], ["tick", "archive", "several"])
+        ]
         self.thread = threading.Thread(target=self._wait, name="numba warm-up", daemon=True)
         self.thread.start()
 
@@ -114,8 +126,10 @@ def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> Non
         terminalreporter.write_line(config.stash[_WARMUP].said())
     slow = config.stash.get(_NOT_FREE, None)
     if slow:
-        terminalreporter.write_line("modules marked kernel_free compiled a simulator kernel "
-                                    f"before the warm-up ended (take them out): {', '.join(sorted(slow))}")
+        terminalreporter.write_line(
+            "modules marked kernel_free compiled a simulator kernel "
+            f"before the warm-up ended (take them out): {', '.join(sorted(slow))}"
+        )
 
 
 _NOT_FREE = pytest.StashKey[set[str]]()
@@ -215,9 +229,14 @@ def _copy_new_files(source: Path, target: Path) -> None:
     worker compiled itself keeps its own files."""
     if not source.is_dir():
         return
-    files = sorted((p for p in source.rglob("*") if p.is_file()
-                    and not any(part.startswith("worker-") for part in p.relative_to(source).parts)),
-                   key=lambda p: p.suffix == ".nbi")
+    files = sorted(
+        (
+            p
+            for p in source.rglob("*")
+            if p.is_file() and not any(part.startswith("worker-") for part in p.relative_to(source).parts)
+        ),
+        key=lambda p: p.suffix == ".nbi",
+    )
     for path in files:
         destination = target / path.relative_to(source)
         if destination.exists() or (path.suffix == ".nbc" and _indexed(destination)):

@@ -4,6 +4,7 @@ gives the session Python's handler back, so the commands the tests start can be 
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -24,11 +25,18 @@ def test_a_command_started_by_a_test_hears_ctrl_c() -> None:
 
 
 def test_a_session_started_with_ctrl_c_ignored_hears_it_again() -> None:
-    """pytest started as a background job starts it (SIGINT ignored, inherited through exec)."""
+    """pytest started as a background job starts it (SIGINT ignored, inherited through exec), a session of its
+    own: not this worker's (xdist's and the numba warm-up's variables left out)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTEST_", "TABLEBOT_TEST_", "COV_CORE"))}
+    test = f"{Path(__file__).name}::test_a_command_started_by_a_test_hears_ctrl_c"
     done = subprocess.run(
-        [sys.executable, "-m", "pytest", f"{Path(__file__).name}::test_a_command_started_by_a_test_hears_ctrl_c",
-         "-v", "-n", "0", "-p", "no:cacheprovider"],  # -v: the summary line addopts' -q leaves out
-        cwd=Path(__file__).parent, capture_output=True, text=True, timeout=300,
+        # -v: the summary line addopts' -q leaves out
+        [sys.executable, "-m", "pytest", test, "-v", "-n", "0", "-p", "no:cacheprovider"],
+        cwd=Path(__file__).parent,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
     )
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
