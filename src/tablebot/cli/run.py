@@ -85,9 +85,10 @@ def _drive(connection: Connection, seconds: float | None, out: Path | None, quie
     return done
 
 
-#: Why a run ended (tablebot.loop.EXIT_CODES' keys, which records keep as they are), in the reader's words.
-REASONS = {"done": N_("done"), "stopped": N_("stopped"), "error": N_("error"), "link_lost": N_("link lost"),
-           "watchdog": N_("watchdog"), "behind": N_("fell behind"), "interrupted": N_("interrupted"),
+#: Why a run ended (tablebot.loop.EXIT_CODES' keys, which records keep as they are), in the reader's words; the
+#: English words are the keys themselves, as the command always said them.
+REASONS = {"done": N_("done"), "stopped": N_("stopped"), "error": N_("error"), "link_lost": N_("link_lost"),
+           "watchdog": N_("watchdog"), "behind": N_("behind"), "interrupted": N_("interrupted"),
            "terminated": N_("terminated")}
 
 
