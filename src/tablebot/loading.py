@@ -177,8 +177,13 @@ class Loaded:
                 robot.source,
                 robot.line("tables"),
                 1,
-                N_("{what} runs the main table ({main}) only so far, not {others}: the outputs only they write "
-                   "stay at 0", what=what, main=self.tables.names[0], others=others),
+                N_(
+                    "{what} runs the main table ({main}) only so far, not {others}: the outputs only they write "
+                    "stay at 0",
+                    what=what,
+                    main=self.tables.names[0],
+                    others=others,
+                ),
                 N_("tablebot trace, check and diagram run every table (docs/engine.md, Several tables)"),
                 "note",
             )

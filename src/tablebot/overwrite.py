@@ -87,20 +87,26 @@ def writing(path: str | Path, is_user_file: Callable[[Path], bool]) -> None:
         return
     path = Path(path)
     if _is_input(scope, path):
-        raise fail(path, N_("this command reads this file, so it will not write over it"),
-                   N_("write the output to another file"))
+        raise fail(
+            path,
+            N_("this command reads this file, so it will not write over it"),
+            N_("write the output to another file"),
+        )
     key = os.path.realpath(path)
     if key in scope.replaced or not path.is_file() or not is_user_file(path):
         return
     if not scope.force and not scope.offered:
-        raise fail(path, N_("{name} exists and is a {kind}: this command never replaces it",
-                              name=path.name, kind=kind(path)),
-                   N_("write into another folder, or move the file away"))
+        raise fail(
+            path,
+            N_("{name} exists and is a {kind}: this command never replaces it", name=path.name, kind=kind(path)),
+            N_("write into another folder, or move the file away"),
+        )
     if not scope.force:
-        raise fail(path, N_("{name} exists and is a {kind}: it is not replaced without --force",
-                              name=path.name, kind=kind(path)),
-                   N_("write to another file, or add --force (the old file is then kept as {name}.bak)",
-                      name=path.name))
+        raise fail(
+            path,
+            N_("{name} exists and is a {kind}: it is not replaced without --force", name=path.name, kind=kind(path)),
+            N_("write to another file, or add --force (the old file is then kept as {name}.bak)", name=path.name),
+        )
     _back_up(scope, path)
 
 
@@ -156,9 +162,15 @@ def not_a_link(path: Path) -> None:
     except OSError:
         special = False  # a dangling link: writing would create whatever it names
     if not special:
-        raise fail(path, N_("{name} is a symbolic link (to {target}): tablebot never writes through a link",
-                              name=path.name, target=os.readlink(path)),
-                   N_("remove the link, or give the path of the file it points to if that is the one to replace"))
+        raise fail(
+            path,
+            N_(
+                "{name} is a symbolic link (to {target}): tablebot never writes through a link",
+                name=path.name,
+                target=os.readlink(path),
+            ),
+            N_("remove the link, or give the path of the file it points to if that is the one to replace"),
+        )
 
 
 def kind(path: Path) -> Message:

@@ -135,8 +135,11 @@ def check(project: Loaded, *, targets: Sequence[str] = (), progress: Progress | 
     known = registry.check_targets()
     for name in targets:
         if name not in known:
-            raise fail("--target", N_("unknown export target {name!r}", name=name),
-                       N_("use one of {known}", known=tuple(known)))
+            raise fail(
+                "--target",
+                N_("unknown export target {name!r}", name=name),
+                N_("use one of {known}", known=tuple(known)),
+            )
     props = project.properties()
     shown.start("steps", 3 + len(props), done=1)  # reading is done; exploring, findings, then each property
     try:

@@ -25,8 +25,15 @@ def targets() -> list[str]:
     return [b.name for b in registry.exporters("export")]
 
 
-def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathLike | None = None,
-           lists: Sequence[str] | None = None, lookup: str = "auto") -> Exported:
+def export(
+    project: Loaded,
+    to: str,
+    out: PathLike | None = None,
+    *,
+    into: PathLike | None = None,
+    lists: Sequence[str] | None = None,
+    lookup: str = "auto",
+) -> Exported:
     """Export the table (``tablebot export TABLE OUT --to TO``): its files replace an earlier export's in
     ``out`` all at once (a table or robot file of yours is never replaced). ``into``: the ROBO Pro program to
     update (``robopro-rpp``); ``lists``: its event, action and timer lists' names; ``lookup``: the C engine's
@@ -41,13 +48,18 @@ def export(project: Loaded, to: str, out: PathLike | None = None, *, into: PathL
 
     backend = registry.exporter(to)
     if backend is None or backend.kind != "export":
-        raise fail("--to", N_("unknown export target {name!r}", name=to),
-                   N_("use one of {known}", known=tuple(targets())))
+        raise fail(
+            "--to", N_("unknown export target {name!r}", name=to), N_("use one of {known}", known=tuple(targets()))
+        )
     if out is None and backend.needs_out:
-        raise fail("OUTDIR", N_("--to {to} needs a folder to write into", to=to),
-                   N_("tablebot export TABLE OUTDIR --to {to}", to=to))
-    options = registry.ExportOptions(into=Path(into) if into is not None else None, lists=_three(lists),
-                                     lookup=_lookup(lookup))
+        raise fail(
+            "OUTDIR",
+            N_("--to {to} needs a folder to write into", to=to),
+            N_("tablebot export TABLE OUTDIR --to {to}", to=to),
+        )
+    options = registry.ExportOptions(
+        into=Path(into) if into is not None else None, lists=_three(lists), lookup=_lookup(lookup)
+    )
     with project.writing():
         return backend.export(project.machine, Path(out) if out is not None else None, options)
 
@@ -57,13 +69,17 @@ def _three(lists: Sequence[str] | None) -> tuple[str, str, str] | None:
     if lists is None:
         return None
     if len(lists) != 3:
-        raise fail("--event-list", N_("give three list names (event, action, timer), not {n}", n=len(lists)),
-                   N_("--event-list, --action-list and --timer-list"))
+        raise fail(
+            "--event-list",
+            N_("give three list names (event, action, timer), not {n}", n=len(lists)),
+            N_("--event-list, --action-list and --timer-list"),
+        )
     return lists[0], lists[1], lists[2]
 
 
 def _lookup(lookup: str) -> Lookup:
     if lookup not in LOOKUPS:
-        raise fail("--lookup", N_("unknown lookup {name!r}", name=lookup),
-                   N_("use one of {known}", known=tuple(LOOKUPS)))
+        raise fail(
+            "--lookup", N_("unknown lookup {name!r}", name=lookup), N_("use one of {known}", known=tuple(LOOKUPS))
+        )
     return lookup  # type: ignore[return-value]  # one of LOOKUPS

@@ -191,8 +191,11 @@ def trace_runs(runs: Traced, total: int) -> list[int]:
             raise fail("--trace", exc.diagnostics[0].message, N_("give run numbers: 0,17 or 0..9")) from None
     beyond = [k for k in runs if not 0 <= k < total]
     if beyond:
-        raise fail("--trace", N_("--trace {run}: the sweep has runs 0..{last}", run=beyond[0], last=total - 1),
-                   N_("give run numbers it has"))
+        raise fail(
+            "--trace",
+            N_("--trace {run}: the sweep has runs 0..{last}", run=beyond[0], last=total - 1),
+            N_("give run numbers it has"),
+        )
     return list(runs)
 
 

@@ -47,8 +47,12 @@ def _pick(rng: np.random.Generator, items: Sequence[int]) -> int | None:
 
 def motor(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """One motor cell of one row: a step of 1 or 2, reversed, stopped, kept or any speed."""
-    cells = [(i, m) for i, gene in enumerate(c) for m, name in enumerate(space.motors)
-             if space.may_set(name) and not space.limits.cell_frozen(gene, name)]
+    cells = [
+        (i, m)
+        for i, gene in enumerate(c)
+        for m, name in enumerate(space.motors)
+        if space.may_set(name) and not space.limits.cell_frozen(gene, name)
+    ]
     if not cells:
         return None
     i, m = cells[int(rng.integers(len(cells)))]
@@ -68,26 +72,38 @@ def motor(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | N
     if new == old or (new is not None and new not in speeds):
         return None
     motors = tuple(new if k == m else v for k, v in enumerate(c[i].motors))
-    return (*c[:i], replace(c[i], motors=motors), *c[i + 1:])
+    return (*c[:i], replace(c[i], motors=motors), *c[i + 1 :])
 
 
 def lamp(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """One lamp cell of one row (a table of several that writes lamps): off, full, a step of 1 or 2, any level,
     or kept."""
-    cells = [(i, k) for i, gene in enumerate(c) for k in space.own_lamps()
-             if not space.limits.cell_frozen(gene, space.lamps[k])]
+    cells = [
+        (i, k)
+        for i, gene in enumerate(c)
+        for k in space.own_lamps()
+        if not space.limits.cell_frozen(gene, space.lamps[k])
+    ]
     if not cells:
         return None
     i, k = cells[int(rng.integers(len(cells)))]
     old = c[i].lamps[k]
     choice = int(rng.integers(5))
-    new: int | None = (0 if choice == 0 else MAX_LAMP if choice == 1 else None if choice == 2 else
-                       int(rng.integers(0, MAX_LAMP + 1)) if choice == 3 or old is None else
-                       int(np.clip(old + int(rng.choice([-2, -1, 1, 2])), 0, MAX_LAMP)))
+    new: int | None = (
+        0
+        if choice == 0
+        else MAX_LAMP
+        if choice == 1
+        else None
+        if choice == 2
+        else int(rng.integers(0, MAX_LAMP + 1))
+        if choice == 3 or old is None
+        else int(np.clip(old + int(rng.choice([-2, -1, 1, 2])), 0, MAX_LAMP))
+    )
     if new == old:
         return None
     lamps = tuple(new if n == k else v for n, v in enumerate(c[i].lamps))
-    return (*c[:i], replace(c[i], lamps=lamps), *c[i + 1:])
+    return (*c[:i], replace(c[i], lamps=lamps), *c[i + 1 :])
 
 
 def timer(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
@@ -103,7 +119,7 @@ def timer(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | N
         new = int(np.clip(round(old * float(np.exp(rng.normal(0.0, 0.5)))), 0, top))
     if new == old:
         new = min(top, old + 1)
-    return None if new == old else (*c[:i], replace(c[i], timer=new), *c[i + 1:])
+    return None if new == old else (*c[:i], replace(c[i], timer=new), *c[i + 1 :])
 
 
 def next_state(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
@@ -113,7 +129,7 @@ def next_state(c: Candidate, space: Space, rng: np.random.Generator) -> Candidat
     if i is None or len(space.states) < 2:
         return None
     choices = [s for s in space.states if s != c[i].next]
-    return (*c[:i], replace(c[i], next=choices[int(rng.integers(len(choices)))]), *c[i + 1:])
+    return (*c[:i], replace(c[i], next=choices[int(rng.integers(len(choices)))]), *c[i + 1 :])
 
 
 def add_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
@@ -125,8 +141,11 @@ def add_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate |
     open_states = [s for s in space.states if not space.limits.state_frozen(s)]
     if not open_states:
         return None
-    state = source.state if rng.random() < 0.5 and source.state in open_states else \
-        open_states[int(rng.integers(len(open_states)))]
+    state = (
+        source.state
+        if rng.random() < 0.5 and source.state in open_states
+        else open_states[int(rng.integers(len(open_states)))]
+    )
     where = [i for i, gene in enumerate(c) if gene.state == state]
     slots = [*where, where[-1] + 1] if where else [len(c)]
     at = slots[int(rng.integers(len(slots)))]
@@ -137,21 +156,23 @@ def add_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate |
 
 def remove_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """Remove a row that may be removed, when its state keeps another."""
-    rows = [i for i, gene in enumerate(c) if not space.limits.row_fixed(gene)
-            and sum(g.state == gene.state for g in c) > 1]
+    rows = [
+        i for i, gene in enumerate(c) if not space.limits.row_fixed(gene) and sum(g.state == gene.state for g in c) > 1
+    ]
     i = _pick(rng, rows)
-    return None if i is None else (*c[:i], *c[i + 1:])
+    return None if i is None else (*c[:i], *c[i + 1 :])
 
 
 def move_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """Move a row to another place among its state's rows (which row of the state is tried first)."""
-    rows = [i for i, gene in enumerate(c) if not space.limits.row_fixed(gene)
-            and sum(g.state == gene.state for g in c) > 1]
+    rows = [
+        i for i, gene in enumerate(c) if not space.limits.row_fixed(gene) and sum(g.state == gene.state for g in c) > 1
+    ]
     i = _pick(rng, rows)
     if i is None:
         return None
     gene = c[i]
-    rest = (*c[:i], *c[i + 1:])
+    rest = (*c[:i], *c[i + 1 :])
     places = [k for k, g in enumerate(rest) if g.state == gene.state]
     places.append(places[-1] + 1)
     at = places[int(rng.integers(len(places)))]
@@ -162,8 +183,12 @@ def move_row(c: Candidate, space: Space, rng: np.random.Generator) -> Candidate 
 def take_state(c: Candidate, other: Candidate, space: Space, rng: np.random.Generator) -> Candidate | None:
     """Crossover: the rows of one state (that may change) taken from a second parent, where this
     parent's rows of that state first were."""
-    differ = [s for s in space.states if not space.limits.state_frozen(s)
-              and [g.effect() for g in c if g.state == s] != [g.effect() for g in other if g.state == s]]
+    differ = [
+        s
+        for s in space.states
+        if not space.limits.state_frozen(s)
+        and [g.effect() for g in c if g.state == s] != [g.effect() for g in other if g.state == s]
+    ]
     if not differ:
         return None
     state = differ[int(rng.integers(len(differ)))]
@@ -172,20 +197,25 @@ def take_state(c: Candidate, other: Candidate, space: Space, rng: np.random.Gene
         return None
     theirs = tuple(g for g in other if g.state == state)
     rest = [g for g in c if g.state != state]
-    out = (*rest[:mine[0]], *theirs, *rest[mine[0]:])
+    out = (*rest[: mine[0]], *theirs, *rest[mine[0] :])
     return out if len(out) <= space.limits.max_rows else None
 
 
 OPERATORS: dict[str, tuple[Operator, float]] = {
-    "motor": (motor, 3.0), "timer": (timer, 3.0), "next": (next_state, 1.0), "add": (add_row, 1.0),
-    "remove": (remove_row, 1.0), "move": (move_row, 1.0),
+    "motor": (motor, 3.0),
+    "timer": (timer, 3.0),
+    "next": (next_state, 1.0),
+    "add": (add_row, 1.0),
+    "remove": (remove_row, 1.0),
+    "move": (move_row, 1.0),
     "lamp": (lamp, 3.0),  # last, and weighed 0 where no lamp may change: a robot of one table draws as it did
 }
 CROSSOVER_RATE = 0.2
 
 
-def vary(parent: Candidate, space: Space, rng: np.random.Generator, other: Candidate | None = None,
-         tries: int = 50) -> Candidate | None:
+def vary(
+    parent: Candidate, space: Space, rng: np.random.Generator, other: Candidate | None = None, tries: int = 50
+) -> Candidate | None:
     """A child of ``parent``: a crossover with ``other`` now and then, then one or more mutations (one
     most often, a few at times); None when nothing could change."""
     names = list(OPERATORS)

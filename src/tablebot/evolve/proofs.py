@@ -40,16 +40,22 @@ def canonical(machine: Machine) -> str:
         raise ValueError("canonical form needs a table of at most FLAT_BITS event columns")
     width = 1 << len(machine.table.events)
     rows = machine.rows
+
     def effect(index: int) -> list | None:
         if index < 0:
             return None
         row = rows[index]
         return [str(machine.states[row.next]), row.timer, list(row.outputs), list(row.loads)]
-    per_state = {str(state): [effect(flat[s * width + e]) for e in range(width)]
-                 for s, state in enumerate(machine.states)}
-    data = {"events": list(machine.table.events), "outputs": list(machine.output_names),
-            "start": [str(machine.states[machine.initial_state]), machine.initial_timer],
-            "states": dict(sorted(per_state.items()))}
+
+    per_state = {
+        str(state): [effect(flat[s * width + e]) for e in range(width)] for s, state in enumerate(machine.states)
+    }
+    data = {
+        "events": list(machine.table.events),
+        "outputs": list(machine.output_names),
+        "start": [str(machine.states[machine.initial_state]), machine.initial_timer],
+        "states": dict(sorted(per_state.items())),
+    }
     return hashlib.sha256(json.dumps(data, separators=(",", ":")).encode()).hexdigest()[:24]
 
 
@@ -202,10 +208,18 @@ def refuse_line_conditions(prover: Prover, machine: Machine) -> None:
         texts = [c.text for c in (prop.cond, prop.when, prop.then) if c is not None]
         if any(LINE_WORD.search(text) for text in texts):
             where = f"{prop.source}:{prop.line}" if prop.line else prop.source
-            raise fail(where, N_("property {name} names a file line; evolve adds, removes and moves rows, so a line "
-                                  "number would name another row", name=prop.name),
-                       N_("write the property with states, events and outputs instead of line (or give evolve "
-                          "other properties with --properties)"))
+            raise fail(
+                where,
+                N_(
+                    "property {name} names a file line; evolve adds, removes and moves rows, so a line "
+                    "number would name another row",
+                    name=prop.name,
+                ),
+                N_(
+                    "write the property with states, events and outputs instead of line (or give evolve "
+                    "other properties with --properties)"
+                ),
+            )
 
 
 def refuse_fixed(whole: Whole, prover: Prover) -> None:
@@ -216,9 +230,20 @@ def refuse_fixed(whole: Whole, prover: Prover) -> None:
         if whole.depends(prop) or prover.check(prop, robot.machines[whole.index]).status == "holds":
             continue
         deciders = ", ".join(robot.names[k] for k in sorted(robot.influence(prop.tables)))
-        raise fail("--table", N_("--table {name}: property {prop} fails in the robot as it is, and only table "
-                                 "{deciders} decides it, which evolve --table {name} leaves as it is, so no "
-                                 "{name} table could keep it", name=whole.name, prop=prop.name, deciders=deciders),
-                   N_("mend table {deciders} first (tablebot check shows the counterexample; evolve --table "
-                      "repairs the table it evolves), or give --properties files without {prop}", deciders=deciders,
-                      prop=prop.name))
+        raise fail(
+            "--table",
+            N_(
+                "--table {name}: property {prop} fails in the robot as it is, and only table "
+                "{deciders} decides it, which evolve --table {name} leaves as it is, so no "
+                "{name} table could keep it",
+                name=whole.name,
+                prop=prop.name,
+                deciders=deciders,
+            ),
+            N_(
+                "mend table {deciders} first (tablebot check shows the counterexample; evolve --table "
+                "repairs the table it evolves), or give --properties files without {prop}",
+                deciders=deciders,
+                prop=prop.name,
+            ),
+        )

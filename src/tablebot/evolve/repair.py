@@ -61,8 +61,9 @@ class Repaired:
 PREFERENCES = ("keep", "copy")
 
 
-def repair(candidate: Candidate, base: Table, prover: Prover, space: Space, prefer: str = "keep",
-           max_steps: int = 30) -> Repaired:
+def repair(
+    candidate: Candidate, base: Table, prover: Prover, space: Space, prefer: str = "keep", max_steps: int = 30
+) -> Repaired:
     """Add guard rows until every property holds (or no proposal helps, or ``max_steps`` rows are in).
     Among guard rows that mend equally well, ``prefer`` decides: "keep" (keep going while pressed) or
     "copy" (do what another row does for those inputs); evolve seeds its archive with both repairs."""
@@ -114,8 +115,7 @@ def weigh(mended: Candidate, base: Table, prover: Prover, target: Result, before
         return None
     results, stuck = prover.results(machine)
     after = Weighed(machine, results, stuck)
-    if score(after, target.prop.name) > score(before, target.prop.name) or \
-            set(after.failing) - set(before.failing):
+    if score(after, target.prop.name) > score(before, target.prop.name) or set(after.failing) - set(before.failing):
         return None
     return after
 
@@ -126,8 +126,14 @@ def score(report: Weighed, name: str) -> tuple[int, int]:
     return len(report.failing), -(len(target.inputs) if target is not None else 10**9)
 
 
-def guard_proposals(candidate: Candidate, machine: Machine, result: Result, space: Space,
-                    prefer: str = "keep", whole: Whole | None = None) -> list[tuple[Candidate, Step]]:
+def guard_proposals(
+    candidate: Candidate,
+    machine: Machine,
+    result: Result,
+    space: Space,
+    prefer: str = "keep",
+    whole: Whole | None = None,
+) -> list[tuple[Candidate, Step]]:
     """Candidates with one guard row added where the counterexample goes wrong (see the module doc); of a
     robot of several tables (``whole``), the counterexample replays every table, and the guard rows are the
     evolved table's."""
@@ -137,7 +143,7 @@ def guard_proposals(candidate: Candidate, machine: Machine, result: Result, spac
     watched = _watched(machine, result) if whole is None else whole.watched(result.prop)
     out: list[tuple[Candidate, Step]] = []
     seen: set[tuple] = set()
-    for state, pressed, fired in ticks[max(0, len(ticks) - window):]:
+    for state, pressed, fired in ticks[max(0, len(ticks) - window) :]:
         if space.limits.state_frozen(state) or len(candidate) >= space.limits.max_rows:
             continue
         guard = (pressed & watched) or pressed
@@ -184,16 +190,33 @@ def _actions(table: Table, state: StateId, events: frozenset[str], prop: str, pr
         does = f"{what.text}{', ' + what.timer if what.timer else ''}"
         # Messages, not text: made in a worker process, said in the reader's language by the report
         text = N_("{when}: {action} (guard for {prop})", when=when, action=does, prop=prop)
-        gene = Gene(state, events, row.motors, row.timer, row.next, text, row.counters, row.lamps,
-                    note=N_("guard for {prop}, doing what line {line} does", prop=prop, line=row.line))
+        gene = Gene(
+            state,
+            events,
+            row.motors,
+            row.timer,
+            row.next,
+            text,
+            row.counters,
+            row.lamps,
+            note=N_("guard for {prop}, doing what line {line} does", prop=prop, line=row.line),
+        )
         copies.setdefault(gene.effect(), gene)
     keep = (None,) * len(table.robot.motors)
     lamps = (None,) * len(table.robot.lamps)
     counters = (None,) * len(table.robot.counter_names)
     for ticks in STAY_TIMERS:
-        gene = Gene(state, events, keep, ticks, state, N_("{when}: keep going (guard for {prop})", when=when,
-                                                           prop=prop), counters, lamps,
-                    note=N_("guard for {prop}: keep the motors while {when}", prop=prop, when=when))
+        gene = Gene(
+            state,
+            events,
+            keep,
+            ticks,
+            state,
+            N_("{when}: keep going (guard for {prop})", when=when, prop=prop),
+            counters,
+            lamps,
+            note=N_("guard for {prop}: keep the motors while {when}", prop=prop, when=when),
+        )
         keeps.setdefault(gene.effect(), gene)
     first, second = (keeps, copies) if prefer == "keep" else (copies, keeps)
     return [*first.values(), *second.values()]

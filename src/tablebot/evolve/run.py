@@ -88,9 +88,14 @@ class Store:
     def open(self) -> dict[str, Means]:
         spec_file = self.folder / "spec.json"
         if spec_file.exists() and spec_file.read_text(encoding="utf-8") != self.spec:
-            raise fail(self.folder, N_("--out holds another evolve run (another table, robot file, world, properties, "
-                                          "scenarios, objective, descriptors, limits or seed)"),
-                       N_("give --out a new folder, or delete this one to start over"))
+            raise fail(
+                self.folder,
+                N_(
+                    "--out holds another evolve run (another table, robot file, world, properties, "
+                    "scenarios, objective, descriptors, limits or seed)"
+                ),
+                N_("give --out a new folder, or delete this one to start over"),
+            )
         if not spec_file.exists():
             write_text(spec_file, self.spec)
         # a line cut by a kill is skipped: that candidate runs again
@@ -104,8 +109,15 @@ class Store:
         try:
             return [repaired_from_json(item) for item in json.loads(path.read_text(encoding="utf-8", errors="replace"))]
         except (ValueError, KeyError, TypeError, IndexError):  # written whole, so damaged or edited since
-            notify(Diagnostic(str(path), None, None, N_("not the repairs evolve writes: the repair is made again"),
-                              severity="note"))
+            notify(
+                Diagnostic(
+                    str(path),
+                    None,
+                    None,
+                    N_("not the repairs evolve writes: the repair is made again"),
+                    severity="note",
+                )
+            )
             return None
 
     def keep_repairs(self, repairs: Sequence[Repaired]) -> None:
@@ -117,26 +129,52 @@ class Store:
 
 
 def gene_to_json(gene: Gene) -> dict[str, Any]:
-    return {"state": gene.state, "events": sorted(gene.events), "motors": list(gene.motors), "timer": gene.timer,
-            "next": gene.next, "description": gene.description, "counters": list(gene.counters),
-            "lamps": list(gene.lamps), "origin": gene.origin, "note": gene.note}
+    return {
+        "state": gene.state,
+        "events": sorted(gene.events),
+        "motors": list(gene.motors),
+        "timer": gene.timer,
+        "next": gene.next,
+        "description": gene.description,
+        "counters": list(gene.counters),
+        "lamps": list(gene.lamps),
+        "origin": gene.origin,
+        "note": gene.note,
+    }
 
 
 def gene_from_json(item: dict[str, Any]) -> Gene:
-    return Gene(item["state"], frozenset(item["events"]), tuple(item["motors"]), item["timer"], item["next"],
-                item["description"], tuple(item["counters"]), tuple(item["lamps"]), item["origin"], item["note"])
+    return Gene(
+        item["state"],
+        frozenset(item["events"]),
+        tuple(item["motors"]),
+        item["timer"],
+        item["next"],
+        item["description"],
+        tuple(item["counters"]),
+        tuple(item["lamps"]),
+        item["origin"],
+        item["note"],
+    )
 
 
 def repaired_to_json(r: Repaired) -> dict[str, Any]:
-    return {"candidate": [gene_to_json(g) for g in r.candidate], "failing": list(r.failing),
-            "proposals": r.proposals, "steps": [{"prop": s.prop, "state": s.state, "gene": gene_to_json(s.gene),
-                                                 "ticks": s.counterexample_ticks} for s in r.steps]}
+    return {
+        "candidate": [gene_to_json(g) for g in r.candidate],
+        "failing": list(r.failing),
+        "proposals": r.proposals,
+        "steps": [
+            {"prop": s.prop, "state": s.state, "gene": gene_to_json(s.gene), "ticks": s.counterexample_ticks}
+            for s in r.steps
+        ],
+    }
 
 
 def repaired_from_json(item: dict[str, Any]) -> Repaired:
     steps = [Step(s["prop"], s["state"], gene_from_json(s["gene"]), s["ticks"]) for s in item["steps"]]
-    return Repaired(tuple(gene_from_json(g) for g in item["candidate"]), steps, tuple(item["failing"]),
-                    item["proposals"])
+    return Repaired(
+        tuple(gene_from_json(g) for g in item["candidate"]), steps, tuple(item["failing"]), item["proposals"]
+    )
 
 
 def qd_module() -> ModuleType:
@@ -193,11 +231,18 @@ class Evolution:
             mended = [r for r in repairs if r.ok]
             if not mended:
                 failing = sorted({name for r in repairs for name in r.failing})
-                raise fail(self.base.path, N_("the table breaks {broken}, and evolve found no guard rows that mend it "
-                                               "({failing} still fail)", broken=tuple(verdict.failed),
-                                               failing=tuple(failing)),
-                           N_("mend the table by hand (tablebot check shows the counterexample), or give evolve "
-                              "the properties it must keep with --properties"))
+                raise fail(
+                    self.base.path,
+                    N_(
+                        "the table breaks {broken}, and evolve found no guard rows that mend it ({failing} still fail)",
+                        broken=tuple(verdict.failed),
+                        failing=tuple(failing),
+                    ),
+                    N_(
+                        "mend the table by hand (tablebot check shows the counterexample), or give evolve "
+                        "the properties it must keep with --properties"
+                    ),
+                )
             seeds = []
             for r in mended:
                 key, _ = self.prover.verdict(to_table(r.candidate, self.base))
@@ -221,8 +266,19 @@ class Evolution:
                 self.evaluate(keys)
                 self.offer(archive, keys)
                 history.append(self.snapshot(archive))
-        return Outcome(start_key, verdict, repairs, seeds, archive, self.candidates, self.means, self.order,
-                       self.counts, history, time.perf_counter() - started)
+        return Outcome(
+            start_key,
+            verdict,
+            repairs,
+            seeds,
+            archive,
+            self.candidates,
+            self.means,
+            self.order,
+            self.counts,
+            history,
+            time.perf_counter() - started,
+        )
 
     def breed(self, parents: Sequence[str], rng: Any, count: int) -> list[str]:
         """Up to ``count`` children of the parents that are proved and behave unlike any table seen. The
@@ -290,5 +346,10 @@ class Evolution:
     def snapshot(self, archive: Any) -> dict[str, float]:
         stats = archive.stats
         best = fitness(self.settings.objective, float(stats.obj_max)) if stats.num_elites else float("nan")
-        return {"evaluated": len(self.order), "best": best, "elites": int(stats.num_elites),
-                "coverage": float(stats.coverage), "qd_score": float(stats.qd_score)}
+        return {
+            "evaluated": len(self.order),
+            "best": best,
+            "elites": int(stats.num_elites),
+            "coverage": float(stats.coverage),
+            "qd_score": float(stats.qd_score),
+        }

@@ -67,19 +67,31 @@ class Limits:
         """Whether a cell of the gene may not change (a row of a frozen state, a frozen row or cell)."""
         if self.state_frozen(gene.state):
             return True
-        return gene.origin is not None and bool({(gene.origin, column), (gene.origin, WHOLE_ROW)}
-                                                & self.frozen_cells)
+        return gene.origin is not None and bool({(gene.origin, column), (gene.origin, WHOLE_ROW)} & self.frozen_cells)
 
     def row_fixed(self, gene: Gene) -> bool:
         """Whether the row may not be removed or moved: its state is frozen, or some cell of it is."""
-        return self.state_frozen(gene.state) or (gene.origin is not None
-                                                 and any(line == gene.origin for line, _ in self.frozen_cells))
+        return self.state_frozen(gene.state) or (
+            gene.origin is not None and any(line == gene.origin for line, _ in self.frozen_cells)
+        )
 
 
 def start(table: Table) -> Candidate:
     """The table as a candidate (every row's origin is its file line)."""
-    return tuple(Gene(row.state, row.events, row.motors, row.timer, row.next, row.description, row.counters,
-                      row.lamps, origin=row.line) for row in table.rows)
+    return tuple(
+        Gene(
+            row.state,
+            row.events,
+            row.motors,
+            row.timer,
+            row.next,
+            row.description,
+            row.counters,
+            row.lamps,
+            origin=row.line,
+        )
+        for row in table.rows
+    )
 
 
 def to_table(candidate: Candidate, base: Table, path: str = "<evolved>") -> Table:
@@ -94,9 +106,20 @@ def to_table(candidate: Candidate, base: Table, path: str = "<evolved>") -> Tabl
             line = last + added
         else:
             line = gene.origin
-        rows.append(Row(index=index, line=line, description=gene.description, state=gene.state, events=gene.events,
-                        motors=gene.motors, timer=gene.timer, next=gene.next, counters=gene.counters,
-                        lamps=gene.lamps))
+        rows.append(
+            Row(
+                index=index,
+                line=line,
+                description=gene.description,
+                state=gene.state,
+                events=gene.events,
+                motors=gene.motors,
+                timer=gene.timer,
+                next=gene.next,
+                counters=gene.counters,
+                lamps=gene.lamps,
+            )
+        )
     return replace(base, rows=tuple(rows), path=path)  # its name and cross-table columns too (several tables)
 
 
@@ -123,8 +146,11 @@ def parse_freeze_states(values: Sequence[str], table: Table) -> frozenset[StateI
     for value in values:
         for part in (p.strip() for p in value.split(",") if p.strip()):
             if part not in by_text:
-                raise fail("--freeze-state", N_("--freeze-state {part}: the table has no state {part}", part=part),
-                           N_("name states of the table: {states}", states=tuple(map(str, table.states))))
+                raise fail(
+                    "--freeze-state",
+                    N_("--freeze-state {part}: the table has no state {part}", part=part),
+                    N_("name states of the table: {states}", states=tuple(map(str, table.states))),
+                )
             out.add(by_text[part])
     return frozenset(out)
 
@@ -141,19 +167,29 @@ def parse_freeze_cells(values: Sequence[str], table: Table) -> frozenset[tuple[i
         for part in (p.strip() for p in value.split(",") if p.strip()):
             found = FREEZE_RE.match(part)
             if not found or len(found[1]) > MAX_NUMBER_CHARS:  # int() of a longer number may fail
-                raise fail("--freeze-cell", N_("--freeze-cell: {part!r} does not name a cell", part=part),
-                           N_('write "line 5 timer", "line 5 M1", "line 5 next" or "line 5" (the whole row)'))
+                raise fail(
+                    "--freeze-cell",
+                    N_("--freeze-cell: {part!r} does not name a cell", part=part),
+                    N_('write "line 5 timer", "line 5 M1", "line 5 next" or "line 5" (the whole row)'),
+                )
             line = int(found[1])
             if line not in lines:
-                raise fail("--freeze-cell", N_("--freeze-cell: line {line} of {path} is not a row of the table",
-                                               line=line, path=str(table.path)),
-                           N_("rows are on lines {first}..{last}", first=min(lines), last=max(lines)))
+                raise fail(
+                    "--freeze-cell",
+                    N_(
+                        "--freeze-cell: line {line} of {path} is not a row of the table",
+                        line=line,
+                        path=str(table.path),
+                    ),
+                    N_("rows are on lines {first}..{last}", first=min(lines), last=max(lines)),
+                )
             column = found[2]
             if column is not None and column.lower() not in columns:
-                raise fail("--freeze-cell", N_("--freeze-cell: {column!r} is not a cell evolution changes",
-                                               column=column),
-                           N_("name one of {known}, or give just the line to freeze the row",
-                              known=tuple(columns.values())))
+                raise fail(
+                    "--freeze-cell",
+                    N_("--freeze-cell: {column!r} is not a cell evolution changes", column=column),
+                    N_("name one of {known}, or give just the line to freeze the row", known=tuple(columns.values())),
+                )
             out.add((line, WHOLE_ROW if column is None else columns[column.lower()]))
     return frozenset(out)
 

@@ -66,9 +66,15 @@ class CsvDocument:
     @classmethod
     def from_bytes(cls, data: bytes, path: str) -> CsvDocument:
         if len(data) > MAX_TABLE_BYTES:
-            raise fail(path, N_("the file has {size:,} bytes; the studio edits tables up to {limit:,}",
-                                size=len(data), limit=MAX_TABLE_BYTES),
-                       N_("edit it in a spreadsheet or split it"))
+            raise fail(
+                path,
+                N_(
+                    "the file has {size:,} bytes; the studio edits tables up to {limit:,}",
+                    size=len(data),
+                    limit=MAX_TABLE_BYTES,
+                ),
+                N_("edit it in a spreadsheet or split it"),
+            )
         try:
             if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
                 text, encoding = data.decode("utf-16"), "utf-16"
@@ -78,15 +84,21 @@ class CsvDocument:
                 text, encoding = data.decode("utf-8"), "utf-8"
         except UnicodeDecodeError as exc:
             line = data[: exc.start].count(b"\n") + 1
-            raise fail(path, N_("byte {at} is not {encoding} text: the studio edits tables saved as UTF-8 or UTF-16",
-                                at=exc.start, encoding=exc.encoding.upper()),
-                       N_("save it as UTF-8 (Excel: CSV UTF-8), or edit it in a spreadsheet"), line) from None
+            raise fail(
+                path,
+                N_(
+                    "byte {at} is not {encoding} text: the studio edits tables saved as UTF-8 or UTF-16",
+                    at=exc.start,
+                    encoding=exc.encoding.upper(),
+                ),
+                N_("save it as UTF-8 (Excel: CSV UTF-8), or edit it in a spreadsheet"),
+                line,
+            ) from None
         return cls.from_text(text, encoding, path)
 
     @classmethod
     def from_text(cls, text: str, encoding: str = "utf-8", path: str = "<table>") -> CsvDocument:
-        first = next((line for line in text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-                      if line.strip()), "")
+        first = next((line for line in text.replace("\r\n", "\n").replace("\r", "\n").split("\n") if line.strip()), "")
         excel = SEP_RE.match(first)
         delimiter = excel[1] if excel else detect_delimiter(first)
         try:
@@ -181,8 +193,10 @@ class CsvDocument:
         alike keep their bytes, rows edited are edited cell by cell, others inserted or deleted."""
         width = len(self.header_values())
         if len(header) != width or any(len(row) > width for row in rows):
-            raise Refused(f"the table now has {width} columns, the edits {max(map(len, [header, *rows]))}: "
-                          "they cannot be put back (copy them from the page by hand)")
+            raise Refused(
+                f"the table now has {width} columns, the edits {max(map(len, [header, *rows]))}: "
+                "they cannot be put back (copy them from the page by hand)"
+            )
         for column, value in enumerate(header):
             if value != self.header_values()[column]:
                 self.set_cell(-1, column, value)

@@ -29,9 +29,15 @@ def spec_of(path: Path, robot: Robot) -> TableSpec | None:
     for spec in specs:
         if (base / spec.file).resolve() == path.resolve():
             return spec
-    raise fail(path, N_("this table is none of the tables of {robot} ({tables})", robot=str(robot.source),
-                        tables=tuple(f"{s.name} = {s.file}" for s in specs)),
-               N_("give the robot's folder or robot file, or add this table to its [tables]"))
+    raise fail(
+        path,
+        N_(
+            "this table is none of the tables of {robot} ({tables})",
+            robot=str(robot.source),
+            tables=tuple(f"{s.name} = {s.file}" for s in specs),
+        ),
+        N_("give the robot's folder or robot file, or add this table to its [tables]"),
+    )
 
 
 def robot_for_table(path: Path, robot: Robot) -> tuple[Robot, str]:
@@ -44,9 +50,15 @@ def cross_column(cell: Cell, robot: Robot, out: Collector) -> CrossEvent | None:
     """The header cell as a cross-table event column (None: it is not one); a bad one is reported at its cell."""
     cross = parse_cross(cell.text, robot)
     if isinstance(cross, str):
-        out.error(cell.line, cell.column, cross,
-                  N_("a cross-table column is NAME=S, NAME=S1,S2 or NAME=20..29 with NAME from [tables] (quote it "
-                     "in a CSV when it has a comma)"))
+        out.error(
+            cell.line,
+            cell.column,
+            cross,
+            N_(
+                "a cross-table column is NAME=S, NAME=S1,S2 or NAME=20..29 with NAME from [tables] (quote it "
+                "in a CSV when it has a comma)"
+            ),
+        )
         return None
     return None if cross is None else replace(cross, line=cell.line, at=cell.column)
 
@@ -60,8 +72,9 @@ def writes(columns: Iterable[tuple[str, str, Cell]]) -> dict[str, tuple[int, int
     return found
 
 
-def grouped(rows: list[Row], robot: Robot, out: Collector, state_cells: dict[int, Cell],
-            next_cells: dict[int, Cell]) -> list[Row]:
+def grouped(
+    rows: list[Row], robot: Robot, out: Collector, state_cells: dict[int, Cell], next_cells: dict[int, Cell]
+) -> list[Row]:
     """The rows with those written for a state group made one per state of it (:func:`expand_groups`); a
     problem is reported at the row's state or next cell (line -> that cell)."""
     groups = groups_of(robot)

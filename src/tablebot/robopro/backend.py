@@ -28,11 +28,22 @@ def cross_problems(machine: Machine) -> list[Diagnostic]:
     """A cross-table column of the main table: the three lists hold the main table alone, so the state it
     reads is nowhere (refused at the column, rather than read as never present)."""
     table = machine.table
-    return [Diagnostic(table.path, event.line, event.at,
-                       N_("{column}: the ROBO Pro lists hold table {table} alone, without table {other} whose "
-                          "state this column reads", column=event.column, table=table.name, other=event.table),
-                       N_("export --to robopro-program runs every table, one process each (docs: ROBO Pro)"))
-            for event in table.cross.values()]
+    return [
+        Diagnostic(
+            table.path,
+            event.line,
+            event.at,
+            N_(
+                "{column}: the ROBO Pro lists hold table {table} alone, without table {other} whose "
+                "state this column reads",
+                column=event.column,
+                table=table.name,
+                other=event.table,
+            ),
+            N_("export --to robopro-program runs every table, one process each (docs: ROBO Pro)"),
+        )
+        for event in table.cross.values()
+    ]
 
 
 def _refuse_cross(machine: Machine) -> None:
@@ -50,9 +61,15 @@ def main_only(machine: Machine) -> tuple[str, ...]:
     specs = tables_of(machine.table.robot)
     if not specs:
         return ()
-    return (N_("the robot has {n} tables: the ROBO Pro lists hold its main table ({main}) only, not {others}; "
-               "export --to robopro-program runs every table, one process each", n=len(specs), main=specs[0].name,
-               others=", ".join(spec.name for spec in specs[1:])),)
+    return (
+        N_(
+            "the robot has {n} tables: the ROBO Pro lists hold its main table ({main}) only, not {others}; "
+            "export --to robopro-program runs every table, one process each",
+            n=len(specs),
+            main=specs[0].name,
+            others=", ".join(spec.name for spec in specs[1:]),
+        ),
+    )
 
 
 def export_lists(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -81,12 +98,18 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
         raise fail("--event-list", N_("the three list names must differ"), N_("give each list its own name"))
     target = out_folder(out, "OUTDIR") / into.name if out else None
     written, from_csv = rpp.write_lists(into, named, target)
-    return Exported((written,), (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),
-                    main_only(machine) + tuple(
-                    f"list {name} loads its values from column {column} of a CSV file when the program starts "
-                          "(its load-from-CSV setting), which replaces the values written here; turn that off in "
-                          "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
-                          "CSV files instead" for name, column in from_csv.items()))
+    return Exported(
+        (written,),
+        (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),
+        main_only(machine)
+        + tuple(
+            f"list {name} loads its values from column {column} of a CSV file when the program starts "
+            "(its load-from-CSV setting), which replaces the values written here; turn that off in "
+            "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
+            "CSV files instead"
+            for name, column in from_csv.items()
+        ),
+    )
 
 
 def program_fit(machine: Machine) -> list[Diagnostic]:
@@ -119,17 +142,43 @@ def export_program(machine: Machine, out: Path | None, options: ExportOptions) -
     path = write_text(out_folder(out, "OUTDIR") / file_name(machine.table), text)
     lines: tuple[str, ...] = (f"wrote {path}: open it in ROBO Pro 4.x",)
     if tables is not None:
-        lines += (N_("its main program runs a process per table ({tables}) and a clock process that starts "
-                     "each tick for all of them", tables=", ".join(tables.names)),)
+        lines += (
+            N_(
+                "its main program runs a process per table ({tables}) and a clock process that starts "
+                "each tick for all of them",
+                tables=", ".join(tables.names),
+            ),
+        )
     return Exported((path,), lines)
 
 
-ROBOPRO = register(ExportBackend(name="robopro", makes="the document's three ROBO Pro lists (event, action, timer)",
-                                 help="the three lists as CSV", fit=fit, export=export_lists))
-ROBOPRO_RPP = register(ExportBackend(name="robopro-rpp", makes="the three lists written into a ROBO Pro program",
-                                     help="the lists written into a ROBO Pro program (--into)", fit=fit,
-                                     export=export_rpp, needs_out=False))
-ROBOPRO_PROGRAM = register(ExportBackend(
-    name="robopro-program", makes="a whole ROBO Pro program running the table (the document's engine)",
-    help="a whole ROBO Pro program that runs the table", fit=program_fit, export=export_program,
-    section="robopro", read_section=read_robot_robopro))
+ROBOPRO = register(
+    ExportBackend(
+        name="robopro",
+        makes="the document's three ROBO Pro lists (event, action, timer)",
+        help="the three lists as CSV",
+        fit=fit,
+        export=export_lists,
+    )
+)
+ROBOPRO_RPP = register(
+    ExportBackend(
+        name="robopro-rpp",
+        makes="the three lists written into a ROBO Pro program",
+        help="the lists written into a ROBO Pro program (--into)",
+        fit=fit,
+        export=export_rpp,
+        needs_out=False,
+    )
+)
+ROBOPRO_PROGRAM = register(
+    ExportBackend(
+        name="robopro-program",
+        makes="a whole ROBO Pro program running the table (the document's engine)",
+        help="a whole ROBO Pro program that runs the table",
+        fit=program_fit,
+        export=export_program,
+        section="robopro",
+        read_section=read_robot_robopro,
+    )
+)

@@ -92,8 +92,9 @@ def find_lists(text: str) -> list[ListElement]:
         attrs = _attrs(attr_text)
         element = None
         if tag == "o" and attrs.get("classname", ("",))[0] == LIST_CLASS:
-            element = ListElement(html.unescape(attrs.get("name", ("",))[0]), text.count("\n", 0, m.start()) + 1,
-                                  m.start(), m.end())
+            element = ListElement(
+                html.unescape(attrs.get("name", ("",))[0]), text.count("\n", 0, m.start()) + 1, m.start(), m.end()
+            )
             if "N" in attrs:
                 value, a, b = attrs["N"]
                 element.n_span = (m.start(3) + a, m.start(3) + b)
@@ -129,16 +130,19 @@ def _init_texts(text: str, element: ListElement, values: Sequence[int]) -> tuple
         first_start, first_end = element.inits[0]
         sample = text[first_start:first_end]
         indent = _line_indent(text, first_start)
-        separator = text[first_end:element.inits[1][0]] if len(element.inits) > 1 else newline + indent
+        separator = text[first_end : element.inits[1][0]] if len(element.inits) > 1 else newline + indent
         # an init without a value (<init/>) has no form to copy: take ROBO Pro's own
-        form = VALUE_RE.sub('value="\x00"', sample, count=1) if VALUE_RE.search(sample) else \
-            DEFAULT_INIT.replace("\x01", newline + indent)
+        form = (
+            VALUE_RE.sub('value="\x00"', sample, count=1)
+            if VALUE_RE.search(sample)
+            else DEFAULT_INIT.replace("\x01", newline + indent)
+        )
         return first_start, element.inits[-1][1], separator.join(form.replace("\x00", xml_attr(str(v))) for v in values)
     indent = _line_indent(text, element.close) + "    "
     form = DEFAULT_INIT.replace("\x01", newline + indent)
     lines = "".join(f"{indent}{form.replace(chr(0), xml_attr(str(v)))}{newline}" for v in values)
     line_start = text.rfind("\n", 0, element.close) + 1
-    if text[line_start:element.close].strip() == "" and line_start > 0:
+    if text[line_start : element.close].strip() == "" and line_start > 0:
         return line_start, line_start, lines  # the closing tag has its own line: insert above it
     return element.close, element.close, newline + lines + indent[:-4]
 
@@ -147,12 +151,16 @@ def _unwritable(element: ListElement) -> tuple[str, str] | None:
     """Why the values cannot be written into ``element`` (message, hint), or None."""
     name = element.name
     if element.datatype != INTEGER:
-        return (f"list {name!r} holds floats (datatype {element.datatype}, inits value0/value1/value2); the "
-                "document's lists hold integers",
-                f"choose an integer list, or set {name}'s type to integer in ROBO Pro")
+        return (
+            f"list {name!r} holds floats (datatype {element.datatype}, inits value0/value1/value2); the "
+            "document's lists hold integers",
+            f"choose an integer list, or set {name}'s type to integer in ROBO Pro",
+        )
     if element.close == -2:
-        return (f"list {name!r} is an empty element <o .../> with no place for values",
-                f"give it an end tag: <o ...></o>, or give {name} a value in ROBO Pro and save again")
+        return (
+            f"list {name!r} is an empty element <o .../> with no place for values",
+            f"give it an end tag: <o ...></o>, or give {name} a value in ROBO Pro and save again",
+        )
     if element.close < 0:
         return f"list {name!r} is never closed", "is the .rpp file complete?"
     return None
@@ -170,17 +178,30 @@ def rewrite(text: str, lists: Mapping[str, Sequence[int]], path: str | Path = "<
     for name, values in lists.items():
         matches = by_name.get(name, [])
         if not matches:
-            out.error(None, None, N_("no list named {name!r} ({kind}) in this program", name=name, kind=LIST_CLASS),
-                      N_("lists in the program: {names}; choose names with --event-list/--action-list/--timer-list",
-                         names=names))
+            out.error(
+                None,
+                None,
+                N_("no list named {name!r} ({kind}) in this program", name=name, kind=LIST_CLASS),
+                N_(
+                    "lists in the program: {names}; choose names with --event-list/--action-list/--timer-list",
+                    names=names,
+                ),
+            )
             continue
         global_names = sorted({e.globalname for e in matches})
         if len(global_names) > 1:
-            out.error(matches[1].line, None, N_("{n} different lists are named {name!r} (global names {globals}, "
-                                                "lines {lines})", n=len(matches), name=name,
-                                                globals=tuple(map(repr, global_names)),
-                                                lines=tuple(str(e.line) for e in matches)),
-                      N_("rename all but one in ROBO Pro"))
+            out.error(
+                matches[1].line,
+                None,
+                N_(
+                    "{n} different lists are named {name!r} (global names {globals}, lines {lines})",
+                    n=len(matches),
+                    name=name,
+                    globals=tuple(map(repr, global_names)),
+                    lines=tuple(str(e.line) for e in matches),
+                ),
+                N_("rename all but one in ROBO Pro"),
+            )
             continue
         for element in matches:  # a global list: one copy per subprogram that uses it, each written
             problem = _unwritable(element)
@@ -214,8 +235,7 @@ def csv_loaded(text: str, names: Sequence[str]) -> dict[str, int]:
     return found
 
 
-def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]],
-                out: Path | None = None) -> tuple[Path, dict[str, int]]:
+def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]], out: Path | None = None) -> tuple[Path, dict[str, int]]:
     """Rewrite ``rpp`` (or write the result to ``out``); returns the path and the lists loaded from a CSV
     file (with their columns)."""
     data = read_bytes(rpp)
@@ -223,11 +243,18 @@ def write_lists(rpp: Path, lists: Mapping[str, Sequence[int]],
     try:
         text = data.decode(encoding)
     except UnicodeDecodeError as exc:
-        raise fail(rpp, N_("not a ROBO Pro program: byte {at} is not {encoding} text", at=exc.start, encoding=encoding),
-                   N_("give a .rpp file saved by ROBO Pro")) from None
+        raise fail(
+            rpp,
+            N_("not a ROBO Pro program: byte {at} is not {encoding} text", at=exc.start, encoding=encoding),
+            N_("give a .rpp file saved by ROBO Pro"),
+        ) from None
     except LookupError:
-        raise fail(rpp, N_("unknown text encoding {encoding!r} in the XML declaration", encoding=encoding),
-                   N_("save the program again in ROBO Pro (it writes UTF-8)"), 1) from None
+        raise fail(
+            rpp,
+            N_("unknown text encoding {encoding!r} in the XML declaration", encoding=encoding),
+            N_("save the program again in ROBO Pro (it writes UTF-8)"),
+            1,
+        ) from None
     if "<cvg" not in text[:4096] and LIST_CLASS not in text:
         raise fail(rpp, N_("not a ROBO Pro program (no <cvg> document element)"), N_("give a .rpp file"), 1, 1)
     new = rewrite(text, lists, rpp)

@@ -82,23 +82,41 @@ class _Reader:
         if isinstance(value, dict):
             unknown = sorted(set(value) - {word, *extra})
             if unknown:
-                self.error(name, N_("{name}: unknown key {keys}", name=name, keys=tuple(unknown)),
-                           N_("a {kind} takes {keys}", kind=KIND_WORDS[kind], keys=(word, *extra)))
+                self.error(
+                    name,
+                    N_("{name}: unknown key {keys}", name=name, keys=tuple(unknown)),
+                    N_("a {kind} takes {keys}", kind=KIND_WORDS[kind], keys=(word, *extra)),
+                )
                 return None
             options = {k: value[k] for k in extra if k in value}
             value = value.get(word, DEFAULT)
         terminal = _default(name, kind, self.robot) if value is DEFAULT else _terminal(value, kind)
         if terminal is None:
             shown = N_("no terminal") if value is DEFAULT else repr(value)
-            self.error(name, N_("{name}: {shown} is not a {kind} terminal of the controller", name=name, shown=shown,
-                                kind=KIND_WORDS[kind]),
-                       N_('write {word} = "{letter}1" … "{letter}{count}"', word=word, letter=letter, count=count))
+            self.error(
+                name,
+                N_(
+                    "{name}: {shown} is not a {kind} terminal of the controller",
+                    name=name,
+                    shown=shown,
+                    kind=KIND_WORDS[kind],
+                ),
+                N_('write {word} = "{letter}1" … "{letter}{count}"', word=word, letter=letter, count=count),
+            )
             return None
         for key, allowed in extra.items():
             if key in options and options[key] not in allowed:
-                self.error(name, N_("{name}: {key} = {value!r} is not one of {allowed}", name=name, key=key,
-                                    value=options[key], allowed=tuple(map(repr, allowed))),
-                           N_("write {key} = {value!r}", key=key, value=allowed[0]))
+                self.error(
+                    name,
+                    N_(
+                        "{name}: {key} = {value!r} is not one of {allowed}",
+                        name=name,
+                        key=key,
+                        value=options[key],
+                        allowed=tuple(map(repr, allowed)),
+                    ),
+                    N_("write {key} = {value!r}", key=key, value=allowed[0]),
+                )
                 return None
         return terminal, options
 
@@ -107,24 +125,33 @@ def read_robot_robopro(src: Source, section: Any, robot: Robot) -> Wiring:
     """``[robopro]`` of a robot file (a reader of :data:`tablebot.robot.SECTION_READERS`); errors go to
     ``src`` with their lines."""
     if not isinstance(section, dict):
-        src.key_error(("", None, "robopro"), N_("[robopro] must be a table"),
-                      N_("for example: {example}", example='controller = "txt"'))
+        src.key_error(
+            ("", None, "robopro"),
+            N_("[robopro] must be a table"),
+            N_("for example: {example}", example='controller = "txt"'),
+        )
         return wiring_of(robot, {})
     reader = _Reader(src, robot)
     controller = section.get("controller", "robo-interface")
     if controller not in CONTROLLERS:
-        reader.error("controller", N_("controller = {controller!r} is not one ROBO Pro drives here",
-                                      controller=controller),
-                     N_("write controller = one of {known}", known=tuple(map(repr, CONTROLLERS))))
+        reader.error(
+            "controller",
+            N_("controller = {controller!r} is not one ROBO Pro drives here", controller=controller),
+            N_("write controller = one of {known}", known=tuple(map(repr, CONTROLLERS))),
+        )
     for name in section:
         if name != "controller" and name not in (*robot.inputs, *robot.motors, *robot.counter_names, *robot.lamps):
-            reader.error(name, N_("wires {name!r}, which robot {robot} does not have", name=name, robot=robot.name),
-                         N_("wire the robot's inputs, motors, counters and lamps (names from the robot file)"))
+            reader.error(
+                name,
+                N_("wires {name!r}, which robot {robot} does not have", name=name, robot=robot.name),
+                N_("wire the robot's inputs, motors, counters and lamps (names from the robot file)"),
+            )
     return wiring_of(robot, section, reader, str(controller))
 
 
-def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = None,
-              controller: str = "robo-interface") -> Wiring:
+def wiring_of(
+    robot: Robot, section: dict[str, Any], reader: _Reader | None = None, controller: str = "robo-interface"
+) -> Wiring:
     """The wiring ``section`` says, defaults filled in; names that cannot be wired are listed in
     ``problems`` (mistakes in the section itself go through ``reader``)."""
     inputs: dict[str, tuple[int, int]] = {}
@@ -134,9 +161,17 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
     problems: list[tuple[str, str, str]] = []
     reader = reader or _Reader(None, robot)
     extras: dict[str, dict[str, tuple[Any, ...]]] = {
-        "input": {"active": (1, 0)}, "motor": {"forward": COMMANDS}, "counter": {}, "lamp": {}}
-    for kind, names in (("input", robot.inputs), ("motor", robot.motors), ("counter", robot.counter_names),
-                        ("lamp", robot.lamps)):
+        "input": {"active": (1, 0)},
+        "motor": {"forward": COMMANDS},
+        "counter": {},
+        "lamp": {},
+    }
+    for kind, names in (
+        ("input", robot.inputs),
+        ("motor", robot.motors),
+        ("counter", robot.counter_names),
+        ("lamp", robot.lamps),
+    ):
         extra = extras[kind]
         for name in names:
             if name in section:
@@ -146,8 +181,13 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
                 got = (terminal, {}) if terminal is not None and name not in section else None
             if got is None:
                 letter, count = TERMINALS[kind]
-                problems.append((name, f"{kind} {name} is wired to no terminal of the controller",
-                                 f'add to [robopro]: {name} = "{letter}1" (one of {letter}1…{letter}{count})'))
+                problems.append(
+                    (
+                        name,
+                        f"{kind} {name} is wired to no terminal of the controller",
+                        f'add to [robopro]: {name} = "{letter}1" (one of {letter}1…{letter}{count})',
+                    )
+                )
                 continue
             terminal, options = got
             if kind == "input":
@@ -158,8 +198,14 @@ def wiring_of(robot: Robot, section: dict[str, Any], reader: _Reader | None = No
                 lamps[name] = terminal
             else:
                 counters[name] = terminal
-    return Wiring(controller if controller in CONTROLLERS else "robo-interface", inputs, motors, counters, lamps,
-                  tuple(problems) + tuple(reader.errors))
+    return Wiring(
+        controller if controller in CONTROLLERS else "robo-interface",
+        inputs,
+        motors,
+        counters,
+        lamps,
+        tuple(problems) + tuple(reader.errors),
+    )
 
 
 def _free_output(name: str, robot: Robot, motors: dict[str, tuple[int, str]], lamps: dict[str, int]) -> int | None:

@@ -40,6 +40,14 @@ def open_sim(machine: Machine, link: LinkOptions) -> Opened:
     return Opened(bot, "sim", N_("simulated, seed {seed}", seed=seed))
 
 
-SIM = register(LiveBackend(name="sim", makes="the simulator, driven in real time by `tablebot run`",
-                           help="sim[:WORLD] (the simulator, in real time)", section="sim",
-                           read_section=read_section, open=open_sim, addresses=("sim", "sim:WORLD.toml")))
+SIM = register(
+    LiveBackend(
+        name="sim",
+        makes="the simulator, driven in real time by `tablebot run`",
+        help="sim[:WORLD] (the simulator, in real time)",
+        section="sim",
+        read_section=read_section,
+        open=open_sim,
+        addresses=("sim", "sim:WORLD.toml"),
+    )
+)

@@ -97,8 +97,18 @@ class SimRun:
     def block(self) -> TickBlock:
         """The whole run as one block of ticks, with the simulator's trace fields."""
         assert self.hist is not None and self.hist_columns is None, "the trace needs every robot row"
-        return TickBlock(0, self.masks, self.pulses, self.events, self.rows, self.states, self.timers,
-                         self.outputs, self.counters, {**field_columns(self.scene, self.hist[:-1]), **self.others})
+        return TickBlock(
+            0,
+            self.masks,
+            self.pulses,
+            self.events,
+            self.rows,
+            self.states,
+            self.timers,
+            self.outputs,
+            self.counters,
+            {**field_columns(self.scene, self.hist[:-1]), **self.others},
+        )
 
     def write_trace(self, stream: IO[str]) -> int:
         """Write the run's trace as JSON Lines (what ``tablebot sim`` writes live); returns the number of ticks."""
@@ -120,8 +130,9 @@ class History:
 
     COLUMNS = ("masks", "events", "rows", "states", "timers", "outputs", "counters", "pulses")
 
-    def __init__(self, robot: SimRobot, dtype: type = np.float64, rows: bool | tuple[int, ...] = True,
-                 zeros: Zeros = _zeros) -> None:
+    def __init__(
+        self, robot: SimRobot, dtype: type = np.float64, rows: bool | tuple[int, ...] = True, zeros: Zeros = _zeros
+    ) -> None:
         self.robot, self.dtype, self.zeros = robot, dtype, zeros
         self.rows = bool(rows)
         self.kept = None if isinstance(rows, bool) else tuple(rows)  # the columns kept (None: all)
@@ -140,9 +151,16 @@ class History:
         self.path = np.zeros((ticks // PATH_STRIDE + 1, 2))
         self._keep_row(0, self.robot.s)
         small = np.int16 if len(machine.states) < 32768 and len(machine.rows) < 32768 else np.int32
-        shapes = {"masks": ((ticks,), np.int32), "events": ((ticks,), np.int32), "rows": ((ticks,), small),
-                  "states": ((ticks,), small), "timers": ((ticks,), np.int32), "outputs": ((ticks, n_out), np.int8),
-                  "counters": ((ticks, n_c), np.int32), "pulses": ((ticks, n_c), np.int32)}
+        shapes = {
+            "masks": ((ticks,), np.int32),
+            "events": ((ticks,), np.int32),
+            "rows": ((ticks,), small),
+            "states": ((ticks,), small),
+            "timers": ((ticks,), np.int32),
+            "outputs": ((ticks, n_out), np.int8),
+            "counters": ((ticks, n_c), np.int32),
+            "pulses": ((ticks, n_c), np.int32),
+        }
         self.columns = {name: self.zeros(name, shape, dtype) for name, (shape, dtype) in shapes.items()}
 
     def block(self, block: TickBlock) -> None:
@@ -156,8 +174,8 @@ class History:
             if self.rows:
                 self.hist[a:b] = block.raw if self.kept is None else block.raw[:, self._kept]
             first = -(-a // PATH_STRIDE) * PATH_STRIDE  # the first row of the block on the path's stride
-            points = block.raw[first - a::PATH_STRIDE][:, [L.X, L.Y]]
-            self.path[first // PATH_STRIDE:first // PATH_STRIDE + len(points)] = points
+            points = block.raw[first - a :: PATH_STRIDE][:, [L.X, L.Y]]
+            self.path[first // PATH_STRIDE : first // PATH_STRIDE + len(points)] = points
         self._keep_row(b, self.robot.s)
         self.done = b
 
@@ -173,11 +191,21 @@ class History:
     def result(self, scene: Scene, seed: int, wall_s: float) -> SimRun:
         robot, n = self.robot, self.done
         cut = {name: column[:n] for name, column in self.columns.items()}  # a run cut short keeps what ran
-        return SimRun(scene=scene, seed=seed, hist=self.hist[: n + 1] if self.rows else None,
-                      ends=np.stack((self.first, robot.s)), path=self.path[: n // PATH_STRIDE + 1], **cut,
-                      collision_rows=robot.collisions, collision_count=robot.collision_count,
-                      reached_row=robot.reached_row, end=self.ended, wall_s=wall_s,  # type: ignore[arg-type]
-                      hist_columns=self.kept, others={k: v[:n] for k, v in self.others.items()})
+        return SimRun(
+            scene=scene,
+            seed=seed,
+            hist=self.hist[: n + 1] if self.rows else None,
+            ends=np.stack((self.first, robot.s)),
+            path=self.path[: n // PATH_STRIDE + 1],
+            **cut,
+            collision_rows=robot.collisions,
+            collision_count=robot.collision_count,
+            reached_row=robot.reached_row,
+            end=self.ended,  # type: ignore[arg-type]
+            wall_s=wall_s,
+            hist_columns=self.kept,
+            others={k: v[:n] for k, v in self.others.items()},
+        )
 
 
 def other_keys(scene: Scene) -> list[str]:
@@ -212,16 +240,30 @@ def ticks_for(scene: Scene, seconds: float) -> int:
     """The ticks in ``seconds`` of robot time (at least one); more than MAX_TICKS are refused."""
     ticks = max(1, round(seconds / scene.tick_s))
     if ticks > MAX_TICKS:
-        raise fail("--seconds", N_("{seconds:g} s at tick_ms = {tick_ms} is {ticks:,} ticks; a run holds at most "
-                                   "{most:,}", seconds=seconds, tick_ms=scene.table.robot.tick_ms, ticks=ticks,
-                                   most=MAX_TICKS),
-                   N_("simulate at most {most:g} s", most=MAX_TICKS * scene.tick_s))
+        raise fail(
+            "--seconds",
+            N_(
+                "{seconds:g} s at tick_ms = {tick_ms} is {ticks:,} ticks; a run holds at most {most:,}",
+                seconds=seconds,
+                tick_ms=scene.table.robot.tick_ms,
+                ticks=ticks,
+                most=MAX_TICKS,
+            ),
+            N_("simulate at most {most:g} s", most=MAX_TICKS * scene.tick_s),
+        )
     return ticks
 
 
-def simulate(scene: Scene, seconds: float, seed: int = 1, progress: Callable[[int], None] | None = None,
-        sinks: Sequence[Sink] = (), history: type = np.float64, rows: bool | tuple[int, ...] = True,
-        zeros: Zeros = _zeros) -> SimRun:
+def simulate(
+    scene: Scene,
+    seconds: float,
+    seed: int = 1,
+    progress: Callable[[int], None] | None = None,
+    sinks: Sequence[Sink] = (),
+    history: type = np.float64,
+    rows: bool | tuple[int, ...] = True,
+    zeros: Zeros = _zeros,
+) -> SimRun:
     """Simulate ``seconds`` of robot time through the run loop; ``progress(ticks_done)`` is called
     after each block of ticks and ``sinks`` (a trace writer, say) see the run as it happens, after the
     run's :class:`History` (made with ``history``, ``rows`` and ``zeros``) has kept each block.

@@ -67,9 +67,15 @@ class LiveView:
             self.lateness = self.lateness or Lateness(self.info.tick_s)
             for ms in late:
                 self.lateness.note(ms / 1000)
-        self.last = {"tick": block.start + i, "mask": int(block.masks[i]), "state": int(block.states[i]),
-                     "timer": int(block.timers[i]), "outputs": tuple(block.outputs[i]),
-                     "counters": tuple(block.counters[i]), "late_ms": None if late is None else late[i]}
+        self.last = {
+            "tick": block.start + i,
+            "mask": int(block.masks[i]),
+            "state": int(block.states[i]),
+            "timer": int(block.timers[i]),
+            "outputs": tuple(block.outputs[i]),
+            "counters": tuple(block.counters[i]),
+            "late_ms": None if late is None else late[i],
+        }
 
     def end(self, end: RunEnd) -> None:
         if self.live is not None:
@@ -80,8 +86,10 @@ class LiveView:
         assert self.info is not None
         machine = self.info.engine.machine
         last = self.last
-        title = Text(_("tablebot run — {target}").format(target=plain(self.info.target))
-                     + (f" ({plain(str(localise(self.device)))})" if self.device else ""))
+        title = Text(
+            _("tablebot run — {target}").format(target=plain(self.info.target))
+            + (f" ({plain(str(localise(self.device)))})" if self.device else "")
+        )
         if not last:
             return Panel(Text(_("connecting…"), style="dim"), title=title, title_align="left")
         state = machine.states[last["state"]]
@@ -90,10 +98,16 @@ class LiveView:
         if name:
             head.append(f"  {plain(name)}", style="cyan")
         seconds = (last["tick"] + 1) * self.info.tick_s
-        head.append(_("   timer {timer}   t {seconds:8.2f} s   tick {tick}").format(
-            timer=last["timer"], seconds=seconds, tick=last["tick"]))
-        return Panel(Group(head, self._inputs(last["mask"]), self._outputs(last), self._lateness(last)),
-                     title=title, title_align="left")
+        head.append(
+            _("   timer {timer}   t {seconds:8.2f} s   tick {tick}").format(
+                timer=last["timer"], seconds=seconds, tick=last["tick"]
+            )
+        )
+        return Panel(
+            Group(head, self._inputs(last["mask"]), self._outputs(last), self._lateness(last)),
+            title=title,
+            title_align="left",
+        )
 
     def _inputs(self, mask: int) -> Columns:
         """One cell per input the table reads, lit while it reads 1; cells wrap to the terminal's width."""
@@ -125,5 +139,6 @@ class LiveView:
             return Text("")
         count = self.lateness.count if self.lateness is not None else 0
         style = "red" if count else "dim"
-        return Text(_("ticks late {count}   this tick {ms:.1f} ms late").format(count=count, ms=last["late_ms"]),
-                    style=style)
+        return Text(
+            _("ticks late {count}   this tick {ms:.1f} ms late").format(count=count, ms=last["late_ms"]), style=style
+        )

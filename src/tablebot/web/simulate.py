@@ -64,8 +64,14 @@ class ArenaSettings:
         if speed not in SPEEDS:
             raise Refused(_speeds())
         paused = message.get("paused", old.paused)
-        return cls(int(seed) if seed is not None else old.seed, charge if charge is not None else old.charge,
-                   start, lamp, speed, bool(paused))
+        return cls(
+            int(seed) if seed is not None else old.seed,
+            charge if charge is not None else old.charge,
+            start,
+            lamp,
+            speed,
+            bool(paused),
+        )
 
 
 def _speeds() -> Message:
@@ -102,20 +108,25 @@ class Arena:
             shown = self.tables is not None and name and name != self.tables.names[0]
             self.run.sink.colour_by = f"{name}.state" if shown else None
 
-    def reset(self, table: Table, machine: Machine, settings: ArenaSettings,
-              tables: RobotTables | None = None) -> dict[str, Any]:
+    def reset(
+        self, table: Table, machine: Machine, settings: ArenaSettings, tables: RobotTables | None = None
+    ) -> dict[str, Any]:
         """Start the table over in the world with ``settings`` (``tables``: the robot's, all of them run, the
         main one ``table``); a world problem is reported, not raised."""
         self.close()
         self.settings, self.table, self.machine, self.tables = settings, table, machine, tables
         try:
             # the table as edited, with the world the CLI would find for it
-            loaded = Loaded(table, machine) if tables is None else Loaded(tables.table, tables.machines[0],
-                                                                          tables=tables)
+            loaded = (
+                Loaded(table, machine) if tables is None else Loaded(tables.table, tables.machines[0], tables=tables)
+            )
             robot_world = loaded.robot_world()
             if robot_world is not None and robot_world.exists() and not robot_world.is_file():
-                raise fail(robot_world, N_("the robot's world is not a regular file (a folder, pipe or device)"),
-                           N_("name a world .toml file in the robot file's [sim] section"))
+                raise fail(
+                    robot_world,
+                    N_("the robot's world is not a regular file (a folder, pipe or device)"),
+                    N_("name a world .toml file in the robot file's [sim] section"),
+                )
             base: World = loaded.default_world()
             world = moved(base, settings.start, settings.lamp)
             overrides = {"battery": {"charge": settings.charge}} if settings.charge is not None else {}
@@ -127,9 +138,18 @@ class Arena:
         self.problem = None
         self.run = LiveRun(scene, _robot(scene, settings.seed), settings.speed, settings.paused)
         self.view = self._view  # the path coloured by the table shown
-        return {"ok": True, "world": world_json(world, scene.params), "tick_ms": table.robot.tick_ms,
-                "settings": {"seed": settings.seed, "charge": scene.params["battery"]["charge"],
-                             "speed": settings.speed, "start": list(world.start)}, **self.status()}
+        return {
+            "ok": True,
+            "world": world_json(world, scene.params),
+            "tick_ms": table.robot.tick_ms,
+            "settings": {
+                "seed": settings.seed,
+                "charge": scene.params["battery"]["charge"],
+                "speed": settings.speed,
+                "start": list(world.start),
+            },
+            **self.status(),
+        }
 
     def control(self, action: str, message: dict[str, Any]) -> None:
         run = self.run
@@ -162,8 +182,9 @@ class Arena:
         name, on = message.get("input"), message.get("on")
         bits = self.machine.input_bits
         if name not in bits:
-            raise Refused(N_("unknown input {name}: the robot's inputs are {inputs}", name=repr(name),
-                             inputs=", ".join(bits)))
+            raise Refused(
+                N_("unknown input {name}: the robot's inputs are {inputs}", name=repr(name), inputs=", ".join(bits))
+            )
         if on not in (True, False, None):
             raise Refused(N_('"on" must be true, false or null'))
         run.hold(bits[name], on)
@@ -174,8 +195,14 @@ class Arena:
             return {"running": False, "paused": True, "speed": self.settings.speed, "held": {}}
         bits = self.machine.input_bits if self.machine else {}
         held = {name: run.robot.forced[bit] for name, bit in bits.items() if bit in run.robot.forced}
-        return {"running": run.running, "paused": run.paused, "speed": run.speed, "held": held,
-                "scripted": len(run.robot.script), "error": run.error}
+        return {
+            "running": run.running,
+            "paused": run.paused,
+            "speed": run.speed,
+            "held": held,
+            "scripted": len(run.robot.script),
+            "error": run.error,
+        }
 
     def frame(self, explain: Callable[..., list[dict[str, Any]]]) -> dict[str, Any] | None:
         run = self.run
@@ -187,17 +214,33 @@ class Arena:
         latest = data["latest"]
         states = self.machine.states
         extra = latest.extra or {}
-        frame = {"type": "frame", "tick": latest.tick, "state": latest.state, "state_id": str(states[latest.state]),
-                 "prev_state": latest.prev_state, "timer": latest.timer, "event": latest.event, "mask": latest.mask,
-                 "row": latest.row, "outputs": list(latest.outputs), "fired": data["fired"],
-                 # by state id: the page colours a point by its state, and an edit may reorder the states
-                 "path": data["path"],  # [x, y, state id]: coloured by the table shown
-                 "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
-                 "bumpers": extra.get("bumpers", 0), "light": list(extra.get("light", (0.0, 0.0))),
-                 "battery_v": extra.get("battery_v"), "late_ms": extra.get("late_ms"), **self.status()}
+        frame = {
+            "type": "frame",
+            "tick": latest.tick,
+            "state": latest.state,
+            "state_id": str(states[latest.state]),
+            "prev_state": latest.prev_state,
+            "timer": latest.timer,
+            "event": latest.event,
+            "mask": latest.mask,
+            "row": latest.row,
+            "outputs": list(latest.outputs),
+            "fired": data["fired"],
+            # by state id: the page colours a point by its state, and an edit may reorder the states
+            "path": data["path"],  # [x, y, state id]: coloured by the table shown
+            "pose": [extra.get("x"), extra.get("y"), extra.get("heading")],
+            "bumpers": extra.get("bumpers", 0),
+            "light": list(extra.get("light", (0.0, 0.0))),
+            "battery_v": extra.get("battery_v"),
+            "late_ms": extra.get("late_ms"),
+            **self.status(),
+        }
         # each lamp's output this tick (0: off, up to 8: full), drawn on the robot
-        frame["lamps"] = {name: latest.outputs[i] for i, name in enumerate(self.machine.output_names)
-                          if name in self.table.robot.lamps}
+        frame["lamps"] = {
+            name: latest.outputs[i]
+            for i, name in enumerate(self.machine.output_names)
+            if name in self.table.robot.lamps
+        }
         if self.tables is not None and self.view and self.view != self.tables.names[0]:
             shown = viewed(self.tables, self.view, extra, latest.tick)
             if run.paused:
@@ -244,13 +287,23 @@ def viewed(tables: RobotTables, name: str, extra: dict[str, Any], tick: int) -> 
     row = next((r.index for r in table.rows if r.as_written == written), -1) if written is not None else -1
     state = extra.get(f"{name}.state")
     states = tables.machines[tables.index(name)].states
-    return {"state": states.index(state) if state in states else 0, "state_id": str(state), "row": row,
-            "timer": extra.get(f"{name}.timer", 0), "event": extra.get(f"{name}.event", 0),
-            "fired": [[tick, row]] if row >= 0 else []}
+    return {
+        "state": states.index(state) if state in states else 0,
+        "state_id": str(state),
+        "row": row,
+        "timer": extra.get(f"{name}.timer", 0),
+        "event": extra.get(f"{name}.event", 0),
+        "fired": [[tick, row]] if row >= 0 else [],
+    }
 
 
-def why_viewed(tables: RobotTables, name: str, before: dict[str, Any] | None, extra: dict[str, Any],
-               explain: Callable[..., list[dict[str, Any]]]) -> list[dict[str, Any]]:
+def why_viewed(
+    tables: RobotTables,
+    name: str,
+    before: dict[str, Any] | None,
+    extra: dict[str, Any],
+    explain: Callable[..., list[dict[str, Any]]],
+) -> list[dict[str, Any]]:
     """Why each row of table ``name``'s state fired or not on the latest tick: its state before the tick (the
     tick before's ``NAME.state``; on the first, its start) and its events then."""
     k = tables.index(name)

@@ -32,9 +32,15 @@ def read_trace_bytes(data: bytes, name: str) -> list[dict[str, Any]]:
     """Parse JSON Lines (through the one trace reader, :func:`tablebot.formats.trace_lines.parse_trace`); every bad line
     is reported (the first ten) with its number."""
     if len(data) > MAX_PLAYER_TRACE_BYTES:
-        raise fail(name, N_("the trace has {size:,} bytes; the player opens traces up to {limit:,}", size=len(data),
-                            limit=MAX_PLAYER_TRACE_BYTES),
-                   N_("cut the run shorter (--seconds) or open a part of it"))
+        raise fail(
+            name,
+            N_(
+                "the trace has {size:,} bytes; the player opens traces up to {limit:,}",
+                size=len(data),
+                limit=MAX_PLAYER_TRACE_BYTES,
+            ),
+            N_("cut the run shorter (--seconds) or open a part of it"),
+        )
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -30,8 +30,13 @@ DEFAULTS: dict[str, dict[str, tuple[Any, Number, Number, str]]] = {
         "front": (0.12, 0.01, 2.0, "m from the axle centre to the front bumper (estimate)"),
         "rear": (0.07, 0.01, 2.0, "m from the axle centre to the rear bumper (estimate)"),
         "half_width": (0.09, 0.01, 2.0, "m, half the body width over the wheels (estimate)"),
-        "bumper_overlap": (0.012, 0.0, 1.0, "m each half of the front bumper reaches past the middle: "
-                           "a hit this close to the middle closes both switches (estimate)"),
+        "bumper_overlap": (
+            0.012,
+            0.0,
+            1.0,
+            "m each half of the front bumper reaches past the middle: "
+            "a hit this close to the middle closes both switches (estimate)",
+        ),
         "bumper_wrap": (0.02, 0.0, 1.0, "m each front bumper wraps round its corner (estimate)"),
         "switch_travel": (0.001, 0.0, 0.05, "m an obstacle may be from a bumper and still close it"),
         "gyration_radius": (0.07, 0.005, 2.0, "m; how a corner push splits into shift and turn (estimate)"),
@@ -91,8 +96,15 @@ SECTIONS = (*DEFAULTS, "wiring")
 #: the robot simulated: a table with another tick_ms runs on the same motors.
 SPIN_TICK_S = 0.010
 #: Which robot names play which part; the document's BumberBot wiring.
-WIRING: dict[str, str] = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
-                          "rear": "I5", "light_right": "I7", "light_left": "I8"}
+WIRING: dict[str, str] = {
+    "right_motor": "M1",
+    "left_motor": "M2",
+    "front_right": "I3",
+    "front_left": "I4",
+    "rear": "I5",
+    "light_right": "I7",
+    "light_left": "I8",
+}
 INPUT_ROLES = ("front_right", "front_left", "rear", "light_right", "light_left")  # layout B_* order
 
 
@@ -140,11 +152,17 @@ def read_robot_sim(src: Source, sim: Any, robot: Any) -> SimSection:
     world = sim.get("world")
     path = Path(src.path).parent / world if isinstance(world, str) else None
     if world is not None and not isinstance(world, str):
-        src.error(("sim", None, "world"), N_("sim.world must be a file name"),
-                  N_("for example: {example}", example='world = "arena.toml"'))
+        src.error(
+            ("sim", None, "world"),
+            N_("sim.world must be a file name"),
+            N_("for example: {example}", example='world = "arena.toml"'),
+        )
     elif path is not None and not path.is_file():
-        src.error(("sim", None, "world"), N_("sim.world: {path} is not a file", path=str(path)),
-                  N_("name a world file, relative to the robot file's folder"))
+        src.error(
+            ("sim", None, "world"),
+            N_("sim.world: {path} is not a file", path=str(path)),
+            N_("name a world file, relative to the robot file's folder"),
+        )
         path = None
     return SimSection(layer, path)
 
@@ -159,8 +177,11 @@ def _wiring_value(src: Source, name: str, key: str, value: Any) -> str | None:
     """The robot name a role is wired to ("" for a sensor that is "none"), else None after an error."""
     if isinstance(value, str) and (value or not key.endswith("motor")):
         return "" if value.lower() == "none" else value
-    src.error((name, None, key), N_("[{name}] {key} must name a robot input or motor", name=name, key=key),
-              N_('for example: {key} = "{value}" (a sensor may be "none")', key=key, value=WIRING[key]))
+    src.error(
+        (name, None, key),
+        N_("[{name}] {key} must name a robot input or motor", name=name, key=key),
+        N_('for example: {key} = "{value}" (a sensor may be "none")', key=key, value=WIRING[key]),
+    )
     return None
 
 
@@ -269,7 +290,7 @@ def param_row(params: Params, tick_s: float, sensors: tuple[Sensor, ...] = ()) -
     p[L.P_DRANGE], p[L.P_DMIN_RANGE] = dist["range"], dist["blind"]
     p[L.P_DBEAM], p[L.P_DRES] = math.radians(dist["beam"]), dist["resolution"]
     for k, sensor in enumerate(sensors[: L.MAX_SENSORS]):
-        p[L.P_SENSOR + k * L.SENSOR_FIELDS: L.P_SENSOR + (k + 1) * L.SENSOR_FIELDS] = sensor_fields(sensor)
+        p[L.P_SENSOR + k * L.SENSOR_FIELDS : L.P_SENSOR + (k + 1) * L.SENSOR_FIELDS] = sensor_fields(sensor)
     return p
 
 

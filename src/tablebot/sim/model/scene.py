@@ -86,16 +86,27 @@ def find_world(table: Table, world_path: Path | None, robot_world: Path | None) 
     return load_world(beside) if beside.is_file() else default_world()
 
 
-def scene_for(table: Table, machine: Machine, world_path: Path | None = None,
-              overrides: dict[str, Any] | None = None, tables: RobotTables | None = None) -> Scene:
+def scene_for(
+    table: Table,
+    machine: Machine,
+    world_path: Path | None = None,
+    overrides: dict[str, Any] | None = None,
+    tables: RobotTables | None = None,
+) -> Scene:
     """The whole chain for one table (or, with ``tables``, every table of the robot): its robot's [sim], its
     world (see :func:`find_world`), checked and packed."""
     layer, robot_world = robot_layer(table.robot)
     return prepare(table, machine, find_world(table, world_path, robot_world), layer, overrides, tables)
 
 
-def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str, Any] | None = None,
-            overrides: dict[str, Any] | None = None, tables: RobotTables | None = None) -> Scene:
+def prepare(
+    table: Table,
+    machine: Machine,
+    world: World,
+    robot_params: dict[str, Any] | None = None,
+    overrides: dict[str, Any] | None = None,
+    tables: RobotTables | None = None,
+) -> Scene:
     """Check that robot, table and world fit together and pack them for the physics core; with ``tables``,
     for every table of the robot (its inputs wired in the robot-wide layout)."""
     if tables is not None:
@@ -104,11 +115,14 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     params = _unwire_absent_sensors(merged(robot_params, world.params, overrides or {}), table.robot)
     found: list[tuple[str, str, str, str]] = [
         (section, key, message, N_("fix the value in the world or robot file"))
-        for section, key, message in problems(params)]
+        for section, key, message in problems(params)
+    ]
     found += _wiring_errors(params, table.robot)
     if found:
-        raise TableBotError(Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
-                            for section, key, message, hint in found)
+        raise TableBotError(
+            Diagnostic(*_locate(section, key, world, table.robot, robot_params), None, message, hint)
+            for section, key, message, hint in found
+        )
     _check_tick(params, table.robot)
     tick_s = table.robot.tick_s
     _check_sensor_count(table.robot)
@@ -119,18 +133,29 @@ def prepare(table: Table, machine: Machine, world: World, robot_params: dict[str
     outputs = machine.output_names
     robot = table.robot
     # the BumberBot roles' bits, then one per declared sensor (sensor slot k at B_SENSOR + k)
-    bits = np.array([machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES]
-                    + [machine.input_bits.get(sensor.name, 0) for sensor in robot.sensors], dtype=np.int64)
+    bits = np.array(
+        [machine.input_bits.get(params.wiring[role], 0) for role in INPUT_ROLES]
+        + [machine.input_bits.get(sensor.name, 0) for sensor in robot.sensors],
+        dtype=np.int64,
+    )
     motor_roles = {params.wiring["right_motor"]: "right_motor", params.wiring["left_motor"]: "left_motor"}
     columns = tuple(SIDE_COLUMNS[motor_roles[c.motor]] if c.motor in motor_roles else -1 for c in robot.counters)
-    return Scene(table=table, machine=machine, world=world, params=params, geometry=geo, P=P, bits=bits,
-                 drive=(outputs.index(params.wiring["right_motor"]), outputs.index(params.wiring["left_motor"])),
-                 pulse_columns=columns, lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps),
-                 tables=tables)
+    return Scene(
+        table=table,
+        machine=machine,
+        world=world,
+        params=params,
+        geometry=geo,
+        P=P,
+        bits=bits,
+        drive=(outputs.index(params.wiring["right_motor"]), outputs.index(params.wiring["left_motor"])),
+        pulse_columns=columns,
+        lamp_outputs=tuple(outputs.index(lamp) for lamp in robot.lamps),
+        tables=tables,
+    )
 
 
-def _locate(section: str, key: str, world: World, robot: Robot,
-            robot_params: dict[str, Any]) -> tuple[str, int | None]:
+def _locate(section: str, key: str, world: World, robot: Robot, robot_params: dict[str, Any]) -> tuple[str, int | None]:
     """The file and line that set ``[section] key`` (the world wins over the robot's ``[sim.*]``), else
     the section's line; a value no file set is the robot's to fix."""
     for whole in (False, True):
@@ -146,19 +171,31 @@ def _unwire_absent_sensors(params: Params, robot: Robot) -> Params:
     """Sensor roles left at the BumberBot's wiring stay unconnected on a robot without that input, or
     whose input is a sensor the robot file declares in [sensors]."""
     declared = {s.name for s in robot.sensors}
-    wiring = {role: name if role.endswith("motor") or role in params.wired
-              or (name in robot.inputs and name not in declared) else ""
-              for role, name in params.wiring.items()}
+    wiring = {
+        role: name
+        if role.endswith("motor") or role in params.wired or (name in robot.inputs and name not in declared)
+        else ""
+        for role, name in params.wiring.items()
+    }
     return replace(params, wiring=wiring)
 
 
 def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, str]]:
     """Drive motors must be two motors of the robot; a sensor must name an input ("" = not connected)."""
     if len(robot.motors) < 2:
-        return [("wiring", "right_motor", NP_("the simulated robot drives two wheels, but robot {robot} has {n} motor",
-                                              "the simulated robot drives two wheels, but robot {robot} has {n} "
-                                              "motors", len(robot.motors), robot=robot.name),
-                 N_("add a right and a left motor to [motors] in the robot file"))]
+        return [
+            (
+                "wiring",
+                "right_motor",
+                NP_(
+                    "the simulated robot drives two wheels, but robot {robot} has {n} motor",
+                    "the simulated robot drives two wheels, but robot {robot} has {n} motors",
+                    len(robot.motors),
+                    robot=robot.name,
+                ),
+                N_("add a right and a left motor to [motors] in the robot file"),
+            )
+        ]
     errors: list[tuple[str, str, str, str]] = []
     for role, name in params.wiring.items():
         motor = role.endswith("motor")
@@ -169,13 +206,29 @@ def _wiring_errors(params: Params, robot: Robot) -> list[tuple[str, str, str, st
     declared = {s.name: s for s in robot.sensors}
     for role, name in params.wiring.items():
         if name in declared:
-            errors.append(("wiring", role, N_("wiring: {role} = {name!r}, but {name} is declared in [sensors] as a "
-                                              "{model} sensor", role=role, name=name, model=declared[name].model),
-                           N_('wire {role} to another input, or to "none"', role=role)))
+            errors.append(
+                (
+                    "wiring",
+                    role,
+                    N_(
+                        "wiring: {role} = {name!r}, but {name} is declared in [sensors] as a {model} sensor",
+                        role=role,
+                        name=name,
+                        model=declared[name].model,
+                    ),
+                    N_('wire {role} to another input, or to "none"', role=role),
+                )
+            )
     right, left = params.wiring["right_motor"], params.wiring["left_motor"]
     if right == left and right in robot.motors:
-        errors.append(("wiring", "left_motor", N_("wiring: right_motor and left_motor are both {right}", right=right),
-                       N_("the simulated robot drives two wheels: give each its own motor")))
+        errors.append(
+            (
+                "wiring",
+                "left_motor",
+                N_("wiring: right_motor and left_motor are both {right}", right=right),
+                N_("the simulated robot drives two wheels: give each its own motor"),
+            )
+        )
     return errors
 
 
@@ -188,25 +241,47 @@ def _not_wired(role: str, name: str, motor: bool, robot: str) -> Message:
 def _wire_hint(role: str, wanted: tuple[str, ...] | list[str], motor: bool) -> Message:
     known = tuple(wanted) or (N_("none"),)
     if motor:
-        return N_("its motors are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file",
-                  known=known, role=role)
-    return N_('its inputs are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file ("none": '
-              "not connected)", known=known, role=role)
+        return N_(
+            "its motors are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file",
+            known=known,
+            role=role,
+        )
+    return N_(
+        'its inputs are {known}; set [wiring] {role} in the world or [sim.wiring] in the robot file ("none": '
+        "not connected)",
+        known=known,
+        role=role,
+    )
 
 
 def _check_sensor_count(robot: Robot) -> None:
     if len(robot.sensors) > L.MAX_SENSORS:
-        raise fail(robot.source, N_("the simulator models at most {most} sensors in [sensors], and robot {robot} "
-                                     "declares {n}", most=L.MAX_SENSORS, robot=robot.name, n=len(robot.sensors)),
-                   N_("declare fewer sensors"), robot.line("sensors"))
+        raise fail(
+            robot.source,
+            N_(
+                "the simulator models at most {most} sensors in [sensors], and robot {robot} declares {n}",
+                most=L.MAX_SENSORS,
+                robot=robot.name,
+                n=len(robot.sensors),
+            ),
+            N_("declare fewer sensors"),
+            robot.line("sensors"),
+        )
 
 
 def _check_events(table: Table) -> None:
     """The compiled simulator looks each tick's row up in a flat table of every event set: 2**events per state."""
     if len(table.events) > FLAT_BITS:
-        raise fail(table.path, N_("the table has {n} event columns (T, inputs and counters); the simulator takes at "
-                                   "most {most}", n=len(table.events), most=FLAT_BITS),
-                   N_("simulate a table that looks at fewer inputs"), 1)
+        raise fail(
+            table.path,
+            N_(
+                "the table has {n} event columns (T, inputs and counters); the simulator takes at most {most}",
+                n=len(table.events),
+                most=FLAT_BITS,
+            ),
+            N_("simulate a table that looks at fewer inputs"),
+            1,
+        )
 
 
 def _check_tick(params: Params, robot: Robot) -> None:
@@ -214,11 +289,20 @@ def _check_tick(params: Params, robot: Robot) -> None:
     top = top_speed(params)
     step = robot.seconds(top)
     if step > MAX_STEP_M:
-        raise fail(robot.source, N_("tick_ms = {tick_ms} is too coarse for the simulator: the robot would move up "
-                                     "to {cm:.0f} cm per tick, through thin walls", tick_ms=robot.tick_ms,
-                                     cm=100 * step),
-                   N_("simulate with tick_ms = {most} or less (the engine and the firmware take any tick)",
-                      most=math.floor(MAX_STEP_M / top * 1000)), robot.line("", "tick_ms"))
+        raise fail(
+            robot.source,
+            N_(
+                "tick_ms = {tick_ms} is too coarse for the simulator: the robot would move up "
+                "to {cm:.0f} cm per tick, through thin walls",
+                tick_ms=robot.tick_ms,
+                cm=100 * step,
+            ),
+            N_(
+                "simulate with tick_ms = {most} or less (the engine and the firmware take any tick)",
+                most=math.floor(MAX_STEP_M / top * 1000),
+            ),
+            robot.line("", "tick_ms"),
+        )
 
 
 def check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
@@ -230,7 +314,17 @@ def check_start(world: World, geo: Geometry, P: np.ndarray) -> None:
     body_corners(s, P[0], corners)
     hit = deepest_contact(s, P[0], corners, geo.verts, geo.pstart, geo.pbound, geo.circles)
     if hit[0] > 1e-9:
-        raise fail(world.path, N_("the robot at its start pose ({x:g}, {y:g}, heading {heading:g}°) overlaps a wall "
-                                   "or obstacle near ({hx:.2f}, {hy:.2f})", x=x, y=y, heading=heading,
-                                   hx=hit[3], hy=hit[4]),
-                   N_("move [start] at, or turn it with heading"), world.line("start", "at"))
+        raise fail(
+            world.path,
+            N_(
+                "the robot at its start pose ({x:g}, {y:g}, heading {heading:g}°) overlaps a wall "
+                "or obstacle near ({hx:.2f}, {hy:.2f})",
+                x=x,
+                y=y,
+                heading=heading,
+                hx=hit[3],
+                hy=hit[4],
+            ),
+            N_("move [start] at, or turn it with heading"),
+            world.line("start", "at"),
+        )
