@@ -48,3 +48,8 @@ def test_a_robot_files_sim_and_robopro_sections_are_refused_in_german(tmp_path: 
     assert "Fehler: [robopro] M1: 'X9' ist kein Anschluss (Motor) des Controllers" in shown
     assert 'Tipp: output = "M1" … "M4" schreiben' in shown
     assert "Fehler: sim.world muss ein Dateiname sein" in shown
+
+
+def test_the_robo_pro_program_export_says_what_it_wrote_in_german(tmp_path: Path) -> None:
+    shown = run_in("de", ["export", str(EXAMPLE), str(tmp_path / "out"), "--to", "robopro-program"])
+    assert "geschrieben: in ROBO Pro 4.x öffnen" in shown and "open it" not in shown, shown

@@ -79,7 +79,7 @@ def export_lists(machine: Machine, out: Path | None, options: ExportOptions) -> 
     _refuse_cross(machine)
     encoded = lists.encode(machine.table)
     files = tuple(lists.write_lists(encoded, out_folder(out, "OUTDIR")))
-    return Exported(files, tuple(f"wrote {path}" for path in files), main_only(machine))
+    return Exported(files, tuple(N_("wrote {file}", file=str(path)) for path in files), main_only(machine))
 
 
 def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
@@ -100,13 +100,24 @@ def export_rpp(machine: Machine, out: Path | None, options: ExportOptions) -> Ex
     written, from_csv = rpp.write_lists(into, named, target)
     return Exported(
         (written,),
-        (f"wrote {written} (lists {', '.join(named)}: {len(encoded.event)} values each)",),
+        (
+            N_(
+                "wrote {file} (lists {lists}: {n} values each)",
+                file=str(written),
+                lists=tuple(named),
+                n=len(encoded.event),
+            ),
+        ),
         main_only(machine)
         + tuple(
-            f"list {name} loads its values from column {column} of a CSV file when the program starts "
-            "(its load-from-CSV setting), which replaces the values written here; turn that off in "
-            "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
-            "CSV files instead"
+            N_(
+                "list {name} loads its values from column {column} of a CSV file when the program starts "
+                "(its load-from-CSV setting), which replaces the values written here; turn that off in "
+                "the list's properties in ROBO Pro, or load the lists from `tablebot export --to robopro` "
+                "CSV files instead",
+                name=name,
+                column=column,
+            )
             for name, column in from_csv.items()
         ),
     )
@@ -140,7 +151,7 @@ def export_program(machine: Machine, out: Path | None, options: ExportOptions) -
     tables = several(machine.table)
     text = generate(machine.table) if tables is None else generate_several(tables)
     path = write_text(out_folder(out, "OUTDIR") / file_name(machine.table), text)
-    lines: tuple[str, ...] = (f"wrote {path}: open it in ROBO Pro 4.x",)
+    lines: tuple[str, ...] = (N_("wrote {file}: open it in ROBO Pro 4.x", file=str(path)),)
     if tables is not None:
         lines += (
             N_(
