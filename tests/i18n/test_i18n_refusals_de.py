@@ -53,3 +53,13 @@ def test_a_robot_files_sim_and_robopro_sections_are_refused_in_german(tmp_path: 
 def test_the_robo_pro_program_export_says_what_it_wrote_in_german(tmp_path: Path) -> None:
     shown = run_in("de", ["export", str(EXAMPLE), str(tmp_path / "out"), "--to", "robopro-program"])
     assert "geschrieben: in ROBO Pro 4.x öffnen" in shown and "open it" not in shown, shown
+
+
+def test_a_motor_too_weak_for_its_calibration_spin_is_refused_in_german(tmp_path: Path) -> None:
+    robot = tmp_path / "bot"
+    shutil.copytree(EXAMPLE, robot)
+    with (robot / "arena.toml").open("a", encoding="utf-8") as extra:
+        extra.write("\n[motor]\nfriction_volts = 5\n")
+    shown = run_in("de", ["sim", str(robot), "--seconds", "1", "--no-plots"])
+    assert "Fehler: die Tempostufe der Kalibrierdrehung überwindet friction_volts nicht" in shown, shown
+    assert "Tipp: den Wert in der Welt- oder Roboterdatei korrigieren" in shown

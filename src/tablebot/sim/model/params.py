@@ -211,7 +211,7 @@ def problems(params: Params) -> list[tuple[str, str, str]]:
     try:
         speed_per_volt(params)
     except ValueError as exc:
-        found.append(("motor", "friction_volts", str(exc)))
+        found.append(("motor", "friction_volts", exc.args[0]))  # the message itself: said in the reader's language
     return found
 
 
@@ -253,7 +253,7 @@ def speed_per_volt(params: Params) -> float:
     duty, _ = _formulas()
     drive = duty(level, m["levels"]) * volts - m["friction_volts"]
     if drive <= 0:
-        raise ValueError("the calibration spin's speed level cannot overcome friction_volts")
+        raise ValueError(N_("the calibration spin's speed level cannot overcome friction_volts"))
     return spin_speed(params) / drive
 
 
