@@ -19,7 +19,7 @@ from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
 from tablebot.sim.physics.kernel import end_tick, robot_scratch, start_tick
-from tablebot.sim.physics.structures import Record, RobotState, Wiring, WorldArrays
+from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tables import RobotTables
 from tablebot.tick import EVENT, ROW, STATE, TIMER, Program, registers
 
@@ -147,7 +147,15 @@ def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: S
     """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
-    scratch = robot_scratch(robot, world)
+    several_ticks(robot, world, sp, st, wiring, ticks, noise, bitgen, record, tables, robot_scratch(robot, world))
+
+
+@njit(nogil=True, refcounts=False)
+def several_ticks(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: SeveralState, wiring: Wiring,
+                  ticks: int, noise: np.ndarray, bitgen: np.uint64, record: Record, tables: np.ndarray,
+                  scratch: Scratch) -> None:
+    """:func:`run_several`'s loop, given its scratch space: compiled without reference counting (tablebot.jit), as
+    the one-table loop (kernel.run_ticks) is."""
     for t in range(ticks):
         mask = start_tick(t, robot, wiring, record, scratch)
         tick_several(sp, st, robot.outputs, mask, scratch.pulses)
