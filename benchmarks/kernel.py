@@ -32,6 +32,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from kernel_several import several_against_one  # beside this file (a script's folder is on the path)
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -75,35 +77,8 @@ def measure(example: str, repeats: int) -> dict[str, float]:
     fleet.run(1000, threads=False)
     rows = np.concatenate([np.concatenate(trace.rows) for trace in fleet.traces.values()])
     out.update(_parts(rows, scene, fleet, repeats))
-    out.update(_several(repeats))
+    out.update(several_against_one(repeats))
     return out
-
-
-SEVERAL = "bumberbot-lights"  # a robot of two tables: its drive table alone, and with its lights table
-
-
-def _several(repeats: int) -> dict[str, float]:
-    """ns per robot-tick of a fleet of 300 robots of several tables (every table each tick) and of the same robot
-    running its main table alone, 1,000 ticks on this thread, and their ratio: what a robot's other tables cost."""
-    import tablebot
-    from tablebot.fleet.run import Fleet, RobotSpec
-
-    project = tablebot.open(ROOT / "examples" / SEVERAL)
-    layer = _sim("model.scene").robot_layer(project.robot)[0]
-
-    def run(every: bool) -> float:
-        scene = project.scene(every_table=every)
-        fleet = Fleet(project.table, project.machine, scene.world, [RobotSpec(seed=s) for s in range(300)], layer,
-                      tables=project.tables if every else None)
-        started = time.process_time()
-        fleet.run(1000, threads=False)
-        return (time.process_time() - started) / 300e3 * 1e9
-
-    run(True), run(False)  # compiled or loaded, warm
-    several = statistics.median(run(True) for _ in range(repeats))
-    one = statistics.median(run(False) for _ in range(repeats))
-    return {f"{SEVERAL}: several tables": several, f"{SEVERAL}: main table alone": one,
-            f"{SEVERAL}: several / alone": several / one}
 
 
 def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
@@ -126,21 +101,35 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
 
     copy = ns("copy", rows, s)
     regs, outputs, counters = (a.copy() for a in fleet.initial)
-    light = ("light_shade", rows, p, g.edges, g.circles, g.lamps, np.empty(4), shade) if shade is not None else (
-        "light", rows, p, g.edges, g.circles, g.lamps, np.empty(4))
+    light = (
+        ("light_shade", rows, p, g.edges, g.circles, g.lamps, np.empty(4), shade)
+        if shade is not None
+        else ("light", rows, p, g.edges, g.circles, g.lamps, np.empty(4))
+    )
     parts = {
         "light (2 phototransistors)": ns(*light),
         "bumpers": ns("bumpers", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, *near_centre) - copy,
-        "contacts": ns("contacts", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, np.empty((4, 2)),
-                       *near_centre) - copy,
+        "contacts": ns("contacts", rows, p, g.verts, g.pstart, g.pbound, g.circles, s, np.empty((4, 2)), *near_centre)
+        - copy,
         "motors": ns("motors", rows, p, s, np.zeros(4)) - copy,
-        "declared sensors": ns("declared", rows, p, g.edges, g.circles, g.lamps, g.lines, s,
-                               "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func)) - copy,
+        "declared sensors": ns(
+            "declared",
+            rows,
+            p,
+            g.edges,
+            g.circles,
+            g.lamps,
+            g.lines,
+            s,
+            "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func),
+        )
+        - copy,
         "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s)
         - copy,
         "noise (4 normals)": ns("noise", rows.shape[0], fleet.bitgens[0]),
-        "engine tick": ns("engine", rows, regs, outputs, counters, np.zeros(counters.shape[0], np.int64),
-                          fleet.machine.arrays.program),
+        "engine tick": ns(
+            "engine", rows, regs, outputs, counters, np.zeros(counters.shape[0], np.int64), fleet.machine.arrays.program
+        ),
         "heading cos+sin": ns("trig", rows),
     }
     return parts
@@ -175,43 +164,72 @@ def _loops() -> dict[str, Any]:
         return t
 
     @fast
-    def light_shade(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
-                    turns: np.ndarray, shade: np.ndarray) -> float:
+    def light_shade(
+        rows: np.ndarray,
+        p: np.ndarray,
+        edges: np.ndarray,
+        circles: np.ndarray,
+        lamps: np.ndarray,
+        turns: np.ndarray,
+        shade: np.ndarray,
+    ) -> float:
         total = 0.0
         ph.aim_turns(p, turns)
         for i in range(rows.shape[0]):
             s = rows[i]
             c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += (ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade)
-                      + ph.light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade))
+            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade) + ph.light_side(
+                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade
+            )
         return total
 
     @fast
-    def light(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
-              turns: np.ndarray) -> float:  # trees without a grid
+    def light(
+        rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, turns: np.ndarray
+    ) -> float:  # trees without a grid
         total = 0.0
         ph.aim_turns(p, turns)
         for i in range(rows.shape[0]):
             s = rows[i]
             c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += (ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps)
-                      + ph.light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps))
+            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
+                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps
+            )
         return total
 
     @fast
-    def bumpers(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                circles: np.ndarray, s: np.ndarray, near: np.ndarray, centre: np.ndarray) -> float:
+    def bumpers(
+        rows: np.ndarray,
+        p: np.ndarray,
+        verts: np.ndarray,
+        pstart: np.ndarray,
+        pbound: np.ndarray,
+        circles: np.ndarray,
+        s: np.ndarray,
+        near: np.ndarray,
+        centre: np.ndarray,
+    ) -> float:
         reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.sense_bumpers(s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach,
-                             wide, near, centre)
+            co.sense_bumpers(
+                s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach, wide, near, centre
+            )
         return s[0]
 
     @fast
-    def contacts(rows: np.ndarray, p: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                 circles: np.ndarray, s: np.ndarray, corners: np.ndarray, near: np.ndarray,
-                 centre: np.ndarray) -> float:
+    def contacts(
+        rows: np.ndarray,
+        p: np.ndarray,
+        verts: np.ndarray,
+        pstart: np.ndarray,
+        pbound: np.ndarray,
+        circles: np.ndarray,
+        s: np.ndarray,
+        corners: np.ndarray,
+        near: np.ndarray,
+        centre: np.ndarray,
+    ) -> float:
         reach, wide = co.reaches(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
@@ -226,8 +244,16 @@ def _loops() -> dict[str, Any]:
         return s[0]
 
     @fast
-    def declared(rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
-                 lines: np.ndarray, s: np.ndarray, skip: bool) -> float:
+    def declared(
+        rows: np.ndarray,
+        p: np.ndarray,
+        edges: np.ndarray,
+        circles: np.ndarray,
+        lamps: np.ndarray,
+        lines: np.ndarray,
+        s: np.ndarray,
+        skip: bool,
+    ) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
             if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
@@ -250,8 +276,14 @@ def _loops() -> dict[str, Any]:
         return t
 
     @fast
-    def engine(rows: np.ndarray, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, pulses: np.ndarray,
-               program: np.ndarray) -> int:
+    def engine(
+        rows: np.ndarray,
+        regs: np.ndarray,
+        outputs: np.ndarray,
+        counters: np.ndarray,
+        pulses: np.ndarray,
+        program: np.ndarray,
+    ) -> int:
         t = 0
         for i in range(rows.shape[0]):
             tick_compiled(regs, outputs, counters, int(rows[i, L.MASK]), pulses, program)
@@ -264,8 +296,12 @@ def _loops() -> dict[str, Any]:
 def baseline_sources(ref: str) -> str:
     """REF's src/ exported (git archive) into a folder named after its commit, kept in the temporary folder so
     that its compiled code (numba caches by source path) serves the next run: the tree the baseline imports."""
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", f"{ref}^{{commit}}"], check=True,
-                            capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--verify", f"{ref}^{{commit}}"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout.strip()
     folder = Path(tempfile.gettempdir()) / f"tablebot-kernel-baseline-{commit[:12]}"
     if not (folder / "src").is_dir():
         partial = Path(tempfile.mkdtemp(prefix=folder.name + "."))
@@ -279,15 +315,22 @@ def child(example: str, repeats: int, src: str | None) -> dict[str, float]:
     """:func:`measure` in a fresh process importing tablebot from ``src`` (this tree's when None)."""
     env = dict(os.environ, PYTHONPATH=src or str(ROOT / "src"))
     env.pop("NUMBA_CACHE_DIR", None)  # each tree its own cache (tablebot.jit names it after the sources)
-    done = subprocess.run([sys.executable, __file__, "--json", "--example", example, "--repeats", str(repeats)],
-                          env=env, check=True, capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, __file__, "--json", "--example", example, "--repeats", str(repeats)],
+        env=env,
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     return json.loads(done.stdout.splitlines()[-1])
 
 
 def report(now: dict[str, list[float]], base: dict[str, list[float]] | None) -> None:
     whole = statistics.median(now[WHOLE])
-    print(f"{'ns per robot-tick (one core)':<30} {'this tree':>10}" + (f" {'baseline':>10} {'ratio':>7}" if base else
-                                                                       f" {'of a tick':>10}"))
+    print(
+        f"{'ns per robot-tick (one core)':<30} {'this tree':>10}"
+        + (f" {'baseline':>10} {'ratio':>7}" if base else f" {'of a tick':>10}")
+    )
     for part, values in now.items():
         mine = statistics.median(values)
         if base:
@@ -295,9 +338,14 @@ def report(now: dict[str, list[float]], base: dict[str, list[float]] | None) -> 
             print(f"{part:<30} {mine:10.1f} {theirs:10.1f} {mine / theirs:7.2f}")
         else:
             print(f"{part:<30} {mine:10.1f} {mine / whole:10.0%}")
-    print(f"whole kernel: {1e3 / whole:.2f} M robot-ticks/s per core"
-          + (f" (baseline {1e3 / statistics.median(base[WHOLE]):.2f}; x{statistics.median(base[WHOLE]) / whole:.2f})"
-             if base else ""))
+    print(
+        f"whole kernel: {1e3 / whole:.2f} M robot-ticks/s per core"
+        + (
+            f" (baseline {1e3 / statistics.median(base[WHOLE]):.2f}; x{statistics.median(base[WHOLE]) / whole:.2f})"
+            if base
+            else ""
+        )
+    )
 
 
 def main() -> None:
@@ -311,8 +359,10 @@ def main() -> None:
     if args.json:
         print(json.dumps(measure(args.example, args.repeats)))
         return
-    print(f"load average {os.getloadavg()[0]:.1f} {os.getloadavg()[1]:.1f} {os.getloadavg()[2]:.1f} "
-          f"on {os.cpu_count()} cores; example {args.example}")
+    print(
+        f"load average {os.getloadavg()[0]:.1f} {os.getloadavg()[1]:.1f} {os.getloadavg()[2]:.1f} "
+        f"on {os.cpu_count()} cores; example {args.example}"
+    )
     now: dict[str, list[float]] = {}
     base: dict[str, list[float]] = {}
     src = baseline_sources(args.baseline) if args.baseline else None
