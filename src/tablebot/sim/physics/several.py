@@ -68,10 +68,12 @@ def several_program(tables: RobotTables) -> SeveralProgram:
             source, states = tables.covers(event)
             for state in states:
                 cross[k, source, state] |= table.bit(name)
-    writers = np.array([-1 if (w := tables.writer(name)) is None else w for name in tables.output_names],
-                       dtype=np.int64)
-    counter_writers = np.array([-1 if (w := tables.writer(name)) is None else w
-                                for name in tables.robot.counter_names], dtype=np.int64)
+    writers = np.array(
+        [-1 if (w := tables.writer(name)) is None else w for name in tables.output_names], dtype=np.int64
+    )
+    counter_writers = np.array(
+        [-1 if (w := tables.writer(name)) is None else w for name in tables.robot.counter_names], dtype=np.int64
+    )
     timers, loads = table_values(tables)
     return SeveralProgram(tuple(programs), inputs, cross, writers, counter_writers, timers[0], loads[0])
 
@@ -86,8 +88,8 @@ def table_values(tables: RobotTables) -> tuple[np.ndarray, np.ndarray]:
     loads = np.zeros((1, len(arrays), most, counters), dtype=np.int64)
     for k, a in enumerate(arrays):
         assert a is not None, "several_program refuses a table too wide for the flat lookup"
-        timers[0, k, :len(a.timer)] = a.timer
-        loads[0, k, :len(a.timer)] = a.loads.reshape(len(a.timer), counters)
+        timers[0, k, : len(a.timer)] = a.timer
+        loads[0, k, : len(a.timer)] = a.loads.reshape(len(a.timer), counters)
     return timers, loads
 
 
@@ -127,8 +129,18 @@ def tick_several(sp: SeveralProgram, st: SeveralState, outputs: np.ndarray, mask
         for source in range(count):
             events |= sp.cross[k, source, st.starts[source]]
         p = sp.programs[k]  # with the timers and loads of this robot's variant
-        program = Program(p.input_mask, p.timer_bit, p.lookup, p.next_state, sp.timers[k], p.outputs, p.keep,
-                          sp.loads[k], p.load_set, p.counter_bits)
+        program = Program(
+            p.input_mask,
+            p.timer_bit,
+            p.lookup,
+            p.next_state,
+            sp.timers[k],
+            p.outputs,
+            p.keep,
+            sp.loads[k],
+            p.load_set,
+            p.counter_bits,
+        )
         tick_compiled(st.regs[k], st.outputs[k], st.counters[k], events, pulses, program)
     for o in range(outputs.shape[0]):
         writer = sp.writers[o]
@@ -142,8 +154,18 @@ def tick_several(sp: SeveralProgram, st: SeveralState, outputs: np.ndarray, mask
 
 
 @njit(nogil=True)
-def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: SeveralState, wiring: Wiring,
-                ticks: int, noise: np.ndarray, bitgen: np.uint64, record: Record, tables: np.ndarray) -> None:
+def run_several(
+    robot: RobotState,
+    world: WorldArrays,
+    sp: SeveralProgram,
+    st: SeveralState,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgen: np.uint64,
+    record: Record,
+    tables: np.ndarray,
+) -> None:
     """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
@@ -151,9 +173,19 @@ def run_several(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: S
 
 
 @njit(nogil=True, refcounts=False)
-def several_ticks(robot: RobotState, world: WorldArrays, sp: SeveralProgram, st: SeveralState, wiring: Wiring,
-                  ticks: int, noise: np.ndarray, bitgen: np.uint64, record: Record, tables: np.ndarray,
-                  scratch: Scratch) -> None:
+def several_ticks(
+    robot: RobotState,
+    world: WorldArrays,
+    sp: SeveralProgram,
+    st: SeveralState,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgen: np.uint64,
+    record: Record,
+    tables: np.ndarray,
+    scratch: Scratch,
+) -> None:
     """:func:`run_several`'s loop, given its scratch space: compiled without reference counting (tablebot.jit), as
     the one-table loop (kernel.run_ticks) is."""
     for t in range(ticks):
