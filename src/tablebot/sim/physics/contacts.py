@@ -33,74 +33,15 @@ from tablebot.sim.columns import (
     X,
     Y,
 )
+from tablebot.sim.physics.broad import NEAR_MARGIN as NEAR_MARGIN  # the broad phase's names, here as before
+from tablebot.sim.physics.broad import might_be_near, refresh_near
+from tablebot.sim.physics.broad import new_near as new_near
 from tablebot.sim.physics.geometry import point_segment_within, segments_within, within
 
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
 TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)
-#: Metres beyond the bumpers' reach within which pieces are kept as candidates (:func:`refresh_near`): the list
-#: serves every tick until the robot is half this far from where it was made (about ten ticks at full speed).
-NEAR_MARGIN = 0.05
 
-# --- the broad phase and the body ------------------------------------------------------------------------------
-
-
-@njit(cache=True, refcounts=False, inline="always")
-def might_be_near(px: float, py: float, verts: np.ndarray, a: int, b: int, pbound: np.ndarray, k: int,
-                  reach: float) -> bool:
-    """Whether convex piece verts[a:b] may come within ``reach`` of point p (the broad phase).
-
-    Never wrong in the other direction: a piece it rules out is farther than ``reach`` (with a 1 µm
-    margin over rounding), so skipping it changes no result. Its bounding circle is tested first (the
-    test the narrow phase always had); a wall or segment is then tested by its squared distance.
-    """
-    if not within(pbound[k, 0] - px, pbound[k, 1] - py, pbound[k, 2] + reach):
-        return False
-    if b - a != 2:
-        return True
-    ax, ay = verts[a, 0], verts[a, 1]
-    ex, ey = verts[a + 1, 0] - ax, verts[a + 1, 1] - ay
-    length2 = ex * ex + ey * ey
-    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, ((px - ax) * ex + (py - ay) * ey) / length2))
-    dx, dy = px - ax - t * ex, py - ay - t * ey
-    margin = reach + 1e-6
-    return dx * dx + dy * dy <= margin * margin
-
-
-@njit(cache=True)
-def new_near(pstart: np.ndarray, circles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Scratch space of one robot's candidate list (see :func:`refresh_near`): the list, and where it was made."""
-    return np.zeros(2 + pstart.shape[0] - 1 + circles.shape[0], dtype=np.int64), np.zeros(3)
-
-
-@njit(cache=True, refcounts=False, inline="always")
-def refresh_near(x: float, y: float, reach: float, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                 circles: np.ndarray, near: np.ndarray, centre: np.ndarray) -> None:
-    """Keep ``near`` the list of the pieces and circles that may come within ``reach`` of the robot's centre
-    (x, y) -- near[0] pieces, then near[1] circles, their indices from near[2] on, in index order -- remade
-    only when the robot is half NEAR_MARGIN away from where it was made (``centre``: x, y, 1 when made).
-
-    Exact: the list is made for ``reach + NEAR_MARGIN``, so what it leaves out is farther than ``reach`` by
-    centimetres, far beyond rounding, wherever the robot is until the list is remade; the callers still apply
-    their own exact broad-phase test to every candidate, so they decide as if they had scanned every piece.
-    Pieces and circles from the 63rd on are always listed (the bumpers' bit masks keep them all).
-    """
-    dx, dy = x - centre[0], y - centre[1]
-    half = 0.5 * NEAR_MARGIN
-    if centre[2] > 0.0 and dx * dx + dy * dy < half * half:
-        return
-    wide = reach + NEAR_MARGIN
-    n = 0
-    for k in range(pstart.shape[0] - 1):
-        if k >= 62 or might_be_near(x, y, verts, pstart[k], pstart[k + 1], pbound, k, wide):
-            near[2 + n] = k
-            n += 1
-    m = 0
-    for k in range(circles.shape[0]):
-        if k >= 62 or within(circles[k, 0] - x, circles[k, 1] - y, circles[k, 2] + wide + 1e-6):
-            near[2 + n + m] = k
-            m += 1
-    near[0], near[1] = n, m
-    centre[0], centre[1], centre[2] = x, y, 1.0
+# --- the body ------------------------------------------------------------------------------
 
 
 @njit(cache=True, refcounts=False, inline="always")
@@ -136,8 +77,9 @@ def reaches(p: np.ndarray) -> tuple[float, float]:
 
 
 @njit(cache=True, refcounts=False)
-def piece_contact(ux: float, uy: float, corners: np.ndarray, verts: np.ndarray, a: int,
-                  b: int) -> tuple[float, float, float, float, float]:
+def piece_contact(
+    ux: float, uy: float, corners: np.ndarray, verts: np.ndarray, a: int, b: int
+) -> tuple[float, float, float, float, float]:
     """Separating-axis test of the body (heading cosine ``ux`` and sine ``uy``, corners ``corners``) against
     convex piece verts[a:b].
 
@@ -196,8 +138,9 @@ def piece_contact(ux: float, uy: float, corners: np.ndarray, verts: np.ndarray, 
 
 
 @njit(cache=True, refcounts=False)
-def circle_contact(s: np.ndarray, p: np.ndarray, c: float, sn: float, cx: float, cy: float,
-                   radius: float) -> tuple[float, float, float, float, float]:
+def circle_contact(
+    s: np.ndarray, p: np.ndarray, c: float, sn: float, cx: float, cy: float, radius: float
+) -> tuple[float, float, float, float, float]:
     """Body rectangle (heading cosine ``c``, sine ``sn``) against a circle; the result as :func:`piece_contact`'s."""
     rx, ry = cx - s[X], cy - s[Y]
     bx, by = c * rx + sn * ry, -sn * rx + c * ry  # circle centre in the body frame
@@ -219,14 +162,21 @@ def circle_contact(s: np.ndarray, p: np.ndarray, c: float, sn: float, cx: float,
             return 0.0, 0.0, 0.0, 0.0, 0.0
         depth = radius - gap
         nbx, nby = (qx - bx) / gap, (qy - by) / gap
-    return (depth, c * nbx - sn * nby, sn * nbx + c * nby,
-            s[X] + c * qx - sn * qy, s[Y] + sn * qx + c * qy)
+    return (depth, c * nbx - sn * nby, sn * nbx + c * nby, s[X] + c * qx - sn * qy, s[Y] + sn * qx + c * qy)
 
 
 @njit(cache=True, refcounts=False)
-def deepest_near(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-                 pbound: np.ndarray, circles: np.ndarray, reach: float,
-                 near: np.ndarray) -> tuple[tuple[float, float, float, float, float], float, float]:
+def deepest_near(
+    s: np.ndarray,
+    p: np.ndarray,
+    corners: np.ndarray,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    circles: np.ndarray,
+    reach: float,
+    near: np.ndarray,
+) -> tuple[tuple[float, float, float, float, float], float, float]:
     """The deepest overlap of the body with the pieces and circles of candidate list ``near`` that the
     broad phase keeps for ``reach`` (bounding circles prune the rest), scanned in index order; and the
     heading's cosine and sine (worked out, with the corners, only when something is that near).
@@ -259,8 +209,15 @@ def deepest_near(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.nd
 
 
 @njit(cache=True)
-def deepest_contact(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-                    pbound: np.ndarray, circles: np.ndarray) -> tuple[float, float, float, float, float]:
+def deepest_contact(
+    s: np.ndarray,
+    p: np.ndarray,
+    corners: np.ndarray,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    circles: np.ndarray,
+) -> tuple[float, float, float, float, float]:
     """The deepest overlap of the body with any piece or circle (bounding circles prune the rest)."""
     near, centre = new_near(pstart, circles)
     reach, wide = reaches(p)
@@ -269,9 +226,19 @@ def deepest_contact(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def resolve(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray, pstart: np.ndarray,
-            pbound: np.ndarray, circles: np.ndarray, reach: float, wide: float, near: np.ndarray,
-            centre: np.ndarray) -> bool:
+def resolve(
+    s: np.ndarray,
+    p: np.ndarray,
+    corners: np.ndarray,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    circles: np.ndarray,
+    reach: float,
+    wide: float,
+    near: np.ndarray,
+    centre: np.ndarray,
+) -> bool:
     """Push the body out of whatever it overlaps (position-based: the push splits into shift and turn);
     returns whether it moved the robot. ``reach``/``wide``: :func:`reaches`; ``near``/``centre``: the
     robot's candidate list (:func:`refresh_near`).
@@ -307,8 +274,21 @@ def resolve(s: np.ndarray, p: np.ndarray, corners: np.ndarray, verts: np.ndarray
 
 
 @njit(cache=True, refcounts=False)
-def near_plate(s: np.ndarray, c: float, sn: float, gap: float, x0: float, y0: float, x1: float, y1: float,
-               verts: np.ndarray, pstart: np.ndarray, near: int, circles: np.ndarray, near_circles: int) -> bool:
+def near_plate(
+    s: np.ndarray,
+    c: float,
+    sn: float,
+    gap: float,
+    x0: float,
+    y0: float,
+    x1: float,
+    y1: float,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    near: int,
+    circles: np.ndarray,
+    near_circles: int,
+) -> bool:
     """Whether anything lies within the switch travel ``gap`` of a bumper plate given in the body frame
     (``c``, ``sn``: the heading's cosine and sine; ``near``/``near_circles``: bits of the pieces and
     circles the broad phase kept, the 63rd bit standing for every piece from the 63rd on)."""
@@ -325,14 +305,22 @@ def near_plate(s: np.ndarray, c: float, sn: float, gap: float, x0: float, y0: fl
                 return True
     for k in range(circles.shape[0]):
         if near_circles >> min(k, 62) & 1 and point_segment_within(
-                circles[k, 0], circles[k, 1], ax, ay, bx, by, circles[k, 2] + gap):
+            circles[k, 0], circles[k, 1], ax, ay, bx, by, circles[k, 2] + gap
+        ):
             return True
     return False
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def broad_phase(s: np.ndarray, reach: float, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-                circles: np.ndarray, near: np.ndarray) -> tuple[np.int64, np.int64]:
+def broad_phase(
+    s: np.ndarray,
+    reach: float,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    circles: np.ndarray,
+    near: np.ndarray,
+) -> tuple[np.int64, np.int64]:
     """Bits of the pieces and of the circles of candidate list ``near`` that may lie within ``reach`` of the
     robot's centre (exact: what it rules out is farther); pieces and circles from the 63rd on share bit 62
     and are kept. The same bits as a scan of every piece, since the list leaves out only far ones."""
@@ -351,9 +339,20 @@ def broad_phase(s: np.ndarray, reach: float, verts: np.ndarray, pstart: np.ndarr
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_bumpers(s: np.ndarray, p: np.ndarray, c: float, sn: float, verts: np.ndarray, pstart: np.ndarray,
-                  pbound: np.ndarray, circles: np.ndarray, reach: float, wide: float, near: np.ndarray,
-                  centre: np.ndarray) -> None:
+def sense_bumpers(
+    s: np.ndarray,
+    p: np.ndarray,
+    c: float,
+    sn: float,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    circles: np.ndarray,
+    reach: float,
+    wide: float,
+    near: np.ndarray,
+    centre: np.ndarray,
+) -> None:
     """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and
     rear; ``c``/``sn``: the heading's cosine and sine; the rest as :func:`resolve`'s."""
     f, r, w, ov, wrap, gap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP], p[P_GAP]
@@ -361,9 +360,11 @@ def sense_bumpers(s: np.ndarray, p: np.ndarray, c: float, sn: float, verts: np.n
     near_p, near_c = broad_phase(s, reach + gap, verts, pstart, pbound, circles, near)
     fr = fl = rear = False
     if near_p or near_c:  # in the open (most ticks) no plate can touch anything
-        fr = (near_plate(s, c, sn, gap, f, -w, f, ov, verts, pstart, near_p, circles, near_c)
-              or near_plate(s, c, sn, gap, f - wrap, -w, f, -w, verts, pstart, near_p, circles, near_c))
-        fl = (near_plate(s, c, sn, gap, f, -ov, f, w, verts, pstart, near_p, circles, near_c)
-              or near_plate(s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near_p, circles, near_c))
+        fr = near_plate(s, c, sn, gap, f, -w, f, ov, verts, pstart, near_p, circles, near_c) or near_plate(
+            s, c, sn, gap, f - wrap, -w, f, -w, verts, pstart, near_p, circles, near_c
+        )
+        fl = near_plate(s, c, sn, gap, f, -ov, f, w, verts, pstart, near_p, circles, near_c) or near_plate(
+            s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near_p, circles, near_c
+        )
         rear = near_plate(s, c, sn, gap, r, -w, r, w, verts, pstart, near_p, circles, near_c)
     s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
