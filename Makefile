@@ -1,4 +1,4 @@
-# The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff, the docs site, ESLint);
+# The two commands of the README: `make demo` and `make test` (pytest, the import layers, ruff's lint and format, the docs site, ESLint);
 # both set themselves up first.
 .PHONY: setup demo test bench lock audit docs golden
 
@@ -33,6 +33,7 @@ test: setup
 	[ $$tests -eq 0 ] && [ $$types -eq 0 ]
 	.venv/bin/lint-imports
 	.venv/bin/ruff check .
+	.venv/bin/ruff format --check .
 	$(MKDOCS)
 	node_modules/.bin/eslint src/tablebot/web/static src/tablebot/formats/statecharts eslint.config.js
 

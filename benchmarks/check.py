@@ -53,8 +53,18 @@ def random_table(seed: int, states: int = 50, rows_per_state: int = 10) -> Table
         for _ in range(rows_per_state):
             events = frozenset(rng.sample(EVENTS, rng.choice((1, 1, 2))))
             motors = tuple(None if rng.random() < 0.1 else rng.randint(-6, 6) for _ in BUMBERBOT.motors)
-            rows.append(Row(len(rows), len(rows) + 2, f"row {len(rows)}", state, events, motors,
-                            rng.randint(0, 300), rng.randint(1, states)))
+            rows.append(
+                Row(
+                    len(rows),
+                    len(rows) + 2,
+                    f"row {len(rows)}",
+                    state,
+                    events,
+                    motors,
+                    rng.randint(0, 300),
+                    rng.randint(1, states),
+                )
+            )
     robot = dataclasses.replace(BUMBERBOT, initial_state=1, name="Random")
     return Table(robot, EVENTS, tuple(rows), f"<random seed {seed}>")
 
@@ -66,8 +76,14 @@ def random_properties(machine: Machine) -> list[Property]:
     return [
         Property("home", "can always get back to state 1", "always_reachable", cond=cond("state == 1")),
         Property("calm", "never forward in state 7", "never", cond=cond("state == 7 and M1 > 0 and M2 > 0")),
-        Property("stop", "front bump stops within 10 ticks", "when", when=cond("I3"),
-                 then=cond("M1 <= 0 and M2 <= 0"), within=10),
+        Property(
+            "stop",
+            "front bump stops within 10 ticks",
+            "when",
+            when=cond("I3"),
+            then=cond("M1 <= 0 and M2 <= 0"),
+            within=10,
+        ),
         Property("reach", "state 42 can happen", "reachable", cond=cond("state == 42")),
     ]
 
@@ -79,8 +95,10 @@ def timed(label: str, run: Callable[[], str], repeat: int) -> float:
         summary = run()
         times.append(time.perf_counter() - start)
     median = statistics.median(times)
-    print(f"{label:<44} median {median * 1000:8.1f} ms  (min {min(times) * 1000:.1f}, max {max(times) * 1000:.1f}, "
-          f"n={repeat})  {summary}")
+    print(
+        f"{label:<44} median {median * 1000:8.1f} ms  (min {min(times) * 1000:.1f}, max {max(times) * 1000:.1f}, "
+        f"n={repeat})  {summary}"
+    )
     return median
 
 
@@ -106,8 +124,10 @@ def scale_csv(rows: int, seed: int) -> str:
             events = set(rng.sample(EVENTS, rng.choice((1, 1, 2))))
             motors = [rng.choice(("3", "-3", "0", "=", "5")) for _ in range(2)]
             cells = ["1" if e in events else "" for e in EVENTS]
-            lines.append(f"row {state}.{k},{state},{','.join(cells)},{motors[0]},{motors[1]},"
-                         f"{rng.randint(0, 300)},{rng.randint(1, states)}")
+            lines.append(
+                f"row {state}.{k},{state},{','.join(cells)},{motors[0]},{motors[1]},"
+                f"{rng.randint(0, 300)},{rng.randint(1, states)}"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -115,8 +135,9 @@ def check_process(path: Path) -> float:
     """Seconds of one `tablebot check TABLE` process (start-up, loading, findings, printing to a pipe)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "tablebot.cli", "check", str(path)], capture_output=True,
-                          env=env, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot.cli", "check", str(path)], capture_output=True, env=env, check=False
+    )
     elapsed = time.perf_counter() - start
     if done.returncode not in (0, 1):
         raise SystemExit(f"tablebot check failed on {path}:\n{done.stderr.decode()}")
@@ -132,13 +153,17 @@ def scaling(seed: int, repeat: int) -> bool:
             path.write_text(scale_csv(rows, seed), encoding="utf-8")
             times = [check_process(path) for _ in range(repeat)]
             medians.append(statistics.median(times))
-            print(f"check, {rows:>7,} rows, {rows // ROWS_PER_STATE:>5,} states (whole process)  median "
-                  f"{medians[-1]:7.2f} s  (min {min(times):.2f}, max {max(times):.2f}, n={repeat})")
+            print(
+                f"check, {rows:>7,} rows, {rows // ROWS_PER_STATE:>5,} states (whole process)  median "
+                f"{medians[-1]:7.2f} s  (min {min(times):.2f}, max {max(times):.2f}, n={repeat})"
+            )
     logs = [(math.log(r), math.log(t)) for r, t in zip(SCALE_ROWS, medians, strict=True)]
     steps = [(b[1] - a[1]) / (b[0] - a[0]) for a, b in itertools.pairwise(logs)]
     overall = (logs[-1][1] - logs[0][1]) / (logs[-1][0] - logs[0][0])
-    print(f"growth: slope {' then '.join(f'{s:.2f}' for s in steps)} (overall {overall:.2f}; 1 = linear, "
-          f"2 = quadratic); 100k/10k time ratio {medians[-1] / medians[-2]:.1f}x for 10x the rows")
+    print(
+        f"growth: slope {' then '.join(f'{s:.2f}' for s in steps)} (overall {overall:.2f}; 1 = linear, "
+        f"2 = quadratic); 100k/10k time ratio {medians[-1] / medians[-2]:.1f}x for 10x the rows"
+    )
     print(f"target (100,000 rows < {SCALE_TARGET:g} s): {'met' if medians[-1] < SCALE_TARGET else 'MISSED'}")
     return medians[-1] < SCALE_TARGET
 
@@ -173,9 +198,11 @@ def three_tables(folder: Path) -> Path:
         (folder / name).write_text((LIGHTS / name).read_text(encoding="utf-8"), encoding="utf-8")
     robot = (folder / "robot.toml").read_text(encoding="utf-8")
     robot = robot.replace('L2 = "right lamp"\n', 'L2 = "right lamp"\nL3 = "beacon"\n', 1)
-    robot = robot.replace('initial_state = "flash_left", initial_timer = 0 }\n',
-                          'initial_state = "flash_left", initial_timer = 0 }\nbeacon = { file = "beacon.csv", '
-                          'initial_state = "off" }\n', 1)
+    robot = robot.replace(
+        'initial_state = "flash_left", initial_timer = 0 }\n',
+        'initial_state = "flash_left", initial_timer = 0 }\nbeacon = { file = "beacon.csv", initial_state = "off" }\n',
+        1,
+    )
     robot = robot.replace('L2 = "O6"\n', 'L2 = "O6"\nL3 = "O7"\n')
     (folder / "robot.toml").write_text(robot, encoding="utf-8")
     (folder / "beacon.csv").write_text(BEACON, encoding="utf-8")
@@ -191,8 +218,10 @@ def check_robot(folder: Path) -> str:
     report = Loaded.open(folder).check_report()
     explored = max(r.explored for r in report.results)
     failed = [r.prop.name for r in report.results if r.failed]
-    return (f"[{report.situations} situations in the product, up to {explored} per proof; "
-            f"{len(report.results)} properties, not holding: {', '.join(failed) or 'none'}]")
+    return (
+        f"[{report.situations} situations in the product, up to {explored} per proof; "
+        f"{len(report.results)} properties, not holding: {', '.join(failed) or 'none'}]"
+    )
 
 
 BENCH_BUMBERBOT = """
@@ -218,21 +247,30 @@ def bumberbot_ratio(baseline: str, repeat: int) -> float | None:
         old.mkdir()
         archive = subprocess.run(["git", "-C", str(ROOT), "archive", baseline, "src"], capture_output=True)
         if archive.returncode:
-            print(f"BumberBot ratio: no baseline ({baseline} is not in this checkout's history: "
-                  f"{archive.stderr.decode().strip()})")
+            print(
+                f"BumberBot ratio: no baseline ({baseline} is not in this checkout's history: "
+                f"{archive.stderr.decode().strip()})"
+            )
             return None
         subprocess.run(["tar", "-x", "-C", str(old)], input=archive.stdout, check=True)
         times: dict[str, list[float]] = {"baseline": [], "now": []}
         for _ in range(repeat):
             for label, src in (("baseline", old / "src"), ("now", ROOT / "src")):
                 env = {**os.environ, "PYTHONPATH": str(src)}
-                done = subprocess.run([sys.executable, "-c", BENCH_BUMBERBOT, str(EXAMPLE)], env=env,
-                                      capture_output=True, text=True, check=True)
+                done = subprocess.run(
+                    [sys.executable, "-c", BENCH_BUMBERBOT, str(EXAMPLE)],
+                    env=env,
+                    capture_output=True,
+                    text=True,
+                    check=True,
+                )
                 times[label].append(float(done.stdout.strip().splitlines()[-1]))
     medians = {label: statistics.median(values) for label, values in times.items()}
     ratio = medians["now"] / medians["baseline"]
-    print(f"BumberBot check in-process, baseline {baseline}: median {medians['baseline'] * 1000:.1f} ms, now "
-          f"{medians['now'] * 1000:.1f} ms; ratio now/baseline {ratio:.2f} (n={repeat} each, alternating)")
+    print(
+        f"BumberBot check in-process, baseline {baseline}: median {medians['baseline'] * 1000:.1f} ms, now "
+        f"{medians['now'] * 1000:.1f} ms; ratio now/baseline {ratio:.2f} (n={repeat} each, alternating)"
+    )
     return ratio
 
 
@@ -242,8 +280,9 @@ def several_tables(repeat: int, baseline: str) -> bool:
         three = timed("3 tables (+ beacon), 13 properties", lambda: check_robot(three_tables(Path(folder))), repeat)
     ratio = bumberbot_ratio(baseline, repeat)
     ok = two < 10.0 and three < 30.0 and (ratio is None or ratio < 1.10)
-    print(f"targets (2 tables < 10 s, 3 tables < 30 s, BumberBot not slower: ratio < 1.10): "
-          f"{'met' if ok else 'MISSED'}")
+    print(
+        f"targets (2 tables < 10 s, 3 tables < 30 s, BumberBot not slower: ratio < 1.10): {'met' if ok else 'MISSED'}"
+    )
     return ok
 
 

@@ -63,8 +63,20 @@ def target(name: str) -> Iterator[tuple[str, Any, Callable[[], list[float]]]]:
 def whole_command(name: str, seconds: float) -> dict[str, Any]:
     with target(name) as (address, _emulator, times), tempfile.TemporaryDirectory() as out:
         started = time.perf_counter()
-        command = [sys.executable, "-m", "tablebot", "run", str(EXAMPLE), "--on", address, "--seconds", str(seconds),
-                   "--out", out, "--quiet"]
+        command = [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "run",
+            str(EXAMPLE),
+            "--on",
+            address,
+            "--seconds",
+            str(seconds),
+            "--out",
+            out,
+            "--quiet",
+        ]
         if name == "roboif@38400":  # refused before the run at tick_ms = 10: measured here with slow timers accepted
             command += ["--behind-limit", "0"]
         done = subprocess.run(command, capture_output=True, text=True, timeout=seconds + 60)
@@ -75,11 +87,19 @@ def whole_command(name: str, seconds: float) -> dict[str, Any]:
     if done.returncode != 0:
         raise SystemExit(f"{name}: tablebot run failed ({done.returncode}): {done.stderr.strip()[-400:]}")
     probes = 0 if name == "txt" else PROBES  # the serial links are timed with exchanges before the run
-    run = arrived[probes + 1:-1]  # the ticks' exchanges (not the first with outputs off, nor the last that stops them)
+    run = arrived[
+        probes + 1 : -1
+    ]  # the ticks' exchanges (not the first with outputs off, nor the last that stops them)
     gaps = sorted(1000 * (b - a) for a, b in itertools.pairwise(run))
-    return {"per_s": (len(run) - 1) / (run[-1] - run[0]), "median": statistics.median(gaps),
-            "p95": gaps[int(0.95 * (len(gaps) - 1))], "max": gaps[-1], "late": summary.get("late_ticks", 0),
-            "ticks": summary.get("ticks", len(run)), "wall": wall}
+    return {
+        "per_s": (len(run) - 1) / (run[-1] - run[0]),
+        "median": statistics.median(gaps),
+        "p95": gaps[int(0.95 * (len(gaps) - 1))],
+        "max": gaps[-1],
+        "late": summary.get("late_ticks", 0),
+        "ticks": summary.get("ticks", len(run)),
+        "wall": wall,
+    }
 
 
 def link_alone(name: str, exchanges: int = 500) -> float:
@@ -127,20 +147,26 @@ def main() -> None:
     parser.add_argument("--only", default="txt,robotx,roboif,roboif@38400", help="targets, comma-separated")
     args = parser.parse_args()
     names = args.only.split(",")
-    print(f"tablebot run examples/bumberbot --on TARGET --seconds {args.seconds:g} (whole command, fresh process; "
-          "targets are emulators: no controller is here)")
-    print(f"load average at the start: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (a loaded machine "
-          "stretches every gap: compare ratios)")
+    print(
+        f"tablebot run examples/bumberbot --on TARGET --seconds {args.seconds:g} (whole command, fresh process; "
+        "targets are emulators: no controller is here)"
+    )
+    print(
+        f"load average at the start: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (a loaded machine "
+        "stretches every gap: compare ratios)"
+    )
     print(f"{'target':<14}{'exch/s':>8}{'gap median':>12}{'p95':>8}{'max':>8}{'late':>6}   link alone")
     base: dict[str, Any] | None = None
     for name in names:
         figures = whole_command(name, args.seconds)
         alone = link_alone(name)
         base = base or figures
-        print(f"{name:<14}{figures['per_s']:>8.1f}{figures['median']:>10.2f}ms{figures['p95']:>6.2f}ms"
-              f"{figures['max']:>6.1f}ms{figures['late']:>6}   {alone:,.0f} µs/exchange"
-              f"   (exch/s {figures['per_s'] / base['per_s']:.2f}x, p95 gap {figures['p95'] / base['p95']:.2f}x "
-              f"the {names[0]}'s)")
+        print(
+            f"{name:<14}{figures['per_s']:>8.1f}{figures['median']:>10.2f}ms{figures['p95']:>6.2f}ms"
+            f"{figures['max']:>6.1f}ms{figures['late']:>6}   {alone:,.0f} µs/exchange"
+            f"   (exch/s {figures['per_s'] / base['per_s']:.2f}x, p95 gap {figures['p95'] / base['p95']:.2f}x "
+            f"the {names[0]}'s)"
+        )
 
 
 if __name__ == "__main__":

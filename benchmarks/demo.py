@@ -55,8 +55,11 @@ class Run:
 
 def fresh_env(caches: Path) -> dict[str, str]:
     """This environment with every cache a first run fills pointed at new empty folders."""
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("PYTHONDONTWRITEBYTECODE", "VIRTUAL_ENV", "PYTHONPATH", "MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("PYTHONDONTWRITEBYTECODE", "VIRTUAL_ENV", "PYTHONPATH", "MAKEFLAGS", "MFLAGS", "MAKELEVEL")
+    }
     for name in ("UV_CACHE_DIR", "NUMBA_CACHE_DIR", "XDG_CACHE_HOME", "PIP_CACHE_DIR", "MPLCONFIGDIR"):
         env[name] = str(caches / name.lower())
     env["npm_config_cache"] = str(caches / "npm")
@@ -66,12 +69,15 @@ def fresh_env(caches: Path) -> dict[str, str]:
 def timed_lines(argv: list[str], cwd: Path, env: dict[str, str]) -> tuple[float, list[tuple[float, str]], int]:
     """Run ``argv``; its wall seconds, each output line with the second it came, its exit code."""
     started = time.monotonic()
-    proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            errors="replace", bufsize=1)
+    proc = subprocess.Popen(
+        argv, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", bufsize=1
+    )
     assert proc.stdout is not None
     lines: list[tuple[float, str]] = []
-    reader = threading.Thread(target=lambda: lines.extend((time.monotonic() - started, line.rstrip("\n"))
-                                                          for line in proc.stdout), daemon=True)  # type: ignore[union-attr]
+    reader = threading.Thread(
+        target=lambda: lines.extend((time.monotonic() - started, line.rstrip("\n")) for line in proc.stdout),  # type: ignore[union-attr]
+        daemon=True,
+    )
     reader.start()
     code = proc.wait()
     seconds = time.monotonic() - started
@@ -91,8 +97,9 @@ def one(command: str, workdir: Path) -> Run:
     gaps = [(b - a, lines[k - 1][1] if k else "(the start)") for k, (a, b) in enumerate(itertools.pairwise(marks))]
     silence, after = max(gaps)
     setup = next((at for at, line in lines if line.startswith(SIMULATING)), None)
-    compiled = next((float(m[1]) for _, line in lines if (m := re.search(r"compiled the simulator in (\d+) s", line))),
-                    None)
+    compiled = next(
+        (float(m[1]) for _, line in lines if (m := re.search(r"compiled the simulator in (\d+) s", line))), None
+    )
     return Run(seconds, setup, compiled, silence, after, all((clone / p).is_file() for p in PICTURES))
 
 
@@ -102,10 +109,14 @@ def runs(command: str, count: int, label: str) -> list[Run]:
         with tempfile.TemporaryDirectory(prefix="tablebot-demo-bench-") as workdir:
             run = one(command, Path(workdir))
         done.append(run)
-        parts = "".join(f", {name} {value:.1f} s" for name, value in (("set-up", run.setup_s),
-                                                                        ("compile", run.compile_s)) if value)
-        print(f"  {label} {k + 1}/{count}: {run.seconds:.1f} s{parts}; longest silence {run.silence_s:.1f} s "
-              f"after {run.silence_after[:70]!r}; pictures {'written' if run.pictures else 'MISSING'}", flush=True)
+        parts = "".join(
+            f", {name} {value:.1f} s" for name, value in (("set-up", run.setup_s), ("compile", run.compile_s)) if value
+        )
+        print(
+            f"  {label} {k + 1}/{count}: {run.seconds:.1f} s{parts}; longest silence {run.silence_s:.1f} s "
+            f"after {run.silence_after[:70]!r}; pictures {'written' if run.pictures else 'MISSING'}",
+            flush=True,
+        )
     return done
 
 
@@ -121,20 +132,27 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if shutil.which("make") is None:
         raise SystemExit("make is needed (the demo is `make demo`)")
-    print(f"make demo from empty caches, fresh clones of {ROOT} at HEAD; load average {os.getloadavg()[0]:.1f} "
-          f"on {os.cpu_count()} cores", flush=True)
+    print(
+        f"make demo from empty caches, fresh clones of {ROOT} at HEAD; load average {os.getloadavg()[0]:.1f} "
+        f"on {os.cpu_count()} cores",
+        flush=True,
+    )
     demo = runs("make demo", args.runs, "make demo")
     whole = statistics.median(r.seconds for r in demo)
-    print(f"make demo: median {whole:.1f} s (set-up {median([r.setup_s for r in demo]) or 0:.1f} s, first compile "
-          f"{median([r.compile_s for r in demo]) or 0:.1f} s); longest silence {max(r.silence_s for r in demo):.1f} s")
+    print(
+        f"make demo: median {whole:.1f} s (set-up {median([r.setup_s for r in demo]) or 0:.1f} s, first compile "
+        f"{median([r.compile_s for r in demo]) or 0:.1f} s); longest silence {max(r.silence_s for r in demo):.1f} s"
+    )
     if args.baseline_runs:
         old = runs(OLD_DEMO, args.baseline_runs, "old demo (developer set-up + sim)")
         before = statistics.median(r.seconds for r in old)
         print(f"old demo: median {before:.1f} s; make demo takes {whole / before:.2f} of it")
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
-    checks = [(f"make demo ≤ {TARGET_S:.0f} s (median)", whole <= TARGET_S),
-              (f"never silent for more than {SILENCE_S:.0f} s", all(r.silence_s <= SILENCE_S for r in demo)),
-              ("both pictures written", all(r.pictures for r in demo))]
+    checks = [
+        (f"make demo ≤ {TARGET_S:.0f} s (median)", whole <= TARGET_S),
+        (f"never silent for more than {SILENCE_S:.0f} s", all(r.silence_s <= SILENCE_S for r in demo)),
+        ("both pictures written", all(r.pictures for r in demo)),
+    ]
     print("targets:")
     for label, ok in checks:
         print(f"  {label:<40} {'ok' if ok else 'MISSED'}")

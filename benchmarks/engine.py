@@ -82,6 +82,7 @@ def random_masks(machine: Machine, ticks: int, seed: int = 2009) -> list[int]:
 
 # --- the contestants: each runs all masks from the start and returns (state, timer, outputs) ---------
 
+
 def engine_batch(machine: Machine, masks: Sequence[int]) -> Result:
     engine = Engine(machine)
     engine.run(masks)
@@ -135,8 +136,13 @@ def bare_tables(machine: Machine) -> list[dict[int, tuple[int, int, int, tuple[i
     tables: list[dict[int, tuple[int, int, int, tuple[int | None, ...], bool]]] = []
     for state in range(len(machine.states)):
         rows = [row for row in machine.rows if row.state == state]
-        tables.append({events: (row.index, row.next, row.timer, row.outputs, row.keeps)
-                       for events in range(1 << width) if (row := first_match(rows, events)) is not None})
+        tables.append(
+            {
+                events: (row.index, row.next, row.timer, row.outputs, row.keeps)
+                for events in range(1 << width)
+                if (row := first_match(rows, events)) is not None
+            }
+        )
     return tables
 
 
@@ -162,8 +168,9 @@ class BareStep:
             self.row = -1
         else:
             self.row, self.state, timer, new, keeps = hit
-            self.outputs = tuple(o if n is None else n for o, n in zip(self.outputs, new, strict=True)) if keeps \
-                else new
+            self.outputs = (
+                tuple(o if n is None else n for o, n in zip(self.outputs, new, strict=True)) if keeps else new
+            )
         self.timer = timer
         return self.outputs
 
@@ -205,11 +212,17 @@ def build_transitions(machine: Machine) -> Bot:
     """The table as a ``transitions`` machine: one ``tick(events)`` trigger, one transition per row."""
     bot = Bot(machine)
     names = [str(s) for s in machine.states]
-    fsm = TransitionsMachine(model=bot, states=names, initial=names[machine.initial_state],
-                             auto_transitions=False, send_event=False)
+    fsm = TransitionsMachine(
+        model=bot, states=names, initial=names[machine.initial_state], auto_transitions=False, send_event=False
+    )
     for row in machine.rows:  # added in row order, and transitions tries them in that order
-        fsm.add_transition("tick", names[row.state], names[row.next],
-                           conditions=[_guard(row.mask)], after=[_action(bot, row.timer, row.outputs)])
+        fsm.add_transition(
+            "tick",
+            names[row.state],
+            names[row.next],
+            conditions=[_guard(row.mask)],
+            after=[_action(bot, row.timer, row.outputs)],
+        )
     return bot
 
 
@@ -221,6 +234,7 @@ def _action(bot: Bot, timer: int, outputs: tuple[int | None, ...]) -> Callable[[
     def act(_events: int) -> None:
         bot.timer = timer
         bot.outputs = tuple(o if n is None else n for o, n in zip(bot.outputs, outputs, strict=True))
+
     return act
 
 
@@ -239,8 +253,10 @@ def transitions_run(machine: Machine, masks: Sequence[int]) -> Result:
 
 # --- measuring ------------------------------------------------------------------------------------------
 
-def measure(contestants: Contestants, machine: Machine,
-            repeats: int) -> tuple[dict[str, list[float]], dict[str, Result]]:
+
+def measure(
+    contestants: Contestants, machine: Machine, repeats: int
+) -> tuple[dict[str, list[float]], dict[str, Result]]:
     """CPU seconds of each repeat per contestant, and each one's result.
 
     The repeats go round-robin (every contestant once, then again), so a machine that gets busier
@@ -266,20 +282,31 @@ def main(argv: list[str] | None = None) -> int:
     masks = random_masks(machine, args.ticks)
     few = masks[: args.transitions_ticks]
     contestants: Contestants = {
-        "step": (engine_step, masks), "bare step": (bare_step, masks), "linear scan": (linear_scan, masks),
-        "transitions": (transitions_run, few), "batch": (engine_batch, masks),
-        "batch (array)": (engine_batch_array, np.array(masks, np.uint8)), "bare loop": (bare_loop, masks)}
-    print(f"BumberBot, {args.ticks:,} random input ticks ({len(few):,} for transitions), "
-          f"median of {args.repeats}, Python {sys.version.split()[0]}, load average {_load()}")
+        "step": (engine_step, masks),
+        "bare step": (bare_step, masks),
+        "linear scan": (linear_scan, masks),
+        "transitions": (transitions_run, few),
+        "batch": (engine_batch, masks),
+        "batch (array)": (engine_batch_array, np.array(masks, np.uint8)),
+        "bare loop": (bare_loop, masks),
+    }
+    print(
+        f"BumberBot, {args.ticks:,} random input ticks ({len(few):,} for transitions), "
+        f"median of {args.repeats}, Python {sys.version.split()[0]}, load average {_load()}"
+    )
     start = time.perf_counter()
     Engine(machine).run(masks[:10])
-    print(f"  (first batch call, compiling the loop or loading it from numba's cache: "
-          f"{time.perf_counter() - start:.2f} s, not counted below)")
+    print(
+        f"  (first batch call, compiling the loop or loading it from numba's cache: "
+        f"{time.perf_counter() - start:.2f} s, not counted below)"
+    )
     times, results = measure(contestants, machine, args.repeats)
     seconds = {name: statistics.median(t) for name, t in times.items()}
     rates = {name: len(contestants[name][1]) / seconds[name] for name in contestants}
-    for kind, names in (("closed loop (a call per tick, as a robot needs)", CLOSED),
-                        ("open loop (all inputs known in advance)", OPEN)):
+    for kind, names in (
+        ("closed loop (a call per tick, as a robot needs)", CLOSED),
+        ("open loop (all inputs known in advance)", OPEN),
+    ):
         print(f" {kind}:")
         for name in names:
             rate = rates[name]
@@ -313,8 +340,10 @@ def report(rates: dict[str, float], rounds: dict[str, list[float]]) -> int:
         ok = ratio >= target
         missed += not ok
         goal = f">= {target:g}x" if target >= 1 else f">= {target:.3g}x (within {1 / target:g}x)"
-        print(f"  {label:<32} {ratio:7.2f}x ({min(each):.2f}..{max(each):.2f})   target {goal:<24} "
-              f"{'ok' if ok else 'MISSED'}")
+        print(
+            f"  {label:<32} {ratio:7.2f}x ({min(each):.2f}..{max(each):.2f})   target {goal:<24} "
+            f"{'ok' if ok else 'MISSED'}"
+        )
     return 1 if missed else 0
 
 

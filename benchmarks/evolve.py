@@ -45,8 +45,10 @@ if TYPE_CHECKING:
     from tablebot.table import Table
 
 #: What the inner loop measures: its rates (medians) and the candidates/s of each repeat.
-InnerRates = TypedDict("InnerRates", {"candidates/s": float, "robot-ticks/s": float,
-                                      "baseline robot-ticks/s": float, "spread": list[float]})
+InnerRates = TypedDict(
+    "InnerRates",
+    {"candidates/s": float, "robot-ticks/s": float, "baseline robot-ticks/s": float, "spread": list[float]},
+)
 
 
 def environment(src: str | None) -> dict[str, str]:
@@ -84,9 +86,26 @@ def whole(budget: int, seconds: float, src: str | None = None) -> dict[str, floa
     robot-ticks from its report (the search may end before the budget), the fresh-seed check after the
     search not counted in them."""
     with tempfile.TemporaryDirectory() as folder:
-        command = [sys.executable, "-m", "tablebot", "evolve", str(EXAMPLE), "--out", folder, "--budget", str(budget),
-                   "--batch", "16", "--seeds", "0..15", "--check-seeds", "100..115", "--seconds", str(seconds),
-                   "--quiet"]
+        command = [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "evolve",
+            str(EXAMPLE),
+            "--out",
+            folder,
+            "--budget",
+            str(budget),
+            "--batch",
+            "16",
+            "--seeds",
+            "0..15",
+            "--check-seeds",
+            "100..115",
+            "--seconds",
+            str(seconds),
+            "--quiet",
+        ]
         started = time.perf_counter()
         proc = subprocess.Popen(command, env=environment(src), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         cpu = tree_cpu(proc)
@@ -101,8 +120,17 @@ def whole(budget: int, seconds: float, src: str | None = None) -> dict[str, floa
     ran = re.search(r"(\d+) tables run on the fleet, each on (\d+) scenarios", report)
     tables, scenarios = int(ran[1]), int(ran[2])  # type: ignore[index]
     ticks = tables * scenarios * ticks_of(seconds)
-    return {"wall": wall, "cpu": cpu, "tables": tables, "tables/s": tables / wall, "robot-ticks/s": ticks / wall,
-            "fleet robot-ticks/s": ticks / fleet, "proofs": proofs, "repair": repair, "fleet": fleet}
+    return {
+        "wall": wall,
+        "cpu": cpu,
+        "tables": tables,
+        "tables/s": tables / wall,
+        "robot-ticks/s": ticks / wall,
+        "fleet robot-ticks/s": ticks / fleet,
+        "proofs": proofs,
+        "repair": repair,
+        "fleet": fleet,
+    }
 
 
 def ticks_of(seconds: float) -> int:
@@ -158,20 +186,30 @@ def inner(repeat: int, count: int, seconds: float) -> InnerRates:
             started = time.perf_counter()
             evaluator.run(tables, lambda *a: None)
             evolve_s.append(time.perf_counter() - started)
-            jobs = [Job(plan.table, plan.worlds[0], plan.robot_params, robots * 4, plan.spec.ticks, first=k)
-                    for k in range(count // 4)]  # the same robot-ticks, one program, 64 robots a job
+            jobs = [
+                Job(plan.table, plan.worlds[0], plan.robot_params, robots * 4, plan.spec.ticks, first=k)
+                for k in range(count // 4)
+            ]  # the same robot-ticks, one program, 64 robots a job
             started = time.perf_counter()
             runner.run(jobs, lambda *a: None, run_job)
             fleet_s.append(time.perf_counter() - started)
     e, f = statistics.median(evolve_s), statistics.median(fleet_s)
-    return {"candidates/s": count / e, "robot-ticks/s": ticks / e, "baseline robot-ticks/s": ticks / f,
-            "spread": [count / t for t in evolve_s]}
+    return {
+        "candidates/s": count / e,
+        "robot-ticks/s": ticks / e,
+        "baseline robot-ticks/s": ticks / f,
+        "spread": [count / t for t in evolve_s],
+    }
 
 
 def inner_process(repeat: int, count: int, seconds: float, src: str | None) -> InnerRates:
     """:func:`inner` in a fresh process of ``src``'s code (this tree's when None)."""
-    done = subprocess.run([sys.executable, __file__, "--inner-only", str(repeat), str(count), str(seconds)],
-                          env=environment(src), capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, __file__, "--inner-only", str(repeat), str(count), str(seconds)],
+        env=environment(src),
+        capture_output=True,
+        text=True,
+    )
     if done.returncode:
         raise SystemExit(f"the inner loop failed:\n{done.stderr}")
     return json.loads(done.stdout.splitlines()[-1])
@@ -197,8 +235,10 @@ def proving(count: int) -> None:
     started = time.perf_counter()
     kept = sum(prover.verdict(kid)[1].ok for kid in kids)
     took = time.perf_counter() - started
-    print(f"proving (in this process, no workers): {count} children in {took:.2f} s ({count / took:.0f} proofs/s "
-          f"incl. cache hits: {prover.proved} proved, {prover.hits} from the cache), {kept} kept")
+    print(
+        f"proving (in this process, no workers): {count} children in {took:.2f} s ({count / took:.0f} proofs/s "
+        f"incl. cache hits: {prover.proved} proved, {prover.hits} from the cache), {kept} kept"
+    )
 
 
 def load() -> str:
@@ -207,22 +247,26 @@ def load() -> str:
 
 def say_whole(label: str, runs: list[dict[str, float]], budget: int, seconds: float) -> dict[str, float]:
     med = {key: statistics.median(r[key] for r in runs) for key in runs[0]}
-    print(f"whole process (what the user waits for), {label}: tablebot evolve examples/bumberbot --budget {budget}, "
-          f"16 scenarios × {seconds:g} s, median of {len(runs)}: {med['wall']:.1f} s for {med['tables']:.0f} tables, "
-          f"{med['tables/s']:.2f} candidates/s ({spread([r['tables/s'] for r in runs])}), "
-          f"{med['robot-ticks/s'] / 1e6:.3f} M robot-ticks/s of search per wall second; process tree CPU "
-          f"{med['cpu']:.1f} s; of the wall time: proofs {med['proofs'] / med['wall']:.0%}, repair "
-          f"{med['repair'] / med['wall']:.0%}, waiting for the fleet {med['fleet'] / med['wall']:.0%} (the rest: "
-          f"start-up, the fresh-seed check, the files) [{load()}]")
+    print(
+        f"whole process (what the user waits for), {label}: tablebot evolve examples/bumberbot --budget {budget}, "
+        f"16 scenarios × {seconds:g} s, median of {len(runs)}: {med['wall']:.1f} s for {med['tables']:.0f} tables, "
+        f"{med['tables/s']:.2f} candidates/s ({spread([r['tables/s'] for r in runs])}), "
+        f"{med['robot-ticks/s'] / 1e6:.3f} M robot-ticks/s of search per wall second; process tree CPU "
+        f"{med['cpu']:.1f} s; of the wall time: proofs {med['proofs'] / med['wall']:.0%}, repair "
+        f"{med['repair'] / med['wall']:.0%}, waiting for the fleet {med['fleet'] / med['wall']:.0%} (the rest: "
+        f"start-up, the fresh-seed check, the files) [{load()}]"
+    )
     return med
 
 
 def say_inner(label: str, loop: InnerRates, count: int, seconds: float, repeat: int) -> None:
-    print(f"inner loop (evaluation only), {label}: {count} tables × 16 scenarios × {seconds:g} s on the warm local "
-          f"backend, median of {repeat}: {loop['candidates/s']:.1f} candidates/s "
-          f"({spread(loop['spread'])}), {loop['robot-ticks/s'] / 1e6:.2f} M robot-ticks/s; baseline, the same "
-          f"robot-ticks as plain fleets of one table: {loop['baseline robot-ticks/s'] / 1e6:.2f} M robot-ticks/s; "
-          f"inner/baseline = {loop['robot-ticks/s'] / loop['baseline robot-ticks/s']:.2f}× [{load()}]")
+    print(
+        f"inner loop (evaluation only), {label}: {count} tables × 16 scenarios × {seconds:g} s on the warm local "
+        f"backend, median of {repeat}: {loop['candidates/s']:.1f} candidates/s "
+        f"({spread(loop['spread'])}), {loop['robot-ticks/s'] / 1e6:.2f} M robot-ticks/s; baseline, the same "
+        f"robot-ticks as plain fleets of one table: {loop['baseline robot-ticks/s'] / 1e6:.2f} M robot-ticks/s; "
+        f"inner/baseline = {loop['robot-ticks/s'] / loop['baseline robot-ticks/s']:.2f}× [{load()}]"
+    )
 
 
 def main() -> None:
@@ -246,15 +290,19 @@ def main() -> None:
     med = say_whole("this tree", mine, budget, seconds)
     loop = inner_process(repeat, count, seconds, None)
     say_inner("this tree", loop, count, seconds, repeat)
-    print(f"whole process / inner loop: {med['tables/s'] / loop['candidates/s']:.2f}× in candidates/s, "
-          f"{med['robot-ticks/s'] / loop['robot-ticks/s']:.2f}× in robot-ticks/s")
+    print(
+        f"whole process / inner loop: {med['tables/s'] / loop['candidates/s']:.2f}× in candidates/s, "
+        f"{med['robot-ticks/s'] / loop['robot-ticks/s']:.2f}× in robot-ticks/s"
+    )
     if args.against:
         old = say_whole(args.against, theirs, budget, seconds)
         old_loop = inner_process(repeat, count, seconds, args.against)
         say_inner(args.against, old_loop, count, seconds, repeat)
-        print(f"this tree / {args.against} (after/before): whole process {old['wall'] / med['wall']:.2f}× as fast "
-              f"({med['tables/s'] / old['tables/s']:.2f}× candidates/s, {old['cpu'] / med['cpu']:.2f}× less CPU); "
-              f"inner loop {loop['candidates/s'] / old_loop['candidates/s']:.2f}× candidates/s")
+        print(
+            f"this tree / {args.against} (after/before): whole process {old['wall'] / med['wall']:.2f}× as fast "
+            f"({med['tables/s'] / old['tables/s']:.2f}× candidates/s, {old['cpu'] / med['cpu']:.2f}× less CPU); "
+            f"inner loop {loop['candidates/s'] / old_loop['candidates/s']:.2f}× candidates/s"
+        )
     proving(100 if args.quick else 300)
 
 

@@ -56,8 +56,10 @@ def sweep(robots: int, ticks: int, folder: Path) -> int:
     print(f"{robots} random robots of 2-3 tables, {ticks} ticks each (load {os.getloadavg()[0]:.1f}):")
     for name, seconds in times.items():
         median = statistics.median(seconds)
-        print(f"  {name:18} agreed {agreed[name]:3}/{len(seconds)}   median {median:7.3f} s a robot   "
-              f"x{median / base:8.1f} the Python engine")
+        print(
+            f"  {name:18} agreed {agreed[name]:3}/{len(seconds)}   median {median:7.3f} s a robot   "
+            f"x{median / base:8.1f} the Python engine"
+        )
     for failure in failures:
         print("DIFFERS:", failure)
     return 1 if failures else 0

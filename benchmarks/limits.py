@@ -79,8 +79,14 @@ def run(args: list[str], expect: tuple[int, ...]) -> Figure:
     """Wall seconds and peak resident MiB of one fresh process, started by :data:`LAUNCHER`; its exit code must
     be one of ``expect``."""
     with tempfile.NamedTemporaryFile() as err:
-        done = subprocess.run([sys.executable, "-c", LAUNCHER, err.name, *args], capture_output=True, text=True,
-                              check=True, cwd=ROOT, env=child_env())
+        done = subprocess.run(
+            [sys.executable, "-c", LAUNCHER, err.name, *args],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=ROOT,
+            env=child_env(),
+        )
         wall, kib, code = done.stdout.split()
         if int(code) not in expect:
             raise SystemExit(f"{' '.join(args)} ended with {code}, not {expect}:\n{Path(err.name).read_text()[-2000:]}")
@@ -95,6 +101,7 @@ def measured(args: list[str], repeat: int, expect: tuple[int, ...] = (0, 1)) -> 
 
 # --- the inputs ------------------------------------------------------------------------------------------------
 
+
 def _rows(rng: random.Random, events: tuple[str, ...], states: int, count: int) -> list[list[str]]:
     """``count`` rows (state, event cells, M1, M2, timer, next) spread evenly over ``states`` states, each row
     needing one or two events of five its state looks at (check explores at most 16 per state); every state has
@@ -104,8 +111,16 @@ def _rows(rng: random.Random, events: tuple[str, ...], states: int, count: int) 
         state = k * states // count + 1
         window = [events[(state * 5 + j) % len(events)] for j in range(min(5, len(events)))]
         needed = set(rng.sample(window, rng.choice((1, 1, 2))))
-        rows.append([str(state), *("1" if e in needed else "" for e in events), rng.choice(("3", "-3", "0", "=")),
-                     rng.choice(("3", "-3", "0", "=")), str(rng.randint(0, 300)), str(rng.randint(1, states))])
+        rows.append(
+            [
+                str(state),
+                *("1" if e in needed else "" for e in events),
+                rng.choice(("3", "-3", "0", "=")),
+                rng.choice(("3", "-3", "0", "=")),
+                str(rng.randint(0, 300)),
+                str(rng.randint(1, states)),
+            ]
+        )
     return rows
 
 
@@ -138,8 +153,9 @@ def widest_table(folder: Path, rng: random.Random, events_count: int = MAX_EVENT
     path = folder / f"widest-{events_count}" / "table.csv"
     path.parent.mkdir()
     robot = "".join(f'{name} = "input {name}"\n' for name in inputs)
-    (path.parent / "robot.toml").write_text(f'name = "Wide"\ninitial_state = 1\n[inputs]\n{robot}'
-                                            '[motors]\nM1 = "right"\nM2 = "left"\n')
+    (path.parent / "robot.toml").write_text(
+        f'name = "Wide"\ninitial_state = 1\n[inputs]\n{robot}[motors]\nM1 = "right"\nM2 = "left"\n'
+    )
     text = "\n".join(lines) + "\n"
     assert len(text) < MAX_TABLE_BYTES, len(text)
     path.write_text(text)
@@ -172,9 +188,11 @@ def trace_jsonl(folder: Path, rng: random.Random) -> Path:
     size, tick = 0, 0
     with path.open("w") as stream:
         while True:
-            line = (f'{{"tick":{tick},"event":{rng.randrange(64)},"row":{rng.randrange(37)},"state":2,"timer":0,'
-                    f'"M1":4,"M2":4,"x":{rng.random():.4f},"y":{rng.random():.4f},"heading":{rng.random():.4f},'
-                    f'"battery":8.91}}\n')
+            line = (
+                f'{{"tick":{tick},"event":{rng.randrange(64)},"row":{rng.randrange(37)},"state":2,"timer":0,'
+                f'"M1":4,"M2":4,"x":{rng.random():.4f},"y":{rng.random():.4f},"heading":{rng.random():.4f},'
+                f'"battery":8.91}}\n'
+            )
             if size + len(line) > MAX_TEXT_BYTES - 1024:
                 return path
             stream.write(line)
@@ -191,14 +209,17 @@ def dense_table(folder: Path, rng: random.Random) -> Path:
         lines.append(f"{state},{needs},3,3,{rng.randint(0, 300)},{rng.randint(1, MAX_STATES)}")
     path = folder / "dense" / "table.csv"
     path.parent.mkdir()
-    (path.parent / "robot.toml").write_text('name = "Dense"\ninitial_state = 1\n[inputs]\n'
-                                            + "".join(f'{n} = "{n}"\n' for n in inputs)
-                                            + '[motors]\nM1 = "right"\nM2 = "left"\n')
+    (path.parent / "robot.toml").write_text(
+        'name = "Dense"\ninitial_state = 1\n[inputs]\n'
+        + "".join(f'{n} = "{n}"\n' for n in inputs)
+        + '[motors]\nM1 = "right"\nM2 = "left"\n'
+    )
     path.write_text("\n".join(lines) + "\n")
     return path
 
 
 # --- the runs --------------------------------------------------------------------------------------------------
+
 
 def check(table: Path) -> list[str]:
     return [*TABLEBOT, "check", str(table)]
@@ -229,17 +250,27 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         longest, cells = longest_table(folder, rng), longest_cells(folder, rng)
-        tables = {"check": {"longest table (100,000 rows, 16 MB)": longest,
-                            "widest table (1,000 cells, 63 events)": widest_table(folder, rng),
-                            "longest cells (4,000 characters)": cells},
-                  "sim": {"longest table (100,000 rows, 16 MB)": longest,
-                          "widest it takes (1,000 cells, 10 events)": widest_table(folder, rng, FLAT_BITS),
-                          "longest cells (4,000 characters)": cells}}
-        recordings = {"1,000,000 ticks of inputs (CSV)": inputs_csv(folder, rng),
-                      "a 64 MB trace replayed (JSON Lines)": trace_jsonl(folder, rng)}
+        tables = {
+            "check": {
+                "longest table (100,000 rows, 16 MB)": longest,
+                "widest table (1,000 cells, 63 events)": widest_table(folder, rng),
+                "longest cells (4,000 characters)": cells,
+            },
+            "sim": {
+                "longest table (100,000 rows, 16 MB)": longest,
+                "widest it takes (1,000 cells, 10 events)": widest_table(folder, rng, FLAT_BITS),
+                "longest cells (4,000 characters)": cells,
+            },
+        }
+        recordings = {
+            "1,000,000 ticks of inputs (CSV)": inputs_csv(folder, rng),
+            "a 64 MB trace replayed (JSON Lines)": trace_jsonl(folder, rng),
+        }
         subprocess.run(sim(EXAMPLE, folder / "warm"), check=True, env=child_env(), capture_output=True)  # numba cache
-        print(f"fresh processes, median of {args.repeat} (memory: the largest peak), load average "
-              f"{os.getloadavg()[0]:.2f}; ratios to the BumberBot example (time, memory)")
+        print(
+            f"fresh processes, median of {args.repeat} (memory: the largest peak), load average "
+            f"{os.getloadavg()[0]:.2f}; ratios to the BumberBot example (time, memory)"
+        )
         print(f"  {'':<46}{'wall':>10}{'peak':>12}  {'ratios':>15}")
         ok = True
         for name, command in (("check", check), ("sim", lambda t: sim(t, folder / "out"))):
@@ -250,15 +281,23 @@ def main() -> int:
         base = measured(trace(EXAMPLE, EXAMPLE / "inputs.csv"), args.repeat)
         row("trace BumberBot's 3,000 ticks (baseline)", base, None, (TARGET_S, TARGET_MIB))
         for label, recording in recordings.items():
-            ok = row(f"trace {label}", measured(trace(EXAMPLE, recording), args.repeat), base,
-                     (TARGET_S, TARGET_MIB)) and ok
+            ok = (
+                row(f"trace {label}", measured(trace(EXAMPLE, recording), args.repeat), base, (TARGET_S, TARGET_MIB))
+                and ok
+            )
         ok = refusals(folder, rng, args.repeat) and ok
         if args.dense:
             print("  (no target)")
-            row("check dense (1,000 states x 100 rows, 12 events)", measured(check(dense_table(folder, rng)), 1),
-                None, (float("inf"), float("inf")))
-    print(f"targets (accepted < {TARGET_S:g} s and {TARGET_MIB:g} MiB; refused < {REFUSE_S:g} s and "
-          f"{REFUSE_MIB:g} MiB): {'met' if ok else 'MISSED'}")
+            row(
+                "check dense (1,000 states x 100 rows, 12 events)",
+                measured(check(dense_table(folder, rng)), 1),
+                None,
+                (float("inf"), float("inf")),
+            )
+    print(
+        f"targets (accepted < {TARGET_S:g} s and {TARGET_MIB:g} MiB; refused < {REFUSE_S:g} s and "
+        f"{REFUSE_MIB:g} MiB): {'met' if ok else 'MISSED'}"
+    )
     return 0 if ok else 1
 
 
@@ -277,10 +316,12 @@ def refusals(folder: Path, rng: random.Random, repeat: int) -> bool:
     ticks = inputs_csv(folder, rng, MAX_INPUT_TICKS + 1)
     ok = True
     print("refused (exit 2):")
-    for label, args in (("check: 200,000 header columns", check(wide)),
-                        ("check: 100,001 lines below the header", check(rows)),
-                        ("check: a table file of 16 MB + 1 byte", check(big)),
-                        ("trace: 1,000,001 ticks of inputs", trace(EXAMPLE, ticks))):
+    for label, args in (
+        ("check: 200,000 header columns", check(wide)),
+        ("check: 100,001 lines below the header", check(rows)),
+        ("check: a table file of 16 MB + 1 byte", check(big)),
+        ("trace: 1,000,001 ticks of inputs", trace(EXAMPLE, ticks)),
+    ):
         ok = row(label, measured(args, repeat, expect=(2,)), None, (REFUSE_S, REFUSE_MIB)) and ok
     return ok
 

@@ -40,9 +40,13 @@ def measure(machine: Machine, ticks: list[TickInput], work: Path, harness: Path)
     if run.trace != list(replay(machine, ticks)) or run.problems:
         sys.exit(f"the firmware's trace differs from the Python engine's ({work}): no figures for a wrong firmware")
     result: dict[str, Any] = {
-        "ticks": len(ticks), "flash": firmware.flash, "ram": firmware.ram,
-        "lookup": "dense" if firmware.layout.dense else "scan", "lookup_bytes": firmware.layout.lookup_bytes,
-        "step_run": summary([c.step for c in run.cycles]), "isr_run": summary([c.isr for c in run.cycles]),
+        "ticks": len(ticks),
+        "flash": firmware.flash,
+        "ram": firmware.ram,
+        "lookup": "dense" if firmware.layout.dense else "scan",
+        "lookup_bytes": firmware.layout.lookup_bytes,
+        "step_run": summary([c.step for c in run.cycles]),
+        "isr_run": summary([c.isr for c in run.cycles]),
     }
     for lookup in ("dense", "scan"):
         bench = build(machine, "uno", work / f"bench-{lookup}", lookup, BENCH_MAIN)
@@ -78,16 +82,24 @@ def report(results: dict[str, dict[str, Any]]) -> list[str]:
         ("lookup used (bytes of flash)", lambda r: f"{r['lookup']} ({r['lookup_bytes']})"),
     ]
     width = max(len(label) for label, _ in rows) + 2
-    lines = ["ATmega328P @ 16 MHz, Arduino Uno firmware, cycles counted exactly by simavr", "",
-             " " * width + "".join(f"{n:>30}" for n in names)]
+    lines = [
+        "ATmega328P @ 16 MHz, Arduino Uno firmware, cycles counted exactly by simavr",
+        "",
+        " " * width + "".join(f"{n:>30}" for n in names),
+    ]
     lines += [label.ljust(width) + "".join(f"{fmt(results[n]):>30}" for n in names) for label, fmt in rows]
     bb = results["BumberBot"]
     worst = max(bb["step_all_dense"]["max"], bb["step_run"]["max"])
-    checks = [(f"BumberBot step worst case {worst:g} <= {STEP_TARGET} cycles", worst <= STEP_TARGET),
-              (f"BumberBot flash {bb['flash']} < {FLASH_TARGET} bytes", bb["flash"] < FLASH_TARGET),
-              (f"BumberBot static RAM {bb['ram']} < {RAM_TARGET} bytes", bb["ram"] < RAM_TARGET)]
-    lines += ["", *(f"{'PASS' if ok else 'FAIL'}  {text}" for text, ok in checks),
-              "(the document's engine spent about 120 cycles on each bitwise AND of its ROBO Interface)"]
+    checks = [
+        (f"BumberBot step worst case {worst:g} <= {STEP_TARGET} cycles", worst <= STEP_TARGET),
+        (f"BumberBot flash {bb['flash']} < {FLASH_TARGET} bytes", bb["flash"] < FLASH_TARGET),
+        (f"BumberBot static RAM {bb['ram']} < {RAM_TARGET} bytes", bb["ram"] < RAM_TARGET),
+    ]
+    lines += [
+        "",
+        *(f"{'PASS' if ok else 'FAIL'}  {text}" for text, ok in checks),
+        "(the document's engine spent about 120 cycles on each bitwise AND of its ROBO Interface)",
+    ]
     return lines
 
 
@@ -99,8 +111,10 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="tablebot-mcu-") as tmp:
         work = Path(tmp)
         harness = build_harness(work / "harness")
-        results = {name: measure(machine, ticks, work / str(i), harness)
-                   for i, (name, (machine, ticks)) in enumerate(tables(args.ticks).items())}
+        results = {
+            name: measure(machine, ticks, work / str(i), harness)
+            for i, (name, (machine, ticks)) in enumerate(tables(args.ticks).items())
+        }
     lines = report(results)
     print("\n".join(lines))
     if args.json:

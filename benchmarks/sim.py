@@ -130,11 +130,16 @@ def inner(repeat: int, seconds: float) -> float:
     short = min(seconds, 60.0)  # the tick-by-tick baseline is slow: a minute of it, scaled
     one = median_of(repeat, lambda: tick_by_tick_seconds(scene, round(short / scene.tick_s), 1)) * seconds / short
     engine = median_of(repeat, lambda: engine_seconds(scene, short, 1)) * seconds / short
-    print(f"inner loop: one {table.robot.name} in {scene.world.name}, {seconds:g} s simulated ({ticks:,} ticks), "
-          f"median of {repeat}")
+    print(
+        f"inner loop: one {table.robot.name} in {scene.world.name}, {seconds:g} s simulated ({ticks:,} ticks), "
+        f"median of {repeat}"
+    )
     print(f"  {'':<44}{'wall s':>9}{'µs/tick':>9}{'× real time':>13}")
-    for name, wall in (("run loop, compiled block path", loop), ("run loop, tick by tick from Python (baseline)", one),
-                       ("engine alone, Engine.step on recorded inputs", engine)):
+    for name, wall in (
+        ("run loop, compiled block path", loop),
+        ("run loop, tick by tick from Python (baseline)", one),
+        ("engine alone, Engine.step on recorded inputs", engine),
+    ):
         print(f"  {name:<44}{wall:9.3f}{wall / ticks * 1e6:9.2f}{seconds / wall:13,.0f}")
     print(f"  compiled loop vs tick-by-tick: {one / loop:.1f}×")
     return seconds / loop
@@ -142,6 +147,7 @@ def inner(repeat: int, seconds: float) -> float:
 
 def whole(repeat: int) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as tmp:
+
         def sim(run: int) -> list[str]:  # a new folder each run: replacing a run's 59 MB trace costs more
             return [*TABLEBOT, "sim", str(EXAMPLE), "--seconds", "3600", "-q", "--out", f"{tmp}/{run}"]
 
@@ -155,21 +161,36 @@ def whole(repeat: int) -> dict[str, float]:
                 shutil.rmtree(f"{tmp}/{folder}")
     helps = [command([*TABLEBOT, "--help"])[0] for _ in range(repeat)]
     python = [command([sys.executable, "-c", "pass"])[0] for _ in range(repeat)]
-    figures = {"hour": statistics.median(r[0] for r in runs), "hour_mib": max(r[1] for r in runs),
-               "hour_private": max(r[2] for r in runs), "hour_cpu": statistics.median(r[3] for r in runs),
-               "bare": statistics.median(r[0] for r in bare), "bare_mib": max(r[1] for r in bare),
-               "bare_private": max(r[2] for r in bare), "bare_cpu": statistics.median(r[3] for r in bare),
-               "help": statistics.median(helps), "python": statistics.median(python)}
-    print(f"whole command (fresh processes, median of {repeat}, load average {load:.2f} at the start; CPU: user + "
-          "system of the whole process tree; memory: peak resident, and in brackets the private part, without "
-          "shared library pages):")
-    print(f"  tablebot sim (1 h, trace + pictures)    {figures['hour']:6.2f} s   CPU {figures['hour_cpu']:5.2f} s   "
-          f"peak {figures['hour_mib']:5.0f} MiB ({figures['hour_private']:.0f} MiB private)   "
-          f"{figures['hour'] / figures['bare']:.2f}x --no-plots")
-    print(f"  tablebot sim (1 h, --no-plots)          {figures['bare']:6.2f} s   CPU {figures['bare_cpu']:5.2f} s   "
-          f"peak {figures['bare_mib']:5.0f} MiB ({figures['bare_private']:.0f} MiB private)")
-    print(f"  tablebot --help                         {figures['help']:6.3f} s   "
-          f"({figures['help'] / figures['python']:.1f}× python -c pass, {figures['python']:.3f} s)")
+    figures = {
+        "hour": statistics.median(r[0] for r in runs),
+        "hour_mib": max(r[1] for r in runs),
+        "hour_private": max(r[2] for r in runs),
+        "hour_cpu": statistics.median(r[3] for r in runs),
+        "bare": statistics.median(r[0] for r in bare),
+        "bare_mib": max(r[1] for r in bare),
+        "bare_private": max(r[2] for r in bare),
+        "bare_cpu": statistics.median(r[3] for r in bare),
+        "help": statistics.median(helps),
+        "python": statistics.median(python),
+    }
+    print(
+        f"whole command (fresh processes, median of {repeat}, load average {load:.2f} at the start; CPU: user + "
+        "system of the whole process tree; memory: peak resident, and in brackets the private part, without "
+        "shared library pages):"
+    )
+    print(
+        f"  tablebot sim (1 h, trace + pictures)    {figures['hour']:6.2f} s   CPU {figures['hour_cpu']:5.2f} s   "
+        f"peak {figures['hour_mib']:5.0f} MiB ({figures['hour_private']:.0f} MiB private)   "
+        f"{figures['hour'] / figures['bare']:.2f}x --no-plots"
+    )
+    print(
+        f"  tablebot sim (1 h, --no-plots)          {figures['bare']:6.2f} s   CPU {figures['bare_cpu']:5.2f} s   "
+        f"peak {figures['bare_mib']:5.0f} MiB ({figures['bare_private']:.0f} MiB private)"
+    )
+    print(
+        f"  tablebot --help                         {figures['help']:6.3f} s   "
+        f"({figures['help'] / figures['python']:.1f}× python -c pass, {figures['python']:.3f} s)"
+    )
     return figures
 
 
@@ -183,9 +204,13 @@ def main(argv: list[str] | None = None) -> int:
     checks = [("run loop ≥ 10,000× real time", speed >= 10_000)]
     if not args.no_commands:
         f = whole(args.repeat)
-        checks += [("whole hour < 2 s", f["hour"] < 2), ("--no-plots hour < 2 s", f["bare"] < 2),
-                   ("peak memory < 200 MiB (resident)", f["hour_mib"] < 200),
-                   ("peak memory < 200 MiB (private)", f["hour_private"] < 200), ("--help < 0.15 s", f["help"] < 0.15)]
+        checks += [
+            ("whole hour < 2 s", f["hour"] < 2),
+            ("--no-plots hour < 2 s", f["bare"] < 2),
+            ("peak memory < 200 MiB (resident)", f["hour_mib"] < 200),
+            ("peak memory < 200 MiB (private)", f["hour_private"] < 200),
+            ("--help < 0.15 s", f["help"] < 0.15),
+        ]
     print("targets:")
     for label, ok in checks:
         print(f"  {label:<32} {'ok' if ok else 'MISSED'}")

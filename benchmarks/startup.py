@@ -100,8 +100,10 @@ def commands(quick: bool) -> list[tuple[str, list[str]]]:
         ("check", ["check", str(EXAMPLE)]),
         ("sim --no-plots", ["sim", str(EXAMPLE), "--seconds", hour, "--no-plots", "--out", "OUT"]),
         ("sim (pictures)", ["sim", str(EXAMPLE), "--seconds", hour, "--out", "OUT"]),
-        ("sweep --no-plots", ["sweep", str(EXAMPLE), "--robots", robots, "--seconds", "10", "--no-plots",
-                              "--out", "OUT/sweep"]),
+        (
+            "sweep --no-plots",
+            ["sweep", str(EXAMPLE), "--robots", robots, "--seconds", "10", "--no-plots", "--out", "OUT/sweep"],
+        ),
     ]
 
 
@@ -128,8 +130,9 @@ fleet.run(1); lap("its first tick (loads the fleet kernel)")
 
 
 def phases() -> list[tuple[str, float]]:
-    done = subprocess.run([sys.executable, "-c", PHASES, str(EXAMPLE)], cwd=ROOT, env=child_env(),
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-c", PHASES, str(EXAMPLE)], cwd=ROOT, env=child_env(), capture_output=True, text=True
+    )
     if done.returncode:
         raise SystemExit(f"the phases script failed:\n{done.stderr[-2000:]}")
     return [(name, float(sec)) for name, sec in (line.split("\t") for line in done.stdout.splitlines() if "\t" in line)]
@@ -138,8 +141,22 @@ def phases() -> list[tuple[str, float]]:
 def warm_up() -> None:
     """The compiled code into this machine's cache (not counted)."""
     with tempfile.TemporaryDirectory() as warm:
-        timed([sys.executable, "-m", "tablebot", "sweep", str(EXAMPLE), "--robots", "64", "--seconds", "1",
-               "--no-plots", "--out", warm + "/s"])
+        timed(
+            [
+                sys.executable,
+                "-m",
+                "tablebot",
+                "sweep",
+                str(EXAMPLE),
+                "--robots",
+                "64",
+                "--seconds",
+                "1",
+                "--no-plots",
+                "--out",
+                warm + "/s",
+            ]
+        )
         timed([sys.executable, "-m", "tablebot", "sim", str(EXAMPLE), "--seconds", "1", "--out", warm + "/t"])
 
 
@@ -166,15 +183,23 @@ def help_only(repeat: int) -> int:
     for name, rows in runs.items():
         walls = [w / p[0] for (w, _c), p in zip(rows, runs["python -c pass"], strict=True)]
         cpus = [c / t[1] for (_w, c), t in zip(rows, runs["import typer"], strict=True)]
-        print(f"{name:<16} {med(w for w, _ in rows):7.3f} {med(c for _, c in rows):7.3f} {med(walls):16.1f}x "
-              f"{med(cpus):16.2f}x")
+        print(
+            f"{name:<16} {med(w for w, _ in rows):7.3f} {med(c for _, c in rows):7.3f} {med(walls):16.1f}x "
+            f"{med(cpus):16.2f}x"
+        )
     for name in ("--help", "--help (de)"):
         wall = med(w for w, _ in runs[name])
         print(f"{name}: {wall:.3f} s wall, target under {HELP_TARGET} s ({'met' if wall < HELP_TARGET else 'NOT met'})")
     load, cores = os.getloadavg()[0], os.cpu_count() or 1
-    print(f"load average {load:.2f} at the end" + (f": above {cores}, a process's wall time includes waiting for a "
-                                                   "core; its cpu seconds, and the ratios, move less" if load > cores
-                                                   else ""))
+    print(
+        f"load average {load:.2f} at the end"
+        + (
+            f": above {cores}, a process's wall time includes waiting for a "
+            "core; its cpu seconds, and the ratios, move less"
+            if load > cores
+            else ""
+        )
+    )
     return 0
 
 
@@ -185,8 +210,10 @@ def main() -> int:
     parser.add_argument("--help-only", action="store_true", help="only the interpreter and --help in both languages")
     args = parser.parse_args()
     med = statistics.median
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); medians of "
-          f"{args.repeat} fresh processes")
+    print(
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start (shared machine); medians of "
+        f"{args.repeat} fresh processes"
+    )
     if args.help_only:
         return help_only(args.repeat)
     warm_up()
@@ -198,8 +225,11 @@ def main() -> int:
         runs = []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as out:
-                argv = [sys.executable, "-c", "pass"] if not cmd else \
-                    [sys.executable, "-m", "tablebot", *[a.replace("OUT", out) for a in cmd]]
+                argv = (
+                    [sys.executable, "-c", "pass"]
+                    if not cmd
+                    else [sys.executable, "-m", "tablebot", *[a.replace("OUT", out) for a in cmd]]
+                )
                 runs.append(timed(argv))
         wall, cpu = med(r[0] for r in runs), med(r[1] for r in runs)
         if name.startswith("--help"):
@@ -211,13 +241,17 @@ def main() -> int:
         heavy = ", ".join(imported(cmd)) if cmd else ""
         shown = f"{run:7.2f}" if run is not None else f"{'':7}"
         print(f"{name:<18} {wall:7.2f} {cpu:7.2f} {shown} {around}  {heavy or '-'}")
-    print(f"(run s: the run as the command reports it; around = wall - run: start-up, planning, files. The "
-          f"interpreter alone is {floor:.3f} s.)")
+    print(
+        f"(run s: the run as the command reports it; around = wall - run: start-up, planning, files. The "
+        f"interpreter alone is {floor:.3f} s.)"
+    )
     assert floor is not None  # python -c pass is the first row
     helps = {name: med(w) for name, w in help_walls.items()}
     for name, wall in helps.items():
-        print(f"{name}: {wall:.3f} s, {wall / floor:.1f}x the interpreter alone; target under {HELP_TARGET} s "
-              f"({'met' if wall < HELP_TARGET else 'NOT met'})")
+        print(
+            f"{name}: {wall:.3f} s, {wall / floor:.1f}x the interpreter alone; target under {HELP_TARGET} s "
+            f"({'met' if wall < HELP_TARGET else 'NOT met'})"
+        )
 
     print("\nphases of a fresh process (a sweep's start-up, step by step; medians, ms):")
     laps = [phases() for _ in range(args.repeat)]

@@ -86,13 +86,16 @@ def main() -> int:
     table = load_table(ROOT / "examples" / "bumberbot" / "table.csv")
     machine = compile_table(table)
     ticks = load_inputs(ROOT / "examples" / "bumberbot" / "inputs.csv", machine)
-    payloads: list[dict[str, Any]] = [{name: int(bool(t.mask & bit)) for name, bit in machine.input_bits.items()}
-                                      for t in ticks]
+    payloads: list[dict[str, Any]] = [
+        {name: int(bool(t.mask & bit)) for name, bit in machine.input_bits.items()} for t in ticks
+    ]
     scxml, config = export_scxml([table]), export_xstate([table])
     with tempfile.TemporaryDirectory() as folder:
-        runs = {"Engine.step (baseline)": [engine(machine, ticks) for _ in range(repeats)],
-                "SCXML in python-statemachine": [statemachine(scxml, payloads) for _ in range(repeats)],
-                "XState 5 in Node": [xstate(config, payloads, Path(folder)) for _ in range(repeats)]}
+        runs = {
+            "Engine.step (baseline)": [engine(machine, ticks) for _ in range(repeats)],
+            "SCXML in python-statemachine": [statemachine(scxml, payloads) for _ in range(repeats)],
+            "XState 5 in Node": [xstate(config, payloads, Path(folder)) for _ in range(repeats)],
+        }
     want = runs["Engine.step (baseline)"][0][1]
     base = statistics.median(seconds for seconds, _ in runs["Engine.step (baseline)"])
     print(f"BumberBot, {len(ticks)} ticks, median of {repeats}:")
@@ -103,8 +106,10 @@ def main() -> int:
         same = all(states == want for _, states in results)
         keeps = per_tick < TICK_US
         failed |= not (same and keeps)
-        print(f"  {name:30} {per_tick:9.1f} µs/tick  {seconds / base:8.1f}x the engine  "
-              f"{'keeps' if keeps else 'MISSES'} the 10 ms tick  {'same states' if same else 'STATES DIFFER'}")
+        print(
+            f"  {name:30} {per_tick:9.1f} µs/tick  {seconds / base:8.1f}x the engine  "
+            f"{'keeps' if keeps else 'MISSES'} the 10 ms tick  {'same states' if same else 'STATES DIFFER'}"
+        )
     return 1 if failed else 0
 
 

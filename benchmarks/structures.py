@@ -35,8 +35,12 @@ N_STATE = 8
 P_DT, P_BASE, P_KV, P_VF, P_ALPHA, P_VFULL, P_VEMPTY, P_RINT, P_CAP, P_IIDLE, P_IMOTOR = range(11)
 N_PARAM = 11
 STATE_DTYPE = np.dtype([(name, np.float64) for name in ("x", "y", "th", "v_r", "v_l", "soc", "gain_r", "gain_l")])
-PARAM_DTYPE = np.dtype([(name, np.float64) for name in ("dt", "base", "kv", "vf", "alpha", "vfull", "vempty", "rint",
-                                                         "cap", "iidle", "imotor")])
+PARAM_DTYPE = np.dtype(
+    [
+        (name, np.float64)
+        for name in ("dt", "base", "kv", "vf", "alpha", "vfull", "vempty", "rint", "cap", "iidle", "imotor")
+    ]
+)
 DUTY_R, DUTY_L = 0.75, 0.5  # the motor levels' duties (6/8 and 4/8), the same every tick
 
 fast = njit(cache=False, refcounts=False)
@@ -155,10 +159,15 @@ def forms(n: int) -> dict[str, Callable[[int], np.ndarray]]:
             rows, params = as_records(S, P)
             kernel(rows, params, ticks)
             return rows.view(np.float64).reshape(n, N_STATE)
+
         return run
 
-    return {"positional": positional, "NamedTuple": named, "record, by field": record(_records),
-            "record, rows as views": record(_record_views)}
+    return {
+        "positional": positional,
+        "NamedTuple": named,
+        "record, by field": record(_records),
+        "record, rows as views": record(_record_views),
+    }
 
 
 def cpu(run: Callable[[int], np.ndarray], ticks: int) -> float:
@@ -184,8 +193,10 @@ def main() -> None:
             times[name].append(cpu(run, args.ticks))
     work = args.robots * args.ticks
     base = statistics.median(times["positional"])
-    print(f"{args.robots:,} robots x {args.ticks:,} ticks, one thread, CPU time, medians of {args.repeat}; "
-          "every form's rows identical")
+    print(
+        f"{args.robots:,} robots x {args.ticks:,} ticks, one thread, CPU time, medians of {args.repeat}; "
+        "every form's rows identical"
+    )
     for name, spent in times.items():
         median = statistics.median(spent)
         print(f"  {name:<24} {median / work * 1e9:6.2f} ns per robot-tick   x{median / base:.2f} the positional form's")

@@ -72,16 +72,21 @@ def edit_latency(folder: Path) -> None:
         server.stop()
     print("edit -> findings, BumberBot (37 rows, 7 properties)")
     print(f"  baseline: tablebot check's steps (parse, compile, check)  {baseline:7.1f} ms")
-    print(f"  studio analysis of one edit                               {studio:7.1f} ms  "
-          f"({studio / baseline:.2f}x the baseline)")
-    print(f"  round trip through the server (edit sent -> findings in)  {trip:7.1f} ms  "
-          f"({trip / baseline:.2f}x the baseline; target < 100 ms: {'met' if trip < 100 else 'MISSED'})")
+    print(
+        f"  studio analysis of one edit                               {studio:7.1f} ms  "
+        f"({studio / baseline:.2f}x the baseline)"
+    )
+    print(
+        f"  round trip through the server (edit sent -> findings in)  {trip:7.1f} ms  "
+        f"({trip / baseline:.2f}x the baseline; target < 100 ms: {'met' if trip < 100 else 'MISSED'})"
+    )
 
 
 async def round_trips(server: Background) -> float:
     """Median edit round trip, as the studio's page talks (its Origin and token header)."""
-    async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
-                                  additional_headers=server.headers) as ws:
+    async with websockets.connect(
+        server.origin.replace("http", "ws") + "/ws", max_size=2**24, additional_headers=server.headers
+    ) as ws:
         await ws.send(json.dumps({"op": "open", "path": "table.csv"}))
         await _until(ws, lambda m: m["type"] == "analysis")
         times = []
@@ -116,8 +121,9 @@ def live_view(folder: Path) -> None:
     server = Background(folder, "table.csv")
     try:
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=str(chromium), args=["--headless=new", "--no-sandbox",
-                                                                             "--disable-gpu"])
+            browser = p.chromium.launch(
+                executable_path=str(chromium), args=["--headless=new", "--no-sandbox", "--disable-gpu"]
+            )
             page = browser.new_page(viewport={"width": 1366, "height": 768})
             page.goto(server.url)
             page.wait_for_function("() => document.querySelector('#counts').textContent.includes('states')")
@@ -140,8 +146,7 @@ def _measure(page: Page, speed: str, label: str, seconds: float = 6.0) -> None:
     page.wait_for_function("() => stats.ticks > 50")
     start = page.evaluate("() => ({t: performance.now(), tick: stats.ticks, frames: stats.frames})")
     page.wait_for_timeout(seconds * 1000)
-    end = page.evaluate("() => ({t: performance.now(), tick: stats.ticks, frames: stats.frames, "
-                        "draw: stats.drawMs})")
+    end = page.evaluate("() => ({t: performance.now(), tick: stats.ticks, frames: stats.frames, draw: stats.drawMs})")
     page.click("#play")  # pause
     wall = (end["t"] - start["t"]) / 1000
     ticks = end["tick"] - start["tick"]
@@ -149,11 +154,15 @@ def _measure(page: Page, speed: str, label: str, seconds: float = 6.0) -> None:
     frames = (end["frames"] - start["frames"]) / wall
     if speed == "10":
         verdict = "keeps up" if speedup >= 9.8 else "FALLS BEHIND"
-        print(f"  10x: {speedup:6.2f}x real time shown ({speedup / 10:.3f} of the target: {verdict}), "
-              f"{frames:4.1f} frames/s drawn")
+        print(
+            f"  10x: {speedup:6.2f}x real time shown ({speedup / 10:.3f} of the target: {verdict}), "
+            f"{frames:4.1f} frames/s drawn"
+        )
     else:
-        print(f"  max: {speedup:6.0f}x real time shown ({speedup / 10:.0f}x the 10x target), "
-              f"{frames:4.1f} frames/s drawn, last draw {end['draw']:.2f} ms")
+        print(
+            f"  max: {speedup:6.0f}x real time shown ({speedup / 10:.0f}x the 10x target), "
+            f"{frames:4.1f} frames/s drawn, last draw {end['draw']:.2f} ms"
+        )
 
 
 def main() -> None:

@@ -43,8 +43,11 @@ class Studio:
     """A ``tablebot studio`` process and what its page sends (Origin, token header)."""
 
     def __init__(self, folder: Path) -> None:
-        self.process = subprocess.Popen([sys.executable, "-m", "tablebot.cli", "studio", str(folder), "--port", "0",
-                                         "--no-browser"], stderr=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "tablebot.cli", "studio", str(folder), "--port", "0", "--no-browser"],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         assert self.process.stderr is not None
         while not (found := re.search(r"http://127\.0\.0\.1:(\d+)/\?token=([\w-]+)", self.process.stderr.readline())):
             if self.process.poll() is not None:
@@ -75,8 +78,9 @@ class Studio:
 
 async def open_tab(studio: Studio) -> tuple[Any, bool]:
     """A tab as the page opens it, playing its robot as fast as it goes; whether the studio took it."""
-    ws = await websockets.connect(studio.origin.replace("http", "ws") + "/ws", additional_headers=studio.headers,
-                                  max_size=2**24)
+    ws = await websockets.connect(
+        studio.origin.replace("http", "ws") + "/ws", additional_headers=studio.headers, max_size=2**24
+    )
     await ws.send(json.dumps({"op": "open", "path": "table.csv"}))
     while (message := json.loads(await asyncio.wait_for(ws.recv(), 120)))["type"] not in ("arena", "error"):
         pass
@@ -106,8 +110,12 @@ async def one_round(studio: Studio, tabs: int) -> dict[str, float]:
         await ws.close()
     await asyncio.gather(*readers)
     await asyncio.sleep(SETTLE_S)
-    return {"accepted": sum(took for _, took in opened), "wait_ms": wait_ms, "open_mb": size,
-            "closed_mb": studio.rss_mb()}
+    return {
+        "accepted": sum(took for _, took in opened),
+        "wait_ms": wait_ms,
+        "open_mb": size,
+        "closed_mb": studio.rss_mb(),
+    }
 
 
 async def measure(studio: Studio, tabs: int, rounds: int) -> None:
@@ -121,10 +129,12 @@ async def measure(studio: Studio, tabs: int, rounds: int) -> None:
         r = await one_round(studio, tabs)
         took = r["open_mb"] - base_mb
         back = (r["open_mb"] - r["closed_mb"]) / took if took > 0 else 1.0
-        print(f"  round {number}: {r['accepted']:.0f} of {tabs} tabs served; a new request waited "
-              f"{r['wait_ms']:7.1f} ms ({r['wait_ms'] / idle_ms:5.1f}x the baseline); {r['open_mb']:6.1f} MB "
-              f"open (+{took:5.1f}), {r['closed_mb']:6.1f} MB closed (+{r['closed_mb'] - base_mb:5.1f}: "
-              f"{100 * back:3.0f}% given back)")
+        print(
+            f"  round {number}: {r['accepted']:.0f} of {tabs} tabs served; a new request waited "
+            f"{r['wait_ms']:7.1f} ms ({r['wait_ms'] / idle_ms:5.1f}x the baseline); {r['open_mb']:6.1f} MB "
+            f"open (+{took:5.1f}), {r['closed_mb']:6.1f} MB closed (+{r['closed_mb'] - base_mb:5.1f}: "
+            f"{100 * back:3.0f}% given back)"
+        )
 
 
 def main() -> None:

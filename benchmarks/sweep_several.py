@@ -34,9 +34,27 @@ def command_s(example: Path, robots: int, seconds: float) -> float:
     """Wall seconds of ``tablebot sweep`` of ``example`` as a fresh process (it must succeed)."""
     with tempfile.TemporaryDirectory(prefix="tablebot-bench-") as out:
         started = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "tablebot", "sweep", str(example), "--robots", str(robots), "--seconds",
-                        f"{seconds:g}", "--no-plots", "--quiet", "--out", out], cwd=ROOT, env=child_env(), check=True,
-                       capture_output=True)
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "tablebot",
+                "sweep",
+                str(example),
+                "--robots",
+                str(robots),
+                "--seconds",
+                f"{seconds:g}",
+                "--no-plots",
+                "--quiet",
+                "--out",
+                out,
+            ],
+            cwd=ROOT,
+            env=child_env(),
+            check=True,
+            capture_output=True,
+        )
         return time.perf_counter() - started
 
 
@@ -52,11 +70,18 @@ def fleet_runner(example: Path, robots: int, ticks: int) -> Callable[[], float]:
     layer = robot_layer(project.robot)[0]
 
     def run() -> float:
-        fleet = Fleet(project.table, project.machine, scene.world, [RobotSpec(seed=k) for k in range(robots)], layer,
-                      tables=project.tables)
+        fleet = Fleet(
+            project.table,
+            project.machine,
+            scene.world,
+            [RobotSpec(seed=k) for k in range(robots)],
+            layer,
+            tables=project.tables,
+        )
         started = time.perf_counter()
         fleet.run(ticks)
         return time.perf_counter() - started
+
     run()  # compiled (or loaded) and warm
     return run
 
@@ -82,8 +107,10 @@ def main() -> None:
     for what, times in (("tablebot sweep (whole process)", whole), ("fleet alone (warm, in process)", inner)):
         ratios = [b / a for a, b in zip(times["alone"], times["lights"], strict=True)]
         a, b = statistics.median(times["alone"]), statistics.median(times["lights"])
-        print(f"{what}: bumberbot {a:.2f} s ({work / a / 1e6:.2f} M robot-ticks/s), bumberbot-lights {b:.2f} s "
-              f"({work / b / 1e6:.2f} M/s); time ratio lights/alone, median of pairs: {statistics.median(ratios):.2f}")
+        print(
+            f"{what}: bumberbot {a:.2f} s ({work / a / 1e6:.2f} M robot-ticks/s), bumberbot-lights {b:.2f} s "
+            f"({work / b / 1e6:.2f} M/s); time ratio lights/alone, median of pairs: {statistics.median(ratios):.2f}"
+        )
     print(f"load average {os.getloadavg()[0]:.1f}")
 
 

@@ -54,12 +54,20 @@ def measure(charges: list[float], seeds: list[int]) -> list[Level]:
     counted = turns(folder / "counted.csv", charges, seeds)
     levels = []
     for charge in charges:
+
         def pick(found: list[Turn], c: float = charge) -> list[Turn]:
             return [t for t in found if t.charge == c]
-        levels.append(Level(charge, pick(timed)[0].volts, [t.degrees for t in pick(timed)],
-                            [t.degrees for t in pick(counted)],
-                            lamp_times(EXAMPLES / "bumberbot", charge, seeds),
-                            lamp_times(EXAMPLES / "bumberbot-counters", charge, seeds)))
+
+        levels.append(
+            Level(
+                charge,
+                pick(timed)[0].volts,
+                [t.degrees for t in pick(timed)],
+                [t.degrees for t in pick(counted)],
+                lamp_times(EXAMPLES / "bumberbot", charge, seeds),
+                lamp_times(EXAMPLES / "bumberbot-counters", charge, seeds),
+            )
+        )
     return levels
 
 
@@ -71,19 +79,41 @@ def found(times: list[float | None]) -> str:
 def write_table(levels: list[Level], out: Path) -> str:
     with (out / "turn_drift.csv").open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f, lineterminator="\n")
-        w.writerow(["charge", "volts", "timed_mean", "timed_min", "timed_max", "counted_mean", "counted_min",
-                    "counted_max", "timed_bot_found", "counters_bot_found"])
+        w.writerow(
+            [
+                "charge",
+                "volts",
+                "timed_mean",
+                "timed_min",
+                "timed_max",
+                "counted_mean",
+                "counted_min",
+                "counted_max",
+                "timed_bot_found",
+                "counters_bot_found",
+            ]
+        )
         for lv in levels:
-            w.writerow([f"{lv.charge:.2f}", f"{lv.volts:.3f}",
-                        *(f"{v:.2f}" for d in (lv.timed, lv.counted) for v in (statistics.mean(d), min(d), max(d))),
-                        sum(t is not None for t in lv.timed_lamp), sum(t is not None for t in lv.counted_lamp)])
-    lines = ["| battery | volts | timed turn (°) | counted turn (°) | BumberBot finds the lamp | "
-             "with counters |", "|---:|---:|---:|---:|---:|---:|"]
+            w.writerow(
+                [
+                    f"{lv.charge:.2f}",
+                    f"{lv.volts:.3f}",
+                    *(f"{v:.2f}" for d in (lv.timed, lv.counted) for v in (statistics.mean(d), min(d), max(d))),
+                    sum(t is not None for t in lv.timed_lamp),
+                    sum(t is not None for t in lv.counted_lamp),
+                ]
+            )
+    lines = [
+        "| battery | volts | timed turn (°) | counted turn (°) | BumberBot finds the lamp | with counters |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
     for lv in levels:
-        lines.append(f"| {lv.charge:.0%} | {lv.volts:.2f} | {statistics.mean(lv.timed):.1f} "
-                     f"({min(lv.timed):.1f}…{max(lv.timed):.1f}) | {statistics.mean(lv.counted):.1f} "
-                     f"({min(lv.counted):.1f}…{max(lv.counted):.1f}) | {found(lv.timed_lamp)} | "
-                     f"{found(lv.counted_lamp)} |")
+        lines.append(
+            f"| {lv.charge:.0%} | {lv.volts:.2f} | {statistics.mean(lv.timed):.1f} "
+            f"({min(lv.timed):.1f}…{max(lv.timed):.1f}) | {statistics.mean(lv.counted):.1f} "
+            f"({min(lv.counted):.1f}…{max(lv.counted):.1f}) | {found(lv.timed_lamp)} | "
+            f"{found(lv.counted_lamp)} |"
+        )
     text = "\n".join(lines) + "\n"
     (out / "turn_drift.md").write_text(text, encoding="utf-8")
     return text
@@ -97,10 +127,21 @@ def plot(levels: list[Level], seeds: int, out: Path) -> Path:
     x = [100 * lv.charge for lv in levels]
     _turn_panel(ax, levels, x)
     _lamp_panel(lamp, levels, x)
-    fig.suptitle("Timer or pulse counter: the BumberBot's turns as the battery drains", fontsize=14,
-                 fontweight="bold", x=0.06, ha="left", y=0.99)
-    fig.text(0.06, 0.9, f"simulated, {seeds} seeds per point (band: min…max); "
-             "examples/bumberbot-counters, benchmarks/turn_drift.py", fontsize=9, color="#444")
+    fig.suptitle(
+        "Timer or pulse counter: the BumberBot's turns as the battery drains",
+        fontsize=14,
+        fontweight="bold",
+        x=0.06,
+        ha="left",
+        y=0.99,
+    )
+    fig.text(
+        0.06,
+        0.9,
+        f"simulated, {seeds} seeds per point (band: min…max); examples/bumberbot-counters, benchmarks/turn_drift.py",
+        fontsize=9,
+        color="#444",
+    )
     fig.subplots_adjust(left=0.06, right=0.98, top=0.8, bottom=0.11)
     path = out / "turn_drift.png"
     fig.savefig(path, facecolor="white")
@@ -110,9 +151,11 @@ def plot(levels: list[Level], seeds: int, out: Path) -> Path:
 def _turn_panel(ax: Axes, levels: list[Level], x: list[float]) -> None:
     ax.axhspan(TARGET - TOLERANCE, TARGET + TOLERANCE, color=COUNTED, alpha=0.12, label="90° ± 3°")
     ax.axhline(DRIFTED, color="#555", ls=":", lw=1)
-    ax.text(x[0], DRIFTED + 0.6, " 80°: the document's \"80° and less\"", fontsize=8, color="#555", ha="left")
-    for key, colour, label in (("timed", TIMED, "timed: 298 ticks of the timer"),
-                               ("counted", COUNTED, "counted: 35 encoder pulses per wheel")):
+    ax.text(x[0], DRIFTED + 0.6, ' 80°: the document\'s "80° and less"', fontsize=8, color="#555", ha="left")
+    for key, colour, label in (
+        ("timed", TIMED, "timed: 298 ticks of the timer"),
+        ("counted", COUNTED, "counted: 35 encoder pulses per wheel"),
+    ):
         data = [getattr(lv, key) for lv in levels]
         ax.fill_between(x, [min(d) for d in data], [max(d) for d in data], color=colour, alpha=0.25, lw=0)
         ax.plot(x, [statistics.mean(d) for d in data], "o-", color=colour, lw=2, label=label)
@@ -128,8 +171,10 @@ def _turn_panel(ax: Axes, levels: list[Level], x: list[float]) -> None:
 
 
 def _lamp_panel(lamp: Axes, levels: list[Level], x: list[float]) -> None:
-    for key, colour, label, dx in (("timed_lamp", TIMED, "BumberBot (timed turns)", -1.2),
-                                   ("counted_lamp", COUNTED, "with counters", 1.2)):
+    for key, colour, label, dx in (
+        ("timed_lamp", TIMED, "BumberBot (timed turns)", -1.2),
+        ("counted_lamp", COUNTED, "with counters", 1.2),
+    ):
         for lv, xi in zip(levels, x, strict=True):
             times = getattr(lv, key)
             hits = [t for t in times if t is not None]

@@ -80,9 +80,24 @@ def run_round(index: int, pins: list[Pin], folder: Path, options: list[str], out
     requirements, report = folder / f"round-{index}.txt", folder / "report.json"
     requirements.write_text("".join(pin.line() + "\n" for pin in pins), encoding="utf-8")
     report.unlink(missing_ok=True)
-    command = [sys.executable, "-m", "pip_audit", "-r", str(requirements), "--disable-pip", "--strict",
-               "--format", "json", "--output", str(report), "--progress-spinner", "off",
-               "--cache-dir", str(folder / "cache"), *options]  # an empty cache: the database's answer of now
+    command = [
+        sys.executable,
+        "-m",
+        "pip_audit",
+        "-r",
+        str(requirements),
+        "--disable-pip",
+        "--strict",
+        "--format",
+        "json",
+        "--output",
+        str(report),
+        "--progress-spinner",
+        "off",
+        "--cache-dir",
+        str(folder / "cache"),
+        *options,
+    ]  # an empty cache: the database's answer of now
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     answer = _json(report) if report.exists() else None
     if answer is None:
@@ -97,8 +112,9 @@ def run_round(index: int, pins: list[Pin], folder: Path, options: list[str], out
         for vuln in dependency.get("vulns", []):
             fixes = ", ".join(vuln.get("fix_versions", [])) or "no fixed version yet"
             aliases = f" ({', '.join(vuln['aliases'])})" if vuln.get("aliases") else ""
-            outcome.found.append(f"  {dependency['name']} {dependency['version']}: {vuln['id']}{aliases}; "
-                                 f"fixed in {fixes}")
+            outcome.found.append(
+                f"  {dependency['name']} {dependency['version']}: {vuln['id']}{aliases}; fixed in {fixes}"
+            )
 
 
 def _json(path: Path) -> Any:
@@ -128,16 +144,22 @@ def say(lock: Path, pins: list[Pin], options: list[str], outcome: Outcome) -> in
         print(line)
     if outcome.found:
         count = f"{len(outcome.found)} known vulnerabilit{'y' if len(outcome.found) == 1 else 'ies'}"
-        print(f"make audit: {count} in {where}: move the packages named to a "
-              "fixed version (`make lock UPGRADE=1`, or a bound in pyproject.toml and `make lock`), then "
-              "`make audit` again")
+        print(
+            f"make audit: {count} in {where}: move the packages named to a "
+            "fixed version (`make lock UPGRADE=1`, or a bound in pyproject.toml and `make lock`), then "
+            "`make audit` again"
+        )
     if outcome.unchecked:
-        print(f"make audit: NOT CHECKED: the vulnerability database could not be reached or had no answer for "
-              f"{lock}; this is not a clean result, nothing is known of the unchecked pins. pip-audit said:")
+        print(
+            f"make audit: NOT CHECKED: the vulnerability database could not be reached or had no answer for "
+            f"{lock}; this is not a clean result, nothing is known of the unchecked pins. pip-audit said:"
+        )
         for reason in outcome.unchecked:
             print(f"  {reason}")
-        print("Run `make audit` again where the database answers (PyPI's JSON API at pypi.org/pypi/NAME/VERSION"
-              "/json; or `make audit AUDIT_ARGS=\"-s osv\"` for api.osv.dev).")
+        print(
+            "Run `make audit` again where the database answers (PyPI's JSON API at pypi.org/pypi/NAME/VERSION"
+            '/json; or `make audit AUDIT_ARGS="-s osv"` for api.osv.dev).'
+        )
     if outcome.found:
         return FOUND
     if outcome.unchecked:
@@ -155,8 +177,10 @@ def main(argv: list[str]) -> int:
         print(f"make audit: NOT CHECKED: {lock}: no such file (`make lock` writes it)")
         return NOT_CHECKED
     if importlib.util.find_spec("pip_audit") is None:
-        print(f"make audit: NOT CHECKED: pip-audit is not installed for {sys.executable} (`make setup` installs "
-              "it from the lock)")
+        print(
+            f"make audit: NOT CHECKED: pip-audit is not installed for {sys.executable} (`make setup` installs "
+            "it from the lock)"
+        )
         return NOT_CHECKED
     pins = read_pins(lock)
     if not pins:

@@ -44,7 +44,8 @@ WIDTH = 120
 def marked() -> Iterator[tuple[str | tuple[str, str], str]]:
     """(msgid or (singular, plural), file) of every text marked in the code."""
     for filename, _line, message, _comments, _context in extract_from_dir(
-            SOURCE, method_map=[("**.py", "python")], keywords=KEYWORDS, comment_tags=()):
+        SOURCE, method_map=[("**.py", "python")], keywords=KEYWORDS, comment_tags=()
+    ):
         if isinstance(message, tuple):
             singular, plural = message[0], message[1]
             if singular and plural:
@@ -65,8 +66,16 @@ def help_texts() -> Iterator[str]:
 
 
 def template() -> Catalog:
-    catalog = Catalog(project="tablebot", version="", copyright_holder="", msgid_bugs_address="",
-                      creation_date=FIXED_DATE, revision_date=FIXED_DATE, charset="utf-8", fuzzy=False)
+    catalog = Catalog(
+        project="tablebot",
+        version="",
+        copyright_holder="",
+        msgid_bugs_address="",
+        creation_date=FIXED_DATE,
+        revision_date=FIXED_DATE,
+        charset="utf-8",
+        fuzzy=False,
+    )
     for message, where in marked():
         catalog.add(message, locations=[(where, 0)], flags=_flags(message))
     for text in help_texts():
@@ -81,8 +90,9 @@ def _flags(message: str | tuple[str, str]) -> tuple[str, ...]:
 
 def po_bytes(catalog: Catalog, header: bool = True) -> bytes:
     out = io.BytesIO()
-    write_po(out, catalog, width=WIDTH, sort_output=True, include_lineno=False, omit_header=not header,
-             ignore_obsolete=True)
+    write_po(
+        out, catalog, width=WIDTH, sort_output=True, include_lineno=False, omit_header=not header, ignore_obsolete=True
+    )
     return out.getvalue()
 
 
@@ -104,8 +114,11 @@ def read(path: Path, language: str | None = None) -> Catalog:
 def merged(language: str, pot: Catalog) -> Catalog:
     """The language's catalog updated to the template (a text no longer in the code is dropped)."""
     path = po_path(language)
-    catalog = read(path, language) if path.exists() else Catalog(locale=language, project="tablebot",
-                                                                  creation_date=FIXED_DATE, fuzzy=False)
+    catalog = (
+        read(path, language)
+        if path.exists()
+        else Catalog(locale=language, project="tablebot", creation_date=FIXED_DATE, fuzzy=False)
+    )
     catalog.update(pot, no_fuzzy_matching=True, update_header_comment=False)
     catalog.revision_date = FIXED_DATE
     return catalog
@@ -136,13 +149,14 @@ def stale() -> list[str]:
     """What is out of date, each with the command that brings it up to date."""
     problems = []
     if not TEMPLATE.exists() or TEMPLATE.read_bytes() != po_bytes(template()):
-        problems.append(f"{TEMPLATE.relative_to(ROOT)} differs from the texts in the code: run scripts/catalog.py "
-                        "update, then translate what it adds")
+        problems.append(
+            f"{TEMPLATE.relative_to(ROOT)} differs from the texts in the code: run scripts/catalog.py "
+            "update, then translate what it adds"
+        )
     for language in TRANSLATED:
         po, mo = po_path(language), po_path(language).with_suffix(".mo")
         if not po.exists() or not mo.exists() or mo.read_bytes() != mo_bytes(read(po, language)):
-            problems.append(f"{mo.relative_to(ROOT)} is not what {po.name} compiles to: run scripts/catalog.py "
-                            "compile")
+            problems.append(f"{mo.relative_to(ROOT)} is not what {po.name} compiles to: run scripts/catalog.py compile")
     return problems
 
 

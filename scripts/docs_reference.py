@@ -66,10 +66,19 @@ def commands_page() -> str:
 
     group: Any = typer.main.get_command(app)  # a group: typer builds it on a click of its own
     top = _context(group, "tablebot", None)
-    lines = [GENERATED, "# Commands and options", "",
-             "Every command of `tablebot` with every argument and option, as `tablebot COMMAND -h` prints them. "
-             "`-h` and `--help` work everywhere.", "",
-             "```", group.get_usage(top), "```", "", *_params_table(group, top)]
+    lines = [
+        GENERATED,
+        "# Commands and options",
+        "",
+        "Every command of `tablebot` with every argument and option, as `tablebot COMMAND -h` prints them. "
+        "`-h` and `--help` work everywhere.",
+        "",
+        "```",
+        group.get_usage(top),
+        "```",
+        "",
+        *_params_table(group, top),
+    ]
     lines += ["| command | what it does |", "|---|---|"]
     names = list(group.commands)
     for name in names:
@@ -79,8 +88,17 @@ def commands_page() -> str:
     for name in names:
         command = group.commands[name]
         ctx = _context(command, name, top)
-        lines += [f"## `tablebot {name}` {{#{name}}}", "", _paragraphs(command.help or ""), "",
-                  "```", command.get_usage(ctx), "```", "", *_params_table(command, ctx)]
+        lines += [
+            f"## `tablebot {name}` {{#{name}}}",
+            "",
+            _paragraphs(command.help or ""),
+            "",
+            "```",
+            command.get_usage(ctx),
+            "```",
+            "",
+            *_params_table(command, ctx),
+        ]
     return "\n".join(lines).rstrip() + "\n"
 
 
@@ -88,22 +106,38 @@ def sim_parameters_page() -> str:
     """docs/sim-parameters.md: every ``[sim.SECTION]`` key of a robot file (and world file section)."""
     from tablebot.sim.model.params import DEFAULTS, WIRING
 
-    lines = [GENERATED, "# Simulator parameters", "",
-             "The simulated robot's physical parameters. Each has a default, fitted to the BumberBot; a robot file "
-             "changes one in a section `[sim.SECTION]` (`[sim.motor]` `friction_volts = 0.4`), a world file in a "
-             "section `[SECTION]` of its own, which wins over the robot file's. A value outside its range is an "
-             "error naming the file and line. Where a number comes from is said beside it (*estimate* where no "
-             "source gives it). `tablebot sweep --grid SECTION.KEY=V1,V2` runs a robot over several values.", ""]
+    lines = [
+        GENERATED,
+        "# Simulator parameters",
+        "",
+        "The simulated robot's physical parameters. Each has a default, fitted to the BumberBot; a robot file "
+        "changes one in a section `[sim.SECTION]` (`[sim.motor]` `friction_volts = 0.4`), a world file in a "
+        "section `[SECTION]` of its own, which wins over the robot file's. A value outside its range is an "
+        "error naming the file and line. Where a number comes from is said beside it (*estimate* where no "
+        "source gives it). `tablebot sweep --grid SECTION.KEY=V1,V2` runs a robot over several values.",
+        "",
+    ]
     for section, keys in DEFAULTS.items():
-        lines += [f"## `[sim.{section}]`", "", "| key | default | range | what it is, and its source |",
-                  "|---|---|---|---|"]
+        lines += [
+            f"## `[sim.{section}]`",
+            "",
+            "| key | default | range | what it is, and its source |",
+            "|---|---|---|---|",
+        ]
         for key, (default, low, high, what) in keys.items():
             lines.append(f"| `{key}` | {default:g} | {low:g} … {high:g} | {_text(what)} |")
         lines.append("")
-    lines += ["## `[sim.wiring]`", "",
-              "Which of the robot's inputs and motors play the simulated BumberBot's parts (an input declared in "
-              "`[sensors]` is read as that sensor instead, and cannot be wired to a part here).", "",
-              "| key | default |", "|---|---|", *[f"| `{role}` | `{name}` |" for role, name in WIRING.items()], ""]
+    lines += [
+        "## `[sim.wiring]`",
+        "",
+        "Which of the robot's inputs and motors play the simulated BumberBot's parts (an input declared in "
+        "`[sensors]` is read as that sensor instead, and cannot be wired to a part here).",
+        "",
+        "| key | default |",
+        "|---|---|",
+        *[f"| `{role}` | `{name}` |" for role, name in WIRING.items()],
+        "",
+    ]
     return "\n".join(lines).rstrip() + "\n"
 
 
@@ -132,7 +166,9 @@ if __name__ == "__main__":
     if sys.argv[1:] == ["--check"]:
         old = stale()
         if old:
-            print(f"out of date: {', '.join('docs/' + n for n in old)}; run .venv/bin/python scripts/docs_reference.py",
-                  file=sys.stderr)
+            print(
+                f"out of date: {', '.join('docs/' + n for n in old)}; run .venv/bin/python scripts/docs_reference.py",
+                file=sys.stderr,
+            )
         sys.exit(1 if old else 0)
     write()

@@ -38,8 +38,14 @@ SIMULATED = ("sim-trace.jsonl",)
 
 def tablebot(*args: str) -> str:
     """Run tablebot as a user does, in the checkout; its standard output. A failure says what it printed."""
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=600, env={**os.environ, "TABLEBOT_LANG": "en", "COLUMNS": "120"})
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "TABLEBOT_LANG": "en", "COLUMNS": "120"},
+    )
     if done.returncode != 0:
         raise RuntimeError(f"tablebot {' '.join(args)} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
     return done.stdout
@@ -61,8 +67,11 @@ def make(out: Path) -> dict[str, bytes]:
 
 def recorded() -> dict[str, bytes]:
     """The golden files as committed (PLATFORM and .gitattributes aside)."""
-    return {path.relative_to(GOLDEN).as_posix(): path.read_bytes() for path in sorted(GOLDEN.rglob("*"))
-            if path.is_file() and path.name not in ("PLATFORM", ".gitattributes")}
+    return {
+        path.relative_to(GOLDEN).as_posix(): path.read_bytes()
+        for path in sorted(GOLDEN.rglob("*"))
+        if path.is_file() and path.name not in ("PLATFORM", ".gitattributes")
+    }
 
 
 def write() -> None:
@@ -79,8 +88,11 @@ def write() -> None:
         partial.write_bytes(data)
         partial.replace(path)
     (GOLDEN / "PLATFORM").write_text(PLATFORM + "\n", encoding="utf-8")
-    print(f"wrote {len(made)} golden files into {GOLDEN.relative_to(ROOT)} on {PLATFORM}"
-          + (f" (removed {', '.join(sorted(stale))})" if stale else "") + "; review them with git diff")
+    print(
+        f"wrote {len(made)} golden files into {GOLDEN.relative_to(ROOT)} on {PLATFORM}"
+        + (f" (removed {', '.join(sorted(stale))})" if stale else "")
+        + "; review them with git diff"
+    )
 
 
 if __name__ == "__main__":

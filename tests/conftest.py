@@ -40,6 +40,11 @@ for _folder in FOLDERS:
     if str(_folder) not in sys.path:
         sys.path.insert(1, str(_folder))
 
+#: The studio modules' shared fixtures (a module's Chromium, its screenshot folder, its studio), in
+#: tests/web/studio_fixtures.py: a plugin rather than a tests/web/conftest.py, whose module name "conftest"
+#: mypy would take for a second tests/conftest.py. A module's own fixture of the same name wins over them.
+pytest_plugins = ["studio_fixtures"]
+
 #: The markers, declared in the modules they apply to (``pytestmark = [pytest.mark.realtime]``):
 MARKERS = {
     "realtime": (

@@ -16,18 +16,23 @@ from tablebot.loop import RealTimeClock, RunEnd, TickBlock, run
 from tablebot.machine import Machine, compile_table
 
 #: The document's wiring, as examples/bumberbot/robot.toml states it for every controller.
-BUMBER_WIRING = {"I3": {"terminal": "I3", "mode": "switch", "pressed": 1},
-                 "I4": {"terminal": "I4", "mode": "switch", "pressed": 1},
-                 "I5": {"terminal": "I5", "mode": "switch", "pressed": 1},
-                 "I7": {"terminal": "I7", "mode": "phototransistor", "lit": 1},
-                 "I8": {"terminal": "I8", "mode": "phototransistor", "lit": 1}, "M1": "M1", "M2": "M2"}
+BUMBER_WIRING = {
+    "I3": {"terminal": "I3", "mode": "switch", "pressed": 1},
+    "I4": {"terminal": "I4", "mode": "switch", "pressed": 1},
+    "I5": {"terminal": "I5", "mode": "switch", "pressed": 1},
+    "I7": {"terminal": "I7", "mode": "phototransistor", "lit": 1},
+    "I8": {"terminal": "I8", "mode": "phototransistor", "lit": 1},
+    "M1": "M1",
+    "M2": "M2",
+}
 
 
 def bumberbot(section: str, wiring: dict[str, Any] | None = None, example: str = "bumberbot") -> Machine:
     """An example's table on a robot whose ``section`` holds ``wiring`` (raw data, as a Robot made in code)."""
     table = load_table(EXAMPLE.parent / example / "table.csv")
-    robot = dataclasses.replace(table.robot, sections={**table.robot.sections,
-                                                       section: BUMBER_WIRING if wiring is None else wiring})
+    robot = dataclasses.replace(
+        table.robot, sections={**table.robot.sections, section: BUMBER_WIRING if wiring is None else wiring}
+    )
     return compile_table(dataclasses.replace(table, robot=robot))
 
 
@@ -67,12 +72,20 @@ class StopAt(Record):
             raise RuntimeError("a bug in a sink")
 
 
-def drive(machine: Machine, robot: Any, ticks: int | None = 30, sinks: tuple = (),
-          behind_limit_s: float | None = None) -> RunEnd:
+def drive(
+    machine: Machine, robot: Any, ticks: int | None = 30, sinks: tuple = (), behind_limit_s: float | None = None
+) -> RunEnd:
     robot.connect()
     clock = RealTimeClock(machine.table.robot.tick_s)
-    return run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="test",
-               behind_limit_s=behind_limit_s)
+    return run(
+        Engine(machine),
+        robot,
+        clock=clock,
+        sinks=list(sinks),
+        ticks=ticks,
+        target="test",
+        behind_limit_s=behind_limit_s,
+    )
 
 
 def settle(emulator: Any, name: str | None = None, timeout_s: float = 2.0) -> None:

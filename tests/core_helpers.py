@@ -47,8 +47,9 @@ L2 = "rear lamp"
 """
 
 
-def write_table(tmp_path: Path, text: str, robot: str | None = None, name: str = "table.csv",
-                encoding: str = "utf-8") -> Path:
+def write_table(
+    tmp_path: Path, text: str, robot: str | None = None, name: str = "table.csv", encoding: str = "utf-8"
+) -> Path:
     """Write a table (and its robot.toml when given) into ``tmp_path``; returns the table path."""
     path = tmp_path / name
     path.write_bytes(text.encode(encoding))

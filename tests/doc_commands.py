@@ -21,7 +21,7 @@ FENCE_RE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.M | re.S)
 #: Lines that are not tablebot commands, or tablebot commands the tests cannot run as typed, and why.
 EXEMPT = {
     "make demo": "the Makefile's demo target: make setup, then its tablebot command, which "
-                 "test_the_makefiles_demo_command_runs runs",
+    "test_the_makefiles_demo_command_runs runs",
     "make test": "the test suite itself (it runs this test)",
     "PYTHON=python3.12 make demo": "make demo on macOS, with Homebrew's Python (see make demo)",
     "brew install python@3.12 node": "installs system packages (macOS)",
@@ -58,7 +58,7 @@ class Command:
     @property
     def argv(self) -> list[str]:
         """The words after ``tablebot`` (empty when this is not a tablebot command)."""
-        words = self.words[len(self.env):]
+        words = self.words[len(self.env) :]
         return words[1:] if words[:1] == ["tablebot"] else []
 
     def __str__(self) -> str:
@@ -77,8 +77,7 @@ def commands(doc: str) -> list[Command]:
         for offset, raw in enumerate(joined.splitlines()):
             words = shlex.split(raw, comments=True)
             if words:
-                found.append(Command(doc, first + offset, " ".join(shlex.quote(w) if " " in w else w
-                                                                     for w in words)))
+                found.append(Command(doc, first + offset, " ".join(shlex.quote(w) if " " in w else w for w in words)))
     return found
 
 

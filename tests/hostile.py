@@ -34,11 +34,13 @@ def toml_str(text: str) -> str:
 
 def robot_toml(name: str = HOSTILE[0]) -> str:
     labels = dict(zip(("I3", "I4", "I5", "I7", "I8"), HOSTILE[1:6], strict=True))
-    lines = [f"name = {toml_str(name)}", "initial_state = \"seek\"", "[inputs]"]
+    lines = [f"name = {toml_str(name)}", 'initial_state = "seek"', "[inputs]"]
     lines += [f"{key} = {toml_str(text)}" for key, text in labels.items()]
     lines += ["[motors]", f"M1 = {toml_str('right ' + HOSTILE[6])}", f"M2 = {toml_str('left ' + HOSTILE[7])}"]
-    lines += ["[states]", *(f"{toml_str(s)} = {toml_str(HOSTILE[(i + 8) % len(HOSTILE)])}"
-                            for i, s in enumerate(STATES))]
+    lines += [
+        "[states]",
+        *(f"{toml_str(s)} = {toml_str(HOSTILE[(i + 8) % len(HOSTILE)])}" for i, s in enumerate(STATES)),
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -57,8 +59,13 @@ def table_csv() -> str:
 def properties_toml() -> str:
     lines = []
     for i, text in enumerate(HOSTILE):
-        lines += [f"[prop_{i}]", f"text = {toml_str(text)}", f"note = {toml_str(text)}",
-                  f"reachable = {toml_str('state == seek')}" if i % 2 else "never = \"M1 > 5\"", ""]
+        lines += [
+            f"[prop_{i}]",
+            f"text = {toml_str(text)}",
+            f"note = {toml_str(text)}",
+            f"reachable = {toml_str('state == seek')}" if i % 2 else 'never = "M1 > 5"',
+            "",
+        ]
     return "\n".join(lines)
 
 

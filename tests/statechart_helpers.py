@@ -66,9 +66,13 @@ class Robot:
     def payloads(self, inputs: Sequence[TickInput]) -> list[tuple[dict[str, int], dict[str, int]]]:
         """Each tick's event data: every input 0 or 1, every counter's pulses."""
         counters = self.tables[0].robot.counter_names
-        return [({name: int(bool(tick.mask & bit)) for name, bit in self.input_bits.items()},
-                 dict(zip(counters, (*tick.pulses, *[0] * len(counters)), strict=False)))
-                for tick in inputs]
+        return [
+            (
+                {name: int(bool(tick.mask & bit)) for name, bit in self.input_bits.items()},
+                dict(zip(counters, (*tick.pulses, *[0] * len(counters)), strict=False)),
+            )
+            for tick in inputs
+        ]
 
 
 def one_table(table: Table) -> tuple[Robot, Machine]:
@@ -99,8 +103,13 @@ def random_several(rng: random.Random, folder: Path, count: int) -> RobotTables:
 def random_ticks(rng: random.Random, tables: RobotTables, count: int) -> list[TickInput]:
     """Inputs for a robot of several tables: many ticks with no input at all (where the rules part), pulses."""
     width, counters = len(tables.input_bits), len(tables.robot.counters)
-    return [TickInput(rng.randrange(1 << width) if rng.random() < 0.4 else 0,
-                      tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters))) for _ in range(count)]
+    return [
+        TickInput(
+            rng.randrange(1 << width) if rng.random() < 0.4 else 0,
+            tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters)),
+        )
+        for _ in range(count)
+    ]
 
 
 def _mask(part: Part, chart: Chart, data: dict[str, Any], before: dict[str, str]) -> int:
@@ -118,8 +127,9 @@ def _mask(part: Part, chart: Chart, data: dict[str, Any], before: dict[str, str]
     return mask
 
 
-def line(chart: Chart, tick: int, before: dict[str, str], after: dict[str, str],
-         data: dict[str, Any]) -> dict[str, Any]:
+def line(
+    chart: Chart, tick: int, before: dict[str, str], after: dict[str, str], data: dict[str, Any]
+) -> dict[str, Any]:
     """One tick in tablebot's trace keys (:func:`tablebot.replay.record`, ``record_several``)."""
     robot = chart.main.robot
     out: dict[str, Any] = {"tick": tick}
@@ -127,8 +137,14 @@ def line(chart: Chart, tick: int, before: dict[str, str], after: dict[str, str],
         key = "" if k == 0 else f"{part.table.name}."
         state = next(s for s in part.table.states if part.state(s) == after[part.region])
         row = data[part.row]
-        out.update({f"{key}event": _mask(part, chart, data, before), f"{key}row": None if row == -1 else row,
-                    f"{key}state": state, f"{key}timer": data[part.timer]})
+        out.update(
+            {
+                f"{key}event": _mask(part, chart, data, before),
+                f"{key}row": None if row == -1 else row,
+                f"{key}state": state,
+                f"{key}timer": data[part.timer],
+            }
+        )
         if k == 0:
             out.update({name: data[name] for name in (*robot.motors, *robot.lamps, *robot.counter_names)})
     return out
@@ -162,8 +178,13 @@ def _active(machine: Any, regions: dict[str, str]) -> dict[str, str]:
 
 def _data_names(chart: Chart) -> set[str]:
     robot = chart.main.robot
-    names = {*robot.motors, *robot.lamps, *robot.counter_names, *(f"has_{n}" for n in chart.inputs),
-             *(f"has_{c}" for c in robot.counter_names)}
+    names = {
+        *robot.motors,
+        *robot.lamps,
+        *robot.counter_names,
+        *(f"has_{n}" for n in chart.inputs),
+        *(f"has_{c}" for c in robot.counter_names),
+    }
     for part in chart.parts:
         names |= {part.timer, part.row, part.pending, f"{part.prefix}has_{TIMER_EVENT}"}
     return names
@@ -190,8 +211,15 @@ def run_xstate(robot: Robot, folder: Path, inputs: Sequence[TickInput]) -> list[
     (folder / "ticks.json").write_text(json.dumps(robot.payloads(inputs)), encoding="utf-8")
     if not (folder / "node_modules").exists():
         (folder / "node_modules").symlink_to(NODE_MODULES)  # ES modules find packages beside them, not on a path
-    done = subprocess.run(["node", "driver.mjs"], cwd=folder, capture_output=True, text=True, timeout=120,
-                          check=False, env={"PATH": os.environ.get("PATH", "")})
+    done = subprocess.run(
+        ["node", "driver.mjs"],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env={"PATH": os.environ.get("PATH", "")},
+    )
     assert done.returncode == 0, done.stderr
     single = chart.parts[0].region
     lines = []

@@ -21,8 +21,15 @@ from core_helpers import EXAMPLE
 from tablebot.web.app import Background
 
 CHROMIUM = Path("/usr/bin/chromium")
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
+FLAGS = [
+    "--headless=new",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-dev-shm-usage",
+    "--no-first-run",
+    "--disable-extensions",
+]
 
 
 def wait_for(condition: Callable[[], Any], what: str, timeout: float = 60) -> Any:
@@ -111,11 +118,13 @@ def other_port(page: str) -> Iterator[OtherPort]:
     server.close()
 
 
-def http(server: Background, path: str, headers: dict[str, str] | None = None, data: bytes | None = None,
-         timeout: float = 10) -> tuple[int, bytes]:
+def http(
+    server: Background, path: str, headers: dict[str, str] | None = None, data: bytes | None = None, timeout: float = 10
+) -> tuple[int, bytes]:
     """Status and body of a request to the studio; ``headers`` replace the page's own."""
-    request = urllib.request.Request(f"{server.origin}/{path}", data=data,
-                                     headers=server.headers if headers is None else headers)
+    request = urllib.request.Request(
+        f"{server.origin}/{path}", data=data, headers=server.headers if headers is None else headers
+    )
     try:
         with urllib.request.urlopen(request, timeout=timeout) as reply:
             return reply.status, reply.read()

@@ -16,14 +16,14 @@ from tablebot.jit import USUALLY, Compiling
 from tablebot.loop import TickBlock
 from tablebot.talk import SPINNER, Talking
 
-KERNEL = '''
+KERNEL = """
 from tablebot.jit import njit
 
 
 @njit
 def twice(x):
     return 2 * x
-'''
+"""
 
 
 def fresh_kernel(folder: Path, name: str) -> ModuleType:
@@ -135,8 +135,13 @@ def test_a_first_short_run_writes_its_trace_in_python_rather_than_compile_the_tr
     (tmp_path / "compiled.pickle").write_bytes(pickle.dumps(files))
     cache = tmp_path / "numba"
     env = child_env(NUMBA_CACHE_DIR=str(cache))
-    done = subprocess.run([sys.executable, "-c", FIRST_SHORT_RUN, str(tmp_path / "compiled.pickle"), str(example),
-                           str(tmp_path / "out")], env=env, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-c", FIRST_SHORT_RUN, str(tmp_path / "compiled.pickle"), str(example), str(tmp_path / "out")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     assert not list(cache.rglob("trace_text._lines-*.nbi")), "the trace writer's lines were compiled"
     written = (tmp_path / "out" / "trace.jsonl").read_bytes()

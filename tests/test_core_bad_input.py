@@ -33,6 +33,7 @@ def fails(*args: object) -> str:
 
 # --- input files ------------------------------------------------------------------------------------
 
+
 def test_folder_without_a_table(tmp_path: Path) -> None:
     assert "holds no table.csv" in fails("check", tmp_path)
 
@@ -62,12 +63,16 @@ def test_bad_state_name_hint_says_what_a_name_may_hold(tmp_path: Path) -> None:
 
 # --- output paths -----------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("command", [
-    ["tests", EXAMPLE, "--out"],
-    ["demo", "--out"],
-    ["export", EXAMPLE, "--to", "robopro"],
-    ["export", EXAMPLE, "--to", "c"],
-])
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["tests", EXAMPLE, "--out"],
+        ["demo", "--out"],
+        ["export", EXAMPLE, "--to", "robopro"],
+        ["export", EXAMPLE, "--to", "c"],
+    ],
+)
 def test_output_folder_that_is_a_file(tmp_path: Path, command: list[str | Path]) -> None:
     afile = tmp_path / "afile"
     afile.write_text("keep me")
@@ -91,10 +96,13 @@ def test_an_unusable_counterexample_folder_still_shows_the_report(tmp_path: Path
     assert "54 ticks (not written)" in result.stdout and "tick 53:" in result.stdout  # the story is kept
 
 
-@pytest.mark.parametrize("command", [
-    ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
-    ["diagram", EXAMPLE, "--format", "dot", "--out"],
-])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
+        ["diagram", EXAMPLE, "--format", "dot", "--out"],
+    ],
+)
 def test_output_file_that_is_a_folder(tmp_path: Path, command: list[str | Path]) -> None:
     assert "--out names a folder, not a file" in fails(*command, tmp_path)
 
@@ -141,22 +149,25 @@ def test_unknown_check_target_names_the_option() -> None:
 GOOD_TABLE = "state,T,A,M1,timer,next\n1,1,,3,10,1\n"
 
 
-@pytest.mark.parametrize(("change", "pattern", "line"), [
-    (("initial_timer = 0", "initial_timer = true"), "initial_timer must be a whole number 0..65535, not True", 3),
-    (("initial_timer = 0", "initial_timer = 1.5"), "initial_timer must be", 3),
-    (("initial_state = 1", "initial_state = true"), "initial_state True is not a state", 2),
-    (("initial_state = 1", "initial_state = [1]"), r"initial_state \[1\] is not a state", 2),
-    (("initial_state = 1", "initial_state = 1.0"), "initial_state 1.0 is not a state", 2),
-    (("initial_state = 1", "initial_state = -1"), "initial_state -1 is not a state", 2),
-    (("initial_state = 1", "initial_state = {a = 1}"), "is not a state", 2),
-    (("initial_state = 1", 'initial_state = "a \\"b"'), "is not a state", 2),
-    (('name = "Mini"', "name = 5"), "name must be text, not 5", 1),
-    (('M1 = "right"', "M1 = 7"), r"\[motors\] M1: the label must be text, not 7", 8),
-    (('A = "left switch"', "A = {a = 1}"), r"\[inputs\] A: the label must be text", 5),
-    (("initial_timer = 0", "initial_timer = 0\ntick_ms = 99999999999999999999"), "tick_ms must be a positive", 4),
-    (("initial_timer = 0", "initial_timer = 0\ntick_ms = true"), "tick_ms must be a positive whole number", 4),
-    (("[motors]", "tick_ms = 5\n[motors]"), r"tick_ms is inside \[inputs\]", 7),
-])
+@pytest.mark.parametrize(
+    ("change", "pattern", "line"),
+    [
+        (("initial_timer = 0", "initial_timer = true"), "initial_timer must be a whole number 0..65535, not True", 3),
+        (("initial_timer = 0", "initial_timer = 1.5"), "initial_timer must be", 3),
+        (("initial_state = 1", "initial_state = true"), "initial_state True is not a state", 2),
+        (("initial_state = 1", "initial_state = [1]"), r"initial_state \[1\] is not a state", 2),
+        (("initial_state = 1", "initial_state = 1.0"), "initial_state 1.0 is not a state", 2),
+        (("initial_state = 1", "initial_state = -1"), "initial_state -1 is not a state", 2),
+        (("initial_state = 1", "initial_state = {a = 1}"), "is not a state", 2),
+        (("initial_state = 1", 'initial_state = "a \\"b"'), "is not a state", 2),
+        (('name = "Mini"', "name = 5"), "name must be text, not 5", 1),
+        (('M1 = "right"', "M1 = 7"), r"\[motors\] M1: the label must be text, not 7", 8),
+        (('A = "left switch"', "A = {a = 1}"), r"\[inputs\] A: the label must be text", 5),
+        (("initial_timer = 0", "initial_timer = 0\ntick_ms = 99999999999999999999"), "tick_ms must be a positive", 4),
+        (("initial_timer = 0", "initial_timer = 0\ntick_ms = true"), "tick_ms must be a positive whole number", 4),
+        (("[motors]", "tick_ms = 5\n[motors]"), r"tick_ms is inside \[inputs\]", 7),
+    ],
+)
 def test_robot_file_wrong_types(tmp_path: Path, change: tuple[str, str], pattern: str, line: int) -> None:
     robot = MINI_ROBOT.replace(*change)
     assert robot != MINI_ROBOT
@@ -164,12 +175,15 @@ def test_robot_file_wrong_types(tmp_path: Path, change: tuple[str, str], pattern
     assert d.path.endswith("robot.toml") and d.line == line and d.hint
 
 
-@pytest.mark.parametrize(("extra", "pattern", "line"), [
-    ('[states]\n1 = ["x"]\n', r"\[states\] 1: the name must be text", 11),
-    ('[states]\n"-3" = "neg"\n', r"\[states\] '-3' is not a state", 11),
-    ('[counters]\nC1 = {motor = "M1", extra = 3}\n', "counter C1 may only say motor", 11),
-    ('[counters]\nC1 = 5\n', "counter C1 counts motor 5", 11),
-])
+@pytest.mark.parametrize(
+    ("extra", "pattern", "line"),
+    [
+        ('[states]\n1 = ["x"]\n', r"\[states\] 1: the name must be text", 11),
+        ('[states]\n"-3" = "neg"\n', r"\[states\] '-3' is not a state", 11),
+        ('[counters]\nC1 = {motor = "M1", extra = 3}\n', "counter C1 may only say motor", 11),
+        ("[counters]\nC1 = 5\n", "counter C1 counts motor 5", 11),
+    ],
+)
 def test_robot_file_wrong_types_in_sections(tmp_path: Path, extra: str, pattern: str, line: int) -> None:
     d = find(problems(write_table(tmp_path, GOOD_TABLE, MINI_ROBOT + extra)), pattern)
     assert d.line == line and d.hint
@@ -182,11 +196,15 @@ def test_robot_file_errors_go_through_the_cli(tmp_path: Path) -> None:
 
 # --- inputs CSVs ------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize(("text", "where", "pattern"), [
-    ("I3,I3\n1,0\n", "1:4", "column 'I3' appears twice"),
-    ("I3,I4\n1,0,1\n", "2:5", "cell '1' is beyond the last column"),
-    ("I3,,I4\n1,x,1\n", "2:3", "cell 'x' is in a column with no header"),
-])
+
+@pytest.mark.parametrize(
+    ("text", "where", "pattern"),
+    [
+        ("I3,I3\n1,0\n", "1:4", "column 'I3' appears twice"),
+        ("I3,I4\n1,0,1\n", "2:5", "cell '1' is beyond the last column"),
+        ("I3,,I4\n1,x,1\n", "2:3", "cell 'x' is in a column with no header"),
+    ],
+)
 def test_inputs_csv_problems(tmp_path: Path, text: str, where: str, pattern: str) -> None:
     (tmp_path / "in.csv").write_text(text)
     err = fails("trace", EXAMPLE, "--inputs", tmp_path / "in.csv")
@@ -201,13 +219,17 @@ def test_inputs_csv_tick_column_and_trailing_blank_cells_are_fine(tmp_path: Path
 
 # --- property files ---------------------------------------------------------------------------------
 
-@pytest.mark.parametrize(("body", "pattern"), [
-    ('[p]\nwhen = "I3"\nthen = "M1 <= 0"\n', "property p: within is missing"),
-    ('[p]\nnever = "I3"\ntext = 5\n', "property p: text must be text, not 5"),
-    ('[p]\nnever = "I3"\nnote = ["x"]\n', r"property p: note must be text, not \['x'\]"),
-    ('[p]\nnever = "I3"\nlevel = "fatal"\n', "property p: level must be error or warning"),
-    ('[p]\nnever = "I3"\nlevel = 3\n', "property p: level must be error or warning"),
-])
+
+@pytest.mark.parametrize(
+    ("body", "pattern"),
+    [
+        ('[p]\nwhen = "I3"\nthen = "M1 <= 0"\n', "property p: within is missing"),
+        ('[p]\nnever = "I3"\ntext = 5\n', "property p: text must be text, not 5"),
+        ('[p]\nnever = "I3"\nnote = ["x"]\n', r"property p: note must be text, not \['x'\]"),
+        ('[p]\nnever = "I3"\nlevel = "fatal"\n', "property p: level must be error or warning"),
+        ('[p]\nnever = "I3"\nlevel = 3\n', "property p: level must be error or warning"),
+    ],
+)
 def test_property_file_problems_have_hints(tmp_path: Path, body: str, pattern: str) -> None:
     (tmp_path / "p.toml").write_text(body)
     err = fails("check", EXAMPLE, "--properties", tmp_path / "p.toml")
@@ -222,13 +244,20 @@ def test_property_too_large_to_search_is_unknown_not_a_table_error(monkeypatch: 
     machine = example_machine()
     real = prove.search
     monkeypatch.setattr(prove, "search", lambda model, monitor, budget=1000: real(model, monitor, budget))
-    prop = Property("slow", "slow", "when", when=parse_condition("I3", machine),
-                    then=parse_condition("M1 < 0", machine), within=10_000)
+    prop = Property(
+        "slow",
+        "slow",
+        "when",
+        when=parse_condition("I3", machine),
+        then=parse_condition("M1 < 0", machine),
+        within=10_000,
+    )
     result = prove.check_property(prop, machine)
     assert result.status == "unknown" and "a shorter within" in result.detail
 
 
 # --- ROBO Pro import --------------------------------------------------------------------------------
+
 
 @pytest.fixture
 def lists(tmp_path: Path) -> Path:
@@ -259,11 +288,14 @@ def test_import_empty_lists(lists: Path) -> None:
     assert "the lists are empty" in fails("import", lists, "--from", "robopro")
 
 
-@pytest.mark.parametrize(("states", "pattern"), [
-    ("number,name\n1,seek\n1,turn\n", "is given twice"),
-    ("number,name\n1,seek\n2,seek\n", "is given twice"),
-    ('number,name\n1,"a ""b"\n', "expected number,name"),
-])
+@pytest.mark.parametrize(
+    ("states", "pattern"),
+    [
+        ("number,name\n1,seek\n1,turn\n", "is given twice"),
+        ("number,name\n1,seek\n2,seek\n", "is given twice"),
+        ('number,name\n1,"a ""b"\n', "expected number,name"),
+    ],
+)
 def test_import_bad_state_names(lists: Path, states: str, pattern: str) -> None:
     (lists / "states.csv").write_text(states)
     assert pattern in fails("import", lists, "--from", "robopro")
@@ -277,6 +309,7 @@ def test_import_from_a_file_or_nothing(tmp_path: Path) -> None:
 
 # --- table parsing order and diagrams ---------------------------------------------------------------
 
+
 def test_row_errors_come_in_column_order(tmp_path: Path) -> None:
     table = write_table(tmp_path, "state,T,next,\n,1,,junk,more\n1,1,1\n", MINI_ROBOT)
     assert [(d.line, d.column) for d in problems(table)] == [(2, 1), (2, 4), (2, 5), (2, 10)]
@@ -287,8 +320,9 @@ def test_mermaid_ids_of_names_that_differ_only_in_punctuation_stay_apart(tmp_pat
     from tablebot.formats.table_read import load_table
 
     robot = MINI_ROBOT.replace("initial_state = 1", 'initial_state = "a.b"')
-    table = write_table(tmp_path, "state,T,M1,M2,timer,next\na.b,1,1,1,5,a-b\na-b,1,2,2,5,a b\na b,1,0,0,5,a.b\n",
-                        robot)
+    table = write_table(
+        tmp_path, "state,T,M1,M2,timer,next\na.b,1,1,1,5,a-b\na-b,1,2,2,5,a b\na b,1,0,0,5,a.b\n", robot
+    )
     text = to_mermaid(load_table(table))
     assert "s_a_b --> s_a_b_2" in text and "s_a_b_2 --> s_a_b_3" in text and "s_a_b_3 --> s_a_b:" in text
 
@@ -306,15 +340,19 @@ def test_top_level_key_below_states_says_where_it_belongs(tmp_path: Path) -> Non
 
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
-@pytest.mark.parametrize("command", [
-    ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
-    ["diagram", EXAMPLE, "--format", "dot", "--out"],
-])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["trace", EXAMPLE, "--inputs", EXAMPLE / "inputs.csv", "--out"],
+        ["diagram", EXAMPLE, "--format", "dot", "--out"],
+    ],
+)
 def test_a_full_disk_names_the_output_file(command: list[str | Path]) -> None:
     assert fails(*command, "/dev/full").startswith("/dev/full: error: cannot write or read: No space left")
 
 
 # --- what spreadsheets save -------------------------------------------------------------------------
+
 
 def test_excel_sep_line_names_the_delimiter_and_keeps_line_numbers(tmp_path: Path) -> None:
     from tablebot.formats.table_read import load_table

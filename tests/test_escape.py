@@ -45,9 +45,12 @@ def test_c_string_and_comment_compile_and_print_back(tmp_path: Path) -> None:
     texts = [t for t in TEXTS if "\ud800" not in t]
     body = "\n".join(f"    /* {c_comment(t)} */ put({c_string(t)}, {len(t.encode())});" for t in texts)
     source = tmp_path / "s.c"
-    source.write_text('#include <stdio.h>\nstatic void put(const char *s, unsigned long n) '
-                      '{ fwrite(s, 1, n, stdout); fputc(0xff, stdout); }\n'
-                      f"int main(void)\n{{\n{body}\n    return 0;\n}}\n", encoding="ascii")
+    source.write_text(
+        "#include <stdio.h>\nstatic void put(const char *s, unsigned long n) "
+        "{ fwrite(s, 1, n, stdout); fputc(0xff, stdout); }\n"
+        f"int main(void)\n{{\n{body}\n    return 0;\n}}\n",
+        encoding="ascii",
+    )
     exe = tmp_path / "s"
     subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-o", exe, source], check=True)
     out = subprocess.run([exe], capture_output=True, check=True).stdout
@@ -63,10 +66,10 @@ def test_c_comment_is_one_inert_line(text: str) -> None:
 
 @pytest.mark.parametrize("text", TEXTS)
 def test_xml_text_and_attr_parse_back(text: str) -> None:
-    expected = "".join(REPLACEMENT if c in "\ufffe\ud800" or (ord(c) < 32 and c not in "\t\r\n") else c
-                       for c in text)
-    root = ET.fromstring(f"<r a=\"{xml_attr(text)}\" b='{xml_attr(text)}'>{xml_text(text)}</r>".encode(
-        "utf-8", "surrogatepass"))
+    expected = "".join(REPLACEMENT if c in "\ufffe\ud800" or (ord(c) < 32 and c not in "\t\r\n") else c for c in text)
+    root = ET.fromstring(
+        f"<r a=\"{xml_attr(text)}\" b='{xml_attr(text)}'>{xml_text(text)}</r>".encode("utf-8", "surrogatepass")
+    )
     assert root.get("a") == expected and root.get("b") == expected
     assert (root.text or "") == expected.replace("\r\n", "\n").replace("\r", "\n")
     assert list(root) == []  # no element came from the text
@@ -92,8 +95,9 @@ def test_html_text_parses_back(text: str) -> None:
     parser = _Collect()
     parser.feed(f'<p title="{html_text(text)}">{html_text(text)}</p>')
     parser.close()
-    expected = "".join(REPLACEMENT if (ord(c) < 32 and c not in "\t\r\n") or 0x7f <= ord(c) <= 0x9f else c
-                       for c in text)
+    expected = "".join(
+        REPLACEMENT if (ord(c) < 32 and c not in "\t\r\n") or 0x7F <= ord(c) <= 0x9F else c for c in text
+    )
     assert parser.tags == ["p"] and parser.attrs == [("title", expected)]
     assert parser.data == expected
 
@@ -123,8 +127,10 @@ def test_terminal_prints_literally(text: str) -> None:
     shown = captured.get()
     assert "\x1b" not in shown and "\x07" not in shown and "\x00" not in shown
     breaks = {"\n": "\\n", "\r": "\\r", "\x85": "\\x85", "\u2028": "\\u2028", "\u2029": "\\u2029"}
-    visible = "".join(breaks.get(c) or (f"\\x{ord(c):02x}" if (ord(c) < 32 and c != "\t") or 0x7f <= ord(c) <= 0x9f
-                                        else c) for c in text)
+    visible = "".join(
+        breaks.get(c) or (f"\\x{ord(c):02x}" if (ord(c) < 32 and c != "\t") or 0x7F <= ord(c) <= 0x9F else c)
+        for c in text
+    )
     # on one line: a line break in user text is shown, not obeyed (rich expands tabs)
     assert shown == ("<" + visible + ">").expandtabs(console.tab_size) + "\n"
 

@@ -29,12 +29,29 @@ SHOW_CURSOR, HIDE_CURSOR = b"\x1b[?25h", b"\x1b[?25l"
 
 def test_sigterm_ends_a_sweep_as_ctrl_c_does_and_gives_the_terminal_its_cursor_back(tmp_path: Path) -> None:
     out = tmp_path / "s"
-    command = [sys.executable, "-m", "tablebot", "sweep", str(BUMBERBOT), "--grid", "start=random", "--seeds",
-               "0..31", "--seconds", "200", "--workers", "2", "--out", str(out), "--no-plots"]
+    command = [
+        sys.executable,
+        "-m",
+        "tablebot",
+        "sweep",
+        str(BUMBERBOT),
+        "--grid",
+        "start=random",
+        "--seeds",
+        "0..31",
+        "--seconds",
+        "200",
+        "--workers",
+        "2",
+        "--out",
+        str(out),
+        "--no-plots",
+    ]
     main, terminal = pty.openpty()  # stderr a terminal: the progress bar is drawn (and hides the cursor)
     proc = subprocess.Popen(command, env=ENV, stdout=subprocess.PIPE, stderr=terminal, stdin=subprocess.DEVNULL)
     os.close(terminal)
     screen = bytearray()
+
     def read() -> None:
         while True:
             try:
@@ -44,6 +61,7 @@ def test_sigterm_ends_a_sweep_as_ctrl_c_does_and_gives_the_terminal_its_cursor_b
             if not data:
                 return
             screen.extend(data)
+
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
     deadline = time.monotonic() + 120
@@ -71,12 +89,34 @@ def test_sigterm_ends_a_sweep_as_ctrl_c_does_and_gives_the_terminal_its_cursor_b
 
 def tune_command(folder: Path, out: Path) -> list[str]:
     (folder / "robot.toml").write_text(ROBOT, encoding="utf-8")
-    (folder / "table.csv").write_text("description,state,T,I3,M1,M2,timer,next\ngo,1,1,,8,8,500,2\n"
-                                      "stop,2,1,,0,0,0,2\n", encoding="utf-8")
+    (folder / "table.csv").write_text(
+        "description,state,T,I3,M1,M2,timer,next\ngo,1,1,,8,8,500,2\nstop,2,1,,0,0,0,2\n", encoding="utf-8"
+    )
     (folder / "hall.toml").write_text(HALL, encoding="utf-8")
-    return ["tune", str(folder / "table.csv"), "--world", str(folder / "hall.toml"), "--grid", "battery=1.0",
-            "--seeds", "0..3", "--check-seeds", "9..9", "--seconds", "9", "--objective", "lamp_distance",
-            "--cells", "line 2 timer=0..899", "--budget", "256", "--workers", "1", "--out", str(out)]
+    return [
+        "tune",
+        str(folder / "table.csv"),
+        "--world",
+        str(folder / "hall.toml"),
+        "--grid",
+        "battery=1.0",
+        "--seeds",
+        "0..3",
+        "--check-seeds",
+        "9..9",
+        "--seconds",
+        "9",
+        "--objective",
+        "lamp_distance",
+        "--cells",
+        "line 2 timer=0..899",
+        "--budget",
+        "256",
+        "--workers",
+        "1",
+        "--out",
+        str(out),
+    ]
 
 
 def test_tune_keeps_its_evaluations_when_interrupted_and_the_same_command_resumes(tmp_path: Path) -> None:
@@ -85,8 +125,13 @@ def test_tune_keeps_its_evaluations_when_interrupted_and_the_same_command_resume
     out = tmp_path / "out"
     command = tune_command(tmp_path, out)
     journal = out / "evaluations.partial.json"
-    proc = subprocess.Popen([sys.executable, "-m", "tablebot", *command], env=ENV, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tablebot", *command],
+        env=ENV,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 120
     while not journal.exists():
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -102,7 +147,7 @@ def test_tune_keeps_its_evaluations_when_interrupted_and_the_same_command_resume
     assert again.exit_code == 143, again.output
     assert f"resuming: {len(kept)} evaluations" in again.output
     more = json.loads(journal.read_text())["evaluations"]
-    assert more[:len(kept)] == kept and len(more) > len(kept)
+    assert more[: len(kept)] == kept and len(more) > len(kept)
     done = CliRunner().invoke(app, command)
     assert done.exit_code == 0, done.output
     assert f"resuming: {len(more)} evaluations" in done.output

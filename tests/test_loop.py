@@ -25,8 +25,13 @@ def bumberbot() -> Engine:
 class ScriptedRobot:
     """Reads a fixed list of masks; records every write and every stop; can fail or stall on a tick."""
 
-    def __init__(self, masks: Sequence[int], fail_at: int | None = None, stall_at: int | None = None,
-                 error: type[Exception] = RuntimeError) -> None:
+    def __init__(
+        self,
+        masks: Sequence[int],
+        fail_at: int | None = None,
+        stall_at: int | None = None,
+        error: type[Exception] = RuntimeError,
+    ) -> None:
         self.masks, self.fail_at, self.stall_at, self.error = list(masks), fail_at, stall_at, error
         self.reads = 0
         self.writes: list[tuple[int, ...]] = []

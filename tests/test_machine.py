@@ -60,6 +60,7 @@ class Spec:
 
 # --- the reference: the document's algorithm, literally ---------------------------------------------
 
+
 class Naive:
     """Linear scan over the generated rows, names and sets only."""
 
@@ -112,24 +113,41 @@ def specs(draw: st.DrawFn, max_rows: int = 12) -> Spec:
     columns = tuple(draw(st.permutations(candidates)))
     states = tuple(draw(st.lists(st.sampled_from(STATE_POOL), min_size=1, max_size=4, unique=True)))
     forms = (draw(st.sampled_from(["signed", "doc"])), draw(st.sampled_from(["signed", "doc"])))
-    rows = draw(st.lists(st.builds(
-        SpecRow,
-        state=st.sampled_from(states),
-        events=st.frozensets(st.sampled_from(columns)) if columns else st.just(frozenset()),
-        motors=st.tuples(*[_motor_values(form) for form in forms]),
-        lamps=st.tuples(*[st.one_of(st.none(), st.integers(0, 8)) for _ in lamps]),
-        loads=st.tuples(*[st.one_of(st.none(), st.integers(0, 4)) for _ in counters]),
-        timer=st.integers(0, 4),
-        next=st.sampled_from(states),
-    ), max_size=max_rows))
+    rows = draw(
+        st.lists(
+            st.builds(
+                SpecRow,
+                state=st.sampled_from(states),
+                events=st.frozensets(st.sampled_from(columns)) if columns else st.just(frozenset()),
+                motors=st.tuples(*[_motor_values(form) for form in forms]),
+                lamps=st.tuples(*[st.one_of(st.none(), st.integers(0, 8)) for _ in lamps]),
+                loads=st.tuples(*[st.one_of(st.none(), st.integers(0, 4)) for _ in counters]),
+                timer=st.integers(0, 4),
+                next=st.sampled_from(states),
+            ),
+            max_size=max_rows,
+        )
+    )
     for state in states:  # every state needs a row, else "next state unknown"
         if all(r.state != state for r in rows):
-            rows.insert(draw(st.integers(0, len(rows))), SpecRow(state, frozenset(), (0, 0), (None,) * len(lamps),
-                                                                  (None,) * len(counters), 1, states[0]))
+            rows.insert(
+                draw(st.integers(0, len(rows))),
+                SpecRow(state, frozenset(), (0, 0), (None,) * len(lamps), (None,) * len(counters), 1, states[0]),
+            )
     n_columns = 4 + len(columns) + sum(2 if f == "doc" else 1 for f in forms) + len(lamps) + len(counters)
-    return Spec(inputs, counters, lamps, columns, forms, states, tuple(rows),
-                initial_state=draw(st.sampled_from(states)), initial_timer=draw(st.integers(0, 3)),
-                order=tuple(draw(st.permutations(range(n_columns)))), match=draw(st.sampled_from(MATCHES)))
+    return Spec(
+        inputs,
+        counters,
+        lamps,
+        columns,
+        forms,
+        states,
+        tuple(rows),
+        initial_state=draw(st.sampled_from(states)),
+        initial_timer=draw(st.integers(0, 3)),
+        order=tuple(draw(st.permutations(range(n_columns)))),
+        match=draw(st.sampled_from(MATCHES)),
+    )
 
 
 def _motor_values(form: str) -> st.SearchStrategy[int | None]:
@@ -139,10 +157,16 @@ def _motor_values(form: str) -> st.SearchStrategy[int | None]:
 
 
 def robot_of(spec: Spec) -> Robot:
-    return Robot(name="Random", inputs=spec.inputs, motors=MOTORS,
-                 counters=tuple(Counter(name, motor) for name, motor in zip(spec.counters, MOTORS, strict=False)),
-                 lamps=spec.lamps, initial_state=spec.initial_state, initial_timer=spec.initial_timer,
-                 match=spec.match)
+    return Robot(
+        name="Random",
+        inputs=spec.inputs,
+        motors=MOTORS,
+        counters=tuple(Counter(name, motor) for name, motor in zip(spec.counters, MOTORS, strict=False)),
+        lamps=spec.lamps,
+        initial_state=spec.initial_state,
+        initial_timer=spec.initial_timer,
+        match=spec.match,
+    )
 
 
 def _motor_cells(value: int | None, form: str, rnd: random.Random) -> list[str]:
@@ -173,8 +197,11 @@ def to_csv(spec: Spec) -> str:
     rnd = random.Random(repr(spec))  # blanks vs zeros vary, but the same spec always gives the same text
     lines = [_header(spec)]
     for index, row in enumerate(spec.rows):
-        cells = [f"r{index}", str(row.state), *("1" if e in row.events else rnd.choice(["", "0"])
-                                                 for e in spec.columns)]
+        cells = [
+            f"r{index}",
+            str(row.state),
+            *("1" if e in row.events else rnd.choice(["", "0"]) for e in spec.columns),
+        ]
         for value, form in zip(row.motors, spec.forms, strict=True):
             cells += _motor_cells(value, form, rnd)
         cells += [rnd.choice(["", "="]) if v is None else str(v) for v in row.lamps]
@@ -188,8 +215,9 @@ def build(spec: Spec) -> Machine:
     return compile_table(parse_table(to_csv(spec), "<random>", robot_of(spec)))
 
 
-ticks = st.lists(st.tuples(st.frozensets(st.sampled_from(INPUTS)), st.tuples(st.integers(0, 2), st.integers(0, 2))),
-                 max_size=40)
+ticks = st.lists(
+    st.tuples(st.frozensets(st.sampled_from(INPUTS)), st.tuples(st.integers(0, 2), st.integers(0, 2))), max_size=40
+)
 
 
 def mask_of(present: set[str], columns: tuple[str, ...]) -> int:
@@ -199,14 +227,14 @@ def mask_of(present: set[str], columns: tuple[str, ...]) -> int:
 
 # --- the properties ---------------------------------------------------------------------------------
 
+
 @SETTINGS
 @given(spec=specs(), inputs=ticks)
 def test_compiled_engine_equals_linear_scan(spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]]) -> None:
     machine = build(spec)
     engine, naive = Engine(machine), Naive(spec)
     for present, pulses in inputs:
-        outputs = engine.step({name: 1 for name in present if name in machine.input_bits},
-                              pulses[: len(spec.counters)])
+        outputs = engine.step({name: 1 for name in present if name in machine.input_bits}, pulses[: len(spec.counters)])
         row, events = naive.step(set(present) & set(spec.inputs), pulses[: len(spec.counters)])
         assert engine.row == (NO_ROW if row is None else row)
         assert engine.event == mask_of(events, event_columns(spec))
@@ -218,8 +246,9 @@ def test_compiled_engine_equals_linear_scan(spec: Spec, inputs: list[tuple[froze
 
 @SETTINGS
 @given(spec=specs(), inputs=ticks, split=st.integers(0, 40), jit=st.booleans())
-def test_batch_path_equals_step_path(spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]], split: int,
-                                     jit: bool) -> None:
+def test_batch_path_equals_step_path(
+    spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]], split: int, jit: bool
+) -> None:
     """``run(masks)`` (no pulses on that path), compiled or in Python, gives what ``step`` gives,
     also when a run resumes from where the last one stopped."""
     machine = build(spec)
@@ -230,8 +259,10 @@ def test_batch_path_equals_step_path(spec: Spec, inputs: list[tuple[frozenset[st
         stepper.step(mask)
         expected.append((stepper.event, stepper.row, stepper.state, stepper.timer))
     first, second = batcher.run(masks[:split], jit=jit), batcher.run(masks[split:], jit=jit)
-    got = [*zip(first.events, first.rows, first.states, first.timers, strict=True),
-           *zip(second.events, second.rows, second.states, second.timers, strict=True)]
+    got = [
+        *zip(first.events, first.rows, first.states, first.timers, strict=True),
+        *zip(second.events, second.rows, second.states, second.timers, strict=True),
+    ]
     assert got == expected
     assert batcher.snapshot() == stepper.snapshot()
     assert (batcher.event, batcher.row) == (stepper.event, stepper.row) or not masks
@@ -260,7 +291,8 @@ def test_lookup_beyond_prefill_width(data: st.DataObject) -> None:
     rows = tuple(Row(i, i + 2, "", 1, events, (i % 9,), 0, 1) for i, events in enumerate(required))
     machine = compile_table(Table(robot, names, rows))
     assert machine.dispatch[0].relevant.bit_count() > PREFILL_BITS or len(machine.dispatch[0]) == 1 << (
-        machine.dispatch[0].relevant.bit_count())
+        machine.dispatch[0].relevant.bit_count()
+    )
     events_list = data.draw(st.lists(st.integers(0, (1 << len(names)) - 1), max_size=50))
     for events in [0, *events_list]:
         row = None if match == "document" and not events else first_match(machine.rows, events)
@@ -271,6 +303,7 @@ def test_lookup_beyond_prefill_width(data: st.DataObject) -> None:
 
 
 # --- compilation details ----------------------------------------------------------------------------
+
 
 def test_bumberbot_compiles_to_ten_states_with_document_bits() -> None:
     machine = example_machine()
@@ -317,9 +350,9 @@ def test_random_tables_round_trip_through_the_writer(spec: Spec) -> None:
 
 @SETTINGS
 @given(spec=specs(), inputs=ticks, split=st.integers(0, 40))
-def test_the_compiled_tick_rule_equals_step_with_pulses(spec: Spec,
-                                                        inputs: list[tuple[frozenset[str], tuple[int, int]]],
-                                                        split: int) -> None:
+def test_the_compiled_tick_rule_equals_step_with_pulses(
+    spec: Spec, inputs: list[tuple[frozenset[str], tuple[int, int]]], split: int
+) -> None:
     """tablebot.tick.tick, compiled (the simulator's and the fleet's rule), takes step's decisions
     tick for tick, counters counting down by their pulses included."""
     machine = build(spec)
@@ -332,7 +365,9 @@ def test_the_compiled_tick_rule_equals_step_with_pulses(spec: Spec,
         expected.append((stepper.event, stepper.row, stepper.state, stepper.timer))
     first = batcher.run(masks[:split], pulses[:split], jit=None)
     second = batcher.run(masks[split:], pulses[split:], jit=None)
-    got = [*zip(first.events, first.rows, first.states, first.timers, strict=True),
-           *zip(second.events, second.rows, second.states, second.timers, strict=True)]
+    got = [
+        *zip(first.events, first.rows, first.states, first.timers, strict=True),
+        *zip(second.events, second.rows, second.states, second.timers, strict=True),
+    ]
     assert got == expected
     assert batcher.snapshot() == stepper.snapshot()

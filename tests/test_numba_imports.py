@@ -15,8 +15,9 @@ HELD = ("scipy", "coverage", "yaml")
 
 
 def fresh(code: str, cwd: Path = ROOT) -> list[str]:
-    done = subprocess.run([sys.executable, "-c", code], cwd=cwd, env=child_env(), capture_output=True, text=True,
-                          timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=cwd, env=child_env(), capture_output=True, text=True, timeout=120
+    )
     assert done.returncode == 0, done.stderr
     return done.stdout.splitlines()
 
@@ -44,6 +45,7 @@ print(coverage_support.coverage_available)
 
 def test_a_numba_config_file_in_the_working_folder_is_still_read(tmp_path: Path) -> None:
     (tmp_path / ".numba_config.yaml").write_text("boundscheck: 1\n", encoding="utf-8")
-    lines = fresh("import sys, tablebot.jit, numba; print('yaml' in sys.modules, numba.config.BOUNDSCHECK)",
-                  cwd=tmp_path)
+    lines = fresh(
+        "import sys, tablebot.jit, numba; print('yaml' in sys.modules, numba.config.BOUNDSCHECK)", cwd=tmp_path
+    )
     assert lines == ["True 1"]

@@ -56,8 +56,9 @@ class Teed:
 
     def __init__(self, command: list[str], log: Path) -> None:
         self.log = log
-        self.command = subprocess.Popen(command, env=env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                        stdin=subprocess.DEVNULL)
+        self.command = subprocess.Popen(
+            command, env=env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL
+        )
         assert self.command.stdout is not None
         self.reader = subprocess.Popen(["tee", str(log)], stdin=self.command.stdout, stdout=subprocess.DEVNULL)
         self.command.stdout.close()  # the pipe's write end is now held by the command and what it started, only
@@ -113,8 +114,18 @@ def tablebot(*args: str) -> list[str]:
 
 
 def test_evolve_killed_with_sigkill_takes_its_workers_with_it(tmp_path: Path) -> None:
-    command = tablebot("evolve", str(BUMBERBOT), "--out", str(tmp_path / "out"), "--budget", "200", "--workers", "2",
-                       "--backend", "local")
+    command = tablebot(
+        "evolve",
+        str(BUMBERBOT),
+        "--out",
+        str(tmp_path / "out"),
+        "--budget",
+        "200",
+        "--workers",
+        "2",
+        "--backend",
+        "local",
+    )
     with teed(command, tmp_path / "log") as pipeline:
         pipeline.started(2, "prover process")
         pipeline.kill_and_check()
@@ -122,8 +133,9 @@ def test_evolve_killed_with_sigkill_takes_its_workers_with_it(tmp_path: Path) ->
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="with one core, sim draws in its own process")
 def test_sim_killed_with_sigkill_takes_its_drawing_copy_with_it(tmp_path: Path) -> None:
-    with teed(tablebot("sim", str(BUMBERBOT), "--seconds", "3000", "--out", str(tmp_path / "out")),
-              tmp_path / "log") as pipeline:
+    with teed(
+        tablebot("sim", str(BUMBERBOT), "--seconds", "3000", "--out", str(tmp_path / "out")), tmp_path / "log"
+    ) as pipeline:
         pipeline.started(1, "drawing copy")
         pipeline.kill_and_check()
 

@@ -11,14 +11,28 @@ from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "bumberbot"
-EVERY_BACKEND = ["robopro", "robopro-rpp", "robopro-program", "c", "scxml", "xstate", "uno", "ftduino", "txt",
-                 "robotx", "roboif", "txt4", "sim"]
+EVERY_BACKEND = [
+    "robopro",
+    "robopro-rpp",
+    "robopro-program",
+    "c",
+    "scxml",
+    "xstate",
+    "uno",
+    "ftduino",
+    "txt",
+    "robotx",
+    "roboif",
+    "txt4",
+    "sim",
+]
 
 
 def fresh(code: str) -> list[str]:
     """The lines a fresh interpreter running ``code`` prints."""
-    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=child_env(), capture_output=True, text=True,
-                          timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, env=child_env(), capture_output=True, text=True, timeout=120
+    )
     assert done.returncode == 0, done.stderr
     return done.stdout.splitlines()
 
@@ -38,7 +52,7 @@ print('tablebot.robopro.backend' in sys.modules)
 def test_a_robot_file_read_first_is_read_with_every_back_end_s_section() -> None:
     lines = fresh(f"""
 from tablebot.robot import load_robot
-robot = load_robot({str(EXAMPLE / 'robot.toml')!r})
+robot = load_robot({str(EXAMPLE / "robot.toml")!r})
 print(sorted(robot.sections))
 """)
     assert lines == [str(sorted(["txt", "robotx", "roboif"]))]  # none refused as an unknown section

@@ -28,25 +28,119 @@ EXAMPLE = ROOT / "examples" / "bumberbot"
 
 POSIX_MODULES = ("fcntl", "termios", "pty", "resource", "pwd", "grp", "tty")
 #: POSIX-only names of os and signal that tablebot's code uses (each one guarded), taken out in the child.
-OS_NAMES = ("fork", "forkpty", "openpty", "ttyname", "readv", "fwalk", "fchmod", "setsid", "killpg", "getpgid",
-            "setpgid", "mkfifo", "O_NOFOLLOW", "O_DIRECTORY", "O_NOCTTY", "O_CLOEXEC", "O_NONBLOCK")
-SIGNAL_NAMES = ("SIGKILL", "SIGALRM", "SIGHUP", "SIGQUIT", "SIGUSR1", "SIGUSR2", "setitimer", "getitimer", "alarm",
-                "pause", "pthread_sigmask", "pthread_kill", "sigwait", "ITIMER_REAL", "SIG_BLOCK", "SIG_UNBLOCK",
-                "SIG_SETMASK")
+OS_NAMES = (
+    "fork",
+    "forkpty",
+    "openpty",
+    "ttyname",
+    "readv",
+    "fwalk",
+    "fchmod",
+    "setsid",
+    "killpg",
+    "getpgid",
+    "setpgid",
+    "mkfifo",
+    "O_NOFOLLOW",
+    "O_DIRECTORY",
+    "O_NOCTTY",
+    "O_CLOEXEC",
+    "O_NONBLOCK",
+)
+SIGNAL_NAMES = (
+    "SIGKILL",
+    "SIGALRM",
+    "SIGHUP",
+    "SIGQUIT",
+    "SIGUSR1",
+    "SIGUSR2",
+    "setitimer",
+    "getitimer",
+    "alarm",
+    "pause",
+    "pthread_sigmask",
+    "pthread_kill",
+    "sigwait",
+    "ITIMER_REAL",
+    "SIG_BLOCK",
+    "SIG_UNBLOCK",
+    "SIG_SETMASK",
+)
 #: Every POSIX-only name of os and signal (Python's documentation: "Availability: Unix", not Windows) that a
 #: module might reach for; tablebot's code may use one only if it is in OS_NAMES / SIGNAL_NAMES above.
 POSIX_ONLY = {
-    "os": {*OS_NAMES, "getuid", "geteuid", "getgid", "getegid", "getgroups", "setuid", "setgid", "nice", "sync",
-           "statvfs", "fstatvfs", "chown", "lchown", "fchown", "chroot", "getloadavg", "sched_getaffinity",
-           "sched_setaffinity", "pipe2", "writev", "preadv", "pwritev", "posix_spawn", "wait3", "wait4", "WNOHANG",
-           "register_at_fork", "sysconf", "confstr", "pathconf", "getpgrp", "tcgetpgrp", "ctermid", "O_SYNC",
-           "O_DSYNC", "O_ASYNC", "O_NDELAY", "O_PATH", "fchdir", "mknod", "major", "minor", "getsid", "setpgrp"},
-    "signal": {*SIGNAL_NAMES, "SIGCHLD", "SIGPIPE", "SIGCONT", "SIGSTOP", "SIGTSTP", "SIGTTIN", "SIGTTOU", "SIGWINCH",
-               "SIGIO", "SIGPROF", "SIGVTALRM", "SIGXCPU", "sigpending", "sigtimedwait", "sigwaitinfo",
-               "siginterrupt", "ITIMER_VIRTUAL", "ITIMER_PROF", "pidfd_send_signal"},
+    "os": {
+        *OS_NAMES,
+        "getuid",
+        "geteuid",
+        "getgid",
+        "getegid",
+        "getgroups",
+        "setuid",
+        "setgid",
+        "nice",
+        "sync",
+        "statvfs",
+        "fstatvfs",
+        "chown",
+        "lchown",
+        "fchown",
+        "chroot",
+        "getloadavg",
+        "sched_getaffinity",
+        "sched_setaffinity",
+        "pipe2",
+        "writev",
+        "preadv",
+        "pwritev",
+        "posix_spawn",
+        "wait3",
+        "wait4",
+        "WNOHANG",
+        "register_at_fork",
+        "sysconf",
+        "confstr",
+        "pathconf",
+        "getpgrp",
+        "tcgetpgrp",
+        "ctermid",
+        "O_SYNC",
+        "O_DSYNC",
+        "O_ASYNC",
+        "O_NDELAY",
+        "O_PATH",
+        "fchdir",
+        "mknod",
+        "major",
+        "minor",
+        "getsid",
+        "setpgrp",
+    },
+    "signal": {
+        *SIGNAL_NAMES,
+        "SIGCHLD",
+        "SIGPIPE",
+        "SIGCONT",
+        "SIGSTOP",
+        "SIGTSTP",
+        "SIGTTIN",
+        "SIGTTOU",
+        "SIGWINCH",
+        "SIGIO",
+        "SIGPROF",
+        "SIGVTALRM",
+        "SIGXCPU",
+        "sigpending",
+        "sigtimedwait",
+        "sigwaitinfo",
+        "siginterrupt",
+        "ITIMER_VIRTUAL",
+        "ITIMER_PROF",
+        "pidfd_send_signal",
+    },
 }
 
-HOOK = f'''
+HOOK = f"""
 import builtins, os, signal, sys
 BLOCKED = {set(POSIX_MODULES)!r}
 _import = builtins.__import__
@@ -86,7 +180,7 @@ import multiprocessing.context as _contexts
 # processes start by spawn, as on Windows, which has no fork server (nor fork: see os.fork above)
 _contexts._concrete_contexts.pop("forkserver", None)
 multiprocessing.set_start_method("spawn", force=True)
-'''
+"""
 
 #: Modules no user command imports: test helpers (a pseudo-terminal standing in for a serial device).
 NOT_FOR_USERS = ("tablebot.testing",)
@@ -101,33 +195,38 @@ def windowsish(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
 
 
 def tablebot(env: dict[str, str], cwd: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=300
+    )
     assert done.returncode in (0, 1), f"tablebot {' '.join(args)} failed ({done.returncode}):\n{done.stderr[-3000:]}"
     assert "Traceback" not in done.stderr and "internal error" not in done.stderr, done.stderr[-3000:]
     return done
 
 
 def test_the_hook_takes_the_posix_modules_and_names_away(windowsish: dict[str, str]) -> None:
-    probe = "import os, signal\n" \
-            f"for name in {POSIX_MODULES!r}:\n" \
-            "    try:\n        exec('import ' + name, {'__name__': 'tablebot.probe'})\n" \
-            "    except ImportError:\n        pass\n" \
-            "    else:\n        raise SystemExit('imported ' + name)\n" \
-            "print(hasattr(os, 'fork'), hasattr(os, 'O_NOFOLLOW'), hasattr(signal, 'SIGKILL'),\n" \
-            "      hasattr(signal, 'SIGINT'))"
+    probe = (
+        "import os, signal\n"
+        f"for name in {POSIX_MODULES!r}:\n"
+        "    try:\n        exec('import ' + name, {'__name__': 'tablebot.probe'})\n"
+        "    except ImportError:\n        pass\n"
+        "    else:\n        raise SystemExit('imported ' + name)\n"
+        "print(hasattr(os, 'fork'), hasattr(os, 'O_NOFOLLOW'), hasattr(signal, 'SIGKILL'),\n"
+        "      hasattr(signal, 'SIGINT'))"
+    )
     done = subprocess.run([sys.executable, "-c", probe], env=windowsish, capture_output=True, text=True, check=True)
     assert done.stdout.split() == ["False", "False", "False", "True"]
 
 
 def test_every_module_a_user_command_reaches_imports_without_them(windowsish: dict[str, str]) -> None:
-    program = "import importlib, pkgutil, tablebot\n" \
-              f"skip = {NOT_FOR_USERS!r}\n" \
-              "names = [m.name for m in pkgutil.walk_packages(tablebot.__path__, 'tablebot.')]\n" \
-              "for name in names:\n" \
-              "    if not name.startswith(skip) and not name.endswith('__main__'):  # that one runs the CLI\n" \
-              "        importlib.import_module(name)\n" \
-              "print(len(names))"
+    program = (
+        "import importlib, pkgutil, tablebot\n"
+        f"skip = {NOT_FOR_USERS!r}\n"
+        "names = [m.name for m in pkgutil.walk_packages(tablebot.__path__, 'tablebot.')]\n"
+        "for name in names:\n"
+        "    if not name.startswith(skip) and not name.endswith('__main__'):  # that one runs the CLI\n"
+        "        importlib.import_module(name)\n"
+        "print(len(names))"
+    )
     done = subprocess.run([sys.executable, "-c", program], env=windowsish, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-3000:]
     assert int(done.stdout) > 100  # the whole package was walked
@@ -177,15 +276,35 @@ def test_the_main_commands_run_without_them_in_awkward_folders(windowsish: dict[
     assert (run / "trace.jsonl").read_text(encoding="utf-8").count("\n") > 400
 
 
-def test_sweep_and_evolve_with_worker_processes_started_as_on_windows(windowsish: dict[str, str],
-                                                                      tmp_path: Path) -> None:
+def test_sweep_and_evolve_with_worker_processes_started_as_on_windows(
+    windowsish: dict[str, str], tmp_path: Path
+) -> None:
     """evolve's provers are processes: from a fork server on POSIX, spawned on Windows (which has none)."""
     home = tmp_path / "Schüler Arbeit"
     home.mkdir()
     tablebot(windowsish, home, "sweep", str(EXAMPLE), "--robots", "8", "--seconds", "3", "--out", "Flotte")
     assert (home / "Flotte" / "results.csv").exists()
-    tablebot(windowsish, home, "evolve", str(EXAMPLE), "--out", "Evolution", "--budget", "3", "--batch", "2",
-             "--seeds", "0..1", "--check-seeds", "10..11", "--seconds", "2", "--workers", "2", "-q")
+    tablebot(
+        windowsish,
+        home,
+        "evolve",
+        str(EXAMPLE),
+        "--out",
+        "Evolution",
+        "--budget",
+        "3",
+        "--batch",
+        "2",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "10..11",
+        "--seconds",
+        "2",
+        "--workers",
+        "2",
+        "-q",
+    )
     assert (home / "Evolution").is_dir()
 
 
@@ -223,8 +342,13 @@ def test_the_studios_files_are_read_and_saved_without_dir_fd(windowsish: dict[st
     folder.mkdir(parents=True)
     for name in ("table.csv", "robot.toml"):
         (folder / name).write_bytes((EXAMPLE / name).read_bytes())
-    done = subprocess.run([sys.executable, "-c", WORKSPACE, str(folder.parent)], env=windowsish, capture_output=True,
-                          text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-c", WORKSPACE, str(folder.parent)],
+        env=windowsish,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     said = done.stdout.splitlines()
     assert said[0].startswith("conflict: Gruppe ä/table.csv was changed on disk since you opened it"), said

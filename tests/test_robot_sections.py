@@ -27,27 +27,32 @@ def errors(tmp_path: Path, extra: str) -> list[str]:
 
 def test_a_top_level_wiring_section_is_refused_on_its_line(tmp_path: Path) -> None:
     found = errors(tmp_path, '[wiring]\nright_motor = "M9"\n')
-    assert found == [f"{tmp_path / 'robot.toml'}:8:1: error: unknown section 'wiring'\n"
-                     "    hint: the simulator's wiring goes in [sim.wiring] in a robot file "
-                     "([wiring] is for world files)"]
+    assert found == [
+        f"{tmp_path / 'robot.toml'}:8:1: error: unknown section 'wiring'\n"
+        "    hint: the simulator's wiring goes in [sim.wiring] in a robot file "
+        "([wiring] is for world files)"
+    ]
 
 
-@pytest.mark.parametrize("extra, line, message", [
-    ("[gearbox]\nratio = 3\n", 8, "unknown section 'gearbox'"),
-    ("[battery]\ncharge = 0.5\n", 8, "unknown section 'battery'"),
-    ("[sim.battery]\ncharge = 5\n", 9, "charge"),
-    ("[sim]\nworld = \"nowhere.toml\"\n", 9, "sim.world"),
-    ("[sim]\nspeed = 3\n", 9, "speed"),
-    ("[board.arduino]\nI3 = \"D2\"\n", 8, "unknown board 'arduino'"),
-    ("[board.uno]\nI3 = \"D99\"\n", 9, "input I3 cannot use 'D99'"),
-])
+@pytest.mark.parametrize(
+    "extra, line, message",
+    [
+        ("[gearbox]\nratio = 3\n", 8, "unknown section 'gearbox'"),
+        ("[battery]\ncharge = 0.5\n", 8, "unknown section 'battery'"),
+        ("[sim.battery]\ncharge = 5\n", 9, "charge"),
+        ('[sim]\nworld = "nowhere.toml"\n', 9, "sim.world"),
+        ("[sim]\nspeed = 3\n", 9, "speed"),
+        ('[board.arduino]\nI3 = "D2"\n', 8, "unknown board 'arduino'"),
+        ('[board.uno]\nI3 = "D99"\n', 9, "input I3 cannot use 'D99'"),
+    ],
+)
 def test_every_section_is_checked_when_the_file_is_read(tmp_path: Path, extra: str, line: int, message: str) -> None:
     found = errors(tmp_path, extra)
     assert any(f"robot.toml:{line}" in e and message in e for e in found), found
 
 
 def test_sections_are_typed(tmp_path: Path) -> None:
-    room = '[arena]\nwalls = [[0, 0], [1, 0], [1, 1], [0, 1]]\n[start]\nat = [0.5, 0.5]\n'
+    room = "[arena]\nwalls = [[0, 0], [1, 0], [1, 1], [0, 1]]\n[start]\nat = [0.5, 0.5]\n"
     (tmp_path / "arena.toml").write_text(room)
     path = tmp_path / "robot.toml"
     path.write_text(BASE + '[sim]\nworld = "arena.toml"\n[sim.battery]\ncharge = 0.5\n[board.uno]\nI3 = "D4"\n')
@@ -57,11 +62,18 @@ def test_sections_are_typed(tmp_path: Path) -> None:
 
 
 def test_reading_robot_and_world_files_does_not_load_the_simulator() -> None:
-    code = ("import sys; from tablebot.robot import load_robot; from tablebot.sim.model.world import load_world; "
-            "load_robot('examples/bumberbot/robot.toml'); load_world('examples/bumberbot/arena.toml'); "
-            "print(sorted(m for m in ('numba', 'matplotlib', 'tablebot.sim.physics.step') if m in sys.modules))")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                          cwd=Path(__file__).resolve().parents[1])
+    code = (
+        "import sys; from tablebot.robot import load_robot; from tablebot.sim.model.world import load_world; "
+        "load_robot('examples/bumberbot/robot.toml'); load_world('examples/bumberbot/arena.toml'); "
+        "print(sorted(m for m in ('numba', 'matplotlib', 'tablebot.sim.physics.step') if m in sys.modules))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=Path(__file__).resolve().parents[1],
+    )
     assert done.stdout.strip() == "[]"
 
 

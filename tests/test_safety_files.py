@@ -108,6 +108,7 @@ def test_check_writes_nothing_unless_asked(bot: Path, tmp_path: Path, monkeypatc
 
 # --- tablebot.files --------------------------------------------------------------------------------
 
+
 def test_an_interrupted_write_keeps_the_old_file(tmp_path: Path) -> None:
     path = tmp_path / "d.png"
     path.write_bytes(b"old")
@@ -144,12 +145,15 @@ def test_a_device_is_written_not_replaced(tmp_path: Path) -> None:
     os.close(reader)
 
 
-@pytest.mark.parametrize("header", [
-    b"\xef\xbb\xbfstate,T,I3,timer,next\n",  # Excel's "CSV UTF-8": a BOM before the first column
-    b"sep=;\nDescription;St;T;I3;Timer;Next-State\n",  # aliases, another delimiter, Excel's sep= line
-    b'"state"\t"T"\t"next"\n',  # quoted cells, tabs
-    "state,T,I3,timer,next\n".encode("utf-16"),  # Excel's "Unicode Text"
-])
+@pytest.mark.parametrize(
+    "header",
+    [
+        b"\xef\xbb\xbfstate,T,I3,timer,next\n",  # Excel's "CSV UTF-8": a BOM before the first column
+        b"sep=;\nDescription;St;T;I3;Timer;Next-State\n",  # aliases, another delimiter, Excel's sep= line
+        b'"state"\t"T"\t"next"\n',  # quoted cells, tabs
+        "state,T,I3,timer,next\n".encode("utf-16"),  # Excel's "Unicode Text"
+    ],
+)
 def test_every_spelling_of_a_table_header_is_protected(tmp_path: Path, header: bytes) -> None:
     """Reproduced: a table saved with a BOM before its state column was replaced without --force."""
     table = tmp_path / "mine.csv"
@@ -184,4 +188,3 @@ def test_a_file_that_cannot_be_made_is_named_as_the_user_named_it(args: list[str
     assert result.exit_code == 2, result.output
     assert result.output.startswith(f"{args[-1]}: error: cannot write or read"), result.output
     assert ".tmp" not in result.output and ".tablebot-" not in result.output
-

@@ -83,8 +83,12 @@ def test_every_writer_refuses_a_link(tmp_path: Path, victim: Path, dangling: boo
     target = tmp_path / "nowhere" if dangling else victim
     link = tmp_path / "out.jsonl"
     link.symlink_to(target)
-    writers = [lambda: files.write_text(link, "x"), lambda: files.PendingFile(link),
-               lambda: files.replacing(link).__enter__(), lambda: files.append(link).__enter__()]
+    writers = [
+        lambda: files.write_text(link, "x"),
+        lambda: files.PendingFile(link),
+        lambda: files.replacing(link).__enter__(),
+        lambda: files.append(link).__enter__(),
+    ]
     for write in writers:
         with pytest.raises(TableBotError, match="is a symbolic link"):
             write()

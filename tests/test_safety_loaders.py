@@ -91,8 +91,12 @@ def test_every_kind_of_input_has_a_size_limit(tmp_path: Path, monkeypatch: pytes
     monkeypatch.setattr("tablebot.formats.trace_lines.MAX_TRACE_BYTES", 1000)
     path = tmp_path / "big"
     path.write_text("#" * 1001)
-    calls = {"table": lambda: load_table(path), "robot": lambda: load_robot(path), "trace": lambda: read_trace(path),
-             "inputs": lambda: csvtext.read_text(path)}
+    calls = {
+        "table": lambda: load_table(path),
+        "robot": lambda: load_robot(path),
+        "trace": lambda: read_trace(path),
+        "inputs": lambda: csvtext.read_text(path),
+    }
     with pytest.raises(TableBotError) as info:
         calls[loader]()
     assert "larger than 1000 bytes" in info.value.diagnostics[0].message
@@ -116,6 +120,7 @@ def test_toml_that_is_not_toml_does_not_echo_its_contents(tmp_path: Path) -> Non
 
 
 # --- Windows-1252 tables (issue 15) ---------------------------------------------------------------------
+
 
 def test_cp1252_table_is_read_with_a_note(tmp_path: Path) -> None:
     text = f"{HEADER}\nZurück – à gauche €,1,1,,,3,3,10,1\n"
@@ -155,11 +160,15 @@ def test_robot_file_is_not_guessed(tmp_path: Path) -> None:
 
 # --- trace files ---------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize(("text", "message"), [
-    ('{"tick": 0}\n{"tick": 1\n', "line 2 is not JSON"),
-    ('{"tick": 0}\n[1, 2]\n', "line 2 is JSON but not an object"),
-    ("[" * 100000 + "]" * 100000 + "\n", "line 1 is not JSON"),
-])
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('{"tick": 0}\n{"tick": 1\n', "line 2 is not JSON"),
+        ('{"tick": 0}\n[1, 2]\n', "line 2 is JSON but not an object"),
+        ("[" * 100000 + "]" * 100000 + "\n", "line 1 is not JSON"),
+    ],
+)
 def test_bad_trace_files(tmp_path: Path, text: str, message: str) -> None:
     path = tmp_path / "t.jsonl"
     path.write_text(text)
@@ -168,6 +177,7 @@ def test_bad_trace_files(tmp_path: Path, text: str, message: str) -> None:
 
 
 # --- the last line of defence ----------------------------------------------------------------------------
+
 
 def _crash(*args: object, **kwargs: object) -> Never:
     raise RuntimeError("boom \x1b[31m")
@@ -191,6 +201,12 @@ def test_internal_error_is_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pyt
 
 def test_python_dash_m_runs_the_cli() -> None:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    done = subprocess.run([sys.executable, "-m", "tablebot.cli", "--help"], capture_output=True, text=True,
-                          env=env, check=False, cwd=Path(__file__).parent)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot.cli", "--help"],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        cwd=Path(__file__).parent,
+    )
     assert done.returncode == 0 and "check" in done.stdout

@@ -23,7 +23,12 @@ def errors(folder: Path) -> list[str]:
 def test_a_group_row_is_a_row_of_each_of_its_states_in_its_place(tmp_path: Path) -> None:
     table = load_table(robot(tmp_path) / "table.csv")
     assert [(r.state, r.line, r.as_written, r.group) for r in table.rows] == [
-        (1, 2, 0, "moving"), (2, 2, 0, "moving"), (1, 3, 1, ""), (2, 4, 2, ""), (3, 5, 3, "")]
+        (1, 2, 0, "moving"),
+        (2, 2, 0, "moving"),
+        (1, 3, 1, ""),
+        (2, 4, 2, ""),
+        (3, 5, 3, ""),
+    ]
     assert [r.index for r in table.rows] == [0, 1, 2, 3, 4]
 
 
@@ -52,7 +57,9 @@ def test_two_writers_of_one_output_is_an_error_at_the_second_naming_both(tmp_pat
 def test_a_cross_table_event_must_name_states_its_table_has(tmp_path: Path) -> None:
     found = errors(robot(tmp_path, lights=LIGHTS.replace('"drive=3"', '"drive=3,7,40..49"')))
     assert [f.split(": error: ")[1].splitlines()[0] for f in found] == [
-        "drive=3,7,40..49: table drive has no state 7", "drive=3,7,40..49: table drive has no state 40..49"]
+        "drive=3,7,40..49: table drive has no state 7",
+        "drive=3,7,40..49: table drive has no state 40..49",
+    ]
     assert all(":1:9:" in f for f in found)
     found = errors(robot(tmp_path, lights=LIGHTS.replace('"drive=3"', '"wheels=3"')))
     assert "lights.csv:1:9: error: 'wheels=3' names table 'wheels', which is not in [tables]" in found[0]

@@ -53,10 +53,21 @@ class FakeTxt:
     """``period_s`` paces exchange replies on a grid (0: answer at once, as ftrobopy_server does). A ``fault`` like
     ``("silent", 40)`` applies from the 40th ExchangeData on: silent, late, close, garbage, wrong_id."""
 
-    def __init__(self, script: Script = still, period_s: float = 0.01, device: str = "TXT-fake",
-                 version: int = 0x04060600, fault: tuple[str, int] | None = None, late_s: float = 0.2,
-                 i2c: bool = False, drift_s: float = 0.0, host: str = "127.0.0.1", port: int = 0,
-                 single_recv: bool = False, latency_s: float = 0.0) -> None:
+    def __init__(
+        self,
+        script: Script = still,
+        period_s: float = 0.01,
+        device: str = "TXT-fake",
+        version: int = 0x04060600,
+        fault: tuple[str, int] | None = None,
+        late_s: float = 0.2,
+        i2c: bool = False,
+        drift_s: float = 0.0,
+        host: str = "127.0.0.1",
+        port: int = 0,
+        single_recv: bool = False,
+        latency_s: float = 0.0,
+    ) -> None:
         self.script, self.period_s, self.device, self.version = script, period_s, device, version
         self.latency_s = latency_s  # before every reply: a controller far away (a bad Wi-Fi)
         self.single_recv = single_recv
@@ -180,10 +191,10 @@ class FakeTxt:
                 return None
             if not chunk:
                 return None
-            buffer[:len(chunk)] = chunk
+            buffer[: len(chunk)] = chunk
             (command,) = struct.unpack_from("<I", buffer)
             extra = COMMANDS[command][1] if command in COMMANDS else 0
-            return command, bytes(buffer[4:4 + extra]), len(chunk) == 4 + extra
+            return command, bytes(buffer[4 : 4 + extra]), len(chunk) == 4 + extra
         head = self._read(conn, 4)
         if head is None:
             return None
@@ -255,18 +266,31 @@ class FakeTxt:
             motors = list(config[4:8])
             inputs = [(config[8 + 4 * i], config[9 + 4 * i]) for i in range(8)]  # UNI_CONFIG: mode, digital, dummy[2]
             counters = [config[40 + 4 * i] for i in range(4)]  # CNT_CONFIG: mode, dummy[3]
-            return {"config_id": config_id, "extension": extension, "motors": motors, "inputs": inputs,
-                    "counters": counters}
+            return {
+                "config_id": config_id,
+                "extension": extension,
+                "motors": motors,
+                "inputs": inputs,
+                "counters": counters,
+            }
         if name == "ExchangeData":
             values = struct.unpack_from("<24h3H", body, 0)
-            return {"pwm": list(values[0:8]), "master": list(values[8:12]), "distance": list(values[12:16]),
-                    "motor_ids": list(values[16:20]), "counter_reset_ids": list(values[20:24])}
+            return {
+                "pwm": list(values[0:8]),
+                "master": list(values[8:12]),
+                "distance": list(values[12:16]),
+                "motor_ids": list(values[16:20]),
+                "counter_reset_ids": list(values[20:24]),
+            }
         return {}
 
     def _reply(self, name: str, response: int) -> bytes:
         if name == "QueryStatus":
-            return struct.pack("<I", response) + self.device.encode()[:15].ljust(16, b"\0") + struct.pack(
-                "<I", self.version)
+            return (
+                struct.pack("<I", response)
+                + self.device.encode()[:15].ljust(16, b"\0")
+                + struct.pack("<I", self.version)
+            )
         return struct.pack("<I", response)
 
     def _exchange_reply(self, number: int) -> bytes:

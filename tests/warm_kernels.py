@@ -40,8 +40,10 @@ def warm_loop() -> None:
     # half a minute on it (the readings are wrong, the argument types the same: only the cache matters)
     # (a robot starts through kernel.first_readings, compiled code that calls sense: both are skipped, since a
     # Python stand-in for sense alone cannot be called from compiled code)
-    with mock.patch.object(kernel, "sense", lambda *args: None), \
-            mock.patch.object(kernel, "first_readings", lambda *args: None):
+    with (
+        mock.patch.object(kernel, "sense", lambda *args: None),
+        mock.patch.object(kernel, "first_readings", lambda *args: None),
+    ):
         simulate(scene, 0.05, 1)
     run_loop(Engine(machine), SimRobot(scene, 1), clock=SimulatedClock(), sinks=[], ticks=3)
 
@@ -107,8 +109,7 @@ def warm_several() -> None:
     warm(make_plan(EXAMPLES / "bumberbot-lights", None, [], [], "0", None, 1.0, every_table=True).jobs()[0])
 
 
-PARTS = {"loop": warm_loop, "fleet": warm_fleet, "tick": warm_tick, "archive": warm_archive,
-         "several": warm_several}
+PARTS = {"loop": warm_loop, "fleet": warm_fleet, "tick": warm_tick, "archive": warm_archive, "several": warm_several}
 
 if __name__ == "__main__":
     for name in sys.argv[1:] or list(PARTS):

@@ -81,14 +81,17 @@ def read_bytes(path: Path, limit: int | None = None) -> bytes:
         raise fail(path, N_("cannot read: {reason}", reason=exc.strerror or exc), N_("check the file name")) from None
     overwrite.read(path)
     if len(data) > limit:
-        raise fail(path, N_("the file is larger than {size}, the most tablebot reads of such a file",
-                            size=size_text(limit)),
-                   N_("is this the right file? split it, or give a smaller one"))
+        raise fail(
+            path,
+            N_("the file is larger than {size}, the most tablebot reads of such a file", size=size_text(limit)),
+            N_("is this the right file? split it, or give a smaller one"),
+        )
     return data
 
 
-def read_text(path: Path, encoding_hint: str = CSV_ENCODING_HINT, limit: int | None = None,
-              spreadsheet: bool = True) -> str:
+def read_text(
+    path: Path, encoding_hint: str = CSV_ENCODING_HINT, limit: int | None = None, spreadsheet: bool = True
+) -> str:
     """Decode a file as UTF-8 (BOM allowed; UTF-16 with its BOM too).
 
     A ``spreadsheet`` file (CSV) that is not UTF-8 but is text, with no UTF-8 sequence in it at all, is
@@ -117,10 +120,20 @@ def _legacy(path: Path, data: bytes, first_bad: int) -> str:
     except UnicodeDecodeError:  # cp1252 leaves five bytes undefined; Latin-1 has them all
         text, name = data.decode("latin-1"), "Latin-1 (ISO-8859-1)"
     bad = _bad_bytes(path, data, "")[0]
-    notify(Diagnostic(str(path), bad.line, bad.column,
-                      N_("not UTF-8 (byte 0x{byte:02x}); read as {name}, as a Western European Excel saves 'CSV'",
-                         byte=data[first_bad], name=name),
-                      N_("if characters look wrong, {hint}", hint=CSV_ENCODING_HINT), "note"))
+    notify(
+        Diagnostic(
+            str(path),
+            bad.line,
+            bad.column,
+            N_(
+                "not UTF-8 (byte 0x{byte:02x}); read as {name}, as a Western European Excel saves 'CSV'",
+                byte=data[first_bad],
+                name=name,
+            ),
+            N_("if characters look wrong, {hint}", hint=CSV_ENCODING_HINT),
+            "note",
+        )
+    )
     return text
 
 
@@ -133,8 +146,11 @@ def _bad_bytes(path: Path, data: bytes, hint: str) -> list[Diagnostic]:
             raw.decode("utf-8")
         except UnicodeDecodeError as exc:
             column = len(raw[: exc.start].decode("utf-8")) + 1
-            found.append(Diagnostic(str(path), number, column,
-                                    N_("byte 0x{byte:02x} is not UTF-8 text", byte=raw[exc.start]), hint))
+            found.append(
+                Diagnostic(
+                    str(path), number, column, N_("byte 0x{byte:02x} is not UTF-8 text", byte=raw[exc.start]), hint
+                )
+            )
             if len(found) == MAX_BAD_LINES:
                 break
     return found
@@ -279,15 +295,23 @@ def _check_cell(cells: list[Cell], path: str) -> None:
 
 
 def _too_wide(path: str, line: int, column: int) -> TableBotError:
-    return fail(path, N_("this line has more than {most:,} cells, the most tablebot reads", most=MAX_COLUMNS),
-                N_("a table has a column per input and output, a few dozen at most: is this the right file?"),
-                line, column)
+    return fail(
+        path,
+        N_("this line has more than {most:,} cells, the most tablebot reads", most=MAX_COLUMNS),
+        N_("a table has a column per input and output, a few dozen at most: is this the right file?"),
+        line,
+        column,
+    )
 
 
 def _too_long(path: str, line: int, column: int) -> TableBotError:
-    return fail(path, N_("this cell is longer than {most:,} characters, the most tablebot reads",
-                         most=MAX_CELL_CHARS),
-                N_("shorten it (a description is a sentence or two); is this the right file?"), line, column)
+    return fail(
+        path,
+        N_("this cell is longer than {most:,} characters, the most tablebot reads", most=MAX_CELL_CHARS),
+        N_("shorten it (a description is a sentence or two); is this the right file?"),
+        line,
+        column,
+    )
 
 
 def _quoted(text: str, i: int, line: int, column: int, path: str, bounded: bool) -> tuple[str, int, int, int]:
@@ -305,27 +329,38 @@ def _quoted(text: str, i: int, line: int, column: int, path: str, bounded: bool)
             parts.append('"')
             j = k + 2
             continue
-        raw = text[start:k + 1]
+        raw = text[start : k + 1]
         newlines = raw.count("\n")
         column = len(raw) - raw.rfind("\n") if newlines else column + len(raw)
         return "".join(parts), k + 1, line + newlines, column
     if k >= 0:
         raise _too_long(path, line, column)
-    raise fail(path, N_("a quoted cell is never closed"), N_('add the closing " (write "" for a quote inside)'),
-               line, column)
+    raise fail(
+        path, N_("a quoted cell is never closed"), N_('add the closing " (write "" for a quote inside)'), line, column
+    )
 
 
 def cells_beyond(cells: Sequence[Cell], width: int, out: Collector) -> None:
     """Report the filled cells right of a ``width``-column header (a spreadsheet shows them; nothing reads them)."""
     for cell in cells[width:]:
         if cell.text.strip():
-            out.error(cell.line, cell.column, N_("cell {text!r} is beyond the last column", text=cell.text.strip()),
-                      N_("remove it or add a header for it; a cell holding a comma (0,5s in a comma-separated "
-                         "file) is written in quotes: \"0,5s\""))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("cell {text!r} is beyond the last column", text=cell.text.strip()),
+                N_(
+                    "remove it or add a header for it; a cell holding a comma (0,5s in a comma-separated "
+                    'file) is written in quotes: "0,5s"'
+                ),
+            )
 
 
 def headerless(cell: Cell, out: Collector) -> None:
     """Report a filled cell in a column whose header is blank."""
     if cell.text.strip():
-        out.error(cell.line, cell.column, N_("cell {text!r} is in a column with no header", text=cell.text.strip()),
-                  N_("name the column in the header, or clear the cell"))
+        out.error(
+            cell.line,
+            cell.column,
+            N_("cell {text!r} is in a column with no header", text=cell.text.strip()),
+            N_("name the column in the header, or clear the cell"),
+        )

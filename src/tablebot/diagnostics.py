@@ -81,8 +81,9 @@ class Collector:
             raise TableBotError(self.items)
 
 
-def fail(path: str | Path, message: str, hint: str = "", line: int | None = None,
-         column: int | None = None, detail: str = "") -> TableBotError:
+def fail(
+    path: str | Path, message: str, hint: str = "", line: int | None = None, column: int | None = None, detail: str = ""
+) -> TableBotError:
     """Build (not raise) an error with a single diagnostic (one line: a tool's output goes in ``detail``)."""
     return TableBotError([Diagnostic(str(path), line, column, message, hint, detail=detail)])
 

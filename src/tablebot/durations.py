@@ -44,21 +44,30 @@ def to_ticks(text: str, tick_ms: int) -> int:
     if match is None:
         raise DurationError(N_("{text!r} is not a duration", text=text.strip()), _forms(tick_ms))
     if len(match[1]) > MAX_NUMBER_CHARS:
-        raise DurationError(N_("a number of {count:,} characters is no duration", count=len(match[1])),
-                            N_("{forms}; a number has at most {most} characters", forms=_forms(tick_ms),
-                               most=MAX_NUMBER_CHARS))
+        raise DurationError(
+            N_("a number of {count:,} characters is no duration", count=len(match[1])),
+            N_("{forms}; a number has at most {most} characters", forms=_forms(tick_ms), most=MAX_NUMBER_CHARS),
+        )
     amount, unit = Fraction(match[1].replace(",", ".")), (match[2] or "ticks").lower()
     ticks = amount if unit.startswith("tick") else amount * MS_PER[unit] / tick_ms
     if ticks.denominator == 1:
         return int(ticks)
     shown = text.strip()
     if unit.startswith("tick"):
-        raise DurationError(N_("{text} is not a whole number of ticks", text=shown),
-                            N_("nearest: {below} or {above} (one tick is {tick} ms)", below=math.floor(ticks),
-                               above=math.ceil(ticks), tick=tick_ms))
+        raise DurationError(
+            N_("{text} is not a whole number of ticks", text=shown),
+            N_(
+                "nearest: {below} or {above} (one tick is {tick} ms)",
+                below=math.floor(ticks),
+                above=math.ceil(ticks),
+                tick=tick_ms,
+            ),
+        )
     below, above = (nearest(t, unit, tick_ms) for t in (math.floor(ticks), math.ceil(ticks)))
-    raise DurationError(N_("{text} is not a whole number of {tick} ms ticks", text=shown, tick=tick_ms),
-                        N_("nearest: {below} or {above}", below=below, above=above))
+    raise DurationError(
+        N_("{text} is not a whole number of {tick} ms ticks", text=shown, tick=tick_ms),
+        N_("nearest: {below} or {above}", below=below, above=above),
+    )
 
 
 def _forms(tick_ms: int) -> Message:

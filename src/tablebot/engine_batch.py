@@ -30,8 +30,15 @@ def available() -> bool:
 if njit is not None:
 
     @njit(nogil=True)
-    def batch(masks: np.ndarray, pulses: np.ndarray, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray,
-              program: tuple, columns: np.ndarray) -> None:
+    def batch(
+        masks: np.ndarray,
+        pulses: np.ndarray,
+        regs: np.ndarray,
+        outputs: np.ndarray,
+        counters: np.ndarray,
+        program: tuple,
+        columns: np.ndarray,
+    ) -> None:
         """Run one tick per mask, with ``pulses[i]`` per counter (or none when ``pulses`` has no rows), and
         write events, rows, states, timers per tick into ``columns``; ``regs``, ``outputs`` and
         ``counters`` are updated in place."""

@@ -25,6 +25,7 @@ _RICH_TAG_RE = re.compile(r"(\\*)\[(?=[a-z#/@][^[]*?\])")
 
 # --- C ----------------------------------------------------------------------------------------------
 
+
 def c_string(text: str) -> str:
     """A complete C string literal (with its quotes) holding ``text`` as UTF-8 bytes.
 
@@ -55,6 +56,7 @@ def c_comment(text: str) -> str:
 
 # --- XML, SVG, HTML ---------------------------------------------------------------------------------
 
+
 def xml_text(text: str) -> str:
     """Character data for XML (ROBO Pro .rpp, SVG): ``& < >`` as entities; characters XML 1.0 cannot
     hold at all (most controls, lone surrogates) become U+FFFD."""
@@ -73,8 +75,13 @@ def html_text(text: str) -> str:
     """Text for HTML element content or a quoted attribute value (both quotes escaped); controls other
     than tab and line ends become U+FFFD."""
     text = _CONTROL_RE.sub(REPLACEMENT, text)
-    return (text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
-            .replace('"', "&quot;").replace("'", "&#x27;"))
+    return (
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace('"', "&quot;")
+        .replace("'", "&#x27;")
+    )
 
 
 # --- diagrams ---------------------------------------------------------------------------------------
@@ -82,8 +89,23 @@ def html_text(text: str) -> str:
 #: Mermaid's state-diagram lexer ends a label at ':' ';' or a line end, takes '"' as a string end and
 #: '%%' as a comment, decodes '#name;' entities, renders '<b>' and backquoted markdown, and turns any
 #: line containing 'direction LR' into a direction statement; these stand-ins read the same to a person.
-_MERMAID = str.maketrans({":": "∶", ";": ",", '"': "'", "`": "'", "<": "‹", ">": "›", "&": "＆", "#": "＃",
-                          "%": "％", "{": "(", "}": ")", "|": "¦", "\\": "/"})
+_MERMAID = str.maketrans(
+    {
+        ":": "∶",
+        ";": ",",
+        '"': "'",
+        "`": "'",
+        "<": "‹",
+        ">": "›",
+        "&": "＆",
+        "#": "＃",
+        "%": "％",
+        "{": "(",
+        "}": ")",
+        "|": "¦",
+        "\\": "/",
+    }
+)
 _DOT_KEYWORDS = {"node", "edge", "graph", "digraph", "subgraph", "strict"}
 _MERMAID_DIRECTION_RE = re.compile(r"(?i)(direction)\s+(?=tb|bt|rl|lr|td)")
 
@@ -137,6 +159,7 @@ def markdown_code(text: str) -> str:
 
 
 # --- command lines, Python, terminal ---------------------------------------------------------------
+
 
 def shell_word(text: str) -> str:
     """One POSIX shell word that a shell reads back as ``text`` (for printing a command a person may

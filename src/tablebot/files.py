@@ -41,14 +41,19 @@ OS_HINTS = {
 def out_folder(path: Path, option: str) -> Path:
     """The folder an option names for writing into, created (with its parents) if missing."""
     if path.exists() and not path.is_dir():
-        raise fail(path, N_("{option} names a file, not a folder", option=option),
-                   N_("give {option} a folder (it is created if missing)", option=option))
+        raise fail(
+            path,
+            N_("{option} names a file, not a folder", option=option),
+            N_("give {option} a folder (it is created if missing)", option=option),
+        )
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise fail(exc.filename or path, N_("cannot create the folder for {option}: {reason}", option=option,
-                                            reason=exc.strerror),
-                   OS_HINTS.get(exc.errno or 0, N_("give {option} another folder", option=option))) from None
+        raise fail(
+            exc.filename or path,
+            N_("cannot create the folder for {option}: {reason}", option=option, reason=exc.strerror),
+            OS_HINTS.get(exc.errno or 0, N_("give {option} another folder", option=option)),
+        ) from None
     return path
 
 
@@ -56,18 +61,30 @@ def out_file(path: Path, option: str, make_folder: bool = False) -> Path:
     """The file an option names for writing (an existing file is replaced); its folder must exist,
     unless ``make_folder`` says to create it."""
     if path.is_dir():
-        raise fail(path, N_("{option} names a folder, not a file", option=option),
-                   N_("give {option} a file name", option=option))
+        raise fail(
+            path,
+            N_("{option} names a folder, not a file", option=option),
+            N_("give {option} a file name", option=option),
+        )
     if make_folder:
         if path.parent.exists() and not path.parent.is_dir():
-            raise fail(path.parent, N_("the folder of {option} {path} is a file", option=option, path=path),
-                       N_("give {option} a file in a folder", option=option))
+            raise fail(
+                path.parent,
+                N_("the folder of {option} {path} is a file", option=option, path=path),
+                N_("give {option} a file in a folder", option=option),
+            )
         out_folder(path.parent, option)
     elif not path.parent.is_dir():
-        problem = N_("the folder of {option} {path} is not a folder", option=option, path=path) \
-            if path.parent.exists() else N_("the folder of {option} {path} does not exist", option=option, path=path)
-        raise fail(path.parent, problem,
-                   N_("create the folder first, or give {option} a file in an existing folder", option=option))
+        problem = (
+            N_("the folder of {option} {path} is not a folder", option=option, path=path)
+            if path.parent.exists()
+            else N_("the folder of {option} {path} does not exist", option=option, path=path)
+        )
+        raise fail(
+            path.parent,
+            problem,
+            N_("create the folder first, or give {option} a file in an existing folder", option=option),
+        )
     return path
 
 
@@ -93,8 +110,7 @@ def _open_direct(path: Path, mode: str, encoding: str | None, newline: str | Non
     return open(path, mode, encoding=None if "b" in mode else encoding, newline=None if "b" in mode else newline)
 
 
-def _temporary(path: Path, where: Path, mode: str, encoding: str | None,
-               newline: str | None) -> tuple[IO, Path]:
+def _temporary(path: Path, where: Path, mode: str, encoding: str | None, newline: str | None) -> tuple[IO, Path]:
     """An open temporary file beside ``where`` (same folder, so the rename is atomic: ``where`` is ``path``,
     or its place in a set's staging folder) and its name; the command's guard first refuses a path it must
     not write over (see :mod:`tablebot.overwrite`)."""
@@ -111,8 +127,9 @@ def _temporary(path: Path, where: Path, mode: str, encoding: str | None,
 
 
 @contextmanager
-def atomic_write(path: str | Path, mode: str = "w", encoding: str | None = "utf-8",
-                 newline: str | None = None) -> Iterator[IO]:
+def atomic_write(
+    path: str | Path, mode: str = "w", encoding: str | None = "utf-8", newline: str | None = None
+) -> Iterator[IO]:
     """Open ``path`` for writing through a temporary file that replaces it only if the block completes.
 
     An OSError raised while writing names ``path`` (a full disk reports no file name of its own).

@@ -70,7 +70,6 @@ os.environ.setdefault(ENV, cache_dir())  # before numba's first import, which re
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 
-
 def _import_numba() -> ModuleType:
     """numba, imported without importing scipy, coverage or yaml, which it imports for what tablebot never uses.
 
@@ -86,8 +85,11 @@ def _import_numba() -> ModuleType:
         import numba
 
         return numba
-    held = [name for name in ("scipy", "coverage", "yaml") if name not in sys.modules
-            and not (name == "yaml" and os.path.isfile(".numba_config.yaml"))]
+    held = [
+        name
+        for name in ("scipy", "coverage", "yaml")
+        if name not in sys.modules and not (name == "yaml" and os.path.isfile(".numba_config.yaml"))
+    ]
     for name in held:
         sys.modules[name] = None  # type: ignore[assignment]  # `import NAME` raises ImportError meanwhile
     try:
@@ -123,8 +125,11 @@ def _load_cached_code_directly() -> None:
     from numba.core.runtime import nrt
 
     original = Cache.load_overload
-    if getattr(original, "direct", False) or not hasattr(Cache, "_load_overload") \
-            or not hasattr(nrt.rtsys, "initialize"):
+    if (
+        getattr(original, "direct", False)
+        or not hasattr(Cache, "_load_overload")
+        or not hasattr(nrt.rtsys, "initialize")
+    ):
         return  # done already, or another numba: keep its own path
 
     def load_overload(self: Any, sig: Any, target_context: Any) -> Any:
@@ -163,8 +168,13 @@ def say_compiling(what: str, *functions: Any) -> None:
     """One line on stderr when ``functions`` are about to be compiled, not loaded from the cache: the first
     run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
     if not compiled(*functions):
-        print(_("compiling {what} for this machine (first run only, usually 30-60 s; later runs start at once)…")
-              .format(what=localise(what)), file=sys.stderr, flush=True)
+        print(
+            _("compiling {what} for this machine (first run only, usually 30-60 s; later runs start at once)…").format(
+                what=localise(what)
+            ),
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 class Compiling:
@@ -178,11 +188,17 @@ class Compiling:
         from tablebot.talk import Talking
 
         self.active = not compiled(*functions)
-        self.talking = Talking(N_("compiling {what} for this machine", what=what),
-                               N_("first run only, usually 30-60 s; later runs start at once"),
-                               N_("compiled {what} in {{s}} s (kept in the cache: later runs start at once)",
-                                  what=what),
-                               every_s=every_s, stream=stream) if self.active else None
+        self.talking = (
+            Talking(
+                N_("compiling {what} for this machine", what=what),
+                N_("first run only, usually 30-60 s; later runs start at once"),
+                N_("compiled {what} in {{s}} s (kept in the cache: later runs start at once)", what=what),
+                every_s=every_s,
+                stream=stream,
+            )
+            if self.active
+            else None
+        )
 
     def done(self, finished: bool = True) -> None:
         """The compile is over: stop talking and, when it ``finished`` (not cut short by an error or Ctrl-C),
@@ -238,8 +254,11 @@ def cache_files() -> dict[str, dict[str, bytes]]:
         folder = _cache_folder(source)
         if not folder.is_dir():
             continue
-        found = {path.name: path.read_bytes() for path in folder.iterdir()
-                 if path.name.startswith(source.stem + ".") and path.suffix in (".nbi", ".nbc")}
+        found = {
+            path.name: path.read_bytes()
+            for path in folder.iterdir()
+            if path.name.startswith(source.stem + ".") and path.suffix in (".nbi", ".nbc")
+        }
         if found:
             out[source.relative_to(ROOT).as_posix()] = found
     return out

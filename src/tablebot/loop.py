@@ -39,9 +39,29 @@ if TYPE_CHECKING:
     import numpy as np
 
 #: The loop's own names, and the clocks, watchdog and pace of :mod:`tablebot.pacing` that a run is given.
-__all__ = ["BEHIND_WINDOW_S", "BLOCK_TICKS", "EXIT_CODES", "BlockIO", "Clock", "Lateness", "LinkLost", "Pace",
-           "Reading", "RealTimeClock", "RobotIO", "RunEnd", "RunInfo", "SimulatedClock", "Sink", "StopRequest",
-           "TickBlock", "Watchdog", "WatchdogTimeout", "exchange", "run"]
+__all__ = [
+    "BEHIND_WINDOW_S",
+    "BLOCK_TICKS",
+    "EXIT_CODES",
+    "BlockIO",
+    "Clock",
+    "Lateness",
+    "LinkLost",
+    "Pace",
+    "Reading",
+    "RealTimeClock",
+    "RobotIO",
+    "RunEnd",
+    "RunInfo",
+    "SimulatedClock",
+    "Sink",
+    "StopRequest",
+    "TickBlock",
+    "Watchdog",
+    "WatchdogTimeout",
+    "exchange",
+    "run",
+]
 
 
 @dataclass(frozen=True)
@@ -109,9 +129,18 @@ class TickBlock:
         fields = {**(reading.extra or {}), **(extra or {})}
         if isinstance(engine, RobotEngine):
             fields.update(engine.fields())
-        return TickBlock(engine.tick - 1, [reading.mask], [reading.pulses], [engine.event], [engine.row],
-                         [engine.state], [engine.timer], [engine.outputs], [tuple(engine.counters)],
-                         {k: [v] for k, v in fields.items()})
+        return TickBlock(
+            engine.tick - 1,
+            [reading.mask],
+            [reading.pulses],
+            [engine.event],
+            [engine.row],
+            [engine.state],
+            [engine.timer],
+            [engine.outputs],
+            [tuple(engine.counters)],
+            {k: [v] for k, v in fields.items()},
+        )
 
 
 @dataclass(frozen=True)
@@ -125,8 +154,16 @@ class RunInfo:
 
 
 #: Why a run ended, and the process exit code each reason gives.
-EXIT_CODES = {"done": 0, "stopped": 0, "error": 1, "link_lost": 3, "watchdog": 4, "behind": 5,
-              "interrupted": 130, "terminated": 143}
+EXIT_CODES = {
+    "done": 0,
+    "stopped": 0,
+    "error": 1,
+    "link_lost": 3,
+    "watchdog": 4,
+    "behind": 5,
+    "interrupted": 130,
+    "terminated": 143,
+}
 
 
 @dataclass(frozen=True)
@@ -163,9 +200,18 @@ class Sink(Protocol):
 BLOCK_TICKS = 4096  # ticks per block on the compiled path: few Python round trips, bounded memory
 
 
-def run(engine: Engine | RobotEngine, robot: RobotIO, *, clock: Clock | None = None, sinks: Sequence[Sink] = (),
-        ticks: int | None = None, watchdog: Watchdog | None = None, target: str = "",
-        behind_limit_s: float | None = None, block_ticks: int = BLOCK_TICKS) -> RunEnd:
+def run(
+    engine: Engine | RobotEngine,
+    robot: RobotIO,
+    *,
+    clock: Clock | None = None,
+    sinks: Sequence[Sink] = (),
+    ticks: int | None = None,
+    watchdog: Watchdog | None = None,
+    target: str = "",
+    behind_limit_s: float | None = None,
+    block_ticks: int = BLOCK_TICKS,
+) -> RunEnd:
     """Drive ``robot`` with ``engine`` for ``ticks`` ticks (None: until stopped) and return why it ended.
 
     The robot's outputs are stopped and its link closed on every way out; sinks always get ``end``.
@@ -243,8 +289,17 @@ def exchange(engine: Engine | RobotEngine, robot: RobotIO) -> Reading:
     return reading
 
 
-def _run_ticks(engine: Engine | RobotEngine, robot: RobotIO, clock: Clock, sinks: Sequence[Sink], ticks: int | None,
-               watchdog: Watchdog, late: Lateness, pace: Pace | None, stop: StopRequest) -> None:
+def _run_ticks(
+    engine: Engine | RobotEngine,
+    robot: RobotIO,
+    clock: Clock,
+    sinks: Sequence[Sink],
+    ticks: int | None,
+    watchdog: Watchdog,
+    late: Lateness,
+    pace: Pace | None,
+    stop: StopRequest,
+) -> None:
     """One tick at a time: the path of real robots and of the real-time rehearsal."""
     while ticks is None or engine.tick < ticks:
         stop.check()
@@ -255,14 +310,21 @@ def _run_ticks(engine: Engine | RobotEngine, robot: RobotIO, clock: Clock, sinks
         watchdog.arm()
         reading = exchange(engine, robot)
         watchdog.disarm()
-        block = TickBlock.of_tick(engine, reading, {"late_ms": round(1000 * delay, 3)} if not clock.free_running
-                                  else None)
+        block = TickBlock.of_tick(
+            engine, reading, {"late_ms": round(1000 * delay, 3)} if not clock.free_running else None
+        )
         for sink in sinks:
             sink.block(block)
 
 
-def _run_blocks(engine: Engine | RobotEngine, robot: BlockIO, sinks: Sequence[Sink], ticks: int | None,
-                block_ticks: int, stop: StopRequest) -> None:
+def _run_blocks(
+    engine: Engine | RobotEngine,
+    robot: BlockIO,
+    sinks: Sequence[Sink],
+    ticks: int | None,
+    block_ticks: int,
+    stop: StopRequest,
+) -> None:
     """Many ticks per call: the compiled simulator."""
     while ticks is None or engine.tick < ticks:
         stop.check()

@@ -140,9 +140,17 @@ class Machine:
         document's rule is part of it only where it can matter (a row that requires no event), so a table's
         signature, and the C engine's table hash made from it, is what it was before the rule was a choice."""
         rule = ("needs an event",) if self.needs_event and any(not r.mask for r in self.rows) else ()
-        return (self.states, self.table.events, self.timer_bit, self.counter_bits,
-                tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
-                self.initial_state, self.initial_timer, self.output_names, *rule)
+        return (
+            self.states,
+            self.table.events,
+            self.timer_bit,
+            self.counter_bits,
+            tuple((r.state, r.mask, r.next, r.timer, r.outputs, r.loads) for r in self.rows),
+            self.initial_state,
+            self.initial_timer,
+            self.output_names,
+            *rule,
+        )
 
 
 @dataclass(frozen=True)
@@ -167,9 +175,18 @@ class MachineArrays:
     @cached_property
     def program(self) -> Program:
         """The arrays as compiled loops take them (:class:`Program`)."""
-        return Program(input_mask=self.input_mask, timer_bit=self.timer_bit, lookup=self.lookup,
-                       next_state=self.next, timers=self.timer, outputs=self.outputs, keep=self.keep,
-                       loads=self.loads, load_set=self.load_set, counter_bits=self.counter_bits)
+        return Program(
+            input_mask=self.input_mask,
+            timer_bit=self.timer_bit,
+            lookup=self.lookup,
+            next_state=self.next,
+            timers=self.timer,
+            outputs=self.outputs,
+            keep=self.keep,
+            loads=self.loads,
+            load_set=self.load_set,
+            counter_bits=self.counter_bits,
+        )
 
     @staticmethod
     def of(machine: Machine) -> MachineArrays:
@@ -184,10 +201,12 @@ class MachineArrays:
             outputs=np.array(outputs, dtype=np.int64).reshape(len(rows), n_out),
             keep=np.array([[v is None for v in row.outputs] for row in rows], dtype=np.bool_).reshape(len(rows), n_out),
             loads=np.array(loads, dtype=np.int64).reshape(len(rows), n_counters),
-            load_set=np.array([[v is not None for v in row.loads] for row in rows],
-                              dtype=np.bool_).reshape(len(rows), n_counters),
+            load_set=np.array([[v is not None for v in row.loads] for row in rows], dtype=np.bool_).reshape(
+                len(rows), n_counters
+            ),
             counter_bits=np.array(machine.counter_bits, dtype=np.int64).reshape(n_counters),
-            input_mask=machine.input_mask, timer_bit=machine.timer_bit,
+            input_mask=machine.input_mask,
+            timer_bit=machine.timer_bit,
         )
 
 
@@ -197,20 +216,31 @@ def compile_table(table: Table) -> Machine:
     index = {state: i for i, state in enumerate(states)}
     robot = table.robot
     rows = tuple(
-        CompiledRow(index=row.index, state=index[row.state], mask=table.mask(row.events),
-                    next=index[row.next], timer=row.timer, outputs=(*row.motors, *row.lamps),
-                    loads=row.counters, keeps=None in (*row.motors, *row.lamps))
-        for row in table.rows)
+        CompiledRow(
+            index=row.index,
+            state=index[row.state],
+            mask=table.mask(row.events),
+            next=index[row.next],
+            timer=row.timer,
+            outputs=(*row.motors, *row.lamps),
+            loads=row.counters,
+            keeps=None in (*row.motors, *row.lamps),
+        )
+        for row in table.rows
+    )
     per_state: list[list[CompiledRow]] = [[] for _ in states]
     for row in rows:
         per_state[row.state].append(row)
     bit = table.bit
     return Machine(
-        table=table, states=states, rows=rows,
+        table=table,
+        states=states,
+        rows=rows,
         dispatch=tuple(Dispatch(r) for r in per_state),
         timer_bit=bit(TIMER_EVENT) if TIMER_EVENT in table.events else 0,
         counter_bits=tuple(bit(c) if c in table.events else 0 for c in robot.counter_names),
         input_bits={name: bit(name) for name in table.engine_inputs},  # inputs and cross-table events
-        initial_state=index[robot.initial_state], initial_timer=robot.initial_timer,
+        initial_state=index[robot.initial_state],
+        initial_timer=robot.initial_timer,
         needs_event=robot.match == MATCH_DOCUMENT,
     )

@@ -17,8 +17,18 @@ from typing import Any, Protocol
 from tablebot.i18n import N_, Message
 from tablebot.interrupts import Terminated
 
-__all__ = ["BEHIND_WINDOW_S", "Behind", "Clock", "Lateness", "Pace", "RealTimeClock", "SimulatedClock", "StopRequest",
-           "Watchdog", "WatchdogTimeout"]
+__all__ = [
+    "BEHIND_WINDOW_S",
+    "Behind",
+    "Clock",
+    "Lateness",
+    "Pace",
+    "RealTimeClock",
+    "SimulatedClock",
+    "StopRequest",
+    "Watchdog",
+    "WatchdogTimeout",
+]
 
 
 # --- clocks ---------------------------------------------------------------------------------------
@@ -61,8 +71,9 @@ class RealTimeClock:
 
     free_running = False
 
-    def __init__(self, tick_s: float, now: Callable[[], float] = time.monotonic,
-                 sleep: Callable[[float], None] = time.sleep) -> None:
+    def __init__(
+        self, tick_s: float, now: Callable[[], float] = time.monotonic, sleep: Callable[[float], None] = time.sleep
+    ) -> None:
         self.tick_s, self.now, self.sleep = tick_s, now, sleep
         self.origin, self.anchor, self.anchor_tick = 0.0, 0.0, 0
         self.behind_s = 0.0
@@ -108,8 +119,11 @@ class Watchdog:
     @contextmanager
     def installed(self, on_fire: Callable[[], None]) -> Iterator[None]:
         self._on_fire, self.fired = on_fire, False  # a watchdog may guard one run after another
-        self._use_signal = (self.deadline_s is not None and hasattr(signal, "setitimer")
-                            and threading.current_thread() is threading.main_thread())
+        self._use_signal = (
+            self.deadline_s is not None
+            and hasattr(signal, "setitimer")
+            and threading.current_thread() is threading.main_thread()
+        )
         previous = signal.signal(signal.SIGALRM, self._alarm) if self._use_signal else None
         try:
             yield
@@ -230,15 +244,28 @@ class Pace:
         longest = max(b[1] - a[1] for a, b in itertools.pairwise(self._ticks))
         limit = N_("limit {limit:g} s within any {window:g} s", limit=self.limit_s, window=self.window_s)
         if longest - self.tick_s >= fell / 2:  # mostly one gap: a stall, not a slow robot
-            return N_("the run fell {fell:.2f} s behind the wall clock ({limit}): one tick started {gap:.0f} ms after "
-                      "the one before it (the robot's link or this machine stalled), and the table's timers would "
-                      "stretch by as much", fell=fell, limit=limit, gap=1000 * longest)
+            return N_(
+                "the run fell {fell:.2f} s behind the wall clock ({limit}): one tick started {gap:.0f} ms after "
+                "the one before it (the robot's link or this machine stalled), and the table's timers would "
+                "stretch by as much",
+                fell=fell,
+                limit=limit,
+                gap=1000 * longest,
+            )
         ms, mean = 1000 * self.tick_s, 1000 * wall / ticks
-        return N_("the robot cannot keep the table's {ms:g} ms tick: over the last {wall:.1f} s its ticks took "
-                  "{mean:.1f} ms on average, so the table's timers would run {slow} slow ({fell:.2f} s behind "
-                  "the wall clock; {limit}). Give the robot file a longer tick_ms (write the table's timers as times, "
-                  "such as 500ms, so they keep their length) or use a faster link; --behind-limit 0 runs on with slow "
-                  "timers", ms=ms, wall=wall, mean=mean, slow=f"{100 * (mean / ms - 1):.0f} %", fell=fell, limit=limit)
+        return N_(
+            "the robot cannot keep the table's {ms:g} ms tick: over the last {wall:.1f} s its ticks took "
+            "{mean:.1f} ms on average, so the table's timers would run {slow} slow ({fell:.2f} s behind "
+            "the wall clock; {limit}). Give the robot file a longer tick_ms (write the table's timers as times, "
+            "such as 500ms, so they keep their length) or use a faster link; --behind-limit 0 runs on with slow "
+            "timers",
+            ms=ms,
+            wall=wall,
+            mean=mean,
+            slow=f"{100 * (mean / ms - 1):.0f} %",
+            fell=fell,
+            limit=limit,
+        )
 
 
 class Behind(Exception):

@@ -27,8 +27,24 @@ if TYPE_CHECKING:
     from tablebot.machine import Machine
 
 __all__ = [
-    "KINDS", "Backend", "ExportBackend", "ExportOptions", "Exported", "LinkOptions", "LiveBackend", "Opened",
-    "backends", "check_targets", "exporter", "exporters", "get", "live_for", "lives", "names", "refused", "register",
+    "KINDS",
+    "Backend",
+    "ExportBackend",
+    "ExportOptions",
+    "Exported",
+    "LinkOptions",
+    "LiveBackend",
+    "Opened",
+    "backends",
+    "check_targets",
+    "exporter",
+    "exporters",
+    "get",
+    "live_for",
+    "lives",
+    "names",
+    "refused",
+    "register",
 ]
 
 Kind = Literal["export", "board", "live"]

@@ -53,8 +53,9 @@ def record_several(robot: Several) -> dict[str, Any]:
     return line
 
 
-def replay_several(tables: RobotTables, ticks: Iterable[TickInput],
-                   order: Sequence[int] | None = None) -> Iterator[dict[str, Any]]:
+def replay_several(
+    tables: RobotTables, ticks: Iterable[TickInput], order: Sequence[int] | None = None
+) -> Iterator[dict[str, Any]]:
     """:func:`replay` for a robot of several tables, its inputs in the robot-wide layout (``order``: the order
     the tables are stepped in, which changes nothing)."""
     robot = Several(tables, order)

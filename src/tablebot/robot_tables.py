@@ -104,8 +104,12 @@ def parse_cross(text: str, robot: Robot) -> CrossEvent | str | None:
     name, _, what = (part.strip() for part in text.strip().partition("="))
     names = [spec.name for spec in specs]
     if name not in names:
-        return N_("{text!r} names table {name!r}, which is not in [tables] ({names})", text=text.strip(), name=name,
-                  names=tuple(names))
+        return N_(
+            "{text!r} names table {name!r}, which is not in [tables] ({names})",
+            text=text.strip(),
+            name=name,
+            names=tuple(names),
+        )
     states: list[StateId] = []
     ranges: list[tuple[int, int]] = []
     for part in (p.strip() for p in what.split(",")):
@@ -115,8 +119,12 @@ def parse_cross(text: str, robot: Robot) -> CrossEvent | str | None:
             continue
         state = _state(part)
         if state is None:
-            return N_("{part!r} in {text!r} is no state, list of states or range LOW..HIGH of table {name}", part=part,
-                      text=text.strip(), name=name)
+            return N_(
+                "{part!r} in {text!r} is no state, list of states or range LOW..HIGH of table {name}",
+                part=part,
+                text=text.strip(),
+                name=name,
+            )
         states.append(state)
     column = f"{name}={','.join(p.strip() for p in what.split(','))}"
     return CrossEvent(column, name, tuple(states), tuple(ranges))
@@ -131,6 +139,7 @@ def _state(text: str) -> StateId | None:
 
 # --- reading the robot file's sections ------------------------------------------------------------------
 
+
 def _read_tables(src: Source, data: Any, robot: Robot) -> tuple[TableSpec, ...]:
     """``[tables]``: NAME = { file = ..., initial_state = ..., initial_timer = ..., match = ... }."""
     if not isinstance(data, dict) or not data:
@@ -143,49 +152,80 @@ def _read_tables(src: Source, data: Any, robot: Robot) -> tuple[TableSpec, ...]:
         if spec is None:
             continue
         if spec.file in files:
-            src.key_error(("tables", None, name), N_("tables {first} and {second} both read {file}",
-                                                     first=files[spec.file], second=name, file=spec.file),
-                          N_("give each table its own file"))
+            src.key_error(
+                ("tables", None, name),
+                N_("tables {first} and {second} both read {file}", first=files[spec.file], second=name, file=spec.file),
+                N_("give each table its own file"),
+            )
         files.setdefault(spec.file, name)
         specs.append(spec)
     if len(data) > MAX_TABLES:
-        src.key_error(("", None, "tables"), N_("[tables] names {count} tables, more than {most}", count=len(data),
-                                               most=MAX_TABLES),
-                      N_("join tables that drive the same outputs; a robot runs at most eight at once"))
+        src.key_error(
+            ("", None, "tables"),
+            N_("[tables] names {count} tables, more than {most}", count=len(data), most=MAX_TABLES),
+            N_("join tables that drive the same outputs; a robot runs at most eight at once"),
+        )
     return tuple(specs)
 
 
 def _spec(src: Source, name: str, entry: Any, robot: Robot) -> TableSpec | None:
     where = ("tables", None, name)
     if not NAME_RE.match(name):
-        src.key_error(where, N_("bad table name {name!r}", name=name),
-                      N_("use a letter then letters/digits, like drive or lights"))
+        src.key_error(
+            where,
+            N_("bad table name {name!r}", name=name),
+            N_("use a letter then letters/digits, like drive or lights"),
+        )
         return None
     if not isinstance(entry, dict) or not isinstance(entry.get("file"), str) or not entry["file"].strip():
-        src.key_error(where, N_("table {name} must say which file it is", name=name),
-                      N_('write {name} = {{ file = "{name}.csv" }}', name=name))
+        src.key_error(
+            where,
+            N_("table {name} must say which file it is", name=name),
+            N_('write {name} = {{ file = "{name}.csv" }}', name=name),
+        )
         return None
     for key in entry:
         if key not in SPEC_KEYS:
-            src.key_error(where, N_("table {name}: unknown key {key!r}", name=name, key=key),
-                          N_("known keys: {keys}", keys=tuple(SPEC_KEYS)))
+            src.key_error(
+                where,
+                N_("table {name}: unknown key {key!r}", name=name, key=key),
+                N_("known keys: {keys}", keys=tuple(SPEC_KEYS)),
+            )
     state = entry.get("initial_state", src.data.get("initial_state"))
     initial = _state(str(state)) if isinstance(state, int | str) and not isinstance(state, bool) else None
     if initial is None:
-        src.key_error(where, N_("table {name}: initial_state {state!r} is not a state", name=name, state=state)
-                      if state is not None else
-                      N_("table {name} has no initial_state (and the robot file none above [tables])", name=name),
-                      N_("write {name} = {{ file = ..., initial_state = 1 }}; {hint}", name=name, hint=STATE_HINT))
+        src.key_error(
+            where,
+            N_("table {name}: initial_state {state!r} is not a state", name=name, state=state)
+            if state is not None
+            else N_("table {name} has no initial_state (and the robot file none above [tables])", name=name),
+            N_("write {name} = {{ file = ..., initial_state = 1 }}; {hint}", name=name, hint=STATE_HINT),
+        )
     timer = entry.get("initial_timer", robot.initial_timer)
     if not isinstance(timer, int) or isinstance(timer, bool) or not 0 <= timer <= MAX_TIMER:
-        src.key_error(where, N_("table {name}: initial_timer must be a whole number 0..{most}, not {timer!r}",
-                                name=name, most=MAX_TIMER, timer=timer),
-                      N_("the timer counts ticks; 0 means it has expired"))
+        src.key_error(
+            where,
+            N_(
+                "table {name}: initial_timer must be a whole number 0..{most}, not {timer!r}",
+                name=name,
+                most=MAX_TIMER,
+                timer=timer,
+            ),
+            N_("the timer counts ticks; 0 means it has expired"),
+        )
         timer = 0
     match = entry.get("match", robot.match)
     if match not in MATCHES:
-        src.key_error(where, N_("table {name}: match must be one of {matches}, not {match!r}", name=name,
-                                matches=tuple(MATCHES), match=match), MATCH_HINT)
+        src.key_error(
+            where,
+            N_(
+                "table {name}: match must be one of {matches}, not {match!r}",
+                name=name,
+                matches=tuple(MATCHES),
+                match=match,
+            ),
+            MATCH_HINT,
+        )
         match = robot.match
     return TableSpec(name, entry["file"], initial if initial is not None else 0, timer, cast(Match, match))
 
@@ -194,8 +234,11 @@ def _read_groups(src: Source, data: Any, robot: Robot) -> dict[str, tuple[StateI
     """``[groups]``: NAME = [state, state, ...]; a row whose state is NAME is a row of each of them."""
     del robot  # groups are checked against the tables when they are read
     if not isinstance(data, dict):
-        src.key_error(("", None, "groups"), N_("[groups] must be a table of NAME = [states]"),
-                      N_("for example: {example}", example="seeking = [1, 2, 11]"))
+        src.key_error(
+            ("", None, "groups"),
+            N_("[groups] must be a table of NAME = [states]"),
+            N_("for example: {example}", example="seeking = [1, 2, 11]"),
+        )
         return {}
     groups: dict[str, tuple[StateId, ...]] = {}
     for name, members in data.items():
@@ -203,18 +246,25 @@ def _read_groups(src: Source, data: Any, robot: Robot) -> dict[str, tuple[StateI
         if _state(name) is None or name.isdigit():
             src.key_error(where, N_("group name {name!r} must be a state name, not a number", name=name), STATE_HINT)
             continue
-        states = [_state(str(m)) if isinstance(m, int | str) and not isinstance(m, bool) else None
-                  for m in members] if isinstance(members, list) else [None]
+        states = (
+            [_state(str(m)) if isinstance(m, int | str) and not isinstance(m, bool) else None for m in members]
+            if isinstance(members, list)
+            else [None]
+        )
         if not states or None in states:
-            src.key_error(where, N_("group {name} must list its states, not {members!r}", name=name, members=members),
-                          N_("for example: {example}", example=name + " = [1, 2, 11]"))
+            src.key_error(
+                where,
+                N_("group {name} must list its states, not {members!r}", name=name, members=members),
+                N_("for example: {example}", example=name + " = [1, 2, 11]"),
+            )
             continue
         if len(set(states)) != len(states):
             src.key_error(where, N_("group {name} lists a state twice", name=name), N_("list each state once"))
             continue
         if name in states:
-            src.key_error(where, N_("group {name} lists itself", name=name),
-                          N_("a group lists states, not other groups"))
+            src.key_error(
+                where, N_("group {name} lists itself", name=name), N_("a group lists states, not other groups")
+            )
             continue
         groups[name] = tuple(s for s in states if s is not None)
     return groups

@@ -85,17 +85,38 @@ def register_kind(kind: SensorKind) -> SensorKind:
     return kind
 
 
-register_kind(SensorKind(
-    "line", ("line",), 1, "", "", N_("1 over a line"), ("line", 1.0, 0), "spot"))
-register_kind(SensorKind(
-    "distance", ("distance", "ultrasonic"), 2, "length", '"20 cm"', "", ("cm", 100.0, 1), "beam",
-    spread=("distance", "beam"), panel=Panel("distance (cm)\n-- on, ·· off", 100.0, False, 1),
-    modes={"ultrasonic": 100.0}, high=lambda params, light: params["distance"]["range"]))
-register_kind(SensorKind(
-    "light", ("phototransistor", "photoresistor", "light"), 3, "level", "1.5",
-    N_("1 is the level at which a phototransistor switches"), ("light", 1.0, 4), "cone",
-    spread=("light", "half_response"), panel=Panel("light\n(× threshold)", 1.0, True, 0),
-    high=lambda params, light: light))
+register_kind(SensorKind("line", ("line",), 1, "", "", N_("1 over a line"), ("line", 1.0, 0), "spot"))
+register_kind(
+    SensorKind(
+        "distance",
+        ("distance", "ultrasonic"),
+        2,
+        "length",
+        '"20 cm"',
+        "",
+        ("cm", 100.0, 1),
+        "beam",
+        spread=("distance", "beam"),
+        panel=Panel("distance (cm)\n-- on, ·· off", 100.0, False, 1),
+        modes={"ultrasonic": 100.0},
+        high=lambda params, light: params["distance"]["range"],
+    )
+)
+register_kind(
+    SensorKind(
+        "light",
+        ("phototransistor", "photoresistor", "light"),
+        3,
+        "level",
+        "1.5",
+        N_("1 is the level at which a phototransistor switches"),
+        ("light", 1.0, 4),
+        "cone",
+        spread=("light", "half_response"),
+        panel=Panel("light\n(× threshold)", 1.0, True, 0),
+        high=lambda params, light: light,
+    )
+)
 
 
 def word_kinds() -> dict[str, str]:
@@ -173,8 +194,11 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
     if section is None:
         return ()
     if not isinstance(section, dict):
-        src.key_error(("", None, "sensors"), N_("[sensors] must be a table of INPUT = { sensor = ... }"),
-                      N_('for example: I1 = { sensor = "line", at = [0.1, 0.01] }'))
+        src.key_error(
+            ("", None, "sensors"),
+            N_("[sensors] must be a table of INPUT = { sensor = ... }"),
+            N_('for example: I1 = { sensor = "line", at = [0.1, 0.01] }'),
+        )
         return ()
     found = [_sensor(src, name, value, inputs) for name, value in section.items()]
     return tuple(s for s in found if s is not None)
@@ -183,25 +207,44 @@ def parse_sensors(src: Source, inputs: dict[str, str]) -> tuple[Sensor, ...]:
 def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Sensor | None:
     where = ("sensors", None, name)
     if name not in inputs:
-        src.key_error(where, N_("[sensors] {name} is not an input of the robot", name=name),
-                      N_("add {name} to [inputs] first (its column in the table is the sensor's event)", name=name))
+        src.key_error(
+            where,
+            N_("[sensors] {name} is not an input of the robot", name=name),
+            N_("add {name} to [inputs] first (its column in the table is the sensor's event)", name=name),
+        )
         return None
     if not isinstance(value, dict):
-        src.key_error(where, N_('[sensors] {name} must be a table like {{ sensor = "distance", ... }}, not {value!r}',
-                                name=name, value=value),
-                      N_('for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}', name=name))
+        src.key_error(
+            where,
+            N_(
+                '[sensors] {name} must be a table like {{ sensor = "distance", ... }}, not {value!r}',
+                name=name,
+                value=value,
+            ),
+            N_('for example: {name} = {{ sensor = "distance", below = "20 cm", at = [0.12, 0] }}', name=name),
+        )
         return None
     unknown = sorted(set(value) - set(KEYS))
     if unknown:
-        src.key_error(where, NP_("[sensors] {name}: unknown key {keys}", "[sensors] {name}: unknown keys {keys}",
-                                 len(unknown), name=name, keys=", ".join(unknown)),
-                      N_("known keys: {known}", known=", ".join(KEYS)))
+        src.key_error(
+            where,
+            NP_(
+                "[sensors] {name}: unknown key {keys}",
+                "[sensors] {name}: unknown keys {keys}",
+                len(unknown),
+                name=name,
+                keys=", ".join(unknown),
+            ),
+            N_("known keys: {known}", known=", ".join(KEYS)),
+        )
     model = value.get("sensor")
     words = word_kinds()
     if model not in words:
-        src.key_error(where, N_("[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows", name=name,
-                                model=model),
-                      N_("write sensor = one of {kinds}", kinds=", ".join(repr(k) for k in words)))
+        src.key_error(
+            where,
+            N_("[sensors] {name}: sensor = {model!r} is not a sensor kind tablebot knows", name=name, model=model),
+            N_("write sensor = one of {kinds}", kinds=", ".join(repr(k) for k in words)),
+        )
         return None
     kind = SENSOR_KINDS[words[model]]
     at = _at(src, name, value.get("at"))
@@ -218,23 +261,38 @@ def _sensor(src: Source, name: str, value: Any, inputs: dict[str, str]) -> Senso
     return Sensor(name, model, at, angle, direction, level, hysteresis[0], unit)
 
 
-def _unthresholded(src: Source, name: str, model: str, kind: SensorKind, value: dict[str, Any],
-                   at: tuple[float, float] | None, angle: float | None) -> Sensor | None:
+def _unthresholded(
+    src: Source,
+    name: str,
+    model: str,
+    kind: SensorKind,
+    value: dict[str, Any],
+    at: tuple[float, float] | None,
+    angle: float | None,
+) -> Sensor | None:
     """A kind without a threshold (a floor sensor reads the floor straight below it): no direction, no angle."""
     extra = [k for k in ("below", "above", "hysteresis", "angle") if k in value]
     if extra:
-        src.key_error(("sensors", None, name), N_("[sensors] {name}: a {kind} sensor has no {keys}", name=name,
-                                                  kind=kind.name, keys=", ".join(extra)),
-                      N_("it reads {reads} and 0 elsewhere; give only sensor and at", reads=kind.reads))
+        src.key_error(
+            ("sensors", None, name),
+            N_("[sensors] {name}: a {kind} sensor has no {keys}", name=name, kind=kind.name, keys=", ".join(extra)),
+            N_("it reads {reads} and 0 elsewhere; give only sensor and at", reads=kind.reads),
+        )
     return None if at is None or angle is None or extra else Sensor(name, model, at)
 
 
 def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
     ok = isinstance(value, list) and len(value) == 2 and all(is_number(v) and abs(v) <= MAX_OFFSET for v in value)
     if not ok:
-        src.key_error(("sensors", None, name), N_("[sensors] {name}: at must be [forward, left] in metres from the "
-                                                  "axle centre, not {value!r}", name=name, value=value),
-                      N_("for example: at = [0.12, 0] (each within ±{most} m)", most=str(MAX_OFFSET)))
+        src.key_error(
+            ("sensors", None, name),
+            N_(
+                "[sensors] {name}: at must be [forward, left] in metres from the axle centre, not {value!r}",
+                name=name,
+                value=value,
+            ),
+            N_("for example: at = [0.12, 0] (each within ±{most} m)", most=str(MAX_OFFSET)),
+        )
         return None
     return float(value[0]), float(value[1])
 
@@ -242,25 +300,32 @@ def _at(src: Source, name: str, value: Any) -> tuple[float, float] | None:
 def _angle(src: Source, name: str, value: dict[str, Any]) -> float | None:
     angle = value.get("angle", 0.0)
     if not is_number(angle) or not -180 <= angle <= 180:
-        src.key_error(("sensors", None, name), N_("[sensors] {name}: angle must be degrees from -180 to 180, not "
-                                                  "{angle!r}", name=name, angle=angle),
-                      N_("0 points straight ahead, positive to the left"))
+        src.key_error(
+            ("sensors", None, name),
+            N_("[sensors] {name}: angle must be degrees from -180 to 180, not {angle!r}", name=name, angle=angle),
+            N_("0 points straight ahead, positive to the left"),
+        )
         return None
     return float(angle)
 
 
-def _threshold(src: Source, name: str, model: str, kind: SensorKind,
-               value: dict[str, Any]) -> tuple[str, float, str] | None:
+def _threshold(
+    src: Source, name: str, model: str, kind: SensorKind, value: dict[str, Any]
+) -> tuple[str, float, str] | None:
     """(below|above, threshold in metres or light units, unit written)."""
     given = [k for k in ("below", "above") if k in value]
     if len(given) != 1:
         example = kind.example
-        src.key_error(("sensors", None, name),
-                      N_("[sensors] {name}: a {model} sensor needs one of below or above, not both", name=name,
-                         model=model) if given else
-                      N_("[sensors] {name}: a {model} sensor needs a threshold", name=name, model=model),
-                      N_("write below = {example} (the event is 1 while the reading is below it) or above = {example}",
-                         example=example))
+        src.key_error(
+            ("sensors", None, name),
+            N_("[sensors] {name}: a {model} sensor needs one of below or above, not both", name=name, model=model)
+            if given
+            else N_("[sensors] {name}: a {model} sensor needs a threshold", name=name, model=model),
+            N_(
+                "write below = {example} (the event is 1 while the reading is below it) or above = {example}",
+                example=example,
+            ),
+        )
         return None
     direction = given[0]
     amount = _amount(src, name, direction, value[direction], kind)
@@ -277,20 +342,33 @@ def _amount(src: Source, name: str, key: str, raw: Any, kind: SensorKind) -> tup
             return 0.0, "cm"
         match = LENGTH_RE.match(raw) if isinstance(raw, str) else None
         if match is None:
-            src.key_error(where, N_("[sensors] {name}: {key} must be a length with its unit, not {raw!r}", name=name,
-                                    key=key, raw=raw),
-                          N_('write it in quotes with mm, cm or m: {key} = "20 cm"', key=key))
+            src.key_error(
+                where,
+                N_("[sensors] {name}: {key} must be a length with its unit, not {raw!r}", name=name, key=key, raw=raw),
+                N_('write it in quotes with mm, cm or m: {key} = "20 cm"', key=key),
+            )
             return None
         metres, unit = float(match[1]) * LENGTH_UNITS[match[2]], match[2]
     else:
         if not is_number(raw):
-            src.key_error(where, N_("[sensors] {name}: {key} must be a {kind} level (a number), not {raw!r}",
-                                    name=name, key=key, kind=kind.name, raw=raw),
-                          N_("{reads}: {key} = {example}", reads=kind.reads, key=key, example=kind.example))
+            src.key_error(
+                where,
+                N_(
+                    "[sensors] {name}: {key} must be a {kind} level (a number), not {raw!r}",
+                    name=name,
+                    key=key,
+                    kind=kind.name,
+                    raw=raw,
+                ),
+                N_("{reads}: {key} = {example}", reads=kind.reads, key=key, example=kind.example),
+            )
             return None
         metres = float(raw)
     if metres < 0 or not math.isfinite(metres):
-        src.key_error(where, N_("[sensors] {name}: {key} must not be negative", name=name, key=key),
-                      N_("write {key} as 0 or more", key=key))
+        src.key_error(
+            where,
+            N_("[sensors] {name}: {key} must not be negative", name=name, key=key),
+            N_("write {key} as 0 or more", key=key),
+        )
         return None
     return metres, unit

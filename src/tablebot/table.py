@@ -24,8 +24,13 @@ MAX_LAMP = 8
 TIMER_EVENT = "T"
 #: The fixed columns of a table, and the other spellings the reader takes for them.
 FIXED = ("description", "state", "timer", "next")
-ALIASES = {"desc": "description", "next_state": "next", "timer_value": "timer", "st": "state",
-           **GERMAN_FIXED}  # Beschreibung, Zustand, Folgezustand: a German table reads the same in any language
+ALIASES = {
+    "desc": "description",
+    "next_state": "next",
+    "timer_value": "timer",
+    "st": "state",
+    **GERMAN_FIXED,
+}  # Beschreibung, Zustand, Folgezustand: a German table reads the same in any language
 
 
 def from_direction_speed(direction: int, speed: int) -> int | None:
@@ -188,21 +193,30 @@ def _quiet_tick(table: Table, state: StateId) -> str:
     robot = table.robot
     if TIMER_EVENT not in table.events:
         if set(robot.counter_names) & set(table.events):
-            return N_("the table has no T column, so a tick on which no input reads 1 and no counter is at 0 has no "
-                      "event")
+            return N_(
+                "the table has no T column, so a tick on which no input reads 1 and no counter is at 0 has no event"
+            )
         return N_("the table has no T column, so a tick on which no input reads 1 has no event")
     if state == robot.initial_state and robot.initial_timer > 0:
-        return N_("the robot starts in it with timer {timer}, and T is absent until that runs out",
-                  timer=robot.initial_timer)
+        return N_(
+            "the robot starts in it with timer {timer}, and T is absent until that runs out", timer=robot.initial_timer
+        )
     slow = [r for r in table.rows if r.next == state and r.timer > 1]
     if not slow:
         return ""
     if len(slow) > 1:
-        return NP_("line {line} leads into it with timer {timer} (and {n} more row), and T is absent until that runs "
-                   "out", "line {line} leads into it with timer {timer} (and {n} more rows), and T is absent until "
-                   "that runs out", len(slow) - 1, line=slow[0].line, timer=slow[0].timer)
-    return N_("line {line} leads into it with timer {timer}, and T is absent until that runs out", line=slow[0].line,
-              timer=slow[0].timer)
+        return NP_(
+            "line {line} leads into it with timer {timer} (and {n} more row), and T is absent until that runs out",
+            "line {line} leads into it with timer {timer} (and {n} more rows), and T is absent until that runs out",
+            len(slow) - 1,
+            line=slow[0].line,
+            timer=slow[0].timer,
+        )
+    return N_(
+        "line {line} leads into it with timer {timer}, and T is absent until that runs out",
+        line=slow[0].line,
+        timer=slow[0].timer,
+    )
 
 
 #: A state that is used but has no rows: (the row whose next state it is, or None when the robot
@@ -214,20 +228,40 @@ def missing_states(rows: Sequence[Row], robot: Robot) -> list[MissingState]:
     """Every next state, the initial state and every named state must have rows of its own."""
     with_rows = {row.state for row in rows}
     found: list[MissingState] = [
-        (row, ("", "next"), N_("next state {state!r} is unknown: no row has state {state!r}", state=row.next),
-         N_("add rows for state {state!r} or fix the next state", state=row.next))
-        for row in {r.line: r for r in rows if r.next not in with_rows}.values()]  # a group row once
+        (
+            row,
+            ("", "next"),
+            N_("next state {state!r} is unknown: no row has state {state!r}", state=row.next),
+            N_("add rows for state {state!r} or fix the next state", state=row.next),
+        )
+        for row in {r.line: r for r in rows if r.next not in with_rows}.values()
+    ]  # a group row once
     if robot.initial_state not in with_rows:
-        found.append((None, ("", "initial_state"),
-                      N_("initial state {state!r} (from {source} robot {robot}) has no rows",
-                         state=robot.initial_state, source=robot.source, robot=robot.name),
-                      N_("add rows for it or change initial_state in the robot file")))
+        found.append(
+            (
+                None,
+                ("", "initial_state"),
+                N_(
+                    "initial state {state!r} (from {source} robot {robot}) has no rows",
+                    state=robot.initial_state,
+                    source=robot.source,
+                    robot=robot.name,
+                ),
+                N_("add rows for it or change initial_state in the robot file"),
+            )
+        )
     if tables_of(robot):  # [states] names the states of all the robot's tables (tablebot.tables checks them)
         return found
-    found += [(None, ("states", str(state)),
-               N_("state {state!r} is named in {source} but has no rows", state=state, source=robot.source),
-               N_("add rows for it or remove it from [states]"))
-              for state in robot.state_names if state not in with_rows]
+    found += [
+        (
+            None,
+            ("states", str(state)),
+            N_("state {state!r} is named in {source} but has no rows", state=state, source=robot.source),
+            N_("add rows for it or remove it from [states]"),
+        )
+        for state in robot.state_names
+        if state not in with_rows
+    ]
     return found
 
 
@@ -250,8 +284,7 @@ def is_table_header(cells: Iterable[str]) -> bool:
 GroupProblem = tuple[Row, str, str, str]
 
 
-def expand_groups(rows: Sequence[Row],
-                  groups: dict[str, tuple[StateId, ...]]) -> tuple[list[Row], list[GroupProblem]]:
+def expand_groups(rows: Sequence[Row], groups: dict[str, tuple[StateId, ...]]) -> tuple[list[Row], list[GroupProblem]]:
     """The rows as the engine runs them: a row whose state is a group (``[groups]``) becomes one row per state of
     the group, in its place, so that a state's candidate rows are its own and its groups', in table order.
     Indices are renumbered; each row keeps its line and its index as written (:attr:`Row.as_written`). A group
@@ -260,8 +293,15 @@ def expand_groups(rows: Sequence[Row],
     if not used:
         return list(rows), []
     problems: list[GroupProblem] = [
-        (row, "next", f"next state {row.next!r} is a group ([groups]): a robot is in one state at a time",
-         "go to one of its states") for row in rows if row.next in groups]
+        (
+            row,
+            "next",
+            f"next state {row.next!r} is a group ([groups]): a robot is in one state at a time",
+            "go to one of its states",
+        )
+        for row in rows
+        if row.next in groups
+    ]
     expanded: list[Row] = []
     for row in rows:
         states = groups.get(row.state, (row.state,)) if row.state in used else (row.state,)

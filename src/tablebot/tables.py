@@ -137,13 +137,26 @@ def _cross_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
         for event in table.cross.values():
             known = states[event.table]
             missing = [s for s in event.states if s not in known]
-            empty = [f"{low}..{high}" for low, high in event.ranges
-                     if not any(isinstance(s, int) and low <= s <= high for s in known)]
+            empty = [
+                f"{low}..{high}"
+                for low, high in event.ranges
+                if not any(isinstance(s, int) and low <= s <= high for s in known)
+            ]
             for what in (*(repr(s) for s in missing), *empty):
-                found.append(Diagnostic(table.path, event.line, event.at,
-                                        N_("{column}: table {table} has no state {state}", column=event.column,
-                                           table=event.table, state=what),
-                                        N_("its states: {states}", states=tuple(map(str, known)))))
+                found.append(
+                    Diagnostic(
+                        table.path,
+                        event.line,
+                        event.at,
+                        N_(
+                            "{column}: table {table} has no state {state}",
+                            column=event.column,
+                            table=event.table,
+                            state=what,
+                        ),
+                        N_("its states: {states}", states=tuple(map(str, known))),
+                    )
+                )
     return found
 
 
@@ -156,12 +169,25 @@ def _writer_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
             owner = first.setdefault(output, table)
             if owner is not table:
                 at = owner.writes[output]
-                found.append(Diagnostic(
-                    table.path, line, column,
-                    N_("{output} is written by two tables, {first} ({place}) and {second}", output=output,
-                       first=owner.name, place=":".join(map(str, (owner.path, *at))), second=table.name),
-                    N_("each motor, lamp and counter load has one writer: remove the {output} column from one table",
-                       output=output)))
+                found.append(
+                    Diagnostic(
+                        table.path,
+                        line,
+                        column,
+                        N_(
+                            "{output} is written by two tables, {first} ({place}) and {second}",
+                            output=output,
+                            first=owner.name,
+                            place=":".join(map(str, (owner.path, *at))),
+                            second=table.name,
+                        ),
+                        N_(
+                            "each motor, lamp and counter load has one writer: "
+                            "remove the {output} column from one table",
+                            output=output,
+                        ),
+                    )
+                )
     return found
 
 
@@ -169,8 +195,14 @@ def _named_problems(tables: tuple[Table, ...]) -> list[Diagnostic]:
     """A state ``[states]`` names that no table has rows for (the names are the robot's, for all its tables)."""
     robot = tables[0].robot
     with_rows = {row.state for t in tables for row in t.rows}
-    return [Diagnostic(robot.source, robot.line("states", str(state)), 1,
-                       N_("state {state!r} is named in {file} but no table has rows for it", state=state,
-                          file=robot.source),
-                       N_("add rows for it or remove it from [states]"))
-            for state in robot.state_names if state not in with_rows]
+    return [
+        Diagnostic(
+            robot.source,
+            robot.line("states", str(state)),
+            1,
+            N_("state {state!r} is named in {file} but no table has rows for it", state=state, file=robot.source),
+            N_("add rows for it or remove it from [states]"),
+        )
+        for state in robot.state_names
+        if state not in with_rows
+    ]

@@ -19,16 +19,25 @@ class Talking:
     first says nothing (a step that ends sooner needs no word). :meth:`done` stops it and, if it spoke and
     ``finished``, says ``done_text`` with the time taken (``{s}``)."""
 
-    def __init__(self, what: str, why: str = "", done_text: str = "", *, every_s: float = 10.0,
-                 delay_s: float = 0.0, stream: Any = None) -> None:
+    def __init__(
+        self,
+        what: str,
+        why: str = "",
+        done_text: str = "",
+        *,
+        every_s: float = 10.0,
+        delay_s: float = 0.0,
+        stream: Any = None,
+    ) -> None:
         self.what, self.why, self.done_text, self.every_s = what, why, done_text, every_s
         self.stream = stream if stream is not None else sys.stderr
         self.live = bool(getattr(self.stream, "isatty", lambda: False)())
         self.started = time.monotonic()
         self.spoke = False
         self._stop = threading.Event()
-        self._thread: threading.Thread | None = threading.Thread(target=self._talk, args=(delay_s,),
-                                                                 name="talking", daemon=True)
+        self._thread: threading.Thread | None = threading.Thread(
+            target=self._talk, args=(delay_s,), name="talking", daemon=True
+        )
         self._thread.start()
 
     def elapsed(self) -> float:

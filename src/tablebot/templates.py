@@ -23,13 +23,22 @@ EXAMPLES = ("bumberbot", "line-follower", "obstacle-avoider")
 TEMPLATES = (*EXAMPLES, "empty")
 FILES = ("table.csv", "robot.toml", "arena.toml", "properties.toml")
 #: What each file is for, shown after ``tablebot new``.
-PURPOSE = {"table.csv": N_("the behaviour: one row per transition (open it in a spreadsheet)"),
-           "robot.toml": N_("its inputs, motors, sensors and state names"),
-           "arena.toml": N_("the world `tablebot sim` drives it in"),
-           "properties.toml": N_("claims about every run that `tablebot check` proves or refutes")}
+PURPOSE = {
+    "table.csv": N_("the behaviour: one row per transition (open it in a spreadsheet)"),
+    "robot.toml": N_("its inputs, motors, sensors and state names"),
+    "arena.toml": N_("the world `tablebot sim` drives it in"),
+    "properties.toml": N_("claims about every run that `tablebot check` proves or refutes"),
+}
 #: The simulator's default parts (tablebot.sim.model.params.WIRING): a renamed BumberBot keeps them wired.
-BUMBERBOT_ROLES = {"right_motor": "M1", "left_motor": "M2", "front_right": "I3", "front_left": "I4",
-                   "rear": "I5", "light_right": "I7", "light_left": "I8"}
+BUMBERBOT_ROLES = {
+    "right_motor": "M1",
+    "left_motor": "M2",
+    "front_right": "I3",
+    "front_left": "I4",
+    "rear": "I5",
+    "light_right": "I7",
+    "light_left": "I8",
+}
 Named = tuple[str, str]  # (name, label; "" keeps the template's label)
 HARDWARE_SECTIONS = ("txt", "robotx", "roboif", "board")  # robot-file sections that wire the table's names to terminals
 
@@ -51,12 +60,20 @@ def parse_names(values: list[str], option: str) -> list[Named]:
                 continue
             name, _, label = (s.strip() for s in part.partition("="))
             if not NAME_RE.match(name) or name in RESERVED_NAMES or name.lower() in RESERVED_LOWER:
-                raise fail(option, N_("{name!r} cannot name a column", name=name),
-                           N_("use a letter then letters or digits, like I1 or M2 (not T, state, timer or next); add "
-                              "a label with NAME=label"))
+                raise fail(
+                    option,
+                    N_("{name!r} cannot name a column", name=name),
+                    N_(
+                        "use a letter then letters or digits, like I1 or M2 (not T, state, timer or next); add "
+                        "a label with NAME=label"
+                    ),
+                )
             if '"' in label or "\\" in label:
-                raise fail(option, N_("the label of {name} may not hold quotes or backslashes", name=name),
-                           N_("write it without them"))
+                raise fail(
+                    option,
+                    N_("the label of {name} may not hold quotes or backslashes", name=name),
+                    N_("write it without them"),
+                )
             names.append((name, label))
     seen = [n for n, _ in names]
     twice = sorted({n for n in seen if seen.count(n) > 1})
@@ -68,8 +85,11 @@ def parse_names(values: list[str], option: str) -> list[Named]:
 def make(template: str, name: str, inputs: list[Named], motors: list[Named]) -> Template:
     """The files of a new robot called ``name`` from ``template`` (see TEMPLATES)."""
     if template == "empty":
-        return empty(name, inputs or [("I1", "input 1"), ("I2", "input 2")],
-                     motors or [("M1", "right motor"), ("M2", "left motor")])
+        return empty(
+            name,
+            inputs or [("I1", "input 1"), ("I2", "input 2")],
+            motors or [("M1", "right motor"), ("M2", "left motor")],
+        )
     folder = example_path(template)
     files = {f: (folder / f).read_text(encoding="utf-8") for f in FILES}
     return renamed(template, files, inputs, motors)
@@ -87,23 +107,40 @@ def renamed(template: str, files: dict[str, str], inputs: list[Named], motors: l
         if not given:
             continue
         if len(given) != len(old):
-            raise fail(option, N_("the {template} template has {n} {section} ({names}); {option} gives {given}",
-                                  template=template, n=len(old), section=section, names=", ".join(old), option=option,
-                                  given=len(given)),
-                       N_("give {n} names, in that order, or leave {option} out", n=len(old), option=option))
+            raise fail(
+                option,
+                N_(
+                    "the {template} template has {n} {section} ({names}); {option} gives {given}",
+                    template=template,
+                    n=len(old),
+                    section=section,
+                    names=", ".join(old),
+                    option=option,
+                    given=len(given),
+                ),
+                N_("give {n} names, in that order, or leave {option} out", n=len(old), option=option),
+            )
         mapping.update({o: n for o, (n, _) in zip(old, given, strict=True)})
         labels.update({n: label for n, label in given if label})
     if not mapping and not labels:
         return Template(files)
-    out = {"robot.toml": _rename_robot(files["robot.toml"], mapping),
-           "properties.toml": _rename_words(files["properties.toml"], mapping),
-           "table.csv": _rename_header(files["table.csv"], mapping), "arena.toml": files["arena.toml"]}
+    out = {
+        "robot.toml": _rename_robot(files["robot.toml"], mapping),
+        "properties.toml": _rename_words(files["properties.toml"], mapping),
+        "table.csv": _rename_header(files["table.csv"], mapping),
+        "arena.toml": files["arena.toml"],
+    }
     out["robot.toml"] = _relabel(out["robot.toml"], labels)
-    wiring = {role: mapping[name] for role, name in BUMBERBOT_ROLES.items()
-              if name in mapping and mapping[name] != name and name not in _declared(robot)}
+    wiring = {
+        role: mapping[name]
+        for role, name in BUMBERBOT_ROLES.items()
+        if name in mapping and mapping[name] != name and name not in _declared(robot)
+    }
     if wiring:
-        out["robot.toml"] += ("\n# The simulator's bumpers, phototransistors and drive motors, under their new names.\n"
-                              "[sim.wiring]\n" + "".join(f'{role} = "{new}"\n' for role, new in wiring.items()))
+        out["robot.toml"] += (
+            "\n# The simulator's bumpers, phototransistors and drive motors, under their new names.\n"
+            "[sim.wiring]\n" + "".join(f'{role} = "{new}"\n' for role, new in wiring.items())
+        )
     return Template(out)
 
 
@@ -114,8 +151,9 @@ def _declared(robot: dict) -> set[str]:
 
 def _word_re(mapping: dict[str, str]) -> re.Pattern[str]:
     # a name stands alone or before a column suffix (M1_dir): never inside a longer name (I13, XM1)
-    return re.compile(r"(?<![A-Za-z0-9_])(" + "|".join(map(re.escape, sorted(mapping, key=len, reverse=True)))
-                      + r")(?![A-Za-z0-9])")
+    return re.compile(
+        r"(?<![A-Za-z0-9_])(" + "|".join(map(re.escape, sorted(mapping, key=len, reverse=True))) + r")(?![A-Za-z0-9])"
+    )
 
 
 def _rename_words(text: str, mapping: dict[str, str]) -> str:
@@ -138,7 +176,7 @@ def _rename_robot(text: str, mapping: dict[str, str]) -> str:
         if section in HARDWARE_SECTIONS and not header:
             key = re.match(r"^(\s*)([A-Za-z][A-Za-z0-9]*)(\s*=)", line)
             if key and key[2] in mapping:
-                line = f"{key[1]}{mapping[key[2]]}{key[3]}{line[key.end():]}"
+                line = f"{key[1]}{mapping[key[2]]}{key[3]}{line[key.end() :]}"
             out.append(line)
         else:
             out.append(words.sub(lambda m: mapping[m[1]], line))
@@ -159,23 +197,34 @@ def _labelled(label: str) -> Callable[[re.Match[str]], str]:
 def _relabel(robot_toml: str, labels: dict[str, str]) -> str:
     """``NAME = "label"`` lines of [inputs] and [motors] get the labels given."""
     for name, label in labels.items():
-        robot_toml = re.sub(rf'(?m)^(\s*{re.escape(name)}\s*=\s*)"[^"\n]*"', _labelled(label), robot_toml,
-                            count=1)
+        robot_toml = re.sub(rf'(?m)^(\s*{re.escape(name)}\s*=\s*)"[^"\n]*"', _labelled(label), robot_toml, count=1)
     return robot_toml
 
 
 def empty(name: str, inputs: list[Named], motors: list[Named]) -> Template:
     """A robot of the given inputs and motors, a table that drives it straight on and turns now and then
     (into the walls, until its first input is made a sensor), an empty room."""
-    notes = () if len(motors) >= 2 else (
-        "the simulator drives two wheels: `tablebot sim` needs two motors in [motors] (check and tests work now)",)
+    notes = (
+        ()
+        if len(motors) >= 2
+        else (
+            "the simulator drives two wheels: `tablebot sim` needs two motors in [motors] (check and tests work now)",
+        )
+    )
     inputs_toml = "".join(f'{n} = "{label or "input " + str(k + 1)}"\n' for k, (n, label) in enumerate(inputs))
     sides = ("right motor", "left motor")  # the simulator drives the first two as right and left wheel
     motors_toml = "".join(f'{n} = "{label or (sides[k] if k < 2 else n)}"\n' for k, (n, label) in enumerate(motors))
-    files = {"robot.toml": ROBOT.format(name=name.replace('"', "'"), inputs=inputs_toml, motors=motors_toml,
-                                        sensors=_sensor_examples([n for n, _ in inputs] or ["I1"])),
-             "table.csv": _empty_table(inputs, motors), "arena.toml": ARENA,
-             "properties.toml": _empty_properties([n for n, _ in motors])}
+    files = {
+        "robot.toml": ROBOT.format(
+            name=name.replace('"', "'"),
+            inputs=inputs_toml,
+            motors=motors_toml,
+            sensors=_sensor_examples([n for n, _ in inputs] or ["I1"]),
+        ),
+        "table.csv": _empty_table(inputs, motors),
+        "arena.toml": ARENA,
+        "properties.toml": _empty_properties([n for n, _ in motors]),
+    }
     return Template(files, notes)
 
 
@@ -186,8 +235,9 @@ def _sensor_examples(inputs: list[str]) -> str:
     line = '{ sensor = "line", at = [0.1, 0.01] }                       # track sensor: 1 over tape'
     if len(inputs) >= 2:
         return f"# {inputs[0]} = {distance}\n# {inputs[1]} = {line}\n"
-    return (f"# {inputs[0]} = {distance}\n"
-            f'#   (or a track sensor, 1 over tape: {{ sensor = "line", at = [0.1, 0.01] }})\n')
+    return (
+        f'# {inputs[0]} = {distance}\n#   (or a track sensor, 1 over tape: {{ sensor = "line", at = [0.1, 0.01] }})\n'
+    )
 
 
 def _empty_table(inputs: list[Named], motors: list[Named]) -> str:
@@ -205,17 +255,37 @@ def _empty_table(inputs: list[Named], motors: list[Named]) -> str:
     def words(text: Message) -> str:
         return str(localise(text, said))
 
-    example = row(words(N_("# {name} reads 1 while driving: turn away for 1 s", name=names[0])), 2, "",
-                  {names[0]: "1"}, [5, -5], "1s", 1) if names else \
-        words(N_("# description,state,T,inputs...,motors...,timer,next"))
-    return "\n".join([
-        header,
-        words(N_("# A row fires in its state when its marked events are present: it sets the motors and loads "
-                 "the timer and the robot goes to the next state (the first such row of a state wins)")),
-        words(N_("# Remove the # of the next line to use it (it must come before the other state 2 row):")),
-        example,
-        row(words(N_("start driving")), 1, "1", {}, [6, 6], "8s", 2),
-        row(words(N_("time to turn")), 2, "1", {}, [5, -5], "0.7s", 1)]) + "\n"
+    example = (
+        row(
+            words(N_("# {name} reads 1 while driving: turn away for 1 s", name=names[0])),
+            2,
+            "",
+            {names[0]: "1"},
+            [5, -5],
+            "1s",
+            1,
+        )
+        if names
+        else words(N_("# description,state,T,inputs...,motors...,timer,next"))
+    )
+    return (
+        "\n".join(
+            [
+                header,
+                words(
+                    N_(
+                        "# A row fires in its state when its marked events are present: it sets the motors and loads "
+                        "the timer and the robot goes to the next state (the first such row of a state wins)"
+                    )
+                ),
+                words(N_("# Remove the # of the next line to use it (it must come before the other state 2 row):")),
+                example,
+                row(words(N_("start driving")), 1, "1", {}, [6, 6], "8s", 2),
+                row(words(N_("time to turn")), 2, "1", {}, [5, -5], "0.7s", 1),
+            ]
+        )
+        + "\n"
+    )
 
 
 ROBOT = """\
@@ -256,16 +326,21 @@ heading = 30
 # size = [0.4, 0.3]
 """
 
+
 def _empty_properties(motors: list[str]) -> str:
-    text = ("# Claims about every run of the table, proved or refuted by `tablebot check` (docs/checking.md).\n\n"
-            "[back_to_the_start]\n"
-            'text = "from every situation the robot can get back to state 1"\n'
-            'always_reachable = "state == 1"\n')
+    text = (
+        "# Claims about every run of the table, proved or refuted by `tablebot check` (docs/checking.md).\n\n"
+        "[back_to_the_start]\n"
+        'text = "from every situation the robot can get back to state 1"\n'
+        'always_reachable = "state == 1"\n'
+    )
     if motors:
         still, moving = " and ".join(f"{m} == 0" for m in motors), " or ".join(f"{m} != 0" for m in motors)
-        text += ("\n[keeps_moving]\n"
-                 'text = "the robot never stands still for more than 1 s"\n'
-                 f'when = "{still}"\nthen = "{moving}"\nwithin = "1 s"\n')
+        text += (
+            "\n[keeps_moving]\n"
+            'text = "the robot never stands still for more than 1 s"\n'
+            f'when = "{still}"\nthen = "{moving}"\nwithin = "1 s"\n'
+        )
     return text
 
 

@@ -40,8 +40,9 @@ class Program(NamedTuple):
     counter_bits: np.ndarray
 
 
-def tick(regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: int, pulses: np.ndarray,
-         program: Program) -> int:
+def tick(
+    regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, inputs: int, pulses: np.ndarray, program: Program
+) -> int:
     """One tick of the document's engine; returns the fired row (-1: none).
 
     1. after the first tick the timer counts down (never below 0) and each counter by its pulses;

@@ -48,12 +48,14 @@ def loads(path: str | Path, text: str, hint: str) -> dict[str, Any]:
         else:  # "(at end of document)": the last line, after its last character
             lines = text.splitlines() or [""]
             line, col = len(lines), len(lines[-1]) + 1
-        message, better, line, col = worded(text, re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc)), line,
-                                            col)
+        message, better, line, col = worded(
+            text, re.sub(r"\s*\(at (line|end of document).*\)", "", str(exc)), line, col
+        )
         raise fail(path, message, better or hint, line, col) from None
     except RecursionError:  # nesting that _unreadable() did not count (it is a safety net, not the parser)
-        raise fail(path, N_("nested too deeply to read"),
-                   N_("no tablebot file nests that deep: is this the right file?"), 1, 1) from None
+        raise fail(
+            path, N_("nested too deeply to read"), N_("no tablebot file nests that deep: is this the right file?"), 1, 1
+        ) from None
 
 
 #: What may follow a digit in one TOML value or bare key: a number, a date or time, or a key such as ``20``.
@@ -89,16 +91,27 @@ def _unreadable(text: str) -> tuple[str, str, int, int] | None:
         elif ch in "[{":
             depth += 1
             if depth > MAX_DEPTH:
-                return (N_("arrays or inline tables nested more than {most} levels deep", most=MAX_DEPTH),
-                        N_("no tablebot file nests that deep: is this the right file?"), line, column)
+                return (
+                    N_("arrays or inline tables nested more than {most} levels deep", most=MAX_DEPTH),
+                    N_("no tablebot file nests that deep: is this the right file?"),
+                    line,
+                    column,
+                )
         elif ch in "]}":
             depth = max(0, depth - 1)
         elif token := TOKEN_RE.match(text, i):  # a value or a bare key: skipped whole
             length = token.end() - i
             if length > MAX_NUMBER_CHARS and ch in "0123456789+-":
-                return (N_("a number of {count:,} characters, more than the {most} tablebot reads", count=length,
-                           most=MAX_NUMBER_CHARS),
-                        N_("no tablebot setting needs such a number: is this the right file?"), line, column)
+                return (
+                    N_(
+                        "a number of {count:,} characters, more than the {most} tablebot reads",
+                        count=length,
+                        most=MAX_NUMBER_CHARS,
+                    ),
+                    N_("no tablebot setting needs such a number: is this the right file?"),
+                    line,
+                    column,
+                )
             i += length - 1
             column += length - 1
         i += 1
@@ -119,8 +132,9 @@ class Source:
         return cls(path, text, data)
 
     @classmethod
-    def parse(cls, path: str | Path, text: str,
-              hint: str = "see the commented example examples/bumberbot/arena.toml") -> Source:
+    def parse(
+        cls, path: str | Path, text: str, hint: str = "see the commented example examples/bumberbot/arena.toml"
+    ) -> Source:
         return cls(path, text, loads(path, text, hint))
 
     def line(self, section: str = "", index: int | None = None, key: str | None = None) -> int | None:
@@ -169,16 +183,33 @@ def number(src: Source, where: Where, value: Any, low: float, high: float, integ
     """A number in [low, high] (an integer when asked), or None after reporting why not."""
     # the file's own numbers, written as the file writes them: a point in every language (issue 38)
     low_s, high_s = f"{low:g}", f"{high:g}"
-    write = N_("write an integer from {low} to {high}", low=low_s, high=high_s) if integer else \
-        N_("write a number from {low} to {high}", low=low_s, high=high_s)
+    write = (
+        N_("write an integer from {low} to {high}", low=low_s, high=high_s)
+        if integer
+        else N_("write a number from {low} to {high}", low=low_s, high=high_s)
+    )
     if not is_number(value) or (integer and not isinstance(value, int)):
-        src.error(where, N_("{name} must be an integer, not {value!r}", name=label(where), value=value) if integer
-                  else N_("{name} must be a number, not {value!r}", name=label(where), value=value), write)
+        src.error(
+            where,
+            N_("{name} must be an integer, not {value!r}", name=label(where), value=value)
+            if integer
+            else N_("{name} must be a number, not {value!r}", name=label(where), value=value),
+            write,
+        )
         return None
     if not low <= value <= high:
         value_s = f"{value:g}"
-        src.error(where, N_("{name} = {value} is out of range {low}..{high}", name=label(where), value=value_s,
-                            low=low_s, high=high_s), write)
+        src.error(
+            where,
+            N_(
+                "{name} = {value} is out of range {low}..{high}",
+                name=label(where),
+                value=value_s,
+                low=low_s,
+                high=high_s,
+            ),
+            write,
+        )
         return None
     return value
 
@@ -194,28 +225,42 @@ def point(src: Source, where: Where, value: Any) -> tuple[float, float] | None:
     if pair and all(abs(v) <= MAX_COORDINATE for v in value):
         return float(value[0]), float(value[1])
     if pair:  # a point, but no room is that large (and the physics' floats would lose their millimetres)
-        src.error(where, N_("{name}: the point {value!r} is out of range", name=label(where), value=value),
-                  N_("write x and y from {low} to {high} metres", low=_MOST_S[0], high=_MOST_S[1]))
+        src.error(
+            where,
+            N_("{name}: the point {value!r} is out of range", name=label(where), value=value),
+            N_("write x and y from {low} to {high} metres", low=_MOST_S[0], high=_MOST_S[1]),
+        )
     else:
-        src.error(where, N_("{name} must be a point [x, y] in metres, not {value!r}", name=label(where), value=value),
-                  N_("for example: [1.2, 0.5]"))
+        src.error(
+            where,
+            N_("{name} must be a point [x, y] in metres, not {value!r}", name=label(where), value=value),
+            N_("for example: [1.2, 0.5]"),
+        )
     return None
 
 
 def table_of(src: Source, where: Where, value: Any) -> dict[str, Any]:
     if isinstance(value, dict):
         return value
-    src.error(where, N_("{name} must be a table", name=label(where)),
-              N_("write it as a [{section}] section", section=where[0]))
+    src.error(
+        where,
+        N_("{name} must be a table", name=label(where)),
+        N_("write it as a [{section}] section", section=where[0]),
+    )
     return {}
 
 
-def known_keys(src: Source, where_section: tuple[str, int | None], table: dict[str, Any],
-               known: tuple[str, ...]) -> None:
+def known_keys(
+    src: Source, where_section: tuple[str, int | None], table: dict[str, Any], known: tuple[str, ...]
+) -> None:
     for key in table:
         if key not in known:
             section, index = where_section
             place = label((section, index, None))
-            src.error((section, index, key), N_("unknown key {key!r} in {place}", key=key, place=place) if place
-                      else N_("unknown key {key!r} in the file", key=key),
-                      N_("known keys: {known}", known=", ".join(known)))
+            src.error(
+                (section, index, key),
+                N_("unknown key {key!r} in {place}", key=key, place=place)
+                if place
+                else N_("unknown key {key!r} in the file", key=key),
+                N_("known keys: {known}", known=", ".join(known)),
+            )

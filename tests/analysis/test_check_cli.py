@@ -35,12 +35,18 @@ def check(*args: object, out: Path) -> Result:
     return result
 
 
-@pytest.mark.parametrize(("name", "strict", "code"), [
-    ("counters.csv", False, 0), ("counters.csv", True, 0),
-    ("shadowed.csv", False, 0), ("shadowed.csv", True, 1),
-    ("stuckloop.csv", False, 2), ("stuckloop.csv", True, 2),
-    ("bump.csv", False, 2),  # an error-level property is violated
-])
+@pytest.mark.parametrize(
+    ("name", "strict", "code"),
+    [
+        ("counters.csv", False, 0),
+        ("counters.csv", True, 0),
+        ("shadowed.csv", False, 0),
+        ("shadowed.csv", True, 1),
+        ("stuckloop.csv", False, 2),
+        ("stuckloop.csv", True, 2),
+        ("bump.csv", False, 2),  # an error-level property is violated
+    ],
+)
 def test_exit_codes(tmp_path: Path, name: str, strict: bool, code: int) -> None:
     result = check(FIX / name, *(["--strict"] if strict else []), out=tmp_path)
     assert result.exit_code == code, result.output
@@ -102,8 +108,14 @@ def test_bumberbot_shipped_properties(tmp_path: Path) -> None:
     result = check(EXAMPLE, "--format", "json", out=tmp_path)
     data = json.loads(result.stdout)
     status = {p["name"]: p["status"] for p in data["properties"]}
-    assert status == {"collision_stops": "holds", "collision_pause": "holds", "never_stands_still": "holds",
-                      "back_to_seeking": "holds", "can_follow_light": "holds", "front_bumper_stops": "violated"}
+    assert status == {
+        "collision_stops": "holds",
+        "collision_pause": "holds",
+        "never_stands_still": "holds",
+        "back_to_seeking": "holds",
+        "can_follow_light": "holds",
+        "front_bumper_stops": "violated",
+    }
     assert result.exit_code == 0  # the found bug is shipped as a warning ...
     assert check(EXAMPLE, "--strict", out=tmp_path).exit_code == 1  # ... which --strict turns into 1
 
@@ -111,10 +123,18 @@ def test_bumberbot_shipped_properties(tmp_path: Path) -> None:
 def test_the_replay_line_can_be_pasted_into_a_shell(tmp_path: Path) -> None:
     """A folder with a space in its name: the printed command must still name it as one word."""
     out = tmp_path / "my counterexamples"
-    line = next(text for text in check(EXAMPLE, out=out).stdout.splitlines()
-                if "replay:" in text and "front_bumper_stops" in text)
-    assert shlex.split(line.split("replay:", 1)[1]) == ["tablebot", "trace", str(EXAMPLE), "--inputs",
-                                                        str(out / "front_bumper_stops.csv")]
+    line = next(
+        text
+        for text in check(EXAMPLE, out=out).stdout.splitlines()
+        if "replay:" in text and "front_bumper_stops" in text
+    )
+    assert shlex.split(line.split("replay:", 1)[1]) == [
+        "tablebot",
+        "trace",
+        str(EXAMPLE),
+        "--inputs",
+        str(out / "front_bumper_stops.csv"),
+    ]
 
 
 def test_bumberbot_text_tells_the_story(tmp_path: Path) -> None:

@@ -55,8 +55,9 @@ def random_table(seed: int, states: int, per_state: int) -> Table:
         for _ in range(per_state):
             events = frozenset(rng.sample(EVENTS, rng.choice((0, 1, 1, 2, 3))))
             motors = (rng.choice((0, 3, None)), rng.choice((0, 3)))
-            rows.append(Row(len(rows), len(rows) + 2, "", state, events, motors, rng.choice((0, 10)),
-                            rng.randint(1, states)))
+            rows.append(
+                Row(len(rows), len(rows) + 2, "", state, events, motors, rng.choice((0, 10)), rng.randint(1, states))
+            )
     return Table(BUMBERBOT, EVENTS, tuple(rows), "<random>")
 
 

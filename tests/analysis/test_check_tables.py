@@ -37,8 +37,11 @@ always_reachable = "lights == 1"
 
 
 def check(folder: Path, *args: str) -> dict[str, Any]:
-    done = subprocess.run([sys.executable, "-m", "tablebot", "check", str(folder), "--format", "json", *args],
-                          capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "check", str(folder), "--format", "json", *args],
+        capture_output=True,
+        text=True,
+    )
     assert done.stderr == "", done.stderr
     return json.loads(done.stdout)
 
@@ -50,7 +53,9 @@ def test_properties_across_tables_are_proved_or_broken_with_a_counterexample_tha
     status = {p["name"]: p["status"] for p in report["properties"]}
     assert status == {"stopped_dark": "violated", "lamp_follows": "holds", "comes_back": "holds"}
     assert [(t["name"], Path(t["table"]).name, t["rows"], t["states"]) for t in report["tables"]] == [
-        ("drive", "table.csv", 5, 3), ("lights", "lights.csv", 4, 2)]
+        ("drive", "table.csv", 5, 3),
+        ("lights", "lights.csv", 4, 2),
+    ]
     broken = next(p for p in report["properties"] if p["name"] == "stopped_dark")
     assert broken["shortest"] and broken["ticks"] == 2  # I1 at once: drive in 3 on tick 0, lights sees it on 1
     loaded = Loaded.open(folder)
@@ -69,8 +74,9 @@ def test_each_tables_findings_name_its_table_and_file(tmp_path: Path) -> None:
     assert late and all(f["file"] == str(folder / "lights.csv") for f in late)
     assert all(f["message"].startswith("table lights: ") for f in late)
     assert all("table" not in f for f in findings if f["lines"] and f["lines"][0] <= 5 and "file" not in f)
-    done = subprocess.run([sys.executable, "-m", "tablebot", "check", str(folder), "-v"], capture_output=True,
-                          text=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "check", str(folder), "-v"], capture_output=True, text=True
+    )
     assert f"{folder / 'lights.csv'}:6: warning: table lights: row on line 6 can never fire" in done.stdout
 
 
@@ -103,8 +109,9 @@ def test_every_run_of_the_engine_is_a_run_of_the_product(tmp_path_factory: Any, 
 
 @settings(max_examples=15, deadline=None)
 @given(st.integers(0, 2**32))
-def test_leaving_out_tables_that_cannot_influence_changes_nothing_a_property_sees(tmp_path_factory: Any,
-                                                                                  seed: int) -> None:
+def test_leaving_out_tables_that_cannot_influence_changes_nothing_a_property_sees(
+    tmp_path_factory: Any, seed: int
+) -> None:
     rng = random.Random(seed)
     folder = random_robot(rng, tmp_path_factory.mktemp("robot"), RobotShape(tables=3, states=3))
     tables = Loaded.open(folder / "t0.csv").tables
@@ -116,7 +123,13 @@ def test_leaving_out_tables_that_cannot_influence_changes_nothing_a_property_see
         outputs = [i for i, name in enumerate(tables.output_names) if tables.writer(name) in relevant]
 
         def seen(nodes: list[Any], relevant: frozenset[int] = relevant, outputs: list[int] = outputs) -> set[Any]:
-            return {(tuple(n[0][k] for k in sorted(relevant)), tuple(n[1][k] for k in sorted(relevant)),
-                     tuple(n[3][i] for i in outputs)) for n in nodes}
+            return {
+                (
+                    tuple(n[0][k] for k in sorted(relevant)),
+                    tuple(n[1][k] for k in sorted(relevant)),
+                    tuple(n[3][i] for i in outputs),
+                )
+                for n in nodes
+            }
 
         assert seen(part) == seen(whole)

@@ -34,11 +34,18 @@ def test_condition_drops_sets_that_add_nothing() -> None:
     assert condition(BB, [frozenset()]) == "always"
 
 
-@pytest.mark.parametrize(("motors", "words", "kind"), [
-    ((4, 4), "forward 4", "forward"), ((-3, -3), "reverse 3", "reverse"), ((0, 0), "stop", "stop"),
-    ((None, None), "keep", "keep"), ((-2, 2), "spin right L2 R-2", "turn"),  # M1 is the right motor
-    ((1, 5), "curve right L5 R1", "turn"), ((-3, -2), "back, turn right L-2 R-3", "reverse"),
-])
+@pytest.mark.parametrize(
+    ("motors", "words", "kind"),
+    [
+        ((4, 4), "forward 4", "forward"),
+        ((-3, -3), "reverse 3", "reverse"),
+        ((0, 0), "stop", "stop"),
+        ((None, None), "keep", "keep"),
+        ((-2, 2), "spin right L2 R-2", "turn"),  # M1 is the right motor
+        ((1, 5), "curve right L5 R1", "turn"),
+        ((-3, -2), "back, turn right L-2 R-3", "reverse"),
+    ],
+)
 def test_motion_words(motors: tuple[int | None, int | None], words: str, kind: str) -> None:
     assert motion_of(BB, motors) == (words, kind)
 
@@ -83,10 +90,13 @@ def test_command_mermaid_to_stdout_and_bad_format() -> None:
 def test_a_fallback_row_reads_otherwise_and_descriptions_never_name_states(tmp_path: Path) -> None:
     robot = (FIX / "robot.toml").read_text()
     (tmp_path / "robot.toml").write_text(robot, encoding="utf-8")
-    (tmp_path / "t.csv").write_text("description,state,T,A,B,M1,M2,timer,next\n"
-                                    "search,1,,1,,3,3,0,2\n"
-                                    "search – give up,1,,,,0,0,0,1\n"
-                                    "wait,2,,,,0,0,0,1\n", encoding="utf-8")
+    (tmp_path / "t.csv").write_text(
+        "description,state,T,A,B,M1,M2,timer,next\n"
+        "search,1,,1,,3,3,0,2\n"
+        "search – give up,1,,,,0,0,0,1\n"
+        "wait,2,,,,0,0,0,1\n",
+        encoding="utf-8",
+    )
     table = load_table(tmp_path / "t.csv")
     by_pair = {(e.source, e.target): e for e in edges(table)}
     assert by_pair[(1, 1)].lines[0][0] == "otherwise"  # tried after the row that needs A

@@ -32,8 +32,12 @@ def test_one_diagram_per_table_with_cross_table_events_labelled() -> None:
 
 
 def test_mermaid_has_a_concurrent_region_per_table(tmp_path: Path) -> None:
-    done = subprocess.run([sys.executable, "-m", "tablebot", "diagram", str(EXAMPLE), "--format", "mermaid"],
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "diagram", str(EXAMPLE), "--format", "mermaid"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     lines = done.stdout.splitlines()
     assert lines[:3] == ["stateDiagram-v2", "    direction LR", "    [*] --> robot_BumberBot_with_lights"]
     assert lines.count("        --") == 1
@@ -41,6 +45,7 @@ def test_mermaid_has_a_concurrent_region_per_table(tmp_path: Path) -> None:
     assert "        [*] --> drive_s_2" in lines[:split] and "        [*] --> lights_s_flash_left" in lines[split:]
     assert "        lights_s_flash_left --> lights_s_burn: drive in (11,12) / L1=8 L2=8" in lines  # {} is Mermaid's
     out = tmp_path / "robot.png"
-    subprocess.run([sys.executable, "-m", "tablebot", "diagram", str(EXAMPLE), "--out", str(out)], check=True,
-                   capture_output=True)
+    subprocess.run(
+        [sys.executable, "-m", "tablebot", "diagram", str(EXAMPLE), "--out", str(out)], check=True, capture_output=True
+    )
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -31,8 +31,15 @@ pytestmark = [pytest.mark.browser]
 SVG = "{http://www.w3.org/2000/svg}"
 STATES = {"s_1", "s_2", "s_11", "s_12", "s_20", "s_21", "s_22", "s_24", "s_26", "s_29"}  # the BumberBot's
 CHROMIUM = Path("/usr/bin/chromium")
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-         "--disable-dev-shm-usage", "--no-first-run", "--disable-extensions"]
+FLAGS = [
+    "--headless=new",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-dev-shm-usage",
+    "--no-first-run",
+    "--disable-extensions",
+]
 
 
 @pytest.fixture(scope="module")
@@ -52,8 +59,12 @@ def no_packaged(tmp_path_factory: pytest.TempPathFactory) -> str:
     venv = tmp_path_factory.mktemp("no-graphviz-pure") / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
     python = venv / ("Scripts" if os.name == "nt" else "bin") / Path(sys.executable).name
-    site = subprocess.run([python, "-c", "import sysconfig; print(sysconfig.get_path('purelib'))"],
-                          capture_output=True, text=True, check=True).stdout.strip()
+    site = subprocess.run(
+        [python, "-c", "import sysconfig; print(sysconfig.get_path('purelib'))"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
     ours = sysconfig.get_path("purelib")
     Path(site, "tablebot-packages.pth").write_text(f"import site; site.addsitedir({ours!r})\n")
     assert not list(python.parent.glob("graphviz-pure*"))
@@ -61,8 +72,9 @@ def no_packaged(tmp_path_factory: pytest.TempPathFactory) -> str:
 
 
 def tablebot(python: str, env: dict[str, str], *args: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([python, "-m", "tablebot", *map(str, args)], env=env, capture_output=True, text=True,
-                          timeout=120, check=False)
+    return subprocess.run(
+        [python, "-m", "tablebot", *map(str, args)], env=env, capture_output=True, text=True, timeout=120, check=False
+    )
 
 
 def node_titles(svg: bytes | str) -> set[str]:
@@ -82,8 +94,9 @@ def test_diagram_draws_svg_and_png_with_no_dot_on_path(bare: dict[str, str], tmp
         assert png.format == "PNG" and png.width > 1000 and png.height > 1500  # 150 dpi, as with dot
 
 
-def test_with_no_graphviz_at_all_the_command_says_what_to_install(no_packaged: str, bare: dict[str, str],
-                                                                   tmp_path: Path) -> None:
+def test_with_no_graphviz_at_all_the_command_says_what_to_install(
+    no_packaged: str, bare: dict[str, str], tmp_path: Path
+) -> None:
     done = tablebot(no_packaged, bare, "diagram", EXAMPLE, "--out", tmp_path / "bb.svg")
     assert done.returncode == 2 and not (tmp_path / "bb.svg").exists()
     said = " ".join(done.stderr.split())
@@ -93,8 +106,9 @@ def test_with_no_graphviz_at_all_the_command_says_what_to_install(no_packaged: s
     assert mermaid.returncode == 0 and mermaid.stdout.startswith("stateDiagram-v2")
 
 
-def test_a_system_dot_draws_where_graphviz_pure_is_missing(no_packaged: str, bare: dict[str, str],
-                                                           tmp_path: Path) -> None:
+def test_a_system_dot_draws_where_graphviz_pure_is_missing(
+    no_packaged: str, bare: dict[str, str], tmp_path: Path
+) -> None:
     dot = shutil.which("dot")
     if dot is None:
         pytest.skip("no system Graphviz here (scripts/bootstrap.sh installs one)")
@@ -107,6 +121,7 @@ def test_a_system_dot_draws_where_graphviz_pure_is_missing(no_packaged: str, bar
 
 
 # --- the studio, in a real Chromium ---------------------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[object]:
@@ -140,8 +155,13 @@ def studio_diagram(browser: object, python: str, env: dict[str, str], folder: Pa
     """Start ``tablebot studio`` on a copy of the BumberBot as a user does, open its page and wait for the
     diagram panel to fill: its inner HTML, and its text."""
     shutil.copytree(EXAMPLE, folder)
-    process = subprocess.Popen([python, "-m", "tablebot", "studio", str(folder), "--port", "0", "--no-browser"],
-                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [python, "-m", "tablebot", "studio", str(folder), "--port", "0", "--no-browser"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         url = address(process)
         context = browser.new_context()  # type: ignore[attr-defined]
@@ -169,15 +189,16 @@ def studio_diagram(browser: object, python: str, env: dict[str, str], folder: Pa
                 process.communicate()
 
 
-def test_the_studio_draws_its_diagram_with_no_dot_on_path(browser: object, bare: dict[str, str],
-                                                           tmp_path: Path) -> None:
+def test_the_studio_draws_its_diagram_with_no_dot_on_path(
+    browser: object, bare: dict[str, str], tmp_path: Path
+) -> None:
     html, _ = studio_diagram(browser, sys.executable, bare, tmp_path / "bot")
     assert html.startswith("<svg") and set(re.findall(r"<title>(s_\d+)</title>", html)) >= STATES
 
 
-def test_with_no_graphviz_at_all_the_studio_says_so_in_the_diagram_panel(browser: object, no_packaged: str,
-                                                                          bare: dict[str, str],
-                                                                          tmp_path: Path) -> None:
+def test_with_no_graphviz_at_all_the_studio_says_so_in_the_diagram_panel(
+    browser: object, no_packaged: str, bare: dict[str, str], tmp_path: Path
+) -> None:
     html, text = studio_diagram(browser, no_packaged, bare, tmp_path / "bot")
     assert "<svg" not in html
     said = " ".join(text.split())

@@ -50,19 +50,22 @@ def test_input_bits_are_recorded_for_the_model() -> None:
     assert both.watch == I3  # shared inputs are OR-ed (a sum once turned I3 into another bit)
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("I9", "unknown name 'I9'"),
-    ("state == 23", "no state 23"),
-    ("state < 3", "==, != or in"),
-    ("I3 == 1", "I3 is an event"),
-    ("M1", "the condition ends too early"),
-    ("M1 > fast", "needs a number"),
-    ("(I3 or I4", "the condition ends too early"),
-    ("I3 I4", "unexpected 'I4'"),
-    ("line == 1", "no row of the table is on line 1"),
-    ("", "empty"),
-    ("__import__('os').system('true')", "cannot read"),  # no eval, ever
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("I9", "unknown name 'I9'"),
+        ("state == 23", "no state 23"),
+        ("state < 3", "==, != or in"),
+        ("I3 == 1", "I3 is an event"),
+        ("M1", "the condition ends too early"),
+        ("M1 > fast", "needs a number"),
+        ("(I3 or I4", "the condition ends too early"),
+        ("I3 I4", "unexpected 'I4'"),
+        ("line == 1", "no row of the table is on line 1"),
+        ("", "empty"),
+        ("__import__('os').system('true')", "cannot read"),  # no eval, ever
+    ],
+)
 def test_bad_conditions(text: str, message: str) -> None:
     with pytest.raises(ConditionError, match=message.replace("(", r"\(").replace("[", r"\[")):
         parse_condition(text, BB)
@@ -75,7 +78,9 @@ def write(tmp_path: Path, text: str) -> Path:
 
 
 def test_kinds_and_durations(tmp_path: Path) -> None:
-    path = write(tmp_path, """
+    path = write(
+        tmp_path,
+        """
 [a]
 never = "state == 20 and M1 > 0"
 [b]
@@ -95,7 +100,8 @@ always_reachable = "state == 1"
 text = "back to 1"
 level = "warning"
 note = "why"
-""")
+""",
+    )
     props = {p.name: p for p in load_properties(BB, [path])}
     assert props["a"].kind == "never" and props["a"].horizon == 1
     assert (props["b"].within, props["c"].within, props["d"].within) == (5, 150, 3)
@@ -105,7 +111,9 @@ note = "why"
 
 
 def test_errors_are_all_reported_with_lines(tmp_path: Path) -> None:
-    path = write(tmp_path, """[ok]
+    path = write(
+        tmp_path,
+        """[ok]
 never = "I3"
 
 [two_kinds]
@@ -119,12 +127,15 @@ within = "15 ms"
 
 [typo]
 nevr = "I3"
-""")
+""",
+    )
     with pytest.raises(TableBotError) as info:
         load_properties(BB, [path])
     found = [(d.line, d.message) for d in info.value.diagnostics]
-    assert (4, "property two_kinds needs exactly one of never, always, reachable, always_reachable, when "
-               "(found 2)") in found
+    assert (
+        4,
+        "property two_kinds needs exactly one of never, always, reachable, always_reachable, when (found 2)",
+    ) in found
     assert any(line == 8 and "not a whole number of 10 ms ticks" in m for line, m in found)
     assert any(line == 13 and "unknown key 'nevr'" in m for line, m in found)
 

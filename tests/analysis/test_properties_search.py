@@ -129,8 +129,14 @@ def test_timed_property_is_exact_to_the_tick() -> None:
     machine = compile_table(load_table(EXAMPLES / "table.csv"))
 
     def pause(ticks: int) -> Property:
-        return Property("p", "p", "when", when=parse_condition("state == 20", machine),
-                        then=parse_condition("state != 20", machine), within=ticks)
+        return Property(
+            "p",
+            "p",
+            "when",
+            when=parse_condition("state == 20", machine),
+            then=parse_condition("state != 20", machine),
+            within=ticks,
+        )
 
     assert check_property(pause(50), machine).status == "holds"
     result = check_property(pause(49), machine)
@@ -139,8 +145,9 @@ def test_timed_property_is_exact_to_the_tick() -> None:
 
 def test_within_zero_means_the_same_tick(tmp_path: Path) -> None:
     machine = compile_table(load_table(FIX / "bump.csv"))
-    prop = Property("z", "z", "when", when=parse_condition("A", machine),
-                    then=parse_condition("M1 == 0", machine), within=0)
+    prop = Property(
+        "z", "z", "when", when=parse_condition("A", machine), then=parse_condition("M1 == 0", machine), within=0
+    )
     result = check_property(prop, machine)
     assert result.status == "violated" and replayed_violation(machine, result, tmp_path) == len(result.inputs) - 1
 
@@ -159,8 +166,18 @@ def tables(draw: st.DrawFn) -> Table:
         for _ in range(draw(st.integers(1, 3))):
             events = frozenset(e for e in EVENTS if draw(st.booleans()))
             motors = (draw(st.integers(-2, 2)), draw(st.sampled_from([None, -1, 0, 1])))
-            rows.append(Row(len(rows), len(rows) + 2, "", state, events, motors,
-                            draw(st.integers(0, 6)), draw(st.integers(1, n))))
+            rows.append(
+                Row(
+                    len(rows),
+                    len(rows) + 2,
+                    "",
+                    state,
+                    events,
+                    motors,
+                    draw(st.integers(0, 6)),
+                    draw(st.integers(1, n)),
+                )
+            )
     robot = replace(ROBOT, match=draw(st.sampled_from(MATCHES)))  # the document's: no event, no row
     return Table(robot, EVENTS, tuple(rows), "<random>")
 
@@ -176,8 +193,11 @@ def test_the_model_offers_every_row_any_inputs_can_fire(table: Table) -> None:
     for state in range(len(machine.states)):
         for context in (0, machine.timer_bit):
             offered = {row for _, row in model.classes(state, context)}
-            assert offered == {machine.lookup(state, inputs | context) for inputs in every_input_set
-                               if not inputs & ~machine.input_mask}
+            assert offered == {
+                machine.lookup(state, inputs | context)
+                for inputs in every_input_set
+                if not inputs & ~machine.input_mask
+            }
 
 
 CONDITIONS = ["A", "state == 1", "state == 2", "M1 > 0", "M2 < 0", "T", "fired", "not A and M1 == 0"]
@@ -185,15 +205,19 @@ CONDITIONS = ["A", "state == 1", "state == 2", "M1 > 0", "M2 < 0", "T", "fired",
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(tables(), st.sampled_from(CONDITIONS), st.sampled_from(CONDITIONS), st.integers(0, 4), st.randoms())
-def test_abstract_proofs_are_sound_and_counterexamples_real(table: Table, when: str, then: str, within: int,
-                                                            rnd: random.Random) -> None:
+def test_abstract_proofs_are_sound_and_counterexamples_real(
+    table: Table, when: str, then: str, within: int, rnd: random.Random
+) -> None:
     machine = compile_table(table)
     coarse, fine = Model(machine).explore(), Model.exact(machine).explore()
     assert {(n[0], n[3]) for n in coarse.nodes} == {(n[0], n[3]) for n in fine.nodes}  # same situations
     assert coarse.fired_rows() == fine.fired_rows()
-    for prop in (Property("n", "n", "never", cond=parse_condition(f"{when} and {then}", machine)),
-                 Property("r", "r", "when", when=parse_condition(when, machine),
-                          then=parse_condition(then, machine), within=within)):
+    for prop in (
+        Property("n", "n", "never", cond=parse_condition(f"{when} and {then}", machine)),
+        Property(
+            "r", "r", "when", when=parse_condition(when, machine), then=parse_condition(then, machine), within=within
+        ),
+    ):
         abstract, _ = search(Model(machine, prop.horizon, prop.watch), monitor_of(prop))
         exact, _ = search(Model.exact(machine, prop.watch), monitor_of(prop))
         assert abstract is not None or exact is None  # a proof in the model is a proof

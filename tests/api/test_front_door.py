@@ -58,12 +58,28 @@ def moved(folder: str, to: str) -> Path:
 
 def test_sim_saved_from_memory_and_run_into_a_folder_is_what_sim_writes(here: Path) -> None:
     # 42 s: two of the trace writer's blocks (4096 ticks each), and the painter draws the path as the run goes
-    command("sim", "examples/bumberbot", "--seconds", "42", "--seed", "3", "--battery", "0.7", "--html",
-            "--out", "cli", "-q")
+    command(
+        "sim",
+        "examples/bumberbot",
+        "--seconds",
+        "42",
+        "--seed",
+        "3",
+        "--battery",
+        "0.7",
+        "--html",
+        "--out",
+        "cli",
+        "-q",
+    )
     robot = tablebot.open("examples/bumberbot")
     run = robot.simulate(seconds=42, seed=3, battery=0.7)
-    assert [p.name for p in run.save("memory", html=True)] == ["trace.jsonl", "trajectory.png", "timeline.png",
-                                                                 "run.html"]
+    assert [p.name for p in run.save("memory", html=True)] == [
+        "trace.jsonl",
+        "trajectory.png",
+        "timeline.png",
+        "run.html",
+    ]
     into = robot.simulate(seconds=42, seed=3, battery=0.7, out="into", html=True)
     expected = contents(Path("cli"))
     assert set(expected) == {"trace.jsonl", "trajectory.png", "timeline.png", "run.html"}
@@ -120,8 +136,25 @@ def test_sweep_results_traces_and_pictures_are_the_commands(here: Path) -> None:
 
 def test_tune_outputs_are_the_commands(here: Path) -> None:
     options = {"objective": "collisions", "budget": 3, "seeds": "0..1", "check_seeds": "9..10", "seconds": 2}
-    command("tune", "examples/bumberbot", "--cells", "line 5 timer", "--objective", "collisions", "--budget", "3",
-            "--seeds", "0..1", "--check-seeds", "9..10", "--seconds", "2", "--out", "out", "-q")
+    command(
+        "tune",
+        "examples/bumberbot",
+        "--cells",
+        "line 5 timer",
+        "--objective",
+        "collisions",
+        "--budget",
+        "3",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "9..10",
+        "--seconds",
+        "2",
+        "--out",
+        "out",
+        "-q",
+    )
     cli = contents(moved("out", "cli"))
     robot = tablebot.open("examples/bumberbot")
     into = robot.tune("line 5 timer", out="out", **options)  # type: ignore[arg-type]  # (a dict of mixed values)
@@ -134,11 +167,29 @@ def test_tune_outputs_are_the_commands(here: Path) -> None:
 
 
 def test_evolve_outputs_are_the_commands(here: Path) -> None:
-    command("evolve", "examples/bumberbot", "--budget", "2", "--batch", "1", "--seeds", "0..1", "--check-seeds",
-            "9..10", "--seconds", "1", "--workers", "1", "--out", "out", "-q")
+    command(
+        "evolve",
+        "examples/bumberbot",
+        "--budget",
+        "2",
+        "--batch",
+        "1",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "9..10",
+        "--seconds",
+        "1",
+        "--workers",
+        "1",
+        "--out",
+        "out",
+        "-q",
+    )
     cli = contents(moved("out", "cli"))
-    evolved = tablebot.open("examples/bumberbot").evolve(out="out", budget=2, batch=1, seeds="0..1",
-                                                          check_seeds="9..10", seconds=1, workers=1)
+    evolved = tablebot.open("examples/bumberbot").evolve(
+        out="out", budget=2, batch=1, seeds="0..1", check_seeds="9..10", seconds=1, workers=1
+    )
     assert contents(Path("out")) == cli
     assert {"report.md", "archive.png", "best-1.csv", "evaluations.csv"} <= set(cli)
     assert len(evolved.outcome.order) >= 2
@@ -151,8 +202,21 @@ def test_export_to_c_is_the_commands(here: Path) -> None:
     assert sorted(p.name for p in done.files) == ["tb_config.h", "tb_engine.c", "tb_engine.h", "tb_table.c"]
 
 
-@pytest.mark.parametrize("module", ["api", "api.project", "api.simulation", "api.checking", "api.sweeping",
-                                    "api.tuning", "api.evolution", "api.exporting", "api.running", "api.progress"])
+@pytest.mark.parametrize(
+    "module",
+    [
+        "api",
+        "api.project",
+        "api.simulation",
+        "api.checking",
+        "api.sweeping",
+        "api.tuning",
+        "api.evolution",
+        "api.exporting",
+        "api.running",
+        "api.progress",
+    ],
+)
 def test_the_examples_in_the_docstrings_hold(module: str, here: Path) -> None:
     """Each result type's docstring shows it in use (docs/api.md shows them): what they show is what it does."""
     result = doctest.testmod(importlib.import_module(f"tablebot.{module}"))

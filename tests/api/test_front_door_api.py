@@ -24,10 +24,12 @@ HEAVY = ("numba", "llvmlite", "matplotlib", "dask", "distributed")
 
 
 def test_import_tablebot_and_open_load_no_compiler_pictures_or_cluster() -> None:
-    code = ("import sys, tablebot\n"
-            "robot = tablebot.open('examples/bumberbot')\n"
-            "assert robot.table.rows and robot.property_files\n"
-            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))\n")
+    code = (
+        "import sys, tablebot\n"
+        "robot = tablebot.open('examples/bumberbot')\n"
+        "assert robot.table.rows and robot.property_files\n"
+        f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))\n"
+    )
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
@@ -38,7 +40,7 @@ def _section(text: str, heading: str) -> str:
     """A page's text from ``heading`` to the next heading of its level."""
     start = text.index(f"\n{heading}\n")
     end = text.find("\n## ", start + len(heading) + 2)
-    return text[start:end if end >= 0 else len(text)]
+    return text[start : end if end >= 0 else len(text)]
 
 
 def test_the_public_names_are_exactly_the_documented_ones() -> None:
@@ -79,9 +81,18 @@ def test_open_takes_a_folder_a_table_or_a_robot_file(tmp_path: Path, monkeypatch
         tablebot.open(tmp_path / "alone" / "robot.toml")
 
 
-@pytest.mark.parametrize(("method", "home"), [("simulate", "simulation"), ("check", "checking"), ("sweep", "sweeping"),
-                                              ("tune", "tuning"), ("evolve", "evolution"), ("export", "exporting"),
-                                              ("connect", "running")])
+@pytest.mark.parametrize(
+    ("method", "home"),
+    [
+        ("simulate", "simulation"),
+        ("check", "checking"),
+        ("sweep", "sweeping"),
+        ("tune", "tuning"),
+        ("evolve", "evolution"),
+        ("export", "exporting"),
+        ("connect", "running"),
+    ],
+)
 def test_each_call_takes_what_its_function_takes(method: str, home: str) -> None:
     """Project's methods spell out the options of the functions they call (typed, for an editor to offer): the
     same names, kinds and defaults, so that neither can change without the other."""

@@ -38,8 +38,9 @@ def refusal(link: str) -> str:
     return text
 
 
-@pytest.mark.parametrize("example", ["bumberbot", "line-follower", "bumberbot-counters",
-                                     "document/bumberbot-table.tsv"])
+@pytest.mark.parametrize(
+    "example", ["bumberbot", "line-follower", "bumberbot-counters", "document/bumberbot-table.tsv"]
+)
 def test_a_link_gives_back_the_files_byte_for_byte(tmp_path: Path, example: str) -> None:
     link = share.encode(share.collect(EXAMPLES / example))
     folder = tmp_path / "opened"
@@ -96,7 +97,7 @@ def test_a_cut_link_is_refused_in_words() -> None:
 def test_a_damaged_link_says_which_character() -> None:
     link = share.encode(share.collect(EXAMPLES / "line-follower"))
     at = len(link) - 20
-    text = refusal(link[:at] + " " + link[at + 1:])
+    text = refusal(link[:at] + " " + link[at + 1 :])
     assert f"(' ' at character {at + 1} of the link)" in text and "chat program" in text
 
 
@@ -121,8 +122,12 @@ def test_contents_that_are_not_a_table_or_leave_the_folder_are_refused() -> None
 
 def test_a_link_carrying_a_broken_table_names_the_file_line_and_column() -> None:
     robot = (EXAMPLES / "line-follower" / "robot.toml").read_text()
-    body = {"name": "broken", "table": ["table.csv", "description,state,T,I1,I2,M1,M2,timer,next\n"
-                                        "go,1,1,,,9,6,1s,1\n"], "robot": ["robot.toml", robot], "world": None}
+    body = {
+        "name": "broken",
+        "table": ["table.csv", "description,state,T,I1,I2,M1,M2,timer,next\ngo,1,1,,,9,6,1s,1\n"],
+        "robot": ["robot.toml", robot],
+        "world": None,
+    }
     shared = share.decode(forged(body))
     with pytest.raises(TableBotError) as caught:
         shared.check("pupils.txt:3")
@@ -152,14 +157,17 @@ def test_any_text_is_a_link_or_refused_in_words() -> None:
     payload = link.split("share=1.", 1)[1]
 
     @settings(max_examples=300, deadline=None, derandomize=True)
-    @given(st.one_of(st.text(max_size=200).map(lambda t: "#share=1." + t),
-                     st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(b).decode()),
-                     st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(
-                         zlib.compress(b)).decode()),
-                     st.integers(0, len(payload)).map(lambda n: link[:len(link) - n]),
-                     st.tuples(st.integers(0, len(payload) - 1), st.characters()).map(
-                         lambda c: link[:len(link) - len(payload) + c[0]] + c[1] + link[len(link) - len(payload)
-                                                                                      + c[0] + 1:])))
+    @given(
+        st.one_of(
+            st.text(max_size=200).map(lambda t: "#share=1." + t),
+            st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(b).decode()),
+            st.binary(max_size=300).map(lambda b: "#share=1." + base64.urlsafe_b64encode(zlib.compress(b)).decode()),
+            st.integers(0, len(payload)).map(lambda n: link[: len(link) - n]),
+            st.tuples(st.integers(0, len(payload) - 1), st.characters()).map(
+                lambda c: link[: len(link) - len(payload) + c[0]] + c[1] + link[len(link) - len(payload) + c[0] + 1 :]
+            ),
+        )
+    )
     def pasted(text: str) -> None:
         with contextlib.suppress(TableBotError):  # refused in words is fine; anything else fails the test
             share.decode(text)

@@ -32,14 +32,43 @@ def test_the_trace_array_has_every_table_as_the_file_has_it(tmp_path: Path) -> N
     assert len(set(trace["lights.state"].tolist())) > 1  # the lights table moved on
     read = traces.from_file(tmp_path / "api" / "trace.jsonl", run.scene.machine)
     assert read.dtype == trace.dtype and all(np.array_equal(read[n], trace[n]) for n in names)
-    done = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(EXAMPLES / "bumberbot-lights"), "--seconds",
-                           "3", "--seed", "4", "--no-plots", "--out", str(tmp_path / "cli")], capture_output=True,
-                          text=True, check=False)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "sim",
+            str(EXAMPLES / "bumberbot-lights"),
+            "--seconds",
+            "3",
+            "--seed",
+            "4",
+            "--no-plots",
+            "--out",
+            str(tmp_path / "cli"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "cli" / "trace.jsonl").read_bytes() == (tmp_path / "api" / "trace.jsonl").read_bytes()
 
 
 def test_a_one_table_trace_array_is_unchanged() -> None:
     trace = tablebot.open(EXAMPLES / "bumberbot").simulate(seconds=1, seed=4).trace
-    assert trace.dtype.names == ("tick", "event", "row", "state", "timer", "M1", "M2", "x", "y", "heading",
-                                 "I7_light", "I8_light", "battery_v")
+    assert trace.dtype.names == (
+        "tick",
+        "event",
+        "row",
+        "state",
+        "timer",
+        "M1",
+        "M2",
+        "x",
+        "y",
+        "heading",
+        "I7_light",
+        "I8_light",
+        "battery_v",
+    )

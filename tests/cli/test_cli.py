@@ -54,6 +54,7 @@ def assert_located_errors(stderr: str, count: int) -> list[re.Match]:
 
 # --- help ---------------------------------------------------------------------------------------------
 
+
 def commands() -> dict[str, Any]:
     """The commands as the command line has them (click's, as typer builds them)."""
     return dict(typer.main.get_command(app).commands)  # type: ignore[attr-defined]
@@ -77,8 +78,11 @@ def test_a_commands_help_says_what_it_does_and_lists_every_option(command: str) 
 def test_no_arguments_lists_every_command_with_what_it_does() -> None:
     result = invoke()
     lines = result.output.splitlines()
-    listed = {line.split()[0]: line.split(maxsplit=1)[1] for line in lines[lines.index("Commands:") + 1:]
-              if line.startswith("  ") and len(line.split()) > 1}
+    listed = {
+        line.split()[0]: line.split(maxsplit=1)[1]
+        for line in lines[lines.index("Commands:") + 1 :]
+        if line.startswith("  ") and len(line.split()) > 1
+    }
     assert set(listed) == set(commands()) and len(listed) >= 15
     for name, command in commands().items():
         first = command.get_short_help_str().split()[:3]  # the index's summary (tablebot.cli.index)
@@ -88,12 +92,15 @@ def test_no_arguments_lists_every_command_with_what_it_does() -> None:
 def test_a_missing_argument_is_named_with_where_to_read_about_it() -> None:
     result = invoke("check")
     assert result.exit_code == 2
-    assert result.output.splitlines() == ["TABLE: error: TABLE is missing",
-                                          "    hint: tablebot check -h says what TABLE takes"]
+    assert result.output.splitlines() == [
+        "TABLE: error: TABLE is missing",
+        "    hint: tablebot check -h says what TABLE takes",
+    ]
     assert "Traceback" not in result.output
 
 
 # --- check --------------------------------------------------------------------------------------------
+
 
 def test_check_seed_tsv(tmp_path: Path) -> None:
     shutil.copy(SEED_TSV, tmp_path / "bumberbot-table.tsv")
@@ -157,6 +164,7 @@ def test_real_command_is_plain_when_piped(tmp_path: Path) -> None:
 
 # --- export and import --------------------------------------------------------------------------------
 
+
 def test_export_then_import_round_trip(tmp_path: Path) -> None:
     out = tmp_path / "lists"
     result = invoke("export", EXAMPLE / "table.csv", out, "--to", "robopro")
@@ -211,6 +219,7 @@ def test_import_errors(tmp_path: Path) -> None:
 
 # --- trace and demo -----------------------------------------------------------------------------------
 
+
 def test_trace_to_stdout_and_file_are_the_same_bytes(tmp_path: Path) -> None:
     inputs = EXAMPLE / "inputs.csv"
     to_stdout = invoke("trace", EXAMPLE, "--inputs", inputs)
@@ -246,8 +255,15 @@ def test_demo_writes_the_trace_of_the_example(tmp_path: Path) -> None:
 
 def test_trace_into_a_closed_pipe_stops_quietly() -> None:
     """`tablebot trace ... | head -1`: the reader leaving early is no error."""
-    command = [sys.executable, "-c", "from tablebot.cli import main; main()", "trace", str(EXAMPLE),
-               "--inputs", str(EXAMPLE / "inputs.csv")]
+    command = [
+        sys.executable,
+        "-c",
+        "from tablebot.cli import main; main()",
+        "trace",
+        str(EXAMPLE),
+        "--inputs",
+        str(EXAMPLE / "inputs.csv"),
+    ]
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdout is not None and proc.stderr is not None
     first = proc.stdout.readline()
@@ -263,8 +279,19 @@ def test_the_command_line_loads_no_heavy_library_until_a_command_runs() -> None:
     of the engine, the simulator and the analysis only the light modules that register back-ends."""
     code = "import json, sys, tablebot.cli; print(json.dumps(sorted(sys.modules)))"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    heavy = ("numpy", "numba", "matplotlib", "starlette", "uvicorn", "httpx", "graphviz", "serial", "dask",
-             "tablebot.engine", "tablebot.machine")
+    heavy = (
+        "numpy",
+        "numba",
+        "matplotlib",
+        "starlette",
+        "uvicorn",
+        "httpx",
+        "graphviz",
+        "serial",
+        "dask",
+        "tablebot.engine",
+        "tablebot.machine",
+    )
     registering = {"tablebot.sim", "tablebot.sim.backend", "tablebot.analysis", "tablebot.analysis.section"}
     loaded = [m for m in json.loads(done.stdout) if m.startswith((*heavy, "tablebot.sim", "tablebot.analysis"))]
     assert [m for m in loaded if m not in registering] == []

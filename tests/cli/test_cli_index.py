@@ -32,8 +32,9 @@ main()
 
 def run(*args: str) -> tuple[str, set[str]]:
     """What ``tablebot ARGS`` printed (its last line, the modules, taken off) and the cli modules it imported."""
-    done = subprocess.run([sys.executable, "-c", MODULES, *args], cwd=ROOT, env=child_env(), capture_output=True,
-                          text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-c", MODULES, *args], cwd=ROOT, env=child_env(), capture_output=True, text=True, timeout=60
+    )
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert lines[-1].startswith("MODULES")
@@ -75,7 +76,13 @@ def test_a_command_imports_its_own_module_alone_and_shows_its_whole_help() -> No
 
 
 def test_a_mistyped_command_is_answered_from_the_index() -> None:
-    done = subprocess.run([sys.executable, "-m", "tablebot", "sweeep"], cwd=ROOT, env=child_env(),
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "sweeep"],
+        cwd=ROOT,
+        env=child_env(),
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 2
     assert "'sweeep' is not a tablebot command" in done.stderr and "did you mean sweep" in done.stderr

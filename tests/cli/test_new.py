@@ -51,7 +51,7 @@ def test_the_empty_template_uses_your_names_and_shows_an_example_row(tmp_path: P
     table = load_table(folder / "table.csv")
     assert len(table.rows) == 2 and table.robot.name == "rover"
     assert table.robot.labels == {"Bump": "front bumper", "Dark": "input 2", "R": "right motor", "L": "left wheel"}
-    assert "when = \"R == 0 and L == 0\"" in (folder / "properties.toml").read_text()
+    assert 'when = "R == 0 and L == 0"' in (folder / "properties.toml").read_text()
 
 
 def test_a_renamed_bumberbot_runs_exactly_like_the_bumberbot(tmp_path: Path) -> None:
@@ -68,13 +68,19 @@ def test_a_renamed_bumberbot_runs_exactly_like_the_bumberbot(tmp_path: Path) -> 
     assert renamed == original  # the same bumpers and light sensors, wired under their new names
 
 
-@pytest.mark.parametrize(("args", "words"), [
-    (["--from", "line-follower", "--inputs", "I1"], "template has 2 inputs (I1, I2); --inputs gives 1"),
-    (["--inputs", "T,X"], "'T' cannot name a column"),
-    (["--motors", "M1,M1"], "M1 given twice"),
-    (["--from", "rocket"], "--from: error: 'rocket' is not one of the choices of --from\n    hint: use one of: "
-                           "bumberbot, line-follower, obstacle-avoider, empty"),  # tablebot's words, not the parser's
-])
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--from", "line-follower", "--inputs", "I1"], "template has 2 inputs (I1, I2); --inputs gives 1"),
+        (["--inputs", "T,X"], "'T' cannot name a column"),
+        (["--motors", "M1,M1"], "M1 given twice"),
+        (
+            ["--from", "rocket"],
+            "--from: error: 'rocket' is not one of the choices of --from\n    hint: use one of: "
+            "bumberbot, line-follower, obstacle-avoider, empty",
+        ),  # tablebot's words, not the parser's
+    ],
+)
 def test_bad_options_are_named(tmp_path: Path, args: list[str], words: str) -> None:
     result = runner.invoke(app, ["new", str(tmp_path / "x"), *args])
     assert result.exit_code == 2 and words in result.output

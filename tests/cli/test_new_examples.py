@@ -66,8 +66,9 @@ def variants(made: templates.Template) -> list[Variant]:
             first = uncomment(text.splitlines()[block[0]]).lstrip()
             header = first.startswith("[") and not first.startswith("[[")
             for number in block[1:] if header and len(block) > 2 else ():
-                out.append((f"{file} lines {block[0] + 1}, {number + 1}",
-                            {file: with_uncommented(text, [block[0], number])}))
+                out.append(
+                    (f"{file} lines {block[0] + 1}, {number + 1}", {file: with_uncommented(text, [block[0], number])})
+                )
         every[file] = with_uncommented(text, [n for block in found for n in block])
     return [*out, ("every example at once", every)]
 
@@ -78,13 +79,18 @@ def loads_whole(folder: Path) -> None:
     project.scene()  # robot, table and world checked together, as sim and sweep check them
 
 
-TEMPLATES = [(name, names) for name in templates.TEMPLATES for names in ([], [("A", "")], [("A", ""), ("B", "")])
-             if not (names and name != "empty")]
+TEMPLATES = [
+    (name, names)
+    for name in templates.TEMPLATES
+    for names in ([], [("A", "")], [("A", ""), ("B", "")])
+    if not (names and name != "empty")
+]
 
 
 @pytest.mark.parametrize(("template", "inputs"), TEMPLATES)
-def test_every_commented_example_can_be_uncommented(tmp_path: Path, template: str,
-                                                    inputs: list[tuple[str, str]]) -> None:
+def test_every_commented_example_can_be_uncommented(
+    tmp_path: Path, template: str, inputs: list[tuple[str, str]]
+) -> None:
     made = templates.make(template, "mine", inputs, [])
     tried = variants(made)
     for k, (what, changed) in enumerate(tried):

@@ -44,8 +44,10 @@ CORE = ("tick", "event", "row", "state", "timer", "M1", "M2")
 def bumps(seed: int = 3) -> Script:
     """Bumpers and light that change every few ticks, so the BumberBot takes many different rows."""
     rng = random.Random(seed)
-    held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
-            for _ in range(200)]
+    held = [
+        [0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
+        for _ in range(200)
+    ]
     return lambda n: (held[(n // 7) % len(held)], [0, 0, 0, 0])
 
 
@@ -62,8 +64,18 @@ def invoke(*args: object) -> Result:
 
 def test_a_run_writes_a_live_trace_that_tablebot_trace_replays_to_the_same_decisions(tmp_path: Path) -> None:
     with FakeTxt(bumps()) as fake:
-        result = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.8", "--out", tmp_path,
-                        "--link-timeout", "0.2")
+        result = invoke(
+            "run",
+            EXAMPLE,
+            "--on",
+            f"txt://127.0.0.1:{fake.port}",
+            "--seconds",
+            "0.8",
+            "--out",
+            tmp_path,
+            "--link-timeout",
+            "0.2",
+        )
     assert result.exit_code == 0, result.output
     assert "ran 80 ticks (0.80 s): done" in result.output
     lines = read_trace(tmp_path / "trace.jsonl")
@@ -78,8 +90,9 @@ def test_a_run_writes_a_live_trace_that_tablebot_trace_replays_to_the_same_decis
     assert summary["target"] == f"txt://127.0.0.1:{fake.port}"
     visited = list(dict.fromkeys(str(line["state"]) for line in lines))  # in order of first visit
     assert list(summary["seconds_per_state"]) == visited
-    assert summary["seconds_per_state"] == {s: round(0.01 * sum(str(x["state"]) == s for x in lines), 3)
-                                            for s in visited}
+    assert summary["seconds_per_state"] == {
+        s: round(0.01 * sum(str(x["state"]) == s for x in lines), 3) for s in visited
+    }
     assert summary["rows_fired"] == sum(line["row"] is not None for line in lines)
     assert not (tmp_path / "trace.partial.jsonl").exists()
 
@@ -87,8 +100,18 @@ def test_a_run_writes_a_live_trace_that_tablebot_trace_replays_to_the_same_decis
 def test_a_lost_link_ends_with_a_record_a_partial_trace_and_exit_3(tmp_path: Path) -> None:
     (tmp_path / "trace.jsonl").write_text("the previous complete run\n")
     with FakeTxt(fault=("silent", 20)) as fake:
-        result = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "5", "--out", tmp_path,
-                        "--link-timeout", "0.1")
+        result = invoke(
+            "run",
+            EXAMPLE,
+            "--on",
+            f"txt://127.0.0.1:{fake.port}",
+            "--seconds",
+            "5",
+            "--out",
+            tmp_path,
+            "--link-timeout",
+            "0.1",
+        )
     assert result.exit_code == 3 and "link_lost — no answer from" in result.output
     assert "Traceback" not in result.output
     lines = read_trace(tmp_path / "trace.partial.jsonl")
@@ -104,8 +127,9 @@ def test_a_lost_link_ends_with_a_record_a_partial_trace_and_exit_3(tmp_path: Pat
 
 def test_link_timeout_is_an_option(tmp_path: Path) -> None:
     with FakeTxt(fault=("late", 5), late_s=0.1) as fake:
-        slow = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.2",
-                      "--link-timeout", "0.5")
+        slow = invoke(
+            "run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.2", "--link-timeout", "0.5"
+        )
     assert slow.exit_code == 0, slow.output
     with FakeTxt(fault=("late", 5), late_s=0.1) as fake:
         default = invoke("run", EXAMPLE, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.2")
@@ -114,21 +138,37 @@ def test_link_timeout_is_an_option(tmp_path: Path) -> None:
 
 def spawn(args: list[str]) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    return subprocess.Popen([sys.executable, "-c", "from tablebot.cli import main; main()", *args], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-c", "from tablebot.cli import main; main()", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
-@pytest.mark.parametrize(("seconds", "sig", "code", "reason", "trace"), [
-    (None, signal.SIGINT, 0, "stopped", "trace.jsonl"),
-    ("30", signal.SIGINT, 130, "interrupted", "trace.partial.jsonl"),
-    ("30", signal.SIGTERM, 143, "terminated", "trace.partial.jsonl"),
-])
-def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(tmp_path: Path, seconds: str | None,
-                                                                       sig: int, code: int, reason: str,
-                                                                       trace: str) -> None:
+@pytest.mark.parametrize(
+    ("seconds", "sig", "code", "reason", "trace"),
+    [
+        (None, signal.SIGINT, 0, "stopped", "trace.jsonl"),
+        ("30", signal.SIGINT, 130, "interrupted", "trace.partial.jsonl"),
+        ("30", signal.SIGTERM, 143, "terminated", "trace.partial.jsonl"),
+    ],
+)
+def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(
+    tmp_path: Path, seconds: str | None, sig: int, code: int, reason: str, trace: str
+) -> None:
     with FakeTxt(bumps()) as fake:
-        args = ["run", str(EXAMPLE), "--on", f"txt://127.0.0.1:{fake.port}", "--out", str(tmp_path), "--link-timeout",
-                "0.3"]
+        args = [
+            "run",
+            str(EXAMPLE),
+            "--on",
+            f"txt://127.0.0.1:{fake.port}",
+            "--out",
+            str(tmp_path),
+            "--link-timeout",
+            "0.3",
+        ]
         process = spawn(args + (["--seconds", seconds] if seconds else []))
         try:
             fake.wait_for(30)
@@ -176,8 +216,9 @@ def test_the_live_view_shows_state_inputs_motors_and_lateness_with_user_text_mad
     view = LiveView(console, "TXT-fake 4.6.6")
     view.info = RunInfo(engine, 0.01, "txt://127.0.0.1:65000", None)
     engine.restore({**engine.snapshot(), "state": 2, "timer": 37, "outputs": {"M1": -4, "M2": 8}})
-    view.block(TickBlock.of_tick(engine, Reading(machine.input_bits["I3"] | machine.input_bits["I8"]),
-                                 {"late_ms": 7.5}))
+    view.block(
+        TickBlock.of_tick(engine, Reading(machine.input_bits["I3"] | machine.input_bits["I8"]), {"late_ms": 7.5})
+    )
     console.print(view)
     text = console.export_text()
     assert "state 2  Seek[31m turn [bold]" in text  # shown as it is written, never read as markup
@@ -202,8 +243,11 @@ def test_a_run_trace_that_cannot_be_replayed_is_a_located_error(tmp_path: Path) 
 def test_the_live_view_lets_no_control_character_of_a_label_reach_the_terminal(tmp_path: Path) -> None:
     """A NUL, a shift-out (switches a VT100's character set) and a one-byte C1 CSI act on a terminal as an
     ESC does; none of them reaches it, while the label's brackets stay as written."""
-    robot = (EXAMPLE / "robot.toml").read_text().replace('I3 = "front-right bumper"',
-                                                         'I3 = "front\\u0000\\u000e\\u009b31m [right]"')
+    robot = (
+        (EXAMPLE / "robot.toml")
+        .read_text()
+        .replace('I3 = "front-right bumper"', 'I3 = "front\\u0000\\u000e\\u009b31m [right]"')
+    )
     (tmp_path / "robot.toml").write_text(robot)
     (tmp_path / "table.csv").write_text((EXAMPLE / "table.csv").read_text())
     machine = compile_table(load_table(tmp_path / "table.csv"))
@@ -237,8 +281,9 @@ def test_auto_runs_on_the_address_that_answers_as_a_txt(monkeypatch: pytest.Monk
         other = Listener("127.0.0.7", fake.port, "400")
         try:
             monkeypatch.setattr(txt_link, "AUTO_HOSTS", ("127.0.0.7", "127.0.0.8", "127.0.0.9"))
-            result = invoke("run", EXAMPLE, "--on", f"txt://auto:{fake.port}", "--seconds", "0.05",
-                            "--link-timeout", "1")
+            result = invoke(
+                "run", EXAMPLE, "--on", f"txt://auto:{fake.port}", "--seconds", "0.05", "--link-timeout", "1"
+            )
             monkeypatch.setattr(txt_link, "AUTO_HOSTS", ("127.0.0.7", "127.0.0.8"))
             none = invoke("run", EXAMPLE, "--on", f"txt://auto:{fake.port}", "--seconds", "0.05")
         finally:

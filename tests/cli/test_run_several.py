@@ -15,8 +15,18 @@ LIGHTS = Path(__file__).resolve().parents[2] / "examples" / "bumberbot-lights"
 
 def test_a_live_run_of_several_tables_replays_to_the_same_decisions(tmp_path: Path) -> None:
     with FakeTxt(bumps()) as fake:
-        result = invoke("run", LIGHTS, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "0.8", "--out",
-                        tmp_path, "--link-timeout", "1")
+        result = invoke(
+            "run",
+            LIGHTS,
+            "--on",
+            f"txt://127.0.0.1:{fake.port}",
+            "--seconds",
+            "0.8",
+            "--out",
+            tmp_path,
+            "--link-timeout",
+            "1",
+        )
     assert result.exit_code == 0, result.output
     lines = read_trace(tmp_path / "trace.jsonl")
     assert len(lines) == 80
@@ -32,8 +42,18 @@ def test_a_live_run_of_several_tables_replays_to_the_same_decisions(tmp_path: Pa
 def test_a_lost_link_stops_every_tables_outputs(tmp_path: Path) -> None:
     """The lamps the lights table drives are off when the link is lost, as the motors are: one loop stops them."""
     with FakeTxt(bumps(), fault=("silent", 20)) as fake:
-        result = invoke("run", LIGHTS, "--on", f"txt://127.0.0.1:{fake.port}", "--seconds", "5", "--out", tmp_path,
-                        "--link-timeout", "0.1")
+        result = invoke(
+            "run",
+            LIGHTS,
+            "--on",
+            f"txt://127.0.0.1:{fake.port}",
+            "--seconds",
+            "5",
+            "--out",
+            tmp_path,
+            "--link-timeout",
+            "0.1",
+        )
     assert result.exit_code == 3 and "link_lost" in result.output and "Traceback" not in result.output
     lines = read_trace(tmp_path / "trace.partial.jsonl")
     assert lines[-1]["end"] == "link_lost" and any(line.get("L1") or line.get("L2") for line in lines[:-1])

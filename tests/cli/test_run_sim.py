@@ -35,11 +35,39 @@ def test_run_on_sim_takes_the_decisions_tablebot_sim_takes_for_the_same_recorded
     world = tmp_path / "box.toml"
     world.write_text(BOX, encoding="utf-8")
     runner = CliRunner()
-    live = runner.invoke(app, ["run", str(EXAMPLE), "--on", f"sim:{world}", "--seconds", "1.5", "--seed", "3",
-                               "--out", str(tmp_path / "run")])
+    live = runner.invoke(
+        app,
+        [
+            "run",
+            str(EXAMPLE),
+            "--on",
+            f"sim:{world}",
+            "--seconds",
+            "1.5",
+            "--seed",
+            "3",
+            "--out",
+            str(tmp_path / "run"),
+        ],
+    )
     assert live.exit_code == 0, live.output
-    batch = runner.invoke(app, ["sim", str(EXAMPLE), "--world", str(world), "--seconds", "1.5", "--seed", "3",
-                                "--out", str(tmp_path / "sim"), "--no-plots", "-q"])
+    batch = runner.invoke(
+        app,
+        [
+            "sim",
+            str(EXAMPLE),
+            "--world",
+            str(world),
+            "--seconds",
+            "1.5",
+            "--seed",
+            "3",
+            "--out",
+            str(tmp_path / "sim"),
+            "--no-plots",
+            "-q",
+        ],
+    )
     assert batch.exit_code == 0, batch.output
     ran, simulated = lines(tmp_path / "run" / "trace.jsonl"), lines(tmp_path / "sim" / "trace.jsonl")
     assert len(ran) == len(simulated) == 150
@@ -47,4 +75,5 @@ def test_run_on_sim_takes_the_decisions_tablebot_sim_takes_for_the_same_recorded
     assert len({line["row"] for line in simulated}) >= 4  # it met the lamp and turned: real decisions
     replayed = runner.invoke(app, ["trace", str(EXAMPLE), "--inputs", str(tmp_path / "run" / "trace.jsonl")])
     assert [json.loads(line) for line in replayed.output.splitlines()] == [
-        {k: line[k] for k in CORE} for line in simulated]
+        {k: line[k] for k in CORE} for line in simulated
+    ]

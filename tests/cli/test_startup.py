@@ -25,8 +25,14 @@ main()
 
 
 def python(code: str, *args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-c", code, *args], cwd=ROOT, capture_output=True, text=True,
-                          env={**os.environ, **(env or {})}, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-c", code, *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env={**os.environ, **(env or {})},
+        timeout=300,
+    )
 
 
 def packages_of(*args: str) -> set[str]:
@@ -56,8 +62,9 @@ print(sorted(m for m in ('numba.np.arraymath', 'numba.np.linalg', 'scipy', 'scip
 
 
 def test_numba_comes_without_scipy_and_scipy_still_imports() -> None:
-    done = python("import sys, tablebot.jit; print('scipy' in sys.modules); "
-                  "import scipy.linalg; print(scipy.linalg.__name__)")
+    done = python(
+        "import sys, tablebot.jit; print('scipy' in sys.modules); import scipy.linalg; print(scipy.linalg.__name__)"
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["False", "scipy.linalg"]
 
@@ -68,16 +75,27 @@ def test_check_imports_neither_numba_nor_pictures() -> None:
 
 def test_parsing_a_command_s_options_imports_no_pydantic(tmp_path: Path) -> None:
     # typer 0.29 coerces every option through pydantic (+0.1-0.2 s a process): pyproject.toml keeps typer below it
-    found = packages_of("sim", str(EXAMPLE), "--seconds", "0.05", "--seed", "3", "--no-plots", "--quiet",
-                        "--out", str(tmp_path / "sim"))
+    found = packages_of(
+        "sim", str(EXAMPLE), "--seconds", "0.05", "--seed", "3", "--no-plots", "--quiet", "--out", str(tmp_path / "sim")
+    )
     assert "typer" in found and "numba" in found  # it parsed options and ran the robot
     assert "pydantic" not in found
 
 
 def test_a_sweep_without_pictures_imports_neither_matplotlib_nor_scipy(tmp_path: Path) -> None:
     def sweep(out: str) -> set[str]:
-        return packages_of("sweep", str(EXAMPLE), "--robots", "4", "--seconds", "0.1", "--no-plots", "--quiet",
-                           "--out", str(tmp_path / out))
+        return packages_of(
+            "sweep",
+            str(EXAMPLE),
+            "--robots",
+            "4",
+            "--seconds",
+            "0.1",
+            "--no-plots",
+            "--quiet",
+            "--out",
+            str(tmp_path / out),
+        )
 
     sweep("first")  # on a cold cache this one compiles (numba's whole compiler, scipy included)
     found = sweep("second")

@@ -15,8 +15,11 @@ from tablebot.codegen.packing import MAX_EVENTS
 
 pytestmark = [pytest.mark.kernel_free]
 
-WIDE_ROBOT = ('name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'I{i} = ""\n' for i in range(MAX_EVENTS))
-              + '[motors]\nM1 = ""\n')
+WIDE_ROBOT = (
+    'name = "Wide"\ninitial_state = 1\n[inputs]\n'
+    + "".join(f'I{i} = ""\n' for i in range(MAX_EVENTS))
+    + '[motors]\nM1 = ""\n'
+)
 WIDE_TABLE = f"state,T,{','.join(f'I{i}' for i in range(MAX_EVENTS))},M1,timer,next\n1,1{',' * MAX_EVENTS},1,5,1\n"
 
 
@@ -65,9 +68,18 @@ def test_the_commands_choices_are_the_registered_back_ends() -> None:
     assert registry.names("export") == ["robopro", "robopro-rpp", "robopro-program", "c", "scxml", "xstate", "txt4"]
     assert registry.names("board") == ["uno", "ftduino"]
     assert registry.names("live") == ["txt", "robotx", "roboif", "sim"]
-    assert registry.check_targets() == ["robopro", "robopro-rpp", "robopro-program", "c", "uno", "ftduino", "txt",
-                                        "robotx", "roboif",
-                                        "txt4"]
+    assert registry.check_targets() == [
+        "robopro",
+        "robopro-rpp",
+        "robopro-program",
+        "c",
+        "uno",
+        "ftduino",
+        "txt",
+        "robotx",
+        "roboif",
+        "txt4",
+    ]
     from tablebot.cli.export import Target
     from tablebot.cli.firmware import BoardName
 

@@ -57,23 +57,45 @@ def test_a_robot_name_with_a_line_break_forges_no_line(bot: Path) -> None:
 
 def test_a_tools_own_output_prints_below_its_diagnostic_marked_as_part_of_it() -> None:
     with err_console.capture() as captured:
-        print_diagnostic(Diagnostic("avr-gcc", None, None, "avr-gcc failed", "report this",
-                                    detail="tb.c:3: error: x\ntb.c:4: note: y"))
-    assert captured.get().splitlines() == ["avr-gcc: error: avr-gcc failed", "    hint: report this",
-                                           "    | tb.c:3: error: x", "    | tb.c:4: note: y"]
+        print_diagnostic(
+            Diagnostic(
+                "avr-gcc", None, None, "avr-gcc failed", "report this", detail="tb.c:3: error: x\ntb.c:4: note: y"
+            )
+        )
+    assert captured.get().splitlines() == [
+        "avr-gcc: error: avr-gcc failed",
+        "    hint: report this",
+        "    | tb.c:3: error: x",
+        "    | tb.c:4: note: y",
+    ]
 
 
 def test_a_quiet_run_that_fails_still_says_why(tmp_path: Path) -> None:
     with FakeTxt(fault=("silent", 20)) as fake:
-        result = CliRunner().invoke(app, ["run", str(EXAMPLE), "--on", f"txt://127.0.0.1:{fake.port}", "-q",
-                                          "--seconds", "5", "--link-timeout", "0.1", "--out", str(tmp_path)])
+        result = CliRunner().invoke(
+            app,
+            [
+                "run",
+                str(EXAMPLE),
+                "--on",
+                f"txt://127.0.0.1:{fake.port}",
+                "-q",
+                "--seconds",
+                "5",
+                "--link-timeout",
+                "0.1",
+                "--out",
+                str(tmp_path),
+            ],
+        )
     assert result.exit_code == 3
     assert "ran 20 ticks: link_lost — no answer from" in result.stderr
     assert f"kept {tmp_path / 'trace.partial.jsonl'}" in result.stderr
     assert result.stdout == ""  # quiet: no summary
     with FakeTxt() as fake:
-        result = CliRunner().invoke(app, ["run", str(EXAMPLE), "--on", f"txt://127.0.0.1:{fake.port}", "-q",
-                                          "--seconds", "0.1"])
+        result = CliRunner().invoke(
+            app, ["run", str(EXAMPLE), "--on", f"txt://127.0.0.1:{fake.port}", "-q", "--seconds", "0.1"]
+        )
     assert result.exit_code == 0 and result.output == ""  # a run that succeeds stays silent
 
 
@@ -96,33 +118,50 @@ def test_a_deeply_nested_property_is_a_located_error_and_a_long_flat_one_works(b
     assert f"{bot / 'properties.toml'}:4: error: property negated" in output
     flat = " or ".join(["state == 20"] * 1000)
     every = " and ".join(["I3"] * 1000)
-    (bot / "properties.toml").write_text(f'[flat]\nnever = "{flat}"\nlevel = "warning"\n\n'
-                                         f'[every]\nnever = "{every} and M1 > 8"\n')
+    (bot / "properties.toml").write_text(
+        f'[flat]\nnever = "{flat}"\nlevel = "warning"\n\n[every]\nnever = "{every} and M1 > 8"\n'
+    )
     code, output = invoke("check", bot)
     assert code == 0, output
     assert "VIOLATED flat" in output and "holds    every" in output
 
 
-@pytest.mark.parametrize(("args", "words"), [
-    (["new", "x", "--from", "nothing"], "--from: error: 'nothing' is not one of the choices of --from\n"
-                                        "    hint: use one of: bumberbot, line-follower, obstacle-avoider, empty"),
-    (["export", str(EXAMPLE), "out", "--to", "cc"], "--to: error: 'cc' is not one of the choices of --to\n"
-                                                    f"    hint: use one of: {EXPORTS}"),
-    (["export", str(EXAMPLE), "out"], f"--to: error: --to is missing\n    hint: give --to one of: {EXPORTS}"),
-    (["sim", str(EXAMPLE), "--seconds", "abc"], "--seconds: error: 'abc' is not a number"),
-    (["sim", str(EXAMPLE), "--seconds", "9999"], "--seconds: error: --seconds 9999 is out of range\n"
-                                                 "    hint: give --seconds a value from 0.01 to 3600"),
-    (["sim", str(EXAMPLE), "--battery", "nan"], "--battery: error: --battery nan is not a finite number\n"
-                                                "    hint: give --battery a value from 0.0 to 1.0"),
-    (["sweep", str(EXAMPLE), "--seconds", "inf"], "--seconds: error: --seconds inf is not a finite number"),
-    (["run", str(EXAMPLE), "--on", "sim", "--seconds", "0.3", "-q", "--behind-limit", "nan"],
-     "--behind-limit: error: --behind-limit nan is not a finite number\n"
-     "    hint: give --behind-limit a value of at least 0.0"),
-    (["sim", str(EXAMPLE), "--sed", "3"], "--sed: error: --sed is not an option of this command\n"
-                                          "    hint: did you mean --seconds or --seed?"),
-    (["chek", str(EXAMPLE)], "chek: error: 'chek' is not a tablebot command\n    hint: did you mean check?"),
-    (["new"], "FOLDER: error: FOLDER is missing"),
-])
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (
+            ["new", "x", "--from", "nothing"],
+            "--from: error: 'nothing' is not one of the choices of --from\n"
+            "    hint: use one of: bumberbot, line-follower, obstacle-avoider, empty",
+        ),
+        (
+            ["export", str(EXAMPLE), "out", "--to", "cc"],
+            f"--to: error: 'cc' is not one of the choices of --to\n    hint: use one of: {EXPORTS}",
+        ),
+        (["export", str(EXAMPLE), "out"], f"--to: error: --to is missing\n    hint: give --to one of: {EXPORTS}"),
+        (["sim", str(EXAMPLE), "--seconds", "abc"], "--seconds: error: 'abc' is not a number"),
+        (
+            ["sim", str(EXAMPLE), "--seconds", "9999"],
+            "--seconds: error: --seconds 9999 is out of range\n    hint: give --seconds a value from 0.01 to 3600",
+        ),
+        (
+            ["sim", str(EXAMPLE), "--battery", "nan"],
+            "--battery: error: --battery nan is not a finite number\n    hint: give --battery a value from 0.0 to 1.0",
+        ),
+        (["sweep", str(EXAMPLE), "--seconds", "inf"], "--seconds: error: --seconds inf is not a finite number"),
+        (
+            ["run", str(EXAMPLE), "--on", "sim", "--seconds", "0.3", "-q", "--behind-limit", "nan"],
+            "--behind-limit: error: --behind-limit nan is not a finite number\n"
+            "    hint: give --behind-limit a value of at least 0.0",
+        ),
+        (
+            ["sim", str(EXAMPLE), "--sed", "3"],
+            "--sed: error: --sed is not an option of this command\n    hint: did you mean --seconds or --seed?",
+        ),
+        (["chek", str(EXAMPLE)], "chek: error: 'chek' is not a tablebot command\n    hint: did you mean check?"),
+        (["new"], "FOLDER: error: FOLDER is missing"),
+    ],
+)
 def test_a_wrong_command_line_is_answered_in_tablebots_words(args: list[str], words: str) -> None:
     """`new x --from nothing` answered "Invalid value for '--from': Value error, 'nothing' is not one of ..."."""
     code, output = invoke(*args)
@@ -140,8 +179,12 @@ def test_no_number_option_of_any_command_takes_nan_or_inf() -> None:
     from tablebot.cli.app import app
 
     group = typer.main.get_command(app)
-    options = [(name, param) for name, command in group.commands.items()  # type: ignore[attr-defined]
-               for param in command.params if isinstance(param.type, FloatParamType)]
+    options = [
+        (name, param)
+        for name, command in group.commands.items()  # type: ignore[attr-defined]
+        for param in command.params
+        if isinstance(param.type, FloatParamType)
+    ]
     assert len(options) == 9  # sim, sweep, tune, evolve, run, monitor: their --seconds, and four more
     for name, param in options:
         for text in ("nan", "-inf", "inf", "NaN"):
@@ -179,11 +222,16 @@ def test_compiled_tells_a_cached_function_from_one_still_to_compile(tmp_path: Pa
     import sys
 
     (tmp_path / "tiny.py").write_text("from tablebot.jit import njit\n\n@njit\ndef add(x):\n    return x + 1\n")
-    script = ("import tiny; from tablebot.jit import compiled\n"
-              "print(compiled(tiny.add)); tiny.add(1); print(compiled(tiny.add))\n")
+    script = (
+        "import tiny; from tablebot.jit import compiled\n"
+        "print(compiled(tiny.add)); tiny.add(1); print(compiled(tiny.add))\n"
+    )
     root = Path(__file__).resolve().parents[2]
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
-           "PYTHONPATH": os.pathsep.join([str(tmp_path), str(root / "src")])}
+    env = {
+        **os.environ,
+        "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+        "PYTHONPATH": os.pathsep.join([str(tmp_path), str(root / "src")]),
+    }
     done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120)
     assert done.stdout.split() == ["False", "True"], done.stderr
 

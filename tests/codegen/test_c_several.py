@@ -18,9 +18,10 @@ from tablebot.codegen.source import template
 from tablebot.loading import Loaded
 from tablebot.replay import replay_several
 
-pytestmark = pytest.mark.skipif(subprocess.run(["sh", "-c", "command -v cc || command -v gcc"],
-                                               capture_output=True, check=False).returncode != 0,
-                                reason="no C compiler")
+pytestmark = pytest.mark.skipif(
+    subprocess.run(["sh", "-c", "command -v cc || command -v gcc"], capture_output=True, check=False).returncode != 0,
+    reason="no C compiler",
+)
 LIGHTS = Path(__file__).resolve().parents[2] / "examples" / "bumberbot-lights"
 
 
@@ -49,19 +50,48 @@ def test_export_writes_a_unit_per_table_beside_the_engine_as_it_is(tmp_path: Pat
     """What a user gets: the engine files byte for byte as for one table, each table's unit, the robot's tick;
     they compile with a main of the user's own (here: the host runner) by the command tb_robot.h gives."""
     out = tmp_path / "c"
-    done = subprocess.run([".venv/bin/tablebot", "export", str(LIGHTS), "--to", "c", str(out)],
-                          capture_output=True, text=True, check=False, cwd=LIGHTS.parents[1])
+    done = subprocess.run(
+        [".venv/bin/tablebot", "export", str(LIGHTS), "--to", "c", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=LIGHTS.parents[1],
+    )
     assert done.returncode == 0, done.stderr
     assert sorted(p.name for p in out.iterdir()) == [
-        "tb_config.h", "tb_engine.c", "tb_engine.h", "tb_robot.c", "tb_robot.h", "tb_table_drive.c",
-        "tb_table_drive_config.h", "tb_table_lights.c", "tb_table_lights_config.h"]
+        "tb_config.h",
+        "tb_engine.c",
+        "tb_engine.h",
+        "tb_robot.c",
+        "tb_robot.h",
+        "tb_table_drive.c",
+        "tb_table_drive_config.h",
+        "tb_table_lights.c",
+        "tb_table_lights_config.h",
+    ]
     for name in ("tb_engine.c", "tb_engine.h"):
         assert (out / name).read_text(encoding="utf-8") == template(name)
     assert "Build: cc tb_robot.c tb_table_drive.c tb_table_lights.c YOUR_MAIN.c" in (out / "tb_robot.h").read_text()
     (out / "main.c").write_text(template("host_several.c"), encoding="utf-8")
-    built = subprocess.run([find_compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-o", "robot",
-                            "tb_robot.c", "tb_table_drive.c", "tb_table_lights.c", "main.c"],
-                           cwd=out, capture_output=True, text=True, check=False)
+    built = subprocess.run(
+        [
+            find_compiler(),
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-o",
+            "robot",
+            "tb_robot.c",
+            "tb_table_drive.c",
+            "tb_table_lights.c",
+            "main.c",
+        ],
+        cwd=out,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert built.returncode == 0, built.stderr
     ran = subprocess.run([str(out / "robot")], input="0\n16\n", capture_output=True, text=True, check=True)
     assert len(ran.stdout.splitlines()) == 2
@@ -72,13 +102,20 @@ def test_a_robot_reading_more_inputs_than_the_c_mask_holds_is_refused(tmp_path: 
     read by two tables are refused at the robot file, before any file is written."""
     names = [f"B{i}" for i in range(34)]
     (tmp_path / "robot.toml").write_text(
-        'name = "Wide"\n[inputs]\n' + "".join(f'{n} = "button {n}"\n' for n in names)
+        'name = "Wide"\n[inputs]\n'
+        + "".join(f'{n} = "button {n}"\n' for n in names)
         + '[motors]\nM1 = "right"\nM2 = "left"\n[tables]\n'
-        + 'a = { file = "a.csv", initial_state = 1 }\nb = { file = "b.csv", initial_state = 1 }\n')
+        + 'a = { file = "a.csv", initial_state = 1 }\nb = { file = "b.csv", initial_state = 1 }\n'
+    )
     for file, motor, part in (("a.csv", "M1", names[:17]), ("b.csv", "M2", names[17:])):
         (tmp_path / file).write_text(f"state,{','.join(part)},{motor},timer,next\n1,{',' * (len(part) - 1)},1,0,1\n")
-    done = subprocess.run([".venv/bin/tablebot", "export", str(tmp_path / "a.csv"), "--to", "c", str(tmp_path / "c")],
-                          capture_output=True, text=True, check=False, cwd=LIGHTS.parents[1])
+    done = subprocess.run(
+        [".venv/bin/tablebot", "export", str(tmp_path / "a.csv"), "--to", "c", str(tmp_path / "c")],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=LIGHTS.parents[1],
+    )
     assert done.returncode == 2, done.stdout + done.stderr
     assert "the robot's tables read 34 inputs, more than the 32 the C engine of several tables takes" in done.stderr
     assert not (tmp_path / "c").exists()

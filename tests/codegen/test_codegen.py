@@ -41,18 +41,25 @@ def bumberbot() -> tuple[Machine, list[TickInput]]:
 
 
 @pytest.mark.parametrize("lookup", ["dense", "scan"])
-def test_bumberbot_host_c_equals_python(bumberbot: tuple[Machine, list[TickInput]], lookup: str,
-                                        tmp_path: Path) -> None:
+def test_bumberbot_host_c_equals_python(
+    bumberbot: tuple[Machine, list[TickInput]], lookup: str, tmp_path: Path
+) -> None:
     machine, ticks = bumberbot
     exe = build_host(machine, tmp_path, lookup)
     assert run_host(exe, machine, ticks) == list(replay(machine, ticks))
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(seed=st.integers(0, 2**32 - 1), lookup=st.sampled_from(["dense", "scan"]),
-       lamps=st.integers(0, 2), counters=st.integers(0, 3), states=st.integers(1, 7))
-def test_random_tables_host_c_equals_python(tmp_path_factory: pytest.TempPathFactory, seed: int, lookup: str,
-                                            lamps: int, counters: int, states: int) -> None:
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    lookup=st.sampled_from(["dense", "scan"]),
+    lamps=st.integers(0, 2),
+    counters=st.integers(0, 3),
+    states=st.integers(1, 7),
+)
+def test_random_tables_host_c_equals_python(
+    tmp_path_factory: pytest.TempPathFactory, seed: int, lookup: str, lamps: int, counters: int, states: int
+) -> None:
     rng = random.Random(seed)
     table = random_table(rng, Shape(states=states, rows=states * 3, lamps=lamps, counters=counters))
     machine = compile_table(table)
@@ -82,8 +89,23 @@ def test_wide_table_uses_16_bit_rows_and_scan(tmp_path: Path) -> None:
 
 
 def _avr_gcc_compiles(folder: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(["avr-gcc", "-mmcu=atmega328p", "-std=c99", "-Wall", "-Wextra", "-Werror", "-Os",
-                           "-c", "tb_engine.c", "tb_table.c"], cwd=folder, capture_output=True, text=True)
+    return subprocess.run(
+        [
+            "avr-gcc",
+            "-mmcu=atmega328p",
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-Os",
+            "-c",
+            "tb_engine.c",
+            "tb_table.c",
+        ],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+    )
 
 
 @pytest.mark.parametrize("shape", [Shape(), Shape(lamps=2, counters=2, states=9), Shape(states=1, rows=1)])

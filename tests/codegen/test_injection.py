@@ -26,8 +26,10 @@ if TYPE_CHECKING:
 RPP = Path(__file__).resolve().parents[1] / "fixtures" / "rpp" / "engine.rpp"
 SVG = "{http://www.w3.org/2000/svg}"
 runner = CliRunner()
-needs = {tool: pytest.mark.skipif(shutil.which(tool) is None, reason=f"{tool} is not installed")
-         for tool in ("gcc", "avr-gcc", "dot")}
+needs = {
+    tool: pytest.mark.skipif(shutil.which(tool) is None, reason=f"{tool} is not installed")
+    for tool in ("gcc", "avr-gcc", "dot")
+}
 
 
 @pytest.fixture
@@ -45,8 +47,12 @@ def run(*args: object, code: int = 0) -> Result:
 
 def code_only(path: Path, compiler: str = "gcc") -> str:
     """A C file with its comments removed by the compiler's own preprocessor: what the compiler sees."""
-    done = subprocess.run([compiler, "-std=c99", "-fpreprocessed", "-dD", "-E", "-P", "-x", "c", str(path)],
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run(
+        [compiler, "-std=c99", "-fpreprocessed", "-dD", "-E", "-P", "-x", "c", str(path)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return done.stdout
 
 
@@ -164,8 +170,12 @@ def test_flash_dry_run_prints_a_command_a_shell_reads_back(tmp_path: Path) -> No
     result = run("flash", hexfile, "--board", "uno", "--port", port, "--dry-run")
     printed = result.stdout.strip()
     assert "\x1b" not in printed
-    argv = subprocess.run(["bash", "-c", f'for a in {printed}; do printf "%s\\0" "$a"; done'],
-                          capture_output=True, check=True, cwd=tmp_path).stdout.split(b"\0")[:-1]
+    argv = subprocess.run(
+        ["bash", "-c", f'for a in {printed}; do printf "%s\\0" "$a"; done'],
+        capture_output=True,
+        check=True,
+        cwd=tmp_path,
+    ).stdout.split(b"\0")[:-1]
     assert argv[argv.index(b"-P") + 1] == port.encode()
     assert argv[-1] == f"flash:w:{hexfile}:i".encode()
     assert not (tmp_path / "pwned").exists()

@@ -60,7 +60,8 @@ def test_unreachable_state_and_busy_timer_reasons(tmp_path: Path) -> None:
     _, cov = golden_files(FIX / "unreachable.csv", tmp_path / "u")
     assert [r["why_not"] for r in cov["rows"] if not r["covered"]] == [
         "state 3 (Lost) can never be reached from the initial state 1 (Drive): no row leads to it; "
-        "its rows (line 4) are dead"]
+        "its rows (line 4) are dead"
+    ]
     _, cov = golden_files(FIX / "busy.csv", tmp_path / "b")
     (why,) = [r["why_not"] for r in cov["rows"] if not r["covered"]]
     assert "timer never runs out" in why

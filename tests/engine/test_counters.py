@@ -54,6 +54,7 @@ def test_counter_counts_its_own_motors_pulses_and_never_below_zero(tmp_path: Pat
 
 def test_pulses_as_a_numpy_array(tmp_path: Path) -> None:
     import numpy as np
+
     engine = Engine(machine_of(tmp_path, COUNT_DOWN, COUNTER_ROBOT))
     for pulses in ([0, 0], np.array([1, 0]), np.array([2, 0], dtype=np.int64)):
         engine.step(np.int64(0), pulses)
@@ -110,6 +111,7 @@ def test_counter_state_survives_snapshot(tmp_path: Path) -> None:
 
 
 # --- signed motors --------------------------------------------------------------------------------------
+
 
 def to_signed(text: str, keep: str = "=") -> str:
     """The BumberBot table rewritten with one signed column per motor."""
@@ -183,18 +185,21 @@ def test_blank_motor_cell_stops_but_blank_lamp_keeps(tmp_path: Path) -> None:
 HEADER = "description,state,T,C1,M1,M2_dir,M2_speed,L1,C1_load,timer,next"
 
 
-@pytest.mark.parametrize(("line", "index", "pattern"), [
-    ("a,1,1,,9,,0,,,0,1", 4, r"M1: 9 is out of range -8\.\.8"),
-    ("a,1,1,,-9,,0,,,0,1", 4, r"M1: -9 is out of range -8\.\.8"),
-    ("a,1,1,,fast,,0,,,0,1", 4, r"M1: 'fast' is not an integer"),
-    ("a,1,1,,0,,=,,,0,1", 6, r"M2_speed: '=' is not an integer"),
-    ("a,1,1,,0,,0,9,,0,1", 7, r"L1: 9 is out of range 0\.\.8"),
-    ("a,1,1,,0,,0,-1,,0,1", 7, r"L1: -1 is out of range 0\.\.8"),
-    ("a,1,1,,0,,0,on,,0,1", 7, r"L1: 'on' is not an integer"),
-    ("a,1,1,,0,,0,,-1,0,1", 8, r"C1_load: -1 is out of range 0\.\.65535"),
-    ("a,1,1,,0,,0,,65536,0,1", 8, r"C1_load: 65536 is out of range"),
-    ("a,1,1,2,0,,0,,,0,1", 3, r"event C1: 2 is out of range 0\.\.1"),
-])
+@pytest.mark.parametrize(
+    ("line", "index", "pattern"),
+    [
+        ("a,1,1,,9,,0,,,0,1", 4, r"M1: 9 is out of range -8\.\.8"),
+        ("a,1,1,,-9,,0,,,0,1", 4, r"M1: -9 is out of range -8\.\.8"),
+        ("a,1,1,,fast,,0,,,0,1", 4, r"M1: 'fast' is not an integer"),
+        ("a,1,1,,0,,=,,,0,1", 6, r"M2_speed: '=' is not an integer"),
+        ("a,1,1,,0,,0,9,,0,1", 7, r"L1: 9 is out of range 0\.\.8"),
+        ("a,1,1,,0,,0,-1,,0,1", 7, r"L1: -1 is out of range 0\.\.8"),
+        ("a,1,1,,0,,0,on,,0,1", 7, r"L1: 'on' is not an integer"),
+        ("a,1,1,,0,,0,,-1,0,1", 8, r"C1_load: -1 is out of range 0\.\.65535"),
+        ("a,1,1,,0,,0,,65536,0,1", 8, r"C1_load: 65536 is out of range"),
+        ("a,1,1,2,0,,0,,,0,1", 3, r"event C1: 2 is out of range 0\.\.1"),
+    ],
+)
 def test_out_of_range_values_are_located(tmp_path: Path, line: str, index: int, pattern: str) -> None:
     diagnostics = problems(write_table(tmp_path, HEADER + "\n" + line + "\n", COUNTER_ROBOT))
     assert len(diagnostics) == 1, [d.message for d in diagnostics]
@@ -209,11 +214,14 @@ def test_signed_error_hint_mentions_keep(tmp_path: Path) -> None:
     assert "keep" in d.hint
 
 
-@pytest.mark.parametrize("header", [
-    "state,T,M1,M1_dir,M1_speed,timer,next",
-    "state,T,M1_speed,M1,timer,next",
-    "state,T,M1_dir,M1,timer,next",
-])
+@pytest.mark.parametrize(
+    "header",
+    [
+        "state,T,M1,M1_dir,M1_speed,timer,next",
+        "state,T,M1_speed,M1,timer,next",
+        "state,T,M1_dir,M1,timer,next",
+    ],
+)
 def test_mixed_forms_for_one_motor(tmp_path: Path, header: str) -> None:
     diagnostics = problems(write_table(tmp_path, header + "\n1,1,1,1,1,0,1\n", COUNTER_ROBOT))
     hits = [d for d in diagnostics if "both as M1 and as M1_dir/M1_speed" in d.message]

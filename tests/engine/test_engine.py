@@ -39,6 +39,7 @@ def run(engine: Engine, masks: list[int]) -> list[tuple[int, int, StateId, int, 
 
 # --- the BumberBot, as the document describes it ------------------------------------------------------
 
+
 def test_first_tick_timer_zero_fires_seek_turn() -> None:
     engine = bumberbot()
     assert engine.snapshot() == {"tick": 0, "state": 2, "timer": 0, "counters": {}, "outputs": {"M1": 0, "M2": 0}}
@@ -129,22 +130,34 @@ def test_row_without_events_fires_every_tick(tmp_path: Path) -> None:
     table = "state,A,M1,M2,timer,next\n1,1,8,8,9,1\n1,,1,1,3,1\n"
     engine = Engine(machine_of(tmp_path, table, MINI_ROBOT))
     assert [(engine.step({"A": a}), engine.row, engine.timer) for a in (0, 1, 0, 1)] == [
-        ((1, 1), 1, 3), ((8, 8), 0, 9), ((1, 1), 1, 3), ((8, 8), 0, 9)]
+        ((1, 1), 1, 3),
+        ((8, 8), 0, 9),
+        ((1, 1), 1, 3),
+        ((8, 8), 0, 9),
+    ]
 
 
 def test_initial_timer_from_the_robot(tmp_path: Path) -> None:
     robot = MINI_ROBOT.replace("initial_timer = 0", "initial_timer = 3")
     engine = Engine(machine_of(tmp_path, "state,T,M1,timer,next\n1,1,5,0,1\n", robot))
     assert [(engine.step(), engine.timer, engine.row) for _ in range(5)] == [
-        ((0, 0), 3, NO_ROW), ((0, 0), 2, NO_ROW), ((0, 0), 1, NO_ROW), ((5, 0), 0, 0), ((5, 0), 0, 0)]
+        ((0, 0), 3, NO_ROW),
+        ((0, 0), 2, NO_ROW),
+        ((0, 0), 1, NO_ROW),
+        ((5, 0), 0, 0),
+        ((5, 0), 0, 0),
+    ]
 
 
-@pytest.mark.parametrize(("timer", "fired"), [
-    (0, [0, 0, 0, 0, 0, 0]),  # timer 0: T is present again on the very next tick
-    (1, [0, 0, 0, 0, 0, 0]),  # 1 is counted down to 0 before the next tick looks for T
-    (2, [0, NO_ROW, 0, NO_ROW, 0, NO_ROW]),
-    (3, [0, NO_ROW, NO_ROW, 0, NO_ROW, NO_ROW]),
-])
+@pytest.mark.parametrize(
+    ("timer", "fired"),
+    [
+        (0, [0, 0, 0, 0, 0, 0]),  # timer 0: T is present again on the very next tick
+        (1, [0, 0, 0, 0, 0, 0]),  # 1 is counted down to 0 before the next tick looks for T
+        (2, [0, NO_ROW, 0, NO_ROW, 0, NO_ROW]),
+        (3, [0, NO_ROW, NO_ROW, 0, NO_ROW, NO_ROW]),
+    ],
+)
 def test_a_timer_of_n_fires_t_n_ticks_later(tmp_path: Path, timer: int, fired: list[int]) -> None:
     engine = Engine(machine_of(tmp_path, f"state,T,M1,timer,next\n1,1,=,{timer},1\n", MINI_ROBOT))
     rows = []
@@ -164,6 +177,7 @@ def test_table_without_t_column_never_sees_the_timer(tmp_path: Path) -> None:
 
 
 # --- snapshot and restore -----------------------------------------------------------------------------
+
 
 def example_ticks() -> tuple[Machine, list[TickInput]]:
     machine = example_machine()
@@ -218,14 +232,17 @@ def test_snapshot_names_named_states(tmp_path: Path) -> None:
     assert other.step() == engine.step()
 
 
-@pytest.mark.parametrize(("change", "pattern"), [
-    ({"state": 99}, "state: 99"),
-    ({"timer": -1}, "must not be negative"),
-    ({"tick": -5}, "must not be negative"),
-    ({"outputs": {"M1": 0}}, "must name exactly"),
-    ({"counters": {"C1": 0}}, "must name exactly"),
-    ({"timer": "soon"}, "timer"),
-])
+@pytest.mark.parametrize(
+    ("change", "pattern"),
+    [
+        ({"state": 99}, "state: 99"),
+        ({"timer": -1}, "must not be negative"),
+        ({"tick": -5}, "must not be negative"),
+        ({"outputs": {"M1": 0}}, "must name exactly"),
+        ({"counters": {"C1": 0}}, "must name exactly"),
+        ({"timer": "soon"}, "timer"),
+    ],
+)
 def test_restore_refuses_a_snapshot_that_does_not_fit(change: dict[str, object], pattern: str) -> None:
     engine = bumberbot()
     with pytest.raises(ValueError, match=pattern):
@@ -252,6 +269,7 @@ def test_failed_restore_leaves_the_engine_as_it_was() -> None:
 
 # --- the batch path -----------------------------------------------------------------------------------
 
+
 def test_batch_results_as_lists_and_arrays() -> None:
     engine = bumberbot()
     batch = engine.run([0, I7, 0, I5])
@@ -267,14 +285,17 @@ def test_batch_results_as_lists_and_arrays() -> None:
     assert all(type(v) is int for v in (engine.state, engine.timer, engine.event, engine.row, *engine.outputs))
 
 
-@pytest.mark.parametrize("masks", [
-    [0, I3 | I4, 0, 0],
-    (0, I3 | I4, 0, 0),
-    np.array([0, I3 | I4, 0, 0], dtype=np.uint8),
-    np.array([0, I3 | I4, 0, 0], dtype=np.int32),
-    np.array([0, I3 | I4, 0, 0, 99], dtype=np.int64)[:4],
-    [0, I3 | I4 | T, 0, 0],  # T's bit is the engine's to make: ignored, as step does
-])
+@pytest.mark.parametrize(
+    "masks",
+    [
+        [0, I3 | I4, 0, 0],
+        (0, I3 | I4, 0, 0),
+        np.array([0, I3 | I4, 0, 0], dtype=np.uint8),
+        np.array([0, I3 | I4, 0, 0], dtype=np.int32),
+        np.array([0, I3 | I4, 0, 0, 99], dtype=np.int64)[:4],
+        [0, I3 | I4 | T, 0, 0],  # T's bit is the engine's to make: ignored, as step does
+    ],
+)
 def test_batch_accepts_any_integer_sequence(masks: list[int] | tuple[int, ...] | np.ndarray) -> None:
     assert bumberbot().run(masks).rows == [7, 0, NO_ROW, NO_ROW]
 
@@ -283,8 +304,11 @@ def test_batch_accepts_any_integer_sequence(masks: list[int] | tuple[int, ...] |
 @pytest.mark.parametrize("bad", [-1, 64, 256, 1 << 40])
 def test_masks_beyond_the_tables_events_are_refused(bad: int, jit: bool | None) -> None:
     """Issue 14: a negative or too-wide mask is a ValueError naming the valid range and the inputs."""
-    with pytest.raises(ValueError, match=r"0\.\.63.*I3=16") if jit is False else pytest.raises(ValueError,
-                                                                                            match=r"0\.\.63"):
+    with (
+        pytest.raises(ValueError, match=r"0\.\.63.*I3=16")
+        if jit is False
+        else pytest.raises(ValueError, match=r"0\.\.63")
+    ):
         bumberbot().run([0, bad], jit=jit)
     engine = bumberbot()
     with pytest.raises(ValueError, match=rf"input mask {bad} .*0\.\.63.*I3=16, I4=8, I5=4, I7=2, I8=1"):
@@ -292,15 +316,18 @@ def test_masks_beyond_the_tables_events_are_refused(bad: int, jit: bool | None) 
     assert engine.tick == 0  # refused before anything changed
 
 
-@pytest.mark.parametrize("inputs, message", [
-    ({"i3": 1}, r"unknown input 'i3'; the inputs are I3=16, I4=8"),
-    ({"I3": 2}, r"input 'I3': 2 is not 0 or 1"),
-    ({"I3": 0.5}, r"input 'I3': 0.5 is not 0 or 1"),
-    ("I3", r"not str"),
-    (1.0, r"not float"),
-    (True, r"not bool"),
-    (None, r"not NoneType"),
-])
+@pytest.mark.parametrize(
+    "inputs, message",
+    [
+        ({"i3": 1}, r"unknown input 'i3'; the inputs are I3=16, I4=8"),
+        ({"I3": 2}, r"input 'I3': 2 is not 0 or 1"),
+        ({"I3": 0.5}, r"input 'I3': 0.5 is not 0 or 1"),
+        ("I3", r"not str"),
+        (1.0, r"not float"),
+        (True, r"not bool"),
+        (None, r"not NoneType"),
+    ],
+)
 def test_wrong_inputs_name_the_offending_key_and_the_valid_ones(inputs: object, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         bumberbot().step(inputs)  # type: ignore[arg-type]  # what the hint refuses, refused at run time too
@@ -329,8 +356,10 @@ def wide_engine(tmp_path: Path, inputs: int) -> Engine:
     names = [f"I{i}" for i in range(inputs)]
     robot = 'name = "Wide"\ninitial_state = 1\n[inputs]\n' + "".join(f'{n} = ""\n' for n in names)
     robot += '[motors]\nM1 = ""\n'
-    rows = [f"1,{','.join('1' if j in (i, (i * 7) % inputs) else '' for j in range(inputs))},{i % 9},{i},2"
-            for i in range(inputs)]
+    rows = [
+        f"1,{','.join('1' if j in (i, (i * 7) % inputs) else '' for j in range(inputs))},{i % 9},{i},2"
+        for i in range(inputs)
+    ]
     rows += [f"2,{','.join('1' if j == i else '' for j in range(inputs))},-{i % 9},{i},1" for i in range(inputs)]
     table = f"state,{','.join(names)},M1,timer,next\n" + "\n".join(rows) + "\n"
     return Engine(machine_of(tmp_path, table, robot))

@@ -73,14 +73,17 @@ def test_a_refused_input_names_what_is_wrong_and_changes_nothing(bad: object, me
 
 
 def test_refused_pulses_change_nothing_not_even_the_tick(tmp_path: Path) -> None:
-    counting = Engine(machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,1,,5,3,2,1\n1,,1,0,=,0,1\n",
-                                 COUNTER_ROBOT))
+    counting = Engine(
+        machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,1,,5,3,2,1\n1,,1,0,=,0,1\n", COUNTER_ROBOT)
+    )
     counting.step(0, (0, 0))
     before = whole_state(counting)
-    for pulses, message in (((1, 2, 3), r"pulses: 3 values for 2 counters \(C1, C2\)"),
-                            ((1,), r"pulses: 1 values for 2 counters"),
-                            ((2, -1), r"pulses: -1 for counter 2 is negative"),
-                            ((-1, 0), r"pulses: -1 for counter 1 is negative")):
+    for pulses, message in (
+        ((1, 2, 3), r"pulses: 3 values for 2 counters \(C1, C2\)"),
+        ((1,), r"pulses: 1 values for 2 counters"),
+        ((2, -1), r"pulses: -1 for counter 2 is negative"),
+        ((-1, 0), r"pulses: -1 for counter 1 is negative"),
+    ):
         with pytest.raises(ValueError, match=message):
             counting.step(0, pulses)
         assert whole_state(counting) == before
@@ -100,8 +103,12 @@ def test_no_pulses_as_none_empty_tuple_or_empty_list() -> None:
     nothing: tuple[Sequence[int] | np.ndarray | None, ...] = (None, (), [], np.zeros(0, dtype=np.int64))
     for pulses in nothing:
         engine = Engine(example_machine())
-        trace.append([(engine.step(mask, pulses), engine.event, engine.row, engine.timer)
-                      for mask in [0, I7, 0, I5, I3 | I4] * 3])
+        trace.append(
+            [
+                (engine.step(mask, pulses), engine.event, engine.row, engine.timer)
+                for mask in [0, I7, 0, I5, I3 | I4] * 3
+            ]
+        )
     assert trace[0] == trace[1] == trace[2] == trace[3]
     engine = Engine(example_machine())
     assert [engine.step(mask) for mask in [0, I7]] == [(4, 4), (1, 5)]
@@ -121,8 +128,9 @@ def test_the_engines_own_bits_in_a_mask_are_ignored_by_every_input_kind(ticks_be
 
 
 def test_counter_bits_in_a_mask_are_ignored(tmp_path: Path) -> None:
-    machine = machine_of(tmp_path, "state,T,C1,A,M1,C1_load,timer,next\n1,1,,,5,3,9,2\n2,,1,,6,=,0,1\n"
-                                   "2,,,1,7,=,0,1\n", COUNTER_ROBOT)
+    machine = machine_of(
+        tmp_path, "state,T,C1,A,M1,C1_load,timer,next\n1,1,,,5,3,9,2\n2,,1,,6,=,0,1\n2,,,1,7,=,0,1\n", COUNTER_ROBOT
+    )
     c1, a = machine.table.bit("C1"), machine.input_bits["A"]
     with_bit, without = Engine(machine), Engine(machine)
     for mask in (0, c1, c1 | a, c1, c1, c1):
@@ -200,8 +208,7 @@ def test_the_first_tick_after_restoring_tick_0_does_not_count_down(tmp_path: Pat
 
 
 def test_counters_assign_and_read_as_a_copy(tmp_path: Path) -> None:
-    machine = machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,,1,7,=,0,1\n1,1,,=,=,0,1\n",
-                         COUNTER_ROBOT)
+    machine = machine_of(tmp_path, "state,T,C1,M1,C1_load,timer,next\n1,,1,7,=,0,1\n1,1,,=,=,0,1\n", COUNTER_ROBOT)
     engine = Engine(machine)
     engine.counters = [2, 0]
     engine.step(0, (0, 0))

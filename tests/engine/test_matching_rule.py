@@ -56,12 +56,14 @@ def folder(tmp_path: Path, match: str | None) -> Path:
     tmp_path.mkdir(parents=True, exist_ok=True)
     (tmp_path / "table.csv").write_text(TABLE, encoding="utf-8")
     if match != "-":
-        (tmp_path / "robot.toml").write_text(ROBOT.format(match=f'match = "{match}"' if match else ""),
-                                             encoding="utf-8")
+        (tmp_path / "robot.toml").write_text(
+            ROBOT.format(match=f'match = "{match}"' if match else ""), encoding="utf-8"
+        )
     return tmp_path / "table.csv"
 
 
 # --- the robot file -----------------------------------------------------------------------------------
+
 
 def test_a_robot_file_chooses_the_rule_and_says_so_or_gets_the_old_rule(tmp_path: Path) -> None:
     for match, says in (("document", True), ("always", True), (None, False)):
@@ -83,11 +85,16 @@ def test_a_bad_rule_is_a_located_error_naming_both_words(tmp_path: Path, value: 
 
 
 def test_the_shipped_robots_say_their_rule_and_the_two_newer_ones_drive_alike_under_both() -> None:
-    rules = {name: load_table(ROOT / "examples" / name / "table.csv").robot for name in
-             ("bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider")}
+    rules = {
+        name: load_table(ROOT / "examples" / name / "table.csv").robot
+        for name in ("bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider")
+    }
     assert {name: (r.match, r.says_match) for name, r in rules.items()} == {
-        "bumberbot": ("document", True), "bumberbot-counters": ("document", True),
-        "line-follower": ("always", True), "obstacle-avoider": ("always", True)}
+        "bumberbot": ("document", True),
+        "bumberbot-counters": ("document", True),
+        "line-follower": ("always", True),
+        "obstacle-avoider": ("always", True),
+    }
     for name, rows in (("line-follower", 3), ("obstacle-avoider", 1)):
         table, _ = load(ROOT / "examples" / name)
         found = no_event_rows(table)
@@ -99,21 +106,38 @@ def test_the_shipped_robots_say_their_rule_and_the_two_newer_ones_drive_alike_un
 
 # --- check ----------------------------------------------------------------------------------------------
 
+
 def findings(table: Path) -> list[dict]:
     result = runner.invoke(app, ["check", str(table), "--format", "json"])
     return [f for f in json.loads(result.stdout)["findings"] if f["code"] == "no-event-row"]
 
 
-@pytest.mark.parametrize(("match", "severity", "words"), [
-    ("always", "info", ['with match = "always" (', "robot.toml:3)", "fires even on a tick with no event",
-                        "line 4 leads into it with timer 100", "the document's engine looks a row up only if"]),
-    ("document", "info", ['with match = "document" (', "fires only on a tick with some event",
-                          "then nothing fires"]),
-    (None, "warning", ["does not say which matching rule", 'by default (match = "always"']),
-    ("-", "warning", ["has no robot file", "built-in BumberBot", 'match = "document"']),
-])
-def test_check_says_what_the_rule_does_with_a_row_that_requires_no_event(tmp_path: Path, match: str | None,
-                                                                         severity: str, words: list[str]) -> None:
+@pytest.mark.parametrize(
+    ("match", "severity", "words"),
+    [
+        (
+            "always",
+            "info",
+            [
+                'with match = "always" (',
+                "robot.toml:3)",
+                "fires even on a tick with no event",
+                "line 4 leads into it with timer 100",
+                "the document's engine looks a row up only if",
+            ],
+        ),
+        (
+            "document",
+            "info",
+            ['with match = "document" (', "fires only on a tick with some event", "then nothing fires"],
+        ),
+        (None, "warning", ["does not say which matching rule", 'by default (match = "always"']),
+        ("-", "warning", ["has no robot file", "built-in BumberBot", 'match = "document"']),
+    ],
+)
+def test_check_says_what_the_rule_does_with_a_row_that_requires_no_event(
+    tmp_path: Path, match: str | None, severity: str, words: list[str]
+) -> None:
     (found,) = findings(folder(tmp_path, match))
     assert (found["severity"], found["lines"], found["state"]) == (severity, [3], 1)
     assert found["message"].startswith("row on line 3 requires no event")
@@ -139,6 +163,7 @@ def test_check_names_every_row_that_requires_no_event_a_later_one_of_its_state_t
 
 
 # --- the lists: run by the document's engine ----------------------------------------------------------------
+
 
 @pytest.mark.parametrize("match", ["always", None])
 def test_the_list_export_refuses_a_row_the_document_would_not_fire(tmp_path: Path, match: str | None) -> None:
@@ -176,6 +201,7 @@ def test_import_warns_when_the_robot_would_fire_what_the_lists_did_not(tmp_path:
 
 # --- the studio's explanation -------------------------------------------------------------------------------
 
+
 def test_the_studio_says_why_a_row_that_requires_no_event_did_not_fire(tmp_path: Path) -> None:
     for match in ("document", "always"):
         table, machine = load(folder(tmp_path / match, match))
@@ -188,8 +214,10 @@ def test_the_studio_says_why_a_row_that_requires_no_event_did_not_fire(tmp_path:
             assert cruise["status"] == "fired"
 
 
-@pytest.mark.parametrize(("template", "match"), [("empty", "document"), ("bumberbot", "document"),
-                                                 ("line-follower", "always"), ("obstacle-avoider", "always")])
+@pytest.mark.parametrize(
+    ("template", "match"),
+    [("empty", "document"), ("bumberbot", "document"), ("line-follower", "always"), ("obstacle-avoider", "always")],
+)
 def test_new_robots_write_the_rule_down(tmp_path: Path, template: str, match: str) -> None:
     result = runner.invoke(app, ["new", str(tmp_path / "bot"), "--from", template])
     assert result.exit_code == 0, result.output
@@ -201,8 +229,9 @@ def test_the_robopro_program_is_generated_for_the_robot_files_rule(tmp_path: Pat
     """export --to robopro-program takes the rule from the robot file: the document's test of EV, or none."""
     for match in ("document", "always"):
         out = tmp_path / "out" / match
-        result = runner.invoke(app, ["export", str(folder(tmp_path / match, match)), "--to", "robopro-program",
-                                     str(out)])
+        result = runner.invoke(
+            app, ["export", str(folder(tmp_path / match, match)), "--to", "robopro-program", str(out)]
+        )
         assert result.exit_code == 0, result.output
         text = (out / "Cruiser.rpp").read_text(encoding="utf-8")
         assert ("if an event is detected (EV &gt; 0)" in text) == (match == "document")

@@ -42,14 +42,19 @@ def literal(tables: RobotTables, ticks: list[TickInput]) -> list[dict[str, Any]]
         fired: list[Row | None] = []
         events: list[set[str]] = []
         for k, table in enumerate(tables.tables):
-            present = {e for e in table.events if e in pressed
-                       or (e == TIMER_EVENT and timers[k] == 0)
-                       or (e in robot.counter_names and counters[robot.counter_names.index(e)] == 0)
-                       or (e in table.cross and table.cross[e].covers(start[tables.index(table.cross[e].table)]))}
+            present = {
+                e
+                for e in table.events
+                if e in pressed
+                or (e == TIMER_EVENT and timers[k] == 0)
+                or (e in robot.counter_names and counters[robot.counter_names.index(e)] == 0)
+                or (e in table.cross and table.cross[e].covers(start[tables.index(table.cross[e].table)]))
+            }
             events.append(present)
             quiet = not present and table.robot.match == "document"
-            fired.append(None if quiet else next((r for r in table.rows if r.state == start[k]
-                                                  and r.events <= present), None))
+            fired.append(
+                None if quiet else next((r for r in table.rows if r.state == start[k] and r.events <= present), None)
+            )
         for k, row in enumerate(fired):
             if row is None:
                 continue
@@ -62,26 +67,45 @@ def literal(tables: RobotTables, ticks: list[TickInput]) -> list[dict[str, Any]]
     return lines
 
 
-def _line(tables: RobotTables, n: int, events: list[set[str]], fired: list[Row | None], states: list[Any],
-          timers: list[int], outputs: dict[str, int], counters: list[int]) -> dict[str, Any]:
+def _line(
+    tables: RobotTables,
+    n: int,
+    events: list[set[str]],
+    fired: list[Row | None],
+    states: list[Any],
+    timers: list[int],
+    outputs: dict[str, int],
+    counters: list[int],
+) -> dict[str, Any]:
     def mask(table: Table, present: set[str]) -> int:
         return table.mask(present)
 
     main = tables.tables[0]
-    line: dict[str, Any] = {"tick": n, "event": mask(main, events[0]),
-                            "row": fired[0].as_written if fired[0] else None, "state": states[0], "timer": timers[0],
-                            **outputs, **dict(zip(tables.robot.counter_names, counters, strict=True))}
+    line: dict[str, Any] = {
+        "tick": n,
+        "event": mask(main, events[0]),
+        "row": fired[0].as_written if fired[0] else None,
+        "state": states[0],
+        "timer": timers[0],
+        **outputs,
+        **dict(zip(tables.robot.counter_names, counters, strict=True)),
+    }
     for k, table in enumerate(tables.tables[1:], start=1):
-        line |= {f"{table.name}.event": mask(table, events[k]),
-                 f"{table.name}.row": fired[k].as_written if fired[k] else None,  # type: ignore[union-attr]
-                 f"{table.name}.state": states[k], f"{table.name}.timer": timers[k]}
+        line |= {
+            f"{table.name}.event": mask(table, events[k]),
+            f"{table.name}.row": fired[k].as_written if fired[k] else None,  # type: ignore[union-attr]
+            f"{table.name}.state": states[k],
+            f"{table.name}.timer": timers[k],
+        }
     return line
 
 
 def ticks_for(rng: random.Random, tables: RobotTables, count: int) -> list[TickInput]:
     width = len(tables.input_bits)
-    return [TickInput(rng.randrange(1 << width) if rng.random() < 0.4 else 0, (rng.choice((0, 0, 1, 3)),))
-            for _ in range(count)]
+    return [
+        TickInput(rng.randrange(1 << width) if rng.random() < 0.4 else 0, (rng.choice((0, 0, 1, 3)),))
+        for _ in range(count)
+    ]
 
 
 @settings(max_examples=25, deadline=None)
@@ -101,12 +125,34 @@ def test_cross_table_events_are_read_at_the_start_of_the_tick(tmp_path: Path) ->
     """The lights table sees drive's state before drive fires: drive enters 3 on tick 3, lights sees it on 4."""
     folder = robot(tmp_path)
     (folder / "inputs.csv").write_text("I1,I2\n0,0\n0,0\n0,1\n1,0\n0,0\n0,0\n")
-    done = subprocess.run([sys.executable, "-m", "tablebot", "trace", str(folder), "--inputs",
-                           str(folder / "inputs.csv")], capture_output=True, text=True, check=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "trace", str(folder), "--inputs", str(folder / "inputs.csv")],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     lines = [json.loads(line) for line in done.stdout.splitlines()]
-    assert list(lines[0]) == ["tick", "event", "row", "state", "timer", "M1", "M2", "L1",
-                              "lights.event", "lights.row", "lights.state", "lights.timer"]
+    assert list(lines[0]) == [
+        "tick",
+        "event",
+        "row",
+        "state",
+        "timer",
+        "M1",
+        "M2",
+        "L1",
+        "lights.event",
+        "lights.row",
+        "lights.state",
+        "lights.timer",
+    ]
     assert [(line["state"], line["lights.state"], line["L1"]) for line in lines] == [
-        (2, 1, 0), (2, 1, 0), (2, 1, 0), (3, 1, 0), (3, 2, 8), (3, 1, 8)]
+        (2, 1, 0),
+        (2, 1, 0),
+        (2, 1, 0),
+        (3, 1, 0),
+        (3, 2, 8),
+        (3, 1, 8),
+    ]
     assert lines[3]["row"] == 0  # the group row, as written (the first line below the header)
     assert lines[0]["row"] == 1

@@ -37,8 +37,9 @@ def bumberbot_space(**limits: Any) -> tuple[Table, Space]:
 
 
 def test_variation_keeps_the_states_the_row_limit_and_every_frozen_cell() -> None:
-    table, sp = bumberbot_space(max_rows=40, frozen_states=frozenset({20, 21}),
-                                frozen_cells=frozenset({(5, "timer"), (9, "*"), (15, "M1")}))
+    table, sp = bumberbot_space(
+        max_rows=40, frozen_states=frozenset({20, 21}), frozen_cells=frozenset({(5, "timer"), (9, "*"), (15, "M1")})
+    )
     rng = np.random.default_rng(3)
     start = space.start(table)
     frozen = [g for g in start if g.state in (20, 21) or g.origin == 9]
@@ -102,19 +103,22 @@ def evolve(*args: str) -> tuple[int, str]:
     return result.exit_code, result.output
 
 
-@pytest.mark.parametrize(("args", "words"), [
-    (["--objective", "laps"], "--objective laps: the worlds cannot measure it"),
-    (["--objective", "speed"], "--objective speed: unknown objective"),
-    (["--descriptors", "wiggles"], "--descriptors wiggles: unknown descriptor"),
-    (["--descriptors", "distance=3..1"], "the range must be LOW..HIGH"),
-    (["--descriptors", "distance,collisions,laps"], "the worlds cannot measure it"),
-    (["--freeze-cell", "line 99 timer"], "line 99 of"),
-    (["--freeze-cell", "line 5 I3"], "'I3' is not a cell evolution changes"),
-    (["--freeze-state", "7"], "the table has no state 7"),
-    (["--max-rows", "10"], "--max-rows 10 is fewer than the 37 rows"),
-    (["--batch", "50", "--budget", "10"], "--batch 50 is more than --budget 10"),
-    (["--descriptors", ""], "--descriptors needs one or two descriptors, not 0"),
-])
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--objective", "laps"], "--objective laps: the worlds cannot measure it"),
+        (["--objective", "speed"], "--objective speed: unknown objective"),
+        (["--descriptors", "wiggles"], "--descriptors wiggles: unknown descriptor"),
+        (["--descriptors", "distance=3..1"], "the range must be LOW..HIGH"),
+        (["--descriptors", "distance,collisions,laps"], "the worlds cannot measure it"),
+        (["--freeze-cell", "line 99 timer"], "line 99 of"),
+        (["--freeze-cell", "line 5 I3"], "'I3' is not a cell evolution changes"),
+        (["--freeze-state", "7"], "the table has no state 7"),
+        (["--max-rows", "10"], "--max-rows 10 is fewer than the 37 rows"),
+        (["--batch", "50", "--budget", "10"], "--batch 50 is more than --budget 10"),
+        (["--descriptors", ""], "--descriptors needs one or two descriptors, not 0"),
+    ],
+)
 def test_bad_options_are_clear_errors_naming_the_option(tmp_path: Path, args: list[str], words: str) -> None:
     code, output = evolve(str(BUMBERBOT), "--out", str(tmp_path / "o"), "--seeds", "0..1", *args)
     assert code == 2, output
@@ -146,8 +150,10 @@ def test_the_before_after_change_is_weighed_against_its_spread() -> None:
     from tablebot.evolve.report import paired
 
     lamp = MEASURES["time_to_lamp"]  # low is better
-    assert paired(lamp, np.array([30.0]), np.array([20.0])) == \
-        "-10.000 (one scenario, so no standard error): no clear difference"
+    assert (
+        paired(lamp, np.array([30.0]), np.array([20.0]))
+        == "-10.000 (one scenario, so no standard error): no clear difference"
+    )
     assert paired(lamp, np.array([30.0, 31.0, 29.0]), np.array([20.0, 22.0, 19.0])).endswith(": better")
     assert paired(lamp, np.array([30.0, 10.0, 29.0]), np.array([20.0, 40.0, 19.0])).endswith("no clear difference")
     assert "nan" not in paired(lamp, np.array([5.0, 5.0]), np.array([5.0, 5.0]))

@@ -49,8 +49,23 @@ def line_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_the_bumberbot_is_repaired_first_and_every_table_written_is_usable(tmp_path: Path) -> None:
     out = tmp_path / "evo"
-    args = [str(BUMBERBOT), "--out", str(out), "--seeds", "0..2", "--check-seeds", "50..51", "--seconds", "4",
-            "--budget", "8", "--batch", "4", "--workers", "2"]
+    args = [
+        str(BUMBERBOT),
+        "--out",
+        str(out),
+        "--seeds",
+        "0..2",
+        "--check-seeds",
+        "50..51",
+        "--seconds",
+        "4",
+        "--budget",
+        "8",
+        "--batch",
+        "4",
+        "--workers",
+        "2",
+    ]
     code, output = evolve(*args)
     assert code == 0, output
     report = (out / "report.md").read_text(encoding="utf-8")
@@ -61,8 +76,19 @@ def test_the_bumberbot_is_repaired_first_and_every_table_written_is_usable(tmp_p
     tables = sorted(p for p in out.rglob("*.csv") if p.name != "evaluations.csv")
     assert {"repaired.csv", "best-1.csv"} <= {p.name for p in tables}
     for table in tables:  # check itself, on the written file, proves every property
-        result = CliRunner().invoke(app, ["check", str(table), "--robot", str(BUMBERBOT / "robot.toml"),
-                                          "--properties", str(BUMBERBOT / "properties.toml"), "--format", "json"])
+        result = CliRunner().invoke(
+            app,
+            [
+                "check",
+                str(table),
+                "--robot",
+                str(BUMBERBOT / "robot.toml"),
+                "--properties",
+                str(BUMBERBOT / "properties.toml"),
+                "--format",
+                "json",
+            ],
+        )
         statuses = {p["name"]: p["status"] for p in json.loads(result.output)["properties"]}
         assert set(statuses.values()) == {"holds"} and len(statuses) == 6, (table, statuses)
     command = next(line for line in report.splitlines() if "best-1.csv" in line and "tablebot sim" in line)
@@ -82,8 +108,7 @@ def test_the_bumberbot_is_repaired_first_and_every_table_written_is_usable(tmp_p
     assert all(p.read_bytes() == data for p, data in again.items())
 
 
-def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_run: Path,
-                                                          dask_cluster: str) -> None:  # noqa: F811
+def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_run: Path, dask_cluster: str) -> None:  # noqa: F811
     code, output = evolve(str(LINE), "--out", str(tmp_path / "dask"), *LINE_RUN, "--scheduler", dask_cluster)
     assert code == 0, output
     assert "# Evolving line-follower/table.csv: laps (high is better)" in output
@@ -108,8 +133,18 @@ def test_sigterm_and_ctrl_c_keep_what_ran_and_the_same_command_resumes(tmp_path:
     """Cut by SIGTERM (two worker processes), then by Ctrl-C (this process alone), then run to the end:
     the same tables and numbers as the run never cut, whatever ran where."""
     out = tmp_path / "cut"
-    command = [sys.executable, "-m", "tablebot", "evolve", str(LINE), "--out", str(out), *LINE_RUN, "--backend",
-               "local"]
+    command = [
+        sys.executable,
+        "-m",
+        "tablebot",
+        "evolve",
+        str(LINE),
+        "--out",
+        str(out),
+        *LINE_RUN,
+        "--backend",
+        "local",
+    ]
     records = out / "evaluations.jsonl"
     first = stop_when_some_ran([*command, "--workers", "2"], records, signal.SIGTERM, 4)
     assert 4 <= len(first) < 18 and not (out / "report.md").exists()
@@ -142,12 +177,32 @@ def test_the_report_gives_a_working_command_for_every_world(tmp_path: Path) -> N
     one ``tablebot sweep`` runs a table on every world and scenario of the search: each of them runs."""
     other = tmp_path / "other place"
     other.mkdir()
-    (other / "arena.toml").write_text((LINE / "arena.toml").read_text().replace('name = "oval track"',
-                                                                                'name = "second track"'))
+    (other / "arena.toml").write_text(
+        (LINE / "arena.toml").read_text().replace('name = "oval track"', 'name = "second track"')
+    )
     out = tmp_path / "out dir"
-    code, output = evolve(str(LINE), "--world", str(LINE / "arena.toml"), "--world", str(other / "arena.toml"),
-                          "--out", str(out), "--seeds", "0..1", "--check-seeds", "5..5", "--seconds", "1",
-                          "--budget", "3", "--batch", "2", "--workers", "1", "-q")
+    code, output = evolve(
+        str(LINE),
+        "--world",
+        str(LINE / "arena.toml"),
+        "--world",
+        str(other / "arena.toml"),
+        "--out",
+        str(out),
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "5..5",
+        "--seconds",
+        "1",
+        "--budget",
+        "3",
+        "--batch",
+        "2",
+        "--workers",
+        "1",
+        "-q",
+    )
     assert code == 0, output
     report = (out / "report.md").read_text(encoding="utf-8")
     block = report.split("- `best-1.csv`")[1].split("\n- ")[0]

@@ -37,7 +37,7 @@ def properties(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The example's properties without front_bumper_stops: the drive table breaks it (the document's known
     bug), and no lights table can mend that (test_a_property_only_other_tables_decide_stops_it_first)."""
     text = (EXAMPLE / "properties.toml").read_text(encoding="utf-8")
-    cut = text[:text.index("# A found bug")] + text[text.index("# --- the lights"):]
+    cut = text[: text.index("# A found bug")] + text[text.index("# --- the lights") :]
     path = tmp_path_factory.mktemp("props") / "properties.toml"
     path.write_text(cut, encoding="utf-8")
     return path
@@ -52,14 +52,16 @@ def evolve(*args: str) -> tuple[int, str]:
 def lights_run(tmp_path_factory: pytest.TempPathFactory, properties: Path) -> tuple[Path, dict[str, str]]:
     before = digests(EXAMPLE)
     out = tmp_path_factory.mktemp("several") / "lights"
-    code, output = evolve(str(EXAMPLE), "--table", "lights", "--properties", str(properties), "--out", str(out),
-                          *RUN, "--workers", "2")
+    code, output = evolve(
+        str(EXAMPLE), "--table", "lights", "--properties", str(properties), "--out", str(out), *RUN, "--workers", "2"
+    )
     assert code == 0, output
     return out, before
 
 
 def test_only_the_lights_table_is_written_and_the_robot_files_are_untouched(
-        lights_run: tuple[Path, dict[str, str]]) -> None:
+    lights_run: tuple[Path, dict[str, str]],
+) -> None:
     out, before = lights_run
     assert digests(EXAMPLE) == before  # the drive table (and every file of the robot) as it was
     tables = sorted(p.relative_to(out).as_posix() for p in out.rglob("*.csv") if p.name != "evaluations.csv")
@@ -78,14 +80,21 @@ def test_only_the_lights_table_is_written_and_the_robot_files_are_untouched(
 
 
 def test_the_printed_command_runs_the_evolved_lights_beside_the_drive_table(
-        lights_run: tuple[Path, dict[str, str]], tmp_path: Path) -> None:
+    lights_run: tuple[Path, dict[str, str]], tmp_path: Path
+) -> None:
     out, _ = lights_run
     report = (out / "report.md").read_text(encoding="utf-8")
     line = next(row for row in report.splitlines() if row.startswith("- `lights.best-1.csv`"))
     command = line.split(": `", 1)[1].rstrip("`")
     tablebot_bin = str(ROOT / ".venv" / "bin" / "tablebot")
-    done = subprocess.run(command.replace("tablebot sim", f"{tablebot_bin} sim"), shell=True, capture_output=True,
-                          text=True, timeout=120, cwd=ROOT)
+    done = subprocess.run(
+        command.replace("tablebot sim", f"{tablebot_bin} sim"),
+        shell=True,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
     assert done.returncode == 0, done.stderr
     placed = out / "robot" / "lights.best-1"
     assert (placed / "lights.csv").read_bytes() == (out / "lights.best-1.csv").read_bytes()
@@ -93,27 +102,32 @@ def test_the_printed_command_runs_the_evolved_lights_beside_the_drive_table(
     assert "main table" not in done.stderr  # every table ran
 
 
-def test_the_same_seed_gives_the_same_bytes(lights_run: tuple[Path, dict[str, str]], properties: Path,
-                                            tmp_path: Path) -> None:
+def test_the_same_seed_gives_the_same_bytes(
+    lights_run: tuple[Path, dict[str, str]], properties: Path, tmp_path: Path
+) -> None:
     out, _ = lights_run
     again = tmp_path / "again"
-    code, output = evolve(str(EXAMPLE), "--table", "lights", "--properties", str(properties), "--out", str(again),
-                          *RUN, "--workers", "1")
+    code, output = evolve(
+        str(EXAMPLE), "--table", "lights", "--properties", str(properties), "--out", str(again), *RUN, "--workers", "1"
+    )
     assert code == 0, output
     for name in ("evaluations.csv", "lights.best-1.csv", "lights.best-1.check.txt", "spec.json"):
         assert (out / name).read_bytes() == (again / name).read_bytes(), name
-    fresh = [(p / "report.md").read_text().split("## Before and after")[1].split("## The tables")[0]
-             for p in (out, again)]
+    fresh = [
+        (p / "report.md").read_text().split("## Before and after")[1].split("## The tables")[0] for p in (out, again)
+    ]
     assert fresh[0] == fresh[1]
 
 
-def test_every_candidate_changes_lights_only_and_keeps_the_properties_over_both_tables(properties: Path,
-                                                                                        tmp_path: Path) -> None:
+def test_every_candidate_changes_lights_only_and_keeps_the_properties_over_both_tables(
+    properties: Path, tmp_path: Path
+) -> None:
     """Through the front door: every candidate evolve kept is a lights table of the lights table's columns,
     and, put beside the drive table as it is, satisfies every property (proved here over the product)."""
     robot = tablebot.open(EXAMPLE, properties=[properties])
-    evolved = robot.evolve(out=tmp_path / "api", table="lights", budget=6, batch=3, seeds="0..1",
-                           check_seeds="9..10", seconds=2, workers=1)
+    evolved = robot.evolve(
+        out=tmp_path / "api", table="lights", budget=6, batch=3, seeds="0..1", check_seeds="9..10", seconds=2, workers=1
+    )
     drive = load_table(EXAMPLE / "table.csv")
     lights = load_table(EXAMPLE / "lights.csv")
     outcome = evolved.outcome
@@ -124,8 +138,9 @@ def test_every_candidate_changes_lights_only_and_keeps_the_properties_over_both_
         table = to_table(outcome.candidates[key], lights, str(EXAMPLE / "lights.csv"))
         assert table.events == lights.events and set(table.states) == set(lights.states)
         assert all(all(m is None for m in row.motors) for row in table.rows)  # no motor column to write
-        changed += [(r.state, r.events, r.lamps, r.timer, r.next) for r in table.rows] != \
-            [(r.state, r.events, r.lamps, r.timer, r.next) for r in lights.rows]
+        changed += [(r.state, r.events, r.lamps, r.timer, r.next) for r in table.rows] != [
+            (r.state, r.events, r.lamps, r.timer, r.next) for r in lights.rows
+        ]
         both = load_tables(drive, {"lights": table})
         assert both.tables[0].rows == drive.rows  # the drive table as it is
         props = load_properties(both.machines[0], [properties], both)
@@ -137,8 +152,9 @@ def test_every_candidate_changes_lights_only_and_keeps_the_properties_over_both_
 
 def test_a_mutation_never_sets_a_motor_the_table_has_no_column_for_and_changes_its_lamps() -> None:
     lights = load_table(EXAMPLE / "lights.csv")
-    space = Space(lights.states, lights.robot.motors, Limits(len(lights.rows) + 8), frozenset(lights.writes),
-                  lights.robot.lamps)
+    space = Space(
+        lights.states, lights.robot.motors, Limits(len(lights.rows) + 8), frozenset(lights.writes), lights.robot.lamps
+    )
     rng = np.random.default_rng(0)
     child, levels = start(lights), set()
     for _ in range(300):
@@ -162,8 +178,7 @@ def test_unknown_table_and_table_on_a_one_table_robot_are_located_errors(tmp_pat
     code, output = evolve(str(EXAMPLE), "--table", "wheels", "--out", str(tmp_path / "a"), *RUN)
     assert code == 2 and "--table: error: --table wheels: the robot has no table of that name" in output
     assert "drive, lights" in output
-    code, output = evolve(str(ROOT / "examples" / "bumberbot"), "--table", "lights", "--out", str(tmp_path / "b"),
-                          *RUN)
+    code, output = evolve(str(ROOT / "examples" / "bumberbot"), "--table", "lights", "--out", str(tmp_path / "b"), *RUN)
     assert code == 2 and "--table: error: --table lights: the robot has one table" in output
     with pytest.raises(TableBotError) as caught:
         tablebot.open(EXAMPLE).evolve(out=tmp_path / "c", table="wheels", budget=2, seeds="0", seconds=1)
@@ -201,6 +216,7 @@ def test_a_lights_table_written_back_loads_beside_the_drive_table(tmp_path: Path
         (copy / name).write_bytes((EXAMPLE / name).read_bytes())
     (copy / "lights.csv").write_text(format_table(lights), encoding="utf-8")
     both = load_tables(load_table(copy / "table.csv"))
+
     def cells(table: Table) -> list[tuple]:
         return [(r.state, r.events, r.motors, r.lamps, r.timer, r.next) for r in table.rows]
 
@@ -211,8 +227,23 @@ def test_the_main_table_is_repaired_on_counterexamples_of_the_whole_robot(tmp_pa
     """Without --table the drive table evolves: it breaks front_bumper_stops, and the repair, replaying check's
     counterexamples on both tables, mends it so that every property of the robot holds beside the lights."""
     out = tmp_path / "drive"
-    code, output = evolve(str(EXAMPLE), "--out", str(out), "--seeds", "0", "--check-seeds", "9", "--seconds", "1",
-                          "--budget", "3", "--batch", "1", "--workers", "2")
+    code, output = evolve(
+        str(EXAMPLE),
+        "--out",
+        str(out),
+        "--seeds",
+        "0",
+        "--check-seeds",
+        "9",
+        "--seconds",
+        "1",
+        "--budget",
+        "3",
+        "--batch",
+        "1",
+        "--workers",
+        "2",
+    )
     assert code == 0, output
     report = (out / "report.md").read_text(encoding="utf-8")
     assert "It breaks front_bumper_stops" in report and "**drive.repaired.csv** (" in report

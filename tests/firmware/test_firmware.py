@@ -47,8 +47,9 @@ def bumberbot() -> tuple[Machine, list[TickInput]]:
     return machine, load_inputs(EXAMPLE / "inputs.csv", machine)
 
 
-def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
-                                                      tmp_path: Path) -> None:
+def test_bumberbot_on_uno_equals_python_tick_for_tick(
+    bumberbot: tuple[Machine, list[TickInput]], harness: Path, tmp_path: Path
+) -> None:
     machine, ticks = bumberbot
     firmware = build(machine, "uno", tmp_path / "fw")
     run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
@@ -61,8 +62,9 @@ def test_bumberbot_on_uno_equals_python_tick_for_tick(bumberbot: tuple[Machine, 
     assert firmware.hex.read_text().startswith(":")
 
 
-def test_bumberbot_on_ftduino_equals_python(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
-                                            tmp_path: Path) -> None:
+def test_bumberbot_on_ftduino_equals_python(
+    bumberbot: tuple[Machine, list[TickInput]], harness: Path, tmp_path: Path
+) -> None:
     machine, ticks = bumberbot
     firmware = build(machine, "ftduino", tmp_path / "fw")
     run = emulate(firmware, machine, ticks, tmp_path / "run", harness)
@@ -81,8 +83,9 @@ def test_counters_example_with_encoder_pulses(board: str, harness: Path, tmp_pat
     assert run.problems == [] and run.trace == expected
 
 
-def test_remapped_active_high_inputs_under_emulation(bumberbot: tuple[Machine, list[TickInput]], harness: Path,
-                                                     tmp_path: Path) -> None:
+def test_remapped_active_high_inputs_under_emulation(
+    bumberbot: tuple[Machine, list[TickInput]], harness: Path, tmp_path: Path
+) -> None:
     machine, ticks = bumberbot
     robot = _robot(sections={"board": {"uno": {"I7": "A2", "I8": "A3", "M1": "B", "active_high": ["I7", "I8"]}}})
     table = load(EXAMPLE)[0]
@@ -100,12 +103,26 @@ def _fits(board: str, shape: Shape) -> bool:
 
 
 @settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(seed=st.integers(0, 2**32 - 1), board=st.sampled_from(["uno", "uno", "ftduino"]),
-       inputs=st.integers(0, 4), motors=st.integers(1, 2), lamps=st.integers(0, 2), counters=st.integers(0, 2),
-       lookup=st.sampled_from(["auto", "scan"]))
-def test_random_tables_in_firmware_equal_python(tmp_path_factory: pytest.TempPathFactory, harness: Path, seed: int,
-                                                board: str, inputs: int, motors: int, lamps: int, counters: int,
-                                                lookup: str) -> None:
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    board=st.sampled_from(["uno", "uno", "ftduino"]),
+    inputs=st.integers(0, 4),
+    motors=st.integers(1, 2),
+    lamps=st.integers(0, 2),
+    counters=st.integers(0, 2),
+    lookup=st.sampled_from(["auto", "scan"]),
+)
+def test_random_tables_in_firmware_equal_python(
+    tmp_path_factory: pytest.TempPathFactory,
+    harness: Path,
+    seed: int,
+    board: str,
+    inputs: int,
+    motors: int,
+    lamps: int,
+    counters: int,
+    lookup: str,
+) -> None:
     shape = Shape(states=5, rows=15, inputs=inputs, motors=motors, lamps=lamps, counters=counters)
     assert _fits(board, shape)
     rng = random.Random(seed)
@@ -123,16 +140,19 @@ def test_random_tables_in_firmware_equal_python(tmp_path_factory: pytest.TempPat
 def test_both_matching_rules_in_firmware_on_tables_where_they_part(harness: Path, tmp_path: Path, match: Match) -> None:
     """Under emulation the firmware follows the table's rule where the two part (the scan lookup carries
     the rule as code, the dense one as data)."""
-    table, ticks = random_case(random.Random(f"fw-{match}"), Shape(states=3, rows=9, inputs=3, counters=1,
-                                                                     match=match), ticks=120)
+    table, ticks = random_case(
+        random.Random(f"fw-{match}"), Shape(states=3, rows=9, inputs=3, counters=1, match=match), ticks=120
+    )
     machine = compile_table(table)
     for lookup in ("scan", "dense"):
-        run = emulate(build(machine, "uno", tmp_path / lookup / "fw", lookup), machine, ticks, tmp_path / lookup,
-                      harness)
+        run = emulate(
+            build(machine, "uno", tmp_path / lookup / "fw", lookup), machine, ticks, tmp_path / lookup, harness
+        )
         assert run.problems == [] and run.trace == list(replay(machine, ticks))
 
 
 # --- boards and wiring --------------------------------------------------------------------------
+
 
 def _robot(**changes: Any) -> Robot:
     """The BumberBot with ``changes``; a ``sections`` board table is read as a robot file's would be."""
@@ -172,8 +192,10 @@ def test_ftduino_c2_carries_the_trace_not_a_counter() -> None:
     wiring = wire(robot, load_board("ftduino"))
     assert wiring.counters == {"C1": "C1", "C2": "C3"}  # C2 is TXD1: the counter takes the next free one
     with pytest.raises(TableBotError, match="cannot use 'C2'"):
-        wire(_robot(counters=(Counter("C1", "M1"),), sections={"board": {"ftduino": {"C1": "C2"}}}),
-             load_board("ftduino"))
+        wire(
+            _robot(counters=(Counter("C1", "M1"),), sections={"board": {"ftduino": {"C1": "C2"}}}),
+            load_board("ftduino"),
+        )
 
 
 def test_unknown_board_terminal_is_reported() -> None:

@@ -53,13 +53,16 @@ def wiring_errors(tmp_path: Path, extra: str, board: str = "uno") -> list[str]:
 
 # --- build: wiring onto a board -------------------------------------------------------------------
 
+
 def test_board_section_errors_name_their_line(tmp_path: Path) -> None:
     lines = ROBOT_TEXT.count("\n")
     found = wiring_errors(tmp_path, '\n[board.uno]\nI3 = "D99"\nI4 = 5\nX9 = "D4"\n')
     path = tmp_path / "robot.toml"
     assert any(e.startswith(f"{path}:{lines + 3}: error: input I3 cannot use 'D99'") for e in found), found
-    assert any(e.startswith(f"{path}:{lines + 4}: error: [board.uno] I4 must be a terminal name, not 5")
-               and 'I4 = "D2"' in e for e in found), found
+    assert any(
+        e.startswith(f"{path}:{lines + 4}: error: [board.uno] I4 must be a terminal name, not 5") and 'I4 = "D2"' in e
+        for e in found
+    ), found
     assert any(e.startswith(f"{path}:{lines + 5}: error: [board.uno] maps 'X9'") for e in found), found
 
 
@@ -81,6 +84,7 @@ def test_too_many_inputs_name_the_inputs_line_and_what_to_do(tmp_path: Path) -> 
 
 
 # --- monitor --------------------------------------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def bumberbot() -> tuple[Machine, list[dict[str, Any]]]:
@@ -113,14 +117,15 @@ def test_a_stream_of_another_table_without_hello_is_refused_with_few_warnings(tm
     other = compile_table(table)
     stream = encode(other, list(replay(other, random_inputs(rng, table, 200))))
     capture = tmp_path / "other.bin"
-    capture.write_bytes(stream[stream.index(b"\x7eT"):])  # from the first tick frame: no hello
+    capture.write_bytes(stream[stream.index(b"\x7eT") :])  # from the first tick frame: no hello
     result = invoke("monitor", str(capture), "--table", str(EXAMPLE))
     assert result.exit_code == 2 and "tick frames are impossible for this table" in result.output
     assert result.output.count("warning:") == 21 and "not this table's firmware?" in result.output
 
 
-def test_a_truncated_stream_keeps_its_whole_frames(tmp_path: Path,
-                                                   bumberbot: tuple[Machine, list[dict[str, Any]]]) -> None:
+def test_a_truncated_stream_keeps_its_whole_frames(
+    tmp_path: Path, bumberbot: tuple[Machine, list[dict[str, Any]]]
+) -> None:
     machine, trace = bumberbot
     capture = tmp_path / "cut.bin"
     capture.write_bytes(encode(machine, trace)[:-5])
@@ -137,7 +142,7 @@ def test_checksum_problems_give_stream_positions_not_chunk_positions(
     stream[15 + 7 * 12 + 5] ^= 0x55  # inside tick frame 7 (after the 15-byte hello; 12 bytes a frame)
     decoder = Decoder(machine)
     for at in range(0, len(stream), 7):
-        decoder.feed(bytes(stream[at:at + 7]))
+        decoder.feed(bytes(stream[at : at + 7]))
     assert decoder.problems and all("of this chunk" not in p for p in decoder.problems)
     positions = [int(p.split("byte ")[1].split(";")[0]) for p in decoder.problems if "checksum" in p]
     assert positions == [15 + 7 * 12], decoder.problems
@@ -150,6 +155,7 @@ def test_monitor_options_out_of_range_are_usage_errors(tmp_path: Path, option: l
 
 
 # --- flash --dry-run ------------------------------------------------------------------------------
+
 
 def test_flash_refuses_a_file_that_is_not_intel_hex(tmp_path: Path) -> None:
     bad = tmp_path / "fw.hex"
@@ -181,9 +187,11 @@ LISTS = {"Event": [1, 2], "Action": [3, 4], "Timer": [5, 6]}
 
 
 def test_inits_without_a_value_are_replaced_not_copied_blank() -> None:
-    text = ('<cvg><o classname="ftProDataArray1D" name="Event" N="1"><init/></o>\n'
-            '<o classname="ftProDataArray1D" name="Action" N="1"><init value="0"/></o>\n'
-            '<o classname="ftProDataArray1D" name="Timer" N="1"></o></cvg>')
+    text = (
+        '<cvg><o classname="ftProDataArray1D" name="Event" N="1"><init/></o>\n'
+        '<o classname="ftProDataArray1D" name="Action" N="1"><init value="0"/></o>\n'
+        '<o classname="ftProDataArray1D" name="Timer" N="1"></o></cvg>'
+    )
     new = rewrite(text, LISTS)
     # ROBO Pro's own form (issue 20): <init value="…"> and </init> on lines of their own
     assert '<init value="1">\n</init>' in new and '<init value="2">\n</init>' in new and "<init/>" not in new
@@ -211,6 +219,7 @@ def test_binary_and_unknown_encoding_files_are_not_programs(tmp_path: Path) -> N
 
 # --- output paths -----------------------------------------------------------------------------------
 
+
 def test_build_out_naming_a_file_is_refused_before_building(tmp_path: Path) -> None:
     afile = tmp_path / "afile"
     afile.write_text("keep", encoding="utf-8")
@@ -218,8 +227,9 @@ def test_build_out_naming_a_file_is_refused_before_building(tmp_path: Path) -> N
     assert result.exit_code == 2 and "--out names a file, not a folder" in result.output
 
 
-def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path,
-                                                bumberbot: tuple[Machine, list[dict[str, Any]]]) -> None:
+def test_monitor_out_naming_a_folder_is_refused(
+    tmp_path: Path, bumberbot: tuple[Machine, list[dict[str, Any]]]
+) -> None:
     machine, trace = bumberbot
     capture = tmp_path / "uart.bin"
     capture.write_bytes(encode(machine, trace))
@@ -228,8 +238,9 @@ def test_monitor_out_naming_a_folder_is_refused(tmp_path: Path,
 
 
 def test_a_lamp_on_an_ftduino_output_a_motor_drives_is_already_used(tmp_path: Path) -> None:
-    robot = ('name = "L"\ninitial_state = 1\n[motors]\nM1 = "a"\nM2 = "b"\n[lamps]\nL1 = "x"\n'
-             '[board.ftduino]\nL1 = "O1"\n')
+    robot = (
+        'name = "L"\ninitial_state = 1\n[motors]\nM1 = "a"\nM2 = "b"\n[lamps]\nL1 = "x"\n[board.ftduino]\nL1 = "O1"\n'
+    )
     path = tmp_path / "robot.toml"
     path.write_text(robot, encoding="utf-8")
     with pytest.raises(TableBotError) as info:

@@ -48,7 +48,7 @@ def test_frames_round_trip_in_any_chunking(bumberbot: tuple[Machine, list[dict[s
     lines, at = [], 0
     while at < len(stream):
         step = rng.randint(1, 40)
-        lines += decoder.feed(stream[at:at + step])
+        lines += decoder.feed(stream[at : at + step])
         at += step
     assert lines == trace and decoder.problems == [] and len(decoder.hellos) == 1
 
@@ -76,8 +76,9 @@ def test_corruption_is_skipped_and_reported(bumberbot: tuple[Machine, list[dict[
     frames = [tick_frame(machine, layout, line) for line in trace[:6]]
     broken = bytearray(frames[2])
     broken[5] ^= 0xFF  # the checksum no longer matches
-    stream = b"\x00\x7e\x99" + hello_frame(machine, layout) + b"".join(frames[:2]) + bytes(broken) \
-        + b"".join(frames[3:])
+    stream = (
+        b"\x00\x7e\x99" + hello_frame(machine, layout) + b"".join(frames[:2]) + bytes(broken) + b"".join(frames[3:])
+    )
     decoder = Decoder(machine)
     lines = decoder.feed(stream)
     assert [line["tick"] for line in lines] == [0, 1, 3, 4, 5]
@@ -104,8 +105,9 @@ def test_monitor_file_writes_the_core_trace(bumberbot: tuple[Machine, list[dict[
     assert [json.loads(line) for line in out.read_text().splitlines()] == trace
 
 
-def test_monitor_refuses_firmware_of_another_table(bumberbot: tuple[Machine, list[dict[str, Any]]],
-                                                   tmp_path: Path) -> None:
+def test_monitor_refuses_firmware_of_another_table(
+    bumberbot: tuple[Machine, list[dict[str, Any]]], tmp_path: Path
+) -> None:
     machine, trace = bumberbot
     other = compile_table(random_table(random.Random(2)))
     capture = tmp_path / "uart.bin"
@@ -131,22 +133,37 @@ def test_monitor_missing_port_is_a_clear_error() -> None:
 
 # --- flash: the command line only (no board here) ---------------------------------------------
 
+
 def test_avrdude_command_for_the_uno_and_the_ftduino(tmp_path: Path) -> None:
     hexfile = tmp_path / "fw.hex"
     assert avrdude_command(load_board("uno"), hexfile, "/dev/ttyACM0") == [
-        "avrdude", "-p", "atmega328p", "-c", "arduino", "-P", "/dev/ttyACM0", "-b", "115200", "-D",
-        "-U", f"flash:w:{hexfile}:i"]
+        "avrdude",
+        "-p",
+        "atmega328p",
+        "-c",
+        "arduino",
+        "-P",
+        "/dev/ttyACM0",
+        "-b",
+        "115200",
+        "-D",
+        "-U",
+        f"flash:w:{hexfile}:i",
+    ]
     ftduino = avrdude_command(load_board("ftduino"), hexfile, "COM5", baud=19200)
     assert ftduino[1:7] == ["-p", "atmega32u4", "-c", "avr109", "-P", "COM5"] and ftduino[8] == "19200"
 
 
 def test_flash_dry_run_builds_then_prints_the_command(tmp_path: Path) -> None:
-    result = runner.invoke(app, ["flash", str(EXAMPLE), "--board", "uno", "--port", "/dev/ttyUSB0",
-                                 "--out", str(tmp_path), "--dry-run"])
+    result = runner.invoke(
+        app, ["flash", str(EXAMPLE), "--board", "uno", "--port", "/dev/ttyUSB0", "--out", str(tmp_path), "--dry-run"]
+    )
     assert result.exit_code == 0, result.output
     assert (tmp_path / "tablebot.hex").is_file()
-    assert f"avrdude -p atmega328p -c arduino -P /dev/ttyUSB0 -b 115200 -D -U flash:w:{tmp_path}/tablebot.hex:i" \
+    assert (
+        f"avrdude -p atmega328p -c arduino -P /dev/ttyUSB0 -b 115200 -D -U flash:w:{tmp_path}/tablebot.hex:i"
         in result.output
+    )
 
 
 def test_flash_of_a_missing_hex_is_refused(tmp_path: Path) -> None:

@@ -34,8 +34,15 @@ def test_the_built_firmware_runs_both_tables_as_the_engine_does(tmp_path: Path) 
     tables = Loaded.open(LIGHTS).tables
     assert tables is not None
     board = load_board("uno")  # the firmware as the command wrote it
-    firmware = Firmware(tmp_path / "fw" / "tablebot.elf", tmp_path / "fw" / "tablebot.hex", board,
-                        wire(tables.robot, board), plan(tables.machines[0]), 0, 0)
+    firmware = Firmware(
+        tmp_path / "fw" / "tablebot.elf",
+        tmp_path / "fw" / "tablebot.hex",
+        board,
+        wire(tables.robot, board),
+        plan(tables.machines[0]),
+        0,
+        0,
+    )
     inputs = several_ticks(random.Random(2), tables, 300, density=0.2)
     got = emulate_several(firmware, tables, inputs, tmp_path / "run", robot_machine(tables))
     assert got == list(replay_several(tables, inputs))
@@ -43,7 +50,7 @@ def test_the_built_firmware_runs_both_tables_as_the_engine_does(tmp_path: Path) 
     monitored = invoke("monitor", uart, "--table", LIGHTS)  # what a user reads off the board's serial port
     assert monitored.exit_code == 0, monitored.output
     traced = [json.loads(line) for line in monitored.output.splitlines() if line.startswith("{")]
-    assert traced[:len(got)] == got
+    assert traced[: len(got)] == got
     broken = bytearray(uart.read_bytes())
     broken[40] ^= 0x01
     with pytest.raises(TableBotError, match=r"bad checksum at byte \d+"):

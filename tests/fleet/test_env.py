@@ -95,10 +95,12 @@ def test_the_vector_env_takes_a_seed_per_robot() -> None:
     np.testing.assert_array_equal(vector.reset(seed=[20, 21, 22])[0], vector.reset(seed=20)[0])
 
 
-@pytest.mark.parametrize(("example", "declared"), [("obstacle-avoider", ("I1_cm", "I2_cm")),
-                                                    ("line-follower", ("I1_line", "I2_line"))])
-def test_the_observation_carries_each_declared_sensor_as_its_trace_writes_it(example: str,
-                                                                             declared: tuple[str, ...]) -> None:
+@pytest.mark.parametrize(
+    ("example", "declared"), [("obstacle-avoider", ("I1_cm", "I2_cm")), ("line-follower", ("I1_line", "I2_line"))]
+)
+def test_the_observation_carries_each_declared_sensor_as_its_trace_writes_it(
+    example: str, declared: tuple[str, ...]
+) -> None:
     """A robot's declared sensors follow the BumberBot's part, named and scaled as in its trace, inside the
     space (each kind's bounds), alike in the single env and in the fleet's."""
     path = BUMBERBOT.parent / example

@@ -33,8 +33,23 @@ from test_sim_helpers import BUMBERBOT, trace_text
 def test_robot_k_of_a_fleet_writes_the_trace_tablebot_sim_writes(tmp_path: Path) -> None:
     """Through the real command: ``tablebot sim --battery 0.6 --seed 7`` against robot 2 of a fleet."""
     out = tmp_path / "sim"
-    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "20", "--seed", "7", "--battery", "0.6",
-                                      "--no-plots", "--quiet", "--out", str(out)])
+    result = CliRunner().invoke(
+        app,
+        [
+            "sim",
+            str(BUMBERBOT),
+            "--seconds",
+            "20",
+            "--seed",
+            "7",
+            "--battery",
+            "0.6",
+            "--no-plots",
+            "--quiet",
+            "--out",
+            str(out),
+        ],
+    )
     assert result.exit_code == 0, result.output
     table, machine = load(BUMBERBOT)
     scene = scene_for(table, machine)
@@ -61,15 +76,22 @@ def test_every_shipped_robot_runs_alike_alone_and_in_a_fleet(example: str) -> No
 @pytest.mark.parametrize("case", range(4))
 def test_random_tables_worlds_and_seeds_run_alike_alone_and_in_a_fleet(case: int) -> None:
     rng = random.Random(1000 + case)
-    table = random_table(rng, Shape(states=4, rows=14, inputs=8, counters=case % 2, max_timer=300, max_load=40,
-                                    event_density=0.25))
+    table = random_table(
+        rng, Shape(states=4, rows=14, inputs=8, counters=case % 2, max_timer=300, max_load=40, event_density=0.25)
+    )
     machine = compile_table(table)
     world = parse_world(Source.parse("<random>", random_world(rng)))
-    specs = [RobotSpec(seed=rng.randrange(10**6),
-                       start=None if k == 0 else (rng.uniform(0.4, 0.7), rng.uniform(0.4, 0.7), rng.uniform(-180, 180)),
-                       params=(("battery", "charge", rng.choice([1.0, 0.7, 0.3])),
-                               ("motor", "friction_volts", rng.choice([0.3, 0.5]))))
-             for k in range(5)]
+    specs = [
+        RobotSpec(
+            seed=rng.randrange(10**6),
+            start=None if k == 0 else (rng.uniform(0.4, 0.7), rng.uniform(0.4, 0.7), rng.uniform(-180, 180)),
+            params=(
+                ("battery", "charge", rng.choice([1.0, 0.7, 0.3])),
+                ("motor", "friction_volts", rng.choice([0.3, 0.5])),
+            ),
+        )
+        for k in range(5)
+    ]
     fleet = Fleet(table, machine, world, specs, traced=range(len(specs)))
     fleet.run(900, block_ticks=300)
     summary = fleet.summary()
@@ -104,8 +126,9 @@ def test_program_variants_run_each_robot_with_its_own_timers() -> None:
     changed = variants.timers[0].copy()
     changed[3] = 300  # Seek - Straight: 895 -> 300
     variants = Variants(np.stack([variants.timers[0], changed]), np.repeat(variants.loads, 2, axis=0))
-    fleet = Fleet(table, machine, world, [RobotSpec(seed=3, variant=1), RobotSpec(seed=3)], traced=[0, 1],
-                  variants=variants)
+    fleet = Fleet(
+        table, machine, world, [RobotSpec(seed=3, variant=1), RobotSpec(seed=3)], traced=[0, 1], variants=variants
+    )
     fleet.run(1200)
     rows = tuple(replace(row, timer=300) if row.index == 3 else row for row in table.rows)
     edited = replace(table, rows=rows)
@@ -119,11 +142,15 @@ def test_the_compiled_simulator_and_the_fleet_follow_the_tables_matching_rule(ma
     """A random table in a random world on which the two rules drive different runs: the compiled loop,
     alone and as robot 0 of a fleet, takes ``Engine.step``'s decisions over the inputs it sensed."""
     rng = random.Random(5)  # a table and world where the two rules part on 268 of 400 ticks
-    table = random_table(rng, Shape(states=4, rows=14, inputs=8, max_timer=300, event_density=0.25,
-                                    no_event_chance=0.3))
+    table = random_table(
+        rng, Shape(states=4, rows=14, inputs=8, max_timer=300, event_density=0.25, no_event_chance=0.3)
+    )
     world = parse_world(Source.parse("<random>", random_world(rng)))
-    runs = {rule: simulate(prepare(t, compile_table(t), world), 4.0, 3) for rule in MATCHES
-            for t in [with_match(table, rule)]}
+    runs = {
+        rule: simulate(prepare(t, compile_table(t), world), 4.0, 3)
+        for rule in MATCHES
+        for t in [with_match(table, rule)]
+    }
     assert runs["document"].rows.tolist() != runs["always"].rows.tolist()  # the rules part here
     alone = runs[match]
     machine = alone.scene.machine

@@ -9,8 +9,20 @@ from tablebot.fleet.generators import generators, matches_numpy, pool_words
 
 pytestmark = [pytest.mark.kernel_free]
 
-SEEDS = [*range(300), 2**31, 2**32 - 1, 2**32, 2**32 + 1, 2**40 + 3, 2**63, 2**64 - 1, 2**64, 2**96 + 17, 2**128 - 1,
-         123_456_789_012_345_678]
+SEEDS = [
+    *range(300),
+    2**31,
+    2**32 - 1,
+    2**32,
+    2**32 + 1,
+    2**40 + 3,
+    2**63,
+    2**64 - 1,
+    2**64,
+    2**96 + 17,
+    2**128 - 1,
+    123_456_789_012_345_678,
+]
 
 
 def test_the_seed_hashing_is_numpys() -> None:
@@ -30,7 +42,8 @@ def test_each_generator_draws_what_default_rng_draws() -> None:
 @pytest.mark.parametrize("seeds", [[], [2**128], [3, 2**130]])
 def test_seeds_beyond_the_shortcut_go_to_numpy(seeds: list[int]) -> None:
     assert [r.bit_generator.state for r in generators(seeds)] == [
-        np.random.default_rng(s).bit_generator.state for s in seeds]
+        np.random.default_rng(s).bit_generator.state for s in seeds
+    ]
 
 
 def test_a_negative_seed_is_numpys_error() -> None:

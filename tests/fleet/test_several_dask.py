@@ -49,9 +49,27 @@ def test_a_dask_sweep_of_several_tables_gives_the_local_results(tmp_path: Path, 
 
 def test_a_dask_tuning_of_another_tables_timer_gives_the_local_evaluations(tmp_path: Path, cluster: str) -> None:
     folder = robot(tmp_path)
-    spec = ["tune", str(folder / "drive.csv"), "--robot", str(folder / "robot.toml"), "--world",
-            str(folder / "hall.toml"), "--cells", "clock: line 2 timer=600..660", "--budget", "12", "--seeds", "0..3",
-            "--check-seeds", "7..8", "--seconds", "9", "--objective", "lamp_distance", "--quiet"]
+    spec = [
+        "tune",
+        str(folder / "drive.csv"),
+        "--robot",
+        str(folder / "robot.toml"),
+        "--world",
+        str(folder / "hall.toml"),
+        "--cells",
+        "clock: line 2 timer=600..660",
+        "--budget",
+        "12",
+        "--seeds",
+        "0..3",
+        "--check-seeds",
+        "7..8",
+        "--seconds",
+        "9",
+        "--objective",
+        "lamp_distance",
+        "--quiet",
+    ]
     command(*spec, "--out", str(tmp_path / "local"), "--backend", "local", "--workers", "2")
     command(*spec, "--out", str(tmp_path / "dask"), "--scheduler", cluster)
     local = (tmp_path / "local" / "evaluations.csv").read_bytes()

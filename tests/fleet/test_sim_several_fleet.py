@@ -30,8 +30,15 @@ def test_robot_k_of_a_fleet_of_several_tables_runs_as_sim() -> None:
     assert project.tables is not None
     scene = project.scene(every_table=True)
     specs = [RobotSpec(seed=s, params=(("battery", "charge", c),)) for s, c in ((4, 1.0), (5, 0.6), (4, 1.0))]
-    fleet = Fleet(project.table, project.machine, scene.world, specs, robot_layer(project.robot)[0], traced=[0, 1],
-                  tables=project.tables)
+    fleet = Fleet(
+        project.table,
+        project.machine,
+        scene.world,
+        specs,
+        robot_layer(project.robot)[0],
+        traced=[0, 1],
+        tables=project.tables,
+    )
     fleet.run(700, block_ticks=256)
     for k, spec in enumerate(specs[:2]):
         alone = simulate(project.scene(every_table=True, overrides=spec.overrides()), 7.0, spec.seed)
@@ -48,9 +55,27 @@ def test_a_sweep_of_several_tables_is_n_sims(tmp_path: Path) -> None:
     """tablebot sweep of the BumberBot with its lights: each run's trace is what tablebot sim writes for its seed
     (every table, the lights table's keys too); the spec's table digest covers the lights table."""
     sweep = tmp_path / "sweep"
-    done = subprocess.run([sys.executable, "-m", "tablebot", "sweep", str(EXAMPLE), "--seeds", "2,3", "--seconds",
-                           "3", "--trace", "0,1", "--no-plots", "--out", str(sweep)], capture_output=True, text=True,
-                          check=False)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "sweep",
+            str(EXAMPLE),
+            "--seeds",
+            "2,3",
+            "--seconds",
+            "3",
+            "--trace",
+            "0,1",
+            "--no-plots",
+            "--out",
+            str(sweep),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert "main table" not in done.stderr
     for run, seed in ((0, 2), (1, 3)):

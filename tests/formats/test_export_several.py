@@ -33,8 +33,9 @@ def test_a_cross_table_column_is_refused_by_the_lists_where_it_is(tmp_path: Path
     (tmp_path / "other.csv").write_text(OTHER)
     result = invoke("export", tmp_path / "drive.csv", "--to", "robopro", tmp_path / "out")
     assert result.exit_code == 2, result.output
-    assert f"{tmp_path / 'drive.csv'}:1:12: error: other=2: the ROBO Pro lists hold table drive alone" in \
-        " ".join(result.output.split())
+    assert f"{tmp_path / 'drive.csv'}:1:12: error: other=2: the ROBO Pro lists hold table drive alone" in " ".join(
+        result.output.split()
+    )
     assert not (tmp_path / "out").exists()
     program = invoke("export", tmp_path / "drive.csv", "--to", "robopro-program", tmp_path / "program")
     assert program.exit_code == 0 and "process per table (drive, other)" in program.output, program.output

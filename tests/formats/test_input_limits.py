@@ -53,6 +53,7 @@ def diagnostics_of(path: Path) -> tuple[Diagnostic, ...]:
 
 # --- numbers in table cells ------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("command", ["check", "sim"])
 def test_a_cell_of_5000_digits_is_a_located_error(tmp_path: Path, command: str) -> None:
     """Reproduced: int() of more than 4,300 digits raised ValueError in check and sim (exit 70)."""
@@ -61,10 +62,13 @@ def test_a_cell_of_5000_digits_is_a_located_error(tmp_path: Path, command: str) 
     assert f"table.csv:2:{len('go,1,1,,,3,3,') + 1}: error: this cell is longer than 4,000 characters" in err
 
 
-@pytest.mark.parametrize(("cell", "message"), [
-    ("1" + "0" * MAX_NUMBER_CHARS, "timer: a number of 101 characters is out of range 0..65535"),
-    ("1" + "0" * MAX_NUMBER_CHARS + "ms", "a number of 101 characters is no duration"),
-])
+@pytest.mark.parametrize(
+    ("cell", "message"),
+    [
+        ("1" + "0" * MAX_NUMBER_CHARS, "timer: a number of 101 characters is out of range 0..65535"),
+        ("1" + "0" * MAX_NUMBER_CHARS + "ms", "a number of 101 characters is no duration"),
+    ],
+)
 def test_a_timer_past_the_number_limit_is_refused_at_its_cell(tmp_path: Path, cell: str, message: str) -> None:
     (d,) = diagnostics_of(write_table(tmp_path, f"{HEADER}\ngo,1,1,,,3,3,{cell},1\n", MINI_ROBOT))
     assert (d.line, d.column) == (2, 14) and message in d.message
@@ -73,8 +77,9 @@ def test_a_timer_past_the_number_limit_is_refused_at_its_cell(tmp_path: Path, ce
 def test_state_numbers_have_at_most_100_digits(tmp_path: Path) -> None:
     """A state number of 101 digits was read (and carried into every trace and export); 100 still are."""
     longest, over = "9" * MAX_NUMBER_CHARS, "9" * (MAX_NUMBER_CHARS + 1)
-    table = load_table(write_table(tmp_path, f"{HEADER}\ngo,1,1,,,3,3,0,{longest}\nback,{longest},1,,,3,3,0,1\n",
-                                   MINI_ROBOT))
+    table = load_table(
+        write_table(tmp_path, f"{HEADER}\ngo,1,1,,,3,3,0,{longest}\nback,{longest},1,,,3,3,0,1\n", MINI_ROBOT)
+    )
     assert table.rows[1].state == int(longest)
     (d,) = diagnostics_of(write_table(tmp_path, f"{HEADER}\ngo,1,1,,,3,3,0,1\nback,{over},1,,,3,3,0,1\n"))
     assert (d.line, d.column) == (3, 6) and "state: a number of 101 characters is too long" in d.message
@@ -82,9 +87,10 @@ def test_state_numbers_have_at_most_100_digits(tmp_path: Path) -> None:
 
 # --- the table's dimensions --------------------------------------------------------------------------------
 
+
 def test_a_cell_just_over_the_length_limit_is_refused_and_one_at_it_is_read(tmp_path: Path) -> None:
     at_limit = "x" * MAX_CELL_CHARS
-    table = load_table(write_table(tmp_path, f'{HEADER}\n{at_limit},1,1,,,3,3,0,1\n', MINI_ROBOT))
+    table = load_table(write_table(tmp_path, f"{HEADER}\n{at_limit},1,1,,,3,3,0,1\n", MINI_ROBOT))
     assert table.rows[0].description == at_limit
     (d,) = diagnostics_of(write_table(tmp_path, f"{HEADER}\ngo,1,1,,,3,3,0,1\n{at_limit}y,1,,1,,3,3,0,1\n"))
     assert (d.line, d.column) == (3, 1) and "longer than 4,000 characters" in d.message
@@ -93,8 +99,9 @@ def test_a_cell_just_over_the_length_limit_is_refused_and_one_at_it_is_read(tmp_
 def test_a_quoted_cell_over_the_length_limit_is_refused_where_it_starts(tmp_path: Path) -> None:
     """The quoted path (a cell may span lines) is bounded too, at the cell's first line and column."""
     long = "a\n" + '""' * (MAX_CELL_CHARS // 2)  # a line break and 2,001 quotes: 2,003 characters of value...
-    (d,) = diagnostics_of(write_table(tmp_path, f'{HEADER}\ngo,1,1,,,3,3,0,1\nx,"{long}{"b" * MAX_CELL_CHARS}",1\n',
-                                      MINI_ROBOT))
+    (d,) = diagnostics_of(
+        write_table(tmp_path, f'{HEADER}\ngo,1,1,,,3,3,0,1\nx,"{long}{"b" * MAX_CELL_CHARS}",1\n', MINI_ROBOT)
+    )
     assert (d.line, d.column) == (3, 3) and "longer than 4,000 characters" in d.message
 
 
@@ -109,8 +116,9 @@ def test_a_200000_column_header_is_refused_by_the_whole_command(tmp_path: Path) 
     """Reproduced: 200,000 unknown columns were 200,000 errors, printed for 70 s; now one, at column 1,001."""
     header = ",".join(f"c{i}" for i in range(200_000))
     path = write_table(tmp_path, header + "\n" + "1," * 199_999 + "1\n")
-    done = subprocess.run([sys.executable, "-m", "tablebot", "check", str(path)], capture_output=True, text=True,
-                          check=False, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "check", str(path)], capture_output=True, text=True, check=False, timeout=60
+    )
     column = len(",".join(f"c{i}" for i in range(1000))) + 2
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert done.stderr.count("error:") == 1 and f"table.csv:1:{column}: error: this line has more than" in done.stderr
@@ -118,8 +126,9 @@ def test_a_200000_column_header_is_refused_by_the_whole_command(tmp_path: Path) 
 
 def test_event_columns_beyond_63_are_refused_at_the_first_one_too_many(tmp_path: Path) -> None:
     """Reproduced: sim of a table of 200 event columns ended in OverflowError (the event word is 64-bit)."""
-    robot = MINI_ROBOT.replace('A = "left switch"\nB = "right switch"\n',
-                               "".join(f'I{i} = "in"\n' for i in range(MAX_EVENT_COLUMNS)))
+    robot = MINI_ROBOT.replace(
+        'A = "left switch"\nB = "right switch"\n', "".join(f'I{i} = "in"\n' for i in range(MAX_EVENT_COLUMNS))
+    )
     names = [f"I{i}" for i in range(MAX_EVENT_COLUMNS)]
     write_table(tmp_path, f"state,{','.join(names[:-1])},T,M1,M2,next\n1,{'1,' * 63}3,3,1\n", robot)
     assert len(compile_table(load_table(tmp_path / "table.csv")).table.events) == MAX_EVENT_COLUMNS
@@ -137,8 +146,10 @@ def test_sim_of_more_event_columns_than_its_lookup_holds_is_refused_at_the_heade
     write_table(tmp_path, f"state,T,{names},M1,M2,next\n1,1,{'1,' * 10}3,3,1\n", robot)
     assert runner.invoke(app, ["check", str(tmp_path)]).exit_code in (0, 1)
     err = refused("sim", tmp_path, "--seconds", "0.1", "--out", tmp_path / "out")
-    assert "table.csv:1: error: the table has 11 event columns (T, inputs and counters); the simulator takes at " \
-           "most 10" in err
+    assert (
+        "table.csv:1: error: the table has 11 event columns (T, inputs and counters); the simulator takes at "
+        "most 10" in err
+    )
 
 
 @pytest.mark.parametrize("first", ["go", '"go, first"'])  # without a quote, lines are counted before any is read
@@ -151,7 +162,8 @@ def test_lines_below_the_header_are_counted(tmp_path: Path, monkeypatch: pytest.
 
 
 def test_states_past_the_limit_are_refused_at_the_cell_naming_the_first_too_many(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(table_read, "MAX_STATES", 3)  # 1,000 in use
     rows = ["a,1,1,,,3,3,0,2", "b,2,1,,,3,3,0,3", "c,3,1,,,3,3,0,1"]
     assert len(compile_table(load_table(table_dir(tmp_path, rows) / "table.csv")).states) == 3
@@ -169,8 +181,10 @@ def test_a_table_file_past_16_mb_is_refused_before_it_is_read(tmp_path: Path) ->
 
 # --- recorded inputs ---------------------------------------------------------------------------------------
 
-def test_inputs_past_the_tick_limit_are_refused_as_they_are_read(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+
+def test_inputs_past_the_tick_limit_are_refused_as_they_are_read(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Reproduced: 3 M rows of inputs took 2.1 GB in `trace --inputs`; now a limit, counted row by row."""
     monkeypatch.setattr(inputs_csv, "MAX_INPUT_TICKS", 3)  # 1,000,000 in use
     machine = compile_table(load_table(EXAMPLE / "table.csv"))
@@ -193,7 +207,8 @@ def test_pulses_of_5000_digits_are_a_located_error(tmp_path: Path) -> None:
     assert "in.csv:2:1: error: this cell is longer than" in refused("trace", counters, "--inputs", inputs)
     inputs.write_text(f"C1,C2\n{'1' * (MAX_NUMBER_CHARS + 1)},0\n")
     assert "in.csv:2:1: error: C1: a number of 101 characters is too many pulses" in refused(
-        "trace", counters, "--inputs", inputs)
+        "trace", counters, "--inputs", inputs
+    )
 
 
 def test_a_trace_line_with_a_5000_digit_number_says_so_where_it_is(tmp_path: Path) -> None:
@@ -205,8 +220,11 @@ def test_a_trace_line_with_a_5000_digit_number_says_so_where_it_is(tmp_path: Pat
 
 # --- numbers in TOML files and properties ------------------------------------------------------------------
 
-@pytest.mark.parametrize(("line", "column"), [(f"initial_timer = {HUGE}", 17), (f"initial_timer = 0x{'f' * 99}", 17),
-                                              (f"initial_timer = -{HUGE}", 17)])
+
+@pytest.mark.parametrize(
+    ("line", "column"),
+    [(f"initial_timer = {HUGE}", 17), (f"initial_timer = 0x{'f' * 99}", 17), (f"initial_timer = -{HUGE}", 17)],
+)
 def test_a_toml_number_past_100_characters_is_a_located_error(tmp_path: Path, line: str, column: int) -> None:
     """Reproduced: tomllib's int() of 5,000 digits raised ValueError (exit 70); a huge hexadecimal number was read
     and failed wherever it was printed."""
@@ -217,8 +235,9 @@ def test_a_toml_number_past_100_characters_is_a_located_error(tmp_path: Path, li
 
 def test_a_toml_number_of_100_characters_is_read(tmp_path: Path) -> None:
     hexadecimal = "0x" + "0" * 97 + "5"
-    table_dir(tmp_path, ["go,1,1,,,3,3,0,1"], robot=MINI_ROBOT.replace("initial_timer = 0",
-                                                                       f"initial_timer = {hexadecimal}"))
+    table_dir(
+        tmp_path, ["go,1,1,,,3,3,0,1"], robot=MINI_ROBOT.replace("initial_timer = 0", f"initial_timer = {hexadecimal}")
+    )
     assert load_table(tmp_path / "table.csv").robot.initial_timer == 5
 
 
@@ -233,8 +252,10 @@ def test_a_quoted_state_of_5000_digits_in_the_robot_file_is_a_located_error(tmp_
     assert "robot.toml:11:1: error: [states]" in refused("check", tmp_path)
 
 
-@pytest.mark.parametrize("claim", [f'never = "line == {HUGE}"', f'never = "M1 > {HUGE}"',
-                                   f'when = "M1 > 0"\nthen = "M1 == 0"\nwithin = "{HUGE} ms"'])
+@pytest.mark.parametrize(
+    "claim",
+    [f'never = "line == {HUGE}"', f'never = "M1 > {HUGE}"', f'when = "M1 > 0"\nthen = "M1 == 0"\nwithin = "{HUGE} ms"'],
+)
 def test_property_numbers_of_5000_digits_are_located_errors(tmp_path: Path, claim: str) -> None:
     properties = tmp_path / "p.toml"
     properties.write_text(f"[huge]\n{claim}\n")
@@ -259,6 +280,7 @@ def test_a_robopro_states_csv_with_a_5000_digit_number(tmp_path: Path) -> None:
 
 
 # --- numbers in options ------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("seeds", [f"0..{HUGE}", HUGE, "0..99999999999"])
 def test_sweep_seeds_past_the_limits_are_refused_before_any_is_made(tmp_path: Path, seeds: str) -> None:

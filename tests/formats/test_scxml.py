@@ -49,8 +49,10 @@ def test_a_wrong_export_is_caught_by_the_comparison() -> None:
     robot, machine = one_table(table)
     first = next(line["row"] for line in expected(machine, case.inputs) if line["row"] is not None)
     changed = replace(table, rows=tuple(replace(r, timer=r.timer + 1) if r.index == first else r for r in table.rows))
-    assert first_difference(run_statemachine(robot, export_scxml([changed]), case.inputs),
-                            expected(machine, case.inputs)) is not None
+    assert (
+        first_difference(run_statemachine(robot, export_scxml([changed]), case.inputs), expected(machine, case.inputs))
+        is not None
+    )
 
 
 def test_the_scxml_has_no_delayed_send_and_one_tick_transition(tmp_path: Path) -> None:

@@ -35,8 +35,20 @@ def _engine() -> list[tuple[int, int, int, int | None]]:
 
 
 def _export(tmp_path: Path, to: str) -> None:
-    subprocess.run([sys.executable, "-m", "tablebot", "export", str(ROOT / "examples" / "bumberbot"),
-                    str(tmp_path / "out" / to), "--to", to], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "export",
+            str(ROOT / "examples" / "bumberbot"),
+            str(tmp_path / "out" / to),
+            "--to",
+            to,
+        ],
+        check=True,
+        capture_output=True,
+    )
 
 
 def test_the_python_block_drives_the_scxml_as_the_engine_runs_the_table(tmp_path: Path) -> None:

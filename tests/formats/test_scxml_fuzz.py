@@ -28,11 +28,20 @@ LIGHTS = Loaded.open(EXAMPLES / "bumberbot-lights").tables
 assert LIGHTS is not None
 #: Two tables with group rows (their group and index are written for them alone) and cross-table events.
 SEVERAL = json.loads(export_xstate(LIGHTS.tables))
-EDITS = st.lists(st.tuples(st.integers(0, len(SCXML) - 1), st.sampled_from(["drop", "double", "put"]),
-                           st.sampled_from(list('<>/="& \n-_x1')) | st.characters()), min_size=1, max_size=4)
-JSON = st.recursive(st.none() | st.booleans() | st.integers(-3, 70000) | st.text(max_size=8),
-                    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
-                    max_leaves=6)
+EDITS = st.lists(
+    st.tuples(
+        st.integers(0, len(SCXML) - 1),
+        st.sampled_from(["drop", "double", "put"]),
+        st.sampled_from(list('<>/="& \n-_x1')) | st.characters(),
+    ),
+    min_size=1,
+    max_size=4,
+)
+JSON = st.recursive(
+    st.none() | st.booleans() | st.integers(-3, 70000) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
+    max_leaves=6,
+)
 
 
 def _paths(value: Any, path: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
@@ -55,7 +64,7 @@ def test_an_edited_scxml_is_read_or_refused_with_a_location(edits: list[tuple[in
     text = SCXML
     for at, how, char in sorted(edits, reverse=True):  # from the end, so that each place is still where it was
         if at < len(text):
-            text = text[:at] + {"drop": "", "double": text[at] * 2, "put": char}[how] + text[at + 1:]
+            text = text[:at] + {"drop": "", "double": text[at] * 2, "put": char}[how] + text[at + 1 :]
     try:
         read_scxml(text, "in.scxml")
     except TableBotError as exc:
@@ -64,8 +73,9 @@ def test_an_edited_scxml_is_read_or_refused_with_a_location(edits: list[tuple[in
 
 @settings(max_examples=400, deadline=None)
 @given(st.sampled_from(PLACES), JSON)
-def test_an_edited_xstate_config_is_read_or_refused_with_its_json_path(place: tuple[dict[str, Any], tuple[Any, ...]],
-                                                                       value: Any) -> None:
+def test_an_edited_xstate_config_is_read_or_refused_with_its_json_path(
+    place: tuple[dict[str, Any], tuple[Any, ...]], value: Any
+) -> None:
     original, path = place
     config = json.loads(json.dumps(original))
     holder = config

@@ -54,6 +54,7 @@ def test_the_hostile_table_reads_back(table: Table) -> None:
     for row, back in zip(table.rows, from_xml.rows, strict=True):
         if row.index in unholdable:
             assert back.description == row.description.replace("\x1b", "\ufffd").replace("\x07", "\ufffd").replace(
-                "\x00", "\ufffd")
+                "\x00", "\ufffd"
+            )
         else:
             assert replace(back, line=0) == replace(row, line=0)

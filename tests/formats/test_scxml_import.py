@@ -68,13 +68,16 @@ def test_a_foreign_attribute_a_missing_element_and_another_namespace_are_refused
     foreign = text.replace('<data id="M1"', '<data foo="1" id="M1"')
     assert "has foo='1', where tablebot writes no foo" in _refused(foreign)
     assert "holds 4 elements, where tablebot writes 5" in _refused(
-        text.replace('        <assign location="is_pending" expr="0"/>\n', "", 1))
-    assert "in the namespace 'urn:other'" in _refused(text.replace('<scxml ', '<scxml xmlns:o="urn:other" o:x="1" '))
+        text.replace('        <assign location="is_pending" expr="0"/>\n', "", 1)
+    )
+    assert "in the namespace 'urn:other'" in _refused(text.replace("<scxml ", '<scxml xmlns:o="urn:other" o:x="1" '))
 
 
 def test_an_entity_bomb_is_refused_before_any_entity_is_declared(text: str) -> None:
-    bomb = ('<!DOCTYPE scxml [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
-            '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>\n')
+    bomb = (
+        '<!DOCTYPE scxml [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+        '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>\n'
+    )
     said = _refused(text.replace("<scxml ", bomb + "<scxml ", 1).replace('name="BumberBot"', 'name="&c;"'))
     assert "in.scxml:3:1: error: a DOCTYPE" in said
 
@@ -88,8 +91,7 @@ def test_the_import_command_writes_the_table_and_refuses_with_a_location(tmp_pat
     source = tmp_path / "machine.scxml"
     source.write_text(text, encoding="utf-8")
     command = [sys.executable, "-m", "tablebot", "import", str(source), "--from", "scxml"]
-    done = subprocess.run([*command, "--out", str(tmp_path / "table.csv")], capture_output=True, text=True,
-                          check=False)
+    done = subprocess.run([*command, "--out", str(tmp_path / "table.csv")], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "table.csv").read_text() == format_table(load_table(Path("examples/bumberbot/table.csv")))
     source.write_text(text.replace('tb:match="document"', 'tb:match="sometimes"'), encoding="utf-8")

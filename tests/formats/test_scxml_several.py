@@ -33,8 +33,7 @@ def test_the_bumberbot_with_its_lights_runs_in_python_statemachine_as_in_the_eng
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_random_robots_of_several_tables_run_in_python_statemachine_as_in_the_engine(tmp_path: Path,
-                                                                                     seed: int) -> None:
+def test_random_robots_of_several_tables_run_in_python_statemachine_as_in_the_engine(tmp_path: Path, seed: int) -> None:
     rng = random.Random(seed)
     tables = random_several(rng, tmp_path, 2 + seed % 2)
     inputs = random_ticks(rng, tables, 100)
@@ -56,13 +55,18 @@ def test_the_import_command_writes_tables_a_robot_file_reads_again(tmp_path: Pat
     original does."""
     original = Path("examples/bumberbot-lights")
     run = [sys.executable, "-m", "tablebot"]
-    subprocess.run([*run, "export", str(original), str(tmp_path / "out"), "--to", "scxml"], check=True,
-                   capture_output=True)
-    done = subprocess.run([*run, "import", str(tmp_path / "out" / "machine.scxml"), "--from", "scxml", "--out",
-                           str(tmp_path / "back")], check=True, capture_output=True, text=True)
+    subprocess.run(
+        [*run, "export", str(original), str(tmp_path / "out"), "--to", "scxml"], check=True, capture_output=True
+    )
+    done = subprocess.run(
+        [*run, "import", str(tmp_path / "out" / "machine.scxml"), "--from", "scxml", "--out", str(tmp_path / "back")],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     assert (tmp_path / "back" / "lights.csv").read_bytes() == (original / "lights.csv").read_bytes()
     assert 'drive = { file = "table.csv", initial_state = 2' in done.stderr
-    assert 'seeking = [1, 2, 11]' in done.stderr
+    assert "seeking = [1, 2, 11]" in done.stderr
     (tmp_path / "back" / "robot.toml").write_bytes((original / "robot.toml").read_bytes())
     tables, again = Loaded.open(original).tables, Loaded.open(tmp_path / "back").tables
     assert tables is not None and again is not None
@@ -74,12 +78,16 @@ def test_the_import_command_writes_tables_a_robot_file_reads_again(tmp_path: Pat
 def test_python_statemachine_runs_an_scxml_documents_regions_in_document_order(first: str, second: str) -> None:
     from statemachine.io import load
 
-    regions = "".join(f'<state id="{r}" initial="{r}1"><state id="{r}1"><transition event="go" target="{r}2">'
-                      f'<assign location="x" expr="x * 10 + {k}"/></transition></state><state id="{r}2"/></state>'
-                      for k, r in ((1, first), (2, second)))
-    machine = load(f'<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="p"><datamodel>'
-                   f'<data id="x" expr="0"/></datamodel><parallel id="p">{regions}</parallel></scxml>',
-                   format="scxml")()
+    regions = "".join(
+        f'<state id="{r}" initial="{r}1"><state id="{r}1"><transition event="go" target="{r}2">'
+        f'<assign location="x" expr="x * 10 + {k}"/></transition></state><state id="{r}2"/></state>'
+        for k, r in ((1, first), (2, second))
+    )
+    machine = load(
+        f'<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="p"><datamodel>'
+        f'<data id="x" expr="0"/></datamodel><parallel id="p">{regions}</parallel></scxml>',
+        format="scxml",
+    )()
     machine.send("go")
     assert machine.model.x == 12  # the first region's action, then the second's
 
@@ -94,8 +102,12 @@ def test_an_import_that_would_replace_a_table_of_yours_writes_none(tmp_path: Pat
     folder = tmp_path / "robot"
     folder.mkdir()
     (folder / "lights.csv").write_text("state,next\n1,1\n", encoding="utf-8")
-    done = subprocess.run([sys.executable, "-m", "tablebot", "import", str(source), "--from", "scxml", "--out",
-                           str(folder)], capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "import", str(source), "--from", "scxml", "--out", str(folder)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 2 and "lights.csv exists and is a table file" in done.stderr
     assert sorted(p.name for p in folder.iterdir()) == ["lights.csv"]
     assert (folder / "lights.csv").read_text(encoding="utf-8") == "state,next\n1,1\n"

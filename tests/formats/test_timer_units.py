@@ -19,7 +19,7 @@ pytestmark = [pytest.mark.kernel_free]
 if TYPE_CHECKING:
     from pathlib import Path
 
-ROBOT7 = "name = \"Seven\"\ntick_ms = 7\ninitial_state = 1\n[inputs]\nA = \"a\"\n[motors]\nM1 = \"m\"\n"
+ROBOT7 = 'name = "Seven"\ntick_ms = 7\ninitial_state = 1\n[inputs]\nA = "a"\n[motors]\nM1 = "m"\n'
 HEADER = "state,T,A,M1,timer,next"
 
 
@@ -31,19 +31,38 @@ def timers(text: str, robot: Robot = BUMBERBOT) -> list[int]:
 
 def test_times_and_ticks_read_as_ticks() -> None:
     assert timers("50|500ms|0.5s|0.5 s|500 MS|3 ticks|1 tick|.25s|1.5s|0ms|") == [
-        50, 50, 50, 50, 50, 3, 1, 25, 150, 0, 0]
+        50,
+        50,
+        50,
+        50,
+        50,
+        3,
+        1,
+        25,
+        150,
+        0,
+        0,
+    ]
 
 
-@pytest.mark.parametrize(("cell", "message", "hint"), [
-    ("505ms", "timer: 505ms is not a whole number of 10 ms ticks", "nearest: 500ms (50 ticks) or 510ms (51 ticks)"),
-    ("0.505s", "timer: 0.505s is not a whole number of 10 ms ticks", "nearest: 0.5s (50 ticks) or 0.51s (51 ticks)"),
-    ("5ms", "timer: 5ms is not a whole number of 10 ms ticks", "nearest: 0ms (0 ticks) or 10ms (1 tick)"),
-    ("2.5 ticks", "timer: 2.5 ticks is not a whole number of ticks", "nearest: 2 or 3"),
-    ("700s", "timer: 700s is 70000 ticks, more than the timer holds (65535)", "655.35 s at 10 ms a tick"),
-    ("5 min", "timer: '5 min' is not a duration", "500ms, 0.5s"),
-])
-def test_bad_times_are_located_with_the_nearest_valid_values(tmp_path: Path, cell: str, message: str,
-                                                             hint: str) -> None:
+@pytest.mark.parametrize(
+    ("cell", "message", "hint"),
+    [
+        ("505ms", "timer: 505ms is not a whole number of 10 ms ticks", "nearest: 500ms (50 ticks) or 510ms (51 ticks)"),
+        (
+            "0.505s",
+            "timer: 0.505s is not a whole number of 10 ms ticks",
+            "nearest: 0.5s (50 ticks) or 0.51s (51 ticks)",
+        ),
+        ("5ms", "timer: 5ms is not a whole number of 10 ms ticks", "nearest: 0ms (0 ticks) or 10ms (1 tick)"),
+        ("2.5 ticks", "timer: 2.5 ticks is not a whole number of ticks", "nearest: 2 or 3"),
+        ("700s", "timer: 700s is 70000 ticks, more than the timer holds (65535)", "655.35 s at 10 ms a tick"),
+        ("5 min", "timer: '5 min' is not a duration", "500ms, 0.5s"),
+    ],
+)
+def test_bad_times_are_located_with_the_nearest_valid_values(
+    tmp_path: Path, cell: str, message: str, hint: str
+) -> None:
     line = f"1,1,,3,{cell},1"
     d = find(problems(write_table(tmp_path, f"{HEADER}\n{line}\n", MINI_ROBOT)), "^timer")
     assert (d.line, d.column) == (2, column_of(line, 4))
@@ -56,6 +75,7 @@ def test_nearest_values_use_the_robots_tick(tmp_path: Path) -> None:
     table = tmp_path / "table.csv"
     table.write_text(f"{HEADER}\n1,1,,3,100ms,1\n1,,,3,98ms,1\n", encoding="utf-8")
     from tablebot.formats.table_read import load_table
+
     with pytest.raises(TableBotError) as info:
         load_table(table)
     (d,) = info.value.diagnostics

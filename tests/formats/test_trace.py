@@ -89,6 +89,7 @@ def test_counters_and_lamps_follow_the_motors(tmp_path: Path) -> None:
 
 # --- the inputs CSV -----------------------------------------------------------------------------------
 
+
 def test_inputs_blank_is_zero_and_tick_column_is_ignored(tmp_path: Path) -> None:
     machine = example_machine()
     path = tmp_path / "in.csv"
@@ -104,13 +105,16 @@ def inputs_error(tmp_path: Path, text: str, machine: Machine | None = None) -> t
     return info.value.diagnostics
 
 
-@pytest.mark.parametrize(("text", "where", "pattern"), [
-    ("I3,T\n1,\n", (1, 4), "T is never an input"),
-    ("I3,I9\n1,\n", (1, 4), "unknown input 'I9'"),
-    ("I3,I4\n1,2\n", (2, 3), r"I4: '2' is not 0 or 1"),
-    ("I3,I4\n1,x\n", (2, 3), r"I4: 'x' is not 0 or 1"),
-    ("I3\n²\n", (2, 1), r"I3: '²' is not 0 or 1"),
-])
+@pytest.mark.parametrize(
+    ("text", "where", "pattern"),
+    [
+        ("I3,T\n1,\n", (1, 4), "T is never an input"),
+        ("I3,I9\n1,\n", (1, 4), "unknown input 'I9'"),
+        ("I3,I4\n1,2\n", (2, 3), r"I4: '2' is not 0 or 1"),
+        ("I3,I4\n1,x\n", (2, 3), r"I4: 'x' is not 0 or 1"),
+        ("I3\n²\n", (2, 1), r"I3: '²' is not 0 or 1"),
+    ],
+)
 def test_inputs_errors_are_located(tmp_path: Path, text: str, where: tuple[int, int], pattern: str) -> None:
     diagnostics = inputs_error(tmp_path, text)
     assert len(diagnostics) == 1
@@ -148,22 +152,38 @@ def test_the_compiled_trace_writer_writes_pythons_bytes() -> None:
     rng = np.random.default_rng(4)
     n = 20_000
     hairs = rng.choice([0.0, 5e-6, -5e-6, 4.99999e-6], n // 4)  # ties and near-ties at five places
-    raw = np.concatenate([rng.uniform(-3, 3, n // 4), rng.uniform(-1e-4, 1e-4, n // 4),
-                          rng.integers(-10**6, 10**6, n // 4) / 10**5 + hairs,
-                          rng.choice([0.0, -0.0, 1e-5, -1e-5, 9.5e-5, 1e-4, 123456.78912, -7.0, 0.5, 2.5e-6], n // 4)])
-    states = ["Seek", 29, "Dreh\u00fcng \"rechts\"", "\u2028x"]
+    raw = np.concatenate(
+        [
+            rng.uniform(-3, 3, n // 4),
+            rng.uniform(-1e-4, 1e-4, n // 4),
+            rng.integers(-(10**6), 10**6, n // 4) / 10**5 + hairs,
+            rng.choice([0.0, -0.0, 1e-5, -1e-5, 9.5e-5, 1e-4, 123456.78912, -7.0, 0.5, 2.5e-6], n // 4),
+        ]
+    )
+    states = ["Seek", 29, 'Dreh\u00fcng "rechts"', "\u2028x"]
     names = json_names(states)
     ints = rng.integers(-(2**40), 2**40, n)
     rows = rng.integers(-1, 30, n)
     which = rng.integers(0, len(states), n)
     for places in (1, 3, 4, 5, 6):
         rounded = exact_round_array(raw, places)
-        text = block_bytes([b'{"t":', b',"row":', b',"state":', b',"x":', b"}\n"], [INT, ROW, STATE, DECIMAL],
-                           [ints, rows, which, rounded], [0, 0, 0, places], names)
+        text = block_bytes(
+            [b'{"t":', b',"row":', b',"state":', b',"x":', b"}\n"],
+            [INT, ROW, STATE, DECIMAL],
+            [ints, rows, which, rounded],
+            [0, 0, 0, places],
+            names,
+        )
         assert text is not None
-        expected = "".join(json.dumps({"t": int(i), "row": None if r < 0 else int(r), "state": states[s], "x": x},
-                                      separators=(",", ":"), ensure_ascii=False) + "\n"
-                           for i, r, s, x in zip(ints, rows, which, rounded.tolist(), strict=True))
+        expected = "".join(
+            json.dumps(
+                {"t": int(i), "row": None if r < 0 else int(r), "state": states[s], "x": x},
+                separators=(",", ":"),
+                ensure_ascii=False,
+            )
+            + "\n"
+            for i, r, s, x in zip(ints, rows, which, rounded.tolist(), strict=True)
+        )
         assert text.decode() == expected
     # what it cannot write the Python way, it leaves to Python
     assert block_bytes([b"", b"\n"], [DECIMAL], [np.array([np.inf])], [3], []) is None

@@ -49,8 +49,12 @@ def test_a_wrong_export_is_caught_by_the_comparison(tmp_path: Path) -> None:
     robot, machine = one_table(table)
     first = next(line["row"] for line in expected(machine, case.inputs) if line["row"] is not None)
     changed = replace(table, rows=tuple(replace(r, timer=r.timer + 1) if r.index == first else r for r in table.rows))
-    assert first_difference(run_xstate(replace(robot, tables=(changed,)), tmp_path, case.inputs),
-                            expected(machine, case.inputs)) is not None
+    assert (
+        first_difference(
+            run_xstate(replace(robot, tables=(changed,)), tmp_path, case.inputs), expected(machine, case.inputs)
+        )
+        is not None
+    )
 
 
 def test_the_config_is_plain_json_with_named_guards_and_actions() -> None:

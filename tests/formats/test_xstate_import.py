@@ -68,7 +68,7 @@ def test_extra_keys_missing_keys_wrong_types_and_unknown_events_are_refused(conf
     assert "$: has no key 'on'" in _refused(missing)
     typed = json.loads(json.dumps(config))
     typed["meta"]["tablebot"]["tickMs"] = "10"
-    assert "$.meta.tablebot.tickMs: is \"10\", not a whole number" in _refused(typed)
+    assert '$.meta.tablebot.tickMs: is "10", not a whole number' in _refused(typed)
     unknown = json.loads(json.dumps(config))
     unknown["states"]["s1"]["always"][0]["guard"]["params"]["flags"] = ["has_I9"]
     assert "$.states.s1.always[0].guard.params: names 'I9', which is no event column" in _refused(unknown)
@@ -93,7 +93,11 @@ def test_text_that_is_not_json_is_located_by_line_and_column() -> None:
 def test_the_import_command_writes_the_table(tmp_path: Path, config: dict) -> None:
     source = tmp_path / "machine.json"
     source.write_text(json.dumps(config), encoding="utf-8")
-    done = subprocess.run([sys.executable, "-m", "tablebot", "import", str(source), "--from", "xstate"],
-                          capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "import", str(source), "--from", "xstate"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout == format_table(load_table(Path("examples/bumberbot/table.csv")))

@@ -29,8 +29,7 @@ def test_the_bumberbot_with_its_lights_runs_in_xstate_as_in_the_engine(tmp_path:
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_random_robots_of_several_tables_run_in_xstate_as_in_the_engine(tmp_path: Path,
-                                                                                     seed: int) -> None:
+def test_random_robots_of_several_tables_run_in_xstate_as_in_the_engine(tmp_path: Path, seed: int) -> None:
     rng = random.Random(seed)
     tables = random_several(rng, tmp_path, 2 + seed % 2)
     inputs = random_ticks(rng, tables, 100)

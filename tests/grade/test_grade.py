@@ -55,8 +55,14 @@ def pupils(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="module")
 def graded(pupils: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("graded") / "out"
-    code, output = grade(LAMP, *(pupils / n for n in ("anna", "ben", "carl.csv", "dora", "emil", "links.txt")),
-                         "--out", out, "--workers", "2")
+    code, output = grade(
+        LAMP,
+        *(pupils / n for n in ("anna", "ben", "carl.csv", "dora", "emil", "links.txt")),
+        "--out",
+        out,
+        "--workers",
+        "2",
+    )
     assert code == 0, output
     return out
 
@@ -72,8 +78,10 @@ def test_the_class_is_graded_and_ranked(graded: Path) -> None:
 
 def test_a_table_that_breaks_a_rule_scores_nothing_with_the_counterexamples_words(graded: Path) -> None:
     ben = next(r for r in rows(graded) if r["name"] == "ben")
-    assert ben["score"] == "" and ben["why"].startswith("breaks front_bumper_stops (whenever a front bumper is "
-                                                        "pressed, within 1 tick both motors are stopped or reversing)")
+    assert ben["score"] == "" and ben["why"].startswith(
+        "breaks front_bumper_stops (whenever a front bumper is "
+        "pressed, within 1 tick both motors are stopped or reversing)"
+    )
     assert "state 29" in ben["why"] and "(it shows here)" in ben["why"]
 
 
@@ -104,8 +112,10 @@ def test_a_submission_reads_nothing_outside_its_own_files(tmp_path: Path) -> Non
     code, output = grade(LAMP, linked, worldly, "--out", tmp_path / "out", "--workers", "1")
     assert code == 0, output
     why = {r["name"]: r["why"] for r in rows(tmp_path / "out")}
-    assert why["linked"] == "table.csv: this file is a link to a file outside the submission (hand in the file " \
-                            "itself, not a link to it)"
+    assert (
+        why["linked"] == "table.csv: this file is a link to a file outside the submission (hand in the file "
+        "itself, not a link to it)"
+    )
     assert why["worldly"].startswith(f"robot.toml: sim.world names {secret}, a file outside the submission")
 
 
@@ -114,19 +124,29 @@ def test_line_laps_ranks_more_laps_first(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "examples" / "line-follower", slow)
     text = (slow / "table.csv").read_text()
     (slow / "table.csv").write_text(text.replace(",6,6,", ",4,4,", 1))
-    code, output = grade("line-laps", ROOT / "examples" / "line-follower", slow, "--out", tmp_path / "out",
-                         "--workers", "2")  # a shipped challenge by its name
+    code, output = grade(
+        "line-laps", ROOT / "examples" / "line-follower", slow, "--out", tmp_path / "out", "--workers", "2"
+    )  # a shipped challenge by its name
     assert code == 0, output
     table = rows(tmp_path / "out")
     assert [r["rank"] for r in table] == ["1", "2"], table
     assert [r["name"] for r in table] == ["line-follower", "slow"] and float(table[0]["score"]) > 1
 
 
-def test_dask_grades_both_shipped_challenges_byte_for_byte_as_this_machine(graded: Path, pupils: Path,
-                                                                           tmp_path: Path,
-                                                                           dask_cluster: str) -> None:  # noqa: F811
-    code, output = grade(LAMP, *(pupils / n for n in ("anna", "ben", "carl.csv", "dora", "emil", "links.txt")),
-                         "--out", tmp_path / "dask", "--scheduler", dask_cluster)
+def test_dask_grades_both_shipped_challenges_byte_for_byte_as_this_machine(
+    graded: Path,
+    pupils: Path,
+    tmp_path: Path,
+    dask_cluster: str,  # noqa: F811  (the fixture imported from test_sweep)
+) -> None:
+    code, output = grade(
+        LAMP,
+        *(pupils / n for n in ("anna", "ben", "carl.csv", "dora", "emil", "links.txt")),
+        "--out",
+        tmp_path / "dask",
+        "--scheduler",
+        dask_cluster,
+    )
     assert code == 0, output
     assert (tmp_path / "dask" / "scores.csv").read_bytes() == (graded / "scores.csv").read_bytes()
     assert (tmp_path / "dask" / "leaderboard.html").read_bytes() == (graded / "leaderboard.html").read_bytes()
@@ -185,16 +205,23 @@ def test_the_examples_in_the_docstrings_hold(module: str, tmp_path: Path, monkey
 def test_a_broken_challenge_is_refused_with_every_mistake_located(tmp_path: Path) -> None:
     for name in ("robot.toml", "rules.toml", "track.toml"):
         shutil.copy(LAPS / name, tmp_path / name)
-    (tmp_path / "challenge.toml").write_text('title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml", "nowhere"]\n'
-                                             'seconds = 99999\nseeds = "5..1"\nscore = "laps"\ncolour = 3\n')
+    (tmp_path / "challenge.toml").write_text(
+        'title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml", "nowhere"]\n'
+        'seconds = 99999\nseeds = "5..1"\nscore = "laps"\ncolour = 3\n'
+    )
     code, output = grade(tmp_path, ROOT / "examples" / "line-follower", "--out", tmp_path / "out")
     assert code == 2 and "Traceback" not in output
-    for words in ("challenge.toml:7: error: unknown key 'colour'", "challenge.toml:3:1: error: worlds[1]: nowhere "
-                  "is neither a file", "challenge.toml:4: error: seconds = 99999 is out of range",
-                  "challenge.toml:5:1: error: seeds 5..1 is an empty range"):
+    for words in (
+        "challenge.toml:7: error: unknown key 'colour'",
+        "challenge.toml:3:1: error: worlds[1]: nowhere is neither a file",
+        "challenge.toml:4: error: seconds = 99999 is out of range",
+        "challenge.toml:5:1: error: seeds 5..1 is an empty range",
+    ):
         assert words in output
-    (tmp_path / "challenge.toml").write_text('title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml"]\n'
-                                             'seconds = 9\nseeds = "0..1"\nscore = "time_to_lamp"\n')
+    (tmp_path / "challenge.toml").write_text(
+        'title = "x"\nrobot = "robot.toml"\nworlds = ["track.toml"]\n'
+        'seconds = 9\nseeds = "0..1"\nscore = "time_to_lamp"\n'
+    )
     code, output = grade(tmp_path, ROOT / "examples" / "line-follower", "--out", tmp_path / "out")
     assert code == 2 and "challenge.toml:6:1: error: score = 'time_to_lamp': the worlds cannot measure it" in output
     assert not (tmp_path / "out").exists()

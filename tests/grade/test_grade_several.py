@@ -30,18 +30,39 @@ def test_a_pupils_table_runs_beside_the_challenges_other_tables(tmp_path: Path) 
     challenge, pupil = tmp_path / "stop-in-time", tmp_path / "pia"
     challenge.mkdir()
     pupil.mkdir()
-    for name, text in (("challenge.toml", CHALLENGE), ("robot.toml", ROBOT), ("drive.csv", DRIVE),
-                       ("clock.csv", CLOCK), ("hall.toml", HALL)):
+    for name, text in (
+        ("challenge.toml", CHALLENGE),
+        ("robot.toml", ROBOT),
+        ("drive.csv", DRIVE),
+        ("clock.csv", CLOCK),
+        ("hall.toml", HALL),
+    ):
         (challenge / name).write_text(text, encoding="utf-8")
     (pupil / "table.csv").write_text(DRIVE, encoding="utf-8")
-    result = CliRunner().invoke(app, ["grade", str(challenge), str(pupil), "--out", str(tmp_path / "out"),
-                                      "--workers", "1"])
+    result = CliRunner().invoke(
+        app, ["grade", str(challenge), str(pupil), "--out", str(tmp_path / "out"), "--workers", "1"]
+    )
     assert result.exit_code == 0, result.output
     scores = list(csv.DictReader(io.StringIO((tmp_path / "out" / "scores.csv").read_text(encoding="utf-8"))))
     assert [(r["name"], r["rank"], r["why"]) for r in scores] == [("pia", "1", "")]
-    swept = CliRunner().invoke(app, ["sweep", str(challenge / "drive.csv"), "--robot", str(challenge / "robot.toml"),
-                                     "--world", str(challenge / "hall.toml"), "--seeds", "0..3", "--seconds", "9",
-                                     "--no-plots", "--out", str(tmp_path / "sweep")])
+    swept = CliRunner().invoke(
+        app,
+        [
+            "sweep",
+            str(challenge / "drive.csv"),
+            "--robot",
+            str(challenge / "robot.toml"),
+            "--world",
+            str(challenge / "hall.toml"),
+            "--seeds",
+            "0..3",
+            "--seconds",
+            "9",
+            "--no-plots",
+            "--out",
+            str(tmp_path / "sweep"),
+        ],
+    )
     assert swept.exit_code == 0, swept.output
     runs = list(csv.DictReader(io.StringIO((tmp_path / "sweep" / "results.csv").read_text(encoding="utf-8"))))
     mean = sum(float(r["distance_m"]) for r in runs) / len(runs)
@@ -57,8 +78,13 @@ def test_a_pupils_own_copy_of_another_table_is_graded_with_it(tmp_path: Path) ->
     challenge, pupil = tmp_path / "stop-in-time", tmp_path / "pia"
     challenge.mkdir()
     pupil.mkdir()
-    for name, text in (("challenge.toml", CHALLENGE), ("robot.toml", ROBOT), ("drive.csv", DRIVE),
-                       ("clock.csv", CLOCK), ("hall.toml", HALL)):
+    for name, text in (
+        ("challenge.toml", CHALLENGE),
+        ("robot.toml", ROBOT),
+        ("drive.csv", DRIVE),
+        ("clock.csv", CLOCK),
+        ("hall.toml", HALL),
+    ):
         (challenge / name).write_text(text, encoding="utf-8")
     (pupil / "table.csv").write_text(DRIVE, encoding="utf-8")
     (pupil / "clock.csv").write_text(CLOCK.replace(",500,", ",5000,"), encoding="utf-8")

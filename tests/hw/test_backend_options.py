@@ -51,8 +51,17 @@ def test_link_timeout_is_the_real_links_timeout(kind: str) -> None:
     for timeout in ("0.37", None):
         controller, address = silent_controller(kind)
         with controller:
-            done = invoke("run", EXAMPLE, "--on", address, "--seconds", "2", "--behind-limit", "0",
-                          *(["--link-timeout", timeout] if timeout else []))
+            done = invoke(
+                "run",
+                EXAMPLE,
+                "--on",
+                address,
+                "--seconds",
+                "2",
+                "--behind-limit",
+                "0",
+                *(["--link-timeout", timeout] if timeout else []),
+            )
         assert done.exit_code == 3, done.output
         said[timeout] = " ".join(done.output.split())
     assert "link_lost" in said["0.37"] and "within 370 ms" in said["0.37"] and "within 50 ms" not in said["0.37"]
@@ -65,8 +74,9 @@ def test_behind_limit_zero_reaches_the_links_judge() -> None:
     said = {}
     for extra in ([], ["--behind-limit", "0"]):
         with RoboifEmulator(baud=38400) as emu:
-            said[bool(extra)] = invoke("run", EXAMPLE, "--on", f"roboif://{emu.device}", "--seconds", "0.1",
-                                       "--link-timeout", "0.5", *extra)
+            said[bool(extra)] = invoke(
+                "run", EXAMPLE, "--on", f"roboif://{emu.device}", "--seconds", "0.1", "--link-timeout", "0.5", *extra
+            )
     refused, accepted = said[False], said[True]
     assert refused.exit_code == 2 and "accept timers" in refused.output and "--behind-limit 0" in refused.output
     assert accepted.exit_code == 0, accepted.output
@@ -97,11 +107,11 @@ def test_lookup_reaches_the_c_generator(tmp_path: Path) -> None:
 def test_into_and_the_list_names_reach_the_rpp_writer(tmp_path: Path) -> None:
     done = invoke("export", EXAMPLE, tmp_path, "--to", "robopro-rpp", "--into", RPP)
     assert done.exit_code == 0 and "lists Event, Action, Timer" in done.output, done.output
-    renamed = invoke("export", EXAMPLE, tmp_path / "other", "--to", "robopro-rpp", "--into", RPP, "--event-list",
-                     "Other")
+    renamed = invoke(
+        "export", EXAMPLE, tmp_path / "other", "--to", "robopro-rpp", "--into", RPP, "--event-list", "Other"
+    )
     assert renamed.exit_code == 0 and "lists Other, Action, Timer" in renamed.output, renamed.output
-    missing = invoke("export", EXAMPLE, tmp_path / "none", "--to", "robopro-rpp", "--into", RPP, "--timer-list",
-                     "Uhr")
+    missing = invoke("export", EXAMPLE, tmp_path / "none", "--to", "robopro-rpp", "--into", RPP, "--timer-list", "Uhr")
     assert missing.exit_code == 2 and "no list named 'Uhr'" in missing.output
     nowhere = invoke("export", EXAMPLE, tmp_path, "--to", "robopro-rpp")
     assert nowhere.exit_code == 2 and nowhere.output.startswith("--into: error:")

@@ -7,9 +7,16 @@ from __future__ import annotations
 from tablebot.hw.terminals import InputWire, OutputWire, Wiring
 
 INPUTS = tuple(f"I{i + 1}" for i in range(8))
-WIRED = Wiring(inputs=(InputWire("bumper", "I3", "switch", True), InputWire("eye", "I7", "phototransistor", True)),
-               bits=(1, 2), outputs=(OutputWire("M1", "motor", "M1"), OutputWire("M2", "motor", "M2", reverse=True),
-                                     OutputWire("L1", "lamp", "O5")), counters=())
+WIRED = Wiring(
+    inputs=(InputWire("bumper", "I3", "switch", True), InputWire("eye", "I7", "phototransistor", True)),
+    bits=(1, 2),
+    outputs=(
+        OutputWire("M1", "motor", "M1"),
+        OutputWire("M2", "motor", "M2", reverse=True),
+        OutputWire("L1", "lamp", "O5"),
+    ),
+    counters=(),
+)
 
 
 def test_a_lamps_pair_drives_no_motor() -> None:

@@ -79,8 +79,9 @@ class TimedRobot:
         pass
 
 
-def run_on_fake_time(io_s: Callable[[int], float], ticks: int, limit_s: float | None = 0.5,
-                     sinks: Sequence = ()) -> tuple[RunEnd, TimedRobot, FakeTime]:
+def run_on_fake_time(
+    io_s: Callable[[int], float], ticks: int, limit_s: float | None = 0.5, sinks: Sequence = ()
+) -> tuple[RunEnd, TimedRobot, FakeTime]:
     time = FakeTime()
     robot = TimedRobot(time, io_s)
     clock = RealTimeClock(TICK_S, now=lambda: time.now, sleep=time.sleep)
@@ -128,8 +129,9 @@ def test_one_stall_longer_than_the_limit_ends_the_run_and_says_it_was_one_stall(
 
 
 @pytest.mark.parametrize(("tick_s", "reason"), [(0.0105, "done"), (0.0110, "done"), (0.0120, "behind")])
-def test_the_limit_is_half_a_second_within_any_five_so_ticks_11_percent_too_slow_end_the_run(tick_s: float,
-                                                                                            reason: str) -> None:
+def test_the_limit_is_half_a_second_within_any_five_so_ticks_11_percent_too_slow_end_the_run(
+    tick_s: float, reason: str
+) -> None:
     end, _, time = run_on_fake_time(lambda tick: tick_s, ticks=1500)  # 15 s of table time
     assert end.reason == reason
     if reason == "behind":  # 2 ms lost every 12 ms: 0.5 s after 3 s of wall time
@@ -157,8 +159,9 @@ def test_a_serial_link_too_slow_for_the_tick_ends_the_run_as_behind_with_every_o
 
 def spawn(*args: str) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    return subprocess.run([sys.executable, "-m", "tablebot", "run", *args], env=env, capture_output=True, text=True,
-                          timeout=60)
+    return subprocess.run(
+        [sys.executable, "-m", "tablebot", "run", *args], env=env, capture_output=True, text=True, timeout=60
+    )
 
 
 def test_the_robo_interface_at_38400_baud_is_refused_for_a_10_ms_tick_naming_what_to_do() -> None:
@@ -178,15 +181,25 @@ def test_the_robo_interface_at_38400_baud_is_refused_for_a_10_ms_tick_naming_wha
 
 def test_the_robo_interface_at_38400_baud_runs_with_slow_timers_accepted_or_with_a_longer_tick(tmp_path: Path) -> None:
     with RoboifEmulator(baud=38400) as emu:
-        accepted = spawn(str(EXAMPLE), "--on", f"roboif://{emu.device}", "--seconds", "0.2", "--behind-limit", "0",
-                         "--link-timeout", "0.5")
+        accepted = spawn(
+            str(EXAMPLE),
+            "--on",
+            f"roboif://{emu.device}",
+            "--seconds",
+            "0.2",
+            "--behind-limit",
+            "0",
+            "--link-timeout",
+            "0.5",
+        )
     assert accepted.returncode == 0, accepted.stderr
     assert "warning:" in accepted.stderr and "timers will run" in " ".join(accepted.stderr.split())
     robot = tmp_path / "robot.toml"
     robot.write_text((EXAMPLE / "robot.toml").read_text().replace("tick_ms = 10 ", "tick_ms = 50 "))
     with RoboifEmulator(baud=38400) as emu:
-        longer = spawn(str(EXAMPLE / "table.csv"), "--robot", str(robot), "--on", f"roboif://{emu.device}",
-                       "--seconds", "0.5")
+        longer = spawn(
+            str(EXAMPLE / "table.csv"), "--robot", str(robot), "--on", f"roboif://{emu.device}", "--seconds", "0.5"
+        )
     assert longer.returncode == 0 and "ran 10 ticks (0.50 s): done" in longer.stdout, longer.stderr
 
 
@@ -218,8 +231,9 @@ def test_the_judgement_warns_when_the_link_takes_more_than_half_the_tick_and_loc
     assert "at least 50 % slow" in problem.message and "tick_ms = 50" in problem.hint
     (accepted,) = judge(machine, LinkTime("t://x", "one exchange", 0.015), accept_slow=True)
     assert "timers will run at least 50 % slow" in accepted
-    builtin = compile_table(dataclasses.replace(machine.table, robot=dataclasses.replace(machine.table.robot,
-                                                                                          toml=None)))
+    builtin = compile_table(
+        dataclasses.replace(machine.table, robot=dataclasses.replace(machine.table.robot, toml=None))
+    )
     with pytest.raises(TableBotError) as on:
         judge(builtin, LinkTime("t://x", "one exchange", 0.015), accept_slow=False)
     assert on.value.diagnostics[0].path == "--on"

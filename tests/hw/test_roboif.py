@@ -32,18 +32,28 @@ def robot_on(emulator: RoboifEmulator, machine: Machine | None = None, timeout_s
 
 def libroboint_request(m_main: int, pwm: list[int]) -> bytes:
     """FtThread's out[0..16] for FT_ROBO_IF_COM, transcribed from lib/libroboint.c (byte by byte, as it packs)."""
-    out = [0xF2, m_main,
-           (pwm[0] & 7) | (pwm[1] << 3 & 0x38) | (pwm[2] << 6 & 0xC0),
-           (pwm[2] >> 2 & 1) | (pwm[3] << 1 & 0xE) | (pwm[4] << 4 & 0x70) | (pwm[5] << 7 & 0x80),
-           (pwm[5] >> 1 & 3) | (pwm[6] << 2 & 0x1C) | (pwm[7] << 5 & 0xE0)]
+    out = [
+        0xF2,
+        m_main,
+        (pwm[0] & 7) | (pwm[1] << 3 & 0x38) | (pwm[2] << 6 & 0xC0),
+        (pwm[2] >> 2 & 1) | (pwm[3] << 1 & 0xE) | (pwm[4] << 4 & 0x70) | (pwm[5] << 7 & 0x80),
+        (pwm[5] >> 1 & 3) | (pwm[6] << 2 & 0x1C) | (pwm[7] << 5 & 0xE0),
+    ]
     return bytes(out + [0] * 12)
 
 
 def libroboint_reads(i: bytes) -> tuple[int, dict[str, int], int, int]:
     """FtThread's reading of a 21-byte reply into the transfer area, transcribed from lib/libroboint.c."""
-    analog = {"AX": i[4] | (i[8] & 0x3) << 8, "AY": i[5] | (i[8] & 0xC) << 6, "A1": i[6] | (i[8] & 0x30) << 4,
-              "A2": i[7] | (i[8] & 0xC0) << 2, "AZ": i[9] | (i[13] & 0x3) << 8, "D1": i[10] | (i[13] & 0xC) << 6,
-              "D2": i[11] | (i[13] & 0x30) << 4, "AV": i[12] | (i[13] & 0xC0) << 2}
+    analog = {
+        "AX": i[4] | (i[8] & 0x3) << 8,
+        "AY": i[5] | (i[8] & 0xC) << 6,
+        "A1": i[6] | (i[8] & 0x30) << 4,
+        "A2": i[7] | (i[8] & 0xC0) << 2,
+        "AZ": i[9] | (i[13] & 0x3) << 8,
+        "D1": i[10] | (i[13] & 0xC) << 6,
+        "D2": i[11] | (i[13] & 0x30) << 4,
+        "AV": i[12] | (i[13] & 0xC0) << 2,
+    }
     return i[0], analog, i[14], i[15]
 
 
@@ -78,13 +88,18 @@ def test_it_greets_exchanges_every_10_ms_with_the_engines_outputs_and_says_goodb
     assert sent[0] == sent[-1] == (0, [0] * 8) and any(bits for bits, _ in sent)
     assert all(r.fields["extensions"] == [0] * 12 for r in exchanges)
     bits = machine.input_bits
-    assert [b.masks[0] for b in record.blocks] == [(bits["I3"] if 10 <= n < 25 else 0) | (bits["I7"] if n >= 40 else 0)
-                                                   for n in range(60)]
+    assert [b.masks[0] for b in record.blocks] == [
+        (bits["I3"] if 10 <= n < 25 else 0) | (bits["I7"] if n >= 40 else 0) for n in range(60)
+    ]
 
 
 def test_motors_lamps_and_analog_thresholds_map_to_the_interfaces_bits() -> None:
-    wiring = {**BUMBER_WIRING, "I3": {"terminal": "AX", "mode": "resistance", "below": 300},
-              "I7": {"terminal": "D1", "mode": "distance", "above": 500}, "M1": {"terminal": "M3", "reverse": True}}
+    wiring = {
+        **BUMBER_WIRING,
+        "I3": {"terminal": "AX", "mode": "resistance", "below": 300},
+        "I7": {"terminal": "D1", "mode": "distance", "above": 500},
+        "M1": {"terminal": "M3", "reverse": True},
+    }
     machine = bumberbot("roboif", wiring)
     wired = roboif_wiring(machine)
     assert wired.outputs((8, -1)) == (0b0010_1000, [0, 0, 0, 0, 7, 7, 0, 0])  # M3 "B" at 7, M2 "B" at 0
@@ -95,7 +110,11 @@ def test_motors_lamps_and_analog_thresholds_map_to_the_interfaces_bits() -> None
     bits = machine.input_bits
     assert end.reason == "done"
     assert [b.masks[0] & (bits["I3"] | bits["I7"]) for b in record.blocks] == [
-        bits["I7"], bits["I3"] | bits["I7"], bits["I7"], bits["I3"] | bits["I7"]]
+        bits["I7"],
+        bits["I3"] | bits["I7"],
+        bits["I7"],
+        bits["I3"] | bits["I7"],
+    ]
     assert [b.extra["I3_raw"][0] for b in record.blocks] == [900, 100, 900, 100]
 
 
@@ -105,14 +124,16 @@ def test_a_table_with_counters_or_a_terminal_the_interface_lacks_is_refused_with
     text = str(info.value)
     assert "counter C1: the ROBO Interface has no counter inputs" in text and "C2" in text
     with pytest.raises(TableBotError, match=r"terminals for this are AX, AY"):
-        roboif_wiring(bumberbot("roboif", {**BUMBER_WIRING, "I3": {"terminal": "AZ", "mode": "resistance",
-                                                                    "below": 3}}))
+        roboif_wiring(
+            bumberbot("roboif", {**BUMBER_WIRING, "I3": {"terminal": "AZ", "mode": "resistance", "below": 3}})
+        )
     with pytest.raises(TableBotError, match="case-sensitive"):
         roboif_wiring(bumberbot("roboif", {**BUMBER_WIRING, "M1": "m1"}))
 
 
-@pytest.mark.parametrize(("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"),
-                                             ("bug", "error")])
+@pytest.mark.parametrize(
+    ("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"), ("bug", "error")]
+)
 def test_every_way_a_run_ends_sends_every_output_off_then_the_farewell(how: str, reason: str) -> None:
     with RoboifEmulator() as emu:
         if how == "bug":
@@ -127,16 +148,26 @@ def test_every_way_a_run_ends_sends_every_output_off_then_the_farewell(how: str,
     assert any(bits for bits, _ in sent) and sent[-1] == (0, [0] * 8)
 
 
-@pytest.mark.parametrize(("fault", "says"), [
-    ("silent", "no answer"), ("late", "no answer"), ("short", "only 20 of 21 bytes"),
-    ("extra", "unexpected bytes beyond the 21-byte reply"), ("chatter", "unexpected bytes"),
-    ("hang_up", "disconnected|Input/output error")])
+@pytest.mark.parametrize(
+    ("fault", "says"),
+    [
+        ("silent", "no answer"),
+        ("late", "no answer"),
+        ("short", "only 20 of 21 bytes"),
+        ("extra", "unexpected bytes beyond the 21-byte reply"),
+        ("chatter", "unexpected bytes"),
+        ("hang_up", "disconnected|Input/output error"),
+    ],
+)
 def test_every_fault_ends_the_run_as_link_lost_with_the_outputs_off_where_possible(fault: str, says: str) -> None:
     with RoboifEmulator(fault=(fault, 12)) as emu:
         end = drive(bumberbot("roboif"), robot_on(emu, timeout_s=0.1), ticks=60)
         stopped = fault == "hang_up" or eventually(
-            lambda: (emu.requests("exchange")[-1].fields["outputs"], emu.requests("exchange")[-1].fields["pwm"])
-            == (0, [0] * 8))
+            lambda: (
+                (emu.requests("exchange")[-1].fields["outputs"], emu.requests("exchange")[-1].fields["pwm"])
+                == (0, [0] * 8)
+            )
+        )
     assert end.reason == "link_lost" and end.exit_code == 3 and 12 <= end.ticks <= 13, end
     assert any(word in end.message for word in says.split("|")), end.message
     assert stopped
@@ -159,8 +190,12 @@ def test_at_38400_baud_an_exchange_takes_the_whole_10_ms_tick() -> None:
 
 
 def test_auto_greets_every_port_but_those_of_other_controllers() -> None:
-    ports = [PortInfo("/dev/ttyACM0", 0x221D, 0x1000, "ROBO TX Controller"), PortInfo("/dev/ttyUSB0", 0x0403, 0x6001),
-             PortInfo("/dev/ttyACM1", 0x1C40, 0x0538, "ftDuino"), PortInfo("/dev/ttyS0")]
+    ports = [
+        PortInfo("/dev/ttyACM0", 0x221D, 0x1000, "ROBO TX Controller"),
+        PortInfo("/dev/ttyUSB0", 0x0403, 0x6001),
+        PortInfo("/dev/ttyACM1", 0x1C40, 0x0538, "ftDuino"),
+        PortInfo("/dev/ttyS0"),
+    ]
     assert [p.device for p in roboif_link.candidates(ports)] == ["/dev/ttyUSB0", "/dev/ttyS0"]
     with RoboifEmulator() as emu, RoboifEmulator(greeting_reply=b"\r\n>") as other:
         assert roboif_link.find([PortInfo(other.device), PortInfo(emu.device)], timeout_s=0.2) == emu.device

@@ -39,7 +39,7 @@ def test_a_frame_is_as_the_pc_programming_manual_draws_it() -> None:
     assert frame[12:14] == b"\x34\x12" and frame[14:16] == b"\x07\x00"  # TID, SID (L,H)
     assert frame[16:20] == b"\x02\0\0\0" and frame[20:24] == b"\x01\0\0\0" and frame[24:28] == b"\0\0\0\0"
     assert (sum(frame[2:-3]) + int.from_bytes(frame[-3:-1], "big")) & 0xFFFF == 0  # CRC (H,L) over length..payload
-    assert frame[28 + 12:28 + 14] == (512).to_bytes(2, "little")  # duty[0] after cnt_reset_cmd_id[4], master[4]
+    assert frame[28 + 12 : 28 + 14] == (512).to_bytes(2, "little")  # duty[0] after cnt_reset_cmd_id[4], master[4]
     assert wire.decode(frame).area() == wire.output([512] + [0] * 7)
     for broken in (b"\x02\x56" + frame[2:], frame[:-1] + b"\x04", frame[:-3] + b"\0\0\x03", frame[:10]):
         with pytest.raises(wire.WireError):
@@ -69,8 +69,9 @@ def test_it_greets_configures_and_exchanges_every_10_ms_with_the_engines_duty() 
     assert exchanges[0].fields["duty"] == exchanges[-1].fields["duty"] == [0] * 8
     assert any(any(r.fields["duty"]) for r in exchanges)
     bits = machine.input_bits  # inputs served for exchange n are the engine's at tick n (one exchange old)
-    assert [b.masks[0] for b in record.blocks] == [(bits["I3"] if 10 <= n < 25 else 0) | (bits["I7"] if n >= 40 else 0)
-                                                   for n in range(60)]
+    assert [b.masks[0] for b in record.blocks] == [
+        (bits["I3"] if 10 <= n < 25 else 0) | (bits["I7"] if n >= 40 else 0) for n in range(60)
+    ]
     gaps = [b.t - a.t for a, b in itertools.pairwise(exchanges[1:-1])]
     assert 0.0085 < statistics.median(gaps) < 0.0115, gaps
 
@@ -78,12 +79,19 @@ def test_it_greets_configures_and_exchanges_every_10_ms_with_the_engines_duty() 
 def test_counters_count_pulses_and_a_wiring_of_every_kind_configures_and_drives_its_terminals() -> None:
     """The BumberBot with counters, C1 on C3 and C2 on C1, I3 an ultrasonic threshold, I4 an inverted switch,
     M1 reversed on M2, M2 on M1; then a lamp's pair made single outputs."""
-    wiring = {**BUMBER_WIRING, "I3": {"terminal": "I2", "mode": "ultrasonic", "below": 20},
-              "I4": {"terminal": "I4", "mode": "switch", "pressed": 0}, "M1": {"terminal": "M2", "reverse": True},
-              "M2": "M1", "C1": "C3", "C2": "C1"}
+    wiring = {
+        **BUMBER_WIRING,
+        "I3": {"terminal": "I2", "mode": "ultrasonic", "below": 20},
+        "I4": {"terminal": "I4", "mode": "switch", "pressed": 0},
+        "M1": {"terminal": "M2", "reverse": True},
+        "M2": "M1",
+        "C1": "C3",
+        "C2": "C1",
+    }
     machine = bumberbot("robotx", wiring, "bumberbot-counters")
     counts = [0, 3, 3, 9, 65530, 4, 2]  # up 3, 0, 6; far back (a reset: 0); up 10 across the 16-bit wrap; back
     record = Record()
+
     def script(n: int) -> tuple[list[int], list[int]]:
         return [0, 10 if n % 2 else 50, 0, 1, 0, 0, 0, 0], [counts[min(n, 6)], 0, 2 * n, 0]
 
@@ -102,8 +110,9 @@ def test_counters_count_pulses_and_a_wiring_of_every_kind_configures_and_drives_
     assert robotx_wiring(lamp).config().motors == (True, True, True, True)
 
 
-@pytest.mark.parametrize(("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"),
-                                             ("bug", "error")])
+@pytest.mark.parametrize(
+    ("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"), ("bug", "error")]
+)
 def test_every_way_a_run_ends_sends_zero_duty_last(how: str, reason: str) -> None:
     with RobotxEmulator(lambda n: ([0] * 8, [0] * 4)) as emu:
         if how == "bug":
@@ -118,10 +127,20 @@ def test_every_way_a_run_ends_sends_zero_duty_last(how: str, reason: str) -> Non
     assert any(any(d) for d in duty) and duty[-1] == [0] * 8
 
 
-@pytest.mark.parametrize(("fault", "says"), [
-    ("silent", "no answer"), ("late", "no answer"), ("garbage", "garbage"), ("bad_crc", "checksum"),
-    ("wrong_tid", "wrong answer"), ("wrong_code", "reply code 105"), ("new_session", "new session"),
-    ("short", "wrong answer"), ("hang_up", "disconnected|Input/output error")])
+@pytest.mark.parametrize(
+    ("fault", "says"),
+    [
+        ("silent", "no answer"),
+        ("late", "no answer"),
+        ("garbage", "garbage"),
+        ("bad_crc", "checksum"),
+        ("wrong_tid", "wrong answer"),
+        ("wrong_code", "reply code 105"),
+        ("new_session", "new session"),
+        ("short", "wrong answer"),
+        ("hang_up", "disconnected|Input/output error"),
+    ],
+)
 def test_every_fault_ends_the_run_as_link_lost_with_zero_duty_sent_where_the_link_allows(fault: str, says: str) -> None:
     with RobotxEmulator(lambda n: ([0] * 8, [0] * 4), fault=(fault, 12)) as emu:
         end = drive(bumberbot("robotx"), robot_on(emu, timeout_s=0.1), ticks=60)
@@ -158,13 +177,18 @@ def test_a_shell_prompt_before_the_first_frame_is_skipped_and_a_device_that_spea
 
 
 def test_auto_finds_the_controller_by_its_usb_id_then_checks_it_answers_fish_x1() -> None:
-    ports = [PortInfo("/dev/ttyUSB0", 0x0403, 0x6001, "FT232R"), PortInfo("/dev/rfcomm0"),
-             PortInfo("/dev/ttyACM3", 0x221D, 0x1000, "ROBO TX Controller"), PortInfo("/dev/ttyS0")]
+    ports = [
+        PortInfo("/dev/ttyUSB0", 0x0403, 0x6001, "FT232R"),
+        PortInfo("/dev/rfcomm0"),
+        PortInfo("/dev/ttyACM3", 0x221D, 0x1000, "ROBO TX Controller"),
+        PortInfo("/dev/ttyS0"),
+    ]
     assert [p.device for p in robotx_link.candidates(ports)] == ["/dev/ttyACM3", "/dev/rfcomm0"]
     with RobotxEmulator() as emu, RobotxEmulator(fault=("silent", 0)) as other:
         other._echo = lambda *args: None  # type: ignore[method-assign]  # a port that never answers, on purpose
-        found = robotx_link.find([PortInfo(other.device, 0x221D, 0x1000), PortInfo(emu.device, 0x221D, 0x1000)],
-                                 timeout_s=0.2)
+        found = robotx_link.find(
+            [PortInfo(other.device, 0x221D, 0x1000), PortInfo(emu.device, 0x221D, 0x1000)], timeout_s=0.2
+        )
     assert found is not None and found[0] == emu.device and found[1].device == "ROBO TX-000"
 
 

@@ -49,13 +49,15 @@ def events(rule: object, readings: list[int]) -> list[bool]:
     return seen
 
 
-CASES = [(direction, limit, hysteresis) for direction in ("below", "above") for limit in (20, 35)
-         for hysteresis in (0, 1, 5)]
+CASES = [
+    (direction, limit, hysteresis) for direction in ("below", "above") for limit in (20, 35) for hysteresis in (0, 1, 5)
+]
 
 
 @pytest.mark.parametrize(("direction", "limit", "hysteresis"), CASES)
-def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                                  direction: str, limit: int, hysteresis: int) -> None:
+def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, direction: str, limit: int, hysteresis: int
+) -> None:
     readings = walk(random.Random(limit * 7 + hysteresis), limit - 12, limit + 12, 300)
     sensor = Sensor("I1", "ultrasonic", (0.1, 0.0), 0.0, direction, limit / 100, hysteresis / 100, "cm")
     above = direction == "above"
@@ -63,25 +65,48 @@ def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(tmp_path: Path,
     the_rule = events(lambda v, on: threshold_event(v, above, limit, off, on), readings)
     assert True in the_rule and False in the_rule  # the walk crossed the threshold both ways
 
-    wire = InputWire("I1", "I1", "ultrasonic", False, below=None if above else limit, above=limit if above else None,
-                     hysteresis=hysteresis)
+    wire = InputWire(
+        "I1",
+        "I1",
+        "ultrasonic",
+        False,
+        below=None if above else limit,
+        above=limit if above else None,
+        hysteresis=hysteresis,
+    )
     assert events(lambda v, on: wire.reads(v, on), readings) == the_rule  # the TXT, the ROBO TX and ROBO Interface
     txt = TxtWiring(Wiring((wire,), (1,), (), ()))
     assert events(lambda v, on: txt.mask([v] + [0] * 7, on), readings) == the_rule  # as the TXT's replies reach it
 
     p = np.zeros(L.N_PARAM)  # the simulator's compiled sensing, readings in metres
-    p[L.P_SENSOR: L.P_SENSOR + L.SENSOR_FIELDS] = sensor_fields(sensor)
+    p[L.P_SENSOR : L.P_SENSOR + L.SENSOR_FIELDS] = sensor_fields(sensor)
     s, bits = np.zeros(L.N_STATE), np.zeros(L.N_BITS, dtype=np.int64)
     bits[L.B_SENSOR] = 1
 
     def simulated(value: int, on: bool) -> bool:
         s[L.READING] = value / 100
         return bool(sensor_events(s, p, bits, int(on)))
+
     assert events(simulated, readings) == events(lambda v, on: sensor.event(v / 100, on), readings)
 
-    table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "ultrasonic", "bit": 1, "invert": False,
-                         "below": wire.below, "above": wire.above, "hysteresis": hysteresis}],
-             "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
+    table = {
+        "inputs": [
+            {
+                "name": "I1",
+                "terminal": 1,
+                "mode": "ultrasonic",
+                "bit": 1,
+                "invert": False,
+                "below": wire.below,
+                "above": wire.above,
+                "hysteresis": hysteresis,
+            }
+        ],
+        "motors": [],
+        "lamps": [],
+        "counters": [],
+        "n_outputs": 0,
+    }
     robot = stub_robot(tmp_path, monkeypatch, table, [[v, 0, 0, 0, 0, 0, 0, 0] for v in readings])
     assert [bool(robot.read()[0]) for _ in readings] == the_rule  # the TXT 4.0 program
 
@@ -91,14 +116,31 @@ def test_the_txt4_program_scales_speeds_and_lamps_as_the_txt(tmp_path: Path, mon
     one the TXT's wiring sends, both :func:`level_pwm`."""
     levels = list(range(-10, 11))
     assert [level_pwm(v) for v in levels] == [max(0, min(8, v)) * 64 for v in levels]  # level 8 = PWM 512
-    table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "switch", "bit": 1, "invert": False, "below": None,
-                         "above": None}],
-             "motors": [{"name": "A", "output": 0, "terminal": 1, "reverse": False, "encoder": False},
-                        {"name": "B", "output": 1, "terminal": 2, "reverse": True, "encoder": False}],
-             "lamps": [{"name": "L", "output": 2, "terminal": 5}], "counters": [], "n_outputs": 3}
+    table = {
+        "inputs": [
+            {"name": "I1", "terminal": 1, "mode": "switch", "bit": 1, "invert": False, "below": None, "above": None}
+        ],
+        "motors": [
+            {"name": "A", "output": 0, "terminal": 1, "reverse": False, "encoder": False},
+            {"name": "B", "output": 1, "terminal": 2, "reverse": True, "encoder": False},
+        ],
+        "lamps": [{"name": "L", "output": 2, "terminal": 5}],
+        "counters": [],
+        "n_outputs": 3,
+    }
     robot = stub_robot(tmp_path, monkeypatch, table, [[0] * 8] * (len(levels) + 1))
-    txt = TxtWiring(Wiring((), (), (OutputWire("A", "motor", "M1"), OutputWire("B", "motor", "M2", reverse=True),
-                                    OutputWire("L", "lamp", "O5")), ()))
+    txt = TxtWiring(
+        Wiring(
+            (),
+            (),
+            (
+                OutputWire("A", "motor", "M1"),
+                OutputWire("B", "motor", "M2", reverse=True),
+                OutputWire("L", "lamp", "O5"),
+            ),
+            (),
+        )
+    )
     expected = []
     for tick, level in enumerate(levels):
         robot.read()
@@ -169,9 +211,13 @@ class LoopRobot(LinkRobot):
         return Reading(mask, tuple(pulses))
 
 
-STALLS = {"a quick link": {}, "a 0.3 s stall": {5: 0.3}, "a 0.7 s stall": {5: 0.7},
-          "a link slower than the tick": dict.fromkeys(range(60), 0.013),
-          "a jittery link": {n: random.Random(n).uniform(0.0, 0.02) for n in range(60)}}
+STALLS = {
+    "a quick link": {},
+    "a 0.3 s stall": {5: 0.3},
+    "a 0.7 s stall": {5: 0.7},
+    "a link slower than the tick": dict.fromkeys(range(60), 0.013),
+    "a jittery link": {n: random.Random(n).uniform(0.0, 0.02) for n in range(60)},
+}
 
 
 @pytest.mark.parametrize("case", STALLS)
@@ -193,8 +239,12 @@ def test_the_txt4_programs_loop_paces_stops_and_falls_behind_as_the_run_loop(cas
     reason = txt4_runtime.run(table, program_robot, 60, now=program_time.now, sleep=program_time.sleep, log=said.append)
     clock = RealTimeClock(machine.table.robot.tick_s, now=loop_time.now, sleep=loop_time.sleep)
     end = run(Engine(machine), loop_robot, clock=clock, ticks=60, behind_limit_s=txt4_runtime.BEHIND_LIMIT_S)
-    assert (reason, program_robot.writes, program_time.sleeps, program_robot.stops) == \
-        (end.reason, loop_robot.writes, loop_time.sleeps, loop_robot.stops)
+    assert (reason, program_robot.writes, program_time.sleeps, program_robot.stops) == (
+        end.reason,
+        loop_robot.writes,
+        loop_time.sleeps,
+        loop_robot.stops,
+    )
     assert f"({end.late_ticks} late)" in said[-1]
     assert end.reason == ("behind" if case == "a 0.7 s stall" else "done")
     assert end.late_ticks > 0 or case == "a quick link"

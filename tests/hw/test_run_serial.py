@@ -38,8 +38,10 @@ runner = CliRunner()
 def bumps(kind: str, seed: int = 3) -> Callable[[int], tuple[list[int], Any]]:  # Any: a list or a dict, by kind
     """Bumpers and light that change every few ticks, so the BumberBot takes many different rows."""
     rng = random.Random(seed)
-    held = [[0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
-            for _ in range(200)]
+    held = [
+        [0, 0, rng.randint(0, 1), rng.randint(0, 1), rng.randint(0, 1), 0, rng.randint(0, 1), rng.randint(0, 1)]
+        for _ in range(200)
+    ]
     other: list[int] | dict[str, int] = [0, 0, 0, 0] if kind == "robotx" else {}
     return lambda n: (held[(max(0, n - PROBES) // 7) % len(held)], other)  # the same inputs whatever timing came first
 
@@ -57,8 +59,9 @@ def off(kind: str, request: Request) -> bool:
 
 def spawn(args: list[str]) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    return subprocess.Popen([sys.executable, "-m", "tablebot", *args], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "tablebot", *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
 
 
 def read_trace(path: Path) -> list[dict]:
@@ -66,11 +69,24 @@ def read_trace(path: Path) -> list[dict]:
 
 
 @pytest.mark.parametrize("kind", ["robotx", "roboif"])
-def test_a_run_as_a_process_writes_a_trace_that_tablebot_trace_replays_to_the_same_decisions(tmp_path: Path,
-                                                                                             kind: str) -> None:
+def test_a_run_as_a_process_writes_a_trace_that_tablebot_trace_replays_to_the_same_decisions(
+    tmp_path: Path, kind: str
+) -> None:
     with emulator(kind) as emu:
-        process = spawn(["run", str(EXAMPLE), "--on", f"{kind}://{emu.device}", "--seconds", "0.8", "--out",
-                         str(tmp_path), "--link-timeout", "0.3"])
+        process = spawn(
+            [
+                "run",
+                str(EXAMPLE),
+                "--on",
+                f"{kind}://{emu.device}",
+                "--seconds",
+                "0.8",
+                "--out",
+                str(tmp_path),
+                "--link-timeout",
+                "0.3",
+            ]
+        )
         out, err = process.communicate(timeout=60)
     assert process.returncode == 0, err
     assert "ran 80 ticks (0.80 s): done" in out and "Traceback" not in err
@@ -83,17 +99,30 @@ def test_a_run_as_a_process_writes_a_trace_that_tablebot_trace_replays_to_the_sa
     assert summary["ended"] == "done" and summary["target"] == f"{kind}://{emu.device}"
     exchanges = emu.requests("exchange")  # the link timed with every output off, then outputs off at open,
     assert len(exchanges) == PROBES + 82  # one per tick and outputs off at the end
-    assert all(off(kind, r) for r in exchanges[:PROBES + 1]) and off(kind, exchanges[-1])
+    assert all(off(kind, r) for r in exchanges[: PROBES + 1]) and off(kind, exchanges[-1])
     assert not all(off(kind, r) for r in exchanges)
     assert "warning" not in err  # the emulators answer at full speed: the 10 ms tick fits
 
 
 @pytest.mark.parametrize(("kind", "fault"), [("robotx", "bad_crc"), ("roboif", "silent")])
-def test_a_lost_link_ends_the_process_with_exit_3_a_link_lost_record_and_the_outputs_off(tmp_path: Path, kind: str,
-                                                                                         fault: str) -> None:
+def test_a_lost_link_ends_the_process_with_exit_3_a_link_lost_record_and_the_outputs_off(
+    tmp_path: Path, kind: str, fault: str
+) -> None:
     with emulator(kind, fault=(fault, PROBES + 20)) as emu:  # tick 20's exchange, after the link was timed
-        process = spawn(["run", str(EXAMPLE), "--on", f"{kind}://{emu.device}", "--seconds", "5", "--out",
-                         str(tmp_path), "--link-timeout", "0.2"])
+        process = spawn(
+            [
+                "run",
+                str(EXAMPLE),
+                "--on",
+                f"{kind}://{emu.device}",
+                "--seconds",
+                "5",
+                "--out",
+                str(tmp_path),
+                "--link-timeout",
+                "0.2",
+            ]
+        )
         out, err = process.communicate(timeout=60)
         stopped = emu.wait_for("exchange", PROBES + 22, timeout_s=2) and off(kind, emu.requests("exchange")[-1])
     assert process.returncode == 3 and "link_lost" in out and "Traceback" not in err + out
@@ -102,13 +131,28 @@ def test_a_lost_link_ends_the_process_with_exit_3_a_link_lost_record_and_the_out
     assert stopped
 
 
-@pytest.mark.parametrize(("kind", "sig", "code", "reason"), [("robotx", signal.SIGINT, 130, "interrupted"),
-                                                             ("roboif", signal.SIGTERM, 143, "terminated")])
-def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(tmp_path: Path, kind: str, sig: int, code: int,
-                                                                       reason: str) -> None:
+@pytest.mark.parametrize(
+    ("kind", "sig", "code", "reason"),
+    [("robotx", signal.SIGINT, 130, "interrupted"), ("roboif", signal.SIGTERM, 143, "terminated")],
+)
+def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(
+    tmp_path: Path, kind: str, sig: int, code: int, reason: str
+) -> None:
     with emulator(kind) as emu:
-        process = spawn(["run", str(EXAMPLE), "--on", f"{kind}://{emu.device}", "--seconds", "30", "--out",
-                         str(tmp_path), "--link-timeout", "0.3"])
+        process = spawn(
+            [
+                "run",
+                str(EXAMPLE),
+                "--on",
+                f"{kind}://{emu.device}",
+                "--seconds",
+                "30",
+                "--out",
+                str(tmp_path),
+                "--link-timeout",
+                "0.3",
+            ]
+        )
         try:
             assert emu.wait_for("exchange", PROBES + 30, timeout_s=30)
             process.send_signal(sig)
@@ -125,7 +169,9 @@ def test_a_signal_to_the_process_stops_the_outputs_and_keeps_the_trace(tmp_path:
 
 def test_a_table_the_interface_cannot_hold_is_refused_before_the_port_is_opened() -> None:
     with RoboifEmulator() as emu:
-        result = runner.invoke(app, ["run", str(EXAMPLE.parent / "bumberbot-counters"), "--on", f"roboif://{emu.device}"])
+        result = runner.invoke(
+            app, ["run", str(EXAMPLE.parent / "bumberbot-counters"), "--on", f"roboif://{emu.device}"]
+        )
         assert emu.names() == []
     assert result.exit_code != 0 and "ROBO Interface has no counter inputs" in result.output
 

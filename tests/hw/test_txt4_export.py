@@ -55,8 +55,14 @@ def with_txt_section(table: Table) -> Machine:
 @pytest.mark.parametrize("seed", range(12))
 def test_the_exported_engine_takes_the_python_engines_decisions_tick_for_tick(tmp_path: Path, seed: int) -> None:
     rng = random.Random(seed)
-    shape = Shape(states=rng.randint(1, 6), rows=rng.randint(4, 24), inputs=rng.randint(1, 5),
-                  motors=rng.randint(1, 2), lamps=rng.randint(0, 3), counters=rng.randint(0, 3))
+    shape = Shape(
+        states=rng.randint(1, 6),
+        rows=rng.randint(4, 24),
+        inputs=rng.randint(1, 5),
+        motors=rng.randint(1, 2),
+        lamps=rng.randint(0, 3),
+        counters=rng.randint(0, 3),
+    )
     machine = with_txt_section(random_table(rng, shape))
     export_txt4(machine).write(tmp_path)
     program = load_program(tmp_path)
@@ -88,11 +94,20 @@ def test_export_writes_a_workspace_and_refuses_a_table_that_does_not_fit(tmp_pat
     result = runner.invoke(app, ["export", str(EXAMPLE), str(tmp_path / "ok"), "--to", "txt4"])
     assert result.exit_code == 0, result.output
     assert sorted(p.relative_to(tmp_path / "ok").as_posix() for p in (tmp_path / "ok").rglob("*") if p.is_file()) == [
-        ".project.json", "BumberBot.py", "lib/__init__.py", "lib/tablebot_program.py"]
+        ".project.json",
+        "BumberBot.py",
+        "lib/__init__.py",
+        "lib/tablebot_program.py",
+    ]
     assert "tablebot upload" in result.output
     project = (tmp_path / "ok" / ".project.json").read_text()
-    assert json.loads(project) == {"uuid": json.loads(project)["uuid"], "name": "BumberBot", "mode": "PROFESSIONAL",
-                                   "version": "1.0", "controller": "TXT4"}
+    assert json.loads(project) == {
+        "uuid": json.loads(project)["uuid"],
+        "name": "BumberBot",
+        "mode": "PROFESSIONAL",
+        "version": "1.0",
+        "controller": "TXT4",
+    }
     assert list(json.loads(project)) == ["uuid", "name", "mode", "version", "controller"]  # ROBO Pro Coding's order
     assert "\n" not in project and str(uuid.UUID(json.loads(project)["uuid"])) == json.loads(project)["uuid"]
     assert not list((tmp_path / "ok").rglob("*.blockly"))  # PROFESSIONAL: Python only, no blocks
@@ -130,5 +145,3 @@ def test_python_string_is_a_literal_that_reads_back_exactly(text: str) -> None:
     literal = python_string(text)
     assert literal.isascii() and "\n" not in literal and "\r" not in literal
     assert ast.literal_eval(literal) == text
-
-

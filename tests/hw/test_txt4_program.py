@@ -51,16 +51,31 @@ print("runner: main thread exits", flush=True)
 """
 
 
-def run_on_stub(folder: Path, name: str, inputs: list[list[int]], pulses: list[list[int]] | None = None,
-                runner: list[str] | None = None) -> tuple[list[dict], subprocess.CompletedProcess]:
+def run_on_stub(
+    folder: Path,
+    name: str,
+    inputs: list[list[int]],
+    pulses: list[list[int]] | None = None,
+    runner: list[str] | None = None,
+) -> tuple[list[dict], subprocess.CompletedProcess]:
     """Run the exported program as the controller would (``python NAME.py`` in its folder, or through
     ``runner``), without site-packages (so no numpy, no tablebot), against the stub."""
     script, log = folder / "script.json", folder / "calls.jsonl"
     script.write_text(json.dumps({"inputs": inputs, "pulses": pulses or [[0, 0, 0, 0]]}))
-    env = {"PATH": os.environ["PATH"], "PYTHONPATH": str(STUB), "TABLEBOT_STUB_SCRIPT": str(script),
-           "TABLEBOT_STUB_LOG": str(log)}
-    done = subprocess.run([sys.executable, "-S", *(runner or [f"{name}.py"])], cwd=folder, env=env,
-                          capture_output=True, text=True, timeout=60)
+    env = {
+        "PATH": os.environ["PATH"],
+        "PYTHONPATH": str(STUB),
+        "TABLEBOT_STUB_SCRIPT": str(script),
+        "TABLEBOT_STUB_LOG": str(log),
+    }
+    done = subprocess.run(
+        [sys.executable, "-S", *(runner or [f"{name}.py"])],
+        cwd=folder,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     return [json.loads(line) for line in log.read_text().splitlines()], done
 
 
@@ -110,10 +125,16 @@ def test_the_program_drives_the_stub_as_the_engine_decides_and_stops_on_sigterm(
     assert [c["args"] for c in calls if c["call"] == "initialized"] == [[[]]]  # neither numpy nor tablebot loaded
     assert {"device": "C3", "call": "set_motor", "args": ["M2"], "tick": -1, "phase": "run"} in calls
     bits = machine.input_bits
-    ticks = [TickInput((bits["I1"] if u[0] else 0) | (bits["I2"] if not u[3] else 0) | (bits["I3"] if u[5] < 20 else 0),
-                       (pulses[n][1],)) for n, u in enumerate(inputs)]
-    expected = [{"M2": motor(-line["M1"]), "M1": motor(line["M2"]), "O7": line["L1"] * 64}
-                for line in replay(machine, ticks)]
+    ticks = [
+        TickInput(
+            (bits["I1"] if u[0] else 0) | (bits["I2"] if not u[3] else 0) | (bits["I3"] if u[5] < 20 else 0),
+            (pulses[n][1],),
+        )
+        for n, u in enumerate(inputs)
+    ]
+    expected = [
+        {"M2": motor(-line["M1"]), "M1": motor(line["M2"]), "O7": line["L1"] * 64} for line in replay(machine, ticks)
+    ]
     seen = outputs_per_tick(calls, 120)
     assert [{k: s.get(k) for k in ("M1", "M2", "O7")} for s in seen] == expected
     assert stopped_last(calls, {"M1", "M2", "O7"})
@@ -162,8 +183,13 @@ def test_when_the_runner_exits_under_the_program_its_outputs_are_stopped(tmp_pat
     assert any(c["call"] == "start" for c in calls) and stopped_last(calls, {"M1", "M2"})
 
 
-def stub_robot(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, table: dict, inputs: list[list[int]],
-               pulses: list[list[int]] | None = None) -> Any:
+def stub_robot(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    table: dict,
+    inputs: list[list[int]],
+    pulses: list[list[int]] | None = None,
+) -> Any:
     """The runtime's robot for ``table`` in this process, on a fresh import of the stub serving ``inputs``."""
     script = tmp_path / "script.json"
     script.write_text(json.dumps({"inputs": inputs, "pulses": pulses or [[0, 0, 0, 0]]}))
@@ -181,25 +207,48 @@ def stub_robot(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, table: dict, inp
 
 def test_every_input_mode_reads_through_its_own_call(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     def wire(terminal: int, mode: str, bit: int, **how: object) -> dict:
-        return {"name": f"X{terminal}", "terminal": terminal, "mode": mode, "bit": bit,
-                "invert": how.get("invert", False), "below": how.get("below"), "above": how.get("above")}
+        return {
+            "name": f"X{terminal}",
+            "terminal": terminal,
+            "mode": mode,
+            "bit": bit,
+            "invert": how.get("invert", False),
+            "below": how.get("below"),
+            "above": how.get("above"),
+        }
 
-    table = {"inputs": [wire(1, "switch", 1), wire(2, "phototransistor", 2, invert=True),
-                        wire(3, "ultrasonic", 4, below=20), wire(4, "voltage", 8, above=5000),
-                        wire(5, "resistance", 16, below=1000), wire(6, "trail", 32, invert=True)],
-             "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
+    table = {
+        "inputs": [
+            wire(1, "switch", 1),
+            wire(2, "phototransistor", 2, invert=True),
+            wire(3, "ultrasonic", 4, below=20),
+            wire(4, "voltage", 8, above=5000),
+            wire(5, "resistance", 16, below=1000),
+            wire(6, "trail", 32, invert=True),
+        ],
+        "motors": [],
+        "lamps": [],
+        "counters": [],
+        "n_outputs": 0,
+    }
     robot = stub_robot(tmp_path, monkeypatch, table, [[1, 1, 19, 6000, 900, 0, 0, 0], [0, 0, 20, 5000, 1000, 1, 0, 0]])
     assert [robot.read() for _ in range(2)] == [(1 | 4 | 8 | 16 | 32, []), (2, [])]
 
 
-def test_encoder_pulses_are_counted_across_restarts_and_reversals(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_encoder_pulses_are_counted_across_restarts_and_reversals(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """A motor's distance starts again from 0 at each start, whichever way it turns: every pulse is
     counted once (a count that only followed differences would lose them at each restart)."""
-    table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "switch", "bit": 1, "invert": False,
-                         "below": None, "above": None}],
-             "motors": [{"name": "M1", "output": 0, "terminal": 1, "reverse": False, "encoder": True}],
-             "lamps": [], "counters": [{"name": "C1", "terminal": 1, "motor": 1}], "n_outputs": 1}
+    table = {
+        "inputs": [
+            {"name": "I1", "terminal": 1, "mode": "switch", "bit": 1, "invert": False, "below": None, "above": None}
+        ],
+        "motors": [{"name": "M1", "output": 0, "terminal": 1, "reverse": False, "encoder": True}],
+        "lamps": [],
+        "counters": [{"name": "C1", "terminal": 1, "motor": 1}],
+        "n_outputs": 1,
+    }
     rng = random.Random(3)
     pulses = [[rng.randint(1, 5), 0, 0, 0] for _ in range(40)]
     robot = stub_robot(tmp_path, monkeypatch, table, [[0] * 8] * 40, pulses)
@@ -244,12 +293,17 @@ def test_the_on_board_loop_stops_when_it_falls_behind_is_interrupted_asked_or_fa
 
     ticks = iter(range(10_000))  # every tick 14.3 ms against the table's 10: never one stall, always too slow
     robot = CountingRobot()
-    reason = txt4_runtime.run(table, robot, 1000, now=lambda: 0.0143 * next(ticks), sleep=lambda s: None,
-                              log=said.append)
+    reason = txt4_runtime.run(
+        table, robot, 1000, now=lambda: 0.0143 * next(ticks), sleep=lambda s: None, log=said.append
+    )
     assert reason == "behind" and 110 <= len(robot.writes) <= 120 and "fell 0.50 s behind" in said[-2]
     ticks = iter(range(10_000))
-    assert txt4_runtime.run(table, CountingRobot(), 500, now=lambda: 0.0105 * next(ticks), sleep=lambda s: None,
-                            log=said.append) == "done"  # 5 % slow: within the limit
+    assert (
+        txt4_runtime.run(
+            table, CountingRobot(), 500, now=lambda: 0.0105 * next(ticks), sleep=lambda s: None, log=said.append
+        )
+        == "done"
+    )  # 5 % slow: within the limit
 
     class Interrupted(CountingRobot):
         def read(self) -> tuple[int, list[int]]:
@@ -281,9 +335,24 @@ def test_the_on_board_loop_stops_when_it_falls_behind_is_interrupted_asked_or_fa
 def test_the_on_board_program_keeps_the_declared_hysteresis(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """An ultrasonic input below 25 cm with 5 cm hysteresis: on at 24, still on at 29, off at 30."""
     rows = [[cm, 0, 0, 0, 0, 0, 0, 0] for cm in (40, 24, 29, 30, 24)]
-    table = {"inputs": [{"name": "I1", "terminal": 1, "mode": "ultrasonic", "bit": 1, "invert": False,
-                         "below": 25, "above": None, "hysteresis": 5}],
-             "motors": [], "lamps": [], "counters": [], "n_outputs": 0}
+    table = {
+        "inputs": [
+            {
+                "name": "I1",
+                "terminal": 1,
+                "mode": "ultrasonic",
+                "bit": 1,
+                "invert": False,
+                "below": 25,
+                "above": None,
+                "hysteresis": 5,
+            }
+        ],
+        "motors": [],
+        "lamps": [],
+        "counters": [],
+        "n_outputs": 0,
+    }
     robot = stub_robot(tmp_path, monkeypatch, table, rows)
     assert [robot.read()[0] for _ in rows] == [0, 1, 1, 0, 1]
 

@@ -26,9 +26,13 @@ from core_helpers import EXAMPLE
 
 SOFTXT = os.environ.get("TABLEBOT_SOFTXT", "")
 PYTHON = os.environ.get("TABLEBOT_SOFTXT_PYTHON", "/usr/bin/python3")
-pytestmark = [pytest.mark.skipif(not (SOFTXT and Path(SOFTXT, "txt-4.0.py").is_file()),
-                                 reason="TABLEBOT_SOFTXT does not name a checkout of harbaum/SofTXT"),
-              pytest.mark.realtime]
+pytestmark = [
+    pytest.mark.skipif(
+        not (SOFTXT and Path(SOFTXT, "txt-4.0.py").is_file()),
+        reason="TABLEBOT_SOFTXT does not name a checkout of harbaum/SofTXT",
+    ),
+    pytest.mark.realtime,
+]
 
 #: SofTXT's factories.py looks for an ftDuino by USB id; this makes it find the pty in $FTDUINO_PTY.
 SITECUSTOMIZE = """
@@ -58,7 +62,7 @@ class FtDuino:
             if not select.select([self.master], [], [], 0.1)[0]:
                 continue
             text += os.read(self.master, 4096).decode()
-            while (text := text.lstrip()):
+            while text := text.lstrip():
                 try:
                     command, end = decoder.raw_decode(text)
                 except ValueError:
@@ -86,24 +90,41 @@ def test_upload_start_and_stop_under_softxt(tmp_path: Path) -> None:
     (tmp_path / "site").mkdir()
     (tmp_path / "site" / "sitecustomize.py").write_text(SITECUSTOMIZE)
     ftduino, port = FtDuino(), free_port()
-    env = {"PATH": f"{Path(PYTHON).parent}:/usr/bin:/bin", "QT_QPA_PLATFORM": "offscreen", "FTDUINO_PTY": ftduino.path,
-           "PYTHONPATH": str(tmp_path / "site"), "HOME": str(tmp_path)}
-    server = subprocess.Popen([PYTHON, "txt-4.0.py", "-l", "127.0.0.1", "-p", str(port)], cwd=softxt, env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    env = {
+        "PATH": f"{Path(PYTHON).parent}:/usr/bin:/bin",
+        "QT_QPA_PLATFORM": "offscreen",
+        "FTDUINO_PTY": ftduino.path,
+        "PYTHONPATH": str(tmp_path / "site"),
+        "HOME": str(tmp_path),
+    }
+    server = subprocess.Popen(
+        [PYTHON, "txt-4.0.py", "-l", "127.0.0.1", "-p", str(port)],
+        cwd=softxt,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     try:
         url = f"http://127.0.0.1:{port}"
         wait_for(lambda: httpx.get(f"{url}/api/v1/ping", timeout=1).status_code == 200)
         program = tmp_path / "program"
         tablebot = [str(Path(sys.executable).parent / "tablebot")]
-        subprocess.run([*tablebot, "export", str(EXAMPLE), str(program), "--to", "txt4"], check=True,
-                       capture_output=True)
+        subprocess.run(
+            [*tablebot, "export", str(EXAMPLE), str(program), "--to", "txt4"], check=True, capture_output=True
+        )
         lines: list[str] = []
         threading.Thread(target=listen, args=(f"{url}/api/v1/controller/message-stream", lines), daemon=True).start()
-        done = subprocess.run([*tablebot, "upload", str(program), "--to", f"txt4://127.0.0.1:{port}"],
-                              env={**os.environ, "TABLEBOT_TXT4_KEY": "any"}, capture_output=True, text=True)
+        done = subprocess.run(
+            [*tablebot, "upload", str(program), "--to", f"txt4://127.0.0.1:{port}"],
+            env={**os.environ, "TABLEBOT_TXT4_KEY": "any"},
+            capture_output=True,
+            text=True,
+        )
         assert done.returncode == 0, done.stdout + done.stderr
         assert (softxt / "workspaces" / "BumberBot" / "lib" / "tablebot_program.py").read_bytes() == (
-            program / "lib" / "tablebot_program.py").read_bytes()
+            program / "lib" / "tablebot_program.py"
+        ).read_bytes()
         wait_for(lambda: ("m1", "left") in ftduino.motor_modes())  # it drives (SofTXT: CCW is "left")
         assert any("the main thread hands SIGTERM over" in line for line in lines), lines
         httpx.delete(f"{url}/api/v1/stop", timeout=5)

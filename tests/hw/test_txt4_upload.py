@@ -35,8 +35,11 @@ def test_upload_stops_sends_every_file_and_starts(tmp_path: Path, monkeypatch: p
         result = runner.invoke(app, ["upload", str(program), "--to", f"txt4://127.0.0.1:{fake.port}"])
     assert result.exit_code == 0, result.output
     assert [method + " " + path for method, path in fake.calls] == [
-        "GET /api/v1/ping", "DELETE /api/v1/stop", "POST /api/v1/workspaces/BumberBot/files",
-        "POST /api/v1/application/BumberBot/start"]
+        "GET /api/v1/ping",
+        "DELETE /api/v1/stop",
+        "POST /api/v1/workspaces/BumberBot/files",
+        "POST /api/v1/application/BumberBot/start",
+    ]
     assert fake.keys == ["SECRET"] * 4 and fake.started == ["BumberBot"]
     assert sorted(fake.filenames) == ["/.project.json", "/BumberBot.py", "/lib/__init__.py", "/lib/tablebot_program.py"]
     for path in program.rglob("*"):
@@ -49,8 +52,18 @@ def test_no_start_only_installs_and_the_key_may_come_from_a_file(tmp_path: Path)
     program = exported(tmp_path)
     (tmp_path / "key").write_text("SECRET\n")
     with FakeTxt4(tmp_path / "controller") as fake:
-        result = runner.invoke(app, ["upload", str(program), "--to", f"txt4://127.0.0.1:{fake.port}",
-                                     "--key-file", str(tmp_path / "key"), "--no-start"])
+        result = runner.invoke(
+            app,
+            [
+                "upload",
+                str(program),
+                "--to",
+                f"txt4://127.0.0.1:{fake.port}",
+                "--key-file",
+                str(tmp_path / "key"),
+                "--no-start",
+            ],
+        )
     assert result.exit_code == 0, result.output
     assert fake.started == [] and set(fake.keys) == {"SECRET"}
 
@@ -62,8 +75,20 @@ def test_the_key_is_asked_for_on_a_terminal_without_echo(tmp_path: Path) -> None
     with FakeTxt4(tmp_path / "controller") as fake:
         pid, master = pty.fork()
         if pid == 0:  # the child: tablebot, with the pty as its controlling terminal
-            os.execve(sys.executable, [sys.executable, "-m", "tablebot", "upload", str(program), "--to",
-                                       f"txt4://127.0.0.1:{fake.port}", "--no-start"], env)
+            os.execve(
+                sys.executable,
+                [
+                    sys.executable,
+                    "-m",
+                    "tablebot",
+                    "upload",
+                    str(program),
+                    "--to",
+                    f"txt4://127.0.0.1:{fake.port}",
+                    "--no-start",
+                ],
+                env,
+            )
         seen = read_until(master, b"(shown on its display): ")  # the final space: echo is off by then
         os.write(master, b"SECRET\n")
         seen += read_until(master, b"uploaded")

@@ -50,8 +50,10 @@ def test_status_config_and_exchanges_round_trip_through_the_fake() -> None:
         link.connect()
         status = link.query_status()
         link.start_online("tablebot")
-        config = wire.Config(motors=(True, False, True, True),
-                             inputs=(wire.InputConfig(wire.InputMode.ULTRASONIC, False),) + (wire.InputConfig(),) * 7)
+        config = wire.Config(
+            motors=(True, False, True, True),
+            inputs=(wire.InputConfig(wire.InputMode.ULTRASONIC, False),) + (wire.InputConfig(),) * 7,
+        )
         link.update_config(config)
         replies = [link.exchange([64 * i, 0, 0, 0, 0, 0, 0, 0]) for i in range(5)]
         link.stop_online()
@@ -64,8 +66,7 @@ def test_status_config_and_exchanges_round_trip_through_the_fake() -> None:
     assert [r.universal[0] for r in replies] == [0, 1, 2, 3, 4]
     assert [r.counter_values[0] for r in replies] == [0, 2, 4, 6, 8]
     assert [r.fields["pwm"][0] for r in fake.requests("ExchangeData")] == [0, 64, 128, 192, 256]
-    assert fake.names() == ["QueryStatus", "StartOnline", "UpdateConfig", *["ExchangeData"] * 5, "StopOnline",
-                            "closed"]
+    assert fake.names() == ["QueryStatus", "StartOnline", "UpdateConfig", *["ExchangeData"] * 5, "StopOnline", "closed"]
 
 
 def test_a_reply_left_unread_is_skipped_so_the_next_exchange_gets_its_own_reply() -> None:
@@ -89,9 +90,15 @@ def test_keep_alive_sends_a_query_status_only_after_a_second_of_silence() -> Non
     assert fake.names().count("QueryStatus") == 1
 
 
-@pytest.mark.parametrize(("fault", "message"), [("silent", "no answer from"), ("garbage", "malformed reply"),
-                                                ("wrong_id", "wrong response id 0xBAC9723E (expected 0x4EEFAC41)"),
-                                                ("close", "closed the connection")])
+@pytest.mark.parametrize(
+    ("fault", "message"),
+    [
+        ("silent", "no answer from"),
+        ("garbage", "malformed reply"),
+        ("wrong_id", "wrong response id 0xBAC9723E (expected 0x4EEFAC41)"),
+        ("close", "closed the connection"),
+    ],
+)
 def test_every_fault_is_link_lost_with_a_sentence(fault: str, message: str) -> None:
     with FakeTxt(fault=(fault, 2)) as fake:
         link = online(fake, timeout_s=0.05)
@@ -131,8 +138,9 @@ class Listener:
 
     def __init__(self, host: str, port: int, kind: str) -> None:
         if kind == "http":
-            self.server: socketserver.BaseServer = http.server.ThreadingHTTPServer((host, port),
-                                                                                  http.server.BaseHTTPRequestHandler)
+            self.server: socketserver.BaseServer = http.server.ThreadingHTTPServer(
+                (host, port), http.server.BaseHTTPRequestHandler
+            )
         else:
             self.server = socketserver.ThreadingTCPServer((host, port), BadRequest)
         self.server.daemon_threads = True
@@ -167,8 +175,10 @@ def test_auto_takes_the_first_address_that_answers_as_a_txt() -> None:
     assert found == "127.0.0.5" and none is None
     assert tried == tried_none
     assert tried[0].startswith("127.0.0.2: no answer from 127.0.0.2")
-    assert tried[1] == (f"127.0.0.3: malformed reply from 127.0.0.3:{port}: QUERY_STATUS: "
-                        "wrong response id 0x50545448 (expected 0xBAC9723E)")
+    assert tried[1] == (
+        f"127.0.0.3: malformed reply from 127.0.0.3:{port}: QUERY_STATUS: "
+        "wrong response id 0x50545448 (expected 0xBAC9723E)"
+    )
     assert tried[2].startswith(f"127.0.0.4: cannot connect to 127.0.0.4:{port}")
     assert took < 1.0  # asked at once, not one after the other
     assert fake.names()[0] == "QueryStatus"
@@ -214,11 +224,15 @@ def test_against_a_server_that_reads_each_request_with_one_recv_every_request_ar
 
 
 @pytest.mark.parametrize("single_recv", [False, True], ids=["txt", "ftrobopy_server"])
-def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(capsys: pytest.CaptureFixture,
-                                                                             single_recv: bool) -> None:
+def test_unmodified_ftrobopy_sets_a_motor_and_reads_an_input_through_the_fake(
+    capsys: pytest.CaptureFixture, single_recv: bool
+) -> None:
     import ftrobopy  # a dev dependency (pyproject.toml): missing, this fails rather than skips
-    with FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True, single_recv=single_recv) as fake, \
-            warnings.catch_warnings():
+
+    with (
+        FakeTxt(lambda n: ([0, 0, 1, 0, 0, 0, 0, 0], [0] * 4), i2c=True, single_recv=single_recv) as fake,
+        warnings.catch_warnings(),
+    ):
         warnings.simplefilter("ignore", DeprecationWarning)  # ftrobopy uses Thread.setDaemon
         txt = ftrobopy.ftrobopy("127.0.0.1", fake.port)
         motor = txt.motor(1)

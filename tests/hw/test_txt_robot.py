@@ -33,21 +33,30 @@ from txt_fake import FakeTxt
 
 pytestmark = [pytest.mark.realtime]
 
-FLAVOURS: dict[str, dict[str, object]] = {"txt": {"period_s": 0.01},
-            "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000, "single_recv": True}}
+FLAVOURS: dict[str, dict[str, object]] = {
+    "txt": {"period_s": 0.01},
+    "ftrobopy_server": {"period_s": 0.0, "device": "TX2013", "version": 0x04070000, "single_recv": True},
+}
 
 
 def bumberbot() -> Machine:
     return compile_table(load_table(EXAMPLE / "table.csv"))
 
 
-def drive(machine: Machine, fake: FakeTxt, ticks: int | None = 40, sinks: tuple = (), timeout_s: float = 0.15,
-          behind_limit_s: float | None = None) -> RunEnd:
+def drive(
+    machine: Machine,
+    fake: FakeTxt,
+    ticks: int | None = 40,
+    sinks: tuple = (),
+    timeout_s: float = 0.15,
+    behind_limit_s: float | None = None,
+) -> RunEnd:
     robot = TxtRobot(txt_wiring(machine), "127.0.0.1", fake.port, link_timeout_s=timeout_s)
     robot.connect()
     clock = RealTimeClock(machine.table.robot.tick_s)
-    end = run(Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="txt",
-              behind_limit_s=behind_limit_s)
+    end = run(
+        Engine(machine), robot, clock=clock, sinks=list(sinks), ticks=ticks, target="txt", behind_limit_s=behind_limit_s
+    )
     fake_settles(fake)
     assert all(r.whole for r in fake.requests()), "a request arrived in pieces"
     return end
@@ -89,8 +98,13 @@ def test_pwm_follows_the_engine_for_the_inputs_the_fake_serves(tmp_path: Path, f
     threshold, a reversed motor on another pair, a lamp, a counter on C3."""
     machine = wired_random_machine(tmp_path)
     rng = random.Random(5)
-    script = [([rng.randint(0, 1), 0, 0, rng.randint(0, 1), 0, rng.choice([5, 19, 20, 80]), 0, 0],
-               [0, 0, rng.randint(0, 3), 0]) for _ in range(90)]
+    script = [
+        (
+            [rng.randint(0, 1), 0, 0, rng.randint(0, 1), 0, rng.choice([5, 19, 20, 80]), 0, 0],
+            [0, 0, rng.randint(0, 3), 0],
+        )
+        for _ in range(90)
+    ]
     counts = [sum(s[1][2] for s in script[: n + 1]) for n in range(len(script))]
     with FakeTxt(lambda n: (script[n][0], [0, 0, counts[n], 0]), **flavour) as fake:
         end = drive(machine, fake, ticks=80)
@@ -99,9 +113,13 @@ def test_pwm_follows_the_engine_for_the_inputs_the_fake_serves(tmp_path: Path, f
     inputs = fake.requests("UpdateConfig")[0].fields["inputs"]
     assert inputs[0] == (1, 1) and inputs[3] == (1, 1) and inputs[5] == (3, 0)  # ultrasonic, analog
     bits = machine.input_bits
-    ticks = [TickInput((bits["I1"] if u[0] else 0) | (bits["I2"] if not u[3] else 0) | (bits["I3"] if u[5] < 20 else 0),
-                       (0 if n == 0 else c[2],))
-             for n, (u, c) in enumerate(script[:80])]
+    ticks = [
+        TickInput(
+            (bits["I1"] if u[0] else 0) | (bits["I2"] if not u[3] else 0) | (bits["I3"] if u[5] < 20 else 0),
+            (0 if n == 0 else c[2],),
+        )
+        for n, (u, c) in enumerate(script[:80])
+    ]
     expected = [pwm_of(line) for line in replay(machine, ticks)]
     sent = [r.fields["pwm"] for r in fake.requests("ExchangeData")]
     assert sent[0] == [0] * 8 and sent[-1] == [0] * 8
@@ -119,9 +137,12 @@ def wired_random_machine(tmp_path: Path) -> Machine:
         'I1 = { terminal = "I1", mode = "switch", pressed = 1 }\n'
         'I2 = { terminal = "I4", mode = "switch", pressed = 0 }\n'
         'I3 = { terminal = "I6", mode = "ultrasonic", below = 20 }\n'
-        'M1 = { terminal = "M2", reverse = true }\nM2 = "M1"\nL1 = "O7"\nC1 = "C3"\n', encoding="utf-8")
-    robot = dataclasses.replace(load_robot(robot_file), initial_state=table.robot.initial_state,
-                                initial_timer=table.robot.initial_timer)
+        'M1 = { terminal = "M2", reverse = true }\nM2 = "M1"\nL1 = "O7"\nC1 = "C3"\n',
+        encoding="utf-8",
+    )
+    robot = dataclasses.replace(
+        load_robot(robot_file), initial_state=table.robot.initial_state, initial_timer=table.robot.initial_timer
+    )
     return compile_table(Table(robot=robot, events=table.events, rows=table.rows, path=table.path))
 
 
@@ -158,10 +179,12 @@ class StopAt:
         pass
 
 
-@pytest.mark.parametrize(("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"),
-                                             ("bug", "error")])
-def test_every_stop_path_zeroes_every_output_in_the_exchange_before_stop_online(how: str, reason: str,
-                                                                                flavour: dict) -> None:
+@pytest.mark.parametrize(
+    ("how", "reason"), [("end", "done"), ("ctrl-c", "interrupted"), ("sigterm", "terminated"), ("bug", "error")]
+)
+def test_every_stop_path_zeroes_every_output_in_the_exchange_before_stop_online(
+    how: str, reason: str, flavour: dict
+) -> None:
     with FakeTxt(**flavour) as fake:
         if how == "bug":
             with pytest.raises(RuntimeError, match="a bug in a sink"):
@@ -179,15 +202,20 @@ def test_every_stop_path_zeroes_every_output_in_the_exchange_before_stop_online(
 
 @pytest.mark.parametrize("fault", ["silent", "late", "garbage", "wrong_id"])
 def test_a_faulty_link_ends_the_run_as_link_lost_with_the_outputs_zeroed_where_the_link_allows(
-        fault: str, flavour: dict) -> None:
+    fault: str, flavour: dict
+) -> None:
     with FakeTxt(fault=(fault, 15), **flavour) as fake:
         started = time.monotonic()
         end = drive(bumberbot(), fake, ticks=100, timeout_s=0.1)
         took = time.monotonic() - started
     assert end.reason == "link_lost" and end.exit_code == 3 and 13 <= end.ticks <= 15, end
     assert took < 2.0
-    what = {"silent": "no answer", "late": "no answer", "garbage": "malformed reply",
-            "wrong_id": "wrong response id 0xBAC9723E"}[fault]
+    what = {
+        "silent": "no answer",
+        "late": "no answer",
+        "garbage": "malformed reply",
+        "wrong_id": "wrong response id 0xBAC9723E",
+    }[fault]
     assert what in end.message
     assert fake.last_exchange_before_stop().fields["pwm"] == [0] * 8  # the fake still reads what it is sent
 

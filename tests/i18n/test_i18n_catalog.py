@@ -27,16 +27,21 @@ EXAMPLE = ROOT / "examples" / "bumberbot"
 
 
 def test_the_template_and_the_compiled_catalogs_are_up_to_date() -> None:
-    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "catalog.py"), "check"], capture_output=True,
-                          text=True, cwd=ROOT)
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "catalog.py"), "check"], capture_output=True, text=True, cwd=ROOT
+    )
     assert done.returncode == 0, done.stderr
 
 
 def test_msgfmt_finds_german_complete_and_well_formed() -> None:
     msgfmt = shutil.which("msgfmt")
     assert msgfmt, "msgfmt is missing: it is Debian's gettext package, which make setup installs"
-    done = subprocess.run([msgfmt, "--check", "--statistics", "-o", "/dev/null", str(PO)], capture_output=True,
-                          text=True, env={"LC_ALL": "C", "PATH": "/usr/bin:/bin"})
+    done = subprocess.run(
+        [msgfmt, "--check", "--statistics", "-o", "/dev/null", str(PO)],
+        capture_output=True,
+        text=True,
+        env={"LC_ALL": "C", "PATH": "/usr/bin:/bin"},
+    )
     assert done.returncode == 0, done.stderr
     assert re.fullmatch(r"\d+ translated messages\.\n", done.stderr), done.stderr  # no fuzzy, no untranslated
 
@@ -99,9 +104,16 @@ def test_every_help_is_marked(args: list[str]) -> None:
 
 
 BAD_LINES = [
-    ["sim"], ["sim", "a", "b"], ["sim", str(EXAMPLE), "--seconds"], ["sim", str(EXAMPLE), "--seconds", "nan"],
-    ["sim", str(EXAMPLE), "--seconds", "1e9"], ["sim", str(EXAMPLE), "--seconds", "many"],
-    ["sim", str(EXAMPLE), "--sed", "3"], ["simm"], ["--bogus"], ["check", str(EXAMPLE), "--format", "yaml"],
+    ["sim"],
+    ["sim", "a", "b"],
+    ["sim", str(EXAMPLE), "--seconds"],
+    ["sim", str(EXAMPLE), "--seconds", "nan"],
+    ["sim", str(EXAMPLE), "--seconds", "1e9"],
+    ["sim", str(EXAMPLE), "--seconds", "many"],
+    ["sim", str(EXAMPLE), "--sed", "3"],
+    ["simm"],
+    ["--bogus"],
+    ["check", str(EXAMPLE), "--format", "yaml"],
 ]
 
 
@@ -118,18 +130,30 @@ def test_the_language_is_chosen_before_the_help_is_built() -> None:
     """--lang anywhere, else TABLEBOT_LANG, else the system's locale; a language tablebot does not speak is refused
     by name when asked for, and English when it is merely the system's."""
     env = {"PATH": "/usr/bin:/bin", "LANG": "de_DE.UTF-8"}
-    cases = [(["--help"], {}, "Aufruf:"), (["--help", "--lang", "en"], {}, "Usage:"),
-             (["sim", "--lang=de", "-h"], {"LANG": "C"}, "Aufruf:"), (["-h"], {"TABLEBOT_LANG": "en"}, "Usage:"),
-             (["-h"], {"LANG": "fr_FR.UTF-8"}, "Usage:"), (["-h"], {"LC_ALL": "de_AT", "LANG": "en_GB"}, "Aufruf:")]
+    cases = [
+        (["--help"], {}, "Aufruf:"),
+        (["--help", "--lang", "en"], {}, "Usage:"),
+        (["sim", "--lang=de", "-h"], {"LANG": "C"}, "Aufruf:"),
+        (["-h"], {"TABLEBOT_LANG": "en"}, "Usage:"),
+        (["-h"], {"LANG": "fr_FR.UTF-8"}, "Usage:"),
+        (["-h"], {"LC_ALL": "de_AT", "LANG": "en_GB"}, "Aufruf:"),
+    ]
     for args, extra, expected in cases:
-        done = subprocess.run([sys.executable, "-m", "tablebot", *args], capture_output=True, text=True,
-                              env={**env, **extra}, cwd=ROOT)
+        done = subprocess.run(
+            [sys.executable, "-m", "tablebot", *args], capture_output=True, text=True, env={**env, **extra}, cwd=ROOT
+        )
         assert done.returncode == 0 and done.stdout.startswith(expected), (args, extra, done.stdout[:80])
-    refused = subprocess.run([sys.executable, "-m", "tablebot", "-h"], capture_output=True, text=True,
-                             env={**env, "TABLEBOT_LANG": "fr"}, cwd=ROOT)
+    refused = subprocess.run(
+        [sys.executable, "-m", "tablebot", "-h"],
+        capture_output=True,
+        text=True,
+        env={**env, "TABLEBOT_LANG": "fr"},
+        cwd=ROOT,
+    )
     assert refused.returncode == 2, refused.stderr
-    assert refused.stderr == ("TABLEBOT_LANG: error: 'fr' is not a language tablebot speaks\n"
-                              "    hint: use one of: en, de\n")
+    assert refused.stderr == (
+        "TABLEBOT_LANG: error: 'fr' is not a language tablebot speaks\n    hint: use one of: en, de\n"
+    )
 
 
 def test_the_windows_user_interface_language() -> None:
@@ -142,18 +166,34 @@ def test_the_windows_user_interface_language() -> None:
 def example_words(folder: Path) -> set[str]:
     """Every word of an example's own files and their names (its states' names, inputs' labels, properties'
     texts, table.csv): the user's."""
-    return {w for path in folder.iterdir() if path.is_file()
-            for w in re.findall(r"[A-Za-z]+", f"{path.name} {path.read_text()}")}
+    return {
+        w
+        for path in folder.iterdir()
+        if path.is_file()
+        for w in re.findall(r"[A-Za-z]+", f"{path.name} {path.read_text()}")
+    }
 
 
-@pytest.mark.parametrize("args", [["check", str(EXAMPLE), "-v"], ["sim", str(EXAMPLE), "--seconds", "2",
-                                                                  "--no-plots", "--out", "OUT"]], ids=lambda a: a[0])
+@pytest.mark.parametrize(
+    "args",
+    [["check", str(EXAMPLE), "-v"], ["sim", str(EXAMPLE), "--seconds", "2", "--no-plots", "--out", "OUT"]],
+    ids=lambda a: a[0],
+)
 def test_check_and_sim_say_nothing_outside_the_markers(args: list[str], tmp_path: Path) -> None:
     args = [a.replace("OUT", str(tmp_path / "out")) for a in args]
-    done = subprocess.run([sys.executable, "-m", "tablebot", *args], capture_output=True, text=True, cwd=ROOT,
-                          env={"PATH": "/usr/bin:/bin", "TABLEBOT_LANG": i18n.PSEUDO, "HOME": str(Path.home()),
-                               # the test session's compiled kernels (else sim compiles them all: a minute)
-                               **{k: v for k, v in os.environ.items() if k == "NUMBA_CACHE_DIR"}})
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={
+            "PATH": "/usr/bin:/bin",
+            "TABLEBOT_LANG": i18n.PSEUDO,
+            "HOME": str(Path.home()),
+            # the test session's compiled kernels (else sim compiles them all: a minute)
+            **{k: v for k, v in os.environ.items() if k == "NUMBA_CACHE_DIR"},
+        },
+    )
     assert done.returncode in (0, 1), done.stderr
     allowed = names(typer.main.get_command(app)) | set(args) | example_words(EXAMPLE) | {"jsonl"}
     shown = done.stdout + done.stderr

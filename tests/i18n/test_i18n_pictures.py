@@ -19,11 +19,14 @@ from tablebot.sim.summary import summarise
 from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 
 #: Texts each picture shows, English and German (the catalog's words: Zustand, Startwert, Schwelle ...).
-TRAJECTORY = {"en": ["seed 1", "path colour = state (time in it)", "m driven", "lamp reached: never", "obstacle"],
-              "de": ["Startwert 1", "Farbe der Bahn = Zustand (Zeit darin)", "m gefahren", "Lampe erreicht: nie",
-                     "Hindernis"]}
-TIMELINE = {"en": ["time (s)", "state", "events", "threshold", "motor speed\n(+ forward)", "(red lines: collisions"],
-            "de": ["Zeit (s)", "Zustand", "Ereignisse", "Schwelle", "Motortempo\n(+ vorwärts)", "(rote Linien:"]}
+TRAJECTORY = {
+    "en": ["seed 1", "path colour = state (time in it)", "m driven", "lamp reached: never", "obstacle"],
+    "de": ["Startwert 1", "Farbe der Bahn = Zustand (Zeit darin)", "m gefahren", "Lampe erreicht: nie", "Hindernis"],
+}
+TIMELINE = {
+    "en": ["time (s)", "state", "events", "threshold", "motor speed\n(+ forward)", "(red lines: collisions"],
+    "de": ["Zeit (s)", "Zustand", "Ereignisse", "Schwelle", "Motortempo\n(+ vorwärts)", "(rote Linien:"],
+}
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +51,9 @@ def texts(fig: Figure) -> Iterator[Text]:
 
 @pytest.mark.parametrize("language", ["en", "de"])
 @pytest.mark.parametrize(("picture", "expected"), [("trajectory", TRAJECTORY), ("timeline", TIMELINE)])
-def test_a_picture_speaks_the_readers_language(run: SimRun, language: str, picture: str,
-                                               expected: dict[str, list[str]]) -> None:
+def test_a_picture_speaks_the_readers_language(
+    run: SimRun, language: str, picture: str, expected: dict[str, list[str]]
+) -> None:
     words = "\n".join(drawn(language, run, picture))
     other = "de" if language == "en" else "en"
     assert all(w in words for w in expected[language]), words
@@ -57,16 +61,46 @@ def test_a_picture_speaks_the_readers_language(run: SimRun, language: str, pictu
 
 
 #: The table's and robot's own words in the BumberBot's pictures (names, state titles, sensor labels), and units.
-THEIRS = ("BumberBot", "arena", "M1", "M2", "T", "I3", "I4", "I5", "I7", "I8", "Seek:", "drive", "straight", "turn",
-          "right", "left", "front-right", "front-left", "rear", "bumper", "phototransistor", "motor)", "(right",
-          "(left", "timer", "s", "s)", "m", "x", "y", "(m)")
+THEIRS = (
+    "BumberBot",
+    "arena",
+    "M1",
+    "M2",
+    "T",
+    "I3",
+    "I4",
+    "I5",
+    "I7",
+    "I8",
+    "Seek:",
+    "drive",
+    "straight",
+    "turn",
+    "right",
+    "left",
+    "front-right",
+    "front-left",
+    "rear",
+    "bumper",
+    "phototransistor",
+    "motor)",
+    "(right",
+    "(left",
+    "timer",
+    "s",
+    "s)",
+    "m",
+    "x",
+    "y",
+    "(m)",
+)
 
 
 def unmarked(text: str) -> list[str]:
     """The words of ``text`` outside the pseudo-locale's markers (a marked text's arguments are inside them)."""
     while i18n.PSEUDO_OPEN in text:
         start = text.index(i18n.PSEUDO_OPEN)
-        text = text[:start] + text[text.index(i18n.PSEUDO_CLOSE, start) + 1:]
+        text = text[:start] + text[text.index(i18n.PSEUDO_CLOSE, start) + 1 :]
     return [w for w in text.split() if any(c.isalpha() for c in w)]
 
 
@@ -84,8 +118,25 @@ def test_sim_with_lang_de_draws_german_pictures(tmp_path: Path) -> None:
     pictures = {}
     for language in ("en", "de"):
         out = tmp_path / language
-        subprocess.run([sys.executable, "-m", "tablebot", "--lang", language, "sim", str(BUMBERBOT), "--seconds", "2",
-                        "--out", str(out), "-q"], check=True, capture_output=True, timeout=120)
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "tablebot",
+                "--lang",
+                language,
+                "sim",
+                str(BUMBERBOT),
+                "--seconds",
+                "2",
+                "--out",
+                str(out),
+                "-q",
+            ],
+            check=True,
+            capture_output=True,
+            timeout=120,
+        )
         pictures[language] = {n: (out / n).read_bytes() for n in ("trace.jsonl", "trajectory.png", "timeline.png")}
     assert pictures["en"]["trace.jsonl"] == pictures["de"]["trace.jsonl"]
     assert pictures["en"]["trajectory.png"] != pictures["de"]["trajectory.png"]
@@ -104,16 +155,33 @@ def test_the_leaderboard_speaks_the_readers_language(tmp_path: Path) -> None:
     (pupil / "table.csv").write_bytes((ROOT / "tests" / "fixtures" / "analysis" / "bumberbot_fixed.csv").read_bytes())
     i18n.use("de")
     try:
-        result = CliRunner().invoke(app, ["grade", str(ROOT / "examples" / "challenges" / "find-the-lamp"),
-                                          str(pupil), "--out", str(tmp_path / "out")])
+        result = CliRunner().invoke(
+            app,
+            [
+                "grade",
+                str(ROOT / "examples" / "challenges" / "find-the-lamp"),
+                str(pupil),
+                "--out",
+                str(tmp_path / "out"),
+            ],
+        )
     finally:
         i18n.use("en")
     assert result.exit_code == 0, result.output
     page = (tmp_path / "out" / "leaderboard.html").read_text(encoding="utf-8")
-    head = page[:page.index("<script")]  # the board, not the packed replays
-    for german in ('<html lang="de">', "Rangliste</title>", "<th>Platz</th>", "<th>Punkte</th>", "<th>Regeln</th>",
-                   "1 Einreichung, gefahren auf", "(niedrig ist besser)", " bis ", "▶ beste: Startwert",
-                   "schließen (Esc)"):
+    head = page[: page.index("<script")]  # the board, not the packed replays
+    for german in (
+        '<html lang="de">',
+        "Rangliste</title>",
+        "<th>Platz</th>",
+        "<th>Punkte</th>",
+        "<th>Regeln</th>",
+        "1 Einreichung, gefahren auf",
+        "(niedrig ist besser)",
+        " bis ",
+        "▶ beste: Startwert",
+        "schließen (Esc)",
+    ):
         assert german in page, german
     for english in ("leaderboard", "<th>rank", "submission", "is better", " to ", "seed ", "close"):
         assert english not in head, english
@@ -129,8 +197,22 @@ def test_sweeps_pictures_speak_the_readers_language(tmp_path: Path) -> None:
     from tablebot.fleet.plots import outcomes_figure, starts_figure
 
     out = tmp_path / "s"
-    result = CliRunner().invoke(app, ["sweep", str(BUMBERBOT), "--seeds", "0..3", "--seconds", "1", "--workers", "1",
-                                      "--out", str(out), "--no-plots"])
+    result = CliRunner().invoke(
+        app,
+        [
+            "sweep",
+            str(BUMBERBOT),
+            "--seeds",
+            "0..3",
+            "--seconds",
+            "1",
+            "--workers",
+            "1",
+            "--out",
+            str(out),
+            "--no-plots",
+        ],
+    )
     assert result.exit_code == 0, result.output
     plan, rows = make_plan(BUMBERBOT, None, [], [], "0..3", None, 1.0), read_results(out / "results.csv")
     words = {}
@@ -141,10 +223,24 @@ def test_sweeps_pictures_speak_the_readers_language(tmp_path: Path) -> None:
         finally:
             i18n.use("en")
         words[language] = "\n".join(t.get_text() for fig in figures for t in texts(fig))
-    english = ["4 runs of 1 s", "reached the lamp (%)", "never: 4", "time to first light (s)", "Start positions in",
-               "0 of 4 reached the lamp", "never reached the lamp"]
-    german = ["4 Fahrten zu je 1 s", "erreichten die Lampe (%)", "nie: 4", "Zeit bis zum ersten Licht (s)",
-              "Startpositionen in", "0 von 4 erreichten die Lampe", "erreichte die Lampe nie"]
+    english = [
+        "4 runs of 1 s",
+        "reached the lamp (%)",
+        "never: 4",
+        "time to first light (s)",
+        "Start positions in",
+        "0 of 4 reached the lamp",
+        "never reached the lamp",
+    ]
+    german = [
+        "4 Fahrten zu je 1 s",
+        "erreichten die Lampe (%)",
+        "nie: 4",
+        "Zeit bis zum ersten Licht (s)",
+        "Startpositionen in",
+        "0 von 4 erreichten die Lampe",
+        "erreichte die Lampe nie",
+    ]
     assert all(w in words["en"] for w in english), words["en"]
     assert all(w in words["de"] for w in german) and not any(w in words["de"] for w in english), words["de"]
 
@@ -179,9 +275,26 @@ def test_view_without_a_window_says_so_in_german(tmp_path: Path) -> None:
     """sim --view where no window can open: the error and its hint in the reader's language."""
     import os
 
-    done = subprocess.run([sys.executable, "-m", "tablebot", "--lang", "de", "sim", str(BUMBERBOT), "--seconds", "1",
-                           "--view", "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=60,
-                          env={**os.environ, "MPLBACKEND": "agg"})
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "--lang",
+            "de",
+            "sim",
+            str(BUMBERBOT),
+            "--seconds",
+            "1",
+            "--view",
+            "--out",
+            str(tmp_path / "o"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "MPLBACKEND": "agg"},
+    )
     assert done.returncode != 0
     assert "--view: Fehler: hier lässt sich kein Fenster öffnen" in done.stderr + done.stdout
     assert "Tipp: ohne --view starten und die Bilder öffnen" in done.stderr + done.stdout

@@ -19,8 +19,16 @@ from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[2]
 BUMBERBOT = ROOT / "examples" / "bumberbot"
-GERMAN = {"description": "Beschreibung", "state": "ZUSTAND", "timer": "Timer", "next": "folgezustand",
-          "M1_dir": "M1_Richtung", "M1_speed": "M1_tempo", "M2_dir": "M2_richtung", "M2_speed": "M2_Tempo"}
+GERMAN = {
+    "description": "Beschreibung",
+    "state": "ZUSTAND",
+    "timer": "Timer",
+    "next": "folgezustand",
+    "M1_dir": "M1_Richtung",
+    "M1_speed": "M1_tempo",
+    "M2_dir": "M2_richtung",
+    "M2_speed": "M2_Tempo",
+}
 
 
 def twins(folder: Path) -> tuple[Path, Path]:
@@ -34,9 +42,9 @@ def twins(folder: Path) -> tuple[Path, Path]:
     for side in (english, german):
         side.mkdir()
         shutil.copy(BUMBERBOT / "robot.toml", side / "robot.toml")
-    timed = [[*row[:at], f"{int(row[at]) / 100:g} s", *row[at + 1:]] for row in rows]  # 50 -> "0.5 s"
+    timed = [[*row[:at], f"{int(row[at]) / 100:g} s", *row[at + 1 :]] for row in rows]  # 50 -> "0.5 s"
     (english / "table.csv").write_text("\n".join(",".join(r) for r in [header, *timed]) + "\n")
-    german_rows = [[*r[:at], r[at].replace(".", ",").replace(" s", "s"), *r[at + 1:]] for r in timed]
+    german_rows = [[*r[:at], r[at].replace(".", ",").replace(" s", "s"), *r[at + 1 :]] for r in timed]
     german_header = [GERMAN.get(name, name) for name in header]
     (german / "table.csv").write_text("\n".join(";".join(r) for r in [german_header, *german_rows]) + "\n")
     return english / "table.csv", german / "table.csv"
@@ -46,8 +54,12 @@ SMALL_ROBOT = 'name = "Small"\ntick_ms = 10\ninitial_state = 1\n[inputs]\nI3 = "
 
 
 def trace(table: Path, *lang: str) -> bytes:
-    done = subprocess.run([sys.executable, "-m", "tablebot", *lang, "trace", str(table), "--inputs",
-                           str(BUMBERBOT / "inputs.csv")], capture_output=True, env=child_env(), cwd=ROOT)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", *lang, "trace", str(table), "--inputs", str(BUMBERBOT / "inputs.csv")],
+        capture_output=True,
+        env=child_env(),
+        cwd=ROOT,
+    )
     assert done.returncode == 0, done.stderr.decode()
     return done.stdout
 
@@ -114,11 +126,24 @@ def outside(text: str) -> str:
 HEAD = "description,state,I3,M1_dir,M1_speed,timer,next\n"
 #: Bad tables (the hardening cases of the table reader), each with a word that must stay as the file wrote it.
 BAD_TABLES = [
-    "", HEAD, "state,I9,next\n1,,1\n", "state,state,next\n1,1,1\n", "description,state,I3\n1,1,1\n",
-    HEAD + "a,1,x,,2,0,1\n", HEAD + "a,1,7,,2,0,1\n", HEAD + "a,1,,,2,70000,1\n", HEAD + "a,1,,,2,0.505s,1\n",
-    HEAD + "a,1,,,2,11 minutes,1\n", HEAD + "a,1,,,2,0,\n", HEAD + "a,-3,,,2,0,1\n", HEAD + "a,1,,,2,0,9\n",
-    HEAD + "a,1,,,2,0,'bad'\n", HEAD + "a,1,,,2,1000s,1\n", "state,M1,M1_dir,M1_speed,next\n1,1,,2,1\n",
-    "state,M1_dir,next\n1,1,1\n", "state,next\n" + "1" * 200 + ",1\n",
+    "",
+    HEAD,
+    "state,I9,next\n1,,1\n",
+    "state,state,next\n1,1,1\n",
+    "description,state,I3\n1,1,1\n",
+    HEAD + "a,1,x,,2,0,1\n",
+    HEAD + "a,1,7,,2,0,1\n",
+    HEAD + "a,1,,,2,70000,1\n",
+    HEAD + "a,1,,,2,0.505s,1\n",
+    HEAD + "a,1,,,2,11 minutes,1\n",
+    HEAD + "a,1,,,2,0,\n",
+    HEAD + "a,-3,,,2,0,1\n",
+    HEAD + "a,1,,,2,0,9\n",
+    HEAD + "a,1,,,2,0,'bad'\n",
+    HEAD + "a,1,,,2,1000s,1\n",
+    "state,M1,M1_dir,M1_speed,next\n1,1,,2,1\n",
+    "state,M1_dir,next\n1,1,1\n",
+    "state,next\n" + "1" * 200 + ",1\n",
 ]
 
 
@@ -143,16 +168,22 @@ def test_a_table_written_in_german_reads_back_the_same() -> None:
 
     table = load_table(BUMBERBOT / "table.csv")
     german = format_table(table, "de")
-    assert german.startswith("Beschreibung,Zustand,T,I3,I4,I5,I7,I8,M1_Richtung,M1_Tempo,M2_Richtung,M2_Tempo,Timer,"
-                             "Folgezustand\n")
+    assert german.startswith(
+        "Beschreibung,Zustand,T,I3,I4,I5,I7,I8,M1_Richtung,M1_Tempo,M2_Richtung,M2_Tempo,Timer,Folgezustand\n"
+    )
     assert parse_table(german, "de.csv", table.robot).rows == table.rows
     assert format_table(table) == format_table(table, "en") and format_table(table).startswith("description,state,")
 
 
 def test_new_writes_a_german_table_when_asked(tmp_path: Path) -> None:
     def new(folder: str, *args: str, **env: str) -> str:
-        done = subprocess.run([sys.executable, "-m", "tablebot", "new", str(tmp_path / folder), *args],
-                              capture_output=True, text=True, env=child_env(**env), cwd=ROOT)
+        done = subprocess.run(
+            [sys.executable, "-m", "tablebot", "new", str(tmp_path / folder), *args],
+            capture_output=True,
+            text=True,
+            env=child_env(**env),
+            cwd=ROOT,
+        )
         assert done.returncode == 0, done.stderr
         return done.stdout
 
@@ -166,12 +197,17 @@ def test_new_writes_a_german_table_when_asked(tmp_path: Path) -> None:
 
 
 BAD_ROBOTS = [
-    "name = 1\n[motors]\nM1 = 2\n", "tick_ms = 0\ninitial_state = 1\n[motors]\nM1 = 'm'\n", "initial_state = 1\n",
+    "name = 1\n[motors]\nM1 = 2\n",
+    "tick_ms = 0\ninitial_state = 1\n[motors]\nM1 = 'm'\n",
+    "initial_state = 1\n",
     "initial_state = 1\nmatch = 'sometimes'\n[inputs]\nI1 = 'a'\n[motors]\nI1 = 'b'\n",
     "initial_state = 1\n[motors]\nM1 = 'm'\n[counters]\nC1 = 'M9'\n",
     "initial_state = 1\n[motors]\nM1 = 'm'\n[wiring]\n",
-    "initial_state = 1\n[motors]\nZustand = 'm'\n", "initial_state = 1\n[motors\n", "initial_state = 1\nx = = 2\n",
-    "initial_state = 1\n[motors]\nM1 = 'm'\nname = 'late'\n", "initial_state = [1]\n[states]\nx-y = 3\n",
+    "initial_state = 1\n[motors]\nZustand = 'm'\n",
+    "initial_state = 1\n[motors\n",
+    "initial_state = 1\nx = = 2\n",
+    "initial_state = 1\n[motors]\nM1 = 'm'\nname = 'late'\n",
+    "initial_state = [1]\n[states]\nx-y = 3\n",
 ]
 
 

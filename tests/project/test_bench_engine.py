@@ -25,11 +25,16 @@ def load_benchmark() -> ModuleType:
     return module
 
 
-ROW = re.compile(r"^  (?P<name>[a-z ()]+?)\s+(?P<cpu>[\d.]+) s CPU\s+(?P<rate>[\d,]+) ticks/s"
-                 r"\s+(?P<ns>[\d.]+) ns/tick$", re.MULTILINE)
-TARGET = re.compile(r"^  (?P<a>[a-z ]+?) vs (?P<b>[a-z ]+?)(?: \([^)]*\))?\s+(?P<ratio>[\d.]+)x "
-                    r"\((?P<low>[\d.]+)\.\.(?P<high>[\d.]+)\)\s+target >= (?P<want>[\d.]+)x\s+(?P<verdict>ok|MISSED)$",
-                    re.MULTILINE)
+ROW = re.compile(
+    r"^  (?P<name>[a-z ()]+?)\s+(?P<cpu>[\d.]+) s CPU\s+(?P<rate>[\d,]+) ticks/s"
+    r"\s+(?P<ns>[\d.]+) ns/tick$",
+    re.MULTILINE,
+)
+TARGET = re.compile(
+    r"^  (?P<a>[a-z ]+?) vs (?P<b>[a-z ]+?)(?: \([^)]*\))?\s+(?P<ratio>[\d.]+)x "
+    r"\((?P<low>[\d.]+)\.\.(?P<high>[\d.]+)\)\s+target >= (?P<want>[\d.]+)x\s+(?P<verdict>ok|MISSED)$",
+    re.MULTILINE,
+)
 
 
 def test_a_short_run_reports_figures_that_agree_with_each_other(capsys: pytest.CaptureFixture[str]) -> None:
@@ -45,8 +50,12 @@ def test_a_short_run_reports_figures_that_agree_with_each_other(capsys: pytest.C
     for m in ROW.finditer(out):
         assert float(m["rate"].replace(",", "")) * float(m["ns"]) == pytest.approx(1e9, rel=0.002)
     targets = list(TARGET.finditer(out))
-    assert [(t["a"], t["b"]) for t in targets] == [("step", "bare step"), ("step", "linear scan"),
-                                                   ("step", "transitions"), ("batch", "bare loop")]
+    assert [(t["a"], t["b"]) for t in targets] == [
+        ("step", "bare step"),
+        ("step", "linear scan"),
+        ("step", "transitions"),
+        ("batch", "bare loop"),
+    ]
     for t in targets:
         ratio = float(t["ratio"])
         # one round: its own median; the rates are printed rounded, so a large ratio differs in its last digits

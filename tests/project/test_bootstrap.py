@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-REFUSE = "#!/bin/sh\necho \"$0 $*\" >>\"{log}\"\nexit 1\n"
+REFUSE = '#!/bin/sh\necho "$0 $*" >>"{log}"\nexit 1\n'
 NO_ENSUREPIP = "raise SystemExit('ensurepip is not available (as on Debian without python3-venv)')\n"
 
 
@@ -46,8 +46,9 @@ def test_the_user_set_up_needs_no_pip_no_uv_and_no_system_package(tmp_path: Path
     env |= {"PATH": os.pathsep.join(path), "PYTHONPATH": str(blocked.parent)}
     for check in (["-m", "pip", "--version"], ["-m", "ensurepip"]):
         assert subprocess.run([str(tools / "python3"), *check], env=env, capture_output=True).returncode != 0
-    done = subprocess.run(["bash", "scripts/bootstrap.sh", "user"], cwd=work, env=env, capture_output=True, text=True,
-                          timeout=600)
+    done = subprocess.run(
+        ["bash", "scripts/bootstrap.sh", "user"], cwd=work, env=env, capture_output=True, text=True, timeout=600
+    )
     said = done.stdout + done.stderr
     assert done.returncode == 0, said
     assert "this Python has no pip: fetching pip's wheel from PyPI" in said
@@ -56,6 +57,7 @@ def test_the_user_set_up_needs_no_pip_no_uv_and_no_system_package(tmp_path: Path
     assert (venv / "uv").exists() and (work / ".venv" / ".installed-user").exists()
     version = subprocess.run([str(venv / "tablebot"), "--version"], env=env, capture_output=True, text=True)
     assert version.returncode == 0 and version.stdout.startswith("tablebot "), version.stderr
-    again = subprocess.run(["bash", "scripts/bootstrap.sh", "user"], cwd=work, env=env, capture_output=True,
-                           text=True, timeout=60)
+    again = subprocess.run(
+        ["bash", "scripts/bootstrap.sh", "user"], cwd=work, env=env, capture_output=True, text=True, timeout=60
+    )
     assert again.returncode == 0 and again.stdout == "", again.stdout  # set up: nothing to do, nothing said

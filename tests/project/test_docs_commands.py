@@ -117,7 +117,7 @@ def shown_output(doc: str) -> dict[int, list[str]]:
     blocks = list(FENCE_RE.finditer(text))
     shown = {}
     for above, below in pairwise(blocks):
-        if above[1] == "sh" and below[1] == "" and not text[above.end():below.start()].strip():
+        if above[1] == "sh" and below[1] == "" and not text[above.end() : below.start()].strip():
             last = text.count("\n", 0, above.start(2)) + len(above[2].rstrip("\n").splitlines())
             shown[last] = [line for line in below[2].splitlines() if line.strip() not in ("", "...")]
     return shown
@@ -138,8 +138,14 @@ def completion_installs(folder: Path) -> str:
     home.mkdir(exist_ok=True)
     env = {**os.environ, "HOME": str(home), "PYTHONPATH": str(ROOT / "src")}
     tablebot = Path(sys.executable).parent / "tablebot"  # the command as installed: its name is what completes
-    done = subprocess.run(["bash", "-c", f"'{tablebot}' --install-completion; exit $?"], cwd=folder, env=env,
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        ["bash", "-c", f"'{tablebot}' --install-completion; exit $?"],
+        cwd=folder,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     if done.returncode != 0:
         return f"exit {done.returncode}: {(done.stdout + done.stderr)[-600:]}"
     script = home / ".bash_completions" / "tablebot.sh"
@@ -152,8 +158,9 @@ def studio_serves(command: Command, folder: Path) -> str:
     --no-browser on a free port; the page it prints must load, then Ctrl-C must end it."""
     argv = [sys.executable, "-m", "tablebot", *command.argv, "--no-browser", "--port", "0"]
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    with subprocess.Popen(argv, cwd=folder, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          text=True) as studio:
+    with subprocess.Popen(
+        argv, cwd=folder, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    ) as studio:
         assert studio.stdout is not None
         said, deadline = "", time.monotonic() + 60
         while "http://" not in said and time.monotonic() < deadline and studio.poll() is None:
@@ -197,8 +204,11 @@ def demo_commands() -> list[list[str]]:
     lines = recipe[1].splitlines()
     for script in re.findall(r"\./(scripts/[\w.-]+\.sh)", recipe[1]):
         lines += (ROOT / script).read_text(encoding="utf-8").splitlines()
-    return [line.split()[1:] for line in (raw.strip().lstrip("@") for raw in lines)
-            if line.startswith(".venv/bin/tablebot ")]
+    return [
+        line.split()[1:]
+        for line in (raw.strip().lstrip("@") for raw in lines)
+        if line.startswith(".venv/bin/tablebot ")
+    ]
 
 
 def test_the_makefiles_demo_command_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -241,8 +251,9 @@ def test_the_german_tutorials_table_drives_as_the_english_one(tmp_path: Path, mo
         if name == "german":
             (tmp_path / name / "table.csv").write_bytes((ROOT / "docs" / "tutorial-de" / "table.csv").read_bytes())
         table, robot = tmp_path / name / "table.csv", tmp_path / name / "robot.toml"
-        table.write_text(re.sub(r"^# (I1 \w+ 1)", r"\1", table.read_text(encoding="utf-8"), flags=re.M),
-                         encoding="utf-8")
+        table.write_text(
+            re.sub(r"^# (I1 \w+ 1)", r"\1", table.read_text(encoding="utf-8"), flags=re.M), encoding="utf-8"
+        )
         uncomment(robot, block_after(TUTORIAL, "## 5. Give it a sensor", "toml"))
         assert run(["sim", name, "--seconds", "20", "--no-plots", "--out", f"out-{name}"]).exit_code == 0
     english, german = ((tmp_path / f"out-{name}" / "trace.jsonl").read_bytes() for name in ("english", "german"))

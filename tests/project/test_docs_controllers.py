@@ -83,7 +83,7 @@ def _timed(argv: list[str]) -> list[str]:
         argv = [*argv, "--link-timeout", "1"]
     if "--seconds" in argv:
         at = argv.index("--seconds") + 1
-        return [*argv[:at], SECONDS, *argv[at + 1:]]
+        return [*argv[:at], SECONDS, *argv[at + 1 :]]
     return [*argv, "--seconds", SECONDS]
 
 
@@ -105,7 +105,8 @@ def run_all(cmds: list[Command], folder: Path) -> list[str]:
 
 
 def test_every_command_of_the_controllers_page_runs_against_the_stand_ins(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     cmds = commands(PAGE)
     assert not unaccounted(cmds), "run these commands in the test, or exempt them with the reason"
     assert {c.argv[0] for c in cmds if c.argv} >= {"run", "trace", "export", "upload", "new", "check"}
@@ -132,14 +133,18 @@ def robot_file_commands() -> list[Command]:
             for quoted in re.findall(r"`((?:tablebot|--on) [^`]+)`", text):
                 if quoted.startswith("tablebot") and "examples/" not in quoted:
                     continue
-                found.append(Command(doc, number - 1, quoted if quoted.startswith("tablebot")
-                                     else f"tablebot run {folder} {quoted}"))
+                found.append(
+                    Command(
+                        doc, number - 1, quoted if quoted.startswith("tablebot") else f"tablebot run {folder} {quoted}"
+                    )
+                )
             comment = []
     return found
 
 
-def test_every_command_an_example_robot_file_gives_runs_as_typed(tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_every_command_an_example_robot_file_gives_runs_as_typed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """examples/bumberbot/robot.toml told the reader to run `--on roboif:///dev/ttyUSB0`, which was refused
     at its 10 ms tick: each command its comments give must run as typed."""
     cmds = robot_file_commands()
@@ -148,8 +153,9 @@ def test_every_command_an_example_robot_file_gives_runs_as_typed(tmp_path: Path,
     assert run_all(cmds, tmp_path) == []
 
 
-def test_the_robo_interface_refuses_the_bumberbots_10_ms_tick_at_38400_baud(tmp_path: Path,
-                                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_robo_interface_refuses_the_bumberbots_10_ms_tick_at_38400_baud(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """What the two tests above rely on: the stand-in for the ROBO Interface is slow enough to refuse the
     example as it stands, so a page that gave that command would fail them."""
     monkeypatch.chdir(examples_copy(tmp_path))

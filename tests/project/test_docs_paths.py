@@ -25,8 +25,11 @@ PATH_RE = re.compile(r"`((?:examples|docs|src|tests|benchmarks|scripts|shared|re
 OTHER_PROJECTS = {"src/ftrobopy_server.cpp"}
 #: How the project was made is no reader's business: an issue's number, a session, other people's test runs, a
 #: folder beside the repository. (The changelog is exempt: it is where changes are told.)
-NOTEBOOK_RE = re.compile(r"\bissue \d+|\bissues? notes\b|\bin the session\b|\bthis session\b|other engineers|"
-                         r"\.\./shared\b|\bshared/|this 2-core machine|these 2-core machines|measured here\b", re.I)
+NOTEBOOK_RE = re.compile(
+    r"\bissue \d+|\bissues? notes\b|\bin the session\b|\bthis session\b|other engineers|"
+    r"\.\./shared\b|\bshared/|this 2-core machine|these 2-core machines|measured here\b",
+    re.I,
+)
 #: The README's first screen: what a reader sees before scrolling (the picture alone fills most of it).
 FIRST_SCREEN = 30
 
@@ -77,14 +80,23 @@ def test_the_readme_is_a_front_page() -> None:
 
 
 def test_no_page_tells_how_the_project_was_made() -> None:
-    found = [f"{doc.name}: {m[0]!r}" for doc in DOCS if doc.name != "CHANGELOG.md"
-             for m in NOTEBOOK_RE.finditer(doc.read_text(encoding="utf-8"))]
+    found = [
+        f"{doc.name}: {m[0]!r}"
+        for doc in DOCS
+        if doc.name != "CHANGELOG.md"
+        for m in NOTEBOOK_RE.finditer(doc.read_text(encoding="utf-8"))
+    ]
     assert not found, found
 
 
 def test_the_notebook_pattern_catches_what_the_readme_used_to_say() -> None:
-    for said in ("issue 22's targets", "in the session, against", "other engineers' test runs",
-                 "`../shared/rpp-corpus`", "4.4 s on this 2-core machine"):
+    for said in (
+        "issue 22's targets",
+        "in the session, against",
+        "other engineers' test runs",
+        "`../shared/rpp-corpus`",
+        "4.4 s on this 2-core machine",
+    ):
         assert NOTEBOOK_RE.search(said), said
 
 
@@ -92,8 +104,14 @@ def test_every_german_page_is_the_twin_of_an_english_one_in_the_navigation() -> 
     """The site's language switch leads from PAGE.de.md to PAGE.md and back: each German page has its English
     page, which the navigation lists (mkdocs.yml), and the German home page names each German page."""
     german = sorted((ROOT / "docs").glob("*.de.md"))
-    assert {p.name for p in german} >= {"index.de.md", "getting-started.de.md", "install.de.md", "tutorial.de.md",
-                                        "teachers.de.md", "classroom.de.md"}
+    assert {p.name for p in german} >= {
+        "index.de.md",
+        "getting-started.de.md",
+        "install.de.md",
+        "tutorial.de.md",
+        "teachers.de.md",
+        "classroom.de.md",
+    }
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
     home = (ROOT / "docs" / "index.de.md").read_text(encoding="utf-8")
     for page in german:

@@ -54,8 +54,13 @@ def codes_in_code() -> set[str]:
     found: set[str] = set()
     for path in sorted(ANALYSIS.glob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
-        constants = {t.id: str(node.value.value) for node in tree.body if isinstance(node, ast.Assign)
-                     for t in node.targets if isinstance(t, ast.Name) and isinstance(node.value, ast.Constant)}
+        constants = {
+            t.id: str(node.value.value)
+            for node in tree.body
+            if isinstance(node, ast.Assign)
+            for t in node.targets
+            if isinstance(t, ast.Name) and isinstance(node.value, ast.Constant)
+        }
         for node in ast.walk(tree):
             if not (isinstance(node, ast.Call) and getattr(node.func, "id", None) == "Finding" and node.args):
                 continue
@@ -79,8 +84,8 @@ def test_the_findings_page_lists_exactly_the_codes_the_analysis_has() -> None:
     page = (DOCS / "findings.md").read_text(encoding="utf-8")
     listed = set(re.findall(r"^## `([a-z-]+)` \{#", page, re.M))
     assert "encoding-TARGET" not in listed
-    section = page[page.index("## `encoding-TARGET`"):]
-    targets = targets_listed(section[section.index("The targets:"):section.index("```")])
+    section = page[page.index("## `encoding-TARGET`") :]
+    targets = targets_listed(section[section.index("The targets:") : section.index("```")])
     code = codes_in_code()
     assert "no-event-row" in code and "encoding-robopro" in code
     assert listed | targets == code
@@ -88,8 +93,8 @@ def test_the_findings_page_lists_exactly_the_codes_the_analysis_has() -> None:
 
 def test_checkings_table_lists_every_code_too() -> None:
     page = (DOCS / "checking.md").read_text(encoding="utf-8")
-    table = page[page.index("| finding | level |"):]
-    rows = set(re.findall(r"^\| `([a-zA-Z-]+)` \|", table[:table.index("\n\n")], re.M))
+    table = page[page.index("| finding | level |") :]
+    rows = set(re.findall(r"^\| `([a-zA-Z-]+)` \|", table[: table.index("\n\n")], re.M))
     assert "encoding-TARGET" in rows
     assert (rows - {"encoding-TARGET"}) | {c for c in codes_in_code() if c.startswith("encoding-")} == codes_in_code()
 
@@ -117,8 +122,15 @@ def test_the_file_formats_page_names_every_key() -> None:
     sections = world_section_keys()
     assert {"box", "line", "arena"} <= set(sections)
     plugins.load()  # every back-end's robot-file section registered
-    keys = {*ROBOT_KEYS, *CORE_SECTIONS, *SECTION_READERS, *SENSOR_KEYS, *PROPERTY_KEYS, *WORLD_KEYS,
-            *(k for ks in sections.values() for k in ks)}
+    keys = {
+        *ROBOT_KEYS,
+        *CORE_SECTIONS,
+        *SECTION_READERS,
+        *SENSOR_KEYS,
+        *PROPERTY_KEYS,
+        *WORLD_KEYS,
+        *(k for ks in sections.values() for k in ks),
+    }
     assert sorted(keys - named) == []
 
 
@@ -165,8 +177,12 @@ def unknown_options(text: str) -> list[str]:
         known = {"-h", "--help"}
         for param in commands[words[0]].params:
             known |= {*getattr(param, "opts", ()), *getattr(param, "secondary_opts", ())}
-        bad += [f"tablebot {words[0]} {option}" for word in words[1:]
-                for option in re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", word) if option not in known]
+        bad += [
+            f"tablebot {words[0]} {option}"
+            for word in words[1:]
+            for option in re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", word)
+            if option not in known
+        ]
     return bad
 
 
@@ -181,6 +197,8 @@ def test_every_option_a_page_gives_a_command_exists() -> None:
 
 
 def test_a_renamed_option_is_caught() -> None:
-    page = ("```sh\ntablebot sweep TABLE [--world W ...] (--robots N | --seeds 0..9)\n"
-            "               [--grid start=random] [--bogus 3]\n```\nthen `tablebot sim x --no-plots --colour`.\n")
+    page = (
+        "```sh\ntablebot sweep TABLE [--world W ...] (--robots N | --seeds 0..9)\n"
+        "               [--grid start=random] [--bogus 3]\n```\nthen `tablebot sim x --no-plots --colour`.\n"
+    )
     assert unknown_options(page) == ["tablebot sweep --bogus", "tablebot sim --colour"]

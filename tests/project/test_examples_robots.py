@@ -48,7 +48,7 @@ def test_the_floor_sensors_read_the_tape_under_them(follower: SimRun) -> None:
     lines = scene.geometry.lines
     for k, sensor in enumerate(scene.table.robot.sensors):
         fx, fy = sensor.at
-        for row in h[:: 97]:  # a sample of the run: thousands of checks, on and off the tape
+        for row in h[::97]:  # a sample of the run: thousands of checks, on and off the tape
             c, s = float(np.cos(row[L.TH])), float(np.sin(row[L.TH]))
             x, y = float(row[L.X]) + c * fx - s * fy, float(row[L.Y]) + s * fx + c * fy
             gap = min(point_segment_distance(x, y, *seg[:4]) - seg[4] for seg in lines)
@@ -68,8 +68,7 @@ def test_the_obstacle_avoider_drives_a_minute_without_touching_anything(seed: in
 
 @pytest.mark.parametrize("example", ["line-follower", "obstacle-avoider"])
 def test_the_examples_keep_their_properties(example: str, tmp_path: Path) -> None:
-    result = CliRunner().invoke(app, ["check", str(EXAMPLES / example), "--strict", "--counterexamples",
-                                      str(tmp_path)])
+    result = CliRunner().invoke(app, ["check", str(EXAMPLES / example), "--strict", "--counterexamples", str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert result.output.count("holds") == 5 and "VIOLATED" not in result.output
 

@@ -61,6 +61,14 @@ def test_each_output_is_byte_for_byte_the_recorded_one(made: dict[str, bytes], n
 
 def test_a_change_shows_as_a_readable_diff() -> None:
     said = difference("check.txt", b"holds    a\nholds    b\nholds    c\n", b"holds    a\nVIOLATED b\nholds    c\n")
-    assert said.splitlines() == ["check.txt changed:", "--- tests/golden/check.txt", "+++ made now: check.txt",
-                                 "@@ -1,3 +1,3 @@", " holds    a", "-holds    b", "+VIOLATED b", " holds    c"]
+    assert said.splitlines() == [
+        "check.txt changed:",
+        "--- tests/golden/check.txt",
+        "+++ made now: check.txt",
+        "@@ -1,3 +1,3 @@",
+        " holds    a",
+        "-holds    b",
+        "+VIOLATED b",
+        " holds    c",
+    ]
     assert difference("x.bin", b"\xff\x00", b"\xff") == "x.bin: 2 bytes recorded, 1 made"

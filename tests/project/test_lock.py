@@ -59,8 +59,9 @@ def test_the_lock_pins_every_package_pyproject_asks_for_in_a_version_it_allows()
     for requirement in asked():
         name = canonicalize_name(requirement.name)
         assert name in here, f"{name}: in pyproject.toml, not in {LOCK.name}: run `make lock`"
-        assert requirement.specifier.contains(here[name], prereleases=True), \
+        assert requirement.specifier.contains(here[name], prereleases=True), (
             f"{name} {here[name]} is pinned, pyproject.toml asks for {requirement}: run `make lock`"
+        )
     assert "distributed" in here  # dask[distributed]: an extra's packages are pinned too
 
 
@@ -122,14 +123,27 @@ def osv(known: dict[tuple[str, str], list[dict[str, Any]]]) -> Iterator[str]:
 
 def audit(lock: Path, url: str) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "NO_PROXY": "127.0.0.1", "no_proxy": "127.0.0.1"}  # a proxy set here must not take it
-    return subprocess.run([sys.executable, str(AUDIT), str(lock), "-s", "osv", "--osv-url", url], env=env,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, str(AUDIT), str(lock), "-s", "osv", "--osv-url", url],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 def vulnerability(name: str, fixed: str) -> dict[str, Any]:
-    return {"id": "GHSA-test-0001", "summary": "made up for the test", "aliases": ["CVE-0000-0001"],
-            "affected": [{"package": {"name": name, "ecosystem": "PyPI"},
-                          "ranges": [{"type": "ECOSYSTEM", "events": [{"introduced": "0"}, {"fixed": fixed}]}]}]}
+    return {
+        "id": "GHSA-test-0001",
+        "summary": "made up for the test",
+        "aliases": ["CVE-0000-0001"],
+        "affected": [
+            {
+                "package": {"name": name, "ecosystem": "PyPI"},
+                "ranges": [{"type": "ECOSYSTEM", "events": [{"introduced": "0"}, {"fixed": fixed}]}],
+            }
+        ],
+    }
 
 
 @pytest.fixture(scope="module")

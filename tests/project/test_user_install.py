@@ -45,8 +45,14 @@ class Installed:
     work: Path  # a folder outside the checkout, holding a copy of the BumberBot as bumberbot/
 
     def tablebot(self, *args: str | Path, ok: tuple[int, ...] = (0,)) -> subprocess.CompletedProcess[str]:
-        done = subprocess.run([str(self.python.with_name("tablebot")), *map(str, args)], cwd=self.work, env=self.env,
-                              capture_output=True, text=True, timeout=300)
+        done = subprocess.run(
+            [str(self.python.with_name("tablebot")), *map(str, args)],
+            cwd=self.work,
+            env=self.env,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert done.returncode in ok, f"tablebot {' '.join(map(str, args))}: {done.returncode}\n{done.stderr[-3000:]}"
         assert "Traceback" not in done.stderr and "internal error" not in done.stderr, done.stderr[-3000:]
         return done
@@ -69,8 +75,14 @@ def hand_over_compiled_code(python: Path, env: dict[str, str], scratch: Path) ->
             os.utime(installed, ns=(stat.st_atime_ns, stat.st_mtime_ns))
     files = scratch / "compiled.pickle"
     files.write_bytes(pickle.dumps(jit.cache_files()))
-    run(python, "-c", "import pickle, sys; from tablebot import jit; "
-                      "jit.install_cache_files(pickle.loads(open(sys.argv[1], 'rb').read()))", files, env=env)
+    run(
+        python,
+        "-c",
+        "import pickle, sys; from tablebot import jit; "
+        "jit.install_cache_files(pickle.loads(open(sys.argv[1], 'rb').read()))",
+        files,
+        env=env,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -84,12 +96,30 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Installed]:
     run(UV, "venv", "--quiet", "--python", sys.executable, venv)
     python = venv / "bin" / "python"
     # PyPI's packages as the user lock pins them (uv's cache holds them after the set-up: no download)
-    run(UV, "pip", "install", "--quiet", "--python", python, "--constraint", ROOT / "requirements" / "user.lock",
-        wheels[0])
-    env = {key: value for key, value in os.environ.items()
-           if key not in ("PYTHONPATH", "PYTHONDONTWRITEBYTECODE", "VIRTUAL_ENV")}
-    env |= {"PATH": str(venv / "bin"), "NUMBA_CACHE_DIR": str(base / "numba"), "HOME": str(base / "home"),
-            "XDG_CACHE_HOME": str(base / "cache"), "MPLCONFIGDIR": str(base / "mpl"), "COLUMNS": "200"}
+    run(
+        UV,
+        "pip",
+        "install",
+        "--quiet",
+        "--python",
+        python,
+        "--constraint",
+        ROOT / "requirements" / "user.lock",
+        wheels[0],
+    )
+    env = {
+        key: value
+        for key, value in os.environ.items()
+        if key not in ("PYTHONPATH", "PYTHONDONTWRITEBYTECODE", "VIRTUAL_ENV")
+    }
+    env |= {
+        "PATH": str(venv / "bin"),
+        "NUMBA_CACHE_DIR": str(base / "numba"),
+        "HOME": str(base / "home"),
+        "XDG_CACHE_HOME": str(base / "cache"),
+        "MPLCONFIGDIR": str(base / "mpl"),
+        "COLUMNS": "200",
+    }
     assert not [tool for tool in TOOLS if shutil.which(tool, path=env["PATH"])]
     hand_over_compiled_code(python, env, base)
     work = base / "work"
@@ -98,8 +128,9 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Installed]:
 
 
 def test_the_wheel_holds_tablebot_alone_and_runs_outside_the_checkout(installed: Installed) -> None:
-    where = run(installed.python, "-c", "import tablebot; print(tablebot.__file__)", env=installed.env,
-                cwd=installed.work).stdout
+    where = run(
+        installed.python, "-c", "import tablebot; print(tablebot.__file__)", env=installed.env, cwd=installed.work
+    ).stdout
     assert "site-packages" in where and str(ROOT) not in where
     assert installed.tablebot("--version").stdout.startswith("tablebot ")
 
@@ -131,11 +162,45 @@ def test_run_on_sim_sweep_tune_evolve(installed: Installed) -> None:
     assert "ran 30 ticks" in ran.stdout + ran.stderr
     t("sweep", "bumberbot", "--robots", "20", "--seconds", "5", "--out", "sweep")
     assert (work / "sweep" / "results.csv").exists()
-    t("tune", "bumberbot", "--cells", "line 5 timer=800..900", "--budget", "3", "--seeds", "0..1", "--check-seeds",
-      "5..5", "--seconds", "2", "--workers", "1", "-q", "--out", "tuned")
+    t(
+        "tune",
+        "bumberbot",
+        "--cells",
+        "line 5 timer=800..900",
+        "--budget",
+        "3",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "5..5",
+        "--seconds",
+        "2",
+        "--workers",
+        "1",
+        "-q",
+        "--out",
+        "tuned",
+    )
     assert (work / "tuned" / "report.md").exists()
-    t("evolve", "bumberbot", "--out", "evolved", "--budget", "3", "--batch", "2", "--seeds", "0..1",
-      "--check-seeds", "10..11", "--seconds", "2", "--workers", "1", "-q")
+    t(
+        "evolve",
+        "bumberbot",
+        "--out",
+        "evolved",
+        "--budget",
+        "3",
+        "--batch",
+        "2",
+        "--seeds",
+        "0..1",
+        "--check-seeds",
+        "10..11",
+        "--seconds",
+        "2",
+        "--workers",
+        "1",
+        "-q",
+    )
     assert (work / "evolved").is_dir()
 
 
@@ -149,9 +214,20 @@ def test_the_controllers_run_and_upload(installed: Installed, tmp_path: Path) ->
     installed.tablebot("export", "bumberbot", "program", "--to", "txt4")
     with FakeTxt4(tmp_path / "controller") as controller:
         env = {**installed.env, "TABLEBOT_TXT4_KEY": "SECRET"}
-        done = subprocess.run([str(installed.python.with_name("tablebot")), "upload", "program", "--to",
-                               f"txt4://127.0.0.1:{controller.port}"], cwd=installed.work, env=env,
-                              capture_output=True, text=True, timeout=120)
+        done = subprocess.run(
+            [
+                str(installed.python.with_name("tablebot")),
+                "upload",
+                "program",
+                "--to",
+                f"txt4://127.0.0.1:{controller.port}",
+            ],
+            cwd=installed.work,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert done.returncode == 0, done.stderr
     assert controller.started == ["BumberBot"]
 
@@ -167,14 +243,18 @@ def test_the_user_lock_pins_what_pyproject_asks_for_at_the_dev_locks_versions() 
         for line in (ROOT / "requirements" / lock).read_text(encoding="utf-8").splitlines():
             if line[:1].isalnum() and "==" in line:
                 requirement = Requirement(line.rstrip(" \\"))
-                found[canonicalize_name(requirement.name), str(requirement.marker or "")] = \
-                    str(requirement.specifier).removeprefix("==")
+                found[canonicalize_name(requirement.name), str(requirement.marker or "")] = str(
+                    requirement.specifier
+                ).removeprefix("==")
         return found
 
     user, dev = pins("user.lock"), pins("dev.lock")
     # a package may be pinned for fewer platforms in the user lock (colorama: Windows only), never to another version
-    differ = [(name, version) for (name, _), version in user.items()
-              if version not in {v for (n, _), v in dev.items() if n == name}]
+    differ = [
+        (name, version)
+        for (name, _), version in user.items()
+        if version not in {v for (n, _), v in dev.items() if n == name}
+    ]
     assert user and not differ, f"requirements/user.lock differs from dev.lock ({differ}): run make lock"
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
     names = {name for name, _ in user}
@@ -186,8 +266,11 @@ def test_only_firmware_needs_a_toolchain_and_it_says_how_to_get_it_on_each_syste
     done = installed.tablebot("build", "bumberbot", "--board", "uno", "--out", "firmware", ok=(2,))
     said = " ".join(done.stderr.split())
     assert "avr-gcc not found (only firmware needs it)" in said
-    for system in ("Debian or Ubuntu sudo apt-get install gcc-avr avr-libc", "macOS brew tap osx-cross/avr",
-                   "Windows unpack Microchip's AVR 8-bit Toolchain"):
+    for system in (
+        "Debian or Ubuntu sudo apt-get install gcc-avr avr-libc",
+        "macOS brew tap osx-cross/avr",
+        "Windows unpack Microchip's AVR 8-bit Toolchain",
+    ):
         assert system in said, said
     assert not list(installed.work.glob("firmware/**/*.hex"))
 
@@ -196,11 +279,22 @@ def test_uv_tool_install_from_the_checkout_puts_a_working_tablebot_on_path(tmp_p
     tools, bin_dir = tmp_path / "tools", tmp_path / "bin"
     env = {key: value for key, value in os.environ.items() if key not in ("VIRTUAL_ENV", "PYTHONPATH")}
     env |= {"UV_TOOL_DIR": str(tools), "UV_TOOL_BIN_DIR": str(bin_dir)}
-    run(UV, "tool", "install", "--quiet", "--python", sys.executable, "--constraints",
-        ROOT / "requirements" / "user.lock", ROOT, env=env)
+    run(
+        UV,
+        "tool",
+        "install",
+        "--quiet",
+        "--python",
+        sys.executable,
+        "--constraints",
+        ROOT / "requirements" / "user.lock",
+        ROOT,
+        env=env,
+    )
     user = {**env, "PATH": str(bin_dir), "HOME": str(tmp_path), "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     work = tmp_path / "work"
     shutil.copytree(EXAMPLE, work / "bumberbot")
-    checked = subprocess.run(["tablebot", "check", "bumberbot"], cwd=work, env=user, capture_output=True, text=True,
-                             timeout=120)
+    checked = subprocess.run(
+        ["tablebot", "check", "bumberbot"], cwd=work, env=user, capture_output=True, text=True, timeout=120
+    )
     assert checked.returncode in (0, 1) and "0 errors" in checked.stdout, checked.stderr

@@ -38,14 +38,17 @@ def test_seed_tsv_encodes_the_same(tmp_path: Path) -> None:
     assert robopro.encode(load_table(tmp_path / "seed.tsv")) == robopro.encode(example_table())
 
 
-@pytest.mark.parametrize(("index", "expected"), [
-    (3, (1 * 64 + 32, 2 * 256 + 128 + 2 * 16 + 2, 895)),  # Seek - Straight: M1 backward
-    (8, (20 * 64 + 32, 21 * 256 + 7 * 16 + 7, 0)),  # Collision Entry: speed 7 (keep), direction 0
-    (9, (21 * 64 + 16 + 8, 22 * 256 + 128 + 3 * 16 + 8 + 3, 75)),  # Collision Frontal: both backward
-    (16, (22 * 64 + 4, 29 * 256 + 3 * 16 + 8 + 3, 150)),  # Collision Rear: I5
-    (20, (1 * 64 + 2 + 1, 11 * 256 + 5 * 16 + 5, 125)),  # Seek Light: I7 and I8
-    (36, (12 * 64 + 32, 1 * 256 + 4 * 16 + 4, 500)),  # last row
-])
+@pytest.mark.parametrize(
+    ("index", "expected"),
+    [
+        (3, (1 * 64 + 32, 2 * 256 + 128 + 2 * 16 + 2, 895)),  # Seek - Straight: M1 backward
+        (8, (20 * 64 + 32, 21 * 256 + 7 * 16 + 7, 0)),  # Collision Entry: speed 7 (keep), direction 0
+        (9, (21 * 64 + 16 + 8, 22 * 256 + 128 + 3 * 16 + 8 + 3, 75)),  # Collision Frontal: both backward
+        (16, (22 * 64 + 4, 29 * 256 + 3 * 16 + 8 + 3, 150)),  # Collision Rear: I5
+        (20, (1 * 64 + 2 + 1, 11 * 256 + 5 * 16 + 5, 125)),  # Seek Light: I7 and I8
+        (36, (12 * 64 + 32, 1 * 256 + 4 * 16 + 4, 500)),  # last row
+    ],
+)
 def test_bumberbot_rows_encode_with_the_documents_bit_weights(index: int, expected: tuple[int, int, int]) -> None:
     lists = robopro.encode(example_table())
     assert (lists.event[index], lists.action[index], lists.timer[index]) == expected
@@ -113,12 +116,15 @@ def test_named_states_come_back_on_import(tmp_path: Path) -> None:
     back = robopro.decode(robopro.read_lists(tmp_path / "lists"), table.robot)
     assert [row.state for row in back.rows] == ["seek", "seek", "back off", 1, 3]
     assert back.events == ("T", "A", "B")  # the robot's layout; the table had no B column
+
     def behaviour(t: Table) -> list[tuple[object, ...]]:
         return [(r.state, r.events, r.motors, r.timer, r.next) for r in t.rows]
+
     assert behaviour(back) == behaviour(table)
 
 
 # --- limits -------------------------------------------------------------------------------------------
+
 
 def fit_errors(tmp_path: Path, text: str, robot: str = MINI_ROBOT) -> tuple[Diagnostic, ...]:
     table = load_table(write_table(tmp_path, text, robot))
@@ -130,12 +136,15 @@ def fit_errors(tmp_path: Path, text: str, robot: str = MINI_ROBOT) -> tuple[Diag
 HEADER = "description,state,T,A,M1,M2,timer,next\n"
 
 
-@pytest.mark.parametrize(("rows", "line", "pattern"), [
-    ("a,1,1,,1,1,5,128\nb,128,1,,0,0,0,1\n", 2, r"row 0: next state 128 is number 128, over 127"),
-    ("a,1,1,,1,1,32768,1\n", 2, r"row 0: timer 32768 is over 32767"),
-    ("a,1,1,,1,1,5,1\nb,1,,1,-7,1,5,1\n", 3, r"row 1: M1 speed 7 does not fit"),
-    ("a,1,1,,1,8,5,1\n", 2, r"row 0: M2 speed 8 does not fit"),
-])
+@pytest.mark.parametrize(
+    ("rows", "line", "pattern"),
+    [
+        ("a,1,1,,1,1,5,128\nb,128,1,,0,0,0,1\n", 2, r"row 0: next state 128 is number 128, over 127"),
+        ("a,1,1,,1,1,32768,1\n", 2, r"row 0: timer 32768 is over 32767"),
+        ("a,1,1,,1,1,5,1\nb,1,,1,-7,1,5,1\n", 3, r"row 1: M1 speed 7 does not fit"),
+        ("a,1,1,,1,8,5,1\n", 2, r"row 0: M2 speed 8 does not fit"),
+    ],
+)
 def test_rows_that_do_not_fit_are_named(tmp_path: Path, rows: str, line: int, pattern: str) -> None:
     diagnostics = fit_errors(tmp_path, HEADER + rows)
     hits = [d for d in diagnostics if re.search(pattern, d.message)]
@@ -173,6 +182,7 @@ def test_counters_and_lamps_do_not_fit(tmp_path: Path) -> None:
 
 # --- import errors ------------------------------------------------------------------------------------
 
+
 def lists_dir(tmp_path: Path, event: str = "88\n", action: str = "5120\n", timer: str = "50\n") -> Path:
     folder = tmp_path / "lists"
     folder.mkdir(exist_ok=True)
@@ -189,16 +199,20 @@ def read_error(folder: Path) -> Diagnostic:
 
 
 def test_import_tolerates_extra_columns_and_blank_lines(tmp_path: Path) -> None:
-    lists = robopro.read_lists(lists_dir(tmp_path, event="\ufeff88;x\n\n96\n", action="5120\n674\n",
-                                         timer="50,1\n895\n"))
+    lists = robopro.read_lists(
+        lists_dir(tmp_path, event="\ufeff88;x\n\n96\n", action="5120\n674\n", timer="50,1\n895\n")
+    )
     assert (lists.event, lists.action, lists.timer) == ((88, 96), (5120, 674), (50, 895))
 
 
-@pytest.mark.parametrize(("files", "name", "line", "pattern"), [
-    ({"event": "88\nabc\n"}, "event.csv", 2, "'abc' is not an integer"),
-    ({"timer": "-3\n"}, "timer.csv", 1, "-3 is not a value"),
-    ({"action": "70000\n"}, "action.csv", 1, "70000 is not a value"),
-])
+@pytest.mark.parametrize(
+    ("files", "name", "line", "pattern"),
+    [
+        ({"event": "88\nabc\n"}, "event.csv", 2, "'abc' is not an integer"),
+        ({"timer": "-3\n"}, "timer.csv", 1, "-3 is not a value"),
+        ({"action": "70000\n"}, "action.csv", 1, "70000 is not a value"),
+    ],
+)
 def test_import_errors_are_located(tmp_path: Path, files: dict[str, str], name: str, line: int, pattern: str) -> None:
     d = read_error(lists_dir(tmp_path, **files))
     assert d.path.endswith(name) and d.line == line and pattern in d.message

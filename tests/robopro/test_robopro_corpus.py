@@ -31,8 +31,10 @@ from test_robopro_program import fitting
 pytestmark = [pytest.mark.kernel_free]
 
 CORPUS = corpus_dir()
-needs_corpus = pytest.mark.skipif(CORPUS is None, reason="the ROBO Pro corpus is not here: set "
-                                  "TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository")
+needs_corpus = pytest.mark.skipif(
+    CORPUS is None,
+    reason="the ROBO Pro corpus is not here: set TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository",
+)
 
 
 @pytest.fixture(scope="module")
@@ -46,19 +48,22 @@ def fresh() -> dict[str, object]:
 
 
 def programs() -> list[str]:
-    table = fitting(random_table(random.Random(3), Shape(states=3, rows=6, inputs=3, counters=2)),
-                    {"controller": "tx", "I3": {"terminal": "I8", "active": 0}})
-    return [generate(load_table(EXAMPLE / "table.csv"), "document"),
-            generate(load_table(ROOT / "examples" / "bumberbot-counters" / "table.csv")),
-            generate(table, "always"),
-            generate_several(load_tables(load_table(ROOT / "examples" / "bumberbot-lights" / "table.csv")))]
+    table = fitting(
+        random_table(random.Random(3), Shape(states=3, rows=6, inputs=3, counters=2)),
+        {"controller": "tx", "I3": {"terminal": "I8", "active": 0}},
+    )
+    return [
+        generate(load_table(EXAMPLE / "table.csv"), "document"),
+        generate(load_table(ROOT / "examples" / "bumberbot-counters" / "table.csv")),
+        generate(table, "always"),
+        generate_several(load_tables(load_table(ROOT / "examples" / "bumberbot-lights" / "table.csv"))),
+    ]
 
 
 @needs_corpus
 def test_the_committed_vocabulary_is_what_the_corpus_yields(fresh: dict[str, object]) -> None:
     assert fresh["files"] == 79
-    assert dump(fresh) == VOCABULARY.read_text(encoding="utf-8"), \
-        "regenerate it: python -m tablebot.testing.rpp_corpus"
+    assert dump(fresh) == VOCABULARY.read_text(encoding="utf-8"), "regenerate it: python -m tablebot.testing.rpp_corpus"
 
 
 @needs_corpus
@@ -73,8 +78,9 @@ def test_processes_are_the_corpus_own_and_the_lamp_output_is_not(fresh: dict[str
     robot's, 11). No program of the corpus drives a lamp output: that element comes from BEYOND_CORPUS (real
     programs outside the corpus), and this says so the day the corpus has one."""
     assert CORPUS is not None
-    starts = [len(re.findall(r'classname="ftProProcessStart"', f.read_text(encoding="utf-8")))
-              for f in CORPUS.glob("*.rpp")]
+    starts = [
+        len(re.findall(r'classname="ftProProcessStart"', f.read_text(encoding="utf-8"))) for f in CORPUS.glob("*.rpp")
+    ]
     assert max(starts) >= 2
     assert not set(BEYOND_CORPUS) & set(fresh["elements"])
 
@@ -101,12 +107,15 @@ def test_every_real_header_is_the_generated_one() -> None:
     assert vocabulary()["headers"] == [[c.get("classname", c.tag) if c.tag == "o" else c.tag for c in root]]
 
 
-@pytest.mark.parametrize(("change", "complaint"), [
-    (('classname="ftProFlowIf"', 'classname="ftProFlowLoop"'), "appears in no real program"),
-    (('operation="XOR"', 'operation="NAND"'), "not a value real programs use"),
-    ((' id="100003"', ' id="100002"'), "used twice"),
-    (('<roboprover>04060600', '<roboprover>09000000'), "not a value real programs use"),
-])
+@pytest.mark.parametrize(
+    ("change", "complaint"),
+    [
+        (('classname="ftProFlowIf"', 'classname="ftProFlowLoop"'), "appears in no real program"),
+        (('operation="XOR"', 'operation="NAND"'), "not a value real programs use"),
+        ((' id="100003"', ' id="100002"'), "used twice"),
+        (("<roboprover>04060600", "<roboprover>09000000"), "not a value real programs use"),
+    ],
+)
 def test_the_check_catches_what_real_programs_never_have(change: tuple[str, str], complaint: str) -> None:
     text = programs()[0]
     old, new = change

@@ -40,11 +40,15 @@ COUNTERS = ROOT / "examples" / "bumberbot-counters"
 
 def lists_of(text: str) -> dict[str, list[int]]:
     root = ET.fromstring(text.encode("utf-8"))
-    return {o.attrib["name"]: [int(i.attrib["value"]) for i in o.findall("init")]
-            for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
+    return {
+        o.attrib["name"]: [int(i.attrib["value"]) for i in o.findall("init")]
+        for o in root.iter("o")
+        if o.get("classname") == "ftProDataArray1D"
+    }
 
 
 # --- the reference ------------------------------------------------------------------------------------
+
 
 def reference(machine: Machine, inputs: list[TickInput], rule: Rule) -> list[tuple]:
     """The tick rule with either matching rule: (event, row, state, timer, outputs, counters) per tick.
@@ -86,17 +90,17 @@ def program_ticks(table: Table, text: str, inputs: list[TickInput], rule: Rule) 
     return [astuple(d) for d in run(table, inputs, rule)]
 
 
-
-
 def fitting(table: Table, sections: dict) -> Table:
     """A random table the program can hold: speeds within the document's 0..6, the robot wired as given."""
-    rows = tuple(replace(r, motors=tuple(None if m is None else max(-6, min(6, m)) for m in r.motors))
-                 for r in table.rows)
+    rows = tuple(
+        replace(r, motors=tuple(None if m is None else max(-6, min(6, m)) for m in r.motors)) for r in table.rows
+    )
     robot = replace(table.robot, sections={"robopro": sections})
     return Table(robot=robot, events=table.events, rows=rows, path=table.path)
 
 
 # --- the examples ---------------------------------------------------------------------------------------
+
 
 def test_bumberbot_lists_hold_the_documents_encoding() -> None:
     table = load_table(EXAMPLE / "table.csv")
@@ -110,8 +114,9 @@ def test_bumberbot_program_keeps_to_real_programs() -> None:
     text = generate(load_table(EXAMPLE / "table.csv"), "document")
     assert vocabulary_problems(text) == []
     assert text.startswith('<?xml version="1.0" encoding="UTF-8" standalone="yes"?>\n')
-    names = [o.get("name") for o in ET.fromstring(text.encode()).iter("o")
-             if o.get("classname") == "ftProSubroutineFunction"]
+    names = [
+        o.get("name") for o in ET.fromstring(text.encode()).iter("o") if o.get("classname") == "ftProSubroutineFunction"
+    ]
     assert names == ["Main program", "DetectEvent", "DetermineAction", "ExecuteAction", "CountDown"]
     assert "Collision Frontal" in text and "Seek: turn" in text  # descriptions and state names as comments
 
@@ -141,17 +146,27 @@ def test_counters_reach_the_program() -> None:
 
 # --- random tables ----------------------------------------------------------------------------------------
 
-WIRINGS = st.fixed_dictionaries({"controller": st.sampled_from(["tx", "txt"])}, optional={
-    "I2": st.fixed_dictionaries({"terminal": st.just("I6"), "active": st.sampled_from([0, 1])}),
-    "M2": st.fixed_dictionaries({"output": st.just("M4"), "forward": st.sampled_from(["cw", "ccw"])}),
-})
+WIRINGS = st.fixed_dictionaries(
+    {"controller": st.sampled_from(["tx", "txt"])},
+    optional={
+        "I2": st.fixed_dictionaries({"terminal": st.just("I6"), "active": st.sampled_from([0, 1])}),
+        "M2": st.fixed_dictionaries({"output": st.just("M4"), "forward": st.sampled_from(["cw", "ccw"])}),
+    },
+)
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**32), counters=st.integers(0, 2), inputs=st.integers(0, 3), lamps=st.integers(0, 2),
-       rule=st.sampled_from(["document", "always"]), sections=WIRINGS)
-def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, lamps: int, rule: Rule,
-                                     sections: dict[str, Any]) -> None:
+@given(
+    seed=st.integers(0, 2**32),
+    counters=st.integers(0, 2),
+    inputs=st.integers(0, 3),
+    lamps=st.integers(0, 2),
+    rule=st.sampled_from(["document", "always"]),
+    sections=WIRINGS,
+)
+def test_random_tables_tick_for_tick(
+    seed: int, counters: int, inputs: int, lamps: int, rule: Rule, sections: dict[str, Any]
+) -> None:
     rng = random.Random(seed)
     shape = Shape(states=3, rows=8, inputs=inputs, counters=counters, lamps=lamps, max_timer=4, max_load=5)
     table = with_match(fitting(random_table(rng, shape), sections), rule)
@@ -166,8 +181,10 @@ def test_random_tables_tick_for_tick(seed: int, counters: int, inputs: int, lamp
 def test_the_program_follows_the_tables_own_rule_where_the_rules_part(rule: Rule) -> None:
     """Generated for the table's own rule (the robot file's match, no rule given), on tables and inputs where
     the two rules take different decisions: the program takes the engine's."""
-    table, ticks = random_case(random.Random(f"robopro-{rule}"),
-                               Shape(states=3, rows=8, inputs=2, counters=1, max_timer=4, max_load=5, match=rule))
+    table, ticks = random_case(
+        random.Random(f"robopro-{rule}"),
+        Shape(states=3, rows=8, inputs=2, counters=1, max_timer=4, max_load=5, match=rule),
+    )
     table = fitting(table, {"controller": "txt"})  # the TXT counts pulses; the ROBO Interface has no counters
     assert [astuple(d) for d in run(table, ticks)] == engine_ticks(compile_table(table), ticks)
 
@@ -187,10 +204,12 @@ def test_the_rules_differ_where_the_document_says() -> None:
 
 # --- what does not fit -------------------------------------------------------------------------------------
 
+
 def test_check_says_why_a_table_does_not_fit(tmp_path: Path) -> None:
     (tmp_path / "robot.toml").write_text(
         'name = "Big"\ninitial_state = 1\n[inputs]\nI1 = "a"\n[motors]\nM1 = "m"\nM2 = "n"\nM3 = "o"\n'
-        '[lamps]\nL1 = "lamp"\n[counters]\nC1 = "M1"\n')
+        '[lamps]\nL1 = "lamp"\n[counters]\nC1 = "M1"\n'
+    )
     (tmp_path / "t.csv").write_text("state,I1,M1,M2,M3,timer,next\n1,1,7,0,0,40000,300\n300,,0,0,0,0,1\n")
     found = [d.message for d in problems(load_table(tmp_path / "t.csv"))]
     text = "\n".join(found)
@@ -203,13 +222,21 @@ def test_check_says_why_a_table_does_not_fit(tmp_path: Path) -> None:
 def test_lamps_are_lamp_outputs_and_one_on_a_motors_output_is_refused(tmp_path: Path) -> None:
     """A lamp is ROBO Pro's lamp output (``ftProDataOutSngl``) on the single output the motors leave free, or the
     one ``[robopro]`` names; one wired to a motor's output is refused, naming both."""
-    (tmp_path / "robot.toml").write_text('name = "Lit"\ninitial_state = 1\n[inputs]\nI1 = "a"\n[motors]\n'
-                                         'M1 = "m"\n[lamps]\nL1 = "front"\nL2 = "back"\n[robopro]\nL2 = "O8"\n')
+    (tmp_path / "robot.toml").write_text(
+        'name = "Lit"\ninitial_state = 1\n[inputs]\nI1 = "a"\n[motors]\n'
+        'M1 = "m"\n[lamps]\nL1 = "front"\nL2 = "back"\n[robopro]\nL2 = "O8"\n'
+    )
     (tmp_path / "t.csv").write_text("state,I1,M1,L1,L2,timer,next\n1,1,3,8,,0,2\n2,,,0,5,0,1\n")
     table = load_table(tmp_path / "t.csv")
     root = ET.fromstring(generate(table).encode("utf-8"))
-    assert sorted(o.get("output", "") for o in root.iter("o") if o.get("classname") == "ftProDataOutSngl") \
-        == ["2", "2", "2", "7", "7", "7"]  # O3 and O8: each turned off at the start, then Off and On by the lists
+    assert sorted(o.get("output", "") for o in root.iter("o") if o.get("classname") == "ftProDataOutSngl") == [
+        "2",
+        "2",
+        "2",
+        "7",
+        "7",
+        "7",
+    ]  # O3 and O8: each turned off at the start, then Off and On by the lists
     ticks = [TickInput(1, ()), TickInput(0, ()), TickInput(1, ())]
     assert [d.outputs for d in run(table, ticks)] == [(3, 8, 0), (0, 0, 5), (3, 8, 5)]  # a blank L2 keeps it
     assert [astuple(d) for d in run(table, ticks)] == engine_ticks(compile_table(table), ticks)
@@ -241,6 +268,7 @@ def test_rows_and_state_numbers() -> None:
 
 
 # --- the layout ---------------------------------------------------------------------------------------------
+
 
 def wire_segments(text: str) -> dict[str, list[tuple[str, tuple[int, int], tuple[int, int]]]]:
     found = {}
@@ -285,8 +313,9 @@ def test_wires_do_not_cross_and_everything_sits_on_the_grid(which: str) -> None:
         table = random_table(random.Random(11), Shape(states=3, rows=8, inputs=3, counters=2))
         text = generate(fitting(table, {"controller": "tx"}))
     for name, segments in wire_segments(text).items():
-        crossed = [(a[0], b[0]) for n, a in enumerate(segments) for b in segments[n + 1:]
-                   if a[0] != b[0] and crossing(a, b)]
+        crossed = [
+            (a[0], b[0]) for n, a in enumerate(segments) for b in segments[n + 1 :] if a[0] != b[0] and crossing(a, b)
+        ]
         assert crossed == [], f"{name}: wires cross"
         assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
 
@@ -319,8 +348,9 @@ def test_the_commands(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     assert lists_of((out / "BumberBot.rpp").read_text(encoding="utf-8"))["Event"][0] == 88
     refused = tmp_path / "refused"
-    result = runner.invoke(app, ["export", str(ROOT / "examples" / "line-follower"), "--to", "robopro-program",
-                                 str(refused)])
+    result = runner.invoke(
+        app, ["export", str(ROOT / "examples" / "line-follower"), "--to", "robopro-program", str(refused)]
+    )
     assert result.exit_code == 2 and "line sensor" in result.output and not refused.exists()
     result = runner.invoke(app, ["check", str(ROOT / "examples" / "line-follower"), "--target", "robopro-program"])
     assert result.exit_code == 2 and "robopro-program: input I1 is a line sensor" in " ".join(result.output.split())
@@ -331,7 +361,8 @@ def test_a_wrong_robopro_section_is_a_located_error(tmp_path: Path) -> None:
 
     (tmp_path / "robot.toml").write_text(
         'name = "W"\ninitial_state = 1\n[inputs]\nI3 = "a"\n[motors]\nM1 = "m"\n[robopro]\ncontroller = "nxt"\n'
-        'I3 = "I9"\nM1 = { output = "M1", forward = "left" }\nX1 = "I1"\n')
+        'I3 = "I9"\nM1 = { output = "M1", forward = "left" }\nX1 = "I1"\n'
+    )
     with pytest.raises(TableBotError) as info:
         load_robot(tmp_path / "robot.toml")
     found = {(d.line, d.message.split(":")[0]) for d in info.value.diagnostics}

@@ -57,8 +57,9 @@ def test_the_bumberbot_with_its_lights_on_its_recorded_inputs(lights: RobotTable
         assert several_differences(lights, Run(list(some), run_several(lights, some, seed=seed))) is None
 
 
-def test_without_the_start_of_tick_image_the_lights_see_the_drive_table_move(lights: RobotTables,
-                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+def test_without_the_start_of_tick_image_the_lights_see_the_drive_table_move(
+    lights: RobotTables, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The barrier matters: reading the drive table's state as it is (``drive ST``) instead of its image at the
     start of the tick (``drive S0``), the lights process sees this tick's move of the drive table, and the trace
     differs from the engine's."""
@@ -78,20 +79,42 @@ def test_one_process_per_table_and_names_that_do_not_collide(lights: RobotTables
     subs = functions(text)
     starts = [e for e in subs["Main program"].findall("o") if e.get("classname") == "ftProProcessStart"]
     assert len(starts) == 3  # the clock, then a process per table, each a Start of the main program
-    assert set(subs) == {"Main program", *(f"{table} {sub}" for table in ("drive", "lights") for sub in (
-        "DetectEvent", "DetermineAction", "ExecuteAction", "CountDown", "WaitTick"))}
+    assert set(subs) == {
+        "Main program",
+        *(
+            f"{table} {sub}"
+            for table in ("drive", "lights")
+            for sub in ("DetectEvent", "DetermineAction", "ExecuteAction", "CountDown", "WaitTick")
+        ),
+    }
     calls = [e.get("name") for e in subs["Main program"].findall("o") if e.get("classname") == "ftProSubroutineRef"]
-    assert calls == [f"{table} {sub}" for table in ("drive", "lights") for sub in (
-        "WaitTick", "DetectEvent", "DetermineAction", "ExecuteAction", "WaitTick", "CountDown")]
+    assert calls == [
+        f"{table} {sub}"
+        for table in ("drive", "lights")
+        for sub in ("WaitTick", "DetectEvent", "DetermineAction", "ExecuteAction", "WaitTick", "CountDown")
+    ]
     for name, sub in subs.items():  # as every real subprogram: an entry and an exit (the processes never return)
         kinds = {e.get("classname") for e in sub.findall("o")}
         assert name == "Main program" or {"ftProSubroutineFlowIn", "ftProSubroutineFlowOut"} <= kinds, name
     root = ET.fromstring(text.encode("utf-8"))
     lists = {o.get("name", "") for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
-    assert lists == {"drive Event", "drive Action", "drive Timer", "lights Event", "lights Action", "lights Timer",
-                     "lights L1", "lights L2", "lights from drive"}
-    lamps = {(o.get("output"), f) for f, sub in subs.items() for o in sub.iter("o")
-             if o.get("classname") == "ftProDataOutSngl"}
+    assert lists == {
+        "drive Event",
+        "drive Action",
+        "drive Timer",
+        "lights Event",
+        "lights Action",
+        "lights Timer",
+        "lights L1",
+        "lights L2",
+        "lights from drive",
+    }
+    lamps = {
+        (o.get("output"), f)
+        for f, sub in subs.items()
+        for o in sub.iter("o")
+        if o.get("classname") == "ftProDataOutSngl"
+    }
     assert {output for output, _ in lamps} == {"4", "5"}  # O5 and O6, as the robot file wires them on the TXT
     assert {f for _, f in lamps} == {"Main program", "lights ExecuteAction"}  # off at the start, then by its rows
     motors = {f for f, sub in subs.items() for o in sub.iter("o") if o.get("classname") == "ftProDataOutDual"}
@@ -126,8 +149,12 @@ def test_wires_do_not_cross_and_everything_sits_on_the_grid(lights: RobotTables,
     three = load_tables(wired_txt(robopro_several_case(1, tmp_path / "robot").tables.table))
     for text in (generate_several(lights), generate_several(three)):
         for name, segments in wire_segments(text).items():
-            crossed = [(a[0], b[0]) for n, a in enumerate(segments) for b in segments[n + 1:]
-                       if a[0] != b[0] and crossing(a, b)]
+            crossed = [
+                (a[0], b[0])
+                for n, a in enumerate(segments)
+                for b in segments[n + 1 :]
+                if a[0] != b[0] and crossing(a, b)
+            ]
             assert crossed == [], f"{name}: wires cross"
             assert all(x % 4 == 0 and y % 4 == 0 for _, p, q in segments for x, y in (p, q)), name
 
@@ -138,8 +165,9 @@ def test_a_row_of_another_table_that_does_not_fit_is_named_once_where_it_is_writ
     for name in ("robot.toml", "table.csv", "lights.csv", "properties.toml"):
         (tmp_path / name).write_text((LIGHTS / name).read_text(encoding="utf-8"), encoding="utf-8")
     lights = (tmp_path / "lights.csv").read_text(encoding="utf-8")
-    (tmp_path / "lights.csv").write_text(lights.replace("flash_left,1,,,,0,8,50,", "flash_left,1,,,,0,8,40000,"),
-                                         encoding="utf-8")
+    (tmp_path / "lights.csv").write_text(
+        lights.replace("flash_left,1,,,,0,8,50,", "flash_left,1,,,,0,8,40000,"), encoding="utf-8"
+    )
     for given in (tmp_path, tmp_path / "lights.csv"):
         said = " ".join(invoke("check", given, "--target", "robopro-program").output.split())
         assert said.count("error:") == 1, said

@@ -43,8 +43,11 @@ def _copy(tmp_path: Path, name: str) -> Path:
 
 def _list_values(data: bytes) -> dict[str, tuple[str, list[int]]]:
     root = ET.fromstring(data)
-    return {o.attrib["name"]: (o.attrib["N"], [int(i.attrib["value"]) for i in o.findall("init")])
-            for o in root.iter("o") if o.get("classname") == "ftProDataArray1D"}
+    return {
+        o.attrib["name"]: (o.attrib["N"], [int(i.attrib["value"]) for i in o.findall("init")])
+        for o in root.iter("o")
+        if o.get("classname") == "ftProDataArray1D"
+    }
 
 
 def _outside_lists(data: bytes) -> bytes:
@@ -64,8 +67,10 @@ def test_cli_writes_the_three_lists_in_place(tmp_path: Path, lists: Lists) -> No
     assert values["Timer"] == ("37", list(lists.timer))
     assert values["Other"] == ("3", [1, 2, 3])
     assert _outside_lists(after) == _outside_lists(before)
-    assert b'<o classname="ftProDataVariable" id="125" name="Timer" flags=" selectable visible" value="0">\n' \
-           b'                <init value="7"></init>' in after  # a variable named Timer is not the list
+    assert (
+        b'<o classname="ftProDataVariable" id="125" name="Timer" flags=" selectable visible" value="0">\n'
+        b'                <init value="7"></init>' in after
+    )  # a variable named Timer is not the list
 
 
 def test_inits_keep_the_programs_layout(tmp_path: Path, lists: Lists) -> None:
@@ -76,8 +81,10 @@ def test_inits_keep_the_programs_layout(tmp_path: Path, lists: Lists) -> None:
     # the empty Timer list gets its inits as real files lay them out: <init value="…"> and </init> on lines
     # of their own, one step deeper than its closing tag
     assert '</o>\n                <init value="50">\n                </init>\n' in text
-    assert '<init value="500">\n                </init>\n            </o>\n            ' \
-           '<o classname="ftProDataArray1D" id="140"' in text
+    assert (
+        '<init value="500">\n                </init>\n            </o>\n            '
+        '<o classname="ftProDataArray1D" id="140"' in text
+    )
     again = program.read_bytes()
     write_lists(program, {"Event": lists.event, "Action": lists.action, "Timer": lists.timer})
     assert program.read_bytes() == again  # writing the same lists again changes nothing
@@ -86,8 +93,23 @@ def test_inits_keep_the_programs_layout(tmp_path: Path, lists: Lists) -> None:
 def test_latin1_crlf_program_with_other_names(tmp_path: Path) -> None:
     program = _copy(tmp_path, "german_latin1_crlf.rpp")
     before = program.read_bytes()
-    result = runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program),
-                                 "--event-list", "Ereignis", "--action-list", "Aktion", "--timer-list", "Zeit"])
+    result = runner.invoke(
+        app,
+        [
+            "export",
+            str(EXAMPLE),
+            "--to",
+            "robopro-rpp",
+            "--into",
+            str(program),
+            "--event-list",
+            "Ereignis",
+            "--action-list",
+            "Aktion",
+            "--timer-list",
+            "Zeit",
+        ],
+    )
     assert result.exit_code == 0, result.output
     assert "Zeit loads its values from column" in " ".join(result.output.split())
     after = program.read_bytes()
@@ -102,8 +124,9 @@ def test_latin1_crlf_program_with_other_names(tmp_path: Path) -> None:
 def test_outdir_leaves_the_program_untouched(tmp_path: Path) -> None:
     program = _copy(tmp_path, "engine.rpp")
     before = program.read_bytes()
-    result = runner.invoke(app, ["export", str(EXAMPLE), str(tmp_path / "out"), "--to", "robopro-rpp",
-                                 "--into", str(program)])
+    result = runner.invoke(
+        app, ["export", str(EXAMPLE), str(tmp_path / "out"), "--to", "robopro-rpp", "--into", str(program)]
+    )
     assert result.exit_code == 0, result.output
     assert program.read_bytes() == before
     assert _list_values((tmp_path / "out" / "engine.rpp").read_bytes())["Timer"][0] == "37"
@@ -119,15 +142,21 @@ def test_a_missing_list_is_refused_and_nothing_is_written(tmp_path: Path) -> Non
 
 
 def test_a_global_list_is_written_in_every_subprogram_that_has_it() -> None:
-    text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
-            '<o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o></cvg>')
-    assert [[int(i.attrib["value"]) for i in o.findall("init")] for o in ET.fromstring(rewrite(text, {"Event": [4, 5]}))
-            .iter("o")] == [[4, 5], [4, 5]]
+    text = (
+        '<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
+        '<o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o></cvg>'
+    )
+    assert [
+        [int(i.attrib["value"]) for i in o.findall("init")]
+        for o in ET.fromstring(rewrite(text, {"Event": [4, 5]})).iter("o")
+    ] == [[4, 5], [4, 5]]
 
 
 def test_two_different_lists_of_one_name_are_refused() -> None:
-    text = ('<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
-            '<o classname="ftProDataArray1D" name="Event" globalname="Other" N="1"></o></cvg>')
+    text = (
+        '<cvg><o classname="ftProDataArray1D" name="Event" globalname="Event" N="1"></o>\n'
+        '<o classname="ftProDataArray1D" name="Event" globalname="Other" N="1"></o></cvg>'
+    )
     with pytest.raises(TableBotError, match="2 different lists are named 'Event'"):
         rewrite(text, {"Event": [1]})
 

@@ -40,8 +40,10 @@ def corpus() -> Path:
     return CORPUS
 
 
-needs_corpus = pytest.mark.skipif(CORPUS is None, reason="the ROBO Pro corpus is not here: set "
-                                  "TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository")
+needs_corpus = pytest.mark.skipif(
+    CORPUS is None,
+    reason="the ROBO Pro corpus is not here: set TABLEBOT_RPP_CORPUS or put shared/rpp-corpus beside the repository",
+)
 runner = CliRunner()
 PIXY = "i2c__Camera-Pixy_v1.0.rpp"
 SRF08 = "i2c__Ultraschall-SRF08_v1.2.rpp"
@@ -60,8 +62,11 @@ def _outside_lists(data: bytes) -> bytes:
 
 
 def copies(data: bytes, name: str) -> list[list[int]]:
-    return [[int(i.attrib["value"]) for i in o.findall("init")] for o in ET.fromstring(data).iter("o")
-            if o.get("classname") == "ftProDataArray1D" and o.get("name") == name]
+    return [
+        [int(i.attrib["value"]) for i in o.findall("init")]
+        for o in ET.fromstring(data).iter("o")
+        if o.get("classname") == "ftProDataArray1D" and o.get("name") == name
+    ]
 
 
 def corpus_copy(tmp_path: Path, name: str) -> Path:
@@ -73,8 +78,23 @@ def corpus_copy(tmp_path: Path, name: str) -> Path:
 
 
 def export(program: Path, *names: str) -> Result:
-    return runner.invoke(app, ["export", str(EXAMPLE), "--to", "robopro-rpp", "--into", str(program),
-                               "--event-list", names[0], "--action-list", names[1], "--timer-list", names[2]])
+    return runner.invoke(
+        app,
+        [
+            "export",
+            str(EXAMPLE),
+            "--to",
+            "robopro-rpp",
+            "--into",
+            str(program),
+            "--event-list",
+            names[0],
+            "--action-list",
+            names[1],
+            "--timer-list",
+            names[2],
+        ],
+    )
 
 
 @needs_corpus
@@ -131,8 +151,11 @@ def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path: Path
     assert export(program, "Data X", "Data Y", "Data Z").exit_code == 0
     after = program.read_text(encoding="utf-8")
     real = (corpus() / SRF08).read_text(encoding="utf-8")
-    real_layout = re.search(r'pinid="3">\r?\n( *)</o>\r?\n +\r?\n( *)<init value0="2" value1="0" value2="0">'
-                            r'\r?\n( *)</init>', real)
+    real_layout = re.search(
+        r'pinid="3">\r?\n( *)</o>\r?\n +\r?\n( *)<init value0="2" value1="0" value2="0">'
+        r"\r?\n( *)</init>",
+        real,
+    )
     assert real_layout and real_layout[1] == real_layout[2] == real_layout[3]  # one indent for pin, init, </init>
     ours = re.findall(r'pinid="3">\n( *)</o>\n +\n( *)<init value="88">\n( *)</init>\n', after)
     assert len(ours) == len(copies(before, "Data X")) and all(a == b == c for a, b, c in ours)
@@ -142,14 +165,17 @@ def test_teachin_empty_lists_get_inits_as_real_files_lay_them_out(tmp_path: Path
 
 # --- the same cases on a small hand-made program (always) ------------------------------------------------------
 
+
 def test_fixture_cases(tmp_path: Path) -> None:
     text = (FIXTURES / "real_cases.rpp").read_text(encoding="utf-8")
     found = {e.name: e for e in find_lists(text)}
     assert sorted(found) == ["Abstände", "Data X", "Messwerte"]
     new = rewrite(text, {"Abstände": [1, 2, 3], "Data X": [4]})
     assert copies(new.encode(), "Abstände") == [[1, 2, 3], [1, 2, 3]]
-    assert '                </o>\n                \n                <init value="4">\n                </init>\n' \
-           '            </o>' in new
+    assert (
+        '                </o>\n                \n                <init value="4">\n                </init>\n'
+        "            </o>" in new
+    )
     assert csv_loaded(new, ["Abstände", "Data X"]) == {"Data X": 0}
     with pytest.raises(TableBotError, match="holds floats"):
         rewrite(text, {"Messwerte": [1]})

@@ -98,10 +98,17 @@ def test_sim_benchmark_reports_figures_that_agree_with_each_other(capsys: pytest
     load_script("sim").main(["--repeat", "1", "--seconds", "5", "--no-commands"])
     out = capsys.readouterr().out
     assert "one BumberBot in BumberBot arena, 5 s simulated (500 ticks), median of 1" in out
-    rows = {m["name"].strip(): (float(m["us"]), float(m["times"].replace(",", ""))) for m in re.finditer(
-        r"^  (?P<name>.+?)\s+(?P<wall>[\d.]+)\s+(?P<us>[\d.]+)\s+(?P<times>[\d,]+)$", out, re.MULTILINE)}
-    assert set(rows) == {"run loop, compiled block path", "run loop, tick by tick from Python (baseline)",
-                         "engine alone, Engine.step on recorded inputs"}
+    rows = {
+        m["name"].strip(): (float(m["us"]), float(m["times"].replace(",", "")))
+        for m in re.finditer(
+            r"^  (?P<name>.+?)\s+(?P<wall>[\d.]+)\s+(?P<us>[\d.]+)\s+(?P<times>[\d,]+)$", out, re.MULTILINE
+        )
+    }
+    assert set(rows) == {
+        "run loop, compiled block path",
+        "run loop, tick by tick from Python (baseline)",
+        "engine alone, Engine.step on recorded inputs",
+    }
     for us, times in rows.values():  # × real time is the 10,000 µs tick over µs a tick (both rounded)
         assert us > 0 and times == pytest.approx(10_000 / us, rel=0.06, abs=1)
     compiled, python = rows["run loop, compiled block path"], rows["run loop, tick by tick from Python (baseline)"]

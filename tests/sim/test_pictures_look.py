@@ -51,8 +51,10 @@ M2 = "left motor"
 """
 #: The tutorial's table before and after its sensor row: the row makes state 2 the first state written.
 BEFORE = "description,state,T,I1,M1,M2,timer,next\nstart driving,1,1,,6,6,8s,2\ntime to turn,2,1,,-5,5,700ms,1\n"
-AFTER = ("description,state,T,I1,M1,M2,timer,next\nI1 while driving,2,,1,-5,5,1s,1\n"
-         "start driving,1,1,,6,6,8s,2\ntime to turn,2,1,,-5,5,700ms,1\n")
+AFTER = (
+    "description,state,T,I1,M1,M2,timer,next\nI1 while driving,2,,1,-5,5,1s,1\n"
+    "start driving,1,1,,6,6,8s,2\ntime to turn,2,1,,-5,5,700ms,1\n"
+)
 
 
 def drawn(figure_of: Callable[..., Figure], *args: Any) -> Figure:
@@ -123,7 +125,7 @@ def test_legends_list_only_what_the_picture_shows(tmp_path: Path) -> None:
     empty.mkdir()
     (empty / "robot.toml").write_text(TUTORIAL_ROBOT.replace('2 = "driving"\n', ""))
     (empty / "table.csv").write_text("description,state,T,I1,M1,M2,timer,next\nspin,1,1,,0,0,0,1\n")
-    (empty / "arena.toml").write_text('[arena]\nwalls = [[0, 0], [2, 0], [2, 2], [0, 2]]\n[start]\nat = [1, 1]\n')
+    (empty / "arena.toml").write_text("[arena]\nwalls = [[0, 0], [2, 0], [2, 2], [0, 2]]\n[start]\nat = [1, 1]\n")
     result = simulate(scene_of(empty / "table.csv"), 5.0)
     fig = drawn(plots.trajectory_figure, result, summarise(result))
     states, marks = ([t.get_text() for t in legend.get_texts()] for legend in fig.legends)
@@ -147,8 +149,9 @@ def test_a_followed_line_shows_its_path_above_the_tape() -> None:
     pixels = np.asarray(canvas.buffer_rgba())
     rows = result.kept_rows()
     x, y = ax.transData.transform(rows[len(rows) // 3, :2])
-    near = {tuple(pixels[len(pixels) - round(y) + dy, round(x) + dx, :3].tolist()) for dx in (-1, 0, 1)
-            for dy in (-1, 0, 1)}
+    near = {
+        tuple(pixels[len(pixels) - round(y) + dy, round(x) + dx, :3].tolist()) for dx in (-1, 0, 1) for dy in (-1, 0, 1)
+    }
     path_colours = {tuple(round(255 * v) for v in c[:3]) for c in np.asarray(path.get_colors()).tolist()}
     assert near & path_colours, (near, path_colours)  # the path's own colour, drawn over the tape
 
@@ -176,7 +179,9 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
         def keep(fig: Figure) -> bytes:
             figures.append(fig)
             return encode(fig)
+
         return keep
+
     with warnings.catch_warnings(record=True) as caught, pytest.MonkeyPatch.context() as patch:
         warnings.simplefilter("always")
         patch.setattr(os, "cpu_count", lambda: 1)  # no painter: both pictures drawn in this process, seen here
@@ -187,9 +192,11 @@ def test_names_are_drawn_printable_and_as_written(tmp_path: Path) -> None:
         def finishing(self: TimelinePicture, *args: Any, **kwargs: Any) -> TimelinePicture:
             figures.append(self.fig)
             return finish(self, *args, **kwargs)
+
         patch.setattr(timeline.TimelinePicture, "finish", finishing)
-        result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "3", "-q", "--gif",
-                                          "--out", str(tmp_path / "o")])
+        result = CliRunner().invoke(
+            app, ["sim", str(tmp_path / "bot"), "--seconds", "3", "-q", "--gif", "--out", str(tmp_path / "o")]
+        )
     assert result.exit_code == 0, result.output
     assert len({id(fig) for fig in figures}) >= 2, "both pictures' figures are looked at"
     assert not [w for w in caught if "missing from" in str(w.message)], [str(w.message) for w in caught]

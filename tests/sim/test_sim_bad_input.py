@@ -34,12 +34,15 @@ def sim(*args: str) -> Result:
 
 # --- wiring and parameters: the message, the file that set the value, its line --------------------
 
+
 def test_wiring_errors_keep_their_message_and_name_the_robot_file_line(tmp_path: Path) -> None:
     found = setup_errors(tmp_path, room(), ROBOT + '[sim.wiring]\nleft_motor = "M7"\n')
     line = ROBOT.count("\n") + 2
-    assert found == [f"{tmp_path / 'robot.toml'}:{line}: error: wiring: left_motor = 'M7' is not a motor of "
-                     "robot TestBot\n    hint: its motors are M1, M2; set [wiring] left_motor in the world or "
-                     "[sim.wiring] in the robot file"]
+    assert found == [
+        f"{tmp_path / 'robot.toml'}:{line}: error: wiring: left_motor = 'M7' is not a motor of "
+        "robot TestBot\n    hint: its motors are M1, M2; set [wiring] left_motor in the world or "
+        "[sim.wiring] in the robot file"
+    ]
 
 
 def test_wiring_errors_in_the_world_name_the_world_line(tmp_path: Path) -> None:
@@ -49,8 +52,10 @@ def test_wiring_errors_in_the_world_name_the_world_line(tmp_path: Path) -> None:
 
 def test_parameter_conflicts_name_the_file_and_line_that_set_them(tmp_path: Path) -> None:
     found = setup_errors(tmp_path, room(), ROBOT + "[sim.battery]\nempty_volts = 9.5\n")
-    assert found == [f"{tmp_path / 'robot.toml'}:{ROBOT.count(chr(10)) + 2}: error: empty_volts must be below "
-                     "full_volts\n    hint: fix the value in the world or robot file"]
+    assert found == [
+        f"{tmp_path / 'robot.toml'}:{ROBOT.count(chr(10)) + 2}: error: empty_volts must be below "
+        "full_volts\n    hint: fix the value in the world or robot file"
+    ]
 
 
 def test_a_robot_without_two_drive_motors_is_refused_once(tmp_path: Path) -> None:
@@ -83,11 +88,15 @@ def test_unknown_sim_keys_and_a_missing_sim_world_are_located(tmp_path: Path) ->
 
 # --- worlds ---------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize(("extra", "words"), [
-    ("[[box]]\nat = [1, 1]\nsize = [0.4, 0.4]\n[[lamp]]\nat = [1.1, 0.9]\n", "inside [[box]] #1"),
-    ("[[circle]]\nat = [1, 1]\nradius = 0.2\n[[lamp]]\nat = [1.05, 1]\nradius = 0\n", "inside [[circle]] #1"),
-    ("[[segment]]\nfrom = [0.5, 2.5]\nto = [2.5, 2.5]\n[[lamp]]\nat = [1, 2.5]\n", "on a wall"),
-])
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        ("[[box]]\nat = [1, 1]\nsize = [0.4, 0.4]\n[[lamp]]\nat = [1.1, 0.9]\n", "inside [[box]] #1"),
+        ("[[circle]]\nat = [1, 1]\nradius = 0.2\n[[lamp]]\nat = [1.05, 1]\nradius = 0\n", "inside [[circle]] #1"),
+        ("[[segment]]\nfrom = [0.5, 2.5]\nto = [2.5, 2.5]\n[[lamp]]\nat = [1, 2.5]\n", "on a wall"),
+    ],
+)
 def test_a_lamp_shut_in_an_obstacle_or_wall_is_refused(tmp_path: Path, extra: str, words: str) -> None:
     found = world_errors(tmp_path, room(extra=extra))
     assert len(found) == 1 and words in found[0] and "its light cannot reach the robot" in found[0], found
@@ -113,8 +122,10 @@ def test_a_world_without_arena_says_it_is_missing(tmp_path: Path) -> None:
 
 def test_a_section_that_is_not_an_array_of_tables_is_one_located_error(tmp_path: Path) -> None:
     found = world_errors(tmp_path, "box = [1, 2]\n" + room())
-    assert found == [f"{tmp_path / 'bad.toml'}:1: error: box must be written as [[box]] tables, not [1, 2]\n"
-                     "    hint: see examples/bumberbot/arena.toml"]
+    assert found == [
+        f"{tmp_path / 'bad.toml'}:1: error: box must be written as [[box]] tables, not [1, 2]\n"
+        "    hint: see examples/bumberbot/arena.toml"
+    ]
 
 
 def test_crossing_walls_are_not_also_called_arealess(tmp_path: Path) -> None:
@@ -123,6 +134,7 @@ def test_crossing_walls_are_not_also_called_arealess(tmp_path: Path) -> None:
 
 
 # --- command line ----------------------------------------------------------------------------------
+
 
 def test_a_negative_seed_is_a_usage_error(tmp_path: Path) -> None:
     result = sim(str(BUMBERBOT), "--seed", "-1", "--out", str(tmp_path))
@@ -143,8 +155,10 @@ def test_too_many_ticks_are_refused_before_simulating(tmp_path: Path) -> None:
     table, world = write_bot(tmp_path, STRAIGHT, room(), robot)
     result = sim(str(table), "--world", str(world), "--seconds", "3600", "--out", str(tmp_path / "out"))
     assert result.exit_code == 2
-    assert "3,600,000 ticks; a run holds at most 360,000" in result.output and "hint: simulate at most 360 s" \
-        in result.output
+    assert (
+        "3,600,000 ticks; a run holds at most 360,000" in result.output
+        and "hint: simulate at most 360 s" in result.output
+    )
     assert not (tmp_path / "out").exists()
 
 
@@ -159,6 +173,7 @@ def test_setup_helper_still_builds(tmp_path: Path) -> None:
 
 
 # --- the robot's tick ------------------------------------------------------------------------------
+
 
 def test_the_motors_do_not_depend_on_the_tables_tick(tmp_path: Path) -> None:
     """The calibration spin is 8.95 s of the document's 10 ms ticks: at 20 ms, 448 ticks turn 270° too."""
@@ -175,6 +190,8 @@ def test_the_motors_do_not_depend_on_the_tables_tick(tmp_path: Path) -> None:
 def test_a_tick_too_coarse_for_the_physics_is_refused_on_its_line(tmp_path: Path) -> None:
     robot = ROBOT.replace("tick_ms = 10", "tick_ms = 1000")
     found = setup_errors(tmp_path, room(), robot)
-    assert found == [f"{tmp_path / 'robot.toml'}:2: error: tick_ms = 1000 is too coarse for the simulator: the robot "
-                     "would move up to 15 cm per tick, through thin walls\n    hint: simulate with tick_ms = 258 or "
-                     "less (the engine and the firmware take any tick)"]
+    assert found == [
+        f"{tmp_path / 'robot.toml'}:2: error: tick_ms = 1000 is too coarse for the simulator: the robot "
+        "would move up to 15 cm per tick, through thin walls\n    hint: simulate with tick_ms = 258 or "
+        "less (the engine and the firmware take any tick)"
+    ]

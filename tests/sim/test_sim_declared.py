@@ -112,8 +112,9 @@ def test_a_wall_seen_at_a_slant_reads_the_nearest_point_inside_the_beam(tmp_path
     scene = sensor_scene(tmp_path, room())
     heading = 60.0  # the wall x = 3 is met by the beam's right edge (45° off its normal) first
     sx = 2.5
-    s = read_at(scene, sx - 0.12 * math.cos(math.radians(heading)), 1.5 - 0.12 * math.sin(math.radians(heading)),
-                heading)
+    s = read_at(
+        scene, sx - 0.12 * math.cos(math.radians(heading)), 1.5 - 0.12 * math.sin(math.radians(heading)), heading
+    )
     edge = math.radians(heading - 15)
     expected = (3.0 - sx) / math.cos(edge)
     assert abs(s[L.READING + 2] - expected) <= 0.01

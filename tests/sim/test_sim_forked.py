@@ -21,9 +21,11 @@ from tablebot.interrupts import FAULT_ENV
 from tablebot.sim.pictures import forked
 from tablebot.sim.pictures.forked import Forked
 
-pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
-                                reason="the copy is forked on Linux with two cores or more (elsewhere the work "
-                                       "runs in place, tested by test_without_a_copy_the_work_runs_here)")
+pytestmark = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or (os.cpu_count() or 1) < 2,
+    reason="the copy is forked on Linux with two cores or more (elsewhere the work "
+    "runs in place, tested by test_without_a_copy_the_work_runs_here)",
+)
 
 
 def copies() -> list[int]:
@@ -59,6 +61,7 @@ def test_the_answer_comes_from_another_process() -> None:
 def test_an_error_in_the_copy_is_raised_here() -> None:
     def work(_: forked.Inbox) -> bytes:
         raise ValueError("no picture today")
+
     with Forked(work) as copy, pytest.raises(ValueError, match="no picture today"):
         copy.result()
     assert copies() == []
@@ -134,8 +137,11 @@ def test_without_a_copy_the_work_runs_here(monkeypatch: pytest.MonkeyPatch) -> N
 def test_sim_interrupted_while_drawing_leaves_no_process(tmp_path: Path, fault: str) -> None:
     """Step 2 is trajectory.png written (the copy may still draw the timeline), step 3 timeline.png."""
     shutil.copytree(EXAMPLE, tmp_path / "bot")
-    result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "20", "-q", "--out",
-                                      str(tmp_path / "out")], env={FAULT_ENV: fault})
+    result = CliRunner().invoke(
+        app,
+        ["sim", str(tmp_path / "bot"), "--seconds", "20", "-q", "--out", str(tmp_path / "out")],
+        env={FAULT_ENV: fault},
+    )
     assert result.exit_code == (130 if fault.endswith("INT") else 143), result.output
     assert copies() == []
     assert not list((tmp_path / "out").glob("*.png"))

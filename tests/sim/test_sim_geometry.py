@@ -16,8 +16,12 @@ def plain(ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: 
     """segments_within as it was: the crossing test, then the four endpoint-to-segment distances."""
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
-    return (point_segment_within(ax, ay, cx, cy, dx, dy, r) or point_segment_within(bx, by, cx, cy, dx, dy, r)
-            or point_segment_within(cx, cy, ax, ay, bx, by, r) or point_segment_within(dx, dy, ax, ay, bx, by, r))
+    return (
+        point_segment_within(ax, ay, cx, cy, dx, dy, r)
+        or point_segment_within(bx, by, cx, cy, dx, dy, r)
+        or point_segment_within(cx, cy, ax, ay, bx, by, r)
+        or point_segment_within(dx, dy, ax, ay, bx, by, r)
+    )
 
 
 @njit
@@ -54,8 +58,9 @@ def test_segments_within_agrees_with_the_plain_test_on_the_threshold_and_on_the_
 
 
 @njit
-def shadow_disagreements(points: np.ndarray, lamps: np.ndarray, edges: np.ndarray, circles: np.ndarray,
-                         shade: np.ndarray) -> tuple[int, int]:
+def shadow_disagreements(
+    points: np.ndarray, lamps: np.ndarray, edges: np.ndarray, circles: np.ndarray, shade: np.ndarray
+) -> tuple[int, int]:
     bad, dark = 0, 0
     for k in range(lamps.shape[0]):
         for j in range(points.shape[0]):
@@ -74,7 +79,10 @@ def test_the_shadow_grid_gives_every_shadow_test_the_full_scans_answer() -> None
     from tablebot.sim.model.world import geometry, parse_world
     from tablebot.tomlfile import Source
 
-    world = parse_world(Source.parse("<w>", """
+    world = parse_world(
+        Source.parse(
+            "<w>",
+            """
 [arena]
 walls = [[0, 0], [3, 0], [3, 2], [1.5, 2.6], [0, 2]]
 [start]
@@ -97,7 +105,9 @@ radius = 0.15
 [[segment]]
 from = [1.5, 2.6]
 to = [1.5, 1.9]
-"""))
+""",
+        )
+    )
     g = geometry(world)
     assert g.shade.shape[0] > 0
     rng = np.random.default_rng(11)

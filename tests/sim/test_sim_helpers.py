@@ -37,12 +37,15 @@ HEADER = "description,state,T,I3,I4,I5,I7,I8,M1,M2,timer,next"
 QUIET = "[noise]\nmotor_spread = 0\nmotor = 0\nlight = 0\n"
 
 
-def room(start: tuple[float, float, float] = (1.5, 1.5, 0.0), extra: str = "", noise: bool = False,
-         size: float = 3.0) -> str:
+def room(
+    start: tuple[float, float, float] = (1.5, 1.5, 0.0), extra: str = "", noise: bool = False, size: float = 3.0
+) -> str:
     """A square room world (no lamp unless ``extra`` adds one); exact physics unless ``noise``."""
     x, y, heading = start
-    text = (f'name = "test room"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
-            f"[start]\nat = [{x}, {y}]\nheading = {heading}\n{extra}\n")
+    text = (
+        f'name = "test room"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
+        f"[start]\nat = [{x}, {y}]\nheading = {heading}\n{extra}\n"
+    )
     return text if noise else text + QUIET
 
 

@@ -26,8 +26,10 @@ from test_sim_helpers import BUMBERBOT, ROOT, scene_of
 if TYPE_CHECKING:
     from tablebot.loop import RunEnd, RunInfo
 
-EXAMPLES = [(BUMBERBOT / "table.csv", None), (ROOT / "examples" / "bumberbot-counters" / "table.csv",
-                                              BUMBERBOT / "arena.toml")]
+EXAMPLES = [
+    (BUMBERBOT / "table.csv", None),
+    (ROOT / "examples" / "bumberbot-counters" / "table.csv", BUMBERBOT / "arena.toml"),
+]
 
 
 class Lines:
@@ -116,8 +118,11 @@ def test_ctrl_c_keeps_the_previous_run_and_a_partial_trace(tmp_path: Path) -> No
 
 def test_sigterm_stops_the_run_the_same_way(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--out", str(out), "-q",
-                             "--seconds", "3600"], stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--out", str(out), "-q", "--seconds", "3600"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60
     while not out.is_dir() or not any(p.name.startswith(".trace.jsonl.") for p in out.rglob("*")):
         assert time.monotonic() < deadline and proc.poll() is None
@@ -140,9 +145,25 @@ def test_a_disk_that_fills_up_under_the_trace_is_a_clear_error_and_leaves_nothin
 
     out = tmp_path / "out"
     out.mkdir()
-    proc = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--out", str(out), "-q",
-                           "--seconds", "600", "--no-plots"], capture_output=True, text=True, preexec_fn=small_files,
-                          timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "sim",
+            str(BUMBERBOT),
+            "--out",
+            str(out),
+            "-q",
+            "--seconds",
+            "600",
+            "--no-plots",
+        ],
+        capture_output=True,
+        text=True,
+        preexec_fn=small_files,
+        timeout=120,
+    )
     assert proc.returncode == 2, proc.stderr
     assert f"{out / 'trace.jsonl'}: error: cannot write or read: File too large" in proc.stderr
     assert "Traceback" not in proc.stderr and list(out.iterdir()) == []

@@ -95,8 +95,9 @@ def test_driving_into_a_wall_stops_at_the_wall(tmp_path: Path) -> None:
 
 @settings(max_examples=12, deadline=None)
 @given(heading=st.floats(-180, 180), right=st.integers(-8, 8), left=st.integers(-8, 8))
-def test_the_robot_never_leaves_the_room(tmp_path_factory: pytest.TempPathFactory, heading: float, right: int,
-                                         left: int) -> None:
+def test_the_robot_never_leaves_the_room(
+    tmp_path_factory: pytest.TempPathFactory, heading: float, right: int, left: int
+) -> None:
     tmp = tmp_path_factory.mktemp("room")
     rows = [f"go,1,1,,,,,,{right},{left},3000,1"]
     extra = "[[box]]\nat = [0.9, 0.9]\nsize = [0.3, 0.3]\nangle = 20\n[[circle]]\nat = [0.3, 0.3]\nradius = 0.08"

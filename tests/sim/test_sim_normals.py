@@ -25,10 +25,12 @@ class OwnPCG64(np.random.PCG64):
 
 def _state(rng: np.random.Generator) -> object:
     """The bit generator's state, arrays (Philox, MT19937) as lists, for ==."""
+
     def plain(value: object) -> object:
         if isinstance(value, dict):
             return {key: plain(item) for key, item in value.items()}
         return value.tolist() if isinstance(value, np.ndarray) else value
+
     return plain(rng.bit_generator.state)
 
 
@@ -95,10 +97,22 @@ def test_draws_interleave_with_numpys_on_one_generator() -> None:
             elif k % 3 == 1:
                 mixed.standard_normal(out=block)
             else:  # other kinds of draw between: raw 64-bit words, doubles, buffered 32-bit integers
-                block = np.concatenate([mixed.random(2), mixed.integers(0, 2**32, 3, dtype=np.uint32),
-                                        mixed.bit_generator.random_raw(2).astype(np.float64)])
-                expected.append(np.concatenate([plain.random(2), plain.integers(0, 2**32, 3, dtype=np.uint32),
-                                                plain.bit_generator.random_raw(2).astype(np.float64)]))
+                block = np.concatenate(
+                    [
+                        mixed.random(2),
+                        mixed.integers(0, 2**32, 3, dtype=np.uint32),
+                        mixed.bit_generator.random_raw(2).astype(np.float64),
+                    ]
+                )
+                expected.append(
+                    np.concatenate(
+                        [
+                            plain.random(2),
+                            plain.integers(0, 2**32, 3, dtype=np.uint32),
+                            plain.bit_generator.random_raw(2).astype(np.float64),
+                        ]
+                    )
+                )
                 out.append(block)
                 continue
             out.append(block)

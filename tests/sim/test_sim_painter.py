@@ -49,8 +49,10 @@ def whole_figures(folder: Path, seconds: float) -> tuple[np.ndarray, np.ndarray]
     scene = scene_of(folder / "table.csv", world if world.exists() else None)
     result = simulate(scene, seconds, 1, history=np.float32)
     summary = summarise(result)
-    return (pixels(plots.png_bytes(plots.trajectory_figure(result, summary))),
-            pixels(plots.png_bytes(plots.timeline_figure(result, summary))))
+    return (
+        pixels(plots.png_bytes(plots.trajectory_figure(result, summary))),
+        pixels(plots.png_bytes(plots.timeline_figure(result, summary))),
+    )
 
 
 def sensor_bot(tmp_path: Path) -> Path:
@@ -63,12 +65,14 @@ def sensor_bot(tmp_path: Path) -> Path:
     return folder
 
 
-@pytest.mark.parametrize(("example", "seconds"), [("bumberbot", 150), ("line-follower", 60),
-                                                  ("obstacle-avoider", 60), ("sensorbot", 60)])
+@pytest.mark.parametrize(
+    ("example", "seconds"), [("bumberbot", 150), ("line-follower", 60), ("obstacle-avoider", 60), ("sensorbot", 60)]
+)
 def test_the_painters_pictures_are_the_figures_drawn_whole(tmp_path: Path, example: str, seconds: float) -> None:
     folder = sensor_bot(tmp_path) if example == "sensorbot" else ROOT / "examples" / example
-    result = CliRunner().invoke(app, ["sim", str(folder), "--seconds", str(seconds), "-q", "--out",
-                                      str(tmp_path / "out")])
+    result = CliRunner().invoke(
+        app, ["sim", str(folder), "--seconds", str(seconds), "-q", "--out", str(tmp_path / "out")]
+    )
     assert result.exit_code == 0, result.output
     trajectory, timeline = whole_figures(folder, seconds)
     assert np.array_equal(pixels(tmp_path / "out" / "trajectory.png"), trajectory)
@@ -119,8 +123,9 @@ def painters_of(root: int) -> dict[int, str]:
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit():
             try:
-                status = dict(line.split(":\t", 1) for line in (entry / "status").read_text().splitlines()
-                              if ":\t" in line)
+                status = dict(
+                    line.split(":\t", 1) for line in (entry / "status").read_text().splitlines() if ":\t" in line
+                )
             except OSError:
                 continue
             parents[int(entry.name)], names[int(entry.name)] = int(status["PPid"]), status["Name"].strip()
@@ -155,17 +160,22 @@ class Watch:
     def alive(self) -> list[int]:
         """The painters seen that still run, after waiting a while for them to go."""
         deadline = time.monotonic() + 20
-        while (left := [pid for pid, when in self.seen.items() if started(pid) == when]) and \
-                time.monotonic() < deadline:
+        while (
+            left := [pid for pid, when in self.seen.items() if started(pid) == when]
+        ) and time.monotonic() < deadline:
             time.sleep(0.02)
         return left
 
 
 def sim(out: Path, *args: str) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    return subprocess.Popen([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--seconds", "3600", "-q",
-                             "--out", str(out), *args], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            text=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--seconds", "3600", "-q", "--out", str(out), *args],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def wait_for(check: Callable[[], object], proc: subprocess.Popen) -> None:
@@ -214,20 +224,28 @@ def test_a_painter_killed_while_the_robot_runs_leaves_the_pictures_to_the_comman
         watch.stop()
     assert proc.returncode == 0, err
     reference = tmp_path / "reference"
-    done = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--seconds", "300", "-q", "--out",
-                           str(reference)], env={**os.environ, "PYTHONPATH": str(ROOT / "src")}, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-m", "tablebot", "sim", str(BUMBERBOT), "--seconds", "300", "-q", "--out", str(reference)],
+        env={**os.environ, "PYTHONPATH": str(ROOT / "src")},
+        timeout=300,
+    )
     assert done.returncode == 0
     for name in ("trace.jsonl", "trajectory.png", "timeline.png"):
-        assert np.array_equal(pixels(out / name), pixels(reference / name)) if name.endswith(".png") \
+        assert (
+            np.array_equal(pixels(out / name), pixels(reference / name))
+            if name.endswith(".png")
             else (out / name).read_bytes() == (reference / name).read_bytes()
+        )
 
 
-def test_without_a_second_core_the_command_draws_its_pictures_itself(tmp_path: Path,
-                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_without_a_second_core_the_command_draws_its_pictures_itself(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(os, "cpu_count", lambda: 1)
     shutil.copytree(BUMBERBOT, tmp_path / "bot")
-    result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "60", "-q", "--out",
-                                      str(tmp_path / "out")])
+    result = CliRunner().invoke(
+        app, ["sim", str(tmp_path / "bot"), "--seconds", "60", "-q", "--out", str(tmp_path / "out")]
+    )
     assert result.exit_code == 0, result.output
     trajectory, timeline = whole_figures(tmp_path / "bot", 60)
     assert np.array_equal(pixels(tmp_path / "out" / "trajectory.png"), trajectory)
@@ -235,8 +253,9 @@ def test_without_a_second_core_the_command_draws_its_pictures_itself(tmp_path: P
 
 
 @pytest.mark.parametrize("case", ["no shared memory", "every row kept (an animation too)"])
-def test_the_pictures_are_the_same_whatever_the_painter_is_handed(tmp_path: Path, case: str,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pictures_are_the_same_whatever_the_painter_is_handed(
+    tmp_path: Path, case: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Without memory to share, the arrays go to the painter when the run is over; with --gif the run keeps
     every column of every robot row, and the painter draws from those."""
     from tablebot.sim.pictures import painter
@@ -247,8 +266,9 @@ def test_the_pictures_are_the_same_whatever_the_painter_is_handed(tmp_path: Path
     args = ["--gif"] if case.startswith("every") else []
     if case == "no shared memory":
         monkeypatch.setattr(painter.Shared, "__init__", refuse)
-    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "40", "-q", "--out", str(tmp_path / "out"),
-                                      *args])
+    result = CliRunner().invoke(
+        app, ["sim", str(BUMBERBOT), "--seconds", "40", "-q", "--out", str(tmp_path / "out"), *args]
+    )
     assert result.exit_code == 0, result.output
     trajectory, timeline = whole_figures(BUMBERBOT, 40)
     assert np.array_equal(pixels(tmp_path / "out" / "trajectory.png"), trajectory)

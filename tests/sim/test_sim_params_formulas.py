@@ -30,8 +30,9 @@ def test_duty_in_python_has_the_compiled_bits(level: int, levels: int) -> None:
 
 @settings(max_examples=200, deadline=None)
 @given(full=VOLTS, empty=VOLTS, charge=st.floats(0.0, 1.0), amps=st.floats(0.0, 20.0), ohms=st.floats(0.0, 20.0))
-def test_pack_volts_in_python_has_the_compiled_bits(full: float, empty: float, charge: float, amps: float,
-                                                    ohms: float) -> None:
+def test_pack_volts_in_python_has_the_compiled_bits(
+    full: float, empty: float, charge: float, amps: float, ohms: float
+) -> None:
     args = (full, empty, charge, amps, ohms)
     assert bits(pack_volts.py_func(*args)) == bits(pack_volts(*args))
 
@@ -39,8 +40,12 @@ def test_pack_volts_in_python_has_the_compiled_bits(full: float, empty: float, c
 @settings(max_examples=50, deadline=None)
 @given(friction=st.floats(0.0, 1.0), ohms=st.floats(0.0, 2.0), level=st.integers(1, 8), full=st.floats(8.0, 12.0))
 def test_the_motor_constant_is_the_compiled_formulas(friction: float, ohms: float, level: int, full: float) -> None:
-    params = P.merged({"motor": {"friction_volts": friction, "spin_level": level},
-                       "battery": {"internal_ohms": ohms, "full_volts": full}})
+    params = P.merged(
+        {
+            "motor": {"friction_volts": friction, "spin_level": level},
+            "battery": {"internal_ohms": ohms, "full_volts": full},
+        }
+    )
     m, b = params["motor"], params["battery"]
     amps = b["idle_amps"] + b["motor_amps"] * sum(duty(v, m["levels"]) for v in (level, level))
     volts = pack_volts(b["full_volts"], b["empty_volts"], 1.0, amps, b["internal_ohms"])

@@ -19,12 +19,16 @@ from test_sim_declared import sensor_scene
 from test_sim_helpers import BUMBERBOT, ROOT, room, scene_of
 
 
-@pytest.mark.parametrize(("pose", "where"), [
-    ((3.0 - 0.12 - 0.0005, 1.2, 0.0), (3.0, 1.2)),  # nose flat against the right wall
-    ((1.0, 0.07 + 0.0005, 90.0), (1.0, 0.0)),  # backed against the bottom wall: the tail touches
-])
-def test_a_collision_is_marked_where_the_body_touches(tmp_path: Path, pose: tuple[float, float, float],
-                                                      where: tuple[float, float]) -> None:
+@pytest.mark.parametrize(
+    ("pose", "where"),
+    [
+        ((3.0 - 0.12 - 0.0005, 1.2, 0.0), (3.0, 1.2)),  # nose flat against the right wall
+        ((1.0, 0.07 + 0.0005, 90.0), (1.0, 0.0)),  # backed against the bottom wall: the tail touches
+    ],
+)
+def test_a_collision_is_marked_where_the_body_touches(
+    tmp_path: Path, pose: tuple[float, float, float], where: tuple[float, float]
+) -> None:
     scene = sensor_scene(tmp_path, room())
     x, y, heading = pose
     cx, cy = contact_point(scene.geometry, scene.params, x, y, math.radians(heading))
@@ -77,7 +81,8 @@ def test_names_with_dollar_signs_are_drawn_as_written(tmp_path: Path) -> None:
     shutil.copytree(BUMBERBOT, tmp_path / "bot")
     robot = tmp_path / "bot" / "robot.toml"
     robot.write_text(robot.read_text().replace('name = "BumberBot"', 'name = "cost $\\\\frac{ room $"'))
-    result = CliRunner().invoke(app, ["sim", str(tmp_path / "bot"), "--seconds", "2", "--out", str(tmp_path / "o"),
-                                      "-q", "--gif"])
+    result = CliRunner().invoke(
+        app, ["sim", str(tmp_path / "bot"), "--seconds", "2", "--out", str(tmp_path / "o"), "-q", "--gif"]
+    )
     assert result.exit_code == 0, result.output
     assert all((tmp_path / "o" / n).stat().st_size > 1000 for n in ("trajectory.png", "timeline.png", "run.gif"))

@@ -56,8 +56,9 @@ def test_another_seed_is_the_same_robot_with_other_noise() -> None:
     first tick, the path drifts apart from the first ticks on by millimetres, then centimetres, and in its
     first second (nothing seen yet) the table decides exactly the same."""
     scene = scene_of(BUMBERBOT / "table.csv")
-    one, two = ([json.loads(line) for line in trace_text(simulate(scene, 20.0, seed=seed)).splitlines()]
-                for seed in (1, 2))
+    one, two = (
+        [json.loads(line) for line in trace_text(simulate(scene, 20.0, seed=seed)).splitlines()] for seed in (1, 2)
+    )
     assert len(one) == len(two) == 2000 and one[0] == two[0]
     assert one[0]["x"] == one[0]["y"] == 0.35 and one[0]["heading"] == 20.0  # the arena's start
     apart = [math.dist((a["x"], a["y"]), (b["x"], b["y"])) for a, b in zip(one, two, strict=True)]
@@ -155,8 +156,9 @@ def test_lamps_of_the_robot_are_traced_and_drawn_lit(tmp_path: Path) -> None:
 
 def test_cli_html_replay_is_one_self_contained_page(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["sim", str(BUMBERBOT), "--seconds", "5", "--out", str(out), "--html",
-                                      "--no-plots", "-q"])
+    result = CliRunner().invoke(
+        app, ["sim", str(BUMBERBOT), "--seconds", "5", "--out", str(out), "--html", "--no-plots", "-q"]
+    )
     assert result.exit_code == 0, result.output
     page = (out / "run.html").read_text(encoding="utf-8")
     assert page.startswith("<!doctype html>") and "default-src 'none'" in page

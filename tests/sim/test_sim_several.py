@@ -39,8 +39,24 @@ def test_sim_runs_every_table_as_several_does() -> None:
 
 def test_sim_command_writes_the_other_tables_keys(tmp_path: Path) -> None:
     """The trace `tablebot sim --out` writes while the robot runs is the one the run makes again afterwards."""
-    done = subprocess.run([sys.executable, "-m", "tablebot", "sim", str(EXAMPLE), "--seconds", "3", "--seed", "3",
-                           "--out", str(tmp_path)], capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "tablebot",
+            "sim",
+            str(EXAMPLE),
+            "--seconds",
+            "3",
+            "--seed",
+            "3",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert "main table" not in done.stderr  # no note that the lights table is left out
     written = (tmp_path / "trace.jsonl").read_text()

@@ -10,8 +10,10 @@ from tablebot.diagnostics import TableBotError
 from tablebot.sim.model.world import geometry, load_world
 from test_sim_helpers import ROBOT, STRAIGHT, bot, room, scene_of, world_errors, write_bot
 
-GOOD = room(extra="[[lamp]]\nat = [2, 2]\n[[box]]\nat = [0.5, 2.5]\nsize = [0.2, 0.3]\nangle = 45\n"
-             "[[circle]]\nat = [2.5, 0.5]\nradius = 0.1\n[[segment]]\nfrom = [0, 1]\nto = [0.5, 1]\n")
+GOOD = room(
+    extra="[[lamp]]\nat = [2, 2]\n[[box]]\nat = [0.5, 2.5]\nsize = [0.2, 0.3]\nangle = 45\n"
+    "[[circle]]\nat = [2.5, 0.5]\nradius = 0.1\n[[segment]]\nfrom = [0, 1]\nto = [0.5, 1]\n"
+)
 
 
 def test_a_good_world_loads_into_arrays(tmp_path: Path) -> None:
@@ -28,22 +30,25 @@ def test_a_good_world_loads_into_arrays(tmp_path: Path) -> None:
 R = room().count("\n")  # lines of the room text; the bad parts follow it
 
 
-@pytest.mark.parametrize(("text", "line", "words"), [
-    ("[arena]\nwalls = [[0, 0], [1, 0]]\n[start]\nat = [0.5, 0.5]\n", 2, "at least three corners"),
-    ("[arena]\nwalls = [[0, 0], [1, 1], [1, 0], [0, 1]]\n[start]\nat = [0.5, 0.3]\n", 2, "cross themselves"),
-    ("[arena]\nwalls = [[0, 0], [2, 0], [2, 2]]\n[start]\nat = [0.2, 1.5]\n", 4, "outside the arena"),
-    (room() + "[[box]]\nat = [1, 1]\nsize = [0.5, -1]\n", R + 3, "size must be positive"),
-    (room() + "[[circle]]\nat = [1, 1]\nradius = \"big\"\n", R + 3, "radius must be a number"),
-    (room() + "[[lamp]]\nat = [1, 1]\ncolour = \"red\"\n", R + 3, "unknown key 'colour'"),
-    (room() + "[[lamp]]\nat = [1]\n", R + 2, "must be a point [x, y]"),
-    # it said "must be a point [x, y]" of a point, with "at = [...]" as the example for walls too
-    (room() + "[[lamp]]\nat = [1e9, 1]\n", R + 2, "[[lamp]] #1 at: the point [1000000000.0, 1] is out of range"),
-    (room() + "[battery]\ncharge = 2\n", R + 2, "charge = 2 is out of range 0..1"),
-    (room() + "[motor]\nlevels = 8.5\n", R + 2, "must be an integer"),
-    (room() + "[[segment]]\nfrom = [1, 1]\nto = [1, 1]\n", R + 3, "has no length"),
-    ("walls = 3\n" + room(), 1, "unknown key 'walls'"),
-    (room() + "[arena\n", R + 1, "TOML syntax"),
-])
+@pytest.mark.parametrize(
+    ("text", "line", "words"),
+    [
+        ("[arena]\nwalls = [[0, 0], [1, 0]]\n[start]\nat = [0.5, 0.5]\n", 2, "at least three corners"),
+        ("[arena]\nwalls = [[0, 0], [1, 1], [1, 0], [0, 1]]\n[start]\nat = [0.5, 0.3]\n", 2, "cross themselves"),
+        ("[arena]\nwalls = [[0, 0], [2, 0], [2, 2]]\n[start]\nat = [0.2, 1.5]\n", 4, "outside the arena"),
+        (room() + "[[box]]\nat = [1, 1]\nsize = [0.5, -1]\n", R + 3, "size must be positive"),
+        (room() + '[[circle]]\nat = [1, 1]\nradius = "big"\n', R + 3, "radius must be a number"),
+        (room() + '[[lamp]]\nat = [1, 1]\ncolour = "red"\n', R + 3, "unknown key 'colour'"),
+        (room() + "[[lamp]]\nat = [1]\n", R + 2, "must be a point [x, y]"),
+        # it said "must be a point [x, y]" of a point, with "at = [...]" as the example for walls too
+        (room() + "[[lamp]]\nat = [1e9, 1]\n", R + 2, "[[lamp]] #1 at: the point [1000000000.0, 1] is out of range"),
+        (room() + "[battery]\ncharge = 2\n", R + 2, "charge = 2 is out of range 0..1"),
+        (room() + "[motor]\nlevels = 8.5\n", R + 2, "must be an integer"),
+        (room() + "[[segment]]\nfrom = [1, 1]\nto = [1, 1]\n", R + 3, "has no length"),
+        ("walls = 3\n" + room(), 1, "unknown key 'walls'"),
+        (room() + "[arena\n", R + 1, "TOML syntax"),
+    ],
+)
 def test_bad_worlds_are_located(tmp_path: Path, text: str, line: int, words: str) -> None:
     found = world_errors(tmp_path, text)
     assert any(f"bad.toml:{line}" in e and words in e for e in found), found

@@ -22,14 +22,25 @@ from tablebot.testing.random_tables import Shape, random_inputs, random_table
 STUB = Path(__file__).resolve().parents[1] / "txt4_stub"
 #: The shapes of the random cases: counters tied to the motors as a TXT's encoder motors are, lamps, keep
 #: cells, timers that run out, inputs the simulator senses (I3-I5 bumpers, I7-I8 lights) and some it does not.
-SHAPES = [Shape(states=4, rows=14, inputs=7, motors=2, lamps=0, counters=2, max_timer=40, max_load=30),
-          Shape(states=5, rows=16, inputs=5, motors=2, lamps=1, counters=1, max_timer=12, max_load=8),
-          Shape(states=3, rows=10, inputs=6, motors=2, lamps=0, counters=2, max_timer=60, max_speed=6),
-          Shape(states=6, rows=20, inputs=6, motors=2, lamps=2, counters=2, max_timer=5, max_load=4,
-                keep_chance=0.4),
-          Shape(states=4, rows=12, inputs=8, motors=2, lamps=2, counters=0, max_timer=30, max_speed=6)]
-ALL = {"python step", "engine batch", "simulator", "fleet", "host C", "AVR firmware", "TXT 4.0 program",
-       "ROBO Pro program", "ROBO TX", "ROBO Interface"}
+SHAPES = [
+    Shape(states=4, rows=14, inputs=7, motors=2, lamps=0, counters=2, max_timer=40, max_load=30),
+    Shape(states=5, rows=16, inputs=5, motors=2, lamps=1, counters=1, max_timer=12, max_load=8),
+    Shape(states=3, rows=10, inputs=6, motors=2, lamps=0, counters=2, max_timer=60, max_speed=6),
+    Shape(states=6, rows=20, inputs=6, motors=2, lamps=2, counters=2, max_timer=5, max_load=4, keep_chance=0.4),
+    Shape(states=4, rows=12, inputs=8, motors=2, lamps=2, counters=0, max_timer=30, max_speed=6),
+]
+ALL = {
+    "python step",
+    "engine batch",
+    "simulator",
+    "fleet",
+    "host C",
+    "AVR firmware",
+    "TXT 4.0 program",
+    "ROBO Pro program",
+    "ROBO TX",
+    "ROBO Interface",
+}
 #: What takes only some tables: the ROBO Pro program holds speeds 0..6 only (lamps too), the ROBO Interface counts
 #: nothing, the AVR firmware has the Uno's pins.
 SOME = {"ROBO Pro program", "ROBO Interface", "AVR firmware"}
@@ -42,8 +53,9 @@ def case_of(seed: int) -> Case:
 
 
 @pytest.mark.parametrize("seed", range(len(SHAPES)))
-def test_every_executor_takes_the_engines_decisions_on_random_tables(tmp_path: Path, seed: int,
-                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_every_executor_takes_the_engines_decisions_on_random_tables(
+    tmp_path: Path, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("TABLEBOT_TXT4_STUB", str(STUB))
     case = case_of(seed)
     report = check(case, tmp_path)
@@ -53,8 +65,9 @@ def test_every_executor_takes_the_engines_decisions_on_random_tables(tmp_path: P
 
 
 @pytest.mark.parametrize("example", ["bumberbot", "bumberbot-counters", "line-follower", "obstacle-avoider"])
-def test_every_executor_takes_the_engines_decisions_on_the_examples(tmp_path: Path, example: str,
-                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_every_executor_takes_the_engines_decisions_on_the_examples(
+    tmp_path: Path, example: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The shipped robots in their own worlds: the simulated ones bump, see light, follow tape and count,
     and every other executor replays what the simulated robot read."""
     monkeypatch.setenv("TABLEBOT_TXT4_STUB", str(STUB))
@@ -71,11 +84,14 @@ def test_every_executor_takes_the_engines_decisions_on_the_examples(tmp_path: Pa
 def test_the_harness_runs_every_registered_executor_somewhere(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Over the cases above, no executor is only ever skipped (each entry of the registry is really run)."""
     monkeypatch.setenv("TABLEBOT_TXT4_STUB", str(STUB))
-    fits = {name: [seed for seed in range(len(SHAPES)) if executor.fits(case_of(seed).machine)]
-            for name, executor in EXECUTORS.items()}
+    fits = {
+        name: [seed for seed in range(len(SHAPES)) if executor.fits(case_of(seed).machine)]
+        for name, executor in EXECUTORS.items()
+    }
     assert all(fits.values()), fits
-    assert all(executor.missing() is None for executor in EXECUTORS.values()), \
-        {name: e.missing() for name, e in EXECUTORS.items()}
+    assert all(executor.missing() is None for executor in EXECUTORS.values()), {
+        name: e.missing() for name, e in EXECUTORS.items()
+    }
 
 
 def test_a_wrong_decision_is_found_at_its_tick() -> None:
@@ -106,8 +122,11 @@ def walk(machine: Machine, model: Model, inputs: list[TickInput]) -> int:
     for tick in inputs:
         before = node_of(model, engine)
         counting = [max(0, c - p) if engine.tick else c for c, p in zip(engine.counters, tick.pulses, strict=True)]
-        zeroed = sum(1 << i for i, (old, new) in enumerate(zip(engine.counters, counting, strict=True))
-                     if model.tracked >> i & 1 and old != 0 and new == 0)
+        zeroed = sum(
+            1 << i
+            for i, (old, new) in enumerate(zip(engine.counters, counting, strict=True))
+            if model.tracked >> i & 1 and old != 0 and new == 0
+        )
         engine.step(tick.mask, tick.pulses)
         made = (engine.event, zeroed, engine.row, node_of(model, engine))
         assert made in model.successors(before), (engine.tick - 1, before, made)
@@ -122,8 +141,15 @@ def test_every_engine_transition_is_a_successor_in_the_analysis_model(seed: int)
     (horizon 1, what ``check`` explores first) the same ticks are successors of the abstracted nodes:
     the abstraction is sound on real runs, counters included."""
     rng = random.Random(seed)
-    shape = Shape(states=rng.randint(2, 6), rows=rng.randint(6, 18), inputs=rng.randint(1, 4),
-                  counters=rng.randint(0, 2), lamps=rng.randint(0, 1), max_timer=8, max_load=5)
+    shape = Shape(
+        states=rng.randint(2, 6),
+        rows=rng.randint(6, 18),
+        inputs=rng.randint(1, 4),
+        counters=rng.randint(0, 2),
+        lamps=rng.randint(0, 1),
+        max_timer=8,
+        max_load=5,
+    )
     machine = compile_table(random_table(rng, shape))
     inputs = random_inputs(rng, machine.table, 300, density=0.3, max_pulses=2)
     exact = Model.exact(machine, watch=machine.input_mask)

@@ -27,8 +27,7 @@ STUB = Path(__file__).resolve().parents[1] / "txt4_stub"
 LIGHTS = Path(__file__).resolve().parents[2] / "examples" / "bumberbot-lights"
 #: The executors that run several tables; the others say they run one table only. The ROBO Interface counts
 #: nothing: it takes the BumberBot with its lights, not the random robots (their tables load a counter).
-SEVERAL = {"python step", "host C", "AVR firmware", "TXT 4.0 program", "ROBO TX", "ROBO Interface",
-           "ROBO Pro program"}
+SEVERAL = {"python step", "host C", "AVR firmware", "TXT 4.0 program", "ROBO TX", "ROBO Interface", "ROBO Pro program"}
 NO_COUNTERS = {"ROBO Interface"}
 #: The ROBO Pro program takes the document's speeds (0..6) only, which random robots seldom keep to: its own
 #: random robots do (tests/robopro/test_robopro_several.py); here it runs where it fits and says why where it does not.
@@ -40,15 +39,19 @@ def test_the_registry_says_which_executors_run_several_tables() -> None:
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_every_executor_of_several_tables_takes_the_engines_decisions(tmp_path: Path, seed: int,
-                                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+def test_every_executor_of_several_tables_takes_the_engines_decisions(
+    tmp_path: Path, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("TABLEBOT_TXT4_STUB", str(STUB))
     case = random_several_case(seed, tmp_path / "robot")
     report = check_several(case, tmp_path / "runs")
     assert report.differ == {}
     assert set(report.agreed) - DOCUMENT_SPEEDS == SEVERAL - NO_COUNTERS - DOCUMENT_SPEEDS, report.skipped
-    assert all(why == "runs one table only" for name, why in report.skipped.items()
-               if name not in NO_COUNTERS | DOCUMENT_SPEEDS), report.skipped
+    assert all(
+        why == "runs one table only"
+        for name, why in report.skipped.items()
+        if name not in NO_COUNTERS | DOCUMENT_SPEEDS
+    ), report.skipped
     assert all(why == "does not take this robot" for name, why in report.skipped.items() if name in DOCUMENT_SPEEDS)
 
 

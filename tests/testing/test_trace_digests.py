@@ -74,6 +74,7 @@ def sim_case(example: str, seconds: float, seed: int, busy: int | None = None) -
         def start(self, info: RunInfo) -> None: ...
         def block(self, block: TickBlock) -> None:
             lines.extend(block_lines(block, machine))
+
         def end(self, end: RunEnd) -> None: ...
 
     run = simulate(scene, seconds, seed, sinks=[Lines()])
@@ -87,8 +88,19 @@ def sim_case(example: str, seconds: float, seed: int, busy: int | None = None) -
 
 def _summary(d: Digest, fleet: object) -> None:
     summary = fleet.summary()  # type: ignore[attr-defined]
-    for name in ("first_light", "reached", "collisions", "distance_m", "battery_start_v", "battery_end_v",
-                 "final_state", "counts", "first_visit", "collision_rows", "final_pose"):
+    for name in (
+        "first_light",
+        "reached",
+        "collisions",
+        "distance_m",
+        "battery_start_v",
+        "battery_end_v",
+        "final_state",
+        "counts",
+        "first_visit",
+        "collision_rows",
+        "final_pose",
+    ):
         d.array(name, getattr(summary, name))
     d.array("S", fleet.S)  # type: ignore[attr-defined]
     d.array("acc", fleet.acc)  # type: ignore[attr-defined]
@@ -106,9 +118,15 @@ def fleet_case(threads: bool, variants: bool = False) -> str:
     chosen = Variants.of(machine)
     if variants:  # a second variant: every timer a tick longer (as tune makes them)
         chosen = Variants(np.concatenate([chosen.timers, chosen.timers + 1]), np.concatenate([chosen.loads] * 2))
-    specs = [RobotSpec(seed=10 + k, start=None if k % 2 else (0.3 + 0.1 * k, 0.4, 30.0 * k),
-                       params=(("battery", "charge", 1.0 - 0.1 * k),) if k % 3 == 0 else (),
-                       variant=k % 2 if variants else 0) for k in range(6)]
+    specs = [
+        RobotSpec(
+            seed=10 + k,
+            start=None if k % 2 else (0.3 + 0.1 * k, 0.4, 30.0 * k),
+            params=(("battery", "charge", 1.0 - 0.1 * k),) if k % 3 == 0 else (),
+            variant=k % 2 if variants else 0,
+        )
+        for k in range(6)
+    ]
     fleet = Fleet(table, machine, world, specs, robot_layer(table.robot)[0], traced=[2], variants=chosen)
     fleet.run(1500, block_ticks=97, threads=threads)
     d = Digest()
@@ -123,8 +141,9 @@ def sweep_case() -> str:
     from tablebot.fleet.plan import make_plan
     from tablebot.fleet.work import run_job
 
-    plan = make_plan(EXAMPLES / "bumberbot" / "table.csv", None, [], ["battery=1.0,0.5", "start=random"], "0..5",
-                     None, 8.0)
+    plan = make_plan(
+        EXAMPLES / "bumberbot" / "table.csv", None, [], ["battery=1.0,0.5", "start=random"], "0..5", None, 8.0
+    )
     d = Digest()
     for job in plan.jobs():
         done, summary = run_job(job)
@@ -140,8 +159,13 @@ def tick_case(commands: bool) -> str:
     from tablebot.sim.model.scene import robot_layer, scene_for
 
     table, machine = _load("bumberbot")
-    fleet = Fleet(table, machine, scene_for(table, machine).world, [RobotSpec(seed=s) for s in range(3)],
-                  robot_layer(table.robot)[0])
+    fleet = Fleet(
+        table,
+        machine,
+        scene_for(table, machine).world,
+        [RobotSpec(seed=s) for s in range(3)],
+        robot_layer(table.robot)[0],
+    )
     rng = np.random.default_rng(5)
     for _ in range(300):
         fleet.tick(rng.integers(-8, 9, size=(3, 2)) if commands else None)
@@ -174,8 +198,16 @@ def _example(name: str) -> Callable[[], str]:
 
 
 CASES: dict[str, Callable[[], str]] = {
-    **{f"sim {name}": _example(name) for name in ("bumberbot", "bumberbot-counters", "document/bumberbot-table.tsv",
-                                                   "line-follower", "obstacle-avoider")},
+    **{
+        f"sim {name}": _example(name)
+        for name in (
+            "bumberbot",
+            "bumberbot-counters",
+            "document/bumberbot-table.tsv",
+            "line-follower",
+            "obstacle-avoider",
+        )
+    },
     "sim bumberbot in a busy room": lambda: sim_case("bumberbot", 30.0, 2, busy=7),
     "sim obstacle-avoider in a busy room": lambda: sim_case("obstacle-avoider", 30.0, 3, busy=11),
     "fleet on one thread": lambda: fleet_case(False),
@@ -191,8 +223,10 @@ CASES: dict[str, Callable[[], str]] = {
 def _golden() -> dict[str, str]:
     recorded = json.loads(GOLDEN.read_text(encoding="utf-8"))
     if PLATFORM not in recorded:
-        pytest.skip(f"golden digests are recorded for {', '.join(recorded)}, not {PLATFORM}: "
-                    "run tests/testing/test_trace_digests.py --record there to make them")
+        pytest.skip(
+            f"golden digests are recorded for {', '.join(recorded)}, not {PLATFORM}: "
+            "run tests/testing/test_trace_digests.py --record there to make them"
+        )
     return dict(recorded[PLATFORM])
 
 

@@ -15,8 +15,10 @@ from tablebot.web.bundle import bundle
 
 pytestmark = [pytest.mark.kernel_free]
 
-needs_node = pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed (scripts/bootstrap.sh "
-                                "installs it for the studio's linter)")
+needs_node = pytest.mark.skipif(
+    shutil.which("node") is None,
+    reason="node is not installed (scripts/bootstrap.sh installs it for the studio's linter)",
+)
 
 
 def write(folder: Path, files: dict[str, str]) -> Path:
@@ -28,13 +30,16 @@ def write(folder: Path, files: dict[str, str]) -> Path:
 
 @needs_node
 def test_a_bundle_runs_as_the_modules_would(tmp_path: Path) -> None:
-    root = write(tmp_path, {
-        "lib/a.js": 'export const base = 40;\nexport function twice(x) { return 2 * x; }\nconsole.log("a");\n',
-        "lib/b.js": 'import { base, twice as double } from "./a.js";\nexport class Adder {\n'
-                    "  add(x) { return base + double(x) / 2; }\n}\nconsole.log(\"b\");\n",
-        "app/main.js": 'import { Adder } from "../lib/b.js";\nimport { base } from "../lib/a.js";\n'
-                       "console.log(new Adder().add(2), base);\n",
-    })
+    root = write(
+        tmp_path,
+        {
+            "lib/a.js": 'export const base = 40;\nexport function twice(x) { return 2 * x; }\nconsole.log("a");\n',
+            "lib/b.js": 'import { base, twice as double } from "./a.js";\nexport class Adder {\n'
+            '  add(x) { return base + double(x) / 2; }\n}\nconsole.log("b");\n',
+            "app/main.js": 'import { Adder } from "../lib/b.js";\nimport { base } from "../lib/a.js";\n'
+            "console.log(new Adder().add(2), base);\n",
+        },
+    )
     script = bundle(root, "app/main.js")
     assert script.count('modules["lib/a.js"] =') == 1
     ran = subprocess.run(["node", "--input-type=module", "-e", script], capture_output=True, text=True, check=True)
@@ -42,15 +47,24 @@ def test_a_bundle_runs_as_the_modules_would(tmp_path: Path) -> None:
 
 
 def test_forms_the_bundler_does_not_understand_are_refused(tmp_path: Path) -> None:
-    cases = {"export default 1;\n": "export", 'import * as a from "./a.js";\n': "import",
-             "const x = 1;\nexport { x };\n": "export", 'export { y } from "./a.js";\n': "export"}
+    cases = {
+        "export default 1;\n": "export",
+        'import * as a from "./a.js";\n': "import",
+        "const x = 1;\nexport { x };\n": "export",
+        'export { y } from "./a.js";\n': "export",
+    }
     write(tmp_path, {"a.js": "export const y = 1;\n"})
     for text, word in cases.items():
         write(tmp_path, {"main.js": text})
         with pytest.raises(ValueError, match=f"an {word} the bundler does not understand"):
             bundle(tmp_path, "main.js")
-    write(tmp_path, {"a.js": 'import { b } from "./b.js";\nexport const a = 1;\n',
-                     "b.js": 'import { a } from "./a.js";\nexport const b = 2;\n'})
+    write(
+        tmp_path,
+        {
+            "a.js": 'import { b } from "./b.js";\nexport const a = 1;\n',
+            "b.js": 'import { a } from "./a.js";\nexport const b = 2;\n',
+        },
+    )
     with pytest.raises(ValueError, match=r"in a circle: a\.js -> b\.js -> a\.js"):
         bundle(tmp_path, "a.js")
 

@@ -31,8 +31,13 @@ def upgrade_status(server: Background, headers: dict[str, str]) -> int:
 def upgrade(server: Background, headers: dict[str, str]) -> tuple[int, str | None]:
     """The status a WebSocket upgrade with ``headers`` gets and the subprotocol accepted, its bytes written by
     hand so that the Host header is exactly the one given."""
-    lines = ["GET /ws HTTP/1.1", "Upgrade: websocket", "Connection: Upgrade", "Sec-WebSocket-Version: 13",
-             "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ=="]
+    lines = [
+        "GET /ws HTTP/1.1",
+        "Upgrade: websocket",
+        "Connection: Upgrade",
+        "Sec-WebSocket-Version: 13",
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+    ]
     headers = {"Host": f"127.0.0.1:{server.access.port}", **headers}
     lines += [f"{key}: {value}" for key, value in headers.items()]
     with socket.create_connection(("127.0.0.1", server.access.port), timeout=10) as conn:
@@ -40,7 +45,7 @@ def upgrade(server: Background, headers: dict[str, str]) -> tuple[int, str | Non
         answer = conn.makefile("rb")
         status = int(answer.readline().split()[1])
         protocol = None
-        while (line := answer.readline().decode("latin-1").strip()):
+        while line := answer.readline().decode("latin-1").strip():
             name, _, value = line.partition(":")
             if name.lower() == "sec-websocket-protocol":
                 protocol = value.strip()
@@ -74,8 +79,12 @@ def test_a_websocket_carries_the_token_as_a_subprotocol(studio: Background) -> N
     offer = {"Origin": studio.origin, "Sec-WebSocket-Protocol": f"tablebot-studio, tablebot-token.{token}"}
     assert upgrade(studio, offer) == (101, "tablebot-studio")
     other = token[:-1] + ("A" if token[-1] != "A" else "B")
-    for wrong in ("tablebot-studio, tablebot-token.", f"tablebot-studio, tablebot-token.{other}",
-                  f"tablebot-studio, {token}", "tablebot-studio"):
+    for wrong in (
+        "tablebot-studio, tablebot-token.",
+        f"tablebot-studio, tablebot-token.{other}",
+        f"tablebot-studio, {token}",
+        "tablebot-studio",
+    ):
         assert upgrade(studio, {**offer, "Sec-WebSocket-Protocol": wrong})[0] == 403, wrong
     assert upgrade(studio, {**offer, "Origin": "http://127.0.0.1:1"})[0] == 403  # the Origin is checked as well
 
@@ -92,12 +101,17 @@ def test_no_answer_sets_a_cookie(studio: Background) -> None:
             assert reply.headers.get_all("Set-Cookie") is None, path
 
 
-@pytest.mark.parametrize("host", ["attacker.example:{port}", "attacker.example", "127.0.0.1:1", "localhost.evil:{port}",
-                                  "10.0.0.8:{port}", ""])
+@pytest.mark.parametrize(
+    "host",
+    ["attacker.example:{port}", "attacker.example", "127.0.0.1:1", "localhost.evil:{port}", "10.0.0.8:{port}", ""],
+)
 def test_a_host_the_studio_does_not_serve_is_refused_before_any_route(studio: Background, host: str) -> None:
     """DNS rebinding: a foreign name resolving to 127.0.0.1 reaches the server with its own Host header."""
-    headers = {**studio.headers, "Host": host.format(port=studio.access.port),
-               "Origin": "http://" + host.format(port=studio.access.port)}
+    headers = {
+        **studio.headers,
+        "Host": host.format(port=studio.access.port),
+        "Origin": "http://" + host.format(port=studio.access.port),
+    }
     for path in ("", "api/config", "static/js/studio/main.js", "no/such/route"):
         status, body = http(studio, path, headers)
         assert status == 403 and b"does not answer to the address" in body, (host, path)
@@ -110,8 +124,10 @@ def test_the_local_names_are_served(studio: Background, name: str) -> None:
     assert http(studio, "api/config", {**studio.headers, "Host": host, "Origin": f"http://{host}"})[0] == 200
 
 
-@pytest.mark.parametrize("origin", ["http://attacker.example", "http://127.0.0.1:1", "null", "https://127.0.0.1:{port}",
-                                    "http://localhost:{port}"])
+@pytest.mark.parametrize(
+    "origin",
+    ["http://attacker.example", "http://127.0.0.1:1", "null", "https://127.0.0.1:{port}", "http://localhost:{port}"],
+)
 def test_a_foreign_origin_is_refused(studio: Background, origin: str) -> None:
     headers = {**studio.headers, "Origin": origin.format(port=studio.access.port)}
     status, body = http(studio, "api/config", headers)

@@ -45,8 +45,13 @@ console.log(JSON.stringify({ operations: protocol.OPERATIONS, messages: protocol
 def page() -> dict[str, Any]:
     node = shutil.which("node")
     assert node is not None, "Node runs the page's modules here"
-    done = subprocess.run([node, "--input-type=module", "-e", NODE_SCRIPT, STUDIO.as_uri()], capture_output=True,
-                          text=True, timeout=60, cwd=ROOT)
+    done = subprocess.run(
+        [node, "--input-type=module", "-e", NODE_SCRIPT, STUDIO.as_uri()],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=ROOT,
+    )
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -59,14 +64,18 @@ def test_the_page_and_the_server_name_the_same_operations_with_the_same_fields(p
 
 def test_the_page_handles_exactly_the_kinds_the_server_sends(page: dict[str, Any]) -> None:
     assert sorted(page["messages"]) == sorted(protocol.MESSAGES) and {"table", "analysis", "error"} <= set(
-        protocol.MESSAGES)
+        protocol.MESSAGES
+    )
     assert sorted(page["handled"]) == sorted(protocol.MESSAGES)
     assert page["partial"].startswith("handlers for table; the protocol has analysis, arena")
 
 
 def test_the_page_sends_only_the_protocols_operations(page: dict[str, Any]) -> None:
-    assert page["refused"] == ["not an operation of the studio: explode", "edit has no field colour",
-                               "not an operation of the studio: toString"]
+    assert page["refused"] == [
+        "not an operation of the studio: explode",
+        "edit has no field colour",
+        "not an operation of the studio: toString",
+    ]
     assert page["sent"] == [{"op": "sim", "action": "reset", "seed": 3, "charge": 0.5}]
 
 
@@ -74,12 +83,17 @@ def test_operations_read_their_fields_or_are_refused_in_the_studios_words() -> N
     assert protocol.operation({"op": "edit", "row": 2, "col": 1, "value": "", "seq": 9}) == protocol.Edit(2, 1, "", 9)
     sim = protocol.operation({"op": "sim", "action": "reset", "seed": 4})
     assert sim == protocol.Sim("reset", {"seed": 4})
-    for message, words in [([1], 'a message must be a JSON object with an "op"'), ({"op": "x"}, "unknown op 'x'"),
-                           ({"op": "edit", "row": True, "col": 0, "value": "1"}, '"row" must be a whole number'),
-                           ({"op": "open", "path": ""}, '"path" must be text'),
-                           ({"op": "save", "force": 3}, '"force" must be the version the conflict named ("theirs")'),
-                           ({"op": "restore", "header": ["a"], "grid": [[1]], "base": "v"},
-                            '"grid" must be rows of text (at most 20,000 rows of 200 cells)')]:
+    for message, words in [
+        ([1], 'a message must be a JSON object with an "op"'),
+        ({"op": "x"}, "unknown op 'x'"),
+        ({"op": "edit", "row": True, "col": 0, "value": "1"}, '"row" must be a whole number'),
+        ({"op": "open", "path": ""}, '"path" must be text'),
+        ({"op": "save", "force": 3}, '"force" must be the version the conflict named ("theirs")'),
+        (
+            {"op": "restore", "header": ["a"], "grid": [[1]], "base": "v"},
+            '"grid" must be rows of text (at most 20,000 rows of 200 cells)',
+        ),
+    ]:
         with pytest.raises(Refused) as refused:
             protocol.operation(message)
         assert str(refused.value) == words
@@ -89,7 +103,12 @@ def test_messages_go_out_with_their_fields_as_the_page_reads_them() -> None:
     assert protocol.ErrorMsg("no", "save").data() == {"type": "error", "message": "no", "op": "save"}
     assert protocol.GridMsg([["1"]], focus=0).data() == {"type": "grid", "grid": [["1"]], "focus": 0}
     assert protocol.AnalysisMsg(None, True, [2], {"cells": []}).data() == {
-        "type": "analysis", "seq": None, "dirty": True, "lines": [2], "cells": []}  # seq null: not after an edit
+        "type": "analysis",
+        "seq": None,
+        "dirty": True,
+        "lines": [2],
+        "cells": [],
+    }  # seq null: not after an edit
 
 
 def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path: Path) -> None:
@@ -98,10 +117,16 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
     for name in ("table.csv", "robot.toml", "arena.toml", "properties.toml"):
         shutil.copy(EXAMPLE / name, tmp_path / name)
     messages: dict[str, dict[str, Any]] = {
-        "open": {"path": "table.csv"}, "edit": {"row": 0, "col": 0, "value": "x", "seq": 1},
-        "insert_row": {"after": 0, "seq": 2}, "delete_row": {"row": 1, "seq": 3}, "save": {},
-        "restore": {"header": None, "grid": None, "base": "v"}, "sim": {"action": "step"},
-        "trace": {"path": "nothing.jsonl"}, "counterexample": {"name": "no_such_property"}, "files": {},
+        "open": {"path": "table.csv"},
+        "edit": {"row": 0, "col": 0, "value": "x", "seq": 1},
+        "insert_row": {"after": 0, "seq": 2},
+        "delete_row": {"row": 1, "seq": 3},
+        "save": {},
+        "restore": {"header": None, "grid": None, "base": "v"},
+        "sim": {"action": "step"},
+        "trace": {"path": "nothing.jsonl"},
+        "counterexample": {"name": "no_such_property"},
+        "files": {},
         "new": {"template": "empty", "name": "table.csv"},  # a taken name: refused in words
         "open_link": {"link": "nonsense"},  # no link opener handed in either: refused in words
         "share": {},  # no link maker handed in (tablebot studio hands one): refused in words
@@ -131,8 +156,13 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
         assert not any("internal error" in m.get("message", "") for m in sent), (op, sent)
     assert [m["type"] for m in replies["open"]][:3] == ["table", "analysis", "diagram"]
     assert replies["save"][0]["type"] == "saved" and replies["files"][0]["type"] == "files"
-    assert replies["restore"] == [{"type": "error", "op": "restore",
-                                   "message": '"header" must be a row of text (at most 20,000 rows of 200 cells)'}]
+    assert replies["restore"] == [
+        {
+            "type": "error",
+            "op": "restore",
+            "message": '"header" must be a row of text (at most 20,000 rows of 200 cells)',
+        }
+    ]
     assert replies["counterexample"][0]["message"] == "property 'no_such_property' has no counterexample"
 
 
@@ -148,23 +178,40 @@ def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> Non
 
         session = Session(Workspace(tmp_path), Hub(), send, language)
         try:
-            for message in ({"op": "open", "path": ""}, {"op": "edit", "row": "1", "col": 0, "value": ""},
-                            {"op": "explode"}, [1], {"op": "open", "path": "../secret.csv"},
-                            {"op": "sim", "action": "play"}, {"op": "save"}):
+            for message in (
+                {"op": "open", "path": ""},
+                {"op": "edit", "row": "1", "col": 0, "value": ""},
+                {"op": "explode"},
+                [1],
+                {"op": "open", "path": "../secret.csv"},
+                {"op": "sim", "action": "play"},
+                {"op": "save"},
+            ):
                 await session.handle(message)
         finally:
             session.close()
         return sent
 
     german = [m["message"] for m in asyncio.run(replies("de"))]
-    assert german == ['"path" muss Text sein', '"row" muss eine ganze Zahl sein', "unbekannte Operation 'explode'",
-                      'eine Nachricht muss ein JSON-Objekt mit einem "op" sein',
-                      "'../secret.csv' liegt außerhalb des freigegebenen Ordners",
-                      "der Roboter fährt nicht: zuerst die Tabelle berichtigen", "zuerst eine Tabelle öffnen"]
+    assert german == [
+        '"path" muss Text sein',
+        '"row" muss eine ganze Zahl sein',
+        "unbekannte Operation 'explode'",
+        'eine Nachricht muss ein JSON-Objekt mit einem "op" sein',
+        "'../secret.csv' liegt außerhalb des freigegebenen Ordners",
+        "der Roboter fährt nicht: zuerst die Tabelle berichtigen",
+        "zuerst eine Tabelle öffnen",
+    ]
     english = [m["message"] for m in asyncio.run(replies("en"))]
-    assert english == ['"path" must be text', '"row" must be a whole number', "unknown op 'explode'",
-                       'a message must be a JSON object with an "op"', "'../secret.csv' is outside the served folder",
-                       "the robot is not running: fix the table first", "open a table first"]
+    assert english == [
+        '"path" must be text',
+        '"row" must be a whole number',
+        "unknown op 'explode'",
+        'a message must be a JSON object with an "op"',
+        "'../secret.csv' is outside the served folder",
+        "the robot is not running: fix the table first",
+        "open a table first",
+    ]
 
 
 def test_why_a_row_fired_is_said_in_the_tabs_language(tmp_path: Path) -> None:

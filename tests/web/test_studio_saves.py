@@ -43,7 +43,7 @@ def marked(original: bytes, row: int, text: str) -> bytes:
     """The table with grid row ``row``'s description set to ``text`` (what that tab's draft must save)."""
     lines = original.split(b"\n")
     line = lines[row + 1]
-    lines[row + 1] = text.encode() + line[line.index(b","):]
+    lines[row + 1] = text.encode() + line[line.index(b",") :]
     return b"\n".join(lines)
 
 
@@ -67,8 +67,9 @@ class Tab:
 
 
 async def open_tab(server: Background, path: str = "table.csv") -> Tab:
-    ws = await websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24, max_queue=None,
-                                  additional_headers=server.headers)  # unread notices never hold up its close
+    ws = await websockets.connect(
+        server.origin.replace("http", "ws") + "/ws", max_size=2**24, max_queue=None, additional_headers=server.headers
+    )  # unread notices never hold up its close
     tab = Tab(ws)
     await tab.send({"op": "open", "path": path})
     await tab.until("analysis")
@@ -146,8 +147,7 @@ def replace_by_rename(path: Path, data: bytes) -> None:
     (path.parent / "incoming.tmp").replace(path)
 
 
-def test_a_table_replaced_by_rename_offers_the_choice_and_both_answers_work(studio: Background,
-                                                                           folder: Path) -> None:
+def test_a_table_replaced_by_rename_offers_the_choice_and_both_answers_work(studio: Background, folder: Path) -> None:
     path = folder / "table.csv"
     original = path.read_bytes()
     theirs = marked(original, 5, "theirs")
@@ -178,7 +178,7 @@ def test_a_table_replaced_by_rename_offers_the_choice_and_both_answers_work(stud
 
 
 def test_a_forced_save_overwrites_only_the_version_it_was_shown(studio: Background, folder: Path) -> None:
-    """"Save mine" names their version: if the file changed again meanwhile, it asks again; a table replaced
+    """ "Save mine" names their version: if the file changed again meanwhile, it asks again; a table replaced
     by the same bytes (a checkout of the same commit) asks nothing; a deleted table is written again."""
     path = folder / "table.csv"
     original = path.read_bytes()
@@ -210,6 +210,7 @@ def test_a_forced_save_overwrites_only_the_version_it_was_shown(studio: Backgrou
 
 # --- line breaks in a cell, and a draft put back ------------------------------------------------------------
 
+
 @pytest.mark.parametrize("newline", ["\n", "\r\n"])
 @pytest.mark.parametrize("typed", ["two\r\nlines", "two\rlines", "two\nlines"])
 def test_a_line_break_in_a_cell_is_one_line_break_whoever_sent_it(newline: str, typed: str) -> None:
@@ -219,8 +220,9 @@ def test_a_line_break_in_a_cell_is_one_line_break_whoever_sent_it(newline: str, 
     doc = CsvDocument.from_text(newline.join(["description,state,next", "x,1,1", "y,1,1", ""]))
     doc.set_cell(0, 0, typed)
     doc.insert_row(1, [typed, "1", "1"])
-    assert doc.text() == newline.join(["description,state,next", '"two', 'lines",1,1', "y,1,1",
-                                       '"two', 'lines",1,1', ""])
+    assert doc.text() == newline.join(
+        ["description,state,next", '"two', 'lines",1,1', "y,1,1", '"two', 'lines",1,1', ""]
+    )
     assert doc.grid()[0][0] == "two\nlines" and CsvDocument.from_text(doc.text()).grid() == doc.grid()
 
 
@@ -254,8 +256,7 @@ def test_a_draft_put_back_changes_only_what_it_changed(studio: Background, folde
         grid.insert(2, ["", "1", "", "", "", "", "", "", "", "0", "", "0", "1", "1"])
         grid[5][1] = "7"
         del grid[6]
-        await tab.send({"op": "restore", "base": loaded["version"], "header": loaded["header"], "grid": grid,
-                        "seq": 5})
+        await tab.send({"op": "restore", "base": loaded["version"], "header": loaded["header"], "grid": grid, "seq": 5})
         shown = await tab.until("grid")
         assert shown["grid"] == grid and len(shown["lines"]) == len(grid)
         assert (await tab.until("analysis"))["dirty"] is True and path.read_bytes() == original
@@ -338,7 +339,8 @@ def test_a_reload_for_another_tabs_save_never_replaces_an_edit_made_meanwhile(fo
         return told
 
     told = asyncio.run(run())
-    after = [m["type"] for m in told][[m["type"] for m in told].index("arena") + 1:]  # b's messages since it opened
+    after = [m["type"] for m in told][[m["type"] for m in told].index("arena") + 1 :]  # b's messages since it opened
     assert after == ["conflict", "analysis", "diagram"]
-    assert next(m for m in told if m["type"] == "conflict")["message"] == ("another tab saved table.csv "
-                                                                                    "while this one has unsaved edits")
+    assert next(m for m in told if m["type"] == "conflict")["message"] == (
+        "another tab saved table.csv while this one has unsaved edits"
+    )

@@ -30,15 +30,17 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Backgroun
     server.stop()
 
 
-def talk(server: Background, messages: list[Any], until: str, limit: int = 20,
-         seq: int | None = None) -> list[dict[str, Any]]:
+def talk(
+    server: Background, messages: list[Any], until: str, limit: int = 20, seq: int | None = None
+) -> list[dict[str, Any]]:
     """Send the messages (text as is, anything else as JSON) as the studio's page would (its Origin and
     token cookie) and collect replies up to one of type ``until`` (with ``seq``, if given)."""
 
     async def run() -> list[dict[str, Any]]:
         replies: list[dict[str, Any]] = []
-        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
-                                      additional_headers=server.headers) as ws:
+        async with websockets.connect(
+            server.origin.replace("http", "ws") + "/ws", max_size=2**24, additional_headers=server.headers
+        ) as ws:
             for message in messages:
                 await ws.send(message if isinstance(message, str) else json.dumps(message))
             while len(replies) < limit:
@@ -58,21 +60,41 @@ def get(server: Background, path: str, data: bytes | None = None) -> urllib.requ
 
 def test_malformed_messages_get_error_replies_and_the_server_goes_on(studio: tuple[Background, Path]) -> None:
     server, _ = studio
-    bad = ["not json", "[1, 2]", {"op": 5}, {"op": "explode"}, {"op": "edit", "row": 0, "col": 0, "value": "x"},
-           {"op": "open", "path": 7}, {"op": "sim", "action": "play"}, {"op": "open", "path": "table.csv"},
-           {"op": "edit", "row": "zero", "col": 1, "value": "1"}, {"op": "edit", "row": 999, "col": 1, "value": "1"},
-           {"op": "sim", "action": "speed", "speed": "warp"},
-           {"op": "sim", "action": "hold", "input": "I99", "on": True},
-           {"op": "sim", "action": "reset", "seed": -4}, {"op": "sim", "action": "reset", "charge": "full"}]
+    bad = [
+        "not json",
+        "[1, 2]",
+        {"op": 5},
+        {"op": "explode"},
+        {"op": "edit", "row": 0, "col": 0, "value": "x"},
+        {"op": "open", "path": 7},
+        {"op": "sim", "action": "play"},
+        {"op": "open", "path": "table.csv"},
+        {"op": "edit", "row": "zero", "col": 1, "value": "1"},
+        {"op": "edit", "row": 999, "col": 1, "value": "1"},
+        {"op": "sim", "action": "speed", "speed": "warp"},
+        {"op": "sim", "action": "hold", "input": "I99", "on": True},
+        {"op": "sim", "action": "reset", "seed": -4},
+        {"op": "sim", "action": "reset", "charge": "full"},
+    ]
     replies = talk(server, [*bad, {"op": "files"}], until="files", limit=40)
     errors = [r["message"] for r in replies if r["type"] == "error"]
-    assert errors[:7] == ["not JSON: Expecting value", 'a message must be a JSON object with an "op"',
-                          'a message must be a JSON object with an "op"', "unknown op 'explode'",
-                          "open a table first", '"path" must be text',
-                          "the robot is not running: fix the table first"]
-    assert errors[7:] == ['"row" must be a whole number', "there is no row 1000", "speed must be one of 1, 10, max",
-                          "unknown input 'I99': the robot's inputs are I3, I4, I5, I7, I8",
-                          '"seed" must be from 0 to 2.14748e+09', '"charge" must be a number']
+    assert errors[:7] == [
+        "not JSON: Expecting value",
+        'a message must be a JSON object with an "op"',
+        'a message must be a JSON object with an "op"',
+        "unknown op 'explode'",
+        "open a table first",
+        '"path" must be text',
+        "the robot is not running: fix the table first",
+    ]
+    assert errors[7:] == [
+        '"row" must be a whole number',
+        "there is no row 1000",
+        "speed must be one of 1, 10, max",
+        "unknown input 'I99': the robot's inputs are I3, I4, I5, I7, I8",
+        '"seed" must be from 0 to 2.14748e+09',
+        '"charge" must be a number',
+    ]
     assert replies[-1]["type"] == "files" and "table.csv" in replies[-1]["tables"]
     assert "trace.jsonl" not in replies[-1]["tables"]
 
@@ -118,8 +140,12 @@ def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background,
 
 def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None:
     server, _ = studio
-    replies = talk(server, [{"op": "open", "path": "table.csv"},
-                                {"op": "edit", "row": 4, "col": 9, "value": "9", "seq": 1}], until="analysis", seq=1)
+    replies = talk(
+        server,
+        [{"op": "open", "path": "table.csv"}, {"op": "edit", "row": 4, "col": 9, "value": "9", "seq": 1}],
+        until="analysis",
+        seq=1,
+    )
     first, edited = (r for r in replies if r["type"] == "analysis")
     assert first["ok"] and first["machine"]["rows"] == 37 and len(first["machine"]["states"]) == 10
     assert not edited["ok"] and "machine" not in edited
@@ -129,16 +155,20 @@ def test_an_edit_is_checked_and_located(studio: tuple[Background, Path]) -> None
 
 
 def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_it_breaks(
-        studio: tuple[Background, Path]) -> None:
+    studio: tuple[Background, Path],
+) -> None:
     server, _ = studio
 
     async def run() -> tuple[dict[str, Any], list[tuple[float, dict[str, Any]]]]:
         control: dict[str, Any] | None = None
         frames: list[tuple[float, dict[str, Any]]] = []
-        async with websockets.connect(server.origin.replace("http", "ws") + "/ws", max_size=2**24,
-                                      additional_headers=server.headers) as ws:
-            for message in ({"op": "open", "path": "table.csv"},
-                            {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"}):
+        async with websockets.connect(
+            server.origin.replace("http", "ws") + "/ws", max_size=2**24, additional_headers=server.headers
+        ) as ws:
+            for message in (
+                {"op": "open", "path": "table.csv"},
+                {"op": "counterexample", "name": "front_bumper_stops", "where": "arena"},
+            ):
                 await ws.send(json.dumps(message))
             while True:
                 reply = json.loads(await asyncio.wait_for(ws.recv(), 10))

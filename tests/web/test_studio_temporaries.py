@@ -59,19 +59,28 @@ def test_a_save_killed_mid_way_leaves_a_temporary_the_next_start_removes(folder:
 def test_only_the_studios_own_stale_temporaries_are_removed(tmp_path: Path, folder: Path) -> None:
     """Removed: the exact name a save gives, a regular file, its writer gone (or the file an hour old).
     Kept: everything else, however alike."""
-    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True,
-                          check=True)
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True, check=True
+    )
     dead = int(gone.stdout)
     (folder / "sub").mkdir()
     (folder / ".git").mkdir()
     outside = tmp_path / "outside.txt"
     outside.write_text("keep me")
-    removed = [f".table.csv.studio-{dead}-0123abcd.tmp", f"sub/.t.TSV.bak.studio-{dead}-89abcdef.tmp",
-               f".table.csv.studio-{os.getpid()}-00000000.tmp"]  # a live writer, but an hour old
-    kept = [f".table.csv.studio-{os.getpid()}-11111111.tmp",  # a save of this very process may be under way
-            ".table.csv.0123abcd.tmp", f"table.csv.studio-{dead}-0123abcd.tmp",  # not our name
-            f".notes.txt.studio-{dead}-0123abcd.tmp", f".table.csv.studio-{dead}-0123ABCD.tmp",
-            f".table.csv.studio-{dead}-0123abcd.tmp.keep", f".git/.table.csv.studio-{dead}-0123abcd.tmp"]
+    removed = [
+        f".table.csv.studio-{dead}-0123abcd.tmp",
+        f"sub/.t.TSV.bak.studio-{dead}-89abcdef.tmp",
+        f".table.csv.studio-{os.getpid()}-00000000.tmp",
+    ]  # a live writer, but an hour old
+    kept = [
+        f".table.csv.studio-{os.getpid()}-11111111.tmp",  # a save of this very process may be under way
+        ".table.csv.0123abcd.tmp",
+        f"table.csv.studio-{dead}-0123abcd.tmp",  # not our name
+        f".notes.txt.studio-{dead}-0123abcd.tmp",
+        f".table.csv.studio-{dead}-0123ABCD.tmp",
+        f".table.csv.studio-{dead}-0123abcd.tmp.keep",
+        f".git/.table.csv.studio-{dead}-0123abcd.tmp",
+    ]
     for name in removed + kept:
         (folder / name).write_text("x")
     old = time.time() - 2 * 3600

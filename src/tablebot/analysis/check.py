@@ -58,8 +58,12 @@ class CheckReport:
         return 1 if strict and counts["warning"] else 0
 
 
-def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, ...] = (),
-              step: Callable[[str], None] = lambda what: None) -> CheckReport:
+def run_check(
+    machine: Machine,
+    props: Sequence[Property],
+    targets: tuple[str, ...] = (),
+    step: Callable[[str], None] = lambda what: None,
+) -> CheckReport:
     """Explore, find, prove; ``step`` is told what starts next (a progress display). A robot of several
     tables: :func:`tablebot.analysis.check_tables.run_check_tables`."""
     try:
@@ -72,8 +76,11 @@ def run_check(machine: Machine, props: Sequence[Property], targets: tuple[str, .
             step(N_("property {name}", name=prop.name))
             results.append(check_property(prop, machine))
     except ModelTooLarge as exc:
-        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
-                   N_("split the table, or give states fewer inputs to look at")) from None
+        raise fail(
+            machine.table.path,
+            N_("too large to explore: {reason}", reason=exc.args[0]),
+            N_("split the table, or give states fewer inputs to look at"),
+        ) from None
     return CheckReport(machine, findings, results, len(graph.nodes))
 
 
@@ -109,16 +116,23 @@ def story(machine: Machine, result: Result, limit: int = 12) -> list[str]:
         text = _tick_text(machine, line, pressed)
         items.append(N_("{step}   <- it shows here", step=text) if last else text)
     if len(items) > limit:
-        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2):]]
+        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2) :]]
     return items
 
 
 def _quiet(first: int, last: int, line: dict[str, Any]) -> Message:
     if first == last:
-        return N_("tick {first}: nothing pressed, nothing fires (state {state}, timer counts down)", first=first,
-                  state=line["state"])
-    return N_("ticks {first}-{last}: nothing pressed, nothing fires (state {state}, timer counts down)", first=first,
-              last=last, state=line["state"])
+        return N_(
+            "tick {first}: nothing pressed, nothing fires (state {state}, timer counts down)",
+            first=first,
+            state=line["state"],
+        )
+    return N_(
+        "ticks {first}-{last}: nothing pressed, nothing fires (state {state}, timer counts down)",
+        first=first,
+        last=last,
+        state=line["state"],
+    )
 
 
 def _tick_text(machine: Machine, line: dict[str, Any], pressed: list[str]) -> Message:
@@ -128,33 +142,64 @@ def _tick_text(machine: Machine, line: dict[str, Any], pressed: list[str]) -> Me
         what = N_("{what}, timer ran out", what=what)
     outputs = " ".join(f"{n} {line[n]}" for n in machine.output_names)
     if line["row"] is None:
-        return N_("tick {tick}: {what}; no row fires (state {state}, {outputs})", tick=line["tick"], what=what,
-                  state=line["state"], outputs=outputs)
+        return N_(
+            "tick {tick}: {what}; no row fires (state {state}, {outputs})",
+            tick=line["tick"],
+            what=what,
+            state=line["state"],
+            outputs=outputs,
+        )
     row = table.rows[line["row"]]
     label = f" ({row.description})" if row.description else ""
-    return N_("tick {tick}: {what} -> line {line}{label} fires: state {state}, {outputs}", tick=line["tick"],
-              what=what, line=row.line, label=label, state=line["state"], outputs=outputs)
+    return N_(
+        "tick {tick}: {what} -> line {line}{label} fires: state {state}, {outputs}",
+        tick=line["tick"],
+        what=what,
+        line=row.line,
+        label=label,
+        state=line["state"],
+        outputs=outputs,
+    )
 
 
 def report_json(report: CheckReport, strict: bool) -> dict[str, Any]:
     table = report.machine.table
     return {
-        "table": table.path, "robot": table.robot.name, "rows": len(table.rows),
-        "states": len(report.machine.states), "situations_explored": report.situations,
+        "table": table.path,
+        "robot": table.robot.name,
+        "rows": len(table.rows),
+        "states": len(report.machine.states),
+        "situations_explored": report.situations,
         "findings": [f.as_json() for f in report.findings],
         "properties": [_result_json(report, r) for r in report.results],
-        "counts": report.counts(), "exit_code": report.exit_code(strict),
-        **({"tables": [{"name": t.name, "table": t.path, "rows": len(t.rows), "states": len(m.states)}
-                       for t, m in zip(report.tables.tables, report.tables.machines, strict=True)]}
-           if report.tables is not None else {}),
+        "counts": report.counts(),
+        "exit_code": report.exit_code(strict),
+        **(
+            {
+                "tables": [
+                    {"name": t.name, "table": t.path, "rows": len(t.rows), "states": len(m.states)}
+                    for t, m in zip(report.tables.tables, report.tables.machines, strict=True)
+                ]
+            }
+            if report.tables is not None
+            else {}
+        ),
     }
 
 
 def _result_json(report: CheckReport, result: Result) -> dict[str, Any]:
     prop = result.prop
-    data: dict[str, Any] = {"name": prop.name, "text": prop.text, "claim": prop.claim(), "status": result.status,
-                            "level": prop.level, "note": prop.note, "source": prop.source, "line": prop.line,
-                            "situations_explored": result.explored}
+    data: dict[str, Any] = {
+        "name": prop.name,
+        "text": prop.text,
+        "claim": prop.claim(),
+        "status": result.status,
+        "level": prop.level,
+        "note": prop.note,
+        "source": prop.source,
+        "line": prop.line,
+        "situations_explored": result.explored,
+    }
     if result.inputs:
         path = report.counterexamples.get(prop.name)
         data["inputs_csv"] = str(path) if path else None

@@ -25,8 +25,12 @@ if TYPE_CHECKING:
     from tablebot.analysis.check import CheckReport
 
 
-def run_check_tables(tables: RobotTables, props: Sequence[Property], targets: tuple[str, ...] = (),
-                     step: Callable[[str], None] = lambda what: None) -> CheckReport:
+def run_check_tables(
+    tables: RobotTables,
+    props: Sequence[Property],
+    targets: tuple[str, ...] = (),
+    step: Callable[[str], None] = lambda what: None,
+) -> CheckReport:
     """Explore the product, find each table's findings, prove the properties over the product."""
     from tablebot.analysis.check import CheckReport
 
@@ -40,17 +44,26 @@ def run_check_tables(tables: RobotTables, props: Sequence[Property], targets: tu
             found = find_all(machine, Model(machine).explore(), targets)
             if k:  # the main table's findings read as a one-table robot's; the others' name their table
                 table = machine.table
-                found = [replace(f, message=N_("table {name}: {message}", name=table.name, message=f.message),
-                                 table=table.name, path=table.path)
-                         for f in found]
+                found = [
+                    replace(
+                        f,
+                        message=N_("table {name}: {message}", name=table.name, message=f.message),
+                        table=table.name,
+                        path=table.path,
+                    )
+                    for f in found
+                ]
             findings += found
         results = []
         for prop in props:
             step(N_("property {name}", name=prop.name))
             results.append(check_product_property(prop, tables))
     except ModelTooLarge as exc:
-        raise fail(main.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
-                   N_("split the tables, or give their states fewer inputs to look at")) from None
+        raise fail(
+            main.table.path,
+            N_("too large to explore: {reason}", reason=exc.args[0]),
+            N_("split the tables, or give their states fewer inputs to look at"),
+        ) from None
     return CheckReport(main, findings, results, situations, tables=tables)
 
 
@@ -72,16 +85,24 @@ def story_of_tables(tables: RobotTables, result: Result, limit: int = 12) -> lis
             items.append(_quiet(quiet_from, n - 1))
             quiet_from = None
         what = " + ".join(pressed) or N_("nothing pressed")
-        lines = tuple(N_("{table} line {line}", table=name, line=e.machine.table.rows[e.row].line)
-                      for name, e in fired) or N_("no row fires")
-        states = " ".join(f"{name} {e.machine.states[e.state]}" for name, e in zip(tables.names, robot.engines,
-                                                                                  strict=True))
+        lines = tuple(
+            N_("{table} line {line}", table=name, line=e.machine.table.rows[e.row].line) for name, e in fired
+        ) or N_("no row fires")
+        states = " ".join(
+            f"{name} {e.machine.states[e.state]}" for name, e in zip(tables.names, robot.engines, strict=True)
+        )
         outputs = " ".join(f"{name} {value}" for name, value in zip(tables.output_names, robot.outputs, strict=True))
-        step = N_("tick {tick}: {what} -> {lines}: {states}, {outputs}", tick=n, what=what, lines=lines,
-                  states=states, outputs=outputs)
+        step = N_(
+            "tick {tick}: {what} -> {lines}: {states}, {outputs}",
+            tick=n,
+            what=what,
+            lines=lines,
+            states=states,
+            outputs=outputs,
+        )
         items.append(N_("{step}   <- it shows here", step=step) if last else step)
     if len(items) > limit:
-        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2):]]
+        items = [items[0], N_("... ({n} more steps) ...", n=len(items) - limit + 1), *items[-(limit - 2) :]]
     return items
 
 

@@ -30,8 +30,14 @@ Obs = tuple[int, int, Any, tuple[int, ...]]
 Predicate = Callable[[int, int, Any, tuple[int, ...]], bool]
 
 TOKEN_RE = re.compile(r"\s*(?:(?P<num>-?\d+)|(?P<op>==|!=|<=|>=|<|>|\(|\)|\[|\]|,)|(?P<word>[A-Za-z_][\w.-]*))")
-COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
-           ">": operator.gt, ">=": operator.ge}
+COMPARE = {
+    "==": operator.eq,
+    "!=": operator.ne,
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+}
 KEYWORDS = {"and", "or", "not", "in", "true", "false", "state", "line", "fired"}
 #: Parentheses and ``not`` nest at most this deep: the parser (and ``not``) recurse once per level, and a
 #: condition a person writes never comes near it.
@@ -79,8 +85,14 @@ def _tokens(text: str) -> list[str]:
         if not match or match.end() == pos:
             raise ConditionError(N_("cannot read {rest!r} in condition {text!r}", rest=text[pos:], text=text))
         if match["num"] and len(match["num"]) > MAX_NUMBER_CHARS:  # int() of it may fail; none is that large
-            raise ConditionError(N_("a number of {count:,} characters in condition: no state, line or output value "
-                                    "has more than {most}", count=len(match["num"]), most=MAX_NUMBER_CHARS))
+            raise ConditionError(
+                N_(
+                    "a number of {count:,} characters in condition: no state, line or output value "
+                    "has more than {most}",
+                    count=len(match["num"]),
+                    most=MAX_NUMBER_CHARS,
+                )
+            )
         tokens.append(match.group().strip())
         pos = match.end()
     if not tokens:
@@ -205,10 +217,21 @@ class _Parser:
             if str(state) == text:
                 return index
         if self.tables is None:
-            raise ConditionError(N_("there is no state {state} in the table (states: {states})", state=text,
-                                    states=tuple(map(str, states))))
-        raise ConditionError(N_("there is no state {state} in table {table} (states: {states})", state=text,
-                                table=self.tables.names[table], states=tuple(map(str, states))))
+            raise ConditionError(
+                N_(
+                    "there is no state {state} in the table (states: {states})",
+                    state=text,
+                    states=tuple(map(str, states)),
+                )
+            )
+        raise ConditionError(
+            N_(
+                "there is no state {state} in table {table} (states: {states})",
+                state=text,
+                table=self.tables.names[table],
+                states=tuple(map(str, states)),
+            )
+        )
 
     def line_test(self) -> Predicate:
         op = self.take(N_("== or in"))
@@ -244,10 +267,20 @@ class _Parser:
                 raise ConditionError(N_("{name} {op} needs a number, not {value!r}", name=name, op=op, value=value))
             compare, number = COMPARE[op], int(value)
             return lambda e, r, s, o: compare(o[index], number)
-        known = [TIMER_EVENT, *self.input_names(), *machine.table.robot.counter_names, *machine.output_names,
-                 *(self.tables.names if self.tables else ())]
-        raise ConditionError(N_("unknown name {name!r}; use state, line, fired or one of {known}", name=name,
-                                known=tuple(map(str, known))))
+        known = [
+            TIMER_EVENT,
+            *self.input_names(),
+            *machine.table.robot.counter_names,
+            *machine.output_names,
+            *(self.tables.names if self.tables else ()),
+        ]
+        raise ConditionError(
+            N_(
+                "unknown name {name!r}; use state, line, fired or one of {known}",
+                name=name,
+                known=tuple(map(str, known)),
+            )
+        )
 
     def input_names(self) -> list[str]:
         return list((self.tables or self.machine).input_bits)
@@ -263,10 +296,10 @@ class _Parser:
             return machine.input_bits[name]
         bit = machine.counter_bits[machine.table.robot.counter_names.index(name)]
         if not bit:
-            raise ConditionError(N_("counter {name} has no event column in the table, so it is never an event",
-                                    name=name))
+            raise ConditionError(
+                N_("counter {name} has no event column in the table, so it is never an event", name=name)
+            )
         return bit
-
 
     def product_bit(self, name: str) -> int:
         """An event's bit in the event word of several tables: the robot's inputs, the main T, each counter."""

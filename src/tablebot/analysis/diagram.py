@@ -21,8 +21,13 @@ FORMATS = ("svg", "png", "dot", "mermaid")
 PNG_DPI = 150  # Graphviz's default 72 dpi draws 9-point labels a few pixels high
 COLOURS = {"forward": "#2e7d32", "reverse": "#c62828", "turn": "#1565c0", "stop": "#222222", "keep": "#888888"}
 #: The legend's word for each colour (the keys above are class names, never shown).
-MOTIONS = {"forward": N_("forward"), "reverse": N_("reverse"), "turn": N_("turn"), "stop": N_("stop"),
-           "keep": N_("keep")}
+MOTIONS = {
+    "forward": N_("forward"),
+    "reverse": N_("reverse"),
+    "turn": N_("turn"),
+    "stop": N_("stop"),
+    "keep": N_("keep"),
+}
 
 
 def motion_legend() -> list[str]:
@@ -84,8 +89,11 @@ def event_label(table: Table, event: str) -> str:
     if cross is None:
         return event
     states = ",".join([*map(str, cross.states), *(f"{low}..{high}" for low, high in cross.ranges)])
-    return _("{table} in {{{states}}}").format(table=cross.table, states=states) if cross.states or \
-        len(cross.ranges) > 1 else _("{table} in {states}").format(table=cross.table, states=states)
+    return (
+        _("{table} in {{{states}}}").format(table=cross.table, states=states)
+        if cross.states or len(cross.ranges) > 1
+        else _("{table} in {states}").format(table=cross.table, states=states)
+    )
 
 
 def action(table: Table, row: Row) -> Action:
@@ -111,8 +119,9 @@ def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:
     if not motors or all(m is None for m in motors):
         return _("keep"), "keep"
     if any(m is None for m in motors):
-        return " ".join(f"{n} {'=' if m is None else f'{m:+d}'}" for n, m in zip(table.robot.motors, motors,
-                                                                                  strict=True)), "turn"
+        return " ".join(
+            f"{n} {'=' if m is None else f'{m:+d}'}" for n, m in zip(table.robot.motors, motors, strict=True)
+        ), "turn"
     speeds = tuple(m for m in motors if m is not None)  # all of them: none is None past the test above
     if all(m == 0 for m in speeds):
         return _("stop"), "stop"
@@ -122,8 +131,11 @@ def motion_of(table: Table, motors: tuple[int | None, ...]) -> tuple[str, str]:
         return text, "forward" if all(m > 0 for m in speeds) else "reverse" if all(m < 0 for m in speeds) else "turn"
     left, right = speeds[sides[0]], speeds[sides[1]]
     if left == right:
-        return (_("forward {speed}").format(speed=left), "forward") if left > 0 else \
-            (_("reverse {speed}").format(speed=-left), "reverse")
+        return (
+            (_("forward {speed}").format(speed=left), "forward")
+            if left > 0
+            else (_("reverse {speed}").format(speed=-left), "reverse")
+        )
     # The heading turns toward the slower side going forward (signed: right > left turns left).
     wheels = f"L{left} R{right}"
     if left * right < 0:
@@ -151,6 +163,7 @@ def _sides(table: Table) -> tuple[int, int] | None:
 
 # --- Graphviz ---------------------------------------------------------------------------------------
 
+
 def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
     # Every user text goes into HTML-like labels (<…>): the only Graphviz strings without escapes of their own.
     graph = digraph(f"{table.robot.name}: {table.path}")
@@ -161,11 +174,28 @@ def to_graphviz(table: Table, colour: bool = True) -> graphviz.Digraph:
 
 def digraph(title: str) -> graphviz.Digraph:
     """An empty diagram titled ``title``, with the house style for its nodes and edges."""
-    graph = graphviz.Digraph("tablebot", graph_attr={
-        "rankdir": "TB", "fontname": "Helvetica", "fontsize": "11", "nodesep": "0.35", "ranksep": "0.9",
-        "labelloc": "t", "label": f"<{dot_label(title)}>", "pad": "0.2"})
-    graph.attr("node", shape="box", style="rounded,filled", fillcolor="#f4f4f4", fontname="Helvetica",
-               fontsize="12", color="#555555")
+    graph = graphviz.Digraph(
+        "tablebot",
+        graph_attr={
+            "rankdir": "TB",
+            "fontname": "Helvetica",
+            "fontsize": "11",
+            "nodesep": "0.35",
+            "ranksep": "0.9",
+            "labelloc": "t",
+            "label": f"<{dot_label(title)}>",
+            "pad": "0.2",
+        },
+    )
+    graph.attr(
+        "node",
+        shape="box",
+        style="rounded,filled",
+        fillcolor="#f4f4f4",
+        fontname="Helvetica",
+        fontsize="12",
+        color="#555555",
+    )
     graph.attr("edge", fontname="Helvetica", fontsize="9", arrowsize="0.7")
     return graph
 
@@ -182,16 +212,28 @@ def draw_table(graph: graphviz.Digraph, table: Table, colour: bool, prefix: str 
         label = table.state_name(state)
         title = f"<<b>{dot_label(str(state))}</b>" + (f"<br/>{dot_label(label)}>" if label else ">")
         initial = state == robot.initial_state
-        graph.node(ids[state], title, penwidth="3" if initial else "2", color=state_colour,
-                   fillcolor="#fff7d6" if initial else "#f4f4f4")
-    graph.edge(start, ids[robot.initial_state],
-               label="< " + dot_label(_("start, timer {timer}").format(timer=robot.initial_timer)) + ">")
+        graph.node(
+            ids[state],
+            title,
+            penwidth="3" if initial else "2",
+            color=state_colour,
+            fillcolor="#fff7d6" if initial else "#f4f4f4",
+        )
+    graph.edge(
+        start,
+        ids[robot.initial_state],
+        label="< " + dot_label(_("start, timer {timer}").format(timer=robot.initial_timer)) + ">",
+    )
     for edge in edges(table):
         first = edge.lines[0][1].motion
         same = all(a.motion == first for _, a in edge.lines)
-        graph.edge(ids[edge.source], ids[edge.target], label=_html_label(edge, colour),
-                   color=COLOURS[first] if colour and same else "#666666",
-                   penwidth="1.6" if colour and same else "1.0")
+        graph.edge(
+            ids[edge.source],
+            ids[edge.target],
+            label=_html_label(edge, colour),
+            color=COLOURS[first] if colour and same else "#666666",
+            penwidth="1.6" if colour and same else "1.0",
+        )
 
 
 def state_ids(states: Sequence[StateId]) -> dict[StateId, str]:
@@ -226,8 +268,11 @@ def _html_label(edge: Edge, colour: bool) -> str:
 
 def _legend(table: Table, colour: bool) -> str:
     robot = table.robot
-    cells = [f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}"
-             for name in (*table.events, *robot.motors) if name != TIMER_EVENT]
+    cells = [
+        f"<b>{dot_label(name)}</b> {dot_label(robot.labels.get(name, ''))}"
+        for name in (*table.events, *robot.motors)
+        if name != TIMER_EVENT
+    ]
     ran_out = _("timer ran out")  # outside the f-string: Babel does not look inside one
     cells.insert(0, f"<b>T</b> {dot_label(ran_out)}")
     cells.append(dot_label(_("times: timer loaded by the row")))
@@ -255,13 +300,15 @@ def drawn(graph: graphviz.Digraph, fmt: str) -> bytes:
     try:
         return draw(graph.source, fmt)
     except NoGraphviz as exc:
-        raise fail("graphviz", exc.args[0], N_("{install}; or use --format dot or --format mermaid",
-                                               install=INSTALL)) from None
+        raise fail(
+            "graphviz", exc.args[0], N_("{install}; or use --format dot or --format mermaid", install=INSTALL)
+        ) from None
     except GraphvizFailed as exc:
         raise fail("graphviz", exc.args[0], N_("report this with the table attached")) from None
 
 
 # --- Mermaid ----------------------------------------------------------------------------------------
+
 
 def to_mermaid(table: Table) -> str:
     """A Mermaid ``stateDiagram-v2`` (renders on GitHub and in many Markdown viewers)."""

@@ -22,13 +22,18 @@ def render_tables(tables: RobotTables, fmt: str, colour: bool = True) -> bytes:
 
 def tables_graphviz(tables: RobotTables, colour: bool = True) -> graphviz.Digraph:
     robot = tables.robot
-    graph = digraph(_("{robot}: {count} tables, run together on every tick").format(robot=robot.name,
-                                                                                    count=len(tables.tables)))
+    graph = digraph(
+        _("{robot}: {count} tables, run together on every tick").format(robot=robot.name, count=len(tables.tables))
+    )
     for k, table in enumerate(tables.tables):
         with graph.subgraph(name=f"cluster_{k}") as cluster:
             role = _("main table {name}") if k == 0 else _("table {name}")
-            cluster.attr(label=f"<<b>{dot_label(role.format(name=table.name))}</b> {dot_label(table.path)}>",
-                         style="rounded", color="#999999", fontsize="12")
+            cluster.attr(
+                label=f"<<b>{dot_label(role.format(name=table.name))}</b> {dot_label(table.path)}>",
+                style="rounded",
+                color="#999999",
+                fontsize="12",
+            )
             draw_table(cluster, table, colour, prefix=f"{dot_id(table.name)}_")
     graph.node("__legend", _legend(tables, colour), shape="plain", fontsize="9")
     return graph
@@ -56,14 +61,20 @@ def _cross_words(event: CrossEvent) -> str:
     states = either.join(map(str, event.states))
     spans = either.join(_("{low} to {high}").format(low=low, high=high) for low, high in event.ranges)
     return _("table {table} was in state {states} at the start of the tick").format(
-        table=event.table, states=either.join(part for part in (states, spans) if part))
+        table=event.table, states=either.join(part for part in (states, spans) if part)
+    )
 
 
 def tables_mermaid(tables: RobotTables) -> str:
     """A Mermaid ``stateDiagram-v2``: the robot as one composite state, each table a concurrent region."""
     robot = dot_id(f"robot_{tables.robot.name}")
-    out = ["stateDiagram-v2", "    direction LR", f"    [*] --> {robot}",
-           f'    state "{mermaid_label(tables.robot.name)}" as {robot}', f"    state {robot} {{"]
+    out = [
+        "stateDiagram-v2",
+        "    direction LR",
+        f"    [*] --> {robot}",
+        f'    state "{mermaid_label(tables.robot.name)}" as {robot}',
+        f"    state {robot} {{",
+    ]
     for k, table in enumerate(tables.tables):
         if k:
             out.append("        --")

@@ -27,5 +27,13 @@ class Finding:
 
     def as_json(self) -> dict[str, Any]:
         where = {"table": self.table, "file": self.path} if self.table else {}
-        return {"code": self.code, "severity": self.severity, "lines": list(self.lines),
-                "state": self.state, "message": self.message, "hint": self.hint, **where, **self.detail}
+        return {
+            "code": self.code,
+            "severity": self.severity,
+            "lines": list(self.lines),
+            "state": self.state,
+            "message": self.message,
+            "hint": self.hint,
+            **where,
+            **self.detail,
+        }

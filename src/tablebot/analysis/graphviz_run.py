@@ -18,8 +18,10 @@ from tablebot.i18n import N_
 
 PACKAGED = "graphviz-pure"
 SYSTEM = "dot"
-INSTALL = N_("pip install {packaged} (into the Python that runs tablebot), or install Graphviz (its dot program, "
-             "on PATH)", packaged=PACKAGED)
+INSTALL = N_(
+    "pip install {packaged} (into the Python that runs tablebot), or install Graphviz (its dot program, on PATH)",
+    packaged=PACKAGED,
+)
 NOT_FOUND = N_("neither {packaged} nor {system} was found", packaged=PACKAGED, system=SYSTEM)
 
 
@@ -58,8 +60,9 @@ def draw(source: str, fmt: str) -> bytes:
     try:
         done = subprocess.run([program, f"-T{fmt}"], input=source.encode(), capture_output=True, check=False)
     except OSError as exc:  # found but not runnable (a wheel for another machine, no execute bit)
-        raise GraphvizFailed(N_("{program} could not be started: {error}", program=program,
-                                error=str(exc.strerror or exc))) from None
+        raise GraphvizFailed(
+            N_("{program} could not be started: {error}", program=program, error=str(exc.strerror or exc))
+        ) from None
     if done.returncode != 0 or not done.stdout:
         said = done.stderr.decode(errors="replace").strip() or N_("exit status {code}", code=done.returncode)
         raise GraphvizFailed(N_("{program} failed: {said}", program=program, said=said))

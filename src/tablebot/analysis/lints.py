@@ -47,6 +47,7 @@ def _same_effect(a: Row, b: Row) -> bool:
 
 # --- row order --------------------------------------------------------------------------------------
 
+
 def _first_rows(masks: list[int]) -> dict[int, int]:
     """Each distinct event mask of a state's rows -> the first of its rows with that mask."""
     first: dict[int, int] = {}
@@ -74,16 +75,31 @@ def shadowed_rows(table: Table) -> list[Finding]:
             if winner == i:
                 continue
             earlier = rows[winner]
-            needs = (N_("needs only {events}, so it always wins first", events=events_text(table, earlier.events))
-                     if earlier.events else N_("needs no event at all, so it fires first every time"))
-            found.append(Finding(
-                "shadowed-row", "warning",
-                N_("row on line {line} can never fire: in {state} the earlier row on line {earlier} {needs}",
-                   line=row.line, state=state_text(table, state), earlier=earlier.line, needs=needs),
-                (row.line, earlier.line),
-                N_("move this row above line {earlier} if it is the more specific case, or delete it",
-                   earlier=earlier.line), state,
-                {"shadowed_by": earlier.line}))
+            needs = (
+                N_("needs only {events}, so it always wins first", events=events_text(table, earlier.events))
+                if earlier.events
+                else N_("needs no event at all, so it fires first every time")
+            )
+            found.append(
+                Finding(
+                    "shadowed-row",
+                    "warning",
+                    N_(
+                        "row on line {line} can never fire: in {state} the earlier row on line {earlier} {needs}",
+                        line=row.line,
+                        state=state_text(table, state),
+                        earlier=earlier.line,
+                        needs=needs,
+                    ),
+                    (row.line, earlier.line),
+                    N_(
+                        "move this row above line {earlier} if it is the more specific case, or delete it",
+                        earlier=earlier.line,
+                    ),
+                    state,
+                    {"shadowed_by": earlier.line},
+                )
+            )
     return found
 
 
@@ -100,8 +116,9 @@ def overlaps(table: Table) -> list[Finding]:
         for j, later in enumerate(rows):
             mask = masks[j]
             if mask not in partners:
-                partners[mask] = [i for i in candidates if masks[i] & mask != masks[i]
-                                  and _winner(first_with, masks[i] | mask) == i]
+                partners[mask] = [
+                    i for i in candidates if masks[i] & mask != masks[i] and _winner(first_with, masks[i] | mask) == i
+                ]
             for i in partners[mask]:
                 if i >= j:
                     break
@@ -109,15 +126,28 @@ def overlaps(table: Table) -> list[Finding]:
                 if _same_effect(first, later):
                     continue  # same effect means order cannot matter
                 both = first.events | later.events
-                kind = N_("specific before general") if later.events <= first.events else \
-                    N_("neither contains the other")
-                found.append(Finding(
-                    "overlap", "info",
-                    N_("in {state}, when {events} happen together, the rows on lines {first} and {later} both "
-                       "match; line {first} wins because it comes first ({kind})", state=state_text(table, state),
-                       events=events_text(table, both), first=first.line, later=later.line, kind=kind),
-                    (first.line, later.line), "", state,
-                    {"events": sorted(both, key=table.events.index), "winner": first.line}))
+                kind = (
+                    N_("specific before general") if later.events <= first.events else N_("neither contains the other")
+                )
+                found.append(
+                    Finding(
+                        "overlap",
+                        "info",
+                        N_(
+                            "in {state}, when {events} happen together, the rows on lines {first} and {later} both "
+                            "match; line {first} wins because it comes first ({kind})",
+                            state=state_text(table, state),
+                            events=events_text(table, both),
+                            first=first.line,
+                            later=later.line,
+                            kind=kind,
+                        ),
+                        (first.line, later.line),
+                        "",
+                        state,
+                        {"events": sorted(both, key=table.events.index), "winner": first.line},
+                    )
+                )
     return found
 
 
@@ -130,10 +160,17 @@ def ignored_inputs(machine: Machine) -> list[Finding]:
         if not ignored or not rows_of(table, state):
             continue
         names = tuple(event_name(table, n) for n in ignored)
-        found.append(Finding(
-            "ignored-inputs", "info", N_("in {state} the robot does not react to {names}",
-                                         state=state_text(table, state), names=names),
-            (rows_of(table, state)[0].line,), "", state, {"inputs": ignored}))
+        found.append(
+            Finding(
+                "ignored-inputs",
+                "info",
+                N_("in {state} the robot does not react to {names}", state=state_text(table, state), names=names),
+                (rows_of(table, state)[0].line,),
+                "",
+                state,
+                {"inputs": ignored},
+            )
+        )
     return found
 
 
@@ -154,6 +191,7 @@ def _never_matters(machine: Machine, state: int, bit: int) -> bool:
 
 
 # --- reachability -----------------------------------------------------------------------------------
+
 
 @dataclass
 class Seen:
@@ -197,24 +235,46 @@ def _unreachable(machine: Machine, state: StateId, rows: list[Row], seen: Seen) 
     table = machine.table
     into = [r for r in table.rows if r.next == state and r.state != state]
     start = state_text(table, machine.states[machine.initial_state])
-    why = (N_("no row leads to it") if not into else
-           N_("the rows that lead to it ({lines}) can never fire", lines=lines_text(into)))
-    return Finding("unreachable-state", "warning",
-                   N_("{state} can never be reached from the initial {start}: {why}; its rows ({lines}) are dead",
-                      state=state_text(table, state), start=start, why=why, lines=lines_text(rows)),
-                   tuple(r.line for r in rows), N_("add a row that leads here, or delete these rows"), state)
+    why = (
+        N_("no row leads to it")
+        if not into
+        else N_("the rows that lead to it ({lines}) can never fire", lines=lines_text(into))
+    )
+    return Finding(
+        "unreachable-state",
+        "warning",
+        N_(
+            "{state} can never be reached from the initial {start}: {why}; its rows ({lines}) are dead",
+            state=state_text(table, state),
+            start=start,
+            why=why,
+            lines=lines_text(rows),
+        ),
+        tuple(r.line for r in rows),
+        N_("add a row that leads here, or delete these rows"),
+        state,
+    )
 
 
 def _dead_end(table: Table, state: StateId, rows: list[Row], seen: Seen) -> list[Finding]:
     leaving = [r for r in rows if r.next != state]
     if any(r.index in seen.fired for r in leaving):
         return []
-    why = (N_("no row of it leads to another state") if not leaving else
-           N_("the rows that lead out ({lines}) can never fire", lines=lines_text(leaving)))
-    return [Finding("dead-end", "warning",
-                    N_("once the robot is in {state} it can never leave: {why}", state=state_text(table, state),
-                       why=why),
-                    (rows[0].line,), N_("add a row that leads to another state (a timeout on T, say)"), state)]
+    why = (
+        N_("no row of it leads to another state")
+        if not leaving
+        else N_("the rows that lead out ({lines}) can never fire", lines=lines_text(leaving))
+    )
+    return [
+        Finding(
+            "dead-end",
+            "warning",
+            N_("once the robot is in {state} it can never leave: {why}", state=state_text(table, state), why=why),
+            (rows[0].line,),
+            N_("add a row that leads to another state (a timeout on T, say)"),
+            state,
+        )
+    ]
 
 
 def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> list[Finding]:
@@ -226,18 +286,35 @@ def _never_fire(machine: Machine, index: int, silent: list[Row], seen: Seen) -> 
     if waiting_for_t:
         busy = sorted(seen.idle_rows.get(index, set()))
         reload = lines_text([table.rows[i] for i in busy]) if busy else N_("other rows")
-        found.append(Finding(
-            "timer-never-expires", "warning",
-            N_("in {state} the timer never runs out: on every tick a row fires first and reloads it ({reload}), "
-               "so {rows} waiting for T can never fire", state=state_text(table, state), reload=reload,
-               rows=rows_phrase(waiting_for_t)),
-            tuple(r.line for r in waiting_for_t), N_("a row that needs no input fires whenever nothing above it "
-                                                     "matches; give it an input to wait for"), state))
+        found.append(
+            Finding(
+                "timer-never-expires",
+                "warning",
+                N_(
+                    "in {state} the timer never runs out: on every tick a row fires first and reloads it ({reload}), "
+                    "so {rows} waiting for T can never fire",
+                    state=state_text(table, state),
+                    reload=reload,
+                    rows=rows_phrase(waiting_for_t),
+                ),
+                tuple(r.line for r in waiting_for_t),
+                N_("a row that needs no input fires whenever nothing above it matches; give it an input to wait for"),
+                state,
+            )
+        )
     for row in silent:
         if row in waiting_for_t:
             continue
-        found.append(Finding("row-never-fires", "warning", _why_silent(machine, index, row, contexts),
-                             (row.line,), N_("check the order and the events of this state's rows"), state))
+        found.append(
+            Finding(
+                "row-never-fires",
+                "warning",
+                _why_silent(machine, index, row, contexts),
+                (row.line,),
+                N_("check the order and the events of this state's rows"),
+                state,
+            )
+        )
     return found
 
 
@@ -250,31 +327,55 @@ def _why_silent(machine: Machine, index: int, row: Row, contexts: set[int]) -> s
     fits = [c for c in contexts if c & needs == needs]
     if not fits:
         missing = [e for e in mask_events(table, needs) if not any(c & table.bit(e) for c in contexts)]
-        return N_("row on line {line} can never fire: it needs {events}, which never happens while the robot is "
-                  "in {where}", line=row.line, events=events_text(table, missing), where=where)
+        return N_(
+            "row on line {line} can never fire: it needs {events}, which never happens while the robot is in {where}",
+            line=row.line,
+            events=events_text(table, missing),
+            where=where,
+        )
     winners = {machine.lookup(index, c | (mask & machine.input_mask)) for c in fits}
     lines = sorted(table.rows[w].line for w in winners if w != NO_ROW)
     if not lines:  # it needs no event, and no event ever comes here: the document's rule looks up no row
-        return N_("row on line {line} can never fire: it requires no event, and in {where} no event ever comes, "
-                  'so under match = "document" no row is looked up there', line=row.line, where=where)
+        return N_(
+            "row on line {line} can never fire: it requires no event, and in {where} no event ever comes, "
+            'so under match = "document" no row is looked up there',
+            line=row.line,
+            where=where,
+        )
     always = functools.reduce(operator.and_, fits) & ~needs
     also = events_text(table, mask_events(table, always))
     if always:
-        return N_("row on line {line} can never fire: whenever its events happen, the row on line {first} fires "
-                  "first (in {where} there is always {also} as well)", line=row.line,
-                  first=", ".join(map(str, lines)), where=where, also=also)
-    return N_("row on line {line} can never fire: whenever its events happen, the row on line {first} fires first",
-              line=row.line, first=", ".join(map(str, lines)))
+        return N_(
+            "row on line {line} can never fire: whenever its events happen, the row on line {first} fires "
+            "first (in {where} there is always {also} as well)",
+            line=row.line,
+            first=", ".join(map(str, lines)),
+            where=where,
+            also=also,
+        )
+    return N_(
+        "row on line {line} can never fire: whenever its events happen, the row on line {first} fires first",
+        line=row.line,
+        first=", ".join(map(str, lines)),
+    )
 
 
 # --- export limits ----------------------------------------------------------------------------------
+
 
 def encoding(machine: Machine, target: str) -> list[Finding]:
     """What an export target cannot hold, as errors (its exporter would refuse the table): the fit
     check of its back-end (:mod:`tablebot.registry`)."""
     table_path = machine.table.path
-    return [Finding(f"encoding-{target}", "error",
-                    N_("{target}: {problem}", target=target, problem=d.message) if d.path == table_path else
-                    N_("{target}: {problem} ({where})", target=target, problem=d.message, where=d.location()),
-                    (d.line,) if d.line is not None and d.path == table_path else (), d.hint)
-            for d in registry.get(target).problems(machine)]
+    return [
+        Finding(
+            f"encoding-{target}",
+            "error",
+            N_("{target}: {problem}", target=target, problem=d.message)
+            if d.path == table_path
+            else N_("{target}: {problem} ({where})", target=target, problem=d.message, where=d.location()),
+            (d.line,) if d.line is not None and d.path == table_path else (),
+            d.hint,
+        )
+        for d in registry.get(target).problems(machine)
+    ]

@@ -35,16 +35,37 @@ def zero_time_loops(graph: Graph) -> list[Finding]:
         path = state_text(table, states[0]) if len(states) < 2 else _arrows([state_text(table, s) for s in states])
         goes = N_("cycles {path}", path=path) if len(states) > 1 else N_("stays in {path}", path=path)
         several = len({r.line for r in row_objs}) > 1
-        message = N_("zero-time loop: {rows} fire on every tick with no input pressed, so the robot {goes} without "
-                     "ever waiting", rows=rows_phrase(row_objs), goes=goes) if several else \
-            N_("zero-time loop: {rows} fires on every tick with no input pressed, so the robot {goes} without ever "
-               "waiting", rows=rows_phrase(row_objs), goes=goes)
-        message = N_("{loop} and no input can ever get it out: it is stuck for good", loop=message) if trapped \
+        message = (
+            N_(
+                "zero-time loop: {rows} fire on every tick with no input pressed, so the robot {goes} without "
+                "ever waiting",
+                rows=rows_phrase(row_objs),
+                goes=goes,
+            )
+            if several
+            else N_(
+                "zero-time loop: {rows} fires on every tick with no input pressed, so the robot {goes} without ever "
+                "waiting",
+                rows=rows_phrase(row_objs),
+                goes=goes,
+            )
+        )
+        message = (
+            N_("{loop} and no input can ever get it out: it is stuck for good", loop=message)
+            if trapped
             else N_("{loop}; it only leaves when an input arrives", loop=message)
-        found.append(Finding("zero-time-loop", "error" if trapped else "warning", message,
-                             tuple(r.line for r in row_objs),
-                             N_("load a timer above 0 and wait for T, or wait for an input"), states[0],
-                             {"states": states}))
+        )
+        found.append(
+            Finding(
+                "zero-time-loop",
+                "error" if trapped else "warning",
+                message,
+                tuple(r.line for r in row_objs),
+                N_("load a timer above 0 and wait for T, or wait for an input"),
+                states[0],
+                {"states": states},
+            )
+        )
     return found
 
 

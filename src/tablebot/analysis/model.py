@@ -90,8 +90,7 @@ class Model:
     def initial(self) -> Node:
         m = self.machine
         # The engine starts with every counter at 0, so their events are present from tick 0.
-        return (m.initial_state, self.timer_class(m.initial_timer), self.tracked,
-                (0,) * len(m.output_names), True)
+        return (m.initial_state, self.timer_class(m.initial_timer), self.tracked, (0,) * len(m.output_names), True)
 
     def counter_events(self, zero: int) -> int:
         return sum(bit for i, bit in enumerate(self.counter_event) if zero >> i & 1)
@@ -114,8 +113,9 @@ class Model:
             spare = m.input_mask & ~bits
             bits |= spare & -spare
         if bits.bit_count() > MAX_ENUMERATED_BITS:
-            raise ModelTooLarge(N_("state {state} depends on {count} inputs", state=m.states[state],
-                                   count=bits.bit_count()))
+            raise ModelTooLarge(
+                N_("state {state} depends on {count} inputs", state=m.states[state], count=bits.bit_count())
+            )
         seen: dict[tuple[int, int], int] = {}
         for inputs in sorted(subsets(bits), key=lambda x: (x.bit_count(), x)):
             events = inputs | context

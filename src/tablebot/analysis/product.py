@@ -55,8 +55,9 @@ class ProductModel:
         self.timer_word = 1 << self.width  # the main table's T in the event word
         robot = tables.robot
         self.counter_word = tuple(1 << (self.width + 1 + c) for c in range(len(robot.counters)))
-        self.tracked = sum(1 << c for c, name in enumerate(robot.counter_names)
-                           if any(m.counter_bits[c] for m in tables.machines))
+        self.tracked = sum(
+            1 << c for c, name in enumerate(robot.counter_names) if any(m.counter_bits[c] for m in tables.machines)
+        )
         self.engine = Several(tables)  # its input and cross-table maps, made once
         self.active = tuple(k for k in range(len(tables.machines)) if self.relevant is None or k in self.relevant)
         self.writers = [tables.writer(name) for name in tables.output_names]
@@ -76,8 +77,13 @@ class ProductModel:
     def initial(self) -> PNode:
         machines = self.tables.machines
         timers = tuple(self.timer_class(m.initial_timer) if k in self.active else 0 for k, m in enumerate(machines))
-        return (tuple(m.initial_state for m in machines), timers, self.tracked, (0,) * len(self.tables.output_names),
-                True)
+        return (
+            tuple(m.initial_state for m in machines),
+            timers,
+            self.tracked,
+            (0,) * len(self.tables.output_names),
+            True,
+        )
 
     def successors(self, node: PNode) -> list[PTick]:
         return memoised(self._succ, node, self._expand)
@@ -96,8 +102,11 @@ class ProductModel:
                 if key in seen:
                     continue
                 seen.add(key)
-                word = mask | (self.timer_word if after[0] == 0 else 0) | sum(
-                    bit for c, bit in enumerate(self.counter_word) if now_zero >> c & 1)
+                word = (
+                    mask
+                    | (self.timer_word if after[0] == 0 else 0)
+                    | sum(bit for c, bit in enumerate(self.counter_word) if now_zero >> c & 1)
+                )
                 for nxt in self._fire(rows, states, after, now_zero, outputs, first):
                     yield word, zeroed, rows[0], nxt
 
@@ -118,8 +127,15 @@ class ProductModel:
             rows.append(machine.lookup(states[k], events))
         return tuple(rows)
 
-    def _fire(self, rows: tuple[int, ...], states: tuple[int, ...], timers: tuple[int, ...], zero: int,
-              outputs: tuple[int, ...], first: bool) -> Iterator[PNode]:
+    def _fire(
+        self,
+        rows: tuple[int, ...],
+        states: tuple[int, ...],
+        timers: tuple[int, ...],
+        zero: int,
+        outputs: tuple[int, ...],
+        first: bool,
+    ) -> Iterator[PNode]:
         """The nodes after the tables fire ``rows``: a table above the horizon that fires nothing may also have
         just come down to it."""
         machines = self.tables.machines
@@ -170,4 +186,3 @@ def _longest(tables: RobotTables, relevant: frozenset[int] | None) -> int:
     """The longest timer value the (relevant) tables load or start with: the horizon of the exact model."""
     machines = [m for k, m in enumerate(tables.machines) if relevant is None or k in relevant]
     return max([1, *(r.timer for m in machines for r in m.rows), *(m.initial_timer for m in machines)])
-

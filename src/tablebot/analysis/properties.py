@@ -32,8 +32,12 @@ from tablebot.tomlfile import Source
 
 KINDS = ("never", "always", "reachable", "always_reachable", "when")
 #: How :meth:`Property.claim` says each kind but ``when`` (the condition is the user's, as written).
-CLAIMS = {"never": N_("never: {cond}"), "always": N_("always: {cond}"), "reachable": N_("reachable: {cond}"),
-          "always_reachable": N_("always reachable: {cond}")}
+CLAIMS = {
+    "never": N_("never: {cond}"),
+    "always": N_("always: {cond}"),
+    "reachable": N_("reachable: {cond}"),
+    "always_reachable": N_("always reachable: {cond}"),
+}
 KEYS = {"text", "level", "note", "never", "always", "reachable", "always_reachable", "when", "then", "within"}
 LEVELS = ("error", "warning")
 PROPERTY_FILES = ("{stem}.properties.toml", "properties.toml")
@@ -79,8 +83,13 @@ class Property:
     def claim(self) -> str:
         """The claim in tablebot's words, e.g. ``never: state == 20 and M1 > 0``."""
         if self.kind == "when":
-            return NP_("when {when}, then {then} within {n} tick", "when {when}, then {then} within {n} ticks",
-                       self.within, when=self.when.text, then=self.then.text)  # type: ignore[union-attr]
+            return NP_(
+                "when {when}, then {then} within {n} tick",
+                "when {when}, then {then} within {n} ticks",
+                self.within,
+                when=self.when.text,  # type: ignore[union-attr]
+                then=self.then.text,  # type: ignore[union-attr]
+            )
         return Message(CLAIMS[self.kind].msgid, {"cond": self.cond.text})  # type: ignore[union-attr]
 
 
@@ -109,8 +118,12 @@ def load_properties(machine: Machine, files: list[Path], tables: RobotTables | N
     errors = []
     for src, entries, section in sources:
         if not isinstance(entries, dict):
-            src.out.error(src.line("", None, "properties"), None, N_("properties must be named tables"),
-                          N_("write [properties.my_name] (robot file) or [my_name] (properties file)"))
+            src.out.error(
+                src.line("", None, "properties"),
+                None,
+                N_("properties must be named tables"),
+                N_("write [properties.my_name] (robot file) or [my_name] (properties file)"),
+            )
         else:
             for name, entry in entries.items():
                 line = src.line(f"{section}.{name}" if section else name) or src.line(section, None, name)
@@ -123,87 +136,144 @@ def load_properties(machine: Machine, files: list[Path], tables: RobotTables | N
     return found
 
 
-def _property(name: str, entry: Any, machine: Machine, out: Collector, source: str,
-              line: int | None, tables: RobotTables | None = None) -> Property | None:
+def _property(
+    name: str,
+    entry: Any,
+    machine: Machine,
+    out: Collector,
+    source: str,
+    line: int | None,
+    tables: RobotTables | None = None,
+) -> Property | None:
     """One property table, or None after reporting everything wrong with it."""
     if not isinstance(entry, dict):
-        out.error(line, None, N_("property {name!r} must be a table of keys", name=name),
-                  N_('write [{name}] followed by lines like never = "state == 3"', name=name))
+        out.error(
+            line,
+            None,
+            N_("property {name!r} must be a table of keys", name=name),
+            N_('write [{name}] followed by lines like never = "state == 3"', name=name),
+        )
         return None
     before = len(out.items)
     if not NAME_RE.match(name):
-        out.error(line, None, N_("property name {name!r} cannot name a file", name=name),
-                  N_("use letters, digits, spaces, _ . and - (its counterexample is written to NAME.csv)"))
+        out.error(
+            line,
+            None,
+            N_("property name {name!r} cannot name a file", name=name),
+            N_("use letters, digits, spaces, _ . and - (its counterexample is written to NAME.csv)"),
+        )
     kind = _kind(name, entry, line, out)
     if kind is None:
         return None
     fields = _claims(name, entry, kind, machine, line, out, tables)
     if len(out.items) > before:
         return None
-    return Property(name=name, text=str(entry.get("text", name)), kind=kind, level=entry.get("level", "error"),
-                    note=str(entry.get("note", "")), source=source, line=line, **fields)
+    return Property(
+        name=name,
+        text=str(entry.get("text", name)),
+        kind=kind,
+        level=entry.get("level", "error"),
+        note=str(entry.get("note", "")),
+        source=source,
+        line=line,
+        **fields,
+    )
 
 
 def _kind(name: str, entry: dict[str, Any], line: int | None, out: Collector) -> str | None:
     """The property's kind (exactly one of KINDS must be given); the other keys are checked on the way."""
     for key in entry:
         if key not in KEYS:
-            out.error(line, None, N_("property {name}: unknown key {key!r}", name=name, key=key),
-                      N_("known keys: {known}", known=", ".join(sorted(KEYS))))
+            out.error(
+                line,
+                None,
+                N_("property {name}: unknown key {key!r}", name=name, key=key),
+                N_("known keys: {known}", known=", ".join(sorted(KEYS))),
+            )
     level = entry.get("level", "error")
     if level not in LEVELS:
-        out.error(line, None, N_("property {name}: level must be error or warning, not {level!r}", name=name,
-                                 level=level),
-                  N_('write level = "warning" to make a violation a warning, or leave level out'))
+        out.error(
+            line,
+            None,
+            N_("property {name}: level must be error or warning, not {level!r}", name=name, level=level),
+            N_('write level = "warning" to make a violation a warning, or leave level out'),
+        )
     for key in ("text", "note"):
         if not isinstance(entry.get(key, ""), str):
-            out.error(line, None, N_("property {name}: {key} must be text, not {value!r}", name=name, key=key,
-                                     value=entry[key]),
-                      N_('write it in quotes: {key} = "…"', key=key))
+            out.error(
+                line,
+                None,
+                N_("property {name}: {key} must be text, not {value!r}", name=name, key=key, value=entry[key]),
+                N_('write it in quotes: {key} = "…"', key=key),
+            )
     kinds = [k for k in KINDS if k in entry]
     if len(kinds) != 1:
-        out.error(line, None, N_("property {name} needs exactly one of {kinds} (found {found})", name=name,
-                                 kinds=", ".join(KINDS), found=len(kinds)),
-                  N_('for example: never = "state == 20 and M1 > 0"'))
+        out.error(
+            line,
+            None,
+            N_(
+                "property {name} needs exactly one of {kinds} (found {found})",
+                name=name,
+                kinds=", ".join(KINDS),
+                found=len(kinds),
+            ),
+            N_('for example: never = "state == 20 and M1 > 0"'),
+        )
         return None
     return kinds[0]
 
 
-def _claims(name: str, entry: dict[str, Any], kind: str, machine: Machine, line: int | None,
-            out: Collector, tables: RobotTables | None = None) -> dict[str, Any]:
+def _claims(
+    name: str,
+    entry: dict[str, Any],
+    kind: str,
+    machine: Machine,
+    line: int | None,
+    out: Collector,
+    tables: RobotTables | None = None,
+) -> dict[str, Any]:
     """The parsed conditions (and ``within``) of a property of ``kind``, as Property fields."""
 
     def condition(key: str) -> Condition | None:
         value = entry.get(key)
         if not isinstance(value, str):
-            out.error(line, None, N_("property {name}: {key} must be a condition in quotes", name=name, key=key),
-                      N_('for example: {key} = "state == 20"', key=key))
+            out.error(
+                line,
+                None,
+                N_("property {name}: {key} must be a condition in quotes", name=name, key=key),
+                N_('for example: {key} = "state == 20"', key=key),
+            )
             return None
         try:
             return parse_condition(value, machine, tables)
         except ConditionError as exc:
-            out.error(line, None, N_("property {name}: {key}: {problem}", name=name, key=key, problem=exc.problem),
-                      N_("see the condition language in docs/checking.md"))
+            out.error(
+                line,
+                None,
+                N_("property {name}: {key}: {problem}", name=name, key=key, problem=exc.problem),
+                N_("see the condition language in docs/checking.md"),
+            )
             return None
 
     if kind != "when":
         return {"cond": condition(kind)}
-    return {"when": condition("when"), "then": condition("then"),
-            "within": _duration(entry.get("within"), machine.table.robot.tick_ms, name, line, out)}
+    return {
+        "when": condition("when"),
+        "then": condition("then"),
+        "within": _duration(entry.get("within"), machine.table.robot.tick_ms, name, line, out),
+    }
 
 
 def _duration(value: Any, tick_ms: int, name: str, line: int | None, out: Collector) -> int:
     """``within`` in ticks, from a number of ticks or a text like "10 ms", "1 tick", "0.5 s"."""
     hint = N_('write within = "100 ms" or "3 ticks" (one tick is {tick} ms)', tick=tick_ms)
     if value is None:
-        out.error(line, None, N_("property {name}: within is missing (when/then needs a time limit)", name=name),
-                  hint)
+        out.error(line, None, N_("property {name}: within is missing (when/then needs a time limit)", name=name), hint)
         return 0
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
         return value
     if not isinstance(value, str):
-        out.error(line, None, N_("property {name}: within = {value!r} is not a duration", name=name, value=value),
-                  hint)
+        out.error(line, None, N_("property {name}: within = {value!r} is not a duration", name=name, value=value), hint)
         return 0
     try:
         return to_ticks(value, tick_ms)

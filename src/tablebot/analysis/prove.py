@@ -48,6 +48,7 @@ class Result:
 
 # --- monitors ---------------------------------------------------------------------------------------
 
+
 class Monitor:
     """Reads ticks; ``step`` returns the next monitor state or VIOLATION."""
 
@@ -109,11 +110,16 @@ def first_violation(prop: Property, machine: Machine, lines: Iterable[dict[str, 
 
 def obs_of_line(machine: Machine, line: dict[str, Any]) -> Obs:
     row = NO_ROW if line["row"] is None else int(line["row"])
-    return (int(line["event"]), row, machine.states.index(line["state"]),
-            tuple(int(line[name]) for name in machine.output_names))
+    return (
+        int(line["event"]),
+        row,
+        machine.states.index(line["state"]),
+        tuple(int(line[name]) for name in machine.output_names),
+    )
 
 
 # --- search -----------------------------------------------------------------------------------------
+
 
 def search(model: Model, monitor: Monitor, budget: int = 10_000_000) -> tuple[Path | None, int]:
     """Breadth-first over (node, monitor state): the shortest path to a violation, and pairs visited."""
@@ -182,6 +188,7 @@ def trapped(graph: Graph, good: Any) -> tuple[Path | None, set[Node]]:
 
 # --- checking ---------------------------------------------------------------------------------------
 
+
 def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET) -> Result:
     """Prove ``prop`` or find its shortest counterexample (for ``reachable``: its shortest witness)."""
     if prop.kind == "always_reachable":
@@ -190,10 +197,14 @@ def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET)
     try:
         path, explored = search(model, monitor_of(prop))
     except ModelTooLarge as exc:
-        detail = N_("too large to search ({reason}); a shorter within makes it smaller", reason=exc.args[0]) \
-            if prop.kind == "when" else \
-            N_("too large to search ({reason}); a condition that reads fewer inputs makes it smaller",
-               reason=exc.args[0])
+        detail = (
+            N_("too large to search ({reason}); a shorter within makes it smaller", reason=exc.args[0])
+            if prop.kind == "when"
+            else N_(
+                "too large to search ({reason}); a condition that reads fewer inputs makes it smaller",
+                reason=exc.args[0],
+            )
+        )
         return Result(prop, "unknown", detail=detail)
     reachable = prop.kind == "reachable"
     if path is None:
@@ -211,8 +222,9 @@ def check_property(prop: Property, machine: Machine, budget: int = EXACT_BUDGET)
         return _confirmed(prop, machine, model, path, explored, reachable, exact=False)
 
 
-def _confirmed(prop: Property, machine: Machine, model: Model, path: Path, explored: int,
-               reachable: bool, exact: bool) -> Result:
+def _confirmed(
+    prop: Property, machine: Machine, model: Model, path: Path, explored: int, reachable: bool, exact: bool
+) -> Result:
     """Turn a path into inputs and replay them on the engine: only what shows there is reported."""
     inputs, _ = model.concretize(path)
     shown = first_violation(prop, machine, replay(machine, inputs))
@@ -237,9 +249,16 @@ def _check_always_reachable(prop: Property, machine: Machine, budget: int) -> Re
         pass
     inputs, _ = model.concretize(path or [])
     state = machine.states[path[-1][1][3][0]] if path else machine.states[machine.initial_state]
-    return Result(prop, "violated", explored, inputs, len(inputs) - 1 if inputs else None,
-                  state=state, exact=model.is_exact,
-                  detail=N_("from state {state} on, no inputs can ever make it happen again", state=state))
+    return Result(
+        prop,
+        "violated",
+        explored,
+        inputs,
+        len(inputs) - 1 if inputs else None,
+        state=state,
+        exact=model.is_exact,
+        detail=N_("from state {state} on, no inputs can ever make it happen again", state=state),
+    )
 
 
 #: A result's words shared with tablebot.analysis.prove_product.

@@ -28,11 +28,17 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
         model = ProductModel(tables, prop.horizon, prop.watch, relevant)
         path, explored = search(model, monitor_of(prop))  # type: ignore[arg-type]  # same interface as Model
     except ModelTooLarge as exc:
-        return Result(prop, "unknown", detail=N_("too large to search ({reason}); a condition that reads fewer "
-                                                 "inputs or a shorter within makes it smaller", reason=exc.args[0]))
+        return Result(
+            prop,
+            "unknown",
+            detail=N_(
+                "too large to search ({reason}); a condition that reads fewer "
+                "inputs or a shorter within makes it smaller",
+                reason=exc.args[0],
+            ),
+        )
     if path is None:
-        return Result(prop, "violated" if reachable else "holds", explored,
-                      detail=NEVER if reachable else "")
+        return Result(prop, "violated" if reachable else "holds", explored, detail=NEVER if reachable else "")
     try:
         exact = model if model.is_exact else ProductModel.exact(tables, prop.watch, relevant)
         if exact is not model:
@@ -46,8 +52,9 @@ def check_product_property(prop: Property, tables: RobotTables, budget: int = EX
     shown = first_violation(prop, tables, inputs)
     if shown is None:
         return Result(prop, "unknown", explored, detail=NO_REPLAY)
-    return Result(prop, "holds" if reachable else "violated", explored, inputs[: shown + 1], shown,
-                  exact=model.is_exact)
+    return Result(
+        prop, "holds" if reachable else "violated", explored, inputs[: shown + 1], shown, exact=model.is_exact
+    )
 
 
 def _always_reachable(prop: Property, tables: RobotTables, budget: int) -> Result:
@@ -65,11 +72,17 @@ def _always_reachable(prop: Property, tables: RobotTables, budget: int) -> Resul
         pass
     inputs, _ = model.concretize(path or [])  # type: ignore[arg-type]
     states: tuple[int, ...] = path[-1][1][3][0] if path else model.initial()[0]  # type: ignore[assignment]
-    state = ", ".join(f"{name} {m.states[s]}" for name, m, s in zip(tables.names, tables.machines, states,
-                                                                    strict=True))
-    return Result(prop, "violated", len(graph.nodes), inputs, len(inputs) - 1 if inputs else None, state=state,
-                  exact=model.is_exact, detail=N_("from {state} on, no inputs can ever make it happen again",
-                                                  state=state))
+    state = ", ".join(f"{name} {m.states[s]}" for name, m, s in zip(tables.names, tables.machines, states, strict=True))
+    return Result(
+        prop,
+        "violated",
+        len(graph.nodes),
+        inputs,
+        len(inputs) - 1 if inputs else None,
+        state=state,
+        exact=model.is_exact,
+        detail=N_("from {state} on, no inputs can ever make it happen again", state=state),
+    )
 
 
 def first_violation(prop: Property, tables: RobotTables, inputs: Sequence[TickInput]) -> int | None:
@@ -91,8 +104,9 @@ def observe(tables: RobotTables, inputs: Sequence[TickInput]) -> Iterator[Obs]:
     for n, tick in enumerate(inputs):
         before = robot.counters
         robot.step(tick.mask, tick.pulses)
-        counted = before if n == 0 else [max(0, c - p) for c, p in zip(before, tick.pulses or [0] * len(before),
-                                                                        strict=True)]
+        counted = (
+            before if n == 0 else [max(0, c - p) for c, p in zip(before, tick.pulses or [0] * len(before), strict=True)]
+        )
         word = tick.mask | (1 << width if robot.engines[0].event & main.timer_bit else 0)
         word |= sum(1 << (width + 1 + c) for c, value in enumerate(counted) if value == 0)
         yield word, robot.engines[0].row, tuple(e.state for e in robot.engines), robot.outputs

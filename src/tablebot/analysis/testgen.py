@@ -57,8 +57,9 @@ def generate(machine: Machine) -> GoldenSet:
     try:
         graph = model.explore()
     except ModelTooLarge as exc:
-        raise fail(machine.table.path, N_("too large to explore: {reason}", reason=exc.args[0]),
-                   N_("split the table")) from None
+        raise fail(
+            machine.table.path, N_("too large to explore: {reason}", reason=exc.args[0]), N_("split the table")
+        ) from None
     golden = GoldenSet(machine, fireable=graph.fired_rows())
     while golden.fireable - golden.covered:
         path = _sequence(model, golden.fireable - golden.covered)
@@ -109,8 +110,11 @@ def _reasons(machine: Machine, graph: Graph, golden: GoldenSet) -> dict[int, str
         if finding.code in REASON_CODES:
             for line in finding.lines[:1] if finding.code == "shadowed-row" else finding.lines:
                 by_line.setdefault(line, finding.message)
-    return {row.index: by_line.get(row.line, "not reached by the generated sequences")
-            for row in machine.table.rows if row.index not in golden.covered}
+    return {
+        row.index: by_line.get(row.line, "not reached by the generated sequences")
+        for row in machine.table.rows
+        if row.index not in golden.covered
+    }
 
 
 def write_golden(golden: GoldenSet, out: Path) -> None:
@@ -130,15 +134,34 @@ def coverage(golden: GoldenSet) -> dict:
     for seq in golden.sequences:
         for row in seq.rows:
             fired_by.setdefault(row, []).append(seq.name)
-    rows = [{"line": r.line, "row": r.index, "state": r.state, "description": r.description,
-             "covered": r.index in golden.covered, "fired_by": fired_by.get(r.index, []),
-             **({"why_not": golden.reasons[r.index]} if r.index in golden.reasons else {})}
-            for r in table.rows]
-    return {"table": table.path, "rows_total": len(table.rows), "rows_fireable": len(golden.fireable),
-            "rows_covered": len(golden.covered),
-            "sequences": [{"inputs": s.inputs_name, "trace": s.trace_name, "ticks": len(s.inputs),
-                           "lines_fired": [table.rows[i].line for i in s.rows]} for s in golden.sequences],
-            "rows": rows}
+    rows = [
+        {
+            "line": r.line,
+            "row": r.index,
+            "state": r.state,
+            "description": r.description,
+            "covered": r.index in golden.covered,
+            "fired_by": fired_by.get(r.index, []),
+            **({"why_not": golden.reasons[r.index]} if r.index in golden.reasons else {}),
+        }
+        for r in table.rows
+    ]
+    return {
+        "table": table.path,
+        "rows_total": len(table.rows),
+        "rows_fireable": len(golden.fireable),
+        "rows_covered": len(golden.covered),
+        "sequences": [
+            {
+                "inputs": s.inputs_name,
+                "trace": s.trace_name,
+                "ticks": len(s.inputs),
+                "lines_fired": [table.rows[i].line for i in s.rows],
+            }
+            for s in golden.sequences
+        ],
+        "rows": rows,
+    }
 
 
 __all__ = ["GoldenSet", "coverage", "generate", "write_golden"]

@@ -29,14 +29,34 @@ if TYPE_CHECKING:
 
 #: Each public name and the module of this package that defines it.
 _HOMES = {
-    "open": "project", "Project": "project",
-    "Simulation": "simulation", "Check": "checking", "PropertyResult": "checking", "Sweep": "sweeping",
-    "Tuning": "tuning", "Evolution": "evolution", "Connection": "running", "LiveRun": "running",
-    "Progress": "progress", "Stopped": "progress",
+    "open": "project",
+    "Project": "project",
+    "Simulation": "simulation",
+    "Check": "checking",
+    "PropertyResult": "checking",
+    "Sweep": "sweeping",
+    "Tuning": "tuning",
+    "Evolution": "evolution",
+    "Connection": "running",
+    "LiveRun": "running",
+    "Progress": "progress",
+    "Stopped": "progress",
 }
 
-__all__ = ["Check", "Connection", "Evolution", "LiveRun", "Progress", "Project", "PropertyResult", "Simulation",
-           "Stopped", "Sweep", "Tuning", "open"]
+__all__ = [
+    "Check",
+    "Connection",
+    "Evolution",
+    "LiveRun",
+    "Progress",
+    "Project",
+    "PropertyResult",
+    "Simulation",
+    "Stopped",
+    "Sweep",
+    "Tuning",
+    "open",
+]
 
 
 def __getattr__(name: str) -> Any:

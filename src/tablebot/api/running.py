@@ -73,8 +73,13 @@ class Connection:
     #: A robot of several tables on a controller or the simulator: all of them, stepped together.
     tables: RobotTables | None = None
 
-    def run(self, seconds: float | None = None, out: PathLike | None = None, sinks: Sequence[Sink] = (),
-            progress: Progress | None = None) -> LiveRun:
+    def run(
+        self,
+        seconds: float | None = None,
+        out: PathLike | None = None,
+        sinks: Sequence[Sink] = (),
+        progress: Progress | None = None,
+    ) -> LiveRun:
         """Drive the robot for ``seconds`` (None: until Ctrl-C), paced by the wall clock, ``sinks`` seeing every
         tick (the command's live view); with ``out`` the trace and summary are written there as it goes. The
         robot's outputs are off on every way out."""
@@ -92,16 +97,23 @@ class Connection:
         sys.setswitchinterval(0.001)  # a live view's thread hands the interpreter back within 1 ms, not 5
         try:
             engine = RobotEngine(self.tables) if self.tables is not None else Engine(machine)
-            end = run(engine, self.opened.robot, clock=RealTimeClock(tick_s),
-                      sinks=[*sinks, *([trace] if trace is not None else [])], ticks=ticks, target=self.opened.where,
-                      behind_limit_s=self.behind_limit or None)
+            end = run(
+                engine,
+                self.opened.robot,
+                clock=RealTimeClock(tick_s),
+                sinks=[*sinks, *([trace] if trace is not None else [])],
+                ticks=ticks,
+                target=self.opened.where,
+                behind_limit_s=self.behind_limit or None,
+            )
         finally:
             sys.setswitchinterval(switch)
         return LiveRun(end, tuple(trace.files) if trace is not None else ())
 
 
-def connect(project: Loaded, on: str, *, link_timeout: float | None = None, behind_limit: float = 0.5,
-            seed: int = 1) -> Connection:
+def connect(
+    project: Loaded, on: str, *, link_timeout: float | None = None, behind_limit: float = 0.5, seed: int = 1
+) -> Connection:
     """Open the live robot ``on`` names (``txt://192.168.7.2``, ``robotx://auto``, ``roboif:///dev/ttyUSB0``,
     ``sim`` or ``sim:WORLD.toml``, ...) for the table: ``link_timeout`` seconds without a valid reply end a
     run as ``link_lost`` (default: 5 ticks); a run ends as ``behind`` when the table's time falls

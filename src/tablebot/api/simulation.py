@@ -82,9 +82,20 @@ class Simulation:
             return _save(self, folder, painter, gif, html)
 
 
-def simulate(project: Loaded, seconds: float = 120.0, seed: int = 1, *, world: PathLike | None = None,
-             battery: float | None = None, out: PathLike | None = None, plots: bool = True, gif: bool = False,
-             html: bool = False, every_row: bool = False, progress: Progress | None = None) -> Simulation:
+def simulate(
+    project: Loaded,
+    seconds: float = 120.0,
+    seed: int = 1,
+    *,
+    world: PathLike | None = None,
+    battery: float | None = None,
+    out: PathLike | None = None,
+    plots: bool = True,
+    gif: bool = False,
+    html: bool = False,
+    every_row: bool = False,
+    progress: Progress | None = None,
+) -> Simulation:
     """Simulate ``seconds`` of the robot running the table (``tablebot sim``): in ``world`` (default: the
     project's), with ``battery`` its charge at the start (0..1; default: the world's), every noise drawn
     from ``seed`` (same seed, same trace). Without ``out`` the run stays in memory (:meth:`Simulation.save`
@@ -119,8 +130,17 @@ def _in_memory(scene: Scene, seconds: float, seed: int, progress: Progress) -> S
     return Simulation(result, summarise(result) if result.end.complete else None)
 
 
-def _into(scene: Scene, seconds: float, seed: int, out: Path, painter: Painter | None, gif: bool, html: bool,
-          every_row: bool, progress: Progress) -> Simulation:
+def _into(
+    scene: Scene,
+    seconds: float,
+    seed: int,
+    out: Path,
+    painter: Painter | None,
+    gif: bool,
+    html: bool,
+    every_row: bool,
+    progress: Progress,
+) -> Simulation:
     """The run written into ``out`` as it goes, once the painter (if any) is on its way."""
     import numpy as np
 
@@ -151,8 +171,9 @@ def _into(scene: Scene, seconds: float, seed: int, out: Path, painter: Painter |
     return Simulation(result, summary, tuple(written))
 
 
-def _run(scene: Scene, seconds: float, seed: int, progress: Progress, sinks: list[Sink] | None = None,
-         **kept: Any) -> SimRun:
+def _run(
+    scene: Scene, seconds: float, seed: int, progress: Progress, sinks: list[Sink] | None = None, **kept: Any
+) -> SimRun:
     """The run, telling ``progress`` the ticks done after each block (a first run compiles the simulator
     before its first tick: ``progress.compiling`` is told first)."""
     from tablebot.sim.physics.kernel import run_robot
@@ -287,6 +308,7 @@ def _pictures(result: SimRun, summary: Summary, out: Path, painter: Painter | No
     written = painter.draw(result, summary, out) if painter is not None else []
     if gif:
         from tablebot.sim.pictures.animate import write_gif
+
         written.append(write_gif(result, summary, out / "run.gif"))
     return written
 

@@ -31,9 +31,19 @@ def blocks(run: SimRun, size: int) -> Iterator[TickBlock]:
     hist = run.kept_rows()
     for a in range(0, run.ticks, size):
         b = min(a + size, run.ticks)
-        yield TickBlock(a, run.masks[a:b], run.pulses[a:b], run.events[a:b], run.rows[a:b], run.states[a:b],
-                        run.timers[a:b], run.outputs[a:b], run.counters[a:b], LazyColumns(run.scene, hist[a:b]),
-                        hist[a:b])
+        yield TickBlock(
+            a,
+            run.masks[a:b],
+            run.pulses[a:b],
+            run.events[a:b],
+            run.rows[a:b],
+            run.states[a:b],
+            run.timers[a:b],
+            run.outputs[a:b],
+            run.counters[a:b],
+            LazyColumns(run.scene, hist[a:b]),
+            hist[a:b],
+        )
 
 
 def _state_column(machine: Machine) -> tuple[Any, np.ndarray]:
@@ -90,13 +100,17 @@ def _with_others(trace: np.ndarray, run: SimRun) -> np.ndarray:
         return trace
     fields: list[tuple[str, Any]] = []
     for name, machine in zip(tables.names[1:], tables.machines[1:], strict=True):
-        fields += [(f"{name}.event", np.int64), (f"{name}.row", np.int32),
-                   (f"{name}.state", _state_column(machine)[0]), (f"{name}.timer", np.int64)]
+        fields += [
+            (f"{name}.event", np.int64),
+            (f"{name}.row", np.int32),
+            (f"{name}.state", _state_column(machine)[0]),
+            (f"{name}.timer", np.int64),
+        ]
     out = np.zeros(len(trace), dtype=np.dtype([*_fields(trace.dtype), *fields]))
     for name in trace.dtype.names or ():
         out[name] = trace[name]
     for key, _ in fields:
-        values = run.others[key][:len(trace)]
+        values = run.others[key][: len(trace)]
         out[key] = [-1 if v is None else v for v in values] if key.endswith(".row") else values
     return out
 

@@ -55,9 +55,12 @@ def main() -> None:
         else:
             where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
             place = f" at {os.path.basename(where.filename)}:{where.lineno}" if where else ""
-            print(f"tablebot: internal error: {type(exc).__name__}{place}: {str(exc)[:200]!r}; this is a bug in "
-                  f"tablebot: please report it with the command and the files it read "
-                  f"(run again with {DEBUG_ENV}=1 to see the traceback)", file=sys.stderr)
+            print(
+                f"tablebot: internal error: {type(exc).__name__}{place}: {str(exc)[:200]!r}; this is a bug in "
+                f"tablebot: please report it with the command and the files it read "
+                f"(run again with {DEBUG_ENV}=1 to see the traceback)",
+                file=sys.stderr,
+            )
         sys.exit(INTERNAL_ERROR)
 
 
@@ -69,7 +72,13 @@ def _choose_language() -> None:
     except LanguageError as exc:
         from tablebot.cli.common import print_diagnostic
 
-        print_diagnostic(Diagnostic(exc.where, None, None, N_("{value!r} is not a language tablebot speaks",
-                                                              value=exc.value),
-                                    N_("use one of: {choices}", choices=", ".join(LANGUAGES))))
+        print_diagnostic(
+            Diagnostic(
+                exc.where,
+                None,
+                None,
+                N_("{value!r} is not a language tablebot speaks", value=exc.value),
+                N_("use one of: {choices}", choices=", ".join(LANGUAGES)),
+            )
+        )
         sys.exit(2)

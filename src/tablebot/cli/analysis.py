@@ -54,15 +54,23 @@ class Format(StrEnum):
 def check_cmd(
     table: Path = TABLE_ARG,
     robot: Path | None = ROBOT_OPT,
-    properties: list[Path] = typer.Option([], "--properties", "-p", help="Property file(s) (default: "
-                                          "NAME.properties.toml or properties.toml beside the table)."),
-    target: list[str] = typer.Option([], "--target", help="Export target whose limits to check (repeatable): "
-                                     f"{', '.join(registry.check_targets())}."),
+    properties: list[Path] = typer.Option(
+        [],
+        "--properties",
+        "-p",
+        help="Property file(s) (default: NAME.properties.toml or properties.toml beside the table).",
+    ),
+    target: list[str] = typer.Option(
+        [], "--target", help=f"Export target whose limits to check (repeatable): {', '.join(registry.check_targets())}."
+    ),
     strict: bool = typer.Option(False, "--strict", help="Exit with 1 when there are warnings."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="List every info finding (overlaps, ignored inputs)."),
     fmt: Format = typer.Option(Format.text, "--format", help="text, or json for machines."),
-    cex_dir: Path | None = typer.Option(None, "--counterexamples", help="Folder to write counterexample "
-                                        "CSVs into (created if missing); without it, check writes nothing."),
+    cex_dir: Path | None = typer.Option(
+        None,
+        "--counterexamples",
+        help="Folder to write counterexample CSVs into (created if missing); without it, check writes nothing.",
+    ),
     force: bool = FORCE_OPT,
 ) -> None:
     """Check a table: rows that never fire, overlaps, unreachable states, loops, properties.
@@ -92,8 +100,11 @@ def _save_counterexamples(report: Check, folder: Path) -> TableBotError | None:
     except TableBotError as exc:
         return exc
     except OSError as exc:
-        return fail(exc.filename or folder, N_("counterexamples not written: {reason}", reason=exc.strerror or exc),
-                    N_("give --counterexamples a folder you can write to"))
+        return fail(
+            exc.filename or folder,
+            N_("counterexamples not written: {reason}", reason=exc.strerror or exc),
+            N_("give --counterexamples a folder you can write to"),
+        )
     return None
 
 
@@ -101,10 +112,15 @@ def _print_report(check: Check, table_arg: Path, verbose: bool, saving: bool) ->
     report = check.report
     machine = report.machine
     table = machine.table
-    console.print(f"[bold]{terminal(table.path)}:[/bold] " + _(
-        "{rows} rows, {states} states, robot {robot}; {situations} situations explored").format(
-        rows=len(table.rows), states=len(machine.states), robot=terminal(table.robot.name),
-        situations=report.situations))
+    console.print(
+        f"[bold]{terminal(table.path)}:[/bold] "
+        + _("{rows} rows, {states} states, robot {robot}; {situations} situations explored").format(
+            rows=len(table.rows),
+            states=len(machine.states),
+            robot=terminal(table.robot.name),
+            situations=report.situations,
+        )
+    )
     hidden: dict[str, int] = {}
     shown = []
     for finding in report.findings:
@@ -122,12 +138,22 @@ def _print_report(check: Check, table_arg: Path, verbose: bool, saving: bool) ->
     counts = report.counts()
     tail = ""
     if hidden:
-        tail = " (" + _("{counts}; --verbose lists them").format(
-            counts=", ".join(f"{n} {code}" for code, n in hidden.items())) + ")"
-    console.print("\n" + ", ".join([
-        ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
-        ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
-        ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"])]) + tail)
+        tail = (
+            " ("
+            + _("{counts}; --verbose lists them").format(counts=", ".join(f"{n} {code}" for code, n in hidden.items()))
+            + ")"
+        )
+    console.print(
+        "\n"
+        + ", ".join(
+            [
+                ngettext("{n} error", "{n} errors", counts["error"]).format(n=counts["error"]),
+                ngettext("{n} warning", "{n} warnings", counts["warning"]).format(n=counts["warning"]),
+                ngettext("{n} note", "{n} notes", counts["info"]).format(n=counts["info"]),
+            ]
+        )
+        + tail
+    )
 
 
 def _print_findings(path: str, findings: list[Finding]) -> None:
@@ -139,8 +165,12 @@ def _print_findings(path: str, findings: list[Finding]) -> None:
     for finding in findings:
         where = f"{finding.path or path}:{finding.lines[0]}" if finding.lines else finding.path or path
         severity = str(localise(FINDING_WORDS[finding.severity]))
-        line = [(plain(where) + ":", "bold"), (" ", ""), (severity, COLOURS[finding.severity]),
-                (": " + plain(str(localise(finding.message))), "")]
+        line = [
+            (plain(where) + ":", "bold"),
+            (" ", ""),
+            (severity, COLOURS[finding.severity]),
+            (": " + plain(str(localise(finding.message))), ""),
+        ]
         if finding.hint:
             line += [("\n    ", ""), (hint_word + ":", "dim"), (" " + plain(str(localise(finding.hint))), "")]
         if not terminal_out:
@@ -161,12 +191,16 @@ def _print_result(check: Check, result: Result, table_arg: Path, verbose: bool, 
     width = max(len(w) for w in words.values())
     colour = {"holds": "green", "violated": "red", "unknown": "yellow"}[result.status]
     mark = f"[{colour}]{words[result.status]:<{width}}[/{colour}]"
-    level = f" [dim]({severity_word(prop.level)})[/dim]" if result.status == "violated" and prop.level != "error" \
-        else ""
+    level = (
+        f" [dim]({severity_word(prop.level)})[/dim]" if result.status == "violated" and prop.level != "error" else ""
+    )
     console.print(f"  {mark} [bold]{terminal(prop.name)}[/bold]{level}: {terminal(prop.text)}")
     if verbose or result.failed:
-        console.print(f"           [dim]{terminal(str(localise(prop.claim())))}; " +
-                      _("{n} situations").format(n=result.explored) + "[/dim]")
+        console.print(
+            f"           [dim]{terminal(str(localise(prop.claim())))}; "
+            + _("{n} situations").format(n=result.explored)
+            + "[/dim]"
+        )
     if result.detail:
         console.print(f"           {terminal(str(localise(result.detail)))}")
     if prop.note and result.failed:
@@ -174,12 +208,23 @@ def _print_result(check: Check, result: Result, table_arg: Path, verbose: bool, 
     if not result.inputs:
         return
     path = check.report.counterexamples.get(prop.name)
-    kind = (_("shortest example") if result.exact else _("example")) if prop.kind == "reachable" else \
-        (_("shortest counterexample") if result.exact else _("counterexample"))
-    written = _(", written to {path}").format(path=terminal(str(path))) if path else \
-        _(" (not written)") if saving else _(" (--counterexamples DIR saves it)")
-    console.print(f"           {kind}: " + ngettext("{n} tick", "{n} ticks", len(result.inputs)).format(
-        n=len(result.inputs)) + written)
+    kind = (
+        (_("shortest example") if result.exact else _("example"))
+        if prop.kind == "reachable"
+        else (_("shortest counterexample") if result.exact else _("counterexample"))
+    )
+    written = (
+        _(", written to {path}").format(path=terminal(str(path)))
+        if path
+        else _(" (not written)")
+        if saving
+        else _(" (--counterexamples DIR saves it)")
+    )
+    console.print(
+        f"           {kind}: "
+        + ngettext("{n} tick", "{n} ticks", len(result.inputs)).format(n=len(result.inputs))
+        + written
+    )
     if path:
         command = " ".join(shell_word(str(word)) for word in ("tablebot", "trace", table_arg, "--inputs", path))
         console.print("           " + _("replay: {command}").format(command=terminal(command)))
@@ -204,15 +249,27 @@ def tests_cmd(
     golden = generate(machine)
     write_golden(golden, out_folder(out, "--out"))
     for seq in golden.sequences:
-        console.print(_("wrote {inputs} and {trace} ({ticks} ticks, {rows} rows)").format(
-            inputs=terminal(str(out / seq.inputs_name)), trace=terminal(seq.trace_name), ticks=len(seq.inputs),
-            rows=len(seq.rows)))
+        console.print(
+            _("wrote {inputs} and {trace} ({ticks} ticks, {rows} rows)").format(
+                inputs=terminal(str(out / seq.inputs_name)),
+                trace=terminal(seq.trace_name),
+                ticks=len(seq.inputs),
+                rows=len(seq.rows),
+            )
+        )
     table_rows = machine.table.rows
-    console.print(_("row coverage: {covered} of {rows} rows fired ({fireable} can fire at all)").format(
-        covered=len(golden.covered), rows=len(table_rows), fireable=len(golden.fireable)))
+    console.print(
+        _("row coverage: {covered} of {rows} rows fired ({fireable} can fire at all)").format(
+            covered=len(golden.covered), rows=len(table_rows), fireable=len(golden.fireable)
+        )
+    )
     for index, reason in sorted(golden.reasons.items()):
-        console.print("  " + _("line {line}: not covered: {reason}").format(
-            line=table_rows[index].line, reason=terminal(str(localise(reason)))))
+        console.print(
+            "  "
+            + _("line {line}: not covered: {reason}").format(
+                line=table_rows[index].line, reason=terminal(str(localise(reason)))
+            )
+        )
     console.print(_("wrote {path}").format(path=terminal(str(out / "coverage.json"))))
 
 
@@ -220,8 +277,9 @@ def tests_cmd(
 @guarded
 def diagram_cmd(
     table: Path = TABLE_ARG,
-    fmt: str | None = typer.Option(None, "--format", help=f"One of {', '.join(FORMATS)} (default: from "
-                                   "--out's suffix, else svg)."),
+    fmt: str | None = typer.Option(
+        None, "--format", help=f"One of {', '.join(FORMATS)} (default: from --out's suffix, else svg)."
+    ),
     out: Path | None = typer.Option(None, "--out", help="File to write (default: standard output)."),
     colour: bool = typer.Option(True, "--colour/--no-colour", help="Colour edges by motion."),
     robot: Path | None = ROBOT_OPT,
@@ -234,13 +292,20 @@ def diagram_cmd(
     if fmt is None:
         fmt, option = named or "svg", "--out"
     elif named in FORMATS and named != fmt:  # a .svg file of PNG bytes opens nowhere
-        raise fail("--format", N_("--format {fmt}, but --out {out} is named as {named}", fmt=fmt, out=out,
-                                  named=named),
-                   N_("drop --format, or give --out the suffix of {fmt}", fmt=fmt))
+        raise fail(
+            "--format",
+            N_("--format {fmt}, but --out {out} is named as {named}", fmt=fmt, out=out, named=named),
+            N_("drop --format, or give --out the suffix of {fmt}", fmt=fmt),
+        )
     if fmt not in FORMATS:
-        raise fail(option, N_("unknown diagram format {fmt!r}", fmt=fmt),
-                   N_("use one of {formats} (--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, "
-                      ".mmd)", formats=", ".join(FORMATS)))
+        raise fail(
+            option,
+            N_("unknown diagram format {fmt!r}", fmt=fmt),
+            N_(
+                "use one of {formats} (--format, or the suffix of --out: .svg, .png, .dot, .gv, .mermaid, .mmd)",
+                formats=", ".join(FORMATS),
+            ),
+        )
     from tablebot.analysis.diagram import render
     from tablebot.analysis.diagram_tables import render_tables
     from tablebot.files import write_bytes
@@ -252,5 +317,4 @@ def diagram_cmd(
         sys.stdout.flush()
         return
     write_bytes(out_file(out, "--out", make_folder=True), data)
-    err_console.print(_("wrote {path} ({fmt}, {size} bytes)").format(path=terminal(str(out)), fmt=fmt,
-                                                                      size=len(data)))
+    err_console.print(_("wrote {path} ({fmt}, {size} bytes)").format(path=terminal(str(out)), fmt=fmt, size=len(data)))

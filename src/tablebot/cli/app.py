@@ -42,8 +42,9 @@ def _print_version(value: bool) -> None:
 
 @app.callback()
 def main(
-    show_version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
-                                      help="Print tablebot's version and exit."),
+    show_version: bool = typer.Option(
+        False, "--version", callback=_print_version, is_eager=True, help="Print tablebot's version and exit."
+    ),
     lang: str = typer.Option("", "--lang", metavar="de|en", show_default=False, help=LANG_HELP),
 ) -> None:
     """Robot behaviour written as a table: check it, trace it, simulate it, export it."""

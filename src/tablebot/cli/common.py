@@ -34,13 +34,17 @@ console = Console(highlight=False, soft_wrap=True, emoji=False)
 
 TABLE_ARG = typer.Argument(..., metavar="TABLE", help="Table file (CSV or TSV) or a folder holding table.csv.")
 ROBOT_OPT = typer.Option(None, "--robot", help="Robot TOML file (default: NAME.toml or robot.toml beside the table).")
-FORCE_OPT = typer.Option(False, "--force", help="Replace an existing table or robot file (the old one is kept as "
-                         "NAME.bak); without it such a file is never replaced.")
+FORCE_OPT = typer.Option(
+    False,
+    "--force",
+    help="Replace an existing table or robot file (the old one is kept as "
+    "NAME.bak); without it such a file is never replaced.",
+)
 
 
-
-def open_project(path: Path, robot_path: Path | None = None, worlds: list[Path] | None = None,
-                 properties: list[Path] | None = None) -> Project:
+def open_project(
+    path: Path, robot_path: Path | None = None, worlds: list[Path] | None = None, properties: list[Path] | None = None
+) -> Project:
     """The command's TABLE (a table, or a folder holding table.csv) with ``--robot``, ``--world`` and
     ``--properties`` as given (None: found as tablebot.api.open finds them)."""
     from tablebot.api import open as open_robot
@@ -61,8 +65,14 @@ class Stages:
     def __init__(self, total: int, delay: float = 1.0) -> None:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-        self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                                 TimeElapsedColumn(), console=err_console, transient=True)
+        self.progress = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=err_console,
+            transient=True,
+        )
         self.task = self.progress.add_task(_("reading"), total=total)
         self.timer = threading.Timer(delay, self.progress.start)
         self.timer.daemon = True
@@ -95,8 +105,10 @@ def print_diagnostic(d: Diagnostic) -> None:
     each (a line break in a name is shown as \\n: it cannot forge a line of its own); a tool's output
     follows, each of its lines marked as part of this diagnostic."""
     colour = {"error": "red", "warning": "yellow"}.get(d.severity, "cyan")
-    err_console.print(f"[bold]{terminal(d.location())}:[/bold] [{colour}]{severity_word(d.severity)}[/{colour}]: "
-                      f"{terminal(localise(d.message))}")
+    err_console.print(
+        f"[bold]{terminal(d.location())}:[/bold] [{colour}]{severity_word(d.severity)}[/{colour}]: "
+        f"{terminal(localise(d.message))}"
+    )
     if d.hint:
         err_console.print(f"    [dim]{localise(HINT_LABEL)}:[/dim] {terminal(localise(d.hint))}")
     for line in d.detail.splitlines():
@@ -127,8 +139,11 @@ def guarded(func: F) -> F:
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            with sigterm_raises(), notes_to(print_diagnostic), overwrite.command(bool(kwargs.get("force", False)),
-                                                                                   offered):
+            with (
+                sigterm_raises(),
+                notes_to(print_diagnostic),
+                overwrite.command(bool(kwargs.get("force", False)), offered),
+            ):
                 return func(*args, **kwargs)
         except TableBotError as exc:
             for d in exc.diagnostics:
@@ -139,9 +154,15 @@ def guarded(func: F) -> F:
             raise typer.Exit(0) from None
         except OSError as exc:  # a file the command had to write (or read) is not there to be had
             where = exc.filename if exc.filename is not None else "tablebot"
-            print_diagnostic(Diagnostic(str(where), None, None,
-                                        N_("cannot write or read: {reason}", reason=exc.strerror or exc),
-                                        OS_HINTS.get(exc.errno or 0, N_("check the path"))))
+            print_diagnostic(
+                Diagnostic(
+                    str(where),
+                    None,
+                    None,
+                    N_("cannot write or read: {reason}", reason=exc.strerror or exc),
+                    OS_HINTS.get(exc.errno or 0, N_("check the path")),
+                )
+            )
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
             print(_("interrupted"), file=sys.stderr)

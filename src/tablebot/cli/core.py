@@ -36,12 +36,19 @@ class Source(StrEnum):
 @app.command("import")
 @guarded
 def import_cmd(
-    directory: Path = typer.Argument(..., metavar="FOLDER|FILE", help="Folder with event.csv, action.csv, "
-                                     "timer.csv (robopro), or the exported statechart (scxml, xstate)."),
-    source: Source = typer.Option(..., "--from", help="What it holds: robopro lists, or what export --to scxml "
-                                  "or --to xstate wrote."),
-    out: Path | None = typer.Option(None, "--out", help="Table CSV to write (default: standard output); a folder "
-                                    "for a statechart of several tables."),
+    directory: Path = typer.Argument(
+        ...,
+        metavar="FOLDER|FILE",
+        help="Folder with event.csv, action.csv, timer.csv (robopro), or the exported statechart (scxml, xstate).",
+    ),
+    source: Source = typer.Option(
+        ..., "--from", help="What it holds: robopro lists, or what export --to scxml or --to xstate wrote."
+    ),
+    out: Path | None = typer.Option(
+        None,
+        "--out",
+        help="Table CSV to write (default: standard output); a folder for a statechart of several tables.",
+    ),
     robot: Path | None = ROBOT_OPT,
     force: bool = FORCE_OPT,
 ) -> None:
@@ -70,9 +77,13 @@ def import_cmd(
         sys.stdout.write(text)
     else:
         write_text(out_file(out, "--out"), text)
-        err_console.print(ngettext("wrote {path} ({n} row; descriptions are not in the lists)",
-                                   "wrote {path} ({n} rows; descriptions are not in the lists)",
-                                   len(table.rows)).format(path=terminal(str(out)), n=len(table.rows)))
+        err_console.print(
+            ngettext(
+                "wrote {path} ({n} row; descriptions are not in the lists)",
+                "wrote {path} ({n} rows; descriptions are not in the lists)",
+                len(table.rows),
+            ).format(path=terminal(str(out)), n=len(table.rows))
+        )
 
 
 def _rule_warnings(table: Table) -> list[Message]:
@@ -83,12 +94,20 @@ def _rule_warnings(table: Table) -> list[Message]:
 
     if table.robot.match == MATCH_DOCUMENT:
         return []
-    return [N_("line {line} of the lists requires no event: the document's engine, which ran these lists, fires "
-               "nothing on a tick with no event, but {source} follows match = \"always\" (it fires the row there), "
-               "and such a tick can come in state {state!r} ({why}); write match = \"document\" in {source} to run "
-               "the table as the lists ran", line=f.row.line, source=table.robot.source, state=f.row.state,
-               why=f.quiet)
-            for f in no_event_rows(table) if f.quiet]
+    return [
+        N_(
+            "line {line} of the lists requires no event: the document's engine, which ran these lists, fires "
+            'nothing on a tick with no event, but {source} follows match = "always" (it fires the row there), '
+            'and such a tick can come in state {state!r} ({why}); write match = "document" in {source} to run '
+            "the table as the lists ran",
+            line=f.row.line,
+            source=table.robot.source,
+            state=f.row.state,
+            why=f.quiet,
+        )
+        for f in no_event_rows(table)
+        if f.quiet
+    ]
 
 
 @app.command("trace")
@@ -115,14 +134,21 @@ def trace_cmd(
         return
     with atomic_write(out_file(out, "--out")) as stream:
         count = write_trace(lines, stream)
-    err_console.print(ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count)
-                      .format(path=terminal(str(out)), n=count))
+    err_console.print(
+        ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count).format(path=terminal(str(out)), n=count)
+    )
 
 
 @app.command("demo")
 @guarded
-def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder for the replayed trace (its own: "
-                                      "make demo fills out/demo with a simulated run's trace and pictures).")) -> None:
+def demo_cmd(
+    out: Path = typer.Option(
+        Path("out/replay"),
+        "--out",
+        help="Folder for the replayed trace (its own: "
+        "make demo fills out/demo with a simulated run's trace and pictures).",
+    ),
+) -> None:
     """Replay the BumberBot on its built-in recorded inputs and summarise what it did."""
     from tablebot.examples import example_path
     from tablebot.files import atomic_write
@@ -141,9 +167,16 @@ def demo_cmd(out: Path = typer.Option(Path("out/replay"), "--out", help="Folder 
     for line in lines:
         visits[line["state"]] = visits.get(line["state"], 0) + 1
     fired = sum(1 for line in lines if line["row"] is not None)
-    console.print(_("BumberBot: {ticks} ticks ({seconds:.1f} s), {fired} rows fired").format(
-        ticks=len(lines), seconds=machine.table.robot.seconds(len(lines)), fired=fired))
+    console.print(
+        _("BumberBot: {ticks} ticks ({seconds:.1f} s), {fired} rows fired").format(
+            ticks=len(lines), seconds=machine.table.robot.seconds(len(lines)), fired=fired
+        )
+    )
     for state, count in visits.items():
-        console.print("  " + _("state {state:>4}: {seconds:6.2f} s").format(
-            state=terminal(str(state)), seconds=machine.table.robot.seconds(count)))
+        console.print(
+            "  "
+            + _("state {state:>4}: {seconds:6.2f} s").format(
+                state=terminal(str(state)), seconds=machine.table.robot.seconds(count)
+            )
+        )
     console.print(_("wrote {path}").format(path=terminal(str(out / "trace.jsonl"))))

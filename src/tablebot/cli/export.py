@@ -30,16 +30,23 @@ class Lookup(StrEnum):
 @guarded
 def export_cmd(
     table: Path = TABLE_ARG,
-    outdir: Path | None = typer.Argument(None, metavar="OUTDIR", help="Folder to write into (created if missing); "
-                                         "for robopro-rpp, where to put the program instead of rewriting it."),
-    to: Target = typer.Option(..., "--to", help="; ".join(f"{b.name}: {b.help}" for b in registry.exporters())
-                              + "."),
+    outdir: Path | None = typer.Argument(
+        None,
+        metavar="OUTDIR",
+        help="Folder to write into (created if missing); "
+        "for robopro-rpp, where to put the program instead of rewriting it.",
+    ),
+    to: Target = typer.Option(..., "--to", help="; ".join(f"{b.name}: {b.help}" for b in registry.exporters()) + "."),
     into: Path | None = typer.Option(None, "--into", help="robopro-rpp: the ROBO Pro program (.rpp) to update."),
     event_list: str = typer.Option(rpp.DEFAULT_NAMES[0], "--event-list", help="robopro-rpp: the event list's name."),
     action_list: str = typer.Option(rpp.DEFAULT_NAMES[1], "--action-list", help="robopro-rpp: the action list's name."),
     timer_list: str = typer.Option(rpp.DEFAULT_NAMES[2], "--timer-list", help="robopro-rpp: the timer list's name."),
-    lookup: Lookup = typer.Option(Lookup.auto, "--lookup", help="c: first-match lookup, dense (O(1) table) or "
-                                  "scan (rows per state); auto takes dense while it needs at most 8 KB."),
+    lookup: Lookup = typer.Option(
+        Lookup.auto,
+        "--lookup",
+        help="c: first-match lookup, dense (O(1) table) or "
+        "scan (rows per state); auto takes dense while it needs at most 8 KB.",
+    ),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
     """Export a table for another system: ROBO Pro lists, a ROBO Pro program, or C source.
@@ -48,8 +55,7 @@ def export_cmd(
     one of their names is never replaced (choose another OUTDIR).
     """
     project = open_project(table, robot)
-    done = project.export(to.value, outdir, into=into, lists=(event_list, action_list, timer_list),
-                          lookup=lookup.value)
+    done = project.export(to.value, outdir, into=into, lists=(event_list, action_list, timer_list), lookup=lookup.value)
     for line in done.lines:
         console.print(terminal(str(localise(line))))
     for line in done.warnings:

@@ -32,8 +32,11 @@ if TYPE_CHECKING:  # the firmware tools are imported when a command runs: `--hel
 #: ``--board``'s choices: every registered board back-end.
 BoardName = StrEnum("BoardName", {b.name: b.name for b in registry.backends("board")})  # type: ignore[misc]
 
-BOARD_OPT = typer.Option(..., "--board", help=" or ".join(f"{b.name} ({b.help})" if b.help else b.name
-                                                         for b in registry.backends("board")) + ".")
+BOARD_OPT = typer.Option(
+    ...,
+    "--board",
+    help=" or ".join(f"{b.name} ({b.help})" if b.help else b.name for b in registry.backends("board")) + ".",
+)
 OUT_OPT = typer.Option(None, "--out", help="Folder for the firmware (default: build/firmware/BOARD).")
 
 
@@ -49,8 +52,9 @@ def _build(table: Path, board: BoardName, out: Path | None, robot: Path | None) 
 
 @app.command("build")
 @guarded
-def build_cmd(table: Path = TABLE_ARG, board: BoardName = BOARD_OPT, out: Path | None = OUT_OPT,
-              robot: Path | None = ROBOT_OPT) -> None:
+def build_cmd(
+    table: Path = TABLE_ARG, board: BoardName = BOARD_OPT, out: Path | None = OUT_OPT, robot: Path | None = ROBOT_OPT
+) -> None:
     """Build firmware (.hex and .elf) running the table every tick and streaming its trace."""
     _build(table, board, out, robot)
 
@@ -58,8 +62,9 @@ def build_cmd(table: Path = TABLE_ARG, board: BoardName = BOARD_OPT, out: Path |
 @app.command("flash")
 @guarded
 def flash_cmd(
-    table: Path = typer.Argument(..., metavar="TABLE_OR_HEX",
-                                help="Table (built first) or a firmware .hex built by `tablebot build`."),
+    table: Path = typer.Argument(
+        ..., metavar="TABLE_OR_HEX", help="Table (built first) or a firmware .hex built by `tablebot build`."
+    ),
     board: BoardName = BOARD_OPT,
     port: str = typer.Option(..., "--port", help="Serial port of the board's bootloader (/dev/ttyACM0, COM3)."),
     out: Path | None = OUT_OPT,
@@ -87,22 +92,26 @@ def flash_cmd(
         err_console.print(f"{severity_word('note')}: {localise(NOTES[board.value])}")
     status = flash(command)
     if status:
-        raise fail("avrdude", N_("avrdude failed with exit status {status}", status=status),
-                   N_("check --port, the cable and the board; the Uno needs no button, the ftDuino a reset just "
-                      "before"))
+        raise fail(
+            "avrdude",
+            N_("avrdude failed with exit status {status}", status=status),
+            N_("check --port, the cable and the board; the Uno needs no button, the ftDuino a reset just before"),
+        )
 
 
 @app.command("monitor")
 @guarded
 def monitor_cmd(
-    source: str = typer.Argument(..., metavar="PORT_OR_FILE",
-                                help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."),
+    source: str = typer.Argument(
+        ..., metavar="PORT_OR_FILE", help="Serial port (/dev/ttyACM0, COM3) or a file of captured UART bytes."
+    ),
     table: Path = typer.Option(..., "--table", help="The table the firmware was built from (names states)."),
     out: Path | None = typer.Option(None, "--out", help="Trace file (JSON Lines; default: standard output)."),
     baud: int = typer.Option(115200, "--baud", min=1, help="Serial speed of the trace stream."),
     ticks: int | None = typer.Option(None, "--ticks", min=1, help="Stop after this many ticks."),
-    seconds: float | None = typer.Option(None, "--seconds", min=0.001,
-                                         help="Stop a serial port after this many seconds."),
+    seconds: float | None = typer.Option(
+        None, "--seconds", min=0.001, help="Stop a serial port after this many seconds."
+    ),
     robot: Path | None = ROBOT_OPT,
     force: bool = FORCE_OPT,
 ) -> None:
@@ -126,5 +135,8 @@ def monitor_cmd(
             err_console.print(_("kept the ticks so far in {path}").format(path=terminal(str(pending.keep_partial()))))
             raise
         pending.commit()
-        err_console.print(ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count).format(
-            path=terminal(str(out)), n=count))
+        err_console.print(
+            ngettext("wrote {path} ({n} tick)", "wrote {path} ({n} ticks)", count).format(
+                path=terminal(str(out)), n=count
+            )
+        )

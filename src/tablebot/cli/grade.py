@@ -19,10 +19,14 @@ from tablebot.i18n import _, localise
 @guarded
 def grade_cmd(
     challenge: Path = typer.Argument(..., metavar="CHALLENGE", help="A challenge folder (its challenge.toml)."),
-    submissions: list[Path] = typer.Argument(..., metavar="SUBMISSION...", help="Tables, folders holding "
-                                             "table.csv, or text files of share links (one a line)."),
-    out: Path = typer.Option(Path("out/grade"), "--out", help="Folder for scores.csv, leaderboard.html and the "
-                             "replays."),
+    submissions: list[Path] = typer.Argument(
+        ...,
+        metavar="SUBMISSION...",
+        help="Tables, folders holding table.csv, or text files of share links (one a line).",
+    ),
+    out: Path = typer.Option(
+        Path("out/grade"), "--out", help="Folder for scores.csv, leaderboard.html and the replays."
+    ),
     backend: str = BACKEND_OPT,
     scheduler: str | None = SCHEDULER_OPT,
     workers: int | None = WORKERS_OPT,
@@ -43,6 +47,9 @@ def grade_cmd(
     if not quiet:
         for line in scores_csv(list(graded.entries), graded.challenge).splitlines():  # pupils' names: user text
             console.print(plain(line), markup=False)
-        err_console.print(_("wrote {scores} and {board}").format(scores=plain(str(Path(out) / "scores.csv")),
-                                                                  board=plain(str(Path(out) / "leaderboard.html"))),
-                          markup=False)
+        err_console.print(
+            _("wrote {scores} and {board}").format(
+                scores=plain(str(Path(out) / "scores.csv")), board=plain(str(Path(out) / "leaderboard.html"))
+            ),
+            markup=False,
+        )

@@ -27,17 +27,28 @@ class From(StrEnum):
 def new_cmd(
     folder: Path = typer.Argument(..., metavar="FOLDER", help="The folder to create (it must not exist, or be empty)."),
     template: From = typer.Option(From.empty, "--from", help="Start from a shipped example, or from an empty robot."),
-    inputs: list[str] = typer.Option([], "--inputs", help="Your input names, comma separated, each optionally "
-                                     "NAME=label (I1,I2 or \"I1=left bumper\"); with --from an example, they "
-                                     "rename its inputs in order."),
-    motors: list[str] = typer.Option([], "--motors", help="Your motor names, the same way (the first two drive "
-                                     "the right and left wheel in the simulator)."),
+    inputs: list[str] = typer.Option(
+        [],
+        "--inputs",
+        help="Your input names, comma separated, each optionally "
+        'NAME=label (I1,I2 or "I1=left bumper"); with --from an example, they '
+        "rename its inputs in order.",
+    ),
+    motors: list[str] = typer.Option(
+        [],
+        "--motors",
+        help="Your motor names, the same way (the first two drive the right and left wheel in the simulator).",
+    ),
 ) -> None:
     """Create FOLDER with a table, its robot file, a world and properties: ready for check, sim and tests."""
     from tablebot import templates
 
-    made = templates.make(template.value, folder.name or "robot", templates.parse_names(inputs, "--inputs"),
-                          templates.parse_names(motors, "--motors"))
+    made = templates.make(
+        template.value,
+        folder.name or "robot",
+        templates.parse_names(inputs, "--inputs"),
+        templates.parse_names(motors, "--motors"),
+    )
     made.files["table.csv"] = header_line(made.files["table.csv"], asked())  # Zustand, Folgezustand with --lang de
     written = templates.write_folder(folder, made)
     source = N_("an empty robot") if template is From.empty else N_("the {name} example", name=template.value)

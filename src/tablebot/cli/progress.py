@@ -31,8 +31,9 @@ class TickBar(Progress):
         self.task: TaskID | None = None
         # until the compile (or the run) starts: a first start compiles numba's and numpy's bytecode, seconds
         # with nothing to show (said only past 3 s)
-        self.loading = Talking(_("loading the simulator"), _("a first start compiles numba's and numpy's bytecode"),
-                               delay_s=3.0)
+        self.loading = Talking(
+            _("loading the simulator"), _("a first start compiles numba's and numpy's bytecode"), delay_s=3.0
+        )
 
     def compiling(self, what: str, *functions: Any) -> None:
         from tablebot.jit import Compiling
@@ -45,8 +46,12 @@ class TickBar(Progress):
             return
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-        columns = (TextColumn(_("simulating")), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
-                   TimeRemainingColumn())
+        columns = (
+            TextColumn(_("simulating")),
+            BarColumn(),
+            TextColumn("{task.percentage:>3.0f}%"),
+            TimeRemainingColumn(),
+        )
         self.bar = Progress(*columns, console=err_console, transient=True)
         self.task = self.bar.add_task("sim", total=total, completed=done)
         if self.compile is None or not self.compile.active:
@@ -93,8 +98,15 @@ class CountBar(Progress):
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
         rate = [TextColumn("{task.fields[rate]}")] if ticks else []
-        self.bar = Progress(TextColumn(str(localise(what))), BarColumn(), MofNCompleteColumn(), *rate,
-                            TimeRemainingColumn(), console=err_console, transient=True)
+        self.bar = Progress(
+            TextColumn(str(localise(what))),
+            BarColumn(),
+            MofNCompleteColumn(),
+            *rate,
+            TimeRemainingColumn(),
+            console=err_console,
+            transient=True,
+        )
         self.bar.start()
         self.task = self.bar.add_task(what, total=total, completed=done, rate="")
 

@@ -21,8 +21,13 @@ QR_OPT = typer.Option(None, "--qr", metavar="FILE.png", help="Also write the lin
 def share_cmd(
     where: Path = typer.Argument(..., metavar="FOLDER|TABLE", help="A folder holding table.csv, or a table file."),
     qr: Path | None = QR_OPT,
-    base: str = typer.Option("", "--base", metavar="URL", help="The studio address the link starts with "
-                             "(default: http://127.0.0.1:8765/, where `tablebot studio` serves)."),
+    base: str = typer.Option(
+        "",
+        "--base",
+        metavar="URL",
+        help="The studio address the link starts with "
+        "(default: http://127.0.0.1:8765/, where `tablebot studio` serves).",
+    ),
 ) -> None:
     """Print a link that carries FOLDER's table, its robot file and its world, compressed into the part after
     '#' (a browser never sends that to any server). The studio (its Open box, or studio --open LINK) and
@@ -39,10 +44,12 @@ def share_cmd(
     if shared.tables:  # a robot of several tables: every one of them
         names = plain(", ".join([shared.table[0], *(name for name, _ in shared.tables)]))
         said = _("{n:,} characters: the tables {tables}, {robot}, {world}").format(
-            n=len(link), tables=names, robot=robot, world=world)
+            n=len(link), tables=names, robot=robot, world=world
+        )
     else:
         said = _("{n:,} characters: the table {table}, {robot}, {world}").format(
-            n=len(link), table=plain(shared.table[0]), robot=robot, world=world)
+            n=len(link), table=plain(shared.table[0]), robot=robot, world=world
+        )
     err_console.print(said, markup=False)
     if qr is not None:
         write_qr(qr, link)
@@ -61,9 +68,11 @@ def write_qr(path: Path, link: str) -> None:
     try:
         code = segno.make(link, error="l", boost_error=True, micro=False)
     except segno.DataOverflowError:
-        raise fail("--qr", N_("the link is too long for a QR code ({n:,} characters; one holds about 2,900)",
-                              n=len(link)),
-                   N_("share the link as text, or shorten the robot and world files' comments")) from None
+        raise fail(
+            "--qr",
+            N_("the link is too long for a QR code ({n:,} characters; one holds about 2,900)", n=len(link)),
+            N_("share the link as text, or shorten the robot and world files' comments"),
+        ) from None
     picture = io.BytesIO()
     code.save(picture, kind="png", scale=QR_SCALE, border=4)
     write_bytes(path, picture.getvalue())

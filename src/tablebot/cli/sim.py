@@ -21,18 +21,26 @@ if TYPE_CHECKING:  # the simulator (numba, matplotlib) is imported only when the
 @guarded
 def sim_cmd(
     table: Path = TABLE_ARG,
-    world: Path | None = typer.Option(None, "--world", help="World TOML (default: the robot's sim.world, "
-                                      "else arena.toml beside the table, else an empty room)."),
+    world: Path | None = typer.Option(
+        None,
+        "--world",
+        help="World TOML (default: the robot's sim.world, else arena.toml beside the table, else an empty room).",
+    ),
     seconds: float = typer.Option(120.0, "--seconds", min=0.01, max=3600, help="Simulated time (up to an hour)."),
     seed: int = typer.Option(1, "--seed", min=0, help="Seed of all simulated noise: same seed, same trace bytes."),
     out: Path = typer.Option(Path("out/sim"), "--out", help="Folder for trace.jsonl and the pictures."),
     view: bool = typer.Option(False, "--view", help="Show the run in a window, in real time."),
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif, an animation of the run."),
     plots: bool = typer.Option(True, "--plots/--no-plots", help="Write trajectory.png and timeline.png."),
-    html: bool = typer.Option(False, "--html", help="Also write run.html: the run replayed in any browser, "
-                              "no server needed (arena, timeline, table and state diagram)."),
-    charge: float | None = typer.Option(None, "--battery", min=0.0, max=1.0,
-                                        help="Battery charge at the start, 0..1 (overrides the world)."),
+    html: bool = typer.Option(
+        False,
+        "--html",
+        help="Also write run.html: the run replayed in any browser, "
+        "no server needed (arena, timeline, table and state diagram).",
+    ),
+    charge: float | None = typer.Option(
+        None, "--battery", min=0.0, max=1.0, help="Battery charge at the start, 0..1 (overrides the world)."
+    ),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no summary."),
     robot: Path | None = ROBOT_OPT,
 ) -> None:
@@ -45,12 +53,23 @@ def sim_cmd(
 
     if view:
         from tablebot.sim.pictures.animate import check_display
+
         check_display()
     project = open_project(table, robot)
     bar = TickBar(quiet)
     try:
-        run = project.simulate(seconds, seed, world=world, battery=charge, out=out, plots=plots, gif=gif, html=html,
-                               every_row=view, progress=bar)
+        run = project.simulate(
+            seconds,
+            seed,
+            world=world,
+            battery=charge,
+            out=out,
+            plots=plots,
+            gif=gif,
+            html=html,
+            every_row=view,
+            progress=bar,
+        )
     finally:
         bar.loading.done(finished=False)  # a refusal before the run (a bad --out) ends the loading notice too
     if not run.complete:
@@ -59,6 +78,7 @@ def sim_cmd(
         _report(run)
     if view:
         from tablebot.sim.pictures.animate import show
+
         assert run.summary is not None
         show(run.run, run.summary)
 
@@ -67,8 +87,12 @@ def _stopped(run: Simulation) -> None:
     """A run cut short (Ctrl-C, SIGTERM): say what was kept and exit with the run's code."""
     end = run.end
     kept = run.files[0] if run.files else None
-    err_console.print(_("{why} after {ticks:,} ticks; kept {kept} (the previous run's files are untouched)").format(
-        why=localise(end.message or end.reason), ticks=run.run.ticks, kept=plain(str(kept))), markup=False)
+    err_console.print(
+        _("{why} after {ticks:,} ticks; kept {kept} (the previous run's files are untouched)").format(
+            why=localise(end.message or end.reason), ticks=run.run.ticks, kept=plain(str(kept))
+        ),
+        markup=False,
+    )
     raise typer.Exit(end.exit_code)
 
 

@@ -23,18 +23,27 @@ LOCAL = "127.0.0.1"
 @app.command("studio")
 @guarded
 def studio_cmd(
-    where: Path = typer.Argument(Path("."), metavar="FOLDER", help="A folder (its table.csv opens first) or a "
-                                 "table file."),
+    where: Path = typer.Argument(
+        Path("."), metavar="FOLDER", help="A folder (its table.csv opens first) or a table file."
+    ),
     port: int = typer.Option(8765, "--port", min=0, max=65535, help="Port to serve on (0: any free port)."),
-    host: str | None = typer.Option(None, "--host", help="Serve on this address instead of 127.0.0.1, "
-                                    "e.g. 0.0.0.0 for the whole network (anyone with the printed address and its "
-                                    "token can read and change the folder's tables)."),
+    host: str | None = typer.Option(
+        None,
+        "--host",
+        help="Serve on this address instead of 127.0.0.1, "
+        "e.g. 0.0.0.0 for the whole network (anyone with the printed address and its "
+        "token can read and change the folder's tables).",
+    ),
     no_browser: bool = typer.Option(False, "--no-browser", help="Do not open a browser."),
-    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every request (the token shown as "
-                                 "[token])."),
-    open_link: str | None = typer.Option(None, "--open", metavar="LINK", help="Open the table a share link "
-                                         "carries (tablebot share): its files go into a new folder in FOLDER, "
-                                         "named as the link names it, and its table opens."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every request (the token shown as [token])."),
+    open_link: str | None = typer.Option(
+        None,
+        "--open",
+        metavar="LINK",
+        help="Open the table a share link "
+        "carries (tablebot share): its files go into a new folder in FOLDER, "
+        "named as the link names it, and its table opens.",
+    ),
 ) -> None:
     """Edit a table in the browser, see its checks as you type, and watch the robot run it live.
 
@@ -66,15 +75,17 @@ def studio_cmd(
         import socket
 
         other = access.url(socket.gethostname(), f"table={quote(table)}" if table else "")
-        err_console.print("  " + _("{address}  (from other machines)").format(address=other), soft_wrap=True,
-                          markup=False)
+        err_console.print(
+            "  " + _("{address}  (from other machines)").format(address=other), soft_wrap=True, markup=False
+        )
     err_console.print(_("(Ctrl-C stops; each start makes a new token)"), soft_wrap=True)
     if table is None:
         _say_no_table(root)
     sharing.maker, sharing.opener = link_maker, link_opener  # the Share button's links, and links pasted in
     visited = threading.Event()
-    uvicorn_server = server(create_app(root, access, table, visited=visited, lang=i18n.named()), access,
-                            "info" if verbose else "warning")
+    uvicorn_server = server(
+        create_app(root, access, table, visited=visited, lang=i18n.named()), access, "info" if verbose else "warning"
+    )
     with ExitStack() as stack:  # the file goes when the studio stops (Ctrl-C, SIGTERM)
         if not no_browser:
             open_in_browser(stack.enter_context(redirect_file(url)), visited)
@@ -92,11 +103,15 @@ def _loopback(address: str) -> bool:
 
 
 def _warn_network(root: Path, address: str, port: int) -> None:
-    err_console.print(f"[bold red]{severity_word('warning')}:[/bold red] " + _(
-        "serving {folder} on {address}:{port}, not only to this machine: anyone who can reach it and has the "
-        "address below (with its token) can read the folder's tables, robot and world files and traces, and change "
-        "its tables. The connection is plain HTTP: anyone who can watch the network can see the token.").format(
-        folder=terminal(str(root)), address=terminal(address), port=port), soft_wrap=True)
+    err_console.print(
+        f"[bold red]{severity_word('warning')}:[/bold red] "
+        + _(
+            "serving {folder} on {address}:{port}, not only to this machine: anyone who can reach it and has the "
+            "address below (with its token) can read the folder's tables, robot and world files and traces, and change "
+            "its tables. The connection is plain HTTP: anyone who can watch the network can see the token."
+        ).format(folder=terminal(str(root)), address=terminal(address), port=port),
+        soft_wrap=True,
+    )
 
 
 def link_maker(table: Path, text: str) -> tuple[str, str]:
@@ -119,8 +134,11 @@ def link_maker(table: Path, text: str) -> tuple[str, str]:
 def _unpack_link(root: Path, link: str) -> str:
     """``--open LINK``: :func:`link_opener`, and the terminal says where the files went."""
     table = link_opener(root, link, "--open")
-    err_console.print(f"tablebot studio: the link's table is {terminal(table)} in {terminal(str(root))} (with "
-                      "its robot file and world), as it was shared", soft_wrap=True)
+    err_console.print(
+        f"tablebot studio: the link's table is {terminal(table)} in {terminal(str(root))} (with "
+        "its robot file and world), as it was shared",
+        soft_wrap=True,
+    )
     return table
 
 
@@ -132,8 +150,11 @@ def link_opener(root: Path, link: str, where: str = "the link") -> str:
 
     shared = share.decode(link, where)
     shared.check(where)
-    folder = next(root / name for name in (shared.name, *(f"{shared.name}-{n}" for n in range(2, 1000)))
-                  if not (root / name).exists() and not (root / name).is_symlink())
+    folder = next(
+        root / name
+        for name in (shared.name, *(f"{shared.name}-{n}" for n in range(2, 1000)))
+        if not (root / name).exists() and not (root / name).is_symlink()
+    )
     return shared.write(folder).relative_to(root).as_posix()
 
 
@@ -145,9 +166,14 @@ def _say_no_table(root: Path) -> None:
 
     if Workspace(root).listing()["tables"]:
         return  # another table there: the page opens it
-    err_console.print(f"[yellow]{severity_word('note')}:[/yellow] " + _(
-        "there is no table in {folder} (a .csv or .tsv whose first line names the state and next columns). Start "
-        "one from a template, then open it:").format(folder=terminal(str(root))), soft_wrap=True)
+    err_console.print(
+        f"[yellow]{severity_word('note')}:[/yellow] "
+        + _(
+            "there is no table in {folder} (a .csv or .tsv whose first line names the state and next columns). Start "
+            "one from a template, then open it:"
+        ).format(folder=terminal(str(root))),
+        soft_wrap=True,
+    )
     for name in TEMPLATES:
         err_console.print(f"  tablebot new my-robot --from {name}", soft_wrap=True, markup=False)
     err_console.print("  tablebot studio my-robot", soft_wrap=True, markup=False)
@@ -175,10 +201,15 @@ def _bind(address: str, port: int) -> socket.socket:
         sock.bind((address, port))
     except OSError as exc:
         sock.close()
-        hint = N_("choose another --port (0 picks a free one)") if exc.errno == errno.EADDRINUSE else \
-            N_("give --host an address of this machine")
-        raise fail("--port" if exc.errno == errno.EADDRINUSE else "--host",
-                   N_("cannot serve on {address}:{port}: {reason}", address=address, port=port, reason=exc.strerror),
-                   hint) from None
+        hint = (
+            N_("choose another --port (0 picks a free one)")
+            if exc.errno == errno.EADDRINUSE
+            else N_("give --host an address of this machine")
+        )
+        raise fail(
+            "--port" if exc.errno == errno.EADDRINUSE else "--host",
+            N_("cannot serve on {address}:{port}: {reason}", address=address, port=port, reason=exc.strerror),
+            hint,
+        ) from None
     sock.listen(64)
     return sock

@@ -52,8 +52,9 @@ class Group(TyperGroup):
         app = self.typer_app()
         load_module(name)
         info = next(i for i in app.registered_commands if i.name == name)
-        command = get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
-                                        rich_markup_mode=app.rich_markup_mode)
+        command = get_command_from_info(
+            info, pretty_exceptions_short=app.pretty_exceptions_short, rich_markup_mode=app.rich_markup_mode
+        )
         return _prepared(command)
 
     def list_commands(self, ctx: Any) -> list[str]:
@@ -93,10 +94,12 @@ class Group(TyperGroup):
         name = args[0] if args else ""
         if name and not name.startswith("-") and self.get_command(ctx, name) is None:
             near = difflib.get_close_matches(name, self.list_commands(ctx), n=2)
-            hint = N_("did you mean {names}? tablebot -h lists the commands", names=_or(near)) if near else \
-                N_("tablebot -h lists the commands")
-            raise OptionError(Diagnostic(name, None, None, N_("{name!r} is not a tablebot command", name=name),
-                                         hint))
+            hint = (
+                N_("did you mean {names}? tablebot -h lists the commands", names=_or(near))
+                if near
+                else N_("tablebot -h lists the commands")
+            )
+            raise OptionError(Diagnostic(name, None, None, N_("{name!r} is not a tablebot command", name=name), hint))
         return super().resolve_command(ctx, args)
 
 
@@ -118,9 +121,15 @@ def lang_option() -> TyperOption:
     """``--lang`` on every command, in its help as in the main one: tablebot.cli.main takes it off the command
     line before typer sees it, so this one is met only when the app is called in-process (a test's CliRunner),
     where it sets the language of what follows."""
-    return TyperOption(param_decls=["--lang"], type=TyperChoice(LANGUAGES), expose_value=False, metavar="de|en",
-                       default=None, callback=lambda ctx, param, value: use(value) if value else None,
-                       help=LANG_HELP)
+    return TyperOption(
+        param_decls=["--lang"],
+        type=TyperChoice(LANGUAGES),
+        expose_value=False,
+        metavar="de|en",
+        default=None,
+        callback=lambda ctx, param, value: use(value) if value else None,
+        help=LANG_HELP,
+    )
 
 
 class FiniteFloat(FloatRange):
@@ -162,44 +171,74 @@ def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
     sub = exc.ctx is not None and exc.ctx.parent is not None and exc.ctx.info_name
     command = f"tablebot {exc.ctx.info_name} -h" if sub and exc.ctx is not None else "tablebot -h"
     if not isinstance(exc, BadParameter | NoSuchOption):  # an extra argument, say
-        return Diagnostic("tablebot", None, None, _click_message(exc.message),
-                          N_("{command} says how to call it", command=command))
+        return Diagnostic(
+            "tablebot", None, None, _click_message(exc.message), N_("{command} says how to call it", command=command)
+        )
     if isinstance(exc, NoSuchOption):
         lists = N_("{command} lists the options", command=command)
-        hint = N_("did you mean {names}? {then}", names=_or(sorted(exc.possibilities)), then=lists) \
-            if exc.possibilities else lists
-        return Diagnostic(exc.option_name, None, None,
-                          N_("{option} is not an option of this command", option=exc.option_name), hint)
+        hint = (
+            N_("did you mean {names}? {then}", names=_or(sorted(exc.possibilities)), then=lists)
+            if exc.possibilities
+            else lists
+        )
+        return Diagnostic(
+            exc.option_name, None, None, N_("{option} is not an option of this command", option=exc.option_name), hint
+        )
     param = exc.param
     name = _name(param)
     choices = _choices(param)
     if isinstance(exc, MissingParameter):
-        hint = N_("give {name} one of: {choices}", name=name, choices=", ".join(choices)) if choices else \
-            N_("{command} says what {name} takes", command=command, name=name)
+        hint = (
+            N_("give {name} one of: {choices}", name=name, choices=", ".join(choices))
+            if choices
+            else N_("{command} says what {name} takes", command=command, name=name)
+        )
         return Diagnostic(name, None, None, N_("{name} is missing", name=name), hint)
     value = _value(given, param)
     shown = repr(value) if value is not None else N_("the value given")
     if choices:
-        return Diagnostic(name, None, None, N_("{shown} is not one of the choices of {name}", shown=shown, name=name),
-                          N_("use one of: {choices}", choices=", ".join(choices)))
+        return Diagnostic(
+            name,
+            None,
+            None,
+            N_("{shown} is not one of the choices of {name}", shown=shown, name=name),
+            N_("use one of: {choices}", choices=", ".join(choices)),
+        )
     number = _number_kind(param)
     if number and value is not None and not _parses(value, number):
-        return Diagnostic(name, None, None, N_("{shown} is not a number", shown=shown),
-                          N_("give a whole number") if number is int else N_("give a number, such as 2 or 0.5"))
+        return Diagnostic(
+            name,
+            None,
+            None,
+            N_("{shown} is not a number", shown=shown),
+            N_("give a whole number") if number is int else N_("give a number, such as 2 or 0.5"),
+        )
     if number:
         assert param is not None  # a number kind comes only from a parameter's type
         low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
-        hint = N_("give {name} a value from {low} to {high}", name=name, low=low, high=high) \
-            if low is not None and high is not None else \
-            N_("give {name} a value of at least {low}", name=name, low=low) if low is not None else \
-            N_("give {name} a value of at most {high}", name=name, high=high) if high is not None else \
-            N_("give {name} a value such as 0.5", name=name)
+        hint = (
+            N_("give {name} a value from {low} to {high}", name=name, low=low, high=high)
+            if low is not None and high is not None
+            else N_("give {name} a value of at least {low}", name=name, low=low)
+            if low is not None
+            else N_("give {name} a value of at most {high}", name=name, high=high)
+            if high is not None
+            else N_("give {name} a value such as 0.5", name=name)
+        )
         finite = number is int or value is None or math.isfinite(float(value))
-        wrong = N_("{name} {value} is out of range", name=name, value=value) if finite else \
-            N_("{name} {value} is not a finite number", name=name, value=value)
+        wrong = (
+            N_("{name} {value} is out of range", name=name, value=value)
+            if finite
+            else N_("{name} {value} is not a finite number", name=name, value=value)
+        )
         return Diagnostic(name, None, None, wrong, hint)
-    return Diagnostic(name, None, None, N_("{shown}: {problem}", shown=shown, problem=_click_message(exc.message)),
-                      N_("{command} says what {name} takes", command=command, name=name))
+    return Diagnostic(
+        name,
+        None,
+        None,
+        N_("{shown}: {problem}", shown=shown, problem=_click_message(exc.message)),
+        N_("{command} says what {name} takes", command=command, name=name),
+    )
 
 
 def _or(names: Sequence[str]) -> str:
@@ -212,14 +251,22 @@ def _or(names: Sequence[str]) -> str:
 #: click's own messages that reach a user (its copy in typer writes them in English), as tablebot's: a pattern
 #: of click's text, and the message with the pattern's groups as its arguments.
 CLICK_MESSAGES = (
-    (re.compile(r"Got unexpected extra argument(?:s|\(s\))? \((?P<args>.*)\)$", re.S),
-     lambda args: N_("unexpected extra argument(s): {args}", args=args)),
-    (re.compile(r"Option '(?P<option>[^']*)' requires (?:an argument|(?P<n>\d+) arguments)\.?$"),
-     lambda option, n: N_("{option} needs a value", option=option)),
-    (re.compile(r"Option '(?P<option>[^']*)' does not take a value\.?$"),
-     lambda option: N_("{option} takes no value", option=option)),
-    (re.compile(r"(?P<value>'.*') is not a valid (?P<kind>[a-z ]+)\.?$", re.S),
-     lambda value, kind: N_("{value} is not a valid value", value=value)),
+    (
+        re.compile(r"Got unexpected extra argument(?:s|\(s\))? \((?P<args>.*)\)$", re.S),
+        lambda args: N_("unexpected extra argument(s): {args}", args=args),
+    ),
+    (
+        re.compile(r"Option '(?P<option>[^']*)' requires (?:an argument|(?P<n>\d+) arguments)\.?$"),
+        lambda option, n: N_("{option} needs a value", option=option),
+    ),
+    (
+        re.compile(r"Option '(?P<option>[^']*)' does not take a value\.?$"),
+        lambda option: N_("{option} takes no value", option=option),
+    ),
+    (
+        re.compile(r"(?P<value>'.*') is not a valid (?P<kind>[a-z ]+)\.?$", re.S),
+        lambda value, kind: N_("{value} is not a valid value", value=value),
+    ),
 )
 
 
@@ -272,5 +319,5 @@ def _value(given: Sequence[str], param: Any) -> str | None:
             if word == opt and k + 1 < len(given):
                 found = given[k + 1]
             elif word.startswith(opt + "="):
-                found = word[len(opt) + 1:]
+                found = word[len(opt) + 1 :]
     return found

@@ -25,17 +25,37 @@ from tablebot.i18n import N_, gettext
 
 #: The words typer's copy of click writes itself, marked for the catalog (they are translated in :func:`localise`).
 CLICK_WORDS = (
-    N_("Usage: "), N_("[OPTIONS]"), N_("COMMAND [ARGS]..."), N_("Show this message and exit."),
-    N_("<path>"), N_("<text>"), N_("<integer>"), N_("<float>"), N_("<int range>"), N_("<float range>"),
-    N_("<file>"), N_("<directory>"), N_("<boolean>"), N_("<filename>"),
+    N_("Usage: "),
+    N_("[OPTIONS]"),
+    N_("COMMAND [ARGS]..."),
+    N_("Show this message and exit."),
+    N_("<path>"),
+    N_("<text>"),
+    N_("<integer>"),
+    N_("<float>"),
+    N_("<int range>"),
+    N_("<float range>"),
+    N_("<file>"),
+    N_("<directory>"),
+    N_("<boolean>"),
+    N_("<filename>"),
     # typer.core's gettext calls (the section titles, the extras after an option's help)
-    N_("Arguments"), N_("Options"), N_("Commands"), N_("default: {default}"), N_("required"), N_("(dynamic)"),
-    N_("env var: {var}"), N_("Aborted!"), N_("Missing command."),
+    N_("Arguments"),
+    N_("Options"),
+    N_("Commands"),
+    N_("default: {default}"),
+    N_("required"),
+    N_("(dynamic)"),
+    N_("env var: {var}"),
+    N_("Aborted!"),
+    N_("Missing command."),
 )
 HELP_NAMES = ["-h", "--help"]
 #: ``--lang``'s help, the main one's and every command's (the option is taken anywhere on the line).
-LANG_HELP = ("The language of tablebot's messages: de (Deutsch) or en (English); default: TABLEBOT_LANG, else the "
-             "system's language. It may stand anywhere on the line.")
+LANG_HELP = (
+    "The language of tablebot's messages: de (Deutsch) or en (English); default: TABLEBOT_LANG, else the "
+    "system's language. It may stand anywhere on the line."
+)
 
 
 def _translate(text: str) -> str:
@@ -91,8 +111,12 @@ def _param(param: Any, ctx: Context) -> None:
         return
     if param.param_type_name == "argument":
         return
-    if param.metavar is None and not getattr(param, "is_flag", False) and not getattr(param, "count", False) \
-            and param.type.get_metavar(param=param, ctx=ctx) is None:
+    if (
+        param.metavar is None
+        and not getattr(param, "is_flag", False)
+        and not getattr(param, "count", False)
+        and param.type.get_metavar(param=param, ctx=ctx) is None
+    ):
         name = param.type.name
         shown = name if name.startswith("<") else f"<{name}>"  # click's own form of a type's name
         param.metavar = gettext(shown)

@@ -40,10 +40,26 @@ def export(machine: Machine, out: Path | None, options: ExportOptions) -> Export
     source = generate(machine, options.lookup) if tables is None else generate_several(tables, options.lookup)
     files = tuple(source.write(out_folder(out, "OUTDIR")))
     kind = "dense" if source.layout.dense else "scan"
-    return Exported(files, (*(N_("wrote {file}", file=str(path)) for path in files),
-                            N_("lookup: {kind}, {size} bytes; table hash 0x{hash:08x}", kind=kind,
-                               size=source.layout.lookup_bytes, hash=source.layout.table_hash)))
+    return Exported(
+        files,
+        (
+            *(N_("wrote {file}", file=str(path)) for path in files),
+            N_(
+                "lookup: {kind}, {size} bytes; table hash 0x{hash:08x}",
+                kind=kind,
+                size=source.layout.lookup_bytes,
+                hash=source.layout.table_hash,
+            ),
+        ),
+    )
 
 
-C = register(ExportBackend(name="c", makes="a portable C99 engine and the table as const data",
-                           help="portable C99 engine + table", fit=fit, export=export))
+C = register(
+    ExportBackend(
+        name="c",
+        makes="a portable C99 engine and the table as const data",
+        help="portable C99 engine + table",
+        fit=fit,
+        export=export,
+    )
+)

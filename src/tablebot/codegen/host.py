@@ -43,11 +43,24 @@ def build_host(machine: Machine, outdir: Path, lookup: str = "auto") -> Path:
     return exe
 
 
-def trace_line(machine: Machine, tick: int, event: int, row: int, state: int, timer: int,
-               outputs: Sequence[int], counters: Sequence[int]) -> dict[str, Any]:
+def trace_line(
+    machine: Machine,
+    tick: int,
+    event: int,
+    row: int,
+    state: int,
+    timer: int,
+    outputs: Sequence[int],
+    counters: Sequence[int],
+) -> dict[str, Any]:
     """A core trace line (see :func:`tablebot.formats.trace_lines.record`) from raw engine values."""
-    line: dict[str, Any] = {"tick": tick, "event": event, "row": None if row == NO_ROW else row,
-                            "state": machine.states[state], "timer": timer}
+    line: dict[str, Any] = {
+        "tick": tick,
+        "event": event,
+        "row": None if row == NO_ROW else row,
+        "state": machine.states[state],
+        "timer": timer,
+    }
     line.update(zip(machine.output_names, outputs, strict=True))
     line.update(zip(machine.table.robot.counter_names, counters, strict=True))
     return line
@@ -56,24 +69,25 @@ def trace_line(machine: Machine, tick: int, event: int, row: int, state: int, ti
 def run_host(exe: Path, machine: Machine, ticks: Sequence[TickInput]) -> list[dict[str, Any]]:
     """Run the compiled engine over recorded inputs; one trace line per tick."""
     n_counters = len(machine.table.robot.counters)
-    text = "".join(" ".join(map(str, [t.mask, *(list(t.pulses) + [0] * n_counters)[:n_counters]])) + "\n"
-                   for t in ticks)
+    text = "".join(
+        " ".join(map(str, [t.mask, *(list(t.pulses) + [0] * n_counters)[:n_counters]])) + "\n" for t in ticks
+    )
     done = subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True)
     n_out = len(machine.output_names)
     lines = []
     for tick, raw in enumerate(done.stdout.splitlines()):
         values = [int(v) for v in raw.split()]
         event, row, state, timer = values[:4]
-        lines.append(trace_line(machine, tick, event, row, state, timer,
-                                values[4:4 + n_out], values[4 + n_out:]))
+        lines.append(trace_line(machine, tick, event, row, state, timer, values[4 : 4 + n_out], values[4 + n_out :]))
     return lines
 
 
 HOST_SEVERAL = "host_several.c"
 
 
-def build_host_several(tables: RobotTables, outdir: Path, lookup: str = "auto",
-                       order: Sequence[int] | None = None) -> Path:
+def build_host_several(
+    tables: RobotTables, outdir: Path, lookup: str = "auto", order: Sequence[int] | None = None
+) -> Path:
     """:func:`build_host` for a robot of several tables (``order``: the order its tick steps the tables in)."""
     from tablebot.codegen.several import generate_several
 
@@ -81,8 +95,16 @@ def build_host_several(tables: RobotTables, outdir: Path, lookup: str = "auto",
     source.write(outdir)
     exe = outdir / "host_several"
     units = [str(outdir / name) for name in source.files if name.endswith(".c") and name != "tb_engine.c"]
-    command = [find_compiler(), *WARNINGS, "-O1", f"-I{outdir}", "-o", str(exe), str(template_path(HOST_SEVERAL)),
-               *units]
+    command = [
+        find_compiler(),
+        *WARNINGS,
+        "-O1",
+        f"-I{outdir}",
+        "-o",
+        str(exe),
+        str(template_path(HOST_SEVERAL)),
+        *units,
+    ]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
         raise fail(outdir, NO_COMPILE, BUG, detail=done.stderr)
@@ -93,8 +115,9 @@ def run_host_several(exe: Path, tables: RobotTables, ticks: Sequence[TickInput])
     """Run a robot's compiled tables over recorded inputs (the robot's input layout); one trace line per tick,
     keyed as :func:`tablebot.replay.record_several` keys them."""
     n_counters = len(tables.robot.counters)
-    text = "".join(" ".join(map(str, [t.mask, *(list(t.pulses) + [0] * n_counters)[:n_counters]])) + "\n"
-                   for t in ticks)
+    text = "".join(
+        " ".join(map(str, [t.mask, *(list(t.pulses) + [0] * n_counters)[:n_counters]])) + "\n" for t in ticks
+    )
     done = subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True)
     n_tables, n_out = len(tables.machines), len(tables.output_names)
     lines = []
@@ -102,14 +125,14 @@ def run_host_several(exe: Path, tables: RobotTables, ticks: Sequence[TickInput])
         values = [int(v) for v in raw.split()]
         line: dict[str, Any] = {"tick": tick}
         for i, (name, machine) in enumerate(zip(tables.names, tables.machines, strict=True)):
-            event, row, state, timer = values[4 * i: 4 * i + 4]
+            event, row, state, timer = values[4 * i : 4 * i + 4]
             key = "" if i == 0 else f"{name}."
             line[f"{key}event"] = event
             line[f"{key}row"] = None if row < 0 else machine.table.rows[row].as_written
             line[f"{key}state"] = machine.states[state]
             line[f"{key}timer"] = timer
             if i == 0:  # the main table's keys, then the robot's outputs and counters, as a trace has them
-                rest = values[4 * n_tables:]
+                rest = values[4 * n_tables :]
                 line.update(zip(tables.output_names, rest[:n_out], strict=True))
                 line.update(zip(tables.robot.counter_names, rest[n_out:], strict=True))
         lines.append(line)

@@ -69,17 +69,25 @@ def check_fits(machine: Machine) -> None:
     table = machine.table
     n_events = len(table.events)
     if n_events > MAX_EVENTS:
-        raise fail(table.path, N_("{count} event columns; the C engine holds at most {most}", count=n_events,
-                                  most=MAX_EVENTS),
-                   N_("drop event columns the table does not need"), 1)
+        raise fail(
+            table.path,
+            N_("{count} event columns; the C engine holds at most {most}", count=n_events, most=MAX_EVENTS),
+            N_("drop event columns the table does not need"),
+            1,
+        )
     counters = len(table.robot.counters)
     if counters > MAX_COUNTERS:
-        raise fail(table.robot.source, N_("{count} counters; the C engine holds at most {most}", count=counters,
-                                          most=MAX_COUNTERS),
-                   N_("use fewer counters"))
+        raise fail(
+            table.robot.source,
+            N_("{count} counters; the C engine holds at most {most}", count=counters, most=MAX_COUNTERS),
+            N_("use fewer counters"),
+        )
     if len(machine.rows) >= 0xFFFF:
-        raise fail(table.path, N_("{count} rows; the C engine holds at most 65534", count=len(machine.rows)),
-                   N_("split the table"))
+        raise fail(
+            table.path,
+            N_("{count} rows; the C engine holds at most 65534", count=len(machine.rows)),
+            N_("split the table"),
+        )
 
 
 def reachable(rows: list[tuple[int, int]]) -> list[tuple[int, int]]:
@@ -104,8 +112,11 @@ def _scan(machine: Machine) -> tuple[tuple[int, ...], tuple[tuple[int, int], ...
 
 def _dense(machine: Machine, no_row: int) -> tuple[int, ...]:
     n = len(machine.table.events)
-    return tuple(no_row if (r := machine.lookup(s, ev)) == NO_ROW else r
-                 for s in range(len(machine.states)) for ev in range(1 << n))
+    return tuple(
+        no_row if (r := machine.lookup(s, ev)) == NO_ROW else r
+        for s in range(len(machine.states))
+        for ev in range(1 << n)
+    )
 
 
 def plan(machine: Machine, lookup: str = "auto") -> Layout:
@@ -117,16 +128,22 @@ def plan(machine: Machine, lookup: str = "auto") -> Layout:
     row = unsigned_for(len(machine.rows))  # the largest value is the "no row" marker
     no_row = (1 << (8 * row.size)) - 1
     dense_bytes = len(machine.states) * (1 << n_events) * row.size if n_events <= 16 else None
-    dense = lookup == "dense" or (lookup == "auto" and dense_bytes is not None
-                                  and dense_bytes <= DENSE_LIMIT_BYTES)
+    dense = lookup == "dense" or (lookup == "auto" and dense_bytes is not None and dense_bytes <= DENSE_LIMIT_BYTES)
     if dense and dense_bytes is None:
-        raise fail(machine.table.path, N_("a dense lookup of {count} event bits is too large", count=n_events),
-                   N_("use the scan lookup"))
+        raise fail(
+            machine.table.path,
+            N_("a dense lookup of {count} event bits is too large", count=n_events),
+            N_("use the scan lookup"),
+        )
     starts, entries = ((), ()) if dense else _scan(machine)
     return Layout(
         event=unsigned_for((1 << n_events) - 1 if n_events else 0),
         state=unsigned_for(len(machine.states) - 1),
-        row=row, no_row=no_row, dense=dense,
+        row=row,
+        no_row=no_row,
+        dense=dense,
         lookup=_dense(machine, no_row) if dense else (),
-        scan_start=starts, scan=entries, table_hash=table_hash(machine),
+        scan_start=starts,
+        scan=entries,
+        table_hash=table_hash(machine),
     )

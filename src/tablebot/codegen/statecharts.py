@@ -41,20 +41,40 @@ def export_scxml(machine: Machine, out: Path | None, options: ExportOptions) -> 
     from tablebot.formats.statecharts.scxml import export_scxml as scxml
 
     text = scxml(_tables(machine))
-    return _write(out, {SCXML_FILE: text}, N_("send it one event 'tick' per tick, the inputs and pulses as its data "
-                                              "(docs: Statecharts)"))
+    return _write(
+        out,
+        {SCXML_FILE: text},
+        N_("send it one event 'tick' per tick, the inputs and pulses as its data (docs: Statecharts)"),
+    )
 
 
 def export_xstate(machine: Machine, out: Path | None, options: ExportOptions) -> Exported:
     from tablebot.formats.statecharts.xstate import RUNTIME, export_xstate, runtime_module
 
     text = export_xstate(_tables(machine))
-    return _write(out, {XSTATE_FILE: text, RUNTIME: runtime_module()},
-                  N_("createActor(tablebotMachine(config)) from {runtime}, then one 'tick' event per tick "
-                     "(docs: Statecharts)", runtime=RUNTIME))
+    return _write(
+        out,
+        {XSTATE_FILE: text, RUNTIME: runtime_module()},
+        N_(
+            "createActor(tablebotMachine(config)) from {runtime}, then one 'tick' event per tick (docs: Statecharts)",
+            runtime=RUNTIME,
+        ),
+    )
 
 
-SCXML = register(ExportBackend(name="scxml", makes="a W3C SCXML statechart, one 'tick' event per tick",
-                               help="SCXML statechart", export=export_scxml))
-XSTATE = register(ExportBackend(name="xstate", makes="an XState 5 machine config (JSON) and the module that "
-                                "implements its guards and actions", help="XState 5 machine", export=export_xstate))
+SCXML = register(
+    ExportBackend(
+        name="scxml",
+        makes="a W3C SCXML statechart, one 'tick' event per tick",
+        help="SCXML statechart",
+        export=export_scxml,
+    )
+)
+XSTATE = register(
+    ExportBackend(
+        name="xstate",
+        makes="an XState 5 machine config (JSON) and the module that implements its guards and actions",
+        help="XState 5 machine",
+        export=export_xstate,
+    )
+)

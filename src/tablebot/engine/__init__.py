@@ -63,8 +63,9 @@ class Engine:
 
     # --- the tick ------------------------------------------------------------------------------
 
-    def step(self, inputs: int | np.integer | Mapping[str, int] = 0,
-             pulses: Sequence[int] | np.ndarray | None = None) -> tuple[int, ...]:
+    def step(
+        self, inputs: int | np.integer | Mapping[str, int] = 0, pulses: Sequence[int] | np.ndarray | None = None
+    ) -> tuple[int, ...]:
         """Advance one tick; ``pulses`` are encoder pulses per robot counter since the last tick (a sequence or
         numpy array; None or () when there are none).
 
@@ -89,8 +90,9 @@ class Engine:
         if pulses is not None and pulses is not _NONE:  # None, and the () of callers without counters: nothing
             self._count_down(pulses, tick, inputs)
         try:
-            self.event, self.row, effect = (self._running if tick < self._deadline
-                                            else self._at_zero)[self.state][inputs]
+            self.event, self.row, effect = (self._running if tick < self._deadline else self._at_zero)[self.state][
+                inputs
+            ]
         except IndexError:  # the state's list is not made yet, or the mask is beyond the table's events
             self.event, self.row, effect = self._entry(tick, inputs)
         self._tick = tick
@@ -120,8 +122,10 @@ class Engine:
         value = int(inputs)
         width = self._width
         if value < 0 or value >> width:
-            raise ValueError(f"input mask {value} is not a mask of this table's {width} event columns "
-                             f"(0..{(1 << width) - 1}); its inputs are {bits_text(m)}")
+            raise ValueError(
+                f"input mask {value} is not a mask of this table's {width} event columns "
+                f"(0..{(1 << width) - 1}); its inputs are {bits_text(m)}"
+            )
         return value & m.input_mask
 
     def _entry(self, tick: int, inputs: int) -> Entry:
@@ -145,8 +149,10 @@ class Engine:
         if len(pulses) != len(counters):
             if not len(pulses):
                 return
-            raise ValueError(f"pulses: {len(pulses)} values for {len(counters)} counters "
-                             f"({', '.join(self.machine.table.robot.counter_names) or 'none'})")
+            raise ValueError(
+                f"pulses: {len(pulses)} values for {len(counters)} counters "
+                f"({', '.join(self.machine.table.robot.counter_names) or 'none'})"
+            )
         if min(pulses, default=0) < 0:
             i = next(i for i, count in enumerate(pulses) if count < 0)
             raise ValueError(f"pulses: {pulses[i]} for counter {i + 1} is negative")
@@ -191,15 +197,23 @@ class Engine:
     def _choose_lookups(self) -> None:
         """The lookups for the Cn bits of the counters at 0; called whenever a counter may have reached
         or left 0, so that a tick needs no counter test."""
-        zero = sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0) \
-            if self._counter_bits else 0  # () when no counter is an event column
+        zero = (
+            sum(bit for bit, count in zip(self._counter_bits, self._counters, strict=True) if count == 0)
+            if self._counter_bits
+            else 0
+        )  # () when no counter is an event column
         self._zero_counters = zero
         self._running, self._at_zero = self._lookups[zero], self._lookups[zero | self.machine.timer_bit]
 
     # --- the batch path ------------------------------------------------------------------------
 
-    def run(self, masks: Sequence[int] | np.ndarray, pulses: Sequence[Sequence[int]] | np.ndarray | None = None, *,
-            jit: bool | None = None) -> Batch:
+    def run(
+        self,
+        masks: Sequence[int] | np.ndarray,
+        pulses: Sequence[Sequence[int]] | np.ndarray | None = None,
+        *,
+        jit: bool | None = None,
+    ) -> Batch:
         """Many ticks in one call, inputs as event-layout bitmasks; same semantics as ``step``.
 
         ``pulses`` (one row per mask, a value per counter) count the counters down; without them the
@@ -212,8 +226,7 @@ class Engine:
             from tablebot import engine_batch as kernels
 
             if kernels.available():
-                return self._run_compiled(arrays, mask_array(masks, self._width),
-                                          self._pulse_array(pulses, len(masks)))
+                return self._run_compiled(arrays, mask_array(masks, self._width), self._pulse_array(pulses, len(masks)))
         if jit:
             raise RuntimeError("the compiled batch path needs numba and at most FLAT_BITS event columns")
         return self._run_python(masks, pulses)
@@ -246,8 +259,9 @@ class Engine:
         self.outputs = tuple(outputs.tolist())
         self.counters = counters.tolist()
 
-    def _run_python(self, masks: Sequence[int] | np.ndarray,
-                    pulses: Sequence[Sequence[int]] | np.ndarray | None) -> Batch:
+    def _run_python(
+        self, masks: Sequence[int] | np.ndarray, pulses: Sequence[Sequence[int]] | np.ndarray | None
+    ) -> Batch:
         """The batch loop without numba: ``step`` per tick, collecting the columns."""
         columns: tuple[list[int], ...] = ([], [], [], [])
         step = self.step

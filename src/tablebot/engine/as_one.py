@@ -38,8 +38,9 @@ class RobotEngine:
         self.several = Several(tables)
         self.machine = robot_machine(tables)
 
-    def step(self, inputs: int | np.integer | Mapping[str, int] = 0,
-             pulses: Sequence[int] | np.ndarray | None = None) -> tuple[int, ...]:
+    def step(
+        self, inputs: int | np.integer | Mapping[str, int] = 0, pulses: Sequence[int] | np.ndarray | None = None
+    ) -> tuple[int, ...]:
         return self.several.step(inputs, pulses)
 
     @property

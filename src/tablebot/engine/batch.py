@@ -16,8 +16,9 @@ class Batch:
 
     FIELDS = ("events", "rows", "states", "timers")
 
-    def __init__(self, events: Sequence[int], rows: Sequence[int], states: Sequence[int],
-                 timers: Sequence[int]) -> None:
+    def __init__(
+        self, events: Sequence[int], rows: Sequence[int], states: Sequence[int], timers: Sequence[int]
+    ) -> None:
         self._columns: dict[str, Sequence[int]] = dict(zip(self.FIELDS, (events, rows, states, timers), strict=True))
 
     def _list(self, name: str) -> list[int]:
@@ -77,6 +78,7 @@ def mask_array(masks: Sequence[int] | np.ndarray, width: int) -> np.ndarray:
             array = np.asarray(masks, dtype=np.int64)
     if len(array) and (array.min() < 0 or int(array.max()) >> width):
         bad = next(int(v) for v in array.tolist() if v < 0 or v >> width)
-        raise ValueError(f"input mask {bad} is not a mask of this table's {width} event columns "
-                         f"(0..{(1 << width) - 1})")
+        raise ValueError(
+            f"input mask {bad} is not a mask of this table's {width} event columns (0..{(1 << width) - 1})"
+        )
     return array

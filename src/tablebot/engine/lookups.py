@@ -39,8 +39,9 @@ class Lookups(dict[int, list[Any]]):
 
     def __missing__(self, present: int) -> list[Any]:
         m = self.machine
-        self[present] = lookups = [[] if m.flat is not None else WideEntries(self, state, present)
-                                   for state in range(len(m.states))]
+        self[present] = lookups = [
+            [] if m.flat is not None else WideEntries(self, state, present) for state in range(len(m.states))
+        ]
         return lookups
 
     def made(self, present: int, state: int) -> list[Entry] | WideEntries:

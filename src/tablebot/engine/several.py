@@ -35,8 +35,9 @@ class Several:
         self.cross_maps = [cross_bits(tables, i) for i in range(len(self.engines))]
         robot = tables.robot
         self._writers = [tables.writer(name) for name in tables.output_names]
-        self._counter_writers = [(c, w) for c, name in enumerate(robot.counter_names)
-                                 if (w := tables.writer(name)) is not None]
+        self._counter_writers = [
+            (c, w) for c, name in enumerate(robot.counter_names) if (w := tables.writer(name)) is not None
+        ]
         self.outputs: tuple[int, ...] = (0,) * len(tables.output_names)
 
     @property
@@ -47,8 +48,9 @@ class Several:
     def counters(self) -> list[int]:
         return self.engines[0].counters
 
-    def step(self, inputs: int | np.integer | Mapping[str, int] = 0,
-             pulses: Sequence[int] | np.ndarray | None = None) -> tuple[int, ...]:
+    def step(
+        self, inputs: int | np.integer | Mapping[str, int] = 0, pulses: Sequence[int] | np.ndarray | None = None
+    ) -> tuple[int, ...]:
         """One tick of every table (see :mod:`tablebot.tables`); a refused input changes nothing."""
         mask = self.events_of(inputs)
         states = [engine.state for engine in self.engines]  # the start of the tick, before any table fires
@@ -63,7 +65,7 @@ class Several:
             value = engines[w].counters[c]
             for engine in engines:
                 if engine.counters[c] != value:
-                    engine.counters = [*engine.counters[:c], value, *engine.counters[c + 1:]]
+                    engine.counters = [*engine.counters[:c], value, *engine.counters[c + 1 :]]
         return self.outputs
 
     def events_of(self, inputs: int | np.integer | Mapping[str, int]) -> int:
@@ -79,8 +81,10 @@ class Several:
                 mask |= bits[name] if value else 0
             return mask
         if isinstance(inputs, bool) or not isinstance(inputs, int | np.integer) or not 0 <= inputs < 1 << len(bits):
-            raise ValueError(f"input mask {inputs!r} is not a mask of the robot's {len(bits)} inputs "
-                             f"({', '.join(f'{n}={b}' for n, b in bits.items()) or 'none'})")
+            raise ValueError(
+                f"input mask {inputs!r} is not a mask of the robot's {len(bits)} inputs "
+                f"({', '.join(f'{n}={b}' for n, b in bits.items()) or 'none'})"
+            )
         return int(inputs)
 
 
@@ -111,4 +115,3 @@ def _input_map(tables: RobotTables, index: int) -> Callable[[int], int]:
     if width <= LIST_BITS:
         return [sum(table_bit for bit, table_bit in pairs if mask & bit) for mask in range(1 << width)].__getitem__
     return lambda mask: sum(table_bit for bit, table_bit in pairs if mask & bit)
-

@@ -25,9 +25,14 @@ Breed = Callable[[Sequence[str], np.random.Generator, int], list[str]]
 def make_archive(descriptors: Sequence[Descriptor], worst: float = 0.0, seed: int = 0) -> GridArchive:
     """A grid of ``cells`` per descriptor over its range; solutions are candidate keys. ``worst``: the
     lowest objective (as maximised) a run can have, so the QD score counts every elite as a gain."""
-    return GridArchive(solution_dim=(), dims=[d.cells for d in descriptors],
-                       ranges=[(d.low, d.high) for d in descriptors], solution_dtype=object, qd_score_offset=worst,
-                       seed=seed)  # pyribs draws with it only in sample_elites, which evolve does not call
+    return GridArchive(
+        solution_dim=(),
+        dims=[d.cells for d in descriptors],
+        ranges=[(d.low, d.high) for d in descriptors],
+        solution_dtype=object,
+        qd_score_offset=worst,
+        seed=seed,
+    )  # pyribs draws with it only in sample_elites, which evolve does not call
 
 
 class TableEmitter(EmitterBase):
@@ -35,8 +40,7 @@ class TableEmitter(EmitterBase):
     ``breed`` varies, proves and deduplicates them."""
 
     def __init__(self, archive: GridArchive, breed: Breed, batch: int, seed: int) -> None:
-        super().__init__(archive, solution_dim=archive.solution_dim, bounds=None, lower_bounds=None,
-                         upper_bounds=None)
+        super().__init__(archive, solution_dim=archive.solution_dim, bounds=None, lower_bounds=None, upper_bounds=None)
         self.breed, self.batch, self.seed = breed, batch, seed
         self.generation = 0
 
@@ -57,8 +61,9 @@ class TableEmitter(EmitterBase):
         return out
 
 
-def add(archive: GridArchive, keys: Sequence[str], objective: Sequence[float],
-        measures: Sequence[Sequence[float]]) -> Any:
+def add(
+    archive: GridArchive, keys: Sequence[str], objective: Sequence[float], measures: Sequence[Sequence[float]]
+) -> Any:
     """Put candidates into the archive directly (the start and the repaired table, before any asking)."""
     solutions = np.empty(len(keys), dtype=object)
     for k, key in enumerate(keys):
@@ -70,6 +75,8 @@ def elites(archive: GridArchive) -> list[tuple[str, float, tuple[float, ...], tu
     """Every elite: key, objective (as the archive maximises it), measures, grid cell; best first."""
     data = archive.data(["solution", "objective", "measures", "index"])
     cells = archive.int_to_grid_index(data["index"]) if len(data["index"]) else []
-    out = [(str(s), float(o), tuple(float(v) for v in m), tuple(int(c) for c in cell))
-           for s, o, m, cell in zip(data["solution"], data["objective"], data["measures"], cells, strict=True)]
+    out = [
+        (str(s), float(o), tuple(float(v) for v in m), tuple(int(c) for c in cell))
+        for s, o, m, cell in zip(data["solution"], data["objective"], data["measures"], cells, strict=True)
+    ]
     return sorted(out, key=lambda e: (-e[1], e[3]))

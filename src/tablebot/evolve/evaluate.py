@@ -63,10 +63,11 @@ def joint(tables: Sequence[Table]) -> Table:
     robot = tables[0].robot
     rows: list[Row] = []
     for k, table in enumerate(tables):
-        rows += [replace(row, index=len(rows) + i, state=(k, row.state), next=(k, row.next))
-                 for i, row in enumerate(table.rows)]
-    return Table(replace(robot, initial_state=(0, robot.initial_state)), tables[0].events, tuple(rows),
-                 tables[0].path)
+        rows += [
+            replace(row, index=len(rows) + i, state=(k, row.state), next=(k, row.next))
+            for i, row in enumerate(table.rows)
+        ]
+    return Table(replace(robot, initial_state=(0, robot.initial_state)), tables[0].events, tuple(rows), tables[0].path)
 
 
 def starts(machine: Machine, parts: int) -> np.ndarray:
@@ -143,18 +144,22 @@ def measure_all(fleet: Fleet, world: World, poses: Poses, owner: np.ndarray) -> 
     candidate in the joint table (its share of time per state is read from that candidate's states)."""
     s = fleet.summary()
     seconds = s.ticks * s.tick_s
-    out = {"collisions": s.collisions.astype(float), "collision_share": poses.touching / poses.samples,
-           "distance": s.distance_m.astype(float)}
+    out = {
+        "collisions": s.collisions.astype(float),
+        "collision_share": poses.touching / poses.samples,
+        "distance": s.distance_m.astype(float),
+    }
     if world.lamps:
         out["time_to_lamp"] = np.where(s.reached < 0, seconds, s.reached * s.tick_s)
         out["time_to_light"] = np.where(s.first_light < 0, seconds, s.first_light * s.tick_s)
         out["missed_lamp"] = (s.reached < 0).astype(float)
         lamps = np.array([lamp.at for lamp in world.lamps])
         pose = s.final_pose
-        out["lamp_distance"] = np.min(np.hypot(pose[:, None, 0] - lamps[None, :, 0],
-                                               pose[:, None, 1] - lamps[None, :, 1]), axis=1)
+        out["lamp_distance"] = np.min(
+            np.hypot(pose[:, None, 0] - lamps[None, :, 0], pose[:, None, 1] - lamps[None, :, 1]), axis=1
+        )
     if len(world.walls) >= 3:
-        out["area_covered"] = poses.visited.sum(axis=1) * CELL_M ** 2
+        out["area_covered"] = poses.visited.sum(axis=1) * CELL_M**2
     if poses.loop is not None:
         out["laps"] = poses.laps.copy()
     total = np.maximum(1, s.counts.sum(axis=1))
@@ -232,23 +237,44 @@ class Evaluator:
                 chunk = scenarios[a:b]
                 for world in dict.fromkeys(r[0] for r in chunk):
                     mine = [r for r in chunk if r[0] == world]
-                    jobs.append(EvalJob(tables.table, plan.worlds[world], plan.robot_params, [r[2] for r in mine],
-                                        plan.spec.ticks, first=mine[0][1], tables=tables,
-                                        parts=(Part(key, tuple(r[1] for r in mine)),)))
+                    jobs.append(
+                        EvalJob(
+                            tables.table,
+                            plan.worlds[world],
+                            plan.robot_params,
+                            [r[2] for r in mine],
+                            plan.spec.ticks,
+                            first=mine[0][1],
+                            tables=tables,
+                            parts=(Part(key, tuple(r[1] for r in mine)),),
+                        )
+                    )
         return jobs
 
     @staticmethod
-    def job(candidates: Sequence[tuple[str, Table]], robots: list[tuple[int, int, int, RobotSpec]], plan: Plan,
-            world: int) -> EvalJob:
+    def job(
+        candidates: Sequence[tuple[str, Table]], robots: list[tuple[int, int, int, RobotSpec]], plan: Plan, world: int
+    ) -> EvalJob:
         """One fleet of ``robots`` (candidate, world, scenario index, robot), all in ``world``."""
         order = list(dict.fromkeys(r[0] for r in robots))
         parts = tuple(Part(candidates[k][0], tuple(r[2] for r in robots if r[0] == k)) for k in order)
         specs = [r[3] for k in order for r in robots if r[0] == k]
-        return EvalJob(joint([candidates[k][1] for k in order]), plan.worlds[world], plan.robot_params, specs,
-                       plan.spec.ticks, first=robots[0][2], parts=parts)
+        return EvalJob(
+            joint([candidates[k][1] for k in order]),
+            plan.worlds[world],
+            plan.robot_params,
+            specs,
+            plan.spec.ticks,
+            first=robots[0][2],
+            parts=parts,
+        )
 
-    def run(self, candidates: Sequence[tuple[str, Table]], done: Callable[[str, Means, dict[str, np.ndarray]], None],
-            plan: Plan | None = None) -> None:
+    def run(
+        self,
+        candidates: Sequence[tuple[str, Table]],
+        done: Callable[[str, Means, dict[str, np.ndarray]], None],
+        plan: Plan | None = None,
+    ) -> None:
         """Evaluate every candidate; ``done(key, means, values)`` as soon as all of one candidate's robots
         are in (``values``: per measure, each scenario's number in scenario order)."""
         plan = plan or self.plan
@@ -266,7 +292,7 @@ class Evaluator:
             for part in job.parts:
                 n, where = len(part.scenarios), list(part.scenarios)
                 for name in self.names:
-                    values[part.key][name][where] = measured[name][at:at + n]
+                    values[part.key][name][where] = measured[name][at : at + n]
                 at += n
                 self.robot_ticks += n * plan.spec.ticks
                 waiting[part.key] -= 1

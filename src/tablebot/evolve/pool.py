@@ -88,16 +88,18 @@ class Workers:
     They come from a fork server (spawned afresh on Windows), so, as for any ``multiprocessing`` program, the
     main module must be importable without side effects (``tablebot``, ``python -m tablebot`` and pytest are)."""
 
-    def __init__(self, files: Sequence[Path], base: Table, count: int | None = None,
-                 whole: Whole | None = None) -> None:
+    def __init__(
+        self, files: Sequence[Path], base: Table, count: int | None = None, whole: Whole | None = None
+    ) -> None:
         self.count = max(1, count if count is not None else os.cpu_count() or 1)
         self.context = Context(Prover(list(files), whole=whole), base)
         self.pool: Any = None
         if self.count > 1:
             from concurrent.futures import ProcessPoolExecutor
 
-            self.pool = ProcessPoolExecutor(self.count, _spawner(), initializer=_start,
-                                            initargs=(list(files), base, whole))
+            self.pool = ProcessPoolExecutor(
+                self.count, _spawner(), initializer=_start, initargs=(list(files), base, whole)
+            )
 
     def __enter__(self) -> Workers:
         return self
@@ -136,8 +138,9 @@ Ahead = tuple[Candidate | None, Machine | None, str, Answer | None]
 _END = object()
 
 
-def proved_ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None],
-                 window: Callable[[], int]) -> Generator[Ahead, None, None]:
+def proved_ahead(
+    workers: Workers, prover: Prover, children: Iterator[Candidate | None], window: Callable[[], int]
+) -> Generator[Ahead, None, None]:
     """The children in order, each with its machine, its canonical key and, unless the prover knows that
     key already, the answer of its proof, started in a worker up to ``window()`` children ahead of the one
     handed out (None children: a variation that gave nothing, handed out as they come)."""
@@ -151,8 +154,14 @@ def proved_ahead(workers: Workers, prover: Prover, children: Iterator[Candidate 
                 answer.drop()
 
 
-def _ahead(workers: Workers, prover: Prover, children: Iterator[Candidate | None], window: Callable[[], int],
-           queue: deque[Ahead], sent: dict[str, Answer]) -> Iterator[Ahead]:
+def _ahead(
+    workers: Workers,
+    prover: Prover,
+    children: Iterator[Candidate | None],
+    window: Callable[[], int],
+    queue: deque[Ahead],
+    sent: dict[str, Answer],
+) -> Iterator[Ahead]:
     while True:
         while len(queue) < window():
             child = next(children, _END)
@@ -212,8 +221,9 @@ def _end_with_parent() -> None:
     writes to, or its process handle on Windows) becomes ready when the parent ends, on every platform."""
     parent = multiprocessing.parent_process()
     if parent is not None:
-        threading.Thread(target=_exit_when_ready, args=(parent.sentinel,), name="tablebot-parent-watch",
-                         daemon=True).start()
+        threading.Thread(
+            target=_exit_when_ready, args=(parent.sentinel,), name="tablebot-parent-watch", daemon=True
+        ).start()
 
 
 def _exit_when_ready(sentinel: int) -> None:

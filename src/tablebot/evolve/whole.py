@@ -60,8 +60,10 @@ class Whole:
         :func:`tablebot.tables.load_tables` makes of a robot (cross-table columns name states their table has, one
         writer per output) hold as they held for the robot's own files."""
         k = self.index
-        return RobotTables(tuple(machine.table if i == k else t for i, t in enumerate(self.tables.tables)),
-                           tuple(machine if i == k else m for i, m in enumerate(self.tables.machines)))
+        return RobotTables(
+            tuple(machine.table if i == k else t for i, t in enumerate(self.tables.tables)),
+            tuple(machine if i == k else m for i, m in enumerate(self.tables.machines)),
+        )
 
     def depends(self, prop: Property) -> bool:
         """Whether a candidate can change what ``prop`` sees (the evolved table is one its tables read from)."""
@@ -92,13 +94,18 @@ def choose(tables: RobotTables | None, name: str | None) -> Whole | None:
     robot of one table without ``--table``."""
     if tables is None:
         if name is not None:
-            raise fail("--table", N_("--table {name}: the robot has one table, so there is no other to name",
-                                     name=name),
-                       N_("leave --table out (it names one of the tables a robot file's [tables] lists)"))
+            raise fail(
+                "--table",
+                N_("--table {name}: the robot has one table, so there is no other to name", name=name),
+                N_("leave --table out (it names one of the tables a robot file's [tables] lists)"),
+            )
         return None
     if name is None:
         return Whole(tables, 0)
     if name not in tables.names:
-        raise fail("--table", N_("--table {name}: the robot has no table of that name", name=name),
-                   N_("name one of its tables: {names}", names=", ".join(tables.names)))
+        raise fail(
+            "--table",
+            N_("--table {name}: the robot has no table of that name", name=name),
+            N_("name one of its tables: {names}", names=", ".join(tables.names)),
+        )
     return Whole(tables, tables.names.index(name))

@@ -44,21 +44,54 @@ def export_for(board: str) -> Exporter:
         firmware = build(machine, board, folder) if tables is None else build_several(tables, board, folder)
         wiring = firmware.wiring
         assert wiring is not None
-        pins = ", ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
-                         for n, t in kind.items())
-        return Exported((firmware.hex, firmware.elf), (
-            N_("wrote {hex} and {elf} for {board}", hex=str(firmware.hex), elf=str(firmware.elf),
-               board=firmware.board.title),
-            N_("flash {flash} bytes, static RAM {ram} bytes; wiring: {pins}", flash=firmware.flash, ram=firmware.ram,
-               pins=pins),
-            N_("trace: {uart}, {baud} baud 8N1", uart=firmware.board.uart, baud=firmware.board.baud)), value=firmware)
+        pins = ", ".join(
+            f"{n}={t}"
+            for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
+            for n, t in kind.items()
+        )
+        return Exported(
+            (firmware.hex, firmware.elf),
+            (
+                N_(
+                    "wrote {hex} and {elf} for {board}",
+                    hex=str(firmware.hex),
+                    elf=str(firmware.elf),
+                    board=firmware.board.title,
+                ),
+                N_(
+                    "flash {flash} bytes, static RAM {ram} bytes; wiring: {pins}",
+                    flash=firmware.flash,
+                    ram=firmware.ram,
+                    pins=pins,
+                ),
+                N_("trace: {uart}, {baud} baud 8N1", uart=firmware.board.uart, baud=firmware.board.baud),
+            ),
+            value=firmware,
+        )
 
     return export
 
 
-UNO = register(ExportBackend(name="uno", board=True, makes="AVR firmware for an Arduino Uno with the Motor Shield Rev3",
-                             help="Arduino Uno + Motor Shield Rev3", fit=fit_for("uno"), section="board",
-                             read_section=read_section, export=export_for("uno")))
-FTDUINO = register(ExportBackend(name="ftduino", board=True, makes="AVR firmware for the ftDuino",
-                                 fit=fit_for("ftduino"), section="board", read_section=read_section,
-                                 export=export_for("ftduino")))
+UNO = register(
+    ExportBackend(
+        name="uno",
+        board=True,
+        makes="AVR firmware for an Arduino Uno with the Motor Shield Rev3",
+        help="Arduino Uno + Motor Shield Rev3",
+        fit=fit_for("uno"),
+        section="board",
+        read_section=read_section,
+        export=export_for("uno"),
+    )
+)
+FTDUINO = register(
+    ExportBackend(
+        name="ftduino",
+        board=True,
+        makes="AVR firmware for the ftDuino",
+        fit=fit_for("ftduino"),
+        section="board",
+        read_section=read_section,
+        export=export_for("ftduino"),
+    )
+)

@@ -12,8 +12,13 @@ from tablebot.firmware.framing import tick_payload
 from tablebot.i18n import N_
 from tablebot.machine import Machine
 
-PRESCALERS = ((1, "(1 << CS10)"), (8, "(1 << CS11)"), (64, "((1 << CS11) | (1 << CS10))"),
-              (256, "(1 << CS12)"), (1024, "((1 << CS12) | (1 << CS10))"))
+PRESCALERS = (
+    (1, "(1 << CS10)"),
+    (8, "(1 << CS11)"),
+    (64, "((1 << CS11) | (1 << CS10))"),
+    (256, "(1 << CS12)"),
+    (1024, "((1 << CS12) | (1 << CS10))"),
+)
 #: Pin-change interrupt group per port, and external interrupts, of each MCU.
 PCINT = {"atmega328p": {"B": 0, "C": 1, "D": 2}, "atmega32u4": {"B": 0}}
 EXTINT = {"atmega328p": {"PD2": 0, "PD3": 1}, "atmega32u4": {"PD0": 0, "PD1": 1, "PD2": 2, "PD3": 3}}
@@ -37,9 +42,11 @@ def timer_setting(f_cpu: int, tick_ms: int, where: str = "robot") -> tuple[int, 
         counts, rest = divmod(f_cpu * tick_ms, prescaler * 1000)
         if rest == 0 and 0 < counts <= 65536:
             return counts - 1, bits
-    raise fail(where, N_("tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz",
-                         tick_ms=tick_ms, f_cpu=f_cpu),
-               N_("use a tick of at most 4000 ms (above 1048 ms, a multiple of 8 ms)"))
+    raise fail(
+        where,
+        N_("tick_ms = {tick_ms} cannot be timed exactly by a 16-bit timer at {f_cpu} Hz", tick_ms=tick_ms, f_cpu=f_cpu),
+        N_("use a tick of at most 4000 ms (above 1048 ms, a multiple of 8 ms)"),
+    )
 
 
 def ubrr(f_cpu: int, baud: int) -> int:
@@ -52,6 +59,7 @@ def _pin(spec: str) -> tuple[str, int]:
 
 
 # --- inputs -------------------------------------------------------------------------------------
+
 
 def _inputs_uno(machine: Machine, wiring: Wiring) -> list[str]:
     lines = ["    tb_event_t ev = 0;"]
@@ -85,6 +93,7 @@ def _inputs_ftduino(machine: Machine, wiring: Wiring) -> list[str]:
 
 # --- outputs ------------------------------------------------------------------------------------
 
+
 def _ft_bits(wiring: Wiring, terminal: str) -> tuple[int, int]:
     """(highside, lowside) driver bits of an ftDuino O terminal."""
     k = wiring.board.outputs[terminal]
@@ -104,8 +113,7 @@ def _output_statements(machine: Machine, wiring: Wiring) -> list[str]:
                 first, second = (_ft_bits(wiring, o) for o in wiring.board.motors[channel].split())
                 every = first[0] | first[1] | second[0] | second[1]
                 left, right = first[1] | second[0], first[0] | second[1]
-                call = (f"ft_set(0x{every:04x}u, v > 0 ? 0x{left:04x}u : 0x{right:04x}u, "
-                        f"(uint8_t)(v < 0 ? -v : v));")
+                call = f"ft_set(0x{every:04x}u, v > 0 ? 0x{left:04x}u : 0x{right:04x}u, (uint8_t)(v < 0 ? -v : v));"
             where = f"{name} on {channel}"
         else:
             terminal = wiring.lamps[name]
@@ -116,12 +124,18 @@ def _output_statements(machine: Machine, wiring: Wiring) -> list[str]:
                 high, low = _ft_bits(wiring, terminal)
                 call = f"ft_set(0x{high | low:04x}u, 0x{high:04x}u, (uint8_t)v);"
             where = f"{name} on {terminal}"
-        lines += [f"    v = out[{i}]; /* {c_comment(where)} */", f"    if (v != tb_last[{i}]) {{",
-                  f"        tb_last[{i}] = v;", f"        {call}", "    }"]
+        lines += [
+            f"    v = out[{i}]; /* {c_comment(where)} */",
+            f"    if (v != tb_last[{i}]) {{",
+            f"        tb_last[{i}] = v;",
+            f"        {call}",
+            "    }",
+        ]
     return lines
 
 
 # --- counters -----------------------------------------------------------------------------------
+
 
 def _counter_groups(machine: Machine, wiring: Wiring) -> tuple[dict[int, list], dict[int, int]]:
     """Counters by pin-change group {group: [(index, port, bit)]} and by external interrupt."""
@@ -143,28 +157,40 @@ def _counter_code(machine: Machine, wiring: Wiring) -> tuple[list[str], list[str
     n = len(machine.table.robot.counters)
     if not n:
         return [], []
-    top = [f"static volatile uint8_t tb_count[{n}];",
-           "#define TB_COUNT(i) do { if (tb_count[i] != 255) tb_count[i]++; } while (0)"]
+    top = [
+        f"static volatile uint8_t tb_count[{n}];",
+        "#define TB_COUNT(i) do { if (tb_count[i] != 255) tb_count[i]++; } while (0)",
+    ]
     init: list[str] = []
     pullup = wiring.board.name == "uno"  # the ftDuino has external pull-ups on C1..C4
     groups, external = _counter_groups(machine, wiring)
     for group, pins in groups.items():
         port = pins[0][1]
-        top += [f"static uint8_t tb_pc_last{group};", f"ISR(PCINT{group}_vect)", "{",
-                f"    uint8_t now = PIN{port};", f"    uint8_t rise = (uint8_t)(now & ~tb_pc_last{group});",
-                f"    tb_pc_last{group} = now;"]
+        top += [
+            f"static uint8_t tb_pc_last{group};",
+            f"ISR(PCINT{group}_vect)",
+            "{",
+            f"    uint8_t now = PIN{port};",
+            f"    uint8_t rise = (uint8_t)(now & ~tb_pc_last{group});",
+            f"    tb_pc_last{group} = now;",
+        ]
         top += [f"    if (rise & (1u << {bit})) TB_COUNT({i});" for i, _, bit in pins]
         top.append("}")
         mask = sum(1 << bit for _, _, bit in pins)
         init += [f"    DDR{port} &= (uint8_t)~{mask}u;"]
         if pullup:
             init.append(f"    PORT{port} |= {mask}u;")
-        init += [f"    tb_pc_last{group} = PIN{port};", f"    PCMSK{group} |= {mask}u;",
-                 f"    PCICR |= 1u << PCIE{group};"]
+        init += [
+            f"    tb_pc_last{group} = PIN{port};",
+            f"    PCMSK{group} |= {mask}u;",
+            f"    PCICR |= 1u << PCIE{group};",
+        ]
     for number, i in external.items():
         top += [f"ISR(INT{number}_vect)", "{", f"    TB_COUNT({i});", "}"]
-        init += [f"    EICRA |= (1u << ISC{number}1) | (1u << ISC{number}0); /* rising edge */",
-                 f"    EIMSK |= 1u << INT{number};"]
+        init += [
+            f"    EICRA |= (1u << ISC{number}1) | (1u << ISC{number}0); /* rising edge */",
+            f"    EIMSK |= 1u << INT{number};",
+        ]
     return top, init
 
 
@@ -188,34 +214,71 @@ def board_header(machine: Machine, wiring: Wiring, layout: Layout, payload: int 
     board, robot = wiring.board, machine.table.robot
     payload = tick_payload(machine, layout) if payload is None else payload
     if payload + 3 > 128:
-        raise fail(machine.table.path, N_("a trace frame of {size} bytes is too long for the UART ring",
-                                          size=payload + 3),
-                   N_("use fewer outputs and counters"))
+        raise fail(
+            machine.table.path,
+            N_("a trace frame of {size} bytes is too long for the UART ring", size=payload + 3),
+            N_("use fewer outputs and counters"),
+        )
     top, ticks = timer_setting(board.f_cpu, robot.tick_ms, robot.source)
     isrs, counter_init = _counter_code(machine, wiring)
     channels = [int(t[1:]) - 1 for n, t in wiring.inputs.items() if n in machine.input_bits]
     n_out = max(1, len(machine.output_names))
-    wiring_note = "; ".join(f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters)
-                            for n, t in kind.items())
-    lines = [f"/* Generated by tablebot: {c_comment(robot.name)} on {c_comment(board.title)}. Do not edit.",
-             f" * Wiring: {c_comment(wiring_note or 'none')}. */",
-             "#ifndef TB_BOARD_H", "#define TB_BOARD_H", "",
-             f"#define TB_TICK_TOP {top}u", f"#define TB_TICK_CS {ticks}",
-             f"#define TB_UBRR {ubrr(board.f_cpu, board.baud)}u /* {board.baud} baud */",
-             f"#define TB_TICK_PAYLOAD {payload}u", f"#define TB_TX_SIZE {tx_size(payload)}u"]
+    wiring_note = "; ".join(
+        f"{n}={t}" for kind in (wiring.inputs, wiring.motors, wiring.lamps, wiring.counters) for n, t in kind.items()
+    )
+    lines = [
+        f"/* Generated by tablebot: {c_comment(robot.name)} on {c_comment(board.title)}. Do not edit.",
+        f" * Wiring: {c_comment(wiring_note or 'none')}. */",
+        "#ifndef TB_BOARD_H",
+        "#define TB_BOARD_H",
+        "",
+        f"#define TB_TICK_TOP {top}u",
+        f"#define TB_TICK_CS {ticks}",
+        f"#define TB_UBRR {ubrr(board.f_cpu, board.baud)}u /* {board.baud} baud */",
+        f"#define TB_TICK_PAYLOAD {payload}u",
+        f"#define TB_TX_SIZE {tx_size(payload)}u",
+    ]
     if board.name == "ftduino":
-        lines += [f"#define TB_FT_N_CHANNELS {len(channels)}",
-                  "#define TB_FT_CHANNELS {" + ", ".join(map(str, channels)) + "}",
-                  f"#define TB_FT_THRESHOLD {FT_THRESHOLD}u"]
-    lines += [f'#include "board_{board.name}.h"', "", *isrs, "",
-              f"static int8_t tb_last[{n_out}]; /* outputs as last driven */", "",
-              "static inline void tb_wiring_init(void)", "{",
-              *_init_statements(machine, wiring), *counter_init, "}", "",
-              "static inline tb_event_t tb_wiring_inputs(void)", "{",
-              *(_inputs_uno if board.name == "uno" else _inputs_ftduino)(machine, wiring), "}", "",
-              "static inline void tb_wiring_pulses(uint16_t *p)", "{"]
+        lines += [
+            f"#define TB_FT_N_CHANNELS {len(channels)}",
+            "#define TB_FT_CHANNELS {" + ", ".join(map(str, channels)) + "}",
+            f"#define TB_FT_THRESHOLD {FT_THRESHOLD}u",
+        ]
+    lines += [
+        f'#include "board_{board.name}.h"',
+        "",
+        *isrs,
+        "",
+        f"static int8_t tb_last[{n_out}]; /* outputs as last driven */",
+        "",
+        "static inline void tb_wiring_init(void)",
+        "{",
+        *_init_statements(machine, wiring),
+        *counter_init,
+        "}",
+        "",
+        "static inline tb_event_t tb_wiring_inputs(void)",
+        "{",
+        *(_inputs_uno if board.name == "uno" else _inputs_ftduino)(machine, wiring),
+        "}",
+        "",
+        "static inline void tb_wiring_pulses(uint16_t *p)",
+        "{",
+    ]
     lines += [f"    p[{i}] = tb_count[{i}];\n    tb_count[{i}] = 0;" for i in range(len(robot.counters))]
-    lines += ["    (void)p;", "}", "", "static inline void tb_wiring_outputs(const int8_t *out)", "{",
-              "    int8_t v;", *_output_statements(machine, wiring), "    (void)v;", "    (void)out;", "}",
-              "", "#endif", ""]
+    lines += [
+        "    (void)p;",
+        "}",
+        "",
+        "static inline void tb_wiring_outputs(const int8_t *out)",
+        "{",
+        "    int8_t v;",
+        *_output_statements(machine, wiring),
+        "    (void)v;",
+        "    (void)out;",
+        "}",
+        "",
+        "#endif",
+        "",
+    ]
     return "\n".join(lines)

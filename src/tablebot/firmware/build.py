@@ -50,10 +50,15 @@ BUG = N_("report this as a tablebot bug")
 def tool(name: str) -> str:
     found = shutil.which(name)
     if not found:
-        raise fail(name, N_("{name} not found (only firmware needs it)", name=name),
-                   N_("install the AVR toolchain: on Debian or Ubuntu sudo apt-get install gcc-avr avr-libc; on macOS "
-                      "brew tap osx-cross/avr, then brew install avr-gcc; on Windows unpack Microchip's AVR 8-bit "
-                      "Toolchain (Windows) and add its bin folder to PATH (docs/install.md)"))
+        raise fail(
+            name,
+            N_("{name} not found (only firmware needs it)", name=name),
+            N_(
+                "install the AVR toolchain: on Debian or Ubuntu sudo apt-get install gcc-avr avr-libc; on macOS "
+                "brew tap osx-cross/avr, then brew install avr-gcc; on Windows unpack Microchip's AVR 8-bit "
+                "Toolchain (Windows) and add its bin folder to PATH (docs/install.md)"
+            ),
+        )
     return found
 
 
@@ -61,8 +66,9 @@ def c_source(name: str) -> str:
     return resources.files("tablebot.firmware").joinpath("c").joinpath(name).read_text(encoding="utf-8")
 
 
-def write_sources(machine: Machine, board: Board, srcdir: Path, lookup: str = "auto",
-                  main: str = FIRMWARE_MAIN) -> tuple[Wiring | None, Layout]:
+def write_sources(
+    machine: Machine, board: Board, srcdir: Path, lookup: str = "auto", main: str = FIRMWARE_MAIN
+) -> tuple[Wiring | None, Layout]:
     """All C files of one firmware into ``srcdir``; the benchmark main needs no wiring."""
     source = generate(machine, lookup)
     source.write(srcdir)
@@ -94,8 +100,7 @@ def sizes(elf: Path) -> tuple[int, int]:
     return text + data, data + bss
 
 
-def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto",
-          main: str = FIRMWARE_MAIN) -> Firmware:
+def build(machine: Machine, board_name: str, outdir: Path, lookup: str = "auto", main: str = FIRMWARE_MAIN) -> Firmware:
     """Generate, compile and link; ``outdir`` gets ``src/``, ``NAME.elf`` and ``NAME.hex``."""
     board = load_board(board_name)
     srcdir = outdir / "src"
@@ -113,8 +118,20 @@ def compile_and_link(board: Board, srcdir: Path, units: Sequence[str], elf: Path
     # until the set is swapped in, the tools read the files where they are being written
     sources = [str(current(srcdir / name)) for name in units]
     with replacing(elf) as temp:  # the tools write in place: a half-written .elf or .hex must not stay
-        _run([tool("avr-gcc"), f"-mmcu={board.mcu}", f"-DF_CPU={board.f_cpu}UL", *CFLAGS,
-              f"-I{current(srcdir)}", "-Wl,--gc-sections", "-o", str(temp), *sources], "avr-gcc")
+        _run(
+            [
+                tool("avr-gcc"),
+                f"-mmcu={board.mcu}",
+                f"-DF_CPU={board.f_cpu}UL",
+                *CFLAGS,
+                f"-I{current(srcdir)}",
+                "-Wl,--gc-sections",
+                "-o",
+                str(temp),
+                *sources,
+            ],
+            "avr-gcc",
+        )
     with replacing(hexfile) as temp:
         _run([tool("avr-objcopy"), "-O", "ihex", "-R", ".eeprom", str(current(elf)), str(temp)], "avr-objcopy")
     return sizes(current(elf))

@@ -48,10 +48,23 @@ def build_harness(where: Path | None = None) -> Path:
     cc = shutil.which("cc") or shutil.which("gcc")
     flags = subprocess.run(["pkg-config", "--cflags", "simavr"], capture_output=True, text=True, check=False)
     if not cc or flags.returncode:
-        raise fail("harness", N_("cannot build the simavr harness: need a C compiler and libsimavr-dev"),
-                   N_("apt-get install gcc simavr libsimavr-dev libelf-dev pkg-config (scripts/bootstrap.sh)"))
-    command = [cc, "-O2", "-Wall", "-Wextra", *flags.stdout.split(), str(folder / "harness.c"),
-               "-lsimavr", "-lelf", "-o", str(exe) + ".tmp"]
+        raise fail(
+            "harness",
+            N_("cannot build the simavr harness: need a C compiler and libsimavr-dev"),
+            N_("apt-get install gcc simavr libsimavr-dev libelf-dev pkg-config (scripts/bootstrap.sh)"),
+        )
+    command = [
+        cc,
+        "-O2",
+        "-Wall",
+        "-Wextra",
+        *flags.stdout.split(),
+        str(folder / "harness.c"),
+        "-lsimavr",
+        "-lelf",
+        "-o",
+        str(exe) + ".tmp",
+    ]
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode:
         raise fail("harness", N_("compiling the harness failed"), N_("check libsimavr-dev"), detail=done.stderr)
@@ -60,6 +73,7 @@ def build_harness(where: Path | None = None) -> Path:
 
 
 # --- inputs as pin levels -----------------------------------------------------------------------
+
 
 def _signal(wiring: Wiring, name: str) -> tuple[str, int, int]:
     """(harness column, level when active, level when not) of one robot input."""
@@ -78,12 +92,13 @@ def pins_csv(machine: Machine, wiring: Wiring, ticks: Sequence[TickInput]) -> st
     for tick in ticks:
         cells = [str(active if tick.mask & bit else idle) for bit, _, active, idle in signals]
         pulses = list(tick.pulses) + [0] * len(counters)
-        cells += [str(p) for p in pulses[:len(counters)]]
+        cells += [str(p) for p in pulses[: len(counters)]]
         lines.append(",".join(cells))
     return "\n".join(lines) + "\n"
 
 
 # --- running ------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class TickCycles:
@@ -107,9 +122,11 @@ class Emulation:
 def run_harness(harness: Path, args: list[str], timeout: float = 120) -> None:
     done = subprocess.run([str(harness), *args], capture_output=True, text=True, timeout=timeout, check=False)
     if done.returncode:
-        raise fail("harness", N_("emulation failed ({code}): {error}", code=done.returncode,
-                                 error=done.stderr.strip()),
-                   N_("run the harness by hand with the same arguments to see more"))
+        raise fail(
+            "harness",
+            N_("emulation failed ({code}): {error}", code=done.returncode, error=done.stderr.strip()),
+            N_("run the harness by hand with the same arguments to see more"),
+        )
 
 
 def read_cycles(path: Path) -> tuple[int, list[TickCycles]]:
@@ -124,20 +141,36 @@ def read_cycles(path: Path) -> tuple[int, list[TickCycles]]:
     return overhead, cycles
 
 
-def emulate(firmware: Firmware, machine: Machine, ticks: Sequence[TickInput], workdir: Path,
-            harness: Path | None = None) -> Emulation:
+def emulate(
+    firmware: Firmware, machine: Machine, ticks: Sequence[TickInput], workdir: Path, harness: Path | None = None
+) -> Emulation:
     """Run the firmware over recorded inputs and decode what it sent."""
     if firmware.wiring is None:
-        raise fail(firmware.elf, N_("this firmware has no wiring (a benchmark build?)"),
-                   N_("build with main firmware"))
+        raise fail(firmware.elf, N_("this firmware has no wiring (a benchmark build?)"), N_("build with main firmware"))
     harness = harness or build_harness()
     workdir.mkdir(parents=True, exist_ok=True)
     pins, ticks_out, uart = workdir / "pins.csv", workdir / "ticks.csv", workdir / "uart.bin"
     pins.write_text(pins_csv(machine, firmware.wiring, ticks), encoding="utf-8")
     board = firmware.board
-    run_harness(harness, ["--elf", str(firmware.elf), "--mcu", board.mcu, "--freq", str(board.f_cpu),
-                          "--uart", str(board.usart), "--inputs", str(pins), "--ticks-out", str(ticks_out),
-                          "--uart-out", str(uart)])
+    run_harness(
+        harness,
+        [
+            "--elf",
+            str(firmware.elf),
+            "--mcu",
+            board.mcu,
+            "--freq",
+            str(board.f_cpu),
+            "--uart",
+            str(board.usart),
+            "--inputs",
+            str(pins),
+            "--ticks-out",
+            str(ticks_out),
+            "--uart-out",
+            str(uart),
+        ],
+    )
     decoder = Decoder(machine, firmware.layout)
     trace = decoder.feed(uart.read_bytes())
     overhead, cycles = read_cycles(ticks_out)
@@ -154,8 +187,22 @@ def bench_steps(firmware: Firmware, workdir: Path, harness: Path | None = None) 
     workdir.mkdir(parents=True, exist_ok=True)
     marks = workdir / "marks.csv"
     board = firmware.board
-    run_harness(harness, ["--elf", str(firmware.elf), "--mcu", board.mcu, "--freq", str(board.f_cpu),
-                          "--marks-out", str(marks), "--max-ms", "60000"], timeout=600)
+    run_harness(
+        harness,
+        [
+            "--elf",
+            str(firmware.elf),
+            "--mcu",
+            board.mcu,
+            "--freq",
+            str(board.f_cpu),
+            "--marks-out",
+            str(marks),
+            "--max-ms",
+            "60000",
+        ],
+        timeout=600,
+    )
     overhead, start, steps = 0, 0, []
     for line in marks.read_text().splitlines():
         value, cycle = (int(v) for v in line.split(","))

@@ -40,8 +40,15 @@ class Hello:
 
 def tick_payload(machine: Machine, layout: Layout) -> int:
     """Bytes of a tick frame's payload: tick, event, row, state, timer, outputs, counters."""
-    return (2 + layout.event.size + layout.row.size + layout.state.size + 2
-            + len(machine.output_names) + 2 * len(machine.table.robot.counters))
+    return (
+        2
+        + layout.event.size
+        + layout.row.size
+        + layout.state.size
+        + 2
+        + len(machine.output_names)
+        + 2 * len(machine.table.robot.counters)
+    )
 
 
 def checksum(body: bytes) -> int:
@@ -57,8 +64,9 @@ class FrameStream(Protocol):
     problems: list[str]
 
 
-def take_frames(stream: FrameStream, data: bytes, lengths: Mapping[int, int],
-                take: Callable[[int, bytes], None]) -> None:
+def take_frames(
+    stream: FrameStream, data: bytes, lengths: Mapping[int, int], take: Callable[[int, bytes], None]
+) -> None:
     """Every whole frame in ``stream``'s buffer with ``data`` added, as ``take(type, payload)``, in order: a frame's
     payload length is ``lengths[type]``; a byte that starts no known frame is skipped, and after a bad checksum
     the stream resynchronises on the next sync byte (a problem noted at its byte in the stream). What is left is
@@ -76,7 +84,7 @@ def take_frames(stream: FrameStream, data: bytes, lengths: Mapping[int, int],
         end = at + 2 + length + 1
         if end > len(buf):
             break
-        body = bytes(buf[at + 1:end])
+        body = bytes(buf[at + 1 : end])
         if sum(body) & 0xFF:
             stream.problems.append(N_("bad checksum at byte {at}; resynchronising", at=stream.consumed + at))
             at += 1
@@ -140,7 +148,7 @@ class Decoder:
         values = []
         at = 0
         for size in (2, lay.event.size, lay.row.size, lay.state.size, 2):
-            values.append(int.from_bytes(payload[at:at + size], "little"))
+            values.append(int.from_bytes(payload[at : at + size], "little"))
             at += size
         tick16, event, row, state, timer = values
         row = NO_ROW if row == lay.no_row else row
@@ -149,9 +157,9 @@ class Decoder:
             self.problems.append(N_("tick frame {tick} {wrong}: not this table's firmware?", tick=tick16, wrong=wrong))
             self.rejected += 1
             return None
-        outputs = [b - 256 if b > 127 else b for b in payload[at:at + self.n_outputs]]
+        outputs = [b - 256 if b > 127 else b for b in payload[at : at + self.n_outputs]]
         at += self.n_outputs
-        counters = [int.from_bytes(payload[at + 2 * i:at + 2 * i + 2], "little") for i in range(self.n_counters)]
+        counters = [int.from_bytes(payload[at + 2 * i : at + 2 * i + 2], "little") for i in range(self.n_counters)]
         tick = self._unwrap(tick16)
         return trace_line(self.machine, tick, event, row, state, timer, outputs, counters)
 
@@ -163,14 +171,20 @@ class Decoder:
         if state >= len(machine.states):
             return N_("names state index {state}", state=state)
         if event >> len(machine.table.events):
-            return N_("has event bits {bits:#x} beyond the table's {count} events", bits=event,
-                      count=len(machine.table.events))
+            return N_(
+                "has event bits {bits:#x} beyond the table's {count} events",
+                bits=event,
+                count=len(machine.table.events),
+            )
         if row == NO_ROW:
             if machine.lookup(state, event) != NO_ROW:
                 return N_("says no row fired, but row {row} matches its events", row=machine.lookup(state, event))
             if machine.timer_bit and (timer == 0) != bool(event & machine.timer_bit):
-                return N_("has timer {timer} but no T event", timer=timer) if timer == 0 else \
-                    N_("has timer {timer} but T event", timer=timer)
+                return (
+                    N_("has timer {timer} but no T event", timer=timer)
+                    if timer == 0
+                    else N_("has timer {timer} but T event", timer=timer)
+                )
             return ""
         if row >= len(machine.rows):
             return N_("names row {row}", row=row)
@@ -186,16 +200,25 @@ class Decoder:
         else:
             tick = self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
             if tick != self.last_tick + 1:
-                self.problems.append(N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1,
-                                        last=tick - 1))
+                self.problems.append(
+                    N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1, last=tick - 1)
+                )
         self.last_tick = tick
         return tick
 
 
 def hello_frame(machine: Machine, layout: Layout) -> bytes:
     """The hello frame the firmware of this machine sends."""
-    payload = struct.pack(HELLO_FORMAT, VERSION, layout.table_hash, len(machine.states), len(machine.rows),
-                          layout.event.size, len(machine.output_names), len(machine.table.robot.counters))
+    payload = struct.pack(
+        HELLO_FORMAT,
+        VERSION,
+        layout.table_hash,
+        len(machine.states),
+        len(machine.rows),
+        layout.event.size,
+        len(machine.output_names),
+        len(machine.table.robot.counters),
+    )
     return _frame(HELLO, payload)
 
 

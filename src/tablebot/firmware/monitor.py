@@ -28,13 +28,15 @@ def chunks_from(source: str, baud: int, seconds: float | None) -> Iterator[bytes
     """The bytes of a capture file, or of a serial port when ``source`` names one."""
     path = Path(source)
     if path.is_dir():
-        raise fail(source, N_("is a folder, not a capture file or serial port"),
-                   N_("give the file of captured bytes"))
+        raise fail(source, N_("is a folder, not a capture file or serial port"), N_("give the file of captured bytes"))
     if path.is_file():
         return file_chunks(path)
     if not PORT_RE.match(source):
-        raise fail(source, N_("no such file, and not a serial port name"),
-                   N_("give a file of captured UART bytes, or a port such as /dev/ttyACM0 or COM3"))
+        raise fail(
+            source,
+            N_("no such file, and not a serial port name"),
+            N_("give a file of captured UART bytes, or a port such as /dev/ttyACM0 or COM3"),
+        )
     return serial_chunks(source, baud, seconds)
 
 
@@ -53,9 +55,11 @@ def serial_chunks(port: str, baud: int, seconds: float | None) -> Iterator[bytes
     try:
         link = serial.Serial(port, baud, timeout=0.1)
     except (serial.SerialException, OSError) as exc:
-        raise fail(port, N_("cannot open serial port: {error}", error=str(exc)),
-                   N_("check the port name (ls /dev/tty*) and that no other program (an IDE's serial monitor) "
-                      "holds it")) from None
+        raise fail(
+            port,
+            N_("cannot open serial port: {error}", error=str(exc)),
+            N_("check the port name (ls /dev/tty*) and that no other program (an IDE's serial monitor) holds it"),
+        ) from None
     end = None if seconds is None else time.monotonic() + seconds
     with link:
         while end is None or time.monotonic() < end:
@@ -70,12 +74,25 @@ def check_hello(decoder: Decoder, source: str) -> None:
     assert layout is not None
     for hello in decoder.hellos:
         if hello.table_hash != layout.table_hash:
-            raise fail(source, N_("the firmware runs another table (hash 0x{theirs:08x}, this table 0x{ours:08x})",
-                                  theirs=hello.table_hash, ours=layout.table_hash), BUILT_FROM)
+            raise fail(
+                source,
+                N_(
+                    "the firmware runs another table (hash 0x{theirs:08x}, this table 0x{ours:08x})",
+                    theirs=hello.table_hash,
+                    ours=layout.table_hash,
+                ),
+                BUILT_FROM,
+            )
 
 
-def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str,
-            ticks: int | None = None, warn: Callable[[str], Any] = print) -> int:
+def monitor(
+    machine: Machine,
+    chunks: Iterator[bytes],
+    out: IO[str],
+    source: str,
+    ticks: int | None = None,
+    warn: Callable[[str], Any] = print,
+) -> int:
     """Decode until the chunks end or ``ticks`` lines are written; returns the lines written.
 
     A stream in which no frame decodes at all is refused: it is not this firmware's trace.
@@ -87,11 +104,21 @@ def monitor(machine: Machine, chunks: Iterator[bytes], out: IO[str], source: str
     written = _copy(decoder, chunks, out, source, ticks, warn, lambda: check_hello(decoder, source))
     if ticks is not None and written >= ticks:
         return written
-    _none_decoded(decoder, source, N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this "
-                                      "table by `tablebot build`"))
+    _none_decoded(
+        decoder,
+        source,
+        N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this table by `tablebot build`"),
+    )
     if decoder.rejected * 10 > decoder.rejected + decoder.ticks:  # more than noise: another table's stream
-        raise fail(source, N_("{rejected} of {count} tick frames are impossible for this table",
-                              rejected=decoder.rejected, count=decoder.rejected + decoder.ticks), BUILT_FROM)
+        raise fail(
+            source,
+            N_(
+                "{rejected} of {count} tick frames are impossible for this table",
+                rejected=decoder.rejected,
+                count=decoder.rejected + decoder.ticks,
+            ),
+            BUILT_FROM,
+        )
     _leftover(decoder, source, warn)
     return written
 
@@ -105,21 +132,37 @@ def _warning(source: str, text: str) -> str:
     return f"{source}: {severity_word('warning')}: {localise(text)}"
 
 
-def _monitor_several(tables: RobotTables, chunks: Iterator[bytes], out: IO[str], source: str, ticks: int | None,
-                     warn: Callable[[str], Any]) -> int:
+def _monitor_several(
+    tables: RobotTables,
+    chunks: Iterator[bytes],
+    out: IO[str],
+    source: str,
+    ticks: int | None,
+    warn: Callable[[str], Any],
+) -> int:
     """:func:`monitor` of the firmware of a robot of several tables (tablebot.firmware.several)."""
     decoder = SeveralDecoder(tables)
     written = _copy(decoder, chunks, out, source, ticks, warn)
     if ticks is not None and written >= ticks:
         return written
-    _none_decoded(decoder, source, N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this "
-                                      "robot by `tablebot build`"))
+    _none_decoded(
+        decoder,
+        source,
+        N_("give the UART bytes (115200 baud 8N1, or --baud) of firmware built from this robot by `tablebot build`"),
+    )
     _leftover(decoder, source, warn)
     return written
 
 
-def _copy(decoder: Decoder | SeveralDecoder, chunks: Iterator[bytes], out: IO[str], source: str, ticks: int | None,
-          warn: Callable[[str], Any], check: Callable[[], None] = lambda: None) -> int:
+def _copy(
+    decoder: Decoder | SeveralDecoder,
+    chunks: Iterator[bytes],
+    out: IO[str],
+    source: str,
+    ticks: int | None,
+    warn: Callable[[str], Any],
+    check: Callable[[], None] = lambda: None,
+) -> int:
     """The decoded lines of ``chunks`` onto ``out`` (``ticks`` of them at the most, None: all), the decoder's
     problems passed to ``warn`` as they come; ``check`` after every chunk may refuse the stream. Lines written."""
     written = warned = 0
@@ -127,7 +170,7 @@ def _copy(decoder: Decoder | SeveralDecoder, chunks: Iterator[bytes], out: IO[st
         lines = decoder.feed(chunk)
         check()
         warned = _warn(decoder, source, warn, warned)
-        for line in lines[:len(lines) if ticks is None else ticks - written]:
+        for line in lines[: len(lines) if ticks is None else ticks - written]:
             out.write(dumps(line) + "\n")
             written += 1
         if ticks is not None and written >= ticks:

@@ -40,8 +40,12 @@ FLUSH_MS = 25
 
 def tick_payload(tables: RobotTables) -> int:
     """Bytes of a tick frame's payload: tick, each table's decisions, the outputs, the counters."""
-    return 2 + struct.calcsize(TABLE_FORMAT) * len(tables.machines) + len(tables.output_names) \
+    return (
+        2
+        + struct.calcsize(TABLE_FORMAT) * len(tables.machines)
+        + len(tables.output_names)
         + 2 * len(tables.robot.counters)
+    )
 
 
 def build_several(tables: RobotTables, board_name: str, outdir: Path, machine: Machine | None = None) -> Firmware:
@@ -64,8 +68,9 @@ def build_several(tables: RobotTables, board_name: str, outdir: Path, machine: M
     return Firmware(elf, hexfile, board, wiring, source.layout, flash, ram)
 
 
-def emulate_several(firmware: Firmware, tables: RobotTables, ticks: Sequence[TickInput], workdir: Path,
-                    machine: Machine | None = None) -> list[dict[str, Any]]:
+def emulate_several(
+    firmware: Firmware, tables: RobotTables, ticks: Sequence[TickInput], workdir: Path, machine: Machine | None = None
+) -> list[dict[str, Any]]:
     """Run the firmware under simavr over recorded inputs (the robot's input layout); the decoded trace."""
     assert firmware.wiring is not None
     machine = machine or robot_machine(tables)
@@ -73,14 +78,31 @@ def emulate_several(firmware: Firmware, tables: RobotTables, ticks: Sequence[Tic
     pins, ticks_out, uart = workdir / "pins.csv", workdir / "ticks.csv", workdir / "uart.bin"
     pins.write_text(pins_csv(machine, firmware.wiring, ticks), encoding="utf-8")
     board = firmware.board
-    run_harness(build_harness(), ["--elf", str(firmware.elf), "--mcu", board.mcu, "--freq", str(board.f_cpu),
-                                  "--uart", str(board.usart), "--inputs", str(pins), "--ticks-out", str(ticks_out),
-                                  "--uart-out", str(uart), "--flush-ms", str(FLUSH_MS)])
+    run_harness(
+        build_harness(),
+        [
+            "--elf",
+            str(firmware.elf),
+            "--mcu",
+            board.mcu,
+            "--freq",
+            str(board.f_cpu),
+            "--uart",
+            str(board.usart),
+            "--inputs",
+            str(pins),
+            "--ticks-out",
+            str(ticks_out),
+            "--uart-out",
+            str(uart),
+            "--flush-ms",
+            str(FLUSH_MS),
+        ],
+    )
     lines = decode(tables, uart.read_bytes())
     if len(lines) < len(ticks):
-        raise fail("uart", N_("{frames} tick frames for {ticks} ticks", frames=len(lines), ticks=len(ticks)),
-                   BUG)
-    return lines[:len(ticks)]
+        raise fail("uart", N_("{frames} tick frames for {ticks} ticks", frames=len(lines), ticks=len(ticks)), BUG)
+    return lines[: len(ticks)]
 
 
 def decode(tables: RobotTables, data: bytes) -> list[dict[str, Any]]:
@@ -124,16 +146,22 @@ class SeveralDecoder:
         self.hellos += 1
         self.last_tick = None  # the firmware restarted: its tick count starts again at 0
         if payload[0] != VERSION or payload[1] != len(self.tables.machines):
-            self.problems.append(N_("the firmware says version {version}, {count} tables: not this robot's",
-                                    version=payload[0], count=payload[1]))
+            self.problems.append(
+                N_(
+                    "the firmware says version {version}, {count} tables: not this robot's",
+                    version=payload[0],
+                    count=payload[1],
+                )
+            )
 
     def _line(self, payload: bytes) -> dict[str, Any]:
         tables = self.tables
         tick16 = struct.unpack_from("<H", payload)[0]
         tick = tick16 if self.last_tick is None else self.last_tick + ((tick16 - self.last_tick) & 0xFFFF)
         if self.last_tick is not None and tick != self.last_tick + 1:
-            self.problems.append(N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1,
-                                    last=tick - 1))
+            self.problems.append(
+                N_("ticks {first}..{last} missing from the stream", first=self.last_tick + 1, last=tick - 1)
+            )
         self.last_tick = tick
         line: dict[str, Any] = {"tick": tick}
         at, size = 2, struct.calcsize(TABLE_FORMAT)
@@ -142,8 +170,14 @@ class SeveralDecoder:
             event, row, state, timer = struct.unpack_from(TABLE_FORMAT, payload, at)
             at += size
             key, into = ("", line) if i == 0 else (f"{name}.", later)
-            into.update({f"{key}event": event, f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
-                         f"{key}state": machine.states[state], f"{key}timer": timer})
+            into.update(
+                {
+                    f"{key}event": event,
+                    f"{key}row": None if row < 0 else machine.table.rows[row].as_written,
+                    f"{key}state": machine.states[state],
+                    f"{key}timer": timer,
+                }
+            )
         n_out = len(tables.output_names)
         line.update(zip(tables.output_names, struct.unpack_from(f"<{n_out}b", payload, at), strict=True))
         counters = struct.unpack_from(f"<{len(tables.robot.counters)}H", payload, at + n_out)

@@ -26,8 +26,9 @@ if TYPE_CHECKING:
 
 __all__ = ["CELL_RE", "Cell", "cell_variants", "grid_variants", "parse_cells"]
 
-CELL_RE = re.compile(r"^(?:([^\s:,]+)\s*:\s*)?line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$",
-                     re.IGNORECASE)
+CELL_RE = re.compile(
+    r"^(?:([^\s:,]+)\s*:\s*)?line\s+(\d+)\s+([A-Za-z]\w*)\s*(?:=\s*(\d+)\s*\.\.\s*(\d+))?$", re.IGNORECASE
+)
 
 
 @dataclass(frozen=True)
@@ -68,9 +69,14 @@ def _parse_cells(text: str, table: Table, tables: RobotTables | None) -> list[Ce
     for part in (p.strip() for p in text.split(",") if p.strip()):
         found = CELL_RE.match(part)
         if not found:
-            raise fail("--cells", N_("--cells: {part!r} does not name a cell", part=part),
-                       N_('write "line 5 timer, line 9 timer" (file lines, the header is line 1), optionally with a '
-                          'range: "line 5 timer=100..2000"'))
+            raise fail(
+                "--cells",
+                N_("--cells: {part!r} does not name a cell", part=part),
+                N_(
+                    'write "line 5 timer, line 9 timer" (file lines, the header is line 1), optionally with a '
+                    'range: "line 5 timer=100..2000"'
+                ),
+            )
         index, own = _table_of(found[1], part, table, tables)
         cell = _cell(part, found, own, index, found[1] or "")
         if any((c.table, c.line, c.column) == (cell.table, cell.line, cell.column) for c in cells):
@@ -86,13 +92,21 @@ def _table_of(name: str | None, part: str, table: Table, tables: RobotTables | N
     if name is None:
         return 0, table
     if tables is None:
-        raise fail("--cells", N_("--cells: {part!r} names the table {name}, but the robot has one table", part=part,
-                                 name=name),
-                   N_('leave the table out: "line 5 timer"'))
+        raise fail(
+            "--cells",
+            N_("--cells: {part!r} names the table {name}, but the robot has one table", part=part, name=name),
+            N_('leave the table out: "line 5 timer"'),
+        )
     if name not in tables.names:
-        raise fail("--cells", N_("--cells: {part!r}: the robot has no table {name}", part=part, name=name),
-                   N_("its tables ([tables] in {file}): {names}", file=Path(tables.robot.source).name,
-                      names=", ".join(tables.names)))
+        raise fail(
+            "--cells",
+            N_("--cells: {part!r}: the robot has no table {name}", part=part, name=name),
+            N_(
+                "its tables ([tables] in {file}): {names}",
+                file=Path(tables.robot.source).name,
+                names=", ".join(tables.names),
+            ),
+        )
     k = tables.names.index(name)
     return k, tables.tables[k]
 
@@ -104,27 +118,47 @@ def _cell(part: str, found: re.Match[str], table: Table, index: int, name: str) 
     counters = table.robot.counter_names
     line, column = int(found[2]), found[3]
     if line not in by_line:
-        raise fail("--cells", N_("--cells: line {line} of {file} is not a row of the table", line=line,
-                                 file=Path(table.path).name),
-                   N_("rows are on lines {first}..{last}", first=min(by_line), last=max(by_line)))
+        raise fail(
+            "--cells",
+            N_("--cells: line {line} of {file} is not a row of the table", line=line, file=Path(table.path).name),
+            N_("rows are on lines {first}..{last}", first=min(by_line), last=max(by_line)),
+        )
     row = by_line[line][0]
     counter = _counter_of(column, counters)
     if column.lower() != "timer" and counter is None:
-        raise fail("--cells", N_("--cells: {part!r} is not a timer or a counter load", part=part),
-                   N_("only timer cells (timer) and counter loads ({loads}) can be tuned",
-                      loads=", ".join(f"{c}_load" for c in counters) or N_("none in this robot")))
+        raise fail(
+            "--cells",
+            N_("--cells: {part!r} is not a timer or a counter load", part=part),
+            N_(
+                "only timer cells (timer) and counter loads ({loads}) can be tuned",
+                loads=", ".join(f"{c}_load" for c in counters) or N_("none in this robot"),
+            ),
+        )
     value = row.timer if counter is None else row.counters[counter]
     if value is None:
-        raise fail("--cells", N_("--cells: line {line} leaves {counter} alone (its load is blank)", line=line,
-                                 counter=counters[counter]),  # type: ignore[index]
-                   N_("tune a load the row sets, or write a load into the cell first"))
+        raise fail(
+            "--cells",
+            N_("--cells: line {line} leaves {counter} alone (its load is blank)", line=line, counter=counters[counter]),  # type: ignore[index]
+            N_("tune a load the row sets, or write a load into the cell first"),
+        )
     low, high = (int(found[4]), int(found[5])) if found[4] else (0, min(MAX_TIMER, max(2 * value, 100)))
     if not 0 <= low <= high <= MAX_TIMER:
-        raise fail("--cells", N_("--cells: {part!r}: the range must be LOW..HIGH within 0..{most}", part=part,
-                                 most=MAX_TIMER),
-                   N_("write for example line 5 timer=100..2000"))
-    return Cell(line, tuple(r.index for r in by_line[line]), "timer" if counter is None else
-                f"{counters[counter]}_load", counter, value, low, high, index, name)
+        raise fail(
+            "--cells",
+            N_("--cells: {part!r}: the range must be LOW..HIGH within 0..{most}", part=part, most=MAX_TIMER),
+            N_("write for example line 5 timer=100..2000"),
+        )
+    return Cell(
+        line,
+        tuple(r.index for r in by_line[line]),
+        "timer" if counter is None else f"{counters[counter]}_load",
+        counter,
+        value,
+        low,
+        high,
+        index,
+        name,
+    )
 
 
 def _counter_of(column: str, counters: tuple[str, ...]) -> int | None:
@@ -134,8 +168,9 @@ def _counter_of(column: str, counters: tuple[str, ...]) -> int | None:
     return None
 
 
-def cell_variants(tables: RobotTables | None, machine: Machine, cells: Sequence[Cell],
-                  candidates: Sequence[Sequence[int]]) -> Variants:
+def cell_variants(
+    tables: RobotTables | None, machine: Machine, cells: Sequence[Cell], candidates: Sequence[Sequence[int]]
+) -> Variants:
     """The table's timers and loads with each candidate's values written into its cells (a robot of several
     tables: every table's, each cell in its own table)."""
     several = tables is not None
@@ -163,8 +198,9 @@ class _Axis(Protocol):
     def values(self) -> tuple[Any, ...]: ...
 
 
-def grid_variants(axes: Sequence[_Axis], table: Table, tables: RobotTables | None,
-                  machine: Machine) -> tuple[Variants | None, dict[tuple[Any, ...], int]]:
+def grid_variants(
+    axes: Sequence[_Axis], table: Table, tables: RobotTables | None, machine: Machine
+) -> tuple[Variants | None, dict[tuple[Any, ...], int]]:
     """A sweep's table cells on its grid (``--grid "lights: line 4 timer=20,50"``, ``axes``): a program variant
     per combination of their values, and each combination's variant (none without such a key)."""
     if not axes:

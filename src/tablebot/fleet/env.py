@@ -36,8 +36,14 @@ OBSERVATION = tuple(name for name, _ in BUILT_IN)
 class Setup:
     """The table, world and parameters an environment runs, loaded once (errors as in ``tablebot sim``)."""
 
-    def __init__(self, table: str | Path | None, world: str | Path | None, robot: str | Path | None,
-                 seconds: float, battery: float | None) -> None:
+    def __init__(
+        self,
+        table: str | Path | None,
+        world: str | Path | None,
+        robot: str | Path | None,
+        seconds: float,
+        battery: float | None,
+    ) -> None:
         from tablebot.examples import example_path
         from tablebot.formats.table_read import load_table, resolve_table_path
         from tablebot.machine import compile_table
@@ -55,8 +61,9 @@ class Setup:
         self.scene = prepare(self.table, self.machine, self.world, self.robot_params, self.spec(0).overrides())
         self.ticks = ticks_for(self.scene, seconds)
         levels = int(self.scene.params["motor"]["levels"])
-        self.action_space = spaces.MultiDiscrete([2 * levels + 1, 2 * levels + 1], start=[-levels, -levels],
-                                                 dtype=np.int64)
+        self.action_space = spaces.MultiDiscrete(
+            [2 * levels + 1, 2 * levels + 1], start=[-levels, -levels], dtype=np.int64
+        )
         observation = Observation.of(self.scene)
         self.observation_names = observation.names
         self.observation_space = spaces.Box(observation.low, observation.high, dtype=np.float64)
@@ -74,8 +81,15 @@ class TableBotEnv(gym.Env):
     # gymnasium declares metadata as an instance variable, but it is (and is documented as) a class attribute
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}  # type: ignore[misc]
 
-    def __init__(self, table: str | Path | None = None, world: str | Path | None = None, seconds: float = 60.0,
-                 battery: float | None = None, robot: str | Path | None = None, render_mode: str | None = None) -> None:
+    def __init__(
+        self,
+        table: str | Path | None = None,
+        world: str | Path | None = None,
+        seconds: float = 60.0,
+        battery: float | None = None,
+        robot: str | Path | None = None,
+        render_mode: str | None = None,
+    ) -> None:
         from tablebot.engine import Engine
         from tablebot.sim.simrobot import SimRobot
 
@@ -106,8 +120,13 @@ class TableBotEnv(gym.Env):
         self.ticks += 1
         reached = self.robot.reached_row is not None
         info = {"state": self.setup.machine.states[self.engine.state], "collisions": self.robot.collision_count}
-        return self._observation(), -self.setup.scene.tick_s, reached, self.ticks >= self.setup.ticks and not reached, \
-            info
+        return (
+            self._observation(),
+            -self.setup.scene.tick_s,
+            reached,
+            self.ticks >= self.setup.ticks and not reached,
+            info,
+        )
 
     def _observation(self) -> np.ndarray:
         return self.robot.observation()
@@ -121,17 +140,25 @@ class TableBotVectorEnv(VectorEnv):
 
     # gymnasium declares metadata as an instance variable, but it is (and is documented as) a class attribute
     metadata: ClassVar[dict[str, Any]] = {  # type: ignore[misc]
-        "autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+        "render_modes": [],
+    }
 
-    def __init__(self, num_envs: int = 8, table: str | Path | None = None, world: str | Path | None = None,
-                 seconds: float = 60.0, battery: float | None = None, robot: str | Path | None = None,
-                 render_mode: str | None = None) -> None:
+    def __init__(
+        self,
+        num_envs: int = 8,
+        table: str | Path | None = None,
+        world: str | Path | None = None,
+        seconds: float = 60.0,
+        battery: float | None = None,
+        robot: str | Path | None = None,
+        render_mode: str | None = None,
+    ) -> None:
         from tablebot.fleet.run import Fleet
 
         self.setup = Setup(table, world, robot, seconds, battery)
         self.num_envs, self.render_mode = num_envs, render_mode
-        self.single_action_space, self.single_observation_space = self.setup.action_space, \
-            self.setup.observation_space
+        self.single_action_space, self.single_observation_space = self.setup.action_space, self.setup.observation_space
         self.action_space = batch_space(self.single_action_space, num_envs)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         s = self.setup
@@ -140,8 +167,9 @@ class TableBotVectorEnv(VectorEnv):
         self.done = np.zeros(num_envs, dtype=bool)
         self.generators: list[np.random.Generator] = []
 
-    def reset(self, *, seed: int | list[int] | None = None,
-              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict]:
         """Sub-environment k gets seed ``seed + k`` (or ``seed[k]``): its robot's seed, and the seed of the
         generator its later autoresets draw robot seeds from, as TableBotEnv.reset(seed=...) does."""
         from gymnasium.utils import seeding
@@ -177,5 +205,6 @@ class TableBotVectorEnv(VectorEnv):
 
 
 if ENV_ID not in gym.registry:
-    gym.register(ENV_ID, entry_point="tablebot.fleet.env:TableBotEnv",
-                 vector_entry_point="tablebot.fleet.env:TableBotVectorEnv")
+    gym.register(
+        ENV_ID, entry_point="tablebot.fleet.env:TableBotEnv", vector_entry_point="tablebot.fleet.env:TableBotVectorEnv"
+    )

@@ -67,8 +67,10 @@ def pool_words(seeds: np.ndarray) -> np.ndarray:
     # hashmix(value): value ^= const; const *= MULT_A; value *= const; value ^= value >> 16
     consts = iter(_hash_constants(POOL + POOL * (POOL - 1) + 1, INIT_A, MULT_A)[1:])
     first = _hash_constants(1, INIT_A, MULT_A)[0]
+
     def hashmix(value: np.ndarray, before: np.uint32, after: np.uint32) -> np.ndarray:
         return _xorshift((value ^ before) * after)
+
     const = first
     mixer = np.empty_like(entropy)
     for i in range(POOL):
@@ -101,8 +103,10 @@ def matches_numpy() -> bool:
     if _checked is None:
         probe = np.array([0, 1, 7, 2**32 - 1, 2**32 + 5, 2**64 - 3, 12_345_678_901_234_567_890_123], dtype=object)
         ours = state_words(pool_words(probe))
-        _checked = all(np.array_equal(ours[k], SeedSequence(int(s)).generate_state(PCG64_WORDS, np.uint64))
-                       for k, s in enumerate(probe))
+        _checked = all(
+            np.array_equal(ours[k], SeedSequence(int(s)).generate_state(PCG64_WORDS, np.uint64))
+            for k, s in enumerate(probe)
+        )
     return _checked
 
 

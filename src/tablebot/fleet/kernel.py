@@ -28,28 +28,59 @@ from tablebot.tick import Program
 
 
 @njit(nogil=True)
-def run_one(i: int, fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
-            ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
+def run_one(
+    i: int,
+    fleet: FleetState,
+    world: WorldArrays,
+    program: Program,
+    variants: ProgramVariants,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgens: np.ndarray,
+    record: FleetRecord,
+) -> None:
     """Robot i of :func:`run_fleet`."""
     v = variants.variant[i]
-    own = Program(program.input_mask, program.timer_bit, program.lookup, program.next_state, variants.timers[v],
-                  program.outputs, program.keep, variants.loads[v], program.load_set, program.counter_bits)
+    own = Program(
+        program.input_mask,
+        program.timer_bit,
+        program.lookup,
+        program.next_state,
+        variants.timers[v],
+        program.outputs,
+        program.keep,
+        variants.loads[v],
+        program.load_set,
+        program.counter_bits,
+    )
     slot = record.traced[i]
     if slot >= 0:
         rows, ints = record.hist[slot], record.ints[slot]
     else:  # neither rows nor tick records: the tally is all a robot leaves
         rows = np.empty((0, fleet.S.shape[1]))
         ints = np.empty((0, record.ints.shape[2]), dtype=np.int64)
-    robot = RobotState(fleet.S[i], fleet.P[i], fleet.regs[i], fleet.outputs[i], fleet.counters[i], fleet.acc[i],
-                       fleet.collisions[i])
-    kept = Record(rows, ints, record.counts[i], record.first_visit[i], record.first_light[i:i + 1], record.light_bits,
-                  record.t0)
+    robot = RobotState(
+        fleet.S[i], fleet.P[i], fleet.regs[i], fleet.outputs[i], fleet.counters[i], fleet.acc[i], fleet.collisions[i]
+    )
+    kept = Record(
+        rows, ints, record.counts[i], record.first_visit[i], record.first_light[i : i + 1], record.light_bits, record.t0
+    )
     run_robot(robot, world, own, wiring, ticks, noise[i], bitgens[i], kept)
 
 
 @njit(nogil=True, parallel=True)
-def run_fleet(fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
-              ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
+def run_fleet(
+    fleet: FleetState,
+    world: WorldArrays,
+    program: Program,
+    variants: ProgramVariants,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgens: np.ndarray,
+    record: FleetRecord,
+) -> None:
     """Advance every robot ``ticks`` ticks: robot i runs ``run_robot`` on row i of each of the fleet's arrays,
     with its program variant's timers and counter loads (``variants.variant[i]``), its noise rows ``noise[i]``
     or, when they are empty, noise drawn from its Generator (``bitgens[i]``, see sim.physics.normals).
@@ -62,17 +93,37 @@ def run_fleet(fleet: FleetState, world: WorldArrays, program: Program, variants:
 
 
 @njit(nogil=True)
-def run_fleet_serial(fleet: FleetState, world: WorldArrays, program: Program, variants: ProgramVariants, wiring: Wiring,
-                     ticks: int, noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord) -> None:
+def run_fleet_serial(
+    fleet: FleetState,
+    world: WorldArrays,
+    program: Program,
+    variants: ProgramVariants,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgens: np.ndarray,
+    record: FleetRecord,
+) -> None:
     """:func:`run_fleet` on this thread alone (small fleets, single-threaded workers: no thread pool to wake)."""
     for i in range(fleet.S.shape[0]):
         run_one(i, fleet, world, program, variants, wiring, ticks, noise, bitgens, record)
 
 
 @njit(nogil=True)
-def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: SeveralProgram, variants: ProgramVariants,
-                    tables: SeveralState, wiring: Wiring, ticks: int, noise: np.ndarray, bitgens: np.ndarray,
-                    record: FleetRecord, kept_tables: np.ndarray) -> None:
+def run_one_several(
+    i: int,
+    fleet: FleetState,
+    world: WorldArrays,
+    program: SeveralProgram,
+    variants: ProgramVariants,
+    tables: SeveralState,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgens: np.ndarray,
+    record: FleetRecord,
+    kept_tables: np.ndarray,
+) -> None:
     """Robot i of :func:`run_fleet_several`: sim.physics.several.run_several on its rows (``tables``: every table's
     registers, outputs and counters, a row per robot; ``kept_tables``: each traced robot's tables per tick),
     every table with its variant's timers and loads (``variants.timers[v]``: tables × rows)."""
@@ -86,36 +137,62 @@ def run_one_several(i: int, fleet: FleetState, world: WorldArrays, program: Seve
         ints = np.empty((0, record.ints.shape[2]), dtype=np.int64)
         kept = np.empty((0, kept_tables.shape[2], kept_tables.shape[3]), dtype=np.int64)
     state = SeveralState(tables.regs[i], tables.outputs[i], tables.counters[i], tables.starts[i])
-    robot = RobotState(fleet.S[i], fleet.P[i], state.regs[0], fleet.outputs[i], state.counters[0], fleet.acc[i],
-                       fleet.collisions[i])
-    record_i = Record(rows, ints, record.counts[i], record.first_visit[i], record.first_light[i:i + 1],
-                      record.light_bits, record.t0)
+    robot = RobotState(
+        fleet.S[i], fleet.P[i], state.regs[0], fleet.outputs[i], state.counters[0], fleet.acc[i], fleet.collisions[i]
+    )
+    record_i = Record(
+        rows, ints, record.counts[i], record.first_visit[i], record.first_light[i : i + 1], record.light_bits, record.t0
+    )
     run_several(robot, world, mine, state, wiring, ticks, noise[i], bitgens[i], record_i, kept)
 
 
 @njit(nogil=True)
-def run_fleet_several_serial(fleet: FleetState, world: WorldArrays, program: SeveralProgram,
-                             variants: ProgramVariants, tables: SeveralState, wiring: Wiring, ticks: int,
-                             noise: np.ndarray, bitgens: np.ndarray, record: FleetRecord,
-                             kept_tables: np.ndarray) -> None:
+def run_fleet_several_serial(
+    fleet: FleetState,
+    world: WorldArrays,
+    program: SeveralProgram,
+    variants: ProgramVariants,
+    tables: SeveralState,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgens: np.ndarray,
+    record: FleetRecord,
+    kept_tables: np.ndarray,
+) -> None:
     """Advance every robot of several tables ``ticks`` ticks (every table each tick, as ``tablebot sim`` runs them),
     on this thread: numba's parallel loop cannot take a tuple of programs (each table's), so a fleet runs this on
     slices of its robots in threads of its own (:func:`tablebot.fleet.run.in_threads`; it holds no GIL)."""
     for i in range(fleet.S.shape[0]):
-        run_one_several(i, fleet, world, program, variants, tables, wiring, ticks, noise, bitgens, record,
-                        kept_tables)
+        run_one_several(i, fleet, world, program, variants, tables, wiring, ticks, noise, bitgens, record, kept_tables)
 
 
 @njit(nogil=True, parallel=True)
-def move_parallel(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
-                  bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def move_parallel(
+    S: np.ndarray,
+    P: np.ndarray,
+    world: WorldArrays,
+    commands: np.ndarray,
+    noise: np.ndarray,
+    bits: np.ndarray,
+    acc: np.ndarray,
+    collisions: np.ndarray,
+) -> None:
     for i in prange(S.shape[0]):
         move(S[i], commands[i, 0], commands[i, 1], P[i], world, noise[i], bits, acc[i], collisions[i])
 
 
 @njit(nogil=True)
-def move_serial(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
-                bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def move_serial(
+    S: np.ndarray,
+    P: np.ndarray,
+    world: WorldArrays,
+    commands: np.ndarray,
+    noise: np.ndarray,
+    bits: np.ndarray,
+    acc: np.ndarray,
+    collisions: np.ndarray,
+) -> None:
     for i in range(S.shape[0]):
         move(S[i], commands[i, 0], commands[i, 1], P[i], world, noise[i], bits, acc[i], collisions[i])
 
@@ -131,8 +208,16 @@ def parallel(robots: int, ticks: int) -> bool:
     return robots > 1 and robots * ticks >= PARALLEL_WORK and numba.get_num_threads() > 1
 
 
-def move_fleet(S: np.ndarray, P: np.ndarray, world: WorldArrays, commands: np.ndarray, noise: np.ndarray,
-               bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def move_fleet(
+    S: np.ndarray,
+    P: np.ndarray,
+    world: WorldArrays,
+    commands: np.ndarray,
+    noise: np.ndarray,
+    bits: np.ndarray,
+    acc: np.ndarray,
+    collisions: np.ndarray,
+) -> None:
     """One tick of physics for every robot with the motor levels ``commands[i]`` (right, left) given
     from outside (a learned controller): ``sim.physics.kernel.move`` on each robot's rows."""
     kernel = move_parallel if parallel(S.shape[0], 1) else move_serial

@@ -47,16 +47,23 @@ class FleetSummary:
     def summary(self, i: int) -> Summary:
         """Robot i's numbers as :func:`tablebot.sim.summary.summarise` gives them for a single run, but for
         laps round a track (they need the whole path, which a fleet does not keep: None)."""
+
         def seconds(tick: int) -> float | None:
             return None if tick < 0 else tick * self.tick_s
+
         count = int(self.collisions[i])
-        return Summary(seconds=self.ticks * self.tick_s, first_light_s=seconds(int(self.first_light[i])),
-                       reached_s=seconds(int(self.reached[i])), collisions=count,
-                       collision_ticks=tuple(self.collision_rows[i, : min(count, FLEET_COLLISIONS)].tolist()),
-                       distance_m=float(self.distance_m[i]),
-                       state_seconds=seconds_per_state(self.counts[i], self.first_visit[i], self.states, self.tick_s),
-                       battery_start_v=float(self.battery_start_v[i]), battery_end_v=float(self.battery_end_v[i]),
-                       lamps=self.lamps)
+        return Summary(
+            seconds=self.ticks * self.tick_s,
+            first_light_s=seconds(int(self.first_light[i])),
+            reached_s=seconds(int(self.reached[i])),
+            collisions=count,
+            collision_ticks=tuple(self.collision_rows[i, : min(count, FLEET_COLLISIONS)].tolist()),
+            distance_m=float(self.distance_m[i]),
+            state_seconds=seconds_per_state(self.counts[i], self.first_visit[i], self.states, self.tick_s),
+            battery_start_v=float(self.battery_start_v[i]),
+            battery_end_v=float(self.battery_end_v[i]),
+            lamps=self.lamps,
+        )
 
 
 @dataclass
@@ -78,13 +85,27 @@ class Trace:
 
         def column(name: str) -> np.ndarray:
             return np.concatenate([np.asarray(getattr(b, name)) for b in blocks])
+
         hist = np.concatenate([*self.rows, s[None, :]])
         count = int(acc[K.A_COLLISIONS])
         reached = int(acc[K.A_REACHED])
-        return SimRun(scene=robot.scene, seed=robot.seed, hist=hist, ends=hist[[0, -1]],
-                      path=hist[::PATH_STRIDE, [L.X, L.Y]], masks=column("masks"), events=column("events"),
-                      rows=column("rows"), states=column("states"), timers=column("timers"),
-                      outputs=column("outputs"), counters=column("counters"), pulses=column("pulses"),
-                      collision_rows=collisions[: min(count, FLEET_COLLISIONS)].tolist(),
-                      collision_count=count, reached_row=None if reached < 0 else reached,
-                      end=RunEnd("done", ticks), wall_s=0.0)
+        return SimRun(
+            scene=robot.scene,
+            seed=robot.seed,
+            hist=hist,
+            ends=hist[[0, -1]],
+            path=hist[::PATH_STRIDE, [L.X, L.Y]],
+            masks=column("masks"),
+            events=column("events"),
+            rows=column("rows"),
+            states=column("states"),
+            timers=column("timers"),
+            outputs=column("outputs"),
+            counters=column("counters"),
+            pulses=column("pulses"),
+            collision_rows=collisions[: min(count, FLEET_COLLISIONS)].tolist(),
+            collision_count=count,
+            reached_row=None if reached < 0 else reached,
+            end=RunEnd("done", ticks),
+            wall_s=0.0,
+        )

@@ -13,6 +13,8 @@ if TYPE_CHECKING:
     from tablebot.tables import RobotTables
 
 Pose = tuple[float, float, float]  # x, y (m), heading (degrees)
+
+
 @dataclass(frozen=True)
 class RobotSpec:
     """One robot of a fleet: its seed, where it starts (None: the world's start), its ``[sim]``

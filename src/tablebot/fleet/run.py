@@ -45,8 +45,18 @@ from tablebot.table import Table
 from tablebot.tables import RobotTables
 from tablebot.tick import STATE, registers
 
-__all__ = ["BLOCK_TICKS", "FLEET_COLLISIONS", "Fleet", "FleetSummary", "NoiseRows", "Prepared", "RobotSpec", "Trace",
-           "Variants", "with_start"]
+__all__ = [
+    "BLOCK_TICKS",
+    "FLEET_COLLISIONS",
+    "Fleet",
+    "FleetSummary",
+    "NoiseRows",
+    "Prepared",
+    "RobotSpec",
+    "Trace",
+    "Variants",
+    "with_start",
+]
 
 BLOCK_TICKS = 256  # ticks per compiled call (progress is reported, and traced robots' blocks kept, per block)
 
@@ -56,10 +66,18 @@ class Fleet:
     ``tables``, of every table of a robot of several (``table`` and ``machine`` its main one's; ``variants`` then
     of every table's timers and loads, :meth:`Variants.of_tables`)."""
 
-    def __init__(self, table: Table, machine: Machine, world: World, specs: Sequence[RobotSpec],
-                 robot_params: dict[str, Any] | None = None, traced: Sequence[int] = (),
-                 variants: Variants | None = None, prepared: Prepared | None = None,
-                 tables: RobotTables | None = None) -> None:
+    def __init__(
+        self,
+        table: Table,
+        machine: Machine,
+        world: World,
+        specs: Sequence[RobotSpec],
+        robot_params: dict[str, Any] | None = None,
+        traced: Sequence[int] = (),
+        variants: Variants | None = None,
+        prepared: Prepared | None = None,
+        tables: RobotTables | None = None,
+    ) -> None:
         if machine.arrays is None:
             raise ValueError("the compiled simulator needs a table of at most FLAT_BITS event columns")
         self.table, self.machine, self.world_model, self.robot_params = table, machine, world, robot_params
@@ -79,8 +97,11 @@ class Fleet:
         n_out, n_c, n_states = len(machine.output_names), len(machine.counter_bits), len(machine.states)
         # a fresh Engine's registers, outputs and counters, without making one: its step's lookups, which no
         # compiled loop reads, were a fifth of a sweep chunk's set-up
-        self.initial = (registers(0, machine.initial_state, machine.initial_timer),
-                        np.zeros(n_out, dtype=np.int64), np.zeros(n_c, dtype=np.int64))
+        self.initial = (
+            registers(0, machine.initial_state, machine.initial_timer),
+            np.zeros(n_out, dtype=np.int64),
+            np.zeros(n_c, dtype=np.int64),
+        )
         self.S, self.P = np.zeros((n, L.N_STATE)), np.zeros((n, self.scenes[0].P.shape[1]))
         self.acc, self.collisions = np.zeros((n, K.N_ACC)), np.zeros((n, FLEET_COLLISIONS), dtype=np.int64)
         self.regs = np.zeros((n, len(self.initial[0])), dtype=np.int64)
@@ -123,9 +144,12 @@ class Fleet:
         self.program = several_program(self.tables)
         self.table_initial = np.stack([registers(0, m.initial_state, m.initial_timer) for m in machines])
         count = len(machines)
-        self.table_rows = SeveralState(np.repeat(self.table_initial[None], n, axis=0),
-                                       np.zeros((n, count, n_out), dtype=np.int64),
-                                       np.zeros((n, count, n_c), dtype=np.int64), np.zeros((n, count), dtype=np.int64))
+        self.table_rows = SeveralState(
+            np.repeat(self.table_initial[None], n, axis=0),
+            np.zeros((n, count, n_out), dtype=np.int64),
+            np.zeros((n, count, n_c), dtype=np.int64),
+            np.zeros((n, count), dtype=np.int64),
+        )
 
     def _reset_tables(self, i: int) -> None:
         if self.tables is not None:
@@ -164,8 +188,13 @@ class Fleet:
     def __len__(self) -> int:
         return len(self.specs)
 
-    def run(self, ticks: int, progress: Callable[[int], None] | None = None, block_ticks: int = BLOCK_TICKS,
-            threads: bool | None = None) -> None:
+    def run(
+        self,
+        ticks: int,
+        progress: Callable[[int], None] | None = None,
+        block_ticks: int = BLOCK_TICKS,
+        threads: bool | None = None,
+    ) -> None:
         """Advance every robot ``ticks`` ticks; ``progress(ticks_done)`` after each block. ``threads``: run on
         numba's thread pool (True) or on this thread (False); None: the pool when the work is worth it."""
         done = 0
@@ -183,8 +212,9 @@ class Fleet:
             rng.standard_normal(out=noise[i])
         return noise
 
-    def step_block(self, noise: np.ndarray | None = None, ticks: int | None = None,
-                   threads: bool | None = None) -> None:
+    def step_block(
+        self, noise: np.ndarray | None = None, ticks: int | None = None, threads: bool | None = None
+    ) -> None:
         """Advance every robot ``noise.shape[1]`` ticks with the given noise rows, or ``ticks`` ticks with
         noise each robot draws from its own Generator as it goes (the same numbers :meth:`draw_noise` gives);
         ``threads`` as in :meth:`run`."""
@@ -199,23 +229,47 @@ class Fleet:
         v = self.variants
         pool = parallel(len(self.specs), ticks) if threads is None else threads
         fleet = FleetState(self.S, self.P, self.regs, self.outputs, self.counters, self.acc, self.collisions)
-        record = FleetRecord(self.counts, self.first_visit, self.first_light, self.traced, hist, ints, self.light_bits,
-                             self.t0)
+        record = FleetRecord(
+            self.counts, self.first_visit, self.first_light, self.traced, hist, ints, self.light_bits, self.t0
+        )
         kept = None
         if self.tables is None:
             kernel = run_fleet if pool else run_fleet_serial
-            kernel(fleet, self.world, self.machine.arrays.program, ProgramVariants(v.timers, v.loads, self.variant),  # type: ignore[union-attr]
-                   self.wiring, ticks, noise, self.bitgens, record)
+            kernel(
+                fleet,
+                self.world,
+                self.machine.arrays.program,  # type: ignore[union-attr]
+                ProgramVariants(v.timers, v.loads, self.variant),
+                self.wiring,
+                ticks,
+                noise,
+                self.bitgens,
+                record,
+            )
         else:
             kept = np.zeros((n_traced, ticks, len(self.tables.machines), N_K), dtype=np.int64)
             variants = ProgramVariants(v.timers, v.loads, self.variant)
 
             def robots(a: int, b: int) -> None:  # robots a..b-1: every per-robot array cut to them
                 run_fleet_several_serial(
-                    _rows(fleet, a, b), self.world, self.program, variants._replace(variant=self.variant[a:b]),
-                    _rows(self.table_rows, a, b), self.wiring, ticks, noise[a:b], self.bitgens[a:b],
-                    record._replace(counts=self.counts[a:b], first_visit=self.first_visit[a:b],
-                                    first_light=self.first_light[a:b], traced=self.traced[a:b]), kept)
+                    _rows(fleet, a, b),
+                    self.world,
+                    self.program,
+                    variants._replace(variant=self.variant[a:b]),
+                    _rows(self.table_rows, a, b),
+                    self.wiring,
+                    ticks,
+                    noise[a:b],
+                    self.bitgens[a:b],
+                    record._replace(
+                        counts=self.counts[a:b],
+                        first_visit=self.first_visit[a:b],
+                        first_light=self.first_light[a:b],
+                        traced=self.traced[a:b],
+                    ),
+                    kept,
+                )
+
             in_threads(numba.get_num_threads() if pool else 1, len(self.specs), robots)
             self.regs[:], self.counters[:] = self.table_rows.regs[:, 0], self.table_rows.counters[:, 0]
         n_out, n_c = self.outputs.shape[1], self.counters.shape[1]
@@ -242,8 +296,16 @@ class Fleet:
         if commands is None:
             self.step_block(noise[:, None, :])
         else:
-            move_fleet(self.S, self.P, self.world, np.asarray(commands, dtype=np.int64).reshape(len(self), 2), noise,
-                       self.bits, self.acc, self.collisions)
+            move_fleet(
+                self.S,
+                self.P,
+                self.world,
+                np.asarray(commands, dtype=np.int64).reshape(len(self), 2),
+                noise,
+                self.bits,
+                self.acc,
+                self.collisions,
+            )
 
     def restart(self, i: int, spec: RobotSpec) -> None:
         """Robot i starts again as ``spec`` says (:meth:`place`), its noise stream with it."""
@@ -266,12 +328,22 @@ class Fleet:
 
     def summary(self) -> FleetSummary:
         return FleetSummary(
-            ticks=self.t0, tick_s=self.tick_s, states=self.machine.states, first_light=self.first_light.copy(),
-            reached=self.acc[:, K.A_REACHED].astype(np.int64), collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
-            distance_m=self.S[:, L.DIST].copy(), battery_start_v=self.battery_start_v.copy(),
-            battery_end_v=self.S[:, L.VBAT].copy(), final_state=self.regs[:, STATE].copy(), counts=self.counts.copy(),
-            first_visit=self.first_visit.copy(), collision_rows=self.collisions.copy(),
-            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(), lamps=bool(self.world_model.lamps))
+            ticks=self.t0,
+            tick_s=self.tick_s,
+            states=self.machine.states,
+            first_light=self.first_light.copy(),
+            reached=self.acc[:, K.A_REACHED].astype(np.int64),
+            collisions=self.acc[:, K.A_COLLISIONS].astype(np.int64),
+            distance_m=self.S[:, L.DIST].copy(),
+            battery_start_v=self.battery_start_v.copy(),
+            battery_end_v=self.S[:, L.VBAT].copy(),
+            final_state=self.regs[:, STATE].copy(),
+            counts=self.counts.copy(),
+            first_visit=self.first_visit.copy(),
+            collision_rows=self.collisions.copy(),
+            final_pose=self.S[:, [L.X, L.Y, L.TH]].copy(),
+            lamps=bool(self.world_model.lamps),
+        )
 
     def trace_lines(self, i: int) -> list[str]:
         """Robot i's trace (it must be traced), line for line what ``tablebot sim`` writes."""

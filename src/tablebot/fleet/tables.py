@@ -31,7 +31,18 @@ def main_table_only(robot: Robot) -> None:
     specs = tables_of(robot)
     if specs:
         others = ", ".join(spec.name for spec in specs[1:])
-        notify(Diagnostic(robot.source, robot.line("tables"), 1,
-                          N_("this runs the main table ({main}) only so far, not {others}: the outputs only they write "
-                             "stay at 0", main=specs[0].name, others=others),
-                          N_("tablebot sim, sweep, tune and grade run every table (docs/engine.md)"), "note"))
+        notify(
+            Diagnostic(
+                robot.source,
+                robot.line("tables"),
+                1,
+                N_(
+                    "this runs the main table ({main}) only so far, not {others}: the outputs only they write "
+                    "stay at 0",
+                    main=specs[0].name,
+                    others=others,
+                ),
+                N_("tablebot sim, sweep, tune and grade run every table (docs/engine.md)"),
+                "note",
+            )
+        )

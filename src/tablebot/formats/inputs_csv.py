@@ -61,8 +61,9 @@ def load_inputs(path: str | Path, machine: Events) -> list[TickInput]:
     records = read_records(text, str(path))  # one at a time: only the ticks are kept
     header = next((record for record in records if not record.is_blank()), None)  # blank lines above it
     if header is None:  # (below it, a blank row is a tick)
-        raise fail(path, N_("the inputs file is empty"), N_("write a header of input names, then one row per tick"),
-                   1, 1)
+        raise fail(
+            path, N_("the inputs file is empty"), N_("write a header of input names, then one row per tick"), 1, 1
+        )
     after = records_after(text, header.line)
     if after is not None and after > MAX_INPUT_TICKS:  # known at once: no row is read
         raise _too_many_ticks(path, header.line + MAX_INPUT_TICKS + 1)
@@ -91,8 +92,13 @@ def _count(ticks: list[TickInput], path: Path, line: int) -> None:
 
 
 def _too_many_ticks(path: Path, line: int) -> TableBotError:
-    return fail(path, N_("more than {most:,} ticks, the most tablebot replays", most=MAX_INPUT_TICKS),
-                N_("replay a shorter recording (split the file)"), line, 1)
+    return fail(
+        path,
+        N_("more than {most:,} ticks, the most tablebot replays", most=MAX_INPUT_TICKS),
+        N_("replay a shorter recording (split the file)"),
+        line,
+        1,
+    )
 
 
 def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tuple[str, str]]:
@@ -103,20 +109,42 @@ def _columns(header: Sequence[Cell], machine: Events, out: Collector) -> list[tu
     seen: dict[str, Cell] = {}
     for cell in header:
         name = cell.text.strip()
-        kind = ("input" if name in robot.inputs else "pulses" if name in robot.counter_names
-                else "tick" if name == "tick" else "blank" if not name else "bad")
+        kind = (
+            "input"
+            if name in robot.inputs
+            else "pulses"
+            if name in robot.counter_names
+            else "tick"
+            if name == "tick"
+            else "blank"
+            if not name
+            else "bad"
+        )
         if name == TIMER_EVENT:
-            out.error(cell.line, cell.column, N_("T is never an input: the engine makes it from the timer"),
-                      N_("remove the T column"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("T is never an input: the engine makes it from the timer"),
+                N_("remove the T column"),
+            )
         elif kind == "bad":
-            out.error(cell.line, cell.column, N_("unknown input {name!r} for robot {robot}", name=name,
-                                                 robot=robot.name),
-                      N_("inputs are {inputs}; counters (pulses per tick) are {counters}",
-                         inputs=", ".join(robot.inputs), counters=", ".join(robot.counter_names) or N_("none")))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("unknown input {name!r} for robot {robot}", name=name, robot=robot.name),
+                N_(
+                    "inputs are {inputs}; counters (pulses per tick) are {counters}",
+                    inputs=", ".join(robot.inputs),
+                    counters=", ".join(robot.counter_names) or N_("none"),
+                ),
+            )
         elif name in seen:
-            out.error(cell.line, cell.column, N_("column {name!r} appears twice (first at column {first})", name=name,
-                                                 first=seen[name].column),
-                      N_("delete or rename one of them"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("column {name!r} appears twice (first at column {first})", name=name, first=seen[name].column),
+                N_("delete or rename one of them"),
+            )
             kind = "bad"
         if name:
             seen.setdefault(name, cell)
@@ -136,18 +164,28 @@ def _tick(cells: Sequence[Cell], columns: list[tuple[str, str]], machine: Events
             headerless(cell, out)
         elif not (text.isascii() and text.isdigit()) or (kind == "input" and text not in ("0", "1")):
             if kind == "input":
-                out.error(cell.line, cell.column, N_("{name}: {text!r} is not 0 or 1", name=name, text=text),
-                          N_("write 0 or 1; blank means 0"))
+                out.error(
+                    cell.line,
+                    cell.column,
+                    N_("{name}: {text!r} is not 0 or 1", name=name, text=text),
+                    N_("write 0 or 1; blank means 0"),
+                )
             else:
-                out.error(cell.line, cell.column, N_("{name}: {text!r} is not a pulse count (0 or more)", name=name,
-                                                     text=text),
-                          N_("write a pulse count (0 or more); blank means 0"))
+                out.error(
+                    cell.line,
+                    cell.column,
+                    N_("{name}: {text!r} is not a pulse count (0 or more)", name=name, text=text),
+                    N_("write a pulse count (0 or more); blank means 0"),
+                )
         elif kind == "input":
             mask |= machine.input_bits.get(name, 0) if text == "1" else 0
         elif len(text) > MAX_NUMBER_CHARS:  # int() of it may fail, and no encoder counts that many in a tick
-            out.error(cell.line, cell.column, N_("{name}: a number of {count:,} characters is too many pulses",
-                                                 name=name, count=len(text)),
-                      N_("write the pulses of one tick (a few at most); blank means 0"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("{name}: a number of {count:,} characters is too many pulses", name=name, count=len(text)),
+                N_("write the pulses of one tick (a few at most); blank means 0"),
+            )
         else:
             pulses[counters.index(name)] = int(text)
     cells_beyond(cells, len(columns), out)
@@ -187,11 +225,16 @@ def trace_inputs(path: Path, text: str, machine: Events) -> list[TickInput]:
     seen: dict[tuple[Any, ...], TickInput] = {}  # one tick object per distinct tick: a run repeats a few
     for number, data in trace_records(text, out):
         values: list[Any] = [data.get(key) for key in keys]  # JSON values, checked just below
-        bad = [key for key, v in zip(keys, values, strict=True)
-               if isinstance(v, bool) or not isinstance(v, int) or v < 0]
+        bad = [
+            key for key, v in zip(keys, values, strict=True) if isinstance(v, bool) or not isinstance(v, int) or v < 0
+        ]
         if bad:
-            out.error(number, 1, N_("this trace line has no whole-number {key}", key=bad[0]),
-                      N_("replay a trace that a run of this table recorded (tablebot run --out)"))
+            out.error(
+                number,
+                1,
+                N_("this trace line has no whole-number {key}", key=bad[0]),
+                N_("replay a trace that a run of this table recorded (tablebot run --out)"),
+            )
             continue
         _count(ticks, path, number)
         key = (values[0] & machine.input_mask, *values[1:])

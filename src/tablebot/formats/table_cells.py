@@ -16,14 +16,24 @@ from tablebot.i18n import N_, Message
 from tablebot.robot import MAX_TIMER, STATE_HINT, STATE_RE, StateId
 from tablebot.table import MAX_LAMP, MAX_SPEED, from_direction_speed
 
-__all__ = ["INT_RE", "KEEP_WORDS", "NUMBERS", "TIME_RE", "Column", "motor_speed", "range_hint", "read_int",
-           "read_state", "read_timer", "read_value", "whole"]
+__all__ = [
+    "INT_RE",
+    "KEEP_WORDS",
+    "NUMBERS",
+    "TIME_RE",
+    "Column",
+    "motor_speed",
+    "range_hint",
+    "read_int",
+    "read_state",
+    "read_timer",
+    "read_value",
+    "whole",
+]
 
 KEEP_WORDS = {"=", "keep", "k"}
 INT_RE = re.compile(r"^[+-]?\d+(\.0*)?$")
 TIME_RE = re.compile(r"[A-Za-z]\s*$")  # a timer cell that ends in a unit (500ms, 0.5 s, 3 ticks) is a duration
-
-
 
 
 @dataclass(frozen=True)
@@ -40,8 +50,9 @@ def whole(text: str) -> int:
     return int(text.partition(".")[0])
 
 
-def read_int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: int | None = 0,
-         keep: bool = False) -> int | None:
+def read_int(
+    cell: Cell, what: str, low: int, high: int, out: Collector, blank: int | None = 0, keep: bool = False
+) -> int | None:
     text = cell.text.strip()
     if not text:
         return blank
@@ -52,13 +63,27 @@ def read_int(cell: Cell, what: str, low: int, high: int, out: Collector, blank: 
         out.error(cell.line, cell.column, N_("{what}: {text!r} is not an integer", what=what, text=text), hint)
         return blank
     if len(text) > MAX_NUMBER_CHARS:  # never in range, and int() of it may fail
-        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is out of range {low}..{high}",
-                                             what=what, count=len(text), low=low, high=high), hint)
+        out.error(
+            cell.line,
+            cell.column,
+            N_(
+                "{what}: a number of {count:,} characters is out of range {low}..{high}",
+                what=what,
+                count=len(text),
+                low=low,
+                high=high,
+            ),
+            hint,
+        )
         return blank
     value = whole(text)
     if not low <= value <= high:
-        out.error(cell.line, cell.column, N_("{what}: {value} is out of range {low}..{high}", what=what, value=value,
-                                             low=low, high=high), hint)
+        out.error(
+            cell.line,
+            cell.column,
+            N_("{what}: {value} is out of range {low}..{high}", what=what, value=value, low=low, high=high),
+            hint,
+        )
         return blank
     return value
 
@@ -67,8 +92,7 @@ def range_hint(low: int, high: int, keep: bool) -> Message:
     if (low, high) == (0, 1):  # event and direction cells: a flag, not a quantity
         return N_("write 1 or 0 (a blank cell is 0)")
     if (low, high, keep) == (0, MAX_TIMER, False):  # the timer: ticks or a time
-        return N_("write a whole number of ticks from 0 to {high}, or a time such as 500ms, 0.5s or 0,5s",
-                  high=high)
+        return N_("write a whole number of ticks from 0 to {high}, or a time such as 500ms, 0.5s or 0,5s", high=high)
     if keep:
         return N_("write a whole number from {low} to {high}, or = to keep it as it is", low=low, high=high)
     return N_("write a whole number from {low} to {high}", low=low, high=high)
@@ -80,28 +104,40 @@ def read_state(cell: Cell, what: str, out: Collector) -> StateId | None:
         out.error(cell.line, cell.column, N_("{what} is missing", what=what), N_("write a state number or name"))
         return None
     if INT_RE.match(text) and len(text) > MAX_NUMBER_CHARS:  # int() of it may fail
-        out.error(cell.line, cell.column, N_("{what}: a number of {count:,} characters is too long", what=what,
-                                             count=len(text)),
-                  N_("a state number has at most {most} characters; or use a name", most=MAX_NUMBER_CHARS))
+        out.error(
+            cell.line,
+            cell.column,
+            N_("{what}: a number of {count:,} characters is too long", what=what, count=len(text)),
+            N_("a state number has at most {most} characters; or use a name", most=MAX_NUMBER_CHARS),
+        )
         return None
     if INT_RE.match(text):
         value = whole(text)
         if value < 0:
-            out.error(cell.line, cell.column, N_("{what} {value} is negative", what=what, value=value),
-                      N_("states are 0 or more"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("{what} {value} is negative", what=what, value=value),
+                N_("states are 0 or more"),
+            )
         return value
     if not STATE_RE.match(text):
-        out.error(cell.line, cell.column, N_("{what} {text!r} is not a valid state name", what=what, text=text),
-                  STATE_HINT)
+        out.error(
+            cell.line, cell.column, N_("{what} {text!r} is not a valid state name", what=what, text=text), STATE_HINT
+        )
         return None
     return text
 
 
 #: How read_int reads each numeric column kind: (low, high, value of a blank cell, whether "=" keeps).
 NUMBERS: dict[str, tuple[int, int, int | None, bool]] = {
-    "timer": (0, MAX_TIMER, 0, False), "event": (0, 1, 0, False), "dir": (0, 1, 0, False),
-    "speed": (0, MAX_SPEED, 0, False), "signed": (-MAX_SPEED, MAX_SPEED, 0, True),
-    "lamp": (0, MAX_LAMP, None, True), "load": (0, MAX_TIMER, None, True),
+    "timer": (0, MAX_TIMER, 0, False),
+    "event": (0, 1, 0, False),
+    "dir": (0, 1, 0, False),
+    "speed": (0, MAX_SPEED, 0, False),
+    "signed": (-MAX_SPEED, MAX_SPEED, 0, True),
+    "lamp": (0, MAX_LAMP, None, True),
+    "load": (0, MAX_TIMER, None, True),
 }
 
 
@@ -130,10 +166,22 @@ def read_timer(cell: Cell, tick_ms: int, out: Collector) -> int:
         out.error(cell.line, cell.column, N_("timer: {problem}", problem=exc.message), exc.hint)
         return 0
     if ticks > MAX_TIMER:
-        out.error(cell.line, cell.column, N_("timer: {text} is {ticks} ticks, more than the timer holds ({most})",
-                                             text=text, ticks=ticks, most=MAX_TIMER),
-                  N_("the longest timer is {most} ticks ({seconds:g} s at {tick} ms a tick)", most=MAX_TIMER,
-                     seconds=seconds(MAX_TIMER, tick_ms), tick=tick_ms))
+        out.error(
+            cell.line,
+            cell.column,
+            N_(
+                "timer: {text} is {ticks} ticks, more than the timer holds ({most})",
+                text=text,
+                ticks=ticks,
+                most=MAX_TIMER,
+            ),
+            N_(
+                "the longest timer is {most} ticks ({seconds:g} s at {tick} ms a tick)",
+                most=MAX_TIMER,
+                seconds=seconds(MAX_TIMER, tick_ms),
+                tick=tick_ms,
+            ),
+        )
         return 0
     return ticks
 

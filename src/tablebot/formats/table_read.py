@@ -61,9 +61,16 @@ def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
     records = read_records(text, path)  # one at a time: only the rows made of them are kept
     header = next((record for record in records if not record.is_blank()), None)
     if header is None:
-        raise fail(path, N_("the table is empty"), N_("the first line must be a header such as {example}",
-                                                      example="description,state,T,I3,M1_dir,M1_speed,timer,next"),
-                   1, 1)
+        raise fail(
+            path,
+            N_("the table is empty"),
+            N_(
+                "the first line must be a header such as {example}",
+                example="description,state,T,I3,M1_dir,M1_speed,timer,next",
+            ),
+            1,
+            1,
+        )
     columns = _header(header, robot, out)
     events = tuple(c.name for c in columns if c.kind == "event")
     next_at = next((i for i, c in enumerate(columns) if c.kind == "next"), None)
@@ -91,24 +98,38 @@ def parse_table(text: str, path: str, robot: Robot, name: str = "") -> Table:
         if state_at is not None and len(record.cells) > state_at:
             state_cells[record.line] = record.cells[state_at]
     if not rows and not out.items:
-        out.error(header.line + 1, 1, N_("the table has a header but no rows"),
-                  N_("add one row per transition below the header"))
+        out.error(
+            header.line + 1,
+            1,
+            N_("the table has a header but no rows"),
+            N_("add one row per transition below the header"),
+        )
     rows = grouped(rows, robot, out, state_cells, next_cells)
     _check_states(rows, robot, out, next_cells, columns)
     out.raise_if_any()
     cross = {c.name: x for c in columns if c.kind == "event" and (x := cross_column(c.cell, robot, out)) is not None}
-    return Table(robot=robot, events=events, rows=tuple(rows), path=path, name=name, cross=cross,
-                 writes=writes((c.kind, c.name, c.cell) for c in columns))
+    return Table(
+        robot=robot,
+        events=events,
+        rows=tuple(rows),
+        path=path,
+        name=name,
+        cross=cross,
+        writes=writes((c.kind, c.name, c.cell) for c in columns),
+    )
 
 
 def _too_many_rows(path: str, line: int) -> TableBotError:
-    return fail(path, N_("the table has more than {most:,} lines below its header, the most tablebot reads",
-                         most=MAX_TABLE_ROWS),
-                N_("split it into smaller tables; is this the right file?"), line, 1)
+    return fail(
+        path,
+        N_("the table has more than {most:,} lines below its header, the most tablebot reads", most=MAX_TABLE_ROWS),
+        N_("split it into smaller tables; is this the right file?"),
+        line,
+        1,
+    )
 
 
-def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int | None, int | None],
-                  path: str) -> None:
+def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int | None, int | None], path: str) -> None:
     """Add the states ``row`` names (from ``record``; ``at``: its state and next-state columns) to ``states``,
     refusing the one past MAX_STATES at its cell."""
     for value, column in ((row.state, at[0]), (row.next, at[1])):
@@ -116,10 +137,13 @@ def _count_states(states: set[StateId], row: Row, record: Record, at: tuple[int 
             states.add(value)
             if len(states) > MAX_STATES:
                 where = record.cells[column].column if column is not None and column < len(record.cells) else 1
-                raise fail(path, N_("the table has more than {most:,} states, the most tablebot reads",
-                                    most=MAX_STATES),
-                           N_("split the robot's behaviour into smaller tables; is this the right file?"),
-                           record.line, where)
+                raise fail(
+                    path,
+                    N_("the table has more than {most:,} states, the most tablebot reads", most=MAX_STATES),
+                    N_("split the robot's behaviour into smaller tables; is this the right file?"),
+                    record.line,
+                    where,
+                )
 
 
 def is_comment(record: Record) -> bool:
@@ -129,6 +153,7 @@ def is_comment(record: Record) -> bool:
 
 
 # --- header -------------------------------------------------------------------------------------
+
 
 def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
     if name in FIXED:
@@ -151,9 +176,15 @@ def _classify(name: str, robot: Robot) -> tuple[str, str] | None:
 def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
     columns: list[Column] = []
     seen: dict[tuple[str, str], Cell] = {}
-    known = (*FIXED, TIMER_EVENT, *robot.inputs, *robot.counter_names,
-             *(N_("{m}_dir/{m}_speed or {m}", m=m) for m in robot.motors), *robot.lamps,
-             *(f"{c}_load" for c in robot.counter_names))
+    known = (
+        *FIXED,
+        TIMER_EVENT,
+        *robot.inputs,
+        *robot.counter_names,
+        *(N_("{m}_dir/{m}_speed or {m}", m=m) for m in robot.motors),
+        *robot.lamps,
+        *(f"{c}_load" for c in robot.counter_names),
+    )
     for cell in record.cells:
         name = normalise_header(cell.text)
         if not name:
@@ -165,43 +196,73 @@ def _header(record: Record, robot: Robot, out: Collector) -> list[Column]:
             continue
         kind_name = _classify(name, robot)
         if kind_name is None:
-            out.error(cell.line, cell.column, N_("unknown column {name!r} for robot {robot}", name=cell.text.strip(),
-                                                 robot=robot.name),
-                      N_("known columns: {known}; declare new inputs or outputs in the robot file", known=known))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("unknown column {name!r} for robot {robot}", name=cell.text.strip(), robot=robot.name),
+                N_("known columns: {known}; declare new inputs or outputs in the robot file", known=known),
+            )
             columns.append(Column("ignore", name, cell))
             continue
         if kind_name in seen:
             first = seen[kind_name]
-            out.error(cell.line, cell.column, N_("column {name!r} appears twice (first at column {first})",
-                                                 name=cell.text.strip(), first=first.column),
-                      N_("delete or rename one of them"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_(
+                    "column {name!r} appears twice (first at column {first})",
+                    name=cell.text.strip(),
+                    first=first.column,
+                ),
+                N_("delete or rename one of them"),
+            )
         seen[kind_name] = cell
         columns.append(Column(kind_name[0], kind_name[1], cell))
     events = [c.cell for c in columns if c.kind == "event"]
     if len(events) > MAX_EVENT_COLUMNS:
         cell = events[MAX_EVENT_COLUMNS]
-        out.error(cell.line, cell.column, N_("the table has {count} event columns (T, inputs and counters), more "
-                                             "than the {most} the engines' 64-bit event word holds",
-                                             count=len(events), most=MAX_EVENT_COLUMNS),
-                  N_("keep at most {most} event columns (this is the first one too many)", most=MAX_EVENT_COLUMNS))
+        out.error(
+            cell.line,
+            cell.column,
+            N_(
+                "the table has {count} event columns (T, inputs and counters), more "
+                "than the {most} the engines' 64-bit event word holds",
+                count=len(events),
+                most=MAX_EVENT_COLUMNS,
+            ),
+            N_("keep at most {most} event columns (this is the first one too many)", most=MAX_EVENT_COLUMNS),
+        )
     for required in ("state", "next"):
         if (required, required) not in seen:
-            out.error(record.line, None, N_("the header has no {name!r} column", name=required),
-                      N_("every table needs state and next columns"))
+            out.error(
+                record.line,
+                None,
+                N_("the header has no {name!r} column", name=required),
+                N_("every table needs state and next columns"),
+            )
     for motor in robot.motors:
         forms = {k for (k, n) in seen if n == motor}
         if "signed" in forms and forms & {"dir", "speed"}:
             cell = seen[("signed", motor)]
-            out.error(cell.line, cell.column, N_("motor {m} is given both as {m} and as {m}_dir/{m}_speed", m=motor),
-                      N_("use one form per motor"))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("motor {m} is given both as {m} and as {m}_dir/{m}_speed", m=motor),
+                N_("use one form per motor"),
+            )
         elif "dir" in forms and "speed" not in forms:
             cell = seen[("dir", motor)]
-            out.error(cell.line, cell.column, N_("{m}_dir has no {m}_speed column", m=motor),
-                      N_("add a {m}_speed column (or use one signed column {m})", m=motor))
+            out.error(
+                cell.line,
+                cell.column,
+                N_("{m}_dir has no {m}_speed column", m=motor),
+                N_("add a {m}_speed column (or use one signed column {m})", m=motor),
+            )
     return columns
 
 
 # --- rows ---------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class _Layout:
@@ -214,8 +275,11 @@ class _Layout:
 
     @staticmethod
     def of(columns: list[Column]) -> _Layout:
-        return _Layout(columns, [(i, c) for i, c in enumerate(columns) if c.kind != "ignore"],
-                       [i for i, c in enumerate(columns) if c.kind == "ignore" and not c.name])
+        return _Layout(
+            columns,
+            [(i, c) for i, c in enumerate(columns) if c.kind != "ignore"],
+            [i for i, c in enumerate(columns) if c.kind == "ignore" and not c.name],
+        )
 
     def headerless(self, cells: list[Cell], out: Collector) -> None:
         """Report the filled cells under a blank header (their texts joined in C first: they are mostly empty)."""
@@ -224,8 +288,15 @@ class _Layout:
                 headerless(cells[i], out)
 
 
-def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
-         memo: dict[tuple[int, str], Any], index: int, above: str) -> Row | None:
+def _row(
+    record: Record,
+    layout: _Layout,
+    robot: Robot,
+    out: Collector,
+    memo: dict[tuple[int, str], Any],
+    index: int,
+    above: str,
+) -> Row | None:
     """The row of one record (the ``index``-th, 0-based; a blank description continues ``above``, the
     one of the row before), or None when its state or next state is unreadable.
 
@@ -242,16 +313,23 @@ def _row(record: Record, layout: _Layout, robot: Robot, out: Collector,
     state, nxt = values.get(("state", "state")), values.get(("next", "next"))
     if state is None or nxt is None:
         return None
-    return Row(index=index, line=record.line, description=values.get(("description", "description")) or above,
-               state=state, events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
-               motors=tuple(motor_speed(motor, values, bool(tables_of(robot))) for motor in robot.motors),
-               timer=values.get(("timer", "timer")) or 0, next=nxt,
-               counters=tuple(values.get(("load", c.name)) for c in robot.counters),
-               lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps))
+    return Row(
+        index=index,
+        line=record.line,
+        description=values.get(("description", "description")) or above,
+        state=state,
+        events=frozenset(name for (kind, name), v in values.items() if kind == "event" and v),
+        motors=tuple(motor_speed(motor, values, bool(tables_of(robot))) for motor in robot.motors),
+        timer=values.get(("timer", "timer")) or 0,
+        next=nxt,
+        counters=tuple(values.get(("load", c.name)) for c in robot.counters),
+        lamps=tuple(values.get(("lamp", lamp)) for lamp in robot.lamps),
+    )
 
 
-def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any],
-            tick_ms: int) -> Any:
+def _cached(
+    index: int, column: Column, cell: Cell, out: Collector, memo: dict[tuple[int, str], Any], tick_ms: int
+) -> Any:
     """:func:`~tablebot.formats.table_cells.read_value`, remembered per column and text: a long table repeats
     the same few cell texts. A cell with an error is never remembered, so every bad cell is reported at its own
     place."""
@@ -267,8 +345,9 @@ def _cached(index: int, column: Column, cell: Cell, out: Collector, memo: dict[t
     return value
 
 
-def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell],
-                  columns: list[Column]) -> None:
+def _check_states(
+    rows: list[Row], robot: Robot, out: Collector, next_cells: dict[int, Cell], columns: list[Column]
+) -> None:
     """Report :func:`missing_states` at the next-state cell, or where the robot names the state."""
     if not rows:
         return
@@ -280,8 +359,9 @@ def _check_states(rows: list[Row], robot: Robot, out: Collector, next_cells: dic
             out.error(row.line, cell.column if cell else None, message, hint)
 
 
-def _robot_error(out: Collector, robot: Robot, where: tuple[str, str], columns: list[Column], message: str,
-                 hint: str) -> None:
+def _robot_error(
+    out: Collector, robot: Robot, where: tuple[str, str], columns: list[Column], message: str, hint: str
+) -> None:
     """A problem that comes from the robot description: located at its line in the robot file, or,
     for the built-in robot, at the table's state column (where the missing rows belong)."""
     line = robot.line(*where)
@@ -298,6 +378,9 @@ def resolve_table_path(path: Path) -> Path:
         for name in ("table.csv", "table.tsv"):
             if (path / name).is_file():
                 return path / name
-        raise fail(path, N_("this folder holds no table.csv or table.tsv"),
-                   N_("give the table file itself, or a folder that holds table.csv"))
+        raise fail(
+            path,
+            N_("this folder holds no table.csv or table.tsv"),
+            N_("give the table file itself, or a folder that holds table.csv"),
+        )
     return path

@@ -15,8 +15,10 @@ from tablebot.table import DOC_KEEP_SPEED, Row, Table, to_direction_speed
 
 def signed_motors(table: Table) -> frozenset[str]:
     """Motors that need the signed form: some row sets them to speed 7 (or -7)."""
-    speeds = [{abs(speed) for row in table.rows if (speed := row.motors[i]) is not None}
-              for i in range(len(table.robot.motors))]
+    speeds = [
+        {abs(speed) for row in table.rows if (speed := row.motors[i]) is not None}
+        for i in range(len(table.robot.motors))
+    ]
     return frozenset(motor for motor, used in zip(table.robot.motors, speeds, strict=True) if DOC_KEEP_SPEED in used)
 
 
@@ -29,12 +31,15 @@ def owns(table: Table, output: str) -> bool:
 def header(table: Table, signed: frozenset[str], language: str = "en") -> list[str]:
     """The header's cells, in ``language`` (German: Zustand, Folgezustand, M1_Richtung: tablebot.i18n.headers)."""
     robot = table.robot
-    motors = [name for m in robot.motors if owns(table, m)
-              for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])]
+    motors = [
+        name for m in robot.motors if owns(table, m) for name in ([m] if m in signed else [f"{m}_dir", f"{m}_speed"])
+    ]
     lamps = [lamp for lamp in robot.lamps if owns(table, lamp)]
     loads = [f"{c}_load" for c in robot.counter_names if owns(table, c)]
-    return [header_name(name, language) for name in ["description", "state", *table.events, *motors, *lamps,
-                                                      *loads, "timer", "next"]]
+    return [
+        header_name(name, language)
+        for name in ["description", "state", *table.events, *motors, *lamps, *loads, "timer", "next"]
+    ]
 
 
 def _motor_cells(speed: int | None, signed: bool) -> list[str]:
@@ -54,10 +59,16 @@ def row_cells(table: Table, row: Row, previous: Row | None, signed: frozenset[st
     motors = [(m, speed) for m, speed in zip(robot.motors, row.motors, strict=True) if owns(table, m)]
     lamps = [v for lamp, v in zip(robot.lamps, row.lamps, strict=True) if owns(table, lamp)]
     loads = [v for c, v in zip(robot.counter_names, row.counters, strict=True) if owns(table, c)]
-    return [description, str(row.state), *("1" if e in row.events else "" for e in table.events),
-            *(cell for motor, speed in motors for cell in _motor_cells(speed, motor in signed)),
-            *(_keep(v) for v in lamps), *("" if v is None else str(v) for v in loads),
-            str(row.timer), str(row.next)]
+    return [
+        description,
+        str(row.state),
+        *("1" if e in row.events else "" for e in table.events),
+        *(cell for motor, speed in motors for cell in _motor_cells(speed, motor in signed)),
+        *(_keep(v) for v in lamps),
+        *("" if v is None else str(v) for v in loads),
+        str(row.timer),
+        str(row.next),
+    ]
 
 
 def format_table(table: Table, language: str = "en") -> str:

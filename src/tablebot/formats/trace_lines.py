@@ -113,8 +113,9 @@ def trace_records(text: str, out: Collector, required: tuple[str, ...] = ()) -> 
             continue
         except ValueError:  # int() of a number past Python's 4,300 digits
             long = LONG_NUMBER_RE.search(raw)
-            out.error(number, long.start() + 1 if long else 1, N_("line {n} has a number too long to read", n=number),
-                      hint)
+            out.error(
+                number, long.start() + 1 if long else 1, N_("line {n} has a number too long to read", n=number), hint
+            )
             continue
         if not isinstance(line, dict):
             out.error(number, 1, N_("line {n} is JSON but not an object {{...}}", n=number), hint)

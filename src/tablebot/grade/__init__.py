@@ -32,9 +32,16 @@ class Grading:
     files: tuple[Path, ...]
 
 
-def grade(challenge: str | Path, submissions: Sequence[str | Path], out: str | Path, *, backend: str = "auto",
-          scheduler: str | None = None, workers: int | None = None,
-          told: Callable[[str], None] = lambda text: None) -> Grading:
+def grade(
+    challenge: str | Path,
+    submissions: Sequence[str | Path],
+    out: str | Path,
+    *,
+    backend: str = "auto",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    told: Callable[[str], None] = lambda text: None,
+) -> Grading:
     """Grade ``submissions`` (table files, folders holding table.csv, text files of share links) on the
     ``challenge`` (its folder or challenge.toml) on this machine's cores or a Dask cluster (``backend``,
     ``scheduler``, ``workers`` as for sweep), and write ``scores.csv``, ``leaderboard.html`` (its replays in
@@ -66,8 +73,9 @@ def grade(challenge: str | Path, submissions: Sequence[str | Path], out: str | P
 def _previous(folder: Path) -> list[str]:
     """An earlier grading's linked submissions, which the new set replaces."""
     linked = folder / "submissions"
-    return [p.relative_to(folder).as_posix() for p in sorted(linked.rglob("*")) if p.is_file()] \
-        if linked.is_dir() else []
+    return (
+        [p.relative_to(folder).as_posix() for p in sorted(linked.rglob("*")) if p.is_file()] if linked.is_dir() else []
+    )
 
 
 def _copy_linked(tmp: Path, folder: Path) -> list[Path]:

@@ -48,16 +48,25 @@ def load_challenge(path: str | Path) -> Challenge:
         path = example_path(f"challenges/{path}")
     file = path / FILE_NAME if path.is_dir() else path
     if not file.is_file():
-        raise fail(path, N_("no {file} here", file=FILE_NAME),
-                   N_("give a challenge folder holding {file}, or the name of a shipped challenge: {names}",
-                      file=FILE_NAME, names=tuple(SHIPPED)))
+        raise fail(
+            path,
+            N_("no {file} here", file=FILE_NAME),
+            N_(
+                "give a challenge folder holding {file}, or the name of a shipped challenge: {names}",
+                file=FILE_NAME,
+                names=tuple(SHIPPED),
+            ),
+        )
     src = Source.read(file, HINT)
     data = src.data
     known_keys(src, ("", None), data, KEYS)
     for key in ("title", "robot", "worlds", "seconds", "seeds", "score"):
         if key not in data:
-            src.error(("", None, None), N_("{file} has no {key}", file=FILE_NAME, key=key),
-                      N_("add {key} = ... ({hint})", key=key, hint=HINT))
+            src.error(
+                ("", None, None),
+                N_("{file} has no {key}", file=FILE_NAME, key=key),
+                N_("add {key} = ... ({hint})", key=key, hint=HINT),
+            )
     folder = file.parent
     title = _text(src, "title", data.get("title", ""))
     robot = _file(src, folder, "robot", data.get("robot"))
@@ -65,19 +74,34 @@ def load_challenge(path: str | Path) -> Challenge:
     seconds = number(src, ("", None, "seconds"), data.get("seconds", 60), 0.01, 3600)
     seeds = _seeds(src, data.get("seeds", "0..0"))
     properties = _file(src, folder, "properties", data["properties"]) if "properties" in data else None
-    max_rows = number(src, ("", None, "max_rows"), data["max_rows"], 1, 10_000, integer=True) \
-        if "max_rows" in data else None
+    max_rows = (
+        number(src, ("", None, "max_rows"), data["max_rows"], 1, 10_000, integer=True) if "max_rows" in data else None
+    )
     grid = tuple(_text(src, "grid", g) for g in _list(src, "grid", data))
     src.raise_if_any()
     score, better = _score(src, data["score"], worlds)
-    return Challenge(folder, title, robot, worlds, float(seconds or 60), seeds, score, better, properties,
-                     int(max_rows) if max_rows is not None else None, grid)
+    return Challenge(
+        folder,
+        title,
+        robot,
+        worlds,
+        float(seconds or 60),
+        seeds,
+        score,
+        better,
+        properties,
+        int(max_rows) if max_rows is not None else None,
+        grid,
+    )
 
 
 def _text(src: Source, key: str, value: Any) -> str:
     if not isinstance(value, str):
-        src.key_error(("", None, key), N_("{key} must be text in quotes, not {value!r}", key=key, value=value),
-                      N_("for example: {example}", example=key + ' = "..."'))
+        src.key_error(
+            ("", None, key),
+            N_("{key} must be text in quotes, not {value!r}", key=key, value=value),
+            N_("for example: {example}", example=key + ' = "..."'),
+        )
         return ""
     return value
 
@@ -85,8 +109,11 @@ def _text(src: Source, key: str, value: Any) -> str:
 def _list(src: Source, key: str, data: dict[str, Any]) -> list[Any]:
     value = data.get(key, [])
     if not isinstance(value, list):
-        src.key_error(("", None, key), N_("{key} must be a list", key=key),
-                      N_("for example: {example}", example=key + ' = ["arena.toml"]'))
+        src.key_error(
+            ("", None, key),
+            N_("{key} must be a list", key=key),
+            N_("for example: {example}", example=key + ' = ["arena.toml"]'),
+        )
         return []
     return value
 
@@ -96,9 +123,11 @@ def _file(src: Source, folder: Path, key: str, value: Any) -> Path:
     name = _text(src, key, value)
     path = folder / name
     if name and not path.is_file():
-        src.key_error(("", None, key), N_("{key}: {name} is not a file beside challenge.toml",
-                                          key=label(("", None, key)), name=name),
-                      N_("name a file in the challenge's folder"))
+        src.key_error(
+            ("", None, key),
+            N_("{key}: {name} is not a file beside challenge.toml", key=label(("", None, key)), name=name),
+            N_("name a file in the challenge's folder"),
+        )
     return path
 
 
@@ -117,9 +146,15 @@ def _world(src: Source, folder: Path, index: int, value: Any) -> Path | None:
         shipped = None
     if shipped is not None and shipped.is_file():
         return shipped
-    src.key_error(("", None, "worlds"), N_("worlds[{index}]: {name} is neither a file beside challenge.toml nor a "
-                                           "shipped example's world", index=index, name=name),
-                  N_("name a world file, or one of bumberbot, line-follower, obstacle-avoider"))
+    src.key_error(
+        ("", None, "worlds"),
+        N_(
+            "worlds[{index}]: {name} is neither a file beside challenge.toml nor a shipped example's world",
+            index=index,
+            name=name,
+        ),
+        N_("name a world file, or one of bumberbot, line-follower, obstacle-avoider"),
+    )
     return None
 
 
@@ -130,8 +165,9 @@ def _seeds(src: Source, value: Any) -> str:
     try:
         parse_seeds(text, None, "seeds")
     except TableBotError as exc:
-        src.key_error(("", None, "seeds"), exc.diagnostics[0].message,
-                      N_("for example: {example}", example='seeds = "0..31"'))
+        src.key_error(
+            ("", None, "seeds"), exc.diagnostics[0].message, N_("for example: {example}", example='seeds = "0..31"')
+        )
     return text
 
 
@@ -143,7 +179,10 @@ def _score(src: Source, name: Any, worlds: tuple[Path, ...]) -> tuple[str, str]:
     usable = [n for n in allowed([load_world(w) for w in worlds]) if MEASURES[n].objective]
     if name not in usable:
         why = N_("not a measure tablebot has") if name not in MEASURES else N_("the worlds cannot measure it")
-        src.key_error(("", None, "score"), N_("score = {name!r}: {why}", name=name, why=why),
-                      N_("use one of {names}", names=tuple(usable)))
+        src.key_error(
+            ("", None, "score"),
+            N_("score = {name!r}: {why}", name=name, why=why),
+            N_("use one of {names}", names=tuple(usable)),
+        )
         src.raise_if_any()
     return name, MEASURES[name].better

@@ -51,11 +51,18 @@ def replay_pages(entries: list[Entry], challenge: Challenge) -> tuple[Replays, d
         plan = entry.plan
         for which, index in zip(("best", "worst"), best_and_worst(entry, challenge.better), strict=True):
             run = runs(plan.spec, index, index + 1)[0]
-            label = (_("best: seed {seed}, {measure} {value}") if which == "best" else
-                     _("worst: seed {seed}, {measure} {value}")).format(
-                seed=run.seed, measure=challenge.score, value=shown(float(entry.values[index])))
-            data = replay_data(plan.traced(index).trace_lines(0), plan.worlds[run.world], plan.table,
-                               plan.scenes[run.world].params, f"{entry.name}: {label}")
+            label = (
+                _("best: seed {seed}, {measure} {value}")
+                if which == "best"
+                else _("worst: seed {seed}, {measure} {value}")
+            ).format(seed=run.seed, measure=challenge.score, value=shown(float(entry.values[index])))
+            data = replay_data(
+                plan.traced(index).trace_lines(0),
+                plan.worlds[run.world],
+                plan.table,
+                plan.scenes[run.world].params,
+                f"{entry.name}: {label}",
+            )
             key = f"{k + 1:03d}-{which}"
             packed[key] = base64.b64encode(zlib.compress(render_html(data).encode("utf-8"), 9)).decode("ascii")
             links.setdefault(entry.name, []).append((label, key))
@@ -110,16 +117,20 @@ def leaderboard_html(entries: list[Entry], challenge: Challenge, replays: Replay
     rows = "".join(_row(rank, entry, replays.get(entry.name, [])) for rank, entry in ranked(entries, challenge.better))
     pages = "".join(f'<script type="text/plain" id="replay-{key}">{text}</script>' for key, text in packed.items())
     replay, close = h(_("replay")), h(_("close (Esc)"))
-    viewer = (f'<div id="viewer" hidden role="dialog" aria-label="{replay}"><div class="head"><button type="button">'
-              f'{close}</button></div><iframe title="{replay}"></iframe></div>')
+    viewer = (
+        f'<div id="viewer" hidden role="dialog" aria-label="{replay}"><div class="head"><button type="button">'
+        f'{close}</button></div><iframe title="{replay}"></iframe></div>'
+    )
     page_title = h(_("{title}: leaderboard").format(title=challenge.title))
     heads = "".join(f"<th>{h(head)}</th>" for head in (_("rank"), _("name"), _("score"), _("rules"), _("replays")))
-    return (f'<!DOCTYPE html>\n<html lang="{current() if current() != "pseudo" else "en"}"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>{page_title}</title><style>{STYLE}</style>"
-            f"</head><body><h1>{h(challenge.title)}</h1><p class=\"about\">{h(_about(entries, challenge))}</p>"
-            f"<table><thead><tr>{heads}</tr></thead>"
-            f"<tbody>{rows}</tbody></table>{viewer}{pages}<script>{SCRIPT}</script></body></html>\n")
+    return (
+        f'<!DOCTYPE html>\n<html lang="{current() if current() != "pseudo" else "en"}"><head><meta charset="utf-8">'
+        f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+        f"<title>{page_title}</title><style>{STYLE}</style>"
+        f'</head><body><h1>{h(challenge.title)}</h1><p class="about">{h(_about(entries, challenge))}</p>'
+        f"<table><thead><tr>{heads}</tr></thead>"
+        f"<tbody>{rows}</tbody></table>{viewer}{pages}<script>{SCRIPT}</script></body></html>\n"
+    )
 
 
 def _about(entries: list[Entry], challenge: Challenge) -> str:
@@ -128,14 +139,25 @@ def _about(entries: list[Entry], challenge: Challenge) -> str:
 
     planned = [e.plan.spec.total for e in entries if e.plan is not None]  # seeds x grid values x worlds
     scenarios = planned[0] if planned else len(parse_seeds(challenge.seeds, None)) * len(challenge.worlds)
-    ran = ngettext("{n} submission, run on {scenarios} scenarios of {seconds:g} s; ",
-                   "{n} submissions, each run on the same {scenarios} scenarios of {seconds:g} s; ", len(entries))
-    scored = (_("score: {measure} (low is better), the mean over the scenarios ± its standard deviation. A table "
-                "that breaks a rule scores nothing.") if challenge.better == "low" else
-              _("score: {measure} (high is better), the mean over the scenarios ± its standard deviation. A table "
-                "that breaks a rule scores nothing."))
-    return (ran.format(n=len(entries), scenarios=scenarios, seconds=challenge.seconds)
-            + scored.format(measure=challenge.score))
+    ran = ngettext(
+        "{n} submission, run on {scenarios} scenarios of {seconds:g} s; ",
+        "{n} submissions, each run on the same {scenarios} scenarios of {seconds:g} s; ",
+        len(entries),
+    )
+    scored = (
+        _(
+            "score: {measure} (low is better), the mean over the scenarios ± its standard deviation. A table "
+            "that breaks a rule scores nothing."
+        )
+        if challenge.better == "low"
+        else _(
+            "score: {measure} (high is better), the mean over the scenarios ± its standard deviation. A table "
+            "that breaks a rule scores nothing."
+        )
+    )
+    return ran.format(n=len(entries), scenarios=scenarios, seconds=challenge.seconds) + scored.format(
+        measure=challenge.score
+    )
 
 
 def _row(rank: int | None, entry: Entry, replays: list[tuple[str, str]]) -> str:
@@ -143,16 +165,22 @@ def _row(rank: int | None, entry: Entry, replays: list[tuple[str, str]]) -> str:
         score = '<span class="out">' + h(_("no score")) + "</span>"
     else:
         low, high = float(entry.values.min()), float(entry.values.max())
-        score = (f"{shown(entry.score)}<span class=\"spread\">± {shown(entry.spread)} "
-                 + h(_("({low} to {high})").format(low=shown(low), high=shown(high))) + "</span>")
-    links = "".join(f'<button type="button" class="replay" data-replay="{h(key)}">▶ {h(label)}</button>'
-                    for label, key in replays)
+        score = (
+            f'{shown(entry.score)}<span class="spread">± {shown(entry.spread)} '
+            + h(_("({low} to {high})").format(low=shown(low), high=shown(high)))
+            + "</span>"
+        )
+    links = "".join(
+        f'<button type="button" class="replay" data-replay="{h(key)}">▶ {h(label)}</button>' for label, key in replays
+    )
     klass = "" if rank is not None else ' class="unranked"'
     given = Path(entry.sub.given).name if Path(entry.sub.given).exists() else entry.sub.given  # no machine's paths
-    source = f"<br><small class=\"out\">{h(given)}</small>" if given != entry.name else ""
-    return (f"<tr{klass}><td class=\"rank\">{'' if rank is None else rank}</td><td>{h(entry.name)}{source}"
-            f"</td><td class=\"score\">{score}</td>"
-            f"<td>{_rules(entry)}</td><td>{links}</td></tr>")
+    source = f'<br><small class="out">{h(given)}</small>' if given != entry.name else ""
+    return (
+        f'<tr{klass}><td class="rank">{"" if rank is None else rank}</td><td>{h(entry.name)}{source}'
+        f'</td><td class="score">{score}</td>'
+        f"<td>{_rules(entry)}</td><td>{links}</td></tr>"
+    )
 
 
 def _rules(entry: Entry) -> str:
@@ -163,8 +191,10 @@ def _rules(entry: Entry) -> str:
             continue
         verdict = h(_("breaks") if rule.status == "violated" else _("not proved:"))
         story = "\n".join(str(localise(line)) for line in rule.story)  # Messages: in the reader's language
-        parts.append(f'<details open><summary class="broken">✗ {verdict} {h(rule.name)}</summary>'
-                     f"{h(rule.text)}" + (f"<pre>{h(story)}</pre>" if story else "") + "</details>")
+        parts.append(
+            f'<details open><summary class="broken">✗ {verdict} {h(rule.name)}</summary>'
+            f"{h(rule.text)}" + (f"<pre>{h(story)}</pre>" if story else "") + "</details>"
+        )
     if entry.why and not any(rule.status != "holds" for rule in entry.rules):
         parts.append(f'<div class="broken">{h(entry.why)}</div>')
     return "".join(parts)

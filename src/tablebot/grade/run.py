@@ -71,8 +71,9 @@ class Entry:
         return float(np.std(self.values, ddof=1))
 
 
-def grade_all(challenge: Challenge, subs: list[Submission], runner: Runner,
-              told: Callable[[str], None] = lambda text: None) -> list[Entry]:
+def grade_all(
+    challenge: Challenge, subs: list[Submission], runner: Runner, told: Callable[[str], None] = lambda text: None
+) -> list[Entry]:
     """Every submission graded, in the order given (one that breaks anything never stops the others)."""
     entries = []
     for sub in subs:
@@ -101,9 +102,18 @@ def _grade(challenge: Challenge, entry: Entry, runner: Runner) -> None:
     confine(sub)
     _same_robot(challenge, sub)
     with robot_of(challenge, sub) as (table, robot):  # a robot of several tables: the submission's beside them
-        _grade_as(challenge, entry, runner, open_robot(table, robot=robot, worlds=challenge.worlds,
-                                                       properties=[challenge.properties] if challenge.properties
-                                                       else []), robot)
+        _grade_as(
+            challenge,
+            entry,
+            runner,
+            open_robot(
+                table,
+                robot=robot,
+                worlds=challenge.worlds,
+                properties=[challenge.properties] if challenge.properties else [],
+            ),
+            robot,
+        )
 
 
 def _grade_as(challenge: Challenge, entry: Entry, runner: Runner, project: Project, robot: Path) -> None:
@@ -113,9 +123,10 @@ def _grade_as(challenge: Challenge, entry: Entry, runner: Runner, project: Proje
         entry.why = f"{entry.rows} rows, more than the challenge's {challenge.max_rows}"
         return
     check = project.check()
-    entry.rules = [Rule(p.name, p.text or p.claim, p.status,
-                        tuple(check.story(r)) if p.status == "violated" else ())
-                   for p, r in zip(check.properties, check.results, strict=True)]
+    entry.rules = [
+        Rule(p.name, p.text or p.claim, p.status, tuple(check.story(r)) if p.status == "violated" else ())
+        for p, r in zip(check.properties, check.results, strict=True)
+    ]
     broken = [rule for rule in entry.rules if rule.status != "holds"]
     if broken:
         entry.why = "; ".join(_broken(rule) for rule in broken)
@@ -141,9 +152,14 @@ def _same_robot(challenge: Challenge, sub: Submission) -> None:
     mine, theirs = load_robot(sub.robot_file), load_robot(challenge.robot)
     for what in ("inputs", "motors", "counters", "sensors", "tick_ms", "initial_state", "initial_timer", "match"):
         if getattr(mine, what) != getattr(theirs, what):
-            raise fail(sub.robot_file.name, N_("its robot file is not the challenge's robot: its {what} differ",
-                                               what=ROBOT_PARTS.get(what, what.replace("_", " "))),
-                       N_("write the table for the challenge's robot.toml"))
+            raise fail(
+                sub.robot_file.name,
+                N_(
+                    "its robot file is not the challenge's robot: its {what} differ",
+                    what=ROBOT_PARTS.get(what, what.replace("_", " ")),
+                ),
+                N_("write the table for the challenge's robot.toml"),
+            )
 
 
 #: The parts of a robot file a submission must keep as the challenge has them, as a message names them.
@@ -155,8 +171,16 @@ def _run(challenge: Challenge, project: Project, runner: Runner, robot: Path) ->
     from tablebot.evolve.evaluate import Evaluator
     from tablebot.fleet.plan import make_plan
 
-    plan = make_plan(project.path, robot, list(challenge.worlds), list(challenge.grid), challenge.seeds,
-                     None, challenge.seconds, every_table=True)  # a robot of several tables runs whole
+    plan = make_plan(
+        project.path,
+        robot,
+        list(challenge.worlds),
+        list(challenge.grid),
+        challenge.seeds,
+        None,
+        challenge.seconds,
+        every_table=True,
+    )  # a robot of several tables runs whole
     got = {}
 
     def done(key: str, means: dict[str, float], values: dict[str, np.ndarray]) -> None:

@@ -39,9 +39,11 @@ def robot_of(challenge: Challenge, sub: Submission) -> Iterator[tuple[Path, Path
         for k, spec in enumerate(specs):
             target = (root / spec.file).resolve()
             if not target.is_relative_to(root):
-                raise fail(challenge.robot.name, N_("[tables] names {file}, a file outside the challenge's folder",
-                                                    file=spec.file),
-                           N_("keep the challenge's tables beside its robot file"))
+                raise fail(
+                    challenge.robot.name,
+                    N_("[tables] names {file}, a file outside the challenge's folder", file=spec.file),
+                    N_("keep the challenge's tables beside its robot file"),
+                )
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(sub.table if k == 0 else _other(challenge, sub, spec.file), target)
         yield root / specs[0].file, robot

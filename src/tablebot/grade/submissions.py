@@ -115,13 +115,19 @@ def confine(sub: Submission) -> None:
     own = os.path.realpath(sub.own)
     for path in (sub.table, sub.robot_file):
         if path is not None and not _inside(os.path.realpath(path), own):
-            raise fail(path.name, N_("this file is a link to a file outside the submission"),
-                       N_("hand in the file itself, not a link to it"))
+            raise fail(
+                path.name,
+                N_("this file is a link to a file outside the submission"),
+                N_("hand in the file itself, not a link to it"),
+            )
     if sub.robot_file is not None:
         world = _named_world(sub.robot_file)
         if world is not None and not _inside(os.path.realpath(sub.robot_file.parent / world), own):
-            raise fail(sub.robot_file.name, N_("sim.world names {world}, a file outside the submission", world=world),
-                       N_("a submission runs in the challenge's worlds: remove sim.world, or name a file beside it"))
+            raise fail(
+                sub.robot_file.name,
+                N_("sim.world names {world}, a file outside the submission", world=world),
+                N_("a submission runs in the challenge's worlds: remove sim.world, or name a file beside it"),
+            )
 
 
 def _named_world(robot_file: Path) -> str | None:

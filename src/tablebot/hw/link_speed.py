@@ -52,8 +52,17 @@ class Connected(Protocol):
     def close(self) -> None: ...
 
 
-def check_link(bot: Connected, machine: Machine, options: LinkOptions, probe: Callable[[], object], what: str, *,
-               line: str = "", faster: str = "", connect_hint: str = "") -> tuple[str, ...]:
+def check_link(
+    bot: Connected,
+    machine: Machine,
+    options: LinkOptions,
+    probe: Callable[[], object],
+    what: str,
+    *,
+    line: str = "",
+    faster: str = "",
+    connect_hint: str = "",
+) -> tuple[str, ...]:
     """Time ``probe`` (one round trip on the link of a connected ``bot``, moving nothing) and :func:`judge` it
     (``--behind-limit 0``, :attr:`~tablebot.registry.LinkOptions.accept_slow`, accepts slow timers). Refused,
     or lost while being timed, ``bot`` is closed first."""
@@ -69,8 +78,9 @@ def check_link(bot: Connected, machine: Machine, options: LinkOptions, probe: Ca
         raise
 
 
-def median_round_trip(probe: Callable[[], object], probes: int = PROBES,
-                      now: Callable[[], float] = time.perf_counter) -> float:
+def median_round_trip(
+    probe: Callable[[], object], probes: int = PROBES, now: Callable[[], float] = time.perf_counter
+) -> float:
     """The median time ``probe()`` takes over ``probes`` calls (seconds)."""
     times = []
     for _ in range(probes):
@@ -90,20 +100,45 @@ def judge(machine: Machine, link: LinkTime, accept_slow: bool) -> tuple[str, ...
         return ()
     suggested = suggest_tick_ms(machine, need)
     if need <= REFUSE_ABOVE * tick_s:
-        return (N_("{target}: {took}, {share:.0%} of the table's {tick_ms} ms tick: ticks will start late when this "
-                   "machine or the link is busy (tick_ms = {suggested} would leave room)", target=link.target,
-                   took=took, share=need / tick_s, tick_ms=robot.tick_ms, suggested=suggested),)
+        return (
+            N_(
+                "{target}: {took}, {share:.0%} of the table's {tick_ms} ms tick: ticks will start late when this "
+                "machine or the link is busy (tick_ms = {suggested} would leave room)",
+                target=link.target,
+                took=took,
+                share=need / tick_s,
+                tick_ms=robot.tick_ms,
+                suggested=suggested,
+            ),
+        )
     late = format(100 * (need / tick_s - 1), ".0f") + " %"  # outside the msgid: "% s" would read as printf's
     slow = N_("at least {percent} slow", percent=late) if need > tick_s else N_("slow")
     if accept_slow:
-        return (N_("{target}: {took}, more than the table's {tick_ms} ms tick can hold: running anyway "
-                   "(--behind-limit 0), so the table's timers will run {slow}", target=link.target, took=took,
-                   tick_ms=robot.tick_ms, slow=slow),)
+        return (
+            N_(
+                "{target}: {took}, more than the table's {tick_ms} ms tick can hold: running anyway "
+                "(--behind-limit 0), so the table's timers will run {slow}",
+                target=link.target,
+                took=took,
+                tick_ms=robot.tick_ms,
+                slow=slow,
+            ),
+        )
     where, line = _tick_ms_place(robot)
-    raise fail(where, N_("{target}: {took}, more than the table's {tick_ms} ms tick can hold (tick_ms = {tick_ms}): "
-                         "every tick would start late and the table's timers would run {slow}", target=link.target,
-                         took=took, tick_ms=robot.tick_ms, slow=slow),
-               _advice(machine, suggested, link, slow), line=line, column=None if line is None else 1)
+    raise fail(
+        where,
+        N_(
+            "{target}: {took}, more than the table's {tick_ms} ms tick can hold (tick_ms = {tick_ms}): "
+            "every tick would start late and the table's timers would run {slow}",
+            target=link.target,
+            took=took,
+            tick_ms=robot.tick_ms,
+            slow=slow,
+        ),
+        _advice(machine, suggested, link, slow),
+        line=line,
+        column=None if line is None else 1,
+    )
 
 
 def suggest_tick_ms(machine: Machine, need_s: float) -> int:
@@ -124,24 +159,37 @@ def _timers_gcd_ms(machine: Machine) -> int:
 
 def _took(link: LinkTime) -> Message:
     if link.line:
-        return N_("{what} takes {ms:.1f} ms (measured; {line})", what=link.what, ms=1000 * link.measured_s,
-                  line=link.line)
+        return N_(
+            "{what} takes {ms:.1f} ms (measured; {line})", what=link.what, ms=1000 * link.measured_s, line=link.line
+        )
     return N_("{what} takes {ms:.1f} ms (measured)", what=link.what, ms=1000 * link.measured_s)
 
 
 def _advice(machine: Machine, suggested: int, link: LinkTime, slow: str) -> Message:
     robot = machine.table.robot
     timers = [row.timer for row in machine.table.rows if row.timer]
-    example = N_(", e.g. {ms}ms for a timer of {timer}", ms=timers[0] * robot.tick_ms, timer=timers[0]) \
-        if timers else ""
-    fits = N_(" (every timer of this table is a whole number of such ticks)") \
-        if _timers_gcd_ms(machine) % suggested == 0 and timers else ""
-    faster = N_("; or use a faster link ({faster})", faster=link.faster) if link.faster else \
-        N_("; or use a faster link")
-    return N_("give tick_ms = {suggested}{fits} and write the table's timers as times{example}, so that they keep "
-              "their length (a timer in ticks would last {times:g} times as long){faster}; or accept timers {slow} "
-              "with --behind-limit 0", suggested=suggested, fits=fits, example=example,
-              times=suggested / robot.tick_ms, faster=faster, slow=slow)
+    example = (
+        N_(", e.g. {ms}ms for a timer of {timer}", ms=timers[0] * robot.tick_ms, timer=timers[0]) if timers else ""
+    )
+    fits = (
+        N_(" (every timer of this table is a whole number of such ticks)")
+        if _timers_gcd_ms(machine) % suggested == 0 and timers
+        else ""
+    )
+    faster = (
+        N_("; or use a faster link ({faster})", faster=link.faster) if link.faster else N_("; or use a faster link")
+    )
+    return N_(
+        "give tick_ms = {suggested}{fits} and write the table's timers as times{example}, so that they keep "
+        "their length (a timer in ticks would last {times:g} times as long){faster}; or accept timers {slow} "
+        "with --behind-limit 0",
+        suggested=suggested,
+        fits=fits,
+        example=example,
+        times=suggested / robot.tick_ms,
+        faster=faster,
+        slow=slow,
+    )
 
 
 def _tick_ms_place(robot: Robot) -> tuple[str, int | None]:

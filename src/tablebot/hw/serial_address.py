@@ -14,7 +14,7 @@ def parse_serial_address(text: str, scheme: str, hint: str) -> str | None:
     prefix = f"{scheme}://"
     if not text.startswith(prefix):
         raise fail("--on", N_("unknown target {text!r}", text=text), hint)
-    rest = text[len(prefix):]
+    rest = text[len(prefix) :]
     if rest == "auto":
         return None
     if not rest or rest.endswith("/") or "\0" in rest:

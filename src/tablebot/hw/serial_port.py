@@ -101,8 +101,9 @@ class SerialPort:
                 data += self.read_some(size - len(data), deadline, what)
             except LinkLost as exc:
                 if data and "no answer" in str(exc):
-                    raise LinkLost(N_("{exc} (only {value} of {size} bytes came)",
-                                      exc=exc.args[0], value=len(data), size=size)) from None
+                    raise LinkLost(
+                        N_("{exc} (only {value} of {size} bytes came)", exc=exc.args[0], value=len(data), size=size)
+                    ) from None
                 raise
         return bytes(data)
 
@@ -152,17 +153,19 @@ class SerialPort:
         while self.unsent:
             left = deadline - time.monotonic()
             if left <= 0:
-                raise LinkLost(N_("no answer from {device}: expected the device to take our request",
-                                  device=self.device))
+                raise LinkLost(
+                    N_("no answer from {device}: expected the device to take our request", device=self.device)
+                )
             try:
                 port.write_timeout = left
                 sent = port.write(self.unsent)
             except serial.SerialTimeoutException:
-                raise LinkLost(N_("no answer from {device}: expected the device to take our request",
-                                  device=self.device)) from None
+                raise LinkLost(
+                    N_("no answer from {device}: expected the device to take our request", device=self.device)
+                ) from None
             except (serial.SerialException, OSError) as exc:
                 raise self._lost(exc) from None
-            self.unsent = self.unsent[sent if sent is not None else len(self.unsent):]
+            self.unsent = self.unsent[sent if sent is not None else len(self.unsent) :]
 
     def _read_portable(self, most: int, deadline: float, what: str) -> bytes:
         port = self._port()
@@ -204,8 +207,13 @@ class SerialPort:
     def _lost(self, exc: OSError | serial.SerialException) -> LinkLost:
         if "returned no data" in str(exc) or _hung_up(exc):  # pyserial: readable, yet nothing: the other end hung up
             return LinkLost(N_("{device} was disconnected", device=self.device))
-        return LinkLost(N_("lost {device}: {value} (was it unplugged?)",
-                           device=self.device, value=getattr(exc, 'strerror', None) or exc))
+        return LinkLost(
+            N_(
+                "lost {device}: {value} (was it unplugged?)",
+                device=self.device,
+                value=getattr(exc, "strerror", None) or exc,
+            )
+        )
 
 
 def _hung_up(exc: BaseException) -> bool:

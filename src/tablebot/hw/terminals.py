@@ -15,8 +15,18 @@ from tablebot.table import MAX_SPEED
 
 T = TypeVar("T")
 
-__all__ = ["DIGITAL", "Analog", "Digital", "InputWire", "OutputWire", "Section", "Terminals", "Wiring", "input_event",
-           "level_duty"]
+__all__ = [
+    "DIGITAL",
+    "Analog",
+    "Digital",
+    "InputWire",
+    "OutputWire",
+    "Section",
+    "Terminals",
+    "Wiring",
+    "input_event",
+    "level_duty",
+]
 
 
 @dataclass(frozen=True)
@@ -31,9 +41,12 @@ class Digital:
 
 
 #: The digital modes every controller offers (a controller may add its own: :attr:`Terminals.digital_modes`)
-DIGITAL = {"switch": Digital("pressed", N_("a push-button"), N_("while the push-button is pressed")),
-           "phototransistor": Digital("lit", N_("a phototransistor"), N_("while the phototransistor sees light"),
-                                      words=("photo", "light"))}
+DIGITAL = {
+    "switch": Digital("pressed", N_("a push-button"), N_("while the push-button is pressed")),
+    "phototransistor": Digital(
+        "lit", N_("a phototransistor"), N_("while the phototransistor sees light"), words=("photo", "light")
+    ),
+}
 
 
 @dataclass(frozen=True)
@@ -159,8 +172,9 @@ class Wiring:
 
     def levels(self, outputs: Sequence[int]) -> dict[str, int]:
         """Each output's signed level by terminal: a motor's speed -8..8 (``reverse`` applied), a lamp's 0..8."""
-        return {out.terminal: -value if out.reverse else value
-                for out, value in zip(self.outputs, outputs, strict=True)}
+        return {
+            out.terminal: -value if out.reverse else value for out, value in zip(self.outputs, outputs, strict=True)
+        }
 
     def motor_pairs(self, pairs: int) -> tuple[bool, ...]:
         """Per output pair (O1 and O2, O3 and O4, ...) whether it drives a motor: every pair without a lamp."""

@@ -55,11 +55,16 @@ def run(table: Table, inputs: Sequence[TickInput], rule: Rule | None = None) -> 
             command, speed = tick.motors[output]
             motors.append(speed if command == forward else -speed)
         motors += [tick.lamps[p.wiring.lamps[lamp]] for lamp in table.robot.lamps]
-        found.append(Decision(
-            event=sum(table.bit(name) for name in table.events if v["EV"] & p.bits[name]),
-            row=v["ROW"] if (EXECUTE, EXIT) in tick.exits else NO_ROW,
-            state=index_of[v["ST"]], timer=v["TM"], outputs=tuple(motors),
-            counters=tuple(v.get(name, 0) for name in table.robot.counter_names)))
+        found.append(
+            Decision(
+                event=sum(table.bit(name) for name in table.events if v["EV"] & p.bits[name]),
+                row=v["ROW"] if (EXECUTE, EXIT) in tick.exits else NO_ROW,
+                state=index_of[v["ST"]],
+                timer=v["TM"],
+                outputs=tuple(motors),
+                counters=tuple(v.get(name, 0) for name in table.robot.counter_names),
+            )
+        )
     return found
 
 
@@ -76,8 +81,11 @@ def run_several(tables: RobotTables, inputs: Sequence[TickInput], seed: int | No
     robot = tables.robot
     lines = []
     for tick, given in enumerate(inputs):
-        digital = {terminal: int(bool(given.mask & bit)) if active else int(not given.mask & bit)
-                   for name, bit in tables.input_bits.items() for terminal, active in [wired.inputs[name]]}
+        digital = {
+            terminal: int(bool(given.mask & bit)) if active else int(not given.mask & bit)
+            for name, bit in tables.input_bits.items()
+            for terminal, active in [wired.inputs[name]]
+        }
         for counter, pulses in zip(wired.counters.values(), given.pulses, strict=True):
             counts[counter] += pulses
         done = machine.tick(digital, counts)
@@ -101,6 +109,9 @@ def _table_line(p: Plan, done: Tick, key: str) -> dict[str, Any]:
     name = f"{table.name} "
     states = {number: state for state, number in p.numbers.items()}
     fired = (f"{name}{EXECUTE}", EXIT) in done.exits
-    return {f"{key}event": sum(table.bit(e) for e in table.events if v[f"{name}EV"] & p.bits[e]),
-            f"{key}row": table.rows[v[f"{name}ROW"]].as_written if fired else None,
-            f"{key}state": states[v[f"{name}ST"]], f"{key}timer": v[f"{name}TM"]}
+    return {
+        f"{key}event": sum(table.bit(e) for e in table.events if v[f"{name}EV"] & p.bits[e]),
+        f"{key}row": table.rows[v[f"{name}ROW"]].as_written if fired else None,
+        f"{key}state": states[v[f"{name}ST"]],
+        f"{key}timer": v[f"{name}TM"],
+    }

@@ -87,38 +87,76 @@ def fit_problems(table: Table) -> list[Diagnostic]:
     robot = table.robot
     layout = event_layout(robot)
     if len(layout) > MAX_EVENTS:
-        out.error(1, 1, N_("{n} event columns (T and the inputs {inputs}); the ROBO Pro layout holds at most {most}",
-                           n=len(layout), inputs=", ".join(robot.inputs), most=MAX_EVENTS),
-                  N_("use a robot with at most {most} inputs besides T", most=MAX_EVENTS - 1))
+        out.error(
+            1,
+            1,
+            N_(
+                "{n} event columns (T and the inputs {inputs}); the ROBO Pro layout holds at most {most}",
+                n=len(layout),
+                inputs=", ".join(robot.inputs),
+                most=MAX_EVENTS,
+            ),
+            N_("use a robot with at most {most} inputs besides T", most=MAX_EVENTS - 1),
+        )
     if len(robot.motors) > MAX_MOTORS:
-        out.error(1, 1, N_("{n} motors; the ROBO Pro layout holds at most {most}", n=len(robot.motors),
-                           most=MAX_MOTORS),
-                  N_("the document's action word has room for M1 and M2 only"))
+        out.error(
+            1,
+            1,
+            N_("{n} motors; the ROBO Pro layout holds at most {most}", n=len(robot.motors), most=MAX_MOTORS),
+            N_("the document's action word has room for M1 and M2 only"),
+        )
     if robot.counter_names:
-        out.error(1, 1, N_("the robot has counters ({names}); the document's three lists have no place for them",
-                           names=", ".join(robot.counter_names)),
-                  N_("export a table for a robot without counters"))
+        out.error(
+            1,
+            1,
+            N_(
+                "the robot has counters ({names}); the document's three lists have no place for them",
+                names=", ".join(robot.counter_names),
+            ),
+            N_("export a table for a robot without counters"),
+        )
     if robot.lamps:
-        out.error(1, 1, N_("the robot has lamps ({names}); the document's three lists have no place for them",
-                           names=", ".join(robot.lamps)),
-                  N_("export a table for a robot without lamps"))
+        out.error(
+            1,
+            1,
+            N_(
+                "the robot has lamps ({names}); the document's three lists have no place for them",
+                names=", ".join(robot.lamps),
+            ),
+            N_("export a table for a robot without lamps"),
+        )
     numbers = number_states(table)
     for row in table.rows:
         for what, state in ((N_("state"), row.state), (N_("next state"), row.next)):
             if numbers[state] > MAX_STATE:
-                out.error(row.line, None, N_("row {row}: {what} {state!r} is number {number}, over {most}",
-                                             row=row.index, what=what, state=state, number=numbers[state],
-                                             most=MAX_STATE),
-                          N_("number states 0..{most} so the list values stay 16-bit", most=MAX_STATE))
+                out.error(
+                    row.line,
+                    None,
+                    N_(
+                        "row {row}: {what} {state!r} is number {number}, over {most}",
+                        row=row.index,
+                        what=what,
+                        state=state,
+                        number=numbers[state],
+                        most=MAX_STATE,
+                    ),
+                    N_("number states 0..{most} so the list values stay 16-bit", most=MAX_STATE),
+                )
         if row.timer > MAX_TIMER:
-            out.error(row.line, None, N_("row {row}: timer {timer} is over {most}", row=row.index, timer=row.timer,
-                                         most=MAX_TIMER),
-                      N_("ROBO Pro list values are 16-bit signed"))
+            out.error(
+                row.line,
+                None,
+                N_("row {row}: timer {timer} is over {most}", row=row.index, timer=row.timer, most=MAX_TIMER),
+                N_("ROBO Pro list values are 16-bit signed"),
+            )
         for motor, speed in zip(robot.motors, row.motors, strict=True):
             if speed is not None and abs(speed) >= DOC_KEEP_SPEED:
-                out.error(row.line, None, N_("row {row}: {motor} speed {speed} does not fit", row=row.index,
-                                             motor=motor, speed=abs(speed)),
-                          N_("the document's speeds are 0..6 (7 means keep): use 6 or less"))
+                out.error(
+                    row.line,
+                    None,
+                    N_("row {row}: {motor} speed {speed} does not fit", row=row.index, motor=motor, speed=abs(speed)),
+                    N_("the document's speeds are 0..6 (7 means keep): use 6 or less"),
+                )
     _rule_problems(table, out)
     return out.items
 
@@ -130,17 +168,31 @@ def _rule_problems(table: Table, out: Collector) -> None:
     robot = table.robot
     if robot.match == MATCH_DOCUMENT:
         return
-    said = (N_('match = "always" in {source}', source=robot.source) if robot.says_match
-            else N_('{source} does not say match, so "always"', source=robot.source))
+    said = (
+        N_('match = "always" in {source}', source=robot.source)
+        if robot.says_match
+        else N_('{source} does not say match, so "always"', source=robot.source)
+    )
     for found in no_event_rows(table):
         if found.quiet:
-            out.error(found.row.line, None,
-                      N_("row {row} requires no event and the table fires it even on a tick with no event at all "
-                         "({said}), which can come in state {state!r}: {why}; the document's engine, which runs "
-                         "these lists, looks a row up only if an event is detected, so there it would do nothing",
-                         row=found.row.index, said=said, state=found.row.state, why=found.quiet),
-                      N_('write match = "document" in {source} if the robot should do nothing on such a tick '
-                         "(tablebot then runs it so too), or give the row an event to wait for", source=robot.source))
+            out.error(
+                found.row.line,
+                None,
+                N_(
+                    "row {row} requires no event and the table fires it even on a tick with no event at all "
+                    "({said}), which can come in state {state!r}: {why}; the document's engine, which runs "
+                    "these lists, looks a row up only if an event is detected, so there it would do nothing",
+                    row=found.row.index,
+                    said=said,
+                    state=found.row.state,
+                    why=found.quiet,
+                ),
+                N_(
+                    'write match = "document" in {source} if the robot should do nothing on such a tick '
+                    "(tablebot then runs it so too), or give the row an event to wait for",
+                    source=robot.source,
+                ),
+            )
 
 
 def encode(table: Table) -> Lists:
@@ -175,6 +227,7 @@ def write_lists(lists: Lists, outdir: Path) -> list[Path]:
 
 # --- import -------------------------------------------------------------------------------------
 
+
 def _read_list(path: Path) -> list[int]:
     """One list: an integer per line (ROBO Pro may add columns after a separator; they are ignored)."""
     if not path.is_file():
@@ -187,11 +240,17 @@ def _read_list(path: Path) -> list[int]:
         try:
             value = int(text)
         except ValueError:
-            raise fail(path, N_("{text!r} is not an integer", text=text), N_("one integer per line"), number,
-                       1) from None
+            raise fail(
+                path, N_("{text!r} is not an integer", text=text), N_("one integer per line"), number, 1
+            ) from None
         if not 0 <= value <= 32767:
-            raise fail(path, N_("{value} is not a value of the document's encoding", value=value),
-                       N_("list values are 16-bit signed, and the encoding never writes negative ones"), number, 1)
+            raise fail(
+                path,
+                N_("{value} is not a value of the document's encoding", value=value),
+                N_("list values are 16-bit signed, and the encoding never writes negative ones"),
+                number,
+                1,
+            )
         values.append(value)
     return values
 
@@ -212,12 +271,22 @@ def _read_names(directory: Path) -> dict[int, StateId]:
         if record.is_blank():
             continue
         if len(cells) < 2 or not _digits(cells[0]) or not (_digits(cells[1]) or STATE_RE.match(cells[1])):
-            raise fail(path, N_("expected number,name, not {cells!r}", cells=",".join(cells)),
-                       N_("export writes one named state per line, like: 1,seek"), record.line, 1)
+            raise fail(
+                path,
+                N_("expected number,name, not {cells!r}", cells=",".join(cells)),
+                N_("export writes one named state per line, like: 1,seek"),
+                record.line,
+                1,
+            )
         number, name = int(cells[0]), int(cells[1]) if _digits(cells[1]) else cells[1]  # as tables read it
         if number in names or name in names.values():
-            raise fail(path, N_("state number {number} or name {name!r} is given twice", number=number, name=name),
-                       N_("each number names one state and each name one number"), record.line, 1)
+            raise fail(
+                path,
+                N_("state number {number} or name {name!r} is given twice", number=number, name=name),
+                N_("each number names one state and each name one number"),
+                record.line,
+                1,
+            )
         names[number] = name
     return names
 
@@ -231,30 +300,61 @@ def decode(lists: Lists, robot: Robot, events: tuple[str, ...] | None = None, pa
     for index, (event, action, timer) in enumerate(zip(lists.event, lists.action, lists.timer, strict=True)):
         state, bits = divmod(event, STATE_WEIGHT)
         if bits >> len(events):
-            raise fail(Path(path) / LIST_FILES[0], N_("event {event} has bits beyond the {n} events {events}",
-                                                      event=event, n=len(events), events=" ".join(events)),
-                       N_("the lists were written for another robot: pass its --robot"), index + 1, 1)
+            raise fail(
+                Path(path) / LIST_FILES[0],
+                N_(
+                    "event {event} has bits beyond the {n} events {events}",
+                    event=event,
+                    n=len(events),
+                    events=" ".join(events),
+                ),
+                N_("the lists were written for another robot: pass its --robot"),
+                index + 1,
+                1,
+            )
         nxt, low = divmod(action, NEXT_WEIGHT)
         fields = [(low >> 7) & 1, (low >> 4) & 7, (low >> 3) & 1, low & 7]
-        motors = tuple(from_direction_speed(direction, speed)
-                       for direction, speed in ((fields[0], fields[1]), (fields[2], fields[3])))
+        motors = tuple(
+            from_direction_speed(direction, speed)
+            for direction, speed in ((fields[0], fields[1]), (fields[2], fields[3]))
+        )
         required = frozenset(e for i, e in enumerate(events) if bits & (1 << (len(events) - 1 - i)))
-        rows.append(Row(index=index, line=index + 1, description="", state=names.get(state, state),
-                        events=required, motors=motors[: len(robot.motors)], timer=timer,
-                        next=names.get(nxt, nxt), counters=(None,) * len(robot.counters),
-                        lamps=(None,) * len(robot.lamps)))
+        rows.append(
+            Row(
+                index=index,
+                line=index + 1,
+                description="",
+                state=names.get(state, state),
+                events=required,
+                motors=motors[: len(robot.motors)],
+                timer=timer,
+                next=names.get(nxt, nxt),
+                counters=(None,) * len(robot.counters),
+                lamps=(None,) * len(robot.lamps),
+            )
+        )
     return Table(robot=robot, events=events, rows=tuple(rows), path=path)
 
 
 def read_lists(directory: Path) -> Lists:
     if not directory.is_dir():
-        raise fail(directory, N_("not a folder") if directory.exists() else N_("folder not found"),
-                   N_("give the folder that holds {files}", files=", ".join(LIST_FILES)))
+        raise fail(
+            directory,
+            N_("not a folder") if directory.exists() else N_("folder not found"),
+            N_("give the folder that holds {files}", files=", ".join(LIST_FILES)),
+        )
     event, action, timer = (_read_list(directory / name) for name in LIST_FILES)
     if not len(event) == len(action) == len(timer):
-        raise fail(directory, N_("the lists differ in length: event {event}, action {action}, timer {timer}",
-                                 event=len(event), action=len(action), timer=len(timer)),
-                   N_("each row of the table is one entry in every list"))
+        raise fail(
+            directory,
+            N_(
+                "the lists differ in length: event {event}, action {action}, timer {timer}",
+                event=len(event),
+                action=len(action),
+                timer=len(timer),
+            ),
+            N_("each row of the table is one entry in every list"),
+        )
     if not event:
         raise fail(directory, N_("the lists are empty"), N_("export a table with at least one row"))
     numbers = {state: number for number, state in _read_names(directory).items()}
@@ -265,10 +365,19 @@ def read_table(directory: Path, robot: Robot) -> Table:
     """The table that the lists in ``directory`` hold for ``robot``; problems are located in the lists."""
     layout = event_layout(robot)
     if len(layout) > MAX_EVENTS or len(robot.motors) > MAX_MOTORS:
-        raise fail(robot.source, N_("{inputs} inputs and {motors} motors do not fit the ROBO Pro layout",
-                                    inputs=len(layout) - 1, motors=len(robot.motors)),
-                   N_("import needs a robot with at most {inputs} inputs and {motors} motors", inputs=MAX_EVENTS - 1,
-                      motors=MAX_MOTORS))
+        raise fail(
+            robot.source,
+            N_(
+                "{inputs} inputs and {motors} motors do not fit the ROBO Pro layout",
+                inputs=len(layout) - 1,
+                motors=len(robot.motors),
+            ),
+            N_(
+                "import needs a robot with at most {inputs} inputs and {motors} motors",
+                inputs=MAX_EVENTS - 1,
+                motors=MAX_MOTORS,
+            ),
+        )
     table = decode(read_lists(directory), robot, layout, str(directory))
     problems = []
     for row, where, message, hint in missing_states(table.rows, robot):
@@ -277,7 +386,8 @@ def read_table(directory: Path, robot: Robot) -> Table:
         else:
             line = robot.line(*where)
             at: tuple[str, int | None, int | None] = (
-                (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None))
+                (robot.source, line, 1) if line is not None else (str(directory / LIST_FILES[0]), None, None)
+            )
             problems.append(Diagnostic(*at, message, "the lists may be for another robot: pass its --robot"))
     if problems:
         raise TableBotError(problems)

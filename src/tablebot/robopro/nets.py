@@ -64,8 +64,11 @@ def pins_of(function: ET.Element) -> Pins:
             continue
         wire = wire_of[begin.get("id", "")]
         if pin.get("pinclass") == "flowobjectoutput":  # the flow goes to the wire's other end
-            other = end_of(wire) if begin.get("name") == "begin" else next(
-                p for p in wire.findall("o") if p.get("name") == "begin")
+            other = (
+                end_of(wire)
+                if begin.get("name") == "begin"
+                else next(p for p in wire.findall("o") if p.get("name") == "begin")
+            )
             found.next_flow[pid] = arrive(other)
         elif pin.get("pinclass", "").startswith("data"):
             parent[find(pid)] = find(wire.get("id") or str(id(wire)))

@@ -28,8 +28,13 @@ from tablebot.table import Table
 
 Rule = Match  # the robot file's matching rules (tablebot.robot.Match)
 RULES: tuple[Rule, ...] = ("document", "always")
-MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN = ("Main program", "DetectEvent", "DetermineAction", "ExecuteAction",
-                                               "CountDown")
+MAIN, DETECT, DETERMINE, EXECUTE, COUNTDOWN = (
+    "Main program",
+    "DetectEvent",
+    "DetermineAction",
+    "ExecuteAction",
+    "CountDown",
+)
 ENTRY, EXIT, FOUND, NONE = "Entry", "Exit", "Found", "None"
 COLUMN = 136  # x of every subprogram's flow column
 INDENT = "            "  # elements inside a subprogram
@@ -47,8 +52,14 @@ class Builder:
     document's ids, subprograms and variables' initial values with the other tables' builders). ``prefix``
     names this table's variables, lists and subprograms (``drive ST``); "" for a robot of one table."""
 
-    def __init__(self, p: Plan, prefix: str = "", ids: Ids | None = None, subs: dict[str, Sub] | None = None,
-                 inits: dict[str, int] | None = None) -> None:
+    def __init__(
+        self,
+        p: Plan,
+        prefix: str = "",
+        ids: Ids | None = None,
+        subs: dict[str, Sub] | None = None,
+        inits: dict[str, int] | None = None,
+    ) -> None:
         self.p, self.prefix = p, prefix
         self.ids = ids or Ids()
         self.inits = inits if inits is not None else {}
@@ -77,32 +88,56 @@ class Builder:
         right."""
         out = element.pin(0)
         x, y = out.at
-        made = el.variable(x + 12, y, target, self.inits.get(target, 0)) if isinstance(target, str) \
-            else el.lamp(x + 12, y, target.output) if isinstance(target, Lamp) else el.motor(x + 12, y, target)
+        made = (
+            el.variable(x + 12, y, target, self.inits.get(target, 0))
+            if isinstance(target, str)
+            else el.lamp(x + 12, y, target.output)
+            if isinstance(target, Lamp)
+            else el.motor(x + 12, y, target)
+        )
         sheet.canvas.add(made)
         sheet.canvas.connect(out, made.pins_of("dataobjectinput")[0])
         return made
 
-    def assign(self, sheet: Sheet, target: str | int | Lamp, command: str, value: int | None = None,
-               data: Tree | None = None) -> Element:
+    def assign(
+        self, sheet: Sheet, target: str | int | Lamp, command: str, value: int | None = None, data: Tree | None = None
+    ) -> Element:
         element = sheet.step(lambda x, y: el.message(x, y, command, value), data=data)
         self.send(sheet, element, target)
         return element
 
-    def side_send(self, sheet: Sheet, exit_pin: Pin, target: str | int | Lamp, command: str, value: int | None = None,
-                  data: Tree | None = None, hold: bool = False) -> None:
-        sheet.side(exit_pin, [lambda x, y: el.message(x, y, command, value)], data=[data],
-                   extra=lambda e: self.send(sheet, e, target), hold=hold)
+    def side_send(
+        self,
+        sheet: Sheet,
+        exit_pin: Pin,
+        target: str | int | Lamp,
+        command: str,
+        value: int | None = None,
+        data: Tree | None = None,
+        hold: bool = False,
+    ) -> None:
+        sheet.side(
+            exit_pin,
+            [lambda x, y: el.message(x, y, command, value)],
+            data=[data],
+            extra=lambda e: self.send(sheet, e, target),
+            hold=hold,
+        )
 
     def note(self, sheet: Sheet, element: Element, text: str) -> None:
         sheet.note(element.y, text)
 
-    def finish(self, name: str, sheet: Sheet, outputs: list[tuple[str, int]], documentation: str,
-               inputs: list[tuple[str, int]] | None = None) -> Sub:
+    def finish(
+        self,
+        name: str,
+        sheet: Sheet,
+        outputs: list[tuple[str, int]],
+        documentation: str,
+        inputs: list[tuple[str, int]] | None = None,
+    ) -> Sub:
         x = max(sheet.right, sheet.lanes) + 24  # comments right of every lane
         for y, text in sheet.notes:
-            sheet.canvas.comments.append(caption(INDENT, self.ids(), text, (x, y), size=3, align="336",
-                                                 linespace="0"))
+            sheet.canvas.comments.append(caption(INDENT, self.ids(), text, (x, y), size=3, align="336", linespace="0"))
         sub = Sub(name, sheet.canvas, inputs if inputs is not None else [(ENTRY, 1)], outputs, documentation)
         self.subs[name] = sub
         return sub
@@ -110,11 +145,13 @@ class Builder:
     def call(self, sheet: Sheet, name: str, dx: int = 0, release: bool = False) -> Element:
         sub = self.subs[name]
         pins, width, height = el.symbol_pins(sub.inputs, sub.outputs)
-        return sheet.step(lambda x, y: el.call(x, y, name, sub.guid, pins, width, height, INDENT, self.ids()),
-                          dx=dx, release=release)
+        return sheet.step(
+            lambda x, y: el.call(x, y, name, sub.guid, pins, width, height, INDENT, self.ids()), dx=dx, release=release
+        )
 
 
 # --- the subprograms ---------------------------------------------------------------------------------
+
 
 def detect_event(b: Builder) -> Sub:
     p, s, v = b.p, b.sheet(), b.v
@@ -134,8 +171,12 @@ def detect_event(b: Builder) -> Sub:
         b.note(s, branch, p.event_note(name))
     for source, values in p.cross_lists.items():
         cross = b.assign(s, v("EV"), "+", data=ListAt(v(f"from {source}"), values, Var(f"{source} S0")))
-        b.note(s, cross, f"the columns reading table {source}'s state at the start of the tick: "
-                         + ", ".join(f"{n} (+{p.bits[n]})" for n, e in p.table.cross.items() if e.table == source))
+        b.note(
+            s,
+            cross,
+            f"the columns reading table {source}'s state at the start of the tick: "
+            + ", ".join(f"{n} (+{p.bits[n]})" for n, e in p.table.cross.items() if e.table == source),
+        )
     s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
     return b.finish(v(DETECT), s, [(EXIT, 2)], "EV := the events of this tick, one bit each: " + p.bit_text())
 
@@ -149,15 +190,17 @@ def determine_action(b: Builder) -> Sub:
     s.side(more.pins[3], [lambda x, y: el.flow_out(x, y, NONE, 3)], rejoin=False)
     b.note(s, more, f"rows left? (ROW < {len(p.event)})")
     b.assign(s, v("E"), "=", data=ListAt(v("Event"), p.event, Var(v("ROW"))))
-    state = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                   data=Op("XOR", Op("SHR", Var(v("E")), Const(p.shift)), Var(v("ST"))))
+    state = s.step(
+        lambda x, y: el.branch(x, y, yes_down=False),
+        data=Op("XOR", Op("SHR", Var(v("E")), Const(p.shift)), Var(v("ST"))),
+    )
     b.note(s, state, f"row's state (E SHR {p.shift}) is not ST?")
     need = Op("AND", Var(v("E")), Const(p.mask))
-    missing = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                     data=Op("XOR", Op("AND", need, Var(v("EV"))), need))
+    missing = s.step(lambda x, y: el.branch(x, y, yes_down=False), data=Op("XOR", Op("AND", need, Var(v("EV"))), need))
     b.note(s, missing, f"an event of the row (E AND {p.mask}) missing from EV?")
-    (step_on,), wire = s.side(missing.pins[3], [lambda x, y: el.message(x, y, "+", 1)],
-                              extra=lambda e: b.send(s, e, v("ROW")), rejoin=False)
+    (step_on,), wire = s.side(
+        missing.pins[3], [lambda x, y: el.message(x, y, "+", 1)], extra=lambda e: b.send(s, e, v("ROW")), rejoin=False
+    )
     assert wire is not None
     _ex, ey = state.pins[3].at
     sx, sy = wire.points[1]
@@ -165,8 +208,12 @@ def determine_action(b: Builder) -> Sub:
     s.step(lambda x, y: el.flow_out(x, y, FOUND, 2))
     assert loop_wire is not None
     s.loop_back(step_on.pin(2), loop_wire, (loop_in[0], loop_in[1] - 4))
-    return b.finish(v(DETERMINE), s, [(FOUND, 2), (NONE, 3)],
-                    "ROW := the first row of the Event list whose state is ST and whose events are all in EV")
+    return b.finish(
+        v(DETERMINE),
+        s,
+        [(FOUND, 2), (NONE, 3)],
+        "ROW := the first row of the Event list whose state is ST and whose events are all in EV",
+    )
 
 
 def execute_action(b: Builder) -> Sub:
@@ -187,8 +234,12 @@ def execute_action(b: Builder) -> Sub:
         b.note(s, load, f"{name}: a load of -1 leaves the counter alone")
         b.side_send(s, load.pins[3], name, "=", data=Var(v("CL")))
     s.step(lambda x, y: el.flow_out(x, y, EXIT, 2))
-    return b.finish(v(EXECUTE), s, [(EXIT, 2)],
-                    "The action of row ROW: motors (speed 7 keeps), TM from the Timer list, ST := next state")
+    return b.finish(
+        v(EXECUTE),
+        s,
+        [(EXIT, 2)],
+        "The action of row ROW: motors (speed 7 keeps), TM from the Timer list, ST := next state",
+    )
 
 
 def _motor(b: Builder, s: Sheet, motor: str, speed_shift: int, dir_shift: int) -> None:
@@ -205,10 +256,15 @@ def _motor(b: Builder, s: Sheet, motor: str, speed_shift: int, dir_shift: int) -
     moving = s.step(lambda x, y: el.branch(x, y, yes_down=True), data=Var(v("SPEED")))
     b.note(s, moving, f"{motor}: speed 0 stops it")
     b.side_send(s, moving.pins[3], output, "Stop", -32768, hold=True)
-    direction = s.step(lambda x, y: el.branch(x, y, yes_down=False),
-                       data=Op("AND", Op("SHR", Var(v("ACT")), Const(dir_shift)), Const(1)))
-    b.note(s, direction, f"{motor}: direction (ACT SHR {dir_shift}) AND 1: 1 = backward ({backward}), "
-                         f"0 = forward ({forward})")
+    direction = s.step(
+        lambda x, y: el.branch(x, y, yes_down=False),
+        data=Op("AND", Op("SHR", Var(v("ACT")), Const(dir_shift)), Const(1)),
+    )
+    b.note(
+        s,
+        direction,
+        f"{motor}: direction (ACT SHR {dir_shift}) AND 1: 1 = backward ({backward}), 0 = forward ({forward})",
+    )
     b.side_send(s, direction.pins[3], output, backward, data=Var(v("SPEED")), hold=True)
     b.assign(s, output, forward, data=Var(v("SPEED")))
     s.release()
@@ -297,8 +353,11 @@ def engine_loop(b: Builder, s: Sheet, end_tick: Callable[[Sheet], None], notes: 
     assert loop_wire is not None
     s.loop_back(countdown.pins_of("flowobjectoutput")[0], loop_wire, (loop_in[0], loop_in[1] - 4))
     for n, line in enumerate(p.table_notes() if notes else ()):
-        s.canvas.comments.append(caption(INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2,
-                                         align="336", linespace="0"))
+        s.canvas.comments.append(
+            caption(
+                INDENT, b.ids(), line, (max(s.right, s.lanes) + 24 + 96, 8 + 4 * n), size=2, align="336", linespace="0"
+            )
+        )
 
 
 def main_program(b: Builder) -> Sub:
@@ -309,6 +368,7 @@ def main_program(b: Builder) -> Sub:
     def wait(s: Sheet) -> None:
         tick = s.step(lambda x, y: el.wait(x, y, p.table.robot.tick_ms), release=True)
         b.note(s, tick, f"one tick: {p.table.robot.tick_ms} ms")
+
     engine_loop(b, s, wait)
     return b.finish(MAIN, s, [], p.summary(), inputs=[])
 

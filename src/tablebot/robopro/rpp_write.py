@@ -157,11 +157,14 @@ def _straight(wire: Wire) -> Wire:
 
 def _on(points: Sequence[Point], at: Point) -> bool:
     x, y = at
-    return any(min(x0, x1) <= x <= max(x0, x1) and min(y0, y1) <= y <= max(y0, y1)
-               for (x0, y0), (x1, y1) in itertools.pairwise(points))
+    return any(
+        min(x0, x1) <= x <= max(x0, x1) and min(y0, y1) <= y <= max(y0, y1)
+        for (x0, y0), (x1, y1) in itertools.pairwise(points)
+    )
 
 
 # --- text ------------------------------------------------------------------------------------------
+
 
 def attrs_text(pairs: Sequence[tuple[str, str]]) -> str:
     return " ".join(f'{k}="{xml_attr(v)}"' for k, v in pairs)
@@ -176,31 +179,41 @@ def open_tag(indent: str, head: Sequence[tuple[str, str]], at: Point | None, tai
     if at is None:
         return f"{indent}<o {attrs_text([*head, *tail])}>\n"
     rest = f"\n{indent}     {attrs_text(tail)}" if tail else ""
-    return f"{indent}<o {attrs_text(head)}\n{indent}     transform=\"{matrix(*at)}\"{rest}>\n"
+    return f'{indent}<o {attrs_text(head)}\n{indent}     transform="{matrix(*at)}"{rest}>\n'
 
 
 def properties(indent: str, pairs: Sequence[tuple[str, str]]) -> str:
     if not pairs:
         return ""
-    items = "".join(f'{indent}        <o classname="wxDocviewStringProperty" '
-                    f'{attrs_text([("name", k), ("value", v)])}>\n{indent}        </o>\n' for k, v in pairs)
+    items = "".join(
+        f'{indent}        <o classname="wxDocviewStringProperty" '
+        f"{attrs_text([('name', k), ('value', v)])}>\n{indent}        </o>\n"
+        for k, v in pairs
+    )
     return f"{indent}    \n{indent}    <properties>\n{items}{indent}    </properties>\n{indent}    \n"
 
 
 def colours(indent: str, fill: str, stroke: str, width: str = "0.25", fill_attrs: str | None = None) -> str:
     fill_text = fill_attrs if fill_attrs is not None else f'colour="{fill}"'
-    return (f"{indent}    \n{indent}    <properties>\n"
-            f'{indent}        <o classname="wxDocviewRefObjectProperty" name="fill">\n'
-            f'{indent}            <o classname="wxCanvasOneColourFill" {fill_text}>\n{indent}            </o>\n'
-            f"{indent}        </o>\n"
-            f'{indent}        <o classname="wxDocviewRefObjectProperty" name="stroke">\n'
-            f'{indent}            <o classname="wxCanvasOneColourStroke" colour="{stroke}" width="{width}">\n'
-            f"{indent}            </o>\n{indent}        </o>\n{indent}    </properties>\n{indent}    \n")
+    return (
+        f"{indent}    \n{indent}    <properties>\n"
+        f'{indent}        <o classname="wxDocviewRefObjectProperty" name="fill">\n'
+        f'{indent}            <o classname="wxCanvasOneColourFill" {fill_text}>\n{indent}            </o>\n'
+        f"{indent}        </o>\n"
+        f'{indent}        <o classname="wxDocviewRefObjectProperty" name="stroke">\n'
+        f'{indent}            <o classname="wxCanvasOneColourStroke" colour="{stroke}" width="{width}">\n'
+        f"{indent}            </o>\n{indent}        </o>\n{indent}    </properties>\n{indent}    \n"
+    )
 
 
 def pin_text(indent: str, pin: Pin) -> str:
-    head = [("classname", "ftProObjectPin"), ("id", str(pin.id)), ("name", pin.name), ("flags", FLAGS),
-            ("hitflags", HIT)]
+    head = [
+        ("classname", "ftProObjectPin"),
+        ("id", str(pin.id)),
+        ("name", pin.name),
+        ("flags", FLAGS),
+        ("hitflags", HIT),
+    ]
     tail = [("width", str(pin.size[0])), ("height", str(pin.size[1])), ("pinclass", pin.pinclass)]
     if pin.resolve is not None:
         tail.append(("resolveid", str(pin.resolve)))
@@ -222,49 +235,75 @@ def element_text(indent: str, e: Element) -> str:
 
 def wire_text(indent: str, w: Wire) -> str:
     flow = w.kind == "flow"
-    head = [("classname", "ftProFlowWire" if flow else "ftProDataWire"), ("id", str(w.id)),
-            ("layer", "2" if flow else "1"), ("flags", WIRE_FLAGS), ("hitflags", HIT),
-            ("points", str(len(w.points))), ("invert", "false"),
-            ("canbranch", "false" if flow else "true"), ("canconverge", "true"),
-            ("pcobjbegin", "flowobjectoutput" if flow else "dataobjectoutput"),
-            ("pcwirebegin", "flowwireoutput" if flow else "datawireoutput"),
-            ("pcwireend", "flowwireinput" if flow else "datawireinput")]
+    head = [
+        ("classname", "ftProFlowWire" if flow else "ftProDataWire"),
+        ("id", str(w.id)),
+        ("layer", "2" if flow else "1"),
+        ("flags", WIRE_FLAGS),
+        ("hitflags", HIT),
+        ("points", str(len(w.points))),
+        ("invert", "false"),
+        ("canbranch", "false" if flow else "true"),
+        ("canconverge", "true"),
+        ("pcobjbegin", "flowobjectoutput" if flow else "dataobjectoutput"),
+        ("pcwirebegin", "flowwireoutput" if flow else "datawireoutput"),
+        ("pcwireend", "flowwireinput" if flow else "datawireinput"),
+    ]
     kind = "flow" if flow else "data"
     end_id = w.end.id
-    pins = [("begin", w.begin_id, w.points[0], f"{kind}wireoutput", w.begin.id, 7),
-            ("end", w.end_id, w.points[-1], f"{kind}wireinput", end_id, 7)]
+    pins = [
+        ("begin", w.begin_id, w.points[0], f"{kind}wireoutput", w.begin.id, 7),
+        ("end", w.end_id, w.points[-1], f"{kind}wireinput", end_id, 7),
+    ]
     pins += [("dynamic", d.id, d.at, d.pinclass, d.resolve, 9) for d in w.dynamics]
     inner = indent + "    "
     text = f"{indent}<o {attrs_text(head)}>\n{inner}\n{inner}<properties>\n{inner}</properties>\n{inner}\n"
     for name, ident, at, pinclass, resolve, size in pins:
-        text += open_tag(inner, [("classname", "wxCanvasPin"), ("id", str(ident)), ("name", name), ("flags", FLAGS),
-                                 ("hitflags", HIT)], at,
-                         [("width", str(size)), ("height", str(size)), ("pinclass", pinclass),
-                          ("resolveid", str(resolve))])
+        text += open_tag(
+            inner,
+            [("classname", "wxCanvasPin"), ("id", str(ident)), ("name", name), ("flags", FLAGS), ("hitflags", HIT)],
+            at,
+            [("width", str(size)), ("height", str(size)), ("pinclass", pinclass), ("resolveid", str(resolve))],
+        )
         text += f"{inner}</o>\n{inner}\n"
     text += f"{inner}\n" + "".join(f'{inner}<xy x="{x}" y="{y}"/>\n' for x, y in w.points)
     return text + f"{indent}</o>\n{indent}\n"
 
 
-def caption(indent: str, ident: int, text: str, at: Point | None, size: int = 3, align: str = "0",
-            linespace: str = "0.3") -> str:
+def caption(
+    indent: str, ident: int, text: str, at: Point | None, size: int = 3, align: str = "0", linespace: str = "0.3"
+) -> str:
     """A text on the canvas (``wxCanvasTextDc``): a comment, or a symbol's caption."""
     head = [("classname", "wxCanvasTextDc"), ("id", str(ident)), ("flags", FLAGS), ("hitflags", HIT)]
-    tail = [("fontsize", str(size)), ("linespace", linespace), ("caret", "0"), ("caretshow", "false"),
-            ("text", text), ("up", "false"), ("family", "74"), ("style", "90"), ("weight", "90"),
-            ("alignment", align)]
-    return open_tag(indent, head, at, tail) + colours(indent, "", "BLACK", fill_attrs='style="1"') + \
-        f"{indent}</o>\n{indent}\n"
+    tail = [
+        ("fontsize", str(size)),
+        ("linespace", linespace),
+        ("caret", "0"),
+        ("caretshow", "false"),
+        ("text", text),
+        ("up", "false"),
+        ("family", "74"),
+        ("style", "90"),
+        ("weight", "90"),
+        ("alignment", align),
+    ]
+    return (
+        open_tag(indent, head, at, tail)
+        + colours(indent, "", "BLACK", fill_attrs='style="1"')
+        + f"{indent}</o>\n{indent}\n"
+    )
 
 
 def frame(indent: str, x: int, y: int, width: int, height: int) -> str:
     """A subprogram symbol's frame (``wxCanvasRect``), in ROBO Pro's subprogram colours."""
     head = [("classname", "wxCanvasRect"), ("flags", FLAGS), ("hitflags", HIT)]
-    return open_tag(indent, head, (x, y), [("width", str(width)), ("height", str(height))]) + \
-        colours(indent, "#D5FFD5", "#00EA00") + f"{indent}</o>\n{indent}\n"
+    return (
+        open_tag(indent, head, (x, y), [("width", str(width)), ("height", str(height))])
+        + colours(indent, "#D5FFD5", "#00EA00")
+        + f"{indent}</o>\n{indent}\n"
+    )
 
 
 def new_guid(seed: str) -> str:
     """A stable GUID per subprogram name: the same table gives the same file."""
     return str(uuid.uuid5(uuid.NAMESPACE_URL, "tablebot-robopro:" + seed))
-

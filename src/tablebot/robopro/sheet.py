@@ -138,8 +138,15 @@ class Sheet:
         self.y = element.y + 4
         return element
 
-    def step(self, make: Callable[[int, int], Element], data: Tree | None = None, gap: int = 8,
-             entry: Callable[[Element], Pin] | None = None, dx: int = 0, release: bool = False) -> Element:
+    def step(
+        self,
+        make: Callable[[int, int], Element],
+        data: Tree | None = None,
+        gap: int = 8,
+        entry: Callable[[Element], Pin] | None = None,
+        dx: int = 0,
+        release: bool = False,
+    ) -> Element:
         """Place the next element below the column's tail, wire the flow in (and the pending joins onto
         that wire; with ``release``, the held ones too), and feed ``data`` to its data input; the column
         continues from its lower exit."""
@@ -189,9 +196,15 @@ class Sheet:
             self.canvas.join(join.pin, wire, at, via=via)
         self.joins = []
 
-    def side(self, exit_pin: Pin, makers: list[Callable[[int, int], Element]],
-             data: list[Tree | None] | None = None, extra: Callable[[Element], object] | None = None,
-             rejoin: bool = True, hold: bool = False) -> tuple[list[Element], Wire | None]:
+    def side(
+        self,
+        exit_pin: Pin,
+        makers: list[Callable[[int, int], Element]],
+        data: list[Tree | None] | None = None,
+        extra: Callable[[Element], object] | None = None,
+        rejoin: bool = True,
+        hold: bool = False,
+    ) -> tuple[list[Element], Wire | None]:
         """A side column right of the column, entered from ``exit_pin``: the elements ``makers`` make, in a
         chain; its last exit rejoins the column below (or, with no elements, the exit itself does)."""
         data = data or [None] * len(makers)

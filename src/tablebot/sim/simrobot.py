@@ -77,8 +77,17 @@ class SimRobot:
 
     def write(self, outputs: Sequence[int]) -> None:
         right, left = (0, 0) if self.stopped else (outputs[self.scene.drive[0]], outputs[self.scene.drive[1]])
-        K.move(self.s, right, left, self.scene.P[0], self._world, self._noise(1)[0], self.scene.bits, self.acc,
-               self.collision_rows)
+        K.move(
+            self.s,
+            right,
+            left,
+            self.scene.P[0],
+            self._world,
+            self._noise(1)[0],
+            self.scene.bits,
+            self.acc,
+            self.collision_rows,
+        )
 
     def stop(self) -> None:
         """The motors get no more power (a real robot would coast to a halt the same way)."""
@@ -106,8 +115,16 @@ class SimRobot:
         hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
         start = engine.tick
         robot = RobotState(self.s, self.scene.P[0], regs, outputs, counters, self.acc, self.collision_rows)
-        K.run_robot(robot, self._world, arrays.program, self._wiring, ticks, NO_NOISE, bitgen_address(self.rng),
-                    untallied(hist, ints))
+        K.run_robot(
+            robot,
+            self._world,
+            arrays.program,
+            self._wiring,
+            ticks,
+            NO_NOISE,
+            bitgen_address(self.rng),
+            untallied(hist, ints),
+        )
         engine._sync(regs, outputs, counters)
         return self.block(start, ints, hist, n_out, n_c)
 
@@ -120,10 +137,21 @@ class SimRobot:
         ints = np.zeros((ticks, K.I_OUTPUTS + n_out + 2 * n_c), dtype=np.int64)
         hist = np.zeros((ticks if self.record_history else 0, L.N_STATE))
         kept = np.zeros((ticks, state.regs.shape[0], S.N_K), dtype=np.int64)
-        robot = RobotState(self.s, self.scene.P[0], state.regs[0], outputs, state.counters[0], self.acc,
-                           self.collision_rows)
-        S.run_several(robot, self._world, program, state, self._wiring, ticks, NO_NOISE, bitgen_address(self.rng),
-                      untallied(hist, ints), kept)
+        robot = RobotState(
+            self.s, self.scene.P[0], state.regs[0], outputs, state.counters[0], self.acc, self.collision_rows
+        )
+        S.run_several(
+            robot,
+            self._world,
+            program,
+            state,
+            self._wiring,
+            ticks,
+            NO_NOISE,
+            bitgen_address(self.rng),
+            untallied(hist, ints),
+            kept,
+        )
         S.sync(engine, state, outputs)
         block = self.block(start, ints, hist, n_out, n_c)
         block.extra = Joined(block.extra or {}, S.table_columns(engine.tables, kept))
@@ -133,8 +161,17 @@ class SimRobot:
         """The ticks from ``start`` that a compiled loop recorded (``ints``: .kernel's I_* records of ``n_out``
         outputs and ``n_c`` counters; ``hist``: the robot's rows, or none) as the run loop's TickBlock."""
         o, c = K.I_OUTPUTS, K.I_OUTPUTS + n_out  # outputs, then counters, then pulses
-        block = TickBlock(start, ints[:, K.I_MASK], ints[:, c + n_c:], ints[:, K.I_EVENT], ints[:, K.I_ROW],
-                          ints[:, K.I_STATE], ints[:, K.I_TIMER], ints[:, o:c], ints[:, c:c + n_c])
+        block = TickBlock(
+            start,
+            ints[:, K.I_MASK],
+            ints[:, c + n_c :],
+            ints[:, K.I_EVENT],
+            ints[:, K.I_ROW],
+            ints[:, K.I_STATE],
+            ints[:, K.I_TIMER],
+            ints[:, o:c],
+            ints[:, c : c + n_c],
+        )
         if len(hist):
             block.extra = LazyColumns(self.scene, hist)
             block.raw = hist
@@ -201,14 +238,21 @@ class Starter:
         self.spread = params["noise"]["motor_spread"]
         self.acc = K.new_accumulator(scene.world.reach, max(1, round(DEBOUNCE_S / scene.tick_s)))
 
-    def start(self, poses: Sequence[Sequence[float]], rngs: Sequence[np.random.Generator], rows: Sequence[int],
-              S: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+    def start(
+        self,
+        poses: Sequence[Sequence[float]],
+        rngs: Sequence[np.random.Generator],
+        rows: Sequence[int],
+        S: np.ndarray,
+        acc: np.ndarray,
+        collisions: np.ndarray,
+    ) -> None:
         """Fill rows ``rows`` of ``S``, ``acc`` and ``collisions`` for robots starting at ``poses`` (x, y,
         heading in degrees) whose Generators are ``rngs``: each robot's motor gains are its first two
         draws, its first reading's noise the next row (one draw of both: the same numbers)."""
         draws = np.array([rng.standard_normal(2 + L.N_NOISE) for rng in rngs]).reshape(len(rows), 2 + L.N_NOISE)
         S[rows] = self.row
-        S[rows, L.X:L.TH + 1] = [(x, y, math.radians(heading)) for x, y, heading in poses]
+        S[rows, L.X : L.TH + 1] = [(x, y, math.radians(heading)) for x, y, heading in poses]
         S[rows, L.GAIN_R] = 1.0 + self.spread * draws[:, 0]
         S[rows, L.GAIN_L] = 1.0 + self.spread * draws[:, 1]
         acc[rows] = self.acc
@@ -226,16 +270,24 @@ def wired_lights(scene: Scene) -> list[tuple[str, int]]:
     """(trace key, state column) of the phototransistors wired to inputs: a robot without them gets no
     light fields (not two fields both called ``_light``)."""
     wiring = scene.params.wiring
-    return [(f"{wiring[role]}_light", column) for role, column in (("light_right", L.LIGHT_R),
-                                                                     ("light_left", L.LIGHT_L)) if wiring[role]]
+    return [
+        (f"{wiring[role]}_light", column)
+        for role, column in (("light_right", L.LIGHT_R), ("light_left", L.LIGHT_L))
+        if wiring[role]
+    ]
 
 
 def trace_layout(scene: Scene) -> tuple[tuple[str, int, float, int], ...]:
     """What the simulator adds to each trace line, and from where: (key, state column, scale, decimals;
     0 decimals = a whole number). The heading is the column's radians as degrees in -180..180."""
-    return (("x", L.X, 1.0, 5), ("y", L.Y, 1.0, 5), ("heading", L.TH, 1.0, 3),
-            *((key, column, 1.0, 4) for key, column in wired_lights(scene)), ("battery_v", L.VBAT, 1.0, 4),
-            *sensor_columns(scene))
+    return (
+        ("x", L.X, 1.0, 5),
+        ("y", L.Y, 1.0, 5),
+        ("heading", L.TH, 1.0, 3),
+        *((key, column, 1.0, 4) for key, column in wired_lights(scene)),
+        ("battery_v", L.VBAT, 1.0, 4),
+        *sensor_columns(scene),
+    )
 
 
 def field_columns(scene: Scene, hist: np.ndarray) -> dict[str, list]:
@@ -251,8 +303,9 @@ def number_columns(scene: Scene, hist: np.ndarray) -> dict[str, tuple[np.ndarray
         values = hist[:, column].astype(np.float64)
         if column == L.TH:
             values = (np.degrees(values) + 180.0) % 360.0 - 180.0  # as math.degrees and float % do
-        columns[key] = ((values.astype(np.int64), 0) if decimals == 0
-                        else (exact_round_array(values * scale, decimals), decimals))
+        columns[key] = (
+            (values.astype(np.int64), 0) if decimals == 0 else (exact_round_array(values * scale, decimals), decimals)
+        )
     return columns
 
 

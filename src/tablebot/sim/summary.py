@@ -43,18 +43,25 @@ class Summary:
 
         def when(value: float | None) -> str:
             return _("never") if value is None else f"{number(value, '.2f')} s"
+
         pairs: list[tuple[str, str]] = []
         if self.lamps:
             pairs += [(_("first light seen:"), when(self.first_light_s)), (_("lamp reached:"), when(self.reached_s))]
         if self.laps is not None:
             pairs.append((_("laps of the line:"), number(self.laps, ".2f")))
         volts = f"{number(self.battery_start_v, '.2f')} V -> {number(self.battery_end_v, '.2f')} V"
-        pairs += [(_("collisions:"), str(self.collisions)),
-                  (_("distance driven:"), f"{number(self.distance_m, '.2f')} m"), (_("battery:"), volts)]
+        pairs += [
+            (_("collisions:"), str(self.collisions)),
+            (_("distance driven:"), f"{number(self.distance_m, '.2f')} m"),
+            (_("battery:"), volts),
+        ]
         longest = (_("first light seen:"), _("laps of the line:"), *(label for label, _value in pairs))
         width = max(map(len, longest))  # every label, shown or not: the values line up as in any other run
-        out = [_("simulated {seconds:.1f} s").format(seconds=self.seconds),
-               *(f"{label:<{width}} {value}".rstrip() for label, value in pairs), _("time per state:")]
+        out = [
+            _("simulated {seconds:.1f} s").format(seconds=self.seconds),
+            *(f"{label:<{width}} {value}".rstrip() for label, value in pairs),
+            _("time per state:"),
+        ]
         for state, secs in self.state_seconds.items():
             label = f"{state} {names[state]}" if state in names else str(state)
             out.append(f"  {label:<24} {number(secs, '7.2f')} s  {number(100 * secs / self.seconds, '5.1f')} %")
@@ -90,9 +97,12 @@ def summarise(result: SimRun) -> Summary:
         seconds=result.ticks * tick_s,
         first_light_s=None if light is None else light * tick_s,
         reached_s=None if reached is None else reached * tick_s,
-        collisions=result.collision_count, collision_ticks=tuple(result.collision_rows),
-        distance_m=float(at_end[L.DIST]), state_seconds=time_per_state(result.states, result.scene.machine.states,
-                                                                      tick_s),
-        battery_start_v=float(at_start[L.VBAT]), battery_end_v=float(at_end[L.VBAT]),
+        collisions=result.collision_count,
+        collision_ticks=tuple(result.collision_rows),
+        distance_m=float(at_end[L.DIST]),
+        state_seconds=time_per_state(result.states, result.scene.machine.states, tick_s),
+        battery_start_v=float(at_start[L.VBAT]),
+        battery_end_v=float(at_end[L.VBAT]),
         laps=laps(result.scene.world, result.path[:, 0], result.path[:, 1]),
-        lamps=bool(result.scene.world.lamps))
+        lamps=bool(result.scene.world.lamps),
+    )

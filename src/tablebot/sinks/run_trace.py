@@ -26,8 +26,6 @@ from tablebot.sinks.trace_file import TraceFile
 WALL_KEY = "wall"  # Unix time (s, ms resolution) when the tick's line was written
 
 
-
-
 class RunTrace(TraceFile):
     """Writes ``trace.jsonl`` and ``summary.json`` into ``folder`` while the run goes."""
 
@@ -101,8 +99,9 @@ class RunTrace(TraceFile):
         }
 
 
-def seconds_per_state(counts: np.ndarray, first_seen: np.ndarray, names: tuple[StateId, ...],
-                      tick_s: float) -> dict[StateId, float]:
+def seconds_per_state(
+    counts: np.ndarray, first_seen: np.ndarray, names: tuple[StateId, ...], tick_s: float
+) -> dict[StateId, float]:
     """Seconds per state from its tick count and the tick it was first seen (-1: never), in order of
     first visit (a fleet keeps only these two per robot)."""
     visited = np.flatnonzero(first_seen >= 0)

@@ -41,8 +41,13 @@ def block_bytes_of(block: TickBlock, machine: Machine) -> bytes | str:
     return b"".join(views) if isinstance(views, list) else views
 
 
-def block_views_of(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray],
-                   helper: Executor | None = None, compiled: bool = True) -> list[memoryview] | str:
+def block_views_of(
+    block: TickBlock,
+    machine: Machine,
+    scratch: dict[str, np.ndarray],
+    helper: Executor | None = None,
+    compiled: bool = True,
+) -> list[memoryview] | str:
     """:func:`block_bytes_of` as the views of ``scratch``'s memory the compiled code made (see
     trace_text.block_views), or as text when Python made it (always, when not ``compiled``)."""
     block = _rows_as_written(block, machine)
@@ -61,8 +66,9 @@ def _rows_as_written(block: TickBlock, machine: Machine) -> TickBlock:
     if written == list(range(len(written))):
         return block
     rows = [-1 if r < 0 else written[r] for r in _ints(block.rows)]
-    return dataclasses.replace(block, rows=np.array(rows, dtype=np.int64) if isinstance(block.rows, np.ndarray)
-                               else rows)
+    return dataclasses.replace(
+        block, rows=np.array(rows, dtype=np.int64) if isinstance(block.rows, np.ndarray) else rows
+    )
 
 
 def compiled_block(block: TickBlock) -> bool:
@@ -77,8 +83,9 @@ def block_lines(block: TickBlock, machine: Machine) -> list[str]:
     return [line + "\n" for line in text.split("\n")[:-1]]  # no JSON text holds a raw newline
 
 
-def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray],
-                   helper: Executor | None) -> list[memoryview] | None:
+def _compiled_text(
+    block: TickBlock, machine: Machine, scratch: dict[str, np.ndarray], helper: Executor | None
+) -> list[memoryview] | None:
     from tablebot.sinks.trace_text import DECIMAL, INT, ROW, STATE, block_views, json_names
 
     n_out, n_count = len(machine.output_names), len(machine.table.robot.counter_names)
@@ -99,8 +106,9 @@ def _compiled_text(block: TickBlock, machine: Machine, scratch: dict[str, np.nda
         kinds.append(INT if places == 0 else DECIMAL)
         columns.append(values)
         decimals.append(places)
-    return block_views([p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states),
-                       scratch, helper)
+    return block_views(
+        [p.encode() for p in [*pieces, "}\n"]], kinds, columns, decimals, json_names(machine.states), scratch, helper
+    )
 
 
 def _all_arrays(columns: tuple[object, ...]) -> TypeGuard[tuple[np.ndarray, ...]]:
@@ -110,13 +118,20 @@ def _all_arrays(columns: tuple[object, ...]) -> TypeGuard[tuple[np.ndarray, ...]
 def _python_lines(block: TickBlock, machine: Machine) -> list[str]:
     names = [json.dumps(state, ensure_ascii=False) for state in machine.states]
     columns = [*machine.output_names, *machine.table.robot.counter_names]
-    template = ('{"tick":%d,"event":%d,"row":%s,"state":%s,"timer":%d'
-                + "".join(f",{json.dumps(name)}:%d" for name in columns)
-                + "".join(f",{json.dumps(key, ensure_ascii=False)}:%s" for key in block.extra) + "}\n")
+    template = (
+        '{"tick":%d,"event":%d,"row":%s,"state":%s,"timer":%d'
+        + "".join(f",{json.dumps(name)}:%d" for name in columns)
+        + "".join(f",{json.dumps(key, ensure_ascii=False)}:%s" for key in block.extra)
+        + "}\n"
+    )
     n = len(block)
-    values = [range(block.start, block.start + n), _ints(block.events),
-              ["null" if r < 0 else str(r) for r in _ints(block.rows)],
-              [names[s] for s in _ints(block.states)], _ints(block.timers)]
+    values = [
+        range(block.start, block.start + n),
+        _ints(block.events),
+        ["null" if r < 0 else str(r) for r in _ints(block.rows)],
+        [names[s] for s in _ints(block.states)],
+        _ints(block.timers),
+    ]
     values += _int_columns(block.outputs, len(machine.output_names), n)
     values += _int_columns(block.counters, len(machine.table.robot.counter_names), n)
     values += [_json_column(column) for column in block.extra.values()]

@@ -35,8 +35,13 @@ def _reused(scratch: dict[str, np.ndarray], name: str, size: int, dtype: type) -
     return array
 
 
-def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
-                decimals: Sequence[int], names: Sequence[bytes]) -> bytes | None:
+def block_bytes(
+    pieces: Sequence[bytes],
+    kinds: Sequence[int],
+    columns: Sequence[np.ndarray],
+    decimals: Sequence[int],
+    names: Sequence[bytes],
+) -> bytes | None:
     """The lines of a block: field f of each line is ``pieces[f]``, then the value of ``columns[f]`` for that
     line, written as ``kinds[f]`` says (DECIMAL: rounded to ``decimals[f]`` places; STATE: ``names[value]``);
     ``pieces[-1]`` ends each line. None when a DECIMAL value cannot be written here (see the module)."""
@@ -47,9 +52,15 @@ def block_bytes(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
 SPLIT_FROM = 1024  # lines from which a helper thread writes the second half of a block at the same time
 
 
-def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence[np.ndarray],
-                decimals: Sequence[int], names: Sequence[bytes], scratch: dict[str, np.ndarray],
-                helper: Executor | None = None) -> list[memoryview] | None:
+def block_views(
+    pieces: Sequence[bytes],
+    kinds: Sequence[int],
+    columns: Sequence[np.ndarray],
+    decimals: Sequence[int],
+    names: Sequence[bytes],
+    scratch: dict[str, np.ndarray],
+    helper: Executor | None = None,
+) -> list[memoryview] | None:
     """:func:`block_bytes` as views of ``scratch``'s memory (a writer's own dict of arrays, reused from one
     block to the next: the views are good until its next block), in one piece or, with ``helper`` (a
     thread) and a long block, two: the second half's lines written by ``helper`` meanwhile (the compiled
@@ -88,15 +99,24 @@ def block_views(pieces: Sequence[bytes], kinds: Sequence[int], columns: Sequence
         args = (second, *fixed, ints[half:], floats[half:], *names_at)  # one tuple: mypy misreads several *args
         later = helper.submit(_lines, *args)
     # numpy's stubs give ndarray a __buffer__ only for Python 3.12 on (mypy checks as 3.11)
-    views = [memoryview(out)[:_lines(out, *fixed, ints[:half], floats[:half], *names_at)]]  # type: ignore[arg-type]
+    views = [memoryview(out)[: _lines(out, *fixed, ints[:half], floats[:half], *names_at)]]  # type: ignore[arg-type]
     if later is not None:
-        views.append(memoryview(second)[:later.result()])  # type: ignore[arg-type]  # as above
+        views.append(memoryview(second)[: later.result()])  # type: ignore[arg-type]  # as above
     return views
 
 
 @njit(nogil=True, refcounts=False)
-def _lines(out: np.ndarray, pieces: np.ndarray, piece_ends: np.ndarray, kinds: np.ndarray, ints: np.ndarray,
-           floats: np.ndarray, decimals: np.ndarray, names: np.ndarray, name_ends: np.ndarray) -> int:
+def _lines(
+    out: np.ndarray,
+    pieces: np.ndarray,
+    piece_ends: np.ndarray,
+    kinds: np.ndarray,
+    ints: np.ndarray,
+    floats: np.ndarray,
+    decimals: np.ndarray,
+    names: np.ndarray,
+    name_ends: np.ndarray,
+) -> int:
     at = 0
     for t in range(ints.shape[0]):
         start = 0

@@ -26,8 +26,9 @@ class Cluster:
 
 
 @contextlib.contextmanager
-def local_cluster(workers: Sequence[Sequence[str]], env: Mapping[str, str],
-                  worker_env: Mapping[str, str] | None = None) -> Iterator[Cluster]:
+def local_cluster(
+    workers: Sequence[Sequence[str]], env: Mapping[str, str], worker_env: Mapping[str, str] | None = None
+) -> Iterator[Cluster]:
     """A scheduler on 127.0.0.1 (a port the system picks) and one single-threaded worker per item of
     ``workers`` (its extra options, e.g. ``["--preload", "tablebot.fleet.worker"]``), all joined when the
     block starts. ``env``: the processes' environment (``worker_env``: the workers', when it differs)."""
@@ -38,8 +39,9 @@ def local_cluster(workers: Sequence[Sequence[str]], env: Mapping[str, str],
         procs = [_start("dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(file)], env)]
         try:
             address = _address(file, procs[0])
-            procs += [_start("dask_worker", [address, "--nthreads", "1", *options], worker_env or env)
-                      for options in workers]
+            procs += [
+                _start("dask_worker", [address, "--nthreads", "1", *options], worker_env or env) for options in workers
+            ]
             with Client(address, timeout=f"{START_S:g}s") as client:
                 client.wait_for_workers(len(workers), timeout=2 * START_S)
             yield Cluster(address, procs)
@@ -53,8 +55,12 @@ def local_cluster(workers: Sequence[Sequence[str]], env: Mapping[str, str],
 
 
 def _start(program: str, options: Sequence[str], env: Mapping[str, str]) -> subprocess.Popen[bytes]:
-    return subprocess.Popen([sys.executable, "-m", f"distributed.cli.{program}", "--no-dashboard", *options],
-                            env=dict(env), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return subprocess.Popen(
+        [sys.executable, "-m", f"distributed.cli.{program}", "--no-dashboard", *options],
+        env=dict(env),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
 
 
 def _address(file: Path, scheduler: subprocess.Popen[bytes]) -> str:

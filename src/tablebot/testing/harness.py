@@ -93,8 +93,9 @@ def differences(machine: Machine, run: Run) -> str | None:
     return first_difference(run.lines, list(replay(machine, run.inputs)), CORE)
 
 
-def first_difference(lines: Sequence[dict[str, Any]], expected: Sequence[dict[str, Any]],
-                     required: Sequence[str] | None = None) -> str | None:
+def first_difference(
+    lines: Sequence[dict[str, Any]], expected: Sequence[dict[str, Any]], required: Sequence[str] | None = None
+) -> str | None:
     """The first tick and field where an executor's ``lines`` disagree with the engine's ``expected`` lines, or
     None; ``required``: the keys each line must report (None: every key of the engine's line)."""
     if len(lines) != len(expected):
@@ -119,28 +120,33 @@ def random_world(rng: random.Random) -> str:
 
     def spot() -> tuple[float, float]:
         return rng.uniform(1.2, size - 0.3), rng.uniform(1.2, size - 0.3)
+
     lx, ly = spot()
     bx, by = spot()
     cx, cy = spot()
-    while (cx - lx) ** 2 + (cy - ly) ** 2 < 0.15 ** 2:  # a lamp inside the circle is refused (its light is hidden)
+    while (cx - lx) ** 2 + (cy - ly) ** 2 < 0.15**2:  # a lamp inside the circle is refused (its light is hidden)
         cx, cy = spot()
-    return (f'name = "random"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
-            f"[start]\nat = [0.5, 0.5]\nheading = {rng.uniform(-180, 180)}\n"
-            f"[[lamp]]\nat = [{lx}, {ly}]\nintensity = {rng.uniform(1, 5)}\n"
-            f"[[box]]\nat = [{bx}, {by}]\nsize = [0.3, 0.2]\nangle = {rng.uniform(0, 90)}\n"
-            f"[[circle]]\nat = [{cx}, {cy}]\nradius = 0.1\n"
-            f"[noise]\nlight = {rng.choice([0.0, 0.05, 0.2])}\nmotor = {rng.choice([0.0, 0.01, 0.05])}\n")
+    return (
+        f'name = "random"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
+        f"[start]\nat = [0.5, 0.5]\nheading = {rng.uniform(-180, 180)}\n"
+        f"[[lamp]]\nat = [{lx}, {ly}]\nintensity = {rng.uniform(1, 5)}\n"
+        f"[[box]]\nat = [{bx}, {by}]\nsize = [0.3, 0.2]\nangle = {rng.uniform(0, 90)}\n"
+        f"[[circle]]\nat = [{cx}, {cy}]\nradius = 0.1\n"
+        f"[noise]\nlight = {rng.choice([0.0, 0.05, 0.2])}\nmotor = {rng.choice([0.0, 0.01, 0.05])}\n"
+    )
 
 
 def busy_world(rng: random.Random) -> str:
     """A small room where a robot that moves at all soon bumps into walls and a pot and passes a bright lamp, so
     that a random table's inputs really change: a world file's text."""
     size = rng.uniform(0.9, 1.3)
-    return (f'name = "busy"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
-            f"[start]\nat = [{size / 2}, {size / 2}]\nheading = {rng.uniform(-180, 180)}\n"
-            f"[[lamp]]\nat = [{rng.uniform(0.2, size - 0.2)}, {size - 0.15}]\nintensity = {rng.uniform(3, 8)}\n"
-            f"[[circle]]\nat = [{size - 0.2}, 0.2]\nradius = 0.08\n"
-            f"[noise]\nlight = {rng.choice([0.0, 0.05])}\nmotor = {rng.choice([0.0, 0.02])}\n")
+    return (
+        f'name = "busy"\n[arena]\nwalls = [[0, 0], [{size}, 0], [{size}, {size}], [0, {size}]]\n'
+        f"[start]\nat = [{size / 2}, {size / 2}]\nheading = {rng.uniform(-180, 180)}\n"
+        f"[[lamp]]\nat = [{rng.uniform(0.2, size - 0.2)}, {size - 0.15}]\nintensity = {rng.uniform(3, 8)}\n"
+        f"[[circle]]\nat = [{size - 0.2}, 0.2]\nradius = 0.08\n"
+        f"[noise]\nlight = {rng.choice([0.0, 0.05])}\nmotor = {rng.choice([0.0, 0.02])}\n"
+    )
 
 
 def wired_for(table: Table, section: str) -> Machine:
@@ -161,10 +167,15 @@ def fits_controller(machine: Machine, counters: int = 4) -> bool:
     O1..O8 and ``counters`` counters: counter Cn counts motor Mn (an encoder motor's counter is its own input)."""
     robot = machine.table.robot
     names_ok = all(n[:1] == "I" and n[1:].isdigit() and 1 <= int(n[1:]) <= 8 for n in robot.inputs)
-    return (names_ok and len(robot.motors) <= 4 and 2 * len(robot.motors) + len(robot.lamps) <= 8
-            and robot.tick_ms >= 10 and all(name == f"M{i + 1}" for i, name in enumerate(robot.motors))
-            and len(robot.counters) <= counters
-            and all((c.name, c.motor) == (f"C{i + 1}", f"M{i + 1}") for i, c in enumerate(robot.counters)))
+    return (
+        names_ok
+        and len(robot.motors) <= 4
+        and 2 * len(robot.motors) + len(robot.lamps) <= 8
+        and robot.tick_ms >= 10
+        and all(name == f"M{i + 1}" for i, name in enumerate(robot.motors))
+        and len(robot.counters) <= counters
+        and all((c.name, c.motor) == (f"C{i + 1}", f"M{i + 1}") for i, c in enumerate(robot.counters))
+    )
 
 
 @dataclass
@@ -195,8 +206,11 @@ def check(case: Case, workdir: Path, names: Sequence[str] | None = None) -> Repo
     report = Report()
     for name in names or list(EXECUTORS):
         executor = EXECUTORS[name]
-        why = executor.missing() or (None if executor.fits(case.machine) else "does not take this table") or (
-            None if case.rule in executor.rules else f"knows only the rule {executor.rules}")
+        why = (
+            executor.missing()
+            or (None if executor.fits(case.machine) else "does not take this table")
+            or (None if case.rule in executor.rules else f"knows only the rule {executor.rules}")
+        )
         if why:
             report.skipped[name] = why
             continue

@@ -35,13 +35,30 @@ def random_robot(rng: random.Random, folder: Path, shape: RobotShape = RobotShap
     outputs = [*MOTORS, *LAMPS, f"{COUNTER}_load"]
     owner = {output: rng.choice(names) for output in outputs}
     group = states[names[0]][:2]
-    robot = [f'name = "Random"\nmatch = "{rng.choice(("document", "always"))}"\n',
-             "[inputs]", *(f'{i} = "input {i}"' for i in INPUTS), "", "[motors]", 'M1 = "right"', 'M2 = "left"', "",
-             "[lamps]", 'L1 = "front"', 'L2 = "back"', "", "[counters]", f'{COUNTER} = "M1"', "", "[tables]"]
+    robot = [
+        f'name = "Random"\nmatch = "{rng.choice(("document", "always"))}"\n',
+        "[inputs]",
+        *(f'{i} = "input {i}"' for i in INPUTS),
+        "",
+        "[motors]",
+        'M1 = "right"',
+        'M2 = "left"',
+        "",
+        "[lamps]",
+        'L1 = "front"',
+        'L2 = "back"',
+        "",
+        "[counters]",
+        f'{COUNTER} = "M1"',
+        "",
+        "[tables]",
+    ]
     for name in names:
         match = f', match = "{rng.choice(("document", "always"))}"' if rng.random() < 0.5 else ""
-        robot.append(f'{name} = {{ file = "{name}.csv", initial_state = {rng.choice(states[name])}, '
-                     f'initial_timer = {rng.randint(0, 2)}{match} }}')
+        robot.append(
+            f'{name} = {{ file = "{name}.csv", initial_state = {rng.choice(states[name])}, '
+            f"initial_timer = {rng.randint(0, 2)}{match} }}"
+        )
     robot += ["", "[groups]", f"g = [{', '.join(map(str, group))}]", ""]
     (folder / "robot.toml").write_text("\n".join(robot))
     for name in names:
@@ -51,8 +68,15 @@ def random_robot(rng: random.Random, folder: Path, shape: RobotShape = RobotShap
     return folder
 
 
-def _table(rng: random.Random, shape: RobotShape, name: str, names: list[str], states: dict[str, list[int]],
-           writes: list[str], grouped: bool) -> str:
+def _table(
+    rng: random.Random,
+    shape: RobotShape,
+    name: str,
+    names: list[str],
+    states: dict[str, list[int]],
+    writes: list[str],
+    grouped: bool,
+) -> str:
     cross = [_cross(rng, other, states[other]) for other in rng.sample(names, rng.randint(1, len(names)))]
     events = ["T", *INPUTS, COUNTER, *cross]
     header = ["state", *(f'"{e}"' if "," in e else e for e in events), *writes, "timer", "next"]

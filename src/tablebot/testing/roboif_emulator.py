@@ -30,8 +30,15 @@ class RoboifEmulator(PtyDevice):
     """``fault = ("late", 40)`` applies from the 40th exchange on (one of :data:`FAULTS`); ``greeting_reply``
     replaces the answer to the greeting (a device that is not a ROBO Interface)."""
 
-    def __init__(self, script: Script = still, *, fault: tuple[str, int] | None = None, late_s: float = 0.3,
-                 baud: int = 0, greeting_reply: bytes = b"\x5e\x00\x00\x00\x00") -> None:
+    def __init__(
+        self,
+        script: Script = still,
+        *,
+        fault: tuple[str, int] | None = None,
+        late_s: float = 0.3,
+        baud: int = 0,
+        greeting_reply: bytes = b"\x5e\x00\x00\x00\x00",
+    ) -> None:
         self.script, self.fault, self.late_s = script, fault, late_s
         self.greeting_reply = greeting_reply
         self.exchanges = 0
@@ -70,8 +77,16 @@ class RoboifEmulator(PtyDevice):
         n = self.exchanges
         self.exchanges += 1
         a, b, c = out[2], out[3], out[4]
-        pwm = [a & 7, a >> 3 & 7, a >> 6 | (b & 1) << 2, b >> 1 & 7, b >> 4 & 7, b >> 7 | (c & 3) << 1,
-               c >> 2 & 7, c >> 5 & 7]
+        pwm = [
+            a & 7,
+            a >> 3 & 7,
+            a >> 6 | (b & 1) << 2,
+            b >> 1 & 7,
+            b >> 4 & 7,
+            b >> 7 | (c & 3) << 1,
+            c >> 2 & 7,
+            c >> 5 & 7,
+        ]
         self.note("exchange", outputs=out[1], pwm=pwm, extensions=list(out[5:17]), n=n, raw=out)
         levels, analog = self.script(n)
         reply = bytearray(21)

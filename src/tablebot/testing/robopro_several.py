@@ -29,8 +29,10 @@ ROBOPRO_SEVERAL_TICKS = 400
 
 def wired_txt(table: Table) -> Table:
     """A table's robot with a ``[robopro]`` section for a TXT (the controller whose program has counters)."""
-    return dataclasses.replace(table, robot=dataclasses.replace(
-        table.robot, sections={**table.robot.sections, "robopro": {"controller": "txt"}}))
+    return dataclasses.replace(
+        table,
+        robot=dataclasses.replace(table.robot, sections={**table.robot.sections, "robopro": {"controller": "txt"}}),
+    )
 
 
 def _tables(main: Table) -> RobotTables:

@@ -30,8 +30,16 @@ class RobotxEmulator(PtyDevice):
     """``fault = ("late", 40)`` applies from the 40th exchange on (one of :data:`FAULTS`); ``delay_s`` delays
     every reply (a slow link); ``junk`` is written before the first reply (a shell prompt)."""
 
-    def __init__(self, script: Script = still, *, device_name: str = "ROBO TX-000", fault: tuple[str, int] | None
-                 = None, delay_s: float = 0.0, late_s: float = 0.3, junk: bytes = b"") -> None:
+    def __init__(
+        self,
+        script: Script = still,
+        *,
+        device_name: str = "ROBO TX-000",
+        fault: tuple[str, int] | None = None,
+        delay_s: float = 0.0,
+        late_s: float = 0.3,
+        junk: bytes = b"",
+    ) -> None:
         self.script, self.device_name, self.fault = script, device_name, fault
         self.delay_s, self.late_s, self.junk = delay_s, late_s, junk
         self.exchanges = 0
@@ -58,13 +66,13 @@ class RobotxEmulator(PtyDevice):
                 return
             packet = bytes(self._buffer[:total])
             del self._buffer[:total]
-            total_sum = sum(packet[2:4 + length]) & 0xFFFF
+            total_sum = sum(packet[2 : 4 + length]) & 0xFFFF
             sent = (packet[4 + length] << 8) | packet[5 + length]
             if packet[-1] != 0x03 or (total_sum + sent) & 0xFFFF:
                 self.bad_frames += 1
                 self.note("bad frame")
                 continue
-            self._answer(packet[4:4 + length])
+            self._answer(packet[4 : 4 + length])
 
     def _answer(self, body: bytes) -> None:
         tid, sid, code, count = struct.unpack_from("<HHII", body, 8)
@@ -96,8 +104,17 @@ class RobotxEmulator(PtyDevice):
 
     def _config(self, tid: int, sid: int, count: int, data: bytes) -> None:
         ta = data[4:]
-        self.note("config", tid=tid, sid=sid, ta=int.from_bytes(data[:4], "little"), motors=list(ta[0:4]),
-                  uni=list(ta[4:12]), cnt=list(ta[12:16]), size=len(ta), raw=ta)
+        self.note(
+            "config",
+            tid=tid,
+            sid=sid,
+            ta=int.from_bytes(data[:4], "little"),
+            motors=list(ta[0:4]),
+            uni=list(ta[4:12]),
+            cnt=list(ta[12:16]),
+            size=len(ta),
+            raw=ta,
+        )
         self._reply(105, tid, [b""])
 
     def _exchange(self, tid: int, sid: int, count: int, data: bytes) -> None:

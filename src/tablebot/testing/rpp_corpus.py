@@ -36,9 +36,29 @@ REPO = Path(__file__).resolve().parents[3]
 #: numbers the user typed. They are recorded by kind (an integer range, a decimal, a matrix, text);
 #: every other attribute is an enumeration and may only take a value some real program has.
 FREE: dict[str, frozenset[str]] = {
-    "*": frozenset({"id", "resolveid", "transform", "name", "text", "caret", "documentation", "points",
-                    "x", "y", "uniqueID", "uniqueIDs", "version", "refid", "libname", "funcname", "panelname",
-                    "panelitem", "label"}),
+    "*": frozenset(
+        {
+            "id",
+            "resolveid",
+            "transform",
+            "name",
+            "text",
+            "caret",
+            "documentation",
+            "points",
+            "x",
+            "y",
+            "uniqueID",
+            "uniqueIDs",
+            "version",
+            "refid",
+            "libname",
+            "funcname",
+            "panelname",
+            "panelitem",
+            "label",
+        }
+    ),
     "ftProDataArray1D": frozenset({"globalname", "N", "savecsvcolumnname"}),
     "ftProDataConst": frozenset({"value", "value0", "value1", "value2"}),
     "ftProDataMssg": frozenset({"value", "value0", "value1", "value2", "valuetext"}),
@@ -157,6 +177,7 @@ def read_corpus(folder: Path) -> dict[str, object]:
 
 def dump(vocabulary: dict[str, object]) -> str:
     """JSON with one element per line, so that a change in the corpus shows as a readable diff."""
+
     def compact(value: object) -> str:
         return json.dumps(value, ensure_ascii=False, sort_keys=True, separators=(",", ":"))
 

@@ -18,8 +18,16 @@ TEXT = "#text"
 INT_RE = re.compile(r"-?\d+")
 DECIMAL_RE = re.compile(r"-?\d+(\.\d+)?")
 MATRIX_RE = re.compile(r"matrix\( 1 0 0 1 -?\d+(\.\d+)? -?\d+(\.\d+)? \)")
-INTERFACE_PINS = frozenset({"ftProSubroutineRef", "ftProSubroutineSymbol", "ftProSubroutineFlowIn",
-                            "ftProSubroutineFlowOut", "ftProSubroutineDataIn", "ftProSubroutineDataOut"})
+INTERFACE_PINS = frozenset(
+    {
+        "ftProSubroutineRef",
+        "ftProSubroutineSymbol",
+        "ftProSubroutineFlowIn",
+        "ftProSubroutineFlowOut",
+        "ftProSubroutineDataIn",
+        "ftProSubroutineDataOut",
+    }
+)
 
 
 #: Numbering rules real programs show in part, and the generator extends: the corpus has inputs I1–I4 as
@@ -38,12 +46,20 @@ _FLAGS = " selectable visible draggable shadow filled snap"
 #: (4.4.4, two processes flashing two lamps).
 BEYOND_CORPUS: dict[str, Any] = {
     "ftProDataOutSngl": {
-        "attribute_orders": [["classname", "id", "flags", "hitflags", "transform", "output", "module", "image",
-                              "resolution"]],
-        "attributes": {"classname": {"values": ["ftProDataOutSngl"]}, "id": {"kind": "int"},
-                       "flags": {"values": [_FLAGS]}, "hitflags": {"values": [" fill visible"]},
-                       "transform": {"kind": "matrix"}, "output": {"values": [str(n) for n in range(8)]},
-                       "module": {"values": ["IF1"]}, "image": {"values": ["1"]}, "resolution": {"values": ["0"]}},
+        "attribute_orders": [
+            ["classname", "id", "flags", "hitflags", "transform", "output", "module", "image", "resolution"]
+        ],
+        "attributes": {
+            "classname": {"values": ["ftProDataOutSngl"]},
+            "id": {"kind": "int"},
+            "flags": {"values": [_FLAGS]},
+            "hitflags": {"values": [" fill visible"]},
+            "transform": {"kind": "matrix"},
+            "output": {"values": [str(n) for n in range(8)]},
+            "module": {"values": ["IF1"]},
+            "image": {"values": ["1"]},
+            "resolution": {"values": ["0"]},
+        },
         "children": ["ftProObjectPin"],
         "pins": [[["", "dataobjectinput", "0", "matrix( 1 0 0 1 -8 0 )", "4", "4", ""]]],
     },
@@ -62,8 +78,9 @@ def with_beyond(known: dict[str, Any]) -> dict[str, Any]:
     merged = copy.deepcopy(known)
     elements = merged["elements"]
     elements.update(copy.deepcopy(BEYOND_CORPUS))
-    elements["ftProSubroutineFunction"]["children"] = sorted({*elements["ftProSubroutineFunction"]["children"],
-                                                               *BEYOND_CORPUS})
+    elements["ftProSubroutineFunction"]["children"] = sorted(
+        {*elements["ftProSubroutineFunction"]["children"], *BEYOND_CORPUS}
+    )
     command = elements["ftProDataMssg"]["attributes"]["command"]
     command["values"] = sorted({*command["values"], *BEYOND_COMMANDS})
     return merged
@@ -96,16 +113,18 @@ def _fits(rule: dict[str, Any], value: str, series: tuple[range, ...] = ()) -> b
     return True
 
 
-def _element_problems(element: ET.Element, parent: ET.Element | None, where: str,
-                      elements: dict[str, Any]) -> list[str]:
+def _element_problems(
+    element: ET.Element, parent: ET.Element | None, where: str, elements: dict[str, Any]
+) -> list[str]:
     kind = key(element)
     known = elements.get(kind)
     if known is None:
         return [f"{where}: element {kind!r} appears in no real program"]
     problems = []
     if list(element.attrib) not in known["attribute_orders"]:
-        problems.append(f"{where}: {kind} with attributes {list(element.attrib)} in this order: no real program "
-                        "writes them so")
+        problems.append(
+            f"{where}: {kind} with attributes {list(element.attrib)} in this order: no real program writes them so"
+        )
     values = dict(element.attrib)
     if element.tag != "o" and element.text and element.text.strip():
         values[TEXT] = element.text.strip()

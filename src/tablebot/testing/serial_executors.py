@@ -60,13 +60,16 @@ def _terminal_values(m: Machine, tick: TickInput) -> list[int]:
     return values
 
 
-def _lines(m: Machine, section: str, record: _Record, outputs: list[dict[str, int]], ticks: int,
-           several: bool = False) -> Run:
+def _lines(
+    m: Machine, section: str, record: _Record, outputs: list[dict[str, int]], ticks: int, several: bool = False
+) -> Run:
     """The engine's decisions per tick with each output as the wire carried it (``outputs[t]``: by terminal);
     ``several``: a robot of several tables, its main table's row as written and the other tables' fields."""
     if record.end_reason != "done" or len(record.blocks) != ticks or len(outputs) != ticks:
-        raise AssertionError(f"the run ended {record.end_reason} after {len(record.blocks)} of {ticks} ticks, "
-                             f"{len(outputs)} exchanges carried outputs")
+        raise AssertionError(
+            f"the run ended {record.end_reason} after {len(record.blocks)} of {ticks} ticks, "
+            f"{len(outputs)} exchanges carried outputs"
+        )
     inputs, lines = [], []
     terminal_of = m.table.robot.sections[section]  # as wired_for wrote it: name -> terminal
     for t, block in enumerate(record.blocks):
@@ -74,8 +77,13 @@ def _lines(m: Machine, section: str, record: _Record, outputs: list[dict[str, in
         row = None if block.rows[0] < 0 else int(block.rows[0])
         if several and row is not None:
             row = m.table.rows[row].as_written
-        line: dict[str, Any] = {"tick": block.start, "event": int(block.events[0]), "row": row,
-                                "state": m.states[block.states[0]], "timer": int(block.timers[0])}
+        line: dict[str, Any] = {
+            "tick": block.start,
+            "event": int(block.events[0]),
+            "row": row,
+            "state": m.states[block.states[0]],
+            "timer": int(block.timers[0]),
+        }
         for name in m.output_names:
             line[name] = outputs[t][terminal_of[name]]
         line.update(zip(m.table.robot.counter_names, (int(c) for c in block.counters[0]), strict=True))
@@ -120,9 +128,10 @@ def _robotx_run(m: Machine, engine: Engine | RobotEngine, ticks: list[TickInput]
         robot.connect()
         run(engine, robot, clock=SimulatedClock(), sinks=[record], ticks=len(ticks), target="robotx")
         duties = [r.fields["duty"] for r in emulator.requests("exchange")]
-    outputs = [{f"{kind}{i + 1}": _levels(f"{kind}{i + 1}", duty, 64) for kind in "MO" for i in range(8 if kind == "O"
-                                                                                                     else 4)}
-               for duty in duties[1:len(ticks) + 1]]
+    outputs = [
+        {f"{kind}{i + 1}": _levels(f"{kind}{i + 1}", duty, 64) for kind in "MO" for i in range(8 if kind == "O" else 4)}
+        for duty in duties[1 : len(ticks) + 1]
+    ]
     return _lines(m, "robotx", record, outputs, len(ticks), several)
 
 
@@ -143,7 +152,6 @@ def _roboif_run(m: Machine, engine: Engine | RobotEngine, ticks: list[TickInput]
     from tablebot.hw.roboif.wiring import roboif_wiring
     from tablebot.testing.roboif_emulator import RoboifEmulator
 
-
     def script(n: int) -> tuple[list[int], dict[str, int]]:
         return (_terminal_values(m, ticks[n]) if n < len(ticks) else [0] * 8), {}
 
@@ -162,15 +170,26 @@ def _roboif_run(m: Machine, engine: Engine | RobotEngine, ticks: list[TickInput]
             return pwm[2 * index] + 1
         return -(pwm[2 * index + 1] + 1) if bits >> (2 * index + 1) & 1 else 0
 
-    outputs = [{f"{kind}{i + 1}": level(bits, pwm, f"{kind}{i + 1}") for kind in "MO" for i in range(8 if kind == "O"
-                                                                                                      else 4)}
-               for bits, pwm in exchanges[1:len(ticks) + 1]]
+    outputs = [
+        {f"{kind}{i + 1}": level(bits, pwm, f"{kind}{i + 1}") for kind in "MO" for i in range(8 if kind == "O" else 4)}
+        for bits, pwm in exchanges[1 : len(ticks) + 1]
+    ]
     return _lines(m, "roboif", record, outputs, len(ticks), several)
 
 
 SERIAL_EXECUTORS = (
-    Executor("ROBO TX", _robotx, fits=fits_controller, several=_robotx_several,
-             what="run --on robotx://: loop.run with the ROBO TX over fish.X1 to its emulator on a pty"),
-    Executor("ROBO Interface", _roboif, fits=lambda m: fits_controller(m, counters=0), several=_roboif_several,
-             what="run --on roboif://: loop.run with the ROBO Interface to its emulator on a pty"),
+    Executor(
+        "ROBO TX",
+        _robotx,
+        fits=fits_controller,
+        several=_robotx_several,
+        what="run --on robotx://: loop.run with the ROBO TX over fish.X1 to its emulator on a pty",
+    ),
+    Executor(
+        "ROBO Interface",
+        _roboif,
+        fits=lambda m: fits_controller(m, counters=0),
+        several=_roboif_several,
+        what="run --on roboif://: loop.run with the ROBO Interface to its emulator on a pty",
+    ),
 )

@@ -20,16 +20,20 @@ from tablebot.replay import replay_several
 from tablebot.tables import RobotTables
 from tablebot.testing.harness import EXECUTORS, Report, Run, SeveralCase, executor_folder, first_difference, wired_for
 
-__all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks",
-           "wired_robot"]
+__all__ = ["SeveralCase", "check_several", "random_several_case", "several_differences", "several_ticks", "wired_robot"]
 
 
 def several_ticks(rng: random.Random, tables: RobotTables, count: int, density: float = 0.4) -> list[TickInput]:
     """Inputs for a robot of several tables: many ticks with no input at all (where the two matching rules
     part), encoder pulses for every counter."""
     width, counters = len(tables.input_bits), len(tables.robot.counters)
-    return [TickInput(rng.randrange(1 << width) if rng.random() < density else 0,
-                      tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters))) for _ in range(count)]
+    return [
+        TickInput(
+            rng.randrange(1 << width) if rng.random() < density else 0,
+            tuple(rng.choice((0, 0, 1, 3)) for _ in range(counters)),
+        )
+        for _ in range(count)
+    ]
 
 
 def random_several_case(seed: int, folder: Path, ticks: int = 240) -> SeveralCase:
@@ -64,8 +68,11 @@ def check_several(case: SeveralCase, workdir: Path, names: Sequence[str] | None 
     report = Report()
     for name in names or list(EXECUTORS):
         executor = EXECUTORS[name]
-        why = executor.missing() or (None if executor.several else "runs one table only") or (
-            None if executor.fits(robot_machine(case.tables)) else "does not take this robot")
+        why = (
+            executor.missing()
+            or (None if executor.several else "runs one table only")
+            or (None if executor.fits(robot_machine(case.tables)) else "does not take this robot")
+        )
         if why or executor.several is None:
             report.skipped[name] = why or ""
             continue

@@ -40,8 +40,9 @@ def open_room() -> World:
     return parse_world(Source.parse("<open room>", OPEN_ROOM))
 
 
-def turns(table_path: Path, charges: list[float], seeds: list[int], seconds: float = 6.0,
-          world: World | None = None) -> list[Turn]:
+def turns(
+    table_path: Path, charges: list[float], seeds: list[int], seconds: float = 6.0, world: World | None = None
+) -> list[Turn]:
     """Run ``table_path`` once per (charge, seed) and measure how far the robot turned."""
     table = load_table(table_path)
     machine = compile_table(table)

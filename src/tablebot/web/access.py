@@ -51,8 +51,7 @@ TOKEN_PROTOCOL = "tablebot-token."
 #: What the page is made of: files that hold no secret, served without the token (to GET and HEAD only).
 PUBLIC_PATHS = ("/", "/static/")
 #: Sent with every answer: no sniffing JSON as script, no framing, no address (with its token) in a Referer.
-HEADERS = [(b"x-content-type-options", b"nosniff"), (b"x-frame-options", b"DENY"),
-           (b"referrer-policy", b"no-referrer")]
+HEADERS = [(b"x-content-type-options", b"nosniff"), (b"x-frame-options", b"DENY"), (b"referrer-policy", b"no-referrer")]
 
 
 def host_name(address: str) -> str:
@@ -117,8 +116,10 @@ class Access:
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
         host = headers.get("host", "")
         if not self.serves(host):
-            return (f"refused: this studio does not answer to the address {host[:100]!r} "
-                    "(open the address that tablebot studio printed)")
+            return (
+                f"refused: this studio does not answer to the address {host[:100]!r} "
+                "(open the address that tablebot studio printed)"
+            )
         origin = headers.get("origin")
         if origin is not None and origin.lower() != f"http://{host.lower()}":
             return f"refused: a page from {origin[:100]!r} may not use this studio"
@@ -130,15 +131,20 @@ class Access:
             return f"refused: the request was started by another page ({fetch_site[:20]})"
         if public or self.has_token(given_tokens(scope)):
             return None
-        return ("refused: the studio's key is missing or out of date: open the address that tablebot "
-                "studio printed (…/?token=…); each start makes a new one")
+        return (
+            "refused: the studio's key is missing or out of date: open the address that tablebot "
+            "studio printed (…/?token=…); each start makes a new one"
+        )
 
 
 def _public(scope: Scope) -> bool:
     """The page or one of its files (no secret in them), fetched, not posted."""
     path = str(scope.get("path", ""))
-    return scope["type"] == "http" and scope.get("method") in ("GET", "HEAD") \
+    return (
+        scope["type"] == "http"
+        and scope.get("method") in ("GET", "HEAD")
         and (path == PUBLIC_PATHS[0] or path.startswith(PUBLIC_PATHS[1]))
+    )
 
 
 def given_tokens(scope: Scope) -> list[str]:
@@ -149,7 +155,7 @@ def given_tokens(scope: Scope) -> list[str]:
         if key.lower() == TOKEN_HEADER.encode():
             given.append(value.decode("latin-1").strip())
     if scope["type"] == "websocket":
-        given += [p[len(TOKEN_PROTOCOL):] for p in scope.get("subprotocols", []) if p.startswith(TOKEN_PROTOCOL)]
+        given += [p[len(TOKEN_PROTOCOL) :] for p in scope.get("subprotocols", []) if p.startswith(TOKEN_PROTOCOL)]
     return given
 
 
@@ -193,8 +199,12 @@ async def _deny(scope: Scope, send: Send, reason: str) -> None:
     (Not the ASGI "websocket.http.response" extension: uvicorn's sans-I/O WebSocket protocol logs that
     as a handshake never completed.)"""
     body = (reason + "\n").encode("utf-8")
-    headers = [(b"content-type", b"text/plain; charset=utf-8"), (b"content-length", str(len(body)).encode()),
-               (b"cache-control", b"no-store"), *HEADERS]
+    headers = [
+        (b"content-type", b"text/plain; charset=utf-8"),
+        (b"content-length", str(len(body)).encode()),
+        (b"cache-control", b"no-store"),
+        *HEADERS,
+    ]
     if scope["type"] == "http":
         await send({"type": "http.response.start", "status": 403, "headers": headers})
         await send({"type": "http.response.body", "body": body})

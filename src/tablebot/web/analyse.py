@@ -59,8 +59,9 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
     return out
 
 
-def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
-            others: Mapping[str, Table] | None = None) -> Analysis:
+def analyse(
+    doc: CsvDocument, path: Path, robot: Robot, display: str, others: Mapping[str, Table] | None = None
+) -> Analysis:
     """Parse the document's text as the CLI would, then check it; located results for the grid. A table of a
     robot of several tables is read as one of them (its name, start and rule) and checked with the others:
     ``others`` as the studio has them (edited), the rest from their files."""
@@ -77,12 +78,16 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
         table = replace(table_read.parse_table(doc.text(), display, robot, name), path=str(path))
         machine = compile_table(table)
         tables = load_tables(table, others) if tables_of(robot) else None
-        loaded = Loaded(table, machine, property_files=tuple(property_files(path))) if tables is None else \
-            Loaded(tables.table, tables.machines[0], property_files=tuple(property_files(path)), tables=tables)
+        loaded = (
+            Loaded(table, machine, property_files=tuple(property_files(path)))
+            if tables is None
+            else Loaded(tables.table, tables.machines[0], property_files=tuple(property_files(path)), tables=tables)
+        )
         report = loaded.check_report()  # its properties found and proved as check does
     except TableBotError as exc:
-        diagnostics = [_locate(_as_shown(d, path, display), display, places, lines, header_line)
-                       for d in exc.diagnostics]
+        diagnostics = [
+            _locate(_as_shown(d, path, display), display, places, lines, header_line) for d in exc.diagnostics
+        ]
     data: dict[str, Any] = {
         "ok": table is not None and not diagnostics,
         "diagnostics": diagnostics,
@@ -98,8 +103,12 @@ def analyse(doc: CsvDocument, path: Path, robot: Robot, display: str,
 
 def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
     """What the grid shows when the robot file itself does not read: its errors, the columns unknown."""
-    return {"ok": False, "columns": [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()],
-            "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics], "ms": 0}
+    return {
+        "ok": False,
+        "columns": [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()],
+        "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics],
+        "ms": 0,
+    }
 
 
 def machine_json(table: Table, machine: Machine, tables: RobotTables | None = None) -> dict[str, Any]:
@@ -107,41 +116,78 @@ def machine_json(table: Table, machine: Machine, tables: RobotTables | None = No
     the PNGs of a run give it (the page only looks colours up, so the two can never disagree). A robot of
     several tables: its name and the main one's, and each table's rows as a trace names them (as written) ->
     their lines, for the trace player's other tables."""
-    several = {} if tables is None else {
-        "name": table.name, "main_name": tables.names[0],
-        "table_lines": {t.name: {r.as_written: r.line for r in t.rows} for t in tables.tables}}
+    several = (
+        {}
+        if tables is None
+        else {
+            "name": table.name,
+            "main_name": tables.names[0],
+            "table_lines": {t.name: {r.as_written: r.line for r in t.rows} for t in tables.tables},
+        }
+    )
     robot = table.robot
     colours = state_colours(machine.states)
     return {
-        "states": [{"id": str(s), "label": table.state_name(s), "colour": c}
-                   for s, c in zip(machine.states, colours, strict=True)],
-        "rows": len(table.rows), "events": list(table.events), "inputs": list(table.input_events),
-        "input_bits": machine.input_bits, "timer_bit": machine.timer_bit, "outputs": list(machine.output_names),
-        "motors": list(robot.motors), "lamps": list(robot.lamps), "tick_ms": robot.tick_ms,
-        "initial_state": str(robot.initial_state), "robot": robot.name, "labels": dict(robot.labels),
+        "states": [
+            {"id": str(s), "label": table.state_name(s), "colour": c}
+            for s, c in zip(machine.states, colours, strict=True)
+        ],
+        "rows": len(table.rows),
+        "events": list(table.events),
+        "inputs": list(table.input_events),
+        "input_bits": machine.input_bits,
+        "timer_bit": machine.timer_bit,
+        "outputs": list(machine.output_names),
+        "motors": list(robot.motors),
+        "lamps": list(robot.lamps),
+        "tick_ms": robot.tick_ms,
+        "initial_state": str(robot.initial_state),
+        "robot": robot.name,
+        "labels": dict(robot.labels),
         # row i (a trace's 0-based ``row``) is this line of the file: the number the grid and every message show
         "row_lines": [row.line for row in table.rows],
         # a trace names a row as written (a group's row once): that row's line, by the trace's number
-        "written_lines": {row.as_written: row.line for row in table.rows}, **several,
+        "written_lines": {row.as_written: row.line for row in table.rows},
+        **several,
     }
 
 
 def _report_json(report: CheckReport, lines: dict[int, int], table: str) -> dict[str, Any]:
     """``table``: the name of the table the grid shows ("" the main one): only its findings mark its rows."""
-    findings = [{"code": f.code, "severity": f.severity, "message": f.message, "hint": f.hint, "lines": list(f.lines),
-                 "rows": [lines[n] for n in f.lines if n in lines] if f.table == table else []}
-                for f in report.findings]
+    findings = [
+        {
+            "code": f.code,
+            "severity": f.severity,
+            "message": f.message,
+            "hint": f.hint,
+            "lines": list(f.lines),
+            "rows": [lines[n] for n in f.lines if n in lines] if f.table == table else [],
+        }
+        for f in report.findings
+    ]
     props = []
     for result in report.results:
         prop = result.prop
-        props.append({"name": prop.name, "text": prop.text, "claim": prop.claim(), "status": result.status,
-                      "level": prop.level, "note": prop.note, "detail": result.detail,
-                      "severity": report.severity_of(result), "ticks": len(result.inputs),
-                      "at_tick": result.at_tick, "example": prop.kind == "reachable"})
+        props.append(
+            {
+                "name": prop.name,
+                "text": prop.text,
+                "claim": prop.claim(),
+                "status": result.status,
+                "level": prop.level,
+                "note": prop.note,
+                "detail": result.detail,
+                "severity": report.severity_of(result),
+                "ticks": len(result.inputs),
+                "at_tick": result.at_tick,
+                "example": prop.kind == "reachable",
+            }
+        )
     return {"findings": findings, "properties": props, "counts": report.counts(), "situations": report.situations}
 
 
 # --- placing diagnostics ------------------------------------------------------------------------------
+
 
 def _cell_places(doc: CsvDocument) -> dict[tuple[int, int], tuple[int, int]]:
     """(line, column) of each cell -> (grid row, column); the header is grid row -1."""
@@ -178,8 +224,13 @@ def _as_shown(d: Diagnostic, path: Path, display: str) -> Diagnostic:
     return replace(d, path=(PurePosixPath(display).parent / inside.as_posix()).as_posix())
 
 
-def _locate(d: Diagnostic, display: str, places: dict[tuple[int, int], tuple[int, int]],
-            lines: dict[int, int], header_line: int | None) -> dict[str, Any]:
+def _locate(
+    d: Diagnostic,
+    display: str,
+    places: dict[tuple[int, int], tuple[int, int]],
+    lines: dict[int, int],
+    header_line: int | None,
+) -> dict[str, Any]:
     """A diagnostic with the grid cell (or row) it belongs to; problems of other files have none."""
     row = column = None
     if d.path == display and d.line is not None:
@@ -189,11 +240,21 @@ def _locate(d: Diagnostic, display: str, places: dict[tuple[int, int], tuple[int
             row = -1
         else:
             row = lines.get(d.line)
-    return {"file": d.path, "line": d.line, "column": d.column, "message": d.message, "hint": d.hint,
-            "severity": d.severity, "text": d.render(), "row": row, "col": column}
+    return {
+        "file": d.path,
+        "line": d.line,
+        "column": d.column,
+        "message": d.message,
+        "hint": d.hint,
+        "severity": d.severity,
+        "text": d.render(),
+        "row": row,
+        "col": column,
+    }
 
 
 # --- why a row fired ---------------------------------------------------------------------------------
+
 
 def explain(table: Table, machine: Machine, state: int, events: int) -> list[dict[str, Any]]:
     """For each row of ``state`` (an index), in table order: fired, or why not, given the event mask."""
@@ -205,23 +266,35 @@ def explain(table: Table, machine: Machine, state: int, events: int) -> list[dic
             continue
         row = table.rows[compiled.index]
         missing = [e for e in names if compiled.mask & table.bit(e) and not events & table.bit(e)]
-        line = N_("line {line} ({description})", line=row.line, description=row.description) if row.description \
+        line = (
+            N_("line {line} ({description})", line=row.line, description=row.description)
+            if row.description
             else N_("line {line}", line=row.line)
+        )
         if compiled.index == fired:
-            why = N_("{line} fired: it needs {events}, all present", line=line,
-                     events=" + ".join(e for e in names if e in row.events)) if row.events \
+            why = (
+                N_(
+                    "{line} fired: it needs {events}, all present",
+                    line=line,
+                    events=" + ".join(e for e in names if e in row.events),
+                )
+                if row.events
                 else N_("{line} fired: it needs nothing", line=line)
+            )
             status = "fired"
         elif missing:
             why = N_("{line} did not fire: it needs {events}", line=line, events=" + ".join(missing))
             status = "missing"
         elif fired == NO_ROW:  # it needs nothing, yet nothing fired: the document's rule on a tick with no event
-            why = N_('{line} did not fire: no event this tick, and with match = "document" no row is looked up then',
-                     line=line)
+            why = N_(
+                '{line} did not fire: no event this tick, and with match = "document" no row is looked up then',
+                line=line,
+            )
             status = "missing"
         else:
-            why = N_("{line} did not fire: line {first} comes first and matches too", line=line,
-                     first=table.rows[fired].line)
+            why = N_(
+                "{line} did not fire: line {first} comes first and matches too", line=line, first=table.rows[fired].line
+            )
             status = "shadowed"
         out.append({"row": compiled.index, "status": status, "why": why, "line": row.line})
     if fired == NO_ROW:

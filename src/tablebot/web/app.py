@@ -41,16 +41,24 @@ MAX_MESSAGE_BYTES = 2 * 1024 * 1024  # an edit is a cell; a whole table is at mo
 MAX_TABS = 8
 TIDY_AFTER_S = 0.25  # tabs closing together (a window of them) go within this; their memory goes back at once
 #: Scripts and styles only from this server; nothing from the internet.
-CSP = ("default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
-       "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
+CSP = (
+    "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
+    "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'"
+)
 
 
 class Gone(Exception):
     """The tab closed its WebSocket: stop talking to it."""
 
 
-def create_app(root: Path, access: Access, table: str | None = None, max_tabs: int = MAX_TABS,
-               visited: threading.Event | None = None, lang: str | None = None) -> Gate:
+def create_app(
+    root: Path,
+    access: Access,
+    table: str | None = None,
+    max_tabs: int = MAX_TABS,
+    visited: threading.Event | None = None,
+    lang: str | None = None,
+) -> Gate:
     """The studio for folder ``root``, behind ``access``'s gate; ``table`` (relative to it) opens first;
     at most ``max_tabs`` tabs at once; ``visited`` is set when a page comes with the token in its address;
     ``lang`` is the language asked for (``tablebot studio --lang``), which the page speaks unless its switch says
@@ -60,8 +68,9 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
     tabs = Tabs(max_tabs)
 
     async def index(request: Request) -> Response:
-        response = FileResponse(STATIC / "index.html", headers={"Content-Security-Policy": CSP,
-                                                                "Cache-Control": "no-store"})
+        response = FileResponse(
+            STATIC / "index.html", headers={"Content-Security-Policy": CSP, "Cache-Control": "no-store"}
+        )
         if visited is not None and access.has_token(request.query_params.getlist("token")):
             visited.set()  # the browser came with the token (the page keeps it; the server sets no cookie)
         return response
@@ -69,9 +78,10 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
     async def config(request: Request) -> Response:
         listing = await asyncio.to_thread(workspace.listing)
         # templates: what `tablebot new` offers, for a folder without a table
-        return JSONResponse({"table": table, "folder": workspace.root.name, "templates": list(TEMPLATES), "lang": lang,
-                             **listing},
-                            headers={"Cache-Control": "no-store"})
+        return JSONResponse(
+            {"table": table, "folder": workspace.root.name, "templates": list(TEMPLATES), "lang": lang, **listing},
+            headers={"Cache-Control": "no-store"},
+        )
 
     async def upload_trace(request: Request) -> Response:
         """A trace file from the user's computer (the body), size-limited while it arrives."""
@@ -81,11 +91,18 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
             async for chunk in request.stream():
                 body += chunk
                 if len(body) > MAX_PLAYER_TRACE_BYTES:
-                    return JSONResponse(ErrorMsg(f"the trace is larger than {MAX_PLAYER_TRACE_BYTES:,} bytes",
-                                                 hint="cut the run shorter").data(), status_code=413)
+                    return JSONResponse(
+                        ErrorMsg(
+                            f"the trace is larger than {MAX_PLAYER_TRACE_BYTES:,} bytes", hint="cut the run shorter"
+                        ).data(),
+                        status_code=413,
+                    )
         except ClientDisconnect:  # the tab closed or reloaded mid-upload: nobody is left to answer
-            log.warning("an uploaded trace (%s) was cut off after %s: the page closed the connection, nothing "
-                        "was read", terminal(name), _of_bytes(len(body), request.headers.get("content-length")))
+            log.warning(
+                "an uploaded trace (%s) was cut off after %s: the page closed the connection, nothing was read",
+                terminal(name),
+                _of_bytes(len(body), request.headers.get("content-length")),
+            )
             return Response(status_code=400)
         try:
             lines = await asyncio.to_thread(read_trace_bytes, bytes(body), name)
@@ -132,13 +149,18 @@ def create_app(root: Path, access: Access, table: str | None = None, max_tabs: i
             await asyncio.to_thread(session.close)
             await tabs.gone()
 
-    routes = [Route("/", index), Route("/api/config", config), Route("/api/trace", upload_trace, methods=["POST"]),
-              WebSocketRoute("/ws", socket), Mount("/static", StaticFiles(directory=STATIC), name="static")]
+    routes = [
+        Route("/", index),
+        Route("/api/config", config),
+        Route("/api/trace", upload_trace, methods=["POST"]),
+        WebSocketRoute("/ws", socket),
+        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+    ]
     return Gate(Starlette(routes=routes), access)
 
 
 def _of_bytes(got: int, announced: str | None) -> str:
-    """"1,050 of 100,000 bytes" (or "1,050 bytes" when the upload did not say its length)."""
+    """ "1,050 of 100,000 bytes" (or "1,050 bytes" when the upload did not say its length)."""
     return f"{got:,} of {int(announced):,} bytes" if announced and announced.isdigit() else f"{got:,} bytes"
 
 
@@ -174,11 +196,19 @@ class Tabs:
         since the page reads a closed one as the studio stopping)."""
         tabs = f"{self.most} tab{'s' if self.most != 1 else ''}"
         if not self.told:
-            log.warning("refused a tab: %s %s open already, the most one studio serves at once (close one of "
-                        "them in the browser)", tabs, "are" if self.most != 1 else "is")
+            log.warning(
+                "refused a tab: %s %s open already, the most one studio serves at once (close one of "
+                "them in the browser)",
+                tabs,
+                "are" if self.most != 1 else "is",
+            )
             self.told = True
-        refusal = json.dumps(ErrorMsg(f"this studio already has {tabs} open, the most it serves at once: close one "
-                                      "of them, then reload this tab").data())
+        refusal = json.dumps(
+            ErrorMsg(
+                f"this studio already has {tabs} open, the most it serves at once: close one "
+                "of them, then reload this tab"
+            ).data()
+        )
         try:
             await websocket.send_text(refusal)
             while (await websocket.receive())["type"] != "websocket.disconnect":
@@ -227,8 +257,13 @@ async def _frames(session: Session) -> None:
 
 def server(app: Gate, access: Access, log_level: str = "warning") -> uvicorn.Server:
     """A uvicorn server for the studio (run it with ``sockets=[...]``); the token never reaches its logs."""
-    config = uvicorn.Config(app, log_level=log_level, access_log=log_level in ("info", "debug", "trace"),
-                            ws_max_size=MAX_MESSAGE_BYTES, lifespan="off")
+    config = uvicorn.Config(
+        app,
+        log_level=log_level,
+        access_log=log_level in ("info", "debug", "trace"),
+        ws_max_size=MAX_MESSAGE_BYTES,
+        lifespan="off",
+    )
     hide_token_in_logs(access.token)  # uvicorn configured its loggers just now, in Config()
     return uvicorn.Server(config)
 
@@ -238,8 +273,16 @@ class Background:
     ``origin`` and ``headers`` (what its own page sends: its Origin and token header) for other clients,
     :meth:`stop` to end."""
 
-    def __init__(self, root: Path, table: str | None = None, host: str = "127.0.0.1", port: int = 0,
-                 log_level: str = "warning", max_tabs: int = MAX_TABS, lang: str | None = None) -> None:
+    def __init__(
+        self,
+        root: Path,
+        table: str | None = None,
+        host: str = "127.0.0.1",
+        port: int = 0,
+        log_level: str = "warning",
+        max_tabs: int = MAX_TABS,
+        lang: str | None = None,
+    ) -> None:
         import socket
 
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)

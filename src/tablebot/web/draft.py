@@ -91,8 +91,13 @@ class Draft:
         opened = await asyncio.to_thread(self.workspace.read, name, Kind.TABLE, MAX_TABLE_BYTES)
         return opened, CsvDocument.from_bytes(opened.data, opened.name)
 
-    async def show(self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None,
-                   replaced: Callable[[], None] = lambda: None) -> bool:
+    async def show(
+        self,
+        opened: Opened,
+        doc: CsvDocument,
+        unless_edited_since: int | None = None,
+        replaced: Callable[[], None] = lambda: None,
+    ) -> bool:
         """Make ``doc`` (read from ``opened``) the draft, with no edits, and send it to the page; not if the
         draft was edited after edit count ``unless_edited_since`` meanwhile (the edit would be lost).
         ``replaced`` runs once the draft is replaced, before the page hears of it (the old robot stops)."""
@@ -113,9 +118,21 @@ class Draft:
         """The draft to the page as it is now (opened, or its tab shown again with its edits)."""
         doc, opened = self.need_doc(), self.opened
         assert opened is not None
-        await self.say(TableMsg(opened.name, doc.header_values(), doc.grid(), grid_lines(doc), self.version,
-                                {"delimiter": doc.dialect.delimiter, "encoding": doc.dialect.encoding,
-                                 "newline": repr(doc.dialect.newline)[1:-1]}, self.dirty))
+        await self.say(
+            TableMsg(
+                opened.name,
+                doc.header_values(),
+                doc.grid(),
+                grid_lines(doc),
+                self.version,
+                {
+                    "delimiter": doc.dialect.delimiter,
+                    "encoding": doc.dialect.encoding,
+                    "newline": repr(doc.dialect.newline)[1:-1],
+                },
+                self.dirty,
+            )
+        )
 
     async def reanalyse(self, seq: object) -> None:
         """Check the draft and send the analysis (and the state diagram of a table that reads)."""
@@ -124,8 +141,9 @@ class Draft:
             assert self.robot_error is not None
             await self.say(AnalysisMsg(seq, self.dirty, grid_lines(self.doc), robot_failed(self.robot_error, self.doc)))
             return
-        self.analysis = await asyncio.to_thread(analyse, self.doc, self.path, self.robot, self.opened.name,
-                                                self.others())
+        self.analysis = await asyncio.to_thread(
+            analyse, self.doc, self.path, self.robot, self.opened.name, self.others()
+        )
         data = {**self.analysis.data, "tables": self.tabs()}
         await self.say(AnalysisMsg(seq, self.dirty, grid_lines(self.doc), data))
         if self.analysis.table is not None:
@@ -171,8 +189,15 @@ class Draft:
             await self.say(conflict(said(exc), exc.how, exc.theirs, exc.name, "save"))
             return None
         self.opened, self.base, self.dirty = saved.file, None, False
-        await self.say(SavedMsg("save", saved.file.version, saved.file.name,
-                                None if saved.backup is None else saved.file.name + BACKUP_SUFFIX, saved.backup))
+        await self.say(
+            SavedMsg(
+                "save",
+                saved.file.version,
+                saved.file.name,
+                None if saved.backup is None else saved.file.name + BACKUP_SUFFIX,
+                saved.backup,
+            )
+        )
         return saved.file
 
     async def restore(self, op: Restore) -> None:
@@ -193,9 +218,18 @@ class Draft:
 def conflict(message: str, how: str, theirs: str, path: str, op: str) -> ConflictMsg:
     """The page's choice when the file on disk is not the draft's: save yours over theirs (version
     ``theirs``, kept as NAME.bak) or load theirs."""
-    return ConflictMsg(op, message, how, theirs, path, path + BACKUP_SUFFIX,
-                       N_("your edits are kept: save yours (theirs are kept as {backup}), or load theirs (yours are "
-                          "dropped)", backup=path + BACKUP_SUFFIX))
+    return ConflictMsg(
+        op,
+        message,
+        how,
+        theirs,
+        path,
+        path + BACKUP_SUFFIX,
+        N_(
+            "your edits are kept: save yours (theirs are kept as {backup}), or load theirs (yours are dropped)",
+            backup=path + BACKUP_SUFFIX,
+        ),
+    )
 
 
 def grid_lines(doc: CsvDocument) -> list[int]:

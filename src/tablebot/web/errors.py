@@ -19,7 +19,6 @@ log = logging.getLogger("tablebot.studio")
 INTERNAL = N_("internal error in the studio (the terminal running tablebot studio shows the details)")
 
 
-
 def said(exc: Exception) -> str:
     """What a refusal says: its :class:`~tablebot.i18n.Message` when it carries one (so that the tab's language
     renders it; ``str(exc)`` would be its English text alone), else its text."""

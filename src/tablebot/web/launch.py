@@ -80,7 +80,11 @@ def open_in_browser(path: Path, visited: threading.Event, patience_s: float = PA
         if not webbrowser.open(path.as_uri()):
             log.warning("no browser could be opened: open the address above in one")
         elif not visited.wait(patience_s):
-            log.warning("the browser has not come to the studio after %g s: if it cannot find %s (a browser "
-                        "installed as a snap cannot read that folder), open the address above", patience_s, path)
+            log.warning(
+                "the browser has not come to the studio after %g s: if it cannot find %s (a browser "
+                "installed as a snap cannot read that folder), open the address above",
+                patience_s,
+                path,
+            )
 
     threading.Thread(target=run, name="tablebot-browser", daemon=True).start()

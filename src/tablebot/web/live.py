@@ -84,8 +84,15 @@ class PageClock:
             self._rebase(tick)
         return -ahead
 
-    def control(self, *, paused: bool | None = None, speed: float | None = None, step: bool = False,
-                stop: bool = False, tick: int = 0) -> None:
+    def control(
+        self,
+        *,
+        paused: bool | None = None,
+        speed: float | None = None,
+        step: bool = False,
+        stop: bool = False,
+        tick: int = 0,
+    ) -> None:
         with self._cond:
             if paused is not None and paused != self.paused:
                 self.paused = paused
@@ -124,9 +131,12 @@ class HandInputs:
         for bit, on in self.forced.items():
             mask = mask | bit if on else mask & ~bit
         s = self.robot.s
-        extra = {**(reading.extra or {}), "sensed": reading.mask,
-                 "bumpers": int(s[L.BUMP_FR] > 0) | int(s[L.BUMP_FL] > 0) << 1 | int(s[L.BUMP_REAR] > 0) << 2,
-                 "light": (float(s[L.LIGHT_R]), float(s[L.LIGHT_L]))}
+        extra = {
+            **(reading.extra or {}),
+            "sensed": reading.mask,
+            "bumpers": int(s[L.BUMP_FR] > 0) | int(s[L.BUMP_FL] > 0) << 1 | int(s[L.BUMP_REAR] > 0) << 2,
+            "light": (float(s[L.LIGHT_R]), float(s[L.LIGHT_L])),
+        }
         return Reading(mask, reading.pulses, extra)
 
     def write(self, outputs: Sequence[int]) -> None:
@@ -184,8 +194,11 @@ class FrameSink:
                     self._fired.append([block.start + k, row])
                 if "x" in extra:
                     by = extra.get(self.colour_by) if self.colour_by else None
-                    self._add_point(float(extra["x"][k]), float(extra["y"][k]),
-                                    str(by[k] if by is not None else self._states[state]))
+                    self._add_point(
+                        float(extra["x"][k]),
+                        float(extra["y"][k]),
+                        str(by[k] if by is not None else self._states[state]),
+                    )
                 latest.prev_state, latest.state = latest.state, state
             k = len(block) - 1
             latest.tick, latest.timer, latest.event = block.start + k, int(block.timers[k]), int(block.events[k])
@@ -219,8 +232,15 @@ class FrameSink:
 class LiveRun:
     """A simulated robot running a table in a thread, through the loop, until :meth:`close`."""
 
-    def __init__(self, scene: Scene, robot: SimRobot, speed: str = "1", paused: bool = True,
-                 on_end: Callable[[RunEnd], None] | None = None, sinks: Sequence[Sink] = ()) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        robot: SimRobot,
+        speed: str = "1",
+        paused: bool = True,
+        on_end: Callable[[RunEnd], None] | None = None,
+        sinks: Sequence[Sink] = (),
+    ) -> None:
         self.scene = scene
         # a robot of several tables runs whole: every table stepped together, the lights table's lamps too
         self.engine: Engine | RobotEngine = Engine(scene.machine) if scene.tables is None else RobotEngine(scene.tables)

@@ -20,8 +20,13 @@ def new_robot(root: Path, template: object, name: object) -> str:
     from tablebot.templates import TEMPLATES, make, write_folder
 
     if template not in TEMPLATES:
-        raise Refused(N_("no template {template}: tablebot new has {templates}", template=repr(str(template)[:40]),
-                         templates=", ".join(TEMPLATES)))
+        raise Refused(
+            N_(
+                "no template {template}: tablebot new has {templates}",
+                template=repr(str(template)[:40]),
+                templates=", ".join(TEMPLATES),
+            )
+        )
     if not isinstance(name, str) or not NEW_NAME.fullmatch(name):
         raise Refused(N_("a new robot's name is letters, digits, - and _ (at most 64, not starting with - or _)"))
     folder = root / name

@@ -31,8 +31,13 @@ def changed(name: str, how: str) -> Message:
 def refusal(exc: OSError, name: str) -> Refused:
     """An OS error on the way to ``name``, in the studio's words."""
     if exc.errno in (errno.ELOOP, errno.ENOTDIR, errno.EMLINK):
-        return Refused(N_("{name} changed while the studio was opening it (a link appeared on its way): nothing "
-                          "was read or written; try again", name=name))
+        return Refused(
+            N_(
+                "{name} changed while the studio was opening it (a link appeared on its way): nothing "
+                "was read or written; try again",
+                name=name,
+            )
+        )
     if exc.errno == errno.ENXIO:  # a socket
         return Refused(not_regular(name))
     if exc.errno == errno.ENOENT:

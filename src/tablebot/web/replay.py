@@ -42,8 +42,13 @@ def json_for_script(data: Any) -> str:
     return re.sub("[<>&\u2028\u2029]", lambda m: f"\\u{ord(m.group()):04x}", text)
 
 
-def replay_data(lines: Iterable[Mapping[str, Any] | str], world: World, table: Table,
-                params: Params | None = None, title: str | None = None) -> dict[str, Any]:
+def replay_data(
+    lines: Iterable[Mapping[str, Any] | str],
+    world: World,
+    table: Table,
+    params: Params | None = None,
+    title: str | None = None,
+) -> dict[str, Any]:
     """Everything the replay page shows, as plain JSON-able data."""
     parsed = [json.loads(line) if isinstance(line, str) else dict(line) for line in lines]
     columns = trace_columns(parsed)
@@ -58,11 +63,20 @@ def replay_data(lines: Iterable[Mapping[str, Any] | str], world: World, table: T
         tables = several(table)
     except TableBotError:  # its other files changed since the run: their states are still said, not their lines
         tables = None
-    return {"title": title or f"{table.robot.name}: {Path(table.path).name} in {world.name}",
-            "table": {"path": Path(table.path).name, "header": header, "grid": grid, "lines": lines_of,
-                      "columns": columns_of(header, table.robot)},
-            "machine": machine_json(table, machine, tables), "world": world_json(world, params),
-            "diagram": studio_diagram(table), "trace": columns}
+    return {
+        "title": title or f"{table.robot.name}: {Path(table.path).name} in {world.name}",
+        "table": {
+            "path": Path(table.path).name,
+            "header": header,
+            "grid": grid,
+            "lines": lines_of,
+            "columns": columns_of(header, table.robot),
+        },
+        "machine": machine_json(table, machine, tables),
+        "world": world_json(world, params),
+        "diagram": studio_diagram(table),
+        "trace": columns,
+    }
 
 
 def _table_cells(table: Table) -> tuple[list[str], list[list[str]], list[int]]:
@@ -83,12 +97,20 @@ def render_html(data: dict[str, Any]) -> str:
     for part in (style, scripts):
         if "</" + "script" in part.lower() or "</" + "style" in part.lower():
             raise ValueError("an inlined script or stylesheet would end its element")  # a bug in the package files
-    return (template.replace("/*STYLE*/", style).replace("/*SCRIPTS*/", scripts)
-            .replace("/*DATA*/", json_for_script(data)))
+    return (
+        template.replace("/*STYLE*/", style).replace("/*SCRIPTS*/", scripts).replace("/*DATA*/", json_for_script(data))
+    )
 
 
-def write_html(path: str | Path, lines: Iterable[Mapping[str, Any] | str], world: World, table: Table, *,
-               params: Params | None = None, title: str | None = None) -> Path:
+def write_html(
+    path: str | Path,
+    lines: Iterable[Mapping[str, Any] | str],
+    world: World,
+    table: Table,
+    *,
+    params: Params | None = None,
+    title: str | None = None,
+) -> Path:
     """Write the replay of a run to ``path`` (atomically): ``lines`` are its trace lines (dicts, or the
     JSON text lines of a trace.jsonl), ``world`` and ``table`` what it ran in and on, ``params`` the
     simulator's parameters (for the robot's outline; the default body when None)."""

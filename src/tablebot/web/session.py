@@ -92,8 +92,11 @@ class Session:
 
     def new_draft(self) -> Draft:
         draft = Draft(self.workspace, self.say, self.robot.diagram)
-        draft.others = lambda: {d.name: d.analysis.table for d in self.drafts.values()
-                                if d is not draft and d.name and d.analysis is not None and d.analysis.table}
+        draft.others = lambda: {
+            d.name: d.analysis.table
+            for d in self.drafts.values()
+            if d is not draft and d.name and d.analysis is not None and d.analysis.table
+        }
         return draft
 
     async def say(self, message: Message) -> None:
@@ -108,8 +111,13 @@ class Session:
         try:
             await self.dispatch(operation(message))
         except TableBotError as exc:
-            await self.say(ErrorMsg(exc.diagnostics[0].message if exc.diagnostics else said(exc), name,
-                                    diagnostics_text(exc.diagnostics, self.language)))
+            await self.say(
+                ErrorMsg(
+                    exc.diagnostics[0].message if exc.diagnostics else said(exc),
+                    name,
+                    diagnostics_text(exc.diagnostics, self.language),
+                )
+            )
         except Refused as exc:
             await self.error(said(exc), name)
 
@@ -177,8 +185,9 @@ class Session:
         """Whether table ``name`` is one of the tables of the robot this tab shows (a tab of it)."""
         return any(tab["file"] == name for tab in self.draft.tabs())
 
-    async def show(self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None,
-                   restart: bool = True) -> bool:
+    async def show(
+        self, opened: Opened, doc: CsvDocument, unless_edited_since: int | None = None, restart: bool = True
+    ) -> bool:
         """Make ``doc`` this tab's draft (:meth:`Draft.show`), check it, and start its arena robot over (not
         with ``restart`` False, when it runs this table's robot already: the first look at another table)."""
         if not await self.draft.show(opened, doc, unless_edited_since, self.robot.restart if restart else _nothing):
@@ -208,9 +217,15 @@ class Session:
             if shown:
                 await self.say(NoticeMsg(N_("reloaded: the table was saved in another tab")))
                 return
-        await self.say(conflict(N_("another tab saved {name} while this one has unsaved edits", name=file.name),
-                                OTHER_TAB,
-                                file.version, file.name, ""))
+        await self.say(
+            conflict(
+                N_("another tab saved {name} while this one has unsaved edits", name=file.name),
+                OTHER_TAB,
+                file.version,
+                file.name,
+                "",
+            )
+        )
 
     async def error(self, text: str, op: str = "") -> None:
         await self.say(ErrorMsg(text, op))

@@ -48,8 +48,11 @@ def sweep(root: str | os.PathLike[str]) -> list[str]:
                 removed.append(PurePosixPath(os.path.relpath(os.path.join(folder, name), root)).as_posix())
     for name in removed:
         leaf = TEMP_RE.fullmatch(PurePosixPath(name).name)
-        log.warning("removed %s: a save of %s that a stopped studio never finished (the table is as it was)",
-                    name, leaf["leaf"] if leaf else "a table")
+        log.warning(
+            "removed %s: a save of %s that a stopped studio never finished (the table is as it was)",
+            name,
+            leaf["leaf"] if leaf else "a table",
+        )
     return removed
 
 
@@ -68,8 +71,11 @@ def _stale(name: str, folder: str, fd: int | None, now: float) -> bool:
     if found is None:
         return False
     try:
-        info = os.stat(name, dir_fd=fd, follow_symlinks=False) if fd is not None else \
-            os.stat(os.path.join(folder, name), follow_symlinks=False)
+        info = (
+            os.stat(name, dir_fd=fd, follow_symlinks=False)
+            if fd is not None
+            else os.stat(os.path.join(folder, name), follow_symlinks=False)
+        )
     except OSError:
         return False
     if not stat.S_ISREG(info.st_mode):

@@ -44,6 +44,9 @@ class TracePlayer:
         from tablebot.replay import replay, replay_several
 
         # a robot of several tables: all of them replayed, the player shows the tab's table and says the others
-        lines = list(replay(analysis.report.machine, result.inputs) if analysis.tables is None
-                     else replay_several(analysis.tables, result.inputs))
+        lines = list(
+            replay(analysis.report.machine, result.inputs)
+            if analysis.tables is None
+            else replay_several(analysis.tables, result.inputs)
+        )
         await self.say(TraceMsg(f"counterexample: {op.name}", trace_columns(lines), result.at_tick))

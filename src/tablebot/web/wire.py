@@ -51,11 +51,19 @@ def _rows(message: Mapping[str, Any], key: str, single: bool = False) -> list[li
     """A list of rows of text (``single``: one row) from the page."""
     value = message.get(key)
     rows = [value] if single else value
-    if not isinstance(rows, list) or len(rows) > MAX_ROWS or not all(
-            isinstance(row, list) and len(row) <= MAX_COLUMNS and all(isinstance(c, str) for c in row) for row in rows):
+    if (
+        not isinstance(rows, list)
+        or len(rows) > MAX_ROWS
+        or not all(
+            isinstance(row, list) and len(row) <= MAX_COLUMNS and all(isinstance(c, str) for c in row) for row in rows
+        )
+    ):
         limits = {"key": key, "rows": f"{MAX_ROWS:,}", "columns": MAX_COLUMNS}
-        raise Refused(N_('"{key}" must be a row of text (at most {rows} rows of {columns} cells)', **limits) if single
-                      else N_('"{key}" must be rows of text (at most {rows} rows of {columns} cells)', **limits))
+        raise Refused(
+            N_('"{key}" must be a row of text (at most {rows} rows of {columns} cells)', **limits)
+            if single
+            else N_('"{key}" must be rows of text (at most {rows} rows of {columns} cells)', **limits)
+        )
     return rows
 
 
@@ -76,5 +84,12 @@ def _optional_text(message: Mapping[str, Any], key: str) -> str | None:
 
 
 #: How a field of an operation is read from the page's message, by its type (unless its :func:`wire` says).
-READERS: dict[str, Reader] = {"str": text, "int": _int, "Any": _as_is, "list[str]": _row, "list[list[str]]": _rows,
-                              "bool | str": _force, "str | None": _optional_text}
+READERS: dict[str, Reader] = {
+    "str": text,
+    "int": _int,
+    "Any": _as_is,
+    "list[str]": _row,
+    "list[list[str]]": _rows,
+    "bool | str": _force,
+    "str | None": _optional_text,
+}

@@ -45,9 +45,10 @@ DETAIL = "    | "  # how Diagnostic.render sets a tool's own output under the me
 
 
 def _diagnostic(data: dict[str, Any]) -> Diagnostic:
-    detail = "\n".join(line[len(DETAIL):] for line in str(data["text"]).splitlines() if line.startswith(DETAIL))
-    return Diagnostic(data["file"], data["line"], data["column"], data["message"], data["hint"] or "",
-                      data["severity"], detail)
+    detail = "\n".join(line[len(DETAIL) :] for line in str(data["text"]).splitlines() if line.startswith(DETAIL))
+    return Diagnostic(
+        data["file"], data["line"], data["column"], data["message"], data["hint"] or "", data["severity"], detail
+    )
 
 
 def diagnostics_text(diagnostics: Iterable[Diagnostic], language: str) -> str:

@@ -45,6 +45,8 @@ def pulses(counter: str) -> str:
     """The key of a counter's pulses in a tick's event data (``C1_pulses``: python-statemachine gives the event
     data's keys as names to expressions, before the data model's, so ``C1`` there would hide the counter)."""
     return f"{counter}_pulses"
+
+
 _PLAIN = re.compile(r"[A-Za-z0-9]")
 _CODE = re.compile(r"_([0-9a-f]{1,6})_")
 
@@ -60,9 +62,14 @@ def state_of(ident: str, prefix: str = "") -> StateId | None:
     """The state an id names (:func:`state_id` read back), or None when it is no such id."""
     if not ident.startswith(prefix):
         return None
-    body = ident[len(prefix):]
-    if body[:1] == "s" and body[1:].isascii() and body[1:].isdigit() and len(body) <= 10 \
-            and (body == "s0" or body[1] != "0"):
+    body = ident[len(prefix) :]
+    if (
+        body[:1] == "s"
+        and body[1:].isascii()
+        and body[1:].isdigit()
+        and len(body) <= 10
+        and (body == "s0" or body[1] != "0")
+    ):
         return int(body[1:])
     if not body.startswith("n_") or len(body) == 2:
         return None

@@ -46,11 +46,21 @@ def table_text(table: Table) -> str:
         motors = [i for i, m in enumerate(robot.motors) if m in table.writes]
         lamps = [i for i, lamp in enumerate(robot.lamps) if lamp in table.writes]
         counters = [i for i, c in enumerate(robot.counter_names) if c in table.writes]
-        rows = [replace(r, motors=tuple(r.motors[i] for i in motors), lamps=tuple(r.lamps[i] for i in lamps),
-                        counters=tuple(r.counters[i] for i in counters)) for r in rows]
-        robot = replace(robot, motors=tuple(robot.motors[i] for i in motors),
-                        lamps=tuple(robot.lamps[i] for i in lamps),
-                        counters=tuple(robot.counters[i] for i in counters))
+        rows = [
+            replace(
+                r,
+                motors=tuple(r.motors[i] for i in motors),
+                lamps=tuple(r.lamps[i] for i in lamps),
+                counters=tuple(r.counters[i] for i in counters),
+            )
+            for r in rows
+        ]
+        robot = replace(
+            robot,
+            motors=tuple(robot.motors[i] for i in motors),
+            lamps=tuple(robot.lamps[i] for i in lamps),
+            counters=tuple(robot.counters[i] for i in counters),
+        )
     return format_table(replace(table, robot=robot, rows=tuple(rows)))
 
 
@@ -76,28 +86,42 @@ def read_statechart(path: Path, kind: str) -> tuple[Table, ...]:
 def _against(tables: tuple[Table, ...], robot: Robot) -> None:
     """Every name the statechart uses is the robot file's, or a located error on the robot file."""
     used = tables[0].robot
-    for section, names, known in (("inputs", used.inputs, robot.inputs), ("motors", used.motors, robot.motors),
-                                  ("lamps", used.lamps, robot.lamps),
-                                  ("counters", used.counter_names, robot.counter_names)):
+    for section, names, known in (
+        ("inputs", used.inputs, robot.inputs),
+        ("motors", used.motors, robot.motors),
+        ("lamps", used.lamps, robot.lamps),
+        ("counters", used.counter_names, robot.counter_names),
+    ):
         missing = [name for name in names if name not in known]
         if missing:
-            raise fail(robot.source, N_("[{section}] has no {names}, which the statechart uses", section=section,
-                                        names=tuple(missing)),
-                       N_('add {name} = "what it is" to [{section}], or import without --robot', name=missing[0],
-                          section=section), robot.line(section))
+            raise fail(
+                robot.source,
+                N_("[{section}] has no {names}, which the statechart uses", section=section, names=tuple(missing)),
+                N_(
+                    'add {name} = "what it is" to [{section}], or import without --robot',
+                    name=missing[0],
+                    section=section,
+                ),
+                robot.line(section),
+            )
 
 
 def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | None) -> tuple[str | None, list[str]]:
     """Read the statechart and write its tables: (the CSV text for standard output, or None when written to
     ``out``; the lines to say)."""
     if out is not None and out.resolve() == path.resolve():
-        raise fail("--out", N_("--out is {out}, the statechart being read", out=str(out)),
-                   N_("write the table to another file"))
+        raise fail(
+            "--out",
+            N_("--out is {out}, the statechart being read", out=str(out)),
+            N_("write the table to another file"),
+        )
     tables = read_statechart(path, kind)
     if robot is not None:
         _against(tables, robot)
-    said = [_("the robot file's [groups]: ") + "; ".join(f"{name} = {list(states)!r}".replace("'", '"')
-                                                        for name, states in groups(tables).items())]
+    said = [
+        _("the robot file's [groups]: ")
+        + "; ".join(f"{name} = {list(states)!r}".replace("'", '"') for name, states in groups(tables).items())
+    ]
     said = said if groups(tables) else []
     if len(tables) == 1:
         text = table_text(tables[0])
@@ -106,15 +130,24 @@ def import_statechart(path: Path, kind: str, out: Path | None, robot: Robot | No
         write_text(out, text)
         return None, [_("wrote {file} ({count} rows)").format(file=out, count=len(tables[0].rows)), *said]
     if out is None:
-        raise fail("--out", N_("{file} holds {count} tables", file=str(path), count=len(tables)),
-                   N_("give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv"))
+        raise fail(
+            "--out",
+            N_("{file} holds {count} tables", file=str(path), count=len(tables)),
+            N_("give --out FOLDER: the main table is written there as table.csv, each other as NAME.csv"),
+        )
     folder = out_folder(out, "--out")
     files = ["table.csv", *(f"{t.name}.csv" for t in tables[1:])]  # the main one where a folder's table is
     with file_set(folder):  # all the tables or none: a refused one (a table of yours, no --force) leaves none
-        lines = [_("wrote {file}").format(file=write_text(folder / name, table_text(t)))
-                 for name, t in zip(files, tables, strict=True)]
-    lines.append(_("the robot file's [tables]: ") + "; ".join(
-        f'{t.name} = {{ file = "{name}", initial_state = {t.robot.initial_state!r}, '
-        f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}'
-        for name, t in zip(files, tables, strict=True)).replace("'", '"'))
+        lines = [
+            _("wrote {file}").format(file=write_text(folder / name, table_text(t)))
+            for name, t in zip(files, tables, strict=True)
+        ]
+    lines.append(
+        _("the robot file's [tables]: ")
+        + "; ".join(
+            f'{t.name} = {{ file = "{name}", initial_state = {t.robot.initial_state!r}, '
+            f'initial_timer = {t.robot.initial_timer}, match = "{t.robot.match}" }}'
+            for name, t in zip(files, tables, strict=True)
+        ).replace("'", '"')
+    )
     return None, [*lines, *said]

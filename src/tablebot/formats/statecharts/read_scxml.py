@@ -44,8 +44,9 @@ def _attr(element: Element, name: str, path: str) -> str:
 def _int(element: Element, name: str, path: str) -> int:
     text = _attr(element, name, path)
     if not text.lstrip("-").isdigit() or len(text) > 9:
-        raise _error(element, path, N_("{name}={text!r} on <{tag}> is not a whole number", name=name, text=text,
-                                       tag=element.tag))
+        raise _error(
+            element, path, N_("{name}={text!r} on <{tag}> is not a whole number", name=name, text=text, tag=element.tag)
+        )
     return int(text)
 
 
@@ -61,13 +62,20 @@ def _found(root: Element, path: str) -> Found:
     if root.tag != "scxml":
         raise _error(root, path, N_("the document is <{tag}>, not <scxml>", tag=root.tag))
     data = _child(root, "datamodel", path).children
-    kinds = {kind: tuple(_attr(d, "id", path) for d in data if d.attrs.get("tb:kind") == kind)
-             for kind in ("motor", "lamp")}
-    counters = tuple(Counter(_attr(d, "id", path), _attr(d, "tb:motor", path))
-                     for d in data if d.attrs.get("tb:kind") == "counter")
-    found = Found(_attr(root, "tb:name", path), _int(root, "tb:tick-ms", path),
-                  tuple(d.attrs["tb:input"] for d in data if "tb:input" in d.attrs), kinds["motor"], kinds["lamp"],
-                  counters)
+    kinds = {
+        kind: tuple(_attr(d, "id", path) for d in data if d.attrs.get("tb:kind") == kind) for kind in ("motor", "lamp")
+    }
+    counters = tuple(
+        Counter(_attr(d, "id", path), _attr(d, "tb:motor", path)) for d in data if d.attrs.get("tb:kind") == "counter"
+    )
+    found = Found(
+        _attr(root, "tb:name", path),
+        _int(root, "tb:tick-ms", path),
+        tuple(d.attrs["tb:input"] for d in data if "tb:input" in d.attrs),
+        kinds["motor"],
+        kinds["lamp"],
+        counters,
+    )
     values = {d.attrs.get("id", ""): d for d in data}
     wrapper = next((c for c in root.children if c.attrs.get("id") == WRAPPER), None)
     if wrapper is None:
@@ -80,9 +88,14 @@ def _found(root: Element, path: str) -> Found:
         timer = values.get(f"{prefix}timer")
         if timer is None:
             raise _error(root, path, N_("the data model has no {prefix}timer", prefix=prefix))
-        table = FoundTable(name, tuple(_attr(holder, "tb:events", path).split()), _attr(holder, "tb:match", path),
-                           _state(holder, _attr(holder, "initial", path), prefix, path), _int(timer, "expr", path),
-                           tuple(holder.attrs.get("tb:writes", "").split()))
+        table = FoundTable(
+            name,
+            tuple(_attr(holder, "tb:events", path).split()),
+            _attr(holder, "tb:match", path),
+            _state(holder, _attr(holder, "initial", path), prefix, path),
+            _int(timer, "expr", path),
+            tuple(holder.attrs.get("tb:writes", "").split()),
+        )
         for state in holder.children:
             if state.tag == "state" and state is not holder:
                 table.rows.extend(_rows(state, table, prefix, found, path))
@@ -107,19 +120,26 @@ def _rows(element: Element, table: FoundTable, prefix: str, found: Found, path: 
         events = transition.attrs.get("tb:events", "").split()
         unknown = [e for e in events if e not in table.events]
         if unknown:
-            raise _error(transition, path, N_("tb:events names {name!r}, which is no event column of the table",
-                                                  name=unknown[0]))
+            raise _error(
+                transition, path, N_("tb:events names {name!r}, which is no event column of the table", name=unknown[0])
+            )
         values = {a.attrs.get("location", ""): a for a in transition.children if a.tag == "assign"}
         timer = values.get(f"{prefix}timer")
         if timer is None:
             raise _error(transition, path, N_("this row does not load {prefix}timer", prefix=prefix))
-        rows.append(FoundRow(
-            state=state, events=frozenset(events), timer=_int(timer, "expr", path),
-            outputs={name: _int(a, "expr", path) for name, a in values.items() if name in outputs},
-            next=_state(transition, _attr(transition, "target", path), prefix, path),
-            description=transition.attrs.get("tb:description", ""), written=_int(transition, "tb:row", path),
-            group=transition.attrs.get("tb:group", ""),
-            index=_int(transition, "tb:index", path) if "tb:index" in transition.attrs else 0))
+        rows.append(
+            FoundRow(
+                state=state,
+                events=frozenset(events),
+                timer=_int(timer, "expr", path),
+                outputs={name: _int(a, "expr", path) for name, a in values.items() if name in outputs},
+                next=_state(transition, _attr(transition, "target", path), prefix, path),
+                description=transition.attrs.get("tb:description", ""),
+                written=_int(transition, "tb:row", path),
+                group=transition.attrs.get("tb:group", ""),
+                index=_int(transition, "tb:index", path) if "tb:index" in transition.attrs else 0,
+            )
+        )
     return rows
 
 
@@ -132,11 +152,22 @@ def _same(read: Element, made: Element, path: str) -> None:
             want = made.attrs.get(name)
             said = f"{name}={read.attrs[name]!r}" if name in read.attrs else N_("no {name}", name=name)
             wrote = f"{name}={want!r}" if want is not None else N_("no {name}", name=name)
-            raise _error(read, path, N_("<{tag}> has {said}, where tablebot writes {wrote}", tag=read.tag, said=said,
-                                        wrote=wrote))
+            raise _error(
+                read,
+                path,
+                N_("<{tag}> has {said}, where tablebot writes {wrote}", tag=read.tag, said=said, wrote=wrote),
+            )
     for child, model in zip(read.children, made.children, strict=False):
         _same(child, model, path)
     if len(read.children) != len(made.children):
         extra = read.children[len(made.children)] if len(read.children) > len(made.children) else read
-        raise _error(extra, path, N_("<{tag}> holds {count} elements, where tablebot writes {made}", tag=read.tag,
-                                     count=len(read.children), made=len(made.children)))
+        raise _error(
+            extra,
+            path,
+            N_(
+                "<{tag}> holds {count} elements, where tablebot writes {made}",
+                tag=read.tag,
+                count=len(read.children),
+                made=len(made.children),
+            ),
+        )

@@ -81,12 +81,20 @@ def read_xstate(text: str, path: str) -> tuple[Table, ...]:
 def _found(root: _At) -> Found:
     meta = root["meta"]["tablebot"]
     if meta["format"].value != FORMAT:
-        raise meta["format"].error(N_("is {value!r}: this tablebot reads format {format}",
-                                            value=meta["format"].value, format=FORMAT))
-    counters = tuple(Counter(c["name"].of(str, N_("a name")), c["motor"].of(str, N_("a name")))
-                     for c in meta["counters"].list())
-    found = Found(root["id"].of(str, N_("a name")), meta["tickMs"].of(int, N_("a whole number")),
-                  meta["inputs"].names(), meta["motors"].names(), meta["lamps"].names(), counters)
+        raise meta["format"].error(
+            N_("is {value!r}: this tablebot reads format {format}", value=meta["format"].value, format=FORMAT)
+        )
+    counters = tuple(
+        Counter(c["name"].of(str, N_("a name")), c["motor"].of(str, N_("a name"))) for c in meta["counters"].list()
+    )
+    found = Found(
+        root["id"].of(str, N_("a name")),
+        meta["tickMs"].of(int, N_("a whole number")),
+        meta["inputs"].names(),
+        meta["motors"].names(),
+        meta["lamps"].names(),
+        counters,
+    )
     tables = meta["tables"].list()
     if not tables:
         raise meta["tables"].error(N_("names no table"))
@@ -95,9 +103,14 @@ def _found(root: _At) -> Found:
         name = entry["name"].of(str, N_("a name"))
         prefix = f"{name}_" if several else ""
         holder = root["states"][name] if several else root
-        table = FoundTable(name, entry["events"].names(), entry["match"].of(str, N_("a rule")),
-                           _state(holder["initial"], prefix), root["context"][f"{prefix}timer"].of(int, N_("a number")),
-                           entry["writes"].names())
+        table = FoundTable(
+            name,
+            entry["events"].names(),
+            entry["match"].of(str, N_("a rule")),
+            _state(holder["initial"], prefix),
+            root["context"][f"{prefix}timer"].of(int, N_("a number")),
+            entry["writes"].names(),
+        )
         for ident, state in holder["states"].items():
             source = _state(_At(ident, f"{state.path}", state.file), prefix)
             table.rows.extend(_row(t, source, table, prefix) for t in state["always"].list() if _is_row(t))
@@ -110,8 +123,9 @@ def _is_row(transition: _At) -> bool:
     guard = transition["guard"]
     kind = guard.get("type", None)
     if kind not in ("row", "idle"):
-        raise guard.error(N_("is {value}, not a row's guard (type row) or the idle one",
-                              value=json.dumps(guard.value)[:60]))
+        raise guard.error(
+            N_("is {value}, not a row's guard (type row) or the idle one", value=json.dumps(guard.value)[:60])
+        )
     return bool(kind == "row")
 
 
@@ -135,12 +149,17 @@ def _row(transition: _At, state: StateId, table: FoundTable, prefix: str) -> Fou
         raise params.error(N_("names {name!r}, which is no event column of the table", name=unknown[0]))
     fire = transition["actions"][0]["params"]
     meta = transition["meta"]
-    return FoundRow(state=state, events=frozenset(events),
-                    outputs={name: value.of(int, N_("a number")) for name, value in fire["set"].items()},
-                    timer=fire["load"].of(int, N_("a number")), next=_state(transition["target"], prefix),
-                    description=_optional(transition, "description", str, ""),
-                    written=meta["row"].of(int, N_("a number")),
-                    group=_optional(meta, "group", str, ""), index=_optional(meta, "index", int, 0))
+    return FoundRow(
+        state=state,
+        events=frozenset(events),
+        outputs={name: value.of(int, N_("a number")) for name, value in fire["set"].items()},
+        timer=fire["load"].of(int, N_("a number")),
+        next=_state(transition["target"], prefix),
+        description=_optional(transition, "description", str, ""),
+        written=meta["row"].of(int, N_("a number")),
+        group=_optional(meta, "group", str, ""),
+        index=_optional(meta, "index", int, 0),
+    )
 
 
 def _optional(at: _At, key: str, kind: type, default: Any) -> Any:
@@ -157,12 +176,25 @@ def _same(read: Any, made: Any, where: str, path: str, depth: int) -> None:
     if isinstance(made, dict) and isinstance(read, dict):
         for key in {**made, **read}:
             if key not in read or key not in made:
-                raise fail(path, N_("{where}: has no key {key!r}", where=where, key=key) if key not in read else
-                           N_("{where}: has a key {key!r} tablebot does not write", where=where, key=key), HINT)
+                raise fail(
+                    path,
+                    N_("{where}: has no key {key!r}", where=where, key=key)
+                    if key not in read
+                    else N_("{where}: has a key {key!r} tablebot does not write", where=where, key=key),
+                    HINT,
+                )
             _same(read[key], made[key], f"{where}.{key}", path, depth + 1)
     elif isinstance(made, list) and isinstance(read, list) and len(made) == len(read):
         for i, (got, want) in enumerate(zip(read, made, strict=True)):
             _same(got, want, f"{where}[{i}]", path, depth + 1)
     elif read != made or type(read) is not type(made):
-        raise fail(path, N_("{where}: is {value}, where tablebot writes {made}", where=where,
-                            value=json.dumps(read)[:80], made=json.dumps(made)[:80]), HINT)
+        raise fail(
+            path,
+            N_(
+                "{where}: is {value}, where tablebot writes {made}",
+                where=where,
+                value=json.dumps(read)[:80],
+                made=json.dumps(made)[:80],
+            ),
+            HINT,
+        )

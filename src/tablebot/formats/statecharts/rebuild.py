@@ -65,20 +65,35 @@ def build(found: Found, path: str, where: tuple[int | None, int | None] = (None,
         raise fail(path, N_("the statechart holds no table"), AS_EXPORTED, *where)
     for table in found.tables:
         if table.match not in MATCHES:
-            raise fail(path, N_("matching rule {match!r} is not one of {matches}", match=table.match,
-                                matches=tuple(MATCHES)), AS_EXPORTED, *where)
-    robot = Robot(name=found.name, inputs=found.inputs, motors=found.motors, lamps=found.lamps,
-                  counters=found.counters, tick_ms=found.tick_ms, source=path)
+            raise fail(
+                path,
+                N_("matching rule {match!r} is not one of {matches}", match=table.match, matches=tuple(MATCHES)),
+                AS_EXPORTED,
+                *where,
+            )
+    robot = Robot(
+        name=found.name,
+        inputs=found.inputs,
+        motors=found.motors,
+        lamps=found.lamps,
+        counters=found.counters,
+        tick_ms=found.tick_ms,
+        source=path,
+    )
     if len(found.tables) == 1:
         only = found.tables[0]
-        robot = replace(robot, initial_state=only.initial_state, initial_timer=only.initial_timer,
-                        match=_match(only.match))
+        robot = replace(
+            robot, initial_state=only.initial_state, initial_timer=only.initial_timer, match=_match(only.match)
+        )
         return (_table(robot, only, path, ""),)
-    specs = tuple(TableSpec(t.name, f"{t.name}.csv", t.initial_state, t.initial_timer, _match(t.match))
-                  for t in found.tables)
+    specs = tuple(
+        TableSpec(t.name, f"{t.name}.csv", t.initial_state, t.initial_timer, _match(t.match)) for t in found.tables
+    )
     robot = replace(robot, sections={"tables": specs})
-    return tuple(_table(spec_robot(robot, spec), table, path, table.name) for spec, table in zip(
-        specs, found.tables, strict=True))
+    return tuple(
+        _table(spec_robot(robot, spec), table, path, table.name)
+        for spec, table in zip(specs, found.tables, strict=True)
+    )
 
 
 def _match(text: str) -> Match:
@@ -87,12 +102,23 @@ def _match(text: str) -> Match:
 
 def _table(robot: Robot, found: FoundTable, path: str, name: str) -> Table:
     grouped = any(row.group for row in found.rows)  # then every row keeps its index as written (expand_groups)
-    rows = tuple(Row(index=i, line=row.written + 2, description=row.description, state=row.state,
-                     events=row.events, motors=tuple(row.outputs.get(m) for m in robot.motors), timer=row.timer,
-                     next=row.next, counters=tuple(row.outputs.get(c) for c in robot.counter_names),
-                     lamps=tuple(row.outputs.get(lamp) for lamp in robot.lamps), group=row.group,
-                     written=row.written if grouped else None)
-                 for i, row in enumerate(sorted(found.rows, key=lambda r: (r.written, r.index))))
+    rows = tuple(
+        Row(
+            index=i,
+            line=row.written + 2,
+            description=row.description,
+            state=row.state,
+            events=row.events,
+            motors=tuple(row.outputs.get(m) for m in robot.motors),
+            timer=row.timer,
+            next=row.next,
+            counters=tuple(row.outputs.get(c) for c in robot.counter_names),
+            lamps=tuple(row.outputs.get(lamp) for lamp in robot.lamps),
+            group=row.group,
+            written=row.written if grouped else None,
+        )
+        for i, row in enumerate(sorted(found.rows, key=lambda r: (r.written, r.index)))
+    )
     cross = {}
     for event in found.events:
         parsed = parse_cross(event, robot) if name else None

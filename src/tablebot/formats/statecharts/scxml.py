@@ -20,8 +20,10 @@ from tablebot.table import Row, Table
 
 __all__ = ["export_scxml", "scxml_tree"]
 
-COMMENT = ("written by tablebot (export, to scxml): send one event, tick, per tick with each input (0 or 1) and "
-           "the pulses of each counter (C1_pulses) as its data; the timers live in the data model")
+COMMENT = (
+    "written by tablebot (export, to scxml): send one event, tick, per tick with each input (0 or 1) and "
+    "the pulses of each counter (C1_pulses) as its data; the timers live in the data model"
+)
 
 
 def export_scxml(tables: Sequence[Table]) -> str:
@@ -32,16 +34,28 @@ def export_scxml(tables: Sequence[Table]) -> str:
 def scxml_tree(chart: Chart) -> Element:
     main = chart.main
     robot = main.robot
-    root = Element("scxml", {"version": "1.0", "datamodel": "ecmascript", "name": identifier(robot.name),
-                             "initial": WRAPPER, "tb:name": robot.name, "tb:tick-ms": str(robot.tick_ms)})
+    root = Element(
+        "scxml",
+        {
+            "version": "1.0",
+            "datamodel": "ecmascript",
+            "name": identifier(robot.name),
+            "initial": WRAPPER,
+            "tb:name": robot.name,
+            "tb:tick-ms": str(robot.tick_ms),
+        },
+    )
     _datamodel(root.add("datamodel"), chart)
     wrapper = root.add("parallel" if chart.several else "state", id=WRAPPER)
     if not chart.several:
         wrapper.attrs["initial"] = chart.parts[0].state(main.robot.initial_state)
     _tick(wrapper.add("transition", event=TICK), chart)
     for part in chart.parts:
-        holder = wrapper if not chart.several else wrapper.add(
-            "state", id=part.region, initial=part.state(part.table.robot.initial_state))
+        holder = (
+            wrapper
+            if not chart.several
+            else wrapper.add("state", id=part.region, initial=part.state(part.table.robot.initial_state))
+        )
         holder.attrs.update({"tb:events": " ".join(part.table.events), "tb:match": part.table.robot.match})
         if chart.several:
             holder.attrs["tb:writes"] = " ".join(part.table.writes)
@@ -125,13 +139,21 @@ def guard(part: Part, row: Row, chart: Chart) -> str:
 
 def _row(state: Element, part: Part, row: Row, chart: Chart) -> None:
     robot = part.table.robot
-    transition = state.add("transition", cond=guard(part, row, chart), target=part.state(row.next),
-                           tb_row=str(row.as_written), tb_description=row.description,
-                           tb_events=" ".join(e for e in part.table.events if e in row.events))
+    transition = state.add(
+        "transition",
+        cond=guard(part, row, chart),
+        target=part.state(row.next),
+        tb_row=str(row.as_written),
+        tb_description=row.description,
+        tb_events=" ".join(e for e in part.table.events if e in row.events),
+    )
     if row.group:  # one row as written for each state of a group: its group, and where in the table it runs
         transition.attrs.update({"tb:group": row.group, "tb:index": str(row.index)})
-    outputs = [*zip(robot.motors, row.motors, strict=True), *zip(robot.lamps, row.lamps, strict=True),
-               *zip(robot.counter_names, row.counters, strict=True)]
+    outputs = [
+        *zip(robot.motors, row.motors, strict=True),
+        *zip(robot.lamps, row.lamps, strict=True),
+        *zip(robot.counter_names, row.counters, strict=True),
+    ]
     for name, value in outputs:
         if value is not None:
             _assign(transition, name, str(value))

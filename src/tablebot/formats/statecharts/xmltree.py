@@ -79,8 +79,12 @@ def parse(text: str, path: str) -> Element:
         if len(stack) >= MAX_DEPTH:
             refuse(N_("elements nested more than {most} deep", most=MAX_DEPTH), N_("tablebot's export nests five deep"))
         line, column = where()
-        element = Element(_name(name, path, line, column), {_name(k, path, line, column): v for k, v in attrs.items()},
-                          line=line, column=column)
+        element = Element(
+            _name(name, path, line, column),
+            {_name(k, path, line, column): v for k, v in attrs.items()},
+            line=line,
+            column=column,
+        )
         (stack[-1].children if stack else done).append(element)
         stack.append(element)
 
@@ -92,8 +96,13 @@ def parse(text: str, path: str) -> Element:
         line, column = where()  # expat is past the DOCTYPE's name: point at its start
         before = text.splitlines()[line - 1][:column] if line <= len(text.splitlines()) else ""
         start = before.rfind("<!DOCTYPE")
-        raise fail(path, N_("a DOCTYPE (a DTD can declare entities, and a table is data)"),
-                   N_("remove the <!DOCTYPE ...>"), line, start + 1 if start >= 0 else column)
+        raise fail(
+            path,
+            N_("a DOCTYPE (a DTD can declare entities, and a table is data)"),
+            N_("remove the <!DOCTYPE ...>"),
+            line,
+            start + 1 if start >= 0 else column,
+        )
 
     parser.StartElementHandler = start
     parser.EndElementHandler = lambda name: stack.pop()
@@ -103,8 +112,13 @@ def parse(text: str, path: str) -> Element:
     try:
         parser.Parse(text, True)
     except expat.ExpatError as exc:
-        raise fail(path, N_("not well-formed XML: {error}", error=expat.ErrorString(exc.code)),
-                   N_("an SCXML file as tablebot export --to scxml writes it"), exc.lineno, exc.offset + 1) from None
+        raise fail(
+            path,
+            N_("not well-formed XML: {error}", error=expat.ErrorString(exc.code)),
+            N_("an SCXML file as tablebot export --to scxml writes it"),
+            exc.lineno,
+            exc.offset + 1,
+        ) from None
     return done[0]
 
 
@@ -115,6 +129,11 @@ def _name(name: str, path: str, line: int, column: int) -> str:
     if not space:
         return local
     if space not in PREFIXES:
-        raise fail(path, N_("{name!r} is in the namespace {space!r}", name=local, space=space),
-                   N_("tablebot reads SCXML and its own attributes"), line, column)
+        raise fail(
+            path,
+            N_("{name!r} is in the namespace {space!r}", name=local, space=space),
+            N_("tablebot reads SCXML and its own attributes"),
+            line,
+            column,
+        )
     return PREFIXES[space] + local

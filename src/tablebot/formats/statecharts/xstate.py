@@ -44,17 +44,37 @@ def xstate_config(chart: Chart) -> dict[str, Any]:
     for counter in robot.counter_names:
         context.update({counter: 0, f"has_{counter}": False})
     for part in chart.parts:
-        context.update({part.timer: part.table.robot.initial_timer, f"{part.prefix}has_T": False,
-                        part.pending: 0, part.row: -1})
-    tick = {"type": "tick", "params": {
-        "inputs": list(chart.inputs), "started": STARTED,
-        "counters": [{"name": c, "pulses": pulses(c)} for c in robot.counter_names],
-        "tables": [{"timer": p.timer, "flag": f"{p.prefix}has_T", "pending": p.pending} for p in chart.parts]}}
-    meta = {"tablebot": {
-        "format": FORMAT, "tickMs": robot.tick_ms, "inputs": list(chart.inputs), "motors": list(robot.motors),
-        "lamps": list(robot.lamps), "counters": [{"name": c.name, "motor": c.motor} for c in robot.counters],
-        "tables": [{"name": p.table.name, "events": list(p.table.events), "match": p.table.robot.match,
-                    "writes": list(p.table.writes) if chart.several else []} for p in chart.parts]}}
+        context.update(
+            {part.timer: part.table.robot.initial_timer, f"{part.prefix}has_T": False, part.pending: 0, part.row: -1}
+        )
+    tick = {
+        "type": "tick",
+        "params": {
+            "inputs": list(chart.inputs),
+            "started": STARTED,
+            "counters": [{"name": c, "pulses": pulses(c)} for c in robot.counter_names],
+            "tables": [{"timer": p.timer, "flag": f"{p.prefix}has_T", "pending": p.pending} for p in chart.parts],
+        },
+    }
+    meta = {
+        "tablebot": {
+            "format": FORMAT,
+            "tickMs": robot.tick_ms,
+            "inputs": list(chart.inputs),
+            "motors": list(robot.motors),
+            "lamps": list(robot.lamps),
+            "counters": [{"name": c.name, "motor": c.motor} for c in robot.counters],
+            "tables": [
+                {
+                    "name": p.table.name,
+                    "events": list(p.table.events),
+                    "match": p.table.robot.match,
+                    "writes": list(p.table.writes) if chart.several else [],
+                }
+                for p in chart.parts
+            ],
+        }
+    }
     config: dict[str, Any] = {"id": robot.name, "context": context, "meta": meta, "on": {TICK: {"actions": [tick]}}}
     if chart.several:
         config["type"] = "parallel"
@@ -65,10 +85,14 @@ def xstate_config(chart: Chart) -> dict[str, Any]:
 
 
 def _region(part: Part, chart: Chart) -> dict[str, Any]:
-    idle = {"guard": {"type": "idle", "params": {"pending": part.pending}},
-            "actions": [{"type": "idle", "params": {"pending": part.pending, "row": part.row}}]}
-    states = {part.state(state): {"always": [*(_row(part, row, chart) for row in rows), idle]}
-              for state, rows in part.states_rows()}
+    idle = {
+        "guard": {"type": "idle", "params": {"pending": part.pending}},
+        "actions": [{"type": "idle", "params": {"pending": part.pending, "row": part.row}}],
+    }
+    states = {
+        part.state(state): {"always": [*(_row(part, row, chart) for row in rows), idle]}
+        for state, rows in part.states_rows()
+    }
     return {"initial": part.state(part.table.robot.initial_state), "states": states}
 
 
@@ -82,18 +106,36 @@ def _row(part: Part, row: Row, chart: Chart) -> dict[str, Any]:
     required = [e for e in table.events if e in row.events]
     some = None
     if part.needs_some(row):
-        some = {"flags": [f for e in table.events if (f := part.flag(e))],
-                "cross": [_cross(part, e, chart) for e in table.events if e in table.cross]}
-    params = {"pending": part.pending, "flags": [f for e in required if (f := part.flag(e))],
-              "cross": [_cross(part, e, chart) for e in required if e in table.cross], "some": some}
-    outputs = [*zip(robot.motors, row.motors, strict=True), *zip(robot.lamps, row.lamps, strict=True),
-               *zip(robot.counter_names, row.counters, strict=True)]
-    fire = {"set": {name: value for name, value in outputs if value is not None},
-            "timer": part.timer, "load": row.timer, "row": part.row, "index": row.as_written,
-            "pending": part.pending}
-    transition: dict[str, Any] = {"guard": {"type": "row", "params": params}, "target": part.state(row.next),
-                                  "actions": [{"type": "fire", "params": fire}], "description": row.description,
-                                  "meta": {"row": row.as_written}}
+        some = {
+            "flags": [f for e in table.events if (f := part.flag(e))],
+            "cross": [_cross(part, e, chart) for e in table.events if e in table.cross],
+        }
+    params = {
+        "pending": part.pending,
+        "flags": [f for e in required if (f := part.flag(e))],
+        "cross": [_cross(part, e, chart) for e in required if e in table.cross],
+        "some": some,
+    }
+    outputs = [
+        *zip(robot.motors, row.motors, strict=True),
+        *zip(robot.lamps, row.lamps, strict=True),
+        *zip(robot.counter_names, row.counters, strict=True),
+    ]
+    fire = {
+        "set": {name: value for name, value in outputs if value is not None},
+        "timer": part.timer,
+        "load": row.timer,
+        "row": part.row,
+        "index": row.as_written,
+        "pending": part.pending,
+    }
+    transition: dict[str, Any] = {
+        "guard": {"type": "row", "params": params},
+        "target": part.state(row.next),
+        "actions": [{"type": "fire", "params": fire}],
+        "description": row.description,
+        "meta": {"row": row.as_written},
+    }
     if row.group:  # one row as written for each state of a group: its group, and where in the table it runs
         transition["meta"].update({"group": row.group, "index": row.index})
     return transition

@@ -17,10 +17,14 @@ if TYPE_CHECKING:
 
 ADDRESSES = ("roboif://auto", N_("roboif:///dev/ttyUSB0 (its serial port)"), "roboif://COM1")
 ADDRESS_HINT = N_("write --on roboif://auto, roboif:///dev/ttyUSB0 or roboif://COM1 (the interface's serial port)")
-CONNECT_HINT = N_("is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
-                  "serial port only, not on its USB port (docs/controllers.md)")
-FASTER = N_("a ROBO TX or a TXT on its USB cable: the interface's serial port runs at 38400 baud only, and tablebot "
-            "does not drive its USB port")
+CONNECT_HINT = N_(
+    "is the ROBO Interface on and its serial port connected (38400 baud)? tablebot drives it on its "
+    "serial port only, not on its USB port (docs/controllers.md)"
+)
+FASTER = N_(
+    "a ROBO TX or a TXT on its USB cable: the interface's serial port runs at 38400 baud only, and tablebot "
+    "does not drive its USB port"
+)
 
 
 def read_section(src: Source, data: Any, robot: Robot) -> Any:
@@ -57,15 +61,34 @@ def open_roboif(machine: Machine, link: LinkOptions) -> Opened:
         bot.connect()
     except LinkLost as exc:
         raise fail("--on", exc.args[0], CONNECT_HINT) from None
-    line = N_("its {count} bytes alone take {ms:.1f} ms on the {baud}-baud line",
-              count=wire.REQUEST_BYTES + wire.REPLY_BYTES, ms=1000 * wire.EXCHANGE_LINE_S, baud=wire.BAUD)
-    warnings = check_link(bot, machine, link, lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
-                          N_("one exchange with the ROBO Interface"), line=line, faster=FASTER,
-                          connect_hint=CONNECT_HINT)
+    line = N_(
+        "its {count} bytes alone take {ms:.1f} ms on the {baud}-baud line",
+        count=wire.REQUEST_BYTES + wire.REPLY_BYTES,
+        ms=1000 * wire.EXCHANGE_LINE_S,
+        baud=wire.BAUD,
+    )
+    warnings = check_link(
+        bot,
+        machine,
+        link,
+        lambda: bot.link.exchange(*OFF, bot.link.setup_timeout_s),
+        N_("one exchange with the ROBO Interface"),
+        line=line,
+        faster=FASTER,
+        connect_hint=CONNECT_HINT,
+    )
     return Opened(bot, bot.target, "ROBO Interface (serial, 38400 baud)", warnings)
 
 
-ROBOIF = register(LiveBackend(
-    name="roboif", makes="a ROBO Interface driven live over its serial port by `tablebot run`",
-    help="roboif://DEVICE (a ROBO Interface on its serial port), roboif://auto", fit=fit,
-    section="roboif", read_section=read_section, open=open_roboif, addresses=ADDRESSES))
+ROBOIF = register(
+    LiveBackend(
+        name="roboif",
+        makes="a ROBO Interface driven live over its serial port by `tablebot run`",
+        help="roboif://DEVICE (a ROBO Interface on its serial port), roboif://auto",
+        fit=fit,
+        section="roboif",
+        read_section=read_section,
+        open=open_roboif,
+        addresses=ADDRESSES,
+    )
+)

@@ -65,9 +65,15 @@ class RoboifLink:
         reply = self.port.read(wire.HELLO_REPLY_BYTES, deadline, N_("the answer to the greeting"))
         if reply[0] != wire.HELLO_OK:
             self._trusted = False
-            raise LinkLost(N_("wrong answer from {device}: {reply} to the greeting (a ROBO Interface answers "
-                              "0x{ok:02x} first): is this a ROBO Interface?", device=self.device,
-                              reply=reply.hex(" "), ok=wire.HELLO_OK))
+            raise LinkLost(
+                N_(
+                    "wrong answer from {device}: {reply} to the greeting (a ROBO Interface answers "
+                    "0x{ok:02x} first): is this a ROBO Interface?",
+                    device=self.device,
+                    reply=reply.hex(" "),
+                    ok=wire.HELLO_OK,
+                )
+            )
         self.online = True
         self._expect_quiet(N_("after the greeting's answer"), settle_s=0.005)
         return reply
@@ -83,8 +89,11 @@ class RoboifLink:
         self._expect_quiet(N_("before a request was sent"))
         self._owed += wire.REPLY_BYTES
         self.port.write(wire.exchange(directions, list(pwm)), deadline)
-        data = self.port.read(wire.REPLY_BYTES, deadline, N_("the {size}-byte reply within {ms:.0f} ms",
-                                                              size=wire.REPLY_BYTES, ms=1000 * timeout_s))
+        data = self.port.read(
+            wire.REPLY_BYTES,
+            deadline,
+            N_("the {size}-byte reply within {ms:.0f} ms", size=wire.REPLY_BYTES, ms=1000 * timeout_s),
+        )
         self._owed -= wire.REPLY_BYTES
         self._expect_quiet(N_("beyond the {size}-byte reply", size=wire.REPLY_BYTES))
         return wire.decode(data)
@@ -111,9 +120,16 @@ class RoboifLink:
         extra = self.port.pending()
         if extra:
             self._trusted = False
-            raise LinkLost(N_("garbage from {device}: {count} unexpected bytes {when} ({first}{more})",
-                              device=self.device, count=len(extra), when=when, first=extra[:8].hex(" "),
-                              more=" ..." if len(extra) > 8 else ""))
+            raise LinkLost(
+                N_(
+                    "garbage from {device}: {count} unexpected bytes {when} ({first}{more})",
+                    device=self.device,
+                    count=len(extra),
+                    when=when,
+                    first=extra[:8].hex(" "),
+                    more=" ..." if len(extra) > 8 else "",
+                )
+            )
 
     def _discard_owed(self, deadline: float) -> None:
         while self._owed > 0:

@@ -57,12 +57,21 @@ def exchange(directions: int, pwm: list[int] | tuple[int, ...]) -> bytes:
 
 def decode(data: bytes) -> Inputs:
     if len(data) != REPLY_BYTES:
-        raise WireError(N_("a reply of {value} bytes (expected {REPLY_BYTES})",
-                           value=len(data), REPLY_BYTES=REPLY_BYTES))
+        raise WireError(
+            N_("a reply of {value} bytes (expected {REPLY_BYTES})", value=len(data), REPLY_BYTES=REPLY_BYTES)
+        )
 
     def ten(low: int, high_byte: int, shift: int) -> int:
         return data[low] | ((data[high_byte] >> shift) & 0x3) << 8
 
-    analog = {"AX": ten(4, 8, 0), "AY": ten(5, 8, 2), "A1": ten(6, 8, 4), "A2": ten(7, 8, 6),
-              "AZ": ten(9, 13, 0), "D1": ten(10, 13, 2), "D2": ten(11, 13, 4), "AV": ten(12, 13, 6)}
+    analog = {
+        "AX": ten(4, 8, 0),
+        "AY": ten(5, 8, 2),
+        "A1": ten(6, 8, 4),
+        "A2": ten(7, 8, 6),
+        "AZ": ten(9, 13, 0),
+        "D1": ten(10, 13, 2),
+        "D2": ten(11, 13, 4),
+        "AV": ten(12, 13, 6),
+    }
     return Inputs(digital=data[0], analog=analog, ir=data[14], modules=data[15])

@@ -23,13 +23,20 @@ if TYPE_CHECKING:
 
 INPUTS = tuple(f"I{i + 1}" for i in range(wire.N_INPUTS))
 TERMINALS = wiring.Terminals(
-    section="roboif", controller="ROBO Interface", digital_inputs=INPUTS,
-    analog={"resistance": wiring.Analog("raw 0..1023", 1023, ("AX", "AY")),
-            "voltage": wiring.Analog("raw 0..1023", 1023, ("A1", "A2")),
-            "distance": wiring.Analog("raw 0..1023", 1023, ("D1", "D2"))},
-    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
-    counters=(), min_tick_ms=10, tick_reason=N_("libroboint exchanges every 10 ms, and at 38400 baud one exchange "
-                                                 "already takes 9.9 ms on the wire"))
+    section="roboif",
+    controller="ROBO Interface",
+    digital_inputs=INPUTS,
+    analog={
+        "resistance": wiring.Analog("raw 0..1023", 1023, ("AX", "AY")),
+        "voltage": wiring.Analog("raw 0..1023", 1023, ("A1", "A2")),
+        "distance": wiring.Analog("raw 0..1023", 1023, ("D1", "D2")),
+    },
+    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)),
+    lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
+    counters=(),
+    min_tick_ms=10,
+    tick_reason=N_("libroboint exchanges every 10 ms, and at 38400 baud one exchange already takes 9.9 ms on the wire"),
+)
 
 
 def read_robot_roboif(src: Source, section: Any, robot: Robot) -> wiring.Section:

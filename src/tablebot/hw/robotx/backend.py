@@ -16,10 +16,13 @@ if TYPE_CHECKING:
     from tablebot.machine import Machine
 
 ADDRESSES = ("robotx://auto", "robotx:///dev/ttyACM0 (USB)", "robotx:///dev/rfcomm0 (Bluetooth)", "robotx://COM3")
-ADDRESS_HINT = N_("write --on robotx://auto, robotx:///dev/ttyACM0 (USB), robotx:///dev/rfcomm0 (Bluetooth) or "
-                  "robotx://COM3")
-CONNECT_HINT = N_("is the ROBO TX on and connected? Over USB it is a serial port /dev/ttyACM* (USB id 221d:1000); "
-                  "over Bluetooth pair it and bind an rfcomm device first (docs/controllers.md)")
+ADDRESS_HINT = N_(
+    "write --on robotx://auto, robotx:///dev/ttyACM0 (USB), robotx:///dev/rfcomm0 (Bluetooth) or robotx://COM3"
+)
+CONNECT_HINT = N_(
+    "is the ROBO TX on and connected? Over USB it is a serial port /dev/ttyACM* (USB id 221d:1000); "
+    "over Bluetooth pair it and bind an rfcomm device first (docs/controllers.md)"
+)
 FASTER = N_("the ROBO TX on its USB cable, robotx:///dev/ttyACM0, rather than Bluetooth")
 
 
@@ -50,20 +53,36 @@ def open_robotx(machine: Machine, link: LinkOptions) -> Opened:
     if device is None:
         found = find()
         if found is None:
-            raise fail("--on", N_("robotx://auto found no serial port that answers as a ROBO TX Controller"),
-                       CONNECT_HINT)
+            raise fail(
+                "--on", N_("robotx://auto found no serial port that answers as a ROBO TX Controller"), CONNECT_HINT
+            )
         device = found[0]
     bot = RobotxRobot(wiring, device, link_timeout_s=link.timeout_s(machine.table.robot.tick_s))
     try:
         info = bot.connect()
     except LinkLost as exc:
         raise fail("--on", exc.args[0], CONNECT_HINT) from None
-    warnings = check_link(bot, machine, link, lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
-                          N_("one exchange with the ROBO TX"), faster=FASTER, connect_hint=CONNECT_HINT)
+    warnings = check_link(
+        bot,
+        machine,
+        link,
+        lambda: bot.link.exchange(ZERO, bot.link.setup_timeout_s),
+        N_("one exchange with the ROBO TX"),
+        faster=FASTER,
+        connect_hint=CONNECT_HINT,
+    )
     return Opened(bot, bot.target, f"{info.device} {info.version_text}", warnings)
 
 
-ROBOTX = register(LiveBackend(
-    name="robotx", makes="a ROBO TX Controller driven live over fish.X1 by `tablebot run`",
-    help="robotx://DEVICE (a ROBO TX on its USB or Bluetooth serial port), robotx://auto", fit=fit,
-    section="robotx", read_section=read_section, open=open_robotx, addresses=ADDRESSES))
+ROBOTX = register(
+    LiveBackend(
+        name="robotx",
+        makes="a ROBO TX Controller driven live over fish.X1 by `tablebot run`",
+        help="robotx://DEVICE (a ROBO TX on its USB or Bluetooth serial port), robotx://auto",
+        fit=fit,
+        section="robotx",
+        read_section=read_section,
+        open=open_robotx,
+        addresses=ADDRESSES,
+    )
+)

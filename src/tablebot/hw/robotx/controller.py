@@ -70,5 +70,8 @@ class RobotxRobot(ExchangeRobot):
 
     def _reading_of(self, reply: wire.Inputs) -> Reading:
         previous = self._previous_mask()
-        return Reading(self.wiring.mask(reply, previous), self._pulses(reply.counter_values, self.wiring.counters),
-                       self.wiring.raw(reply) or None)
+        return Reading(
+            self.wiring.mask(reply, previous),
+            self._pulses(reply.counter_values, self.wiring.counters),
+            self.wiring.raw(reply) or None,
+        )

@@ -76,8 +76,9 @@ class RobotxLink:
     def exchange(self, duty: Sequence[int], timeout_s: float | None = None) -> wire.Inputs:
         """Send O1..O8's duty, get the inputs back (within ``timeout_s``; default: the reply timeout of a run)."""
         self.online = True
-        reply = self._request(Command.EXCHANGE, ((wire.TA_LOCAL, wire.output(list(duty))),),
-                              timeout_s or self.reply_timeout_s)
+        reply = self._request(
+            Command.EXCHANGE, ((wire.TA_LOCAL, wire.output(list(duty))),), timeout_s or self.reply_timeout_s
+        )
         return wire.decode_inputs(self._area(reply, Command.EXCHANGE, wire.INPUT_BYTES))
 
     def send_best_effort(self, duty: Sequence[int], timeout_s: float) -> bool:
@@ -102,11 +103,16 @@ class RobotxLink:
         self.tid = self.tid % 0xFFFF + 1  # 1..65535
         return wire.encode(Frame(command, self.tid, self.sid or 0, areas))
 
-    def _request(self, command: Command, areas: tuple[tuple[int, bytes], ...], timeout_s: float,
-                 first: bool = False) -> Frame:
+    def _request(
+        self, command: Command, areas: tuple[tuple[int, bytes], ...], timeout_s: float, first: bool = False
+    ) -> Frame:
         if not self._trusted:
-            raise LinkLost(N_("{device} sent a malformed or wrong reply earlier: its replies cannot be trusted",
-                              device=self.device))
+            raise LinkLost(
+                N_(
+                    "{device} sent a malformed or wrong reply earlier: its replies cannot be trusted",
+                    device=self.device,
+                )
+            )
         deadline = time.monotonic() + timeout_s
         self.port.write(b"", deadline)  # the rest of a request a signal cut short (its reply is owed)
         self._discard_owed(deadline)
@@ -126,13 +132,20 @@ class RobotxLink:
     def _check(self, reply: Frame, command: Command) -> None:
         problem = ""
         if reply.command != command.reply:
-            problem = N_("reply code {code} to {name} (expected {expected})", code=reply.command, name=command.name,
-                         expected=command.reply)
+            problem = N_(
+                "reply code {code} to {name} (expected {expected})",
+                code=reply.command,
+                name=command.name,
+                expected=command.reply,
+            )
         elif reply.tid != self.tid:
             problem = N_("the reply to transaction {got} where {sent} was sent", got=reply.tid, sent=self.tid)
         elif self.sid is not None and reply.sid != self.sid:
-            problem = N_("session {got} where it was {was}: the controller started a new session (it ended the "
-                         "online link)", got=reply.sid, was=self.sid)
+            problem = N_(
+                "session {got} where it was {was}: the controller started a new session (it ended the online link)",
+                got=reply.sid,
+                was=self.sid,
+            )
         if problem:
             self._trusted = False
             raise LinkLost(N_("wrong answer from {device}: {problem}", device=self.device, problem=problem))
@@ -144,8 +157,15 @@ class RobotxLink:
         if data is None or len(data) != size:
             self._trusted = False
             got = N_("no data for the controller") if data is None else N_("{count} bytes", count=len(data))
-            raise LinkLost(N_("wrong answer from {device}: {got} in the reply to {name} (expected {size} bytes)",
-                              device=self.device, got=got, name=command.name, size=size))
+            raise LinkLost(
+                N_(
+                    "wrong answer from {device}: {got} in the reply to {name} (expected {size} bytes)",
+                    device=self.device,
+                    got=got,
+                    name=command.name,
+                    size=size,
+                )
+            )
         return data
 
     def _read_frame(self, deadline: float, what: str, skip_junk: bool = False) -> Frame:
@@ -161,8 +181,9 @@ class RobotxLink:
             if previous == wire.STX and byte == wire.MARK:
                 return bytes((wire.STX, wire.MARK)) + self.port.read(2, deadline, what)
             previous = byte
-        raise wire.WireError(N_("{MAX_JUNK} bytes without a fish.X1 frame: is this a ROBO TX Controller?",
-                                MAX_JUNK=MAX_JUNK))
+        raise wire.WireError(
+            N_("{MAX_JUNK} bytes without a fish.X1 frame: is this a ROBO TX Controller?", MAX_JUNK=MAX_JUNK)
+        )
 
     def _discard_owed(self, deadline: float) -> None:
         """Read and drop the replies still owed (each frame found by its start, whatever came before)."""

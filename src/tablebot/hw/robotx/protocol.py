@@ -139,11 +139,17 @@ def encode(frame: Frame) -> bytes:
 def frame_length(start: bytes) -> int:
     """The whole frame's size from its first four bytes (STX, 0x55, length); WireError if they are not that."""
     if len(start) < 4 or start[0] != STX or start[1] != MARK:
-        raise WireError(N_("not the start of a fish.X1 frame: {value}", value=start[:4].hex(' ')))
+        raise WireError(N_("not the start of a fish.X1 frame: {value}", value=start[:4].hex(" ")))
     length = int.from_bytes(start[2:4], "big")
     if not HEADER_BYTES <= length <= MAX_LENGTH:
-        raise WireError(N_("a frame length of {length} bytes (a fish.X1 frame has {HEADER_BYTES}..{MAX_LENGTH})",
-                           length=length, HEADER_BYTES=HEADER_BYTES, MAX_LENGTH=MAX_LENGTH))
+        raise WireError(
+            N_(
+                "a frame length of {length} bytes (a fish.X1 frame has {HEADER_BYTES}..{MAX_LENGTH})",
+                length=length,
+                HEADER_BYTES=HEADER_BYTES,
+                MAX_LENGTH=MAX_LENGTH,
+            )
+        )
     return 2 + 2 + length + 3
 
 
@@ -159,7 +165,7 @@ def decode(data: bytes) -> Frame:
     if got != expected:
         raise WireError(N_("checksum 0x{got:04x} where the bytes give 0x{expected:04x}", got=got, expected=expected))
     src, dst, tid, sid, command, count = _HEAD.unpack_from(data, 4)
-    payload = data[4 + _HEAD.size:-3]
+    payload = data[4 + _HEAD.size : -3]
     return Frame(command, tid, sid, _areas(payload, count), src, dst)
 
 
@@ -171,8 +177,9 @@ def _areas(payload: bytes, count: int) -> tuple[tuple[int, bytes], ...]:
     if count > 9 or len(payload) % count or len(payload) // count < _TA_ID.size:
         raise WireError(N_("{value} bytes of data cannot be {count} transfer areas", value=len(payload), count=count))
     each = len(payload) // count
-    return tuple((_TA_ID.unpack_from(payload, i * each)[0], payload[i * each + 4:(i + 1) * each])
-                 for i in range(count))
+    return tuple(
+        (_TA_ID.unpack_from(payload, i * each)[0], payload[i * each + 4 : (i + 1) * each]) for i in range(count)
+    )
 
 
 # --- payloads -----------------------------------------------------------------------------------------
@@ -193,8 +200,9 @@ def config(cfg: Config) -> bytes:
 
 def decode_inputs(data: bytes) -> Inputs:
     if len(data) != INPUT_BYTES:
-        raise WireError(N_("TA_INPUT of {value} bytes (expected {INPUT_BYTES})",
-                           value=len(data), INPUT_BYTES=INPUT_BYTES))
+        raise WireError(
+            N_("TA_INPUT of {value} bytes (expected {INPUT_BYTES})", value=len(data), INPUT_BYTES=INPUT_BYTES)
+        )
     values = _INPUT.unpack(data)
     return Inputs(universal=values[0:8], counter_levels=values[8:12], counter_values=values[12:16])
 

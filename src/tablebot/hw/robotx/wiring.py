@@ -19,15 +19,28 @@ if TYPE_CHECKING:
 INPUTS = tuple(f"I{i + 1}" for i in range(wire.N_INPUTS))
 #: ROBO_TX_FW.h: MODE_U 10 V (mV up to U_MAX 9999), MODE_R 5 kOhm (R_MAX 4999), ultrasonic (cm, up to 1023).
 TERMINALS = wiring.Terminals(
-    section="robotx", controller="ROBO TX Controller", digital_inputs=INPUTS,
-    analog={"resistance": wiring.Analog("ohm", 4999, INPUTS), "voltage": wiring.Analog("mV", 9999, INPUTS),
-            "ultrasonic": wiring.Analog("cm", 1023, INPUTS)},
-    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
-    counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)), min_tick_ms=10,
-    tick_reason=N_("ftMscLib exchanges the transfer area every 10 ms"), distance_mode="ultrasonic")
-MODES = {"switch": (wire.InputMode.RESISTANCE, True), "phototransistor": (wire.InputMode.RESISTANCE, True),
-         "resistance": (wire.InputMode.RESISTANCE, False), "voltage": (wire.InputMode.VOLTAGE, False),
-         "ultrasonic": (wire.InputMode.ULTRASONIC, False)}
+    section="robotx",
+    controller="ROBO TX Controller",
+    digital_inputs=INPUTS,
+    analog={
+        "resistance": wiring.Analog("ohm", 4999, INPUTS),
+        "voltage": wiring.Analog("mV", 9999, INPUTS),
+        "ultrasonic": wiring.Analog("cm", 1023, INPUTS),
+    },
+    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)),
+    lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
+    counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)),
+    min_tick_ms=10,
+    tick_reason=N_("ftMscLib exchanges the transfer area every 10 ms"),
+    distance_mode="ultrasonic",
+)
+MODES = {
+    "switch": (wire.InputMode.RESISTANCE, True),
+    "phototransistor": (wire.InputMode.RESISTANCE, True),
+    "resistance": (wire.InputMode.RESISTANCE, False),
+    "voltage": (wire.InputMode.VOLTAGE, False),
+    "ultrasonic": (wire.InputMode.ULTRASONIC, False),
+}
 
 
 def read_robot_robotx(src: Source, section: Any, robot: Robot) -> wiring.Section:

@@ -18,8 +18,10 @@ PORT = 65000
 ADDRESSES = ("txt://192.168.7.2 (USB)", "txt://HOST:PORT", "txt://auto")
 FIRMWARE_HINT = N_("update the TXT's firmware to 4.6.6 or later")
 ADDRESS_HINT = N_("write --on txt://192.168.7.2 (USB), txt://HOST:PORT or txt://auto")
-CONNECT_HINT = N_("is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
-                  "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)")
+CONNECT_HINT = N_(
+    "is the controller on and connected? A TXT answers at 192.168.7.2 (USB), 192.168.8.2 (Wi-Fi) "
+    "or 192.168.9.2 (Bluetooth); a TXT 4.0 needs ftrobopy_server running (docs/controllers.md)"
+)
 FASTER = N_("the TXT on its USB cable, txt://192.168.7.2, rather than Wi-Fi or Bluetooth")
 
 
@@ -41,7 +43,7 @@ def parse_address(text: str, hint: str) -> tuple[str | None, int]:
     a located error."""
     if not text.startswith("txt://"):
         raise fail("--on", N_("unknown target {text!r}", text=text), hint)
-    rest = text[len("txt://"):].rstrip("/")
+    rest = text[len("txt://") :].rstrip("/")
     host, _, port = rest.rpartition(":") if ":" in rest else (rest, "", "")
     if not host or (port and not (port.isdigit() and 0 < int(port) < 65536)):
         raise fail("--on", N_("{text!r} is not txt://HOST or txt://HOST:PORT", text=text), hint)
@@ -73,12 +75,28 @@ def open_txt(machine: Machine, link: LinkOptions) -> Opened:
         raise fail("--on", exc.args[0], CONNECT_HINT) from None
     # Before going online only QueryStatus can be asked; it costs the network's round trip, as each exchange
     # does (a TXT then paces exchanges at 10 ms on its own side).
-    warnings = check_link(bot, machine, link, bot.link.query_status, N_("a round trip to the controller"),
-                          faster=FASTER, connect_hint=CONNECT_HINT)
+    warnings = check_link(
+        bot,
+        machine,
+        link,
+        bot.link.query_status,
+        N_("a round trip to the controller"),
+        faster=FASTER,
+        connect_hint=CONNECT_HINT,
+    )
     return Opened(bot, bot.target, f"{status.device} {status.version_text}", warnings)
 
 
-TXT = register(LiveBackend(
-    name="txt", makes="a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",
-    help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), txt://auto (USB, Wi-Fi, Bluetooth "
-    "addresses)", fit=fit, section="txt", read_section=read_section, open=open_txt, addresses=ADDRESSES))
+TXT = register(
+    LiveBackend(
+        name="txt",
+        makes="a TXT (or TXT 4.0 with ftrobopy_server) driven live by `tablebot run`",
+        help="txt://HOST[:PORT] (a TXT, or a TXT 4.0 running ftrobopy_server), txt://auto (USB, Wi-Fi, Bluetooth "
+        "addresses)",
+        fit=fit,
+        section="txt",
+        read_section=read_section,
+        open=open_txt,
+        addresses=ADDRESSES,
+    )
+)

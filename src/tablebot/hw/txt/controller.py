@@ -29,8 +29,15 @@ class FirmwareTooOld(LinkLost):
 class TxtRobot(ExchangeRobot):
     """The robot behind ``host:port``; a reply missing for ``link_timeout_s`` (or malformed) ends the run."""
 
-    def __init__(self, wiring: TxtWiring, host: str, port: int = wire.PORT, *, link_timeout_s: float = 0.05,
-                 client_name: str = "tablebot") -> None:
+    def __init__(
+        self,
+        wiring: TxtWiring,
+        host: str,
+        port: int = wire.PORT,
+        *,
+        link_timeout_s: float = 0.05,
+        client_name: str = "tablebot",
+    ) -> None:
         self.wiring = wiring
         self.link = TxtLink(host, port, reply_timeout_s=link_timeout_s)
         self.client_name = client_name
@@ -48,10 +55,16 @@ class TxtRobot(ExchangeRobot):
         self.status = self.link.query_status()
         if self.status.version < wire.MIN_VERSION:
             self.link.close()
-            raise FirmwareTooOld(N_("{device} at {where} runs firmware {version} (0x{number:08X}); the online "
-                                    "protocol needs 4.6.6 or later, as fischertechnik's own online client checks",
-                                    device=self.status.device, where=self.link.where,
-                                    version=self.status.version_text, number=self.status.version))
+            raise FirmwareTooOld(
+                N_(
+                    "{device} at {where} runs firmware {version} (0x{number:08X}); the online "
+                    "protocol needs 4.6.6 or later, as fischertechnik's own online client checks",
+                    device=self.status.device,
+                    where=self.link.where,
+                    version=self.status.version_text,
+                    number=self.status.version,
+                )
+            )
         return self.status
 
     # --- RobotIO ----------------------------------------------------------------------------------

@@ -45,16 +45,17 @@ def probe(host: str, port: int = wire.PORT, timeout_s: float = 0.5) -> wire.Stat
         link.close()
 
 
-def find_controller(hosts: Sequence[str] = AUTO_HOSTS, port: int = wire.PORT,
-                    timeout_s: float = 0.5) -> tuple[str | None, list[str]]:
+def find_controller(
+    hosts: Sequence[str] = AUTO_HOSTS, port: int = wire.PORT, timeout_s: float = 0.5
+) -> tuple[str | None, list[str]]:
     """The first of ``hosts`` that answers as a TXT (all asked at once, each for ``timeout_s``), and what
     each of the others did. A server that merely accepts the connection does not count."""
     with ThreadPoolExecutor(max_workers=max(1, len(hosts))) as pool:
         answers = list(pool.map(lambda host: probe(host, port, timeout_s), hosts))
-    found = next((host for host, answer in zip(hosts, answers, strict=True) if isinstance(answer, wire.Status)),
-                 None)
-    return found, [f"{host}: {answer}" for host, answer in zip(hosts, answers, strict=True)
-                   if not isinstance(answer, wire.Status)]
+    found = next((host for host, answer in zip(hosts, answers, strict=True) if isinstance(answer, wire.Status)), None)
+    return found, [
+        f"{host}: {answer}" for host, answer in zip(hosts, answers, strict=True) if not isinstance(answer, wire.Status)
+    ]
 
 
 @contextlib.contextmanager
@@ -73,8 +74,9 @@ def signals_held() -> Iterator[None]:
 class TxtLink:
     """A connection to ``host:port``. Exchanges must be answered within ``reply_timeout_s``."""
 
-    def __init__(self, host: str, port: int = wire.PORT, reply_timeout_s: float = 0.05,
-                 setup_timeout_s: float = SETUP_TIMEOUT_S) -> None:
+    def __init__(
+        self, host: str, port: int = wire.PORT, reply_timeout_s: float = 0.05, setup_timeout_s: float = SETUP_TIMEOUT_S
+    ) -> None:
         self.host, self.port = host, port
         self.reply_timeout_s, self.setup_timeout_s = reply_timeout_s, setup_timeout_s
         self.sock: socket.socket | None = None
@@ -95,14 +97,17 @@ class TxtLink:
         try:
             self.sock = socket.create_connection((self.host, self.port), timeout=timeout_s)
         except socket.gaierror as exc:
-            raise LinkLost(N_("cannot find the controller {host}: {strerror}",
-                              host=self.host, strerror=exc.strerror)) from None
+            raise LinkLost(
+                N_("cannot find the controller {host}: {strerror}", host=self.host, strerror=exc.strerror)
+            ) from None
         except TimeoutError:
-            raise LinkLost(N_("no controller answered at {where} within {timeout_s:g} s",
-                              where=self.where, timeout_s=timeout_s)) from None
+            raise LinkLost(
+                N_("no controller answered at {where} within {timeout_s:g} s", where=self.where, timeout_s=timeout_s)
+            ) from None
         except OSError as exc:
-            raise LinkLost(N_("cannot connect to {where}: {value}",
-                              where=self.where, value=exc.strerror or exc)) from None
+            raise LinkLost(
+                N_("cannot connect to {where}: {value}", where=self.where, value=exc.strerror or exc)
+            ) from None
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # one small packet per request, at once
         self.last_reply = time.monotonic()
 
@@ -128,8 +133,9 @@ class TxtLink:
 
     def exchange(self, pwm: Sequence[int]) -> wire.Inputs:
         """Send O1..O8's PWM, get the inputs back (the TXT answers 10 ms after its previous answer)."""
-        return wire.decode_exchange(self._request(Command.EXCHANGE_DATA, wire.exchange(list(pwm)),
-                                                  self.reply_timeout_s))
+        return wire.decode_exchange(
+            self._request(Command.EXCHANGE_DATA, wire.exchange(list(pwm)), self.reply_timeout_s)
+        )
 
     def stop_online(self) -> None:
         self.online = False
@@ -163,8 +169,9 @@ class TxtLink:
         if self.sock is None:
             raise LinkLost(N_("not connected to {where}", where=self.where))
         if not self._trusted:
-            raise LinkLost(N_("{where} sent a malformed reply earlier: its replies cannot be trusted",
-                              where=self.where))
+            raise LinkLost(
+                N_("{where} sent a malformed reply earlier: its replies cannot be trusted", where=self.where)
+            )
         deadline = time.monotonic() + timeout_s
         self._discard_owed(deadline, command)  # the rest of a reply a signal cut short, or one given up on
         self._owed = wire.REPLY_SIZE[command]  # owed from the moment the request may be out
@@ -177,8 +184,9 @@ class TxtLink:
         """The whole request in one ``sendall``, signals held; a request that may have gone out in part
         leaves the connection unusable (what follows would be misread)."""
         if not self._sendable:
-            raise LinkLost(N_("{where}: a request went out in part earlier; nothing more can be sent",
-                              where=self.where))
+            raise LinkLost(
+                N_("{where}: a request went out in part earlier; nothing more can be sent", where=self.where)
+            )
         sock = self._socket()
         sock.settimeout(self._remaining(deadline, command, "sending"))
         with signals_held():
@@ -186,8 +194,9 @@ class TxtLink:
                 sock.sendall(payload)
             except TimeoutError:
                 self._sendable = False
-                raise LinkLost(N_("{where} did not take {name} in time (its buffer is full)",
-                                  where=self.where, name=command.name)) from None
+                raise LinkLost(
+                    N_("{where} did not take {name} in time (its buffer is full)", where=self.where, name=command.name)
+                ) from None
             except OSError as exc:
                 self._sendable = False
                 raise self._lost(exc, command) from None
@@ -241,5 +250,11 @@ class TxtLink:
         return self.sock
 
     def _lost(self, exc: OSError, command: Command) -> LinkLost:
-        return LinkLost(N_("lost the connection to {where} during {name}: {value}",
-                           where=self.where, name=command.name, value=exc.strerror or exc))
+        return LinkLost(
+            N_(
+                "lost the connection to {where} during {name}: {value}",
+                where=self.where,
+                name=command.name,
+                value=exc.strerror or exc,
+            )
+        )

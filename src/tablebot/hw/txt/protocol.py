@@ -58,17 +58,25 @@ class InputMode(IntEnum):
 _ID = struct.Struct("<I")
 _STATUS = struct.Struct("<I16sI")
 _START = struct.Struct("<I64s")
-_CONFIG = struct.Struct("<Ihh" "BB2x" "4B" + "BB2x" * N_INPUTS + "B3x" * N_COUNTERS + "16h")
+_CONFIG = struct.Struct("<IhhBB2x4B" + "BB2x" * N_INPUTS + "B3x" * N_COUNTERS + "16h")
 _EXCHANGE = struct.Struct("<I8h4h4h4h4h3H2x")
 _EXCHANGE_REPLY = struct.Struct("<I8h4h4h4h4hH" + "4bB" * 5 + "x")
 
 #: Bytes of each request and of its reply.
-REQUEST_SIZE = {Command.QUERY_STATUS: _ID.size, Command.START_ONLINE: _START.size,
-                Command.UPDATE_CONFIG: _CONFIG.size, Command.EXCHANGE_DATA: _EXCHANGE.size,
-                Command.STOP_ONLINE: _ID.size}
-REPLY_SIZE = {Command.QUERY_STATUS: _STATUS.size, Command.START_ONLINE: _ID.size,
-              Command.UPDATE_CONFIG: _ID.size, Command.EXCHANGE_DATA: _EXCHANGE_REPLY.size,
-              Command.STOP_ONLINE: _ID.size}
+REQUEST_SIZE = {
+    Command.QUERY_STATUS: _ID.size,
+    Command.START_ONLINE: _START.size,
+    Command.UPDATE_CONFIG: _CONFIG.size,
+    Command.EXCHANGE_DATA: _EXCHANGE.size,
+    Command.STOP_ONLINE: _ID.size,
+}
+REPLY_SIZE = {
+    Command.QUERY_STATUS: _STATUS.size,
+    Command.START_ONLINE: _ID.size,
+    Command.UPDATE_CONFIG: _ID.size,
+    Command.EXCHANGE_DATA: _EXCHANGE_REPLY.size,
+    Command.STOP_ONLINE: _ID.size,
+}
 
 
 class WireError(ValueError):
@@ -124,16 +132,28 @@ def _id(data: bytes, expected: int, what: str) -> None:
         raise WireError(N_("{what}: {value} bytes is too short for a reply", what=what, value=len(data)))
     (got,) = _ID.unpack_from(data)
     if got != expected:
-        raise WireError(N_("{what}: wrong response id 0x{got:08X} (expected 0x{expected:08X})",
-                           what=what, got=got, expected=expected))
+        raise WireError(
+            N_(
+                "{what}: wrong response id 0x{got:08X} (expected 0x{expected:08X})",
+                what=what,
+                got=got,
+                expected=expected,
+            )
+        )
 
 
 def check_reply(command: Command, data: bytes) -> None:
     """Raise :class:`WireError` unless ``data`` is a whole reply to ``command`` with its response id."""
     _id(data, REPLY_ID[command], command.name)
     if len(data) != REPLY_SIZE[command]:
-        raise WireError(N_("{name}: reply of {value} bytes (expected {value2})",
-                           name=command.name, value=len(data), value2=REPLY_SIZE[command]))
+        raise WireError(
+            N_(
+                "{name}: reply of {value} bytes (expected {value2})",
+                name=command.name,
+                value=len(data),
+                value2=REPLY_SIZE[command],
+            )
+        )
 
 
 # --- requests ---------------------------------------------------------------------------------------
@@ -183,5 +203,10 @@ def decode_status(data: bytes) -> Status:
 def decode_exchange(data: bytes) -> Inputs:
     check_reply(Command.EXCHANGE_DATA, data)
     values = _EXCHANGE_REPLY.unpack(data)
-    return Inputs(universal=values[1:9], counter_inputs=values[9:13], counter_values=values[13:17],
-                  counter_command_ids=values[17:21], motor_command_ids=values[21:25])
+    return Inputs(
+        universal=values[1:9],
+        counter_inputs=values[9:13],
+        counter_values=values[13:17],
+        counter_command_ids=values[17:21],
+        motor_command_ids=values[21:25],
+    )

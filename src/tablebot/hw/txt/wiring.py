@@ -26,24 +26,40 @@ INPUTS = tuple(f"I{i + 1}" for i in range(wire.N_INPUTS))
 #: ``trailfollower`` reads it (ftrobopy.py) and ftrobopy_server maps mode (0, digital) to ``ft::TrailFollower``;
 #: ROBO Pro Coding's ``create_trail_follower(...).get_state()`` reads 0 on the line (fischertechnik's FTS
 #: program, ORBIS-Modellfabrik ``integrations/TXT-FTS/.../lib/line_follower.py``).
-TRAIL = wiring.Digital("dark", N_("a track sensor"), N_("while the track sensor's spot is over the dark line"),
-                       reports=0, words=("track", "trail"))
+TRAIL = wiring.Digital(
+    "dark",
+    N_("a track sensor"),
+    N_("while the track sensor's spot is over the dark line"),
+    reports=0,
+    words=("track", "trail"),
+)
 TRAIL_LIGHT_MV = 600  # ftrobopy: a trail sensor reporting millivolts reads light above 600 mV
 TERMINALS = wiring.Terminals(
-    section="txt", controller="TXT", digital_inputs=INPUTS,
-    analog={"resistance": wiring.Analog("ohm", 15000, INPUTS), "voltage": wiring.Analog("mV", 10000, INPUTS),
-            "ultrasonic": wiring.Analog("cm", 1024, INPUTS)},
-    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)), lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
-    counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)), min_tick_ms=10,
-    tick_reason=N_("it answers one exchange every 10 ms"), distance_mode="ultrasonic",
-    digital_modes={**wiring.DIGITAL, "trail": TRAIL})
+    section="txt",
+    controller="TXT",
+    digital_inputs=INPUTS,
+    analog={
+        "resistance": wiring.Analog("ohm", 15000, INPUTS),
+        "voltage": wiring.Analog("mV", 10000, INPUTS),
+        "ultrasonic": wiring.Analog("cm", 1024, INPUTS),
+    },
+    motors=tuple(f"M{i + 1}" for i in range(wire.N_MOTORS)),
+    lamps=tuple(f"O{i + 1}" for i in range(wire.N_OUTPUTS)),
+    counters=tuple(f"C{i + 1}" for i in range(wire.N_COUNTERS)),
+    min_tick_ms=10,
+    tick_reason=N_("it answers one exchange every 10 ms"),
+    distance_mode="ultrasonic",
+    digital_modes={**wiring.DIGITAL, "trail": TRAIL},
+)
 #: mode -> the input's UpdateConfig (measuring mode, reported as 0/1)
-MODES = {"switch": wire.InputConfig(wire.InputMode.RESISTANCE, True),
-         "phototransistor": wire.InputConfig(wire.InputMode.RESISTANCE, True),
-         "trail": wire.InputConfig(wire.InputMode.VOLTAGE, True),
-         "resistance": wire.InputConfig(wire.InputMode.RESISTANCE, False),
-         "voltage": wire.InputConfig(wire.InputMode.VOLTAGE, False),
-         "ultrasonic": wire.InputConfig(wire.InputMode.ULTRASONIC, False)}
+MODES = {
+    "switch": wire.InputConfig(wire.InputMode.RESISTANCE, True),
+    "phototransistor": wire.InputConfig(wire.InputMode.RESISTANCE, True),
+    "trail": wire.InputConfig(wire.InputMode.VOLTAGE, True),
+    "resistance": wire.InputConfig(wire.InputMode.RESISTANCE, False),
+    "voltage": wire.InputConfig(wire.InputMode.VOLTAGE, False),
+    "ultrasonic": wire.InputConfig(wire.InputMode.ULTRASONIC, False),
+}
 
 
 def level_pwm(level: int) -> int:

@@ -22,11 +22,25 @@ def export(machine: Machine, out: Path | None, options: ExportOptions) -> Export
     assert out is not None
     workspace = export_txt4(machine)  # a table that does not fit is refused before anything is written
     files = tuple(workspace.write(out_folder(out, "OUTDIR")))
-    return Exported(files, (*(N_("wrote {file}", file=str(path)) for path in files),
-                            N_("upload and start it: tablebot upload {folder} --to txt4://192.168.7.2 (it asks for "
-                               "the API key the TXT 4.0 shows)", folder=shell_word(str(out)))))
+    return Exported(
+        files,
+        (
+            *(N_("wrote {file}", file=str(path)) for path in files),
+            N_(
+                "upload and start it: tablebot upload {folder} --to txt4://192.168.7.2 (it asks for "
+                "the API key the TXT 4.0 shows)",
+                folder=shell_word(str(out)),
+            ),
+        ),
+    )
 
 
-TXT4 = register(ExportBackend(name="txt4", makes="a program that runs the table on a TXT 4.0 by itself",
-                              help="a program that runs the table on a TXT 4.0 itself (then: tablebot upload)",
-                              fit=txt.fit, export=export))
+TXT4 = register(
+    ExportBackend(
+        name="txt4",
+        makes="a program that runs the table on a TXT 4.0 by itself",
+        help="a program that runs the table on a TXT 4.0 itself (then: tablebot upload)",
+        fit=txt.fit,
+        export=export,
+    )
+)

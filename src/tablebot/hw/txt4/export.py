@@ -26,12 +26,12 @@ from tablebot.machine import Machine
 from tablebot.tables import RobotTables, several
 
 PROGRAM = "lib/tablebot_program.py"
-LAUNCHER = '''\
+LAUNCHER = """\
 # Runs a tablebot table on this TXT 4.0; written by `tablebot export --to txt4` (see lib/tablebot_program.py).
 from lib.tablebot_program import main
 
 main()
-'''
+"""
 
 
 @dataclass(frozen=True)
@@ -68,8 +68,15 @@ def export_txt4(machine: Machine) -> Workspace:
     table = f"# --- the table, written by `tablebot export --to txt4` ---\n\nTABLE = {literal(data)}\n"
     program = f"{runtime_text()}\n\n{table}"
     digest = hashlib.sha256(program.encode("utf-8")).hexdigest()
-    return Workspace(name, {f"{name}.py": LAUNCHER, "lib/__init__.py": "", PROGRAM: program,
-                            ".project.json": project_json(name, uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}"))})
+    return Workspace(
+        name,
+        {
+            f"{name}.py": LAUNCHER,
+            "lib/__init__.py": "",
+            PROGRAM: program,
+            ".project.json": project_json(name, uuid.uuid5(uuid.NAMESPACE_URL, f"tablebot:{digest}")),
+        },
+    )
 
 
 #: The runtime's import of how it stops: the program carries that code itself, so the line is dropped.
@@ -87,8 +94,11 @@ def runtime_text() -> str:
     if STOP_IMPORT not in runtime or future not in stop:  # tablebot's own files, changed without this function
         raise RuntimeError("tablebot/hw/txt4: runtime.py no longer imports runtime_stop as export_txt4 expects")
     stop_code = stop.split(future, 1)[1].lstrip("\n")
-    return (runtime.replace(STOP_IMPORT, "").rstrip("\n")
-            + "\n\n\n# --- how the program stops (tablebot.hw.txt4.runtime_stop) ---\n\n" + stop_code)
+    return (
+        runtime.replace(STOP_IMPORT, "").rstrip("\n")
+        + "\n\n\n# --- how the program stops (tablebot.hw.txt4.runtime_stop) ---\n\n"
+        + stop_code
+    )
 
 
 def project_json(name: str, project_uuid: uuid.UUID) -> str:
@@ -97,8 +107,7 @@ def project_json(name: str, project_uuid: uuid.UUID) -> str:
     Mode ``PROFESSIONAL`` is ROBO Pro Coding's Python mode (``FF_AI_24V``: Python files only); an
     ``ADVANCED`` project is edited in blocks and carries ``NAME.blockly`` beside ``NAME.py``, which a
     program written as Python has not."""
-    project = {"uuid": str(project_uuid), "name": name, "mode": "PROFESSIONAL", "version": "1.0",
-               "controller": "TXT4"}
+    project = {"uuid": str(project_uuid), "name": name, "mode": "PROFESSIONAL", "version": "1.0", "controller": "TXT4"}
     return json.dumps(project, separators=(",", ":"))
 
 
@@ -113,20 +122,50 @@ def table_data(machine: Machine, wiring: TxtWiring) -> dict[str, Any]:
     counted = {c.motor for c in robot.counters}
     terminal_of = {out.name: _number(out.terminal) for _, out in motors}
     return {
-        "name": robot.name, "source": table.path, "tick_ms": robot.tick_ms,
-        "states": list(machine.states), "initial_state": machine.initial_state, "initial_timer": machine.initial_timer,
-        "input_mask": machine.input_mask, "timer_bit": machine.timer_bit, "counter_bits": list(machine.counter_bits),
+        "name": robot.name,
+        "source": table.path,
+        "tick_ms": robot.tick_ms,
+        "states": list(machine.states),
+        "initial_state": machine.initial_state,
+        "initial_timer": machine.initial_timer,
+        "input_mask": machine.input_mask,
+        "timer_bit": machine.timer_bit,
+        "counter_bits": list(machine.counter_bits),
         "match": robot.match,
-        "n_outputs": len(machine.output_names), "rows": per_state,
-        "inputs": [{"name": w.name, "terminal": _number(w.terminal), "mode": w.mode, "invert": w.invert,
-                    "below": w.below, "above": w.above, "hysteresis": w.hysteresis, "bit": bit}
-                   for w, bit in zip(wired.inputs, wired.bits, strict=True)],
-        "motors": [{"name": out.name, "output": i, "terminal": _number(out.terminal), "reverse": out.reverse,
-                    "encoder": out.name in counted} for i, out in motors],
-        "lamps": [{"name": out.name, "output": i, "terminal": _number(out.terminal)}
-                  for i, out in enumerate(wired.outputs) if out.kind == "lamp"],
-        "counters": [{"name": c.name, "terminal": _number(t), "motor": terminal_of.get(c.motor)}
-                     for c, t in zip(robot.counters, wired.counters, strict=True)],
+        "n_outputs": len(machine.output_names),
+        "rows": per_state,
+        "inputs": [
+            {
+                "name": w.name,
+                "terminal": _number(w.terminal),
+                "mode": w.mode,
+                "invert": w.invert,
+                "below": w.below,
+                "above": w.above,
+                "hysteresis": w.hysteresis,
+                "bit": bit,
+            }
+            for w, bit in zip(wired.inputs, wired.bits, strict=True)
+        ],
+        "motors": [
+            {
+                "name": out.name,
+                "output": i,
+                "terminal": _number(out.terminal),
+                "reverse": out.reverse,
+                "encoder": out.name in counted,
+            }
+            for i, out in motors
+        ],
+        "lamps": [
+            {"name": out.name, "output": i, "terminal": _number(out.terminal)}
+            for i, out in enumerate(wired.outputs)
+            if out.kind == "lamp"
+        ],
+        "counters": [
+            {"name": c.name, "terminal": _number(t), "motor": terminal_of.get(c.motor)}
+            for c, t in zip(robot.counters, wired.counters, strict=True)
+        ],
     }
 
 
@@ -135,10 +174,17 @@ def engine_data(machine: Machine) -> dict[str, Any]:
     per_state: list[list[list[Any]]] = [[] for _ in machine.states]
     for row in machine.rows:
         per_state[row.state].append([row.index, row.mask, row.next, row.timer, list(row.outputs), list(row.loads)])
-    return {"states": list(machine.states), "initial_state": machine.initial_state,
-            "initial_timer": machine.initial_timer, "input_mask": machine.input_mask, "timer_bit": machine.timer_bit,
-            "counter_bits": list(machine.counter_bits), "match": machine.table.robot.match,
-            "n_outputs": len(machine.output_names), "rows": per_state}
+    return {
+        "states": list(machine.states),
+        "initial_state": machine.initial_state,
+        "initial_timer": machine.initial_timer,
+        "input_mask": machine.input_mask,
+        "timer_bit": machine.timer_bit,
+        "counter_bits": list(machine.counter_bits),
+        "match": machine.table.robot.match,
+        "n_outputs": len(machine.output_names),
+        "rows": per_state,
+    }
 
 
 def tables_data(tables: RobotTables) -> dict[str, Any]:
@@ -148,11 +194,17 @@ def tables_data(tables: RobotTables) -> dict[str, Any]:
     indices = range(len(tables.machines))
     cross = [[[source, bits] for source, bits in cross_bits(tables, i)] for i in indices]
     writers = [tables.writer(name) for name in tables.output_names]
-    counter_writers = [[c, w] for c, name in enumerate(tables.robot.counter_names)
-                       if (w := tables.writer(name)) is not None]
-    return {"table_names": list(tables.names), "tables": [engine_data(m) for m in tables.machines],
-            "table_inputs": [[[bit, own] for _, bit, own in input_bits(tables, i)] for i in indices],
-            "cross": cross, "writers": [-1 if w is None else w for w in writers], "counter_writers": counter_writers}
+    counter_writers = [
+        [c, w] for c, name in enumerate(tables.robot.counter_names) if (w := tables.writer(name)) is not None
+    ]
+    return {
+        "table_names": list(tables.names),
+        "tables": [engine_data(m) for m in tables.machines],
+        "table_inputs": [[[bit, own] for _, bit, own in input_bits(tables, i)] for i in indices],
+        "cross": cross,
+        "writers": [-1 if w is None else w for w in writers],
+        "counter_writers": counter_writers,
+    }
 
 
 def _number(terminal: str) -> int:

@@ -34,8 +34,11 @@ from tablebot.i18n import N_
 DEFAULT_PORT = 80
 KEY_ENV = "TABLEBOT_TXT4_KEY"
 URL_HINT = N_("write --to txt4://192.168.7.2 (USB), txt4://192.168.8.2 (Wi-Fi) or txt4://HOST:PORT")
-KEY_HINT = N_("give the key the TXT 4.0 shows (the one ROBO Pro Coding asks for) in ${env}, with --key-file FILE, "
-              "at the prompt (run it in a terminal), or with --key KEY", env=KEY_ENV)
+KEY_HINT = N_(
+    "give the key the TXT 4.0 shows (the one ROBO Pro Coding asks for) in ${env}, with --key-file FILE, "
+    "at the prompt (run it in a terminal), or with --key KEY",
+    env=KEY_ENV,
+)
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
@@ -56,8 +59,11 @@ def api_key(key: str | None, key_file: Path | None, prompt: Callable[[], str] | 
         try:
             key = key_file.read_text(encoding="utf-8").strip()
         except (OSError, UnicodeDecodeError) as exc:
-            raise fail(key_file, N_("cannot read the key file: {reason}", reason=getattr(exc, "strerror", None) or exc),
-                       N_("the file holds the key the TXT 4.0 shows, on one line")) from None
+            raise fail(
+                key_file,
+                N_("cannot read the key file: {reason}", reason=getattr(exc, "strerror", None) or exc),
+                N_("the file holds the key the TXT 4.0 shows, on one line"),
+            ) from None
         if not key:
             raise fail(key_file, N_("the key file is empty"), N_("write the key the TXT 4.0 shows into it"))
     key = key if key is not None else os.environ.get(KEY_ENV) or None
@@ -78,15 +84,22 @@ def workspace_files(folder: Path) -> tuple[str, dict[str, bytes]]:
     except (OSError, ValueError, AttributeError):
         name = None
     if not isinstance(name, str) or not NAME_RE.match(name):
-        raise fail(folder, N_("this folder is not a program written by `tablebot export --to txt4`"),
-                   N_("export one first: tablebot export TABLE OUTDIR --to txt4"))
-    files = {"/" + p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*"))
-             if p.is_file() and "__pycache__" not in p.parts}
+        raise fail(
+            folder,
+            N_("this folder is not a program written by `tablebot export --to txt4`"),
+            N_("export one first: tablebot export TABLE OUTDIR --to txt4"),
+        )
+    files = {
+        "/" + p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and "__pycache__" not in p.parts
+    }
     return name, files
 
 
-def upload(folder: Path, target: str, key: str, start: bool = True, timeout_s: float = 10.0,
-           say: Callable[[str], None] = print) -> str:
+def upload(
+    folder: Path, target: str, key: str, start: bool = True, timeout_s: float = 10.0, say: Callable[[str], None] = print
+) -> str:
     """Stop whatever runs, send the workspace's files, start it; returns the workspace name."""
     url = base_url(target)
     name, files = workspace_files(folder)
@@ -98,8 +111,13 @@ def upload(folder: Path, target: str, key: str, start: bool = True, timeout_s: f
         say(N_("uploaded {n} files to workspace {name} on {target}", n=len(files), name=name, target=target))
         if start:
             _call(client, "POST", f"/api/v1/application/{name}/start", target)
-            say(N_("started {name}; stop it on the controller, or: curl -X DELETE {url}/api/v1/stop", name=name,
-                   url=url))
+            say(
+                N_(
+                    "started {name}; stop it on the controller, or: curl -X DELETE {url}/api/v1/stop",
+                    name=name,
+                    url=url,
+                )
+            )
     return name
 
 
@@ -107,20 +125,41 @@ def _call(client: httpx.Client, method: str, path: str, target: str, **kwargs: o
     try:
         response = client.request(method, path, **kwargs)  # type: ignore[arg-type]
     except httpx.TimeoutException:
-        raise fail("--to", N_("{target} did not answer {method} {path} in time", target=target, method=method,
-                              path=path),
-                   N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?")) from None
+        raise fail(
+            "--to",
+            N_("{target} did not answer {method} {path} in time", target=target, method=method, path=path),
+            N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?"),
+        ) from None
     except httpx.HTTPError as exc:
-        raise fail("--to", N_("cannot reach {target}: {reason}", target=target, reason=str(exc)),
-                   N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?")) from None
+        raise fail(
+            "--to",
+            N_("cannot reach {target}: {reason}", target=target, reason=str(exc)),
+            N_("is the TXT 4.0 on, and this computer on its USB or Wi-Fi network?"),
+        ) from None
     if response.status_code in (401, 403):
-        raise fail("--key", N_("{target} refused the API key ({status} on {method} {path})", target=target,
-                               status=response.status_code, method=method, path=path),
-                   N_("the TXT 4.0 shows a new key now and then: read it again from its display"))
+        raise fail(
+            "--key",
+            N_(
+                "{target} refused the API key ({status} on {method} {path})",
+                target=target,
+                status=response.status_code,
+                method=method,
+                path=path,
+            ),
+            N_("the TXT 4.0 shows a new key now and then: read it again from its display"),
+        )
     if response.status_code >= 400:
-        raise fail("--to", N_("{target} answered {status} to {method} {path}", target=target,
-                              status=response.status_code, method=method, path=path),
-                   N_("check that it is a TXT 4.0 with the ROBO Pro Coding interface switched on"))
+        raise fail(
+            "--to",
+            N_(
+                "{target} answered {status} to {method} {path}",
+                target=target,
+                status=response.status_code,
+                method=method,
+                path=path,
+            ),
+            N_("check that it is a TXT 4.0 with the ROBO Pro Coding interface switched on"),
+        )
     return response
 
 

@@ -13,9 +13,18 @@ from tablebot.sim import columns as L
 from tablebot.sim.model.scene import Scene
 
 #: The robot's own part of every observation, in order, and the state column each is read from.
-BUILT_IN = (("x", L.X), ("y", L.Y), ("cos_heading", L.TH), ("sin_heading", L.TH), ("light_right", L.LIGHT_R),
-            ("light_left", L.LIGHT_L), ("bump_front_right", L.BUMP_FR), ("bump_front_left", L.BUMP_FL),
-            ("bump_rear", L.BUMP_REAR), ("battery_v", L.VBAT))
+BUILT_IN = (
+    ("x", L.X),
+    ("y", L.Y),
+    ("cos_heading", L.TH),
+    ("sin_heading", L.TH),
+    ("light_right", L.LIGHT_R),
+    ("light_left", L.LIGHT_L),
+    ("bump_front_right", L.BUMP_FR),
+    ("bump_front_left", L.BUMP_FL),
+    ("bump_rear", L.BUMP_REAR),
+    ("battery_v", L.VBAT),
+)
 
 
 @dataclass(frozen=True)
@@ -49,8 +58,9 @@ class Observation:
             low.append(0.0)
             high.append(kind.high(scene.params, light) * scale)
             scales.append(scale)
-        return Observation(names, columns, np.array(low, dtype=np.float64), np.array(high, dtype=np.float64),
-                           tuple(scales))
+        return Observation(
+            names, columns, np.array(low, dtype=np.float64), np.array(high, dtype=np.float64), tuple(scales)
+        )
 
     def __call__(self, rows: np.ndarray) -> np.ndarray:
         """The observations of robot rows ``rows`` (N, N_STATE): the heading as its cosine and sine, the
@@ -59,5 +69,5 @@ class Observation:
         obs = rows[:, list(self.columns)].copy()
         obs[:, 2], obs[:, 3] = np.cos(rows[:, L.TH]), np.sin(rows[:, L.TH])
         if self.declared:
-            obs[:, len(BUILT_IN):] *= np.array(self.declared)
+            obs[:, len(BUILT_IN) :] *= np.array(self.declared)
         return obs

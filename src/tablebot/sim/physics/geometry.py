@@ -43,8 +43,9 @@ def within(dx: float, dy: float, r: float, strict: bool = False) -> bool:
 
 
 @njit(cache=True, refcounts=False)
-def point_segment_within(px: float, py: float, ax: float, ay: float, bx: float, by: float, r: float,
-                         strict: bool = False) -> bool:
+def point_segment_within(
+    px: float, py: float, ax: float, ay: float, bx: float, by: float, r: float, strict: bool = False
+) -> bool:
     """``point_segment_distance(px, py, ax, ay, bx, by) <= r`` (``< r`` when ``strict``), by :func:`within`."""
     ex, ey = bx - ax, by - ay
     length2 = ex * ex + ey * ey
@@ -59,8 +60,9 @@ LINE_MARGIN = 1e-9
 
 
 @njit(cache=True, refcounts=False)
-def segments_within(ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float,
-                    r: float) -> bool:
+def segments_within(
+    ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float, r: float
+) -> bool:
     """Whether segments ab and cd come within ``r`` of each other (0 apart when they cross): the nearest
     of the four endpoint-to-segment distances, each tested by :func:`within`.
 
@@ -76,8 +78,12 @@ def segments_within(ax: float, ay: float, bx: float, by: float, cx: float, cy: f
             return False
     if segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return r >= 0.0
-    return (point_segment_within(ax, ay, cx, cy, dx, dy, r) or point_segment_within(bx, by, cx, cy, dx, dy, r)
-            or point_segment_within(cx, cy, ax, ay, bx, by, r) or point_segment_within(dx, dy, ax, ay, bx, by, r))
+    return (
+        point_segment_within(ax, ay, cx, cy, dx, dy, r)
+        or point_segment_within(bx, by, cx, cy, dx, dy, r)
+        or point_segment_within(cx, cy, ax, ay, bx, by, r)
+        or point_segment_within(dx, dy, ax, ay, bx, by, r)
+    )
 
 
 @njit(cache=True, refcounts=False)
@@ -94,14 +100,14 @@ def segments_cross(ax: float, ay: float, bx: float, by: float, cx: float, cy: fl
 
 
 @njit(cache=True, refcounts=False)
-def shadowed(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray,
-             circles: np.ndarray) -> bool:
+def shadowed(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray, circles: np.ndarray) -> bool:
     """Whether a wall, obstacle edge or circle blocks the straight line from sensor to lamp."""
     for k in range(edges.shape[0]):
         if segments_cross(sx, sy, lx, ly, edges[k, 0], edges[k, 1], edges[k, 2], edges[k, 3]):
             return True
     for k in range(circles.shape[0]):
         if int(circles[k, 3]) != lamp and point_segment_within(
-                circles[k, 0], circles[k, 1], sx, sy, lx, ly, circles[k, 2], True):
+            circles[k, 0], circles[k, 1], sx, sy, lx, ly, circles[k, 2], True
+        ):
             return True
     return False

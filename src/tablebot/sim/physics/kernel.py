@@ -72,8 +72,15 @@ def observe(s: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.nd
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def tally(counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, light_bits: int, state: int, mask: int,
-          tick: int) -> None:
+def tally(
+    counts: np.ndarray,
+    first_visit: np.ndarray,
+    first_light: np.ndarray,
+    light_bits: int,
+    state: int,
+    mask: int,
+    tick: int,
+) -> None:
     """Count a tick that ends in ``state`` (ticks per state, the first tick in each) and note the first tick
     whose input ``mask`` has any of ``light_bits``: what a fleet keeps of a robot's ticks."""
     counts[state] += 1
@@ -84,8 +91,16 @@ def tally(counts: np.ndarray, first_visit: np.ndarray, first_light: np.ndarray, 
 
 
 @njit(nogil=True)
-def run_robot(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
-              noise: np.ndarray, bitgen: np.uint64, record: Record) -> None:
+def run_robot(
+    robot: RobotState,
+    world: WorldArrays,
+    program: Program,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgen: np.uint64,
+    record: Record,
+) -> None:
     """Run one robot for ``ticks`` ticks, tick t moved by noise row ``noise[t]`` -- or, when ``noise`` has no
     rows, by a row drawn from the numpy Generator whose handle is ``bitgen`` (sim.physics.normals.bitgen_address).
 
@@ -104,13 +119,30 @@ def robot_scratch(robot: RobotState, world: WorldArrays) -> Scratch:
     reach, wide = reaches(robot.p)
     turns = np.empty(4)
     aim_turns(robot.p, turns)
-    return Scratch(np.zeros(robot.counters.shape[0], dtype=np.int64), np.empty((4, 2)), near, centre, turns,
-                   np.empty(N_NOISE), reach, wide)
+    return Scratch(
+        np.zeros(robot.counters.shape[0], dtype=np.int64),
+        np.empty((4, 2)),
+        near,
+        centre,
+        turns,
+        np.empty(N_NOISE),
+        reach,
+        wide,
+    )
 
 
 @njit(nogil=True, refcounts=False)
-def run_ticks(robot: RobotState, world: WorldArrays, program: Program, wiring: Wiring, ticks: int,
-              noise: np.ndarray, bitgen: np.uint64, record: Record, scratch: Scratch) -> None:
+def run_ticks(
+    robot: RobotState,
+    world: WorldArrays,
+    program: Program,
+    wiring: Wiring,
+    ticks: int,
+    noise: np.ndarray,
+    bitgen: np.uint64,
+    record: Record,
+    scratch: Scratch,
+) -> None:
     """:func:`run_robot`'s loop, given its scratch space (compiled without reference counting: see tablebot.jit)."""
     for t in range(ticks):
         mask = start_tick(t, robot, wiring, record, scratch)
@@ -134,8 +166,17 @@ def start_tick(t: int, robot: RobotState, wiring: Wiring, record: Record, scratc
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def end_tick(t: int, mask: int, robot: RobotState, world: WorldArrays, wiring: Wiring, noise: np.ndarray,
-             bitgen: np.uint64, record: Record, scratch: Scratch) -> None:
+def end_tick(
+    t: int,
+    mask: int,
+    robot: RobotState,
+    world: WorldArrays,
+    wiring: Wiring,
+    noise: np.ndarray,
+    bitgen: np.uint64,
+    record: Record,
+    scratch: Scratch,
+) -> None:
     """Tick t ends, the tables ticked: its integer record into ``record.ints`` and its tally into the record's
     counts (each when it has rows), then the robot moves one tick on noise row t (or a row drawn from
     ``bitgen``: see :func:`run_robot`) and its new row is folded into its summary."""
@@ -143,8 +184,9 @@ def end_tick(t: int, mask: int, robot: RobotState, world: WorldArrays, wiring: W
     if record.ints.shape[0]:
         _record(record.ints, t, mask, regs, outputs, robot.counters, scratch.pulses)
     if record.counts.shape[0]:
-        tally(record.counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask,
-              record.t0 + t)
+        tally(
+            record.counts, record.first_visit, record.first_light, record.light_bits, regs[STATE], mask, record.t0 + t
+        )
     if noise.shape[0]:
         for k in range(N_NOISE):
             z[k] = noise[t, k]
@@ -157,8 +199,9 @@ def end_tick(t: int, mask: int, robot: RobotState, world: WorldArrays, wiring: W
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def _record(ints: np.ndarray, t: int, mask: int, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray,
-            pulses: np.ndarray) -> None:
+def _record(
+    ints: np.ndarray, t: int, mask: int, regs: np.ndarray, outputs: np.ndarray, counters: np.ndarray, pulses: np.ndarray
+) -> None:
     ints[t, I_MASK] = mask
     ints[t, I_EVENT] = regs[EVENT]
     ints[t, I_ROW] = regs[ROW]
@@ -186,16 +229,33 @@ def sense(s: np.ndarray, p: np.ndarray, world: WorldArrays, z: np.ndarray, bits:
 
 
 @njit(nogil=True)
-def move(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, z: np.ndarray, bits: np.ndarray,
-         acc: np.ndarray, collisions: np.ndarray) -> None:
+def move(
+    s: np.ndarray,
+    right: int,
+    left: int,
+    p: np.ndarray,
+    world: WorldArrays,
+    z: np.ndarray,
+    bits: np.ndarray,
+    acc: np.ndarray,
+    collisions: np.ndarray,
+) -> None:
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
     advance_called(s, right, left, p, world, bits, np.bool_(True), _scratch(p, world, z))  # not True: see sense
     observe(s, world.lamps, acc, collisions)
 
 
 @njit(nogil=True)
-def first_readings(S: np.ndarray, p: np.ndarray, world: WorldArrays, rows: np.ndarray, draws: np.ndarray,
-                   bits: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def first_readings(
+    S: np.ndarray,
+    p: np.ndarray,
+    world: WorldArrays,
+    rows: np.ndarray,
+    draws: np.ndarray,
+    bits: np.ndarray,
+    acc: np.ndarray,
+    collisions: np.ndarray,
+) -> None:
     """Robots ``rows`` of ``S`` read their sensors where they start (:func:`sense`, robot ``rows[k]`` moved by
     noise row ``draws[k, 2:]``) and fold that first row into their summaries (:func:`observe`): a fleet's
     robots start in one call, not two calls from Python each."""

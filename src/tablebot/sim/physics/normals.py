@@ -145,28 +145,36 @@ def bitgen_addresses(rngs: list[np.random.Generator]) -> np.ndarray:
 @intrinsic
 def _word(typingctx: TypingContext, address: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
     """The 64-bit word stored at ``address``."""
+
     def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         return builder.load(builder.inttoptr(args[0], ir.IntType(64).as_pointer()))
+
     return types.uint64(types.uint64), codegen
 
 
 @intrinsic
-def _next_uint64(typingctx: TypingContext, function: types.Type,
-                 state: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
+def _next_uint64(
+    typingctx: TypingContext, function: types.Type, state: types.Type
+) -> tuple[Signature, Callable[..., ir.Value]]:
     """Call the bit generator's ``uint64_t next_uint64(void *state)`` at address ``function``."""
+
     def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         kind = ir.FunctionType(ir.IntType(64), [ir.IntType(64)])
         return builder.call(builder.inttoptr(args[0], kind.as_pointer()), [args[1]])
+
     return types.uint64(types.uint64, types.uint64), codegen
 
 
 @intrinsic
-def _next_double(typingctx: TypingContext, function: types.Type,
-                 state: types.Type) -> tuple[Signature, Callable[..., ir.Value]]:
+def _next_double(
+    typingctx: TypingContext, function: types.Type, state: types.Type
+) -> tuple[Signature, Callable[..., ir.Value]]:
     """Call the bit generator's ``double next_double(void *state)`` at address ``function``."""
+
     def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         kind = ir.FunctionType(ir.DoubleType(), [ir.IntType(64)])
         return builder.call(builder.inttoptr(args[0], kind.as_pointer()), [args[1]])
+
     return types.float64(types.uint64, types.uint64), codegen
 
 
@@ -175,17 +183,21 @@ def _pcg64_next64(typingctx: TypingContext, address: types.Type) -> tuple[Signat
     """numpy's ``pcg64_next64`` on the ``pcg64_random_t`` (state, inc: 128-bit each) at ``address``
     (numpy/random/src/pcg64/pcg64.h, pcg_setseq_128_xsl_rr_64_random_r): state = state * multiplier + inc,
     stored back; the output is the XSL-RR of the new state."""
+
     def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
         i64, i128 = ir.IntType(64), ir.IntType(128)
         words = builder.inttoptr(args[0], i128.as_pointer())
         inc_words = builder.gep(words, [ir.Constant(ir.IntType(32), 1)])
-        state = builder.add(builder.mul(builder.load(words, align=8), ir.Constant(i128, PCG64_MULTIPLIER)),
-                            builder.load(inc_words, align=8))
+        state = builder.add(
+            builder.mul(builder.load(words, align=8), ir.Constant(i128, PCG64_MULTIPLIER)),
+            builder.load(inc_words, align=8),
+        )
         builder.store(state, words, align=8)
         xored = builder.xor(builder.trunc(builder.lshr(state, ir.Constant(i128, 64)), i64), builder.trunc(state, i64))
         rot = builder.trunc(builder.lshr(state, ir.Constant(i128, 122)), i64)
         back = builder.and_(builder.neg(rot), ir.Constant(i64, 63))  # pcg_rotr_64: (v >> rot) | (v << (-rot & 63))
         return builder.or_(builder.lshr(xored, rot), builder.shl(xored, back))
+
     return types.uint64(types.uint64), codegen
 
 
@@ -195,18 +207,24 @@ def _next64(handle: np.uint64) -> np.uint64:
     # the ignores here and below: numba's stubs type an @intrinsic's call as its typing function's (typingctx first)
     if handle & np.uint64(INLINE):
         return _pcg64_next64(handle - np.uint64(INLINE))  # type: ignore[call-arg,arg-type]
-    return _next_uint64(_word(handle + np.uint64(_NEXT_UINT64 * WORD)),  # type: ignore[call-arg,arg-type]
-                        _word(handle))  # type: ignore[call-arg,arg-type]
+    return _next_uint64(  # type: ignore[call-arg]
+        _word(handle + np.uint64(_NEXT_UINT64 * WORD)),  # type: ignore[call-arg,arg-type]
+        _word(handle),  # type: ignore[call-arg,arg-type]
+    )
 
 
 @njit(nogil=True, refcounts=False, inline="always")
 def _next_uniform(handle: np.uint64) -> float:
     """The bit generator's next_double: for PCG64 numpy's ``uint64_to_double`` of next_uint64 (_common.pxd)."""
     if handle & np.uint64(INLINE):
-        return float(_pcg64_next64(handle - np.uint64(INLINE))  # type: ignore[call-arg,arg-type]  # as above
-                     >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-    return _next_double(_word(handle + np.uint64(_NEXT_DOUBLE * WORD)),  # type: ignore[call-arg,arg-type]
-                        _word(handle))  # type: ignore[call-arg,arg-type]
+        return float(
+            _pcg64_next64(handle - np.uint64(INLINE))  # type: ignore[call-arg,arg-type]  # as above
+            >> np.uint64(11)
+        ) * (1.0 / 9007199254740992.0)
+    return _next_double(  # type: ignore[call-arg]
+        _word(handle + np.uint64(_NEXT_DOUBLE * WORD)),  # type: ignore[call-arg,arg-type]
+        _word(handle),  # type: ignore[call-arg,arg-type]
+    )
 
 
 @njit(nogil=True, refcounts=False, inline="always")
@@ -231,8 +249,9 @@ def standard_normal(bitgen: np.uint64) -> float:
                 yy = -np.log1p(-_next_uniform(handle))
                 if yy + yy > xx * xx:
                     return -(ziggurat_nor_r + xx) if (rabs >> np.uint64(8)) & np.uint64(1) else ziggurat_nor_r + xx
-        elif ((fi_double[idx - np.uint64(1)] - fi_double[idx]) * _next_uniform(handle) + fi_double[idx]
-              < np.exp(-0.5 * x * x)):
+        elif (fi_double[idx - np.uint64(1)] - fi_double[idx]) * _next_uniform(handle) + fi_double[idx] < np.exp(
+            -0.5 * x * x
+        ):
             return x
 
 

@@ -48,8 +48,19 @@ K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "dis
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_from(s: np.ndarray, c: float, sn: float, p: np.ndarray, lx: float, ly: float, turn: float,
-               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray = NO_SHADE) -> float:
+def light_from(
+    s: np.ndarray,
+    c: float,
+    sn: float,
+    p: np.ndarray,
+    lx: float,
+    ly: float,
+    turn: float,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    shade: np.ndarray = NO_SHADE,
+) -> float:
     """Light a sensor at (lx, ly) in the body frame, pointing ``turn`` radians left of ahead, receives:
     sum of intensity / d² × cos(angle)^k over unshadowed lamps (``c``, ``sn``: the heading's cosine and sine;
     ``shade``: the world's shadow grid, sim.physics.shadows).
@@ -84,8 +95,21 @@ def lamp_light(p: np.ndarray, intensity: float, cosine: float, d: float) -> floa
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def light_turned(s: np.ndarray, c: float, sn: float, p: np.ndarray, lx: float, ly: float, turn: float, ct: float,
-                 st: float, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray) -> float:
+def light_turned(
+    s: np.ndarray,
+    c: float,
+    sn: float,
+    p: np.ndarray,
+    lx: float,
+    ly: float,
+    turn: float,
+    ct: float,
+    st: float,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    shade: np.ndarray,
+) -> float:
     """:func:`light_from`'s answer, for a sensor whose turn from the heading has cosine ``ct`` and sine ``st``:
     each lamp is first ruled out cheaply when surely out of view (:func:`out_of_view`) or in shadow, and only
     the lamps left are worked out as light_from does (the aim's cos/sin and the hypot only for them).
@@ -166,8 +190,9 @@ def beam_segment(ux: float, uy: float, cb: float, sb: float, ax: float, ay: floa
             t1 = min(t1, ha / (ha - hb))
     if t0 > t1:
         return math.inf
-    return point_segment_distance(0.0, 0.0, ax + t0 * (bx - ax), ay + t0 * (by - ay),
-                                  ax + t1 * (bx - ax), ay + t1 * (by - ay))
+    return point_segment_distance(
+        0.0, 0.0, ax + t0 * (bx - ax), ay + t0 * (by - ay), ax + t1 * (bx - ax), ay + t1 * (by - ay)
+    )
 
 
 @njit(cache=True, refcounts=False)
@@ -224,8 +249,17 @@ def echo(sx: float, sy: float, aim: float, p: np.ndarray, edges: np.ndarray, cir
 
 
 @njit(cache=True, refcounts=False)
-def sense_declared(s: np.ndarray, c: float, sn: float, p: np.ndarray, edges: np.ndarray, circles: np.ndarray,
-                   lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray = NO_SHADE) -> None:
+def sense_declared(
+    s: np.ndarray,
+    c: float,
+    sn: float,
+    p: np.ndarray,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    lines: np.ndarray,
+    shade: np.ndarray = NO_SHADE,
+) -> None:
     """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
     (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.physics.shadows)."""
     for k in range(MAX_SENSORS):

@@ -37,8 +37,9 @@ def shade_grid(edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray) -> np.
     empty when the world has no lamps or nothing to cast a shadow."""
     if not lamps.shape[0] or not edges.shape[0] + circles.shape[0]:
         return NO_SHADE
-    points = np.concatenate([edges[:, :2], edges[:, 2:], circles[:, :2] - circles[:, 2:3],
-                             circles[:, :2] + circles[:, 2:3], lamps[:, :2]])
+    points = np.concatenate(
+        [edges[:, :2], edges[:, 2:], circles[:, :2] - circles[:, 2:3], circles[:, :2] + circles[:, 2:3], lamps[:, :2]]
+    )
     low, high = points.min(axis=0), points.max(axis=0)
     size = max(1.0, float(np.abs(points).max()), float((high - low).max()))
     scale = CELLS / max(float((high - low).max()), 1e-3)  # cells per metre
@@ -47,14 +48,19 @@ def shade_grid(edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray) -> np.
     i, j = np.meshgrid(np.arange(nx), np.arange(ny))  # cell j * nx + i
     x0, y0 = i.ravel() / scale + low[0] - margin, j.ravel() / scale + low[1] - margin
     x1, y1 = (i.ravel() + 1) / scale + low[0] + margin, (j.ravel() + 1) / scale + low[1] + margin
-    corners = np.stack([np.stack([x0, y0], 1), np.stack([x1, y0], 1), np.stack([x1, y1], 1),
-                        np.stack([x0, y1], 1)], 1)  # (cells, 4, 2)
+    corners = np.stack(
+        [np.stack([x0, y0], 1), np.stack([x1, y0], 1), np.stack([x1, y1], 1), np.stack([x0, y1], 1)], 1
+    )  # (cells, 4, 2)
     counts: list = []
     items: list = []
     for k, lamp in enumerate(lamps[:, :2]):
         keep = [_edge_may_block(corners, lamp, e, tolerance) for e in edges]
-        keep += [_circle_may_block(corners, lamp, c, margin, tolerance) if int(c[3]) != k  # never its own base
-                 else np.zeros(nx * ny, bool) for c in circles]
+        keep += [
+            _circle_may_block(corners, lamp, c, margin, tolerance)
+            if int(c[3]) != k  # never its own base
+            else np.zeros(nx * ny, bool)
+            for c in circles
+        ]
         table = np.stack(keep, 1)  # (cells, pieces)
         counts.append(table.sum(1))
         items.append(np.nonzero(table)[1])  # row by row: each cell's pieces in index order
@@ -79,8 +85,9 @@ def _edge_may_block(corners: np.ndarray, lamp: np.ndarray, edge: np.ndarray, tol
     return ~(apart | beside)
 
 
-def _circle_may_block(corners: np.ndarray, lamp: np.ndarray, circle: np.ndarray, margin: float,
-                      tolerance: float) -> np.ndarray:
+def _circle_may_block(
+    corners: np.ndarray, lamp: np.ndarray, circle: np.ndarray, margin: float, tolerance: float
+) -> np.ndarray:
     """Per cell: False when the circle is surely farther than its radius from every segment cell -> lamp."""
     cx, cy, r = circle[0], circle[1], circle[2] + margin
     px, py = corners[..., 0], corners[..., 1]
@@ -95,8 +102,9 @@ def _circle_may_block(corners: np.ndarray, lamp: np.ndarray, circle: np.ndarray,
 
 
 @njit(cache=True, refcounts=False)
-def shadowed_near(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray, circles: np.ndarray,
-                  shade: np.ndarray) -> bool:
+def shadowed_near(
+    sx: float, sy: float, lx: float, ly: float, lamp: int, edges: np.ndarray, circles: np.ndarray, shade: np.ndarray
+) -> bool:
     """:func:`tablebot.sim.physics.geometry.shadowed`'s answer, testing only the pieces the grid ``shade`` lists for
     the sensor's cell (every piece when there is no grid or the sensor is outside it)."""
     if shade.shape[0] == 0:
@@ -112,7 +120,8 @@ def shadowed_near(sx: float, sy: float, lx: float, ly: float, lamp: int, edges: 
         if k < n_edges:
             if segments_cross(sx, sy, lx, ly, edges[k, 0], edges[k, 1], edges[k, 2], edges[k, 3]):
                 return True
-        elif point_segment_within(circles[k - n_edges, 0], circles[k - n_edges, 1], sx, sy, lx, ly,
-                                  circles[k - n_edges, 2], True):
+        elif point_segment_within(
+            circles[k - n_edges, 0], circles[k - n_edges, 1], sx, sy, lx, ly, circles[k - n_edges, 2], True
+        ):
             return True
     return False

@@ -79,9 +79,21 @@ NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 
 # --- light ---------------------------------------------------------------------------------------
 
+
 @njit(cache=True, refcounts=False, inline="always")
-def light_side(s: np.ndarray, c: float, sn: float, p: np.ndarray, side: float, ct: float, st: float,
-               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, shade: np.ndarray) -> float:
+def light_side(
+    s: np.ndarray,
+    c: float,
+    sn: float,
+    p: np.ndarray,
+    side: float,
+    ct: float,
+    st: float,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    shade: np.ndarray,
+) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives (``c``,
     ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
     the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
@@ -97,14 +109,22 @@ def aim_turns(p: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def light_at(s: np.ndarray, p: np.ndarray, side: float, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray,
-             shade: np.ndarray = NO_SHADE) -> float:
+def light_at(
+    s: np.ndarray,
+    p: np.ndarray,
+    side: float,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    shade: np.ndarray = NO_SHADE,
+) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
     turns = np.empty(4)
     aim_turns(p, turns)
     k = 0 if side < 0.0 else 2
-    return light_side(s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps,
-                      shade)
+    return light_side(
+        s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps, shade
+    )
 
 
 # --- motors, battery, motion ---------------------------------------------------------------------
@@ -123,8 +143,9 @@ def pack_volts(full: float, empty: float, charge: float, amps: float, ohms: floa
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def motor(s: np.ndarray, p: np.ndarray, level: int, volts: float, gain: int, speed: int, enc: int, pul: int,
-          noise: float) -> None:
+def motor(
+    s: np.ndarray, p: np.ndarray, level: int, volts: float, gain: int, speed: int, enc: int, pul: int, noise: float
+) -> None:
     """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
     The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
@@ -173,10 +194,25 @@ def input_mask(s: np.ndarray, bits: np.ndarray) -> int:
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, pstart: np.ndarray, pbound: np.ndarray,
-               edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, lines: np.ndarray, shade: np.ndarray,
-               bits: np.ndarray, reach: float, wide: float, near: np.ndarray, centre: np.ndarray,
-               turns: np.ndarray) -> None:
+def sense_near(
+    s: np.ndarray,
+    p: np.ndarray,
+    z: np.ndarray,
+    verts: np.ndarray,
+    pstart: np.ndarray,
+    pbound: np.ndarray,
+    edges: np.ndarray,
+    circles: np.ndarray,
+    lamps: np.ndarray,
+    lines: np.ndarray,
+    shade: np.ndarray,
+    bits: np.ndarray,
+    reach: float,
+    wide: float,
+    near: np.ndarray,
+    centre: np.ndarray,
+    turns: np.ndarray,
+) -> None:
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.physics.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
@@ -193,8 +229,16 @@ def sense_near(s: np.ndarray, p: np.ndarray, z: np.ndarray, verts: np.ndarray, p
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray, move: bool,
-            scratch: Scratch) -> None:
+def advance(
+    s: np.ndarray,
+    right: int,
+    left: int,
+    p: np.ndarray,
+    world: WorldArrays,
+    bits: np.ndarray,
+    move: bool,
+    scratch: Scratch,
+) -> None:
     """One robot, one tick: drive with motor levels ``right``/``left`` (when ``move``), resolve contacts,
     sense, moved by the noise row ``scratch.z``; fills the robot's MASK column. ``scratch`` also keeps the
     robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.physics.contacts.new_near`)."""
@@ -203,16 +247,42 @@ def advance(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArr
         x0, y0 = s[X], s[Y]
         cmd = (right, left)
         drive(s, cmd, p, scratch.z)
-        resolve(s, p, scratch.corners, w.verts, w.pstart, w.pbound, w.circles, scratch.reach, scratch.wide, near,
-                centre)
+        resolve(
+            s, p, scratch.corners, w.verts, w.pstart, w.pbound, w.circles, scratch.reach, scratch.wide, near, centre
+        )
         s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
-    sense_near(s, p, scratch.z, w.verts, w.pstart, w.pbound, w.edges, w.circles, w.lamps, w.lines, w.shade, bits,
-               scratch.reach, scratch.wide, near, centre, scratch.turns)
+    sense_near(
+        s,
+        p,
+        scratch.z,
+        w.verts,
+        w.pstart,
+        w.pbound,
+        w.edges,
+        w.circles,
+        w.lamps,
+        w.lines,
+        w.shade,
+        bits,
+        scratch.reach,
+        scratch.wide,
+        near,
+        centre,
+        scratch.turns,
+    )
 
 
 @njit(cache=True, refcounts=False)
-def advance_called(s: np.ndarray, right: int, left: int, p: np.ndarray, world: WorldArrays, bits: np.ndarray,
-                   move: bool, scratch: Scratch) -> None:
+def advance_called(
+    s: np.ndarray,
+    right: int,
+    left: int,
+    p: np.ndarray,
+    world: WorldArrays,
+    bits: np.ndarray,
+    move: bool,
+    scratch: Scratch,
+) -> None:
     """:func:`advance` compiled once as a function of its own, for sim.physics.kernel.move and sense: the tick-by-tick
     robot, a fleet's first readings and the Gymnasium env's physics-only loop (fleet.kernel.move_serial),
     where a call per robot-tick costs little beside the rest of a controller's step, and each inlined copy

@@ -52,8 +52,17 @@ class Player:
         self.trail = LineCollection([], linewidths=1.8, zorder=4)
         self.ax.add_collection(self.trail)
         self.robot = RobotArtist(self.ax, scene.params, len(scene.lamp_outputs), sensors=scene.table.robot.sensors)
-        self.hud = self.ax.text(1.0, 1.02, "", transform=self.ax.transAxes, va="bottom", ha="right", fontsize=9,
-                                family="monospace", zorder=20)
+        self.hud = self.ax.text(
+            1.0,
+            1.02,
+            "",
+            transform=self.ax.transAxes,
+            va="bottom",
+            ha="right",
+            fontsize=9,
+            family="monospace",
+            zorder=20,
+        )
         self.speed = speed
         self.frames = result.ticks // ticks_per_frame + 1
 
@@ -66,17 +75,23 @@ class Player:
         assert r.hist is not None  # checked when made
         h = r.hist[t]
         last = r.outputs[t - 1] if t > 0 else np.zeros(len(scene.machine.output_names), dtype=np.int64)
-        self.robot.update(h[L.X], h[L.Y], h[L.TH],
-                          bumpers=(h[L.BUMP_FR] > 0, h[L.BUMP_FL] > 0, h[L.BUMP_REAR] > 0),
-                          lights=(h[L.LIGHT_R] >= 1, h[L.LIGHT_L] >= 1),
-                          lamps=tuple(int(last[i]) for i in scene.lamp_outputs),
-                          readings=sensor_readings(h, scene.table.robot.sensors))
+        self.robot.update(
+            h[L.X],
+            h[L.Y],
+            h[L.TH],
+            bumpers=(h[L.BUMP_FR] > 0, h[L.BUMP_FL] > 0, h[L.BUMP_REAR] > 0),
+            lights=(h[L.LIGHT_R] >= 1, h[L.LIGHT_L] >= 1),
+            lamps=tuple(int(last[i]) for i in scene.lamp_outputs),
+            readings=sensor_readings(h, scene.table.robot.sensors),
+        )
         state = scene.machine.states[r.states[max(0, t - 1)]] if r.ticks else scene.table.robot.initial_state
         names = scene.machine.output_names
         n_motors = scene.machine.n_motors
         on, off = _("on {level}"), _("off")  # a lamp's words
-        outputs = "  ".join(f"{n} {int(v):+d}" if k < n_motors else f"{n} {on.format(level=int(v)) if v else off}"
-                            for k, (n, v) in enumerate(zip(names, last, strict=True)))
+        outputs = "  ".join(
+            f"{n} {int(v):+d}" if k < n_motors else f"{n} {on.format(level=int(v)) if v else off}"
+            for k, (n, v) in enumerate(zip(names, last, strict=True))
+        )
         speed = "   " + _("({speed:g}× speed)").format(speed=self.speed) if self.speed != 1 else ""
         now = picture(f"{scene.table.state_title(state)}   {outputs}")
         self.hud.set_text(f"t = {number(t * r.tick_s, '6.2f')} s{speed}\n{now}")
@@ -111,8 +126,9 @@ def write_gif(result: SimRun, summary: Summary, path: Path) -> Path:
     palette = frames[-1].quantize(colors=255, method=Image.Quantize.MEDIANCUT)
     indexed = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
     with atomic_write(path, "wb") as stream:
-        indexed[0].save(stream, format="GIF", save_all=True, append_images=indexed[1:],
-                        duration=round(1000 / GIF_FPS), loop=0)
+        indexed[0].save(
+            stream, format="GIF", save_all=True, append_images=indexed[1:], duration=round(1000 / GIF_FPS), loop=0
+        )
     return path
 
 
@@ -121,9 +137,14 @@ def check_display() -> None:
     import matplotlib.pyplot as plt
 
     if not _interactive(plt.get_backend()):
-        raise fail("--view", N_("no window can be opened here (no display, or matplotlib's backend is {backend!r})",
-                                backend=plt.get_backend()),
-                   N_("run without --view and open the pictures, or use --gif"))
+        raise fail(
+            "--view",
+            N_(
+                "no window can be opened here (no display, or matplotlib's backend is {backend!r})",
+                backend=plt.get_backend(),
+            ),
+            N_("run without --view and open the pictures, or use --gif"),
+        )
 
 
 @literal_text()
@@ -135,12 +156,18 @@ def show(result: SimRun, summary: Summary) -> None:
     fig = plt.figure(figsize=(9, 7.5))
     fps = 20
     player = Player(fig, result, summary, max(1, round(1 / fps / result.tick_s)), 1.0)
-    animation = FuncAnimation(fig, player.draw, frames=player.frames, interval=1000 / fps, blit=True,
-                              repeat=False)
+    animation = FuncAnimation(fig, player.draw, frames=player.frames, interval=1000 / fps, blit=True, repeat=False)
     plt.show()
     del animation
 
 
 def _interactive(backend: str) -> bool:
-    return backend.lower() not in ("agg", "pdf", "ps", "svg", "cairo", "pgf", "template") and \
-        not backend.lower().startswith("module://matplotlib_inline")
+    return backend.lower() not in (
+        "agg",
+        "pdf",
+        "ps",
+        "svg",
+        "cairo",
+        "pgf",
+        "template",
+    ) and not backend.lower().startswith("module://matplotlib_inline")

@@ -32,6 +32,7 @@ from tablebot.sim.model.world import Geometry, World
 def literal_text() -> Any:
     return matplotlib.rc_context({"text.parse_math": False})
 
+
 FLOOR, WALL, OBSTACLE, OBSTACLE_EDGE = "#f6f3ec", "#2f3640", "#a4b0be", "#57606f"
 LAMP_ON, LAMP_OFF, BODY, BUMPER, BUMPER_ON = "#ffd32a", "#d2dae2", "#dfe4ea", "#57606f", "#ff3f34"
 COLLISION, LIGHT_SEEN, REACHED = "#e8413a", "#f0a500", "#20bf6b"
@@ -45,29 +46,71 @@ def draw_world(ax: Axes, world: World, lamp_glow: bool = True) -> None:
     floor = Polygon(world.walls, closed=True, facecolor=FLOOR, edgecolor=WALL, linewidth=3, zorder=0)
     ax.add_patch(floor)
     for box in world.boxes:
-        ax.add_patch(Polygon(box.corners(), closed=True, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE,
-                             linewidth=1.2, hatch="//", zorder=2))
+        ax.add_patch(
+            Polygon(
+                box.corners(),
+                closed=True,
+                facecolor=OBSTACLE,
+                edgecolor=OBSTACLE_EDGE,
+                linewidth=1.2,
+                hatch="//",
+                zorder=2,
+            )
+        )
     for circle in world.circles:
-        ax.add_patch(CirclePatch(circle.at, circle.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE,
-                                 linewidth=1.2, hatch="//", zorder=2))
+        ax.add_patch(
+            CirclePatch(
+                circle.at,
+                circle.radius,
+                facecolor=OBSTACLE,
+                edgecolor=OBSTACLE_EDGE,
+                linewidth=1.2,
+                hatch="//",
+                zorder=2,
+            )
+        )
     for seg in world.segments:
         ax.plot(*zip(seg.start, seg.end, strict=True), color=WALL, linewidth=3, solid_capstyle="round", zorder=2)
     draw_tape(ax, world)
     for lamp in world.lamps:
         if lamp_glow:
             for k, radius in enumerate((0.45, 0.3, 0.18)):
-                ax.add_patch(CirclePatch(lamp.at, radius, facecolor=LAMP_ON, alpha=0.12 + 0.08 * k,
-                                         linewidth=0, zorder=1))
+                ax.add_patch(
+                    CirclePatch(lamp.at, radius, facecolor=LAMP_ON, alpha=0.12 + 0.08 * k, linewidth=0, zorder=1)
+                )
             # a sensor looking straight at the lamp reads the threshold at sqrt(intensity) metres
-            ring = CirclePatch(lamp.at, math.sqrt(lamp.intensity), fill=False, edgecolor="#b8860b",
-                               linestyle="--", linewidth=1, alpha=0.6, zorder=1)
+            ring = CirclePatch(
+                lamp.at,
+                math.sqrt(lamp.intensity),
+                fill=False,
+                edgecolor="#b8860b",
+                linestyle="--",
+                linewidth=1,
+                alpha=0.6,
+                zorder=1,
+            )
             ax.add_patch(ring)
             ring.set_clip_path(floor)
         if lamp.radius > 0:  # the lamp's base is an obstacle the robot bumps into: drawn as one, to scale
-            ax.add_patch(CirclePatch(lamp.at, lamp.radius, facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, linewidth=1.2,
-                                     hatch="//", zorder=2))
-        ax.plot(*lamp.at, marker="*", markersize=9 if lamp.radius > 0 else 16, color=LAMP_ON,
-                markeredgecolor="#b8860b", zorder=12)
+            ax.add_patch(
+                CirclePatch(
+                    lamp.at,
+                    lamp.radius,
+                    facecolor=OBSTACLE,
+                    edgecolor=OBSTACLE_EDGE,
+                    linewidth=1.2,
+                    hatch="//",
+                    zorder=2,
+                )
+            )
+        ax.plot(
+            *lamp.at,
+            marker="*",
+            markersize=9 if lamp.radius > 0 else 16,
+            color=LAMP_ON,
+            markeredgecolor="#b8860b",
+            zorder=12,
+        )
     xs, ys = zip(*world.walls, strict=True)
     pad = 0.05 * max(max(xs) - min(xs), max(ys) - min(ys))
     ax.set_xlim(min(xs) - pad, max(xs) + pad)
@@ -94,7 +137,7 @@ def draw_tape(ax: Axes, world: World) -> None:
 
 def contact_point(geometry: Geometry, params: Params, x: float, y: float, theta: float) -> tuple[float, float]:
     """Where the robot at this pose touches the world (see :func:`contact_points`)."""
-    (cx, cy), = contact_points(geometry, params, np.array([[x, y, theta]]))
+    ((cx, cy),) = contact_points(geometry, params, np.array([[x, y, theta]]))
     return float(cx), float(cy)
 
 
@@ -110,7 +153,7 @@ def contact_points(geometry: Geometry, params: Params, poses: np.ndarray) -> np.
     found = np.empty((len(poses), 2))
     step = max(1, (1 << 18) // len(outline))
     for at in range(0, len(poses), step):
-        found[at:at + step] = _touching(geometry, outline, math.hypot(max(f, -r), w), poses[at:at + step])
+        found[at : at + step] = _touching(geometry, outline, math.hypot(max(f, -r), w), poses[at : at + step])
     return found
 
 
@@ -141,8 +184,10 @@ def _touching(geometry: Geometry, outline: np.ndarray, reach: float, poses: np.n
         points = np.stack((nx[rows, :, edge], ny[rows, :, edge]), axis=-1)  # (N, M, 2)
         for k in range(n):  # the middle of each stretch, summed in the order numpy sums it alone
             where[k] = points[k, touching[k]].mean(axis=0)
-    circles = _near(np.hypot(geometry.circles[:, 0] - x[:, None], geometry.circles[:, 1] - y[:, None])
-                    - geometry.circles[:, 2], 2 * reach + 1e-6)
+    circles = _near(
+        np.hypot(geometry.circles[:, 0] - x[:, None], geometry.circles[:, 1] - y[:, None]) - geometry.circles[:, 2],
+        2 * reach + 1e-6,
+    )
     if circles.shape[1]:
         held = geometry.circles[circles][:, None]  # (N, 1, K, 3)
         ox, oy = px - held[..., 0], py - held[..., 1]
@@ -171,7 +216,7 @@ def _near(distance: np.ndarray, slack: float) -> np.ndarray:
     if not distance.shape[1]:
         return np.zeros((len(distance), 0), dtype=np.int64)
     near = distance <= distance.min(axis=1, keepdims=True) + slack
-    order = np.sort(np.where(near, np.arange(near.shape[1]), near.shape[1]), axis=1)[:, :near.sum(axis=1).max()]
+    order = np.sort(np.where(near, np.arange(near.shape[1]), near.shape[1]), axis=1)[:, : near.sum(axis=1).max()]
     last = order[np.arange(len(order)), near.sum(axis=1) - 1]
     return np.where(order == near.shape[1], last[:, None], order)
 
@@ -180,8 +225,12 @@ def _near(distance: np.ndarray, slack: float) -> np.ndarray:
 def _outline(f: float, r: float, w: float) -> np.ndarray:
     """The body's outline in its own frame, a point every 2 mm (made once per body, not per collision)."""
     corners = np.array([(f, -w), (f, w), (r, w), (r, -w), (f, -w)])
-    outline = np.concatenate([np.linspace(a, b, max(2, int(math.hypot(*(b - a)) / 0.002)), endpoint=False)
-                              for a, b in itertools.pairwise(corners)])
+    outline = np.concatenate(
+        [
+            np.linspace(a, b, max(2, int(math.hypot(*(b - a)) / 0.002)), endpoint=False)
+            for a, b in itertools.pairwise(corners)
+        ]
+    )
     outline.flags.writeable = False
     return outline
 
@@ -208,28 +257,40 @@ class RobotArtist:
         self.body_pts = np.array([(f, -w), (f, w), (r, w), (r, -w)])
         t = 0.012  # drawn bumper thickness
         # bumpers drawn just inside the outline (the body outline is what touches)
-        self.bump_pts = [np.array([(f, -w), (f, ov), (f - t, ov), (f - t, -w)]),
-                         np.array([(f, -ov), (f, w), (f - t, w), (f - t, -ov)]),
-                         np.array([(r, -w), (r, w), (r + t, w), (r + t, -w)])]
+        self.bump_pts = [
+            np.array([(f, -w), (f, ov), (f - t, ov), (f - t, -w)]),
+            np.array([(f, -ov), (f, w), (f - t, w), (f - t, -ov)]),
+            np.array([(r, -w), (r, w), (r + t, w), (r + t, -w)]),
+        ]
         self.lamp_pts = np.array([(r + 0.03 + 0.035 * k, 0.0) for k in range(self.n_lamps)]).reshape(-1, 2)
         self.cone_len = 0.25
         self.sensor_pts = np.array([(light["forward"], -light["sideways"]), (light["forward"], light["sideways"])])
         self.toe = math.radians(light["toe_out"])
         self.fov = light["half_response"]
         z = 8
-        self.body = Polygon(self.body_pts, closed=True, facecolor=BODY, edgecolor=WALL, lw=1.2, alpha=self.alpha,
-                            zorder=z)
-        self.bumpers = [Polygon(p, closed=True, facecolor=BUMPER, lw=0, alpha=self.alpha, zorder=z + 1)
-                        for p in self.bump_pts]
-        self.cones = [Wedge((0, 0), self.cone_len, 0, 1, facecolor=LAMP_ON, alpha=0.18 * self.alpha, lw=0,
-                            zorder=z - 1) for _ in range(2)]
-        self.lamps = [CirclePatch((0, 0), 0.016, facecolor=LAMP_OFF, edgecolor=WALL, lw=0.8, alpha=self.alpha,
-                                  zorder=z + 3) for _ in range(self.n_lamps)]
-        self.glows = [CirclePatch((0, 0), 0.04, facecolor=LAMP_ON, lw=0, alpha=0.0, zorder=z + 2)
-                      for _ in range(self.n_lamps)]
+        self.body = Polygon(
+            self.body_pts, closed=True, facecolor=BODY, edgecolor=WALL, lw=1.2, alpha=self.alpha, zorder=z
+        )
+        self.bumpers = [
+            Polygon(p, closed=True, facecolor=BUMPER, lw=0, alpha=self.alpha, zorder=z + 1) for p in self.bump_pts
+        ]
+        self.cones = [
+            Wedge((0, 0), self.cone_len, 0, 1, facecolor=LAMP_ON, alpha=0.18 * self.alpha, lw=0, zorder=z - 1)
+            for _ in range(2)
+        ]
+        self.lamps = [
+            CirclePatch((0, 0), 0.016, facecolor=LAMP_OFF, edgecolor=WALL, lw=0.8, alpha=self.alpha, zorder=z + 3)
+            for _ in range(self.n_lamps)
+        ]
+        self.glows = [
+            CirclePatch((0, 0), 0.04, facecolor=LAMP_ON, lw=0, alpha=0.0, zorder=z + 2) for _ in range(self.n_lamps)
+        ]
         wiring = self.params.wiring  # a bumper or phototransistor not wired to an input is not drawn
-        for patch, role in zip([*self.bumpers, *self.cones], ("front_right", "front_left", "rear", "light_right",
-                                                             "light_left"), strict=True):
+        for patch, role in zip(
+            [*self.bumpers, *self.cones],
+            ("front_right", "front_left", "rear", "light_right", "light_left"),
+            strict=True,
+        ):
             patch.set_visible(bool(wiring.get(role)))
         self.heading = self.ax.plot([], [], color=WALL, lw=1.5, alpha=self.alpha, zorder=z + 1)[0]
         self.declared = [self._sensor_patch(sensor, z) for sensor in self.sensors]
@@ -239,17 +300,25 @@ class RobotArtist:
     def _sensor_patch(self, sensor: Sensor, z: int) -> Polygon | Wedge:
         """How its kind is drawn (``SensorKind.draw``): a spot, a beam or a cone."""
         if sensor.sensor_kind.draw == "spot":  # a 12 mm spot on the body, dark while it reads 1 (over tape)
-            return Polygon(np.zeros((4, 2)), closed=True, facecolor="white", edgecolor=TAPE, lw=0.8,
-                           alpha=self.alpha, zorder=z + 4)
+            return Polygon(
+                np.zeros((4, 2)), closed=True, facecolor="white", edgecolor=TAPE, lw=0.8, alpha=self.alpha, zorder=z + 4
+            )
         colour = BEAM if sensor.sensor_kind.draw == "beam" else LAMP_ON
         return Wedge((0, 0), 0.01, 0, 1, facecolor=colour, alpha=0.2 * self.alpha, lw=0, zorder=z - 1)
 
     def artists(self) -> list:
         return [self.body, *self.bumpers, *self.cones, *self.glows, *self.lamps, *self.declared, self.heading]
 
-    def update(self, x: float, y: float, theta: float, bumpers: tuple[bool, bool, bool] = (False,) * 3,
-               lights: tuple[bool, bool] = (False, False), lamps: tuple[int, ...] = (),
-               readings: tuple[float, ...] = ()) -> None:
+    def update(
+        self,
+        x: float,
+        y: float,
+        theta: float,
+        bumpers: tuple[bool, bool, bool] = (False,) * 3,
+        lights: tuple[bool, bool] = (False, False),
+        lamps: tuple[int, ...] = (),
+        readings: tuple[float, ...] = (),
+    ) -> None:
         """Move to (x, y, theta); ``readings`` are the declared sensors' (``sensor_readings``)."""
         self.body.set_xy(_transform(self.body_pts, x, y, theta))
         for patch, pts, on in zip(self.bumpers, self.bump_pts, bumpers, strict=True):
@@ -273,8 +342,9 @@ class RobotArtist:
         for spot, sensor, value in zip(self.declared, self.sensors, values, strict=True):
             self._update_sensor(spot, sensor, value, x, y, theta)
 
-    def _update_sensor(self, patch: Polygon | Wedge, sensor: Sensor, value: float, x: float, y: float,
-                       theta: float) -> None:
+    def _update_sensor(
+        self, patch: Polygon | Wedge, sensor: Sensor, value: float, x: float, y: float, theta: float
+    ) -> None:
         at = np.array(sensor.at)
         if isinstance(patch, Polygon):
             spot = at + np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)]) * 0.006

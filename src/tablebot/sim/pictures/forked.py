@@ -171,8 +171,9 @@ def _pipe(opened: list[int]) -> tuple[int, int]:
     return read, write
 
 
-def _child(work: Callable[[Inbox], bytes], answers: int, questions: int, parent: int,
-           blocked: set[int | signal.Signals]) -> None:
+def _child(
+    work: Callable[[Inbox], bytes], answers: int, questions: int, parent: int, blocked: set[int | signal.Signals]
+) -> None:
     """The copy: do the work, write the answer, end without any of the parent's clean-up."""
     code = 1
     try:
@@ -236,7 +237,7 @@ def _write_message(pipe: int, message: object) -> None:
 def _write_all(pipe: int, data: bytes | memoryview) -> None:
     view = memoryview(data).cast("B")
     while len(view):
-        view = view[os.write(pipe, view):]
+        view = view[os.write(pipe, view) :]
 
 
 def _read_message(pipe: int) -> Any:

@@ -70,8 +70,10 @@ class Shared:
         """The arrays another process made with :meth:`zeros` (``made`` is its :attr:`made`)."""
         import numpy as np
 
-        return {name: np.ndarray(shape, np.dtype(dtype), buffer=self.memory, offset=at)
-                for name, (at, shape, dtype) in made.items()}
+        return {
+            name: np.ndarray(shape, np.dtype(dtype), buffer=self.memory, offset=at)
+            for name, (at, shape, dtype) in made.items()
+        }
 
 
 class Painter:
@@ -161,13 +163,26 @@ def _paint(shared: Shared | None, inbox: Inbox) -> bytes:
     while (message := inbox.get())[0] != "done":
         if message[0] == "arrays" and shared is not None:
             arrays = shared.arrays(message[1])
-        elif message[0] == "rows" and "hist" in arrays and "states" in arrays and message[1] - drawn >= ticks // 8 \
-                and not inbox.waiting():  # the path so far, an eighth of the run at a time (more news: the next)
+        elif (
+            message[0] == "rows"
+            and "hist" in arrays
+            and "states" in arrays
+            and message[1] - drawn >= ticks // 8
+            and not inbox.waiting()
+        ):  # the path so far, an eighth of the run at a time (more news: the next)
             hist, drawn = arrays["hist"], message[1]
             painting.grow(hist[:, kept.index(L.X)], hist[:, kept.index(L.Y)], arrays["states"], drawn)
     _, ticks, ends, summary, unshared = message
     arrays.update(unshared)
     # the run's History kept the columns start chose (kept)
-    run = RunView(scene, seed, arrays["hist"][: ticks + 1], kept, ends, arrays["states"][:ticks],
-                  arrays["outputs"][:ticks], arrays["events"][:ticks])
+    run = RunView(
+        scene,
+        seed,
+        arrays["hist"][: ticks + 1],
+        kept,
+        ends,
+        arrays["states"][:ticks],
+        arrays["outputs"][:ticks],
+        arrays["events"][:ticks],
+    )
     return pickle.dumps(painting.finish(run, summary), protocol=5)

@@ -42,23 +42,30 @@ def title_of(result: Run) -> str:
 def title(scene: SceneView | Scene, ticks: int, seed: int) -> str:
     """The pictures' title: the robot, the world, the run's length and seed (all known before the run)."""
     robot, world = picture(scene.table.robot.name), picture(scene.world.name)
-    return _("{robot} in {world} — {seconds:g} s, seed {seed}").format(robot=robot, world=world,
-                                                                        seconds=ticks * scene.tick_s, seed=seed)
+    return _("{robot} in {world} — {seconds:g} s, seed {seed}").format(
+        robot=robot, world=world, seconds=ticks * scene.tick_s, seed=seed
+    )
 
 
 def subtitle_of(summary: Summary) -> str:
     """The summary line under the title, in the reader's language (numbers with
     a decimal point, the same as the axes' ticks and every file tablebot writes)."""
+
     def when(v: float | None) -> str:
         return _("never") if v is None else f"{v:.1f} s"
+
     parts = []
     if summary.lamps:
-        parts += [_("light first seen: {when}").format(when=when(summary.first_light_s)),
-                  _("lamp reached: {when}").format(when=when(summary.reached_s))]
+        parts += [
+            _("light first seen: {when}").format(when=when(summary.first_light_s)),
+            _("lamp reached: {when}").format(when=when(summary.reached_s)),
+        ]
     if summary.laps is not None:
         parts.append(_("{laps:.2f} laps of the line").format(laps=summary.laps))
-    parts += [ngettext("{n} collision", "{n} collisions", summary.collisions).format(n=summary.collisions),
-              _("{metres:.2f} m driven").format(metres=summary.distance_m)]
+    parts += [
+        ngettext("{n} collision", "{n} collisions", summary.collisions).format(n=summary.collisions),
+        _("{metres:.2f} m driven").format(metres=summary.distance_m),
+    ]
     return "   ·   ".join(parts)
 
 
@@ -124,7 +131,8 @@ def deflated(rows: np.ndarray, above: np.ndarray | None, last: bool) -> tuple[by
     packer = zlib.compressobj(PNG_LEVEL, zlib.DEFLATED, -15)  # raw deflate: the zlib frame is made once
     # the ignores: numpy's stubs give ndarray a __buffer__ only for Python 3.12 on (mypy checks as 3.11)
     data = packer.compress(filtered) + packer.flush(  # type: ignore[arg-type]
-        zlib.Z_FINISH if last else zlib.Z_FULL_FLUSH)
+        zlib.Z_FINISH if last else zlib.Z_FULL_FLUSH
+    )
     return data, zlib.adler32(filtered), filtered.size  # type: ignore[arg-type]
 
 
@@ -135,12 +143,16 @@ def png_of_parts(parts: list[tuple[bytes, int, int]], width: int, height: int, d
         check = _adler32_combine(check, adler, length)
     stream = b"".join((b"\x78\x01", *(data for data, _adler, _length in parts), struct.pack(">I", check)))
     per_metre = int(dpi / 0.0254 + 0.5)
-    return b"".join((b"\x89PNG\r\n\x1a\n",
-                     _chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)),
-                     _chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
-                     _chunk(b"tEXt", b"Software\0" + SOFTWARE.encode("latin-1")),
-                     _chunk(b"IDAT", stream),
-                     _chunk(b"IEND", b"")))
+    return b"".join(
+        (
+            b"\x89PNG\r\n\x1a\n",
+            _chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)),
+            _chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+            _chunk(b"tEXt", b"Software\0" + SOFTWARE.encode("latin-1")),
+            _chunk(b"IDAT", stream),
+            _chunk(b"IEND", b""),
+        )
+    )
 
 
 def _adler32_combine(first: int, second: int, length: int) -> int:

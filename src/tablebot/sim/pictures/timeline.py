@@ -98,8 +98,9 @@ class TimelinePicture:
             if summary.first_light_s is not None:
                 ax.axvline(summary.first_light_s, color=LIGHT_SEEN, lw=1.5, ls="--", zorder=0)
             if k == 0:
-                key = "   " + (_("(red lines: collisions, dashed: first light)") if summary.lamps
-                               else _("(red lines: collisions)"))
+                key = "   " + (
+                    _("(red lines: collisions, dashed: first light)") if summary.lamps else _("(red lines: collisions)")
+                )
                 self.fig.text(0.07, 0.935, subtitle_of(summary) + key, fontsize=10, color="#444")
             self.finished.add(k)
         return self
@@ -142,7 +143,7 @@ class TimelinePicture:
             for artist in theirs:
                 artist.set_visible(True)
         pixels = np.asarray(cast(FigureCanvasAgg, self.fig.canvas).buffer_rgba())  # made on an Agg canvas
-        others = pixels[:edge] if lower else pixels[edge - 1:]  # the gap row above the edge must be blank
+        others = pixels[:edge] if lower else pixels[edge - 1 :]  # the gap row above the edge must be blank
         if not (others == 255).all():
             return None
         if lower:
@@ -168,10 +169,16 @@ def _vlines(ax: Axes, x: np.ndarray) -> None:
     segments = np.full((len(x), 3, 2), np.nan)
     segments[:, :2, 0] = x[:, None]
     segments[:, 0, 1], segments[:, 1, 1] = 0.0, 1.0
-    paths = [np.concatenate(segments[layer])[:-1] for layer in _apart(ax.transData.transform(
-        np.column_stack((x, np.zeros(len(x)))))[:, 0])]
-    ax.add_collection(LineCollection(paths, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0,
-                                     transform=ax.get_xaxis_transform()), autolim=False)
+    paths = [
+        np.concatenate(segments[layer])[:-1]
+        for layer in _apart(ax.transData.transform(np.column_stack((x, np.zeros(len(x)))))[:, 0])
+    ]
+    ax.add_collection(
+        LineCollection(
+            paths, colors=COLLISION, linewidths=0.8, alpha=0.5, zorder=0, transform=ax.get_xaxis_transform()
+        ),
+        autolim=False,
+    )
 
 
 APART_PX = 4.0  # a 0.8-point line at 150 dpi, snapped to the pixel grid and smoothed, covers under 3 pixels
@@ -248,8 +255,15 @@ def _output_panel(ax: Axes, result: RunView, t: np.ndarray) -> None:
         wide = k == 0  # the first drawn wide and pale, so equal speeds show both lines
         values = result.outputs[:, k]
         steps = np.concatenate(([0], np.flatnonzero(np.diff(values)) + 1, [len(values) - 1]))  # where it changes
-        ax.step(t[steps], values[steps], where="post", lw=3.2 if wide else 1.3, alpha=0.55 if wide else 1.0,
-                ls=style, label=label)
+        ax.step(
+            t[steps],
+            values[steps],
+            where="post",
+            lw=3.2 if wide else 1.3,
+            alpha=0.55 if wide else 1.0,
+            ls=style,
+            label=label,
+        )
     ax.axhline(0, color="#999", lw=0.6)
     ax.legend(loc="upper right", fontsize=8, ncol=len(names), frameon=False)
 
@@ -258,8 +272,9 @@ def _event_setup(ax: Axes, scene: SceneView) -> None:
     table, labels = scene.table, scene.table.robot.labels
     ax.set_yticks(range(len(table.events)))
     timer, counter = _("timer = 0"), _("counter = 0")  # what an event the robot does not label means
-    ax.set_yticklabels([picture(f"{n} {labels.get(n, timer if n == 'T' else counter)}")
-                        for n in table.events], fontsize=8)
+    ax.set_yticklabels(
+        [picture(f"{n} {labels.get(n, timer if n == 'T' else counter)}") for n in table.events], fontsize=8
+    )
     ax.set_ylim(-0.7, len(table.events) - 0.3)
     ax.invert_yaxis()
     ax.set_ylabel(_("events"))
@@ -298,8 +313,11 @@ def _panel_of(kind: SensorKind) -> Panel:
         if panel.log:
             _log_scale(ax)
         else:  # the range where the table's thresholds act, not the far wall
-            ax.set_ylim(0, max(level * panel.scale for _, sensor in _sensors(scene, kind.name)
-                               for level in sensor.switch_points()) * 3)
+            ax.set_ylim(
+                0,
+                max(level * panel.scale for _, sensor in _sensors(scene, kind.name) for level in sensor.switch_points())
+                * 3,
+            )
         ax.set_ylabel(_(panel.label))  # marked in _KIND_LABELS
 
     def draw(ax: Axes, result: RunView, t: np.ndarray) -> None:

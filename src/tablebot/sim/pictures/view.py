@@ -62,8 +62,16 @@ class RunView:
         assert result.hist is not None, "a run drawn keeps its robot rows (simulate with rows=True)"
         wanted = picture_columns(result.scene.table)
         rows = result.hist if result.hist_columns == wanted else result.hist[:, _indices(result, wanted)]
-        return cls(SceneView.of(result.scene), result.seed, rows, wanted, ends_of(result), result.states,
-                   result.outputs, result.events)
+        return cls(
+            SceneView.of(result.scene),
+            result.seed,
+            rows,
+            wanted,
+            ends_of(result),
+            result.states,
+            result.outputs,
+            result.events,
+        )
 
     @property
     def ticks(self) -> int:

@@ -50,8 +50,12 @@ motor_factory = None
 
 def _log(device: str, call: str, *args: object) -> None:
     try:
-        _LOG.write(json.dumps({"tick": _state["tick"], "phase": _state["phase"], "device": device, "call": call,
-                               "args": list(args)}) + "\n")
+        _LOG.write(
+            json.dumps(
+                {"tick": _state["tick"], "phase": _state["phase"], "device": device, "call": call, "args": list(args)}
+            )
+            + "\n"
+        )
         _LOG.flush()
     except (ValueError, AttributeError, TypeError):  # a __del__ during interpreter teardown
         pass

@@ -1,5 +1,5 @@
-"""The fixtures every studio test module shares, once: a real Chromium for the module, a folder for its
-screenshots, and the studio served for the module's ``folder``.
+"""The fixtures every studio test module shares, once (a plugin tests/conftest.py names): a real Chromium
+for the module, a folder for its screenshots, and the studio served for the module's ``folder``.
 
 A module overrides any of them by defining its own of the same name: test_studio_attacks starts its Chromium
 with flags of its own, and the modules whose tests each need a fresh folder (access, saves, drafts) serve a
