@@ -141,3 +141,32 @@ def test_a_pictures_axes_write_the_readers_numbers() -> None:
     german, english = labels("de"), labels("en")
     assert "0,4" in german[0] and "0.4" not in german[0] and german[1] == ["a", "b", "c"], german
     assert "0.4" in english[0], english
+
+
+def test_speaking_is_one_threads_language_and_ends_with_its_block() -> None:
+    """The studio draws a German tab's diagram in a thread while the process (and another tab) speaks English:
+    the language of :func:`speaking` holds in its thread's block alone."""
+    import threading
+
+    from tablebot.i18n import current, speaking
+
+    use("en")  # the process's language, as a command's main() leaves it
+    seen: dict[str, str] = {}
+
+    def german() -> None:
+        with speaking("de"):
+            seen["inside"] = number(0.5)
+            barrier.wait(5)  # the main thread reads its language while this block still speaks German
+            barrier.wait(5)
+        seen["after"] = number(0.5)
+
+    barrier = threading.Barrier(2)
+    worker = threading.Thread(target=german)
+    worker.start()
+    barrier.wait(5)
+    seen["main"] = f"{current()} {number(0.5)}"
+    barrier.wait(5)
+    worker.join(5)
+    assert seen == {"inside": "0,5", "main": "en 0.5", "after": "0.5"}
+    with pytest.raises(ValueError, match="xx"), speaking("xx"):
+        pass

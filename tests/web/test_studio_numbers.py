@@ -153,3 +153,19 @@ def test_a_drafts_time_of_day_is_the_pages_language_not_the_browsers(browser: An
         assert re.search(r"um \d\d:\d\d geändert", said), said
         assert not re.search(r"AM|PM", said), said
         page.context.close()
+
+
+def diagram_text(page: Any) -> str:
+    page.wait_for_selector("#diagram svg", timeout=60_000)
+    return str(page.eval_on_selector("#diagram svg", "e => e.textContent"))
+
+
+def test_a_german_tabs_diagram_is_german_whatever_the_studio_speaks(browser: Any, studio: Background) -> None:
+    """The studio process speaks English here (the tests' language): a German tab's state diagram is drawn in
+    German all the same (8,95 s on a timer's edge) while an English tab beside it keeps 8.95 s."""
+    german, english = open_page(browser, studio.url, "de-DE"), open_page(browser, studio.url, "en-US")
+    drawn = {"de": diagram_text(german), "en": diagram_text(english)}
+    assert "8,95 s" in drawn["de"] and not POINT.search(drawn["de"]), drawn["de"]
+    assert "8.95 s" in drawn["en"] and "8,95" not in drawn["en"], drawn["en"]
+    german.context.close()
+    english.context.close()

@@ -20,7 +20,9 @@ import numbers
 import os
 import string
 import sys
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any, cast
 
@@ -44,6 +46,7 @@ __all__ = [
     "ngettext",
     "number",
     "set_from",
+    "speaking",
     "system_language",
     "translation",
     "use",
@@ -80,11 +83,14 @@ class _Pseudo(_gettext.NullTranslations):
 
 _loaded: dict[str, _gettext.NullTranslations] = {}
 _language = LANGUAGES[0]
+#: The language of one piece of work, in its thread or task alone (:func:`speaking`): the studio draws a tab's
+#: diagram in that tab's language while another tab speaks another, in the same process.
+_speaking: ContextVar[str | None] = ContextVar("tablebot_speaking", default=None)
 
 
 def translation(language: str | None = None) -> _gettext.NullTranslations:
     """The catalog of ``language`` (default: the one in use), loaded once. English is the code's own text."""
-    language = language or _language
+    language = language or current()
     if language not in _loaded:
         if language == PSEUDO:
             _loaded[language] = _Pseudo()
@@ -106,8 +112,24 @@ def use(language: str) -> None:
 
 
 def current() -> str:
-    """The language in use."""
-    return _language
+    """The language in use: :func:`speaking`'s in its block, else the process's (:func:`use`)."""
+    return _speaking.get() or _language
+
+
+@contextmanager
+def speaking(language: str) -> Iterator[None]:
+    """Speak ``language`` inside the block, in this thread or asyncio task only (a context variable:
+    ``asyncio.to_thread`` carries it into the thread). When to use which: :func:`use` for a command, which
+    speaks one language throughout; this for one reader's piece of work in a process that serves several,
+    as the studio's tabs."""
+    if language not in (*LANGUAGES, PSEUDO):
+        raise LanguageError("language", language)
+    translation(language)
+    token = _speaking.set(language)
+    try:
+        yield
+    finally:
+        _speaking.reset(token)
 
 
 def gettext(message: str) -> str:
@@ -188,7 +210,7 @@ def number(value: float, spec: str = "g", language: str | None = None) -> str:
     for text a person reads; machine-readable output (CSV, JSON, trace files, ``--format json``) keeps
     Python's point in every language."""
     text = format(value, spec)
-    table = _DECIMALS.get(language or _language)
+    table = _DECIMALS.get(language or current())
     return text.translate(table) if table else text
 
 

@@ -17,7 +17,8 @@ from typing import Any
 
 from tablebot.diagnostics import TableBotError
 from tablebot.formats.csv_document import CsvDocument
-from tablebot.i18n import N_
+from tablebot.i18n import N_, speaking
+from tablebot.table import Table
 from tablebot.web.arena_robot import ArenaRobot
 from tablebot.web.draft import Draft, conflict
 from tablebot.web.errors import Refused, log, said
@@ -90,8 +91,14 @@ class Session:
         self.draft = self.new_draft()
         self.player = TracePlayer(self.workspace, self.say, lambda: self.draft.analysis, self.robot)
 
+    def diagram(self, table: Table) -> str:
+        """The state diagram in this tab's language, whatever the studio process speaks (its timers' 1,5 s,
+        its words): another tab may speak another."""
+        with speaking(self.language):
+            return self.robot.diagram(table)
+
     def new_draft(self) -> Draft:
-        draft = Draft(self.workspace, self.say, self.robot.diagram)
+        draft = Draft(self.workspace, self.say, self.diagram)
         draft.others = lambda: {
             d.name: d.analysis.table
             for d in self.drafts.values()

@@ -11,7 +11,7 @@ from typing import Any
 from tablebot.analysis.diagram import to_graphviz
 from tablebot.analysis.graphviz_run import INSTALL, NOT_FOUND, GraphvizFailed, NoGraphviz, draw
 from tablebot.diagnostics import TableBotError, fail
-from tablebot.i18n import N_, Message
+from tablebot.i18n import N_, Message, current
 from tablebot.loading import Loaded
 from tablebot.machine import Machine
 from tablebot.sim.model.scene import Scene
@@ -251,8 +251,9 @@ class Arena:
         return frame
 
     def diagram(self, table: Table) -> str:
-        """The state diagram as SVG text (cached per table; Graphviz takes tens of milliseconds)."""
-        key = (table.rows, table.events, table.robot)
+        """The state diagram as SVG text in the language in use (cached per table and language; Graphviz takes
+        tens of milliseconds)."""
+        key = (table.rows, table.events, table.robot, current())
         if self._diagram is None or self._diagram[0] != key:
             svg = studio_diagram(table)
             self._diagram = (key, svg)
