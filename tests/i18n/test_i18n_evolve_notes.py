@@ -58,3 +58,18 @@ def test_a_copied_row_says_which_line_it_copies_in_german() -> None:
     gene = pickle.loads(pickle.dumps(copies[0]))
     assert "(added: a copy of line " in describe(gene, table)
     assert "(hinzugefügt: eine Kopie von Zeile " in in_german(lambda: describe(gene, table))
+
+
+def test_a_resumed_runs_guard_rows_are_described_in_german_too() -> None:
+    """A run resumed from its folder reads the repairs an earlier run wrote to repairs.json: the notes come back
+    as messages, said in the reader's language (they came back as their English text)."""
+    import json
+
+    from tablebot.evolve.run import repaired_from_json, repaired_to_json
+
+    table, sp = bumberbot_space()
+    found = repair(space.start(table), table, Prover(find_property_files(BUMBERBOT)), sp, "keep")
+    kept = repaired_from_json(json.loads(json.dumps(repaired_to_json(found))))
+    german = in_german(lambda: format_table(as_table(kept.candidate, table, Path("repaired.csv"))))
+    assert "weiterfahren (Schutz für front_bumper_stops)" in german and "guard for" not in german
+    assert kept.candidate == found.candidate  # the genes themselves come back equal

@@ -30,7 +30,7 @@ from tablebot.evolve.proofs import Prover, Verdict
 from tablebot.evolve.repair import PREFERENCES, Repaired, Step
 from tablebot.evolve.space import Candidate, Gene, start, to_table
 from tablebot.files import append, json_records, write_text
-from tablebot.i18n import N_
+from tablebot.i18n import N_, from_json, to_json
 from tablebot.table import Table
 
 TRIES_PER_CHILD = 30  # variations tried per child asked for before a generation gives up on it
@@ -135,11 +135,11 @@ def gene_to_json(gene: Gene) -> dict[str, Any]:
         "motors": list(gene.motors),
         "timer": gene.timer,
         "next": gene.next,
-        "description": gene.description,
+        "description": to_json(gene.description),
         "counters": list(gene.counters),
         "lamps": list(gene.lamps),
         "origin": gene.origin,
-        "note": gene.note,
+        "note": to_json(gene.note),
     }
 
 
@@ -150,11 +150,11 @@ def gene_from_json(item: dict[str, Any]) -> Gene:
         tuple(item["motors"]),
         item["timer"],
         item["next"],
-        item["description"],
+        from_json(item["description"]),
         tuple(item["counters"]),
         tuple(item["lamps"]),
         item["origin"],
-        item["note"],
+        from_json(item["note"]),
     )
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "asked",
     "choose",
     "current",
+    "from_json",
     "gettext",
     "localise",
     "named",
@@ -48,6 +49,7 @@ __all__ = [
     "set_from",
     "speaking",
     "system_language",
+    "to_json",
     "translation",
     "use",
 ]
@@ -224,6 +226,26 @@ class _NumberFormatter(string.Formatter):
         if isinstance(value, numbers.Real) and not isinstance(value, bool):  # numpy's numbers too
             return number(cast(float, value), format_spec, self.language)
         return super().format_field(value, format_spec)
+
+
+def to_json(text: Any) -> Any:
+    """``text`` as JSON keeps it: a :class:`Message` as its id, plural and arguments (so a file written in one
+    run says it in the reader's language when read back in another: evolve's ``repairs.json``), a tuple of
+    them as a list, anything else as it is."""
+    if isinstance(text, Message):
+        return {"msgid": text.msgid, "plural": text.plural, "args": {k: to_json(v) for k, v in text.args.items()}}
+    if isinstance(text, tuple):
+        return {"items": [to_json(item) for item in text]}
+    return text
+
+
+def from_json(item: Any) -> Any:
+    """:func:`to_json`'s value back; a plain string (a file written before Messages were kept) as it is."""
+    if isinstance(item, dict) and "msgid" in item:
+        return Message(item["msgid"], {k: from_json(v) for k, v in item["args"].items()}, item["plural"])
+    if isinstance(item, dict) and "items" in item:
+        return tuple(from_json(v) for v in item["items"])
+    return item
 
 
 def N_(msgid: str, /, **args: Any) -> Message:
