@@ -15,7 +15,7 @@ from typing import Any
 from tablebot.csvtext import read_text
 from tablebot.diagnostics import Collector, fail
 from tablebot.durations import MAX_NUMBER_CHARS
-from tablebot.i18n import N_
+from tablebot.i18n import N_, as_typed
 from tablebot.tomlwords import worded
 
 HEADER_RE = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
@@ -181,8 +181,7 @@ def is_number(value: Any) -> bool:
 
 def number(src: Source, where: Where, value: Any, low: float, high: float, integer: bool = False) -> float | None:
     """A number in [low, high] (an integer when asked), or None after reporting why not."""
-    # the file's own numbers, written as the file writes them: a point in every language (issue 38)
-    low_s, high_s = f"{low:g}", f"{high:g}"
+    low_s, high_s = as_typed(low, "g"), as_typed(high, "g")  # the file's own syntax
     write = (
         N_("write an integer from {low} to {high}", low=low_s, high=high_s)
         if integer

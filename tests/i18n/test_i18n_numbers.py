@@ -13,6 +13,8 @@ from tablebot.i18n import N_, localise, number, use
 from tablebot.tomlfile import Source
 from tablebot.tomlfile import number as file_number
 
+ROOT = Path(__file__).resolve().parents[2]
+
 pytestmark = [pytest.mark.kernel_free]
 
 
@@ -170,3 +172,21 @@ def test_speaking_is_one_threads_language_and_ends_with_its_block() -> None:
     assert seen == {"inside": "0,5", "main": "en 0.5", "after": "0.5"}
     with pytest.raises(ValueError, match="xx"), speaking("xx"):
         pass
+
+
+def test_a_bound_the_reader_types_next_keeps_its_point_in_german() -> None:
+    """The command line reads 0.01, not 0,01: a German hint that says which values an option takes writes them
+    as they are typed (a range error's message and hint, --grid's), though its other numbers are German."""
+    import subprocess
+    import sys
+
+    def german(*args: str) -> str:
+        run = [sys.executable, "-m", "tablebot", "--lang", "de", *args]
+        done = subprocess.run(run, capture_output=True, text=True, timeout=120, cwd=ROOT)
+        assert done.returncode != 0, done.stdout
+        return done.stderr
+
+    said = german("sim", str(ROOT / "examples" / "bumberbot"), "--seconds", "99999")
+    assert "von 0.01 bis 3600" in said and "0,01" not in said, said
+    said = german("sweep", str(ROOT / "examples" / "bumberbot"), "--robots", "2", "--grid", "battery=7")
+    assert "von 0.0 bis 1.0" in said and "0,0" not in said, said

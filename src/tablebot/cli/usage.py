@@ -27,7 +27,7 @@ from typer.main import Typer, get_command_from_info
 from tablebot.cli.index import BY_NAME, COMMANDS, Commands, load_module
 from tablebot.cli.words import LANG_HELP, localise, localise_params
 from tablebot.diagnostics import Diagnostic
-from tablebot.i18n import LANGUAGES, N_, Message, gettext, use
+from tablebot.i18n import LANGUAGES, N_, Message, as_typed, gettext, use
 from tablebot.i18n import localise as l10n
 
 
@@ -215,7 +215,9 @@ def explain(exc: UsageError, given: Sequence[str]) -> Diagnostic:
         )
     if number:
         assert param is not None  # a number kind comes only from a parameter's type
-        low, high = getattr(param.type, "min", None), getattr(param.type, "max", None)
+        # the bounds as the command line takes them (0.01, not German 0,01): the user types them next
+        bounds = (getattr(param.type, "min", None), getattr(param.type, "max", None))
+        low, high = (None if b is None else as_typed(b) for b in bounds)
         hint = (
             N_("give {name} a value from {low} to {high}", name=name, low=low, high=high)
             if low is not None and high is not None

@@ -23,7 +23,7 @@ from tablebot.diagnostics import fail
 from tablebot.durations import MAX_NUMBER_CHARS
 from tablebot.fleet.cells import CELL_RE
 from tablebot.fleet.robots import Pose
-from tablebot.i18n import N_
+from tablebot.i18n import N_, as_typed
 from tablebot.sim.model.params import DEFAULTS
 from tablebot.sim.model.world import inside
 
@@ -227,6 +227,7 @@ def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
             ),
         )
     default, low, high, _ = DEFAULTS[section][name]
+    shown = {"low": as_typed(low), "high": as_typed(high)}  # as --grid takes them: 0.5, not German 0,5
     out = []
     for cell in cells:
         try:
@@ -235,13 +236,13 @@ def _numbers(key: str, cells: list[str]) -> tuple[float, ...]:
             raise fail(
                 "--grid",
                 N_("--grid {key}: {cell!r} is not a number", key=key, cell=cell),
-                N_("write numbers from {low} to {high}", low=low, high=high),
+                N_("write numbers from {low} to {high}", **shown),
             ) from None
         if not low <= value <= high or (isinstance(default, int) and value != int(value)):
             hint = (
-                N_("write a whole number from {low} to {high}", low=low, high=high)
+                N_("write a whole number from {low} to {high}", **shown)
                 if isinstance(default, int)
-                else N_("write a number from {low} to {high}", low=low, high=high)
+                else N_("write a number from {low} to {high}", **shown)
             )
             raise fail("--grid", N_("--grid {key}: {cell} is out of range", key=key, cell=cell), hint)
         out.append(int(value) if isinstance(default, int) else value)

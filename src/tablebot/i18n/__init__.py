@@ -37,6 +37,7 @@ __all__ = [
     "LanguageError",
     "Message",
     "_",
+    "as_typed",
     "asked",
     "choose",
     "current",
@@ -214,6 +215,13 @@ def number(value: float, spec: str = "g", language: str | None = None) -> str:
     text = format(value, spec)
     table = _DECIMALS.get(language or current())
     return text.translate(table) if table else text
+
+
+def as_typed(value: float, spec: str = "") -> str:
+    """``value`` as the reader types it, the point in every language: a number a hint tells them to write in a
+    file or on the command line (``--seconds`` from 0.01 to 3600), which :func:`number` must not turn into
+    German (the command line and TOML read 0.01, not 0,01). A text field, so a message leaves it as it is."""
+    return format(value, spec)
 
 
 class _NumberFormatter(string.Formatter):
