@@ -16,26 +16,19 @@ demo:
 
 # pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
 # once first), then the wall-clock ones (marked realtime there) two at a time with nothing CPU-bound beside
-# them but mypy at the lowest priority (nice 19). The wall-clock tests mostly wait on the clock (14 CPU-s in
-# 56 s one by one; 31-34 s two at a time, passing even beside two busy loops at normal priority), so mypy's
-# 45 s of CPU from an empty cache (the sources, tests and benchmarks) mostly fit in what they leave idle; its
-# report is printed after the pass.
+# them but the checks that read the code at the lowest priority (nice 19: scripts/checks.sh). The wall-clock
+# tests mostly wait on the clock (14 CPU-s in 56 s one by one; 31-34 s two at a time, passing even beside two
+# busy loops at normal priority), so mypy's 45 s of CPU from an empty cache (the sources, tests and benchmarks),
+# lint-imports, ruff, the docs site and ESLint mostly fit in what they leave idle; their reports are printed after
+# the pass.
 test: setup
 	@mkdir -p build/coverage
 	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15 -rs \
 	  --cov --cov-report=
 	@echo "coverage of the pass above, least covered first (all: .venv/bin/coverage html, then build/coverage/html):"
 	@.venv/bin/coverage report | sed -n 1,27p; .venv/bin/coverage report --format=total | sed 's/^/total: /;s/$$/ %/'
-	@log=$$(mktemp); nice -n 19 .venv/bin/mypy >"$$log" 2>&1 & mypy=$$!; \
-	echo '.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs  (and .venv/bin/mypy)'; \
-	.venv/bin/python -m pytest -n 2 -m realtime --durations=5 -rs; tests=$$?; \
-	wait $$mypy; types=$$?; echo ".venv/bin/mypy"; cat "$$log"; rm -f "$$log"; \
-	[ $$tests -eq 0 ] && [ $$types -eq 0 ]
-	.venv/bin/lint-imports
-	.venv/bin/ruff check .
-	.venv/bin/ruff format --check .
-	$(MKDOCS)
-	node_modules/.bin/eslint src/tablebot/web/static src/tablebot/formats/statecharts eslint.config.js
+	@# the wall-clock tests, with mypy, lint-imports, ruff, the docs site and ESLint beside them (niced)
+	scripts/checks.sh $(MKDOCS)
 
 # The documentation site, from docs/ (mkdocs.yml) into site/: strict, so a warning fails it, a link, anchor or
 # file that is not there and a page made from the code (scripts/docs_reference.py) that is out of date included.
