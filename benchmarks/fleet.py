@@ -10,7 +10,8 @@ is the kernel can be told apart:
   cores, robot-ticks/s over the wall time; beside it the kernel alone (the same 10,000 robots as one
   in-process fleet, warm). Targets: the whole process >= 3.5 M robot-ticks/s on 2 cores (issue 22) and >= 0.6x
   the kernel's speed (issue 35); where the rest of the process's time goes (benchmarks/fleet_phases.py: the
-  imports before planning, planning, the chunks, the result rows written meanwhile, merging).
+  imports before planning, planning, the chunks, the result rows written meanwhile, merging), and the floor: a
+  process that only imports the fleet and loads a chunk's machine code, the best ratio any sweep process could reach.
 * **from Python**: the same sweep as ``tablebot.open("examples/bumberbot").sweep(robots=10000, seconds=10,
   plots=False)`` in this process (no process start; its first call, which loads the compiled code, not
   counted), against the kernel alone measured alternately. Target (issue 35): >= 0.85x.

@@ -142,13 +142,30 @@ def inner_child(robots: int, seconds: float, src: str) -> dict[str, float]:
     return found
 
 
+#: The least any sweep process does before its first chunk can run: Python starts, imports the fleet (numpy,
+#: numba, the compiled modules) and loads the machine code a chunk runs -- no command line, table, plan or results.
+FLOOR = (
+    "import tablebot.fleet.run; from tablebot.fleet.work import chunk_functions, preload; "
+    "assert preload(*chunk_functions(1)) > 0"
+)
+
+
+def floor_s(src: str) -> float:
+    """Wall seconds of a fresh process doing :data:`FLOOR` with the tree ``src``."""
+    started = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", FLOOR], cwd=ROOT, env=env_for(src), capture_output=True, text=True)
+    if done.returncode:
+        raise SystemExit(f"the floor process failed:\n{done.stderr}")
+    return time.perf_counter() - started
+
+
 def rounds(robots: int, seconds: float, src: str) -> dict[str, Any]:
-    """One round of the tree ``src``: the process (wall, CPU), its phases, and :func:`inner`."""
+    """One round of the tree ``src``: the process (wall, CPU), its phases, the floor, and :func:`inner`."""
     wall = sweep_process(robots, seconds, src=src)
     cpu = CPU_S[-1]
     with tempfile.TemporaryDirectory() as out:
         parts = phases(sweep_args(robots, seconds, out + "/sweep"), env_for(src))
-    return {"wall": wall, "cpu": cpu, "parts": parts, **inner_child(robots, seconds, src)}
+    return {"wall": wall, "cpu": cpu, "parts": parts, "floor": floor_s(src), **inner_child(robots, seconds, src)}
 
 
 def verdict(ok: bool) -> str:
@@ -178,6 +195,11 @@ def report(name: str, found: list[dict[str, Any]], robots: int, seconds: float) 
     print(
         "  where a sweep process's time goes (medians, s): "
         + ", ".join(f"{key} {med(p[key] for p in parts):.3f}" for key in parts[0] if not key.startswith("cpu: "))
+    )
+    floor, kernel_s = med(f["floor"] for f in found), med(work / f["kernel"] for f in found)
+    print(
+        f"  the floor (a process that only imports the fleet and loads a chunk's machine code): {floor:.3f} s; "
+        f"a sweep process that did nothing else would run at {kernel_s / (kernel_s + floor):.2f}x its kernel"
     )
     kernel_cpu = med(f["kernel_cpu"] for f in found)
     print(
