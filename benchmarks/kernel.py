@@ -121,7 +121,9 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
             g.lamps,
             g.lines,
             s,
-            "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func),
+            any(
+                skip in inspect.getsource(ph.sense_near.py_func) for skip in ("P_SENSOR + F_KIND", "sensor[0, F_KIND]")
+            ),
         )
         - copy,
         "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s)
@@ -144,6 +146,7 @@ def _loops() -> dict[str, Any]:
     co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
     standard_normal, sense_declared = _sim("physics.normals").standard_normal, _sim("physics.sensing").sense_declared
     fast = njit(refcounts=False, cache=False)
+    S, P = _viewers(fast)
 
     @fast
     def put(s: np.ndarray, rows: np.ndarray, i: int) -> None:
@@ -174,13 +177,13 @@ def _loops() -> dict[str, Any]:
         shade: np.ndarray,
     ) -> float:
         total = 0.0
-        ph.aim_turns(p, turns)
+        ph.aim_turns(P(p), turns)
         for i in range(rows.shape[0]):
-            s = rows[i]
-            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade) + ph.light_side(
-                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade
-            )
+            s = S(rows[i])
+            c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
+            total += ph.light_side(
+                s, c, sn, P(p), -1.0, turns[0], turns[1], edges, circles, lamps, shade
+            ) + ph.light_side(s, c, sn, P(p), 1.0, turns[2], turns[3], edges, circles, lamps, shade)
         return total
 
     @fast
@@ -188,12 +191,12 @@ def _loops() -> dict[str, Any]:
         rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, turns: np.ndarray
     ) -> float:  # trees without a grid
         total = 0.0
-        ph.aim_turns(p, turns)
+        ph.aim_turns(P(p), turns)
         for i in range(rows.shape[0]):
-            s = rows[i]
-            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
-                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps
+            s = S(rows[i])
+            c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
+            total += ph.light_side(s, c, sn, P(p), -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
+                s, c, sn, P(p), 1.0, turns[2], turns[3], edges, circles, lamps
             )
         return total
 
@@ -209,12 +212,11 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(p)
+        reach, wide = co.reaches(P(p))
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.sense_bumpers(
-                s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach, wide, near, centre
-            )
+            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
+            co.sense_bumpers(S(s), P(p), c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
@@ -230,17 +232,17 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(p)
+        reach, wide = co.reaches(P(p))
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.resolve(S(s), P(p), corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
     def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, z: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.drive(s, (2, -2), p, z)
+            ph.drive(S(s), (2, -2), P(p), z)
         return s[0]
 
     @fast
@@ -257,14 +259,14 @@ def _loops() -> dict[str, Any]:
         for i in range(rows.shape[0]):
             put(s, rows, i)
             if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
-                sense_declared(s, math.cos(s[L.TH]), math.sin(s[L.TH]), p, edges, circles, lamps, lines)
+                sense_declared(S(s), math.cos(s[L.TH]), math.sin(s[L.TH]), P(p), edges, circles, lamps, lines)
         return s[0]
 
     @fast
     def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray) -> float:
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            K.observe(s, lamps, acc, collisions)
+            K.observe(S(s), lamps, acc, collisions)
         return s[0]
 
     @fast
@@ -291,6 +293,21 @@ def _loops() -> dict[str, Any]:
         return t
 
     return dict(locals())
+
+
+def _viewers(fast: Any) -> tuple[Any, Any]:
+    """How the tree's physics takes a robot's state and parameter rows: as records read by name
+    (sim.physics.layout's as_state, as_params) or, in a tree from before, as the float64 rows themselves."""
+    try:
+        layout = importlib.import_module("tablebot.sim.physics.layout")
+    except ModuleNotFoundError:
+
+        @fast
+        def same(row: np.ndarray) -> np.ndarray:
+            return row
+
+        return same, same
+    return layout.as_state, layout.as_params
 
 
 def baseline_sources(ref: str) -> str:
