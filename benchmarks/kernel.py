@@ -32,7 +32,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kernel_several import several_against_one  # beside this file (a script's folder is on the path)
+from kernel_rows import as_rows, viewers  # beside this file (a script's folder is on the path)
+from kernel_several import several_against_one
 
 if TYPE_CHECKING:
     import numpy as np
@@ -102,9 +103,9 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     copy = ns("copy", rows, s)
     regs, outputs, counters = (a.copy() for a in fleet.initial)
     light = (
-        ("light_shade", rows, p, g.edges, g.circles, g.lamps, np.empty(4), shade)
+        ("light_shade", rows, as_rows(rows), p, g.edges, g.circles, g.lamps, np.empty(4), shade)
         if shade is not None
-        else ("light", rows, p, g.edges, g.circles, g.lamps, np.empty(4))
+        else ("light", rows, as_rows(rows), p, g.edges, g.circles, g.lamps, np.empty(4))
     )
     parts = {
         "light (2 phototransistors)": ns(*light),
@@ -146,7 +147,7 @@ def _loops() -> dict[str, Any]:
     co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
     standard_normal, sense_declared = _sim("physics.normals").standard_normal, _sim("physics.sensing").sense_declared
     fast = njit(refcounts=False, cache=False)
-    S, P = _viewers(fast)
+    S, P = viewers(fast)
 
     @fast
     def put(s: np.ndarray, rows: np.ndarray, i: int) -> None:
@@ -169,6 +170,7 @@ def _loops() -> dict[str, Any]:
     @fast
     def light_shade(
         rows: np.ndarray,
+        recs: np.ndarray,
         p: np.ndarray,
         edges: np.ndarray,
         circles: np.ndarray,
@@ -177,26 +179,34 @@ def _loops() -> dict[str, Any]:
         shade: np.ndarray,
     ) -> float:
         total = 0.0
-        ph.aim_turns(P(p), turns)
+        q = P(p)
+        ph.aim_turns(q, turns)
         for i in range(rows.shape[0]):
-            s = S(rows[i])
+            s = recs[i]
             c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
-            total += ph.light_side(
-                s, c, sn, P(p), -1.0, turns[0], turns[1], edges, circles, lamps, shade
-            ) + ph.light_side(s, c, sn, P(p), 1.0, turns[2], turns[3], edges, circles, lamps, shade)
+            total += ph.light_side(s, c, sn, q, -1.0, turns[0], turns[1], edges, circles, lamps, shade) + ph.light_side(
+                s, c, sn, q, 1.0, turns[2], turns[3], edges, circles, lamps, shade
+            )
         return total
 
     @fast
     def light(
-        rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, turns: np.ndarray
+        rows: np.ndarray,
+        recs: np.ndarray,
+        p: np.ndarray,
+        edges: np.ndarray,
+        circles: np.ndarray,
+        lamps: np.ndarray,
+        turns: np.ndarray,
     ) -> float:  # trees without a grid
         total = 0.0
-        ph.aim_turns(P(p), turns)
+        q = P(p)
+        ph.aim_turns(q, turns)
         for i in range(rows.shape[0]):
-            s = S(rows[i])
+            s = recs[i]
             c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
-            total += ph.light_side(s, c, sn, P(p), -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
-                s, c, sn, P(p), 1.0, turns[2], turns[3], edges, circles, lamps
+            total += ph.light_side(s, c, sn, q, -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
+                s, c, sn, q, 1.0, turns[2], turns[3], edges, circles, lamps
             )
         return total
 
@@ -212,11 +222,12 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(P(p))
+        row, q = S(s), P(p)  # views of the rows, once
+        reach, wide = co.reaches(q)
         for i in range(rows.shape[0]):
             put(s, rows, i)
             c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            co.sense_bumpers(S(s), P(p), c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.sense_bumpers(row, q, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
@@ -232,17 +243,19 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(P(p))
+        row, q = S(s), P(p)  # views of the rows, once
+        reach, wide = co.reaches(q)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.resolve(S(s), P(p), corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.resolve(row, q, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
     def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, z: np.ndarray) -> float:
+        row, q = S(s), P(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.drive(S(s), (2, -2), P(p), z)
+            ph.drive(row, (2, -2), q, z)
         return s[0]
 
     @fast
@@ -256,17 +269,19 @@ def _loops() -> dict[str, Any]:
         s: np.ndarray,
         skip: bool,
     ) -> float:
+        row, q = S(s), P(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
             if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
-                sense_declared(S(s), math.cos(s[L.TH]), math.sin(s[L.TH]), P(p), edges, circles, lamps, lines)
+                sense_declared(row, math.cos(s[L.TH]), math.sin(s[L.TH]), q, edges, circles, lamps, lines)
         return s[0]
 
     @fast
     def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray) -> float:
+        row = S(s)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            K.observe(S(s), lamps, acc, collisions)
+            K.observe(row, lamps, acc, collisions)
         return s[0]
 
     @fast
@@ -293,21 +308,6 @@ def _loops() -> dict[str, Any]:
         return t
 
     return dict(locals())
-
-
-def _viewers(fast: Any) -> tuple[Any, Any]:
-    """How the tree's physics takes a robot's state and parameter rows: as records read by name
-    (sim.physics.layout's as_state, as_params) or, in a tree from before, as the float64 rows themselves."""
-    try:
-        layout = importlib.import_module("tablebot.sim.physics.layout")
-    except ModuleNotFoundError:
-
-        @fast
-        def same(row: np.ndarray) -> np.ndarray:
-            return row
-
-        return same, same
-    return layout.as_state, layout.as_params
 
 
 def baseline_sources(ref: str) -> str:
