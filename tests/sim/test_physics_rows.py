@@ -5,6 +5,7 @@ that row itself, not a copy."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tablebot.jit import njit, numba
 from tablebot.sim import columns as L
@@ -63,3 +64,18 @@ def test_compiled_code_reads_and_writes_the_row_itself() -> None:
     assert _nudge(s, p) == 0.5
     assert (s[L.X], s[L.READING + 2]) == (0.01, 3.0)
     assert np.count_nonzero(s) == 3  # nothing else written
+
+
+@njit(cache=False)
+def _x_of(s: np.ndarray) -> float:
+    return as_state(s).x
+
+
+def test_compiled_code_refuses_a_row_of_another_width() -> None:
+    """Compiled code reads a row's memory as a record without numba's view (whose checks cost the physics-only
+    loop x1.04): the width is still checked, since a record would read past a shorter row's end."""
+    assert _x_of(np.full(L.N_STATE, 2.0)) == 2.0
+    with pytest.raises(ValueError, match="wrong width"):
+        _x_of(np.zeros(L.N_STATE - 1))
+    with pytest.raises(ValueError, match="wrong width"):
+        _x_of(np.zeros(2 * L.N_STATE)[::2])  # a strided row
