@@ -32,7 +32,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kernel_several import several_against_one  # beside this file (a script's folder is on the path)
+from kernel_rows import as_rows, viewers  # beside this file (a script's folder is on the path)
+from kernel_several import several_against_one
 
 if TYPE_CHECKING:
     import numpy as np
@@ -102,9 +103,9 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
     copy = ns("copy", rows, s)
     regs, outputs, counters = (a.copy() for a in fleet.initial)
     light = (
-        ("light_shade", rows, p, g.edges, g.circles, g.lamps, np.empty(4), shade)
+        ("light_shade", rows, as_rows(rows), p, g.edges, g.circles, g.lamps, np.empty(4), shade)
         if shade is not None
-        else ("light", rows, p, g.edges, g.circles, g.lamps, np.empty(4))
+        else ("light", rows, as_rows(rows), p, g.edges, g.circles, g.lamps, np.empty(4))
     )
     parts = {
         "light (2 phototransistors)": ns(*light),
@@ -121,7 +122,9 @@ def _parts(rows: Any, scene: Any, fleet: Any, repeats: int) -> dict[str, float]:
             g.lamps,
             g.lines,
             s,
-            "P_SENSOR + F_KIND" in inspect.getsource(ph.sense_near.py_func),
+            any(
+                skip in inspect.getsource(ph.sense_near.py_func) for skip in ("P_SENSOR + F_KIND", "sensor[0, F_KIND]")
+            ),
         )
         - copy,
         "summary (observe)": ns("observe", rows, g.lamps, K.new_accumulator(0.25, 20), np.zeros(16, np.int64), s)
@@ -144,6 +147,7 @@ def _loops() -> dict[str, Any]:
     co, K, ph = _sim("physics.contacts"), _sim("physics.kernel"), _sim("physics.step")
     standard_normal, sense_declared = _sim("physics.normals").standard_normal, _sim("physics.sensing").sense_declared
     fast = njit(refcounts=False, cache=False)
+    S, P = viewers(fast)
 
     @fast
     def put(s: np.ndarray, rows: np.ndarray, i: int) -> None:
@@ -166,6 +170,7 @@ def _loops() -> dict[str, Any]:
     @fast
     def light_shade(
         rows: np.ndarray,
+        recs: np.ndarray,
         p: np.ndarray,
         edges: np.ndarray,
         circles: np.ndarray,
@@ -174,26 +179,34 @@ def _loops() -> dict[str, Any]:
         shade: np.ndarray,
     ) -> float:
         total = 0.0
-        ph.aim_turns(p, turns)
+        q = P(p)
+        ph.aim_turns(q, turns)
         for i in range(rows.shape[0]):
-            s = rows[i]
-            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade) + ph.light_side(
-                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade
+            s = recs[i]
+            c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
+            total += ph.light_side(s, c, sn, q, -1.0, turns[0], turns[1], edges, circles, lamps, shade) + ph.light_side(
+                s, c, sn, q, 1.0, turns[2], turns[3], edges, circles, lamps, shade
             )
         return total
 
     @fast
     def light(
-        rows: np.ndarray, p: np.ndarray, edges: np.ndarray, circles: np.ndarray, lamps: np.ndarray, turns: np.ndarray
+        rows: np.ndarray,
+        recs: np.ndarray,
+        p: np.ndarray,
+        edges: np.ndarray,
+        circles: np.ndarray,
+        lamps: np.ndarray,
+        turns: np.ndarray,
     ) -> float:  # trees without a grid
         total = 0.0
-        ph.aim_turns(p, turns)
+        q = P(p)
+        ph.aim_turns(q, turns)
         for i in range(rows.shape[0]):
-            s = rows[i]
-            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-            total += ph.light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
-                s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps
+            s = recs[i]
+            c, sn = math.cos(rows[i, L.TH]), math.sin(rows[i, L.TH])
+            total += ph.light_side(s, c, sn, q, -1.0, turns[0], turns[1], edges, circles, lamps) + ph.light_side(
+                s, c, sn, q, 1.0, turns[2], turns[3], edges, circles, lamps
             )
         return total
 
@@ -209,12 +222,12 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(p)
+        row, q = S(s), P(p)  # views of the rows, once
+        reach, wide = co.reaches(q)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.sense_bumpers(
-                s, p, math.cos(s[L.TH]), math.sin(s[L.TH]), verts, pstart, pbound, circles, reach, wide, near, centre
-            )
+            c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
+            co.sense_bumpers(row, q, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
@@ -230,17 +243,19 @@ def _loops() -> dict[str, Any]:
         near: np.ndarray,
         centre: np.ndarray,
     ) -> float:
-        reach, wide = co.reaches(p)
+        row, q = S(s), P(p)  # views of the rows, once
+        reach, wide = co.reaches(q)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            co.resolve(s, p, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
+            co.resolve(row, q, corners, verts, pstart, pbound, circles, reach, wide, near, centre)
         return s[0]
 
     @fast
     def motors(rows: np.ndarray, p: np.ndarray, s: np.ndarray, z: np.ndarray) -> float:
+        row, q = S(s), P(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            ph.drive(s, (2, -2), p, z)
+            ph.drive(row, (2, -2), q, z)
         return s[0]
 
     @fast
@@ -254,17 +269,19 @@ def _loops() -> dict[str, Any]:
         s: np.ndarray,
         skip: bool,
     ) -> float:
+        row, q = S(s), P(p)
         for i in range(rows.shape[0]):
             put(s, rows, i)
             if not skip or p[L.P_SENSOR + L.F_KIND] != 0.0:  # skip: the tree's kernel skips robots without any
-                sense_declared(s, math.cos(s[L.TH]), math.sin(s[L.TH]), p, edges, circles, lamps, lines)
+                sense_declared(row, math.cos(s[L.TH]), math.sin(s[L.TH]), q, edges, circles, lamps, lines)
         return s[0]
 
     @fast
     def observe(rows: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray, s: np.ndarray) -> float:
+        row = S(s)
         for i in range(rows.shape[0]):
             put(s, rows, i)
-            K.observe(s, lamps, acc, collisions)
+            K.observe(row, lamps, acc, collisions)
         return s[0]
 
     @fast

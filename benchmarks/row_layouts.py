@@ -17,7 +17,10 @@ flat row in the same run. Every form must leave the same numbers (checked).
 
 At load 8-13 on 2 cores (1,000-2,000 robots) the record was within noise of the flat row (x0.89-1.21 over runs)
 and the per-field arrays a little slower (x1.02-1.26); yet the whole kernel converted to records (23d8e35) ran
-x1.07-1.38 the flat rows' time in fresh processes (see f175ea0), so the kernels keep the flat rows.
+x1.07-1.38 the flat rows' time in fresh processes (see f175ea0). The records were not the cause: that commit also
+made each motor return its speed, encoder and pulses for the caller to store, and that alone, on the flat rows,
+cost x1.15; with the motor writing each field as it is worked out the kernels read records at the flat rows'
+speed (sim.physics.layout).
 """
 
 from __future__ import annotations

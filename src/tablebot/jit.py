@@ -38,7 +38,7 @@ def cache_dir() -> str:
 
 
 #: Files whose functions or constants compiled code reads, though they compile nothing themselves.
-COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py")
+COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py", "layout.py")
 
 
 ROOT = Path(__file__).resolve().parent  # the tablebot package

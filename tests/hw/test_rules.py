@@ -25,6 +25,7 @@ from tablebot.machine import compile_table
 from tablebot.sensors import Sensor, threshold_event
 from tablebot.sim import columns as L
 from tablebot.sim.model.params import sensor_fields
+from tablebot.sim.physics.layout import as_params, as_state
 from tablebot.sim.physics.sensing import sensor_events
 from test_txt4_program import stub_robot
 
@@ -85,7 +86,7 @@ def test_the_simulator_the_txt_and_the_txt4_program_switch_alike(
 
     def simulated(value: int, on: bool) -> bool:
         s[L.READING] = value / 100
-        return bool(sensor_events(s, p, bits, int(on)))
+        return bool(sensor_events(as_state(s), as_params(p), bits, int(on)))  # rows read by name
 
     assert events(simulated, readings) == events(lambda v, on: sensor.event(v / 100, on), readings)
 

@@ -12,6 +12,7 @@ import pytest
 from tablebot.sim import columns as L
 from tablebot.sim.model.scene import Scene
 from tablebot.sim.physics.kernel import sense
+from tablebot.sim.physics.layout import as_params, as_state
 from tablebot.sim.physics.sensing import sensor_events
 from tablebot.sim.physics.step import light_at
 from tablebot.sim.runner import simulate
@@ -137,7 +138,7 @@ def test_thresholds_switch_with_the_declared_hysteresis(tmp_path: Path) -> None:
     mask, seen = 0, []
     for cm in (30, 21, 20, 19, 22, 24, 24.9, 25, 26, 20, 19.5):
         s[L.READING + 2] = cm / 100
-        mask = sensor_events(s, p, bits, mask)
+        mask = sensor_events(as_state(s), as_params(p), bits, mask)  # the physics reads rows' fields by name
         seen.append(bool(mask & bit))
     #            30     21     20     19    22    24    24.9  25     26     20     19.5
     assert seen == [False, False, False, True, True, True, True, False, False, False, True]

@@ -109,6 +109,7 @@ def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path:
     inside or outside the field of view's edge and for headings after thousands of turns."""
     import math
 
+    from tablebot.sim.physics.layout import as_params, as_state
     from tablebot.sim.physics.sensing import light_from
     from tablebot.sim.physics.step import light_at
 
@@ -127,7 +128,10 @@ def test_the_quick_out_of_view_test_never_hides_a_lamp_light_from_sees(tmp_path:
         off = fov * rng.choice([-1.0, 1.0]) + rng.choice([0.0, 1e-13, -1e-13, 1e-9, -1e-9, rng.uniform(-3, 3)])
         s[L.TH] = towards + off + turns
         c, sn = math.cos(s[L.TH]), math.sin(s[L.TH])
-        exact = light_from(s, c, sn, p, p[L.P_LX], side * p[L.P_LY], side * p[L.P_TOE], g.edges, g.circles, g.lamps)
+        row, params = as_state(s), as_params(p)  # the physics reads rows' fields by name
+        exact = light_from(
+            row, c, sn, params, p[L.P_LX], side * p[L.P_LY], side * p[L.P_TOE], g.edges, g.circles, g.lamps
+        )
         assert light_at(s, p, side, g.edges, g.circles, g.lamps) == exact
         assert light_at(s, p, side, g.edges, g.circles, g.lamps, g.shade) == exact  # the shadow grid
         hidden += exact == 0.0

@@ -17,26 +17,11 @@ import math
 import numpy as np
 
 from tablebot.jit import njit
-from tablebot.sim.columns import (
-    BUMP_FL,
-    BUMP_FR,
-    BUMP_REAR,
-    CONTACT,
-    P_FRONT,
-    P_GAP,
-    P_GYR2,
-    P_HALF_W,
-    P_OVERLAP,
-    P_REAR,
-    P_WRAP,
-    TH,
-    X,
-    Y,
-)
 from tablebot.sim.physics.broad import NEAR_MARGIN as NEAR_MARGIN  # the broad phase's names, here as before
 from tablebot.sim.physics.broad import might_be_near, refresh_near
 from tablebot.sim.physics.broad import new_near as new_near
 from tablebot.sim.physics.geometry import point_segment_within, segments_within, within
+from tablebot.sim.physics.layout import Params, State, as_params, as_state
 
 RESOLVE_ITERATIONS = 4  # contact projections per tick; one suffices except in corners
 TIE = 1e-7  # metres: features this close in depth count as touching together (head-on = both)
@@ -45,32 +30,33 @@ TIE = 1e-7  # metres: features this close in depth count as touching together (h
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def body_corners_at(s: np.ndarray, p: np.ndarray, c: float, sn: float, out: np.ndarray) -> None:
+def body_corners_at(s: State, p: Params, c: float, sn: float, out: np.ndarray) -> None:
     """The body rectangle's corners in world coordinates (front-right, front-left, rear-left, rear-right),
     given the heading's cosine ``c`` and sine ``sn``."""
-    f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
+    f, r, w = p.front, -p.rear, p.half_w
     for k, (bx, by) in enumerate(((f, -w), (f, w), (r, w), (r, -w))):
-        out[k, 0] = s[X] + c * bx - sn * by
-        out[k, 1] = s[Y] + sn * bx + c * by
+        out[k, 0] = s.x + c * bx - sn * by
+        out[k, 1] = s.y + sn * bx + c * by
 
 
 @njit(cache=True, refcounts=False)
 def body_corners(s: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     """The body rectangle's corners in world coordinates: front-right, front-left, rear-left, rear-right."""
-    body_corners_at(s, p, math.cos(s[TH]), math.sin(s[TH]), out)
+    row = as_state(s)  # a float64 row from Python, or a record
+    body_corners_at(row, as_params(p), math.cos(row.th), math.sin(row.th), out)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def bounding_radius(p: np.ndarray) -> float:
-    return math.hypot(max(p[P_FRONT], p[P_REAR]), p[P_HALF_W])
+def bounding_radius(p: Params) -> float:
+    return math.hypot(max(p.front, p.rear), p.half_w)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def reaches(p: np.ndarray) -> tuple[float, float]:
+def reaches(p: Params) -> tuple[float, float]:
     """The bounding radius (the contacts' broad phase), and the reach a candidate list must serve (the
     bumpers': the radius plus the switch travel), computed as every caller computes them."""
     reach = bounding_radius(p)
-    return reach, max(reach, reach + p[P_GAP])
+    return reach, max(reach, reach + p.gap)
 
 
 # --- contacts ------------------------------------------------------------------------------------
@@ -139,12 +125,12 @@ def piece_contact(
 
 @njit(cache=True, refcounts=False)
 def circle_contact(
-    s: np.ndarray, p: np.ndarray, c: float, sn: float, cx: float, cy: float, radius: float
+    s: State, p: Params, c: float, sn: float, cx: float, cy: float, radius: float
 ) -> tuple[float, float, float, float, float]:
     """Body rectangle (heading cosine ``c``, sine ``sn``) against a circle; the result as :func:`piece_contact`'s."""
-    rx, ry = cx - s[X], cy - s[Y]
+    rx, ry = cx - s.x, cy - s.y
     bx, by = c * rx + sn * ry, -sn * rx + c * ry  # circle centre in the body frame
-    f, r, w = p[P_FRONT], -p[P_REAR], p[P_HALF_W]
+    f, r, w = p.front, -p.rear, p.half_w
     qx, qy = min(f, max(r, bx)), min(w, max(-w, by))
     if qx == bx and qy == by:  # centre inside the body: leave through the nearest face
         faces = (f - bx, bx - r, w - by, by + w)
@@ -162,13 +148,13 @@ def circle_contact(
             return 0.0, 0.0, 0.0, 0.0, 0.0
         depth = radius - gap
         nbx, nby = (qx - bx) / gap, (qy - by) / gap
-    return (depth, c * nbx - sn * nby, sn * nbx + c * nby, s[X] + c * qx - sn * qy, s[Y] + sn * qx + c * qy)
+    return (depth, c * nbx - sn * nby, sn * nbx + c * nby, s.x + c * qx - sn * qy, s.y + sn * qx + c * qy)
 
 
 @njit(cache=True, refcounts=False)
 def deepest_near(
-    s: np.ndarray,
-    p: np.ndarray,
+    s: State,
+    p: Params,
     corners: np.ndarray,
     verts: np.ndarray,
     pstart: np.ndarray,
@@ -187,20 +173,20 @@ def deepest_near(
     n = near[0]
     for j in range(n):
         k = near[2 + j]
-        if not might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
+        if not might_be_near(s.x, s.y, verts, pstart[k], pstart[k + 1], pbound, k, reach):
             continue
         if not ready:
-            c, sn, ready = math.cos(s[TH]), math.sin(s[TH]), True
+            c, sn, ready = math.cos(s.th), math.sin(s.th), True
             body_corners_at(s, p, c, sn, corners)
         hit = piece_contact(c, sn, corners, verts, pstart[k], pstart[k + 1])
         if hit[0] > best[0]:
             best = hit
     for j in range(near[1]):
         k = near[2 + n + j]
-        if not within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach):
+        if not within(circles[k, 0] - s.x, circles[k, 1] - s.y, circles[k, 2] + reach):
             continue
         if not ready:
-            c, sn, ready = math.cos(s[TH]), math.sin(s[TH]), True
+            c, sn, ready = math.cos(s.th), math.sin(s.th), True
             body_corners_at(s, p, c, sn, corners)
         hit = circle_contact(s, p, c, sn, circles[k, 0], circles[k, 1], circles[k, 2])
         if hit[0] > best[0]:
@@ -219,16 +205,17 @@ def deepest_contact(
     circles: np.ndarray,
 ) -> tuple[float, float, float, float, float]:
     """The deepest overlap of the body with any piece or circle (bounding circles prune the rest)."""
+    row, params = as_state(s), as_params(p)  # float64 rows from Python, or records
     near, centre = new_near(pstart, circles)
-    reach, wide = reaches(p)
-    refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
-    return deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near)[0]
+    reach, wide = reaches(params)
+    refresh_near(row.x, row.y, wide, verts, pstart, pbound, circles, near, centre)
+    return deepest_near(row, params, corners, verts, pstart, pbound, circles, reach, near)[0]
 
 
 @njit(cache=True, refcounts=False, inline="always")
 def resolve(
-    s: np.ndarray,
-    p: np.ndarray,
+    s: State,
+    p: Params,
     corners: np.ndarray,
     verts: np.ndarray,
     pstart: np.ndarray,
@@ -246,27 +233,27 @@ def resolve(
     A corner touching first turns the robot about it, as a real robot pushing one bumper corner
     against a wall swings square to it; the touching point is clamped to the body.
     """
-    s[CONTACT] = 0.0
+    s.contact = 0.0
     moved = False
     for _ in range(RESOLVE_ITERATIONS):
-        refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
+        refresh_near(s.x, s.y, wide, verts, pstart, pbound, circles, near, centre)
         if near[0] == 0 and near[1] == 0:  # in the open nothing can overlap the body (most ticks)
             return moved
         hit, c, sn = deepest_near(s, p, corners, verts, pstart, pbound, circles, reach, near)
         depth, dx, dy, px, py = hit
         if depth <= 0.0:
             return moved
-        s[CONTACT] = 1.0
+        s.contact = 1.0
         moved = True
-        rx, ry = px - s[X], py - s[Y]
-        bx = min(p[P_FRONT], max(-p[P_REAR], c * rx + sn * ry))
-        by = min(p[P_HALF_W], max(-p[P_HALF_W], -sn * rx + c * ry))
+        rx, ry = px - s.x, py - s.y
+        bx = min(p.front, max(-p.rear, c * rx + sn * ry))
+        by = min(p.half_w, max(-p.half_w, -sn * rx + c * ry))
         rx, ry = c * bx - sn * by, sn * bx + c * by
         arm = rx * dy - ry * dx  # turning leverage of the push about the axle centre
-        weight = 1.0 + arm * arm / p[P_GYR2]
-        s[X] += dx * depth / weight
-        s[Y] += dy * depth / weight
-        s[TH] += arm / p[P_GYR2] * depth / weight
+        weight = 1.0 + arm * arm / p.gyr2
+        s.x += dx * depth / weight
+        s.y += dy * depth / weight
+        s.th += arm / p.gyr2 * depth / weight
     return moved
 
 
@@ -275,7 +262,7 @@ def resolve(
 
 @njit(cache=True, refcounts=False)
 def near_plate(
-    s: np.ndarray,
+    s: State,
     c: float,
     sn: float,
     gap: float,
@@ -292,8 +279,8 @@ def near_plate(
     """Whether anything lies within the switch travel ``gap`` of a bumper plate given in the body frame
     (``c``, ``sn``: the heading's cosine and sine; ``near``/``near_circles``: bits of the pieces and
     circles the broad phase kept, the 63rd bit standing for every piece from the 63rd on)."""
-    ax, ay = s[X] + c * x0 - sn * y0, s[Y] + sn * x0 + c * y0
-    bx, by = s[X] + c * x1 - sn * y1, s[Y] + sn * x1 + c * y1
+    ax, ay = s.x + c * x0 - sn * y0, s.y + sn * x0 + c * y0
+    bx, by = s.x + c * x1 - sn * y1, s.y + sn * x1 + c * y1
     for k in range(pstart.shape[0] - 1):
         if not near >> min(k, 62) & 1:
             continue
@@ -313,7 +300,7 @@ def near_plate(
 
 @njit(cache=True, refcounts=False, inline="always")
 def broad_phase(
-    s: np.ndarray,
+    s: State,
     reach: float,
     verts: np.ndarray,
     pstart: np.ndarray,
@@ -328,20 +315,20 @@ def broad_phase(
     n = near[0]
     for j in range(n):
         k = near[2 + j]
-        if k >= 62 or might_be_near(s[X], s[Y], verts, pstart[k], pstart[k + 1], pbound, k, reach):
+        if k >= 62 or might_be_near(s.x, s.y, verts, pstart[k], pstart[k + 1], pbound, k, reach):
             bits |= np.int64(1) << min(k, 62)
     bits_circles = np.int64(0)
     for j in range(near[1]):
         k = near[2 + n + j]
-        if k >= 62 or within(circles[k, 0] - s[X], circles[k, 1] - s[Y], circles[k, 2] + reach + 1e-6):
+        if k >= 62 or within(circles[k, 0] - s.x, circles[k, 1] - s.y, circles[k, 2] + reach + 1e-6):
             bits_circles |= np.int64(1) << min(k, 62)
     return bits, bits_circles
 
 
 @njit(cache=True, refcounts=False, inline="always")
 def sense_bumpers(
-    s: np.ndarray,
-    p: np.ndarray,
+    s: State,
+    p: Params,
     c: float,
     sn: float,
     verts: np.ndarray,
@@ -355,8 +342,8 @@ def sense_bumpers(
 ) -> None:
     """Front-right, front-left (each a half plate wrapping round its corner; they overlap in the middle) and
     rear; ``c``/``sn``: the heading's cosine and sine; the rest as :func:`resolve`'s."""
-    f, r, w, ov, wrap, gap = p[P_FRONT], -p[P_REAR], p[P_HALF_W], p[P_OVERLAP], p[P_WRAP], p[P_GAP]
-    refresh_near(s[X], s[Y], wide, verts, pstart, pbound, circles, near, centre)
+    f, r, w, ov, wrap, gap = p.front, -p.rear, p.half_w, p.overlap, p.wrap, p.gap
+    refresh_near(s.x, s.y, wide, verts, pstart, pbound, circles, near, centre)
     near_p, near_c = broad_phase(s, reach + gap, verts, pstart, pbound, circles, near)
     fr = fl = rear = False
     if near_p or near_c:  # in the open (most ticks) no plate can touch anything
@@ -367,4 +354,4 @@ def sense_bumpers(
             s, c, sn, gap, f - wrap, w, f, w, verts, pstart, near_p, circles, near_c
         )
         rear = near_plate(s, c, sn, gap, r, -w, r, w, verts, pstart, near_p, circles, near_c)
-    s[BUMP_FR], s[BUMP_FL], s[BUMP_REAR] = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)
+    s.bump_fr, s.bump_fl, s.bump_rear = (1.0 if fr else 0.0), (1.0 if fl else 0.0), (1.0 if rear else 0.0)

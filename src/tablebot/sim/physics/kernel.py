@@ -16,12 +16,13 @@ import numpy as np
 
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.sim.columns import BUMP_FL, BUMP_FR, BUMP_REAR, CONTACT, MASK, N_NOISE, X, Y
+from tablebot.sim.columns import N_NOISE
 from tablebot.sim.physics.contacts import new_near, reaches
 from tablebot.sim.physics.geometry import within
+from tablebot.sim.physics.layout import Params, State, as_params, as_state
 from tablebot.sim.physics.normals import standard_normal
 from tablebot.sim.physics.step import advance, advance_called, aim_turns
-from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
+from tablebot.sim.physics.structures import NamedRobot, Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tick import EVENT, ROW, STATE, TIMER, Program
 
 # --- the integer record of each tick: ints[t, :] -------------------------------------------------
@@ -50,17 +51,17 @@ def new_accumulator(reach: float, debounce_rows: int) -> np.ndarray:
 
 
 @njit(nogil=True, refcounts=False, inline="always")
-def observe(s: np.ndarray, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
+def observe(s: State, lamps: np.ndarray, acc: np.ndarray, collisions: np.ndarray) -> None:
     """Fold one robot row into the running summary: reaching a lamp and the start of each collision
     (a rise of any bumper or contact with no touch in the debounce rows before it)."""
     robot_row = acc[A_ROWS]  # the row's number (not tick.py's ROW register, nor a noise row)
     acc[A_ROWS] = robot_row + 1.0
     if acc[A_REACHED] < 0.0:
         for k in range(lamps.shape[0]):
-            if within(s[X] - lamps[k, 0], s[Y] - lamps[k, 1], acc[A_REACH]):
+            if within(s.x - lamps[k, 0], s.y - lamps[k, 1], acc[A_REACH]):
                 acc[A_REACHED] = robot_row
                 break
-    touching = s[BUMP_FR] + s[BUMP_FL] + s[BUMP_REAR] + s[CONTACT] > 0.0
+    touching = s.bump_fr + s.bump_fl + s.bump_rear + s.contact > 0.0
     if touching:
         if acc[A_TOUCHING] == 0.0 and acc[A_LAST_TOUCH] < robot_row - acc[A_DEBOUNCE]:
             n = int(acc[A_COLLISIONS])
@@ -109,11 +110,28 @@ def run_robot(
     ``acc``/``collisions`` (see :func:`observe`), and, when ``record.counts`` has room, tallies each tick
     (numbered from ``record.t0``) into the record's counts, first visits and first light (see :func:`tally`).
     """
-    run_ticks(robot, world, program, wiring, ticks, noise, bitgen, record, robot_scratch(robot, world))
+    mine = named(robot)
+    run_ticks(mine, world, program, wiring, ticks, noise, bitgen, record, robot_scratch(mine, world))
 
 
 @njit(nogil=True, inline="always")
-def robot_scratch(robot: RobotState, world: WorldArrays) -> Scratch:
+def named(robot: RobotState) -> NamedRobot:
+    """``robot`` with its state and parameter rows as records (sim.physics.layout: the physics reads their
+    fields by name; the same memory)."""
+    return NamedRobot(
+        as_state(robot.s),
+        as_params(robot.p),
+        robot.regs,
+        robot.outputs,
+        robot.counters,
+        robot.acc,
+        robot.collisions,
+        robot.s,
+    )
+
+
+@njit(nogil=True, inline="always")
+def robot_scratch(robot: NamedRobot, world: WorldArrays) -> Scratch:
     """A robot's working space for a run of its table(s): its counters' pulses and one tick of physics."""
     near, centre = new_near(world.pstart, world.circles)
     reach, wide = reaches(robot.p)
@@ -133,7 +151,7 @@ def robot_scratch(robot: RobotState, world: WorldArrays) -> Scratch:
 
 @njit(nogil=True, refcounts=False)
 def run_ticks(
-    robot: RobotState,
+    robot: NamedRobot,
     world: WorldArrays,
     program: Program,
     wiring: Wiring,
@@ -153,23 +171,23 @@ def run_ticks(
 # The two halves of a tick round the tables' tick, shared by every loop (one table here, several in
 # sim.physics.several), so that the rows a robot's run records are written by one piece of code.
 @njit(nogil=True, refcounts=False, inline="always")
-def start_tick(t: int, robot: RobotState, wiring: Wiring, record: Record, scratch: Scratch) -> int:
+def start_tick(t: int, robot: NamedRobot, wiring: Wiring, record: Record, scratch: Scratch) -> int:
     """Tick t starts: the robot row (the robot as its sensors read it) into ``record.hist`` when it keeps rows,
     the counters' pulses into ``scratch.pulses``; returns the input mask the tables tick on."""
-    s, hist, pulses, pcols = robot.s, record.hist, scratch.pulses, wiring.pulse_columns
+    row, hist, pulses, pcols = robot.row, record.hist, scratch.pulses, wiring.pulse_columns
     if hist.shape[0]:
-        for j in range(s.shape[0]):
-            hist[t, j] = s[j]
-    for c in range(pulses.shape[0]):
-        pulses[c] = 0 if pcols[c] < 0 else int(s[pcols[c]])
-    return int(s[MASK])
+        for j in range(row.shape[0]):
+            hist[t, j] = row[j]
+    for c in range(pulses.shape[0]):  # by column: pulse_columns names the wheel's (sim.model.scene)
+        pulses[c] = 0 if pcols[c] < 0 else int(row[pcols[c]])
+    return int(robot.s.mask)
 
 
 @njit(nogil=True, refcounts=False, inline="always")
 def end_tick(
     t: int,
     mask: int,
-    robot: RobotState,
+    robot: NamedRobot,
     world: WorldArrays,
     wiring: Wiring,
     noise: np.ndarray,
@@ -225,7 +243,8 @@ def sense(s: np.ndarray, p: np.ndarray, world: WorldArrays, z: np.ndarray, bits:
     # not the constants 0 and False: numba would compile advance_called again for their literal types
     # (half a minute), since move passes variables
     still, moving = np.int64(0), np.bool_(False)
-    advance_called(s, still, still, p, world, bits, moving, _scratch(p, world, z))
+    params = as_params(p)
+    advance_called(as_state(s), still, still, params, world, bits, moving, _scratch(params, world, z))
 
 
 @njit(nogil=True)
@@ -241,8 +260,9 @@ def move(
     collisions: np.ndarray,
 ) -> None:
     """One tick of physics for one robot, driven from Python (the real-time, tick-by-tick path)."""
-    advance_called(s, right, left, p, world, bits, np.bool_(True), _scratch(p, world, z))  # not True: see sense
-    observe(s, world.lamps, acc, collisions)
+    row, params = as_state(s), as_params(p)  # float64 rows from Python, or records
+    advance_called(row, right, left, params, world, bits, np.bool_(True), _scratch(params, world, z))  # see sense
+    observe(row, world.lamps, acc, collisions)
 
 
 @njit(nogil=True)
@@ -259,17 +279,17 @@ def first_readings(
     """Robots ``rows`` of ``S`` read their sensors where they start (:func:`sense`, robot ``rows[k]`` moved by
     noise row ``draws[k, 2:]``) and fold that first row into their summaries (:func:`observe`): a fleet's
     robots start in one call, not two calls from Python each."""
-    z = np.empty(N_NOISE)
+    z, params = np.empty(N_NOISE), as_params(p)
     for k in range(rows.shape[0]):
         i = rows[k]
         for j in range(N_NOISE):
             z[j] = draws[k, 2 + j]
-        sense(S[i], p, world, z, bits)
-        observe(S[i], world.lamps, acc[i], collisions[i])
+        sense(S[i], params, world, z, bits)
+        observe(as_state(S[i]), world.lamps, acc[i], collisions[i])
 
 
 @njit(nogil=True, inline="always")
-def _scratch(p: np.ndarray, world: WorldArrays, z: np.ndarray) -> Scratch:
+def _scratch(p: Params, world: WorldArrays, z: np.ndarray) -> Scratch:
     """A robot's working space for one tick of physics alone (no table: no pulses)."""
     near, centre = new_near(world.pstart, world.circles)
     reach, wide = reaches(p)

@@ -22,21 +22,9 @@ from tablebot.sim.columns import (
     F_X,
     F_Y,
     MAX_SENSORS,
-    P_COS_FOV,
-    P_DBEAM,
-    P_DMIN,
-    P_DMIN_RANGE,
-    P_DRANGE,
-    P_DRES,
-    P_EXP,
-    P_SENSOR,
-    READING,
-    SENSOR_FIELDS,
-    TH,
-    X,
-    Y,
 )
 from tablebot.sim.physics.geometry import point_segment_distance, point_segment_within
+from tablebot.sim.physics.layout import Params, State
 from tablebot.sim.physics.shadows import NO_SHADE, shadowed_near
 
 if TYPE_CHECKING:
@@ -49,10 +37,10 @@ K_LINE, K_DISTANCE, K_LIGHT = (SENSOR_KINDS[name].code for name in ("line", "dis
 
 @njit(cache=True, refcounts=False, inline="always")
 def light_from(
-    s: np.ndarray,
+    s: State,
     c: float,
     sn: float,
-    p: np.ndarray,
+    p: Params,
     lx: float,
     ly: float,
     turn: float,
@@ -67,18 +55,18 @@ def light_from(
 
     The response fades to zero over the last quarter of the field of view (a lens tube's edge).
     """
-    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly
-    aim = s[TH] + turn
+    sx, sy = s.x + c * lx - sn * ly, s.y + sn * lx + c * ly
+    aim = s.th + turn
     ax, ay = math.cos(aim), math.sin(aim)
     total = 0.0
     for k in range(lamps.shape[0]):
         dx, dy = lamps[k, 0] - sx, lamps[k, 1] - sy
         ahead = dx * ax + dy * ay
-        if ahead <= 0.0 and p[P_COS_FOV] >= 0.0 and (dx != 0.0 or dy != 0.0):
+        if ahead <= 0.0 and p.cos_fov >= 0.0 and (dx != 0.0 or dy != 0.0):
             continue  # behind the sensor: its cosine (ahead / d, d > 0) is <= 0 <= cos_fov, no hypot needed
         d = math.hypot(dx, dy)
         cosine = 1.0 if d == 0.0 else ahead / d
-        if cosine <= p[P_COS_FOV]:
+        if cosine <= p.cos_fov:
             continue
         if not shadowed_near(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles, shade):  # first: spares the power
             total += lamp_light(p, lamps[k, 2], cosine, d)
@@ -86,20 +74,20 @@ def light_from(
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def lamp_light(p: np.ndarray, intensity: float, cosine: float, d: float) -> float:
+def lamp_light(p: Params, intensity: float, cosine: float, d: float) -> float:
     """What one unshadowed lamp in view gives at distance ``d`` and ``cosine`` off the sensor's axis."""
-    d = max(d, p[P_DMIN])
+    d = max(d, p.dmin)
     # cos^k response, tapered linearly to 0 at the field of view: no jump for the robot to dither on
-    taper = min(1.0, (cosine - p[P_COS_FOV]) / (1.0 - p[P_COS_FOV]) * 4.0)
-    return intensity * cosine ** p[P_EXP] * taper / (d * d)
+    taper = min(1.0, (cosine - p.cos_fov) / (1.0 - p.cos_fov) * 4.0)
+    return intensity * cosine**p.exp * taper / (d * d)
 
 
 @njit(cache=True, refcounts=False, inline="always")
 def light_turned(
-    s: np.ndarray,
+    s: State,
     c: float,
     sn: float,
-    p: np.ndarray,
+    p: Params,
     lx: float,
     ly: float,
     turn: float,
@@ -115,8 +103,8 @@ def light_turned(
     the lamps left are worked out as light_from does (the aim's cos/sin and the hypot only for them).
     Exact: a lamp out of view or shadowed adds nothing there either, and the others add the same terms in
     the same order."""
-    cos_fov = p[P_COS_FOV]
-    sx, sy = s[X] + c * lx - sn * ly, s[Y] + sn * lx + c * ly  # as light_from places the sensor
+    cos_fov = p.cos_fov
+    sx, sy = s.x + c * lx - sn * ly, s.y + sn * lx + c * ly  # as light_from places the sensor
     bx, by = c * ct - sn * st, sn * ct + c * st  # the aim, to within AIM_SLACK
     ax = ay = 0.0
     aimed = False
@@ -128,7 +116,7 @@ def light_turned(
         if shadowed_near(sx, sy, lamps[k, 0], lamps[k, 1], k, edges, circles, shade):
             continue
         if not aimed:
-            aim = s[TH] + turn
+            aim = s.th + turn
             ax, ay, aimed = math.cos(aim), math.sin(aim), True
         ahead = dx * ax + dy * ay
         if ahead <= 0.0 and cos_fov >= 0.0 and (dx != 0.0 or dy != 0.0):
@@ -219,15 +207,15 @@ def beam_circle(ux: float, uy: float, cb: float, sb: float, cx: float, cy: float
 
 
 @njit(cache=True, refcounts=False)
-def echo(sx: float, sy: float, aim: float, p: np.ndarray, edges: np.ndarray, circles: np.ndarray) -> float:
+def echo(sx: float, sy: float, aim: float, p: Params, edges: np.ndarray, circles: np.ndarray) -> float:
     """An ultrasonic sensor's reading in metres: the nearest wall, obstacle edge or circle inside its beam.
 
     Rounded to the sensor's resolution and never below its blind zone; with nothing in range it reads
     the range itself. Every surface echoes (no glancing-angle misses): see params.py's [distance].
     """
     ux, uy = math.cos(aim), math.sin(aim)
-    cb, sb = math.cos(p[P_DBEAM]), math.sin(p[P_DBEAM])
-    best = p[P_DRANGE]
+    cb, sb = math.cos(p.dbeam), math.sin(p.dbeam)
+    best = p.drange
     hit = False
     for k in range(edges.shape[0]):
         ax, ay, bx, by = edges[k, 0] - sx, edges[k, 1] - sy, edges[k, 2] - sx, edges[k, 3] - sy
@@ -244,16 +232,16 @@ def echo(sx: float, sy: float, aim: float, p: np.ndarray, edges: np.ndarray, cir
         if d < best:
             best, hit = d, True
     if not hit:
-        return p[P_DRANGE]
-    return max(p[P_DMIN_RANGE], round(best / p[P_DRES]) * p[P_DRES])
+        return p.drange
+    return max(p.dmin_range, round(best / p.dres) * p.dres)
 
 
 @njit(cache=True, refcounts=False)
 def sense_declared(
-    s: np.ndarray,
+    s: State,
     c: float,
     sn: float,
-    p: np.ndarray,
+    p: Params,
     edges: np.ndarray,
     circles: np.ndarray,
     lamps: np.ndarray,
@@ -263,32 +251,31 @@ def sense_declared(
     """Fill the reading of every declared sensor slot: line 1/0, distance in metres, light in light units
     (``c``, ``sn``: the heading's cosine and sine; ``shade``: the world's shadow grid, sim.physics.shadows)."""
     for k in range(MAX_SENSORS):
-        base = P_SENSOR + k * SENSOR_FIELDS
-        kind = p[base + F_KIND]
+        kind = p.sensor[k, F_KIND]
         if kind == 0.0:
             continue
-        bx, by = p[base + F_X], p[base + F_Y]
+        bx, by = p.sensor[k, F_X], p.sensor[k, F_Y]
         if kind == K_LIGHT:
-            s[READING + k] = light_from(s, c, sn, p, bx, by, p[base + F_AIM], edges, circles, lamps, shade)
+            s.reading[k] = light_from(s, c, sn, p, bx, by, p.sensor[k, F_AIM], edges, circles, lamps, shade)
             continue
-        sx, sy = s[X] + c * bx - sn * by, s[Y] + sn * bx + c * by
+        sx, sy = s.x + c * bx - sn * by, s.y + sn * bx + c * by
         if kind == K_LINE:
-            s[READING + k] = on_a_line(sx, sy, lines)
+            s.reading[k] = on_a_line(sx, sy, lines)
         elif kind == K_DISTANCE:
-            s[READING + k] = echo(sx, sy, s[TH] + p[base + F_AIM], p, edges, circles)
+            s.reading[k] = echo(sx, sy, s.th + p.sensor[k, F_AIM], p, edges, circles)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def sensor_events(s: np.ndarray, p: np.ndarray, bits: np.ndarray, previous: int) -> int:
+def sensor_events(s: State, p: Params, bits: np.ndarray, previous: int) -> int:
     """The event bits of the declared sensors (:func:`tablebot.sensors.threshold_event`: a reading past its
     threshold turns the event on; once on, it stays on until the reading is back past the threshold by the
     hysteresis; ``previous`` = last mask)."""
     mask = 0
     for k in range(min(MAX_SENSORS, bits.shape[0] - B_SENSOR)):
         bit = bits[B_SENSOR + k]
-        base = P_SENSOR + k * SENSOR_FIELDS
-        if bit == 0 or p[base + F_KIND] == 0.0:
+        if bit == 0 or p.sensor[k, F_KIND] == 0.0:
             continue
-        if threshold(s[READING + k], p[base + F_SIGN] > 0.0, p[base + F_ON], p[base + F_OFF], (previous & bit) != 0):
+        on, off = p.sensor[k, F_ON], p.sensor[k, F_OFF]
+        if threshold(s.reading[k], p.sensor[k, F_SIGN] > 0.0, on, off, (previous & bit) != 0):
             mask |= bit
     return mask

@@ -18,8 +18,8 @@ import numpy as np
 from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
-from tablebot.sim.physics.kernel import end_tick, robot_scratch, start_tick
-from tablebot.sim.physics.structures import Record, RobotState, Scratch, Wiring, WorldArrays
+from tablebot.sim.physics.kernel import end_tick, named, robot_scratch, start_tick
+from tablebot.sim.physics.structures import NamedRobot, Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tables import RobotTables
 from tablebot.tick import EVENT, ROW, STATE, TIMER, Program, registers
 
@@ -169,12 +169,13 @@ def run_several(
     """:func:`.kernel.run_robot` for a robot of several tables: ``robot.regs`` and ``robot.counters``
     are the main table's rows of ``st``, ``robot.outputs`` the robot's; ``tables[t]`` (when it has rows) gets
     every table's event, row, state and timer of tick t."""
-    several_ticks(robot, world, sp, st, wiring, ticks, noise, bitgen, record, tables, robot_scratch(robot, world))
+    mine = named(robot)
+    several_ticks(mine, world, sp, st, wiring, ticks, noise, bitgen, record, tables, robot_scratch(mine, world))
 
 
 @njit(nogil=True, refcounts=False)
 def several_ticks(
-    robot: RobotState,
+    robot: NamedRobot,
     world: WorldArrays,
     sp: SeveralProgram,
     st: SeveralState,

@@ -18,59 +18,19 @@ import numpy as np
 
 from tablebot.jit import njit
 from tablebot.sim.columns import (
-    AMPS,
     B_FL,
     B_FR,
     B_LIGHT_L,
     B_LIGHT_R,
     B_REAR,
-    BUMP_FL,
-    BUMP_FR,
-    BUMP_REAR,
-    DIST,
-    ENC_L,
-    ENC_R,
     F_KIND,
-    GAIN_L,
-    GAIN_R,
-    LIGHT_L,
-    LIGHT_R,
-    MASK,
-    P_ALPHA,
-    P_BASE,
-    P_CAP,
-    P_DT,
-    P_IIDLE,
-    P_IMOTOR,
-    P_KV,
-    P_LEVELS,
-    P_LX,
-    P_LY,
-    P_NLIGHT,
-    P_NMOTOR,
-    P_PPR,
-    P_RINT,
-    P_SENSOR,
-    P_TOE,
-    P_VEMPTY,
-    P_VF,
-    P_VFULL,
-    P_WHEEL_R,
-    PUL_L,
-    PUL_R,
-    SOC,
-    TH,
-    V_L,
-    V_R,
-    VBAT,
     Z_LIGHT_L,
     Z_LIGHT_R,
     Z_MOTOR_L,
     Z_MOTOR_R,
-    X,
-    Y,
 )
 from tablebot.sim.physics.contacts import resolve, sense_bumpers
+from tablebot.sim.physics.layout import Params, State, as_params, as_state
 from tablebot.sim.physics.sensing import light_turned, sense_declared, sensor_events
 from tablebot.sim.physics.shadows import NO_SHADE
 from tablebot.sim.physics.structures import Scratch, WorldArrays
@@ -82,10 +42,10 @@ NO_LINES = np.zeros((0, 5))  # a world without tape on its floor
 
 @njit(cache=True, refcounts=False, inline="always")
 def light_side(
-    s: np.ndarray,
+    s: State,
     c: float,
     sn: float,
-    p: np.ndarray,
+    p: Params,
     side: float,
     ct: float,
     st: float,
@@ -98,14 +58,14 @@ def light_side(
     ``sn``: the heading's cosine and sine; ``ct``, ``st``: those of its turn, :func:`aim_turns`; ``shade``:
     the world's shadow grid). Most ticks no lamp is in its field of view, or it is in shadow:
     :func:`sim.physics.sensing.light_turned` rules such lamps out cheaply, with light_from's answer."""
-    return light_turned(s, c, sn, p, p[P_LX], side * p[P_LY], side * p[P_TOE], ct, st, edges, circles, lamps, shade)
+    return light_turned(s, c, sn, p, p.lx, side * p.ly, side * p.toe, ct, st, edges, circles, lamps, shade)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def aim_turns(p: np.ndarray, out: np.ndarray) -> None:
+def aim_turns(p: Params, out: np.ndarray) -> None:
     """``out``: cosine and sine of the right phototransistor's turn from the heading, then the left one's."""
-    out[0], out[1] = math.cos(-1.0 * p[P_TOE]), math.sin(-1.0 * p[P_TOE])
-    out[2], out[3] = math.cos(1.0 * p[P_TOE]), math.sin(1.0 * p[P_TOE])
+    out[0], out[1] = math.cos(-1.0 * p.toe), math.sin(-1.0 * p.toe)
+    out[2], out[3] = math.cos(1.0 * p.toe), math.sin(1.0 * p.toe)
 
 
 @njit(cache=True)
@@ -119,11 +79,12 @@ def light_at(
     shade: np.ndarray = NO_SHADE,
 ) -> float:
     """Light the right (side -1) or left (+1) phototransistor of the BumberBot's wiring receives."""
+    row, params = as_state(s), as_params(p)  # float64 rows from Python, or records
     turns = np.empty(4)
-    aim_turns(p, turns)
+    aim_turns(params, turns)
     k = 0 if side < 0.0 else 2
     return light_side(
-        s, math.cos(s[TH]), math.sin(s[TH]), p, side, turns[k], turns[k + 1], edges, circles, lamps, shade
+        row, math.cos(row.th), math.sin(row.th), params, side, turns[k], turns[k + 1], edges, circles, lamps, shade
     )
 
 
@@ -143,60 +104,69 @@ def pack_volts(full: float, empty: float, charge: float, amps: float, ohms: floa
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def motor(
-    s: np.ndarray, p: np.ndarray, level: int, volts: float, gain: int, speed: int, enc: int, pul: int, noise: float
-) -> None:
-    """One motor: target speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
+def motor(s: State, p: Params, level: int, volts: float, right: bool, noise: float) -> None:
+    """One motor, the right one when ``right`` (a constant at each call: the branch compiles away): target
+    speed ∝ duty × battery volts - friction volts, reached with a first-order lag.
 
-    The encoder counts the motor's own turns (a wheel slipping against a wall still counts).
+    The encoder counts the motor's own turns (a wheel slipping against a wall still counts). Each field is
+    written as soon as it is worked out, as the flat rows' motor wrote its columns: a motor that returned its
+    speed, encoder and pulses for the caller to store made the whole kernel x1.15 slower, with the same
+    instructions in a different order (benchmarks/kernel.py; sim.physics.layout says more).
     """
-    power = duty(level, p[P_LEVELS])
-    target = np.sign(level) * s[gain] * p[P_KV] * max(0.0, power * volts - p[P_VF]) * (1.0 + p[P_NMOTOR] * noise)
-    s[speed] += (target - s[speed]) * p[P_ALPHA]
-    before = s[enc]
-    s[enc] += abs(s[speed]) * p[P_DT] / (2.0 * math.pi * p[P_WHEEL_R]) * p[P_PPR]
-    s[pul] = math.floor(s[enc]) - math.floor(before)
+    power = duty(level, p.levels)
+    gain = s.gain_r if right else s.gain_l
+    target = np.sign(level) * gain * p.kv * max(0.0, power * volts - p.vf) * (1.0 + p.nmotor * noise)
+    if right:
+        s.v_r += (target - s.v_r) * p.alpha
+        before = s.enc_r
+        s.enc_r += abs(s.v_r) * p.dt / (2.0 * math.pi * p.wheel_r) * p.ppr
+        s.pul_r = math.floor(s.enc_r) - math.floor(before)
+    else:
+        s.v_l += (target - s.v_l) * p.alpha
+        before = s.enc_l
+        s.enc_l += abs(s.v_l) * p.dt / (2.0 * math.pi * p.wheel_r) * p.ppr
+        s.pul_l = math.floor(s.enc_l) - math.floor(before)
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def drive(s: np.ndarray, cmd: tuple[int, int], p: np.ndarray, z: np.ndarray) -> None:
+def drive(s: State, cmd: tuple[int, int], p: Params, z: np.ndarray) -> None:
     """One tick of battery (open-circuit volts fall with charge, sag with current), motors and wheels."""
-    dt = p[P_DT]
-    amps = p[P_IIDLE] + p[P_IMOTOR] * (duty(cmd[0], p[P_LEVELS]) + duty(cmd[1], p[P_LEVELS]))
-    volts = pack_volts(p[P_VFULL], p[P_VEMPTY], s[SOC], amps, p[P_RINT])
-    s[AMPS], s[VBAT] = amps, volts
-    s[SOC] = max(0.0, s[SOC] - amps * dt / p[P_CAP])
-    motor(s, p, cmd[0], volts, GAIN_R, V_R, ENC_R, PUL_R, z[Z_MOTOR_R])
-    motor(s, p, cmd[1], volts, GAIN_L, V_L, ENC_L, PUL_L, z[Z_MOTOR_L])
-    turn = (s[V_R] - s[V_L]) / p[P_BASE] * dt
-    ahead = 0.5 * (s[V_R] + s[V_L]) * dt
-    mid = s[TH] + 0.5 * turn  # midpoint heading: exact for straight runs and spins, close on arcs
-    s[X] += ahead * math.cos(mid)
-    s[Y] += ahead * math.sin(mid)
-    s[TH] += turn
+    dt = p.dt
+    amps = p.iidle + p.imotor * (duty(cmd[0], p.levels) + duty(cmd[1], p.levels))
+    volts = pack_volts(p.vfull, p.vempty, s.soc, amps, p.rint)
+    s.amps, s.vbat = amps, volts
+    s.soc = max(0.0, s.soc - amps * dt / p.cap)
+    motor(s, p, cmd[0], volts, True, z[Z_MOTOR_R])
+    motor(s, p, cmd[1], volts, False, z[Z_MOTOR_L])
+    turn = (s.v_r - s.v_l) / p.base * dt
+    ahead = 0.5 * (s.v_r + s.v_l) * dt
+    mid = s.th + 0.5 * turn  # midpoint heading: exact for straight runs and spins, close on arcs
+    s.x += ahead * math.cos(mid)
+    s.y += ahead * math.sin(mid)
+    s.th += turn
 
 
 @njit(cache=True, refcounts=False, inline="always")
-def input_mask(s: np.ndarray, bits: np.ndarray) -> int:
+def input_mask(s: State, bits: np.ndarray) -> int:
     """The engine's input bits from the switch states and the light readings (1 = above threshold)."""
     mask = 0
-    if s[BUMP_FR] > 0.0:
+    if s.bump_fr > 0.0:
         mask |= bits[B_FR]
-    if s[BUMP_FL] > 0.0:
+    if s.bump_fl > 0.0:
         mask |= bits[B_FL]
-    if s[BUMP_REAR] > 0.0:
+    if s.bump_rear > 0.0:
         mask |= bits[B_REAR]
-    if s[LIGHT_R] >= 1.0:
+    if s.light_r >= 1.0:
         mask |= bits[B_LIGHT_R]
-    if s[LIGHT_L] >= 1.0:
+    if s.light_l >= 1.0:
         mask |= bits[B_LIGHT_L]
     return mask
 
 
 @njit(cache=True, refcounts=False, inline="always")
 def sense_near(
-    s: np.ndarray,
-    p: np.ndarray,
+    s: State,
+    p: Params,
     z: np.ndarray,
     verts: np.ndarray,
     pstart: np.ndarray,
@@ -216,24 +186,24 @@ def sense_near(
     """Everything one robot senses where it stands: bumpers, phototransistors, the sensors its robot file
     declares (sim.physics.sensing), and the input mask they make (hysteresis reads the previous mask). The heading's
     cosine and sine are worked out once for all of them."""
-    c, sn = math.cos(s[TH]), math.sin(s[TH])
+    c, sn = math.cos(s.th), math.sin(s.th)
     sense_bumpers(s, p, c, sn, verts, pstart, pbound, circles, reach, wide, near, centre)
     right = light_side(s, c, sn, p, -1.0, turns[0], turns[1], edges, circles, lamps, shade)
-    s[LIGHT_R] = max(0.0, right * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_R]))
+    s.light_r = max(0.0, right * (1.0 + p.nlight * z[Z_LIGHT_R]))
     left = light_side(s, c, sn, p, 1.0, turns[2], turns[3], edges, circles, lamps, shade)
-    s[LIGHT_L] = max(0.0, left * (1.0 + p[P_NLIGHT] * z[Z_LIGHT_L]))
-    if p[P_SENSOR + F_KIND] != 0.0:  # declared sensors fill the slots from the first: none declared, no pass
+    s.light_l = max(0.0, left * (1.0 + p.nlight * z[Z_LIGHT_L]))
+    if p.sensor[0, F_KIND] != 0.0:  # declared sensors fill the slots from the first: none declared, no pass
         sense_declared(s, c, sn, p, edges, circles, lamps, lines, shade)
-    previous = int(s[MASK])
-    s[MASK] = input_mask(s, bits) | sensor_events(s, p, bits, previous)
+    previous = int(s.mask)
+    s.mask = input_mask(s, bits) | sensor_events(s, p, bits, previous)
 
 
 @njit(cache=True, refcounts=False, inline="always")
 def advance(
-    s: np.ndarray,
+    s: State,
     right: int,
     left: int,
-    p: np.ndarray,
+    p: Params,
     world: WorldArrays,
     bits: np.ndarray,
     move: bool,
@@ -244,13 +214,13 @@ def advance(
     robot's candidate obstacles from tick to tick (:func:`~tablebot.sim.physics.contacts.new_near`)."""
     w, near, centre = world, scratch.near, scratch.centre
     if move:
-        x0, y0 = s[X], s[Y]
+        x0, y0 = s.x, s.y
         cmd = (right, left)
         drive(s, cmd, p, scratch.z)
         resolve(
             s, p, scratch.corners, w.verts, w.pstart, w.pbound, w.circles, scratch.reach, scratch.wide, near, centre
         )
-        s[DIST] += math.hypot(s[X] - x0, s[Y] - y0)
+        s.dist += math.hypot(s.x - x0, s.y - y0)
     sense_near(
         s,
         p,
@@ -274,10 +244,10 @@ def advance(
 
 @njit(cache=True, refcounts=False)
 def advance_called(
-    s: np.ndarray,
+    s: State,
     right: int,
     left: int,
-    p: np.ndarray,
+    p: Params,
     world: WorldArrays,
     bits: np.ndarray,
     move: bool,

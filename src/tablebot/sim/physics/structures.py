@@ -4,15 +4,18 @@ ticks, a robot's working space; a fleet's robots and program variants (the table
 
 Each is a NamedTuple of arrays (and a few numbers): numba hands a tuple to a compiled function as the values
 it holds, so a kernel taking four of them costs what the same kernel taking their thirty-odd fields costs,
-and reads each by name. A robot's own row stays one float64 array whose columns :mod:`tablebot.sim.columns`
-names (it is copied into the trace a tick at a time, and the physics indexes it in its innermost loops).
+and reads each by name. A robot's own rows stay float64 arrays whose columns :mod:`tablebot.sim.columns` names
+outside the compiled loops; inside them they are records read by name (:mod:`tablebot.sim.physics.layout`).
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+if TYPE_CHECKING:  # not at run time: this module stays free of numba (sim.physics.layout compiles)
+    from tablebot.sim.physics.layout import Params, State
 
 
 class WorldArrays(NamedTuple):
@@ -48,6 +51,21 @@ class RobotState(NamedTuple):
     counters: np.ndarray  # int64 (counters,)
     acc: np.ndarray  # float64 (N_ACC,): sim.physics.kernel's A_* fields
     collisions: np.ndarray  # int64: the robot rows where collisions began (as many as fit)
+
+
+class NamedRobot(NamedTuple):
+    """:class:`RobotState` inside the compiled loops: its state and parameter rows as records, read by name
+    (sim.physics.layout; sim.physics.kernel.named makes it, no copy), and the state row as it is, which the
+    trace copies and the counters' pulses are read from by column."""
+
+    s: State
+    p: Params
+    regs: np.ndarray
+    outputs: np.ndarray
+    counters: np.ndarray
+    acc: np.ndarray
+    collisions: np.ndarray
+    row: np.ndarray  # float64 (N_STATE,): the memory of ``s``
 
 
 class Record(NamedTuple):
