@@ -49,3 +49,37 @@ def test_a_numba_config_file_in_the_working_folder_is_still_read(tmp_path: Path)
         "import sys, tablebot.jit, numba; print('yaml' in sys.modules, numba.config.BOUNDSCHECK)", cwd=tmp_path
     )
     assert lines == ["True 1"]
+
+
+TWICE = """
+from tablebot.jit import njit
+
+
+@njit
+def twice(x):
+    return 2 * x
+"""
+
+
+def test_a_call_the_cache_holds_loads_without_numbas_set_up_for_compiling(tmp_path: Path) -> None:
+    """numba reads every installed package's entry points (its extensions) before its first compile or load of a
+    process; a load from the cache needs none of it (tablebot.jit._loading_first: 18-26 ms of a sweep). A call
+    whose types the cache lacks still takes numba's own path, the set-up included, and compiles."""
+    (tmp_path / "twice.py").write_text(TWICE, encoding="utf-8")
+    env = child_env(NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+
+    def run(value: str) -> list[str]:
+        code = (
+            "import numpy as np, twice, numba.core.entrypoints as e; "
+            f"print(twice.twice({value})); print(e._already_initialized)"
+        )
+        done = subprocess.run(
+            [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120
+        )
+        assert done.returncode == 0, done.stderr
+        return done.stdout.splitlines()
+
+    assert run("np.arange(3.0)") == ["[0. 2. 4.]", "True"]  # compiled: numba's set-up ran
+    assert run("np.arange(3.0)") == ["[0. 2. 4.]", "False"]  # loaded from the cache: no set-up
+    assert run("np.arange(3)") == ["[0 2 4]", "True"]  # other types: numba's own path compiles them
+    assert run("np.arange(3)") == ["[0 2 4]", "False"]

@@ -226,8 +226,44 @@ def njit(*args: Any, refcounts: bool = True, **kwargs: Any) -> Callable[..., Any
     if not refcounts:
         kwargs["_nrt"] = False
     if args and callable(args[0]) and len(args) == 1 and not kwargs.keys() - {"cache"}:
-        return numba.njit(cache=kwargs["cache"])(args[0])
-    return numba.njit(*args, **kwargs)
+        return _loading_first(numba.njit(cache=kwargs["cache"])(args[0]))
+    decorate = numba.njit(*args, **kwargs)
+    return lambda function: _loading_first(decorate(function))
+
+
+def cached_signatures(function: Any) -> list[Any]:
+    """The argument types whose machine code ``function`` (made with :func:`njit`) has in the on-disk cache for this
+    machine and these sources (uses numba's cache internals: another numba finds none, and nothing changes)."""
+    try:
+        cache, codegen = function._cache, function.targetctx.codegen()
+        keys = list(cache._cache_file._load_index())
+        return [key[0] for key in keys if cache._index_key(key[0], codegen) == key]
+    except Exception:  # another numba, no cache, or no index yet
+        return []
+
+
+def _loading_first(dispatcher: Any) -> Any:
+    """``dispatcher`` with a first call (for each new set of argument types) that loads the machine code the cache
+    holds for them without numba's compilation chain set-up. numba runs that set-up before compiling or loading any
+    call it has no code for yet -- ``init_all``: reading every installed package's entry points for numba extensions,
+    18-26 ms of a sweep here, on its critical path -- though loading needs none of it, and tablebot compiles with no
+    extension. Types the cache lacks, and any failure, take numba's own path: the set-up, then the compile."""
+    original = getattr(dispatcher, "_compile_for_args", None)
+    if original is None:  # another numba: as it is
+        return dispatcher
+
+    def compile_for_args(*args: Any, **kws: Any) -> Any:
+        if not kws:
+            try:
+                types = tuple(dispatcher.typeof_pyval(arg) for arg in args)
+                if types in cached_signatures(dispatcher):
+                    return dispatcher.compile(types)  # the entry point, as numba's own returns it
+            except Exception:  # numba's own path says what is wrong
+                pass
+        return original(*args, **kws)
+
+    dispatcher._compile_for_args = compile_for_args
+    return dispatcher
 
 
 # --- handing compiled code to another process (a fresh cluster worker) -------------------------------------------

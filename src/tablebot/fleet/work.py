@@ -136,15 +136,11 @@ def preload(*functions: Any) -> int:
     LLVM linking the code, which leaves the GIL -- instead of in the first chunk, while the other thread waits
     for numba's compiler lock. What the cache lacks is left to compile at its first call, as ever. Returns
     how many overloads it loaded (this uses numba's cache internals: another numba loads nothing here)."""
+    from tablebot.jit import cached_signatures
+
     loaded = 0
     for function in functions:
-        try:
-            cache, codegen = function._cache, function.targetctx.codegen()
-            keys = list(cache._cache_file._load_index())
-            wanted = [key[0] for key in keys if cache._index_key(key[0], codegen) == key]
-        except Exception:  # another numba, or no index: the first call loads (or compiles) as before
-            continue
-        for signature in wanted:
+        for signature in cached_signatures(function):  # none: the first call loads (or compiles) as before
             function.compile(signature)
             loaded += 1
     return loaded
