@@ -147,13 +147,31 @@ def emulate(
     """Run the firmware over recorded inputs and decode what it sent."""
     if firmware.wiring is None:
         raise fail(firmware.elf, N_("this firmware has no wiring (a benchmark build?)"), N_("build with main firmware"))
-    harness = harness or build_harness()
+    ticks_out, uart = run_recorded(firmware, machine, ticks, workdir, harness)
+    decoder = Decoder(machine, firmware.layout)
+    trace = decoder.feed(uart.read_bytes())
+    overhead, cycles = read_cycles(ticks_out)
+    return Emulation(trace, decoder.hellos, decoder.problems, cycles, overhead)
+
+
+def run_recorded(
+    firmware: Firmware,
+    machine: Machine,
+    ticks: Sequence[TickInput],
+    workdir: Path,
+    harness: Path | None = None,
+    extra: Sequence[str] = (),
+) -> tuple[Path, Path]:
+    """Run the firmware under the simavr harness over recorded inputs (its pins per tick, written into
+    ``workdir``; ``extra``: more harness options); returns the files the harness wrote, its per-tick cycle
+    markers and the UART bytes the firmware sent."""
+    assert firmware.wiring is not None
     workdir.mkdir(parents=True, exist_ok=True)
     pins, ticks_out, uart = workdir / "pins.csv", workdir / "ticks.csv", workdir / "uart.bin"
     pins.write_text(pins_csv(machine, firmware.wiring, ticks), encoding="utf-8")
     board = firmware.board
     run_harness(
-        harness,
+        harness or build_harness(),
         [
             "--elf",
             str(firmware.elf),
@@ -169,12 +187,10 @@ def emulate(
             str(ticks_out),
             "--uart-out",
             str(uart),
+            *extra,
         ],
     )
-    decoder = Decoder(machine, firmware.layout)
-    trace = decoder.feed(uart.read_bytes())
-    overhead, cycles = read_cycles(ticks_out)
-    return Emulation(trace, decoder.hellos, decoder.problems, cycles, overhead)
+    return ticks_out, uart
 
 
 def summary(values: Sequence[int]) -> dict[str, float]:

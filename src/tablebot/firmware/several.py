@@ -21,7 +21,7 @@ from tablebot.fileset import file_set
 from tablebot.firmware.board_header import board_header
 from tablebot.firmware.boards import load_board, wire
 from tablebot.firmware.build import BUG, Firmware, c_source, compile_and_link, write_main
-from tablebot.firmware.emulate import build_harness, pins_csv, run_harness
+from tablebot.firmware.emulate import run_recorded
 from tablebot.firmware.framing import take_frames
 from tablebot.formats.inputs_csv import TickInput
 from tablebot.i18n import N_
@@ -72,33 +72,8 @@ def emulate_several(
     firmware: Firmware, tables: RobotTables, ticks: Sequence[TickInput], workdir: Path, machine: Machine | None = None
 ) -> list[dict[str, Any]]:
     """Run the firmware under simavr over recorded inputs (the robot's input layout); the decoded trace."""
-    assert firmware.wiring is not None
     machine = machine or robot_machine(tables)
-    workdir.mkdir(parents=True, exist_ok=True)
-    pins, ticks_out, uart = workdir / "pins.csv", workdir / "ticks.csv", workdir / "uart.bin"
-    pins.write_text(pins_csv(machine, firmware.wiring, ticks), encoding="utf-8")
-    board = firmware.board
-    run_harness(
-        build_harness(),
-        [
-            "--elf",
-            str(firmware.elf),
-            "--mcu",
-            board.mcu,
-            "--freq",
-            str(board.f_cpu),
-            "--uart",
-            str(board.usart),
-            "--inputs",
-            str(pins),
-            "--ticks-out",
-            str(ticks_out),
-            "--uart-out",
-            str(uart),
-            "--flush-ms",
-            str(FLUSH_MS),
-        ],
-    )
+    _, uart = run_recorded(firmware, machine, ticks, workdir, extra=("--flush-ms", str(FLUSH_MS)))
     lines = decode(tables, uart.read_bytes())
     if len(lines) < len(ticks):
         raise fail("uart", N_("{frames} tick frames for {ticks} ticks", frames=len(lines), ticks=len(ticks)), BUG)
