@@ -69,10 +69,11 @@ def tablebot(*args: str, src: str | None = None, again: bool = True) -> float:
     return elapsed
 
 
-def sweep_args(robots: int, seconds: float, out: str) -> list[str]:
+def sweep_args(robots: int, seconds: float, out: str, example: Path = EXAMPLE) -> list[str]:
+    """``tablebot sweep``'s arguments for ``robots`` runs of ``seconds`` each, no pictures, quiet, into ``out``."""
     return [
         "sweep",
-        str(EXAMPLE),
+        str(example),
         "--robots",
         str(robots),
         "--seconds",

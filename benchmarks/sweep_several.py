@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from fleet_sweep import sweep_args  # beside this file (a script's folder is on the path)
 from tablebot.testing.processes import child_env
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,21 +36,7 @@ def command_s(example: Path, robots: int, seconds: float) -> float:
     with tempfile.TemporaryDirectory(prefix="tablebot-bench-") as out:
         started = time.perf_counter()
         subprocess.run(
-            [
-                sys.executable,
-                "-m",
-                "tablebot",
-                "sweep",
-                str(example),
-                "--robots",
-                str(robots),
-                "--seconds",
-                f"{seconds:g}",
-                "--no-plots",
-                "--quiet",
-                "--out",
-                out,
-            ],
+            [sys.executable, "-m", "tablebot", *sweep_args(robots, seconds, out, example)],
             cwd=ROOT,
             env=child_env(),
             check=True,
