@@ -144,21 +144,30 @@ def sim_parameters_page() -> str:
 PAGES = {"commands.md": commands_page, "sim-parameters.md": sim_parameters_page}
 
 
+def made(name: str) -> str:
+    """Page ``name`` as the code makes it now, in English whatever the process speaks (the German site translates
+    the pages; a test run whose earlier test left the process speaking German found the page out of date)."""
+    from tablebot.i18n import speaking
+
+    with speaking("en"):
+        return PAGES[name]()
+
+
 def stale() -> list[str]:
     """The generated pages whose file differs from what the code makes now."""
     out = []
-    for name, make in PAGES.items():
+    for name in PAGES:
         path = DOCS / name
-        if not path.exists() or path.read_text(encoding="utf-8") != make():
+        if not path.exists() or path.read_text(encoding="utf-8") != made(name):
             out.append(name)
     return out
 
 
 def write() -> None:
-    for name, make in PAGES.items():
+    for name in PAGES:
         path = DOCS / name
         tmp = path.with_name(f".{name}.tmp")
-        tmp.write_text(make(), encoding="utf-8")
+        tmp.write_text(made(name), encoding="utf-8")
         tmp.replace(path)
 
 

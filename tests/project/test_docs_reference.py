@@ -41,6 +41,19 @@ def test_the_pages_made_from_the_code_are_up_to_date() -> None:
     assert reference_script().stale() == [], "run .venv/bin/python scripts/docs_reference.py"
 
 
+def test_the_pages_are_made_in_english_whatever_the_process_speaks() -> None:
+    """A test before this one in the same worker that left the process speaking German made the English page
+    read as out of date (the command help came out German)."""
+    from tablebot import i18n
+
+    before = i18n.current()
+    i18n.use("de")
+    try:
+        assert reference_script().stale() == []
+    finally:
+        i18n.use(before)
+
+
 def test_the_command_reference_has_every_command_and_option() -> None:
     page = (DOCS / "commands.md").read_text(encoding="utf-8")
     for name in ("sim", "check", "run", "evolve", "studio"):
