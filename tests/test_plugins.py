@@ -74,3 +74,51 @@ for t in threads: t.join()
 print(len(seen), all(names == seen[0] for names in seen), seen[0])
 """)
     assert lines == [f"8 True {EVERY_BACKEND}"]
+
+
+def test_a_robot_file_s_reader_imports_the_modules_of_its_own_sections_only() -> None:
+    lines = fresh(f"""
+import sys
+from tablebot.robot import load_robot
+load_robot({str(EXAMPLE / "robot.toml")!r})
+print(sorted(m for m in sys.modules if m.endswith('.backend')))
+""")
+    # the BumberBot's [txt], [robotx] and [roboif]: not the ROBO Pro, C, statechart, firmware or sim back-ends
+    assert lines == [str(["tablebot.hw.roboif.backend", "tablebot.hw.robotx.backend", "tablebot.hw.txt.backend"])]
+
+
+def test_the_catalog_names_every_section_load_all_registers_in_its_order() -> None:
+    lines = fresh("""
+from tablebot import catalog
+from tablebot.robot import SECTION_READERS
+catalog.load_all()
+print(list(SECTION_READERS))
+print(list(catalog.SECTIONS))
+""")
+    assert lines[0] == lines[1]
+
+
+def test_each_section_s_module_registers_its_reader_in_a_fresh_process() -> None:
+    lines = fresh("""
+import subprocess, sys
+from tablebot import catalog
+for section, module in catalog.SECTIONS.items():
+    code = (f"import importlib, tablebot; from tablebot.robot import SECTION_READERS; "
+            f"importlib.import_module({module!r}); print({section!r} in SECTION_READERS)")
+    print(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip())
+""")
+    assert lines == ["True"] * 9
+
+
+def test_an_unknown_section_is_told_with_every_section_there_is(tmp_path: Path) -> None:
+    robot = tmp_path / "robot.toml"
+    robot.write_text((EXAMPLE / "robot.toml").read_text(encoding="utf-8") + "\n[simm]\nx = 1\n", encoding="utf-8")
+    lines = fresh(f"""
+from tablebot.diagnostics import TableBotError
+from tablebot.robot import load_robot
+try:
+    load_robot({str(robot)!r})
+except TableBotError as exc:
+    print(exc.diagnostics[0].hint)
+""")
+    assert "tables, groups, robopro, board, txt, robotx, roboif, sim, properties" in lines[0], lines

@@ -55,7 +55,6 @@ def __getattr__(name: str) -> Any:
 
 # Every back-end registers itself and its robot-file section when the registry or a robot file's reader first
 # needs them (tablebot.plugins): their modules bring the table machinery, which `tablebot --help` does without.
-from tablebot import plugins  # noqa: E402
-from tablebot.catalog import load_all  # noqa: E402
+from tablebot import catalog  # noqa: E402
 
-plugins.defer(load_all)
+catalog.defer()

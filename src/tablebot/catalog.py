@@ -9,6 +9,35 @@ it imports is light (what it needs to run is imported when it runs). A new back-
 
 from __future__ import annotations
 
+from functools import partial
+from importlib import import_module
+
+from tablebot import plugins
+
+#: Each robot-file section and the module whose import registers its reader, in the order :func:`load_all`
+#: registers them (a robot file's error lists them so). A file's reader imports only the modules of the
+#: sections it has (:func:`tablebot.plugins.load_sections`); tests/test_plugins.py holds this to what
+#: :func:`load_all` registers.
+SECTIONS = {
+    "tables": "tablebot.robot_tables",  # first: the ROBO Pro back-end's module imports it
+    "groups": "tablebot.robot_tables",
+    "robopro": "tablebot.robopro.backend",
+    "board": "tablebot.firmware.backend",
+    "txt": "tablebot.hw.txt.backend",
+    "robotx": "tablebot.hw.robotx.backend",
+    "roboif": "tablebot.hw.roboif.backend",
+    "sim": "tablebot.sim.backend",
+    "properties": "tablebot.analysis.section",
+}
+
+
+def defer() -> None:
+    """Hand :func:`load_all` and each section's module to :mod:`tablebot.plugins`, which imports them when
+    first needed (by name: nothing here imports a back-end before then)."""
+    plugins.defer(load_all)
+    for section, module in SECTIONS.items():
+        plugins.defer_section(section, partial(import_module, module))
+
 
 def load_all() -> None:
     """Import every back-end module (in the order commands list them) and the analysis's section."""

@@ -62,9 +62,10 @@ SectionReader = Callable[[Source, Any, "Robot"], Any]
 #: Sections of a robot file that belong to other stages (``[sim]``, ``[board]``, ``[properties]``, ``[txt]``,
 #: ...), each with its reader. The stages register them (:func:`register_section`, called by
 #: :func:`tablebot.registry.register` for back-ends), so this module imports none of them; reading a robot
-#: file registers every one first (:func:`tablebot.catalog.load_all`, through :func:`tablebot.plugins.load`),
-#: and so does asking the registry. Every section is read when the
-#: file is, so all its mistakes show at once, whichever command runs.
+#: file registers the readers of the sections it has first (their modules, named in
+#: :data:`tablebot.catalog.SECTIONS`, through :func:`tablebot.plugins.load_sections`); asking the registry
+#: registers every one. Every section is read when the file is, so all its mistakes show at once, whichever
+#: command runs.
 SECTION_READERS: dict[str, SectionReader] = {}
 
 
@@ -188,10 +189,10 @@ def find_robot_file(table_path: Path) -> Path | None:
 
 def load_robot(path: str | Path) -> Robot:
     """Read a robot TOML file, reporting every problem with its line."""
-    plugins.load()  # every back-end's section registered
     path = Path(path)
     src = Source.read(path, N_("see the robot file format in the README"))
     data = src.data
+    plugins.load_sections(key for key in data if key not in TOP_KEYS and key not in CORE_SECTIONS)
     for key in data:
         if key not in TOP_KEYS and key not in CORE_SECTIONS and key not in SECTION_READERS:
             unknown = (
@@ -207,7 +208,7 @@ def load_robot(path: str | Path) -> Robot:
                     N_(
                         "known keys: {keys}; sections: {sections}",
                         keys=", ".join(TOP_KEYS),
-                        sections=", ".join((*CORE_SECTIONS, *SECTION_READERS)),
+                        sections=", ".join((*CORE_SECTIONS, *plugins.sections(), *_undeclared())),
                     ),
                 ),
             )
@@ -282,10 +283,15 @@ def load_robot(path: str | Path) -> Robot:
     return robot
 
 
+def _undeclared() -> list[str]:
+    """Sections a back-end registered without naming them to :mod:`tablebot.plugins` (none of tablebot's)."""
+    return [name for name in SECTION_READERS if name not in plugins.sections()]
+
+
 def _foreign_sections(src: Source, robot: Robot) -> dict[str, Any]:
     """Each stage's section, read by its own reader (see SECTION_READERS); all problems at once."""
     typed = {}
-    for key, reader in SECTION_READERS.items():
+    for key, reader in list(SECTION_READERS.items()):  # (a reader may import a module that registers one)
         if key in src.data:
             typed[key] = reader(src, src.data[key], robot)
     src.raise_if_any()
