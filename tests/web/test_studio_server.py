@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import os
 import shutil
 import time
 import urllib.error
@@ -124,6 +125,36 @@ def test_static_files_stay_in_the_package(studio: tuple[Background, Path]) -> No
     for module in modules:  # no script is fetched from anywhere else
         text = urllib.request.urlopen(get(server, "static/" + module)).read()
         assert b"http" not in text.replace(b'location.protocol === "https:"', b""), module
+
+
+def test_the_page_asks_for_every_module_its_script_imports_at_once(studio: tuple[Background, Path]) -> None:
+    """A modulepreload link per module the page's script imports, however deep (found by reading the
+    modules' own imports here, not by the server's list), each served; none for a module nothing imports."""
+    import re
+
+    from tablebot.web.app import STATIC
+
+    server, _ = studio
+    with urllib.request.urlopen(server.url) as reply:
+        page, headers = reply.read().decode(), reply.headers
+    assert headers["Cache-Control"] == "no-store" and "script-src 'self'" in headers["Content-Security-Policy"]
+    preloaded = re.findall(r'<link rel="modulepreload" href="/static/([^"]+)">', page)
+    assert page.index("modulepreload") < page.index('<script type="module" src="/static/js/studio/main.js">')
+    wanted, todo = set(), ["js/studio/main.js"]
+    while todo:
+        name = todo.pop()
+        if name not in wanted:
+            wanted.add(name)
+            text = (STATIC / name).read_text(encoding="utf-8")
+            todo += [
+                (Path(name).parent / spec).as_posix().replace("/./", "/")
+                for spec in re.findall(r'from "(\.[^"]+)"', text)
+            ]
+    wanted = {str(Path(os.path.normpath(name)).as_posix()) for name in wanted}
+    assert sorted(preloaded) == sorted(wanted) and len(preloaded) == len(set(preloaded)) > 20
+    for name in preloaded:
+        with urllib.request.urlopen(get(server, "static/" + name)) as reply:
+            assert reply.status == 200 and "javascript" in reply.headers["Content-Type"], name
 
 
 def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background, Path]) -> None:

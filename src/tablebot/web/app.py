@@ -15,7 +15,7 @@ from typing import Any
 import uvicorn
 from starlette.applications import Starlette
 from starlette.requests import ClientDisconnect, Request
-from starlette.responses import FileResponse, JSONResponse, Response
+from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
@@ -25,6 +25,7 @@ from tablebot.escape import terminal
 from tablebot.i18n import N_
 from tablebot.templates import TEMPLATES
 from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
+from tablebot.web.bundle import module_order
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.live import give_back_memory
 from tablebot.web.protocol import ErrorMsg, TraceMsg
@@ -47,6 +48,23 @@ CSP = (
 )
 
 
+#: The page's first module, under STATIC.
+ENTRY = "js/studio/main.js"
+
+
+def index_page() -> str:
+    """The studio's page, with a ``modulepreload`` link for every module its script imports, however deep:
+    the browser asks for all of them at once instead of finding each level of imports only when the level
+    above has arrived (five round trips in a row: ~0.2 s of each page opened on this machine, more over a
+    classroom's Wi-Fi)."""
+    html = (STATIC / "index.html").read_text(encoding="utf-8")
+    script = f'<script type="module" src="/static/{ENTRY}"></script>'
+    if script not in html:
+        raise RuntimeError(f"index.html no longer loads /static/{ENTRY}")
+    links = "".join(f'<link rel="modulepreload" href="/static/{name}">\n' for name in module_order(STATIC, ENTRY))
+    return html.replace(script, links + script)
+
+
 class Gone(Exception):
     """The tab closed its WebSocket: stop talking to it."""
 
@@ -67,10 +85,10 @@ def create_app(
     hub = Hub()
     tabs = Tabs(max_tabs)
 
+    page = index_page()
+
     async def index(request: Request) -> Response:
-        response = FileResponse(
-            STATIC / "index.html", headers={"Content-Security-Policy": CSP, "Cache-Control": "no-store"}
-        )
+        response = HTMLResponse(page, headers={"Content-Security-Policy": CSP, "Cache-Control": "no-store"})
         if visited is not None and access.has_token(request.query_params.getlist("token")):
             visited.set()  # the browser came with the token (the page keeps it; the server sets no cookie)
         return response

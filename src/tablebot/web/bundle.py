@@ -21,12 +21,17 @@ LEFT_OVER_RE = re.compile(r"^\s*(import|export)\b", re.M)
 
 def bundle(root: Path, entry: str) -> str:
     """The module ``entry`` (a path under ``root``) and everything it imports, as one classic script body."""
-    order: list[str] = []
-    _visit(root, entry, order, ())
     parts = ["const modules = {};"]
-    for name in order:
+    for name in module_order(root, entry):
         parts.append(_wrapped(root, name))
     return "\n".join(parts) + "\n"
+
+
+def module_order(root: Path, entry: str) -> list[str]:
+    """``entry`` (a path under ``root``) and every module it imports, each once, a module after its imports."""
+    order: list[str] = []
+    _visit(root, entry, order, ())
+    return order
 
 
 def _visit(root: Path, name: str, order: list[str], stack: tuple[str, ...]) -> None:
