@@ -33,8 +33,7 @@ function replay(data) {
   player.load(data.trace, data.machine, 0);
   wirePlayerControls(player);
   wireZoom(arena);
-  const paint = () => { arena.draw(); requestAnimationFrame(paint); };
-  paint();
+  arena.invalidate();  // drawn now, and again whenever it changes
 }
 
 const holder = byId("tb-data");

@@ -35,12 +35,7 @@ wirePlayerControls(views.player);
 wireZoom(views.arena);
 keepFitted();
 
-function paint() {
-  const t0 = performance.now();
-  views.arena.draw();
-  stats.drawMs = performance.now() - t0;
-  requestAnimationFrame(paint);
-}
+views.arena.onDrawn = (ms) => { stats.drawMs = ms; };  // the arena draws itself when it changes
 
 async function start() {
   const params = new URLSearchParams(location.search);  // without the token (../lib/key.js took it)
@@ -68,5 +63,5 @@ function connectionDown(tries) {
   banner(t(tries < 3 ? "link.lost" : "link.gone") + kept, "bad");
 }
 
-requestAnimationFrame(paint);
+views.arena.invalidate();
 start();

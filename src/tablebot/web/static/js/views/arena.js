@@ -19,7 +19,9 @@ export class Arena {
     this.replayPath = null;
     this.marker = null;  // {x, y, label}: where a counterexample breaks its property
     this.onClick = onClick;
+    this.onDrawn = null;  // (ms) => ...: told how long each draw took
     this.dirty = true;
+    this.framed = false;  // a frame is asked for
     if (onClick) this._listen();
     new ResizeObserver(() => this.resize()).observe(canvas.parentElement);
   }
@@ -62,7 +64,7 @@ export class Arena {
   clearPath() {
     this.pathLayer.getContext("2d").clearRect(0, 0, this.pathLayer.width, this.pathLayer.height);
     this.lastPoint = null;
-    this.dirty = true;
+    this.invalidate();
   }
 
   // points: [[x, y, stateId], ...] in metres; drawn once onto the path layer (never redrawn per frame).
@@ -80,7 +82,7 @@ export class Arena {
       last = p;
     }
     this.lastPoint = last;
-    this.dirty = true;
+    this.invalidate();
   }
 
   /** The robot's pose, bumpers, light sensors and lamps ({L1: 0..8, ...}: off, or on that bright). */
@@ -88,13 +90,28 @@ export class Arena {
     this.pose = pose; this.bumpers = bumpers || 0; this.light = light || [0, 0]; this.lamps = lamps || {};
     // what the lamps show, for a person's tools and the tests: "L1=0 L2=8"
     this.canvas.dataset.lamps = Object.entries(this.lamps).map(([name, v]) => `${name}=${v}`).join(" ");
-    this.dirty = true;
+    this.invalidate();
   }
 
   /** Mark a place (a red ring and a label; null: none), e.g. where a counterexample breaks its property. */
   setMarker(marker) {
     this.marker = marker;
+    this.invalidate();
+  }
+
+  // Drawn when something in it changed, at the browser's next frame, not at every frame: a page left open
+  // all lesson asks nothing of the computer meanwhile (a frame loop that draws nothing took ~6 % of a core in
+  // headless Chromium).
+  invalidate() {
     this.dirty = true;
+    if (this.framed) return;
+    this.framed = true;
+    requestAnimationFrame(() => {
+      this.framed = false;
+      const t0 = performance.now();
+      this.draw();
+      if (this.onDrawn) this.onDrawn(performance.now() - t0);
+    });
   }
 
   draw() {
