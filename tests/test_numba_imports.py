@@ -83,3 +83,20 @@ def test_a_call_the_cache_holds_loads_without_numbas_set_up_for_compiling(tmp_pa
     assert run("np.arange(3.0)") == ["[0. 2. 4.]", "False"]  # loaded from the cache: no set-up
     assert run("np.arange(3)") == ["[0 2 4]", "True"]  # other types: numba's own path compiles them
     assert run("np.arange(3)") == ["[0 2 4]", "False"]
+
+
+def test_the_compiled_files_are_every_file_that_says_njit_and_the_constants_it_reads() -> None:
+    """jit.COMPILED_FILES, which names the cache folder, is what reading every source file finds (as the digest
+    was made before the list), in the same order: the same digest, so the same cache folder for the same code."""
+    import hashlib
+
+    from tablebot import jit
+
+    constants = ("tick.py", "columns.py", "sensors.py", "layout.py")  # compiled code reads them (no njit)
+    found = [p for p in sorted(jit.ROOT.rglob("*.py")) if b"njit" in p.read_bytes() or p.name in constants]
+    assert tuple(p.relative_to(jit.ROOT).as_posix() for p in found) == jit.COMPILED_FILES
+    digest = hashlib.sha1()
+    for path in found:
+        digest.update(path.relative_to(jit.ROOT).as_posix().encode() + b"\0" + path.read_bytes())
+    assert jit.sources_digest() == digest.hexdigest()[:12]
+    assert [p.name for p in jit.compiled_sources()] == [p.name for p in found if b"njit" in p.read_bytes()]

@@ -37,8 +37,30 @@ def cache_dir() -> str:
     return os.path.join(platformdirs.user_cache_dir("tablebot"), f"numba-{tag}-{sources_digest()}")
 
 
-#: Files whose functions or constants compiled code reads, though they compile nothing themselves.
-COMPILED_CONSTANTS = ("tick.py", "columns.py", "sensors.py", "layout.py")
+#: The files of the tablebot package whose functions are compiled (they call :func:`njit`) and those whose
+#: functions or constants compiled code reads though they compile nothing themselves (tick.py, sim/columns.py,
+#: sensors.py), in the order their paths sort: the sources of the cache folder's name. Named here rather than
+#: found by reading all ~300 files for ``njit`` (~10 ms of every process that runs a robot);
+#: tests/test_numba_imports.py holds the list to that search.
+COMPILED_FILES = (
+    "engine_batch.py",
+    "fleet/kernel.py",
+    "jit.py",
+    "sensors.py",
+    "sim/columns.py",
+    "sim/physics/broad.py",
+    "sim/physics/contacts.py",
+    "sim/physics/geometry.py",
+    "sim/physics/kernel.py",
+    "sim/physics/layout.py",
+    "sim/physics/normals.py",
+    "sim/physics/sensing.py",
+    "sim/physics/several.py",
+    "sim/physics/shadows.py",
+    "sim/physics/step.py",
+    "sinks/trace_text.py",
+    "tick.py",
+)
 
 
 ROOT = Path(__file__).resolve().parent  # the tablebot package
@@ -46,20 +68,17 @@ ROOT = Path(__file__).resolve().parent  # the tablebot package
 
 @functools.lru_cache(maxsize=1)
 def sources_digest() -> str:
-    """A short digest of the tablebot sources that end up in compiled code (every file that compiles a
-    function, and the constants they read). Worked out once a process (reading every source file: tens of ms;
-    a sweep asked twice): the process's cache folder is named after it when it is first imported."""
+    """A short digest of the tablebot sources that end up in compiled code (:data:`COMPILED_FILES`). Worked out
+    once a process (a sweep asks twice): the process's cache folder is named after it when it is first imported."""
     digest = hashlib.sha1()
-    for path in sorted(ROOT.rglob("*.py")):
-        text = path.read_bytes()
-        if b"njit" in text or path.name in COMPILED_CONSTANTS:
-            digest.update(str(path.relative_to(ROOT)).encode() + b"\0" + text)
+    for name in COMPILED_FILES:
+        digest.update(name.encode() + b"\0" + (ROOT / name).read_bytes())
     return digest.hexdigest()[:12]
 
 
 def compiled_sources() -> list[Path]:
     """The tablebot source files that define compiled functions."""
-    return [path for path in sorted(ROOT.rglob("*.py")) if b"njit" in path.read_bytes()]
+    return [ROOT / name for name in COMPILED_FILES if b"njit" in (ROOT / name).read_bytes()]
 
 
 os.environ.setdefault(ENV, cache_dir())  # before numba's first import, which reads its configuration
