@@ -58,6 +58,17 @@ print(sorted(robot.sections))
     assert lines == [str(sorted(["txt", "robotx", "roboif"]))]  # none refused as an unknown section
 
 
+def test_the_back_ends_keep_their_order_when_a_robot_file_registered_some_first() -> None:
+    lines = fresh(f"""
+from tablebot import catalog, registry
+from tablebot.robot import load_robot
+load_robot({str(EXAMPLE / "robot.toml")!r})  # registers txt, robotx and roboif
+print(registry.names())
+print(list(catalog.BACKENDS))
+""")
+    assert lines == [str(EVERY_BACKEND)] * 2  # txt, robotx and roboif first before put_in_order
+
+
 def test_threads_asking_at_once_each_see_every_back_end() -> None:
     lines = fresh("""
 import threading

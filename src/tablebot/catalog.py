@@ -31,6 +31,25 @@ SECTIONS = {
 }
 
 
+#: Every back-end, in the order the commands list them (``--to``, ``--board``, ``--on``, ``check --target``): the
+#: order of :func:`load_all`'s imports; tests/test_plugins.py holds it to them.
+BACKENDS = (
+    "robopro",
+    "robopro-rpp",
+    "robopro-program",
+    "c",
+    "scxml",
+    "xstate",
+    "uno",
+    "ftduino",
+    "txt",
+    "robotx",
+    "roboif",
+    "txt4",
+    "sim",
+)
+
+
 def defer() -> None:
     """Hand :func:`load_all` and each section's module to :mod:`tablebot.plugins`, which imports them when
     first needed (by name: nothing here imports a back-end before then)."""
@@ -55,3 +74,7 @@ def load_all() -> None:
     from tablebot import robot_tables as _tables  # [tables], [groups]
 
     del _robopro, _c, _statecharts, _boards, _txt, _robotx, _roboif, _txt4, _sim, _properties, _tables
+    from tablebot import registry
+
+    # a robot file read first registered its sections' back-ends first (tablebot.plugins.load_sections)
+    registry.put_in_order(BACKENDS)

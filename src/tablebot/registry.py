@@ -43,6 +43,7 @@ __all__ = [
     "live_for",
     "lives",
     "names",
+    "put_in_order",
     "refused",
     "register",
 ]
@@ -207,6 +208,16 @@ def register(backend: B) -> B:
         register_section(backend.section, backend.read_section)
     _BACKENDS[backend.name] = backend
     return backend
+
+
+def put_in_order(names: tuple[str, ...]) -> None:
+    """List the back-ends ``names`` first, in that order, then any other in the order it registered: the
+    order commands list them in, whichever back-end a robot file's section registered first
+    (:func:`tablebot.catalog.load_all` calls this once every back-end has registered)."""
+    first = [_BACKENDS[name] for name in names if name in _BACKENDS]
+    rest = [backend for name, backend in _BACKENDS.items() if name not in names]
+    _BACKENDS.clear()
+    _BACKENDS.update((backend.name, backend) for backend in (*first, *rest))
 
 
 def backends(kind: Kind | None = None) -> list[Backend]:
