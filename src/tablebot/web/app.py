@@ -16,8 +16,7 @@ import uvicorn
 from starlette.applications import Starlette
 from starlette.requests import ClientDisconnect, Request
 from starlette.responses import HTMLResponse, JSONResponse, Response
-from starlette.routing import Mount, Route, WebSocketRoute
-from starlette.staticfiles import StaticFiles
+from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from tablebot.diagnostics import TableBotError
@@ -25,6 +24,7 @@ from tablebot.escape import terminal
 from tablebot.i18n import N_
 from tablebot.templates import TEMPLATES
 from tablebot.web.access import TOKEN_HEADER, Access, Gate, hide_token_in_logs, subprotocol
+from tablebot.web.assets import Assets
 from tablebot.web.bundle import module_order
 from tablebot.web.errors import INTERNAL, log
 from tablebot.web.live import give_back_memory
@@ -86,6 +86,7 @@ def create_app(
     tabs = Tabs(max_tabs)
 
     page = index_page()
+    assets = Assets(STATIC)  # the page's scripts and style, read once
 
     async def index(request: Request) -> Response:
         response = HTMLResponse(page, headers={"Content-Security-Policy": CSP, "Cache-Control": "no-store"})
@@ -172,7 +173,7 @@ def create_app(
         Route("/api/config", config),
         Route("/api/trace", upload_trace, methods=["POST"]),
         WebSocketRoute("/ws", socket),
-        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+        Route("/static/{path:path}", assets.endpoint, methods=["GET", "HEAD"]),
     ]
     return Gate(Starlette(routes=routes), access)
 
