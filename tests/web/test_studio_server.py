@@ -157,6 +157,17 @@ def test_the_page_asks_for_every_module_its_script_imports_at_once(studio: tuple
             assert reply.status == 200 and "javascript" in reply.headers["Content-Type"], name
 
 
+def test_a_table_comes_with_the_columns_its_analysis_gives_so_the_page_draws_its_grid_once(
+    studio: tuple[Background, Path],
+) -> None:
+    server, _ = studio
+    replies = talk(server, [{"op": "open", "path": "table.csv"}], until="analysis")
+    table = next(r for r in replies if r["type"] == "table")
+    analysis = next(r for r in replies if r["type"] == "analysis")
+    assert table["columns"] == analysis["columns"] and table["tick_ms"] == analysis["machine"]["tick_ms"] == 10
+    assert {"event", "dir", "speed", "timer", "state", "next"} <= {c["kind"] for c in table["columns"]}
+
+
 def test_an_uploaded_trace_is_read_with_located_errors(studio: tuple[Background, Path]) -> None:
     server, _ = studio
     good = b'{"tick":0,"event":32,"row":7,"state":1,"timer":500,"M1":4,"M2":4}\n'

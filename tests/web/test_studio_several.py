@@ -68,11 +68,17 @@ def tabs(page: Any) -> list[list[str]]:
     )
 
 
+#: Each header cell's column name, without the label under it (which comes with the table: its grid is drawn once).
+HEADER_NAMES = (
+    "hs => hs.map(h => [...h.childNodes].filter(n => n.nodeName !== 'SMALL').map(n => n.textContent).join(''))"
+)
+
+
 def show(page: Any, name: str, header: str) -> None:
     """Click table ``name``'s tab and wait for its grid (a header cell ``header`` of it)."""
     page.click(f"#table-tabs button[data-table={name}]")
     wait_for(
-        lambda: header in page.eval_on_selector_all("table.grid thead th", "hs => hs.map(h => h.textContent)"),
+        lambda: header in page.eval_on_selector_all("table.grid thead th", HEADER_NAMES),
         f"the grid of {name}",
         30,
     )

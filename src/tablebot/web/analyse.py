@@ -7,6 +7,7 @@ and hints are the CLI's.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -57,6 +58,16 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
         label = robot.labels.get(base, N_("timer ran out") if base == "T" else "")  # said in the tab's language
         out.append({"kind": kind, "name": base, "label": label})
     return out
+
+
+def table_columns(doc: CsvDocument, path: Path, robot: Robot | None) -> list[dict[str, str]]:
+    """The grid's columns of ``doc`` as :func:`analyse` will give them (the table's own robot, for one of several
+    tables), sent with the table itself so the page draws its grid once; every column unknown without a robot."""
+    if robot is None:
+        return [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()]
+    with contextlib.suppress(TableBotError):  # the analysis says what is wrong; its columns are the file's robot's
+        robot, _ = robot_for_table(path, robot)
+    return columns_of(doc.header_values(), robot)
 
 
 def analyse(

@@ -15,7 +15,7 @@ from tablebot.i18n import N_
 from tablebot.robot import Robot
 from tablebot.robot_tables import tables_of
 from tablebot.table import Table
-from tablebot.web.analyse import Analysis, analyse, robot_failed, robot_for
+from tablebot.web.analyse import Analysis, analyse, robot_failed, robot_for, table_columns
 from tablebot.web.errors import Refused, said
 from tablebot.web.protocol import (
     AnalysisMsg,
@@ -131,6 +131,8 @@ class Draft:
                     "newline": repr(doc.dialect.newline)[1:-1],
                 },
                 self.dirty,
+                table_columns(doc, self.workspace.root / opened.name, self.robot),
+                None if self.robot is None else self.robot.tick_ms,
             )
         )
 

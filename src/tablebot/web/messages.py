@@ -6,7 +6,7 @@ fields; a :class:`Message`'s :meth:`~Message.data` is what goes to the page as J
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 
@@ -42,6 +42,10 @@ class TableMsg(Message):
     version: str | None
     dialect: Mapping[str, str]
     dirty: bool = False  # a tab of a robot's other table shown again, with its edits not yet saved
+    # each header cell's kind and label, as the analysis will give them, and the robot's tick: the grid is
+    # drawn once, with its flags as buttons and its timers' times, before the analysis comes
+    columns: list[dict[str, str]] = field(default_factory=list)
+    tick_ms: int | None = None
 
 
 @dataclass(frozen=True)

@@ -97,7 +97,7 @@ function offerDraft(store, send, drafts, m) {
 // A table from the server (opened, reloaded, connected again): the draft kept of it is offered when the page
 // asked for it (not when another tab's save reloaded it).
 function table(store, views, send, drafts, m) {
-  views.grid.setTable(m.header, m.grid, m.lines);
+  views.grid.setTable(m.header, m.grid, m.lines, m.columns, m.tick_ms);  // drawn once: its columns come with it
   const offer = store.get().offerDraft === m.path;
   store.set({ path: m.path, dirty: Boolean(m.dirty), version: m.version, offerDraft: null });
   if (offer) offerDraft(store, send, drafts, m);

@@ -35,15 +35,19 @@ export class Grid {
     this.rowLines = null;  // the machine's rows as file lines (row i of a trace fired line rowLines[i])
   }
 
-  setTable(header, rows, lines) {
+  // columns and tickMs, when the table comes with them: its grid is drawn once, not again when its analysis comes
+  setTable(header, rows, lines, columns, tickMs) {
     this.header = header;
     this.values = rows.map((r) => r.slice());
     this.lines = lines || rows.map((_, i) => i + 2);
+    if (columns && columns.length) this.columns = columns;
+    if (tickMs) this.tickMs = tickMs;
     this.render();
   }
 
   setColumns(columns, tickMs) {
-    const changed = JSON.stringify(columns.map((c) => c.kind)) !== JSON.stringify(this.columns.map((c) => c.kind));
+    const changed = JSON.stringify(columns.map((c) => c.kind)) !== JSON.stringify(this.columns.map((c) => c.kind))
+      || Boolean(tickMs && tickMs !== this.tickMs);  // the timers' times beside their cells
     this.columns = columns;
     if (tickMs) this.tickMs = tickMs;
     if (changed && this.header) this.render();
