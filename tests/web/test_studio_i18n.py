@@ -290,7 +290,8 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
     assert page.locator("#tplay").inner_text() == "▶ Start"
     assert page.locator("table.grid thead th").first.inner_text() == "Zeile"
     page.screenshot(path=str(shots / "replay-german.png"))
-    page.select_option("#language", "en")
+    with page.expect_navigation():  # the switch reloads the page: wait in the new one, not in the one going away
+        page.select_option("#language", "en")
     page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')", timeout=60_000)
     assert page.locator("#tplay").inner_text() == "▶ Play"
     context.close()
