@@ -107,6 +107,7 @@ print(list(SECTION_READERS))
 print(list(catalog.SECTIONS))
 """)
     assert lines[0] == lines[1]
+    assert lines[0] == str(["tables", "groups", "robopro", "board", "txt", "robotx", "roboif", "sim", "properties"])
 
 
 def test_each_section_s_module_registers_its_reader_in_a_fresh_process() -> None:

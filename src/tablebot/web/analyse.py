@@ -60,11 +60,16 @@ def columns_of(header: list[str], robot: Robot) -> list[dict[str, str]]:
     return out
 
 
+def unknown_columns(doc: CsvDocument) -> list[dict[str, str]]:
+    """Every header cell of ``doc`` as a column of unknown kind (no robot to tell what it is)."""
+    return [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()]
+
+
 def table_columns(doc: CsvDocument, path: Path, robot: Robot | None) -> list[dict[str, str]]:
     """The grid's columns of ``doc`` as :func:`analyse` will give them (the table's own robot, for one of several
     tables), sent with the table itself so the page draws its grid once; every column unknown without a robot."""
     if robot is None:
-        return [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()]
+        return unknown_columns(doc)
     with contextlib.suppress(TableBotError):  # the analysis says what is wrong; its columns are the file's robot's
         robot, _ = robot_for_table(path, robot)
     return columns_of(doc.header_values(), robot)
@@ -116,7 +121,7 @@ def robot_failed(error: TableBotError, doc: CsvDocument) -> dict[str, Any]:
     """What the grid shows when the robot file itself does not read: its errors, the columns unknown."""
     return {
         "ok": False,
-        "columns": [{"kind": "unknown", "name": h, "label": ""} for h in doc.header_values()],
+        "columns": unknown_columns(doc),
         "diagnostics": [_locate(d, "", {}, {}, None) for d in error.diagnostics],
         "ms": 0,
     }
