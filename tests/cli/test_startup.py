@@ -120,3 +120,24 @@ print(duty(3, 8), sum(duty.stats.cache_hits.values()), sum(duty.stats.cache_miss
     assert second.returncode == 0, second.stderr
     assert second.stdout.splitlines()[0] == "1 1 0 0"  # duty loaded before any call; body_corners not compiled
     assert second.stdout.splitlines()[1] == "0.375 1 0"  # from the cache
+
+
+def test_a_sweep_loads_its_kernel_on_a_thread_once_its_modules_are_imported_in_the_callers_thread() -> None:
+    """Runner.load_compiled (a sweep calls it before importing the rest of the fleet and planning): the kernel's
+    modules are imported in the calling thread, so the loading thread never imports beside it, and the thread
+    loads every function a local chunk calls from the cache (warmed by the test session), none compiled."""
+    load_it = """
+import sys, threading
+from tablebot.fleet.backends import Runner
+from tablebot.fleet.work import chunk_functions
+runner = Runner(workers=2)
+runner.load_compiled()
+print("tablebot.fleet.kernel" in sys.modules, "tablebot.fleet.plan" in sys.modules, runner._loading.name)
+runner._loading.join()
+functions = chunk_functions(1)
+print(all(len(f.overloads) > 0 for f in functions), sum(sum(f.stats.cache_misses.values()) for f in functions))
+runner.close()
+"""
+    done = python(load_it)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["True False tablebot-load", "True 0"]

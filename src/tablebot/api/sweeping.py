@@ -156,8 +156,10 @@ def _start(
     pictures: bool,
 ) -> Plan:
     """The fleet's modules imported and the sweep planned, while a cluster's workers start up or this process's
-    compiled code loads on a thread (:meth:`Runner.imported`); the robot's tables as ``project`` read them."""
+    compiled code loads on a thread (:meth:`Runner.load_compiled`, started as soon as the kernel's modules are
+    imported); the robot's tables as ``project`` read them."""
     runner.start(imported=False)  # a cluster's workers start up while this process imports and plans
+    runner.load_compiled()  # locally: the kernel's machine code loads on a thread while the rest imports and plans
     from tablebot.fleet.plan import make_plan
 
     if pictures:  # before the run (an interrupt never lands in matplotlib's import)

@@ -107,15 +107,23 @@ class Runner:
         if sys.modules.get("distributed") is not None:  # (without Dask, connecting says what to install)
             check_address(self.address or "")  # a mistyped address stops the command before it writes
 
-    def imported(self) -> None:
-        """The caller has imported the fleet (see :meth:`start`); locally, this process's compiled code starts
-        loading on a thread while the caller plans (:func:`~tablebot.fleet.work.preload`: mostly LLVM, which
-        leaves the GIL), instead of in the first chunks, the second thread waiting for numba's lock."""
-        self._imported.set()
+    def load_compiled(self) -> None:
+        """Locally, start loading this process's compiled code on a thread (:func:`~tablebot.fleet.work.preload`:
+        mostly LLVM, which leaves the GIL) while the caller goes on importing and planning, instead of in the
+        first chunks, the second thread waiting for numba's lock. The compiled modules are imported here, in the
+        calling thread, so that thread never imports what the caller imports meanwhile. Called as early as
+        the caller can (the sooner the thread starts, the more of its LLVM work runs beside the caller's Python);
+        :meth:`imported` calls it when the caller has not. A cluster loads its workers' code instead."""
         if self.backend == "local" and self._loading is None:
-            threads = 1 if self._local_workers > 1 else None  # as _run_local runs them
-            self._loading = threading.Thread(target=preload_quietly, args=(threads,), name="tablebot-load", daemon=True)
+            functions = chunk_functions(1 if self._local_workers > 1 else None)  # as _run_local runs them
+            self._loading = threading.Thread(target=preload_quietly, args=functions, name="tablebot-load", daemon=True)
             self._loading.start()
+
+    def imported(self) -> None:
+        """The caller has imported the fleet (see :meth:`start`): a cluster's workers are sent this process's
+        compiled code; locally, :meth:`load_compiled` if the caller has not called it yet."""
+        self._imported.set()
+        self.load_compiled()
 
     def _open(self) -> None:
         try:
@@ -224,8 +232,8 @@ class Runner:
             raise
 
 
-def preload_quietly(threads: int | None) -> None:
-    """:func:`~tablebot.fleet.work.preload` the functions a chunk calls on ``threads`` (any error left for
-    the first call to meet and report, as it would have without this)."""
+def preload_quietly(*functions: Any) -> None:
+    """:func:`~tablebot.fleet.work.preload` compiled ``functions`` (any error left for the first call to meet and
+    report, as it would have without this)."""
     with contextlib.suppress(Exception):
-        preload(*chunk_functions(threads))
+        preload(*functions)
