@@ -87,10 +87,10 @@ def warm_archive() -> None:
 
 
 def warm_several() -> None:
-    """The loop of a robot of several tables (sim.physics.several.run_several), for 2 and 3 tables, and its fleet's
-    (the BumberBot with its lights, as sweep, tune and evolve run it): numba types a
-    tuple of tables by its length, so each is compiled once (a minute each on one core, in every test process
-    that simulates such a robot on a cold cache)."""
+    """The loop of a robot of several tables (sim.physics.several.run_several) and its fleet's (the BumberBot with
+    its lights, as sweep, tune and evolve run it): one compiled loop serves every number of tables (their programs
+    come as a tuple of MAX_TABLES), so one robot of three tables warms it for all (~40 CPU-s, in every test process
+    that simulates such a robot on a cold cache otherwise)."""
     import random
     import tempfile
 
@@ -104,12 +104,11 @@ def warm_several() -> None:
     with (
         mock.patch.object(kernel, "sense", lambda *args: None),
         mock.patch.object(kernel, "first_readings", lambda *args: None),
+        tempfile.TemporaryDirectory(prefix="tablebot-warm-") as tmp,
     ):
-        for tables in (2, 3):
-            with tempfile.TemporaryDirectory(prefix="tablebot-warm-") as tmp:
-                folder = random_robot(random.Random(tables), Path(tmp), RobotShape(tables=tables))
-                project = tablebot.open(folder / "t0.csv", robot=folder / "robot.toml")
-                simulate(project.scene(every_table=True), 0.05, seed=1)
+        folder = random_robot(random.Random(3), Path(tmp), RobotShape(tables=3))
+        project = tablebot.open(folder / "t0.csv", robot=folder / "robot.toml")
+        simulate(project.scene(every_table=True), 0.05, seed=1)
     from tablebot.fleet.plan import make_plan
     from tablebot.fleet.work import warm
 

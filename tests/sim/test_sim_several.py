@@ -136,6 +136,30 @@ def test_random_robots_simulate_as_several_steps_them(seed: int, tmp_path: Path)
         assert run.pulses.any()
 
 
+def test_robots_of_any_number_of_tables_share_one_compiled_loop(tmp_path: Path) -> None:
+    """The compiled loop takes every robot's programs as a tuple of MAX_TABLES (the main table's repeated after
+    the robot's own), so robots of 2, 3 and MAX_TABLES tables run on one compiled loop -- numba compiles once
+    per tuple length: a minute of compiling for each new number of tables otherwise -- and each still steps as
+    Several does (the padding is never read)."""
+    from tablebot.robot_tables import MAX_TABLES
+    from tablebot.sim.physics.several import run_several
+    from tablebot.sim.runner import simulate
+    from tablebot.testing.random_robots import RobotShape, random_robot
+
+    for count in (2, 3, MAX_TABLES):
+        # two states a table, seed 1: many random robots of MAX_TABLES tables have a table of more event columns
+        # (cross-table ones) than the compiled simulator takes
+        folder = random_robot(random.Random(1), tmp_path / str(count), RobotShape(tables=count, states=2))
+        project = tablebot.open(folder / "t0.csv", robot=folder / "robot.toml")
+        assert project.tables is not None and len(project.tables.machines) == count
+        run = simulate(project.scene(every_table=True), 1.0, seed=count)
+        text = io.StringIO()
+        run.write_trace(text)
+        lines = [json.loads(line) for line in text.getvalue().splitlines()]
+        assert several_differences(project.tables, Run(run.inputs(), lines)) is None, count
+    assert len(run_several.signatures) == 1, run_several.signatures
+
+
 def test_run_on_sim_steps_every_table(tmp_path: Path) -> None:
     """tablebot run --on sim (the simulator paced in real time, the code path of a controller) of the BumberBot with
     its lights runs both tables: its trace is sim's for the seed, the lights table's keys too (and the clock's)."""

@@ -3,10 +3,15 @@ rules of :mod:`tablebot.tables`, tick for tick as :class:`tablebot.engine.severa
 
 Each table is its own :class:`~tablebot.tick.Program` (a tuple of them, one numba type: every array of every
 table has the same dtype and number of dimensions), with its own registers, outputs and counters (a row each of
-:class:`SeveralState`). A tick: the robot's input mask is read once and spread into each table's event layout
-(``inputs``), each table gets the cross-table events of the states every table was in at the start of the tick
-(``cross``), each steps by the one-table rule, and then each output is its one writer's and each counter load
-its writer's (``writers``, ``counter_writers``), which every table then sees.
+:class:`SeveralState`). The tuple always holds :data:`~tablebot.robot_tables.MAX_TABLES` programs, the robot's
+own and then the main table's again, never read (the loop counts the tables by :class:`SeveralState`'s rows):
+numba compiles a function once per tuple length, and a minute of compiling for every new number of tables
+(two, then three...) is what a user would wait for, on every cold cache.
+
+A tick: the robot's input mask is read once and spread into each table's event layout (``inputs``), each table
+gets the cross-table events of the states every table was in at the start of the tick (``cross``), each steps by
+the one-table rule, and then each output is its one writer's and each counter load its writer's (``writers``,
+``counter_writers``), which every table then sees.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import numpy as np
 from tablebot.engine.as_one import RobotEngine
 from tablebot.engine_batch import tick_compiled
 from tablebot.jit import njit
+from tablebot.robot_tables import MAX_TABLES
 from tablebot.sim.physics.kernel import end_tick, named, robot_scratch, start_tick
 from tablebot.sim.physics.structures import NamedRobot, Record, RobotState, Scratch, Wiring, WorldArrays
 from tablebot.tables import RobotTables
@@ -31,7 +37,7 @@ N_K = 4
 class SeveralProgram(NamedTuple):
     """A robot's tables as the compiled loop reads them (made by :func:`several_program`)."""
 
-    programs: tuple  # one tick.Program per table, the main one first
+    programs: tuple  # MAX_TABLES tick.Programs: each table's, the main one first, then the main one again (unread)
     inputs: np.ndarray  # int64 (tables, robot inputs): table k's event bit for the robot's input bit j (0: none)
     cross: np.ndarray  # int64 (tables, tables, most states): table k's bits while table s is in state i
     writers: np.ndarray  # int64 (outputs,): the table that writes each output, -1: none (it stays 0)
@@ -75,6 +81,7 @@ def several_program(tables: RobotTables) -> SeveralProgram:
         [-1 if (w := tables.writer(name)) is None else w for name in tables.robot.counter_names], dtype=np.int64
     )
     timers, loads = table_values(tables)
+    programs += [programs[0]] * (MAX_TABLES - count)  # one compiled loop for every number of tables
     return SeveralProgram(tuple(programs), inputs, cross, writers, counter_writers, timers[0], loads[0])
 
 
