@@ -95,12 +95,13 @@ def pytest_sessionstart(session: pytest.Session) -> None:
 
 class _WarmUp:
     """The kernels compiled into ``shared`` by two processes, one per core, of about a minute each (CPU): the
-    tick-by-tick robot (physics.advance_called, which every robot's first reading then loads), the env and the
-    batch engine, the robot's loop, the fleet's, which calls it, and pyribs' archive; beside them the loops of a
-    robot of several tables, the longest single part. (Split as [loop, fleet] | [tick, archive, several] the
-    second took ~107 CPU-s against the first's ~41, and set the wall.) A function both reach may be compiled by
-    both: numba writes a cache file whole, by renaming it into place; each part skips a robot's first reading
-    while the other compiles it. A thread writes ``marker`` when both have ended, "ok" or their errors."""
+    tick-by-tick robot (physics.advance_called, which every robot's first reading then loads: ~26 CPU-s), the env
+    and the batch engine, the robot's loop (~39), the fleet's, which calls it (~4); beside them the loops of a robot
+    of several tables (~65, the longest single part: it compiles the physics again for itself) and pyribs' archive
+    (~6). The halves are balanced because the first to end leaves a core idle while every test worker waits for
+    the other. A function both reach may be compiled by both: numba writes a cache file whole, by renaming it
+    into place; each part skips a robot's first reading while the other compiles it. A thread writes ``marker``
+    when both have ended, "ok" or their errors."""
 
     def __init__(self, shared: str, marker: Path) -> None:
         self.shared, self.marker, self.started = shared, marker, time.monotonic()
@@ -115,7 +116,7 @@ class _WarmUp:
                 stderr=subprocess.PIPE,
                 text=True,
             )
-            for names in (["tick", "loop", "fleet", "archive"], ["several"])
+            for names in (["tick", "loop", "fleet"], ["several", "archive"])
         ]
         self.thread = threading.Thread(target=self._wait, name="numba warm-up", daemon=True)
         self.thread.start()
