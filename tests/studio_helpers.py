@@ -4,16 +4,17 @@ another loopback port (the page of someone else's program) that records what the
 
 from __future__ import annotations
 
+import asyncio
 import os
 import shutil
 import threading
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Coroutine, Iterator
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import pytest
 
@@ -41,18 +42,71 @@ def wait_for(condition: Callable[[], Any], what: str, timeout: float = 60) -> An
     return found
 
 
-def chromium(*flags: str) -> Iterator[Any]:
-    """Debian's Chromium through Playwright, started with :data:`FLAGS` and ``flags`` (a module fixture
-    yields from it); skipped where it is missing, except in CI, whose set-up installs it."""
-    if not CHROMIUM.exists():
-        if os.environ.get("CI"):
-            raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-        pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
-    sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
-    with sync_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=str(CHROMIUM), args=[*FLAGS, *flags])
+T = TypeVar("T")
+
+
+def run_async(coroutine: Coroutine[Any, Any, T]) -> T:
+    """``asyncio.run(coroutine)`` on a thread of its own, its result or its exception handed back: the test
+    process's Chromium (:class:`Browsers`) keeps Playwright's event loop set on the main thread from the first
+    browser module on, and asyncio.run refuses to start a loop where one is set."""
+    outcome: list[Any] = []
+
+    def run() -> None:
+        try:
+            outcome.append((True, asyncio.run(coroutine)))
+        except BaseException as exc:  # handed to the caller's thread, raised there
+            outcome.append((False, exc))
+
+    thread = threading.Thread(target=run, name="test-asyncio")
+    thread.start()
+    thread.join()
+    ok, value = outcome[0]
+    if not ok:
+        raise value
+    return value
+
+
+class Browsers:
+    """Debian's Chromium through Playwright for a whole test process (a session fixture holds it, tests/web/
+    studio_fixtures.py): one Playwright and one browser per set of extra ``flags`` (beside :data:`FLAGS`),
+    launched at the first module that asks. A launch costs ~1.3 CPU-s (the browser and Playwright's driver) and
+    ~20 modules each launched their own. Each module still gets a browser of its own contexts: :meth:`module`
+    closes the contexts it opened when it ends, with their pages' timers and sockets; a browser that went away
+    (a crash) is launched again. Skipped where Chromium is missing, except in CI, whose set-up installs it."""
+
+    def __init__(self) -> None:
+        self._playwright: Any = None
+        self._launched: dict[tuple[str, ...], Any] = {}
+
+    def get(self, *flags: str) -> Any:
+        if not CHROMIUM.exists():
+            if os.environ.get("CI"):
+                raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
+            pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
+        sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
+        if self._playwright is None:
+            self._playwright = sync_api.sync_playwright().start()
+        browser = self._launched.get(flags)
+        if browser is None or not browser.is_connected():
+            browser = self._playwright.chromium.launch(executable_path=str(CHROMIUM), args=[*FLAGS, *flags])
+            self._launched[flags] = browser
+        return browser
+
+    def module(self, *flags: str) -> Iterator[Any]:
+        """The browser for one module (its fixture yields from this), its contexts closed afterwards."""
+        browser = self.get(*flags)
+        before = set(browser.contexts)
         yield browser
-        browser.close()
+        for context in browser.contexts:
+            if context not in before:
+                context.close()
+
+    def close(self) -> None:
+        for browser in self._launched.values():
+            if browser.is_connected():
+                browser.close()
+        if self._playwright is not None:
+            self._playwright.stop()
 
 
 def studio_works(page: Any) -> None:

@@ -25,21 +25,12 @@ import pytest
 from PIL import Image
 
 from core_helpers import EXAMPLE
+from studio_helpers import Browsers
 
 pytestmark = [pytest.mark.browser]
 
 SVG = "{http://www.w3.org/2000/svg}"
 STATES = {"s_1", "s_2", "s_11", "s_12", "s_20", "s_21", "s_22", "s_24", "s_26", "s_29"}  # the BumberBot's
-CHROMIUM = Path("/usr/bin/chromium")
-FLAGS = [
-    "--headless=new",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-dev-shm-usage",
-    "--no-first-run",
-    "--disable-extensions",
-]
 
 
 @pytest.fixture(scope="module")
@@ -124,16 +115,8 @@ def test_a_system_dot_draws_where_graphviz_pure_is_missing(
 
 
 @pytest.fixture(scope="module")
-def browser() -> Iterator[object]:
-    sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
-    if not CHROMIUM.exists():
-        if os.environ.get("CI"):  # CI runs scripts/bootstrap.sh, which installs it: missing there is a failure
-            raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-        pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
-    with sync_api.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), args=FLAGS)
-        yield chromium
-        chromium.close()
+def browser(browsers: Browsers) -> Iterator[object]:
+    yield from browsers.module()
 
 
 def address(process: subprocess.Popen[str]) -> str:

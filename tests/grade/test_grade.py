@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from studio_helpers import chromium
+from studio_helpers import Browsers
 from tablebot import share
 from tablebot.cli import app
 from test_sweep import dask_cluster, env  # noqa: F401  (dask_cluster: a real scheduler and two workers)
@@ -160,8 +160,8 @@ def test_dask_grades_both_shipped_challenges_byte_for_byte_as_this_machine(
 
 
 @pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
+def browser(browsers: Browsers) -> Iterator[Any]:
+    yield from browsers.module()
 
 
 def test_the_leaderboard_opens_offline_with_no_console_error(graded: Path, browser: Any) -> None:

@@ -1,5 +1,6 @@
 """The fixtures every studio test module shares, once (a plugin tests/conftest.py names): a real Chromium
-for the module, a folder for its screenshots, and the studio served for the module's ``folder``.
+for the module (one browser for the whole test process, the module's contexts closed after it), a folder for its
+screenshots, and the studio served for the module's ``folder``.
 
 A module overrides any of them by defining its own of the same name: test_studio_attacks starts its Chromium
 with flags of its own, and the modules whose tests each need a fresh folder (access, saves, drafts) serve a
@@ -13,13 +14,21 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import chromium, screenshots, served
+from studio_helpers import Browsers, screenshots, served
 from tablebot.web.app import Background
 
 
+@pytest.fixture(scope="session")
+def browsers() -> Iterator[Browsers]:
+    """This test process's Chromium, launched once for every module that needs one."""
+    shared = Browsers()
+    yield shared
+    shared.close()
+
+
 @pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium()
+def browser(browsers: Browsers) -> Iterator[Any]:
+    yield from browsers.module()
 
 
 @pytest.fixture(scope="module")

@@ -23,7 +23,7 @@ import pytest
 import websockets
 
 from core_helpers import EXAMPLE
-from studio_helpers import bumberbot, http, served
+from studio_helpers import bumberbot, http, run_async, served
 from tablebot.web.app import Background
 from tablebot.web.errors import Refused
 from tablebot.web.workspace import Kind, Workspace
@@ -89,7 +89,7 @@ def talk(server: Background, messages: list[Any], until: str, limit: int = 40) -
                     break
         return replies
 
-    return asyncio.run(run())
+    return run_async(run())
 
 
 # --- what the page may name ----------------------------------------------------------------------------------
@@ -166,7 +166,7 @@ def _swap_then_save(studio: Background, swap: Any, force: bool = True) -> list[d
             await ws.send(json.dumps({"op": "files"}))  # the connection lives on
             return [reply, await _until(ws, "files")]
 
-    return asyncio.run(run())
+    return run_async(run())
 
 
 async def _until(ws: Any, *types: str) -> dict[str, Any]:
@@ -284,7 +284,7 @@ def test_a_binary_frame_is_an_error_and_the_connection_lives(studio: Background)
             await ws.send(json.dumps({"op": "files"}))
             return [json.loads(await ws.recv()), json.loads(await ws.recv())]
 
-    first, second = asyncio.run(run())
+    first, second = run_async(run())
     assert first["message"] == "a message must be JSON text, not binary data" and second["type"] == "files"
 
 

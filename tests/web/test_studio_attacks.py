@@ -20,7 +20,7 @@ from typing import Any
 
 import pytest
 
-from studio_helpers import OtherPort, bumberbot, chromium, other_port, served
+from studio_helpers import Browsers, OtherPort, bumberbot, other_port, served
 from tablebot.web.app import Background
 
 pytestmark = [pytest.mark.browser]
@@ -148,8 +148,8 @@ def attacker(studio: Background) -> Iterator[str]:
 
 
 @pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    yield from chromium(*FLAGS)
+def browser(browsers: Browsers) -> Iterator[Any]:
+    yield from browsers.module(*FLAGS)
 
 
 @pytest.fixture

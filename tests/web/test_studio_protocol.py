@@ -16,6 +16,7 @@ from typing import Any
 import pytest
 
 from core_helpers import EXAMPLE
+from studio_helpers import run_async
 from tablebot.web import protocol
 from tablebot.web.errors import Refused
 from tablebot.web.session import Hub, Session
@@ -149,7 +150,7 @@ def test_a_real_session_answers_every_operation_in_the_protocols_kinds(tmp_path:
             session.close()
         return replies
 
-    replies = asyncio.run(run())
+    replies = run_async(run())
     for op, sent in replies.items():
         assert sent, f"{op} was not answered"
         assert {m["type"] for m in sent} <= set(protocol.MESSAGES), (op, sent)
@@ -192,7 +193,7 @@ def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> Non
             session.close()
         return sent
 
-    german = [m["message"] for m in asyncio.run(replies("de"))]
+    german = [m["message"] for m in run_async(replies("de"))]
     assert german == [
         '"path" muss Text sein',
         '"row" muss eine ganze Zahl sein',
@@ -202,7 +203,7 @@ def test_a_refused_operation_is_said_in_the_tabs_language(tmp_path: Path) -> Non
         "der Roboter fährt nicht: zuerst die Tabelle berichtigen",
         "zuerst eine Tabelle öffnen",
     ]
-    english = [m["message"] for m in asyncio.run(replies("en"))]
+    english = [m["message"] for m in run_async(replies("en"))]
     assert english == [
         '"path" must be text',
         '"row" must be a whole number',
@@ -239,7 +240,7 @@ def test_why_a_row_fired_is_said_in_the_tabs_language(tmp_path: Path) -> None:
             session.close()
         raise AssertionError("no frame")
 
-    german, english = asyncio.run(why("de")), asyncio.run(why("en"))
+    german, english = run_async(why("de")), run_async(why("en"))
     assert english[0].startswith("line ") and " fired" in " ".join(english), english
     assert german[0].startswith("Zeile ") and "hat geschaltet" in " ".join(german), german
     assert len(german) == len(english)

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 import websockets
 
-from studio_helpers import bumberbot, served
+from studio_helpers import bumberbot, run_async, served
 from tablebot.web.app import Background
 
 TABS = 8
@@ -119,7 +119,7 @@ def test_eight_tabs_saving_at_once_lose_no_edit(studio: Background, folder: Path
         assert on_disk[1] == original and version(on_disk[0]) == first_saved(first)
         return first, chain
 
-    first, chain = asyncio.run(run())
+    first, chain = run_async(run())
     assert [r["type"] for r in first].count("saved") == 1
     for reply in first:
         if reply["type"] == "conflict":
@@ -174,7 +174,7 @@ def test_a_table_replaced_by_rename_offers_the_choice_and_both_answers_work(stud
         for tab in (mine, other):
             await tab.ws.close()
 
-    asyncio.run(run())
+    run_async(run())
 
 
 def test_a_forced_save_overwrites_only_the_version_it_was_shown(studio: Background, folder: Path) -> None:
@@ -205,7 +205,7 @@ def test_a_forced_save_overwrites_only_the_version_it_was_shown(studio: Backgrou
         assert bad["type"] == "error" and bad["message"] == '"force" must be the version the conflict named ("theirs")'
         await tab.ws.close()
 
-    asyncio.run(run())
+    run_async(run())
 
 
 # --- line breaks in a cell, and a draft put back ------------------------------------------------------------
@@ -236,7 +236,7 @@ def test_a_line_break_sent_over_the_socket_adds_one_line(studio: Background, fol
         assert (await save(tab))["type"] == "saved"
         await tab.ws.close()
 
-    asyncio.run(run())
+    run_async(run())
     assert path.read_bytes() == original.replace(b"Collision detection,1,,1,1,", b'"Collision\ndetection",1,,1,1,', 1)
     assert path.read_bytes().count(b"\n") == original.count(b"\n") + 1
 
@@ -263,7 +263,7 @@ def test_a_draft_put_back_changes_only_what_it_changed(studio: Background, folde
         assert (await save(tab))["type"] == "saved"
         await tab.ws.close()
 
-    asyncio.run(run())
+    run_async(run())
     assert path.read_text() == "\n".join(wanted)
 
 
@@ -292,7 +292,7 @@ def test_a_draft_from_an_older_version_asks_before_it_is_saved(studio: Backgroun
         assert "the table now has 14 columns, the edits 2" in (await tab.until("error"))["message"]
         await tab.ws.close()
 
-    asyncio.run(run())
+    run_async(run())
     assert path.read_bytes() == marked(original, 2, "mine")
     assert (folder / "table.csv.bak").read_bytes() == marked(original, 5, "theirs")
 
@@ -338,7 +338,7 @@ def test_a_reload_for_another_tabs_save_never_replaces_an_edit_made_meanwhile(fo
             tab.close()
         return told
 
-    told = asyncio.run(run())
+    told = run_async(run())
     after = [m["type"] for m in told][[m["type"] for m in told].index("arena") + 1 :]  # b's messages since it opened
     assert after == ["conflict", "analysis", "diagram"]
     assert next(m for m in told if m["type"] == "conflict")["message"] == (

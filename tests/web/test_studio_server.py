@@ -18,6 +18,7 @@ import pytest
 import websockets
 
 from core_helpers import EXAMPLE, ROOT
+from studio_helpers import run_async
 from tablebot.web.app import Background
 
 
@@ -51,7 +52,7 @@ def talk(
                     break
         return replies
 
-    return asyncio.run(run())
+    return run_async(run())
 
 
 def get(server: Background, path: str, data: bytes | None = None) -> urllib.request.Request:
@@ -221,7 +222,7 @@ def test_a_counterexample_plays_in_the_arena_at_once_slows_down_and_stops_where_
                         assert control is not None, "no control message came before the violating tick"
                         return control, frames
 
-    control, frames = asyncio.run(run())
+    control, frames = run_async(run())
     assert not control["paused"] and 0 < control["scripted"] <= 54  # it plays at once, no Play needed
     # its last 12 ticks (42-53) are played 10 times slower than real time; it stops on tick 53, where it breaks
     slow_from = next(at for at, frame in frames if frame["tick"] >= 42)
