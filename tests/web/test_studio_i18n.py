@@ -127,6 +127,7 @@ def test_the_switch_changes_the_language_and_is_kept(browser: Any, studio: Backg
     assert page.locator("#save").inner_text() == "Save"
     page.select_option("#language", "de")
     page.wait_for_selector("#save:text-is('Speichern')")
+    assert page.url.endswith("/?lang=de"), page.url  # the choice in the address (the token long out of it)
     again = page.context.new_page()  # another visit, same browser: still German
     again.goto(studio.url)
     again.wait_for_selector("#save:text-is('Speichern')")
@@ -294,6 +295,11 @@ def test_the_replay_file_speaks_its_readers_language_and_switches(browser: Any, 
         page.select_option("#language", "en")
     page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('tick 0')", timeout=60_000)
     assert page.locator("#tplay").inner_text() == "▶ Play"
+    # the choice comes back in the page's address as well as kept: a reload that read only the kept choice read
+    # the old language on a busy machine, before the write had reached the browser's store
+    assert page.url == page_file.as_uri() + "?lang=en"
+    page.goto(page_file.as_uri() + "?lang=de")  # an address's language wins over the kept one
+    page.wait_for_function("() => document.querySelector('#status').textContent.startsWith('Takt 0')", timeout=60_000)
     context.close()
     assert errors == []
 

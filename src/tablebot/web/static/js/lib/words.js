@@ -9,13 +9,17 @@ import { EN } from "./words_en.js";
 
 export const LANGUAGES = Object.freeze(["en", "de"]);
 const KEPT = "tablebot-studio-lang";  // the switch's choice, in localStorage (kept across visits)
+const PARAM = "lang";  // the switch's choice in the address of the page it loads again
 /** Not a language: English between markers, so a test finds any text that does not come from the catalog. */
 export const PSEUDO = "qps";
 export const CATALOGS = Object.freeze({ en: EN, de: DE });
 let language = "en";
 
-/** The page's language: the switch's choice (kept), else the studio's --lang (`server`), else the browser's. */
+/** The page's language: the switch's choice (in the address after a switch, else kept), else the studio's
+ * --lang (`server`), else the browser's. */
 export function chooseLanguage(server) {
+  const asked = new URLSearchParams(location.search).get(PARAM);
+  if (asked === PSEUDO || LANGUAGES.includes(asked)) return asked;
   let kept = null;
   try { kept = localStorage.getItem(KEPT); } catch { /* storage off: not kept */ }
   if (kept === PSEUDO || LANGUAGES.includes(kept)) return kept;
@@ -97,5 +101,12 @@ export function wireSwitch(select) {
     return option;
   }));
   select.value = language === PSEUDO ? "en" : language;
-  select.addEventListener("change", () => { setLanguage(select.value, true); location.reload(); });
+  select.addEventListener("change", () => {
+    setLanguage(select.value, true);
+    // The page comes again with the choice in its address too: localStorage's write travels to the browser's
+    // store on its own, and a reloaded page read the old language before it got there (seen on a busy machine).
+    const again = new URL(location.href);
+    again.searchParams.set(PARAM, select.value);
+    location.replace(again.href);
+  });
 }
