@@ -118,6 +118,28 @@ def test_an_interrupted_write_keeps_the_old_file(tmp_path: Path) -> None:
     assert path.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["d.png"]
 
 
+def test_a_ctrl_c_just_after_the_temporary_file_opens_stays_a_ctrl_c(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The interrupt lands after os.fdopen returned its file object and before it was kept (the object is
+    dropped, closing the descriptor): the command still hears KeyboardInterrupt, not EBADF from closing it twice
+    (a sweep stopped with Ctrl-C said "Bad file descriptor" in a CI run), and the old file and folder are as
+    they were."""
+    target = tmp_path / "out.txt"
+    target.write_text("old", encoding="utf-8")
+    real_fdopen = os.fdopen
+
+    def fdopen_then_interrupted(fd: int, *args: object, **kwargs: object) -> object:
+        real_fdopen(fd, *args, **kwargs).close()  # type: ignore[call-overload]  # made, then dropped by the unwinding
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(files.os, "fdopen", fdopen_then_interrupted)
+    with pytest.raises(KeyboardInterrupt), atomic_write(target) as stream:
+        stream.write("new")
+    assert target.read_text(encoding="utf-8") == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
 def test_a_tool_output_is_renamed_only_when_complete(tmp_path: Path) -> None:
     elf = tmp_path / "x.elf"
     with pytest.raises(RuntimeError), replacing(elf) as temp:

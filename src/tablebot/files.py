@@ -120,10 +120,24 @@ def _temporary(path: Path, where: Path, mode: str, encoding: str | None, newline
     try:
         stream = os.fdopen(fd, mode, encoding=encoding, newline=newline)
     except BaseException:
-        os.close(fd)
+        _close_if_mine(fd, name)
         os.unlink(name)
         raise
     return stream, Path(name)
+
+
+def _close_if_mine(fd: int, name: str) -> None:
+    """Close ``fd`` if it is still the temporary file ``name``. A Ctrl-C can land just after ``os.fdopen`` has
+    made its file object, which then closes the descriptor as the interrupt unwinds: closing it again raised
+    EBADF in the interrupt's place (a sweep stopped with Ctrl-C said "cannot write or read: Bad file
+    descriptor", exit 2, not "interrupted", 130), or would close whatever another thread opened meanwhile under
+    the same number. Compared by device and inode, so only our own file is closed."""
+    try:
+        mine = os.path.samestat(os.fstat(fd), os.stat(name))
+    except OSError:  # closed already
+        return
+    if mine:
+        os.close(fd)
 
 
 @contextmanager
