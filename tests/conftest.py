@@ -43,7 +43,7 @@ for _folder in FOLDERS:
 #: The studio modules' shared fixtures (a module's Chromium, its screenshot folder, its studio), in
 #: tests/web/studio_fixtures.py: a plugin rather than a tests/web/conftest.py, whose module name "conftest"
 #: mypy would take for a second tests/conftest.py. A module's own fixture of the same name wins over them.
-pytest_plugins = ["studio_fixtures", "cluster_fixtures"]
+pytest_plugins = ["studio_fixtures"]
 
 #: The markers, declared in the modules they apply to (``pytestmark = [pytest.mark.realtime]``):
 MARKERS = {
@@ -179,8 +179,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if item.get_closest_marker("browser"):
             item.add_marker(pytest.mark.xdist_group("browser"))
-        elif "dask_cluster" in getattr(item, "fixturenames", ()):  # one worker, one cluster (cluster_fixtures.py)
-            item.add_marker(pytest.mark.xdist_group("dask"))
 
 
 def _hear_ctrl_c() -> None:

@@ -17,7 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tablebot.cli import app
-from test_sweep import env
+from test_sweep import dask_cluster, env  # noqa: F401  (dask_cluster: a real scheduler and two workers)
 
 ROOT = Path(__file__).resolve().parents[2]
 BUMBERBOT = ROOT / "examples" / "bumberbot"
@@ -108,7 +108,7 @@ def test_the_bumberbot_is_repaired_first_and_every_table_written_is_usable(tmp_p
     assert all(p.read_bytes() == data for p, data in again.items())
 
 
-def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_run: Path, dask_cluster: str) -> None:
+def test_a_dask_cluster_gives_the_local_run_byte_for_byte(tmp_path: Path, line_run: Path, dask_cluster: str) -> None:  # noqa: F811
     code, output = evolve(str(LINE), "--out", str(tmp_path / "dask"), *LINE_RUN, "--scheduler", dask_cluster)
     assert code == 0, output
     assert "# Evolving line-follower/table.csv: laps (high is better)" in output

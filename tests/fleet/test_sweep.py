@@ -20,10 +20,11 @@ from tablebot.cli.common import load
 from tablebot.fleet.run import Fleet, RobotSpec
 from tablebot.fleet.store import read_results
 from tablebot.sim.model.scene import robot_layer, scene_for
+from tablebot.testing.dask_cluster import local_cluster
 from test_sim_helpers import BUMBERBOT
 
 if TYPE_CHECKING:
-    pass
+    from collections.abc import Iterator
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src"
@@ -261,6 +262,15 @@ def test_ctrl_c_keeps_finished_chunks_and_the_same_command_resumes(tmp_path: Pat
     assert {r["run"]: r for r in kept}.items() <= {r["run"]: r for r in rows}.items()
     assert all((out / "parts" / name).read_bytes() == data for name, data in parts.items())
     assert not (out / "results.partial.csv").exists()
+
+
+@pytest.fixture
+def dask_cluster() -> Iterator[str]:
+    """A real Dask scheduler and two single-threaded workers on this machine (separate processes), one of
+    them started with tablebot's preload (tablebot.fleet.worker), one plain."""
+    pytest.importorskip("distributed", reason="the Dask backend needs the cluster extra (the dev extra has it)")
+    with local_cluster([[], ["--preload", "tablebot.fleet.worker"]], env()) as cluster:
+        yield cluster.address
 
 
 def test_a_sweep_draws_its_pictures(tmp_path: Path) -> None:

@@ -12,10 +12,10 @@ from typing import Any
 import pytest
 
 from test_sim_helpers import BUMBERBOT
-from test_sweep import env, sweep
+from test_sweep import dask_cluster, env, sweep  # noqa: F401  (dask_cluster: a real scheduler and two workers)
 
 
-def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask_cluster: str) -> None:
+def test_a_dask_cluster_gives_the_local_results_row_for_row(tmp_path: Path, dask_cluster: str) -> None:  # noqa: F811
     spec = ["--grid", "battery=1.0,0.7", "--grid", "start=random", "--seeds", "0..23", "--seconds", "10", "--no-plots"]
     code, output = sweep(*spec, "--out", str(tmp_path / "local"), "--backend", "local", "--workers", "2")
     assert code == 0, output

@@ -18,6 +18,7 @@ from typer.testing import CliRunner
 from studio_helpers import Browsers
 from tablebot import share
 from tablebot.cli import app
+from test_sweep import dask_cluster, env  # noqa: F401  (dask_cluster: a real scheduler and two workers)
 
 ROOT = Path(__file__).resolve().parents[2]
 CHALLENGES = ROOT / "examples" / "challenges"
@@ -136,7 +137,7 @@ def test_dask_grades_both_shipped_challenges_byte_for_byte_as_this_machine(
     graded: Path,
     pupils: Path,
     tmp_path: Path,
-    dask_cluster: str,
+    dask_cluster: str,  # noqa: F811  (the fixture imported from test_sweep)
 ) -> None:
     code, output = grade(
         LAMP,
