@@ -15,14 +15,20 @@ demo:
 	@./scripts/demo.sh
 
 # pytest twice: every test but the wall-clock ones on all cores (tests/conftest.py compiles numba's kernels
-# once first), then the wall-clock ones (marked realtime there) two at a time; beside both, from the start, the
-# checks that read the code at the lowest priority (nice 19): mypy's 45 s of CPU from an empty cache (the sources,
-# tests and benchmarks), lint-imports, ruff, the docs site and ESLint take the idle moments of the first pass and
-# what the wall-clock tests leave (they mostly wait on the clock: 14 CPU-s in 56 s one by one; 31-34 s two at a
-# time, passing even beside two busy loops at normal priority). Their reports are printed after the passes
-# (scripts/test.sh).
+# once first), then the wall-clock ones (marked realtime there) two at a time with nothing CPU-bound beside
+# them but the checks that read the code at the lowest priority (nice 19: scripts/checks.sh). The wall-clock
+# tests mostly wait on the clock (14 CPU-s in 56 s one by one; 31-34 s two at a time, passing even beside two
+# busy loops at normal priority), so mypy's 45 s of CPU from an empty cache (the sources, tests and benchmarks),
+# lint-imports, ruff, the docs site and ESLint mostly fit in what they leave idle; their reports are printed after
+# the pass.
 test: setup
-	scripts/test.sh $(MKDOCS)
+	@mkdir -p build/coverage
+	.venv/bin/python -m pytest -n auto --dist loadgroup -m "not realtime" --durations=15 -rs \
+	  --cov --cov-report=
+	@echo "coverage of the pass above, least covered first (all: .venv/bin/coverage html, then build/coverage/html):"
+	@.venv/bin/coverage report | sed -n 1,27p; .venv/bin/coverage report --format=total | sed 's/^/total: /;s/$$/ %/'
+	@# the wall-clock tests, with mypy, lint-imports, ruff, the docs site and ESLint beside them (niced)
+	scripts/checks.sh $(MKDOCS)
 
 # The documentation site, from docs/ (mkdocs.yml) into site/: strict, so a warning fails it, a link, anchor or
 # file that is not there and a page made from the code (scripts/docs_reference.py) that is out of date included.
