@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import mimetypes
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -81,8 +82,8 @@ class Assets:
 def _read(path: Path) -> Asset | None:
     """The file at ``path`` as served, or None if it is not a regular file (a link, a folder, gone)."""
     try:
-        before = os.lstat(path)
-        if not path.is_file() or path.is_symlink():
+        before = os.lstat(path)  # the entry itself: a link is not a regular file here
+        if not stat.S_ISREG(before.st_mode):
             return None
         body = path.read_bytes()
     except OSError:
