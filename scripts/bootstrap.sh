@@ -8,9 +8,9 @@
 #                               dev packages (requirements/dev.lock), and on a Debian-like machine the system
 #                               packages (graphviz, which diagrams fall back to where graphviz-pure from PyPI
 #                               is missing: the tests check that it still draws; avr-gcc/avr-libc/simavr for
-#                               firmware and its emulation, chromium for the studio's browser tests, node and
-#                               npm for the studio's JavaScript linter, gettext's msgfmt for the message
-#                               catalogs' check) and ESLint from npm.
+#                               firmware and its emulation, chromium and its headless shell for the studio's
+#                               browser tests, node and npm for the studio's JavaScript linter, gettext's
+#                               msgfmt for the message catalogs' check) and ESLint from npm.
 #
 # The system packages install while the Python packages do (two downloads at once: on a fresh machine
 # each takes about 40 s, one after the other 80).
@@ -27,7 +27,7 @@ esac
 apt_pid=""
 apt_log=""
 if [ "$LEVEL" = dev ]; then
-  SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config chromium gettext)
+  SYSTEM_PACKAGES=(graphviz gcc-avr avr-libc simavr libsimavr-dev libelf-dev pkg-config chromium chromium-headless-shell gettext)
   missing=()
   for pkg in "${SYSTEM_PACKAGES[@]}"; do
     dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")  # no dpkg (not Debian-like): all missing, said below

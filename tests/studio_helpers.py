@@ -21,9 +21,15 @@ import pytest
 from core_helpers import EXAMPLE
 from tablebot.web.app import Background
 
-CHROMIUM = Path("/usr/bin/chromium")
+#: The browser the studio's tests drive: Debian's chromium-headless-shell, Chromium's own engine (Blink, V8) from
+#: the same sources and version as its chromium package, without the desktop browser around it -- what Playwright's
+#: own headless tests run by default. The desktop browser in headless mode took twice the CPU for the same pages: the
+#: browser tests (``-m "browser and not realtime"``, ``-n 3``) took 158 CPU-s and 83 s with it, 109 CPU-s and 59 s
+#: with the shell, on this 2-core machine.
+CHROMIUM = Path("/usr/bin/chromium-headless-shell")
+#: The desktop Chromium a teacher opens: test_studio_browser drives the studio in it too (``full=True``).
+FULL_CHROMIUM = Path("/usr/bin/chromium")
 FLAGS = [
-    "--headless=new",
     "--no-sandbox",
     "--disable-gpu",
     "--disable-background-networking",
@@ -68,7 +74,8 @@ def run_async(coroutine: Coroutine[Any, Any, T]) -> T:
 
 class Browsers:
     """Debian's Chromium through Playwright for a whole test process (a session fixture holds it, tests/web/
-    studio_fixtures.py): one Playwright and one browser per set of extra ``flags`` (beside :data:`FLAGS`),
+    studio_fixtures.py): one Playwright and one browser per set of extra ``flags`` (beside :data:`FLAGS`) -- the
+    headless shell (:data:`CHROMIUM`), or with ``full`` the desktop browser headless (:data:`FULL_CHROMIUM`) --
     launched at the first module that asks. A launch costs ~1.3 CPU-s (the browser and Playwright's driver) and
     ~20 modules each launched their own. Each module still gets a browser of its own contexts: :meth:`module`
     closes the contexts it opened when it ends, with their pages' timers and sockets; a browser that went away
@@ -76,20 +83,23 @@ class Browsers:
 
     def __init__(self) -> None:
         self._playwright: Any = None
-        self._launched: dict[tuple[str, ...], Any] = {}
+        self._launched: dict[tuple[bool, tuple[str, ...]], Any] = {}
 
-    def get(self, *flags: str) -> Any:
-        if not CHROMIUM.exists():
+    def get(self, *flags: str, full: bool = False) -> Any:
+        program = FULL_CHROMIUM if full else CHROMIUM
+        if not program.exists():
             if os.environ.get("CI"):
-                raise RuntimeError("/usr/bin/chromium is missing: scripts/bootstrap.sh should have installed it")
-            pytest.skip("the browser tests need Debian's chromium (scripts/bootstrap.sh installs it)")
+                raise RuntimeError(f"{program} is missing: scripts/bootstrap.sh should have installed it")
+            pytest.skip(f"the browser tests need Debian's {program.name} (scripts/bootstrap.sh installs it)")
         sync_api = pytest.importorskip("playwright.sync_api", reason="the browser tests need playwright (pip)")
         if self._playwright is None:
             self._playwright = sync_api.sync_playwright().start()
-        browser = self._launched.get(flags)
+        browser = self._launched.get((full, flags))
         if browser is None or not browser.is_connected():
-            browser = self._playwright.chromium.launch(executable_path=str(CHROMIUM), args=[*FLAGS, *flags])
-            self._launched[flags] = browser
+            # the desktop browser in its headless mode, named as before (the shell has no other)
+            args = [*FLAGS, *flags, *(["--headless=new"] if full else [])]
+            browser = self._playwright.chromium.launch(executable_path=str(program), args=args)
+            self._launched[(full, flags)] = browser
         return browser
 
     def module(self, *flags: str) -> Iterator[Any]:

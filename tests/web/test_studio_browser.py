@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from studio_helpers import bumberbot
+from studio_helpers import Browsers, bumberbot
 from tablebot.colours import state_colours
 from tablebot.web.app import Background
 
@@ -125,6 +125,23 @@ def test_the_bumberbot_loads_with_37_rows_and_10_states(tab: Tab) -> None:
     assert len([s for s in states if s.startswith("s_")]) == 10
     assert "front_bumper_stops" in page.locator("#properties").inner_text()
     tab.shot("table")
+
+
+def test_the_desktop_chromium_a_teacher_opens_runs_the_studio_too(
+    browsers: Browsers, studio: Background, shots: Path
+) -> None:
+    """The other tests drive Chromium's headless shell (half the CPU); the desktop browser loads the same page,
+    draws its diagram and plays the robot, without an error in its console."""
+    tab = Tab(browsers.get(full=True), studio.url, shots, "desktop")
+    try:
+        page = tab.page
+        assert re.search(r"37 rows · 10 states", page.locator("#counts").inner_text())
+        page.wait_for_selector("#diagram svg g.node")
+        page.click("#play")
+        page.wait_for_function("() => stats.ticks > 50")
+        tab.shot("playing")
+    finally:
+        tab.close()
 
 
 def test_a_broken_cell_shows_its_located_error_then_clears(tab: Tab) -> None:
