@@ -230,8 +230,9 @@ def compiled(*functions: Any) -> bool:
     return True
 
 
-#: How long a first compile of the simulator takes, as a user is told (2 cores: ~36 s idle, ~60 s busy).
-USUALLY = "usually 30-60 s"
+#: How long a first compile of the simulator takes, as a user is told (2 cores: a first `sim` 23 s idle, 38 s beside
+#: two busy programs; a first sweep 26 s).
+USUALLY = "usually 20-40 s"
 
 
 def say_compiling(what: str, *functions: Any) -> None:
@@ -239,7 +240,7 @@ def say_compiling(what: str, *functions: Any) -> None:
     run of a new tablebot (or Python) spends tens of seconds there, which must not look like a hang."""
     if not compiled(*functions):
         print(
-            _("compiling {what} for this machine (first run only, usually 30-60 s; later runs start at once)…").format(
+            _("compiling {what} for this machine (first run only, usually 20-40 s; later runs start at once)…").format(
                 what=localise(what)
             ),
             file=sys.stderr,
@@ -261,7 +262,7 @@ class Compiling:
         self.talking = (
             Talking(
                 N_("compiling {what} for this machine", what=what),
-                N_("first run only, usually 30-60 s; later runs start at once"),
+                N_("first run only, usually 20-40 s; later runs start at once"),
                 N_("compiled {what} in {{s}} s (kept in the cache: later runs start at once)", what=what),
                 every_s=every_s,
                 stream=stream,
