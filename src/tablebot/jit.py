@@ -6,7 +6,6 @@ chosen before numba is first imported; read-only installs and cluster workers th
 
 from __future__ import annotations
 
-import copy
 import functools
 import hashlib
 import os
@@ -18,6 +17,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from tablebot import jit_inlining
 from tablebot.i18n import N_, _, localise
 
 ENV = "NUMBA_CACHE_DIR"
@@ -166,55 +166,7 @@ def _load_cached_code_directly() -> None:
 
 _load_cached_code_directly()
 
-_scope_copies: dict[int, tuple[Any, Any]] | None = None  # while numba inlines one call: each scope's one copy
-
-
-def _copy_each_scope_once() -> None:
-    """Let numba's inliner copy a callee's variables once per copy of the callee, not once per block of it.
-
-    To inline a call (``inline="always"``) numba copies the callee's IR block by block, each block with a
-    ``deepcopy`` of its own, and each of those copies the function's whole scope -- every variable of the
-    callee -- again: blocks × variables, for every call inlined (numba issues #8989 and #9204; numba-cuda #688
-    measured the same). The simulator's tick loops inline the whole physics, and a first compile spent most of
-    its time there: ``run_ticks`` 29 s, then 7 s with this. While one call is inlined (``inline_ir``), every
-    block's copy of a scope is the one copy made by the first block, as the blocks shared the original (numba's
-    inliner then keeps one scope of them anyway). The machine code is the same: tests/test_numba_imports.py
-    compares it, and every function of a sweep's and a ``sim``'s kernels disassembled the same from both ways.
-    Another numba (without ``inline_ir``, or whose scopes copy themselves) is left as it is."""
-    from numba.core import ir
-    from numba.core.inline_closurecall import InlineWorker
-
-    original = getattr(InlineWorker, "inline_ir", None)
-    if original is None or getattr(original, "scopes_once", False) or "__deepcopy__" in vars(ir.Scope):
-        return
-
-    def scope_deepcopy(self: Any, memo: dict[int, Any]) -> Any:
-        made = _scope_copies.get(id(self)) if _scope_copies is not None else None
-        if made is not None:
-            memo[id(self)] = made[1]
-            return made[1]
-        new = object.__new__(type(self))  # what deepcopy does for a plain object: new, remembered, its state copied
-        memo[id(self)] = new
-        new.__dict__.update(copy.deepcopy(self.__dict__, memo))
-        if _scope_copies is not None:
-            _scope_copies[id(self)] = (self, new)  # the original is held: its id stays its own meanwhile
-        return new
-
-    def inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
-        global _scope_copies
-        outer, _scope_copies = _scope_copies, {}  # per call: a callee inlined again gets copies of its own
-        try:
-            return original(self, *args, **kwargs)
-        finally:
-            _scope_copies = outer
-
-    inline_ir.scopes_once = True  # type: ignore[attr-defined]
-    inline_ir.original = original  # type: ignore[attr-defined]  # numba's own (tests compare the two)
-    ir.Scope.__deepcopy__ = scope_deepcopy  # type: ignore[attr-defined]
-    InlineWorker.inline_ir = inline_ir  # type: ignore[method-assign]
-
-
-_copy_each_scope_once()
+jit_inlining.copy_each_scope_once()  # when numba's inliner is first imported: on a process's first compile
 
 
 def compiled(*functions: Any) -> bool:
