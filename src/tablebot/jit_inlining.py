@@ -4,10 +4,11 @@ To inline a call (``inline="always"``) numba copies the callee's IR block by blo
 of its own, and each of those copies the function's whole scope -- every variable of the callee -- again: blocks ×
 variables, for every call inlined (numba issues #8989 and #9204; numba-cuda #688 measured the same). The simulator's
 tick loops inline the whole physics, and a first compile spent most of its time there: ``run_ticks`` 29 s, 7 s with
-this; every kernel the tests warm, 91 s, 46 s with this. While one call is inlined (``InlineWorker.inline_ir``),
-every block's copy of a scope is the one copy the first block made, as the blocks shared the original (numba's
-inliner keeps one scope of them anyway). The machine code is the same: tests/test_numba_inlining.py compiles an
-inlined function both ways, and every function of the kernels disassembled the same both ways.
+this; the simulator's kernels the tests warm (one process, an empty cache) 91 s, 46 s with this. While one call is
+inlined (``InlineWorker.inline_ir``), every block's copy of a scope is the one copy the first block made, as the
+blocks shared the original (numba's inliner keeps one scope of them anyway). The machine code is the same:
+tests/test_numba_inlining.py compiles an inlined function both ways, and every function of the kernels
+disassembled the same both ways.
 
 The change is made when numba's inliner module is first imported (:func:`copy_each_scope_once`), which numba does
 for its first compile: a process that only loads cached machine code never imports it (~30 ms). Another numba
