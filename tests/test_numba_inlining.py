@@ -18,7 +18,7 @@ from tablebot.testing.processes import child_env
 pytestmark = [pytest.mark.kernel_free]
 
 BOTH_WAYS = r"""
-import copy, json, re, sys
+import json, re, sys
 import numpy as np
 import tablebot.jit  # the change is made when numba's inliner is first imported
 

@@ -27,7 +27,9 @@ from types import ModuleType
 from typing import Any
 
 INLINER = "numba.core.inline_closurecall"
-_scope_copies: dict[int, tuple[Any, Any]] | None = None  # while numba inlines one call: each scope's one copy
+# While numba inlines one call: each scope's one copy. One table for the process, not per thread: numba compiles,
+# and so inlines, under its global compiler lock, one call at a time.
+_scope_copies: dict[int, tuple[Any, Any]] | None = None
 
 
 def copy_each_scope_once() -> None:
