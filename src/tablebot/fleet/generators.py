@@ -110,10 +110,19 @@ def matches_numpy() -> bool:
     return _checked
 
 
-def generators(seeds: Sequence[int]) -> list[Generator]:
-    """``[np.random.default_rng(seed) for seed in seeds]`` (non-negative integer seeds below 2**128)."""
+def seed_words(seeds: Sequence[int]) -> np.ndarray | None:
+    """``SeedSequence(seed).generate_state(4, np.uint64)`` for every seed, as an (N, 4) array: what
+    ``default_rng(seed)`` seeds its PCG64 with. None where this module cannot tell (no seeds, a seed below 0
+    or from 2**128, a numpy whose SeedSequence differs): numpy then makes each Generator itself."""
     if not len(seeds) or not matches_numpy() or min(seeds) < 0 or max(seeds) >= 2**128:
+        return None
+    return state_words(pool_words(np.asarray(seeds, dtype=object)))
+
+
+def generators(seeds: Sequence[int]) -> list[Generator]:
+    """``[np.random.default_rng(seed) for seed in seeds]``."""
+    words = seed_words(seeds)
+    if words is None:
         return [np.random.default_rng(seed) for seed in seeds]
-    words = state_words(pool_words(np.asarray(seeds, dtype=object)))
     # numpy's stub lists SeedSequence only, but PCG64 takes any ISeedSequence
     return [Generator(PCG64(_Words(row))) for row in words]  # type: ignore[arg-type]

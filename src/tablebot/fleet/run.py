@@ -1,10 +1,10 @@
 """Many simulated robots of one table in one world, advanced together in compiled code (fleet.kernel); how they
 start is :mod:`tablebot.fleet.starts`, what their run amounts to :mod:`tablebot.fleet.results`.
 
-Each robot is set up by :class:`~tablebot.sim.simrobot.SimRobot` itself (start row, gains, first reading,
-its own numpy Generator) and draws its noise from that Generator exactly as SimRobot does (inside the
-compiled loop, sim.physics.normals), so robot k of a fleet gives the trace ``tablebot sim`` gives for the same
-table, world, start, battery and seed.
+Each robot is set up as :class:`~tablebot.sim.simrobot.SimRobot` sets itself up (start row, gains, first
+reading, from its own ``default_rng(seed)`` stream, kept by :mod:`tablebot.fleet.streams`) and draws its noise
+from that stream exactly as SimRobot does (inside the compiled loop, sim.physics.normals), so robot k of a
+fleet gives the trace ``tablebot sim`` gives for the same table, world, start, battery and seed.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from tablebot.fleet.generators import generators
 from tablebot.fleet.kernel import (
     NO_TICK,
     move_fleet,
@@ -28,6 +27,7 @@ from tablebot.fleet.kernel import (
 from tablebot.fleet.results import FLEET_COLLISIONS, FleetSummary, Trace
 from tablebot.fleet.robots import Pose, RobotSpec, Variants
 from tablebot.fleet.starts import Prepared, Starts, with_start
+from tablebot.fleet.streams import Streams
 from tablebot.jit import numba
 from tablebot.machine import Machine
 from tablebot.sim import columns as L
@@ -35,7 +35,6 @@ from tablebot.sim.model.observation import Observation
 from tablebot.sim.model.scene import Scene
 from tablebot.sim.model.world import World
 from tablebot.sim.physics import kernel as K
-from tablebot.sim.physics.normals import bitgen_address
 from tablebot.sim.physics.several import N_K, SeveralState, several_program, table_columns
 from tablebot.sim.physics.structures import FleetRecord, FleetState, ProgramVariants
 from tablebot.sim.runner import SimRun
@@ -111,9 +110,8 @@ class Fleet:
         self.first_light = np.full(n, NO_TICK, dtype=np.int64)
         self.variant = np.zeros(n, dtype=np.int64)
         self.battery_start_v = np.zeros(n)
-        self.rngs: list[np.random.Generator] = [np.random.default_rng(0)] * n
-        # each robot's Generator's handle (sim.physics.normals.bitgen_address)
-        self.bitgens = np.zeros(n, dtype=np.uint64)
+        self.streams = Streams(n)  # each robot's noise stream: default_rng(its seed)'s
+        self.bitgens = self.streams.handles  # what the compiled code draws through
         self.traces: dict[int, Trace] = {}
         self.traced = np.full(n, -1, dtype=np.int64)
         first = self.scenes[0]  # the world and wiring, shared by all robots (as SimRobot packs them)
@@ -121,7 +119,6 @@ class Fleet:
         self.wiring = wiring_of(first)
         self.regs[:], self.outputs[:], self.counters[:] = self.initial
         self._setup_tables(n, n_out, n_c)
-        rngs = generators([spec.seed for spec in self.specs])  # default_rng(seed) each, made at once
         by_params: dict[tuple, list[int]] = defaultdict(list)  # untraced robots, by parameter set
         recorded = set(traced)
         for i, spec in enumerate(self.specs):
@@ -131,7 +128,8 @@ class Fleet:
             else:
                 by_params[spec.params].append(i)
         for rows in by_params.values():
-            self._start(rows, [rngs[i] for i in rows], self.scenes[rows[0]], [self.scenes[i].world.start for i in rows])
+            self.streams.seed(rows, [self.specs[i].seed for i in rows])
+            self._start(rows, self.scenes[rows[0]], [self.scenes[i].world.start for i in rows])
         self.bits = self.scenes[0].bits
         self.light_bits = light_bits(self.scenes[0])
         self.width = K.I_OUTPUTS + n_out + 2 * n_c
@@ -165,25 +163,25 @@ class Fleet:
         self._reset_tables(i)
         self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
         if not record:
-            self._start([i], [np.random.default_rng(spec.seed)], scene, [scene.world.start])
+            self.streams.use(i, np.random.default_rng(spec.seed))
+            self._start([i], scene, [scene.world.start])
             return None
         robot = SimRobot(scene, spec.seed, record_history=True)
         self.S[i], self.acc[i], self.P[i] = robot.s, robot.acc, scene.P[0]
         self.collisions[i] = robot.collision_rows[:FLEET_COLLISIONS]
         self.variant[i], self.battery_start_v[i] = spec.variant, robot.s[L.VBAT]
-        self.rngs[i], self.bitgens[i] = robot.rng, bitgen_address(robot.rng)
+        self.streams.use(i, robot.rng)
         return robot
 
-    def _start(self, rows: list[int], rngs: list[np.random.Generator], scene: Scene, starts: list[Pose]) -> None:
-        """Robots ``rows`` (of one parameter set, that of ``scene``) at their ``starts``, each with its
-        Generator (``default_rng(seed)``), written straight into the fleet's rows: a SimRobot each was
-        most of a sweep's set-up."""
-        self.starts.starter(self.specs[rows[0]], scene).start(starts, rngs, rows, self.S, self.acc, self.collisions)
+    def _start(self, rows: list[int], scene: Scene, starts: list[Pose]) -> None:
+        """Robots ``rows`` (of one parameter set, that of ``scene``) at their ``starts``, each drawing from its
+        stream (seeded already), written straight into the fleet's rows: a SimRobot each was most of a sweep's
+        set-up."""
+        starter = self.starts.starter(self.specs[rows[0]], scene)
+        starter.start(starts, self.bitgens[rows], rows, self.S, self.acc, self.collisions)
         self.P[rows] = scene.P[0]
         self.variant[rows] = [self.specs[i].variant for i in rows]
         self.battery_start_v[rows] = self.S[rows, L.VBAT]
-        for i, rng in zip(rows, rngs, strict=True):
-            self.rngs[i], self.bitgens[i] = rng, bitgen_address(rng)
 
     def __len__(self) -> int:
         return len(self.specs)
@@ -208,8 +206,8 @@ class Fleet:
     def draw_noise(self, ticks: int) -> np.ndarray:
         """The next ``ticks`` rows of every robot's noise stream (as SimRobot draws its own, robot by robot)."""
         noise = np.empty((len(self.specs), ticks, L.N_NOISE))
-        for i, rng in enumerate(self.rngs):
-            rng.standard_normal(out=noise[i])
+        for i in range(len(self.specs)):
+            self.streams.generator(i).standard_normal(out=noise[i])
         return noise
 
     def step_block(
@@ -388,7 +386,7 @@ class NoiseRows:
             self.refill(k)
 
     def refill(self, k: int) -> None:
-        self.fleet.rngs[k].standard_normal(out=self.rows[k])
+        self.fleet.streams.generator(k).standard_normal(out=self.rows[k])
         self.at[k] = 0
 
     def next(self) -> np.ndarray:

@@ -246,14 +246,15 @@ def ready_worker(
 
 
 def chunk_functions(threads: int | None) -> tuple[Any, ...]:
-    """The compiled functions a chunk calls: the start check of a scene, its robots' first readings, and the fleet
-    loop on this thread alone or, with more ``threads``, on numba's pool too (small fleets still run on the
-    calling thread)."""
+    """The compiled functions a chunk calls: the start check of a scene, its robots' streams seeded and first
+    numbers drawn, their first readings, and the fleet loop on this thread alone or, with more ``threads``, on
+    numba's pool too (small fleets still run on the calling thread)."""
     from tablebot.fleet.kernel import run_fleet, run_fleet_serial
-    from tablebot.sim.physics import contacts, kernel
+    from tablebot.sim.physics import contacts, kernel, normals
 
     loops = (run_fleet_serial,) if threads == 1 else (run_fleet_serial, run_fleet)
-    return (contacts.body_corners, contacts.deepest_contact, kernel.first_readings, *loops)
+    starting = (normals.seed_pcg64, normals.normal_rows, kernel.first_readings)
+    return (contacts.body_corners, contacts.deepest_contact, *starting, *loops)
 
 
 def warm_worker(

@@ -20,7 +20,7 @@ from tablebot.sim.model.params import terminal_volts
 from tablebot.sim.model.scene import Scene, sensor_columns
 from tablebot.sim.physics import kernel as K
 from tablebot.sim.physics import several as S
-from tablebot.sim.physics.normals import bitgen_address
+from tablebot.sim.physics.normals import bitgen_address, normal_rows
 from tablebot.sim.physics.structures import RobotState, Wiring, WorldArrays, untallied
 from tablebot.tick import registers
 
@@ -56,7 +56,8 @@ class SimRobot:
             self.seed = seed
         self.rng = np.random.default_rng(self.seed)
         S, acc = np.zeros((1, L.N_STATE)), np.zeros((1, K.N_ACC))
-        Starter(self.scene).start([self.scene.world.start], [self.rng], [0], S, acc, self.collision_rows[None, :])
+        handle = np.array([bitgen_address(self.rng)], dtype=np.uint64)
+        Starter(self.scene).start([self.scene.world.start], handle, [0], S, acc, self.collision_rows[None, :])
         self.s, self.acc = S[0], acc[0]
         self.stopped = False
         return self.read(), {"seed": self.seed}
@@ -241,16 +242,18 @@ class Starter:
     def start(
         self,
         poses: Sequence[Sequence[float]],
-        rngs: Sequence[np.random.Generator],
+        handles: np.ndarray,
         rows: Sequence[int],
         S: np.ndarray,
         acc: np.ndarray,
         collisions: np.ndarray,
     ) -> None:
         """Fill rows ``rows`` of ``S``, ``acc`` and ``collisions`` for robots starting at ``poses`` (x, y,
-        heading in degrees) whose Generators are ``rngs``: each robot's motor gains are its first two
-        draws, its first reading's noise the next row (one draw of both: the same numbers)."""
-        draws = np.array([rng.standard_normal(2 + L.N_NOISE) for rng in rngs]).reshape(len(rows), 2 + L.N_NOISE)
+        heading in degrees) whose Generators' handles (:func:`bitgen_address`) are ``handles``: each robot's
+        motor gains are its first two draws, its first reading's noise the next row (one draw of both: the
+        same numbers), drawn in compiled code for all of them at once."""
+        draws = np.empty((len(rows), 2 + L.N_NOISE))
+        normal_rows(handles, draws)
         S[rows] = self.row
         S[rows, L.X : L.TH + 1] = [(x, y, math.radians(heading)) for x, y, heading in poses]
         S[rows, L.GAIN_R] = 1.0 + self.spread * draws[:, 0]

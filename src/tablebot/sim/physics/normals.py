@@ -260,3 +260,62 @@ def fill(bitgen: np.uint64, out: np.ndarray) -> None:
     """``Generator.standard_normal(out=out)`` for a one-dimensional ``out``."""
     for k in range(out.shape[0]):
         out[k] = standard_normal(bitgen)
+
+
+@njit(nogil=True, refcounts=False)
+def normal_rows(handles: np.ndarray, out: np.ndarray) -> None:
+    """``out[k] = Generator.standard_normal(out.shape[1])`` from the Generator whose handle is ``handles[k]``,
+    for every row k: a fleet's robots draw their first numbers in one call, not one Python call each."""
+    for k in range(out.shape[0]):
+        fill(handles[k], out[k])
+
+
+# --- robots' PCG64 states kept in an array, seeded as numpy seeds them ---------------------------------------
+
+
+@intrinsic
+def _pcg64_seed(
+    typingctx: TypingContext,
+    address: types.Type,
+    state_high: types.Type,
+    state_low: types.Type,
+    seq_high: types.Type,
+    seq_low: types.Type,
+) -> tuple[Signature, Callable[..., ir.Value]]:
+    """numpy's ``pcg64_set_seed`` into the ``pcg64_random_t`` at ``address`` (numpy/random/src/pcg64/pcg64.c;
+    pcg_setseq_128_srandom_r of pcg64.h): inc = initseq << 1 | 1, state = 0, one step, state += initstate,
+    one step. The 128-bit initstate and initseq each come as their high and low words."""
+
+    def codegen(context: BaseContext, builder: ir.IRBuilder, sig: Signature, args: Sequence[ir.Value]) -> ir.Value:
+        i128 = ir.IntType(128)
+
+        def wide(high: ir.Value, low: ir.Value) -> ir.Value:
+            return builder.or_(builder.shl(builder.zext(high, i128), ir.Constant(i128, 64)), builder.zext(low, i128))
+
+        words = builder.inttoptr(args[0], i128.as_pointer())
+        inc = builder.or_(builder.shl(wide(args[3], args[4]), ir.Constant(i128, 1)), ir.Constant(i128, 1))
+        state = builder.add(inc, wide(args[1], args[2]))  # the first step from 0 leaves inc; then + initstate
+        state = builder.add(builder.mul(state, ir.Constant(i128, PCG64_MULTIPLIER)), inc)
+        builder.store(state, words, align=8)
+        builder.store(inc, builder.gep(words, [ir.Constant(ir.IntType(32), 1)]), align=8)
+        return context.get_dummy_value()
+
+    return types.void(types.uint64, types.uint64, types.uint64, types.uint64, types.uint64), codegen
+
+
+@njit(nogil=True, refcounts=False)
+def seed_pcg64(states: np.ndarray, words: np.ndarray) -> None:
+    """Row k of ``states`` (an (N, 4) uint64 array: state then increment, low word first, as numpy's PCG64 keeps
+    them) becomes what ``PCG64`` seeded with ``words[k]`` holds (its seed sequence's ``generate_state(4,
+    np.uint64)``: initstate's high and low words, then initseq's)."""
+    base = states.ctypes.data
+    for k in range(states.shape[0]):
+        row, seed = np.uint64(base + k * 4 * WORD), words[k]
+        _pcg64_seed(row, seed[0], seed[1], seed[2], seed[3])  # type: ignore[call-arg,arg-type]  # as above
+
+
+def state_handles(states: np.ndarray) -> np.ndarray:
+    """The inline handles (see :func:`bitgen_address`) of the PCG64 states in the rows of ``states`` (an (N, 4)
+    C-ordered uint64 array the caller keeps alive, and in place, while compiled code draws from it)."""
+    assert states.flags.c_contiguous and states.dtype == np.uint64 and states.shape[1] == 4
+    return np.uint64(states.ctypes.data + INLINE) + np.arange(len(states), dtype=np.uint64) * np.uint64(4 * WORD)
