@@ -5,6 +5,7 @@ same bytes whichever way its streams are kept."""
 from __future__ import annotations
 
 from dataclasses import fields
+from typing import Any
 
 import numpy as np
 import pytest
@@ -89,7 +90,7 @@ def test_seeds_beyond_the_array_path_get_numpys_generators(seeds: list[int]) -> 
     assert np.array_equal(drawn, np.array([np.random.default_rng(seed).standard_normal(6) for seed in seeds]))
 
 
-def fleet_results(run: bool) -> tuple[list[object], list[str]]:
+def fleet_results(run: bool) -> tuple[list[Any], list[str]]:
     """40 BumberBots (robot 3 traced) after 300 ticks as a sweep runs them (``run``), or tick by tick from Python
     as the Gymnasium env does (every robot's Generator asked for): their summary's arrays and the trace."""
     table, machine = load(BUMBERBOT)
