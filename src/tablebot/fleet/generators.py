@@ -22,6 +22,8 @@ from numpy.random.bit_generator import ISeedSequence
 if TYPE_CHECKING:
     from numpy.typing import DTypeLike
 
+__all__ = ["generators", "matches_numpy", "pool_words", "seed_words", "state_words"]
+
 POOL = 4  # SeedSequence's default pool_size (words of entropy kept)
 INIT_A, MULT_A = 0x43B0D7E5, 0x931E8875  # mixing the seed into the pool
 INIT_B, MULT_B = 0x8B51F9DD, 0x58F38DED  # drawing the state out of the pool
