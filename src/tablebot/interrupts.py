@@ -1,6 +1,8 @@
 """Ctrl-C and SIGTERM outside the run loop: SIGTERM raised as :class:`Terminated`, which, like
 KeyboardInterrupt, is no ``Exception``, so every clean-up on the way out runs; :func:`held` keeps both
-signals out of the few lines that must not be cut (a set of files being swapped in).
+signals out of the few lines that must not be cut (a set of files being swapped in); and neither is lost
+when it lands in a weakref callback or a ``__del__``, where Python prints and drops any exception (see
+:func:`_delivered_again`).
 
 It also holds the test hook ``TABLEBOT_FAULT=N[:SIGNAL]``: at the N-th file step (a file written, a
 file of a set renamed into place) the process sends itself SIGNAL (INT, TERM or KILL; default INT), so
@@ -9,10 +11,14 @@ a test can interrupt a command at every point of its writing, deterministically.
 
 from __future__ import annotations
 
+import _thread
+import functools
 import os
 import signal
+import sys
 import threading
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -39,17 +45,46 @@ def _raise_terminated(signum: int, frame: Any) -> None:
 @contextmanager
 def sigterm_raises() -> Iterator[None]:
     """One command: while it runs, SIGTERM raises :class:`Terminated` (Python's default would end the
-    process at once: no temporary file removed, no terminal restored, nothing kept); the fault hook
-    counts its steps from the command's start."""
+    process at once: no temporary file removed, no terminal restored, nothing kept), and a Ctrl-C or SIGTERM
+    Python dropped is delivered again (:func:`_delivered_again`); the fault hook counts its steps from the
+    command's start."""
     _fault[:] = [None, 0]
     if not _main_thread():
         yield
         return
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    hook = sys.unraisablehook
+    sys.unraisablehook = functools.partial(_delivered_again, hook)
     try:
         yield
     finally:
+        sys.unraisablehook = hook
         signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+
+
+#: How long the helper thread waits before delivering a dropped signal again: the callback that dropped it
+#: is over by then (delivered while it still ran, the signal would be dropped once more).
+AGAIN_AFTER_S = 0.01
+
+
+def _delivered_again(previous: Callable[[Any], object], unraisable: Any) -> None:
+    """``sys.unraisablehook`` while a command runs. A signal's exception raised inside a weakref callback or a
+    ``__del__`` (the main thread runs them wherever an object happens to be freed: in the middle of an
+    import, say) cannot leave it: Python prints "Exception ignored" and goes on as if the user had never
+    pressed Ctrl-C -- a tune interrupted that way ran to its end. Here such a KeyboardInterrupt or
+    :class:`Terminated` is raised again in the main thread, by the same signal sent from a helper thread once
+    the callback is over; any other exception goes to the hook there was (``previous``)."""
+    kind = unraisable.exc_type
+    if kind is not None and issubclass(kind, INTERRUPTS):
+        signum = signal.SIGTERM if issubclass(kind, Terminated) else signal.SIGINT
+        threading.Thread(target=_interrupt_main, args=(signum,), name="tablebot-signal-again", daemon=True).start()
+        return
+    previous(unraisable)
+
+
+def _interrupt_main(signum: signal.Signals) -> None:
+    time.sleep(AGAIN_AFTER_S)
+    _thread.interrupt_main(signum)
 
 
 @contextmanager
