@@ -163,7 +163,7 @@ class Fleet:
         self._reset_tables(i)
         self.counts[i], self.first_visit[i], self.first_light[i] = 0, NO_TICK, NO_TICK
         if not record:
-            self.streams.use(i, np.random.default_rng(spec.seed))
+            self.streams.seed([i], [spec.seed])
             self._start([i], scene, [scene.world.start])
             return None
         robot = SimRobot(scene, spec.seed, record_history=True)

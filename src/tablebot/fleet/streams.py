@@ -18,7 +18,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from tablebot.fleet.generators import generators, seed_words
-from tablebot.sim.physics.normals import bitgen_address, pcg64_inline, seed_pcg64, state_handles
+from tablebot.sim.physics.normals import (
+    bitgen_address,
+    pcg64_inline,
+    pcg64_ints,
+    pcg64_words,
+    seed_pcg64,
+    state_handles,
+)
 
 __all__ = ["Streams", "arrays_hold"]
 
@@ -43,7 +50,7 @@ def _seeds_as_numpy(seeds: list[int]) -> bool:
     seed_pcg64(states, words)
     for row, seed in zip(states.tolist(), seeds, strict=True):
         theirs = np.random.PCG64(seed).state["state"]
-        if [theirs["state"] & 2**64 - 1, theirs["state"] >> 64, theirs["inc"] & 2**64 - 1, theirs["inc"] >> 64] != row:
+        if pcg64_words(theirs["state"], theirs["inc"]) != row:
             return False
     return True
 
@@ -54,6 +61,7 @@ class Streams:
     def __init__(self, n: int) -> None:
         self.handles = np.zeros(n, dtype=np.uint64)  # each robot's handle (sim.physics.normals.bitgen_address)
         self._states = np.zeros((n, 4), dtype=np.uint64)  # PCG64 words of the robots whose Generator is not made
+        self._state_handles = state_handles(self._states)  # each row's inline handle (the array stays in place)
         self._rngs: list[np.random.Generator | None] = [None] * n
 
     def seed(self, rows: Sequence[int], seeds: Sequence[int]) -> None:
@@ -67,7 +75,7 @@ class Streams:
         states = np.zeros((len(index), 4), dtype=np.uint64)
         seed_pcg64(states, words)
         self._states[index] = states
-        self.handles[index] = state_handles(self._states)[index]
+        self.handles[index] = self._state_handles[index]
         for i in rows:
             self._rngs[i] = None
 
@@ -79,11 +87,11 @@ class Streams:
         """Robot ``i``'s Generator, where its stream has got to (made from its row's state when first asked for)."""
         rng = self._rngs[i]
         if rng is None:
-            low_state, high_state, low_inc, high_inc = (int(w) for w in self._states[i])
-            bit_generator = np.random.PCG64()
+            state, inc = pcg64_ints(self._states[i].tolist())
+            bit_generator = np.random.PCG64(0)  # any seed (0: no entropy read from the system): its state is set
             bit_generator.state = {
                 "bit_generator": "PCG64",
-                "state": {"state": high_state << 64 | low_state, "inc": high_inc << 64 | low_inc},
+                "state": {"state": state, "inc": inc},
                 "has_uint32": 0,
                 "uinteger": 0,
             }

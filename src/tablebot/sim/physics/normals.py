@@ -110,7 +110,7 @@ def _layout_holds() -> bool:
         for _ in range(3):
             state, inc = probe.state["state"]["state"], probe.state["state"]["inc"]
             memory = [_word_at(words + k * WORD) for k in range(4)]
-            if memory != [state & 2**64 - 1, state >> 64, inc & 2**64 - 1, inc >> 64]:
+            if memory != pcg64_words(state, inc):
                 return False
             after, expected = _step(state, inc)
             if int(probe.random_raw()) != expected:
@@ -136,6 +136,17 @@ def bitgen_address(rng: np.random.Generator) -> np.uint64:
     if ctypes.sizeof(ctypes.c_void_p) != WORD:
         raise RuntimeError("drawing numpy's normals in compiled code needs a 64-bit platform")
     return np.uint64(_bitgen_t(bit_generator))
+
+
+def pcg64_words(state: int, inc: int) -> list[int]:
+    """A PCG64's state and increment (``PCG64.state``'s integers) as its ``pcg64_random_t`` holds them in memory:
+    four 64-bit words, each 128-bit integer low word first."""
+    return [state & 2**64 - 1, state >> 64, inc & 2**64 - 1, inc >> 64]
+
+
+def pcg64_ints(words: Sequence[int]) -> tuple[int, int]:
+    """:func:`pcg64_words` back: the state and increment of four words in memory."""
+    return words[1] << 64 | words[0], words[3] << 64 | words[2]
 
 
 def bitgen_addresses(rngs: list[np.random.Generator]) -> np.ndarray:
